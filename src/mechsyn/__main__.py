@@ -1,0 +1,3 @@
+from mechsyn.cli.main import main
+
+main()

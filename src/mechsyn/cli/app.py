@@ -1,0 +1,23 @@
+"""The Typer application objects that every command module registers on."""
+
+from __future__ import annotations
+
+import typer
+
+app = typer.Typer(
+    name="mechsyn",
+    help=(
+        "Structural analysis, kinematics and synthesis of mechanisms of robots, "
+        "manipulators and grippers."
+    ),
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+synth_app = typer.Typer(
+    help="Synthesis: structural (groups, fingers) and dimensional (path, function, motion).",
+    no_args_is_help=True,
+)
+app.add_typer(synth_app, name="synth")

@@ -1,0 +1,100 @@
+"""Helpers shared by the command modules: output, errors, progress."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, TypeVar
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.results import dumps, write_atomic
+
+T = TypeVar("T")
+
+console = Console()
+err_console = Console(stderr=True)
+
+
+def emit_json(obj: Any, out: Path | None = None) -> None:
+    """Print ``obj`` as JSON on stdout, or write it whole to ``out``."""
+    text = dumps(obj)
+    if out is None:
+        sys.stdout.write(text + "\n")
+    else:
+        write_atomic(out, text + "\n")
+
+
+def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
+    """Stop the command with one clear message and exit status 2."""
+    raise MechsynInputError(message, hint=hint, source=source)
+
+
+def parse_floats(text: str, option: str, count: int | None = None) -> list[float]:
+    """Parse ``"1,2.5,-3"`` into floats, naming ``option`` on error."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip() != ""]
+    except ValueError:
+        raise MechsynInputError(
+            f"expected comma-separated numbers, got {text!r}", source=option,
+            hint=f"write e.g. {option} 1,0",
+        ) from None
+    if count is not None and len(values) != count:
+        raise MechsynInputError(
+            f"expected {count} numbers, got {len(values)} in {text!r}", source=option
+        )
+    return values
+
+
+def parse_range(text: str, option: str) -> tuple[float, float, float]:
+    """Parse ``START:STOP:STEP`` (all three numbers) naming ``option`` on error."""
+    parts = text.split(":")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        start, stop, step = (float(p) for p in parts)
+    except ValueError:
+        raise MechsynInputError(
+            f"expected START:STOP:STEP, got {text!r}", source=option,
+            hint=f"write e.g. {option} 0:360:1",
+        ) from None
+    if step == 0 or (stop - start) * step < 0:
+        raise MechsynInputError(
+            f"step {step:g} does not lead from {start:g} to {stop:g}", source=option
+        )
+    return start, stop, step
+
+
+@contextmanager
+def progress_bar(description: str, total: int | None, enabled: bool = True) -> Iterator[Any]:
+    """A rich progress bar on stderr (silent when ``enabled`` is false or not a TTY).
+
+    Yields a callable ``advance(n=1)``.
+    """
+    if not enabled or not err_console.is_terminal:
+        yield lambda n=1: None
+        return
+    with Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+        TimeRemainingColumn(), console=err_console, transient=True,
+    ) as progress:
+        task = progress.add_task(description, total=total)
+        yield lambda n=1: progress.advance(task, n)
+
+
+def track(items: Iterable[T], description: str, total: int | None = None) -> Iterator[T]:
+    """Iterate with a progress bar on stderr when it is a terminal."""
+    with progress_bar(description, total) as advance:
+        for item in items:
+            yield item
+            advance()
+
+
+def exit_with(error: MechsynInputError) -> None:
+    err_console.print(f"[bold red]error:[/] {error.format()}", highlight=False, soft_wrap=True)
+    raise typer.Exit(2)

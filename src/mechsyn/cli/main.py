@@ -1,0 +1,49 @@
+"""Entry point of the ``mechsyn`` console script.
+
+Command modules are imported here for their side effect of registering on the app.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from mechsyn.cli.app import app
+from mechsyn.errors import MechsynInputError
+
+# Command modules (each registers its commands on the app when imported).
+from mechsyn.cli import version as _version  # noqa: F401
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; bad input exits with status 2 and one message."""
+    from mechsyn.cli.common import err_console
+
+    try:
+        app(args=argv, prog_name="mechsyn", standalone_mode=False)
+    except MechsynInputError as error:
+        err_console.print(f"[bold red]error:[/] {error.format()}", highlight=False, soft_wrap=True)
+        return _exit(2, argv)
+    except SystemExit as exc:  # typer.Exit inside commands
+        return _exit(int(exc.code or 0), argv)
+    except Exception as exc:  # click's (typer's vendored click's) own exceptions
+        name = type(exc).__name__
+        if name == "Abort":
+            err_console.print("aborted")
+            return _exit(130, argv)
+        if hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
+            exc.show()
+            return _exit(int(exc.exit_code), argv)
+        if hasattr(exc, "exit_code"):  # Exit
+            return _exit(int(exc.exit_code), argv)
+        raise
+    return _exit(0, argv)
+
+
+def _exit(code: int, argv: list[str] | None) -> int:
+    if argv is None:
+        sys.exit(code)
+    return code
+
+
+if __name__ == "__main__":
+    main()

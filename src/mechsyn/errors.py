@@ -1,0 +1,67 @@
+"""Exceptions raised by mechsyn.
+
+Every error caused by a user's input is a :class:`MechsynInputError`: it names the
+file, the line or field, says what is wrong and how to fix it. The command line turns
+it into one message and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+
+class MechsynError(Exception):
+    """Base class of mechsyn's own errors."""
+
+
+class MechsynInputError(MechsynError, ValueError):
+    """Bad input: a file, a field or an argument that cannot be used.
+
+    Parameters
+    ----------
+    message:
+        What is wrong, in one sentence.
+    source:
+        The file (or ``"--option"``) the input came from.
+    field:
+        Dotted path of the offending field, e.g. ``joints[2].links``.
+    line:
+        1-based line number in ``source`` where known.
+    hint:
+        How to fix it.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        source: str | None = None,
+        field: str | None = None,
+        line: int | None = None,
+        hint: str | None = None,
+    ) -> None:
+        self.message = message
+        self.source = source
+        self.field = field
+        self.line = line
+        self.hint = hint
+        super().__init__(self.format())
+
+    def format(self) -> str:
+        where = ""
+        if self.source:
+            where = self.source
+            if self.line is not None:
+                where += f":{self.line}"
+            where += ": "
+        field = f"{self.field}: " if self.field else ""
+        text = f"{where}{field}{self.message}"
+        if self.hint:
+            text += f" (fix: {self.hint})"
+        return text
+
+    def with_source(self, source: str) -> "MechsynInputError":
+        """Return a copy that names ``source`` when it had none."""
+        if self.source:
+            return self
+        return MechsynInputError(
+            self.message, source=source, field=self.field, line=self.line, hint=self.hint
+        )
