@@ -11,6 +11,7 @@ from mechsyn.cli.app import app
 from mechsyn.errors import MechsynInputError
 
 # Command modules (each registers its commands on the app when imported).
+from mechsyn.cli import analyze as _analyze  # noqa: F401
 from mechsyn.cli import version as _version  # noqa: F401
 
 
