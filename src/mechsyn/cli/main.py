@@ -13,6 +13,7 @@ from mechsyn.errors import MechsynInputError
 # Command modules (each registers its commands on the app when imported).
 from mechsyn.cli import analyze as _analyze  # noqa: F401
 from mechsyn.cli import version as _version  # noqa: F401
+from mechsyn.cli import simulate as _simulate  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:

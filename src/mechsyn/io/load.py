@@ -377,6 +377,18 @@ class _Builder:
                 raise self.error(path + ["limits"], "limits must be [min, max] with min <= max")
             limits = (float(entry.limits[0]), float(entry.limits[1]))
         attrs = {"description": entry.description} if entry.description else {}
+        if entry.profile is not None:
+            if jtype != "cam":
+                raise self.error(path + ["profile"], "only a cam pair has a profile", "remove `profile`")
+            if isinstance(entry.profile, list):
+                pts = [self.vector(p, path + ["profile", k], "profile point") for k, p in enumerate(entry.profile)]
+                if len(pts) < 4:
+                    raise self.error(path + ["profile"], "a cam profile needs at least 4 points",
+                                     "list points round the whole cam")
+                attrs["profile"] = [[float(x) for x in p] for p in pts]
+            else:
+                c = self.vector(entry.profile.center, path + ["profile", "center"], "profile centre")
+                attrs["profile"] = {"center": [float(x) for x in c], "radius": float(entry.profile.radius)}
         return Joint(
             id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
             axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
@@ -427,6 +439,39 @@ class _Builder:
                 "add the missing joints or remove the stray links",
             )
 
+    def loads(self, entries: Sequence[Any], names: dict[str, str], ids: dict[int, str],
+              points: dict[str, PointSpec]) -> list[dict[str, Any]]:
+        out = []
+        for k, e in enumerate(entries):
+            path: list[Any] = ["loads", k]
+            link = self.resolve_link(e.link, path + ["link"], names, ids)
+            if e.force is None and e.moment is None:
+                raise self.error(path, "a load needs a force or a moment", "add force: [Fx, Fy] or moment: M")
+            if e.at is not None and e.point is not None:
+                raise self.error(path, "give either `at` or `point`, not both")
+            at = self.vector(e.at, path + ["at"], "load point")
+            if e.point is not None:
+                if e.point not in points:
+                    raise self.error(path + ["point"], f"unknown point {e.point!r}",
+                                     f"points are: {', '.join(points) or '(none)'}")
+                if points[e.point].link != link:
+                    raise self.error(path + ["point"], f"point {e.point} is on link {points[e.point].link}, "
+                                     f"not {link}")
+                at = points[e.point].at
+            d: dict[str, Any] = {"link": link}
+            if e.force is not None:
+                d["force"] = [float(x) for x in self.vector(e.force, path + ["force"], "force")]
+            if at is not None:
+                d["at"] = [float(x) for x in at]
+            if e.point is not None:
+                d["point"] = e.point
+            if e.moment is not None:
+                d["moment"] = float(e.moment)
+            if e.description:
+                d["description"] = e.description
+            out.append(d)
+        return out
+
     # whole file --------------------------------------------------------------------------
     def build(self) -> Mechanism:
         spec = self.spec
@@ -458,6 +503,8 @@ class _Builder:
             )
         attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
                                    ("units", spec.units)) if v}
+        if spec.loads:
+            attrs["loads"] = self.loads(spec.loads, names, ids, points)
         return Mechanism(
             name=spec.name, kind=spec.kind, ground=ground, links=tuple(links), joints=tuple(joints),
             points=points, contours=contours, states=states, mobility=spec.mobility,
@@ -482,6 +529,8 @@ def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
         d["limits"] = list(j.limits)
     if j.actuated:
         d["actuated"] = True
+    if j.attrs.get("profile") is not None:
+        d["profile"] = j.attrs["profile"]
     if j.attrs.get("description"):
         d["description"] = j.attrs["description"]
     return d
@@ -503,6 +552,9 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
     for key in ("description", "source", "units"):
         if mech.attrs.get(key):
             d[key] = mech.attrs[key]
+    if mech.attrs.get("loads"):
+        d["loads"] = [{k: v for k, v in ld.items() if not (k == "at" and "point" in ld)}
+                      for ld in mech.attrs["loads"]]
     if mech.states:
         states = {}
         for name, s in mech.states.items():

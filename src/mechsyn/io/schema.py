@@ -39,6 +39,26 @@ class LinkEntry(BaseModel):
     description: str | None = None
 
 
+class CamProfile(_Strict):
+    """A circular cam profile (disc or eccentric)."""
+
+    center: list[float]
+    radius: float = Field(gt=0)
+
+
+class LoadEntry(_Strict):
+    """An external load on a link (force analysis): a force at a point and/or a moment."""
+
+    link: LinkRef = Field(description="The link the load acts on.")
+    force: list[float] | None = Field(None, description="Force [Fx, Fy] (global directions).")
+    at: list[float] | None = Field(
+        None, description="Point of application in the assembled configuration (default: the centre of mass, "
+                          "else the link's first joint).")
+    point: str | None = Field(None, description="A named point (from `points`) as point of application.")
+    moment: float | None = Field(None, description="A moment (counter-clockwise positive).")
+    description: str | None = None
+
+
 class JointEntry(_Strict):
     """A kinematic pair. ``links: [a, b]``: ``b`` moves relative to ``a``."""
 
@@ -68,6 +88,12 @@ class JointEntry(_Strict):
         None, description="Variable-length link mode of a prismatic pair (paper 000).",
     )
     limits: list[float] | None = Field(None, description="[min, max] of the joint coordinate (VLL length limits).")
+    profile: "CamProfile | list[list[float]] | None" = Field(
+        None, description=(
+            "cam: the profile fixed on the first link, in the assembled configuration: "
+            "{center: [x, y], radius: r} (a disc, e.g. an eccentric) or a closed list of points [[x, y], ...] "
+            "(interpolated by a periodic cubic spline)."),
+    )
     description: str | None = None
 
     @field_validator("id", mode="before")
@@ -117,6 +143,7 @@ class MechanismFile(_Strict):
         None, description="Independent contours, each an ordered list of joint ids (paper 003's order matters).",
     )
     states: dict[str, StateEntry] = Field(default_factory=dict)
+    loads: list[LoadEntry] = Field(default_factory=list, description="External loads for force analysis.")
     mobility: int | None = Field(
         None, description="Actual mobility W (idle mobilities included) when known from elsewhere.",
     )
@@ -138,3 +165,6 @@ def json_schema() -> dict[str, Any]:
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "mechsyn mechanism file"
     return schema
+
+
+JointEntry.model_rebuild()

@@ -1,0 +1,432 @@
+"""Closed-form position analysis by Assur groups of class II (dyads), vectorised.
+
+A mechanism of R and P pairs whose links can be found one driver at a time and then
+two at a time (a *dyad*: two links, three pairs, joined to links already known) is
+solved in closed form for all input values at once (Artobolevsky, *Theory of
+Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR, RPP, PRP):
+
+* RRR: the middle joint ``B`` is the intersection of the circles ``|B - A| = L1`` and
+  ``|B - C| = L2``: with ``d = C - A``, ``a = (L1^2 - L2^2 + |d|^2) / (2|d|)``,
+  ``h = sqrt(L1^2 - a^2)``, ``B = A + a d/|d| + sigma h R90 d/|d|``;
+* RRP / PRR: the intersection of a circle and a line, ``lambda^2 + 2 p lambda + c = 0``;
+* RPR: the slide line keeps the offset ``e`` from both pivots:
+  ``cos(phi + nu - delta) = e / |C - A|``;
+* RPP / PRP: orientations are known, positions follow from two linear equations.
+
+The assembly mode ``sigma`` of each dyad is taken from the file's configuration, so the
+result equals the continuation of :func:`mechsyn.kinematics.solve.sweep` on that branch
+(tests check both agree). Where a square root is negative the dyad cannot be assembled:
+the row is NaN and ``assembled`` is false (dead points are then located by the Newton
+path). Velocities and accelerations of driver + RRR chains are in closed form
+(``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``e1 = B - A``, ``e2 = B - C``); other
+chains use batched linear solves of the differentiated constraints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
+
+__all__ = ["Plan", "decompose", "solve_positions", "solve_all"]
+
+
+@dataclass(frozen=True)
+class Step:
+    kind: str                 # "drive_R", "drive_P", "RRR", "RRP", "RPR", "RPP", "PRP"
+    links: tuple[int, ...]    # new links
+    known: tuple[int, ...]    # known links used
+    joints: tuple[str, ...]
+    data: dict
+    sigma: float = 1.0
+
+
+@dataclass(frozen=True)
+class Plan:
+    steps: tuple[Step, ...]
+
+    @property
+    def closed_form_rates(self) -> bool:
+        return all(s.kind in ("drive_R", "RRR") for s in self.steps)
+
+    def describe(self) -> list[str]:
+        return [f"{s.kind} ({', '.join(s.joints)})" for s in self.steps]
+
+
+def _cons_of(S: PlanarSystem, jid: str) -> list[Con]:
+    return [c for c in S.cons if c.joint == jid]
+
+
+def _jtype(S: PlanarSystem, jid: str) -> str:
+    return S.mech.joint(jid).type
+
+
+def decompose(S: PlanarSystem) -> Plan | None:
+    """Drivers and dyads in solving order, or None when the mechanism does not decompose."""
+    mech = S.mech
+    if any(c.kind in ("gear", "curve") or c.role in ("lock", "idle") for c in S.cons):
+        return None
+    known = {-1}
+    steps: list[Step] = []
+    used: set[str] = set()
+    joints = {j.id: j for j in mech.joints}
+    link_joints: dict[int, list[str]] = {}
+    for j in mech.joints:
+        for ln in j.links:
+            link_joints.setdefault(S.index(ln), []).append(j.id)
+    drivers = {d.joint for d in S.drivers}
+
+    def ends(jid: str) -> tuple[int, int]:
+        a, b = joints[jid].links
+        return S.index(a), S.index(b)
+
+    progress = True
+    while progress and len(known) < len(S.links) + 1:
+        progress = False
+        for jid in drivers - used:
+            a, b = ends(jid)
+            if (a in known) == (b in known):
+                continue
+            k, new = (a, b) if a in known else (b, a)
+            steps.append(Step("drive_" + _jtype(S, jid), (new,), (k,), (jid,), {}))
+            known.add(new)
+            used.add(jid)
+            progress = True
+        if progress:
+            continue
+        # dyads: b1, b2 unknown, J2 between them, J1: known-b1, J3: b2-known
+        for b1 in range(len(S.links)):
+            if b1 in known:
+                continue
+            j1s = [j for j in link_joints.get(b1, []) if j not in used and (set(ends(j)) - {b1}) <= known
+                   and j not in drivers]
+            if len(j1s) != 1:
+                continue
+            J1 = j1s[0]
+            for J2 in link_joints.get(b1, []):
+                if J2 in used or J2 == J1 or J2 in drivers:
+                    continue
+                a2, c2 = ends(J2)
+                b2 = c2 if a2 == b1 else a2
+                if b2 in known:
+                    continue
+                j3s = [j for j in link_joints.get(b2, []) if j not in used and j != J2
+                       and (set(ends(j)) - {b2}) <= known and j not in drivers]
+                if len(j3s) != 1:
+                    continue
+                J3 = j3s[0]
+                types = "".join(_jtype(S, j) for j in (J1, J2, J3))
+                if types == "PPP" or any(t not in "RP" for t in types):
+                    continue
+                k1 = (set(ends(J1)) - {b1}).pop()
+                k3 = (set(ends(J3)) - {b2}).pop()
+                steps.append(Step(types, (b1, b2), (k1, k3), (J1, J2, J3), {}))
+                known.update((b1, b2))
+                used.update((J1, J2, J3))
+                progress = True
+                break
+            if progress:
+                break
+    if len(known) < len(S.links) + 1:
+        return None
+    if set(j.id for j in mech.joints) - used:
+        return None  # closing constraints left over (redundant): Newton handles them
+    return Plan(tuple(steps))
+
+
+# --------------------------------------------------------------------------- states
+class _State:
+    """Poses of the links known so far, for all N inputs."""
+
+    def __init__(self, S: PlanarSystem, N: int) -> None:
+        self.S = S
+        self.r = np.full((N, len(S.links), 2), np.nan)
+        self.phi = np.full((N, len(S.links)), np.nan)
+        self.N = N
+
+    def pose(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        if i < 0:
+            return np.zeros((self.N, 2)), np.zeros(self.N)
+        return self.r[:, i], self.phi[:, i]
+
+    def point(self, i: int, s: np.ndarray) -> np.ndarray:
+        r, phi = self.pose(i)
+        c, sn = _rot(phi)
+        return r + _apply(c, sn, s)
+
+    def set(self, i: int, r: np.ndarray, phi: np.ndarray) -> None:
+        self.r[:, i] = r
+        self.phi[:, i] = phi
+
+
+def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
+    j = S.mech.joint(jid)
+    name = S.mech.ground if i < 0 else S.links[i]
+    return S.to_local(name, j.point)
+
+
+def _rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:
+    """Constant ``phi_to - phi_from`` of a P joint between links frm and to."""
+    con = next(c for c in _cons_of(S, jid) if c.kind == "angle" and c.role == "rotation")
+    return con.c0 if (con.a, con.b) == (frm, to) else -con.c0
+
+
+def _line(S: PlanarSystem, jid: str) -> Con:
+    return next(c for c in _cons_of(S, jid) if c.kind == "line" and c.role == "pair")
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return (x + np.pi) % (2 * np.pi) - np.pi
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
+    c, sn = _rot(phi)
+    st.set(i, P - _apply(c, sn, s_local), phi)
+
+
+def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: float | None) -> float:
+    """Solve one step in place; return its assembly sign (sigma) for the branch."""
+    if step.kind == "drive_R":
+        (new,), (k,), (jid,) = step.links, step.known, step.joints
+        con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+        th = u[:, con.driver]
+        _, phik = st.pose(k)
+        phi = phik + th if con.b == new else phik - th
+        P = st.point(k, _local(S, k, jid))
+        _pin(st, new, P, _local(S, new, jid), phi)
+        return 1.0
+    if step.kind == "drive_P":
+        (new,), (k,), (jid,) = step.links, step.known, step.joints
+        drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
+        line = _line(S, jid)
+        val = u[:, drive.driver]
+        if drive.a == k:
+            ra, pa = st.pose(k)
+            ca, sa_ = _rot(pa)
+            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+            Pa = st.point(k, line.sa)
+            Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
+            _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
+        else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
+            pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
+            ca, sa_ = _rot(pa)
+            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+            Pb = st.point(k, drive.sb)
+            Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
+            st.set(new, Oa, pa)
+        return 1.0
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    if step.kind == "RRR":
+        A = st.point(A_s, _local(S, A_s, J1))
+        C = st.point(B_s, _local(S, B_s, J3))
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
+        d = C - A
+        D2 = _dot(d, d)
+        D = np.sqrt(D2)
+        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
+        h2 = L1 ** 2 - a ** 2
+        h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
+        h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
+        e = d / D[:, None]
+        if sigma is None:
+            sigma = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+        B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
+        beta1 = np.arctan2(*(s2 - s1)[::-1])
+        beta2 = np.arctan2(*(t2 - t3)[::-1])
+        phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
+        phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
+        _pin(st, b1, A, s1, phi1)
+        _pin(st, b2, C, t3, phi2)
+        return sigma
+    if step.kind in ("RRP", "PRR"):
+        # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
+        if step.kind == "RRP":
+            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
+        else:
+            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+        A = st.point(kr, _local(S, kr, Jr))
+        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+        line = _line(S, Jp)
+        # the P joint's point on lp and the known line through kp's joint point
+        t_p = line.sb if line.b == lp else line.sa
+        s_k = line.sa if line.a == kp else line.sb
+        Pk = st.point(kp, s_k)
+        phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
+        ca, sa_ = _rot(phi_axis)
+        w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
+        cp, sp = _rot(phi_p)
+        tB = _local(S, lp, J2)
+        Q = Pk + _apply(cp, sp, tB - t_p)
+        L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
+        p = _dot(w, Q - A)
+        cc = _dot(Q - A, Q - A) - L1 ** 2
+        disc = p ** 2 - cc
+        disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
+        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        if sigma is None:
+            lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+            sigma = 1.0 if lam0 + p[0] >= 0 else -1.0
+        lam = -p + sigma * root
+        B = Q + lam[:, None] * w
+        sr = _local(S, lr, Jr)
+        beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
+        phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
+        _pin(st, lr, A, sr, phi_r)
+        _pin(st, lp, B, tB, phi_p)
+        return sigma
+    if step.kind == "RPR":
+        A = st.point(A_s, _local(S, A_s, J1))
+        C = st.point(B_s, _local(S, B_s, J3))
+        c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
+        line = _line(S, J2)
+        n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
+                                                      np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
+        # n_loc: the slide normal in b1's frame
+        sA, sP = _local(S, b1, J1), _local(S, b1, J2)
+        tC, tP = _local(S, b2, J3), _local(S, b2, J2)
+        cc, sc = np.cos(c), np.sin(c)
+        Rc = np.array([[cc, -sc], [sc, cc]])
+        e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
+        d = C - A
+        D = np.sqrt(_dot(d, d))
+        delta = np.arctan2(d[:, 1], d[:, 0])
+        nu = np.arctan2(n_loc[1], n_loc[0])
+        ratio = e / D
+        ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
+        ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
+        if sigma is None:
+            phi0 = float(st.S.q0[3 * b1 + 2])
+            sigma = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
+        phi1 = delta - nu + sigma * ac
+        _pin(st, b1, A, sA, phi1)
+        _pin(st, b2, C, tC, phi1 + c)
+        return sigma
+    if step.kind in ("RPP", "PRP"):
+        raise _NotHandled
+    raise _NotHandled
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+class _NotHandled(Exception):
+    pass
+
+
+def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
+                    sigmas: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
+    """Poses ``q`` (N, n) for all inputs, NaN rows where a dyad cannot be assembled."""
+    inputs = np.atleast_2d(np.asarray(inputs, float))
+    st = _State(S, inputs.shape[0])
+    out_sig = []
+    for k, step in enumerate(plan.steps):
+        out_sig.append(_solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
+    q = np.empty((inputs.shape[0], S.n))
+    q[:, 0::3][:, :len(S.links)] = st.r[:, :, 0]
+    q[:, 1::3][:, :len(S.links)] = st.r[:, :, 1]
+    # angles continuous with the file's configuration, then unwrapped along the sweep
+    phi = S.q0[2:3 * len(S.links):3] + _wrap(st.phi - S.q0[2:3 * len(S.links):3])
+    q[:, 2::3][:, :len(S.links)] = phi
+    return q, out_sig
+
+
+def _unwrap_angles(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
+    ok = np.all(np.isfinite(q), axis=1)
+    if ok.sum() > 1:
+        cols = np.arange(2, 3 * len(S.links), 3)
+        sub = q[np.ix_(ok, cols)]
+        q[np.ix_(ok, cols)] = np.unwrap(sub, axis=0)
+    return q
+
+
+def closed_form_rates(S: PlanarSystem, plan: Plan, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations of driver-R + RRR chains in closed form (all inputs)."""
+    N = q.shape[0]
+    nl = len(S.links)
+    v = np.zeros((N, nl, 2))
+    w = np.zeros((N, nl))
+    a = np.zeros((N, nl, 2))
+    al = np.zeros((N, nl))
+
+    def pt(i: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if i < 0:
+            P = np.broadcast_to(s, (N, 2))
+            z = np.zeros((N, 2))
+            return P, z, z
+        r, phi = q[:, 3 * i:3 * i + 2], q[:, 3 * i + 2]
+        c, sn = _rot(phi)
+        As = _apply(c, sn, s)
+        return (r + As, v[:, i] + w[:, i, None] * _perp(As),
+                a[:, i] + al[:, i, None] * _perp(As) - (w[:, i] ** 2)[:, None] * As)
+
+    def set_from(i: int, P: np.ndarray, VP: np.ndarray, AP: np.ndarray) -> None:
+        rel = q[:, 3 * i:3 * i + 2] - P
+        v[:, i] = VP + w[:, i, None] * _perp(rel)
+        a[:, i] = AP + al[:, i, None] * _perp(rel) - (w[:, i] ** 2)[:, None] * rel
+
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            sgn = 1.0 if con.b == new else -1.0
+            wk = np.zeros(N) if k < 0 else w[:, k]
+            alk = np.zeros(N) if k < 0 else al[:, k]
+            w[:, new] = wk + sgn * speeds[con.driver]
+            al[:, new] = alk
+            P, VP, AP = pt(k, _local(S, k, jid))
+            set_from(new, P, VP, AP)
+        else:  # RRR
+            (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+            A, VA, AA = pt(k1, _local(S, k1, J1))
+            C, VC, AC = pt(k3, _local(S, k3, J3))
+            r1, p1 = q[:, 3 * b1:3 * b1 + 2], q[:, 3 * b1 + 2]
+            c1, s1 = _rot(p1)
+            B = r1 + _apply(c1, s1, _local(S, b1, J2))
+            e1, e2 = B - A, B - C
+            den = _cross(e1, e2)
+            dv = VC - VA
+            w1 = _dot(dv, e2) / den
+            w2 = _dot(dv, e1) / den
+            da = AC - AA - (w2 ** 2)[:, None] * e2 + (w1 ** 2)[:, None] * e1
+            w[:, b1], w[:, b2] = w1, w2
+            al[:, b1], al[:, b2] = _dot(da, e2) / den, _dot(da, e1) / den
+            set_from(b1, A, VA, AA)
+            set_from(b2, C, VC, AC)
+    qd = np.zeros((N, S.n))
+    qdd = np.zeros((N, S.n))
+    qd[:, 0:3 * nl:3], qd[:, 1:3 * nl:3], qd[:, 2:3 * nl:3] = v[:, :, 0], v[:, :, 1], w
+    qdd[:, 0:3 * nl:3], qdd[:, 1:3 * nl:3], qdd[:, 2:3 * nl:3] = a[:, :, 0], a[:, :, 1], al
+    return qd, qdd
+
+
+def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
+              chunk: int = 20000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions, velocities, accelerations for all inputs (closed form where possible)."""
+    from mechsyn.kinematics.solve import batch_rates
+
+    q, _ = solve_positions(S, plan, inputs)
+    q = _unwrap_angles(S, q)
+    ok = np.all(np.isfinite(q), axis=1)
+    if plan.closed_form_rates:
+        qd, qdd = closed_form_rates(S, plan, q, speeds)
+    else:
+        qd = np.full_like(q, np.nan)
+        qdd = np.full_like(q, np.nan)
+        idx = np.flatnonzero(ok)
+        for start in range(0, len(idx), chunk):
+            sel = idx[start:start + chunk]
+            qd[sel], qdd[sel] = batch_rates(S, q[sel], speeds)
+    qd[~ok] = np.nan
+    qdd[~ok] = np.nan
+    return q, qd, qdd

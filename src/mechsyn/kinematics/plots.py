@@ -1,0 +1,190 @@
+"""Matplotlib figures of a simulation (paths, velocities, accelerations, reactions) and an
+animation of the mechanism with its point paths (GIF by Pillow)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from mechsyn.results import save_figure_atomic
+
+__all__ = ["plot_simulation", "plot_forces", "animate", "link_outlines"]
+
+
+def _mpl():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def link_outlines(sim, k: int) -> dict[str, np.ndarray]:
+    """Global coordinates of every link's joint points at step ``k`` (frame included)."""
+    S = sim.system
+    q = sim.sweep.q[k:k + 1]
+    out = {}
+    for name in S.mech.link_names:
+        i = S.index(name)
+        pts = [S.point(q, i, S.to_local(name, j.point))[0] for j in S.mech.joints_of(name)]
+        pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
+        out[name] = np.array(pts)
+    return out
+
+
+def _draw_mechanism(ax, sim, k: int, color: str = "0.2", alpha: float = 1.0) -> list:
+    S = sim.system
+    arts = []
+    outl = link_outlines(sim, k)
+    cmap = _mpl().get_cmap("tab10")
+    for n, (name, pts) in enumerate(outl.items()):
+        if name == S.mech.ground:
+            arts += ax.plot(pts[:, 0], pts[:, 1], "^", ms=10, color="0.35", alpha=alpha, zorder=3)
+            continue
+        c = cmap(n % 10)
+        if len(pts) >= 3:
+            centre = pts.mean(axis=0)
+            order = np.argsort(np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0]))
+            poly = pts[order]
+            arts += ax.fill(poly[:, 0], poly[:, 1], color=c, alpha=0.35 * alpha, zorder=2)
+            closed = np.vstack([poly, poly[:1]])
+            arts += ax.plot(closed[:, 0], closed[:, 1], "-", color=c, lw=2.5, alpha=alpha, zorder=2)
+        elif len(pts) == 2:
+            arts += ax.plot(pts[:, 0], pts[:, 1], "-", color=c, lw=3, alpha=alpha, zorder=2,
+                            solid_capstyle="round")
+        arts += ax.plot(pts[:, 0], pts[:, 1], "o", ms=5, mfc="white", mec=c, alpha=alpha, zorder=4)
+    for j in S.mech.joints:
+        if j.type == "P":
+            b = j.links[1]
+            P = outl[b][[x.id for x in S.mech.joints_of(b)].index(j.id)]
+            arts += ax.plot([P[0]], [P[1]], "s", ms=11, mfc="none", mec="0.1", alpha=alpha, zorder=5)
+    return arts
+
+
+def _input_axis(sim) -> tuple[np.ndarray, str]:
+    main = sim.main_input
+    unit = "deg" if sim.input_types[main] == "R" else "length"
+    return sim.inputs[main], f"input {main} ({unit})"
+
+
+def plot_simulation(sim, path: str | Path, title: str | None = None) -> None:
+    """Four panels: mechanism and point paths; point speeds; point accelerations; link
+    angular velocities, over the input."""
+    plt = _mpl()
+    x, xlabel = _input_axis(sim)
+    fig, axs = plt.subplots(2, 2, figsize=(12, 9))
+    ax = axs[0, 0]
+    k0 = int(np.argmax(sim.assembled)) if sim.assembled.any() else None
+    if k0 is not None:
+        _draw_mechanism(ax, sim, k0)
+    for name, pm in sim.points.items():
+        ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1.5, label=f"path of {name}")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title("mechanism (first assembled input) and point paths")
+    ax.grid(alpha=0.3)
+    if sim.points:
+        ax.legend(fontsize=8, loc="best")
+    for ax, key, lab in ((axs[0, 1], "velocity", "speed |v| (length/s)"),
+                         (axs[1, 0], "acceleration", "acceleration |a| (length/s²)")):
+        for name, pm in sim.points.items():
+            ax.plot(x, np.linalg.norm(getattr(pm, key), axis=1), label=name)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3)
+        if sim.points:
+            ax.legend(fontsize=8)
+        ax.set_title(f"point {key}")
+    ax = axs[1, 1]
+    for name, lm in sim.links.items():
+        ax.plot(x, lm.angular_velocity, label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("angular velocity (rad/s)")
+    ax.set_title("link angular velocities")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    for e in sim.events:
+        if e["kind"] == "dead point" and isinstance(e.get("input"), dict):
+            v = e["input"].get(sim.main_input)
+            for a in (axs[0, 1], axs[1, 0], axs[1, 1]):
+                a.axvline(v, color="red", ls=":", lw=1)
+    fig.suptitle(title or f"{sim.mechanism}: kinematics ({sim.method})")
+    fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def plot_forces(fa, path: str | Path, title: str | None = None) -> None:
+    """Reaction magnitudes in every joint and the balancing efforts, over the input."""
+    plt = _mpl()
+    sim = fa.simulation
+    x, xlabel = _input_axis(sim)
+    fig, axs = plt.subplots(1, 2, figsize=(13, 5))
+    for j, F in fa.reactions.force.items():
+        axs[0].plot(x, np.linalg.norm(F, axis=1), label=j)
+    axs[0].set_title("joint reactions |F|")
+    axs[0].set_xlabel(xlabel)
+    axs[0].set_ylabel("force")
+    axs[0].grid(alpha=0.3)
+    axs[0].legend(fontsize=8, ncol=2)
+    for j, e in fa.reactions.effort.items():
+        axs[1].plot(x, e, label=f"{j} ({fa.reactions.effort_kind[j]})")
+    axs[1].axhline(0, color="0.5", lw=0.8)
+    axs[1].set_title("balancing moment / force at the driven joints")
+    axs[1].set_xlabel(xlabel)
+    axs[1].grid(alpha=0.3)
+    axs[1].legend(fontsize=8)
+    kind = "static" if fa.static else "kinetostatic"
+    fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, gravity {fa.gravity}")
+    fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def animate(sim, path: str | Path, max_frames: int = 90, fps: int = 15) -> None:
+    """A GIF of the mechanism moving over the assembled inputs, tracing its points' paths."""
+    plt = _mpl()
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    idx = np.flatnonzero(sim.assembled)
+    if len(idx) == 0:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError("nothing to animate: the mechanism is not assembled at any input",
+                                source="--animate")
+    frames = idx[np.unique(np.linspace(0, len(idx) - 1, min(max_frames, len(idx))).astype(int))]
+    allpts = np.vstack([np.vstack(list(link_outlines(sim, k).values())) for k in frames[:: max(1, len(frames) // 12)]]
+                       + [pm.position[idx] for pm in sim.points.values()])
+    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
+    pad = 0.08 * max(hi - lo) + 1e-9
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    x, xlabel = _input_axis(sim)
+
+    def draw(k):
+        ax.clear()
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        for name, pm in sim.points.items():
+            ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
+            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
+            ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
+        arts = _draw_mechanism(ax, sim, k)
+        ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
+        if sim.points:
+            ax.legend(fontsize=8, loc="upper right")
+        return arts
+
+    anim = FuncAnimation(fig, draw, frames=list(frames), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    try:
+        anim.save(str(tmp), writer=PillowWriter(fps=fps))
+        tmp.replace(path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+        plt.close(fig)
