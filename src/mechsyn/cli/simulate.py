@@ -198,25 +198,31 @@ def _render_simulation(sim, derived_d: dict) -> None:
     main = sim.main_input
     x = sim.inputs[main]
     unit = "deg" if sim.input_types[main] == "R" else ""
-    t = Table(title=f"{sim.mechanism}: {len(x)} input values, {int(sim.assembled.sum())} assembled "
-                    f"({sim.method})")
+    rows = _table_rows(len(x))
+    console.print(f"[bold]{sim.mechanism}[/]: {len(x)} input values, {int(sim.assembled.sum())} assembled "
+                  f"(method: {sim.method})", highlight=False)
+    for name, pm in sim.points.items():
+        t = Table(title=f"point {name} (on {pm.link})")
+        for col in (f"{main} {unit}".strip(), "x", "y", "vx", "vy", "ax", "ay"):
+            t.add_column(col, justify="right")
+        for k in rows:
+            if not sim.assembled[k]:
+                t.add_row(f"{x[k]:g}", "not assembled", *[""] * 5)
+                continue
+            t.add_row(f"{x[k]:g}", *(_fmt(v) for v in (*pm.position[k], *pm.velocity[k], *pm.acceleration[k])))
+        console.print(t)
+    t = Table(title="links: angle (deg), angular velocity (rad/s), angular acceleration (rad/s²)")
     t.add_column(f"{main} {unit}".strip(), justify="right")
-    for name in sim.points:
-        t.add_column(f"{name} x, y", justify="right")
-        t.add_column(f"|v_{name}|", justify="right")
-        t.add_column(f"|a_{name}|", justify="right")
-    for name in list(sim.links)[:4]:
-        t.add_column(f"ω {name}", justify="right")
-    for k in _table_rows(len(x)):
-        row = [f"{x[k]:g}"]
-        for pm in sim.points.values():
-            p = pm.position[k]
-            row += [f"{_fmt(p[0])}, {_fmt(p[1])}" if sim.assembled[k] else "not assembled",
-                    _fmt(float(np.linalg.norm(pm.velocity[k]))), _fmt(float(np.linalg.norm(pm.acceleration[k])))]
-        for lm in list(sim.links.values())[:4]:
-            row.append(_fmt(lm.angular_velocity[k]))
-        t.add_row(*row)
+    names = list(sim.links)[:4]
+    for name in names:
+        t.add_column(f"{name} θ, ω, α", justify="right")
+    for k in rows:
+        t.add_row(f"{x[k]:g}", *(("—" if not sim.assembled[k] else
+                                  f"{sim.links[n].angle[k]:.4f}, {sim.links[n].angular_velocity[k]:.4g}, "
+                                  f"{sim.links[n].angular_acceleration[k]:.4g}") for n in names))
     console.print(t)
+    if len(sim.links) > 4:
+        console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
     for r in sim.working_ranges():
         console.print(f"working range of {main}: {r[0]:g} .. {r[1]:g} {unit}", highlight=False)
     for e in sim.events:

@@ -3,7 +3,8 @@
 A mechanism of R and P pairs whose links can be found one driver at a time and then
 two at a time (a *dyad*: two links, three pairs, joined to links already known) is
 solved in closed form for all input values at once (Artobolevsky, *Theory of
-Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR, RPP, PRP):
+Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR; the rarer RPP and PRP
+are left to the Newton solver):
 
 * RRR: the middle joint ``B`` is the intersection of the circles ``|B - A| = L1`` and
   ``|B - C| = L2``: with ``d = C - A``, ``a = (L1^2 - L2^2 + |d|^2) / (2|d|)``,
@@ -11,7 +12,6 @@ Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR, RPP, PRP):
 * RRP / PRR: the intersection of a circle and a line, ``lambda^2 + 2 p lambda + c = 0``;
 * RPR: the slide line keeps the offset ``e`` from both pivots:
   ``cos(phi + nu - delta) = e / |C - A|``;
-* RPP / PRP: orientations are known, positions follow from two linear equations.
 
 The assembly mode ``sigma`` of each dyad is taken from the file's configuration, so the
 result equals the continuation of :func:`mechsyn.kinematics.solve.sweep` on that branch
@@ -118,8 +118,8 @@ def decompose(S: PlanarSystem) -> Plan | None:
                     continue
                 J3 = j3s[0]
                 types = "".join(_jtype(S, j) for j in (J1, J2, J3))
-                if types == "PPP" or any(t not in "RP" for t in types):
-                    continue
+                if types not in ("RRR", "RRP", "PRR", "RPR"):
+                    continue  # RPP, PRP, PPR, ...: left to the Newton solver
                 k1 = (set(ends(J1)) - {b1}).pop()
                 k3 = (set(ends(J3)) - {b2}).pop()
                 steps.append(Step(types, (b1, b2), (k1, k3), (J1, J2, J3), {}))
@@ -326,28 +326,39 @@ class _NotHandled(Exception):
 
 def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
                     sigmas: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
-    """Poses ``q`` (N, n) for all inputs, NaN rows where a dyad cannot be assembled."""
+    """Poses ``q`` (N, n) for all inputs, NaN rows where a dyad cannot be assembled.
+
+    Angles of links placed by a dyad come from ``atan2``; they are made continuous along
+    each run of assembled inputs, and each run is shifted by whole turns to follow the
+    previous one (links turned by a driver keep the input's own value).
+    """
     inputs = np.atleast_2d(np.asarray(inputs, float))
     st = _State(S, inputs.shape[0])
     out_sig = []
     for k, step in enumerate(plan.steps):
         out_sig.append(_solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
+    nl = len(S.links)
     q = np.empty((inputs.shape[0], S.n))
-    q[:, 0::3][:, :len(S.links)] = st.r[:, :, 0]
-    q[:, 1::3][:, :len(S.links)] = st.r[:, :, 1]
-    # angles continuous with the file's configuration, then unwrapped along the sweep
-    phi = S.q0[2:3 * len(S.links):3] + _wrap(st.phi - S.q0[2:3 * len(S.links):3])
-    q[:, 2::3][:, :len(S.links)] = phi
+    q[:, 0:3 * nl:3] = st.r[:, :, 0]
+    q[:, 1:3 * nl:3] = st.r[:, :, 1]
+    phi = st.phi.copy()
+    dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
+    ok = np.all(np.isfinite(phi), axis=1)
+    if dyad_links and ok.any():
+        ref = S.q0[[3 * i + 2 for i in dyad_links]]
+        sub = ref + _wrap(phi[:, dyad_links] - ref)
+        idx = np.flatnonzero(ok)
+        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+        prev = None
+        for run in runs:
+            block = np.unwrap(sub[run], axis=0)
+            if prev is not None:
+                block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
+            sub[run] = block
+            prev = block[-1]
+        phi[:, dyad_links] = sub
+    q[:, 2:3 * nl:3] = phi
     return q, out_sig
-
-
-def _unwrap_angles(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
-    ok = np.all(np.isfinite(q), axis=1)
-    if ok.sum() > 1:
-        cols = np.arange(2, 3 * len(S.links), 3)
-        sub = q[np.ix_(ok, cols)]
-        q[np.ix_(ok, cols)] = np.unwrap(sub, axis=0)
-    return q
 
 
 def closed_form_rates(S: PlanarSystem, plan: Plan, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -416,7 +427,6 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     from mechsyn.kinematics.solve import batch_rates
 
     q, _ = solve_positions(S, plan, inputs)
-    q = _unwrap_angles(S, q)
     ok = np.all(np.isfinite(q), axis=1)
     if plan.closed_form_rates:
         qd, qdd = closed_form_rates(S, plan, q, speeds)
