@@ -64,7 +64,8 @@ def transmission_angles(sim) -> dict[str, np.ndarray]:
             ax = np.asarray(S.to_local_dir(j.links[0], j.axis if j.axis is not None else [1.0, 0.0]))
             c, s = np.cos(ang), np.sin(ang)
             v = np.stack([-(s * ax[0] + c * ax[1]), c * ax[0] - s * ax[1]], axis=1)  # slide normal
-        cosmu = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cosmu = np.sum(u * v, axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
         if step.kind != "RRR":
             cosmu = np.abs(cosmu)
         mu = np.degrees(np.arccos(np.clip(cosmu, -1, 1)))

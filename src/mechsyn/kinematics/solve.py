@@ -320,14 +320,28 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             cur = nxt
             cur_u = u
         elif cur is None and last_good is not None:
-            cand, ok = newton(S, last_good[0], u, max_iter=15)
+            ok = False
+            for guess in (last_good[0], q_start):
+                cand, ok = newton(S, guess, u, max_iter=15)
+                if ok:
+                    break
             if ok:
                 cur, cur_u = cand, u
-                if refine_limits:
-                    ul, _ = _limit(S, cand, u, inputs[i - 1])
-                    events.append({"index": i, "kind": "dead point", "input": ul.tolist(),
+                # follow the new branch backwards into the gap as far as it assembles
+                bq, bu, j = cand, u, i - 1
+                while j >= 0 and not np.isfinite(q[j, 0]):
+                    nb = _track(S, bq, bu, inputs[j])
+                    if nb is None:
+                        break
+                    q[j] = nb
+                    fac_j, X_j, det_sign[j], sig[j] = _factor(S, nb)
+                    qd[j], qdd[j] = _rates_from(S, nb, fac_j, X_j, speeds)
+                    bq, bu, j = nb, inputs[j], j - 1
+                if refine_limits and j >= 0:
+                    ul, _ = _limit(S, bq, bu, inputs[j])
+                    events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
                                    "message": "assembly starts again here: the other limit of a working range"})
-                events.append({"index": i, "kind": "reassembled", "input": u.tolist(),
+                events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
                                "message": "assembles again after a gap (branch chosen by Newton from the "
                                           "last configuration)"})
         if cur is not None:
