@@ -423,20 +423,286 @@ def closed_form_rates(S: PlanarSystem, plan: Plan, q: np.ndarray, speeds: np.nda
 
 def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
               chunk: int = 20000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Positions, velocities, accelerations for all inputs (closed form where possible)."""
+    """Positions, velocities, accelerations (N, n) for all inputs (closed form where possible)."""
     from mechsyn.kinematics.solve import batch_rates
 
+    inputs = np.atleast_2d(np.asarray(inputs, float))
+    if plan.closed_form_rates:
+        return _poses_from_chain(S, plan, inputs, fast_chain(S, plan, inputs, speeds, rates=True))
     q, _ = solve_positions(S, plan, inputs)
     ok = np.all(np.isfinite(q), axis=1)
-    if plan.closed_form_rates:
-        qd, qdd = closed_form_rates(S, plan, q, speeds)
-    else:
-        qd = np.full_like(q, np.nan)
-        qdd = np.full_like(q, np.nan)
-        idx = np.flatnonzero(ok)
-        for start in range(0, len(idx), chunk):
-            sel = idx[start:start + chunk]
-            qd[sel], qdd[sel] = batch_rates(S, q[sel], speeds)
-    qd[~ok] = np.nan
-    qdd[~ok] = np.nan
+    qd = np.full_like(q, np.nan)
+    qdd = np.full_like(q, np.nan)
+    idx = np.flatnonzero(ok)
+    for start in range(0, len(idx), chunk):
+        sel = idx[start:start + chunk]
+        qd[sel], qdd[sel] = batch_rates(S, q[sel], speeds)
     return q, qd, qdd
+
+
+def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
+    N, nl = r.cos.shape
+    q = np.empty((N, S.n))
+    qd = np.empty((N, S.n))
+    qdd = np.empty((N, S.n))
+    phi = np.arctan2(r.sin, r.cos)
+    for i in range(nl):
+        jid, sa = r.anchor[i]
+        c, s = r.cos[:, i], r.sin[:, i]
+        rel = np.stack([-(c * sa[0] - s * sa[1]), -(s * sa[0] + c * sa[1])], axis=1)  # r - P_anchor
+        P, V, A = r.points[jid], r.velocities[jid], r.accelerations[jid]
+        w, al = r.omega[:, i], r.alpha[:, i]
+        q[:, 3 * i:3 * i + 2] = P + rel
+        qd[:, 3 * i:3 * i + 2] = V + w[:, None] * np.stack([-rel[:, 1], rel[:, 0]], axis=1)
+        qdd[:, 3 * i:3 * i + 2] = (A + al[:, None] * np.stack([-rel[:, 1], rel[:, 0]], axis=1)
+                                   - (w ** 2)[:, None] * rel)
+        qd[:, 3 * i + 2], qdd[:, 3 * i + 2] = w, al
+    # angles: drivers' links take the input itself, dyad links are made continuous
+    drive_links = {}
+    for step in plan.steps:
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            drive_links[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
+    ok = np.all(np.isfinite(r.cos), axis=1) & np.all(np.isfinite(r.omega), axis=1)
+    for i in range(nl):
+        if i in drive_links:
+            k, sgn = drive_links[i]
+            phi[:, i] = sgn * U[:, k]
+    others = [i for i in range(nl) if i not in drive_links]
+    if others and ok.any():
+        ref = S.q0[[3 * i + 2 for i in others]]
+        sub = ref + _wrap(phi[:, others] - ref)
+        idx = np.flatnonzero(ok)
+        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+        prev = None
+        for run in runs:
+            block = np.unwrap(sub[run], axis=0)
+            if prev is not None:
+                block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
+            sub[run] = block
+            prev = block[-1]
+        phi[:, others] = sub
+    q[:, 2:3 * nl:3] = phi
+    for a in (q, qd, qdd):
+        a[~ok] = np.nan
+    return q, qd, qdd
+
+
+# --------------------------------------------------------------------------- fast chains
+@dataclass
+class ChainResult:
+    """Joint points (and their rates) and link rotations for driver-R + RRR chains.
+
+    ``points[j]``: (N, 2) position of joint ``j`` (on its second moving link);
+    ``velocities[j]``, ``accelerations[j]`` likewise (when rates were asked for);
+    ``cos, sin, omega, alpha``: (N, n_links) rotation of every moving link and its rates.
+    """
+
+    points: dict[str, np.ndarray]
+    velocities: dict[str, np.ndarray] | None
+    accelerations: dict[str, np.ndarray] | None
+    cos: np.ndarray
+    sin: np.ndarray
+    omega: np.ndarray | None
+    alpha: np.ndarray | None
+    anchor: dict[int, tuple[str, np.ndarray]]
+
+
+def chain_supported(plan: Plan | None) -> bool:
+    return plan is not None and plan.closed_form_rates
+
+
+def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
+               rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
+               rotations: bool = True) -> ChainResult:
+    """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
+
+    Every link is carried by an *anchor* (the joint that placed it: its position,
+    velocity, acceleration) and its rotation ``(cos phi, sin phi)``, computed only when
+    a point off the joints is asked for, so no ``atan2`` or trigonometric call is made
+    except for the input angles. RRR: ``B = A + f d + sigma g R90 d`` with ``d = C - A``,
+    ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g = sqrt(L1^2 / |d|^2 - f^2)``; rates:
+    ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``omega_2 = (v_C - v_A) . e1 / (e1 x e2)``
+    and likewise for the accelerations (see :func:`closed_form_rates`). The work is done
+    in chunks that stay in the processor's cache.
+    """
+    U = np.atleast_2d(np.asarray(U, float))
+    N = U.shape[0]
+    nl = len(S.links)
+    speeds = np.ones(U.shape[1]) if speeds is None else np.asarray(speeds, float)
+    want = joints if joints is not None else [j.id for j in S.mech.joints]
+    prog = []
+    anchor: dict[int, tuple[str, np.ndarray]] = {}
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            sgn = 1.0 if con.b == new else -1.0
+            anchor[new] = (jid, _local(S, new, jid))
+            prog.append(("drive", new, k, jid, con.driver, sgn))
+        else:
+            (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+            s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+            t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+            L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+            A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
+            sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
+            anchor[b1] = (J1, s1)
+            anchor[b2] = (J3, t3)
+            prog.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
+                         (s2 - s1) / L1s, (t2 - t3) / L2s))
+    jpos = {j: np.empty((N, 2)) for j in want}
+    jvel = {j: np.empty((N, 2)) for j in want} if rates else None
+    jacc = {j: np.empty((N, 2)) for j in want} if rates else None
+    cos_out = np.empty((N, nl)) if rotations else None
+    sin_out = np.empty((N, nl)) if rotations else None
+    w_out = np.empty((N, nl)) if rates else None
+    al_out = np.empty((N, nl)) if rates else None
+    fixed = {}
+    for j in S.mech.joints:
+        fixed[j.id] = j.point
+    err = np.seterr(invalid="ignore", divide="ignore")
+    try:
+        for start in range(0, N, chunk):
+            sl = slice(start, min(N, start + chunk))
+            n = sl.stop - sl.start
+            rot: dict[int, list] = {}    # link -> [c, s] (lazy) or a recipe
+            rate: dict[int, tuple] = {}  # link -> (omega, alpha)
+            jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
+
+            def rotation(i: int) -> tuple:
+                r = rot[i]
+                if r[0] == "vec":  # from a joint-to-joint vector e and its local vector / L^2
+                    _, ex, ey, bv = r
+                    c = ex * bv[0] + ey * bv[1]
+                    sn = ey * bv[0] - ex * bv[1]
+                    rot[i] = ("cs", c, sn)
+                    return c, sn
+                return r[1], r[2]
+
+            def point(i: int, jid: str | None, s: np.ndarray) -> tuple:
+                if jid is not None and jid in jst and (i < 0 or _on(i, jid)):
+                    return jst[jid]
+                if i < 0:
+                    return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if rates else (s[0], s[1])
+                ajid, sa = anchor[i]
+                A = jst[ajid]
+                dxl, dyl = s[0] - sa[0], s[1] - sa[1]
+                c, sn = rotation(i)
+                dx = c * dxl - sn * dyl
+                dy = sn * dxl + c * dyl
+                if not rates:
+                    return (A[0] + dx, A[1] + dy)
+                w, al = rate[i]
+                w2 = w * w
+                wdx, wdy = w * dx, w * dy
+                if isinstance(al, float) and al == 0.0:  # a driver at constant speed
+                    return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx, A[4] - w * wdx, A[5] - w * wdy)
+                return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
+                        A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
+
+            def _on(i: int, jid: str) -> bool:
+                return True
+
+            for op in prog:
+                if op[0] == "drive":
+                    _, new, k, jid, di, sgn = op
+                    th = U[sl, di]
+                    ct, st = np.cos(th), np.sin(th)
+                    if sgn < 0:
+                        st = -st
+                    if k < 0:
+                        rot[new] = ("cs", ct, st)
+                        if rates:
+                            rate[new] = (sgn * speeds[di], 0.0)
+                        P = fixed[jid]
+                        jst[jid] = (P[0], P[1], 0.0, 0.0, 0.0, 0.0) if rates else (P[0], P[1])
+                    else:
+                        ck, sk = rotation(k)
+                        rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
+                        if rates:
+                            rate[new] = (rate[k][0] + sgn * speeds[di], rate[k][1])
+                        jst[jid] = point(k, jid, _local(S, k, jid))
+                else:
+                    _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
+                    A = point(k1, J1, _local(S, k1, J1))
+                    C = point(k3, J3, _local(S, k3, J3))
+                    jst[J1], jst[J3] = A, C
+                    dx = C[0] - A[0]
+                    dy = C[1] - A[1]
+                    inv = dx * dx
+                    inv += dy * dy
+                    np.divide(1.0, inv, out=inv)
+                    f = inv * (0.5 * (L1s - L2s))
+                    f += 0.5
+                    g = inv * L1s
+                    g -= f * f
+                    np.maximum(g, 0.0, out=g, where=g > -1e-12)
+                    np.sqrt(g, out=g)
+                    if sigma < 0:
+                        np.negative(g, out=g)
+                    e1x = f * dx
+                    e1x -= g * dy
+                    e1y = f * dy
+                    e1y += g * dx
+                    Bx = e1x + A[0]
+                    By = e1y + A[1]
+                    e2x = Bx - C[0]
+                    e2y = By - C[1]
+                    rot[b1] = ("vec", e1x, e1y, bv1)
+                    rot[b2] = ("vec", e2x, e2y, bv2)
+                    if rates:
+                        den = e1x * e2y
+                        den -= e1y * e2x
+                        np.divide(1.0, den, out=den)
+                        dvx, dvy = C[2] - A[2], C[3] - A[3]
+                        w1 = dvx * e2x
+                        w1 += dvy * e2y
+                        w1 *= den
+                        w2 = dvx * e1x
+                        w2 += dvy * e1y
+                        w2 *= den
+                        w1s, w2s = w1 * w1, w2 * w2
+                        dax = C[4] - A[4]
+                        dax -= w2s * e2x
+                        dax += w1s * e1x
+                        day = C[5] - A[5]
+                        day -= w2s * e2y
+                        day += w1s * e1y
+                        a1 = dax * e2x
+                        a1 += day * e2y
+                        a1 *= den
+                        a2 = dax * e1x
+                        a2 += day * e1y
+                        a2 *= den
+                        rate[b1], rate[b2] = (w1, a1), (w2, a2)
+                        VBx = A[2] - w1 * e1y
+                        VBy = A[3] + w1 * e1x
+                        ABx = A[4] - a1 * e1y
+                        ABx -= w1s * e1x
+                        ABy = A[5] + a1 * e1x
+                        ABy -= w1s * e1y
+                        jst[J2] = (Bx, By, VBx, VBy, ABx, ABy)
+                    else:
+                        jst[J2] = (Bx, By)
+            if rotations:
+                for i in range(nl):
+                    cos_out[sl, i], sin_out[sl, i] = rotation(i)
+            if rates:
+                for i in range(nl):
+                    w_out[sl, i], al_out[sl, i] = rate[i]
+            for jid in want:
+                if jid in jst:
+                    P = jst[jid]
+                else:
+                    j = S.mech.joint(jid)
+                    side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
+                    P = point(side, None, _local(S, side, jid))
+                jpos[jid][sl, 0], jpos[jid][sl, 1] = P[0], P[1]
+                if rates:
+                    jvel[jid][sl, 0], jvel[jid][sl, 1] = P[2], P[3]
+                    jacc[jid][sl, 0], jacc[jid][sl, 1] = P[4], P[5]
+    finally:
+        np.seterr(**err)
+    return ChainResult(jpos, jvel, jacc, cos_out, sin_out, w_out, al_out, anchor)
