@@ -132,7 +132,7 @@ def simulate_cmd(
     modes = _parse_pairs(vll, "--vll", False)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     n = len(next(iter(inputs.values())))
-    with progress_bar("simulating", n, enabled=n >= 2000) as advance:
+    with progress_bar("simulating", n, enabled=n >= 200) as advance:
         sim = simulate(mech, inputs, speeds=speeds, points=names, vll=modes, method=method, progress=advance)
     out = sim.to_dict()
     derived_d: dict[str, Any] = {}
@@ -267,7 +267,7 @@ def forces_cmd(
     mech = load_mechanism(file)
     inputs = _parse_inputs(input)
     n = len(next(iter(inputs.values())))
-    with progress_bar("force analysis", n, enabled=n >= 2000) as advance:
+    with progress_bar("force analysis", n, enabled=n >= 200) as advance:
         fa = forces(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), gravity=(0.0, -gravity),
                     static=static, vll=_parse_pairs(vll, "--vll", False), method=method, progress=advance)
     sim = fa.simulation

@@ -552,13 +552,15 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
             anchor[b2] = (J3, t3)
             prog.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
                          (s2 - s1) / L1s, (t2 - t3) / L2s))
-    jpos = {j: np.empty((N, 2)) for j in want}
-    jvel = {j: np.empty((N, 2)) for j in want} if rates else None
-    jacc = {j: np.empty((N, 2)) for j in want} if rates else None
-    cos_out = np.empty((N, nl)) if rotations else None
-    sin_out = np.empty((N, nl)) if rotations else None
-    w_out = np.empty((N, nl)) if rates else None
-    al_out = np.empty((N, nl)) if rates else None
+    # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
+    # that every chunk writes contiguous memory
+    jpos = {j: np.empty((2, N)).T for j in want}
+    jvel = {j: np.empty((2, N)).T for j in want} if rates else None
+    jacc = {j: np.empty((2, N)).T for j in want} if rates else None
+    cos_out = np.empty((nl, N)).T if rotations else None
+    sin_out = np.empty((nl, N)).T if rotations else None
+    w_out = np.empty((nl, N)).T if rates else None
+    al_out = np.empty((nl, N)).T if rates else None
     fixed = {}
     for j in S.mech.joints:
         fixed[j.id] = j.point
@@ -588,10 +590,15 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
                     return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if rates else (s[0], s[1])
                 ajid, sa = anchor[i]
                 A = jst[ajid]
-                dxl, dyl = s[0] - sa[0], s[1] - sa[1]
+                dxl, dyl = float(s[0] - sa[0]), float(s[1] - sa[1])
                 c, sn = rotation(i)
-                dx = c * dxl - sn * dyl
-                dy = sn * dxl + c * dyl
+                if dyl == 0.0:
+                    dx, dy = c * dxl, sn * dxl
+                elif dxl == 0.0:
+                    dx, dy = sn * -dyl, c * dyl
+                else:
+                    dx = c * dxl - sn * dyl
+                    dy = sn * dxl + c * dyl
                 if not rates:
                     return (A[0] + dx, A[1] + dy)
                 w, al = rate[i]

@@ -28,7 +28,8 @@ def link_outlines(sim, k: int) -> dict[str, np.ndarray]:
     out = {}
     for name in S.mech.link_names:
         i = S.index(name)
-        pts = [S.point(q, i, S.to_local(name, j.point))[0] for j in S.mech.joints_of(name)]
+        pts = [S.point(q, i, S.to_local(name, j.point))[0] for j in S.mech.joints_of(name)
+               if j.type != "cam"]  # a cam's contact point moves on both links: drawn apart
         pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
         out[name] = np.array(pts)
     return out
@@ -55,6 +56,29 @@ def _draw_mechanism(ax, sim, k: int, color: str = "0.2", alpha: float = 1.0) -> 
             arts += ax.plot(pts[:, 0], pts[:, 1], "-", color=c, lw=3, alpha=alpha, zorder=2,
                             solid_capstyle="round")
         arts += ax.plot(pts[:, 0], pts[:, 1], "o", ms=5, mfc="white", mec=c, alpha=alpha, zorder=4)
+    for con in S.cons:
+        if con.kind != "curve":
+            continue
+        j = S.mech.joint(con.joint)
+        q = sim.sweep.q[k:k + 1]
+        prof = j.attrs.get("profile")
+        a_name = j.links[0]
+        if isinstance(prof, dict):
+            t = np.linspace(0, 2 * np.pi, 121)
+            pts = np.asarray(prof["center"]) + prof["radius"] * np.stack([np.cos(t), np.sin(t)], 1)
+        else:
+            pts = np.vstack([prof, prof[:1]])
+        loc = np.array([S.to_local(a_name, p) for p in pts])
+        g = np.array([S.point(q, con.a, p)[0] for p in loc])
+        arts += ax.fill(g[:, 0], g[:, 1], color="tab:orange", alpha=0.25 * alpha, zorder=1)
+        arts += ax.plot(g[:, 0], g[:, 1], "-", color="tab:orange", lw=1.5, alpha=alpha, zorder=1)
+        centre = S.point(q, con.b, con.sb)[0]
+        others = [x for x in S.mech.joints_of(j.links[1]) if x.id != j.id and x.type == "R"]
+        rho = float(np.linalg.norm(others[0].point - j.point)) if others else 0.0
+        if rho > 0:
+            t = np.linspace(0, 2 * np.pi, 61)
+            arts += ax.plot(centre[0] + rho * np.cos(t), centre[1] + rho * np.sin(t), "-", color="tab:green",
+                            lw=1.5, alpha=alpha, zorder=3)
     for j in S.mech.joints:
         if j.type == "P":
             b = j.links[1]
@@ -154,11 +178,16 @@ def animate(sim, path: str | Path, max_frames: int = 90, fps: int = 15) -> None:
         raise MechsynInputError("nothing to animate: the mechanism is not assembled at any input",
                                 source="--animate")
     frames = idx[np.unique(np.linspace(0, len(idx) - 1, min(max_frames, len(idx))).astype(int))]
-    allpts = np.vstack([np.vstack(list(link_outlines(sim, k).values())) for k in frames[:: max(1, len(frames) // 12)]]
-                       + [pm.position[idx] for pm in sim.points.values()])
-    lo, hi = allpts.min(axis=0), allpts.max(axis=0)
-    pad = 0.08 * max(hi - lo) + 1e-9
     fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    # the view: everything drawn at a dozen frames, with the point paths
+    for k in frames[:: max(1, len(frames) // 12)]:
+        _draw_mechanism(ax, sim, k)
+    for pm in sim.points.values():
+        ax.plot(pm.position[idx, 0], pm.position[idx, 1])
+    ax.relim()
+    lo = np.array([ax.dataLim.x0, ax.dataLim.y0])
+    hi = np.array([ax.dataLim.x1, ax.dataLim.y1])
+    pad = 0.08 * max(hi - lo) + 1e-9
     x, xlabel = _input_axis(sim)
 
     def draw(k):
