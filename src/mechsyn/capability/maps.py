@@ -97,10 +97,10 @@ def self_motion(arm: SerialArm, point, q1: np.ndarray | None = None, branch: str
             start[:, 0] = np.tile(q1, seeds)
         q, ok = ik_numeric(arm, point, start, fixed_first=q1 is not None,
                            respect_limits=respect_limits)
-        q = (q + math.pi) % (2 * math.pi) - math.pi if arm.is_revolute.all() else q
         q, ok = q[ok], ok[ok]
-        if len(q):
-            _, keep = np.unique(np.round(q, 4), axis=0, return_index=True)
+        if len(q):  # the same configuration up to full turns of R joints counts once
+            key = np.where(arm.is_revolute, (q + math.pi) % (2 * math.pi) - math.pi, q)
+            _, keep = np.unique(np.round(key, 4), axis=0, return_index=True)
             q, ok = q[np.sort(keep)], ok[np.sort(keep)]
     valid = ok & (arm.within_limits(np.nan_to_num(q)) if respect_limits else True)
     return q, valid
@@ -297,9 +297,9 @@ def plot_map(cmap: CapabilityMap, path, units: str = "mm/s") -> None:
 
     n = cmap.q.shape[-1]
     panels = 1 + n
-    cols = min(panels, 4)
+    cols = 2 if panels <= 4 else 3
     rows_ = math.ceil(panels / cols)
-    fig, axs = plt.subplots(rows_, cols, figsize=(4.6 * cols, 4.0 * rows_), squeeze=False)
+    fig, axs = plt.subplots(rows_, cols, figsize=(5.2 * cols, 4.4 * rows_), squeeze=False)
     small = cmap.xs.size * cmap.ys.size <= 144
     qu = cmap.q_user()
     fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
@@ -313,11 +313,12 @@ def plot_map(cmap: CapabilityMap, path, units: str = "mm/s") -> None:
         mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
         fig.colorbar(mesh, ax=ax, shrink=0.85)
         finite = np.isfinite(data)
-        if cmap.xs.size > 2 and cmap.ys.size > 2 and finite.sum() > 4 and np.nanstd(data) > 0:
+        if (idx == 0 and cmap.xs.size > 2 and cmap.ys.size > 2 and finite.sum() > 4
+                and np.nanstd(data) > 0):
             try:
                 cs = ax.contour(cmap.xs, cmap.ys, data.T, levels=8, colors="k", linewidths=0.6)
                 if not small:
-                    ax.clabel(cs, fontsize=7, fmt="%.0f")
+                    ax.clabel(cs, fontsize=8, fmt="%.0f")
             except (ValueError, TypeError):
                 pass
         if small:
