@@ -291,11 +291,16 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
                                 ) from None
     except ValueError as exc:
         raise MechsynInputError(str(exc), source=source) from None
-    if isinstance(spec, PlanarSerialSpec):
-        return _build_planar(spec)
-    if isinstance(spec, DHSpec):
-        return _build_dh(spec)
-    return _build_urdf(spec, source, base_dir or Path("."))
+    try:
+        if isinstance(spec, PlanarSerialSpec):
+            return _build_planar(spec)
+        if isinstance(spec, DHSpec):
+            return _build_dh(spec)
+        return _build_urdf(spec, source, base_dir or Path("."))
+    except MechsynInputError as exc:
+        raise exc.with_source(source) if source else exc from None
+    except ValueError as exc:  # e.g. a URDF chain whose lengths do not fit the file's lists
+        raise MechsynInputError(str(exc), source=source) from None
 
 
 def load_arm(path: str | Path) -> SerialArm:
