@@ -281,7 +281,7 @@ def interpolate_configuration(cmap: CapabilityMap, method: str = "cubic"
 
     def at(x, y):
         x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
-        return interp(np.stack([x, y], -1))
+        return interp(np.stack([x.ravel(), y.ravel()], -1)).reshape(*x.shape, q.shape[-1])
 
     return at
 

@@ -193,11 +193,10 @@ def velocity_polytope(J, w) -> VelocityPolytope:
             hull = ConvexHull(local)
         except QhullError:
             hull = ConvexHull(local, qhull_options="QJ")
-        idx = hull.vertices
-        if r == 2:  # order counter-clockwise
-            c = local[idx].mean(0)
-            idx = idx[np.argsort(np.arctan2(local[idx, 1] - c[1], local[idx, 0] - c[0]))]
-        verts = local[idx] @ basis.T
+        verts = local[hull.vertices] @ basis.T
+        if m == 2:  # order counter-clockwise
+            c = verts - verts.mean(0)
+            verts = verts[np.argsort(np.arctan2(c[:, 1], c[:, 0]))]
         eq = np.unique(np.round(hull.equations, 12), axis=0)
         normals = eq[:, :-1] @ basis.T
     normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
@@ -225,12 +224,13 @@ class VelocityEllipse:
 
 
 def velocity_ellipse(J, w) -> VelocityEllipse:
-    """Velocity ellipse(-oid): eigen-decomposition of ``J diag(w^2) J^T``."""
+    """Velocity ellipse(-oid) of ``J diag(w^2) J^T``, from the SVD of ``J diag(w)``
+    (semi-axes = singular values, accurate also at singular configurations)."""
     J = np.asarray(J, float)
-    M = (J * np.asarray(w, float) ** 2) @ J.T
-    vals, vecs = np.linalg.eigh(M)
-    order = np.argsort(vals)[::-1]
-    return VelocityEllipse(np.sqrt(np.clip(vals[order], 0, None)), vecs[:, order])
+    U, S, _ = np.linalg.svd(J * np.asarray(w, float))
+    semi = np.zeros(J.shape[0])
+    semi[: S.size] = S
+    return VelocityEllipse(semi, U)
 
 
 MEASURES = ("exact", "component", "min_norm", "stepped_min_norm", "stepped")
