@@ -98,15 +98,33 @@ def test_polytope_flat_when_singular():
         exact_limit(J, [1, 1, 1], (1, 2))[0], rel=1e-12)
 
 
-def test_lp_in_three_dimensions_matches_polytope():
+def test_three_dimensions_lp_facets_and_polytope_agree():
     rng = np.random.default_rng(7)
     for _ in range(10):
         J = rng.normal(size=(3, 6))
         w = rng.uniform(0.5, 2, 6)
         d = rng.normal(size=3)
-        lp = exact_limit(J, w, d)[0]  # 3-D: linear program
+        lp = exact_limit_lp(J, w, d)[0]
+        assert exact_limit(J, w, d)[0] == pytest.approx(lp, rel=1e-9)  # facet closed form
         poly = velocity_polytope(J, w)
         assert poly.directional_limit(d) == pytest.approx(lp, rel=1e-7)
+
+
+@pytest.mark.parametrize("m,n", [(3, 3), (3, 6), (3, 7), (4, 5), (6, 6), (6, 7)])
+def test_facet_closed_form_equals_linprog_with_singular(m, n):
+    rng = np.random.default_rng(10 * m + n)
+    N = 40
+    J = _random_jacobians(rng, N, m, n)
+    for k in range(2, N, 7):
+        J[k][:, 0] = 2 * J[k][:, 1]  # parallel generators (full rank may remain)
+    for k in range(3, N, 11):
+        J[k][m - 1] = J[k][0] + J[k][1]  # rank m - 1
+    w = rng.uniform(0.5, 2, size=(N, n))
+    d = rng.normal(size=(N, m))
+    d[3] = J[3] @ rng.normal(size=n)  # inside the range of a rank-deficient J
+    exact = exact_limit(J, w, d)
+    np.testing.assert_allclose(exact, exact_limit_lp(J, w, d), rtol=1e-8, atol=1e-9)
+    assert exact[3] > 0 and exact[1] == 0
 
 
 def test_min_norm_rates_and_weights():

@@ -8,7 +8,9 @@ For a unit direction ``d`` (paper 004, "mobility"):
 * :func:`exact_limit` -- the largest speed of *pure* motion along ``d``:
   ``max s`` s.t. ``J q_dot = s d``, ``|q_dot_i| <= w_i``. In 2-D, closed form:
   ``s* = min_k h(n_k) / |n_k . d|`` over the facet normals ``n_k = perp(g_k)`` of Z with
-  the support function ``h(n) = sum_i |n . g_i|``; otherwise a linear program (HiGHS).
+  the support function ``h(n) = sum_i |n . g_i|``. In m-D (spatial arms) the same over
+  the normals of (m-1)-subsets of generators; a linear program (HiGHS) where J is
+  rank-deficient (:func:`exact_limit_lp`).
 * :func:`component_limit` -- the largest component along ``d`` with the perpendicular
   part free: ``h(d) = sum_i w_i |d . J[:, i]|`` (>= the exact limit).
 * :func:`min_norm_limit` -- the limit of the (weighted) minimum-norm joint rates
@@ -52,15 +54,24 @@ def exact_limit(J, w, d) -> np.ndarray:
     are ``perp(g_k)`` (the facet normals of a full zonotope) and ``g_k`` itself (each a
     valid bound; they make the degenerate case exact, where Z is a segment along
     ``d``). Normals perpendicular to ``d`` give no bound; if no normal is left (J = 0)
-    the limit is 0. Other task dimensions: :func:`exact_limit_lp`.
+    the limit is 0. Other task dimensions: facet enumeration (see the module docstring),
+    a linear program for rank-deficient Jacobians.
     """
     J, w, d = _prep(J, w, d)
-    if J.shape[1] != 2:
-        return exact_limit_lp(J, w, d)
+    m, n = J.shape[1], J.shape[2]
+    if m != 2:
+        if m < 2 or m > 6 or n > 12:
+            return exact_limit_lp(J, w, d)
+        return _exact_limit_facets(J, w, d)
     G = J * w[:, None, :]  # (N, 2, n) generators
     P = np.stack([-G[:, 1], G[:, 0]], 1)  # perpendiculars
     normals = np.concatenate([P, G], axis=2)  # (N, 2, 2n)
-    length = np.linalg.norm(normals, axis=1)  # (N, 2n)
+    return _limit_from_normals(G, normals, d)
+
+
+def _limit_from_normals(G: np.ndarray, normals: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """``min_k h(n_k) / |n_k . d|`` over candidate normals (N, m, K); 0 if none bounds."""
+    length = np.linalg.norm(normals, axis=1)  # (N, K)
     size = length.max(axis=1, keepdims=True)
     usable = length > _PERP_TOL * size
     unit = normals / np.where(usable, length, 1.0)[:, None, :]
@@ -70,6 +81,32 @@ def exact_limit(J, w, d) -> np.ndarray:
     ratio = np.where(usable, h / np.where(usable, nd, 1.0), np.inf)
     s = ratio.min(axis=1)
     return np.where(np.isfinite(s), s, 0.0)
+
+
+def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """m-D closed form: the facet normals of a full-dimensional zonotope are the normals
+    of the hyperplanes spanned by (m-1)-subsets of generators (generalised cross products,
+    by cofactors); configurations whose J is rank-deficient go to the linear program."""
+    from itertools import combinations
+
+    N, m, n = J.shape
+    G = J * w[:, None, :]
+    subsets = np.array(list(combinations(range(n), m - 1)))  # (C, m-1)
+    if subsets.size == 0:
+        return exact_limit_lp(J, w, d)
+    sub = G[:, :, subsets]  # (N, m, C, m-1)
+    sub = np.moveaxis(sub, 2, 1)  # (N, C, m, m-1)
+    normals = np.empty((N, m, subsets.shape[0]))
+    for r in range(m):
+        minor = np.delete(sub, r, axis=2)  # (N, C, m-1, m-1)
+        normals[:, r, :] = (-1) ** r * np.linalg.det(minor)
+    normals = np.concatenate([normals, G], axis=2)
+    out = _limit_from_normals(G, normals, d)
+    sv = np.linalg.svd(G, compute_uv=False)
+    deficient = sv[:, -1] <= 1e-9 * np.maximum(sv[:, 0], 1e-300)
+    if deficient.any():
+        out[deficient] = exact_limit_lp(J[deficient], w[deficient], d[deficient])
+    return out
 
 
 def exact_limit_lp(J, w, d) -> np.ndarray:
