@@ -14,6 +14,7 @@ from typing import Optional
 import numpy as np
 import typer
 from rich import box
+from rich.console import Console
 from rich.table import Table
 
 from mechsyn.capability.arm import SerialArm, load_arm
@@ -132,8 +133,10 @@ def capability(
     if (point is None) == (grid is None):
         raise MechsynInputError("give exactly one of --point and --grid", source="--point",
                                 hint="--point 1300,900 or --grid 1300:2100:200,100:900:200")
-    if point is None and continuous and not is_closed_form(arm):
-        raise MechsynInputError("--continuous needs a planar 3R arm", source="--continuous")
+    if continuous and not is_closed_form(arm):
+        raise MechsynInputError("the continuous self-motion search needs a planar 3R arm",
+                                source="--continuous",
+                                hint="sample the self-motion instead (--q1 or the default)")
     if point is not None:
         if map_png or csv_out:
             raise MechsynInputError("--map and --csv go with --grid", source="--map")
@@ -189,11 +192,15 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
                         f"at ({', '.join(f'{c:g}' for c in p)})")
     table.add_column("")
     for name in arm.joint_names:
-        table.add_column(name, justify="right")
+        table.add_column(name, justify="right", no_wrap=True, min_width=6)
     for head in ("exact", "compon.", "min-nrm", "st.mn", "stepped"):
         table.add_column(head, justify="right", no_wrap=True)
     kbest = int(np.argmax(meas[measure])) if configs else -1
-    for k, c in enumerate(configs):
+    shown = list(range(len(configs)))
+    if len(configs) > 15:  # many IK solutions (spatial arms): the best ones
+        shown = sorted(np.argsort(-meas[measure], kind="stable")[:12].tolist())
+    for k in shown:
+        c = configs[k]
         table.add_row("best" if k == kbest else "", *[f"{v:.1f}" for v in c["q_deg"]],
                       *[f"{c[mn]:.2f}" for mn in MEASURES],
                       style="bold green" if k == kbest else None)
@@ -201,7 +208,12 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
     if cb:
         table.add_row("cont", *[f"{v:.1f}" for v in cb["q_deg"]],
                       *[f"{cb[mn]:.2f}" for mn in MEASURES], style="cyan")
-    console.print(table)
+    need = 12 + 8 * arm.n + 50
+    out = console if console.is_terminal or console.width >= need else Console(width=need)
+    out.print(table)
+    if len(shown) < len(configs):
+        console.print(f"showing the best {len(shown)} of {len(configs)} configurations "
+                      "(all with --json)")
     if not configs:
         console.print("[yellow]no allowed configuration reaches this point[/]")
     else:
