@@ -167,3 +167,30 @@ def test_bad_files(tmp_path):
     broken.write_text("<robot><joint name='a' type='revolute'></robot>")
     with pytest.raises(MechsynInputError):
         load_arm(broken)
+
+
+def test_refine_over_self_motion_planar_matches_continuous_search():
+    from mechsyn.capability.maps import continuous_best, refine_over_self_motion
+
+    arm = load_arm(PAPER)
+    p = np.array([1300.0, 900.0])
+    q0, _ = self_motion(arm, p, np.radians([80.0, 100.0]))
+    qr, vr = refine_over_self_motion(arm, p, q0, (1, 0))
+    _, vc = continuous_best(arm, p[None], (1, 0))
+    assert vr.max() == pytest.approx(vc[0], rel=1e-6)
+    np.testing.assert_allclose(arm.fk(qr), [p, p], atol=1e-6)
+    assert arm.within_limits(qr).all()
+
+
+def test_refine_over_self_motion_spatial_improves_and_stays_on_point():
+    from mechsyn.capability.maps import measure_values, refine_over_self_motion
+
+    arm = load_arm(UR5)
+    p = np.array([400.0, 200.0, 300.0])
+    q, valid = self_motion(arm, p, seeds=16)
+    q = q[valid][:4]
+    v0 = measure_values(arm, q, (1, 0, 0))
+    qr, vr = refine_over_self_motion(arm, p, q, (1, 0, 0), iterations=15)
+    assert np.all(vr >= v0) and vr.max() > v0.max()
+    np.testing.assert_allclose(arm.fk(qr), np.tile(p, (len(q), 1)), atol=1e-5)
+    np.testing.assert_allclose(measure_values(arm, qr, (1, 0, 0)), vr, rtol=1e-12)

@@ -113,6 +113,9 @@ def test_spatial_dh_arm_point_and_grid(tmp_path, capsys):
     q = np.radians(np.array([c["q_deg"] for c in r["configurations"]]))
     np.testing.assert_allclose(arm.fk(q), np.tile([400, 200, 300], (len(q), 1)), atol=1e-3)
     assert r["best"]["exact"] == max(c["exact"] for c in r["configurations"])
+    cb = r["continuous_best"]  # local search over the self-motion from the best ones
+    assert cb["exact"] >= r["best"]["exact"]
+    np.testing.assert_allclose(arm.fk(np.radians(cb["q_deg"])), [[400, 200, 300]], atol=1e-4)
     png = tmp_path / "ur5.png"
     g = run_json(capsys, UR5, "--grid", "300:500:200,0:200:200", "--z", "300",
                  "--direction", "0,0,1", "--map", str(png))

@@ -168,6 +168,49 @@ def continuous_best(arm: SerialArm, points: np.ndarray, direction, measure: str 
     return best_q, best_v
 
 
+def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
+                            measure: str = "exact", respect_limits: bool = True,
+                            iterations: int = 40, step: float = 0.2
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """Local search over the self-motion manifold from configurations ``q0`` (K, n).
+
+    Pattern search in the null space of J: each iteration tries ``q +/- h v_j`` for every
+    null-space basis vector ``v_j`` (from the SVD of J), pulls each trial back onto the
+    point with damped least squares (:func:`ik_numeric`), keeps the best improving one
+    (within the limits), and halves ``h`` where nothing improves. Vectorised over the K
+    starts; deterministic. Returns the refined ``q`` (K, n) and their measure (K,).
+    """
+    q = np.atleast_2d(np.asarray(q0, float)).copy()
+    K, n = q.shape
+    val = measure_values(arm, q, direction, measure)
+    h = np.full(K, step)
+    for _ in range(iterations):
+        J = arm.jacobian(q)
+        _, S, Vt = np.linalg.svd(J)
+        r = arm.task_dim
+        null = Vt[:, r:, :]  # (K, n - r, n)
+        if null.shape[1] == 0:
+            break
+        moves = np.concatenate([null, -null], axis=1) * h[:, None, None]  # (K, T, n)
+        T = moves.shape[1]
+        trial = (q[:, None, :] + moves).reshape(-1, n)
+        trial, ok = ik_numeric(arm, point, trial, respect_limits=respect_limits,
+                               iterations=30, tol=1e-9)
+        tv = measure_values(arm, trial, direction, measure)
+        if respect_limits:
+            ok &= arm.within_limits(trial)
+        tv = np.where(ok, tv, -np.inf).reshape(K, T)
+        k = np.argmax(tv, axis=1)
+        best = tv[np.arange(K), k]
+        better = best > val + 1e-12 * np.abs(val)
+        q[better] = trial.reshape(K, T, n)[np.arange(K), k][better]
+        val = np.where(better, best, val)
+        h = np.where(better, h, h / 2)
+        if np.all(h < 1e-6):
+            break
+    return q, val
+
+
 @dataclass
 class CapabilityMap:
     """V_max over a grid: ``value[i, j]`` at ``(xs[i], ys[j])`` with the optimal
@@ -213,7 +256,8 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     """Best configuration and V_max at every grid point (paper 004, Table 2).
 
     ``q1`` (radians) samples the self-motion (default: 20 deg steps over q1's limits, the
-    paper's choice); ``continuous`` uses :func:`continuous_best` instead (planar 3R).
+    paper's choice); ``continuous`` uses :func:`continuous_best` instead (planar 3R), or
+    refines the best 8 IK solutions with :func:`refine_over_self_motion` (other arms).
     ``advance(k)`` is called after each chunk of k points (for a progress bar).
     Spatial arms need ``z`` (the grid lies in the plane z = const).
     """
@@ -227,7 +271,7 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     qopt = np.full((P, arm.n), np.nan)
     for start in range(0, P, chunk):
         sl = slice(start, min(start + chunk, P))
-        if continuous:
+        if continuous and is_closed_form(arm):
             qopt[sl], value[sl] = continuous_best(arm, pts[sl], direction, measure, branch,
                                                   respect_limits)
         elif is_closed_form(arm):
@@ -254,9 +298,14 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
             for p in range(sl.start, sl.stop):
                 q, valid = self_motion(arm, pts[p], q1, branch, respect_limits)
                 if valid.any():
-                    v = measure_values(arm, q[valid], direction, measure)
+                    q = q[valid]
+                    v = measure_values(arm, q, direction, measure)
+                    if continuous:
+                        top = np.argsort(-v, kind="stable")[:8]
+                        q, v = refine_over_self_motion(arm, pts[p], q[top], direction,
+                                                       measure, respect_limits)
                     k = int(np.argmax(v))
-                    value[p], qopt[p] = v[k], q[valid][k]
+                    value[p], qopt[p] = v[k], q[k]
         if advance is not None:
             advance(sl.stop - sl.start)
     qopt[~np.isfinite(value)] = np.nan
@@ -306,8 +355,10 @@ def plot_map(cmap: CapabilityMap, path, units: str = "mm/s") -> None:
                f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
                f"[{units}]\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
     for k in range(n):
-        unit = "deg" if cmap.joint_is_revolute[k] else ""
-        fields.append((qu[..., k], f"optimal {cmap.joint_names[k]} [{unit}]", "coolwarm"))
+        data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else ""
+        if cmap.joint_is_revolute[k] and np.nanmax(np.abs(data), initial=0.0) > 180:
+            data, unit = (data + 180) % 360 - 180, "deg, shown mod 360"  # same pose
+        fields.append((data, f"optimal {cmap.joint_names[k]} [{unit}]", "coolwarm"))
     for idx, (data, title, cm) in enumerate(fields):
         ax = axs[idx // cols][idx % cols]
         mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)

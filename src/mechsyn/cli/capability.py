@@ -19,8 +19,8 @@ from rich.table import Table
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
-    BRANCHES, capability_map, continuous_best, is_closed_form, measure_values, plot_map,
-    self_motion,
+    BRANCHES, capability_map, continuous_best, is_closed_form, plot_map,
+    refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
@@ -97,8 +97,8 @@ def capability(
     measure: str = typer.Option("exact", "--measure", help="what 'best' maximises: "
                                 + ", ".join(MEASURES)),
     step: float = typer.Option(5.0, "--step", help="speed step of the paper's stepping method"),
-    continuous: bool = typer.Option(False, "--continuous", help="maps: continuous q1 search "
-                                    "instead of the samples (planar 3R)"),
+    continuous: bool = typer.Option(False, "--continuous", help="maps: continuous search "
+                                    "over the self-motion instead of the samples"),
     polytope: bool = typer.Option(False, "--polytope", help="add the best configuration's "
                                   "velocity polytope and ellipse"),
     map_png: Optional[Path] = typer.Option(None, "--map", help="write a heat/contour map (PNG)"),
@@ -133,10 +133,6 @@ def capability(
     if (point is None) == (grid is None):
         raise MechsynInputError("give exactly one of --point and --grid", source="--point",
                                 hint="--point 1300,900 or --grid 1300:2100:200,100:900:200")
-    if continuous and not is_closed_form(arm):
-        raise MechsynInputError("the continuous self-motion search needs a planar 3R arm",
-                                source="--continuous",
-                                hint="sample the self-motion instead (--q1 or the default)")
     if point is not None:
         if map_png or csv_out:
             raise MechsynInputError("--map and --csv go with --grid", source="--map")
@@ -180,11 +176,18 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
                 "semi_axes": ell.semi_axes, "axes": ell.axes.T, "radius_along_d": ell.radius(dn)}
     if is_closed_form(arm):
         qc, vc = continuous_best(arm, p[None], dn, measure, br, respect)
-        if np.isfinite(vc[0]):
-            mc = _measures_at(arm, qc, dn, step)
-            result["continuous_best"] = _config_entry(arm, qc[0], mc, 0)
-        else:
-            result["continuous_best"] = None
+    elif configs:
+        top = np.argsort(-meas[measure], kind="stable")[:8]
+        qc, vc = refine_over_self_motion(arm, p, qv[top], dn, measure, respect)
+        k = int(np.argmax(vc))
+        qc, vc = qc[k:k + 1], vc[k:k + 1]
+    else:
+        qc, vc = None, np.array([-np.inf])
+    if np.isfinite(vc[0]):
+        mc = _measures_at(arm, qc, dn, step)
+        result["continuous_best"] = _config_entry(arm, qc[0], mc, 0)
+    else:
+        result["continuous_best"] = None
     if json_out:
         emit_json(result)
         return
@@ -218,7 +221,8 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
         console.print("[yellow]no allowed configuration reaches this point[/]")
     else:
         console.print(f"best sampled ({measure}): {configs[kbest][measure]:.3f}"
-                      + (f"; continuous q1 search (cont): {cb[measure]:.3f}" if cb else ""))
+                      + (f"; continuous search over the self-motion (cont): "
+                         f"{cb[measure]:.3f}" if cb else ""))
     for r in rejected:
         console.print(f"rejected q = ({', '.join(f'{v:.2f}' for v in r['q_deg'])}): {r['reason']}")
     console.print("[dim]exact: " + MEASURE_HELP["exact"] + "; compon.: " + MEASURE_HELP["component"]
