@@ -16,8 +16,7 @@ from mechsyn.cli.main import main
 ROOT = Path(__file__).resolve().parents[2]
 PAPER = str(ROOT / "examples" / "capability" / "paper004_3r.yaml")
 UR5 = str(ROOT / "examples" / "capability" / "ur5_dh.yaml")
-REF = json.loads(Path("/work/shared/spec/data/paper004_results.json").read_text()) \
-    if Path("/work/shared/spec/data/paper004_results.json").exists() else None
+REF = json.loads((Path(__file__).parent / "data" / "paper004_results.json").read_text())
 
 
 def run_json(capsys, *args):

@@ -353,7 +353,8 @@ def plot_map(cmap: CapabilityMap, path, units: str = "mm/s") -> None:
     qu = cmap.q_user()
     fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
                f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
-               f"[{units}]\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
+               f"[{units}]" + ("" if cmap.z is None else f" in z = {cmap.z:g}")
+               + f"\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
     for k in range(n):
         data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else ""
         if cmap.joint_is_revolute[k] and np.nanmax(np.abs(data), initial=0.0) > 180:
