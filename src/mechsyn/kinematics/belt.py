@@ -57,6 +57,8 @@ __all__ = [
     "path_quality",
     "equivalent_four_bar",
     "compare_with_four_bar",
+    "BeltCase",
+    "load_belt_case",
 ]
 
 
@@ -655,6 +657,11 @@ def path_quality(
     s_lo, s_hi = min(segment), max(segment)
     if s_hi <= s_lo:
         raise MechsynInputError("the segment must have two distinct ends", field="segment")
+    tiny = 1e-9 * max(1.0, abs(lo), abs(hi))
+    if s_lo < lo - tiny or s_hi > hi + tiny:
+        raise MechsynInputError(
+            f"segment {math.degrees(s_lo):g}:{math.degrees(s_hi):g} deg lies outside the range "
+            f"{math.degrees(lo):g}:{math.degrees(hi):g} deg", field="segment")
     seg_state = analyze(design, np.linspace(s_lo, s_hi, samples))
     seg = seg_state.H if point == "H" else seg_state.C
     seg = seg[np.all(np.isfinite(seg), axis=1)]
@@ -807,3 +814,118 @@ def compare_with_four_bar(
         out[name] = entry
     out["translation_tol_deg"] = math.degrees(translation_tol)
     return out
+
+
+# ------------------------------------------------------------------ example files
+# Schema of a belt-manipulator case file (YAML or JSON), e.g. examples/belt/paper001.yaml:
+#
+#   name: Paper 001 example
+#   design: {a: 500, c: 350, h: 100, r: 75}          # or synthesis: {...} below
+#   phi_deg: {start: -73, stop: 85, step: 1}
+#   motion: {law: constant, omega_deg_s: 60}         # trapezoidal: omega_max_deg_s, accel_deg_s2
+#   paths: {segment_deg: [-73, 0], translation_tol_deg: 3}
+#
+#   synthesis: {h0: [-350, 600], hf: [324.6, 597.5], phi_of_deg: -60, r: 75, a0: [0, 0]}
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator  # noqa: E402
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class DesignSpec(_Strict):
+    """Dimensions of the mechanism (lengths in any one unit, mm in paper 001)."""
+
+    a: float = Field(gt=0, description="lever 1 length |A0 A|")
+    c: float = Field(gt=0, description="x offset of C to the left of A")
+    h: float = Field(description="height of H above C")
+    r: float = Field(gt=0, description="pulley radius")
+
+
+class SynthesisSpec(_Strict):
+    """Working scene for the synthesis (machine frame, y along the machine's axis)."""
+
+    h0: tuple[float, float] = Field(description="design position of H")
+    hf: tuple[float, float] = Field(description="final position of H")
+    phi_of_deg: float = Field(description="rotation of lever 1 from H0 to Hf, degrees")
+    r: float = Field(gt=0, description="pulley radius")
+    a0: tuple[float, float] = Field((0.0, 0.0), description="base point A0")
+
+
+class RangeSpec(_Strict):
+    start: float
+    stop: float
+    step: float = 1.0
+
+
+class MotionSpec(_Strict):
+    law: Literal["constant", "trapezoidal", "table"] = "constant"
+    omega_deg_s: float | None = Field(None, gt=0, description="constant input speed")
+    omega_max_deg_s: float | None = Field(None, gt=0, description="trapezoidal: top speed")
+    accel_deg_s2: float | None = Field(None, gt=0, description="trapezoidal: acceleration")
+    t: list[float] | None = Field(None, description="table: times, s")
+    phi_deg: list[float] | None = Field(None, description="table: Δφ at those times, deg")
+
+    @model_validator(mode="after")
+    def _complete(self) -> "MotionSpec":
+        if self.law == "trapezoidal" and (self.omega_max_deg_s is None
+                                          or self.accel_deg_s2 is None):
+            raise ValueError("a trapezoidal law needs omega_max_deg_s and accel_deg_s2")
+        if self.law == "table" and (self.t is None or self.phi_deg is None):
+            raise ValueError("a table law needs t and phi_deg lists")
+        return self
+
+
+class PathsSpec(_Strict):
+    segment_deg: tuple[float, float] | None = None
+    translation_tol_deg: float = Field(3.0, gt=0)
+
+
+class BeltCase(_Strict):
+    """A belt-manipulator case: the design (or its synthesis data) and what to analyse."""
+
+    name: str = "belt manipulator"
+    design: DesignSpec | None = None
+    synthesis: SynthesisSpec | None = None
+    phi_deg: RangeSpec | None = None
+    motion: MotionSpec | None = None
+    paths: PathsSpec = PathsSpec()
+
+    @model_validator(mode="after")
+    def _one_design(self) -> "BeltCase":
+        if (self.design is None) == (self.synthesis is None):
+            raise ValueError("give exactly one of 'design' and 'synthesis'")
+        return self
+
+
+def load_belt_case(path: str) -> BeltCase:
+    """Read and validate a belt case file (YAML or JSON); MechsynInputError on bad input
+    (naming the file, the line of a syntax error, or the offending field)."""
+    from pathlib import Path
+
+    import yaml
+
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise MechsynInputError(f"cannot read the file: {exc.strerror or exc}",
+                                source=str(path)) from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        raise MechsynInputError(
+            f"not valid YAML/JSON: {getattr(exc, 'problem', None) or exc}", source=str(path),
+            line=(mark.line + 1) if mark is not None else None) from None
+    if not isinstance(data, dict):
+        raise MechsynInputError("expected a mapping (name, design, phi_deg, ...) at the top",
+                                source=str(path))
+    try:
+        return BeltCase.model_validate(data)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        loc = ".".join(str(x) for x in first["loc"]) or None
+        raise MechsynInputError(first["msg"], source=str(path), field=loc,
+                                hint="see docs/belt.md for the file's keys") from None
