@@ -326,3 +326,16 @@ def test_inverse_constant_speed_duration_is_path_length_over_speed():
     inv = inverse_input(st, 1000.0, 0.0, "H")
     length = np.sum(np.hypot(*np.diff(st.H, axis=0).T))
     assert inv.t[-1] == pytest.approx(length / 1000.0, rel=1e-5)
+
+
+def test_four_bar_mechanism_dict_geometry():
+    from mechsyn.kinematics.belt import four_bar_mechanism_dict
+
+    m = four_bar_mechanism_dict(PAPER)
+    P = {j["id"]: np.array(j["point"]) for j in m["joints"]}
+    assert np.linalg.norm(P["A"] - P["A0"]) == pytest.approx(PAPER.a)
+    assert np.linalg.norm(P["B"] - P["A"]) == pytest.approx(PAPER.r)
+    assert np.linalg.norm(P["B0"] - P["B"]) == pytest.approx(PAPER.b0)
+    assert np.linalg.norm(P["B0"] - P["A0"]) == pytest.approx(PAPER.l0)
+    assert (P["A"] - P["B"]) @ (P["B0"] - P["B"]) == pytest.approx(0.0, abs=1e-9)
+    assert m["points"]["H"]["at"] == pytest.approx([-350.0, 600.0])

@@ -344,6 +344,10 @@ def _print_analysis(result: dict[str, Any], state: kb.BeltState,
                   f"r = {d['r']:g}  ->  b0 = {d['b0']:.3f}, l0 = {d['l0']:.3f}, "
                   f"α0 = {d['alpha0_deg']:.3f}°")
     deg = math.degrees
+    n_slack = int(np.count_nonzero(~state.valid))
+    if n_slack:
+        console.print(f"[yellow]warning:[/] at {n_slack} of {state.dphi.size} positions the "
+                      "belt is slack or crosses the pulley (d <= r): shown as nan")
     t = Table(title="transfer functions (derivatives w.r.t. Δφ in rad)")
     for col in ("Δφ°", "Δψ°", "β°", "b", "d", "ψ'", "ψ''"):
         t.add_column(col, justify="right")

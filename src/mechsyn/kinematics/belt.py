@@ -57,6 +57,7 @@ __all__ = [
     "path_quality",
     "equivalent_four_bar",
     "compare_with_four_bar",
+    "four_bar_mechanism_dict",
     "BeltCase",
     "load_belt_case",
 ]
@@ -685,8 +686,8 @@ def path_quality(
         extent_x=float(np.ptp(P[fin, 0])), extent_y=float(np.ptp(P[fin, 1])),
         segment_deg=(math.degrees(s_lo), math.degrees(s_hi)),
         segment_span=float(np.ptp(along)),
-        max_positive_deviation=float(max(dev.max(), 0.0)),
-        max_negative_deviation=float(max(-dev.min(), 0.0)),
+        max_positive_deviation=float(max(dev.max(), 0.0)) + 0.0,
+        max_negative_deviation=float(max(-dev.min(), 0.0)) + 0.0,
         best_line_deviation=bl_dev, best_line_angle_deg=ang,
         translation_tol_deg=math.degrees(translation_tol),
         translation_length=float(np.nanmax(xr) - np.nanmin(xr)),
@@ -929,3 +930,28 @@ def load_belt_case(path: str) -> BeltCase:
         loc = ".".join(str(x) for x in first["loc"]) or None
         raise MechsynInputError(first["msg"], source=str(path), field=loc,
                                 hint="see docs/belt.md for the file's keys") from None
+
+
+def four_bar_mechanism_dict(design: BeltDesign, name: str | None = None) -> dict[str, object]:
+    """The equivalent four-bar A0-A-B-B0 of the design position as a mechanism-file dict
+    (issue 2's YAML/JSON format, for the general planar solver): frame, lever (A0 A),
+    hand (A B, carrying C and H: link 2 with its pulley) and rocker (B B0, the belt's free
+    run frozen at b0). The belt mechanism itself differs from it beyond second order."""
+    a, c, h, r = design.a, design.c, design.h, design.r
+    b0 = design.b0
+    return {
+        "name": name or f"equivalent four-bar of the belt manipulator a={a:g} c={c:g} "
+                        f"h={h:g} r={r:g}",
+        "kind": "planar",
+        "ground": "frame",
+        "links": ["frame", "lever", "hand", "rocker"],
+        "joints": [
+            {"id": "A0", "type": "R", "links": ["frame", "lever"], "point": [0.0, 0.0],
+             "actuated": True},
+            {"id": "A", "type": "R", "links": ["lever", "hand"], "point": [0.0, a]},
+            {"id": "B", "type": "R", "links": ["hand", "rocker"], "point": [r, a]},
+            {"id": "B0", "type": "R", "links": ["rocker", "frame"], "point": [r, a - b0]},
+        ],
+        "points": {"C": {"link": "hand", "at": [-c, a]},
+                   "H": {"link": "hand", "at": [-c, a + h]}},
+    }

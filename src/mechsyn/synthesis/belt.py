@@ -133,14 +133,13 @@ def synthesize_belt(
             abs(design.B0[0] - r) < 1e-9 * scale and abs(math.degrees(st.beta[0]) - 90) < 1e-9
         ),
         "b0_below_a": bool(design.b0 < a),
-        "reaches_Hf": bool(np.allclose(st.H[-1], [xf, yf], atol=1e-6 * scale)),
     }
     notes: list[str] = []
     if not checks["belt_taut_and_straight (d > r)"]:
         raise MechsynInputError(
             f"the belt would go slack or cross the pulley's centre (d <= r) between H0 and "
             f"Hf (min d - r = {margin:.6g})", field="r", hint="use a smaller pulley radius r")
-    if not checks["reaches_Hf"]:
+    if not np.allclose(st.H[-1], [xf, yf], atol=1e-6 * scale):
         miss = math.dist((float(st.H[-1, 0]), float(st.H[-1, 1])), (xf, yf))
         notes.append(
             f"at Δφ = φ_of the belt mechanism puts H {miss:.6g} from Hf: the primary-chain "
