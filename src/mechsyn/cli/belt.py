@@ -243,8 +243,8 @@ def synthesize_cmd(
 # ------------------------------------------------------------------------- analyze
 @belt_app.command("analyze")
 def analyze_cmd(
-    file: Optional[Path] = typer.Option(None, "--file", "-f",
-                                        help="case file (YAML/JSON), e.g. examples/belt/paper001.yaml"),
+    file: Optional[Path] = typer.Option(
+        None, "--file", "-f", help="case file (YAML/JSON), e.g. examples/belt/paper001.yaml"),
     a: Optional[float] = typer.Option(None, "--a", help="lever length |A0 A|"),
     c: Optional[float] = typer.Option(None, "--c", help="x offset of C left of A"),
     h: Optional[float] = typer.Option(None, "--h", help="height of H above C"),
@@ -255,11 +255,16 @@ def analyze_cmd(
                                 "(default: range start to the design position)"),
     tol: Optional[float] = typer.Option(None, "--tol",
                                         help="translation tolerance on θ, deg (default 3)"),
-    law: Optional[str] = typer.Option(None, "--law", help="input law: constant, trapezoidal, table"),
-    omega: Optional[float] = typer.Option(None, "--omega", help="constant input speed, deg/s (60)"),
-    omega_max: Optional[float] = typer.Option(None, "--omega-max", help="trapezoidal top speed, deg/s"),
-    accel: Optional[float] = typer.Option(None, "--accel", help="trapezoidal acceleration, deg/s²"),
-    table: Optional[Path] = typer.Option(None, "--table", help="table law: CSV of t (s), dphi (deg)"),
+    law: Optional[str] = typer.Option(
+        None, "--law", help="input law: constant, trapezoidal, table"),
+    omega: Optional[float] = typer.Option(
+        None, "--omega", help="constant input speed, deg/s (60)"),
+    omega_max: Optional[float] = typer.Option(
+        None, "--omega-max", help="trapezoidal top speed, deg/s"),
+    accel: Optional[float] = typer.Option(
+        None, "--accel", help="trapezoidal acceleration, deg/s²"),
+    table: Optional[Path] = typer.Option(
+        None, "--table", help="table law: CSV of t (s), dphi (deg)"),
     samples: int = typer.Option(201, "--samples", help="time samples of the motion"),
     json_out: bool = typer.Option(False, "--json", help="print JSON"),
     csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table of positions"),
@@ -291,6 +296,11 @@ def analyze_cmd(
     if samples < 2 or samples > _MAX_POSITIONS:
         raise MechsynInputError(f"--samples must be 2..{_MAX_POSITIONS}", source="--samples")
 
+    motion_law = _law(law or "", grid_deg, omega, omega_max, accel, table, case)
+    if animate is not None:
+        from mechsyn.kinematics.belt_plot import check_animation_target
+
+        check_animation_target(animate)
     dphi = np.radians(grid_deg)
     state = kb.analyze(design, dphi)
     if not np.any(state.valid):
@@ -304,7 +314,6 @@ def analyze_cmd(
         raise exc.with_source("--segment" if exc.field == "segment" else "--phi") from None
     four_bar = kb.equivalent_four_bar(design, dphi)
     comparison = kb.compare_with_four_bar(design, rng, math.radians(tol_deg))
-    motion_law = _law(law or "", grid_deg, omega, omega_max, accel, table, case)
     mres = kb.motion(design, motion_law, samples)
 
     result: dict[str, Any] = {

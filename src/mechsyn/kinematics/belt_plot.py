@@ -26,7 +26,7 @@ from mechsyn.kinematics.belt import (
     equivalent_four_bar,
 )
 
-__all__ = ["draw_mechanism", "figure_mechanism", "save_animation"]
+__all__ = ["check_animation_target", "draw_mechanism", "figure_mechanism", "save_animation"]
 
 
 def _dense(design: BeltDesign, state: BeltState, n: int = 1500) -> BeltState:
@@ -147,11 +147,9 @@ def figure_mechanism(design: BeltDesign, state: BeltState, four_bar: FourBarStat
     return fig
 
 
-def save_animation(design: BeltDesign, state: BeltState, path: str | os.PathLike[str],
-                   fps: int = 20, max_frames: int = 160, title: str = "") -> None:
-    """Write an animated GIF of the motion over ``state`` (whole file or nothing)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
-    from matplotlib.figure import Figure
+def check_animation_target(path: str | os.PathLike[str]) -> Path:
+    """Raise MechsynInputError unless a GIF can be written to ``path``."""
+    from matplotlib.animation import PillowWriter
 
     if not PillowWriter.isAvailable():
         raise MechsynInputError("--animate needs the pillow package",
@@ -160,6 +158,16 @@ def save_animation(design: BeltDesign, state: BeltState, path: str | os.PathLike
     if path.suffix.lower() != ".gif":
         raise MechsynInputError(f"the animation is a GIF: use a .gif file name, not {path.name}",
                                 source="--animate")
+    return path
+
+
+def save_animation(design: BeltDesign, state: BeltState, path: str | os.PathLike[str],
+                   fps: int = 20, max_frames: int = 160, title: str = "") -> None:
+    """Write an animated GIF of the motion over ``state`` (whole file or nothing)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.figure import Figure
+
+    path = check_animation_target(path)
     idx = np.nonzero(state.valid)[0]
     if idx.size == 0:
         raise MechsynInputError("nothing to animate: the belt is slack over the whole range")
