@@ -174,3 +174,28 @@ def test_bad_inputs_exit_2(capsys, tmp_path):
         assert "Traceback" not in err
         assert needle in err, (argv, err)
     assert not (tmp_path / "m.mp4").exists()
+
+
+def test_table_law_and_reverse_range(capsys, tmp_path):
+    table = tmp_path / "law.csv"
+    table.write_text("# t, dphi_deg\nt,dphi_deg\n" + "".join(
+        f"{t / 10:g},{-73 + 73 * (t / 10) ** 2:g}\n" for t in range(11)))
+    out = _json(capsys, ["belt", "analyze", *PAPER_ARGS, "--phi", "-73:0:1", "--law", "table",
+                         "--table", str(table), "--samples", "11", "--json"])
+    assert out["motion"]["law"] == "TableLaw"
+    assert out["motion"]["phid_deg_s"][5] == pytest.approx(2 * 73 * 0.5, rel=1e-9)
+    # a range run backwards: the input speed is negative, speeds stay positive
+    out = _json(capsys, ["belt", "analyze", *PAPER_ARGS, "--phi", "0:-73:-1", "--json"])
+    assert out["rows"][0]["dphi_deg"] == 0.0
+    assert out["motion"]["phid_deg_s"][0] == pytest.approx(-60.0)
+    assert min(out["motion"]["H"]["speed"]) > 0
+
+
+def test_partly_slack_range_warns(capsys):
+    assert main(["belt", "analyze", "--a", "100", "--c", "300", "--h", "0", "--r", "200",
+                 "--phi", "-30:40:1"]) == 0
+    assert "slack" in capsys.readouterr().out
+    out = _json(capsys, ["belt", "analyze", "--a", "100", "--c", "300", "--h", "0",
+                         "--r", "200", "--phi", "-30:40:1", "--json"])
+    assert out["rows"][0]["valid"] is False and out["rows"][0]["b"] is None
+    assert out["rows"][-1]["valid"] is True
