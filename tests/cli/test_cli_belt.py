@@ -199,3 +199,20 @@ def test_partly_slack_range_warns(capsys):
                          "--r", "200", "--phi", "-30:40:1", "--json"])
     assert out["rows"][0]["valid"] is False and out["rows"][0]["b"] is None
     assert out["rows"][-1]["valid"] is True
+
+
+def test_four_bar_file_for_the_planar_solver(capsys, tmp_path):
+    from mechsyn.io import load_mechanism
+
+    out = tmp_path / "fb.yaml"
+    assert main(["belt", "analyze", *PAPER_ARGS, "--phi", "-10:10:1", "--four-bar-file",
+                 str(out), "--json"]) == 0
+    capsys.readouterr()
+    mech = load_mechanism(str(out))
+    bundled = load_mechanism(str(ROOT / "examples" / "belt" / "paper001_four_bar.yaml"))
+    for j, k in zip(mech.joints, bundled.joints):
+        assert j.id == k.id and j.point == pytest.approx(k.point)
+    assert mech.joint("B0").point == pytest.approx([75.0, 500.0 - 500 * 350 / 425])
+    assert mech.points["H"].at == pytest.approx([-350.0, 600.0])
+    assert main(["analyze", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["mobility"] == 1

@@ -270,6 +270,9 @@ def analyze_cmd(
     csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table of positions"),
     plot: Optional[Path] = typer.Option(None, "--plot", help="write the figure (PNG/SVG/PDF)"),
     animate: Optional[Path] = typer.Option(None, "--animate", help="write an animated GIF"),
+    four_bar_file: Optional[Path] = typer.Option(
+        None, "--four-bar-file", help="write the equivalent four-bar A0-A-B-B0 as a mechanism "
+                                      "file (YAML, or JSON by suffix)"),
 ) -> None:
     """Transfer functions, paths of C and H, path straightness, speeds and accelerations.
 
@@ -335,6 +338,12 @@ def analyze_cmd(
 
         fig = figure_mechanism(design, state, four_bar, mres, title=result["name"])
         save_figure_atomic(fig, plot)
+    if four_bar_file is not None:
+        from mechsyn.io import mechanism_from_dict, write_mechanism
+
+        fb_dict = kb.four_bar_mechanism_dict(design)
+        mechanism_from_dict(fb_dict)  # validate against the file format before writing
+        write_mechanism(fb_dict, four_bar_file)
     if animate is not None:
         from mechsyn.kinematics.belt_plot import save_animation
 
