@@ -19,7 +19,7 @@ from rich.table import Table
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
-    BRANCHES, capability_map, continuous_best, is_closed_form, plot_map,
+    capability_map, continuous_best, is_closed_form, plot_map,
     refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
