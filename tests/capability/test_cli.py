@@ -105,6 +105,18 @@ def test_grid_text_summary(capsys):
     assert "9 points" in out and "continuous" in out
 
 
+def test_grid_interpolated_configuration(capsys):
+    r = run_json(capsys, PAPER, "--grid", "1300:1700:50,300:700:50", "--direction", "1,0",
+                 "--continuous", "--interpolate", "1425,515")
+    it = r["interpolated"]
+    assert it["method"] == "cubic" and it["tool_error"] < 1.0  # mm, on a smooth optimum
+    arm = load_arm(PAPER)
+    q = np.radians(it["q_deg"])
+    assert np.linalg.norm(arm.fk(q)[0] - [1425, 515]) == pytest.approx(it["tool_error"])
+    v = np.array(r["v_max"])
+    assert v.min() - 1 < it["exact"] < v.max() + 1
+
+
 def test_spatial_dh_arm_point_and_grid(tmp_path, capsys):
     r = run_json(capsys, UR5, "--point", "400,200,300", "--direction", "1,0,0")
     arm = load_arm(UR5)
@@ -139,6 +151,8 @@ def test_spatial_dh_arm_point_and_grid(tmp_path, capsys):
     [UR5, "--grid", "0:100:50,0:100:50", "--direction", "1,0,0"],
     [UR5, "--point", "400,200,300", "--direction", "1,0,0", "--branch", "both"],
     ["/no/such/arm.yaml", "--point", "1,2", "--direction", "1,0"],
+    [PAPER, "--point", "1300,900", "--direction", "1,0", "--interpolate", "1,2"],
+    [PAPER, "--grid", "1300:1500:100,300:500:100", "--direction", "1,0", "--interpolate", "0,0"],
 ])
 def test_bad_inputs_exit_2(args, capsys):
     assert main(["capability", *args]) == 2

@@ -19,8 +19,8 @@ from rich.table import Table
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
-    capability_map, continuous_best, is_closed_form, plot_map,
-    refine_over_self_motion, self_motion,
+    capability_map, continuous_best, interpolate_configuration, is_closed_form,
+    measure_values, plot_map, refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
@@ -103,6 +103,8 @@ def capability(
                                   "velocity polytope and ellipse"),
     map_png: Optional[Path] = typer.Option(None, "--map", help="write a heat/contour map (PNG)"),
     csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV"),
+    interpolate: Optional[str] = typer.Option(None, "--interpolate", help="grid: the optimal "
+                                              "configuration interpolated at X,Y"),
     json_out: bool = typer.Option(False, "--json", help="print JSON on stdout"),
 ) -> None:
     """Largest tool speed along a direction under joint speed limits (paper 004), at a point
@@ -134,13 +136,19 @@ def capability(
         raise MechsynInputError("give exactly one of --point and --grid", source="--point",
                                 hint="--point 1300,900 or --grid 1300:2100:200,100:900:200")
     if point is not None:
-        if map_png or csv_out:
-            raise MechsynInputError("--map and --csv go with --grid", source="--map")
+        if map_png or csv_out or interpolate:
+            raise MechsynInputError("--map, --csv and --interpolate go with --grid",
+                                    source="--map" if map_png else "--csv" if csv_out
+                                    else "--interpolate")
         _point(arm, np.array(parse_floats(point, "--point", m)), d, q1_vals, br,
                not ignore_limits, measure, step, polytope, json_out)
     else:
+        at = None
+        if interpolate is not None:
+            at = np.array(parse_floats(interpolate, "--interpolate", 2))
+            _check_finite(at, "--interpolate")
         _grid(arm, grid, z, d, q1_vals, br, not ignore_limits, measure, continuous,
-              map_png, csv_out, json_out)
+              map_png, csv_out, json_out, at)
 
 
 def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -> None:
@@ -231,7 +239,7 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
 
 
 def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, csv_out,
-          json_out) -> None:
+          json_out, at=None) -> None:
     parts = grid.split(",")
     if len(parts) != 2:
         raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
@@ -259,8 +267,26 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
     if map_png is not None:
         plot_map(cmap, map_png)
     v = np.where(np.isfinite(cmap.value), cmap.value, np.nan)
+    interp = None
+    if at is not None:
+        if not (xs.min() <= at[0] <= xs.max() and ys.min() <= at[1] <= ys.max()):
+            raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid",
+                                    source="--interpolate")
+        method = "cubic" if xs.size >= 4 and ys.size >= 4 else "linear"
+        qi = interpolate_configuration(cmap, method)(at[0], at[1])
+        target = at if arm.kind == "planar" else np.array([at[0], at[1], z])
+        interp = {"point": target, "method": method, "q_deg": None, "tool_error": None,
+                  measure: None}
+        if np.all(np.isfinite(qi)):
+            interp.update({
+                "q_deg": arm.to_user(qi),
+                "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
+                measure: float(measure_values(arm, qi[None], d, measure)[0])})
     if json_out:
-        emit_json(cmap)
+        out = cmap.to_dict()
+        if interp is not None:
+            out["interpolated"] = interp
+        emit_json(out)
         return
     if total <= 144:
         table = Table(title=f"V_max ({measure}, {cmap.search}); rows x, columns y")
@@ -277,6 +303,14 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
                       f"{np.nanmin(v):.3f} to {np.nanmax(v):.3f} (at x={xs[i]:g}, y={ys[j]:g})")
     else:
         console.print(f"{total} points, none reachable with the allowed configurations")
+    if interp is not None:
+        if interp["q_deg"] is None:
+            console.print("interpolation: no optimal configuration near this point")
+        else:
+            console.print(f"interpolated optimal configuration at ({at[0]:g}, {at[1]:g}) "
+                          f"({interp['method']}): q = ({', '.join(f'{c:.3f}' for c in interp['q_deg'])})"
+                          f"; tool {interp['tool_error']:.3g} from the point (correct with IK); "
+                          f"{measure} {interp[measure]:.3f}")
     for what, path in (("map", map_png), ("csv", csv_out)):
         if path is not None:
             console.print(f"wrote {what}: {path}")
