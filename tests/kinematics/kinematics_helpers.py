@@ -1,8 +1,22 @@
 """Helpers for the kinematics tests."""
 
+from pathlib import Path
+
 import numpy as np
 
-from mechsyn.io import mechanism_from_dict
+import pytest
+
+from mechsyn.io import load_mechanism, mechanism_from_dict
+
+EX = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.fixture
+def ex():
+    """Load an example file by its path under examples/."""
+    def load(rel: str):
+        return load_mechanism(EX / rel)
+    return load
 
 
 def fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0, branch=1, extra=None):

@@ -7,7 +7,7 @@ import pytest
 
 from mechsyn.cli.main import main
 
-from conftest import EX
+from kinematics_helpers import EX
 
 
 def run(capsys, *args):

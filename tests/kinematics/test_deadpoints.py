@@ -6,6 +6,8 @@ import pytest
 from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.results import to_jsonable
 
+from kinematics_helpers import ex  # noqa: F401
+
 
 def limit_angle(a, b, c, g):
     """Input angle where coupler and rocker are stretched out: |BD| = b + c (law of cosines)."""

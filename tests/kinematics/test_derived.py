@@ -7,7 +7,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import derived
 from mechsyn.kinematics.analysis import input_grid, simulate
 
-from kinematics_helpers import fourbar
+from kinematics_helpers import ex, fourbar  # noqa: F401
 
 
 @pytest.mark.parametrize("lengths, cls, grashof", [

@@ -8,7 +8,7 @@ from mechsyn.kinematics.analysis import forces, input_grid
 from mechsyn.kinematics.forces import loads_from_file, mass_model
 from mechsyn.kinematics.system import _cross2
 
-from kinematics_helpers import fourbar_dict
+from kinematics_helpers import ex, fourbar_dict  # noqa: F401
 
 
 def power_residual(fa):

@@ -8,7 +8,7 @@ from mechsyn.kinematics import dyads
 from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.system import build_system
 
-from kinematics_helpers import fourbar
+from kinematics_helpers import ex, fourbar  # noqa: F401
 
 
 def rocker_angle_freudenstein(theta, a, b, c, g, branch=1):

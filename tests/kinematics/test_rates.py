@@ -7,7 +7,7 @@ from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.solve import assemble, newton, rates
 from mechsyn.kinematics.system import build_system
 
-from kinematics_helpers import fourbar
+from kinematics_helpers import ex, fourbar  # noqa: F401
 
 CASES = [
     ("kinematics/crank_rocker.yaml", {"A": 37.0}, None),

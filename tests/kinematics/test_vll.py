@@ -8,6 +8,8 @@ from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.solve import check_mobility
 from mechsyn.kinematics.system import build_system
 
+from kinematics_helpers import ex  # noqa: F401
+
 
 def vll_length(sim, joint="S"):
     return sim.system.coordinate(np.nan_to_num(sim.sweep.q), joint)
