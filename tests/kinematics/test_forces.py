@@ -135,3 +135,93 @@ def test_loads_schema_errors():
     d = fourbar_dict(extra={"loads": [{"link": "nope", "moment": 1}]})
     with pytest.raises(MechsynInputError, match="unknown link"):
         mechanism_from_dict(d, "x")
+
+
+def geared_five_bar():
+    """A geared five-bar: two meshing gears on the frame each carry a crank pin."""
+    return {"name": "geared five-bar", "ground": "frame",
+            "links": ["frame", {"name": "g1", "mass": 1.0, "inertia": 0.3},
+                      {"name": "g2", "mass": 2.0, "inertia": 0.8},
+                      {"name": "l1", "mass": 0.7, "inertia": 0.4}, {"name": "l2", "mass": 0.6, "inertia": 0.3}],
+            "joints": [
+                {"id": "O1", "type": "R", "links": ["frame", "g1"], "point": [0, 0], "actuated": True},
+                {"id": "O2", "type": "R", "links": ["frame", "g2"], "point": [3, 0]},
+                {"id": "G", "type": "gear", "links": ["g1", "g2"], "point": [1, 0]},
+                {"id": "P1", "type": "R", "links": ["g1", "l1"], "point": [0, 0.8]},
+                {"id": "P2", "type": "R", "links": ["g2", "l2"], "point": [3, 1.5]},
+                {"id": "Q", "type": "R", "links": ["l1", "l2"], "point": [1.6, 3.2]},
+            ],
+            "loads": [{"link": "l2", "force": [0.3, -1.0], "at": [1.6, 3.2]}]}
+
+
+def test_virtual_work_geared_five_bar():
+    m = mechanism_from_dict(geared_five_bar(), "geared")
+    # g1's reference line runs from O1 to the pitch point G: the file is at input 0
+    fa = forces(m, {"O1": input_grid(-20, 20, 5)}, gravity=(0, -9.81), speeds={"O1": 2.0})
+    assert fa.simulation.method == "newton" and fa.simulation.assembled.all()
+    assert np.allclose(fa.simulation.links["g2"].angular_velocity, -1.0)  # ratio -r1/r2 = -1/2
+    res, scale = power_residual(fa)
+    assert np.all(np.abs(res) <= 1e-9 * scale)
+    # the teeth only push: the reaction moment about the pitch point vanishes
+    assert np.allclose(fa.reactions.moment["G"], 0, atol=1e-9 * scale.max())
+
+
+FREE_BODY_CASES = [
+    ("kinematics/crank_rocker.yaml", {"A": input_grid(0, 360, 30)}, None),
+    ("textbook/slider_crank.yaml", {"A": input_grid(0, 360, 30)}, None),
+    ("kinematics/inverted_slider_crank.yaml", {"A": input_grid(0, 360, 30)}, None),
+    ("kinematics/cam_roller.yaml", {"O": input_grid(0, 360, 30)}, None),
+    ("fingers/two_phalanx_vll_000.yaml", {"E": input_grid(-10, 40, 10)}, None),
+    ("geared", {"O1": input_grid(-20, 20, 10)}, None),
+]
+
+
+@pytest.mark.parametrize("rel, inp, vll", FREE_BODY_CASES)
+def test_every_link_is_in_equilibrium(ex, rel, inp, vll):
+    """Free body of every moving link: joint forces + loads + gravity + inertia = 0 (forces
+    and moments about the origin), with the reported reactions (first link on second)."""
+    from mechsyn.io import mechanism_to_dict
+
+    if rel == "geared":
+        m = mechanism_from_dict(geared_five_bar(), "geared")
+    else:
+        d = mechanism_to_dict(ex(rel))
+        d["links"] = [ln if (ln if isinstance(ln, str) else ln["name"]) == d["ground"] else
+                      {"name": ln if isinstance(ln, str) else ln["name"], "mass": 1.0 + k, "inertia": 0.2 * k}
+                      for k, ln in enumerate(d["links"])]
+        m = mechanism_from_dict(d, rel)
+    g = (0.0, -9.81)
+    fa = forces(m, inp, gravity=g, speeds={j: 1.5 for j in inp})
+    sim = fa.simulation
+    S, sw = sim.system, sim.sweep
+    q, qd, qdd = sw.q, sw.qd, sw.qdd
+    mm = mass_model(S)
+    loads = loads_from_file(S, mm)
+    R = fa.reactions
+    for i, name in enumerate(S.links):
+        Fsum = np.zeros((len(q), 2))
+        Msum = np.zeros(len(q))
+        PG, _, aG = S.point_state(q, qd, qdd, i, mm.com[i])
+        Fi = mm.mass[i] * (np.asarray(g) - aG)
+        Fsum += Fi
+        Msum += _cross2(PG, Fi) - mm.inertia[i] * qdd[:, 3 * i + 2]
+        for k in range(len(loads.link)):
+            if loads.link[k] == i:
+                P = S.point(q, i, loads.at[k])
+                Fsum += loads.force[k]
+                Msum += _cross2(P, np.broadcast_to(loads.force[k], P.shape)) + loads.moment[k]
+        for j in m.joints_of(name):
+            sign = 1.0 if j.links[1] == name else -1.0  # reported: on the second link by the first
+            side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
+            side_name = S.links[side]
+            P = S.point(q, side, S.to_local(side_name, j.point))
+            if j.type == "gear":  # the tooth force acts at the pitch point (the carrier is the frame)
+                P = np.broadcast_to(j.point, P.shape)
+            F = sign * R.force[j.id]
+            Fsum += F
+            Msum += _cross2(P, F) + sign * R.moment[j.id]
+            if j.id in R.effort and j.type == "R":
+                Msum += sign * R.effort[j.id]
+        scale = np.abs(Fi).max() + 1.0
+        assert np.abs(Fsum).max() < 1e-9 * scale * 10, (name, np.abs(Fsum).max())
+        assert np.abs(Msum).max() < 1e-8 * scale * 10 * S.scale, (name, np.abs(Msum).max())

@@ -291,17 +291,36 @@ def forces_cmd(
         return
     main = sim.main_input
     x = sim.inputs[main]
-    t = Table(title=f"{sim.mechanism}: {'static' if static else 'kinetostatic'} analysis "
-                    f"(gravity {gravity:g} along -y); reactions |F| on the second link of each joint")
+    rows = _table_rows(len(x))
+    kind = "static" if static else "kinetostatic"
+    console.print(f"[bold]{sim.mechanism}[/]: {kind} analysis, gravity {gravity:g} along -y, "
+                  f"{int(sim.assembled.sum())} of {len(x)} inputs assembled", highlight=False)
+    joints = list(R.force)
+    per_input = joints if len(joints) <= 5 else []
+    t = Table(title="balancing efforts at the drives" + (" and reactions |F| (on each joint's second link)"
+                                                         if per_input else ""))
     t.add_column(main, justify="right")
-    for j in R.force:
-        t.add_column(f"|F_{j}|", justify="right")
     for j in R.effort:
         t.add_column(f"{R.effort_kind[j]} at {j}", justify="right")
-    for k in _table_rows(len(x)):
-        row = [f"{x[k]:g}"] + [_fmt(float(np.linalg.norm(F[k]))) for F in R.force.values()]
-        row += [_fmt(float(e[k])) for e in R.effort.values()]
+    for j in per_input:
+        t.add_column(f"|F_{j}|", justify="right")
+    for k in rows:
+        row = [f"{x[k]:g}"] + [_fmt(float(e[k])) for e in R.effort.values()]
+        row += [_fmt(float(np.linalg.norm(R.force[j][k]))) for j in per_input]
         t.add_row(*row)
+    console.print(t)
+    mech_joints = {j.id: j for j in sim.system.mech.joints}
+    t = Table(title="joint reactions over the sweep (force of the first link on the second)")
+    for col in ("joint", "links", "max |F|", f"at {main}", "min |F|", "max |M|"):
+        t.add_column(col, justify="left" if col in ("joint", "links") else "right")
+    for j in joints:
+        mag = np.linalg.norm(R.force[j], axis=1)
+        if not np.isfinite(mag).any():
+            t.add_row(j, " - ".join(mech_joints[j].links), "—", "—", "—", "—")
+            continue
+        k = int(np.nanargmax(mag))
+        t.add_row(j, " → ".join(mech_joints[j].links), _fmt(float(mag[k])), f"{x[k]:g}",
+                  _fmt(float(np.nanmin(mag))), _fmt(float(np.nanmax(np.abs(R.moment[j])))))
     console.print(t)
     if R.indeterminate:
         console.print("[yellow]note:[/] redundant constraints: the reactions are statically indeterminate; "

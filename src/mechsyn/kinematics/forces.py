@@ -193,7 +193,50 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
         if j.id in drive_rows:
             effort[j.id] = -lam[:, drive_rows[j.id]]
             kinds[j.id] = "moment" if j.type == "R" else "force"
+    for con in S.cons:
+        if con.kind == "gear":
+            _gear_tooth_force(S, con, q, force, moment)
     return Reactions(force, moment, effort, kinds, indeterminate, lam)
+
+
+def _gear_tooth_force(S: PlanarSystem, con, q: np.ndarray, force: dict, moment: dict) -> None:
+    """Turn a gear pair's constraint couples into the tooth force at the pitch point.
+
+    The ratio constraint ``(phi_b - phi_c) = k (phi_a - phi_c) + const`` only carries
+    couples; physically the teeth push with a force ``F`` along the line of action
+    (the joint's ``normal``, else the pitch-circle tangent) through the pitch point
+    ``P``, with ``(P - O_b) x F`` equal to the couple on gear ``b``, and the axles carry
+    ``-F`` more (gear ``b``) and ``+F`` more (gear ``a``). The totals on every link are
+    unchanged.
+    """
+    j = S.mech.joint(con.joint)
+    a_name, b_name = j.links
+    c_name = S.mech.ground if con.c < 0 else S.links[con.c]
+    axle = {}
+    for g in (a_name, b_name):
+        axle[g] = next(x for x in S.mech.joints if x.type == "R" and set(x.links) == {c_name, g})
+    P = S.point(q, con.c, S.to_local(c_name, j.point))
+    Oa = S.point(q, con.c, S.to_local(c_name, axle[a_name].point))
+    Ob = S.point(q, con.c, S.to_local(c_name, axle[b_name].point))
+    if j.normal is not None:
+        n0 = S.to_local_dir(c_name, j.normal)
+        cc, ss = np.cos(S.link_angle_i(q, con.c)), np.sin(S.link_angle_i(q, con.c))
+        n = np.stack([cc * n0[0] - ss * n0[1], ss * n0[0] + cc * n0[1]], axis=1)
+    else:
+        d = Ob - Oa
+        n = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
+    # the couple on gear b by gear a from the ratio constraint (the force part is zero)
+    couple_b = moment[j.id]
+    lever = _cross2(P - Ob, n)
+    F = (couple_b / lever)[:, None] * n          # on gear b, by gear a
+    force[j.id] = F
+    moment[j.id] = np.where(np.isfinite(couple_b), 0.0, np.nan)
+    for g, dF in ((b_name, -F), (a_name, F)):
+        ax = axle[g]
+        if ax.id not in force:
+            continue
+        # the axle's reported force is on its second link by its first
+        force[ax.id] = force[ax.id] + (dF if ax.links[1] == g else -dF)
 
 
 def _joint_point(S: PlanarSystem, q: np.ndarray, jid: str, side: int) -> np.ndarray:
