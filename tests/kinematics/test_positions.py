@@ -172,3 +172,51 @@ def test_assur_equals_newton_random_fourbars():
         first_gap = np.argmin(ok) if not ok.all() else len(ok)
         sl = slice(0, first_gap)
         assert np.abs(s1.points["M"].position[sl] - s2.points["M"].position[sl]).max() < 1e-10
+
+
+def scotch_yoke():
+    """Scotch yoke: crank pin B drives a block sliding vertically in a yoke that slides
+    horizontally on the frame (dyad R-P-P): yoke x = r cos(theta) + const."""
+    return mechanism_from_dict({
+        "name": "Scotch yoke", "ground": "frame", "links": ["frame", "crank", "block", "yoke"],
+        "joints": [
+            {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0], "actuated": True},
+            {"id": "B", "type": "R", "links": ["crank", "block"], "point": [0.6, 0.8]},
+            {"id": "S1", "type": "P", "links": ["block", "yoke"], "point": [0.6, 0.8], "axis": [0, 1]},
+            {"id": "S2", "type": "P", "links": ["frame", "yoke"], "point": [0.6, -1.5], "axis": [1, 0]},
+        ], "points": {"Y": {"link": "yoke", "at": [0.6, -1.5]}}}, "yoke")
+
+
+def crank_guide_prp():
+    """A crank carrying a guide; a block slides on it, pinned to a vertical slider at x = 2
+    (dyad P-R-P): the pin is at (2, 2 tan(theta))."""
+    return mechanism_from_dict({
+        "name": "crank guide", "ground": "frame", "links": ["frame", "crank", "block", "slider"],
+        "joints": [
+            {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0], "actuated": True},
+            {"id": "G", "type": "P", "links": ["crank", "block"], "point": [2, 1], "axis": [2, 1]},
+            {"id": "B", "type": "R", "links": ["block", "slider"], "point": [2, 1]},
+            {"id": "V", "type": "P", "links": ["frame", "slider"], "point": [2, 1], "axis": [0, 1]},
+        ]}, "prp")
+
+
+@pytest.mark.parametrize("method", ["assur", "newton"])
+def test_scotch_yoke_rpp(method):
+    m = scotch_yoke()
+    assert [s.kind for s in dyads.decompose(build_system(m)).steps] == ["drive_R", "RPP"]
+    sim = simulate(m, {"A": input_grid(0, 360, 15)}, points=["Y", "B"], method=method)
+    th = np.radians(sim.inputs["A"])
+    assert np.allclose(sim.points["Y"].position[:, 0], np.cos(th), atol=1e-12)
+    assert np.allclose(sim.points["Y"].position[:, 1], -1.5, atol=1e-12)
+    assert np.allclose(sim.points["Y"].velocity[:, 0], -np.sin(th), atol=1e-12)
+    assert np.allclose(sim.points["Y"].acceleration[:, 0], -np.cos(th), atol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["assur", "newton"])
+def test_crank_guide_prp(method):
+    m = crank_guide_prp()
+    assert [s.kind for s in dyads.decompose(build_system(m)).steps] == ["drive_R", "PRP"]
+    sim = simulate(m, {"A": input_grid(0, 60, 5)}, points=["B"], method=method)
+    th = np.radians(sim.inputs["A"])
+    assert np.allclose(sim.points["B"].position, np.stack([np.full_like(th, 2), 2 * np.tan(th)], 1), atol=1e-12)
+    assert np.allclose(sim.points["B"].velocity[:, 1], 2 / np.cos(th) ** 2, atol=1e-11)

@@ -3,8 +3,7 @@
 A mechanism of R and P pairs whose links can be found one driver at a time and then
 two at a time (a *dyad*: two links, three pairs, joined to links already known) is
 solved in closed form for all input values at once (Artobolevsky, *Theory of
-Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR; the rarer RPP and PRP
-are left to the Newton solver):
+Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR, RPP, PRP):
 
 * RRR: the middle joint ``B`` is the intersection of the circles ``|B - A| = L1`` and
   ``|B - C| = L2``: with ``d = C - A``, ``a = (L1^2 - L2^2 + |d|^2) / (2|d|)``,
@@ -12,6 +11,8 @@ are left to the Newton solver):
 * RRP / PRR: the intersection of a circle and a line, ``lambda^2 + 2 p lambda + c = 0``;
 * RPR: the slide line keeps the offset ``e`` from both pivots:
   ``cos(phi + nu - delta) = e / |C - A|``;
+* RPP / PRP: the orientations follow from the P pairs, the positions from two linear
+  equations ``n_1 . X = h_1``, ``n_2 . X = h_2`` (the two slide lines).
 
 The assembly mode ``sigma`` of each dyad is taken from the file's configuration, so the
 result equals the continuation of :func:`mechsyn.kinematics.solve.sweep` on that branch
@@ -118,8 +119,8 @@ def decompose(S: PlanarSystem) -> Plan | None:
                     continue
                 J3 = j3s[0]
                 types = "".join(_jtype(S, j) for j in (J1, J2, J3))
-                if types not in ("RRR", "RRP", "PRR", "RPR"):
-                    continue  # RPP, PRP, PPR, ...: left to the Newton solver
+                if types not in ("RRR", "RRP", "PRR", "RPR", "RPP", "PPR", "PRP"):
+                    continue  # PPP: not a dyad of a planar mechanism
                 k1 = (set(ends(J1)) - {b1}).pop()
                 k3 = (set(ends(J3)) - {b2}).pop()
                 steps.append(Step(types, (b1, b2), (k1, k3), (J1, J2, J3), {}))
@@ -311,9 +312,54 @@ def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: f
         _pin(st, b1, A, sA, phi1)
         _pin(st, b2, C, tC, phi1 + c)
         return sigma
-    if step.kind in ("RPP", "PRP"):
-        raise _NotHandled
+    if step.kind in ("RPP", "PPR"):
+        # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
+        if step.kind == "RPP":
+            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
+        else:
+            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+        phi_r = phi_p + _rel_angle(S, J2, lp, lr)
+        A = st.point(kr, _local(S, kr, Jr))
+        _pin(st, lr, A, _local(S, lr, Jr), phi_r)
+        w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
+        w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
+        st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
+        return 1.0
+    if step.kind == "PRP":
+        phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
+        phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
+        sB, tB = _local(S, b1, J2), _local(S, b2, J2)
+        w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
+        w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
+        B = _solve2(w1, h1, w2, h2)
+        _pin(st, b1, B, sB, phi1)
+        _pin(st, b2, B, tB, phi2)
+        return 1.0
     raise _NotHandled
+
+
+def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.ndarray,
+             s_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A P pair's line condition ``n . (P_b - P_a) = 0`` as ``n . X = h`` for the unknown
+    position ``X`` of the local point ``s_ref`` of a link whose angle ``phi_u`` is known."""
+    cu, su = _rot(phi_u)
+    if con.b == unknown:
+        _, pa = st.pose(con.a)
+        ca, sa_ = _rot(pa)
+        n = _apply(ca, sa_, con.w)
+        Pa = st.point(con.a, con.sa)
+        return n, _dot(n, Pa - _apply(cu, su, con.sb - s_ref))
+    n = _apply(cu, su, con.w)
+    Pb = st.point(con.b, con.sb)
+    return n, _dot(n, Pb - _apply(cu, su, con.sa - s_ref))
+
+
+def _solve2(w1: np.ndarray, h1: np.ndarray, w2: np.ndarray, h2: np.ndarray) -> np.ndarray:
+    """Solve ``w1 . X = h1``, ``w2 . X = h2`` (NaN where the two lines are parallel)."""
+    det = w1[:, 0] * w2[:, 1] - w1[:, 1] * w2[:, 0]
+    det = np.where(np.abs(det) < 1e-12, np.nan, det)
+    return np.stack([(h1 * w2[:, 1] - h2 * w1[:, 1]) / det, (w1[:, 0] * h2 - w2[:, 0] * h1) / det], axis=1)
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
