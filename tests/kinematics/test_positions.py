@@ -220,3 +220,25 @@ def test_crank_guide_prp(method):
     th = np.radians(sim.inputs["A"])
     assert np.allclose(sim.points["B"].position, np.stack([np.full_like(th, 2), 2 * np.tan(th)], 1), atol=1e-12)
     assert np.allclose(sim.points["B"].velocity[:, 1], 2 / np.cos(th) ** 2, atol=1e-11)
+
+
+@pytest.mark.parametrize("method", ["assur", "newton"])
+def test_slider_driven_slider_crank(ex, method):
+    """Driven by the slider (a P input, in length units): the crank angle follows from
+    the law of cosines, cos(theta) = (x^2 + r^2 - l^2) / (2 r x)."""
+    from mechsyn.io import mechanism_to_dict
+
+    d = mechanism_to_dict(ex("textbook/slider_crank.yaml"))
+    d["joints"][0].pop("actuated")
+    d["joints"][3]["actuated"] = True
+    m = mechanism_from_dict(d, "slider driven")
+    S = build_system(m)
+    assert [s.kind for s in dyads.decompose(S).steps] == ["drive_P", "RRR"]
+    assert np.isclose(S.drivers[0].assembled, m.joint("D").point[0])  # the slide coordinate is x
+    x = np.linspace(3.0, 3.9, 10)
+    sim = simulate(m, {"D": x}, points=["B", "C"], method=method)
+    assert np.allclose(sim.points["C"].position[:, 0], x, atol=1e-12)
+    r, l = 1.0, float(np.linalg.norm(m.joint("C").point - m.joint("B").point))
+    th = np.arccos((x ** 2 + r ** 2 - l ** 2) / (2 * r * x))
+    assert np.allclose(np.radians(sim.links["crank"].angle), th, atol=1e-10)
+    assert np.allclose(sim.points["C"].velocity[:, 0], 1.0, atol=1e-12)  # unit input speed

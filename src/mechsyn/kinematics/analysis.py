@@ -263,7 +263,7 @@ def _fast_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
     """Dead points (refined by Newton bisection) where the closed form stops assembling."""
     out = []
     ok = sw.assembled
-    for k in range(1, len(ok)):
+    for k in (np.flatnonzero(ok[1:] != ok[:-1]) + 1).tolist():
         if ok[k - 1] and not ok[k]:
             ul, _ = _limit(S, sw.q[k - 1], sw.inputs[k - 1], sw.inputs[k])
             out.append({"index": k, "kind": "dead point", "input": ul.tolist(),

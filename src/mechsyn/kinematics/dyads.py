@@ -489,20 +489,25 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
 def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
     """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
     N, nl = r.cos.shape
-    q = np.empty((N, S.n))
-    qd = np.empty((N, S.n))
-    qdd = np.empty((N, S.n))
+    # component-major buffers (returned transposed): every column written is contiguous
+    q = np.empty((S.n, N)).T
+    qd = np.empty((S.n, N)).T
+    qdd = np.empty((S.n, N)).T
     phi = np.arctan2(r.sin, r.cos)
     for i in range(nl):
         jid, sa = r.anchor[i]
         c, s = r.cos[:, i], r.sin[:, i]
-        rel = np.stack([-(c * sa[0] - s * sa[1]), -(s * sa[0] + c * sa[1])], axis=1)  # r - P_anchor
+        relx = -(c * sa[0] - s * sa[1])  # r - P_anchor
+        rely = -(s * sa[0] + c * sa[1])
         P, V, A = r.points[jid], r.velocities[jid], r.accelerations[jid]
         w, al = r.omega[:, i], r.alpha[:, i]
-        q[:, 3 * i:3 * i + 2] = P + rel
-        qd[:, 3 * i:3 * i + 2] = V + w[:, None] * np.stack([-rel[:, 1], rel[:, 0]], axis=1)
-        qdd[:, 3 * i:3 * i + 2] = (A + al[:, None] * np.stack([-rel[:, 1], rel[:, 0]], axis=1)
-                                   - (w ** 2)[:, None] * rel)
+        w2 = w * w
+        q[:, 3 * i] = P[:, 0] + relx
+        q[:, 3 * i + 1] = P[:, 1] + rely
+        qd[:, 3 * i] = V[:, 0] - w * rely
+        qd[:, 3 * i + 1] = V[:, 1] + w * relx
+        qdd[:, 3 * i] = A[:, 0] - al * rely - w2 * relx
+        qdd[:, 3 * i + 1] = A[:, 1] + al * relx - w2 * rely
         qd[:, 3 * i + 2], qdd[:, 3 * i + 2] = w, al
     # angles: drivers' links take the input itself, dyad links are made continuous
     drive_links = {}
@@ -530,8 +535,9 @@ def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResul
             prev = block[-1]
         phi[:, others] = sub
     q[:, 2:3 * nl:3] = phi
-    for a in (q, qd, qdd):
-        a[~ok] = np.nan
+    if not ok.all():
+        for a in (q, qd, qdd):
+            a[~ok] = np.nan
     return q, qd, qdd
 
 
