@@ -76,3 +76,27 @@ def test_bad_vll_options(ex):
         build_system(m, vll={"S": "floppy"})
     with pytest.raises(MechsynInputError, match="no joint"):
         build_system(m, vll={"Z": "locked"})
+
+
+def test_three_phalanx_forces_both_modes(ex):
+    """Virtual power balance of the three-phalanx finger, locked and free (prescribed)."""
+    from mechsyn.io import mechanism_to_dict, mechanism_from_dict
+    from mechsyn.kinematics.analysis import forces
+
+    d = mechanism_to_dict(ex("fingers/three_phalanx_vll_000.yaml"))
+    d["loads"] = [{"link": "distal", "force": [-2.0, 0.5], "at": [0, 95]}]
+    m = mechanism_from_dict(d, "three")
+    locked = forces(m, {"F": np.linspace(0, 20, 5)}, static=True)
+    free = forces(m, {"F": np.linspace(0, 20, 5), "S1": np.linspace(28.8, 27, 5), "S2": np.full(5, 32.0)},
+                  vll={"S1": "free", "S2": "free"}, static=True)
+    for fa in (locked, free):
+        sim = fa.simulation
+        S, sw = sim.system, sim.sweep
+        tip = S.point_state(sw.q, sw.qd, sw.qdd, S.index("distal"), S.to_local("distal", np.array([0.0, 95.0])))
+        power = tip[1] @ np.array([-2.0, 0.5])
+        for k, dr in enumerate(S.drivers):
+            power = power + fa.reactions.effort[dr.joint] * sw.speeds[k]
+        assert np.abs(power).max() < 1e-9 * np.abs(tip[1]).max() * 2
+    # locked: the VLLs carry axial force; free: their "drive" force is what a spring must give
+    assert set(free.reactions.effort) == {"F", "S1", "S2"}
+    assert np.abs(locked.reactions.force["S1"]).max() > 0
