@@ -24,7 +24,7 @@ def test_triple_rocker_dead_points(ex, method):
     assert np.array_equal(sim.assembled, expected), x[sim.assembled != expected]
     dead = sorted(e["input"]["A"] for e in sim.events if e["kind"] == "dead point")
     assert len(dead) == 2
-    assert abs(dead[0] - lim) < 0.01 and abs(dead[1] - (360 - lim)) < 0.01
+    assert abs(dead[0] - lim) < 1e-6 and abs(dead[1] - (360 - lim)) < 1e-6
     # not assembled: NaN (null in JSON), never a wrong number
     assert np.isnan(sim.points["C"].position[~expected]).all()
     assert np.isfinite(sim.points["C"].position[expected]).all()

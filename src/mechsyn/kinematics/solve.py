@@ -253,11 +253,17 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
     return _track(S, qm, um, ub, depth - 1)
 
 
-def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 24) -> tuple[np.ndarray, np.ndarray]:
+def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
     for _ in range(iters):
         um = (ua + ub) / 2
         qm = _track(S, q, ua, um, depth=3)
+        if qm is None:
+            # near the fold Newton converges only linearly: give it room (no branch check,
+            # both branches meet there)
+            qm, ok = newton(S, q, um, max_iter=60)
+            if not ok:
+                qm = None
         if qm is None:
             ub = um
         else:
