@@ -314,6 +314,15 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
         u = inputs[i]
         if cur is not None and i > 0:
             nxt = _track(S, cur, cur_u, u, X=X)
+            if nxt is None and np.isfinite(sig[i - 1]) and sig[i - 1] < 1e-6:
+                # leaving a singular (change / branch) point: the predictor has no unique
+                # direction; let Newton pick the continuation and say so
+                cand, ok = newton(S, cur + X @ (u - cur_u), u, max_iter=40)
+                if ok:
+                    nxt = cand
+                    events.append({"index": i, "kind": "branch point", "input": cur_u.tolist(),
+                                   "message": "continued past a singular configuration (change or branch "
+                                              "point) by Newton: the assembly branch may have switched"})
             if nxt is None:
                 if refine_limits:
                     ul, _ = _limit(S, cur, cur_u, u)
@@ -361,4 +370,10 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
         if progress is not None:
             progress()
     assembled = np.all(np.isfinite(q), axis=1)
+    for i in np.flatnonzero(np.isfinite(sig) & (sig < 1e-6)).tolist():
+        events.append({"index": i, "kind": "singular", "input": inputs[i].tolist(),
+                       "message": f"near-singular configuration (pivot ratio {sig[i]:.1e}): a change, branch or "
+                                  "dead point; the branch may switch here and positions are accurate only to "
+                                  "about the square root of the solver tolerance"})
+    events.sort(key=lambda e: e["index"])
     return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)
