@@ -253,6 +253,15 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
     return _track(S, qm, um, ub, depth - 1)
 
 
+def _turns(S: PlanarSystem, u: np.ndarray) -> np.ndarray:
+    """Whole turns (as radians) between R inputs ``u`` and the file's values."""
+    out = np.zeros(len(S.drivers))
+    for k, d in enumerate(S.drivers):
+        if d.type == "R":
+            out[k] = 2 * np.pi * np.round((u[k] - d.assembled) / (2 * np.pi))
+    return out
+
+
 def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
     for _ in range(iters):
@@ -292,6 +301,15 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     N, k = inputs.shape
     if k != len(S.drivers):
         raise ValueError(f"expected {len(S.drivers)} input columns, got {k}")
+    # an R input differing from the file's angle by whole turns is the same configuration:
+    # start from the equivalent value nearest the file's (a full turn could cross a toggle)
+    shift = _turns(S, inputs[0])
+    if np.any(shift):
+        sw = sweep(S, inputs - shift, speeds, progress, refine_limits)
+        sw.inputs = inputs
+        for e in sw.events:
+            e["input"] = (np.asarray(e["input"]) + shift).tolist()
+        return sw
     speeds = np.ones(k) if speeds is None else np.asarray(speeds, float)
     q_start = assemble(S)
     q = np.full((N, S.n), np.nan)
