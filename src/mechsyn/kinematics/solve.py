@@ -307,6 +307,13 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     if np.any(shift):
         sw = sweep(S, inputs - shift, speeds, progress, refine_limits)
         sw.inputs = inputs
+        # a link driven from the frame takes the input's own turn count (same positions)
+        for con in S.cons:
+            if con.role == "drive" and con.kind == "angle" and shift[con.driver]:
+                if con.a < 0 and con.b >= 0:
+                    sw.q[:, 3 * con.b + 2] += shift[con.driver]
+                elif con.b < 0 and con.a >= 0:
+                    sw.q[:, 3 * con.a + 2] -= shift[con.driver]
         for e in sw.events:
             e["input"] = (np.asarray(e["input"]) + shift).tolist()
         return sw
