@@ -31,7 +31,7 @@ import numpy as np
 
 from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
 
-__all__ = ["Plan", "decompose", "solve_positions", "solve_all"]
+__all__ = ["Plan", "decompose", "solve_positions", "solve_all", "fast_chain", "ChainResult"]
 
 
 @dataclass(frozen=True)
@@ -407,66 +407,6 @@ def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
     return q, out_sig
 
 
-def closed_form_rates(S: PlanarSystem, plan: Plan, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Velocities and accelerations of driver-R + RRR chains in closed form (all inputs)."""
-    N = q.shape[0]
-    nl = len(S.links)
-    v = np.zeros((N, nl, 2))
-    w = np.zeros((N, nl))
-    a = np.zeros((N, nl, 2))
-    al = np.zeros((N, nl))
-
-    def pt(i: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        if i < 0:
-            P = np.broadcast_to(s, (N, 2))
-            z = np.zeros((N, 2))
-            return P, z, z
-        r, phi = q[:, 3 * i:3 * i + 2], q[:, 3 * i + 2]
-        c, sn = _rot(phi)
-        As = _apply(c, sn, s)
-        return (r + As, v[:, i] + w[:, i, None] * _perp(As),
-                a[:, i] + al[:, i, None] * _perp(As) - (w[:, i] ** 2)[:, None] * As)
-
-    def set_from(i: int, P: np.ndarray, VP: np.ndarray, AP: np.ndarray) -> None:
-        rel = q[:, 3 * i:3 * i + 2] - P
-        v[:, i] = VP + w[:, i, None] * _perp(rel)
-        a[:, i] = AP + al[:, i, None] * _perp(rel) - (w[:, i] ** 2)[:, None] * rel
-
-    for step in plan.steps:
-        if step.kind == "drive_R":
-            (new,), (k,), (jid,) = step.links, step.known, step.joints
-            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
-            sgn = 1.0 if con.b == new else -1.0
-            wk = np.zeros(N) if k < 0 else w[:, k]
-            alk = np.zeros(N) if k < 0 else al[:, k]
-            w[:, new] = wk + sgn * speeds[con.driver]
-            al[:, new] = alk
-            P, VP, AP = pt(k, _local(S, k, jid))
-            set_from(new, P, VP, AP)
-        else:  # RRR
-            (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-            A, VA, AA = pt(k1, _local(S, k1, J1))
-            C, VC, AC = pt(k3, _local(S, k3, J3))
-            r1, p1 = q[:, 3 * b1:3 * b1 + 2], q[:, 3 * b1 + 2]
-            c1, s1 = _rot(p1)
-            B = r1 + _apply(c1, s1, _local(S, b1, J2))
-            e1, e2 = B - A, B - C
-            den = _cross(e1, e2)
-            dv = VC - VA
-            w1 = _dot(dv, e2) / den
-            w2 = _dot(dv, e1) / den
-            da = AC - AA - (w2 ** 2)[:, None] * e2 + (w1 ** 2)[:, None] * e1
-            w[:, b1], w[:, b2] = w1, w2
-            al[:, b1], al[:, b2] = _dot(da, e2) / den, _dot(da, e1) / den
-            set_from(b1, A, VA, AA)
-            set_from(b2, C, VC, AC)
-    qd = np.zeros((N, S.n))
-    qdd = np.zeros((N, S.n))
-    qd[:, 0:3 * nl:3], qd[:, 1:3 * nl:3], qd[:, 2:3 * nl:3] = v[:, :, 0], v[:, :, 1], w
-    qdd[:, 0:3 * nl:3], qdd[:, 1:3 * nl:3], qdd[:, 2:3 * nl:3] = a[:, :, 0], a[:, :, 1], al
-    return qd, qdd
-
-
 def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
               chunk: int = 20000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Positions, velocities, accelerations (N, n) for all inputs (closed form where possible)."""
@@ -576,7 +516,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     except for the input angles. RRR: ``B = A + f d + sigma g R90 d`` with ``d = C - A``,
     ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g = sqrt(L1^2 / |d|^2 - f^2)``; rates:
     ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``omega_2 = (v_C - v_A) . e1 / (e1 x e2)``
-    and likewise for the accelerations (see :func:`closed_form_rates`). The work is done
+    and likewise for the accelerations. The work is done
     in chunks that stay in the processor's cache.
     """
     U = np.atleast_2d(np.asarray(U, float))

@@ -280,13 +280,6 @@ def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters
     return ua, q
 
 
-def _sigma(S: PlanarSystem, q: np.ndarray) -> tuple[float, float]:
-    J = S.jacobian(q[None])[0]
-    sv = np.linalg.svd(J, compute_uv=False)
-    sign = float(np.sign(np.linalg.det(J))) if J.shape[0] == J.shape[1] else 0.0
-    return sign, float(sv.min() / max(sv.max(), 1e-300))
-
-
 def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
           progress=None, refine_limits: bool = True) -> Sweep:
     """Positions, velocities, accelerations over input values (N, n_inputs), by continuation.

@@ -225,6 +225,10 @@ class PlanarSystem:
         return (r + As, v + w[:, None] * _perp(As),
                 a + al[:, None] * _perp(As) - (w ** 2)[:, None] * As)
 
+    def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
+        """Angles (N,) of link index ``i`` (frame: zeros)."""
+        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
+
     def link_angle(self, q: np.ndarray, link: str) -> np.ndarray:
         i = self.index(link)
         return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
@@ -456,11 +460,6 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
     raise AssertionError(k)
 
 
-def _link_angle_i(self: PlanarSystem, q: np.ndarray, i: int) -> np.ndarray:
-    return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
-
-
-PlanarSystem.link_angle_i = _link_angle_i  # type: ignore[attr-defined]
 
 
 # --------------------------------------------------------------------------- building
