@@ -556,11 +556,13 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     fixed = {}
     for j in S.mech.joints:
         fixed[j.id] = j.point
+    filled: set[str] = set()
     err = np.seterr(invalid="ignore", divide="ignore")
     try:
         for start in range(0, N, chunk):
             sl = slice(start, min(N, start + chunk))
             n = sl.stop - sl.start
+            written: set[str] = set()    # joints whose outputs were computed in place
             rot: dict[int, list] = {}    # link -> [c, s] (lazy) or a recipe
             rate: dict[int, tuple] = {}  # link -> (omega, alpha)
             jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
@@ -645,8 +647,13 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
                     e1x -= g * dy
                     e1y = f * dy
                     e1y += g * dx
-                    Bx = e1x + A[0]
-                    By = e1y + A[1]
+                    if J2 in jpos:  # straight into the output buffers
+                        Bx = np.add(e1x, A[0], out=jpos[J2][sl, 0])
+                        By = np.add(e1y, A[1], out=jpos[J2][sl, 1])
+                        written.add(J2)
+                    else:
+                        Bx = e1x + A[0]
+                        By = e1y + A[1]
                     e2x = Bx - C[0]
                     e2y = By - C[1]
                     rot[b1] = ("vec", e1x, e1y, bv1)
@@ -676,11 +683,13 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
                         a2 += day * e1y
                         a2 *= den
                         rate[b1], rate[b2] = (w1, a1), (w2, a2)
-                        VBx = A[2] - w1 * e1y
-                        VBy = A[3] + w1 * e1x
-                        ABx = A[4] - a1 * e1y
+                        outs = ((jvel[J2][sl, 0], jvel[J2][sl, 1], jacc[J2][sl, 0], jacc[J2][sl, 1])
+                                if J2 in jpos else (None,) * 4)
+                        VBx = np.subtract(A[2], w1 * e1y, out=outs[0])
+                        VBy = np.add(A[3], w1 * e1x, out=outs[1])
+                        ABx = np.subtract(A[4], a1 * e1y, out=outs[2])
                         ABx -= w1s * e1x
-                        ABy = A[5] + a1 * e1x
+                        ABy = np.add(A[5], a1 * e1x, out=outs[3])
                         ABy -= w1s * e1y
                         jst[J2] = (Bx, By, VBx, VBy, ABx, ABy)
                     else:
@@ -692,8 +701,17 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
                 for i in range(nl):
                     w_out[sl, i], al_out[sl, i] = rate[i]
             for jid in want:
+                if jid in written or jid in filled:
+                    continue
                 if jid in jst:
                     P = jst[jid]
+                    if not isinstance(P[0], np.ndarray):  # a point of the frame: fill once
+                        jpos[jid][:, 0], jpos[jid][:, 1] = P[0], P[1]
+                        if rates:
+                            jvel[jid][:] = 0.0
+                            jacc[jid][:] = 0.0
+                        filled.add(jid)
+                        continue
                 else:
                     j = S.mech.joint(jid)
                     side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
