@@ -145,6 +145,16 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
     """
     mm = mm or mass_model(S)
     loads = loads if loads is not None else loads_from_file(S, mm)
+    N = q.shape[0]
+    chunk = 20000
+    if N > chunk:  # bounded memory: the Jacobians are (N, m, n)
+        parts = [kinetostatics(S, q[k:k + chunk], None if qd is None else qd[k:k + chunk],
+                               None if qdd is None else qdd[k:k + chunk], gravity, mm, loads)
+                 for k in range(0, N, chunk)]
+        cat = lambda name: {j: np.concatenate([getattr(p, name)[j] for p in parts])  # noqa: E731
+                            for j in getattr(parts[0], name)}
+        return Reactions(cat("force"), cat("moment"), cat("effort"), parts[0].effort_kind,
+                         any(p.indeterminate for p in parts), np.concatenate([p.lam for p in parts]))
     ok = np.all(np.isfinite(q), axis=1)
     N = q.shape[0]
     lam = np.full((N, S.m), np.nan)
