@@ -387,8 +387,23 @@ class _Builder:
                                      "list points round the whole cam")
                 attrs["profile"] = [[float(x) for x in p] for p in pts]
             else:
-                c = self.vector(entry.profile.center, path + ["profile", "center"], "profile centre")
-                attrs["profile"] = {"center": [float(x) for x in c], "radius": float(entry.profile.radius)}
+                prof = entry.profile
+                c = self.vector(prof.center, path + ["profile", "center"], "profile centre")
+                if (prof.radius is None) == (prof.polar is None):
+                    raise self.error(path + ["profile"], "a cam profile needs either radius or polar",
+                                     "write {center: [x, y], radius: r} or {center: [x, y], polar: '1 + 0.2*cos(t)'}")
+                if prof.radius is not None:
+                    attrs["profile"] = {"center": [float(x) for x in c], "radius": float(prof.radius)}
+                else:
+                    from mechsyn.kinematics.expr import ExpressionError, polar_points
+
+                    try:
+                        pts = polar_points(prof.polar, c)
+                    except ExpressionError as exc:
+                        raise self.error(path + ["profile", "polar"], str(exc),
+                                         "use t, pi, numbers, + - * / **, sin, cos, tan, exp, sqrt, abs") from None
+                    attrs["profile"] = {"center": [float(x) for x in c], "polar": prof.polar,
+                                        "points": pts.tolist()}
         return Joint(
             id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
             axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
@@ -530,7 +545,8 @@ def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
     if j.actuated:
         d["actuated"] = True
     if j.attrs.get("profile") is not None:
-        d["profile"] = j.attrs["profile"]
+        prof = j.attrs["profile"]
+        d["profile"] = {k: v for k, v in prof.items() if k != "points"} if isinstance(prof, dict) else prof
     if j.attrs.get("description"):
         d["description"] = j.attrs["description"]
     return d

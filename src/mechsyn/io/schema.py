@@ -40,10 +40,13 @@ class LinkEntry(BaseModel):
 
 
 class CamProfile(_Strict):
-    """A circular cam profile (disc or eccentric)."""
+    """A cam profile about a centre: a disc (``radius``) or a polar function ``polar`` of
+    the angle ``t`` (radians, from the x axis of the assembled configuration), e.g.
+    ``"1 + 0.2*sin(t)**2"``: the profile points are ``center + r(t) (cos t, sin t)``."""
 
     center: list[float]
-    radius: float = Field(gt=0)
+    radius: float | None = Field(None, gt=0, description="Radius of a disc (eccentric) cam.")
+    polar: str | None = Field(None, description="r(t): +, -, *, /, **, sin, cos, tan, exp, sqrt, abs, pi, t.")
 
 
 class LoadEntry(_Strict):
@@ -91,7 +94,8 @@ class JointEntry(_Strict):
     profile: "CamProfile | list[list[float]] | None" = Field(
         None, description=(
             "cam: the profile fixed on the first link, in the assembled configuration: "
-            "{center: [x, y], radius: r} (a disc, e.g. an eccentric) or a closed list of points [[x, y], ...] "
+            "{center: [x, y], radius: r} (a disc, e.g. an eccentric), {center: [x, y], polar: 'r(t)'} "
+            "(a function of the angle t) or a closed list of points [[x, y], ...] "
             "(interpolated by a periodic cubic spline)."),
     )
     description: str | None = None

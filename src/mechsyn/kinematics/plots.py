@@ -63,7 +63,9 @@ def _draw_mechanism(ax, sim, k: int, color: str = "0.2", alpha: float = 1.0) -> 
         q = sim.sweep.q[k:k + 1]
         prof = j.attrs.get("profile")
         a_name = j.links[0]
-        if isinstance(prof, dict):
+        if isinstance(prof, dict) and "points" in prof:
+            pts = np.vstack([prof["points"], prof["points"][:1]])
+        elif isinstance(prof, dict):
             t = np.linspace(0, 2 * np.pi, 121)
             pts = np.asarray(prof["center"]) + prof["radius"] * np.stack([np.cos(t), np.sin(t)], 1)
         else:

@@ -107,6 +107,8 @@ def _cam_curve(profile: Any, center_local: np.ndarray, rho: float, contact_local
     """Build the offset curve followed by the roller centre from the joint's profile."""
     from scipy.interpolate import make_interp_spline
 
+    if isinstance(profile, dict) and "points" in profile:  # a polar function, sampled
+        profile = profile["points"]
     if isinstance(profile, dict):
         c = to_local(np.asarray(profile["center"], float))
         r = float(profile["radius"])
