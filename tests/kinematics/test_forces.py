@@ -52,6 +52,7 @@ def test_virtual_work_crank_rocker(ex, gravity, static):
     ("textbook/slider_crank.yaml", {"A": input_grid(0, 360, 20)}, None),
     ("kinematics/inverted_slider_crank.yaml", {"A": input_grid(0, 360, 20)}, None),
     ("kinematics/cam_roller.yaml", {"O": input_grid(0, 360, 20)}, None),
+    ("kinematics/cam_polar.yaml", {"O": input_grid(0, 360, 20)}, None),
     ("textbook/watt_sixbar.yaml", {"A": input_grid(60, 110, 5)}, None),
     ("textbook/stephenson_sixbar.yaml", {"A": input_grid(60, 110, 5)}, None),
     ("textbook/five_bar_5r.yaml", {"A": np.linspace(100, 120, 6), "E": np.linspace(60, 75, 6)}, None),

@@ -14,6 +14,7 @@ CASES = [
     ("textbook/slider_crank.yaml", {"A": 200.0}, None),
     ("kinematics/inverted_slider_crank.yaml", {"A": 123.0}, None),
     ("kinematics/cam_roller.yaml", {"O": 140.0}, None),
+    ("kinematics/cam_polar.yaml", {"O": 125.0}, None),
     ("textbook/watt_sixbar.yaml", {"A": 80.0}, None),
     ("textbook/stephenson_sixbar.yaml", {"A": 75.0}, None),
     ("textbook/five_bar_5r.yaml", {"A": 110.0, "E": 70.0}, None),
