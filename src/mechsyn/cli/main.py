@@ -12,6 +12,7 @@ from mechsyn.errors import MechsynInputError
 
 # Command modules (each registers its commands on the app when imported).
 from mechsyn.cli import version as _version  # noqa: F401
+from mechsyn.cli import atlas as _atlas  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
