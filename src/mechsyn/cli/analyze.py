@@ -1,0 +1,144 @@
+"""``mechsyn analyze FILE``: structural analysis by the papers' formulas, and ``mechsyn schema``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+from rich.panel import Panel
+from rich.table import Table
+
+from mechsyn.cli.app import app
+from mechsyn.cli.common import console, emit_json
+from mechsyn.io import json_schema, load_mechanism
+from mechsyn.results import to_jsonable, write_atomic
+from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
+from mechsyn.structure.remedies import Remedy, find_remedies
+from mechsyn.structure.report import pair_list, to_markdown
+
+
+SHORT_TITLES = {
+    "chebyshev": "Chebyshev", "grubler": "Grübler", "malyshev": "Malyshev",
+    "somov_malyshev": "Somov-Malyshev", "gokhman_contours": "Gokhman K", "scheme_check": "scheme check",
+    "ozol_redundant": "Ozol q", "redundant_from_mobility": "S from W",
+}
+
+
+def _fmt(x: float | None) -> str:
+    if x is None:
+        return "n/a"
+    return str(int(x)) if float(x).is_integer() else f"{x:g}"
+
+
+def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
+    pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
+    console.print(Panel.fit(
+        f"[bold]{title_prefix}{a.name}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
+        f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
+    ))
+    t = Table(title="Formulas", show_lines=False)
+    t.add_column("formula", no_wrap=True)
+    t.add_column("expression", no_wrap=True)
+    t.add_column("value", justify="right")
+    for key, f in a.formulas.items():
+        t.add_row(SHORT_TITLES.get(key, key), f.expression, _fmt(f.value))
+    console.print(t)
+    if a.contours:
+        c = Table(title="Contours (paper 003, sequential reading)")
+        for col in ("#", "joints", "new pairs", "n_j", "n_k", "S_j", "idle", "T_j", "Z_j", "A_j"):
+            c.add_column(col, justify="right" if col not in ("joints", "new pairs") else "left")
+        for r in a.contours:
+            c.add_row(f"{r.index}{'' if r.from_file else '*'}", " ".join(r.joints), pair_list(r.new_pairs),
+                      str(r.n_j), str(r.n_k), str(r.S), str(r.idle_mobilities), _fmt(r.T), str(r.Z), str(r.A))
+        console.print(c)
+        if a.contours_chosen_by_program:
+            console.print("  * contour chosen by the program")
+        for r in a.contours:
+            console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
+    console.print(
+        f"S_Σ = {a.structural_redundancy} ({a.redundant_constraints} redundant constraints, "
+        f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
+        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
+        soft_wrap=True)
+    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({a.mobility_source});  "
+                  f"drives: {a.degrees_of_mobility_expression}", highlight=False, soft_wrap=True)
+    if a.external is not None:
+        e = a.external
+        console.print(f"external (paper 002): S_a = {e.S_a}, W_f = {e.W_f}, W_rob = {e.W_rob}, "
+                      f"W_a = {e.W_a}, S_ai = {e.S_ai}", highlight=False)
+        console.print(f"  {e.external_redundant.expression}\n  {e.system_redundant.expression}", highlight=False)
+    for n in a.notes:
+        console.print(f"[dim]note:[/] {n}", highlight=False, soft_wrap=True)
+    for name, sub in a.states.items():
+        console.print()
+        render(sub, title_prefix=f"state '{name}': ")
+
+
+def render_remedies(remedies: list[Remedy]) -> None:
+    t = Table(title="Remedies (pair-class changes; fewest changes first)")
+    t.add_column("#", justify="right")
+    t.add_column("changes")
+    t.add_column("S_j after", justify="right")
+    t.add_column("W after")
+    for k, r in enumerate(remedies, 1):
+        t.add_row(str(k), "\n".join(c.describe() for c in r.changes),
+                  ", ".join(str(x.S) for x in r.analysis.contours),
+                  r.analysis.formulas["somov_malyshev"].expression)
+    if not remedies:
+        console.print("No class-change remedy: nothing to remedy, or a planar mechanism "
+                      "(its pairs' planar classes are fixed).")
+    else:
+        console.print(t)
+        left = remedies[0].analysis.metric_constraints
+        if left:
+            console.print(f"note: {left:g} metric constraint(s) remain in every variant: class changes cannot "
+                          "remove them; change the structure (e.g. replace the duplicating link by a two-link "
+                          "group, as paper 003 does for fig. 4).", highlight=False)
+
+
+@app.command("analyze")
+def analyze(
+    file: Annotated[Path, typer.Argument(help="Mechanism file (YAML or JSON).")],
+    json_out: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
+    markdown: Annotated[bool, typer.Option("--markdown", help="Print a Markdown report.")] = False,
+    remedies: Annotated[bool, typer.Option("--remedies", help="List pair-class changes that remove redundant constraints and idle mobilities.")] = False,
+    max_variants: Annotated[int, typer.Option("--max-variants", min=1, help="Remedy variants to list.")] = 10,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Write the JSON or Markdown to this file instead.")] = None,
+) -> None:
+    """Structural analysis: mobility by the classic formulas (Chebyshev, Grübler, Malyshev,
+    Somov-Malyshev, Gokhman, Ozol), paper 003's per-contour redundant constraints, idle
+    mobilities, redundant links, metric constraints and drives, and each state of a
+    variable-structure mechanism with paper 002's external constraints."""
+    mech = load_mechanism(file)
+    result = analyze_structure(mech)
+    rem = find_remedies(mech, max_variants=max_variants) if remedies else None
+    if json_out:
+        data = to_jsonable(result)
+        if rem is not None:
+            data["remedies"] = [to_jsonable(r) for r in rem]
+        emit_json(data, out)
+    elif markdown:
+        text = to_markdown(result, rem)
+        if out is None:
+            typer.echo(text, nl=False)
+        else:
+            write_atomic(out, text)
+    else:
+        render(result)
+        if rem is not None:
+            console.print()
+            render_remedies(rem)
+
+
+@app.command("schema")
+def schema(
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Write the schema to this file.")] = None,
+) -> None:
+    """Print the JSON Schema of mechanism files."""
+    text = json.dumps(json_schema(), indent=2)
+    if out is None:
+        typer.echo(text)
+    else:
+        write_atomic(out, text + "\n")
