@@ -113,3 +113,21 @@ def test_mechanism_dict_frame_choice():
     assert doc["ground"] == "L1"
     act = [j for j in doc["joints"] if j.get("actuated")]
     assert act[0]["links"] == ["L1", "L3"]
+
+
+@pytest.mark.parametrize("n,f", [(8, 1), (7, 2)])
+def test_mechanism_files_pass_analyze(tmp_path, capsys, n, f):
+    """Every chain's mechanism file loads with the model and `mechsyn analyze` finds
+    the chain's mobility."""
+    from mechsyn.io import load_mechanism
+
+    assert main(["atlas", "-n", str(n), "-F", str(f), "--mechanisms", str(tmp_path)]) == 0
+    capsys.readouterr()
+    files = sorted(tmp_path.glob("*.yaml"))
+    assert len(files) == {8: 16, 7: 4}[n]
+    for path in files:
+        mech = load_mechanism(path)
+        assert mech.n_moving == n - 1
+        assert sum(j.actuated for j in mech.joints) == f
+        assert main(["analyze", str(path), "--json"]) == 0
+        assert json.loads(capsys.readouterr().out)["mobility"] == f
