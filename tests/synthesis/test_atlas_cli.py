@@ -28,9 +28,10 @@ def test_six_bar_inversions_watt_2_stephenson_3():
     assert by_triangles == {"watt": 2, "stephenson": 3}
 
 
-def test_eight_link_inversions_total_71():
-    # 71 distinct eight-link single-dof mechanisms by choice of frame (literature)
-    assert sum(len(frame_orbits(c)) for c in synthesize_chains(8, 1)) == 71
+@pytest.mark.parametrize("n,total", [(4, 1), (6, 5), (8, 71), (10, 1834)])
+def test_inversions_by_choice_of_frame(n, total):
+    # distinct single-dof mechanisms by choice of frame: 1, 5, 71, 1834 (literature)
+    assert sum(len(frame_orbits(c)) for c in synthesize_chains(n, 1)) == total
 
 
 def test_mechanisms_with_input_are_orbit_representatives():

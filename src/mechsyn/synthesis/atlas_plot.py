@@ -83,14 +83,16 @@ def atlas_figure(chains: Sequence[KinematicChain], title: str, columns: int | No
     n = len(chains)
     columns = columns or (2 if n <= 4 else 4)
     rows = max(1, math.ceil(n / columns))
-    fig, axes = plt.subplots(rows, columns, figsize=(columns * 3.6, rows * 1.95 + 0.5),
-                             squeeze=False)
+    height = rows * 1.95 + 0.5
+    fig, axes = plt.subplots(rows, columns, figsize=(columns * 3.6, height), squeeze=False)
     for i, ax in enumerate(axes.flat):
         if i < n:
             draw_chain(ax, chains[i], number=i + 1)
         else:
             ax.axis("off")
-    fig.suptitle(title + "   (left: graph, node = link, edge = joint; right: kinematic "
-                 "sketch; B/T/Q = binary/ternary/quaternary links)", fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 1 - 0.35 / (rows * 1.95 + 0.5)))
+    fig.suptitle(title + "\n(left: graph, node = link, edge = joint; right: kinematic "
+                 "sketch; B/T/Q/P = binary/ternary/quaternary/pentagonal links)",
+                 fontsize=9, y=1 - 0.08 / height, va="top")
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.1 / height, top=1 - 0.5 / height,
+                        wspace=0.05, hspace=0.25)
     return fig
