@@ -98,3 +98,14 @@ def test_finger_bad_input(capsys):
     assert "nothing to attach" in capsys.readouterr().err
     with pytest.raises(MechsynInputError):
         synthesize_fingers(load_mechanism(EX.parent / "structural" / "gripper_003.yaml"))
+
+
+def test_three_phalanx_two_separate_groups():
+    """Paper 000 step 6: W0 - 1 = 2 groups of W_f = -1 each instead of one group."""
+    s = synthesize_fingers(load_mechanism(EX / "three_phalanx_base_000.yaml"), 1, 4,
+                           separate=True)
+    kinds = {r.groups for r in s.results}
+    assert ((1, 2), (1, 2)) in kinds
+    for r in s.results:
+        assert len(r.groups) == 2 and r.mobility_locked == 1
+        assert sum(3 * n - 2 * p for n, p in r.groups) == -2

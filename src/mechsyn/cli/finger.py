@@ -20,6 +20,8 @@ def finger(
     out: Optional[Path] = typer.Option(
         None, "--out", "-o", help="Directory for one mechanism file per result + drawing."),
     json_out: bool = typer.Option(False, "--json", help="Print JSON."),
+    separate: bool = typer.Option(
+        False, "--separate", help="Attach W0 - A groups of W_f = -1 instead of one group."),
 ) -> None:
     """Attach a group of links to the finger's free leashes so that it is fully actuated
     with its variable-length links (VLL) locked; list VLL candidates (paper 000)."""
@@ -28,7 +30,7 @@ def finger(
     from mechsyn.synthesis.finger import synthesize_fingers
 
     mech = load_mechanism(base)
-    synth = synthesize_fingers(mech, actuators, max_links)
+    synth = synthesize_fingers(mech, actuators, max_links, separate=separate)
     files = []
     if out is not None:
         from dataclasses import replace
@@ -54,13 +56,13 @@ def finger(
     console.print("admissible groups: " + ", ".join(
         f"n_f={r.n_f}, P_f={r.P_f}, m_f={r.m_f}" for r in synth.groups), highlight=False)
     t = Table(title=f"{len(synth.results)} distinct fingers")
-    for col in ("#", "n_f", "P_f", "attached to", "structure (VLL locked)", "VLL candidates",
+    for col in ("#", "groups (n_f, P_f)", "attached to", "structure (VLL locked)", "VLL candidates",
                 "W with VLL free"):
         t.add_column(col)
     for r in synth.results:
         free = "; ".join(f"{'+'.join(c.links)}: {c.underactuated_mobility}"
                          for c in r.vll_combinations if len(c.links) == 1)
-        t.add_row(str(r.number), str(r.n_f), str(r.P_f),
+        t.add_row(str(r.number), " + ".join(f"({n}, {p})" for n, p in r.groups),
                   ", ".join(f"{k}: {'/'.join(v)}" for k, v in r.attachments.items()),
                   r.structural_formula, ", ".join(r.vll_candidates), free)
     console.print(t)

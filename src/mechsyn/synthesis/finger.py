@@ -25,8 +25,8 @@ Steps (spec ``structural.md`` section 4, paper 000 steps 1-7):
    becomes two links and a prismatic pair: ``+3 - 2``) gives the underactuated mobility
    ``A + k``.
 
-Only one attached group is built (the paper also allows ``W0 - 1`` groups of
-``W_f = -1`` each; not enumerated here).
+One group is attached, or with ``separate`` the paper's alternative of ``W0 - A``
+groups of ``W_f = -1`` each (``W0 - 1`` for one drive).
 """
 
 from __future__ import annotations
@@ -61,6 +61,7 @@ class FingerResult:
     n_f: int
     P_f: int
     group_links: tuple[str, ...]
+    groups: tuple[tuple[int, int], ...]  # (n_f, P_f) of each attached group
     group_pairs: tuple[tuple[str, str], ...]  # (a, b) link pairs of the group's joints
     attachments: dict[str, list[str]]  # base link -> group links jointed to it
     mobility_locked: int
@@ -125,10 +126,15 @@ def _certificate(names: list[str], edges: list[tuple[str, str]], colours: list[s
 
 
 def synthesize_fingers(
-    mech, actuators: int = 1, max_links: int = 5, max_results: int = 200
+    mech, actuators: int = 1, max_links: int = 5, max_results: int = 200,
+    separate: bool = False,
 ) -> FingerSynthesis:
     """Every distinct way to make the finger ``mech`` fully actuated by ``actuators`` drives
-    by attaching one group of links to its free leashes (paper 000), with VLL candidates."""
+    by attaching one group of links to its free leashes (paper 000), with VLL candidates.
+
+    ``separate``: attach ``W0 - A`` groups of ``W_f = -1`` each instead (``max_links``
+    then bounds their total number of links).
+    """
     from mechsyn.io import mechanism_to_dict
 
     if mech.kind != "planar":
@@ -154,24 +160,40 @@ def synthesize_fingers(
             sites.append(link)
     notes = [f"leash sites (one new pair each): {', '.join(sites) or 'none'}; "
              f"the frame {mech.ground} takes the group's other leashes",
-             "one group attached (W0 - 1 separate groups are not enumerated)"]
+             "one group attached (--separate: W0 - A groups of W_f = -1)"]
     if len(sites) < table.m_0:
         notes.append(f"the base offers {len(sites)} leash site(s), fewer than m_0 = {table.m_0}")
     base = mechanism_to_dict(mech)
     base_edges = [tuple(j.links) for j in mech.joints]
     actuated_links = {x for j in mech.joints if j.actuated for x in j.links} - {mech.ground}
     outputs = set(dec.output_links)
-    seen: dict[bytes, FingerResult] = {}
+    plans: list[tuple] = [(row,) for row in rows]
+    if separate and w0 - actuators >= 2:
+        unit = [r for r in group_table(actuators + 1, actuators, max_links).rows]
+        plans = [plan for plan in itertools.combinations_with_replacement(unit, w0 - actuators)
+                 if sum(r.n_f for r in plan) <= max_links]
+        notes[1] = f"{w0 - actuators} separate groups of W_f = -1 attached"
+    seen: dict[bytes, FingerResult | None] = {}
     results: list[FingerResult] = []
-    for row in rows:
-        n_f, P_f, m_f = row.n_f, row.P_f, row.m_f
+    for plan in plans:
+        sizes = [r.n_f for r in plan]
+        leashes = [r.m_f for r in plan]
+        n_f, P_f, m_f = sum(sizes), sum(r.P_f for r in plan), sum(leashes)
         names = [f"g{i + 1}" for i in range(n_f)]
+        starts = list(itertools.accumulate([0] + sizes))
+        component = [c for c, n in enumerate(sizes) for _ in range(n)]
         k = min(m_f, len(sites))
+        forests = [sum(([(names[starts[c] + a], names[starts[c] + b]) for a, b in t]
+                        for c, t in enumerate(trees)), [])
+                   for trees in itertools.product(*[_trees(n) for n in sizes])]
         for used in itertools.combinations(sites, k):
             targets = list(used) + [mech.ground] * (m_f - k)
-            for tree in _trees(n_f):
-                tree_edges = [(names[a], names[b]) for a, b in tree]
+            for tree_edges in forests:
                 for assign in itertools.product(range(n_f), repeat=m_f):
+                    if len(plan) > 1 and any(
+                            sum(component[g] == c for g in assign) != leashes[c]
+                            for c in range(len(plan))):
+                        continue  # each group keeps its own number of leashes
                     ext = [(targets[t], names[g]) for t, g in enumerate(assign)]
                     edges = base_edges + tree_edges + ext
                     if len({frozenset(e) for e in edges}) < len(edges):
@@ -192,9 +214,9 @@ def synthesize_fingers(
                         continue
                     idx = {n: i for i, n in enumerate(all_names)}
                     if rigid_subchain([(idx[a], idx[b]) for a, b in edges], len(all_names)):
-                        seen[cert] = None  # type: ignore[assignment]
+                        seen[cert] = None
                         continue
-                    result = _build(mech, base, dec, names, tree_edges, ext, row, deg,
+                    result = _build(mech, base, names, tree_edges, ext, plan, deg,
                                     actuators, len(results) + 1, cert)
                     seen[cert] = result
                     if result is not None:
@@ -209,7 +231,7 @@ def synthesize_fingers(
                            dec.structural_formula, rows, results, tuple(notes))
 
 
-def _build(mech, base, dec, names, tree_edges, ext, row, deg, actuators, number, cert):
+def _build(mech, base, names, tree_edges, ext, plan, deg, actuators, number, cert):
     """The mechanism data of one attachment, or None when it is not fully actuated."""
     from mechsyn.io import mechanism_from_dict
 
@@ -226,7 +248,9 @@ def _build(mech, base, dec, names, tree_edges, ext, row, deg, actuators, number,
     data = {k: v for k, v in base.items() if k not in ("links", "joints", "contours",
                                                      "mobility", "name")}
     attach_text = ", ".join(f"{g}-{t}" for t, g in ext)
-    data = {"name": f"{mech.name} + group n_f={row.n_f}, P_f={row.P_f} ({attach_text})",
+    n_f, P_f = sum(r.n_f for r in plan), sum(r.P_f for r in plan)
+    label = " + ".join(f"group n_f={r.n_f}, P_f={r.P_f}" for r in plan)
+    data = {"name": f"{mech.name} + {label} ({attach_text})",
             **data, "links": links, "joints": joints}
     try:
         result_mech = mechanism_from_dict(data)
@@ -248,7 +272,8 @@ def _build(mech, base, dec, names, tree_edges, ext, row, deg, actuators, number,
     for t, g in ext:
         attachments.setdefault(t, []).append(g)
     return FingerResult(
-        number=number, n_f=row.n_f, P_f=row.P_f, group_links=tuple(names),
+        number=number, n_f=n_f, P_f=P_f, group_links=tuple(names),
+        groups=tuple((r.n_f, r.P_f) for r in plan),
         group_pairs=tuple(new_pairs), attachments=attachments,
         mobility_locked=dec2.mobility, mobility_expression=expr,
         structural_formula=dec2.structural_formula, mechanism_class=dec2.mechanism_class,
