@@ -110,3 +110,13 @@ def test_structure_bad_input(capsys, tmp_path):
                    {"id": "C", "type": "R", "links": ["b", "f"]}]})
     with pytest.raises(MechsynInputError):
         assur_decomposition(rigid)
+
+
+def test_three_phalanx_finger_base_000():
+    """W0 = 3 with one drive: two imaginary inputs, the proximal phalanx (on the palm) and
+    the distal phalanx (on the middle one, a pair between moving links)."""
+    d, groups = _summary("fingers/three_phalanx_base_000.yaml")
+    assert d.mobility == 3
+    assert set(d.imaginary_input_links) == {"proximal", "distal"}
+    assert (2, 2, {"middle", "rod"}) in groups
+    assert d.structural_formula.endswith("I(middle,distal)")
