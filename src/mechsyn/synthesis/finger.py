@@ -301,25 +301,22 @@ def _points(mech, names, tree_edges, ext) -> np.ndarray:
     used: dict[str, int] = {}
     ext_pts = []
     centre = np.mean(list(base_pts.values()), axis=0)
-    for t, _ in ext:
+    for t, _ in ext:  # leash points beside the finger (+x), spread along it
         k = used.get(t, 0)
         used[t] = k + 1
-        direction = base_pts[t] - centre
-        norm = np.linalg.norm(direction)
-        direction = direction / norm if norm > 1e-9 else np.array([1.0, 0.0])
-        normal = np.array([-direction[1], direction[0]])
-        ext_pts.append(base_pts[t] + 0.12 * span * normal + 0.12 * span * k * direction)
+        ext_pts.append(base_pts[t] + span * np.array([0.22 + 0.08 * k, 0.06 * k]))
     anchor = {}
     for g in names:
         ps = [ext_pts[i] for i, (_, gg) in enumerate(ext) if gg == g]
-        anchor[g] = np.mean(ps, axis=0) if ps else centre + 0.3 * span
+        anchor[g] = (np.mean(ps, axis=0) + np.array([0.15 * span, 0.0])) if ps \
+            else centre + 0.3 * span
     # links without leashes: between their neighbours
     for _ in range(3):
         for g in names:
             if not any(gg == g for _, gg in ext):
                 nb = [anchor[b if a == g else a] for a, b in tree_edges if g in (a, b)]
-                anchor[g] = np.mean(nb, axis=0) + 0.1 * span
-    tree_pts = [(anchor[a] + anchor[b]) / 2 + 0.05 * span for a, b in tree_edges]
+                anchor[g] = np.mean(nb, axis=0) + np.array([0.1 * span, 0.0])
+    tree_pts = [(anchor[a] + anchor[b]) / 2 + np.array([0.05 * span, 0.0]) for a, b in tree_edges]
     new = np.array(tree_pts + ext_pts, dtype=float).reshape(-1, 2)
     all_names = list(mech.link_names) + names
     idx = {n: i for i, n in enumerate(all_names)}

@@ -66,7 +66,8 @@ def fingers_figure(results, base_data: dict, title: str):
     n = len(results) + 1
     columns = min(4, n)
     rows = math.ceil(n / columns)
-    fig, axes = plt.subplots(rows, columns, figsize=(columns * 3.2, rows * 3.4), squeeze=False)
+    height = rows * 3.4 + 0.9
+    fig, axes = plt.subplots(rows, columns, figsize=(columns * 3.2, height), squeeze=False)
     draw_mechanism(axes.flat[0], base_data, "base mechanism")
     for ax, r in zip(list(axes.flat)[1:], results):
         attach = ", ".join(f"{t}: {'/'.join(g)}" for t, g in r.attachments.items())
@@ -76,7 +77,8 @@ def fingers_figure(results, base_data: dict, title: str):
                        vll=r.vll_candidates, group=r.group_links)
     for ax in list(axes.flat)[n:]:
         ax.axis("off")
-    fig.suptitle(title + "  (grey: base, orange: attached group, dashed red: VLL "
-                 "candidates, yellow: actuated pair)", fontsize=9)
-    fig.tight_layout()
+    fig.suptitle(title + "\n(grey: base, orange: attached group, dashed red: VLL "
+                 "candidates, yellow: actuated pair)", fontsize=9, y=1 - 0.08 / height, va="top")
+    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.1 / height, top=1 - 1.15 / height,
+                        wspace=0.1, hspace=0.45)
     return fig
