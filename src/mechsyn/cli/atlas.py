@@ -17,6 +17,11 @@ from mechsyn.results import write_atomic
 MAX_DRAWN = 600
 
 
+def _label(assortment: dict[int, int]) -> str:
+    names = {2: "B", 3: "T", 4: "Q", 5: "P", 6: "H"}
+    return " ".join(f"{c}{names.get(d, f'd{d}')}" for d, c in sorted(assortment.items()))
+
+
 @app.command("atlas")
 def atlas(
     links: int = typer.Option(..., "--links", "-n", help="Number of links, frame included."),
@@ -35,7 +40,8 @@ def atlas(
 ) -> None:
     """All non-isomorphic planar simple-jointed kinematic chains with N links and
     mobility F, their link assortments and distinct mechanisms (choices of frame)."""
-    from mechsyn.synthesis.chains import n_units, synthesize_chains, synthesize_chains_to_file
+    from mechsyn.synthesis.chains import (
+        link_assortments, n_units, synthesize_chains, synthesize_chains_to_file)
     from mechsyn.synthesis.mechanisms import distinct_mechanisms, frame_orbits, mechanism_dict
 
     if out is not None and out.suffix.lower() not in (".svg", ".png", ".pdf"):
@@ -64,6 +70,12 @@ def atlas(
         records.append(rec)
     good = [c for c in chains if not c.degenerate]
     by_assortment: dict[str, dict] = {}
+    for assortment in link_assortments(links, mobility):  # number synthesis, in order
+        key = ",".join(f"{d}:{c}" for d, c in sorted(assortment.items()))
+        by_assortment[key] = {
+            "assortment": {str(d): c for d, c in sorted(assortment.items())},
+            "label": _label(assortment), "chains": 0, "non_planar": 0,
+            "fractionated": 0, "degenerate": 0, "mechanisms": 0}
     for chain, rec in zip(chains, records):
         key = ",".join(f"{d}:{c}" for d, c in sorted(chain.assortment.items()))
         row = by_assortment.setdefault(key, {
@@ -116,13 +128,18 @@ def atlas(
         table.add_column(col, justify="right" if col != "assortment" else "left")
     if include_degenerate:
         table.add_column("degenerate", justify="right")
-    for row in by_assortment.values():
+    realised = [row for row in by_assortment.values() if row["chains"] or row["degenerate"]]
+    empty = [row["label"] for row in by_assortment.values() if row not in realised]
+    for row in realised:
         cells = [row["label"], str(row["chains"]), str(row["non_planar"]),
                  str(row["fractionated"]), str(row["mechanisms"])]
         if include_degenerate:
             cells.append(str(row["degenerate"]))
         table.add_row(*cells)
     console.print(table)
+    if empty:
+        console.print("assortments without a non-degenerate chain: " + ", ".join(empty),
+                      highlight=False)
     if len(chains) <= 40:
         for rec, chain in zip(records, chains):
             console.print(f"#{rec['number']} {chain.assortment_label()}: joints "
