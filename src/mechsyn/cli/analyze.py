@@ -29,8 +29,15 @@ from mechsyn.structure.rank import (
     rank_summary_lines,
     rank_to_markdown,
 )
-from mechsyn.structure.report import FORMULA_TITLES, pair_list, to_markdown
 from mechsyn.errors import MechsynInputError
+from mechsyn.structure.report import pair_list, to_markdown
+
+
+SHORT_TITLES = {
+    "chebyshev": "Chebyshev", "grubler": "Grübler", "malyshev": "Malyshev",
+    "somov_malyshev": "Somov-Malyshev", "gokhman_contours": "Gokhman K", "scheme_check": "scheme check",
+    "ozol_redundant": "Ozol q", "redundant_from_mobility": "S from W",
+}
 
 
 def _fmt(x: float | None) -> str:
@@ -46,11 +53,11 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
     ))
     t = Table(title="Formulas", show_lines=False)
-    t.add_column("formula")
-    t.add_column("expression")
+    t.add_column("formula", no_wrap=True)
+    t.add_column("expression", no_wrap=True)
     t.add_column("value", justify="right")
     for key, f in a.formulas.items():
-        t.add_row(FORMULA_TITLES.get(key, key), f.expression, _fmt(f.value))
+        t.add_row(SHORT_TITLES.get(key, key), f.expression, _fmt(f.value))
     console.print(t)
     if a.contours:
         c = Table(title="Contours (paper 003, sequential reading)")
@@ -63,20 +70,21 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         if a.contours_chosen_by_program:
             console.print("  * contour chosen by the program")
         for r in a.contours:
-            console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False)
+            console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
     console.print(
         f"S_Σ = {a.structural_redundancy} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
-        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False)
+        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
+        soft_wrap=True)
     console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({a.mobility_source});  "
-                  f"drives: {a.degrees_of_mobility_expression}", highlight=False)
+                  f"drives: {a.degrees_of_mobility_expression}", highlight=False, soft_wrap=True)
     if a.external is not None:
         e = a.external
         console.print(f"external (paper 002): S_a = {e.S_a}, W_f = {e.W_f}, W_rob = {e.W_rob}, "
                       f"W_a = {e.W_a}, S_ai = {e.S_ai}", highlight=False)
         console.print(f"  {e.external_redundant.expression}\n  {e.system_redundant.expression}", highlight=False)
     for n in a.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False)
+        console.print(f"[dim]note:[/] {n}", highlight=False, soft_wrap=True)
     for name, sub in a.states.items():
         console.print()
         render(sub, title_prefix=f"state '{name}': ")

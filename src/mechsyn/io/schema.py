@@ -111,7 +111,7 @@ class MechanismFile(_Strict):
     kind: Literal["planar", "spatial"] = Field("planar", description="planar | spatial.")
     ground: LinkRef = Field(description="The frame link (name or id).")
     links: list[str | LinkEntry] = Field(min_length=1, description="Links, frame included.")
-    joints: list[JointEntry] = Field(default_factory=list)
+    joints: list[JointEntry] = Field(description="Kinematic pairs.")
     points: dict[str, PointEntry] = Field(default_factory=dict)
     contours: list[list[str]] | None = Field(
         None, description="Independent contours, each an ordered list of joint ids (paper 003's order matters).",

@@ -248,8 +248,8 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
         forms["chebyshev"] = F.chebyshev(n, p5, p4)
         forms["grubler"] = F.grubler(N, p5, p4)
     else:
-        forms["chebyshev"] = F.Formula(None, "not applicable: a spatial mechanism (see malyshev)")
-        forms["grubler"] = F.Formula(None, "not applicable: a spatial mechanism (see malyshev)")
+        forms["chebyshev"] = F.Formula(None, "n/a: spatial mechanism")
+        forms["grubler"] = F.Formula(None, "n/a: spatial mechanism")
     forms["malyshev"] = F.malyshev(n, pbc)
     s_sum = sum(r.S for r in rows)
     t_sum = sum(r.T for r in rows)

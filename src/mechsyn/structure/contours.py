@@ -37,16 +37,18 @@ def _insert(basis: dict[int, int], vec: int) -> bool:
     return False
 
 
-def fundamental_cycles(mech: Mechanism) -> list[tuple[str, ...]]:
-    """Fundamental cycles (ordered joint ids) of a BFS spanning tree rooted at the frame."""
+def fundamental_cycles(mech: Mechanism, root: str | None = None) -> list[tuple[str, ...]]:
+    """Fundamental cycles (ordered joint ids) of a BFS spanning tree rooted at ``root``
+    (default: the frame)."""
+    root = mech.ground if root is None else root
     adj: dict[str, list[tuple[str, str]]] = {name: [] for name in mech.link_names}
     for j in mech.joints:
         a, b = j.links
         adj[a].append((b, j.id))
         adj[b].append((a, j.id))
-    parent: dict[str, tuple[str, str] | None] = {mech.ground: None}
-    depth = {mech.ground: 0}
-    queue = deque([mech.ground])
+    parent: dict[str, tuple[str, str] | None] = {root: None}
+    depth = {root: 0}
+    queue = deque([root])
     tree: set[str] = set()
     while queue:
         u = queue.popleft()
@@ -130,7 +132,12 @@ def independent_contours(
             chosen.append(tuple(c))
             from_file.append(True)
     if len(chosen) < k_total:
-        cands = sorted(fundamental_cycles(mech), key=lambda c: (len(c), sorted(index[j] for j in c)))
+        roots = [mech.ground] + [n for n in mech.link_names if n != mech.ground]
+        pool: dict[int, tuple[str, ...]] = {}
+        for r, root in enumerate(roots):
+            for c in fundamental_cycles(mech, root):
+                pool.setdefault(_mask(c, index), c)
+        cands = sorted(pool.values(), key=lambda c: (len(c), sorted(index[j] for j in c)))
         for c in cands:
             if len(chosen) == k_total:
                 break

@@ -109,4 +109,4 @@ def ozol(W: int, K: int, freedoms: list[int], planar: bool = False) -> Formula:
     for x in freedoms:
         counts[x] = counts.get(x, 0) + 1
     f_expr = " + ".join(f"{c}·{x}" for x, c in sorted(counts.items()))
-    return Formula(q, f"q = {W} + {lam}·{K} - f = {W} + {lam}·{K} - {f} = {q}  (f = {f_expr or 0} = {f})")
+    return Formula(q, f"q = {W} + {lam}·{K} - {f} = {q} (f = {f_expr or 0})")

@@ -811,11 +811,12 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
                                          "no link moves (coaxial or duplicated pairs)"))
             idle_basis = np.concatenate([idle_basis, z_all], axis=1)
         driven = _actuated_columns(sysm)[0]
-        degree = {n: len(mech.joints_of(n)) for n in names}
+        # links joined to one neighbour only (by one or several pairs) are outputs
+        degree = {n: len({j.other(n) for j in mech.joints_of(n)}) for n in names}
         points_on = {n: [p for p in mech.points.values() if p.link == n] for n in names}
         for li, name in enumerate(names):
             if degree[name] < 2:
-                continue  # a leaf link is an output: its motion is the function
+                continue  # a leaf link (one neighbour) is an output: its motion is the function
             others = np.delete(LT, li, axis=0).reshape(-1, mobility)
             z = _null(others, tol)
             if z.shape[1] <= z_all.shape[1]:
