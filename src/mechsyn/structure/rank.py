@@ -31,7 +31,7 @@ is of order one. A singular value counts as zero when it is below
 file gives (half a unit in the last decimal written, when coordinates are written with
 3..9 decimals; exact otherwise), so that special geometry typed with a few decimals
 (Bennett's linkage, 4 decimals) is still recognised. Singular values between ``tol`` and
-``1e-3`` are reported as a near-singularity.
+``1e-2`` are reported as a near-singularity.
 
 **Singularity check.** The configuration is followed numerically along a few random
 null-space directions (step ``0.05`` rad / ``0.05 L``, seeded), re-assembled by
@@ -45,7 +45,7 @@ curvature is not in the file).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -754,11 +754,14 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     notes: list[str] = []
     sv = np.linalg.svd(M, compute_uv=False) if M.size else np.zeros(0)
     rank = int(np.sum(sv > tol))
-    near = bool(np.any((sv > tol) & (sv < 1e-3)))
+    near = bool(np.any((sv > tol) & (sv < 1e-2)))
     if near:
-        small = sv[(sv > tol) & (sv < 1e-3)]
-        notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} between the "
-                     f"tolerance {tol:.2g} and 1e-3; a slightly different geometry (or --tol) changes the rank")
+        small = sv[(sv > tol) & (sv < 1e-2)]
+        k = small.size
+        notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} above the tolerance "
+                     f"{tol:.2g} but small; if the geometry is meant to be special (typed with few decimals), "
+                     f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {lam * K - rank + k} "
+                     f"redundant constraint(s)")
     mobility = F - rank
     redundant = lam * K - rank
     N = _null(M, tol) if F else np.zeros((0, 0))
@@ -871,7 +874,16 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
             singular = r_near != rank
             if singular:
                 notes.append(f"singular configuration: {mobility} instantaneous freedom(s) but {max(finite, 0)} "
-                             f"finite one(s) at nearby assembled configurations")
+                             f"finite one(s) at nearby assembled configurations; away from it "
+                             f"{max(finite - len(idle), 0)} drive(s) and {lam * K - r_near} redundant "
+                             f"constraint(s)")
+                lead = "singular configuration (pairs lined up): "
+                if lam * K - r_near == 0:
+                    lead += "every redundant constraint vanishes at nearby configurations"
+                    contours = [replace(c, reason=lead) if c.redundant else c for c in contours]
+                else:
+                    lead += f"{r_near - rank} redundant constraint(s) vanish at nearby configurations; otherwise "
+                    contours = [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
     elif mobility == 0:
         finite = 0
     smallest = sorted(float(x) for x in sv)[: min(4, len(sv))]
