@@ -358,3 +358,45 @@ def test_cli_bad_inputs(tmp_path, capsys):
     assert "joint A" in err and "point" in err
     assert main(["analyze", str(f), "--json"]) == 0  # formulas only by default
     assert json.loads(capsys.readouterr().out)["rank"] is None
+
+
+def _unit(v):
+    v = np.asarray(v, float)
+    return (v / np.linalg.norm(v)).tolist()
+
+
+def test_spherical_fourbar_concurrent_axes():
+    """Spherical 4R (all axes through the origin): Malyshev -2, mobility 1, three forces
+    through the centre repeat (Hunt 1978)."""
+    axes = [_unit([1, 0, 0.3]), _unit([0.2, 1, 0.4]), _unit([-0.8, 0.3, 1]), _unit([0.1, -0.7, 0.9])]
+    links = ["frame", "a", "b", "c"]
+    mech = mechanism_from_dict({
+        "name": "spherical 4R", "kind": "spatial", "ground": "frame", "links": links,
+        "joints": [{"id": f"J{k}", "type": "R", "links": [links[k], links[(k + 1) % 4]],
+                    "point": (2 * np.array(axes[k])).tolist(), "axis": axes[k]} for k in range(4)]})
+    r = analyze_rank(mech)
+    assert analyze_structure(mech).formulas["malyshev"].value == -2
+    assert (r.mobility, r.redundant_constraints) == (1, 3)
+    assert r.redundant_directions == [["forces along x, y, z through (0, 0, 0)"]]
+    assert r.contours[0].reason.startswith("concurrent axes")
+
+
+def test_bennett_typed_with_two_decimals_is_flagged_near_singular():
+    import yaml
+
+    d = yaml.safe_load((EX / "textbook/bennett.yaml").read_text())
+    for j in d["joints"]:
+        j["point"] = [round(x, 2) for x in j["point"]]
+        j["axis"] = [round(x, 2) for x in j["axis"]]
+    r = analyze_rank(mechanism_from_dict(d))
+    # two decimals are taken as exact: a generic 4R (a structure), but the small singular
+    # value is reported with the tolerance that recovers Bennett's mobility
+    assert r.mobility == 0 and r.near_singular
+    assert any("gives mobility 1" in n for n in r.notes)
+
+
+def test_markdown_report_has_rank_and_comparison(capsys):
+    assert main(["analyze", str(EX / "structural/gripper_003.yaml"), "--markdown", "--remedies"]) == 0
+    out = capsys.readouterr().out
+    assert "## Rank method (screw theory)" in out and "side by side" in out
+    assert "Remedies re-checked by the rank method" in out and "rejected by the rank method" in out

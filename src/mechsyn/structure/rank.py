@@ -608,6 +608,13 @@ def describe_wrenches(W: np.ndarray, centre: np.ndarray, scale: float, planar: b
     if couples.shape[1]:
         out.append(_axis_words(couples, "moment"))
     forces = _orth(Fp)
+    if forces.shape[1] >= 2 and not couples.shape[1]:
+        # do all the force lines pass through one point?  m_i = r × F_i  for every basis wrench
+        A = np.concatenate([-np.array([[0, -f[2], f[1]], [f[2], 0, -f[0]], [-f[1], f[0], 0]]) for f in Fp.T])
+        r, *_ = np.linalg.lstsq(A, Mp.T.reshape(-1), rcond=None)
+        if np.linalg.norm(A @ r - Mp.T.reshape(-1)) < 1e-7:
+            out.append(f"{_axis_words(forces, 'force')} through {_vec(centre + scale * r)}")
+            return out
     if forces.shape[1]:
         # aligned basis when the force subspace contains coordinate axes
         proj = forces @ forces.T
