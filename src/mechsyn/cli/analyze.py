@@ -113,7 +113,7 @@ def render_remedies(remedies: list[Remedy]) -> None:
 
 
 def render_rank(ra: RankAnalysis, comparisons: list[Comparison] | None, title: str = "") -> None:
-    lines = rank_summary_lines(ra)
+    lines = [f"[bold red]{x}[/]" if x.startswith("SINGULAR") else x for x in rank_summary_lines(ra)]
     console.print(Panel.fit("[bold]Rank method (screw theory)" + (f": {title}" if title else "") + "[/]\n"
                             + "\n".join(lines), border_style="cyan"), highlight=False)
     if any(c.redundant for c in ra.contours):

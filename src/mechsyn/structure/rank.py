@@ -650,6 +650,8 @@ def _contour_reason(sysm: _System, idx: int, Wj: np.ndarray) -> str:
         return ""
     cols = sorted({c for c, _ in sysm.factors[idx]})
     types = {sysm.joints[sysm.col_joint[c]].type for c in cols}
+    if sysm.planar and types <= {"P"}:
+        return "translations only: the moment about z repeats"
     if sysm.planar:
         return ("metric constraint: a constraint repeated only under these exact dimensions "
                 "(a duplicated link, coaxial or coincident joints)")
@@ -1000,7 +1002,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
         if f.value == q and q:
             why = f"agree: {reasons}"
         out.append(Comparison("redundant constraints", "Ozol q = W + λK - f (002)", f.value, q, f.value == q, why))
-    if fa.contours and len(fa.contours) == len(ra.contours):
+    if fa.contours and len(fa.contours) == len(ra.contours) and not planar:
         for fc, rc in zip(fa.contours, ra.contours):
             sj = max(fc.S, 0) + fc.T
             agree = sj == rc.redundant
@@ -1015,12 +1017,13 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
             out.append(Comparison(f"redundant constraints, contour {fc.index}", "003: max(S_j, 0) + T_j",
                                   sj, rc.redundant, agree, why))
     f_idle = fa.idle_mobilities
-    out.append(Comparison(
-        "idle mobilities", "003: Σ max(-S_j, 0)", f_idle, idle, f_idle == idle,
-        "agree" + (f": {_idle_words(ra)}" if idle else "") if f_idle == idle else
-        (f"the rank method finds {idle}: {_idle_words(ra) or 'none'}"
-         + ("; the per-contour count misses idle motions that a contour's redundant constraints mask"
-            if idle > f_idle else "; the per-contour count assumes a generic geometry"))))
+    if not planar:
+        out.append(Comparison(
+            "idle mobilities", "003: Σ max(-S_j, 0)", f_idle, idle, f_idle == idle,
+            "agree" + (f": {_idle_words(ra)}" if idle else "") if f_idle == idle else
+            (f"the rank method finds {idle}: {_idle_words(ra) or 'none'}"
+             + ("; the per-contour count misses idle motions that a contour's redundant constraints mask"
+                if idle > f_idle else "; the per-contour count assumes a generic geometry"))))
     h = fa.degrees_of_mobility
     why = "agree" if h == ra.drives_needed else (
         f"drives needed = useful mobility = {ra.drives_needed} (rank); the rule H = n - Σ A_j is "
@@ -1126,13 +1129,21 @@ def check_remedy(original: Mechanism, variant: Mechanism, base: RankAnalysis, me
     redundant constraints remain than the metric constraints the formulas admit
     (``metric_left``, which class changes cannot remove).
     """
+    old = {j.id: j for j in original.joints}
+    moved = [j for j in variant.joints if j.actuated and j.type != old[j.id].type
+             and not (old[j.id].type == "P" and j.type == "C")]
+    if moved:
+        return RemedyCheck(False, "rejected by the rank method: " + "; ".join(
+            f"the driven pair {j.id} would become {j.type} ({j.freedom} freedoms): a drive sets one coordinate"
+            for j in moved), None, {})
     best: tuple[tuple[int, int, int], RankAnalysis, dict[str, Any]] | None = None
     for mech, geo in _variant_geometry(original, variant):
         try:
             r = analyze_rank(mech, tol=tol if tol is not None else base.tolerance, check_singular=False)
         except InsufficientGeometry as exc:
             return RemedyCheck(True, f"not checked: {exc.message}", None, {})
-        score = (abs(r.useful_mobility - base.useful_mobility), len(r.idle_mobilities),
+        lost_drive = int(base.actuation_determined is True and r.actuation_determined is False)
+        score = (abs(r.useful_mobility - base.useful_mobility) + lost_drive, len(r.idle_mobilities),
                  max(0, r.redundant_constraints - int(round(metric_left))))
         if best is None or score < best[0]:
             best = (score, r, geo)
@@ -1146,8 +1157,10 @@ def check_remedy(original: Mechanism, variant: Mechanism, base: RankAnalysis, me
         return RemedyCheck(True, f"confirmed: useful mobility {r.useful_mobility}, no idle mobility, "
                                  f"no redundant constraint{extra}", r, geo)
     why = []
-    if score[0]:
+    if score[0] and r.useful_mobility != base.useful_mobility:
         why.append(f"changes the useful mobility from {base.useful_mobility} to {r.useful_mobility}")
+    elif score[0]:
+        why.append(f"the drives at {', '.join(r.actuated)} no longer determine the motion")
     if score[1]:
         why.append(f"leaves {len(r.idle_mobilities)} idle mobility(ies): {_idle_words(r)}")
     if score[2]:
