@@ -400,3 +400,23 @@ def test_markdown_report_has_rank_and_comparison(capsys):
     out = capsys.readouterr().out
     assert "## Rank method (screw theory)" in out and "side by side" in out
     assert "Remedies re-checked by the rank method" in out and "rejected by the rank method" in out
+
+
+def test_planetary_gear_train_given_by_ratios():
+    """Sun, planet on a carrier, ring: a 2-freedom differential (Chebyshev 3·4 - 2·4 - 2 = 2);
+    one drive at the sun does not determine it."""
+    d = {"name": "planetary", "kind": "planar", "ground": "frame",
+         "links": ["frame", "sun", "carrier", "planet", "ring"],
+         "joints": [{"id": "Os", "type": "R", "links": ["frame", "sun"], "point": [0, 0], "actuated": True},
+                    {"id": "Oc", "type": "R", "links": ["frame", "carrier"], "point": [0, 0]},
+                    {"id": "Or", "type": "R", "links": ["frame", "ring"], "point": [0, 0]},
+                    {"id": "Op", "type": "R", "links": ["carrier", "planet"], "point": [3, 0]},
+                    {"id": "M1", "type": "gear", "links": ["sun", "planet"], "ratio": -2},
+                    {"id": "M2", "type": "gear", "links": ["planet", "ring"], "ratio": 0.25}]}
+    mech = mechanism_from_dict(d)
+    r = analyze_rank(mech)
+    assert r.mobility == analyze_structure(mech).formulas["chebyshev"].value == 2
+    assert r.redundant_constraints == 0 and r.actuation_determined is False
+    # fixing the ring (a third R pair between ring and frame would be redundant; instead drive it)
+    d["joints"][2]["actuated"] = True
+    assert analyze_rank(mechanism_from_dict(d)).actuation_determined is True

@@ -105,8 +105,9 @@ def _need(joint: Joint, what: str, hint: str) -> InsufficientGeometry:
 def _gear_geometry(joint: Joint, mech: Mechanism | None) -> tuple[np.ndarray, np.ndarray]:
     """Pitch point and line of action of a gear mesh given by ``ratio`` (20° pressure angle).
 
-    The two wheels must turn in revolute pairs on a common link (carrier or frame); the
-    pitch point divides the centre line so that ``ω_b/ω_a = ratio`` (negative: external).
+    The wheels' centres are their revolute pairs (preferably on a common link: carrier or
+    frame); the pitch point divides the centre line so that ``|ratio| = r_a/r_b``
+    (``ω_b/ω_a`` relative to the carrier; negative: external mesh, positive: internal).
     """
     if mech is None:
         raise _need(joint, "point and normal", "give point (pitch point) and normal (line of action)")
@@ -119,9 +120,12 @@ def _gear_geometry(joint: Joint, mech: Mechanism | None) -> tuple[np.ndarray, np
             if wheel in j.links:
                 pivots[wheel][j.other(wheel)] = j
     common = [c for c in pivots[a] if c in pivots[b]]
-    if not common:
-        raise _need(joint, "point and normal", "give point and normal, or turn both wheels in R pairs on one link")
-    oa, ob = _pad3(pivots[a][common[0]].point), _pad3(pivots[b][common[0]].point)
+    if common:
+        oa, ob = _pad3(pivots[a][common[0]].point), _pad3(pivots[b][common[0]].point)
+    elif pivots[a] and pivots[b]:  # e.g. a planet on its carrier meshing with a sun on the frame
+        oa, ob = _pad3(next(iter(pivots[a].values())).point), _pad3(next(iter(pivots[b].values())).point)
+    else:
+        raise _need(joint, "point and normal", "give point and normal, or turn both wheels in R pairs")
     d = ob - oa
     if joint.point is not None:
         p = _pad3(joint.point)
