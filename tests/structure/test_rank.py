@@ -10,7 +10,6 @@ Watt, Stephenson (1), 5R (2), Bennett (1), RSSR (1 + 1 idle), Sarrus (1), 3-RPS 
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np

@@ -260,8 +260,6 @@ def missing_geometry(mech: Mechanism, planar: bool | None = None) -> list[str]:
 def as_spatial(mech: Mechanism) -> Mechanism:
     """A planar mechanism seen in 3-D: points at ``z = 0``, R axes along ``z``, P axes in
     the plane, cams and gears as line contacts (class 2) along ``z``."""
-    from dataclasses import replace
-
     from mechsyn.model.pairs import PAIR_KINDS
 
     if mech.kind == "spatial":
@@ -1079,7 +1077,6 @@ def _variant_geometry(original: Mechanism, variant: Mechanism) -> list[tuple[Mec
     """Geometric realisations of a remedy variant: changed pairs at the same point with the
     same axis; directions a new pair needs (sphere-with-pin's blocked rotation, a line
     contact's line) tried among the directions to the neighbouring joints and x, y, z."""
-    from dataclasses import replace
     import itertools
 
     old = {j.id: j for j in original.joints}
