@@ -660,27 +660,35 @@ def _contour_reason(sysm: _System, idx: int, Wj: np.ndarray) -> str:
     tw = sysm.twists[cols]
     lower_rot = [c for c in cols if sysm.joints[sysm.col_joint[c]].type in ("R", "C", "H")
                  and np.linalg.norm(sysm.twists[c, :3]) > 0.5]
-    if len(lower_rot) >= 2 and np.linalg.svd(sysm.twists[lower_rot, :3].T, compute_uv=False)[1] < 1e-6:
-        tw = sysm.twists[lower_rot]
+    all_rot = [c for c in cols if np.linalg.norm(sysm.twists[c, :3]) > 0.5]
+    if len(lower_rot) >= 2:
+        axes = sysm.twists[lower_rot, :3]
+        counts = (np.abs(axes @ axes.T) > 1 - 1e-9).sum(axis=1)
+        k = int(np.argmax(counts))
+        if counts[k] >= 2:
+            d = axes[k]
+            # split the redundant wrenches: out-of-plane (force ∥ d, moments ⊥ d) vs in-plane
+            P = np.concatenate([np.outer(d, d) @ Wj[:3], (np.eye(3) - np.outer(d, d)) @ Wj[3:]])
+            in_plane = int(np.linalg.matrix_rank(P, tol=1e-6)) if P.size else 0
+            out_plane = q - in_plane
+            if out_plane > 0:
+                dname = next((_AXIS_NAMES[i] for i in range(3) if abs(abs(d[i]) - 1) < 1e-6), _vec(d))
+                n_par = int(counts[k])
+                if n_par == len(all_rot):
+                    text = (f"parallel axes (all along {dname}): the contour moves in parallel planes, so "
+                            f"{out_plane} of its out-of-plane constraints repeat")
+                else:
+                    text = (f"parallel axes ({n_par} of the contour's {len(all_rot)} rotation axes along {dname}): "
+                            f"the other pairs free part of the out-of-plane motion, {out_plane} out-of-plane "
+                            f"constraint(s) repeat")
+                if in_plane:
+                    text += (f"; and {in_plane} metric constraint(s) in the plane (coaxial, coincident or "
+                             "duplicated links)")
+                return text
     rot = tw[np.linalg.norm(tw[:, :3], axis=1) > 0.5]
     tra = tw[np.linalg.norm(tw[:, :3], axis=1) <= 0.5][:, 3:]
     if len(rot):
         w = rot[:, :3]
-        u, s, _ = np.linalg.svd(w.T)
-        parallel = s.size < 2 or s[1] < 1e-6 * max(s[0], 1)
-        if parallel:
-            d = u[:, 0]
-            # split the redundant wrenches: out-of-plane (force ∥ d, moments ⊥ d) vs in-plane
-            P = np.concatenate([np.outer(d, d) @ Wj[:3], (np.eye(3) - np.outer(d, d)) @ Wj[3:]])
-            in_plane = np.linalg.matrix_rank(P, tol=1e-6) if P.size else 0
-            out_plane = q - in_plane
-            dname = next((_AXIS_NAMES[k] for k in range(3) if abs(abs(d[k]) - 1) < 1e-6), _vec(d))
-            text = (f"parallel axes (all along {dname}): the contour moves in parallel planes, so "
-                    f"{out_plane} of its out-of-plane constraints repeat")
-            if in_plane:
-                text += (f"; and {in_plane} metric constraint(s) in the plane (coaxial, coincident or "
-                         "duplicated links)")
-            return text
         # concurrent axes: every rotation axis through one point, no slides
         v = rot[:, 3:]
         # p × w = v for a common point p:  -[w]× p = v
