@@ -172,9 +172,7 @@ def analyze(
     mobilities, redundant links, metric constraints and drives, and each state of a
     variable-structure mechanism with paper 002's external constraints.
 
-    When the file gives the joints' geometry, the rank method (screw theory) answers
-    exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per
-    contour and their directions, drives, singularity; each formula is shown next to it."""
+    When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
     if method is not None and method not in ("formulas", "rank", "both"):
         raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="use formulas, rank or both")
     if tol is not None and not (0 < tol < 1):
