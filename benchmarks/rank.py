@@ -9,18 +9,26 @@ loop-closure matrix, the floor of any rank-based tool (what a user who hand-asse
 the screw matrix would get).
 
 Run: PYTHONPATH=src python benchmarks/rank.py
+BLAS runs single-threaded here (the matrices are small: threads only add overhead, and on a
+loaded machine multi-threaded OpenBLAS makes each small SVD 10-50x slower); set
+OPENBLAS_NUM_THREADS yourself to compare.
 """
 
 from __future__ import annotations
 
-import time
-from pathlib import Path
+import os
 
-import numpy as np
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from mechsyn.io import load_mechanism, mechanism_from_dict
-from mechsyn.structure.analysis import analyze_structure
-from mechsyn.structure.rank import _build_system, analyze_rank, as_spatial
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from mechsyn.io import load_mechanism, mechanism_from_dict  # noqa: E402
+from mechsyn.structure.analysis import analyze_structure  # noqa: E402
+from mechsyn.structure.rank import _build_system, analyze_rank, as_spatial  # noqa: E402
 
 
 def ladder(loops: int) -> dict:

@@ -314,10 +314,15 @@ def _exp(xi: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return g
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
 def _adjoint(g: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """``Ad_g ξ``: the twist ``ξ`` moved by the displacement ``g``."""
     R, p = g[:3, :3], g[:3, 3]
     w = R @ xi[:3]
-    return np.concatenate([w, R @ xi[3:] + np.cross(p, w)])
+    return np.concatenate([w, R @ xi[3:] + _cross(p, w)])
 
 
 def _svd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -787,33 +792,36 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     if N.shape[1] != mobility:  # pragma: no cover - consistent by construction
         N = N[:, :mobility]
 
-    # -- redundant constraints per contour (sequential) and their directions
+    # -- redundant constraints per contour (sequential) and their directions: the rows of
+    # contour k are reduced against the row space of contours 1..k-1 (orthonormal basis Q);
+    # combinations c of its rows whose residual vanishes are its redundant constraints,
+    # c being the contour's self-stress wrench [moment about the centre; force].
     contours: list[ContourRank] = []
-    prev_rank = 0
-    prev_left = np.zeros((0, 0))
+    Q = np.zeros((F, 0))
     for k in range(K):
-        Mk = M[: lam * (k + 1)]
-        rk = _rank(Mk, tol)
-        qk = lam - (rk - prev_rank)
-        prev_rank = rk
-        left = _null(Mk.T, tol)  # λ(k+1) × (λ(k+1) - rk)
+        B = M[lam * k: lam * (k + 1)]
+        res = B - (B @ Q) @ Q.T if Q.shape[1] else B
+        u_k, s_k, vt_k = np.linalg.svd(res, full_matrices=True)
+        s_full = np.zeros(lam)
+        s_full[: s_k.size] = s_k
+        inc = int(np.sum(s_full > tol))
+        Q = np.concatenate([Q, vt_k[:inc].T], axis=1)
+        qk = lam - inc
+        part = u_k[:, inc:]
         dirs: list[str] = []
         Wj = np.zeros((6, 0))
         if qk > 0:
-            old = np.zeros((lam * (k + 1), prev_left.shape[1]))
-            old[: prev_left.shape[0]] = prev_left
-            new = left - old @ (old.T @ left) if old.size else left
-            newb = _orth(new, 1e-6)[:, :qk]
-            part = newb[lam * k:]
             if planar:
                 Wj = np.zeros((6, part.shape[1]))
                 Wj[PLANAR_ROWS] = part
             else:
                 Wj = part
             dirs = describe_wrenches(Wj, sysm.centre, sysm.scale, planar, tol)
-        prev_left = left
         contours.append(ContourRank(index=k + 1, joints=list(sysm.contours[k]), redundant=qk,
                                     directions=dirs, reason=_contour_reason(sysm, k, Wj)))
+    if sum(c.redundant for c in contours) != redundant:  # borderline singular values: say so
+        notes.append(f"per-contour counts ({', '.join(str(c.redundant) for c in contours)}) and the total "
+                     f"{redundant} differ at this tolerance: a singular value is close to it")
 
     # -- idle mobilities: motions of one link alone (other than a leaf/output link)
     names, T = _link_twist_map(mech, sysm)
@@ -836,11 +844,14 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
         # links joined to one neighbour only (by one or several pairs) are outputs
         degree = {n: len({j.other(n) for j in mech.joints_of(n)}) for n in names}
         points_on = {n: [p for p in mech.points.values() if p.link == n] for n in names}
+        # null space of the other links' twists, for every link at once: eigenvectors of the
+        # Gram matrices  G_others = G_all - G_link  (m × m) with eigenvalue below tol²
+        G = np.einsum("lrm,lrn->lmn", LT, LT)
+        evals, evecs = np.linalg.eigh(G.sum(axis=0)[None] - G)
         for li, name in enumerate(names):
             if degree[name] < 2:
                 continue  # a leaf link (one neighbour) is an output: its motion is the function
-            others = np.delete(LT, li, axis=0).reshape(-1, mobility)
-            z = _null(others, tol)
+            z = evecs[li][:, evals[li] < tol * tol]
             if z.shape[1] <= z_all.shape[1]:
                 continue
             z = z - z_all @ (z_all.T @ z) if z_all.shape[1] else z
