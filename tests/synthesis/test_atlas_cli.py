@@ -65,6 +65,9 @@ def test_atlas_json_contract(capsys):
     assert main(["atlas", "--links", "7", "--mobility", "2", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["count"] == 4
+    # number synthesis: every solution of the assortment equations is listed
+    rows = {r["label"]: r["chains"] for r in data["assortments"]}
+    assert rows == {"6B 1Q": 1, "5B 2T": 3}
     assert sum(c["fractionated"] for c in data["chains"]) == 1
     for chain in data["chains"]:
         assert {"assortment", "edges", "degenerate", "fractionated", "planar_graph"} <= set(chain)
