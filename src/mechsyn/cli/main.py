@@ -14,6 +14,9 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.cli import analyze as _analyze  # noqa: F401
 from mechsyn.cli import synth_groups as _synth_groups  # noqa: F401
 from mechsyn.cli import version as _version  # noqa: F401
+from mechsyn.cli import atlas as _atlas  # noqa: F401
+from mechsyn.cli import structure as _structure  # noqa: F401
+from mechsyn.cli import finger as _finger  # noqa: F401
 from mechsyn.cli import capability as _capability  # noqa: F401
 from mechsyn.cli import belt as _belt  # noqa: F401
 from mechsyn.cli import simulate as _simulate  # noqa: F401
