@@ -83,3 +83,20 @@ def test_redundant_parallelogram_passes_its_change_points():
     # the balancing moment is still determinate: m g times the coupler's horizontal travel rate
     assert np.allclose(fa.reactions.effort["A1"], 9.81 * np.cos(np.radians(fa.simulation.inputs["A1"])),
                        atol=1e-9)
+
+
+def test_singular_file_configurations(ex):
+    """Files assembled at a dead centre or folded flat: the sweep runs, the singular rows
+    have positions but null rates, and a note says the file's configuration is singular."""
+    sim = simulate(ex("textbook/fourbar_dead_centre.yaml"), {"A": input_grid(0, 360, 30)})
+    dead = sorted(e["input"]["A"] for e in sim.events if e["kind"] == "dead point")
+    lim = np.degrees(np.arctan2(2, 1))  # the file's crank angle is the dead centre
+    assert abs(dead[0] - lim) < 1e-6 and abs(dead[1] - (360 - lim)) < 1e-6
+    assert any("singular" in n for n in sim.notes)
+    sim = simulate(ex("textbook/fourbar_folded.yaml"), {"A": input_grid(0, 360, 30)}, points=["C"])
+    assert sim.assembled.all()
+    assert np.allclose(sim.points["C"].position[0], [5, 0])
+    assert np.isnan(sim.points["C"].velocity[0]).all() and np.isfinite(sim.points["C"].velocity[1]).all()
+    assert {e["input"]["A"] for e in sim.events if e["kind"] == "singular"} == {0.0, 360.0}
+    d = to_jsonable(sim)
+    assert d["points"]["C"]["velocity"][0] == [None, None] or d["points"]["C"]["velocity"][0] is None

@@ -9,6 +9,7 @@ from typing import Annotated, Any, Optional
 
 import numpy as np
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from mechsyn.cli.app import app
@@ -199,7 +200,7 @@ def _render_simulation(sim, derived_d: dict) -> None:
     x = sim.inputs[main]
     unit = "deg" if sim.input_types[main] == "R" else ""
     rows = _table_rows(len(x))
-    console.print(f"[bold]{sim.mechanism}[/]: {len(x)} input values, {int(sim.assembled.sum())} assembled "
+    console.print(f"[bold]{escape(sim.mechanism)}[/]: {len(x)} input values, {int(sim.assembled.sum())} assembled "
                   f"(method: {sim.method})", highlight=False)
     for name, pm in sim.points.items():
         t = Table(title=f"point {name} (on {pm.link})")
@@ -218,8 +219,8 @@ def _render_simulation(sim, derived_d: dict) -> None:
         t.add_column(f"{name} θ, ω, α", justify="right")
     for k in rows:
         t.add_row(f"{x[k]:g}", *(("—" if not sim.assembled[k] else
-                                  f"{sim.links[n].angle[k]:.4f}, {sim.links[n].angular_velocity[k]:.4g}, "
-                                  f"{sim.links[n].angular_acceleration[k]:.4g}") for n in names))
+                                  f"{sim.links[n].angle[k]:.4f}, {_fmt(sim.links[n].angular_velocity[k])}, "
+                                  f"{_fmt(sim.links[n].angular_acceleration[k])}") for n in names))
     console.print(t)
     if len(sim.links) > 4:
         console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
@@ -227,9 +228,9 @@ def _render_simulation(sim, derived_d: dict) -> None:
         console.print(f"working range of {main}: {r[0]:g} .. {r[1]:g} {unit}", highlight=False)
     for e in sim.events:
         where = ", ".join(f"{k} = {v:.6g}" for k, v in e["input"].items()) if isinstance(e.get("input"), dict) else ""
-        console.print(f"[yellow]{e['kind']}[/] {where}: {e['message']}", highlight=False)
+        console.print(f"[yellow]{e['kind']}[/] {where}: {escape(e['message'])}", highlight=False)
     for note in sim.notes:
-        console.print(f"note: {note}", highlight=False)
+        console.print(f"note: {escape(note)}", highlight=False)
     if "grashof" in derived_d:
         g = derived_d["grashof"]
         console.print(f"Grashof: {g['expression']} → {g['classification']}", highlight=False)
@@ -293,7 +294,7 @@ def forces_cmd(
     x = sim.inputs[main]
     rows = _table_rows(len(x))
     kind = "static" if static else "kinetostatic"
-    console.print(f"[bold]{sim.mechanism}[/]: {kind} analysis, gravity {gravity:g} along -y, "
+    console.print(f"[bold]{escape(sim.mechanism)}[/]: {kind} analysis, gravity {gravity:g} along -y, "
                   f"{int(sim.assembled.sum())} of {len(x)} inputs assembled", highlight=False)
     joints = list(R.force)
     per_input = joints if len(joints) <= 5 else []
@@ -327,4 +328,4 @@ def forces_cmd(
                       "minimum-norm values shown", highlight=False)
     for e in sim.events:
         where = ", ".join(f"{k} = {v:.6g}" for k, v in e["input"].items()) if isinstance(e.get("input"), dict) else ""
-        console.print(f"[yellow]{e['kind']}[/] {where}: {e['message']}", highlight=False)
+        console.print(f"[yellow]{e['kind']}[/] {where}: {escape(e['message'])}", highlight=False)

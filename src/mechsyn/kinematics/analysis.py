@@ -219,6 +219,12 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         events = sw.events
         used = "newton"
     ok = sw.assembled
+    rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+    for k in np.flatnonzero(ok & ~rates_ok).tolist():
+        events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
+                       "message": "singular configuration: assembled, but the velocities and accelerations "
+                                  "are not defined here (null)"})
+    events.sort(key=lambda e: e["index"])
     links = {}
     for i, name in enumerate(S.links):
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
@@ -229,13 +235,21 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         P, V, A = S.point_state(np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd), i, s)
         for arr in (P, V, A):
             arr[~ok] = np.nan
+        V[~rates_ok] = np.nan
+        A[~rates_ok] = np.nan
         pm[name] = PointMotion(P, V, A, link)
     events = [_event_units(S, e) for e in events]
+    from mechsyn.kinematics.solve import singular_configuration
+
+    notes = list(S.notes)
+    if singular_configuration(S):
+        notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
+                     "position): the assembly branch chosen from it is arbitrary")
     events.extend(_limit_events(S, sw))
     return Simulation(
         mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
         speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
-        events=events, method=used, notes=list(S.notes), vll=dict(S.vll), sweep=sw, system=S)
+        events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:

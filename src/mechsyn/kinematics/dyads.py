@@ -428,6 +428,11 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
 
 def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
     """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
+    with np.errstate(invalid="ignore", over="ignore"):  # inf rates at singular rows become NaN
+        return _poses_from_chain_(S, plan, U, r)
+
+
+def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
     N, nl = r.cos.shape
     # component-major buffers (returned transposed): every column written is contiguous
     q = np.empty((S.n, N)).T
@@ -455,7 +460,7 @@ def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResul
         if step.kind == "drive_R" and step.known[0] < 0:
             con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
             drive_links[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
-    ok = np.all(np.isfinite(r.cos), axis=1) & np.all(np.isfinite(r.omega), axis=1)
+    ok = np.all(np.isfinite(r.cos), axis=1)
     for i in range(nl):
         if i in drive_links:
             k, sgn = drive_links[i]
@@ -478,6 +483,12 @@ def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResul
     if not ok.all():
         for a in (q, qd, qdd):
             a[~ok] = np.nan
+    # at a singular configuration (e.g. folded flat) the position exists but the rates
+    # do not: NaN rates, reported as "singular" events by the caller
+    bad = ~(np.all(np.isfinite(qd), axis=1) & np.all(np.isfinite(qdd), axis=1))
+    if bad.any():
+        qd[bad] = np.nan
+        qdd[bad] = np.nan
     return q, qd, qdd
 
 

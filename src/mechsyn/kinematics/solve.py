@@ -130,9 +130,31 @@ def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
             "redundant": S.m - rank}
 
 
+def generic_free(S: PlanarSystem, q: np.ndarray | None = None, trials: int = 3) -> int:
+    """Free coordinates of the mechanism in general position: the rank of ``Phi_q`` at
+    configurations near ``q`` (a dead-centre or folded file configuration lowers the rank
+    at ``q`` only)."""
+    q = S.q0 if q is None else q
+    rng = np.random.default_rng(0)
+    best = S.n
+    for _ in range(trials):
+        dq = rng.normal(size=S.n) * 1e-3
+        dq[:3 * len(S.links)] *= np.where(np.arange(3 * len(S.links)) % 3 == 2, 1.0, S.scale)
+        best = min(best, check_mobility(S, q + dq)["free"])
+    return best
+
+
+def singular_configuration(S: PlanarSystem, q: np.ndarray | None = None) -> bool:
+    """``Phi_q`` loses rank at ``q`` though the mechanism is determined in general position."""
+    q = S.q0 if q is None else q
+    return check_mobility(S, q)["free"] > 0 and generic_free(S, q) == 0
+
+
 def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:
     info = check_mobility(S, q)
     src = S.mech.source or "<mechanism>"
+    if info["free"] > 0 and generic_free(S, q) == 0:
+        return info  # a singular file configuration (dead centre, folded): reported by the sweep
     if info["free"] > 0:
         passive = [j for j, mode in S.vll.items() if mode == "passive"]
         hint = "mark more joints actuated"

@@ -488,7 +488,7 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
     for j in mech.joints:
         if j.point is None:
             raise MechsynInputError(f"joint {j.id} has no point", source=src, field=f"joints.{j.id}.point",
-                                    hint="give every joint a point [x, y] in the assembled configuration")
+                                    hint="give every joint a point, e.g. point: [0, 0], in the assembled configuration")
         if j.type not in ("R", "P", "cam", "gear"):
             raise MechsynInputError(f"joint {j.id}: pair type {j.type} is not supported by planar kinematics",
                                     source=src, field=f"joints.{j.id}.type", hint="use R, P, cam or gear")
@@ -601,8 +601,8 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
             if profile is None:
                 raise MechsynInputError(
                     f"cam joint {j.id} has no profile", source=src, field=f"joints.{j.id}.profile",
-                    hint="add profile: {center: [x, y], radius: r} or a list of points [[x, y], ...] on the "
-                         f"cam link {a_name}")
+                    hint="add e.g. profile: {center: [0, 0], radius: 1}, or a polar function r(t), or a list "
+                         f"of points [[1, 0], [0, 1], [-1, 0], [0, -1]] on the cam link {a_name}")
             others = [x for x in mech.joints_of(b_name) if x.id != j.id and x.type == "R"]
             if others:
                 centre = others[0].point
