@@ -20,6 +20,7 @@ from mechsyn.cli import finger as _finger  # noqa: F401
 from mechsyn.cli import capability as _capability  # noqa: F401
 from mechsyn.cli import belt as _belt  # noqa: F401
 from mechsyn.cli import simulate as _simulate  # noqa: F401
+from mechsyn.cli import synth_finger_design as _synth_finger_design  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -50,7 +50,7 @@ from mechsyn.errors import MechsynInputError
 __all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
            "Evaluation", "evaluate_locked", "stage1_objective", "vll_range", "mode_forces",
            "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE", "points_in_region",
-           "underactuated_paths"]
+           "underactuated_paths", "design_figure"]
 
 INFEASIBLE = 1e6
 Objective = Callable[[np.ndarray], float]
@@ -726,3 +726,78 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
                         case.tolerance_deg, time.monotonic() - t0, stopped)
+
+
+# --------------------------------------------------------------------------- plot
+def design_figure(case: FingerCase, result: FingerDesign) -> Any:
+    """Two panels: the fully actuated mode (finger at the targets, tip path, region) and
+    the underactuated mode (paths for VLL lengths across its range, region)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib import cm
+
+    v = result.best_variant
+    combo = v.combination
+    ev = evaluate_locked(case, np.array(list(v.design.values())), combo)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 7.5), gridspec_kw={"width_ratios": [1, 1.5]})
+    S = ev.system
+    idx = np.searchsorted(ev.inputs, case.target_inputs)
+    joints = [(j.id, j.links) for j in S.mech.joints]
+    reg = np.vstack([case.region, case.region[:1]])
+    for ax in axes:
+        ax.fill(reg[:, 0], reg[:, 1], color="#d9f0d3", alpha=0.6, zorder=0, label="working region")
+        ax.plot(reg[:, 0], reg[:, 1], color="#1b7837", lw=1.2, zorder=1)
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+    ax = axes[0]
+    cols = cm.viridis(np.linspace(0, 0.9, len(idx)))
+    for c, k in zip(cols, idx):
+        q = ev.q[k:k + 1]
+        for i, name in enumerate(S.links):
+            pts = [S.point(q, i, S.to_local(name, S.mech.joint(jid).point))[0]
+                   for jid, lk in joints if name in lk]
+            pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
+            if len(pts) >= 2:
+                P = np.array(pts + pts[:1]) if len(pts) > 2 else np.array(pts)
+                ax.plot(P[:, 0], P[:, 1], "-o", color=c, lw=1.6, ms=2.5, alpha=0.85)
+        ax.plot([], [], color=c, lw=2, label=f"crank +{ev.inputs[k]:g}°")
+    for name, P in ev.paths.items():
+        ax.plot(P[:, 0], P[:, 1], "k--", lw=1.2, label=f"{name} path")
+    gp = np.array([j.point for j in S.mech.joints if S.mech.ground in j.links])
+    ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7, label="palm pivots")
+    ax.set_title(f"Fully actuated mode (VLL {'+'.join(combo)} locked at its minimum)\n"
+                 f"target error RMS {v.error_rms:.3g}°, max {v.error_max:.3g}°", fontsize=11)
+    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
+    ax = axes[1]
+    for jid, u in v.underactuated.items():
+        lens = u["lengths"]
+        lc = cm.plasma(np.linspace(0, 0.85, len(lens)))
+        for name, P in u["paths"].items():
+            for r in range(len(lens)):
+                ax.plot(P[r, :, 0], P[r, :, 1], color=lc[r], lw=1.6,
+                        label=f"{name}, {jid} = {lens[r]:.4g}" if name == case.points[0] else None)
+            for k in idx:  # adaptive motion with the motor still: the VLL sweeps its range
+                ax.plot(P[:, k, 0], P[:, k, 1], color="0.35", lw=0.9, ls=":")
+        ax.plot([], [], color="0.35", ls=":", label="motor still, VLL moving")
+    rng = ", ".join(f"{j}: [{a:.4g}, {b:.4g}]" for j, (a, b) in v.vll_ranges.items())
+    ax.set_title(f"Underactuated mode (VLL free), length range {rng}\n"
+                 f"peak reaction {v.forces['peak_reaction']:.3g}, peak input moment "
+                 f"{v.forces['peak_input_moment']:.3g}", fontsize=11)
+    for name, P in ev.paths.items():
+        ax.plot(P[:, 0], P[:, 1], "k--", lw=1.0, label=f"{name}, VLL locked (left panel)")
+    ax.legend(fontsize=8, loc="lower left")
+    box = np.vstack([case.region] + [u["paths"][n].reshape(-1, 2) for u in v.underactuated.values()
+                                     for n in u["paths"]])
+    box = box[np.all(np.isfinite(box), axis=1)]
+    lo, hi = box.min(axis=0), box.max(axis=0)
+    pad = 0.08 * (hi - lo).max()
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - 0.6 * (hi[1] - lo[1]) - pad, hi[1] + pad)  # room for the legend
+    ax.set_title(ax.get_title() + " (zoom on the region)", fontsize=11)
+    fig.suptitle(f"Paper 000, steps 8-13: {S.mech.name}", fontsize=12)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,94 @@
+"""``mechsyn synth finger-design CASE``: paper 000's parametric synthesis of a finger with VLL."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.table import Table
+
+from mechsyn.cli.app import synth_app
+from mechsyn.cli.common import console, emit_json, err_console
+from mechsyn.errors import MechsynInputError
+
+
+@synth_app.command("finger-design")
+def finger_design(
+    case_file: Path = typer.Argument(..., help="Case YAML/JSON: mechanism with VLL, variables, targets, region."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the differential evolution (reproducible)."),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Seconds for the optimisation (all stages)."),
+    json_out: bool = typer.Option(False, "--json", help="Print JSON on stdout."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="PNG: both modes' motion and the region."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+) -> None:
+    """Optimise a finger's link lengths on discrete positions with its VLL locked, find
+    each VLL's length range keeping the paths in the working region, minimise joint
+    reactions and input moment in both modes; best VLL combination (paper 000, steps 8-13)."""
+    from mechsyn.synthesis.finger_design import design_figure, design_finger, load_case
+
+    if time_limit <= 0:
+        raise MechsynInputError("--time-limit must be positive", source="--time-limit")
+    if plot is not None and plot.suffix.lower() != ".png":
+        raise MechsynInputError(f"{plot}: expected a .png file", source="--plot")
+    if out is not None and out.suffix.lower() not in (".yaml", ".yml", ".json"):
+        raise MechsynInputError(f"{out}: expected a .yaml or .json file", source="--out")
+    case = load_case(case_file)
+    progress = None if json_out or not err_console.is_terminal else (
+        lambda msg: err_console.print(f"[dim]{msg}[/]", highlight=False))
+    res = design_finger(case, seed=seed, time_limit=time_limit, progress=progress)
+    best = res.best_variant
+    if out is not None:
+        from mechsyn.io import write_mechanism
+
+        mech = dict(best.mechanism)
+        mech["name"] = f"{mech.get('name', 'finger')} (finger-design, seed {seed})"
+        write_mechanism(mech, out)
+    if plot is not None:
+        from mechsyn.results import save_figure_atomic
+
+        save_figure_atomic(design_figure(case, res), plot, dpi=110)
+    if json_out:
+        emit_json(res)
+        return
+    t = Table(title=f"Finger design: {case_file.name} (seed {seed}, {res.seconds:.1f} s)")
+    t.add_column("VLL")
+    t.add_column("stage-1 RMS err (deg)")
+    t.add_column("final RMS / max err (deg)")
+    t.add_column("VLL range")
+    t.add_column("peak |R| (joint) stage 1 -> final")
+    t.add_column("peak |M_in| stage 1 -> final")
+    for k, v in enumerate(res.variants):
+        fa = v.forces
+        t.add_row(("* " if k == res.best else "") + "+".join(v.combination), f"{v.stage1_error_rms:.4g}",
+                  f"{v.error_rms:.4g} / {v.error_max:.4g}",
+                  ", ".join(f"{j}: [{a:.4g}, {b:.4g}]" for j, (a, b) in v.vll_ranges.items()),
+                  f"{v.stage1_forces['peak_reaction']:.4g} -> {fa['peak_reaction']:.4g}",
+                  f"{v.stage1_forces['peak_input_moment']:.4g} -> {fa['peak_input_moment']:.4g}")
+    console.print(t)
+    d = Table(title="Best design (drawn, open configuration)")
+    d.add_column("variable")
+    d.add_column("stage 1")
+    d.add_column("final")
+    for name, val in best.design.items():
+        d.add_row(name, f"{best.stage1_design[name]:.5g}", f"{val:.5g}")
+    console.print(d)
+    tg = Table(title="Targets: phalanx rotation (deg) at crank rotation (deg)")
+    tg.add_column("crank")
+    for link in best.achieved:
+        tg.add_column(f"{link} target")
+        tg.add_column(f"{link} achieved")
+    for k, th in enumerate(res.targets["inputs"]):
+        row = [f"{th:g}"]
+        for link, ach in best.achieved.items():
+            row += [f"{res.targets['rotations'][link][k]:.4g}", f"{ach[k]:.4g}"]
+        tg.add_row(*row)
+    console.print(tg)
+    if not best.force_stage_improved:
+        console.print("force stage: no design found with lower reactions and input moment at the same accuracy; "
+                      "the stage-1 design is kept", highlight=False)
+    if res.stopped_by_time_limit:
+        console.print(f"note: stopped by the time limit ({time_limit:g} s)", highlight=False)
+    for path, what in ((out, "mechanism file"), (plot, "plot")):
+        if path is not None:
+            console.print(f"{what} written to {path}", highlight=False)
