@@ -99,20 +99,30 @@ def test_force_stage_never_increases_peak_reaction(result):
     assert fa["assembled"] and all(u["assembled"] for u in v.forces["underactuated"])
 
 
-def test_merged_locked_model_forces_match_full_file(result):
-    """The fast locked model (cylinder + piston merged) gives the full file's input moment."""
+def test_mode_forces_match_engine_newton_on_full_file(result):
+    """Both modes' peaks from the fast merged model equal the kinematics engine's Newton
+    solution of the full file (cylinder + piston; VLL locked, then free and held)."""
     case, res = result
     from mechsyn.kinematics.analysis import forces
-    from mechsyn.synthesis.finger_design import _peaks
 
     v = res.best_variant
-    x = np.array(list(v.design.values()))
-    ev = evaluate_locked(case, x, ("S",))
-    _pr, pm, _ = _peaks(ev.system, ev.q, case)
-    mech = mechanism_from_dict(apply_design(case, x))
-    fa = forces(mech, {"E": _drawn(mech, "E") + ev.inputs}, gravity=(0, -case.gravity), static=True,
-                vll={"S": "locked"}, method="newton")
-    assert pm == pytest.approx(float(np.max(np.abs(fa.reactions.effort["E"]))), rel=1e-6)
+    mech = mechanism_from_dict(v.mechanism)
+    grid = _drawn(mech, "E") + case.sweep_inputs
+    fa = forces(mech, {"E": grid}, gravity=(0, -case.gravity), static=True, vll={"S": "locked"},
+                method="newton")
+    assert v.forces["fully_actuated"]["peak_input_moment"] == pytest.approx(
+        float(np.max(np.abs(fa.reactions.effort["E"]))), rel=1e-6)
+    for s in v.forces["underactuated"]:
+        fu = forces(mech, {"E": grid, "S": np.full(len(grid), s["vll_length"])}, gravity=(0, -case.gravity),
+                    static=True, vll={"S": "free"}, method="newton")
+        assert fu.simulation.assembled.all()
+        assert s["peak_input_moment"] == pytest.approx(float(np.max(np.abs(fu.reactions.effort["E"]))), rel=1e-5)
+        peak_engine = max(float(np.max(np.linalg.norm(fu.reactions.force[j], axis=1))) for j in "ABCDEKL")
+        assert s["peak_reaction"] == pytest.approx(peak_engine, rel=1e-5)
+        # the force a spring / stop holding the free VLL must supply (engine: the P pair's effort) equals
+        # the merged link's axial force at the piston's pivot L up to the piston's own weight
+        piston_weight = 0.002 * case.gravity
+        assert abs(s["vll_force_peak"] - float(np.max(np.abs(fu.reactions.effort["S"])))) <= piston_weight
 
 
 def test_infeasible_designs_get_no_reward():

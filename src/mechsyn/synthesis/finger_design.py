@@ -50,7 +50,7 @@ from mechsyn.errors import MechsynInputError
 __all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
            "Evaluation", "evaluate_locked", "stage1_objective", "vll_range", "mode_forces",
            "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE", "points_in_region",
-           "underactuated_paths", "design_figure"]
+           "underactuated_paths", "design_figure", "redraw", "evaluate_drawn"]
 
 INFEASIBLE = 1e6
 Objective = Callable[[np.ndarray], float]
@@ -88,6 +88,7 @@ class FingerCase:
     maxiter: int = 60
     popsize: int = 12
     force_maxiter: int = 15
+    candidates: int = 3
 
     @property
     def sweep_inputs(self) -> np.ndarray:
@@ -230,7 +231,7 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
                      ("step_deg", float)):
         if key in data:
             setattr(case, key, typ(data[key]))
-    for key in ("maxiter", "popsize", "force_maxiter", "vll_steps"):
+    for key in ("maxiter", "popsize", "force_maxiter", "vll_steps", "candidates"):
         if key in opt:
             val = int(opt[key])
             if val < 1:
@@ -368,16 +369,26 @@ class Evaluation:
     violation: float = 0.0
 
 
-def evaluate_locked(case: FingerCase, x: np.ndarray, combo: tuple[str, ...],
-                    lengths: dict[str, float] | None = None) -> Evaluation:
-    """Closed-form positions of design ``x`` in the locked mode over ``case.sweep_inputs``."""
+def evaluate_locked(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] = ()) -> Evaluation:
+    """Closed-form positions of design ``x`` (VLL locked at their minimum) over
+    ``case.sweep_inputs``, with the target errors and the region check."""
+    try:
+        d = apply_design(case, x)
+    except (MechsynInputError, ValueError, KeyError) as exc:
+        return Evaluation(False, f"cannot build: {exc}", violation=1e3)
+    return evaluate_drawn(case, d)
+
+
+def evaluate_drawn(case: FingerCase, d: dict) -> Evaluation:
+    """Closed-form positions of the mechanism dict ``d`` with every VLL locked at its
+    drawn length (the locked model), over the crank grid ``case.sweep_inputs``."""
     from mechsyn.io import mechanism_from_dict
     from mechsyn.kinematics import dyads
     from mechsyn.kinematics.system import build_system
 
     vlls = [j["id"] for j in case.mech_dict["joints"] if j.get("vll")]
     try:
-        d = locked_model(apply_design(case, x, lengths), vlls, case.source)
+        d = locked_model(d, vlls, case.source)
         mech = mechanism_from_dict(d, source=case.source)
         S = build_system(mech)
         plan = dyads.decompose(S)
@@ -427,68 +438,118 @@ def stage1_objective(case: FingerCase, combo: tuple[str, ...]) -> Objective:
 
 
 # --------------------------------------------------------------------------- VLL range
-def underactuated_paths(case: FingerCase, design: dict, jid: str, lengths: np.ndarray,
-                        inputs: np.ndarray | None = None) -> dict[str, np.ndarray]:
-    """Output paths in the underactuated mode (VLL ``jid`` free, its length prescribed),
-    by the kinematics engine's Newton continuation over a serpentine of the
-    (length, crank) grid: point -> (n_lengths, n_inputs, 2), NaN where not assembled."""
+def redraw(case: FingerCase, design: dict, lengths: dict[str, float], steps: int = 4) -> dict | None:
+    """The mechanism dict redrawn at the same crank angle with the VLL lengths
+    ``lengths``: the underactuated mode (VLL free, length prescribed) solved by the
+    kinematics engine's Newton continuation from the drawn lengths; None when it cannot
+    be assembled. Joint points, named points, centres of mass and P axes follow their
+    links; a VLL's ``limits`` are kept."""
     from mechsyn.io import mechanism_from_dict
     from mechsyn.kinematics.analysis import simulate
-    from mechsyn.kinematics.system import build_system
+    from mechsyn.kinematics.system import _rot, build_system
 
-    mech = mechanism_from_dict(design, source=case.source)
-    S0 = build_system(mech, vll={jid: "free"}, prescribed=(jid,))
-    th0 = np.degrees(next(dr.assembled for dr in S0.drivers if dr.joint == case.input))
-    inputs = case.sweep_inputs if inputs is None else inputs
-    rows_E, rows_S = [], []
-    for k, l in enumerate(lengths):
-        seq = inputs if k % 2 == 0 else inputs[::-1]
-        rows_E.append(th0 + seq)
-        rows_S.append(np.full(len(seq), l))
-    lo, hi = case.vll_limits(jid)
-    design_lim = {jid: [min(lo, float(np.min(lengths))), max(hi, float(np.max(lengths)))]}
-    for j in design["joints"]:
-        if j["id"] in design_lim:
-            j["limits"] = design_lim[j["id"]]
-    mech = mechanism_from_dict(design, source=case.source)
-    sim = simulate(mech, {case.input: np.concatenate(rows_E), jid: np.concatenate(rows_S)},
-                   points=case.points, vll={jid: "free"}, method="newton")
-    out = {}
-    n = len(inputs)
-    for name, pm in sim.points.items():
-        P = pm.position.reshape(len(lengths), n, 2).copy()
-        P[1::2] = P[1::2, ::-1]
-        out[name] = P
+    d = copy.deepcopy(design)
+    for j in d["joints"]:  # the engine refuses lengths outside limits: widen them for the solve
+        if j["id"] in lengths:
+            lim = j.get("limits") or [lengths[j["id"]]] * 2
+            j["limits"] = [min(lim[0], lengths[j["id"]]), max(lim[1], lengths[j["id"]])]
+    mech = mechanism_from_dict(d, source=case.source)
+    S0 = build_system(mech)
+    th0 = float(np.degrees(next(dr.assembled for dr in S0.drivers if dr.joint == case.input)))
+    cur = {}
+    for jid in lengths:
+        j = mech.joint(jid)
+        K = _vll_ends(design, jid, case.source)[2]
+        cur[jid] = float(np.linalg.norm(j.point - mech.joint(K).point))
+    inputs = {case.input: np.full(steps + 1, th0)}
+    inputs.update({jid: np.linspace(cur[jid], lengths[jid], steps + 1) for jid in lengths})
+    try:
+        sim = simulate(mech, inputs, points=[], vll={jid: "free" for jid in lengths}, method="newton")
+    except MechsynInputError:
+        return None
+    if not sim.assembled[-1]:
+        return None
+    S, q = sim.system, sim.sweep.q[-1:]
+    ground = mech.ground
+
+    def moved(link: str, p: Any) -> list[float]:
+        if link == ground:
+            return [float(v) for v in p]
+        return S.point(q, S.index(link), S.to_local(link, np.asarray(p, float)))[0].tolist()
+
+    def turned(link: str, u: Any) -> list[float]:
+        if link == ground:
+            return [float(v) for v in u]
+        i = S.index(link)
+        c, sn = _rot(q[:, 3 * i + 2] - S.q0[3 * i + 2])
+        u = np.asarray(u, float)
+        return [float(c[0] * u[0] - sn[0] * u[1]), float(sn[0] * u[0] + c[0] * u[1])]
+
+    for j in d["joints"]:
+        link = j["links"][1] if j["links"][1] != ground else j["links"][0]
+        if j.get("axis") is not None:
+            j["axis"] = turned(j["links"][0], j["axis"])
+        j["point"] = moved(link, j["point"])
+    for p in (d.get("points") or {}).values():
+        p["at"] = moved(p["link"], p["at"])
+    for k, e in enumerate(d["links"]):
+        name = e if isinstance(e, str) else e["name"]
+        if name == ground:
+            continue
+        if isinstance(e, str):
+            e = d["links"][k] = {"name": e}
+        if e.get("com") is None:  # the file's default (its joints' mean, drawn), fixed on the link
+            e["com"] = np.mean([j["point"] for j in design["joints"] if name in j["links"]], axis=0).tolist()
+        e["com"] = moved(name, e["com"])
+    for ld in d.get("loads") or []:
+        if ld.get("at") is not None:
+            ld["at"] = moved(ld["link"], ld["at"])
+    for j in d["joints"]:
+        if j["id"] in lengths:
+            j["limits"] = next(x for x in design["joints"] if x["id"] == j["id"]).get("limits")
+    return d
+
+
+def underactuated_paths(case: FingerCase, design: dict, jid: str, lengths: np.ndarray
+                        ) -> dict[str, np.ndarray]:
+    """Output paths over the crank grid in the underactuated mode with VLL ``jid`` held
+    at each length: point -> (n_lengths, n_inputs, 2), NaN where not assembled. Each
+    length: :func:`redraw`, then the closed-form locked model."""
+    n = len(case.sweep_inputs)
+    out = {p: np.full((len(lengths), n, 2), np.nan) for p in case.points}
+    for r, length in enumerate(lengths):
+        d = redraw(case, design, {jid: float(length)})
+        if d is None:
+            continue
+        ev = evaluate_drawn(case, d)
+        for p, P in ev.paths.items():
+            out[p][r] = P
     return out
 
 
-def vll_range(case: FingerCase, design: dict, jid: str) -> tuple[float, float, dict[str, np.ndarray],
-                                                                  np.ndarray]:
+def vll_range(case: FingerCase, design: dict, jid: str, rel_tol: float = 1e-3
+              ) -> tuple[float, float, dict[str, np.ndarray], np.ndarray]:
     """(l_min, l_max, paths, lengths): the largest ``l_max`` in the VLL's limits such that
-    every output path for every length in ``[l_min, l_max]`` is assembled and inside the
-    region (grid of ``case.vll_steps`` lengths, then bisection to 1e-3 of the range)."""
+    every output path (whole crank range) for the lengths ``l_min ... l_max`` is
+    assembled and inside the region (grid of ``case.vll_steps`` lengths, then bisection
+    to ``rel_tol`` of the limits' range)."""
     lo, hi = case.vll_limits(jid)
     lengths = np.linspace(lo, hi, case.vll_steps + 1)
-    paths = underactuated_paths(case, copy.deepcopy(design), jid, lengths)
+    paths = underactuated_paths(case, design, jid, lengths)
 
-    def good_rows(P: dict[str, np.ndarray]) -> np.ndarray:
-        ok = np.ones(next(iter(P.values())).shape[0], bool)
-        for arr in P.values():
-            for r in range(arr.shape[0]):
-                ok[r] &= bool(points_in_region(arr[r], case.region).all())
-        return ok
+    def inside(P: dict[str, np.ndarray], r: int) -> bool:
+        return all(points_in_region(arr[r], case.region).all() for arr in P.values())
 
-    ok = good_rows(paths)
+    ok = np.array([inside(paths, r) for r in range(len(lengths))])
     if not ok[0]:
         return lo, lo, paths, lengths
     last = int(np.argmin(ok)) - 1 if not ok.all() else len(ok) - 1
     l_max = float(lengths[last])
     if last < len(lengths) - 1:  # bisection between the last good and the first bad length
         a, b = l_max, float(lengths[last + 1])
-        for _ in range(int(np.ceil(np.log2(max((b - a) / (1e-3 * (hi - lo)), 1.0))))):
+        while b - a > rel_tol * (hi - lo):
             m = 0.5 * (a + b)
-            P = underactuated_paths(case, copy.deepcopy(design), jid, np.array([lo, m]))
-            if good_rows(P).all():
+            if inside(underactuated_paths(case, design, jid, np.array([m])), 0):
                 a = m
             else:
                 b = m
@@ -514,44 +575,56 @@ def _peaks(S: Any, q: np.ndarray, case: FingerCase, skip: tuple[str, ...] = ()) 
 def mode_forces(case: FingerCase, design: dict, combo: tuple[str, ...],
                 ranges: dict[str, tuple[float, float]]) -> dict[str, Any]:
     """Peak joint reaction and peak balancing moment at the input over the crank range,
-    statically (gravity, the file's loads), in the fully actuated mode (VLL locked at
-    ``l_min``) and in the underactuated mode (VLL free, held at each end of its range:
-    the force the VLL must then supply is reported too), by the kinematics engine."""
-    from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics.analysis import forces
-
-    mech = mechanism_from_dict(design, source=case.source)
-    th0 = _drawn_input(case, mech)
-    grid = th0 + case.sweep_inputs
-    out: dict[str, Any] = {}
-    fa = forces(mech, {case.input: grid}, gravity=(0.0, -case.gravity), static=True, method="newton")
-    out["fully_actuated"] = _summary(fa, case, ())
-    worst = {"peak_reaction": 0.0, "peak_input_moment": 0.0}
+    statically (gravity along -y, the file's loads), in the fully actuated mode (VLL
+    locked at ``l_min``) and in the underactuated mode (VLL free, held at each end of
+    its range by a spring or stop: the axial force at the piston's pivot is reported as
+    ``vll_force_peak``; the spring force differs from it by at most the piston's weight). Closed-form locked models (``kinetostatics`` on the merged
+    cylinder-piston link); the tests compare them with the engine's Newton solution of
+    the full file in both modes."""
+    out: dict[str, Any] = {"fully_actuated": _static_summary(case, design, ())}
+    if not out["fully_actuated"]["assembled"]:
+        raise MechsynInputError("the design does not assemble over the crank range", source=case.source)
+    worst = {"peak_reaction": out["fully_actuated"]["peak_reaction"],
+             "peak_input_moment": out["fully_actuated"]["peak_input_moment"]}
+    out["underactuated"] = []
     for jid in combo:
         lo, hi = ranges[jid]
-        for l in (lo, hi):
-            vals = {case.input: grid, jid: np.full(len(grid), l)}
-            fu = forces(mech, vals, gravity=(0.0, -case.gravity), static=True, vll={jid: "free"},
-                        method="newton")
-            s = _summary(fu, case, (jid,))
-            s["vll_force_peak"] = float(np.nanmax(np.abs(fu.reactions.effort[jid])))
-            s["vll_length"] = l
-            out.setdefault("underactuated", []).append(s)
+        for length in sorted({lo, hi}):
+            d = design if length == lo else redraw(case, design, {jid: length})
+            s = _static_summary(case, d, (jid,)) if d is not None else {"assembled": False}
+            if not s["assembled"]:
+                raise MechsynInputError(f"the design does not assemble with {jid} = {length:g}",
+                                        source=case.source)
+            s["vll_length"] = length
+            out["underactuated"].append(s)
             for k in worst:
                 worst[k] = max(worst[k], s[k])
-    out["peak_reaction"] = max(out["fully_actuated"]["peak_reaction"], worst["peak_reaction"])
-    out["peak_input_moment"] = max(out["fully_actuated"]["peak_input_moment"], worst["peak_input_moment"])
+    out.update(worst)
     out["criterion"] = out["peak_reaction"] + case.weight_moment * out["peak_input_moment"]
     return out
 
 
-def _summary(fa: Any, case: FingerCase, skip: tuple[str, ...]) -> dict[str, Any]:
-    R = fa.reactions
-    mags = {j: float(np.nanmax(np.linalg.norm(F, axis=1))) for j, F in R.force.items()}
+def _static_summary(case: FingerCase, d: dict, vlls: tuple[str, ...]) -> dict[str, Any]:
+    from mechsyn.kinematics.forces import kinetostatics
+
+    ev = evaluate_drawn(case, d)
+    if ev.q is None:
+        return {"assembled": False}
+    S, q = ev.system, ev.q
+    R = kinetostatics(S, q, None, None, gravity=(0.0, -case.gravity))
+    mags = {j: float(np.max(np.linalg.norm(F, axis=1))) for j, F in R.force.items()}
     j = max(mags, key=mags.get)
-    return {"peak_reaction": mags[j], "peak_joint": j,
-            "peak_input_moment": float(np.nanmax(np.abs(R.effort[case.input]))),
-            "assembled": bool(fa.simulation.assembled.all())}
+    out = {"peak_reaction": mags[j], "peak_joint": j,
+           "peak_input_moment": float(np.max(np.abs(R.effort[case.input]))), "assembled": True}
+    for jid in vlls:  # axial force in the merged VLL link, at the piston's pivot L
+        _cyl, L, K, _pis = _vll_ends(case.mech_dict, jid, case.source)
+        jl, jk = S.mech.joint(L), S.mech.joint(K)
+        cyl = jl.links[0]
+        pl = S.point(q, S.index(cyl), S.to_local(cyl, jl.point))
+        pk = S.point(q, S.index(cyl), S.to_local(cyl, jk.point))
+        u = (pl - pk) / np.linalg.norm(pl - pk, axis=1)[:, None]
+        out["vll_force_peak"] = float(np.max(np.abs(np.sum(R.force[L] * u, axis=1))))
+    return out
 
 
 def _drawn_input(case: FingerCase, mech: Any) -> float:
@@ -650,7 +723,8 @@ def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int
     r = differential_evolution(f, bounds, seed=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
                                mutation=(0.5, 1.0), recombination=0.9, polish=False, init=init,
                                callback=cb, updating="deferred")
-    return np.asarray(r.x), float(r.fun), int(r.nfev), stopped[0]
+    pop = sorted(zip(np.asarray(r.population), np.asarray(r.population_energies)), key=lambda t: t[1])
+    return np.asarray(r.x), float(r.fun), int(r.nfev), stopped[0], pop
 
 
 def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
@@ -665,7 +739,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     for combo in case.combinations:
         if progress:
             progress(f"VLL {'+'.join(combo)}: stage 1 (targets, VLL locked at l_min)")
-        x1, f1, n1, st1 = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
+        x1, f1, n1, st1, _ = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
                               deadline)
         if f1 >= INFEASIBLE:
             raise MechsynInputError(
@@ -689,21 +763,31 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             init[k] = np.clip(x1 + 0.05 * (hi - lo) * rng.standard_normal(len(bounds)), lo, hi)
         if progress:
             progress("stage 2: forces (both modes)")
-        x2, f2, n2, st2 = _de(force_objective(case, combo, tol), bounds, seed, case.force_maxiter,
-                              case.popsize, deadline, init=init)
+        x2, f2, n2, st2, pop = _de(force_objective(case, combo, tol), bounds, seed, case.force_maxiter,
+                                   case.popsize, deadline, init=init)
         stopped = stopped or st1 or st2
         chosen, ranges, forces_, improved = x1, ranges1, forces1, False
-        if f2 < INFEASIBLE and not np.allclose(x2, x1):
-            d2 = apply_design(case, x2)
+        # the locked-mode criterion steers the search; the best few distinct members are
+        # then checked in both modes (VLL range and forces) and one is accepted only if
+        # the peak reaction does not rise and the criterion falls
+        uniq: list[np.ndarray] = []
+        for x, e in pop:
+            if e < INFEASIBLE and not np.allclose(x, x1) and not any(
+                    np.allclose(x, u, rtol=0, atol=1e-6) for u in uniq):
+                uniq.append(x)
+        for x in uniq[:case.candidates]:
+            if time.monotonic() > deadline:
+                stopped = True
+                break
+            d2 = apply_design(case, x)
             try:
                 ranges2 = {j: vll_range(case, d2, j)[:2] for j in combo}
                 forces2 = mode_forces(case, d2, combo, ranges2)
             except MechsynInputError:
-                forces2 = None
-            if forces2 is not None and all(r[1] > r[0] for r in ranges2.values()) \
-                    and forces2["peak_reaction"] <= forces1["peak_reaction"] \
-                    and forces2["criterion"] < forces1["criterion"]:
-                chosen, ranges, forces_, improved = x2, ranges2, forces2, True
+                continue
+            if all(r[1] > r[0] for r in ranges2.values()) and forces2["peak_reaction"] <= forces_["peak_reaction"] \
+                    and forces2["criterion"] < forces_["criterion"]:
+                chosen, ranges, forces_, improved = x, ranges2, forces2, True
         ev = evaluate_locked(case, chosen, combo)
         d = apply_design(case, chosen)
         for j in d["joints"]:
@@ -712,7 +796,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
         under = {}
         for jid in combo:
             lens = np.linspace(ranges[jid][0], ranges[jid][1], 5)
-            under[jid] = {"lengths": lens, "paths": underactuated_paths(case, copy.deepcopy(d), jid, lens)}
+            under[jid] = {"lengths": lens, "paths": underactuated_paths(case, d, jid, lens)}
         variants.append(VariantResult(
             combination=combo, stage1_design=dict(zip(names, x1.tolist())), stage1_error_rms=ev1.error_rms,
             stage1_error_max=ev1.error_max, design=dict(zip(names, chosen.tolist())), error_rms=ev.error_rms,
