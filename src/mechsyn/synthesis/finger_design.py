@@ -14,10 +14,12 @@ Steps 8-13 of paper 000 (spec ``structural.md`` section 4), for every VLL combin
    such that every output point's path for every length in ``[l_min, l_max]`` stays in
    the working region (a polygon) and the finger stays assembled.
 3. **Force stage (steps 10-12)**: static force analysis (gravity, the file's loads) in
-   both modes; a second optimisation minimises ``peak |R| + w * peak |M_in|`` (largest
-   joint reaction and balancing moment over the sweep) subject to the stage-1 accuracy
-   (``tolerance_deg``) and the region; candidates are re-checked in both modes and one
-   is accepted only if its peak reaction is not above the stage-1 design's.
+   both modes; a second optimisation (seeded with the stage-1 design) minimises
+   ``peak |R| + w * peak |M_in|`` (largest joint reaction and balancing moment over the
+   crank range) of the locked mode subject to the accuracy ``max(tolerance_deg, stage-1
+   RMS error)`` and the region; its best few distinct designs are then checked in both
+   modes (VLL range found again, forces at ``l_min`` and ``l_max``) and one replaces the
+   stage-1 design only if its peak reaction is not higher and its criterion lower.
 4. **Best variant (step 13)**: the combination with the smallest force criterion.
 
 **Objective interface** (``scipy.optimize.differential_evolution``, seeded): a design
@@ -93,7 +95,7 @@ class FingerCase:
     @property
     def sweep_inputs(self) -> np.ndarray:
         """Dense crank grid over the targets' range, the targets included."""
-        lo, hi = float(self.target_inputs.min()), float(self.target_inputs.max())
+        lo, hi = min(0.0, float(self.target_inputs.min())), max(0.0, float(self.target_inputs.max()))
         n = max(2, int(np.ceil((hi - lo) / self.step_deg)) + 1)
         return np.unique(np.concatenate([np.linspace(lo, hi, n), self.target_inputs, [0.0]]))
 
@@ -668,6 +670,7 @@ class VariantResult:
     stage1_forces: dict[str, Any]
     forces: dict[str, Any]
     force_stage_improved: bool
+    assembled_at_all_targets: bool = False
     mechanism: dict = field(repr=False, default_factory=dict)
     underactuated: dict[str, Any] = field(repr=False, default_factory=dict)
     evaluations: int = 0
@@ -676,7 +679,7 @@ class VariantResult:
         return {k: getattr(self, k) for k in (
             "combination", "stage1_design", "stage1_error_rms", "stage1_error_max", "design", "error_rms",
             "error_max", "achieved", "vll_ranges", "stage1_forces", "forces", "force_stage_improved",
-            "evaluations")}
+            "assembled_at_all_targets", "evaluations")}
 
 
 @dataclass
@@ -700,7 +703,7 @@ class FingerDesign:
                     "combination": b.combination, "design": b.design, "error_rms_deg": b.error_rms,
                     "error_max_deg": b.error_max, "vll_ranges": b.vll_ranges,
                     "peak_reaction": b.forces["peak_reaction"], "peak_input_moment": b.forces["peak_input_moment"],
-                    "assembled_at_all_targets": True},
+                    "assembled_at_all_targets": b.assembled_at_all_targets},
                 "targets": self.targets, "tolerance_deg": self.tolerance_deg,
                 "variants": [v.to_dict() for v in self.variants], "seconds": self.seconds,
                 "stopped_by_time_limit": self.stopped_by_time_limit,
@@ -802,6 +805,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             stage1_error_max=ev1.error_max, design=dict(zip(names, chosen.tolist())), error_rms=ev.error_rms,
             error_max=ev.error_max, achieved={k: v.tolist() for k, v in ev.achieved.items()},
             vll_ranges=ranges, stage1_forces=forces1, forces=forces_, force_stage_improved=improved,
+            assembled_at_all_targets=bool(ev.q is not None and np.isfinite(ev.q).all()),
             mechanism=d, underactuated=under, evaluations=n1 + n2))
     crit = [v.forces["criterion"] if all(r[1] > r[0] for r in v.vll_ranges.values()) else np.inf
             for v in variants]
