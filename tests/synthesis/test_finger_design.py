@@ -20,7 +20,7 @@ from mechsyn.io import load_mechanism, mechanism_from_dict
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger_design import (
-    INFEASIBLE, apply_design, case_from_dict, design_finger, evaluate_locked, force_objective, load_case,
+    INFEASIBLE, case_from_dict, design_finger, evaluate_locked, force_objective, load_case,
     points_in_region, stage1_objective)
 
 EX = Path(__file__).resolve().parents[2] / "examples" / "fingers"
@@ -198,3 +198,27 @@ def test_missing_case_file_exit_2(tmp_path):
 def test_case_from_dict_rejects_non_mapping():
     with pytest.raises(MechsynInputError):
         case_from_dict([1, 2, 3])
+
+
+def _tiny_case():
+    case = load_case(CASE)
+    case.maxiter, case.popsize, case.force_maxiter, case.vll_steps, case.candidates = 4, 5, 1, 3, 1
+    return case
+
+
+def test_same_seed_same_design():
+    a = design_finger(_tiny_case(), seed=7)
+    b = design_finger(_tiny_case(), seed=7)
+    assert a.best_variant.design == b.best_variant.design
+    assert a.best_variant.vll_ranges == b.best_variant.vll_ranges
+
+
+def test_no_feasible_design_is_an_input_error(tmp_path, capsys):
+    data = yaml.safe_load(CASE.read_text())
+    data["mechanism"] = str(EX / data["mechanism"])
+    data["region"] = [[100, 100], [110, 100], [110, 110]]     # no finger reaches it
+    data["optimizer"] = {"maxiter": 2, "popsize": 5}
+    case = tmp_path / "case.yaml"
+    case.write_text(yaml.safe_dump(data))
+    assert main(["synth", "finger-design", str(case)]) == 2
+    assert "no feasible design" in capsys.readouterr().err

@@ -39,7 +39,6 @@ mode (Newton continuation), an independent method.
 from __future__ import annotations
 
 import copy
-import itertools
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
