@@ -16,8 +16,9 @@ Steps 8-13 of paper 000 (spec ``structural.md`` section 4), for every VLL combin
 3. **Force stage (steps 10-12)**: static force analysis (gravity, the file's loads) in
    both modes; a second optimisation (seeded with the stage-1 design) minimises
    ``peak |R| + w * peak |M_in|`` (largest joint reaction and balancing moment over the
-   crank range) of the locked mode subject to the accuracy ``max(tolerance_deg, stage-1
-   RMS error)`` and the region; its best few distinct designs are then checked in both
+   crank range) of both modes (the VLL held at stage 1's ``l_max``) subject to the
+   accuracy ``max(tolerance_deg, stage-1 RMS error)``, the region and the stage-1 VLL
+   range (see :func:`force_objective`); its best few distinct designs are then checked in both
    modes (VLL range found again, forces at ``l_min`` and ``l_max``) and one replaces the
    stage-1 design only if its peak reaction is not higher and its criterion lower.
 4. **Best variant (step 13)**: the combination with the smallest force criterion.
@@ -439,14 +440,14 @@ def stage1_objective(case: FingerCase, combo: tuple[str, ...]) -> Objective:
 
 
 # --------------------------------------------------------------------------- VLL range
-def redraw(case: FingerCase, design: dict, lengths: dict[str, float], steps: int = 4) -> dict | None:
+def redraw(case: FingerCase, design: dict, lengths: dict[str, float]) -> dict | None:
     """The mechanism dict redrawn at the same crank angle with the VLL lengths
     ``lengths``: the underactuated mode (VLL free, length prescribed) solved by the
     kinematics engine's Newton continuation from the drawn lengths; None when it cannot
     be assembled. Joint points, named points, centres of mass and P axes follow their
     links; a VLL's ``limits`` are kept."""
     from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics.analysis import simulate
+    from mechsyn.kinematics.solve import assemble
     from mechsyn.kinematics.system import _rot, build_system
 
     d = copy.deepcopy(design)
@@ -455,22 +456,13 @@ def redraw(case: FingerCase, design: dict, lengths: dict[str, float], steps: int
             lim = j.get("limits") or [lengths[j["id"]]] * 2
             j["limits"] = [min(lim[0], lengths[j["id"]]), max(lim[1], lengths[j["id"]])]
     mech = mechanism_from_dict(d, source=case.source)
-    S0 = build_system(mech)
-    th0 = float(np.degrees(next(dr.assembled for dr in S0.drivers if dr.joint == case.input)))
-    cur = {}
-    for jid in lengths:
-        j = mech.joint(jid)
-        K = _vll_ends(design, jid, case.source)[2]
-        cur[jid] = float(np.linalg.norm(j.point - mech.joint(K).point))
-    inputs = {case.input: np.full(steps + 1, th0)}
-    inputs.update({jid: np.linspace(cur[jid], lengths[jid], steps + 1) for jid in lengths})
+    free = tuple(lengths)
     try:
-        sim = simulate(mech, inputs, points=[], vll={jid: "free" for jid in lengths}, method="newton")
+        S = build_system(mech, vll={jid: "free" for jid in free}, prescribed=free)
+        u = np.array([lengths[dr.joint] if dr.joint in lengths else dr.assembled for dr in S.drivers])
+        q = assemble(S, u)[None]  # Newton continuation from the drawn lengths (crank held)
     except MechsynInputError:
         return None
-    if not sim.assembled[-1]:
-        return None
-    S, q = sim.system, sim.sweep.q[-1:]
     ground = mech.ground
 
     def moved(link: str, p: Any) -> list[float]:
@@ -635,9 +627,18 @@ def _drawn_input(case: FingerCase, mech: Any) -> float:
     return float(np.degrees(next(dr.assembled for dr in S.drivers if dr.joint == case.input)))
 
 
-def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float) -> Objective:
-    """Stage 2: ``peak |R| + w peak |M_in|`` of the locked model (static, closed form),
-    feasible only when the target error stays within ``tol`` (deg RMS) and in the region."""
+def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float,
+                    hold: dict[str, float] | None = None, bound: float = np.inf) -> Objective:
+    """Stage 2: ``peak |R| + w peak |M_in|`` (static, closed form), feasible only when the
+    target error stays within ``tol`` (deg RMS) and the paths in the region.
+
+    The locked mode is evaluated first; its value is a lower bound of the both-mode
+    criterion, so only a design whose locked value is below ``bound`` (the stage-1
+    design's both-mode criterion) is also evaluated in the underactuated mode with the
+    VLL held at ``hold`` (stage 1's ``l_max``): there it must assemble over the crank
+    range and keep the paths in the region (the force stage keeps the adaptive range),
+    and its value becomes the both-mode criterion.
+    """
     def f(x: np.ndarray) -> float:
         ev = evaluate_locked(case, x, combo)
         if not ev.feasible:
@@ -650,7 +651,18 @@ def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float) -> Obj
             return INFEASIBLE + 1.0
         if not (np.isfinite(pr) and np.isfinite(pm)):
             return INFEASIBLE + 1.0
-        return pr + case.weight_moment * pm
+        value = pr + case.weight_moment * pm
+        if not hold or value >= bound:
+            return value
+        d = redraw(case, apply_design(case, x), hold)
+        ev2 = evaluate_drawn(case, d) if d is not None else None
+        if ev2 is None or not ev2.feasible:
+            return INFEASIBLE + (ev2.violation if ev2 is not None else 1.0)
+        try:
+            pr2, pm2, _ = _peaks(ev2.system, ev2.q, case)
+        except Exception:  # noqa: BLE001
+            return INFEASIBLE + 1.0
+        return max(pr, pr2) + case.weight_moment * max(pm, pm2)
     return f
 
 
@@ -765,7 +777,8 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             init[k] = np.clip(x1 + 0.05 * (hi - lo) * rng.standard_normal(len(bounds)), lo, hi)
         if progress:
             progress("stage 2: forces (both modes)")
-        x2, f2, n2, st2, pop = _de(force_objective(case, combo, tol), bounds, seed, case.force_maxiter,
+        x2, f2, n2, st2, pop = _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
+                                                   forces1["criterion"]), bounds, seed, case.force_maxiter,
                                    case.popsize, deadline, init=init)
         stopped = stopped or st1 or st2
         chosen, ranges, forces_, improved = x1, ranges1, forces1, False
