@@ -63,7 +63,8 @@ def finger_design(
         t.add_row(("* " if k == res.best else "") + "+".join(v.combination), f"{v.stage1_error_rms:.4g}",
                   f"{v.error_rms:.4g} / {v.error_max:.4g}",
                   ", ".join(f"{j}: [{a:.4g}, {b:.4g}]" for j, (a, b) in v.vll_ranges.items()),
-                  f"{v.stage1_forces['peak_reaction']:.4g} -> {fa['peak_reaction']:.4g}",
+                  f"{v.stage1_forces['peak_reaction']:.4g} ({v.stage1_forces['peak_joint']}) -> "
+                  f"{fa['peak_reaction']:.4g} ({fa['peak_joint']})",
                   f"{v.stage1_forces['peak_input_moment']:.4g} -> {fa['peak_input_moment']:.4g}")
     console.print(t)
     d = Table(title="Best design (drawn, open configuration)")

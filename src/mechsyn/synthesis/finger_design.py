@@ -593,6 +593,8 @@ def mode_forces(case: FingerCase, design: dict, combo: tuple[str, ...],
             for k in worst:
                 worst[k] = max(worst[k], s[k])
     out.update(worst)
+    modes = [out["fully_actuated"]] + out["underactuated"]
+    out["peak_joint"] = max(modes, key=lambda m: m["peak_reaction"])["peak_joint"]
     out["criterion"] = out["peak_reaction"] + case.weight_moment * out["peak_input_moment"]
     return out
 
