@@ -309,3 +309,26 @@ def test_cli_simulate_runs_the_file_and_bad_file_exits_2(capsys, tmp_path):
     bad.write_text(FILE.read_text().replace("wrap: ccw", "wrap: sideways"))
     assert main(["simulate", str(bad), "--input", "A0=90"]) == 2
     assert "wrap" in capsys.readouterr().err
+
+
+def test_sweep_stops_where_the_anchor_reaches_the_pulley():
+    # a winch: the anchor E (on a crank, |E| = rho) comes within r of the pulley centre Q:
+    # the run cannot stay straight and taut (d <= r). The limits satisfy |Q - E(φ)| = r.
+    d = {
+        "name": "winch", "ground": "frame", "links": ["frame", "carrier", "wheel"],
+        "joints": [
+            {"id": "O", "type": "R", "links": ["frame", "carrier"], "point": [0, 0], "actuated": True},
+            {"id": "Q", "type": "R", "links": ["frame", "wheel"], "point": [3, 1]},
+            {"id": "W", "type": "belt", "links": ["carrier", "wheel"], "point": [3, 1],
+             "anchor": [-0.5, 0.8], "radius": 2.5, "wrap": "ccw"},
+        ],
+    }
+    sim = simulate(mechanism_from_dict(d), {"O": np.arange(0.0, 360.0, 10.0)})
+    ok = sim.sweep.assembled
+    assert not ok[0] and ok[10] and not ok[-1]
+    rho, Q, r = math.hypot(-0.5, 0.8), np.array([3.0, 1.0]), 2.5
+    c = (Q @ Q + rho ** 2 - r ** 2) / (2 * rho * math.hypot(*Q))
+    phase = math.degrees(math.atan2(Q[1], Q[0]))
+    limits = sorted(((phase + s * math.degrees(math.acos(c))) % 360.0) for s in (1, -1))
+    found = sorted(e["input"]["O"] for e in sim.events if e["kind"] == "dead point")
+    assert np.allclose([found[0], found[-1]], limits, atol=1e-4)
