@@ -332,3 +332,40 @@ def test_sweep_stops_where_the_anchor_reaches_the_pulley():
     limits = sorted(((phase + s * math.degrees(math.acos(c))) % 360.0) for s in (1, -1))
     found = sorted(e["input"]["O"] for e in sim.events if e["kind"] == "dead point")
     assert np.allclose([found[0], found[-1]], limits, atol=1e-4)
+
+
+def test_static_forces_belt_tension_and_virtual_power():
+    # a downward load on H (left of A) turns the hand counter-clockwise about A; the belt
+    # holds it by a tension along its straight run, pulling the pulley towards B0
+    from mechsyn.kinematics.analysis import forces
+
+    d = mechanism_to_dict(load_mechanism(FILE))
+    d["loads"] = [{"link": "hand", "force": [0.0, -100.0], "point": "H"}]
+    mech = mechanism_from_dict(d)
+    u = 90.0 + np.arange(-70.0, 80.0 + 1e-9, 10.0)
+    fa = forces(mech, {"A0": u}, static=True)
+    sim = simulate(mech, {"A0": u}, points=["H", "A"])
+    F = np.array([0.0, -100.0])
+    # virtual power at unit input speed: M_A0 + F . v_H = 0
+    M = fa.reactions.effort["A0"]
+    vH = sim.points["H"].velocity
+    assert np.abs(M + vH @ F).max() <= 1e-9 * np.abs(vH @ F).max()
+    # the belt's force on the hand lies along the run: F = -tension * g
+    FW, MW = fa.reactions.force["W"], fa.reactions.moment["W"]
+    tension = fa.reactions.tension["W"]
+    B0 = np.asarray(mech.joint("W").attrs["anchor"])
+    for k in range(len(u)):
+        A = sim.points["A"].position[k]
+        T, g, _ = belt_tangent(A, B0, 75.0, "ccw")
+        assert np.allclose(FW[k], -tension[k] * g, atol=1e-9 * abs(tension[k]))
+        # about the pulley centre its moment is that of the tension at the tangent point
+        assert math.isclose(MW[k], (T - A)[0] * FW[k, 1] - (T - A)[1] * FW[k, 0], rel_tol=1e-9)
+    # design position: moments about A, load 100 * c = tension * r
+    k0 = int(np.flatnonzero(u == 90.0)[0])
+    assert math.isclose(tension[k0], 100.0 * PAPER.c / PAPER.r, rel_tol=1e-12)
+    # at Δφ = -70° H is right of A: the load turns the hand clockwise and the belt would
+    # have to push; it goes slack there, and the result says so
+    assert tension[0] < 0 and np.all(tension[1:] > 0)
+    notes = fa.notes()
+    assert len(notes) == 1 and "belt W is in compression" in notes[0] and "from 20 to 20" in notes[0]
+    assert fa.to_dict()["belts"]["W"]["tension"][k0] == pytest.approx(466.6666666666667)
