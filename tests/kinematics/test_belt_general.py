@@ -369,3 +369,19 @@ def test_static_forces_belt_tension_and_virtual_power():
     notes = fa.notes()
     assert len(notes) == 1 and "belt W is in compression" in notes[0] and "from 20 to 20" in notes[0]
     assert fa.to_dict()["belts"]["W"]["tension"][k0] == pytest.approx(466.6666666666667)
+
+
+def test_rank_of_a_belt_in_a_spatial_file_is_a_clear_note(capsys, tmp_path):
+    f = tmp_path / "spatial_belt.yaml"
+    f.write_text("""name: spatial belt
+kind: spatial
+ground: frame
+links: [frame, lever, hand]
+joints:
+- {id: A0, type: R, links: [frame, lever], point: [0, 0, 0], axis: [0, 0, 1], actuated: true}
+- {id: A, type: R, links: [lever, hand], point: [0, 500, 0], axis: [0, 0, 1]}
+- {id: W, type: belt, links: [frame, hand], point: [0, 500, 0], anchor: [75, 88.2, 0], radius: 75, wrap: ccw}
+""")
+    assert main(["analyze", str(f), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["rank"] is None and "not supported for belt pairs" in d["rank_unavailable"]

@@ -585,7 +585,8 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
             if np.linalg.norm(p - pts[0]) > 1e-12:
                 angle0[i] = _dir_angle(p - pts[0])
                 break
-    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()])
+    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()]
+                      + [np.asarray(j.attrs["anchor"], float) for j in mech.joints if j.type == "belt"])
     scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
 
     n_links = len(moving)
