@@ -385,3 +385,26 @@ joints:
     assert main(["analyze", str(f), "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["rank"] is None and "not supported for belt pairs" in d["rank_unavailable"]
+
+
+def test_belt_mechanism_dict_is_the_example_file_and_the_cli_writes_it(capsys, tmp_path):
+    from mechsyn.kinematics.belt import belt_mechanism_dict
+
+    ex = load_mechanism(FILE)
+    gen = mechanism_from_dict(belt_mechanism_dict(PAPER))
+    for j in ex.joints:
+        g = gen.joint(j.id)
+        assert g.type == j.type and g.links == j.links and np.allclose(g.point, j.point, atol=1e-12)
+        assert g.attrs.keys() == j.attrs.keys()
+    assert np.allclose(gen.joint("W").attrs["anchor"], ex.joint("W").attrs["anchor"], atol=1e-12)
+    for name, p in ex.points.items():
+        assert gen.points[name].link == p.link and np.allclose(gen.points[name].at, p.at, atol=1e-12)
+    out = tmp_path / "design.yaml"
+    args = ["belt", "analyze", "--a", "420", "--c", "260", "--h", "80", "--r", "55", "--phi", "-10:10:10"]
+    assert main([*args, "--mechanism-file", str(out)]) == 0
+    capsys.readouterr()
+    design = BeltDesign(a=420.0, c=260.0, h=80.0, r=55.0)
+    sim = simulate(load_mechanism(out), {"A0": 90.0 + np.array([-40.0, 0.0, 60.0])})
+    st = analyze(design, np.radians([-40.0, 0.0, 60.0]))
+    _close(sim.points["H"].position, st.H)
+    _close(sim.points["H"].acceleration, st.H2)
