@@ -326,6 +326,8 @@ def forces_cmd(
     if R.indeterminate:
         console.print("[yellow]note:[/] redundant constraints: the reactions are statically indeterminate; "
                       "minimum-norm values shown", highlight=False)
+    for note in fa.notes():
+        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
     for e in sim.events:
         where = ", ".join(f"{k} = {v:.6g}" for k, v in e["input"].items()) if isinstance(e.get("input"), dict) else ""
         console.print(f"[yellow]{e['kind']}[/] {where}: {escape(e['message'])}", highlight=False)

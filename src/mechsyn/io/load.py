@@ -308,7 +308,7 @@ class _Builder:
             raise self.error(
                 path + ["type"],
                 f"pair {jtype} ({kind.title}) is spatial and cannot appear in a planar mechanism",
-                "use R, P, cam, gear or generic, or set `kind: spatial`",
+                "use R, P, cam, gear, belt or generic, or set `kind: spatial`",
             )
         if len(entry.links) != 2:
             raise self.error(path + ["links"], f"a pair joins exactly two links, {len(entry.links)} given",
@@ -404,11 +404,35 @@ class _Builder:
                                          "use t, pi, numbers, + - * / **, sin, cos, tan, exp, sqrt, abs") from None
                     attrs["profile"] = {"center": [float(x) for x in c], "polar": prof.polar,
                                         "points": pts.tolist()}
+        belt_fields = {"anchor": entry.anchor, "radius": entry.radius, "wrap": entry.wrap}
+        if jtype != "belt":
+            for key, v in belt_fields.items():
+                if v is not None:
+                    raise self.error(path + [key], f"only a belt pair has `{key}`", f"remove `{key}` or set type: belt")
+        else:
+            attrs.update(self.belt(entry, path, point))
         return Joint(
             id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
             axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
             vll=entry.vll, limits=limits, attrs=attrs, higher_override=higher_override,
         )
+
+    def belt(self, entry: JointEntry, path: list[Any], point: np.ndarray | None) -> dict[str, Any]:
+        """Check a belt pair's fields: anchor (on the first link), radius, wrap, point (the
+        pulley centre on the second link); the anchor must lie outside the pulley."""
+        example = "e.g. {id: W, type: belt, links: [frame, hand], point: [0, 500], anchor: [75, 88.2], radius: 75, wrap: ccw}"
+        for key in ("anchor", "radius", "wrap"):
+            if getattr(entry, key) is None:
+                raise self.error(path, f"belt pair {entry.id} needs `{key}`", example)
+        if point is None:
+            raise self.error(path, f"belt pair {entry.id} needs `point` (the pulley centre)", example)
+        anchor = self.vector(entry.anchor, path + ["anchor"], "anchor")
+        d = float(np.linalg.norm(anchor[:2] - point[:2]))
+        if d <= entry.radius:
+            raise self.error(path + ["anchor"],
+                             f"the anchor is {d:g} from the pulley centre, not outside the radius {entry.radius:g}",
+                             "a taut straight belt needs the anchor farther from the centre than the radius")
+        return {"anchor": [float(x) for x in anchor], "radius": float(entry.radius), "wrap": entry.wrap}
 
     def joints(self, entries: Sequence[JointEntry], path0: list[Any], names: dict[str, str],
                ids: dict[int, str], taken: set[str]) -> list[Joint]:
@@ -530,7 +554,7 @@ class _Builder:
 # --------------------------------------------------------------------------- writing
 def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
     d: dict[str, Any] = {"id": j.id, "type": j.type, "links": list(j.links)}
-    if j.type == "generic" or (kind == "spatial" and j.type in ("cam", "gear")):
+    if j.type == "generic" or (kind == "spatial" and j.type in ("cam", "gear", "belt")):
         d["class"] = j.pair_class
     for key in ("point", "axis", "axis2", "normal"):
         v = getattr(j, key)
@@ -547,6 +571,10 @@ def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
     if j.attrs.get("profile") is not None:
         prof = j.attrs["profile"]
         d["profile"] = {k: v for k, v in prof.items() if k != "points"} if isinstance(prof, dict) else prof
+    if j.type == "belt":
+        for key in ("anchor", "radius", "wrap"):
+            if j.attrs.get(key) is not None:
+                d[key] = j.attrs[key]
     if j.attrs.get("description"):
         d["description"] = j.attrs["description"]
     return d

@@ -69,7 +69,8 @@ class JointEntry(_Strict):
     type: str = Field(
         description=(
             "Pair type: R, P, H (with pitch), C, U (with axis2), S, E (axis = plane normal), "
-            "S_pin, line_contact, point_contact, cam, gear (planar higher pairs), generic "
+            "S_pin, line_contact, point_contact, cam, gear (planar higher pairs), belt (a belt, "
+            "chain, band or rope anchored on the first link wrapping a pulley on the second), generic "
             "(with class). Aliases: revolute, prismatic, spherical, cylindrical, ..."
         )
     )
@@ -98,6 +99,13 @@ class JointEntry(_Strict):
             "(a function of the angle t) or a closed list of points [[x, y], ...] "
             "(interpolated by a periodic cubic spline)."),
     )
+    anchor: list[float] | None = Field(
+        None, description="belt: where the flexible element is pinned on the first link (assembled configuration).")
+    radius: float | None = Field(
+        None, gt=0, description="belt: pulley radius; the pulley is fixed on the second link, centred at `point`.")
+    wrap: Literal["ccw", "cw"] | None = Field(
+        None, description="belt: sense in which the belt turns round the pulley going from the anchor: "
+                          "ccw (counter-clockwise) or cw.")
     description: str | None = None
 
     @field_validator("id", mode="before")

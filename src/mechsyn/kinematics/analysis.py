@@ -342,11 +342,29 @@ class ForceAnalysis:
                            "moment": mask(r.moment[j])} for j in r.force},
             "drives": {j: {"kind": r.effort_kind[j], "value": mask(r.effort[j])} for j in r.effort},
             "indeterminate": r.indeterminate,
+            **({"belts": {j: {"tension": mask(t)} for j, t in r.tension.items()}} if r.tension else {}),
+            "notes": self.notes(),
             "events": sim.events,
             "method": sim.method,
             "convention": "force: exerted by the joint's first link on its second; drive value: moment (R) "
                           "or force (P) the actuator applies to the second link",
         }
+
+
+    def notes(self) -> list[str]:
+        """Warnings on the result: belts that would have to push (they go slack)."""
+        out = []
+        sim = self.simulation
+        main = sim.main_input
+        lam = self.reactions.lam
+        scale = float(np.nanmax(np.abs(lam))) if lam is not None and np.isfinite(lam).any() else 0.0
+        for j, t in self.reactions.tension.items():
+            bad = np.flatnonzero(sim.assembled & (np.nan_to_num(t) < -1e-9 * scale))
+            if len(bad):
+                vals = np.asarray(sim.inputs[main], float)[bad]
+                out.append(f"belt {j} is in compression (a belt can only pull: it goes slack) at {len(bad)} "
+                           f"of the inputs, {main} from {vals.min():g} to {vals.max():g}")
+        return out
 
 
 def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,

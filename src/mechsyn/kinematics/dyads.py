@@ -67,7 +67,7 @@ def _jtype(S: PlanarSystem, jid: str) -> str:
 def decompose(S: PlanarSystem) -> Plan | None:
     """Drivers and dyads in solving order, or None when the mechanism does not decompose."""
     mech = S.mech
-    if any(c.kind in ("gear", "curve") or c.role in ("lock", "idle") for c in S.cons):
+    if any(c.kind in ("gear", "curve", "belt") or c.role in ("lock", "idle") for c in S.cons):
         return None
     known = {-1}
     steps: list[Step] = []

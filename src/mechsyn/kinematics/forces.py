@@ -103,6 +103,9 @@ class Reactions:
     effort_kind: dict[str, str]
     indeterminate: bool
     lam: np.ndarray = field(repr=False, default=None)
+    #: belt pairs: tension of the straight run (N,); negative: the belt would have to
+    #: push, so it goes slack and the computed motion does not happen.
+    tension: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def generalised_loads(S: PlanarSystem, q: np.ndarray, qdd: np.ndarray | None, qd: np.ndarray | None,
@@ -154,7 +157,8 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
         cat = lambda name: {j: np.concatenate([getattr(p, name)[j] for p in parts])  # noqa: E731
                             for j in getattr(parts[0], name)}
         return Reactions(cat("force"), cat("moment"), cat("effort"), parts[0].effort_kind,
-                         any(p.indeterminate for p in parts), np.concatenate([p.lam for p in parts]))
+                         any(p.indeterminate for p in parts), np.concatenate([p.lam for p in parts]),
+                         cat("tension"))
     ok = np.all(np.isfinite(q), axis=1)
     N = q.shape[0]
     lam = np.full((N, S.m), np.nan)
@@ -203,10 +207,17 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
         if j.id in drive_rows:
             effort[j.id] = -lam[:, drive_rows[j.id]]
             kinds[j.id] = "moment" if j.type == "R" else "force"
+    tension = {}
+    row = 0
     for con in S.cons:
         if con.kind == "gear":
             _gear_tooth_force(S, con, q, force, moment)
-    return Reactions(force, moment, effort, kinds, indeterminate, lam)
+        if con.kind == "belt":
+            # the belt row's Jacobian is g (the unit run from anchor to tangent point) on the
+            # pulley's link: the force there is -λ g, so the tension is λ
+            tension[con.joint] = lam[:, row].copy()
+        row += con.rows
+    return Reactions(force, moment, effort, kinds, indeterminate, lam, tension)
 
 
 def _gear_tooth_force(S: PlanarSystem, con, q: np.ndarray, force: dict, moment: dict) -> None:

@@ -21,6 +21,13 @@ def _mpl():
     return plt
 
 
+def _joint_point_on(j, link: str) -> np.ndarray:
+    """The joint's point on ``link``: a belt's anchor on its first link, else its point."""
+    if j.type == "belt" and j.links[0] == link:
+        return np.asarray(j.attrs["anchor"], float)
+    return j.point
+
+
 def link_outlines(sim, k: int) -> dict[str, np.ndarray]:
     """Global coordinates of every link's joint points at step ``k`` (frame included)."""
     S = sim.system
@@ -28,7 +35,7 @@ def link_outlines(sim, k: int) -> dict[str, np.ndarray]:
     out = {}
     for name in S.mech.link_names:
         i = S.index(name)
-        pts = [S.point(q, i, S.to_local(name, j.point))[0] for j in S.mech.joints_of(name)
+        pts = [S.point(q, i, S.to_local(name, _joint_point_on(j, name)))[0] for j in S.mech.joints_of(name)
                if j.type != "cam"]  # a cam's contact point moves on both links: drawn apart
         pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
         out[name] = np.array(pts)
@@ -81,6 +88,27 @@ def _draw_mechanism(ax, sim, k: int, color: str = "0.2", alpha: float = 1.0) -> 
             t = np.linspace(0, 2 * np.pi, 61)
             arts += ax.plot(centre[0] + rho * np.cos(t), centre[1] + rho * np.sin(t), "-", color="tab:green",
                             lw=1.5, alpha=alpha, zorder=3)
+    for con in S.cons:
+        if con.kind != "belt":
+            continue
+        # the pulley, the straight run from the anchor to the tangent point, the wrapped arc
+        from mechsyn.model.pairs import belt_tangent
+
+        j = S.mech.joint(con.joint)
+        q = sim.sweep.q[k:k + 1]
+        centre, anchor = S.point(q, con.b, con.sb)[0], S.point(q, con.a, con.sa)[0]
+        t = np.linspace(0, 2 * np.pi, 91)
+        arts += ax.plot(centre[0] + con.radius * np.cos(t), centre[1] + con.radius * np.sin(t), "-",
+                        color="tab:green", lw=1.5, alpha=alpha, zorder=3)
+        try:
+            T, _, _ = belt_tangent(centre, anchor, con.radius, j.attrs["wrap"])
+        except ValueError:
+            continue
+        arts += ax.plot([anchor[0], T[0]], [anchor[1], T[1]], "-", color="k", lw=2, alpha=alpha, zorder=3)
+        t0 = np.arctan2(T[1] - centre[1], T[0] - centre[0])
+        arc = t0 + con.sigma * np.linspace(0, np.pi / 2, 20)
+        arts += ax.plot(centre[0] + con.radius * np.cos(arc), centre[1] + con.radius * np.sin(arc), "-",
+                        color="k", lw=2, alpha=alpha, zorder=3)
     for j in S.mech.joints:
         if j.type == "P":
             b = j.links[1]

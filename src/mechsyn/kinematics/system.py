@@ -20,7 +20,14 @@ Joints become constraint rows ``Phi(q, u) = 0`` (``u``: the input coordinates):
 * gear pair (ratio ``k``, carrier ``c``): ``(phi_b - phi_c) - k (phi_a - phi_c) = const``;
 * cam with a roller (or knife edge) on link ``b``: the roller centre stays on the
   profile's offset curve ``O(t)`` fixed on the cam ``a``:
-  ``P_b - r_a - A_a O(t) = 0`` (2 rows, one extra unknown ``t``).
+  ``P_b - r_a - A_a O(t) = 0`` (2 rows, one extra unknown ``t``);
+* belt (paper 001; chain, band, rope): anchored at ``E`` on link ``a``, wrapping a pulley
+  of radius ``r`` centred at ``P`` on link ``b`` in the sense ``σ`` (+1 ccw, -1 cw). With
+  ``D = P - E``, ``d = |D|``, ``δ = arg D``, free length ``b = sqrt(d² - r²)`` and tangent
+  point at ``τ = δ - σ atan2(b, -r)``, the belt length ``b + σ r (φ_b - τ)`` (straight run
+  plus ``r`` times the angle wrapped, measured in the pulley's frame) is constant:
+  ``b - r atan(b/r) + σ r (φ_b - δ) = const`` (1 row). Its Jacobian row is
+  ``g·dD + σ r dφ_b`` with ``g`` the unit belt direction (the tension's line of action).
 
 The Jacobian ``Phi_q`` is analytic; ``gamma`` is the right-hand side of the
 acceleration equation ``Phi_q q'' = gamma`` (Haug eq. 3.3.11). All functions work on a
@@ -29,13 +36,14 @@ batch of configurations: ``q`` has shape ``(N, n)``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.model.mechanism import Joint, Mechanism
+from mechsyn.model.pairs import BELT_WRAPS
 
 __all__ = ["PlanarSystem", "build_system", "VLL_MODES", "CamCurve"]
 
@@ -160,6 +168,9 @@ class Con:
     tvar: int = -1                # cam contact parameter's column
     curve: CamCurve | None = None
     role: str = ""                # "pair", "drive", "lock", "rotation", "idle"
+    radius: float = 0.0           # belt: pulley radius
+    sigma: float = 0.0            # belt: wrap sense, +1 ccw, -1 cw
+    ref: float = 0.0              # belt: phi_b - delta in the file's configuration
 
 
 @dataclass(frozen=True)
@@ -351,6 +362,15 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         c, s = _rot(pa)
         O = con.curve.eval(q[:, con.tvar])
         return S.point(q, con.b, con.sb) - ra - _apply(c, s, O)
+    if k == "belt":
+        D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
+        d2 = _dot(D, D)
+        r = con.radius
+        with np.errstate(invalid="ignore"):
+            b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))   # NaN: belt not taut and straight
+        rel = S.link_angle_i(q, con.b) - np.arctan2(D[:, 1], D[:, 0]) - con.ref
+        rel = np.mod(rel + np.pi, 2 * np.pi) - np.pi                 # continuous within half a turn
+        return (b - r * np.arctan2(b, r) + con.sigma * r * rel - con.c0)[:, None]
     raise AssertionError(k)
 
 
@@ -415,7 +435,31 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
             _put(J, row, con.a, -eye, -_perp(_apply(c, s, O)))
         J[:, row:row + 2, con.tvar] = -_apply(c, s, O1)
         return
+    if k == "belt":
+        g, _, _ = _belt_terms(S, con, q)
+        for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
+            if i < 0:
+                continue
+            _, phi = S.pose(q, i)
+            c, sn = _rot(phi)
+            dphi = sign * _dot(g, _perp(_apply(c, sn, sl)))
+            if i == con.b:
+                dphi = dphi + con.sigma * con.radius
+            _put(J, row, i, sign * g[:, None, :], dphi[:, None])
+        return
     raise AssertionError(k)
+
+
+def _belt_terms(S: PlanarSystem, con: Con, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit belt direction ``g = (b D - σ r R90 D)/d²`` (anchor to tangent point), ``D``
+    and the free length ``b`` of a belt constraint (NaN where ``d <= r``)."""
+    D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
+    d2 = _dot(D, D)
+    r = con.radius
+    with np.errstate(invalid="ignore"):
+        b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))
+    g = (b[:, None] * D - con.sigma * r * _perp(D)) / d2[:, None]
+    return g, D, b
 
 
 def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarray | None:
@@ -459,6 +503,27 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         g = ((wb ** 2)[:, None] * _apply(cb, sb, con.sb) - (wa ** 2)[:, None] * _apply(c, s, O)
              + (2 * wa * td)[:, None] * _perp(_apply(c, s, O1)) + (td ** 2)[:, None] * _apply(c, s, O2))
         return g
+    if k == "belt":
+        # Phi'' = dg/dt . D' + g . D'' + σ r phi_b'' with D'' = (terms in q'') - w_b² A_b s_b
+        # + w_a² A_a s_a, and dg/dt = w_g R90 g, w_g = (R90 D . D')/d² + σ r (D . D')/(d² b)
+        # (g turns with D's direction less the tangent offset arcsin(r/d)).
+        g, D, b = _belt_terms(S, con, q)
+        d2 = _dot(D, D)
+        out = 0.0
+        Dd = 0.0
+        for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
+            if i < 0:
+                continue
+            _, phi = S.pose(q, i)
+            c, sn = _rot(phi)
+            As = _apply(c, sn, sl)
+            v, w = _link_rates(S, qd, i)
+            Dd = Dd + sign * (v + w[:, None] * _perp(As))
+            out = out + sign * w ** 2 * _dot(g, As)
+        if np.ndim(Dd) == 0:
+            return np.zeros((q.shape[0], 1))
+        wg = _dot(_perp(D), Dd) / d2 + con.sigma * con.radius * _dot(D, Dd) / (d2 * b)
+        return (out - wg * _dot(_perp(g), Dd))[:, None]
     raise AssertionError(k)
 
 
@@ -489,9 +554,9 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
         if j.point is None:
             raise MechsynInputError(f"joint {j.id} has no point", source=src, field=f"joints.{j.id}.point",
                                     hint="give every joint a point, e.g. point: [0, 0], in the assembled configuration")
-        if j.type not in ("R", "P", "cam", "gear"):
+        if j.type not in ("R", "P", "cam", "gear", "belt"):
             raise MechsynInputError(f"joint {j.id}: pair type {j.type} is not supported by planar kinematics",
-                                    source=src, field=f"joints.{j.id}.type", hint="use R, P, cam or gear")
+                                    source=src, field=f"joints.{j.id}.type", hint="use R, P, cam, gear or belt")
     modes: dict[str, str] = {j.id: j.vll for j in mech.joints if j.vll}
     for jid, mode in (vll or {}).items():
         try:
@@ -512,13 +577,16 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
     origin0 = np.zeros((len(moving), 2))
     angle0 = np.zeros(len(moving))
     for i, name in enumerate(moving):
-        pts = [j.point for j in mech.joints_of(name)]
+        # a belt's point (the pulley centre) is on its second link; its first has the anchor
+        pts = [np.asarray(j.attrs["anchor"], float) if j.type == "belt" and j.links[0] == name else j.point
+               for j in mech.joints_of(name)]
         origin0[i] = pts[0]
         for p in pts[1:]:
             if np.linalg.norm(p - pts[0]) > 1e-12:
                 angle0[i] = _dir_angle(p - pts[0])
                 break
-    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()])
+    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()]
+                      + [np.asarray(j.attrs["anchor"], float) for j in mech.joints if j.type == "belt"])
     scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
 
     n_links = len(moving)
@@ -622,6 +690,20 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
                 ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], f)[0]
                 cons.append(Con("angle", j.id, 1, f, b, c0=float(ang), role="idle"))
                 notes.append(f"roller {b_name}: its spin about {others[0].id} is an idle mobility, held fixed")
+        elif j.type == "belt":
+            sa, sb = loc(a_name, np.asarray(j.attrs["anchor"], float)), loc(b_name, j.point)
+            sigma = BELT_WRAPS[j.attrs["wrap"]]
+            r = float(j.attrs["radius"])
+            con = Con("belt", j.id, 1, a, b, sa=sa, sb=sb, radius=r, sigma=sigma, role="pair")
+            D = j.point - np.asarray(j.attrs["anchor"], float)
+            ref = float(partial.link_angle_i(q0[None], b)[0] - np.arctan2(D[1], D[0]))
+            con = replace(con, ref=ref)
+            c0 = float(_residual(partial, con, q0[None], np.zeros((1, 0)))[0, 0])
+            cons.append(replace(con, c0=c0))
+            if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id
+                       and np.linalg.norm(x.point - j.point) < 1e-9 * scale for x in mech.joints):
+                notes.append(f"belt {j.id}: the pulley centre is on no R pair of {b_name} "
+                             "(a pulley usually turns on its carrier there)")
     for jid in prescribed:
         if jid not in [d.joint for d in drivers]:
             raise MechsynInputError(f"joint {jid} cannot be given an input", source="--input",
