@@ -88,6 +88,8 @@ def finger_design(
     if not best.force_stage_improved:
         console.print("force stage: no design found with lower reactions and input moment at the same accuracy; "
                       "the stage-1 design is kept", highlight=False)
+    for note in res.notes:
+        console.print(f"note: {note}", highlight=False)
     if res.stopped_by_time_limit:
         console.print(f"note: stopped by the time limit ({time_limit:g} s)", highlight=False)
     for path, what in ((out, "mechanism file"), (plot, "plot")):

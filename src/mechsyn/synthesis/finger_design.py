@@ -705,6 +705,7 @@ class FingerDesign:
     tolerance_deg: float
     seconds: float
     stopped_by_time_limit: bool = False
+    notes: list[str] = field(default_factory=list)
 
     @property
     def best_variant(self) -> VariantResult:
@@ -719,7 +720,7 @@ class FingerDesign:
                     "assembled_at_all_targets": b.assembled_at_all_targets},
                 "targets": self.targets, "tolerance_deg": self.tolerance_deg,
                 "variants": [v.to_dict() for v in self.variants], "seconds": self.seconds,
-                "stopped_by_time_limit": self.stopped_by_time_limit,
+                "stopped_by_time_limit": self.stopped_by_time_limit, "notes": self.notes,
                 "units": {"angles": "deg", "lengths": "file unit", "forces": "file force unit",
                           "moments": "force x length"}}
 
@@ -751,6 +752,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     bounds = [v.bounds for v in case.variables]
     names = [v.name for v in case.variables]
     variants = []
+    notes: list[str] = []
     stopped = False
     for combo in case.combinations:
         if progress:
@@ -758,10 +760,9 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
         x1, f1, n1, st1, _ = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
                               deadline)
         if f1 >= INFEASIBLE:
-            raise MechsynInputError(
-                f"no feasible design for VLL {'+'.join(combo)}: every tried design fails to assemble over the "
-                "crank range or leaves the region", source=case.source, field="variables",
-                hint="widen the bounds or the region, or move the targets")
+            notes.append(f"VLL {'+'.join(combo)}: no feasible design (every tried design fails to assemble over "
+                         "the crank range or leaves the region)")
+            continue
         ev1 = evaluate_locked(case, x1, combo)
         tol = max(case.tolerance_deg, ev1.error_rms)  # stage 2 keeps stage 1's accuracy
         d1 = apply_design(case, x1)
@@ -821,13 +822,17 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             vll_ranges=ranges, stage1_forces=forces1, forces=forces_, force_stage_improved=improved,
             assembled_at_all_targets=bool(ev.q is not None and np.isfinite(ev.q).all()),
             mechanism=d, underactuated=under, evaluations=n1 + n2))
+    if not variants:
+        raise MechsynInputError(
+            "no feasible design: " + "; ".join(notes), source=case.source, field="variables",
+            hint="widen the bounds or the region, or move the targets")
     crit = [v.forces["criterion"] if all(r[1] > r[0] for r in v.vll_ranges.values()) else np.inf
             for v in variants]
     best = int(np.argmin(crit))
     return FingerDesign(case.source, seed, variants, best,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
-                        case.tolerance_deg, time.monotonic() - t0, stopped)
+                        case.tolerance_deg, time.monotonic() - t0, stopped, notes)
 
 
 # --------------------------------------------------------------------------- plot
