@@ -179,6 +179,9 @@ def test_cli_json_out_and_plot(tmp_path, capsys):
     (lambda d: d.update(targets=[{"input": 0, "proximal": 0}]), []),
     (lambda d: d.update(combinations=[["K"]]), []),
     (lambda d: d.update(mechanism="nope.yaml"), []),
+    (lambda d: d.update(masses={"nolink": {"mass": 1}}), []),
+    (lambda d: d.update(masses={"distal": {"mass": "heavy"}}), []),
+    (lambda d: d.update(loads=[{"link": "distal", "force": [1]}]), []),
 ])
 def test_cli_bad_inputs_exit_2(tmp_path, capsys, mutate, args):
     data = yaml.safe_load(CASE.read_text())
@@ -222,3 +225,28 @@ def test_no_feasible_design_is_an_input_error(tmp_path, capsys):
     case.write_text(yaml.safe_dump(data))
     assert main(["synth", "finger-design", str(case)]) == 2
     assert "no feasible design" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_three_phalanx_every_vll_combination(tmp_path):
+    """Two VLLs: the combinations S1, S2 and S1+S2 are each designed; the best has the
+    smallest force criterion; a VLL outside the combination is rigid at its drawn length."""
+    case = load_case(EX / "finger_design_three_phalanx.yaml")
+    case.maxiter, case.popsize, case.force_maxiter, case.vll_steps, case.candidates = 12, 6, 2, 4, 1
+    res = design_finger(case, seed=0)
+    assert [v.combination for v in res.variants] == [("S1",), ("S2",), ("S1", "S2")]
+    crit = [v.forces["criterion"] for v in res.variants]
+    assert res.best == int(np.argmin(crit)) and min(crit) > 0      # masses and loads from the case
+    for v in res.variants:
+        assert v.assembled_at_all_targets and v.error_max <= 2.0
+        assert set(v.vll_ranges) == set(v.combination)
+        for jid, (lo, hi) in v.vll_ranges.items():
+            assert lo == case.vll_limits(jid)[0] and hi >= lo
+        lengths = {j["id"]: float(np.linalg.norm(np.subtract(j["point"], next(
+            k["point"] for k in v.mechanism["joints"] if k["id"] == ("K1" if j["id"] == "S1" else "K2")))))
+            for j in v.mechanism["joints"] if j["id"] in ("S1", "S2")}
+        for jid, length in lengths.items():
+            if jid in v.combination:
+                assert length == pytest.approx(case.vll_limits(jid)[0])
+            else:
+                assert length > case.vll_limits(jid)[0] + 1.0           # drawn length, not the minimum

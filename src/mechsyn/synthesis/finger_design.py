@@ -40,6 +40,7 @@ mode (Newton continuation), an independent method.
 from __future__ import annotations
 
 import copy
+import itertools
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -149,6 +150,40 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
     mech = load_mechanism(mpath)
     md = mechanism_to_dict(mech)
     joints = {j["id"]: j for j in md["joints"]}
+    names = [x if isinstance(x, str) else x["name"] for x in md["links"]]
+    masses = data.get("masses") or {}
+    if not isinstance(masses, dict):
+        raise _err("masses must map link names to {mass, com, inertia}", src, "masses")
+    for name, attrs in masses.items():
+        if name not in names or name == md["ground"] or not isinstance(attrs, dict) \
+                or set(attrs) - {"mass", "com", "inertia"}:
+            raise _err(f"masses.{name}: a moving link of the mechanism with mass, com, inertia", src,
+                       f"masses.{name}", hint=f"links: {', '.join(n for n in names if n != md['ground'])}")
+        k = names.index(name)
+        entry = {"name": name} if isinstance(md["links"][k], str) else md["links"][k]
+        for key, val in attrs.items():
+            entry[key] = _floats(val, 2, src, f"masses.{name}.com") if key == "com" else \
+                _floats([val], 1, src, f"masses.{name}.{key}")[0]
+        md["links"][k] = entry
+    if "loads" in data:
+        loads = data["loads"] or []
+        if not isinstance(loads, list):
+            raise _err("loads must be a list like the mechanism file's", src, "loads")
+        out_loads = []
+        for k, ld in enumerate(loads):
+            if not isinstance(ld, dict) or ld.get("link") not in names:
+                raise _err("each load names a link of the mechanism", src, f"loads[{k}]")
+            ld = dict(ld)
+            if "point" in ld:  # a named point: its drawn coordinates
+                pt = (md.get("points") or {}).get(ld["point"])
+                if pt is None or pt["link"] != ld["link"]:
+                    raise _err(f"loads[{k}].point must be a point of link {ld['link']}", src, f"loads[{k}]")
+            if "force" in ld:
+                ld["force"] = _floats(ld["force"], 2, src, f"loads[{k}].force")
+            if "at" in ld:
+                ld["at"] = _floats(ld["at"], 2, src, f"loads[{k}].at")
+            out_loads.append(ld)
+        md["loads"] = out_loads
     inp = str(data["input"])
     if inp not in joints or not joints[inp].get("actuated") or joints[inp]["type"] != "R":
         raise _err(f"input {inp!r} is not an actuated R joint of {mpath.name}", src, "input")
@@ -161,7 +196,8 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
         if lim is None or not (0 < lim[0] < lim[1]):
             raise _err(f"VLL {jid} needs limits [min, max] with 0 < min < max", src, "mechanism",
                        hint="the min is the minimum constructible length (paper 000, step 7)")
-    combos_raw = data.get("combinations") or [[j] for j in vll_all]
+    combos_raw = data.get("combinations") or [list(c) for r in range(1, len(vll_all) + 1)
+                                              for c in itertools.combinations(vll_all, r)]
     combos = []
     for c in combos_raw:
         c = [c] if isinstance(c, str) else list(c)
@@ -259,9 +295,11 @@ def _vll_ends(md: dict, jid: str, src: str) -> tuple[str, str, str, str]:
 
 
 # --------------------------------------------------------------------------- designs
-def apply_design(case: FingerCase, x: np.ndarray, lengths: dict[str, float] | None = None) -> dict:
-    """The mechanism dict of design ``x``: joint / point coordinates set, and each VLL
-    redrawn at its length (``lengths``, default its minimum) along its direction."""
+def apply_design(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] | None = None) -> dict:
+    """The mechanism dict of design ``x``: joint / point coordinates set; each VLL of the
+    combination ``combo`` (default: every VLL) drawn at its minimum constructible length
+    along its direction, the other VLL (plain rigid links in this variant) at their drawn
+    length."""
     d = copy.deepcopy(case.mech_dict)
     joints = {j["id"]: j for j in d["joints"]}
     angles: dict[str, float] = {}
@@ -279,7 +317,7 @@ def apply_design(case: FingerCase, x: np.ndarray, lengths: dict[str, float] | No
         pk = np.asarray(joints[K]["point"], float)
         u = np.asarray(j["point"], float) - pk
         ang = np.radians(angles[jid]) if jid in angles else np.arctan2(u[1], u[0])
-        length = (lengths or {}).get(jid, case.vll_limits(jid)[0])
+        length = case.vll_limits(jid)[0] if combo is None or jid in combo else float(np.linalg.norm(u))
         u = np.array([np.cos(ang), np.sin(ang)])
         p = pk + length * u
         j["point"] = p.tolist()
@@ -375,7 +413,7 @@ def evaluate_locked(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] = ()
     """Closed-form positions of design ``x`` (VLL locked at their minimum) over
     ``case.sweep_inputs``, with the target errors and the region check."""
     try:
-        d = apply_design(case, x)
+        d = apply_design(case, x, combo or None)
     except (MechsynInputError, ValueError, KeyError) as exc:
         return Evaluation(False, f"cannot build: {exc}", violation=1e3)
     return evaluate_drawn(case, d)
@@ -656,7 +694,7 @@ def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float,
         value = pr + case.weight_moment * pm
         if not hold or value >= bound:
             return value
-        d = redraw(case, apply_design(case, x), hold)
+        d = redraw(case, apply_design(case, x, combo), hold)
         ev2 = evaluate_drawn(case, d) if d is not None else None
         if ev2 is None or not ev2.feasible:
             return INFEASIBLE + (ev2.violation if ev2 is not None else 1.0)
@@ -765,7 +803,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             continue
         ev1 = evaluate_locked(case, x1, combo)
         tol = max(case.tolerance_deg, ev1.error_rms)  # stage 2 keeps stage 1's accuracy
-        d1 = apply_design(case, x1)
+        d1 = apply_design(case, x1, combo)
         if progress:
             progress("VLL ranges and forces of the stage-1 design")
         ranges1 = {j: vll_range(case, d1, j)[:2] for j in combo}
@@ -797,7 +835,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             if time.monotonic() > deadline:
                 stopped = True
                 break
-            d2 = apply_design(case, x)
+            d2 = apply_design(case, x, combo)
             try:
                 ranges2 = {j: vll_range(case, d2, j)[:2] for j in combo}
                 forces2 = mode_forces(case, d2, combo, ranges2)
@@ -807,7 +845,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                     and forces2["criterion"] < forces_["criterion"]:
                 chosen, ranges, forces_, improved = x, ranges2, forces2, True
         ev = evaluate_locked(case, chosen, combo)
-        d = apply_design(case, chosen)
+        d = apply_design(case, chosen, combo)
         for j in d["joints"]:
             if j["id"] in ranges:
                 j["limits"] = list(ranges[j["id"]])
@@ -859,7 +897,7 @@ def design_figure(case: FingerCase, result: FingerDesign) -> Any:
 
     v = result.best_variant
     combo = v.combination
-    d = apply_design(case, np.array(list(v.design.values())))
+    d = apply_design(case, np.array(list(v.design.values())), combo)
     ev = evaluate_drawn(case, d)
     fig, axes = plt.subplots(1, 3, figsize=(17, 7.2), gridspec_kw={"width_ratios": [1, 1, 1.3]})
     S = ev.system
