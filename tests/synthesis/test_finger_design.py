@@ -36,7 +36,10 @@ def small(case):
 @pytest.fixture(scope="module")
 def result():
     case = small(load_case(CASE))
-    return case, design_finger(case, seed=3, time_limit=60)
+    msgs: list[str] = []
+    res = design_finger(case, seed=3, time_limit=60, progress=msgs.append)
+    res.messages = msgs
+    return case, res
 
 
 def _drawn(mech, jid):
@@ -88,6 +91,16 @@ def test_vll_range_keeps_paths_in_region_dense_resimulation(result):
         sim = simulate(mechanism_from_dict(d), {"E": th0 + crank, "S": np.full(len(crank), beyond)},
                        points=["tip"], vll={"S": "free"}, method="newton")
         assert not (sim.assembled.all() and points_in_region(sim.points["tip"].position, case.region).all())
+
+
+def test_progress_reports_best_error_so_far(result):
+    _case, res = result
+    import re
+
+    best = [float(m.group(1)) for m in (re.search(r"stage 1, generation \d+/\d+, best RMS error (\S+) deg", t)
+                                        for t in res.messages) if m]
+    assert len(best) >= 2 and all(b <= a for a, b in zip(best, best[1:]))
+    assert best[-1] == pytest.approx(res.best_variant.stage1_error_rms, rel=1e-3)   # printed to 4 digits
 
 
 def test_force_stage_never_increases_peak_reaction(result):

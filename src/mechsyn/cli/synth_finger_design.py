@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Optional
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
@@ -34,9 +35,12 @@ def finger_design(
     if out is not None and out.suffix.lower() not in (".yaml", ".yml", ".json"):
         raise MechsynInputError(f"{out}: expected a .yaml or .json file", source="--out")
     case = load_case(case_file)
-    progress = None if json_out or not err_console.is_terminal else (
-        lambda msg: err_console.print(f"[dim]{msg}[/]", highlight=False))
-    res = design_finger(case, seed=seed, time_limit=time_limit, progress=progress)
+    if json_out or not err_console.is_terminal:
+        res = design_finger(case, seed=seed, time_limit=time_limit)
+    else:  # a status line on stderr with the stage and the best value so far
+        with err_console.status("finger design") as status:
+            res = design_finger(case, seed=seed, time_limit=time_limit,
+                                progress=lambda msg: status.update(escape(msg)))
     best = res.best_variant
     if out is not None:
         from mechsyn.io import write_mechanism

@@ -764,12 +764,18 @@ class FingerDesign:
 
 
 def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int, popsize: int,
-        deadline: float, init: Any = "latinhypercube") -> tuple[np.ndarray, float, int, bool]:
+        deadline: float, init: Any = "latinhypercube", report: Callable[[int, float], None] | None = None
+        ) -> tuple[np.ndarray, float, int, bool, list]:
+    """Seeded differential evolution; stops at ``deadline``; ``report(generation, best)``."""
     from scipy.optimize import differential_evolution
 
     stopped = [False]
+    gen = [0]
 
-    def cb(*_a: Any, **_k: Any) -> bool:
+    def cb(intermediate_result: Any) -> bool:
+        gen[0] += 1
+        if report is not None:
+            report(gen[0], float(intermediate_result.fun))
         if time.monotonic() > deadline:
             stopped[0] = True
             return True
@@ -795,8 +801,15 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     for combo in case.combinations:
         if progress:
             progress(f"VLL {'+'.join(combo)}: stage 1 (targets, VLL locked at l_min)")
+        label = "+".join(combo)
+
+        def report1(g: int, best: float, label: str = label) -> None:
+            if progress:
+                progress(f"VLL {label}: stage 1, generation {g}/{case.maxiter}, best " + (
+                    f"RMS error {best:.4g} deg" if best < INFEASIBLE else "design still infeasible"))
+
         x1, f1, n1, st1, _ = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
-                              deadline)
+                                 deadline, report=report1)
         if f1 >= INFEASIBLE:
             notes.append(f"VLL {'+'.join(combo)}: no feasible design (every tried design fails to assemble over "
                          "the crank range or leaves the region)")
@@ -820,7 +833,10 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             progress("stage 2: forces (both modes)")
         x2, f2, n2, st2, pop = _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
                                                    forces1["criterion"]), bounds, seed, case.force_maxiter,
-                                   case.popsize, deadline, init=init)
+                                   case.popsize, deadline, init=init,
+                                   report=(lambda g, best: progress(
+                                       f"VLL {label}: force stage, generation {g}/{case.force_maxiter}, best "
+                                       f"criterion {best:.4g}")) if progress else None)
         stopped = stopped or st1 or st2
         chosen, ranges, forces_, improved = x1, ranges1, forces1, False
         # the locked-mode criterion steers the search; the best few distinct members are
