@@ -18,7 +18,7 @@ from mechsyn.errors import MechsynInputError
 def finger_design(
     case_file: Path = typer.Argument(..., help="Case YAML/JSON: mechanism with VLL, variables, targets, region."),
     seed: int = typer.Option(0, "--seed", help="Seed of the differential evolution (reproducible)."),
-    time_limit: float = typer.Option(60.0, "--time-limit", help="Seconds for the optimisation (all stages)."),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Seconds for the optimisation stages (the final checks still run)."),
     json_out: bool = typer.Option(False, "--json", help="Print JSON on stdout."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="PNG: both modes' motion and the region."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
