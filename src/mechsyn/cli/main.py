@@ -12,6 +12,7 @@ from mechsyn.errors import MechsynInputError
 
 # Command modules (each registers its commands on the app when imported).
 from mechsyn.cli import version as _version  # noqa: F401
+from mechsyn.cli import synth_path as _synth_path  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -60,12 +60,13 @@ OptimizerFn = Callable[..., GlobalResult]
 def scipy_de(fitness, lower, upper, *, seed: int, should_stop, options: dict[str, Any]) -> GlobalResult:
     """SciPy ``differential_evolution``, vectorised, no built-in polish, stall stopping.
 
-    Options (defaults): ``strategy`` ("currenttobest1bin"), ``popsize`` (10),
-    ``maxiter`` (1500), ``mutation`` ((0.5, 1.0)), ``recombination`` (0.9), ``stall``
-    (generations without a relative improvement of 1e-6 before stopping; 150),
-    ``init`` ("latinhypercube").
+    Options (defaults): ``strategy`` ("randtobest1bin"), ``popsize`` (10),
+    ``maxiter`` (700), ``mutation`` ((0.5, 1.0)), ``recombination`` (0.9), ``stall``
+    (generations without a relative improvement of 1e-6 before stopping; 300),
+    ``init_oversample`` (20: the initial population is the best ``popsize * d`` of
+    ``20 popsize d`` uniform samples, ranked by the feasibility-first fitness).
     """
-    stall = int(options.get("stall", 150))
+    stall = int(options.get("stall", 300))
     state = {"best": np.inf, "since": 0}
 
     def callback(intermediate_result):
@@ -88,8 +89,8 @@ def scipy_de(fitness, lower, upper, *, seed: int, should_stop, options: dict[str
         init = X[np.argsort(f, kind="stable")[:npop]]
     res = differential_evolution(
         lambda X: fitness(X.T), list(zip(lower, upper)), vectorized=True, updating="deferred",
-        strategy=options.get("strategy", "currenttobest1bin"), popsize=int(options.get("popsize", 10)),
-        maxiter=int(options.get("maxiter", 1500)), mutation=options.get("mutation", (0.5, 1.0)),
+        strategy=options.get("strategy", "randtobest1bin"), popsize=int(options.get("popsize", 10)),
+        maxiter=int(options.get("maxiter", 700)), mutation=options.get("mutation", (0.5, 1.0)),
         recombination=float(options.get("recombination", 0.9)), init=init,
         tol=0.0, atol=0.0, seed=seed, polish=False, callback=callback,
     )
@@ -230,8 +231,8 @@ def restart_seeds(seed: int, restarts: int) -> list[int]:
 
 
 def synthesize_path(
-    case: PathCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 6, workers: int = 1,
-    optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
+    case: PathCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
+    optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
     progress: Callable[[int, int, float], None] | None = None,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
