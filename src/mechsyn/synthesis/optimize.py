@@ -152,17 +152,20 @@ class RestartResult:
 
 
 def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options: dict[str, Any],
-                 deadline: float, n_polish: int, report=None) -> RestartResult:
+                 deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0) -> RestartResult:
     t0 = time.monotonic()
     problem = PathProblem(case)
     m = problem.reduced_dim
     lower, upper = problem.lower[:m], problem.upper[:m]
     fn = OPTIMIZERS[optimizer]
 
+    # leave a little of the budget for polishing, so the whole run keeps its time limit
+    search_deadline = deadline - polish_reserve
+
     def should_stop(best):
         if report is not None:
             report(index, best)
-        return time.time() >= deadline
+        return time.time() >= search_deadline
 
     g = fn(problem.reduced_fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
     nfev = g.nfev
@@ -249,6 +252,7 @@ def synthesize_path(
     options = dict(options or {})
     t0 = time.time()
     deadline = t0 + time_limit
+    reserve = min(2.0, 0.05 * time_limit)
     seeds = restart_seeds(seed, restarts)
     results: list[RestartResult] = []
     best = [np.inf]
@@ -268,11 +272,11 @@ def synthesize_path(
             if results and time.time() >= deadline:
                 break
             r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
-                             report=lambda idx, f, done=len(results): note(done, f))
+                             report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve)
             results.append(r)
             note(len(results), r.fitness)
     else:
-        jobs = [(case, i, s, optimizer, options, deadline, n_polish) for i, s in enumerate(seeds)]
+        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
         with ProcessPoolExecutor(max_workers=workers) as pool:
             for r in pool.map(_restart_job, jobs):
                 results.append(r)
