@@ -219,13 +219,19 @@ def synth_motion(
             header="coupler point P = origin of the guided body's frame; joints at pose 1")
     if plot is not None:
         def draw(ax):
+            best_pts = np.array([best.O2, best.O4, *P[:, :2]])
+            lo, hi = best_pts.min(axis=0), best_pts.max(axis=0)
+            pad = 0.6 * (hi - lo).max() + 1e-9
             if len(P) == 4:
-                M, _ = center_point_curve(P)
-                ax.plot(M[:, 0], M[:, 1], ".", ms=1.5, color="0.6", label="centre-point curve")
+                M, _ = center_point_curve(P, n_dir=1440)
+                inside = np.all((M > lo - pad) & (M < hi + pad), axis=1)
+                ax.plot(M[inside, 0], M[inside, 1], ".", ms=1.5, color="0.6", label="centre-point curve")
+            ax.set_xlim(lo[0] - pad, hi[0] + pad)
+            ax.set_ylim(lo[1] - pad, hi[1] + pad)
             L = 0.15 * (np.ptp(P[:, :2], axis=0).max() + 1)
             for j, (x, y, a) in enumerate(P):
                 ax.annotate("", (x + L * np.cos(a), y + L * np.sin(a)), (x, y),
-                            arrowprops={"arrowstyle": "->", "color": "tab:red"})
+                            arrowprops={"arrowstyle": "->", "color": "tab:red", "lw": 2})
                 ax.text(x, y, f" {j + 1}", color="tab:red")
             for s in sols[:1]:
                 from mechsyn.synthesis.fourbar import fourbar_position
@@ -233,10 +239,12 @@ def synth_motion(
                                         x0=s.O2[0], y0=s.O2[1], theta0=s.theta0)
                 ch = np.array([s.O2, pose.A, pose.B, s.O4])
                 ax.plot(ch[:, 0], ch[:, 1], "-o", color="k", label="best linkage at pose 1")
-            ax.set_aspect("equal", adjustable="datalim")
+                tri = np.array([pose.A, pose.B, P[0, :2]])
+                ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3, label="coupler (guided body)")
+            ax.set_aspect("equal", adjustable="box")
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=8)
-            ax.set_title(f"Burmester synthesis, {len(P)} poses")
+            ax.set_title(f"Burmester synthesis, {len(P)} poses (red: required poses)")
         _save_plot(plot, draw)
     if as_json:
         emit_json({"solutions": [to_jsonable_motion(s) for s in sols[:top]], "count": len(sols),
