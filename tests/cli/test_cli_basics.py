@@ -9,3 +9,17 @@ def test_version(capsys):
 
 def test_unknown_command_is_usage_error(capsys):
     assert main(["no-such-command"]) == 2
+
+
+def test_write_atomic_gives_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    from mechsyn.results import write_atomic
+
+    mask = os.umask(0o022)
+    try:
+        write_atomic(tmp_path / "a.txt", "x")
+    finally:
+        os.umask(mask)
+    assert stat.S_IMODE(os.stat(tmp_path / "a.txt").st_mode) == 0o644

@@ -1,1 +1,34 @@
-"""mechsyn.capability."""
+"""mechsyn.capability: velocity capability of serial arms under joint speed limits.
+
+Paper 004 (mobility of a redundant planar manipulator), done exactly and vectorised:
+
+* :mod:`~mechsyn.capability.arm` -- arm files (planar_serial, dh, urdf), forward
+  kinematics, Jacobians, inverse kinematics over the self-motion;
+* :mod:`~mechsyn.capability.measures` -- exact directional speed limit (closed form over
+  the velocity zonotope), largest component, minimum-norm limit, the paper's stepping,
+  velocity polytope and ellipse;
+* :mod:`~mechsyn.capability.maps` -- best configuration over the self-motion, maps over
+  grids, interpolation of the optimal configuration, plots.
+"""
+
+from mechsyn.capability.arm import (
+    SerialArm, arm_from_dict, ik_numeric, ik_planar_3r, load_arm,
+)
+from mechsyn.capability.maps import (
+    CapabilityMap, capability_map, continuous_best, interpolate_configuration,
+    measure_values, plot_map, refine_over_self_motion, self_motion,
+)
+from mechsyn.capability.measures import (
+    MEASURES, VelocityEllipse, VelocityPolytope, all_measures, component_limit,
+    exact_limit, exact_limit_lp, min_norm_limit, min_norm_rates, stepped_limit,
+    velocity_ellipse, velocity_polytope,
+)
+
+__all__ = [
+    "SerialArm", "arm_from_dict", "ik_numeric", "ik_planar_3r", "load_arm",
+    "CapabilityMap", "capability_map", "continuous_best", "interpolate_configuration",
+    "measure_values", "plot_map", "refine_over_self_motion", "self_motion",
+    "MEASURES", "VelocityEllipse", "VelocityPolytope", "all_measures", "component_limit",
+    "exact_limit", "exact_limit_lp", "min_norm_limit", "min_norm_rates", "stepped_limit",
+    "velocity_ellipse", "velocity_polytope",
+]

@@ -11,7 +11,14 @@ from mechsyn.cli.app import app
 from mechsyn.errors import MechsynInputError
 
 # Command modules (each registers its commands on the app when imported).
+from mechsyn.cli import analyze as _analyze  # noqa: F401
+from mechsyn.cli import synth_groups as _synth_groups  # noqa: F401
 from mechsyn.cli import version as _version  # noqa: F401
+from mechsyn.cli import atlas as _atlas  # noqa: F401
+from mechsyn.cli import structure as _structure  # noqa: F401
+from mechsyn.cli import finger as _finger  # noqa: F401
+from mechsyn.cli import capability as _capability  # noqa: F401
+from mechsyn.cli import belt as _belt  # noqa: F401
 from mechsyn.cli import synth_path as _synth_path  # noqa: F401
 
 

@@ -1,1 +1,16 @@
-"""mechsyn.io."""
+"""The mechanism file format: reading, validation, writing, JSON Schema."""
+
+from mechsyn.io.load import (
+    load_mechanism,
+    mechanism_from_dict,
+    mechanism_from_text,
+    mechanism_to_dict,
+    read_data,
+    write_mechanism,
+)
+from mechsyn.io.schema import json_schema
+
+__all__ = [
+    "load_mechanism", "mechanism_from_dict", "mechanism_from_text", "mechanism_to_dict",
+    "read_data", "write_mechanism", "json_schema",
+]

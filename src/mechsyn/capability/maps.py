@@ -1,0 +1,390 @@
+"""Search over the self-motion of a redundant arm, and capability maps over a region.
+
+Paper 004: at every point A_i of a working region, the configurations M_i reaching it are
+sampled (q1 in 20 deg steps, the other joints by inverse kinematics); the best one gives
+V_max(A_i); tables over the region give maps of V_max and of the optimal joint angles, to
+be interpolated for motion planning. Here the search is also continuous (a dense q1 scan
+refined by golden-section search), vectorised over all points of a grid at once.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+from scipy.stats import qmc
+
+from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
+from mechsyn.capability.measures import (
+    MEASURES, component_limit, exact_limit, min_norm_limit, stepped_limit,
+)
+
+BRANCHES = {"negative": (-1,), "positive": (1,), "both": (-1, 1)}
+
+
+def measure_values(arm: SerialArm, q: np.ndarray, direction, measure: str = "exact",
+                   step: float = 5.0) -> np.ndarray:
+    """One directional measure (see :mod:`mechsyn.capability.measures`) at configurations
+    ``q`` (N, n); NaN rows (unreachable) give ``-inf``."""
+    if measure not in MEASURES:
+        raise ValueError(f"unknown measure {measure!r}; one of {', '.join(MEASURES)}")
+    q = np.atleast_2d(np.asarray(q, float))
+    good = np.all(np.isfinite(q), axis=1)
+    out = np.full(q.shape[0], -np.inf)
+    if not good.any():
+        return out
+    J = arm.jacobian(q[good])
+    w = arm.qd_max
+    if measure == "exact":
+        v = exact_limit(J, w, direction)
+    elif measure == "component":
+        v = component_limit(J, w, direction)
+    elif measure == "min_norm":
+        v = min_norm_limit(J, w, direction, arm.weights)
+    elif measure == "stepped":
+        v = stepped_limit(exact_limit(J, w, direction), step)
+    else:
+        v = stepped_limit(min_norm_limit(J, w, direction, arm.weights), step)
+    out[good] = v
+    return out
+
+
+def is_closed_form(arm: SerialArm) -> bool:
+    """Planar 3R arms have exact IK for given q1 (:func:`ik_planar_3r`)."""
+    return arm.kind == "planar" and arm.n == 3 and bool(arm.is_revolute.all())
+
+
+def q1_range(arm: SerialArm, respect_limits: bool = True) -> tuple[float, float]:
+    """Interval of the redundancy parameter q1 (radians): its limits, else a full turn."""
+    lo, hi = arm.lower[0], arm.upper[0]
+    if not respect_limits or not np.isfinite(lo) or not np.isfinite(hi):
+        return -math.pi, math.pi
+    return float(lo), float(hi)
+
+
+def self_motion(arm: SerialArm, point, q1: np.ndarray | None = None, branch: str = "negative",
+                respect_limits: bool = True, seeds: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Configurations reaching ``point`` over the self-motion.
+
+    Planar 3R: exact IK for each ``q1`` (radians) and each elbow of ``branch``
+    (``negative``: q3 < 0, paper 004's table; ``positive``; ``both``). Other arms: damped
+    least squares from ``seeds`` quasi-random starts (joint 1 fixed at each ``q1`` when
+    given), duplicates removed. Returns ``q`` (K, n) and ``valid`` (K,): reached and, when
+    ``respect_limits``, inside the joint limits.
+    """
+    if branch not in BRANCHES:
+        raise ValueError(f"branch must be one of {', '.join(BRANCHES)}")
+    if is_closed_form(arm):
+        if q1 is None:
+            lo, hi = q1_range(arm, respect_limits)
+            q1 = np.arange(lo, hi + 1e-9, math.radians(20.0))
+        qs, oks = [], []
+        for b in BRANCHES[branch]:
+            q, ok = ik_planar_3r(arm, point, q1, b)
+            qs.append(q)
+            oks.append(ok)
+        q, ok = np.concatenate(qs), np.concatenate(oks)
+    else:
+        lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+        hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+        start = qmc.scale(qmc.Halton(d=arm.n, scramble=False).random(seeds + 1)[1:], lo, hi)
+        if q1 is not None:
+            q1 = np.atleast_1d(q1)
+            start = np.repeat(start, q1.size, axis=0)
+            start[:, 0] = np.tile(q1, seeds)
+        q, ok = ik_numeric(arm, point, start, fixed_first=q1 is not None,
+                           respect_limits=respect_limits)
+        q, ok = q[ok], ok[ok]
+        if len(q):  # the same configuration up to full turns of R joints counts once
+            key = np.where(arm.is_revolute, (q + math.pi) % (2 * math.pi) - math.pi, q)
+            _, keep = np.unique(np.round(key, 4), axis=0, return_index=True)
+            q, ok = q[np.sort(keep)], ok[np.sort(keep)]
+    valid = ok & (arm.within_limits(np.nan_to_num(q)) if respect_limits else True)
+    return q, valid
+
+
+def _golden_max(f: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
+                iterations: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """Vectorised golden-section search for a maximum of ``f`` on ``[a, b]`` (arrays)."""
+    r = (math.sqrt(5) - 1) / 2
+    c, d = b - r * (b - a), a + r * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(iterations):
+        left = fc >= fd  # the maximum lies in [a, d]; else in [c, b]
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        nc = np.where(left, b - r * (b - a), d)
+        nd = np.where(left, c, a + r * (b - a))
+        fnew = f(np.where(left, nc, nd))
+        fc, fd = np.where(left, fnew, fd), np.where(left, fc, fnew)
+        c, d = nc, nd
+    x = np.where(fc >= fd, c, d)
+    return x, np.maximum(fc, fd)
+
+
+def continuous_best(arm: SerialArm, points: np.ndarray, direction, measure: str = "exact",
+                    branch: str = "negative", respect_limits: bool = True,
+                    scan_step_deg: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Best configuration over a continuous q1 for each of ``points`` (P, 2), planar 3R.
+
+    A q1 scan in ``scan_step_deg`` steps, then golden-section refinement within one step
+    of the best sample (infeasible q1 count as -inf). Returns ``q`` (P, 3), NaN where no
+    configuration reaches the point, and the measure (P,), -inf there.
+    """
+    if not is_closed_form(arm):
+        raise ValueError("continuous self-motion search is implemented for planar 3R arms")
+    points = np.atleast_2d(np.asarray(points, float))
+    P = points.shape[0]
+    lo, hi = q1_range(arm, respect_limits)
+    K = max(int(math.ceil((hi - lo) / math.radians(scan_step_deg))), 1) + 1
+    scan = np.linspace(lo, hi, K)
+    h = (hi - lo) / (K - 1) if K > 1 else 0.0
+    best_q = np.full((P, 3), np.nan)
+    best_v = np.full(P, -np.inf)
+    for b in BRANCHES[branch]:
+        def f(q1: np.ndarray, pts: np.ndarray = points, b: int = b) -> np.ndarray:
+            q, ok = ik_planar_3r(arm, pts, q1, b)
+            v = measure_values(arm, q, direction, measure)
+            if respect_limits:
+                v = np.where(arm.within_limits(np.nan_to_num(q, nan=np.inf)), v, -np.inf)
+            return np.where(ok, v, -np.inf)
+
+        grid_pts = np.repeat(points, K, axis=0)
+        vals = f(np.tile(scan, P), grid_pts).reshape(P, K)
+        k = np.argmax(vals, axis=1)
+        q1s, vs = scan[k], vals[np.arange(P), k]
+        a = np.clip(q1s - h, lo, hi)
+        c = np.clip(q1s + h, lo, hi)
+        x, fx = _golden_max(f, a, c)
+        better = fx > vs
+        q1s, vs = np.where(better, x, q1s), np.where(better, fx, vs)
+        q, ok = ik_planar_3r(arm, points, q1s, b)
+        improve = vs > best_v
+        best_v = np.where(improve, vs, best_v)
+        best_q[improve] = q[improve]
+    best_q[~np.isfinite(best_v)] = np.nan
+    return best_q, best_v
+
+
+def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
+                            measure: str = "exact", respect_limits: bool = True,
+                            iterations: int = 40, step: float = 0.2
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """Local search over the self-motion manifold from configurations ``q0`` (K, n).
+
+    Pattern search in the null space of J: each iteration tries ``q +/- h v_j`` for every
+    null-space basis vector ``v_j`` (from the SVD of J), pulls each trial back onto the
+    point with damped least squares (:func:`ik_numeric`), keeps the best improving one
+    (within the limits), and halves ``h`` where nothing improves. Vectorised over the K
+    starts; deterministic. Returns the refined ``q`` (K, n) and their measure (K,).
+    """
+    q = np.atleast_2d(np.asarray(q0, float)).copy()
+    K, n = q.shape
+    val = measure_values(arm, q, direction, measure)
+    h = np.full(K, step)
+    for _ in range(iterations):
+        J = arm.jacobian(q)
+        _, S, Vt = np.linalg.svd(J)
+        r = arm.task_dim
+        null = Vt[:, r:, :]  # (K, n - r, n)
+        if null.shape[1] == 0:
+            break
+        moves = np.concatenate([null, -null], axis=1) * h[:, None, None]  # (K, T, n)
+        T = moves.shape[1]
+        trial = (q[:, None, :] + moves).reshape(-1, n)
+        trial, ok = ik_numeric(arm, point, trial, respect_limits=respect_limits,
+                               iterations=30, tol=1e-9)
+        tv = measure_values(arm, trial, direction, measure)
+        if respect_limits:
+            ok &= arm.within_limits(trial)
+        tv = np.where(ok, tv, -np.inf).reshape(K, T)
+        k = np.argmax(tv, axis=1)
+        best = tv[np.arange(K), k]
+        better = best > val + 1e-12 * np.abs(val)
+        q[better] = trial.reshape(K, T, n)[np.arange(K), k][better]
+        val = np.where(better, best, val)
+        h = np.where(better, h, h / 2)
+        if np.all(h < 1e-6):
+            break
+    return q, val
+
+
+@dataclass
+class CapabilityMap:
+    """V_max over a grid: ``value[i, j]`` at ``(xs[i], ys[j])`` with the optimal
+    configuration ``q[i, j]`` (radians; NaN where no allowed configuration reaches)."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    z: float | None
+    direction: np.ndarray
+    measure: str
+    search: str
+    value: np.ndarray
+    q: np.ndarray
+    joint_names: tuple[str, ...]
+    joint_is_revolute: np.ndarray
+
+    def q_user(self) -> np.ndarray:
+        """Optimal joint values in file units (degrees for R joints)."""
+        return np.where(self.joint_is_revolute, np.degrees(self.q), self.q)
+
+    def to_dict(self) -> dict:
+        v = np.where(np.isfinite(self.value), self.value, np.nan)
+        return {"x": self.xs, "y": self.ys, "z": self.z, "direction": self.direction,
+                "measure": self.measure, "search": self.search,
+                "v_max": v, "q_opt": self.q_user(), "joints": list(self.joint_names)}
+
+    def rows(self) -> list[list[float]]:
+        """CSV rows ``x, y, v_max, q...`` (x outer, y inner)."""
+        qu = self.q_user()
+        out = []
+        for i, x in enumerate(self.xs):
+            for j, y in enumerate(self.ys):
+                v = self.value[i, j]
+                out.append([x, y, v if np.isfinite(v) else np.nan, *qu[i, j]])
+        return out
+
+
+def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
+                   measure: str = "exact", q1: np.ndarray | None = None,
+                   branch: str = "negative", respect_limits: bool = True,
+                   continuous: bool = False, chunk: int = 2048,
+                   advance: Callable[[int], None] | None = None) -> CapabilityMap:
+    """Best configuration and V_max at every grid point (paper 004, Table 2).
+
+    ``q1`` (radians) samples the self-motion (default: 20 deg steps over q1's limits, the
+    paper's choice); ``continuous`` uses :func:`continuous_best` instead (planar 3R), or
+    refines the best 8 IK solutions with :func:`refine_over_self_motion` (other arms).
+    ``advance(k)`` is called after each chunk of k points (for a progress bar).
+    Spatial arms need ``z`` (the grid lies in the plane z = const).
+    """
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    pts = np.stack([X.ravel(), Y.ravel()], 1)
+    if arm.kind == "spatial":
+        pts = np.hstack([pts, np.full((pts.shape[0], 1), 0.0 if z is None else z)])
+    P = pts.shape[0]
+    value = np.full(P, -np.inf)
+    qopt = np.full((P, arm.n), np.nan)
+    for start in range(0, P, chunk):
+        sl = slice(start, min(start + chunk, P))
+        if continuous and is_closed_form(arm):
+            qopt[sl], value[sl] = continuous_best(arm, pts[sl], direction, measure, branch,
+                                                  respect_limits)
+        elif is_closed_form(arm):
+            if q1 is None:
+                lo, hi = q1_range(arm, respect_limits)
+                q1s = np.arange(lo, hi + 1e-9, math.radians(20.0))
+            else:
+                q1s = np.atleast_1d(q1)
+            K = q1s.size
+            pp = np.repeat(pts[sl], K, axis=0)
+            bq, bv = [], []
+            for b in BRANCHES[branch]:
+                q, ok = ik_planar_3r(arm, pp, np.tile(q1s, sl.stop - sl.start), b)
+                v = measure_values(arm, q, direction, measure)
+                if respect_limits:
+                    v = np.where(arm.within_limits(np.nan_to_num(q, nan=np.inf)), v, -np.inf)
+                bq.append(q.reshape(-1, K, 3))
+                bv.append(v.reshape(-1, K))
+            qq, vv = np.concatenate(bq, 1), np.concatenate(bv, 1)
+            k = np.argmax(vv, axis=1)
+            rows = np.arange(vv.shape[0])
+            value[sl], qopt[sl] = vv[rows, k], qq[rows, k]
+        else:
+            for p in range(sl.start, sl.stop):
+                q, valid = self_motion(arm, pts[p], q1, branch, respect_limits)
+                if valid.any():
+                    q = q[valid]
+                    v = measure_values(arm, q, direction, measure)
+                    if continuous:
+                        top = np.argsort(-v, kind="stable")[:8]
+                        q, v = refine_over_self_motion(arm, pts[p], q[top], direction,
+                                                       measure, respect_limits)
+                    k = int(np.argmax(v))
+                    value[p], qopt[p] = v[k], q[k]
+        if advance is not None:
+            advance(sl.stop - sl.start)
+    qopt[~np.isfinite(value)] = np.nan
+    d = np.asarray(direction, float)
+    return CapabilityMap(xs, ys, z, d / np.linalg.norm(d), measure,
+                         "continuous" if continuous else "sampled",
+                         value.reshape(X.shape), qopt.reshape(*X.shape, arm.n),
+                         arm.joint_names, arm.is_revolute)
+
+
+def interpolate_configuration(cmap: CapabilityMap, method: str = "cubic"
+                              ) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """Interpolant ``(x, y) -> q`` (radians, shape (..., n)) of the optimal configuration
+    over the map (paper 004 suggests Lagrange polynomials; here
+    scipy's RegularGridInterpolator, ``linear``, ``cubic`` or ``quintic``). Points
+    near unreachable cells give NaN; the optimum may jump between self-motion branches,
+    so check the interpolated configuration with forward kinematics before use.
+    """
+    q = cmap.q
+    interp = RegularGridInterpolator((cmap.xs, cmap.ys), q, method=method,
+                                     bounds_error=False, fill_value=np.nan)
+
+    def at(x, y):
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        return interp(np.stack([x.ravel(), y.ravel()], -1)).reshape(*x.shape, q.shape[-1])
+
+    return at
+
+
+def plot_map(cmap: CapabilityMap, path, units: str = "mm/s") -> None:
+    """Heat map with contour lines of V_max and panels of the optimal joint values."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mechsyn.results import save_figure_atomic
+
+    n = cmap.q.shape[-1]
+    panels = 1 + n
+    cols = 2 if panels <= 4 else 3
+    rows_ = math.ceil(panels / cols)
+    fig, axs = plt.subplots(rows_, cols, figsize=(5.2 * cols, 4.4 * rows_), squeeze=False)
+    small = cmap.xs.size * cmap.ys.size <= 144
+    qu = cmap.q_user()
+    fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
+               f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
+               f"[{units}]" + ("" if cmap.z is None else f" in z = {cmap.z:g}")
+               + f"\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
+    for k in range(n):
+        data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else ""
+        if cmap.joint_is_revolute[k] and np.nanmax(np.abs(data), initial=0.0) > 180:
+            data, unit = (data + 180) % 360 - 180, "deg, shown mod 360"  # same pose
+        fields.append((data, f"optimal {cmap.joint_names[k]} [{unit}]", "coolwarm"))
+    for idx, (data, title, cm) in enumerate(fields):
+        ax = axs[idx // cols][idx % cols]
+        mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
+        fig.colorbar(mesh, ax=ax, shrink=0.85)
+        finite = np.isfinite(data)
+        if (idx == 0 and cmap.xs.size > 2 and cmap.ys.size > 2 and finite.sum() > 4
+                and np.nanstd(data) > 0):
+            try:
+                cs = ax.contour(cmap.xs, cmap.ys, data.T, levels=8, colors="k", linewidths=0.6)
+                if not small:
+                    ax.clabel(cs, fontsize=8, fmt="%.0f")
+            except (ValueError, TypeError):
+                pass
+        if small:
+            for i, x in enumerate(cmap.xs):
+                for j, y in enumerate(cmap.ys):
+                    if np.isfinite(data[i, j]):
+                        ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=8,
+                                color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_aspect("equal")
+    for idx in range(panels, rows_ * cols):
+        axs[idx // cols][idx % cols].axis("off")
+    fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,286 @@
+"""Velocity capability measures of an arm configuration under joint speed limits.
+
+The joint rates lie in the box ``|q_dot_i| <= w_i`` (``w`` = joint speed limits); the end
+point velocities ``v = J q_dot`` then fill the *velocity zonotope*
+``Z = { sum_i a_i g_i : |a_i| <= 1 }`` with generators ``g_i = w_i J[:, i]``.
+For a unit direction ``d`` (paper 004, "mobility"):
+
+* :func:`exact_limit` -- the largest speed of *pure* motion along ``d``:
+  ``max s`` s.t. ``J q_dot = s d``, ``|q_dot_i| <= w_i``. In 2-D, closed form:
+  ``s* = min_k h(n_k) / |n_k . d|`` over the facet normals ``n_k = perp(g_k)`` of Z with
+  the support function ``h(n) = sum_i |n . g_i|``. In m-D (spatial arms) the same over
+  the normals of (m-1)-subsets of generators; a linear program (HiGHS) where J is
+  rank-deficient (:func:`exact_limit_lp`).
+* :func:`component_limit` -- the largest component along ``d`` with the perpendicular
+  part free: ``h(d) = sum_i w_i |d . J[:, i]|`` (>= the exact limit).
+* :func:`min_norm_limit` -- the limit of the (weighted) minimum-norm joint rates
+  ``q_dot = J^+ s d`` (paper 004's Q_dot_N): ``1 / max_i |(J^+ d)_i| / w_i``.
+* :func:`stepped_limit` -- paper 004's procedure: raise the speed from 5 mm/s in 5 mm/s
+  steps until a joint rate limit is broken; the last feasible value (0 if none).
+
+All functions take stacks: ``J`` of shape (N, m, n); ``w`` (n,) or (N, n); ``d`` (m,) or
+(N, m) (normalised inside). Singular configurations give finite values, never NaN.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linprog
+from scipy.spatial import ConvexHull, QhullError
+
+# relative tolerance for "this facet normal is perpendicular to d" (round-off level)
+_PERP_TOL = 1e-12
+
+
+def _prep(J, w, d):
+    J = np.asarray(J, float)
+    if J.ndim == 2:
+        J = J[None]
+    N, m, n = J.shape
+    w = np.broadcast_to(np.asarray(w, float), (N, n))
+    d = np.broadcast_to(np.asarray(d, float), (N, m))
+    norm = np.linalg.norm(d, axis=-1, keepdims=True)
+    if np.any(norm == 0) or not np.all(np.isfinite(d)):
+        raise ValueError("direction must be a finite non-zero vector")
+    return J, w, d / norm
+
+
+def exact_limit(J, w, d) -> np.ndarray:
+    """Largest speed of pure motion along ``d`` (see module docstring), shape (N,).
+
+    2-D tasks: the closed form over the zonotope's facets, vectorised. Candidate normals
+    are ``perp(g_k)`` (the facet normals of a full zonotope) and ``g_k`` itself (each a
+    valid bound; they make the degenerate case exact, where Z is a segment along
+    ``d``). Normals perpendicular to ``d`` give no bound; if no normal is left (J = 0)
+    the limit is 0. Other task dimensions: facet enumeration (see the module docstring),
+    a linear program for rank-deficient Jacobians.
+    """
+    J, w, d = _prep(J, w, d)
+    m, n = J.shape[1], J.shape[2]
+    if m != 2:
+        if m < 2 or m > 6 or n > 12:
+            return exact_limit_lp(J, w, d)
+        return _exact_limit_facets(J, w, d)
+    G = J * w[:, None, :]  # (N, 2, n) generators
+    P = np.stack([-G[:, 1], G[:, 0]], 1)  # perpendiculars
+    normals = np.concatenate([P, G], axis=2)  # (N, 2, 2n)
+    return _limit_from_normals(G, normals, d)
+
+
+def _limit_from_normals(G: np.ndarray, normals: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """``min_k h(n_k) / |n_k . d|`` over candidate normals (N, m, K); 0 if none bounds."""
+    length = np.linalg.norm(normals, axis=1)  # (N, K)
+    size = length.max(axis=1, keepdims=True)
+    usable = length > _PERP_TOL * size
+    unit = normals / np.where(usable, length, 1.0)[:, None, :]
+    h = np.abs(np.einsum("nik,nij->nkj", unit, G)).sum(-1)  # support values (N, 2n)
+    nd = np.abs(np.einsum("nik,ni->nk", unit, d))
+    usable &= nd > _PERP_TOL
+    ratio = np.where(usable, h / np.where(usable, nd, 1.0), np.inf)
+    s = ratio.min(axis=1)
+    return np.where(np.isfinite(s), s, 0.0)
+
+
+def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """m-D closed form: the facet normals of a full-dimensional zonotope are the normals
+    of the hyperplanes spanned by (m-1)-subsets of generators (generalised cross products,
+    by cofactors); configurations whose J is rank-deficient go to the linear program."""
+    from itertools import combinations
+
+    N, m, n = J.shape
+    G = J * w[:, None, :]
+    subsets = np.array(list(combinations(range(n), m - 1)))  # (C, m-1)
+    if subsets.size == 0:
+        return exact_limit_lp(J, w, d)
+    sub = G[:, :, subsets]  # (N, m, C, m-1)
+    sub = np.moveaxis(sub, 2, 1)  # (N, C, m, m-1)
+    normals = np.empty((N, m, subsets.shape[0]))
+    for r in range(m):
+        minor = np.delete(sub, r, axis=2)  # (N, C, m-1, m-1)
+        normals[:, r, :] = (-1) ** r * np.linalg.det(minor)
+    normals = np.concatenate([normals, G], axis=2)
+    out = _limit_from_normals(G, normals, d)
+    sv = np.linalg.svd(G, compute_uv=False)
+    deficient = sv[:, -1] <= 1e-9 * np.maximum(sv[:, 0], 1e-300)
+    if deficient.any():
+        out[deficient] = exact_limit_lp(J[deficient], w[deficient], d[deficient])
+    return out
+
+
+def exact_limit_lp(J, w, d) -> np.ndarray:
+    """The same as :func:`exact_limit` by a linear program per configuration.
+
+    ``max s`` over ``(q_dot, s)`` s.t. ``J q_dot - s d = 0``, ``-w <= q_dot <= w``,
+    ``s >= 0`` (scipy.optimize.linprog, HiGHS). Any task dimension.
+    """
+    J, w, d = _prep(J, w, d)
+    N, m, n = J.shape
+    out = np.zeros(N)
+    c = np.zeros(n + 1)
+    c[-1] = -1.0
+    for k in range(N):
+        A = np.hstack([J[k], -d[k][:, None]])
+        bounds = [(-w[k, i], w[k, i]) for i in range(n)] + [(0, None)]
+        res = linprog(c, A_eq=A, b_eq=np.zeros(m), bounds=bounds, method="highs")
+        out[k] = res.x[-1] if res.status == 0 else 0.0
+    return out
+
+
+def component_limit(J, w, d) -> np.ndarray:
+    """Largest component of the velocity along ``d``, the rest free: ``sum_i w_i |d.J_i|``."""
+    J, w, d = _prep(J, w, d)
+    return np.abs(np.einsum("nmk,nm->nk", J, d) * w).sum(-1)
+
+
+def min_norm_rates(J, d, weights=None, rcond: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:
+    """(Weighted) minimum-norm joint rates for a unit velocity along ``d``.
+
+    ``q_dot = W^-1 J^T (J W^-1 J^T)^+ d`` (W = diag(weights); W = I is the
+    pseudo-inverse of paper 004). Returns ``q_dot`` (N, n) and ``attains`` (N,): whether
+    ``J q_dot = d`` (false where ``d`` leaves the range of a singular J).
+    """
+    J = np.asarray(J, float)
+    if J.ndim == 2:
+        J = J[None]
+    N, m, n = J.shape
+    d = np.broadcast_to(np.asarray(d, float), (N, m))
+    winv = np.ones(n) if weights is None else 1.0 / np.asarray(weights, float)
+    JW = J * winv[None, None, :]
+    A = JW @ np.swapaxes(J, 1, 2)  # (N, m, m)
+    lam = np.einsum("nij,nj->ni", np.linalg.pinv(A, rcond=rcond, hermitian=True), d)
+    qd = np.einsum("nmk,nm->nk", JW, lam)
+    residual = np.linalg.norm(np.einsum("nmk,nk->nm", J, qd) - d, axis=1)
+    return qd, residual < 1e-9 * np.maximum(1.0, np.linalg.norm(d, axis=1))
+
+
+def min_norm_limit(J, w, d, weights=None) -> np.ndarray:
+    """Largest speed along ``d`` with minimum-norm joint rates: ``1 / max_i |q_dot_i| / w_i``
+    for the unit-speed rates of :func:`min_norm_rates`; 0 where ``d`` is out of reach."""
+    J, w, d = _prep(J, w, d)
+    qd, ok = min_norm_rates(J, d, weights)
+    worst = np.max(np.abs(qd) / w, axis=1)
+    return np.where(ok & (worst > 0), 1.0 / np.where(worst > 0, worst, 1.0), 0.0)
+
+
+def stepped_limit(limit: np.ndarray, step: float = 5.0) -> np.ndarray:
+    """Paper 004's stepping: speeds ``step, 2 step, ...`` are tried until one breaks a
+    joint rate limit; the last feasible one is returned (0 if even ``step`` fails).
+
+    ``limit`` is the exact feasibility threshold of the rates used (:func:`min_norm_limit`
+    for the paper's minimum-norm rates, :func:`exact_limit` when the null space is used to
+    full effect): a speed ``v`` is feasible iff ``v <= limit`` (the rates scale linearly
+    with ``v``). So the loop's answer is ``step * floor(limit / step)``, computed with an
+    exact check of the neighbouring steps against round-off.
+    """
+    limit = np.asarray(limit, float)
+    k = np.floor(limit / step)
+    k = np.where((k + 1) * step <= limit, k + 1, k)
+    k = np.where(k * step > limit, k - 1, k)
+    return np.maximum(k, 0.0) * step
+
+
+# --------------------------------------------------------------------------- polytope, ellipse
+@dataclass
+class VelocityPolytope:
+    """The velocity zonotope of one configuration: ``vertices`` (V, m) (counter-clockwise
+    in 2-D) and facets ``normals . v <= offsets`` (unit ``normals`` (F, m)); ``equalities``
+    (E, m) with ``equalities . v = 0`` when the polytope is flat (singular J)."""
+
+    vertices: np.ndarray
+    normals: np.ndarray
+    offsets: np.ndarray
+    equalities: np.ndarray
+
+    def directional_limit(self, d) -> float:
+        """Largest ``s`` with ``s d`` in the polytope."""
+        d = np.asarray(d, float) / np.linalg.norm(d)
+        if self.equalities.size and np.any(np.abs(self.equalities @ d) > 1e-9):
+            return 0.0
+        nd = self.normals @ d
+        pos = nd > _PERP_TOL
+        return float(np.min(self.offsets[pos] / nd[pos])) if pos.any() else 0.0
+
+
+def velocity_polytope(J, w) -> VelocityPolytope:
+    """Vertices and facets of ``{J q_dot : |q_dot_i| <= w_i}`` for one configuration.
+
+    The vertices are images of box corners; the hull is taken in the range of J (SVD), so
+    singular configurations give a flat polytope with equality rows. Facet offsets are
+    the support values ``h(n) = sum_i |n . g_i|``.
+    """
+    J = np.asarray(J, float)
+    m, n = J.shape
+    G = J * np.asarray(w, float)
+    U, S, _ = np.linalg.svd(G)
+    r = int(np.sum(S > 1e-12 * max(S.max() if S.size else 0.0, 1e-300)))
+    basis, null = U[:, :r], U[:, r:]
+    corners = np.array(np.meshgrid(*[[-1.0, 1.0]] * n, indexing="ij")).reshape(n, -1).T
+    pts = corners @ G.T  # (2^n, m)
+    if r == 0:
+        return VelocityPolytope(np.zeros((1, m)), np.zeros((0, m)), np.zeros(0), null.T)
+    local = pts @ basis
+    if r == 1:
+        lo, hi = local[:, 0].min(), local[:, 0].max()
+        verts = np.array([[lo], [hi]]) @ basis.T
+        normals = np.array([basis[:, 0], -basis[:, 0]])
+    else:
+        try:
+            hull = ConvexHull(local)
+        except QhullError:
+            hull = ConvexHull(local, qhull_options="QJ")
+        verts = local[hull.vertices] @ basis.T
+        if m == 2:  # order counter-clockwise
+            c = verts - verts.mean(0)
+            verts = verts[np.argsort(np.arctan2(c[:, 1], c[:, 0]))]
+        eq = np.unique(np.round(hull.equations, 12), axis=0)
+        normals = eq[:, :-1] @ basis.T
+    normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
+    offsets = np.abs(normals @ G).sum(1)
+    return VelocityPolytope(verts, normals, offsets, null.T)
+
+
+@dataclass
+class VelocityEllipse:
+    """Image of the joint-rate ball ``sum (q_dot_i / w_i)^2 <= 1`` (inscribed in the box):
+    ``semi_axes`` (m,) along the columns of ``axes`` (m, m), largest first."""
+
+    semi_axes: np.ndarray
+    axes: np.ndarray
+
+    def radius(self, d) -> float:
+        """Speed along ``d`` on the ellipse's boundary (0 if ``d`` leaves a flat ellipse)."""
+        d = np.asarray(d, float) / np.linalg.norm(d)
+        c = self.axes.T @ d
+        small = self.semi_axes <= 1e-12 * max(self.semi_axes.max(), 1e-300)
+        if np.any(np.abs(c[small]) > 1e-9):
+            return 0.0
+        val = np.sum((c[~small] / self.semi_axes[~small]) ** 2)
+        return float(1 / np.sqrt(val)) if val > 0 else 0.0
+
+
+def velocity_ellipse(J, w) -> VelocityEllipse:
+    """Velocity ellipse(-oid) of ``J diag(w^2) J^T``, from the SVD of ``J diag(w)``
+    (semi-axes = singular values, accurate also at singular configurations)."""
+    J = np.asarray(J, float)
+    U, S, _ = np.linalg.svd(J * np.asarray(w, float))
+    semi = np.zeros(J.shape[0])
+    semi[: S.size] = S
+    return VelocityEllipse(semi, U)
+
+
+MEASURES = ("exact", "component", "min_norm", "stepped_min_norm", "stepped")
+
+
+def all_measures(J, w, d, weights=None, step: float = 5.0) -> dict[str, np.ndarray]:
+    """Every directional measure for a stack of configurations (see module docstring)."""
+    exact = exact_limit(J, w, d)
+    mn = min_norm_limit(J, w, d, weights)
+    return {
+        "exact": exact,
+        "component": component_limit(J, w, d),
+        "min_norm": mn,
+        "stepped_min_norm": stepped_limit(mn, step),
+        "stepped": stepped_limit(exact, step),
+    }

@@ -1,0 +1,316 @@
+"""``mechsyn capability``: directional speed limits of a (redundant) serial arm.
+
+A thin layer over :mod:`mechsyn.capability`.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+from rich import box
+from rich.console import Console
+from rich.table import Table
+
+from mechsyn.capability.arm import SerialArm, load_arm
+from mechsyn.capability.maps import (
+    capability_map, continuous_best, interpolate_configuration, is_closed_form,
+    measure_values, plot_map, refine_over_self_motion, self_motion,
+)
+from mechsyn.capability.measures import (
+    MEASURES, all_measures, velocity_ellipse, velocity_polytope,
+)
+from mechsyn.cli.app import app
+from mechsyn.cli.common import console, emit_json, parse_floats, parse_range, progress_bar
+from mechsyn.errors import MechsynInputError
+from mechsyn.results import write_atomic
+
+MEASURE_HELP = {
+    "exact": "largest speed of pure motion along d (joint rates free within their limits)",
+    "component": "largest velocity component along d, perpendicular part free",
+    "min_norm": "limit of the minimum-norm joint rates J+ v (paper 004's Q_dot_N)",
+    "stepped_min_norm": "paper 004's 5-step raise with minimum-norm rates",
+    "stepped": "paper 004's 5-step raise with the null space used to full effect",
+}
+_BRANCH_ALIASES = {"negative": "negative", "neg": "negative", "-": "negative", "down": "negative",
+                   "positive": "positive", "pos": "positive", "+": "positive", "up": "positive",
+                   "both": "both"}
+
+
+def _values(text: str, option: str) -> np.ndarray:
+    """``A:B:S`` (inclusive of B) or a single number or a comma list."""
+    if ":" in text:
+        a, b, s = parse_range(text, option)
+        n = int(math.floor((b - a) / s + 1e-9)) + 1
+        if n > 100_000:
+            raise MechsynInputError(f"{n} values is too many", source=option)
+        return a + s * np.arange(n)
+    return np.array(parse_floats(text, option))
+
+
+def _check_finite(values, option: str) -> None:
+    if not np.all(np.isfinite(values)):
+        raise MechsynInputError("values must be finite", source=option)
+
+
+def _measures_at(arm: SerialArm, q: np.ndarray, d: np.ndarray, step: float) -> dict:
+    return all_measures(arm.jacobian(q), arm.qd_max, d, arm.weights, step)
+
+
+def _reason(arm: SerialArm, q: np.ndarray) -> str:
+    if not np.all(np.isfinite(q)):
+        return "point out of reach"
+    qu = arm.to_user(q)
+    lo, hi = arm.to_user(arm.lower), arm.to_user(arm.upper)
+    for i, name in enumerate(arm.joint_names):
+        if qu[i] < lo[i] - 1e-7:
+            return f"{name} = {qu[i]:.2f} below its lower limit {lo[i]:g}"
+        if qu[i] > hi[i] + 1e-7:
+            return f"{name} = {qu[i]:.2f} above its upper limit {hi[i]:g}"
+    return "outside the joint limits"
+
+
+def _config_entry(arm: SerialArm, q: np.ndarray, meas: dict, k: int) -> dict:
+    entry = {"q_deg": np.round(arm.to_user(q), 10)}
+    entry.update({m: float(meas[m][k]) for m in MEASURES})
+    return entry
+
+
+@app.command("capability")
+def capability(
+    arm_file: Path = typer.Argument(..., help="arm file (YAML/JSON: planar_serial, dh, urdf) or .urdf"),
+    point: Optional[str] = typer.Option(None, "--point", help="tool point X,Y (X,Y,Z for spatial arms)"),
+    grid: Optional[str] = typer.Option(None, "--grid", help="X0:X1:DX,Y0:Y1:DY: a map over a grid"),
+    z: Optional[float] = typer.Option(None, "--z", help="plane z = Z of the grid (spatial arms)"),
+    direction: str = typer.Option(..., "--direction", help="direction d of motion, e.g. 1,0"),
+    q1: Optional[str] = typer.Option(None, "--q1", help="q1 samples in degrees, START:STOP:STEP "
+                                     "or a list (default: 20 deg steps over q1's limits)"),
+    branch: Optional[str] = typer.Option(None, "--branch", help="planar 3R elbow: negative "
+                                         "(q3 < 0, the paper's, default), positive or both"),
+    ignore_limits: bool = typer.Option(False, "--ignore-limits", help="let configurations "
+                                       "outside the joint position limits through"),
+    measure: str = typer.Option("exact", "--measure", help="what 'best' maximises: "
+                                + ", ".join(MEASURES)),
+    step: float = typer.Option(5.0, "--step", help="speed step of the paper's stepping method"),
+    continuous: bool = typer.Option(False, "--continuous", help="maps: continuous search "
+                                    "over the self-motion instead of the samples"),
+    polytope: bool = typer.Option(False, "--polytope", help="add the best configuration's "
+                                  "velocity polytope and ellipse"),
+    map_png: Optional[Path] = typer.Option(None, "--map", help="write a heat/contour map (PNG)"),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV"),
+    interpolate: Optional[str] = typer.Option(None, "--interpolate", help="grid: the optimal "
+                                              "configuration interpolated at X,Y"),
+    json_out: bool = typer.Option(False, "--json", help="print JSON on stdout"),
+) -> None:
+    """Largest tool speed along a direction under joint speed limits (paper 004), at a point
+    over the arm's self-motion, or mapped over a grid."""
+    arm = load_arm(arm_file)
+    m = arm.task_dim
+    d = np.array(parse_floats(direction, "--direction", m))
+    _check_finite(d, "--direction")
+    if not np.any(d):
+        raise MechsynInputError("the direction must not be zero", source="--direction")
+    if measure not in MEASURES:
+        raise MechsynInputError(f"unknown measure {measure!r}", source="--measure",
+                                hint="one of " + ", ".join(MEASURES))
+    if not (step > 0 and math.isfinite(step)):
+        raise MechsynInputError("step must be positive", source="--step")
+    if branch is not None:
+        if branch.lower() not in _BRANCH_ALIASES:
+            raise MechsynInputError(f"unknown branch {branch!r}", source="--branch",
+                                    hint="negative (q3 < 0), positive or both")
+        if not is_closed_form(arm):
+            raise MechsynInputError("--branch applies to planar 3R arms only", source="--branch")
+    br = _BRANCH_ALIASES[(branch or "negative").lower()]
+    q1_vals = None
+    if q1 is not None:
+        q1_vals = _values(q1, "--q1")
+        _check_finite(q1_vals, "--q1")
+        q1_vals = np.radians(q1_vals) if arm.is_revolute[0] else q1_vals
+    if (point is None) == (grid is None):
+        raise MechsynInputError("give exactly one of --point and --grid", source="--point",
+                                hint="--point 1300,900 or --grid 1300:2100:200,100:900:200")
+    if point is not None:
+        if map_png or csv_out or interpolate:
+            raise MechsynInputError("--map, --csv and --interpolate go with --grid",
+                                    source="--map" if map_png else "--csv" if csv_out
+                                    else "--interpolate")
+        _point(arm, np.array(parse_floats(point, "--point", m)), d, q1_vals, br,
+               not ignore_limits, measure, step, polytope, json_out)
+    else:
+        at = None
+        if interpolate is not None:
+            at = np.array(parse_floats(interpolate, "--interpolate", 2))
+            _check_finite(at, "--interpolate")
+        _grid(arm, grid, z, d, q1_vals, br, not ignore_limits, measure, continuous,
+              map_png, csv_out, json_out, at)
+
+
+def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -> None:
+    _check_finite(p, "--point")
+    dn = d / np.linalg.norm(d)
+    q, valid = self_motion(arm, p, q1_vals, br, respect_limits=respect)
+    # without limits self_motion marks only reachability; list the rejected ones with why
+    qv = q[valid]
+    meas = _measures_at(arm, qv, dn, step) if len(qv) else {k: np.zeros(0) for k in MEASURES}
+    configs = [_config_entry(arm, qv[k], meas, k) for k in range(len(qv))]
+    rejected = [{"q_deg": np.round(arm.to_user(qq), 10), "reason": _reason(arm, qq)}
+                for qq in q[~valid]] if is_closed_form(arm) else []
+    result: dict = {
+        "arm": arm.name, "point": p, "direction": dn, "measure": measure,
+        "units": "speeds in the arm's length unit per second (mm/s for mm); q_deg in degrees "
+                 "(R joints) or lengths (P joints)",
+        "measures": MEASURE_HELP, "configurations": configs, "rejected": rejected,
+        "best": None,
+    }
+    if configs:
+        k = int(np.argmax(meas[measure]))
+        best = dict(configs[k])
+        result["best"] = best
+        if polytope:
+            J = arm.jacobian(qv[k])[0]
+            poly = velocity_polytope(J, arm.qd_max)
+            ell = velocity_ellipse(J, arm.qd_max)
+            result["best_velocity_polytope"] = {
+                "vertices": poly.vertices, "facet_normals": poly.normals,
+                "facet_offsets": poly.offsets, "equalities": poly.equalities,
+                "limit_along_d": poly.directional_limit(dn)}
+            result["best_velocity_ellipse"] = {
+                "semi_axes": ell.semi_axes, "axes": ell.axes.T, "radius_along_d": ell.radius(dn)}
+    if is_closed_form(arm):
+        qc, vc = continuous_best(arm, p[None], dn, measure, br, respect)
+    elif configs:
+        top = np.argsort(-meas[measure], kind="stable")[:8]
+        qc, vc = refine_over_self_motion(arm, p, qv[top], dn, measure, respect)
+        k = int(np.argmax(vc))
+        qc, vc = qc[k:k + 1], vc[k:k + 1]
+    else:
+        qc, vc = None, np.array([-np.inf])
+    if np.isfinite(vc[0]):
+        mc = _measures_at(arm, qc, dn, step)
+        result["continuous_best"] = _config_entry(arm, qc[0], mc, 0)
+    else:
+        result["continuous_best"] = None
+    if json_out:
+        emit_json(result)
+        return
+    table = Table(box=box.SIMPLE_HEAD, pad_edge=False, title=f"{arm.name}: speed along ({', '.join(f'{c:g}' for c in np.round(dn, 4))}) "
+                        f"at ({', '.join(f'{c:g}' for c in p)})")
+    table.add_column("")
+    for name in arm.joint_names:
+        table.add_column(name, justify="right", no_wrap=True, min_width=6)
+    for head in ("exact", "compon.", "min-nrm", "st.mn", "stepped"):
+        table.add_column(head, justify="right", no_wrap=True)
+    kbest = int(np.argmax(meas[measure])) if configs else -1
+    shown = list(range(len(configs)))
+    if len(configs) > 15:  # many IK solutions (spatial arms): the best ones
+        shown = sorted(np.argsort(-meas[measure], kind="stable")[:12].tolist())
+    for k in shown:
+        c = configs[k]
+        table.add_row("best" if k == kbest else "", *[f"{v:.1f}" for v in c["q_deg"]],
+                      *[f"{c[mn]:.2f}" for mn in MEASURES],
+                      style="bold green" if k == kbest else None)
+    cb = result.get("continuous_best")
+    if cb:
+        table.add_row("cont", *[f"{v:.1f}" for v in cb["q_deg"]],
+                      *[f"{cb[mn]:.2f}" for mn in MEASURES], style="cyan")
+    need = 12 + 8 * arm.n + 50
+    out = console if console.is_terminal or console.width >= need else Console(width=need)
+    out.print(table)
+    if len(shown) < len(configs):
+        console.print(f"showing the best {len(shown)} of {len(configs)} configurations "
+                      "(all with --json)")
+    if not configs:
+        console.print("[yellow]no allowed configuration reaches this point[/]")
+    else:
+        console.print(f"best sampled ({measure}): {configs[kbest][measure]:.3f}"
+                      + (f"; continuous search over the self-motion (cont): "
+                         f"{cb[measure]:.3f}" if cb else ""))
+    for r in rejected:
+        console.print(f"rejected q = ({', '.join(f'{v:.2f}' for v in r['q_deg'])}): {r['reason']}")
+    console.print("[dim]exact: " + MEASURE_HELP["exact"] + "; compon.: " + MEASURE_HELP["component"]
+                  + "; min-nrm: " + MEASURE_HELP["min_norm"] + "; st.mn / stepped: the paper's "
+                  f"{step:g}-step raise with minimum-norm rates / with the null space in full[/]")
+
+
+def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, csv_out,
+          json_out, at=None) -> None:
+    parts = grid.split(",")
+    if len(parts) != 2:
+        raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
+    xs, ys = _values(parts[0], "--grid"), _values(parts[1], "--grid")
+    for v in (xs, ys):
+        _check_finite(v, "--grid")
+    if xs.size * ys.size > 5_000_000:
+        raise MechsynInputError("more than 5,000,000 grid points", source="--grid")
+    if arm.kind == "spatial" and z is None:
+        raise MechsynInputError("a spatial arm's grid needs its plane", source="--z",
+                                hint="add --z 400 (the grid lies in z = 400)")
+    total = xs.size * ys.size
+    chunk = 2048 if is_closed_form(arm) else 1
+    with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as adv:
+        cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1_vals, branch=br,
+                              respect_limits=respect, continuous=continuous, chunk=chunk,
+                              advance=adv)
+    if csv_out is not None:
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(["x", "y", f"v_max_{measure}", *[f"{n}_opt" for n in arm.joint_names]])
+        for row in cmap.rows():
+            w.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
+        write_atomic(csv_out, buf.getvalue())
+    if map_png is not None:
+        plot_map(cmap, map_png)
+    v = np.where(np.isfinite(cmap.value), cmap.value, np.nan)
+    interp = None
+    if at is not None:
+        if not (xs.min() <= at[0] <= xs.max() and ys.min() <= at[1] <= ys.max()):
+            raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid",
+                                    source="--interpolate")
+        method = "cubic" if xs.size >= 4 and ys.size >= 4 else "linear"
+        qi = interpolate_configuration(cmap, method)(at[0], at[1])
+        target = at if arm.kind == "planar" else np.array([at[0], at[1], z])
+        interp = {"point": target, "method": method, "q_deg": None, "tool_error": None,
+                  measure: None}
+        if np.all(np.isfinite(qi)):
+            interp.update({
+                "q_deg": arm.to_user(qi),
+                "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
+                measure: float(measure_values(arm, qi[None], d, measure)[0])})
+    if json_out:
+        out = cmap.to_dict()
+        if interp is not None:
+            out["interpolated"] = interp
+        emit_json(out)
+        return
+    if total <= 144:
+        table = Table(title=f"V_max ({measure}, {cmap.search}); rows x, columns y")
+        table.add_column("x \\ y")
+        for y in ys:
+            table.add_column(f"{y:g}", justify="right")
+        for i, x in enumerate(xs):
+            table.add_row(f"{x:g}", *["-" if not np.isfinite(c) else f"{c:.2f}" for c in v[i]])
+        console.print(table)
+    reach = np.isfinite(v)
+    if reach.any():
+        i, j = np.unravel_index(np.nanargmax(v), v.shape)
+        console.print(f"{total} points, {int(reach.sum())} reachable; V_max from "
+                      f"{np.nanmin(v):.3f} to {np.nanmax(v):.3f} (at x={xs[i]:g}, y={ys[j]:g})")
+    else:
+        console.print(f"{total} points, none reachable with the allowed configurations")
+    if interp is not None:
+        if interp["q_deg"] is None:
+            console.print("interpolation: no optimal configuration near this point")
+        else:
+            console.print(f"interpolated optimal configuration at ({at[0]:g}, {at[1]:g}) "
+                          f"({interp['method']}): q = ({', '.join(f'{c:.3f}' for c in interp['q_deg'])})"
+                          f"; tool {interp['tool_error']:.3g} from the point (correct with IK); "
+                          f"{measure} {interp[measure]:.3f}")
+    for what, path in (("map", map_png), ("csv", csv_out)):
+        if path is not None:
+            console.print(f"wrote {what}: {path}")

@@ -1,0 +1,534 @@
+"""Reading and writing mechanism files (YAML or JSON), with clear errors.
+
+Every problem raises :class:`mechsyn.errors.MechsynInputError` naming the file, the
+line, the field and how to fix it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import networkx as nx
+import numpy as np
+import yaml
+from pydantic import ValidationError
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
+from mechsyn.model.contour import contour_links
+from mechsyn.model.mechanism import (
+    ExternalSpec,
+    Joint,
+    Link,
+    Mechanism,
+    PointSpec,
+    StateSpec,
+)
+from mechsyn.model.pairs import PAIR_KINDS, canonical_pair_type
+from mechsyn.results import to_jsonable, write_atomic
+
+__all__ = [
+    "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
+    "mechanism_to_dict", "write_mechanism", "read_data",
+]
+
+
+# --------------------------------------------------------------------------- reading
+def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
+    """Parse a YAML or JSON file into Python data; return it with its text."""
+    p = Path(path)
+    if not p.exists():
+        raise MechsynInputError("no such file", source=str(p), hint="check the path")
+    if p.is_dir():
+        raise MechsynInputError("is a directory, not a file", source=str(p))
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise MechsynInputError(
+            f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(p),
+            hint="save the file as UTF-8 YAML or JSON",
+        ) from None
+    return parse_text(text, str(p)), text
+
+
+def parse_text(text: str, source: str) -> Any:
+    """Parse YAML (or JSON, when the source ends in .json) text."""
+    if source.lower().endswith(".json"):
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise MechsynInputError(
+                f"JSON syntax error: {exc.msg} (column {exc.colno})", source=source,
+                line=exc.lineno, hint="fix the JSON syntax at that line",
+            ) from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else None
+        problem = exc.problem or exc.context or "cannot parse"
+        column = f" (column {mark.column + 1})" if mark is not None else ""
+        raise MechsynInputError(
+            f"YAML syntax error: {problem}{column}", source=source, line=line,
+            hint="fix the YAML syntax at that line (indentation, brackets, colons)",
+        ) from None
+    except yaml.YAMLError as exc:
+        raise MechsynInputError(f"YAML syntax error: {exc}", source=source) from None
+
+
+def _line_finder(text: str | None, source: str) -> Any:
+    """A function mapping a data path (keys and indices) to its 1-based line."""
+    root = None
+    if text is not None:
+        try:
+            root = yaml.compose(text)
+        except yaml.YAMLError:
+            root = None
+
+    def find(path: Sequence[Any]) -> int | None:
+        node = root
+        line = None
+        for key in path:
+            if node is None:
+                break
+            if isinstance(node, yaml.MappingNode):
+                nxt = None
+                for k, v in node.value:
+                    if str(getattr(k, "value", None)) == str(key):
+                        nxt = v
+                        line = k.start_mark.line + 1
+                        break
+                node = nxt
+            elif isinstance(node, yaml.SequenceNode) and isinstance(key, int):
+                if 0 <= key < len(node.value):
+                    node = node.value[key]
+                    line = node.start_mark.line + 1
+                else:
+                    node = None
+            else:
+                break
+        return line
+
+    return find
+
+
+def _field_name(path: Sequence[Any]) -> str:
+    out = ""
+    for key in path:
+        if isinstance(key, int):
+            out += f"[{key}]"
+        else:
+            out += ("." if out else "") + str(key)
+    return out
+
+
+def _data_path(data: Any, loc: Sequence[Any]) -> list[Any]:
+    """Keep the parts of a pydantic error location that exist in the data."""
+    path: list[Any] = []
+    node = data
+    for key in loc:
+        if isinstance(node, dict) and key in node:
+            node = node[key]
+            path.append(key)
+        elif isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node):
+            node = node[key]
+            path.append(key)
+        elif isinstance(node, dict) and isinstance(key, str) and key not in node and not path[-1:] == [key]:
+            # a missing field (pydantic names it) or a union member name: keep missing fields
+            if key in _KNOWN_FIELDS:
+                path.append(key)
+                node = None
+        # otherwise a union tag such as 'str' or 'LinkEntry': skip
+    return path
+
+
+_KNOWN_FIELDS = set(MechanismFile.model_fields) | set(JointEntry.model_fields) | {"class"} \
+    | set(StateEntry.model_fields) | {"link", "at"}
+
+
+_HINTS = {
+    "missing": "add the field",
+    "extra_forbidden": "remove it or check its spelling",
+    "literal_error": None,
+    "int_parsing": "give a whole number",
+    "float_parsing": "give a number",
+    "list_type": "give a list, e.g. [a, b]",
+    "dict_type": "give a mapping of names to values",
+    "string_type": "give a text value",
+    "too_short": None,
+}
+
+
+def _validation_error(exc: ValidationError, data: Any, source: str, text: str | None) -> MechsynInputError:
+    errors = exc.errors()
+    # Prefer the most specific error: for unions pydantic reports one per member.
+    err = errors[0]
+    loc = _data_path(data, err["loc"])
+    find = _line_finder(text, source)
+    msg = err["msg"]
+    if err["type"] == "extra_forbidden":
+        msg = "unknown field"
+    elif err["type"] == "missing":
+        msg = "required field is missing"
+    more = len({tuple(_data_path(data, e["loc"])) for e in errors}) - 1
+    if more > 0:
+        msg += f" (and {more} more problem{'s' if more > 1 else ''})"
+    return MechsynInputError(
+        msg, source=source, field=_field_name(loc) or None, line=find(loc),
+        hint=_HINTS.get(err["type"]),
+    )
+
+
+def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = None) -> Mechanism:
+    """Validate mechanism-file data and build a :class:`Mechanism`.
+
+    ``text`` (the file's text) lets errors name their line.
+    """
+    if not isinstance(data, dict):
+        raise MechsynInputError(
+            "a mechanism file must be a mapping with name, kind, ground, links, joints",
+            source=source, line=1, hint="see `mechsyn schema` and the files in examples/",
+        )
+    try:
+        spec = MechanismFile.model_validate(data)
+    except ValidationError as exc:
+        raise _validation_error(exc, data, source, text) from None
+    return _Builder(spec, source, _line_finder(text, source)).build()
+
+
+def mechanism_from_text(text: str, source: str = "<text>") -> Mechanism:
+    """Parse and build a mechanism from YAML/JSON text."""
+    return mechanism_from_dict(parse_text(text, source), source, text)
+
+
+def load_mechanism(path: str | os.PathLike[str]) -> Mechanism:
+    """Read a mechanism file (YAML or JSON), validated.
+
+    Raises
+    ------
+    MechsynInputError
+        naming the file, line and field of the first problem, with a fix.
+    """
+    data, text = read_data(path)
+    return mechanism_from_dict(data, str(path), text)
+
+
+class _Builder:
+    """Resolves names, checks the semantics, converts to the model."""
+
+    def __init__(self, spec: MechanismFile, source: str, find: Any) -> None:
+        self.spec = spec
+        self.source = source
+        self.find = find
+        self.kind = spec.kind
+        self.dim = 2 if spec.kind == "planar" else 3
+
+    def error(self, path: Sequence[Any], message: str, hint: str | None = None) -> MechsynInputError:
+        return MechsynInputError(
+            message, source=self.source, field=_field_name(path), line=self.find(path), hint=hint,
+        )
+
+    # links ---------------------------------------------------------------------------
+    def _links(self, entries: Sequence[str | LinkEntry], path0: str, names: dict[str, str] | None = None,
+               ids: dict[int, str] | None = None) -> tuple[list[Link], dict[str, str], dict[int, str]]:
+        links: list[Link] = []
+        names = dict(names or {})
+        ids = dict(ids or {})
+        for i, entry in enumerate(entries):
+            path = [path0, i]
+            if isinstance(entry, str):
+                name, attrs, lid = entry, {}, None
+            else:
+                attrs = entry.model_dump(exclude_none=True, exclude={"name", "id"})
+                lid = entry.id
+                name = entry.name if entry.name is not None else (str(lid) if lid is not None else None)
+                if name is None:
+                    raise self.error(path, "a link needs a name or an id", "add `name: ...`")
+            name = name.strip()
+            if not name:
+                raise self.error(path, "empty link name")
+            if name in names:
+                raise self.error(path, f"duplicate link name {name!r}", "give each link a unique name")
+            if lid is not None:
+                if lid in ids:
+                    raise self.error(path, f"duplicate link id {lid}", "give each link a unique id")
+                ids[lid] = name
+            names[name] = name
+            links.append(Link(name=name, attrs=attrs))
+        return links, names, ids
+
+    def resolve_link(self, ref: Any, path: Sequence[Any], names: dict[str, str], ids: dict[int, str]) -> str:
+        if isinstance(ref, bool):
+            raise self.error(path, f"{ref!r} is not a link")
+        if isinstance(ref, int):
+            if ref in ids:
+                return ids[ref]
+            if str(ref) in names:
+                return str(ref)
+            raise self.error(path, f"unknown link id {ref}", f"links are: {', '.join(names)}")
+        if ref in names:
+            return ref
+        raise self.error(path, f"unknown link {ref!r}", f"links are: {', '.join(names)}")
+
+    # geometry --------------------------------------------------------------------------
+    def vector(self, values: list[float] | None, path: Sequence[Any], what: str, dim: int | None = None,
+               unit: bool = False) -> np.ndarray | None:
+        if values is None:
+            return None
+        dim = dim or self.dim
+        if len(values) != dim:
+            raise self.error(
+                path, f"{what} has {len(values)} coordinates; a {self.kind} mechanism needs {dim}",
+                f"write [{', '.join('x y z'.split()[:dim])}]",
+            )
+        v = np.asarray(values, dtype=float)
+        if not np.all(np.isfinite(v)):
+            raise self.error(path, f"{what} must be finite numbers")
+        if unit:
+            norm = float(np.linalg.norm(v))
+            if norm < 1e-12:
+                raise self.error(path, f"{what} is a zero vector", "give a direction, e.g. [1, 0]")
+            v = v / norm
+        return v
+
+    # joints ----------------------------------------------------------------------------
+    def joint(self, entry: JointEntry, path: list[Any], names: dict[str, str], ids: dict[int, str]) -> Joint:
+        jtype = canonical_pair_type(entry.type)
+        if jtype is None:
+            raise self.error(
+                path + ["type"], f"unknown pair type {entry.type!r}",
+                f"use one of {', '.join(PAIR_KINDS)}",
+            )
+        kind = PAIR_KINDS[jtype]
+        if self.kind == "planar" and not kind.planar:
+            raise self.error(
+                path + ["type"],
+                f"pair {jtype} ({kind.title}) is spatial and cannot appear in a planar mechanism",
+                "use R, P, cam, gear or generic, or set `kind: spatial`",
+            )
+        if len(entry.links) != 2:
+            raise self.error(path + ["links"], f"a pair joins exactly two links, {len(entry.links)} given",
+                             "write links: [a, b]")
+        a = self.resolve_link(entry.links[0], path + ["links", 0], names, ids)
+        b = self.resolve_link(entry.links[1], path + ["links", 1], names, ids)
+        if a == b:
+            raise self.error(path + ["links"], f"a pair must join two different links, both are {a!r}")
+        given = entry.pair_class
+        if given is not None and not 1 <= given <= 5:
+            raise self.error(path + ["class"], f"class {given} is out of 1..5",
+                             "the class is the number of constraints: 1 (point contact) .. 5 (R, P, H)")
+        higher_override = None
+        if self.kind == "planar":
+            if jtype == "generic":
+                if given is None:
+                    raise self.error(path, "a generic pair needs `class`", "add class: 5 (lower) or 4 (higher)")
+                if given not in (4, 5):
+                    raise self.error(path + ["class"], f"class {given} is not a planar pair class",
+                                     "in a planar mechanism use 5 (lower pair) or 4 (higher pair)")
+                pair_class = given
+                higher_override = given == 4
+            else:
+                pair_class = 4 if kind.higher else 5
+                if given is not None and given != pair_class:
+                    raise self.error(path + ["class"],
+                                     f"a planar {jtype} pair counts as class {pair_class}, not {given}",
+                                     "remove `class`")
+        else:
+            if kind.pair_class is None:
+                if jtype == "generic" and given is None:
+                    raise self.error(path, "a generic pair needs `class`", "add class: 1..5")
+                pair_class = given if given is not None else 2  # cam/gear: line contact
+            else:
+                pair_class = kind.pair_class
+                if given is not None and given != pair_class:
+                    raise self.error(
+                        path + ["class"], f"a {jtype} pair ({kind.title}) is class {pair_class}, not {given}",
+                        "remove `class`, or use type: generic to give any class",
+                    )
+            if jtype == "generic":
+                higher_override = pair_class <= 2
+        point = self.vector(entry.point, path + ["point"], "point")
+        axis = None
+        if entry.axis is not None:
+            if self.kind == "planar":
+                if jtype == "R":
+                    raise self.error(path + ["axis"],
+                                     "an R pair in a planar mechanism turns about the plane's normal",
+                                     "remove `axis`")
+                axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+            else:
+                axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+        axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
+        normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
+        if entry.pitch is not None and jtype != "H":
+            raise self.error(path + ["pitch"], "only a helical (H) pair has a pitch", "remove `pitch`")
+        if entry.ratio is not None and jtype != "gear":
+            raise self.error(path + ["ratio"], "only a gear pair has a ratio", "remove `ratio`")
+        if entry.vll is not None and jtype not in ("P", "C", "generic"):
+            raise self.error(path + ["vll"], "a variable-length link is a prismatic (P) pair",
+                             "set type: P or remove `vll`")
+        limits = None
+        if entry.limits is not None:
+            if len(entry.limits) != 2 or entry.limits[0] > entry.limits[1]:
+                raise self.error(path + ["limits"], "limits must be [min, max] with min <= max")
+            limits = (float(entry.limits[0]), float(entry.limits[1]))
+        attrs = {"description": entry.description} if entry.description else {}
+        return Joint(
+            id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
+            axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
+            vll=entry.vll, limits=limits, attrs=attrs, higher_override=higher_override,
+        )
+
+    def joints(self, entries: Sequence[JointEntry], path0: list[Any], names: dict[str, str],
+               ids: dict[int, str], taken: set[str]) -> list[Joint]:
+        out = []
+        for i, entry in enumerate(entries):
+            path = path0 + [i]
+            if entry.id in taken:
+                raise self.error(path + ["id"], f"duplicate joint id {entry.id!r}", "give each joint a unique id")
+            taken.add(entry.id)
+            out.append(self.joint(entry, path, names, ids))
+        return out
+
+    def contours(self, contours: list[list[str]] | None, path0: list[Any], joints: dict[str, Joint]) -> tuple[tuple[str, ...], ...] | None:
+        if contours is None:
+            return None
+        out = []
+        for c, ids in enumerate(contours):
+            path = path0 + [c]
+            for k, jid in enumerate(ids):
+                if jid not in joints:
+                    raise self.error(path + [k], f"unknown joint {jid!r} in contour",
+                                     f"joints are: {', '.join(joints)}")
+            if len(set(ids)) != len(ids):
+                raise self.error(path, "a joint appears twice in the contour")
+            if contour_links([joints[j] for j in ids]) is None:
+                raise self.error(
+                    path, f"contour {' '.join(ids)} is not a closed loop",
+                    "list the joints in the order met walking round the loop, each sharing a link "
+                    "with the next and the last with the first",
+                )
+            out.append(tuple(ids))
+        return tuple(out)
+
+    def check_connected(self, links: Sequence[Link], joints: Sequence[Joint], path: list[Any]) -> None:
+        g = nx.MultiGraph()
+        g.add_nodes_from(link.name for link in links)
+        g.add_edges_from(j.links for j in joints)
+        if g.number_of_nodes() and not nx.is_connected(g):
+            parts = sorted((sorted(c) for c in nx.connected_components(g)), key=len)
+            raise self.error(
+                path, f"the mechanism is disconnected: {', '.join(parts[0])} "
+                f"{'is' if len(parts[0]) == 1 else 'are'} joined to no other part",
+                "add the missing joints or remove the stray links",
+            )
+
+    # whole file --------------------------------------------------------------------------
+    def build(self) -> Mechanism:
+        spec = self.spec
+        links, names, ids = self._links(spec.links, "links")
+        ground = self.resolve_link(spec.ground, ["ground"], names, ids)
+        taken: set[str] = set()
+        joints = self.joints(spec.joints, ["joints"], names, ids, taken)
+        self.check_connected(links, joints, ["joints"])
+        by_id = {j.id: j for j in joints}
+        contours = self.contours(spec.contours, ["contours"], by_id)
+        points = {}
+        for pname, p in spec.points.items():
+            link = self.resolve_link(p.link, ["points", pname, "link"], names, ids)
+            points[pname] = PointSpec(link=link, at=self.vector(p.at, ["points", pname, "at"], "point"))
+        states = {}
+        for sname, s in spec.states.items():
+            spath: list[Any] = ["states", sname]
+            slinks, snames, sids = self._links(s.add_links, "add_links", names, ids) if s.add_links else ([], names, ids)
+            sjoints = self.joints(s.add_joints, spath + ["add_joints"], snames, sids, set(taken))
+            all_joints = {**by_id, **{j.id: j for j in sjoints}}
+            scontours = self.contours(s.contours, spath + ["contours"], all_joints)
+            self.check_connected(links + slinks, joints + sjoints, spath)
+            ext = None
+            if s.external is not None:
+                ext = ExternalSpec(**s.external.model_dump())
+            states[sname] = StateSpec(
+                name=sname, description=s.description or "", add_links=tuple(slinks),
+                add_joints=tuple(sjoints), contours=scontours, external=ext, mobility=s.mobility,
+            )
+        attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
+                                   ("units", spec.units)) if v}
+        return Mechanism(
+            name=spec.name, kind=spec.kind, ground=ground, links=tuple(links), joints=tuple(joints),
+            points=points, contours=contours, states=states, mobility=spec.mobility,
+            source=self.source, attrs=attrs,
+        )
+
+
+# --------------------------------------------------------------------------- writing
+def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
+    d: dict[str, Any] = {"id": j.id, "type": j.type, "links": list(j.links)}
+    if j.type == "generic" or (kind == "spatial" and j.type in ("cam", "gear")):
+        d["class"] = j.pair_class
+    for key in ("point", "axis", "axis2", "normal"):
+        v = getattr(j, key)
+        if v is not None:
+            d[key] = [float(x) for x in v]
+    for key in ("pitch", "ratio", "vll"):
+        v = getattr(j, key)
+        if v is not None:
+            d[key] = v
+    if j.limits is not None:
+        d["limits"] = list(j.limits)
+    if j.actuated:
+        d["actuated"] = True
+    if j.attrs.get("description"):
+        d["description"] = j.attrs["description"]
+    return d
+
+
+def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
+    """The file-format data of ``mech`` (inverse of :func:`mechanism_from_dict`)."""
+    links: list[Any] = [
+        {"name": link.name, **to_jsonable(link.attrs)} if link.attrs else link.name for link in mech.links
+    ]
+    d: dict[str, Any] = {"name": mech.name, "kind": mech.kind, "ground": mech.ground, "links": links,
+                         "joints": [_joint_dict(j, mech.kind) for j in mech.joints]}
+    if mech.points:
+        d["points"] = {k: {"link": p.link, "at": [float(x) for x in p.at]} for k, p in mech.points.items()}
+    if mech.contours is not None:
+        d["contours"] = [list(c) for c in mech.contours]
+    if mech.mobility is not None:
+        d["mobility"] = mech.mobility
+    for key in ("description", "source", "units"):
+        if mech.attrs.get(key):
+            d[key] = mech.attrs[key]
+    if mech.states:
+        states = {}
+        for name, s in mech.states.items():
+            sd: dict[str, Any] = {}
+            if s.description:
+                sd["description"] = s.description
+            if s.add_links:
+                sd["add_links"] = [{"name": lk.name, **lk.attrs} if lk.attrs else lk.name for lk in s.add_links]
+            if s.add_joints:
+                sd["add_joints"] = [_joint_dict(j, mech.kind) for j in s.add_joints]
+            if s.contours is not None:
+                sd["contours"] = [list(c) for c in s.contours]
+            if s.external is not None:
+                sd["external"] = {k: v for k, v in to_jsonable(s.external).items() if v is not None}
+            if s.mobility is not None:
+                sd["mobility"] = s.mobility
+            states[name] = sd
+        d["states"] = states
+    return d
+
+
+def write_mechanism(mech: Mechanism | dict[str, Any], path: str | os.PathLike[str]) -> None:
+    """Write a mechanism (or file-format data) as YAML, or JSON for a ``.json`` path; atomic."""
+    data = mechanism_to_dict(mech) if isinstance(mech, Mechanism) else to_jsonable(mech)
+    if str(path).lower().endswith(".json"):
+        text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    else:
+        text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=None, width=100)
+    write_atomic(path, text)

@@ -1,0 +1,140 @@
+"""The mechanism file format (YAML or JSON, one schema), as pydantic models.
+
+``mechsyn schema`` prints :func:`json_schema`. Example::
+
+    name: Four-bar linkage
+    kind: planar            # planar | spatial
+    ground: frame           # the frame link
+    links: [frame, crank, coupler, rocker]
+    joints:
+      - {id: A, type: R, links: [frame, crank], point: [0, 0], actuated: true}
+      - {id: B, type: R, links: [crank, coupler], point: [1, 2]}
+      - {id: C, type: R, links: [coupler, rocker], point: [4, 3]}
+      - {id: D, type: R, links: [rocker, frame], point: [5, 0]}
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+LinkRef = str | int
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+
+
+class LinkEntry(BaseModel):
+    """A link given as an object: a name (or an integer id) and extra attributes."""
+
+    model_config = ConfigDict(extra="allow")
+
+    name: str | None = Field(None, description="Link name; defaults to the id as text.")
+    id: int | None = Field(None, description="Integer id that joints may use instead of the name.")
+    mass: float | None = Field(None, ge=0, description="Mass (for force analysis).")
+    com: list[float] | None = Field(None, description="Centre of mass in the assembled configuration.")
+    inertia: float | None = Field(None, ge=0, description="Moment of inertia about the centre of mass.")
+    description: str | None = None
+
+
+class JointEntry(_Strict):
+    """A kinematic pair. ``links: [a, b]``: ``b`` moves relative to ``a``."""
+
+    id: str = Field(description="Unique joint id (e.g. A, B5, D3).")
+    type: str = Field(
+        description=(
+            "Pair type: R, P, H (with pitch), C, U (with axis2), S, E (axis = plane normal), "
+            "S_pin, line_contact, point_contact, cam, gear (planar higher pairs), generic "
+            "(with class). Aliases: revolute, prismatic, spherical, cylindrical, ..."
+        )
+    )
+    links: list[LinkRef] = Field(description="The two links the pair joins, by name or id.")
+    pair_class: int | None = Field(
+        None, alias="class",
+        description="Class i = constraints imposed (1..5); required for generic pairs.",
+    )
+    point: list[float] | None = Field(None, description="Joint (or contact / pitch) point.")
+    axis: list[float] | None = Field(
+        None, description="Unit axis: rotation axis (R, H, C, U first axis), sliding direction (P), plane normal (E).",
+    )
+    axis2: list[float] | None = Field(None, description="U: second axis, fixed in the second link.")
+    normal: list[float] | None = Field(None, description="Higher pairs: contact normal / line of action.")
+    pitch: float | None = Field(None, description="H: lead per radian of rotation.")
+    ratio: float | None = Field(None, description="gear: angular velocity ratio of the second link to the first.")
+    actuated: bool = Field(False, description="Driven joint (a drive sets its coordinate).")
+    vll: Literal["active", "passive", "locked"] | None = Field(
+        None, description="Variable-length link mode of a prismatic pair (paper 000).",
+    )
+    limits: list[float] | None = Field(None, description="[min, max] of the joint coordinate (VLL length limits).")
+    description: str | None = None
+
+    @field_validator("id", mode="before")
+    @classmethod
+    def _id_as_text(cls, v: Any) -> Any:
+        return str(v) if isinstance(v, int) and not isinstance(v, bool) else v
+
+
+class PointEntry(_Strict):
+    """A named point fixed on a link, by its coordinates in the assembled configuration."""
+
+    link: LinkRef
+    at: list[float]
+
+
+class ExternalEntry(_Strict):
+    """Paper 002's external-constraint quantities of a state."""
+
+    W_rob: int = Field(0, ge=0, description="Working mobility with the external constraints on.")
+    S_ai: int = Field(0, ge=0, description="External constraints that take the main mobility and fix the body.")
+    W_a: int = Field(6, ge=0, le=6, description="Mobilities the external body loses (6 for a free body).")
+    S_a: int | None = Field(None, ge=0, description="External constraints; default: sum of the added contacts' classes.")
+    W_f: int | None = Field(None, description="Mobility of the mechanism isolated from the object; default: its W.")
+
+
+class StateEntry(_Strict):
+    """A state of a variable-structure mechanism: bodies and contacts it adds."""
+
+    description: str | None = None
+    add_links: list[str | LinkEntry] = Field(default_factory=list)
+    add_joints: list[JointEntry] = Field(default_factory=list)
+    contours: list[list[str]] | None = None
+    external: ExternalEntry | None = None
+    mobility: int | None = None
+
+
+class MechanismFile(_Strict):
+    """A mechanism file."""
+
+    name: str = Field(description="Name of the mechanism.")
+    kind: Literal["planar", "spatial"] = Field("planar", description="planar | spatial.")
+    ground: LinkRef = Field(description="The frame link (name or id).")
+    links: list[str | LinkEntry] = Field(min_length=1, description="Links, frame included.")
+    joints: list[JointEntry] = Field(description="Kinematic pairs.")
+    points: dict[str, PointEntry] = Field(default_factory=dict)
+    contours: list[list[str]] | None = Field(
+        None, description="Independent contours, each an ordered list of joint ids (paper 003's order matters).",
+    )
+    states: dict[str, StateEntry] = Field(default_factory=dict)
+    mobility: int | None = Field(
+        None, description="Actual mobility W (idle mobilities included) when known from elsewhere.",
+    )
+    description: str | None = None
+    source: str | None = Field(None, description="Where the mechanism comes from (paper, figure).")
+    units: str | None = None
+
+    @field_validator("contours", mode="before")
+    @classmethod
+    def _contour_ids_as_text(cls, v: Any) -> Any:
+        if isinstance(v, list):
+            return [[str(x) if isinstance(x, int) else x for x in c] if isinstance(c, list) else c for c in v]
+        return v
+
+
+def json_schema() -> dict[str, Any]:
+    """The JSON Schema of mechanism files."""
+    schema = MechanismFile.model_json_schema(by_alias=True)
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "mechsyn mechanism file"
+    return schema

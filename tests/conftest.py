@@ -1,0 +1,34 @@
+import json
+from pathlib import Path
+
+import pytest
+
+from mechsyn.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+SPEC = ROOT.parent / "shared" / "spec"
+
+
+@pytest.fixture
+def run_cli(capsys):
+    """Run the command line in-process; return (exit status, stdout, stderr)."""
+
+    def run(*args: str) -> tuple[int, str, str]:
+        code = main([str(a) for a in args])
+        out = capsys.readouterr()
+        return code, out.out, out.err
+
+    return run
+
+
+@pytest.fixture
+def cli_json(run_cli):
+    """Run a command with --json and parse its output (asserting exit status 0)."""
+
+    def run(*args: str) -> dict:
+        code, out, err = run_cli(*args, "--json")
+        assert code == 0, err
+        return json.loads(out)
+
+    return run
