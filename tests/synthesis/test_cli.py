@@ -43,6 +43,14 @@ def test_synth_path_json_contract(p2_file, tmp_path, capsys, public_data):
     assert np.linalg.norm(pts["D"] - pts["C"]) == pytest.approx(d["r4"])
     pose = fourbar_position(d["r1"], d["r2"], d["r3"], d["r4"], np.pi / 6, rcx=d["rcx"], rcy=d["rcy"])
     assert np.allclose(mech["points"]["P"]["at"], pose.C)
+    # other tools take it: the model loads it and analyze finds one degree of freedom
+    from mechsyn.io import load_mechanism
+
+    m = load_mechanism(out)
+    assert m.n_moving == 3 and m.joint("A").actuated and m.points["P"].link == "coupler"
+    capsys.readouterr()
+    assert main(["analyze", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["formulas"]["chebyshev"]["value"] == 1
 
 
 def test_synth_path_collection_needs_case(tmp_path, capsys, public_data):

@@ -55,13 +55,20 @@ def mechanism_yaml(mech: dict[str, Any], header: str = "") -> str:
 def write_mechanism_file(mech: dict[str, Any], path, header: str = "") -> None:
     """Write a mechanism dict as YAML (``.yaml``/``.yml``) or JSON, atomically.
 
-    Uses :func:`mechsyn.io.write_mechanism` when the model package provides it.
+    The dict is validated by :func:`mechsyn.io.mechanism_from_dict` first; the YAML keeps
+    a comment header (how the linkage was obtained).
     """
     from pathlib import Path
 
     from mechsyn.results import dumps, write_atomic
 
     path = Path(path)
+    try:  # validate against the mechanism model when it is available
+        from mechsyn.io import mechanism_from_dict
+    except ImportError:  # pragma: no cover - older model package
+        mechanism_from_dict = None
+    if mechanism_from_dict is not None:
+        mechanism_from_dict(mech)
     if path.suffix.lower() == ".json":
         write_atomic(path, dumps(mech) + "\n")
     else:
