@@ -68,3 +68,31 @@ def test_pluggable_optimizer(public_cases):
         OPTIMIZERS.pop("centre-test")
     with pytest.raises(MechsynInputError):
         synthesize_path(public_cases["P2_kk5_timing"], optimizer="nope")
+
+
+@pytest.mark.slow
+def test_dask_local_cluster_equals_local_run(public_cases):
+    distributed = pytest.importorskip("dask.distributed")
+    case = public_cases["P2_kk5_timing"]
+    local = synthesize_path(case, seed=5, restarts=2, time_limit=120, options=FAST, n_polish=1)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+        with distributed.Client(cluster) as client:
+            remote = synthesize_path(case, seed=5, restarts=2, time_limit=120, options=FAST, n_polish=1,
+                                     scheduler=client)
+    assert remote.design == local.design and remote.restart_errors == local.restart_errors
+
+
+def test_scheduler_without_dask_is_a_clear_error(public_cases, monkeypatch):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_dask(name, *a, **k):
+        if name.startswith("dask"):
+            raise ImportError(name)
+        return real_import(name, *a, **k)
+
+    monkeypatch.setattr(builtins, "__import__", no_dask)
+    with pytest.raises(MechsynInputError) as exc:
+        synthesize_path(public_cases["P2_kk5_timing"], restarts=1, options=FAST, scheduler="tcp://127.0.0.1:1")
+    assert "dask" in str(exc.value)

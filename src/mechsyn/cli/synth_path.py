@@ -57,6 +57,7 @@ def synth_path(
     time_limit: float = typer.Option(60.0, "--time-limit", help="Wall-clock budget in seconds."),
     restarts: int = typer.Option(10, "--restarts", help="Number of restarts (child seeds of --seed)."),
     workers: int = typer.Option(1, "--workers", help="Run restarts in N local processes."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask])."),
     optimizer: str = typer.Option("de", "--optimizer", help="Global optimiser (de | random | registered)."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
@@ -84,10 +85,10 @@ def synth_path(
                 prog.update(task, completed=done, best=f"{best:.6g}" if np.isfinite(best) else "-")
 
             res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                                  optimizer=optimizer, progress=progress)
+                                  optimizer=optimizer, progress=progress, scheduler=scheduler)
     else:
         res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                              optimizer=optimizer)
+                              optimizer=optimizer, scheduler=scheduler)
     d = {**case.fixed, **res.design}
     if out is not None:
         if not res.feasible:

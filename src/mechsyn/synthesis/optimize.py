@@ -195,6 +195,29 @@ def _restart_job(args):
     return _run_restart(*args)
 
 
+def _run_on_dask(scheduler, jobs) -> list[RestartResult]:
+    """Run restart jobs on an existing Dask cluster (optional extra ``mechsyn[dask]``)."""
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
+                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+    if isinstance(scheduler, Client):
+        futures = scheduler.map(_restart_job, jobs, pure=False)
+        return scheduler.gather(futures)
+    try:
+        client = Client(scheduler, timeout=10)
+    except (OSError, TimeoutError) as exc:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+                                hint="give the address printed by dask-scheduler, e.g. tcp://host:8786") from None
+    with client:
+        return client.gather(client.map(_restart_job, jobs, pure=False))
+
+
 @dataclass
 class PathSynthesisResult:
     """Outcome of :func:`synthesize_path` (serialisable; ``to_dict`` gives the CLI JSON)."""
@@ -236,13 +259,15 @@ def restart_seeds(seed: int, restarts: int) -> list[int]:
 def synthesize_path(
     case: PathCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
     optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
-    progress: Callable[[int, int, float], None] | None = None,
+    progress: Callable[[int, int, float], None] | None = None, scheduler: str | None = None,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
 
     ``progress(restarts_done, restarts, best_error_so_far)`` is called as the run goes.
-    With ``workers > 1`` restarts run in that many local processes; the result equals
-    the single-process one (same seeds, same deterministic choice of the best).
+    With ``workers > 1`` restarts run in that many local processes, with ``scheduler``
+    (a ``dask.distributed`` scheduler address, or a ``Client``) on a Dask cluster; the
+    result equals the single-process one (same seeds, same deterministic choice of the
+    best), unless the time limit cuts runs short.
     """
     if optimizer not in OPTIMIZERS:
         from mechsyn.errors import MechsynInputError
@@ -252,7 +277,7 @@ def synthesize_path(
     options = dict(options or {})
     t0 = time.time()
     deadline = t0 + time_limit
-    reserve = min(2.0, 0.05 * time_limit)
+    reserve = min(4.0, 0.07 * time_limit)
     seeds = restart_seeds(seed, restarts)
     results: list[RestartResult] = []
     best = [np.inf]
@@ -267,12 +292,17 @@ def synthesize_path(
     def problem_feasible_score(f):
         return f < problem.penalty_base
 
-    if workers <= 1:
+    if workers <= 1 and scheduler is None:
         for i, s in enumerate(seeds):
             if results and time.time() >= deadline:
                 break
             r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
                              report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve)
+            results.append(r)
+            note(len(results), r.fitness)
+    elif scheduler is not None:
+        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
+        for r in _run_on_dask(scheduler, jobs):
             results.append(r)
             note(len(results), r.fitness)
     else:
