@@ -112,10 +112,10 @@ def coupler_point(r1, r2, r3, r4, theta2, branch: int = -1, rcx=0.0, rcy=0.0, x0
         assembled = np.abs(ca) <= 1.0
         sa = np.sqrt(1.0 - ca * ca)
         gx, gy = dx / d, dy / d
-    ux = gx * ca + branch * gy * sa
-    uy = gy * ca - branch * gx * sa
-    cx = ax + rcx * ux - rcy * uy
-    cy = ay + rcx * uy + rcy * ux
+        ux = gx * ca + branch * gy * sa
+        uy = gy * ca - branch * gx * sa
+        cx = ax + rcx * ux - rcy * uy
+        cy = ay + rcx * uy + rcy * ux
     c0, s0 = np.cos(theta0), np.sin(theta0)
     return c0 * cx - s0 * cy + x0, s0 * cx + c0 * cy + y0, assembled
 

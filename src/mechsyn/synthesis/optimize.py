@@ -180,10 +180,13 @@ def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options:
             if len(cands) >= n_polish:
                 break
     best_z, best_f = None, np.inf
+    last = 0.5  # estimated seconds per polish; a polish starts only if it should end in time
     for c in cands:
         z = problem.expand(c)[0]
-        if time.time() < deadline or best_z is None:
+        if time.time() + 1.5 * last < deadline:
+            tp = time.time()
             z = polish(problem, z)
+            last = time.time() - tp
         f = float(problem.fitness(z[None, :])[0])
         if f < best_f:
             best_z, best_f = z, f
@@ -294,8 +297,8 @@ def synthesize_path(
 
     if workers <= 1 and scheduler is None:
         for i, s in enumerate(seeds):
-            if results and time.time() >= deadline:
-                break
+            if results and time.time() >= deadline - reserve:
+                break  # too little time left for a useful restart
             r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
                              report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve)
             results.append(r)
