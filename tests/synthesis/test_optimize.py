@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from dimsynth_data import public_cases, public_data  # noqa: F401  (fixtures)
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.synthesis.optimize import (

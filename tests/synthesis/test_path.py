@@ -4,6 +4,7 @@ import copy
 
 import numpy as np
 import pytest
+from dimsynth_data import public_cases, public_data  # noqa: F401  (fixtures)
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design

@@ -1,3 +1,5 @@
+"""Fixtures of the dimensional-synthesis tests: the public path-synthesis cases."""
+
 import json
 from pathlib import Path
 

@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+from dimsynth_data import public_cases, public_data  # noqa: F401  (fixtures)
 import yaml
 
 from mechsyn.cli.main import main
