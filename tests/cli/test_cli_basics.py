@@ -23,3 +23,11 @@ def test_write_atomic_gives_ordinary_permissions(tmp_path):
     finally:
         os.umask(mask)
     assert stat.S_IMODE(os.stat(tmp_path / "a.txt").st_mode) == 0o644
+
+
+def test_error_text_in_brackets_is_shown(run_cli, tmp_path):
+    p = tmp_path / "m.yaml"
+    p.write_text("name: x\nground: frame\nlinks: [frame, a]\njoints:\n  - {id: A, type: R, links: [frame, b]}\n")
+    code, _, err = run_cli("analyze", p)
+    assert code == 2
+    assert "joints[0].links[1]" in err  # rich markup must not swallow [0]

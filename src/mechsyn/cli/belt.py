@@ -273,6 +273,9 @@ def analyze_cmd(
     four_bar_file: Optional[Path] = typer.Option(
         None, "--four-bar-file", help="write the equivalent four-bar A0-A-B-B0 as a mechanism "
                                       "file (YAML, or JSON by suffix)"),
+    mechanism_file: Optional[Path] = typer.Option(
+        None, "--mechanism-file", help="write the belt mechanism itself (with a belt pair) as a "
+                                       "mechanism file for `mechsyn simulate` (YAML, or JSON by suffix)"),
 ) -> None:
     """Transfer functions, paths of C and H, path straightness, speeds and accelerations.
 
@@ -344,6 +347,12 @@ def analyze_cmd(
         fb_dict = kb.four_bar_mechanism_dict(design)
         mechanism_from_dict(fb_dict)  # validate against the file format before writing
         write_mechanism(fb_dict, four_bar_file)
+    if mechanism_file is not None:
+        from mechsyn.io import mechanism_from_dict, write_mechanism
+
+        bm_dict = kb.belt_mechanism_dict(design)
+        mechanism_from_dict(bm_dict)  # validate against the file format before writing
+        write_mechanism(bm_dict, mechanism_file)
     if animate is not None:
         from mechsyn.kinematics.belt_plot import save_animation
 

@@ -10,6 +10,7 @@ from typing import Any, TypeVar
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from mechsyn.errors import MechsynInputError
@@ -96,5 +97,5 @@ def track(items: Iterable[T], description: str, total: int | None = None) -> Ite
 
 
 def exit_with(error: MechsynInputError) -> None:
-    err_console.print(f"[bold red]error:[/] {error.format()}", highlight=False, soft_wrap=True)
+    err_console.print(f"[bold red]error:[/] {escape(error.format())}", highlight=False, soft_wrap=True)
     raise typer.Exit(2)

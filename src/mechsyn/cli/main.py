@@ -19,17 +19,20 @@ from mechsyn.cli import structure as _structure  # noqa: F401
 from mechsyn.cli import finger as _finger  # noqa: F401
 from mechsyn.cli import capability as _capability  # noqa: F401
 from mechsyn.cli import belt as _belt  # noqa: F401
+from mechsyn.cli import simulate as _simulate  # noqa: F401
 from mechsyn.cli import synth_path as _synth_path  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; bad input exits with status 2 and one message."""
+    from rich.markup import escape
+
     from mechsyn.cli.common import err_console
 
     try:
         app(args=argv, prog_name="mechsyn", standalone_mode=False)
     except MechsynInputError as error:
-        err_console.print(f"[bold red]error:[/] {error.format()}", highlight=False, soft_wrap=True)
+        err_console.print(f"[bold red]error:[/] {escape(error.format())}", highlight=False, soft_wrap=True)
         return _exit(2, argv)
     except SystemExit as exc:  # typer.Exit inside commands
         return _exit(int(exc.code or 0), argv)

@@ -308,7 +308,7 @@ class _Builder:
             raise self.error(
                 path + ["type"],
                 f"pair {jtype} ({kind.title}) is spatial and cannot appear in a planar mechanism",
-                "use R, P, cam, gear or generic, or set `kind: spatial`",
+                "use R, P, cam, gear, belt or generic, or set `kind: spatial`",
             )
         if len(entry.links) != 2:
             raise self.error(path + ["links"], f"a pair joins exactly two links, {len(entry.links)} given",
@@ -377,11 +377,62 @@ class _Builder:
                 raise self.error(path + ["limits"], "limits must be [min, max] with min <= max")
             limits = (float(entry.limits[0]), float(entry.limits[1]))
         attrs = {"description": entry.description} if entry.description else {}
+        if entry.profile is not None:
+            if jtype != "cam":
+                raise self.error(path + ["profile"], "only a cam pair has a profile", "remove `profile`")
+            if isinstance(entry.profile, list):
+                pts = [self.vector(p, path + ["profile", k], "profile point") for k, p in enumerate(entry.profile)]
+                if len(pts) < 4:
+                    raise self.error(path + ["profile"], "a cam profile needs at least 4 points",
+                                     "list points round the whole cam")
+                attrs["profile"] = [[float(x) for x in p] for p in pts]
+            else:
+                prof = entry.profile
+                c = self.vector(prof.center, path + ["profile", "center"], "profile centre")
+                if (prof.radius is None) == (prof.polar is None):
+                    raise self.error(path + ["profile"], "a cam profile needs either radius or polar",
+                                     "write {center: [x, y], radius: r} or {center: [x, y], polar: '1 + 0.2*cos(t)'}")
+                if prof.radius is not None:
+                    attrs["profile"] = {"center": [float(x) for x in c], "radius": float(prof.radius)}
+                else:
+                    from mechsyn.kinematics.expr import ExpressionError, polar_points
+
+                    try:
+                        pts = polar_points(prof.polar, c)
+                    except ExpressionError as exc:
+                        raise self.error(path + ["profile", "polar"], str(exc),
+                                         "use t, pi, numbers, + - * / **, sin, cos, tan, exp, sqrt, abs") from None
+                    attrs["profile"] = {"center": [float(x) for x in c], "polar": prof.polar,
+                                        "points": pts.tolist()}
+        belt_fields = {"anchor": entry.anchor, "radius": entry.radius, "wrap": entry.wrap}
+        if jtype != "belt":
+            for key, v in belt_fields.items():
+                if v is not None:
+                    raise self.error(path + [key], f"only a belt pair has `{key}`", f"remove `{key}` or set type: belt")
+        else:
+            attrs.update(self.belt(entry, path, point))
         return Joint(
             id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
             axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
             vll=entry.vll, limits=limits, attrs=attrs, higher_override=higher_override,
         )
+
+    def belt(self, entry: JointEntry, path: list[Any], point: np.ndarray | None) -> dict[str, Any]:
+        """Check a belt pair's fields: anchor (on the first link), radius, wrap, point (the
+        pulley centre on the second link); the anchor must lie outside the pulley."""
+        example = "e.g. {id: W, type: belt, links: [frame, hand], point: [0, 500], anchor: [75, 88.2], radius: 75, wrap: ccw}"
+        for key in ("anchor", "radius", "wrap"):
+            if getattr(entry, key) is None:
+                raise self.error(path, f"belt pair {entry.id} needs `{key}`", example)
+        if point is None:
+            raise self.error(path, f"belt pair {entry.id} needs `point` (the pulley centre)", example)
+        anchor = self.vector(entry.anchor, path + ["anchor"], "anchor")
+        d = float(np.linalg.norm(anchor[:2] - point[:2]))
+        if d <= entry.radius:
+            raise self.error(path + ["anchor"],
+                             f"the anchor is {d:g} from the pulley centre, not outside the radius {entry.radius:g}",
+                             "a taut straight belt needs the anchor farther from the centre than the radius")
+        return {"anchor": [float(x) for x in anchor], "radius": float(entry.radius), "wrap": entry.wrap}
 
     def joints(self, entries: Sequence[JointEntry], path0: list[Any], names: dict[str, str],
                ids: dict[int, str], taken: set[str]) -> list[Joint]:
@@ -427,6 +478,39 @@ class _Builder:
                 "add the missing joints or remove the stray links",
             )
 
+    def loads(self, entries: Sequence[Any], names: dict[str, str], ids: dict[int, str],
+              points: dict[str, PointSpec]) -> list[dict[str, Any]]:
+        out = []
+        for k, e in enumerate(entries):
+            path: list[Any] = ["loads", k]
+            link = self.resolve_link(e.link, path + ["link"], names, ids)
+            if e.force is None and e.moment is None:
+                raise self.error(path, "a load needs a force or a moment", "add force: [Fx, Fy] or moment: M")
+            if e.at is not None and e.point is not None:
+                raise self.error(path, "give either `at` or `point`, not both")
+            at = self.vector(e.at, path + ["at"], "load point")
+            if e.point is not None:
+                if e.point not in points:
+                    raise self.error(path + ["point"], f"unknown point {e.point!r}",
+                                     f"points are: {', '.join(points) or '(none)'}")
+                if points[e.point].link != link:
+                    raise self.error(path + ["point"], f"point {e.point} is on link {points[e.point].link}, "
+                                     f"not {link}")
+                at = points[e.point].at
+            d: dict[str, Any] = {"link": link}
+            if e.force is not None:
+                d["force"] = [float(x) for x in self.vector(e.force, path + ["force"], "force")]
+            if at is not None:
+                d["at"] = [float(x) for x in at]
+            if e.point is not None:
+                d["point"] = e.point
+            if e.moment is not None:
+                d["moment"] = float(e.moment)
+            if e.description:
+                d["description"] = e.description
+            out.append(d)
+        return out
+
     # whole file --------------------------------------------------------------------------
     def build(self) -> Mechanism:
         spec = self.spec
@@ -458,6 +542,8 @@ class _Builder:
             )
         attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
                                    ("units", spec.units)) if v}
+        if spec.loads:
+            attrs["loads"] = self.loads(spec.loads, names, ids, points)
         return Mechanism(
             name=spec.name, kind=spec.kind, ground=ground, links=tuple(links), joints=tuple(joints),
             points=points, contours=contours, states=states, mobility=spec.mobility,
@@ -468,7 +554,7 @@ class _Builder:
 # --------------------------------------------------------------------------- writing
 def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
     d: dict[str, Any] = {"id": j.id, "type": j.type, "links": list(j.links)}
-    if j.type == "generic" or (kind == "spatial" and j.type in ("cam", "gear")):
+    if j.type == "generic" or (kind == "spatial" and j.type in ("cam", "gear", "belt")):
         d["class"] = j.pair_class
     for key in ("point", "axis", "axis2", "normal"):
         v = getattr(j, key)
@@ -482,6 +568,13 @@ def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
         d["limits"] = list(j.limits)
     if j.actuated:
         d["actuated"] = True
+    if j.attrs.get("profile") is not None:
+        prof = j.attrs["profile"]
+        d["profile"] = {k: v for k, v in prof.items() if k != "points"} if isinstance(prof, dict) else prof
+    if j.type == "belt":
+        for key in ("anchor", "radius", "wrap"):
+            if j.attrs.get(key) is not None:
+                d[key] = j.attrs[key]
     if j.attrs.get("description"):
         d["description"] = j.attrs["description"]
     return d
@@ -503,6 +596,9 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
     for key in ("description", "source", "units"):
         if mech.attrs.get(key):
             d[key] = mech.attrs[key]
+    if mech.attrs.get("loads"):
+        d["loads"] = [{k: v for k, v in ld.items() if not (k == "at" and "point" in ld)}
+                      for ld in mech.attrs["loads"]]
     if mech.states:
         states = {}
         for name, s in mech.states.items():

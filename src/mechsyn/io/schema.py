@@ -39,6 +39,29 @@ class LinkEntry(BaseModel):
     description: str | None = None
 
 
+class CamProfile(_Strict):
+    """A cam profile about a centre: a disc (``radius``) or a polar function ``polar`` of
+    the angle ``t`` (radians, from the x axis of the assembled configuration), e.g.
+    ``"1 + 0.2*sin(t)**2"``: the profile points are ``center + r(t) (cos t, sin t)``."""
+
+    center: list[float]
+    radius: float | None = Field(None, gt=0, description="Radius of a disc (eccentric) cam.")
+    polar: str | None = Field(None, description="r(t): +, -, *, /, **, sin, cos, tan, exp, sqrt, abs, pi, t.")
+
+
+class LoadEntry(_Strict):
+    """An external load on a link (force analysis): a force at a point and/or a moment."""
+
+    link: LinkRef = Field(description="The link the load acts on.")
+    force: list[float] | None = Field(None, description="Force [Fx, Fy] (global directions).")
+    at: list[float] | None = Field(
+        None, description="Point of application in the assembled configuration (default: the centre of mass, "
+                          "else the link's first joint).")
+    point: str | None = Field(None, description="A named point (from `points`) as point of application.")
+    moment: float | None = Field(None, description="A moment (counter-clockwise positive).")
+    description: str | None = None
+
+
 class JointEntry(_Strict):
     """A kinematic pair. ``links: [a, b]``: ``b`` moves relative to ``a``."""
 
@@ -46,7 +69,8 @@ class JointEntry(_Strict):
     type: str = Field(
         description=(
             "Pair type: R, P, H (with pitch), C, U (with axis2), S, E (axis = plane normal), "
-            "S_pin, line_contact, point_contact, cam, gear (planar higher pairs), generic "
+            "S_pin, line_contact, point_contact, cam, gear (planar higher pairs), belt (a belt, "
+            "chain, band or rope anchored on the first link wrapping a pulley on the second), generic "
             "(with class). Aliases: revolute, prismatic, spherical, cylindrical, ..."
         )
     )
@@ -68,6 +92,20 @@ class JointEntry(_Strict):
         None, description="Variable-length link mode of a prismatic pair (paper 000).",
     )
     limits: list[float] | None = Field(None, description="[min, max] of the joint coordinate (VLL length limits).")
+    profile: "CamProfile | list[list[float]] | None" = Field(
+        None, description=(
+            "cam: the profile fixed on the first link, in the assembled configuration: "
+            "{center: [x, y], radius: r} (a disc, e.g. an eccentric), {center: [x, y], polar: 'r(t)'} "
+            "(a function of the angle t) or a closed list of points [[x, y], ...] "
+            "(interpolated by a periodic cubic spline)."),
+    )
+    anchor: list[float] | None = Field(
+        None, description="belt: where the flexible element is pinned on the first link (assembled configuration).")
+    radius: float | None = Field(
+        None, gt=0, description="belt: pulley radius; the pulley is fixed on the second link, centred at `point`.")
+    wrap: Literal["ccw", "cw"] | None = Field(
+        None, description="belt: sense in which the belt turns round the pulley going from the anchor: "
+                          "ccw (counter-clockwise) or cw.")
     description: str | None = None
 
     @field_validator("id", mode="before")
@@ -117,6 +155,7 @@ class MechanismFile(_Strict):
         None, description="Independent contours, each an ordered list of joint ids (paper 003's order matters).",
     )
     states: dict[str, StateEntry] = Field(default_factory=dict)
+    loads: list[LoadEntry] = Field(default_factory=list, description="External loads for force analysis.")
     mobility: int | None = Field(
         None, description="Actual mobility W (idle mobilities included) when known from elsewhere.",
     )
@@ -138,3 +177,6 @@ def json_schema() -> dict[str, Any]:
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "mechsyn mechanism file"
     return schema
+
+
+JointEntry.model_rebuild()

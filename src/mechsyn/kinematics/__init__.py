@@ -1,1 +1,21 @@
-"""mechsyn.kinematics."""
+"""Planar kinematics and force analysis.
+
+Modules: ``analysis`` (:func:`simulate`, :func:`forces`: the entry points), ``system``
+(link poses and constraint equations, analytic Jacobian), ``solve`` (Newton continuation,
+velocities, accelerations), ``dyads`` (closed-form Assur dyads, vectorised), ``forces``
+(kinetostatics), ``derived`` (transmission angle, mechanical advantage, Grashof, path
+extent, straightness), ``plots`` (figures and animation); ``belt`` (paper 001's belt
+drive, separately).
+"""
+
+from typing import Any
+
+__all__ = ["simulate", "forces", "input_grid"]
+
+
+def __getattr__(name: str) -> Any:  # lazy: importing the package stays cheap
+    if name in __all__:
+        from mechsyn.kinematics import analysis
+
+        return getattr(analysis, name)
+    raise AttributeError(name)

@@ -58,6 +58,7 @@ __all__ = [
     "equivalent_four_bar",
     "compare_with_four_bar",
     "four_bar_mechanism_dict",
+    "belt_mechanism_dict",
     "BeltCase",
     "load_belt_case",
 ]
@@ -954,4 +955,31 @@ def four_bar_mechanism_dict(design: BeltDesign, name: str | None = None) -> dict
         ],
         "points": {"C": {"link": "hand", "at": [-c, a]},
                    "H": {"link": "hand", "at": [-c, a + h]}},
+    }
+
+
+def belt_mechanism_dict(design: BeltDesign, name: str | None = None) -> dict[str, object]:
+    """The belt manipulator itself as a mechanism-file dict for the general planar solver,
+    in the design position: frame, lever (A0 A, driven at A0), hand (link 2 with its
+    pulley, C and H) and a ``belt`` pair from the frame (anchor B0 = (r, a - b0)) to the
+    hand's pulley centred on A, wrapped counter-clockwise. A0's input is the lever's
+    direction: 90° + Δφ (``examples/belt/paper001_mechanism.yaml`` for the paper's numbers).
+    """
+    a, c, h, r = design.a, design.c, design.h, design.r
+    B0 = [float(x) for x in design.B0]
+    return {
+        "name": name or f"belt manipulator a={a:g} c={c:g} h={h:g} r={r:g}",
+        "kind": "planar",
+        "ground": "frame",
+        "links": ["frame", "lever", "hand"],
+        "joints": [
+            {"id": "A0", "type": "R", "links": ["frame", "lever"], "point": [0.0, 0.0],
+             "actuated": True},
+            {"id": "A", "type": "R", "links": ["lever", "hand"], "point": [0.0, a]},
+            {"id": "W", "type": "belt", "links": ["frame", "hand"], "point": [0.0, a],
+             "anchor": B0, "radius": r, "wrap": "ccw"},
+        ],
+        "points": {"C": {"link": "hand", "at": [-c, a]},
+                   "H": {"link": "hand", "at": [-c, a + h]},
+                   "B0": {"link": "frame", "at": B0}},
     }

@@ -6,11 +6,20 @@ paper 003's per-contour formula, higher pairs (line or point contact) ``m = 4``.
 
 In a *planar* mechanism a lower pair (R or P in the plane) counts as ``p5`` and a
 higher pair (cam, gear tooth contact) as ``p4`` (Chebyshev's formula).
+
+A **belt** pair (belt, chain, band or rope; paper 001) joins the link its flexible
+element is anchored on to the link carrying the pulley it wraps. The inextensible,
+non-slipping belt keeps ``b + r·(wrapped angle)`` constant: one constraint on the
+relative motion in the plane, so it counts like a higher pair, class 4 (``p4``). Its
+instantaneous equivalent is a contact whose normal is the straight belt run through the
+tangent point (the tension's line of action): :func:`belt_tangent`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+import numpy as np
 
 
 @dataclass(frozen=True)
@@ -54,6 +63,9 @@ PAIR_KINDS: dict[str, PairKind] = {
         # contact of parallel cylinders (class 2) unless the file gives `class`.
         PairKind("cam", "cam (planar higher pair)", None, True, True),
         PairKind("gear", "gear mesh (planar higher pair)", None, True, True),
+        # A flexible element anchored on one link wrapping a pulley on the other: one
+        # constraint in the plane (p4, like a higher pair; spatial class 2 by default).
+        PairKind("belt", "belt / chain / rope wrapping a pulley (planar, p4)", None, True, True),
         PairKind("generic", "generic pair of a given class", None, False, True),
     )
 }
@@ -72,6 +84,8 @@ PAIR_ALIASES: dict[str, str] = {
     "line": "line_contact", "linecontact": "line_contact",
     "point": "point_contact", "pointcontact": "point_contact",
     "gear_pair": "gear", "tooth": "gear",
+    "chain": "belt", "rope": "belt", "band": "belt", "cable": "belt", "belt_wrap": "belt",
+    "flexible": "belt",
 }
 
 
@@ -96,3 +110,30 @@ def suggest_type(old_type: str, new_class: int, higher: bool) -> str:
     if old_type == "S" and new_class == 4:
         return "S_pin"
     return SUGGESTED_LOWER.get(new_class, "generic")
+
+
+#: Wrap senses of a belt pair: +1 counter-clockwise, -1 clockwise.
+BELT_WRAPS = {"ccw": 1.0, "cw": -1.0}
+
+
+def belt_tangent(point: np.ndarray, anchor: np.ndarray, radius: float,
+                 wrap: str) -> tuple[np.ndarray, np.ndarray, float]:
+    """Tangent point ``T``, unit belt direction ``g`` (anchor to ``T``) and free length ``b``
+    of a belt from ``anchor`` wrapping a pulley of ``radius`` centred at ``point``.
+
+    With ``D = point - anchor``, ``d = |D|``, ``σ = +1`` (``ccw``) or ``-1`` (``cw``)::
+
+        b = sqrt(d^2 - r^2),  g = (b D - σ r R90 D) / d^2,  T = anchor + b g
+
+    (the belt leaves the anchor along ``g`` and turns round the pulley in the sense
+    ``σ``; paper 001: B0 = (r, a - b0), centre (0, a), ``ccw``: T = (r, a), g = (0, 1)).
+    Raises ValueError when the anchor is not outside the pulley (d <= r).
+    """
+    sigma = BELT_WRAPS[wrap]
+    D = np.asarray(point, float)[:2] - np.asarray(anchor, float)[:2]
+    d2 = float(D @ D)
+    if d2 <= radius * radius:
+        raise ValueError("the anchor is not outside the pulley: the belt cannot run straight to it")
+    b = float(np.sqrt(d2 - radius * radius))
+    g = (b * D - sigma * radius * np.array([-D[1], D[0]])) / d2
+    return np.asarray(anchor, float)[:2] + b * g, g, b

@@ -142,6 +142,28 @@ def _gear_geometry(joint: Joint, mech: Mechanism | None) -> tuple[np.ndarray, np
     return p, normal
 
 
+def _belt_geometry(joint: Joint) -> tuple[np.ndarray, np.ndarray]:
+    """Contact point and normal of a belt pair's instantaneous equivalent: the straight belt
+    run is the tension's line of action, so the belt acts like a higher pair (rolling
+    contact) with normal along the run through the tangent point
+    (:func:`mechsyn.model.pairs.belt_tangent`)."""
+    from mechsyn.model.pairs import belt_tangent
+
+    anchor, radius, wrap = (joint.attrs.get(k) for k in ("anchor", "radius", "wrap"))
+    if joint.point is None or anchor is None or radius is None or wrap is None:
+        raise _need(joint, "point, anchor, radius and wrap", "give the pulley centre, anchor, radius and wrap")
+    if len(anchor) != 2:
+        raise InsufficientGeometry(
+            f"joint {joint.id}: rank analysis is not supported for belt pairs in a spatial file",
+            field=f"joints[{joint.id}]", hint="describe the belt drive in a planar file (kind: planar)")
+    try:
+        T, g, _ = belt_tangent(joint.point, np.asarray(anchor, float), float(radius), wrap)
+    except ValueError as exc:
+        raise InsufficientGeometry(f"joint {joint.id} (belt): {exc}", field=f"joints[{joint.id}]",
+                                   hint="put the anchor outside the pulley") from None
+    return _pad3(T), _pad3(g)
+
+
 def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np.ndarray:
     """Unit twists ``[ω; v]`` (``f × 6``) the pair permits at the assembled configuration.
 
@@ -167,6 +189,18 @@ def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np
         raise InsufficientGeometry(
             f"joint {joint.id} is a generic pair of class {joint.pair_class}: its permitted motions are unknown",
             field=f"joints[{joint.id}]", hint="give the pair's real type (R, P, C, S, ...) with its point and axis")
+    if t == "belt":
+        p, n = _belt_geometry(joint)
+        if planar:
+            return np.array([_rot(p, z), _tr(np.cross(z, n))])
+        t = "line_contact" if joint.pair_class == 2 else ("point_contact" if joint.pair_class == 1 else "generic")
+        if t == "generic":
+            raise InsufficientGeometry(f"joint {joint.id}: a spatial belt of class {joint.pair_class} "
+                                       "has unknown permitted motions", field=f"joints[{joint.id}]",
+                                       hint="use class 2 (the belt's instantaneous line contact along z)")
+        if a is None:
+            a = z
+        joint = replace(joint, normal=n)
     if planar:
         if t in ("cam", "gear"):
             if t == "gear" and joint.normal is None:
@@ -186,7 +220,7 @@ def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np
             if a is None:
                 raise _need(joint, "axis", "give axis: the sliding direction [dx, dy]")
             return np.array([_tr(a)])
-        raise _need(joint, "planar twist", "use R, P, cam or gear in a planar file")
+        raise _need(joint, "planar twist", "use R, P, cam, gear or belt in a planar file")
     if t in ("cam", "gear"):
         t = "line_contact" if joint.pair_class == 2 else ("point_contact" if joint.pair_class == 1 else "generic")
         if t == "generic":
@@ -272,6 +306,12 @@ def as_spatial(mech: Mechanism) -> Mechanism:
             kw["axis"] = z
         elif j.type == "P":
             kw["axis"] = _pad3(j.axis)
+        elif j.type == "belt":
+            kw["axis"] = z
+            try:  # its instantaneous equivalent: a line contact along the belt's tangent line
+                kw["point"], kw["normal"] = _belt_geometry(j)
+            except InsufficientGeometry:
+                pass
         elif j.type in ("cam", "gear"):
             kw["axis"] = z
             if j.type == "gear" and j.normal is None:
@@ -282,7 +322,7 @@ def as_spatial(mech: Mechanism) -> Mechanism:
                     pass
             else:
                 kw["normal"] = _pad3(j.normal)
-        cls = PAIR_KINDS[j.type].pair_class or (2 if j.type in ("cam", "gear") else j.pair_class)
+        cls = PAIR_KINDS[j.type].pair_class or (2 if j.type in ("cam", "gear", "belt") else j.pair_class)
         joints.append(replace(j, pair_class=cls, higher_override=None if j.type != "generic" else j.higher_override, **kw))
     points = {k: replace(v, at=_pad3(v.at)) for k, v in mech.points.items()}
     return replace(mech, kind="spatial", joints=tuple(joints), points=points,

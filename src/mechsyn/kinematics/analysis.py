@@ -1,0 +1,378 @@
+"""Simulation of a planar mechanism over input values: the library's main entry points.
+
+:func:`simulate` runs the Assur-group closed form when the mechanism decomposes into
+drivers and dyads (vectorised over all inputs), otherwise the Newton continuation, and
+returns every link's angle, angular velocity and acceleration and every requested
+point's position, velocity and acceleration, with NaN (JSON ``null``) where the
+mechanism is not assembled and the events of the sweep (dead points, reassembly,
+singular crossings, VLL limits).
+
+Units: R inputs and link angles in degrees, angular velocities in rad/s and angular
+accelerations in rad/s^2 (the driven joint turns at 1 rad/s unless a speed is given);
+P inputs and lengths in the file's length unit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics import dyads
+from mechsyn.kinematics.forces import Reactions, kinetostatics
+from mechsyn.kinematics.solve import Sweep, _limit, assemble, sweep
+from mechsyn.kinematics.system import PlanarSystem, build_system
+from mechsyn.model.mechanism import Mechanism
+
+__all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
+           "ForceAnalysis", "forces"]
+
+
+@dataclass
+class PointMotion:
+    position: np.ndarray       # (N, 2)
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    link: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"position": self.position, "velocity": self.velocity, "acceleration": self.acceleration}
+
+
+@dataclass
+class LinkMotion:
+    angle: np.ndarray                 # (N,) degrees
+    angular_velocity: np.ndarray      # rad/s
+    angular_acceleration: np.ndarray  # rad/s^2
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"angle": self.angle, "angular_velocity": self.angular_velocity,
+                "angular_acceleration": self.angular_acceleration}
+
+
+@dataclass
+class Simulation:
+    """Motion of a mechanism over a sweep of input values (see the module doc)."""
+
+    mechanism: str
+    inputs: dict[str, np.ndarray]         # joint -> values (deg for R, length for P)
+    input_types: dict[str, str]
+    speeds: dict[str, float]
+    assembled: np.ndarray
+    points: dict[str, PointMotion]
+    links: dict[str, LinkMotion]
+    events: list[dict] = field(default_factory=list)
+    method: str = "newton"
+    notes: list[str] = field(default_factory=list)
+    vll: dict[str, str] = field(default_factory=dict)
+    sweep: Sweep | None = field(default=None, repr=False)
+    system: PlanarSystem | None = field(default=None, repr=False)
+
+    @property
+    def main_input(self) -> str:
+        return next(iter(self.inputs))
+
+    def working_ranges(self) -> list[list[float]]:
+        """Runs of consecutive assembled inputs, as [first, last] values of the main input."""
+        vals = self.inputs[self.main_input]
+        out, start = [], None
+        for k, ok in enumerate(self.assembled):
+            if ok and start is None:
+                start = k
+            if (not ok or k == len(vals) - 1) and start is not None:
+                end = k if ok else k - 1
+                out.append([float(vals[start]), float(vals[end])])
+                start = None
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        ok = self.assembled
+
+        def mask(a: np.ndarray) -> list:
+            out = np.asarray(a, float).tolist()
+            return [v if good else None for v, good in zip(out, ok)]
+
+        main = self.main_input
+        return {
+            "mechanism": self.mechanism,
+            "input": {"joint": main, "values": self.inputs[main], "unit": _unit(self.input_types[main]),
+                      "speed": self.speeds[main]},
+            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": _unit(self.input_types[j]),
+                           "speed": self.speeds[j]} for j, v in self.inputs.items()},
+            "assembled": ok,
+            "points": {name: {k: mask(v) for k, v in pm.to_dict().items()} for name, pm in self.points.items()},
+            "links": {name: {k: mask(v) for k, v in lm.to_dict().items()} for name, lm in self.links.items()},
+            "working_ranges": self.working_ranges(),
+            "events": self.events,
+            "method": self.method,
+            "vll": self.vll,
+            "notes": self.notes,
+            "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"},
+        }
+
+
+def _unit(t: str) -> str:
+    return "deg" if t == "R" else "length"
+
+
+def input_grid(start: float, stop: float, step: float) -> np.ndarray:
+    """``start, start + step, ..., stop`` (stop included when on the grid)."""
+    n = int(np.floor((stop - start) / step + 1e-9)) + 1
+    return start + step * np.arange(n)
+
+
+def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:
+    """Named points (file ``points`` or joint ids) -> (link, assembled coordinates)."""
+    out: dict[str, tuple[str, np.ndarray]] = {}
+    if names is None:
+        if mech.points:
+            names = list(mech.points)
+        else:
+            names = [j.id for j in mech.joints]
+    for name in names:
+        if name in mech.points:
+            p = mech.points[name]
+            out[name] = (p.link, np.asarray(p.at, float))
+            continue
+        try:
+            j = mech.joint(name)
+        except KeyError:
+            known = list(mech.points) + [j.id for j in mech.joints]
+            raise MechsynInputError(f"no point or joint named {name!r}", source="--points",
+                                    hint=f"known: {', '.join(known)}") from None
+        link = j.links[1] if j.links[1] != mech.ground else j.links[0]
+        out[name] = (link, np.asarray(j.point, float))
+    return out
+
+
+def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
+             points: list[str] | None = None, vll: dict[str, str] | None = None,
+             method: str = "auto", progress: Any = None) -> Simulation:
+    """Positions, velocities and accelerations over a sweep of the inputs.
+
+    ``inputs``: joint id -> values (degrees for R, length for P), all of the same
+    length; drivers not listed keep their value of the file. ``method``: ``"auto"``
+    (closed-form Assur groups when the mechanism decomposes, else Newton),
+    ``"assur"`` or ``"newton"``.
+    """
+    if not inputs:
+        raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+    prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    S = build_system(mech, vll=vll, prescribed=prescribed)
+    drivers = [d.joint for d in S.drivers]
+    lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
+    if len(lengths) != 1:
+        raise MechsynInputError("all inputs need the same number of values", source="--input")
+    N = lengths.pop()
+    if N == 0:
+        raise MechsynInputError("the input range is empty", source="--input")
+    U = np.tile([d.assembled for d in S.drivers], (N, 1)).astype(float)
+    types: dict[str, str] = {}
+    for jid, vals in inputs.items():
+        if jid not in drivers:
+            try:
+                j = mech.joint(jid)
+            except KeyError:
+                raise MechsynInputError(f"no joint {jid!r}", source="--input",
+                                        hint=f"driven joints: {', '.join(drivers) or '(none)'}") from None
+            raise MechsynInputError(
+                f"joint {jid} ({j.type}) is not driven", source="--input",
+                hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
+        k = drivers.index(jid)
+        vals = np.asarray(vals, float)
+        if not np.all(np.isfinite(vals)):
+            raise MechsynInputError(f"input values of {jid} must be finite numbers", source="--input")
+        d = S.drivers[k]
+        U[:, k] = np.radians(vals) if d.type == "R" else vals
+        types[jid] = d.type
+        lim = mech.joint(jid).limits
+        if lim is not None and d.type == "P" and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
+            raise MechsynInputError(
+                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", source="--input",
+                hint="keep the VLL length within its limits")
+    sp = np.zeros(len(drivers))
+    speeds = dict(speeds or {})
+    for jid in speeds:
+        if jid not in inputs:
+            raise MechsynInputError(f"--speed names {jid}, which has no --input", source="--speed")
+    for jid in inputs:
+        sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
+    pts = resolve_points(mech, points)
+    plan = dyads.decompose(S) if method in ("auto", "assur") else None
+    if method == "assur" and plan is None:
+        raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
+                                hint="use the Newton method")
+    events: list[dict] = []
+    if plan is not None:
+        assemble(S)  # checks the file configuration and the mobility
+        q, qd, qdd = dyads.solve_all(S, plan, U, sp)
+        ok = np.all(np.isfinite(q), axis=1)
+        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), events, method="assur")
+        events.extend(_fast_events(S, sw))
+        used = "assur"
+        if progress is not None:
+            progress(N)
+    else:
+        sw = sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
+        events = sw.events
+        used = "newton"
+    ok = sw.assembled
+    rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+    for k in np.flatnonzero(ok & ~rates_ok).tolist():
+        events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
+                       "message": "singular configuration: assembled, but the velocities and accelerations "
+                                  "are not defined here (null)"})
+    events.sort(key=lambda e: e["index"])
+    links = {}
+    for i, name in enumerate(S.links):
+        links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
+    pm = {}
+    for name, (link, at) in pts.items():
+        i = S.index(link)
+        s = S.to_local(link, at)
+        P, V, A = S.point_state(np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd), i, s)
+        for arr in (P, V, A):
+            arr[~ok] = np.nan
+        V[~rates_ok] = np.nan
+        A[~rates_ok] = np.nan
+        pm[name] = PointMotion(P, V, A, link)
+    events = [_event_units(S, e) for e in events]
+    from mechsyn.kinematics.solve import singular_configuration
+
+    notes = list(S.notes)
+    if singular_configuration(S):
+        notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
+                     "position): the assembly branch chosen from it is arbitrary")
+    events.extend(_limit_events(S, sw))
+    return Simulation(
+        mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
+        speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
+        events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+
+
+def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
+    from mechsyn.kinematics.system import VLL_MODES
+
+    mode = (vll or {}).get(jid)
+    if mode is not None:
+        return VLL_MODES.get(mode) == "passive"
+    try:
+        return mech.joint(jid).vll == "passive"
+    except KeyError:
+        return False
+
+
+def _event_units(S: PlanarSystem, e: dict) -> dict:
+    e = dict(e)
+    vals = e.get("input")
+    if vals is not None:
+        e["input"] = {d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
+                      for d, v in zip(S.drivers, vals)}
+    return e
+
+
+def _fast_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
+    """Dead points (refined by Newton bisection) where the closed form stops assembling."""
+    out = []
+    ok = sw.assembled
+    for k in (np.flatnonzero(ok[1:] != ok[:-1]) + 1).tolist():
+        if ok[k - 1] and not ok[k]:
+            ul, _ = _limit(S, sw.q[k - 1], sw.inputs[k - 1], sw.inputs[k])
+            out.append({"index": k, "kind": "dead point", "input": ul.tolist(),
+                        "message": "assembly ends: the Jacobian becomes singular (dead point / limit of the "
+                                   "working range)"})
+        elif ok[k] and not ok[k - 1]:
+            ul, _ = _limit(S, sw.q[k], sw.inputs[k], sw.inputs[k - 1])
+            out.append({"index": k, "kind": "dead point", "input": ul.tolist(),
+                        "message": "assembly starts again here: the other limit of a working range"})
+            out.append({"index": k, "kind": "reassembled", "input": sw.inputs[k].tolist(),
+                        "message": "assembles again after a gap (in the file's assembly mode)"})
+    if not ok[0]:
+        out.insert(0, {"index": 0, "kind": "not assembled", "input": sw.inputs[0].tolist(),
+                       "message": "the mechanism cannot be assembled at the first input"})
+    return out
+
+
+def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
+    """Where a VLL's length leaves its limits."""
+    out = []
+    for j in S.mech.joints:
+        if j.type != "P" or j.limits is None:
+            continue
+        s = S.coordinate(np.nan_to_num(sw.q), j.id)
+        bad = sw.assembled & ((s < j.limits[0] - 1e-9) | (s > j.limits[1] + 1e-9))
+        if bad.any():
+            k = int(np.argmax(bad))
+            out.append({"index": k, "kind": "limit", "joint": j.id, "value": float(s[k]),
+                        "message": f"VLL {j.id} length {s[k]:.6g} is outside its limits "
+                                   f"[{j.limits[0]:g}, {j.limits[1]:g}] at {int(bad.sum())} input value(s)"})
+    return out
+
+
+# --------------------------------------------------------------------------- forces
+@dataclass
+class ForceAnalysis:
+    """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``)."""
+
+    simulation: Simulation
+    reactions: Reactions
+    gravity: tuple[float, float]
+    static: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        sim = self.simulation
+        ok = sim.assembled
+
+        def mask(a: np.ndarray) -> list:
+            out = np.asarray(a, float).tolist()
+            return [v if good else None for v, good in zip(out, ok)]
+
+        main = sim.main_input
+        r = self.reactions
+        return {
+            "mechanism": sim.mechanism,
+            "input": {"joint": main, "values": sim.inputs[main], "unit": _unit(sim.input_types[main]),
+                      "speed": sim.speeds[main]},
+            "assembled": ok,
+            "static": self.static,
+            "gravity": list(self.gravity),
+            "joints": {j: {"force": mask(r.force[j]), "magnitude": mask(np.linalg.norm(r.force[j], axis=1)),
+                           "moment": mask(r.moment[j])} for j in r.force},
+            "drives": {j: {"kind": r.effort_kind[j], "value": mask(r.effort[j])} for j in r.effort},
+            "indeterminate": r.indeterminate,
+            **({"belts": {j: {"tension": mask(t)} for j, t in r.tension.items()}} if r.tension else {}),
+            "notes": self.notes(),
+            "events": sim.events,
+            "method": sim.method,
+            "convention": "force: exerted by the joint's first link on its second; drive value: moment (R) "
+                          "or force (P) the actuator applies to the second link",
+        }
+
+
+    def notes(self) -> list[str]:
+        """Warnings on the result: belts that would have to push (they go slack)."""
+        out = []
+        sim = self.simulation
+        main = sim.main_input
+        lam = self.reactions.lam
+        scale = float(np.nanmax(np.abs(lam))) if lam is not None and np.isfinite(lam).any() else 0.0
+        for j, t in self.reactions.tension.items():
+            bad = np.flatnonzero(sim.assembled & (np.nan_to_num(t) < -1e-9 * scale))
+            if len(bad):
+                vals = np.asarray(sim.inputs[main], float)[bad]
+                out.append(f"belt {j} is in compression (a belt can only pull: it goes slack) at {len(bad)} "
+                           f"of the inputs, {main} from {vals.min():g} to {vals.max():g}")
+        return out
+
+
+def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
+           gravity: tuple[float, float] = (0.0, 0.0), static: bool = False, vll: dict[str, str] | None = None,
+           method: str = "auto", progress: Any = None) -> ForceAnalysis:
+    """Kinetostatic (or static) analysis over a sweep of the inputs."""
+    sim = simulate(mech, inputs, speeds=speeds, points=[], vll=vll, method=method, progress=progress)
+    sw = sim.sweep
+    R = kinetostatics(sim.system, sw.q, None if static else sw.qd, None if static else sw.qdd,
+                      gravity=gravity)
+    return ForceAnalysis(sim, R, tuple(float(g) for g in gravity), static)

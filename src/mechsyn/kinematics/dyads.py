@@ -1,0 +1,736 @@
+"""Closed-form position analysis by Assur groups of class II (dyads), vectorised.
+
+A mechanism of R and P pairs whose links can be found one driver at a time and then
+two at a time (a *dyad*: two links, three pairs, joined to links already known) is
+solved in closed form for all input values at once (Artobolevsky, *Theory of
+Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR, RPP, PRP):
+
+* RRR: the middle joint ``B`` is the intersection of the circles ``|B - A| = L1`` and
+  ``|B - C| = L2``: with ``d = C - A``, ``a = (L1^2 - L2^2 + |d|^2) / (2|d|)``,
+  ``h = sqrt(L1^2 - a^2)``, ``B = A + a d/|d| + sigma h R90 d/|d|``;
+* RRP / PRR: the intersection of a circle and a line, ``lambda^2 + 2 p lambda + c = 0``;
+* RPR: the slide line keeps the offset ``e`` from both pivots:
+  ``cos(phi + nu - delta) = e / |C - A|``;
+* RPP / PRP: the orientations follow from the P pairs, the positions from two linear
+  equations ``n_1 . X = h_1``, ``n_2 . X = h_2`` (the two slide lines).
+
+The assembly mode ``sigma`` of each dyad is taken from the file's configuration, so the
+result equals the continuation of :func:`mechsyn.kinematics.solve.sweep` on that branch
+(tests check both agree). Where a square root is negative the dyad cannot be assembled:
+the row is NaN and ``assembled`` is false (dead points are then located by the Newton
+path). Velocities and accelerations of driver + RRR chains are in closed form
+(``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``e1 = B - A``, ``e2 = B - C``); other
+chains use batched linear solves of the differentiated constraints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
+
+__all__ = ["Plan", "decompose", "solve_positions", "solve_all", "fast_chain", "ChainResult"]
+
+
+@dataclass(frozen=True)
+class Step:
+    kind: str                 # "drive_R", "drive_P", "RRR", "RRP", "RPR", "RPP", "PRP"
+    links: tuple[int, ...]    # new links
+    known: tuple[int, ...]    # known links used
+    joints: tuple[str, ...]
+    data: dict
+    sigma: float = 1.0
+
+
+@dataclass(frozen=True)
+class Plan:
+    steps: tuple[Step, ...]
+
+    @property
+    def closed_form_rates(self) -> bool:
+        return all(s.kind in ("drive_R", "RRR") for s in self.steps)
+
+    def describe(self) -> list[str]:
+        return [f"{s.kind} ({', '.join(s.joints)})" for s in self.steps]
+
+
+def _cons_of(S: PlanarSystem, jid: str) -> list[Con]:
+    return [c for c in S.cons if c.joint == jid]
+
+
+def _jtype(S: PlanarSystem, jid: str) -> str:
+    return S.mech.joint(jid).type
+
+
+def decompose(S: PlanarSystem) -> Plan | None:
+    """Drivers and dyads in solving order, or None when the mechanism does not decompose."""
+    mech = S.mech
+    if any(c.kind in ("gear", "curve", "belt") or c.role in ("lock", "idle") for c in S.cons):
+        return None
+    known = {-1}
+    steps: list[Step] = []
+    used: set[str] = set()
+    joints = {j.id: j for j in mech.joints}
+    link_joints: dict[int, list[str]] = {}
+    for j in mech.joints:
+        for ln in j.links:
+            link_joints.setdefault(S.index(ln), []).append(j.id)
+    drivers = {d.joint for d in S.drivers}
+
+    def ends(jid: str) -> tuple[int, int]:
+        a, b = joints[jid].links
+        return S.index(a), S.index(b)
+
+    progress = True
+    while progress and len(known) < len(S.links) + 1:
+        progress = False
+        for jid in drivers - used:
+            a, b = ends(jid)
+            if (a in known) == (b in known):
+                continue
+            k, new = (a, b) if a in known else (b, a)
+            steps.append(Step("drive_" + _jtype(S, jid), (new,), (k,), (jid,), {}))
+            known.add(new)
+            used.add(jid)
+            progress = True
+        if progress:
+            continue
+        # dyads: b1, b2 unknown, J2 between them, J1: known-b1, J3: b2-known
+        for b1 in range(len(S.links)):
+            if b1 in known:
+                continue
+            j1s = [j for j in link_joints.get(b1, []) if j not in used and (set(ends(j)) - {b1}) <= known
+                   and j not in drivers]
+            if len(j1s) != 1:
+                continue
+            J1 = j1s[0]
+            for J2 in link_joints.get(b1, []):
+                if J2 in used or J2 == J1 or J2 in drivers:
+                    continue
+                a2, c2 = ends(J2)
+                b2 = c2 if a2 == b1 else a2
+                if b2 in known:
+                    continue
+                j3s = [j for j in link_joints.get(b2, []) if j not in used and j != J2
+                       and (set(ends(j)) - {b2}) <= known and j not in drivers]
+                if len(j3s) != 1:
+                    continue
+                J3 = j3s[0]
+                types = "".join(_jtype(S, j) for j in (J1, J2, J3))
+                if types not in ("RRR", "RRP", "PRR", "RPR", "RPP", "PPR", "PRP"):
+                    continue  # PPP: not a dyad of a planar mechanism
+                k1 = (set(ends(J1)) - {b1}).pop()
+                k3 = (set(ends(J3)) - {b2}).pop()
+                steps.append(Step(types, (b1, b2), (k1, k3), (J1, J2, J3), {}))
+                known.update((b1, b2))
+                used.update((J1, J2, J3))
+                progress = True
+                break
+            if progress:
+                break
+    if len(known) < len(S.links) + 1:
+        return None
+    if set(j.id for j in mech.joints) - used:
+        return None  # closing constraints left over (redundant): Newton handles them
+    return Plan(tuple(steps))
+
+
+# --------------------------------------------------------------------------- states
+class _State:
+    """Poses of the links known so far, for all N inputs."""
+
+    def __init__(self, S: PlanarSystem, N: int) -> None:
+        self.S = S
+        self.r = np.full((N, len(S.links), 2), np.nan)
+        self.phi = np.full((N, len(S.links)), np.nan)
+        self.N = N
+
+    def pose(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        if i < 0:
+            return np.zeros((self.N, 2)), np.zeros(self.N)
+        return self.r[:, i], self.phi[:, i]
+
+    def point(self, i: int, s: np.ndarray) -> np.ndarray:
+        r, phi = self.pose(i)
+        c, sn = _rot(phi)
+        return r + _apply(c, sn, s)
+
+    def set(self, i: int, r: np.ndarray, phi: np.ndarray) -> None:
+        self.r[:, i] = r
+        self.phi[:, i] = phi
+
+
+def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
+    j = S.mech.joint(jid)
+    name = S.mech.ground if i < 0 else S.links[i]
+    return S.to_local(name, j.point)
+
+
+def _rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:
+    """Constant ``phi_to - phi_from`` of a P joint between links frm and to."""
+    con = next(c for c in _cons_of(S, jid) if c.kind == "angle" and c.role == "rotation")
+    return con.c0 if (con.a, con.b) == (frm, to) else -con.c0
+
+
+def _line(S: PlanarSystem, jid: str) -> Con:
+    return next(c for c in _cons_of(S, jid) if c.kind == "line" and c.role == "pair")
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return (x + np.pi) % (2 * np.pi) - np.pi
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
+    c, sn = _rot(phi)
+    st.set(i, P - _apply(c, sn, s_local), phi)
+
+
+def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: float | None) -> float:
+    """Solve one step in place; return its assembly sign (sigma) for the branch."""
+    if step.kind == "drive_R":
+        (new,), (k,), (jid,) = step.links, step.known, step.joints
+        con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+        th = u[:, con.driver]
+        _, phik = st.pose(k)
+        phi = phik + th if con.b == new else phik - th
+        P = st.point(k, _local(S, k, jid))
+        _pin(st, new, P, _local(S, new, jid), phi)
+        return 1.0
+    if step.kind == "drive_P":
+        (new,), (k,), (jid,) = step.links, step.known, step.joints
+        drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
+        line = _line(S, jid)
+        val = u[:, drive.driver]
+        if drive.a == k:
+            ra, pa = st.pose(k)
+            ca, sa_ = _rot(pa)
+            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+            Pa = st.point(k, line.sa)
+            Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
+            _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
+        else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
+            pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
+            ca, sa_ = _rot(pa)
+            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+            Pb = st.point(k, drive.sb)
+            Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
+            st.set(new, Oa, pa)
+        return 1.0
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    if step.kind == "RRR":
+        A = st.point(A_s, _local(S, A_s, J1))
+        C = st.point(B_s, _local(S, B_s, J3))
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
+        d = C - A
+        D2 = _dot(d, d)
+        D = np.sqrt(D2)
+        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
+        h2 = L1 ** 2 - a ** 2
+        h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
+        h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
+        e = d / D[:, None]
+        if sigma is None:
+            sigma = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+        B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
+        beta1 = np.arctan2(*(s2 - s1)[::-1])
+        beta2 = np.arctan2(*(t2 - t3)[::-1])
+        phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
+        phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
+        _pin(st, b1, A, s1, phi1)
+        _pin(st, b2, C, t3, phi2)
+        return sigma
+    if step.kind in ("RRP", "PRR"):
+        # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
+        if step.kind == "RRP":
+            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
+        else:
+            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+        A = st.point(kr, _local(S, kr, Jr))
+        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+        line = _line(S, Jp)
+        # the P joint's point on lp and the known line through kp's joint point
+        t_p = line.sb if line.b == lp else line.sa
+        s_k = line.sa if line.a == kp else line.sb
+        Pk = st.point(kp, s_k)
+        phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
+        ca, sa_ = _rot(phi_axis)
+        w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
+        cp, sp = _rot(phi_p)
+        tB = _local(S, lp, J2)
+        Q = Pk + _apply(cp, sp, tB - t_p)
+        L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
+        p = _dot(w, Q - A)
+        cc = _dot(Q - A, Q - A) - L1 ** 2
+        disc = p ** 2 - cc
+        disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
+        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        if sigma is None:
+            lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+            sigma = 1.0 if lam0 + p[0] >= 0 else -1.0
+        lam = -p + sigma * root
+        B = Q + lam[:, None] * w
+        sr = _local(S, lr, Jr)
+        beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
+        phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
+        _pin(st, lr, A, sr, phi_r)
+        _pin(st, lp, B, tB, phi_p)
+        return sigma
+    if step.kind == "RPR":
+        A = st.point(A_s, _local(S, A_s, J1))
+        C = st.point(B_s, _local(S, B_s, J3))
+        c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
+        line = _line(S, J2)
+        n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
+                                                      np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
+        # n_loc: the slide normal in b1's frame
+        sA, sP = _local(S, b1, J1), _local(S, b1, J2)
+        tC, tP = _local(S, b2, J3), _local(S, b2, J2)
+        cc, sc = np.cos(c), np.sin(c)
+        Rc = np.array([[cc, -sc], [sc, cc]])
+        e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
+        d = C - A
+        D = np.sqrt(_dot(d, d))
+        delta = np.arctan2(d[:, 1], d[:, 0])
+        nu = np.arctan2(n_loc[1], n_loc[0])
+        ratio = e / D
+        ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
+        ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
+        if sigma is None:
+            phi0 = float(st.S.q0[3 * b1 + 2])
+            sigma = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
+        phi1 = delta - nu + sigma * ac
+        _pin(st, b1, A, sA, phi1)
+        _pin(st, b2, C, tC, phi1 + c)
+        return sigma
+    if step.kind in ("RPP", "PPR"):
+        # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
+        if step.kind == "RPP":
+            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
+        else:
+            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+        phi_r = phi_p + _rel_angle(S, J2, lp, lr)
+        A = st.point(kr, _local(S, kr, Jr))
+        _pin(st, lr, A, _local(S, lr, Jr), phi_r)
+        w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
+        w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
+        st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
+        return 1.0
+    if step.kind == "PRP":
+        phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
+        phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
+        sB, tB = _local(S, b1, J2), _local(S, b2, J2)
+        w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
+        w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
+        B = _solve2(w1, h1, w2, h2)
+        _pin(st, b1, B, sB, phi1)
+        _pin(st, b2, B, tB, phi2)
+        return 1.0
+    raise _NotHandled
+
+
+def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.ndarray,
+             s_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A P pair's line condition ``n . (P_b - P_a) = 0`` as ``n . X = h`` for the unknown
+    position ``X`` of the local point ``s_ref`` of a link whose angle ``phi_u`` is known."""
+    cu, su = _rot(phi_u)
+    if con.b == unknown:
+        _, pa = st.pose(con.a)
+        ca, sa_ = _rot(pa)
+        n = _apply(ca, sa_, con.w)
+        Pa = st.point(con.a, con.sa)
+        return n, _dot(n, Pa - _apply(cu, su, con.sb - s_ref))
+    n = _apply(cu, su, con.w)
+    Pb = st.point(con.b, con.sb)
+    return n, _dot(n, Pb - _apply(cu, su, con.sa - s_ref))
+
+
+def _solve2(w1: np.ndarray, h1: np.ndarray, w2: np.ndarray, h2: np.ndarray) -> np.ndarray:
+    """Solve ``w1 . X = h1``, ``w2 . X = h2`` (NaN where the two lines are parallel)."""
+    det = w1[:, 0] * w2[:, 1] - w1[:, 1] * w2[:, 0]
+    det = np.where(np.abs(det) < 1e-12, np.nan, det)
+    return np.stack([(h1 * w2[:, 1] - h2 * w1[:, 1]) / det, (w1[:, 0] * h2 - w2[:, 0] * h1) / det], axis=1)
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+class _NotHandled(Exception):
+    pass
+
+
+def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
+                    sigmas: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
+    """Poses ``q`` (N, n) for all inputs, NaN rows where a dyad cannot be assembled.
+
+    Angles of links placed by a dyad come from ``atan2``; they are made continuous along
+    each run of assembled inputs, and each run is shifted by whole turns to follow the
+    previous one (links turned by a driver keep the input's own value).
+    """
+    inputs = np.atleast_2d(np.asarray(inputs, float))
+    st = _State(S, inputs.shape[0])
+    out_sig = []
+    for k, step in enumerate(plan.steps):
+        out_sig.append(_solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
+    nl = len(S.links)
+    q = np.empty((inputs.shape[0], S.n))
+    q[:, 0:3 * nl:3] = st.r[:, :, 0]
+    q[:, 1:3 * nl:3] = st.r[:, :, 1]
+    phi = st.phi.copy()
+    dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
+    ok = np.all(np.isfinite(phi), axis=1)
+    if dyad_links and ok.any():
+        ref = S.q0[[3 * i + 2 for i in dyad_links]]
+        sub = ref + _wrap(phi[:, dyad_links] - ref)
+        idx = np.flatnonzero(ok)
+        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+        prev = None
+        for run in runs:
+            block = np.unwrap(sub[run], axis=0)
+            if prev is not None:
+                block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
+            sub[run] = block
+            prev = block[-1]
+        phi[:, dyad_links] = sub
+    q[:, 2:3 * nl:3] = phi
+    return q, out_sig
+
+
+def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
+              chunk: int = 20000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions, velocities, accelerations (N, n) for all inputs (closed form where possible)."""
+    from mechsyn.kinematics.solve import batch_rates
+
+    inputs = np.atleast_2d(np.asarray(inputs, float))
+    if plan.closed_form_rates:
+        return _poses_from_chain(S, plan, inputs, fast_chain(S, plan, inputs, speeds, rates=True))
+    q, _ = solve_positions(S, plan, inputs)
+    ok = np.all(np.isfinite(q), axis=1)
+    qd = np.full_like(q, np.nan)
+    qdd = np.full_like(q, np.nan)
+    idx = np.flatnonzero(ok)
+    for start in range(0, len(idx), chunk):
+        sel = idx[start:start + chunk]
+        qd[sel], qdd[sel] = batch_rates(S, q[sel], speeds)
+    return q, qd, qdd
+
+
+def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
+    with np.errstate(invalid="ignore", over="ignore"):  # inf rates at singular rows become NaN
+        return _poses_from_chain_(S, plan, U, r)
+
+
+def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+    N, nl = r.cos.shape
+    # component-major buffers (returned transposed): every column written is contiguous
+    q = np.empty((S.n, N)).T
+    qd = np.empty((S.n, N)).T
+    qdd = np.empty((S.n, N)).T
+    phi = np.arctan2(r.sin, r.cos)
+    for i in range(nl):
+        jid, sa = r.anchor[i]
+        c, s = r.cos[:, i], r.sin[:, i]
+        relx = -(c * sa[0] - s * sa[1])  # r - P_anchor
+        rely = -(s * sa[0] + c * sa[1])
+        P, V, A = r.points[jid], r.velocities[jid], r.accelerations[jid]
+        w, al = r.omega[:, i], r.alpha[:, i]
+        w2 = w * w
+        q[:, 3 * i] = P[:, 0] + relx
+        q[:, 3 * i + 1] = P[:, 1] + rely
+        qd[:, 3 * i] = V[:, 0] - w * rely
+        qd[:, 3 * i + 1] = V[:, 1] + w * relx
+        qdd[:, 3 * i] = A[:, 0] - al * rely - w2 * relx
+        qdd[:, 3 * i + 1] = A[:, 1] + al * relx - w2 * rely
+        qd[:, 3 * i + 2], qdd[:, 3 * i + 2] = w, al
+    # angles: drivers' links take the input itself, dyad links are made continuous
+    drive_links = {}
+    for step in plan.steps:
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            drive_links[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
+    ok = np.all(np.isfinite(r.cos), axis=1)
+    for i in range(nl):
+        if i in drive_links:
+            k, sgn = drive_links[i]
+            phi[:, i] = sgn * U[:, k]
+    others = [i for i in range(nl) if i not in drive_links]
+    if others and ok.any():
+        ref = S.q0[[3 * i + 2 for i in others]]
+        sub = ref + _wrap(phi[:, others] - ref)
+        idx = np.flatnonzero(ok)
+        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+        prev = None
+        for run in runs:
+            block = np.unwrap(sub[run], axis=0)
+            if prev is not None:
+                block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
+            sub[run] = block
+            prev = block[-1]
+        phi[:, others] = sub
+    q[:, 2:3 * nl:3] = phi
+    if not ok.all():
+        for a in (q, qd, qdd):
+            a[~ok] = np.nan
+    # at a singular configuration (e.g. folded flat) the position exists but the rates
+    # do not: NaN rates, reported as "singular" events by the caller
+    bad = ~(np.all(np.isfinite(qd), axis=1) & np.all(np.isfinite(qdd), axis=1))
+    if bad.any():
+        qd[bad] = np.nan
+        qdd[bad] = np.nan
+    return q, qd, qdd
+
+
+# --------------------------------------------------------------------------- fast chains
+@dataclass
+class ChainResult:
+    """Joint points (and their rates) and link rotations for driver-R + RRR chains.
+
+    ``points[j]``: (N, 2) position of joint ``j`` (on its second moving link);
+    ``velocities[j]``, ``accelerations[j]`` likewise (when rates were asked for);
+    ``cos, sin, omega, alpha``: (N, n_links) rotation of every moving link and its rates.
+    """
+
+    points: dict[str, np.ndarray]
+    velocities: dict[str, np.ndarray] | None
+    accelerations: dict[str, np.ndarray] | None
+    cos: np.ndarray
+    sin: np.ndarray
+    omega: np.ndarray | None
+    alpha: np.ndarray | None
+    anchor: dict[int, tuple[str, np.ndarray]]
+
+
+def chain_supported(plan: Plan | None) -> bool:
+    return plan is not None and plan.closed_form_rates
+
+
+def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
+               rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
+               rotations: bool = True) -> ChainResult:
+    """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
+
+    Every link is carried by an *anchor* (the joint that placed it: its position,
+    velocity, acceleration) and its rotation ``(cos phi, sin phi)``, computed only when
+    a point off the joints is asked for, so no ``atan2`` or trigonometric call is made
+    except for the input angles. RRR: ``B = A + f d + sigma g R90 d`` with ``d = C - A``,
+    ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g = sqrt(L1^2 / |d|^2 - f^2)``; rates:
+    ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``omega_2 = (v_C - v_A) . e1 / (e1 x e2)``
+    and likewise for the accelerations. The work is done
+    in chunks that stay in the processor's cache.
+    """
+    U = np.atleast_2d(np.asarray(U, float))
+    N = U.shape[0]
+    nl = len(S.links)
+    speeds = np.ones(U.shape[1]) if speeds is None else np.asarray(speeds, float)
+    want = joints if joints is not None else [j.id for j in S.mech.joints]
+    prog = []
+    anchor: dict[int, tuple[str, np.ndarray]] = {}
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            sgn = 1.0 if con.b == new else -1.0
+            anchor[new] = (jid, _local(S, new, jid))
+            prog.append(("drive", new, k, jid, con.driver, sgn))
+        else:
+            (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+            s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+            t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+            L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+            A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
+            sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
+            anchor[b1] = (J1, s1)
+            anchor[b2] = (J3, t3)
+            prog.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
+                         (s2 - s1) / L1s, (t2 - t3) / L2s))
+    # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
+    # that every chunk writes contiguous memory
+    jpos = {j: np.empty((2, N)).T for j in want}
+    jvel = {j: np.empty((2, N)).T for j in want} if rates else None
+    jacc = {j: np.empty((2, N)).T for j in want} if rates else None
+    cos_out = np.empty((nl, N)).T if rotations else None
+    sin_out = np.empty((nl, N)).T if rotations else None
+    w_out = np.empty((nl, N)).T if rates else None
+    al_out = np.empty((nl, N)).T if rates else None
+    fixed = {}
+    for j in S.mech.joints:
+        fixed[j.id] = j.point
+    filled: set[str] = set()
+    err = np.seterr(invalid="ignore", divide="ignore")
+    try:
+        for start in range(0, N, chunk):
+            sl = slice(start, min(N, start + chunk))
+            n = sl.stop - sl.start
+            written: set[str] = set()    # joints whose outputs were computed in place
+            rot: dict[int, list] = {}    # link -> [c, s] (lazy) or a recipe
+            rate: dict[int, tuple] = {}  # link -> (omega, alpha)
+            jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
+
+            def rotation(i: int) -> tuple:
+                r = rot[i]
+                if r[0] == "vec":  # from a joint-to-joint vector e and its local vector / L^2
+                    _, ex, ey, bv = r
+                    c = ex * bv[0] + ey * bv[1]
+                    sn = ey * bv[0] - ex * bv[1]
+                    rot[i] = ("cs", c, sn)
+                    return c, sn
+                return r[1], r[2]
+
+            def point(i: int, jid: str | None, s: np.ndarray) -> tuple:
+                if jid is not None and jid in jst and (i < 0 or _on(i, jid)):
+                    return jst[jid]
+                if i < 0:
+                    return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if rates else (s[0], s[1])
+                ajid, sa = anchor[i]
+                A = jst[ajid]
+                dxl, dyl = float(s[0] - sa[0]), float(s[1] - sa[1])
+                c, sn = rotation(i)
+                if dyl == 0.0:
+                    dx, dy = c * dxl, sn * dxl
+                elif dxl == 0.0:
+                    dx, dy = sn * -dyl, c * dyl
+                else:
+                    dx = c * dxl - sn * dyl
+                    dy = sn * dxl + c * dyl
+                if not rates:
+                    return (A[0] + dx, A[1] + dy)
+                w, al = rate[i]
+                w2 = w * w
+                wdx, wdy = w * dx, w * dy
+                if isinstance(al, float) and al == 0.0:  # a driver at constant speed
+                    return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx, A[4] - w * wdx, A[5] - w * wdy)
+                return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
+                        A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
+
+            def _on(i: int, jid: str) -> bool:
+                return True
+
+            for op in prog:
+                if op[0] == "drive":
+                    _, new, k, jid, di, sgn = op
+                    th = U[sl, di]
+                    ct, st = np.cos(th), np.sin(th)
+                    if sgn < 0:
+                        st = -st
+                    if k < 0:
+                        rot[new] = ("cs", ct, st)
+                        if rates:
+                            rate[new] = (sgn * speeds[di], 0.0)
+                        P = fixed[jid]
+                        jst[jid] = (P[0], P[1], 0.0, 0.0, 0.0, 0.0) if rates else (P[0], P[1])
+                    else:
+                        ck, sk = rotation(k)
+                        rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
+                        if rates:
+                            rate[new] = (rate[k][0] + sgn * speeds[di], rate[k][1])
+                        jst[jid] = point(k, jid, _local(S, k, jid))
+                else:
+                    _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
+                    A = point(k1, J1, _local(S, k1, J1))
+                    C = point(k3, J3, _local(S, k3, J3))
+                    jst[J1], jst[J3] = A, C
+                    dx = C[0] - A[0]
+                    dy = C[1] - A[1]
+                    inv = dx * dx
+                    inv += dy * dy
+                    np.divide(1.0, inv, out=inv)
+                    f = inv * (0.5 * (L1s - L2s))
+                    f += 0.5
+                    g = inv * L1s
+                    g -= f * f
+                    np.maximum(g, 0.0, out=g, where=g > -1e-12)
+                    np.sqrt(g, out=g)
+                    if sigma < 0:
+                        np.negative(g, out=g)
+                    e1x = f * dx
+                    e1x -= g * dy
+                    e1y = f * dy
+                    e1y += g * dx
+                    if J2 in jpos:  # straight into the output buffers
+                        Bx = np.add(e1x, A[0], out=jpos[J2][sl, 0])
+                        By = np.add(e1y, A[1], out=jpos[J2][sl, 1])
+                        written.add(J2)
+                    else:
+                        Bx = e1x + A[0]
+                        By = e1y + A[1]
+                    e2x = Bx - C[0]
+                    e2y = By - C[1]
+                    rot[b1] = ("vec", e1x, e1y, bv1)
+                    rot[b2] = ("vec", e2x, e2y, bv2)
+                    if rates:
+                        den = e1x * e2y
+                        den -= e1y * e2x
+                        np.divide(1.0, den, out=den)
+                        dvx, dvy = C[2] - A[2], C[3] - A[3]
+                        w1 = dvx * e2x
+                        w1 += dvy * e2y
+                        w1 *= den
+                        w2 = dvx * e1x
+                        w2 += dvy * e1y
+                        w2 *= den
+                        w1s, w2s = w1 * w1, w2 * w2
+                        dax = C[4] - A[4]
+                        dax -= w2s * e2x
+                        dax += w1s * e1x
+                        day = C[5] - A[5]
+                        day -= w2s * e2y
+                        day += w1s * e1y
+                        a1 = dax * e2x
+                        a1 += day * e2y
+                        a1 *= den
+                        a2 = dax * e1x
+                        a2 += day * e1y
+                        a2 *= den
+                        rate[b1], rate[b2] = (w1, a1), (w2, a2)
+                        outs = ((jvel[J2][sl, 0], jvel[J2][sl, 1], jacc[J2][sl, 0], jacc[J2][sl, 1])
+                                if J2 in jpos else (None,) * 4)
+                        VBx = np.subtract(A[2], w1 * e1y, out=outs[0])
+                        VBy = np.add(A[3], w1 * e1x, out=outs[1])
+                        ABx = np.subtract(A[4], a1 * e1y, out=outs[2])
+                        ABx -= w1s * e1x
+                        ABy = np.add(A[5], a1 * e1x, out=outs[3])
+                        ABy -= w1s * e1y
+                        jst[J2] = (Bx, By, VBx, VBy, ABx, ABy)
+                    else:
+                        jst[J2] = (Bx, By)
+            if rotations:
+                for i in range(nl):
+                    cos_out[sl, i], sin_out[sl, i] = rotation(i)
+            if rates:
+                for i in range(nl):
+                    w_out[sl, i], al_out[sl, i] = rate[i]
+            for jid in want:
+                if jid in written or jid in filled:
+                    continue
+                if jid in jst:
+                    P = jst[jid]
+                    if not isinstance(P[0], np.ndarray):  # a point of the frame: fill once
+                        jpos[jid][:, 0], jpos[jid][:, 1] = P[0], P[1]
+                        if rates:
+                            jvel[jid][:] = 0.0
+                            jacc[jid][:] = 0.0
+                        filled.add(jid)
+                        continue
+                else:
+                    j = S.mech.joint(jid)
+                    side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
+                    P = point(side, None, _local(S, side, jid))
+                jpos[jid][sl, 0], jpos[jid][sl, 1] = P[0], P[1]
+                if rates:
+                    jvel[jid][sl, 0], jvel[jid][sl, 1] = P[2], P[3]
+                    jacc[jid][sl, 0], jacc[jid][sl, 1] = P[4], P[5]
+    finally:
+        np.seterr(**err)
+    return ChainResult(jpos, jvel, jacc, cos_out, sin_out, w_out, al_out, anchor)

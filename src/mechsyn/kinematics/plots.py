@@ -1,0 +1,249 @@
+"""Matplotlib figures of a simulation (paths, velocities, accelerations, reactions) and an
+animation of the mechanism with its point paths (GIF by Pillow)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from mechsyn.results import save_figure_atomic
+
+__all__ = ["plot_simulation", "plot_forces", "animate", "link_outlines"]
+
+
+def _mpl():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _joint_point_on(j, link: str) -> np.ndarray:
+    """The joint's point on ``link``: a belt's anchor on its first link, else its point."""
+    if j.type == "belt" and j.links[0] == link:
+        return np.asarray(j.attrs["anchor"], float)
+    return j.point
+
+
+def link_outlines(sim, k: int) -> dict[str, np.ndarray]:
+    """Global coordinates of every link's joint points at step ``k`` (frame included)."""
+    S = sim.system
+    q = sim.sweep.q[k:k + 1]
+    out = {}
+    for name in S.mech.link_names:
+        i = S.index(name)
+        pts = [S.point(q, i, S.to_local(name, _joint_point_on(j, name)))[0] for j in S.mech.joints_of(name)
+               if j.type != "cam"]  # a cam's contact point moves on both links: drawn apart
+        pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
+        out[name] = np.array(pts)
+    return out
+
+
+def _draw_mechanism(ax, sim, k: int, color: str = "0.2", alpha: float = 1.0) -> list:
+    S = sim.system
+    arts = []
+    outl = link_outlines(sim, k)
+    cmap = _mpl().get_cmap("tab10")
+    for n, (name, pts) in enumerate(outl.items()):
+        if name == S.mech.ground:
+            arts += ax.plot(pts[:, 0], pts[:, 1], "^", ms=10, color="0.35", alpha=alpha, zorder=3)
+            continue
+        c = cmap(n % 10)
+        if len(pts) >= 3:
+            centre = pts.mean(axis=0)
+            order = np.argsort(np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0]))
+            poly = pts[order]
+            arts += ax.fill(poly[:, 0], poly[:, 1], color=c, alpha=0.35 * alpha, zorder=2)
+            closed = np.vstack([poly, poly[:1]])
+            arts += ax.plot(closed[:, 0], closed[:, 1], "-", color=c, lw=2.5, alpha=alpha, zorder=2)
+        elif len(pts) == 2:
+            arts += ax.plot(pts[:, 0], pts[:, 1], "-", color=c, lw=3, alpha=alpha, zorder=2,
+                            solid_capstyle="round")
+        arts += ax.plot(pts[:, 0], pts[:, 1], "o", ms=5, mfc="white", mec=c, alpha=alpha, zorder=4)
+    for con in S.cons:
+        if con.kind != "curve":
+            continue
+        j = S.mech.joint(con.joint)
+        q = sim.sweep.q[k:k + 1]
+        prof = j.attrs.get("profile")
+        a_name = j.links[0]
+        if isinstance(prof, dict) and "points" in prof:
+            pts = np.vstack([prof["points"], prof["points"][:1]])
+        elif isinstance(prof, dict):
+            t = np.linspace(0, 2 * np.pi, 121)
+            pts = np.asarray(prof["center"]) + prof["radius"] * np.stack([np.cos(t), np.sin(t)], 1)
+        else:
+            pts = np.vstack([prof, prof[:1]])
+        loc = np.array([S.to_local(a_name, p) for p in pts])
+        g = np.array([S.point(q, con.a, p)[0] for p in loc])
+        arts += ax.fill(g[:, 0], g[:, 1], color="tab:orange", alpha=0.25 * alpha, zorder=1)
+        arts += ax.plot(g[:, 0], g[:, 1], "-", color="tab:orange", lw=1.5, alpha=alpha, zorder=1)
+        centre = S.point(q, con.b, con.sb)[0]
+        others = [x for x in S.mech.joints_of(j.links[1]) if x.id != j.id and x.type == "R"]
+        rho = float(np.linalg.norm(others[0].point - j.point)) if others else 0.0
+        if rho > 0:
+            t = np.linspace(0, 2 * np.pi, 61)
+            arts += ax.plot(centre[0] + rho * np.cos(t), centre[1] + rho * np.sin(t), "-", color="tab:green",
+                            lw=1.5, alpha=alpha, zorder=3)
+    for con in S.cons:
+        if con.kind != "belt":
+            continue
+        # the pulley, the straight run from the anchor to the tangent point, the wrapped arc
+        from mechsyn.model.pairs import belt_tangent
+
+        j = S.mech.joint(con.joint)
+        q = sim.sweep.q[k:k + 1]
+        centre, anchor = S.point(q, con.b, con.sb)[0], S.point(q, con.a, con.sa)[0]
+        t = np.linspace(0, 2 * np.pi, 91)
+        arts += ax.plot(centre[0] + con.radius * np.cos(t), centre[1] + con.radius * np.sin(t), "-",
+                        color="tab:green", lw=1.5, alpha=alpha, zorder=3)
+        try:
+            T, _, _ = belt_tangent(centre, anchor, con.radius, j.attrs["wrap"])
+        except ValueError:
+            continue
+        arts += ax.plot([anchor[0], T[0]], [anchor[1], T[1]], "-", color="k", lw=2, alpha=alpha, zorder=3)
+        t0 = np.arctan2(T[1] - centre[1], T[0] - centre[0])
+        arc = t0 + con.sigma * np.linspace(0, np.pi / 2, 20)
+        arts += ax.plot(centre[0] + con.radius * np.cos(arc), centre[1] + con.radius * np.sin(arc), "-",
+                        color="k", lw=2, alpha=alpha, zorder=3)
+    for j in S.mech.joints:
+        if j.type == "P":
+            b = j.links[1]
+            P = outl[b][[x.id for x in S.mech.joints_of(b)].index(j.id)]
+            arts += ax.plot([P[0]], [P[1]], "s", ms=11, mfc="none", mec="0.1", alpha=alpha, zorder=5)
+    return arts
+
+
+def _input_axis(sim) -> tuple[np.ndarray, str]:
+    main = sim.main_input
+    unit = "deg" if sim.input_types[main] == "R" else "length"
+    return sim.inputs[main], f"input {main} ({unit})"
+
+
+def plot_simulation(sim, path: str | Path, title: str | None = None) -> None:
+    """Four panels: mechanism and point paths; point speeds; point accelerations; link
+    angular velocities, over the input."""
+    plt = _mpl()
+    x, xlabel = _input_axis(sim)
+    fig, axs = plt.subplots(2, 2, figsize=(12, 9))
+    ax = axs[0, 0]
+    k0 = int(np.argmax(sim.assembled)) if sim.assembled.any() else None
+    if k0 is not None:
+        _draw_mechanism(ax, sim, k0)
+    for name, pm in sim.points.items():
+        ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1.5, label=f"path of {name}")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title("mechanism (first assembled input) and point paths")
+    ax.grid(alpha=0.3)
+    if sim.points:
+        ax.legend(fontsize=8, loc="best")
+    for ax, key, lab in ((axs[0, 1], "velocity", "speed |v| (length/s)"),
+                         (axs[1, 0], "acceleration", "acceleration |a| (length/s²)")):
+        for name, pm in sim.points.items():
+            ax.plot(x, np.linalg.norm(getattr(pm, key), axis=1), label=name)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3)
+        if sim.points:
+            ax.legend(fontsize=8)
+        ax.set_title(f"point {key}")
+    ax = axs[1, 1]
+    for name, lm in sim.links.items():
+        ax.plot(x, lm.angular_velocity, label=name)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("angular velocity (rad/s)")
+    ax.set_title("link angular velocities")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    for e in sim.events:
+        if e["kind"] == "dead point" and isinstance(e.get("input"), dict):
+            v = e["input"].get(sim.main_input)
+            for a in (axs[0, 1], axs[1, 0], axs[1, 1]):
+                a.axvline(v, color="red", ls=":", lw=1)
+    fig.suptitle(title or f"{sim.mechanism}: kinematics ({sim.method})")
+    fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def plot_forces(fa, path: str | Path, title: str | None = None) -> None:
+    """Reaction magnitudes in every joint and the balancing efforts, over the input."""
+    plt = _mpl()
+    sim = fa.simulation
+    x, xlabel = _input_axis(sim)
+    fig, axs = plt.subplots(1, 2, figsize=(13, 5))
+    for j, F in fa.reactions.force.items():
+        axs[0].plot(x, np.linalg.norm(F, axis=1), label=j)
+    axs[0].set_title("joint reactions |F|")
+    axs[0].set_xlabel(xlabel)
+    axs[0].set_ylabel("force")
+    axs[0].grid(alpha=0.3)
+    axs[0].legend(fontsize=8, ncol=2)
+    for j, e in fa.reactions.effort.items():
+        axs[1].plot(x, e, label=f"{j} ({fa.reactions.effort_kind[j]})")
+    axs[1].axhline(0, color="0.5", lw=0.8)
+    axs[1].set_title("balancing moment / force at the driven joints")
+    axs[1].set_xlabel(xlabel)
+    axs[1].grid(alpha=0.3)
+    axs[1].legend(fontsize=8)
+    kind = "static" if fa.static else "kinetostatic"
+    fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, gravity {fa.gravity}")
+    fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def animate(sim, path: str | Path, max_frames: int = 90, fps: int = 15) -> None:
+    """A GIF of the mechanism moving over the assembled inputs, tracing its points' paths."""
+    plt = _mpl()
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    idx = np.flatnonzero(sim.assembled)
+    if len(idx) == 0:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError("nothing to animate: the mechanism is not assembled at any input",
+                                source="--animate")
+    frames = idx[np.unique(np.linspace(0, len(idx) - 1, min(max_frames, len(idx))).astype(int))]
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    # the view: everything drawn at a dozen frames, with the point paths
+    for k in frames[:: max(1, len(frames) // 12)]:
+        _draw_mechanism(ax, sim, k)
+    for pm in sim.points.values():
+        ax.plot(pm.position[idx, 0], pm.position[idx, 1])
+    ax.relim()
+    lo = np.array([ax.dataLim.x0, ax.dataLim.y0])
+    hi = np.array([ax.dataLim.x1, ax.dataLim.y1])
+    pad = 0.08 * max(hi - lo) + 1e-9
+    x, xlabel = _input_axis(sim)
+
+    def draw(k):
+        ax.clear()
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        for name, pm in sim.points.items():
+            ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
+            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
+            ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
+        arts = _draw_mechanism(ax, sim, k)
+        ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
+        if sim.points:
+            ax.legend(fontsize=8, loc="upper right")
+        return arts
+
+    anim = FuncAnimation(fig, draw, frames=list(frames), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    try:
+        anim.save(str(tmp), writer=PillowWriter(fps=fps))
+        tmp.replace(path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+        plt.close(fig)

@@ -1,0 +1,419 @@
+"""Position, velocity and acceleration analysis by Newton's method and linear solves.
+
+Positions: Newton-Raphson on ``Phi(q, u) = 0`` with the analytic Jacobian (square
+systems: LU; redundant constraints: least squares). A sweep over input values is a
+continuation: each step is predicted from the velocities (``Phi_q dq = B du``),
+corrected by Newton and halved when Newton fails or jumps, so the solution follows the
+file's assembly branch. Where the step cannot be made smaller and still converge, the
+mechanism cannot be assembled (a dead point: ``Phi_q`` singular at the limit).
+
+Velocities: ``Phi_q q' = B u'``; accelerations: ``Phi_q q'' = gamma + B u''``
+(Haug 1989, eqs. 3.3.9-3.3.11), both with the LU factors of ``Phi_q``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.system import PlanarSystem
+
+__all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton"]
+
+
+@dataclass
+class Sweep:
+    """Result of a sweep: poses and their rates at every input value.
+
+    ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
+    ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates.
+    """
+
+    system: PlanarSystem
+    inputs: np.ndarray
+    speeds: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    assembled: np.ndarray
+    det_sign: np.ndarray
+    sigma_min: np.ndarray
+    events: list[dict] = field(default_factory=list)
+    method: str = "newton"
+
+    @property
+    def n(self) -> int:
+        return self.q.shape[0]
+
+
+def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    if J.shape[0] == J.shape[1]:
+        try:
+            lu = sla.lu_factor(J, check_finite=False)
+            x = sla.lu_solve(lu, rhs, check_finite=False)
+            if np.all(np.isfinite(x)):
+                return x
+        except (sla.LinAlgError, ValueError):
+            pass
+    return sla.lstsq(J, rhs, check_finite=False, lapack_driver="gelsy")[0]
+
+
+def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = None,
+           max_iter: int = 12) -> tuple[np.ndarray, bool]:
+    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged)."""
+    tol = tol if tol is not None else 1e-12 * S.scale
+    q = q.copy()
+    u2 = u[None]
+    prev = np.inf
+    for _ in range(max_iter):
+        r = S.residual(q[None], u2)[0]
+        norm = float(np.abs(r).max()) if r.size else 0.0
+        if not np.isfinite(norm):
+            return q, False
+        if norm < tol:
+            return q, True
+        if norm > 4 * prev and prev < 1e-3 * S.scale:
+            return q, False
+        prev = norm
+        dq = _solve_lin(S.jacobian(q[None])[0], -r)
+        if not np.all(np.isfinite(dq)):
+            return q, False
+        q += dq
+    r = S.residual(q[None], u2)[0]
+    return q, bool(np.abs(r).max() < tol * 10)
+
+
+def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
+          accel: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations (n,) at one configuration ``q`` (n,)."""
+    J = S.jacobian(q[None])[0]
+    B = S.input_matrix()
+    ud = np.asarray(speeds, float)
+    udd = np.zeros_like(ud) if accel is None else np.asarray(accel, float)
+    if J.shape[0] == J.shape[1]:
+        lu = sla.lu_factor(J, check_finite=False)
+        qd = sla.lu_solve(lu, B @ ud, check_finite=False)
+        qdd = sla.lu_solve(lu, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)
+    else:
+        qd = sla.lstsq(J, B @ ud, check_finite=False)[0]
+        qdd = sla.lstsq(J, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)[0]
+    return qd, qdd
+
+
+def batch_rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations for a batch of configurations (N, n), vectorised."""
+    N = q.shape[0]
+    J = S.jacobian(q)
+    B = S.input_matrix()
+    rhs = np.broadcast_to(B @ np.asarray(speeds, float), (N, S.m))
+    if S.m == S.n:
+        qd = np.linalg.solve(J, rhs[..., None])[..., 0]
+        qdd = np.linalg.solve(J, S.gamma(q, qd)[..., None])[..., 0]
+    else:
+        pinv = np.linalg.pinv(J)
+        qd = np.einsum("nij,nj->ni", pinv, rhs)
+        qdd = np.einsum("nij,nj->ni", pinv, S.gamma(q, qd))
+    return qd, qdd
+
+
+def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
+    """Rank of ``Phi_q`` at ``q``: free coordinates beyond the inputs, redundant constraints."""
+    q = S.q0 if q is None else q
+    J = S.jacobian(q[None])[0]
+    sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
+    tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
+    rank = int(np.sum(sv > tol))
+    return {"unknowns": S.n, "equations": S.m, "rank": rank, "free": S.n - rank,
+            "redundant": S.m - rank}
+
+
+def generic_free(S: PlanarSystem, q: np.ndarray | None = None, trials: int = 3) -> int:
+    """Free coordinates of the mechanism in general position: the rank of ``Phi_q`` at
+    configurations near ``q`` (a dead-centre or folded file configuration lowers the rank
+    at ``q`` only)."""
+    q = S.q0 if q is None else q
+    rng = np.random.default_rng(0)
+    best = S.n
+    for _ in range(trials):
+        dq = rng.normal(size=S.n) * 1e-3
+        dq[:3 * len(S.links)] *= np.where(np.arange(3 * len(S.links)) % 3 == 2, 1.0, S.scale)
+        best = min(best, check_mobility(S, q + dq)["free"])
+    return best
+
+
+def singular_configuration(S: PlanarSystem, q: np.ndarray | None = None) -> bool:
+    """``Phi_q`` loses rank at ``q`` though the mechanism is determined in general position."""
+    q = S.q0 if q is None else q
+    return check_mobility(S, q)["free"] > 0 and generic_free(S, q) == 0
+
+
+def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:
+    info = check_mobility(S, q)
+    src = S.mech.source or "<mechanism>"
+    if info["free"] > 0 and generic_free(S, q) == 0:
+        return info  # a singular file configuration (dead centre, folded): reported by the sweep
+    if info["free"] > 0:
+        passive = [j for j, mode in S.vll.items() if mode == "passive"]
+        hint = "mark more joints actuated"
+        if passive:
+            hint = (f"lock the free VLL ({', '.join(f'--vll {p}=locked' for p in passive)}) or give its "
+                    f"length as an input (--input {passive[0]}=...)")
+        raise MechsynInputError(
+            f"the mechanism has {info['free']} free coordinate(s) beyond its {len(S.drivers)} input(s): "
+            "its motion is not determined by the inputs", source=src, hint=hint)
+    return info
+
+
+def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
+    """The configuration at inputs ``u`` reached from the file's assembled configuration.
+
+    The file's configuration is first made exact by Newton, then followed continuously
+    from its own input values to ``u`` (so the file chooses the assembly branch).
+    """
+    u_asm = np.array([d.assembled for d in S.drivers])
+    q, ok = newton(S, S.q0, u_asm, max_iter=30)
+    src = S.mech.source or "<mechanism>"
+    if not ok:
+        worst = _worst_joint(S, S.q0, u_asm)
+        raise MechsynInputError(
+            f"the joint points of the file do not assemble (largest error at joint {worst})", source=src,
+            hint="check the joint points: each link's joints must keep their distances")
+    moved = float(np.abs(q - S.q0)[:3 * len(S.links)].max()) if S.links else 0.0
+    if moved > 1e-6 * S.scale:
+        raise MechsynInputError(
+            f"the file's configuration is not assembled: joint {_worst_joint(S, S.q0, u_asm)} is off "
+            f"by up to {moved:.3g}", source=src,
+            hint="give joint points of one consistent configuration")
+    _require_determined(S, q)
+    if u is None:
+        return q
+    qq = _track(S, q, u_asm, np.asarray(u, float), depth=14)
+    if qq is None:
+        raise MechsynInputError("the mechanism cannot reach the requested input from its file configuration",
+                                source="--input")
+    return qq
+
+
+def _worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
+    r = np.abs(S.residual(q[None], u[None])[0])
+    row, best, worst = 0, -1.0, "?"
+    for con in S.cons:
+        v = float(r[row:row + con.rows].max())
+        if v > best:
+            best, worst = v, con.joint
+        row += con.rows
+    return worst
+
+
+def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, float]:
+    """LU of ``Phi_q`` at q, ``dq/du`` (n, k), det sign and a singularity measure.
+
+    The measure is min |U_ii| / max |U_ii| of the LU factors (0 at a singular point).
+    """
+    J = S.jacobian(q[None])[0]
+    B = S.input_matrix()
+    if J.shape[0] == J.shape[1]:
+        try:
+            lu = sla.lu_factor(J, check_finite=False)
+            X = sla.lu_solve(lu, B, check_finite=False)
+            d = np.abs(np.diag(lu[0]))
+            piv = int(np.sum(lu[1] != np.arange(len(lu[1]))))
+            sign = float(np.prod(np.sign(np.diag(lu[0]))) * (-1) ** piv)
+            if np.all(np.isfinite(X)):
+                return lu, X, sign, float(d.min() / max(d.max(), 1e-300))
+        except (sla.LinAlgError, ValueError):
+            pass
+    X = sla.lstsq(J, B, check_finite=False)[0]
+    sv = np.linalg.svd(J, compute_uv=False)
+    return (J,), X, 0.0, float(sv[min(J.shape) - 1] / max(sv.max(), 1e-300)) if sv.size else 1.0
+
+
+def _solve_with(S: PlanarSystem, fac: tuple, rhs: np.ndarray) -> np.ndarray:
+    if len(fac) == 2:
+        return sla.lu_solve(fac, rhs, check_finite=False)
+    return sla.lstsq(fac[0], rhs, check_finite=False)[0]
+
+
+def _rates_from(S: PlanarSystem, q: np.ndarray, fac: tuple, X: np.ndarray,
+                speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    qd = X @ speeds
+    qdd = _solve_with(S, fac, S.gamma(q[None], qd[None])[0])
+    return qd, qdd
+
+
+def _step_ok(S: PlanarSystem, q_old: np.ndarray, q_new: np.ndarray, q_pred: np.ndarray) -> bool:
+    """Reject a Newton correction much larger than the predicted step (a branch jump)."""
+    nl = 3 * len(S.links)
+    step = np.abs(q_pred - q_old)[:nl]
+    corr = np.abs(q_new - q_pred)[:nl]
+    scale = np.where(np.arange(nl) % 3 == 2, 1.0, S.scale)
+    return bool(np.max(corr / scale) <= max(0.25 * np.max(step / scale), 1e-6))
+
+
+def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth: int = 10,
+           X: np.ndarray | None = None) -> np.ndarray | None:
+    """Follow the branch from (q, ua) to ub; None when it cannot be assembled.
+
+    ``X = dq/du`` at q (computed when not given) predicts the step.
+    """
+    du = ub - ua
+    if X is None:
+        X = _factor(S, q)[1]
+    q_pred = q + X @ du
+    q_new, ok = newton(S, q_pred, ub)
+    if ok and _step_ok(S, q, q_new, q_pred):
+        return q_new
+    if depth == 0:
+        return None
+    um = ua + du / 2
+    qm = _track(S, q, ua, um, depth - 1, X)
+    if qm is None:
+        return None
+    return _track(S, qm, um, ub, depth - 1)
+
+
+def _turns(S: PlanarSystem, u: np.ndarray) -> np.ndarray:
+    """Whole turns (as radians) between R inputs ``u`` and the file's values."""
+    out = np.zeros(len(S.drivers))
+    for k, d in enumerate(S.drivers):
+        if d.type == "R":
+            out[k] = 2 * np.pi * np.round((u[k] - d.assembled) / (2 * np.pi))
+    return out
+
+
+def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
+    """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
+    for _ in range(iters):
+        um = (ua + ub) / 2
+        qm = _track(S, q, ua, um, depth=3)
+        if qm is None:
+            # near the fold Newton converges only linearly: give it room (no branch check,
+            # both branches meet there)
+            qm, ok = newton(S, q, um, max_iter=60)
+            if not ok:
+                qm = None
+        if qm is None:
+            ub = um
+        else:
+            q, ua = qm, um
+    return ua, q
+
+
+def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
+          progress=None, refine_limits: bool = True) -> Sweep:
+    """Positions, velocities, accelerations over input values (N, n_inputs), by continuation.
+
+    ``speeds`` are the input rates (rad/s or length/s; default 1 for every input).
+    Events (``dead point``: the input where assembly ends, refined by bisection;
+    ``reassembled``: the mechanism assembles again after a gap, possibly on another
+    branch; ``singular``: ``det Phi_q`` changes sign between two steps, a branch point
+    was crossed) are listed in ``Sweep.events``.
+    """
+    inputs = np.atleast_2d(np.asarray(inputs, float))
+    N, k = inputs.shape
+    if k != len(S.drivers):
+        raise ValueError(f"expected {len(S.drivers)} input columns, got {k}")
+    # an R input differing from the file's angle by whole turns is the same configuration:
+    # start from the equivalent value nearest the file's (a full turn could cross a toggle)
+    shift = _turns(S, inputs[0])
+    if np.any(shift):
+        sw = sweep(S, inputs - shift, speeds, progress, refine_limits)
+        sw.inputs = inputs
+        # a link driven from the frame takes the input's own turn count (same positions)
+        for con in S.cons:
+            if con.role == "drive" and con.kind == "angle" and shift[con.driver]:
+                if con.a < 0 and con.b >= 0:
+                    sw.q[:, 3 * con.b + 2] += shift[con.driver]
+                elif con.b < 0 and con.a >= 0:
+                    sw.q[:, 3 * con.a + 2] -= shift[con.driver]
+        for e in sw.events:
+            e["input"] = (np.asarray(e["input"]) + shift).tolist()
+        return sw
+    speeds = np.ones(k) if speeds is None else np.asarray(speeds, float)
+    q_start = assemble(S)
+    q = np.full((N, S.n), np.nan)
+    qd = np.full((N, S.n), np.nan)
+    qdd = np.full((N, S.n), np.nan)
+    det_sign = np.full(N, np.nan)
+    sig = np.full(N, np.nan)
+    events: list[dict] = []
+    u_asm = np.array([d.assembled for d in S.drivers])
+    cur = _track(S, q_start, u_asm, inputs[0], depth=14)
+    cur_u = inputs[0]
+    X = None
+    last_good: tuple[np.ndarray, np.ndarray] | None = (q_start, u_asm)
+    if cur is None:
+        if refine_limits:
+            ul, _ = _limit(S, q_start, u_asm, inputs[0])
+            events.append({"index": 0, "kind": "dead point", "input": ul.tolist(),
+                           "message": "the mechanism cannot move from its file configuration to the first input"})
+    for i in range(N):
+        u = inputs[i]
+        if cur is not None and i > 0:
+            nxt = _track(S, cur, cur_u, u, X=X)
+            if nxt is None and np.isfinite(sig[i - 1]) and sig[i - 1] < 1e-6:
+                # leaving a singular (change / branch) point: the predictor has no unique
+                # direction; let Newton pick the continuation and say so
+                cand, ok = newton(S, cur + X @ (u - cur_u), u, max_iter=40)
+                if ok:
+                    nxt = cand
+                    events.append({"index": i, "kind": "branch point", "input": cur_u.tolist(),
+                                   "message": "continued past a singular configuration (change or branch "
+                                              "point) by Newton: the assembly branch may have switched"})
+            if nxt is None:
+                if refine_limits:
+                    ul, _ = _limit(S, cur, cur_u, u)
+                else:
+                    ul = cur_u
+                events.append({"index": i, "kind": "dead point", "input": ul.tolist(),
+                               "message": "assembly ends: the Jacobian becomes singular (dead point / "
+                                          "limit of the working range)"})
+                last_good = (cur, cur_u)
+            cur = nxt
+            cur_u = u
+        elif cur is None and last_good is not None:
+            ok = False
+            for guess in (last_good[0], q_start):
+                cand, ok = newton(S, guess, u, max_iter=15)
+                if ok:
+                    break
+            if ok:
+                cur, cur_u = cand, u
+                # follow the new branch backwards into the gap as far as it assembles
+                bq, bu, j = cand, u, i - 1
+                while j >= 0 and not np.isfinite(q[j, 0]):
+                    nb = _track(S, bq, bu, inputs[j])
+                    if nb is None:
+                        break
+                    q[j] = nb
+                    fac_j, X_j, det_sign[j], sig[j] = _factor(S, nb)
+                    qd[j], qdd[j] = _rates_from(S, nb, fac_j, X_j, speeds)
+                    bq, bu, j = nb, inputs[j], j - 1
+                if refine_limits and j >= 0:
+                    ul, _ = _limit(S, bq, bu, inputs[j])
+                    events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
+                                   "message": "assembly starts again here: the other limit of a working range"})
+                events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
+                               "message": "assembles again after a gap (branch chosen by Newton from the "
+                                          "last configuration)"})
+        if cur is not None:
+            q[i] = cur
+            fac, X, det_sign[i], sig[i] = _factor(S, cur)
+            qd[i], qdd[i] = _rates_from(S, cur, fac, X, speeds)
+            if i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0:
+                events.append({"index": i, "kind": "singular", "input": u.tolist(),
+                               "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
+                                          "crossed between this input and the previous"})
+        if progress is not None:
+            progress()
+    assembled = np.all(np.isfinite(q), axis=1)
+    for i in np.flatnonzero(np.isfinite(sig) & (sig < 1e-6)).tolist():
+        events.append({"index": i, "kind": "singular", "input": inputs[i].tolist(),
+                       "message": f"near-singular configuration (pivot ratio {sig[i]:.1e}): a change, branch or "
+                                  "dead point; the branch may switch here and positions are accurate only to "
+                                  "about the square root of the solver tolerance"})
+    events.sort(key=lambda e: e["index"])
+    return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)

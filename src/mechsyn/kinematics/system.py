@@ -1,0 +1,720 @@
+"""A planar mechanism as a system of constraint equations on link poses.
+
+Every moving link ``i`` has the pose ``q_i = (x_i, y_i, phi_i)``: the position of its
+origin and the absolute angle of its reference line (Haug's *body coordinates*,
+E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems*, 1989,
+ch. 3). The frame is fixed at ``(0, 0, 0)``. A point with local coordinates ``s`` on
+link ``i`` is at ``P = r_i + A(phi_i) s``.
+
+Link frames come from the file's assembled configuration: the origin of a link is the
+point of its first joint (file order) and its reference line points to the first
+other joint point, so a crank's angle is the direction of the crank line. The frame
+link keeps the global frame.
+
+Joints become constraint rows ``Phi(q, u) = 0`` (``u``: the input coordinates):
+
+* R pair: ``P_a - P_b = 0`` (2 rows);
+* P pair: ``phi_b - phi_a = const`` and ``n_a . (P_b - P_a) = 0`` (2 rows);
+* driven R: ``phi_b - phi_a - theta = 0``; driven or locked P (``vll``):
+  ``u_a . (P_b - O_a) - s = 0`` with ``O_a`` the origin of link ``a``;
+* gear pair (ratio ``k``, carrier ``c``): ``(phi_b - phi_c) - k (phi_a - phi_c) = const``;
+* cam with a roller (or knife edge) on link ``b``: the roller centre stays on the
+  profile's offset curve ``O(t)`` fixed on the cam ``a``:
+  ``P_b - r_a - A_a O(t) = 0`` (2 rows, one extra unknown ``t``);
+* belt (paper 001; chain, band, rope): anchored at ``E`` on link ``a``, wrapping a pulley
+  of radius ``r`` centred at ``P`` on link ``b`` in the sense ``σ`` (+1 ccw, -1 cw). With
+  ``D = P - E``, ``d = |D|``, ``δ = arg D``, free length ``b = sqrt(d² - r²)`` and tangent
+  point at ``τ = δ - σ atan2(b, -r)``, the belt length ``b + σ r (φ_b - τ)`` (straight run
+  plus ``r`` times the angle wrapped, measured in the pulley's frame) is constant:
+  ``b - r atan(b/r) + σ r (φ_b - δ) = const`` (1 row). Its Jacobian row is
+  ``g·dD + σ r dφ_b`` with ``g`` the unit belt direction (the tension's line of action).
+
+The Jacobian ``Phi_q`` is analytic; ``gamma`` is the right-hand side of the
+acceleration equation ``Phi_q q'' = gamma`` (Haug eq. 3.3.11). All functions work on a
+batch of configurations: ``q`` has shape ``(N, n)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.model.mechanism import Joint, Mechanism
+from mechsyn.model.pairs import BELT_WRAPS
+
+__all__ = ["PlanarSystem", "build_system", "VLL_MODES", "CamCurve"]
+
+#: Accepted spellings of the VLL modes on the command line.
+VLL_MODES = {"active": "active", "driven": "active", "passive": "passive", "free": "passive",
+             "locked": "locked", "rigid": "locked"}
+
+
+def _rot(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return np.cos(phi), np.sin(phi)
+
+
+def _apply(c: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``A(phi) v`` for a batch of angles (``c, s`` shape (N,)) and a vector ``v`` (2,) or (N, 2)."""
+    vx, vy = v[..., 0], v[..., 1]
+    x = c * vx - s * vy
+    out = np.empty(x.shape + (2,))
+    out[..., 0] = x
+    out[..., 1] = s * vx + c * vy
+    return out
+
+
+def _perp(v: np.ndarray) -> np.ndarray:
+    """``R90 v``: the vector turned by +90 degrees."""
+    out = np.empty(v.shape)
+    out[..., 0] = -v[..., 1]
+    out[..., 1] = v[..., 0]
+    return out
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+# --------------------------------------------------------------------------- cams
+@dataclass(frozen=True)
+class CamCurve:
+    """The curve the roller centre follows on the cam (profile offset by the roller radius).
+
+    ``kind`` is ``"circle"`` (an eccentric disc: exact) or ``"spline"`` (a periodic cubic
+    spline through the offset of the profile points), in the cam's local frame.
+    """
+
+    kind: str
+    center: np.ndarray | None = None
+    radius: float = 0.0
+    spline: Any = None
+    period: float = 2 * np.pi
+
+    def eval(self, t: np.ndarray, der: int = 0) -> np.ndarray:
+        if self.kind == "circle":
+            ang = t + der * np.pi / 2
+            out = self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
+            return out + (self.center if der == 0 else 0.0)
+        return self.spline(np.mod(t, self.period), der)
+
+    def closest(self, p: np.ndarray) -> float:
+        """Parameter of the curve point nearest ``p`` (local coordinates)."""
+        if self.kind == "circle":
+            d = p - self.center
+            return float(np.arctan2(d[1], d[0]))
+        ts = np.linspace(0, self.period, 4001)
+        pts = self.eval(ts)
+        return float(ts[np.argmin(np.sum((pts - p) ** 2, axis=1))])
+
+
+def _cam_curve(profile: Any, center_local: np.ndarray, rho: float, contact_local: np.ndarray,
+               to_local: Any, source: str, jid: str) -> CamCurve:
+    """Build the offset curve followed by the roller centre from the joint's profile."""
+    from scipy.interpolate import make_interp_spline
+
+    if isinstance(profile, dict) and "points" in profile:  # a polar function, sampled
+        profile = profile["points"]
+    if isinstance(profile, dict):
+        c = to_local(np.asarray(profile["center"], float))
+        r = float(profile["radius"])
+        d = float(np.linalg.norm(center_local - c))
+        # roller outside (r + rho) or inside (r - rho) the disc: whichever matches
+        r_off = r + rho if abs(d - (r + rho)) <= abs(d - abs(r - rho)) else abs(r - rho)
+        return CamCurve("circle", center=c, radius=r_off)
+    pts = np.array([to_local(np.asarray(p, float)) for p in profile])
+    if np.allclose(pts[0], pts[-1]):
+        pts = pts[:-1]
+    closed = np.vstack([pts, pts[:1]])
+    t = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
+    if np.any(np.diff(t) <= 0):
+        raise MechsynInputError(f"cam profile of joint {jid} repeats a point", source=source,
+                                field=f"joints.{jid}.profile", hint="list distinct points round the cam")
+    spl = make_interp_spline(t, closed, k=3, bc_type="periodic")
+    if rho == 0:
+        return CamCurve("spline", spline=spl, period=float(t[-1]))
+    ts = np.linspace(0, t[-1], 16 * len(pts) + 400, endpoint=False)
+    p, d1 = spl(ts), spl(ts, 1)
+    nrm = np.stack([d1[:, 1], -d1[:, 0]], axis=1) / np.linalg.norm(d1, axis=1)[:, None]
+    # offset to the side where the roller centre is
+    k = int(np.argmin(np.sum((p - contact_local) ** 2, axis=1)))
+    sign = 1.0 if _dot(nrm[k], center_local - p[k]) >= 0 else -1.0
+    off = p + sign * rho * nrm
+    off_closed = np.vstack([off, off[:1]])
+    to = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(off_closed, axis=0), axis=1))])
+    spl2 = make_interp_spline(to, off_closed, k=3, bc_type="periodic")
+    return CamCurve("spline", spline=spl2, period=float(to[-1]))
+
+
+# --------------------------------------------------------------------------- constraints
+@dataclass(frozen=True)
+class Con:
+    """One constraint block. ``kind``: R, angle, line, gear, curve."""
+
+    kind: str
+    joint: str
+    rows: int
+    a: int                   # link indices (-1: frame)
+    b: int
+    sa: np.ndarray | None = None
+    sb: np.ndarray | None = None
+    w: np.ndarray | None = None   # local unit direction on a (line)
+    c0: float = 0.0
+    driver: int | None = None     # index into the input vector u
+    c: int = -1                   # gear carrier
+    k: float = 0.0                # gear ratio
+    tvar: int = -1                # cam contact parameter's column
+    curve: CamCurve | None = None
+    role: str = ""                # "pair", "drive", "lock", "rotation", "idle"
+    radius: float = 0.0           # belt: pulley radius
+    sigma: float = 0.0            # belt: wrap sense, +1 ccw, -1 cw
+    ref: float = 0.0              # belt: phi_b - delta in the file's configuration
+
+
+@dataclass(frozen=True)
+class Driver:
+    """An input coordinate: a driven (or prescribed passive) joint."""
+
+    joint: str
+    type: str            # "R" (radians) or "P" (length)
+    assembled: float     # its value in the file's configuration
+    role: str            # "drive" (actuated / active VLL) or "prescribed" (passive VLL)
+
+
+@dataclass(frozen=True, eq=False)
+class PlanarSystem:
+    """A compiled planar mechanism: unknowns, constraints, inputs (see the module doc)."""
+
+    mech: Mechanism
+    links: tuple[str, ...]             # moving links; link i has columns 3i..3i+2
+    origin0: np.ndarray                # (nl, 2) assembled origins
+    angle0: np.ndarray                 # (nl,) assembled reference angles
+    cons: tuple[Con, ...]
+    drivers: tuple[Driver, ...]
+    n: int                             # unknowns
+    m: int                             # equations
+    q0: np.ndarray                     # file configuration
+    scale: float                       # characteristic length
+    vll: dict[str, str] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    # -- geometry helpers ----------------------------------------------------------
+    def index(self, link: str) -> int:
+        return -1 if link == self.mech.ground else self.links.index(link)
+
+    def to_local(self, link: str, p: np.ndarray) -> np.ndarray:
+        i = self.index(link)
+        if i < 0:
+            return np.asarray(p, float)
+        c, s = np.cos(-self.angle0[i]), np.sin(-self.angle0[i])
+        d = np.asarray(p, float) - self.origin0[i]
+        return np.array([c * d[0] - s * d[1], s * d[0] + c * d[1]])
+
+    def pose(self, q: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """(r (N,2), phi (N,)) of link ``i`` (frame: zeros)."""
+        if i < 0:
+            z = np.zeros(q.shape[0])
+            return np.zeros((q.shape[0], 2)), z
+        return q[:, 3 * i:3 * i + 2], q[:, 3 * i + 2]
+
+    def point(self, q: np.ndarray, i: int, s: np.ndarray) -> np.ndarray:
+        r, phi = self.pose(q, i)
+        c, sn = _rot(phi)
+        return r + _apply(c, sn, s)
+
+    def point_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, i: int,
+                    s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity, acceleration of the local point ``s`` on link ``i``."""
+        r, phi = self.pose(q, i)
+        c, sn = _rot(phi)
+        As = _apply(c, sn, s)
+        if i < 0:
+            z = np.zeros_like(As)
+            return r + As, z, z
+        v, w = qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
+        a, al = qdd[:, 3 * i:3 * i + 2], qdd[:, 3 * i + 2]
+        return (r + As, v + w[:, None] * _perp(As),
+                a + al[:, None] * _perp(As) - (w ** 2)[:, None] * As)
+
+    def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
+        """Angles (N,) of link index ``i`` (frame: zeros)."""
+        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
+
+    def link_angle(self, q: np.ndarray, link: str) -> np.ndarray:
+        i = self.index(link)
+        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
+
+    def driver_index(self, joint: str) -> int:
+        for k, d in enumerate(self.drivers):
+            if d.joint == joint:
+                return k
+        raise KeyError(joint)
+
+    def coordinate(self, q: np.ndarray, joint: str) -> np.ndarray:
+        """The joint coordinate: relative angle (R, rad) or slide coordinate (P)."""
+        j = self.mech.joint(joint)
+        a, b = self.index(j.links[0]), self.index(j.links[1])
+        if j.type == "R":
+            return self.link_angle(q, j.links[1]) - self.link_angle(q, j.links[0])
+        u_loc = self.to_local_dir(j.links[0], _axis(j))
+        sb = self.to_local(j.links[1], j.point)
+        ra, pa = self.pose(q, a)
+        c, s = _rot(pa)
+        return _dot(_apply(c, s, u_loc), self.point(q, b, sb) - ra)
+
+    def coordinate_rate(self, q: np.ndarray, qd: np.ndarray, joint: str) -> np.ndarray:
+        """Time derivative of :meth:`coordinate` (by the Jacobian of the coordinate)."""
+        h = 1e-7
+        # the coordinate is smooth in q: a central difference along qd is exact to O(h^2)
+        qa, qb = np.nan_to_num(q - h * qd), np.nan_to_num(q + h * qd)
+        return (self.coordinate(qb, joint) - self.coordinate(qa, joint)) / (2 * h)
+
+    def to_local_dir(self, link: str, u: np.ndarray) -> np.ndarray:
+        i = self.index(link)
+        if i < 0:
+            return np.asarray(u, float)
+        c, s = np.cos(-self.angle0[i]), np.sin(-self.angle0[i])
+        return np.array([c * u[0] - s * u[1], s * u[0] + c * u[1]])
+
+    # -- equations -----------------------------------------------------------------
+    def residual(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """``Phi(q, u)``, shape (N, m); ``u`` has shape (N, n_inputs)."""
+        out = np.empty((q.shape[0], self.m))
+        row = 0
+        for con in self.cons:
+            out[:, row:row + con.rows] = _residual(self, con, q, u)
+            row += con.rows
+        return out
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """``Phi_q``, shape (N, m, n)."""
+        J = np.zeros((q.shape[0], self.m, self.n))
+        row = 0
+        for con in self.cons:
+            _jacobian(self, con, q, J, row)
+            row += con.rows
+        return J
+
+    def input_matrix(self) -> np.ndarray:
+        """``B`` with ``Phi_q q' = B u'`` (rows of drivers are 1 in their input column)."""
+        B = np.zeros((self.m, len(self.drivers)))
+        row = 0
+        for con in self.cons:
+            if con.driver is not None:
+                B[row, con.driver] = 1.0
+            row += con.rows
+        return B
+
+    def gamma(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """Velocity-dependent right-hand side of ``Phi_q q'' = gamma + B u''``."""
+        out = np.zeros((q.shape[0], self.m))
+        row = 0
+        for con in self.cons:
+            g = _gamma(self, con, q, qd)
+            if g is not None:
+                out[:, row:row + con.rows] = g
+            row += con.rows
+        return out
+
+    def rows_of(self, joint: str) -> list[int]:
+        rows, row = [], 0
+        for con in self.cons:
+            if con.joint == joint:
+                rows.extend(range(row, row + con.rows))
+            row += con.rows
+        return rows
+
+
+def _axis(j: Joint) -> np.ndarray:
+    if j.axis is None:
+        return np.array([1.0, 0.0])
+    return np.asarray(j.axis, float)
+
+
+# ------------------------------------------------------------------ per-constraint code
+def _link_rates(sys_: PlanarSystem, qd: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
+    if i < 0:
+        return np.zeros((qd.shape[0], 2)), np.zeros(qd.shape[0])
+    return qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
+
+
+def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.ndarray:
+    k = con.kind
+    if k == "R":
+        return S.point(q, con.a, con.sa) - S.point(q, con.b, con.sb)
+    if k == "angle":
+        val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
+        return (S.link_angle_i(q, con.b) - S.link_angle_i(q, con.a) - val)[:, None]
+    if k == "line":
+        ra, pa = S.pose(q, con.a)
+        c, s = _rot(pa)
+        w = _apply(c, s, con.w)
+        d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
+        val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
+        return (_dot(w, d) - val)[:, None]
+    if k == "gear":
+        pa, pb, pc = (S.link_angle_i(q, i) for i in (con.a, con.b, con.c))
+        return ((pb - pc) - con.k * (pa - pc) - con.c0)[:, None]
+    if k == "curve":
+        ra, pa = S.pose(q, con.a)
+        c, s = _rot(pa)
+        O = con.curve.eval(q[:, con.tvar])
+        return S.point(q, con.b, con.sb) - ra - _apply(c, s, O)
+    if k == "belt":
+        D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
+        d2 = _dot(D, D)
+        r = con.radius
+        with np.errstate(invalid="ignore"):
+            b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))   # NaN: belt not taut and straight
+        rel = S.link_angle_i(q, con.b) - np.arctan2(D[:, 1], D[:, 0]) - con.ref
+        rel = np.mod(rel + np.pi, 2 * np.pi) - np.pi                 # continuous within half a turn
+        return (b - r * np.arctan2(b, r) + con.sigma * r * rel - con.c0)[:, None]
+    raise AssertionError(k)
+
+
+def _put(J: np.ndarray, row: int, i: int, vals_r: np.ndarray | None, vals_phi: np.ndarray) -> None:
+    """Add entries for link i: vals_r (N, rows, 2) and vals_phi (N, rows)."""
+    if i < 0:
+        return
+    if vals_r is not None:
+        J[:, row:row + vals_phi.shape[1], 3 * i:3 * i + 2] += vals_r
+    J[:, row:row + vals_phi.shape[1], 3 * i + 2] += vals_phi
+
+
+def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int) -> None:
+    N = q.shape[0]
+    k = con.kind
+    if k == "R":
+        eye = np.broadcast_to(np.eye(2), (N, 2, 2))
+        for i, s, sign in ((con.a, con.sa, 1.0), (con.b, con.sb, -1.0)):
+            if i < 0:
+                continue
+            _, phi = S.pose(q, i)
+            c, sn = _rot(phi)
+            _put(J, row, i, sign * eye, sign * _perp(_apply(c, sn, s)))
+        return
+    if k == "angle":
+        one = np.ones((N, 1))
+        _put(J, row, con.b, None, one)
+        _put(J, row, con.a, None, -one)
+        return
+    if k == "line":
+        ra, pa = S.pose(q, con.a)
+        c, s = _rot(pa)
+        w = _apply(c, s, con.w)
+        Pa = S.point(q, con.a, con.sa)
+        Pb = S.point(q, con.b, con.sb)
+        d = Pb - Pa
+        if con.a >= 0:
+            Asa = _apply(c, s, con.sa)
+            _put(J, row, con.a, -w[:, None, :], (_dot(_perp(w), d) - _dot(w, _perp(Asa)))[:, None])
+        if con.b >= 0:
+            _, pb = S.pose(q, con.b)
+            cb, sb = _rot(pb)
+            _put(J, row, con.b, w[:, None, :], _dot(w, _perp(_apply(cb, sb, con.sb)))[:, None])
+        return
+    if k == "gear":
+        one = np.ones((N, 1))
+        _put(J, row, con.b, None, one)
+        _put(J, row, con.a, None, -con.k * one)
+        _put(J, row, con.c, None, (con.k - 1.0) * one)
+        return
+    if k == "curve":
+        eye = np.broadcast_to(np.eye(2), (N, 2, 2))
+        ra, pa = S.pose(q, con.a)
+        c, s = _rot(pa)
+        t = q[:, con.tvar]
+        O, O1 = con.curve.eval(t), con.curve.eval(t, 1)
+        if con.b >= 0:
+            _, pb = S.pose(q, con.b)
+            cb, sb = _rot(pb)
+            _put(J, row, con.b, eye, _perp(_apply(cb, sb, con.sb)))
+        if con.a >= 0:
+            _put(J, row, con.a, -eye, -_perp(_apply(c, s, O)))
+        J[:, row:row + 2, con.tvar] = -_apply(c, s, O1)
+        return
+    if k == "belt":
+        g, _, _ = _belt_terms(S, con, q)
+        for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
+            if i < 0:
+                continue
+            _, phi = S.pose(q, i)
+            c, sn = _rot(phi)
+            dphi = sign * _dot(g, _perp(_apply(c, sn, sl)))
+            if i == con.b:
+                dphi = dphi + con.sigma * con.radius
+            _put(J, row, i, sign * g[:, None, :], dphi[:, None])
+        return
+    raise AssertionError(k)
+
+
+def _belt_terms(S: PlanarSystem, con: Con, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit belt direction ``g = (b D - σ r R90 D)/d²`` (anchor to tangent point), ``D``
+    and the free length ``b`` of a belt constraint (NaN where ``d <= r``)."""
+    D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
+    d2 = _dot(D, D)
+    r = con.radius
+    with np.errstate(invalid="ignore"):
+        b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))
+    g = (b[:, None] * D - con.sigma * r * _perp(D)) / d2[:, None]
+    return g, D, b
+
+
+def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarray | None:
+    k = con.kind
+    if k in ("angle", "gear"):
+        return None
+    if k == "R":
+        out = 0.0
+        for i, s, sign in ((con.a, con.sa, 1.0), (con.b, con.sb, -1.0)):
+            if i < 0:
+                continue
+            _, phi = S.pose(q, i)
+            c, sn = _rot(phi)
+            w = qd[:, 3 * i + 2]
+            out = out + sign * (w ** 2)[:, None] * _apply(c, sn, s)
+        return np.broadcast_to(out, (q.shape[0], 2)) if np.ndim(out) else np.zeros((q.shape[0], 2))
+    if k == "line":
+        _, pa = S.pose(q, con.a)
+        c, s = _rot(pa)
+        w = _apply(c, s, con.w)
+        va, wa = _link_rates(S, qd, con.a)
+        vb, wb = _link_rates(S, qd, con.b)
+        Asa = _apply(c, s, con.sa)
+        _, pb = S.pose(q, con.b)
+        cb, sb = _rot(pb)
+        Asb = _apply(cb, sb, con.sb)
+        d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
+        dd = vb + wb[:, None] * _perp(Asb) - va - wa[:, None] * _perp(Asa)
+        g = (wa ** 2 * _dot(w, d) - 2 * wa * _dot(_perp(w), dd)
+             + wb ** 2 * _dot(w, Asb) - wa ** 2 * _dot(w, Asa))
+        return g[:, None]
+    if k == "curve":
+        _, pa = S.pose(q, con.a)
+        c, s = _rot(pa)
+        _, pb = S.pose(q, con.b)
+        cb, sb = _rot(pb)
+        _, wa = _link_rates(S, qd, con.a)
+        _, wb = _link_rates(S, qd, con.b)
+        t, td = q[:, con.tvar], qd[:, con.tvar]
+        O, O1, O2 = (con.curve.eval(t, d) for d in (0, 1, 2))
+        g = ((wb ** 2)[:, None] * _apply(cb, sb, con.sb) - (wa ** 2)[:, None] * _apply(c, s, O)
+             + (2 * wa * td)[:, None] * _perp(_apply(c, s, O1)) + (td ** 2)[:, None] * _apply(c, s, O2))
+        return g
+    if k == "belt":
+        # Phi'' = dg/dt . D' + g . D'' + σ r phi_b'' with D'' = (terms in q'') - w_b² A_b s_b
+        # + w_a² A_a s_a, and dg/dt = w_g R90 g, w_g = (R90 D . D')/d² + σ r (D . D')/(d² b)
+        # (g turns with D's direction less the tangent offset arcsin(r/d)).
+        g, D, b = _belt_terms(S, con, q)
+        d2 = _dot(D, D)
+        out = 0.0
+        Dd = 0.0
+        for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
+            if i < 0:
+                continue
+            _, phi = S.pose(q, i)
+            c, sn = _rot(phi)
+            As = _apply(c, sn, sl)
+            v, w = _link_rates(S, qd, i)
+            Dd = Dd + sign * (v + w[:, None] * _perp(As))
+            out = out + sign * w ** 2 * _dot(g, As)
+        if np.ndim(Dd) == 0:
+            return np.zeros((q.shape[0], 1))
+        wg = _dot(_perp(D), Dd) / d2 + con.sigma * con.radius * _dot(D, Dd) / (d2 * b)
+        return (out - wg * _dot(_perp(g), Dd))[:, None]
+    raise AssertionError(k)
+
+
+
+
+# --------------------------------------------------------------------------- building
+def _dir_angle(v: np.ndarray) -> float:
+    return float(np.arctan2(v[1], v[0]))
+
+
+def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
+                 prescribed: tuple[str, ...] = ()) -> PlanarSystem:
+    """Compile a planar mechanism with joint points into a :class:`PlanarSystem`.
+
+    Parameters
+    ----------
+    vll: joint id -> mode (``active``/``passive``/``locked``; ``free`` = passive),
+        overriding the file's ``vll`` modes (paper 000's fully actuated mode is the
+        VLL locked, the underactuated one the VLL free).
+    prescribed: passive joints whose coordinate is given as an input (their
+        actuator force is then reported as the force a spring or stop must supply).
+    """
+    src = mech.source or "<mechanism>"
+    if mech.kind != "planar":
+        raise MechsynInputError("kinematics needs a planar mechanism", source=src, field="kind",
+                                hint="set kind: planar (spatial kinematics is not implemented)")
+    for j in mech.joints:
+        if j.point is None:
+            raise MechsynInputError(f"joint {j.id} has no point", source=src, field=f"joints.{j.id}.point",
+                                    hint="give every joint a point, e.g. point: [0, 0], in the assembled configuration")
+        if j.type not in ("R", "P", "cam", "gear", "belt"):
+            raise MechsynInputError(f"joint {j.id}: pair type {j.type} is not supported by planar kinematics",
+                                    source=src, field=f"joints.{j.id}.type", hint="use R, P, cam, gear or belt")
+    modes: dict[str, str] = {j.id: j.vll for j in mech.joints if j.vll}
+    for jid, mode in (vll or {}).items():
+        try:
+            j = mech.joint(jid)
+        except KeyError:
+            raise MechsynInputError(f"no joint {jid!r}", source="--vll",
+                                    hint=f"joints are: {', '.join(x.id for x in mech.joints)}") from None
+        if j.type != "P":
+            raise MechsynInputError(f"joint {jid} is a {j.type} pair; a variable-length link is a P pair",
+                                    source="--vll")
+        if mode not in VLL_MODES:
+            raise MechsynInputError(f"unknown VLL mode {mode!r}", source="--vll",
+                                    hint="use locked, free (passive) or active")
+        modes[jid] = VLL_MODES[mode]
+
+    ground = mech.ground
+    moving = mech.moving_links
+    origin0 = np.zeros((len(moving), 2))
+    angle0 = np.zeros(len(moving))
+    for i, name in enumerate(moving):
+        # a belt's point (the pulley centre) is on its second link; its first has the anchor
+        pts = [np.asarray(j.attrs["anchor"], float) if j.type == "belt" and j.links[0] == name else j.point
+               for j in mech.joints_of(name)]
+        origin0[i] = pts[0]
+        for p in pts[1:]:
+            if np.linalg.norm(p - pts[0]) > 1e-12:
+                angle0[i] = _dir_angle(p - pts[0])
+                break
+    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()]
+                      + [np.asarray(j.attrs["anchor"], float) for j in mech.joints if j.type == "belt"])
+    scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
+
+    n_links = len(moving)
+    partial = PlanarSystem(mech, tuple(moving), origin0, angle0, (), (), 3 * n_links, 0,
+                           np.zeros(3 * n_links), scale)
+    idx = partial.index
+    loc = partial.to_local
+    cons: list[Con] = []
+    drivers: list[Driver] = []
+    notes: list[str] = []
+    n = 3 * n_links
+    q0 = np.zeros(n)
+    for i in range(n_links):
+        q0[3 * i:3 * i + 2] = origin0[i]
+        q0[3 * i + 2] = angle0[i]
+    extra_q: list[float] = []
+
+    def add_driver(j: Joint, typ: str, value: float, role: str) -> int:
+        drivers.append(Driver(j.id, typ, value, role))
+        return len(drivers) - 1
+
+    for j in mech.joints:
+        a_name, b_name = j.links
+        a, b = idx(a_name), idx(b_name)
+        if j.type == "R":
+            cons.append(Con("R", j.id, 2, a, b, sa=loc(a_name, j.point), sb=loc(b_name, j.point), role="pair"))
+            if j.actuated:
+                ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], a)[0]
+                k = add_driver(j, "R", float(ang), "drive")
+                cons.append(Con("angle", j.id, 1, a, b, driver=k, role="drive"))
+        elif j.type == "P":
+            u = _axis(j)
+            u_loc = partial.to_local_dir(a_name, u)
+            n_loc = np.array([-u_loc[1], u_loc[0]])
+            ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], a)[0]
+            cons.append(Con("angle", j.id, 1, a, b, c0=float(ang), role="rotation"))
+            cons.append(Con("line", j.id, 1, a, b, sa=loc(a_name, j.point), sb=loc(b_name, j.point),
+                            w=n_loc, role="pair"))
+            o_a = np.zeros(2) if a < 0 else origin0[a]
+            s0 = float(u @ (j.point - o_a))
+            mode = modes.get(j.id)
+            if mode is None:
+                mode = "active" if j.actuated else None
+            if mode == "active" or (mode == "passive" and j.id in prescribed):
+                k = add_driver(j, "P", s0, "drive" if mode == "active" else "prescribed")
+                cons.append(Con("line", j.id, 1, a, b, sa=np.zeros(2), sb=loc(b_name, j.point), w=u_loc,
+                                driver=k, role="drive"))
+            elif mode == "locked":
+                cons.append(Con("line", j.id, 1, a, b, sa=np.zeros(2), sb=loc(b_name, j.point), w=u_loc,
+                                c0=s0, role="lock"))
+            elif j.actuated and mode == "passive":
+                notes.append(f"joint {j.id} is marked actuated but its VLL is free (passive)")
+        elif j.type == "gear":
+            carriers = [c for c in mech.link_names
+                        if any(x.type == "R" and set(x.links) == {c, a_name} for x in mech.joints)
+                        and any(x.type == "R" and set(x.links) == {c, b_name} for x in mech.joints)]
+            if not carriers:
+                raise MechsynInputError(f"gear pair {j.id}: no link carries both gears' axes", source=src,
+                                        field=f"joints.{j.id}", hint="join both gears by R pairs to one carrier link")
+            cname = carriers[0]
+            ra = next(x for x in mech.joints if x.type == "R" and set(x.links) == {cname, a_name})
+            rb = next(x for x in mech.joints if x.type == "R" and set(x.links) == {cname, b_name})
+            if j.ratio is not None:
+                ratio = float(j.ratio)
+            else:
+                r1 = float(np.linalg.norm(j.point - ra.point))
+                r2 = float(np.linalg.norm(j.point - rb.point))
+                if r2 < 1e-12:
+                    raise MechsynInputError(f"gear pair {j.id}: the pitch point is on a gear's axis",
+                                            source=src, field=f"joints.{j.id}.point", hint="give ratio")
+                between = (j.point - ra.point) @ (j.point - rb.point) < 0
+                ratio = -r1 / r2 if between else r1 / r2
+            c = idx(cname)
+            q0a = q0[None]
+            pa_, pb_, pc_ = (partial.link_angle_i(q0a, i)[0] for i in (a, b, c))
+            cons.append(Con("gear", j.id, 1, a, b, c=c, k=ratio,
+                            c0=float((pb_ - pc_) - ratio * (pa_ - pc_)), role="pair"))
+        elif j.type == "cam":
+            profile = j.attrs.get("profile")
+            if profile is None:
+                raise MechsynInputError(
+                    f"cam joint {j.id} has no profile", source=src, field=f"joints.{j.id}.profile",
+                    hint="add e.g. profile: {center: [0, 0], radius: 1}, or a polar function r(t), or a list "
+                         f"of points [[1, 0], [0, 1], [-1, 0], [0, -1]] on the cam link {a_name}")
+            others = [x for x in mech.joints_of(b_name) if x.id != j.id and x.type == "R"]
+            if others:
+                centre = others[0].point
+                rho = float(np.linalg.norm(centre - j.point))
+            else:
+                centre, rho = j.point, 0.0
+            tvar = n + len(extra_q)
+            curve = _cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
+                               lambda p, _a=a_name: loc(_a, p), src, j.id)
+            extra_q.append(curve.closest(loc(a_name, centre)))
+            cons.append(Con("curve", j.id, 2, a, b, sb=loc(b_name, centre), tvar=tvar, curve=curve,
+                            role="pair"))
+            if others and len(mech.joints_of(b_name)) == 2 and not any(
+                    p.link == b_name for p in mech.points.values()):
+                f_name = others[0].other(b_name)
+                f = idx(f_name)
+                ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], f)[0]
+                cons.append(Con("angle", j.id, 1, f, b, c0=float(ang), role="idle"))
+                notes.append(f"roller {b_name}: its spin about {others[0].id} is an idle mobility, held fixed")
+        elif j.type == "belt":
+            sa, sb = loc(a_name, np.asarray(j.attrs["anchor"], float)), loc(b_name, j.point)
+            sigma = BELT_WRAPS[j.attrs["wrap"]]
+            r = float(j.attrs["radius"])
+            con = Con("belt", j.id, 1, a, b, sa=sa, sb=sb, radius=r, sigma=sigma, role="pair")
+            D = j.point - np.asarray(j.attrs["anchor"], float)
+            ref = float(partial.link_angle_i(q0[None], b)[0] - np.arctan2(D[1], D[0]))
+            con = replace(con, ref=ref)
+            c0 = float(_residual(partial, con, q0[None], np.zeros((1, 0)))[0, 0])
+            cons.append(replace(con, c0=c0))
+            if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id
+                       and np.linalg.norm(x.point - j.point) < 1e-9 * scale for x in mech.joints):
+                notes.append(f"belt {j.id}: the pulley centre is on no R pair of {b_name} "
+                             "(a pulley usually turns on its carrier there)")
+    for jid in prescribed:
+        if jid not in [d.joint for d in drivers]:
+            raise MechsynInputError(f"joint {jid} cannot be given an input", source="--input",
+                                    hint="inputs go to actuated joints and to free (passive) VLL joints")
+    q0 = np.concatenate([q0, extra_q])
+    n = len(q0)
+    m = sum(c.rows for c in cons)
+    return PlanarSystem(mech, tuple(moving), origin0, angle0, tuple(cons), tuple(drivers), n, m, q0,
+                        scale, vll=modes, notes=tuple(notes))
+
+
+def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """2-D cross product ``a x b`` (a scalar per row)."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]

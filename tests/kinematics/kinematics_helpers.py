@@ -1,0 +1,50 @@
+"""Helpers for the kinematics tests."""
+
+from pathlib import Path
+
+import numpy as np
+
+import pytest
+
+from mechsyn.io import load_mechanism, mechanism_from_dict
+
+EX = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.fixture
+def ex():
+    """Load an example file by its path under examples/."""
+    def load(rel: str):
+        return load_mechanism(EX / rel)
+    return load
+
+
+def fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0, branch=1, extra=None):
+    """A four-bar (crank a, coupler b, rocker c, frame g) assembled at crank angle theta."""
+    A = np.array([0.0, 0.0])
+    D = np.array([g, 0.0])
+    B = a * np.array([np.cos(np.radians(theta)), np.sin(np.radians(theta))])
+    d = D - B
+    L = np.linalg.norm(d)
+    aa = (b ** 2 - c ** 2 + L ** 2) / (2 * L)
+    h = np.sqrt(b ** 2 - aa ** 2)
+    e = d / L
+    C = B + aa * e + branch * h * np.array([-e[1], e[0]])
+    data = {
+        "name": "four-bar", "kind": "planar", "ground": "frame",
+        "links": ["frame", "crank", "coupler", "rocker"],
+        "joints": [
+            {"id": "A", "type": "R", "links": ["frame", "crank"], "point": A.tolist(), "actuated": True},
+            {"id": "B", "type": "R", "links": ["crank", "coupler"], "point": B.tolist()},
+            {"id": "C", "type": "R", "links": ["coupler", "rocker"], "point": C.tolist()},
+            {"id": "D", "type": "R", "links": ["rocker", "frame"], "point": D.tolist()},
+        ],
+        "points": {"M": {"link": "coupler", "at": (B + 0.5 * (C - B) + [0.3, 0.8]).tolist()}},
+    }
+    if extra:
+        data.update(extra)
+    return data
+
+
+def fourbar(**kw):
+    return mechanism_from_dict(fourbar_dict(**kw), "fourbar")
