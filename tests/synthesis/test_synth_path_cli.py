@@ -52,6 +52,14 @@ def test_synth_path_json_contract(p2_file, tmp_path, capsys, public_data):
     capsys.readouterr()
     assert main(["analyze", str(out), "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["formulas"]["chebyshev"]["value"] == 1
+    # and the project's general simulator, driving joint A through the prescribed angles,
+    # moves point P through the targets with the same error (independent kinematics)
+    assert main(["simulate", str(out), "-i", "A=30,45,60,75,90", "--points", "P", "--json"]) == 0
+    sim = json.loads(capsys.readouterr().out)
+    assert all(sim["assembled"])
+    got = np.array(sim["points"]["P"]["position"])
+    sim_error = float(np.sum((got - np.array(public_data["cases"][0]["targets"])) ** 2))
+    assert sim_error == pytest.approx(data["error"], rel=1e-6)
 
 
 def test_synth_path_collection_needs_case(tmp_path, capsys, public_data):
