@@ -1,0 +1,261 @@
+"""``mechsyn synth path|function|motion``: dimensional synthesis of four-bars."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import typer
+from rich.table import Table
+
+from mechsyn.cli.app import synth_app
+from mechsyn.cli.common import console, emit_json, err_console, parse_floats
+from mechsyn.errors import MechsynInputError
+
+
+def _pick_case(file: Path, case_id: Optional[str]):
+    from mechsyn.synthesis.path import load_cases
+
+    cases = load_cases(file)
+    if case_id is None:
+        if len(cases) == 1:
+            return cases[0]
+        raise MechsynInputError(
+            f"the file holds {len(cases)} cases", source=str(file),
+            hint="choose one with --case " + " | ".join(c.id for c in cases))
+    for c in cases:
+        if c.id == case_id:
+            return c
+    raise MechsynInputError(f"no case {case_id!r}", source="--case",
+                            hint="one of " + ", ".join(c.id for c in cases))
+
+
+def _save_plot(path: Path, draw) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from mechsyn.results import save_figure_atomic
+
+    fig, ax = plt.subplots(figsize=(7, 6), dpi=120)
+    try:
+        draw(ax)
+        fig.tight_layout()
+        save_figure_atomic(fig, path)
+    finally:
+        plt.close(fig)
+
+
+@synth_app.command("path")
+def synth_path(
+    case_file: Path = typer.Argument(..., help="Case JSON (schema of synthesis_cases_public.json): one case, or a file of cases with --case."),
+    case_id: Optional[str] = typer.Option(None, "--case", help="Case id when the file holds several."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the reproducible multi-start."),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Wall-clock budget in seconds."),
+    restarts: int = typer.Option(10, "--restarts", help="Number of restarts (child seeds of --seed)."),
+    workers: int = typer.Option(1, "--workers", help="Run restarts in N local processes."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask])."),
+    optimizer: str = typer.Option("de", "--optimizer", help="Global optimiser (de | random | registered)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
+) -> None:
+    """Path generation: a four-bar whose coupler point passes through the targets."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from mechsyn.synthesis.export import fourbar_mechanism_dict, plot_fourbar_path, write_mechanism_file
+    from mechsyn.synthesis.optimize import synthesize_path
+
+    if time_limit <= 0:
+        raise MechsynInputError("must be positive", source="--time-limit")
+    if restarts < 1 or workers < 1:
+        raise MechsynInputError("must be at least 1", source="--restarts/--workers")
+    case = _pick_case(case_file, case_id)
+    show = err_console.is_terminal
+    if show:
+        with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} restarts"),
+                      TextColumn("best error {task.fields[best]}"), TimeElapsedColumn(),
+                      console=err_console, transient=True) as prog:
+            task = prog.add_task(f"synth path {case.id}", total=restarts, best="-")
+
+            def progress(done, total, best):
+                prog.update(task, completed=done, best=f"{best:.6g}" if np.isfinite(best) else "-")
+
+            res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
+                                  optimizer=optimizer, progress=progress, scheduler=scheduler)
+    else:
+        res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
+                              optimizer=optimizer, scheduler=scheduler)
+    d = {**case.fixed, **res.design}
+    if out is not None:
+        if not res.feasible:
+            raise MechsynInputError("no feasible design found; nothing written", source="--out",
+                                    hint="raise --time-limit or --restarts, or widen the bounds")
+        mech = fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(res.theta2[0]), branch=case.branch,
+                                      rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
+                                      name=f"Four-bar for path case {case.id}")
+        write_mechanism_file(mech, out, header=(
+            f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
+            f"joint points at target 1 (crank angle {np.degrees(res.theta2[0]):.4f} deg), branch {case.branch}"))
+    if plot is not None:
+        _save_plot(plot, lambda ax: plot_fourbar_path(
+            ax, d, case.targets, res.theta2, case.branch,
+            title=f"{case.id}: error {res.error:.4g} (published best {case.best_known:.4g})" if case.best_known
+            else f"{case.id}: error {res.error:.4g}"))
+    if as_json:
+        emit_json(res)
+        return
+    t = Table(title=f"Path synthesis {case.id}")
+    t.add_column("variable")
+    t.add_column("value", justify="right")
+    for k, v in res.design.items():
+        t.add_row(k, f"{v:.8g}")
+    console.print(t)
+    console.print(f"error (sum of squared distances): [bold]{res.error:.8g}[/]"
+                  + (f"   published best: {case.best_known:.8g}" if case.best_known else ""))
+    console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
+                  f"branch {case.branch}   {res.restarts} restarts, {res.seconds:.1f} s")
+
+
+@synth_app.command("function")
+def synth_function(
+    phi: str = typer.Option(..., "--phi", help="Three crank angles [deg], from the ground line, e.g. 30,60,90."),
+    psi: str = typer.Option(..., "--psi", help="Three rocker angles [deg], e.g. 100,120,135."),
+    ground: float = typer.Option(1.0, "--ground", help="Ground link length."),
+    as_json: bool = typer.Option(False, "--json"),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file."),
+) -> None:
+    """Function generation by Freudenstein's equation (3 precision positions), verified by simulation."""
+    from mechsyn.synthesis.exact import freudenstein_synthesis
+    from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
+
+    ph = np.radians(parse_floats(phi, "--phi", 3))
+    ps = np.radians(parse_floats(psi, "--psi", 3))
+    if not ground > 0:
+        raise MechsynInputError("must be positive", source="--ground")
+    r = freudenstein_synthesis(ph, ps, ground)
+    data = {"design": r.design, "K": r.K, "branch": r.branch, "phi_deg": np.degrees(r.phi),
+            "psi_deg": np.degrees(r.psi), "psi_simulated_deg": np.degrees(r.psi_simulated),
+            "max_error_deg": np.degrees(r.max_error), "branch_defect": r.branch_defect,
+            "order_defect": r.order_defect, "grashof": r.grashof, "notes": r.notes,
+            "verified": bool(r.max_error < 1e-8 and not r.branch_defect and not r.order_defect)}
+    if out is not None:
+        write_mechanism_file(fourbar_mechanism_dict(r.r1, r.r2, r.r3, r.r4, float(r.phi[0]), branch=r.branch,
+                                                    name="Four-bar function generator (Freudenstein)"), out)
+    if as_json:
+        emit_json(data)
+        return
+    t = Table(title="Freudenstein 3-position function generation")
+    for c in ("position", "phi [deg]", "psi required", "psi simulated"):
+        t.add_column(c, justify="right")
+    for i in range(3):
+        t.add_row(str(i + 1), f"{np.degrees(r.phi[i]):.4f}", f"{np.degrees(r.psi[i]):.4f}",
+                  f"{np.degrees(r.psi_simulated[i]):.4f}")
+    console.print(t)
+    console.print("K1, K2, K3 = " + ", ".join(f"{k:.6g}" for k in r.K))
+    console.print(f"ground {r.r1:.6g}, crank {r.r2:.6g}, coupler {r.r3:.6g}, rocker {r.r4:.6g}  ({r.grashof}), branch {r.branch}")
+    console.print(f"branch defect: {r.branch_defect}   order defect: {r.order_defect}")
+    for n in r.notes:
+        console.print(f"note: {n}")
+
+
+def _read_poses(file: Optional[Path], poses: Optional[str]) -> np.ndarray:
+    if file is not None:
+        try:
+            data = json.loads(file.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise MechsynInputError("file not found", source=str(file)) from None
+        except json.JSONDecodeError as exc:
+            raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(file), line=exc.lineno) from None
+        items = data.get("poses") if isinstance(data, dict) else data
+        try:
+            P = np.array([[float(p[0]), float(p[1]), float(p[2])] for p in items])
+        except (TypeError, ValueError, IndexError, KeyError):
+            raise MechsynInputError("poses must be [x, y, angle_deg] triples", source=str(file), field="poses") from None
+    elif poses is not None:
+        vals = parse_floats(poses, "--poses")
+        if len(vals) % 3:
+            raise MechsynInputError("expected x,y,angle triples", source="--poses")
+        P = np.array(vals).reshape(-1, 3)
+    else:
+        raise MechsynInputError("give the poses", source="poses", hint="--poses x1,y1,a1,x2,y2,a2,... or a JSON file")
+    if not 3 <= len(P) <= 5:
+        raise MechsynInputError(f"need 3, 4 or 5 poses, got {len(P)}", source="poses")
+    P[:, 2] = np.radians(P[:, 2])
+    return P
+
+
+@synth_app.command("motion")
+def synth_motion(
+    poses_file: Optional[Path] = typer.Argument(None, help="JSON file {\"poses\": [[x, y, angle_deg], ...]} (3-5 poses)."),
+    poses: Optional[str] = typer.Option(None, "--poses", help="Poses inline: x1,y1,a1,x2,y2,a2,... (angles in deg)."),
+    circle_points: Optional[str] = typer.Option(None, "--circle-points", help="3 poses: two moving pivots in the coupler frame: x1,y1,x2,y2."),
+    center_points: Optional[str] = typer.Option(None, "--center-points", help="3 poses: two ground pivots: x1,y1,x2,y2."),
+    top: int = typer.Option(5, "--top", help="How many solutions to list."),
+    as_json: bool = typer.Option(False, "--json"),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Centre-point curve / solution plot (PNG)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the best linkage as a mechanism file."),
+) -> None:
+    """Motion generation by Burmester theory (3, 4 or 5 poses), each linkage verified by simulation."""
+    from mechsyn.synthesis.exact import center_point_curve, motion_synthesis, to_jsonable_motion
+    from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
+
+    P = _read_poses(poses_file, poses)
+    cp = np.array(parse_floats(circle_points, "--circle-points", 4)).reshape(2, 2) if circle_points else None
+    mp = np.array(parse_floats(center_points, "--center-points", 4)).reshape(2, 2) if center_points else None
+    if (cp is not None or mp is not None) and len(P) != 3:
+        raise MechsynInputError("circle/centre points are chosen only for 3 poses", source="--circle-points")
+    sols = motion_synthesis(P, circle_points=cp, center_points=mp)
+    if not sols:
+        raise MechsynInputError("no linkage found for these poses", source="poses")
+    best = sols[0]
+    if out is not None:
+        d = best.design()
+        write_mechanism_file(fourbar_mechanism_dict(
+            d["r1"], d["r2"], d["r3"], d["r4"], float(best.theta2[0]), branch=best.branch, rcx=d["rcx"], rcy=d["rcy"],
+            x0=d["x0"], y0=d["y0"], theta0=d["theta0"], name="Four-bar motion generator (Burmester)"), out,
+            header="coupler point P = origin of the guided body's frame; joints at pose 1")
+    if plot is not None:
+        def draw(ax):
+            best_pts = np.array([best.O2, best.O4, *P[:, :2]])
+            lo, hi = best_pts.min(axis=0), best_pts.max(axis=0)
+            pad = 0.6 * (hi - lo).max() + 1e-9
+            if len(P) == 4:
+                M, _ = center_point_curve(P, n_dir=1440)
+                inside = np.all((M > lo - pad) & (M < hi + pad), axis=1)
+                ax.plot(M[inside, 0], M[inside, 1], ".", ms=1.5, color="0.6", label="centre-point curve")
+            ax.set_xlim(lo[0] - pad, hi[0] + pad)
+            ax.set_ylim(lo[1] - pad, hi[1] + pad)
+            L = 0.15 * (np.ptp(P[:, :2], axis=0).max() + 1)
+            for j, (x, y, a) in enumerate(P):
+                ax.annotate("", (x + L * np.cos(a), y + L * np.sin(a)), (x, y),
+                            arrowprops={"arrowstyle": "->", "color": "tab:red", "lw": 2})
+                ax.text(x, y, f" {j + 1}", color="tab:red")
+            for s in sols[:1]:
+                from mechsyn.synthesis.fourbar import fourbar_position
+                pose = fourbar_position(s.r1, s.r2, s.r3, s.r4, s.theta2[0], branch=s.branch,
+                                        x0=s.O2[0], y0=s.O2[1], theta0=s.theta0)
+                ch = np.array([s.O2, pose.A, pose.B, s.O4])
+                ax.plot(ch[:, 0], ch[:, 1], "-o", color="k", label="best linkage at pose 1")
+                tri = np.array([pose.A, pose.B, P[0, :2]])
+                ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3, label="coupler (guided body)")
+            ax.set_aspect("equal", adjustable="box")
+            ax.grid(True, alpha=0.3)
+            ax.legend(fontsize=8)
+            ax.set_title(f"Burmester synthesis, {len(P)} poses (red: required poses)")
+        _save_plot(plot, draw)
+    if as_json:
+        emit_json({"solutions": [to_jsonable_motion(s) for s in sols[:top]], "count": len(sols),
+                   "verified_count": sum(s.ok for s in sols)})
+        return
+    t = Table(title=f"Burmester motion generation, {len(P)} poses ({sum(s.ok for s in sols)} of {len(sols)} verified)")
+    for c in ("O2", "O4", "r1", "r2", "r3", "r4", "type", "min mu [deg]", "defects", "pos. error"):
+        t.add_column(c, justify="right")
+    for s in sols[:top]:
+        defects = ", ".join(k for k, v in (("branch", s.branch_defect), ("order", s.order_defect)) if v) or "none"
+        t.add_row(f"({s.O2[0]:.4g}, {s.O2[1]:.4g})", f"({s.O4[0]:.4g}, {s.O4[1]:.4g})", f"{s.r1:.4g}", f"{s.r2:.4g}",
+                  f"{s.r3:.4g}", f"{s.r4:.4g}", s.grashof, f"{s.min_transmission_deg:.1f}", defects, f"{s.position_error:.2e}")
+    console.print(t)

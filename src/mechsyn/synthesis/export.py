@@ -1,0 +1,103 @@
+"""Synthesised linkages as mechanism files (issue-2 format) and plots."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from mechsyn.synthesis.fourbar import fourbar_position, rotate
+
+
+def fourbar_mechanism_dict(
+    r1: float, r2: float, r3: float, r4: float, theta2: float, *, branch: int = -1,
+    rcx: float = 0.0, rcy: float = 0.0, x0: float = 0.0, y0: float = 0.0, theta0: float = 0.0,
+    name: str = "Synthesised four-bar", point_name: str = "P",
+) -> dict[str, Any]:
+    """A four-bar as a mechanism-file dict, joint points at crank angle ``theta2``.
+
+    Joints: ``A`` frame-crank at ``O2`` (actuated), ``B`` crank-coupler, ``C``
+    coupler-rocker, ``D`` rocker-frame at ``O4``; the coupler point is ``points.P`` on the
+    coupler (global coordinates in the same configuration).
+    """
+    pose = fourbar_position(r1, r2, r3, r4, theta2, branch=branch, rcx=rcx, rcy=rcy, x0=x0, y0=y0, theta0=theta0)
+    if not bool(pose.assembled):
+        raise ValueError("the four-bar does not assemble at the given crank angle")
+    ox, oy = rotate(np.float64(r1), np.float64(0.0), theta0)
+    o4 = [float(ox + x0), float(oy + y0)]
+
+    def pt(a):
+        return [float(a[0]), float(a[1])]
+
+    return {
+        "name": name,
+        "kind": "planar",
+        "ground": "frame",
+        "links": ["frame", "crank", "coupler", "rocker"],
+        "joints": [
+            {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [float(x0), float(y0)], "actuated": True},
+            {"id": "B", "type": "R", "links": ["crank", "coupler"], "point": pt(pose.A)},
+            {"id": "C", "type": "R", "links": ["coupler", "rocker"], "point": pt(pose.B)},
+            {"id": "D", "type": "R", "links": ["rocker", "frame"], "point": o4},
+        ],
+        "points": {point_name: {"link": "coupler", "at": pt(pose.C)}},
+    }
+
+
+def mechanism_yaml(mech: dict[str, Any], header: str = "") -> str:
+    """YAML text of a mechanism dict with an optional ``#`` comment header."""
+    import yaml
+
+    lines = "".join(f"# {h}\n" for h in header.splitlines()) if header else ""
+    return lines + yaml.safe_dump(mech, sort_keys=False, default_flow_style=None)
+
+
+def write_mechanism_file(mech: dict[str, Any], path, header: str = "") -> None:
+    """Write a mechanism dict as YAML (``.yaml``/``.yml``) or JSON, atomically.
+
+    The dict is validated by :func:`mechsyn.io.mechanism_from_dict` first; the YAML keeps
+    a comment header (how the linkage was obtained).
+    """
+    from pathlib import Path
+
+    from mechsyn.results import dumps, write_atomic
+
+    path = Path(path)
+    try:  # validate against the mechanism model when it is available
+        from mechsyn.io import mechanism_from_dict
+    except ImportError:  # pragma: no cover - older model package
+        mechanism_from_dict = None
+    if mechanism_from_dict is not None:
+        mechanism_from_dict(mech)
+    if path.suffix.lower() == ".json":
+        write_atomic(path, dumps(mech) + "\n")
+    else:
+        write_atomic(path, mechanism_yaml(mech, header))
+
+
+def plot_fourbar_path(ax, design: dict[str, float], targets: np.ndarray, theta2: np.ndarray, branch: int,
+                      title: str = "") -> None:
+    """Draw the targets, the achieved points, the coupler curve and the linkage at target 1."""
+    g = {k: design.get(k, 0.0) for k in ("x0", "y0", "theta0", "rcx", "rcy")}
+    r = [design[k] for k in ("r1", "r2", "r3", "r4")]
+    sweep = np.linspace(0, 2 * np.pi, 721)
+    curve = fourbar_position(*r, sweep, branch=branch, **g)
+    C = np.where(curve.assembled[:, None], curve.C, np.nan)
+    ax.plot(C[:, 0], C[:, 1], "-", color="0.6", lw=1, label="coupler curve (branch)")
+    at = fourbar_position(*r, np.asarray(theta2), branch=branch, **g)
+    ax.plot(targets[:, 0], targets[:, 1], "o", mfc="none", mec="tab:red", ms=9, label="targets")
+    ax.plot(at.C[:, 0], at.C[:, 1], "x", color="tab:blue", ms=7, label="achieved")
+    p0 = fourbar_position(*r, float(theta2[0]), branch=branch, **g)
+    ox, oy = rotate(np.float64(r[0]), np.float64(0.0), g["theta0"])
+    O2 = np.array([g["x0"], g["y0"]])
+    O4 = np.array([ox + g["x0"], oy + g["y0"]])
+    chain = np.array([O2, p0.A, p0.B, O4])
+    ax.plot(chain[:, 0], chain[:, 1], "-o", color="k", lw=2, ms=4, label="linkage at target 1")
+    tri = np.array([p0.A, p0.C, p0.B])
+    ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3)
+    ax.plot([O2[0], O4[0]], [O2[1], O4[1]], "k--", lw=1)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)

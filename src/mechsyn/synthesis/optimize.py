@@ -1,0 +1,329 @@
+"""Global optimisation for dimensional synthesis: multi-start, polishing, pluggable back ends.
+
+Pipeline of :func:`synthesize_path` for one seed ``S``:
+
+1. ``restarts`` child seeds are drawn from ``numpy.random.SeedSequence(S)`` (reproducible:
+   the same ``S`` and ``restarts`` give the same result, whatever ``workers`` is, unless
+   the time limit cuts runs short);
+2. each restart runs the global optimiser (default: SciPy's ``differential_evolution``
+   with ``vectorized=True``, so the whole population is one NumPy evaluation) on the
+   problem's feasibility-first fitness. For free timing the global search sees only the
+   linkage variables; each candidate's crank angles come from a vectorised nearest-point
+   projection onto its coupler curve (:meth:`PathProblem.project_timing`);
+3. the best few distinct members are polished by ``scipy.optimize.least_squares`` on all
+   variables (the residuals ``C_i - Cd_i``); a polished design is kept only if it is
+   feasible and better;
+4. the best restart wins (ties: lowest restart index).
+
+Pluggable optimisers
+--------------------
+An optimiser is a callable registered in :data:`OPTIMIZERS`::
+
+    def my_optimizer(fitness, lower, upper, *, seed, should_stop, options) -> GlobalResult
+
+``fitness(X)`` takes an array ``(P, d)`` and returns ``(P,)`` scores (lower is better;
+infeasible designs already score worse than every feasible one); ``lower``/``upper`` are
+the bounds ``(d,)``; ``seed`` an ``int``; ``should_stop(best_score)`` returns true when the
+run must end (time limit); ``options`` a dict of optimiser settings. It returns a
+:class:`GlobalResult` (best vector, its score, evaluations, optionally the final population
+for polishing). ``register_optimizer("name", fn)`` makes it available as ``--optimizer name``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import differential_evolution, least_squares
+
+from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design
+
+
+@dataclass
+class GlobalResult:
+    """Outcome of one global optimiser run."""
+
+    x: np.ndarray
+    fun: float
+    nfev: int
+    population: np.ndarray | None = None
+    population_fun: np.ndarray | None = None
+
+
+OptimizerFn = Callable[..., GlobalResult]
+
+
+def scipy_de(fitness, lower, upper, *, seed: int, should_stop, options: dict[str, Any]) -> GlobalResult:
+    """SciPy ``differential_evolution``, vectorised, no built-in polish, stall stopping.
+
+    Options (defaults): ``strategy`` ("randtobest1bin"), ``popsize`` (10),
+    ``maxiter`` (700), ``mutation`` ((0.5, 1.0)), ``recombination`` (0.9), ``stall``
+    (generations without a relative improvement of 1e-6 before stopping; 300),
+    ``init_oversample`` (20: the initial population is the best ``popsize * d`` of
+    ``20 popsize d`` uniform samples, ranked by the feasibility-first fitness).
+    """
+    stall = int(options.get("stall", 300))
+    state = {"best": np.inf, "since": 0}
+
+    def callback(intermediate_result):
+        fun = float(intermediate_result.fun)
+        if fun < state["best"] - 1e-6 * abs(state["best"]) or not np.isfinite(state["best"]):
+            state["best"], state["since"] = fun, 0
+        else:
+            state["since"] += 1
+        return bool(state["since"] >= stall or should_stop(fun))
+
+    init = options.get("init", "latinhypercube")
+    npop = int(options.get("popsize", 10)) * len(lower)
+    oversample = int(options.get("init_oversample", 20))
+    if oversample > 1 and isinstance(init, str):
+        # start from the best of many uniform samples (feasible ones first): the same
+        # feasibility-first fitness ranks them, so DE starts inside the feasible region
+        rng = np.random.default_rng(seed)
+        X = rng.uniform(lower, upper, size=(oversample * npop, len(lower)))
+        f = np.concatenate([fitness(chunk) for chunk in np.array_split(X, oversample)])
+        init = X[np.argsort(f, kind="stable")[:npop]]
+    res = differential_evolution(
+        lambda X: fitness(X.T), list(zip(lower, upper)), vectorized=True, updating="deferred",
+        strategy=options.get("strategy", "randtobest1bin"), popsize=int(options.get("popsize", 10)),
+        maxiter=int(options.get("maxiter", 700)), mutation=options.get("mutation", (0.5, 1.0)),
+        recombination=float(options.get("recombination", 0.9)), init=init,
+        tol=0.0, atol=0.0, seed=seed, polish=False, callback=callback,
+    )
+    return GlobalResult(x=np.asarray(res.x), fun=float(res.fun), nfev=int(res.nfev),
+                        population=getattr(res, "population", None),
+                        population_fun=getattr(res, "population_energies", None))
+
+
+def random_search(fitness, lower, upper, *, seed: int, should_stop, options: dict[str, Any]) -> GlobalResult:
+    """Uniform random sampling (a baseline showing the interface; not for real use)."""
+    rng = np.random.default_rng(seed)
+    batch, rounds = int(options.get("popsize", 10)) * len(lower) * 10, int(options.get("maxiter", 100))
+    best_x, best_f, nfev = None, np.inf, 0
+    for _ in range(rounds):
+        X = rng.uniform(lower, upper, size=(batch, len(lower)))
+        f = fitness(X)
+        nfev += batch
+        i = int(np.argmin(f))
+        if f[i] < best_f:
+            best_x, best_f = X[i], float(f[i])
+        if should_stop(best_f):
+            break
+    return GlobalResult(x=best_x, fun=best_f, nfev=nfev)
+
+
+OPTIMIZERS: dict[str, OptimizerFn] = {"de": scipy_de, "random": random_search}
+
+
+def register_optimizer(name: str, fn: OptimizerFn) -> None:
+    """Make ``fn`` (see the module docstring for its signature) available by ``name``."""
+    OPTIMIZERS[name] = fn
+
+
+def polish(problem: PathProblem, z: np.ndarray, max_nfev: int = 400) -> np.ndarray:
+    """Least-squares polish of a full internal vector; returns it unchanged unless the
+    polished design is feasible and strictly better (feasibility first)."""
+    z = np.clip(np.asarray(z, float), problem.lower, problem.upper)
+    f0 = problem.fitness(z[None, :])[0]
+    try:
+        res = least_squares(problem.residuals, z, bounds=(problem.lower, problem.upper), x_scale="jac",
+                            method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=max_nfev)
+    except (ValueError, np.linalg.LinAlgError):
+        return z
+    f1 = problem.fitness(res.x[None, :])[0]
+    ev = problem.evaluate(res.x[None, :])
+    if bool(ev.feasible[0]) and f1 < f0:
+        return res.x
+    return z
+
+
+@dataclass
+class RestartResult:
+    index: int
+    seed: int
+    z: np.ndarray
+    fitness: float
+    nfev: int
+    seconds: float
+
+
+def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options: dict[str, Any],
+                 deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0) -> RestartResult:
+    t0 = time.monotonic()
+    problem = PathProblem(case)
+    m = problem.reduced_dim
+    lower, upper = problem.lower[:m], problem.upper[:m]
+    fn = OPTIMIZERS[optimizer]
+
+    # leave a little of the budget for polishing, so the whole run keeps its time limit
+    search_deadline = deadline - polish_reserve
+
+    def should_stop(best):
+        if report is not None:
+            report(index, best)
+        return time.time() >= search_deadline
+
+    g = fn(problem.reduced_fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
+    nfev = g.nfev
+    # candidates to polish: the best, then the best distinct population members
+    cands = [np.asarray(g.x, float)]
+    if g.population is not None and g.population_fun is not None and n_polish > 1:
+        order = np.argsort(g.population_fun)
+        for i in order:
+            x = g.population[i]
+            if all(np.linalg.norm((x - c) / (upper - lower + 1e-300)) > 1e-3 for c in cands):
+                cands.append(x)
+            if len(cands) >= n_polish:
+                break
+    best_z, best_f = None, np.inf
+    last = 0.5  # estimated seconds per polish; a polish starts only if it should end in time
+    for c in cands:
+        z = problem.expand(c)[0]
+        if time.time() + 1.5 * last < deadline:
+            tp = time.time()
+            z = polish(problem, z)
+            last = time.time() - tp
+        f = float(problem.fitness(z[None, :])[0])
+        if f < best_f:
+            best_z, best_f = z, f
+    return RestartResult(index=index, seed=seed, z=best_z, fitness=best_f, nfev=nfev,
+                         seconds=time.monotonic() - t0)
+
+
+def _restart_job(args):
+    return _run_restart(*args)
+
+
+def _run_on_dask(scheduler, jobs) -> list[RestartResult]:
+    """Run restart jobs on an existing Dask cluster (optional extra ``mechsyn[dask]``)."""
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
+                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+    if isinstance(scheduler, Client):
+        futures = scheduler.map(_restart_job, jobs, pure=False)
+        return scheduler.gather(futures)
+    try:
+        client = Client(scheduler, timeout=10)
+    except (OSError, TimeoutError) as exc:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+                                hint="give the address printed by dask-scheduler, e.g. tcp://host:8786") from None
+    with client:
+        return client.gather(client.map(_restart_job, jobs, pure=False))
+
+
+@dataclass
+class PathSynthesisResult:
+    """Outcome of :func:`synthesize_path` (serialisable; ``to_dict`` gives the CLI JSON)."""
+
+    case_id: str
+    error: float
+    design: dict[str, float]
+    assembled_at_all_targets: bool
+    feasible: bool
+    seconds: float
+    seed: int
+    restarts: int
+    nfev: int
+    optimizer: str
+    branch: int
+    targets: np.ndarray
+    path: np.ndarray
+    theta2: np.ndarray
+    restart_errors: list[float] = field(default_factory=list)
+    best_known: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "case": self.case_id, "error": self.error, "design": self.design,
+            "assembled_at_all_targets": self.assembled_at_all_targets, "feasible": self.feasible,
+            "seconds": self.seconds, "seed": self.seed, "restarts": self.restarts, "nfev": self.nfev,
+            "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
+            "ratio_to_best_known": (self.error / self.best_known) if self.best_known else None,
+            "restart_errors": self.restart_errors, "theta2": self.theta2, "path": self.path,
+            "targets": self.targets,
+        }
+
+
+def restart_seeds(seed: int, restarts: int) -> list[int]:
+    """Reproducible child seeds of ``seed`` (``numpy.random.SeedSequence.spawn``)."""
+    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(restarts)]
+
+
+def synthesize_path(
+    case: PathCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
+    optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
+    progress: Callable[[int, int, float], None] | None = None, scheduler: str | None = None,
+) -> PathSynthesisResult:
+    """Optimise a path-generation case (see the module docstring for the pipeline).
+
+    ``progress(restarts_done, restarts, best_error_so_far)`` is called as the run goes.
+    With ``workers > 1`` restarts run in that many local processes, with ``scheduler``
+    (a ``dask.distributed`` scheduler address, or a ``Client``) on a Dask cluster; the
+    result equals the single-process one (same seeds, same deterministic choice of the
+    best), unless the time limit cuts runs short.
+    """
+    if optimizer not in OPTIMIZERS:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+                                hint="one of " + ", ".join(sorted(OPTIMIZERS)))
+    options = dict(options or {})
+    t0 = time.time()
+    deadline = t0 + time_limit
+    reserve = min(4.0, 0.07 * time_limit)
+    seeds = restart_seeds(seed, restarts)
+    results: list[RestartResult] = []
+    best = [np.inf]
+    problem = PathProblem(case)
+
+    def note(done, f):
+        if problem_feasible_score(f):
+            best[0] = min(best[0], f)
+        if progress is not None:
+            progress(done, restarts, best[0])
+
+    def problem_feasible_score(f):
+        return f < problem.penalty_base
+
+    if workers <= 1 and scheduler is None:
+        for i, s in enumerate(seeds):
+            if results and time.time() >= deadline - reserve:
+                break  # too little time left for a useful restart
+            r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
+                             report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve)
+            results.append(r)
+            note(len(results), r.fitness)
+    elif scheduler is not None:
+        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
+        for r in _run_on_dask(scheduler, jobs):
+            results.append(r)
+            note(len(results), r.fitness)
+    else:
+        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            for r in pool.map(_restart_job, jobs):
+                results.append(r)
+                note(len(results), r.fitness)
+    results.sort(key=lambda r: r.index)
+    win = min(results, key=lambda r: (r.fitness, r.index))
+    design = problem.design(win.z)
+    check = evaluate_design(case, design)
+    return PathSynthesisResult(
+        case_id=case.id, error=check["error"], design=design,
+        assembled_at_all_targets=check["assembled_at_all_targets"], feasible=check["feasible"],
+        seconds=time.time() - t0, seed=seed, restarts=len(results), nfev=sum(r.nfev for r in results),
+        optimizer=optimizer, branch=case.branch, targets=case.targets, path=check["path"],
+        theta2=check["theta2"],
+        restart_errors=[r.fitness if r.fitness < problem.penalty_base else float("inf") for r in results],
+        best_known=case.best_known,
+    )

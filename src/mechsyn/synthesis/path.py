@@ -1,0 +1,518 @@
+"""Four-bar path generation: the case, its objective and its constraints.
+
+A case follows the schema of ``spec/data/synthesis_cases_public.json``: ``targets``
+(``n`` points), ``timing`` (``prescribed``: a fixed ``theta2`` list; ``prescribed_increment``:
+``theta2_1`` is a variable and ``theta2_i = theta2_1 + (i - 1) step`` with ``timing.step``
+or ``timing.increments``; ``free``: one variable ``theta2_i`` per target), ``fixed`` values,
+``variables`` with bounds, ``kinematics.branch`` and ``constraints``.
+
+Design vector names: ``x0, y0`` (crank pivot), ``theta0`` (ground line angle), ``r1`` ground,
+``r2`` crank, ``r3`` coupler, ``r4`` rocker, ``rcx, rcy`` (coupler point in the coupler
+frame), ``theta2_i`` (crank angles, radians). Objective (the cases' ``objective``):
+
+    f = sum_i |C_i - Cd_i|^2     (sum of squared distances, no mean, no root)
+
+Constraints (all must hold; see :meth:`PathProblem.evaluate`):
+
+* the linkage assembles on the case's fixed branch at every target AND along the whole
+  crank motion from one target to the next (so it cannot jump branch or pass a dead
+  position between targets; this is the order/branch-defect check of path generation);
+* Grashof ``s + l <= p + q`` when the case lists a ``Grashof`` constraint (or
+  ``options.grashof`` is true; ``"crank-rocker"`` also asks the crank to be shortest);
+* input angles cyclically ordered (counter-clockwise, at most one turn) for free timing;
+* optional ``options.transmission_angle_min_deg`` (along the motion) and
+  ``options.link_ratio_max`` (longest / shortest of ``r1..r4``);
+* variable bounds.
+
+Feasibility first: an infeasible design scores ``U + violation`` where ``U`` is an upper
+bound of the objective of every design within the bounds, so no infeasible design can
+ever rank better than a feasible one (Deb's rule as a penalty).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.synthesis.fourbar import (
+    TWO_PI,
+    arc_cos_extremes,
+    coupler_point,
+    crank_cos_range,
+    fourbar_position,
+    grashof_excess,
+)
+
+LINKAGE_NAMES = ("x0", "y0", "theta0", "r1", "r2", "r3", "r4", "rcx", "rcy")
+LENGTHS = ("r1", "r2", "r3", "r4")
+TIMING_TYPES = ("prescribed", "prescribed_increment", "free")
+_TOL = 1e-9  # rad: allowed overlap of the first and last crank angle (free timing)
+FEASIBILITY_TOL = 1e-12  # total violation treated as numerically zero
+
+
+@dataclass(frozen=True)
+class Variable:
+    name: str
+    lower: float
+    upper: float
+
+
+@dataclass(frozen=True)
+class PathCase:
+    """A path-generation case (see the module docstring for the schema)."""
+
+    id: str
+    targets: np.ndarray
+    timing: str
+    theta2: np.ndarray | None  # prescribed angles, or increments from theta2_1
+    fixed: dict[str, float]
+    variables: tuple[Variable, ...]
+    branch: int = -1
+    grashof: bool | str = False
+    order: str = "ccw"
+    transmission_angle_min_deg: float | None = None
+    link_ratio_max: float | None = None
+    title: str = ""
+    published: tuple[dict, ...] = ()
+    best_known: float | None = None
+    raw: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def n(self) -> int:
+        return len(self.targets)
+
+    def bounds(self) -> dict[str, tuple[float, float]]:
+        return {v.name: (v.lower, v.upper) for v in self.variables}
+
+    @classmethod
+    def from_dict(cls, data: Any, source: str | None = None) -> "PathCase":
+        """Validate a case object; :class:`MechsynInputError` naming the field on bad input."""
+
+        def bad(msg: str, fld: str, hint: str | None = None) -> MechsynInputError:
+            return MechsynInputError(msg, source=source, field=fld, hint=hint)
+
+        if not isinstance(data, dict):
+            raise bad("a case must be a JSON object", "(top level)")
+        try:
+            targets = np.asarray(data["targets"], dtype=float)
+        except KeyError:
+            raise bad("missing", "targets", "give a list of [x, y] points") from None
+        except (TypeError, ValueError):
+            raise bad("must be a list of [x, y] numbers", "targets") from None
+        if targets.ndim != 2 or targets.shape[1] != 2 or len(targets) < 1:
+            raise bad(f"must be a list of [x, y] points, got shape {targets.shape}", "targets")
+        if not np.all(np.isfinite(targets)):
+            raise bad("must be finite numbers", "targets")
+        n = len(targets)
+        timing = data.get("timing") or {}
+        ttype = timing.get("type") if isinstance(timing, dict) else None
+        if ttype not in TIMING_TYPES:
+            raise bad(f"unknown timing type {ttype!r}", "timing.type", "one of " + ", ".join(TIMING_TYPES))
+        theta2 = None
+        if ttype == "prescribed":
+            try:
+                theta2 = np.asarray(timing["theta2"], dtype=float)
+            except (KeyError, TypeError, ValueError):
+                raise bad("prescribed timing needs a list of n angles [rad]", "timing.theta2") from None
+            if theta2.shape != (n,):
+                raise bad(f"expected {n} angles, got {theta2.size}", "timing.theta2")
+        elif ttype == "prescribed_increment":
+            if "increments" in timing:
+                inc = np.asarray(timing["increments"], dtype=float)
+                if inc.shape != (n - 1,):
+                    raise bad(f"expected {n - 1} increments", "timing.increments")
+            elif "step" in timing:
+                inc = np.full(n - 1, float(timing["step"]))
+            else:
+                raise bad("needs 'step' or 'increments' [rad]", "timing")
+            theta2 = np.concatenate([[0.0], np.cumsum(inc)])
+        fixed_raw = data.get("fixed") or {}
+        if not isinstance(fixed_raw, dict):
+            raise bad("must be an object name -> value", "fixed")
+        fixed: dict[str, float] = {}
+        for k, v in fixed_raw.items():
+            if k not in LINKAGE_NAMES:
+                raise bad(f"unknown design name {k!r}", f"fixed.{k}", "one of " + ", ".join(LINKAGE_NAMES))
+            try:
+                fixed[k] = float(v)
+            except (TypeError, ValueError):
+                raise bad("must be a number", f"fixed.{k}") from None
+        allowed = set(LINKAGE_NAMES)
+        if ttype == "free":
+            allowed |= {f"theta2_{i + 1}" for i in range(n)}
+        elif ttype == "prescribed_increment":
+            allowed.add("theta2_1")
+        variables = []
+        for i, v in enumerate(data.get("variables") or []):
+            try:
+                name, lo, hi = v["name"], float(v["lower"]), float(v["upper"])
+            except (KeyError, TypeError, ValueError):
+                raise bad("needs name, lower and upper", f"variables[{i}]") from None
+            if name not in allowed:
+                raise bad(f"unknown or unusable variable {name!r} for timing {ttype!r}", f"variables[{i}].name")
+            if name in fixed:
+                raise bad(f"{name!r} is both fixed and variable", f"variables[{i}].name")
+            if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
+                raise bad(f"bounds [{lo}, {hi}] are not an interval", f"variables[{i}]")
+            variables.append(Variable(name, lo, hi))
+        names = [v.name for v in variables]
+        if len(set(names)) != len(names):
+            raise bad("a variable is listed twice", "variables")
+        defaults = {"x0": 0.0, "y0": 0.0, "theta0": 0.0}
+        for k in LINKAGE_NAMES:
+            if k not in fixed and k not in names:
+                if k in defaults:
+                    fixed[k] = defaults[k]
+                else:
+                    raise bad(f"{k!r} is neither fixed nor a variable", "variables", f"add {k} with bounds")
+        needed = {f"theta2_{i + 1}" for i in range(n)} if ttype == "free" else (
+            {"theta2_1"} if ttype == "prescribed_increment" else set())
+        missing = sorted(needed - set(names))
+        if missing:
+            raise bad(f"timing {ttype!r} needs variables {missing}", "variables")
+        kin = data.get("kinematics") or {}
+        branch = kin.get("branch", -1)
+        if branch not in (-1, 1):
+            raise bad("must be -1 or +1", "kinematics.branch")
+        options = data.get("options") or {}
+        grashof: bool | str = any(str(c).strip().lower().startswith("grashof") for c in data.get("constraints") or [])
+        if "grashof" in options:
+            grashof = options["grashof"]
+            if grashof not in (True, False, "crank-rocker"):
+                raise bad("must be true, false or \"crank-rocker\"", "options.grashof")
+        order = options.get("order", "ccw")
+        if order not in ("ccw", "cw"):
+            raise bad("must be \"ccw\" or \"cw\"", "options.order")
+        best = data.get("best_known", {})
+        return cls(
+            id=str(data.get("id", "case")), title=str(data.get("title", "")), targets=targets,
+            timing=ttype, theta2=theta2, fixed=fixed, variables=tuple(variables), branch=int(branch),
+            grashof=grashof, order=order,
+            transmission_angle_min_deg=options.get("transmission_angle_min_deg"),
+            link_ratio_max=options.get("link_ratio_max"),
+            published=tuple(data.get("published_solutions") or ()),
+            best_known=best.get("value") if isinstance(best, dict) else None, raw=data,
+        )
+
+
+def load_cases(path: str | Path) -> list[PathCase]:
+    """Load one case object, or every case of a ``{"cases": [...]}`` collection."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise MechsynInputError("file not found", source=str(path)) from None
+    except json.JSONDecodeError as exc:
+        raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(path), line=exc.lineno) from None
+    if isinstance(data, dict) and "cases" in data:
+        items = data["cases"]
+        return [PathCase.from_dict(c, source=f"{path}#cases[{i}]") for i, c in enumerate(items)]
+    return [PathCase.from_dict(data, source=str(path))]
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Objective and constraint state of a batch of designs (arrays of shape ``(P,)``)."""
+
+    error: np.ndarray
+    violation: np.ndarray
+    assembled_at_all_targets: np.ndarray
+
+    @property
+    def feasible(self) -> np.ndarray:
+        return self.violation <= FEASIBILITY_TOL
+
+
+class PathProblem:
+    """The optimisation problem of a :class:`PathCase`.
+
+    The optimiser works on an internal vector ``z``: the linkage variables in the case's
+    order, then the timing variables. For free timing these are ``theta2_1`` and the
+    increments ``delta_i = theta2_(i+1) - theta2_i`` in ``[0, 2 pi]`` (counter-clockwise
+    order; mirrored for ``order = "cw"``), so ordering becomes the single constraint
+    ``sum(delta) <= 2 pi``. :meth:`design` maps ``z`` to the case's own variables.
+    """
+
+    def __init__(self, case: PathCase):
+        self.case = case
+        b = case.bounds()
+        self.linkage_vars = [v.name for v in case.variables if v.name in LINKAGE_NAMES]
+        lo = [b[k][0] for k in self.linkage_vars]
+        hi = [b[k][1] for k in self.linkage_vars]
+        n = case.n
+        if case.timing == "free":
+            lo += [b["theta2_1"][0]] + [0.0] * (n - 1)
+            hi += [b["theta2_1"][1]] + [TWO_PI] * (n - 1)
+        elif case.timing == "prescribed_increment":
+            lo.append(b["theta2_1"][0])
+            hi.append(b["theta2_1"][1])
+        self.lower = np.array(lo, float)
+        self.upper = np.array(hi, float)
+        self.names = self.linkage_vars + (
+            ["theta2_1"] + [f"delta_{i + 1}" for i in range(n - 1)] if case.timing == "free"
+            else (["theta2_1"] if case.timing == "prescribed_increment" else []))
+        self.penalty_base = self._objective_upper_bound()
+
+    @property
+    def dim(self) -> int:
+        return len(self.lower)
+
+    def _objective_upper_bound(self) -> float:
+        """``U``: no design within the bounds can have a larger objective.
+
+        ``|C| <= |(x0, y0)| + r2 + |(rcx, rcy)|`` (coupler point = pivot + crank + offset),
+        so ``f <= n (max|C| + max|Cd|)^2``; doubled and padded for safety.
+        """
+        b = self.case.bounds()
+
+        def mag(k):
+            if k in self.case.fixed:
+                return abs(self.case.fixed[k])
+            return max(abs(b[k][0]), abs(b[k][1]))
+
+        reach = np.hypot(mag("x0"), mag("y0")) + mag("r2") + np.hypot(mag("rcx"), mag("rcy"))
+        tmax = np.max(np.hypot(*self.case.targets.T))
+        return float(2.0 * self.case.n * (reach + tmax) ** 2 + 1.0)
+
+    # -- mapping -------------------------------------------------------------------------
+    def unpack(self, z: np.ndarray) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
+        """Linkage values ``(P,)`` each, crank angles ``(P, n)`` and signed sweeps ``(P, n-1)``."""
+        z = np.atleast_2d(z)
+        P = z.shape[0]
+        vals = {k: np.full(P, v) for k, v in self.case.fixed.items()}
+        for j, k in enumerate(self.linkage_vars):
+            vals[k] = z[:, j]
+        m = len(self.linkage_vars)
+        case = self.case
+        if case.timing == "prescribed":
+            th = np.broadcast_to(case.theta2, (P, case.n))
+        elif case.timing == "prescribed_increment":
+            th = z[:, m:m + 1] + case.theta2[None, :]
+        else:
+            sign = 1.0 if case.order == "ccw" else -1.0
+            th = z[:, m:m + 1] + sign * np.concatenate(
+                [np.zeros((P, 1)), np.cumsum(z[:, m + 1:], axis=1)], axis=1)
+        sweeps = np.diff(th, axis=1)
+        return vals, th, sweeps
+
+    def design(self, z: np.ndarray) -> dict[str, Any]:
+        """The case's design variables (names as in the case) for one internal vector."""
+        vals, th, _ = self.unpack(np.asarray(z, float)[None, :])
+        out: dict[str, Any] = {k: float(vals[k][0]) for k in self.linkage_vars}
+        if self.case.timing != "prescribed":
+            b = self.case.bounds()
+            angles = []
+            for i, t in enumerate(th[0]):
+                lo, hi = b.get(f"theta2_{i + 1}", b["theta2_1"])
+                if hi - lo >= TWO_PI - 1e-12:
+                    t = lo + np.mod(t - lo, TWO_PI)
+                angles.append(float(t))
+            if self.case.timing == "free":
+                out.update({f"theta2_{i + 1}": a for i, a in enumerate(angles)})
+            else:
+                out["theta2_1"] = angles[0]
+        return out
+
+    def internal(self, design: dict[str, Any]) -> np.ndarray:
+        """Inverse of :meth:`design` (accepts ``theta2`` as a list as in published vectors)."""
+        z = [float(design[k]) for k in self.linkage_vars]
+        if self.case.timing == "free":
+            th = np.asarray(design["theta2"] if "theta2" in design else
+                            [design[f"theta2_{i + 1}"] for i in range(self.case.n)], float)
+            sign = 1.0 if self.case.order == "ccw" else -1.0
+            z += [th[0]] + list(np.mod(sign * np.diff(th), TWO_PI))
+        elif self.case.timing == "prescribed_increment":
+            z.append(float(design["theta2_1"]))
+        return np.array(z)
+
+    @property
+    def reduced_dim(self) -> int:
+        """Number of variables the global search sees (free timing: linkage only)."""
+        return len(self.linkage_vars) if self.case.timing == "free" else self.dim
+
+    def project_timing(self, zl: np.ndarray, samples: int = 96, refinements: int = 2) -> np.ndarray:
+        """Complete linkage-only vectors ``(P, m)`` with their best crank angles (free timing).
+
+        For each design the coupler curve is sampled at ``samples`` crank angles on the
+        case's branch; each target takes the angle of its nearest curve point, refined
+        ``refinements`` times by a parabola through the squared distances at the angle and
+        its neighbours (spacing divided by 6 each time). The result is a full internal
+        vector whose objective is evaluated as usual (so it is the objective of a real
+        design, not an estimate); ordering and assembly are checked as for any design.
+        """
+        zl = np.atleast_2d(np.asarray(zl, float))
+        P, m = zl.shape
+        case = self.case
+        vals = {k: np.full(P, v) for k, v in case.fixed.items()}
+        for j, k in enumerate(self.linkage_vars):
+            vals[k] = zl[:, j]
+        tx, ty = case.targets[:, 0], case.targets[:, 1]
+
+        def d2(theta, extra_axis):
+            sh = (P, 1, 1) if extra_axis else (P, 1)
+            c = {k: v.reshape(sh) for k, v in vals.items()}
+            cx, cy, ok = coupler_point(c["r1"], c["r2"], c["r3"], c["r4"], theta, case.branch,
+                                       c["rcx"], c["rcy"], c["x0"], c["y0"], c["theta0"])
+            if extra_axis:  # theta (P, n, K): distance of target i to its own samples
+                dx = cx - tx[None, :, None]
+                dy = cy - ty[None, :, None]
+            else:  # theta (1, M): distance of every target to every sample -> (P, M, n)
+                dx = cx[:, :, None] - tx[None, None, :]
+                dy = cy[:, :, None] - ty[None, None, :]
+                ok = ok[:, :, None]
+            return np.where(ok, dx * dx + dy * dy, np.inf)
+
+        h = TWO_PI / samples
+        grid = np.arange(samples) * h
+        dd = d2(grid[None, :], False)
+        k = np.argmin(dd, axis=1)  # (P, n)
+        rows, cols = np.arange(P)[:, None], np.arange(case.n)[None, :]
+        f = np.stack([dd[rows, (k - 1) % samples, cols], dd[rows, k, cols], dd[rows, (k + 1) % samples, cols]], -1)
+        theta = grid[k]
+        for level in range(refinements + 1):
+            fm, f0, fp = f[..., 0], f[..., 1], f[..., 2]
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                den = fm - 2.0 * f0 + fp
+                off = np.where(np.isfinite(den) & (den > 0), 0.5 * (fm - fp) / den, 0.0)
+            theta = theta + np.clip(np.nan_to_num(off), -1.0, 1.0) * h
+            if level == refinements:
+                break
+            h = h / 6.0
+            f = d2(theta[..., None] + h * np.array([-1.0, 0.0, 1.0]), True)
+        sign = 1.0 if case.order == "ccw" else -1.0
+        lo = case.bounds()["theta2_1"][0]
+        t1 = lo + np.mod(theta[:, :1] - lo, TWO_PI)
+        deltas = np.mod(sign * np.diff(theta, axis=1), TWO_PI)
+        return np.concatenate([zl, t1, deltas], axis=1)
+
+    def expand(self, zr: np.ndarray) -> np.ndarray:
+        """Full internal vectors from the global search's vectors (see :attr:`reduced_dim`)."""
+        zr = np.atleast_2d(np.asarray(zr, float))
+        return self.project_timing(zr) if self.case.timing == "free" else zr
+
+    def reduced_fitness(self, zr: np.ndarray) -> np.ndarray:
+        """:meth:`fitness` of :meth:`expand` ``(zr)``."""
+        return self.fitness(self.expand(zr))
+
+    # -- evaluation ----------------------------------------------------------------------
+    def evaluate(self, z: np.ndarray) -> Evaluation:
+        """Objective and total constraint violation for a population ``z`` of shape ``(P, dim)``."""
+        z = np.atleast_2d(np.asarray(z, float))
+        case = self.case
+        vals, th, sweeps = self.unpack(z)
+        r1, r2, r3, r4 = (vals[k][:, None] for k in LENGTHS)
+        cx, cy, assembled = coupler_point(
+            r1, r2, r3, r4, th, case.branch, vals["rcx"][:, None], vals["rcy"][:, None],
+            vals["x0"][:, None], vals["y0"][:, None], vals["theta0"][:, None])
+        ex, ey = cx - case.targets[None, :, 0], cy - case.targets[None, :, 1]
+        error = np.sum(ex * ex + ey * ey, axis=1)
+        assembled_all = np.all(assembled, axis=1)
+        viol = np.zeros(len(z))
+        # positive lengths
+        rmat = np.stack([vals[k] for k in LENGTHS], axis=1)
+        scale = np.maximum(np.max(np.abs(rmat), axis=1), 1e-12)
+        viol += np.sum(np.maximum(0.0, 1e-9 * scale[:, None] - rmat), axis=1) / scale
+        # assembly at every target and along each crank sweep, in cos(theta2) units
+        c_lo, c_hi = crank_cos_range(r1[:, 0], r2[:, 0], r3[:, 0], r4[:, 0])
+        c_lo = np.nan_to_num(c_lo, nan=2.0, posinf=2.0, neginf=-2.0)
+        c_hi = np.nan_to_num(c_hi, nan=-2.0, posinf=2.0, neginf=-2.0)
+        c = np.cos(th)
+        if th.shape[1] > 1:
+            cmin, cmax = arc_cos_extremes(th[:, :-1], sweeps)
+            cmin = np.minimum(cmin, c.min(axis=1, keepdims=True))
+            cmax = np.maximum(cmax, c.max(axis=1, keepdims=True))
+        else:
+            cmin, cmax = c, c
+        viol += np.sum(np.maximum(0.0, c_lo[:, None] - cmin) + np.maximum(0.0, cmax - c_hi[:, None]), axis=1)
+        viol += np.where(assembled_all, 0.0, 1e-6)  # numerical edge cases of the interval test
+        if case.grashof:
+            viol += np.maximum(0.0, grashof_excess(*(vals[k] for k in LENGTHS))) / scale
+            if case.grashof == "crank-rocker":
+                others = np.minimum(np.minimum(vals["r1"], vals["r3"]), vals["r4"])
+                viol += np.maximum(0.0, vals["r2"] - others) / scale
+        if case.timing == "free":
+            m = len(self.linkage_vars)
+            viol += np.maximum(0.0, np.sum(z[:, m + 1:], axis=1) - TWO_PI - _TOL)
+        if case.transmission_angle_min_deg is not None and th.shape[1] >= 1:
+            # cos(mu) = (r3^2 + r4^2 - r1^2 - r2^2 + 2 r1 r2 cos t2) / (2 r3 r4): monotone in cos t2
+            k = np.cos(np.radians(case.transmission_angle_min_deg))
+            def cos_mu(ct):
+                return (r3[:, 0] ** 2 + r4[:, 0] ** 2 - r1[:, 0] ** 2 - r2[:, 0] ** 2
+                        + 2 * r1[:, 0] * r2[:, 0] * ct) / (2 * r3[:, 0] * r4[:, 0])
+            lo_mu = cos_mu(np.min(cmin, axis=1) if cmin.ndim > 1 else cmin)
+            hi_mu = cos_mu(np.max(cmax, axis=1) if cmax.ndim > 1 else cmax)
+            viol += np.nan_to_num(np.maximum(0.0, np.abs(lo_mu) - k) + np.maximum(0.0, np.abs(hi_mu) - k), nan=1.0)
+        if case.link_ratio_max is not None:
+            ratio = np.max(rmat, axis=1) / np.maximum(np.min(rmat, axis=1), 1e-300)
+            viol += np.maximum(0.0, ratio - case.link_ratio_max) / case.link_ratio_max
+        # bounds of the case's own variables (internal bounds hold by construction except
+        # reported angles whose bounds are narrower than a turn)
+        viol += self._bound_violation(z, vals, th)
+        error = np.where(np.isfinite(error), error, np.inf)
+        return Evaluation(error=error, violation=viol, assembled_at_all_targets=assembled_all)
+
+    def _bound_violation(self, z, vals, th) -> np.ndarray:
+        v = np.sum(np.maximum(0.0, self.lower - z) + np.maximum(0.0, z - self.upper), axis=1)
+        if self.case.timing != "prescribed":
+            b = self.case.bounds()
+            for i in range(self.case.n):
+                lo, hi = b.get(f"theta2_{i + 1}", b["theta2_1"])
+                if hi - lo < TWO_PI - 1e-12:
+                    v += np.maximum(0.0, lo - th[:, i]) + np.maximum(0.0, th[:, i] - hi)
+        return v
+
+    def fitness(self, z: np.ndarray) -> np.ndarray:
+        """Feasibility-first scalar score: ``f`` if feasible, else ``U + violation`` (``> f``)."""
+        ev = self.evaluate(z)
+        return np.where(ev.feasible & np.isfinite(ev.error), ev.error, self.penalty_base + ev.violation)
+
+    def residuals(self, z: np.ndarray) -> np.ndarray:
+        """Residual vector ``C - Cd`` (length ``2n``) for local least-squares polishing.
+
+        Where the linkage cannot assemble, the arccos argument is clipped and a large
+        residual proportional to the violation is appended, so a polisher is pushed back to
+        feasible designs (its result is accepted only if feasible).
+        """
+        z = np.asarray(z, float)[None, :]
+        case = self.case
+        vals, th, _ = self.unpack(z)
+        r1, r2, r3, r4 = (vals[k][:, None] for k in LENGTHS)
+        ax, ay = r2 * np.cos(th), r2 * np.sin(th)
+        dx, dy = r1 - ax, -ay
+        d = np.hypot(dx, dy)
+        ca = np.clip((r3 * r3 + d * d - r4 * r4) / (2.0 * r3 * d), -1.0, 1.0)
+        t3 = np.arctan2(dy, dx) - case.branch * np.arccos(ca)
+        cx = ax + vals["rcx"][:, None] * np.cos(t3) - vals["rcy"][:, None] * np.sin(t3)
+        cy = ay + vals["rcx"][:, None] * np.sin(t3) + vals["rcy"][:, None] * np.cos(t3)
+        t0 = vals["theta0"][:, None]
+        gx = np.cos(t0) * cx - np.sin(t0) * cy + vals["x0"][:, None]
+        gy = np.sin(t0) * cx + np.cos(t0) * cy + vals["y0"][:, None]
+        res = np.concatenate([(gx - case.targets[:, 0]).ravel(), (gy - case.targets[:, 1]).ravel()])
+        viol = self.evaluate(z).violation[0]
+        return np.append(res, 1e3 * np.sqrt(self.penalty_base) * viol)
+
+
+def evaluate_design(case: PathCase, design: dict[str, Any]) -> dict[str, Any]:
+    """Recompute a design's objective and constraint state, by the case's conventions.
+
+    ``design`` holds the case's variable names (``theta2`` may be given as a list). Returns
+    ``error``, ``feasible``, ``violation``, ``assembled_at_all_targets`` and the coupler
+    points ``path``.
+    """
+    prob = PathProblem(case)
+    z = prob.internal(design)
+    ev = prob.evaluate(z[None, :])
+    vals, th, _ = prob.unpack(z[None, :])
+    pose = fourbar_position(*(vals[k][:, None] for k in LENGTHS), th, branch=case.branch,
+                            rcx=vals["rcx"][:, None], rcy=vals["rcy"][:, None], x0=vals["x0"][:, None],
+                            y0=vals["y0"][:, None], theta0=vals["theta0"][:, None])
+    return {
+        "error": float(ev.error[0]), "feasible": bool(ev.feasible[0]), "violation": float(ev.violation[0]),
+        "assembled_at_all_targets": bool(ev.assembled_at_all_targets[0]), "path": pose.C[0],
+        "theta2": th[0],
+    }
