@@ -12,7 +12,8 @@ import json
 import math
 import os
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from enum import Enum
 from pathlib import Path
 from typing import Any
@@ -89,14 +90,19 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
         raise
 
 
-def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **kwargs: Any) -> None:
-    """Save a Matplotlib figure whole or not at all, format from the file's suffix."""
+@contextmanager
+def atomic_output(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary path beside ``path``; on success it replaces ``path`` whole.
+
+    For writers that want a file name (Matplotlib's ``savefig``, animation writers): the
+    output appears complete or not at all, with the umask's permissions.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=path.suffix)
     os.close(fd)
     try:
-        fig.savefig(tmp, **kwargs)
+        yield Path(tmp)
         os.chmod(tmp, _umask_mode())
         os.replace(tmp, path)
     except BaseException:
@@ -105,3 +111,9 @@ def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **kwargs: Any) ->
         except FileNotFoundError:
             pass
         raise
+
+
+def save_figure_atomic(fig: Any, path: str | os.PathLike[str], **kwargs: Any) -> None:
+    """Save a Matplotlib figure whole or not at all, format from the file's suffix."""
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, **kwargs)

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.results import atomic_output
 from mechsyn.kinematics.belt import (
     BeltDesign,
     BeltState,
@@ -201,18 +201,5 @@ def save_animation(design: BeltDesign, state: BeltState, path: str | os.PathLike
         return [*current, text]
 
     anim = FuncAnimation(fig, frame, frames=len(idx), blit=False)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".gif")
-    os.close(fd)
-    try:
+    with atomic_output(path) as tmp:
         anim.save(tmp, writer=PillowWriter(fps=fps))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise

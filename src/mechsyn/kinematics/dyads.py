@@ -182,6 +182,22 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
+def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """Link angles made continuous along a sweep: start near the file's angles ``ref``,
+    unwrap each run of assembled rows and keep the turn count across gaps."""
+    sub = ref + _wrap(phi - ref)
+    idx = np.flatnonzero(ok)
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    prev = None
+    for run in runs:
+        block = np.unwrap(sub[run], axis=0)
+        if prev is not None:
+            block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
+        sub[run] = block
+        prev = block[-1]
+    return sub
+
+
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
@@ -391,18 +407,7 @@ def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
     dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
     ok = np.all(np.isfinite(phi), axis=1)
     if dyad_links and ok.any():
-        ref = S.q0[[3 * i + 2 for i in dyad_links]]
-        sub = ref + _wrap(phi[:, dyad_links] - ref)
-        idx = np.flatnonzero(ok)
-        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
-        prev = None
-        for run in runs:
-            block = np.unwrap(sub[run], axis=0)
-            if prev is not None:
-                block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
-            sub[run] = block
-            prev = block[-1]
-        phi[:, dyad_links] = sub
+        phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
     q[:, 2:3 * nl:3] = phi
     return q, out_sig
 
@@ -467,18 +472,7 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
             phi[:, i] = sgn * U[:, k]
     others = [i for i in range(nl) if i not in drive_links]
     if others and ok.any():
-        ref = S.q0[[3 * i + 2 for i in others]]
-        sub = ref + _wrap(phi[:, others] - ref)
-        idx = np.flatnonzero(ok)
-        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
-        prev = None
-        for run in runs:
-            block = np.unwrap(sub[run], axis=0)
-            if prev is not None:
-                block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
-            sub[run] = block
-            prev = block[-1]
-        phi[:, others] = sub
+        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok)
     q[:, 2:3 * nl:3] = phi
     if not ok.all():
         for a in (q, qd, qdd):
