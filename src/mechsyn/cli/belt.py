@@ -284,7 +284,7 @@ def analyze_cmd(
     case = kb.load_belt_case(str(file)) if file is not None else None
     design, synth = _design(a, c, h, r, case, str(file) if file else None)
     if phi is not None:
-        grid_deg = _grid(*parse_range(phi, "--phi"), "--phi")
+        grid_deg = _grid(*parse_range(phi, "--phi", "-73:85:1"), "--phi")
     elif case is not None and case.phi_deg is not None:
         grid_deg = _grid(case.phi_deg.start, case.phi_deg.stop, case.phi_deg.step,
                          f"{file}: phi_deg")
@@ -457,7 +457,7 @@ def inverse_cmd(
     _number(speed, "--speed", positive=True)
     _number(accel, "--accel")
     if phi is not None:
-        grid_deg = _grid(*parse_range(phi, "--phi"), "--phi")
+        grid_deg = _grid(*parse_range(phi, "--phi", "-73:85:1"), "--phi")
     elif case is not None and case.phi_deg is not None:
         grid_deg = _grid(case.phi_deg.start, case.phi_deg.stop, case.phi_deg.step, "phi_deg")
     else:

@@ -52,8 +52,11 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
     return values
 
 
-def parse_range(text: str, option: str) -> tuple[float, float, float]:
-    """Parse ``START:STOP:STEP`` (all three numbers) naming ``option`` on error."""
+def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:
+    """Parse ``START:STOP:STEP`` (all three numbers) naming ``option`` on error.
+
+    ``example`` is what the fix suggests writing after the option (e.g. ``A=0:360:1``).
+    """
     parts = text.split(":")
     try:
         if len(parts) != 3:
@@ -62,7 +65,7 @@ def parse_range(text: str, option: str) -> tuple[float, float, float]:
     except ValueError:
         raise MechsynInputError(
             f"expected START:STOP:STEP, got {text!r}", source=option,
-            hint=f"write e.g. {option} 0:360:1",
+            hint=f"write e.g. {option} {example}",
         ) from None
     if step == 0 or (stop - start) * step < 0:
         raise MechsynInputError(

@@ -42,7 +42,7 @@ def _parse_inputs(items: list[str]) -> dict[str, np.ndarray]:
         jid, spec = item.split("=", 1)
         jid = jid.strip()
         if ":" in spec:
-            start, stop, step = parse_range(spec, "--input")
+            start, stop, step = parse_range(spec, "--input", f"{jid}=0:360:1")
             vals = input_grid(start, stop, step)
         else:
             try:
