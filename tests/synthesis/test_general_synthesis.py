@@ -21,6 +21,7 @@ SIXBAR_CASE = ROOT / "examples" / "synthesis" / "sixbar_path_case.yaml"
 SLIDER_CASE = ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml"
 VALUES = [40, 50, 60, 70, 80, 90]
 X_TRUE = np.array([0.8, 4.2, 5.2, 3.8])        # B.x, C.x, D.x, M.y
+FAST = {"maxiter": 40}   # generations: deterministic budgets (no timing in the tests)
 
 
 def fourbar_case(targets=None, variables=None, **extra):
@@ -44,7 +45,7 @@ def test_recovers_known_fourbar_design():
     c0 = fourbar_case()
     case = fourbar_case(targets_of(c0, X_TRUE))
     assert evaluate_design(case, start_vector(case)).error > 0.1        # the file's design is off
-    res = synthesize_mechanism(case, seed=1, time_limit=4, restarts=1)
+    res = synthesize_mechanism(case, seed=1, time_limit=120, restarts=1, options=FAST)
     assert res.feasible and res.method == "assur"
     assert res.error < 1e-12
     assert np.allclose(list(res.design.values()), X_TRUE, atol=1e-5)
@@ -86,7 +87,7 @@ def test_error_agrees_with_closed_form_fourbar_module(x):
 def test_sixbar_reaches_small_error_from_perturbed_design_targets():
     case = load_case(SIXBAR_CASE)
     assert evaluate_design(case, start_vector(case)).error == pytest.approx(0.7122631869, rel=1e-6)
-    res = synthesize_mechanism(case, seed=0, time_limit=6, restarts=1)
+    res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.feasible and res.method == "assur"
     assert res.error < 1e-10
 
@@ -104,7 +105,7 @@ def test_newton_and_closed_form_evaluations_agree_on_the_sixbar():
 
 def test_slider_crank_path_synthesis_closed_form():
     case = load_case(SLIDER_CASE)
-    res = synthesize_mechanism(case, seed=0, time_limit=6, restarts=1)
+    res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.feasible and res.method == "assur"
     assert res.error < 1e-10
     # the crank length of the generating design (B = (0.6, 0.9)) is recovered
@@ -123,7 +124,7 @@ def test_motion_generation_recovers_coupler_poses():
     case._reference = c0._reference
     assert evaluate_design(case, xt).error < 1e-20
     assert evaluate_design(case, start_vector(case)).error > 1e-3
-    res = synthesize_mechanism(case, seed=0, time_limit=3, restarts=1)
+    res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.error < 1e-12 and np.allclose(list(res.design.values()), xt, atol=1e-5)
 
 
@@ -179,7 +180,7 @@ def test_free_timing_keeps_order_and_fits():
     x_bad = np.concatenate([[3.8], VALUES[::-1][:1] + VALUES[1:-1] + VALUES[:1]])  # out of order
     ev = evaluate_design(case, x_bad)
     assert not ev.feasible and "order" in ev.reason
-    res = synthesize_mechanism(case, seed=0, time_limit=4, restarts=1)
+    res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.feasible
     th = np.array([res.design[f"A_{i + 1}"] for i in range(len(VALUES))])
     assert np.all(np.diff(th) > 0)
@@ -195,7 +196,7 @@ def test_cli_writes_file_that_simulate_reproduces(tmp_path, capsys):
                                  "variables": [{"joint": "D", "coord": "x", "lower": 4.5, "upper": 5.5},
                                                {"point": "M", "coord": "x", "lower": 2.5, "upper": 3.5}]}))
     out, png = tmp_path / "best.yaml", tmp_path / "best.png"
-    assert main(["synth", "mechanism", str(f), "--seed", "3", "--time-limit", "3", "--restarts", "1",
+    assert main(["synth", "mechanism", str(f), "--seed", "3", "--time-limit", "30", "--restarts", "1",
                  "--json", "--out", str(out), "--plot", str(png)]) == 0
     data = json.loads(capsys.readouterr().out)
     for key in ("error", "design", "feasible", "assembled_at_all_targets", "seconds", "achieved", "targets"):
@@ -242,3 +243,30 @@ def test_cli_bad_inputs_exit_2(tmp_path, capsys, patch, opts, word):
 
 def test_cli_missing_case_file_exits_2(tmp_path, capsys):
     assert main(["synth", "mechanism", str(tmp_path / "none.yaml")]) == 2
+
+
+def test_vll_length_variable_on_paper_000_finger():
+    """A locked VLL's length (paper 000's finger) as a design variable: the locked model is
+    evaluated (closed form), and Newton on the same model agrees."""
+    finger = ROOT / "examples" / "fingers" / "two_phalanx_vll_000.yaml"
+    data = {"mechanism": str(finger), "input": {"joint": "E", "values_deg": [0, 10, 20, 30, 40]},
+            "point": "tip", "targets": [[0, 0]] * 5,
+            "variables": [{"joint": "S", "length": True, "lower": 24, "upper": 34},
+                          {"joint": "C", "coord": "x", "lower": 4, "upper": 12}]}
+    c0 = case_from_dict(data, "<test>")
+    assert start_vector(c0)[0] == pytest.approx(np.hypot(16, 24))     # |KL| of the file
+    data["targets"] = targets_of(c0, [30.0, 9.0])
+    case = case_from_dict(data, "<test>")
+    newton = dataclasses.replace(case, method="newton")
+    newton._reference = case._reference
+    a, b = evaluate_design(case, [29.0, 8.0]), evaluate_design(newton, [29.0, 8.0])
+    assert (a.method, b.method) == ("assur", "newton")
+    assert b.error == pytest.approx(a.error, rel=1e-8)
+    res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
+    assert res.error < 1e-12
+    assert res.design["S.length"] == pytest.approx(30.0, abs=1e-5)
+    # the written design keeps the VLL, drawn at the synthesised length
+    S = next(j for j in res.mechanism["joints"] if j["id"] == "S")
+    K = next(j for j in res.mechanism["joints"] if j["id"] == "K")
+    assert np.hypot(*np.subtract(S["point"], K["point"])) == pytest.approx(res.design["S.length"])
+    assert S["vll"] == "locked"

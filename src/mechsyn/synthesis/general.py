@@ -556,6 +556,8 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     start_f = best_f
     errs, stopped, done = [], False, 0
     width = prob.upper - prob.lower
+    # an exact fit (f <= 1e-20 N L^2, L the case's length scale) ends the global search
+    f_atol = float(opts.pop("f_atol", 1e-26 * prob.penalty_base))
 
     for r, s in enumerate(restart_seeds(seed, restarts)):
         if r and time.monotonic() > deadline - 0.1 * time_limit:
@@ -566,7 +568,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         def should_stop(f: float, r: int = r) -> bool:
             if progress is not None:
                 progress(r, restarts, min(best_f, f))
-            return time.monotonic() >= search_end
+            return time.monotonic() >= search_end or f <= f_atol
 
         g = OPTIMIZERS[optimizer](prob.fitness, prob.lower, prob.upper, seed=s, should_stop=should_stop,
                                   options=opts)
@@ -641,6 +643,6 @@ def synthesis_figure(case: MechanismCase, res: MechanismSynthesisResult) -> Any:
     ax.set_aspect("equal")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    ax.set_title(f"{case.name}: {case.problem} synthesis, error {res.error:.4g}", fontsize=10)
+    ax.set_title(f"{case.name} ({case.problem} generation): error {res.error:.4g}", fontsize=10)
     fig.tight_layout()
     return fig
