@@ -208,6 +208,8 @@ def test_cli_writes_file_that_simulate_reproduces(tmp_path, capsys):
     sim = json.loads(capsys.readouterr().out)
     P = np.array(sim["points"]["M"]["position"])
     assert np.sum((P - np.array(T)) ** 2) == pytest.approx(data["error"], rel=1e-9)
+    assert main(["analyze", str(out), "--json"]) == 0            # the other tools read it
+    assert json.loads(capsys.readouterr().out)["formulas"]["chebyshev"]["value"] == 1
 
 
 def test_cli_table_on_sixbar_example(capsys):
