@@ -272,3 +272,16 @@ def test_vll_length_variable_on_paper_000_finger():
     K = next(j for j in res.mechanism["joints"] if j["id"] == "K")
     assert np.hypot(*np.subtract(S["point"], K["point"])) == pytest.approx(res.design["S.length"])
     assert S["vll"] == "locked"
+
+
+def test_cli_reports_infeasible_case_and_writes_nothing(tmp_path, capsys):
+    f = tmp_path / "case.yaml"      # a full turn of the triple rocker: no design within the bounds moves so
+    f.write_text(yaml.safe_dump({"mechanism": str(FOURBAR), "input": {"joint": "A", "values_deg": [60, 420]},
+                                 "point": "M", "targets": [[0, 0], [0, 0]],
+                                 "variables": [{"point": "M", "coord": "y", "lower": 3.5, "upper": 4.5}]}))
+    assert main(["synth", "mechanism", str(f), "--time-limit", "5", "--restarts", "1", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["feasible"] is False and data["error"] is None and "not assembled" in data["reason"]
+    out = tmp_path / "x.yaml"
+    assert main(["synth", "mechanism", str(f), "--time-limit", "5", "--restarts", "1", "--out", str(out)]) == 2
+    assert not out.exists() and "no feasible design" in capsys.readouterr().err

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Optional
 
-import numpy as np
 import typer
 from rich.table import Table
 
@@ -86,5 +85,5 @@ def synth_mechanism(
     console.print(f"feasible: {res.feasible}   evaluation: {res.method}   {res.restarts} restarts, "
                   f"{res.nfev} evaluations, {res.seconds:.1f} s"
                   + ("   (time limit reached)" if res.stopped_by_time_limit else ""))
-    if not np.isfinite(res.error):
-        raise typer.Exit(1)
+    if not res.feasible:
+        console.print(f"[bold red]no feasible design found[/]: {res.reason}")

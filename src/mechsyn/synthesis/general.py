@@ -522,12 +522,13 @@ class MechanismSynthesisResult:
     mechanism: dict = field(repr=False, default_factory=dict)
     restart_errors: list[float] = field(default_factory=list)
     stopped_by_time_limit: bool = False
+    reason: str = ""                   # why the best design is infeasible ("" when feasible)
 
     def to_dict(self) -> dict[str, Any]:
         out = {k: getattr(self, k) for k in (
             "case", "problem", "error", "design", "start_design", "start_error", "feasible",
             "assembled_at_all_targets", "method", "seconds", "seed", "restarts", "nfev", "inputs_deg",
-            "targets", "achieved", "restart_errors", "stopped_by_time_limit")}
+            "targets", "achieved", "restart_errors", "stopped_by_time_limit", "reason")}
         if self.problem == "motion":
             out["achieved_angles_deg"] = self.achieved_angles_deg
             out["target_angles_deg"] = self.target_angles_deg
@@ -609,7 +610,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         achieved=ev.achieved if ok else np.full((N, 2), np.nan),
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,
-        stopped_by_time_limit=stopped)
+        stopped_by_time_limit=stopped, reason=ev.reason)
 
 
 def synthesis_figure(case: MechanismCase, res: MechanismSynthesisResult) -> Any:
