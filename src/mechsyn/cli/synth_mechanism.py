@@ -1,0 +1,89 @@
+"""``mechsyn synth mechanism CASE``: path / motion synthesis of any planar mechanism file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich.table import Table
+
+from mechsyn.cli.app import synth_app
+from mechsyn.cli.common import console, emit_json, err_console
+from mechsyn.errors import MechsynInputError
+
+
+@synth_app.command("mechanism")
+def synth_mechanism(
+    case_file: Path = typer.Argument(..., help="Case YAML/JSON: mechanism file, input values, targets or poses, variables."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the reproducible multi-start."),
+    time_limit: float = typer.Option(30.0, "--time-limit", help="Wall-clock budget in seconds."),
+    restarts: int = typer.Option(3, "--restarts", help="Number of restarts (child seeds of --seed)."),
+    optimizer: str = typer.Option("de", "--optimizer", help="Global optimiser (de | random | registered)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
+    plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
+    out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+) -> None:
+    """Move chosen joint / point coordinates and VLL lengths of a planar mechanism file so
+    a point follows target positions (or a link target poses) at given input angles."""
+    from mechsyn.synthesis.general import load_case, synthesis_figure, synthesize_mechanism
+
+    if not time_limit > 0:
+        raise MechsynInputError("must be positive", source="--time-limit")
+    if restarts < 1:
+        raise MechsynInputError("must be at least 1", source="--restarts")
+    if plot is not None and plot.suffix.lower() != ".png":
+        raise MechsynInputError(f"{plot}: expected a .png file", source="--plot")
+    if out is not None and out.suffix.lower() not in (".yaml", ".yml", ".json"):
+        raise MechsynInputError(f"{out}: expected a .yaml or .json file", source="--out")
+    case = load_case(case_file)
+    if err_console.is_terminal and not as_json:
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+        with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} restarts"),
+                      TextColumn("best {task.fields[best]}"), TimeElapsedColumn(),
+                      console=err_console, transient=True) as prog:
+            task = prog.add_task("synth mechanism", total=restarts, best="-")
+
+            def progress(done: int, total: int, best: float) -> None:
+                prog.update(task, completed=done, best=f"{best:.6g}")
+
+            res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,
+                                       optimizer=optimizer, progress=progress)
+    else:
+        res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer)
+    if (out is not None or plot is not None) and not res.feasible:
+        raise MechsynInputError("no feasible design found; nothing written", source=str(case_file),
+                                hint="raise --time-limit or --restarts, or widen the variable bounds")
+    if out is not None:
+        from mechsyn.io import write_mechanism
+
+        write_mechanism(res.mechanism, out)
+    if plot is not None:
+        import matplotlib.pyplot as plt
+
+        from mechsyn.results import save_figure_atomic
+
+        fig = synthesis_figure(case, res)
+        try:
+            save_figure_atomic(fig, plot, dpi=120)
+        finally:
+            plt.close(fig)
+    if as_json:
+        emit_json(res)
+        return
+    t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}")
+    t.add_column("variable")
+    t.add_column("start", justify="right")
+    t.add_column("design", justify="right")
+    for k, v in res.design.items():
+        t.add_row(k, f"{res.start_design[k]:.6g}", f"{v:.8g}")
+    console.print(t)
+    se = "infeasible" if res.start_error is None else f"{res.start_error:.6g}"
+    console.print(f"error ({'sum of squared distances' if case.problem == 'path' else 'pose error'}): "
+                  f"[bold]{res.error:.8g}[/]   (start design: {se})")
+    console.print(f"feasible: {res.feasible}   evaluation: {res.method}   {res.restarts} restarts, "
+                  f"{res.nfev} evaluations, {res.seconds:.1f} s"
+                  + ("   (time limit reached)" if res.stopped_by_time_limit else ""))
+    if not res.feasible:
+        console.print(f"[bold red]no feasible design found[/]: {res.reason}")

@@ -1,0 +1,650 @@
+"""Dimensional synthesis of any planar mechanism file (path and motion generation).
+
+The design is the file's drawn (assembled) configuration; the user picks which of its
+coordinates move (:class:`DesignVariable`): a joint point's x or y, a named point's x or
+y, or a variable-length link's (VLL's) length. Moving a joint point changes the lengths of
+the links it joins (the drawing stays an assembled configuration, since a joint point is
+shared by its two links).
+
+Objective, evaluated by the kinematics engine (:mod:`mechsyn.kinematics`):
+
+* path generation: ``f = sum_i |P(u_i) - Pd_i|^2`` (sum of squared distances of the
+  named point ``P`` at the input values ``u_i`` to the targets ``Pd_i``);
+* motion generation: ``f = sum_i |O(u_i) - Od_i|^2 + (w (phi(u_i) - phid_i))^2`` with
+  ``O`` the link's reference point (its first joint, file order, or ``point:``), ``phi``
+  the absolute angle of the link's reference line (as ``mechsyn simulate`` reports it),
+  the angle difference wrapped to (-pi, pi], and ``w`` = ``angle_weight`` (length per
+  radian; default 1).
+
+Constraints that hold (feasibility first, never a real-part trick): the mechanism
+assembles at every point of a dense input sweep (steps of at most ``step_deg``) from the
+drawn input value through every target input in order, so it moves continuously on the
+branch of the drawn assembly between consecutive targets; the closed-form dyads keep the
+assembly mode (sign) of the starting design's drawing; free timing keeps the input angles
+monotonic in the order given; variable bounds. An infeasible design scores
+``U + violation`` (``violation >= 1``), where ``U`` caps the score of every feasible
+design, so it is never rewarded.
+
+Evaluation: mechanisms that decompose into a driver and Assur dyads (RRR, RRP, RPR, ...)
+use the engine's vectorised closed form (:func:`mechsyn.kinematics.dyads.solve_positions`)
+for the whole sweep at once; others the engine's Newton continuation
+(:func:`mechsyn.kinematics.solve.sweep`). Optimiser: :mod:`mechsyn.synthesis.optimize`
+(its pluggable ``OPTIMIZERS``, reproducible restart seeds and least-squares ``polish``).
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+
+__all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
+           "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
+           "synthesize_mechanism", "synthesis_figure", "start_vector"]
+
+
+@dataclass(frozen=True)
+class DesignVariable:
+    """One coordinate of the drawn configuration: ``kind`` is ``joint`` / ``point`` (x or
+    y: ``coord`` 0 / 1) or ``length`` (a VLL's length, ``coord`` None)."""
+
+    kind: str
+    target: str
+    coord: int | None
+    lower: float
+    upper: float
+
+    @property
+    def name(self) -> str:
+        return f"{self.target}.length" if self.kind == "length" else f"{self.target}.{'xy'[self.coord]}"
+
+
+@dataclass
+class MechanismCase:
+    source: str
+    mechanism_path: str
+    mech_dict: dict
+    input_joint: str
+    values_deg: np.ndarray
+    variables: list[DesignVariable]
+    problem: str                       # "path" | "motion"
+    targets: np.ndarray                # (N, 2) positions
+    point: str | None = None
+    link: str | None = None
+    angles_deg: np.ndarray | None = None   # motion: (N,)
+    angle_weight: float = 1.0
+    free: bool = False
+    range_deg: tuple[float, float] | None = None
+    step_deg: float = 2.0
+    name: str = "mechanism synthesis"
+    method: str = "auto"                   # "auto" (closed form when it decomposes) | "newton"
+
+    @property
+    def n_targets(self) -> int:
+        return len(self.values_deg)
+
+    @property
+    def n_design(self) -> int:
+        return len(self.variables)
+
+    @property
+    def lower(self) -> np.ndarray:
+        lo = [v.lower for v in self.variables]
+        if self.free:
+            lo += [self.range_deg[0]] * self.n_targets
+        return np.array(lo, float)
+
+    @property
+    def upper(self) -> np.ndarray:
+        hi = [v.upper for v in self.variables]
+        if self.free:
+            hi += [self.range_deg[1]] * self.n_targets
+        return np.array(hi, float)
+
+    @property
+    def names(self) -> list[str]:
+        return [v.name for v in self.variables] + (
+            [f"{self.input_joint}_{i + 1}" for i in range(self.n_targets)] if self.free else [])
+
+
+def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None) -> MechsynInputError:
+    return MechsynInputError(msg, source=source, field=fld, hint=hint)
+
+
+def load_case(path: str | Path) -> MechanismCase:
+    """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism")."""
+    import yaml
+
+    p = Path(path)
+    if not p.is_file():
+        raise _err(f"no such file: {p}", str(p))
+    try:
+        data = yaml.safe_load(p.read_text())
+    except yaml.YAMLError as exc:
+        raise _err(f"not valid YAML/JSON: {exc}", str(p)) from None
+    return case_from_dict(data, source=str(p), base_dir=p.parent)
+
+
+def _floats(v: Any, src: str, fld: str, n: int | None = None) -> np.ndarray:
+    try:
+        a = np.asarray(v, float)
+    except (TypeError, ValueError):
+        raise _err(f"{fld} must be numbers", src, fld) from None
+    if not np.all(np.isfinite(a)) or (n is not None and a.shape[-1:] != (n,)):
+        raise _err(f"{fld} must be finite numbers" + (f", {n} per entry" if n else ""), src, fld)
+    return a
+
+
+def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
+    """Validate a case mapping; the mechanism file path is relative to ``base_dir``."""
+    from mechsyn.io import load_mechanism, mechanism_to_dict
+
+    src = source
+    if not isinstance(data, dict):
+        raise _err("the case must be a mapping", src)
+    known = {"name", "mechanism", "input", "point", "targets", "link", "poses", "variables",
+             "angle_weight", "step_deg", "method"}
+    extra = sorted(set(data) - known)
+    if extra:
+        raise _err(f"unknown key(s): {', '.join(extra)}", src, extra[0], hint="keys: " + ", ".join(sorted(known)))
+    if "mechanism" not in data:
+        raise _err("missing `mechanism:` (path to a planar mechanism file)", src, "mechanism")
+    mpath = Path(str(data["mechanism"]))
+    if not mpath.is_absolute() and base_dir is not None:
+        mpath = base_dir / mpath
+    mech = load_mechanism(mpath)
+    if mech.kind != "planar":
+        raise _err(f"{mpath}: a planar mechanism is needed", src, "mechanism")
+    md = mechanism_to_dict(mech)
+    inp = data.get("input")
+    if not isinstance(inp, dict) or "joint" not in inp or "values_deg" not in inp:
+        raise _err("`input:` needs `joint` and `values_deg`", src, "input",
+                   hint="input: {joint: A, values_deg: [0, 30, 60]}")
+    jid = str(inp["joint"])
+    try:
+        j = mech.joint(jid)
+    except KeyError:
+        raise _err(f"no joint {jid!r} in the mechanism", src, "input.joint") from None
+    if j.type != "R" or not j.actuated:
+        raise _err(f"input joint {jid} must be an actuated R pair", src, "input.joint",
+                   hint="mark it `actuated: true` in the mechanism file")
+    values = _floats(inp["values_deg"], src, "input.values_deg").ravel()
+    if len(values) < 1:
+        raise _err("input.values_deg is empty", src, "input.values_deg")
+    free = bool(inp.get("free", False))
+    rng = None
+    if free:
+        r = _floats(inp.get("range_deg", [float(values.min()), float(values.max())]), src, "input.range_deg")
+        if r.shape != (2,) or not r[0] < r[1]:
+            raise _err("input.range_deg must be [lower, upper] with lower < upper", src, "input.range_deg")
+        rng = (float(r[0]), float(r[1]))
+    step = float(data.get("step_deg", 2.0))
+    if not step > 0:
+        raise _err("step_deg must be positive", src, "step_deg")
+    method = str(data.get("method", "auto"))
+    if method not in ("auto", "newton"):
+        raise _err("method must be auto or newton", src, "method")
+    if ("point" in data or "targets" in data) == ("link" in data or "poses" in data):
+        raise _err("give either `point` + `targets` (path) or `link` + `poses` (motion)", src,
+                   hint="path: point: P, targets: [[x, y], ...]")
+    names_pts = set(md.get("points") or {})
+    joint_ids = {x["id"] for x in md["joints"]}
+    link_names = {(e if isinstance(e, str) else e["name"]) for e in md["links"]}
+    kw: dict[str, Any] = {}
+    if "point" in data:
+        pt = str(data.get("point"))
+        if pt not in names_pts and pt not in joint_ids:
+            raise _err(f"no point or joint {pt!r} in the mechanism", src, "point",
+                       hint="points: " + ", ".join(sorted(names_pts) or ["(none)"]))
+        T = _floats(data.get("targets"), src, "targets", 2)
+        if T.ndim != 2:
+            raise _err("targets must be [[x, y], ...]", src, "targets")
+        kw.update(problem="path", point=pt, targets=T)
+    else:
+        lk = str(data.get("link"))
+        if lk not in link_names or lk == md["ground"]:
+            raise _err(f"no moving link {lk!r} in the mechanism", src, "link")
+        P = _floats(data.get("poses"), src, "poses", 3)
+        if P.ndim != 2:
+            raise _err("poses must be [[x, y, angle_deg], ...]", src, "poses")
+        pt = data.get("point")
+        kw.update(problem="motion", link=lk, targets=P[:, :2], angles_deg=P[:, 2], point=None)
+        w = float(data.get("angle_weight", 1.0))
+        if not w >= 0:
+            raise _err("angle_weight must be >= 0", src, "angle_weight")
+        kw["angle_weight"] = w
+    if len(kw["targets"]) != len(values):
+        raise _err(f"{len(values)} input values but {len(kw['targets'])} targets", src, "input.values_deg",
+                   hint="one input value per target (the start values with free: true)")
+    vs = data.get("variables")
+    if not isinstance(vs, list) or not vs:
+        raise _err("`variables:` must be a non-empty list", src, "variables",
+                   hint="- {joint: B, coord: x, lower: 0, upper: 2}")
+    variables = []
+    for k, v in enumerate(vs):
+        f = f"variables[{k}]"
+        if not isinstance(v, dict) or "lower" not in v or "upper" not in v:
+            raise _err("a variable needs `lower` and `upper`", src, f)
+        lo, hi = float(v["lower"]), float(v["upper"])
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise _err("a variable needs finite bounds with lower < upper", src, f)
+        if "point" in v:
+            kind, tgt = "point", str(v["point"])
+            if tgt not in names_pts:
+                raise _err(f"no point {tgt!r} in the mechanism", src, f)
+        elif "joint" in v:
+            tgt = str(v["joint"])
+            if tgt not in joint_ids:
+                raise _err(f"no joint {tgt!r} in the mechanism", src, f)
+            kind = "length" if v.get("length") else "joint"
+            jj = next(x for x in md["joints"] if x["id"] == tgt)
+            if kind == "length" and not jj.get("vll"):
+                raise _err(f"joint {tgt} is not a variable-length link (vll)", src, f,
+                           hint="`length: true` needs a P pair with `vll:`")
+            if kind == "joint" and jj.get("point") is None:
+                raise _err(f"joint {tgt} has no point", src, f)
+        else:
+            raise _err("a variable names a `joint` or a `point`", src, f)
+        coord = None
+        if kind != "length":
+            c = str(v.get("coord", ""))
+            if c not in ("x", "y"):
+                raise _err("coord must be x or y", src, f)
+            coord = "xy".index(c)
+        variables.append(DesignVariable(kind, tgt, coord, lo, hi))
+    if len({x.name for x in variables}) != len(variables):
+        raise _err("a coordinate is listed twice in variables", src, "variables")
+    case = MechanismCase(source=src, mechanism_path=str(mpath), mech_dict=md, input_joint=jid,
+                         values_deg=values, variables=variables, free=free, range_deg=rng, step_deg=step,
+                         name=str(data.get("name", mech.name)), method=method, **kw)
+    case._reference = _reference_branch(case)  # type: ignore[attr-defined]
+    return case
+
+
+# --------------------------------------------------------------------------- designs
+def start_vector(case: MechanismCase) -> np.ndarray:
+    """The file's geometry as a design vector (the starting design)."""
+    md = case.mech_dict
+    joints = {j["id"]: j for j in md["joints"]}
+    x = []
+    for v in case.variables:
+        if v.kind == "joint":
+            x.append(float(joints[v.target]["point"][v.coord]))
+        elif v.kind == "point":
+            x.append(float(md["points"][v.target]["at"][v.coord]))
+        else:
+            from mechsyn.synthesis.finger_design import _vll_ends
+
+            _c, _L, K, _p = _vll_ends(md, v.target, case.source)
+            x.append(float(np.linalg.norm(np.subtract(joints[v.target]["point"], joints[K]["point"]))))
+    if case.free:
+        x += list(case.values_deg)
+    return np.array(x, float)
+
+
+def apply_design(case: MechanismCase, x: np.ndarray) -> dict:
+    """The mechanism dict of design vector ``x`` (design part; timing values ignored).
+    A VLL's length moves its piston pivot along the cylinder's direction (paper 000's
+    drawing, as in :func:`mechsyn.synthesis.finger_design.apply_design`)."""
+    d = copy.deepcopy(case.mech_dict)
+    joints = {j["id"]: j for j in d["joints"]}
+    for v, val in zip(case.variables, np.asarray(x, float)):
+        if v.kind == "joint":
+            joints[v.target]["point"][v.coord] = float(val)
+        elif v.kind == "point":
+            d["points"][v.target]["at"][v.coord] = float(val)
+    for v, val in zip(case.variables, np.asarray(x, float)):
+        if v.kind == "length":
+            from mechsyn.synthesis.finger_design import _vll_ends
+
+            _c, L, K, _p = _vll_ends(d, v.target, case.source)
+            pk = np.asarray(joints[K]["point"], float)
+            u = np.asarray(joints[v.target]["point"], float) - pk
+            u = u / np.linalg.norm(u)
+            p = (pk + float(val) * u).tolist()
+            joints[v.target]["point"] = p
+            joints[v.target]["axis"] = u.tolist()
+            joints[L]["point"] = p
+    return d
+
+
+def _sweep_grid(u0_deg: float, values: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Dense input grid from the drawn value ``u0_deg`` (shifted by whole turns to the one
+    nearest ``values[0]``) through every value in order; returns (grid, target indices)."""
+    u0 = u0_deg + 360.0 * np.round((values[0] - u0_deg) / 360.0)
+    knots = np.concatenate([[u0], values])
+    parts, idx, n = [np.array([u0])], [], 1
+    for a, b in zip(knots[:-1], knots[1:]):
+        m = max(1, int(np.ceil(abs(b - a) / step)))
+        parts.append(np.linspace(a, b, m + 1)[1:])
+        n += m
+        idx.append(n - 1)
+    return np.concatenate(parts), np.array(idx)
+
+
+@dataclass
+class MechanismEvaluation:
+    """One design: feasibility, error and the achieved path / angles at the targets."""
+
+    feasible: bool
+    reason: str
+    error: float = np.inf
+    violation: float = 0.0
+    achieved: np.ndarray | None = None         # (N, 2)
+    achieved_angles_deg: np.ndarray | None = None
+    path: np.ndarray | None = None             # dense sweep path of the point
+    inputs_deg: np.ndarray | None = None       # the target inputs used
+    method: str = ""
+    sigmas: list[float] | None = None
+
+
+def _build(case: MechanismCase, x: np.ndarray) -> tuple[Any, Any, Any, dict]:
+    from mechsyn.io import mechanism_from_dict
+    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics.system import build_system
+
+    d = apply_design(case, x)
+    ev_d = d
+    if any(j.get("vll") == "locked" for j in d["joints"]):
+        from mechsyn.synthesis.finger_design import locked_model
+
+        ev_d = locked_model(d, [j["id"] for j in d["joints"] if j.get("vll") == "locked"], case.source)
+    mech = mechanism_from_dict(ev_d, source=case.source)
+    S = build_system(mech)
+    return mech, S, dyads.decompose(S), d
+
+
+def _reference_branch(case: MechanismCase) -> list[float] | None:
+    """Assembly modes (one sign per closed-form dyad) of the file's own drawing."""
+    from mechsyn.kinematics import dyads
+
+    _m, S, plan, _d = _build(case, start_vector(case))
+    if plan is None:
+        return None
+    k = S.driver_index(case.input_joint)
+    U = np.array([[dr.assembled for dr in S.drivers]], float)
+    U[0, k] = S.drivers[k].assembled
+    with np.errstate(invalid="ignore", divide="ignore"):
+        _q, sig = dyads.solve_positions(S, plan, U)
+    return [float(s) for s in sig]
+
+
+def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
+    """Sweep design ``x`` with the engine and compute the case's objective."""
+    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics.analysis import resolve_points
+    from mechsyn.kinematics.solve import sweep
+
+    x = np.asarray(x, float)
+    nd = case.n_design
+    values = x[nd:] if case.free else case.values_deg
+    viol_order = 0.0
+    if case.free and len(values) > 1:
+        dv = np.diff(values)
+        sgn = 1.0 if values[-1] >= values[0] else -1.0
+        viol_order = float(np.sum(np.maximum(0.0, -sgn * dv)))
+    try:
+        mech, S, plan, d = _build(case, x[:nd])
+    except (MechsynInputError, ValueError, KeyError, ZeroDivisionError, np.linalg.LinAlgError) as exc:
+        return MechanismEvaluation(False, f"cannot build: {exc}", violation=1e3)
+    k = S.driver_index(case.input_joint)
+    grid, idx = _sweep_grid(float(np.degrees(S.drivers[k].assembled)), values, case.step_deg)
+    U = np.tile([dr.assembled for dr in S.drivers], (len(grid), 1)).astype(float)
+    U[:, k] = np.radians(grid)
+    ref = getattr(case, "_reference", None)
+    if plan is not None and case.method != "newton":
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            q, sig = dyads.solve_positions(S, plan, U)
+        ok = np.all(np.isfinite(q), axis=1)
+        method = "assur"
+        branch_viol = 0.0 if ref is None or len(ref) != len(sig) else \
+            float(sum(1 for a, b in zip(sig, ref) if np.sign(a) != np.sign(b)))
+    else:
+        try:
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                sw = sweep(S, U, refine_limits=False)
+        except (MechsynInputError, ValueError, np.linalg.LinAlgError) as exc:
+            return MechanismEvaluation(False, f"cannot sweep: {exc}", violation=1e3)
+        q, ok, method, sig = sw.q, sw.assembled, "newton", None
+        branch_viol = float(sum(1 for e in sw.events if e.get("kind") in ("branch point", "singular")))
+    n_bad = int((~ok).sum())
+    viol = n_bad / len(grid) + branch_viol + viol_order
+    if viol > 0:
+        why = []
+        if n_bad:
+            why.append(f"not assembled at {n_bad} of {len(grid)} inputs of the sweep")
+        if branch_viol:
+            why.append("off the file's assembly branch")
+        if viol_order:
+            why.append("input angles out of order")
+        return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
+    qt = q[idx]
+    if case.problem == "path":
+        link, at = resolve_points(mech, [case.point])[case.point]
+        s = S.to_local(link, at)
+        i = S.index(link)
+        P = S.point(qt, i, s)
+        path = S.point(q, i, s)
+        err = float(np.sum((P - case.targets) ** 2))
+        return MechanismEvaluation(True, "", err, achieved=P, path=path, inputs_deg=np.asarray(values, float),
+                                   method=method, sigmas=sig)
+    i = S.index(case.link)
+    s = S.to_local(case.link, S.origin0[i])
+    P = S.point(qt, i, s)
+    phi = S.link_angle(qt, case.link)
+    dphi = np.angle(np.exp(1j * (phi - np.radians(case.angles_deg))))
+    err = float(np.sum((P - case.targets) ** 2) + np.sum((case.angle_weight * dphi) ** 2))
+    return MechanismEvaluation(True, "", err, achieved=P, achieved_angles_deg=np.degrees(phi),
+                               path=S.point(q, i, s), inputs_deg=np.asarray(values, float), method=method,
+                               sigmas=sig)
+
+
+class MechanismProblem:
+    """Feasibility-first fitness over populations, and least-squares residuals, in the
+    interface :func:`mechsyn.synthesis.optimize.polish` expects."""
+
+    def __init__(self, case: MechanismCase) -> None:
+        self.case = case
+        self.lower, self.upper = case.lower, case.upper
+        pts = [case.targets]
+        for j in case.mech_dict["joints"]:
+            if j.get("point") is not None:
+                pts.append(np.atleast_2d(j["point"]))
+        span = np.ptp(np.vstack(pts), axis=0)
+        ext = float(np.hypot(*span)) + float(np.max(np.abs(self.upper - self.lower)))
+        w = case.angle_weight * 2 * np.pi if case.problem == "motion" else 0.0
+        # U: feasible scores are capped at U, infeasible ones are U + violation (>= 1)
+        self.penalty_base = 1e6 * case.n_targets * (max(1.0, ext) ** 2 + w ** 2)
+        self.n_evaluations = 0   # designs swept
+
+    def evaluate(self, Z: np.ndarray) -> list[MechanismEvaluation]:
+        self.n_evaluations += len(np.atleast_2d(Z))
+        return _EvalList([evaluate_design(self.case, z) for z in np.atleast_2d(Z)])
+
+    def score(self, ev: MechanismEvaluation) -> float:
+        if ev.feasible and np.isfinite(ev.error):
+            return min(ev.error, self.penalty_base)
+        return self.penalty_base + max(1.0, ev.violation)
+
+    def fitness(self, Z: np.ndarray) -> np.ndarray:
+        return np.array([self.score(e) for e in self.evaluate(Z)])
+
+    def residuals(self, z: np.ndarray) -> np.ndarray:
+        c = self.case
+        self.n_evaluations += 1
+        ev = evaluate_design(c, z)
+        n = 2 * c.n_targets + (c.n_targets if c.problem == "motion" else 0)
+        if not ev.feasible:
+            return np.full(n, np.sqrt(self.penalty_base / n) * (1.0 + ev.violation))
+        r = [(ev.achieved - c.targets).ravel()]
+        if c.problem == "motion":
+            dphi = np.angle(np.exp(1j * np.radians(ev.achieved_angles_deg - c.angles_deg)))
+            r.append(c.angle_weight * dphi)
+        return np.concatenate(r)
+
+
+class _EvalList(list):
+    @property
+    def feasible(self) -> np.ndarray:
+        return np.array([e.feasible for e in self])
+
+
+@dataclass
+class MechanismSynthesisResult:
+    """Outcome of :func:`synthesize_mechanism`; ``to_dict`` gives the CLI JSON."""
+
+    case: str
+    problem: str
+    error: float
+    design: dict[str, float]
+    start_design: dict[str, float]
+    start_error: float | None
+    feasible: bool
+    assembled_at_all_targets: bool
+    method: str
+    seconds: float
+    seed: int
+    restarts: int
+    nfev: int
+    inputs_deg: np.ndarray
+    targets: np.ndarray
+    achieved: np.ndarray
+    achieved_angles_deg: np.ndarray | None
+    target_angles_deg: np.ndarray | None
+    path: np.ndarray
+    mechanism: dict = field(repr=False, default_factory=dict)
+    restart_errors: list[float] = field(default_factory=list)
+    stopped_by_time_limit: bool = False
+    reason: str = ""                   # why the best design is infeasible ("" when feasible)
+
+    def to_dict(self) -> dict[str, Any]:
+        out = {k: getattr(self, k) for k in (
+            "case", "problem", "error", "design", "start_design", "start_error", "feasible",
+            "assembled_at_all_targets", "method", "seconds", "seed", "restarts", "nfev", "inputs_deg",
+            "targets", "achieved", "restart_errors", "stopped_by_time_limit", "reason")}
+        if self.problem == "motion":
+            out["achieved_angles_deg"] = self.achieved_angles_deg
+            out["target_angles_deg"] = self.target_angles_deg
+        return out
+
+
+def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 3,
+                         optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
+                         progress: Callable[[int, int, float], None] | None = None) -> MechanismSynthesisResult:
+    """Optimise the case: per restart (child seeds of ``seed``, as in
+    :func:`mechsyn.synthesis.optimize.restart_seeds`) the registered global optimiser on
+    the feasibility-first fitness, then a least-squares polish of the best few members
+    (:func:`mechsyn.synthesis.optimize.polish`); the file's own design competes too."""
+    from mechsyn.synthesis.optimize import OPTIMIZERS, polish, restart_seeds
+
+    if optimizer not in OPTIMIZERS:
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+                                hint="one of " + ", ".join(sorted(OPTIMIZERS)))
+    t0 = time.monotonic()
+    deadline = t0 + time_limit
+    opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
+    opts.update(options or {})
+    prob = MechanismProblem(case)
+    x0 = np.clip(start_vector(case), prob.lower, prob.upper)
+    best_z, best_f = x0, float(prob.fitness(x0[None, :])[0])
+    start_f = best_f
+    errs, stopped, done = [], False, 0
+    width = prob.upper - prob.lower
+    # a near-exact fit (f <= 1e-12 N L^2, L the case's length scale) ends the global search;
+    # the least-squares polish then finishes it
+    f_atol = float(opts.pop("f_atol", 1e-18 * prob.penalty_base))
+
+    for r, s in enumerate(restart_seeds(seed, restarts)):
+        if r and time.monotonic() > deadline - 0.1 * time_limit:
+            stopped = True
+            break
+        search_end = t0 + time_limit * (0.85 * (r + 1) / restarts)
+
+        def should_stop(f: float, r: int = r) -> bool:
+            if progress is not None:
+                progress(r, restarts, min(best_f, f))
+            return time.monotonic() >= search_end or f <= f_atol
+
+        g = OPTIMIZERS[optimizer](prob.fitness, prob.lower, prob.upper, seed=s, should_stop=should_stop,
+                                  options=opts)
+        cands = [np.asarray(g.x, float)]
+        if g.population is not None and g.population_fun is not None:
+            for i in np.argsort(g.population_fun):
+                z = np.asarray(g.population[i], float)
+                if len(cands) >= n_polish:
+                    break
+                if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
+                    cands.append(z)
+        rbest = np.inf
+        for c in cands:
+            if time.monotonic() < deadline:
+                c = polish(prob, c)
+            f = float(prob.fitness(c[None, :])[0])
+            rbest = min(rbest, f)
+            if f < best_f:
+                best_z, best_f = c, f
+        errs.append(rbest if rbest < prob.penalty_base else float("inf"))
+        done += 1
+        if progress is not None:
+            progress(done, restarts, best_f)
+    ev = evaluate_design(case, best_z)
+    names = case.names
+    design = {n: float(v) for n, v in zip(names, best_z)}
+    d = apply_design(case, best_z[:case.n_design])
+    d["name"] = f"{d.get('name', 'mechanism')} (synthesised, seed {seed})"
+    ok = bool(ev.feasible)
+    N = case.n_targets
+    return MechanismSynthesisResult(
+        case=case.name, problem=case.problem, error=ev.error if ok else float("inf"), design=design,
+        start_design={n: float(v) for n, v in zip(names, start_vector(case))},
+        start_error=start_f if start_f < prob.penalty_base else None, feasible=ok,
+        assembled_at_all_targets=ok, method=ev.method, seconds=time.monotonic() - t0, seed=seed,
+        restarts=done, nfev=prob.n_evaluations, inputs_deg=ev.inputs_deg if ok else case.values_deg, targets=case.targets,
+        achieved=ev.achieved if ok else np.full((N, 2), np.nan),
+        achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
+        path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,
+        stopped_by_time_limit=stopped, reason=ev.reason)
+
+
+def synthesis_figure(case: MechanismCase, res: MechanismSynthesisResult) -> Any:
+    """Targets against the achieved points and the swept path, with the design drawn at
+    its file configuration."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 6))
+    if len(res.path):
+        ax.plot(res.path[:, 0], res.path[:, 1], "-", color="0.6", lw=1, label="swept path")
+    ax.plot(res.targets[:, 0], res.targets[:, 1], "o", mfc="none", mec="C3", ms=9, label="targets")
+    ax.plot(res.achieved[:, 0], res.achieved[:, 1], "x", color="C0", ms=8, label="achieved")
+    for t, a in zip(res.targets, res.achieved):
+        ax.plot([t[0], a[0]], [t[1], a[1]], "-", color="C3", lw=0.8)
+    pts = {j["id"]: j["point"] for j in res.mechanism["joints"] if j.get("point") is not None}
+    by_link: dict[str, list] = {}
+    for j in res.mechanism["joints"]:
+        if j.get("point") is None:
+            continue
+        for lk in j["links"]:
+            by_link.setdefault(lk, []).append(pts[j["id"]])
+    for lk, ps in by_link.items():
+        if lk == res.mechanism["ground"] or len(ps) < 2:
+            continue
+        P = np.array(ps + [ps[0]] if len(ps) > 2 else ps)
+        ax.plot(P[:, 0], P[:, 1], "-", color="k", lw=1.4, alpha=0.7)
+    J = np.array(list(pts.values()))
+    ax.plot(J[:, 0], J[:, 1], "o", color="k", ms=4, label="design (file configuration)")
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(f"{case.name} ({case.problem} generation): error {res.error:.4g}", fontsize=10)
+    fig.tight_layout()
+    return fig
