@@ -52,6 +52,13 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
     return values
 
 
+def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
+                        what: str | None = None) -> None:
+    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work)."""
+    if path is not None and path.suffix.lower() not in suffixes:
+        raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
+
+
 def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:
     """Parse ``START:STOP:STEP`` (all three numbers) naming ``option`` on error.
 

@@ -13,7 +13,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, parse_range, progress_bar
+from mechsyn.cli.common import check_output_suffix, console, emit_json, parse_range, progress_bar
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 from mechsyn.results import to_jsonable, write_atomic
@@ -75,11 +75,6 @@ def _parse_pairs(items: list[str] | None, option: str, number: bool) -> dict[str
     return out
 
 
-def _check_out(path: Path | None, suffixes: tuple[str, ...], option: str) -> None:
-    if path is not None and path.suffix.lower() not in suffixes:
-        raise MechsynInputError(f"{path}: expected a {' or '.join(suffixes)} file", source=option)
-
-
 def _fmt(v: float) -> str:
     return "—" if v is None or not np.isfinite(v) else f"{v:.6g}"
 
@@ -122,9 +117,9 @@ def simulate_cmd(
     from mechsyn.kinematics import derived
     from mechsyn.kinematics.analysis import simulate
 
-    _check_out(plot, (".png", ".pdf", ".svg"), "--plot")
-    _check_out(animate, (".gif",), "--animate")
-    _check_out(csv_out, (".csv",), "--csv")
+    check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
+    check_output_suffix(animate, (".gif",), "--animate")
+    check_output_suffix(csv_out, (".csv",), "--csv")
     if method not in ("auto", "assur", "newton"):
         raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
     mech = load_mechanism(file)
@@ -261,8 +256,8 @@ def forces_cmd(
     """Joint reactions and the balancing moment/force at each driven joint over the input."""
     from mechsyn.kinematics.analysis import forces
 
-    _check_out(plot, (".png", ".pdf", ".svg"), "--plot")
-    _check_out(csv_out, (".csv",), "--csv")
+    check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
+    check_output_suffix(csv_out, (".csv",), "--csv")
     if not np.isfinite(gravity):
         raise MechsynInputError("gravity must be a finite number", source="--gravity")
     mech = load_mechanism(file)

@@ -10,7 +10,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
 from mechsyn.errors import MechsynInputError
 
 
@@ -30,10 +30,8 @@ def finger_design(
 
     if time_limit <= 0:
         raise MechsynInputError("--time-limit must be positive", source="--time-limit")
-    if plot is not None and plot.suffix.lower() != ".png":
-        raise MechsynInputError(f"{plot}: expected a .png file", source="--plot")
-    if out is not None and out.suffix.lower() not in (".yaml", ".yml", ".json"):
-        raise MechsynInputError(f"{out}: expected a .yaml or .json file", source="--out")
+    check_output_suffix(plot, (".png",), "--plot")
+    check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
     case = load_case(case_file)
     if json_out or not err_console.is_terminal:
         res = design_finger(case, seed=seed, time_limit=time_limit)

@@ -9,7 +9,7 @@ import typer
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
 from mechsyn.errors import MechsynInputError
 
 
@@ -32,10 +32,8 @@ def synth_mechanism(
         raise MechsynInputError("must be positive", source="--time-limit")
     if restarts < 1:
         raise MechsynInputError("must be at least 1", source="--restarts")
-    if plot is not None and plot.suffix.lower() != ".png":
-        raise MechsynInputError(f"{plot}: expected a .png file", source="--plot")
-    if out is not None and out.suffix.lower() not in (".yaml", ".yml", ".json"):
-        raise MechsynInputError(f"{out}: expected a .yaml or .json file", source="--out")
+    check_output_suffix(plot, (".png",), "--plot")
+    check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
     case = load_case(case_file)
     if err_console.is_terminal and not as_json:
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
