@@ -187,8 +187,6 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
     if callback is not None:
         callback({"stage": "build", "done": done, "total": total, "curves": kept})
     if scheduler is not None and todo:
-        from mechsyn.synthesis.optimize import _dask_client  # type: ignore[attr-defined]
-
         client = _dask_client(scheduler)
         futures = client.map(_build_one, todo, pure=False)
         from dask.distributed import as_completed
@@ -209,6 +207,24 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
         if callback is not None:
             callback({"stage": "build", "done": done, "total": total, "curves": kept})
     return directory
+
+
+def _dask_client(scheduler):
+    """A ``dask.distributed`` client for an address (or the client given)."""
+    from mechsyn.errors import MechsynInputError
+
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
+                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+    if isinstance(scheduler, Client):
+        return scheduler
+    try:
+        return Client(scheduler, timeout=10)
+    except (OSError, TimeoutError) as exc:
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+                                hint="give the address printed by dask-scheduler, e.g. tcp://host:8786") from None
 
 
 def _write(path: Path, data: dict) -> None:

@@ -57,7 +57,8 @@ from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
 __all__ = ["CurveCandidate", "CurveSynthesisResult", "synthesize_curve", "curve_errors"]
 
 M_TARGET = 64          # target points for the residuals
-N_TRACE = 96           # input samples along the range
+N_TRACE = 96           # input samples along the range (refinement)
+N_FINAL = 360          # input samples of the reported path and errors
 PENALTY = 1.0          # residual (in target diagonals) of an unassembled design
 
 
@@ -203,10 +204,10 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tu
 # ---------------------------------------------------------------------------- evaluation
 
 
-def _offsets(start: float, stop: float, closed: bool) -> np.ndarray:
+def _offsets(start: float, stop: float, closed: bool, n: int = N_TRACE) -> np.ndarray:
     if closed:
-        return start + np.arange(N_TRACE) * (360.0 / N_TRACE)
-    return np.linspace(start, stop, N_TRACE)
+        return start + np.arange(n) * (360.0 / n)
+    return np.linspace(start, stop, n)
 
 
 @dataclass
@@ -399,7 +400,7 @@ def _refine(seed: _Seed, target: TargetCurve, ground_region, max_link_ratio, max
 
 def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, closed: bool,
                target: TargetCurve, nfev: int) -> CurveCandidate | None:
-    off = _offsets(start, stop, closed)
+    off = _offsets(start, stop, closed, N_FINAL)
     res = simulate_batch(topo.plan, x[None], off, transmission=True)
     if not res.assembled.all() or res.branch_jump[0]:
         return None
@@ -417,7 +418,7 @@ def _verify(c: CurveCandidate) -> None:
 
     t = c.topology
     closed = c.stop - c.start >= 360.0 - 1e-9
-    off = _offsets(c.start, c.stop, closed)
+    off = _offsets(c.start, c.stop, closed, N_FINAL)
     try:
         mech = mechanism_from_dict(c.mechanism())
         # the reference configuration first: simulate takes the assembly mode from it
