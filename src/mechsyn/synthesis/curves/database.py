@@ -242,9 +242,10 @@ def _build_one(job) -> tuple[str, dict]:
     n = 0 if have is None else len(have["ranges"])
     tries = 0
     while n < per_topology and tries < 200:
+        size = int(min(batch, 2 * (per_topology - n) + 64))
         rng = np.random.default_rng([seed, i, drawn])
-        ev = evaluate_designs(topo, sample_designs(topo, batch, rng))
-        drawn += batch
+        ev = evaluate_designs(topo, sample_designs(topo, size, rng))
+        drawn += size
         tries += 1
         take = min(per_topology - n, len(ev.ranges))
         parts["designs"].append(ev.designs[:take].astype(np.float32))
