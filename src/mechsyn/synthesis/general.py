@@ -414,17 +414,9 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
             return MechanismEvaluation(False, f"cannot sweep: {exc}", violation=1e3)
         q, ok, method, sig = sw.q, sw.assembled, "newton", None
         branch_viol = float(sum(1 for e in sw.events if e.get("kind") in ("branch point", "singular")))
-    n_bad = int((~ok).sum())
-    viol = n_bad / len(grid) + branch_viol + viol_order
-    if viol > 0:
-        why = []
-        if n_bad:
-            why.append(f"not assembled at {n_bad} of {len(grid)} inputs of the sweep")
-        if branch_viol:
-            why.append("off the file's assembly branch")
-        if viol_order:
-            why.append("input angles out of order")
-        return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
+    bad = infeasibility(int((~ok).sum()), len(grid), branch_viol, viol_order, method)
+    if bad is not None:
+        return bad
     qt = q[idx]
     if case.problem == "path":
         link, at = resolve_points(mech, [case.point])[case.point]
@@ -444,6 +436,22 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
     return MechanismEvaluation(True, "", err, achieved=P, achieved_angles_deg=np.degrees(phi),
                                path=S.point(q, i, s), inputs_deg=np.asarray(values, float), method=method,
                                sigmas=sig)
+
+
+def infeasibility(n_bad: int, n_grid: int, branch_viol: float, viol_order: float,
+                  method: str) -> MechanismEvaluation | None:
+    """The infeasible evaluation (violation and reasons) of a swept design, or None."""
+    viol = n_bad / n_grid + branch_viol + viol_order
+    if viol <= 0:
+        return None
+    why = []
+    if n_bad:
+        why.append(f"not assembled at {n_bad} of {n_grid} inputs of the sweep")
+    if branch_viol:
+        why.append("off the file's assembly branch")
+    if viol_order:
+        why.append("input angles out of order")
+    return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
 
 
 class MechanismProblem:

@@ -39,7 +39,7 @@ class BatchEvaluator:
 
     def evaluate(self, Z: np.ndarray) -> list:
         from mechsyn.kinematics.batch import simulate_batch
-        from mechsyn.synthesis.general import MechanismEvaluation
+        from mechsyn.synthesis.general import MechanismEvaluation, infeasibility
 
         case = self.case
         Z = np.atleast_2d(np.asarray(Z, float))
@@ -77,17 +77,10 @@ class BatchEvaluator:
         n_bad_all = np.sum(~res.assembled & valid, axis=1)
         branch_all = np.sum(np.sign(res.sigmas) != np.sign(self.reference_sigmas)[None, :], axis=1)
         for k in range(K):
-            n_bad, branch = int(n_bad_all[k]), float(branch_all[k])
-            viol = n_bad / n_grid[k] + branch + float(viol_order[k])
-            if viol > 0:
-                why = []
-                if n_bad:
-                    why.append(f"not assembled at {n_bad} of {n_grid[k]} inputs of the sweep")
-                if branch:
-                    why.append("off the file's assembly branch")
-                if viol_order[k]:
-                    why.append("input angles out of order")
-                out[k] = MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method="batch")
+            bad = infeasibility(int(n_bad_all[k]), int(n_grid[k]), float(branch_all[k]), float(viol_order[k]),
+                                "batch")
+            if bad is not None:
+                out[k] = bad
                 continue
             ach = path[k, idx]
             err = float(np.sum((ach - case.targets) ** 2))
