@@ -160,3 +160,16 @@ def test_cli_synth_curve_and_curves_build(small_db, tmp_path, cli_json, run_cli)
     assert code == 2 and "not found" in err
     s = cli_json("curves", "build", "--links", "4", "--per-topology", "50", "--database", tmp_path / "db")
     assert s["curves"] == 50 and s["topologies"] == 1
+
+
+def test_default_database_builds_on_first_use(tmp_path, monkeypatch):
+    from mechsyn.synthesis.curves import database
+
+    monkeypatch.setattr(database, "DEFAULT_PER_TOPOLOGY", 40)
+    monkeypatch.setenv("MECHSYN_CURVE_DB", str(tmp_path / "cache"))
+    states = []
+    db = load_database(max_links=4, callback=states.append)
+    assert len(db) == 40 and (tmp_path / "cache").is_dir()
+    assert states[0]["done"] == 0 and states[-1]["done"] == states[-1]["total"] == 1
+    with pytest.raises(MechsynInputError, match="no curve database"):
+        load_database(tmp_path / "empty", build_if_missing=False)

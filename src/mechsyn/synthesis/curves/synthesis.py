@@ -444,7 +444,7 @@ def synthesize_curve(
     max_links: int = 8,
     time_limit: float = 60.0,
     top: int = 5,
-    n_refine: int = 24,
+    n_refine: int = 32,
     retrieve: int = 300,
     crank: bool = False,
     ground_region: tuple[float, float, float, float] | None = None,
