@@ -151,7 +151,7 @@ def test_cli_synth_curve_and_curves_build(small_db, tmp_path, cli_json, run_cli)
     f = tmp_path / "t.json"
     f.write_text(json.dumps({"points": _fourbar_curve(11).tolist(), "closed": True}))
     out = tmp_path / "out"
-    data = cli_json("synth", "curve", f, "--max-links", "4", "--top", "1", "--time-limit", "20",
+    data = cli_json("synth", "curve", f, "--max-links", "4", "--top", "1", "--time-limit", "4",
                     "--database", small_db, "--out", out)
     c = data["candidates"][0]
     assert c["links"] == 4 and c["topology"] == "four-bar" and c["tracer"] == "T"

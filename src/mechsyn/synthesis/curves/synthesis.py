@@ -351,19 +351,16 @@ def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, cr
         by_topo.setdefault(int(db.topology[r]), []).append(r)
     for ti, rs in by_topo.items():
         topo = db.topologies[ti]
-        curves = []
-        for r in rs:
-            a, b = db.ranges[r]
-            off = _offsets(a, b, bool(db.closed[r]))
-            P = simulate_batch(topo.plan, db.designs[r][None], off).paths[TRACER][0]
-            if not np.all(np.isfinite(P)):
-                curves.append(None)
-                continue
-            curves.append(resample(P, 64, closed=bool(db.closed[r])))
-        ok = [i for i, c in enumerate(curves) if c is not None]
-        if not ok:
+        rs_a = np.array(rs)
+        offs = np.array([_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
+        P = simulate_batch(topo.plan, np.array([db.designs[r] for r in rs]), offs, flags=False).paths[TRACER]
+        fine = np.all(np.isfinite(P), axis=(1, 2))
+        if not fine.any():
             continue
-        al = align(np.array([curves[i] for i in ok]), w)
+        ok = np.flatnonzero(fine)
+        closed_rows = db.closed[rs_a[ok]]
+        curves = [resample(P[i], 64, closed=bool(c)) for i, c in zip(ok, closed_rows)]
+        al = align(np.array(curves), w)
         for j, i in enumerate(ok):
             r = rs[i]
             a, b = (float(v) for v in db.ranges[r])
