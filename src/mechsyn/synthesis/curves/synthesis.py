@@ -450,6 +450,7 @@ def synthesize_curve(
     database: CurveDatabase | str | None = None,
     callback: Callable[[dict], None] | None = None,
     max_nfev: int = 60,
+    tolerance: float = 1e-3,
 ) -> CurveSynthesisResult:
     """Ranked linkages (4 to ``max_links`` links) whose tracing point follows a curve.
 
@@ -460,7 +461,8 @@ def synthesize_curve(
     max_links : {4, 6, 8}
         Largest linkage considered.
     time_limit : float
-        Seconds for retrieval and refinement; the best found so far is returned.
+        Seconds for retrieval and refinement: a refinement is not started when the
+        longest one so far would overrun it; the best found so far is returned.
     top : int
         Candidates returned (distinct designs, best chamfer error first).
     n_refine, retrieve : int
@@ -476,6 +478,9 @@ def synthesize_curve(
         penalised in the refinement (0: no penalty); reported for every candidate.
     database : CurveDatabase or directory, optional
         Default: the local database (built on first use).
+    tolerance : float
+        The search ends early once ``top`` candidates have a chamfer error at most this
+        (in target diagonals; default 0.1 %).
     callback : callable, optional
         ``callback(state)`` with ``state = {"stage", "done", "total", "best", "nfev"}``
         (``best``: the best chamfer error so far, in target diagonals).
@@ -539,12 +544,18 @@ def synthesize_curve(
     nfev = 0
     interrupted = False
     best = float("inf")
+    longest = 0.0
     try:
         for i, s in enumerate(picked):
-            if time.perf_counter() - t0 > time_limit:
-                notes.append(f"time limit reached after {i} of {len(picked)} refinements")
+            now = time.perf_counter()
+            if now - t0 + longest > time_limit:
+                notes.append(f"time limit: {i} of {len(picked)} refinements done")
+                break
+            if sum(c.chamfer <= tolerance for c in cands) >= top:
+                notes.append(f"{top} candidate(s) within {100 * tolerance:g} % after {i} refinements")
                 break
             c = _refine(s, target, ground_region, max_link_ratio, max_nfev, min_transmission)
+            longest = max(longest, time.perf_counter() - now)
             if c is not None:
                 nfev += c.nfev
                 if (max_link_ratio is None or c.link_length_ratio <= max_link_ratio * (1 + 1e-6)) and \
