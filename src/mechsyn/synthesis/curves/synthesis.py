@@ -530,7 +530,7 @@ def synthesize_curve(
     seeds = _retrieve(database, target, retrieve, max_links, crank)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
     notes: list[str] = []
-    # diversity: at most a third of the refinements from one topology
+    # diversity: at most a third of the refinements from one topology, then fill up
     picked: list[_Seed] = []
     per: dict[str, int] = {}
     cap = max(2, n_refine // 3)
@@ -540,7 +540,12 @@ def synthesize_curve(
             per[s.topo.key] = per.get(s.topo.key, 0) + 1
         if len(picked) >= n_refine:
             break
+    if len(picked) < n_refine:
+        chosen = {id(s) for s in picked}
+        picked += [s for s in seeds if id(s) not in chosen][:n_refine - len(picked)]
+        picked.sort(key=lambda s: s.score)
     cands: list[CurveCandidate] = []
+    done = 0
     nfev = 0
     interrupted = False
     best = float("inf")
@@ -556,6 +561,7 @@ def synthesize_curve(
                 break
             c = _refine(s, target, ground_region, max_link_ratio, max_nfev, min_transmission)
             longest = max(longest, time.perf_counter() - now)
+            done += 1
             if c is not None:
                 nfev += c.nfev
                 if (max_link_ratio is None or c.link_length_ratio <= max_link_ratio * (1 + 1e-6)) and \
@@ -581,7 +587,7 @@ def synthesize_curve(
         if len(out) >= top:
             break
     report("done", 1, 1, out[0].chamfer if out else float("nan"), nfev)
-    return CurveSynthesisResult(target, out, time.perf_counter() - t0, len(seeds), len(picked), interrupted, notes)
+    return CurveSynthesisResult(target, out, time.perf_counter() - t0, len(seeds), done, interrupted, notes)
 
 
 def _in_region(c: CurveCandidate, box) -> bool:
