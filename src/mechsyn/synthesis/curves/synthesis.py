@@ -39,6 +39,7 @@ descriptors instead of a neural encoder.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -447,7 +448,7 @@ def synthesize_curve(
     ground_region: tuple[float, float, float, float] | None = None,
     max_link_ratio: float | None = None,
     min_transmission: float = 15.0,
-    database: CurveDatabase | str | None = None,
+    database: CurveDatabase | str | os.PathLike[str] | None = None,
     callback: Callable[[dict], None] | None = None,
     max_nfev: int = 60,
     tolerance: float = 1e-3,
@@ -519,7 +520,7 @@ def synthesize_curve(
     if crank and not target.closed:
         raise MechsynInputError("a crank (full turn) traces a closed curve; the target is open",
                                 source="--crank", hint="drop --crank or close the target")
-    if database is None or isinstance(database, str):
+    if database is None or isinstance(database, (str, os.PathLike)):
         database = load_database(database, max_links=max_links, callback=callback)
 
     def report(stage, done, total, best, nfev):
