@@ -143,13 +143,17 @@ class CurveDatabase:
     def __len__(self) -> int:
         return len(self.topology)
 
-    def tree(self):
-        """A cKDTree over the descriptors (built once)."""
-        if getattr(self, "_tree", None) is None:
+    def tree(self, n_links: int):
+        """``(cKDTree, rows)`` over the descriptors of the ``n_links``-bar rows (built
+        once per link count; ``(None, rows)`` when there are none)."""
+        cache = self.__dict__.setdefault("_trees", {})
+        if n_links not in cache:
             from scipy.spatial import cKDTree
 
-            self._tree = cKDTree(self.descriptors)
-        return self._tree
+            links = np.array([t.n_links for t in self.topologies])[self.topology]
+            rows = np.flatnonzero(links == n_links)
+            cache[n_links] = (cKDTree(self.descriptors[rows]) if len(rows) else None, rows)
+        return cache[n_links]
 
 
 def _file(directory: Path, topo: CurveTopology) -> Path:

@@ -65,7 +65,7 @@ def plot_candidate(candidate, target, ax=None, linkage: bool = True, color: str 
     pad = 0.08 * (hi - lo).max()
     ax.set_xlim(lo[0] - pad, hi[0] + pad)
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
-    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_aspect("equal", adjustable="box")
     ax.grid(True, alpha=0.3)
     return drawn
 

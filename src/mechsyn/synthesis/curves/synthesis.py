@@ -334,14 +334,16 @@ def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) 
 def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool) -> list[_Seed]:
     w = resample(target.points, 64, closed=target.closed)
     d = fourier_descriptor(w)
-    tree = db.tree()
     rows: set[int] = set()
-    kk = min(k, len(db))
-    for q in (d, swap_direction(d)):
-        _, ii = tree.query(q.astype(np.float32), k=kk)
-        rows.update(np.atleast_1d(ii).tolist())
-    rows_a = np.array(sorted(r for r in rows if r < len(db)))
-    rows_a = rows_a[[db.topologies[db.topology[r]].n_links <= max_links for r in rows_a]]
+    for n in range(4, max_links + 1, 2):   # each link count its own share of the retrieval
+        tree, sub = db.tree(n)
+        if tree is None:
+            continue
+        kk = min(k, len(sub))
+        for q in (d, swap_direction(d)):
+            _, ii = tree.query(q.astype(np.float32), k=kk)
+            rows.update(sub[np.atleast_1d(ii)].tolist())
+    rows_a = np.array(sorted(rows), int)
     if crank:
         rows_a = rows_a[db.closed[rows_a]]
     if not target.closed:
