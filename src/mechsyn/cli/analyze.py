@@ -30,7 +30,7 @@ from mechsyn.structure.rank import (
     rank_to_markdown,
 )
 from mechsyn.errors import MechsynInputError
-from mechsyn.structure.report import pair_list, to_markdown
+from mechsyn.structure.report import CONTOUR_READING, formula_title, pair_list, to_markdown
 
 
 SHORT_TITLES = {
@@ -57,10 +57,10 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
     t.add_column("expression", no_wrap=True)
     t.add_column("value", justify="right")
     for key, f in a.formulas.items():
-        t.add_row(SHORT_TITLES.get(key, key), f.expression, _fmt(f.value))
+        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, _fmt(f.value))
     console.print(t)
     if a.contours:
-        c = Table(title="Contours (paper 003, sequential reading)")
+        c = Table(title=f"Contours (paper 003, sequential reading{CONTOUR_READING[a.kind]})")
         for col in ("#", "joints", "new pairs", "n_j", "n_k", "S_j", "idle", "T_j", "Z_j", "A_j"):
             c.add_column(col, justify="right" if col not in ("joints", "new pairs") else "left")
         for r in a.contours:
@@ -72,7 +72,7 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         for r in a.contours:
             console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
     console.print(
-        f"S_Σ = {a.structural_redundancy} ({a.redundant_constraints} redundant constraints, "
+        f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
         f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
         soft_wrap=True)

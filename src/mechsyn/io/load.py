@@ -362,6 +362,9 @@ class _Builder:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
             else:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+        if self.kind == "planar" and jtype == "P" and axis is None and point is not None:
+            raise self.error(path + ["axis"], f"planar P pair {entry.id} has no axis: its sliding direction "
+                             "is not assumed", "add axis: [dx, dy], e.g. axis: [1, 0] to slide along x")
         axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
         normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
         if entry.pitch is not None and jtype != "H":

@@ -996,14 +996,15 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
     planar = ra.motion == "planar"
     reasons = _q_reasons(ra)
     idle_txt = f"; it includes {idle} idle mobility(ies): {_idle_words(ra)}" if idle else ""
-    main = ("chebyshev", "Chebyshev W = 3n - 2p5 - p4") if planar else ("malyshev", "Malyshev W = 6n - Σ i·p_i")
+    main = (("chebyshev", "Chebyshev W = 3n - 2p5 - p4 (planar)") if planar
+            else ("malyshev", "Malyshev W = 6n - Σ i·p_i (spatial)"))
     f = fa.formulas.get(main[0])
     if f is not None and f.value is not None:
         w = f.value
         if w == m:
             why = "agree: no constraint is redundant" + idle_txt
         else:
-            why = (f"W = m - q = {m} - {q}: the formula counts every constraint as independent, "
+            why = (f"W = m - q = {m} - {q} = {m - q}: the formula counts every constraint as independent, "
                    f"{q} are redundant ({reasons})" + idle_txt)
         out.append(Comparison("mobility", main[1], w, m, w == m, why))
     if not planar:
@@ -1016,7 +1017,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
             elif w == u:
                 why = (f"W equals the useful mobility {u}: S_Σ = {fa.structural_redundancy} nets "
                        f"{s_idle} idle mobility(ies) against redundant constraints; the rank method counts "
-                       f"{q} redundant constraint(s) and {idle} idle mobility(ies) apart (m = {u} + {idle})")
+                       f"{q} redundant constraint(s) and {idle} idle mobility(ies) apart (m = {m} = {u} + {idle})")
             else:
                 bad = []
                 for rc, fc in zip(ra.contours, fa.contours):
@@ -1027,7 +1028,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
                 why = ("the per-contour counts assume generic geometry (each contour's pairs independent): "
                        + ("; ".join(bad) if bad else f"S_Σ + G_Σ = {fa.structural_redundancy + fa.constructive_redundancy:g}"
                           f" vs rank q = {q}") + idle_txt)
-            out.append(Comparison("mobility", "Somov-Malyshev W = 6n - Σ i·p_i + S_Σ + G_Σ (003)", w, m, w == m, why))
+            out.append(Comparison("mobility", "Somov-Malyshev W = 6n - Σ i·p_i + S_Σ + G_Σ (003, spatial)", w, m, w == m, why))
     f = fa.formulas.get("ozol_redundant")
     if f is not None and f.value is not None:
         w_used = fa.declared_mobility if fa.declared_mobility is not None else fa.mobility
@@ -1036,7 +1037,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
                f"mobility m = {m} (idle included) it gives q = {q}")
         if f.value == q and q:
             why = f"agree: {reasons}"
-        out.append(Comparison("redundant constraints", "Ozol q = W + λK - f (002)", f.value, q, f.value == q, why))
+        out.append(Comparison("redundant constraints", f"Ozol q = W + {3 if planar else 6}K - f (002, {ra.motion})", f.value, q, f.value == q, why))
     if fa.contours and len(fa.contours) == len(ra.contours) and not planar:
         for fc, rc in zip(fa.contours, ra.contours):
             sj = max(fc.S, 0) + fc.T
