@@ -11,7 +11,7 @@ from rich.panel import Panel
 from rich.table import Table
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json
+from mechsyn.cli.common import console, emit_json, err_console
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import to_jsonable, write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
@@ -155,6 +155,22 @@ def _rank_or_reason(mech, tol):
     return analyze_rank(mech, tol=tol), None
 
 
+#: From this many joints, ``analyze`` says the size and shows the rank method's stages on stderr.
+LARGE_JOINTS = 1000
+
+
+def _analyze_rank_reporting(mech, tol):
+    if len(mech.joints) < LARGE_JOINTS:
+        return analyze_rank(mech, tol=tol)
+    from mechsyn.structure.contours import cycle_rank
+
+    err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
+                      f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
+                      f"of loops (2,000 joints: a few seconds)", highlight=False)
+    with err_console.status("rank method") as status:
+        return analyze_rank(mech, tol=tol, progress=lambda stage: status.update(f"rank method: {stage}"))
+
+
 @app.command("analyze")
 def analyze(
     file: Annotated[Path, typer.Argument(help="Mechanism file (YAML or JSON).")],
@@ -192,7 +208,7 @@ def analyze(
             "the rank method needs each joint's geometry: " + "; ".join(problems), source=str(file),
             hint="add point/axis (see `mechsyn schema`), or use --method formulas")
     result = analyze_structure(mech)
-    ra = analyze_rank(mech, tol=tol) if method != "formulas" else None
+    ra = _analyze_rank_reporting(mech, tol) if method != "formulas" else None
     comparisons = compare_with_formulas(result, ra) if ra is not None else None
     state_ranks: dict[str, tuple[RankAnalysis | None, str | None]] = {}
     if ra is not None:

@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -83,7 +83,7 @@ def _perp_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rot(p: np.ndarray, a: np.ndarray) -> np.ndarray:
-    return np.concatenate([a, np.cross(p, a)])
+    return np.concatenate([a, _cross(p, a)])
 
 
 def _tr(a: np.ndarray) -> np.ndarray:
@@ -359,13 +359,6 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _adjoint(g: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """``Ad_g ξ``: the twist ``ξ`` moved by the displacement ``g``."""
-    R, p = g[:3, :3], g[:3, 3]
-    w = R @ xi[:3]
-    return np.concatenate([w, R @ xi[3:] + _cross(p, w)])
-
-
 def _svd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if a.size == 0:
         return (np.zeros((a.shape[0], 0)), np.zeros(0), np.zeros((0, a.shape[1])))
@@ -394,6 +387,124 @@ def _orth(a: np.ndarray, tol: float = 1e-9) -> np.ndarray:
         return a.reshape(a.shape[0], 0)
     u, s, _ = np.linalg.svd(a, full_matrices=False)
     return u[:, : int(np.sum(s > tol * max(1.0, s[0] if s.size else 1.0)))]
+
+
+#: Above this many pair freedoms the loop-closure matrix is reduced contour by contour
+#: (:func:`_eliminate`) instead of by one dense SVD (``O(F³)``).
+DENSE_MAX_FREEDOMS = 120
+
+
+@dataclass
+class _Reduction:
+    """Rank, null space and per-contour increments of a loop-closure matrix."""
+
+    rank: int
+    null: np.ndarray  # F × m, orthonormal columns
+    increments: list[int]  # per contour: new independent equations
+    left: list[np.ndarray]  # per contour: λ × λ left singular vectors (redundant ones last)
+    singular_values: np.ndarray  # what the rank decisions were taken on
+
+
+def _reduce_dense(M: np.ndarray, lam: int, tol: float) -> _Reduction:
+    """One SVD for rank and null space; each contour's rows reduced against the row space
+    of the contours before it (orthonormal basis ``Q``)."""
+    F = M.shape[1]
+    sv = np.linalg.svd(M, compute_uv=False) if M.size else np.zeros(0)
+    rank = int(np.sum(sv > tol))
+    N = _null(M, tol) if F else np.zeros((0, 0))
+    incs, lefts = [], []
+    Q = np.zeros((F, 0))
+    for k in range(M.shape[0] // lam):
+        B = M[lam * k: lam * (k + 1)]
+        res = B - (B @ Q) @ Q.T if Q.shape[1] else B
+        u_k, s_k, vt_k = np.linalg.svd(res, full_matrices=True)
+        s_full = np.zeros(lam)
+        s_full[: s_k.size] = s_k
+        inc = int(np.sum(s_full > tol))
+        Q = np.concatenate([Q, vt_k[:inc].T], axis=1)
+        incs.append(inc)
+        lefts.append(u_k)
+    return _Reduction(rank, N[:, : F - rank], incs, lefts, sv)
+
+
+def _eliminate(M: np.ndarray, cols: list[np.ndarray], lam: int, tol: float) -> _Reduction:
+    """Rank and null space contour by contour, touching only each contour's columns.
+
+    The motions allowed by contours ``1..k-1`` are kept as orthonormal parameter vectors
+    (a pair freedom not yet met by any contour, or a combination stored as a full vector).
+    Contour ``k`` (rows ``B``, columns ``cols[k]``) meets only the parameters that move
+    its columns: the SVD of ``B P_J`` (``λ × |J|``) gives its new independent equations
+    (the sequential reading), its redundant ones (left null vectors, as in
+    :func:`_reduce_dense`) and the combinations of ``P_J`` it leaves free. A column no
+    later contour touches is retired from the bookkeeping. For a chain of loops ``|J|``
+    stays small: the work grows about linearly with the contours (a dense SVD, cubically).
+    """
+    F = M.shape[1]
+    last = np.full(F, -1)  # the last contour that touches each column: later, it is retired
+    for k, ck in enumerate(cols):
+        last[ck] = k
+    unit: dict[int, int] = {c: c for c in range(F)}  # parameter -> its column (unit vector)
+    dense: dict[int, np.ndarray] = {}  # parameter -> full vector
+    active: dict[int, np.ndarray] = {}  # dense parameter -> columns it moves that a later contour touches
+    touch: list[set[int]] = [{c} for c in range(F)]
+    next_id = F
+    incs, lefts, svs = [], [], []
+    for k, ck in enumerate(cols):
+        B = M[lam * k: lam * (k + 1), ck]
+        J = sorted(set().union(*(touch[c] for c in ck)))
+        if not J:  # every freedom of the contour is already locked
+            incs.append(0)
+            lefts.append(np.eye(lam))
+            svs.append(np.zeros(lam))
+            continue
+        pos = {c: i for i, c in enumerate(ck)}
+        BP = np.empty((lam, len(J)))
+        for i, pid in enumerate(J):
+            BP[:, i] = B[:, pos[unit[pid]]] if pid in unit else B @ dense[pid][ck]
+        u, s, vt = np.linalg.svd(BP, full_matrices=True)
+        s_full = np.zeros(lam)
+        s_full[: s.size] = s
+        inc = int(np.sum(s_full > tol))
+        incs.append(inc)
+        lefts.append(u)
+        svs.append(s_full)
+        if inc == 0:
+            continue
+        Z = vt[inc:].T
+        new = np.zeros((F, Z.shape[1]))
+        for i, pid in enumerate(J):
+            if pid in unit:
+                c = unit.pop(pid)
+                new[c] += Z[i]
+                touch[c].discard(pid)
+            else:
+                new += np.outer(dense.pop(pid), Z[i])
+                for c in active.pop(pid):
+                    touch[c].discard(pid)
+        for i in range(new.shape[1]):
+            v = new[:, i]
+            v[np.abs(v) <= 1e-15 * np.max(np.abs(v))] = 0.0
+            moved = np.flatnonzero(v)
+            act = moved[last[moved] > k]
+            dense[next_id], active[next_id] = v, act
+            for c in act:
+                touch[c].add(next_id)
+            next_id += 1
+    N = np.zeros((F, len(unit) + len(dense)))
+    for i, c in enumerate(sorted(unit.values())):
+        N[c, i] = 1.0
+    for i, pid in enumerate(sorted(dense), start=len(unit)):
+        N[:, i] = dense[pid]
+    sv = np.concatenate(svs) if svs else np.zeros(0)
+    return _Reduction(F - N.shape[1], N, incs, lefts, sv)
+
+
+def _reduce(sysm: "_System", M: np.ndarray, tol: float) -> _Reduction:
+    """Rank and null space of the loop-closure matrix ``M``: one dense SVD for small
+    systems, contour-by-contour elimination above :data:`DENSE_MAX_FREEDOMS`."""
+    if M.shape[1] <= DENSE_MAX_FREEDOMS:
+        return _reduce_dense(M, sysm.lam, tol)
+    return _eliminate(M, sysm.contour_columns(), sysm.lam, tol)
 
 
 # --------------------------------------------------------------------------- results
@@ -505,24 +616,45 @@ class _System:
     def rows(self, mat: np.ndarray) -> np.ndarray:
         return mat[PLANAR_ROWS] if self.planar else mat
 
+    def contour_columns(self) -> list[np.ndarray]:
+        """The columns (pair freedoms) each contour's equations touch."""
+        return [np.array(sorted({c for c, _ in fac}), dtype=int) for fac in self.factors]
+
     def closure(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Loop-closure twist matrix ``M(θ)`` (λK × F) and the closure error (λK)."""
+        """Loop-closure twist matrix ``M(θ)`` (λK × F) and the closure error (λK).
+
+        Every contour's product of exponentials is taken step by step for all contours at
+        once (contours padded to the longest one)."""
         F = self.twists.shape[0]
         K = len(self.factors)
         lam = self.lam
         M = np.zeros((lam * K, F))
         err = np.zeros(lam * K)
-        exps = _exp(self.twists, theta)
-        inv_exps = _exp(self.twists, -theta)
+        if K == 0:
+            return M, err
+        exps = np.concatenate([_exp(self.twists, theta), _exp(self.twists, -theta)])  # + then - sign
+        L = max(len(f) for f in self.factors)
+        cols = np.full((K, L), -1)
+        signs = np.zeros((K, L))
         for k, fac in enumerate(self.factors):
-            g = np.eye(4)
-            for col, sign in fac:
-                xi = _adjoint(g, self.twists[col]) * sign
-                M[k * lam:(k + 1) * lam, col] = self.rows(xi)
-                g = g @ (exps[col] if sign > 0 else inv_exps[col])
-            R, p = g[:3, :3], g[:3, 3]
-            e = np.concatenate([0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]), p])
-            err[k * lam:(k + 1) * lam] = self.rows(e)
+            cols[k, : len(fac)] = [c for c, _ in fac]
+            signs[k, : len(fac)] = [sg for _, sg in fac]
+        rows = PLANAR_ROWS if self.planar else np.arange(6)
+        g = np.tile(np.eye(4), (K, 1, 1))
+        for t in range(L):
+            k = np.flatnonzero(cols[:, t] >= 0)
+            c, sg = cols[k, t], signs[k, t]
+            xi = self.twists[c] * sg[:, None]
+            R, p = g[k, :3, :3], g[k, :3, 3]
+            w = np.einsum("kij,kj->ki", R, xi[:, :3])
+            v = np.einsum("kij,kj->ki", R, xi[:, 3:]) + np.cross(p, w)
+            adj = np.concatenate([w, v], axis=1)[:, rows]
+            M[(k * lam)[:, None] + np.arange(lam), c[:, None]] = adj
+            g[k] = g[k] @ exps[np.where(sg > 0, c, c + F)]
+        R, p = g[:, :3, :3], g[:, :3, 3]
+        e = np.concatenate([0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0],
+                                             R[:, 1, 0] - R[:, 0, 1]], axis=1), p], axis=1)
+        err[:] = e[:, rows].reshape(-1)
         return M, err
 
 
@@ -790,6 +922,21 @@ def _actuated_columns(sysm: _System) -> tuple[list[int], list[str]]:
     return cols, names
 
 
+def _gauss_newton_step(M: np.ndarray, err: np.ndarray, tol: float) -> np.ndarray:
+    """Least-norm step ``δ`` with ``M δ ≈ err``: truncated SVD with the rank tolerance
+    (near-null directions left alone) for small systems; for large ones the damped
+    least-norm step ``Mᵀ (M Mᵀ + tol² I)⁻¹ err`` by a sparse LU (banded for chains)."""
+    if M.shape[1] <= DENSE_MAX_FREEDOMS:
+        u, sv, vt = np.linalg.svd(M, full_matrices=False)
+        keep = sv > tol
+        return vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
+    from scipy.sparse import csc_matrix, identity
+    from scipy.sparse.linalg import spsolve
+
+    A = csc_matrix(M)
+    return A.T @ spsolve((A @ A.T + tol * tol * identity(M.shape[0], format="csc")).tocsc(), err)
+
+
 def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int = 3,
             step: float = 0.05, seed: int = 0) -> tuple[int | None, list[str]]:
     """Rank at nearby assembled configurations along random null-space directions."""
@@ -807,17 +954,14 @@ def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int =
             if np.linalg.norm(err) < max(1e-11, 10.0 * tol * step):
                 ok = True
                 break
-            # Gauss-Newton with the same rank tolerance (near-null directions left alone)
-            u, sv, vt = np.linalg.svd(M, full_matrices=False)
-            keep = sv > tol
-            theta = theta - vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
+            theta = theta - _gauss_newton_step(M, err, tol)
         if not ok:
             continue
         if np.max(np.abs(theta)) < 0.2 * step:
             returned += 1
             continue
         M, _ = sysm.closure(theta)
-        ranks.append(_rank(M, tol))
+        ranks.append(_reduce(sysm, M, tol).rank)
     if not ranks:
         if returned:
             notes.append("the instantaneous motions do not extend to finite motions (a shaky configuration)")
@@ -828,14 +972,28 @@ def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int =
 
 
 def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None = None,
-                 check_singular: bool = True, seed: int = 0) -> RankAnalysis:
+                 check_singular: bool = True, seed: int = 0,
+                 progress: Callable[[str], None] | None = None) -> RankAnalysis:
     """Screw-theory rank analysis of ``mech`` at its assembled configuration.
 
     ``planar`` defaults to the file's kind (a planar file is analysed with planar
     motion, 3 equations per contour; see :func:`as_spatial` for the 3-D picture).
-    Raises :class:`InsufficientGeometry` when a joint lacks the geometry its twists need.
+    ``progress`` is called with the name of each stage as it starts (``"contours"``,
+    ``"rank"``, ``"idle"``, ``"singularity"``). BLAS runs on one thread meanwhile: the
+    method makes many small decompositions, which threads only slow down (and on a
+    loaded machine by 10-50x). Raises :class:`InsufficientGeometry` when a joint lacks
+    the geometry its twists need.
     """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _analyze_rank(mech, planar, tol, check_singular, seed, progress or (lambda stage: None))
+
+
+def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check_singular: bool, seed: int,
+                  progress: Callable[[str], None]) -> RankAnalysis:
     planar = mech.kind == "planar" if planar is None else planar
+    progress("contours")
     sysm = _build_system(mech, planar)
     lam, K = sysm.lam, len(sysm.contours)
     F = sysm.twists.shape[0]
@@ -844,8 +1002,9 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
         tol = max(1e-6, min(1e-3, 50.0 * eps / sysm.scale))
     M, _ = sysm.closure(np.zeros(F))
     notes: list[str] = []
-    sv = np.linalg.svd(M, compute_uv=False) if M.size else np.zeros(0)
-    rank = int(np.sum(sv > tol))
+    progress("rank")
+    red = _reduce(sysm, M, tol)
+    sv, rank = red.singular_values, red.rank
     near = bool(np.any((sv > tol) & (sv < 1e-2)))
     if near:
         small = sv[(sv > tol) & (sv < 1e-2)]
@@ -856,24 +1015,15 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
                      f"redundant constraint(s)")
     mobility = F - rank
     redundant = lam * K - rank
-    N = _null(M, tol) if F else np.zeros((0, 0))
-    if N.shape[1] != mobility:  # pragma: no cover - consistent by construction
-        N = N[:, :mobility]
+    N = red.null
 
     # -- redundant constraints per contour (sequential) and their directions: the rows of
-    # contour k are reduced against the row space of contours 1..k-1 (orthonormal basis Q);
-    # combinations c of its rows whose residual vanishes are its redundant constraints,
-    # c being the contour's self-stress wrench [moment about the centre; force].
+    # contour k reduced against the row space of contours 1..k-1; combinations c of its
+    # rows whose residual vanishes are its redundant constraints, c being the contour's
+    # self-stress wrench [moment about the centre; force].
     contours: list[ContourRank] = []
-    Q = np.zeros((F, 0))
     for k in range(K):
-        B = M[lam * k: lam * (k + 1)]
-        res = B - (B @ Q) @ Q.T if Q.shape[1] else B
-        u_k, s_k, vt_k = np.linalg.svd(res, full_matrices=True)
-        s_full = np.zeros(lam)
-        s_full[: s_k.size] = s_k
-        inc = int(np.sum(s_full > tol))
-        Q = np.concatenate([Q, vt_k[:inc].T], axis=1)
+        inc, u_k = red.increments[k], red.left[k]
         qk = lam - inc
         part = u_k[:, inc:]
         dirs: list[str] = []
@@ -892,6 +1042,7 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
                      f"{redundant} differ at this tolerance: a singular value is close to it")
 
     # -- idle mobilities (families (a) and (b), mechsyn.structure.idle) with every drive at rest
+    progress("idle")
     acols, anames = _actuated_columns(sysm)
     if mobility and acols:
         Z0 = _null(N[acols], tol)
@@ -924,6 +1075,7 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     # -- singularity
     singular, finite = False, None
     if check_singular and mobility > 0:
+        progress("singularity")
         r_near, fnotes = _follow(sysm, N, tol, rank, seed=seed)
         notes.extend(fnotes)
         if r_near is not None:
