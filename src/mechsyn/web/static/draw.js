@@ -138,9 +138,9 @@ export function draw(svg, state) {
     const pts = m.joints.map((id) => pos.joints[id]).concat(m.points.map((n) => pos.points[n])).filter(Boolean).map(P);
     if (pts.length < 2) continue;
     let cls = "";
-    for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
-    if (invalid.has(`link:${name}`)) cls += " invalid";
     const colour = groupOf[name] !== undefined ? GROUP_COLOURS[groupOf[name] % GROUP_COLOURS.length] : null;
+    if (!colour) for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
+    if (invalid.has(`link:${name}`)) cls += " invalid";
     const g = el("g", { "data-link": name }, layers.links);
     if (pts.length === 2) {
       el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar" + cls, stroke: colour }, g);

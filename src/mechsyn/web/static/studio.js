@@ -69,7 +69,7 @@ const simulateSoon = coalescing(
     state.simulations += 1;
     state.lastSimMs = ms;
     if (mech !== state.mech && !state.dragging) return; // a newer mechanism is on its way
-    state.sim = r; state.errors = []; state.notes = r.notes || [];
+    state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
     if (state.frame >= r.assembled.length) state.frame = 0;
     render();
     if (!state.dragging) renderAnalysis();
@@ -77,7 +77,7 @@ const simulateSoon = coalescing(
   (e, mech) => {
     state.simulations += 1;
     if (mech !== state.mech && !state.dragging) return;
-    state.sim = null; state.notes = [];
+    state.sim = null; state.simFor = mech; state.notes = [];
     state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
     render(); renderAnalysis();
   });
@@ -483,7 +483,7 @@ $("synth-run").onclick = async () => {
   source = new EventSource(eventsUrl(job.id));
   const show = (snap) => {
     const p = snap.progress;
-    $("synth-progress").max = p.total; $("synth-progress").value = p.done;
+    $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
     $("synth-status").textContent = `${snap.state}: ${p.done}/${p.total} restarts, best error ${p.best === null ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
   };
   source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
