@@ -198,7 +198,13 @@ def test_synthesise_fourbar_through_five_points(serve, page):
     path = np.array([p for p in sim["points"]["P"] if p is not None])
     clicked = np.array(page.evaluate("window.__studio.targets"))
     gap = max(np.min(np.linalg.norm(path - t, axis=1)) for t in clicked)
-    assert gap < 0.1  # the four-bar's coupler point passes near every clicked point (length units)
+    best = page.locator("[data-result='0']").inner_text()
+    error = float(best.split()[1])
+    # the applied four-bar's coupler point passes through every clicked point, up to the reported
+    # error and half a step of the drawn sweep (180 input values)
+    step = np.max(np.linalg.norm(np.diff(path, axis=0), axis=1))
+    assert gap <= np.sqrt(error) + step / 2, (gap, step, best)
+    assert error < 0.05, best
     shot(page, "studio_synthesis.png")
     assert page.console_errors == []
 

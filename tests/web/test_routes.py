@@ -264,3 +264,17 @@ def test_events_stream(client):
         assert r.headers["content-type"].startswith("text/event-stream")
         text = "".join(r.iter_text())
     assert "event: end" in text and '"state": "done"' in text
+
+
+@pytest.mark.parametrize("name", ["fourbar", "watt_sixbar", "slider_crank", "crank_rocker"])
+def test_drag_preview_equals_full_simulation(client, name):
+    m = mechanism_to_dict(load_mechanism(example_path(name)))
+    full = client.post("/api/simulate", json={"mechanism": m, "steps": 120}).json()
+    fast = client.post("/api/simulate", json={"mechanism": m, "steps": 120, "preview": True}).json()
+    assert fast["preview"] and fast["input"] == full["input"] and fast["assembled"] == full["assembled"]
+    for group in ("joints", "points"):
+        for key, pts in full[group].items():
+            for p, q in zip(pts, fast[group][key]):
+                assert (p is None) == (q is None)
+                if p is not None:
+                    assert q == pytest.approx(p, abs=1e-9)

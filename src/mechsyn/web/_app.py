@@ -251,7 +251,8 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     async def simulate(request: Request) -> Any:
         data = await _body(request)
         steps = _int(data.get("steps", 180), "steps")
-        return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps)
+        fn = _service.simulate_preview if data.get("preview") is True else _service.simulate
+        return await run_in_threadpool(fn, _need(data, "mechanism"), steps)
 
     @api
     async def files(request: Request) -> Any:

@@ -168,6 +168,65 @@ def _driver_start(mech, jid: str) -> float:
     raise MechsynInputError(f"joint {jid} is not driven", field="input", hint="mark it as a drive")
 
 
+def _sweep(mech, steps: int, span: float | None) -> tuple[Any, np.ndarray]:
+    """The first drive and its input values, starting at the drawn configuration."""
+    drives = [j for j in mech.joints if j.actuated]
+    if not drives:
+        raise MechsynInputError("no drive: nothing moves", field="joints",
+                                hint="mark a joint to the frame as a drive")
+    if not 2 <= int(steps) <= MAX_STEPS:
+        raise MechsynInputError(f"steps must be within 2..{MAX_STEPS}", field="steps")
+    drive = drives[0]
+    start = _driver_start(mech, drive.id)
+    n = int(steps)
+    if drive.type == "P":
+        span = _scale(mech) if span is None else span
+        return drive, start + np.linspace(-span / 2, span / 2, n)
+    if span is None or abs(span - 360.0) < 1e-12:
+        return drive, start + np.linspace(0.0, 360.0, n + 1)[:n]
+    return drive, start + np.linspace(0, span, n)
+
+
+def simulate_preview(data: Any, steps: int = 180) -> dict[str, Any]:
+    """Positions only, for the drag loop: the closed-form Assur-group solution of
+    :func:`simulate` without its dead-point refinement, velocities and events (those come
+    with the full :func:`simulate` when the drag ends). Falls back to :func:`simulate`
+    when the mechanism does not decompose into drivers and dyads.
+    """
+    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics.analysis import resolve_points
+    from mechsyn.kinematics.solve import assemble
+    from mechsyn.kinematics.system import build_system
+
+    mech = build(data)
+    drive, values = _sweep(mech, steps, None)
+    S = build_system(mech)
+    plan = dyads.decompose(S)
+    if plan is None:
+        return simulate(data, steps)
+    assemble(S)  # the drawn configuration must assemble (else an input error, as in simulate)
+    U = np.tile([d.assembled for d in S.drivers], (len(values), 1)).astype(float)
+    k = [d.joint for d in S.drivers].index(drive.id)
+    U[:, k] = np.radians(values) if drive.type == "R" else values
+    q, _ = dyads.solve_positions(S, plan, U)
+    ok = np.all(np.isfinite(q), axis=1)
+    qz, zero = np.nan_to_num(q), np.zeros_like(q)
+    names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
+    pos = {}
+    for name, (link, at) in resolve_points(mech, names).items():
+        P, _, _ = S.point_state(qz, zero, zero, S.index(link), S.to_local(link, at))
+        P[~ok] = np.nan
+        pos[name] = P
+    return {"mechanism": mech.name, "preview": True,
+            "input": {"joint": drive.id, "type": drive.type, "values": _finite(values),
+                      "unit": "deg" if drive.type == "R" else "length"},
+            "assembled": ok.tolist(),
+            "joints": {j.id: _xy(pos[j.id]) for j in mech.joints if j.id in pos},
+            "points": {p: _xy(pos[p]) for p in mech.points},
+            "velocity": {}, "acceleration": {}, "links": {}, "working_ranges": [], "events": [], "notes": [],
+            "transmission_angle": {}, "method": "assur (positions only)"}
+
+
 def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str, Any]:
     """Positions of every joint and named point over a sweep of the first drive.
 
@@ -181,21 +240,7 @@ def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str
     from mechsyn.kinematics.analysis import simulate as _simulate
 
     mech = build(data)
-    drives = [j for j in mech.joints if j.actuated]
-    if not drives:
-        raise MechsynInputError("no drive: nothing moves", field="joints",
-                                hint="mark a joint to the frame as a drive")
-    if not 2 <= int(steps) <= MAX_STEPS:
-        raise MechsynInputError(f"steps must be within 2..{MAX_STEPS}", field="steps")
-    drive = drives[0]
-    start = _driver_start(mech, drive.id)
-    if span is None:
-        span = 360.0 if drive.type == "R" else _scale(mech)
-    n = int(steps)
-    if drive.type == "R" and abs(span - 360.0) < 1e-12:
-        values = start + np.linspace(0.0, 360.0, n + 1)[:n]
-    else:
-        values = start + np.linspace(-span / 2, span / 2, n) if drive.type == "P" else start + np.linspace(0, span, n)
+    drive, values = _sweep(mech, steps, span)
     names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
     sim = _simulate(mech, {drive.id: values}, points=names)
     ok = sim.assembled

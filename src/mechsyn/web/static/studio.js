@@ -64,17 +64,18 @@ function statusLine() {
 
 // ------------------------------------------------------------------ simulation and analysis
 const simulateSoon = coalescing(
-  (mech) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: mech, steps: 180 }).then((r) => ({ r, ms: performance.now() - t0 })); },
-  ({ r, ms }, mech) => {
+  // while dragging: positions only (the closed form, fast); on release: the full simulation
+  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, preview: !!req.preview }).then((r) => ({ r, ms: performance.now() - t0 })); },
+  ({ r, ms }, { mech }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
-    if (mech !== state.mech && !state.dragging) return; // a newer mechanism is on its way
+    if ((mech !== state.mech || r.preview) && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
     if (state.frame >= r.assembled.length) state.frame = 0;
     render();
     if (!state.dragging) renderAnalysis();
   },
-  (e, mech) => {
+  (e, { mech }) => {
     state.simulations += 1;
     if (mech !== state.mech && !state.dragging) return;
     state.sim = null; state.simFor = mech; state.notes = [];
@@ -106,7 +107,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
   if (!keepFrame) state.frame = 0;
   if (fit) fitView();
   state.errors = [];
-  if (mech.joints.some((j) => j.actuated)) simulateSoon(mech);
+  if (mech.joints.some((j) => j.actuated)) simulateSoon({ mech });
   else { state.sim = null; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
   analyseSoon();
   render();
@@ -304,7 +305,7 @@ svg.addEventListener("pointermove", (ev) => {
   gesture.moved = true;
   state.mech = m;
   render();
-  simulateSoon(m);
+  simulateSoon({ mech: m, preview: true });
 });
 
 function endGesture() {
@@ -314,7 +315,7 @@ function endGesture() {
   if (g.kind === "drag") {
     state.dragging = false;
     if (!g.moved) state.undo.pop();
-    setMech(state.mech, { record: false });
+    setMech(clone(state.mech), { record: false });
   }
 }
 svg.addEventListener("pointerup", endGesture);
