@@ -25,6 +25,7 @@ from mechsyn.cli import synth_path as _synth_path  # noqa: F401
 from mechsyn.cli import synth_mechanism as _synth_mechanism  # noqa: F401
 from mechsyn.cli import synth_curve as _synth_curve  # noqa: F401
 from mechsyn.cli import curves as _curves  # noqa: F401
+from mechsyn.cli import serve as _serve  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
