@@ -24,6 +24,7 @@ from mechsyn.cli import synth_finger_design as _synth_finger_design  # noqa: F40
 from mechsyn.cli import synth_path as _synth_path  # noqa: F401
 from mechsyn.cli import synth_mechanism as _synth_mechanism  # noqa: F401
 from mechsyn.cli import convert as _convert  # noqa: F401
+from mechsyn.cli import export as _export  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
