@@ -23,13 +23,27 @@ console = Console()
 err_console = Console(stderr=True)
 
 
-def emit_json(obj: Any, out: Path | None = None) -> None:
-    """Print ``obj`` as JSON on stdout, or write it whole to ``out``."""
-    text = dumps(obj)
-    if out is None:
-        sys.stdout.write(text + "\n")
+STDOUT = "-"
+
+
+def is_stdout(path: Path | str | None) -> bool:
+    """Whether an output option names standard output (``-o -``)."""
+    return path is not None and str(path) == STDOUT
+
+
+def write_output(out: Path | str, text: str) -> None:
+    """Write ``text`` whole to the file ``out``, or to stdout when ``out`` is ``-``."""
+    if is_stdout(out):
+        sys.stdout.write(text)
+        sys.stdout.flush()
     else:
-        write_atomic(out, text + "\n")
+        write_atomic(out, text)
+
+
+def emit_json(obj: Any, out: Path | None = None) -> None:
+    """Print ``obj`` as JSON on stdout, or write it whole to ``out`` (``-``: stdout)."""
+    text = dumps(obj)
+    write_output(STDOUT if out is None else out, text + "\n")
 
 
 def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
@@ -55,7 +69,12 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
 
 def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
                         what: str | None = None) -> None:
-    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work)."""
+    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work).
+
+    ``-`` (standard output) passes for text formats (.csv, .json, .yaml, .md, .pyslvs, .svg).
+    """
+    if is_stdout(path) and set(suffixes) & {".csv", ".json", ".yaml", ".md", ".pyslvs", ".svg", ".txt"}:
+        return
     if path is not None and path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
 

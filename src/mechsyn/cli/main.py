@@ -26,6 +26,8 @@ from mechsyn.cli import synth_mechanism as _synth_mechanism  # noqa: F401
 from mechsyn.cli import synth_curve as _synth_curve  # noqa: F401
 from mechsyn.cli import curves as _curves  # noqa: F401
 from mechsyn.cli import serve as _serve  # noqa: F401
+from mechsyn.cli import convert as _convert  # noqa: F401
+from mechsyn.cli import export as _export  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
