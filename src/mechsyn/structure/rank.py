@@ -995,114 +995,125 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     planar = mech.kind == "planar" if planar is None else planar
     progress("contours")
     sysm = _build_system(mech, planar)
-    lam, K = sysm.lam, len(sysm.contours)
-    F = sysm.twists.shape[0]
-    if tol is None:
-        eps = _input_rounding(mech)
-        tol = max(1e-6, min(1e-3, 50.0 * eps / sysm.scale))
+    lam, K, F = sysm.lam, len(sysm.contours), sysm.twists.shape[0]
+    tol = _default_tolerance(mech, sysm) if tol is None else tol
     M, _ = sysm.closure(np.zeros(F))
     notes: list[str] = []
     progress("rank")
     red = _reduce(sysm, M, tol)
-    sv, rank = red.singular_values, red.rank
-    near = bool(np.any((sv > tol) & (sv < 1e-2)))
-    if near:
-        small = sv[(sv > tol) & (sv < 1e-2)]
+    near = _near_singular_note(red.singular_values, tol, F, lam * K, red.rank, notes)
+    mobility, redundant, N = F - red.rank, lam * K - red.rank, red.null
+    contours = _contour_ranks(sysm, red, tol)
+    if sum(c.redundant for c in contours) != redundant:  # borderline singular values: say so
+        notes.append(f"per-contour counts ({', '.join(str(c.redundant) for c in contours)}) and the total "
+                     f"{redundant} differ at this tolerance: a singular value is close to it")
+    progress("idle")
+    acols, anames = _actuated_columns(sysm)
+    Z0 = _null(N[acols], tol) if mobility and acols else np.eye(mobility)
+    idle, _, idle_notes = find_idle_mobilities(_idle_inputs(mech, sysm, N, Z0), tol) if mobility else ([], None, [])
+    notes.extend(idle_notes)
+    useful = mobility - len(idle)
+    determined, anote = _actuation(sysm, N, Z0, acols, anames, len(idle), tol)
+    singular, finite = False, (0 if mobility == 0 else None)
+    if check_singular and mobility > 0:
+        progress("singularity")
+        singular, finite, contours = _singularity(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
+    sv = red.singular_values
+    return RankAnalysis(
+        motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
+        idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
+        actuated=anames, actuation_determined=determined, actuation_note=anote, singular=singular,
+        finite_mobility=finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
+        equations=lam * K, rank=red.rank, smallest_singular_values=sorted(float(x) for x in sv)[: min(4, len(sv))],
+        near_singular=near, notes=notes,
+    )
+
+
+def _default_tolerance(mech: Mechanism, sysm: _System) -> float:
+    """``max(1e-6, min(1e-3, 50 ε / L))`` with ``ε`` the rounding of the file's coordinates."""
+    return max(1e-6, min(1e-3, 50.0 * _input_rounding(mech) / sysm.scale))
+
+
+def _near_singular_note(sv: np.ndarray, tol: float, F: int, equations: int, rank: int, notes: list[str]) -> bool:
+    """Singular values between the tolerance and ``1e-2``: a near-singularity, said in ``notes``."""
+    small = sv[(sv > tol) & (sv < 1e-2)]
+    if small.size:
         k = small.size
         notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} above the tolerance "
                      f"{tol:.2g} but small; if the geometry is meant to be special (typed with few decimals), "
-                     f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {lam * K - rank + k} "
+                     f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {equations - rank + k} "
                      f"redundant constraint(s)")
-    mobility = F - rank
-    redundant = lam * K - rank
-    N = red.null
+    return bool(small.size)
 
-    # -- redundant constraints per contour (sequential) and their directions: the rows of
-    # contour k reduced against the row space of contours 1..k-1; combinations c of its
-    # rows whose residual vanishes are its redundant constraints, c being the contour's
-    # self-stress wrench [moment about the centre; force].
+
+def _contour_ranks(sysm: _System, red: _Reduction, tol: float) -> list[ContourRank]:
+    """Redundant constraints per contour (sequential) and their directions: the rows of
+    contour k reduced against the row space of contours 1..k-1; combinations c of its rows
+    whose residual vanishes are its redundant constraints, c being the contour's
+    self-stress wrench [moment about the centre; force]."""
+    lam = sysm.lam
     contours: list[ContourRank] = []
-    for k in range(K):
+    for k in range(len(sysm.contours)):
         inc, u_k = red.increments[k], red.left[k]
         qk = lam - inc
         part = u_k[:, inc:]
         dirs: list[str] = []
         Wj = np.zeros((6, 0))
         if qk > 0:
-            if planar:
+            if sysm.planar:
                 Wj = np.zeros((6, part.shape[1]))
                 Wj[PLANAR_ROWS] = part
             else:
                 Wj = part
-            dirs = describe_wrenches(Wj, sysm.centre, sysm.scale, planar, tol)
+            dirs = describe_wrenches(Wj, sysm.centre, sysm.scale, sysm.planar, tol)
         contours.append(ContourRank(index=k + 1, joints=list(sysm.contours[k]), redundant=qk,
                                     directions=dirs, reason=_contour_reason(sysm, k, Wj)))
-    if sum(c.redundant for c in contours) != redundant:  # borderline singular values: say so
-        notes.append(f"per-contour counts ({', '.join(str(c.redundant) for c in contours)}) and the total "
-                     f"{redundant} differ at this tolerance: a singular value is close to it")
+    return contours
 
-    # -- idle mobilities (families (a) and (b), mechsyn.structure.idle) with every drive at rest
-    progress("idle")
-    acols, anames = _actuated_columns(sysm)
-    if mobility and acols:
-        Z0 = _null(N[acols], tol)
-    else:
-        Z0 = np.eye(mobility)
-    idle, _, idle_notes = find_idle_mobilities(_idle_inputs(mech, sysm, N, Z0), tol) if mobility else ([], None, [])
-    notes.extend(idle_notes)
-    useful = mobility - len(idle)
 
-    # -- drives: they determine the motion when every motion left with them at rest is idle
-    determined: bool | None = None
-    anote = ""
-    if anames:
-        uncontrolled = Z0.shape[1] - len(idle)
-        determined = uncontrolled == 0
-        ra = _rank(N[acols], tol) if mobility else 0
-        if not determined:
-            anote = (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
-                     f"{useful} drive(s) needed")
-        elif ra < len(acols):
-            locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
-                      and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
-            anote = (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
-                     "are not independent (redundant actuation: the drives fight each other)"
-                     + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
-                        if locked else ""))
-        else:
-            anote = f"the drives at {', '.join(anames)} determine the motion"
+def _actuation(sysm: _System, N: np.ndarray, Z0: np.ndarray, acols: list[int], anames: list[str], idle: int,
+               tol: float) -> tuple[bool | None, str]:
+    """Whether the drives determine the motion (every motion left with them at rest is
+    idle), and the sentence that says so."""
+    if not anames:
+        return None, ""
+    mobility = N.shape[1]
+    uncontrolled = Z0.shape[1] - idle
+    if uncontrolled:
+        return False, (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
+                       f"{mobility - idle} drive(s) needed")
+    ra = _rank(N[acols], tol) if mobility else 0
+    if ra < len(acols):
+        locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
+                  and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
+        return True, (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
+                      "are not independent (redundant actuation: the drives fight each other)"
+                      + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
+                         if locked else ""))
+    return True, f"the drives at {', '.join(anames)} determine the motion"
 
-    # -- singularity
-    singular, finite = False, None
-    if check_singular and mobility > 0:
-        progress("singularity")
-        r_near, fnotes = _follow(sysm, N, tol, rank, seed=seed)
-        notes.extend(fnotes)
-        if r_near is not None:
-            finite = F - r_near
-            singular = r_near != rank
-            if singular:
-                notes.append(f"singular configuration: {mobility} instantaneous freedom(s) but {max(finite, 0)} "
-                             f"finite one(s) at nearby assembled configurations; away from it "
-                             f"{max(finite - len(idle), 0)} drive(s) and {lam * K - r_near} redundant "
-                             f"constraint(s)")
-                lead = "singular configuration (pairs lined up): "
-                if lam * K - r_near == 0:
-                    lead += "every redundant constraint vanishes at nearby configurations"
-                    contours = [replace(c, reason=lead) if c.redundant else c for c in contours]
-                else:
-                    lead += f"{r_near - rank} redundant constraint(s) vanish at nearby configurations; otherwise "
-                    contours = [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
-    elif mobility == 0:
-        finite = 0
-    smallest = sorted(float(x) for x in sv)[: min(4, len(sv))]
-    return RankAnalysis(
-        motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
-        idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
-        actuated=anames, actuation_determined=determined, actuation_note=anote, singular=singular,
-        finite_mobility=finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
-        equations=lam * K, rank=rank, smallest_singular_values=smallest, near_singular=near, notes=notes,
-    )
+
+def _singularity(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, contours: list[ContourRank],
+                 notes: list[str], seed: int) -> tuple[bool, int | None, list[ContourRank]]:
+    """Singular when the rank at nearby assembled configurations is larger; the finite
+    mobility there, and the contours' reasons amended."""
+    F, equations = sysm.twists.shape[0], sysm.lam * len(sysm.contours)
+    r_near, fnotes = _follow(sysm, N, tol, rank, seed=seed)
+    notes.extend(fnotes)
+    if r_near is None:
+        return False, None, contours
+    finite = F - r_near
+    if r_near == rank:
+        return False, finite, contours
+    notes.append(f"singular configuration: {N.shape[1]} instantaneous freedom(s) but {max(finite, 0)} "
+                 f"finite one(s) at nearby assembled configurations; away from it "
+                 f"{max(finite - idle, 0)} drive(s) and {equations - r_near} redundant constraint(s)")
+    lead = "singular configuration (pairs lined up): "
+    if equations - r_near == 0:
+        lead += "every redundant constraint vanishes at nearby configurations"
+        return True, finite, [replace(c, reason=lead) if c.redundant else c for c in contours]
+    lead += f"{r_near - rank} redundant constraint(s) vanish at nearby configurations; otherwise "
+    return True, finite, [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
 
 
 # --------------------------------------------------------------------------- formulas side by side
