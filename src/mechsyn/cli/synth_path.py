@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats
+from mechsyn.cli.common import console, emit_json, err_console, parse_floats, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -98,7 +98,8 @@ def synth_path(
                                       rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
                                       name=f"Four-bar for path case {case.id}")
         write_mechanism_file(mech, out, header=(
-            f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
+            ("INTERRUPTED (Ctrl-C): the best design found before the interrupt\n" if res.interrupted else "")
+            + f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
             f"joint points at target 1 (crank angle {np.degrees(res.theta2[0]):.4f} deg), branch {case.branch}"))
     if plot is not None:
         _save_plot(plot, lambda ax: plot_fourbar_path(
@@ -107,8 +108,9 @@ def synth_path(
             else f"{case.id}: error {res.error:.4g}"))
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"Path synthesis {case.id}")
+    t = Table(title=f"Path synthesis {case.id}" + (" (interrupted: best so far)" if res.interrupted else ""))
     t.add_column("variable")
     t.add_column("value", justify="right")
     for k, v in res.design.items():
@@ -118,6 +120,7 @@ def synth_path(
                   + (f"   published best: {case.best_known:.8g}" if case.best_known else ""))
     console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
                   f"branch {case.branch}   {res.restarts} restarts, {res.seconds:.1f} s")
+    stop_if_interrupted(res)
 
 
 @synth_app.command("function")
