@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Optional
 
@@ -167,12 +166,9 @@ def synth_function(
 
 def _read_poses(file: Optional[Path], poses: Optional[str]) -> np.ndarray:
     if file is not None:
-        try:
-            data = json.loads(file.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise MechsynInputError("file not found", source=str(file)) from None
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(file), line=exc.lineno) from None
+        from mechsyn.io.files import read_data
+
+        data, _ = read_data(file, "poses file", fmt="json")
         items = data.get("poses") if isinstance(data, dict) else data
         try:
             P = np.array([[float(p[0]), float(p[1]), float(p[2])] for p in items])

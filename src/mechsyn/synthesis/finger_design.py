@@ -112,12 +112,10 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> FingerCase:
     """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    from mechsyn.io.load import read_data
+    from mechsyn.io.files import read_data
 
     path = Path(path)
-    if not path.is_file():
-        raise _err(f"no such file: {path}", str(path))
-    data, _text = read_data(path)
+    data, _text = read_data(path, "case file")
     return case_from_dict(data, str(path), base_dir=path.parent)
 
 

@@ -121,15 +121,10 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> MechanismCase:
     """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism")."""
-    import yaml
+    from mechsyn.io.files import read_data
 
     p = Path(path)
-    if not p.is_file():
-        raise _err(f"no such file: {p}", str(p))
-    try:
-        data = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as exc:
-        raise _err(f"not valid YAML/JSON: {exc}", str(p)) from None
+    data, _ = read_data(p, "case file", fmt="yaml")
     return case_from_dict(data, source=str(p), base_dir=p.parent)
 
 
