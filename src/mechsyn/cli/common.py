@@ -173,6 +173,17 @@ def track(items: Iterable[T], description: str, total: int | None = None) -> Ite
             advance()
 
 
+def stop_if_interrupted(result: Any) -> None:
+    """Exit with status 130 (``interrupted``) when ``result`` says Ctrl-C ended it.
+
+    Called by a search command after it has written and shown its best result so far.
+    """
+    if getattr(result, "interrupted", False):
+        from mechsyn.interrupt import INTERRUPT_EXIT_CODE
+
+        raise typer.Exit(INTERRUPT_EXIT_CODE)
+
+
 def exit_with(error: MechsynInputError) -> None:
     err_console.print(f"[bold red]error:[/] {escape(error.format())}", highlight=False, soft_wrap=True)
     raise typer.Exit(2)

@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.interrupt import BestSoFar
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
@@ -120,15 +121,10 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> MechanismCase:
     """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism")."""
-    import yaml
+    from mechsyn.io.files import read_data
 
     p = Path(path)
-    if not p.is_file():
-        raise _err(f"no such file: {p}", str(p))
-    try:
-        data = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as exc:
-        raise _err(f"not valid YAML/JSON: {exc}", str(p)) from None
+    data, _ = read_data(p, "case file", fmt="yaml")
     return case_from_dict(data, source=str(p), base_dir=p.parent)
 
 
@@ -536,12 +532,13 @@ class MechanismSynthesisResult:
     restart_errors: list[float] = field(default_factory=list)
     stopped_by_time_limit: bool = False
     reason: str = ""                   # why the best design is infeasible ("" when feasible)
+    interrupted: bool = False          # Ctrl-C ended the search: the best design so far
 
     def to_dict(self) -> dict[str, Any]:
         out = {k: getattr(self, k) for k in (
             "case", "problem", "error", "design", "start_design", "start_error", "feasible",
             "assembled_at_all_targets", "method", "seconds", "seed", "restarts", "nfev", "inputs_deg",
-            "targets", "achieved", "restart_errors", "stopped_by_time_limit", "reason")}
+            "targets", "achieved", "restart_errors", "stopped_by_time_limit", "reason", "interrupted")}
         if self.problem == "motion":
             out["achieved_angles_deg"] = self.achieved_angles_deg
             out["target_angles_deg"] = self.target_angles_deg
@@ -557,7 +554,10 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     the feasibility-first fitness, then a least-squares polish of the best few members
     (:func:`mechsyn.synthesis.optimize.polish`); the file's own design competes too.
     ``batch``: evaluate populations through the batch engine where the case allows
-    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design."""
+    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
+    returns the best design evaluated so far with ``interrupted=True``."""
     from mechsyn.synthesis.optimize import OPTIMIZERS, polish, restart_seeds
 
     if optimizer not in OPTIMIZERS:
@@ -577,44 +577,52 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     # the least-squares polish then finishes it
     f_atol = float(opts.pop("f_atol", 1e-18 * prob.penalty_base))
 
-    for r, s in enumerate(restart_seeds(seed, restarts)):
-        if r and time.monotonic() > deadline - 0.1 * time_limit:
-            stopped = True
-            break
-        search_end = t0 + time_limit * (0.85 * (r + 1) / restarts)
+    tracker = BestSoFar()
+    interrupted = False
+    try:
+        for r, s in enumerate(restart_seeds(seed, restarts)):
+            if r and time.monotonic() > deadline - 0.1 * time_limit:
+                stopped = True
+                break
+            search_end = t0 + time_limit * (0.85 * (r + 1) / restarts)
 
-        def should_stop(f: float, r: int = r) -> bool:
+            def should_stop(f: float, r: int = r) -> bool:
+                if progress is not None:
+                    progress(r, restarts, min(best_f, f))
+                return time.monotonic() >= search_end or f <= f_atol
+
+            g = OPTIMIZERS[optimizer](tracker.wrap(prob.fitness), prob.lower, prob.upper, seed=s, should_stop=should_stop,
+                                      options=opts)
+            cands = [np.asarray(g.x, float)]
+            if g.population is not None and g.population_fun is not None:
+                for i in np.argsort(g.population_fun):
+                    z = np.asarray(g.population[i], float)
+                    if len(cands) >= n_polish:
+                        break
+                    if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
+                        cands.append(z)
+            rbest = np.inf
+            for c in cands:
+                if time.monotonic() < deadline:
+                    c = polish(prob, c)
+                f = float(prob.fitness(c[None, :])[0])
+                rbest = min(rbest, f)
+                if f < best_f:
+                    best_z, best_f = c, f
+            errs.append(rbest if rbest < prob.penalty_base else float("inf"))
+            done += 1
             if progress is not None:
-                progress(r, restarts, min(best_f, f))
-            return time.monotonic() >= search_end or f <= f_atol
-
-        g = OPTIMIZERS[optimizer](prob.fitness, prob.lower, prob.upper, seed=s, should_stop=should_stop,
-                                  options=opts)
-        cands = [np.asarray(g.x, float)]
-        if g.population is not None and g.population_fun is not None:
-            for i in np.argsort(g.population_fun):
-                z = np.asarray(g.population[i], float)
-                if len(cands) >= n_polish:
-                    break
-                if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
-                    cands.append(z)
-        rbest = np.inf
-        for c in cands:
-            if time.monotonic() < deadline:
-                c = polish(prob, c)
-            f = float(prob.fitness(c[None, :])[0])
-            rbest = min(rbest, f)
-            if f < best_f:
-                best_z, best_f = c, f
-        errs.append(rbest if rbest < prob.penalty_base else float("inf"))
-        done += 1
-        if progress is not None:
-            progress(done, restarts, best_f)
+                progress(done, restarts, best_f)
+    except KeyboardInterrupt:  # Ctrl-C: keep the best design evaluated so far
+        interrupted = True
+        if tracker.x is not None and tracker.f < best_f:
+            best_z, best_f = tracker.x, tracker.f
     ev = evaluate_design(case, best_z)
     names = case.names
     design = {n: float(v) for n, v in zip(names, best_z)}
     d = apply_design(case, best_z[:case.n_design])
-    d["name"] = f"{d.get('name', 'mechanism')} (synthesised, seed {seed})"
+    d["name"] = (f"{d.get('name', 'mechanism')} (synthesised, seed {seed}"
+                 + (", interrupted: best so far)" if interrupted else ")"))
     ok = bool(ev.feasible)
     N = case.n_targets
     return MechanismSynthesisResult(
@@ -626,4 +634,4 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         achieved=ev.achieved if ok else np.full((N, 2), np.nan),
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,
-        stopped_by_time_limit=stopped, reason=ev.reason)
+        stopped_by_time_limit=stopped, reason=ev.reason, interrupted=interrupted)
