@@ -14,7 +14,7 @@ from rich.table import Table
 
 from mechsyn.cli.app import app
 from mechsyn.cli.common import (check_output_suffix, console, emit_json, is_stdout, one_stdout, parse_range,
-                                progress_bar, write_output)
+                                progress_bar, save_animation, save_plot, write_output)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 from mechsyn.results import to_jsonable
@@ -176,11 +176,11 @@ def simulate_cmd(
             cols += [lm.angle, lm.angular_velocity, lm.angular_acceleration]
         write_output(csv_out, _csv_text(header, cols))
     if plot is not None:
-        from mechsyn.kinematics.plots import plot_simulation
-        plot_simulation(sim, plot)
+        from mechsyn.plot.kinematics import plot_simulation
+        save_plot(plot, plot_simulation, sim)
     if animate is not None:
-        from mechsyn.kinematics.plots import animate as anim
-        anim(sim, animate)
+        from mechsyn.plot.kinematics import animate_simulation
+        save_animation(animate, animate_simulation, sim, dpi=100)
     if is_stdout(csv_out):
         return
     if json_:
@@ -285,8 +285,8 @@ def forces_cmd(
             cols.append(e)
         write_output(csv_out, _csv_text(header, cols))
     if plot is not None:
-        from mechsyn.kinematics.plots import plot_forces
-        plot_forces(fa, plot)
+        from mechsyn.plot.kinematics import plot_forces
+        save_plot(plot, plot_forces, fa)
     if is_stdout(csv_out):
         return
     if json_:
