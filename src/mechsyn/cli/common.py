@@ -40,6 +40,13 @@ def write_output(out: Path | str, text: str) -> None:
         write_atomic(out, text)
 
 
+def one_stdout(json_: bool, *outs: Path | str | None) -> None:
+    """Refuse two outputs to stdout (``--json`` and a ``-`` file, or two ``-`` files)."""
+    if int(bool(json_)) + sum(is_stdout(o) for o in outs) > 1:
+        raise MechsynInputError("two outputs to stdout", source="-",
+                                hint="send one of them to a file (or drop --json)")
+
+
 def emit_json(obj: Any, out: Path | None = None) -> None:
     """Print ``obj`` as JSON on stdout, or write it whole to ``out`` (``-``: stdout)."""
     text = dumps(obj)
