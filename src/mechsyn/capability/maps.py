@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechsyn._result import Result
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
 from mechsyn.capability.measures import (
     MEASURES, component_limit, exact_limit, min_norm_limit, stepped_limit,
@@ -269,10 +270,12 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
     return q, val
 
 
-@dataclass
-class CapabilityMap:
+@dataclass(repr=False)
+class CapabilityMap(Result):
     """V_max over a grid: ``value[i, j]`` at ``(xs[i], ys[j])`` with the optimal
     configuration ``q[i, j]`` (radians; NaN where no allowed configuration reaches)."""
+
+    _plot = "capability:plot_capability_map"
 
     xs: np.ndarray
     ys: np.ndarray
@@ -437,58 +440,3 @@ def interpolate_configuration(cmap: CapabilityMap, method: str = "cubic"
         return interp(np.stack([x.ravel(), y.ravel()], -1)).reshape(*x.shape, q.shape[-1])
 
     return at
-
-
-def plot_map(cmap: CapabilityMap, path, units: str = "mm/s") -> None:
-    """Heat map with contour lines of V_max and panels of the optimal joint values."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mechsyn.results import save_figure_atomic
-
-    n = cmap.q.shape[-1]
-    panels = 1 + n
-    cols = 2 if panels <= 4 else 3
-    rows_ = math.ceil(panels / cols)
-    fig, axs = plt.subplots(rows_, cols, figsize=(5.2 * cols, 4.4 * rows_), squeeze=False)
-    small = cmap.xs.size * cmap.ys.size <= 144
-    qu = cmap.q_user()
-    fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
-               f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
-               f"[{units}]" + ("" if cmap.z is None else f" in z = {cmap.z:g}")
-               + f"\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
-    for k in range(n):
-        data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else ""
-        if cmap.joint_is_revolute[k] and np.nanmax(np.abs(data), initial=0.0) > 180:
-            data, unit = (data + 180) % 360 - 180, "deg, shown mod 360"  # same pose
-        fields.append((data, f"optimal {cmap.joint_names[k]} [{unit}]", "coolwarm"))
-    for idx, (data, title, cm) in enumerate(fields):
-        ax = axs[idx // cols][idx % cols]
-        mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
-        fig.colorbar(mesh, ax=ax, shrink=0.85)
-        finite = np.isfinite(data)
-        if (idx == 0 and cmap.xs.size > 2 and cmap.ys.size > 2 and finite.sum() > 4
-                and np.nanstd(data) > 0):
-            try:
-                cs = ax.contour(cmap.xs, cmap.ys, data.T, levels=8, colors="k", linewidths=0.6)
-                if not small:
-                    ax.clabel(cs, fontsize=8, fmt="%.0f")
-            except (ValueError, TypeError):
-                pass
-        if small:
-            for i, x in enumerate(cmap.xs):
-                for j, y in enumerate(cmap.ys):
-                    if np.isfinite(data[i, j]):
-                        ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=8,
-                                color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
-        ax.set_title(title, fontsize=9)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        ax.set_aspect("equal")
-    for idx in range(panels, rows_ * cols):
-        axs[idx // cols][idx % cols].axis("off")
-    fig.tight_layout()
-    save_figure_atomic(fig, path, dpi=110)
-    plt.close(fig)

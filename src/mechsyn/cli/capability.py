@@ -18,7 +18,7 @@ from rich.table import Table
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
     capability_map, continuous_best, interpolate_configuration, is_closed_form,
-    measure_values, plot_map, refine_over_self_motion, self_motion,
+    measure_values, refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
@@ -258,7 +258,10 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
     if csv_out is not None:
         write_atomic(csv_out, cmap.to_csv())
     if map_png is not None:
-        plot_map(cmap, map_png)
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.capability import plot_capability_map
+
+        save_plot(map_png, plot_capability_map, cmap)
     v = np.where(np.isfinite(cmap.value), cmap.value, np.nan)
     interp = None
     if at is not None:
