@@ -53,6 +53,24 @@ def emit_json(obj: Any, out: Path | None = None) -> None:
     write_output(STDOUT if out is None else out, text + "\n")
 
 
+#: The library's errors name its parameters (``MechsynInputError(field="tol")``); the command
+#: line shows them as its options. One table for every command.
+PARAMETER_OPTIONS: dict[str, str] = {
+    "method": "--method", "tol": "--tol", "inputs": "--input", "points": "--points", "speeds": "--speed",
+    "vll": "--vll", "animate": "--animate", "seed": "--seed", "time_limit": "--time-limit",
+    "restarts": "--restarts", "workers": "--workers", "optimizer": "--optimizer", "direction": "--direction",
+    "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output",
+}
+
+
+def option_error(error: MechsynInputError) -> MechsynInputError:
+    """``error`` with a library parameter (its ``field``) shown as the command-line option."""
+    if error.source is None and error.field in PARAMETER_OPTIONS:
+        return MechsynInputError(error.message, source=PARAMETER_OPTIONS[error.field], line=error.line,
+                                 hint=error.hint)
+    return error
+
+
 def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
     """Stop the command with one clear message and exit status 2."""
     raise MechsynInputError(message, hint=hint, source=source)

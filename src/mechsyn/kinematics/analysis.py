@@ -375,6 +375,14 @@ class ForceAnalysis(Result):
 
     _plot = "kinematics:plot_forces"
 
+    def _summary(self) -> list[tuple[str, str]]:
+        sim, r = self.simulation, self.reactions
+        return [("mechanism", sim.mechanism), ("analysis", "static" if self.static else "kinetostatic"),
+                ("gravity", f"({self.gravity[0]:g}, {self.gravity[1]:g})"),
+                ("assembled", f"{int(np.count_nonzero(sim.assembled))} of {len(sim.assembled)}"),
+                ("joints", ", ".join(r.force) or "-"),
+                ("drives", ", ".join(f"{j} ({r.effort_kind[j]})" for j in r.effort) or "-")]
+
     simulation: Simulation
     reactions: Reactions
     gravity: tuple[float, float]
