@@ -16,18 +16,20 @@ from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import to_jsonable, write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
 from mechsyn.structure.remedies import Remedy, find_remedies
-from mechsyn.structure.rank import (
+from mechsyn.structure.compare import (
     Comparison,
-    InsufficientGeometry,
-    RankAnalysis,
     RemedyCheck,
-    analyze_rank,
-    as_spatial,
     check_remedy,
     compare_with_formulas,
+    rank_to_markdown,
+)
+from mechsyn.structure.rank import (
+    InsufficientGeometry,
+    RankAnalysis,
+    analyze_rank,
+    as_spatial,
     missing_geometry,
     rank_summary_lines,
-    rank_to_markdown,
 )
 from mechsyn.errors import MechsynInputError
 from mechsyn.structure.report import CONTOUR_READING, formula_title, pair_list, to_markdown
