@@ -89,12 +89,13 @@ __all__ = [
 DENSE_MAX_FREEDOMS = 120
 
 
-def _reduce(sysm: "_System", M: np.ndarray, tol: float) -> _Reduction:
-    """Rank and null space of the loop-closure matrix ``M``: one dense SVD for small
-    systems, contour-by-contour elimination above :data:`DENSE_MAX_FREEDOMS`."""
-    if M.shape[1] <= DENSE_MAX_FREEDOMS:
-        return _reduce_dense(M, sysm.lam, tol)
-    return _eliminate(M, sysm.contour_columns(), sysm.lam, tol)
+def _reduce(sysm: "_System", theta: np.ndarray, tol: float) -> _Reduction:
+    """Rank and null space of the loop-closure matrix at ``θ``: one dense SVD for small
+    systems, contour-by-contour elimination on its blocks above :data:`DENSE_MAX_FREEDOMS`."""
+    if sysm.twists.shape[0] <= DENSE_MAX_FREEDOMS:
+        return _reduce_dense(sysm.closure(theta)[0], sysm.lam, tol)
+    blocks, _ = sysm.closure_blocks(theta)
+    return _eliminate(blocks, sysm.contour_columns(), sysm.lam, tol, sysm.twists.shape[0])
 
 
 # --------------------------------------------------------------------------- results
@@ -198,6 +199,7 @@ class _System:
     factors: list[list[tuple[int, int]]]  # per contour: (column, sign) in product order
     centre: np.ndarray
     scale: float
+    _cols: list[np.ndarray] | None = None
 
     @property
     def lam(self) -> int:
@@ -207,29 +209,34 @@ class _System:
         return mat[PLANAR_ROWS] if self.planar else mat
 
     def contour_columns(self) -> list[np.ndarray]:
-        """The columns (pair freedoms) each contour's equations touch."""
-        return [np.array(sorted({c for c, _ in fac}), dtype=int) for fac in self.factors]
+        """The columns (pair freedoms) each contour's equations touch, sorted."""
+        if self._cols is None:
+            self._cols = [np.array(sorted({c for c, _ in fac}), dtype=int) for fac in self.factors]
+        return self._cols
 
-    def closure(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Loop-closure twist matrix ``M(θ)`` (λK × F) and the closure error (λK).
+    def closure_blocks(self, theta: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+        """Per contour, its ``λ`` loop-closure rows on its own columns
+        (:meth:`contour_columns`), and the closure error (λK): the loop-closure matrix
+        without its zeros (a large mechanism's dense matrix would not fit in memory).
 
         Every contour's product of exponentials is taken step by step for all contours at
         once (contours padded to the longest one)."""
         F = self.twists.shape[0]
         K = len(self.factors)
         lam = self.lam
-        M = np.zeros((lam * K, F))
-        err = np.zeros(lam * K)
         if K == 0:
-            return M, err
+            return [], np.zeros(0)
         exps = np.concatenate([_exp(self.twists, theta), _exp(self.twists, -theta)])  # + then - sign
         L = max(len(f) for f in self.factors)
         cols = np.full((K, L), -1)
+        where = np.zeros((K, L), dtype=int)  # position of the column in the contour's own columns
         signs = np.zeros((K, L))
-        for k, fac in enumerate(self.factors):
+        for k, (fac, own) in enumerate(zip(self.factors, self.contour_columns())):
             cols[k, : len(fac)] = [c for c, _ in fac]
+            where[k, : len(fac)] = np.searchsorted(own, [c for c, _ in fac])
             signs[k, : len(fac)] = [sg for _, sg in fac]
         rows = PLANAR_ROWS if self.planar else np.arange(6)
+        blocks = np.zeros((K, lam, L))
         g = np.tile(np.eye(4), (K, 1, 1))
         for t in range(L):
             k = np.flatnonzero(cols[:, t] >= 0)
@@ -238,14 +245,31 @@ class _System:
             R, p = g[k, :3, :3], g[k, :3, 3]
             w = np.einsum("kij,kj->ki", R, xi[:, :3])
             v = np.einsum("kij,kj->ki", R, xi[:, 3:]) + np.cross(p, w)
-            adj = np.concatenate([w, v], axis=1)[:, rows]
-            M[(k * lam)[:, None] + np.arange(lam), c[:, None]] = adj
+            blocks[k, :, where[k, t]] = np.concatenate([w, v], axis=1)[:, rows]
             g[k] = g[k] @ exps[np.where(sg > 0, c, c + F)]
         R, p = g[:, :3, :3], g[:, :3, 3]
         e = np.concatenate([0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0],
                                              R[:, 1, 0] - R[:, 0, 1]], axis=1), p], axis=1)
-        err[:] = e[:, rows].reshape(-1)
+        return [blocks[k, :, : len(own)] for k, own in enumerate(self.contour_columns())], e[:, rows].reshape(-1)
+
+    def closure(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Loop-closure twist matrix ``M(θ)`` (λK × F, dense) and the closure error (λK)."""
+        blocks, err = self.closure_blocks(theta)
+        lam = self.lam
+        M = np.zeros((lam * len(blocks), self.twists.shape[0]))
+        for k, (B, own) in enumerate(zip(blocks, self.contour_columns())):
+            M[lam * k: lam * (k + 1), own] = B
         return M, err
+
+    def sparse_closure(self, blocks: list[np.ndarray]) -> Any:
+        """The loop-closure matrix from its blocks, as a SciPy sparse matrix."""
+        from scipy.sparse import coo_matrix
+
+        lam = self.lam
+        rows = [np.repeat(lam * k + np.arange(lam), len(own)) for k, own in enumerate(self.contour_columns())]
+        cols = [np.tile(own, lam) for own in self.contour_columns()]
+        return coo_matrix((np.concatenate([B.reshape(-1) for B in blocks]), (np.concatenate(rows),
+                          np.concatenate(cols))), shape=(lam * len(blocks), self.twists.shape[0])).tocsc()
 
 
 def _build_system(mech: Mechanism, planar: bool) -> _System:
@@ -432,19 +456,22 @@ def _actuated_columns(sysm: _System) -> tuple[list[int], list[str]]:
     return cols, names
 
 
-def _gauss_newton_step(M: np.ndarray, err: np.ndarray, tol: float) -> np.ndarray:
-    """Least-norm step ``δ`` with ``M δ ≈ err``: truncated SVD with the rank tolerance
-    (near-null directions left alone) for small systems; for large ones the damped
-    least-norm step ``Mᵀ (M Mᵀ + tol² I)⁻¹ err`` by a sparse LU (banded for chains)."""
-    if M.shape[1] <= DENSE_MAX_FREEDOMS:
+def _gauss_newton_step(sysm: "_System", theta: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The closure error at ``θ`` and the least-norm step ``δ`` with ``M δ ≈ err``:
+    truncated SVD with the rank tolerance (near-null directions left alone) for small
+    systems; for large ones the damped step ``Mᵀ (M Mᵀ + tol² I)⁻¹ err`` by a sparse LU
+    (banded for chains)."""
+    if sysm.twists.shape[0] <= DENSE_MAX_FREEDOMS:
+        M, err = sysm.closure(theta)
         u, sv, vt = np.linalg.svd(M, full_matrices=False)
         keep = sv > tol
-        return vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
-    from scipy.sparse import csc_matrix, identity
+        return err, vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
+    from scipy.sparse import identity
     from scipy.sparse.linalg import spsolve
 
-    A = csc_matrix(M)
-    return A.T @ spsolve((A @ A.T + tol * tol * identity(M.shape[0], format="csc")).tocsc(), err)
+    blocks, err = sysm.closure_blocks(theta)
+    A = sysm.sparse_closure(blocks)
+    return err, A.T @ spsolve((A @ A.T + tol * tol * identity(A.shape[0], format="csc")).tocsc(), err)
 
 
 def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int = 3,
@@ -460,18 +487,17 @@ def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int =
         theta = d.copy()
         ok = False
         for _it in range(60):
-            M, err = sysm.closure(theta)
+            err, delta = _gauss_newton_step(sysm, theta, tol)
             if np.linalg.norm(err) < max(1e-11, 10.0 * tol * step):
                 ok = True
                 break
-            theta = theta - _gauss_newton_step(M, err, tol)
+            theta = theta - delta
         if not ok:
             continue
         if np.max(np.abs(theta)) < 0.2 * step:
             returned += 1
             continue
-        M, _ = sysm.closure(theta)
-        ranks.append(_reduce(sysm, M, tol).rank)
+        ranks.append(_reduce(sysm, theta, tol).rank)
     if not ranks:
         if returned:
             notes.append("the instantaneous motions do not extend to finite motions (a shaky configuration)")
@@ -507,10 +533,9 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     sysm = _build_system(mech, planar)
     lam, K, F = sysm.lam, len(sysm.contours), sysm.twists.shape[0]
     tol = _default_tolerance(mech, sysm) if tol is None else tol
-    M, _ = sysm.closure(np.zeros(F))
     notes: list[str] = []
     progress("rank")
-    red = _reduce(sysm, M, tol)
+    red = _reduce(sysm, np.zeros(F), tol)
     near = _near_singular_note(red.singular_values, tol, F, lam * K, red.rank, notes)
     mobility, redundant, N = F - red.rank, lam * K - red.rank, red.null
     contours = _contour_ranks(sysm, red, tol)

@@ -388,43 +388,48 @@ def _reduce_dense(M: np.ndarray, lam: int, tol: float) -> _Reduction:
     return _Reduction(rank, N[:, : F - rank], incs, lefts, sv)
 
 
-def _eliminate(M: np.ndarray, cols: list[np.ndarray], lam: int, tol: float) -> _Reduction:
+def _eliminate(blocks: list[np.ndarray], cols: list[np.ndarray], lam: int, tol: float, F: int) -> _Reduction:
     """Rank and null space contour by contour, touching only each contour's columns.
 
-    The motions allowed by contours ``1..k-1`` are kept as orthonormal parameter vectors
-    (a pair freedom not yet met by any contour, or a combination stored as a full vector).
-    Contour ``k`` (rows ``B``, columns ``cols[k]``) meets only the parameters that move
-    its columns: the SVD of ``B P_J`` (``λ × |J|``) gives its new independent equations
-    (the sequential reading), its redundant ones (left null vectors, as in
-    :func:`_reduce_dense`) and the combinations of ``P_J`` it leaves free. A column no
-    later contour touches is retired from the bookkeeping. For a chain of loops ``|J|``
-    stays small: the work grows about linearly with the contours (a dense SVD, cubically).
+    ``blocks[k]`` are contour ``k``'s ``λ`` rows on its columns ``cols[k]``. The motions
+    the contours seen so far allow are kept as orthonormal parameter vectors: a pair freedom
+    no contour has met yet, or a combination ``Σ z_i P_i`` of earlier parameters. Contour
+    ``k`` meets only the parameters that move its columns: the SVD of ``B P_J``
+    (``λ × |J|``) gives its new independent equations (the sequential reading), its
+    redundant ones (left null vectors, as in :func:`_reduce_dense`) and the combinations of
+    ``P_J`` it leaves free. A parameter keeps its values only on the columns a later
+    contour touches, plus its recipe; the null space is expanded from the recipes at the
+    end. For a chain of loops ``|J|`` stays small and the work grows linearly with the
+    contours (a dense SVD grows with their cube).
     """
-    F = M.shape[1]
-    last = np.full(F, -1)  # the last contour that touches each column: later, it is retired
+    last = np.full(F, -1)  # the last contour that touches each column
     for k, ck in enumerate(cols):
         last[ck] = k
-    unit: dict[int, int] = {c: c for c in range(F)}  # parameter -> its column (unit vector)
-    dense: dict[int, np.ndarray] = {}  # parameter -> full vector
-    active: dict[int, np.ndarray] = {}  # dense parameter -> columns it moves that a later contour touches
+    live_unit: set[int] = set(range(F))  # parameter c < F: the unit vector of column c
+    values: dict[int, dict[int, float]] = {}  # combined parameter -> values on columns still in use
+    recipe: dict[int, tuple[list[int], np.ndarray]] = {}  # combined parameter -> (parents, coefficients)
     touch: list[set[int]] = [{c} for c in range(F)]
     next_id = F
     incs, lefts, svs = [], [], []
-    for k, ck in enumerate(cols):
-        B = M[lam * k: lam * (k + 1), ck]
+    for k, (B, ck) in enumerate(zip(blocks, cols)):
         J = sorted(set().union(*(touch[c] for c in ck)))
         if not J:  # every freedom of the contour is already locked
             incs.append(0)
             lefts.append(np.eye(lam))
             svs.append(np.zeros(lam))
             continue
-        pos = {c: i for i, c in enumerate(ck)}
-        BP = np.empty((lam, len(J)))
+        pos = {int(c): i for i, c in enumerate(ck)}
+        PJ = np.zeros((len(ck), len(J)))
         for i, pid in enumerate(J):
-            BP[:, i] = B[:, pos[unit[pid]]] if pid in unit else B @ dense[pid][ck]
-        u, s, vt = np.linalg.svd(BP, full_matrices=True)
+            if pid < F:
+                PJ[pos[pid], i] = 1.0
+            else:
+                for c, x in values[pid].items():
+                    if c in pos:
+                        PJ[pos[c], i] = x
+        u, sv, vt = np.linalg.svd(B @ PJ, full_matrices=True)
         s_full = np.zeros(lam)
-        s_full[: s.size] = s
+        s_full[: sv.size] = sv
         inc = int(np.sum(s_full > tol))
         incs.append(inc)
         lefts.append(u)
@@ -432,32 +437,59 @@ def _eliminate(M: np.ndarray, cols: list[np.ndarray], lam: int, tol: float) -> _
         if inc == 0:
             continue
         Z = vt[inc:].T
-        new = np.zeros((F, Z.shape[1]))
+        merged: dict[int, np.ndarray] = {}  # column still in use -> values of the J parameters there
         for i, pid in enumerate(J):
-            if pid in unit:
-                c = unit.pop(pid)
-                new[c] += Z[i]
-                touch[c].discard(pid)
+            if pid < F:
+                live_unit.discard(pid)
+                touch[pid].discard(pid)
+                if last[pid] > k:
+                    merged.setdefault(pid, np.zeros(len(J)))[i] = 1.0
             else:
-                new += np.outer(dense.pop(pid), Z[i])
-                for c in active.pop(pid):
+                for c, x in values.pop(pid).items():
                     touch[c].discard(pid)
-        for i in range(new.shape[1]):
-            v = new[:, i]
-            v[np.abs(v) <= 1e-15 * np.max(np.abs(v))] = 0.0
-            moved = np.flatnonzero(v)
-            act = moved[last[moved] > k]
-            dense[next_id], active[next_id] = v, act
-            for c in act:
+                    if last[c] > k:
+                        merged.setdefault(c, np.zeros(len(J)))[i] = x
+        for j in range(Z.shape[1]):
+            vals = {c: float(row @ Z[:, j]) for c, row in merged.items()}
+            big = max((abs(x) for x in vals.values()), default=0.0)
+            values[next_id] = {c: x for c, x in vals.items() if abs(x) > 1e-15 * big}
+            recipe[next_id] = (J, Z[:, j].copy())
+            for c in values[next_id]:
                 touch[c].add(next_id)
             next_id += 1
-    N = np.zeros((F, len(unit) + len(dense)))
-    for i, c in enumerate(sorted(unit.values())):
+    N = _expand(sorted(live_unit), sorted(values), recipe, F)
+    sv_all = np.concatenate(svs) if svs else np.zeros(0)
+    return _Reduction(F - N.shape[1], N, incs, lefts, sv_all)
+
+
+def _expand(units: list[int], combined: list[int], recipe: dict[int, tuple[list[int], np.ndarray]],
+            F: int) -> np.ndarray:
+    """The null space (``F × m``) from the surviving parameters: unit columns, and combined
+    parameters expanded through their recipes (coefficients pushed from the newest
+    parameter down to the pair freedoms, all surviving parameters at once)."""
+    m = len(units) + len(combined)
+    N = np.zeros((F, m))
+    for i, c in enumerate(units):
         N[c, i] = 1.0
-    for i, pid in enumerate(sorted(dense), start=len(unit)):
-        N[:, i] = dense[pid]
-    sv = np.concatenate(svs) if svs else np.zeros(0)
-    return _Reduction(F - N.shape[1], N, incs, lefts, sv)
+    if not combined:
+        return N
+    coef: dict[int, np.ndarray] = {}
+    for i, pid in enumerate(combined, start=len(units)):
+        coef[pid] = np.zeros(m)
+        coef[pid][i] = 1.0
+    for pid in sorted(recipe, reverse=True):
+        row = coef.pop(pid, None)
+        if row is None:
+            continue
+        parents, z = recipe[pid]
+        for parent, zi in zip(parents, z):
+            if parent < F:
+                N[parent] += zi * row
+            elif parent in coef:
+                coef[parent] += zi * row
+            else:
+                coef[parent] = zi * row
+    return N
 
 
 # --------------------------------------------------------------------------- wrenches named
