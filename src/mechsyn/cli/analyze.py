@@ -15,7 +15,8 @@ from mechsyn.cli.common import console, emit_json, err_console
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis
-from mechsyn.structure.rank import Comparison, RankAnalysis, RemedyCheck, rank_summary_lines
+from mechsyn.structure.compare import Comparison, RemedyCheck
+from mechsyn.structure.rank import RankAnalysis, rank_summary_lines
 from mechsyn.structure.remedies import Remedy
 from mechsyn.structure.report import StructureReport, pair_list
 from mechsyn.structure.report import analyze as structure_report
