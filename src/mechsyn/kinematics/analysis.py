@@ -204,23 +204,11 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     if method == "assur" and plan is None:
         raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
                                 hint="use the Newton method")
-    events: list[dict] = []
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-        tracked = dyads.solve_tracked(S, plan, U)
-        q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-        qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
-        qdd[tracked.singular] = np.nan
-        ok = np.all(np.isfinite(q), axis=1)
-        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), events, method="assur")
-        events.extend(_fast_events(tracked, sw))
-        used = "assur"
-        if progress is not None:
-            progress(N)
-    else:
-        sw = sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-        events = sw.events
-        used = "newton"
+    sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress))
+    events = sw.events
+    used = sw.method
     ok = sw.assembled
     rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
     flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
@@ -256,6 +244,81 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
         speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
         events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+
+
+def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any) -> Sweep:
+    """One sweep from the drawn configuration through the rows of ``U`` in order."""
+    N = U.shape[0]
+    if plan is None:
+        return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
+    tracked = dyads.solve_tracked(S, plan, U)
+    q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
+    qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
+    qdd[tracked.singular] = np.nan
+    ok = np.all(np.isfinite(q), axis=1)
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
+    sw.events = _fast_events(tracked, sw)
+    if progress is not None:
+        progress(N)
+    return sw
+
+
+def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
+    """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
+    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    isR = np.array([d.type == "R" for d in S.drivers])
+    for k in range(1, U.shape[0]):
+        a, b = U[k - 1], U[k]
+        u = np.where(isR, u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi)), u0)
+        for shift in (0.0, 2 * np.pi, -2 * np.pi):
+            v = np.where(isR, u + shift, u)
+            d = b - a
+            dd = float(d @ d)
+            if dd == 0.0:
+                continue
+            t = float((v - a) @ d) / dd
+            if 0.0 < t <= 1.0 and np.abs(a + t * d - v).max() <= 1e-12 * (1 + np.abs(v).max()):
+                return k
+    return None
+
+
+def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
+    """The sweep computed outwards from the drawn configuration when the drawn input lies
+    inside it (rows after it forwards, rows before it backwards), so every sweep that
+    contains the drawn input passes through the drawn configuration; else one run."""
+    k = _drawn_row(S, U)
+    if k is None:
+        return run(U)
+    fwd = run(U[k:])
+    bwd = run(U[:k][::-1].copy())
+    events = []
+    for e in bwd.events:
+        e = dict(e)
+        ib = e["index"]
+        at_row = e["kind"] == "singular" and not e.get("crossed")
+        e["index"] = (k - 1 - ib) if at_row else max(0, k - ib)
+        e.pop("before_sweep", None)
+        if e["kind"] == "dead point":
+            e["message"] = "a limit of the working range: the Jacobian is singular (dead point)"
+        elif e["kind"] == "reassembled":
+            e["message"] = ("assembles again (going back from the drawn configuration) after a gap, in the "
+                            "assembly mode nearest the drawn one")
+        events.append(e)
+    for e in fwd.events:
+        e = dict(e)
+        if e.get("before_sweep"):
+            e.pop("before_sweep")
+        e["index"] += k
+        events.append(e)
+    events.sort(key=lambda e: e["index"])
+
+    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[::-1], b])
+
+    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
+                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
+                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method)
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:

@@ -926,6 +926,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
                            "message": f"assembles again after a gap, in the assembly mode of the drawn "
                                       f"configuration for the group {group} (the mode nearest the drawn one)"})
     # bifurcations: local minima of the discriminant at zero
+    touched: list = []
     cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
     for i in cand.tolist():
         t_star, dmin = _touch(S, plan, k, sigmas, X, i)
@@ -946,8 +947,12 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         else:
             row, at = i, i
         u = X[i] + t_star * (X[i + 1] - X[i]) if t_star >= 0 else X[i] + t_star * (X[i] - X[i - 1])
+        if any(abs(i - j) <= 2 and np.abs(u - v).max() < 1e-8 for j, v in touched):
+            continue  # the same crossing seen from the neighbouring sample
+        touched.append((i, u))
         breaks.append((row, "flip"))
         events.append({"index": at, "kind": "singular", "input": u.tolist(), "group": group,
+                       "crossed": not singular[i],
                        "message": f"change / branch point: the group {group} is folded flat here (its two "
                                   "assembly modes meet); the motion continues on the branch whose velocity is "
                                   "continuous (the drawn branch)"
@@ -991,4 +996,22 @@ def _touch(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i: 
         t = brentq(slope, lo + h, hi - h, xtol=1e-12)
     except ValueError:
         t = float(ts[j])
-    return t, float(at(np.array([t]))[0])
+    dmin = float(at(np.array([t]))[0])
+    if abs(dmin) <= 1e-10:
+        # the minimum of a quadratic is found by its slope only to about sqrt(eps): at a
+        # tangency the signed height sqrt(Delta) is linear on each side, so the secants
+        # of sqrt(Delta) from both sides, extrapolated to zero spacing (Richardson),
+        # give its zero to round-off
+        def secant_roots(dt: float) -> float:
+            ts_ = t + np.array([-2 * dt, -dt, dt, 2 * dt])
+            f = np.sqrt(np.maximum(at(ts_), 0.0))
+            left = ts_[1] - f[1] * (ts_[1] - ts_[0]) / (f[1] - f[0])
+            right = ts_[2] - f[2] * (ts_[3] - ts_[2]) / (f[3] - f[2])
+            return 0.5 * (left + right)
+
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r1, r2 = secant_roots(1e-2), secant_roots(2e-2)
+        t_fine = (4 * r1 - r2) / 3
+        if np.isfinite(t_fine) and abs(t_fine - t) < 0.1:
+            t = float(t_fine)
+    return t, dmin
