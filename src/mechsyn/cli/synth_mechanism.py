@@ -9,7 +9,7 @@ import typer
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -26,7 +26,7 @@ def synth_mechanism(
 ) -> None:
     """Move chosen joint / point coordinates and VLL lengths of a planar mechanism file so
     a point follows target positions (or a link target poses) at given input angles."""
-    from mechsyn.synthesis.general import load_case, synthesis_figure, synthesize_mechanism
+    from mechsyn.synthesis.general import load_case, synthesize_mechanism
 
     if not time_limit > 0:
         raise MechsynInputError("must be positive", source="--time-limit")
@@ -58,19 +58,16 @@ def synth_mechanism(
 
         write_mechanism(res.mechanism, out)
     if plot is not None:
-        import matplotlib.pyplot as plt
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.synthesis import plot_mechanism_synthesis
 
-        from mechsyn.results import save_figure_atomic
-
-        fig = synthesis_figure(case, res)
-        try:
-            save_figure_atomic(fig, plot, dpi=120)
-        finally:
-            plt.close(fig)
+        save_plot(plot, plot_mechanism_synthesis, case, res, dpi=120)
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}")
+    t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}"
+              + (" (interrupted: best so far)" if res.interrupted else ""))
     t.add_column("variable")
     t.add_column("start", justify="right")
     t.add_column("design", justify="right")
@@ -85,3 +82,4 @@ def synth_mechanism(
                   + ("   (time limit reached)" if res.stopped_by_time_limit else ""))
     if not res.feasible:
         console.print(f"[bold red]no feasible design found[/]: {res.reason}")
+    stop_if_interrupted(res)

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
+from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design
 
 
@@ -152,12 +153,14 @@ class RestartResult:
 
 
 def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options: dict[str, Any],
-                 deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0) -> RestartResult:
+                 deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0,
+                 tracker: BestSoFar | None = None) -> RestartResult:
     t0 = time.monotonic()
     problem = PathProblem(case)
     m = problem.reduced_dim
     lower, upper = problem.lower[:m], problem.upper[:m]
     fn = OPTIMIZERS[optimizer]
+    fitness = problem.reduced_fitness if tracker is None else tracker.wrap(problem.reduced_fitness)
 
     # leave a little of the budget for polishing, so the whole run keeps its time limit
     search_deadline = deadline - polish_reserve
@@ -167,7 +170,7 @@ def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options:
             report(index, best)
         return time.time() >= search_deadline
 
-    g = fn(problem.reduced_fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
+    g = fn(fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
     nfev = g.nfev
     # candidates to polish: the best, then the best distinct population members
     cands = [np.asarray(g.x, float)]
@@ -241,10 +244,11 @@ class PathSynthesisResult:
     theta2: np.ndarray
     restart_errors: list[float] = field(default_factory=list)
     best_known: float | None = None
+    interrupted: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "case": self.case_id, "error": self.error, "design": self.design,
+            "case": self.case_id, "interrupted": self.interrupted, "error": self.error, "design": self.design,
             "assembled_at_all_targets": self.assembled_at_all_targets, "feasible": self.feasible,
             "seconds": self.seconds, "seed": self.seed, "restarts": self.restarts, "nfev": self.nfev,
             "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
@@ -271,6 +275,11 @@ def synthesize_path(
     (a ``dask.distributed`` scheduler address, or a ``Client``) on a Dask cluster; the
     result equals the single-process one (same seeds, same deterministic choice of the
     best), unless the time limit cuts runs short.
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``progress``) ends the search
+    and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
+    with workers, the restarts finished so far); it propagates only when nothing was
+    evaluated yet.
     """
     if optimizer not in OPTIMIZERS:
         from mechsyn.errors import MechsynInputError
@@ -295,25 +304,38 @@ def synthesize_path(
     def problem_feasible_score(f):
         return f < problem.penalty_base
 
-    if workers <= 1 and scheduler is None:
-        for i, s in enumerate(seeds):
-            if results and time.time() >= deadline - reserve:
-                break  # too little time left for a useful restart
-            r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
-                             report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve)
-            results.append(r)
-            note(len(results), r.fitness)
-    elif scheduler is not None:
-        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
-        for r in _run_on_dask(scheduler, jobs):
-            results.append(r)
-            note(len(results), r.fitness)
-    else:
-        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            for r in pool.map(_restart_job, jobs):
+    interrupted = False
+    tracker = BestSoFar()
+    try:
+        if workers <= 1 and scheduler is None:
+            for i, s in enumerate(seeds):
+                if results and time.time() >= deadline - reserve:
+                    break  # too little time left for a useful restart
+                tracker = BestSoFar()
+                r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
+                                 report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve,
+                                 tracker=tracker)
                 results.append(r)
                 note(len(results), r.fitness)
+        elif scheduler is not None:
+            jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
+            for r in _run_on_dask(scheduler, jobs):
+                results.append(r)
+                note(len(results), r.fitness)
+        else:
+            jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                for r in pool.map(_restart_job, jobs):
+                    results.append(r)
+                    note(len(results), r.fitness)
+    except KeyboardInterrupt:
+        interrupted = True
+        if tracker.x is not None and len(results) < len(seeds):
+            results.append(RestartResult(index=len(results), seed=seeds[len(results)],
+                                         z=problem.expand(tracker.x[None, :])[0], fitness=tracker.f,
+                                         nfev=0, seconds=0.0))
+        if not results:
+            raise
     results.sort(key=lambda r: r.index)
     win = min(results, key=lambda r: (r.fitness, r.index))
     design = problem.design(win.z)
@@ -325,5 +347,5 @@ def synthesize_path(
         optimizer=optimizer, branch=case.branch, targets=case.targets, path=check["path"],
         theta2=check["theta2"],
         restart_errors=[r.fitness if r.fitness < problem.penalty_base else float("inf") for r in results],
-        best_known=case.best_known,
+        best_known=case.best_known, interrupted=interrupted,
     )
