@@ -14,7 +14,7 @@ P inputs and lengths in the file's length unit.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -28,6 +28,7 @@ from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
+           "KinematicPlan", "compile_plan",
            "ForceAnalysis", "forces"]
 
 
@@ -216,8 +217,75 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+    return compile_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
+        inputs, speeds=speeds, points=points, method=method, progress=progress)
+
+
+@dataclass(frozen=True, eq=False)
+class KinematicPlan:
+    """A mechanism compiled for repeated simulation: its constraint system and its
+    solution plan (drivers, then Assur groups in solving order; ``groups`` is None when
+    the mechanism does not split into dyads and Newton continuation is used).
+
+    Build it once with :func:`compile_plan`; :meth:`simulate` sweeps its inputs.
+    :meth:`with_joint_points` is the incremental re-simulation of an editor's drag loop:
+    the same topology with moved joints (new link dimensions and a new drawn
+    configuration) keeps the solution plan and rebuilds only the geometry.
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism
+    >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
+    >>> plan = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
+    >>> [s.kind for s in plan.groups.steps]
+    ['drive_R', 'RRR']
+    >>> moved = plan.with_joint_points({"C": (3.1, 2.9)})   # the user drags joint C
+    >>> sim = moved.simulate({"A": input_grid(0, 360, 1)})
+    >>> bool(sim.assembled.all())
+    True
+    """
+
+    mechanism: Mechanism
+    system: PlanarSystem
+    groups: "dyads.Plan | None"
+    vll: dict | None = None
+    prescribed: tuple = ()
+
+    def with_joint_points(self, points: dict[str, Any]) -> "KinematicPlan":
+        """The same mechanism with some joints moved (``{joint id: (x, y)}``), reusing the
+        solution plan: only the geometry (link frames, lengths, drawn configuration) is
+        rebuilt. Named points keep their drawn positions."""
+        mech = self.mechanism
+        for jid in points:
+            mech.joint(jid)  # KeyError names an unknown joint
+        joints = tuple(replace(j, point=np.asarray(points[j.id], float)) if j.id in points else j
+                       for j in mech.joints)
+        new = mech.with_joints(joints)
+        S = build_system(new, vll=self.vll, prescribed=self.prescribed)
+        return KinematicPlan(new, S, self.groups, self.vll, self.prescribed)
+
+    def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
+                 points: list[str] | None = None, method: str = "auto", progress: Any = None) -> Simulation:
+        """The sweep of :func:`simulate` with this plan."""
+        return _simulate_plan(self, inputs, speeds, points, method, progress)
+
+
+def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
+    """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
+    input values, which decides whether a passive VLL is prescribed)."""
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
     S = build_system(mech, vll=vll, prescribed=prescribed)
+    return KinematicPlan(mech, S, dyads.decompose(S), vll, prescribed)
+
+
+def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
+                   points: list[str] | None, method: str, progress: Any) -> Simulation:
+    mech, S = kp.mechanism, kp.system
+    if not inputs:
+        raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+    if tuple(j for j in inputs if _is_passive(mech, j, kp.vll)) != kp.prescribed:
+        kp = compile_plan(mech, kp.vll, tuple(inputs))
+        S = kp.system
     drivers = [d.joint for d in S.drivers]
     lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
     if len(lengths) != 1:
@@ -257,7 +325,7 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     for jid in inputs:
         sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
     pts = resolve_points(mech, points)
-    plan = dyads.decompose(S) if method in ("auto", "assur") else None
+    plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
         raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
                                 hint="use the Newton method")
@@ -323,20 +391,20 @@ def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarr
 def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
     row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
+    if U.shape[0] < 2:
+        return None
     u0 = np.array([d.assembled for d in S.drivers], float)
     isR = np.array([d.type == "R" for d in S.drivers])
-    for k in range(1, U.shape[0]):
-        a, b = U[k - 1], U[k]
-        u = np.where(isR, u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi)), u0)
-        for shift in (0.0, 2 * np.pi, -2 * np.pi):
-            v = np.where(isR, u + shift, u)
-            d = b - a
-            dd = float(d @ d)
-            if dd == 0.0:
-                continue
-            t = float((v - a) @ d) / dd
-            if 0.0 < t <= 1.0 and np.abs(a + t * d - v).max() <= 1e-12 * (1 + np.abs(v).max()):
-                return k
+    a, d = U[:-1], np.diff(U, axis=0)
+    dd = np.einsum("ij,ij->i", d, d)
+    for shift in (0.0, 2 * np.pi, -2 * np.pi):
+        v = np.where(isR, u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi)) + shift, u0)  # (N-1, k)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.einsum("ij,ij->i", v - a, d) / dd
+        off = np.abs(a + t[:, None] * d - v).max(axis=1)
+        hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
+        if hit.any():
+            return int(np.argmax(hit)) + 1
     return None
 
 

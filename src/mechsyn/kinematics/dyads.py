@@ -57,7 +57,12 @@ class Plan:
 
 
 def _cons_of(S: PlanarSystem, jid: str) -> list[Con]:
-    return [c for c in S.cons if c.joint == jid]
+    memo = _memo(S)
+    key = ("cons", jid)
+    out = memo.get(key)
+    if out is None:
+        out = memo[key] = [c for c in S.cons if c.joint == jid]
+    return out
 
 
 def _jtype(S: PlanarSystem, jid: str) -> str:
@@ -162,10 +167,25 @@ class _State:
         self.phi[:, i] = phi
 
 
+def _memo(S: PlanarSystem) -> dict:
+    """Per-system cache of look-ups that depend only on the system (local joint points,
+    constraints of a joint): a plan evaluated many times (events, drags) reuses them."""
+    memo = S.__dict__.get("_dyads_memo")
+    if memo is None:
+        memo = {}
+        object.__setattr__(S, "_dyads_memo", memo)
+    return memo
+
+
 def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
-    j = S.mech.joint(jid)
-    name = S.mech.ground if i < 0 else S.links[i]
-    return S.to_local(name, j.point)
+    memo = _memo(S)
+    key = ("local", i, jid)
+    out = memo.get(key)
+    if out is None:
+        j = S.mech.joint(jid)
+        name = S.mech.ground if i < 0 else S.links[i]
+        out = memo[key] = S.to_local(name, j.point)
+    return out
 
 
 def _rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:

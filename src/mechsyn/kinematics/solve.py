@@ -62,8 +62,11 @@ def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 
 def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = None,
-           max_iter: int = 12) -> tuple[np.ndarray, bool]:
-    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged)."""
+           max_iter: int = 12, polish: bool = False) -> tuple[np.ndarray, bool]:
+    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged).
+
+    ``polish``: one more step after convergence where the Jacobian is well conditioned
+    (the sweep's positions then agree with the closed form to round-off)."""
     tol = tol if tol is not None else 1e-12 * S.scale
     q = q.copy()
     u2 = u[None]
@@ -74,9 +77,9 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
         if not np.isfinite(norm):
             return q, False
         if norm < tol:
-            if norm > 1e-3 * tol:  # one more step: the error squares (a polish, not a new solve)
+            if polish and norm > 1e-3 * tol:  # one more step: the error squares (a polish, not a new solve)
                 dq = _solve_lin(S.jacobian(q[None])[0], -r)
-                if np.all(np.isfinite(dq)):
+                if np.all(np.isfinite(dq)) and float(np.abs(dq).max()) <= 1e2 * norm:  # well conditioned
                     q2 = q + dq
                     if float(np.abs(S.residual(q2[None], u2)[0]).max()) <= norm:
                         q = q2
@@ -269,7 +272,7 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
     if X is None:
         X = _factor(S, q)[1]
     q_pred = q + X @ du
-    q_new, ok = newton(S, q_pred, ub)
+    q_new, ok = newton(S, q_pred, ub, polish=True)
     if ok and _step_ok(S, q, q_new, q_pred):
         return q_new
     if depth == 0:
@@ -344,7 +347,7 @@ def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
             return cand if ok else None
         return nxt
     pred = _extrapolate(hist, u)
-    cand, ok = newton(S, pred, u, max_iter=40)
+    cand, ok = newton(S, pred, u, max_iter=40, polish=True)
     if ok:
         return cand
     return nxt
