@@ -135,11 +135,57 @@ def decompose(S: PlanarSystem) -> Plan | None:
                 break
             if progress:
                 break
+        if not progress:
+            progress = _double_joint_dyad(S, known, used, drivers, link_joints, ends, steps)
     if len(known) < len(S.links) + 1:
         return None
     if set(j.id for j in mech.joints) - used:
         return None  # closing constraints left over (redundant): Newton handles them
     return Plan(tuple(steps))
+
+
+def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, link_joints: dict, ends,
+                       steps: list) -> bool:
+    """A dyad whose middle joint is a *double joint*: links ``b1`` and ``b2`` both pinned to
+    a third link ``m`` at one point (two R pairs ``b1-m``, ``b2-m`` at the same place).
+
+    The point is the intersection of the circles about ``b1``'s and ``b2``'s known joints,
+    as in an RRR dyad; ``m`` is placed later through the pair ``b1-m`` (the pair ``b2-m``
+    is then satisfied, being at the same point). Appends the step and returns True when
+    one is found."""
+    mech = S.mech
+    pts = {j.id: np.asarray(j.point, float) for j in mech.joints}
+    for b1 in range(len(S.links)):
+        if b1 in known:
+            continue
+        j1s = [j for j in link_joints.get(b1, []) if j not in used and j not in drivers
+               and (set(ends(j)) - {b1}) <= known]
+        if len(j1s) != 1 or _jtype(S, j1s[0]) != "R":
+            continue
+        for J2a in link_joints.get(b1, []):
+            if J2a in used or J2a in drivers or _jtype(S, J2a) != "R":
+                continue
+            m = (set(ends(J2a)) - {b1}).pop()
+            if m in known:
+                continue
+            for J2b in link_joints.get(m, []):
+                if J2b == J2a or J2b in used or J2b in drivers or _jtype(S, J2b) != "R":
+                    continue
+                b2 = (set(ends(J2b)) - {m}).pop()
+                if b2 in known or b2 == b1 or np.abs(pts[J2a] - pts[J2b]).max() > 1e-9 * S.scale:
+                    continue
+                j3s = [j for j in link_joints.get(b2, []) if j not in used and j not in drivers and j != J2b
+                       and (set(ends(j)) - {b2}) <= known]
+                if len(j3s) != 1 or _jtype(S, j3s[0]) != "R":
+                    continue
+                J1, J3 = j1s[0], j3s[0]
+                k1 = (set(ends(J1)) - {b1}).pop()
+                k3 = (set(ends(J3)) - {b2}).pop()
+                steps.append(Step("RRR", (b1, b2), (k1, k3), (J1, J2a, J3), {"double": J2b}))
+                known.update((b1, b2))
+                used.update((J1, J3, J2b))
+                return True
+    return False
 
 
 # --------------------------------------------------------------------------- states
