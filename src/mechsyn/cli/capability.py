@@ -26,7 +26,7 @@ from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
 )
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, parse_floats, parse_range, progress_bar
+from mechsyn.cli.common import check_writable, console, emit_json, parse_floats, parse_range, progress_bar
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 
@@ -109,6 +109,8 @@ def capability(
 ) -> None:
     """Largest tool speed along a direction under joint speed limits (paper 004), at a point
     over the arm's self-motion, or mapped over a grid."""
+    check_writable(map_png, "--map")
+    check_writable(csv_out, "--csv")
     arm = load_arm(arm_file)
     m = arm.task_dim
     d = np.array(parse_floats(direction, "--direction", m))

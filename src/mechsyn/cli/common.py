@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -54,9 +56,35 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
 
 def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
                         what: str | None = None) -> None:
-    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work)."""
+    """Refuse, before any work, an output file whose suffix is not one of ``suffixes`` or
+    that cannot be written (see :func:`check_writable`)."""
     if path is not None and path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
+    check_writable(path, option)
+
+
+def check_writable(path: Path | None, option: str, directory: bool = False) -> None:
+    """Refuse, before any work, an output ``path`` that could not be written.
+
+    Its folder is created (as the writer would) and a temporary file is created and
+    removed in it: the real test, whatever the user's privileges. ``directory``: the path
+    is a folder to write files into.
+    """
+    if path is None:
+        return
+    path = Path(path)
+    if path.exists() and path.is_dir() != directory:
+        raise MechsynInputError(f"{path} is {'not ' if directory else ''}a directory", source=option,
+                                hint="give another path")
+    folder = path if directory else path.absolute().parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".mechsyn-write-test.")
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise MechsynInputError(f"cannot write {path}: {exc.strerror or exc}", source=option,
+                                hint="give a path in a folder you can write to") from None
 
 
 def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:
