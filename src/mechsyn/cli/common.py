@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import os
 import sys
 import tempfile
@@ -24,13 +25,34 @@ console = Console()
 err_console = Console(stderr=True)
 
 
-def emit_json(obj: Any, out: Path | None = None) -> None:
-    """Print ``obj`` as JSON on stdout, or write it whole to ``out``."""
-    text = dumps(obj)
-    if out is None:
-        sys.stdout.write(text + "\n")
+STDOUT = "-"
+
+
+def is_stdout(path: Path | str | None) -> bool:
+    """Whether an output option names standard output (``-o -``)."""
+    return path is not None and str(path) == STDOUT
+
+
+def write_output(out: Path | str, text: str) -> None:
+    """Write ``text`` whole to the file ``out``, or to stdout when ``out`` is ``-``."""
+    if is_stdout(out):
+        sys.stdout.write(text)
+        sys.stdout.flush()
     else:
-        write_atomic(out, text + "\n")
+        write_atomic(out, text)
+
+
+def one_stdout(json_: bool, *outs: Path | str | None) -> None:
+    """Refuse two outputs to stdout (``--json`` and a ``-`` file, or two ``-`` files)."""
+    if int(bool(json_)) + sum(is_stdout(o) for o in outs) > 1:
+        raise MechsynInputError("two outputs to stdout", source="-",
+                                hint="send one of them to a file (or drop --json)")
+
+
+def emit_json(obj: Any, out: Path | None = None) -> None:
+    """Print ``obj`` as JSON on stdout, or write it whole to ``out`` (``-``: stdout)."""
+    text = dumps(obj)
+    write_output(STDOUT if out is None else out, text + "\n")
 
 
 def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
@@ -57,7 +79,12 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
 def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
                         what: str | None = None) -> None:
     """Refuse, before any work, an output file whose suffix is not one of ``suffixes`` or
-    that cannot be written (see :func:`check_writable`)."""
+    that cannot be written (see :func:`check_writable`).
+
+    ``-`` (standard output) passes for text formats (.csv, .json, .yaml, .md, .pyslvs, .svg).
+    """
+    if is_stdout(path) and set(suffixes) & {".csv", ".json", ".yaml", ".md", ".pyslvs", ".svg", ".txt"}:
+        return
     if path is not None and path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
     check_writable(path, option)
@@ -70,7 +97,7 @@ def check_writable(path: Path | None, option: str, directory: bool = False) -> N
     removed in it: the real test, whatever the user's privileges. ``directory``: the path
     is a folder to write files into.
     """
-    if path is None:
+    if path is None or is_stdout(path):
         return
     path = Path(path)
     if path.exists() and path.is_dir() != directory:
@@ -85,6 +112,53 @@ def check_writable(path: Path | None, option: str, directory: bool = False) -> N
     except OSError as exc:
         raise MechsynInputError(f"cannot write {path}: {exc.strerror or exc}", source=option,
                                 hint="give a path in a folder you can write to") from None
+
+
+def save_plot(path: Path, draw: Any, *args: Any, dpi: int = 110, figsize: tuple[float, float] = (7, 6),
+              **kwargs: Any) -> None:
+    """Draw with a ``mechsyn.plot`` function on a bare Figure (no pyplot, no backend) and write
+    it whole to ``path``. ``draw`` takes ``fig=`` (it sizes the figure) or ``ax=``."""
+    from matplotlib.figure import Figure
+
+    from mechsyn.results import save_figure_atomic
+
+    fig = Figure(figsize=figsize)
+    if "fig" in inspect.signature(draw).parameters:
+        draw(*args, fig=fig, **kwargs)
+    else:
+        draw(*args, ax=fig.add_subplot(), **kwargs)
+        fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=dpi)
+
+
+def check_animation_target(path: Path, option: str = "--animate") -> Path:
+    """Raise MechsynInputError unless a GIF can be written to ``path`` (before any work)."""
+    from matplotlib.animation import PillowWriter
+
+    if not PillowWriter.isAvailable():
+        raise MechsynInputError(f"{option} needs the pillow package", hint="pip install pillow", source=option)
+    if path.suffix.lower() != ".gif":
+        raise MechsynInputError(f"the animation is a GIF: use a .gif file name, not {path.name}", source=option)
+    return path
+
+
+def save_animation(path: Path, animate: Any, *args: Any, fps: int = 15, dpi: int = 80,
+                   option: str = "--animate", **kwargs: Any) -> None:
+    """Build an animation with a ``mechsyn.plot`` function on a bare Figure and write it to
+    ``path`` as a GIF, whole or not at all."""
+    from matplotlib.animation import PillowWriter
+    from matplotlib.figure import Figure
+
+    from mechsyn.results import atomic_output
+
+    check_animation_target(path, option)
+    fig = Figure()
+    try:
+        anim = animate(*args, fig=fig, **kwargs)
+    except MechsynInputError as exc:
+        raise exc.with_source(option) from None
+    with atomic_output(path) as tmp:
+        anim.save(str(tmp), writer=PillowWriter(fps=fps), dpi=dpi)
 
 
 def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:

@@ -49,7 +49,7 @@ from mechsyn.limits import limit, limit_hint
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
-           "synthesize_mechanism", "synthesis_figure", "start_vector"]
+           "synthesize_mechanism", "start_vector"]
 
 
 @dataclass(frozen=True)
@@ -419,17 +419,9 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
             return MechanismEvaluation(False, f"cannot sweep: {exc}", violation=1e3)
         q, ok, method, sig = sw.q, sw.assembled, "newton", None
         branch_viol = float(sum(1 for e in sw.events if e.get("kind") in ("branch point", "singular")))
-    n_bad = int((~ok).sum())
-    viol = n_bad / len(grid) + branch_viol + viol_order
-    if viol > 0:
-        why = []
-        if n_bad:
-            why.append(f"not assembled at {n_bad} of {len(grid)} inputs of the sweep")
-        if branch_viol:
-            why.append("off the file's assembly branch")
-        if viol_order:
-            why.append("input angles out of order")
-        return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
+    bad = infeasibility(int((~ok).sum()), len(grid), branch_viol, viol_order, method)
+    if bad is not None:
+        return bad
     qt = q[idx]
     if case.problem == "path":
         link, at = resolve_points(mech, [case.point])[case.point]
@@ -451,11 +443,27 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
                                sigmas=sig)
 
 
+def infeasibility(n_bad: int, n_grid: int, branch_viol: float, viol_order: float,
+                  method: str) -> MechanismEvaluation | None:
+    """The infeasible evaluation (violation and reasons) of a swept design, or None."""
+    viol = n_bad / n_grid + branch_viol + viol_order
+    if viol <= 0:
+        return None
+    why = []
+    if n_bad:
+        why.append(f"not assembled at {n_bad} of {n_grid} inputs of the sweep")
+    if branch_viol:
+        why.append("off the file's assembly branch")
+    if viol_order:
+        why.append("input angles out of order")
+    return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
+
+
 class MechanismProblem:
     """Feasibility-first fitness over populations, and least-squares residuals, in the
     interface :func:`mechsyn.synthesis.optimize.polish` expects."""
 
-    def __init__(self, case: MechanismCase) -> None:
+    def __init__(self, case: MechanismCase, batch: bool = True) -> None:
         self.case = case
         self.lower, self.upper = case.lower, case.upper
         pts = [case.targets]
@@ -468,9 +476,14 @@ class MechanismProblem:
         # U: feasible scores are capped at U, infeasible ones are U + violation (>= 1)
         self.penalty_base = 1e6 * case.n_targets * (max(1.0, ext) ** 2 + w ** 2)
         self.n_evaluations = 0   # designs swept
+        from mechsyn.synthesis.general_batch import batch_evaluator
+
+        self.batch = batch_evaluator(case) if batch else None  # whole populations at once
 
     def evaluate(self, Z: np.ndarray) -> list[MechanismEvaluation]:
         self.n_evaluations += len(np.atleast_2d(Z))
+        if self.batch is not None:
+            return _EvalList(self.batch.evaluate(Z))
         return _EvalList([evaluate_design(self.case, z) for z in np.atleast_2d(Z)])
 
     def score(self, ev: MechanismEvaluation) -> float:
@@ -484,7 +497,7 @@ class MechanismProblem:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         c = self.case
         self.n_evaluations += 1
-        ev = evaluate_design(c, z)
+        ev = self.batch.evaluate(z)[0] if self.batch is not None else evaluate_design(c, z)
         n = 2 * c.n_targets + (c.n_targets if c.problem == "motion" else 0)
         if not ev.feasible:
             return np.full(n, np.sqrt(self.penalty_base / n) * (1.0 + ev.violation))
@@ -543,11 +556,14 @@ class MechanismSynthesisResult:
 
 def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 3,
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
-                         progress: Callable[[int, int, float], None] | None = None) -> MechanismSynthesisResult:
+                         progress: Callable[[int, int, float], None] | None = None,
+                         batch: bool = True) -> MechanismSynthesisResult:
     """Optimise the case: per restart (child seeds of ``seed``, as in
     :func:`mechsyn.synthesis.optimize.restart_seeds`) the registered global optimiser on
     the feasibility-first fitness, then a least-squares polish of the best few members
     (:func:`mechsyn.synthesis.optimize.polish`); the file's own design competes too.
+    ``batch``: evaluate populations through the batch engine where the case allows
+    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
 
     Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
     returns the best design evaluated so far with ``interrupted=True``."""
@@ -560,7 +576,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     deadline = t0 + time_limit
     opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
     opts.update(options or {})
-    prob = MechanismProblem(case)
+    prob = MechanismProblem(case, batch=batch)
     x0 = np.clip(start_vector(case), prob.lower, prob.upper)
     best_z, best_f = x0, float(prob.fitness(x0[None, :])[0])
     start_f = best_f
@@ -628,40 +644,3 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,
         stopped_by_time_limit=stopped, reason=ev.reason, interrupted=interrupted)
-
-
-def synthesis_figure(case: MechanismCase, res: MechanismSynthesisResult) -> Any:
-    """Targets against the achieved points and the swept path, with the design drawn at
-    its file configuration."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 6))
-    if len(res.path):
-        ax.plot(res.path[:, 0], res.path[:, 1], "-", color="0.6", lw=1, label="swept path")
-    ax.plot(res.targets[:, 0], res.targets[:, 1], "o", mfc="none", mec="C3", ms=9, label="targets")
-    ax.plot(res.achieved[:, 0], res.achieved[:, 1], "x", color="C0", ms=8, label="achieved")
-    for t, a in zip(res.targets, res.achieved):
-        ax.plot([t[0], a[0]], [t[1], a[1]], "-", color="C3", lw=0.8)
-    pts = {j["id"]: j["point"] for j in res.mechanism["joints"] if j.get("point") is not None}
-    by_link: dict[str, list] = {}
-    for j in res.mechanism["joints"]:
-        if j.get("point") is None:
-            continue
-        for lk in j["links"]:
-            by_link.setdefault(lk, []).append(pts[j["id"]])
-    for lk, ps in by_link.items():
-        if lk == res.mechanism["ground"] or len(ps) < 2:
-            continue
-        P = np.array(ps + [ps[0]] if len(ps) > 2 else ps)
-        ax.plot(P[:, 0], P[:, 1], "-", color="k", lw=1.4, alpha=0.7)
-    J = np.array(list(pts.values()))
-    ax.plot(J[:, 0], J[:, 1], "o", color="k", ms=4, label="design (file configuration)")
-    ax.set_aspect("equal")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
-    ax.set_title(f"{case.name} ({case.problem} generation): error {res.error:.4g}", fontsize=10)
-    fig.tight_layout()
-    return fig
