@@ -7,7 +7,7 @@ from typing import Optional
 
 import typer
 import yaml
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
 from mechsyn.cli.common import check_writable, console, emit_json, progress_bar

@@ -13,7 +13,7 @@ import numpy as np
 import typer
 from rich import box
 from rich.console import Console
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (

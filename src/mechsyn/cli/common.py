@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import inspect
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Iterable, Iterator
@@ -11,8 +12,10 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
 import typer
 from rich.console import Console
+from rich.table import Table as RichTable
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -21,8 +24,73 @@ from mechsyn.results import dumps, write_atomic
 
 T = TypeVar("T")
 
-console = Console()
-err_console = Console(stderr=True)
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+_LINK_TAG = re.compile(r"(?<!\\)\[(/?link\b)", re.IGNORECASE)  # not already escaped
+
+
+def strip_control(text: str) -> str:
+    """``text`` without control characters (escape sequences, bells, backspaces...);
+    newlines and tabs are kept.
+
+    >>> strip_control("a\x1b[31mred\x07")
+    'a[31mred'
+    """
+    return _CONTROL.sub("", text)
+
+
+def safe(text: object, limit: int = 120) -> str:
+    r"""Text from a file, fit to print: control characters stripped, rich markup escaped,
+    capped at ``limit`` characters (the rest counted).
+
+    >>> print(safe("[link=https://x.example]click[/link]"))
+    \[link=https://x.example]click\[/link]
+    >>> safe("x" * 130, limit=10)
+    'xxxxxxxxxx… (120 more characters)'
+    """
+    text = strip_control(str(text))
+    if len(text) > limit:
+        text = f"{text[:limit]}… ({len(text) - limit} more characters)"
+    return escape(text)
+
+
+class SafeConsole(Console):
+    """A rich Console that never sends a file's control characters to the terminal and
+    never turns text into a hyperlink: every string it renders (messages and table cells,
+    whatever the command) is stripped of control characters and its ``[link]`` markup is
+    shown as text. The commands' own styles ([bold], [red]...) still work."""
+
+    def render_str(self, text: str, *args: Any, **kwargs: Any) -> Any:
+        return super().render_str(_LINK_TAG.sub(r"\\[\1", strip_control(text)), *args, **kwargs)
+
+
+class Table(RichTable):
+    """A rich Table whose cells wrap (fold) instead of being cut with an ellipsis: at 80
+    columns a number is never shown truncated (1.60e-15 never becomes "1.60e…")."""
+
+    def add_column(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("overflow", "fold")
+        super().add_column(*args, **kwargs)
+
+
+def fmt_number(value: Any, spec: str = ".6g", scale: float = 1.0) -> str:
+    """A number for a table: ``—`` when missing or not finite, 0 for float noise (below
+    1e-12 times ``scale``, e.g. -1.38778e-15 for a fixed pivot's velocity).
+
+    >>> fmt_number(-1.38778e-15), fmt_number(2.5e-3), fmt_number(float("nan"))
+    ('0', '0.0025', '—')
+    """
+    if value is None:
+        return "—"
+    v = float(value)
+    if not np.isfinite(v):
+        return "—"
+    if abs(v) <= 1e-12 * abs(scale):
+        v = 0.0
+    return format(v, spec)
+
+
+console = SafeConsole()
+err_console = SafeConsole(stderr=True)
 
 
 STDOUT = "-"
