@@ -8,10 +8,10 @@ from typing import Annotated, Optional
 
 import typer
 from rich.panel import Panel
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, err_console
+from mechsyn.cli.common import console, emit_json, err_console, safe
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis
@@ -38,7 +38,7 @@ def _fmt(x: float | None) -> str:
 def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
     pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
     console.print(Panel.fit(
-        f"[bold]{title_prefix}{a.name}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
+        f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
         f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
     ))
     t = Table(title="Formulas", show_lines=False)
@@ -76,7 +76,7 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         console.print(f"[dim]note:[/] {n}", highlight=False, soft_wrap=True)
     for name, sub in a.states.items():
         console.print()
-        render(sub, title_prefix=f"state '{name}': ")
+        render(sub, title_prefix=f"state '{safe(name)}': ")
 
 
 def render_remedies(remedies: list[Remedy]) -> None:

@@ -14,7 +14,7 @@ from typing import Any, Optional
 
 import numpy as np
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
 from mechsyn.cli.common import console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, write_output
