@@ -53,6 +53,20 @@ def shot(page, name):
     page.screenshot(path=str(IMAGES / name))
 
 
+def save_gif(pngs, name):
+    """The drag as a small looping GIF for the README (frames shown 120 ms, then back)."""
+    import io
+
+    from PIL import Image
+
+    imgs = [Image.open(io.BytesIO(b)).convert("RGB") for b in pngs]
+    w, h = imgs[0].size
+    imgs = [im.resize((520, round(520 * h / w)), Image.Resampling.LANCZOS).quantize(48, method=Image.Quantize.MAXCOVERAGE) for im in imgs]
+    seq = imgs + imgs[-2:0:-1]
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    seq[0].save(IMAGES / name, save_all=True, append_images=seq[1:], duration=120, loop=0, optimize=True)
+
+
 def open_studio(page, srv):
     page.goto(srv.url)
     wait_js(page, "() => window.__studio && window.__studio.simulations > 0", timeout=30)
@@ -69,12 +83,16 @@ def test_serve_fourbar_drag_joint_path_follows(serve, page):
     box = joint.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     n = page.evaluate("window.__studio.simulations")
+    frames, stage = [], page.locator("#stage").bounding_box()
     page.mouse.move(x, y)
     page.mouse.down()
-    for k in range(1, 6):
-        page.mouse.move(x - 6 * k, y - 4 * k)
+    for k in range(1, 13):
+        page.mouse.move(x - 5 * k, y - 3 * k)
+        wait_js(page, "() => window.__studio.simFor === window.__studio.mech")
+        frames.append(page.screenshot(clip=stage))
     page.mouse.up()
     wait_simulated(page)
+    save_gif(frames, "studio_drag.gif")
     d1 = path.get_attribute("d")
     assert d1 != d0  # the path followed the drag
     b = page.evaluate("window.__studio.mech.joints.find(j => j.id === 'B').point")
