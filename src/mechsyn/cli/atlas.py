@@ -112,12 +112,11 @@ def atlas(
             text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
             write_atomic(mechanisms / f"chain_{links}_{mobility}_{i:04d}.yaml", text)
     if out is not None:
-        from mechsyn.results import save_figure_atomic
-        from mechsyn.synthesis.atlas_plot import atlas_figure
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.atlas import plot_atlas
 
-        fig = atlas_figure(chains, f"Planar kinematic chains: {links} links, mobility "
-                           f"{mobility}: {len(good)} chains")
-        save_figure_atomic(fig, out, dpi=110)
+        save_plot(out, plot_atlas, chains, f"Planar kinematic chains: {links} links, mobility "
+                  f"{mobility}: {len(good)} chains")
     if json_out:
         emit_json(result)
         return

@@ -20,7 +20,7 @@ from mechsyn.cli.app import app
 from mechsyn.cli.common import console, emit_json, parse_floats, parse_range
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import belt as kb
-from mechsyn.results import save_figure_atomic, write_atomic
+from mechsyn.results import write_atomic
 from mechsyn.synthesis.belt import BeltSynthesis, synthesize_belt
 
 belt_app = typer.Typer(
@@ -304,7 +304,7 @@ def analyze_cmd(
 
     motion_law = _law(law or "", grid_deg, omega, omega_max, accel, table, case)
     if animate is not None:
-        from mechsyn.kinematics.belt_plot import check_animation_target
+        from mechsyn.cli.common import check_animation_target
 
         check_animation_target(animate)
     dphi = np.radians(grid_deg)
@@ -337,10 +337,10 @@ def analyze_cmd(
     if csv_out is not None:
         write_atomic(csv_out, _csv_text(state))
     if plot is not None:
-        from mechsyn.kinematics.belt_plot import figure_mechanism
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.belt import plot_belt
 
-        fig = figure_mechanism(design, state, four_bar, mres, title=result["name"])
-        save_figure_atomic(fig, plot)
+        save_plot(plot, plot_belt, design, state, four_bar, mres, title=result["name"], dpi=100)
     if four_bar_file is not None:
         from mechsyn.io import mechanism_from_dict, write_mechanism
 
@@ -354,9 +354,10 @@ def analyze_cmd(
         mechanism_from_dict(bm_dict)  # validate against the file format before writing
         write_mechanism(bm_dict, mechanism_file)
     if animate is not None:
-        from mechsyn.kinematics.belt_plot import save_animation
+        from mechsyn.cli.common import save_animation
+        from mechsyn.plot.belt import animate_belt
 
-        save_animation(design, state, animate, title=result["name"])
+        save_animation(animate, animate_belt, design, state, title=result["name"], fps=20)
     if json_out:
         emit_json(result)
         return

@@ -5,8 +5,6 @@ A thin layer over :mod:`mechsyn.capability`.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from pathlib import Path
 from typing import Optional
@@ -20,7 +18,7 @@ from rich.table import Table
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
     capability_map, continuous_best, interpolate_configuration, is_closed_form,
-    measure_values, plot_map, refine_over_self_motion, self_motion,
+    measure_values, refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
@@ -252,20 +250,18 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
         raise MechsynInputError("a spatial arm's grid needs its plane", source="--z",
                                 hint="add --z 400 (the grid lies in z = 400)")
     total = xs.size * ys.size
-    chunk = 2048 if is_closed_form(arm) else 1
+    chunk = 2048 if is_closed_form(arm) else 64  # numeric IK: 64 points at once
     with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as adv:
         cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1_vals, branch=br,
                               respect_limits=respect, continuous=continuous, chunk=chunk,
                               advance=adv)
     if csv_out is not None:
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(["x", "y", f"v_max_{measure}", *[f"{n}_opt" for n in arm.joint_names]])
-        for row in cmap.rows():
-            w.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
-        write_atomic(csv_out, buf.getvalue())
+        write_atomic(csv_out, cmap.to_csv())
     if map_png is not None:
-        plot_map(cmap, map_png)
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.capability import plot_capability_map
+
+        save_plot(map_png, plot_capability_map, cmap)
     v = np.where(np.isfinite(cmap.value), cmap.value, np.nan)
     interp = None
     if at is not None:

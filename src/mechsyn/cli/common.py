@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import sys
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
@@ -22,13 +23,27 @@ console = Console()
 err_console = Console(stderr=True)
 
 
-def emit_json(obj: Any, out: Path | None = None) -> None:
-    """Print ``obj`` as JSON on stdout, or write it whole to ``out``."""
-    text = dumps(obj)
-    if out is None:
-        sys.stdout.write(text + "\n")
+STDOUT = "-"
+
+
+def is_stdout(path: Path | str | None) -> bool:
+    """Whether an output option names standard output (``-o -``)."""
+    return path is not None and str(path) == STDOUT
+
+
+def write_output(out: Path | str, text: str) -> None:
+    """Write ``text`` whole to the file ``out``, or to stdout when ``out`` is ``-``."""
+    if is_stdout(out):
+        sys.stdout.write(text)
+        sys.stdout.flush()
     else:
-        write_atomic(out, text + "\n")
+        write_atomic(out, text)
+
+
+def emit_json(obj: Any, out: Path | None = None) -> None:
+    """Print ``obj`` as JSON on stdout, or write it whole to ``out`` (``-``: stdout)."""
+    text = dumps(obj)
+    write_output(STDOUT if out is None else out, text + "\n")
 
 
 def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
@@ -54,9 +69,61 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
 
 def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
                         what: str | None = None) -> None:
-    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work)."""
+    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work).
+
+    ``-`` (standard output) passes for text formats (.csv, .json, .yaml, .md, .pyslvs, .svg).
+    """
+    if is_stdout(path) and set(suffixes) & {".csv", ".json", ".yaml", ".md", ".pyslvs", ".svg", ".txt"}:
+        return
     if path is not None and path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
+
+
+def save_plot(path: Path, draw: Any, *args: Any, dpi: int = 110, figsize: tuple[float, float] = (7, 6),
+              **kwargs: Any) -> None:
+    """Draw with a ``mechsyn.plot`` function on a bare Figure (no pyplot, no backend) and write
+    it whole to ``path``. ``draw`` takes ``fig=`` (it sizes the figure) or ``ax=``."""
+    from matplotlib.figure import Figure
+
+    from mechsyn.results import save_figure_atomic
+
+    fig = Figure(figsize=figsize)
+    if "fig" in inspect.signature(draw).parameters:
+        draw(*args, fig=fig, **kwargs)
+    else:
+        draw(*args, ax=fig.add_subplot(), **kwargs)
+        fig.tight_layout()
+    save_figure_atomic(fig, path, dpi=dpi)
+
+
+def check_animation_target(path: Path, option: str = "--animate") -> Path:
+    """Raise MechsynInputError unless a GIF can be written to ``path`` (before any work)."""
+    from matplotlib.animation import PillowWriter
+
+    if not PillowWriter.isAvailable():
+        raise MechsynInputError(f"{option} needs the pillow package", hint="pip install pillow", source=option)
+    if path.suffix.lower() != ".gif":
+        raise MechsynInputError(f"the animation is a GIF: use a .gif file name, not {path.name}", source=option)
+    return path
+
+
+def save_animation(path: Path, animate: Any, *args: Any, fps: int = 15, dpi: int = 80,
+                   option: str = "--animate", **kwargs: Any) -> None:
+    """Build an animation with a ``mechsyn.plot`` function on a bare Figure and write it to
+    ``path`` as a GIF, whole or not at all."""
+    from matplotlib.animation import PillowWriter
+    from matplotlib.figure import Figure
+
+    from mechsyn.results import atomic_output
+
+    check_animation_target(path, option)
+    fig = Figure()
+    try:
+        anim = animate(*args, fig=fig, **kwargs)
+    except MechsynInputError as exc:
+        raise exc.with_source(option) from None
+    with atomic_output(path) as tmp:
+        anim.save(str(tmp), writer=PillowWriter(fps=fps), dpi=dpi)
 
 
 def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:

@@ -23,7 +23,11 @@ from mechsyn.cli import simulate as _simulate  # noqa: F401
 from mechsyn.cli import synth_finger_design as _synth_finger_design  # noqa: F401
 from mechsyn.cli import synth_path as _synth_path  # noqa: F401
 from mechsyn.cli import synth_mechanism as _synth_mechanism  # noqa: F401
+from mechsyn.cli import synth_curve as _synth_curve  # noqa: F401
+from mechsyn.cli import curves as _curves  # noqa: F401
 from mechsyn.cli import serve as _serve  # noqa: F401
+from mechsyn.cli import convert as _convert  # noqa: F401
+from mechsyn.cli import export as _export  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:

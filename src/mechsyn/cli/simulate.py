@@ -13,7 +13,8 @@ from rich.markup import escape
 from rich.table import Table
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, parse_range, progress_bar
+from mechsyn.cli.common import (check_output_suffix, console, emit_json, parse_range, progress_bar, save_animation,
+                                save_plot)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 from mechsyn.results import to_jsonable, write_atomic
@@ -174,11 +175,11 @@ def simulate_cmd(
             cols += [lm.angle, lm.angular_velocity, lm.angular_acceleration]
         write_atomic(csv_out, _csv_text(header, cols))
     if plot is not None:
-        from mechsyn.kinematics.plots import plot_simulation
-        plot_simulation(sim, plot)
+        from mechsyn.plot.kinematics import plot_simulation
+        save_plot(plot, plot_simulation, sim)
     if animate is not None:
-        from mechsyn.kinematics.plots import animate as anim
-        anim(sim, animate)
+        from mechsyn.plot.kinematics import animate_simulation
+        save_animation(animate, animate_simulation, sim, dpi=100)
     if json_:
         emit_json(out)
         return
@@ -280,8 +281,8 @@ def forces_cmd(
             cols.append(e)
         write_atomic(csv_out, _csv_text(header, cols))
     if plot is not None:
-        from mechsyn.kinematics.plots import plot_forces
-        plot_forces(fa, plot)
+        from mechsyn.plot.kinematics import plot_forces
+        save_plot(plot, plot_forces, fa)
     if json_:
         emit_json(fa.to_dict())
         return

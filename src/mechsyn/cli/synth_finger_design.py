@@ -26,7 +26,7 @@ def finger_design(
     """Optimise a finger's link lengths on discrete positions with its VLL locked, find
     each VLL's length range keeping the paths in the working region, minimise joint
     reactions and input moment in both modes; best VLL combination (paper 000, steps 8-13)."""
-    from mechsyn.synthesis.finger_design import design_figure, design_finger, load_case
+    from mechsyn.synthesis.finger_design import design_finger, load_case
 
     if time_limit <= 0:
         raise MechsynInputError("--time-limit must be positive", source="--time-limit")
@@ -47,9 +47,10 @@ def finger_design(
         mech["name"] = f"{mech.get('name', 'finger')} (finger-design, seed {seed})"
         write_mechanism(mech, out)
     if plot is not None:
-        from mechsyn.results import save_figure_atomic
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.finger import plot_finger_design
 
-        save_figure_atomic(design_figure(case, res), plot, dpi=110)
+        save_plot(plot, plot_finger_design, case, res)
     if json_out:
         emit_json(res)
         return

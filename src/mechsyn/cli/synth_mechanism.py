@@ -26,7 +26,7 @@ def synth_mechanism(
 ) -> None:
     """Move chosen joint / point coordinates and VLL lengths of a planar mechanism file so
     a point follows target positions (or a link target poses) at given input angles."""
-    from mechsyn.synthesis.general import load_case, synthesis_figure, synthesize_mechanism
+    from mechsyn.synthesis.general import load_case, synthesize_mechanism
 
     if not time_limit > 0:
         raise MechsynInputError("must be positive", source="--time-limit")
@@ -58,15 +58,10 @@ def synth_mechanism(
 
         write_mechanism(res.mechanism, out)
     if plot is not None:
-        import matplotlib.pyplot as plt
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.synthesis import plot_mechanism_synthesis
 
-        from mechsyn.results import save_figure_atomic
-
-        fig = synthesis_figure(case, res)
-        try:
-            save_figure_atomic(fig, plot, dpi=120)
-        finally:
-            plt.close(fig)
+        save_plot(plot, plot_mechanism_synthesis, case, res, dpi=120)
     if as_json:
         emit_json(res)
         return

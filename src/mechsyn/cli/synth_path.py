@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats
+from mechsyn.cli.common import console, emit_json, err_console, parse_floats, save_plot
 from mechsyn.errors import MechsynInputError
 
 
@@ -32,23 +32,6 @@ def _pick_case(file: Path, case_id: Optional[str]):
                             hint="one of " + ", ".join(c.id for c in cases))
 
 
-def _save_plot(path: Path, draw) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mechsyn.results import save_figure_atomic
-
-    fig, ax = plt.subplots(figsize=(7, 6), dpi=120)
-    try:
-        draw(ax)
-        fig.tight_layout()
-        save_figure_atomic(fig, path)
-    finally:
-        plt.close(fig)
-
-
 @synth_app.command("path")
 def synth_path(
     case_file: Path = typer.Argument(..., help="Case JSON (schema of synthesis_cases_public.json): one case, or a file of cases with --case."),
@@ -66,7 +49,8 @@ def synth_path(
     """Path generation: a four-bar whose coupler point passes through the targets."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from mechsyn.synthesis.export import fourbar_mechanism_dict, plot_fourbar_path, write_mechanism_file
+    from mechsyn.plot.synthesis import plot_fourbar_path
+    from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
     from mechsyn.synthesis.optimize import synthesize_path
 
     if time_limit <= 0:
@@ -101,10 +85,9 @@ def synth_path(
             f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
             f"joint points at target 1 (crank angle {np.degrees(res.theta2[0]):.4f} deg), branch {case.branch}"))
     if plot is not None:
-        _save_plot(plot, lambda ax: plot_fourbar_path(
-            ax, d, case.targets, res.theta2, case.branch,
-            title=f"{case.id}: error {res.error:.4g} (published best {case.best_known:.4g})" if case.best_known
-            else f"{case.id}: error {res.error:.4g}"))
+        save_plot(plot, plot_fourbar_path, d, case.targets, res.theta2, case.branch, dpi=120,
+                  title=f"{case.id}: error {res.error:.4g}"
+                  + (f" (published best {case.best_known:.4g})" if case.best_known else ""))
     if as_json:
         emit_json(res)
         return
@@ -200,7 +183,8 @@ def synth_motion(
     out: Optional[Path] = typer.Option(None, "--out", help="Write the best linkage as a mechanism file."),
 ) -> None:
     """Motion generation by Burmester theory (3, 4 or 5 poses), each linkage verified by simulation."""
-    from mechsyn.synthesis.exact import center_point_curve, motion_synthesis, to_jsonable_motion
+    from mechsyn.plot.synthesis import plot_motion_synthesis
+    from mechsyn.synthesis.exact import motion_synthesis, to_jsonable_motion
     from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
 
     P = _read_poses(poses_file, poses)
@@ -219,34 +203,7 @@ def synth_motion(
             x0=d["x0"], y0=d["y0"], theta0=d["theta0"], name="Four-bar motion generator (Burmester)"), out,
             header="coupler point P = origin of the guided body's frame; joints at pose 1")
     if plot is not None:
-        def draw(ax):
-            best_pts = np.array([best.O2, best.O4, *P[:, :2]])
-            lo, hi = best_pts.min(axis=0), best_pts.max(axis=0)
-            pad = 0.6 * (hi - lo).max() + 1e-9
-            if len(P) == 4:
-                M, _ = center_point_curve(P, n_dir=1440)
-                inside = np.all((M > lo - pad) & (M < hi + pad), axis=1)
-                ax.plot(M[inside, 0], M[inside, 1], ".", ms=1.5, color="0.6", label="centre-point curve")
-            ax.set_xlim(lo[0] - pad, hi[0] + pad)
-            ax.set_ylim(lo[1] - pad, hi[1] + pad)
-            L = 0.15 * (np.ptp(P[:, :2], axis=0).max() + 1)
-            for j, (x, y, a) in enumerate(P):
-                ax.annotate("", (x + L * np.cos(a), y + L * np.sin(a)), (x, y),
-                            arrowprops={"arrowstyle": "->", "color": "tab:red", "lw": 2})
-                ax.text(x, y, f" {j + 1}", color="tab:red")
-            for s in sols[:1]:
-                from mechsyn.synthesis.fourbar import fourbar_position
-                pose = fourbar_position(s.r1, s.r2, s.r3, s.r4, s.theta2[0], branch=s.branch,
-                                        x0=s.O2[0], y0=s.O2[1], theta0=s.theta0)
-                ch = np.array([s.O2, pose.A, pose.B, s.O4])
-                ax.plot(ch[:, 0], ch[:, 1], "-o", color="k", label="best linkage at pose 1")
-                tri = np.array([pose.A, pose.B, P[0, :2]])
-                ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3, label="coupler (guided body)")
-            ax.set_aspect("equal", adjustable="box")
-            ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=8)
-            ax.set_title(f"Burmester synthesis, {len(P)} poses (red: required poses)")
-        _save_plot(plot, draw)
+        save_plot(plot, plot_motion_synthesis, P, sols, dpi=120)
     if as_json:
         emit_json({"solutions": [to_jsonable_motion(s) for s in sols[:top]], "count": len(sols),
                    "verified_count": sum(s.ok for s in sols)})

@@ -33,7 +33,7 @@ from mechsyn.results import to_jsonable, write_atomic
 
 __all__ = [
     "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
-    "mechanism_to_dict", "write_mechanism", "read_data",
+    "mechanism_to_dict", "mechanism_text", "write_mechanism", "read_data",
 ]
 
 
@@ -620,11 +620,14 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
     return d
 
 
+def mechanism_text(mech: Mechanism | dict[str, Any], as_json: bool = False) -> str:
+    """The text of a mechanism file (YAML, or JSON when ``as_json``) of ``mech`` or its data."""
+    data = mechanism_to_dict(mech) if isinstance(mech, Mechanism) else to_jsonable(mech)
+    if as_json:
+        return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=None, width=100)
+
+
 def write_mechanism(mech: Mechanism | dict[str, Any], path: str | os.PathLike[str]) -> None:
     """Write a mechanism (or file-format data) as YAML, or JSON for a ``.json`` path; atomic."""
-    data = mechanism_to_dict(mech) if isinstance(mech, Mechanism) else to_jsonable(mech)
-    if str(path).lower().endswith(".json"):
-        text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
-    else:
-        text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=None, width=100)
-    write_atomic(path, text)
+    write_atomic(path, mechanism_text(mech, str(path).lower().endswith(".json")))

@@ -19,10 +19,11 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import dyads
 from mechsyn.kinematics.forces import Reactions, kinetostatics
-from mechsyn.kinematics.solve import Sweep, _limit, assemble, sweep
+from mechsyn.kinematics.solve import Sweep, assemble, sweep
 from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
@@ -52,9 +53,15 @@ class LinkMotion:
                 "angular_acceleration": self.angular_acceleration}
 
 
-@dataclass
-class Simulation:
-    """Motion of a mechanism over a sweep of input values (see the module doc)."""
+@dataclass(repr=False)
+class Simulation(Result):
+    """Motion of a mechanism over a sweep of input values (see the module doc).
+
+    ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
+    table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
+    """
+
+    _plot = "kinematics:plot_paths"
 
     mechanism: str
     inputs: dict[str, np.ndarray]         # joint -> values (deg for R, length for P)
@@ -73,6 +80,56 @@ class Simulation:
     @property
     def main_input(self) -> str:
         return next(iter(self.inputs))
+
+    def _summary(self) -> list[tuple[str, str]]:
+        x = self.inputs[self.main_input]
+        unit = _unit(self.input_types[self.main_input])
+        rows = [("mechanism", self.mechanism), ("method", self.method),
+                ("input", f"{self.main_input}: {len(x)} values, {x[0]:g} to {x[-1]:g} {unit}" if len(x) else "none"),
+                ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
+                ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
+        if self.events:
+            rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
+        return rows
+
+    def point(self, name: str) -> np.ndarray:
+        """Positions (N, 2) of named point ``name`` over the sweep (NaN where not assembled)."""
+        if name not in self.points:
+            raise MechsynInputError(f"no point {name!r} in this simulation", field="points",
+                                    hint="one of " + (", ".join(self.points) or "none: pass points=[...]"))
+        return self.points[name].position
+
+    def link(self, name: str) -> LinkMotion:
+        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
+        if name not in self.links:
+            raise MechsynInputError(f"no link {name!r} in this simulation", field="link",
+                                    hint="one of " + ", ".join(self.links))
+        return self.links[name]
+
+    def to_pandas(self) -> Any:
+        """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
+        every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise ImportError("Simulation.to_pandas needs pandas: pip install pandas "
+                              "(or use to_dict(), which needs nothing)") from None
+        cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
+        cols["assembled"] = self.assembled
+        for name, pm in self.points.items():
+            for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
+                cols[f"{name}_{key}x"], cols[f"{name}_{key}y"] = arr[:, 0], arr[:, 1]
+        for name, lm in self.links.items():
+            cols[f"{name}_angle"], cols[f"{name}_omega"] = lm.angle, lm.angular_velocity
+            cols[f"{name}_alpha"] = lm.angular_acceleration
+        return pd.DataFrame(cols)
+
+    def animate(self, fig: Any = None, **kwargs: Any) -> Any:
+        """The mechanism moving over the sweep: a :class:`matplotlib.animation.FuncAnimation`
+        (``anim.save("m.gif", writer="pillow")``, or ``anim.to_jshtml()`` in a notebook)."""
+        from mechsyn.plot.kinematics import animate_simulation
+
+        return animate_simulation(self, fig=fig, **kwargs)
 
     def working_ranges(self) -> list[list[float]]:
         """Runs of consecutive assembled inputs, as [first, last] values of the main input."""
@@ -207,10 +264,13 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     events: list[dict] = []
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-        q, qd, qdd = dyads.solve_all(S, plan, U, sp)
+        tracked = dyads.solve_tracked(S, plan, U)
+        q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
+        qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
+        qdd[tracked.singular] = np.nan
         ok = np.all(np.isfinite(q), axis=1)
         sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), events, method="assur")
-        events.extend(_fast_events(S, sw))
+        events.extend(_fast_events(tracked, sw))
         used = "assur"
         if progress is not None:
             progress(N)
@@ -220,7 +280,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         used = "newton"
     ok = sw.assembled
     rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+    flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
     for k in np.flatnonzero(ok & ~rates_ok).tolist():
+        if k in flagged:
+            continue
         events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
                        "message": "singular configuration: assembled, but the velocities and accelerations "
                                   "are not defined here (null)"})
@@ -273,23 +336,11 @@ def _event_units(S: PlanarSystem, e: dict) -> dict:
     return e
 
 
-def _fast_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
-    """Dead points (refined by Newton bisection) where the closed form stops assembling."""
-    out = []
-    ok = sw.assembled
-    for k in (np.flatnonzero(ok[1:] != ok[:-1]) + 1).tolist():
-        if ok[k - 1] and not ok[k]:
-            ul, _ = _limit(S, sw.q[k - 1], sw.inputs[k - 1], sw.inputs[k])
-            out.append({"index": k, "kind": "dead point", "input": ul.tolist(),
-                        "message": "assembly ends: the Jacobian becomes singular (dead point / limit of the "
-                                   "working range)"})
-        elif ok[k] and not ok[k - 1]:
-            ul, _ = _limit(S, sw.q[k], sw.inputs[k], sw.inputs[k - 1])
-            out.append({"index": k, "kind": "dead point", "input": ul.tolist(),
-                        "message": "assembly starts again here: the other limit of a working range"})
-            out.append({"index": k, "kind": "reassembled", "input": sw.inputs[k].tolist(),
-                        "message": "assembles again after a gap (in the file's assembly mode)"})
-    if not ok[0]:
+def _fast_events(tracked: "dyads.TrackedPositions", sw: Sweep) -> list[dict]:
+    """Events of the closed-form sweep: dead points, reassembly and change / branch points
+    found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
+    out = list(tracked.events)
+    if not sw.assembled[0]:
         out.insert(0, {"index": 0, "kind": "not assembled", "input": sw.inputs[0].tolist(),
                        "message": "the mechanism cannot be assembled at the first input"})
     return out
@@ -312,9 +363,11 @@ def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
 
 
 # --------------------------------------------------------------------------- forces
-@dataclass
-class ForceAnalysis:
+@dataclass(repr=False)
+class ForceAnalysis(Result):
     """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``)."""
+
+    _plot = "kinematics:plot_forces"
 
     simulation: Simulation
     reactions: Reactions

@@ -54,6 +54,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.structure.contours import independent_contours
+from mechsyn.structure.idle import IdleInputs, IdleMobility, find_idle_mobilities
 
 __all__ = [
     "RankAnalysis", "IdleMobility", "ContourRank", "InsufficientGeometry",
@@ -397,18 +398,6 @@ def _orth(a: np.ndarray, tol: float = 1e-9) -> np.ndarray:
 
 # --------------------------------------------------------------------------- results
 @dataclass(frozen=True)
-class IdleMobility:
-    """An idle (local) mobility: a motion of one link alone that changes no function."""
-
-    link: str
-    joints: list[str]
-    description: str
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"link": self.link, "joints": self.joints, "description": self.description}
-
-
-@dataclass(frozen=True)
 class ContourRank:
     """Rank results of one contour, in the contours' order (sequential reading)."""
 
@@ -584,8 +573,9 @@ def _build_system(mech: Mechanism, planar: bool) -> _System:
                    centre, scale)
 
 
-def _link_twist_map(mech: Mechanism, sysm: _System) -> tuple[list[str], np.ndarray]:
-    """Moving links and the map ``T`` (6·n × F) from joint rates to link twists (spanning tree)."""
+def _link_twists(mech: Mechanism, sysm: _System, N: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Moving links and their twists per null-space motion (``n × 6 × m``), propagated
+    from the frame along a breadth-first spanning tree of the link graph."""
     from collections import deque
 
     adj: dict[str, list[tuple[str, int, int]]] = {n: [] for n in mech.link_names}
@@ -593,21 +583,59 @@ def _link_twist_map(mech: Mechanism, sysm: _System) -> tuple[list[str], np.ndarr
         a, b = j.links
         adj[a].append((b, k, 1))
         adj[b].append((a, k, -1))
-    F = sysm.twists.shape[0]
-    maps: dict[str, np.ndarray] = {mech.ground: np.zeros((6, F))}
+    cols_of = [[] for _ in mech.joints]  # type: list[list[int]]
+    for c, k in enumerate(sysm.col_joint):
+        cols_of[int(k)].append(c)
+    tw: dict[str, np.ndarray] = {mech.ground: np.zeros((6, N.shape[1]))}
     queue = deque([mech.ground])
     while queue:
         u = queue.popleft()
         for v, k, sign in adj[u]:
-            if v in maps:
-                continue
-            m = maps[u].copy()
-            cols = np.flatnonzero(sysm.col_joint == k)
-            m[:, cols] += sign * sysm.twists[cols].T
-            maps[v] = m
-            queue.append(v)
+            if v not in tw:
+                cols = cols_of[k]
+                tw[v] = tw[u] + sign * (sysm.twists[cols].T @ N[cols])
+                queue.append(v)
     names = list(mech.moving_links)
-    return names, np.concatenate([maps[n] for n in names], axis=0) if names else np.zeros((0, F))
+    return names, np.array([tw[n] for n in names]) if names else np.zeros((0, 6, N.shape[1]))
+
+
+_CENTRED_PAIRS = ("R", "H", "C", "U", "S", "S_pin")
+_HIGHER_PAIRS = ("cam", "gear", "belt", "line_contact", "point_contact")
+
+
+def _contact(j: Joint, mech: Mechanism) -> tuple[np.ndarray, np.ndarray] | None:
+    """Contact point and normal of a higher pair (None when the file gives neither)."""
+    if j.type == "belt":
+        return _belt_geometry(j)
+    if j.type == "gear" and j.normal is None and mech.kind == "planar":
+        return _gear_geometry(j, mech)
+    if j.point is None or j.normal is None:
+        return None
+    return _pad3(j.point), _unit(_pad3(j.normal))
+
+
+def _idle_inputs(mech: Mechanism, sysm: _System, N: np.ndarray, Z0: np.ndarray) -> IdleInputs:
+    """The arrays :func:`~mechsyn.structure.idle.find_idle_mobilities` needs (motions ``N @ Z0``)."""
+    names, LT = _link_twists(mech, sysm, N)
+    index = {n: i for i, n in enumerate(names)}
+
+    def norm(p: Any) -> np.ndarray:
+        return (_pad3(p) - sysm.centre) / sysm.scale
+
+    centres, contacts = [], []
+    for j in mech.joints:
+        on = [index[x] for x in j.links if x in index]
+        if j.type in _CENTRED_PAIRS and j.point is not None:
+            centres += [(i, norm(j.point)) for i in on]
+        elif j.type in _HIGHER_PAIRS:
+            pn = _contact(j, mech)
+            if pn is not None:
+                contacts += [(i, norm(pn[0]), pn[1]) for i in on]
+    named = [(index[p.link], norm(p.at)) for p in mech.points.values() if p.link in index]
+    edges = [tuple(index.get(x, -1) for x in j.links) for j in mech.joints]
+    return IdleInputs(A=LT @ Z0, rates=N @ Z0, col_joint=sysm.col_joint, links=names, edges=edges,  # type: ignore[arg-type]
+                      centres=centres, named=named, contacts=contacts, joint_ids=[j.id for j in mech.joints],
+                      centre=sysm.centre, scale=sysm.scale, drives=any(j.actuated for j in mech.joints))
 
 
 def _axis_words(basis: np.ndarray, word: str) -> str:
@@ -863,74 +891,33 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
         notes.append(f"per-contour counts ({', '.join(str(c.redundant) for c in contours)}) and the total "
                      f"{redundant} differ at this tolerance: a singular value is close to it")
 
-    # -- idle mobilities: motions of one link alone (other than a leaf/output link)
-    names, T = _link_twist_map(mech, sysm)
-    idle: list[IdleMobility] = []
-    idle_basis = np.zeros((mobility, 0))
-    if mobility and names:
-        LT = (T @ N).reshape(len(names), 6, mobility)
-        if planar:
-            LT = LT[:, PLANAR_ROWS, :]
-        rows_all = LT.reshape(-1, mobility)
-        z_all = _null(rows_all, tol)
-        if z_all.shape[1]:
-            for i in range(z_all.shape[1]):
-                rates = N @ z_all[:, i]
-                js = sorted({sysm.joints[sysm.col_joint[c]].id for c in np.flatnonzero(np.abs(rates) > 1e-6)})
-                idle.append(IdleMobility(link="", joints=js, description=f"joint rates of {', '.join(js)} cancel: "
-                                         "no link moves (coaxial or duplicated pairs)"))
-            idle_basis = np.concatenate([idle_basis, z_all], axis=1)
-        driven = _actuated_columns(sysm)[0]
-        # links joined to one neighbour only (by one or several pairs) are outputs
-        degree = {n: len({j.other(n) for j in mech.joints_of(n)}) for n in names}
-        points_on = {n: [p for p in mech.points.values() if p.link == n] for n in names}
-        # null space of the other links' twists, for every link at once: eigenvectors of the
-        # Gram matrices  G_others = G_all - G_link  (m × m) with eigenvalue below tol²
-        G = np.einsum("lrm,lrn->lmn", LT, LT)
-        evals, evecs = np.linalg.eigh(G.sum(axis=0)[None] - G)
-        for li, name in enumerate(names):
-            if degree[name] < 2:
-                continue  # a leaf link (one neighbour) is an output: its motion is the function
-            z = evecs[li][:, evals[li] < tol * tol]
-            if z.shape[1] <= z_all.shape[1]:
-                continue
-            z = z - z_all @ (z_all.T @ z) if z_all.shape[1] else z
-            z = _orth(z, 1e-6)
-            for i in range(z.shape[1]):
-                tw6 = (T[li * 6:(li + 1) * 6] @ N @ z[:, i])
-                moves_point = False
-                for p in points_on[name]:
-                    pp = (_pad3(p.at) - sysm.centre) / sysm.scale
-                    if np.linalg.norm(tw6[3:] + np.cross(tw6[:3], pp)) > 1e-6:
-                        moves_point = True
-                rates = N @ z[:, i]
-                if moves_point or (driven and np.max(np.abs(rates[driven])) > 1e-6):
-                    continue  # a named point moves, or a drive moves it: a useful motion
-                js = [sysm.joints[k].id for k in sorted({int(sysm.col_joint[c]) for c in
-                                                          np.flatnonzero(np.abs(rates) > 1e-6)})]
-                idle.append(IdleMobility(link=name, joints=js, description=_spin_words(name, js, tw6, sysm)))
-                idle_basis = np.concatenate([idle_basis, z[:, i:i + 1]], axis=1)
+    # -- idle mobilities (families (a) and (b), mechsyn.structure.idle) with every drive at rest
+    acols, anames = _actuated_columns(sysm)
+    if mobility and acols:
+        Z0 = _null(N[acols], tol)
+    else:
+        Z0 = np.eye(mobility)
+    idle, _, idle_notes = find_idle_mobilities(_idle_inputs(mech, sysm, N, Z0), tol) if mobility else ([], None, [])
+    notes.extend(idle_notes)
     useful = mobility - len(idle)
 
-    # -- drives
-    acols, anames = _actuated_columns(sysm)
+    # -- drives: they determine the motion when every motion left with them at rest is idle
     determined: bool | None = None
     anote = ""
     if anames:
-        AN = N[acols] if mobility else np.zeros((len(acols), 0))
-        za = _null(AN, tol) if mobility else np.zeros((0, 0))
-        uncontrolled = za.shape[1]
-        if uncontrolled:
-            both = np.concatenate([idle_basis, za], axis=1)
-            uncontrolled = _rank(both, 1e-6) - _rank(idle_basis, 1e-6) if idle_basis.size else za.shape[1]
+        uncontrolled = Z0.shape[1] - len(idle)
         determined = uncontrolled == 0
-        ra = _rank(AN, tol) if AN.size else 0
+        ra = _rank(N[acols], tol) if mobility else 0
         if not determined:
             anote = (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
                      f"{useful} drive(s) needed")
         elif ra < len(acols):
+            locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
+                      and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
             anote = (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
-                     "are not independent (redundant actuation: the drives fight each other)")
+                     "are not independent (redundant actuation: the drives fight each other)"
+                     + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
+                        if locked else ""))
         else:
             anote = f"the drives at {', '.join(anames)} determine the motion"
 
@@ -964,19 +951,6 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
         finite_mobility=finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
         equations=lam * K, rank=rank, smallest_singular_values=smallest, near_singular=near, notes=notes,
     )
-
-
-def _spin_words(name: str, joints: list[str], tw6: np.ndarray, sysm: _System) -> str:
-    w = tw6[:3]
-    if np.linalg.norm(w) < 1e-9:
-        return f"{name} slides alone (pairs {', '.join(joints)})"
-    d = _unit(w)
-    v = tw6[3:] / np.linalg.norm(w)
-    r = np.cross(d, v)  # a point on the spin axis (normalised)
-    p = sysm.centre + sysm.scale * r
-    dname = next((_AXIS_NAMES[k] for k in range(3) if abs(abs(d[k]) - 1) < 1e-6), None)
-    dd = dname if dname else _vec(d * np.sign(d[np.argmax(np.abs(d))]))
-    return f"{name} spins about the axis along {dd} through {_vec(p)} (pairs {', '.join(joints)})"
 
 
 # --------------------------------------------------------------------------- formulas side by side

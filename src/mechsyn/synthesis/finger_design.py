@@ -53,7 +53,7 @@ from mechsyn.errors import MechsynInputError
 __all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
            "Evaluation", "evaluate_locked", "stage1_objective", "vll_range", "mode_forces",
            "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE", "points_in_region",
-           "underactuated_paths", "design_figure", "redraw", "evaluate_drawn"]
+           "underactuated_paths", "redraw", "evaluate_drawn"]
 
 INFEASIBLE = 1e6
 Objective = Callable[[np.ndarray], float]
@@ -368,15 +368,26 @@ def locked_model(d: dict, vlls: list[str], source: str = "<case>") -> dict:
     return d
 
 
-def points_in_region(P: np.ndarray, region: np.ndarray) -> np.ndarray:
-    """Which points (N, 2) lie inside the polygon (NaN rows: outside)."""
-    from matplotlib.path import Path as MPath
-
+def points_in_region(P: np.ndarray, region: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Which points (N, 2) lie inside the polygon or within ``tol`` of its boundary (NaN rows:
+    outside). Even-odd ray casting, vectorised over points and edges."""
     P = np.asarray(P, float).reshape(-1, 2)
+    region = np.asarray(region, float)
     ok = np.all(np.isfinite(P), axis=1)
     out = np.zeros(len(P), bool)
-    if ok.any():
-        out[ok] = MPath(region).contains_points(P[ok], radius=1e-9)
+    if not ok.any():
+        return out
+    Q = P[ok]
+    a, b = region, np.roll(region, -1, axis=0)
+    x, y = Q[:, :1], Q[:, 1:]
+    crosses = (a[:, 1] > y) != (b[:, 1] > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xc = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    inside = np.count_nonzero(crosses & (x < xc), axis=1) % 2 == 1
+    ab = b - a
+    t = np.clip(np.einsum("nkj,kj->nk", Q[:, None] - a[None], ab) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0, 1)
+    dist = np.linalg.norm(Q[:, None] - (a[None] + t[..., None] * ab[None]), axis=2).min(axis=1)
+    out[ok] = inside | (dist <= tol)
     return out
 
 
@@ -887,108 +898,3 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
                         case.tolerance_deg, time.monotonic() - t0, stopped, notes)
-
-
-# --------------------------------------------------------------------------- plot
-def _draw_finger(ax: Any, S: Any, q: np.ndarray, color: Any, lw: float = 1.6, ls: str = "-",
-                 alpha: float = 0.85) -> None:
-    """Every moving link as the polygon of its joint and named points, at pose ``q`` (1, n)."""
-    for i, name in enumerate(S.links):
-        pts = [S.point(q, i, S.to_local(name, j.point))[0] for j in S.mech.joints if name in j.links]
-        pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
-        if len(pts) >= 2:
-            P = np.array(pts + pts[:1]) if len(pts) > 2 else np.array(pts)
-            ax.plot(P[:, 0], P[:, 1], ls, marker="o", color=color, lw=lw, ms=2.5, alpha=alpha)
-
-
-def design_figure(case: FingerCase, result: FingerDesign) -> Any:
-    """Three panels: the fully actuated mode (finger at the targets, output paths,
-    region); the underactuated mode (finger at the ends of the VLL range, at the extreme
-    crank angles); a zoom on the output paths for VLL lengths across the range."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib import cm
-
-    v = result.best_variant
-    combo = v.combination
-    d = apply_design(case, np.array(list(v.design.values())), combo)
-    ev = evaluate_drawn(case, d)
-    fig, axes = plt.subplots(1, 3, figsize=(17, 7.2), gridspec_kw={"width_ratios": [1, 1, 1.3]})
-    S = ev.system
-    idx = np.searchsorted(ev.inputs, case.target_inputs)
-    reg = np.vstack([case.region, case.region[:1]])
-    for ax in axes:
-        ax.fill(reg[:, 0], reg[:, 1], color="#d9f0d3", alpha=0.6, zorder=0, label="working region")
-        ax.plot(reg[:, 0], reg[:, 1], color="#1b7837", lw=1.2, zorder=1)
-        ax.set_aspect("equal")
-        ax.grid(alpha=0.3)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-    gp = np.array([j.point for j in S.mech.joints if S.mech.ground in j.links])
-    # 1: fully actuated
-    ax = axes[0]
-    cols = cm.viridis(np.linspace(0, 0.9, len(idx)))
-    for c, k in zip(cols, idx):
-        _draw_finger(ax, S, ev.q[k:k + 1], c)
-        ax.plot([], [], color=c, lw=2, label=f"crank +{ev.inputs[k]:g}° (target)")
-    for name, P in ev.paths.items():
-        ax.plot(P[:, 0], P[:, 1], "k--", lw=1.2, label=f"{name} path")
-    ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7, label="palm pivots")
-    ax.set_title(f"1. Fully actuated: VLL {'+'.join(combo)} locked at its minimum\n"
-                 f"target error RMS {v.error_rms:.3g}°, max {v.error_max:.3g}°", fontsize=11)
-    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
-    # 2: underactuated, the finger at the ends of the VLL range
-    ax = axes[1]
-    rng = ", ".join(f"{j} in [{a:.4g}, {b:.4g}]" for j, (a, b) in v.vll_ranges.items())
-    ends = [(f"{'+'.join(combo)} = min", d, "0.45")]
-    dmax = redraw(case, d, {j: v.vll_ranges[j][1] for j in combo})
-    if dmax is not None:
-        ends.append((f"{'+'.join(combo)} = max", dmax, "#d95f02"))
-    for label, dd, c in ends:
-        e2 = evaluate_drawn(case, dd)
-        if e2.q is None:
-            continue
-        for k, ls in ((0, "-"), (len(e2.inputs) - 1, "--")):
-            _draw_finger(ax, e2.system, e2.q[k:k + 1], c, ls=ls)
-        for P in e2.paths.values():
-            ax.plot(P[:, 0], P[:, 1], color=c, lw=2.2)
-        ax.plot([], [], color=c, lw=2, label=f"VLL {label}")
-    ax.plot([], [], "k-", lw=1, label=f"crank +{ev.inputs[0]:g}° (open)")
-    ax.plot([], [], "k--", lw=1, label=f"crank +{ev.inputs[-1]:g}° (closed)")
-    ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7)
-    ax.set_title(f"2. Underactuated: VLL free, {rng}\npeak reaction {v.forces['peak_reaction']:.3g}, "
-                 f"peak input moment {v.forces['peak_input_moment']:.3g} (both modes)", fontsize=11)
-    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
-    xs = axes[0].get_xlim() + axes[1].get_xlim()
-    ys = axes[0].get_ylim() + axes[1].get_ylim()
-    for ax in axes[:2]:
-        ax.set_xlim(min(xs), max(xs))
-        ax.set_ylim(min(ys), max(ys))
-    # 3: zoom on the output paths across the VLL range
-    ax = axes[2]
-    for jid, u in v.underactuated.items():
-        lens = u["lengths"]
-        lc = cm.plasma(np.linspace(0, 0.85, len(lens)))
-        for name, P in u["paths"].items():
-            for r in range(len(lens)):
-                ax.plot(P[r, :, 0], P[r, :, 1], color=lc[r], lw=1.8,
-                        label=f"{name}, {jid} = {lens[r]:.4g}" if name == case.points[0] else None)
-            for k in idx:  # adaptive motion with the motor still: the VLL sweeps its range
-                ax.plot(P[:, k, 0], P[:, k, 1], color="0.3", lw=1.0, ls=":")
-        ax.plot([], [], color="0.3", ls=":", label="motor still at a target, VLL moving")
-    for name, P in ev.paths.items():
-        ax.plot(P[:, 0], P[:, 1], "k--", lw=1.0, label=f"{name}, VLL locked (panel 1)")
-    ax.legend(fontsize=8, loc="lower left", framealpha=0.9)
-    box = np.vstack([case.region] + [u["paths"][n].reshape(-1, 2) for u in v.underactuated.values()
-                                     for n in u["paths"]])
-    box = box[np.all(np.isfinite(box), axis=1)]
-    blo, bhi = box.min(axis=0), box.max(axis=0)
-    pad = 0.06 * (bhi - blo).max()
-    ax.set_xlim(blo[0] - pad, bhi[0] + pad)
-    ax.set_ylim(blo[1] - 0.5 * (bhi[1] - blo[1]) - pad, bhi[1] + pad)  # room for the legend
-    ax.set_title("3. Output paths over the VLL range (zoom on the region)", fontsize=11)
-    fig.suptitle(f"Paper 000, steps 8-13: {S.mech.name}", fontsize=12)
-    fig.tight_layout()
-    return fig

@@ -47,7 +47,7 @@ from mechsyn.errors import MechsynInputError
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
-           "synthesize_mechanism", "synthesis_figure", "start_vector"]
+           "synthesize_mechanism", "start_vector"]
 
 
 @dataclass(frozen=True)
@@ -611,40 +611,3 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,
         stopped_by_time_limit=stopped, reason=ev.reason)
-
-
-def synthesis_figure(case: MechanismCase, res: MechanismSynthesisResult) -> Any:
-    """Targets against the achieved points and the swept path, with the design drawn at
-    its file configuration."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 6))
-    if len(res.path):
-        ax.plot(res.path[:, 0], res.path[:, 1], "-", color="0.6", lw=1, label="swept path")
-    ax.plot(res.targets[:, 0], res.targets[:, 1], "o", mfc="none", mec="C3", ms=9, label="targets")
-    ax.plot(res.achieved[:, 0], res.achieved[:, 1], "x", color="C0", ms=8, label="achieved")
-    for t, a in zip(res.targets, res.achieved):
-        ax.plot([t[0], a[0]], [t[1], a[1]], "-", color="C3", lw=0.8)
-    pts = {j["id"]: j["point"] for j in res.mechanism["joints"] if j.get("point") is not None}
-    by_link: dict[str, list] = {}
-    for j in res.mechanism["joints"]:
-        if j.get("point") is None:
-            continue
-        for lk in j["links"]:
-            by_link.setdefault(lk, []).append(pts[j["id"]])
-    for lk, ps in by_link.items():
-        if lk == res.mechanism["ground"] or len(ps) < 2:
-            continue
-        P = np.array(ps + [ps[0]] if len(ps) > 2 else ps)
-        ax.plot(P[:, 0], P[:, 1], "-", color="k", lw=1.4, alpha=0.7)
-    J = np.array(list(pts.values()))
-    ax.plot(J[:, 0], J[:, 1], "o", color="k", ms=4, label="design (file configuration)")
-    ax.set_aspect("equal")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
-    ax.set_title(f"{case.name} ({case.problem} generation): error {res.error:.4g}", fontsize=10)
-    fig.tight_layout()
-    return fig

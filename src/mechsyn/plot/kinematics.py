@@ -1,24 +1,22 @@
-"""Matplotlib figures of a simulation (paths, velocities, accelerations, reactions) and an
-animation of the mechanism with its point paths (GIF by Pillow)."""
+"""Figures of a simulation (paths, velocities, accelerations, reactions) and an animation
+of the mechanism with its point paths.
+
+Every function draws on the Axes/Figure it is given (a new pyplot one otherwise) and
+returns it; none writes a file or chooses a backend.
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
+from typing import Any
 
+import matplotlib
 import numpy as np
 
-from mechsyn.results import save_figure_atomic
+from mechsyn.errors import MechsynInputError
+from mechsyn.plot._base import axes, figure
 
-__all__ = ["plot_simulation", "plot_forces", "animate", "link_outlines"]
-
-
-def _mpl():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+__all__ = ["animate_simulation", "draw_mechanism", "link_outlines", "plot_forces", "plot_paths",
+           "plot_simulation"]
 
 
 def _joint_point_on(j, link: str) -> np.ndarray:
@@ -42,11 +40,16 @@ def link_outlines(sim, k: int) -> dict[str, np.ndarray]:
     return out
 
 
-def _draw_mechanism(ax, sim, k: int, color: str = "0.2", alpha: float = 1.0) -> list:
+def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
+    """Draw the mechanism of simulation ``sim`` at step ``k`` on ``ax``; returns the artists.
+
+    Moving links are coloured polygons (or bars) through their joint points, the frame's
+    pivots triangles, prismatic pairs squares; cam profiles and belt pulleys are drawn too.
+    """
     S = sim.system
     arts = []
     outl = link_outlines(sim, k)
-    cmap = _mpl().get_cmap("tab10")
+    cmap = matplotlib.colormaps["tab10"]
     for n, (name, pts) in enumerate(outl.items()):
         if name == S.mech.ground:
             arts += ax.plot(pts[:, 0], pts[:, 1], "^", ms=10, color="0.35", alpha=alpha, zorder=3)
@@ -123,16 +126,24 @@ def _input_axis(sim) -> tuple[np.ndarray, str]:
     return sim.inputs[main], f"input {main} ({unit})"
 
 
-def plot_simulation(sim, path: str | Path, title: str | None = None) -> None:
-    """Four panels: mechanism and point paths; point speeds; point accelerations; link
-    angular velocities, over the input."""
-    plt = _mpl()
-    x, xlabel = _input_axis(sim)
-    fig, axs = plt.subplots(2, 2, figsize=(12, 9))
-    ax = axs[0, 0]
+def plot_paths(sim: Any, ax: Any = None) -> Any:
+    """The mechanism at its first assembled input and the paths of its named points.
+
+    Parameters
+    ----------
+    sim : Simulation
+        From :func:`mechsyn.simulate`.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; a new figure's Axes when omitted.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    ax = axes(ax, (6.4, 5.6))
     k0 = int(np.argmax(sim.assembled)) if sim.assembled.any() else None
     if k0 is not None:
-        _draw_mechanism(ax, sim, k0)
+        draw_mechanism(ax, sim, k0)
     for name, pm in sim.points.items():
         ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1.5, label=f"path of {name}")
     ax.set_aspect("equal", adjustable="datalim")
@@ -140,6 +151,16 @@ def plot_simulation(sim, path: str | Path, title: str | None = None) -> None:
     ax.grid(alpha=0.3)
     if sim.points:
         ax.legend(fontsize=8, loc="best")
+    return ax
+
+
+def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
+    """Four panels: mechanism and point paths; point speeds; point accelerations; link
+    angular velocities, over the input. Returns the Figure."""
+    x, xlabel = _input_axis(sim)
+    fig = figure(fig, (12, 9))
+    axs = fig.subplots(2, 2)
+    plot_paths(sim, axs[0, 0])
     for ax, key, lab in ((axs[0, 1], "velocity", "speed |v| (length/s)"),
                          (axs[1, 0], "acceleration", "acceleration |a| (length/s²)")):
         for name, pm in sim.points.items():
@@ -165,16 +186,16 @@ def plot_simulation(sim, path: str | Path, title: str | None = None) -> None:
                 a.axvline(v, color="red", ls=":", lw=1)
     fig.suptitle(title or f"{sim.mechanism}: kinematics ({sim.method})")
     fig.tight_layout()
-    save_figure_atomic(fig, path, dpi=110)
-    plt.close(fig)
+    return fig
 
 
-def plot_forces(fa, path: str | Path, title: str | None = None) -> None:
-    """Reaction magnitudes in every joint and the balancing efforts, over the input."""
-    plt = _mpl()
+def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
+    """Reaction magnitudes in every joint and the balancing efforts, over the input.
+    Returns the Figure."""
     sim = fa.simulation
     x, xlabel = _input_axis(sim)
-    fig, axs = plt.subplots(1, 2, figsize=(13, 5))
+    fig = figure(fig, (13, 5))
+    axs = fig.subplots(1, 2)
     for j, F in fa.reactions.force.items():
         axs[0].plot(x, np.linalg.norm(F, axis=1), label=j)
     axs[0].set_title("joint reactions |F|")
@@ -192,26 +213,28 @@ def plot_forces(fa, path: str | Path, title: str | None = None) -> None:
     kind = "static" if fa.static else "kinetostatic"
     fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, gravity {fa.gravity}")
     fig.tight_layout()
-    save_figure_atomic(fig, path, dpi=110)
-    plt.close(fig)
+    return fig
 
 
-def animate(sim, path: str | Path, max_frames: int = 90, fps: int = 15) -> None:
-    """A GIF of the mechanism moving over the assembled inputs, tracing its points' paths."""
-    plt = _mpl()
-    from matplotlib.animation import FuncAnimation, PillowWriter
+def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval: float = 1000 / 15) -> Any:
+    """The mechanism moving over the assembled inputs, tracing its points' paths.
+
+    Returns a :class:`matplotlib.animation.FuncAnimation` (save it with a writer, e.g.
+    ``anim.save("m.gif", writer="pillow")``, or show it with ``anim.to_jshtml()``).
+    Raises :class:`~mechsyn.errors.MechsynInputError` when no input is assembled.
+    """
+    from matplotlib.animation import FuncAnimation
 
     idx = np.flatnonzero(sim.assembled)
     if len(idx) == 0:
-        from mechsyn.errors import MechsynInputError
-
         raise MechsynInputError("nothing to animate: the mechanism is not assembled at any input",
-                                source="--animate")
+                                hint="widen the input range")
     frames = idx[np.unique(np.linspace(0, len(idx) - 1, min(max_frames, len(idx))).astype(int))]
-    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    fig = figure(fig, (6.4, 5.6))
+    ax = fig.add_subplot()
     # the view: everything drawn at a dozen frames, with the point paths
     for k in frames[:: max(1, len(frames) // 12)]:
-        _draw_mechanism(ax, sim, k)
+        draw_mechanism(ax, sim, k)
     for pm in sim.points.values():
         ax.plot(pm.position[idx, 0], pm.position[idx, 1])
     ax.relim()
@@ -230,20 +253,10 @@ def animate(sim, path: str | Path, max_frames: int = 90, fps: int = 15) -> None:
             ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
             ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
             ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
-        arts = _draw_mechanism(ax, sim, k)
+        arts = draw_mechanism(ax, sim, k)
         ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
         if sim.points:
             ax.legend(fontsize=8, loc="upper right")
         return arts
 
-    anim = FuncAnimation(fig, draw, frames=list(frames), blit=False)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
-    try:
-        anim.save(str(tmp), writer=PillowWriter(fps=fps))
-        tmp.replace(path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-        plt.close(fig)
+    return FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
