@@ -230,7 +230,7 @@ def test_fourbar_path_synthesis_job(client):
     mech = load_mechanism(example_path("crank_rocker"))
     sim = simulate(mech, {"A": 60 + np.array([0, 40, 80, 120, 160])}, points=["M"])
     targets = sim.points["M"].position.tolist()
-    job = client.post("/api/synth/fourbar_path", json={"targets": targets, "time_limit": 6, "restarts": 2}).json()
+    job = client.post("/api/synth/fourbar_path", json={"targets": targets, "time_limit": 4, "restarts": 2}).json()
     s = _wait(client, job["id"])
     assert s["state"] == "done", s
     res = s["result"]["results"]
@@ -278,3 +278,11 @@ def test_drag_preview_equals_full_simulation(client, name):
                 assert (p is None) == (q is None)
                 if p is not None:
                     assert q == pytest.approx(p, abs=1e-9)
+
+
+def test_curve_synthesis_kind_is_offered_and_checks_its_input(client):
+    kinds = client.get("/api/start").json()["synthesis_kinds"]
+    assert set(kinds) == {"fourbar_path", "curve"}
+    r = client.post("/api/synth/curve", json={"targets": [[0, 0], [1, 1], [2, 0]]})
+    s = _wait(client, r.json()["id"])
+    assert s["state"] == "failed" and s["error"]["field"] == "targets" and "6 points" in s["error"]["message"]

@@ -8,6 +8,7 @@ reports land (``mechsyn.analyze``, an incremental ``simulate``), only this modul
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import math
 from pathlib import Path
@@ -39,9 +40,13 @@ def _examples_dir() -> Path | None:
 
 def examples() -> list[dict[str, str]]:
     """Planar mechanism examples: ``[{"name", "title", "group"}]`` sorted by group and name."""
-    root = _examples_dir()
+    return [dict(e) for e in _examples(_examples_dir())]
+
+
+@functools.lru_cache(maxsize=4)
+def _examples(root: Path | None) -> tuple[dict[str, str], ...]:
     if root is None:
-        return []
+        return ()
     out = []
     for p in sorted(root.rglob("*")):
         if p.suffix not in EXAMPLE_SUFFIXES or not p.is_file():
@@ -55,7 +60,7 @@ def examples() -> list[dict[str, str]]:
         if mech.kind != "planar" or not all(j.point is not None for j in mech.joints):
             continue
         out.append({"name": p.stem, "title": mech.name, "group": p.parent.name})
-    return out
+    return tuple(out)
 
 
 def example_path(name: str) -> Path:
@@ -405,6 +410,8 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
                               progress=report)
         d = {**bcase.fixed, **res.design}
         item = {"error": float(res.error), "feasible": bool(res.feasible), "branch": branch,
+                "label": f"error {res.error:.4g} (sum of squared distances), branch {branch:+d}, "
+                         f"{'feasible' if res.feasible else 'infeasible'}",
                 "design": {k: float(v) for k, v in d.items() if not k.startswith("theta2")},
                 "path": _xy(res.path), "seconds": float(res.seconds)}
         if res.feasible:
@@ -422,8 +429,51 @@ def _with_branch(case, branch: int):
     return dataclasses.replace(case, branch=branch)
 
 
+def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+    """Curve to mechanism (:mod:`mechsyn.synthesis.curves`): ranked 4- to ``max_links``-bar
+    linkages whose tracing point follows the clicked or drawn curve ``params["targets"]``.
+
+    The local curve database is built on first use (a few minutes; its progress is reported).
+    """
+    from mechsyn.synthesis.curves.database import load_database
+    from mechsyn.synthesis.curves.synthesis import synthesize_curve
+    from mechsyn.synthesis.curves.target import target_from_points
+
+    T = np.asarray(params.get("targets"), float)
+    if T.ndim != 2 or T.shape[1:] != (2,) or len(T) < 6 or not np.isfinite(T).all():
+        raise MechsynInputError("give at least 6 points [x, y] along the curve", field="targets",
+                                hint="click more points, or draw the curve")
+    time_limit = float(params.get("time_limit", 20.0))
+    if not 1 <= time_limit <= 600:
+        raise MechsynInputError("time limit must be within 1..600 s", field="time_limit")
+    max_links = int(params.get("max_links", 6))
+    if max_links not in (4, 6, 8):
+        raise MechsynInputError("max_links must be 4, 6 or 8", field="max_links")
+    closed = params.get("closed")
+    target = target_from_points(T, closed=None if closed is None else bool(closed), source="clicked curve")
+
+    def report(state: dict) -> None:
+        best = state.get("best")
+        progress({"done": int(state.get("done") or 0), "total": int(state.get("total") or 1),
+                  "best": float(best) if isinstance(best, float) and math.isfinite(best) else None,
+                  "stage": str(state.get("stage", ""))})
+
+    db = load_database(None, max_links=max_links, callback=report)
+    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, database=db, callback=report)
+    results = []
+    for c in res.candidates:
+        d = c.to_dict()
+        results.append({"error": float(c.chamfer), "feasible": bool(c.verified), "mechanism": d["mechanism"],
+                        "path": _xy(c.path),
+                        "label": f"{d['topology'] or d['topology_key']} ({d['links']} links): chamfer "
+                                 f"{100 * c.chamfer:.2f} % of the diagonal, min μ {c.min_transmission_angle:.0f}°"
+                                 + ("" if c.verified else f", not verified: {c.verification}")})
+    return {"kind": "curve", "targets": T.tolist(), "results": results, "notes": list(res.notes)}
+
+
 # Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
-# Curve-to-mechanism synthesis (branch `curve`) registers here as "curve_atlas" once it lands.
+# Each result dict: {"kind", "targets", "results": [{"label", "error", "feasible", "mechanism", "path"}]}.
 SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, Callable[[dict], None]], dict]]] = {
     "fourbar_path": ("Four-bar path through the clicked points", synthesize_fourbar_path),
+    "curve": ("Curve to mechanism over the atlas (4- to 8-bars)", synthesize_curve_points),
 }

@@ -286,12 +286,22 @@ svg.addEventListener("pointerdown", (ev) => {
   } else if (mode === "target") {
     state.targets.push(p);
     $("target-count").textContent = state.targets.length;
+    gesture = { kind: "draw", last: [ev.clientX, ev.clientY] };
+    svg.setPointerCapture(ev.pointerId);
     render();
   }
 });
 
 svg.addEventListener("pointermove", (ev) => {
   if (!gesture) return;
+  if (gesture.kind === "draw") { // drawing a target curve: a point every 12 px
+    if (Math.hypot(ev.clientX - gesture.last[0], ev.clientY - gesture.last[1]) < 12) return;
+    gesture.last = [ev.clientX, ev.clientY];
+    state.targets.push(worldAt(ev));
+    $("target-count").textContent = state.targets.length;
+    render();
+    return;
+  }
   if (gesture.kind === "pan") {
     const s = state.view.s;
     state.view = { ...gesture.view, ox: gesture.view.ox - (ev.clientX - gesture.x) / s, oy: gesture.view.oy + (ev.clientY - gesture.y) / s };
@@ -477,7 +487,7 @@ $("clear-targets").onclick = () => { state.targets = []; state.preview = null; $
 $("synth-run").onclick = async () => {
   $("synth-status").textContent = "";
   try {
-    job = await call("/api/synth/fourbar_path", { targets: state.targets, time_limit: +$("synth-time").value });
+    job = await call(`/api/synth/${$("synth-kind").value || "fourbar_path"}`, { targets: state.targets, time_limit: +$("synth-time").value });
   } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
   $("synth-run").disabled = true; $("synth-cancel").disabled = false;
   $("synth-results").replaceChildren();
@@ -485,7 +495,7 @@ $("synth-run").onclick = async () => {
   const show = (snap) => {
     const p = snap.progress;
     $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
-    $("synth-status").textContent = `${snap.state}: ${p.done}/${p.total} restarts, best error ${p.best === null ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
+    $("synth-status").textContent = `${snap.state}${p.stage ? " (" + p.stage + ")" : ""}: ${p.done}/${p.total}, best ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
   };
   source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
   source.addEventListener("end", (e) => {
@@ -504,7 +514,7 @@ function showResults(results) {
   const items = results.map((r, i) => {
     const li = h("li");
     li.dataset.result = i;
-    li.append(`error ${r.error.toPrecision(4)} (sum of squared distances), branch ${r.branch}, ${r.feasible ? "feasible" : "infeasible"} `);
+    li.append(`${r.label} `);
     if (r.mechanism) {
       const b = h("button", "Apply"); b.dataset.apply = i;
       b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
@@ -690,6 +700,7 @@ document.addEventListener("keydown", (ev) => {
   try {
     const s = await call("/api/start");
     $("save-name").value = s.name || "";
+    for (const [k, title] of Object.entries(s.synthesis_kinds || {})) $("synth-kind").append(h("option", title, { value: k }));
     const ex = await call("/api/examples");
     for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}`, { value: e.name }));
     refreshFiles();
