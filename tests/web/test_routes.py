@@ -266,18 +266,13 @@ def test_events_stream(client):
     assert "event: end" in text and '"state": "done"' in text
 
 
-@pytest.mark.parametrize("name", ["fourbar", "watt_sixbar", "slider_crank", "crank_rocker"])
-def test_drag_preview_equals_full_simulation(client, name):
-    m = mechanism_to_dict(load_mechanism(example_path(name)))
-    full = client.post("/api/simulate", json={"mechanism": m, "steps": 120}).json()
-    fast = client.post("/api/simulate", json={"mechanism": m, "steps": 120, "preview": True}).json()
-    assert fast["preview"] and fast["input"] == full["input"] and fast["assembled"] == full["assembled"]
-    for group in ("joints", "points"):
-        for key, pts in full[group].items():
-            for p, q in zip(pts, fast[group][key]):
-                assert (p is None) == (q is None)
-                if p is not None:
-                    assert q == pytest.approx(p, abs=1e-9)
+def test_simulate_without_rates(client, fourbar):
+    full = client.post("/api/simulate", json={"mechanism": fourbar, "steps": 60}).json()
+    lean = client.post("/api/simulate", json={"mechanism": fourbar, "steps": 60, "rates": False}).json()
+    assert lean["velocity"] == {} and lean["links"] == {} and not lean["rates"]
+    for key in ("joints", "points", "events", "working_ranges", "transmission_angle", "assembled"):
+        assert lean[key] == full[key]
+    assert client.post("/api/simulate", json={"mechanism": fourbar, "rates": "no"}).status_code == 400
 
 
 def test_curve_synthesis_kind_is_offered_and_checks_its_input(client):

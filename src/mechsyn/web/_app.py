@@ -251,8 +251,10 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     async def simulate(request: Request) -> Any:
         data = await _body(request)
         steps = _int(data.get("steps", 180), "steps")
-        fn = _service.simulate_preview if data.get("preview") is True else _service.simulate
-        return await run_in_threadpool(fn, _need(data, "mechanism"), steps)
+        rates = data.get("rates", True)
+        if not isinstance(rates, bool):
+            raise MechsynInputError("must be true or false", field="rates")
+        return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps, None, rates)
 
     @api
     async def files(request: Request) -> Any:

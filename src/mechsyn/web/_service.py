@@ -192,54 +192,15 @@ def _sweep(mech, steps: int, span: float | None) -> tuple[Any, np.ndarray]:
     return drive, start + np.linspace(0, span, n)
 
 
-def simulate_preview(data: Any, steps: int = 180) -> dict[str, Any]:
-    """Positions only, for the drag loop: the closed-form Assur-group solution of
-    :func:`simulate` without its dead-point refinement, velocities and events (those come
-    with the full :func:`simulate` when the drag ends). Falls back to :func:`simulate`
-    when the mechanism does not decompose into drivers and dyads.
-    """
-    from mechsyn.kinematics import dyads
-    from mechsyn.kinematics.analysis import resolve_points
-    from mechsyn.kinematics.solve import assemble
-    from mechsyn.kinematics.system import build_system
-
-    mech = build(data)
-    drive, values = _sweep(mech, steps, None)
-    S = build_system(mech)
-    plan = dyads.decompose(S)
-    if plan is None:
-        return simulate(data, steps)
-    assemble(S)  # the drawn configuration must assemble (else an input error, as in simulate)
-    U = np.tile([d.assembled for d in S.drivers], (len(values), 1)).astype(float)
-    k = [d.joint for d in S.drivers].index(drive.id)
-    U[:, k] = np.radians(values) if drive.type == "R" else values
-    q, _ = dyads.solve_positions(S, plan, U)
-    ok = np.all(np.isfinite(q), axis=1)
-    qz, zero = np.nan_to_num(q), np.zeros_like(q)
-    names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
-    pos = {}
-    for name, (link, at) in resolve_points(mech, names).items():
-        P, _, _ = S.point_state(qz, zero, zero, S.index(link), S.to_local(link, at))
-        P[~ok] = np.nan
-        pos[name] = P
-    return {"mechanism": mech.name, "preview": True,
-            "input": {"joint": drive.id, "type": drive.type, "values": _finite(values),
-                      "unit": "deg" if drive.type == "R" else "length"},
-            "assembled": ok.tolist(),
-            "joints": {j.id: _xy(pos[j.id]) for j in mech.joints if j.id in pos},
-            "points": {p: _xy(pos[p]) for p in mech.points},
-            "velocity": {}, "acceleration": {}, "links": {}, "working_ranges": [], "events": [], "notes": [],
-            "transmission_angle": {}, "method": "assur (positions only)"}
-
-
-def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str, Any]:
+def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool = True) -> dict[str, Any]:
     """Positions of every joint and named point over a sweep of the first drive.
 
     The sweep starts at the drawn configuration (index 0 is the file's pose) and covers
     ``span`` (360 deg for an R drive, ± its length scale for a P drive) in ``steps``.
     Returns ``joints``/``points`` as lists of [x, y] or null (not assembled),
     ``working_ranges``, ``events`` (dead points, reassembly, singular positions),
-    ``transmission_angle`` and, for a four-bar, ``grashof``.
+    ``transmission_angle`` and, for a four-bar, ``grashof``. ``rates=False`` leaves out
+    the velocities, accelerations and link angles (a smaller answer for the drag loop).
     """
     from mechsyn.kinematics import derived
     from mechsyn.kinematics.analysis import simulate as _simulate
@@ -257,11 +218,12 @@ def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str
         "assembled": ok.tolist(),
         "joints": {j.id: _xy(sim.points[j.id].position) for j in mech.joints if j.id in sim.points},
         "points": {p: _xy(sim.points[p].position) for p in mech.points},
-        "velocity": {p: _xy(pm.velocity) for p, pm in sim.points.items()},
-        "acceleration": {p: _xy(pm.acceleration) for p, pm in sim.points.items()},
+        "velocity": {p: _xy(pm.velocity) for p, pm in sim.points.items()} if rates else {},
+        "acceleration": {p: _xy(pm.acceleration) for p, pm in sim.points.items()} if rates else {},
         "links": {name: {"angle": _finite(lm.angle), "angular_velocity": _finite(lm.angular_velocity),
                          "angular_acceleration": _finite(lm.angular_acceleration)}
-                  for name, lm in sim.links.items()},
+                  for name, lm in sim.links.items()} if rates else {},
+        "rates": rates,
         "working_ranges": sim.working_ranges(),
         "events": to_jsonable(sim.events),
         "notes": list(sim.notes),

@@ -11,7 +11,7 @@ const state = {
   mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
   opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
   targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
-  renders: 0, simulations: 0,
+  renders: 0, simulations: 0, latencies: [],
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
 
@@ -64,15 +64,17 @@ function statusLine() {
 
 // ------------------------------------------------------------------ simulation and analysis
 const simulateSoon = coalescing(
-  // while dragging: positions only (the closed form, fast); on release: the full simulation
-  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, preview: !!req.preview }).then((r) => ({ r, ms: performance.now() - t0 })); },
-  ({ r, ms }, { mech }) => {
+  // while dragging: without velocities and accelerations (a smaller answer); on release: all
+  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
+  ({ r, ms }, { mech, t0 }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
-    if ((mech !== state.mech || r.preview) && !state.dragging) return; // a newer mechanism is on its way
+    if ((mech !== state.mech || !r.rates) && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
     if (state.frame >= r.assembled.length) state.frame = 0;
     render();
+    // drag-to-repaint latency: from the pointer event to the frame that shows its simulation
+    if (t0 !== undefined) requestAnimationFrame(() => state.latencies.push(performance.now() - t0));
     if (!state.dragging) renderAnalysis();
   },
   (e, { mech }) => {
@@ -315,7 +317,7 @@ svg.addEventListener("pointermove", (ev) => {
   gesture.moved = true;
   state.mech = m;
   render();
-  simulateSoon({ mech: m, preview: true });
+  simulateSoon({ mech: m, drag: true, t0: ev.timeStamp });
 });
 
 function endGesture() {
