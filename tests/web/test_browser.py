@@ -215,11 +215,11 @@ def test_synthesise_fourbar_through_five_points(serve, page):
     for p in targets:
         click_world(page, *p)
     assert page.locator("[data-target]").count() == 5
-    page.fill("#synth-time", "4")
+    page.fill("#synth-time", "12")
     page.click("#synth-run")
     wait_js(page, "() => document.querySelector('#synth-progress').value > 0", timeout=30)
     shot(page, "studio_synthesis_progress.png")
-    page.wait_for_selector("[data-apply]", timeout=60000)
+    page.wait_for_selector("[data-apply]", timeout=90000)
     status = page.locator("#synth-status").inner_text()
     assert status.startswith("done")
     page.locator("[data-apply='0']").click()

@@ -230,7 +230,7 @@ def test_fourbar_path_synthesis_job(client):
     mech = load_mechanism(example_path("crank_rocker"))
     sim = simulate(mech, {"A": 60 + np.array([0, 40, 80, 120, 160])}, points=["M"])
     targets = sim.points["M"].position.tolist()
-    job = client.post("/api/synth/fourbar_path", json={"targets": targets, "time_limit": 4, "restarts": 2}).json()
+    job = client.post("/api/synth/fourbar_path", json={"targets": targets, "time_limit": 10, "restarts": 2}).json()
     s = _wait(client, job["id"])
     assert s["state"] == "done", s
     res = s["result"]["results"]
