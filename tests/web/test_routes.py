@@ -199,6 +199,19 @@ def test_import_and_export(client, fourbar):
     assert lines[0].startswith("input_A,assembled,A_x,A_y") and len(lines) == 11
     y = client.post("/api/export", json={"mechanism": fourbar, "format": "yaml"}).text
     assert "joints:" in y
+    assert client.post("/api/export", json={"mechanism": fourbar, "format": "pdf"}).status_code == 400
+
+
+def test_export_animation(client):
+    import io
+
+    from PIL import Image
+
+    crank = mechanism_to_dict(load_mechanism(example_path("crank_rocker")))
+    r = client.post("/api/export", json={"mechanism": crank, "format": "gif", "frames": 12})
+    assert r.status_code == 200 and r.headers["content-type"] == "image/gif"
+    im = Image.open(io.BytesIO(r.content))
+    assert im.format == "GIF" and im.n_frames == 12
 
 
 # ---------------------------------------------------------------- atlas and synthesis

@@ -266,6 +266,27 @@ def simulation_csv(data: Any, steps: int = 180) -> str:
     return buf.getvalue()
 
 
+def animation_gif(data: Any, frames: int = 72) -> bytes:
+    """The mechanism moving over its sweep as a GIF (``mechsyn.plot.animate_simulation``)."""
+    import tempfile
+
+    from matplotlib.animation import PillowWriter
+    from matplotlib.figure import Figure
+
+    from mechsyn.kinematics.analysis import simulate as _simulate
+    from mechsyn.plot.kinematics import animate_simulation
+
+    mech = build(data)
+    drive, values = _sweep(mech, 180, None)
+    sim = _simulate(mech, {drive.id: values})
+    fig = Figure(figsize=(6, 4.5))
+    anim = animate_simulation(sim, fig=fig, max_frames=frames)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "animation.gif"
+        anim.save(str(path), writer=PillowWriter(fps=15), dpi=80)
+        return path.read_bytes()
+
+
 # --------------------------------------------------------------------------- structure
 def analyze(data: Any) -> dict[str, Any]:
     """Mobility formulas with their numbers, the rank result, Assur groups, Grashof."""

@@ -1,7 +1,7 @@
 // Talking to the mechsyn studio server: the per-launch token and JSON requests.
 export const token = new URLSearchParams(location.search).get("token") || "";
 
-export async function call(path, body = undefined, { method, raw = false } = {}) {
+export async function call(path, body = undefined, { method, raw = false, blob = false } = {}) {
   const opts = { method: method || (body === undefined ? "GET" : "POST"), headers: { "X-Mechsyn-Token": token } };
   if (body !== undefined) {
     opts.headers["Content-Type"] = "application/json";
@@ -13,6 +13,7 @@ export async function call(path, body = undefined, { method, raw = false } = {})
   } catch (e) {
     throw { error: "the server does not answer (is `mechsyn serve` still running?)" };
   }
+  if (blob && resp.ok) return resp.blob();
   if (raw && resp.ok) return resp.text();
   let data;
   try { data = await resp.json(); } catch (e) { data = { error: `HTTP ${resp.status}` }; }

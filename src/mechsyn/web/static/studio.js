@@ -642,6 +642,10 @@ $("export").onchange = async (ev) => {
       const ctx = cv.getContext("2d"); ctx.scale(2, 2); ctx.drawImage(img, 0, 0, r.width, r.height);
       URL.revokeObjectURL(url);
       cv.toBlob((b) => download(`${base()}.png`, b), "image/png");
+    } else if (fmt === "gif") {
+      state.notes = ["making the animation…"]; render();
+      download(`${base()}.gif`, await call("/api/export", { mechanism: state.mech, format: "gif" }, { blob: true }));
+      state.notes = []; render();
     } else {
       const text = await call("/api/export", { mechanism: state.mech, format: fmt }, { raw: true });
       download(`${base()}.${fmt}`, new Blob([text], { type: "text/plain" }));
