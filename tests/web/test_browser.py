@@ -200,7 +200,7 @@ def test_build_a_sixbar_from_nothing(serve, page):
     page.click("text=Delete")
     page.mouse.click(*center(page, '[data-link="L4"] .link-hit'))
     page.wait_for_selector("#banner .err, #banner .note")
-    assert page.locator("[data-joint]").count() >= 5
+    assert page.locator("[data-joint]").count() >= 5, page.console_errors
     assert page.console_errors == []
 
 

@@ -1,8 +1,11 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
-import { call, coalescing, eventsUrl } from "./api.js";
+import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
 
-const $ = (id) => document.getElementById(id);
+// Mount the studio on `root` (the page's document, or a notebook widget's element holding
+// the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
+export function mount(root, { onChange = null } = {}) {
+const $ = (id) => root.querySelector(`#${id}`);
 const svg = $("canvas");
 const clone = (x) => JSON.parse(JSON.stringify(x));
 const EMPTY = () => ({ name: "New mechanism", kind: "planar", ground: "frame", links: ["frame"], joints: [], points: {} });
@@ -106,6 +109,7 @@ function analyseSoon() {
 function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
   if (record && state.mech) { state.undo.push(JSON.stringify(state.mech)); state.redo = []; }
   state.mech = mech;
+  if (onChange) onChange(mech);
   if (!keepFrame) state.frame = 0;
   if (fit) fitView();
   state.errors = [];
@@ -493,22 +497,26 @@ $("synth-run").onclick = async () => {
   } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
   $("synth-run").disabled = true; $("synth-cancel").disabled = false;
   $("synth-results").replaceChildren();
-  source = new EventSource(eventsUrl(job.id));
   const show = (snap) => {
     const p = snap.progress;
     $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
     $("synth-status").textContent = `${snap.state}${p.stage ? " (" + p.stage + ")" : ""}: ${p.done}/${p.total}, best ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
   };
-  source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
-  source.addEventListener("end", (e) => {
-    source.close();
-    const snap = JSON.parse(e.data);
+  const end = (snap) => {
     show(snap);
     $("synth-run").disabled = false; $("synth-cancel").disabled = true;
     if (snap.error) $("synth-status").textContent = `failed: ${snap.error.message}`;
     if (snap.result) showResults(snap.result.results);
-  });
-  source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
+  };
+  if (transport.events) {
+    source = new EventSource(eventsUrl(job.id));
+    source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
+    source.addEventListener("end", (e) => { source.close(); end(JSON.parse(e.data)); });
+    source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
+  } else { // no event stream (notebook widget): poll the job
+    const poll = async () => { const snap = await call(`/api/jobs/${job.id}`); if (snap.state === "running") { show(snap); setTimeout(poll, 300); } else end(snap); };
+    poll();
+  }
 };
 $("synth-cancel").onclick = async () => { if (job) await call(`/api/jobs/${job.id}/cancel`, {}); };
 
@@ -666,17 +674,17 @@ async function refreshFiles() {
 function setMode(mode) {
   state.mode = mode;
   if (mode !== "link") { state.building = []; $("finish-link").disabled = true; }
-  for (const b of document.querySelectorAll("#modes button")) b.classList.toggle("on", b.dataset.mode === mode);
+  for (const b of root.querySelectorAll("#modes button")) b.classList.toggle("on", b.dataset.mode === mode);
   if (mode === "target") showTab("synthesis");
   render();
 }
 function showTab(name) {
-  for (const b of document.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
-  for (const t of document.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
+  for (const b of root.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
+  for (const t of root.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
   if (name === "plots") renderPlots();
 }
-for (const b of document.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
-for (const b of document.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
+for (const b of root.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
+for (const b of root.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
 $("finish-link").onclick = finishLink;
 $("undo").onclick = undo;
 $("redo").onclick = redo;
@@ -687,7 +695,7 @@ $("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
 $("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
 $("plot-what").onchange = renderPlots;
 window.addEventListener("resize", render);
-document.addEventListener("keydown", (ev) => {
+(root.addEventListener ? root : document).addEventListener("keydown", (ev) => {
   if (ev.target.matches("input, select, textarea")) return;
   const k = ev.key;
   if ((ev.ctrlKey || ev.metaKey) && k === "z") { ev.preventDefault(); undo(); }
@@ -717,3 +725,4 @@ document.addEventListener("keydown", (ev) => {
     state.mech = EMPTY(); render();
   }
 })();
+}
