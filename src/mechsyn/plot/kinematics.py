@@ -216,6 +216,40 @@ def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
     return fig
 
 
+def _length_unit(sim: Any) -> str:
+    """The length unit of the mechanism file (``units:``), else "length"."""
+    return sim.system.mech.attrs.get("units") or "length"
+
+
+def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.ndarray, xlabel: str,
+                      interval: float) -> Any:
+    """An animation redrawn whole at each frame (cams and belts change shape as they move)."""
+    from matplotlib.animation import FuncAnimation
+
+    xlim, ylim = ax.get_xlim(), ax.get_ylim()
+    unit = _length_unit(sim)
+
+    def draw(k):
+        ax.clear()
+        ax.set_xlim(*xlim)
+        ax.set_ylim(*ylim)
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        ax.set_xlabel(f"x ({unit})")
+        ax.set_ylabel(f"y ({unit})")
+        for name, pm in sim.points.items():
+            ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
+            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
+            ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
+        arts = draw_mechanism(ax, sim, k)
+        ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
+        if sim.points:
+            ax.legend(fontsize=8, loc="upper right")
+        return arts
+
+    return FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+
+
 def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval: float = 1000 / 15) -> Any:
     """The mechanism moving over the assembled inputs, tracing its points' paths.
 
@@ -242,21 +276,71 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
     hi = np.array([ax.dataLim.x1, ax.dataLim.y1])
     pad = 0.08 * max(hi - lo) + 1e-9
     x, xlabel = _input_axis(sim)
+    ax.clear()
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_xlabel(f"x ({_length_unit(sim)})")
+    ax.set_ylabel(f"y ({_length_unit(sim)})")
+    if any(c.kind in ("curve", "belt") for c in sim.system.cons):
+        return _redraw_animation(sim, fig, ax, frames, x, xlabel, interval)
+    # the artists are made once and moved at each frame (no clearing, no re-layout)
+    S = sim.system
+    cmap = matplotlib.colormaps["tab10"]
+    trails = []
+    for name, pm in sim.points.items():
+        ax.plot(pm.position[idx, 0], pm.position[idx, 1], "-", lw=1, color="0.7")
+        trail, = ax.plot([], [], "-", lw=1.8, label=name)
+        dot, = ax.plot([], [], "o", ms=4, color="k")
+        trails.append((pm.position, trail, dot))
+    links = []
+    for n, name in enumerate(S.mech.link_names):
+        c = cmap(n % 10)
+        if name == S.mech.ground:
+            links.append((name, None, ax.plot([], [], "^", ms=10, color="0.35", zorder=3)[0], None))
+            continue
+        fill = ax.fill([0, 0], [0, 0], color=c, alpha=0.35, zorder=2)[0]
+        edge, = ax.plot([], [], "-", color=c, lw=2.5, zorder=2, solid_capstyle="round")
+        pins, = ax.plot([], [], "o", ms=5, mfc="white", mec=c, zorder=4)
+        links.append((name, fill, edge, pins))
+    sliders = [(j.links[1], [x.id for x in S.mech.joints_of(j.links[1])].index(j.id))
+               for j in S.mech.joints if j.type == "P"]
+    squares, = ax.plot([], [], "s", ms=11, mfc="none", mec="0.1", zorder=5)
+    title = ax.set_title("", fontsize=10)
+    if sim.points:
+        ax.legend(fontsize=8, loc="upper right")
 
     def draw(k):
-        ax.clear()
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - pad, hi[1] + pad)
-        ax.set_aspect("equal")
-        ax.grid(alpha=0.3)
-        for name, pm in sim.points.items():
-            ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
-            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
-            ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
-        arts = draw_mechanism(ax, sim, k)
-        ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
-        if sim.points:
-            ax.legend(fontsize=8, loc="upper right")
-        return arts
+        for pos, trail, dot in trails:
+            trail.set_data(pos[:k + 1, 0], pos[:k + 1, 1])
+            dot.set_data([pos[k, 0]], [pos[k, 1]])
+        outl = link_outlines(sim, k)
+        for name, fill, edge, pins in links:
+            pts = outl[name]
+            if fill is None:
+                edge.set_data(pts[:, 0], pts[:, 1])
+                continue
+            if len(pts) >= 3:
+                centre = pts.mean(axis=0)
+                poly = pts[np.argsort(np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0]))]
+                fill.set_xy(poly)
+                fill.set_visible(True)
+                closed = np.vstack([poly, poly[:1]])
+                edge.set_data(closed[:, 0], closed[:, 1])
+                edge.set_linewidth(2.5)
+            else:
+                fill.set_visible(False)
+                edge.set_data(pts[:, 0], pts[:, 1])
+                edge.set_linewidth(3)
+            pins.set_data(pts[:, 0], pts[:, 1])
+        if sliders:
+            sq = np.array([outl[b][i] for b, i in sliders])
+            squares.set_data(sq[:, 0], sq[:, 1])
+        title.set_text(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}")
+        return ([a for _, trail, dot in trails for a in (trail, dot)]
+                + [a for _, f, e, p in links for a in (f, e, p) if a is not None] + [squares, title])
 
-    return FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+    anim = FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+    anim.mechsyn_blit = (draw, list(frames))  # what moves: see mechsyn.plot.frames
+    return anim
