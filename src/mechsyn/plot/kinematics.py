@@ -120,6 +120,23 @@ def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
     return arts
 
 
+def link_colour(sim: Any, link: str) -> Any:
+    """The colour of ``link`` in every figure: Matplotlib's tab10 by the link's place in the file."""
+    names = list(sim.system.mech.link_names) if sim.system is not None else list(sim.links)
+    return matplotlib.colormaps["tab10"](names.index(link) % 10 if link in names else 7)
+
+
+def _point_styles(sim: Any) -> dict[str, tuple[Any, str]]:
+    """Colour (its link's) and line style (solid, then dashed, ... for more points on one link)."""
+    seen: dict[str, int] = {}
+    out = {}
+    for name, pm in sim.points.items():
+        n = seen.get(pm.link, 0)
+        seen[pm.link] = n + 1
+        out[name] = (link_colour(sim, pm.link), ("-", "--", ":", "-.")[n % 4])
+    return out
+
+
 def _input_axis(sim) -> tuple[np.ndarray, str]:
     main = sim.main_input
     unit = "deg" if sim.input_types[main] == "R" else "length"
@@ -144,9 +161,13 @@ def plot_paths(sim: Any, ax: Any = None) -> Any:
     k0 = int(np.argmax(sim.assembled)) if sim.assembled.any() else None
     if k0 is not None:
         draw_mechanism(ax, sim, k0)
+    styles = _point_styles(sim)
     for name, pm in sim.points.items():
-        ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1.5, label=f"path of {name}")
+        c, ls = styles[name]
+        ax.plot(pm.position[:, 0], pm.position[:, 1], ls, color=c, lw=1.5, label=f"path of {name}")
     ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(f"x ({_length_unit(sim)})")
+    ax.set_ylabel(f"y ({_length_unit(sim)})")
     ax.set_title("mechanism (first assembled input) and point paths")
     ax.grid(alpha=0.3)
     if sim.points:
@@ -161,10 +182,13 @@ def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
     fig = figure(fig, (12, 9))
     axs = fig.subplots(2, 2)
     plot_paths(sim, axs[0, 0])
-    for ax, key, lab in ((axs[0, 1], "velocity", "speed |v| (length/s)"),
-                         (axs[1, 0], "acceleration", "acceleration |a| (length/s²)")):
+    unit = _length_unit(sim)
+    styles = _point_styles(sim)
+    for ax, key, lab in ((axs[0, 1], "velocity", f"speed |v| ({unit}/s)"),
+                         (axs[1, 0], "acceleration", f"acceleration |a| ({unit}/s²)")):
         for name, pm in sim.points.items():
-            ax.plot(x, np.linalg.norm(getattr(pm, key), axis=1), label=name)
+            c, ls = styles[name]
+            ax.plot(x, np.linalg.norm(getattr(pm, key), axis=1), ls, color=c, label=name)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
@@ -173,7 +197,7 @@ def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
         ax.set_title(f"point {key}")
     ax = axs[1, 1]
     for name, lm in sim.links.items():
-        ax.plot(x, lm.angular_velocity, label=name)
+        ax.plot(x, lm.angular_velocity, color=link_colour(sim, name), label=name)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("angular velocity (rad/s)")
     ax.set_title("link angular velocities")
@@ -289,9 +313,10 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
     S = sim.system
     cmap = matplotlib.colormaps["tab10"]
     trails = []
+    styles = _point_styles(sim)
     for name, pm in sim.points.items():
         ax.plot(pm.position[idx, 0], pm.position[idx, 1], "-", lw=1, color="0.7")
-        trail, = ax.plot([], [], "-", lw=1.8, label=name)
+        trail, = ax.plot([], [], styles[name][1], color=styles[name][0], lw=1.8, label=name)
         dot, = ax.plot([], [], "o", ms=4, color="k")
         trails.append((pm.position, trail, dot))
     links = []
