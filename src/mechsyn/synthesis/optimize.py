@@ -301,7 +301,7 @@ def synthesize_path(
     def report(index, f):  # within a restart: only where it runs in this process
         note(done[0], f)
 
-    def finished(count, total, r):
+    def finished(count, total, index, r):
         done[0] = count
         note(count, r.fitness)
 
