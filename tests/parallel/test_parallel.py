@@ -89,3 +89,15 @@ def test_unreachable_scheduler_is_one_clear_error():
     with pytest.raises(MechsynInputError) as exc:
         run_tasks(operator.mul, TASKS, scheduler="tcp://127.0.0.1:9")
     assert "--scheduler" in str(exc.value.format())
+
+
+def test_synth_mechanism_restarts_in_processes_equal_one_process():
+    from mechsyn.synthesis.general import load_case, synthesize_mechanism
+
+    case = load_case(ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml")
+    fast = {"maxiter": 15, "popsize": 5}  # generation budgets: no timing decides the result
+    one = synthesize_mechanism(case, seed=2, restarts=2, time_limit=300, options=fast, n_polish=1)
+    two = synthesize_mechanism(case, seed=2, restarts=2, time_limit=300, options=fast, n_polish=1,
+                               workers=2)
+    assert one.design == two.design and one.restart_errors == two.restart_errors
+    assert one.restarts == two.restarts == 2
