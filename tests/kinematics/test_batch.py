@@ -82,3 +82,24 @@ def test_not_decomposable_or_not_R_is_refused():
     mech = load_mechanism(EX / "textbook/slider_crank.yaml")
     with pytest.raises(MechsynInputError):
         compile_plan(mech)
+
+
+def test_reference_inputs_match_simulate_measure_and_2d_inputs():
+    from mechsyn.synthesis.curves.database import sample_designs
+    from mechsyn.synthesis.curves.topologies import curve_topologies
+
+    rng = np.random.default_rng(5)
+    topos = curve_topologies(6)
+    for t in topos[:6]:
+        X = sample_designs(t, 3, rng)
+        got = t.plan.reference_inputs(X)
+        for x, g in zip(X, got):
+            want = compile_plan(mechanism_from_dict(t.mechanism(x)), points=["T"]).reference_input
+            assert abs((g - want + 180) % 360 - 180) < 1e-9
+        off = np.linspace(0, 90, 7)
+        rows = np.vstack([off, off + 30, off - 10])
+        two = simulate_batch(t.plan, X, rows).paths["T"]
+        for k in range(3):
+            one = simulate_batch(t.plan, X[k], rows[k]).paths["T"][0]
+            np.testing.assert_array_equal(np.isnan(one), np.isnan(two[k]))
+            np.testing.assert_allclose(one[np.isfinite(one)], two[k][np.isfinite(two[k])])

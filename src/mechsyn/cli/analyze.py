@@ -11,7 +11,7 @@ from rich.panel import Panel
 from rich.table import Table
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json
+from mechsyn.cli.common import console, emit_json, err_console
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import to_jsonable, write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
@@ -30,7 +30,7 @@ from mechsyn.structure.rank import (
     rank_to_markdown,
 )
 from mechsyn.errors import MechsynInputError
-from mechsyn.structure.report import pair_list, to_markdown
+from mechsyn.structure.report import CONTOUR_READING, formula_title, pair_list, to_markdown
 
 
 SHORT_TITLES = {
@@ -57,10 +57,10 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
     t.add_column("expression", no_wrap=True)
     t.add_column("value", justify="right")
     for key, f in a.formulas.items():
-        t.add_row(SHORT_TITLES.get(key, key), f.expression, _fmt(f.value))
+        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, _fmt(f.value))
     console.print(t)
     if a.contours:
-        c = Table(title="Contours (paper 003, sequential reading)")
+        c = Table(title=f"Contours (paper 003, sequential reading{CONTOUR_READING[a.kind]})")
         for col in ("#", "joints", "new pairs", "n_j", "n_k", "S_j", "idle", "T_j", "Z_j", "A_j"):
             c.add_column(col, justify="right" if col not in ("joints", "new pairs") else "left")
         for r in a.contours:
@@ -72,7 +72,7 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         for r in a.contours:
             console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
     console.print(
-        f"S_Σ = {a.structural_redundancy} ({a.redundant_constraints} redundant constraints, "
+        f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
         f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
         soft_wrap=True)
@@ -155,6 +155,22 @@ def _rank_or_reason(mech, tol):
     return analyze_rank(mech, tol=tol), None
 
 
+#: From this many joints, ``analyze`` says the size and shows the rank method's stages on stderr.
+LARGE_JOINTS = 1000
+
+
+def _analyze_rank_reporting(mech, tol):
+    if len(mech.joints) < LARGE_JOINTS:
+        return analyze_rank(mech, tol=tol)
+    from mechsyn.structure.contours import cycle_rank
+
+    err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
+                      f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
+                      f"of loops (2,000 joints: a few seconds)", highlight=False)
+    with err_console.status("rank method") as status:
+        return analyze_rank(mech, tol=tol, progress=lambda stage: status.update(f"rank method: {stage}"))
+
+
 @app.command("analyze")
 def analyze(
     file: Annotated[Path, typer.Argument(help="Mechanism file (YAML or JSON).")],
@@ -192,7 +208,7 @@ def analyze(
             "the rank method needs each joint's geometry: " + "; ".join(problems), source=str(file),
             hint="add point/axis (see `mechsyn schema`), or use --method formulas")
     result = analyze_structure(mech)
-    ra = analyze_rank(mech, tol=tol) if method != "formulas" else None
+    ra = _analyze_rank_reporting(mech, tol) if method != "formulas" else None
     comparisons = compare_with_formulas(result, ra) if ra is not None else None
     state_ranks: dict[str, tuple[RankAnalysis | None, str | None]] = {}
     if ra is not None:

@@ -24,9 +24,8 @@ from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
 )
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, parse_floats, parse_range, progress_bar
+from mechsyn.cli.common import console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
 from mechsyn.errors import MechsynInputError
-from mechsyn.results import write_atomic
 
 MEASURE_HELP = {
     "exact": "largest speed of pure motion along d (joint rates free within their limits)",
@@ -100,7 +99,7 @@ def capability(
     polytope: bool = typer.Option(False, "--polytope", help="add the best configuration's "
                                   "velocity polytope and ellipse"),
     map_png: Optional[Path] = typer.Option(None, "--map", help="write a heat/contour map (PNG)"),
-    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV"),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV (- for stdout)"),
     interpolate: Optional[str] = typer.Option(None, "--interpolate", help="grid: the optimal "
                                               "configuration interpolated at X,Y"),
     json_out: bool = typer.Option(False, "--json", help="print JSON on stdout"),
@@ -261,8 +260,9 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
         cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1_vals, branch=br,
                               respect_limits=respect, continuous=continuous, chunk=chunk,
                               advance=adv, **(parallel or {}))
+    one_stdout(json_out, csv_out)
     if csv_out is not None:
-        write_atomic(csv_out, cmap.to_csv())
+        write_output(csv_out, cmap.to_csv())
     if map_png is not None:
         from mechsyn.cli.common import save_plot
         from mechsyn.plot.capability import plot_capability_map
@@ -284,6 +284,8 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
                 "q_deg": arm.to_user(qi),
                 "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
                 measure: float(measure_values(arm, qi[None], d, measure)[0])})
+    if is_stdout(csv_out):
+        return
     if json_out:
         out = cmap.to_dict()
         if interp is not None:

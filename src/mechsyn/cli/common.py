@@ -40,6 +40,13 @@ def write_output(out: Path | str, text: str) -> None:
         write_atomic(out, text)
 
 
+def one_stdout(json_: bool, *outs: Path | str | None) -> None:
+    """Refuse two outputs to stdout (``--json`` and a ``-`` file, or two ``-`` files)."""
+    if int(bool(json_)) + sum(is_stdout(o) for o in outs) > 1:
+        raise MechsynInputError("two outputs to stdout", source="-",
+                                hint="send one of them to a file (or drop --json)")
+
+
 def emit_json(obj: Any, out: Path | None = None) -> None:
     """Print ``obj`` as JSON on stdout, or write it whole to ``out`` (``-``: stdout)."""
     text = dumps(obj)
@@ -171,6 +178,17 @@ def track(items: Iterable[T], description: str, total: int | None = None) -> Ite
         for item in items:
             yield item
             advance()
+
+
+def stop_if_interrupted(result: Any) -> None:
+    """Exit with status 130 (``interrupted``) when ``result`` says Ctrl-C ended it.
+
+    Called by a search command after it has written and shown its best result so far.
+    """
+    if getattr(result, "interrupted", False):
+        from mechsyn.interrupt import INTERRUPT_EXIT_CODE
+
+        raise typer.Exit(INTERRUPT_EXIT_CODE)
 
 
 def exit_with(error: MechsynInputError) -> None:

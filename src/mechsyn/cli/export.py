@@ -12,12 +12,11 @@ from rich.table import Table
 from mechsyn.cli.app import app
 from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
 from mechsyn.errors import MechsynInputError
-from mechsyn.io import load_mechanism
 
 
 @app.command("export")
 def export_cmd(
-    file: Annotated[Path, typer.Argument(help="Planar mechanism file (YAML or JSON) with joint points.")],
+    file: Annotated[Path, typer.Argument(help="Planar mechanism file (YAML, JSON or a Pyslvs .pyslvs) with joint points.")],
     dxf: Annotated[Optional[Path], typer.Option("--dxf", help="Write the link plates as DXF (needs the "
                                                 "`cad` extra: ezdxf).")] = None,
     width: Annotated[Optional[float], typer.Option("--width", help="Plate width (default: a fifth of the "
@@ -33,11 +32,12 @@ def export_cmd(
 ) -> None:
     """Link plates with joint holes, laid out flat on a sheet, for a laser cutter or CNC."""
     from mechsyn.export.plates import link_plates
+    from mechsyn.io.convert import load_any
 
     check_output_suffix(dxf, (".dxf",), "--dxf")
     if dxf is None and not json_:
         raise MechsynInputError("nothing to export", source="--dxf", hint="add --dxf parts.dxf or --json")
-    mech = load_mechanism(file)
+    mech = load_any(file)
     layout = link_plates(mech, width=width, hole_diameter=hole, clearance=clearance, frame=frame,
                          sheet_width=sheet_width)
     if dxf is not None:

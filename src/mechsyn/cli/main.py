@@ -9,6 +9,7 @@ import sys
 
 from mechsyn.cli.app import app
 from mechsyn.errors import MechsynInputError
+from mechsyn.interrupt import INTERRUPT_EXIT_CODE
 
 # Command modules (each registers its commands on the app when imported).
 from mechsyn.cli import analyze as _analyze  # noqa: F401
@@ -31,13 +32,21 @@ from mechsyn.cli import export as _export  # noqa: F401
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; bad input exits with status 2 and one message."""
+    """Run the command line; bad input exits with status 2 and one message.
+
+    Ctrl-C exits with status 130 and prints ``interrupted`` (searches have written their
+    best result so far, marked as interrupted, before that).
+    """
     from rich.markup import escape
 
     from mechsyn.cli.common import err_console
 
     try:
-        app(args=argv, prog_name="mechsyn", standalone_mode=False)
+        # typer turns KeyboardInterrupt (and typer.Exit(n) raised by a command) into a
+        # returned exit status when standalone_mode is off
+        status = app(args=argv, prog_name="mechsyn", standalone_mode=False)
+    except KeyboardInterrupt:
+        status = INTERRUPT_EXIT_CODE
     except MechsynInputError as error:
         err_console.print(f"[bold red]error:[/] {escape(error.format())}", highlight=False, soft_wrap=True)
         return _exit(2, argv)
@@ -54,6 +63,10 @@ def main(argv: list[str] | None = None) -> int:
         if hasattr(exc, "exit_code"):  # Exit
             return _exit(int(exc.exit_code), argv)
         raise
+    if isinstance(status, int) and not isinstance(status, bool) and status != 0:
+        if status == INTERRUPT_EXIT_CODE:
+            err_console.print("interrupted", highlight=False)
+        return _exit(status, argv)
     return _exit(0, argv)
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Optional
 
@@ -11,7 +10,7 @@ import typer
 from rich.table import Table
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats, save_plot
+from mechsyn.cli.common import console, emit_json, err_console, parse_floats, save_plot, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -100,7 +99,8 @@ def synth_path(
                                       rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
                                       name=f"Four-bar for path case {case.id}")
         write_mechanism_file(mech, out, header=(
-            f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
+            ("INTERRUPTED (Ctrl-C): the best design found before the interrupt\n" if res.interrupted else "")
+            + f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
             f"joint points at target 1 (crank angle {np.degrees(res.theta2[0]):.4f} deg), branch {case.branch}"))
     if plot is not None:
         save_plot(plot, plot_fourbar_path, d, case.targets, res.theta2, case.branch, dpi=120,
@@ -108,8 +108,9 @@ def synth_path(
                   + (f" (published best {case.best_known:.4g})" if case.best_known else ""))
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"Path synthesis {case.id}")
+    t = Table(title=f"Path synthesis {case.id}" + (" (interrupted: best so far)" if res.interrupted else ""))
     t.add_column("variable")
     t.add_column("value", justify="right")
     for k, v in res.design.items():
@@ -121,6 +122,7 @@ def synth_path(
                   f"branch {case.branch}   {res.restarts} restarts, {res.seconds:.1f} s"
                   + ("   (target error reached)" if res.target_reached else ""))
     console.print(_transmission_line(res))
+    stop_if_interrupted(res)
 
 
 def _with_margins(case, min_transmission: Optional[float], fold_margin: Optional[float]):
@@ -190,12 +192,9 @@ def synth_function(
 
 def _read_poses(file: Optional[Path], poses: Optional[str]) -> np.ndarray:
     if file is not None:
-        try:
-            data = json.loads(file.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise MechsynInputError("file not found", source=str(file)) from None
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(file), line=exc.lineno) from None
+        from mechsyn.io.files import read_data
+
+        data, _ = read_data(file, "poses file", fmt="json")
         items = data.get("poses") if isinstance(data, dict) else data
         try:
             P = np.array([[float(p[0]), float(p[1]), float(p[2])] for p in items])

@@ -18,6 +18,8 @@ import yaml
 from pydantic import ValidationError
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import files
+from mechsyn.io.checks import check_geometry
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -39,45 +41,14 @@ __all__ = [
 
 # --------------------------------------------------------------------------- reading
 def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
-    """Parse a YAML or JSON file into Python data; return it with its text."""
-    p = Path(path)
-    if not p.exists():
-        raise MechsynInputError("no such file", source=str(p), hint="check the path")
-    if p.is_dir():
-        raise MechsynInputError("is a directory, not a file", source=str(p))
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise MechsynInputError(
-            f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(p),
-            hint="save the file as UTF-8 YAML or JSON",
-        ) from None
-    return parse_text(text, str(p)), text
+    """Parse a YAML or JSON file into Python data; return it with its text
+    (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
+    return files.read_data(path)
 
 
 def parse_text(text: str, source: str) -> Any:
     """Parse YAML (or JSON, when the source ends in .json) text."""
-    if source.lower().endswith(".json"):
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(
-                f"JSON syntax error: {exc.msg} (column {exc.colno})", source=source,
-                line=exc.lineno, hint="fix the JSON syntax at that line",
-            ) from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else None
-        problem = exc.problem or exc.context or "cannot parse"
-        column = f" (column {mark.column + 1})" if mark is not None else ""
-        raise MechsynInputError(
-            f"YAML syntax error: {problem}{column}", source=source, line=line,
-            hint="fix the YAML syntax at that line (indentation, brackets, colons)",
-        ) from None
-    except yaml.YAMLError as exc:
-        raise MechsynInputError(f"YAML syntax error: {exc}", source=source) from None
+    return files.parse_data(text, source)
 
 
 def _line_finder(text: str | None, source: str) -> Any:
@@ -159,22 +130,30 @@ _HINTS = {
     "list_type": "give a list, e.g. [a, b]",
     "dict_type": "give a mapping of names to values",
     "string_type": "give a text value",
+    "greater_than_equal": "give a value that is not negative",
+    "greater_than": "give a positive value",
+    "finite_number": "give a finite number",
+    "bool_not_number": "write a number such as 0 or 1, not true/false",
     "too_short": None,
 }
 
 
 def _validation_error(exc: ValidationError, data: Any, source: str, text: str | None) -> MechsynInputError:
     errors = exc.errors()
-    # Prefer the most specific error: for unions pydantic reports one per member.
-    err = errors[0]
-    loc = _data_path(data, err["loc"])
+    # Prefer the most specific error: for unions pydantic reports one per member (a link
+    # given as a mapping fails as text too); the one reaching deepest into the data is
+    # the member the user meant.
+    paths = [tuple(_data_path(data, e["loc"])) for e in errors]
+    best = max(range(len(errors)), key=lambda i: (len(paths[i]), -i))
+    err, loc = errors[best], list(paths[best])
     find = _line_finder(text, source)
     msg = err["msg"]
     if err["type"] == "extra_forbidden":
         msg = "unknown field"
     elif err["type"] == "missing":
         msg = "required field is missing"
-    more = len({tuple(_data_path(data, e["loc"])) for e in errors}) - 1
+    # other problems: other places (not the union members failing at an enclosing one)
+    more = len({p for p in paths if p != tuple(loc) and tuple(loc)[:len(p)] != p})
     if more > 0:
         msg += f" (and {more} more problem{'s' if more > 1 else ''})"
     return MechsynInputError(
@@ -197,7 +176,7 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
         spec = MechanismFile.model_validate(data)
     except ValidationError as exc:
         raise _validation_error(exc, data, source, text) from None
-    return _Builder(spec, source, _line_finder(text, source)).build()
+    return check_geometry(_Builder(spec, source, _line_finder(text, source)).build(), source)
 
 
 def mechanism_from_text(text: str, source: str = "<text>") -> Mechanism:
@@ -362,6 +341,9 @@ class _Builder:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
             else:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+        if self.kind == "planar" and jtype == "P" and axis is None and point is not None:
+            raise self.error(path + ["axis"], f"planar P pair {entry.id} has no axis: its sliding direction "
+                             "is not assumed", "add axis: [dx, dy], e.g. axis: [1, 0] to slide along x")
         axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
         normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
         if entry.pitch is not None and jtype != "H":

@@ -339,8 +339,14 @@ def _event_units(S: PlanarSystem, e: dict) -> dict:
 def _fast_events(tracked: "dyads.TrackedPositions", sw: Sweep) -> list[dict]:
     """Events of the closed-form sweep: dead points, reassembly and change / branch points
     found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
-    out = list(tracked.events)
-    if not sw.assembled[0]:
+    out, seen = [], set()
+    for e in tracked.events:  # a gap of an upstream group is one reassembly of the mechanism
+        if e["kind"] == "reassembled":
+            if e["index"] in seen:
+                continue
+            seen.add(e["index"])
+        out.append(e)
+    if not sw.assembled[0] and not any(e["index"] == 0 and e["kind"] == "dead point" for e in out):
         out.insert(0, {"index": 0, "kind": "not assembled", "input": sw.inputs[0].tolist(),
                        "message": "the mechanism cannot be assembled at the first input"})
     return out

@@ -19,6 +19,16 @@ FORMULA_TITLES = {
 }
 
 
+#: paper 003's per-contour counts are the spatial reading (each contour against 6 freedoms)
+CONTOUR_READING = {"planar": ", spatial reading", "spatial": ""}
+
+
+def formula_title(title: str, f: object) -> str:
+    """``title`` with the formula's planar/spatial reading, when it has one."""
+    reading = getattr(f, "reading", "")
+    return f"{title} ({reading})" if reading in ("planar", "spatial") and reading not in title else title
+
+
 def pair_list(row_pairs: Sequence[object]) -> str:
     return " ".join(f"{p.id}{p.pair_class}" for p in row_pairs)  # type: ignore[attr-defined]
 
@@ -38,9 +48,9 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
     ]
     for key, f in a.formulas.items():
         val = "n/a" if f.value is None else _fmt(f.value)
-        out.append(f"| {FORMULA_TITLES.get(key, key)} | `{f.expression}` | {val} |")
+        out.append(f"| {formula_title(FORMULA_TITLES.get(key, key), f)} | `{f.expression}` | {val} |")
     if a.contours:
-        out += ["", f"{h}# Contours (paper 003)", "",
+        out += ["", f"{h}# Contours (paper 003{CONTOUR_READING[a.kind]})", "",
                 "| # | joints | new pairs | n_j | n_k | S_j | idle | T_j | Z_j | A_j |",
                 "|---|---|---|---|---|---|---|---|---|---|"]
         for r in a.contours:
@@ -49,7 +59,7 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
                        f"{r.S} | {r.idle_mobilities} | {_fmt(r.T)} | {r.Z} | {r.A} |")
         out += [""] + [f"- `{r.S_expression}`; `{r.T_expression}`" for r in a.contours]
     out += [
-        "", f"- structural redundancy S_Σ = {a.structural_redundancy} "
+        "", f"- structural redundancy S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} "
         f"({a.redundant_constraints} redundant constraints, {a.idle_mobilities} idle mobilities)",
         f"- constructive redundancy G_Σ = {_fmt(a.constructive_redundancy)} "
         f"(metric constraints {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})",

@@ -96,7 +96,8 @@ def _nauty_graph(n: int, edges, colours):
 
 def _igraph(n: int, edges):
     ig = _module("igraph")
-    return ig.Graph(n=n, edges=[(a, b) for a, b in edges if a != b])
+    return ig.Graph(n=n, edges=edges if all(a != b for a, b in edges) else
+                    [(a, b) for a, b in edges if a != b])
 
 
 def certificate(n: int, edges: Sequence[tuple[int, int]],
@@ -108,18 +109,12 @@ def certificate(n: int, edges: Sequence[tuple[int, int]],
     if get_backend() == "pynauty":
         return _module("pynauty").certificate(_nauty_graph(n, edges, col))
     g = _igraph(n, edges)
-    perm = [0] * n  # vertex v gets the canonical label perm[v] (igraph gives the inverse)
-    for label, v in enumerate(g.canonical_permutation(color=col)):
-        perm[v] = label
-    labels = [0] * n
-    for v, c in enumerate(col):
-        labels[perm[v]] = c
-    bits = 0  # upper triangle of the canonical adjacency matrix, row by row
-    for a, b in g.get_edgelist():
-        i, j = sorted((perm[a], perm[b]))
-        bits |= 1 << (i * n - i * (i + 1) // 2 + (j - i - 1))
-    head = n.to_bytes(2, "big") + (bytes(labels) if any(labels) else b"")
-    return head + bits.to_bytes((n * (n - 1) // 2 + 7) // 8, "big")
+    order = g.canonical_permutation(color=col if colours is not None else None)
+    # igraph's vector: the vertex that takes canonical label i is order[i]
+    canon = g.permute_vertices(order).get_edgelist()
+    flat = bytes(v for e in sorted(tuple(sorted(e)) for e in canon) for v in e)
+    labels = bytes(col[v] for v in order) if colours is not None else b""
+    return bytes([n & 255, n >> 8, len(labels) > 0]) + labels + flat
 
 
 def generators(n: int, edges: Sequence[tuple[int, int]],

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
+from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design
 
 
@@ -155,12 +156,14 @@ class RestartResult:
 
 def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options: dict[str, Any],
                  deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0,
-                 target_error: float | None = None) -> RestartResult:
+                 target_error: float | None = None,
+                 tracker: BestSoFar | None = None) -> RestartResult:
     t0 = time.monotonic()
     problem = PathProblem(case)
     m = problem.reduced_dim
     lower, upper = problem.lower[:m], problem.upper[:m]
     fn = OPTIMIZERS[optimizer]
+    fitness = problem.reduced_fitness if tracker is None else tracker.wrap(problem.reduced_fitness)
 
     # leave a little of the budget for polishing, so the whole run keeps its time limit
     search_deadline = deadline - polish_reserve
@@ -172,7 +175,7 @@ def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options:
             return True  # feasible (infeasible scores exceed every error) and good enough
         return time.time() >= search_deadline
 
-    g = fn(problem.reduced_fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
+    g = fn(fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
     nfev = g.nfev
     # candidates to polish: the best, then the best distinct population members
     cands = [np.asarray(g.x, float)]
@@ -219,6 +222,7 @@ class PathSynthesisResult:
     theta2: np.ndarray
     restart_errors: list[float] = field(default_factory=list)
     best_known: float | None = None
+    interrupted: bool = False
     target_error: float | None = None
     worst_transmission_angle_deg: float | None = None
     fold_distance_deg: float | None = None
@@ -231,7 +235,7 @@ class PathSynthesisResult:
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "case": self.case_id, "error": self.error, "design": self.design,
+            "case": self.case_id, "interrupted": self.interrupted, "error": self.error, "design": self.design,
             "assembled_at_all_targets": self.assembled_at_all_targets, "feasible": self.feasible,
             "worst_transmission_angle_deg": self.worst_transmission_angle_deg,
             "transmission_angle_min_deg": self.transmission_angle_min_deg,
@@ -273,6 +277,11 @@ def synthesize_path(
     ``target_error`` (e.g. :func:`default_target_error`): a restart's global search ends
     as soon as its best feasible error is at most this, and the run ends after the first
     restart (in seed order) whose result reaches it.
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``progress``) ends the search
+    and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
+    with workers, the restarts finished so far); it propagates only when nothing was
+    evaluated yet.
     """
     from mechsyn.parallel import run_tasks
 
@@ -301,17 +310,33 @@ def synthesize_path(
     def report(index, f):  # within a restart: only where it runs in this process
         note(done[0], f)
 
+    results: list[RestartResult] = []
+
     def finished(count, total, index, r):
         done[0] = count
+        results.append(r)
         note(count, r.fitness)
 
+    # in this process each restart records its best candidate, kept if Ctrl-C cuts it short
+    trackers = [BestSoFar() if local else None for _ in seeds]
     jobs = [(case, i, s, optimizer, options, deadline, n_polish, report if local else None,
-             reserve, target_error) for i, s in enumerate(seeds)]
-    out = run_tasks(_run_restart, jobs, workers=workers, scheduler=scheduler,
-                    progress=finished, deadline=deadline - reserve,
-                    stop=None if target_error is None else
-                    (lambda i, r: r.fitness <= target_error))
-    results = [r for r in out if r is not None]
+             reserve, target_error, trackers[i]) for i, s in enumerate(seeds)]
+    interrupted = False
+    try:
+        run_tasks(_run_restart, jobs, workers=workers, scheduler=scheduler,
+                  progress=finished, deadline=deadline - reserve,
+                  stop=None if target_error is None else (lambda i, r: r.fitness <= target_error))
+    except KeyboardInterrupt:
+        interrupted = True
+        have = {r.index for r in results}
+        for i, t in enumerate(trackers):
+            if t is not None and t.x is not None and i not in have:
+                results.append(RestartResult(index=i, seed=seeds[i], z=problem.expand(t.x[None, :])[0],
+                                             fitness=t.f, nfev=0, seconds=0.0))
+                break
+        if not results:
+            raise
+    results.sort(key=lambda r: r.index)
     win = min(results, key=lambda r: (r.fitness, r.index))
     design = problem.design(win.z)
     check = evaluate_design(case, design)
@@ -322,7 +347,7 @@ def synthesize_path(
         optimizer=optimizer, branch=case.branch, targets=case.targets, path=check["path"],
         theta2=check["theta2"],
         restart_errors=[r.fitness if r.fitness < problem.penalty_base else float("inf") for r in results],
-        best_known=case.best_known, target_error=target_error,
+        best_known=case.best_known, interrupted=interrupted, target_error=target_error,
         worst_transmission_angle_deg=check["worst_transmission_angle_deg"],
         fold_distance_deg=check["fold_distance_deg"],
         transmission_angle_min_deg=case.transmission_angle_min_deg,

@@ -38,7 +38,6 @@ ever rank better than a feasible one (Deb's rule as a penalty).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -222,13 +221,10 @@ class PathCase:
 
 def load_cases(path: str | Path) -> list[PathCase]:
     """Load one case object, or every case of a ``{"cases": [...]}`` collection."""
+    from mechsyn.io.files import read_data
+
     path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise MechsynInputError("file not found", source=str(path)) from None
-    except json.JSONDecodeError as exc:
-        raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(path), line=exc.lineno) from None
+    data, _ = read_data(path, "case file", fmt="json")
     if isinstance(data, dict) and "cases" in data:
         items = data["cases"]
         return [PathCase.from_dict(c, source=f"{path}#cases[{i}]") for i, c in enumerate(items)]
