@@ -18,14 +18,8 @@ import pytest
 from mechsyn.cli.main import main
 from mechsyn.io import load_mechanism, mechanism_from_dict
 from mechsyn.structure.analysis import analyze_structure
-from mechsyn.structure.rank import (
-    InsufficientGeometry,
-    analyze_rank,
-    as_spatial,
-    check_remedy,
-    compare_with_formulas,
-    pair_twists,
-)
+from mechsyn.structure.compare import check_remedy, compare_with_formulas
+from mechsyn.structure.rank import InsufficientGeometry, analyze_rank, as_spatial, pair_twists
 from mechsyn.structure.remedies import find_remedies
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -324,8 +318,8 @@ def test_cli_json_keeps_keys_and_adds_rank(capsys):
                 "redundant_directions", "drives_needed", "actuation_determined", "singular", "tolerance"):
         assert key in rank
     assert new["mobility"] == rank["useful_mobility"] == 3
-    assert rank["idle_mobilities"] == [{"link": "link6", "joints": ["F3", "D3"],
-                                       "description": rank["idle_mobilities"][0]["description"]}]
+    assert [{k: i[k] for k in ("link", "joints", "links", "family")} for i in rank["idle_mobilities"]] == [
+        {"link": "link6", "joints": ["F3", "D3"], "links": ["link6"], "family": "group"}]
     assert old["rank"] is None
 
 

@@ -8,7 +8,7 @@ Paper 004 (mobility of a redundant planar manipulator), done exactly and vectori
   the velocity zonotope), largest component, minimum-norm limit, the paper's stepping,
   velocity polytope and ellipse;
 * :mod:`~mechsyn.capability.maps` -- best configuration over the self-motion, maps over
-  grids, interpolation of the optimal configuration, plots.
+  grids, interpolation of the optimal configuration (figures: :mod:`mechsyn.plot.capability`).
 """
 
 from mechsyn.capability.arm import (
@@ -16,7 +16,7 @@ from mechsyn.capability.arm import (
 )
 from mechsyn.capability.maps import (
     CapabilityMap, capability_map, continuous_best, interpolate_configuration,
-    measure_values, plot_map, refine_over_self_motion, self_motion,
+    measure_values, refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, VelocityEllipse, VelocityPolytope, all_measures, component_limit,
@@ -27,7 +27,7 @@ from mechsyn.capability.measures import (
 __all__ = [
     "SerialArm", "arm_from_dict", "ik_numeric", "ik_planar_3r", "load_arm",
     "CapabilityMap", "capability_map", "continuous_best", "interpolate_configuration",
-    "measure_values", "plot_map", "refine_over_self_motion", "self_motion",
+    "measure_values", "refine_over_self_motion", "self_motion",
     "MEASURES", "VelocityEllipse", "VelocityPolytope", "all_measures", "component_limit",
     "exact_limit", "exact_limit_lp", "min_norm_limit", "min_norm_rates", "stepped_limit",
     "velocity_ellipse", "velocity_polytope",

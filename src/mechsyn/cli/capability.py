@@ -5,8 +5,6 @@ A thin layer over :mod:`mechsyn.capability`.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from pathlib import Path
 from typing import Optional
@@ -15,20 +13,19 @@ import numpy as np
 import typer
 from rich import box
 from rich.console import Console
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
     capability_map, continuous_best, interpolate_configuration, is_closed_form,
-    measure_values, plot_map, refine_over_self_motion, self_motion,
+    measure_values, refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
 )
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, parse_floats, parse_range, progress_bar
+from mechsyn.cli.common import check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
 from mechsyn.errors import MechsynInputError
-from mechsyn.results import write_atomic
 
 MEASURE_HELP = {
     "exact": "largest speed of pure motion along d (joint rates free within their limits)",
@@ -102,13 +99,21 @@ def capability(
     polytope: bool = typer.Option(False, "--polytope", help="add the best configuration's "
                                   "velocity polytope and ellipse"),
     map_png: Optional[Path] = typer.Option(None, "--map", help="write a heat/contour map (PNG)"),
-    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV"),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV (- for stdout)"),
     interpolate: Optional[str] = typer.Option(None, "--interpolate", help="grid: the optimal "
                                               "configuration interpolated at X,Y"),
     json_out: bool = typer.Option(False, "--json", help="print JSON on stdout"),
+    workers: int = typer.Option(1, "--workers", help="grid: solve it in N local processes"),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="grid: solve it on a Dask "
+                                            "cluster (scheduler address; extra mechsyn[dask])"),
 ) -> None:
     """Largest tool speed along a direction under joint speed limits (paper 004), at a point
     over the arm's self-motion, or mapped over a grid."""
+    check_writable(map_png, "--map")
+    check_writable(csv_out, "--csv")
+    from mechsyn.parallel import check_parallel_options
+
+    check_parallel_options(workers, scheduler)
     arm = load_arm(arm_file)
     m = arm.task_dim
     d = np.array(parse_floats(direction, "--direction", m))
@@ -148,7 +153,7 @@ def capability(
             at = np.array(parse_floats(interpolate, "--interpolate", 2))
             _check_finite(at, "--interpolate")
         _grid(arm, grid, z, d, q1_vals, br, not ignore_limits, measure, continuous,
-              map_png, csv_out, json_out, at)
+              map_png, csv_out, json_out, at, {"workers": workers, "scheduler": scheduler})
 
 
 def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -> None:
@@ -239,7 +244,7 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
 
 
 def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, csv_out,
-          json_out, at=None) -> None:
+          json_out, at=None, parallel=None) -> None:
     parts = grid.split(",")
     if len(parts) != 2:
         raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
@@ -252,20 +257,19 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
         raise MechsynInputError("a spatial arm's grid needs its plane", source="--z",
                                 hint="add --z 400 (the grid lies in z = 400)")
     total = xs.size * ys.size
-    chunk = 2048 if is_closed_form(arm) else 1
+    chunk = 2048 if is_closed_form(arm) else 64  # numeric IK: 64 points at once
     with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as adv:
         cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1_vals, branch=br,
                               respect_limits=respect, continuous=continuous, chunk=chunk,
-                              advance=adv)
+                              advance=adv, **(parallel or {}))
+    one_stdout(json_out, csv_out)
     if csv_out is not None:
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(["x", "y", f"v_max_{measure}", *[f"{n}_opt" for n in arm.joint_names]])
-        for row in cmap.rows():
-            w.writerow(["" if not np.isfinite(v) else repr(float(v)) for v in row])
-        write_atomic(csv_out, buf.getvalue())
+        write_output(csv_out, cmap.to_csv())
     if map_png is not None:
-        plot_map(cmap, map_png)
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.capability import plot_capability_map
+
+        save_plot(map_png, plot_capability_map, cmap)
     v = np.where(np.isfinite(cmap.value), cmap.value, np.nan)
     interp = None
     if at is not None:
@@ -282,6 +286,8 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
                 "q_deg": arm.to_user(qi),
                 "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
                 measure: float(measure_values(arm, qi[None], d, measure)[0])})
+    if is_stdout(csv_out):
+        return
     if json_out:
         out = cmap.to_dict()
         if interp is not None:

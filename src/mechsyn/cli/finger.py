@@ -6,7 +6,7 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import console, emit_json
@@ -26,7 +26,6 @@ def finger(
     """Attach a group of links to the finger's free leashes so that it is fully actuated
     with its variable-length links (VLL) locked; list VLL candidates (paper 000)."""
     from mechsyn.io import load_mechanism, mechanism_to_dict, write_mechanism
-    from mechsyn.results import save_figure_atomic
     from mechsyn.synthesis.finger import synthesize_fingers
 
     mech = load_mechanism(base)
@@ -35,7 +34,8 @@ def finger(
     if out is not None:
         from dataclasses import replace
 
-        from mechsyn.synthesis.finger_plot import fingers_figure
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.finger import plot_fingers
 
         new = []
         for r in synth.results:
@@ -44,9 +44,8 @@ def finger(
             new.append(replace(r, file=str(path)))
             files.append(path)
         synth.results[:] = new
-        fig = fingers_figure(synth.results[:39], mechanism_to_dict(mech),
-                             f"{mech.name}: W0 = {synth.W0}, A = {actuators}")
-        save_figure_atomic(fig, out / "fingers.png", dpi=110)
+        save_plot(out / "fingers.png", plot_fingers, synth.results[:39], mechanism_to_dict(mech),
+                  f"{mech.name}: W0 = {synth.W0}, A = {actuators}")
     if json_out:
         emit_json(synth)
         return

@@ -7,10 +7,10 @@ from typing import Optional
 
 import typer
 from rich.markup import escape
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -26,7 +26,7 @@ def finger_design(
     """Optimise a finger's link lengths on discrete positions with its VLL locked, find
     each VLL's length range keeping the paths in the working region, minimise joint
     reactions and input moment in both modes; best VLL combination (paper 000, steps 8-13)."""
-    from mechsyn.synthesis.finger_design import design_figure, design_finger, load_case
+    from mechsyn.synthesis.finger_design import design_finger, load_case
 
     if time_limit <= 0:
         raise MechsynInputError("--time-limit must be positive", source="--time-limit")
@@ -44,16 +44,20 @@ def finger_design(
         from mechsyn.io import write_mechanism
 
         mech = dict(best.mechanism)
-        mech["name"] = f"{mech.get('name', 'finger')} (finger-design, seed {seed})"
+        mech["name"] = (f"{mech.get('name', 'finger')} (finger-design, seed {seed}"
+                        + (", interrupted: best so far)" if res.interrupted else ")"))
         write_mechanism(mech, out)
     if plot is not None:
-        from mechsyn.results import save_figure_atomic
+        from mechsyn.cli.common import save_plot
+        from mechsyn.plot.finger import plot_finger_design
 
-        save_figure_atomic(design_figure(case, res), plot, dpi=110)
+        save_plot(plot, plot_finger_design, case, res)
     if json_out:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"Finger design: {case_file.name} (seed {seed}, {res.seconds:.1f} s)")
+    t = Table(title=f"Finger design: {case_file.name} (seed {seed}, {res.seconds:.1f} s"
+              + (", interrupted: best so far)" if res.interrupted else ")"))
     t.add_column("VLL")
     t.add_column("stage-1 RMS err (deg)")
     t.add_column("final RMS / max err (deg)")
@@ -97,3 +101,4 @@ def finger_design(
     for path, what in ((out, "mechanism file"), (plot, "plot")):
         if path is not None:
             console.print(f"{what} written to {path}", highlight=False)
+    stop_if_interrupted(res)

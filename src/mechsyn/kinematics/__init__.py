@@ -4,13 +4,13 @@ Modules: ``analysis`` (:func:`simulate`, :func:`forces`: the entry points), ``sy
 (link poses and constraint equations, analytic Jacobian), ``solve`` (Newton continuation,
 velocities, accelerations), ``dyads`` (closed-form Assur dyads, vectorised), ``forces``
 (kinetostatics), ``derived`` (transmission angle, mechanical advantage, Grashof, path
-extent, straightness), ``plots`` (figures and animation); ``belt`` (paper 001's belt
-drive, separately).
+extent, straightness); ``belt`` (paper 001's belt drive, separately). Figures and the
+animation: :mod:`mechsyn.plot.kinematics`.
 """
 
 from typing import Any
 
-__all__ = ["simulate", "forces", "input_grid"]
+__all__ = ["simulate", "forces", "input_grid", "compile_plan", "KinematicPlan"]
 
 
 def __getattr__(name: str) -> Any:  # lazy: importing the package stays cheap

@@ -1,4 +1,4 @@
-"""Synthesised linkages as mechanism files (issue-2 format) and plots."""
+"""Synthesised linkages as mechanism files (issue-2 format)."""
 
 from __future__ import annotations
 
@@ -73,31 +73,3 @@ def write_mechanism_file(mech: dict[str, Any], path, header: str = "") -> None:
         write_atomic(path, dumps(mech) + "\n")
     else:
         write_atomic(path, mechanism_yaml(mech, header))
-
-
-def plot_fourbar_path(ax, design: dict[str, float], targets: np.ndarray, theta2: np.ndarray, branch: int,
-                      title: str = "") -> None:
-    """Draw the targets, the achieved points, the coupler curve and the linkage at target 1."""
-    g = {k: design.get(k, 0.0) for k in ("x0", "y0", "theta0", "rcx", "rcy")}
-    r = [design[k] for k in ("r1", "r2", "r3", "r4")]
-    sweep = np.linspace(0, 2 * np.pi, 721)
-    curve = fourbar_position(*r, sweep, branch=branch, **g)
-    C = np.where(curve.assembled[:, None], curve.C, np.nan)
-    ax.plot(C[:, 0], C[:, 1], "-", color="0.6", lw=1, label="coupler curve (branch)")
-    at = fourbar_position(*r, np.asarray(theta2), branch=branch, **g)
-    ax.plot(targets[:, 0], targets[:, 1], "o", mfc="none", mec="tab:red", ms=9, label="targets")
-    ax.plot(at.C[:, 0], at.C[:, 1], "x", color="tab:blue", ms=7, label="achieved")
-    p0 = fourbar_position(*r, float(theta2[0]), branch=branch, **g)
-    ox, oy = rotate(np.float64(r[0]), np.float64(0.0), g["theta0"])
-    O2 = np.array([g["x0"], g["y0"]])
-    O4 = np.array([ox + g["x0"], oy + g["y0"]])
-    chain = np.array([O2, p0.A, p0.B, O4])
-    ax.plot(chain[:, 0], chain[:, 1], "-o", color="k", lw=2, ms=4, label="linkage at target 1")
-    tri = np.array([p0.A, p0.C, p0.B])
-    ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3)
-    ax.plot([O2[0], O4[0]], [O2[1], O4[1]], "k--", lw=1)
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
-    if title:
-        ax.set_title(title, fontsize=10)

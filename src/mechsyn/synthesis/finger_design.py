@@ -49,11 +49,12 @@ from typing import Any, Callable
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.interrupt import BestSoFar
 
 __all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
            "Evaluation", "evaluate_locked", "stage1_objective", "vll_range", "mode_forces",
            "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE", "points_in_region",
-           "underactuated_paths", "design_figure", "redraw", "evaluate_drawn"]
+           "underactuated_paths", "redraw", "evaluate_drawn"]
 
 INFEASIBLE = 1e6
 Objective = Callable[[np.ndarray], float]
@@ -111,20 +112,19 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> FingerCase:
     """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    from mechsyn.io.load import read_data
+    from mechsyn.io.files import read_data
 
     path = Path(path)
-    if not path.is_file():
-        raise _err(f"no such file: {path}", str(path))
-    data, _text = read_data(path)
+    data, _text = read_data(path, "case file")
     return case_from_dict(data, str(path), base_dir=path.parent)
 
 
 def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
-    try:
-        out = [float(x) for x in v]
-    except (TypeError, ValueError):
-        raise _err(f"{fld} must be a list of numbers", src, fld) from None
+    from mechsyn.io.checks import numbers
+
+    if not isinstance(v, (list, tuple)):
+        raise _err(f"{fld} must be a list of numbers", src, fld)
+    out = numbers(v, src, fld).reshape(-1).tolist()
     if n is not None and len(out) != n:
         raise _err(f"{fld} must have {n} numbers", src, fld)
     if not all(np.isfinite(out)):
@@ -368,15 +368,26 @@ def locked_model(d: dict, vlls: list[str], source: str = "<case>") -> dict:
     return d
 
 
-def points_in_region(P: np.ndarray, region: np.ndarray) -> np.ndarray:
-    """Which points (N, 2) lie inside the polygon (NaN rows: outside)."""
-    from matplotlib.path import Path as MPath
-
+def points_in_region(P: np.ndarray, region: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Which points (N, 2) lie inside the polygon or within ``tol`` of its boundary (NaN rows:
+    outside). Even-odd ray casting, vectorised over points and edges."""
     P = np.asarray(P, float).reshape(-1, 2)
+    region = np.asarray(region, float)
     ok = np.all(np.isfinite(P), axis=1)
     out = np.zeros(len(P), bool)
-    if ok.any():
-        out[ok] = MPath(region).contains_points(P[ok], radius=1e-9)
+    if not ok.any():
+        return out
+    Q = P[ok]
+    a, b = region, np.roll(region, -1, axis=0)
+    x, y = Q[:, :1], Q[:, 1:]
+    crosses = (a[:, 1] > y) != (b[:, 1] > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xc = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    inside = np.count_nonzero(crosses & (x < xc), axis=1) % 2 == 1
+    ab = b - a
+    t = np.clip(np.einsum("nkj,kj->nk", Q[:, None] - a[None], ab) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0, 1)
+    dist = np.linalg.norm(Q[:, None] - (a[None] + t[..., None] * ab[None]), axis=2).min(axis=1)
+    out[ok] = inside | (dist <= tol)
     return out
 
 
@@ -744,6 +755,7 @@ class FingerDesign:
     seconds: float
     stopped_by_time_limit: bool = False
     notes: list[str] = field(default_factory=list)
+    interrupted: bool = False    # Ctrl-C ended the search: the best design so far
 
     @property
     def best_variant(self) -> VariantResult:
@@ -758,19 +770,30 @@ class FingerDesign:
                     "assembled_at_all_targets": b.assembled_at_all_targets},
                 "targets": self.targets, "tolerance_deg": self.tolerance_deg,
                 "variants": [v.to_dict() for v in self.variants], "seconds": self.seconds,
-                "stopped_by_time_limit": self.stopped_by_time_limit, "notes": self.notes,
+                "stopped_by_time_limit": self.stopped_by_time_limit, "interrupted": self.interrupted,
+                "notes": self.notes,
                 "units": {"angles": "deg", "lengths": "file unit", "forces": "file force unit",
                           "moments": "force x length"}}
 
 
 def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int, popsize: int,
-        deadline: float, init: Any = "latinhypercube", report: Callable[[int, float], None] | None = None
-        ) -> tuple[np.ndarray, float, int, bool, list]:
-    """Seeded differential evolution; stops at ``deadline``; ``report(generation, best)``."""
+        deadline: float, init: Any = "latinhypercube", report: Callable[[int, float], None] | None = None,
+        state: dict | None = None) -> tuple[np.ndarray, float, int, bool, list]:
+    """Seeded differential evolution; stops at ``deadline``; ``report(generation, best)``.
+
+    Ctrl-C (:class:`KeyboardInterrupt`) ends it with the best design evaluated so far and
+    sets ``state["interrupted"]``; it propagates when nothing was evaluated yet.
+    """
     from scipy.optimize import differential_evolution
 
     stopped = [False]
     gen = [0]
+    best = BestSoFar()
+
+    def tracked(x: np.ndarray) -> float:
+        value = f(x)
+        best.offer(np.atleast_2d(x), np.array([value]))
+        return value
 
     def cb(intermediate_result: Any) -> bool:
         gen[0] += 1
@@ -781,16 +804,27 @@ def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int
             return True
         return False
 
-    r = differential_evolution(f, bounds, seed=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
-                               mutation=(0.5, 1.0), recombination=0.9, polish=False, init=init,
-                               callback=cb, updating="deferred")
+    try:
+        r = differential_evolution(tracked, bounds, seed=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
+                                   mutation=(0.5, 1.0), recombination=0.9, polish=False, init=init,
+                                   callback=cb, updating="deferred")
+    except KeyboardInterrupt:
+        if best.x is None or state is None:
+            raise
+        state["interrupted"] = True
+        return best.x, best.f, 0, False, [(best.x, best.f)]
     pop = sorted(zip(np.asarray(r.population), np.asarray(r.population_energies)), key=lambda t: t[1])
     return np.asarray(r.x), float(r.fun), int(r.nfev), stopped[0], pop
 
 
 def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                   progress: Callable[[str], None] | None = None) -> FingerDesign:
-    """Run paper 000's steps 8-13 on ``case`` (see the module doc)."""
+    """Run paper 000's steps 8-13 on ``case`` (see the module doc).
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search: the
+    variant being searched keeps its best design so far (its force stage is skipped),
+    later variants are not searched, and the result has ``interrupted=True``.
+    """
     t0 = time.monotonic()
     deadline = t0 + time_limit
     bounds = [v.bounds for v in case.variables]
@@ -798,7 +832,11 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     variants = []
     notes: list[str] = []
     stopped = False
+    state = {"interrupted": False}
     for combo in case.combinations:
+        if state["interrupted"]:
+            notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
+            continue
         if progress:
             progress(f"VLL {'+'.join(combo)}: stage 1 (targets, VLL locked at l_min)")
         label = "+".join(combo)
@@ -809,7 +847,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                     f"RMS error {best:.4g} deg" if best < INFEASIBLE else "design still infeasible"))
 
         x1, f1, n1, st1, _ = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
-                                 deadline, report=report1)
+                                 deadline, report=report1, state=state)
         if f1 >= INFEASIBLE:
             notes.append(f"VLL {'+'.join(combo)}: no feasible design (every tried design fails to assemble over "
                          "the crank range or leaves the region)")
@@ -831,12 +869,12 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             init[k] = np.clip(x1 + 0.05 * (hi - lo) * rng.standard_normal(len(bounds)), lo, hi)
         if progress:
             progress("stage 2: forces (both modes)")
-        x2, f2, n2, st2, pop = _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
+        x2, f2, n2, st2, pop = (x1, f1, 0, False, []) if state["interrupted"] else _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
                                                    forces1["criterion"]), bounds, seed, case.force_maxiter,
                                    case.popsize, deadline, init=init,
                                    report=(lambda g, best: progress(
                                        f"VLL {label}: force stage, generation {g}/{case.force_maxiter}, best "
-                                       f"criterion {best:.4g}")) if progress else None)
+                                       f"criterion {best:.4g}")) if progress else None, state=state)
         stopped = stopped or st1 or st2
         chosen, ranges, forces_, improved = x1, ranges1, forces1, False
         # the locked-mode criterion steers the search; the best few distinct members are
@@ -876,6 +914,8 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             vll_ranges=ranges, stage1_forces=forces1, forces=forces_, force_stage_improved=improved,
             assembled_at_all_targets=bool(ev.q is not None and np.isfinite(ev.q).all()),
             mechanism=d, underactuated=under, evaluations=n1 + n2))
+    if not variants and state["interrupted"]:
+        raise KeyboardInterrupt  # nothing feasible to keep
     if not variants:
         raise MechsynInputError(
             "no feasible design: " + "; ".join(notes), source=case.source, field="variables",
@@ -886,109 +926,5 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     return FingerDesign(case.source, seed, variants, best,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
-                        case.tolerance_deg, time.monotonic() - t0, stopped, notes)
-
-
-# --------------------------------------------------------------------------- plot
-def _draw_finger(ax: Any, S: Any, q: np.ndarray, color: Any, lw: float = 1.6, ls: str = "-",
-                 alpha: float = 0.85) -> None:
-    """Every moving link as the polygon of its joint and named points, at pose ``q`` (1, n)."""
-    for i, name in enumerate(S.links):
-        pts = [S.point(q, i, S.to_local(name, j.point))[0] for j in S.mech.joints if name in j.links]
-        pts += [S.point(q, i, S.to_local(name, p.at))[0] for p in S.mech.points.values() if p.link == name]
-        if len(pts) >= 2:
-            P = np.array(pts + pts[:1]) if len(pts) > 2 else np.array(pts)
-            ax.plot(P[:, 0], P[:, 1], ls, marker="o", color=color, lw=lw, ms=2.5, alpha=alpha)
-
-
-def design_figure(case: FingerCase, result: FingerDesign) -> Any:
-    """Three panels: the fully actuated mode (finger at the targets, output paths,
-    region); the underactuated mode (finger at the ends of the VLL range, at the extreme
-    crank angles); a zoom on the output paths for VLL lengths across the range."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib import cm
-
-    v = result.best_variant
-    combo = v.combination
-    d = apply_design(case, np.array(list(v.design.values())), combo)
-    ev = evaluate_drawn(case, d)
-    fig, axes = plt.subplots(1, 3, figsize=(17, 7.2), gridspec_kw={"width_ratios": [1, 1, 1.3]})
-    S = ev.system
-    idx = np.searchsorted(ev.inputs, case.target_inputs)
-    reg = np.vstack([case.region, case.region[:1]])
-    for ax in axes:
-        ax.fill(reg[:, 0], reg[:, 1], color="#d9f0d3", alpha=0.6, zorder=0, label="working region")
-        ax.plot(reg[:, 0], reg[:, 1], color="#1b7837", lw=1.2, zorder=1)
-        ax.set_aspect("equal")
-        ax.grid(alpha=0.3)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-    gp = np.array([j.point for j in S.mech.joints if S.mech.ground in j.links])
-    # 1: fully actuated
-    ax = axes[0]
-    cols = cm.viridis(np.linspace(0, 0.9, len(idx)))
-    for c, k in zip(cols, idx):
-        _draw_finger(ax, S, ev.q[k:k + 1], c)
-        ax.plot([], [], color=c, lw=2, label=f"crank +{ev.inputs[k]:g}° (target)")
-    for name, P in ev.paths.items():
-        ax.plot(P[:, 0], P[:, 1], "k--", lw=1.2, label=f"{name} path")
-    ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7, label="palm pivots")
-    ax.set_title(f"1. Fully actuated: VLL {'+'.join(combo)} locked at its minimum\n"
-                 f"target error RMS {v.error_rms:.3g}°, max {v.error_max:.3g}°", fontsize=11)
-    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
-    # 2: underactuated, the finger at the ends of the VLL range
-    ax = axes[1]
-    rng = ", ".join(f"{j} in [{a:.4g}, {b:.4g}]" for j, (a, b) in v.vll_ranges.items())
-    ends = [(f"{'+'.join(combo)} = min", d, "0.45")]
-    dmax = redraw(case, d, {j: v.vll_ranges[j][1] for j in combo})
-    if dmax is not None:
-        ends.append((f"{'+'.join(combo)} = max", dmax, "#d95f02"))
-    for label, dd, c in ends:
-        e2 = evaluate_drawn(case, dd)
-        if e2.q is None:
-            continue
-        for k, ls in ((0, "-"), (len(e2.inputs) - 1, "--")):
-            _draw_finger(ax, e2.system, e2.q[k:k + 1], c, ls=ls)
-        for P in e2.paths.values():
-            ax.plot(P[:, 0], P[:, 1], color=c, lw=2.2)
-        ax.plot([], [], color=c, lw=2, label=f"VLL {label}")
-    ax.plot([], [], "k-", lw=1, label=f"crank +{ev.inputs[0]:g}° (open)")
-    ax.plot([], [], "k--", lw=1, label=f"crank +{ev.inputs[-1]:g}° (closed)")
-    ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7)
-    ax.set_title(f"2. Underactuated: VLL free, {rng}\npeak reaction {v.forces['peak_reaction']:.3g}, "
-                 f"peak input moment {v.forces['peak_input_moment']:.3g} (both modes)", fontsize=11)
-    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
-    xs = axes[0].get_xlim() + axes[1].get_xlim()
-    ys = axes[0].get_ylim() + axes[1].get_ylim()
-    for ax in axes[:2]:
-        ax.set_xlim(min(xs), max(xs))
-        ax.set_ylim(min(ys), max(ys))
-    # 3: zoom on the output paths across the VLL range
-    ax = axes[2]
-    for jid, u in v.underactuated.items():
-        lens = u["lengths"]
-        lc = cm.plasma(np.linspace(0, 0.85, len(lens)))
-        for name, P in u["paths"].items():
-            for r in range(len(lens)):
-                ax.plot(P[r, :, 0], P[r, :, 1], color=lc[r], lw=1.8,
-                        label=f"{name}, {jid} = {lens[r]:.4g}" if name == case.points[0] else None)
-            for k in idx:  # adaptive motion with the motor still: the VLL sweeps its range
-                ax.plot(P[:, k, 0], P[:, k, 1], color="0.3", lw=1.0, ls=":")
-        ax.plot([], [], color="0.3", ls=":", label="motor still at a target, VLL moving")
-    for name, P in ev.paths.items():
-        ax.plot(P[:, 0], P[:, 1], "k--", lw=1.0, label=f"{name}, VLL locked (panel 1)")
-    ax.legend(fontsize=8, loc="lower left", framealpha=0.9)
-    box = np.vstack([case.region] + [u["paths"][n].reshape(-1, 2) for u in v.underactuated.values()
-                                     for n in u["paths"]])
-    box = box[np.all(np.isfinite(box), axis=1)]
-    blo, bhi = box.min(axis=0), box.max(axis=0)
-    pad = 0.06 * (bhi - blo).max()
-    ax.set_xlim(blo[0] - pad, bhi[0] + pad)
-    ax.set_ylim(blo[1] - 0.5 * (bhi[1] - blo[1]) - pad, bhi[1] + pad)  # room for the legend
-    ax.set_title("3. Output paths over the VLL range (zoom on the region)", fontsize=11)
-    fig.suptitle(f"Paper 000, steps 8-13: {S.mech.name}", fontsize=12)
-    fig.tight_layout()
-    return fig
+                        case.tolerance_deg, time.monotonic() - t0, stopped, notes,
+                        interrupted=state["interrupted"])

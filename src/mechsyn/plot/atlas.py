@@ -7,15 +7,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import matplotlib
+from typing import Any
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Polygon  # noqa: E402
+import numpy as np
+from matplotlib.patches import Circle, Polygon
 
-from mechsyn.synthesis.chains import KinematicChain  # noqa: E402
-from mechsyn.synthesis.mechanisms import chain_layout  # noqa: E402
+from mechsyn.plot._base import axes, figure
+from mechsyn.synthesis.chains import KinematicChain
+from mechsyn.synthesis.mechanisms import chain_layout
+
+__all__ = ["draw_chain", "plot_atlas"]
 
 DEGREE_COLOURS = {2: "#ffffff", 3: "#9ecae1", 4: "#fdae6b", 5: "#a1d99b", 6: "#dadaeb"}
 
@@ -24,9 +25,10 @@ def _colour(d: int) -> str:
     return DEGREE_COLOURS.get(d, "#d9d9d9")
 
 
-def draw_chain(ax, chain: KinematicChain, number: int | None = None,
-               frame: int | None = None) -> None:
-    """Draw one chain into ``ax``: graph on the left, kinematic sketch on the right."""
+def draw_chain(chain: KinematicChain, ax: Any = None, number: int | None = None,
+               frame: int | None = None) -> Any:
+    """Draw one chain: graph on the left, kinematic sketch on the right. Returns the Axes."""
+    ax = axes(ax, (3.6, 1.95))
     link_xy, joints = chain_layout(chain, scale=1.0)
     deg = chain.degrees()
     small = chain.n_links <= 8
@@ -36,7 +38,7 @@ def draw_chain(ax, chain: KinematicChain, number: int | None = None,
     for a, b in chain.edges:
         ax.plot(*zip(link_xy[a], link_xy[b]), color="#555555", lw=0.8, zorder=1)
     for v, (x, y) in enumerate(link_xy):
-        ax.add_patch(plt.Circle((x, y), node_size, facecolor=_colour(deg[v]),
+        ax.add_patch(Circle((x, y), node_size, facecolor=_colour(deg[v]),
                                 edgecolor="black", lw=0.7, zorder=2))
         ax.text(x, y, str(v), ha="center", va="center", fontsize=font, zorder=3)
     # kinematic sketch (right, shifted)
@@ -76,18 +78,21 @@ def draw_chain(ax, chain: KinematicChain, number: int | None = None,
     ax.set_ylim(-1.25, 1.25)
     ax.set_aspect("equal")
     ax.axis("off")
+    return ax
 
 
-def atlas_figure(chains: Sequence[KinematicChain], title: str, columns: int | None = None):
-    """A Matplotlib figure with every chain, numbered from 1, in a grid."""
+def plot_atlas(chains: Sequence[KinematicChain], title: str = "", columns: int | None = None,
+               fig: Any = None) -> Any:
+    """Every chain, numbered from 1, in a grid. Returns the Figure."""
     n = len(chains)
     columns = columns or (2 if n <= 4 else 4)
     rows = max(1, math.ceil(n / columns))
     height = rows * 1.95 + 0.5
-    fig, axes = plt.subplots(rows, columns, figsize=(columns * 3.6, height), squeeze=False)
-    for i, ax in enumerate(axes.flat):
+    fig = figure(fig, (columns * 3.6, height))
+    grid = fig.subplots(rows, columns, squeeze=False)
+    for i, ax in enumerate(grid.flat):
         if i < n:
-            draw_chain(ax, chains[i], number=i + 1)
+            draw_chain(chains[i], ax, number=i + 1)
         else:
             ax.axis("off")
     fig.suptitle(title + "\n(left: graph, node = link, edge = joint; right: kinematic "

@@ -1,22 +1,25 @@
-"""Figures of paper 001's belt manipulator (Matplotlib, object API: no pyplot state).
+"""Figures of paper 001's belt manipulator.
 
-``figure_mechanism`` draws the mechanism in its design and extreme positions with the
+``plot_belt`` draws the mechanism in its design and extreme positions with the
 paths of C and H (as the paper's fig. 4), the equivalent four-bar's coupler paths for
-comparison, and the speed and acceleration curves of C and H; ``save_animation`` writes
-a GIF of the motion (Matplotlib's PillowWriter).
+comparison, and the speed and acceleration curves of C and H; ``animate_belt`` returns
+an animation of the motion. Nothing here writes a file or chooses a backend.
+
+References
+----------
+Paper 001 (seed 001) of /work/shared/seeds: the belt manipulator; see
+:mod:`mechsyn.kinematics.belt` for the full reference.
 """
 
 from __future__ import annotations
 
 import math
-import os
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.results import atomic_output
+from mechsyn.plot._base import figure
 from mechsyn.kinematics.belt import (
     BeltDesign,
     BeltState,
@@ -26,7 +29,7 @@ from mechsyn.kinematics.belt import (
     equivalent_four_bar,
 )
 
-__all__ = ["check_animation_target", "draw_mechanism", "figure_mechanism", "save_animation"]
+__all__ = ["animate_belt", "draw_belt", "plot_belt"]
 
 
 def _dense(design: BeltDesign, state: BeltState, n: int = 1500) -> BeltState:
@@ -48,7 +51,7 @@ def _ground(ax: Any, p: np.ndarray, size: float) -> None:
                 "k", lw=0.5, zorder=4)
 
 
-def draw_mechanism(ax: Any, design: BeltDesign, state: BeltState, i: int, alpha: float = 1.0,
+def draw_belt(ax: Any, design: BeltDesign, state: BeltState, i: int, alpha: float = 1.0,
                    labels: bool = False) -> list[Any]:
     """Draw the mechanism at position ``i`` of ``state``; returns the artists."""
     from matplotlib.patches import Circle
@@ -81,20 +84,20 @@ def draw_mechanism(ax: Any, design: BeltDesign, state: BeltState, i: int, alpha:
     return art
 
 
-def figure_mechanism(design: BeltDesign, state: BeltState, four_bar: FourBarState | None,
-                     motion: MotionResult | None, title: str = "") -> Any:
-    """Figure like paper 001's fig. 4 (left) with speed/acceleration curves (right)."""
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(15, 8), dpi=100, layout="constrained")
+def plot_belt(design: BeltDesign, state: BeltState, four_bar: FourBarState | None = None,
+              motion: MotionResult | None = None, title: str = "", fig: Any = None) -> Any:
+    """Figure like paper 001's fig. 4 (left) with speed/acceleration curves (right).
+    Returns the Figure."""
+    fig = figure(fig, (15, 8))
+    fig.set_layout_engine("constrained")
     gs = fig.add_gridspec(2, 2, width_ratios=[1.35, 1])
     ax = fig.add_subplot(gs[:, 0])
     valid = np.nonzero(state.valid)[0]
     i0 = int(np.argmin(np.abs(state.dphi)))
     ends = [int(valid[0]), int(valid[-1])] if valid.size else []
     for i in ends:
-        draw_mechanism(ax, design, state, i, alpha=0.45)
-    draw_mechanism(ax, design, state, i0, labels=True)
+        draw_belt(ax, design, state, i, alpha=0.45)
+    draw_belt(ax, design, state, i0, labels=True)
     _ground(ax, np.zeros(2), 0.035 * design.a)
     _ground(ax, design.B0, 0.035 * design.a)
     fine = _dense(design, state)
@@ -147,33 +150,18 @@ def figure_mechanism(design: BeltDesign, state: BeltState, four_bar: FourBarStat
     return fig
 
 
-def check_animation_target(path: str | os.PathLike[str]) -> Path:
-    """Raise MechsynInputError unless a GIF can be written to ``path``."""
-    from matplotlib.animation import PillowWriter
+def animate_belt(design: BeltDesign, state: BeltState, max_frames: int = 160, title: str = "",
+                 fig: Any = None, interval: float = 50) -> Any:
+    """The motion over ``state`` as a :class:`matplotlib.animation.FuncAnimation`."""
+    from matplotlib.animation import FuncAnimation
 
-    if not PillowWriter.isAvailable():
-        raise MechsynInputError("--animate needs the pillow package",
-                                hint="pip install pillow", source="--animate")
-    path = Path(path)
-    if path.suffix.lower() != ".gif":
-        raise MechsynInputError(f"the animation is a GIF: use a .gif file name, not {path.name}",
-                                source="--animate")
-    return path
-
-
-def save_animation(design: BeltDesign, state: BeltState, path: str | os.PathLike[str],
-                   fps: int = 20, max_frames: int = 160, title: str = "") -> None:
-    """Write an animated GIF of the motion over ``state`` (whole file or nothing)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
-    from matplotlib.figure import Figure
-
-    path = check_animation_target(path)
     idx = np.nonzero(state.valid)[0]
     if idx.size == 0:
         raise MechsynInputError("nothing to animate: the belt is slack over the whole range")
     if idx.size > max_frames:
         idx = idx[np.linspace(0, idx.size - 1, max_frames).round().astype(int)]
-    fig = Figure(figsize=(8, 6), dpi=80, layout="constrained")
+    fig = figure(fig, (8, 6))
+    fig.set_layout_engine("constrained")
     ax = fig.add_subplot()
     pts = np.concatenate([state.C[idx], state.H[idx], state.A[idx], [design.B0, [0, 0]]])
     pad = 0.12 * design.a
@@ -195,11 +183,9 @@ def save_animation(design: BeltDesign, state: BeltState, path: str | os.PathLike
             artist.remove()
         current.clear()
         i = int(idx[k])
-        current.extend(draw_mechanism(ax, design, state, i))
+        current.extend(draw_belt(ax, design, state, i))
         text.set_text(f"Δφ = {math.degrees(state.dphi[i]):7.2f}°   "
                       f"θ = {math.degrees(state.theta[i]):7.2f}°")
         return [*current, text]
 
-    anim = FuncAnimation(fig, frame, frames=len(idx), blit=False)
-    with atomic_output(path) as tmp:
-        anim.save(tmp, writer=PillowWriter(fps=fps))
+    return FuncAnimation(fig, frame, frames=len(idx), blit=False, interval=interval)

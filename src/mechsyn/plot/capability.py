@@ -1,0 +1,61 @@
+"""Figures of a velocity-capability map (paper 004): V_max and the optimal joint values."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from mechsyn.plot._base import figure
+
+__all__ = ["plot_capability_map"]
+
+
+def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
+    """Heat map with contour lines of V_max and panels of the optimal joint values.
+    Returns the Figure."""
+    n = cmap.q.shape[-1]
+    panels = 1 + n
+    cols = 2 if panels <= 4 else 3
+    rows_ = math.ceil(panels / cols)
+    fig = figure(fig, (5.2 * cols, 4.4 * rows_))
+    axs = fig.subplots(rows_, cols, squeeze=False)
+    small = cmap.xs.size * cmap.ys.size <= 144
+    qu = cmap.q_user()
+    fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
+               f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
+               f"[{units}]" + ("" if cmap.z is None else f" in z = {cmap.z:g}")
+               + f"\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
+    for k in range(n):
+        data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else ""
+        if cmap.joint_is_revolute[k] and np.nanmax(np.abs(data), initial=0.0) > 180:
+            data, unit = (data + 180) % 360 - 180, "deg, shown mod 360"  # same pose
+        fields.append((data, f"optimal {cmap.joint_names[k]} [{unit}]", "coolwarm"))
+    for idx, (data, title, cm) in enumerate(fields):
+        ax = axs[idx // cols][idx % cols]
+        mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
+        fig.colorbar(mesh, ax=ax, shrink=0.85)
+        finite = np.isfinite(data)
+        if (idx == 0 and cmap.xs.size > 2 and cmap.ys.size > 2 and finite.sum() > 4
+                and np.nanstd(data) > 0):
+            try:
+                cs = ax.contour(cmap.xs, cmap.ys, data.T, levels=8, colors="k", linewidths=0.6)
+                if not small:
+                    ax.clabel(cs, fontsize=8, fmt="%.0f")
+            except (ValueError, TypeError):
+                pass
+        if small:
+            for i, x in enumerate(cmap.xs):
+                for j, y in enumerate(cmap.ys):
+                    if np.isfinite(data[i, j]):
+                        ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=8,
+                                color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_aspect("equal")
+    for idx in range(panels, rows_ * cols):
+        axs[idx // cols][idx % cols].axis("off")
+    fig.tight_layout()
+    return fig
