@@ -37,7 +37,8 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
               "their mechanisms."),
     "belt": (("belt",), "Paper 001's manipulator with a belt on a pulley: synthesis, paths, speeds, "
              "accelerations, the inverse problem."),
-    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism"),
+    "curves": (("curves",), "The local curve database of curve synthesis: build or extend it."),
+    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism", "synth_curve"),
               "Synthesis: structural (groups, fingers) and dimensional (path, function, motion)."),
 }
 
