@@ -174,7 +174,7 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
     """Build or extend the curve database (resumable; see the module doc).
 
     ``callback(state)`` is called after each topology with ``stage="build"``, ``done``,
-    ``total`` (topologies) and ``curves`` (kept so far). With ``scheduler`` (a
+    ``total`` (topologies), ``curves`` (kept so far), ``best`` (NaN) and ``nfev`` (0). With ``scheduler`` (a
     ``dask.distributed`` address or ``Client``) the topologies are built on a Dask
     cluster and written here.
     """
@@ -189,7 +189,7 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
             todo.append((i, t.key, max_links, per_topology, seed, batch, have))
     total, done, kept = len(topos), len(topos) - len(todo), 0
     if callback is not None:
-        callback({"stage": "build", "done": done, "total": total, "curves": kept})
+        callback(_state(done, total, kept))
     if scheduler is not None and todo:
         client = _dask_client(scheduler)
         futures = client.map(_build_one, todo, pure=False)
@@ -201,7 +201,7 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
             done += 1
             kept += len(data["ranges"])
             if callback is not None:
-                callback({"stage": "build", "done": done, "total": total, "curves": kept})
+                callback(_state(done, total, kept))
         return directory
     for job in todo:
         key, data = _build_one(job)
@@ -209,8 +209,13 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
         done += 1
         kept += len(data["ranges"])
         if callback is not None:
-            callback({"stage": "build", "done": done, "total": total, "curves": kept})
+            callback(_state(done, total, kept))
     return directory
+
+
+def _state(done: int, total: int, kept: int) -> dict:
+    """Progress state of a build (the synthesis callback's keys, plus ``curves``)."""
+    return {"stage": "build", "done": done, "total": total, "best": float("nan"), "nfev": 0, "curves": kept}
 
 
 def _dask_client(scheduler):
