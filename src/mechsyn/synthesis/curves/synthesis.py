@@ -467,7 +467,8 @@ def synthesize_curve(
         Seconds for retrieval and refinement: a refinement is not started when the
         longest one so far would overrun it; the best found so far is returned.
     top : int
-        Candidates returned (distinct designs, best chamfer error first).
+        Candidates returned (distinct designs, best chamfer error first; among those
+        within ``tolerance``, fewer links first).
     n_refine, retrieve : int
         Designs refined, and nearest descriptors retrieved per query.
     crank : bool
@@ -577,7 +578,8 @@ def synthesize_curve(
         notes.append("interrupted: the best found so far")
     if not picked:
         notes.append("no database design matched the options (crank, links, open/closed)")
-    cands.sort(key=lambda c: c.chamfer)
+    # best first; within the tolerance the simpler linkage first
+    cands.sort(key=lambda c: (max(c.chamfer, tolerance), c.topology.n_links, c.chamfer))
     out: list[CurveCandidate] = []
     for c in cands:
         if any(o.topology.key == c.topology.key and abs(o.chamfer - c.chamfer) < 1e-6 for o in out):
