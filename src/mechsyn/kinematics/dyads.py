@@ -882,9 +882,12 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
     U = np.atleast_2d(np.asarray(inputs, float))
     N = U.shape[0]
     u0 = np.array([d.assembled for d in S.drivers], float)
-    path = _connecting_path(S, u0, _shifted_start(S, u0, U[0]))
+    # R inputs a whole number of turns from the drawn values are the same configurations:
+    # track the sweep shifted next to the drawn values (its rows then follow each other)
+    shift = U[0] - _shifted_start(S, u0, U[0])
+    path = _connecting_path(S, u0, U[0] - shift)
     n0 = path.shape[0]
-    X = np.vstack([path, U])
+    X = np.vstack([path, U - shift])
     M = X.shape[0]
     st = _State(S, M)
     sigmas: list = []
@@ -914,6 +917,11 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
     if dyad_links and ok.any():
         phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
     q[:, 2:3 * nl:3] = phi
+    for step in plan.steps:  # a link driven from the frame takes the input's own turn count
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            sgn = 1.0 if con.b == step.links[0] else -1.0
+            q[n0:, 3 * step.links[0] + 2] += sgn * shift[con.driver]
     events = []
     for e in raw_events:
         e = dict(e)
@@ -921,6 +929,8 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
             e["message"] = "between the drawn configuration and the first input: " + e["message"]
             e["before_sweep"] = True
         e["index"] = max(0, e["index"] - n0)
+        if not e.get("before_sweep"):
+            e["input"] = (np.asarray(e["input"]) + shift).tolist()
         events.append(e)
     sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
     return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:], events)
