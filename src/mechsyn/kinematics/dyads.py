@@ -857,7 +857,7 @@ def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: 
     return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
 
 
-def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPositions:
+def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
     """Poses for all inputs on the branch of the drawn configuration, with branch events.
 
     The branch rules (docs/kinematics.md, "Branches"):
@@ -877,7 +877,9 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
        the signed height ``sigma sqrt(Delta)`` changes sign, so ``sigma`` flips there.
     4. After a gap the group reassembles in the drawn mode.
 
-    ``inputs`` (N, n_inputs) in radians / length.
+    ``inputs`` (N, n_inputs) in radians / length. ``switch``: at change / branch points
+    take the other branch instead (``sigma`` kept: a parallelogram becomes an
+    anti-parallelogram there); the events say so.
     """
     U = np.atleast_2d(np.asarray(inputs, float))
     N = U.shape[0]
@@ -900,7 +902,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
             continue
 
         def choose(disc: np.ndarray, s_file: float, k: int = k) -> np.ndarray:
-            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0)
+            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
             discs[k] = disc
             raw_events.extend(evs)
             singular[sing] = True
@@ -955,7 +957,7 @@ def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray
 
 
 def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
-                  s_file: float, n0: int) -> tuple[np.ndarray, list, np.ndarray]:
+                  s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
     """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
     from scipy.optimize import brentq
 
@@ -1026,12 +1028,15 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         if any(abs(i - j) <= 2 and np.abs(u - v).max() < 1e-8 for j, v in touched):
             continue  # the same crossing seen from the neighbouring sample
         touched.append((i, u))
-        breaks.append((row, "flip"))
+        if not switch:
+            breaks.append((row, "flip"))
         events.append({"index": at, "kind": "singular", "input": u.tolist(), "group": group,
                        "crossed": not singular[i],
                        "message": f"change / branch point: the group {group} is folded flat here (its two "
-                                  "assembly modes meet); the motion continues on the branch whose velocity is "
-                                  "continuous (the drawn branch)"
+                                  "assembly modes meet); "
+                                  + ("the motion switches to the other branch (change_points='switch')" if switch
+                                     else "the motion continues on the branch whose velocity is continuous "
+                                          "(the drawn branch)")
                                   + ("; velocities and accelerations are not defined at this input (null)"
                                      if singular[i] else "")})
     sig = np.full(M, s_file)
