@@ -176,9 +176,24 @@ def _unit(t: str) -> str:
 
 
 def input_grid(start: float, stop: float, step: float) -> np.ndarray:
-    """``start, start + step, ..., stop`` (stop included when on the grid)."""
-    n = int(np.floor((stop - start) / step + 1e-9)) + 1
-    return start + step * np.arange(n)
+    """``start, start + step, ..., stop`` (stop included when on the grid).
+
+    More positions than the limit ``sweep_points`` (:mod:`mechsyn.limits`) raise
+    :class:`~mechsyn.errors.MechsynInputError` before any memory is taken.
+    """
+    from mechsyn.errors import MechsynInputError
+    from mechsyn.limits import limit, limit_hint
+
+    if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
+        raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", source="--input",
+                                hint="write e.g. --input A=0:360:1")
+    count = np.floor((stop - start) / step + 1e-9) + 1
+    if count > limit("sweep_points"):
+        raise MechsynInputError(
+            f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "
+            f"{limit('sweep_points'):,}", source="--input",
+            hint="use a larger step or a shorter range; " + limit_hint("sweep_points"))
+    return start + step * np.arange(int(count))
 
 
 def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:
@@ -515,6 +530,14 @@ class ForceAnalysis(Result):
     """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``)."""
 
     _plot = "kinematics:plot_forces"
+
+    def _summary(self) -> list[tuple[str, str]]:
+        sim, r = self.simulation, self.reactions
+        return [("mechanism", sim.mechanism), ("analysis", "static" if self.static else "kinetostatic"),
+                ("gravity", f"({self.gravity[0]:g}, {self.gravity[1]:g})"),
+                ("assembled", f"{int(np.count_nonzero(sim.assembled))} of {len(sim.assembled)}"),
+                ("joints", ", ".join(r.force) or "-"),
+                ("drives", ", ".join(f"{j} ({r.effort_kind[j]})" for j in r.effort) or "-")]
 
     simulation: Simulation
     reactions: Reactions
