@@ -37,6 +37,8 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
               "their mechanisms."),
     "belt": (("belt",), "Paper 001's manipulator with a belt on a pulley: synthesis, paths, speeds, "
              "accelerations, the inverse problem."),
+    "serve": (("serve",), "mechsyn studio: draw, drag, analyse, animate and synthesise mechanisms in the "
+              "browser (a local web app)."),
     "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism"),
               "Synthesis: structural (groups, fingers) and dimensional (path, function, motion)."),
 }
