@@ -55,6 +55,12 @@ def test_simulate_equals_library(client, fourbar):
 def test_analyze(client):
     six = mechanism_to_dict(load_mechanism(example_path("watt_sixbar")))
     d = client.post("/api/analyze", json={"mechanism": six}).json()
+    import json
+
+    from mechsyn.results import dumps
+    from mechsyn.structure.report import analyze
+
+    assert d["structure"] == json.loads(dumps(analyze(load_mechanism(example_path("watt_sixbar"))).to_dict()))
     assert d["structure"]["formulas"]["chebyshev"]["expression"] == "W = 3·5 - 2·7 - 0 = 1"
     assert d["rank"]["useful_mobility"] == 1
     assert [g["label"] for g in d["assur"]["groups"]] == ["II(coupler,rocker)", "II(link5,link6)"]
