@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from mechsyn.io import load_mechanism, mechanism_to_dict
+from mechsyn.io import load_mechanism, mechanism_from_dict, mechanism_to_dict
 from mechsyn.web._service import example_path
 
 from web_helpers import TOKEN
@@ -192,6 +192,21 @@ def test_symlink_out_refused(client, tmp_path, fourbar):
 def test_wrong_suffix_refused(client, fourbar):
     r = client.post("/api/file", json={"path": "x.txt", "mechanism": fourbar})
     assert r.status_code == 400 and ".yaml" in r.json()["hint"]
+
+
+def test_import_pyslvs(client, tmp_path):
+    from mechsyn.io.pyslvs import read_pyslvs
+
+    src = example_path("crank_rocker").parents[1] / "pyslvs" / "crank_rocker.pyslvs"
+    text = src.read_text()
+    d = client.post("/api/import", json={"text": text, "filename": "crank_rocker.pyslvs"}).json()["mechanism"]
+    assert d == mechanism_to_dict(mechanism_from_dict(read_pyslvs(text, "crank_rocker.pyslvs")[0]))
+    (tmp_path / "crank_rocker.pyslvs").write_text(text)
+    assert "crank_rocker.pyslvs" in client.get("/api/files").json()["files"]
+    assert client.get("/api/file", params={"path": "crank_rocker.pyslvs"}).json()["mechanism"] == d
+    assert client.post("/api/simulate", json={"mechanism": d, "steps": 10}).status_code == 200
+    # opened, not written
+    assert client.post("/api/file", json={"path": "out.pyslvs", "mechanism": d}).status_code == 400
 
 
 def test_import_and_export(client, fourbar):

@@ -78,13 +78,21 @@ def read_mechanism(path: Path) -> dict[str, Any]:
     """A mechanism file read, validated and returned in the file format (dict)."""
     from mechsyn.io import load_mechanism, mechanism_to_dict
 
+    if path.suffix.lower() == ".pyslvs":
+        return parse_mechanism_text(path.read_text(encoding="utf-8"), path.name)
     return mechanism_to_dict(load_mechanism(path))
 
 
 def parse_mechanism_text(text: str, filename: str) -> dict[str, Any]:
-    """An uploaded mechanism file's text (YAML or JSON) → file-format dict."""
-    from mechsyn.io import mechanism_from_text, mechanism_to_dict
+    """An uploaded file's text → file-format dict: a mechanism file (YAML or JSON) or a
+    Pyslvs expression (``.pyslvs``, :mod:`mechsyn.io.pyslvs`)."""
+    from mechsyn.io import mechanism_from_dict, mechanism_from_text, mechanism_to_dict
 
+    if filename.lower().endswith(".pyslvs"):
+        from mechsyn.io.pyslvs import read_pyslvs
+
+        data, _notes = read_pyslvs(text, filename)
+        return mechanism_to_dict(mechanism_from_dict(data, source=filename))
     return mechanism_to_dict(mechanism_from_text(text, source=filename))
 
 
