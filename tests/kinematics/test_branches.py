@@ -78,10 +78,10 @@ def compare(a, b, singular_tol=1e-5):
 
 @pytest.mark.parametrize("name,grid", [
     ("textbook/fourbar.yaml", (0, 360, 4)),
-    ("textbook/fourbar.yaml", (200, 560, 6)),
+    pytest.param("textbook/fourbar.yaml", (200, 560, 6), marks=pytest.mark.slow),
     pytest.param("textbook/watt_sixbar.yaml", (-90, 270, 6), marks=pytest.mark.slow),
     pytest.param("textbook/stephenson_sixbar.yaml", (0, 360, 5), marks=pytest.mark.slow),
-    ("kinematics/triple_rocker.yaml", (-90, 270, 6)),
+    pytest.param("kinematics/triple_rocker.yaml", (-90, 270, 6), marks=pytest.mark.slow),
 ])
 def test_closed_form_equals_newton_through_dead_points_and_gaps(ex, name, grid):
     m = ex(name)
@@ -135,7 +135,8 @@ def test_drawn_branch_decides_where_the_sweep_starts():
 
 
 @pytest.mark.parametrize("name", ["textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "triad"])
-@pytest.mark.parametrize("theta", [20.0, 75.0, pytest.param(100.0, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("theta", [20.0, pytest.param(75.0, marks=pytest.mark.slow),
+                                   pytest.param(100.0, marks=pytest.mark.slow)])
 def test_sweeps_pass_through_the_drawn_configuration(ex, name, theta):
     base = triad() if name == "triad" else ex(name)
     S = build_system(base)
@@ -153,3 +154,25 @@ def test_sweeps_pass_through_the_drawn_configuration(ex, name, theta):
             assert sim.assembled[k]
             for j, P in points.items():
                 assert np.abs(sim.points[j].position[k] - P).max() < 1e-9, (meth, lo, hi, j)
+
+
+def test_option_switches_to_the_other_branch_at_change_points():
+    """change_points='switch': the parallelogram turns anti-parallelogram at its change
+    points (the other assembly mode of the dyad B-C-D)."""
+    m = parallelogram(60.0)
+    x = input_grid(0, 360, 10)
+    keep = simulate(m, {"A": x}, points=["C"])
+    other = simulate(m, {"A": x}, points=["C"], change_points="switch")
+    th = np.radians(x)
+    first = x <= 180  # the drawn part, up to the first change point after the drawn input
+    assert np.allclose(other.points["C"].position[first], keep.points["C"].position[first], atol=1e-12)
+    later = (x > 180) & (x < 360)  # between the change points, where the two modes differ
+    off = np.linalg.norm(other.points["C"].position - np.stack([4 + np.cos(th), np.sin(th)], 1), axis=1)
+    assert off[later].min() > 1e-3
+    # the anti-parallelogram: |BC| = 4, |CD| = 1 still
+    B = np.stack([np.cos(th), np.sin(th)], 1)
+    C = other.points["C"].position
+    assert np.allclose(np.linalg.norm(C - B, axis=1), 4) and np.allclose(np.linalg.norm(C - [4, 0], axis=1), 1)
+    assert any("other branch" in e["message"] for e in other.events if e["kind"] == "singular")
+    with pytest.raises(Exception):
+        simulate(m, {"A": x}, method="newton", change_points="switch")

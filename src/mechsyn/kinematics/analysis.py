@@ -222,18 +222,20 @@ def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[
 
 def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
              points: list[str] | None = None, vll: dict[str, str] | None = None,
-             method: str = "auto", progress: Any = None) -> Simulation:
+             method: str = "auto", progress: Any = None, change_points: str = "keep") -> Simulation:
     """Positions, velocities and accelerations over a sweep of the inputs.
 
     ``inputs``: joint id -> values (degrees for R, length for P), all of the same
     length; drivers not listed keep their value of the file. ``method``: ``"auto"``
     (closed-form Assur groups when the mechanism decomposes, else Newton),
-    ``"assur"`` or ``"newton"``.
+    ``"assur"`` or ``"newton"``. ``change_points``: ``"keep"`` (the drawn branch, whose
+    velocity is continuous, through change and branch points: a parallelogram stays a
+    parallelogram) or ``"switch"`` (the other branch there; closed form only).
     """
     if not inputs:
         raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
     return compile_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
-        inputs, speeds=speeds, points=points, method=method, progress=progress)
+        inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
 
 
 @dataclass(frozen=True, eq=False)
@@ -280,9 +282,10 @@ class KinematicPlan:
         return KinematicPlan(new, S, self.groups, self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
-                 points: list[str] | None = None, method: str = "auto", progress: Any = None) -> Simulation:
+                 points: list[str] | None = None, method: str = "auto", progress: Any = None,
+                 change_points: str = "keep") -> Simulation:
         """The sweep of :func:`simulate` with this plan."""
-        return _simulate_plan(self, inputs, speeds, points, method, progress)
+        return _simulate_plan(self, inputs, speeds, points, method, progress, change_points)
 
 
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
@@ -294,8 +297,11 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
 
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
-                   points: list[str] | None, method: str, progress: Any) -> Simulation:
+                   points: list[str] | None, method: str, progress: Any, change_points: str = "keep") -> Simulation:
     mech, S = kp.mechanism, kp.system
+    if change_points not in ("keep", "switch"):
+        raise MechsynInputError(f"change_points must be 'keep' or 'switch', not {change_points!r}",
+                                source="change_points")
     if not inputs:
         raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
     if tuple(j for j in inputs if _is_passive(mech, j, kp.vll)) != kp.prescribed:
@@ -344,9 +350,12 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if method == "assur" and plan is None:
         raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
                                 hint="use the Newton method")
+    if change_points == "switch" and plan is None:
+        raise MechsynInputError("change_points='switch' needs the closed form (a mechanism of drivers and dyads)",
+                                source="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-    sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress))
+    sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress, change_points == "switch"))
     events = sw.events
     used = sw.method
     ok = sw.assembled
@@ -386,12 +395,13 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
-def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any) -> Sweep:
+def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
+         switch: bool = False) -> Sweep:
     """One sweep from the drawn configuration through the rows of ``U`` in order."""
     N = U.shape[0]
     if plan is None:
         return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-    tracked = dyads.solve_tracked(S, plan, U)
+    tracked = dyads.solve_tracked(S, plan, U, switch=switch)
     q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
     qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
     qdd[tracked.singular] = np.nan

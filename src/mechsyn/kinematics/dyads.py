@@ -857,7 +857,7 @@ def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: 
     return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
 
 
-def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPositions:
+def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
     """Poses for all inputs on the branch of the drawn configuration, with branch events.
 
     The branch rules (docs/kinematics.md, "Branches"):
@@ -877,14 +877,19 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
        the signed height ``sigma sqrt(Delta)`` changes sign, so ``sigma`` flips there.
     4. After a gap the group reassembles in the drawn mode.
 
-    ``inputs`` (N, n_inputs) in radians / length.
+    ``inputs`` (N, n_inputs) in radians / length. ``switch``: at change / branch points
+    take the other branch instead (``sigma`` kept: a parallelogram becomes an
+    anti-parallelogram there); the events say so.
     """
     U = np.atleast_2d(np.asarray(inputs, float))
     N = U.shape[0]
     u0 = np.array([d.assembled for d in S.drivers], float)
-    path = _connecting_path(S, u0, _shifted_start(S, u0, U[0]))
+    # R inputs a whole number of turns from the drawn values are the same configurations:
+    # track the sweep shifted next to the drawn values (its rows then follow each other)
+    shift = U[0] - _shifted_start(S, u0, U[0])
+    path = _connecting_path(S, u0, U[0] - shift)
     n0 = path.shape[0]
-    X = np.vstack([path, U])
+    X = np.vstack([path, U - shift])
     M = X.shape[0]
     st = _State(S, M)
     sigmas: list = []
@@ -897,7 +902,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
             continue
 
         def choose(disc: np.ndarray, s_file: float, k: int = k) -> np.ndarray:
-            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0)
+            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
             discs[k] = disc
             raw_events.extend(evs)
             singular[sing] = True
@@ -914,6 +919,11 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
     if dyad_links and ok.any():
         phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
     q[:, 2:3 * nl:3] = phi
+    for step in plan.steps:  # a link driven from the frame takes the input's own turn count
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            sgn = 1.0 if con.b == step.links[0] else -1.0
+            q[n0:, 3 * step.links[0] + 2] += sgn * shift[con.driver]
     events = []
     for e in raw_events:
         e = dict(e)
@@ -921,6 +931,8 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPos
             e["message"] = "between the drawn configuration and the first input: " + e["message"]
             e["before_sweep"] = True
         e["index"] = max(0, e["index"] - n0)
+        if not e.get("before_sweep"):
+            e["input"] = (np.asarray(e["input"]) + shift).tolist()
         events.append(e)
     sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
     return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:], events)
@@ -945,7 +957,7 @@ def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray
 
 
 def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
-                  s_file: float, n0: int) -> tuple[np.ndarray, list, np.ndarray]:
+                  s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
     """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
     from scipy.optimize import brentq
 
@@ -1016,12 +1028,15 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         if any(abs(i - j) <= 2 and np.abs(u - v).max() < 1e-8 for j, v in touched):
             continue  # the same crossing seen from the neighbouring sample
         touched.append((i, u))
-        breaks.append((row, "flip"))
+        if not switch:
+            breaks.append((row, "flip"))
         events.append({"index": at, "kind": "singular", "input": u.tolist(), "group": group,
                        "crossed": not singular[i],
                        "message": f"change / branch point: the group {group} is folded flat here (its two "
-                                  "assembly modes meet); the motion continues on the branch whose velocity is "
-                                  "continuous (the drawn branch)"
+                                  "assembly modes meet); "
+                                  + ("the motion switches to the other branch (change_points='switch')" if switch
+                                     else "the motion continues on the branch whose velocity is continuous "
+                                          "(the drawn branch)")
                                   + ("; velocities and accelerations are not defined at this input (null)"
                                      if singular[i] else "")})
     sig = np.full(M, s_file)

@@ -155,7 +155,12 @@ def generic_free(S: PlanarSystem, q: np.ndarray | None = None, trials: int = 3) 
 
 def singular_configuration(S: PlanarSystem, q: np.ndarray | None = None) -> bool:
     """``Phi_q`` loses rank at ``q`` though the mechanism is determined in general position."""
-    q = S.q0 if q is None else q
+    if q is None:
+        memo = S.__dict__.get("_singular_drawn")
+        if memo is None:
+            memo = singular_configuration(S, S.q0)
+            object.__setattr__(S, "_singular_drawn", memo)
+        return memo
     return check_mobility(S, q)["free"] > 0 and generic_free(S, q) == 0
 
 
@@ -182,6 +187,9 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
     The file's configuration is first made exact by Newton, then followed continuously
     from its own input values to ``u`` (so the file chooses the assembly branch).
     """
+    memo = S.__dict__.get("_assembled")
+    if memo is not None:  # the checks below depend on the system only: done once per system
+        return memo.copy() if u is None else _reach(S, memo, u)
     u_asm = np.array([d.assembled for d in S.drivers])
     q, ok = newton(S, S.q0, u_asm, max_iter=30)
     src = S.mech.source or "<mechanism>"
@@ -197,8 +205,15 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
             f"by up to {moved:.3g}", source=src,
             hint="give joint points of one consistent configuration")
     _require_determined(S, q)
+    object.__setattr__(S, "_assembled", q.copy())
     if u is None:
         return q
+    return _reach(S, q, u)
+
+
+def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Follow the drawn configuration ``q`` to the inputs ``u``."""
+    u_asm = np.array([d.assembled for d in S.drivers])
     qq = _track(S, q, u_asm, np.asarray(u, float), depth=14)
     if qq is None:
         raise MechsynInputError("the mechanism cannot reach the requested input from its file configuration",
