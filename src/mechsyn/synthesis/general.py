@@ -45,6 +45,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
+from mechsyn.limits import limit, limit_hint
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
@@ -129,11 +130,10 @@ def load_case(path: str | Path) -> MechanismCase:
 
 
 def _floats(v: Any, src: str, fld: str, n: int | None = None) -> np.ndarray:
-    try:
-        a = np.asarray(v, float)
-    except (TypeError, ValueError):
-        raise _err(f"{fld} must be numbers", src, fld) from None
-    if not np.all(np.isfinite(a)) or (n is not None and a.shape[-1:] != (n,)):
+    from mechsyn.io.checks import numbers
+
+    a = numbers(v, src, fld)
+    if n is not None and a.shape[-1:] != (n,):
         raise _err(f"{fld} must be finite numbers" + (f", {n} per entry" if n else ""), src, fld)
     return a
 
@@ -181,9 +181,15 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
         if r.shape != (2,) or not r[0] < r[1]:
             raise _err("input.range_deg must be [lower, upper] with lower < upper", src, "input.range_deg")
         rng = (float(r[0]), float(r[1]))
-    step = float(data.get("step_deg", 2.0))
-    if not step > 0:
-        raise _err("step_deg must be positive", src, "step_deg")
+    step = _floats(data.get("step_deg", 2.0), src, "step_deg").reshape(-1)
+    if step.shape != (1,) or not step[0] > 0:
+        raise _err("step_deg must be a positive number", src, "step_deg")
+    step = float(step[0])
+    sweep = (float(np.sum(np.abs(np.diff(values)))) + 360.0) / step  # at most this many positions
+    if sweep > limit("sweep_points"):
+        raise _err(f"step_deg {step:g} makes a sweep of up to {sweep:,.0f} positions per design, more than "
+                   f"the limit of {limit('sweep_points'):,}", src, "step_deg",
+                   "use step_deg of about 0.5 to 5; " + limit_hint("sweep_points"))
     method = str(data.get("method", "auto"))
     if method not in ("auto", "newton"):
         raise _err("method must be auto or newton", src, "method")
@@ -228,9 +234,12 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
         f = f"variables[{k}]"
         if not isinstance(v, dict) or "lower" not in v or "upper" not in v:
             raise _err("a variable needs `lower` and `upper`", src, f)
-        lo, hi = float(v["lower"]), float(v["upper"])
-        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        lo, hi = _floats([v["lower"], v["upper"]], src, f)
+        if not lo < hi:
             raise _err("a variable needs finite bounds with lower < upper", src, f)
+        if max(abs(lo), abs(hi)) > limit("coordinate"):
+            raise _err(f"bounds [{lo:g}, {hi:g}] are beyond ±{limit('coordinate'):g}: distances would overflow",
+                       src, f, "give bounds of the size of the mechanism")
         if "point" in v:
             kind, tgt = "point", str(v["point"])
             if tgt not in names_pts:
