@@ -176,6 +176,7 @@ def main() -> None:
         (ca, CPU["last"]))
 
     n = args.atlas_links
+    os.environ["MECHSYN_LIMIT_ATLAS_LINKS"] = str(max(n, 12))  # beyond the CLI's default limit
     one, t1 = run([PY, "-c", ATLAS, str(n), "1"], new, 1)
     two, t2 = run([PY, "-c", ATLAS, str(n), "2"], new, 1)
     c1, c2 = json.loads(t1), json.loads(t2)
