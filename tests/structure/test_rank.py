@@ -324,8 +324,8 @@ def test_cli_json_keeps_keys_and_adds_rank(capsys):
                 "redundant_directions", "drives_needed", "actuation_determined", "singular", "tolerance"):
         assert key in rank
     assert new["mobility"] == rank["useful_mobility"] == 3
-    assert rank["idle_mobilities"] == [{"link": "link6", "joints": ["F3", "D3"],
-                                       "description": rank["idle_mobilities"][0]["description"]}]
+    assert [{k: i[k] for k in ("link", "joints", "links", "family")} for i in rank["idle_mobilities"]] == [
+        {"link": "link6", "joints": ["F3", "D3"], "links": ["link6"], "family": "group"}]
     assert old["rank"] is None
 
 

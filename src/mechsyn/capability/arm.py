@@ -24,11 +24,11 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Annotated, Literal, Union
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
 from mechsyn.errors import MechsynInputError
@@ -204,7 +204,7 @@ class SerialArm:
             theta, reach = self._planar_angles(q)
             return self.base + np.stack(
                 [(reach * np.cos(theta)).sum(-1), (reach * np.sin(theta)).sum(-1)], -1)
-        return self._frames(q)[-1][:, :3, 3]
+        return self._frames(q)[1][-1]
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Jacobian of the tool point's velocity, shape (N, task_dim, n).
@@ -213,10 +213,28 @@ class SerialArm:
         absolute link angles ``th_k = q_1 + ... + q_k``; of a P joint, the unit vector of
         its link. Spatial: ``z_i x (p - o_i)`` for R joints, ``z_i`` for P joints.
         """
+        return self.fk_and_jacobian(q)[1]
+
+    def fk_and_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`fk` and :meth:`jacobian` together, the joint frames computed once.
+
+        Returns the tool points (N, task_dim) and the Jacobians (N, task_dim, n); the
+        inner loop of :func:`ik_numeric`.
+
+        Examples
+        --------
+        >>> arm = arm_from_dict({"kind": "planar_serial", "link_lengths": [1.0, 1.0],
+        ...                      "joint_speed_limits_deg_s": [10, 10]})
+        >>> p, J = arm.fk_and_jacobian(np.array([[0.0, np.pi / 2]]))
+        >>> np.round(p, 12).tolist(), np.round(J[0], 12).tolist()
+        ([[1.0, 1.0]], [[-1.0, -1.0], [1.0, 0.0]])
+        """
         q = np.atleast_2d(np.asarray(q, float))
         if self.kind == "planar":
             theta, reach = self._planar_angles(q)
             vx, vy = -reach * np.sin(theta), reach * np.cos(theta)
+            p = self.base + np.stack(
+                [(reach * np.cos(theta)).sum(-1), (reach * np.sin(theta)).sum(-1)], -1)
             # suffix sums: column i gets links i..n-1 (all links move with an R joint i)
             cx = np.cumsum(vx[:, ::-1], axis=1)[:, ::-1]
             cy = np.cumsum(vy[:, ::-1], axis=1)[:, ::-1]
@@ -225,27 +243,33 @@ class SerialArm:
             if prism.any():
                 J[:, 0, prism] = np.cos(theta[:, prism])
                 J[:, 1, prism] = np.sin(theta[:, prism])
-            return J
-        return self.geometric_jacobian(q)[:, :3, :]
+            return p, J
+        J, p = self._geometric_jacobian(self._frames(q))
+        return p, J[:, :3, :]
 
     def geometric_jacobian(self, q: np.ndarray) -> np.ndarray:
         """Spatial arms: (N, 6, n) Jacobian, rows (v_x, v_y, v_z, w_x, w_y, w_z)."""
         if self.kind == "planar":
             raise ValueError("geometric_jacobian is for spatial arms")
         q = np.atleast_2d(np.asarray(q, float))
-        frames = self._frames(q)
-        p = frames[-1][:, :3, 3]
-        J = np.zeros((q.shape[0], 6, self.n))
+        return self._geometric_jacobian(self._frames(q))[0]
+
+    def _geometric_jacobian(self, frames: tuple[list, list]) -> tuple[np.ndarray, np.ndarray]:
+        """(N, 6, n) Jacobian from the joint frames (:meth:`_frames`), and the tool point."""
+        Rs, ps = frames
+        p = ps[-1]
+        J = np.zeros((p.shape[0], 6, self.n))
         for i in range(self.n):
-            Ti = frames[i]  # joint i's frame (before its motion)
-            z = Ti[:, :3, :3] @ self.axes[i]
-            o = Ti[:, :3, 3]
+            z = Rs[i] @ self.axes[i]  # joint axis in the base frame
             if self.joint_types[i] == "R":
-                J[:, :3, i] = np.cross(z, p - o)
+                r = p - ps[i]
+                J[:, 0, i] = z[:, 1] * r[:, 2] - z[:, 2] * r[:, 1]  # z x (p - o)
+                J[:, 1, i] = z[:, 2] * r[:, 0] - z[:, 0] * r[:, 2]
+                J[:, 2, i] = z[:, 0] * r[:, 1] - z[:, 1] * r[:, 0]
                 J[:, 3:, i] = z
             else:
                 J[:, :3, i] = z
-        return J
+        return J, p
 
     def _planar_angles(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         rev = self.is_revolute
@@ -253,21 +277,43 @@ class SerialArm:
         reach = self.link_lengths + np.where(rev, 0.0, q)
         return theta, reach
 
-    def _frames(self, q: np.ndarray) -> list[np.ndarray]:
-        """Frames (N, 4, 4) of joints 1..n (before their motion) and of the tool."""
-        N = q.shape[0]
-        T = np.broadcast_to(self.fixed[0], (N, 4, 4)).copy()
-        frames = []
+    @cached_property
+    def _motion_terms(self) -> list[tuple[np.ndarray, ...]]:
+        """Per joint, ``M_i(q) F_i`` as ``A0 + sin(q) A1 + (1 - cos q) A2`` (rotation
+        and translation parts; Rodrigues with ``K`` the axis' cross-product matrix)."""
+        terms = []
         for i in range(self.n):
-            frames.append(T)
-            M = np.broadcast_to(np.eye(4), (N, 4, 4)).copy()
+            F = self.fixed[i + 1]
+            k = self.axes[i]
+            K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+            K2 = K @ K
+            terms.append((F[:3, :3], K @ F[:3, :3], K2 @ F[:3, :3],
+                          F[:3, 3], K @ F[:3, 3], K2 @ F[:3, 3]))
+        return terms
+
+    def _frames(self, q: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """Rotations (N, 3, 3) and origins (N, 3) of the frames of joints 1..n (before
+        their motion) and of the tool: ``T = F_0 M_1(q_1) F_1 ... M_n(q_n) F_n``."""
+        N = q.shape[0]
+        R = np.broadcast_to(self.fixed[0][:3, :3], (N, 3, 3))
+        p = np.broadcast_to(self.fixed[0][:3, 3], (N, 3))
+        Rs, ps = [], []
+        for i, (A0, A1, A2, b0, b1, b2) in enumerate(self._motion_terms):
+            Rs.append(R)
+            ps.append(p)
             if self.joint_types[i] == "R":
-                M[:, :3, :3] = _rot(self.axes[i], q[:, i])
+                s = np.sin(q[:, i])[:, None]
+                c = 1.0 - np.cos(q[:, i])[:, None]
+                C = A0 + s[:, :, None] * A1 + c[:, :, None] * A2
+                t = b0 + s * b1 + c * b2
             else:
-                M[:, :3, 3] = self.axes[i] * q[:, i][:, None]
-            T = T @ M @ self.fixed[i + 1]
-        frames.append(T)
-        return frames
+                C = A0
+                t = b0 + q[:, i][:, None] * self.axes[i]
+            p = p + (R @ t[:, :, None])[:, :, 0]
+            R = R @ C
+        Rs.append(R)
+        ps.append(p)
+        return Rs, ps
 
 
 # --------------------------------------------------------------------------- building
@@ -305,20 +351,14 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
 
 def load_arm(path: str | Path) -> SerialArm:
     """Read an arm file (YAML or JSON); :class:`MechsynInputError` on bad input."""
+    from mechsyn.io.files import parse_data, read_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MechsynInputError(f"cannot read arm file: {exc.strerror}", source=str(path)) from None
+    text = read_text(path, "arm file")
     if path.suffix.lower() == ".urdf" or text.lstrip().startswith("<"):
         return arm_from_dict({"kind": "urdf", "urdf": path.name, "name": path.stem},
                              source=str(path), base_dir=path.parent)
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        line = getattr(getattr(exc, "problem_mark", None), "line", None)
-        raise MechsynInputError("not valid YAML/JSON", source=str(path),
-                                line=None if line is None else line + 1) from None
+    data = parse_data(text, str(path), fmt="yaml")
     return arm_from_dict(data, source=str(path), base_dir=path.parent)
 
 
@@ -497,29 +537,49 @@ def ik_numeric(arm: SerialArm, point, seeds: np.ndarray, *, fixed_first: bool = 
 
     ``q <- q + J^T (J J^T + lambda^2 I)^-1 (p* - p(q))``, clipped to the limits when
     ``respect_limits``; with ``fixed_first`` joint 1 keeps its seed value (the redundancy
-    parameter of paper 004). Returns ``q`` (K, n) and ``converged`` (K,): end point error
-    below ``tol`` times the arm's size.
+    parameter of paper 004). ``point`` is one target (task_dim,) or one per seed
+    (K, task_dim), so the seeds of many grid points run together.
+
+    Every seed iterates on its own: it stops as soon as its end point error is below
+    ``tol`` times the arm's size (or when an iteration no longer changes it, e.g. held
+    by a joint limit), so its answer does not depend on the other seeds of the batch.
+
+    Returns ``q`` (K, n) and ``converged`` (K,).
+
+    Examples
+    --------
+    >>> arm = arm_from_dict({"kind": "planar_serial", "link_lengths": [1.0, 1.0],
+    ...                      "joint_speed_limits_deg_s": [10, 10]})
+    >>> q, ok = ik_numeric(arm, [[1.0, 1.0], [0.0, 1.5]], [[0.1, 1.0], [1.0, 0.5]])
+    >>> bool(ok.all()), bool(np.abs(arm.fk(q) - [[1.0, 1.0], [0.0, 1.5]]).max() < 1e-6)
+    (True, True)
     """
     q = np.array(np.atleast_2d(seeds), float)
-    target = np.asarray(point, float)
+    K = q.shape[0]
+    target = np.broadcast_to(np.asarray(point, float), (K, arm.task_dim))
     scale = max(_arm_size(arm), 1e-12)
     lam = 1e-3 * scale
     lo = np.where(np.isfinite(arm.lower), arm.lower, -np.inf)
     hi = np.where(np.isfinite(arm.upper), arm.upper, np.inf)
-    m = arm.task_dim
+    damping = lam**2 * np.eye(arm.task_dim)
+    active = np.arange(K)
     for _ in range(iterations):
-        e = target - arm.fk(q)
-        if np.all(np.linalg.norm(e, axis=1) < tol * scale):
+        p, J = arm.fk_and_jacobian(q[active])
+        e = target[active] - p
+        pending = np.linalg.norm(e, axis=1) >= tol * scale
+        active, e, J = active[pending], e[pending], J[pending]
+        if not active.size:
             break
-        J = arm.jacobian(q)
         if fixed_first:
-            J = J.copy()
             J[:, :, 0] = 0.0
-        JJt = J @ np.swapaxes(J, 1, 2) + lam**2 * np.eye(m)
+        JJt = J @ np.swapaxes(J, 1, 2) + damping
         dq = np.einsum("kmn,km->kn", J, np.linalg.solve(JJt, e[:, :, None])[:, :, 0])
-        q = q + dq
-        if respect_limits:
-            q = np.clip(q, lo, hi)
+        old = q[active]
+        new = np.clip(old + dq, lo, hi) if respect_limits else old + dq
+        q[active] = new
+        active = active[np.any(new != old, axis=1)]  # a seed that no longer moves is done
+        if not active.size:
+            break
     err = np.linalg.norm(target - arm.fk(q), axis=1)
     return q, err < tol * scale
 

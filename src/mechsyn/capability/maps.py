@@ -14,8 +14,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
-from scipy.stats import qmc
 
 from mechsyn._result import Result
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
@@ -73,38 +71,93 @@ def self_motion(arm: SerialArm, point, q1: np.ndarray | None = None, branch: str
     Planar 3R: exact IK for each ``q1`` (radians) and each elbow of ``branch``
     (``negative``: q3 < 0, paper 004's table; ``positive``; ``both``). Other arms: damped
     least squares from ``seeds`` quasi-random starts (joint 1 fixed at each ``q1`` when
-    given), duplicates removed. Returns ``q`` (K, n) and ``valid`` (K,): reached and, when
-    ``respect_limits``, inside the joint limits.
+    given), duplicates removed (:func:`self_motions`). Returns ``q`` (K, n) and ``valid``
+    (K,): reached and, when ``respect_limits``, inside the joint limits.
     """
     if branch not in BRANCHES:
         raise ValueError(f"branch must be one of {', '.join(BRANCHES)}")
-    if is_closed_form(arm):
-        if q1 is None:
-            lo, hi = q1_range(arm, respect_limits)
-            q1 = np.arange(lo, hi + 1e-9, math.radians(20.0))
-        qs, oks = [], []
-        for b in BRANCHES[branch]:
-            q, ok = ik_planar_3r(arm, point, q1, b)
-            qs.append(q)
-            oks.append(ok)
-        q, ok = np.concatenate(qs), np.concatenate(oks)
-    else:
-        lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-        hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
-        start = qmc.scale(qmc.Halton(d=arm.n, scramble=False).random(seeds + 1)[1:], lo, hi)
-        if q1 is not None:
-            q1 = np.atleast_1d(q1)
-            start = np.repeat(start, q1.size, axis=0)
-            start[:, 0] = np.tile(q1, seeds)
-        q, ok = ik_numeric(arm, point, start, fixed_first=q1 is not None,
-                           respect_limits=respect_limits)
-        q, ok = q[ok], ok[ok]
-        if len(q):  # the same configuration up to full turns of R joints counts once
-            key = np.where(arm.is_revolute, (q + math.pi) % (2 * math.pi) - math.pi, q)
-            _, keep = np.unique(np.round(key, 4), axis=0, return_index=True)
-            q, ok = q[np.sort(keep)], ok[np.sort(keep)]
+    if not is_closed_form(arm):
+        return self_motions(arm, np.atleast_2d(np.asarray(point, float)), q1,
+                            respect_limits, seeds)[0]
+    if q1 is None:
+        lo, hi = q1_range(arm, respect_limits)
+        q1 = np.arange(lo, hi + 1e-9, math.radians(20.0))
+    qs, oks = [], []
+    for b in BRANCHES[branch]:
+        q, ok = ik_planar_3r(arm, point, q1, b)
+        qs.append(q)
+        oks.append(ok)
+    q, ok = np.concatenate(qs), np.concatenate(oks)
     valid = ok & (arm.within_limits(np.nan_to_num(q)) if respect_limits else True)
     return q, valid
+
+
+def halton(count: int, dim: int) -> np.ndarray:
+    """Points 1..count of the unscrambled Halton sequence in ``[0, 1)^dim``.
+
+    Coordinate j is the radical inverse of the index in the j-th prime base (Halton 1960);
+    the same numbers as ``scipy.stats.qmc.Halton(d=dim, scramble=False).random(count +
+    1)[1:]``, without the 0.9 s import of :mod:`scipy.stats`.
+
+    References
+    ----------
+    J. H. Halton, "On the efficiency of certain quasi-random sequences of points in
+    evaluating multi-dimensional integrals", Numerische Mathematik 2, 84-90, 1960.
+
+    Examples
+    --------
+    >>> halton(3, 2).tolist()
+    [[0.5, 0.3333333333333333], [0.25, 0.6666666666666666], [0.75, 0.1111111111111111]]
+    """
+    primes: list[int] = []
+    k = 2
+    while len(primes) < dim:
+        if all(k % p for p in primes):
+            primes.append(k)
+        k += 1
+    out = np.zeros((count, dim))
+    for j, base in enumerate(primes):
+        i = np.arange(1, count + 1)
+        f = 1.0
+        while i.any():
+            f /= base
+            out[:, j] += f * (i % base)
+            i //= base
+    return out
+
+
+def self_motions(arm: SerialArm, points: np.ndarray, q1: np.ndarray | None = None,
+                 respect_limits: bool = True, seeds: int = 64
+                 ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`self_motion` of a numerically solved arm at many ``points`` (P, task_dim).
+
+    The ``seeds`` starts of every point run through one vectorised damped least squares
+    (:func:`ik_numeric`, each seed stopping when it has converged); the answers are
+    those of solving each point alone. Returns one ``(q, valid)`` per point.
+    """
+    points = np.atleast_2d(np.asarray(points, float))
+    P = points.shape[0]
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    start = lo + halton(seeds, arm.n) * (hi - lo)
+    if q1 is not None:
+        q1 = np.atleast_1d(q1)
+        start = np.repeat(start, q1.size, axis=0)
+        start[:, 0] = np.tile(q1, seeds)
+    S = start.shape[0]
+    q, ok = ik_numeric(arm, np.repeat(points, S, axis=0), np.tile(start, (P, 1)),
+                       fixed_first=q1 is not None, respect_limits=respect_limits)
+    out = []
+    for k in range(P):
+        qk, okk = q[k * S:(k + 1) * S], ok[k * S:(k + 1) * S]
+        qk, okk = qk[okk], okk[okk]
+        if len(qk):  # the same configuration up to full turns of R joints counts once
+            key = np.where(arm.is_revolute, (qk + math.pi) % (2 * math.pi) - math.pi, qk)
+            _, keep = np.unique(np.round(key, 4), axis=0, return_index=True)
+            qk, okk = qk[np.sort(keep)], okk[np.sort(keep)]
+        valid = okk & (arm.within_limits(np.nan_to_num(qk)) if respect_limits else True)
+        out.append((qk, valid))
+    return out
 
 
 def _golden_max(f: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
@@ -178,37 +231,42 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
     Pattern search in the null space of J: each iteration tries ``q +/- h v_j`` for every
     null-space basis vector ``v_j`` (from the SVD of J), pulls each trial back onto the
     point with damped least squares (:func:`ik_numeric`), keeps the best improving one
-    (within the limits), and halves ``h`` where nothing improves. Vectorised over the K
-    starts; deterministic. Returns the refined ``q`` (K, n) and their measure (K,).
+    (within the limits), and halves ``h`` where nothing improves; a start whose ``h``
+    falls below 1e-6 is done. Vectorised over the K starts, each independent of the
+    others; deterministic. ``point`` is one (task_dim,) or one per start (K, task_dim),
+    so the starts of many grid points run together. Returns the refined ``q`` (K, n)
+    and their measure (K,).
     """
     q = np.atleast_2d(np.asarray(q0, float)).copy()
     K, n = q.shape
+    r = arm.task_dim
+    target = np.broadcast_to(np.asarray(point, float), (K, r))
     val = measure_values(arm, q, direction, measure)
     h = np.full(K, step)
+    active = np.arange(K) if n > r else np.arange(0)
     for _ in range(iterations):
-        J = arm.jacobian(q)
-        _, S, Vt = np.linalg.svd(J)
-        r = arm.task_dim
-        null = Vt[:, r:, :]  # (K, n - r, n)
-        if null.shape[1] == 0:
+        if not active.size:
             break
-        moves = np.concatenate([null, -null], axis=1) * h[:, None, None]  # (K, T, n)
+        qa = q[active]
+        A = qa.shape[0]
+        _, _, Vt = np.linalg.svd(arm.jacobian(qa))
+        null = Vt[:, r:, :]  # (A, n - r, n)
+        moves = np.concatenate([null, -null], axis=1) * h[active][:, None, None]  # (A, T, n)
         T = moves.shape[1]
-        trial = (q[:, None, :] + moves).reshape(-1, n)
-        trial, ok = ik_numeric(arm, point, trial, respect_limits=respect_limits,
-                               iterations=30, tol=1e-9)
+        trial, ok = ik_numeric(arm, np.repeat(target[active], T, axis=0),
+                               (qa[:, None, :] + moves).reshape(-1, n),
+                               respect_limits=respect_limits, iterations=30, tol=1e-9)
         tv = measure_values(arm, trial, direction, measure)
         if respect_limits:
             ok &= arm.within_limits(trial)
-        tv = np.where(ok, tv, -np.inf).reshape(K, T)
+        tv = np.where(ok, tv, -np.inf).reshape(A, T)
         k = np.argmax(tv, axis=1)
-        best = tv[np.arange(K), k]
-        better = best > val + 1e-12 * np.abs(val)
-        q[better] = trial.reshape(K, T, n)[np.arange(K), k][better]
-        val = np.where(better, best, val)
-        h = np.where(better, h, h / 2)
-        if np.all(h < 1e-6):
-            break
+        best = tv[np.arange(A), k]
+        better = best > val[active] + 1e-12 * np.abs(val[active])
+        q[active[better]] = trial.reshape(A, T, n)[np.arange(A), k][better]
+        val[active] = np.where(better, best, val[active])
+        h[active] = np.where(better, h[active], h[active] / 2)
+        active = active[h[active] >= 1e-6]
     return q, val
 
 
@@ -240,15 +298,39 @@ class CapabilityMap(Result):
                 "measure": self.measure, "search": self.search,
                 "v_max": v, "q_opt": self.q_user(), "joints": list(self.joint_names)}
 
+    def table(self) -> np.ndarray:
+        """Rows ``x, y, v_max, q...`` (x outer, y inner), shape (P, 3 + n); NaN where no
+        allowed configuration reaches."""
+        X, Y = np.meshgrid(self.xs, self.ys, indexing="ij")
+        v = np.where(np.isfinite(self.value), self.value, np.nan)
+        n = self.q.shape[-1]
+        return np.column_stack([X.ravel(), Y.ravel(), v.ravel(), self.q_user().reshape(-1, n)])
+
     def rows(self) -> list[list[float]]:
-        """CSV rows ``x, y, v_max, q...`` (x outer, y inner)."""
-        qu = self.q_user()
-        out = []
-        for i, x in enumerate(self.xs):
-            for j, y in enumerate(self.ys):
-                v = self.value[i, j]
-                out.append([x, y, v if np.isfinite(v) else np.nan, *qu[i, j]])
-        return out
+        """:meth:`table` as a list of rows."""
+        return self.table().tolist()
+
+    def to_csv(self) -> str:
+        """CSV text: a header ``x, y, v_max_<measure>, <joint>_opt...`` and :meth:`table`,
+        each number the shortest text that reads back to the same float (as ``repr``),
+        empty where not reachable. Formatted from the arrays, no Python loop per value.
+
+        Examples
+        --------
+        >>> m = CapabilityMap(np.array([0.0, 1.0]), np.array([2.0]), None, np.array([1.0, 0]),
+        ...                   "exact", "sampled", np.array([[0.5], [-np.inf]]),
+        ...                   np.array([[[0.1]], [[np.nan]]]), ("q1",), np.array([False]))
+        >>> print(m.to_csv(), end="")
+        x,y,v_max_exact,q1_opt
+        0.0,2.0,0.5,0.1
+        1.0,2.0,,
+        """
+        cells = self.table().astype(str)
+        cells[cells == "nan"] = ""
+        head = ["x", "y", f"v_max_{self.measure}", *[f"{n}_opt" for n in self.joint_names]]
+        lines = [",".join(head)]
+        lines.extend(",".join(row) for row in cells.tolist())
+        return "\n".join(lines) + "\n"
 
 
 def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
@@ -298,17 +380,8 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
             rows = np.arange(vv.shape[0])
             value[sl], qopt[sl] = vv[rows, k], qq[rows, k]
         else:
-            for p in range(sl.start, sl.stop):
-                q, valid = self_motion(arm, pts[p], q1, branch, respect_limits)
-                if valid.any():
-                    q = q[valid]
-                    v = measure_values(arm, q, direction, measure)
-                    if continuous:
-                        top = np.argsort(-v, kind="stable")[:8]
-                        q, v = refine_over_self_motion(arm, pts[p], q[top], direction,
-                                                       measure, respect_limits)
-                    k = int(np.argmax(v))
-                    value[p], qopt[p] = v[k], q[k]
+            value[sl], qopt[sl] = _numeric_best(arm, pts[sl], direction, measure, q1,
+                                                respect_limits, continuous)
         if advance is not None:
             advance(sl.stop - sl.start)
     qopt[~np.isfinite(value)] = np.nan
@@ -317,6 +390,35 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
                          "continuous" if continuous else "sampled",
                          value.reshape(X.shape), qopt.reshape(*X.shape, arm.n),
                          arm.joint_names, arm.is_revolute)
+
+
+def _numeric_best(arm: SerialArm, pts: np.ndarray, direction, measure: str, q1,
+                  respect_limits: bool, continuous: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Best measure (P,) and configuration (P, n) at points of a numerically solved arm:
+    all points' IK together (:func:`self_motions`), then, with ``continuous``, the best
+    8 configurations of every point refined together (:func:`refine_over_self_motion`)."""
+    P = pts.shape[0]
+    value = np.full(P, -np.inf)
+    qopt = np.full((P, arm.n), np.nan)
+    found = [q[valid] for q, valid in self_motions(arm, pts, q1, respect_limits)]
+    sizes = np.array([len(q) for q in found])
+    if not sizes.any():
+        return value, qopt
+    owner = np.repeat(np.arange(P), sizes)
+    q = np.concatenate(found)
+    v = measure_values(arm, q, direction, measure)
+    if continuous:  # the best 8 of each point, in the order of a stable sort
+        order = np.lexsort((np.arange(len(v)), -v, owner))
+        rank = np.arange(len(v)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+        top = order[rank < 8]
+        owner = owner[top]
+        q, v = refine_over_self_motion(arm, pts[owner], q[top], direction, measure,
+                                       respect_limits)
+    for k in np.unique(owner):  # first maximum of each point, as np.argmax
+        rows = np.flatnonzero(owner == k)
+        best = rows[np.argmax(v[rows])]
+        value[k], qopt[k] = v[best], q[best]
+    return value, qopt
 
 
 def interpolate_configuration(cmap: CapabilityMap, method: str = "cubic"
@@ -328,6 +430,8 @@ def interpolate_configuration(cmap: CapabilityMap, method: str = "cubic"
     so check the interpolated configuration with forward kinematics before use.
     """
     q = cmap.q
+    from scipy.interpolate import RegularGridInterpolator  # lazy: 0.5 s of start-up
+
     interp = RegularGridInterpolator((cmap.xs, cmap.ys), q, method=method,
                                      bounds_error=False, fill_value=np.nan)
 

@@ -27,8 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog
-from scipy.spatial import ConvexHull, QhullError
 
 # relative tolerance for "this facet normal is perpendicular to d" (round-off level)
 _PERP_TOL = 1e-12
@@ -94,12 +92,17 @@ def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarr
     subsets = np.array(list(combinations(range(n), m - 1)))  # (C, m-1)
     if subsets.size == 0:
         return exact_limit_lp(J, w, d)
-    sub = G[:, :, subsets]  # (N, m, C, m-1)
-    sub = np.moveaxis(sub, 2, 1)  # (N, C, m, m-1)
-    normals = np.empty((N, m, subsets.shape[0]))
-    for r in range(m):
-        minor = np.delete(sub, r, axis=2)  # (N, C, m-1, m-1)
-        normals[:, r, :] = (-1) ** r * np.linalg.det(minor)
+    if m == 3:  # cross products g_i x g_j of the generator pairs
+        a, b = G[:, :, subsets[:, 0]], G[:, :, subsets[:, 1]]  # (N, 3, C)
+        normals = np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+                            a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                            a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], 1)
+    else:
+        sub = np.moveaxis(G[:, :, subsets], 2, 1)  # (N, C, m, m-1)
+        normals = np.empty((N, m, subsets.shape[0]))
+        for r in range(m):
+            minor = np.delete(sub, r, axis=2)  # (N, C, m-1, m-1)
+            normals[:, r, :] = (-1) ** r * np.linalg.det(minor)
     normals = np.concatenate([normals, G], axis=2)
     out = _limit_from_normals(G, normals, d)
     sv = np.linalg.svd(G, compute_uv=False)
@@ -115,6 +118,8 @@ def exact_limit_lp(J, w, d) -> np.ndarray:
     ``max s`` over ``(q_dot, s)`` s.t. ``J q_dot - s d = 0``, ``-w <= q_dot <= w``,
     ``s >= 0`` (scipy.optimize.linprog, HiGHS). Any task dimension.
     """
+    from scipy.optimize import linprog  # lazy: 0.5 s of start-up
+
     J, w, d = _prep(J, w, d)
     N, m, n = J.shape
     out = np.zeros(N)
@@ -210,6 +215,8 @@ def velocity_polytope(J, w) -> VelocityPolytope:
     singular configurations give a flat polytope with equality rows. Facet offsets are
     the support values ``h(n) = sum_i |n . g_i|``.
     """
+    from scipy.spatial import ConvexHull, QhullError  # lazy: start-up
+
     J = np.asarray(J, float)
     m, n = J.shape
     G = J * np.asarray(w, float)

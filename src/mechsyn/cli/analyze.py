@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -11,13 +12,13 @@ from rich.panel import Panel
 from rich.table import Table
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json
+from mechsyn.cli.common import console, emit_json, err_console
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis
 from mechsyn.structure.rank import Comparison, RankAnalysis, RemedyCheck, rank_summary_lines
 from mechsyn.structure.remedies import Remedy
-from mechsyn.structure.report import StructureReport, pair_list
+from mechsyn.structure.report import CONTOUR_READING, StructureReport, formula_title, pair_list
 from mechsyn.structure.report import analyze as structure_report
 
 
@@ -45,10 +46,10 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
     t.add_column("expression", no_wrap=True)
     t.add_column("value", justify="right")
     for key, f in a.formulas.items():
-        t.add_row(SHORT_TITLES.get(key, key), f.expression, _fmt(f.value))
+        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, _fmt(f.value))
     console.print(t)
     if a.contours:
-        c = Table(title="Contours (paper 003, sequential reading)")
+        c = Table(title=f"Contours (paper 003, sequential reading{CONTOUR_READING[a.kind]})")
         for col in ("#", "joints", "new pairs", "n_j", "n_k", "S_j", "idle", "T_j", "Z_j", "A_j"):
             c.add_column(col, justify="right" if col not in ("joints", "new pairs") else "left")
         for r in a.contours:
@@ -60,7 +61,7 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         for r in a.contours:
             console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
     console.print(
-        f"S_Σ = {a.structural_redundancy} ({a.redundant_constraints} redundant constraints, "
+        f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
         f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
         soft_wrap=True)
@@ -136,6 +137,25 @@ def render_remedy_checks(checks: list[tuple[int, Remedy, RemedyCheck]]) -> None:
         console.print(f"  - {'; '.join(c.describe() for c in r.changes)}: [red]{chk.reason}[/]", highlight=False)
 
 
+#: From this many joints, ``analyze`` says the size and shows the rank method's stages on stderr.
+LARGE_JOINTS = 1000
+
+
+@contextmanager
+def _rank_progress(mech, method):
+    """For a large mechanism: say its size and yield a callback showing the rank method's stages."""
+    if method == "formulas" or len(mech.joints) < LARGE_JOINTS:
+        yield None
+        return
+    from mechsyn.structure.contours import cycle_rank
+
+    err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
+                      f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
+                      f"of loops (2,000 joints: a few seconds)", highlight=False)
+    with err_console.status("rank method") as status:
+        yield lambda stage: status.update(f"rank method: {stage}")
+
+
 @app.command("analyze")
 def analyze(
     file: Annotated[Path, typer.Argument(help="Mechanism file (YAML or JSON).")],
@@ -154,8 +174,10 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
-    report = structure_report(load_mechanism(file), method=method, remedies=remedies,
-                              max_variants=max_variants, tol=tol, as_spatial=spatial)
+    mech = load_mechanism(file)
+    with _rank_progress(mech, method) as progress:
+        report = structure_report(mech, method=method, remedies=remedies, max_variants=max_variants, tol=tol,
+                                  as_spatial=spatial, progress=progress)
     if json_out:
         emit_json(report.to_dict(), out)
     elif markdown:

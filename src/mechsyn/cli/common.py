@@ -23,13 +23,34 @@ console = Console()
 err_console = Console(stderr=True)
 
 
-def emit_json(obj: Any, out: Path | None = None) -> None:
-    """Print ``obj`` as JSON on stdout, or write it whole to ``out``."""
-    text = dumps(obj)
-    if out is None:
-        sys.stdout.write(text + "\n")
+STDOUT = "-"
+
+
+def is_stdout(path: Path | str | None) -> bool:
+    """Whether an output option names standard output (``-o -``)."""
+    return path is not None and str(path) == STDOUT
+
+
+def write_output(out: Path | str, text: str) -> None:
+    """Write ``text`` whole to the file ``out``, or to stdout when ``out`` is ``-``."""
+    if is_stdout(out):
+        sys.stdout.write(text)
+        sys.stdout.flush()
     else:
-        write_atomic(out, text + "\n")
+        write_atomic(out, text)
+
+
+def one_stdout(json_: bool, *outs: Path | str | None) -> None:
+    """Refuse two outputs to stdout (``--json`` and a ``-`` file, or two ``-`` files)."""
+    if int(bool(json_)) + sum(is_stdout(o) for o in outs) > 1:
+        raise MechsynInputError("two outputs to stdout", source="-",
+                                hint="send one of them to a file (or drop --json)")
+
+
+def emit_json(obj: Any, out: Path | None = None) -> None:
+    """Print ``obj`` as JSON on stdout, or write it whole to ``out`` (``-``: stdout)."""
+    text = dumps(obj)
+    write_output(STDOUT if out is None else out, text + "\n")
 
 
 #: The library's errors name its parameters (``MechsynInputError(field="tol")``); the command
@@ -73,7 +94,12 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
 
 def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
                         what: str | None = None) -> None:
-    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work)."""
+    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work).
+
+    ``-`` (standard output) passes for text formats (.csv, .json, .yaml, .md, .pyslvs, .svg).
+    """
+    if is_stdout(path) and set(suffixes) & {".csv", ".json", ".yaml", ".md", ".pyslvs", ".svg", ".txt"}:
+        return
     if path is not None and path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
 
@@ -170,6 +196,17 @@ def track(items: Iterable[T], description: str, total: int | None = None) -> Ite
         for item in items:
             yield item
             advance()
+
+
+def stop_if_interrupted(result: Any) -> None:
+    """Exit with status 130 (``interrupted``) when ``result`` says Ctrl-C ended it.
+
+    Called by a search command after it has written and shown its best result so far.
+    """
+    if getattr(result, "interrupted", False):
+        from mechsyn.interrupt import INTERRUPT_EXIT_CODE
+
+        raise typer.Exit(INTERRUPT_EXIT_CODE)
 
 
 def exit_with(error: MechsynInputError) -> None:

@@ -13,8 +13,8 @@ import importlib
 import sys
 from typing import Any
 
-import click
 import typer
+from typer.core import TyperCommand
 
 from mechsyn.cli import version as _version  # noqa: F401  (the root callback: --version)
 from mechsyn.cli.app import app
@@ -37,12 +37,18 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
               "their mechanisms."),
     "belt": (("belt",), "Paper 001's manipulator with a belt on a pulley: synthesis, paths, speeds, "
              "accelerations, the inverse problem."),
-    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism"),
-              "Synthesis: structural (groups, fingers) and dimensional (path, function, motion)."),
+    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism", "synth_curve"),
+              "Synthesis: structural (groups, fingers) and dimensional (path, function, motion, curve)."),
+    "curves": (("curves",), "The local curve database of curve synthesis."),
+    "serve": (("serve",), "Start mechsyn studio: draw, drag, analyse, animate and synthesise mechanisms in "
+              "the browser."),
+    "convert": (("convert",), "Convert a Pyslvs mechanism expression into a mechanism file, or back."),
+    "export": (("export",), "Link plates with joint holes, laid out flat on a sheet, for a laser cutter or "
+               "CNC."),
 }
 
 
-def _load(name: str) -> click.Command:
+def _load(name: str) -> Any:
     """Import the modules of command ``name`` and return its click command."""
     modules, _ = COMMANDS[name]
     for m in modules:
@@ -55,23 +61,21 @@ def _load(name: str) -> click.Command:
     return group.commands[name]  # type: ignore[attr-defined]
 
 
-class _LazyCommand(click.Command):
+class _LazyCommand(TyperCommand):
     """Stands for a command whose module is not imported yet: lists itself with its help and
     hands parsing and running to the real command."""
 
     def __init__(self, name: str, help: str) -> None:
         super().__init__(name, help=help, short_help=help, add_help_option=False)
-        self.rich_help_panel = None
 
-    def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
-                     **extra: Any) -> click.Context:
+    def make_context(self, info_name: str | None, args: list[str], parent: Any = None, **extra: Any) -> Any:
         return _load(self.name).make_context(info_name, args, parent=parent, **extra)  # type: ignore[arg-type]
 
-    def to_info_dict(self, ctx: click.Context) -> dict[str, Any]:
+    def to_info_dict(self, ctx: Any) -> dict[str, Any]:
         return _load(self.name).to_info_dict(ctx)  # type: ignore[arg-type]
 
 
-def build_cli() -> click.Group:
+def build_cli() -> Any:
     """The root click group: eagerly registered commands plus the lazy ones."""
     group = typer.main.get_command(app)
     for name, (_, text) in COMMANDS.items():
@@ -81,9 +85,18 @@ def build_cli() -> click.Group:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; bad input exits with status 2 and one message."""
+    """Run the command line; bad input exits with status 2 and one message.
+
+    Ctrl-C exits with status 130 and prints ``interrupted`` (searches have written their
+    best result so far, marked as interrupted, before that).
+    """
+    interrupted = 130  # mechsyn.interrupt.INTERRUPT_EXIT_CODE (not imported: it loads NumPy)
     try:
-        build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
+        # typer turns KeyboardInterrupt (and typer.Exit(n) raised by a command) into a
+        # returned exit status when standalone_mode is off
+        status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
+    except KeyboardInterrupt:
+        status = interrupted
     except MechsynInputError as error:
         from rich.markup import escape
 
@@ -105,6 +118,10 @@ def main(argv: list[str] | None = None) -> int:
         if hasattr(exc, "exit_code"):  # Exit
             return _exit(int(exc.exit_code), argv)
         raise
+    if isinstance(status, int) and not isinstance(status, bool) and status != 0:
+        if status == interrupted:
+            print("interrupted", file=sys.stderr)
+        return _exit(status, argv)
     return _exit(0, argv)
 
 

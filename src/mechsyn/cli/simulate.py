@@ -13,11 +13,11 @@ from rich.markup import escape
 from rich.table import Table
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import (check_output_suffix, console, emit_json, parse_range, progress_bar, save_animation,
-                                save_plot)
+from mechsyn.cli.common import (check_output_suffix, console, emit_json, is_stdout, one_stdout, parse_range,
+                                progress_bar, save_animation, save_plot, write_output)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
-from mechsyn.results import to_jsonable, write_atomic
+from mechsyn.results import to_jsonable
 
 InputOpt = Annotated[list[str], typer.Option(
     "--input", "-i", help="Driven joint and its values: J=START:STOP:STEP (deg for R, length for P), "
@@ -121,6 +121,7 @@ def simulate_cmd(
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     check_output_suffix(animate, (".gif",), "--animate")
     check_output_suffix(csv_out, (".csv",), "--csv")
+    one_stdout(json_, csv_out)
     if method not in ("auto", "assur", "newton"):
         raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
     mech = load_mechanism(file)
@@ -173,13 +174,15 @@ def simulate_cmd(
         for name, lm in sim.links.items():
             header += [f"{name}_angle", f"{name}_omega", f"{name}_alpha"]
             cols += [lm.angle, lm.angular_velocity, lm.angular_acceleration]
-        write_atomic(csv_out, _csv_text(header, cols))
+        write_output(csv_out, _csv_text(header, cols))
     if plot is not None:
         from mechsyn.plot.kinematics import plot_simulation
         save_plot(plot, plot_simulation, sim)
     if animate is not None:
         from mechsyn.plot.kinematics import animate_simulation
         save_animation(animate, animate_simulation, sim, dpi=100)
+    if is_stdout(csv_out):
+        return
     if json_:
         emit_json(out)
         return
@@ -259,6 +262,7 @@ def forces_cmd(
 
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     check_output_suffix(csv_out, (".csv",), "--csv")
+    one_stdout(json_, csv_out)
     if not np.isfinite(gravity):
         raise MechsynInputError("gravity must be a finite number", source="--gravity")
     mech = load_mechanism(file)
@@ -279,10 +283,12 @@ def forces_cmd(
         for j, e in R.effort.items():
             header.append(f"drive_{j}_{R.effort_kind[j]}")
             cols.append(e)
-        write_atomic(csv_out, _csv_text(header, cols))
+        write_output(csv_out, _csv_text(header, cols))
     if plot is not None:
         from mechsyn.plot.kinematics import plot_forces
         save_plot(plot, plot_forces, fa)
+    if is_stdout(csv_out):
+        return
     if json_:
         emit_json(fa.to_dict())
         return

@@ -18,6 +18,8 @@ import yaml
 from pydantic import ValidationError
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import files
+from mechsyn.io.checks import check_geometry
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -33,63 +35,19 @@ from mechsyn.results import to_jsonable, write_atomic
 
 __all__ = [
     "load", "loads", "save", "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
-    "mechanism_to_dict", "write_mechanism", "read_data",
+    "mechanism_to_dict", "mechanism_text", "write_mechanism", "read_data",
 ]
-
-#: LibYAML's parser where PyYAML was built with it (several times faster), else PyYAML's own.
-_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-
-
-def safe_load_yaml(text: str) -> Any:
-    """``yaml.safe_load`` through LibYAML when available."""
-    return yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
-
 
 # --------------------------------------------------------------------------- reading
 def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
-    """Parse a YAML or JSON file (or a bundled example, by name) into Python data; return it
-    with its text."""
-    from mechsyn.examples import resolve
-
-    p = resolve(path)
-    if not p.exists():
-        raise MechsynInputError("no such file (nor a bundled example of that name)", source=str(p),
-                                hint="check the path; mechsyn.examples.names() lists the examples")
-    if p.is_dir():
-        raise MechsynInputError("is a directory, not a file", source=str(p))
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise MechsynInputError(
-            f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(p),
-            hint="save the file as UTF-8 YAML or JSON",
-        ) from None
-    return parse_text(text, str(p)), text
+    """Parse a YAML or JSON file into Python data; return it with its text
+    (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
+    return files.read_data(path)
 
 
 def parse_text(text: str, source: str) -> Any:
     """Parse YAML (or JSON, when the source ends in .json) text."""
-    if source.lower().endswith(".json"):
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(
-                f"JSON syntax error: {exc.msg} (column {exc.colno})", source=source,
-                line=exc.lineno, hint="fix the JSON syntax at that line",
-            ) from None
-    try:
-        return safe_load_yaml(text)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else None
-        problem = exc.problem or exc.context or "cannot parse"
-        column = f" (column {mark.column + 1})" if mark is not None else ""
-        raise MechsynInputError(
-            f"YAML syntax error: {problem}{column}", source=source, line=line,
-            hint="fix the YAML syntax at that line (indentation, brackets, colons)",
-        ) from None
-    except yaml.YAMLError as exc:
-        raise MechsynInputError(f"YAML syntax error: {exc}", source=source) from None
+    return files.parse_data(text, source)
 
 
 def _line_finder(text: str | None, source: str) -> Any:
@@ -97,7 +55,7 @@ def _line_finder(text: str | None, source: str) -> Any:
     root = None
     if text is not None:
         try:
-            root = yaml.compose(text, Loader=_YAML_LOADER)
+            root = yaml.compose(text, Loader=files.YAML_LOADER)
         except yaml.YAMLError:
             root = None
 
@@ -171,22 +129,30 @@ _HINTS = {
     "list_type": "give a list, e.g. [a, b]",
     "dict_type": "give a mapping of names to values",
     "string_type": "give a text value",
+    "greater_than_equal": "give a value that is not negative",
+    "greater_than": "give a positive value",
+    "finite_number": "give a finite number",
+    "bool_not_number": "write a number such as 0 or 1, not true/false",
     "too_short": None,
 }
 
 
 def _validation_error(exc: ValidationError, data: Any, source: str, text: str | None) -> MechsynInputError:
     errors = exc.errors()
-    # Prefer the most specific error: for unions pydantic reports one per member.
-    err = errors[0]
-    loc = _data_path(data, err["loc"])
+    # Prefer the most specific error: for unions pydantic reports one per member (a link
+    # given as a mapping fails as text too); the one reaching deepest into the data is
+    # the member the user meant.
+    paths = [tuple(_data_path(data, e["loc"])) for e in errors]
+    best = max(range(len(errors)), key=lambda i: (len(paths[i]), -i))
+    err, loc = errors[best], list(paths[best])
     find = _line_finder(text, source)
     msg = err["msg"]
     if err["type"] == "extra_forbidden":
         msg = "unknown field"
     elif err["type"] == "missing":
         msg = "required field is missing"
-    more = len({tuple(_data_path(data, e["loc"])) for e in errors}) - 1
+    # other problems: other places (not the union members failing at an enclosing one)
+    more = len({p for p in paths if p != tuple(loc) and tuple(loc)[:len(p)] != p})
     if more > 0:
         msg += f" (and {more} more problem{'s' if more > 1 else ''})"
     return MechsynInputError(
@@ -209,7 +175,7 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
         spec = MechanismFile.model_validate(data)
     except ValidationError as exc:
         raise _validation_error(exc, data, source, text) from None
-    return _Builder(spec, source, _line_finder(text, source)).build()
+    return check_geometry(_Builder(spec, source, _line_finder(text, source)).build(), source)
 
 
 def mechanism_from_text(text: str, source: str = "<text>") -> Mechanism:
@@ -455,6 +421,9 @@ class _Builder:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
             else:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+        if self.kind == "planar" and jtype == "P" and axis is None and point is not None:
+            raise self.error(path + ["axis"], f"planar P pair {entry.id} has no axis: its sliding direction "
+                             "is not assumed", "add axis: [dx, dy], e.g. axis: [1, 0] to slide along x")
         axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
         normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
         if entry.pitch is not None and jtype != "H":
@@ -713,11 +682,14 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
     return d
 
 
+def mechanism_text(mech: Mechanism | dict[str, Any], as_json: bool = False) -> str:
+    """The text of a mechanism file (YAML, or JSON when ``as_json``) of ``mech`` or its data."""
+    data = mechanism_to_dict(mech) if isinstance(mech, Mechanism) else to_jsonable(mech)
+    if as_json:
+        return json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    return yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=None, width=100)
+
+
 def write_mechanism(mech: Mechanism | dict[str, Any], path: str | os.PathLike[str]) -> None:
     """Write a mechanism (or file-format data) as YAML, or JSON for a ``.json`` path; atomic."""
-    data = mechanism_to_dict(mech) if isinstance(mech, Mechanism) else to_jsonable(mech)
-    if str(path).lower().endswith(".json"):
-        text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
-    else:
-        text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True, default_flow_style=None, width=100)
-    write_atomic(path, text)
+    write_atomic(path, mechanism_text(mech, str(path).lower().endswith(".json")))

@@ -23,7 +23,7 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import dyads
 from mechsyn.kinematics.forces import Reactions, kinetostatics
-from mechsyn.kinematics.solve import Sweep, _limit, assemble, sweep
+from mechsyn.kinematics.solve import Sweep, assemble, sweep
 from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
@@ -125,7 +125,7 @@ class Simulation(Result):
         return pd.DataFrame(cols)
 
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:
-        """The mechanism moving over the sweep: a :class:`matplotlib.animation.FuncAnimation`
+        """The mechanism moving over the sweep: a Matplotlib ``FuncAnimation``
         (``anim.save("m.gif", writer="pillow")``, or ``anim.to_jshtml()`` in a notebook)."""
         from mechsyn.plot.kinematics import animate_simulation
 
@@ -264,10 +264,13 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     events: list[dict] = []
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-        q, qd, qdd = dyads.solve_all(S, plan, U, sp)
+        tracked = dyads.solve_tracked(S, plan, U)
+        q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
+        qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
+        qdd[tracked.singular] = np.nan
         ok = np.all(np.isfinite(q), axis=1)
         sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), events, method="assur")
-        events.extend(_fast_events(S, sw))
+        events.extend(_fast_events(tracked, sw))
         used = "assur"
         if progress is not None:
             progress(N)
@@ -277,7 +280,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         used = "newton"
     ok = sw.assembled
     rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+    flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
     for k in np.flatnonzero(ok & ~rates_ok).tolist():
+        if k in flagged:
+            continue
         events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
                        "message": "singular configuration: assembled, but the velocities and accelerations "
                                   "are not defined here (null)"})
@@ -330,23 +336,17 @@ def _event_units(S: PlanarSystem, e: dict) -> dict:
     return e
 
 
-def _fast_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
-    """Dead points (refined by Newton bisection) where the closed form stops assembling."""
-    out = []
-    ok = sw.assembled
-    for k in (np.flatnonzero(ok[1:] != ok[:-1]) + 1).tolist():
-        if ok[k - 1] and not ok[k]:
-            ul, _ = _limit(S, sw.q[k - 1], sw.inputs[k - 1], sw.inputs[k])
-            out.append({"index": k, "kind": "dead point", "input": ul.tolist(),
-                        "message": "assembly ends: the Jacobian becomes singular (dead point / limit of the "
-                                   "working range)"})
-        elif ok[k] and not ok[k - 1]:
-            ul, _ = _limit(S, sw.q[k], sw.inputs[k], sw.inputs[k - 1])
-            out.append({"index": k, "kind": "dead point", "input": ul.tolist(),
-                        "message": "assembly starts again here: the other limit of a working range"})
-            out.append({"index": k, "kind": "reassembled", "input": sw.inputs[k].tolist(),
-                        "message": "assembles again after a gap (in the file's assembly mode)"})
-    if not ok[0]:
+def _fast_events(tracked: "dyads.TrackedPositions", sw: Sweep) -> list[dict]:
+    """Events of the closed-form sweep: dead points, reassembly and change / branch points
+    found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
+    out, seen = [], set()
+    for e in tracked.events:  # a gap of an upstream group is one reassembly of the mechanism
+        if e["kind"] == "reassembled":
+            if e["index"] in seen:
+                continue
+            seen.add(e["index"])
+        out.append(e)
+    if not sw.assembled[0] and not any(e["index"] == 0 and e["kind"] == "dead point" for e in out):
         out.insert(0, {"index": 0, "kind": "not assembled", "input": sw.inputs[0].tolist(),
                        "message": "the mechanism cannot be assembled at the first input"})
     return out

@@ -252,11 +252,12 @@ def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: f
         D = np.sqrt(D2)
         a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
         h2 = L1 ** 2 - a ** 2
+        if sigma is None or callable(sigma):
+            s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+            sigma = s_file if sigma is None else sigma(h2 / L1 ** 2, s_file)
         h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
         h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
         e = d / D[:, None]
-        if sigma is None:
-            sigma = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
         B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
         beta1 = np.arctan2(*(s2 - s1)[::-1])
         beta2 = np.arctan2(*(t2 - t3)[::-1])
@@ -288,11 +289,12 @@ def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: f
         p = _dot(w, Q - A)
         cc = _dot(Q - A, Q - A) - L1 ** 2
         disc = p ** 2 - cc
+        if sigma is None or callable(sigma):
+            lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+            s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
+            sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
         disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
         root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        if sigma is None:
-            lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
-            sigma = 1.0 if lam0 + p[0] >= 0 else -1.0
         lam = -p + sigma * root
         B = Q + lam[:, None] * w
         sr = _local(S, lr, Jr)
@@ -319,11 +321,12 @@ def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: f
         delta = np.arctan2(d[:, 1], d[:, 0])
         nu = np.arctan2(n_loc[1], n_loc[0])
         ratio = e / D
+        if sigma is None or callable(sigma):
+            phi0 = float(st.S.q0[3 * b1 + 2])
+            s_file = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
+            sigma = s_file if sigma is None else sigma(1.0 - ratio ** 2, s_file)
         ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
         ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
-        if sigma is None:
-            phi0 = float(st.S.q0[3 * b1 + 2])
-            sigma = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
         phi1 = delta - nu + sigma * ac
         _pin(st, b1, A, sA, phi1)
         _pin(st, b2, C, tC, phi1 + c)
@@ -413,14 +416,20 @@ def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
 
 
 def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
-              chunk: int = 20000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Positions, velocities, accelerations (N, n) for all inputs (closed form where possible)."""
+              chunk: int = 20000, tracked: "TrackedPositions | None" = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions, velocities, accelerations (N, n) for all inputs (closed form where possible).
+
+    ``tracked``: the sweep's positions and modes from :func:`solve_tracked` (the drawn
+    branch followed through bifurcations); without it every group keeps its drawn mode.
+    """
     from mechsyn.kinematics.solve import batch_rates
 
     inputs = np.atleast_2d(np.asarray(inputs, float))
     if plan.closed_form_rates:
-        return _poses_from_chain(S, plan, inputs, fast_chain(S, plan, inputs, speeds, rates=True))
-    q, _ = solve_positions(S, plan, inputs)
+        sig = tracked.sigmas if tracked is not None else None
+        return _poses_from_chain(S, plan, inputs, fast_chain(S, plan, inputs, speeds, rates=True, sigmas=sig))
+    q = tracked.q if tracked is not None else solve_positions(S, plan, inputs)[0]
     ok = np.all(np.isfinite(q), axis=1)
     qd = np.full_like(q, np.nan)
     qdd = np.full_like(q, np.nan)
@@ -512,7 +521,7 @@ def chain_supported(plan: Plan | None) -> bool:
 
 def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
                rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
-               rotations: bool = True) -> ChainResult:
+               rotations: bool = True, sigmas: list | None = None) -> ChainResult:
     """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
 
     Every link is carried by an *anchor* (the joint that placed it: its position,
@@ -522,7 +531,8 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g = sqrt(L1^2 / |d|^2 - f^2)``; rates:
     ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``omega_2 = (v_C - v_A) . e1 / (e1 x e2)``
     and likewise for the accelerations. The work is done
-    in chunks that stay in the processor's cache.
+    in chunks that stay in the processor's cache. ``sigmas``: the assembly sign of every
+    step per input row (from :func:`solve_tracked`); default: the drawn modes.
     """
     U = np.atleast_2d(np.asarray(U, float))
     N = U.shape[0]
@@ -531,7 +541,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     want = joints if joints is not None else [j.id for j in S.mech.joints]
     prog = []
     anchor: dict[int, tuple[str, np.ndarray]] = {}
-    for step in plan.steps:
+    for si, step in enumerate(plan.steps):
         if step.kind == "drive_R":
             (new,), (k,), (jid,) = step.links, step.known, step.joints
             con = next(c for c in _cons_of(S, jid) if c.role == "drive")
@@ -545,6 +555,8 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
             L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
             A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
             sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
+            if sigmas is not None and isinstance(sigmas[si], np.ndarray):
+                sigma = np.asarray(sigmas[si], float)
             anchor[b1] = (J1, s1)
             anchor[b2] = (J3, t3)
             prog.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
@@ -646,7 +658,9 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
                     g -= f * f
                     np.maximum(g, 0.0, out=g, where=g > -1e-12)
                     np.sqrt(g, out=g)
-                    if sigma < 0:
+                    if isinstance(sigma, np.ndarray):
+                        g *= sigma[sl]
+                    elif sigma < 0:
                         np.negative(g, out=g)
                     e1x = f * dx
                     e1x -= g * dy
@@ -728,3 +742,253 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     finally:
         np.seterr(**err)
     return ChainResult(jpos, jvel, jacc, cos_out, sin_out, w_out, al_out, anchor)
+
+
+# --------------------------------------------------------------------------- branches
+#: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
+BRANCHED = ("RRR", "RRP", "PRR", "RPR")
+#: Normalised discriminant below which a group counts as folded (tangent circles,
+#: collinear links): its rates there are not defined.
+SINGULAR_DISC = 1e-12
+#: Relative size of the negative discriminant still taken as zero (round-off).
+_ZERO_DISC = 1e-12
+
+
+@dataclass
+class TrackedPositions:
+    """Positions of a sweep on the drawn branch (see :func:`solve_tracked`).
+
+    ``q`` (N, n) poses (NaN rows: not assembled); ``sigmas`` the assembly sign of every
+    step per row (``None`` for steps without one); ``discs`` the normalised
+    discriminant of every branched step per row; ``singular`` rows where a group is
+    folded flat (rates undefined); ``events`` dead points, reassembly and singular
+    crossings with their input refined on the group's discriminant (input units:
+    radians for R, length for P).
+    """
+
+    q: np.ndarray
+    sigmas: list
+    discs: dict
+    singular: np.ndarray
+    events: list
+
+
+def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.ndarray:
+    """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
+    out = np.array(u_first, float)
+    for k, d in enumerate(S.drivers):
+        if d.type == "R":
+            out[k] -= 2 * np.pi * np.round((u_first[k] - u0[k]) / (2 * np.pi))
+    return out
+
+
+def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: int = 4000) -> np.ndarray:
+    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded) in steps of at most
+    1 degree (R) or 1 % of the mechanism's size (P)."""
+    h = np.array([np.radians(1.0) if d.type == "R" else 0.01 * S.scale for d in S.drivers])
+    n = int(min(max_rows, max(1, np.ceil(np.max(np.abs(u1 - u0) / h)))))
+    t = np.arange(n) / n
+    return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
+
+
+def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray) -> TrackedPositions:
+    """Poses for all inputs on the branch of the drawn configuration, with branch events.
+
+    The branch rules (docs/kinematics.md, "Branches"):
+
+    1. The drawn (file) configuration decides every group's assembly mode. The sweep is
+       reached from the drawn input values along a straight path of inputs (backwards if
+       the sweep starts below them), so the mode at the first input is the drawn mode
+       continued, not the mode re-read there.
+    2. A group's normalised discriminant ``Delta`` (RRR: ``h^2 / L1^2``; RRP: the
+       circle-line discriminant over ``L1^2``; RPR: ``1 - (e/|AC|)^2``) crossing zero is a
+       *fold* (dead point): the group cannot be assembled beyond it; the input is found by
+       Brent's method on ``Delta`` of that group alone (upstream groups re-evaluated at the
+       trial input), to 1e-12 of the step.
+    3. ``Delta`` touching zero without changing sign (a local minimum at zero, found by
+       Brent's method on ``dDelta/du``) is a *bifurcation* (change point, flat rhombus):
+       both modes meet, and the motion whose velocity is continuous is the one on which
+       the signed height ``sigma sqrt(Delta)`` changes sign, so ``sigma`` flips there.
+    4. After a gap the group reassembles in the drawn mode.
+
+    ``inputs`` (N, n_inputs) in radians / length.
+    """
+    U = np.atleast_2d(np.asarray(inputs, float))
+    N = U.shape[0]
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    path = _connecting_path(S, u0, _shifted_start(S, u0, U[0]))
+    n0 = path.shape[0]
+    X = np.vstack([path, U])
+    M = X.shape[0]
+    st = _State(S, M)
+    sigmas: list = []
+    discs: dict = {}
+    singular = np.zeros(M, bool)
+    raw_events: list = []
+    for k, step in enumerate(plan.steps):
+        if step.kind not in BRANCHED:
+            sigmas.append(_solve_step(S, st, step, X, None))
+            continue
+
+        def choose(disc: np.ndarray, s_file: float, k: int = k) -> np.ndarray:
+            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0)
+            discs[k] = disc
+            raw_events.extend(evs)
+            singular[sing] = True
+            return sig
+
+        sigmas.append(_solve_step(S, st, step, X, choose))
+    nl = len(S.links)
+    q = np.empty((M, S.n))
+    q[:, 0:3 * nl:3] = st.r[:, :, 0]
+    q[:, 1:3 * nl:3] = st.r[:, :, 1]
+    phi = st.phi.copy()
+    dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
+    ok = np.all(np.isfinite(phi), axis=1)
+    if dyad_links and ok.any():
+        phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
+    q[:, 2:3 * nl:3] = phi
+    events = []
+    for e in raw_events:
+        e = dict(e)
+        if e["index"] < n0:  # on the way from the drawn configuration to the sweep
+            e["message"] = "between the drawn configuration and the first input: " + e["message"]
+            e["before_sweep"] = True
+        e["index"] = max(0, e["index"] - n0)
+        events.append(e)
+    sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
+    return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:], events)
+
+
+def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Normalised discriminant of step ``k`` at the inputs ``X`` (M, n_inputs), upstream
+    steps solved with their modes of the sweep rows ``rows`` (M,)."""
+    st = _State(S, X.shape[0])
+    for j in range(k):
+        s = sigmas[j]
+        _solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
+    out = []
+
+    def capture(disc: np.ndarray, s_file: float) -> float:
+        out.append(disc)
+        return 1.0
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        _solve_step(S, st, plan.steps[k], X, capture)
+    return out[0]
+
+
+def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
+                  s_file: float, n0: int) -> tuple[np.ndarray, list, np.ndarray]:
+    """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
+    from scipy.optimize import brentq
+
+    M = len(disc)
+    step = plan.steps[k]
+    group = "-".join(step.joints)
+    ok = disc > -_ZERO_DISC
+    d = np.where(ok, np.maximum(disc, 0.0), np.nan)
+
+    def f_line(i0: int, i1: int):
+        rows = np.array([i0])
+
+        def f(t: float) -> float:
+            return float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
+        return f
+
+    events: list = []
+    singular = np.zeros(M, bool)
+    singular[ok & (d < SINGULAR_DISC)] = True
+    breaks: list[tuple[int, str]] = []  # (row, "flip" | "reset")
+    finite = np.isfinite(disc)
+    # folds: the group's own discriminant changes sign between two rows
+    for i in np.flatnonzero(ok[1:] != ok[:-1]) + 1:
+        if not (finite[i] and finite[i - 1]):
+            continue
+        inside = i - 1 if ok[i - 1] else i
+        try:
+            t = brentq(f_line(i - 1, i), 0.0, 1.0, xtol=1e-13, rtol=4 * np.finfo(float).eps)
+        except ValueError:
+            t = 0.0 if inside == i - 1 else 1.0
+        u = X[i - 1] + t * (X[i] - X[i - 1])
+        if ok[i - 1]:
+            events.append({"index": i, "kind": "dead point", "input": u.tolist(), "group": group,
+                           "message": f"assembly ends: the group {group} folds flat (its discriminant "
+                                      "changes sign: a dead point / limit of the working range)"})
+        else:
+            events.append({"index": i, "kind": "dead point", "input": u.tolist(), "group": group,
+                           "message": "assembly starts again here: the other limit of a working range"})
+    # reassembly after a gap (own or upstream): the drawn mode
+    for i in np.flatnonzero(ok[1:] & ~ok[:-1]) + 1:
+        breaks.append((int(i), "reset"))
+        if i >= n0:
+            events.append({"index": int(i), "kind": "reassembled", "input": X[i].tolist(), "group": group,
+                           "message": f"assembles again after a gap, in the assembly mode of the drawn "
+                                      f"configuration for the group {group} (the mode nearest the drawn one)"})
+    # bifurcations: local minima of the discriminant at zero
+    cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
+    for i in cand.tolist():
+        t_star, dmin = _touch(S, plan, k, sigmas, X, i)
+        if dmin > 1e-10:
+            continue  # a sharp but regular turn
+        if dmin < -1e-10:  # the group folds and unfolds within one step: a short gap
+            events.append({"index": i, "kind": "dead point", "input": X[i].tolist(), "group": group,
+                           "message": f"the group {group} cannot be assembled in a short interval near this "
+                                      "input (it folds and unfolds within one step): refine the input step"})
+            breaks.append((i + 1, "reset"))
+            continue
+        # where the crossing lies: at row i (|t| tiny), or between i and a neighbour
+        if abs(t_star) < 1e-7:
+            row, at = i + 1, i
+            singular[i] = True
+        elif t_star > 0:
+            row, at = i + 1, i + 1
+        else:
+            row, at = i, i
+        u = X[i] + t_star * (X[i + 1] - X[i]) if t_star >= 0 else X[i] + t_star * (X[i] - X[i - 1])
+        breaks.append((row, "flip"))
+        events.append({"index": at, "kind": "singular", "input": u.tolist(), "group": group,
+                       "message": f"change / branch point: the group {group} is folded flat here (its two "
+                                  "assembly modes meet); the motion continues on the branch whose velocity is "
+                                  "continuous (the drawn branch)"
+                                  + ("; velocities and accelerations are not defined at this input (null)"
+                                     if singular[i] else "")})
+    sig = np.full(M, s_file)
+    cur = s_file
+    last = 0
+    for row, kind in sorted(breaks):
+        sig[last:row] = cur
+        cur = -cur if kind == "flip" else s_file
+        last = row
+    sig[last:] = cur
+    return sig, events, singular
+
+
+def _touch(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i: int) -> tuple[float, float]:
+    """Where the discriminant of step ``k`` is least near row ``i``: (t, value), with ``t``
+    in [-1, 1] (``t < 0`` towards row i-1, ``t > 0`` towards row i+1), by Brent's method on
+    the central difference of the discriminant."""
+    from scipy.optimize import brentq
+
+    da, db = X[i] - X[i - 1], X[i + 1] - X[i]
+
+    def at(t: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, float)
+        P = X[i] + np.where(t[:, None] >= 0, t[:, None] * db, t[:, None] * da)
+        return _disc_at(S, plan, k, sigmas, np.full(len(t), i), P)
+
+    h = 1e-6
+
+    def slope(t: float) -> float:
+        v = at(np.array([t - h, t + h]))
+        return float(v[1] - v[0])
+
+    ts = np.linspace(-1, 1, 9)
+    vals = at(ts)
+    j = int(np.nanargmin(vals))
+    lo, hi = ts[max(0, j - 1)], ts[min(8, j + 1)]
+    try:
+        t = brentq(slope, lo + h, hi - h, xtol=1e-12)
+    except ValueError:
+        t = float(ts[j])
+    return t, float(at(np.array([t]))[0])

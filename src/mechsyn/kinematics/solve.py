@@ -284,6 +284,81 @@ def _turns(S: PlanarSystem, u: np.ndarray) -> np.ndarray:
     return out
 
 
+def _newton_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
+    """Inputs strictly between the drawn values ``u0`` and ``u1``, at most 5 degrees (R) or
+    5 % of the mechanism's size (P) apart."""
+    h = np.array([np.radians(5.0) if d.type == "R" else 0.05 * S.scale for d in S.drivers])
+    n = int(min(2000, max(1, np.ceil(np.max(np.abs(u1 - u0) / h)))))
+    t = np.arange(1, n) / n
+    return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
+
+
+def _extrapolate(hist: list, u: np.ndarray) -> np.ndarray:
+    """Predict the configuration at ``u`` by the polynomial through the last (up to three)
+    configurations of the run, in the arc length of the inputs (the smooth branch)."""
+    u_last = hist[-1][0]
+    step = u - u_last
+    norm = float(np.linalg.norm(step))
+    if norm == 0.0:
+        return hist[-1][1]
+    direction = step / norm
+    s = [float(direction @ (h[0] - u_last)) for h in hist[-3:]]
+    qs = [h[1] for h in hist[-3:]]
+    pred = np.zeros_like(qs[0])
+    for a, (sa, qa) in enumerate(zip(s, qs)):
+        w = 1.0
+        for b, sb in enumerate(s):
+            if b != a:
+                w *= (norm - sb) / (sa - sb) if sa != sb else 0.0
+        pred += w * qa
+    return pred
+
+
+def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
+    """The next configuration of the run ``hist`` [(u, q, factor)] at ``u`` on the branch
+    whose velocity is continuous.
+
+    The tangent predictor (``dq/du`` at the last configuration) is used while the last
+    configuration is regular and no singular point lies in the step; when the last
+    configuration is singular (its tangent is not unique) or ``det Phi_q`` changes sign
+    within the step (a change or branch point was crossed, where Newton may land on either
+    branch), the prediction is the polynomial through the last configurations of the run,
+    which continues the smooth branch.
+    """
+    u0, q0, (_, X0, det0, sig0) = hist[-1]
+    regular = sig0 >= 1e-6
+    nxt = _track(S, q0, u0, u, X=X0) if regular else None
+    if nxt is not None and len(hist) >= 2:
+        det1 = _factor(S, nxt)[2]
+        if det1 * det0 >= 0:
+            return nxt
+    elif nxt is not None or len(hist) < 2:
+        if nxt is None and not regular:
+            cand, ok = newton(S, q0 + X0 @ (u - u0), u, max_iter=40)
+            return cand if ok else None
+        return nxt
+    pred = _extrapolate(hist, u)
+    cand, ok = newton(S, pred, u, max_iter=40)
+    if ok:
+        return cand
+    return nxt
+
+
+def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray, det: float) -> list:
+    """Configurations at ``u`` with ``det Phi_q`` of sign ``det``, searched from ``q`` along
+    the direction in which ``Phi_q`` is nearest singular (where two assembly modes meet
+    near a fold, they differ along it)."""
+    J = S.jacobian(q[None])[0]
+    v = np.linalg.svd(J)[2][-1]
+    v = v / max(float(np.abs(v).max()), 1e-300)
+    for a in (0.05, 0.2, 0.5, 1.0):
+        for sgn in (1.0, -1.0):
+            c, good = newton(S, q + sgn * a * S.scale * v, u, max_iter=30)
+            if good and _factor(S, c)[2] * det > 0:
+                return [c]
+    return []
+
+
 def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
     for _ in range(iters):
@@ -341,28 +416,27 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     sig = np.full(N, np.nan)
     events: list[dict] = []
     u_asm = np.array([d.assembled for d in S.drivers])
-    cur = _track(S, q_start, u_asm, inputs[0], depth=14)
+    # from the drawn configuration to the first input, on the smooth branch
+    hist = [(u_asm, q_start, _factor(S, q_start))]
+    drawn_det = hist[0][2][2]
+    for u in list(_newton_path(S, u_asm, inputs[0])) + [inputs[0]]:
+        nxt = _continue(S, hist, u)
+        if nxt is None:
+            break
+        hist.append((u, nxt, _factor(S, nxt)))
+    cur = hist[-1][1] if nxt is not None else None
     cur_u = inputs[0]
     X = None
     last_good: tuple[np.ndarray, np.ndarray] | None = (q_start, u_asm)
     if cur is None:
         if refine_limits:
-            ul, _ = _limit(S, q_start, u_asm, inputs[0])
+            ul, _ = _limit(S, hist[-1][1], hist[-1][0], inputs[0])
             events.append({"index": 0, "kind": "dead point", "input": ul.tolist(),
                            "message": "the mechanism cannot move from its file configuration to the first input"})
     for i in range(N):
         u = inputs[i]
         if cur is not None and i > 0:
-            nxt = _track(S, cur, cur_u, u, X=X)
-            if nxt is None and np.isfinite(sig[i - 1]) and sig[i - 1] < 1e-6:
-                # leaving a singular (change / branch) point: the predictor has no unique
-                # direction; let Newton pick the continuation and say so
-                cand, ok = newton(S, cur + X @ (u - cur_u), u, max_iter=40)
-                if ok:
-                    nxt = cand
-                    events.append({"index": i, "kind": "branch point", "input": cur_u.tolist(),
-                                   "message": "continued past a singular configuration (change or branch "
-                                              "point) by Newton: the assembly branch may have switched"})
+            nxt = _continue(S, hist, u)
             if nxt is None:
                 if refine_limits:
                     ul, _ = _limit(S, cur, cur_u, u)
@@ -375,13 +449,22 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             cur = nxt
             cur_u = u
         elif cur is None and last_good is not None:
-            ok = False
-            for guess in (last_good[0], q_start):
-                cand, ok = newton(S, guess, u, max_iter=15)
-                if ok:
-                    break
+            # reassemble in the mode nearest the drawn one: of the configurations Newton
+            # reaches from the drawn and from the last one, the one whose det(Phi_q) has
+            # the drawn configuration's sign (the same assembly mode), else the first
+            cands = []
+            for guess in (q_start, last_good[0]):
+                c, good = newton(S, guess, u, max_iter=15)
+                if good:
+                    cands.append(c)
+            ok = bool(cands)
             if ok:
+                same = [c for c in cands if _factor(S, c)[2] * drawn_det > 0]
+                if not same:
+                    same = _other_mode(S, cands[0], u, drawn_det)
+                cand = (same or cands)[0]
                 cur, cur_u = cand, u
+                hist = [(u, cand, _factor(S, cand))]
                 # follow the new branch backwards into the gap as far as it assembles
                 bq, bu, j = cand, u, i - 1
                 while j >= 0 and not np.isfinite(q[j, 0]):
@@ -397,13 +480,21 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                     events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
                                    "message": "assembly starts again here: the other limit of a working range"})
                 events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
-                               "message": "assembles again after a gap (branch chosen by Newton from the "
-                                          "last configuration)"})
+                               "message": "assembles again after a gap, in the assembly mode of the drawn "
+                                              "configuration (the mode nearest the drawn one)"})
         if cur is not None:
             q[i] = cur
-            fac, X, det_sign[i], sig[i] = _factor(S, cur)
+            f = _factor(S, cur)
+            fac, X, det_sign[i], sig[i] = f
+            if i > 0 and np.isfinite(q[i - 1, 0]):
+                hist.append((u, cur, f))
+                hist = hist[-3:]
             qd[i], qdd[i] = _rates_from(S, cur, fac, X, speeds)
-            if i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0:
+            if sig[i] < 1e-6:  # singular: the rates are not defined here
+                qd[i] = np.nan
+                qdd[i] = np.nan
+            if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
+                    and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
                 events.append({"index": i, "kind": "singular", "input": u.tolist(),
                                "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
                                           "crossed between this input and the previous"})

@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -54,6 +54,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.structure.contours import independent_contours
+from mechsyn.structure.idle import IdleInputs, IdleMobility, find_idle_mobilities
 
 __all__ = [
     "RankAnalysis", "IdleMobility", "ContourRank", "InsufficientGeometry",
@@ -82,7 +83,7 @@ def _perp_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _rot(p: np.ndarray, a: np.ndarray) -> np.ndarray:
-    return np.concatenate([a, np.cross(p, a)])
+    return np.concatenate([a, _cross(p, a)])
 
 
 def _tr(a: np.ndarray) -> np.ndarray:
@@ -358,13 +359,6 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _adjoint(g: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """``Ad_g ξ``: the twist ``ξ`` moved by the displacement ``g``."""
-    R, p = g[:3, :3], g[:3, 3]
-    w = R @ xi[:3]
-    return np.concatenate([w, R @ xi[3:] + _cross(p, w)])
-
-
 def _svd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     if a.size == 0:
         return (np.zeros((a.shape[0], 0)), np.zeros(0), np.zeros((0, a.shape[1])))
@@ -395,19 +389,125 @@ def _orth(a: np.ndarray, tol: float = 1e-9) -> np.ndarray:
     return u[:, : int(np.sum(s > tol * max(1.0, s[0] if s.size else 1.0)))]
 
 
+#: Above this many pair freedoms the loop-closure matrix is reduced contour by contour
+#: (:func:`_eliminate`) instead of by one dense SVD (``O(F³)``).
+DENSE_MAX_FREEDOMS = 120
+
+
+@dataclass
+class _Reduction:
+    """Rank, null space and per-contour increments of a loop-closure matrix."""
+
+    rank: int
+    null: np.ndarray  # F × m, orthonormal columns
+    increments: list[int]  # per contour: new independent equations
+    left: list[np.ndarray]  # per contour: λ × λ left singular vectors (redundant ones last)
+    singular_values: np.ndarray  # what the rank decisions were taken on
+
+
+def _reduce_dense(M: np.ndarray, lam: int, tol: float) -> _Reduction:
+    """One SVD for rank and null space; each contour's rows reduced against the row space
+    of the contours before it (orthonormal basis ``Q``)."""
+    F = M.shape[1]
+    sv = np.linalg.svd(M, compute_uv=False) if M.size else np.zeros(0)
+    rank = int(np.sum(sv > tol))
+    N = _null(M, tol) if F else np.zeros((0, 0))
+    incs, lefts = [], []
+    Q = np.zeros((F, 0))
+    for k in range(M.shape[0] // lam):
+        B = M[lam * k: lam * (k + 1)]
+        res = B - (B @ Q) @ Q.T if Q.shape[1] else B
+        u_k, s_k, vt_k = np.linalg.svd(res, full_matrices=True)
+        s_full = np.zeros(lam)
+        s_full[: s_k.size] = s_k
+        inc = int(np.sum(s_full > tol))
+        Q = np.concatenate([Q, vt_k[:inc].T], axis=1)
+        incs.append(inc)
+        lefts.append(u_k)
+    return _Reduction(rank, N[:, : F - rank], incs, lefts, sv)
+
+
+def _eliminate(M: np.ndarray, cols: list[np.ndarray], lam: int, tol: float) -> _Reduction:
+    """Rank and null space contour by contour, touching only each contour's columns.
+
+    The motions allowed by contours ``1..k-1`` are kept as orthonormal parameter vectors
+    (a pair freedom not yet met by any contour, or a combination stored as a full vector).
+    Contour ``k`` (rows ``B``, columns ``cols[k]``) meets only the parameters that move
+    its columns: the SVD of ``B P_J`` (``λ × |J|``) gives its new independent equations
+    (the sequential reading), its redundant ones (left null vectors, as in
+    :func:`_reduce_dense`) and the combinations of ``P_J`` it leaves free. A column no
+    later contour touches is retired from the bookkeeping. For a chain of loops ``|J|``
+    stays small: the work grows about linearly with the contours (a dense SVD, cubically).
+    """
+    F = M.shape[1]
+    last = np.full(F, -1)  # the last contour that touches each column: later, it is retired
+    for k, ck in enumerate(cols):
+        last[ck] = k
+    unit: dict[int, int] = {c: c for c in range(F)}  # parameter -> its column (unit vector)
+    dense: dict[int, np.ndarray] = {}  # parameter -> full vector
+    active: dict[int, np.ndarray] = {}  # dense parameter -> columns it moves that a later contour touches
+    touch: list[set[int]] = [{c} for c in range(F)]
+    next_id = F
+    incs, lefts, svs = [], [], []
+    for k, ck in enumerate(cols):
+        B = M[lam * k: lam * (k + 1), ck]
+        J = sorted(set().union(*(touch[c] for c in ck)))
+        if not J:  # every freedom of the contour is already locked
+            incs.append(0)
+            lefts.append(np.eye(lam))
+            svs.append(np.zeros(lam))
+            continue
+        pos = {c: i for i, c in enumerate(ck)}
+        BP = np.empty((lam, len(J)))
+        for i, pid in enumerate(J):
+            BP[:, i] = B[:, pos[unit[pid]]] if pid in unit else B @ dense[pid][ck]
+        u, s, vt = np.linalg.svd(BP, full_matrices=True)
+        s_full = np.zeros(lam)
+        s_full[: s.size] = s
+        inc = int(np.sum(s_full > tol))
+        incs.append(inc)
+        lefts.append(u)
+        svs.append(s_full)
+        if inc == 0:
+            continue
+        Z = vt[inc:].T
+        new = np.zeros((F, Z.shape[1]))
+        for i, pid in enumerate(J):
+            if pid in unit:
+                c = unit.pop(pid)
+                new[c] += Z[i]
+                touch[c].discard(pid)
+            else:
+                new += np.outer(dense.pop(pid), Z[i])
+                for c in active.pop(pid):
+                    touch[c].discard(pid)
+        for i in range(new.shape[1]):
+            v = new[:, i]
+            v[np.abs(v) <= 1e-15 * np.max(np.abs(v))] = 0.0
+            moved = np.flatnonzero(v)
+            act = moved[last[moved] > k]
+            dense[next_id], active[next_id] = v, act
+            for c in act:
+                touch[c].add(next_id)
+            next_id += 1
+    N = np.zeros((F, len(unit) + len(dense)))
+    for i, c in enumerate(sorted(unit.values())):
+        N[c, i] = 1.0
+    for i, pid in enumerate(sorted(dense), start=len(unit)):
+        N[:, i] = dense[pid]
+    sv = np.concatenate(svs) if svs else np.zeros(0)
+    return _Reduction(F - N.shape[1], N, incs, lefts, sv)
+
+
+def _reduce(sysm: "_System", M: np.ndarray, tol: float) -> _Reduction:
+    """Rank and null space of the loop-closure matrix ``M``: one dense SVD for small
+    systems, contour-by-contour elimination above :data:`DENSE_MAX_FREEDOMS`."""
+    if M.shape[1] <= DENSE_MAX_FREEDOMS:
+        return _reduce_dense(M, sysm.lam, tol)
+    return _eliminate(M, sysm.contour_columns(), sysm.lam, tol)
+
+
 # --------------------------------------------------------------------------- results
-@dataclass(frozen=True)
-class IdleMobility:
-    """An idle (local) mobility: a motion of one link alone that changes no function."""
-
-    link: str
-    joints: list[str]
-    description: str
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"link": self.link, "joints": self.joints, "description": self.description}
-
-
 @dataclass(frozen=True)
 class ContourRank:
     """Rank results of one contour, in the contours' order (sequential reading)."""
@@ -516,24 +616,45 @@ class _System:
     def rows(self, mat: np.ndarray) -> np.ndarray:
         return mat[PLANAR_ROWS] if self.planar else mat
 
+    def contour_columns(self) -> list[np.ndarray]:
+        """The columns (pair freedoms) each contour's equations touch."""
+        return [np.array(sorted({c for c, _ in fac}), dtype=int) for fac in self.factors]
+
     def closure(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Loop-closure twist matrix ``M(θ)`` (λK × F) and the closure error (λK)."""
+        """Loop-closure twist matrix ``M(θ)`` (λK × F) and the closure error (λK).
+
+        Every contour's product of exponentials is taken step by step for all contours at
+        once (contours padded to the longest one)."""
         F = self.twists.shape[0]
         K = len(self.factors)
         lam = self.lam
         M = np.zeros((lam * K, F))
         err = np.zeros(lam * K)
-        exps = _exp(self.twists, theta)
-        inv_exps = _exp(self.twists, -theta)
+        if K == 0:
+            return M, err
+        exps = np.concatenate([_exp(self.twists, theta), _exp(self.twists, -theta)])  # + then - sign
+        L = max(len(f) for f in self.factors)
+        cols = np.full((K, L), -1)
+        signs = np.zeros((K, L))
         for k, fac in enumerate(self.factors):
-            g = np.eye(4)
-            for col, sign in fac:
-                xi = _adjoint(g, self.twists[col]) * sign
-                M[k * lam:(k + 1) * lam, col] = self.rows(xi)
-                g = g @ (exps[col] if sign > 0 else inv_exps[col])
-            R, p = g[:3, :3], g[:3, 3]
-            e = np.concatenate([0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]), p])
-            err[k * lam:(k + 1) * lam] = self.rows(e)
+            cols[k, : len(fac)] = [c for c, _ in fac]
+            signs[k, : len(fac)] = [sg for _, sg in fac]
+        rows = PLANAR_ROWS if self.planar else np.arange(6)
+        g = np.tile(np.eye(4), (K, 1, 1))
+        for t in range(L):
+            k = np.flatnonzero(cols[:, t] >= 0)
+            c, sg = cols[k, t], signs[k, t]
+            xi = self.twists[c] * sg[:, None]
+            R, p = g[k, :3, :3], g[k, :3, 3]
+            w = np.einsum("kij,kj->ki", R, xi[:, :3])
+            v = np.einsum("kij,kj->ki", R, xi[:, 3:]) + np.cross(p, w)
+            adj = np.concatenate([w, v], axis=1)[:, rows]
+            M[(k * lam)[:, None] + np.arange(lam), c[:, None]] = adj
+            g[k] = g[k] @ exps[np.where(sg > 0, c, c + F)]
+        R, p = g[:, :3, :3], g[:, :3, 3]
+        e = np.concatenate([0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0],
+                                             R[:, 1, 0] - R[:, 0, 1]], axis=1), p], axis=1)
+        err[:] = e[:, rows].reshape(-1)
         return M, err
 
 
@@ -584,8 +705,9 @@ def _build_system(mech: Mechanism, planar: bool) -> _System:
                    centre, scale)
 
 
-def _link_twist_map(mech: Mechanism, sysm: _System) -> tuple[list[str], np.ndarray]:
-    """Moving links and the map ``T`` (6·n × F) from joint rates to link twists (spanning tree)."""
+def _link_twists(mech: Mechanism, sysm: _System, N: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Moving links and their twists per null-space motion (``n × 6 × m``), propagated
+    from the frame along a breadth-first spanning tree of the link graph."""
     from collections import deque
 
     adj: dict[str, list[tuple[str, int, int]]] = {n: [] for n in mech.link_names}
@@ -593,21 +715,59 @@ def _link_twist_map(mech: Mechanism, sysm: _System) -> tuple[list[str], np.ndarr
         a, b = j.links
         adj[a].append((b, k, 1))
         adj[b].append((a, k, -1))
-    F = sysm.twists.shape[0]
-    maps: dict[str, np.ndarray] = {mech.ground: np.zeros((6, F))}
+    cols_of = [[] for _ in mech.joints]  # type: list[list[int]]
+    for c, k in enumerate(sysm.col_joint):
+        cols_of[int(k)].append(c)
+    tw: dict[str, np.ndarray] = {mech.ground: np.zeros((6, N.shape[1]))}
     queue = deque([mech.ground])
     while queue:
         u = queue.popleft()
         for v, k, sign in adj[u]:
-            if v in maps:
-                continue
-            m = maps[u].copy()
-            cols = np.flatnonzero(sysm.col_joint == k)
-            m[:, cols] += sign * sysm.twists[cols].T
-            maps[v] = m
-            queue.append(v)
+            if v not in tw:
+                cols = cols_of[k]
+                tw[v] = tw[u] + sign * (sysm.twists[cols].T @ N[cols])
+                queue.append(v)
     names = list(mech.moving_links)
-    return names, np.concatenate([maps[n] for n in names], axis=0) if names else np.zeros((0, F))
+    return names, np.array([tw[n] for n in names]) if names else np.zeros((0, 6, N.shape[1]))
+
+
+_CENTRED_PAIRS = ("R", "H", "C", "U", "S", "S_pin")
+_HIGHER_PAIRS = ("cam", "gear", "belt", "line_contact", "point_contact")
+
+
+def _contact(j: Joint, mech: Mechanism) -> tuple[np.ndarray, np.ndarray] | None:
+    """Contact point and normal of a higher pair (None when the file gives neither)."""
+    if j.type == "belt":
+        return _belt_geometry(j)
+    if j.type == "gear" and j.normal is None and mech.kind == "planar":
+        return _gear_geometry(j, mech)
+    if j.point is None or j.normal is None:
+        return None
+    return _pad3(j.point), _unit(_pad3(j.normal))
+
+
+def _idle_inputs(mech: Mechanism, sysm: _System, N: np.ndarray, Z0: np.ndarray) -> IdleInputs:
+    """The arrays :func:`~mechsyn.structure.idle.find_idle_mobilities` needs (motions ``N @ Z0``)."""
+    names, LT = _link_twists(mech, sysm, N)
+    index = {n: i for i, n in enumerate(names)}
+
+    def norm(p: Any) -> np.ndarray:
+        return (_pad3(p) - sysm.centre) / sysm.scale
+
+    centres, contacts = [], []
+    for j in mech.joints:
+        on = [index[x] for x in j.links if x in index]
+        if j.type in _CENTRED_PAIRS and j.point is not None:
+            centres += [(i, norm(j.point)) for i in on]
+        elif j.type in _HIGHER_PAIRS:
+            pn = _contact(j, mech)
+            if pn is not None:
+                contacts += [(i, norm(pn[0]), pn[1]) for i in on]
+    named = [(index[p.link], norm(p.at)) for p in mech.points.values() if p.link in index]
+    edges = [tuple(index.get(x, -1) for x in j.links) for j in mech.joints]
+    return IdleInputs(A=LT @ Z0, rates=N @ Z0, col_joint=sysm.col_joint, links=names, edges=edges,  # type: ignore[arg-type]
+                      centres=centres, named=named, contacts=contacts, joint_ids=[j.id for j in mech.joints],
+                      centre=sysm.centre, scale=sysm.scale, drives=any(j.actuated for j in mech.joints))
 
 
 def _axis_words(basis: np.ndarray, word: str) -> str:
@@ -762,6 +922,21 @@ def _actuated_columns(sysm: _System) -> tuple[list[int], list[str]]:
     return cols, names
 
 
+def _gauss_newton_step(M: np.ndarray, err: np.ndarray, tol: float) -> np.ndarray:
+    """Least-norm step ``δ`` with ``M δ ≈ err``: truncated SVD with the rank tolerance
+    (near-null directions left alone) for small systems; for large ones the damped
+    least-norm step ``Mᵀ (M Mᵀ + tol² I)⁻¹ err`` by a sparse LU (banded for chains)."""
+    if M.shape[1] <= DENSE_MAX_FREEDOMS:
+        u, sv, vt = np.linalg.svd(M, full_matrices=False)
+        keep = sv > tol
+        return vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
+    from scipy.sparse import csc_matrix, identity
+    from scipy.sparse.linalg import spsolve
+
+    A = csc_matrix(M)
+    return A.T @ spsolve((A @ A.T + tol * tol * identity(M.shape[0], format="csc")).tocsc(), err)
+
+
 def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int = 3,
             step: float = 0.05, seed: int = 0) -> tuple[int | None, list[str]]:
     """Rank at nearby assembled configurations along random null-space directions."""
@@ -779,17 +954,14 @@ def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int =
             if np.linalg.norm(err) < max(1e-11, 10.0 * tol * step):
                 ok = True
                 break
-            # Gauss-Newton with the same rank tolerance (near-null directions left alone)
-            u, sv, vt = np.linalg.svd(M, full_matrices=False)
-            keep = sv > tol
-            theta = theta - vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
+            theta = theta - _gauss_newton_step(M, err, tol)
         if not ok:
             continue
         if np.max(np.abs(theta)) < 0.2 * step:
             returned += 1
             continue
         M, _ = sysm.closure(theta)
-        ranks.append(_rank(M, tol))
+        ranks.append(_reduce(sysm, M, tol).rank)
     if not ranks:
         if returned:
             notes.append("the instantaneous motions do not extend to finite motions (a shaky configuration)")
@@ -800,183 +972,148 @@ def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int =
 
 
 def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None = None,
-                 check_singular: bool = True, seed: int = 0) -> RankAnalysis:
+                 check_singular: bool = True, seed: int = 0,
+                 progress: Callable[[str], None] | None = None) -> RankAnalysis:
     """Screw-theory rank analysis of ``mech`` at its assembled configuration.
 
     ``planar`` defaults to the file's kind (a planar file is analysed with planar
     motion, 3 equations per contour; see :func:`as_spatial` for the 3-D picture).
-    Raises :class:`InsufficientGeometry` when a joint lacks the geometry its twists need.
+    ``progress`` is called with the name of each stage as it starts (``"contours"``,
+    ``"rank"``, ``"idle"``, ``"singularity"``). BLAS runs on one thread meanwhile: the
+    method makes many small decompositions, which threads only slow down (and on a
+    loaded machine by 10-50x). Raises :class:`InsufficientGeometry` when a joint lacks
+    the geometry its twists need.
     """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _analyze_rank(mech, planar, tol, check_singular, seed, progress or (lambda stage: None))
+
+
+def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check_singular: bool, seed: int,
+                  progress: Callable[[str], None]) -> RankAnalysis:
     planar = mech.kind == "planar" if planar is None else planar
+    progress("contours")
     sysm = _build_system(mech, planar)
-    lam, K = sysm.lam, len(sysm.contours)
-    F = sysm.twists.shape[0]
-    if tol is None:
-        eps = _input_rounding(mech)
-        tol = max(1e-6, min(1e-3, 50.0 * eps / sysm.scale))
+    lam, K, F = sysm.lam, len(sysm.contours), sysm.twists.shape[0]
+    tol = _default_tolerance(mech, sysm) if tol is None else tol
     M, _ = sysm.closure(np.zeros(F))
     notes: list[str] = []
-    sv = np.linalg.svd(M, compute_uv=False) if M.size else np.zeros(0)
-    rank = int(np.sum(sv > tol))
-    near = bool(np.any((sv > tol) & (sv < 1e-2)))
-    if near:
-        small = sv[(sv > tol) & (sv < 1e-2)]
-        k = small.size
-        notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} above the tolerance "
-                     f"{tol:.2g} but small; if the geometry is meant to be special (typed with few decimals), "
-                     f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {lam * K - rank + k} "
-                     f"redundant constraint(s)")
-    mobility = F - rank
-    redundant = lam * K - rank
-    N = _null(M, tol) if F else np.zeros((0, 0))
-    if N.shape[1] != mobility:  # pragma: no cover - consistent by construction
-        N = N[:, :mobility]
-
-    # -- redundant constraints per contour (sequential) and their directions: the rows of
-    # contour k are reduced against the row space of contours 1..k-1 (orthonormal basis Q);
-    # combinations c of its rows whose residual vanishes are its redundant constraints,
-    # c being the contour's self-stress wrench [moment about the centre; force].
-    contours: list[ContourRank] = []
-    Q = np.zeros((F, 0))
-    for k in range(K):
-        B = M[lam * k: lam * (k + 1)]
-        res = B - (B @ Q) @ Q.T if Q.shape[1] else B
-        u_k, s_k, vt_k = np.linalg.svd(res, full_matrices=True)
-        s_full = np.zeros(lam)
-        s_full[: s_k.size] = s_k
-        inc = int(np.sum(s_full > tol))
-        Q = np.concatenate([Q, vt_k[:inc].T], axis=1)
-        qk = lam - inc
-        part = u_k[:, inc:]
-        dirs: list[str] = []
-        Wj = np.zeros((6, 0))
-        if qk > 0:
-            if planar:
-                Wj = np.zeros((6, part.shape[1]))
-                Wj[PLANAR_ROWS] = part
-            else:
-                Wj = part
-            dirs = describe_wrenches(Wj, sysm.centre, sysm.scale, planar, tol)
-        contours.append(ContourRank(index=k + 1, joints=list(sysm.contours[k]), redundant=qk,
-                                    directions=dirs, reason=_contour_reason(sysm, k, Wj)))
+    progress("rank")
+    red = _reduce(sysm, M, tol)
+    near = _near_singular_note(red.singular_values, tol, F, lam * K, red.rank, notes)
+    mobility, redundant, N = F - red.rank, lam * K - red.rank, red.null
+    contours = _contour_ranks(sysm, red, tol)
     if sum(c.redundant for c in contours) != redundant:  # borderline singular values: say so
         notes.append(f"per-contour counts ({', '.join(str(c.redundant) for c in contours)}) and the total "
                      f"{redundant} differ at this tolerance: a singular value is close to it")
-
-    # -- idle mobilities: motions of one link alone (other than a leaf/output link)
-    names, T = _link_twist_map(mech, sysm)
-    idle: list[IdleMobility] = []
-    idle_basis = np.zeros((mobility, 0))
-    if mobility and names:
-        LT = (T @ N).reshape(len(names), 6, mobility)
-        if planar:
-            LT = LT[:, PLANAR_ROWS, :]
-        rows_all = LT.reshape(-1, mobility)
-        z_all = _null(rows_all, tol)
-        if z_all.shape[1]:
-            for i in range(z_all.shape[1]):
-                rates = N @ z_all[:, i]
-                js = sorted({sysm.joints[sysm.col_joint[c]].id for c in np.flatnonzero(np.abs(rates) > 1e-6)})
-                idle.append(IdleMobility(link="", joints=js, description=f"joint rates of {', '.join(js)} cancel: "
-                                         "no link moves (coaxial or duplicated pairs)"))
-            idle_basis = np.concatenate([idle_basis, z_all], axis=1)
-        driven = _actuated_columns(sysm)[0]
-        # links joined to one neighbour only (by one or several pairs) are outputs
-        degree = {n: len({j.other(n) for j in mech.joints_of(n)}) for n in names}
-        points_on = {n: [p for p in mech.points.values() if p.link == n] for n in names}
-        # null space of the other links' twists, for every link at once: eigenvectors of the
-        # Gram matrices  G_others = G_all - G_link  (m × m) with eigenvalue below tol²
-        G = np.einsum("lrm,lrn->lmn", LT, LT)
-        evals, evecs = np.linalg.eigh(G.sum(axis=0)[None] - G)
-        for li, name in enumerate(names):
-            if degree[name] < 2:
-                continue  # a leaf link (one neighbour) is an output: its motion is the function
-            z = evecs[li][:, evals[li] < tol * tol]
-            if z.shape[1] <= z_all.shape[1]:
-                continue
-            z = z - z_all @ (z_all.T @ z) if z_all.shape[1] else z
-            z = _orth(z, 1e-6)
-            for i in range(z.shape[1]):
-                tw6 = (T[li * 6:(li + 1) * 6] @ N @ z[:, i])
-                moves_point = False
-                for p in points_on[name]:
-                    pp = (_pad3(p.at) - sysm.centre) / sysm.scale
-                    if np.linalg.norm(tw6[3:] + np.cross(tw6[:3], pp)) > 1e-6:
-                        moves_point = True
-                rates = N @ z[:, i]
-                if moves_point or (driven and np.max(np.abs(rates[driven])) > 1e-6):
-                    continue  # a named point moves, or a drive moves it: a useful motion
-                js = [sysm.joints[k].id for k in sorted({int(sysm.col_joint[c]) for c in
-                                                          np.flatnonzero(np.abs(rates) > 1e-6)})]
-                idle.append(IdleMobility(link=name, joints=js, description=_spin_words(name, js, tw6, sysm)))
-                idle_basis = np.concatenate([idle_basis, z[:, i:i + 1]], axis=1)
-    useful = mobility - len(idle)
-
-    # -- drives
+    progress("idle")
     acols, anames = _actuated_columns(sysm)
-    determined: bool | None = None
-    anote = ""
-    if anames:
-        AN = N[acols] if mobility else np.zeros((len(acols), 0))
-        za = _null(AN, tol) if mobility else np.zeros((0, 0))
-        uncontrolled = za.shape[1]
-        if uncontrolled:
-            both = np.concatenate([idle_basis, za], axis=1)
-            uncontrolled = _rank(both, 1e-6) - _rank(idle_basis, 1e-6) if idle_basis.size else za.shape[1]
-        determined = uncontrolled == 0
-        ra = _rank(AN, tol) if AN.size else 0
-        if not determined:
-            anote = (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
-                     f"{useful} drive(s) needed")
-        elif ra < len(acols):
-            anote = (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
-                     "are not independent (redundant actuation: the drives fight each other)")
-        else:
-            anote = f"the drives at {', '.join(anames)} determine the motion"
-
-    # -- singularity
-    singular, finite = False, None
+    Z0 = _null(N[acols], tol) if mobility and acols else np.eye(mobility)
+    idle, _, idle_notes = find_idle_mobilities(_idle_inputs(mech, sysm, N, Z0), tol) if mobility else ([], None, [])
+    notes.extend(idle_notes)
+    useful = mobility - len(idle)
+    determined, anote = _actuation(sysm, N, Z0, acols, anames, len(idle), tol)
+    singular, finite = False, (0 if mobility == 0 else None)
     if check_singular and mobility > 0:
-        r_near, fnotes = _follow(sysm, N, tol, rank, seed=seed)
-        notes.extend(fnotes)
-        if r_near is not None:
-            finite = F - r_near
-            singular = r_near != rank
-            if singular:
-                notes.append(f"singular configuration: {mobility} instantaneous freedom(s) but {max(finite, 0)} "
-                             f"finite one(s) at nearby assembled configurations; away from it "
-                             f"{max(finite - len(idle), 0)} drive(s) and {lam * K - r_near} redundant "
-                             f"constraint(s)")
-                lead = "singular configuration (pairs lined up): "
-                if lam * K - r_near == 0:
-                    lead += "every redundant constraint vanishes at nearby configurations"
-                    contours = [replace(c, reason=lead) if c.redundant else c for c in contours]
-                else:
-                    lead += f"{r_near - rank} redundant constraint(s) vanish at nearby configurations; otherwise "
-                    contours = [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
-    elif mobility == 0:
-        finite = 0
-    smallest = sorted(float(x) for x in sv)[: min(4, len(sv))]
+        progress("singularity")
+        singular, finite, contours = _singularity(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
+    sv = red.singular_values
     return RankAnalysis(
         motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
         idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
         actuated=anames, actuation_determined=determined, actuation_note=anote, singular=singular,
         finite_mobility=finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
-        equations=lam * K, rank=rank, smallest_singular_values=smallest, near_singular=near, notes=notes,
+        equations=lam * K, rank=red.rank, smallest_singular_values=sorted(float(x) for x in sv)[: min(4, len(sv))],
+        near_singular=near, notes=notes,
     )
 
 
-def _spin_words(name: str, joints: list[str], tw6: np.ndarray, sysm: _System) -> str:
-    w = tw6[:3]
-    if np.linalg.norm(w) < 1e-9:
-        return f"{name} slides alone (pairs {', '.join(joints)})"
-    d = _unit(w)
-    v = tw6[3:] / np.linalg.norm(w)
-    r = np.cross(d, v)  # a point on the spin axis (normalised)
-    p = sysm.centre + sysm.scale * r
-    dname = next((_AXIS_NAMES[k] for k in range(3) if abs(abs(d[k]) - 1) < 1e-6), None)
-    dd = dname if dname else _vec(d * np.sign(d[np.argmax(np.abs(d))]))
-    return f"{name} spins about the axis along {dd} through {_vec(p)} (pairs {', '.join(joints)})"
+def _default_tolerance(mech: Mechanism, sysm: _System) -> float:
+    """``max(1e-6, min(1e-3, 50 ε / L))`` with ``ε`` the rounding of the file's coordinates."""
+    return max(1e-6, min(1e-3, 50.0 * _input_rounding(mech) / sysm.scale))
+
+
+def _near_singular_note(sv: np.ndarray, tol: float, F: int, equations: int, rank: int, notes: list[str]) -> bool:
+    """Singular values between the tolerance and ``1e-2``: a near-singularity, said in ``notes``."""
+    small = sv[(sv > tol) & (sv < 1e-2)]
+    if small.size:
+        k = small.size
+        notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} above the tolerance "
+                     f"{tol:.2g} but small; if the geometry is meant to be special (typed with few decimals), "
+                     f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {equations - rank + k} "
+                     f"redundant constraint(s)")
+    return bool(small.size)
+
+
+def _contour_ranks(sysm: _System, red: _Reduction, tol: float) -> list[ContourRank]:
+    """Redundant constraints per contour (sequential) and their directions: the rows of
+    contour k reduced against the row space of contours 1..k-1; combinations c of its rows
+    whose residual vanishes are its redundant constraints, c being the contour's
+    self-stress wrench [moment about the centre; force]."""
+    lam = sysm.lam
+    contours: list[ContourRank] = []
+    for k in range(len(sysm.contours)):
+        inc, u_k = red.increments[k], red.left[k]
+        qk = lam - inc
+        part = u_k[:, inc:]
+        dirs: list[str] = []
+        Wj = np.zeros((6, 0))
+        if qk > 0:
+            if sysm.planar:
+                Wj = np.zeros((6, part.shape[1]))
+                Wj[PLANAR_ROWS] = part
+            else:
+                Wj = part
+            dirs = describe_wrenches(Wj, sysm.centre, sysm.scale, sysm.planar, tol)
+        contours.append(ContourRank(index=k + 1, joints=list(sysm.contours[k]), redundant=qk,
+                                    directions=dirs, reason=_contour_reason(sysm, k, Wj)))
+    return contours
+
+
+def _actuation(sysm: _System, N: np.ndarray, Z0: np.ndarray, acols: list[int], anames: list[str], idle: int,
+               tol: float) -> tuple[bool | None, str]:
+    """Whether the drives determine the motion (every motion left with them at rest is
+    idle), and the sentence that says so."""
+    if not anames:
+        return None, ""
+    mobility = N.shape[1]
+    uncontrolled = Z0.shape[1] - idle
+    if uncontrolled:
+        return False, (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
+                       f"{mobility - idle} drive(s) needed")
+    ra = _rank(N[acols], tol) if mobility else 0
+    if ra < len(acols):
+        locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
+                  and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
+        return True, (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
+                      "are not independent (redundant actuation: the drives fight each other)"
+                      + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
+                         if locked else ""))
+    return True, f"the drives at {', '.join(anames)} determine the motion"
+
+
+def _singularity(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, contours: list[ContourRank],
+                 notes: list[str], seed: int) -> tuple[bool, int | None, list[ContourRank]]:
+    """Singular when the rank at nearby assembled configurations is larger; the finite
+    mobility there, and the contours' reasons amended."""
+    F, equations = sysm.twists.shape[0], sysm.lam * len(sysm.contours)
+    r_near, fnotes = _follow(sysm, N, tol, rank, seed=seed)
+    notes.extend(fnotes)
+    if r_near is None:
+        return False, None, contours
+    finite = F - r_near
+    if r_near == rank:
+        return False, finite, contours
+    notes.append(f"singular configuration: {N.shape[1]} instantaneous freedom(s) but {max(finite, 0)} "
+                 f"finite one(s) at nearby assembled configurations; away from it "
+                 f"{max(finite - idle, 0)} drive(s) and {equations - r_near} redundant constraint(s)")
+    lead = "singular configuration (pairs lined up): "
+    if equations - r_near == 0:
+        lead += "every redundant constraint vanishes at nearby configurations"
+        return True, finite, [replace(c, reason=lead) if c.redundant else c for c in contours]
+    lead += f"{r_near - rank} redundant constraint(s) vanish at nearby configurations; otherwise "
+    return True, finite, [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
 
 
 # --------------------------------------------------------------------------- formulas side by side
@@ -1022,14 +1159,15 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
     planar = ra.motion == "planar"
     reasons = _q_reasons(ra)
     idle_txt = f"; it includes {idle} idle mobility(ies): {_idle_words(ra)}" if idle else ""
-    main = ("chebyshev", "Chebyshev W = 3n - 2p5 - p4") if planar else ("malyshev", "Malyshev W = 6n - Σ i·p_i")
+    main = (("chebyshev", "Chebyshev W = 3n - 2p5 - p4 (planar)") if planar
+            else ("malyshev", "Malyshev W = 6n - Σ i·p_i (spatial)"))
     f = fa.formulas.get(main[0])
     if f is not None and f.value is not None:
         w = f.value
         if w == m:
             why = "agree: no constraint is redundant" + idle_txt
         else:
-            why = (f"W = m - q = {m} - {q}: the formula counts every constraint as independent, "
+            why = (f"W = m - q = {m} - {q} = {m - q}: the formula counts every constraint as independent, "
                    f"{q} are redundant ({reasons})" + idle_txt)
         out.append(Comparison("mobility", main[1], w, m, w == m, why))
     if not planar:
@@ -1042,7 +1180,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
             elif w == u:
                 why = (f"W equals the useful mobility {u}: S_Σ = {fa.structural_redundancy} nets "
                        f"{s_idle} idle mobility(ies) against redundant constraints; the rank method counts "
-                       f"{q} redundant constraint(s) and {idle} idle mobility(ies) apart (m = {u} + {idle})")
+                       f"{q} redundant constraint(s) and {idle} idle mobility(ies) apart (m = {m} = {u} + {idle})")
             else:
                 bad = []
                 for rc, fc in zip(ra.contours, fa.contours):
@@ -1053,7 +1191,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
                 why = ("the per-contour counts assume generic geometry (each contour's pairs independent): "
                        + ("; ".join(bad) if bad else f"S_Σ + G_Σ = {fa.structural_redundancy + fa.constructive_redundancy:g}"
                           f" vs rank q = {q}") + idle_txt)
-            out.append(Comparison("mobility", "Somov-Malyshev W = 6n - Σ i·p_i + S_Σ + G_Σ (003)", w, m, w == m, why))
+            out.append(Comparison("mobility", "Somov-Malyshev W = 6n - Σ i·p_i + S_Σ + G_Σ (003, spatial)", w, m, w == m, why))
     f = fa.formulas.get("ozol_redundant")
     if f is not None and f.value is not None:
         w_used = fa.declared_mobility if fa.declared_mobility is not None else fa.mobility
@@ -1062,7 +1200,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
                f"mobility m = {m} (idle included) it gives q = {q}")
         if f.value == q and q:
             why = f"agree: {reasons}"
-        out.append(Comparison("redundant constraints", "Ozol q = W + λK - f (002)", f.value, q, f.value == q, why))
+        out.append(Comparison("redundant constraints", f"Ozol q = W + {3 if planar else 6}K - f (002, {ra.motion})", f.value, q, f.value == q, why))
     if fa.contours and len(fa.contours) == len(ra.contours) and not planar:
         for fc, rc in zip(fa.contours, ra.contours):
             sj = max(fc.S, 0) + fc.T

@@ -10,7 +10,7 @@ request, lists pair-class remedies re-checked by the rank method. The
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,6 +35,16 @@ FORMULA_TITLES = {
 }
 
 
+#: paper 003's per-contour counts are the spatial reading (each contour against 6 freedoms)
+CONTOUR_READING = {"planar": ", spatial reading", "spatial": ""}
+
+
+def formula_title(title: str, f: object) -> str:
+    """``title`` with the formula's planar/spatial reading, when it has one."""
+    reading = getattr(f, "reading", "")
+    return f"{title} ({reading})" if reading in ("planar", "spatial") and reading not in title else title
+
+
 def pair_list(row_pairs: Sequence[object]) -> str:
     return " ".join(f"{p.id}{p.pair_class}" for p in row_pairs)  # type: ignore[attr-defined]
 
@@ -54,9 +64,9 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
     ]
     for key, f in a.formulas.items():
         val = "n/a" if f.value is None else _fmt(f.value)
-        out.append(f"| {FORMULA_TITLES.get(key, key)} | `{f.expression}` | {val} |")
+        out.append(f"| {formula_title(FORMULA_TITLES.get(key, key), f)} | `{f.expression}` | {val} |")
     if a.contours:
-        out += ["", f"{h}# Contours (paper 003)", "",
+        out += ["", f"{h}# Contours (paper 003{CONTOUR_READING[a.kind]})", "",
                 "| # | joints | new pairs | n_j | n_k | S_j | idle | T_j | Z_j | A_j |",
                 "|---|---|---|---|---|---|---|---|---|---|"]
         for r in a.contours:
@@ -65,7 +75,7 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
                        f"{r.S} | {r.idle_mobilities} | {_fmt(r.T)} | {r.Z} | {r.A} |")
         out += [""] + [f"- `{r.S_expression}`; `{r.T_expression}`" for r in a.contours]
     out += [
-        "", f"- structural redundancy S_Σ = {a.structural_redundancy} "
+        "", f"- structural redundancy S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} "
         f"({a.redundant_constraints} redundant constraints, {a.idle_mobilities} idle mobilities)",
         f"- constructive redundancy G_Σ = {_fmt(a.constructive_redundancy)} "
         f"(metric constraints {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})",
@@ -208,7 +218,8 @@ def _rank_or_reason(mech: Mechanism, tol: float | None) -> tuple[Any, str | None
 
 
 def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, max_variants: int = 10,
-            tol: float | None = None, as_spatial: bool = False) -> StructureReport:
+            tol: float | None = None, as_spatial: bool = False,
+            progress: Callable[[str], None] | None = None) -> StructureReport:
     """Structural analysis of ``mech`` by the classic formulas and, where the joints' geometry
     is given, the rank method (screw theory), side by side.
 
@@ -228,6 +239,8 @@ def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, 
         for coordinates written with few decimals).
     as_spatial : bool
         Analyse a planar mechanism as a spatial one (R axes along z).
+    progress : callable, optional
+        Called with the name of each stage of the rank method (large mechanisms).
 
     Returns
     -------
@@ -277,7 +290,7 @@ def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, 
             "the rank method needs each joint's geometry: " + "; ".join(problems), source=mech.source,
             hint="add point/axis (see `mechsyn schema`), or use the formulas method")
     result = analyze_structure(mech)
-    ra = analyze_rank(mech, tol=tol) if method != "formulas" else None
+    ra = analyze_rank(mech, tol=tol, progress=progress) if method != "formulas" else None
     comparisons = compare_with_formulas(result, ra) if ra is not None else []
     state_ranks = {name: _rank_or_reason(mech.in_state(name), tol) for name in mech.states} if ra is not None else {}
     rem = find_remedies(mech, max_variants=max_variants) if remedies else None

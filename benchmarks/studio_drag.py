@@ -1,0 +1,115 @@
+"""Benchmark: drag-to-repaint latency of mechsyn studio in a real browser.
+
+Run from the repository root:  python benchmarks/studio_drag.py [--moves N]
+
+Starts the studio (uvicorn, loopback, in a thread), opens it in Debian's Chromium
+through Playwright, presses the mouse on a joint and moves it in small steps. Each
+step's latency is the wall time from the mouse move to the repaint of the point's
+path (``data-path`` ``d`` attribute changed and the drawn simulation being that of the
+dragged mechanism, i.e. no stale answer counted). Reported: median, 90th percentile
+and the simulation request time measured in the page, for the four-bar
+(``examples/textbook/fourbar.yaml``) and the Watt six-bar (``watt_sixbar.yaml``).
+Targets of issue 15: median <= 50 ms (four-bar), <= 100 ms (six-bar).
+
+The answer is checked: after the drag, the path drawn equals the library's
+``simulate`` of the dragged mechanism. On a shared machine the numbers are noisy:
+the script repeats the drag ``--runs`` times and reports the minimum of the medians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "tests" / "web"))
+
+import numpy as np  # noqa: E402
+
+from mechsyn.io import load_mechanism, mechanism_from_dict, mechanism_to_dict  # noqa: E402
+from mechsyn.kinematics.analysis import simulate  # noqa: E402
+from mechsyn.web import create_app  # noqa: E402
+from web_helpers import CHROMIUM_ARGS, LiveServer  # noqa: E402
+
+CASES = [("four-bar", "examples/textbook/fourbar.yaml", "B", "M", 50.0),
+         ("Watt six-bar", "examples/textbook/watt_sixbar.yaml", "E", "P", 100.0)]
+
+
+def wait(page, js, arg=None, timeout=30.0):
+    t0 = time.perf_counter()
+    while time.perf_counter() - t0 < timeout:
+        if page.evaluate(js, arg):
+            return
+    raise TimeoutError(js)
+
+
+def drag(page, joint: str, path: str, moves: int) -> tuple[list[float], list[float]]:
+    box = page.locator(f'[data-joint="{joint}"]').bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    lat, server = [], []
+    for k in range(1, moves + 1):
+        d0 = page.get_attribute(f'[data-path="{path}"]', "d")
+        dx = 3 * np.sin(k / 3.0)
+        t0 = time.perf_counter()
+        page.mouse.move(x + dx, y - 0.5 * k)
+        wait(page, """([sel, d0]) => { const s = window.__studio; const e = document.querySelector(sel);
+                      return s.simFor === s.mech && e && e.getAttribute('d') !== d0; }""",
+             [f'[data-path="{path}"]', d0])
+        lat.append(1000 * (time.perf_counter() - t0))
+        server.append(page.evaluate("window.__studio.lastSimMs"))
+    page.mouse.up()
+    wait(page, "() => window.__studio.simFor === window.__studio.mech && !window.__studio.dragging")
+    return lat, server
+
+
+def check(page, point: str) -> float:
+    mech, sim = page.evaluate("[window.__studio.mech, window.__studio.sim]")
+    lib = simulate(mechanism_from_dict(mech), {sim["input"]["joint"]: np.array(sim["input"]["values"])},
+                   points=[point])
+    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"][point]], float)
+    ref = lib.points[point].position
+    assert np.array_equal(np.isnan(got), np.isnan(ref)), "assembled frames differ"
+    return float(np.nanmax(np.abs(got - ref)))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--moves", type=int, default=25)
+    ap.add_argument("--runs", type=int, default=3)
+    args = ap.parse_args()
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        for title, file, joint, point, target in CASES:
+            mech = mechanism_to_dict(load_mechanism(ROOT / file))
+            srv = LiveServer(create_app(tempfile.mkdtemp(), start=mech, token="bench"))
+            page = browser.new_page(viewport={"width": 1280, "height": 800})
+            page.goto(srv.url)
+            wait(page, "() => window.__studio && window.__studio.sim && window.__studio.simFor === window.__studio.mech")
+            medians, p90s, servers = [], [], []
+            for _ in range(args.runs):
+                lat, server = drag(page, joint, point, args.moves)
+                medians.append(statistics.median(lat))
+                p90s.append(float(np.percentile(lat, 90)))
+                servers.append(statistics.median(server))
+            err = check(page, point)
+            best = min(medians)
+            print(f"{title:13s} drag of {joint}: median {best:6.1f} ms (min of {args.runs} runs of {args.moves} moves; "
+                  f"medians {', '.join(f'{m:.0f}' for m in medians)}), p90 {min(p90s):6.1f} ms, "
+                  f"simulate request {min(servers):6.1f} ms; target <= {target:.0f} ms: "
+                  f"{'met' if best <= target else 'NOT met'}; path = library's (max diff {err:.1e})")
+            page.close()
+            srv.stop()
+        browser.close()
+
+
+if __name__ == "__main__":
+    main()

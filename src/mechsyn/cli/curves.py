@@ -1,0 +1,53 @@
+"""``mechsyn curves build``: build or extend the local curve database (resumable)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from mechsyn.cli.app import app
+from mechsyn.cli.common import console, emit_json, progress_bar
+from mechsyn.errors import MechsynInputError
+
+curves_app = typer.Typer(help="The local curve database of curve synthesis.", no_args_is_help=True)
+app.add_typer(curves_app, name="curves")
+
+
+@curves_app.command("build")
+def curves_build(
+    links: int = typer.Option(6, "--links", help="Topologies up to this many links: 4, 6 or 8."),
+    per_topology: int = typer.Option(3000, "--per-topology", help="Curves kept per topology."),
+    database: Optional[Path] = typer.Option(None, "--database", help="Directory (default: the local one)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the random designs."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Build on a Dask cluster (scheduler address; extra mechsyn[dask])."),
+    as_json: bool = typer.Option(False, "--json", help="Print a summary as JSON."),
+) -> None:
+    """Build or extend the curve database; rerun to resume or to add curves."""
+    from mechsyn.synthesis.curves.database import build_database, load_database
+    from mechsyn.synthesis.curves.topologies import curve_topologies
+
+    if links not in (4, 6, 8):
+        raise MechsynInputError(f"{links} links: choose 4, 6 or 8", source="--links")
+    if per_topology < 1:
+        raise MechsynInputError("must be at least 1", source="--per-topology")
+    total = len(curve_topologies(links))
+    with progress_bar("curves build", total, enabled=not as_json) as advance:
+        seen = {"done": 0}
+
+        def callback(state: dict) -> None:
+            advance(state["done"] - seen["done"])
+            seen["done"] = state["done"]
+
+        path = build_database(database, max_links=links, per_topology=per_topology, seed=seed,
+                              callback=callback, scheduler=scheduler)
+    db = load_database(path, max_links=links, build_if_missing=False)
+    summary = {"database": str(path), "topologies": len(db.topologies), "curves": len(db),
+               "closed": int(db.closed.sum()), "open": int((~db.closed).sum()),
+               "bytes": sum(f.stat().st_size for f in Path(path).glob("*.npz"))}
+    if as_json:
+        emit_json(summary)
+        return
+    console.print(f"{summary['curves']} curves ({summary['closed']} closed, {summary['open']} open arcs) of "
+                  f"{summary['topologies']} topologies in {path} ({summary['bytes'] / 1e6:.1f} MB)")

@@ -1,0 +1,59 @@
+"""``mechsyn serve [FILE|EXAMPLE]``: the studio, a local web app (see :mod:`mechsyn.web`)."""
+
+from __future__ import annotations
+
+import secrets
+import webbrowser
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from mechsyn.cli.app import app
+from mechsyn.cli.common import console, err_console
+from mechsyn.errors import MechsynInputError
+
+
+@app.command("serve")
+def serve(
+    target: Annotated[Optional[str], typer.Argument(help="Mechanism file, or an example name (e.g. fourbar).")] = None,
+    port: Annotated[int, typer.Option("--port", help="Port (0: any free port).", min=0, max=65535)] = 8765,
+    host: Annotated[str, typer.Option("--host", help="Address to bind; anything but 127.0.0.1 exposes the "
+                                      "studio to the network.")] = "127.0.0.1",
+    no_browser: Annotated[bool, typer.Option("--no-browser", help="Do not open a browser.")] = False,
+) -> None:
+    """Start mechsyn studio: draw, drag, analyse, animate and synthesise mechanisms in the browser."""
+    from mechsyn.web import create_app, run_server
+    from mechsyn.web._app import LOCAL_HOSTS
+    from mechsyn.web._service import example_path, read_mechanism
+
+    start, name = None, ""
+    if target:
+        path = Path(target)
+        if not path.exists() and path.suffix == "":
+            path = example_path(target)
+        elif not path.is_file():
+            raise MechsynInputError(f"{target}: no such file or example", source="FILE",
+                                    hint="give a mechanism file or an example name such as fourbar")
+        start, name = read_mechanism(path), path.name
+    if host not in LOCAL_HOSTS:
+        err_console.print(f"[bold yellow]warning:[/] serving on {host}: anyone who can reach this address and "
+                          "has the URL's token can use the studio and write files in this directory")
+    port = port or _free_port(host)
+    token = secrets.token_urlsafe(24)
+    shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
+    app_ = create_app(Path.cwd(), start=start, token=token, start_name=name,
+                      allowed_hosts=set(LOCAL_HOSTS) | {host, shown})
+    url = f"http://{'[' + shown + ']' if ':' in shown else shown}:{port}/?token={token}"
+    console.print(f"mechsyn studio at [bold]{url}[/]  (Ctrl+C stops it)", highlight=False, soft_wrap=True)
+    if not no_browser:
+        webbrowser.open(url)
+    run_server(app_, host=host, port=port)
+
+
+def _free_port(host: str) -> int:
+    import socket
+
+    with socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET) as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])

@@ -1,0 +1,61 @@
+"""The plates of :func:`mechsyn.export.plates.link_plates` as a DXF drawing (ezdxf).
+
+Layers: ``OUTLINE`` (closed polylines with arcs, one per plate), ``HOLES`` (circles of
+the cut diameter), ``POINTS`` (small marker circles at named points, to drill or
+engrave) and ``LABELS`` (text, to engrave or hide). ezdxf is the optional extra
+``cad``: ``pip install mechsyn[cad]``.
+
+References
+----------
+.. [1] Autodesk, *DXF Reference* (AutoCAD 2012), LWPOLYLINE bulge: tan(arc angle / 4).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.export.plates import PlateLayout
+from mechsyn.results import write_atomic
+
+__all__ = ["layout_to_dxf", "write_dxf"]
+
+_UNITS = {"mm": 4, "cm": 5, "m": 6, "in": 1, "inch": 1, "ft": 2}
+
+
+def _ezdxf():
+    try:
+        import ezdxf
+    except ImportError:
+        raise MechsynInputError("DXF export needs ezdxf", source="--dxf",
+                                hint="pip install 'mechsyn[cad]'") from None
+    return ezdxf
+
+
+def layout_to_dxf(layout: PlateLayout):
+    """An ezdxf document of the plates (R2010 DXF)."""
+    ezdxf = _ezdxf()
+    doc = ezdxf.new("R2010")
+    if layout.units and layout.units.lower() in _UNITS:
+        doc.units = _UNITS[layout.units.lower()]
+    for name, color in (("OUTLINE", 7), ("HOLES", 1), ("POINTS", 3), ("LABELS", 5)):
+        doc.layers.add(name, color=color)
+    msp = doc.modelspace()
+    for p in layout.plates:
+        msp.add_lwpolyline([(x, y, 0.0, 0.0, b) for x, y, b in p.outline], format="xyseb", close=True,
+                           dxfattribs={"layer": "OUTLINE"})
+        for c in p.holes:
+            msp.add_circle((float(c[0]), float(c[1])), layout.cut_diameter / 2, dxfattribs={"layer": "HOLES"})
+        for c in p.markers:
+            msp.add_circle((float(c[0]), float(c[1])), layout.cut_diameter / 6, dxfattribs={"layer": "POINTS"})
+        msp.add_text(p.label, height=0.4 * layout.width,
+                     dxfattribs={"layer": "LABELS", "insert": p.label_at})
+    return doc
+
+
+def write_dxf(layout: PlateLayout, path: str | os.PathLike[str]) -> None:
+    """Write the plates as a DXF file, whole or not at all."""
+    buf = io.StringIO()
+    layout_to_dxf(layout).write(buf)
+    write_atomic(path, buf.getvalue())

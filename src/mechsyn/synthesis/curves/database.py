@@ -1,0 +1,288 @@
+"""A local database of coupler curves: random designs of every candidate topology.
+
+For each topology (:func:`~mechsyn.synthesis.curves.topologies.curve_topologies`)
+random designs are drawn (:func:`sample_designs`: frame pivots and floating joints in a
+box, the crank's other joints close to its pivot so that many cranks turn fully, the
+tracing point near its link's joints) and run through the batch engine
+(:func:`mechsyn.kinematics.batch.simulate_batch`) over a full turn of the crank. A
+design is kept when
+
+* the crank turns fully without a dead point or a stepped-over dead point (a closed
+  curve), or
+* the crank oscillates over a clear range (at least :data:`MIN_RANGE` degrees) around
+  the reference configuration, without a branch jump (an open arc);
+
+and the tracing point's curve is not degenerate (it moves). Each kept design is
+stored with its input range and the Fourier descriptor of its curve
+(:mod:`~mechsyn.synthesis.curves.descriptors`), ``float32``, one ``.npz`` file per
+topology in a directory (default ``$MECHSYN_CURVE_DB`` or
+``~/.cache/mechsyn/curves-v1``). Building is resumable: a topology whose file already
+holds the requested number of curves is skipped, a short one is extended with new
+random designs (the seed continues from the count already drawn).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mechsyn.kinematics.batch import simulate_batch
+from mechsyn.results import write_atomic
+from mechsyn.synthesis.curves.descriptors import fourier_descriptor, resample
+from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology, curve_topologies
+
+__all__ = ["CurveDatabase", "build_database", "load_database", "default_database_dir", "sample_designs",
+           "evaluate_designs", "DEFAULT_PER_TOPOLOGY", "MIN_RANGE"]
+
+SWEEP_SAMPLES = 120          # 3 degree steps over a full turn
+MIN_RANGE = 60.0             # degrees of crank oscillation for an open arc
+DEFAULT_PER_TOPOLOGY = 3000
+DEFAULT_LINKS = 6
+VERSION = 1
+
+
+def default_database_dir() -> Path:
+    """``$MECHSYN_CURVE_DB`` or ``~/.cache/mechsyn/curves-v1``."""
+    env = os.environ.get("MECHSYN_CURVE_DB")
+    if env:
+        return Path(env)
+    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
+    return base / "mechsyn" / f"curves-v{VERSION}"
+
+
+def sample_designs(topo: CurveTopology, k: int, rng: np.random.Generator) -> np.ndarray:
+    """``k`` random designs ``(k, P)`` of a topology (see the module doc)."""
+    names = topo.plan.names
+    links = topo.links_of()
+    n = len(names)
+    xy = rng.uniform(-1.0, 1.0, size=(k, n, 2))
+    idx = {nm: i for i, nm in enumerate(names)}
+    pivot = idx[topo.plan.input_joint]
+    crank = links[f"L{topo.input}"]
+    for nm in crank:
+        if nm == topo.plan.input_joint:
+            continue
+        r = rng.uniform(0.1, 0.5, size=k)
+        a = rng.uniform(0, 2 * np.pi, size=k)
+        xy[:, idx[nm]] = xy[:, pivot] + np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+    on = [idx[nm] for nm in links[f"L{topo.tracer}"] if nm != TRACER]
+    xy[:, idx[TRACER]] = xy[:, on].mean(axis=1) + rng.normal(scale=0.6, size=(k, 2))
+    return xy.reshape(k, 2 * n)
+
+
+@dataclass
+class Evaluated:
+    """Designs that passed (see :func:`evaluate_designs`)."""
+
+    designs: np.ndarray     # (n, P)
+    ranges: np.ndarray      # (n, 2) input offsets [start, stop] degrees
+    closed: np.ndarray      # (n,) bool
+    curves: np.ndarray      # (n, M) complex, arc-length resampled (open: there and back)
+    descriptors: np.ndarray
+
+
+def _runs_around_zero(ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per row of a cyclic mask (sample 0 = reference): assembled samples forward of 0
+    and backward of 0 before the first unassembled one."""
+    n = ok.shape[1]
+    bad = ~ok
+    fwd = np.where(bad.any(axis=1), np.argmax(bad, axis=1), n)
+    back = np.where(bad.any(axis=1), np.argmax(bad[:, ::-1], axis=1), n)
+    return fwd, back
+
+
+def evaluate_designs(topo: CurveTopology, designs: np.ndarray, samples: int = SWEEP_SAMPLES) -> Evaluated:
+    """Run designs over a full turn and keep the usable ones (see the module doc)."""
+    step = 360.0 / samples
+    off = np.arange(samples) * step
+    res = simulate_batch(topo.plan, designs, off)
+    P = res.paths[TRACER]
+    ok = res.assembled
+    closed = res.full_cycle
+    fwd, back = _runs_around_zero(ok)
+    span = (fwd + back - 1) * step
+    arc = ~closed & ~res.branch_jump & ok[:, 0] & (span >= MIN_RANGE) & (fwd < samples)
+    keep = closed | arc
+    idx = np.flatnonzero(keep)
+    curves = np.empty((len(idx), 64), complex)
+    ranges = np.zeros((len(idx), 2))
+    good = np.ones(len(idx), bool)
+    z = P[..., 0] + 1j * P[..., 1]
+    for r, i in enumerate(idx):
+        if closed[i]:
+            pts = z[i]
+            ranges[r] = (0.0, 360.0)
+            curves[r] = resample(pts, 64, closed=True)
+        else:
+            seq = np.concatenate([z[i, samples - back[i]:], z[i, :fwd[i]]])
+            ranges[r] = (-back[i] * step, (fwd[i] - 1) * step)
+            curves[r] = resample(seq, 64, closed=False)
+        ext = np.ptp(curves[r].real) + np.ptp(curves[r].imag)
+        scale = np.abs(designs[i]).max()
+        good[r] = ext > 1e-3 * scale
+    idx, curves, ranges = idx[good], curves[good], ranges[good]
+    return Evaluated(designs[idx], ranges, closed[idx], curves, fourier_descriptor(curves))
+
+
+@dataclass
+class CurveDatabase:
+    """Kept designs of all topologies, rows aligned."""
+
+    topologies: tuple[CurveTopology, ...]
+    topology: np.ndarray        # (n,) index into topologies
+    designs: list[np.ndarray]   # per row, (P,) float
+    ranges: np.ndarray          # (n, 2) degrees (offsets from the reference)
+    closed: np.ndarray          # (n,) bool
+    descriptors: np.ndarray     # (n, D) float32
+
+    def __len__(self) -> int:
+        return len(self.topology)
+
+    def tree(self):
+        """A cKDTree over the descriptors (built once)."""
+        if getattr(self, "_tree", None) is None:
+            from scipy.spatial import cKDTree
+
+            self._tree = cKDTree(self.descriptors)
+        return self._tree
+
+
+def _file(directory: Path, topo: CurveTopology) -> Path:
+    return directory / f"{topo.key}.npz"
+
+
+def _read(path: Path) -> dict | None:
+    try:
+        with np.load(path) as f:
+            return {k: f[k] for k in f.files}
+    except (OSError, ValueError):
+        return None
+
+
+def build_database(directory: str | os.PathLike[str] | None = None, max_links: int = DEFAULT_LINKS,
+                   per_topology: int = DEFAULT_PER_TOPOLOGY, seed: int = 0, batch: int = 4000,
+                   callback: Callable[[dict], None] | None = None, scheduler: str | None = None) -> Path:
+    """Build or extend the curve database (resumable; see the module doc).
+
+    ``callback(state)`` is called after each topology with ``stage="build"``, ``done``,
+    ``total`` (topologies) and ``curves`` (kept so far). With ``scheduler`` (a
+    ``dask.distributed`` address or ``Client``) the topologies are built on a Dask
+    cluster and written here.
+    """
+    directory = Path(directory) if directory is not None else default_database_dir()
+    directory.mkdir(parents=True, exist_ok=True)
+    topos = curve_topologies(max_links)
+    todo = []
+    for i, t in enumerate(topos):
+        have = _read(_file(directory, t))
+        n = 0 if have is None else len(have["ranges"])
+        if n < per_topology:
+            todo.append((i, t.key, max_links, per_topology, seed, batch, have))
+    total, done, kept = len(topos), len(topos) - len(todo), 0
+    if callback is not None:
+        callback({"stage": "build", "done": done, "total": total, "curves": kept})
+    if scheduler is not None and todo:
+        client = _dask_client(scheduler)
+        futures = client.map(_build_one, todo, pure=False)
+        from dask.distributed import as_completed
+
+        for fut in as_completed(futures):
+            key, data = fut.result()
+            _write(directory / f"{key}.npz", data)
+            done += 1
+            kept += len(data["ranges"])
+            if callback is not None:
+                callback({"stage": "build", "done": done, "total": total, "curves": kept})
+        return directory
+    for job in todo:
+        key, data = _build_one(job)
+        _write(directory / f"{key}.npz", data)
+        done += 1
+        kept += len(data["ranges"])
+        if callback is not None:
+            callback({"stage": "build", "done": done, "total": total, "curves": kept})
+    return directory
+
+
+def _dask_client(scheduler):
+    """A ``dask.distributed`` client for an address (or the client given)."""
+    from mechsyn.errors import MechsynInputError
+
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
+                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+    if isinstance(scheduler, Client):
+        return scheduler
+    try:
+        return Client(scheduler, timeout=10)
+    except (OSError, TimeoutError) as exc:
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+                                hint="give the address printed by dask-scheduler, e.g. tcp://host:8786") from None
+
+
+def _write(path: Path, data: dict) -> None:
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **data)
+    write_atomic(path, buf.getvalue())
+
+
+def _build_one(job) -> tuple[str, dict]:
+    i, key, max_links, per_topology, seed, batch, have = job
+    topo = next(t for t in curve_topologies(max_links) if t.key == key)
+    drawn = 0 if have is None else int(have["drawn"])
+    parts = {k: [have[k]] for k in ("designs", "ranges", "closed", "descriptors")} if have is not None else \
+        {k: [] for k in ("designs", "ranges", "closed", "descriptors")}
+    n = 0 if have is None else len(have["ranges"])
+    tries = 0
+    while n < per_topology and tries < 200:
+        size = int(min(batch, 2 * (per_topology - n) + 64))
+        rng = np.random.default_rng([seed, i, drawn])
+        ev = evaluate_designs(topo, sample_designs(topo, size, rng))
+        drawn += size
+        tries += 1
+        take = min(per_topology - n, len(ev.ranges))
+        parts["designs"].append(ev.designs[:take].astype(np.float32))
+        parts["ranges"].append(ev.ranges[:take].astype(np.float32))
+        parts["closed"].append(ev.closed[:take])
+        parts["descriptors"].append(ev.descriptors[:take].astype(np.float32))
+        n += take
+    data = {k: np.concatenate(v) if v else np.zeros(0) for k, v in parts.items()}
+    data["drawn"] = np.array(drawn)
+    return key, data
+
+
+def load_database(directory: str | os.PathLike[str] | None = None, max_links: int = 8,
+                  build_if_missing: bool = True, callback: Callable[[dict], None] | None = None) -> CurveDatabase:
+    """Read the database (topologies up to ``max_links``); build the default small one
+    (4- and 6-bars) first when there is none."""
+    directory = Path(directory) if directory is not None else default_database_dir()
+    topos = curve_topologies(max(max_links, 4))
+    present = [t for t in topos if _file(directory, t).exists()]
+    if not present and build_if_missing:
+        build_database(directory, max_links=min(max_links, DEFAULT_LINKS), callback=callback)
+        present = [t for t in topos if _file(directory, t).exists()]
+    rows_t, designs, ranges, closed, desc = [], [], [], [], []
+    for ti, t in enumerate(present):
+        data = _read(_file(directory, t))
+        if data is None or len(data["ranges"]) == 0:
+            continue
+        m = len(data["ranges"])
+        rows_t.append(np.full(m, ti))
+        designs.extend(np.asarray(data["designs"], float))
+        ranges.append(data["ranges"])
+        closed.append(data["closed"])
+        desc.append(data["descriptors"])
+    if not rows_t:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError(f"no curve database in {directory}", source="--database",
+                                hint="run `mechsyn curves build`")
+    return CurveDatabase(tuple(present), np.concatenate(rows_t), designs, np.concatenate(ranges).astype(float),
+                         np.concatenate(closed).astype(bool), np.concatenate(desc).astype(np.float32))

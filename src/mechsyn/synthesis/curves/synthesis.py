@@ -1,0 +1,588 @@
+"""Curve to mechanism: retrieval from the curve database, then least-squares refinement.
+
+:func:`synthesize_curve` takes a drawn curve and returns ranked 4-, 6- and 8-bar
+linkages whose tracing point follows it:
+
+1. **Normalise** the target: ``M`` points equally spaced in arc length (an open curve
+   there and back), its Fourier descriptor (:mod:`.descriptors`).
+2. **Retrieve**: nearest descriptors in the database (:mod:`.database`, a SciPy
+   ``cKDTree``), for both senses of traversal; the candidates' curves are recomputed by
+   the batch engine and re-ranked by the exact closed-form similarity alignment (best
+   rotation, scale, translation, start point, sense and mirror image at once).
+3. **Map** each retained design into the target's frame by its similarity (a linkage
+   whose joints are rotated, scaled, translated or mirrored traces the curve so
+   transformed, on the same assembly branch, mirrored with its input reversed).
+4. **Refine** the best few dozen by ``scipy.optimize.least_squares`` on the joint and
+   tracer coordinates: residuals are the symmetric chamfer distances (each target
+   point to the traced polyline, each traced point to the target polyline), with the
+   similarity re-solved in closed form before each refinement; the Jacobian is one
+   batch evaluation of all perturbed designs. A design must stay assembled on its
+   branch over the whole input range (no dead point, no stepped-over dead point);
+   leaving it is penalised, never accepted. Options: a crank (fully rotating input),
+   a ground region for the frame pivots, a largest link-length ratio.
+5. **Check** each final candidate by re-simulating its mechanism file through the
+   ordinary :func:`mechsyn.kinematics.simulate` and comparing the tracer's path.
+
+Errors are reported divided by the target's bounding-box diagonal: ``chamfer`` (mean of
+the two mean nearest distances, point to polyline) and ``ordered`` (root mean square
+distance between points equally spaced in arc length along both curves, best start
+and sense, no re-scaling: the timing of a constant-speed crank against the drawing's
+own parametrisation).
+
+The approach follows the retrieve-then-refine scheme of LInK (A. Nobari, A. Srivastava,
+D. Gutfreund, K. Xu and F. Ahmed, "LInK: Learning joint representations of design and
+performance spaces through contrastive learning for mechanism synthesis",
+*Transactions on Machine Learning Research*, 2024), with exact enumeration of the
+topologies (the atlas) instead of a learned embedding, and closed-form invariant
+descriptors instead of a neural encoder.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.batch import simulate_batch
+from mechsyn.synthesis.curves.database import CurveDatabase, load_database
+from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
+from mechsyn.synthesis.curves.target import TargetCurve, target_from_points
+from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
+
+__all__ = ["CurveCandidate", "CurveSynthesisResult", "synthesize_curve", "curve_errors"]
+
+M_TARGET = 64          # target points for the residuals
+N_TRACE = 96           # input samples along the range (refinement)
+N_FINAL = 360          # input samples of the reported path and errors
+PENALTY = 1.0          # residual (in target diagonals) of an unassembled design
+
+
+@dataclass
+class CurveCandidate:
+    """One ranked linkage (see :meth:`to_dict` for the reported fields)."""
+
+    topology: CurveTopology
+    params: np.ndarray              # design in the target's coordinates
+    start: float                    # input offsets from the reference, degrees
+    stop: float
+    chamfer: float                  # / bbox diagonal
+    ordered: float
+    min_transmission_angle: float
+    link_length_ratio: float
+    path: np.ndarray                # (N, 2) traced path
+    verified: bool = False
+    verification: str = ""
+    nfev: int = 0
+    reference_input: float = float("nan")   # input angle (deg) of the design's configuration
+
+    def __post_init__(self) -> None:
+        if not np.isfinite(self.reference_input):
+            from mechsyn.io.load import mechanism_from_dict
+            from mechsyn.kinematics.batch import compile_plan
+
+            self.reference_input = compile_plan(mechanism_from_dict(self.mechanism()),
+                                                points=[TRACER]).reference_input
+
+    def mechanism(self) -> dict:
+        t = self.topology
+        name = f"{t.name or f'{t.n_links}-bar'} tracing the target (mechsyn synth curve)"
+        return t.mechanism(self.params, name=name)
+
+    def to_dict(self) -> dict[str, Any]:
+        t = self.topology
+        ref = self.reference_input
+        return {
+            "mechanism": self.mechanism(),
+            "tracer": TRACER,
+            "input": {"joint": t.plan.input_joint, "start": ref + self.start, "stop": ref + self.stop},
+            "links": t.n_links,
+            "topology": t.name,
+            "topology_key": t.key,
+            "error": {"chamfer": self.chamfer, "ordered": self.ordered},
+            "min_transmission_angle": self.min_transmission_angle,
+            "link_length_ratio": self.link_length_ratio,
+            "crank": bool(self.stop - self.start >= 360.0 - 1e-9),
+            "verified": self.verified,
+            "verification": self.verification,
+        }
+
+
+@dataclass
+class CurveSynthesisResult:
+    """Ranked candidates, best first (``to_dict()`` is the ``--json`` output)."""
+
+    target: TargetCurve
+    candidates: list[CurveCandidate]
+    seconds: float
+    retrieved: int
+    refined: int
+    interrupted: bool = False
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"candidates": [c.to_dict() for c in self.candidates],
+                "target": {"points": self.target.points, "closed": self.target.closed,
+                           "diagonal": self.target.diagonal},
+                "seconds": self.seconds, "retrieved": self.retrieved, "refined": self.refined,
+                "interrupted": self.interrupted, "notes": self.notes}
+
+    def __str__(self) -> str:
+        lines = [f"curve synthesis: {len(self.candidates)} candidates, {self.refined} refined of "
+                 f"{self.retrieved} retrieved, {self.seconds:.1f} s" + (" (interrupted)" if self.interrupted else "")]
+        for i, c in enumerate(self.candidates, 1):
+            lines.append(f"{i}. {c.topology.name or str(c.topology.n_links) + '-bar'} [{c.topology.key}]: "
+                         f"chamfer {100 * c.chamfer:.2f} %, ordered {100 * c.ordered:.2f} %, "
+                         f"min transmission {c.min_transmission_angle:.0f} deg"
+                         + ("" if c.verified else "  NOT VERIFIED"))
+        return "\n".join(lines)
+
+    def plot(self, ax=None, top: int = 3):
+        """Target and the best candidates' paths (see :func:`mechsyn.plot.curves.plot_curve_result`)."""
+        from mechsyn.plot.curves import plot_curve_result
+
+        return plot_curve_result(self, ax=ax, top=top)
+
+
+# ----------------------------------------------------------------------------- distances
+
+
+def _polyline(points: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Segment starts and vectors ``(S, 2)`` of a polyline."""
+    P = points
+    Q = np.roll(P, -1, axis=0) if closed else P[1:]
+    P = P if closed else P[:-1]
+    return P, Q - P
+
+
+def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
+                 k: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Vectors from points ``X (..., n, 2)`` to their nearest point on the polyline
+    (``starts``, ``vecs`` ``(..., S, 2)``), and the index of that segment ``(..., n)``.
+    With ``k`` given, the segments are those (fixed correspondences, for Jacobians)."""
+    if k is not None:
+        shape = np.broadcast_shapes(X.shape[:-1], k.shape, starts.shape[:-2] + k.shape[-1:])
+        st = np.take_along_axis(np.broadcast_to(starts, shape[:-1] + starts.shape[-2:]),
+                                np.broadcast_to(k, shape)[..., None], axis=-2)
+        ve = np.take_along_axis(np.broadcast_to(vecs, shape[:-1] + vecs.shape[-2:]),
+                                np.broadcast_to(k, shape)[..., None], axis=-2)
+        d = X - st
+        L2 = np.sum(ve ** 2, axis=-1)
+        t = np.clip(np.sum(d * ve, axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+        return t[..., None] * ve - d, k
+    d = X[..., :, None, :] - starts[..., None, :, :]                   # (..., n, S, 2)
+    L2 = np.sum(vecs ** 2, axis=-1)[..., None, :]
+    t = np.clip(np.sum(d * vecs[..., None, :, :], axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+    diff = d - t[..., None] * vecs[..., None, :, :]
+    dist2 = np.sum(diff ** 2, axis=-1)
+    k = np.argmin(dist2, axis=-1)
+    return -np.take_along_axis(diff, k[..., None, None], axis=-2)[..., 0, :], k
+
+
+def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[float, float]:
+    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals."""
+    T = target.points
+    ts, tv = _polyline(T, target.closed)
+    ps, pv = _polyline(path, closed_path)
+    a = np.linalg.norm(_to_polyline(T, ps, pv)[0], axis=-1).mean()
+    b = np.linalg.norm(_to_polyline(path, ts, tv)[0], axis=-1).mean()
+    chamfer = 0.5 * (a + b) / target.diagonal
+    m = 128
+    w = resample(T, m, closed=target.closed)
+    z = resample(path, m, closed=closed_path)
+    best = np.inf
+    for zz in (z, z[::-1]):
+        for s in range(m):
+            best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
+    return float(chamfer), best / target.diagonal
+
+
+# ---------------------------------------------------------------------------- evaluation
+
+
+def _offsets(start: float, stop: float, closed: bool, n: int = N_TRACE) -> np.ndarray:
+    if closed:
+        return start + np.arange(n) * (360.0 / n)
+    return np.linspace(start, stop, n)
+
+
+@dataclass
+class _Problem:
+    topo: CurveTopology
+    target: TargetCurve
+    closed_path: bool
+    start: float
+    stop: float
+    ground_region: tuple[float, float, float, float] | None
+    max_link_ratio: float | None
+    min_transmission: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.off = _offsets(self.start, self.stop, self.closed_path)
+        self.T = resample(self.target.points, M_TARGET, closed=self.target.closed)
+        self.T = np.stack([self.T.real, self.T.imag], axis=-1)
+        if not self.target.closed:  # resample there and back: keep the way there
+            self.T = resample(self.target.points, 2 * M_TARGET - 2, closed=False)[:M_TARGET]
+            self.T = np.stack([self.T.real, self.T.imag], axis=-1)
+        self.ts, self.tv = _polyline(self.target.points, self.target.closed)
+        self.diag = self.target.diagonal
+        names = self.topo.plan.names
+        self.frame_pts = [i for i, n in enumerate(names) if n != TRACER and any(
+            j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
+        self.link_pairs = _link_pairs(self.topo)
+        self.nfev = 0
+
+    def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
+        """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
+        segments of the first design are used for all (the Jacobian's perturbations)."""
+        X = np.atleast_2d(X)
+        self.nfev += len(X)
+        res = simulate_batch(self.topo.plan, X, self.off, transmission=self.min_transmission > 0)
+        P = res.paths[TRACER]
+        bad = ~res.assembled.all(axis=1) | res.branch_jump
+        P = np.where(np.isfinite(P), P, 0.0)
+        starts = P if self.closed_path else P[:, :-1]
+        vecs = (np.roll(P, -1, axis=1) if self.closed_path else P[:, 1:]) - starts
+        if keep:
+            r1, k1 = _to_polyline(self.T[None], starts[:1], vecs[:1])
+            r2, k2 = _to_polyline(P[:1], self.ts[None], self.tv[None])
+            r1 = np.concatenate([r1, _to_polyline(self.T[None], starts[1:], vecs[1:], k1)[0]])
+            r2 = np.concatenate([r2, _to_polyline(P[1:], self.ts[None], self.tv[None], k2)[0]])
+        else:
+            r1 = _to_polyline(self.T[None], starts, vecs)[0]        # target -> path
+            r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
+        r1 = r1 / np.sqrt(len(self.T))
+        r2 = r2 / np.sqrt(P.shape[1])
+        r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1)], axis=1) / self.diag
+        r[bad] = PENALTY                 # off its branch or not assembled: never accepted
+        pen = []
+        if self.min_transmission > 0:
+            mu = np.nan_to_num(res.min_transmission_angle, nan=0.0)
+            pen.append(np.maximum(0.0, 1.0 - mu / self.min_transmission)[:, None] * 0.05)
+        if self.max_link_ratio is not None:
+            lr = _link_ratio(X, self.link_pairs)
+            pen.append(np.maximum(0.0, lr / self.max_link_ratio - 1.0)[:, None])
+        if self.ground_region is not None:
+            x0, y0, x1, y1 = self.ground_region
+            G = X.reshape(len(X), -1, 2)[:, self.frame_pts]
+            out = (np.maximum(0, x0 - G[..., 0]) + np.maximum(0, G[..., 0] - x1)
+                   + np.maximum(0, y0 - G[..., 1]) + np.maximum(0, G[..., 1] - y1)) / self.diag
+            pen.append(out * 10.0)
+        self.last_bad = bad
+        return np.concatenate([r] + pen, axis=1)
+
+    def fun(self, x: np.ndarray) -> np.ndarray:
+        return self.residuals(x[None])[0]
+
+    def jac(self, x: np.ndarray) -> np.ndarray:
+        h = 1e-7 * self.diag
+        X = np.vstack([x, x + h * np.eye(len(x))])
+        R = self.residuals(X, keep=True)
+        return (R[1:] - R[0]).T / h
+
+
+def _link_pairs(topo: CurveTopology) -> list[tuple[int, int]]:
+    """Index pairs of joints (and tracer) on the same link: the link lengths."""
+    names = topo.plan.names
+    idx = {n: i for i, n in enumerate(names)}
+    pairs = []
+    for link, pts in topo.links_of().items():
+        pts = [p for p in pts if p != TRACER]
+        for a in range(len(pts)):
+            for b in range(a + 1, len(pts)):
+                pairs.append((idx[pts[a]], idx[pts[b]]))
+    return pairs
+
+
+def _link_ratio(X: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
+    P = np.atleast_2d(X).reshape(len(np.atleast_2d(X)), -1, 2)
+    a = np.array([p[0] for p in pairs])
+    b = np.array([p[1] for p in pairs])
+    L = np.linalg.norm(P[:, a] - P[:, b], axis=-1)
+    return L.max(axis=1) / np.maximum(L.min(axis=1), 1e-300)
+
+
+# ------------------------------------------------------------------------------ retrieval
+
+
+@dataclass
+class _Seed:
+    row: int
+    topo: CurveTopology
+    params: np.ndarray      # in the target's frame
+    start: float
+    stop: float
+    closed: bool
+    score: float
+
+
+def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) -> np.ndarray:
+    z = params[0::2] + 1j * params[1::2]
+    if mirror:
+        z = np.conj(z)
+    w = c * z + t
+    out = np.empty_like(params)
+    out[0::2], out[1::2] = w.real, w.imag
+    return out
+
+
+def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool) -> list[_Seed]:
+    w = resample(target.points, 64, closed=target.closed)
+    d = fourier_descriptor(w)
+    tree = db.tree()
+    rows: set[int] = set()
+    kk = min(k, len(db))
+    for q in (d, swap_direction(d)):
+        _, ii = tree.query(q.astype(np.float32), k=kk)
+        rows.update(np.atleast_1d(ii).tolist())
+    rows_a = np.array(sorted(r for r in rows if r < len(db)))
+    rows_a = rows_a[[db.topologies[db.topology[r]].n_links <= max_links for r in rows_a]]
+    if crank:
+        rows_a = rows_a[db.closed[rows_a]]
+    if not target.closed:
+        rows_a = rows_a[~db.closed[rows_a]]
+    seeds: list[_Seed] = []
+    by_topo: dict[int, list[int]] = {}
+    for r in rows_a.tolist():
+        by_topo.setdefault(int(db.topology[r]), []).append(r)
+    for ti, rs in by_topo.items():
+        topo = db.topologies[ti]
+        curves = []
+        for r in rs:
+            a, b = db.ranges[r]
+            off = _offsets(a, b, bool(db.closed[r]))
+            P = simulate_batch(topo.plan, db.designs[r][None], off).paths[TRACER][0]
+            if not np.all(np.isfinite(P)):
+                curves.append(None)
+                continue
+            curves.append(resample(P, 64, closed=bool(db.closed[r])))
+        ok = [i for i, c in enumerate(curves) if c is not None]
+        if not ok:
+            continue
+        al = align(np.array([curves[i] for i in ok]), w)
+        for j, i in enumerate(ok):
+            r = rs[i]
+            a, b = (float(v) for v in db.ranges[r])
+            if not db.closed[r]:  # keep clear of the dead points that end the range
+                a, b = a + 0.04 * (b - a), b - 0.04 * (b - a)
+            mir = bool(al.mirror[j])
+            if mir:  # a mirrored linkage runs its input the other way
+                a, b = -b, -a
+            params = _transform_design(np.asarray(db.designs[r], float), complex(al.c[j]), complex(al.t[j]), mir)
+            seeds.append(_Seed(r, topo, params, a, b, bool(db.closed[r]), float(al.rms[j]) / target.diagonal))
+    seeds.sort(key=lambda s: s.score)
+    return seeds
+
+
+# ----------------------------------------------------------------------------- refinement
+
+
+def _refine(seed: _Seed, target: TargetCurve, ground_region, max_link_ratio, max_nfev: int,
+            min_transmission: float = 0.0) -> CurveCandidate | None:
+    prob = _Problem(seed.topo, target, seed.closed, seed.start, seed.stop, ground_region, max_link_ratio,
+                    min_transmission)
+    x0 = seed.params
+    prob.fun(x0)
+    if prob.last_bad[0]:  # does not assemble over the range after the mapping
+        return None
+    try:
+        sol = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=target.diagonal,
+                            max_nfev=max_nfev, xtol=1e-10, ftol=1e-10)
+        x = sol.x
+    except np.linalg.LinAlgError:  # a singular step: keep the retrieved design
+        x = x0
+    return _candidate(seed.topo, x, seed.start, seed.stop, seed.closed, target, prob.nfev)
+
+
+def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, closed: bool,
+               target: TargetCurve, nfev: int) -> CurveCandidate | None:
+    off = _offsets(start, stop, closed, N_FINAL)
+    res = simulate_batch(topo.plan, x[None], off, transmission=True)
+    if not res.assembled.all() or res.branch_jump[0]:
+        return None
+    path = res.paths[TRACER][0]
+    ch, od = curve_errors(path, target, closed)
+    return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
+                          float(res.min_transmission_angle[0]), float(_link_ratio(x, _link_pairs(topo))[0]),
+                          path, nfev=nfev)
+
+
+def _verify(c: CurveCandidate) -> None:
+    """Re-simulate through the ordinary ``simulate`` and compare the tracer's path."""
+    from mechsyn.io.load import mechanism_from_dict
+    from mechsyn.kinematics import simulate
+
+    t = c.topology
+    closed = c.stop - c.start >= 360.0 - 1e-9
+    off = _offsets(c.start, c.stop, closed, N_FINAL)
+    try:
+        mech = mechanism_from_dict(c.mechanism())
+        # the reference configuration first: simulate takes the assembly mode from it
+        vals = c.reference_input + np.concatenate([[0.0], off])
+        sim = simulate(mech, {t.plan.input_joint: vals}, points=[TRACER])
+    except MechsynInputError as exc:
+        c.verified, c.verification = False, f"simulate refused the mechanism: {exc.message}"
+        return
+    P = sim.points[TRACER].position[1:]
+    if not sim.assembled.all():
+        c.verified, c.verification = False, "simulate finds it not assembled over the input range"
+        return
+    err = float(np.max(np.abs(P - c.path)))
+    scale = float(np.abs(c.path).max()) + 1.0
+    c.verified = err <= 1e-7 * scale
+    c.verification = f"simulate reproduces the path to {err:.1e}" if c.verified else \
+        f"simulate differs from the batch path by {err:.3g}"
+
+
+def synthesize_curve(
+    target: TargetCurve | np.ndarray,
+    *,
+    max_links: int = 8,
+    time_limit: float = 60.0,
+    top: int = 5,
+    n_refine: int = 24,
+    retrieve: int = 300,
+    crank: bool = False,
+    ground_region: tuple[float, float, float, float] | None = None,
+    max_link_ratio: float | None = None,
+    min_transmission: float = 15.0,
+    database: CurveDatabase | str | None = None,
+    callback: Callable[[dict], None] | None = None,
+    max_nfev: int = 60,
+) -> CurveSynthesisResult:
+    """Ranked linkages (4 to ``max_links`` links) whose tracing point follows a curve.
+
+    Parameters
+    ----------
+    target : TargetCurve or (n, 2) array
+        The curve (arrays: closed when the ends nearly meet).
+    max_links : {4, 6, 8}
+        Largest linkage considered.
+    time_limit : float
+        Seconds for retrieval and refinement; the best found so far is returned.
+    top : int
+        Candidates returned (distinct designs, best chamfer error first).
+    n_refine, retrieve : int
+        Designs refined, and nearest descriptors retrieved per query.
+    crank : bool
+        Only fully rotating inputs.
+    ground_region : (x0, y0, x1, y1), optional
+        Box (target coordinates) the frame pivots must stay in.
+    max_link_ratio : float, optional
+        Largest ratio of the longest to the shortest link length.
+    min_transmission : float
+        Transmission angles (degrees, of every RRR dyad over the range) below this are
+        penalised in the refinement (0: no penalty); reported for every candidate.
+    database : CurveDatabase or directory, optional
+        Default: the local database (built on first use).
+    callback : callable, optional
+        ``callback(state)`` with ``state = {"stage", "done", "total", "best", "nfev"}``
+        (``best``: the best chamfer error so far, in target diagonals).
+
+    Returns
+    -------
+    CurveSynthesisResult
+        Candidates best first, each re-simulated through ``simulate``; Ctrl-C during
+        refinement returns what was found so far (``interrupted``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.synthesis.curves.database import build_database, load_database
+    >>> import tempfile
+    >>> d = tempfile.mkdtemp()
+    >>> _ = build_database(d, max_links=4, per_topology=400)
+    >>> t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    >>> ellipse = np.c_[3 * np.cos(t), np.sin(t)]
+    >>> res = synthesize_curve(ellipse, max_links=4, top=1, n_refine=3, database=load_database(d))
+    >>> c = res.candidates[0]
+    >>> c.topology.name, c.verified, c.chamfer < 0.02
+    ('four-bar', True, True)
+    """
+    t0 = time.perf_counter()
+    if not isinstance(target, TargetCurve):
+        target = target_from_points(target)
+    if max_links not in (4, 6, 8):
+        raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", source="--max-links")
+    if time_limit <= 0:
+        raise MechsynInputError("must be positive", source="--time-limit")
+    if top < 1:
+        raise MechsynInputError("must be at least 1", source="--top")
+    if max_link_ratio is not None and not max_link_ratio > 1:
+        raise MechsynInputError("must be greater than 1", source="--max-link-ratio")
+    if crank and not target.closed:
+        raise MechsynInputError("a crank (full turn) traces a closed curve; the target is open",
+                                source="--crank", hint="drop --crank or close the target")
+    if database is None or isinstance(database, str):
+        database = load_database(database, max_links=max_links, callback=callback)
+
+    def report(stage, done, total, best, nfev):
+        if callback is not None:
+            callback({"stage": stage, "done": done, "total": total, "best": best, "nfev": nfev})
+
+    report("retrieve", 0, 1, float("nan"), 0)
+    seeds = _retrieve(database, target, retrieve, max_links, crank)
+    report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
+    notes: list[str] = []
+    # diversity: at most a third of the refinements from one topology
+    picked: list[_Seed] = []
+    per: dict[str, int] = {}
+    cap = max(2, n_refine // 3)
+    for s in seeds:
+        if per.get(s.topo.key, 0) < cap:
+            picked.append(s)
+            per[s.topo.key] = per.get(s.topo.key, 0) + 1
+        if len(picked) >= n_refine:
+            break
+    cands: list[CurveCandidate] = []
+    nfev = 0
+    interrupted = False
+    best = float("inf")
+    try:
+        for i, s in enumerate(picked):
+            if time.perf_counter() - t0 > time_limit:
+                notes.append(f"time limit reached after {i} of {len(picked)} refinements")
+                break
+            c = _refine(s, target, ground_region, max_link_ratio, max_nfev, min_transmission)
+            if c is not None:
+                nfev += c.nfev
+                if (max_link_ratio is None or c.link_length_ratio <= max_link_ratio * (1 + 1e-6)) and \
+                        (ground_region is None or _in_region(c, ground_region)):
+                    cands.append(c)
+                    best = min(best, c.chamfer)
+            report("refine", i + 1, len(picked), best, nfev)
+    except KeyboardInterrupt:
+        interrupted = True
+        notes.append("interrupted: the best found so far")
+    if not picked:
+        notes.append("no database design matched the options (crank, links, open/closed)")
+    cands.sort(key=lambda c: c.chamfer)
+    out: list[CurveCandidate] = []
+    for c in cands:
+        if any(o.topology.key == c.topology.key and abs(o.chamfer - c.chamfer) < 1e-6 for o in out):
+            continue
+        _verify(c)
+        if c.verified:
+            out.append(c)
+        else:
+            notes.append(f"{c.topology.key}: dropped, {c.verification}")
+        if len(out) >= top:
+            break
+    report("done", 1, 1, out[0].chamfer if out else float("nan"), nfev)
+    return CurveSynthesisResult(target, out, time.perf_counter() - t0, len(seeds), len(picked), interrupted, notes)
+
+
+def _in_region(c: CurveCandidate, box) -> bool:
+    x0, y0, x1, y1 = box
+    names = c.topology.plan.names
+    xy = c.params.reshape(-1, 2)
+    for j in c.topology.template["joints"]:
+        if f"L{c.topology.frame}" in j["links"]:
+            x, y = xy[names.index(j["id"])]
+            if not (x0 - 1e-9 <= x <= x1 + 1e-9 and y0 - 1e-9 <= y <= y1 + 1e-9):
+                return False
+    return True

@@ -1,0 +1,194 @@
+"""Target curves from files: CSV of x,y rows, JSON ``{"points": [...], "closed": true}``,
+or the first ``<path d="...">`` of an SVG file (M, L, H, V, C, S, Q, T, Z commands,
+absolute and relative; arcs are refused with a clear message)."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+
+__all__ = ["TargetCurve", "read_target", "target_from_points"]
+
+
+@dataclass(frozen=True)
+class TargetCurve:
+    """Points ``(n, 2)`` of a drawn curve; ``closed`` when it is a loop."""
+
+    points: np.ndarray
+    closed: bool
+    source: str = "<points>"
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding-box diagonal (the error unit)."""
+        return float(np.hypot(*np.ptp(self.points, axis=0)))
+
+
+def target_from_points(points, closed: bool | None = None, source: str = "<points>") -> TargetCurve:
+    """Check and wrap points; ``closed=None`` decides by the gap between the ends
+    (closed when it is under 5 % of the bounding-box diagonal)."""
+    try:
+        P = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise MechsynInputError("points must be [x, y] pairs of numbers", source=source, field="points") from None
+    if P.ndim != 2 or P.shape[1] != 2:
+        raise MechsynInputError("points must be [x, y] pairs", source=source, field="points")
+    if not np.all(np.isfinite(P)):
+        raise MechsynInputError("points must be finite numbers", source=source, field="points")
+    keep = np.concatenate([[True], np.any(np.abs(np.diff(P, axis=0)) > 0, axis=1)])
+    P = P[keep]
+    if len(P) < 3:
+        raise MechsynInputError(f"a curve needs at least 3 distinct points, got {len(P)}", source=source,
+                                field="points")
+    diag = float(np.hypot(*np.ptp(P, axis=0)))
+    if diag == 0:
+        raise MechsynInputError("all points coincide", source=source, field="points")
+    gap = float(np.hypot(*(P[-1] - P[0])))
+    if closed is None:
+        closed = gap < 0.05 * diag
+    if closed and gap < 1e-9 * diag:
+        P = P[:-1]
+    return TargetCurve(P, bool(closed), source)
+
+
+def read_target(path: str | os.PathLike[str]) -> TargetCurve:
+    """Read a target curve file (CSV, JSON or SVG, by suffix)."""
+    p = Path(path)
+    src = str(p)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise MechsynInputError("file not found", source=src) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise MechsynInputError(f"cannot read the file: {exc}", source=src) from None
+    suffix = p.suffix.lower()
+    if suffix == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise MechsynInputError(f"invalid JSON: {exc.msg}", source=src, line=exc.lineno) from None
+        if not isinstance(data, dict) or "points" not in data:
+            raise MechsynInputError('expected {"points": [[x, y], ...], "closed": true}', source=src,
+                                    field="points")
+        closed = data.get("closed")
+        if closed is not None and not isinstance(closed, bool):
+            raise MechsynInputError("closed must be true or false", source=src, field="closed")
+        return target_from_points(data["points"], closed, src)
+    if suffix == ".svg":
+        m = re.search(r"<path[^>]*\sd\s*=\s*(['\"])(.*?)\1", text, re.S)
+        if not m:
+            raise MechsynInputError("no <path d=...> in the SVG", source=src, field="path")
+        pts, closed = _svg_path(m.group(2), src)
+        pts[:, 1] *= -1.0  # SVG's y axis points down
+        return target_from_points(pts, closed, src)
+    if suffix in (".csv", ".txt"):
+        rows = []
+        for k, line in enumerate(text.splitlines(), 1):
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            parts = [s for s in re.split(r"[,;\s]+", line) if s]
+            try:
+                rows.append([float(parts[0]), float(parts[1])])
+            except (ValueError, IndexError):
+                if not rows:  # a header line
+                    continue
+                raise MechsynInputError(f"expected two numbers x,y, got {line!r}", source=src, line=k) from None
+        return target_from_points(rows, None, src)
+    raise MechsynInputError(f"unknown target format {suffix or '(no suffix)'}", source=src,
+                            hint="give a .csv (x,y rows), .json ({\"points\": ...}) or .svg (a path)")
+
+
+_TOKEN = re.compile(r"([MmLlHhVvCcSsQqTtZzAa])|([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+
+
+def _svg_path(d: str, src: str, per_segment: int = 24) -> tuple[np.ndarray, bool]:
+    toks = [(a, b) for a, b in _TOKEN.findall(d)]
+    pts: list[complex] = []
+    cur = start = 0j
+    cmd = None
+    last_ctrl = None
+    closed = False
+    i = 0
+    t = np.linspace(0, 1, per_segment + 1)[1:]
+
+    def nums(k: int) -> list[float]:
+        nonlocal i
+        out = []
+        for _ in range(k):
+            if i >= len(toks) or toks[i][1] == "":
+                raise MechsynInputError("malformed SVG path data", source=src, field="d")
+            out.append(float(toks[i][1]))
+            i += 1
+        return out
+
+    while i < len(toks):
+        if toks[i][0]:
+            cmd = toks[i][0]
+            i += 1
+            if cmd in "Zz":
+                closed = True
+                cur = start
+                continue
+        if cmd is None:
+            raise MechsynInputError("SVG path data must start with M", source=src, field="d")
+        rel = cmd.islower()
+        c = cmd.upper()
+        base = cur if rel else 0j
+        if c == "A":
+            raise MechsynInputError("SVG arcs (A) are not supported", source=src, field="d",
+                                    hint="convert arcs to curves (e.g. Inkscape: Path > Object to Path)")
+        if c in "ML":
+            x, y = nums(2)
+            cur = base + complex(x, y)
+            if c == "M":
+                if pts:
+                    raise MechsynInputError("the SVG path has several sub-paths", source=src, field="d",
+                                            hint="draw the target as one stroke")
+                start = cur
+                cmd = "l" if rel else "L"
+            pts.append(cur)
+            last_ctrl = None
+        elif c == "H":
+            (x,) = nums(1)
+            cur = complex((cur.real if rel else 0) + x, cur.imag)
+            pts.append(cur)
+            last_ctrl = None
+        elif c == "V":
+            (y,) = nums(1)
+            cur = complex(cur.real, (cur.imag if rel else 0) + y)
+            pts.append(cur)
+            last_ctrl = None
+        elif c in "CS":
+            if c == "C":
+                x1, y1, x2, y2, x, y = nums(6)
+                p1 = base + complex(x1, y1)
+            else:
+                x2, y2, x, y = nums(4)
+                p1 = 2 * cur - last_ctrl if last_ctrl is not None else cur
+            p2, p3 = base + complex(x2, y2), base + complex(x, y)
+            seg = ((1 - t) ** 3 * cur + 3 * (1 - t) ** 2 * t * p1 + 3 * (1 - t) * t ** 2 * p2 + t ** 3 * p3)
+            pts.extend(seg.tolist())
+            cur, last_ctrl = p3, p2
+        elif c in "QT":
+            if c == "Q":
+                x1, y1, x, y = nums(4)
+                p1 = base + complex(x1, y1)
+            else:
+                x, y = nums(2)
+                p1 = 2 * cur - last_ctrl if last_ctrl is not None else cur
+            p2 = base + complex(x, y)
+            seg = (1 - t) ** 2 * cur + 2 * (1 - t) * t * p1 + t ** 2 * p2
+            pts.extend(seg.tolist())
+            cur, last_ctrl = p2, p1
+    if len(pts) < 2:
+        raise MechsynInputError("the SVG path has fewer than two points", source=src, field="d")
+    z = np.array(pts)
+    return np.stack([z.real, z.imag], axis=1), closed

@@ -1,0 +1,150 @@
+"""Candidate topologies for curve synthesis: chain, frame, input crank and tracing link.
+
+From the atlas (:func:`mechsyn.synthesis.chains.synthesize_chains`) every 1-DOF planar
+chain of R pairs with 4, 6 or 8 links; for each, every inequivalent frame and input
+link (:func:`mechsyn.synthesis.mechanisms.distinct_mechanisms`, orbits of the chain's
+automorphism group), and every inequivalent *tracing link*: orbits of the links under
+the automorphisms that fix both the frame and the input link (nauty, with the frame
+and the input coloured apart). Links jointed to the frame trace circular arcs and are
+not offered as tracers. A choice is kept when the mechanism is found by a crank and
+RRR dyads (:func:`mechsyn.kinematics.batch.compile_plan`), so every design of it is
+evaluated in closed form by the batch engine; choices that need a triad (an Assur
+group of class III) are left out: every Stephenson II inversion (a crank on the frame
+leaves a triad) and a share of the 8-link choices.
+
+Six-bar names follow which link is the frame (Watt chain: the two ternary links are
+jointed to each other; Stephenson chain: they are not): Watt I, frame binary; Watt II,
+frame ternary; Stephenson I, frame the binary link jointed to both ternary links;
+Stephenson II, frame a binary link of the two-binary path; Stephenson III, frame
+ternary (J. M. McCarthy and G. S. Soh, *Geometric Design of Linkages*, 2nd ed.,
+Springer, 2011, ch. 1 and 11; authors differ on the numbering of Stephenson I and II,
+the rule used here is the one stated).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import pynauty
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.batch import BatchPlan, compile_plan
+from mechsyn.synthesis.chains import KinematicChain, synthesize_chains
+from mechsyn.synthesis.mechanisms import distinct_mechanisms, mechanism_dict
+
+__all__ = ["CurveTopology", "curve_topologies", "six_bar_name"]
+
+TRACER = "T"
+
+
+@dataclass(frozen=True)
+class CurveTopology:
+    """One candidate: chain, frame, input (crank) link and tracing link."""
+
+    key: str                       # stable id, e.g. "6-1-f0-i2-t3"
+    chain: KinematicChain
+    frame: int
+    input: int
+    tracer: int
+    name: str | None               # Watt I/II, Stephenson I/II/III, four-bar
+    template: dict                 # mechanism-file dict (layout geometry), tracer point "T"
+    plan: BatchPlan
+
+    @property
+    def n_links(self) -> int:
+        return self.chain.n_links
+
+    def mechanism(self, params: np.ndarray, name: str | None = None) -> dict:
+        """The mechanism-file dict of a design (parameters in ``plan.names`` order)."""
+        xy = np.asarray(params, float).reshape(-1, 2)
+        where = {n: [float(v) for v in xy[i]] for i, n in enumerate(self.plan.names)}
+        d = {k: v for k, v in self.template.items() if k not in ("joints", "points")}
+        d["name"] = name or self.template["name"]
+        d["joints"] = [{**j, "point": where[j["id"]]} for j in self.template["joints"]]
+        d["points"] = {TRACER: {"link": f"L{self.tracer}", "at": where[TRACER]}}
+        return d
+
+    def links_of(self) -> dict[str, list[str]]:
+        """Point names (joints and tracer) carried by each link."""
+        out: dict[str, list[str]] = {}
+        for j in self.template["joints"]:
+            for ln in j["links"]:
+                out.setdefault(ln, []).append(j["id"])
+        out.setdefault(f"L{self.tracer}", []).append(TRACER)
+        return out
+
+
+def six_bar_name(chain: KinematicChain, frame: int) -> str | None:
+    """Watt I/II or Stephenson I/II/III by the frame link (see the module doc)."""
+    if chain.n_links == 4:
+        return "four-bar"
+    if chain.n_links != 6:
+        return None
+    deg = chain.degrees()
+    tern = [i for i, d in enumerate(deg) if d == 3]
+    g = chain.graph()
+    watt = g.has_edge(*tern)
+    if deg[frame] == 3:
+        return "Watt II" if watt else "Stephenson III"
+    if watt:
+        return "Watt I"
+    return "Stephenson I" if all(g.has_edge(frame, t) for t in tern) else "Stephenson II"
+
+
+def _tracer_orbits(chain: KinematicChain, frame: int, inp: int) -> list[list[int]]:
+    adj: dict[int, list[int]] = {v: [] for v in range(chain.n_links)}
+    for a, b in chain.edges:
+        adj[a].append(b)
+    rest = set(range(chain.n_links)) - {frame, inp}
+    graph = pynauty.Graph(chain.n_links, directed=False, adjacency_dict=adj,
+                          vertex_coloring=[{frame}, {inp}, rest])
+    groups: dict[int, list[int]] = {}
+    for v, o in enumerate(pynauty.autgrp(graph)[3]):
+        groups.setdefault(int(o), []).append(v)
+    return sorted(groups.values())
+
+
+@lru_cache(maxsize=None)
+def curve_topologies(max_links: int = 8) -> tuple[CurveTopology, ...]:
+    """Every inequivalent (chain, frame, input, tracer) with 4..``max_links`` links whose
+    mechanism is solved by a crank and RRR dyads (see the module doc).
+
+    >>> [t.name for t in curve_topologies(4)]
+    ['four-bar']
+    >>> sorted({t.name for t in curve_topologies(6)} - {'four-bar'})
+    ['Stephenson I', 'Stephenson III', 'Watt I', 'Watt II']
+    """
+    if max_links not in (4, 6, 8):
+        raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", source="--max-links")
+    out: list[CurveTopology] = []
+    for n in range(4, max_links + 1, 2):
+        for ci, chain in enumerate(synthesize_chains(n, 1)):
+            if chain.degenerate or chain.fractionated:
+                continue
+            g = chain.graph()
+            for choice in distinct_mechanisms(chain):
+                frame, inp = choice.frame, choice.input
+                base = mechanism_dict(chain, frame, inp)
+                for orbit in _tracer_orbits(chain, frame, inp):
+                    tr = orbit[0]
+                    if tr in (frame, inp) or g.has_edge(tr, frame):
+                        continue
+                    tmpl = dict(base)
+                    pts = np.array([j["point"] for j in base["joints"]
+                                    if f"L{tr}" in j["links"]], float)
+                    at = pts.mean(axis=0) + np.array([0.17, 0.23]) * 100.0 / max(n, 4)
+                    tmpl["points"] = {TRACER: {"link": f"L{tr}", "at": [round(float(v), 2) for v in at]}}
+                    name = six_bar_name(chain, frame)
+                    label = name or f"{n}-bar chain {ci + 1} ({chain.assortment_label()})"
+                    tmpl["name"] = f"{label}, frame L{frame}, input L{inp}, tracer on L{tr}"
+                    from mechsyn.io.load import mechanism_from_dict
+
+                    try:
+                        plan = compile_plan(mechanism_from_dict(tmpl), points=[TRACER])
+                    except MechsynInputError:
+                        continue  # needs a triad: not in closed form by dyads
+                    key = f"{n}-{ci + 1}-f{frame}-i{inp}-t{tr}"
+                    out.append(CurveTopology(key, chain, frame, inp, tr, name, tmpl, plan))
+    return tuple(out)

@@ -1,0 +1,404 @@
+"""The mechsyn studio application: :func:`create_app` and :func:`run_server`.
+
+The app is thin: every route parses its JSON, makes one call into
+:mod:`mechsyn.web._service` (the only module that calls the library) and returns JSON.
+
+Safety of a local server (issue 15):
+
+* bound to 127.0.0.1 unless a host is given explicitly (:func:`run_server`);
+* the Host header must name this server (``allowed_hosts``), against DNS rebinding;
+* every ``/api/`` request carries the per-launch token (``X-Mechsyn-Token`` header, or
+  ``token`` query parameter for event streams and downloads);
+* files only inside the start directory (:mod:`mechsyn.web._files`);
+* request bodies limited to :data:`MAX_BODY` bytes;
+* a Content-Security-Policy allowing only the server's own scripts, styles and data;
+* malformed requests answer 4xx with a JSON ``{"error", "field", "hint"}``; a bug answers
+  500 ``internal server error`` and the trace goes to the server's log only.
+
+References
+----------
+The layout follows optuna-dashboard (``_app.py create_app``, ``_serializer.py``,
+``json_api_view``), https://github.com/optuna/optuna-dashboard.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import functools
+import json
+import logging
+import secrets
+from pathlib import Path
+from typing import Any, Awaitable, Callable, Iterable
+
+from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
+from starlette.exceptions import HTTPException
+from starlette.requests import Request
+from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
+from starlette.routing import Mount, Route
+from starlette.staticfiles import StaticFiles
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.results import write_atomic
+from mechsyn.web import _files, _service
+from mechsyn.web._jobs import JobTable
+
+log = logging.getLogger("mechsyn.web")
+STATIC = Path(__file__).parent / "static"
+MAX_BODY = 2 * 1024 * 1024
+LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
+       "connect-src 'self'; font-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'")
+TOKEN_HEADER = "x-mechsyn-token"
+
+
+# --------------------------------------------------------------------------- middleware
+def _json_error(status: int, message: str, **extra: Any) -> JSONResponse:
+    return JSONResponse({"error": message, **extra}, status_code=status)
+
+
+def _hostname(host: str) -> str:
+    host = host.strip().lower()
+    if host.startswith("["):  # [::1]:8000
+        return host[1:host.find("]")] if "]" in host else host
+    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+class Guard:
+    """ASGI middleware: Host check, token on /api/, body size limit, security headers."""
+
+    def __init__(self, app: Callable, token: str, allowed_hosts: Iterable[str], max_body: int = MAX_BODY):
+        self.app, self.token, self.max_body = app, token, max_body
+        self.hosts = {h.lower().strip("[]") for h in allowed_hosts}
+
+    async def __call__(self, scope: dict, receive: Callable, send: Callable) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
+        problem = self._check(scope, headers)
+        if problem is not None:
+            await _with_headers(problem, scope)(scope, receive, send)
+            return
+        await self.app(scope, self._limited(receive), _secure_send(send, scope))
+
+    def _check(self, scope: dict, headers: dict[str, str]) -> Response | None:
+        if _hostname(headers.get("host", "")) not in self.hosts:
+            return _json_error(403, "this server answers only to its own address (Host header refused)",
+                               hint="open the URL that `mechsyn serve` printed")
+        if scope["path"].startswith("/api/"):
+            from urllib.parse import parse_qs
+
+            given = headers.get(TOKEN_HEADER) or parse_qs(scope.get("query_string", b"").decode()).get("token", [""])[0]
+            if not secrets.compare_digest(given.encode(), self.token.encode()):
+                return _json_error(403, "missing or wrong token", field="token",
+                                   hint="open the URL with ?token=... that `mechsyn serve` printed")
+        try:
+            length = int(headers.get("content-length", "0") or 0)
+        except ValueError:
+            return _json_error(400, "bad Content-Length header")
+        if length > self.max_body:
+            return _json_error(413, f"request body over {self.max_body // 1024} KiB", hint="send a smaller file")
+        return None
+
+    def _limited(self, receive: Callable) -> Callable:
+        seen = 0
+
+        async def wrapped() -> dict:
+            nonlocal seen
+            message = await receive()
+            if message["type"] == "http.request":
+                seen += len(message.get("body", b""))
+                if seen > self.max_body:
+                    raise HTTPException(413, f"request body over {self.max_body // 1024} KiB")
+            return message
+
+        return wrapped
+
+
+def _security_headers(path: str) -> list[tuple[bytes, bytes]]:
+    out = [(b"content-security-policy", CSP.encode()), (b"x-content-type-options", b"nosniff"),
+           (b"referrer-policy", b"no-referrer"), (b"x-frame-options", b"DENY")]
+    if path.startswith("/api/") or path == "/":
+        out.append((b"cache-control", b"no-store"))
+    return out
+
+
+def _secure_send(send: Callable, scope: dict) -> Callable:
+    async def wrapped(message: dict) -> None:
+        if message["type"] == "http.response.start":
+            message = dict(message)
+            message["headers"] = list(message.get("headers", [])) + _security_headers(scope["path"])
+        await send(message)
+
+    return wrapped
+
+
+def _with_headers(response: Response, scope: dict) -> Callable:
+    for k, v in _security_headers(scope["path"]):
+        response.headers[k.decode()] = v.decode()
+    return response
+
+
+# --------------------------------------------------------------------------- routes
+def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitable[Response]]:
+    """JSON in and out; input errors → 400 naming the field, bugs → 500 without a trace."""
+
+    @functools.wraps(fn)
+    async def wrapped(request: Request) -> Response:
+        try:
+            out = await fn(request)
+        except MechsynInputError as err:
+            return JSONResponse({"error": err.message, "field": err.field, "hint": err.hint,
+                                 "element": getattr(err, "element", None)}, status_code=400)
+        except HTTPException as exc:
+            return _json_error(exc.status_code, str(exc.detail))
+        except Exception:
+            log.exception("%s %s failed", request.method, request.url.path)
+            return _json_error(500, "internal server error (the server's log has the details)")
+        return out if isinstance(out, Response) else JSONResponse(out)
+
+    return wrapped
+
+
+async def _body(request: Request) -> dict[str, Any]:
+    raw = await request.body()
+    try:
+        data = json.loads(raw or b"null")
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise MechsynInputError(f"the request body is not JSON ({exc})", field="body",
+                                hint="send a JSON object") from None
+    if not isinstance(data, dict):
+        raise MechsynInputError("the request body must be a JSON object", field="body")
+    return data
+
+
+def _need(data: dict, key: str) -> Any:
+    if key not in data:
+        raise MechsynInputError("missing", field=key)
+    return data[key]
+
+
+def _int(value: Any, field: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
+        raise MechsynInputError(f"expected a whole number, got {value!r}", field=field)
+    return int(value)
+
+
+def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
+    """A route calling ``_service.<service>(body["mechanism"])``."""
+
+    @api
+    async def route(request: Request) -> Any:
+        data = await _body(request)
+        return await run_in_threadpool(getattr(_service, service), _need(data, "mechanism"))
+
+    return route
+
+
+def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, token: str | None = None,
+               allowed_hosts: Iterable[str] = LOCAL_HOSTS, start_name: str = "") -> Starlette:
+    """The studio as an ASGI app.
+
+    Parameters
+    ----------
+    root
+        The start directory: the only place files are read from and written to.
+    start
+        The mechanism shown first (a file-format dict), or None for an empty canvas.
+    token
+        The per-launch secret every ``/api/`` request must carry (random when None;
+        read it back as ``app.state.token``).
+    allowed_hosts
+        Host names this server answers to (the Host header check).
+    start_name
+        The file name the start mechanism came from (offered when saving).
+
+    Examples
+    --------
+    >>> from starlette.testclient import TestClient
+    >>> app = create_app(token="t")
+    >>> client = TestClient(app, base_url="http://127.0.0.1")
+    >>> client.get("/api/examples").status_code
+    403
+    >>> client.get("/api/examples", headers={"X-Mechsyn-Token": "t"}).status_code
+    200
+    """
+    root = Path(root).resolve()
+    token = token or secrets.token_urlsafe(24)
+    jobs = JobTable()
+
+    async def index(request: Request) -> Response:
+        return FileResponse(STATIC / "index.html", media_type="text/html")
+
+    @api
+    async def start_route(request: Request) -> Any:
+        return {"mechanism": start, "name": start_name, "root": root.name,
+                "synthesis_kinds": {k: v[0] for k, v in _service.SYNTHESIS_KINDS.items()}}
+
+    @api
+    async def examples(request: Request) -> Any:
+        return {"examples": await run_in_threadpool(_service.examples)}
+
+    @api
+    async def example(request: Request) -> Any:
+        path = _service.example_path(request.path_params["name"])
+        return {"mechanism": await run_in_threadpool(_service.read_mechanism, path), "name": path.name}
+
+    @api
+    async def simulate(request: Request) -> Any:
+        data = await _body(request)
+        steps = _int(data.get("steps", 180), "steps")
+        fn = _service.simulate_preview if data.get("preview") is True else _service.simulate
+        return await run_in_threadpool(fn, _need(data, "mechanism"), steps)
+
+    @api
+    async def files(request: Request) -> Any:
+        return {"files": await run_in_threadpool(_files.list_mechanism_files, root)}
+
+    @api
+    async def read_file(request: Request) -> Any:
+        path = _files.resolve_inside(root, request.query_params.get("path"))
+        _files.mechanism_suffix(path)
+        if not path.is_file():
+            raise MechsynInputError(f"{request.query_params.get('path')}: no such file", field="path")
+        return {"mechanism": await run_in_threadpool(_service.read_mechanism, path),
+                "name": path.relative_to(root).as_posix()}
+
+    @api
+    async def save_file(request: Request) -> Any:
+        data = await _body(request)
+        name = _need(data, "path")
+        path = _files.resolve_inside(root, name)
+        suffix = _files.mechanism_suffix(path)
+        if path.exists() and not data.get("overwrite", False):
+            raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
+        if not path.parent.is_dir():
+            raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
+        text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), suffix)
+        await run_in_threadpool(write_atomic, path, text)
+        return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
+
+    @api
+    async def import_text(request: Request) -> Any:
+        data = await _body(request)
+        text, name = _need(data, "text"), str(data.get("filename", "upload.yaml"))
+        if not isinstance(text, str):
+            raise MechsynInputError("must be the file's text", field="text")
+        return {"mechanism": await run_in_threadpool(_service.parse_mechanism_text, text, name), "name": name}
+
+    @api
+    async def export_text(request: Request) -> Any:
+        data = await _body(request)
+        fmt = data.get("format", "yaml")
+        if fmt == "csv":
+            text = await run_in_threadpool(_service.simulation_csv, _need(data, "mechanism"),
+                                           _int(data.get("steps", 180), "steps"))
+            return Response(text, media_type="text/csv")
+        if fmt not in ("yaml", "json"):
+            raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json or csv")
+        text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), "." + fmt)
+        return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
+
+    @api
+    async def atlas(request: Request) -> Any:
+        q = request.query_params
+        try:
+            n, f = int(q.get("links", "6")), int(q.get("mobility", "1"))
+        except ValueError:
+            raise MechsynInputError("links and mobility must be whole numbers", field="links") from None
+        return {"chains": await run_in_threadpool(_service.atlas, n, f)}
+
+    @api
+    async def atlas_mechanism(request: Request) -> Any:
+        data = await _body(request)
+        frame = data.get("frame")
+        inp = data.get("input")
+        mech = await run_in_threadpool(_service.atlas_mechanism, _need(data, "chain"),
+                                       None if frame is None else _int(frame, "frame"),
+                                       None if inp is None else _int(inp, "input"))
+        return {"mechanism": mech}
+
+    @api
+    async def synth_start(request: Request) -> Any:
+        data = await _body(request)
+        kind = request.path_params["kind"]
+        if kind not in _service.SYNTHESIS_KINDS:
+            raise MechsynInputError(f"unknown synthesis kind {kind!r}", field="kind",
+                                    hint="one of " + ", ".join(_service.SYNTHESIS_KINDS))
+        fn = _service.SYNTHESIS_KINDS[kind][1]
+        return jobs.submit(kind, fn, data).snapshot()
+
+    @api
+    async def job_state(request: Request) -> Any:
+        return jobs.get(request.path_params["job"]).snapshot()
+
+    @api
+    async def job_cancel(request: Request) -> Any:
+        job = jobs.get(request.path_params["job"])
+        job.cancel()
+        return job.snapshot()
+
+    @api
+    async def job_events(request: Request) -> Any:
+        job = jobs.get(request.path_params["job"])
+
+        async def stream():
+            seen = -1
+            while True:
+                if await request.is_disconnected():
+                    return
+                if job.version != seen:
+                    seen = job.version
+                    snap = job.snapshot()
+                    yield f"event: {'progress' if snap['state'] == 'running' else 'end'}\ndata: {json.dumps(snap)}\n\n"
+                    if snap["state"] != "running":
+                        return
+                await asyncio.sleep(0.1)
+
+        return StreamingResponse(stream(), media_type="text/event-stream", headers={"cache-control": "no-store"})
+
+    async def not_found(request: Request, exc: Exception) -> Response:
+        status = getattr(exc, "status_code", 404)
+        return _json_error(status, str(getattr(exc, "detail", "not found")))
+
+    routes = [
+        Route("/", index),
+        Route("/api/start", start_route),
+        Route("/api/examples", examples),
+        Route("/api/examples/{name}", example),
+        Route("/api/validate", _on_mechanism("validate"), methods=["POST"]),
+        Route("/api/simulate", simulate, methods=["POST"]),
+        Route("/api/analyze", _on_mechanism("analyze"), methods=["POST"]),
+        Route("/api/files", files),
+        Route("/api/file", read_file),
+        Route("/api/file", save_file, methods=["POST"]),
+        Route("/api/import", import_text, methods=["POST"]),
+        Route("/api/export", export_text, methods=["POST"]),
+        Route("/api/atlas", atlas),
+        Route("/api/atlas/mechanism", atlas_mechanism, methods=["POST"]),
+        Route("/api/synth/{kind}", synth_start, methods=["POST"]),
+        Route("/api/jobs/{job}", job_state),
+        Route("/api/jobs/{job}/cancel", job_cancel, methods=["POST"]),
+        Route("/api/jobs/{job}/events", job_events),
+        Mount("/static", StaticFiles(directory=STATIC), name="static"),
+    ]
+    @contextlib.asynccontextmanager
+    async def lifespan(app: Starlette):
+        yield
+        jobs.cancel_all()
+
+    app = Starlette(routes=routes, exception_handlers={HTTPException: not_found}, lifespan=lifespan)
+    app.state.token = token
+    app.state.root = root
+    app.add_middleware(Guard, token=token, allowed_hosts=allowed_hosts)
+    return app
+
+
+def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> None:
+    """Serve ``app`` with uvicorn until interrupted."""
+    import uvicorn
+
+    uvicorn.run(app, host=host, port=port, log_level="warning")

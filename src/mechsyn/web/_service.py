@@ -1,0 +1,429 @@
+"""Every call of mechsyn studio into the library, in one place.
+
+The routes (:mod:`mechsyn.web._app`) never import the library themselves: they call
+these functions, which take and return plain JSON-able data. When the library's public
+reports land (``mechsyn.analyze``, an incremental ``simulate``), only this module changes.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.results import to_jsonable
+
+MAX_STEPS = 2000
+EXAMPLE_SUFFIXES = (".yaml", ".yml", ".json")
+
+
+# --------------------------------------------------------------------------- examples
+def _examples_dir() -> Path | None:
+    """The examples shipped with mechsyn (package data when present, else the checkout's)."""
+    try:  # the library-first step moves examples into the package
+        from mechsyn import examples as _ex  # type: ignore[attr-defined]
+
+        d = Path(_ex.__file__).parent
+        if any(d.rglob("*.yaml")):
+            return d
+    except ImportError:
+        pass
+    d = Path(__file__).resolve().parents[3] / "examples"
+    return d if d.is_dir() else None
+
+
+def examples() -> list[dict[str, str]]:
+    """Planar mechanism examples: ``[{"name", "title", "group"}]`` sorted by group and name."""
+    root = _examples_dir()
+    if root is None:
+        return []
+    out = []
+    for p in sorted(root.rglob("*")):
+        if p.suffix not in EXAMPLE_SUFFIXES or not p.is_file():
+            continue
+        try:
+            from mechsyn.io import load_mechanism
+
+            mech = load_mechanism(p)
+        except Exception:  # case files and arms are not mechanisms: not listed
+            continue
+        if mech.kind != "planar" or not all(j.point is not None for j in mech.joints):
+            continue
+        out.append({"name": p.stem, "title": mech.name, "group": p.parent.name})
+    return out
+
+
+def example_path(name: str) -> Path:
+    """The file of example ``name`` (its file stem, e.g. ``fourbar``)."""
+    root = _examples_dir()
+    hits = [p for p in root.rglob(f"{name}.*") if p.suffix in EXAMPLE_SUFFIXES] if root else []
+    if not hits:
+        known = ", ".join(e["name"] for e in examples())
+        raise MechsynInputError(f"no example named {name!r}", field="example", hint=f"one of: {known}")
+    return sorted(hits)[0]
+
+
+# --------------------------------------------------------------------------- mechanism files
+def read_mechanism(path: Path) -> dict[str, Any]:
+    """A mechanism file read, validated and returned in the file format (dict)."""
+    from mechsyn.io import load_mechanism, mechanism_to_dict
+
+    return mechanism_to_dict(load_mechanism(path))
+
+
+def parse_mechanism_text(text: str, filename: str) -> dict[str, Any]:
+    """An uploaded mechanism file's text (YAML or JSON) → file-format dict."""
+    from mechsyn.io import mechanism_from_text, mechanism_to_dict
+
+    return mechanism_to_dict(mechanism_from_text(text, source=filename))
+
+
+def mechanism_text(data: dict[str, Any], suffix: str) -> str:
+    """The mechanism as YAML or JSON text (validated first)."""
+    from mechsyn.io import mechanism_from_dict, mechanism_to_dict
+
+    d = mechanism_to_dict(mechanism_from_dict(data, source="mechanism"))
+    if suffix == ".json":
+        import json
+
+        return json.dumps(d, indent=2) + "\n"
+    import yaml
+
+    return yaml.safe_dump(d, sort_keys=False, allow_unicode=True)
+
+
+# --------------------------------------------------------------------------- validation
+def _element_of(data: Any, field: str | None) -> dict[str, str] | None:
+    """``joints[2].links`` → ``{"kind": "joint", "id": <id of joints[2]>}``."""
+    if not field:
+        return None
+    head = field.split(".")[0]
+    for kind, key in (("joint", "joints"), ("link", "links")):
+        if head.startswith(key + "["):
+            try:
+                k = int(head[len(key) + 1:].split("]")[0])
+                item = data[key][k]
+            except (ValueError, IndexError, KeyError, TypeError):
+                return {"kind": kind, "id": ""}
+            ident = item.get("id", item.get("name", "")) if isinstance(item, dict) else item
+            return {"kind": kind, "id": str(ident)}
+    if head.startswith("points"):
+        name = field.split(".")[1] if "." in field else ""
+        return {"kind": "point", "id": name}
+    return None
+
+
+def error_dict(err: MechsynInputError, data: Any = None) -> dict[str, Any]:
+    """One input error as ``{"message", "field", "hint", "element"}``."""
+    return {"message": err.message, "field": err.field, "hint": err.hint, "element": _element_of(data, err.field)}
+
+
+def build(data: Any):
+    """Validate a mechanism dict: the :class:`~mechsyn.model.mechanism.Mechanism`."""
+    from mechsyn.io import mechanism_from_dict
+
+    if not isinstance(data, dict):
+        raise MechsynInputError("the mechanism must be a JSON object", field="mechanism")
+    try:
+        return mechanism_from_dict(data, source="mechanism")
+    except MechsynInputError as err:
+        err.element = _element_of(data, err.field)  # type: ignore[attr-defined]
+        raise
+
+
+def validate(data: Any) -> dict[str, Any]:
+    """``{"ok", "errors": [...], "mechanism": normalised dict or None}``."""
+    from mechsyn.io import mechanism_to_dict
+
+    try:
+        mech = build(data)
+    except MechsynInputError as err:
+        return {"ok": False, "errors": [error_dict(err, data)], "mechanism": None}
+    return {"ok": True, "errors": [], "mechanism": mechanism_to_dict(mech)}
+
+
+# --------------------------------------------------------------------------- simulation
+def _finite(a: np.ndarray) -> list:
+    return [None if not math.isfinite(v) else float(v) for v in np.asarray(a, float).ravel()]
+
+
+def _xy(a: np.ndarray) -> list:
+    return [None if not (math.isfinite(p[0]) and math.isfinite(p[1])) else [float(p[0]), float(p[1])]
+            for p in np.asarray(a, float)]
+
+
+def _driver_start(mech, jid: str) -> float:
+    """The file's value of driven joint ``jid``: crank angle (deg) of an R, 0 for a P."""
+    from mechsyn.kinematics.system import build_system
+
+    S = build_system(mech)
+    for d in S.drivers:
+        if d.joint == jid:
+            return float(np.degrees(d.assembled)) if d.type == "R" else float(d.assembled)
+    raise MechsynInputError(f"joint {jid} is not driven", field="input", hint="mark it as a drive")
+
+
+def _sweep(mech, steps: int, span: float | None) -> tuple[Any, np.ndarray]:
+    """The first drive and its input values, starting at the drawn configuration."""
+    drives = [j for j in mech.joints if j.actuated]
+    if not drives:
+        raise MechsynInputError("no drive: nothing moves", field="joints",
+                                hint="mark a joint to the frame as a drive")
+    if not 2 <= int(steps) <= MAX_STEPS:
+        raise MechsynInputError(f"steps must be within 2..{MAX_STEPS}", field="steps")
+    drive = drives[0]
+    start = _driver_start(mech, drive.id)
+    n = int(steps)
+    if drive.type == "P":
+        span = _scale(mech) if span is None else span
+        return drive, start + np.linspace(-span / 2, span / 2, n)
+    if span is None or abs(span - 360.0) < 1e-12:
+        return drive, start + np.linspace(0.0, 360.0, n + 1)[:n]
+    return drive, start + np.linspace(0, span, n)
+
+
+def simulate_preview(data: Any, steps: int = 180) -> dict[str, Any]:
+    """Positions only, for the drag loop: the closed-form Assur-group solution of
+    :func:`simulate` without its dead-point refinement, velocities and events (those come
+    with the full :func:`simulate` when the drag ends). Falls back to :func:`simulate`
+    when the mechanism does not decompose into drivers and dyads.
+    """
+    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics.analysis import resolve_points
+    from mechsyn.kinematics.solve import assemble
+    from mechsyn.kinematics.system import build_system
+
+    mech = build(data)
+    drive, values = _sweep(mech, steps, None)
+    S = build_system(mech)
+    plan = dyads.decompose(S)
+    if plan is None:
+        return simulate(data, steps)
+    assemble(S)  # the drawn configuration must assemble (else an input error, as in simulate)
+    U = np.tile([d.assembled for d in S.drivers], (len(values), 1)).astype(float)
+    k = [d.joint for d in S.drivers].index(drive.id)
+    U[:, k] = np.radians(values) if drive.type == "R" else values
+    q, _ = dyads.solve_positions(S, plan, U)
+    ok = np.all(np.isfinite(q), axis=1)
+    qz, zero = np.nan_to_num(q), np.zeros_like(q)
+    names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
+    pos = {}
+    for name, (link, at) in resolve_points(mech, names).items():
+        P, _, _ = S.point_state(qz, zero, zero, S.index(link), S.to_local(link, at))
+        P[~ok] = np.nan
+        pos[name] = P
+    return {"mechanism": mech.name, "preview": True,
+            "input": {"joint": drive.id, "type": drive.type, "values": _finite(values),
+                      "unit": "deg" if drive.type == "R" else "length"},
+            "assembled": ok.tolist(),
+            "joints": {j.id: _xy(pos[j.id]) for j in mech.joints if j.id in pos},
+            "points": {p: _xy(pos[p]) for p in mech.points},
+            "velocity": {}, "acceleration": {}, "links": {}, "working_ranges": [], "events": [], "notes": [],
+            "transmission_angle": {}, "method": "assur (positions only)"}
+
+
+def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str, Any]:
+    """Positions of every joint and named point over a sweep of the first drive.
+
+    The sweep starts at the drawn configuration (index 0 is the file's pose) and covers
+    ``span`` (360 deg for an R drive, ± its length scale for a P drive) in ``steps``.
+    Returns ``joints``/``points`` as lists of [x, y] or null (not assembled),
+    ``working_ranges``, ``events`` (dead points, reassembly, singular positions),
+    ``transmission_angle`` and, for a four-bar, ``grashof``.
+    """
+    from mechsyn.kinematics import derived
+    from mechsyn.kinematics.analysis import simulate as _simulate
+
+    mech = build(data)
+    drive, values = _sweep(mech, steps, span)
+    names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
+    sim = _simulate(mech, {drive.id: values}, points=names)
+    ok = sim.assembled
+    mu = derived.transmission_angles(sim)
+    out: dict[str, Any] = {
+        "mechanism": mech.name,
+        "input": {"joint": drive.id, "type": drive.type, "values": _finite(values),
+                  "unit": "deg" if drive.type == "R" else "length"},
+        "assembled": ok.tolist(),
+        "joints": {j.id: _xy(sim.points[j.id].position) for j in mech.joints if j.id in sim.points},
+        "points": {p: _xy(sim.points[p].position) for p in mech.points},
+        "velocity": {p: _xy(pm.velocity) for p, pm in sim.points.items()},
+        "acceleration": {p: _xy(pm.acceleration) for p, pm in sim.points.items()},
+        "links": {name: {"angle": _finite(lm.angle), "angular_velocity": _finite(lm.angular_velocity),
+                         "angular_acceleration": _finite(lm.angular_acceleration)}
+                  for name, lm in sim.links.items()},
+        "working_ranges": sim.working_ranges(),
+        "events": to_jsonable(sim.events),
+        "notes": list(sim.notes),
+        "transmission_angle": {k: {"values": _finite(v), "min": _nan_stat(np.nanmin, v),
+                                   "max": _nan_stat(np.nanmax, v)} for k, v in mu.items()},
+        "method": sim.method,
+    }
+    if _is_four_bar(mech):
+        out["grashof"] = to_jsonable(derived.grashof(mech))
+    return out
+
+
+def _nan_stat(f: Callable, v: np.ndarray) -> float | None:
+    v = np.asarray(v, float)
+    return float(f(v)) if np.isfinite(v).any() else None
+
+
+def _is_four_bar(mech) -> bool:
+    return len(mech.links) == 4 and len(mech.joints) == 4 and all(j.type == "R" for j in mech.joints)
+
+
+def _scale(mech) -> float:
+    pts = np.array([j.point[:2] for j in mech.joints if j.point is not None], float)
+    return float(np.ptp(pts, axis=0).max()) if len(pts) > 1 else 1.0
+
+
+def simulation_csv(data: Any, steps: int = 180) -> str:
+    """The simulation as CSV: input, assembled, then x, y of every joint and point."""
+    sim = simulate(data, steps)
+    cols = {**sim["joints"], **sim["points"]}
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow([f"input_{sim['input']['joint']}", "assembled"] + [f"{n}_{c}" for n in cols for c in "xy"])
+    for k, u in enumerate(sim["input"]["values"]):
+        row = [repr(u), int(sim["assembled"][k])]
+        for n in cols:
+            p = cols[n][k]
+            row += ["", ""] if p is None else [repr(p[0]), repr(p[1])]
+        w.writerow(row)
+    return buf.getvalue()
+
+
+# --------------------------------------------------------------------------- structure
+def analyze(data: Any) -> dict[str, Any]:
+    """Mobility formulas with their numbers, the rank result, Assur groups, Grashof."""
+    from mechsyn.kinematics import derived
+    from mechsyn.structure.analysis import analyze_structure
+    from mechsyn.structure.assur import assur_decomposition
+    from mechsyn.structure.rank import analyze_rank, missing_geometry, rank_summary_lines
+
+    mech = build(data)
+    out: dict[str, Any] = {"structure": to_jsonable(analyze_structure(mech))}
+    problems = missing_geometry(mech)
+    if problems:
+        out["rank"], out["rank_unavailable"] = None, "; ".join(problems)
+    else:
+        ra = analyze_rank(mech)
+        out["rank"] = ra.to_dict()
+        out["rank_summary"] = rank_summary_lines(ra)
+    try:
+        out["assur"] = to_jsonable(assur_decomposition(mech))
+    except MechsynInputError as err:
+        out["assur"], out["assur_unavailable"] = None, err.message
+    out["grashof"] = to_jsonable(derived.grashof(mech)) if _is_four_bar(mech) else None
+    return out
+
+
+# --------------------------------------------------------------------------- atlas
+def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
+    """The non-isomorphic chains with ``n_links`` links and ``mobility``, with a drawing layout."""
+    from mechsyn.synthesis.chains import synthesize_chains
+    from mechsyn.synthesis.mechanisms import chain_layout, distinct_mechanisms
+
+    if not (4 <= n_links <= 10):
+        raise MechsynInputError("the atlas browser lists 4 to 10 links", field="links")
+    out = []
+    for k, chain in enumerate(synthesize_chains(n_links, mobility)):
+        link_xy, joint_xy = chain_layout(chain)
+        out.append({"index": k, "label": chain.assortment_label(), "chain": chain.to_dict(),
+                    "link_xy": link_xy.tolist(), "joint_xy": joint_xy.tolist(),
+                    "mechanisms": [{"frame": c.frame, "input": c.input} for c in distinct_mechanisms(chain)]})
+    return out
+
+
+def atlas_mechanism(chain: dict[str, Any], frame: int | None = None, input_link: int | None = None) -> dict:
+    """A chain of the atlas as a mechanism file dict (frame and input chosen)."""
+    from mechsyn.synthesis.chains import KinematicChain
+    from mechsyn.synthesis.mechanisms import mechanism_dict
+
+    try:
+        kc = KinematicChain.from_dict(chain)
+    except (KeyError, TypeError, ValueError):
+        raise MechsynInputError("not a chain of the atlas", field="chain") from None
+    return mechanism_dict(kc, frame=frame, input_link=input_link)
+
+
+# --------------------------------------------------------------------------- synthesis
+class Cancelled(Exception):
+    """Raised inside a progress callback to stop a synthesis run."""
+
+
+def fourbar_path_case(targets: list, time_limit: float) -> Any:
+    """A four-bar path case through clicked ``targets`` (free timing, bounds from their extent)."""
+    from mechsyn.synthesis.path import PathCase
+
+    T = np.asarray(targets, float)
+    if T.ndim != 2 or T.shape[1] != 2 or not 3 <= len(T) <= 12 or not np.isfinite(T).all():
+        raise MechsynInputError("give 3 to 12 target points [x, y]", field="targets")
+    c = T.mean(axis=0)
+    size = float(max(np.ptp(T, axis=0).max(), 1e-6))
+    L = 3.0 * size
+    var = [{"name": "x0", "lower": c[0] - L, "upper": c[0] + L}, {"name": "y0", "lower": c[1] - L, "upper": c[1] + L},
+           {"name": "theta0", "lower": -math.pi, "upper": math.pi}]
+    var += [{"name": r, "lower": 0.05 * size, "upper": L} for r in ("r1", "r2", "r3", "r4")]
+    var += [{"name": r, "lower": -L, "upper": L} for r in ("rcx", "rcy")]
+    var += [{"name": f"theta2_{i + 1}", "lower": 0.0, "upper": 2 * math.pi} for i in range(len(T))]
+    return PathCase.from_dict({"id": "studio", "targets": T.tolist(), "timing": {"type": "free"},
+                               "variables": var, "options": {"grashof": "crank-rocker"}}, source="targets")
+
+
+def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+    """Four-bar path synthesis through ``params["targets"]``: ranked results (both branches).
+
+    ``progress`` receives ``{"done", "total", "best"}`` and may raise :class:`Cancelled`.
+    """
+    from mechsyn.synthesis.export import fourbar_mechanism_dict
+    from mechsyn.synthesis.optimize import synthesize_path
+
+    time_limit = float(params.get("time_limit", 10.0))
+    if not 0.5 <= time_limit <= 600:
+        raise MechsynInputError("time limit must be within 0.5..600 s", field="time_limit")
+    restarts = int(params.get("restarts", 4))
+    if not 1 <= restarts <= 50:
+        raise MechsynInputError("restarts must be within 1..50", field="restarts")
+    case = fourbar_path_case(params.get("targets"), time_limit)
+    results = []
+    branches = (-1, 1)
+    for b, branch in enumerate(branches):
+        bcase = _with_branch(case, branch)
+
+        def report(done, total, best, b=b):
+            progress({"done": b * total + done, "total": len(branches) * total,
+                      "best": None if not math.isfinite(best) else float(best)})
+
+        res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
+                              progress=report)
+        d = {**bcase.fixed, **res.design}
+        item = {"error": float(res.error), "feasible": bool(res.feasible), "branch": branch,
+                "design": {k: float(v) for k, v in d.items() if not k.startswith("theta2")},
+                "path": _xy(res.path), "seconds": float(res.seconds)}
+        if res.feasible:
+            item["mechanism"] = fourbar_mechanism_dict(
+                d["r1"], d["r2"], d["r3"], d["r4"], float(res.theta2[0]), branch=branch, rcx=d["rcx"],
+                rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"], name="Four-bar through clicked points")
+        results.append(item)
+    results.sort(key=lambda r: (not r["feasible"], r["error"]))
+    return {"kind": "fourbar_path", "targets": case.targets.tolist(), "results": results}
+
+
+def _with_branch(case, branch: int):
+    import dataclasses
+
+    return dataclasses.replace(case, branch=branch)
+
+
+# Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
+# Curve-to-mechanism synthesis (branch `curve`) registers here as "curve_atlas" once it lands.
+SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, Callable[[dict], None]], dict]]] = {
+    "fourbar_path": ("Four-bar path through the clicked points", synthesize_fourbar_path),
+}

@@ -1,0 +1,252 @@
+// SVG drawing of a planar mechanism at one frame of its simulation (no state, no I/O).
+const NS = "http://www.w3.org/2000/svg";
+export const GROUP_COLOURS = ["#e6550d", "#3182bd", "#31a354", "#756bb1", "#de2d26", "#636363", "#fd8d3c", "#6baed6"];
+
+export function el(tag, attrs = {}, parent = null, text = null) {
+  const e = document.createElementNS(NS, tag);
+  for (const [k, v] of Object.entries(attrs)) if (v !== undefined && v !== null) e.setAttribute(k, v);
+  if (text !== null) e.textContent = text;
+  if (parent) parent.appendChild(e);
+  return e;
+}
+
+export const linkName = (l) => (typeof l === "string" ? l : l.name);
+
+export function makeView(svg, view) {
+  const r = svg.getBoundingClientRect();
+  const W = r.width || 800, H = r.height || 600;
+  return {
+    W, H, ...view,
+    toScreen: ([x, y]) => [W / 2 + (x - view.ox) * view.s, H / 2 - (y - view.oy) * view.s],
+    toWorld: ([px, py]) => [view.ox + (px - W / 2) / view.s, view.oy - (py - H / 2) / view.s],
+  };
+}
+
+// Positions of every joint and point at frame k: the simulation's where assembled, else the file's.
+export function positions(mech, sim, k) {
+  const joints = {}, points = {};
+  const ok = !!(sim && sim.assembled[k]);
+  for (const j of mech.joints) joints[j.id] = ok && sim.joints[j.id] && sim.joints[j.id][k] ? sim.joints[j.id][k] : j.point;
+  for (const [n, p] of Object.entries(mech.points || {})) points[n] = ok && sim.points[n] && sim.points[n][k] ? sim.points[n][k] : p.at;
+  return { joints, points, assembled: ok };
+}
+
+export function membership(mech) {
+  const links = {};
+  for (const l of mech.links) links[linkName(l)] = { joints: [], points: [] };
+  for (const j of mech.joints) for (const l of j.links || []) if (links[l]) links[l].joints.push(j.id);
+  for (const [n, p] of Object.entries(mech.points || {})) if (links[p.link]) links[p.link].points.push(n);
+  return links;
+}
+
+function niceStep(s) {
+  const raw = 60 / s, p = 10 ** Math.floor(Math.log10(raw)), m = raw / p;
+  return p * (m < 2 ? 2 : m < 5 ? 5 : 10);
+}
+export const gridStep = (view) => niceStep(view.s) / 2;
+
+function drawGrid(g, v) {
+  const step = gridStep(v);
+  const [x0, y1] = v.toWorld([0, 0]), [x1, y0] = v.toWorld([v.W, v.H]);
+  for (let i = Math.floor(x0 / step); i <= Math.ceil(x1 / step); i++) {
+    const [px] = v.toScreen([i * step, 0]);
+    el("line", { x1: px, y1: 0, x2: px, y2: v.H, class: i % 5 ? "gridline" : "gridline major" }, g);
+  }
+  for (let i = Math.floor(y0 / step); i <= Math.ceil(y1 / step); i++) {
+    const [, py] = v.toScreen([0, i * step]);
+    el("line", { x1: 0, y1: py, x2: v.W, y2: py, class: i % 5 ? "gridline" : "gridline major" }, g);
+  }
+}
+
+function hatchedGround(g, [px, py], angle = 0) {
+  const t = el("g", { transform: `translate(${px.toFixed(1)} ${py.toFixed(1)}) rotate(${angle})`, class: "ground" }, g);
+  el("path", { d: "M0 0 L-9 14 L9 14 Z", class: "ground-base", fill: "#fff" }, t);
+  el("line", { x1: -16, y1: 14, x2: 16, y2: 14, class: "ground-base" }, t);
+  for (let x = -14; x <= 14; x += 6) el("line", { x1: x, y1: 14, x2: x - 6, y2: 21, class: "hatch-line" }, t);
+}
+
+function order(pts) {
+  const c = pts.reduce((a, p) => [a[0] + p[0] / pts.length, a[1] + p[1] / pts.length], [0, 0]);
+  return pts.slice().sort((a, b) => Math.atan2(a[1] - c[1], a[0] - c[0]) - Math.atan2(b[1] - c[1], b[0] - c[0]));
+}
+
+export function pathD(v, pts) {
+  let d = "", pen = false;
+  for (const p of pts) {
+    if (!p) { pen = false; continue; }
+    const [x, y] = v.toScreen(p);
+    d += `${pen ? "L" : "M"}${x.toFixed(1)} ${y.toFixed(1)}`;
+    pen = true;
+  }
+  return d;
+}
+
+function muClass(mu) {
+  if (mu === null || mu === undefined) return null;
+  const dev = Math.abs(90 - mu);
+  return dev <= 50 ? "mu-ok" : dev <= 60 ? "mu-poor" : "mu-bad";
+}
+
+function sliderAxis(mech, sim, j, k) {
+  let [ax, ay] = j.axis || [1, 0];
+  const moving = j.links.find((l) => l !== mech.ground);
+  const carrier = j.links[0] !== mech.ground ? j.links[0] : null;
+  if (carrier && sim && sim.links[carrier] && sim.assembled[k]) {
+    const a = sim.links[carrier].angle;
+    const d = ((a[k] - a[0]) * Math.PI) / 180;
+    [ax, ay] = [ax * Math.cos(d) - ay * Math.sin(d), ax * Math.sin(d) + ay * Math.cos(d)];
+  }
+  return { ax, ay, moving };
+}
+
+// Draw everything into svg; returns {joints, paths} element maps (the contract: data-joint, data-path).
+export function draw(svg, state) {
+  const { mech, sim, frame: k, view, opts } = state;
+  const v = makeView(svg, view);
+  svg.replaceChildren();
+  svg.setAttribute("viewBox", `0 0 ${v.W} ${v.H}`);
+  const layers = {};
+  for (const name of ["grid", "paths", "ground", "links", "sliders", "joints", "points", "marks", "labels"])
+    layers[name] = el("g", { class: `layer-${name}` }, svg);
+  if (opts.grid) drawGrid(layers.grid, v);
+  if (!mech) return { joints: {}, paths: {} };
+  const pos = positions(mech, state.poseFromFile ? null : sim, k);
+  const P = (p) => v.toScreen(p);
+  const invalid = new Set((state.errors || []).map((e) => e.element && `${e.element.kind}:${e.element.id}`));
+  const groupOf = opts.assurColours && state.analysis ? state.analysis.groupOf : {};
+  const muAt = {};
+  if (sim && sim.transmission_angle)
+    for (const [key, t] of Object.entries(sim.transmission_angle)) muAt[key.split("-")[1]] = t.values[k];
+  // paths of the named points (full sweep)
+  const paths = {};
+  if (sim) for (const [n, pts] of Object.entries(sim.points))
+    paths[n] = el("path", { d: pathD(v, pts), class: "path", "data-path": n }, layers.paths);
+  // ground symbols
+  for (const j of mech.joints) {
+    if (!(j.links || []).includes(mech.ground) || !pos.joints[j.id]) continue;
+    if (j.type === "P") {
+      const { ax, ay } = sliderAxis(mech, sim, j, k);
+      const [px, py] = P(pos.joints[j.id]);
+      const L = 60;
+      el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
+    } else hatchedGround(layers.ground, P(pos.joints[j.id]));
+  }
+  // links: bars and plates
+  const mem = membership(mech);
+  for (const [name, m] of Object.entries(mem)) {
+    if (name === mech.ground) continue;
+    const pts = m.joints.map((id) => pos.joints[id]).concat(m.points.map((n) => pos.points[n])).filter(Boolean).map(P);
+    if (pts.length < 2) continue;
+    let cls = "";
+    const colour = groupOf[name] !== undefined ? GROUP_COLOURS[groupOf[name] % GROUP_COLOURS.length] : null;
+    if (!colour) for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
+    if (invalid.has(`link:${name}`)) cls += " invalid";
+    const g = el("g", { "data-link": name }, layers.links);
+    if (pts.length === 2) {
+      el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar" + cls, stroke: colour }, g);
+      el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-hit" }, g);
+    } else {
+      const poly = order(pts).map((p) => p.map((c) => c.toFixed(1)).join(",")).join(" ");
+      el("polygon", { points: poly, class: "link-plate" + cls, fill: colour, stroke: colour }, g);
+    }
+  }
+  // joints
+  const joints = {};
+  for (const j of mech.joints) {
+    const p = pos.joints[j.id];
+    if (!p) continue;
+    const [px, py] = P(p);
+    const onGround = (j.links || []).includes(mech.ground);
+    let cls = "joint" + (onGround ? " ground" : "") + (j.actuated ? " drive" : "") + (invalid.has(`joint:${j.id}`) ? " invalid" : "");
+    if (j.type === "P") {
+      const { ax, ay } = sliderAxis(mech, sim, j, k);
+      const ang = (Math.atan2(-ay, ax) * 180) / Math.PI;
+      joints[j.id] = el("rect", { x: -14, y: -8, width: 28, height: 16, rx: 2, class: "slider-block" + (j.actuated ? " drive" : ""),
+        transform: `translate(${px.toFixed(1)} ${py.toFixed(1)}) rotate(${ang.toFixed(1)})`, "data-joint": j.id,
+        "data-x": p[0], "data-y": p[1] }, layers.sliders);
+      if (!onGround) {
+        const L = 40;
+        el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
+      }
+    } else {
+      joints[j.id] = el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 6.5, class: cls, "data-joint": j.id,
+        "data-x": p[0], "data-y": p[1] }, layers.joints);
+    }
+    el("text", { x: px + 9, y: py - 9, class: "label" }, layers.labels, j.id);
+  }
+  for (const [n, p] of Object.entries(pos.points)) {
+    if (!p) continue;
+    const [px, py] = P(p);
+    el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n }, layers.points);
+    el("text", { x: px + 8, y: py + 14, class: "label" }, layers.labels, n);
+  }
+  // dead points: × on every path where a working range ends
+  if (sim) for (const ev of sim.events) {
+    if (ev.kind !== "dead point") continue;
+    for (const pts of Object.values(sim.points)) {
+      const p = pts[ev.index] || pts[ev.index - 1];
+      if (!p) continue;
+      const [px, py] = P(p);
+      el("path", { d: `M${px - 6} ${py - 6}L${px + 6} ${py + 6}M${px - 6} ${py + 6}L${px + 6} ${py - 6}`,
+        class: "deadpoint", "data-deadpoint": ev.index }, layers.marks);
+    }
+  }
+  // synthesis targets and a previewed path
+  (state.targets || []).forEach((t, i) => {
+    const [px, py] = P(t);
+    el("circle", { cx: px, cy: py, r: 7, class: "target", "data-target": i }, layers.marks);
+    el("text", { x: px + 9, y: py + 4, class: "label" }, layers.labels, `T${i + 1}`);
+  });
+  if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);
+  // the link being built
+  if (state.building && state.building.length) {
+    const pts = state.building.map((b) => P(b.point));
+    el("polyline", { points: pts.map((p) => p.join(",")).join(" "), class: "pending" }, layers.marks);
+    for (const p of pts) el("circle", { cx: p[0], cy: p[1], r: 9, class: "pending" }, layers.marks);
+  }
+  // errors next to their element
+  for (const e of state.errors || []) {
+    if (!e.element) continue;
+    let p = null;
+    if (e.element.kind === "joint") p = pos.joints[e.element.id];
+    if (e.element.kind === "point") p = pos.points[e.element.id];
+    if (e.element.kind === "link" && mem[e.element.id]) p = pos.joints[mem[e.element.id].joints[0]];
+    if (!p) continue;
+    const [px, py] = P(p);
+    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": e.element.id }, layers.labels, e.message);
+  }
+  return { joints, paths };
+}
+
+// A small line plot (input on x) with a cursor at index k; returns the svg.
+export function plot(svg, xs, series, k, ranges = []) {
+  svg.replaceChildren();
+  const W = 300, H = 150, m = 28;
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  const vals = series.flatMap((s) => s.values).filter((y) => y !== null && Number.isFinite(y));
+  if (!vals.length) { el("text", { x: 10, y: 20, class: "label" }, svg, "not defined over the sweep"); return svg; }
+  let lo = Math.min(...vals), hi = Math.max(...vals);
+  if (hi - lo < 1e-12) { lo -= 1; hi += 1; }
+  const x0 = xs[0], x1 = xs[xs.length - 1] || x0 + 1;
+  const X = (x) => m + ((x - x0) / (x1 - x0 || 1)) * (W - m - 6), Y = (y) => H - 16 - ((y - lo) / (hi - lo)) * (H - 26);
+  for (const [a, b] of ranges) el("rect", { x: X(a), y: 4, width: Math.max(1, X(b) - X(a)), height: H - 20, class: "range" }, svg);
+  el("line", { x1: m, y1: H - 16, x2: W - 6, y2: H - 16, class: "axis" }, svg);
+  el("line", { x1: m, y1: 4, x2: m, y2: H - 16, class: "axis" }, svg);
+  el("text", { x: 2, y: 12, class: "label" }, svg, hi.toPrecision(3));
+  el("text", { x: 2, y: H - 18, class: "label" }, svg, lo.toPrecision(3));
+  el("text", { x: m, y: H - 3, class: "label" }, svg, x0.toFixed(0));
+  el("text", { x: W - 40, y: H - 3, class: "label" }, svg, x1.toFixed(0));
+  series.forEach((s, i) => {
+    let d = "", pen = false;
+    xs.forEach((x, n) => {
+      const y = s.values[n];
+      if (y === null || !Number.isFinite(y)) { pen = false; return; }
+      d += `${pen ? "L" : "M"}${X(x).toFixed(1)} ${Y(y).toFixed(1)}`; pen = true;
+    });
+    el("path", { d, class: i ? "plotline y" : "plotline", "data-series": s.name }, svg);
+    el("text", { x: W - 60, y: 14 + 12 * i, class: "label" }, svg, s.name);
+  });
+  el("line", { x1: X(xs[k]), y1: 4, x2: X(xs[k]), y2: H - 16, class: "cursor", "data-cursor": k }, svg);
+  svg.__map = { X, x0, x1, m, W };
+  return svg;
+}

@@ -1,0 +1,702 @@
+// mechsyn studio: the editor's state, the canvas interaction and the side panels.
+import { call, coalescing, eventsUrl } from "./api.js";
+import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
+
+const $ = (id) => document.getElementById(id);
+const svg = $("canvas");
+const clone = (x) => JSON.parse(JSON.stringify(x));
+const EMPTY = () => ({ name: "New mechanism", kind: "planar", ground: "frame", links: ["frame"], joints: [], points: {} });
+
+const state = {
+  mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
+  opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
+  targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
+  renders: 0, simulations: 0,
+};
+window.__studio = state; // for tests and the benchmark (read-only use)
+
+// ------------------------------------------------------------------ rendering
+function render() {
+  try {
+    draw(svg, { ...state, poseFromFile: state.dragging });
+    state.renders += 1;
+    renderBanner();
+    renderPlayer();
+    renderPlots();
+  } catch (e) {
+    console.error(e);
+    $("banner").replaceChildren(div("err", `drawing failed: ${e.message || e}`));
+  }
+}
+
+function div(cls, text) { const d = document.createElement("div"); d.className = cls; d.textContent = text; return d; }
+
+function renderBanner() {
+  const items = state.errors.map((e) => div("err", e.message + (e.hint ? ` — fix: ${e.hint}` : "")));
+  for (const n of state.notes) items.push(div("note", n));
+  if (state.sim && !state.sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
+  $("banner").replaceChildren(...items);
+}
+
+function renderPlayer() {
+  const s = $("input-slider"), sim = state.sim;
+  s.max = sim ? sim.input.values.length - 1 : 0;
+  s.value = state.frame;
+  let text = "";
+  if (sim) {
+    const u = sim.input.values[state.frame];
+    text = `${sim.input.joint} = ${u.toFixed(1)}${sim.input.unit === "deg" ? "°" : ""}`;
+    for (const [key, t] of Object.entries(sim.transmission_angle || {})) {
+      const mu = t.values[state.frame];
+      if (mu !== null) text += `  μ(${key}) = ${mu.toFixed(1)}°`;
+    }
+  }
+  $("input-value").textContent = text;
+  $("status").textContent = statusLine();
+}
+
+function statusLine() {
+  const m = state.mech;
+  if (!m) return "";
+  const moving = m.links.length - 1;
+  return `${m.name}: ${moving} moving links, ${m.joints.length} joints` + (state.sim ? `, ${state.sim.method}` : "");
+}
+
+// ------------------------------------------------------------------ simulation and analysis
+const simulateSoon = coalescing(
+  // while dragging: positions only (the closed form, fast); on release: the full simulation
+  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, preview: !!req.preview }).then((r) => ({ r, ms: performance.now() - t0 })); },
+  ({ r, ms }, { mech }) => {
+    state.simulations += 1;
+    state.lastSimMs = ms;
+    if ((mech !== state.mech || r.preview) && !state.dragging) return; // a newer mechanism is on its way
+    state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
+    if (state.frame >= r.assembled.length) state.frame = 0;
+    render();
+    if (!state.dragging) renderAnalysis();
+  },
+  (e, { mech }) => {
+    state.simulations += 1;
+    if (mech !== state.mech && !state.dragging) return;
+    state.sim = null; state.simFor = mech; state.notes = [];
+    state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
+    render(); renderAnalysis();
+  });
+
+let analyseTimer = null;
+function analyseSoon() {
+  clearTimeout(analyseTimer);
+  analyseTimer = setTimeout(async () => {
+    const mech = state.mech;
+    try {
+      const a = await call("/api/analyze", { mechanism: mech });
+      if (mech !== state.mech) return;
+      a.groupOf = {};
+      if (a.assur) [...a.assur.initial_mechanisms, ...a.assur.groups].forEach((g, i) => g.links.forEach((l) => (a.groupOf[l] = i)));
+      state.analysis = a;
+    } catch (e) {
+      state.analysis = { error: e.error || String(e), hint: e.hint };
+    }
+    renderAnalysis(); render();
+  }, 250);
+}
+
+function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
+  if (record && state.mech) { state.undo.push(JSON.stringify(state.mech)); state.redo = []; }
+  state.mech = mech;
+  if (!keepFrame) state.frame = 0;
+  if (fit) fitView();
+  state.errors = [];
+  if (mech.joints.some((j) => j.actuated)) simulateSoon({ mech });
+  else { state.sim = null; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
+  analyseSoon();
+  render();
+  renderElement();
+}
+
+// The drawn pose becomes the file's pose (the branch drawn is the one kept).
+function rebase() {
+  const { sim, frame: k } = state;
+  if (!sim || k === 0 || !sim.assembled[k]) return clone(state.mech);
+  const m = clone(state.mech);
+  for (const j of m.joints) if (sim.joints[j.id] && sim.joints[j.id][k]) j.point = sim.joints[j.id][k].slice();
+  for (const [n, p] of Object.entries(m.points || {})) if (sim.points[n] && sim.points[n][k]) p.at = sim.points[n][k].slice();
+  state.frame = 0;
+  return m;
+}
+
+// ------------------------------------------------------------------ view
+function fitView() {
+  const m = state.mech;
+  const pts = m ? m.joints.map((j) => j.point).concat(Object.values(m.points || {}).map((p) => p.at)) : [];
+  if (state.sim) for (const ps of Object.values(state.sim.points)) for (const p of ps) if (p) pts.push(p);
+  if (!pts.length) { state.view = { s: 60, ox: 3, oy: 2 }; return; }
+  const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+  const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const r = svg.getBoundingClientRect();
+  const s = Math.min((r.width || 800) / Math.max(x1 - x0, 1e-9), (r.height || 600) / Math.max(y1 - y0, 1e-9)) * 0.7;
+  state.view = { s: Math.min(Math.max(s, 1e-3), 1e6), ox: (x0 + x1) / 2, oy: (y0 + y1) / 2 };
+}
+
+function worldAt(ev) {
+  const r = svg.getBoundingClientRect();
+  let p = makeView(svg, state.view).toWorld([ev.clientX - r.left, ev.clientY - r.top]);
+  if (state.opts.snap) { const g = gridStep(state.view); p = p.map((c) => Math.round(c / g) * g); }
+  return p.map((c) => +c.toPrecision(10));
+}
+
+// ------------------------------------------------------------------ naming
+function nextJointId(m) {
+  const used = new Set(m.joints.map((j) => j.id).concat(Object.keys(m.points || {})));
+  for (const c of "ABCDEFGHIJKLMNOQRSTUVWXYZ") if (!used.has(c)) return c;
+  for (let i = 1; ; i++) if (!used.has(`J${i}`)) return `J${i}`;
+}
+function nextLinkName(m) {
+  const used = new Set(m.links.map(linkName));
+  for (let i = 1; ; i++) if (!used.has(`L${i}`)) return `L${i}`;
+}
+function nextPointName(m) {
+  const used = new Set(m.joints.map((j) => j.id).concat(Object.keys(m.points || {})));
+  for (const c of ["P", "M", "Q", "R", "S"]) if (!used.has(c)) return c;
+  for (let i = 1; ; i++) if (!used.has(`P${i}`)) return `P${i}`;
+}
+
+// ------------------------------------------------------------------ editing
+function addPivot(p) {
+  const m = rebase();
+  m.joints.push({ id: nextJointId(m), type: "R", links: [m.ground], point: p });
+  setMech(m);
+}
+
+function finishLink() {
+  const picks = state.building;
+  state.building = [];
+  $("finish-link").disabled = true;
+  if (picks.length < 2) { render(); return; }
+  const m = rebase();
+  const name = nextLinkName(m);
+  m.links.push(name);
+  for (const pick of picks) {
+    const j = pick.joint && m.joints.find((x) => x.id === pick.joint);
+    if (!j) m.joints.push({ id: nextJointId(m), type: "R", links: [name], point: pick.point });
+    else if (j.links.length < 2) j.links.push(name);
+    else m.joints.push({ id: nextJointId(m), type: "R", links: [j.links[0] === m.ground ? j.links[1] : j.links[0], name], point: j.point.slice() });
+  }
+  setMech(m);
+}
+
+function segDist(p, a, b) {
+  const dx = b[0] - a[0], dy = b[1] - a[1], L = dx * dx + dy * dy || 1e-12;
+  const t = Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / L));
+  return Math.hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
+}
+
+function nearestLink(m, p) {
+  const pos = positions(m, null, 0), mem = membership(m);
+  let best = null, bd = Infinity;
+  for (const [name, g] of Object.entries(mem)) {
+    if (name === m.ground) continue;
+    const pts = g.joints.map((id) => pos.joints[id]);
+    for (let i = 0; i < pts.length; i++) for (let k = i + 1; k < pts.length; k++) {
+      const d = segDist(p, pts[i], pts[k]);
+      if (d < bd) { bd = d; best = name; }
+    }
+  }
+  return best;
+}
+
+function addPoint(p) {
+  const m = rebase();
+  const link = nearestLink(m, p);
+  if (!link) { state.errors = [{ message: "a point needs a moving link: add a link first" }]; render(); return; }
+  m.points = m.points || {};
+  m.points[nextPointName(m)] = { link, at: p };
+  setMech(m);
+}
+
+function toggleDrive(id) {
+  const m = rebase();
+  const j = m.joints.find((x) => x.id === id);
+  if (j.actuated) delete j.actuated; else j.actuated = true;
+  setMech(m);
+}
+
+function deleteJoint(id) {
+  const m = rebase();
+  m.joints = m.joints.filter((j) => j.id !== id);
+  setMech(m);
+}
+function deletePoint(name) {
+  const m = rebase();
+  delete m.points[name];
+  setMech(m);
+}
+function deleteLink(name) {
+  const m = rebase();
+  if (name === m.ground) return;
+  m.links = m.links.filter((l) => linkName(l) !== name);
+  for (const j of m.joints) j.links = j.links.filter((l) => l !== name);
+  m.joints = m.joints.filter((j) => j.links.length > 0);
+  for (const [n, p] of Object.entries(m.points || {})) if (p.link === name) delete m.points[n];
+  setMech(m);
+}
+
+function undo() { if (!state.undo.length) return; state.redo.push(JSON.stringify(state.mech)); setMech(JSON.parse(state.undo.pop()), { record: false }); }
+function redo() { if (!state.redo.length) return; state.undo.push(JSON.stringify(state.mech)); setMech(JSON.parse(state.redo.pop()), { record: false }); }
+
+// ------------------------------------------------------------------ pointer interaction
+let gesture = null;
+svg.addEventListener("pointerdown", (ev) => {
+  if (!state.mech) return;
+  const t = ev.target;
+  const jointEl = t.closest("[data-joint]"), pointEl = t.closest("[data-point]"), linkEl = t.closest("[data-link]");
+  const p = worldAt(ev);
+  const mode = state.mode;
+  if (mode === "select" && (jointEl || pointEl)) {
+    const kind = jointEl ? "joint" : "point", id = jointEl ? jointEl.dataset.joint : pointEl.dataset.point;
+    state.selected = { kind, id };
+    const before = JSON.stringify(state.mech);
+    const m = rebase();
+    const start = kind === "joint" ? m.joints.find((j) => j.id === id).point.slice() : m.points[id].at.slice();
+    const together = kind === "joint" ? m.joints.filter((j) => j.point[0] === start[0] && j.point[1] === start[1]).map((j) => j.id) : [];
+    state.undo.push(before); state.redo = [];
+    state.mech = m; state.dragging = true;
+    gesture = { kind: "drag", what: kind, id, together, moved: false };
+    svg.setPointerCapture(ev.pointerId);
+    renderElement();
+    return;
+  }
+  if (mode === "select" || (mode !== "select" && ev.button === 1)) {
+    gesture = { kind: "pan", x: ev.clientX, y: ev.clientY, view: { ...state.view } };
+    svg.setPointerCapture(ev.pointerId);
+    return;
+  }
+  if (mode === "pivot") addPivot(p);
+  else if (mode === "link") {
+    if (jointEl) { const j = state.mech.joints.find((x) => x.id === jointEl.dataset.joint); state.building.push({ joint: j.id, point: j.point }); }
+    else state.building.push({ joint: null, point: p });
+    $("finish-link").disabled = state.building.length < 2;
+    render();
+  } else if (mode === "point") addPoint(p);
+  else if (mode === "drive" && jointEl) toggleDrive(jointEl.dataset.joint);
+  else if (mode === "delete") {
+    if (jointEl) deleteJoint(jointEl.dataset.joint);
+    else if (pointEl) deletePoint(pointEl.dataset.point);
+    else if (linkEl) deleteLink(linkEl.dataset.link);
+  } else if (mode === "target") {
+    state.targets.push(p);
+    $("target-count").textContent = state.targets.length;
+    render();
+  }
+});
+
+svg.addEventListener("pointermove", (ev) => {
+  if (!gesture) return;
+  if (gesture.kind === "pan") {
+    const s = state.view.s;
+    state.view = { ...gesture.view, ox: gesture.view.ox - (ev.clientX - gesture.x) / s, oy: gesture.view.oy + (ev.clientY - gesture.y) / s };
+    render();
+    return;
+  }
+  const p = worldAt(ev);
+  const m = clone(state.mech);
+  if (gesture.what === "joint") for (const j of m.joints) { if (gesture.together.includes(j.id)) j.point = p.slice(); }
+  else m.points[gesture.id].at = p;
+  gesture.moved = true;
+  state.mech = m;
+  render();
+  simulateSoon({ mech: m, preview: true });
+});
+
+function endGesture() {
+  if (!gesture) return;
+  const g = gesture;
+  gesture = null;
+  if (g.kind === "drag") {
+    state.dragging = false;
+    if (!g.moved) state.undo.pop();
+    setMech(clone(state.mech), { record: false });
+  }
+}
+svg.addEventListener("pointerup", endGesture);
+svg.addEventListener("pointercancel", endGesture);
+
+svg.addEventListener("wheel", (ev) => {
+  ev.preventDefault();
+  const r = svg.getBoundingClientRect();
+  const v = makeView(svg, state.view);
+  const before = v.toWorld([ev.clientX - r.left, ev.clientY - r.top]);
+  const s = state.view.s * Math.exp(-ev.deltaY * 0.0015);
+  state.view = { s, ox: before[0] - (ev.clientX - r.left - v.W / 2) / s, oy: before[1] + (ev.clientY - r.top - v.H / 2) / s };
+  render();
+}, { passive: false });
+
+// ------------------------------------------------------------------ side panels
+function h(tag, text, attrs = {}) { const e = document.createElement(tag); if (text !== undefined && text !== null) e.textContent = text; Object.assign(e, attrs); return e; }
+
+function renderAnalysis() {
+  const box = $("tab-analysis");
+  const a = state.analysis, sim = state.sim;
+  const out = [];
+  if (state.errors.length) out.push(h("p", `Input problem: ${state.errors[0].message}`, { className: "err" }));
+  if (a && a.error) out.push(h("p", `${a.error}${a.hint ? " — fix: " + a.hint : ""}`, { className: "muted" }));
+  if (a && a.structure) {
+    const st = a.structure;
+    out.push(h("h3", `Mobility (formulas): W = ${st.mobility}`));
+    const t = h("table");
+    for (const [name, f] of Object.entries(st.formulas)) {
+      const tr = h("tr");
+      tr.append(h("td", name.replace(/_/g, " ")), h("td", f.expression, { className: "formula" }));
+      t.append(tr);
+    }
+    out.push(t);
+  }
+  if (a && a.rank_summary) { out.push(h("h3", "Rank method (exact)")); for (const l of a.rank_summary) out.push(h("p", l, { className: "formula" })); }
+  else if (a && a.rank_unavailable) out.push(h("p", `rank method: ${a.rank_unavailable}`, { className: "muted" }));
+  if (a && a.assur) {
+    out.push(h("h3", `Assur groups: class ${a.assur.mechanism_class_roman}`));
+    out.push(h("p", a.assur.structural_formula, { className: "formula" }));
+    const ul = h("ul");
+    [...a.assur.initial_mechanisms, ...a.assur.groups].forEach((g, i) => {
+      const li = h("li");
+      const sw = h("span", "", { className: `swatch g${i % GROUP_COLOURS.length}` });
+      li.append(sw, `${g.label} (class ${g.class_roman}, order ${g.order})`);
+      ul.append(li);
+    });
+    out.push(ul);
+  } else if (a && a.assur_unavailable) out.push(h("p", `Assur groups: ${a.assur_unavailable}`, { className: "muted" }));
+  const gr = (sim && sim.grashof) || (a && a.grashof);
+  if (gr) { out.push(h("h3", `Grashof: ${gr.classification}`)); out.push(h("p", gr.expression, { className: "formula" })); }
+  if (sim) {
+    out.push(h("h3", "Motion"));
+    const u = sim.input.unit === "deg" ? "°" : "";
+    out.push(h("p", `working range of ${sim.input.joint}: ` + (sim.working_ranges.map(([x, y]) => `${x.toFixed(1)}${u} … ${y.toFixed(1)}${u}`).join(", ") || "none")));
+    for (const [key, t] of Object.entries(sim.transmission_angle || {}))
+      if (t.min !== null) out.push(h("p", `transmission angle ${key}: ${t.min.toFixed(1)}° … ${t.max.toFixed(1)}°`));
+    const dead = sim.events.filter((e) => e.kind === "dead point");
+    for (const e of dead) out.push(h("p", `dead point at ${Object.entries(e.input).map(([j, v]) => `${j} = ${(+v).toFixed(2)}`).join(", ")}: ${e.message}`, { className: "muted" }));
+  }
+  if (!out.length) out.push(h("p", "Analysis of the drawn mechanism appears here.", { className: "muted" }));
+  box.replaceChildren(...out);
+}
+
+function renderElement() {
+  const box = $("tab-element"), sel = state.selected, m = state.mech;
+  if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it.", { className: "muted" })); return; }
+  const out = [];
+  if (sel.kind === "joint") {
+    const j = m.joints.find((x) => x.id === sel.id);
+    if (!j) { state.selected = null; return renderElement(); }
+    out.push(h("h3", `Joint ${j.id}`));
+    const type = h("select"); for (const t of ["R", "P"]) type.append(h("option", t, { value: t, selected: j.type === t }));
+    type.id = "joint-type";
+    type.onchange = () => { const n = rebase(); const x = n.joints.find((q) => q.id === j.id); x.type = type.value; if (x.type === "P" && !x.axis) x.axis = [1, 0]; if (x.type === "R") delete x.axis; setMech(n); };
+    const drive = h("input", null, { type: "checkbox", checked: !!j.actuated, id: "joint-drive" });
+    drive.onchange = () => toggleDrive(j.id);
+    const links = h("input", null, { value: j.links.join(", "), id: "joint-links", size: 20 });
+    links.onchange = () => { const n = rebase(); n.joints.find((q) => q.id === j.id).links = links.value.split(",").map((s) => s.trim()).filter(Boolean); for (const l of n.joints.find((q) => q.id === j.id).links) if (!n.links.map(linkName).includes(l)) n.links.push(l); setMech(n); };
+    out.push(h("p", "pair type "), type, h("p", "links "), links, h("p", ""), drive, " drive");
+    out.push(h("p", `at (${j.point.map((c) => (+c).toFixed(4)).join(", ")})`));
+    const del = h("button", "Delete joint"); del.onclick = () => deleteJoint(j.id); out.push(del);
+  } else {
+    const p = (m.points || {})[sel.id];
+    if (!p) { state.selected = null; return renderElement(); }
+    out.push(h("h3", `Point ${sel.id} on ${p.link}`), h("p", `at (${p.at.map((c) => (+c).toFixed(4)).join(", ")})`));
+    const del = h("button", "Delete point"); del.onclick = () => deletePoint(sel.id); out.push(del);
+  }
+  box.replaceChildren(...out);
+}
+
+function renderPlots() {
+  const sim = state.sim, sel = $("plot-what");
+  if (!sim) { $("plots").replaceChildren(h("p", "no simulation", { className: "muted" })); return; }
+  const opts = Object.keys(sim.velocity).map((n) => `point:${n}`).concat(Object.keys(sim.links).map((n) => `link:${n}`));
+  if ([...sel.options].map((o) => o.value).join() !== opts.join()) {
+    const keep = sel.value;
+    sel.replaceChildren(...opts.map((o) => h("option", o.replace(":", " "), { value: o })));
+    if (opts.includes(keep)) sel.value = keep; else if (Object.keys(sim.points).length) sel.value = `point:${Object.keys(sim.points)[0]}`;
+  }
+  if (!$("tab-plots").classList.contains("on")) return;
+  const [kind, name] = (sel.value || "").split(":");
+  const xs = sim.input.values, k = state.frame, R = sim.working_ranges;
+  let pairs;
+  if (kind === "point") {
+    const comp = (arr, i) => arr.map((v) => (v ? v[i] : null));
+    pairs = [[`velocity of ${name}`, [{ name: "vx", values: comp(sim.velocity[name], 0) }, { name: "vy", values: comp(sim.velocity[name], 1) }]],
+      [`acceleration of ${name}`, [{ name: "ax", values: comp(sim.acceleration[name], 0) }, { name: "ay", values: comp(sim.acceleration[name], 1) }]]];
+  } else if (kind === "link") {
+    pairs = [[`angular velocity of ${name} (rad/s)`, [{ name: "ω", values: sim.links[name].angular_velocity }]],
+      [`angular acceleration of ${name} (rad/s²)`, [{ name: "α", values: sim.links[name].angular_acceleration }]]];
+  } else return;
+  const out = [];
+  for (const [title, series] of pairs) {
+    out.push(h("p", `${title} against ${sim.input.joint} (${sim.input.unit})`));
+    const s = el("svg", { "data-plot": title });
+    plot(s, xs, series, k, R);
+    s.addEventListener("click", (ev) => {
+      const r = s.getBoundingClientRect(), mp = s.__map, x = ((ev.clientX - r.left) / r.width) * mp.W;
+      const u = mp.x0 + ((x - mp.m) / (mp.W - mp.m - 6)) * (mp.x1 - mp.x0);
+      let best = 0; xs.forEach((v, i) => { if (Math.abs(v - u) < Math.abs(xs[best] - u)) best = i; });
+      state.frame = best; render();
+    });
+    out.push(s);
+  }
+  $("plots").replaceChildren(...out);
+}
+
+// ------------------------------------------------------------------ player
+let timer = null, lastTick = 0;
+function tick(t) {
+  if (!state.playing) return;
+  const fps = +$("speed").value;
+  if (t - lastTick >= 1000 / fps && state.sim) {
+    lastTick = t;
+    const n = state.sim.assembled.length, ok = state.sim.assembled;
+    let next = state.frame + state.dir;
+    const full = ok.every(Boolean);
+    if (full) next = (next + n) % n;
+    else if (next < 0 || next >= n || !ok[next]) { state.dir = -state.dir; next = state.frame + state.dir; if (next < 0 || next >= n || !ok[next]) next = state.frame; }
+    state.frame = next;
+    render();
+  }
+  timer = requestAnimationFrame(tick);
+}
+function setPlaying(on) {
+  state.playing = on && !!state.sim;
+  $("play").textContent = state.playing ? "❚❚" : "▶";
+  cancelAnimationFrame(timer);
+  if (state.playing) timer = requestAnimationFrame(tick);
+}
+$("play").onclick = () => setPlaying(!state.playing);
+$("direction").onclick = () => { state.dir = -state.dir; };
+$("input-slider").oninput = (ev) => { state.frame = +ev.target.value; render(); };
+
+// ------------------------------------------------------------------ synthesis
+let source = null, job = null;
+$("clear-targets").onclick = () => { state.targets = []; state.preview = null; $("target-count").textContent = 0; render(); };
+$("synth-run").onclick = async () => {
+  $("synth-status").textContent = "";
+  try {
+    job = await call("/api/synth/fourbar_path", { targets: state.targets, time_limit: +$("synth-time").value });
+  } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
+  $("synth-run").disabled = true; $("synth-cancel").disabled = false;
+  $("synth-results").replaceChildren();
+  source = new EventSource(eventsUrl(job.id));
+  const show = (snap) => {
+    const p = snap.progress;
+    $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
+    $("synth-status").textContent = `${snap.state}: ${p.done}/${p.total} restarts, best error ${p.best === null ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
+  };
+  source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
+  source.addEventListener("end", (e) => {
+    source.close();
+    const snap = JSON.parse(e.data);
+    show(snap);
+    $("synth-run").disabled = false; $("synth-cancel").disabled = true;
+    if (snap.error) $("synth-status").textContent = `failed: ${snap.error.message}`;
+    if (snap.result) showResults(snap.result.results);
+  });
+  source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
+};
+$("synth-cancel").onclick = async () => { if (job) await call(`/api/jobs/${job.id}/cancel`, {}); };
+
+function showResults(results) {
+  const items = results.map((r, i) => {
+    const li = h("li");
+    li.dataset.result = i;
+    li.append(`error ${r.error.toPrecision(4)} (sum of squared distances), branch ${r.branch}, ${r.feasible ? "feasible" : "infeasible"} `);
+    if (r.mechanism) {
+      const b = h("button", "Apply"); b.dataset.apply = i;
+      b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
+      li.append(b);
+    }
+    li.onmouseenter = () => { state.preview = r.path; render(); };
+    return li;
+  });
+  $("synth-results").replaceChildren(...items);
+  if (results.length) { state.preview = results[0].path; render(); }
+}
+
+// ------------------------------------------------------------------ atlas
+$("atlas-go").onclick = async () => {
+  $("atlas").replaceChildren(h("p", "listing…", { className: "muted" }));
+  try {
+    const { chains } = await call(`/api/atlas?links=${$("atlas-links").value}&mobility=${$("atlas-mobility").value}`);
+    $("atlas").replaceChildren(...chains.map(chainFigure));
+    if (!chains.length) $("atlas").replaceChildren(h("p", "no chains", { className: "muted" }));
+  } catch (e) { $("atlas").replaceChildren(h("p", e.error || String(e), { className: "err" })); }
+};
+
+function chainFigure(c) {
+  const fig = h("figure");
+  const s = el("svg", { viewBox: "-70 -70 140 140", "data-chain": c.index });
+  const jx = c.joint_xy, xs = jx.map((p) => p[0]), ys = jx.map((p) => p[1]);
+  const cx = (Math.min(...xs) + Math.max(...xs)) / 2, cy = (Math.min(...ys) + Math.max(...ys)) / 2;
+  const sc = 110 / Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys), 1e-9);
+  const P = (p) => [(p[0] - cx) * sc, -(p[1] - cy) * sc];
+  const frame = c.mechanisms.length ? c.mechanisms[0].frame : 0;
+  for (let l = 0; l < c.chain.n_links; l++) {
+    const pts = c.chain.edges.map((e, k) => (e.includes(l) ? P(jx[k]) : null)).filter(Boolean);
+    if (pts.length === 2) el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar", "stroke-width": 3, stroke: l === frame ? "#999" : null }, s);
+    else {
+      const cxy = pts.reduce((a, p) => [a[0] + p[0] / pts.length, a[1] + p[1] / pts.length], [0, 0]);
+      pts.sort((a, b) => Math.atan2(a[1] - cxy[1], a[0] - cxy[0]) - Math.atan2(b[1] - cxy[1], b[0] - cxy[0]));
+      el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "link-plate", fill: l === frame ? "#ccc" : null }, s);
+    }
+  }
+  for (const p of jx.map(P)) el("circle", { cx: p[0], cy: p[1], r: 3, class: "joint" }, s);
+  fig.append(s, h("figcaption", `#${c.index + 1} ${c.label}`));
+  const b = h("button", "Open"); b.dataset.openChain = c.index;
+  b.onclick = async () => {
+    try {
+      const ch = c.mechanisms[0] || {};
+      const r = await call("/api/atlas/mechanism", { chain: c.chain, frame: ch.frame, input: ch.input });
+      state.fileName = ""; setMech(r.mechanism, { fit: true });
+    } catch (e) { state.errors = [{ message: e.error }]; render(); }
+  };
+  fig.append(b);
+  return fig;
+}
+
+// ------------------------------------------------------------------ files
+async function openFrom(promise) {
+  try {
+    const r = await promise;
+    state.fileName = r.name || "";
+    $("save-name").value = state.fileName.includes("/") || !state.fileName ? state.fileName : state.fileName;
+    state.selected = null;
+    setMech(r.mechanism, { fit: true });
+    // fit again once the paths are known
+    const n = state.simulations;
+    const wait = () => (state.simulations > n ? (fitView(), render()) : setTimeout(wait, 30));
+    wait();
+  } catch (e) {
+    state.errors = [{ message: e.error || String(e), hint: e.hint }]; render();
+  }
+}
+
+$("examples").onchange = (ev) => { if (ev.target.value) openFrom(call(`/api/examples/${encodeURIComponent(ev.target.value)}`)); ev.target.value = ""; };
+$("files").onfocus = refreshFiles;
+$("files").onchange = (ev) => { if (ev.target.value) openFrom(call(`/api/file?path=${encodeURIComponent(ev.target.value)}`)); ev.target.value = ""; };
+$("upload").onchange = async (ev) => {
+  const f = ev.target.files[0];
+  if (!f) return;
+  openFrom(call("/api/import", { text: await f.text(), filename: f.name }));
+  ev.target.value = "";
+};
+$("save").onclick = async () => {
+  const name = $("save-name").value.trim() || "mechanism.yaml";
+  try {
+    let r;
+    try { r = await call("/api/file", { path: name, mechanism: state.mech }); }
+    catch (e) {
+      if (!/exists/.test(e.error || "") || !confirm(`${name} exists: overwrite it?`)) throw e;
+      r = await call("/api/file", { path: name, mechanism: state.mech, overwrite: true });
+    }
+    state.notes = [`saved ${r.saved} (${r.bytes} bytes)`]; state.fileName = r.saved; render(); refreshFiles();
+  } catch (e) { state.errors = [{ message: `not saved: ${e.error || e}`, hint: e.hint }]; render(); }
+};
+
+function download(name, blob) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob); a.download = name;
+  document.body.append(a); a.click(); a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+}
+async function svgText() {
+  const css = await fetch("/static/studio.css").then((r) => r.text());
+  const c = svg.cloneNode(true);
+  c.setAttribute("xmlns", "http://www.w3.org/2000/svg");
+  const style = document.createElementNS("http://www.w3.org/2000/svg", "style");
+  style.textContent = css;
+  c.insertBefore(style, c.firstChild);
+  const bg = document.createElementNS("http://www.w3.org/2000/svg", "rect");
+  bg.setAttribute("width", "100%"); bg.setAttribute("height", "100%"); bg.setAttribute("fill", "#fff");
+  c.insertBefore(bg, style.nextSibling);
+  return new XMLSerializer().serializeToString(c);
+}
+const base = () => (state.fileName || state.mech.name || "mechanism").replace(/\.[a-z]+$/i, "").replace(/[^\w.-]+/g, "_");
+$("export").onchange = async (ev) => {
+  const fmt = ev.target.value; ev.target.value = "";
+  if (!fmt || !state.mech) return;
+  try {
+    if (fmt === "svg") download(`${base()}.svg`, new Blob([await svgText()], { type: "image/svg+xml" }));
+    else if (fmt === "png") {
+      const url = URL.createObjectURL(new Blob([await svgText()], { type: "image/svg+xml" }));
+      const img = new Image();
+      await new Promise((ok, bad) => { img.onload = ok; img.onerror = bad; img.src = url; });
+      const r = svg.getBoundingClientRect(), cv = document.createElement("canvas");
+      cv.width = r.width * 2; cv.height = r.height * 2;
+      const ctx = cv.getContext("2d"); ctx.scale(2, 2); ctx.drawImage(img, 0, 0, r.width, r.height);
+      URL.revokeObjectURL(url);
+      cv.toBlob((b) => download(`${base()}.png`, b), "image/png");
+    } else {
+      const text = await call("/api/export", { mechanism: state.mech, format: fmt }, { raw: true });
+      download(`${base()}.${fmt}`, new Blob([text], { type: "text/plain" }));
+    }
+  } catch (e) { state.errors = [{ message: `export failed: ${e.error || e}` }]; render(); }
+};
+
+async function refreshFiles() {
+  try {
+    const { files } = await call("/api/files");
+    const keep = $("files").value;
+    $("files").replaceChildren(h("option", "Files…", { value: "" }), ...files.map((f) => h("option", f, { value: f })));
+    $("files").value = keep;
+  } catch (e) { /* the list stays as it was */ }
+}
+
+// ------------------------------------------------------------------ toolbar, keys, start
+function setMode(mode) {
+  state.mode = mode;
+  if (mode !== "link") { state.building = []; $("finish-link").disabled = true; }
+  for (const b of document.querySelectorAll("#modes button")) b.classList.toggle("on", b.dataset.mode === mode);
+  if (mode === "target") showTab("synthesis");
+  render();
+}
+function showTab(name) {
+  for (const b of document.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
+  for (const t of document.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
+  if (name === "plots") renderPlots();
+}
+for (const b of document.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
+for (const b of document.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
+$("finish-link").onclick = finishLink;
+$("undo").onclick = undo;
+$("redo").onclick = redo;
+$("new").onclick = () => { state.fileName = ""; state.selected = null; setMech(EMPTY(), { fit: true }); };
+$("fit").onclick = () => { fitView(); render(); };
+$("grid").onchange = (ev) => { state.opts.grid = ev.target.checked; render(); };
+$("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
+$("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
+$("plot-what").onchange = renderPlots;
+window.addEventListener("resize", render);
+document.addEventListener("keydown", (ev) => {
+  if (ev.target.matches("input, select, textarea")) return;
+  const k = ev.key;
+  if ((ev.ctrlKey || ev.metaKey) && k === "z") { ev.preventDefault(); undo(); }
+  else if ((ev.ctrlKey || ev.metaKey) && (k === "y" || k === "Z")) { ev.preventDefault(); redo(); }
+  else if (k === "Enter" && state.mode === "link") finishLink();
+  else if (k === "Escape") { state.building = []; setMode("select"); }
+  else if (k === " ") { ev.preventDefault(); setPlaying(!state.playing); }
+  else if (!ev.ctrlKey && !ev.metaKey) {
+    const m = { v: "select", g: "pivot", l: "link", p: "point", d: "drive", x: "delete", t: "target" }[k.toLowerCase()];
+    if (m) setMode(m);
+    if (k === "f") { fitView(); render(); }
+  }
+});
+
+(async function start() {
+  try {
+    const s = await call("/api/start");
+    $("save-name").value = s.name || "";
+    const ex = await call("/api/examples");
+    for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}`, { value: e.name }));
+    refreshFiles();
+    if (s.mechanism) openFrom(Promise.resolve({ mechanism: s.mechanism, name: s.name }));
+    else setMech(EMPTY(), { record: false, fit: true });
+  } catch (e) {
+    $("banner").replaceChildren(div("err", `${e.error || e}${e.hint ? " — fix: " + e.hint : ""}`));
+    state.mech = EMPTY(); render();
+  }
+})();
