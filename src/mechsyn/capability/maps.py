@@ -273,7 +273,16 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
 @dataclass(repr=False)
 class CapabilityMap(Result):
     """V_max over a grid: ``value[i, j]`` at ``(xs[i], ys[j])`` with the optimal
-    configuration ``q[i, j]`` (radians; NaN where no allowed configuration reaches)."""
+    configuration ``q[i, j]`` (radians; NaN where no allowed configuration reaches).
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> cmap = ms.capability_map(arm, np.array([900.0, 1000.0]), np.array([900.0, 1000.0]), [1, 0])
+    >>> cmap.value.shape, cmap.q.shape
+    ((2, 2), (2, 2, 3))
+    """
 
     _plot = "capability:plot_capability_map"
 
@@ -345,6 +354,14 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     refines the best 8 IK solutions with :func:`refine_over_self_motion` (other arms).
     ``advance(k)`` is called after each chunk of k points (for a progress bar).
     Spatial arms need ``z`` (the grid lies in the plane z = const).
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> cmap = ms.capability_map(arm, np.array([1000.0]), np.array([1000.0]), [1, 0])
+    >>> bool(np.isfinite(cmap.value).all())
+    True
     """
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     X, Y = np.meshgrid(xs, ys, indexing="ij")

@@ -73,6 +73,13 @@ class PointCapability(Result):
     ``configurations`` are the allowed configurations of the sampled self-motion, each with
     every measure; ``best`` the one with the largest ``measure``; ``continuous_best`` the
     result of the continuous search (None when no allowed configuration reaches).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> r = ms.capability_at(ms.examples.load("paper004_3r"), [1000, 1000], [0, 1])
+    >>> r.best == r.configurations[r.best_index]
+    True
     """
 
     arm: str

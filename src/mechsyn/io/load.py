@@ -190,6 +190,12 @@ def load_mechanism(path: str | os.PathLike[str]) -> Mechanism:
     ------
     MechsynInputError
         naming the file, line and field of the first problem, with a fix.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.load_mechanism(ms.examples.path("slider_crank")).pairs_by_class()
+    {5: 4}
     """
     from mechsyn.examples import resolve
 

@@ -59,6 +59,13 @@ class Simulation(Result):
 
     ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
     table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 360, 10))
+    >>> s.point("M").shape, bool(s.assembled.all())
+    ((37, 2), True)
     """
 
     _plot = "kinematics:plot_paths"
@@ -175,7 +182,14 @@ def _unit(t: str) -> str:
 
 
 def input_grid(start: float, stop: float, step: float) -> np.ndarray:
-    """``start, start + step, ..., stop`` (stop included when on the grid)."""
+    """``start, start + step, ..., stop`` (stop included when on the grid).
+
+    Examples
+    --------
+    >>> from mechsyn.kinematics.analysis import input_grid
+    >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
+    ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
+    """
     n = int(np.floor((stop - start) / step + 1e-9)) + 1
     return start + step * np.arange(n)
 
@@ -213,6 +227,14 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     length; drivers not listed keep their value of the file. ``method``: ``"auto"``
     (closed-form Assur groups when the mechanism decomposes, else Newton),
     ``"assur"`` or ``"newton"``.
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> m = ms.examples.load("crank_rocker")
+    >>> s = ms.simulate(m, {"A": np.linspace(0, 180, 7)})
+    >>> s.link("crank").angle.round(6).tolist()
+    [0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0]
     """
     if not inputs:
         raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
@@ -371,7 +393,15 @@ def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
 # --------------------------------------------------------------------------- forces
 @dataclass(repr=False)
 class ForceAnalysis(Result):
-    """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``)."""
+    """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> f = ms.examples.load("crank_rocker").forces(A=(0, 360, 90), gravity=(0, -9.81))
+    >>> sorted(f.reactions.force), f.reactions.effort_kind["A"]
+    (['A', 'B', 'C', 'D'], 'moment')
+    """
 
     _plot = "kinematics:plot_forces"
 
@@ -437,7 +467,16 @@ class ForceAnalysis(Result):
 def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
            gravity: tuple[float, float] = (0.0, 0.0), static: bool = False, vll: dict[str, str] | None = None,
            method: str = "auto", progress: Any = None) -> ForceAnalysis:
-    """Kinetostatic (or static) analysis over a sweep of the inputs."""
+    """Kinetostatic (or static) analysis over a sweep of the inputs.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.examples.load("crank_rocker")
+    >>> f = ms.forces(m, {"A": ms.input_grid(0, 90, 45)}, static=True, gravity=(0, -9.81))
+    >>> f.reactions.effort["A"].shape
+    (3,)
+    """
     sim = simulate(mech, inputs, speeds=speeds, points=[], vll=vll, method=method, progress=progress)
     sw = sim.sweep
     R = kinetostatics(sim.system, sw.q, None if static else sw.qd, None if static else sw.qdd,

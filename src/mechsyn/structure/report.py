@@ -125,6 +125,13 @@ class StructureReport(Result):
         Pair-class changes (``remedies=True``); with the rank method, only those it confirms.
     rejected : list
         ``(number, Remedy, RemedyCheck)`` of the remedies the rank method dropped.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> r = ms.analyze(ms.examples.load("fourbar"))
+    >>> r.to_dict()["mobility"], r.to_dict()["method"]
+    (1, 'both')
     """
 
     mechanism: Mechanism = field(metadata={"json": False})

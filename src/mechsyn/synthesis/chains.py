@@ -577,6 +577,12 @@ def synthesize_chains(
     chains and chains with non-planar graphs are included and flagged. ``progress`` is
     called with 1 after each assortment. Chains are ordered by assortment, then by
     contracted graph.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> [c.assortment_label() for c in ms.synthesize_chains(4)], len(ms.synthesize_chains(6))  # four-bar; Watt, Stephenson
+    (['4B'], 2)
     """
     _check_request(n_links, mobility)
     chains: list[KinematicChain] = []

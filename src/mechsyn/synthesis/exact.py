@@ -387,6 +387,14 @@ def motion_synthesis(poses, circle_points=None, center_points=None, max_pairs: i
       simulated and ranked (no defect first, then by the smallest transmission angle along
       the motion, larger is better).
     * 5 poses: the (up to four) Burmester point pairs.
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> poses = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, np.radians(20)], [2.0, 0.6, np.radians(45)]])
+    >>> sols = ms.motion_synthesis(poses, circle_points=np.array([[-0.5, 0.0], [0.5, 0.0]]))
+    >>> len(sols), bool(sols[0].position_error < 1e-6)
+    (1, True)
     """
     P = _poses(poses)
     n = len(P)

@@ -134,6 +134,13 @@ def synthesize_fingers(
 
     ``separate``: attach ``W0 - A`` groups of ``W_f = -1`` each instead (``max_links``
     then bounds their total number of links).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> syn = ms.synthesize_fingers(ms.examples.load("two_phalanx_base_000"), actuators=1, max_links=4)
+    >>> syn.W0, syn.W_f, len(syn.results) > 0
+    (2, -1, True)
     """
     from mechsyn.io import mechanism_to_dict
 
