@@ -211,7 +211,7 @@ def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[
             j = mech.joint(name)
         except KeyError:
             known = list(mech.points) + [j.id for j in mech.joints]
-            raise MechsynInputError(f"no point or joint named {name!r}", source="--points",
+            raise MechsynInputError(f"no point or joint named {name!r}", field="points",
                                     hint=f"known: {', '.join(known)}") from None
         link = j.links[1] if j.links[1] != mech.ground else j.links[0]
         out[name] = (link, np.asarray(j.point, float))
@@ -237,16 +237,16 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     [0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0]
     """
     if not inputs:
-        raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+        raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
     S = build_system(mech, vll=vll, prescribed=prescribed)
     drivers = [d.joint for d in S.drivers]
     lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
     if len(lengths) != 1:
-        raise MechsynInputError("all inputs need the same number of values", source="--input")
+        raise MechsynInputError("all inputs need the same number of values", field="inputs")
     N = lengths.pop()
     if N == 0:
-        raise MechsynInputError("the input range is empty", source="--input")
+        raise MechsynInputError("the input range is empty", field="inputs")
     U = np.tile([d.assembled for d in S.drivers], (N, 1)).astype(float)
     types: dict[str, str] = {}
     for jid, vals in inputs.items():
@@ -254,34 +254,34 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
             try:
                 j = mech.joint(jid)
             except KeyError:
-                raise MechsynInputError(f"no joint {jid!r}", source="--input",
+                raise MechsynInputError(f"no joint {jid!r}", field="inputs",
                                         hint=f"driven joints: {', '.join(drivers) or '(none)'}") from None
             raise MechsynInputError(
-                f"joint {jid} ({j.type}) is not driven", source="--input",
+                f"joint {jid} ({j.type}) is not driven", field="inputs",
                 hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
         k = drivers.index(jid)
         vals = np.asarray(vals, float)
         if not np.all(np.isfinite(vals)):
-            raise MechsynInputError(f"input values of {jid} must be finite numbers", source="--input")
+            raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
         d = S.drivers[k]
         U[:, k] = np.radians(vals) if d.type == "R" else vals
         types[jid] = d.type
         lim = mech.joint(jid).limits
         if lim is not None and d.type == "P" and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
             raise MechsynInputError(
-                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", source="--input",
+                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
                 hint="keep the VLL length within its limits")
     sp = np.zeros(len(drivers))
     speeds = dict(speeds or {})
     for jid in speeds:
         if jid not in inputs:
-            raise MechsynInputError(f"--speed names {jid}, which has no --input", source="--speed")
+            raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
     for jid in inputs:
         sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
     pts = resolve_points(mech, points)
     plan = dyads.decompose(S) if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
-        raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
+        raise MechsynInputError("the mechanism does not decompose into drivers and dyads", field="method",
                                 hint="use the Newton method")
     events: list[dict] = []
     if plan is not None:

@@ -81,18 +81,18 @@ def _check_request(n_links: int, mobility: int) -> int:
     """Validate ``(n, F)`` and return the number of joints ``j``."""
     if n_links < 2:
         raise MechsynInputError(
-            f"a kinematic chain needs at least 2 links, got {n_links}", source="--links"
+            f"a kinematic chain needs at least 2 links, got {n_links}", field="n_links"
         )
     if mobility < 1:
         raise MechsynInputError(
-            f"mobility must be at least 1, got {mobility}", source="--mobility",
+            f"mobility must be at least 1, got {mobility}", field="mobility",
             hint="chains of mobility <= 0 are structures",
         )
     if (3 * (n_links - 1) - mobility) % 2:
         raise MechsynInputError(
             f"no planar chain has {n_links} links and mobility {mobility}: "
             "3 (n - 1) - F must be even",
-            source="--links",
+            field="n_links",
             hint=f"use {n_links + 1} or {n_links - 1} links, or mobility {mobility + 1}",
         )
     return (3 * (n_links - 1) - mobility) // 2

@@ -154,7 +154,7 @@ def synthesize_fingers(
     if w0 <= actuators:
         raise MechsynInputError(
             f"W0 = {w0} is not larger than the {actuators} drive(s): nothing to attach",
-            source="--actuators")
+            field="actuators")
     table = group_table(w0, actuators, max_links)
     rows = [r for r in table.rows if r.meets_conditions]
     degree = {n: 0 for n in mech.link_names}

@@ -571,7 +571,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     from mechsyn.synthesis.optimize import OPTIMIZERS, polish, restart_seeds
 
     if optimizer not in OPTIMIZERS:
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     t0 = time.monotonic()
     deadline = t0 + time_limit

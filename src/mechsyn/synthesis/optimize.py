@@ -304,7 +304,7 @@ def synthesize_path(
     if optimizer not in OPTIMIZERS:
         from mechsyn.errors import MechsynInputError
 
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     options = dict(options or {})
     t0 = time.time()
