@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # docs/tutorial.ipynb runs top to bottom (committed without outputs; executed here with nbclient).
 set -euo pipefail
-python -m pip install --quiet -e ".[docs]"
+python -m pip install --quiet -e ".[notebook]"
 workdir=$(mktemp -d)
 MPLBACKEND=Agg python - "$workdir" <<'PY'
 import sys

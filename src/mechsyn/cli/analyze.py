@@ -3,20 +3,20 @@
 from __future__ import annotations
 
 import json
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 from rich.panel import Panel
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, err_console
+from mechsyn.cli.common import console, emit_json, err_console, safe
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis
-from mechsyn.structure.rank import Comparison, RankAnalysis, RemedyCheck, rank_summary_lines
+from mechsyn.structure.compare import Comparison, RemedyCheck
+from mechsyn.structure.rank import RankAnalysis, rank_summary_lines
 from mechsyn.structure.remedies import Remedy
 from mechsyn.structure.report import CONTOUR_READING, StructureReport, formula_title, pair_list
 from mechsyn.structure.report import analyze as structure_report
@@ -38,7 +38,7 @@ def _fmt(x: float | None) -> str:
 def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
     pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
     console.print(Panel.fit(
-        f"[bold]{title_prefix}{a.name}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
+        f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
         f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
     ))
     t = Table(title="Formulas", show_lines=False)
@@ -76,7 +76,7 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         console.print(f"[dim]note:[/] {n}", highlight=False, soft_wrap=True)
     for name, sub in a.states.items():
         console.print()
-        render(sub, title_prefix=f"state '{name}': ")
+        render(sub, title_prefix=f"state '{safe(name)}': ")
 
 
 def render_remedies(remedies: list[Remedy]) -> None:
@@ -141,19 +141,18 @@ def render_remedy_checks(checks: list[tuple[int, Remedy, RemedyCheck]]) -> None:
 LARGE_JOINTS = 1000
 
 
-@contextmanager
-def _rank_progress(mech, method):
-    """For a large mechanism: say its size and yield a callback showing the rank method's stages."""
-    if method == "formulas" or len(mech.joints) < LARGE_JOINTS:
-        yield None
-        return
+def _analyze_reporting(mech, **options):
+    """:func:`mechsyn.structure.report.analyze`, with the size and the rank method's stages on
+    stderr for a large mechanism."""
+    if len(mech.joints) < LARGE_JOINTS:
+        return structure_report(mech, **options)
     from mechsyn.structure.contours import cycle_rank
 
     err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
                       f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
                       f"of loops (2,000 joints: a few seconds)", highlight=False)
     with err_console.status("rank method") as status:
-        yield lambda stage: status.update(f"rank method: {stage}")
+        return structure_report(mech, progress=lambda stage: status.update(f"rank method: {stage}"), **options)
 
 
 @app.command("analyze")
@@ -174,10 +173,8 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
-    mech = load_mechanism(file)
-    with _rank_progress(mech, method) as progress:
-        report = structure_report(mech, method=method, remedies=remedies, max_variants=max_variants, tol=tol,
-                                  as_spatial=spatial, progress=progress)
+    report = _analyze_reporting(load_mechanism(file), method=method, remedies=remedies,
+                                max_variants=max_variants, tol=tol, as_spatial=spatial)
     if json_out:
         emit_json(report.to_dict(), out)
     elif markdown:

@@ -84,19 +84,20 @@ def build_cli() -> Any:
     return group  # type: ignore[return-value]
 
 
+#: exit status of Ctrl-C (128 + SIGINT), as :data:`mechsyn.interrupt.INTERRUPT_EXIT_CODE`
+_INTERRUPTED = 130
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; bad input exits with status 2 and one message.
 
     Ctrl-C exits with status 130 and prints ``interrupted`` (searches have written their
     best result so far, marked as interrupted, before that).
     """
-    interrupted = 130  # mechsyn.interrupt.INTERRUPT_EXIT_CODE (not imported: it loads NumPy)
     try:
-        # typer turns KeyboardInterrupt (and typer.Exit(n) raised by a command) into a
-        # returned exit status when standalone_mode is off
         status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
     except KeyboardInterrupt:
-        status = interrupted
+        status = _INTERRUPTED
     except MechsynInputError as error:
         from rich.markup import escape
 
@@ -109,18 +110,20 @@ def main(argv: list[str] | None = None) -> int:
         return _exit(int(exc.code or 0), argv)
     except Exception as exc:  # click's (typer's vendored click's) own exceptions
         name = type(exc).__name__
-        if name == "Abort":
-            print("aborted", file=sys.stderr)
-            return _exit(130, argv)
-        if hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
+        if name == "Abort":  # click's wrapping of Ctrl-C
+            status = _INTERRUPTED
+        elif hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
             exc.show()
             return _exit(int(exc.exit_code), argv)
-        if hasattr(exc, "exit_code"):  # Exit
+        elif hasattr(exc, "exit_code"):  # Exit
             return _exit(int(exc.exit_code), argv)
-        raise
+        else:
+            raise
     if isinstance(status, int) and not isinstance(status, bool) and status != 0:
-        if status == interrupted:
-            print("interrupted", file=sys.stderr)
+        if status == _INTERRUPTED:  # searches wrote their best so far before this
+            from mechsyn.cli.common import err_console
+
+            err_console.print("interrupted", highlight=False)
         return _exit(status, argv)
     return _exit(0, argv)
 

@@ -7,10 +7,10 @@ from typing import Optional
 
 import numpy as np
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats, save_plot, stop_if_interrupted
+from mechsyn.cli.common import check_output_suffix, check_writable, console, emit_json, err_console, parse_floats, save_plot, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -67,6 +67,8 @@ def synth_path(
     if restarts < 1:
         raise MechsynInputError("must be at least 1", source="--restarts")
     check_parallel_options(workers, scheduler)
+    check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     case = _pick_case(case_file, case_id)
     case = _with_margins(case, min_transmission, fold_margin)
     if target_error is None:
@@ -160,6 +162,7 @@ def synth_function(
     from mechsyn.synthesis.exact import freudenstein_synthesis
     from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
 
+    check_writable(out, "--out")
     ph = np.radians(parse_floats(phi, "--phi", 3))
     ps = np.radians(parse_floats(psi, "--psi", 3))
     if not ground > 0:
@@ -229,6 +232,8 @@ def synth_motion(
     from mechsyn.synthesis.exact import motion_synthesis, to_jsonable_motion
     from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
 
+    check_writable(out, "--out")
+    check_writable(plot, "--plot")
     P = _read_poses(poses_file, poses)
     cp = np.array(parse_floats(circle_points, "--circle-points", 4)).reshape(2, 2) if circle_points else None
     mp = np.array(parse_floats(center_points, "--center-points", 4)).reshape(2, 2) if center_points else None

@@ -95,7 +95,7 @@ def _kind(p: Path, data: Any) -> tuple[str, str]:
 
 @functools.lru_cache(maxsize=1)
 def _catalogue() -> Catalogue:
-    from mechsyn.io.files import safe_load_yaml
+    from mechsyn.io.load import safe_load_yaml
 
     base = root()
     files = sorted(p for p in base.rglob("*") if p.suffix in _SUFFIXES and p.is_file())

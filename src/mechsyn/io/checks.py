@@ -2,7 +2,8 @@
 
 A silent wrong answer is worse than an error, so :func:`check_geometry` refuses
 
-* coordinates so large that squared distances overflow (``|x| > LIMITS["coordinate"]``):
+* coordinates so large that squared distances overflow (beyond the limit ``coordinate``
+  of :mod:`mechsyn.limits`, 1e100):
   every length, angle and Jacobian computed from them would be ``inf`` or ``nan``;
 * a zero-length link: a moving link with two or more revolute joints, all at one point
   (a crank whose both pivots coincide "assembles" everywhere and never moves; all the
@@ -32,11 +33,12 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.limits import limit, limit_hint
 
-__all__ = ["LIMITS", "check_geometry"]
+__all__ = ["check_geometry", "COINCIDENT_REL"]
 
-#: Largest coordinate magnitude accepted (squares of 1e154 already overflow doubles).
-LIMITS: dict[str, float] = {"coordinate": 1e100, "coincident_rel": 1e-12}
+#: Joints closer than this times the file's extent are at one point.
+COINCIDENT_REL = 1e-12
 
 
 def _vectors(mech: Any) -> list[tuple[str, np.ndarray]]:
@@ -61,7 +63,12 @@ def _xyz(p: Any) -> np.ndarray:
 
 def check_geometry(mech: Any, source: str | None = None) -> Any:
     """Raise :class:`MechsynInputError` for geometry no mechanism can have; return ``mech``."""
-    big = LIMITS["coordinate"]
+    big = limit("coordinate")
+    for what, count in (("links", len(mech.links)), ("joints", len(mech.joints))):
+        if count > limit(what):
+            raise MechsynInputError(
+                f"{count:,} {what} are more than the limit of {limit(what):,} (the analyses would run for "
+                "hours or longer)", source=source, field=what, hint=limit_hint(what))
     for what, v in _vectors(mech):
         if v.size and np.max(np.abs(v)) > big:
             raise MechsynInputError(
@@ -77,7 +84,7 @@ def check_geometry(mech: Any, source: str | None = None) -> Any:
     if len(P) < 2:
         return mech
     scale = float(np.max(np.ptp(P, axis=0)))
-    tol = LIMITS["coincident_rel"] * scale
+    tol = COINCIDENT_REL * scale
     bad = []
     for link in mech.link_names:
         if link == mech.ground:
@@ -99,3 +106,39 @@ def check_geometry(mech: Any, source: str | None = None) -> Any:
             what, source=source, field="joints",
             hint="give the joints of each link their own points in the assembled configuration")
     return mech
+
+
+def has_bool(value: Any) -> bool:
+    """Whether ``value`` (a number or nested lists of them) holds a boolean."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, (list, tuple)):
+        return any(has_bool(v) for v in value)
+    return False
+
+
+def numbers(value: Any, source: str | None, field: str) -> np.ndarray:
+    """``value`` as a float array: finite, within ±limit ``coordinate``, no booleans.
+
+    Examples
+    --------
+    >>> numbers([1, 2.5], "case.json", "targets[0]").tolist()
+    [1.0, 2.5]
+    >>> numbers([True, False], "case.json", "point")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: case.json: point: true/false is not a number ...
+    """
+    if has_bool(value):
+        raise MechsynInputError("true/false is not a number", source=source, field=field,
+                                hint="write numbers, e.g. [1.0, 0.0]")
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise MechsynInputError("must be numbers", source=source, field=field) from None
+    if not np.all(np.isfinite(a)):
+        raise MechsynInputError("must be finite numbers", source=source, field=field)
+    if a.size and np.max(np.abs(a)) > limit("coordinate"):
+        raise MechsynInputError(f"values beyond ±{limit('coordinate'):g} would overflow", source=source,
+                                field=field, hint="use a unit that keeps the values below 1e100")
+    return a

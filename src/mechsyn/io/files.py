@@ -2,12 +2,10 @@
 
 :func:`read_text` and :func:`parse_data` turn every way a file can be unreadable into
 one :class:`~mechsyn.errors.MechsynInputError` naming the file and the fix: missing,
-a directory, unreadable, not UTF-8, too large, a syntax error, nesting deeper than
-:data:`LIMITS` ``["nesting"]`` (a RecursionError otherwise) or more values than
-``LIMITS["values"]`` (e.g. YAML aliases expanding a few lines into billions of items).
-
-The limits are module data and can be raised, e.g. ``mechsyn.io.files.LIMITS["bytes"] =
-10**9`` (see docs/reliability.md).
+a directory, unreadable, not UTF-8, larger than the limit ``file_bytes``, a syntax
+error, nested deeper than ``nesting`` (a RecursionError otherwise) or holding more than
+``values`` values (YAML aliases can expand a few lines into billions of items). The
+limits are those of :mod:`mechsyn.limits` (see docs/reliability.md).
 
 Examples
 --------
@@ -29,20 +27,13 @@ from typing import Any
 
 import yaml
 
+#: LibYAML's safe parser where PyYAML was built with it (several times faster), else PyYAML's own.
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 from mechsyn.errors import MechsynInputError
+from mechsyn.limits import limit, limit_hint
 
-__all__ = ["LIMITS", "read_text", "parse_data", "read_data", "check_data_size", "safe_load_yaml"]
-
-#: LibYAML's parser where PyYAML was built with it (several times faster), else PyYAML's own.
-YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-
-
-def safe_load_yaml(text: str) -> Any:
-    """``yaml.safe_load`` through LibYAML when available."""
-    return yaml.load(text, Loader=YAML_LOADER)  # noqa: S506 (a safe loader)
-
-#: Limits of input files: size in bytes, nesting depth of lists/mappings, number of values.
-LIMITS: dict[str, int] = {"bytes": 50_000_000, "nesting": 64, "values": 5_000_000}
+__all__ = ["read_text", "parse_data", "read_data", "check_data_size"]
 
 _BRACKETS = re.compile(r"[\[\]{}]")
 
@@ -62,10 +53,10 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         raise MechsynInputError(f"is a directory, not a {what}", source=str(p))
     try:
         size = p.stat().st_size
-        if size > LIMITS["bytes"]:
+        if size > limit("file_bytes"):
             raise MechsynInputError(
-                f"{what} of {size:,} bytes is larger than the limit of {LIMITS['bytes']:,}",
-                source=str(p), hint="raise mechsyn.io.files.LIMITS['bytes'] if this file is meant")
+                f"{what} of {size:,} bytes is larger than the limit of {limit('file_bytes'):,}",
+                source=str(p), hint=limit_hint("file_bytes"))
         data = p.read_bytes()
     except OSError as exc:
         raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(p),
@@ -89,9 +80,9 @@ def _bracket_depth(text: str) -> int:
 
 
 def check_data_size(data: Any, source: str) -> Any:
-    """Refuse data nested deeper than ``LIMITS["nesting"]`` or with more than
-    ``LIMITS["values"]`` values (counted through shared YAML aliases); return ``data``."""
-    limit, budget = LIMITS["nesting"], LIMITS["values"]
+    """Refuse data nested deeper than the limit ``nesting`` or with more than
+    ``values`` values (counted through shared YAML aliases); return ``data``."""
+    deepest, budget = limit("nesting"), limit("values")
     stack = [(data, 1)]
     seen = 0
     while stack:
@@ -100,14 +91,14 @@ def check_data_size(data: Any, source: str) -> Any:
         if seen > budget:
             raise MechsynInputError(
                 f"more than {budget:,} values (YAML aliases expanding into too many items?)",
-                source=source, hint="write the data out without aliases, or split the file")
+                source=source, hint="write the data out without aliases; " + limit_hint("values"))
         if isinstance(node, dict):
             children = list(node.keys()) + list(node.values())
         elif isinstance(node, (list, tuple)):
             children = node
         else:
             continue
-        if depth > limit and children:
+        if depth > deepest and children:
             raise _too_deep(source)
         stack.extend((c, depth + 1) for c in children)
     return data
@@ -115,16 +106,16 @@ def check_data_size(data: Any, source: str) -> Any:
 
 def _too_deep(source: str) -> MechsynInputError:
     return MechsynInputError(
-        f"nested more than {LIMITS['nesting']} levels deep", source=source,
+        f"nested more than {limit('nesting')} levels deep", source=source,
         hint="mechsyn files are a few levels deep; check the brackets or indentation")
 
 
 def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
     """Parse YAML, or JSON (``fmt="json"``, or a source ending in ``.json``), into data.
 
-    Syntax errors name the line; nesting and size beyond :data:`LIMITS` are refused.
+    Syntax errors name the line; nesting and size beyond the limits are refused.
     """
-    if _bracket_depth(text) > LIMITS["nesting"]:
+    if _bracket_depth(text) > limit("nesting"):
         raise _too_deep(source)
     as_json = fmt == "json" or (fmt is None and source.lower().endswith(".json"))
     try:
@@ -138,7 +129,7 @@ def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
                 ) from None
         else:
             try:
-                data = safe_load_yaml(text)
+                data = yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
             except yaml.MarkedYAMLError as exc:
                 mark = exc.problem_mark or exc.context_mark
                 line = mark.line + 1 if mark is not None else None

@@ -38,11 +38,21 @@ __all__ = [
     "mechanism_to_dict", "mechanism_text", "write_mechanism", "read_data",
 ]
 
+_YAML_LOADER = files._YAML_LOADER
+
+
+def safe_load_yaml(text: str) -> Any:
+    """``yaml.safe_load`` through LibYAML when available."""
+    return yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
+
+
 # --------------------------------------------------------------------------- reading
 def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
-    """Parse a YAML or JSON file into Python data; return it with its text
-    (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
-    return files.read_data(path)
+    """Parse a YAML or JSON file (or a bundled example, by name) into Python data; return it
+    with its text (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
+    from mechsyn.examples import resolve
+
+    return files.read_data(resolve(path))
 
 
 def parse_text(text: str, source: str) -> Any:
@@ -55,7 +65,7 @@ def _line_finder(text: str | None, source: str) -> Any:
     root = None
     if text is not None:
         try:
-            root = yaml.compose(text, Loader=files.YAML_LOADER)
+            root = yaml.compose(text, Loader=files._YAML_LOADER)
         except yaml.YAMLError:
             root = None
 

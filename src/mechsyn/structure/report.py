@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
@@ -200,7 +200,7 @@ class StructureReport(Result):
 
     def to_markdown(self) -> str:
         """The Markdown report (``mechsyn analyze --markdown``)."""
-        from mechsyn.structure.rank import rank_to_markdown
+        from mechsyn.structure.compare import rank_to_markdown
 
         text = to_markdown(self.analysis, self.remedies) if self.method != "rank" else ""
         if self.rank is not None:
@@ -275,7 +275,8 @@ def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, 
     :mod:`mechsyn.structure.analysis`); the rank method Hunt (1978), Davies (1981) and
     Gogu (2005) (see :mod:`mechsyn.structure.rank`).
     """
-    from mechsyn.structure.rank import InsufficientGeometry, analyze_rank, check_remedy, compare_with_formulas
+    from mechsyn.structure.compare import check_remedy, compare_with_formulas
+    from mechsyn.structure.rank import InsufficientGeometry, analyze_rank
     from mechsyn.structure.rank import as_spatial as to_spatial
     from mechsyn.structure.rank import missing_geometry
 

@@ -120,10 +120,11 @@ def load_case(path: str | Path) -> FingerCase:
 
 
 def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
-    try:
-        out = [float(x) for x in v]
-    except (TypeError, ValueError):
-        raise _err(f"{fld} must be a list of numbers", src, fld) from None
+    from mechsyn.io.checks import numbers
+
+    if not isinstance(v, (list, tuple)):
+        raise _err(f"{fld} must be a list of numbers", src, fld)
+    out = numbers(v, src, fld).reshape(-1).tolist()
     if n is not None and len(out) != n:
         raise _err(f"{fld} must have {n} numbers", src, fld)
     if not all(np.isfinite(out)):

@@ -107,12 +107,11 @@ class PathCase:
 
         if not isinstance(data, dict):
             raise bad("a case must be a JSON object", "(top level)")
-        try:
-            targets = np.asarray(data["targets"], dtype=float)
-        except KeyError:
-            raise bad("missing", "targets", "give a list of [x, y] points") from None
-        except (TypeError, ValueError):
-            raise bad("must be a list of [x, y] numbers", "targets") from None
+        from mechsyn.io.checks import numbers
+
+        if "targets" not in data:
+            raise bad("missing", "targets", "give a list of [x, y] points")
+        targets = numbers(data["targets"], source, "targets")
         if targets.ndim != 2 or targets.shape[1] != 2 or len(targets) < 1:
             raise bad(f"must be a list of [x, y] points, got shape {targets.shape}", "targets")
         if not np.all(np.isfinite(targets)):
@@ -147,10 +146,9 @@ class PathCase:
         for k, v in fixed_raw.items():
             if k not in LINKAGE_NAMES:
                 raise bad(f"unknown design name {k!r}", f"fixed.{k}", "one of " + ", ".join(LINKAGE_NAMES))
-            try:
-                fixed[k] = float(v)
-            except (TypeError, ValueError):
-                raise bad("must be a number", f"fixed.{k}") from None
+            fixed[k] = float(numbers(v, source, f"fixed.{k}").reshape(-1)[0]) if np.ndim(v) == 0 else None
+            if fixed[k] is None:
+                raise bad("must be a number", f"fixed.{k}")
         allowed = set(LINKAGE_NAMES)
         if ttype == "free":
             allowed |= {f"theta2_{i + 1}" for i in range(n)}
@@ -158,10 +156,10 @@ class PathCase:
             allowed.add("theta2_1")
         variables = []
         for i, v in enumerate(data.get("variables") or []):
-            try:
-                name, lo, hi = v["name"], float(v["lower"]), float(v["upper"])
-            except (KeyError, TypeError, ValueError):
-                raise bad("needs name, lower and upper", f"variables[{i}]") from None
+            if not isinstance(v, dict) or not {"name", "lower", "upper"} <= set(v):
+                raise bad("needs name, lower and upper", f"variables[{i}]")
+            name = v["name"]
+            lo, hi = (float(b) for b in numbers([v["lower"], v["upper"]], source, f"variables[{i}]"))
             if name not in allowed:
                 raise bad(f"unknown or unusable variable {name!r} for timing {ttype!r}", f"variables[{i}].name")
             if name in fixed:
