@@ -9,7 +9,14 @@ from __future__ import annotations
 
 
 class MechsynError(Exception):
-    """Base class of mechsyn's own errors."""
+    """Base class of mechsyn's own errors.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> issubclass(ms.MechsynInputError, ms.MechsynError)
+    True
+    """
 
 
 class MechsynInputError(MechsynError, ValueError):
@@ -27,6 +34,13 @@ class MechsynInputError(MechsynError, ValueError):
         1-based line number in ``source`` where known.
     hint:
         How to fix it.
+
+    Examples
+    --------
+    >>> from mechsyn.errors import MechsynInputError
+    >>> print(MechsynInputError("unknown joint 'Q'", source="arm.yaml", line=4, field="joints[1]",
+    ...                         hint="use an id from joints"))
+    arm.yaml:4: joints[1]: unknown joint 'Q' (fix: use an id from joints)
     """
 
     def __init__(

@@ -12,7 +12,7 @@ app = typer.Typer(
     ),
     no_args_is_help=True,
     pretty_exceptions_enable=False,
-    add_completion=False,
+    add_completion=True,  # mechsyn --install-completion / --show-completion (docs/python.md)
     context_settings={"help_option_names": ["-h", "--help"]},
 )
 

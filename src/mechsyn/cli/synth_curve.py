@@ -88,13 +88,7 @@ def synth_curve(
 
 
 def _write_out(out: Path, res) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mechsyn.results import save_figure_atomic
-    from mechsyn.synthesis.curves.plot import plot_candidate
+    from mechsyn.cli.common import save_plot
     from mechsyn.synthesis.export import write_mechanism_file
 
     out.mkdir(parents=True, exist_ok=True)
@@ -104,12 +98,13 @@ def _write_out(out: Path, res) -> None:
             f"mechsyn synth curve: candidate {i}, {d['topology'] or c.topology.key}, tracer T\n"
             f"input {d['input']['joint']} from {d['input']['start']:.3f} to {d['input']['stop']:.3f} deg; "
             f"chamfer {100 * c.chamfer:.3f} %, ordered {100 * c.ordered:.3f} % of the target's diagonal"))
-        fig, ax = plt.subplots(figsize=(6, 5), dpi=110)
-        try:
-            plot_candidate(c, res.target, ax=ax)
-            ax.legend(fontsize=8)
-            ax.set_title(f"candidate {i}: {d['topology'] or c.topology.key}")
-            fig.tight_layout()
-            save_figure_atomic(fig, out / f"candidate_{i}.png")
-        finally:
-            plt.close(fig)
+        save_plot(out / f"candidate_{i}.png", _draw_candidate, c, res.target,
+                  f"candidate {i}: {d['topology'] or c.topology.key}", figsize=(6, 5))
+
+
+def _draw_candidate(candidate, target, title: str, ax) -> None:
+    from mechsyn.plot.curves import plot_candidate
+
+    plot_candidate(candidate, target, ax=ax)
+    ax.legend(fontsize=8)
+    ax.set_title(title)

@@ -65,7 +65,7 @@ def _line_finder(text: str | None, source: str) -> Any:
     root = None
     if text is not None:
         try:
-            root = yaml.compose(text, Loader=_YAML_LOADER)
+            root = yaml.compose(text, Loader=files._YAML_LOADER)
         except yaml.YAMLError:
             root = None
 
@@ -200,6 +200,12 @@ def load_mechanism(path: str | os.PathLike[str]) -> Mechanism:
     ------
     MechsynInputError
         naming the file, line and field of the first problem, with a fix.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.load_mechanism(ms.examples.path("slider_crank")).pairs_by_class()
+    {5: 4}
     """
     from mechsyn.examples import resolve
 

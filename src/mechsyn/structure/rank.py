@@ -519,6 +519,13 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     method makes many small decompositions, which threads only slow down (and on a
     loaded machine by 10-50x). Raises :class:`InsufficientGeometry` when a joint lacks
     the geometry its twists need.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ra = ms.analyze_rank(ms.examples.load("bennett"))    # mobile although Grübler says -2
+    >>> ra.mobility, ra.redundant_constraints
+    (1, 3)
     """
     from threadpoolctl import threadpool_limits
 

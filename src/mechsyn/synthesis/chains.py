@@ -107,18 +107,18 @@ def _check_request(n_links: int, mobility: int) -> int:
             hint=f"use at most {limit('atlas_links')} links; {limit_hint('atlas_links')}")
     if n_links < 2:
         raise MechsynInputError(
-            f"a kinematic chain needs at least 2 links, got {n_links}", source="--links"
+            f"a kinematic chain needs at least 2 links, got {n_links}", field="n_links"
         )
     if mobility < 1:
         raise MechsynInputError(
-            f"mobility must be at least 1, got {mobility}", source="--mobility",
+            f"mobility must be at least 1, got {mobility}", field="mobility",
             hint="chains of mobility <= 0 are structures",
         )
     if (3 * (n_links - 1) - mobility) % 2:
         raise MechsynInputError(
             f"no planar chain has {n_links} links and mobility {mobility}: "
             "3 (n - 1) - F must be even",
-            source="--links",
+            field="n_links",
             hint=f"use {n_links + 1} or {n_links - 1} links, or mobility {mobility + 1}",
         )
     return (3 * (n_links - 1) - mobility) // 2
@@ -675,6 +675,12 @@ def synthesize_chains(
     contracted graph. ``workers`` (local processes) or ``scheduler`` (a Dask cluster)
     share the work (:func:`mechsyn.parallel.run_tasks`); the chains are the same, in the
     same order.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> [c.assortment_label() for c in ms.synthesize_chains(4)], len(ms.synthesize_chains(6))  # four-bar; Watt, Stephenson
+    (['4B'], 2)
     """
     _check_request(n_links, mobility)
     chains: list[KinematicChain] = []

@@ -610,12 +610,22 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
 
     Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
-    returns the best design evaluated so far with ``interrupted=True``."""
+    returns the best design evaluated so far with ``interrupted=True``.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.general import load_case
+    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> res = ms.synthesize_mechanism(case, seed=0, time_limit=20, restarts=1)
+    >>> res.feasible, res.error < res.start_error
+    (True, True)
+    """
     from mechsyn.parallel import run_tasks
     from mechsyn.synthesis.optimize import OPTIMIZERS, restart_seeds
 
     if optimizer not in OPTIMIZERS:
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     t0 = time.time()
     deadline = t0 + time_limit
