@@ -124,7 +124,16 @@ def _orth(a: np.ndarray, tol: float = 1e-6) -> np.ndarray:
 def screw_axis(tw: np.ndarray, centre: np.ndarray, scale: float) -> dict[str, Any]:
     """The screw axis of a normalised twist ``[ω; v]``: direction, a point on it (the
     foot of the perpendicular from the centre of the joint points) and pitch, in the file's
-    units; a pure slide has ``point`` and ``pitch`` None."""
+    units; a pure slide has ``point`` and ``pitch`` None.
+
+    Examples
+    --------
+    A turn about the z axis through (1, 0, 0), lengths in units of 2 from the origin:
+
+    >>> import numpy as np
+    >>> screw_axis(np.array([0, 0, 1.0, 0, -0.5, 0]), centre=np.zeros(3), scale=2.0)
+    {'direction': [0.0, 0.0, 1.0], 'point': [1.0, 0.0, 0.0], 'pitch': 0.0}
+    """
     w, v = tw[:3], tw[3:]
     nw = float(np.linalg.norm(w))
     if nw < 1e-9 * max(1.0, float(np.linalg.norm(v))):
