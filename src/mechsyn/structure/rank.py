@@ -593,7 +593,8 @@ def _near_singular_note(sv: np.ndarray, tol: float, F: int, equations: int, rank
     small = sv[(sv > tol) & (sv < 1e-2)]
     if small.size:
         k = small.size
-        notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} above the tolerance "
+        shown = ", ".join(f"{x:.2g}" for x in np.sort(small)[:6]) + (f" and {k - 6} more" if k > 6 else "")
+        notes.append(f"near-singular: singular value(s) {shown} above the tolerance "
                      f"{tol:.2g} but small; if the geometry is meant to be special (typed with few decimals), "
                      f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {equations - rank + k} "
                      f"redundant constraint(s)")
