@@ -7,7 +7,6 @@ from mechsyn.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
-SPEC = ROOT.parent / "shared" / "spec"
 
 
 @pytest.fixture

@@ -5,14 +5,13 @@ from __future__ import annotations
 import itertools
 from pathlib import Path
 
+import ezdxf  # the `cad` extra, in the `test` extra
 import numpy as np
 import pytest
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.export.plates import link_plates, plate_outline
 from mechsyn.io import load_mechanism
-
-ezdxf = pytest.importorskip("ezdxf")  # the `cad` extra, in the `test` extra
 
 ROOT = Path(__file__).resolve().parents[2]
 

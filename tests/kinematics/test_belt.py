@@ -29,15 +29,13 @@ from mechsyn.kinematics.belt import (
     path_quality,
 )
 
-SPEC = Path("/work/shared/spec/data/paper001_vectors.json")
 PAPER = BeltDesign(a=500.0, c=350.0, h=100.0, r=75.0)
 RANGE = (math.radians(-73.0), math.radians(85.0))
 
 
 def _vectors():
-    here = Path(__file__).parent / "data" / "paper001_vectors.json"
-    path = here if here.exists() else SPEC
-    return json.loads(path.read_text())
+    # paper 001's reference vectors (shared/spec/data/paper001_vectors.json, copied here)
+    return json.loads((Path(__file__).parent / "data" / "paper001_vectors.json").read_text())
 
 
 def test_design_constants_to_paper_digits():

@@ -14,13 +14,12 @@ from typing import Any, Optional
 
 import numpy as np
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, parse_floats, parse_range
+from mechsyn.cli.common import console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, write_output
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import belt as kb
-from mechsyn.results import write_atomic
 from mechsyn.synthesis.belt import BeltSynthesis, synthesize_belt
 
 belt_app = typer.Typer(
@@ -103,11 +102,9 @@ def _design(a: float | None, c: float | None, h: float | None, r: float | None,
 
 def _read_table(path: Path) -> tuple[list[float], list[float]]:
     """Two columns t (s), Δφ (deg); header and # comments allowed; , ; or blanks."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MechsynInputError(f"cannot read the table: {exc.strerror or exc}",
-                                source=str(path)) from None
+    from mechsyn.io.files import read_text
+
+    text = read_text(path, "table")
     t: list[float] = []
     phi: list[float] = []
     for lineno, line in enumerate(text.splitlines(), start=1):
@@ -267,9 +264,9 @@ def analyze_cmd(
         None, "--table", help="table law: CSV of t (s), dphi (deg)"),
     samples: int = typer.Option(201, "--samples", help="time samples of the motion"),
     json_out: bool = typer.Option(False, "--json", help="print JSON"),
-    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table of positions"),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table of positions (- for stdout)"),
     plot: Optional[Path] = typer.Option(None, "--plot", help="write the figure (PNG/SVG/PDF)"),
-    animate: Optional[Path] = typer.Option(None, "--animate", help="write an animated GIF"),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="write an animation (.gif, .mp4 or .html)"),
     four_bar_file: Optional[Path] = typer.Option(
         None, "--four-bar-file", help="write the equivalent four-bar A0-A-B-B0 as a mechanism "
                                       "file (YAML, or JSON by suffix)"),
@@ -334,8 +331,9 @@ def analyze_cmd(
         "four_bar_comparison": comparison,
         "motion": {"law": type(motion_law).__name__, **mres.to_dict()},
     }
+    one_stdout(json_out, csv_out)
     if csv_out is not None:
-        write_atomic(csv_out, _csv_text(state))
+        write_output(csv_out, _csv_text(state))
     if plot is not None:
         from mechsyn.cli.common import save_plot
         from mechsyn.plot.belt import plot_belt
@@ -358,6 +356,8 @@ def analyze_cmd(
         from mechsyn.plot.belt import animate_belt
 
         save_animation(animate, animate_belt, design, state, title=result["name"], fps=20)
+    if is_stdout(csv_out):
+        return
     if json_out:
         emit_json(result)
         return
@@ -445,7 +445,7 @@ def inverse_cmd(
                                                      "(unit/s²)"),
     point: str = typer.Option("H", "--point", help="H or C"),
     json_out: bool = typer.Option(False, "--json", help="print JSON"),
-    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table"),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table (- for stdout)"),
 ) -> None:
     """Inverse problem: servo input speed and acceleration for a required path speed.
 
@@ -469,6 +469,7 @@ def inverse_cmd(
                                 source="--phi", hint="narrow the range")
     res = kb.inverse_input(state, speed, accel, point)  # type: ignore[arg-type]
     out = {"design": design.to_dict(), "point": point, **res.to_dict()}
+    one_stdout(json_out, csv_out)
     if csv_out is not None:
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
@@ -476,7 +477,9 @@ def inverse_cmd(
         for row in zip(np.degrees(res.dphi), res.t, np.degrees(res.phid),
                        np.degrees(res.phidd), res.speed, res.accel_tangential):
             w.writerow([repr(float(v)) for v in row])
-        write_atomic(csv_out, buf.getvalue())
+        write_output(csv_out, buf.getvalue())
+    if is_stdout(csv_out):
+        return
     if json_out:
         emit_json(out)
         return

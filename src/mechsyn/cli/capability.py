@@ -13,7 +13,7 @@ import numpy as np
 import typer
 from rich import box
 from rich.console import Console
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
@@ -24,9 +24,8 @@ from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
 )
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, parse_floats, parse_range, progress_bar
+from mechsyn.cli.common import check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
 from mechsyn.errors import MechsynInputError
-from mechsyn.results import write_atomic
 
 MEASURE_HELP = {
     "exact": "largest speed of pure motion along d (joint rates free within their limits)",
@@ -100,13 +99,21 @@ def capability(
     polytope: bool = typer.Option(False, "--polytope", help="add the best configuration's "
                                   "velocity polytope and ellipse"),
     map_png: Optional[Path] = typer.Option(None, "--map", help="write a heat/contour map (PNG)"),
-    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV"),
+    csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the grid as CSV (- for stdout)"),
     interpolate: Optional[str] = typer.Option(None, "--interpolate", help="grid: the optimal "
                                               "configuration interpolated at X,Y"),
     json_out: bool = typer.Option(False, "--json", help="print JSON on stdout"),
+    workers: int = typer.Option(1, "--workers", help="grid: solve it in N local processes"),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="grid: solve it on a Dask "
+                                            "cluster (scheduler address; extra mechsyn[dask])"),
 ) -> None:
     """Largest tool speed along a direction under joint speed limits (paper 004), at a point
     over the arm's self-motion, or mapped over a grid."""
+    check_writable(map_png, "--map")
+    check_writable(csv_out, "--csv")
+    from mechsyn.parallel import check_parallel_options
+
+    check_parallel_options(workers, scheduler)
     arm = load_arm(arm_file)
     m = arm.task_dim
     d = np.array(parse_floats(direction, "--direction", m))
@@ -146,7 +153,7 @@ def capability(
             at = np.array(parse_floats(interpolate, "--interpolate", 2))
             _check_finite(at, "--interpolate")
         _grid(arm, grid, z, d, q1_vals, br, not ignore_limits, measure, continuous,
-              map_png, csv_out, json_out, at)
+              map_png, csv_out, json_out, at, {"workers": workers, "scheduler": scheduler})
 
 
 def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -> None:
@@ -237,7 +244,7 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
 
 
 def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, csv_out,
-          json_out, at=None) -> None:
+          json_out, at=None, parallel=None) -> None:
     parts = grid.split(",")
     if len(parts) != 2:
         raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
@@ -254,9 +261,10 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
     with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as adv:
         cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1_vals, branch=br,
                               respect_limits=respect, continuous=continuous, chunk=chunk,
-                              advance=adv)
+                              advance=adv, **(parallel or {}))
+    one_stdout(json_out, csv_out)
     if csv_out is not None:
-        write_atomic(csv_out, cmap.to_csv())
+        write_output(csv_out, cmap.to_csv())
     if map_png is not None:
         from mechsyn.cli.common import save_plot
         from mechsyn.plot.capability import plot_capability_map
@@ -278,6 +286,8 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
                 "q_deg": arm.to_user(qi),
                 "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
                 measure: float(measure_values(arm, qi[None], d, measure)[0])})
+    if is_stdout(csv_out):
+        return
     if json_out:
         out = cmap.to_dict()
         if interp is not None:

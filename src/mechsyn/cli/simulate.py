@@ -10,14 +10,15 @@ from typing import Annotated, Any, Optional
 import numpy as np
 import typer
 from rich.markup import escape
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import (check_output_suffix, console, emit_json, parse_range, progress_bar, save_animation,
-                                save_plot)
+from mechsyn.cli.common import (check_animation_target, check_output_suffix, console, emit_json, fmt_number,
+                                is_stdout, one_stdout, parse_range,
+                                progress_bar, save_animation, save_plot, write_output)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
-from mechsyn.results import to_jsonable, write_atomic
+from mechsyn.results import to_jsonable
 
 InputOpt = Annotated[list[str], typer.Option(
     "--input", "-i", help="Driven joint and its values: J=START:STOP:STEP (deg for R, length for P), "
@@ -77,13 +78,20 @@ def _parse_pairs(items: list[str] | None, option: str, number: bool) -> dict[str
 
 
 def _fmt(v: float) -> str:
-    return "—" if v is None or not np.isfinite(v) else f"{v:.6g}"
+    return fmt_number(v)
 
 
 def _table_rows(n: int, max_rows: int = 25) -> list[int]:
     if n <= max_rows:
         return list(range(n))
     return sorted(set(np.linspace(0, n - 1, max_rows).astype(int).tolist()))
+
+
+def _say_rows_shown(shown: int, total: int) -> None:
+    """Say when the tables show a subset of the positions, and how to see them all."""
+    if shown < total:
+        console.print(f"(tables show {shown} of {total} positions, evenly spaced; all of them with --json "
+                      "or --csv FILE)", highlight=False)
 
 
 def _csv_text(header: list[str], columns: list[np.ndarray]) -> str:
@@ -112,15 +120,17 @@ def simulate_cmd(
     json_: JsonOpt = False,
     csv_out: CsvOpt = None,
     plot: PlotOpt = None,
-    animate: Annotated[Optional[Path], typer.Option("--animate", help="Write a GIF animation.")] = None,
+    animate: Annotated[Optional[Path], typer.Option("--animate", help="Write an animation: .gif, .mp4 (the video extra) or .html (a self-contained player).")] = None,
 ) -> None:
     """Positions, velocities and accelerations of a planar mechanism over its input."""
     from mechsyn.kinematics import derived
     from mechsyn.kinematics.analysis import simulate
 
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
-    check_output_suffix(animate, (".gif",), "--animate")
+    if animate is not None:
+        check_animation_target(animate)
     check_output_suffix(csv_out, (".csv",), "--csv")
+    one_stdout(json_, csv_out)
     if method not in ("auto", "assur", "newton"):
         raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
     mech = load_mechanism(file)
@@ -173,13 +183,15 @@ def simulate_cmd(
         for name, lm in sim.links.items():
             header += [f"{name}_angle", f"{name}_omega", f"{name}_alpha"]
             cols += [lm.angle, lm.angular_velocity, lm.angular_acceleration]
-        write_atomic(csv_out, _csv_text(header, cols))
+        write_output(csv_out, _csv_text(header, cols))
     if plot is not None:
         from mechsyn.plot.kinematics import plot_simulation
         save_plot(plot, plot_simulation, sim)
     if animate is not None:
         from mechsyn.plot.kinematics import animate_simulation
         save_animation(animate, animate_simulation, sim, dpi=100)
+    if is_stdout(csv_out):
+        return
     if json_:
         emit_json(out)
         return
@@ -220,6 +232,7 @@ def _render_simulation(sim, derived_d: dict) -> None:
     console.print(t)
     if len(sim.links) > 4:
         console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
+    _say_rows_shown(len(rows), len(x))
     for r in sim.working_ranges():
         console.print(f"working range of {main}: {r[0]:g} .. {r[1]:g} {unit}", highlight=False)
     for e in sim.events:
@@ -259,6 +272,7 @@ def forces_cmd(
 
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     check_output_suffix(csv_out, (".csv",), "--csv")
+    one_stdout(json_, csv_out)
     if not np.isfinite(gravity):
         raise MechsynInputError("gravity must be a finite number", source="--gravity")
     mech = load_mechanism(file)
@@ -279,10 +293,12 @@ def forces_cmd(
         for j, e in R.effort.items():
             header.append(f"drive_{j}_{R.effort_kind[j]}")
             cols.append(e)
-        write_atomic(csv_out, _csv_text(header, cols))
+        write_output(csv_out, _csv_text(header, cols))
     if plot is not None:
         from mechsyn.plot.kinematics import plot_forces
         save_plot(plot, plot_forces, fa)
+    if is_stdout(csv_out):
+        return
     if json_:
         emit_json(fa.to_dict())
         return
@@ -306,6 +322,7 @@ def forces_cmd(
         row += [_fmt(float(np.linalg.norm(R.force[j][k]))) for j in per_input]
         t.add_row(*row)
     console.print(t)
+    _say_rows_shown(len(rows), len(x))
     mech_joints = {j.id: j for j in sim.system.mech.joints}
     t = Table(title="joint reactions over the sweep (force of the first link on the second)")
     for col in ("joint", "links", "max |F|", f"at {main}", "min |F|", "max |M|"):

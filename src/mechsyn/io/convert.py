@@ -13,8 +13,9 @@ from pathlib import Path
 from mechsyn.errors import MechsynInputError
 from mechsyn.io.load import load_mechanism, mechanism_from_dict, mechanism_text, mechanism_to_dict
 from mechsyn.io.pyslvs import pyslvs_text, read_pyslvs
+from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["Conversion", "convert_file", "MECHSYN_SUFFIXES", "PYSLVS_SUFFIXES"]
+__all__ = ["Conversion", "convert_file", "load_any", "MECHSYN_SUFFIXES", "PYSLVS_SUFFIXES"]
 
 MECHSYN_SUFFIXES = (".yaml", ".yml", ".json")
 PYSLVS_SUFFIXES = (".pyslvs", ".txt")
@@ -31,6 +32,17 @@ class Conversion:
 
     def to_dict(self) -> dict[str, object]:
         return {"source": self.source, "format": self.target_format, "notes": self.notes, "text": self.text}
+
+
+def load_any(path: str | os.PathLike[str]) -> Mechanism:
+    """A mechanism from a mechanism file (.yaml, .json) or a Pyslvs expression (.pyslvs, .txt)."""
+    p = Path(path)
+    if p.suffix.lower() not in PYSLVS_SUFFIXES:
+        return load_mechanism(p)
+    if not p.is_file():
+        raise MechsynInputError("no such file", source=str(p), hint="check the path")
+    data, _ = read_pyslvs(p.read_text(encoding="utf-8"), str(p))
+    return mechanism_from_dict(data, str(p))
 
 
 def convert_file(path: str | os.PathLike[str], to: str, inputs: list[tuple[int, int]] | None = None,
