@@ -8,27 +8,29 @@ check that follows the motion numerically) against the papers' formulas
 loop-closure matrix, the floor of any rank-based tool (what a user who hand-assembles
 the screw matrix would get).
 
-Run: PYTHONPATH=src python benchmarks/rank.py
-BLAS runs single-threaded here (the matrices are small: threads only add overhead, and on a
-loaded machine multi-threaded OpenBLAS makes each small SVD 10-50x slower); set
-OPENBLAS_NUM_THREADS yourself to compare.
+Then the growth with size (issue 17 §3): ladders of 49 to 1,999 joints, the whole
+``analyze_rank`` (contours, rank, idle mobilities, singularity check) with the machine's
+default BLAS threads (``analyze_rank`` limits BLAS to one thread itself), against the same
+analysis forced onto one dense SVD (the method before the contour-by-contour elimination)
+up to 601 joints; the answers are checked equal, and the growth exponent is fitted between
+199 and 1,999 joints. Targets: 199 joints <= 0.4 s, 1,999 joints <= 10 s, exponent <= 1.3.
+
+Run: PYTHONPATH=src python benchmarks/rank.py [--quick]
+Times are the minimum of several runs; on a machine shared with other jobs they are noisy.
 """
 
 from __future__ import annotations
 
-import os
+import sys
+import time
+from pathlib import Path
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+import numpy as np
 
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-import numpy as np  # noqa: E402
-
-from mechsyn.io import load_mechanism, mechanism_from_dict  # noqa: E402
-from mechsyn.structure.analysis import analyze_structure  # noqa: E402
-from mechsyn.structure.rank import _build_system, analyze_rank, as_spatial  # noqa: E402
+from mechsyn.io import load_mechanism, mechanism_from_dict
+from mechsyn.structure import rank as rank_mod
+from mechsyn.structure.analysis import analyze_structure
+from mechsyn.structure.rank import _build_system, analyze_rank, as_spatial
 
 
 def ladder(loops: int) -> dict:
@@ -81,6 +83,40 @@ def main() -> None:
               f"{1e3 * t_full:14.1f} {1e3 * t_rank:8.1f} {1e3 * t_form:12.1f} {1e3 * t_bare:12.3f} "
               f"{t_full / t_form:6.1f}")
     print("ratio: full rank analysis (with the singularity check) / formulas analysis")
+    scaling("--quick" in sys.argv)
+
+
+def scaling(quick: bool = False) -> None:
+    """Ladders of growing size: elimination against one dense SVD, answers checked equal."""
+    sizes = [16, 66, 200] if quick else [16, 66, 200, 666]
+    print(f"\n{'ladder joints':>13} {'rank s':>8} {'dense SVD s':>12} {'ratio':>6}  answer (m, q, useful)")
+    times = {}
+    for loops in sizes:
+        mech = mechanism_from_dict(ladder(loops))
+        n = len(mech.joints)
+        r = analyze_rank(mech)
+        t = timeit(lambda: analyze_rank(mech), repeat=3 if n < 1000 else 2)
+        times[n] = t
+        dense = ""
+        if n <= 601:
+            saved = rank_mod.DENSE_MAX_FREEDOMS
+            rank_mod.DENSE_MAX_FREEDOMS = 10 ** 9
+            try:
+                rd = analyze_rank(mech)
+                td = timeit(lambda: analyze_rank(mech), repeat=2)
+            finally:
+                rank_mod.DENSE_MAX_FREEDOMS = saved
+            same = (rd.mobility, rd.redundant_constraints, rd.useful_mobility, rd.redundant_by_contour) == \
+                (r.mobility, r.redundant_constraints, r.useful_mobility, r.redundant_by_contour)
+            assert same, "elimination and dense SVD disagree"
+            dense = f"{td:12.3f} {td / t:6.1f}"
+        else:
+            dense = f"{'-':>12} {'-':>6}"
+        print(f"{n:13d} {t:8.3f} {dense}  ({r.mobility}, {r.redundant_constraints}, {r.useful_mobility})")
+    ns = sorted(n for n in times if n >= 199)
+    if len(ns) >= 2:
+        slope = np.polyfit(np.log(ns), np.log([times[n] for n in ns]), 1)[0]
+        print(f"growth exponent (time ~ joints^k, {ns[0]}..{ns[-1]} joints): k = {slope:.2f}")
 
 
 if __name__ == "__main__":

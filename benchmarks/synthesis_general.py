@@ -3,8 +3,10 @@
 Prints the time to evaluate one design (build the mechanism from the file, sweep it with
 the kinematics engine, compute the error) for the four-bar and the Watt six-bar, against
 the closed-form four-bar path module (mechsyn.synthesis.path, vectorised over a DE
-population: the tool a user with a plain four-bar would pick), and the synthesis runs of
-the bundled example cases over 5 seeds.
+population: the tool a user with a plain four-bar would pick), one engine sweep per design
+against the batch engine over the whole population (mechsyn.synthesis.general_batch, with
+the fitness checked equal), and the synthesis runs of the bundled example cases over 5
+seeds, engine and batch.
 
     python benchmarks/synthesis_general.py
 """
@@ -47,9 +49,14 @@ def main() -> None:
     six = load_case(ROOT / "examples/synthesis/sixbar_path_case.yaml")
     rows = []
     for name, case in (("four-bar (general)", fb), ("Watt six-bar (general)", six)):
-        p = MechanismProblem(case)
+        p = MechanismProblem(case, batch=False)
         X = rng.uniform(p.lower, p.upper, size=(200, len(p.lower)))
-        rows.append((name, per_design(p.fitness, X)))
+        rows.append((name + ", engine per design", per_design(p.fitness, X)))
+        pb = MechanismProblem(case)
+        Xb = rng.uniform(p.lower, p.upper, size=(2000, len(p.lower)))
+        rows.append((name + ", batch population", per_design(pb.fitness, Xb)))
+        same = np.allclose(p.fitness(X[:50]), pb.fitness(X[:50]), rtol=1e-9, atol=1e-12)
+        rows.append((f"  (batch fitness equal to the engine's on 50 designs: {same})", None))
     pc = PathCase.from_dict({
         "id": "bench", "targets": [[3, 4]] * 6, "timing": {"type": "prescribed", "theta2": np.radians(values).tolist()},
         "fixed": {"x0": 0, "y0": 0, "theta0": 0},
@@ -63,18 +70,23 @@ def main() -> None:
     print("time per design evaluation (best of 3, shared 2-core machine)")
     print(f"  {'closed-form four-bar (path module, population-vectorised)':60s} {ref * 1e6:9.1f} us")
     for name, t in rows:
-        print(f"  {name:60s} {t * 1e6:9.1f} us   ({t / ref:.0f}x the closed-form module)")
+        if t is None:
+            print(f"  {name}")
+            continue
+        print(f"  {name:60s} {t * 1e6:9.1f} us   ({t / ref:.1f}x the closed-form module)")
     print("\nsynthesis of the bundled cases (1 restart, default options, 5 seeds)")
     for f in ("sixbar_path_case.yaml", "slider_crank_path_case.yaml"):
         case = load_case(ROOT / "examples/synthesis" / f)
         start = MechanismProblem(case).fitness(start_vector(case)[None, :])[0]
-        errs, secs = [], []
-        for seed in range(5):
-            r = synthesize_mechanism(case, seed=seed, time_limit=30, restarts=1)
-            errs.append(r.error)
-            secs.append(r.seconds)
-        print(f"  {f:30s} start {start:.3g}  best {min(errs):.3g}  median {np.median(errs):.3g}  "
-              f"median {np.median(secs):.1f} s")
+        for batch in (False, True):
+            errs, secs = [], []
+            for seed in range(5):
+                r = synthesize_mechanism(case, seed=seed, time_limit=30, restarts=1, batch=batch)
+                errs.append(r.error)
+                secs.append(r.seconds)
+            how = "batch " if batch else "engine"
+            print(f"  {f:30s} {how} start {start:.3g}  best {min(errs):.3g}  median {np.median(errs):.3g}  "
+                  f"median {np.median(secs):.1f} s")
 
 
 if __name__ == "__main__":

@@ -285,3 +285,44 @@ def test_cli_reports_infeasible_case_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "x.yaml"
     assert main(["synth", "mechanism", str(f), "--time-limit", "5", "--restarts", "1", "--out", str(out)]) == 2
     assert not out.exists() and "no feasible design" in capsys.readouterr().err
+
+
+
+def _batch_equals_engine(case, Z):
+    fast, slow = MechanismProblem(case), MechanismProblem(case, batch=False)
+    assert fast.batch is not None and slow.batch is None
+    a, b = fast.evaluate(Z), slow.evaluate(Z)
+    assert [e.feasible for e in a] == [e.feasible for e in b]
+    assert 0 < sum(e.feasible for e in b) < len(b)   # both kinds are compared
+    for ea, eb in zip(a, b):
+        if ea.feasible:
+            assert abs(ea.error - eb.error) <= 1e-9 * max(1.0, eb.error)
+            np.testing.assert_allclose(ea.achieved, eb.achieved, atol=1e-9)
+    np.testing.assert_allclose(fast.fitness(Z), slow.fitness(Z), rtol=1e-9)
+    np.testing.assert_allclose(fast.residuals(Z[0]), slow.residuals(Z[0]), atol=1e-9)
+
+
+def _population(case, rng, spread):
+    from mechsyn.synthesis.general import start_vector
+
+    p = MechanismProblem(case, batch=False)
+    Z = p.lower + rng.random((30, len(p.lower))) * (p.upper - p.lower)
+    Z[0] = np.clip(start_vector(case), p.lower, p.upper)
+    Z[15:] = Z[0] + rng.normal(scale=spread, size=(15, len(p.lower)))   # outside the bounds too
+    return Z
+
+
+def test_batch_population_evaluation_equals_the_engine():
+    case = load_case(SIXBAR_CASE)
+    _batch_equals_engine(case, _population(case, np.random.default_rng(0), 1.5))
+
+
+def test_batch_equals_the_engine_when_the_crank_moves():
+    case = case_from_dict({
+        "mechanism": str(FOURBAR), "input": {"joint": "A", "values_deg": [40, 50, 60, 70, 80, 90]},
+        "point": "M", "targets": [[3, 4]] * 6,
+        "variables": [{"joint": "B", "coord": "x", "lower": 0.5, "upper": 1.5},
+                      {"joint": "B", "coord": "y", "lower": 1.5, "upper": 2.5},
+                      {"joint": "D", "coord": "x", "lower": 4.8, "upper": 5.2},
+                      {"point": "M", "coord": "y", "lower": 3.8, "upper": 4.2}]}, "<test>")
+    _batch_equals_engine(case, _population(case, np.random.default_rng(1), 1.0))

@@ -97,3 +97,14 @@ def test_scheduler_without_dask_is_a_clear_error(public_cases, monkeypatch):
     with pytest.raises(MechsynInputError) as exc:
         synthesize_path(public_cases["P2_kk5_timing"], restarts=1, options=FAST, scheduler="tcp://127.0.0.1:1")
     assert "dask" in str(exc.value)
+
+
+def test_target_error_ends_the_run_at_the_first_restart_reaching_it(public_cases):
+    case = public_cases["P2_kk5_timing"]
+    loose = 1e-3  # far above the published best: the first restart reaches it
+    res = synthesize_path(case, seed=1, restarts=4, time_limit=60, options=FAST, n_polish=1,
+                          target_error=loose)
+    assert res.target_reached and res.restarts == 1 and res.error <= loose
+    assert res.to_dict()["target_reached"] and res.to_dict()["target_error"] == loose
+    assert res.worst_transmission_angle_deg >= case.transmission_angle_min_deg - 1e-6  # feasibility tol
+    assert res.fold_distance_deg >= case.fold_margin_deg

@@ -149,3 +149,51 @@ def test_prescribed_increment_timing():
     prob = PathProblem(case)
     vals, th, sweeps = prob.unpack(np.array([[3, 1, 3, 2, 1, 1, 0.5]]))
     assert np.allclose(th, [[0.5, 0.7, 0.9]])
+
+
+def _change_point_case(**options):
+    return PathCase.from_dict({
+        "targets": [[0.0, 1.0], [0.0, 2.0]], "timing": {"type": "prescribed", "theta2": [1.0, 2.0]},
+        "constraints": ["Grashof"], "options": options,
+        "variables": [{"name": k, "lower": 0, "upper": 5} for k in ("r1", "r2", "r3", "r4", "rcx", "rcy")]})
+
+
+def test_grashof_equality_folds_flat_and_is_refused_by_default():
+    # s + l = p + q (1 + 3 = 2 + 2): the crank reaches theta2 = 0, where all four pivots
+    # line up, so the linkage folds flat once per turn (a change point)
+    flat = {"r1": 3.0, "r2": 1.0, "r3": 2.0, "r4": 2.0, "rcx": 0.5, "rcy": 0.2}
+    out = evaluate_design(_change_point_case(), flat)
+    assert out["fold_distance_deg"] == pytest.approx(0.0, abs=1e-6)
+    assert not out["feasible"]
+    assert evaluate_design(_change_point_case(fold_margin_deg=0), flat)["feasible"]
+    # a little inside Grashof: feasible; its fold distance is the worst transmission angle
+    # at theta2 = 0 and pi (cos mu = (r3^2 + r4^2 - (r1 -/+ r2)^2) / (2 r3 r4)), by hand
+    inside = {**flat, "r1": 2.8}
+    out = evaluate_design(_change_point_case(), inside)
+    mu = np.degrees(np.arccos([(8 - 1.8 ** 2) / 8, (8 - 3.8 ** 2) / 8]))
+    assert out["feasible"] and out["fold_distance_deg"] == pytest.approx(np.min(np.minimum(mu, 180 - mu)))
+
+
+def test_minimum_transmission_angle_over_the_motion_is_the_default():
+    case = _change_point_case(fold_margin_deg=0)
+    assert case.transmission_angle_min_deg == 20.0
+    # r3 = r4 = 2, r1 = 3, r2 = 1: mu(theta2) from cos mu = (8 - 10 + 6 cos t) / 8
+    design = {"r1": 3.0, "r2": 1.0, "r3": 2.0, "r4": 2.0, "rcx": 0.5, "rcy": 0.2}
+    t = np.linspace(1.0, 2.0, 2001)
+    mu = np.degrees(np.arccos((8 - 10 + 6 * np.cos(t)) / 8))
+    worst = np.min(np.minimum(mu, 180 - mu))
+    out = evaluate_design(case, design)
+    assert out["worst_transmission_angle_deg"] == pytest.approx(worst, abs=1e-6)
+    tight = _change_point_case(fold_margin_deg=0, transmission_angle_min_deg=worst + 0.5)
+    assert out["feasible"] and not evaluate_design(tight, design)["feasible"]
+
+
+def test_residual_jacobian_is_one_batch_of_forward_differences(public_cases):
+    from scipy.optimize._numdiff import approx_derivative
+
+    prob = PathProblem(public_cases["P2_kk5_timing"])
+    z = prob.internal(public_cases["P2_kk5_timing"].published[0]["x"])
+    np.testing.assert_allclose(prob.residuals_batch(z[None])[0], prob.residuals(z))
+    J = prob.residual_jacobian(z)
+    ref = approx_derivative(prob.residuals, z, method="2-point", bounds=(prob.lower, prob.upper))
+    np.testing.assert_allclose(J, ref, rtol=1e-6, atol=1e-6)

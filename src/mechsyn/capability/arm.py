@@ -29,7 +29,6 @@ from pathlib import Path
 from typing import Annotated, Literal, Union
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
 from mechsyn.errors import MechsynInputError
@@ -352,20 +351,14 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
 
 def load_arm(path: str | Path) -> SerialArm:
     """Read an arm file (YAML or JSON); :class:`MechsynInputError` on bad input."""
+    from mechsyn.io.files import parse_data, read_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MechsynInputError(f"cannot read arm file: {exc.strerror}", source=str(path)) from None
+    text = read_text(path, "arm file")
     if path.suffix.lower() == ".urdf" or text.lstrip().startswith("<"):
         return arm_from_dict({"kind": "urdf", "urdf": path.name, "name": path.stem},
                              source=str(path), base_dir=path.parent)
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        line = getattr(getattr(exc, "problem_mark", None), "line", None)
-        raise MechsynInputError("not valid YAML/JSON", source=str(path),
-                                line=None if line is None else line + 1) from None
+    data = parse_data(text, str(path), fmt="yaml")
     return arm_from_dict(data, source=str(path), base_dir=path.parent)
 
 

@@ -21,5 +21,5 @@ synth_app = typer.Typer(
     help="Synthesis: structural (groups, fingers) and dimensional (path, function, motion).",
     rich_markup_mode=None,
     no_args_is_help=True,
-)
-app.add_typer(synth_app, name="synth")
+    add_completion=False,
+)  # reached through mechsyn.cli.main's lazy table, not add_typer (see there)

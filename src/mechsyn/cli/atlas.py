@@ -7,10 +7,10 @@ from typing import Optional
 
 import typer
 import yaml
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, progress_bar
+from mechsyn.cli.common import check_writable, console, emit_json, progress_bar
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 
@@ -37,6 +37,8 @@ def atlas(
         False, "--inputs", help="List the distinct mechanisms by frame AND input link."),
     stream: Optional[Path] = typer.Option(
         None, "--stream", help="Stream chains to this JSON-lines file; rerun to resume."),
+    force: bool = typer.Option(
+        False, "--force", help="Let --stream overwrite a file that is not a chain stream."),
 ) -> None:
     """All non-isomorphic planar simple-jointed kinematic chains with N links and
     mobility F, their link assortments and distinct mechanisms (choices of frame)."""
@@ -47,11 +49,14 @@ def atlas(
     if out is not None and out.suffix.lower() not in (".svg", ".png", ".pdf"):
         raise MechsynInputError(f"cannot draw to {out.name!r}", source="--out",
                                 hint="give a file ending in .svg, .png or .pdf")
+    check_writable(out, "--out")
+    check_writable(stream, "--stream")
+    check_writable(mechanisms, "--mechanisms", directory=True)
     total_units = n_units(links, mobility)
     with progress_bar(f"{links}-link chains, F={mobility}", total_units) as advance:
         if stream is not None:
             chains = synthesize_chains_to_file(stream, links, mobility, include_degenerate,
-                                               progress=advance)
+                                               progress=advance, force=force)
         else:
             chains = synthesize_chains(links, mobility, include_degenerate, progress=advance)
     if out is not None and len(chains) > MAX_DRAWN:

@@ -14,7 +14,7 @@ from typing import Any, Optional
 
 import numpy as np
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
 from mechsyn.cli.common import console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, write_output
@@ -102,11 +102,9 @@ def _design(a: float | None, c: float | None, h: float | None, r: float | None,
 
 def _read_table(path: Path) -> tuple[list[float], list[float]]:
     """Two columns t (s), Δφ (deg); header and # comments allowed; , ; or blanks."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MechsynInputError(f"cannot read the table: {exc.strerror or exc}",
-                                source=str(path)) from None
+    from mechsyn.io.files import read_text
+
+    text = read_text(path, "table")
     t: list[float] = []
     phi: list[float] = []
     for lineno, line in enumerate(text.splitlines(), start=1):

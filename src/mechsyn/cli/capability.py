@@ -13,7 +13,7 @@ import numpy as np
 import typer
 from rich import box
 from rich.console import Console
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.capability.arm import SerialArm, load_arm
 from mechsyn.capability.maps import (
@@ -24,7 +24,7 @@ from mechsyn.capability.measures import (
     MEASURES, all_measures, velocity_ellipse, velocity_polytope,
 )
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
+from mechsyn.cli.common import check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
 from mechsyn.errors import MechsynInputError
 
 MEASURE_HELP = {
@@ -106,6 +106,8 @@ def capability(
 ) -> None:
     """Largest tool speed along a direction under joint speed limits (paper 004), at a point
     over the arm's self-motion, or mapped over a grid."""
+    check_writable(map_png, "--map")
+    check_writable(csv_out, "--csv")
     arm = load_arm(arm_file)
     m = arm.task_dim
     d = np.array(parse_floats(direction, "--direction", m))

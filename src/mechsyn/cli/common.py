@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import inspect
+import os
+import re
 import sys
+import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
 import typer
 from rich.console import Console
+from rich.table import Table as RichTable
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -19,8 +24,73 @@ from mechsyn.results import dumps, write_atomic
 
 T = TypeVar("T")
 
-console = Console()
-err_console = Console(stderr=True)
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+_LINK_TAG = re.compile(r"(?<!\\)\[(/?link\b)", re.IGNORECASE)  # not already escaped
+
+
+def strip_control(text: str) -> str:
+    """``text`` without control characters (escape sequences, bells, backspaces...);
+    newlines and tabs are kept.
+
+    >>> strip_control("a\x1b[31mred\x07")
+    'a[31mred'
+    """
+    return _CONTROL.sub("", text)
+
+
+def safe(text: object, limit: int = 120) -> str:
+    r"""Text from a file, fit to print: control characters stripped, rich markup escaped,
+    capped at ``limit`` characters (the rest counted).
+
+    >>> print(safe("[link=https://x.example]click[/link]"))
+    \[link=https://x.example]click\[/link]
+    >>> safe("x" * 130, limit=10)
+    'xxxxxxxxxx… (120 more characters)'
+    """
+    text = strip_control(str(text))
+    if len(text) > limit:
+        text = f"{text[:limit]}… ({len(text) - limit} more characters)"
+    return escape(text)
+
+
+class SafeConsole(Console):
+    """A rich Console that never sends a file's control characters to the terminal and
+    never turns text into a hyperlink: every string it renders (messages and table cells,
+    whatever the command) is stripped of control characters and its ``[link]`` markup is
+    shown as text. The commands' own styles ([bold], [red]...) still work."""
+
+    def render_str(self, text: str, *args: Any, **kwargs: Any) -> Any:
+        return super().render_str(_LINK_TAG.sub(r"\\[\1", strip_control(text)), *args, **kwargs)
+
+
+class Table(RichTable):
+    """A rich Table whose cells wrap (fold) instead of being cut with an ellipsis: at 80
+    columns a number is never shown truncated (1.60e-15 never becomes "1.60e…")."""
+
+    def add_column(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("overflow", "fold")
+        super().add_column(*args, **kwargs)
+
+
+def fmt_number(value: Any, spec: str = ".6g", scale: float = 1.0) -> str:
+    """A number for a table: ``—`` when missing or not finite, 0 for float noise (below
+    1e-12 times ``scale``, e.g. -1.38778e-15 for a fixed pivot's velocity).
+
+    >>> fmt_number(-1.38778e-15), fmt_number(2.5e-3), fmt_number(float("nan"))
+    ('0', '0.0025', '—')
+    """
+    if value is None:
+        return "—"
+    v = float(value)
+    if not np.isfinite(v):
+        return "—"
+    if abs(v) <= 1e-12 * abs(scale):
+        v = 0.0
+    return format(v, spec)
+
+
+console = SafeConsole()
+err_console = SafeConsole(stderr=True)
 
 
 STDOUT = "-"
@@ -53,6 +123,24 @@ def emit_json(obj: Any, out: Path | None = None) -> None:
     write_output(STDOUT if out is None else out, text + "\n")
 
 
+#: The library's errors name its parameters (``MechsynInputError(field="tol")``); the command
+#: line shows them as its options. One table for every command.
+PARAMETER_OPTIONS: dict[str, str] = {
+    "method": "--method", "tol": "--tol", "inputs": "--input", "points": "--points", "speeds": "--speed",
+    "vll": "--vll", "animate": "--animate", "seed": "--seed", "time_limit": "--time-limit",
+    "restarts": "--restarts", "workers": "--workers", "optimizer": "--optimizer", "direction": "--direction",
+    "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output",
+}
+
+
+def option_error(error: MechsynInputError) -> MechsynInputError:
+    """``error`` with a library parameter (its ``field``) shown as the command-line option."""
+    if error.source is None and error.field in PARAMETER_OPTIONS:
+        return MechsynInputError(error.message, source=PARAMETER_OPTIONS[error.field], line=error.line,
+                                 hint=error.hint)
+    return error
+
+
 def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
     """Stop the command with one clear message and exit status 2."""
     raise MechsynInputError(message, hint=hint, source=source)
@@ -76,7 +164,8 @@ def parse_floats(text: str, option: str, count: int | None = None) -> list[float
 
 def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: str,
                         what: str | None = None) -> None:
-    """Refuse an output file whose suffix is not one of ``suffixes`` (before any work).
+    """Refuse, before any work, an output file whose suffix is not one of ``suffixes`` or
+    that cannot be written (see :func:`check_writable`).
 
     ``-`` (standard output) passes for text formats (.csv, .json, .yaml, .md, .pyslvs, .svg).
     """
@@ -84,6 +173,31 @@ def check_output_suffix(path: Path | None, suffixes: tuple[str, ...], option: st
         return
     if path is not None and path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path}: expected a {what or ' or '.join(suffixes)} file", source=option)
+    check_writable(path, option)
+
+
+def check_writable(path: Path | None, option: str, directory: bool = False) -> None:
+    """Refuse, before any work, an output ``path`` that could not be written.
+
+    Its folder is created (as the writer would) and a temporary file is created and
+    removed in it: the real test, whatever the user's privileges. ``directory``: the path
+    is a folder to write files into.
+    """
+    if path is None or is_stdout(path):
+        return
+    path = Path(path)
+    if path.exists() and path.is_dir() != directory:
+        raise MechsynInputError(f"{path} is {'not ' if directory else ''}a directory", source=option,
+                                hint="give another path")
+    folder = path if directory else path.absolute().parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".mechsyn-write-test.")
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise MechsynInputError(f"cannot write {path}: {exc.strerror or exc}", source=option,
+                                hint="give a path in a folder you can write to") from None
 
 
 def save_plot(path: Path, draw: Any, *args: Any, dpi: int = 110, figsize: tuple[float, float] = (7, 6),
@@ -182,6 +296,17 @@ def track(items: Iterable[T], description: str, total: int | None = None) -> Ite
         for item in items:
             yield item
             advance()
+
+
+def stop_if_interrupted(result: Any) -> None:
+    """Exit with status 130 (``interrupted``) when ``result`` says Ctrl-C ended it.
+
+    Called by a search command after it has written and shown its best result so far.
+    """
+    if getattr(result, "interrupted", False):
+        from mechsyn.interrupt import INTERRUPT_EXIT_CODE
+
+        raise typer.Exit(INTERRUPT_EXIT_CODE)
 
 
 def exit_with(error: MechsynInputError) -> None:

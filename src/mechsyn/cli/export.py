@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 from rich.markup import escape
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
 from mechsyn.cli.common import (check_output_suffix, console, emit_json, err_console, is_stdout, one_stdout,

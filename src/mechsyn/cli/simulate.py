@@ -10,11 +10,15 @@ from typing import Annotated, Any, Optional
 import numpy as np
 import typer
 from rich.markup import escape
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
+<<<<<<< HEAD
+from mechsyn.cli.common import (check_output_suffix, console, fmt_number, emit_json, is_stdout, one_stdout, parse_range,
+=======
 from mechsyn.cli.common import (check_animation_target, check_output_suffix, console, emit_json, is_stdout, one_stdout,
                                 parse_range,
+>>>>>>> interop
                                 progress_bar, save_animation, save_plot, write_output)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
@@ -78,13 +82,20 @@ def _parse_pairs(items: list[str] | None, option: str, number: bool) -> dict[str
 
 
 def _fmt(v: float) -> str:
-    return "—" if v is None or not np.isfinite(v) else f"{v:.6g}"
+    return fmt_number(v)
 
 
 def _table_rows(n: int, max_rows: int = 25) -> list[int]:
     if n <= max_rows:
         return list(range(n))
     return sorted(set(np.linspace(0, n - 1, max_rows).astype(int).tolist()))
+
+
+def _say_rows_shown(shown: int, total: int) -> None:
+    """Say when the tables show a subset of the positions, and how to see them all."""
+    if shown < total:
+        console.print(f"(tables show {shown} of {total} positions, evenly spaced; all of them with --json "
+                      "or --csv FILE)", highlight=False)
 
 
 def _csv_text(header: list[str], columns: list[np.ndarray]) -> str:
@@ -225,6 +236,7 @@ def _render_simulation(sim, derived_d: dict) -> None:
     console.print(t)
     if len(sim.links) > 4:
         console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
+    _say_rows_shown(len(rows), len(x))
     for r in sim.working_ranges():
         console.print(f"working range of {main}: {r[0]:g} .. {r[1]:g} {unit}", highlight=False)
     for e in sim.events:
@@ -314,6 +326,7 @@ def forces_cmd(
         row += [_fmt(float(np.linalg.norm(R.force[j][k]))) for j in per_input]
         t.add_row(*row)
     console.print(t)
+    _say_rows_shown(len(rows), len(x))
     mech_joints = {j.id: j for j in sim.system.mech.joints}
     t = Table(title="joint reactions over the sweep (force of the first link on the second)")
     for col in ("joint", "links", "max |F|", f"at {main}", "min |F|", "max |M|"):

@@ -6,10 +6,10 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json
+from mechsyn.cli.common import console, emit_json, safe
 
 
 @app.command("structure")
@@ -29,7 +29,7 @@ def structure(
     if json_out:
         emit_json(result)
         return
-    console.print(f"[bold]{result.name}[/]: mobility W = {result.mobility}, frame "
+    console.print(f"[bold]{safe(result.name)}[/]: mobility W = {result.mobility}, frame "
                   f"{result.frame}", highlight=False)
     table = Table(title="Initial mechanisms and Assur groups, in order of formation")
     for col in ("", "class", "order", "links", "internal pairs", "external pairs", "attached to"):

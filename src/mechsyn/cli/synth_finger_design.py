@@ -7,10 +7,10 @@ from typing import Optional
 
 import typer
 from rich.markup import escape
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -44,7 +44,8 @@ def finger_design(
         from mechsyn.io import write_mechanism
 
         mech = dict(best.mechanism)
-        mech["name"] = f"{mech.get('name', 'finger')} (finger-design, seed {seed})"
+        mech["name"] = (f"{mech.get('name', 'finger')} (finger-design, seed {seed}"
+                        + (", interrupted: best so far)" if res.interrupted else ")"))
         write_mechanism(mech, out)
     if plot is not None:
         from mechsyn.cli.common import save_plot
@@ -53,8 +54,10 @@ def finger_design(
         save_plot(plot, plot_finger_design, case, res)
     if json_out:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"Finger design: {case_file.name} (seed {seed}, {res.seconds:.1f} s)")
+    t = Table(title=f"Finger design: {case_file.name} (seed {seed}, {res.seconds:.1f} s"
+              + (", interrupted: best so far)" if res.interrupted else ")"))
     t.add_column("VLL")
     t.add_column("stage-1 RMS err (deg)")
     t.add_column("final RMS / max err (deg)")
@@ -98,3 +101,4 @@ def finger_design(
     for path, what in ((out, "mechanism file"), (plot, "plot")):
         if path is not None:
             console.print(f"{what} written to {path}", highlight=False)
+    stop_if_interrupted(res)

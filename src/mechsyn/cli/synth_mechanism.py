@@ -6,10 +6,10 @@ from pathlib import Path
 from typing import Optional
 
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -64,8 +64,10 @@ def synth_mechanism(
         save_plot(plot, plot_mechanism_synthesis, case, res, dpi=120)
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}")
+    t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}"
+              + (" (interrupted: best so far)" if res.interrupted else ""))
     t.add_column("variable")
     t.add_column("start", justify="right")
     t.add_column("design", justify="right")
@@ -80,3 +82,4 @@ def synth_mechanism(
                   + ("   (time limit reached)" if res.stopped_by_time_limit else ""))
     if not res.feasible:
         console.print(f"[bold red]no feasible design found[/]: {res.reason}")
+    stop_if_interrupted(res)

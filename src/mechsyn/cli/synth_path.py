@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
 import typer
-from rich.table import Table
+from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats, save_plot
+from mechsyn.cli.common import check_output_suffix, check_writable, console, emit_json, err_console, parse_floats, save_plot, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -42,6 +41,15 @@ def synth_path(
     workers: int = typer.Option(1, "--workers", help="Run restarts in N local processes."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask])."),
     optimizer: str = typer.Option("de", "--optimizer", help="Global optimiser (de | random | registered)."),
+    target_error: Optional[float] = typer.Option(
+        None, "--target-error", help="Stop once a design reaches this error (default: the case's "
+        "best known error + 1 %, if it has one; 0: use the whole budget)."),
+    min_transmission: Optional[float] = typer.Option(
+        None, "--min-transmission-angle", help="Smallest transmission angle [deg] allowed over "
+        "the motion (default: the case's, else 20; 0: no limit)."),
+    fold_margin: Optional[float] = typer.Option(
+        None, "--fold-margin", help="Grashof cases: how far [deg] the linkage must stay from "
+        "folding flat anywhere in the turn (default: the case's, else 5)."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
@@ -49,15 +57,25 @@ def synth_path(
     """Path generation: a four-bar whose coupler point passes through the targets."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from mechsyn.parallel import check_parallel_options
     from mechsyn.plot.synthesis import plot_fourbar_path
     from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
-    from mechsyn.synthesis.optimize import synthesize_path
+    from mechsyn.synthesis.optimize import default_target_error, synthesize_path
 
     if time_limit <= 0:
         raise MechsynInputError("must be positive", source="--time-limit")
-    if restarts < 1 or workers < 1:
-        raise MechsynInputError("must be at least 1", source="--restarts/--workers")
+    if restarts < 1:
+        raise MechsynInputError("must be at least 1", source="--restarts")
+    check_parallel_options(workers, scheduler)
+    check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     case = _pick_case(case_file, case_id)
+    case = _with_margins(case, min_transmission, fold_margin)
+    if target_error is None:
+        target_error = default_target_error(case)
+    elif target_error < 0:
+        raise MechsynInputError("must be >= 0 (0: use the whole budget)", source="--target-error")
+    target_error = target_error or None
     show = err_console.is_terminal
     if show:
         with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} restarts"),
@@ -69,10 +87,11 @@ def synth_path(
                 prog.update(task, completed=done, best=f"{best:.6g}" if np.isfinite(best) else "-")
 
             res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                                  optimizer=optimizer, progress=progress, scheduler=scheduler)
+                                  optimizer=optimizer, progress=progress, scheduler=scheduler,
+                                  target_error=target_error)
     else:
         res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                              optimizer=optimizer, scheduler=scheduler)
+                              optimizer=optimizer, scheduler=scheduler, target_error=target_error)
     d = {**case.fixed, **res.design}
     if out is not None:
         if not res.feasible:
@@ -82,7 +101,8 @@ def synth_path(
                                       rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
                                       name=f"Four-bar for path case {case.id}")
         write_mechanism_file(mech, out, header=(
-            f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
+            ("INTERRUPTED (Ctrl-C): the best design found before the interrupt\n" if res.interrupted else "")
+            + f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
             f"joint points at target 1 (crank angle {np.degrees(res.theta2[0]):.4f} deg), branch {case.branch}"))
     if plot is not None:
         save_plot(plot, plot_fourbar_path, d, case.targets, res.theta2, case.branch, dpi=120,
@@ -90,8 +110,9 @@ def synth_path(
                   + (f" (published best {case.best_known:.4g})" if case.best_known else ""))
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
-    t = Table(title=f"Path synthesis {case.id}")
+    t = Table(title=f"Path synthesis {case.id}" + (" (interrupted: best so far)" if res.interrupted else ""))
     t.add_column("variable")
     t.add_column("value", justify="right")
     for k, v in res.design.items():
@@ -100,7 +121,33 @@ def synth_path(
     console.print(f"error (sum of squared distances): [bold]{res.error:.8g}[/]"
                   + (f"   published best: {case.best_known:.8g}" if case.best_known else ""))
     console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
-                  f"branch {case.branch}   {res.restarts} restarts, {res.seconds:.1f} s")
+                  f"branch {case.branch}   {res.restarts} restarts, {res.seconds:.1f} s"
+                  + ("   (target error reached)" if res.target_reached else ""))
+    console.print(_transmission_line(res))
+    stop_if_interrupted(res)
+
+
+def _with_margins(case, min_transmission: Optional[float], fold_margin: Optional[float]):
+    from dataclasses import replace
+
+    for value, option in ((min_transmission, "--min-transmission-angle"), (fold_margin, "--fold-margin")):
+        if value is not None and not 0.0 <= value < 90.0:
+            raise MechsynInputError("must be an angle in degrees in [0, 90)", source=option)
+    if min_transmission is not None:
+        case = replace(case, transmission_angle_min_deg=min_transmission)
+    if fold_margin is not None:
+        case = replace(case, fold_margin_deg=fold_margin)
+    return case
+
+
+def _transmission_line(res) -> str:
+    mu = res.worst_transmission_angle_deg
+    text = (f"worst transmission angle over the motion: {mu:.2f} deg"
+            + (f" (limit {res.transmission_angle_min_deg:g})" if res.transmission_angle_min_deg else ""))
+    if res.fold_distance_deg is not None:
+        text += f"; {res.fold_distance_deg:.2f} deg from folding flat"
+        text += f" (limit {res.fold_margin_deg:g})" if res.fold_margin_deg else ""
+    return text
 
 
 @synth_app.command("function")
@@ -115,6 +162,7 @@ def synth_function(
     from mechsyn.synthesis.exact import freudenstein_synthesis
     from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
 
+    check_writable(out, "--out")
     ph = np.radians(parse_floats(phi, "--phi", 3))
     ps = np.radians(parse_floats(psi, "--psi", 3))
     if not ground > 0:
@@ -147,12 +195,9 @@ def synth_function(
 
 def _read_poses(file: Optional[Path], poses: Optional[str]) -> np.ndarray:
     if file is not None:
-        try:
-            data = json.loads(file.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise MechsynInputError("file not found", source=str(file)) from None
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(file), line=exc.lineno) from None
+        from mechsyn.io.files import read_data
+
+        data, _ = read_data(file, "poses file", fmt="json")
         items = data.get("poses") if isinstance(data, dict) else data
         try:
             P = np.array([[float(p[0]), float(p[1]), float(p[2])] for p in items])
@@ -187,6 +232,8 @@ def synth_motion(
     from mechsyn.synthesis.exact import motion_synthesis, to_jsonable_motion
     from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
 
+    check_writable(out, "--out")
+    check_writable(plot, "--plot")
     P = _read_poses(poses_file, poses)
     cp = np.array(parse_floats(circle_points, "--circle-points", 4)).reshape(2, 2) if circle_points else None
     mp = np.array(parse_floats(center_points, "--center-points", 4)).reshape(2, 2) if center_points else None

@@ -18,6 +18,8 @@ import yaml
 from pydantic import ValidationError
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import files
+from mechsyn.io.checks import check_geometry
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -32,52 +34,30 @@ from mechsyn.model.pairs import PAIR_KINDS, canonical_pair_type
 from mechsyn.results import to_jsonable, write_atomic
 
 __all__ = [
-    "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
+    "load", "loads", "save", "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
     "mechanism_to_dict", "mechanism_text", "write_mechanism", "read_data",
 ]
+
+_YAML_LOADER = files._YAML_LOADER
+
+
+def safe_load_yaml(text: str) -> Any:
+    """``yaml.safe_load`` through LibYAML when available."""
+    return yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
 
 
 # --------------------------------------------------------------------------- reading
 def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
-    """Parse a YAML or JSON file into Python data; return it with its text."""
-    p = Path(path)
-    if not p.exists():
-        raise MechsynInputError("no such file", source=str(p), hint="check the path")
-    if p.is_dir():
-        raise MechsynInputError("is a directory, not a file", source=str(p))
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise MechsynInputError(
-            f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(p),
-            hint="save the file as UTF-8 YAML or JSON",
-        ) from None
-    return parse_text(text, str(p)), text
+    """Parse a YAML or JSON file (or a bundled example, by name) into Python data; return it
+    with its text (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
+    from mechsyn.examples import resolve
+
+    return files.read_data(resolve(path))
 
 
 def parse_text(text: str, source: str) -> Any:
     """Parse YAML (or JSON, when the source ends in .json) text."""
-    if source.lower().endswith(".json"):
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(
-                f"JSON syntax error: {exc.msg} (column {exc.colno})", source=source,
-                line=exc.lineno, hint="fix the JSON syntax at that line",
-            ) from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else None
-        problem = exc.problem or exc.context or "cannot parse"
-        column = f" (column {mark.column + 1})" if mark is not None else ""
-        raise MechsynInputError(
-            f"YAML syntax error: {problem}{column}", source=source, line=line,
-            hint="fix the YAML syntax at that line (indentation, brackets, colons)",
-        ) from None
-    except yaml.YAMLError as exc:
-        raise MechsynInputError(f"YAML syntax error: {exc}", source=source) from None
+    return files.parse_data(text, source)
 
 
 def _line_finder(text: str | None, source: str) -> Any:
@@ -85,7 +65,7 @@ def _line_finder(text: str | None, source: str) -> Any:
     root = None
     if text is not None:
         try:
-            root = yaml.compose(text)
+            root = yaml.compose(text, Loader=_YAML_LOADER)
         except yaml.YAMLError:
             root = None
 
@@ -159,22 +139,30 @@ _HINTS = {
     "list_type": "give a list, e.g. [a, b]",
     "dict_type": "give a mapping of names to values",
     "string_type": "give a text value",
+    "greater_than_equal": "give a value that is not negative",
+    "greater_than": "give a positive value",
+    "finite_number": "give a finite number",
+    "bool_not_number": "write a number such as 0 or 1, not true/false",
     "too_short": None,
 }
 
 
 def _validation_error(exc: ValidationError, data: Any, source: str, text: str | None) -> MechsynInputError:
     errors = exc.errors()
-    # Prefer the most specific error: for unions pydantic reports one per member.
-    err = errors[0]
-    loc = _data_path(data, err["loc"])
+    # Prefer the most specific error: for unions pydantic reports one per member (a link
+    # given as a mapping fails as text too); the one reaching deepest into the data is
+    # the member the user meant.
+    paths = [tuple(_data_path(data, e["loc"])) for e in errors]
+    best = max(range(len(errors)), key=lambda i: (len(paths[i]), -i))
+    err, loc = errors[best], list(paths[best])
     find = _line_finder(text, source)
     msg = err["msg"]
     if err["type"] == "extra_forbidden":
         msg = "unknown field"
     elif err["type"] == "missing":
         msg = "required field is missing"
-    more = len({tuple(_data_path(data, e["loc"])) for e in errors}) - 1
+    # other problems: other places (not the union members failing at an enclosing one)
+    more = len({p for p in paths if p != tuple(loc) and tuple(loc)[:len(p)] != p})
     if more > 0:
         msg += f" (and {more} more problem{'s' if more > 1 else ''})"
     return MechsynInputError(
@@ -197,7 +185,7 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
         spec = MechanismFile.model_validate(data)
     except ValidationError as exc:
         raise _validation_error(exc, data, source, text) from None
-    return _Builder(spec, source, _line_finder(text, source)).build()
+    return check_geometry(_Builder(spec, source, _line_finder(text, source)).build(), source)
 
 
 def mechanism_from_text(text: str, source: str = "<text>") -> Mechanism:
@@ -213,8 +201,89 @@ def load_mechanism(path: str | os.PathLike[str]) -> Mechanism:
     MechsynInputError
         naming the file, line and field of the first problem, with a fix.
     """
+    from mechsyn.examples import resolve
+
     data, text = read_data(path)
-    return mechanism_from_dict(data, str(path), text)
+    return mechanism_from_dict(data, str(resolve(path)), text)
+
+
+def load(source: str | os.PathLike[str] | dict[str, Any] | Mechanism) -> Mechanism:
+    """A mechanism from a file (YAML or JSON), file-format data (a dict), or the name of
+    one of the bundled examples (:mod:`mechsyn.examples`).
+
+    Parameters
+    ----------
+    source : path, dict or str
+        A mechanism file, its data, or an example's name such as ``"fourbar"``.
+
+    Returns
+    -------
+    Mechanism
+
+    Raises
+    ------
+    MechsynInputError
+        naming the file, line and field of the first problem, with a fix.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.load({"name": "four-bar", "kind": "planar", "ground": "frame",
+    ...              "links": ["frame", "crank", "coupler", "rocker"],
+    ...              "joints": [{"id": "A", "type": "R", "links": ["frame", "crank"]},
+    ...                         {"id": "B", "type": "R", "links": ["crank", "coupler"]},
+    ...                         {"id": "C", "type": "R", "links": ["coupler", "rocker"]},
+    ...                         {"id": "D", "type": "R", "links": ["rocker", "frame"]}]})
+    >>> m.n_moving, len(m.joints)
+    (3, 4)
+    """
+    if isinstance(source, Mechanism):
+        return source
+    if isinstance(source, dict):
+        return mechanism_from_dict(source)
+    return load_mechanism(source)
+
+
+def loads(text: str, format: str = "yaml") -> Mechanism:
+    """A mechanism from the text of a file, ``format`` ``"yaml"`` (JSON is YAML too) or
+    ``"json"``.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.loads('''
+    ... name: slider-crank
+    ... kind: planar
+    ... ground: frame
+    ... links: [frame, crank, rod, slider]
+    ... joints:
+    ...   - {id: A, type: R, links: [frame, crank]}
+    ...   - {id: B, type: R, links: [crank, rod]}
+    ...   - {id: C, type: R, links: [rod, slider]}
+    ...   - {id: D, type: P, links: [slider, frame]}
+    ... ''')
+    >>> m.pairs_by_class()
+    {5: 4}
+    """
+    if format not in ("yaml", "json"):
+        raise MechsynInputError(f"unknown format {format!r}", field="format", hint="use yaml or json")
+    return mechanism_from_text(text, "<text>.json" if format == "json" else "<text>")
+
+
+def save(mech: Mechanism | dict[str, Any], path: str | os.PathLike[str]) -> None:
+    """Write ``mech`` as a mechanism file: YAML, or JSON for a ``.json`` path; whole or not
+    at all (the same as :func:`write_mechanism`).
+
+    Examples
+    --------
+    >>> import mechsyn as ms, tempfile, pathlib
+    >>> m = ms.examples.load("fourbar")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     ms.save(m, pathlib.Path(d) / "copy.yaml")
+    ...     ms.load(pathlib.Path(d) / "copy.yaml").name == m.name
+    True
+    """
+    write_mechanism(mech, path)
 
 
 class _Builder:
@@ -362,6 +431,9 @@ class _Builder:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
             else:
                 axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+        if self.kind == "planar" and jtype == "P" and axis is None and point is not None:
+            raise self.error(path + ["axis"], f"planar P pair {entry.id} has no axis: its sliding direction "
+                             "is not assumed", "add axis: [dx, dy], e.g. axis: [1, 0] to slide along x")
         axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
         normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
         if entry.pitch is not None and jtype != "H":

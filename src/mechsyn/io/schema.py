@@ -15,11 +15,30 @@
 
 from __future__ import annotations
 
-from typing import Any, Literal
+import math
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, field_validator
+from pydantic_core import PydanticCustomError
 
 LinkRef = str | int
+
+
+def _not_bool(v: Any) -> Any:
+    # YAML's true/false would otherwise be read as 1.0/0.0
+    if isinstance(v, bool):
+        raise PydanticCustomError("bool_not_number", "true/false is not a number")
+    return v
+
+
+def _finite(v: float) -> float:
+    if not math.isfinite(v):
+        raise PydanticCustomError("finite_number", "must be a finite number, not {value}", {"value": v})
+    return v
+
+
+#: A finite real number of a file; booleans are refused (not read as 1 and 0).
+Number = Annotated[float, BeforeValidator(_not_bool), AfterValidator(_finite)]
 
 
 class _Strict(BaseModel):
@@ -33,9 +52,9 @@ class LinkEntry(BaseModel):
 
     name: str | None = Field(None, description="Link name; defaults to the id as text.")
     id: int | None = Field(None, description="Integer id that joints may use instead of the name.")
-    mass: float | None = Field(None, ge=0, description="Mass (for force analysis).")
-    com: list[float] | None = Field(None, description="Centre of mass in the assembled configuration.")
-    inertia: float | None = Field(None, ge=0, description="Moment of inertia about the centre of mass.")
+    mass: Number | None = Field(None, ge=0, description="Mass (for force analysis).")
+    com: list[Number] | None = Field(None, description="Centre of mass in the assembled configuration.")
+    inertia: Number | None = Field(None, ge=0, description="Moment of inertia about the centre of mass.")
     description: str | None = None
 
 
@@ -44,8 +63,8 @@ class CamProfile(_Strict):
     the angle ``t`` (radians, from the x axis of the assembled configuration), e.g.
     ``"1 + 0.2*sin(t)**2"``: the profile points are ``center + r(t) (cos t, sin t)``."""
 
-    center: list[float]
-    radius: float | None = Field(None, gt=0, description="Radius of a disc (eccentric) cam.")
+    center: list[Number]
+    radius: Number | None = Field(None, gt=0, description="Radius of a disc (eccentric) cam.")
     polar: str | None = Field(None, description="r(t): +, -, *, /, **, sin, cos, tan, exp, sqrt, abs, pi, t.")
 
 
@@ -53,12 +72,12 @@ class LoadEntry(_Strict):
     """An external load on a link (force analysis): a force at a point and/or a moment."""
 
     link: LinkRef = Field(description="The link the load acts on.")
-    force: list[float] | None = Field(None, description="Force [Fx, Fy] (global directions).")
-    at: list[float] | None = Field(
+    force: list[Number] | None = Field(None, description="Force [Fx, Fy] (global directions).")
+    at: list[Number] | None = Field(
         None, description="Point of application in the assembled configuration (default: the centre of mass, "
                           "else the link's first joint).")
     point: str | None = Field(None, description="A named point (from `points`) as point of application.")
-    moment: float | None = Field(None, description="A moment (counter-clockwise positive).")
+    moment: Number | None = Field(None, description="A moment (counter-clockwise positive).")
     description: str | None = None
 
 
@@ -79,29 +98,29 @@ class JointEntry(_Strict):
         None, alias="class",
         description="Class i = constraints imposed (1..5); required for generic pairs.",
     )
-    point: list[float] | None = Field(None, description="Joint (or contact / pitch) point.")
-    axis: list[float] | None = Field(
+    point: list[Number] | None = Field(None, description="Joint (or contact / pitch) point.")
+    axis: list[Number] | None = Field(
         None, description="Unit axis: rotation axis (R, H, C, U first axis), sliding direction (P), plane normal (E).",
     )
-    axis2: list[float] | None = Field(None, description="U: second axis, fixed in the second link.")
-    normal: list[float] | None = Field(None, description="Higher pairs: contact normal / line of action.")
-    pitch: float | None = Field(None, description="H: lead per radian of rotation.")
-    ratio: float | None = Field(None, description="gear: angular velocity ratio of the second link to the first.")
+    axis2: list[Number] | None = Field(None, description="U: second axis, fixed in the second link.")
+    normal: list[Number] | None = Field(None, description="Higher pairs: contact normal / line of action.")
+    pitch: Number | None = Field(None, description="H: lead per radian of rotation.")
+    ratio: Number | None = Field(None, description="gear: angular velocity ratio of the second link to the first.")
     actuated: bool = Field(False, description="Driven joint (a drive sets its coordinate).")
     vll: Literal["active", "passive", "locked"] | None = Field(
         None, description="Variable-length link mode of a prismatic pair (paper 000).",
     )
-    limits: list[float] | None = Field(None, description="[min, max] of the joint coordinate (VLL length limits).")
-    profile: "CamProfile | list[list[float]] | None" = Field(
+    limits: list[Number] | None = Field(None, description="[min, max] of the joint coordinate (VLL length limits).")
+    profile: "CamProfile | list[list[Number]] | None" = Field(
         None, description=(
             "cam: the profile fixed on the first link, in the assembled configuration: "
             "{center: [x, y], radius: r} (a disc, e.g. an eccentric), {center: [x, y], polar: 'r(t)'} "
             "(a function of the angle t) or a closed list of points [[x, y], ...] "
             "(interpolated by a periodic cubic spline)."),
     )
-    anchor: list[float] | None = Field(
+    anchor: list[Number] | None = Field(
         None, description="belt: where the flexible element is pinned on the first link (assembled configuration).")
-    radius: float | None = Field(
+    radius: Number | None = Field(
         None, gt=0, description="belt: pulley radius; the pulley is fixed on the second link, centred at `point`.")
     wrap: Literal["ccw", "cw"] | None = Field(
         None, description="belt: sense in which the belt turns round the pulley going from the anchor: "
@@ -118,7 +137,7 @@ class PointEntry(_Strict):
     """A named point fixed on a link, by its coordinates in the assembled configuration."""
 
     link: LinkRef
-    at: list[float]
+    at: list[Number]
 
 
 class ExternalEntry(_Strict):

@@ -82,6 +82,19 @@ class BatchPlan:
     links: tuple[str, ...] = ()
     dyads: tuple[tuple[str, str, str], ...] = ()
     reference_input: float = 0.0
+    crank_line: tuple[int, int] | None = None
+
+    def reference_inputs(self, designs: np.ndarray) -> np.ndarray:
+        """Input angle (degrees) of each design's reference configuration, as
+        :func:`mechsyn.kinematics.simulate` measures it: the direction of the crank's
+        reference line (its first joint in file order to its first other joint), signed
+        by the sense of the input joint."""
+        X = np.atleast_2d(np.asarray(designs, float))
+        if self.crank_line is None:
+            return np.full(len(X), self.reference_input)
+        a, b = self.crank_line
+        d = X[:, 2 * b:2 * b + 2] - X[:, 2 * a:2 * a + 2]
+        return self.input_sign * np.degrees(np.arctan2(d[:, 1], d[:, 0]))
 
     @property
     def n_parameters(self) -> int:
@@ -107,6 +120,7 @@ class BatchResult:
     dead_point: np.ndarray                  # (K,) bool: some sample not assembled
     branch_jump: np.ndarray                 # (K,) bool: a dead point stepped over between samples
     min_transmission_angle: np.ndarray | None = None   # (K,) degrees, 0..90
+    sigmas: np.ndarray | None = None        # (K, n_dyads) assembly mode of each dyad (+1 / -1)
     notes: list[str] = field(default_factory=list)
 
     @property
@@ -220,13 +234,20 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
         if p in joints and mech.ground in joints[p].links:
             continue  # a frame pivot: fixed
         need(index[p], link)
-    ref = _reference_input(mech, drv.id, crank, on_link)
+    ref = _reference_input(mech)
+    # the crank's reference line (simulate's link frame): first joint of the crank in file
+    # order to the first other joint point
+    cj = [j for j in mech.joints if crank in j.links]
+    p0 = np.asarray(cj[0].point, float)
+    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
+    line = (index[cj[0].id], index[other.id]) if other is not None else None
     return BatchPlan(names=names, ops=tuple([("ground", ground_pts)] + ops), outputs=tuple(points),
                      input_joint=drv.id, input_sign=sign, n_dyads=len(dyads),
-                     links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref)
+                     links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref,
+                     crank_line=line)
 
 
-def _reference_input(mech: Mechanism, jid: str, crank: str, on_link: dict[str, list[str]]) -> float:
+def _reference_input(mech: Mechanism) -> float:
     """The input value of the file's configuration as :func:`simulate` measures it."""
     from mechsyn.kinematics.system import build_system
 
@@ -253,9 +274,9 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
         From :func:`compile_plan`.
     designs : (K, P) array
         Reference coordinates of the plan's points (``plan.names``), ``x, y`` each.
-    inputs : (N,) array
+    inputs : (N,) or (K, N) array
         Input offsets from the reference configuration, degrees, in the file's sense of
-        the input joint.
+        the input joint (one row per design when 2-D).
     transmission : bool
         Also give the minimum transmission angle of each design (degrees).
     flags : bool
@@ -274,11 +295,14 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
                                 source="designs", hint="one column per coordinate of plan.names")
     u = np.radians(np.asarray(inputs, dtype=float))
     X = designs[:, 0::2] + 1j * designs[:, 1::2]          # (K, M) reference points
-    K, N = len(X), len(u)
+    K, N = len(X), u.shape[-1]
+    if u.ndim == 2 and u.shape[0] != K:
+        raise MechsynInputError(f"inputs have {u.shape[0]} rows for {K} designs", source="inputs")
     pos: dict[int, np.ndarray] = {}
     links: dict[str, tuple[np.ndarray, np.ndarray, int, np.ndarray | complex]] = {}
     ok = np.ones((K, N), dtype=bool)
     jump = np.zeros(K, dtype=bool)
+    sigmas = []
     sin_mu = np.full(K, np.inf) if transmission else None
     for op in plan.ops:
         kind = op[0]
@@ -287,7 +311,8 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
                 pos[p] = X[:, p, None]
         elif kind == "crank":
             _, p, link = op
-            links[link] = (X[:, p, None], np.exp(1j * plan.input_sign * u)[None, :], p, 1.0 + 0j)
+            rot = np.exp(1j * plan.input_sign * u)
+            links[link] = (X[:, p, None], rot if rot.ndim == 2 else rot[None, :], p, 1.0 + 0j)
         elif kind == "point":
             _, p, link = op
             anchor, vec, a, ref = links[link]
@@ -302,6 +327,7 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
             L1s, L2s = (r1 * r1.conj()).real, (r3 * r3.conj()).real
             d0 = X[:, p3] - X[:, p1]
             sigma = np.where((d0.conj() * r1).imag >= 0, 1.0, -1.0)
+            sigmas.append(sigma)
             d = C - A
             t = d.real ** 2 + d.imag ** 2
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -333,7 +359,8 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     if transmission:
         mu = np.degrees(np.arcsin(np.clip(np.where(np.isfinite(sin_mu), sin_mu, np.nan), 0, 1)))
     return BatchResult(inputs=np.asarray(inputs, float), paths=paths, assembled=ok,
-                       dead_point=~ok.all(axis=1), branch_jump=jump, min_transmission_angle=mu)
+                       dead_point=~ok.all(axis=1), branch_jump=jump, min_transmission_angle=mu,
+                       sigmas=np.stack(sigmas, axis=1) if sigmas else np.zeros((K, 0)))
 
 
 def _stepped_over(b: np.ndarray) -> np.ndarray:

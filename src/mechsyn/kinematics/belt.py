@@ -904,23 +904,9 @@ class BeltCase(_Strict):
 def load_belt_case(path: str) -> BeltCase:
     """Read and validate a belt case file (YAML or JSON); MechsynInputError on bad input
     (naming the file, the line of a syntax error, or the offending field)."""
-    from pathlib import Path
+    from mechsyn.io.files import read_data
 
-    import yaml
-
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise MechsynInputError(f"cannot read the file: {exc.strerror or exc}",
-                                source=str(path)) from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        raise MechsynInputError(
-            f"not valid YAML/JSON: {getattr(exc, 'problem', None) or exc}", source=str(path),
-            line=(mark.line + 1) if mark is not None else None) from None
+    data, _ = read_data(path, "belt case file")
     if not isinstance(data, dict):
         raise MechsynInputError("expected a mapping (name, design, phi_deg, ...) at the top",
                                 source=str(path))

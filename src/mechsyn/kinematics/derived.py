@@ -61,7 +61,7 @@ def transmission_angles(sim) -> dict[str, np.ndarray]:
             j = S.mech.joint(jp)
             a = S.index(j.links[0])
             ang = S.link_angle_i(np.nan_to_num(q), a)
-            ax = np.asarray(S.to_local_dir(j.links[0], j.axis if j.axis is not None else [1.0, 0.0]))
+            ax = np.asarray(S.to_local_dir(j.links[0], j.axis))
             c, s = np.cos(ang), np.sin(ang)
             v = np.stack([-(s * ax[0] + c * ax[1]), c * ax[0] - s * ax[1]], axis=1)  # slide normal
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -18,11 +18,23 @@ class ExpressionError(ValueError):
 
 def evaluate(text: str, t: np.ndarray) -> np.ndarray:
     """Evaluate ``text`` (a function of ``t``) on the array ``t``; only arithmetic,
-    ``pi``, numbers and the functions sin, cos, tan, exp, sqrt, abs are allowed."""
+    ``pi``, numbers and the functions sin, cos, tan, exp, sqrt, abs are allowed.
+
+    Expressions longer than the limit ``expression_chars`` (:mod:`mechsyn.limits`) or
+    nested too deeply for Python's parser raise :class:`ExpressionError`.
+    """
+    from mechsyn.limits import limit
+
+    text = str(text)
+    if len(text) > limit("expression_chars"):
+        raise ExpressionError(f"the expression has {len(text):,} characters, more than the limit of "
+                              f"{limit('expression_chars'):,} (MECHSYN_LIMIT_EXPRESSION_CHARS raises it)")
     try:
-        tree = ast.parse(str(text), mode="eval")
+        tree = ast.parse(text, mode="eval")
     except SyntaxError as exc:
-        raise ExpressionError(f"cannot parse {text!r}: {exc.msg}") from None
+        raise ExpressionError(f"cannot parse {text[:60]!r}: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise ExpressionError(f"{text[:60]!r}... is nested too deeply") from None
 
     def ev(node: ast.AST):
         if isinstance(node, ast.Expression):
@@ -46,7 +58,11 @@ def evaluate(text: str, t: np.ndarray) -> np.ndarray:
         raise ExpressionError(f"{ast.unparse(node)!r} is not allowed in {text!r}")
 
     with np.errstate(all="ignore"):
-        out = np.broadcast_to(np.asarray(ev(tree), float), t.shape)
+        try:
+            value = ev(tree)
+        except RecursionError:
+            raise ExpressionError(f"{text[:60]!r}... is nested too deeply") from None
+        out = np.broadcast_to(np.asarray(value, float), t.shape)
     return np.array(out)
 
 

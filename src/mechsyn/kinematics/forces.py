@@ -170,7 +170,16 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
                               mm, loads, np.asarray(gravity, float))
         JT = np.transpose(S.jacobian(qq), (0, 2, 1))
         if S.n == S.m:
-            lam[idx] = np.linalg.solve(JT, Q[..., None])[..., 0]
+            try:
+                lam[idx] = np.linalg.solve(JT, Q[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                # singular positions (e.g. a flat, collinear linkage): the reactions are
+                # not determined there; they stay NaN and the position counts as singular
+                sv = np.linalg.svd(JT, compute_uv=False)
+                regular = sv[:, -1] > 1e-12 * np.maximum(sv[:, 0], 1e-300)
+                if np.any(regular):
+                    lam[idx[regular]] = np.linalg.solve(JT[regular], Q[regular][..., None])[..., 0]
+                ok[idx[~regular]] = False
         else:
             lam[idx] = np.einsum("nij,nj->ni", np.linalg.pinv(JT), Q)
         sv = np.linalg.svd(JT[0], compute_uv=False)

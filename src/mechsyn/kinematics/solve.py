@@ -62,8 +62,11 @@ def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 
 def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = None,
-           max_iter: int = 12) -> tuple[np.ndarray, bool]:
-    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged)."""
+           max_iter: int = 12, polish: bool = False) -> tuple[np.ndarray, bool]:
+    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged).
+
+    ``polish``: one more step after convergence where the Jacobian is well conditioned
+    (the sweep's positions then agree with the closed form to round-off)."""
     tol = tol if tol is not None else 1e-12 * S.scale
     q = q.copy()
     u2 = u[None]
@@ -74,6 +77,12 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
         if not np.isfinite(norm):
             return q, False
         if norm < tol:
+            if polish and norm > 1e-3 * tol:  # one more step: the error squares (a polish, not a new solve)
+                dq = _solve_lin(S.jacobian(q[None])[0], -r)
+                if np.all(np.isfinite(dq)) and float(np.abs(dq).max()) <= 1e2 * norm:  # well conditioned
+                    q2 = q + dq
+                    if float(np.abs(S.residual(q2[None], u2)[0]).max()) <= norm:
+                        q = q2
             return q, True
         if norm > 4 * prev and prev < 1e-3 * S.scale:
             return q, False
@@ -263,7 +272,7 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
     if X is None:
         X = _factor(S, q)[1]
     q_pred = q + X @ du
-    q_new, ok = newton(S, q_pred, ub)
+    q_new, ok = newton(S, q_pred, ub, polish=True)
     if ok and _step_ok(S, q, q_new, q_pred):
         return q_new
     if depth == 0:
@@ -282,6 +291,140 @@ def _turns(S: PlanarSystem, u: np.ndarray) -> np.ndarray:
         if d.type == "R":
             out[k] = 2 * np.pi * np.round((u[k] - d.assembled) / (2 * np.pi))
     return out
+
+
+def _newton_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
+    """Inputs strictly between the drawn values ``u0`` and ``u1``, at most 5 degrees (R) or
+    5 % of the mechanism's size (P) apart."""
+    h = np.array([np.radians(5.0) if d.type == "R" else 0.05 * S.scale for d in S.drivers])
+    n = int(min(2000, max(1, np.ceil(np.max(np.abs(u1 - u0) / h)))))
+    t = np.arange(1, n) / n
+    return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
+
+
+def _extrapolate(hist: list, u: np.ndarray) -> np.ndarray:
+    """Predict the configuration at ``u`` by the polynomial through the last (up to three)
+    configurations of the run, in the arc length of the inputs (the smooth branch)."""
+    u_last = hist[-1][0]
+    step = u - u_last
+    norm = float(np.linalg.norm(step))
+    if norm == 0.0:
+        return hist[-1][1]
+    direction = step / norm
+    s = [float(direction @ (h[0] - u_last)) for h in hist[-3:]]
+    qs = [h[1] for h in hist[-3:]]
+    pred = np.zeros_like(qs[0])
+    for a, (sa, qa) in enumerate(zip(s, qs)):
+        w = 1.0
+        for b, sb in enumerate(s):
+            if b != a:
+                w *= (norm - sb) / (sa - sb) if sa != sb else 0.0
+        pred += w * qa
+    return pred
+
+
+def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
+    """The next configuration of the run ``hist`` [(u, q, factor)] at ``u`` on the branch
+    whose velocity is continuous.
+
+    The tangent predictor (``dq/du`` at the last configuration) is used while the last
+    configuration is regular and no singular point lies in the step; when the last
+    configuration is singular (its tangent is not unique) or ``det Phi_q`` changes sign
+    within the step (a change or branch point was crossed, where Newton may land on either
+    branch), the prediction is the polynomial through the last configurations of the run,
+    which continues the smooth branch.
+    """
+    u0, q0, (_, X0, det0, sig0) = hist[-1]
+    regular = sig0 >= 1e-6
+    nxt = _track(S, q0, u0, u, X=X0) if regular else None
+    if nxt is not None and len(hist) >= 2:
+        det1 = _factor(S, nxt)[2]
+        if det1 * det0 >= 0:
+            return nxt
+    elif nxt is not None or len(hist) < 2:
+        if nxt is None and not regular:
+            cand, ok = newton(S, q0 + X0 @ (u - u0), u, max_iter=40)
+            return cand if ok else None
+        return nxt
+    pred = _extrapolate(hist, u)
+    cand, ok = newton(S, pred, u, max_iter=40, polish=True)
+    if ok:
+        return cand
+    return nxt
+
+
+def _elbows(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
+    """Assembly-mode signature of a configuration: at every R pair joining two moving links
+    that each carry another joint, the side to which the second link turns from the first
+    (the sign of ``(P_J - P_a) x (P_b - P_J)``; for a dyad, its assembly mode)."""
+    out = []
+    mech = S.mech
+
+    def glob(i: int, jid: str) -> np.ndarray:
+        s = S.to_local(S.links[i], mech.joint(jid).point)
+        c, sn = np.cos(q[3 * i + 2]), np.sin(q[3 * i + 2])
+        return q[3 * i:3 * i + 2] + np.array([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])
+
+    for j in mech.joints:
+        if j.type != "R":
+            continue
+        a, b = (S.index(n) for n in j.links)
+        if a < 0 or b < 0:
+            continue
+        oa = [k.id for k in mech.joints_of(j.links[0]) if k.id != j.id]
+        ob = [k.id for k in mech.joints_of(j.links[1]) if k.id != j.id]
+        if not oa or not ob:
+            continue
+        P, Pa, Pb = glob(a, j.id), glob(a, oa[0]), glob(b, ob[0])
+        d1, d2 = P - Pa, Pb - P
+        out.append(np.sign(d1[0] * d2[1] - d1[1] * d2[0]))
+    return np.array(out)
+
+
+def _nearest_mode(S: PlanarSystem, cands: list, u: np.ndarray, q_drawn: np.ndarray, det: float) -> np.ndarray:
+    """Of configurations at ``u``, the one in the assembly mode nearest the drawn one.
+
+    When the mechanism splits into dyads, each dyad's drawn mode gives the configuration
+    directly (closed form, polished by Newton). Otherwise: the candidate (with those found
+    along the nearest-singular direction of each) whose elbow signature
+    (:func:`_elbows`) matches the drawn one most, then whose ``det Phi_q`` has the drawn
+    sign."""
+    from mechsyn.kinematics import dyads
+
+    plan = dyads.decompose(S)
+    if plan is not None:
+        u_asm = np.array([d.assembled for d in S.drivers])
+        _, sig = dyads.solve_positions(S, plan, u_asm[None])
+        with np.errstate(invalid="ignore"):
+            qc = dyads.solve_positions(S, plan, u[None], sigmas=sig)[0][0]
+        if np.all(np.isfinite(qc)):
+            qc, good = newton(S, qc, u, max_iter=10)
+            if good:
+                return qc
+    pool = list(cands)
+    for c in cands:
+        pool.extend(_other_mode(S, c, u))
+    ref = _elbows(S, q_drawn)
+
+    def score(c: np.ndarray) -> tuple:
+        return (int(np.sum(_elbows(S, c) == ref)), _factor(S, c)[2] * det > 0)
+
+    return max(pool, key=score)
+
+
+def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> list:
+    """Configurations at ``u`` other than ``q``, searched from ``q`` along the direction in
+    which ``Phi_q`` is nearest singular (where two assembly modes meet near a fold, they
+    differ along it)."""
+    J = S.jacobian(q[None])[0]
+    v = np.linalg.svd(J)[2][-1]
+    v = v / max(float(np.abs(v).max()), 1e-300)
+    for a in (0.05, 0.2, 0.5, 1.0):
+        for sgn in (1.0, -1.0):
+            c, good = newton(S, q + sgn * a * S.scale * v, u, max_iter=30)
+            if good and np.abs(c - q).max() > 1e-6 * S.scale:
+                return [c]
+    return []
 
 
 def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
@@ -341,28 +484,28 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     sig = np.full(N, np.nan)
     events: list[dict] = []
     u_asm = np.array([d.assembled for d in S.drivers])
-    cur = _track(S, q_start, u_asm, inputs[0], depth=14)
+    # from the drawn configuration to the first input, on the smooth branch
+    hist = [(u_asm, q_start, _factor(S, q_start))]
+    drawn_det = hist[0][2][2]
+    for u in list(_newton_path(S, u_asm, inputs[0])) + [inputs[0]]:
+        nxt = _continue(S, hist, u)
+        if nxt is None:
+            break
+        hist.append((u, nxt, _factor(S, nxt)))
+    cur = hist[-1][1] if nxt is not None else None
     cur_u = inputs[0]
     X = None
     last_good: tuple[np.ndarray, np.ndarray] | None = (q_start, u_asm)
     if cur is None:
         if refine_limits:
-            ul, _ = _limit(S, q_start, u_asm, inputs[0])
+            ul, _ = _limit(S, hist[-1][1], hist[-1][0], inputs[0])
             events.append({"index": 0, "kind": "dead point", "input": ul.tolist(),
+                           "before_sweep": True,
                            "message": "the mechanism cannot move from its file configuration to the first input"})
     for i in range(N):
         u = inputs[i]
         if cur is not None and i > 0:
-            nxt = _track(S, cur, cur_u, u, X=X)
-            if nxt is None and np.isfinite(sig[i - 1]) and sig[i - 1] < 1e-6:
-                # leaving a singular (change / branch) point: the predictor has no unique
-                # direction; let Newton pick the continuation and say so
-                cand, ok = newton(S, cur + X @ (u - cur_u), u, max_iter=40)
-                if ok:
-                    nxt = cand
-                    events.append({"index": i, "kind": "branch point", "input": cur_u.tolist(),
-                                   "message": "continued past a singular configuration (change or branch "
-                                              "point) by Newton: the assembly branch may have switched"})
+            nxt = _continue(S, hist, u)
             if nxt is None:
                 if refine_limits:
                     ul, _ = _limit(S, cur, cur_u, u)
@@ -375,13 +518,19 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             cur = nxt
             cur_u = u
         elif cur is None and last_good is not None:
-            ok = False
-            for guess in (last_good[0], q_start):
-                cand, ok = newton(S, guess, u, max_iter=15)
-                if ok:
-                    break
+            # reassemble in the mode nearest the drawn one: of the configurations Newton
+            # reaches from the drawn and from the last one, the one whose det(Phi_q) has
+            # the drawn configuration's sign (the same assembly mode), else the first
+            cands = []
+            for guess in (q_start, last_good[0]):
+                c, good = newton(S, guess, u, max_iter=15)
+                if good:
+                    cands.append(c)
+            ok = bool(cands)
             if ok:
+                cand = _nearest_mode(S, cands, u, q_start, drawn_det)
                 cur, cur_u = cand, u
+                hist = [(u, cand, _factor(S, cand))]
                 # follow the new branch backwards into the gap as far as it assembles
                 bq, bu, j = cand, u, i - 1
                 while j >= 0 and not np.isfinite(q[j, 0]):
@@ -397,14 +546,22 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                     events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
                                    "message": "assembly starts again here: the other limit of a working range"})
                 events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
-                               "message": "assembles again after a gap (branch chosen by Newton from the "
-                                          "last configuration)"})
+                               "message": "assembles again after a gap, in the assembly mode of the drawn "
+                                              "configuration (the mode nearest the drawn one)"})
         if cur is not None:
             q[i] = cur
-            fac, X, det_sign[i], sig[i] = _factor(S, cur)
+            f = _factor(S, cur)
+            fac, X, det_sign[i], sig[i] = f
+            if i > 0 and np.isfinite(q[i - 1, 0]):
+                hist.append((u, cur, f))
+                hist = hist[-3:]
             qd[i], qdd[i] = _rates_from(S, cur, fac, X, speeds)
-            if i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0:
-                events.append({"index": i, "kind": "singular", "input": u.tolist(),
+            if sig[i] < 1e-6:  # singular: the rates are not defined here
+                qd[i] = np.nan
+                qdd[i] = np.nan
+            if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
+                    and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
+                events.append({"index": i, "kind": "singular", "input": u.tolist(), "crossed": True,
                                "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
                                           "crossed between this input and the previous"})
         if progress is not None:

@@ -328,9 +328,7 @@ class PlanarSystem:
 
 
 def _axis(j: Joint) -> np.ndarray:
-    if j.axis is None:
-        return np.array([1.0, 0.0])
-    return np.asarray(j.axis, float)
+    return np.asarray(j.axis, float)  # given: build_system refuses a P pair without axis
 
 
 # ------------------------------------------------------------------ per-constraint code
@@ -554,6 +552,10 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
         if j.point is None:
             raise MechsynInputError(f"joint {j.id} has no point", source=src, field=f"joints.{j.id}.point",
                                     hint="give every joint a point, e.g. point: [0, 0], in the assembled configuration")
+        if j.type == "P" and j.axis is None:
+            raise MechsynInputError(f"joint {j.id} (P) has no axis: its sliding direction is not assumed",
+                                    source=src, field=f"joints.{j.id}.axis",
+                                    hint="add axis: [dx, dy], e.g. axis: [1, 0] to slide along x")
         if j.type not in ("R", "P", "cam", "gear", "belt"):
             raise MechsynInputError(f"joint {j.id}: pair type {j.type} is not supported by planar kinematics",
                                     source=src, field=f"joints.{j.id}.type", hint="use R, P, cam, gear or belt")

@@ -307,9 +307,17 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
             notes.append(f"Ozol's q = {q} differs from the per-contour S_Σ = {s_sum}: q uses the declared "
                          f"W = {mech.mobility} (idle mobilities included), the per-contour count nets idle "
                          f"mobilities against redundant constraints.")
-        else:
+        elif q == s_sum + g_sum and not planar:
             notes.append(f"Ozol's q = {q} = S_Σ + G_Σ = {s_sum} + {g_sum:g}: it also counts the metric "
                          f"constraints and redundant links of paper 003 as redundant constraints.")
+        elif planar:
+            notes.append(f"Ozol's q = {q} is the planar reading (q = W + 3K - f); paper 003's per-contour "
+                         f"S_Σ = {s_sum} and G_Σ = {g_sum:g} are the spatial reading (each contour against "
+                         f"6 freedoms): they count different constraints and need not agree.")
+        else:
+            notes.append(f"Ozol's q = {q} differs from S_Σ + G_Σ = {s_sum} + {g_sum:g} = {s_sum + g_sum:g}: "
+                         f"q counts every redundant constraint of the W it is given (W = {w_for_ozol}), "
+                         f"the per-contour S_j nets idle mobilities against redundant constraints.")
     if planar and forms["chebyshev"].value is not None and forms["chebyshev"].value <= 0 and K:
         notes.append(f"Chebyshev's W = {forms['chebyshev'].value}: a structure (no motion) unless the "
                      f"geometry is special (e.g. parallel links).")

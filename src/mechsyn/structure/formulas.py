@@ -15,10 +15,13 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class Formula:
-    """A formula's value (``None`` where it does not apply) and its substituted expression."""
+    """A formula's value (``None`` where it does not apply), its substituted expression and
+    its reading: ``"planar"`` (3 freedoms per free link, 3 closure equations per contour),
+    ``"spatial"`` (6 and 6) or ``"topology"`` (counts of links, pairs and contours only)."""
 
     value: float | int | None
     expression: str
+    reading: str = ""
 
 
 def _fmt(x: float | int) -> str:
@@ -43,19 +46,19 @@ def _signed(x: int | float) -> str:
 def chebyshev(n: int, p5: int, p4: int) -> Formula:
     """Chebyshev (1869), planar: ``W = 3n - 2 p5 - p4``."""
     w = 3 * n - 2 * p5 - p4
-    return Formula(w, f"W = 3·{n} - 2·{p5} - {p4} = {w}")
+    return Formula(w, f"W = 3·{n} - 2·{p5} - {p4} = {w}", "planar")
 
 
 def grubler(N: int, p5: int, p4: int) -> Formula:
     """Grübler, planar, ``N`` counting the frame (paper 002): ``W = 3(N - 1) - 2 p5 - p4``."""
     w = 3 * (N - 1) - 2 * p5 - p4
-    return Formula(w, f"W = 3({N} - 1) - 2·{p5} - {p4} = {w}")
+    return Formula(w, f"W = 3({N} - 1) - 2·{p5} - {p4} = {w}", "planar")
 
 
 def malyshev(n: int, pairs_by_class: dict[int, int]) -> Formula:
     """Malyshev, spatial: ``W = 6n - Σ_{i=1..5} i·p_i``."""
     w = 6 * n - sum(i * p for i, p in pairs_by_class.items())
-    return Formula(w, f"W = 6·{n}{_terms(pairs_by_class)} = {w}")
+    return Formula(w, f"W = 6·{n}{_terms(pairs_by_class)} = {w}", "spatial")
 
 
 def somov_malyshev(n: int, pairs_by_class: dict[int, int], s_sum: int, g_sum: int | float) -> Formula:
@@ -67,7 +70,7 @@ def somov_malyshev(n: int, pairs_by_class: dict[int, int], s_sum: int, g_sum: in
     w = 6 * n - sum(i * p for i, p in pairs_by_class.items()) + s_sum + g_sum
     w = int(w) if float(w).is_integer() else w
     extra = (_signed(s_sum) if s_sum else "") + (_signed(g_sum) if g_sum else "")
-    return Formula(w, f"W = 6·{n}{_terms(pairs_by_class)}{extra} = {_fmt(w)}")
+    return Formula(w, f"W = 6·{n}{_terms(pairs_by_class)}{extra} = {_fmt(w)}", "spatial")
 
 
 def redundant_from_mobility(W: int, n: int, pairs_by_class: dict[int, int], planar: bool = False) -> Formula:
@@ -78,23 +81,23 @@ def redundant_from_mobility(W: int, n: int, pairs_by_class: dict[int, int], plan
     if planar:
         p5, p4 = pairs_by_class.get(5, 0), pairs_by_class.get(4, 0)
         s = W - 3 * n + 2 * p5 + p4
-        return Formula(s, f"S = {W} - 3·{n} + 2·{p5} + {p4} = {s}")
+        return Formula(s, f"S = {W} - 3·{n} + 2·{p5} + {p4} = {s}", "planar")
     s = W - 6 * n + sum(i * p for i, p in pairs_by_class.items())
     terms = "".join(f" + {i}·{p}" for i, p in sorted(pairs_by_class.items()) if p)
-    return Formula(s, f"S = {W} - 6·{n}{terms} = {s}")
+    return Formula(s, f"S = {W} - 6·{n}{terms} = {s}", "spatial")
 
 
 def gokhman(n: int, pairs_total: int) -> Formula:
     """Gokhman: number of independent contours ``K = Σ p_i - n``."""
     k = pairs_total - n
-    return Formula(k, f"K = {pairs_total} - {n} = {k}")
+    return Formula(k, f"K = {pairs_total} - {n} = {k}", "topology")
 
 
 def scheme_check(N: int, K: int, pairs_total: int) -> Formula:
     """Check of a drawn structural scheme (paper 002): ``p = N + K - 1``."""
     rhs = N + K - 1
     ok = rhs == pairs_total
-    return Formula(int(ok), f"p = N + K - 1: {pairs_total} {'=' if ok else '≠'} {N} + {K} - 1 = {rhs}")
+    return Formula(int(ok), f"p = N + K - 1: {pairs_total} {'=' if ok else '≠'} {N} + {K} - 1 = {rhs}", "topology")
 
 
 def ozol(W: int, K: int, freedoms: list[int], planar: bool = False) -> Formula:
@@ -109,4 +112,4 @@ def ozol(W: int, K: int, freedoms: list[int], planar: bool = False) -> Formula:
     for x in freedoms:
         counts[x] = counts.get(x, 0) + 1
     f_expr = " + ".join(f"{c}·{x}" for x, c in sorted(counts.items()))
-    return Formula(q, f"q = {W} + {lam}·{K} - {f} = {q} (f = {f_expr or 0})")
+    return Formula(q, f"q = {W} + {lam}·{K} - {f} = {q} (f = {f_expr or 0})", "planar" if planar else "spatial")

@@ -77,8 +77,35 @@ def chain_mobility(n_links: int, n_joints: int) -> int:
     return 3 * (n_links - 1) - 2 * n_joints
 
 
+#: Known chain counts (OEIS A233288 / Tuttle 1996): (n_links, mobility) -> chains.
+KNOWN_COUNTS = {(4, 1): 1, (6, 1): 2, (8, 1): 16, (10, 1): 230, (12, 1): 6856, (14, 1): 318162,
+                (5, 2): 1, (7, 2): 4, (9, 2): 40, (11, 2): 839}
+
+
+def estimated_chains(n_links: int, mobility: int) -> float:
+    """The number of chains of ``(n, F)``: known, or extrapolated from the largest known
+    count of that mobility at the last known growth per two links (about 46-fold)."""
+    if (n_links, mobility) in KNOWN_COUNTS:
+        return float(KNOWN_COUNTS[(n_links, mobility)])
+    known = sorted(n for n, f in KNOWN_COUNTS if f == mobility and (n - n_links) % 2 == 0 and n < n_links)
+    if not known:
+        return float("nan")
+    last = known[-1]
+    growth = KNOWN_COUNTS[(last, mobility)] / KNOWN_COUNTS[(last - 2, mobility)]
+    return KNOWN_COUNTS[(last, mobility)] * growth ** ((n_links - last) / 2)
+
+
 def _check_request(n_links: int, mobility: int) -> int:
     """Validate ``(n, F)`` and return the number of joints ``j``."""
+    from mechsyn.limits import limit, limit_hint
+
+    if n_links > limit("atlas_links"):
+        est = estimated_chains(n_links, mobility)
+        about = f"about {est:.2g} chains" if np.isfinite(est) else "an unknown, very large number of chains"
+        raise MechsynInputError(
+            f"an atlas of {n_links} links has {about}; beyond {limit('atlas_links')} links the "
+            "enumeration runs for hours or longer (about 46 times longer per two links)", source="--links",
+            hint=f"use at most {limit('atlas_links')} links; {limit_hint('atlas_links')}")
     if n_links < 2:
         raise MechsynInputError(
             f"a kinematic chain needs at least 2 links, got {n_links}", source="--links"
@@ -608,8 +635,11 @@ def synthesize_chains_to_file(
     mobility: int = 1,
     include_degenerate: bool = False,
     progress: Callable[[int], None] | None = None,
+    force: bool = False,
 ) -> list[KinematicChain]:
     """Enumerate, streaming every chain to a JSON-lines file as soon as found.
+
+    An existing file that is not such a stream is refused unless ``force``.
 
     Line 1 is a header naming the request; then each assortment's chains, followed by a
     ``{"done": key}`` line once the assortment is complete. Re-running with the same file
@@ -622,7 +652,11 @@ def synthesize_chains_to_file(
               "include_degenerate": include_degenerate}
     done: dict[str, list[KinematicChain]] = {}
     if path.exists() and path.stat().st_size > 0:
-        done = _read_done(path, header)
+        if not force and not _is_chain_stream(path):
+            raise MechsynInputError(
+                "exists and is not a chain stream written by mechsyn atlas; it would be overwritten",
+                source=str(path), hint="give another file, or add --force to overwrite it")
+        done = _read_done(path, header) if _is_chain_stream(path) else {}
     units = _units(n_links, mobility)
     # rewrite the completed part (drops a torn tail), then append
     lines = [json.dumps(header)]
@@ -649,6 +683,16 @@ def synthesize_chains_to_file(
                 progress(1)
     _check_distinct(chains)
     return chains
+
+
+def _is_chain_stream(path: Path) -> bool:
+    """Whether ``path`` starts with the header line of a chain stream."""
+    try:
+        with open(path, "rb") as fh:
+            first = json.loads(fh.readline(4096).decode("utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return False
+    return isinstance(first, dict) and "mechsyn_chains" in first
 
 
 def _read_done(path: Path, header: dict) -> dict[str, list[KinematicChain]]:

@@ -49,6 +49,7 @@ from typing import Any, Callable
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.interrupt import BestSoFar
 
 __all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
            "Evaluation", "evaluate_locked", "stage1_objective", "vll_range", "mode_forces",
@@ -111,20 +112,19 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> FingerCase:
     """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    from mechsyn.io.load import read_data
+    from mechsyn.io.files import read_data
 
     path = Path(path)
-    if not path.is_file():
-        raise _err(f"no such file: {path}", str(path))
-    data, _text = read_data(path)
+    data, _text = read_data(path, "case file")
     return case_from_dict(data, str(path), base_dir=path.parent)
 
 
 def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
-    try:
-        out = [float(x) for x in v]
-    except (TypeError, ValueError):
-        raise _err(f"{fld} must be a list of numbers", src, fld) from None
+    from mechsyn.io.checks import numbers
+
+    if not isinstance(v, (list, tuple)):
+        raise _err(f"{fld} must be a list of numbers", src, fld)
+    out = numbers(v, src, fld).reshape(-1).tolist()
     if n is not None and len(out) != n:
         raise _err(f"{fld} must have {n} numbers", src, fld)
     if not all(np.isfinite(out)):
@@ -755,6 +755,7 @@ class FingerDesign:
     seconds: float
     stopped_by_time_limit: bool = False
     notes: list[str] = field(default_factory=list)
+    interrupted: bool = False    # Ctrl-C ended the search: the best design so far
 
     @property
     def best_variant(self) -> VariantResult:
@@ -769,19 +770,30 @@ class FingerDesign:
                     "assembled_at_all_targets": b.assembled_at_all_targets},
                 "targets": self.targets, "tolerance_deg": self.tolerance_deg,
                 "variants": [v.to_dict() for v in self.variants], "seconds": self.seconds,
-                "stopped_by_time_limit": self.stopped_by_time_limit, "notes": self.notes,
+                "stopped_by_time_limit": self.stopped_by_time_limit, "interrupted": self.interrupted,
+                "notes": self.notes,
                 "units": {"angles": "deg", "lengths": "file unit", "forces": "file force unit",
                           "moments": "force x length"}}
 
 
 def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int, popsize: int,
-        deadline: float, init: Any = "latinhypercube", report: Callable[[int, float], None] | None = None
-        ) -> tuple[np.ndarray, float, int, bool, list]:
-    """Seeded differential evolution; stops at ``deadline``; ``report(generation, best)``."""
+        deadline: float, init: Any = "latinhypercube", report: Callable[[int, float], None] | None = None,
+        state: dict | None = None) -> tuple[np.ndarray, float, int, bool, list]:
+    """Seeded differential evolution; stops at ``deadline``; ``report(generation, best)``.
+
+    Ctrl-C (:class:`KeyboardInterrupt`) ends it with the best design evaluated so far and
+    sets ``state["interrupted"]``; it propagates when nothing was evaluated yet.
+    """
     from scipy.optimize import differential_evolution
 
     stopped = [False]
     gen = [0]
+    best = BestSoFar()
+
+    def tracked(x: np.ndarray) -> float:
+        value = f(x)
+        best.offer(np.atleast_2d(x), np.array([value]))
+        return value
 
     def cb(intermediate_result: Any) -> bool:
         gen[0] += 1
@@ -792,16 +804,27 @@ def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int
             return True
         return False
 
-    r = differential_evolution(f, bounds, seed=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
-                               mutation=(0.5, 1.0), recombination=0.9, polish=False, init=init,
-                               callback=cb, updating="deferred")
+    try:
+        r = differential_evolution(tracked, bounds, seed=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
+                                   mutation=(0.5, 1.0), recombination=0.9, polish=False, init=init,
+                                   callback=cb, updating="deferred")
+    except KeyboardInterrupt:
+        if best.x is None or state is None:
+            raise
+        state["interrupted"] = True
+        return best.x, best.f, 0, False, [(best.x, best.f)]
     pop = sorted(zip(np.asarray(r.population), np.asarray(r.population_energies)), key=lambda t: t[1])
     return np.asarray(r.x), float(r.fun), int(r.nfev), stopped[0], pop
 
 
 def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                   progress: Callable[[str], None] | None = None) -> FingerDesign:
-    """Run paper 000's steps 8-13 on ``case`` (see the module doc)."""
+    """Run paper 000's steps 8-13 on ``case`` (see the module doc).
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search: the
+    variant being searched keeps its best design so far (its force stage is skipped),
+    later variants are not searched, and the result has ``interrupted=True``.
+    """
     t0 = time.monotonic()
     deadline = t0 + time_limit
     bounds = [v.bounds for v in case.variables]
@@ -809,7 +832,11 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     variants = []
     notes: list[str] = []
     stopped = False
+    state = {"interrupted": False}
     for combo in case.combinations:
+        if state["interrupted"]:
+            notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
+            continue
         if progress:
             progress(f"VLL {'+'.join(combo)}: stage 1 (targets, VLL locked at l_min)")
         label = "+".join(combo)
@@ -820,7 +847,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
                     f"RMS error {best:.4g} deg" if best < INFEASIBLE else "design still infeasible"))
 
         x1, f1, n1, st1, _ = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
-                                 deadline, report=report1)
+                                 deadline, report=report1, state=state)
         if f1 >= INFEASIBLE:
             notes.append(f"VLL {'+'.join(combo)}: no feasible design (every tried design fails to assemble over "
                          "the crank range or leaves the region)")
@@ -842,12 +869,12 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             init[k] = np.clip(x1 + 0.05 * (hi - lo) * rng.standard_normal(len(bounds)), lo, hi)
         if progress:
             progress("stage 2: forces (both modes)")
-        x2, f2, n2, st2, pop = _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
+        x2, f2, n2, st2, pop = (x1, f1, 0, False, []) if state["interrupted"] else _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
                                                    forces1["criterion"]), bounds, seed, case.force_maxiter,
                                    case.popsize, deadline, init=init,
                                    report=(lambda g, best: progress(
                                        f"VLL {label}: force stage, generation {g}/{case.force_maxiter}, best "
-                                       f"criterion {best:.4g}")) if progress else None)
+                                       f"criterion {best:.4g}")) if progress else None, state=state)
         stopped = stopped or st1 or st2
         chosen, ranges, forces_, improved = x1, ranges1, forces1, False
         # the locked-mode criterion steers the search; the best few distinct members are
@@ -887,6 +914,8 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
             vll_ranges=ranges, stage1_forces=forces1, forces=forces_, force_stage_improved=improved,
             assembled_at_all_targets=bool(ev.q is not None and np.isfinite(ev.q).all()),
             mechanism=d, underactuated=under, evaluations=n1 + n2))
+    if not variants and state["interrupted"]:
+        raise KeyboardInterrupt  # nothing feasible to keep
     if not variants:
         raise MechsynInputError(
             "no feasible design: " + "; ".join(notes), source=case.source, field="variables",
@@ -897,4 +926,5 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     return FingerDesign(case.source, seed, variants, best,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
-                        case.tolerance_deg, time.monotonic() - t0, stopped, notes)
+                        case.tolerance_deg, time.monotonic() - t0, stopped, notes,
+                        interrupted=state["interrupted"])

@@ -44,6 +44,8 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.interrupt import BestSoFar
+from mechsyn.limits import limit, limit_hint
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
@@ -120,24 +122,18 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> MechanismCase:
     """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism")."""
-    import yaml
+    from mechsyn.io.files import read_data
 
     p = Path(path)
-    if not p.is_file():
-        raise _err(f"no such file: {p}", str(p))
-    try:
-        data = yaml.safe_load(p.read_text())
-    except yaml.YAMLError as exc:
-        raise _err(f"not valid YAML/JSON: {exc}", str(p)) from None
+    data, _ = read_data(p, "case file", fmt="yaml")
     return case_from_dict(data, source=str(p), base_dir=p.parent)
 
 
 def _floats(v: Any, src: str, fld: str, n: int | None = None) -> np.ndarray:
-    try:
-        a = np.asarray(v, float)
-    except (TypeError, ValueError):
-        raise _err(f"{fld} must be numbers", src, fld) from None
-    if not np.all(np.isfinite(a)) or (n is not None and a.shape[-1:] != (n,)):
+    from mechsyn.io.checks import numbers
+
+    a = numbers(v, src, fld)
+    if n is not None and a.shape[-1:] != (n,):
         raise _err(f"{fld} must be finite numbers" + (f", {n} per entry" if n else ""), src, fld)
     return a
 
@@ -185,9 +181,15 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
         if r.shape != (2,) or not r[0] < r[1]:
             raise _err("input.range_deg must be [lower, upper] with lower < upper", src, "input.range_deg")
         rng = (float(r[0]), float(r[1]))
-    step = float(data.get("step_deg", 2.0))
-    if not step > 0:
-        raise _err("step_deg must be positive", src, "step_deg")
+    step = _floats(data.get("step_deg", 2.0), src, "step_deg").reshape(-1)
+    if step.shape != (1,) or not step[0] > 0:
+        raise _err("step_deg must be a positive number", src, "step_deg")
+    step = float(step[0])
+    sweep = (float(np.sum(np.abs(np.diff(values)))) + 360.0) / step  # at most this many positions
+    if sweep > limit("sweep_points"):
+        raise _err(f"step_deg {step:g} makes a sweep of up to {sweep:,.0f} positions per design, more than "
+                   f"the limit of {limit('sweep_points'):,}", src, "step_deg",
+                   "use step_deg of about 0.5 to 5; " + limit_hint("sweep_points"))
     method = str(data.get("method", "auto"))
     if method not in ("auto", "newton"):
         raise _err("method must be auto or newton", src, "method")
@@ -232,9 +234,12 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
         f = f"variables[{k}]"
         if not isinstance(v, dict) or "lower" not in v or "upper" not in v:
             raise _err("a variable needs `lower` and `upper`", src, f)
-        lo, hi = float(v["lower"]), float(v["upper"])
-        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        lo, hi = _floats([v["lower"], v["upper"]], src, f)
+        if not lo < hi:
             raise _err("a variable needs finite bounds with lower < upper", src, f)
+        if max(abs(lo), abs(hi)) > limit("coordinate"):
+            raise _err(f"bounds [{lo:g}, {hi:g}] are beyond ±{limit('coordinate'):g}: distances would overflow",
+                       src, f, "give bounds of the size of the mechanism")
         if "point" in v:
             kind, tgt = "point", str(v["point"])
             if tgt not in names_pts:
@@ -414,17 +419,9 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
             return MechanismEvaluation(False, f"cannot sweep: {exc}", violation=1e3)
         q, ok, method, sig = sw.q, sw.assembled, "newton", None
         branch_viol = float(sum(1 for e in sw.events if e.get("kind") in ("branch point", "singular")))
-    n_bad = int((~ok).sum())
-    viol = n_bad / len(grid) + branch_viol + viol_order
-    if viol > 0:
-        why = []
-        if n_bad:
-            why.append(f"not assembled at {n_bad} of {len(grid)} inputs of the sweep")
-        if branch_viol:
-            why.append("off the file's assembly branch")
-        if viol_order:
-            why.append("input angles out of order")
-        return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
+    bad = infeasibility(int((~ok).sum()), len(grid), branch_viol, viol_order, method)
+    if bad is not None:
+        return bad
     qt = q[idx]
     if case.problem == "path":
         link, at = resolve_points(mech, [case.point])[case.point]
@@ -446,11 +443,27 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
                                sigmas=sig)
 
 
+def infeasibility(n_bad: int, n_grid: int, branch_viol: float, viol_order: float,
+                  method: str) -> MechanismEvaluation | None:
+    """The infeasible evaluation (violation and reasons) of a swept design, or None."""
+    viol = n_bad / n_grid + branch_viol + viol_order
+    if viol <= 0:
+        return None
+    why = []
+    if n_bad:
+        why.append(f"not assembled at {n_bad} of {n_grid} inputs of the sweep")
+    if branch_viol:
+        why.append("off the file's assembly branch")
+    if viol_order:
+        why.append("input angles out of order")
+    return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
+
+
 class MechanismProblem:
     """Feasibility-first fitness over populations, and least-squares residuals, in the
     interface :func:`mechsyn.synthesis.optimize.polish` expects."""
 
-    def __init__(self, case: MechanismCase) -> None:
+    def __init__(self, case: MechanismCase, batch: bool = True) -> None:
         self.case = case
         self.lower, self.upper = case.lower, case.upper
         pts = [case.targets]
@@ -463,9 +476,14 @@ class MechanismProblem:
         # U: feasible scores are capped at U, infeasible ones are U + violation (>= 1)
         self.penalty_base = 1e6 * case.n_targets * (max(1.0, ext) ** 2 + w ** 2)
         self.n_evaluations = 0   # designs swept
+        from mechsyn.synthesis.general_batch import batch_evaluator
+
+        self.batch = batch_evaluator(case) if batch else None  # whole populations at once
 
     def evaluate(self, Z: np.ndarray) -> list[MechanismEvaluation]:
         self.n_evaluations += len(np.atleast_2d(Z))
+        if self.batch is not None:
+            return _EvalList(self.batch.evaluate(Z))
         return _EvalList([evaluate_design(self.case, z) for z in np.atleast_2d(Z)])
 
     def score(self, ev: MechanismEvaluation) -> float:
@@ -479,7 +497,7 @@ class MechanismProblem:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         c = self.case
         self.n_evaluations += 1
-        ev = evaluate_design(c, z)
+        ev = self.batch.evaluate(z)[0] if self.batch is not None else evaluate_design(c, z)
         n = 2 * c.n_targets + (c.n_targets if c.problem == "motion" else 0)
         if not ev.feasible:
             return np.full(n, np.sqrt(self.penalty_base / n) * (1.0 + ev.violation))
@@ -523,12 +541,13 @@ class MechanismSynthesisResult:
     restart_errors: list[float] = field(default_factory=list)
     stopped_by_time_limit: bool = False
     reason: str = ""                   # why the best design is infeasible ("" when feasible)
+    interrupted: bool = False          # Ctrl-C ended the search: the best design so far
 
     def to_dict(self) -> dict[str, Any]:
         out = {k: getattr(self, k) for k in (
             "case", "problem", "error", "design", "start_design", "start_error", "feasible",
             "assembled_at_all_targets", "method", "seconds", "seed", "restarts", "nfev", "inputs_deg",
-            "targets", "achieved", "restart_errors", "stopped_by_time_limit", "reason")}
+            "targets", "achieved", "restart_errors", "stopped_by_time_limit", "reason", "interrupted")}
         if self.problem == "motion":
             out["achieved_angles_deg"] = self.achieved_angles_deg
             out["target_angles_deg"] = self.target_angles_deg
@@ -537,11 +556,17 @@ class MechanismSynthesisResult:
 
 def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 3,
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
-                         progress: Callable[[int, int, float], None] | None = None) -> MechanismSynthesisResult:
+                         progress: Callable[[int, int, float], None] | None = None,
+                         batch: bool = True) -> MechanismSynthesisResult:
     """Optimise the case: per restart (child seeds of ``seed``, as in
     :func:`mechsyn.synthesis.optimize.restart_seeds`) the registered global optimiser on
     the feasibility-first fitness, then a least-squares polish of the best few members
-    (:func:`mechsyn.synthesis.optimize.polish`); the file's own design competes too."""
+    (:func:`mechsyn.synthesis.optimize.polish`); the file's own design competes too.
+    ``batch``: evaluate populations through the batch engine where the case allows
+    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
+    returns the best design evaluated so far with ``interrupted=True``."""
     from mechsyn.synthesis.optimize import OPTIMIZERS, polish, restart_seeds
 
     if optimizer not in OPTIMIZERS:
@@ -551,7 +576,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     deadline = t0 + time_limit
     opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
     opts.update(options or {})
-    prob = MechanismProblem(case)
+    prob = MechanismProblem(case, batch=batch)
     x0 = np.clip(start_vector(case), prob.lower, prob.upper)
     best_z, best_f = x0, float(prob.fitness(x0[None, :])[0])
     start_f = best_f
@@ -561,44 +586,52 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     # the least-squares polish then finishes it
     f_atol = float(opts.pop("f_atol", 1e-18 * prob.penalty_base))
 
-    for r, s in enumerate(restart_seeds(seed, restarts)):
-        if r and time.monotonic() > deadline - 0.1 * time_limit:
-            stopped = True
-            break
-        search_end = t0 + time_limit * (0.85 * (r + 1) / restarts)
+    tracker = BestSoFar()
+    interrupted = False
+    try:
+        for r, s in enumerate(restart_seeds(seed, restarts)):
+            if r and time.monotonic() > deadline - 0.1 * time_limit:
+                stopped = True
+                break
+            search_end = t0 + time_limit * (0.85 * (r + 1) / restarts)
 
-        def should_stop(f: float, r: int = r) -> bool:
+            def should_stop(f: float, r: int = r) -> bool:
+                if progress is not None:
+                    progress(r, restarts, min(best_f, f))
+                return time.monotonic() >= search_end or f <= f_atol
+
+            g = OPTIMIZERS[optimizer](tracker.wrap(prob.fitness), prob.lower, prob.upper, seed=s, should_stop=should_stop,
+                                      options=opts)
+            cands = [np.asarray(g.x, float)]
+            if g.population is not None and g.population_fun is not None:
+                for i in np.argsort(g.population_fun):
+                    z = np.asarray(g.population[i], float)
+                    if len(cands) >= n_polish:
+                        break
+                    if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
+                        cands.append(z)
+            rbest = np.inf
+            for c in cands:
+                if time.monotonic() < deadline:
+                    c = polish(prob, c)
+                f = float(prob.fitness(c[None, :])[0])
+                rbest = min(rbest, f)
+                if f < best_f:
+                    best_z, best_f = c, f
+            errs.append(rbest if rbest < prob.penalty_base else float("inf"))
+            done += 1
             if progress is not None:
-                progress(r, restarts, min(best_f, f))
-            return time.monotonic() >= search_end or f <= f_atol
-
-        g = OPTIMIZERS[optimizer](prob.fitness, prob.lower, prob.upper, seed=s, should_stop=should_stop,
-                                  options=opts)
-        cands = [np.asarray(g.x, float)]
-        if g.population is not None and g.population_fun is not None:
-            for i in np.argsort(g.population_fun):
-                z = np.asarray(g.population[i], float)
-                if len(cands) >= n_polish:
-                    break
-                if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
-                    cands.append(z)
-        rbest = np.inf
-        for c in cands:
-            if time.monotonic() < deadline:
-                c = polish(prob, c)
-            f = float(prob.fitness(c[None, :])[0])
-            rbest = min(rbest, f)
-            if f < best_f:
-                best_z, best_f = c, f
-        errs.append(rbest if rbest < prob.penalty_base else float("inf"))
-        done += 1
-        if progress is not None:
-            progress(done, restarts, best_f)
+                progress(done, restarts, best_f)
+    except KeyboardInterrupt:  # Ctrl-C: keep the best design evaluated so far
+        interrupted = True
+        if tracker.x is not None and tracker.f < best_f:
+            best_z, best_f = tracker.x, tracker.f
     ev = evaluate_design(case, best_z)
     names = case.names
     design = {n: float(v) for n, v in zip(names, best_z)}
     d = apply_design(case, best_z[:case.n_design])
-    d["name"] = f"{d.get('name', 'mechanism')} (synthesised, seed {seed})"
+    d["name"] = (f"{d.get('name', 'mechanism')} (synthesised, seed {seed}"
+                 + (", interrupted: best so far)" if interrupted else ")"))
     ok = bool(ev.feasible)
     N = case.n_targets
     return MechanismSynthesisResult(
@@ -610,4 +643,4 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         achieved=ev.achieved if ok else np.full((N, 2), np.nan),
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,
-        stopped_by_time_limit=stopped, reason=ev.reason)
+        stopped_by_time_limit=stopped, reason=ev.reason, interrupted=interrupted)

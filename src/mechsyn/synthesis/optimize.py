@@ -33,13 +33,13 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
+from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design
 
 
@@ -126,11 +126,14 @@ def register_optimizer(name: str, fn: OptimizerFn) -> None:
 
 def polish(problem: PathProblem, z: np.ndarray, max_nfev: int = 400) -> np.ndarray:
     """Least-squares polish of a full internal vector; returns it unchanged unless the
-    polished design is feasible and strictly better (feasibility first)."""
+    polished design is feasible and strictly better (feasibility first). The finite
+    differences of each Jacobian are one batch evaluation where the problem offers it
+    (:meth:`PathProblem.residual_jacobian`), else SciPy's ``2-point`` scheme."""
     z = np.clip(np.asarray(z, float), problem.lower, problem.upper)
     f0 = problem.fitness(z[None, :])[0]
     try:
-        res = least_squares(problem.residuals, z, bounds=(problem.lower, problem.upper), x_scale="jac",
+        res = least_squares(problem.residuals, z, jac=getattr(problem, "residual_jacobian", "2-point"),
+                            bounds=(problem.lower, problem.upper), x_scale="jac",
                             method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=max_nfev)
     except (ValueError, np.linalg.LinAlgError):
         return z
@@ -152,12 +155,15 @@ class RestartResult:
 
 
 def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options: dict[str, Any],
-                 deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0) -> RestartResult:
+                 deadline: float, n_polish: int, report=None, polish_reserve: float = 0.0,
+                 target_error: float | None = None,
+                 tracker: BestSoFar | None = None) -> RestartResult:
     t0 = time.monotonic()
     problem = PathProblem(case)
     m = problem.reduced_dim
     lower, upper = problem.lower[:m], problem.upper[:m]
     fn = OPTIMIZERS[optimizer]
+    fitness = problem.reduced_fitness if tracker is None else tracker.wrap(problem.reduced_fitness)
 
     # leave a little of the budget for polishing, so the whole run keeps its time limit
     search_deadline = deadline - polish_reserve
@@ -165,9 +171,11 @@ def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options:
     def should_stop(best):
         if report is not None:
             report(index, best)
+        if target_error is not None and best <= target_error:
+            return True  # feasible (infeasible scores exceed every error) and good enough
         return time.time() >= search_deadline
 
-    g = fn(problem.reduced_fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
+    g = fn(fitness, lower, upper, seed=seed, should_stop=should_stop, options=options)
     nfev = g.nfev
     # candidates to polish: the best, then the best distinct population members
     cands = [np.asarray(g.x, float)]
@@ -194,33 +202,6 @@ def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options:
                          seconds=time.monotonic() - t0)
 
 
-def _restart_job(args):
-    return _run_restart(*args)
-
-
-def _run_on_dask(scheduler, jobs) -> list[RestartResult]:
-    """Run restart jobs on an existing Dask cluster (optional extra ``mechsyn[dask]``)."""
-    try:
-        from dask.distributed import Client
-    except ImportError:
-        from mechsyn.errors import MechsynInputError
-
-        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
-                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
-    if isinstance(scheduler, Client):
-        futures = scheduler.map(_restart_job, jobs, pure=False)
-        return scheduler.gather(futures)
-    try:
-        client = Client(scheduler, timeout=10)
-    except (OSError, TimeoutError) as exc:
-        from mechsyn.errors import MechsynInputError
-
-        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
-                                hint="give the address printed by dask-scheduler, e.g. tcp://host:8786") from None
-    with client:
-        return client.gather(client.map(_restart_job, jobs, pure=False))
-
-
 @dataclass
 class PathSynthesisResult:
     """Outcome of :func:`synthesize_path` (serialisable; ``to_dict`` gives the CLI JSON)."""
@@ -241,11 +222,25 @@ class PathSynthesisResult:
     theta2: np.ndarray
     restart_errors: list[float] = field(default_factory=list)
     best_known: float | None = None
+    interrupted: bool = False
+    target_error: float | None = None
+    worst_transmission_angle_deg: float | None = None
+    fold_distance_deg: float | None = None
+    transmission_angle_min_deg: float | None = None
+    fold_margin_deg: float | None = None
+
+    @property
+    def target_reached(self) -> bool:
+        return self.target_error is not None and self.feasible and self.error <= self.target_error
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "case": self.case_id, "error": self.error, "design": self.design,
+            "case": self.case_id, "interrupted": self.interrupted, "error": self.error, "design": self.design,
             "assembled_at_all_targets": self.assembled_at_all_targets, "feasible": self.feasible,
+            "worst_transmission_angle_deg": self.worst_transmission_angle_deg,
+            "transmission_angle_min_deg": self.transmission_angle_min_deg,
+            "fold_distance_deg": self.fold_distance_deg, "fold_margin_deg": self.fold_margin_deg,
+            "target_error": self.target_error, "target_reached": self.target_reached,
             "seconds": self.seconds, "seed": self.seed, "restarts": self.restarts, "nfev": self.nfev,
             "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
             "ratio_to_best_known": (self.error / self.best_known) if self.best_known else None,
@@ -259,19 +254,37 @@ def restart_seeds(seed: int, restarts: int) -> list[int]:
     return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(restarts)]
 
 
+def default_target_error(case: PathCase) -> float | None:
+    """The error at which a run may stop: the case's best known error plus 1 % (so
+    reaching the published best ends the run), ``None`` when the case has none."""
+    return None if not case.best_known else 1.01 * float(case.best_known)
+
+
 def synthesize_path(
     case: PathCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
     optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
-    progress: Callable[[int, int, float], None] | None = None, scheduler: str | None = None,
+    progress: Callable[[int, int, float], None] | None = None, scheduler: Any = None,
+    target_error: float | None = None,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
 
     ``progress(restarts_done, restarts, best_error_so_far)`` is called as the run goes.
     With ``workers > 1`` restarts run in that many local processes, with ``scheduler``
-    (a ``dask.distributed`` scheduler address, or a ``Client``) on a Dask cluster; the
-    result equals the single-process one (same seeds, same deterministic choice of the
-    best), unless the time limit cuts runs short.
+    (a ``dask.distributed`` scheduler address, or a ``Client``) on a Dask cluster
+    (:func:`mechsyn.parallel.run_tasks`); the result equals the single-process one (same
+    seeds, same deterministic choice of the best), unless the time limit cuts runs short.
+
+    ``target_error`` (e.g. :func:`default_target_error`): a restart's global search ends
+    as soon as its best feasible error is at most this, and the run ends after the first
+    restart (in seed order) whose result reaches it.
+
+    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``progress``) ends the search
+    and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
+    with workers, the restarts finished so far); it propagates only when nothing was
+    evaluated yet.
     """
+    from mechsyn.parallel import run_tasks
+
     if optimizer not in OPTIMIZERS:
         from mechsyn.errors import MechsynInputError
 
@@ -282,38 +295,47 @@ def synthesize_path(
     deadline = t0 + time_limit
     reserve = min(4.0, 0.07 * time_limit)
     seeds = restart_seeds(seed, restarts)
-    results: list[RestartResult] = []
     best = [np.inf]
     problem = PathProblem(case)
 
     def note(done, f):
-        if problem_feasible_score(f):
+        if f < problem.penalty_base:  # feasible score
             best[0] = min(best[0], f)
         if progress is not None:
             progress(done, restarts, best[0])
 
-    def problem_feasible_score(f):
-        return f < problem.penalty_base
+    local = workers <= 1 and scheduler is None
+    done = [0]
 
-    if workers <= 1 and scheduler is None:
-        for i, s in enumerate(seeds):
-            if results and time.time() >= deadline - reserve:
-                break  # too little time left for a useful restart
-            r = _run_restart(case, i, s, optimizer, options, deadline, n_polish,
-                             report=lambda idx, f, done=len(results): note(done, f), polish_reserve=reserve)
-            results.append(r)
-            note(len(results), r.fitness)
-    elif scheduler is not None:
-        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
-        for r in _run_on_dask(scheduler, jobs):
-            results.append(r)
-            note(len(results), r.fitness)
-    else:
-        jobs = [(case, i, s, optimizer, options, deadline, n_polish, None, reserve) for i, s in enumerate(seeds)]
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            for r in pool.map(_restart_job, jobs):
-                results.append(r)
-                note(len(results), r.fitness)
+    def report(index, f):  # within a restart: only where it runs in this process
+        note(done[0], f)
+
+    results: list[RestartResult] = []
+
+    def finished(count, total, r):
+        done[0] = count
+        results.append(r)
+        note(count, r.fitness)
+
+    # in this process each restart records its best candidate, kept if Ctrl-C cuts it short
+    trackers = [BestSoFar() if local else None for _ in seeds]
+    jobs = [(case, i, s, optimizer, options, deadline, n_polish, report if local else None,
+             reserve, target_error, trackers[i]) for i, s in enumerate(seeds)]
+    interrupted = False
+    try:
+        run_tasks(_run_restart, jobs, workers=workers, scheduler=scheduler,
+                  progress=finished, deadline=deadline - reserve,
+                  stop=None if target_error is None else (lambda i, r: r.fitness <= target_error))
+    except KeyboardInterrupt:
+        interrupted = True
+        have = {r.index for r in results}
+        for i, t in enumerate(trackers):
+            if t is not None and t.x is not None and i not in have:
+                results.append(RestartResult(index=i, seed=seeds[i], z=problem.expand(t.x[None, :])[0],
+                                             fitness=t.f, nfev=0, seconds=0.0))
+                break
+        if not results:
+            raise
     results.sort(key=lambda r: r.index)
     win = min(results, key=lambda r: (r.fitness, r.index))
     design = problem.design(win.z)
@@ -325,5 +347,9 @@ def synthesize_path(
         optimizer=optimizer, branch=case.branch, targets=case.targets, path=check["path"],
         theta2=check["theta2"],
         restart_errors=[r.fitness if r.fitness < problem.penalty_base else float("inf") for r in results],
-        best_known=case.best_known,
+        best_known=case.best_known, interrupted=interrupted, target_error=target_error,
+        worst_transmission_angle_deg=check["worst_transmission_angle_deg"],
+        fold_distance_deg=check["fold_distance_deg"],
+        transmission_angle_min_deg=case.transmission_angle_min_deg,
+        fold_margin_deg=case.fold_margin_deg if case.grashof else None,
     )

@@ -18,10 +18,17 @@ Constraints (all must hold; see :meth:`PathProblem.evaluate`):
   crank motion from one target to the next (so it cannot jump branch or pass a dead
   position between targets; this is the order/branch-defect check of path generation);
 * Grashof ``s + l <= p + q`` when the case lists a ``Grashof`` constraint (or
-  ``options.grashof`` is true; ``"crank-rocker"`` also asks the crank to be shortest);
+  ``options.grashof`` is true; ``"crank-rocker"`` also asks the crank to be shortest),
+  with a margin: at the crank angles where the four pivots can line up (``theta2 = 0``
+  and ``pi``, where the crank reaches them) the transmission angle must stay at least
+  ``options.fold_margin_deg`` (default 5 deg) away from 0 and 180 deg. At
+  ``s + l = p + q`` the linkage folds flat there once per turn (a change point, where
+  it may leave its branch); Grashof alone lets such designs through;
+* a minimum transmission angle ``options.transmission_angle_min_deg`` (default 20 deg,
+  0 to drop it) over the whole motion from the first target to the last (the angle
+  ``mu`` between coupler and rocker must stay within ``[min, 180 - min]``);
 * input angles cyclically ordered (counter-clockwise, at most one turn) for free timing;
-* optional ``options.transmission_angle_min_deg`` (along the motion) and
-  ``options.link_ratio_max`` (longest / shortest of ``r1..r4``);
+* optional ``options.link_ratio_max`` (longest / shortest of ``r1..r4``);
 * variable bounds.
 
 Feasibility first: an infeasible design scores ``U + violation`` where ``U`` is an upper
@@ -31,7 +38,6 @@ ever rank better than a feasible one (Deb's rule as a penalty).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -52,6 +58,8 @@ LINKAGE_NAMES = ("x0", "y0", "theta0", "r1", "r2", "r3", "r4", "rcx", "rcy")
 LENGTHS = ("r1", "r2", "r3", "r4")
 TIMING_TYPES = ("prescribed", "prescribed_increment", "free")
 _TOL = 1e-9  # rad: allowed overlap of the first and last crank angle (free timing)
+TRANSMISSION_ANGLE_MIN_DEG = 20.0  # default margin of force transmission over the motion
+FOLD_MARGIN_DEG = 5.0  # default distance of a Grashof design from folding flat
 FEASIBILITY_TOL = 1e-12  # total violation treated as numerically zero
 
 
@@ -75,7 +83,8 @@ class PathCase:
     branch: int = -1
     grashof: bool | str = False
     order: str = "ccw"
-    transmission_angle_min_deg: float | None = None
+    transmission_angle_min_deg: float | None = TRANSMISSION_ANGLE_MIN_DEG
+    fold_margin_deg: float = FOLD_MARGIN_DEG
     link_ratio_max: float | None = None
     title: str = ""
     published: tuple[dict, ...] = ()
@@ -98,12 +107,11 @@ class PathCase:
 
         if not isinstance(data, dict):
             raise bad("a case must be a JSON object", "(top level)")
-        try:
-            targets = np.asarray(data["targets"], dtype=float)
-        except KeyError:
-            raise bad("missing", "targets", "give a list of [x, y] points") from None
-        except (TypeError, ValueError):
-            raise bad("must be a list of [x, y] numbers", "targets") from None
+        from mechsyn.io.checks import numbers
+
+        if "targets" not in data:
+            raise bad("missing", "targets", "give a list of [x, y] points")
+        targets = numbers(data["targets"], source, "targets")
         if targets.ndim != 2 or targets.shape[1] != 2 or len(targets) < 1:
             raise bad(f"must be a list of [x, y] points, got shape {targets.shape}", "targets")
         if not np.all(np.isfinite(targets)):
@@ -138,10 +146,9 @@ class PathCase:
         for k, v in fixed_raw.items():
             if k not in LINKAGE_NAMES:
                 raise bad(f"unknown design name {k!r}", f"fixed.{k}", "one of " + ", ".join(LINKAGE_NAMES))
-            try:
-                fixed[k] = float(v)
-            except (TypeError, ValueError):
-                raise bad("must be a number", f"fixed.{k}") from None
+            fixed[k] = float(numbers(v, source, f"fixed.{k}").reshape(-1)[0]) if np.ndim(v) == 0 else None
+            if fixed[k] is None:
+                raise bad("must be a number", f"fixed.{k}")
         allowed = set(LINKAGE_NAMES)
         if ttype == "free":
             allowed |= {f"theta2_{i + 1}" for i in range(n)}
@@ -149,10 +156,10 @@ class PathCase:
             allowed.add("theta2_1")
         variables = []
         for i, v in enumerate(data.get("variables") or []):
-            try:
-                name, lo, hi = v["name"], float(v["lower"]), float(v["upper"])
-            except (KeyError, TypeError, ValueError):
-                raise bad("needs name, lower and upper", f"variables[{i}]") from None
+            if not isinstance(v, dict) or not {"name", "lower", "upper"} <= set(v):
+                raise bad("needs name, lower and upper", f"variables[{i}]")
+            name = v["name"]
+            lo, hi = (float(b) for b in numbers([v["lower"], v["upper"]], source, f"variables[{i}]"))
             if name not in allowed:
                 raise bad(f"unknown or unusable variable {name!r} for timing {ttype!r}", f"variables[{i}].name")
             if name in fixed:
@@ -188,12 +195,22 @@ class PathCase:
         order = options.get("order", "ccw")
         if order not in ("ccw", "cw"):
             raise bad("must be \"ccw\" or \"cw\"", "options.order")
+        margins = {}
+        for key, default in (("transmission_angle_min_deg", TRANSMISSION_ANGLE_MIN_DEG),
+                             ("fold_margin_deg", FOLD_MARGIN_DEG)):
+            value = options.get(key, default)
+            if value is None and key == "transmission_angle_min_deg":
+                value = 0.0
+            if not isinstance(value, (int, float)) or not 0.0 <= float(value) < 90.0:
+                raise bad("must be an angle in degrees in [0, 90)", f"options.{key}")
+            margins[key] = float(value)
         best = data.get("best_known", {})
         return cls(
             id=str(data.get("id", "case")), title=str(data.get("title", "")), targets=targets,
             timing=ttype, theta2=theta2, fixed=fixed, variables=tuple(variables), branch=int(branch),
             grashof=grashof, order=order,
-            transmission_angle_min_deg=options.get("transmission_angle_min_deg"),
+            transmission_angle_min_deg=margins["transmission_angle_min_deg"],
+            fold_margin_deg=margins["fold_margin_deg"],
             link_ratio_max=options.get("link_ratio_max"),
             published=tuple(data.get("published_solutions") or ()),
             best_known=best.get("value") if isinstance(best, dict) else None, raw=data,
@@ -202,13 +219,10 @@ class PathCase:
 
 def load_cases(path: str | Path) -> list[PathCase]:
     """Load one case object, or every case of a ``{"cases": [...]}`` collection."""
+    from mechsyn.io.files import read_data
+
     path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise MechsynInputError("file not found", source=str(path)) from None
-    except json.JSONDecodeError as exc:
-        raise MechsynInputError(f"invalid JSON: {exc.msg}", source=str(path), line=exc.lineno) from None
+    data, _ = read_data(path, "case file", fmt="json")
     if isinstance(data, dict) and "cases" in data:
         items = data["cases"]
         return [PathCase.from_dict(c, source=f"{path}#cases[{i}]") for i, c in enumerate(items)]
@@ -438,15 +452,14 @@ class PathProblem:
         if case.timing == "free":
             m = len(self.linkage_vars)
             viol += np.maximum(0.0, np.sum(z[:, m + 1:], axis=1) - TWO_PI - _TOL)
-        if case.transmission_angle_min_deg is not None and th.shape[1] >= 1:
-            # cos(mu) = (r3^2 + r4^2 - r1^2 - r2^2 + 2 r1 r2 cos t2) / (2 r3 r4): monotone in cos t2
+        cos_mu_motion, cos_mu_fold = _cos_transmission(r1[:, 0], r2[:, 0], r3[:, 0], r4[:, 0],
+                                                       cmin, cmax, c_lo, c_hi)
+        if case.transmission_angle_min_deg:
             k = np.cos(np.radians(case.transmission_angle_min_deg))
-            def cos_mu(ct):
-                return (r3[:, 0] ** 2 + r4[:, 0] ** 2 - r1[:, 0] ** 2 - r2[:, 0] ** 2
-                        + 2 * r1[:, 0] * r2[:, 0] * ct) / (2 * r3[:, 0] * r4[:, 0])
-            lo_mu = cos_mu(np.min(cmin, axis=1) if cmin.ndim > 1 else cmin)
-            hi_mu = cos_mu(np.max(cmax, axis=1) if cmax.ndim > 1 else cmax)
-            viol += np.nan_to_num(np.maximum(0.0, np.abs(lo_mu) - k) + np.maximum(0.0, np.abs(hi_mu) - k), nan=1.0)
+            viol += np.nan_to_num(np.maximum(0.0, cos_mu_motion - k), nan=1.0)
+        if case.grashof and case.fold_margin_deg:
+            k = np.cos(np.radians(case.fold_margin_deg))
+            viol += np.nan_to_num(np.maximum(0.0, cos_mu_fold - k), nan=1.0)
         if case.link_ratio_max is not None:
             ratio = np.max(rmat, axis=1) / np.maximum(np.min(rmat, axis=1), 1e-300)
             viol += np.maximum(0.0, ratio - case.link_ratio_max) / case.link_ratio_max
@@ -478,31 +491,110 @@ class PathProblem:
         residual proportional to the violation is appended, so a polisher is pushed back to
         feasible designs (its result is accepted only if feasible).
         """
-        z = np.asarray(z, float)[None, :]
+        return self.residuals_batch(np.asarray(z, float)[None, :])[0]
+
+    def residuals_batch(self, Z: np.ndarray) -> np.ndarray:
+        """:meth:`residuals` of many designs ``Z`` (P, dim) at once: shape (P, 2n + 1)."""
+        Z = np.atleast_2d(np.asarray(Z, float))
         case = self.case
-        vals, th, _ = self.unpack(z)
+        vals, th, _ = self.unpack(Z)
         r1, r2, r3, r4 = (vals[k][:, None] for k in LENGTHS)
         ax, ay = r2 * np.cos(th), r2 * np.sin(th)
         dx, dy = r1 - ax, -ay
         d = np.hypot(dx, dy)
-        ca = np.clip((r3 * r3 + d * d - r4 * r4) / (2.0 * r3 * d), -1.0, 1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ca = np.clip((r3 * r3 + d * d - r4 * r4) / (2.0 * r3 * d), -1.0, 1.0)
         t3 = np.arctan2(dy, dx) - case.branch * np.arccos(ca)
         cx = ax + vals["rcx"][:, None] * np.cos(t3) - vals["rcy"][:, None] * np.sin(t3)
         cy = ay + vals["rcx"][:, None] * np.sin(t3) + vals["rcy"][:, None] * np.cos(t3)
         t0 = vals["theta0"][:, None]
         gx = np.cos(t0) * cx - np.sin(t0) * cy + vals["x0"][:, None]
         gy = np.sin(t0) * cx + np.cos(t0) * cy + vals["y0"][:, None]
-        res = np.concatenate([(gx - case.targets[:, 0]).ravel(), (gy - case.targets[:, 1]).ravel()])
-        viol = self.evaluate(z).violation[0]
-        return np.append(res, 1e3 * np.sqrt(self.penalty_base) * viol)
+        viol = self.evaluate(Z).violation
+        return np.concatenate([gx - case.targets[:, 0], gy - case.targets[:, 1],
+                               1e3 * np.sqrt(self.penalty_base) * viol[:, None]], axis=1)
+
+    def residual_jacobian(self, z: np.ndarray) -> np.ndarray:
+        """Forward-difference Jacobian of :meth:`residuals` at ``z``, (2n + 1, dim): all
+        ``dim + 1`` designs in one :meth:`residuals_batch` call. Steps as SciPy's
+        ``2-point`` scheme (``sqrt(eps) max(1, |z_j|)``), taken backwards at an upper
+        bound."""
+        z = np.asarray(z, float)
+        h = np.sqrt(np.finfo(float).eps) * np.maximum(1.0, np.abs(z))
+        h = np.where(z + h > self.upper, -h, h)
+        Z = np.vstack([z, z + np.diag(h)])
+        R = self.residuals_batch(Z)
+        return ((R[1:] - R[0]) / h[:, None]).T
+
+
+def _cos_transmission(r1, r2, r3, r4, cmin, cmax, c_lo, c_hi) -> tuple[np.ndarray, np.ndarray]:
+    """Largest ``|cos mu|`` over the motion and at the crank's fold positions, ``(P,)`` each.
+
+    ``cos mu = (r3^2 + r4^2 - r1^2 - r2^2 + 2 r1 r2 cos theta2) / (2 r3 r4)`` is monotone
+    in ``cos theta2``, so over the motion (``cos theta2`` in ``[cmin, cmax]``, arrays
+    ``(P, k)`` of the arcs) its extremes are at the interval's ends. The fold positions
+    are ``theta2 = 0`` and ``pi`` (all four pivots on one line), where the crank reaches
+    them (``cos theta2`` within the assembly range ``[c_lo, c_hi]``); 0 when neither.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        def cos_mu(ct):
+            return (r3 ** 2 + r4 ** 2 - r1 ** 2 - r2 ** 2 + 2 * r1 * r2 * ct) / (2 * r3 * r4)
+
+        lo = np.min(cmin, axis=1) if np.ndim(cmin) > 1 else cmin
+        hi = np.max(cmax, axis=1) if np.ndim(cmax) > 1 else cmax
+        motion = np.maximum(np.abs(cos_mu(lo)), np.abs(cos_mu(hi)))
+        fold = np.zeros_like(motion)
+        for ct in (1.0, -1.0):
+            reach = (c_lo <= ct + 1e-12) & (ct - 1e-12 <= c_hi)
+            fold = np.where(reach, np.maximum(fold, np.abs(cos_mu(ct))), fold)
+    return motion, fold
+
+
+def transmission_angles(case: PathCase, design: dict[str, Any]) -> dict[str, float | None]:
+    """Worst transmission angle of a design, in degrees (``min(mu, 180 - mu)``).
+
+    ``worst_transmission_angle_deg``: over the motion from the first target to the last;
+    ``fold_distance_deg``: at the crank angles 0 and pi where the linkage would fold flat
+    (0 at ``s + l = p + q``; ``None`` when the crank reaches neither).
+
+    Examples
+    --------
+    A change-point four-bar (1 + 3 = 2 + 2) folds flat at theta2 = 0:
+
+    >>> case = PathCase.from_dict({"targets": [[0, 1], [0, 2]], "timing": {"type":
+    ...     "prescribed", "theta2": [1.0, 2.0]}, "variables": [{"name": k, "lower": 0,
+    ...     "upper": 5} for k in ("r1", "r2", "r3", "r4", "rcx", "rcy")]})
+    >>> out = transmission_angles(case, {"r1": 3, "r2": 1, "r3": 2, "r4": 2, "rcx": 0, "rcy": 0})
+    >>> round(out["fold_distance_deg"], 9), out["worst_transmission_angle_deg"] > 20
+    (0.0, True)
+    """
+    prob = PathProblem(case)
+    z = prob.internal(design)[None, :]
+    vals, th, sweeps = prob.unpack(z)
+    r1, r2, r3, r4 = (vals[k] for k in LENGTHS)
+    c = np.cos(th)
+    if th.shape[1] > 1:
+        cmin, cmax = arc_cos_extremes(th[:, :-1], sweeps)
+        cmin, cmax = np.minimum(cmin, c.min(axis=1, keepdims=True)), np.maximum(cmax, c.max(axis=1, keepdims=True))
+    else:
+        cmin, cmax = c, c
+    c_lo, c_hi = crank_cos_range(r1, r2, r3, r4)
+    motion, fold = _cos_transmission(r1, r2, r3, r4, cmin, cmax, c_lo, c_hi)
+    reach = any(bool((c_lo[0] <= ct + 1e-12) & (ct - 1e-12 <= c_hi[0])) for ct in (1.0, -1.0))
+
+    def deg(cm):
+        return float(np.degrees(np.arccos(np.clip(cm, 0.0, 1.0)))) if np.isfinite(cm) else float("nan")
+
+    return {"worst_transmission_angle_deg": deg(motion[0]),
+            "fold_distance_deg": deg(fold[0]) if reach else None}
 
 
 def evaluate_design(case: PathCase, design: dict[str, Any]) -> dict[str, Any]:
     """Recompute a design's objective and constraint state, by the case's conventions.
 
     ``design`` holds the case's variable names (``theta2`` may be given as a list). Returns
-    ``error``, ``feasible``, ``violation``, ``assembled_at_all_targets`` and the coupler
-    points ``path``.
+    ``error``, ``feasible``, ``violation``, ``assembled_at_all_targets``, the coupler
+    points ``path`` and the worst transmission angles (:func:`transmission_angles`).
     """
     prob = PathProblem(case)
     z = prob.internal(design)
@@ -514,5 +606,5 @@ def evaluate_design(case: PathCase, design: dict[str, Any]) -> dict[str, Any]:
     return {
         "error": float(ev.error[0]), "feasible": bool(ev.feasible[0]), "violation": float(ev.violation[0]),
         "assembled_at_all_targets": bool(ev.assembled_at_all_targets[0]), "path": pose.C[0],
-        "theta2": th[0],
+        "theta2": th[0], **transmission_angles(case, design),
     }

@@ -1,0 +1,191 @@
+"""One way to run a long job's independent pieces: here, in local processes, or on Dask.
+
+Every long job of mechsyn (``atlas``, ``capability`` maps, ``synth path``, ``synth
+mechanism``, and for ``synth curve`` and the curve-database build) is cut into
+independent *tasks* -- calls ``fn(*args)`` of a top-level (picklable) function -- and run
+by :func:`run_tasks`:
+
+* ``workers=1, scheduler=None``: in this process, one after the other;
+* ``workers=N``: in N local worker processes (``concurrent.futures``; no Dask needed);
+* ``scheduler="tcp://host:8786"`` (or a ``dask.distributed.Client``): on a Dask cluster
+  (the optional extra ``mechsyn[dask]``; ``dask`` is imported only then).
+
+The contract, the same on every back end:
+
+* **Identical results.** The results come back in task order, whatever order the
+  workers finish in; a task must depend only on its arguments (seeds travel in them),
+  so the answer equals the single-process run.
+* **Progress.** ``progress(done, total, result)`` is called in the calling process each
+  time a task finishes, wherever it ran (a CLI passes its progress bar's advance).
+* **Deadline.** ``deadline`` (a ``time.time()`` value): tasks not started by then are not
+  started (their result is ``None``); running tasks finish, so a task that can run long
+  takes the deadline among its arguments and honours it itself.
+* **Early stop.** ``stop(index, result)`` returning true (e.g. the target error is
+  reached) cancels the tasks after ``index``; the tasks before it still run, so the
+  kept results are the same as in one process, where the run ends at that task.
+* **Ctrl-C.** ``KeyboardInterrupt`` cancels what has not run (local processes are shut
+  down, cluster futures cancelled) and is raised again.
+
+Examples
+--------
+>>> from operator import mul
+>>> run_tasks(mul, [(2, 3), (4, 5), (6, 7)])
+[6, 20, 42]
+>>> run_tasks(mul, [(2, 3), (4, 5), (6, 7)], stop=lambda i, r: r >= 20)
+[6, 20, None]
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from mechsyn.errors import MechsynInputError
+
+ProgressFn = Callable[[int, int, Any], None]
+StopFn = Callable[[int, Any], bool]
+
+__all__ = ["run_tasks", "dask_client", "check_parallel_options"]
+
+
+def check_parallel_options(workers: int, scheduler: Any) -> None:
+    """The CLI's check of ``--workers`` / ``--scheduler`` (one clear line on bad input)."""
+    if workers < 1:
+        raise MechsynInputError("must be at least 1", source="--workers")
+    if scheduler is not None and workers > 1:
+        raise MechsynInputError("give --workers or --scheduler, not both", source="--workers",
+                                hint="the cluster's own workers run the tasks with --scheduler")
+
+
+def dask_client(scheduler: Any):
+    """A ``dask.distributed.Client`` for ``scheduler`` (an address or a Client), and
+    whether the caller owns it (must close it). Clear errors without Dask or cluster."""
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
+                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+    if isinstance(scheduler, Client):
+        return scheduler, False
+    try:
+        return Client(scheduler, timeout=10), True
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+                                hint="give the address printed by dask-scheduler, "
+                                     "e.g. tcp://127.0.0.1:8786") from None
+
+
+def run_tasks(fn: Callable[..., Any], tasks: Sequence[tuple], *, workers: int = 1,
+              scheduler: Any = None, progress: ProgressFn | None = None,
+              deadline: float | None = None, stop: StopFn | None = None) -> list[Any]:
+    """Run ``fn(*args)`` for every ``args`` of ``tasks``; results in task order.
+
+    See the module docstring for the back ends (``workers``, ``scheduler``) and the
+    contract (identical results, ``progress``, ``deadline``, ``stop``, Ctrl-C). Tasks
+    that were not run (deadline, early stop) give ``None``.
+    """
+    tasks = list(tasks)
+    results: list[Any] = [None] * len(tasks)
+    if not tasks:
+        return results
+    if scheduler is not None:
+        return _run_dask(fn, tasks, results, scheduler, progress, deadline, stop)
+    if workers <= 1 or len(tasks) == 1:
+        for i, args in enumerate(tasks):
+            if deadline is not None and time.time() >= deadline and i > 0:
+                break
+            results[i] = fn(*args)
+            if progress is not None:
+                progress(i + 1, len(tasks), results[i])
+            if stop is not None and stop(i, results[i]):
+                break
+        return results
+    return _run_pool(fn, tasks, results, workers, progress, deadline, stop)
+
+
+class _Book:
+    """Bookkeeping shared by the pool and Dask loops: which tasks still count."""
+
+    def __init__(self, n: int, progress: ProgressFn | None, stop: StopFn | None):
+        self.n, self.progress, self.stop = n, progress, stop
+        self.limit = n  # tasks at index >= limit are cancelled (early stop)
+        self.done = 0
+
+    def finished(self, i: int, result: Any, results: list[Any]) -> None:
+        if i >= self.limit:
+            return
+        results[i] = result
+        self.done += 1
+        if self.progress is not None:
+            self.progress(self.done, self.n, result)
+        if self.stop is not None and self.stop(i, result):
+            self.limit = i + 1
+
+
+def _run_pool(fn, tasks, results, workers, progress, deadline, stop) -> list[Any]:
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    book = _Book(len(tasks), progress, stop)
+    pool = ProcessPoolExecutor(max_workers=workers)
+    try:
+        queue = list(range(len(tasks)))
+        running: dict[Any, int] = {}
+        while queue or running:
+            # keep the pool just full, so a deadline or stop leaves later tasks unstarted
+            while queue and len(running) < workers:
+                i = queue.pop(0)
+                if i >= book.limit or (deadline is not None and time.time() >= deadline
+                                       and i > 0):
+                    continue
+                running[pool.submit(fn, *tasks[i])] = i
+            if not running:
+                break
+            finished, _ = wait(list(running), return_when=FIRST_COMPLETED)
+            for fut in sorted(finished, key=running.get):
+                book.finished(running.pop(fut), fut.result(), results)
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+    return results
+
+
+_SKIPPED = "mechsyn.parallel: not started before the deadline"
+
+
+def _guarded(fn, deadline, first, *args):
+    """Run ``fn(*args)`` unless the deadline has passed (the first task always runs)."""
+    if deadline is not None and not first and time.time() >= deadline:
+        return _SKIPPED
+    return fn(*args)
+
+
+def _run_dask(fn, tasks, results, scheduler, progress, deadline, stop) -> list[Any]:
+    client, owned = dask_client(scheduler)
+    from dask.distributed import as_completed
+
+    book = _Book(len(tasks), progress, stop)
+    futures: list[Any] = []
+    try:
+        futures = [client.submit(_guarded, fn, deadline, i == 0, *args, pure=False,
+                                 priority=-i) for i, args in enumerate(tasks)]
+        index = {f.key: i for i, f in enumerate(futures)}
+        for fut in as_completed(futures):
+            i = index[fut.key]
+            if i >= book.limit or fut.cancelled():
+                continue
+            result = fut.result()
+            if isinstance(result, str) and result == _SKIPPED:
+                continue
+            book.finished(i, result, results)
+            if book.limit < len(tasks):
+                client.cancel([f for f in futures[book.limit:] if not f.done()])
+    except BaseException:
+        if futures:
+            client.cancel(futures)
+        raise
+    finally:
+        if owned:
+            client.close()
+    return results

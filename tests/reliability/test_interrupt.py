@@ -1,0 +1,156 @@
+"""Ctrl-C keeps the best result so far (issue 18, item 1).
+
+In-process: KeyboardInterrupt raised from a progress callback or an optimiser; one real
+SIGINT sent to a ``python -m mechsyn`` subprocess.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from mechsyn.interrupt import INTERRUPT_EXIT_CODE, BestSoFar
+from mechsyn.synthesis.optimize import OPTIMIZERS, synthesize_path
+from mechsyn.synthesis.path import evaluate_design, load_cases
+
+ROOT = Path(__file__).resolve().parents[2]
+CASES = ROOT.parent / "shared" / "spec" / "data" / "synthesis_cases_public.json"
+SLIDER_CASE = ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml"
+FINGER_CASE = ROOT / "examples" / "fingers" / "finger_design_case.yaml"
+
+
+def _interrupt_after(n: int):
+    calls = [0]
+
+    def progress(*args):
+        calls[0] += 1
+        if calls[0] >= n:
+            raise KeyboardInterrupt
+
+    return progress
+
+
+def test_best_so_far_keeps_lowest_finite_row():
+    best = BestSoFar()
+    best.offer(np.array([[1.0], [2.0]]), np.array([np.nan, 3.0]))
+    best.offer(np.array([[5.0]]), np.array([np.inf]))
+    assert best.x.tolist() == [2.0] and best.f == 3.0
+
+
+def test_path_search_interrupted_by_callback_returns_best_so_far():
+    case = load_cases(CASES)[0]
+    res = synthesize_path(case, seed=0, restarts=3, time_limit=60, options={"maxiter": 300},
+                          progress=_interrupt_after(20))
+    assert res.interrupted and res.restarts == 1
+    assert res.feasible and np.isfinite(res.error)
+    # the reported error belongs to the reported design
+    assert evaluate_design(case, res.design)["error"] == pytest.approx(res.error, rel=1e-12)
+    assert res.to_dict()["interrupted"] is True
+
+
+def test_path_search_interrupted_before_any_evaluation_propagates(monkeypatch):
+    def optimizer(fitness, lower, upper, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setitem(OPTIMIZERS, "_interrupt_at_once", optimizer)
+    with pytest.raises(KeyboardInterrupt):
+        synthesize_path(load_cases(CASES)[0], seed=0, restarts=1, time_limit=60,
+                        optimizer="_interrupt_at_once")
+
+
+def test_mechanism_search_interrupted_by_callback_returns_best_so_far():
+    from mechsyn.synthesis.general import evaluate_design as evaluate_mechanism
+    from mechsyn.synthesis.general import load_case, synthesize_mechanism
+
+    case = load_case(SLIDER_CASE)
+    res = synthesize_mechanism(case, seed=0, time_limit=60, restarts=2, progress=_interrupt_after(5))
+    assert res.interrupted and res.feasible
+    x = np.array([res.design[n] for n in case.names])
+    assert evaluate_mechanism(case, x).error == pytest.approx(res.error, rel=1e-9)
+    assert res.error <= res.start_error
+    assert "interrupted" in res.mechanism["name"]
+
+
+def test_finger_design_interrupted_keeps_stage1_best():
+    from mechsyn.synthesis.finger_design import design_finger, load_case
+
+    case = load_case(FINGER_CASE)
+    case.maxiter, case.popsize, case.force_maxiter = 200, 8, 4
+
+    def progress(msg):
+        if "generation 6/" in msg:
+            raise KeyboardInterrupt
+
+    res = design_finger(case, seed=1, time_limit=120, progress=progress)
+    assert res.interrupted and not res.stopped_by_time_limit
+    assert len(res.variants) == 1 and np.isfinite(res.best_variant.error_rms)
+    assert any("not searched (interrupted)" in n for n in res.notes) or len(case.combinations) == 1
+
+
+def _interrupting_optimizer(fitness, lower, upper, *, seed, should_stop, options):
+    rng = np.random.default_rng(seed)
+    for _ in range(5):
+        fitness(rng.uniform(lower, upper, size=(64, len(lower))))
+    raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize("command", ["path", "mechanism"])
+def test_cli_interrupted_search_writes_best_and_exits_130(command, run_cli, tmp_path, monkeypatch):
+    monkeypatch.setitem(OPTIMIZERS, "interrupting", _interrupting_optimizer)
+    out = tmp_path / "best.yaml"
+    args = (["synth", "path", CASES, "--case", "P2_kk5_timing"] if command == "path"
+            else ["synth", "mechanism", SLIDER_CASE])
+    code, stdout, stderr = run_cli(*args, "--optimizer", "interrupting", "--out", out, "--time-limit", "30")
+    assert code == INTERRUPT_EXIT_CODE
+    assert stderr.strip().splitlines()[-1] == "interrupted"
+    assert "interrupted" in stdout
+    text = out.read_text()
+    assert "interrupted" in text.lower()
+    assert yaml.safe_load(text)["joints"]
+
+
+def test_cli_interrupted_json_says_so(cli_json, run_cli, monkeypatch):
+    monkeypatch.setitem(OPTIMIZERS, "interrupting", _interrupting_optimizer)
+    code, stdout, _ = run_cli("synth", "mechanism", SLIDER_CASE, "--optimizer", "interrupting", "--json")
+    import json
+
+    assert code == INTERRUPT_EXIT_CODE and json.loads(stdout)["interrupted"] is True
+
+
+def _sigint_subprocess(args: list[str], delay: float, cwd: Path) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    # a child of a non-interactive shell may inherit SIGINT ignored: restore the default so
+    # Python installs its KeyboardInterrupt handler, as in a terminal
+    p = subprocess.Popen([sys.executable, "-m", "mechsyn", *args], env=env, cwd=cwd, text=True,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    time.sleep(delay)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    return subprocess.CompletedProcess(p.args, p.returncode, out, err)
+
+
+@pytest.mark.slow
+def test_real_sigint_to_synth_path_keeps_best(tmp_path):
+    r = _sigint_subprocess(["synth", "path", str(CASES), "--case", "P5_ellipse10_notiming",
+                            "--time-limit", "300", "--out", "x.yaml"], delay=8.0, cwd=tmp_path)
+    assert r.returncode == INTERRUPT_EXIT_CODE, r.stderr
+    assert r.stderr.strip().splitlines()[-1] == "interrupted"
+    assert "Traceback" not in r.stderr
+    assert (tmp_path / "x.yaml").read_text().startswith("# INTERRUPTED")
+
+
+def test_real_sigint_while_loading_exits_130(tmp_path):
+    r = _sigint_subprocess(["analyze", str(ROOT / "examples" / "textbook" / "fourbar.yaml")],
+                           delay=1.0, cwd=tmp_path)
+    assert r.returncode == INTERRUPT_EXIT_CODE, r.stderr
+    assert r.stderr.strip().splitlines()[-1] == "interrupted"
+    assert "Traceback" not in r.stderr
