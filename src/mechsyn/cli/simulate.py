@@ -13,12 +13,8 @@ from rich.markup import escape
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-<<<<<<< HEAD
-from mechsyn.cli.common import (check_output_suffix, console, fmt_number, emit_json, is_stdout, one_stdout, parse_range,
-=======
-from mechsyn.cli.common import (check_animation_target, check_output_suffix, console, emit_json, is_stdout, one_stdout,
-                                parse_range,
->>>>>>> interop
+from mechsyn.cli.common import (check_animation_target, check_output_suffix, console, emit_json, fmt_number,
+                                is_stdout, one_stdout, parse_range,
                                 progress_bar, save_animation, save_plot, write_output)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
