@@ -37,6 +37,8 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
               "their mechanisms."),
     "belt": (("belt",), "Paper 001's manipulator with a belt on a pulley: synthesis, paths, speeds, "
              "accelerations, the inverse problem."),
+    "convert": (("convert",), "Convert a Pyslvs mechanism expression into a mechanism file, or back."),
+    "export": (("export",), "Link plates to cut (DXF, SVG) and a drawing of the mechanism at a pose (SVG)."),
     "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism"),
               "Synthesis: structural (groups, fingers) and dimensional (path, function, motion)."),
 }
