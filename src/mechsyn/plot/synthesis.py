@@ -92,12 +92,11 @@ def plot_motion_synthesis(P: np.ndarray, sols: list, ax: Any = None) -> Any:
     if (hi - lo).max() > 4 * span:
         centre = (plo + phi) / 2
         lo, hi = centre - 1.0 * span, centre + 1.0 * span
-        for name, q in (("O2", best.O2), ("O4", best.O4)):
-            if np.any(q < lo) or np.any(q > hi):
-                d = q - centre
-                edge = centre + d * (0.95 * span / np.abs(d).max())
-                ax.annotate(f"{name} ({q[0]:.3g}, {q[1]:.3g}) off view", edge, fontsize=8, color="0.3",
-                            ha="center")
+        off = [f"{name} ({q[0]:.4g}, {q[1]:.4g})" for name, q in (("O2", best.O2), ("O4", best.O4))
+               if np.any(q < lo) or np.any(q > hi)]
+        if off:
+            ax.text(0.02, 0.02, "ground pivots off view: " + ", ".join(off), transform=ax.transAxes,
+                    fontsize=8, color="0.25", bbox={"fc": "white", "ec": "0.7", "alpha": 0.9})
     pad = 0.3 * (hi - lo).max() + 1e-9
     if len(P) == 4:
         M, _ = center_point_curve(P, n_dir=1440)
