@@ -173,24 +173,8 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
-#: From this many joints, ``analyze`` says the size and shows the rank method's stages on stderr.
-LARGE_JOINTS = 1000
-
-
-def _analyze_reporting(mech, **options):
-    """:func:`mechsyn.structure.report.analyze`, with the size and the rank method's stages on
-    stderr for a large mechanism."""
-    if len(mech.joints) < LARGE_JOINTS:
-        return structure_report(mech, **options)
-    from mechsyn.structure.contours import cycle_rank
-
-    err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
-                      f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
-                      f"of loops (2,000 joints: a few seconds)", highlight=False)
-    with err_console.status("rank method") as status:
-        return structure_report(mech, progress=lambda stage: status.update(f"rank method: {stage}"), **options)
-
-
+    report = _analyze_reporting(load_mechanism(file), method=method, remedies=remedies,
+                                max_variants=max_variants, tol=tol, as_spatial=spatial)
     if json_out:
         emit_json(report.to_dict(), out)
     elif markdown:
