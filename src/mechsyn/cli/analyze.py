@@ -18,7 +18,7 @@ from mechsyn.structure.analysis import StructuralAnalysis
 from mechsyn.structure.compare import Comparison, RemedyCheck
 from mechsyn.structure.rank import RankAnalysis, rank_summary_lines
 from mechsyn.structure.remedies import Remedy
-from mechsyn.structure.report import StructureReport, pair_list
+from mechsyn.structure.report import CONTOUR_READING, StructureReport, formula_title, pair_list
 from mechsyn.structure.report import analyze as structure_report
 
 
