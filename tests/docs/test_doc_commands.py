@@ -6,9 +6,6 @@ runs in-process in a temporary directory (one per page, so a command may read wh
 earlier one on the page wrote) that sees the repository's ``examples/``; ``> FILE``
 redirects its output there.
 
-``mechsyn serve`` starts a server that runs until stopped: it is not run here (the web
-tests start it on loopback); every other documented command is.
-
 Commands that take more than a few seconds (synthesis runs, fine grids, the 12-link
 atlas) and those reading their output run only with ``MECHSYN_DOC_COMMANDS=all``: CI
 runs them in ``.ci/steps/doc-commands.sh``, keeping the default suite short.
@@ -58,13 +55,8 @@ def doc_commands() -> list[tuple[str, str]]:
     return out
 
 
-SERVERS = ("mechsyn serve",)
-
-
 def _params():
     for page, cmd in doc_commands():
-        if cmd.startswith(SERVERS):
-            continue
         long = any(k in cmd for k in LONG)
         if long and not RUN_ALL:
             continue
