@@ -17,7 +17,7 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import files
 from mechsyn.io.checks import check_geometry
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
@@ -162,6 +162,7 @@ def _validation_error(exc: ValidationError, data: Any, source: str, text: str | 
     )
 
 
+@input_boundary("mechanism file")
 def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = None) -> Mechanism:
     """Validate mechanism-file data and build a :class:`Mechanism`.
 
