@@ -17,8 +17,8 @@ Run from the repository root::
 2. **Designer shapes** (heart, lemniscate, D-shaped foot path, kidney, rounded
    triangle): the best candidate of ``synth curve`` for 4, 6 and 8 links, side by side
    with the best four-bar of ``synth path`` (differential evolution on 16 points of the
-   shape, free timing), the latter's whole coupler curve measured with the same
-   chamfer error. With ``--figures DIR`` one PNG per shape (used by docs/synthesis.md).
+   shape, the crank turning in 16 equal steps), the latter's whole coupler curve
+   measured with the same chamfer error. With ``--figures DIR`` one PNG per shape (used by docs/synthesis.md).
 
 The database is the local one (``$MECHSYN_CURVE_DB``) or ``--database``; eight-bar
 targets need it built with ``mechsyn curves build --links 8``. Times are wall-clock on a
@@ -116,7 +116,7 @@ def designer_shapes() -> dict[str, tuple[np.ndarray, bool]]:
 
 
 def best_fourbar_by_synth_path(points: np.ndarray, time_limit: float, seed: int = 0):
-    """The best four-bar of ``synth path`` through 16 points of the shape (free timing);
+    """The best four-bar of ``synth path`` through 16 points of the shape (the crank in 16 equal steps);
     returns its chamfer error against the whole shape and its path."""
     from mechsyn.io.load import mechanism_from_dict
     from mechsyn.kinematics import simulate
@@ -134,10 +134,15 @@ def best_fourbar_by_synth_path(points: np.ndarray, time_limit: float, seed: int 
            {"name": "theta0", "lower": 0.0, "upper": 2 * np.pi}]
     var += [{"name": r, "lower": 0.02 * diag, "upper": 3 * diag} for r in ("r1", "r2", "r3", "r4")]
     var += [{"name": r, "lower": -3 * diag, "upper": 3 * diag} for r in ("rcx", "rcy")]
-    var += [{"name": f"theta2_{i + 1}", "lower": 0.0, "upper": 2 * np.pi} for i in range(len(T))]
-    case = PathCase.from_dict({"id": "shape", "targets": T.tolist(), "timing": {"type": "free"},
+    var += [{"name": "theta2_1", "lower": 0.0, "upper": 2 * np.pi}]
+    # the crank at constant speed: 16 equal steps over one turn (free timing lets the
+    # optimiser collapse all targets onto one crank angle)
+    case = PathCase.from_dict({"id": "shape", "targets": T.tolist(),
+                               "timing": {"type": "prescribed_increment", "step": 2 * np.pi / len(T)},
                                "variables": var, "kinematics": {"branch": -1}})
     res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=2)
+    if not res.feasible:
+        return np.inf, T, False
     d = {**case.fixed, **res.design}
     mech = mechanism_from_dict(fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(res.theta2[0]),
                                                       branch=case.branch, rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"],
@@ -147,9 +152,13 @@ def best_fourbar_by_synth_path(points: np.ndarray, time_limit: float, seed: int 
     P = sim.points["P"].position
     ok = sim.assembled
     closed = bool(ok.all())
-    if not closed:  # the run of assembled inputs from the first target on
-        end = int(np.argmin(ok)) if not ok[0] else 0
-        P = P[:max(end, 2)] if ok[0] else P[ok]
+    if not closed:  # the longest run of assembled inputs (cyclic): what the linkage traces
+        k = int(np.argmin(ok))
+        P, ok = np.roll(P, -k, axis=0), np.roll(ok, -k)
+        idx = np.flatnonzero(ok)
+        runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+        run = max(runs, key=len)
+        P = P[run]
     tgt = target_from_points(points, closed=True)
     ch, _ = curve_errors(P, tgt, closed)
     return ch, P, closed

@@ -15,8 +15,9 @@ The contract, the same on every back end:
 * **Identical results.** The results come back in task order, whatever order the
   workers finish in; a task must depend only on its arguments (seeds travel in them),
   so the answer equals the single-process run.
-* **Progress.** ``progress(done, total, result)`` is called in the calling process each
-  time a task finishes, wherever it ran (a CLI passes its progress bar's advance).
+* **Progress.** ``progress(done, total, index, result)`` is called in the calling
+  process each time a task finishes, wherever it ran (``index``: the task's position;
+  a CLI advances its progress bar, a caller may use finished results at once).
 * **Deadline.** ``deadline`` (a ``time.time()`` value): tasks not started by then are not
   started (their result is ``None``); running tasks finish, so a task that can run long
   takes the deadline among its arguments and honours it itself.
@@ -43,7 +44,7 @@ from typing import Any
 
 from mechsyn.errors import MechsynInputError
 
-ProgressFn = Callable[[int, int, Any], None]
+ProgressFn = Callable[[int, int, int, Any], None]
 StopFn = Callable[[int, Any], bool]
 
 __all__ = ["run_tasks", "dask_client", "check_parallel_options"]
@@ -97,7 +98,7 @@ def run_tasks(fn: Callable[..., Any], tasks: Sequence[tuple], *, workers: int = 
                 break
             results[i] = fn(*args)
             if progress is not None:
-                progress(i + 1, len(tasks), results[i])
+                progress(i + 1, len(tasks), i, results[i])
             if stop is not None and stop(i, results[i]):
                 break
         return results
@@ -118,7 +119,7 @@ class _Book:
         results[i] = result
         self.done += 1
         if self.progress is not None:
-            self.progress(self.done, self.n, result)
+            self.progress(self.done, self.n, i, result)
         if self.stop is not None and self.stop(i, result):
             self.limit = i + 1
 

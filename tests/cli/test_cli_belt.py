@@ -145,7 +145,7 @@ def _bad(tmp_path):
         (["belt", "analyze", *PAPER_ARGS, "--phi", "0:10:1", "--law", "table", "--table",
           str(tmp_path / "nope.csv")], "nope.csv"),
         (["belt", "analyze", *PAPER_ARGS, "--phi", "0:10:1", "--animate",
-          str(tmp_path / "m.mp4")], "--animate"),
+          str(tmp_path / "m.avi")], "--animate"),
         (["belt", "analyze", "--file", str(tmp_path / "missing.yaml")], "missing.yaml"),
         (["belt", "analyze", "--file", str(bad_yaml)], "bad.yaml:"),
         (["belt", "analyze", "--file", str(unknown)], "design.q"),
@@ -173,7 +173,7 @@ def test_bad_inputs_exit_2(capsys, tmp_path):
         assert code == 2, (argv, err)
         assert "Traceback" not in err
         assert needle in err, (argv, err)
-    assert not (tmp_path / "m.mp4").exists()
+    assert not (tmp_path / "m.avi").exists()
 
 
 def test_table_law_and_reverse_range(capsys, tmp_path):

@@ -24,15 +24,19 @@ def _with_params(mech, plan, x):
     return mechanism_from_dict(base)
 
 
-@pytest.mark.parametrize("name", ["kinematics/crank_rocker", "textbook/fourbar", "textbook/watt_sixbar",
-                                  "textbook/stephenson_sixbar"])
+@pytest.mark.parametrize("name", [
+    "kinematics/crank_rocker",
+    # dead points: simulate refines each one (about a second per design), so these are slow
+    pytest.param("textbook/fourbar", marks=pytest.mark.slow),
+    pytest.param("textbook/watt_sixbar", marks=pytest.mark.slow),
+    pytest.param("textbook/stephenson_sixbar", marks=pytest.mark.slow)])
 def test_batch_equals_simulate_on_perturbed_designs(name):
     mech = load_mechanism(EX / f"{name}.yaml")
     plan = compile_plan(mech)
     rng = np.random.default_rng(3)
     x0 = plan.parameters(mech)
-    designs = np.vstack([x0, x0 + rng.normal(scale=0.15, size=(4, len(x0)))])
-    off = np.arange(0.0, 360.0, 2.0)
+    designs = np.vstack([x0, x0 + rng.normal(scale=0.15, size=(2, len(x0)))])
+    off = np.arange(0.0, 360.0, 3.0)
     res = simulate_batch(plan, designs, off, transmission=True)
     for k, x in enumerate(designs):
         m = _with_params(mech, plan, x)

@@ -18,14 +18,8 @@ import pytest
 from mechsyn.cli.main import main
 from mechsyn.io import load_mechanism, mechanism_from_dict
 from mechsyn.structure.analysis import analyze_structure
-from mechsyn.structure.rank import (
-    InsufficientGeometry,
-    analyze_rank,
-    as_spatial,
-    check_remedy,
-    compare_with_formulas,
-    pair_twists,
-)
+from mechsyn.structure.compare import check_remedy, compare_with_formulas
+from mechsyn.structure.rank import InsufficientGeometry, analyze_rank, as_spatial, pair_twists
 from mechsyn.structure.remedies import find_remedies
 
 ROOT = Path(__file__).resolve().parents[2]

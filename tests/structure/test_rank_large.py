@@ -37,9 +37,11 @@ def ladder(loops: int, seed: int = 1) -> dict:
 
 def _same(mech) -> None:
     sysm = _build_system(mech, mech.kind == "planar")
-    M, _ = sysm.closure(np.zeros(sysm.twists.shape[0]))
+    F = sysm.twists.shape[0]
+    M, _ = sysm.closure(np.zeros(F))
+    blocks, _ = sysm.closure_blocks(np.zeros(F))
     tol = 1e-6
-    a, b = _reduce_dense(M, sysm.lam, tol), _eliminate(M, sysm.contour_columns(), sysm.lam, tol)
+    a, b = _reduce_dense(M, sysm.lam, tol), _eliminate(blocks, sysm.contour_columns(), sysm.lam, tol, F)
     assert a.rank == b.rank and a.increments == b.increments
     assert np.allclose(M @ b.null, 0, atol=1e-9)
     assert np.allclose(b.null.T @ b.null, np.eye(b.null.shape[1]), atol=1e-9)

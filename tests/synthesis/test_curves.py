@@ -151,7 +151,7 @@ def test_cli_synth_curve_and_curves_build(small_db, tmp_path, cli_json, run_cli)
     f = tmp_path / "t.json"
     f.write_text(json.dumps({"points": _fourbar_curve(11).tolist(), "closed": True}))
     out = tmp_path / "out"
-    data = cli_json("synth", "curve", f, "--max-links", "4", "--top", "1", "--time-limit", "20",
+    data = cli_json("synth", "curve", f, "--max-links", "4", "--top", "1", "--time-limit", "4",
                     "--database", small_db, "--out", out)
     c = data["candidates"][0]
     assert c["links"] == 4 and c["topology"] == "four-bar" and c["tracer"] == "T"
@@ -160,3 +160,37 @@ def test_cli_synth_curve_and_curves_build(small_db, tmp_path, cli_json, run_cli)
     assert code == 2 and "not found" in err
     s = cli_json("curves", "build", "--links", "4", "--per-topology", "50", "--database", tmp_path / "db")
     assert s["curves"] == 50 and s["topologies"] == 1
+
+
+def test_default_database_builds_on_first_use(tmp_path, monkeypatch):
+    from mechsyn.synthesis.curves import database
+
+    monkeypatch.setattr(database, "DEFAULT_PER_TOPOLOGY", 40)
+    monkeypatch.setenv("MECHSYN_CURVE_DB", str(tmp_path / "cache"))
+    states = []
+    db = load_database(max_links=4, callback=states.append)
+    assert len(db) == 40 and (tmp_path / "cache").is_dir()
+    assert states[0]["done"] == 0 and states[-1]["done"] == states[-1]["total"] == 1
+    with pytest.raises(MechsynInputError, match="no curve database"):
+        load_database(tmp_path / "empty", build_if_missing=False)
+
+
+def test_eight_bar_candidates_run_in_closed_form_and_match_simulate():
+    from mechsyn.synthesis.curves.database import evaluate_designs, sample_designs
+
+    eight = [t for t in curve_topologies(8) if t.n_links == 8]
+    assert len(eight) == 279 and all(t.plan.n_dyads == 3 for t in eight)
+    assert len({t.chain.certificate for t in eight}) == 12   # 4 of the 16 chains need a triad whatever the frame
+    rng = np.random.default_rng(8)
+    for t in (eight[0], eight[140], eight[-1]):
+        ev = evaluate_designs(t, sample_designs(t, 300, rng))
+        assert ev.closed.any()
+        x = ev.designs[np.flatnonzero(ev.closed)[0]]
+        mech = mechanism_from_dict(t.mechanism(x))
+        from mechsyn.kinematics.batch import compile_plan, simulate_batch
+
+        off = np.arange(0.0, 360.0, 5.0)
+        ref = compile_plan(mech, points=["T"]).reference_input
+        sim = simulate(mech, {t.plan.input_joint: ref + off}, points=["T"])
+        np.testing.assert_allclose(simulate_batch(t.plan, x, off).paths["T"][0], sim.points["T"].position,
+                                   atol=1e-9)

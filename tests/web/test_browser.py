@@ -39,6 +39,13 @@ def screen(page, x, y):
         return [r.left + r.width / 2 + (x - v.ox) * v.s, r.top + r.height / 2 - (y - v.oy) * v.s]; }""", [x, y])
 
 
+def center(page, selector):
+    """Page coordinates of the centre of the element drawn now (the drawing is re-made on
+    every repaint, so a locator may hold a detached element)."""
+    return page.evaluate("""sel => { const r = document.querySelector(sel).getBoundingClientRect();
+        return [r.left + r.width / 2, r.top + r.height / 2]; }""", selector)
+
+
 def click_world(page, x, y):
     page.mouse.click(*screen(page, x, y))
 
@@ -48,9 +55,30 @@ def wait_simulated(page, count=None):
     wait_js(page, "() => window.__studio.simFor === window.__studio.mech && window.__studio.sim", timeout=30)
 
 
+def wait_settled(page):
+    """Until the simulation and the analysis shown are those of the mechanism edited."""
+    wait_simulated(page)
+    wait_js(page, "() => window.__studio.analysis !== null")
+    page.wait_for_timeout(400)
+
+
 def shot(page, name):
     IMAGES.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(IMAGES / name))
+
+
+def save_gif(pngs, name):
+    """The drag as a small looping GIF for the README (frames shown 120 ms, then back)."""
+    import io
+
+    from PIL import Image
+
+    imgs = [Image.open(io.BytesIO(b)).convert("RGB") for b in pngs]
+    w, h = imgs[0].size
+    imgs = [im.resize((520, round(520 * h / w)), Image.Resampling.LANCZOS).quantize(48, method=Image.Quantize.MAXCOVERAGE) for im in imgs]
+    seq = imgs + imgs[-2:0:-1]
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    seq[0].save(IMAGES / name, save_all=True, append_images=seq[1:], duration=120, loop=0, optimize=True)
 
 
 def open_studio(page, srv):
@@ -64,17 +92,20 @@ def test_serve_fourbar_drag_joint_path_follows(serve, page):
     path = page.locator('[data-path="M"]')
     d0 = path.get_attribute("d")
     assert d0.count("M") >= 1 and d0.count("L") > 50
-    joint = page.locator('[data-joint="B"]')
-    assert joint.count() == 1
-    box = joint.bounding_box()
-    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    wait_settled(page)
+    assert page.locator('[data-joint="B"]').count() == 1
+    x, y = center(page, '[data-joint="B"]')
     n = page.evaluate("window.__studio.simulations")
+    frames, stage = [], page.locator("#stage").bounding_box()
     page.mouse.move(x, y)
     page.mouse.down()
-    for k in range(1, 6):
-        page.mouse.move(x - 6 * k, y - 4 * k)
+    for k in range(1, 13):
+        page.mouse.move(x - 5 * k, y - 3 * k)
+        wait_js(page, "() => window.__studio.simFor === window.__studio.mech")
+        frames.append(page.screenshot(clip=stage))
     page.mouse.up()
     wait_simulated(page)
+    save_gif(frames, "studio_drag.gif")
     d1 = path.get_attribute("d")
     assert d1 != d0  # the path followed the drag
     b = page.evaluate("window.__studio.mech.joints.find(j => j.id === 'B').point")
@@ -103,7 +134,7 @@ def test_undo_redo_and_animation(serve, page):
     before = page.evaluate("JSON.stringify(window.__studio.mech)")
     page.click("text=Drive")
     n = page.evaluate("window.__studio.simulations")
-    page.locator('[data-joint="A"]').click()
+    page.mouse.click(*center(page, '[data-joint="A"]'))
     assert page.evaluate("window.__studio.mech.joints[0].actuated") is None
     page.wait_for_selector("#banner .note")  # no drive: said, not a blank page
     page.click("#undo")
@@ -143,7 +174,7 @@ def test_build_a_sixbar_from_nothing(serve, page):
             click_world(page, *p)
         page.keyboard.press("Enter")
     page.click("text=Drive")
-    page.locator('[data-joint="A"]').click()
+    page.mouse.click(*center(page, '[data-joint="A"]'))
     page.click("text=Point")
     n = page.evaluate("window.__studio.simulations")
     click_world(page, 5.8, 4.9)
@@ -167,9 +198,9 @@ def test_build_a_sixbar_from_nothing(serve, page):
     shot(page, "studio_sixbar.png")
     # an error is shown next to its element, never a blank page
     page.click("text=Delete")
-    page.locator('[data-link]').first.click()
+    page.mouse.click(*center(page, '[data-link="L4"] .link-hit'))
     page.wait_for_selector("#banner .err, #banner .note")
-    assert page.locator("[data-joint]").count() >= 5
+    assert page.locator("[data-joint]").count() >= 5, page.console_errors
     assert page.console_errors == []
 
 
@@ -184,11 +215,11 @@ def test_synthesise_fourbar_through_five_points(serve, page):
     for p in targets:
         click_world(page, *p)
     assert page.locator("[data-target]").count() == 5
-    page.fill("#synth-time", "6")
+    page.fill("#synth-time", "12")
     page.click("#synth-run")
     wait_js(page, "() => document.querySelector('#synth-progress').value > 0", timeout=30)
     shot(page, "studio_synthesis_progress.png")
-    page.wait_for_selector("[data-apply]", timeout=60000)
+    page.wait_for_selector("[data-apply]", timeout=90000)
     status = page.locator("#synth-status").inner_text()
     assert status.startswith("done")
     page.locator("[data-apply='0']").click()
@@ -250,3 +281,21 @@ def test_atlas_open_a_chain(serve, page):
     wait_js(page, "() => window.__studio.mech.joints.length === 7")
     assert json.dumps(page.evaluate("window.__studio.mech.ground")).startswith('"L')
     assert page.console_errors == []
+
+
+def test_draw_a_target_curve(serve, page):
+    srv = serve(None)
+    page.goto(srv.url)
+    wait_js(page, "() => window.__studio && window.__studio.mech")
+    page.click("text=Targets")
+    x0, y0 = screen(page, 0, 0)
+    page.mouse.move(x0, y0)
+    page.mouse.down()
+    for k in range(1, 21):
+        page.mouse.move(x0 + 10 * k, y0 - 40 * np.sin(k / 6))
+    page.mouse.up()
+    n = page.evaluate("window.__studio.targets.length")
+    assert 10 <= n <= 21 and page.locator("[data-target]").count() == n
+    assert page.locator("#synth-kind option").count() == 2
+    page.click("#clear-targets")
+    assert page.locator("[data-target]").count() == 0

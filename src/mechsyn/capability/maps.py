@@ -337,59 +337,73 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
                    measure: str = "exact", q1: np.ndarray | None = None,
                    branch: str = "negative", respect_limits: bool = True,
                    continuous: bool = False, chunk: int = 2048,
-                   advance: Callable[[int], None] | None = None) -> CapabilityMap:
+                   advance: Callable[[int], None] | None = None,
+                   workers: int = 1, scheduler=None) -> CapabilityMap:
     """Best configuration and V_max at every grid point (paper 004, Table 2).
 
     ``q1`` (radians) samples the self-motion (default: 20 deg steps over q1's limits, the
     paper's choice); ``continuous`` uses :func:`continuous_best` instead (planar 3R), or
     refines the best 8 IK solutions with :func:`refine_over_self_motion` (other arms).
-    ``advance(k)`` is called after each chunk of k points (for a progress bar).
-    Spatial arms need ``z`` (the grid lies in the plane z = const).
+    The grid is solved in chunks of ``chunk`` points; ``advance(k)`` is called after
+    each chunk of k points (for a progress bar). ``workers`` (local processes) or
+    ``scheduler`` (a Dask cluster) solve the chunks in parallel
+    (:func:`mechsyn.parallel.run_tasks`): every point's answer depends only on the point,
+    so the map is the same. Spatial arms need ``z`` (the grid lies in the plane z = const).
     """
+    from mechsyn.parallel import run_tasks
+
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     pts = np.stack([X.ravel(), Y.ravel()], 1)
     if arm.kind == "spatial":
         pts = np.hstack([pts, np.full((pts.shape[0], 1), 0.0 if z is None else z)])
     P = pts.shape[0]
-    value = np.full(P, -np.inf)
-    qopt = np.full((P, arm.n), np.nan)
-    for start in range(0, P, chunk):
-        sl = slice(start, min(start + chunk, P))
-        if continuous and is_closed_form(arm):
-            qopt[sl], value[sl] = continuous_best(arm, pts[sl], direction, measure, branch,
-                                                  respect_limits)
-        elif is_closed_form(arm):
-            if q1 is None:
-                lo, hi = q1_range(arm, respect_limits)
-                q1s = np.arange(lo, hi + 1e-9, math.radians(20.0))
-            else:
-                q1s = np.atleast_1d(q1)
-            K = q1s.size
-            pp = np.repeat(pts[sl], K, axis=0)
-            bq, bv = [], []
-            for b in BRANCHES[branch]:
-                q, ok = ik_planar_3r(arm, pp, np.tile(q1s, sl.stop - sl.start), b)
-                v = measure_values(arm, q, direction, measure)
-                if respect_limits:
-                    v = np.where(arm.within_limits(np.nan_to_num(q, nan=np.inf)), v, -np.inf)
-                bq.append(q.reshape(-1, K, 3))
-                bv.append(v.reshape(-1, K))
-            qq, vv = np.concatenate(bq, 1), np.concatenate(bv, 1)
-            k = np.argmax(vv, axis=1)
-            rows = np.arange(vv.shape[0])
-            value[sl], qopt[sl] = vv[rows, k], qq[rows, k]
-        else:
-            value[sl], qopt[sl] = _numeric_best(arm, pts[sl], direction, measure, q1,
-                                                respect_limits, continuous)
+    tasks = [(arm, pts[start:start + chunk], direction, measure, q1, branch, respect_limits,
+              continuous) for start in range(0, P, chunk)]
+
+    def progress(done: int, total: int, index: int, result) -> None:
         if advance is not None:
-            advance(sl.stop - sl.start)
+            advance(len(result[0]))
+
+    parts = run_tasks(_map_chunk, tasks, workers=workers, scheduler=scheduler,
+                      progress=progress)
+    value = np.concatenate([v for v, _ in parts])
+    qopt = np.concatenate([q for _, q in parts])
     qopt[~np.isfinite(value)] = np.nan
     d = np.asarray(direction, float)
     return CapabilityMap(xs, ys, z, d / np.linalg.norm(d), measure,
                          "continuous" if continuous else "sampled",
                          value.reshape(X.shape), qopt.reshape(*X.shape, arm.n),
                          arm.joint_names, arm.is_revolute)
+
+
+def _map_chunk(arm: SerialArm, pts: np.ndarray, direction, measure: str, q1, branch: str,
+               respect_limits: bool, continuous: bool) -> tuple[np.ndarray, np.ndarray]:
+    """V_max (P,) and the best configuration (P, n) at the points of one chunk."""
+    if continuous and is_closed_form(arm):
+        q, v = continuous_best(arm, pts, direction, measure, branch, respect_limits)
+        return v, q
+    if not is_closed_form(arm):
+        return _numeric_best(arm, pts, direction, measure, q1, respect_limits, continuous)
+    if q1 is None:
+        lo, hi = q1_range(arm, respect_limits)
+        q1s = np.arange(lo, hi + 1e-9, math.radians(20.0))
+    else:
+        q1s = np.atleast_1d(q1)
+    K = q1s.size
+    pp = np.repeat(pts, K, axis=0)
+    bq, bv = [], []
+    for b in BRANCHES[branch]:
+        q, ok = ik_planar_3r(arm, pp, np.tile(q1s, len(pts)), b)
+        v = measure_values(arm, q, direction, measure)
+        if respect_limits:
+            v = np.where(arm.within_limits(np.nan_to_num(q, nan=np.inf)), v, -np.inf)
+        bq.append(q.reshape(-1, K, 3))
+        bv.append(v.reshape(-1, K))
+    qq, vv = np.concatenate(bq, 1), np.concatenate(bv, 1)
+    k = np.argmax(vv, axis=1)
+    rows = np.arange(vv.shape[0])
+    return vv[rows, k], qq[rows, k]
 
 
 def _numeric_best(arm: SerialArm, pts: np.ndarray, direction, measure: str, q1,

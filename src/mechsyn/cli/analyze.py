@@ -13,24 +13,13 @@ from mechsyn.cli.common import Table  # cells fold, numbers never cut
 from mechsyn.cli.app import app
 from mechsyn.cli.common import console, emit_json, err_console, safe
 from mechsyn.io import json_schema, load_mechanism
-from mechsyn.results import to_jsonable, write_atomic
-from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
-from mechsyn.structure.remedies import Remedy, find_remedies
-from mechsyn.structure.rank import (
-    Comparison,
-    InsufficientGeometry,
-    RankAnalysis,
-    RemedyCheck,
-    analyze_rank,
-    as_spatial,
-    check_remedy,
-    compare_with_formulas,
-    missing_geometry,
-    rank_summary_lines,
-    rank_to_markdown,
-)
-from mechsyn.errors import MechsynInputError
-from mechsyn.structure.report import CONTOUR_READING, formula_title, pair_list, to_markdown
+from mechsyn.results import write_atomic
+from mechsyn.structure.analysis import StructuralAnalysis
+from mechsyn.structure.compare import Comparison, RemedyCheck
+from mechsyn.structure.rank import RankAnalysis, rank_summary_lines
+from mechsyn.structure.remedies import Remedy
+from mechsyn.structure.report import StructureReport, pair_list
+from mechsyn.structure.report import analyze as structure_report
 
 
 SHORT_TITLES = {
@@ -148,27 +137,22 @@ def render_remedy_checks(checks: list[tuple[int, Remedy, RemedyCheck]]) -> None:
         console.print(f"  - {'; '.join(c.describe() for c in r.changes)}: [red]{chk.reason}[/]", highlight=False)
 
 
-def _rank_or_reason(mech, tol):
-    problems = missing_geometry(mech)
-    if problems:
-        return None, "geometry insufficient: " + "; ".join(problems)
-    return analyze_rank(mech, tol=tol), None
-
-
 #: From this many joints, ``analyze`` says the size and shows the rank method's stages on stderr.
 LARGE_JOINTS = 1000
 
 
-def _analyze_rank_reporting(mech, tol):
+def _analyze_reporting(mech, **options):
+    """:func:`mechsyn.structure.report.analyze`, with the size and the rank method's stages on
+    stderr for a large mechanism."""
     if len(mech.joints) < LARGE_JOINTS:
-        return analyze_rank(mech, tol=tol)
+        return structure_report(mech, **options)
     from mechsyn.structure.contours import cycle_rank
 
     err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
                       f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
                       f"of loops (2,000 joints: a few seconds)", highlight=False)
     with err_console.status("rank method") as status:
-        return analyze_rank(mech, tol=tol, progress=lambda stage: status.update(f"rank method: {stage}"))
+        return structure_report(mech, progress=lambda stage: status.update(f"rank method: {stage}"), **options)
 
 
 @app.command("analyze")
@@ -189,92 +173,39 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
-    if method is not None and method not in ("formulas", "rank", "both"):
-        raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="use formulas, rank or both")
-    if tol is not None and not (0 < tol < 1):
-        raise MechsynInputError(f"tolerance {tol:g} is out of (0, 1)", source="--tol", hint="e.g. --tol 1e-6")
-    mech = load_mechanism(file)
-    notes_cli: list[str] = []
-    if spatial:
-        if mech.kind == "planar":
-            mech = as_spatial(mech)
-        else:
-            notes_cli.append("--as-spatial: the file is already spatial")
-    problems = missing_geometry(mech)
-    if method is None:
-        method = "formulas" if problems else "both"
-    if method in ("rank", "both") and problems:
-        raise InsufficientGeometry(
-            "the rank method needs each joint's geometry: " + "; ".join(problems), source=str(file),
-            hint="add point/axis (see `mechsyn schema`), or use --method formulas")
-    result = analyze_structure(mech)
-    ra = _analyze_rank_reporting(mech, tol) if method != "formulas" else None
-    comparisons = compare_with_formulas(result, ra) if ra is not None else None
-    state_ranks: dict[str, tuple[RankAnalysis | None, str | None]] = {}
-    if ra is not None:
-        for name in mech.states:
-            state_ranks[name] = _rank_or_reason(mech.in_state(name), tol)
-    rem = find_remedies(mech, max_variants=max_variants) if remedies else None
-    checks: list[tuple[int, Remedy, RemedyCheck]] = []
-    if rem is not None and ra is not None:
-        for k, r in enumerate(rem, 1):
-            checks.append((k, r, check_remedy(mech, r.mechanism, ra, r.analysis.metric_constraints, tol)))
-    kept = [r for _, r, c in checks if c.accepted] if checks else rem
+    report = _analyze_reporting(load_mechanism(file), method=method, remedies=remedies,
+                                max_variants=max_variants, tol=tol, as_spatial=spatial)
     if json_out:
-        data = to_jsonable(result)
-        data["method"] = method
-        data["rank"] = ra.to_dict() if ra is not None else None
-        if ra is None and problems:
-            data["rank_unavailable"] = "; ".join(problems)
-        if ra is not None:
-            data["mobility_formulas"] = data["mobility"]
-            data["mobility"] = ra.useful_mobility
-            data["mobility_source"] = "rank method: useful mobility (idle mobilities excluded)"
-            data["comparison"] = [c.to_dict() for c in comparisons or []]
-            for name, (sr, why) in state_ranks.items():
-                if name in data.get("states", {}):
-                    data["states"][name]["rank"] = sr.to_dict() if sr is not None else None
-                    if why:
-                        data["states"][name]["rank_unavailable"] = why
-        if notes_cli:
-            data["notes"] = list(data.get("notes", [])) + notes_cli
-        if rem is not None:
-            if checks:
-                data["remedies"] = [dict(to_jsonable(r), rank_check=c.to_dict()) for _, r, c in checks if c.accepted]
-                data["remedies_rejected"] = [dict(to_jsonable(r), rank_check=c.to_dict())
-                                             for _, r, c in checks if not c.accepted]
-            else:
-                data["remedies"] = [to_jsonable(r) for r in rem]
-        emit_json(data, out)
+        emit_json(report.to_dict(), out)
     elif markdown:
-        text = to_markdown(result, kept) if method != "rank" else ""
-        if ra is not None:
-            text += "\n" + rank_to_markdown(ra, comparisons if method == "both" else None)
-            if checks:
-                text += "\n## Remedies re-checked by the rank method\n\n" + "\n".join(
-                    f"- variant {k} ({'; '.join(c.joint for c in r.changes)}): {chk.reason}" for k, r, chk in checks) + "\n"
         if out is None:
-            typer.echo(text, nl=False)
+            typer.echo(report.to_markdown(), nl=False)
         else:
-            write_atomic(out, text)
+            write_atomic(out, report.to_markdown())
     else:
-        if method != "rank":
-            render(result)
-        for n in notes_cli:
-            console.print(f"[dim]note:[/] {n}", highlight=False)
-        if ra is not None:
-            console.print()
-            render_rank(ra, comparisons if method == "both" else None)
-            for name, (sr, why) in state_ranks.items():
-                if sr is not None:
-                    render_rank(sr, None, title=f"state '{name}'")
-                else:
-                    console.print(f"[dim]state '{name}': no rank analysis ({why})[/]", highlight=False)
-        if rem is not None:
-            console.print()
-            render_remedies(kept if kept is not None else rem)
-            if checks:
-                render_remedy_checks(checks)
+        render_report(report)
+
+
+def render_report(report: StructureReport) -> None:
+    """The terminal tables of a structural report."""
+    ra, method = report.rank, report.method
+    if method != "rank":
+        render(report.analysis)
+    for n in report.notes:
+        console.print(f"[dim]note:[/] {n}", highlight=False)
+    if ra is not None:
+        console.print()
+        render_rank(ra, report.comparisons if method == "both" else None)
+        for name, (sr, why) in report.state_ranks.items():
+            if sr is not None:
+                render_rank(sr, None, title=f"state '{name}'")
+            else:
+                console.print(f"[dim]state '{name}': no rank analysis ({why})[/]", highlight=False)
+    if report.remedies is not None:
+        console.print()
+        render_remedies(report.remedies)
+        if report.checks:
+            render_remedy_checks(report.checks)
 
 
 @app.command("schema")

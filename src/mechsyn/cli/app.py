@@ -19,5 +19,5 @@ app = typer.Typer(
 synth_app = typer.Typer(
     help="Synthesis: structural (groups, fingers) and dimensional (path, function, motion).",
     no_args_is_help=True,
-)
-app.add_typer(synth_app, name="synth")
+    add_completion=False,
+)  # reached through mechsyn.cli.main's lazy table, not add_typer (see there)

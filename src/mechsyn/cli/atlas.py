@@ -39,11 +39,15 @@ def atlas(
         None, "--stream", help="Stream chains to this JSON-lines file; rerun to resume."),
     force: bool = typer.Option(
         False, "--force", help="Let --stream overwrite a file that is not a chain stream."),
+    workers: int = typer.Option(1, "--workers", help="Share the enumeration among N local processes."),
+    scheduler: Optional[str] = typer.Option(
+        None, "--scheduler", help="Run on a Dask cluster (scheduler address; extra mechsyn[dask])."),
 ) -> None:
     """All non-isomorphic planar simple-jointed kinematic chains with N links and
     mobility F, their link assortments and distinct mechanisms (choices of frame)."""
     from mechsyn.synthesis.chains import (
         link_assortments, n_units, synthesize_chains, synthesize_chains_to_file)
+    from mechsyn.parallel import check_parallel_options
     from mechsyn.synthesis.mechanisms import distinct_mechanisms, frame_orbits, mechanism_dict
 
     if out is not None and out.suffix.lower() not in (".svg", ".png", ".pdf"):
@@ -52,13 +56,16 @@ def atlas(
     check_writable(out, "--out")
     check_writable(stream, "--stream")
     check_writable(mechanisms, "--mechanisms", directory=True)
+    check_parallel_options(workers, scheduler)
     total_units = n_units(links, mobility)
     with progress_bar(f"{links}-link chains, F={mobility}", total_units) as advance:
         if stream is not None:
             chains = synthesize_chains_to_file(stream, links, mobility, include_degenerate,
-                                               progress=advance, force=force)
+                                               progress=advance, force=force, workers=workers,
+                                               scheduler=scheduler)
         else:
-            chains = synthesize_chains(links, mobility, include_degenerate, progress=advance)
+            chains = synthesize_chains(links, mobility, include_degenerate, progress=advance,
+                                       workers=workers, scheduler=scheduler)
     if out is not None and len(chains) > MAX_DRAWN:
         raise MechsynInputError(
             f"{len(chains)} chains are too many to draw on one sheet (limit {MAX_DRAWN})",

@@ -266,7 +266,7 @@ def analyze_cmd(
     json_out: bool = typer.Option(False, "--json", help="print JSON"),
     csv_out: Optional[Path] = typer.Option(None, "--csv", help="write the table of positions (- for stdout)"),
     plot: Optional[Path] = typer.Option(None, "--plot", help="write the figure (PNG/SVG/PDF)"),
-    animate: Optional[Path] = typer.Option(None, "--animate", help="write an animated GIF"),
+    animate: Optional[Path] = typer.Option(None, "--animate", help="write an animation (.gif, .mp4 or .html)"),
     four_bar_file: Optional[Path] = typer.Option(
         None, "--four-bar-file", help="write the equivalent four-bar A0-A-B-B0 as a mechanism "
                                       "file (YAML, or JSON by suffix)"),

@@ -103,11 +103,17 @@ def capability(
     interpolate: Optional[str] = typer.Option(None, "--interpolate", help="grid: the optimal "
                                               "configuration interpolated at X,Y"),
     json_out: bool = typer.Option(False, "--json", help="print JSON on stdout"),
+    workers: int = typer.Option(1, "--workers", help="grid: solve it in N local processes"),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="grid: solve it on a Dask "
+                                            "cluster (scheduler address; extra mechsyn[dask])"),
 ) -> None:
     """Largest tool speed along a direction under joint speed limits (paper 004), at a point
     over the arm's self-motion, or mapped over a grid."""
     check_writable(map_png, "--map")
     check_writable(csv_out, "--csv")
+    from mechsyn.parallel import check_parallel_options
+
+    check_parallel_options(workers, scheduler)
     arm = load_arm(arm_file)
     m = arm.task_dim
     d = np.array(parse_floats(direction, "--direction", m))
@@ -147,7 +153,7 @@ def capability(
             at = np.array(parse_floats(interpolate, "--interpolate", 2))
             _check_finite(at, "--interpolate")
         _grid(arm, grid, z, d, q1_vals, br, not ignore_limits, measure, continuous,
-              map_png, csv_out, json_out, at)
+              map_png, csv_out, json_out, at, {"workers": workers, "scheduler": scheduler})
 
 
 def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -> None:
@@ -238,7 +244,7 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
 
 
 def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, csv_out,
-          json_out, at=None) -> None:
+          json_out, at=None, parallel=None) -> None:
     parts = grid.split(",")
     if len(parts) != 2:
         raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
@@ -255,7 +261,7 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
     with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as adv:
         cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1_vals, branch=br,
                               respect_limits=respect, continuous=continuous, chunk=chunk,
-                              advance=adv)
+                              advance=adv, **(parallel or {}))
     one_stdout(json_out, csv_out)
     if csv_out is not None:
         write_output(csv_out, cmap.to_csv())

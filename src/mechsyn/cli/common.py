@@ -123,6 +123,24 @@ def emit_json(obj: Any, out: Path | None = None) -> None:
     write_output(STDOUT if out is None else out, text + "\n")
 
 
+#: The library's errors name its parameters (``MechsynInputError(field="tol")``); the command
+#: line shows them as its options. One table for every command.
+PARAMETER_OPTIONS: dict[str, str] = {
+    "method": "--method", "tol": "--tol", "inputs": "--input", "points": "--points", "speeds": "--speed",
+    "vll": "--vll", "animate": "--animate", "seed": "--seed", "time_limit": "--time-limit",
+    "restarts": "--restarts", "workers": "--workers", "optimizer": "--optimizer", "direction": "--direction",
+    "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output",
+}
+
+
+def option_error(error: MechsynInputError) -> MechsynInputError:
+    """``error`` with a library parameter (its ``field``) shown as the command-line option."""
+    if error.source is None and error.field in PARAMETER_OPTIONS:
+        return MechsynInputError(error.message, source=PARAMETER_OPTIONS[error.field], line=error.line,
+                                 hint=error.hint)
+    return error
+
+
 def fail(message: str, hint: str | None = None, source: str | None = None) -> None:
     """Stop the command with one clear message and exit status 2."""
     raise MechsynInputError(message, hint=hint, source=source)
@@ -200,24 +218,28 @@ def save_plot(path: Path, draw: Any, *args: Any, dpi: int = 110, figsize: tuple[
 
 
 def check_animation_target(path: Path, option: str = "--animate") -> Path:
-    """Raise MechsynInputError unless a GIF can be written to ``path`` (before any work)."""
-    from matplotlib.animation import PillowWriter
+    """Raise MechsynInputError unless an animation can be written to ``path`` (before any work):
+    .gif (Pillow), .mp4 (imageio-ffmpeg) or .html (a self-contained player)."""
+    import importlib.util
 
-    if not PillowWriter.isAvailable():
-        raise MechsynInputError(f"{option} needs the pillow package", hint="pip install pillow", source=option)
-    if path.suffix.lower() != ".gif":
-        raise MechsynInputError(f"the animation is a GIF: use a .gif file name, not {path.name}", source=option)
+    suffix = path.suffix.lower()
+    if suffix not in (".gif", ".mp4", ".html"):
+        raise MechsynInputError(f"animations are .gif, .mp4 or .html files, not {path.name}", source=option)
+    need = {"gif": "PIL", "html": "PIL", "mp4": "imageio_ffmpeg"}[suffix[1:]]
+    if importlib.util.find_spec(need) is None:
+        extra = "pip install 'mechsyn[video]'" if suffix == ".mp4" else "pip install pillow"
+        raise MechsynInputError(f"{option} {path.name} needs {need}", hint=extra, source=option)
     return path
 
 
 def save_animation(path: Path, animate: Any, *args: Any, fps: int = 15, dpi: int = 80,
                    option: str = "--animate", **kwargs: Any) -> None:
     """Build an animation with a ``mechsyn.plot`` function on a bare Figure and write it to
-    ``path`` as a GIF, whole or not at all."""
-    from matplotlib.animation import PillowWriter
+    ``path`` as GIF, MP4 or HTML (by its suffix), whole or not at all."""
     from matplotlib.figure import Figure
 
-    from mechsyn.results import atomic_output
+    from mechsyn.export.movie import write_animation
+    from mechsyn.plot.frames import animation_frames
 
     check_animation_target(path, option)
     fig = Figure()
@@ -225,8 +247,8 @@ def save_animation(path: Path, animate: Any, *args: Any, fps: int = 15, dpi: int
         anim = animate(*args, fig=fig, **kwargs)
     except MechsynInputError as exc:
         raise exc.with_source(option) from None
-    with atomic_output(path) as tmp:
-        anim.save(str(tmp), writer=PillowWriter(fps=fps), dpi=dpi)
+    title = kwargs.get("title") or getattr(args[0], "mechanism", None) or "mechsyn animation"
+    write_animation(animation_frames(anim, dpi), path, fps=fps, title=str(title))
 
 
 def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:

@@ -10,8 +10,31 @@ from rich.markup import escape
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.common import (check_output_suffix, console, emit_json, err_console, is_stdout, one_stdout,
+                                parse_range, write_output)
 from mechsyn.errors import MechsynInputError
+
+
+def _values(items: list[str] | None) -> dict[str, float]:
+    out = {}
+    for item in items or []:
+        jid, _, v = item.partition("=")
+        try:
+            out[jid.strip()] = float(v)
+        except ValueError:
+            raise MechsynInputError(f"expected J=VALUE, got {item!r}", source="--pose",
+                                    hint="write e.g. --pose A=30") from None
+    return out
+
+
+def _sweep(text: str | None):
+    if text is None:
+        return None
+    from mechsyn.kinematics.analysis import input_grid
+
+    jid, _, spec = text.partition("=")
+    start, stop, step = parse_range(spec, "--sweep", f"{jid or 'A'}=0:360:2")
+    return {jid.strip(): input_grid(start, stop, step)}
 
 
 @app.command("export")
@@ -28,22 +51,50 @@ def export_cmd(
     frame: Annotated[bool, typer.Option("--frame/--no-frame", help="Cut the frame's plate too.")] = True,
     sheet_width: Annotated[Optional[float], typer.Option("--sheet-width", help="Width of the sheet the rows "
                                                          "of plates fill.")] = None,
+    svg: Annotated[Optional[Path], typer.Option("--svg", help="Write the plates as SVG (cut lines, holes, "
+                                                "labels; - for stdout).")] = None,
+    drawing: Annotated[Optional[Path], typer.Option("--drawing", help="Write an SVG drawing of the mechanism at "
+                                                    "a pose, with --path and --dimensions.")] = None,
+    pose: Annotated[Optional[list[str]], typer.Option("--pose", help="Driven joint value of the drawing: J=V "
+                                                      "(deg for R, length for P; default: the file's).")] = None,
+    path: Annotated[Optional[list[str]], typer.Option("--path", help="Draw the path of this point (a name from "
+                                                      "`points:` or a joint id) over --sweep.")] = None,
+    sweep: Annotated[Optional[str], typer.Option("--sweep", help="Input range of the paths: "
+                                                 "J=START:STOP:STEP.")] = None,
+    dimensions: Annotated[bool, typer.Option("--dimensions", help="Write the bar lengths on the drawing.")] = False,
     json_: Annotated[bool, typer.Option("--json", help="Print the plates (hole centres, sizes) as JSON.")] = False,
 ) -> None:
-    """Link plates with joint holes, laid out flat on a sheet, for a laser cutter or CNC."""
+    """Link plates with joint holes, laid out flat on a sheet, for a laser cutter or CNC; a
+    vector drawing of the mechanism at a pose with its paths."""
     from mechsyn.export.plates import link_plates
     from mechsyn.io.convert import load_any
 
     check_output_suffix(dxf, (".dxf",), "--dxf")
-    if dxf is None and not json_:
-        raise MechsynInputError("nothing to export", source="--dxf", hint="add --dxf parts.dxf or --json")
+    check_output_suffix(svg, (".svg",), "--svg")
+    check_output_suffix(drawing, (".svg",), "--drawing")
+    one_stdout(json_, svg, drawing)
+    if dxf is None and svg is None and drawing is None and not json_:
+        raise MechsynInputError("nothing to export", source="--dxf",
+                                hint="add --dxf parts.dxf, --svg parts.svg, --drawing mech.svg or --json")
     mech = load_any(file)
+    if drawing is not None:
+        from mechsyn.export.drawing import drawing_of
+
+        write_output(drawing, drawing_of(mech, _values(pose), path or [], _sweep(sweep), dimensions))
+        if dxf is None and svg is None and not json_:
+            return
     layout = link_plates(mech, width=width, hole_diameter=hole, clearance=clearance, frame=frame,
                          sheet_width=sheet_width)
     if dxf is not None:
         from mechsyn.export.dxf import write_dxf
 
         write_dxf(layout, dxf)
+    if svg is not None:
+        from mechsyn.export.svg import plates_svg
+
+        write_output(svg, plates_svg(layout))
+    if is_stdout(svg):
+        return
     if json_:
         emit_json(layout)
         return

@@ -1,34 +1,87 @@
 """Entry point of the ``mechsyn`` console script.
 
-Command modules are imported here for their side effect of registering on the app.
+Commands are registered lazily: :data:`COMMANDS` names each command's module and its
+one-line help, so ``mechsyn --help`` and ``mechsyn version`` import no command module (nor
+NumPy, SciPy or Matplotlib), and ``mechsyn simulate ...`` imports only ``cli/simulate.py``.
+A command module registers itself on :data:`mechsyn.cli.app.app` (or a sub-app) when
+imported; a module imported eagerly here is picked up the same way.
 """
 
 from __future__ import annotations
 
+import importlib
 import sys
+from typing import Any
 
+import click
+import typer
+
+from mechsyn.cli import version as _version  # noqa: F401  (the root callback: --version)
 from mechsyn.cli.app import app
 from mechsyn.errors import MechsynInputError
-from mechsyn.interrupt import INTERRUPT_EXIT_CODE
 
-# Command modules (each registers its commands on the app when imported).
-from mechsyn.cli import analyze as _analyze  # noqa: F401
-from mechsyn.cli import synth_groups as _synth_groups  # noqa: F401
-from mechsyn.cli import version as _version  # noqa: F401
-from mechsyn.cli import atlas as _atlas  # noqa: F401
-from mechsyn.cli import structure as _structure  # noqa: F401
-from mechsyn.cli import finger as _finger  # noqa: F401
-from mechsyn.cli import capability as _capability  # noqa: F401
-from mechsyn.cli import belt as _belt  # noqa: F401
-from mechsyn.cli import simulate as _simulate  # noqa: F401
-from mechsyn.cli import synth_finger_design as _synth_finger_design  # noqa: F401
-from mechsyn.cli import synth_path as _synth_path  # noqa: F401
-from mechsyn.cli import synth_mechanism as _synth_mechanism  # noqa: F401
-from mechsyn.cli import synth_curve as _synth_curve  # noqa: F401
-from mechsyn.cli import curves as _curves  # noqa: F401
-from mechsyn.cli import serve as _serve  # noqa: F401
-from mechsyn.cli import convert as _convert  # noqa: F401
-from mechsyn.cli import export as _export  # noqa: F401
+#: command -> (module(s) under mechsyn.cli, one-line help shown by ``mechsyn --help``)
+COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
+    "analyze": (("analyze",), "Structural analysis: mobility by the classic formulas and the rank method, "
+                "redundant constraints, idle mobilities, drives, remedies."),
+    "schema": (("analyze",), "Print the JSON Schema of mechanism files."),
+    "structure": (("structure",), "Input links, Assur groups, structural formula and class of a planar "
+                  "mechanism."),
+    "simulate": (("simulate",), "Positions, velocities and accelerations of a planar mechanism over its "
+                 "input."),
+    "forces": (("simulate",), "Joint reactions and the balancing moment/force at each driven joint over "
+               "the input."),
+    "capability": (("capability",), "Largest tool speed along a direction under joint speed limits "
+                   "(paper 004), at a point or over a grid."),
+    "atlas": (("atlas",), "All non-isomorphic planar kinematic chains with N links and mobility F, and "
+              "their mechanisms."),
+    "belt": (("belt",), "Paper 001's manipulator with a belt on a pulley: synthesis, paths, speeds, "
+             "accelerations, the inverse problem."),
+    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism"),
+              "Synthesis: structural (groups, fingers) and dimensional (path, function, motion)."),
+}
+
+
+def _load(name: str) -> click.Command:
+    """Import the modules of command ``name`` and return its click command."""
+    modules, _ = COMMANDS[name]
+    for m in modules:
+        importlib.import_module(f"mechsyn.cli.{m}")
+    if name == "synth":
+        from mechsyn.cli.app import synth_app
+
+        return typer.main.get_command(synth_app)
+    group = typer.main.get_command(app)
+    return group.commands[name]  # type: ignore[attr-defined]
+
+
+class _LazyCommand(click.Command):
+    """Stands for a command whose module is not imported yet: lists itself with its help and
+    hands parsing and running to the real command."""
+
+    def __init__(self, name: str, help: str) -> None:
+        super().__init__(name, help=help, short_help=help, add_help_option=False)
+        self.rich_help_panel = None
+
+    def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
+                     **extra: Any) -> click.Context:
+        return _load(self.name).make_context(info_name, args, parent=parent, **extra)  # type: ignore[arg-type]
+
+    def to_info_dict(self, ctx: click.Context) -> dict[str, Any]:
+        return _load(self.name).to_info_dict(ctx)  # type: ignore[arg-type]
+
+
+def build_cli() -> click.Group:
+    """The root click group: eagerly registered commands plus the lazy ones."""
+    group = typer.main.get_command(app)
+    for name, (_, text) in COMMANDS.items():
+        if name not in group.commands:  # type: ignore[attr-defined]
+            group.add_command(_LazyCommand(name, text))  # type: ignore[attr-defined]
+    return group  # type: ignore[return-value]
+
+
+#: exit status of Ctrl-C (128 + SIGINT), as :data:`mechsyn.interrupt.INTERRUPT_EXIT_CODE`
+_INTERRUPTED = 130
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -37,34 +90,35 @@ def main(argv: list[str] | None = None) -> int:
     Ctrl-C exits with status 130 and prints ``interrupted`` (searches have written their
     best result so far, marked as interrupted, before that).
     """
-    from rich.markup import escape
-
-    from mechsyn.cli.common import err_console
-
     try:
-        # typer turns KeyboardInterrupt (and typer.Exit(n) raised by a command) into a
-        # returned exit status when standalone_mode is off
-        status = app(args=argv, prog_name="mechsyn", standalone_mode=False)
+        status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
     except KeyboardInterrupt:
-        status = INTERRUPT_EXIT_CODE
+        status = _INTERRUPTED
     except MechsynInputError as error:
-        err_console.print(f"[bold red]error:[/] {escape(error.format())}", highlight=False, soft_wrap=True)
+        from rich.markup import escape
+
+        from mechsyn.cli.common import err_console, option_error
+
+        err_console.print(f"[bold red]error:[/] {escape(option_error(error).format())}", highlight=False,
+                          soft_wrap=True)
         return _exit(2, argv)
     except SystemExit as exc:  # typer.Exit inside commands
         return _exit(int(exc.code or 0), argv)
     except Exception as exc:  # click's (typer's vendored click's) own exceptions
         name = type(exc).__name__
-        if name == "Abort":
-            err_console.print("aborted")
-            return _exit(130, argv)
-        if hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
+        if name == "Abort":  # click's wrapping of Ctrl-C
+            status = _INTERRUPTED
+        elif hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
             exc.show()
             return _exit(int(exc.exit_code), argv)
-        if hasattr(exc, "exit_code"):  # Exit
+        elif hasattr(exc, "exit_code"):  # Exit
             return _exit(int(exc.exit_code), argv)
-        raise
+        else:
+            raise
     if isinstance(status, int) and not isinstance(status, bool) and status != 0:
-        if status == INTERRUPT_EXIT_CODE:
+        if status == _INTERRUPTED:  # searches wrote their best so far before this
+            from mechsyn.cli.common import err_console
+
             err_console.print("interrupted", highlight=False)
         return _exit(status, argv)
     return _exit(0, argv)

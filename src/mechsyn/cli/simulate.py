@@ -13,7 +13,8 @@ from rich.markup import escape
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import (check_output_suffix, console, fmt_number, emit_json, is_stdout, one_stdout, parse_range,
+from mechsyn.cli.common import (check_animation_target, check_output_suffix, console, emit_json, fmt_number,
+                                is_stdout, one_stdout, parse_range,
                                 progress_bar, save_animation, save_plot, write_output)
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
@@ -119,14 +120,15 @@ def simulate_cmd(
     json_: JsonOpt = False,
     csv_out: CsvOpt = None,
     plot: PlotOpt = None,
-    animate: Annotated[Optional[Path], typer.Option("--animate", help="Write a GIF animation.")] = None,
+    animate: Annotated[Optional[Path], typer.Option("--animate", help="Write an animation: .gif, .mp4 (the video extra) or .html (a self-contained player).")] = None,
 ) -> None:
     """Positions, velocities and accelerations of a planar mechanism over its input."""
     from mechsyn.kinematics import derived
     from mechsyn.kinematics.analysis import simulate
 
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
-    check_output_suffix(animate, (".gif",), "--animate")
+    if animate is not None:
+        check_animation_target(animate)
     check_output_suffix(csv_out, (".csv",), "--csv")
     one_stdout(json_, csv_out)
     if method not in ("auto", "assur", "newton"):

@@ -20,14 +20,18 @@ def synth_mechanism(
     time_limit: float = typer.Option(30.0, "--time-limit", help="Wall-clock budget in seconds."),
     restarts: int = typer.Option(3, "--restarts", help="Number of restarts (child seeds of --seed)."),
     optimizer: str = typer.Option("de", "--optimizer", help="Global optimiser (de | random | registered)."),
+    workers: int = typer.Option(1, "--workers", help="Run restarts in N local processes."),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask])."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
 ) -> None:
     """Move chosen joint / point coordinates and VLL lengths of a planar mechanism file so
     a point follows target positions (or a link target poses) at given input angles."""
+    from mechsyn.parallel import check_parallel_options
     from mechsyn.synthesis.general import load_case, synthesize_mechanism
 
+    check_parallel_options(workers, scheduler)
     if not time_limit > 0:
         raise MechsynInputError("must be positive", source="--time-limit")
     if restarts < 1:
@@ -47,9 +51,11 @@ def synth_mechanism(
                 prog.update(task, completed=done, best=f"{best:.6g}")
 
             res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,
-                                       optimizer=optimizer, progress=progress)
+                                       optimizer=optimizer, progress=progress, workers=workers,
+                                       scheduler=scheduler)
     else:
-        res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer)
+        res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,
+                                   optimizer=optimizer, workers=workers, scheduler=scheduler)
     if (out is not None or plot is not None) and not res.feasible:
         raise MechsynInputError("no feasible design found; nothing written", source=str(case_file),
                                 hint="raise --time-limit or --restarts, or widen the variable bounds")

@@ -1,11 +1,28 @@
-"""``mechsyn version``."""
+"""``mechsyn version`` and ``mechsyn --version``."""
 
 from __future__ import annotations
+
+from typing import Annotated
 
 import typer
 
 from mechsyn import __version__
 from mechsyn.cli.app import app
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"mechsyn {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def root(
+    version: Annotated[bool, typer.Option("--version", callback=_print_version, is_eager=True,
+                                          help="Print mechsyn's version and exit.")] = False,
+) -> None:
+    """Structural analysis, kinematics and synthesis of mechanisms of robots, manipulators and
+    grippers."""
 
 
 @app.command("version")

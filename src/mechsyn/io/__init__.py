@@ -1,7 +1,10 @@
 """The mechanism file format: reading, validation, writing, JSON Schema."""
 
 from mechsyn.io.load import (
+    load,
     load_mechanism,
+    loads,
+    save,
     mechanism_from_dict,
     mechanism_from_text,
     mechanism_to_dict,
@@ -11,6 +14,6 @@ from mechsyn.io.load import (
 from mechsyn.io.schema import json_schema
 
 __all__ = [
-    "load_mechanism", "mechanism_from_dict", "mechanism_from_text", "mechanism_to_dict",
+    "load", "loads", "save", "load_mechanism", "mechanism_from_dict", "mechanism_from_text", "mechanism_to_dict",
     "read_data", "write_mechanism", "json_schema",
 ]

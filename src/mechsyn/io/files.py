@@ -27,6 +27,9 @@ from typing import Any
 
 import yaml
 
+#: LibYAML's safe parser where PyYAML was built with it (several times faster), else PyYAML's own.
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
@@ -123,7 +126,7 @@ def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
                 ) from None
         else:
             try:
-                data = yaml.safe_load(text)
+                data = yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
             except yaml.MarkedYAMLError as exc:
                 mark = exc.problem_mark or exc.context_mark
                 line = mark.line + 1 if mark is not None else None

@@ -34,16 +34,25 @@ from mechsyn.model.pairs import PAIR_KINDS, canonical_pair_type
 from mechsyn.results import to_jsonable, write_atomic
 
 __all__ = [
-    "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
+    "load", "loads", "save", "load_mechanism", "mechanism_from_dict", "mechanism_from_text",
     "mechanism_to_dict", "mechanism_text", "write_mechanism", "read_data",
 ]
+
+_YAML_LOADER = files._YAML_LOADER
+
+
+def safe_load_yaml(text: str) -> Any:
+    """``yaml.safe_load`` through LibYAML when available."""
+    return yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
 
 
 # --------------------------------------------------------------------------- reading
 def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
-    """Parse a YAML or JSON file into Python data; return it with its text
-    (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
-    return files.read_data(path)
+    """Parse a YAML or JSON file (or a bundled example, by name) into Python data; return it
+    with its text (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
+    from mechsyn.examples import resolve
+
+    return files.read_data(resolve(path))
 
 
 def parse_text(text: str, source: str) -> Any:
@@ -56,7 +65,7 @@ def _line_finder(text: str | None, source: str) -> Any:
     root = None
     if text is not None:
         try:
-            root = yaml.compose(text)
+            root = yaml.compose(text, Loader=_YAML_LOADER)
         except yaml.YAMLError:
             root = None
 
@@ -193,8 +202,89 @@ def load_mechanism(path: str | os.PathLike[str]) -> Mechanism:
     MechsynInputError
         naming the file, line and field of the first problem, with a fix.
     """
+    from mechsyn.examples import resolve
+
     data, text = read_data(path)
-    return mechanism_from_dict(data, str(path), text)
+    return mechanism_from_dict(data, str(resolve(path)), text)
+
+
+def load(source: str | os.PathLike[str] | dict[str, Any] | Mechanism) -> Mechanism:
+    """A mechanism from a file (YAML or JSON), file-format data (a dict), or the name of
+    one of the bundled examples (:mod:`mechsyn.examples`).
+
+    Parameters
+    ----------
+    source : path, dict or str
+        A mechanism file, its data, or an example's name such as ``"fourbar"``.
+
+    Returns
+    -------
+    Mechanism
+
+    Raises
+    ------
+    MechsynInputError
+        naming the file, line and field of the first problem, with a fix.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.load({"name": "four-bar", "kind": "planar", "ground": "frame",
+    ...              "links": ["frame", "crank", "coupler", "rocker"],
+    ...              "joints": [{"id": "A", "type": "R", "links": ["frame", "crank"]},
+    ...                         {"id": "B", "type": "R", "links": ["crank", "coupler"]},
+    ...                         {"id": "C", "type": "R", "links": ["coupler", "rocker"]},
+    ...                         {"id": "D", "type": "R", "links": ["rocker", "frame"]}]})
+    >>> m.n_moving, len(m.joints)
+    (3, 4)
+    """
+    if isinstance(source, Mechanism):
+        return source
+    if isinstance(source, dict):
+        return mechanism_from_dict(source)
+    return load_mechanism(source)
+
+
+def loads(text: str, format: str = "yaml") -> Mechanism:
+    """A mechanism from the text of a file, ``format`` ``"yaml"`` (JSON is YAML too) or
+    ``"json"``.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.loads('''
+    ... name: slider-crank
+    ... kind: planar
+    ... ground: frame
+    ... links: [frame, crank, rod, slider]
+    ... joints:
+    ...   - {id: A, type: R, links: [frame, crank]}
+    ...   - {id: B, type: R, links: [crank, rod]}
+    ...   - {id: C, type: R, links: [rod, slider]}
+    ...   - {id: D, type: P, links: [slider, frame]}
+    ... ''')
+    >>> m.pairs_by_class()
+    {5: 4}
+    """
+    if format not in ("yaml", "json"):
+        raise MechsynInputError(f"unknown format {format!r}", field="format", hint="use yaml or json")
+    return mechanism_from_text(text, "<text>.json" if format == "json" else "<text>")
+
+
+def save(mech: Mechanism | dict[str, Any], path: str | os.PathLike[str]) -> None:
+    """Write ``mech`` as a mechanism file: YAML, or JSON for a ``.json`` path; whole or not
+    at all (the same as :func:`write_mechanism`).
+
+    Examples
+    --------
+    >>> import mechsyn as ms, tempfile, pathlib
+    >>> m = ms.examples.load("fourbar")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     ms.save(m, pathlib.Path(d) / "copy.yaml")
+    ...     ms.load(pathlib.Path(d) / "copy.yaml").name == m.name
+    True
+    """
+    write_mechanism(mech, path)
 
 
 class _Builder:

@@ -14,7 +14,7 @@ P inputs and lengths in the file's length unit.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -28,6 +28,7 @@ from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
+           "KinematicPlan", "compile_plan",
            "ForceAnalysis", "forces"]
 
 
@@ -231,8 +232,75 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+    return compile_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
+        inputs, speeds=speeds, points=points, method=method, progress=progress)
+
+
+@dataclass(frozen=True, eq=False)
+class KinematicPlan:
+    """A mechanism compiled for repeated simulation: its constraint system and its
+    solution plan (drivers, then Assur groups in solving order; ``groups`` is None when
+    the mechanism does not split into dyads and Newton continuation is used).
+
+    Build it once with :func:`compile_plan`; :meth:`simulate` sweeps its inputs.
+    :meth:`with_joint_points` is the incremental re-simulation of an editor's drag loop:
+    the same topology with moved joints (new link dimensions and a new drawn
+    configuration) keeps the solution plan and rebuilds only the geometry.
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism
+    >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
+    >>> plan = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
+    >>> [s.kind for s in plan.groups.steps]
+    ['drive_R', 'RRR']
+    >>> moved = plan.with_joint_points({"C": (3.1, 2.9)})   # the user drags joint C
+    >>> sim = moved.simulate({"A": input_grid(0, 360, 1)})
+    >>> bool(sim.assembled.all())
+    True
+    """
+
+    mechanism: Mechanism
+    system: PlanarSystem
+    groups: "dyads.Plan | None"
+    vll: dict | None = None
+    prescribed: tuple = ()
+
+    def with_joint_points(self, points: dict[str, Any]) -> "KinematicPlan":
+        """The same mechanism with some joints moved (``{joint id: (x, y)}``), reusing the
+        solution plan: only the geometry (link frames, lengths, drawn configuration) is
+        rebuilt. Named points keep their drawn positions."""
+        mech = self.mechanism
+        for jid in points:
+            mech.joint(jid)  # KeyError names an unknown joint
+        joints = tuple(replace(j, point=np.asarray(points[j.id], float)) if j.id in points else j
+                       for j in mech.joints)
+        new = mech.with_joints(joints)
+        S = build_system(new, vll=self.vll, prescribed=self.prescribed)
+        return KinematicPlan(new, S, self.groups, self.vll, self.prescribed)
+
+    def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
+                 points: list[str] | None = None, method: str = "auto", progress: Any = None) -> Simulation:
+        """The sweep of :func:`simulate` with this plan."""
+        return _simulate_plan(self, inputs, speeds, points, method, progress)
+
+
+def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
+    """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
+    input values, which decides whether a passive VLL is prescribed)."""
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
     S = build_system(mech, vll=vll, prescribed=prescribed)
+    return KinematicPlan(mech, S, dyads.decompose(S), vll, prescribed)
+
+
+def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
+                   points: list[str] | None, method: str, progress: Any) -> Simulation:
+    mech, S = kp.mechanism, kp.system
+    if not inputs:
+        raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+    if tuple(j for j in inputs if _is_passive(mech, j, kp.vll)) != kp.prescribed:
+        kp = compile_plan(mech, kp.vll, tuple(inputs))
+        S = kp.system
     drivers = [d.joint for d in S.drivers]
     lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
     if len(lengths) != 1:
@@ -272,27 +340,15 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     for jid in inputs:
         sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
     pts = resolve_points(mech, points)
-    plan = dyads.decompose(S) if method in ("auto", "assur") else None
+    plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
         raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
                                 hint="use the Newton method")
-    events: list[dict] = []
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-        tracked = dyads.solve_tracked(S, plan, U)
-        q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-        qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
-        qdd[tracked.singular] = np.nan
-        ok = np.all(np.isfinite(q), axis=1)
-        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), events, method="assur")
-        events.extend(_fast_events(tracked, sw))
-        used = "assur"
-        if progress is not None:
-            progress(N)
-    else:
-        sw = sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-        events = sw.events
-        used = "newton"
+    sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress))
+    events = sw.events
+    used = sw.method
     ok = sw.assembled
     rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
     flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
@@ -328,6 +384,81 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
         speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
         events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+
+
+def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any) -> Sweep:
+    """One sweep from the drawn configuration through the rows of ``U`` in order."""
+    N = U.shape[0]
+    if plan is None:
+        return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
+    tracked = dyads.solve_tracked(S, plan, U)
+    q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
+    qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
+    qdd[tracked.singular] = np.nan
+    ok = np.all(np.isfinite(q), axis=1)
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
+    sw.events = _fast_events(tracked, sw)
+    if progress is not None:
+        progress(N)
+    return sw
+
+
+def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
+    """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
+    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
+    if U.shape[0] < 2:
+        return None
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    isR = np.array([d.type == "R" for d in S.drivers])
+    a, d = U[:-1], np.diff(U, axis=0)
+    dd = np.einsum("ij,ij->i", d, d)
+    for shift in (0.0, 2 * np.pi, -2 * np.pi):
+        v = np.where(isR, u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi)) + shift, u0)  # (N-1, k)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.einsum("ij,ij->i", v - a, d) / dd
+        off = np.abs(a + t[:, None] * d - v).max(axis=1)
+        hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
+        if hit.any():
+            return int(np.argmax(hit)) + 1
+    return None
+
+
+def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
+    """The sweep computed outwards from the drawn configuration when the drawn input lies
+    inside it (rows after it forwards, rows before it backwards), so every sweep that
+    contains the drawn input passes through the drawn configuration; else one run."""
+    k = _drawn_row(S, U)
+    if k is None:
+        return run(U)
+    fwd = run(U[k:])
+    bwd = run(U[:k][::-1].copy())
+    events = []
+    for e in bwd.events:
+        e = dict(e)
+        ib = e["index"]
+        at_row = e["kind"] == "singular" and not e.get("crossed")
+        e["index"] = (k - 1 - ib) if at_row else max(0, k - ib)
+        e.pop("before_sweep", None)
+        if e["kind"] == "dead point":
+            e["message"] = "a limit of the working range: the Jacobian is singular (dead point)"
+        elif e["kind"] == "reassembled":
+            e["message"] = ("assembles again (going back from the drawn configuration) after a gap, in the "
+                            "assembly mode nearest the drawn one")
+        events.append(e)
+    for e in fwd.events:
+        e = dict(e)
+        if e.get("before_sweep"):
+            e.pop("before_sweep")
+        e["index"] += k
+        events.append(e)
+    events.sort(key=lambda e: e["index"])
+
+    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[::-1], b])
+
+    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
+                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
+                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method)
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
@@ -389,6 +520,14 @@ class ForceAnalysis(Result):
     """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``)."""
 
     _plot = "kinematics:plot_forces"
+
+    def _summary(self) -> list[tuple[str, str]]:
+        sim, r = self.simulation, self.reactions
+        return [("mechanism", sim.mechanism), ("analysis", "static" if self.static else "kinetostatic"),
+                ("gravity", f"({self.gravity[0]:g}, {self.gravity[1]:g})"),
+                ("assembled", f"{int(np.count_nonzero(sim.assembled))} of {len(sim.assembled)}"),
+                ("joints", ", ".join(r.force) or "-"),
+                ("drives", ", ".join(f"{j} ({r.effort_kind[j]})" for j in r.effort) or "-")]
 
     simulation: Simulation
     reactions: Reactions

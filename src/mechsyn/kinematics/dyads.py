@@ -57,7 +57,12 @@ class Plan:
 
 
 def _cons_of(S: PlanarSystem, jid: str) -> list[Con]:
-    return [c for c in S.cons if c.joint == jid]
+    memo = _memo(S)
+    key = ("cons", jid)
+    out = memo.get(key)
+    if out is None:
+        out = memo[key] = [c for c in S.cons if c.joint == jid]
+    return out
 
 
 def _jtype(S: PlanarSystem, jid: str) -> str:
@@ -130,11 +135,57 @@ def decompose(S: PlanarSystem) -> Plan | None:
                 break
             if progress:
                 break
+        if not progress:
+            progress = _double_joint_dyad(S, known, used, drivers, link_joints, ends, steps)
     if len(known) < len(S.links) + 1:
         return None
     if set(j.id for j in mech.joints) - used:
         return None  # closing constraints left over (redundant): Newton handles them
     return Plan(tuple(steps))
+
+
+def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, link_joints: dict, ends,
+                       steps: list) -> bool:
+    """A dyad whose middle joint is a *double joint*: links ``b1`` and ``b2`` both pinned to
+    a third link ``m`` at one point (two R pairs ``b1-m``, ``b2-m`` at the same place).
+
+    The point is the intersection of the circles about ``b1``'s and ``b2``'s known joints,
+    as in an RRR dyad; ``m`` is placed later through the pair ``b1-m`` (the pair ``b2-m``
+    is then satisfied, being at the same point). Appends the step and returns True when
+    one is found."""
+    mech = S.mech
+    pts = {j.id: np.asarray(j.point, float) for j in mech.joints}
+    for b1 in range(len(S.links)):
+        if b1 in known:
+            continue
+        j1s = [j for j in link_joints.get(b1, []) if j not in used and j not in drivers
+               and (set(ends(j)) - {b1}) <= known]
+        if len(j1s) != 1 or _jtype(S, j1s[0]) != "R":
+            continue
+        for J2a in link_joints.get(b1, []):
+            if J2a in used or J2a in drivers or _jtype(S, J2a) != "R":
+                continue
+            m = (set(ends(J2a)) - {b1}).pop()
+            if m in known:
+                continue
+            for J2b in link_joints.get(m, []):
+                if J2b == J2a or J2b in used or J2b in drivers or _jtype(S, J2b) != "R":
+                    continue
+                b2 = (set(ends(J2b)) - {m}).pop()
+                if b2 in known or b2 == b1 or np.abs(pts[J2a] - pts[J2b]).max() > 1e-9 * S.scale:
+                    continue
+                j3s = [j for j in link_joints.get(b2, []) if j not in used and j not in drivers and j != J2b
+                       and (set(ends(j)) - {b2}) <= known]
+                if len(j3s) != 1 or _jtype(S, j3s[0]) != "R":
+                    continue
+                J1, J3 = j1s[0], j3s[0]
+                k1 = (set(ends(J1)) - {b1}).pop()
+                k3 = (set(ends(J3)) - {b2}).pop()
+                steps.append(Step("RRR", (b1, b2), (k1, k3), (J1, J2a, J3), {"double": J2b}))
+                known.update((b1, b2))
+                used.update((J1, J3, J2b))
+                return True
+    return False
 
 
 # --------------------------------------------------------------------------- states
@@ -162,10 +213,25 @@ class _State:
         self.phi[:, i] = phi
 
 
+def _memo(S: PlanarSystem) -> dict:
+    """Per-system cache of look-ups that depend only on the system (local joint points,
+    constraints of a joint): a plan evaluated many times (events, drags) reuses them."""
+    memo = S.__dict__.get("_dyads_memo")
+    if memo is None:
+        memo = {}
+        object.__setattr__(S, "_dyads_memo", memo)
+    return memo
+
+
 def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
-    j = S.mech.joint(jid)
-    name = S.mech.ground if i < 0 else S.links[i]
-    return S.to_local(name, j.point)
+    memo = _memo(S)
+    key = ("local", i, jid)
+    out = memo.get(key)
+    if out is None:
+        j = S.mech.joint(jid)
+        name = S.mech.ground if i < 0 else S.links[i]
+        out = memo[key] = S.to_local(name, j.point)
+    return out
 
 
 def _rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:
@@ -926,6 +992,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
                            "message": f"assembles again after a gap, in the assembly mode of the drawn "
                                       f"configuration for the group {group} (the mode nearest the drawn one)"})
     # bifurcations: local minima of the discriminant at zero
+    touched: list = []
     cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
     for i in cand.tolist():
         t_star, dmin = _touch(S, plan, k, sigmas, X, i)
@@ -946,8 +1013,12 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         else:
             row, at = i, i
         u = X[i] + t_star * (X[i + 1] - X[i]) if t_star >= 0 else X[i] + t_star * (X[i] - X[i - 1])
+        if any(abs(i - j) <= 2 and np.abs(u - v).max() < 1e-8 for j, v in touched):
+            continue  # the same crossing seen from the neighbouring sample
+        touched.append((i, u))
         breaks.append((row, "flip"))
         events.append({"index": at, "kind": "singular", "input": u.tolist(), "group": group,
+                       "crossed": not singular[i],
                        "message": f"change / branch point: the group {group} is folded flat here (its two "
                                   "assembly modes meet); the motion continues on the branch whose velocity is "
                                   "continuous (the drawn branch)"
@@ -991,4 +1062,22 @@ def _touch(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i: 
         t = brentq(slope, lo + h, hi - h, xtol=1e-12)
     except ValueError:
         t = float(ts[j])
-    return t, float(at(np.array([t]))[0])
+    dmin = float(at(np.array([t]))[0])
+    if abs(dmin) <= 1e-10:
+        # the minimum of a quadratic is found by its slope only to about sqrt(eps): at a
+        # tangency the signed height sqrt(Delta) is linear on each side, so the secants
+        # of sqrt(Delta) from both sides, extrapolated to zero spacing (Richardson),
+        # give its zero to round-off
+        def secant_roots(dt: float) -> float:
+            ts_ = t + np.array([-2 * dt, -dt, dt, 2 * dt])
+            f = np.sqrt(np.maximum(at(ts_), 0.0))
+            left = ts_[1] - f[1] * (ts_[1] - ts_[0]) / (f[1] - f[0])
+            right = ts_[2] - f[2] * (ts_[3] - ts_[2]) / (f[3] - f[2])
+            return 0.5 * (left + right)
+
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r1, r2 = secant_roots(1e-2), secant_roots(2e-2)
+        t_fine = (4 * r1 - r2) / 3
+        if np.isfinite(t_fine) and abs(t_fine - t) < 0.1:
+            t = float(t_fine)
+    return t, dmin

@@ -62,8 +62,11 @@ def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 
 def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = None,
-           max_iter: int = 12) -> tuple[np.ndarray, bool]:
-    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged)."""
+           max_iter: int = 12, polish: bool = False) -> tuple[np.ndarray, bool]:
+    """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged).
+
+    ``polish``: one more step after convergence where the Jacobian is well conditioned
+    (the sweep's positions then agree with the closed form to round-off)."""
     tol = tol if tol is not None else 1e-12 * S.scale
     q = q.copy()
     u2 = u[None]
@@ -74,6 +77,12 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
         if not np.isfinite(norm):
             return q, False
         if norm < tol:
+            if polish and norm > 1e-3 * tol:  # one more step: the error squares (a polish, not a new solve)
+                dq = _solve_lin(S.jacobian(q[None])[0], -r)
+                if np.all(np.isfinite(dq)) and float(np.abs(dq).max()) <= 1e2 * norm:  # well conditioned
+                    q2 = q + dq
+                    if float(np.abs(S.residual(q2[None], u2)[0]).max()) <= norm:
+                        q = q2
             return q, True
         if norm > 4 * prev and prev < 1e-3 * S.scale:
             return q, False
@@ -263,7 +272,7 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
     if X is None:
         X = _factor(S, q)[1]
     q_pred = q + X @ du
-    q_new, ok = newton(S, q_pred, ub)
+    q_new, ok = newton(S, q_pred, ub, polish=True)
     if ok and _step_ok(S, q, q_new, q_pred):
         return q_new
     if depth == 0:
@@ -338,23 +347,82 @@ def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
             return cand if ok else None
         return nxt
     pred = _extrapolate(hist, u)
-    cand, ok = newton(S, pred, u, max_iter=40)
+    cand, ok = newton(S, pred, u, max_iter=40, polish=True)
     if ok:
         return cand
     return nxt
 
 
-def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray, det: float) -> list:
-    """Configurations at ``u`` with ``det Phi_q`` of sign ``det``, searched from ``q`` along
-    the direction in which ``Phi_q`` is nearest singular (where two assembly modes meet
-    near a fold, they differ along it)."""
+def _elbows(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
+    """Assembly-mode signature of a configuration: at every R pair joining two moving links
+    that each carry another joint, the side to which the second link turns from the first
+    (the sign of ``(P_J - P_a) x (P_b - P_J)``; for a dyad, its assembly mode)."""
+    out = []
+    mech = S.mech
+
+    def glob(i: int, jid: str) -> np.ndarray:
+        s = S.to_local(S.links[i], mech.joint(jid).point)
+        c, sn = np.cos(q[3 * i + 2]), np.sin(q[3 * i + 2])
+        return q[3 * i:3 * i + 2] + np.array([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])
+
+    for j in mech.joints:
+        if j.type != "R":
+            continue
+        a, b = (S.index(n) for n in j.links)
+        if a < 0 or b < 0:
+            continue
+        oa = [k.id for k in mech.joints_of(j.links[0]) if k.id != j.id]
+        ob = [k.id for k in mech.joints_of(j.links[1]) if k.id != j.id]
+        if not oa or not ob:
+            continue
+        P, Pa, Pb = glob(a, j.id), glob(a, oa[0]), glob(b, ob[0])
+        d1, d2 = P - Pa, Pb - P
+        out.append(np.sign(d1[0] * d2[1] - d1[1] * d2[0]))
+    return np.array(out)
+
+
+def _nearest_mode(S: PlanarSystem, cands: list, u: np.ndarray, q_drawn: np.ndarray, det: float) -> np.ndarray:
+    """Of configurations at ``u``, the one in the assembly mode nearest the drawn one.
+
+    When the mechanism splits into dyads, each dyad's drawn mode gives the configuration
+    directly (closed form, polished by Newton). Otherwise: the candidate (with those found
+    along the nearest-singular direction of each) whose elbow signature
+    (:func:`_elbows`) matches the drawn one most, then whose ``det Phi_q`` has the drawn
+    sign."""
+    from mechsyn.kinematics import dyads
+
+    plan = dyads.decompose(S)
+    if plan is not None:
+        u_asm = np.array([d.assembled for d in S.drivers])
+        _, sig = dyads.solve_positions(S, plan, u_asm[None])
+        with np.errstate(invalid="ignore"):
+            qc = dyads.solve_positions(S, plan, u[None], sigmas=sig)[0][0]
+        if np.all(np.isfinite(qc)):
+            qc, good = newton(S, qc, u, max_iter=10)
+            if good:
+                return qc
+    pool = list(cands)
+    for c in cands:
+        pool.extend(_other_mode(S, c, u))
+    ref = _elbows(S, q_drawn)
+
+    def score(c: np.ndarray) -> tuple:
+        return (int(np.sum(_elbows(S, c) == ref)), _factor(S, c)[2] * det > 0)
+
+    return max(pool, key=score)
+
+
+def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> list:
+    """Configurations at ``u`` other than ``q``, searched from ``q`` along the direction in
+    which ``Phi_q`` is nearest singular (where two assembly modes meet near a fold, they
+    differ along it)."""
     J = S.jacobian(q[None])[0]
     v = np.linalg.svd(J)[2][-1]
     v = v / max(float(np.abs(v).max()), 1e-300)
     for a in (0.05, 0.2, 0.5, 1.0):
         for sgn in (1.0, -1.0):
             c, good = newton(S, q + sgn * a * S.scale * v, u, max_iter=30)
-            if good and _factor(S, c)[2] * det > 0:
+            if good and np.abs(c - q).max() > 1e-6 * S.scale:
                 return [c]
     return []
 
@@ -432,6 +500,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
         if refine_limits:
             ul, _ = _limit(S, hist[-1][1], hist[-1][0], inputs[0])
             events.append({"index": 0, "kind": "dead point", "input": ul.tolist(),
+                           "before_sweep": True,
                            "message": "the mechanism cannot move from its file configuration to the first input"})
     for i in range(N):
         u = inputs[i]
@@ -459,10 +528,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                     cands.append(c)
             ok = bool(cands)
             if ok:
-                same = [c for c in cands if _factor(S, c)[2] * drawn_det > 0]
-                if not same:
-                    same = _other_mode(S, cands[0], u, drawn_det)
-                cand = (same or cands)[0]
+                cand = _nearest_mode(S, cands, u, q_start, drawn_det)
                 cur, cur_u = cand, u
                 hist = [(u, cand, _factor(S, cand))]
                 # follow the new branch backwards into the gap as far as it assembles
@@ -495,7 +561,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                 qdd[i] = np.nan
             if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
                     and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
-                events.append({"index": i, "kind": "singular", "input": u.tolist(),
+                events.append({"index": i, "kind": "singular", "input": u.tolist(), "crossed": True,
                                "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
                                           "crossed between this input and the previous"})
         if progress is not None:

@@ -112,9 +112,23 @@ class StateSpec:
     mobility: int | None = None
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class Mechanism:
     """A mechanism: links (frame included), joints, named points, contours, states.
+
+    ``print(m)`` shows its joints as a table (links joined, pair type and class, drives);
+    ``m.analyze()``, ``m.simulate(A=(0, 360, 1))`` and ``m.forces(...)`` run the analyses;
+    ``m.to_dict()`` gives the file-format data (``mechsyn.save(m, path)`` writes it).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.examples.load("fourbar")
+    >>> m
+    <Mechanism 'Four-bar linkage': planar, 4 links (frame 'frame'), 4 joints, p5 = 4>
+    >>> s = m.simulate(A=(0, 90, 45))
+    >>> s.assembled.tolist(), s.point("M").shape
+    ([True, True, True], (3, 2))
 
     Attributes
     ----------
@@ -202,6 +216,72 @@ class Mechanism:
             counts[j.pair_class] = counts.get(j.pair_class, 0) + 1
         return dict(sorted(counts.items()))
 
+    # -- display --------------------------------------------------------------------
+    def __repr__(self) -> str:
+        pbc = ", ".join(f"p{k} = {v}" for k, v in self.pairs_by_class().items()) or "no pairs"
+        name = self.name if len(self.name) <= 80 else self.name[:77] + "..."
+        return (f"<Mechanism {name!r}: {self.kind}, {len(self.links)} links (frame {self.ground!r}), "
+                f"{len(self.joints)} joints, {pbc}>")
+
+    def _rows(self) -> list[tuple[str, ...]]:
+        return [(j.id, j.type, str(j.pair_class), f"{j.links[0]} - {j.links[1]}",
+                 "drive" if j.actuated else (f"VLL {j.vll}" if j.vll else "")) for j in self.joints]
+
+    def __str__(self) -> str:
+        head = ("joint", "type", "class", "links", "")
+        rows = [head, *self._rows()]
+        widths = [max(len(r[k]) for r in rows) for k in range(len(head))]
+        lines = [repr(self)[1:-1]]
+        lines += ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+        if self.points:
+            lines.append("  points: " + ", ".join(f"{k} on {p.link}" for k, p in self.points.items()))
+        if self.states:
+            lines.append("  states: " + ", ".join(self.states))
+        return "\n".join(lines)
+
+    def _repr_markdown_(self) -> str:
+        out = [f"**{self.name}** ({self.kind}, frame `{self.ground}`)", "",
+               "| joint | type | class | links | |", "|---|---|---|---|---|"]
+        out += ["| " + " | ".join(r) + " |" for r in self._rows()]
+        return "\n".join(out)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The file-format data (what :func:`mechsyn.save` writes)."""
+        from mechsyn.io.load import mechanism_to_dict
+
+        return mechanism_to_dict(self)
+
+    # -- analyses (the library's entry points, as methods) ---------------------------
+    def analyze(self, method: str | None = None, remedies: bool = False, **kwargs: Any) -> Any:
+        """Structural analysis: :func:`mechsyn.analyze` (formulas, rank method, remedies)."""
+        from mechsyn.structure.report import analyze
+
+        return analyze(self, method=method, remedies=remedies, **kwargs)
+
+    def simulate(self, inputs: dict[str, Any] | None = None, *, points: list[str] | None = None,
+                 speeds: dict[str, float] | None = None, vll: dict[str, str] | None = None,
+                 method: str = "auto", **joint_inputs: Any) -> Any:
+        """Kinematics over a sweep: :func:`mechsyn.simulate`, inputs given per joint.
+
+        Each input is ``(start, stop, step)`` (a tuple: a range, ends included) or the values
+        themselves (a list or array); degrees for R joints, lengths for P joints:
+        ``m.simulate(A=(0, 360, 1))`` or ``m.simulate({"A": np.linspace(0, 90, 7)})``.
+        """
+        from mechsyn.kinematics.analysis import simulate
+
+        return simulate(self, _inputs(inputs, joint_inputs), speeds=speeds, points=points, vll=vll,
+                        method=method)
+
+    def forces(self, inputs: dict[str, Any] | None = None, *, gravity: tuple[float, float] = (0.0, 0.0),
+               static: bool = False, speeds: dict[str, float] | None = None, vll: dict[str, str] | None = None,
+               method: str = "auto", **joint_inputs: Any) -> Any:
+        """Joint reactions and drive efforts over a sweep: :func:`mechsyn.forces`, inputs as
+        in :meth:`simulate`."""
+        from mechsyn.kinematics.analysis import forces
+
+        return forces(self, _inputs(inputs, joint_inputs), speeds=speeds, gravity=gravity, static=static,
+                      vll=vll, method=method)
+
     # -- variants -------------------------------------------------------------------
     def with_joints(self, joints: tuple[Joint, ...], name: str | None = None) -> "Mechanism":
         return replace(self, joints=joints, name=name or self.name)
@@ -222,3 +302,25 @@ class Mechanism:
             mobility=spec.mobility if spec.mobility is not None else (
                 self.mobility if not spec.add_joints else None),
         )
+
+
+def _inputs(inputs: dict[str, Any] | None, joint_inputs: dict[str, Any]) -> dict[str, np.ndarray]:
+    """Joint -> values: a tuple ``(start, stop, step)`` is a range with both ends, anything
+    else the values themselves."""
+    from mechsyn.errors import MechsynInputError
+    from mechsyn.kinematics.analysis import input_grid
+
+    out: dict[str, np.ndarray] = {}
+    for jid, v in {**(inputs or {}), **joint_inputs}.items():
+        if isinstance(v, tuple):
+            if len(v) != 3:
+                raise MechsynInputError(f"{jid}: a range is (start, stop, step), got {v!r}", field="inputs",
+                                        hint="give a list or an array for explicit values")
+            start, stop, step = map(float, v)
+            if step == 0 or (stop - start) * step < 0:
+                raise MechsynInputError(f"{jid}: step {step:g} does not lead from {start:g} to {stop:g}",
+                                        field="inputs")
+            out[jid] = input_grid(start, stop, step)
+        else:
+            out[jid] = np.atleast_1d(np.asarray(v, float))
+    return out

@@ -120,6 +120,23 @@ def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
     return arts
 
 
+def link_colour(sim: Any, link: str) -> Any:
+    """The colour of ``link`` in every figure: Matplotlib's tab10 by the link's place in the file."""
+    names = list(sim.system.mech.link_names) if sim.system is not None else list(sim.links)
+    return matplotlib.colormaps["tab10"](names.index(link) % 10 if link in names else 7)
+
+
+def _point_styles(sim: Any) -> dict[str, tuple[Any, str]]:
+    """Colour (its link's) and line style (solid, then dashed, ... for more points on one link)."""
+    seen: dict[str, int] = {}
+    out = {}
+    for name, pm in sim.points.items():
+        n = seen.get(pm.link, 0)
+        seen[pm.link] = n + 1
+        out[name] = (link_colour(sim, pm.link), ("-", "--", ":", "-.")[n % 4])
+    return out
+
+
 def _input_axis(sim) -> tuple[np.ndarray, str]:
     main = sim.main_input
     unit = "deg" if sim.input_types[main] == "R" else "length"
@@ -144,9 +161,13 @@ def plot_paths(sim: Any, ax: Any = None) -> Any:
     k0 = int(np.argmax(sim.assembled)) if sim.assembled.any() else None
     if k0 is not None:
         draw_mechanism(ax, sim, k0)
+    styles = _point_styles(sim)
     for name, pm in sim.points.items():
-        ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1.5, label=f"path of {name}")
+        c, ls = styles[name]
+        ax.plot(pm.position[:, 0], pm.position[:, 1], ls, color=c, lw=1.5, label=f"path of {name}")
     ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(f"x ({_length_unit(sim)})")
+    ax.set_ylabel(f"y ({_length_unit(sim)})")
     ax.set_title("mechanism (first assembled input) and point paths")
     ax.grid(alpha=0.3)
     if sim.points:
@@ -161,10 +182,13 @@ def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
     fig = figure(fig, (12, 9))
     axs = fig.subplots(2, 2)
     plot_paths(sim, axs[0, 0])
-    for ax, key, lab in ((axs[0, 1], "velocity", "speed |v| (length/s)"),
-                         (axs[1, 0], "acceleration", "acceleration |a| (length/s²)")):
+    unit = _length_unit(sim)
+    styles = _point_styles(sim)
+    for ax, key, lab in ((axs[0, 1], "velocity", f"speed |v| ({unit}/s)"),
+                         (axs[1, 0], "acceleration", f"acceleration |a| ({unit}/s²)")):
         for name, pm in sim.points.items():
-            ax.plot(x, np.linalg.norm(getattr(pm, key), axis=1), label=name)
+            c, ls = styles[name]
+            ax.plot(x, np.linalg.norm(getattr(pm, key), axis=1), ls, color=c, label=name)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
@@ -173,7 +197,7 @@ def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
         ax.set_title(f"point {key}")
     ax = axs[1, 1]
     for name, lm in sim.links.items():
-        ax.plot(x, lm.angular_velocity, label=name)
+        ax.plot(x, lm.angular_velocity, color=link_colour(sim, name), label=name)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("angular velocity (rad/s)")
     ax.set_title("link angular velocities")
@@ -216,6 +240,40 @@ def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
     return fig
 
 
+def _length_unit(sim: Any) -> str:
+    """The length unit of the mechanism file (``units:``), else "length"."""
+    return sim.system.mech.attrs.get("units") or "length"
+
+
+def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.ndarray, xlabel: str,
+                      interval: float) -> Any:
+    """An animation redrawn whole at each frame (cams and belts change shape as they move)."""
+    from matplotlib.animation import FuncAnimation
+
+    xlim, ylim = ax.get_xlim(), ax.get_ylim()
+    unit = _length_unit(sim)
+
+    def draw(k):
+        ax.clear()
+        ax.set_xlim(*xlim)
+        ax.set_ylim(*ylim)
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+        ax.set_xlabel(f"x ({unit})")
+        ax.set_ylabel(f"y ({unit})")
+        for name, pm in sim.points.items():
+            ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
+            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
+            ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
+        arts = draw_mechanism(ax, sim, k)
+        ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
+        if sim.points:
+            ax.legend(fontsize=8, loc="upper right")
+        return arts
+
+    return FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+
+
 def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval: float = 1000 / 15) -> Any:
     """The mechanism moving over the assembled inputs, tracing its points' paths.
 
@@ -242,21 +300,72 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
     hi = np.array([ax.dataLim.x1, ax.dataLim.y1])
     pad = 0.08 * max(hi - lo) + 1e-9
     x, xlabel = _input_axis(sim)
+    ax.clear()
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_xlabel(f"x ({_length_unit(sim)})")
+    ax.set_ylabel(f"y ({_length_unit(sim)})")
+    if any(c.kind in ("curve", "belt") for c in sim.system.cons):
+        return _redraw_animation(sim, fig, ax, frames, x, xlabel, interval)
+    # the artists are made once and moved at each frame (no clearing, no re-layout)
+    S = sim.system
+    cmap = matplotlib.colormaps["tab10"]
+    trails = []
+    styles = _point_styles(sim)
+    for name, pm in sim.points.items():
+        ax.plot(pm.position[idx, 0], pm.position[idx, 1], "-", lw=1, color="0.7")
+        trail, = ax.plot([], [], styles[name][1], color=styles[name][0], lw=1.8, label=name)
+        dot, = ax.plot([], [], "o", ms=4, color="k")
+        trails.append((pm.position, trail, dot))
+    links = []
+    for n, name in enumerate(S.mech.link_names):
+        c = cmap(n % 10)
+        if name == S.mech.ground:
+            links.append((name, None, ax.plot([], [], "^", ms=10, color="0.35", zorder=3)[0], None))
+            continue
+        fill = ax.fill([0, 0], [0, 0], color=c, alpha=0.35, zorder=2)[0]
+        edge, = ax.plot([], [], "-", color=c, lw=2.5, zorder=2, solid_capstyle="round")
+        pins, = ax.plot([], [], "o", ms=5, mfc="white", mec=c, zorder=4)
+        links.append((name, fill, edge, pins))
+    sliders = [(j.links[1], [x.id for x in S.mech.joints_of(j.links[1])].index(j.id))
+               for j in S.mech.joints if j.type == "P"]
+    squares, = ax.plot([], [], "s", ms=11, mfc="none", mec="0.1", zorder=5)
+    title = ax.set_title("", fontsize=10)
+    if sim.points:
+        ax.legend(fontsize=8, loc="upper right")
 
     def draw(k):
-        ax.clear()
-        ax.set_xlim(lo[0] - pad, hi[0] + pad)
-        ax.set_ylim(lo[1] - pad, hi[1] + pad)
-        ax.set_aspect("equal")
-        ax.grid(alpha=0.3)
-        for name, pm in sim.points.items():
-            ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
-            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
-            ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
-        arts = draw_mechanism(ax, sim, k)
-        ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
-        if sim.points:
-            ax.legend(fontsize=8, loc="upper right")
-        return arts
+        for pos, trail, dot in trails:
+            trail.set_data(pos[:k + 1, 0], pos[:k + 1, 1])
+            dot.set_data([pos[k, 0]], [pos[k, 1]])
+        outl = link_outlines(sim, k)
+        for name, fill, edge, pins in links:
+            pts = outl[name]
+            if fill is None:
+                edge.set_data(pts[:, 0], pts[:, 1])
+                continue
+            if len(pts) >= 3:
+                centre = pts.mean(axis=0)
+                poly = pts[np.argsort(np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0]))]
+                fill.set_xy(poly)
+                fill.set_visible(True)
+                closed = np.vstack([poly, poly[:1]])
+                edge.set_data(closed[:, 0], closed[:, 1])
+                edge.set_linewidth(2.5)
+            else:
+                fill.set_visible(False)
+                edge.set_data(pts[:, 0], pts[:, 1])
+                edge.set_linewidth(3)
+            pins.set_data(pts[:, 0], pts[:, 1])
+        if sliders:
+            sq = np.array([outl[b][i] for b, i in sliders])
+            squares.set_data(sq[:, 0], sq[:, 1])
+        title.set_text(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}")
+        return ([a for _, trail, dot in trails for a in (trail, dot)]
+                + [a for _, f, e, p in links for a in (f, e, p) if a is not None] + [squares, title])
 
-    return FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+    anim = FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+    anim.mechsyn_blit = (draw, list(frames))  # what moves: see mechsyn.plot.frames
+    return anim

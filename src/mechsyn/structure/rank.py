@@ -40,6 +40,10 @@ the nearby assembled configurations: if the rank there is larger, the given
 configuration is singular (instantaneous mobility > finite mobility). Higher pairs are
 followed as their instantaneously equivalent chain of lower pairs (the contact surfaces'
 curvature is not in the file).
+
+Pair twists and the linear algebra live in :mod:`mechsyn.structure.screws`, idle
+mobilities in :mod:`mechsyn.structure.idle`, the formulas side by side and the remedy
+checks in :mod:`mechsyn.structure.compare`.
 """
 
 from __future__ import annotations
@@ -50,461 +54,48 @@ from typing import Any, Callable
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.structure.contours import independent_contours
 from mechsyn.structure.idle import IdleInputs, IdleMobility, find_idle_mobilities
+from mechsyn.structure.screws import (  # noqa: F401  (re-exported: the names users import from here)
+    _AXIS_NAMES,
+    PLANAR_ROWS,
+    InsufficientGeometry,
+    _belt_geometry,
+    _eliminate,
+    _exp,
+    _gear_geometry,
+    _null,
+    _pad3,
+    _rank,
+    _reduce_dense,
+    _Reduction,
+    _unit,
+    _vec,
+    as_spatial,
+    describe_wrenches,
+    missing_geometry,
+    pair_twists,
+)
 
 __all__ = [
     "RankAnalysis", "IdleMobility", "ContourRank", "InsufficientGeometry",
     "analyze_rank", "pair_twists", "missing_geometry", "as_spatial", "describe_wrenches",
 ]
 
-_E = np.eye(3)
-PLANAR_ROWS = np.array([2, 3, 4])  # ω_z, v_x, v_y of [ω; v]
-_AXIS_NAMES = ("x", "y", "z")
-
-
-class InsufficientGeometry(MechsynInputError):
-    """The file does not give enough geometry for the rank method."""
-
-
-# --------------------------------------------------------------------------- pairs
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v)
-
-
-def _perp_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors perpendicular to unit ``n`` and to each other."""
-    k = int(np.argmin(np.abs(n)))
-    t1 = _unit(np.cross(n, _E[k]))
-    return t1, np.cross(n, t1)
-
-
-def _rot(p: np.ndarray, a: np.ndarray) -> np.ndarray:
-    return np.concatenate([a, _cross(p, a)])
-
-
-def _tr(a: np.ndarray) -> np.ndarray:
-    return np.concatenate([np.zeros(3), a])
-
-
-def _pad3(v: np.ndarray | None) -> np.ndarray | None:
-    if v is None:
-        return None
-    v = np.asarray(v, dtype=float)
-    return v if v.size == 3 else np.array([v[0], v[1], 0.0])
-
-
-def _need(joint: Joint, what: str, hint: str) -> InsufficientGeometry:
-    return InsufficientGeometry(
-        f"joint {joint.id} ({joint.type}) has no {what}: the rank method cannot build its twists",
-        field=f"joints[{joint.id}]", hint=hint)
-
-
-def _gear_geometry(joint: Joint, mech: Mechanism | None) -> tuple[np.ndarray, np.ndarray]:
-    """Pitch point and line of action of a gear mesh given by ``ratio`` (20° pressure angle).
-
-    The wheels' centres are their revolute pairs (preferably on a common link: carrier or
-    frame); the pitch point divides the centre line so that ``|ratio| = r_a/r_b``
-    (``ω_b/ω_a`` relative to the carrier; negative: external mesh, positive: internal).
-    """
-    if mech is None:
-        raise _need(joint, "point and normal", "give point (pitch point) and normal (line of action)")
-    a, b = joint.links
-    pivots: dict[str, dict[str, Joint]] = {a: {}, b: {}}
-    for j in mech.joints:
-        if j is joint or j.type != "R" or j.point is None:
-            continue
-        for wheel in (a, b):
-            if wheel in j.links:
-                pivots[wheel][j.other(wheel)] = j
-    common = [c for c in pivots[a] if c in pivots[b]]
-    if common:
-        oa, ob = _pad3(pivots[a][common[0]].point), _pad3(pivots[b][common[0]].point)
-    elif pivots[a] and pivots[b]:  # e.g. a planet on its carrier meshing with a sun on the frame
-        oa, ob = _pad3(next(iter(pivots[a].values())).point), _pad3(next(iter(pivots[b].values())).point)
-    else:
-        raise _need(joint, "point and normal", "give point and normal, or turn both wheels in R pairs")
-    d = ob - oa
-    if joint.point is not None:
-        p = _pad3(joint.point)
-    elif joint.ratio is not None and joint.ratio != 0:
-        # ω_b/ω_a = ratio: r_a/r_b = |ratio|; external (ratio < 0) between the centres.
-        r = abs(joint.ratio)
-        p = oa + d * (r / (1 + r)) if joint.ratio < 0 else oa + d * (r / (r - 1) if r != 1 else 0.5)
-    else:
-        raise _need(joint, "point", "give point (pitch point) or ratio")
-    z = np.array([0.0, 0.0, 1.0])
-    tangent = _unit(np.cross(z, d))
-    ang = np.radians(20.0)
-    normal = np.cos(ang) * tangent + np.sin(ang) * _unit(d)
-    return p, normal
-
-
-def _belt_geometry(joint: Joint) -> tuple[np.ndarray, np.ndarray]:
-    """Contact point and normal of a belt pair's instantaneous equivalent: the straight belt
-    run is the tension's line of action, so the belt acts like a higher pair (rolling
-    contact) with normal along the run through the tangent point
-    (:func:`mechsyn.model.pairs.belt_tangent`)."""
-    from mechsyn.model.pairs import belt_tangent
-
-    anchor, radius, wrap = (joint.attrs.get(k) for k in ("anchor", "radius", "wrap"))
-    if joint.point is None or anchor is None or radius is None or wrap is None:
-        raise _need(joint, "point, anchor, radius and wrap", "give the pulley centre, anchor, radius and wrap")
-    if len(anchor) != 2:
-        raise InsufficientGeometry(
-            f"joint {joint.id}: rank analysis is not supported for belt pairs in a spatial file",
-            field=f"joints[{joint.id}]", hint="describe the belt drive in a planar file (kind: planar)")
-    try:
-        T, g, _ = belt_tangent(joint.point, np.asarray(anchor, float), float(radius), wrap)
-    except ValueError as exc:
-        raise InsufficientGeometry(f"joint {joint.id} (belt): {exc}", field=f"joints[{joint.id}]",
-                                   hint="put the anchor outside the pulley") from None
-    return _pad3(T), _pad3(g)
-
-
-def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np.ndarray:
-    """Unit twists ``[ω; v]`` (``f × 6``) the pair permits at the assembled configuration.
-
-    ``planar``: the joint's 2-D geometry is embedded in the plane ``z = 0`` (R turns about
-    ``z``; cam and gear permit rotation about ``z`` through the contact point and sliding
-    along the tangent). Raises :class:`InsufficientGeometry` naming what is missing.
-
-    Pair conventions: ``C`` rotation then slide along ``axis``; ``U`` ``axis`` then
-    ``axis2``; ``S`` rotations about x, y, z through ``point``; ``S_pin`` rotations about
-    ``axis`` and ``axis2`` through ``point`` (or every axis perpendicular to ``normal``,
-    the blocked rotation); ``E`` rotation about the plane normal ``axis`` and two slides in
-    the plane; ``line_contact`` rotations about ``normal`` and the contact line ``axis``,
-    slides along the line and across it; ``point_contact`` three rotations about the
-    contact point and two slides perpendicular to ``normal``.
-    """
-    t = joint.type
-    p = _pad3(joint.point)
-    a = _pad3(joint.axis)
-    if a is not None:
-        a = _unit(a)
-    z = np.array([0.0, 0.0, 1.0])
-    if t == "generic":
-        raise InsufficientGeometry(
-            f"joint {joint.id} is a generic pair of class {joint.pair_class}: its permitted motions are unknown",
-            field=f"joints[{joint.id}]", hint="give the pair's real type (R, P, C, S, ...) with its point and axis")
-    if t == "belt":
-        p, n = _belt_geometry(joint)
-        if planar:
-            return np.array([_rot(p, z), _tr(np.cross(z, n))])
-        t = "line_contact" if joint.pair_class == 2 else ("point_contact" if joint.pair_class == 1 else "generic")
-        if t == "generic":
-            raise InsufficientGeometry(f"joint {joint.id}: a spatial belt of class {joint.pair_class} "
-                                       "has unknown permitted motions", field=f"joints[{joint.id}]",
-                                       hint="use class 2 (the belt's instantaneous line contact along z)")
-        if a is None:
-            a = z
-        joint = replace(joint, normal=n)
-    if planar:
-        if t in ("cam", "gear"):
-            if t == "gear" and joint.normal is None:
-                p, n = _gear_geometry(joint, mech)
-            else:
-                if p is None:
-                    raise _need(joint, "point", "give point: the contact point")
-                if joint.normal is None:
-                    raise _need(joint, "normal", "give normal: the contact normal")
-                n = _unit(_pad3(joint.normal))
-            return np.array([_rot(p, z), _tr(np.cross(z, n))])
-        if t == "R":
-            if p is None:
-                raise _need(joint, "point", "give point: [x, y]")
-            return np.array([_rot(p, z)])
-        if t == "P":
-            if a is None:
-                raise _need(joint, "axis", "give axis: the sliding direction [dx, dy]")
-            return np.array([_tr(a)])
-        raise _need(joint, "planar twist", "use R, P, cam, gear or belt in a planar file")
-    if t in ("cam", "gear"):
-        t = "line_contact" if joint.pair_class == 2 else ("point_contact" if joint.pair_class == 1 else "generic")
-        if t == "generic":
-            raise InsufficientGeometry(f"joint {joint.id}: a spatial {joint.type} of class {joint.pair_class} "
-                                       "has unknown permitted motions", field=f"joints[{joint.id}]",
-                                       hint="use class 2 (line contact, with axis) or 1 (point contact)")
-    if t != "P" and p is None:
-        raise _need(joint, "point", "give point: [x, y, z]")
-    if t == "R":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the rotation axis")
-        return np.array([_rot(p, a)])
-    if t == "P":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the sliding direction")
-        return np.array([_tr(a)])
-    if t == "H":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the screw axis")
-        h = joint.pitch or 0.0
-        return np.array([_rot(p, a) + _tr(h * a)])
-    if t == "C":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the cylinder axis")
-        return np.array([_rot(p, a), _tr(a)])
-    if t == "U":
-        if a is None or joint.axis2 is None:
-            raise _need(joint, "axis and axis2", "give axis (fixed in the first link) and axis2 (in the second)")
-        return np.array([_rot(p, a), _rot(p, _unit(_pad3(joint.axis2)))])
-    if t == "S":
-        return np.array([_rot(p, e) for e in _E])
-    if t == "S_pin":
-        if a is not None and joint.axis2 is not None:
-            return np.array([_rot(p, a), _rot(p, _unit(_pad3(joint.axis2)))])
-        if joint.normal is not None:
-            t1, t2 = _perp_basis(_unit(_pad3(joint.normal)))
-            return np.array([_rot(p, t1), _rot(p, t2)])
-        raise _need(joint, "axis and axis2 (or normal)",
-                    "give axis and axis2 (the two permitted rotations) or normal (the blocked rotation)")
-    if t == "E":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the normal of the contact plane")
-        t1, t2 = _perp_basis(a)
-        return np.array([_rot(p, a), _tr(t1), _tr(t2)])
-    if t == "line_contact":
-        if joint.normal is None or a is None:
-            raise _need(joint, "normal and axis", "give normal (contact normal) and axis (contact line)")
-        n = _unit(_pad3(joint.normal))
-        lin = _unit(a - n * (a @ n))
-        return np.array([_rot(p, n), _rot(p, lin), _tr(lin), _tr(np.cross(lin, n))])
-    if t == "point_contact":
-        if joint.normal is None:
-            raise _need(joint, "normal", "give normal: the contact normal")
-        t1, t2 = _perp_basis(_unit(_pad3(joint.normal)))
-        return np.array([_rot(p, e) for e in _E] + [_tr(t1), _tr(t2)])
-    raise _need(joint, "known twists", "use a catalogue pair type")
-
-
-def missing_geometry(mech: Mechanism, planar: bool | None = None) -> list[str]:
-    """Messages for the joints whose geometry is insufficient for the rank method."""
-    planar = mech.kind == "planar" if planar is None else planar
-    out = []
-    for j in mech.joints:
-        try:
-            pair_twists(j, planar, mech)
-        except InsufficientGeometry as exc:
-            out.append(exc.message + (f" ({exc.hint})" if exc.hint else ""))
-    return out
-
-
-def as_spatial(mech: Mechanism) -> Mechanism:
-    """A planar mechanism seen in 3-D: points at ``z = 0``, R axes along ``z``, P axes in
-    the plane, cams and gears as line contacts (class 2) along ``z``."""
-    from mechsyn.model.pairs import PAIR_KINDS
-
-    if mech.kind == "spatial":
-        return mech
-    z = np.array([0.0, 0.0, 1.0])
-    joints = []
-    for j in mech.joints:
-        kw: dict[str, Any] = {"point": _pad3(j.point)}
-        if j.type == "R":
-            kw["axis"] = z
-        elif j.type == "P":
-            kw["axis"] = _pad3(j.axis)
-        elif j.type == "belt":
-            kw["axis"] = z
-            try:  # its instantaneous equivalent: a line contact along the belt's tangent line
-                kw["point"], kw["normal"] = _belt_geometry(j)
-            except InsufficientGeometry:
-                pass
-        elif j.type in ("cam", "gear"):
-            kw["axis"] = z
-            if j.type == "gear" and j.normal is None:
-                try:
-                    p, n = _gear_geometry(j, mech)
-                    kw["point"], kw["normal"] = p, n
-                except InsufficientGeometry:
-                    pass
-            else:
-                kw["normal"] = _pad3(j.normal)
-        cls = PAIR_KINDS[j.type].pair_class or (2 if j.type in ("cam", "gear", "belt") else j.pair_class)
-        joints.append(replace(j, pair_class=cls, higher_override=None if j.type != "generic" else j.higher_override, **kw))
-    points = {k: replace(v, at=_pad3(v.at)) for k, v in mech.points.items()}
-    return replace(mech, kind="spatial", joints=tuple(joints), points=points,
-                   name=f"{mech.name} (as spatial)", states={})
-
-
-# --------------------------------------------------------------------------- linear algebra
-def _exp(xi: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """Batched ``exp(θ ξ̂)`` (``m × 4 × 4``) of unit-rotation or pure-translation twists."""
-    m = xi.shape[0]
-    w, v = xi[:, :3], xi[:, 3:]
-    g = np.tile(np.eye(4), (m, 1, 1))
-    rotating = np.linalg.norm(w, axis=1) > 0.5
-    th = theta[:, None]
-    # translation part for pure translations
-    g[~rotating, :3, 3] = v[~rotating] * th[~rotating]
-    if np.any(rotating):
-        wr, vr, t = w[rotating], v[rotating], theta[rotating]
-        K = np.zeros((wr.shape[0], 3, 3))
-        K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -wr[:, 2], wr[:, 1], -wr[:, 0]
-        K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = wr[:, 2], -wr[:, 1], wr[:, 0]
-        s, c = np.sin(t)[:, None, None], np.cos(t)[:, None, None]
-        R = np.eye(3) + s * K + (1 - c) * (K @ K)
-        wxv = np.cross(wr, vr)
-        p = np.einsum("nij,nj->ni", np.eye(3) - R, wxv) + wr * np.sum(wr * vr, axis=1, keepdims=True) * t[:, None]
-        idx = np.flatnonzero(rotating)
-        g[idx, :3, :3] = R
-        g[idx, :3, 3] = p
-    return g
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def _svd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    if a.size == 0:
-        return (np.zeros((a.shape[0], 0)), np.zeros(0), np.zeros((0, a.shape[1])))
-    return np.linalg.svd(a, full_matrices=True)
-
-
-def _rank(a: np.ndarray, tol: float) -> int:
-    if a.size == 0:
-        return 0
-    s = np.linalg.svd(a, compute_uv=False)
-    return int(np.sum(s > tol))
-
-
-def _null(a: np.ndarray, tol: float) -> np.ndarray:
-    """Orthonormal basis (columns) of the null space of ``a``."""
-    n = a.shape[1]
-    if a.shape[0] == 0:
-        return np.eye(n)
-    _, s, vt = np.linalg.svd(a, full_matrices=True)
-    r = int(np.sum(s > tol))
-    return vt[r:].T
-
-
-def _orth(a: np.ndarray, tol: float = 1e-9) -> np.ndarray:
-    if a.size == 0:
-        return a.reshape(a.shape[0], 0)
-    u, s, _ = np.linalg.svd(a, full_matrices=False)
-    return u[:, : int(np.sum(s > tol * max(1.0, s[0] if s.size else 1.0)))]
-
-
 #: Above this many pair freedoms the loop-closure matrix is reduced contour by contour
 #: (:func:`_eliminate`) instead of by one dense SVD (``O(F³)``).
 DENSE_MAX_FREEDOMS = 120
 
 
-@dataclass
-class _Reduction:
-    """Rank, null space and per-contour increments of a loop-closure matrix."""
-
-    rank: int
-    null: np.ndarray  # F × m, orthonormal columns
-    increments: list[int]  # per contour: new independent equations
-    left: list[np.ndarray]  # per contour: λ × λ left singular vectors (redundant ones last)
-    singular_values: np.ndarray  # what the rank decisions were taken on
-
-
-def _reduce_dense(M: np.ndarray, lam: int, tol: float) -> _Reduction:
-    """One SVD for rank and null space; each contour's rows reduced against the row space
-    of the contours before it (orthonormal basis ``Q``)."""
-    F = M.shape[1]
-    sv = np.linalg.svd(M, compute_uv=False) if M.size else np.zeros(0)
-    rank = int(np.sum(sv > tol))
-    N = _null(M, tol) if F else np.zeros((0, 0))
-    incs, lefts = [], []
-    Q = np.zeros((F, 0))
-    for k in range(M.shape[0] // lam):
-        B = M[lam * k: lam * (k + 1)]
-        res = B - (B @ Q) @ Q.T if Q.shape[1] else B
-        u_k, s_k, vt_k = np.linalg.svd(res, full_matrices=True)
-        s_full = np.zeros(lam)
-        s_full[: s_k.size] = s_k
-        inc = int(np.sum(s_full > tol))
-        Q = np.concatenate([Q, vt_k[:inc].T], axis=1)
-        incs.append(inc)
-        lefts.append(u_k)
-    return _Reduction(rank, N[:, : F - rank], incs, lefts, sv)
-
-
-def _eliminate(M: np.ndarray, cols: list[np.ndarray], lam: int, tol: float) -> _Reduction:
-    """Rank and null space contour by contour, touching only each contour's columns.
-
-    The motions allowed by contours ``1..k-1`` are kept as orthonormal parameter vectors
-    (a pair freedom not yet met by any contour, or a combination stored as a full vector).
-    Contour ``k`` (rows ``B``, columns ``cols[k]``) meets only the parameters that move
-    its columns: the SVD of ``B P_J`` (``λ × |J|``) gives its new independent equations
-    (the sequential reading), its redundant ones (left null vectors, as in
-    :func:`_reduce_dense`) and the combinations of ``P_J`` it leaves free. A column no
-    later contour touches is retired from the bookkeeping. For a chain of loops ``|J|``
-    stays small: the work grows about linearly with the contours (a dense SVD, cubically).
-    """
-    F = M.shape[1]
-    last = np.full(F, -1)  # the last contour that touches each column: later, it is retired
-    for k, ck in enumerate(cols):
-        last[ck] = k
-    unit: dict[int, int] = {c: c for c in range(F)}  # parameter -> its column (unit vector)
-    dense: dict[int, np.ndarray] = {}  # parameter -> full vector
-    active: dict[int, np.ndarray] = {}  # dense parameter -> columns it moves that a later contour touches
-    touch: list[set[int]] = [{c} for c in range(F)]
-    next_id = F
-    incs, lefts, svs = [], [], []
-    for k, ck in enumerate(cols):
-        B = M[lam * k: lam * (k + 1), ck]
-        J = sorted(set().union(*(touch[c] for c in ck)))
-        if not J:  # every freedom of the contour is already locked
-            incs.append(0)
-            lefts.append(np.eye(lam))
-            svs.append(np.zeros(lam))
-            continue
-        pos = {c: i for i, c in enumerate(ck)}
-        BP = np.empty((lam, len(J)))
-        for i, pid in enumerate(J):
-            BP[:, i] = B[:, pos[unit[pid]]] if pid in unit else B @ dense[pid][ck]
-        u, s, vt = np.linalg.svd(BP, full_matrices=True)
-        s_full = np.zeros(lam)
-        s_full[: s.size] = s
-        inc = int(np.sum(s_full > tol))
-        incs.append(inc)
-        lefts.append(u)
-        svs.append(s_full)
-        if inc == 0:
-            continue
-        Z = vt[inc:].T
-        new = np.zeros((F, Z.shape[1]))
-        for i, pid in enumerate(J):
-            if pid in unit:
-                c = unit.pop(pid)
-                new[c] += Z[i]
-                touch[c].discard(pid)
-            else:
-                new += np.outer(dense.pop(pid), Z[i])
-                for c in active.pop(pid):
-                    touch[c].discard(pid)
-        for i in range(new.shape[1]):
-            v = new[:, i]
-            v[np.abs(v) <= 1e-15 * np.max(np.abs(v))] = 0.0
-            moved = np.flatnonzero(v)
-            act = moved[last[moved] > k]
-            dense[next_id], active[next_id] = v, act
-            for c in act:
-                touch[c].add(next_id)
-            next_id += 1
-    N = np.zeros((F, len(unit) + len(dense)))
-    for i, c in enumerate(sorted(unit.values())):
-        N[c, i] = 1.0
-    for i, pid in enumerate(sorted(dense), start=len(unit)):
-        N[:, i] = dense[pid]
-    sv = np.concatenate(svs) if svs else np.zeros(0)
-    return _Reduction(F - N.shape[1], N, incs, lefts, sv)
-
-
-def _reduce(sysm: "_System", M: np.ndarray, tol: float) -> _Reduction:
-    """Rank and null space of the loop-closure matrix ``M``: one dense SVD for small
-    systems, contour-by-contour elimination above :data:`DENSE_MAX_FREEDOMS`."""
-    if M.shape[1] <= DENSE_MAX_FREEDOMS:
-        return _reduce_dense(M, sysm.lam, tol)
-    return _eliminate(M, sysm.contour_columns(), sysm.lam, tol)
+def _reduce(sysm: "_System", theta: np.ndarray, tol: float) -> _Reduction:
+    """Rank and null space of the loop-closure matrix at ``θ``: one dense SVD for small
+    systems, contour-by-contour elimination on its blocks above :data:`DENSE_MAX_FREEDOMS`."""
+    if sysm.twists.shape[0] <= DENSE_MAX_FREEDOMS:
+        return _reduce_dense(sysm.closure(theta)[0], sysm.lam, tol)
+    blocks, _ = sysm.closure_blocks(theta)
+    return _eliminate(blocks, sysm.contour_columns(), sysm.lam, tol, sysm.twists.shape[0])
 
 
 # --------------------------------------------------------------------------- results
@@ -608,6 +199,7 @@ class _System:
     factors: list[list[tuple[int, int]]]  # per contour: (column, sign) in product order
     centre: np.ndarray
     scale: float
+    _cols: list[np.ndarray] | None = None
 
     @property
     def lam(self) -> int:
@@ -617,29 +209,34 @@ class _System:
         return mat[PLANAR_ROWS] if self.planar else mat
 
     def contour_columns(self) -> list[np.ndarray]:
-        """The columns (pair freedoms) each contour's equations touch."""
-        return [np.array(sorted({c for c, _ in fac}), dtype=int) for fac in self.factors]
+        """The columns (pair freedoms) each contour's equations touch, sorted."""
+        if self._cols is None:
+            self._cols = [np.array(sorted({c for c, _ in fac}), dtype=int) for fac in self.factors]
+        return self._cols
 
-    def closure(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Loop-closure twist matrix ``M(θ)`` (λK × F) and the closure error (λK).
+    def closure_blocks(self, theta: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+        """Per contour, its ``λ`` loop-closure rows on its own columns
+        (:meth:`contour_columns`), and the closure error (λK): the loop-closure matrix
+        without its zeros (a large mechanism's dense matrix would not fit in memory).
 
         Every contour's product of exponentials is taken step by step for all contours at
         once (contours padded to the longest one)."""
         F = self.twists.shape[0]
         K = len(self.factors)
         lam = self.lam
-        M = np.zeros((lam * K, F))
-        err = np.zeros(lam * K)
         if K == 0:
-            return M, err
+            return [], np.zeros(0)
         exps = np.concatenate([_exp(self.twists, theta), _exp(self.twists, -theta)])  # + then - sign
         L = max(len(f) for f in self.factors)
         cols = np.full((K, L), -1)
+        where = np.zeros((K, L), dtype=int)  # position of the column in the contour's own columns
         signs = np.zeros((K, L))
-        for k, fac in enumerate(self.factors):
+        for k, (fac, own) in enumerate(zip(self.factors, self.contour_columns())):
             cols[k, : len(fac)] = [c for c, _ in fac]
+            where[k, : len(fac)] = np.searchsorted(own, [c for c, _ in fac])
             signs[k, : len(fac)] = [sg for _, sg in fac]
         rows = PLANAR_ROWS if self.planar else np.arange(6)
+        blocks = np.zeros((K, lam, L))
         g = np.tile(np.eye(4), (K, 1, 1))
         for t in range(L):
             k = np.flatnonzero(cols[:, t] >= 0)
@@ -648,14 +245,31 @@ class _System:
             R, p = g[k, :3, :3], g[k, :3, 3]
             w = np.einsum("kij,kj->ki", R, xi[:, :3])
             v = np.einsum("kij,kj->ki", R, xi[:, 3:]) + np.cross(p, w)
-            adj = np.concatenate([w, v], axis=1)[:, rows]
-            M[(k * lam)[:, None] + np.arange(lam), c[:, None]] = adj
+            blocks[k, :, where[k, t]] = np.concatenate([w, v], axis=1)[:, rows]
             g[k] = g[k] @ exps[np.where(sg > 0, c, c + F)]
         R, p = g[:, :3, :3], g[:, :3, 3]
         e = np.concatenate([0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0],
                                              R[:, 1, 0] - R[:, 0, 1]], axis=1), p], axis=1)
-        err[:] = e[:, rows].reshape(-1)
+        return [blocks[k, :, : len(own)] for k, own in enumerate(self.contour_columns())], e[:, rows].reshape(-1)
+
+    def closure(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Loop-closure twist matrix ``M(θ)`` (λK × F, dense) and the closure error (λK)."""
+        blocks, err = self.closure_blocks(theta)
+        lam = self.lam
+        M = np.zeros((lam * len(blocks), self.twists.shape[0]))
+        for k, (B, own) in enumerate(zip(blocks, self.contour_columns())):
+            M[lam * k: lam * (k + 1), own] = B
         return M, err
+
+    def sparse_closure(self, blocks: list[np.ndarray]) -> Any:
+        """The loop-closure matrix from its blocks, as a SciPy sparse matrix."""
+        from scipy.sparse import coo_matrix
+
+        lam = self.lam
+        rows = [np.repeat(lam * k + np.arange(lam), len(own)) for k, own in enumerate(self.contour_columns())]
+        cols = [np.tile(own, lam) for own in self.contour_columns()]
+        return coo_matrix((np.concatenate([B.reshape(-1) for B in blocks]), (np.concatenate(rows),
+                          np.concatenate(cols))), shape=(lam * len(blocks), self.twists.shape[0])).tocsc()
 
 
 def _build_system(mech: Mechanism, planar: bool) -> _System:
@@ -770,86 +384,6 @@ def _idle_inputs(mech: Mechanism, sysm: _System, N: np.ndarray, Z0: np.ndarray) 
                       centre=sysm.centre, scale=sysm.scale, drives=any(j.actuated for j in mech.joints))
 
 
-def _axis_words(basis: np.ndarray, word: str) -> str:
-    """``"moments about x, y"`` for a subspace of R³ (columns orthonormal)."""
-    d = basis.shape[1]
-    if d == 0:
-        return ""
-    proj = basis @ basis.T
-    named = [_AXIS_NAMES[k] for k in range(3) if abs(proj[k, k] - 1.0) < 1e-6]
-    plural = word + ("s" if d > 1 else "")
-    if len(named) == d:
-        return f"{plural} {'about' if word == 'moment' else 'along'} {', '.join(named)}"
-    if d == 1:
-        v = basis[:, 0] * np.sign(basis[np.argmax(np.abs(basis[:, 0])), 0])
-        return f"{plural} {'about' if word == 'moment' else 'along'} {_vec(v)}"
-    if d == 2:
-        n = np.cross(basis[:, 0], basis[:, 1])
-        n = n * np.sign(n[np.argmax(np.abs(n))])
-        name = next((_AXIS_NAMES[k] for k in range(3) if abs(abs(n[k]) - 1) < 1e-6), _vec(n))
-        return f"{plural} {'about' if word == 'moment' else 'along'} every axis perpendicular to {name}"
-    return f"{plural} {'about' if word == 'moment' else 'along'} x, y, z"
-
-
-def _num(x: float) -> str:
-    x = 0.0 if abs(x) < 5e-10 else x
-    return f"{x:.4g}"
-
-
-def _vec(v: np.ndarray) -> str:
-    return "(" + ", ".join(_num(float(x)) for x in v) + ")"
-
-
-def describe_wrenches(W: np.ndarray, centre: np.ndarray, scale: float, planar: bool = False,
-                      tol: float = 1e-6) -> list[str]:
-    """Readable names of a subspace of wrenches ``[moment about the centre; force]``
-    (columns, normalised units): couples first, then forces with their lines of action."""
-    q = W.shape[1]
-    if q == 0:
-        return []
-    W = _orth(W)
-    Fp, Mp = W[3:], W[:3]
-    nf = _null(Fp, 1e-7)  # combinations with no force: couples
-    couples = _orth(Mp @ nf) if nf.shape[1] else np.zeros((3, 0))
-    out = []
-    if couples.shape[1]:
-        out.append(_axis_words(couples, "moment"))
-    forces = _orth(Fp)
-    if forces.shape[1] >= 2 and not couples.shape[1]:
-        # do all the force lines pass through one point?  m_i = r × F_i  for every basis wrench
-        A = np.concatenate([-np.array([[0, -f[2], f[1]], [f[2], 0, -f[0]], [-f[1], f[0], 0]]) for f in Fp.T])
-        r, *_ = np.linalg.lstsq(A, Mp.T.reshape(-1), rcond=None)
-        if np.linalg.norm(A @ r - Mp.T.reshape(-1)) < 1e-7:
-            out.append(f"{_axis_words(forces, 'force')} through {_vec(centre + scale * r)}")
-            return out
-    if forces.shape[1]:
-        # aligned basis when the force subspace contains coordinate axes
-        proj = forces @ forces.T
-        dirs = [_E[k] for k in range(3) if abs(proj[k, k] - 1.0) < 1e-6]
-        if len(dirs) != forces.shape[1]:
-            dirs = [forces[:, i] for i in range(forces.shape[1])]
-        for d in dirs:
-            d = d * np.sign(d[np.argmax(np.abs(d))])
-            alpha = np.linalg.lstsq(Fp, d, rcond=None)[0]
-            m = Mp @ alpha
-            if couples.shape[1]:
-                m = m - couples @ (couples.T @ m)
-            pitch = float(d @ m)
-            r = np.cross(d, m)  # foot of the line of action (normalised, relative to the centre)
-            name = next((_AXIS_NAMES[k] for k in range(3) if abs(abs(d[k]) - 1) < 1e-9), _vec(d))
-            # is the line's position arbitrary? (couples perpendicular to d span 2 dimensions)
-            perp = couples - np.outer(d, d @ couples) if couples.shape[1] else couples
-            loc_free = perp.shape[1] and np.linalg.matrix_rank(perp, tol=1e-6) >= 2
-            wrench = abs(pitch) > max(1e-6, 10 * tol)
-            text = f"{'wrench' if wrench else 'force'} along {name}"
-            if not loc_free:
-                text += f" through {_vec(centre + scale * r)}"
-            if wrench:
-                text += f" with pitch {_num(pitch * scale)} (force plus moment about it)"
-            out.append(text)
-    return [o for o in out if o]
-
-
 def _contour_reason(sysm: _System, idx: int, Wj: np.ndarray) -> str:
     """Why contour ``idx`` has redundant constraints (``Wj``: its redundant wrenches, 6 × q)."""
     q = Wj.shape[1]
@@ -922,19 +456,22 @@ def _actuated_columns(sysm: _System) -> tuple[list[int], list[str]]:
     return cols, names
 
 
-def _gauss_newton_step(M: np.ndarray, err: np.ndarray, tol: float) -> np.ndarray:
-    """Least-norm step ``δ`` with ``M δ ≈ err``: truncated SVD with the rank tolerance
-    (near-null directions left alone) for small systems; for large ones the damped
-    least-norm step ``Mᵀ (M Mᵀ + tol² I)⁻¹ err`` by a sparse LU (banded for chains)."""
-    if M.shape[1] <= DENSE_MAX_FREEDOMS:
+def _gauss_newton_step(sysm: "_System", theta: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The closure error at ``θ`` and the least-norm step ``δ`` with ``M δ ≈ err``:
+    truncated SVD with the rank tolerance (near-null directions left alone) for small
+    systems; for large ones the damped step ``Mᵀ (M Mᵀ + tol² I)⁻¹ err`` by a sparse LU
+    (banded for chains)."""
+    if sysm.twists.shape[0] <= DENSE_MAX_FREEDOMS:
+        M, err = sysm.closure(theta)
         u, sv, vt = np.linalg.svd(M, full_matrices=False)
         keep = sv > tol
-        return vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
-    from scipy.sparse import csc_matrix, identity
+        return err, vt[keep].T @ ((u[:, keep].T @ err) / sv[keep])
+    from scipy.sparse import identity
     from scipy.sparse.linalg import spsolve
 
-    A = csc_matrix(M)
-    return A.T @ spsolve((A @ A.T + tol * tol * identity(M.shape[0], format="csc")).tocsc(), err)
+    blocks, err = sysm.closure_blocks(theta)
+    A = sysm.sparse_closure(blocks)
+    return err, A.T @ spsolve((A @ A.T + tol * tol * identity(A.shape[0], format="csc")).tocsc(), err)
 
 
 def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int = 3,
@@ -950,18 +487,17 @@ def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int =
         theta = d.copy()
         ok = False
         for _it in range(60):
-            M, err = sysm.closure(theta)
+            err, delta = _gauss_newton_step(sysm, theta, tol)
             if np.linalg.norm(err) < max(1e-11, 10.0 * tol * step):
                 ok = True
                 break
-            theta = theta - _gauss_newton_step(M, err, tol)
+            theta = theta - delta
         if not ok:
             continue
         if np.max(np.abs(theta)) < 0.2 * step:
             returned += 1
             continue
-        M, _ = sysm.closure(theta)
-        ranks.append(_reduce(sysm, M, tol).rank)
+        ranks.append(_reduce(sysm, theta, tol).rank)
     if not ranks:
         if returned:
             notes.append("the instantaneous motions do not extend to finite motions (a shaky configuration)")
@@ -997,10 +533,9 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     sysm = _build_system(mech, planar)
     lam, K, F = sysm.lam, len(sysm.contours), sysm.twists.shape[0]
     tol = _default_tolerance(mech, sysm) if tol is None else tol
-    M, _ = sysm.closure(np.zeros(F))
     notes: list[str] = []
     progress("rank")
-    red = _reduce(sysm, M, tol)
+    red = _reduce(sysm, np.zeros(F), tol)
     near = _near_singular_note(red.singular_values, tol, F, lam * K, red.rank, notes)
     mobility, redundant, N = F - red.rank, lam * K - red.rank, red.null
     contours = _contour_ranks(sysm, red, tol)
@@ -1116,257 +651,6 @@ def _singularity(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int,
     return True, finite, [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
 
 
-# --------------------------------------------------------------------------- formulas side by side
-@dataclass(frozen=True)
-class Comparison:
-    """One formula's answer next to the rank method's, with why they differ."""
-
-    quantity: str
-    formula: str
-    formula_value: float | int | None
-    rank_value: float | int | None
-    agree: bool
-    why: str
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"quantity": self.quantity, "formula": self.formula, "formula_value": self.formula_value,
-                "rank_value": self.rank_value, "agree": self.agree, "why": self.why}
-
-
-def _q_reasons(ra: RankAnalysis) -> str:
-    parts = []
-    for c in ra.contours:
-        if c.redundant:
-            parts.append(f"contour {c.index}: {c.redundant}, {c.reason.split(':')[0]}")
-    return "; ".join(parts)
-
-
-def _idle_words(ra: RankAnalysis) -> str:
-    return ", ".join(f"{i.link or '?'} ({' '.join(i.joints)})" for i in ra.idle_mobilities)
-
-
-def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
-    """Each formula of ``fa`` (:class:`~mechsyn.structure.analysis.StructuralAnalysis`)
-    next to the rank answer ``ra``, with one line on why they differ.
-
-    Identities used: Malyshev's ``W = F - 6K`` and Chebyshev's ``W = F - 3K`` equal
-    ``m - q`` (instantaneous mobility minus redundant constraints), and Ozol's
-    ``q = W + λK - f`` is the rank's ``q`` exactly when ``W`` is the instantaneous mobility.
-    """
-    out: list[Comparison] = []
-    m, u, q = ra.mobility, ra.useful_mobility, ra.redundant_constraints
-    idle = len(ra.idle_mobilities)
-    planar = ra.motion == "planar"
-    reasons = _q_reasons(ra)
-    idle_txt = f"; it includes {idle} idle mobility(ies): {_idle_words(ra)}" if idle else ""
-    main = (("chebyshev", "Chebyshev W = 3n - 2p5 - p4 (planar)") if planar
-            else ("malyshev", "Malyshev W = 6n - Σ i·p_i (spatial)"))
-    f = fa.formulas.get(main[0])
-    if f is not None and f.value is not None:
-        w = f.value
-        if w == m:
-            why = "agree: no constraint is redundant" + idle_txt
-        else:
-            why = (f"W = m - q = {m} - {q} = {m - q}: the formula counts every constraint as independent, "
-                   f"{q} are redundant ({reasons})" + idle_txt)
-        out.append(Comparison("mobility", main[1], w, m, w == m, why))
-    if not planar:
-        f = fa.formulas.get("somov_malyshev")
-        if f is not None and f.value is not None:
-            w = f.value
-            s_idle = fa.idle_mobilities
-            if w == m:
-                why = "agree: the per-contour S_Σ + G_Σ matches the redundant constraints the rank method finds"
-            elif w == u:
-                why = (f"W equals the useful mobility {u}: S_Σ = {fa.structural_redundancy} nets "
-                       f"{s_idle} idle mobility(ies) against redundant constraints; the rank method counts "
-                       f"{q} redundant constraint(s) and {idle} idle mobility(ies) apart (m = {m} = {u} + {idle})")
-            else:
-                bad = []
-                for rc, fc in zip(ra.contours, fa.contours):
-                    fq = max(fc.S, 0) + fc.T
-                    if fq != rc.redundant:
-                        bad.append(f"contour {rc.index}: S + T = {fq:g}, rank {rc.redundant}"
-                                   + (f" ({rc.reason.split(':')[0]})" if rc.reason else ""))
-                why = ("the per-contour counts assume generic geometry (each contour's pairs independent): "
-                       + ("; ".join(bad) if bad else f"S_Σ + G_Σ = {fa.structural_redundancy + fa.constructive_redundancy:g}"
-                          f" vs rank q = {q}") + idle_txt)
-            out.append(Comparison("mobility", "Somov-Malyshev W = 6n - Σ i·p_i + S_Σ + G_Σ (003, spatial)", w, m, w == m, why))
-    f = fa.formulas.get("ozol_redundant")
-    if f is not None and f.value is not None:
-        w_used = fa.declared_mobility if fa.declared_mobility is not None else fa.mobility
-        why = ("agree" if f.value == q else
-               f"Ozol's q = W + {3 if planar else 6}K - f used W = {w_used:g}; with the rank's instantaneous "
-               f"mobility m = {m} (idle included) it gives q = {q}")
-        if f.value == q and q:
-            why = f"agree: {reasons}"
-        out.append(Comparison("redundant constraints", f"Ozol q = W + {3 if planar else 6}K - f (002, {ra.motion})", f.value, q, f.value == q, why))
-    if fa.contours and len(fa.contours) == len(ra.contours) and not planar:
-        for fc, rc in zip(fa.contours, ra.contours):
-            sj = max(fc.S, 0) + fc.T
-            agree = sj == rc.redundant
-            why = "agree" if agree else (
-                f"the rank method finds {rc.redundant}" + (f": {rc.reason}" if rc.reason else "")
-                + (f" (formula: S = {fc.S}, T = {fc.T:g})"))
-            if not agree and rc.redundant < sj:
-                why += ("; S_j counts freedoms, not their directions: with this geometry the pairs' "
-                        "freedoms absorb the constraints it counts as redundant")
-            if agree and rc.redundant:
-                why = f"agree: {', '.join(rc.directions)}"
-            out.append(Comparison(f"redundant constraints, contour {fc.index}", "003: max(S_j, 0) + T_j",
-                                  sj, rc.redundant, agree, why))
-    f_idle = fa.idle_mobilities
-    if not planar:
-        out.append(Comparison(
-            "idle mobilities", "003: Σ max(-S_j, 0)", f_idle, idle, f_idle == idle,
-            "agree" + (f": {_idle_words(ra)}" if idle else "") if f_idle == idle else
-            (f"the rank method finds {idle}: {_idle_words(ra) or 'none'}"
-             + ("; the per-contour count misses idle motions that a contour's redundant constraints mask"
-                if idle > f_idle else "; the per-contour count assumes a generic geometry"))))
-    h = fa.degrees_of_mobility
-    why = "agree" if h == ra.drives_needed else (
-        f"drives needed = useful mobility = {ra.drives_needed} (rank); the rule H = n - Σ A_j is "
-        "topological and misses special geometry" + (f" (exclusive-link reading: {fa.degrees_of_mobility_exclusive})"
-                                                      if fa.degrees_of_mobility_exclusive != h else ""))
-    out.append(Comparison("drives", "003: H = n - Σ A_j", h, ra.drives_needed, h == ra.drives_needed, why))
-    return out
-
-
-# --------------------------------------------------------------------------- remedies re-checked
-@dataclass(frozen=True)
-class RemedyCheck:
-    """The rank method's verdict on a remedy variant."""
-
-    accepted: bool
-    reason: str
-    rank: RankAnalysis | None
-    geometry: dict[str, dict[str, list[float]]]
-
-    def to_dict(self) -> dict[str, Any]:
-        r = self.rank
-        return {"accepted": self.accepted, "reason": self.reason, "geometry": self.geometry,
-                "rank": None if r is None else {
-                    "mobility": r.mobility, "useful_mobility": r.useful_mobility,
-                    "idle_mobilities": [i.to_dict() for i in r.idle_mobilities],
-                    "redundant_constraints": r.redundant_constraints,
-                    "redundant_by_contour": r.redundant_by_contour,
-                    "redundant_directions": r.redundant_directions}}
-
-
-def _candidate_dirs(mech: Mechanism, j: Joint) -> list[np.ndarray]:
-    p = _pad3(j.point)
-    out: list[np.ndarray] = []
-    for other in mech.joints:
-        if other is j or other.point is None or not set(other.links) & set(j.links):
-            continue
-        d = _pad3(other.point) - p
-        if np.linalg.norm(d) > 1e-9:
-            out.append(_unit(d))
-    out += [e for e in _E]
-    uniq: list[np.ndarray] = []
-    for d in out:
-        if all(abs(abs(d @ e) - 1) > 1e-9 for e in uniq):
-            uniq.append(d)
-    return uniq
-
-
-def _variant_geometry(original: Mechanism, variant: Mechanism) -> list[tuple[Mechanism, dict[str, dict[str, list[float]]]]]:
-    """Geometric realisations of a remedy variant: changed pairs at the same point with the
-    same axis; directions a new pair needs (sphere-with-pin's blocked rotation, a line
-    contact's line) tried among the directions to the neighbouring joints and x, y, z."""
-    import itertools
-
-    old = {j.id: j for j in original.joints}
-    choices: list[list[tuple[Joint, dict[str, list[float]]]]] = []
-    for j in variant.joints:
-        o = old[j.id]
-        if o.type == j.type and o.pair_class == j.pair_class:
-            choices.append([(o, {})])
-            continue
-        base = replace(j, point=o.point, axis=o.axis, axis2=o.axis2, normal=o.normal, pitch=None, ratio=None)
-        opts: list[tuple[Joint, dict[str, list[float]]]] = []
-        if j.type == "S_pin" and (o.axis is None or o.axis2 is None):
-            if o.point is not None:
-                for d in _candidate_dirs(original, o):
-                    opts.append((replace(base, normal=d, axis=None, axis2=None), {"normal": [float(x) for x in d]}))
-        elif j.type == "line_contact" and base.axis is None and base.normal is not None:
-            n = _unit(_pad3(base.normal))
-            for e in _E:
-                ln = np.cross(n, e)
-                if np.linalg.norm(ln) > 1e-6:
-                    ln = _unit(ln)
-                    opts.append((replace(base, axis=ln), {"axis": [float(x) for x in ln]}))
-        elif j.type == "U" and o.axis is not None and o.axis2 is None:
-            for d in _candidate_dirs(original, o):
-                a2 = np.cross(_pad3(o.axis), d)
-                if np.linalg.norm(a2) > 1e-6:
-                    opts.append((replace(base, axis2=_unit(a2)), {"axis2": [float(x) for x in _unit(a2)]}))
-        else:
-            g = {}
-            if base.point is not None:
-                g["point"] = [float(x) for x in base.point]
-            if base.axis is not None and j.type not in ("S",):
-                g["axis"] = [float(x) for x in base.axis]
-            opts.append((base, g))
-        choices.append(opts or [(base, {})])
-    combos = itertools.islice(itertools.product(*choices), 64)
-    out = []
-    for combo in combos:
-        joints = tuple(c[0] for c in combo)
-        geo = {j.id: c[1] for j, c in zip(joints, combo) if c[1] and (old[j.id].type != j.type)}
-        out.append((replace(variant, joints=joints), geo))
-    return out
-
-
-def check_remedy(original: Mechanism, variant: Mechanism, base: RankAnalysis, metric_left: float = 0.0,
-                 tol: float | None = None) -> RemedyCheck:
-    """Re-check a remedy variant (paper 003's class changes) with the rank method.
-
-    Accepted when, for some realisation of the new pairs at the old pairs' points and
-    axes, the useful mobility is unchanged, no idle mobility is left and no more
-    redundant constraints remain than the metric constraints the formulas admit
-    (``metric_left``, which class changes cannot remove).
-    """
-    old = {j.id: j for j in original.joints}
-    moved = [j for j in variant.joints if j.actuated and j.type != old[j.id].type
-             and not (old[j.id].type == "P" and j.type == "C")]
-    if moved:
-        return RemedyCheck(False, "rejected by the rank method: " + "; ".join(
-            f"the driven pair {j.id} would become {j.type} ({j.freedom} freedoms): a drive sets one coordinate"
-            for j in moved), None, {})
-    best: tuple[tuple[int, int, int], RankAnalysis, dict[str, Any]] | None = None
-    for mech, geo in _variant_geometry(original, variant):
-        try:
-            r = analyze_rank(mech, tol=tol if tol is not None else base.tolerance, check_singular=False)
-        except InsufficientGeometry as exc:
-            return RemedyCheck(True, f"not checked: {exc.message}", None, {})
-        lost_drive = int(base.actuation_determined is True and r.actuation_determined is False)
-        score = (abs(r.useful_mobility - base.useful_mobility) + lost_drive, len(r.idle_mobilities),
-                 max(0, r.redundant_constraints - int(round(metric_left))))
-        if best is None or score < best[0]:
-            best = (score, r, geo)
-        if score == (0, 0, 0):
-            break
-    assert best is not None
-    score, r, geo = best
-    if score == (0, 0, 0):
-        extra = (f"; {r.redundant_constraints} metric constraint(s) remain, as the formulas say"
-                 if r.redundant_constraints else "")
-        return RemedyCheck(True, f"confirmed: useful mobility {r.useful_mobility}, no idle mobility, "
-                                 f"no redundant constraint{extra}", r, geo)
-    why = []
-    if score[0] and r.useful_mobility != base.useful_mobility:
-        why.append(f"changes the useful mobility from {base.useful_mobility} to {r.useful_mobility}")
-    elif score[0]:
-        why.append(f"the drives at {', '.join(r.actuated)} no longer determine the motion")
-    if score[1]:
-        why.append(f"leaves {len(r.idle_mobilities)} idle mobility(ies): {_idle_words(r)}")
-    if score[2]:
-        locs = "; ".join(f"contour {c.index}: {', '.join(c.directions)}" for c in r.contours if c.redundant)
-        why.append(f"leaves {r.redundant_constraints} redundant constraint(s) ({locs})")
-    return RemedyCheck(False, "rejected by the rank method: " + "; ".join(why), r, geo)
-
-
 # --------------------------------------------------------------------------- report
 def rank_summary_lines(ra: RankAnalysis) -> list[str]:
     """The rank answer in a few plain lines (terminal and Markdown reports)."""
@@ -1389,19 +673,14 @@ def rank_summary_lines(ra: RankAnalysis) -> list[str]:
     return lines
 
 
-def rank_to_markdown(ra: RankAnalysis, comparisons: list[Comparison] | None = None, level: int = 2) -> str:
-    h = "#" * level
-    out = [f"{h} Rank method (screw theory)", ""] + [f"- {x}" for x in rank_summary_lines(ra)]
-    if any(c.redundant for c in ra.contours):
-        out += ["", "| contour | joints | redundant | directions | why |", "|---|---|---|---|---|"]
-        for c in ra.contours:
-            out.append(f"| {c.index} | {' '.join(c.joints)} | {c.redundant} | {'; '.join(c.directions)} | {c.reason} |")
-    if comparisons:
-        out += ["", f"{h}# Formulas and rank side by side", "", "| quantity | formula | formula | rank | why |",
-                "|---|---|---|---|---|"]
-        for c in comparisons:
-            fv = "n/a" if c.formula_value is None else f"{c.formula_value:g}"
-            out.append(f"| {c.quantity} | {c.formula} | {fv} | {c.rank_value} | {c.why} |")
-    if ra.notes:
-        out += [""] + [f"- note: {n}" for n in ra.notes]
-    return "\n".join(out) + "\n"
+_MOVED_TO_COMPARE = ("Comparison", "compare_with_formulas", "RemedyCheck", "check_remedy", "rank_to_markdown")
+
+
+def __getattr__(name: str) -> Any:
+    """The comparison with the formulas and the remedy checks live in
+    :mod:`mechsyn.structure.compare`; importing them from here still works."""
+    if name in _MOVED_TO_COMPARE:
+        from mechsyn.structure import compare
+
+        return getattr(compare, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

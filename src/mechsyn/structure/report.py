@@ -1,11 +1,27 @@
-"""Markdown report of a structural analysis (the terminal report is drawn by the CLI)."""
+"""The structural report: one library call for what ``mechsyn analyze`` shows.
+
+:func:`analyze` runs the classic formulas (:func:`~mechsyn.structure.analysis.analyze_structure`),
+the rank method where the file gives the joints' geometry
+(:func:`~mechsyn.structure.rank.analyze_rank`), compares them, analyses each state and, on
+request, lists pair-class remedies re-checked by the rank method. The
+:class:`StructureReport` it returns gives the same dict as ``mechsyn analyze --json``
+(``to_dict()``) and the same Markdown as ``--markdown`` (``to_markdown()``, shown by Jupyter).
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Callable
 
-from mechsyn.structure.analysis import StructuralAnalysis
-from mechsyn.structure.remedies import Remedy
+from mechsyn._result import Result
+from mechsyn.errors import MechsynInputError
+from mechsyn.model.mechanism import Mechanism
+from mechsyn.results import to_jsonable
+from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
+from mechsyn.structure.remedies import Remedy, find_remedies
+
+__all__ = ["StructureReport", "analyze", "to_markdown"]
 
 FORMULA_TITLES = {
     "chebyshev": "Chebyshev (planar)",
@@ -87,3 +103,200 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
                        + f" — S_j = {', '.join(str(x.S) for x in r.analysis.contours)}, "
                        f"`{r.analysis.formulas['somov_malyshev'].expression}`")
     return "\n".join(out) + "\n"
+
+
+@dataclass(repr=False)
+class StructureReport(Result):
+    """Everything :func:`analyze` found; ``to_dict()`` is ``mechsyn analyze --json``.
+
+    Attributes
+    ----------
+    method : str
+        ``"formulas"``, ``"rank"`` or ``"both"``.
+    analysis : StructuralAnalysis
+        The formulas, contours (paper 003), external constraints (paper 002), states.
+    rank : RankAnalysis or None
+        The rank method's result (None with ``method="formulas"``).
+    comparisons : list of Comparison
+        Each formula beside the rank method, with why they differ.
+    state_ranks : dict
+        State name -> (its RankAnalysis or None, why not).
+    remedies : list of Remedy or None
+        Pair-class changes (``remedies=True``); with the rank method, only those it confirms.
+    rejected : list
+        ``(number, Remedy, RemedyCheck)`` of the remedies the rank method dropped.
+    """
+
+    mechanism: Mechanism = field(metadata={"json": False})
+    method: str
+    analysis: StructuralAnalysis
+    rank: Any = None
+    comparisons: list = field(default_factory=list)
+    state_ranks: dict = field(default_factory=dict)
+    remedies: list | None = None
+    checks: list = field(default_factory=list)
+    rank_unavailable: str | None = None
+    notes: list = field(default_factory=list)
+
+    @property
+    def mobility(self) -> float:
+        """The mobility W: the rank method's useful mobility when it ran, else the formulas'."""
+        return self.rank.useful_mobility if self.rank is not None else self.analysis.mobility
+
+    @property
+    def formulas(self) -> dict:
+        """Each classic formula with its numbers substituted (``.value``, ``.expression``)."""
+        return self.analysis.formulas
+
+    @property
+    def rejected(self) -> list:
+        return [(k, r, c) for k, r, c in self.checks if not c.accepted]
+
+    def _summary(self) -> list[tuple[str, str]]:
+        a = self.analysis
+        rows = [("mechanism", self.mechanism.name), ("method", self.method),
+                ("mobility W", f"{self.mobility:g}"),
+                ("redundant constraints", str(self.rank.redundant_constraints if self.rank is not None
+                                              else a.redundant_constraints)),
+                ("idle mobilities", str(len(self.rank.idle_mobilities) if self.rank is not None else a.idle_mobilities))]
+        if self.remedies is not None:
+            rows.append(("remedies", str(len(self.remedies))))
+        return rows
+
+    def to_dict(self) -> dict[str, Any]:
+        ra = self.rank
+        data = to_jsonable(self.analysis)
+        data["method"] = self.method
+        data["rank"] = ra.to_dict() if ra is not None else None
+        if ra is None and self.rank_unavailable:
+            data["rank_unavailable"] = self.rank_unavailable
+        if ra is not None:
+            data["mobility_formulas"] = data["mobility"]
+            data["mobility"] = ra.useful_mobility
+            data["mobility_source"] = "rank method: useful mobility (idle mobilities excluded)"
+            data["comparison"] = [c.to_dict() for c in self.comparisons]
+            for name, (sr, why) in self.state_ranks.items():
+                if name in data.get("states", {}):
+                    data["states"][name]["rank"] = sr.to_dict() if sr is not None else None
+                    if why:
+                        data["states"][name]["rank_unavailable"] = why
+        if self.notes:
+            data["notes"] = list(data.get("notes", [])) + self.notes
+        if self.remedies is not None:
+            if self.checks:
+                data["remedies"] = [dict(to_jsonable(r), rank_check=c.to_dict()) for _, r, c in self.checks
+                                    if c.accepted]
+                data["remedies_rejected"] = [dict(to_jsonable(r), rank_check=c.to_dict()) for _, r, c in self.rejected]
+            else:
+                data["remedies"] = [to_jsonable(r) for r in self.remedies]
+        return data
+
+    def to_markdown(self) -> str:
+        """The Markdown report (``mechsyn analyze --markdown``)."""
+        from mechsyn.structure.compare import rank_to_markdown
+
+        text = to_markdown(self.analysis, self.remedies) if self.method != "rank" else ""
+        if self.rank is not None:
+            text += "\n" + rank_to_markdown(self.rank, self.comparisons if self.method == "both" else None)
+            if self.checks:
+                text += "\n## Remedies re-checked by the rank method\n\n" + "\n".join(
+                    f"- variant {k} ({'; '.join(c.joint for c in r.changes)}): {chk.reason}"
+                    for k, r, chk in self.checks) + "\n"
+        return text
+
+    def _repr_markdown_(self) -> str:
+        return self.to_markdown()
+
+
+def _rank_or_reason(mech: Mechanism, tol: float | None) -> tuple[Any, str | None]:
+    from mechsyn.structure.rank import analyze_rank, missing_geometry
+
+    problems = missing_geometry(mech)
+    if problems:
+        return None, "geometry insufficient: " + "; ".join(problems)
+    return analyze_rank(mech, tol=tol), None
+
+
+def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, max_variants: int = 10,
+            tol: float | None = None, as_spatial: bool = False,
+            progress: Callable[[str], None] | None = None) -> StructureReport:
+    """Structural analysis of ``mech`` by the classic formulas and, where the joints' geometry
+    is given, the rank method (screw theory), side by side.
+
+    Parameters
+    ----------
+    mech : Mechanism
+        From :func:`mechsyn.load`.
+    method : {"formulas", "rank", "both"}, optional
+        Default: ``"both"`` when every joint has its geometry, else ``"formulas"``.
+    remedies : bool
+        Also list pair-class changes that remove redundant constraints and idle mobilities
+        (paper 003), re-checked by the rank method when it runs.
+    max_variants : int
+        How many remedy variants to list.
+    tol : float, optional
+        Rank tolerance on the normalised singular values, in (0, 1) (default 1e-6, raised
+        for coordinates written with few decimals).
+    as_spatial : bool
+        Analyse a planar mechanism as a spatial one (R axes along z).
+
+    Returns
+    -------
+    StructureReport
+
+    Raises
+    ------
+    MechsynInputError
+        For a bad ``method`` or ``tol`` (naming the parameter), and
+        :class:`~mechsyn.structure.rank.InsufficientGeometry` when the rank method is asked
+        for without the joints' geometry.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> r = ms.analyze(ms.examples.load("fourbar"))
+    >>> r.method, r.mobility, r.formulas["chebyshev"].value
+    ('both', 1, 1)
+    >>> ms.analyze(ms.examples.load("double_parallelogram")).rank.redundant_constraints
+    1
+
+    References
+    ----------
+    The formulas and per-contour reading follow seed papers 002 and 003 (see
+    :mod:`mechsyn.structure.analysis`); the rank method Hunt (1978), Davies (1981) and
+    Gogu (2005) (see :mod:`mechsyn.structure.rank`).
+    """
+    from mechsyn.structure.compare import check_remedy, compare_with_formulas
+    from mechsyn.structure.rank import InsufficientGeometry, analyze_rank
+    from mechsyn.structure.rank import as_spatial as to_spatial
+    from mechsyn.structure.rank import missing_geometry
+
+    if method is not None and method not in ("formulas", "rank", "both"):
+        raise MechsynInputError(f"unknown method {method!r}", field="method", hint="use formulas, rank or both")
+    if tol is not None and not (0 < tol < 1):
+        raise MechsynInputError(f"tolerance {tol:g} is out of (0, 1)", field="tol", hint="e.g. 1e-6")
+    notes: list[str] = []
+    if as_spatial:
+        if mech.kind == "planar":
+            mech = to_spatial(mech)
+        else:
+            notes.append("as_spatial: the mechanism is already spatial")
+    problems = missing_geometry(mech)
+    if method is None:
+        method = "formulas" if problems else "both"
+    if method in ("rank", "both") and problems:
+        raise InsufficientGeometry(
+            "the rank method needs each joint's geometry: " + "; ".join(problems), source=mech.source,
+            hint="add point/axis (see `mechsyn schema`), or use the formulas method")
+    result = analyze_structure(mech)
+    ra = analyze_rank(mech, tol=tol, progress=progress) if method != "formulas" else None
+    comparisons = compare_with_formulas(result, ra) if ra is not None else []
+    state_ranks = {name: _rank_or_reason(mech.in_state(name), tol) for name in mech.states} if ra is not None else {}
+    rem = find_remedies(mech, max_variants=max_variants) if remedies else None
+    checks = []
+    if rem is not None and ra is not None:
+        checks = [(k, r, check_remedy(mech, r.mechanism, ra, r.analysis.metric_constraints, tol))
+                  for k, r in enumerate(rem, 1)]
+    kept = [r for _, r, c in checks if c.accepted] if checks else rem
+    return StructureReport(mech, method, result, ra, comparisons, state_ranks, kept, checks,
+                           "; ".join(problems) if problems else None, notes)

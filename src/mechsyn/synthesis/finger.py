@@ -35,10 +35,10 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-import pynauty
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.structure.assur import assur_decomposition
+from mechsyn.synthesis import canonical
 from mechsyn.synthesis.chains import rigid_subchain
 from mechsyn.synthesis.groups import group_table
 from mechsyn.synthesis.mechanisms import instantaneous_mobility
@@ -114,15 +114,11 @@ def _trees(n: int) -> list[list[tuple[int, int]]]:
 
 def _certificate(names: list[str], edges: list[tuple[str, str]], colours: list[set[str]]) -> bytes:
     index = {n: i for i, n in enumerate(names)}
-    adj: dict[int, list[int]] = {i: [] for i in range(len(names))}
-    for a, b in edges:
-        adj[index[a]].append(index[b])
-    partition = [{index[n] for n in c} for c in colours if c]
-    rest = set(range(len(names))) - set().union(*partition) if partition else set(range(len(names)))
-    if rest:
-        partition.append(rest)
-    return pynauty.certificate(pynauty.Graph(len(names), directed=False, adjacency_dict=adj,
-                                             vertex_coloring=partition))
+    colour = [len(colours)] * len(names)  # uncoloured vertices: a class of their own
+    for k, c in enumerate(colours):
+        for n in c:
+            colour[index[n]] = k
+    return canonical.certificate(len(names), [(index[a], index[b]) for a, b in edges], colour)
 
 
 def synthesize_fingers(

@@ -555,25 +555,70 @@ class MechanismSynthesisResult:
         return out
 
 
+def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, opts: dict[str, Any],
+                       n_polish: int, search_end: float, deadline: float, f_atol: float,
+                       report: Callable[[int, float], None] | None = None, batch: bool = True,
+                       tracker: BestSoFar | None = None) -> tuple[np.ndarray, float, int]:
+    """One restart of :func:`synthesize_mechanism` (a task of :func:`mechsyn.parallel.run_tasks`):
+    the global search until ``search_end`` (``time.time()``), then the polish of the best few
+    members. Returns the best vector, its fitness and the number of evaluations. ``tracker``
+    (in this process only) records the best design evaluated, for Ctrl-C."""
+    from mechsyn.synthesis.optimize import OPTIMIZERS, polish
+
+    prob = MechanismProblem(case, batch=batch)
+    width = prob.upper - prob.lower
+
+    def should_stop(f: float) -> bool:
+        if report is not None:
+            report(r, f)
+        return time.time() >= search_end or f <= f_atol
+
+    fitness = prob.fitness if tracker is None else tracker.wrap(prob.fitness)
+    g = OPTIMIZERS[optimizer](fitness, prob.lower, prob.upper, seed=seed, should_stop=should_stop,
+                              options=opts)
+    cands = [np.asarray(g.x, float)]
+    if g.population is not None and g.population_fun is not None:
+        for i in np.argsort(g.population_fun):
+            z = np.asarray(g.population[i], float)
+            if len(cands) >= n_polish:
+                break
+            if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
+                cands.append(z)
+    best_z, best_f = cands[0], np.inf
+    for c in cands:
+        if time.time() < deadline:
+            c = polish(prob, c)
+        f = float(prob.fitness(c[None, :])[0])
+        if f < best_f:
+            best_z, best_f = c, f
+    return best_z, best_f, prob.n_evaluations
+
+
 def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 3,
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
                          progress: Callable[[int, int, float], None] | None = None,
+                         workers: int = 1, scheduler: Any = None,
                          batch: bool = True) -> MechanismSynthesisResult:
     """Optimise the case: per restart (child seeds of ``seed``, as in
     :func:`mechsyn.synthesis.optimize.restart_seeds`) the registered global optimiser on
     the feasibility-first fitness, then a least-squares polish of the best few members
     (:func:`mechsyn.synthesis.optimize.polish`); the file's own design competes too.
+    ``workers`` (local processes) or ``scheduler`` (a Dask cluster) run the restarts in
+    parallel (:func:`mechsyn.parallel.run_tasks`); restart ``r``'s search has the same time
+    budget either way (until ``0.85 (r + 1) / restarts`` of the limit), so the result is
+    the single-process one unless the time limit cuts the searches short.
     ``batch``: evaluate populations through the batch engine where the case allows
     (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
 
     Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
     returns the best design evaluated so far with ``interrupted=True``."""
-    from mechsyn.synthesis.optimize import OPTIMIZERS, polish, restart_seeds
+    from mechsyn.parallel import run_tasks
+    from mechsyn.synthesis.optimize import OPTIMIZERS, restart_seeds
 
     if optimizer not in OPTIMIZERS:
         raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
-    t0 = time.monotonic()
+    t0 = time.time()
     deadline = t0 + time_limit
     opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
     opts.update(options or {})
@@ -581,52 +626,46 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     x0 = np.clip(start_vector(case), prob.lower, prob.upper)
     best_z, best_f = x0, float(prob.fitness(x0[None, :])[0])
     start_f = best_f
-    errs, stopped, done = [], False, 0
-    width = prob.upper - prob.lower
     # a near-exact fit (f <= 1e-12 N L^2, L the case's length scale) ends the global search;
     # the least-squares polish then finishes it
     f_atol = float(opts.pop("f_atol", 1e-18 * prob.penalty_base))
+    local = workers <= 1 and scheduler is None
+    best = [best_f]
+    outs: dict[int, tuple] = {}
 
-    tracker = BestSoFar()
+    def report(r: int, f: float) -> None:
+        if progress is not None:
+            progress(r, restarts, min(best[0], f))
+
+    def finished(done: int, total: int, index: int, out) -> None:
+        outs[index] = out
+        best[0] = min(best[0], out[1])
+        if progress is not None:
+            progress(done, restarts, best[0])
+
+    seeds = restart_seeds(seed, restarts)
+    trackers = [BestSoFar() if local else None for _ in seeds]
+    tasks = [(case, r, s, optimizer, opts, n_polish, t0 + time_limit * (0.85 * (r + 1) / restarts),
+              deadline, f_atol, report if local else None, batch, trackers[r])
+             for r, s in enumerate(seeds)]
     interrupted = False
     try:
-        for r, s in enumerate(restart_seeds(seed, restarts)):
-            if r and time.monotonic() > deadline - 0.1 * time_limit:
-                stopped = True
-                break
-            search_end = t0 + time_limit * (0.85 * (r + 1) / restarts)
-
-            def should_stop(f: float, r: int = r) -> bool:
-                if progress is not None:
-                    progress(r, restarts, min(best_f, f))
-                return time.monotonic() >= search_end or f <= f_atol
-
-            g = OPTIMIZERS[optimizer](tracker.wrap(prob.fitness), prob.lower, prob.upper, seed=s, should_stop=should_stop,
-                                      options=opts)
-            cands = [np.asarray(g.x, float)]
-            if g.population is not None and g.population_fun is not None:
-                for i in np.argsort(g.population_fun):
-                    z = np.asarray(g.population[i], float)
-                    if len(cands) >= n_polish:
-                        break
-                    if all(np.linalg.norm((z - c) / width) > 1e-3 for c in cands):
-                        cands.append(z)
-            rbest = np.inf
-            for c in cands:
-                if time.monotonic() < deadline:
-                    c = polish(prob, c)
-                f = float(prob.fitness(c[None, :])[0])
-                rbest = min(rbest, f)
-                if f < best_f:
-                    best_z, best_f = c, f
-            errs.append(rbest if rbest < prob.penalty_base else float("inf"))
-            done += 1
-            if progress is not None:
-                progress(done, restarts, best_f)
+        run_tasks(_mechanism_restart, tasks, workers=workers, scheduler=scheduler,
+                  progress=finished, deadline=deadline - 0.1 * time_limit)
     except KeyboardInterrupt:  # Ctrl-C: keep the best design evaluated so far
         interrupted = True
-        if tracker.x is not None and tracker.f < best_f:
-            best_z, best_f = tracker.x, tracker.f
+        for t in trackers:
+            if t is not None and t.x is not None and t.f < best_f:
+                best_z, best_f = t.x, t.f
+    errs, done, nfev = [], 0, prob.n_evaluations
+    for r in sorted(outs):
+        z, f, n = outs[r]
+        errs.append(f if f < prob.penalty_base else float("inf"))
+        done += 1
+        nfev += n
+        if f < best_f:
+            best_z, best_f = z, f
+    stopped = done < restarts and not interrupted
     ev = evaluate_design(case, best_z)
     names = case.names
     design = {n: float(v) for n, v in zip(names, best_z)}
@@ -639,8 +678,8 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         case=case.name, problem=case.problem, error=ev.error if ok else float("inf"), design=design,
         start_design={n: float(v) for n, v in zip(names, start_vector(case))},
         start_error=start_f if start_f < prob.penalty_base else None, feasible=ok,
-        assembled_at_all_targets=ok, method=ev.method, seconds=time.monotonic() - t0, seed=seed,
-        restarts=done, nfev=prob.n_evaluations, inputs_deg=ev.inputs_deg if ok else case.values_deg, targets=case.targets,
+        assembled_at_all_targets=ok, method=ev.method, seconds=time.time() - t0, seed=seed,
+        restarts=done, nfev=nfev, inputs_deg=ev.inputs_deg if ok else case.values_deg, targets=case.targets,
         achieved=ev.achieved if ok else np.full((N, 2), np.nan),
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,

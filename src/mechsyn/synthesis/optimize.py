@@ -312,7 +312,7 @@ def synthesize_path(
 
     results: list[RestartResult] = []
 
-    def finished(count, total, r):
+    def finished(count, total, index, r):
         done[0] = count
         results.append(r)
         note(count, r.fitness)

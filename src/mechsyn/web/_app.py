@@ -251,8 +251,10 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     async def simulate(request: Request) -> Any:
         data = await _body(request)
         steps = _int(data.get("steps", 180), "steps")
-        fn = _service.simulate_preview if data.get("preview") is True else _service.simulate
-        return await run_in_threadpool(fn, _need(data, "mechanism"), steps)
+        rates = data.get("rates", True)
+        if not isinstance(rates, bool):
+            raise MechsynInputError("must be true or false", field="rates")
+        return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps, None, rates)
 
     @api
     async def files(request: Request) -> Any:
@@ -297,8 +299,14 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
             text = await run_in_threadpool(_service.simulation_csv, _need(data, "mechanism"),
                                            _int(data.get("steps", 180), "steps"))
             return Response(text, media_type="text/csv")
+        if fmt == "gif":
+            frames = _int(data.get("frames", 72), "frames")
+            if not 2 <= frames <= 360:
+                raise MechsynInputError("frames must be within 2..360", field="frames")
+            gif = await run_in_threadpool(_service.animation_gif, _need(data, "mechanism"), frames)
+            return Response(gif, media_type="image/gif")
         if fmt not in ("yaml", "json"):
-            raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json or csv")
+            raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json, csv or gif")
         text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), "." + fmt)
         return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
 

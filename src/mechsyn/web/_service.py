@@ -8,6 +8,7 @@ reports land (``mechsyn.analyze``, an incremental ``simulate``), only this modul
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import math
 from pathlib import Path
@@ -39,9 +40,13 @@ def _examples_dir() -> Path | None:
 
 def examples() -> list[dict[str, str]]:
     """Planar mechanism examples: ``[{"name", "title", "group"}]`` sorted by group and name."""
-    root = _examples_dir()
+    return [dict(e) for e in _examples(_examples_dir())]
+
+
+@functools.lru_cache(maxsize=4)
+def _examples(root: Path | None) -> tuple[dict[str, str], ...]:
     if root is None:
-        return []
+        return ()
     out = []
     for p in sorted(root.rglob("*")):
         if p.suffix not in EXAMPLE_SUFFIXES or not p.is_file():
@@ -55,7 +60,7 @@ def examples() -> list[dict[str, str]]:
         if mech.kind != "planar" or not all(j.point is not None for j in mech.joints):
             continue
         out.append({"name": p.stem, "title": mech.name, "group": p.parent.name})
-    return out
+    return tuple(out)
 
 
 def example_path(name: str) -> Path:
@@ -187,54 +192,15 @@ def _sweep(mech, steps: int, span: float | None) -> tuple[Any, np.ndarray]:
     return drive, start + np.linspace(0, span, n)
 
 
-def simulate_preview(data: Any, steps: int = 180) -> dict[str, Any]:
-    """Positions only, for the drag loop: the closed-form Assur-group solution of
-    :func:`simulate` without its dead-point refinement, velocities and events (those come
-    with the full :func:`simulate` when the drag ends). Falls back to :func:`simulate`
-    when the mechanism does not decompose into drivers and dyads.
-    """
-    from mechsyn.kinematics import dyads
-    from mechsyn.kinematics.analysis import resolve_points
-    from mechsyn.kinematics.solve import assemble
-    from mechsyn.kinematics.system import build_system
-
-    mech = build(data)
-    drive, values = _sweep(mech, steps, None)
-    S = build_system(mech)
-    plan = dyads.decompose(S)
-    if plan is None:
-        return simulate(data, steps)
-    assemble(S)  # the drawn configuration must assemble (else an input error, as in simulate)
-    U = np.tile([d.assembled for d in S.drivers], (len(values), 1)).astype(float)
-    k = [d.joint for d in S.drivers].index(drive.id)
-    U[:, k] = np.radians(values) if drive.type == "R" else values
-    q, _ = dyads.solve_positions(S, plan, U)
-    ok = np.all(np.isfinite(q), axis=1)
-    qz, zero = np.nan_to_num(q), np.zeros_like(q)
-    names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
-    pos = {}
-    for name, (link, at) in resolve_points(mech, names).items():
-        P, _, _ = S.point_state(qz, zero, zero, S.index(link), S.to_local(link, at))
-        P[~ok] = np.nan
-        pos[name] = P
-    return {"mechanism": mech.name, "preview": True,
-            "input": {"joint": drive.id, "type": drive.type, "values": _finite(values),
-                      "unit": "deg" if drive.type == "R" else "length"},
-            "assembled": ok.tolist(),
-            "joints": {j.id: _xy(pos[j.id]) for j in mech.joints if j.id in pos},
-            "points": {p: _xy(pos[p]) for p in mech.points},
-            "velocity": {}, "acceleration": {}, "links": {}, "working_ranges": [], "events": [], "notes": [],
-            "transmission_angle": {}, "method": "assur (positions only)"}
-
-
-def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str, Any]:
+def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool = True) -> dict[str, Any]:
     """Positions of every joint and named point over a sweep of the first drive.
 
     The sweep starts at the drawn configuration (index 0 is the file's pose) and covers
     ``span`` (360 deg for an R drive, ± its length scale for a P drive) in ``steps``.
     Returns ``joints``/``points`` as lists of [x, y] or null (not assembled),
     ``working_ranges``, ``events`` (dead points, reassembly, singular positions),
-    ``transmission_angle`` and, for a four-bar, ``grashof``.
+    ``transmission_angle`` and, for a four-bar, ``grashof``. ``rates=False`` leaves out
+    the velocities, accelerations and link angles (a smaller answer for the drag loop).
     """
     from mechsyn.kinematics import derived
     from mechsyn.kinematics.analysis import simulate as _simulate
@@ -252,11 +218,12 @@ def simulate(data: Any, steps: int = 180, span: float | None = None) -> dict[str
         "assembled": ok.tolist(),
         "joints": {j.id: _xy(sim.points[j.id].position) for j in mech.joints if j.id in sim.points},
         "points": {p: _xy(sim.points[p].position) for p in mech.points},
-        "velocity": {p: _xy(pm.velocity) for p, pm in sim.points.items()},
-        "acceleration": {p: _xy(pm.acceleration) for p, pm in sim.points.items()},
+        "velocity": {p: _xy(pm.velocity) for p, pm in sim.points.items()} if rates else {},
+        "acceleration": {p: _xy(pm.acceleration) for p, pm in sim.points.items()} if rates else {},
         "links": {name: {"angle": _finite(lm.angle), "angular_velocity": _finite(lm.angular_velocity),
                          "angular_acceleration": _finite(lm.angular_acceleration)}
-                  for name, lm in sim.links.items()},
+                  for name, lm in sim.links.items()} if rates else {},
+        "rates": rates,
         "working_ranges": sim.working_ranges(),
         "events": to_jsonable(sim.events),
         "notes": list(sim.notes),
@@ -297,6 +264,27 @@ def simulation_csv(data: Any, steps: int = 180) -> str:
             row += ["", ""] if p is None else [repr(p[0]), repr(p[1])]
         w.writerow(row)
     return buf.getvalue()
+
+
+def animation_gif(data: Any, frames: int = 72) -> bytes:
+    """The mechanism moving over its sweep as a GIF (``mechsyn.plot.animate_simulation``)."""
+    import tempfile
+
+    from matplotlib.animation import PillowWriter
+    from matplotlib.figure import Figure
+
+    from mechsyn.kinematics.analysis import simulate as _simulate
+    from mechsyn.plot.kinematics import animate_simulation
+
+    mech = build(data)
+    drive, values = _sweep(mech, 180, None)
+    sim = _simulate(mech, {drive.id: values})
+    fig = Figure(figsize=(6, 4.5))
+    anim = animate_simulation(sim, fig=fig, max_frames=frames)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "animation.gif"
+        anim.save(str(path), writer=PillowWriter(fps=15), dpi=80)
+        return path.read_bytes()
 
 
 # --------------------------------------------------------------------------- structure
@@ -405,6 +393,8 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
                               progress=report)
         d = {**bcase.fixed, **res.design}
         item = {"error": float(res.error), "feasible": bool(res.feasible), "branch": branch,
+                "label": f"error {res.error:.4g} (sum of squared distances), branch {branch:+d}, "
+                         f"{'feasible' if res.feasible else 'infeasible'}",
                 "design": {k: float(v) for k, v in d.items() if not k.startswith("theta2")},
                 "path": _xy(res.path), "seconds": float(res.seconds)}
         if res.feasible:
@@ -422,8 +412,51 @@ def _with_branch(case, branch: int):
     return dataclasses.replace(case, branch=branch)
 
 
+def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+    """Curve to mechanism (:mod:`mechsyn.synthesis.curves`): ranked 4- to ``max_links``-bar
+    linkages whose tracing point follows the clicked or drawn curve ``params["targets"]``.
+
+    The local curve database is built on first use (a few minutes; its progress is reported).
+    """
+    from mechsyn.synthesis.curves.database import load_database
+    from mechsyn.synthesis.curves.synthesis import synthesize_curve
+    from mechsyn.synthesis.curves.target import target_from_points
+
+    T = np.asarray(params.get("targets"), float)
+    if T.ndim != 2 or T.shape[1:] != (2,) or len(T) < 6 or not np.isfinite(T).all():
+        raise MechsynInputError("give at least 6 points [x, y] along the curve", field="targets",
+                                hint="click more points, or draw the curve")
+    time_limit = float(params.get("time_limit", 20.0))
+    if not 1 <= time_limit <= 600:
+        raise MechsynInputError("time limit must be within 1..600 s", field="time_limit")
+    max_links = int(params.get("max_links", 6))
+    if max_links not in (4, 6, 8):
+        raise MechsynInputError("max_links must be 4, 6 or 8", field="max_links")
+    closed = params.get("closed")
+    target = target_from_points(T, closed=None if closed is None else bool(closed), source="clicked curve")
+
+    def report(state: dict) -> None:
+        best = state.get("best")
+        progress({"done": int(state.get("done") or 0), "total": int(state.get("total") or 1),
+                  "best": float(best) if isinstance(best, float) and math.isfinite(best) else None,
+                  "stage": str(state.get("stage", ""))})
+
+    db = load_database(None, max_links=max_links, callback=report)
+    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, database=db, callback=report)
+    results = []
+    for c in res.candidates:
+        d = c.to_dict()
+        results.append({"error": float(c.chamfer), "feasible": bool(c.verified), "mechanism": d["mechanism"],
+                        "path": _xy(c.path),
+                        "label": f"{d['topology'] or d['topology_key']} ({d['links']} links): chamfer "
+                                 f"{100 * c.chamfer:.2f} % of the diagonal, min μ {c.min_transmission_angle:.0f}°"
+                                 + ("" if c.verified else f", not verified: {c.verification}")})
+    return {"kind": "curve", "targets": T.tolist(), "results": results, "notes": list(res.notes)}
+
+
 # Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
-# Curve-to-mechanism synthesis (branch `curve`) registers here as "curve_atlas" once it lands.
+# Each result dict: {"kind", "targets", "results": [{"label", "error", "feasible", "mechanism", "path"}]}.
 SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, Callable[[dict], None]], dict]]] = {
     "fourbar_path": ("Four-bar path through the clicked points", synthesize_fourbar_path),
+    "curve": ("Curve to mechanism over the atlas (4- to 8-bars)", synthesize_curve_points),
 }

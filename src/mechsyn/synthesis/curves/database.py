@@ -266,7 +266,8 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
     topos = curve_topologies(max(max_links, 4))
     present = [t for t in topos if _file(directory, t).exists()]
     if not present and build_if_missing:
-        build_database(directory, max_links=min(max_links, DEFAULT_LINKS), callback=callback)
+        build_database(directory, max_links=min(max_links, DEFAULT_LINKS), per_topology=DEFAULT_PER_TOPOLOGY,
+                       callback=callback)
         present = [t for t in topos if _file(directory, t).exists()]
     rows_t, designs, ranges, closed, desc = [], [], [], [], []
     for ti, t in enumerate(present):

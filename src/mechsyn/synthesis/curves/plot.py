@@ -55,9 +55,24 @@ def plot_candidate(candidate, target, ax=None, linkage: bool = True, color: str 
         drawn["ground"] = ax.plot(G[:, 0], G[:, 1], "^", color="k", ms=8, label="frame pivots")[0]
         drawn["links"] = lines
         drawn["tracer"] = ax.plot(*pts["T"], "o", color=color, ms=5)[0]
+    # frame on the target and the path (a long link or a far pivot is drawn cut off)
+    pts = np.vstack([T, P])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    if linkage:
+        near = np.array([p for p in pts_all(candidate) if np.all(np.abs(p - (lo + hi) / 2) <= 1.5 * (hi - lo).max())])
+        if len(near):
+            lo, hi = np.minimum(lo, near.min(axis=0)), np.maximum(hi, near.max(axis=0))
+    pad = 0.08 * (hi - lo).max()
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True, alpha=0.3)
     return drawn
+
+
+def pts_all(candidate) -> np.ndarray:
+    """Joint and tracer points of a candidate's drawn configuration."""
+    return np.asarray(candidate.params, float).reshape(-1, 2)
 
 
 def plot_curve_result(result, ax=None, top: int = 3) -> dict[str, Any]:

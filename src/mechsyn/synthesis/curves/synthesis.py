@@ -351,19 +351,16 @@ def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, cr
         by_topo.setdefault(int(db.topology[r]), []).append(r)
     for ti, rs in by_topo.items():
         topo = db.topologies[ti]
-        curves = []
-        for r in rs:
-            a, b = db.ranges[r]
-            off = _offsets(a, b, bool(db.closed[r]))
-            P = simulate_batch(topo.plan, db.designs[r][None], off).paths[TRACER][0]
-            if not np.all(np.isfinite(P)):
-                curves.append(None)
-                continue
-            curves.append(resample(P, 64, closed=bool(db.closed[r])))
-        ok = [i for i, c in enumerate(curves) if c is not None]
-        if not ok:
+        rs_a = np.array(rs)
+        offs = np.array([_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
+        P = simulate_batch(topo.plan, np.array([db.designs[r] for r in rs]), offs, flags=False).paths[TRACER]
+        fine = np.all(np.isfinite(P), axis=(1, 2))
+        if not fine.any():
             continue
-        al = align(np.array([curves[i] for i in ok]), w)
+        ok = np.flatnonzero(fine)
+        closed_rows = db.closed[rs_a[ok]]
+        curves = [resample(P[i], 64, closed=bool(c)) for i, c in zip(ok, closed_rows)]
+        al = align(np.array(curves), w)
         for j, i in enumerate(ok):
             r = rs[i]
             a, b = (float(v) for v in db.ranges[r])
@@ -444,7 +441,7 @@ def synthesize_curve(
     max_links: int = 8,
     time_limit: float = 60.0,
     top: int = 5,
-    n_refine: int = 24,
+    n_refine: int = 32,
     retrieve: int = 300,
     crank: bool = False,
     ground_region: tuple[float, float, float, float] | None = None,
@@ -453,6 +450,7 @@ def synthesize_curve(
     database: CurveDatabase | str | None = None,
     callback: Callable[[dict], None] | None = None,
     max_nfev: int = 60,
+    tolerance: float = 1e-3,
 ) -> CurveSynthesisResult:
     """Ranked linkages (4 to ``max_links`` links) whose tracing point follows a curve.
 
@@ -463,7 +461,8 @@ def synthesize_curve(
     max_links : {4, 6, 8}
         Largest linkage considered.
     time_limit : float
-        Seconds for retrieval and refinement; the best found so far is returned.
+        Seconds for retrieval and refinement: a refinement is not started when the
+        longest one so far would overrun it; the best found so far is returned.
     top : int
         Candidates returned (distinct designs, best chamfer error first).
     n_refine, retrieve : int
@@ -479,6 +478,9 @@ def synthesize_curve(
         penalised in the refinement (0: no penalty); reported for every candidate.
     database : CurveDatabase or directory, optional
         Default: the local database (built on first use).
+    tolerance : float
+        The search ends early once ``top`` candidates have a chamfer error at most this
+        (in target diagonals; default 0.1 %).
     callback : callable, optional
         ``callback(state)`` with ``state = {"stage", "done", "total", "best", "nfev"}``
         (``best``: the best chamfer error so far, in target diagonals).
@@ -528,7 +530,7 @@ def synthesize_curve(
     seeds = _retrieve(database, target, retrieve, max_links, crank)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
     notes: list[str] = []
-    # diversity: at most a third of the refinements from one topology
+    # diversity: at most a third of the refinements from one topology, then fill up
     picked: list[_Seed] = []
     per: dict[str, int] = {}
     cap = max(2, n_refine // 3)
@@ -538,16 +540,28 @@ def synthesize_curve(
             per[s.topo.key] = per.get(s.topo.key, 0) + 1
         if len(picked) >= n_refine:
             break
+    if len(picked) < n_refine:
+        chosen = {id(s) for s in picked}
+        picked += [s for s in seeds if id(s) not in chosen][:n_refine - len(picked)]
+        picked.sort(key=lambda s: s.score)
     cands: list[CurveCandidate] = []
+    done = 0
     nfev = 0
     interrupted = False
     best = float("inf")
+    longest = 0.0
     try:
         for i, s in enumerate(picked):
-            if time.perf_counter() - t0 > time_limit:
-                notes.append(f"time limit reached after {i} of {len(picked)} refinements")
+            now = time.perf_counter()
+            if now - t0 + longest > time_limit:
+                notes.append(f"time limit: {i} of {len(picked)} refinements done")
+                break
+            if sum(c.chamfer <= tolerance for c in cands) >= top:
+                notes.append(f"{top} candidate(s) within {100 * tolerance:g} % after {i} refinements")
                 break
             c = _refine(s, target, ground_region, max_link_ratio, max_nfev, min_transmission)
+            longest = max(longest, time.perf_counter() - now)
+            done += 1
             if c is not None:
                 nfev += c.nfev
                 if (max_link_ratio is None or c.link_length_ratio <= max_link_ratio * (1 + 1e-6)) and \
@@ -573,7 +587,7 @@ def synthesize_curve(
         if len(out) >= top:
             break
     report("done", 1, 1, out[0].chamfer if out else float("nan"), nfev)
-    return CurveSynthesisResult(target, out, time.perf_counter() - t0, len(seeds), len(picked), interrupted, notes)
+    return CurveSynthesisResult(target, out, time.perf_counter() - t0, len(seeds), done, interrupted, notes)
 
 
 def _in_region(c: CurveCandidate, box) -> bool:

@@ -27,10 +27,10 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-import pynauty
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import BatchPlan, compile_plan
+from mechsyn.synthesis import canonical
 from mechsyn.synthesis.chains import KinematicChain, synthesize_chains
 from mechsyn.synthesis.mechanisms import distinct_mechanisms, mechanism_dict
 
@@ -94,14 +94,9 @@ def six_bar_name(chain: KinematicChain, frame: int) -> str | None:
 
 
 def _tracer_orbits(chain: KinematicChain, frame: int, inp: int) -> list[list[int]]:
-    adj: dict[int, list[int]] = {v: [] for v in range(chain.n_links)}
-    for a, b in chain.edges:
-        adj[a].append(b)
-    rest = set(range(chain.n_links)) - {frame, inp}
-    graph = pynauty.Graph(chain.n_links, directed=False, adjacency_dict=adj,
-                          vertex_coloring=[{frame}, {inp}, rest])
+    colours = [0 if v == frame else 1 if v == inp else 2 for v in range(chain.n_links)]
     groups: dict[int, list[int]] = {}
-    for v, o in enumerate(pynauty.autgrp(graph)[3]):
+    for v, o in enumerate(canonical.orbits(chain.n_links, chain.edges, colours)):
         groups.setdefault(int(o), []).append(v)
     return sorted(groups.values())
 

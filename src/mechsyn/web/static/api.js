@@ -1,7 +1,12 @@
 // Talking to the mechsyn studio server: the per-launch token and JSON requests.
 export const token = new URLSearchParams(location.search).get("token") || "";
 
-export async function call(path, body = undefined, { method, raw = false } = {}) {
+// How requests travel: HTTP to the studio server, or (notebook widget) messages to the kernel.
+export const transport = { events: true, request: null };
+export function useTransport(t) { Object.assign(transport, t); }
+
+export async function call(path, body = undefined, { method, raw = false, blob = false } = {}) {
+  if (transport.request) return transport.request(path, method || (body === undefined ? "GET" : "POST"), body, raw || blob);
   const opts = { method: method || (body === undefined ? "GET" : "POST"), headers: { "X-Mechsyn-Token": token } };
   if (body !== undefined) {
     opts.headers["Content-Type"] = "application/json";
@@ -13,6 +18,7 @@ export async function call(path, body = undefined, { method, raw = false } = {})
   } catch (e) {
     throw { error: "the server does not answer (is `mechsyn serve` still running?)" };
   }
+  if (blob && resp.ok) return resp.blob();
   if (raw && resp.ok) return resp.text();
   let data;
   try { data = await resp.json(); } catch (e) { data = { error: `HTTP ${resp.status}` }; }

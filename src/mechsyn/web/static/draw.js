@@ -113,7 +113,7 @@ export function draw(svg, state) {
   const pos = positions(mech, state.poseFromFile ? null : sim, k);
   const P = (p) => v.toScreen(p);
   const invalid = new Set((state.errors || []).map((e) => e.element && `${e.element.kind}:${e.element.id}`));
-  const groupOf = opts.assurColours && state.analysis ? state.analysis.groupOf : {};
+  const groupOf = (opts.assurColours && state.analysis && state.analysis.groupOf) || {};
   const muAt = {};
   if (sim && sim.transmission_angle)
     for (const [key, t] of Object.entries(sim.transmission_angle)) muAt[key.split("-")[1]] = t.values[k];

@@ -1,8 +1,11 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
-import { call, coalescing, eventsUrl } from "./api.js";
+import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
 
-const $ = (id) => document.getElementById(id);
+// Mount the studio on `root` (the page's document, or a notebook widget's element holding
+// the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
+export function mount(root, { onChange = null } = {}) {
+const $ = (id) => root.querySelector(`#${id}`);
 const svg = $("canvas");
 const clone = (x) => JSON.parse(JSON.stringify(x));
 const EMPTY = () => ({ name: "New mechanism", kind: "planar", ground: "frame", links: ["frame"], joints: [], points: {} });
@@ -11,7 +14,7 @@ const state = {
   mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
   opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
   targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
-  renders: 0, simulations: 0,
+  renders: 0, simulations: 0, latencies: [],
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
 
@@ -64,15 +67,17 @@ function statusLine() {
 
 // ------------------------------------------------------------------ simulation and analysis
 const simulateSoon = coalescing(
-  // while dragging: positions only (the closed form, fast); on release: the full simulation
-  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, preview: !!req.preview }).then((r) => ({ r, ms: performance.now() - t0 })); },
-  ({ r, ms }, { mech }) => {
+  // while dragging: without velocities and accelerations (a smaller answer); on release: all
+  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
+  ({ r, ms }, { mech, t0 }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
-    if ((mech !== state.mech || r.preview) && !state.dragging) return; // a newer mechanism is on its way
+    if ((mech !== state.mech || !r.rates) && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
     if (state.frame >= r.assembled.length) state.frame = 0;
     render();
+    // drag-to-repaint latency: from the pointer event to the frame that shows its simulation
+    if (t0 !== undefined) requestAnimationFrame(() => state.latencies.push(performance.now() - t0));
     if (!state.dragging) renderAnalysis();
   },
   (e, { mech }) => {
@@ -104,6 +109,7 @@ function analyseSoon() {
 function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
   if (record && state.mech) { state.undo.push(JSON.stringify(state.mech)); state.redo = []; }
   state.mech = mech;
+  if (onChange) onChange(mech);
   if (!keepFrame) state.frame = 0;
   if (fit) fitView();
   state.errors = [];
@@ -286,12 +292,22 @@ svg.addEventListener("pointerdown", (ev) => {
   } else if (mode === "target") {
     state.targets.push(p);
     $("target-count").textContent = state.targets.length;
+    gesture = { kind: "draw", last: [ev.clientX, ev.clientY] };
+    svg.setPointerCapture(ev.pointerId);
     render();
   }
 });
 
 svg.addEventListener("pointermove", (ev) => {
   if (!gesture) return;
+  if (gesture.kind === "draw") { // drawing a target curve: a point every 12 px
+    if (Math.hypot(ev.clientX - gesture.last[0], ev.clientY - gesture.last[1]) < 12) return;
+    gesture.last = [ev.clientX, ev.clientY];
+    state.targets.push(worldAt(ev));
+    $("target-count").textContent = state.targets.length;
+    render();
+    return;
+  }
   if (gesture.kind === "pan") {
     const s = state.view.s;
     state.view = { ...gesture.view, ox: gesture.view.ox - (ev.clientX - gesture.x) / s, oy: gesture.view.oy + (ev.clientY - gesture.y) / s };
@@ -305,7 +321,7 @@ svg.addEventListener("pointermove", (ev) => {
   gesture.moved = true;
   state.mech = m;
   render();
-  simulateSoon({ mech: m, preview: true });
+  simulateSoon({ mech: m, drag: true, t0: ev.timeStamp });
 });
 
 function endGesture() {
@@ -477,26 +493,30 @@ $("clear-targets").onclick = () => { state.targets = []; state.preview = null; $
 $("synth-run").onclick = async () => {
   $("synth-status").textContent = "";
   try {
-    job = await call("/api/synth/fourbar_path", { targets: state.targets, time_limit: +$("synth-time").value });
+    job = await call(`/api/synth/${$("synth-kind").value || "fourbar_path"}`, { targets: state.targets, time_limit: +$("synth-time").value });
   } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
   $("synth-run").disabled = true; $("synth-cancel").disabled = false;
   $("synth-results").replaceChildren();
-  source = new EventSource(eventsUrl(job.id));
   const show = (snap) => {
     const p = snap.progress;
     $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
-    $("synth-status").textContent = `${snap.state}: ${p.done}/${p.total} restarts, best error ${p.best === null ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
+    $("synth-status").textContent = `${snap.state}${p.stage ? " (" + p.stage + ")" : ""}: ${p.done}/${p.total}, best ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
   };
-  source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
-  source.addEventListener("end", (e) => {
-    source.close();
-    const snap = JSON.parse(e.data);
+  const end = (snap) => {
     show(snap);
     $("synth-run").disabled = false; $("synth-cancel").disabled = true;
     if (snap.error) $("synth-status").textContent = `failed: ${snap.error.message}`;
     if (snap.result) showResults(snap.result.results);
-  });
-  source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
+  };
+  if (transport.events) {
+    source = new EventSource(eventsUrl(job.id));
+    source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
+    source.addEventListener("end", (e) => { source.close(); end(JSON.parse(e.data)); });
+    source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
+  } else { // no event stream (notebook widget): poll the job
+    const poll = async () => { const snap = await call(`/api/jobs/${job.id}`); if (snap.state === "running") { show(snap); setTimeout(poll, 300); } else end(snap); };
+    poll();
+  }
 };
 $("synth-cancel").onclick = async () => { if (job) await call(`/api/jobs/${job.id}/cancel`, {}); };
 
@@ -504,7 +524,7 @@ function showResults(results) {
   const items = results.map((r, i) => {
     const li = h("li");
     li.dataset.result = i;
-    li.append(`error ${r.error.toPrecision(4)} (sum of squared distances), branch ${r.branch}, ${r.feasible ? "feasible" : "infeasible"} `);
+    li.append(`${r.label} `);
     if (r.mechanism) {
       const b = h("button", "Apply"); b.dataset.apply = i;
       b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
@@ -630,6 +650,10 @@ $("export").onchange = async (ev) => {
       const ctx = cv.getContext("2d"); ctx.scale(2, 2); ctx.drawImage(img, 0, 0, r.width, r.height);
       URL.revokeObjectURL(url);
       cv.toBlob((b) => download(`${base()}.png`, b), "image/png");
+    } else if (fmt === "gif") {
+      state.notes = ["making the animation…"]; render();
+      download(`${base()}.gif`, await call("/api/export", { mechanism: state.mech, format: "gif" }, { blob: true }));
+      state.notes = []; render();
     } else {
       const text = await call("/api/export", { mechanism: state.mech, format: fmt }, { raw: true });
       download(`${base()}.${fmt}`, new Blob([text], { type: "text/plain" }));
@@ -650,17 +674,17 @@ async function refreshFiles() {
 function setMode(mode) {
   state.mode = mode;
   if (mode !== "link") { state.building = []; $("finish-link").disabled = true; }
-  for (const b of document.querySelectorAll("#modes button")) b.classList.toggle("on", b.dataset.mode === mode);
+  for (const b of root.querySelectorAll("#modes button")) b.classList.toggle("on", b.dataset.mode === mode);
   if (mode === "target") showTab("synthesis");
   render();
 }
 function showTab(name) {
-  for (const b of document.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
-  for (const t of document.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
+  for (const b of root.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
+  for (const t of root.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
   if (name === "plots") renderPlots();
 }
-for (const b of document.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
-for (const b of document.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
+for (const b of root.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
+for (const b of root.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
 $("finish-link").onclick = finishLink;
 $("undo").onclick = undo;
 $("redo").onclick = redo;
@@ -671,7 +695,7 @@ $("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
 $("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
 $("plot-what").onchange = renderPlots;
 window.addEventListener("resize", render);
-document.addEventListener("keydown", (ev) => {
+(root.addEventListener ? root : document).addEventListener("keydown", (ev) => {
   if (ev.target.matches("input, select, textarea")) return;
   const k = ev.key;
   if ((ev.ctrlKey || ev.metaKey) && k === "z") { ev.preventDefault(); undo(); }
@@ -690,6 +714,7 @@ document.addEventListener("keydown", (ev) => {
   try {
     const s = await call("/api/start");
     $("save-name").value = s.name || "";
+    for (const [k, title] of Object.entries(s.synthesis_kinds || {})) $("synth-kind").append(h("option", title, { value: k }));
     const ex = await call("/api/examples");
     for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}`, { value: e.name }));
     refreshFiles();
@@ -700,3 +725,4 @@ document.addEventListener("keydown", (ev) => {
     state.mech = EMPTY(); render();
   }
 })();
+}

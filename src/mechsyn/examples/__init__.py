@@ -1,0 +1,201 @@
+"""The example files shipped with mechsyn: mechanisms of the papers and the textbooks, arm
+files, belt, synthesis and finger-design cases.
+
+>>> import mechsyn as ms
+>>> "crank_rocker" in ms.examples.names()
+True
+>>> m = ms.examples.load("crank_rocker")
+>>> m.name
+'Crank-rocker four-bar'
+>>> ms.examples.path("paper001").name
+'paper001.yaml'
+
+``list()`` gives a table of them all (name, folder, kind, title). The command line
+accepts an example's name where it takes a file: ``mechsyn analyze fourbar``.
+
+In a wheel the files live in this package's ``data`` folder (copied there from the
+repository's ``examples/`` when the wheel is built, see ``setup.py``); in a source checkout
+they are read from ``examples/`` itself.
+"""
+
+from __future__ import annotations
+
+import builtins
+import functools
+from pathlib import Path
+from typing import Any, NamedTuple
+
+from mechsyn.errors import MechsynInputError
+
+__all__ = ["Example", "list", "load", "names", "path", "resolve", "root"]
+
+_SUFFIXES = (".yaml", ".yml", ".json", ".urdf")
+
+
+def root() -> Path:
+    """The folder that holds the example files."""
+    here = Path(__file__).resolve().parent
+    shipped = here / "data"
+    if shipped.is_dir():
+        return shipped
+    return here.parents[2] / "examples"  # a source checkout: src/mechsyn/examples -> examples/
+
+
+class Example(NamedTuple):
+    """One example file: its ``name`` (the file stem), ``folder``, ``kind`` (``mechanism``,
+    ``arm``, ``belt case``, ``synthesis case``, ``finger-design case``) and ``title``."""
+
+    name: str
+    folder: str
+    kind: str
+    title: str
+    path: Path
+
+
+class Catalogue(builtins.list):  # type: ignore[type-arg]
+    """A list of :class:`Example` that prints as a table."""
+
+    def __str__(self, width: int = 80) -> str:
+        w = max((len(e.name) for e in self), default=4)
+        k = max((len(e.kind) for e in self), default=4)
+        room = max(12, width - w - k - 4)
+
+        def cut(t: str) -> str:
+            return t if len(t) <= room else t[:room - 1] + "…"
+
+        rows = [f"{'name':<{w}}  {'kind':<{k}}  title"]
+        rows += [f"{e.name:<{w}}  {e.kind:<{k}}  {cut(e.title)}" for e in self]
+        return "\n".join(rows)
+
+    __repr__ = __str__
+
+    def _repr_markdown_(self) -> str:
+        rows = ["| name | folder | kind | title |", "|---|---|---|---|"]
+        rows += [f"| {e.name} | {e.folder} | {e.kind} | {e.title} |" for e in self]
+        return "\n".join(rows)
+
+
+def _kind(p: Path, data: Any) -> tuple[str, str]:
+    if p.suffix == ".urdf":
+        return "arm", p.stem
+    if not isinstance(data, dict):
+        return "file", p.stem
+    title = str(data.get("name") or data.get("title") or data.get("description") or p.stem)
+    title = title.strip().splitlines()[0] if title.strip() else p.stem
+    if "joints" in data and "links" in data and "ground" in data:
+        return "mechanism", title
+    if p.parent.name == "capability" or "type" in data and data.get("type") in ("planar_serial", "dh", "urdf"):
+        return "arm", title
+    if p.parent.name == "belt":
+        return "belt case", title
+    if p.parent.name == "fingers":
+        return "finger-design case", title
+    return "synthesis case", title
+
+
+@functools.lru_cache(maxsize=1)
+def _catalogue() -> Catalogue:
+    from mechsyn.io.load import safe_load_yaml
+
+    base = root()
+    files = sorted(p for p in base.rglob("*") if p.suffix in _SUFFIXES and p.is_file())
+    out = Catalogue()
+    for p in files:
+        try:
+            data = safe_load_yaml(p.read_text(encoding="utf-8")) if p.suffix != ".urdf" else None
+        except Exception:  # noqa: BLE001 -- a catalogue lists what it cannot parse too
+            data = None
+        kind, title = _kind(p, data)
+        out.append(Example(p.stem, p.parent.relative_to(base).as_posix(), kind, title, p))
+    return out
+
+
+def list() -> Catalogue:  # noqa: A001 -- ms.examples.list() reads as the field's catalogues do
+    """Every example file, as a table (name, folder, kind, title).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> table = ms.examples.list()
+    >>> sorted({e.kind for e in table})[:3]
+    ['arm', 'belt case', 'finger-design case']
+    """
+    return Catalogue(_catalogue())
+
+
+def names() -> builtins.list[str]:
+    """The examples' names (file stems), sorted.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> "fourbar" in ms.examples.names()
+    True
+    """
+    return sorted({e.name for e in _catalogue()})
+
+
+def path(name: str) -> Path:
+    """The file of example ``name`` (its stem, or ``folder/file.ext`` where stems repeat;
+    a YAML file is preferred to a URDF of the same stem).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.examples.path("paper004_3r").suffix, ms.examples.path("capability/paper004_3r.urdf").suffix
+    ('.yaml', '.urdf')
+    """
+    for e in _catalogue():
+        rel = f"{e.folder}/{e.path.name}"
+        if name in (rel, e.path.name, f"{e.folder}/{e.name}"):
+            return e.path
+    same = [e for e in _catalogue() if e.name == name]
+    if same:
+        return min(same, key=lambda e: e.path.suffix == ".urdf").path
+    raise MechsynInputError(f"no example {name!r}", field="name",
+                            hint="see mechsyn.examples.names(): e.g. " + ", ".join(names()[:4]))
+
+
+def resolve(file: str | Path) -> Path:
+    """``file`` itself when it exists or names a folder or suffix, else the example of that
+    name when there is one (how the command line accepts ``mechsyn analyze fourbar``).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.examples.resolve("fourbar").name
+    'fourbar.yaml'
+    """
+    p = Path(file)
+    if p.exists() or p.suffix or len(p.parts) != 1:
+        return p
+    try:
+        return path(str(file))
+    except MechsynInputError:
+        return p
+
+
+def load(name: str) -> Any:
+    """Example ``name`` as a :class:`~mechsyn.model.Mechanism` (mechanism files), or a
+    :class:`~mechsyn.capability.arm.SerialArm` (arm files).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.examples.load("fourbar").n_moving
+    3
+    >>> ms.examples.load("paper004_3r").n
+    3
+    """
+    p = path(name)
+    kind = next(e.kind for e in _catalogue() if e.path == p)
+    if kind == "mechanism":
+        from mechsyn.io.load import load_mechanism
+
+        return load_mechanism(p)
+    if kind == "arm":
+        from mechsyn.capability.arm import load_arm
+
+        return load_arm(p)
+    raise MechsynInputError(f"example {name!r} is a {kind}, not a mechanism or an arm", field="name",
+                            hint=f"read it with its own loader from mechsyn.examples.path({name!r})")

@@ -1,0 +1,4 @@
+// The studio page: mount the editor on the document, talking to the server over HTTP.
+import { mount } from "./studio.js";
+
+mount(document);

@@ -1,0 +1,155 @@
+"""Branches (issue 12 §2-4): the closed form and Newton continuation agree through folds,
+change points and gaps; the drawn configuration decides the branch wherever the sweep
+starts; singular positions give null rates with an event, never a blow-up."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from mechsyn.io import mechanism_from_dict
+from mechsyn.kinematics.analysis import input_grid, simulate
+from mechsyn.kinematics.dyads import decompose
+from mechsyn.kinematics.system import build_system
+
+from kinematics_helpers import ex  # noqa: F401
+
+KINDS = ("dead point", "reassembled", "singular")
+
+
+def parallelogram(theta=60.0, crank=1.0, frame=4.0):
+    """A parallelogram four-bar drawn at crank angle ``theta`` (change points at 0 and 180)."""
+    t = np.radians(theta)
+    B = [crank * np.cos(t), crank * np.sin(t)]
+    C = [frame + B[0], B[1]]
+    return mechanism_from_dict({
+        "name": "parallelogram", "ground": "frame", "links": ["frame", "crank", "coupler", "rocker"],
+        "joints": [
+            {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0], "actuated": True},
+            {"id": "B", "type": "R", "links": ["crank", "coupler"], "point": B},
+            {"id": "C", "type": "R", "links": ["coupler", "rocker"], "point": C},
+            {"id": "D", "type": "R", "links": ["rocker", "frame"], "point": [frame, 0]}]}, "parallelogram")
+
+
+def triad(theta=None):
+    """A six-bar whose driven crank carries a class-III Assur group (a Stephenson triad:
+    a ternary link held by three binary links), which does not split into dyads."""
+    return mechanism_from_dict({
+        "name": "triad", "ground": "frame", "links": ["frame", "crank", "b1", "b2", "b3", "tri"],
+        "joints": [
+            {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0], "actuated": True},
+            {"id": "B", "type": "R", "links": ["crank", "b1"], "point": [0.5, 0.866]},
+            {"id": "P1", "type": "R", "links": ["b1", "tri"], "point": [2.0, 2.5]},
+            {"id": "P2", "type": "R", "links": ["b2", "tri"], "point": [4.0, 3.0]},
+            {"id": "P3", "type": "R", "links": ["b3", "tri"], "point": [3.2, 1.4]},
+            {"id": "G2", "type": "R", "links": ["b2", "frame"], "point": [5.0, 0.5]},
+            {"id": "G3", "type": "R", "links": ["b3", "frame"], "point": [3.0, -0.6]}]}, "triad")
+
+
+def redrawn(mech, theta, method):
+    """The same mechanism drawn at input ``theta`` (its joint points moved there along the
+    file's branch), without its named points."""
+    ids = [j.id for j in mech.joints]
+    sim = simulate(mech, {"A": np.array([theta])}, points=ids, method=method)
+    assert sim.assembled[0]
+    joints = tuple(replace(j, point=np.array(sim.points[j.id].position[0])) for j in mech.joints)
+    return replace(mech.with_joints(joints), points={}), {j: sim.points[j].position[0] for j in ids}
+
+
+def key_events(sim):
+    return sorted((e["index"], e["kind"]) for e in sim.events if e["kind"] in KINDS
+                  and not e.get("before_sweep"))
+
+
+def compare(a, b, singular_tol=1e-5):
+    """Same assembled rows, same positions (1e-9; 1e-5 at singular rows, where Newton's
+    positions are only as accurate as the square root of its tolerance), same events."""
+    assert np.array_equal(a.assembled, b.assembled)
+    regular = a.assembled & np.isfinite(a.links[next(iter(a.links))].angular_velocity)
+    for p in a.points:
+        d = np.abs(a.points[p].position - b.points[p].position).max(axis=1)
+        assert d[regular].max(initial=0) < 1e-9, (p, a.inputs["A"][regular][np.argmax(d[regular])])
+        assert d[a.assembled].max(initial=0) < singular_tol
+    assert key_events(a) == key_events(b)
+    da = [e["input"]["A"] for e in a.events if e["kind"] == "dead point"]
+    db = [e["input"]["A"] for e in b.events if e["kind"] == "dead point"]
+    assert np.allclose(da, db, atol=1e-6, rtol=0)
+
+
+@pytest.mark.parametrize("name,grid", [
+    ("textbook/fourbar.yaml", (0, 360, 4)),
+    ("textbook/fourbar.yaml", (200, 560, 6)),
+    pytest.param("textbook/watt_sixbar.yaml", (-90, 270, 6), marks=pytest.mark.slow),
+    pytest.param("textbook/stephenson_sixbar.yaml", (0, 360, 5), marks=pytest.mark.slow),
+    ("kinematics/triple_rocker.yaml", (-90, 270, 6)),
+])
+def test_closed_form_equals_newton_through_dead_points_and_gaps(ex, name, grid):
+    m = ex(name)
+    a = simulate(m, {"A": input_grid(*grid)}, method="assur")
+    n = simulate(m, {"A": input_grid(*grid)}, method="newton")
+    assert a.method == "assur" and n.method == "newton"
+    assert (~a.assembled).any()  # the sweep crosses a gap: dead points and reassembly
+    compare(a, n)
+
+
+@pytest.mark.parametrize("grid", [(-30, 390, 10), (-25, 385, 10), (170, 550, 7.5)])
+def test_parallelogram_stays_a_parallelogram(grid):
+    """Change points at 0 and 180 degrees: both methods stay on the drawn (parallelogram)
+    branch, report each crossing as singular, and give null rates at a change point that
+    is a sample, never a number of 1e16."""
+    m = parallelogram(60.0)
+    x = input_grid(*grid)
+    th = np.radians(x)
+    exact = np.stack([4 + np.cos(th), np.sin(th)], axis=1)
+    sims = {meth: simulate(m, {"A": x}, points=["C"], method=meth) for meth in ("assur", "newton")}
+    a = sims["assur"]
+    assert np.abs(a.points["C"].position - exact).max() < 1e-12
+    at_change = np.isclose(np.mod(x, 180.0), 0.0) | np.isclose(np.mod(x, 180.0), 180.0)
+    for sim in sims.values():
+        assert sim.assembled.all()
+        v = sim.points["C"].velocity
+        assert np.isnan(v[at_change]).all() and np.isfinite(v[~at_change]).all()
+        assert np.nanmax(np.abs(sim.points["C"].acceleration)) < 10
+        # the velocity of the parallelogram's C equals the crank tip's: (-sin, cos)
+        assert np.allclose(v[~at_change], np.stack([-np.sin(th), np.cos(th)], 1)[~at_change], atol=1e-9)
+    compare(a, sims["newton"])
+    crossings = np.arange(180 * np.ceil(x[0] / 180), x[-1] + 1e-9, 180.0)
+    sing = sorted(e["input"]["A"] for e in a.events if e["kind"] == "singular" and not e.get("before_sweep"))
+    assert len(sing) == len(crossings) and np.allclose(sing, crossings, atol=1e-9, rtol=0)
+
+
+def test_drawn_branch_decides_where_the_sweep_starts():
+    """Drawn at 60 degrees, a sweep over -30..50 (not containing 60, behind a change point)
+    starts on the parallelogram branch continued backwards from the drawn configuration,
+    and says that a change point lies between."""
+    m = parallelogram(60.0)
+    x = input_grid(-30, 50, 5)
+    th = np.radians(x)
+    for meth in ("assur", "newton"):
+        sim = simulate(m, {"A": x}, points=["C"], method=meth)
+        assert np.abs(sim.points["C"].position - np.stack([4 + np.cos(th), np.sin(th)], 1)).max() < 1e-5
+        if meth == "assur":
+            assert np.abs(sim.points["C"].position - np.stack([4 + np.cos(th), np.sin(th)], 1)).max() < 1e-12
+            before = [e for e in sim.events if e.get("before_sweep")]
+            assert [e["kind"] for e in before] == ["singular"] and abs(before[0]["input"]["A"]) < 1e-9
+
+
+@pytest.mark.parametrize("name", ["textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "triad"])
+@pytest.mark.parametrize("theta", [20.0, 75.0, pytest.param(100.0, marks=pytest.mark.slow)])
+def test_sweeps_pass_through_the_drawn_configuration(ex, name, theta):
+    base = triad() if name == "triad" else ex(name)
+    S = build_system(base)
+    methods = ["newton"] if decompose(S) is None else ["assur", "newton"]
+    if name == "triad":
+        assert decompose(S) is None  # a class-III group: Newton continuation
+    drawn, points = redrawn(base, theta, methods[0])
+    for lo, hi, step in [(theta - 80, theta + 20, 5), (theta - 20, theta + 40, 2.5), (theta, theta + 30, 10),
+                         (theta - 30, theta, 6)]:
+        x = input_grid(lo, hi, step)
+        k = int(np.argmin(np.abs(x - theta)))
+        assert abs(x[k] - theta) < 1e-9
+        for meth in methods:
+            sim = simulate(drawn, {"A": x}, points=list(points), method=meth)
+            assert sim.assembled[k]
+            for j, P in points.items():
+                assert np.abs(sim.points[j].position[k] - P).max() < 1e-9, (meth, lo, hi, j)
