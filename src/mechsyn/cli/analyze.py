@@ -8,17 +8,16 @@ from typing import Annotated, Optional
 
 import typer
 from rich.panel import Panel
-from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, err_console, safe
+from mechsyn.cli.common import Table, console, emit_json, err_console, safe  # Table: cells fold
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis
 from mechsyn.structure.compare import Comparison, RemedyCheck
 from mechsyn.structure.rank import RankAnalysis, rank_summary_lines
 from mechsyn.structure.remedies import Remedy
-from mechsyn.structure.report import StructureReport, pair_list
+from mechsyn.structure.report import CONTOUR_READING, StructureReport, formula_title, pair_list
 from mechsyn.structure.report import analyze as structure_report
 
 
