@@ -273,3 +273,14 @@ def test_api_raises_input_errors_not_bare_ones():
                  {"name": "x", "ground": "frame", "links": [["a"]], "joints": [{}]}):
         with pytest.raises(MechsynInputError):
             mechanism_from_dict(data, "m.yaml")
+
+
+@pytest.mark.parametrize("args,expect", [
+    (["simulate"], "Missing argument"), (["simulat"], "No such command"),
+    (["atlas", "--links", "x"], "--links"), (["synth", "path", "--bogus"], "--bogus"),
+])
+def test_usage_errors_are_one_line(run_cli, args, expect):
+    code, _, err = run_cli(*args)
+    msg = one_error_line(err)
+    assert code == 2 and expect in msg and "-h" in msg
+    assert len(err.strip().splitlines()) <= 2

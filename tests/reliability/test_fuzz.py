@@ -258,6 +258,10 @@ def test_random_command_lines(capsys, argv):
     out, err = capsys.readouterr()
     assert "Traceback" not in out + err
     assert code in (0, 2), (argv, code, err)
+    if code == 2 and err.strip():  # (a bare group prints its help instead)
+        assert err.lstrip().startswith(("error:", "Usage:")), err
+        if err.lstrip().startswith("error:"):
+            assert len([ln for ln in err.splitlines() if ln.strip()]) <= 3, err
 
 
 # ----------------------------------------------------------------------- deeper (slow) runs
