@@ -30,6 +30,9 @@ LONG = ("--links 12", "--links 10", "atlas8.svg", "finger-design", "finger_best"
         "ur5_dh.yaml --grid", "--grid 1000:2600", "three_phalanx_base_000.yaml --max-links 4",
         "belt analyze --file", "triple_rocker.yaml --input A=0:360:2 --plot")
 RUN_ALL = os.environ.get("MECHSYN_DOC_COMMANDS") == "all"
+#: commands that start a server and run until stopped: tests/web/test_serve_cli.py starts
+#: them (bound to a free port) instead
+SERVERS = ("mechsyn serve",)
 
 
 def doc_commands() -> list[tuple[str, str]]:
@@ -47,7 +50,7 @@ def doc_commands() -> list[tuple[str, str]]:
                     line = line[2:]
                 for part in line.split("&&"):  # e.g. pip install -e . && mechsyn analyze ...
                     part = part.strip()
-                    if part.startswith("mechsyn "):
+                    if part.startswith("mechsyn ") and not part.startswith(SERVERS):
                         out.append((str(page.relative_to(ROOT)), part))
     return out
 

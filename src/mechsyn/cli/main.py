@@ -37,8 +37,15 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
               "their mechanisms."),
     "belt": (("belt",), "Paper 001's manipulator with a belt on a pulley: synthesis, paths, speeds, "
              "accelerations, the inverse problem."),
-    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism"),
-              "Synthesis: structural (groups, fingers) and dimensional (path, function, motion)."),
+    "synth": (("synth_groups", "finger", "synth_finger_design", "synth_path", "synth_mechanism",
+               "synth_curve"),
+              "Synthesis: structural (groups, fingers), dimensional (path, function, motion) and "
+              "curve to mechanism."),
+    "curves": (("curves",), "The local database of coupler curves used by synth curve: build or extend it."),
+    "serve": (("serve",), "mechsyn studio: draw, drag, analyse and synthesise mechanisms in the browser "
+              "(local server)."),
+    "convert": (("convert",), "Convert Pyslvs mechanism expressions to mechanism files and back."),
+    "export": (("export",), "Export a mechanism: DXF or SVG plates to cut, an SVG drawing at a pose."),
 }
 
 
