@@ -179,9 +179,8 @@ def test_long_chain_refused_with_overridable_limit(run_cli, tmp_path):
     joints = [{"id": f"J{i}", "type": "R", "links": [links[i - 1], links[i]], "point": [i, 0]}
               for i in range(1, n)]
     joints[0]["actuated"] = True
-    text = yaml.safe_dump({"name": "chain", "kind": "planar", "ground": "frame", "links": links,
-                           "joints": joints}, default_flow_style=None, width=200)
-    f = write(tmp_path, "chain.yaml", text)
+    text = json.dumps({"name": "chain", "kind": "planar", "ground": "frame", "links": links, "joints": joints})
+    f = write(tmp_path, "chain.json", text)
     code, _, err = run_cli("analyze", f)
     msg = one_error_line(err)
     assert code == 2 and "MECHSYN_LIMIT_LINKS" in msg

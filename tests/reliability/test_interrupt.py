@@ -148,9 +148,9 @@ def test_real_sigint_to_synth_path_keeps_best(tmp_path):
     assert (tmp_path / "x.yaml").read_text().startswith("# INTERRUPTED")
 
 
-def test_real_sigint_while_loading_exits_130(tmp_path):
-    r = _sigint_subprocess(["analyze", str(ROOT / "examples" / "textbook" / "fourbar.yaml")],
-                           delay=1.0, cwd=tmp_path)
+def test_real_sigint_during_a_plain_command_exits_130(tmp_path):
+    r = _sigint_subprocess(["simulate", str(ROOT / "examples" / "kinematics" / "crank_rocker.yaml"),
+                            "--input", "A=0:3600:0.005", "--json"], delay=2.0, cwd=tmp_path)
     assert r.returncode == INTERRUPT_EXIT_CODE, r.stderr
     assert r.stderr.strip().splitlines()[-1] == "interrupted"
     assert "Traceback" not in r.stderr
