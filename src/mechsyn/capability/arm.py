@@ -31,7 +31,7 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 
 JointType = Literal["R", "P"]
 
@@ -324,6 +324,7 @@ class SerialArm:
 
 
 # --------------------------------------------------------------------------- building
+@input_boundary("arm file")
 def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None = None) -> SerialArm:
     """Validate an arm description (see module docstring) and build the model."""
     if not isinstance(data, dict):

@@ -114,7 +114,17 @@ def main(argv: list[str] | None = None) -> int:
         if name == "Abort":  # click's wrapping of Ctrl-C
             status = _INTERRUPTED
         elif hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
-            exc.show()
+            if name == "NoArgsIsHelpError" or not hasattr(exc, "format_message"):
+                exc.show()  # the help text itself
+            else:  # one line: where, what, and the fix
+                from rich.markup import escape
+
+                from mechsyn.cli.common import err_console
+
+                ctx = getattr(exc, "ctx", None)
+                where = ctx.command_path if ctx is not None else "mechsyn"
+                err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(exc.format_message())} "
+                                  f"(fix: see '{escape(where)} -h')", highlight=False, soft_wrap=True)
             return _exit(int(exc.exit_code), argv)
         elif hasattr(exc, "exit_code"):  # Exit
             return _exit(int(exc.exit_code), argv)

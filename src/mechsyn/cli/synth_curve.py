@@ -9,7 +9,7 @@ import typer
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats
+from mechsyn.cli.common import check_writable, console, emit_json, err_console, parse_floats, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -39,6 +39,7 @@ def synth_curve(
             raise MechsynInputError("expected x0,y0,x1,y1 with x0 < x1 and y0 < y1", source="--ground-region")
     if out is not None and out.exists() and not out.is_dir():
         raise MechsynInputError(f"{out} is a file", source="--out", hint="give a directory")
+    check_writable(out, "--out", directory=True)
     tgt = read_target(target)
     show = err_console.is_terminal
     if show:
@@ -68,6 +69,7 @@ def synth_curve(
         _write_out(out, res)
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
     t = Table(title=f"Curve synthesis: {tgt.source} ({'closed' if tgt.closed else 'open'}, "
                     f"{len(tgt.points)} points)")
@@ -85,6 +87,7 @@ def synth_curve(
                   + ("; interrupted: best so far" if res.interrupted else ""))
     for n in res.notes:
         console.print(f"note: {n}")
+    stop_if_interrupted(res)
 
 
 def _write_out(out: Path, res) -> None:

@@ -17,9 +17,9 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import files
-from mechsyn.io.checks import check_geometry
+from mechsyn.io.checks import check_counts, check_geometry
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -171,6 +171,7 @@ def _validation_error(exc: ValidationError, data: Any, source: str, text: str | 
     )
 
 
+@input_boundary("mechanism file")
 def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = None) -> Mechanism:
     """Validate mechanism-file data and build a :class:`Mechanism`.
 
@@ -181,6 +182,7 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
             "a mechanism file must be a mapping with name, kind, ground, links, joints",
             source=source, line=1, hint="see `mechsyn schema` and the files in examples/",
         )
+    check_counts(data, source)
     try:
         spec = MechanismFile.model_validate(data)
     except ValidationError as exc:

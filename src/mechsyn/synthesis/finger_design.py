@@ -48,7 +48,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.interrupt import BestSoFar
 
 __all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
@@ -132,6 +132,7 @@ def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
     return out
 
 
+@input_boundary("finger-design case")
 def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> FingerCase:
     """Validate a case (see ``docs/finger_design.md``); MechsynInputError on bad input."""
     from mechsyn.io import load_mechanism, mechanism_to_dict

@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.interrupt import BestSoFar
 from mechsyn.limits import limit, limit_hint
 
@@ -138,6 +138,7 @@ def _floats(v: Any, src: str, fld: str, n: int | None = None) -> np.ndarray:
     return a
 
 
+@input_boundary("synthesis case")
 def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
     """Validate a case mapping; the mechanism file path is relative to ``base_dir``."""
     from mechsyn.io import load_mechanism, mechanism_to_dict
