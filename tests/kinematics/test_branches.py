@@ -12,7 +12,7 @@ from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.dyads import decompose
 from mechsyn.kinematics.system import build_system
 
-from kinematics_helpers import ex  # noqa: F401
+from kinematics_helpers import EX, ex  # noqa: F401
 
 KINDS = ("dead point", "reassembled", "singular")
 
@@ -176,3 +176,62 @@ def test_option_switches_to_the_other_branch_at_change_points():
     assert any("other branch" in e["message"] for e in other.events if e["kind"] == "singular")
     with pytest.raises(Exception):
         simulate(m, {"A": x}, method="newton", change_points="switch")
+
+
+def fold_input(mech, crank=("A", "B"), rocker=("C", "D"), coupler=("B", "C")):
+    """The crank angle (degrees) at which the coupler and the rocker of a four-bar lie
+    stretched along one line (a dead point of the crank), by the law of cosines."""
+    P = {j.id: np.asarray(j.point, float) for j in mech.joints}
+    a = np.linalg.norm(P[crank[1]] - P[crank[0]])
+    b = np.linalg.norm(P[coupler[1]] - P[coupler[0]])
+    c = np.linalg.norm(P[rocker[1]] - P[rocker[0]])
+    g = np.linalg.norm(P[rocker[1]] - P[crank[0]])
+    return float(np.degrees(np.arccos((a * a + g * g - (b + c) ** 2) / (2 * a * g))))
+
+
+@pytest.mark.parametrize("method", ["assur", "newton"])
+@pytest.mark.parametrize("side", ["starts", "ends"])
+def test_sweep_at_its_dead_point(ex, method, side):
+    """A sweep that starts (or ends) exactly at the dead point: the sample there is singular,
+    an event says so, and its rates are undefined (NaN), never 1e5 from a nearly singular
+    Jacobian; the closed form and Newton agree."""
+    m = ex("textbook/fourbar.yaml")
+    th = fold_input(m)
+    x = input_grid(th, th + 40, 5) if side == "starts" else input_grid(th - 40, th, 5)
+    k = 0 if side == "starts" else len(x) - 1
+    assert x[k] == th
+    sim = simulate(m, {"A": x}, points=["B", "C", "M"], method=method)
+    assert sim.assembled[k]
+    sing = [e for e in sim.events if e["kind"] == "singular" and e["index"] == k]
+    assert sing and abs(sing[0]["input"]["A"] - th) < 1e-9
+    for lk in sim.links.values():
+        assert np.isnan(lk.angular_velocity[k]) and np.isnan(lk.angular_acceleration[k])
+    for p in sim.points.values():
+        assert np.isnan(p.velocity[k]).all() and np.isnan(p.acceleration[k]).all()
+        regular = sim.assembled.copy()
+        regular[k] = False
+        assert np.isfinite(p.velocity[regular]).all() and np.abs(p.velocity[regular]).max(initial=0) < 1e3
+    if side == "starts":
+        dead = [e for e in sim.events if e["kind"] == "dead point"]
+        assert len(dead) == 1 and abs(dead[0]["input"]["A"] - th) < 1e-9
+    other = simulate(m, {"A": x}, points=["B", "C", "M"], method="assur" if method == "newton" else "newton")
+    compare(sim, other)
+
+
+def test_cli_sweep_at_its_dead_point_gives_null_rates(ex, cli_json):
+    """The same through ``simulate --json``: the flagged row's rates are null, and no value
+    of a numerical blow-up (above 1e6) is presented as a number anywhere."""
+    th = fold_input(ex("textbook/fourbar.yaml"))
+    for method in ("assur", "newton"):
+        d = cli_json("simulate", EX / "textbook/fourbar.yaml", "--input", f"A={th!r}:{th + 40!r}:5",
+                     "--points", "M,C", "--method", method)
+        assert d["input"]["values"][0] == pytest.approx(th, abs=1e-12)
+        flagged = {e["index"] for e in d["events"] if e["kind"] == "singular"}
+        assert 0 in flagged, method
+        for series in list(d["points"].values()) + list(d["links"].values()):
+            for key, rows in series.items():
+                if key in ("velocity", "acceleration", "angular_velocity", "angular_acceleration"):
+                    assert rows[0] is None or all(v is None for v in rows[0]), (method, key)
+                flat = np.array([v for r in rows if r is not None
+                                 for v in (r if isinstance(r, list) else [r]) if v is not None], float)
+                assert np.abs(flat).max(initial=0) < 1e6, (method, key)

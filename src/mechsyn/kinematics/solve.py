@@ -268,6 +268,31 @@ def _rates_from(S: PlanarSystem, q: np.ndarray, fac: tuple, X: np.ndarray,
     return qd, qdd
 
 
+def _settle(S: PlanarSystem, q: np.ndarray, u: np.ndarray, fac: tuple) -> tuple[np.ndarray, tuple]:
+    """Near a singular configuration (pivot ratio below 1e-3), Newton's iterations continued
+    to round-off: at a fold Newton converges only linearly, so the sweep's tolerance leaves
+    the position about the square root of it away (a pivot ratio near 1e-6 at an exact dead
+    point, rates of 1e5 presented as numbers); continued until the residual stops
+    decreasing, the pivot ratio is as small as floats can resolve, and a sample at a
+    singular position is recognised as one (the closed form's test: within 1e-12 of it)."""
+    if fac[3] >= 1e-3:
+        return q, fac
+    u2 = u[None]
+    best = float(np.abs(S.residual(q[None], u2)[0]).max())
+    for _ in range(60):
+        if best == 0.0:
+            break
+        dq = _solve_lin(S.jacobian(q[None])[0], -S.residual(q[None], u2)[0])
+        if not np.all(np.isfinite(dq)) or float(np.abs(dq).max()) > 1e-4 * S.scale:
+            break
+        q2 = q + dq
+        r2 = float(np.abs(S.residual(q2[None], u2)[0]).max())
+        if r2 >= best:
+            break
+        q, best = q2, r2
+    return q, _factor(S, q)
+
+
 def _step_ok(S: PlanarSystem, q_old: np.ndarray, q_new: np.ndarray, q_pred: np.ndarray) -> bool:
     """Reject a Newton correction much larger than the predicted step (a branch jump)."""
     nl = 3 * len(S.links)
@@ -552,9 +577,12 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                     nb = _track(S, bq, bu, inputs[j])
                     if nb is None:
                         break
+                    nb, f_j = _settle(S, nb, inputs[j], _factor(S, nb))
                     q[j] = nb
-                    fac_j, X_j, det_sign[j], sig[j] = _factor(S, nb)
+                    fac_j, X_j, det_sign[j], sig[j] = f_j
                     qd[j], qdd[j] = _rates_from(S, nb, fac_j, X_j, speeds)
+                    if sig[j] < 1e-6:  # singular: the rates are not defined here
+                        qd[j] = qdd[j] = np.nan
                     bq, bu, j = nb, inputs[j], j - 1
                 if refine_limits and j >= 0:
                     ul, _ = _limit(S, bq, bu, inputs[j])
@@ -564,8 +592,8 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                                "message": "assembles again after a gap, in the assembly mode of the drawn "
                                               "configuration (the mode nearest the drawn one)"})
         if cur is not None:
+            cur, f = _settle(S, cur, u, _factor(S, cur))
             q[i] = cur
-            f = _factor(S, cur)
             fac, X, det_sign[i], sig[i] = f
             if i > 0 and np.isfinite(q[i - 1, 0]):
                 hist.append((u, cur, f))
