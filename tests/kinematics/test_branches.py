@@ -65,14 +65,15 @@ def compare(a, b, singular_tol=1e-5):
     """Same assembled rows, same positions (1e-9; 1e-5 at singular rows, where Newton's
     positions are only as accurate as the square root of its tolerance), same events."""
     assert np.array_equal(a.assembled, b.assembled)
+    inp = next(iter(a.inputs))
     regular = a.assembled & np.isfinite(a.links[next(iter(a.links))].angular_velocity)
     for p in a.points:
         d = np.abs(a.points[p].position - b.points[p].position).max(axis=1)
-        assert d[regular].max(initial=0) < 1e-9, (p, a.inputs["A"][regular][np.argmax(d[regular])])
+        assert d[regular].max(initial=0) < 1e-9, (p, a.inputs[inp][regular][np.argmax(d[regular])])
         assert d[a.assembled].max(initial=0) < singular_tol
     assert key_events(a) == key_events(b)
-    da = [e["input"]["A"] for e in a.events if e["kind"] == "dead point"]
-    db = [e["input"]["A"] for e in b.events if e["kind"] == "dead point"]
+    da = [e["input"][inp] for e in a.events if e["kind"] == "dead point"]
+    db = [e["input"][inp] for e in b.events if e["kind"] == "dead point"]
     assert np.allclose(da, db, atol=1e-6, rtol=0)
 
 
@@ -235,3 +236,37 @@ def test_cli_sweep_at_its_dead_point_gives_null_rates(ex, cli_json):
                 flat = np.array([v for r in rows if r is not None
                                  for v in (r if isinstance(r, list) else [r]) if v is not None], float)
                 assert np.abs(flat).max(initial=0) < 1e6, (method, key)
+
+
+@pytest.mark.parametrize("grid", ["between", "on"])
+def test_peaucellier_cell_through_its_flat_rhombus(ex, grid):
+    """The Peaucellier-Lipkin cell passes its flat rhombus (Q coincides with P, the dyad
+    A-Q-B's two modes meet: a bifurcation) at crank angles +-2 acos(sqrt(21)/6): both
+    methods report it as singular (refined input), agree on every position (1e-9 away from
+    a singular sample), keep Q on its straight line x = 3.5 (the smooth branch, not the
+    branch Q = P) and give null rates only at a sample that is the singular position."""
+    m = ex("kinematics/peaucellier.yaml")
+    P = {j.id: np.asarray(j.point, float) for j in m.joints}
+    ell, s = np.linalg.norm(P["A1"] - P["O1"]), np.linalg.norm(P["A1"] - P["P1"])
+    r = np.linalg.norm(P["P1"] - P["E"])
+    k2 = ell ** 2 - s ** 2  # the inversion: OP * OQ = l^2 - s^2
+    flat = float(np.degrees(2 * np.arccos(np.sqrt(k2) / (2 * r))))  # where OP = sqrt(l^2 - s^2)
+    x = input_grid(-100, 100, 5) if grid == "between" else input_grid(-flat, flat, flat / 5)
+    sims = {meth: simulate(m, {"E": x}, points=["P1", "A1", "B1", "Q"], method=meth)
+            for meth in ("assur", "newton")}
+    for meth, sim in sims.items():
+        assert sim.method == meth and sim.assembled.all()
+        sing = sorted(e["input"]["E"] for e in sim.events if e["kind"] == "singular")
+        assert np.allclose(sing, [-flat, flat], atol=1e-9 if meth == "assur" else 1e-6, rtol=0), (meth, sing)
+        assert not [e for e in sim.events if e["kind"] in ("dead point", "reassembled")]
+        on = np.isin(np.arange(len(x)), [e["index"] for e in sim.events if e["kind"] == "singular"]) & (
+            np.isclose(np.abs(x), flat, atol=1e-12))
+        assert on.any() == (grid == "on")
+        Q, Pp = sim.points["Q"].position, sim.points["P1"].position
+        line = np.abs(Q[:, 0] - k2 / (2 * r))
+        assert line[~on].max() < 1e-9 and line[on].max(initial=0) < 1e-6
+        assert np.allclose(np.linalg.norm(Q, axis=1) * np.linalg.norm(Pp, axis=1), k2, atol=1e-6)
+        v = sim.points["Q"].velocity
+        assert np.isnan(v[on]).all() and np.isfinite(v[~on]).all() and np.abs(v[~on]).max() < 10
+        assert np.allclose(v[~on, 0], 0, atol=1e-8)  # Q moves along its line
+    compare(sims["assur"], sims["newton"])

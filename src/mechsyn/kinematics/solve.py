@@ -467,6 +467,27 @@ def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> list:
     return []
 
 
+def _crossing(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, det: float,
+              iters: int = 40) -> np.ndarray:
+    """Bisection for the input between ``ua`` (configuration ``q``, ``det Phi_q`` of sign
+    ``det``) and ``ub`` where ``det Phi_q`` changes sign along the branch (a change or
+    branch point); ``ub`` when the branch cannot be followed there. Next to the singular
+    point the sign of ``det`` is decided by round-off, so the result is accurate to about
+    1e-8 rad, not to the closed form's 1e-13."""
+    for _ in range(iters):
+        if np.abs(ub - ua).max() < 1e-13:
+            break
+        um = (ua + ub) / 2
+        qm = _track(S, q, ua, um, depth=4)
+        if qm is None:
+            return ub
+        if _factor(S, qm)[2] * det > 0:
+            q, ua = qm, um
+        else:
+            ub = um
+    return (ua + ub) / 2
+
+
 def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
     for _ in range(iters):
@@ -604,9 +625,10 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                 qdd[i] = np.nan
             if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
                     and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
-                events.append({"index": i, "kind": "singular", "input": u.tolist(), "crossed": True,
+                uc = _crossing(S, q[i - 1], inputs[i - 1], u, det_sign[i - 1]) if refine_limits else u
+                events.append({"index": i, "kind": "singular", "input": uc.tolist(), "crossed": True,
                                "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
-                                          "crossed between this input and the previous"})
+                                          "crossed between this input and the previous (at the input given)"})
         if progress is not None:
             progress()
     assembled = np.all(np.isfinite(q), axis=1)
