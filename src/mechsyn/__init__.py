@@ -29,7 +29,6 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-from mechsyn._version import __version__
 from mechsyn.errors import MechsynError, MechsynInputError
 
 #: public name -> module that defines it (imported on first use)
@@ -48,6 +47,7 @@ _LAZY: dict[str, str] = {
     # capability (paper 004)
     "SerialArm": "mechsyn.capability.arm", "load_arm": "mechsyn.capability.arm",
     "capability_map": "mechsyn.capability.maps", "CapabilityMap": "mechsyn.capability.maps",
+    "capability_at": "mechsyn.capability.point", "PointCapability": "mechsyn.capability.point",
     # synthesis
     "synthesize_chains": "mechsyn.synthesis.chains", "synthesize_fingers": "mechsyn.synthesis.finger",
     "design_finger": "mechsyn.synthesis.finger_design", "synthesize_path": "mechsyn.synthesis.optimize",
@@ -61,7 +61,9 @@ __all__ = sorted([*_LAZY, *_SUBMODULES, "MechsynError", "MechsynInputError", "__
 
 
 def __getattr__(name: str) -> Any:
-    if name in _LAZY:
+    if name == "__version__":  # package metadata: read on first use (importlib.metadata is slow to import)
+        from mechsyn._version import __version__ as value
+    elif name in _LAZY:
         value = getattr(importlib.import_module(_LAZY[name]), name)
     elif name in _SUBMODULES:
         value = importlib.import_module(f"mechsyn.{name}")

@@ -33,7 +33,7 @@ DEFAULTS: dict[str, tuple[float, str]] = {
     "sweep_points": (1_000_000, "positions of one input sweep or synthesis grid"),
     "links": (2_000, "links of a mechanism file (analysis time grows as the cube)"),
     "joints": (4_000, "joints of a mechanism file"),
-    "atlas_links": (12, "links of an atlas enumeration (the count grows ~30-fold per 2 links)"),
+    "atlas_links": (14, "links of an atlas enumeration (the count grows ~46-fold per 2 links)"),
 }
 
 _overrides: dict[str, float] = {}

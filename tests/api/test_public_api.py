@@ -146,3 +146,20 @@ def test_version_and_lazy_help(run_cli):
                      "if m in sys.modules))", COLUMNS="80")
     assert loaded.splitlines()[-1] == "[]"
     assert "simulate" in loaded and "synth" in loaded
+
+
+def test_capability_point_json_is_the_report(cli_json):
+    arm = ms.examples.path("paper004_3r")
+    data = cli_json("capability", arm, "--point", "1000,1000", "--direction", "1,0", "--polytope")
+    report = ms.capability_at(ms.load_arm(arm), [1000, 1000], [1, 0], polytope=True)
+    assert data == json.loads(json.dumps(to_jsonable(report.to_dict())))
+    assert data["best"]["exact"] == max(c["exact"] for c in data["configurations"])
+
+
+def test_every_public_name_has_a_runnable_example():
+    # pytest --doctest-modules src/mechsyn runs them (.ci/steps/20-doctest.sh)
+    import inspect
+
+    missing = [n for n in ms.__all__ if not n.startswith("__") and not inspect.ismodule(getattr(ms, n))
+               and ">>>" not in (inspect.getdoc(getattr(ms, n)) or "")]
+    assert missing == []

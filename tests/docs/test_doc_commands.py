@@ -97,5 +97,6 @@ def test_documented_command_runs(page, command, page_dirs, monkeypatch, capsys):
     code = main(words[1:])
     out = capsys.readouterr()
     assert code == 0, f"{command}\n{out.err}"
+    assert out.out.strip() or out.err.strip(), f"{command} said nothing"  # a command that did nothing
     if redirect:
         (tmp_path / redirect).write_text(out.out)

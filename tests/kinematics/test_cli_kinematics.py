@@ -94,7 +94,7 @@ def test_vll_option(capsys):
     (["--input", "A=x,y"], "expected numbers"),
     (["--input", "A"], "START:STOP:STEP"),
     (["--input", "A=0:10:1", "--points", "Q"], "no point or joint"),
-    (["--input", "A=0:10:1", "--speed", "B=2"], "has no --input"),
+    (["--input", "A=0:10:1", "--speed", "B=2"], "which has no input"),
     (["--input", "A=0:10:1", "--speed", "A=fast"], "expected a number"),
     (["--input", "A=0:10:1", "--vll", "A=locked"], "P pair"),
     (["--input", "A=0:10:1", "--method", "magic"], "unknown method"),

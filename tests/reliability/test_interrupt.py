@@ -148,9 +148,41 @@ def test_real_sigint_to_synth_path_keeps_best(tmp_path):
     assert (tmp_path / "x.yaml").read_text().startswith("# INTERRUPTED")
 
 
-def test_real_sigint_while_loading_exits_130(tmp_path):
-    r = _sigint_subprocess(["analyze", str(ROOT / "examples" / "textbook" / "fourbar.yaml")],
-                           delay=1.0, cwd=tmp_path)
+def test_real_sigint_during_a_plain_command_exits_130(tmp_path):
+    r = _sigint_subprocess(["simulate", str(ROOT / "examples" / "kinematics" / "crank_rocker.yaml"),
+                            "--input", "A=0:3600:0.005", "--json"], delay=2.0, cwd=tmp_path)
     assert r.returncode == INTERRUPT_EXIT_CODE, r.stderr
     assert r.stderr.strip().splitlines()[-1] == "interrupted"
     assert "Traceback" not in r.stderr
+
+
+def test_cli_interrupted_curve_synthesis_writes_best_and_exits_130(run_cli, tmp_path, monkeypatch):
+    import json
+
+    import mechsyn.synthesis.curves.synthesis as curves
+    from mechsyn.synthesis.curves.database import build_database
+
+    if run_cli("synth", "curve", "-h")[0] != 0:
+        pytest.skip("synth curve is not registered on the command line yet")
+
+    db = tmp_path / "db"
+    build_database(db, max_links=4, per_topology=120)
+    t = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    target = tmp_path / "t.json"
+    target.write_text(json.dumps({"points": np.c_[2 + np.cos(t), 1 + 0.5 * np.sin(t)].tolist(), "closed": True}))
+    refine = curves._refine
+    calls = [0]
+
+    def refine_then_interrupt(*args, **kwargs):
+        calls[0] += 1
+        if calls[0] > 2:
+            raise KeyboardInterrupt
+        return refine(*args, **kwargs)
+
+    monkeypatch.setattr(curves, "_refine", refine_then_interrupt)
+    code, out, err = run_cli("synth", "curve", target, "--max-links", "4", "--database", db, "--json",
+                             "--time-limit", "60")
+    assert code == INTERRUPT_EXIT_CODE, err
+    assert err.strip().splitlines()[-1] == "interrupted"
+    res = json.loads(out)
+    assert res["interrupted"] is True

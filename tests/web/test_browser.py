@@ -1,7 +1,7 @@
 """The studio used as a person would, in Debian's Chromium (Playwright).
 
 Each test starts the server on a free loopback port in a thread. Screenshots for
-docs/studio.md are written to docs/images/ by these tests.
+docs/studio.md are written to docs/images/ by these tests when MECHSYN_SCREENSHOTS=1.
 """
 
 from __future__ import annotations

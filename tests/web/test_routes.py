@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from mechsyn.io import load_mechanism, mechanism_to_dict
+from mechsyn.io import load_mechanism, mechanism_from_dict, mechanism_to_dict
 from mechsyn.web._service import example_path
 
 from web_helpers import TOKEN
@@ -55,6 +55,12 @@ def test_simulate_equals_library(client, fourbar):
 def test_analyze(client):
     six = mechanism_to_dict(load_mechanism(example_path("watt_sixbar")))
     d = client.post("/api/analyze", json={"mechanism": six}).json()
+    import json
+
+    from mechsyn.results import dumps
+    from mechsyn.structure.report import analyze
+
+    assert d["structure"] == json.loads(dumps(analyze(load_mechanism(example_path("watt_sixbar"))).to_dict()))
     assert d["structure"]["formulas"]["chebyshev"]["expression"] == "W = 3·5 - 2·7 - 0 = 1"
     assert d["rank"]["useful_mobility"] == 1
     assert [g["label"] for g in d["assur"]["groups"]] == ["II(coupler,rocker)", "II(link5,link6)"]
@@ -186,6 +192,21 @@ def test_symlink_out_refused(client, tmp_path, fourbar):
 def test_wrong_suffix_refused(client, fourbar):
     r = client.post("/api/file", json={"path": "x.txt", "mechanism": fourbar})
     assert r.status_code == 400 and ".yaml" in r.json()["hint"]
+
+
+def test_import_pyslvs(client, tmp_path):
+    from mechsyn.io.pyslvs import read_pyslvs
+
+    src = example_path("crank_rocker").parents[1] / "pyslvs" / "crank_rocker.pyslvs"
+    text = src.read_text()
+    d = client.post("/api/import", json={"text": text, "filename": "crank_rocker.pyslvs"}).json()["mechanism"]
+    assert d == mechanism_to_dict(mechanism_from_dict(read_pyslvs(text, "crank_rocker.pyslvs")[0]))
+    (tmp_path / "crank_rocker.pyslvs").write_text(text)
+    assert "crank_rocker.pyslvs" in client.get("/api/files").json()["files"]
+    assert client.get("/api/file", params={"path": "crank_rocker.pyslvs"}).json()["mechanism"] == d
+    assert client.post("/api/simulate", json={"mechanism": d, "steps": 10}).status_code == 200
+    # opened, not written
+    assert client.post("/api/file", json={"path": "out.pyslvs", "mechanism": d}).status_code == 400
 
 
 def test_import_and_export(client, fourbar):

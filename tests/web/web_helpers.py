@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import socket
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -11,7 +13,13 @@ TOKEN = "test-token"
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = ["--no-sandbox", "--headless", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--no-first-run", "--disable-sync"]
-IMAGES = Path(__file__).resolve().parents[2] / "docs" / "images"
+#: Screenshots and the README's drag GIF go to docs/images/ only when asked
+#: (MECHSYN_SCREENSHOTS=1); otherwise to a temporary folder, so a test run leaves the
+#: checkout as it was.
+if os.environ.get("MECHSYN_SCREENSHOTS") == "1":
+    IMAGES = Path(__file__).resolve().parents[2] / "docs" / "images"
+else:
+    IMAGES = Path(tempfile.mkdtemp(prefix="mechsyn-screens-"))
 
 
 def free_port() -> int:

@@ -31,7 +31,7 @@ from typing import Annotated, Literal, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 
 JointType = Literal["R", "P"]
 
@@ -154,6 +154,13 @@ class SerialArm:
     (x, y, z)). Internal units: radians, rad/s; lengths and length/s as in the file.
     A spatial chain is ``T = F_0 M_1(q_1) F_1 ... M_n(q_n) F_n``: fixed transforms ``F``
     and joint motions ``M`` about / along unit ``axes`` (in the joint's own frame).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")     # planar 3R of paper 004
+    >>> arm.n, arm.task_dim, arm.joint_names
+    (3, 2, ('q1', 'q2', 'q3'))
     """
 
     name: str
@@ -317,6 +324,7 @@ class SerialArm:
 
 
 # --------------------------------------------------------------------------- building
+@input_boundary("arm file")
 def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None = None) -> SerialArm:
     """Validate an arm description (see module docstring) and build the model."""
     if not isinstance(data, dict):
@@ -350,7 +358,14 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
 
 
 def load_arm(path: str | Path) -> SerialArm:
-    """Read an arm file (YAML or JSON); :class:`MechsynInputError` on bad input."""
+    """Read an arm file (YAML or JSON); :class:`MechsynInputError` on bad input.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.load_arm(ms.examples.path("ur5_dh")).n
+    6
+    """
     from mechsyn.io.files import parse_data, read_text
 
     path = Path(path)

@@ -273,7 +273,16 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
 @dataclass(repr=False)
 class CapabilityMap(Result):
     """V_max over a grid: ``value[i, j]`` at ``(xs[i], ys[j])`` with the optimal
-    configuration ``q[i, j]`` (radians; NaN where no allowed configuration reaches)."""
+    configuration ``q[i, j]`` (radians; NaN where no allowed configuration reaches).
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> cmap = ms.capability_map(arm, np.array([900.0, 1000.0]), np.array([900.0, 1000.0]), [1, 0])
+    >>> cmap.value.shape, cmap.q.shape
+    ((2, 2), (2, 2, 3))
+    """
 
     _plot = "capability:plot_capability_map"
 
@@ -349,6 +358,14 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     ``scheduler`` (a Dask cluster) solve the chunks in parallel
     (:func:`mechsyn.parallel.run_tasks`): every point's answer depends only on the point,
     so the map is the same. Spatial arms need ``z`` (the grid lies in the plane z = const).
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> cmap = ms.capability_map(arm, np.array([1000.0]), np.array([1000.0]), [1, 0])
+    >>> bool(np.isfinite(cmap.value).all())
+    True
     """
     from mechsyn.parallel import run_tasks
 

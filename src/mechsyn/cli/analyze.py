@@ -8,10 +8,9 @@ from typing import Annotated, Optional
 
 import typer
 from rich.panel import Panel
-from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import console, emit_json, err_console, safe
+from mechsyn.cli.common import Table, console, emit_json, err_console, safe  # Table: cells fold
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis

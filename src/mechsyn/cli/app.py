@@ -12,12 +12,14 @@ app = typer.Typer(
     ),
     no_args_is_help=True,
     pretty_exceptions_enable=False,
-    add_completion=False,
+    rich_markup_mode=None,
+    add_completion=True,  # mechsyn --install-completion / --show-completion (docs/python.md)
     context_settings={"help_option_names": ["-h", "--help"]},
 )
 
 synth_app = typer.Typer(
     help="Synthesis: structural (groups, fingers) and dimensional (path, function, motion).",
+    rich_markup_mode=None,
     no_args_is_help=True,
     add_completion=False,
 )  # reached through mechsyn.cli.main's lazy table, not add_typer (see there)

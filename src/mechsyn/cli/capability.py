@@ -16,24 +16,13 @@ from rich.console import Console
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.capability.arm import SerialArm, load_arm
-from mechsyn.capability.maps import (
-    capability_map, continuous_best, interpolate_configuration, is_closed_form,
-    measure_values, refine_over_self_motion, self_motion,
-)
-from mechsyn.capability.measures import (
-    MEASURES, all_measures, velocity_ellipse, velocity_polytope,
-)
+from mechsyn.capability.maps import capability_map, interpolate_configuration, is_closed_form, measure_values
+from mechsyn.capability.measures import MEASURES
+from mechsyn.capability.point import MEASURE_HELP, PointCapability, capability_at
 from mechsyn.cli.app import app
 from mechsyn.cli.common import check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
 from mechsyn.errors import MechsynInputError
 
-MEASURE_HELP = {
-    "exact": "largest speed of pure motion along d (joint rates free within their limits)",
-    "component": "largest velocity component along d, perpendicular part free",
-    "min_norm": "limit of the minimum-norm joint rates J+ v (paper 004's Q_dot_N)",
-    "stepped_min_norm": "paper 004's 5-step raise with minimum-norm rates",
-    "stepped": "paper 004's 5-step raise with the null space used to full effect",
-}
 _BRANCH_ALIASES = {"negative": "negative", "neg": "negative", "-": "negative", "down": "negative",
                    "positive": "positive", "pos": "positive", "+": "positive", "up": "positive",
                    "both": "both"}
@@ -53,29 +42,6 @@ def _values(text: str, option: str) -> np.ndarray:
 def _check_finite(values, option: str) -> None:
     if not np.all(np.isfinite(values)):
         raise MechsynInputError("values must be finite", source=option)
-
-
-def _measures_at(arm: SerialArm, q: np.ndarray, d: np.ndarray, step: float) -> dict:
-    return all_measures(arm.jacobian(q), arm.qd_max, d, arm.weights, step)
-
-
-def _reason(arm: SerialArm, q: np.ndarray) -> str:
-    if not np.all(np.isfinite(q)):
-        return "point out of reach"
-    qu = arm.to_user(q)
-    lo, hi = arm.to_user(arm.lower), arm.to_user(arm.upper)
-    for i, name in enumerate(arm.joint_names):
-        if qu[i] < lo[i] - 1e-7:
-            return f"{name} = {qu[i]:.2f} below its lower limit {lo[i]:g}"
-        if qu[i] > hi[i] + 1e-7:
-            return f"{name} = {qu[i]:.2f} above its upper limit {hi[i]:g}"
-    return "outside the joint limits"
-
-
-def _config_entry(arm: SerialArm, q: np.ndarray, meas: dict, k: int) -> dict:
-    entry = {"q_deg": np.round(arm.to_user(q), 10)}
-    entry.update({m: float(meas[m][k]) for m in MEASURES})
-    return entry
 
 
 @app.command("capability")
@@ -158,52 +124,16 @@ def capability(
 
 def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -> None:
     _check_finite(p, "--point")
-    dn = d / np.linalg.norm(d)
-    q, valid = self_motion(arm, p, q1_vals, br, respect_limits=respect)
-    # without limits self_motion marks only reachability; list the rejected ones with why
-    qv = q[valid]
-    meas = _measures_at(arm, qv, dn, step) if len(qv) else {k: np.zeros(0) for k in MEASURES}
-    configs = [_config_entry(arm, qv[k], meas, k) for k in range(len(qv))]
-    rejected = [{"q_deg": np.round(arm.to_user(qq), 10), "reason": _reason(arm, qq)}
-                for qq in q[~valid]] if is_closed_form(arm) else []
-    result: dict = {
-        "arm": arm.name, "point": p, "direction": dn, "measure": measure,
-        "units": "speeds in the arm's length unit per second (mm/s for mm); q_deg in degrees "
-                 "(R joints) or lengths (P joints)",
-        "measures": MEASURE_HELP, "configurations": configs, "rejected": rejected,
-        "best": None,
-    }
-    if configs:
-        k = int(np.argmax(meas[measure]))
-        best = dict(configs[k])
-        result["best"] = best
-        if polytope:
-            J = arm.jacobian(qv[k])[0]
-            poly = velocity_polytope(J, arm.qd_max)
-            ell = velocity_ellipse(J, arm.qd_max)
-            result["best_velocity_polytope"] = {
-                "vertices": poly.vertices, "facet_normals": poly.normals,
-                "facet_offsets": poly.offsets, "equalities": poly.equalities,
-                "limit_along_d": poly.directional_limit(dn)}
-            result["best_velocity_ellipse"] = {
-                "semi_axes": ell.semi_axes, "axes": ell.axes.T, "radius_along_d": ell.radius(dn)}
-    if is_closed_form(arm):
-        qc, vc = continuous_best(arm, p[None], dn, measure, br, respect)
-    elif configs:
-        top = np.argsort(-meas[measure], kind="stable")[:8]
-        qc, vc = refine_over_self_motion(arm, p, qv[top], dn, measure, respect)
-        k = int(np.argmax(vc))
-        qc, vc = qc[k:k + 1], vc[k:k + 1]
-    else:
-        qc, vc = None, np.array([-np.inf])
-    if np.isfinite(vc[0]):
-        mc = _measures_at(arm, qc, dn, step)
-        result["continuous_best"] = _config_entry(arm, qc[0], mc, 0)
-    else:
-        result["continuous_best"] = None
+    res = capability_at(arm, p, d, measure=measure, q1=q1_vals, branch=br, respect_limits=respect, step=step,
+                        polytope=polytope)
     if json_out:
-        emit_json(result)
+        emit_json(res.to_dict())
         return
+    _render_point(arm, res, step)
+
+
+def _render_point(arm: SerialArm, res: PointCapability, step: float) -> None:
+    p, dn, measure, configs = res.point, res.direction, res.measure, res.configurations
     table = Table(box=box.SIMPLE_HEAD, pad_edge=False, title=f"{arm.name}: speed along ({', '.join(f'{c:g}' for c in np.round(dn, 4))}) "
                         f"at ({', '.join(f'{c:g}' for c in p)})")
     table.add_column("")
@@ -211,16 +141,16 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
         table.add_column(name, justify="right", no_wrap=True, min_width=6)
     for head in ("exact", "compon.", "min-nrm", "st.mn", "stepped"):
         table.add_column(head, justify="right", no_wrap=True)
-    kbest = int(np.argmax(meas[measure])) if configs else -1
+    kbest = res.best_index
     shown = list(range(len(configs)))
     if len(configs) > 15:  # many IK solutions (spatial arms): the best ones
-        shown = sorted(np.argsort(-meas[measure], kind="stable")[:12].tolist())
+        shown = sorted(np.argsort([-c[measure] for c in configs], kind="stable")[:12].tolist())
     for k in shown:
         c = configs[k]
         table.add_row("best" if k == kbest else "", *[f"{v:.1f}" for v in c["q_deg"]],
                       *[f"{c[mn]:.2f}" for mn in MEASURES],
                       style="bold green" if k == kbest else None)
-    cb = result.get("continuous_best")
+    cb = res.continuous_best
     if cb:
         table.add_row("cont", *[f"{v:.1f}" for v in cb["q_deg"]],
                       *[f"{cb[mn]:.2f}" for mn in MEASURES], style="cyan")
@@ -236,7 +166,7 @@ def _point(arm, p, d, q1_vals, br, respect, measure, step, polytope, json_out) -
         console.print(f"best sampled ({measure}): {configs[kbest][measure]:.3f}"
                       + (f"; continuous search over the self-motion (cont): "
                          f"{cb[measure]:.3f}" if cb else ""))
-    for r in rejected:
+    for r in res.rejected:
         console.print(f"rejected q = ({', '.join(f'{v:.2f}' for v in r['q_deg'])}): {r['reason']}")
     console.print("[dim]exact: " + MEASURE_HELP["exact"] + "; compon.: " + MEASURE_HELP["component"]
                   + "; min-nrm: " + MEASURE_HELP["min_norm"] + "; st.mn / stepped: the paper's "

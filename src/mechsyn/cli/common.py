@@ -130,6 +130,8 @@ PARAMETER_OPTIONS: dict[str, str] = {
     "vll": "--vll", "animate": "--animate", "seed": "--seed", "time_limit": "--time-limit",
     "restarts": "--restarts", "workers": "--workers", "optimizer": "--optimizer", "direction": "--direction",
     "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output",
+    "output": "--output", "straight": "--straight", "n_links": "--links", "mobility": "--mobility",
+    "actuators": "--actuators", "phi/psi": "--phi/--psi",
 }
 
 

@@ -81,6 +81,8 @@ def export_cmd(
         from mechsyn.export.drawing import drawing_of
 
         write_output(drawing, drawing_of(mech, _values(pose), path or [], _sweep(sweep), dimensions))
+        if not is_stdout(drawing):
+            err_console.print(f"wrote {escape(str(drawing))}", highlight=False)
         if dxf is None and svg is None and not json_:
             return
     layout = link_plates(mech, width=width, hole_diameter=hole, clearance=clearance, frame=frame,

@@ -13,8 +13,8 @@ import importlib
 import sys
 from typing import Any
 
-import click
 import typer
+from typer.core import TyperCommand
 
 from mechsyn.cli import version as _version  # noqa: F401  (the root callback: --version)
 from mechsyn.cli.app import app
@@ -49,7 +49,7 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
 }
 
 
-def _load(name: str) -> click.Command:
+def _load(name: str) -> Any:
     """Import the modules of command ``name`` and return its click command."""
     modules, _ = COMMANDS[name]
     for m in modules:
@@ -62,23 +62,21 @@ def _load(name: str) -> click.Command:
     return group.commands[name]  # type: ignore[attr-defined]
 
 
-class _LazyCommand(click.Command):
+class _LazyCommand(TyperCommand):
     """Stands for a command whose module is not imported yet: lists itself with its help and
     hands parsing and running to the real command."""
 
     def __init__(self, name: str, help: str) -> None:
         super().__init__(name, help=help, short_help=help, add_help_option=False)
-        self.rich_help_panel = None
 
-    def make_context(self, info_name: str | None, args: list[str], parent: click.Context | None = None,
-                     **extra: Any) -> click.Context:
+    def make_context(self, info_name: str | None, args: list[str], parent: Any = None, **extra: Any) -> Any:
         return _load(self.name).make_context(info_name, args, parent=parent, **extra)  # type: ignore[arg-type]
 
-    def to_info_dict(self, ctx: click.Context) -> dict[str, Any]:
+    def to_info_dict(self, ctx: Any) -> dict[str, Any]:
         return _load(self.name).to_info_dict(ctx)  # type: ignore[arg-type]
 
 
-def build_cli() -> click.Group:
+def build_cli() -> Any:
     """The root click group: eagerly registered commands plus the lazy ones."""
     group = typer.main.get_command(app)
     for name, (_, text) in COMMANDS.items():
@@ -116,7 +114,17 @@ def main(argv: list[str] | None = None) -> int:
         if name == "Abort":  # click's wrapping of Ctrl-C
             status = _INTERRUPTED
         elif hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
-            exc.show()
+            if name == "NoArgsIsHelpError" or not hasattr(exc, "format_message"):
+                exc.show()  # the help text itself
+            else:  # one line: where, what, and the fix
+                from rich.markup import escape
+
+                from mechsyn.cli.common import err_console
+
+                ctx = getattr(exc, "ctx", None)
+                where = ctx.command_path if ctx is not None else "mechsyn"
+                err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(exc.format_message())} "
+                                  f"(fix: see '{escape(where)} -h')", highlight=False, soft_wrap=True)
             return _exit(int(exc.exit_code), argv)
         elif hasattr(exc, "exit_code"):  # Exit
             return _exit(int(exc.exit_code), argv)

@@ -9,7 +9,7 @@ import typer
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json, err_console, parse_floats
+from mechsyn.cli.common import check_writable, console, emit_json, err_console, parse_floats, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -39,6 +39,7 @@ def synth_curve(
             raise MechsynInputError("expected x0,y0,x1,y1 with x0 < x1 and y0 < y1", source="--ground-region")
     if out is not None and out.exists() and not out.is_dir():
         raise MechsynInputError(f"{out} is a file", source="--out", hint="give a directory")
+    check_writable(out, "--out", directory=True)
     tgt = read_target(target)
     show = err_console.is_terminal
     if show:
@@ -68,6 +69,7 @@ def synth_curve(
         _write_out(out, res)
     if as_json:
         emit_json(res)
+        stop_if_interrupted(res)
         return
     t = Table(title=f"Curve synthesis: {tgt.source} ({'closed' if tgt.closed else 'open'}, "
                     f"{len(tgt.points)} points)")
@@ -85,16 +87,11 @@ def synth_curve(
                   + ("; interrupted: best so far" if res.interrupted else ""))
     for n in res.notes:
         console.print(f"note: {n}")
+    stop_if_interrupted(res)
 
 
 def _write_out(out: Path, res) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mechsyn.results import save_figure_atomic
-    from mechsyn.synthesis.curves.plot import plot_candidate
+    from mechsyn.cli.common import save_plot
     from mechsyn.synthesis.export import write_mechanism_file
 
     out.mkdir(parents=True, exist_ok=True)
@@ -104,12 +101,13 @@ def _write_out(out: Path, res) -> None:
             f"mechsyn synth curve: candidate {i}, {d['topology'] or c.topology.key}, tracer T\n"
             f"input {d['input']['joint']} from {d['input']['start']:.3f} to {d['input']['stop']:.3f} deg; "
             f"chamfer {100 * c.chamfer:.3f} %, ordered {100 * c.ordered:.3f} % of the target's diagonal"))
-        fig, ax = plt.subplots(figsize=(6, 5), dpi=110)
-        try:
-            plot_candidate(c, res.target, ax=ax)
-            ax.legend(fontsize=8)
-            ax.set_title(f"candidate {i}: {d['topology'] or c.topology.key}")
-            fig.tight_layout()
-            save_figure_atomic(fig, out / f"candidate_{i}.png")
-        finally:
-            plt.close(fig)
+        save_plot(out / f"candidate_{i}.png", _draw_candidate, c, res.target,
+                  f"candidate {i}: {d['topology'] or c.topology.key}", figsize=(6, 5))
+
+
+def _draw_candidate(candidate, target, title: str, ax) -> None:
+    from mechsyn.plot.curves import plot_candidate
+
+    plot_candidate(candidate, target, ax=ax)
+    ax.legend(fontsize=8)
+    ax.set_title(title)

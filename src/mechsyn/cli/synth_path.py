@@ -121,7 +121,7 @@ def synth_path(
     console.print(f"error (sum of squared distances): [bold]{res.error:.8g}[/]"
                   + (f"   published best: {case.best_known:.8g}" if case.best_known else ""))
     console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
-                  f"branch {case.branch}   {res.restarts} restarts, {res.seconds:.1f} s"
+                  f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
                   + ("   (target error reached)" if res.target_reached else ""))
     console.print(_transmission_line(res))
     stop_if_interrupted(res)
@@ -145,7 +145,7 @@ def _transmission_line(res) -> str:
     text = (f"worst transmission angle over the motion: {mu:.2f} deg"
             + (f" (limit {res.transmission_angle_min_deg:g})" if res.transmission_angle_min_deg else ""))
     if res.fold_distance_deg is not None:
-        text += f"; {res.fold_distance_deg:.2f} deg from folding flat"
+        text += f"\nnearest approach to folding flat: {res.fold_distance_deg:.2f} deg"
         text += f" (limit {res.fold_margin_deg:g})" if res.fold_margin_deg else ""
     return text
 

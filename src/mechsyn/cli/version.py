@@ -6,13 +6,12 @@ from typing import Annotated
 
 import typer
 
-from mechsyn import __version__
 from mechsyn.cli.app import app
 
 
 def _print_version(value: bool) -> None:
     if value:
-        typer.echo(f"mechsyn {__version__}")
+        version()
         raise typer.Exit()
 
 
@@ -28,4 +27,6 @@ def root(
 @app.command("version")
 def version() -> None:
     """Print mechsyn's version."""
+    from mechsyn import __version__
+
     typer.echo(f"mechsyn {__version__}")

@@ -35,7 +35,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["check_geometry", "COINCIDENT_REL"]
+__all__ = ["check_geometry", "check_counts", "COINCIDENT_REL", "numbers"]
 
 #: Joints closer than this times the file's extent are at one point.
 COINCIDENT_REL = 1e-12
@@ -56,6 +56,18 @@ def _vectors(mech: Any) -> list[tuple[str, np.ndarray]]:
     return out
 
 
+def check_counts(data: Any, source: str | None = None) -> None:
+    """Refuse file data with more links or joints than the limits, before validating it."""
+    if not isinstance(data, dict):
+        return
+    for what in ("links", "joints"):
+        items = data.get(what)
+        if isinstance(items, list) and len(items) > limit(what):
+            raise MechsynInputError(
+                f"{len(items):,} {what} are more than the limit of {limit(what):,} (the analyses would run "
+                "for hours or longer)", source=source, field=what, hint=limit_hint(what))
+
+
 def _xyz(p: Any) -> np.ndarray:
     v = np.asarray(p, float).ravel()
     return np.pad(v, (0, 3 - v.size))
@@ -64,11 +76,6 @@ def _xyz(p: Any) -> np.ndarray:
 def check_geometry(mech: Any, source: str | None = None) -> Any:
     """Raise :class:`MechsynInputError` for geometry no mechanism can have; return ``mech``."""
     big = limit("coordinate")
-    for what, count in (("links", len(mech.links)), ("joints", len(mech.joints))):
-        if count > limit(what):
-            raise MechsynInputError(
-                f"{count:,} {what} are more than the limit of {limit(what):,} (the analyses would run for "
-                "hours or longer)", source=source, field=what, hint=limit_hint(what))
     for what, v in _vectors(mech):
         if v.size and np.max(np.abs(v)) > big:
             raise MechsynInputError(

@@ -43,9 +43,12 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
 
     ``what`` names the kind of file in messages (``"case file"``, ``"table"``...).
     """
-    p = Path(path)
+    from mechsyn.examples import resolve
+
+    p = resolve(path)  # a bundled example's name stands for its file
     if not p.exists():
-        raise MechsynInputError(f"no such {what}", source=str(p), hint="check the path")
+        raise MechsynInputError(f"no such {what}", source=str(p),
+                                hint="check the path (mechsyn.examples.names() lists the bundled examples)")
     if p.is_dir():
         raise MechsynInputError(f"is a directory, not a {what}", source=str(p))
     try:
@@ -146,5 +149,7 @@ def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
 def read_data(path: str | os.PathLike[str], what: str = "file",
               fmt: str | None = None) -> tuple[Any, str]:
     """Read and parse a YAML or JSON file; return the data with its text."""
+    from mechsyn.examples import resolve
+
     text = read_text(path, what)
-    return parse_data(text, str(path), fmt), text
+    return parse_data(text, str(resolve(path)), fmt), text

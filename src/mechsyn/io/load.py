@@ -17,9 +17,9 @@ import numpy as np
 import yaml
 from pydantic import ValidationError
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import files
-from mechsyn.io.checks import check_geometry
+from mechsyn.io.checks import check_counts, check_geometry
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -65,7 +65,7 @@ def _line_finder(text: str | None, source: str) -> Any:
     root = None
     if text is not None:
         try:
-            root = yaml.compose(text, Loader=_YAML_LOADER)
+            root = yaml.compose(text, Loader=files._YAML_LOADER)
         except yaml.YAMLError:
             root = None
 
@@ -171,6 +171,7 @@ def _validation_error(exc: ValidationError, data: Any, source: str, text: str | 
     )
 
 
+@input_boundary("mechanism file")
 def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = None) -> Mechanism:
     """Validate mechanism-file data and build a :class:`Mechanism`.
 
@@ -181,6 +182,7 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
             "a mechanism file must be a mapping with name, kind, ground, links, joints",
             source=source, line=1, hint="see `mechsyn schema` and the files in examples/",
         )
+    check_counts(data, source)
     try:
         spec = MechanismFile.model_validate(data)
     except ValidationError as exc:
@@ -200,6 +202,12 @@ def load_mechanism(path: str | os.PathLike[str]) -> Mechanism:
     ------
     MechsynInputError
         naming the file, line and field of the first problem, with a fix.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ms.load_mechanism(ms.examples.path("slider_crank")).pairs_by_class()
+    {5: 4}
     """
     from mechsyn.examples import resolve
 

@@ -60,6 +60,13 @@ class Simulation(Result):
 
     ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
     table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 360, 10))
+    >>> s.point("M").shape, bool(s.assembled.all())
+    ((37, 2), True)
     """
 
     _plot = "kinematics:plot_paths"
@@ -126,7 +133,7 @@ class Simulation(Result):
         return pd.DataFrame(cols)
 
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:
-        """The mechanism moving over the sweep: a :class:`matplotlib.animation.FuncAnimation`
+        """The mechanism moving over the sweep: a Matplotlib ``FuncAnimation``
         (``anim.save("m.gif", writer="pillow")``, or ``anim.to_jshtml()`` in a notebook)."""
         from mechsyn.plot.kinematics import animate_simulation
 
@@ -180,18 +187,24 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
 
     More positions than the limit ``sweep_points`` (:mod:`mechsyn.limits`) raise
     :class:`~mechsyn.errors.MechsynInputError` before any memory is taken.
+
+    Examples
+    --------
+    >>> from mechsyn.kinematics.analysis import input_grid
+    >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
+    ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
     """
     from mechsyn.errors import MechsynInputError
     from mechsyn.limits import limit, limit_hint
 
     if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
-        raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", source="--input",
-                                hint="write e.g. --input A=0:360:1")
+        raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", field="inputs",
+                                hint="e.g. A=0:360:1 on the command line")
     count = np.floor((stop - start) / step + 1e-9) + 1
     if count > limit("sweep_points"):
         raise MechsynInputError(
             f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "
-            f"{limit('sweep_points'):,}", source="--input",
+            f"{limit('sweep_points'):,}", field="inputs",
             hint="use a larger step or a shorter range; " + limit_hint("sweep_points"))
     return start + step * np.arange(int(count))
 
@@ -213,7 +226,7 @@ def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[
             j = mech.joint(name)
         except KeyError:
             known = list(mech.points) + [j.id for j in mech.joints]
-            raise MechsynInputError(f"no point or joint named {name!r}", source="--points",
+            raise MechsynInputError(f"no point or joint named {name!r}", field="points",
                                     hint=f"known: {', '.join(known)}") from None
         link = j.links[1] if j.links[1] != mech.ground else j.links[0]
         out[name] = (link, np.asarray(j.point, float))
@@ -231,9 +244,17 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     ``"assur"`` or ``"newton"``. ``change_points``: ``"keep"`` (the drawn branch, whose
     velocity is continuous, through change and branch points: a parallelogram stays a
     parallelogram) or ``"switch"`` (the other branch there; closed form only).
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> m = ms.examples.load("crank_rocker")
+    >>> s = ms.simulate(m, {"A": np.linspace(0, 180, 7)})
+    >>> s.link("crank").angle.round(6).tolist()
+    [0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0]
     """
     if not inputs:
-        raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+        raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     return compile_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
 
@@ -301,19 +322,19 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     mech, S = kp.mechanism, kp.system
     if change_points not in ("keep", "switch"):
         raise MechsynInputError(f"change_points must be 'keep' or 'switch', not {change_points!r}",
-                                source="change_points")
+                                field="change_points")
     if not inputs:
-        raise MechsynInputError("no input given", source="--input", hint="write --input A=0:360:1")
+        raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     if tuple(j for j in inputs if _is_passive(mech, j, kp.vll)) != kp.prescribed:
         kp = compile_plan(mech, kp.vll, tuple(inputs))
         S = kp.system
     drivers = [d.joint for d in S.drivers]
     lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
     if len(lengths) != 1:
-        raise MechsynInputError("all inputs need the same number of values", source="--input")
+        raise MechsynInputError("all inputs need the same number of values", field="inputs")
     N = lengths.pop()
     if N == 0:
-        raise MechsynInputError("the input range is empty", source="--input")
+        raise MechsynInputError("the input range is empty", field="inputs")
     U = np.tile([d.assembled for d in S.drivers], (N, 1)).astype(float)
     types: dict[str, str] = {}
     for jid, vals in inputs.items():
@@ -321,38 +342,38 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
             try:
                 j = mech.joint(jid)
             except KeyError:
-                raise MechsynInputError(f"no joint {jid!r}", source="--input",
+                raise MechsynInputError(f"no joint {jid!r}", field="inputs",
                                         hint=f"driven joints: {', '.join(drivers) or '(none)'}") from None
             raise MechsynInputError(
-                f"joint {jid} ({j.type}) is not driven", source="--input",
+                f"joint {jid} ({j.type}) is not driven", field="inputs",
                 hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
         k = drivers.index(jid)
         vals = np.asarray(vals, float)
         if not np.all(np.isfinite(vals)):
-            raise MechsynInputError(f"input values of {jid} must be finite numbers", source="--input")
+            raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
         d = S.drivers[k]
         U[:, k] = np.radians(vals) if d.type == "R" else vals
         types[jid] = d.type
         lim = mech.joint(jid).limits
         if lim is not None and d.type == "P" and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
             raise MechsynInputError(
-                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", source="--input",
+                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
                 hint="keep the VLL length within its limits")
     sp = np.zeros(len(drivers))
     speeds = dict(speeds or {})
     for jid in speeds:
         if jid not in inputs:
-            raise MechsynInputError(f"--speed names {jid}, which has no --input", source="--speed")
+            raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
     for jid in inputs:
         sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
     pts = resolve_points(mech, points)
     plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
-        raise MechsynInputError("the mechanism does not decompose into drivers and dyads", source="--method",
+        raise MechsynInputError("the mechanism does not decompose into drivers and dyads", field="method",
                                 hint="use the Newton method")
     if change_points == "switch" and plan is None:
         raise MechsynInputError("change_points='switch' needs the closed form (a mechanism of drivers and dyads)",
-                                source="change_points", hint="keep the drawn branch (change_points='keep')")
+                                field="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
     sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress, change_points == "switch"))
@@ -527,7 +548,15 @@ def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
 # --------------------------------------------------------------------------- forces
 @dataclass(repr=False)
 class ForceAnalysis(Result):
-    """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``)."""
+    """Joint reactions and balancing efforts over the sweep (see ``kinematics.forces``).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> f = ms.examples.load("crank_rocker").forces(A=(0, 360, 90), gravity=(0, -9.81))
+    >>> sorted(f.reactions.force), f.reactions.effort_kind["A"]
+    (['A', 'B', 'C', 'D'], 'moment')
+    """
 
     _plot = "kinematics:plot_forces"
 
@@ -593,7 +622,16 @@ class ForceAnalysis(Result):
 def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
            gravity: tuple[float, float] = (0.0, 0.0), static: bool = False, vll: dict[str, str] | None = None,
            method: str = "auto", progress: Any = None) -> ForceAnalysis:
-    """Kinetostatic (or static) analysis over a sweep of the inputs."""
+    """Kinetostatic (or static) analysis over a sweep of the inputs.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.examples.load("crank_rocker")
+    >>> f = ms.forces(m, {"A": ms.input_grid(0, 90, 45)}, static=True, gravity=(0, -9.81))
+    >>> f.reactions.effort["A"].shape
+    (3,)
+    """
     sim = simulate(mech, inputs, speeds=speeds, points=[], vll=vll, method=method, progress=progress)
     sw = sim.sweep
     R = kinetostatics(sim.system, sw.q, None if static else sw.qd, None if static else sw.qdd,

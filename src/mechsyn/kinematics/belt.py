@@ -85,6 +85,13 @@ class BeltDesign:
     """Dimensions of the manipulator: lever a = |A0 A|, hand offsets c, h, pulley radius r.
 
     C = A + (-c, 0) and H = C + (0, h) in the design position (paper 001, fig. 1).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> d = ms.BeltDesign(a=500, c=350, h=100, r=75)      # paper 001's example
+    >>> round(d.b0, 3), round(d.l0, 3)                    # the paper's values
+    (411.765, 115.804)
     """
 
     a: float

@@ -89,7 +89,7 @@ def mechanical_advantage(sim, output: str) -> np.ndarray:
     """Ideal mechanical advantage ``omega_in / omega_out`` (or ``/ v_out`` for a slider)."""
     main = sim.main_input
     if output not in sim.links:
-        raise MechsynInputError(f"no moving link {output!r}", source="--output",
+        raise MechsynInputError(f"no moving link {output!r}", field="output",
                                 hint=f"links: {', '.join(sim.links)}")
     w_in = sim.speeds[main]
     S = sim.system
@@ -175,7 +175,7 @@ def straightness(path: np.ndarray) -> dict[str, float | list[float]]:
     """Largest deviation of the points (N, 2) from their best (total least-squares) line."""
     p = path[np.all(np.isfinite(path), axis=1)]
     if len(p) < 2:
-        raise MechsynInputError("a straightness check needs at least two assembled points", source="--straight")
+        raise MechsynInputError("a straightness check needs at least two assembled points", field="straight")
     c = p.mean(axis=0)
     _, sv, vt = np.linalg.svd(p - c, full_matrices=False)
     d = vt[0]

@@ -286,6 +286,13 @@ class Mechanism:
     def with_joints(self, joints: tuple[Joint, ...], name: str | None = None) -> "Mechanism":
         return replace(self, joints=joints, name=name or self.name)
 
+    def widget(self, root: str = "."):
+        """This mechanism in mechsyn studio's editor as a Jupyter widget (``mechsyn[web,notebook]``);
+        the widget's ``mechanism`` follows every edit (see :mod:`mechsyn.web.widget`)."""
+        from mechsyn.web.widget import MechanismWidget
+
+        return MechanismWidget(self, root=root)
+
     def in_state(self, state: str) -> "Mechanism":
         """The mechanism with a state's added bodies and contacts (paper 002)."""
         spec = self.states[state]

@@ -10,6 +10,7 @@ a new pyplot figure, and returns it; none writes a file or chooses a backend.
 - :mod:`mechsyn.plot.belt` -- paper 001's belt manipulator
 - :mod:`mechsyn.plot.capability` -- velocity-capability maps (paper 004)
 - :mod:`mechsyn.plot.synthesis` -- path, mechanism and Burmester motion synthesis
+- :mod:`mechsyn.plot.curves` -- curve synthesis: target and traced paths
 - :mod:`mechsyn.plot.atlas` -- atlases of kinematic chains
 - :mod:`mechsyn.plot.finger` -- paper 000's fingers and finger designs
 """
@@ -27,6 +28,7 @@ _WHERE = {
     "plot_fourbar_path": "synthesis", "plot_mechanism_synthesis": "synthesis",
     "plot_motion_synthesis": "synthesis",
     "draw_chain": "atlas", "plot_atlas": "atlas",
+    "plot_candidate": "curves", "plot_curve_result": "curves",
     "plot_finger_design": "finger", "plot_fingers": "finger", "sketch_mechanism": "finger",
 }
 

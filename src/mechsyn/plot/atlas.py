@@ -87,7 +87,7 @@ def plot_atlas(chains: Sequence[KinematicChain], title: str = "", columns: int |
     n = len(chains)
     columns = columns or (2 if n <= 4 else 4)
     rows = max(1, math.ceil(n / columns))
-    height = rows * 1.95 + 0.5
+    height = rows * 1.95 + 0.5 + (0.16 if columns <= 2 else 0.0)
     fig = figure(fig, (columns * 3.6, height))
     grid = fig.subplots(rows, columns, squeeze=False)
     for i, ax in enumerate(grid.flat):
@@ -95,9 +95,11 @@ def plot_atlas(chains: Sequence[KinematicChain], title: str = "", columns: int |
             draw_chain(chains[i], ax, number=i + 1)
         else:
             ax.axis("off")
-    fig.suptitle(title + "\n(left: graph, node = link, edge = joint; right: kinematic "
-                 "sketch; B/T/Q/P = binary/ternary/quaternary/pentagonal links)",
-                 fontsize=9, y=1 - 0.08 / height, va="top")
-    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.1 / height, top=1 - 0.5 / height,
-                        wspace=0.05, hspace=0.25)
+    key = ("(left: graph, node = link, edge = joint; right: kinematic sketch; "
+           "B/T/Q/P = binary/ternary/quaternary/pentagonal links)")
+    if columns <= 2:  # a narrow figure: the key on two lines, so that it is not cut
+        key = key.replace("; right", ";\nright")
+    fig.suptitle(f"{title}\n{key}", fontsize=9, y=1 - 0.08 / height, va="top")
+    top = (0.5 + 0.16 * key.count("\n")) / height
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.1 / height, top=1 - top, wspace=0.05, hspace=0.25)
     return fig

@@ -12,6 +12,31 @@ from mechsyn.plot._base import figure
 __all__ = ["plot_capability_map"]
 
 
+def _labelled_contours(ax: Any, xs: np.ndarray, ys: np.ndarray, data: np.ndarray) -> Any:
+    """Labelled contour lines of ``data`` (xs by ys) on ``ax``, interpolated: a coarse grid
+    is refined by a cubic spline (linear where some nodes are unreachable), so the lines are
+    smooth curves between the nodes rather than polygons through the cells."""
+    from scipy.interpolate import RectBivariateSpline, RegularGridInterpolator
+
+    finite = np.isfinite(data)
+    if xs.size < 2 or ys.size < 2 or finite.sum() < 4 or np.nanstd(data) == 0:
+        return None
+    fx = np.linspace(xs[0], xs[-1], max(200, xs.size))
+    fy = np.linspace(ys[0], ys[-1], max(200, ys.size))
+    if finite.all() and xs.size >= 3 and ys.size >= 3:
+        k = min(3, xs.size - 1, ys.size - 1)
+        fine = RectBivariateSpline(xs, ys, data, kx=k, ky=k)(fx, fy)
+    else:
+        gx, gy = np.meshgrid(fx, fy, indexing="ij")
+        fine = RegularGridInterpolator((xs, ys), data, bounds_error=False)(np.stack([gx, gy], -1))
+    try:
+        cs = ax.contour(fx, fy, fine.T, levels=8, colors="k", linewidths=0.7)
+        ax.clabel(cs, fontsize=8, fmt="%.4g", inline=True)
+    except (ValueError, TypeError):  # no level inside the range
+        return None
+    return cs
+
+
 def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
     """Heat map with contour lines of V_max and panels of the optimal joint values.
     Returns the Figure."""
@@ -36,15 +61,8 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
         ax = axs[idx // cols][idx % cols]
         mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
         fig.colorbar(mesh, ax=ax, shrink=0.85)
-        finite = np.isfinite(data)
-        if (idx == 0 and cmap.xs.size > 2 and cmap.ys.size > 2 and finite.sum() > 4
-                and np.nanstd(data) > 0):
-            try:
-                cs = ax.contour(cmap.xs, cmap.ys, data.T, levels=8, colors="k", linewidths=0.6)
-                if not small:
-                    ax.clabel(cs, fontsize=8, fmt="%.0f")
-            except (ValueError, TypeError):
-                pass
+        if idx == 0:
+            _labelled_contours(ax, cmap.xs, cmap.ys, data)
         if small:
             for i, x in enumerate(cmap.xs):
                 for j, y in enumerate(cmap.ys):
@@ -52,8 +70,9 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
                         ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=8,
                                 color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
         ax.set_title(title, fontsize=9)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
+        length = units.split("/")[0]
+        ax.set_xlabel(f"x [{length}]")
+        ax.set_ylabel(f"y [{length}]")
         ax.set_aspect("equal")
     for idx in range(panels, rows_ * cols):
         axs[idx // cols][idx % cols].axis("off")

@@ -83,9 +83,21 @@ def plot_motion_synthesis(P: np.ndarray, sols: list, ax: Any = None) -> Any:
 
     ax = axes(ax, (7, 6))
     best = sols[0]
+    # the view is scaled to the poses; the linkage widens it only up to four pose spans
+    # (a linkage 30 times larger would shrink the poses to a dot): pivots beyond are marked
+    plo, phi = P[:, :2].min(axis=0), P[:, :2].max(axis=0)
+    span = max(float((phi - plo).max()), 1e-9)
     best_pts = np.array([best.O2, best.O4, *P[:, :2]])
     lo, hi = best_pts.min(axis=0), best_pts.max(axis=0)
-    pad = 0.6 * (hi - lo).max() + 1e-9
+    if (hi - lo).max() > 4 * span:
+        centre = (plo + phi) / 2
+        lo, hi = centre - 1.0 * span, centre + 1.0 * span
+        off = [f"{name} ({q[0]:.4g}, {q[1]:.4g})" for name, q in (("O2", best.O2), ("O4", best.O4))
+               if np.any(q < lo) or np.any(q > hi)]
+        if off:
+            ax.text(0.02, 0.02, "ground pivots off view: " + ", ".join(off), transform=ax.transAxes,
+                    fontsize=8, color="0.25", bbox={"fc": "white", "ec": "0.7", "alpha": 0.9})
+    pad = 0.3 * (hi - lo).max() + 1e-9
     if len(P) == 4:
         M, _ = center_point_curve(P, n_dir=1440)
         inside = np.all((M > lo - pad) & (M < hi + pad), axis=1)
@@ -105,6 +117,8 @@ def plot_motion_synthesis(P: np.ndarray, sols: list, ax: Any = None) -> Any:
         tri = np.array([pose.A, pose.B, P[0, :2]])
         ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3, label="coupler (guided body)")
     ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x (length)")
+    ax.set_ylabel("y (length)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title(f"Burmester synthesis, {len(P)} poses (red: required poses)")

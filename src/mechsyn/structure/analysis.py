@@ -230,6 +230,13 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
     Returns a :class:`StructuralAnalysis`; each state of a variable-structure mechanism
     is analysed separately (``states``), with paper 002's external constraints where the
     state declares them.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> a = ms.analyze_structure(ms.examples.load("fourbar"))
+    >>> a.formulas["chebyshev"].expression
+    'W = 3·3 - 2·4 - 0 = 1'
     """
     n = mech.n_moving
     N = len(mech.links)

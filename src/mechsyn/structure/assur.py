@@ -213,7 +213,7 @@ def assur_decomposition(
     output_links = tuple(output_links)
     for o in output_links:
         if o not in mech.link_names:
-            raise MechsynInputError(f"unknown output link {o!r}", source="--output",
+            raise MechsynInputError(f"unknown output link {o!r}", field="output",
                                     hint="name a link of the file")
     driven = [p for p in pairs if p.weight == 3]
     notes: list[str] = []

@@ -110,7 +110,7 @@ def _point_velocity(Al: np.ndarray, p: np.ndarray) -> np.ndarray:
 def _null_basis(rows: np.ndarray, d: int, tol: float) -> np.ndarray:
     if rows.shape[0] == 0:
         return np.eye(d)
-    _, s, vt = np.linalg.svd(rows, full_matrices=True)
+    _, s, vt = np.linalg.svd(rows, full_matrices=rows.shape[0] < d)  # vt is d × d either way
     return vt[int(np.sum(s > tol)):].T
 
 
@@ -124,7 +124,16 @@ def _orth(a: np.ndarray, tol: float = 1e-6) -> np.ndarray:
 def screw_axis(tw: np.ndarray, centre: np.ndarray, scale: float) -> dict[str, Any]:
     """The screw axis of a normalised twist ``[ω; v]``: direction, a point on it (the
     foot of the perpendicular from the centre of the joint points) and pitch, in the file's
-    units; a pure slide has ``point`` and ``pitch`` None."""
+    units; a pure slide has ``point`` and ``pitch`` None.
+
+    Examples
+    --------
+    A turn about the z axis through (1, 0, 0), lengths in units of 2 from the origin:
+
+    >>> import numpy as np
+    >>> screw_axis(np.array([0, 0, 1.0, 0, -0.5, 0]), centre=np.zeros(3), scale=2.0)
+    {'direction': [0.0, 0.0, 1.0], 'point': [1.0, 0.0, 0.0], 'pitch': 0.0}
+    """
     w, v = tw[:3], tw[3:]
     nw = float(np.linalg.norm(w))
     if nw < 1e-9 * max(1.0, float(np.linalg.norm(v))):
@@ -166,6 +175,25 @@ def _connected_groups(nodes: list[int], adj: dict[int, set[int]], k_max: int,
         if not level:
             break
     return out, False
+
+
+def _components(nodes: list[int], adj: dict[int, set[int]]) -> list[list[int]]:
+    """Connected components (sorted node lists) of the graph ``adj`` on ``nodes``."""
+    seen: set[int] = set()
+    out = []
+    for v in nodes:
+        if v in seen:
+            continue
+        comp, stack = [], [v]
+        seen.add(v)
+        while stack:
+            u = stack.pop()
+            comp.append(u)
+            for w in adj[u] - seen:
+                seen.add(w)
+                stack.append(w)
+        out.append(sorted(comp))
+    return out
 
 
 def _describe(links: list[str], joints: list[str], axis: dict[str, Any] | None, family: str) -> str:
@@ -233,7 +261,12 @@ def find_idle_mobilities(inp: IdleInputs, tol: float) -> tuple[list[IdleMobility
     named_on: dict[int, list[np.ndarray]] = {}
     for li, p in inp.named:
         named_on.setdefault(li, []).append(p)
-    groups, truncated = _connected_groups(moving, adj, MAX_GROUP_LINKS, _MAX_GROUPS)
+    components = _components(moving, adj)
+    if d == 1:  # the one motion moves every movable link: the only candidate is all of them
+        groups, truncated = [tuple(c) for c in components if len(components) == 1], False
+    else:
+        groups, truncated = _connected_groups(moving, adj, MAX_GROUP_LINKS, _MAX_GROUPS)
+        groups += [tuple(c) for c in components if len(c) > MAX_GROUP_LINKS]  # large rigid sub-assemblies
     for g in groups:
         if basis.shape[1] >= d:
             break

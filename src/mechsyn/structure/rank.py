@@ -519,6 +519,30 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     method makes many small decompositions, which threads only slow down (and on a
     loaded machine by 10-50x). Raises :class:`InsufficientGeometry` when a joint lacks
     the geometry its twists need.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> ra = ms.analyze_rank(ms.examples.load("bennett"))    # mobile although Grübler says -2
+    >>> ra.mobility, ra.redundant_constraints
+    (1, 3)
+
+    A spatial RSSR linkage: two instantaneous freedoms, one of them the rod's idle spin
+    between its ball joints, about the line B-C (direction (2, 1, 2.2) normalised).
+
+    >>> from mechsyn.io import mechanism_from_dict
+    >>> rssr = mechanism_from_dict({"name": "RSSR", "kind": "spatial", "ground": "frame",
+    ...     "links": ["frame", "crank", "rod", "rocker"], "joints": [
+    ...     {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0, 0], "axis": [0, 0, 1],
+    ...      "actuated": True},
+    ...     {"id": "B", "type": "S", "links": ["crank", "rod"], "point": [1, 0, 0]},
+    ...     {"id": "C", "type": "S", "links": ["rod", "rocker"], "point": [3, 1, 2.2]},
+    ...     {"id": "D", "type": "R", "links": ["rocker", "frame"], "point": [3, 2, 1], "axis": [1, 0, 0]}]})
+    >>> r = analyze_rank(rssr)
+    >>> r.mobility, r.useful_mobility, r.actuation_determined
+    (2, 1, True)
+    >>> [(i.links, i.family, [round(x, 4) for x in i.axis["direction"]]) for i in r.idle_mobilities]
+    [(['rod'], 'group', [0.6376, 0.3188, 0.7013])]
     """
     from threadpoolctl import threadpool_limits
 
@@ -574,7 +598,8 @@ def _near_singular_note(sv: np.ndarray, tol: float, F: int, equations: int, rank
     small = sv[(sv > tol) & (sv < 1e-2)]
     if small.size:
         k = small.size
-        notes.append(f"near-singular: singular value(s) {', '.join(f'{x:.2g}' for x in small)} above the tolerance "
+        shown = ", ".join(f"{x:.2g}" for x in np.sort(small)[:6]) + (f" and {k - 6} more" if k > 6 else "")
+        notes.append(f"near-singular: singular value(s) {shown} above the tolerance "
                      f"{tol:.2g} but small; if the geometry is meant to be special (typed with few decimals), "
                      f"--tol {float(small.max()) * 2:.1g} gives mobility {F - rank + k} and {equations - rank + k} "
                      f"redundant constraint(s)")

@@ -112,6 +112,13 @@ def find_remedies(mech: Mechanism, max_variants: int = 10, max_changes_per_conto
     rank analysis for treating it as spatial). Returns at most ``max_variants`` variants,
     fewest changed pairs first; each is re-analysed and kept only if its mobility equals
     the original's and all its ``S_j`` are zero.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> rem = ms.find_remedies(ms.examples.load("gripper_003"), max_variants=3)
+    >>> len(rem) > 0 and all(x.analysis.structural_redundancy == 0 for x in rem)
+    True
     """
     base = analyze_structure(mech, _with_states=False)
     if mech.kind == "planar":

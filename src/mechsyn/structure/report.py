@@ -10,7 +10,7 @@ request, lists pair-class remedies re-checked by the rank method. The
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -125,6 +125,13 @@ class StructureReport(Result):
         Pair-class changes (``remedies=True``); with the rank method, only those it confirms.
     rejected : list
         ``(number, Remedy, RemedyCheck)`` of the remedies the rank method dropped.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> r = ms.analyze(ms.examples.load("fourbar"))
+    >>> r.to_dict()["mobility"], r.to_dict()["method"]
+    (1, 'both')
     """
 
     mechanism: Mechanism = field(metadata={"json": False})
@@ -239,6 +246,8 @@ def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, 
         for coordinates written with few decimals).
     as_spatial : bool
         Analyse a planar mechanism as a spatial one (R axes along z).
+    progress : callable, optional
+        Called with the name of each stage of the rank method (large mechanisms).
 
     Returns
     -------

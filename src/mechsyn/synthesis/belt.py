@@ -80,6 +80,13 @@ def synthesize_belt(
     belt that would go slack or cross the pulley's centre (d <= r) between H0 and Hf.
     Checked by construction: lever 1 and the belt are parallel (both along y) in the
     design position, with the belt at distance r from the lever's axis.
+
+    Examples
+    --------
+    >>> import math, mechsyn as ms
+    >>> s = ms.synthesize_belt(H0=(-350, 600), Hf=(300, 560), phi_of=math.radians(-55), r=75)
+    >>> bool(s.design.a > 0 and s.design.c > 0), s.design.r
+    (True, 75.0)
     """
     vals = [*H0, *Hf, *A0, phi_of, r]
     if len(H0) != 2 or len(Hf) != 2 or len(A0) != 2:

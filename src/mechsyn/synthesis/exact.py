@@ -105,12 +105,12 @@ def freudenstein_coefficients(phi, psi) -> np.ndarray:
     phi, psi = np.asarray(phi, float), np.asarray(psi, float)
     if phi.shape != (3,) or psi.shape != (3,):
         raise MechsynInputError("Freudenstein's 3-position synthesis needs exactly 3 angle pairs",
-                                source="--phi/--psi")
+                                field="phi/psi")
     A = np.column_stack([np.cos(psi), -np.cos(phi), np.ones(3)])
     rhs = np.cos(phi - psi)
     if abs(np.linalg.det(A)) < 1e-12:
         raise MechsynInputError("the three positions give a singular Freudenstein system",
-                                source="--phi/--psi", hint="use three distinct, well separated positions")
+                                field="phi/psi", hint="use three distinct, well separated positions")
     return np.linalg.solve(A, rhs)
 
 
@@ -128,12 +128,12 @@ def freudenstein_synthesis(phi, psi, ground: float = 1.0) -> FunctionSynthesisRe
     d = float(ground)
     notes = []
     if abs(K[0]) < 1e-12 or abs(K[1]) < 1e-12:
-        raise MechsynInputError("the positions need an infinitely long crank or rocker", source="--phi/--psi")
+        raise MechsynInputError("the positions need an infinitely long crank or rocker", field="phi/psi")
     a, c = d / K[0], d / K[1]
     b2 = a * a + c * c + d * d - 2 * a * c * K[2]
     if b2 <= 0:
         raise MechsynInputError("no real coupler length for these positions (b^2 <= 0)",
-                                source="--phi/--psi", hint="change the positions or their spacing")
+                                field="phi/psi", hint="change the positions or their spacing")
     b = float(np.sqrt(b2))
     crank_off = np.pi if a < 0 else 0.0
     rocker_off = np.pi if c < 0 else 0.0
@@ -387,6 +387,14 @@ def motion_synthesis(poses, circle_points=None, center_points=None, max_pairs: i
       simulated and ranked (no defect first, then by the smallest transmission angle along
       the motion, larger is better).
     * 5 poses: the (up to four) Burmester point pairs.
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> poses = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, np.radians(20)], [2.0, 0.6, np.radians(45)]])
+    >>> sols = ms.motion_synthesis(poses, circle_points=np.array([[-0.5, 0.0], [0.5, 0.0]]))
+    >>> len(sols), bool(sols[0].position_error < 1e-6)
+    (1, True)
     """
     P = _poses(poses)
     n = len(P)

@@ -130,6 +130,13 @@ def synthesize_fingers(
 
     ``separate``: attach ``W0 - A`` groups of ``W_f = -1`` each instead (``max_links``
     then bounds their total number of links).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> syn = ms.synthesize_fingers(ms.examples.load("two_phalanx_base_000"), actuators=1, max_links=4)
+    >>> syn.W0, syn.W_f, len(syn.results) > 0
+    (2, -1, True)
     """
     from mechsyn.io import mechanism_to_dict
 
@@ -143,7 +150,7 @@ def synthesize_fingers(
     if w0 <= actuators:
         raise MechsynInputError(
             f"W0 = {w0} is not larger than the {actuators} drive(s): nothing to attach",
-            source="--actuators")
+            field="actuators")
     table = group_table(w0, actuators, max_links)
     rows = [r for r in table.rows if r.meets_conditions]
     degree = {n: 0 for n in mech.link_names}

@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.interrupt import BestSoFar
 from mechsyn.limits import limit, limit_hint
 
@@ -138,6 +138,7 @@ def _floats(v: Any, src: str, fld: str, n: int | None = None) -> np.ndarray:
     return a
 
 
+@input_boundary("synthesis case")
 def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
     """Validate a case mapping; the mechanism file path is relative to ``base_dir``."""
     from mechsyn.io import load_mechanism, mechanism_to_dict
@@ -610,12 +611,22 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
 
     Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
-    returns the best design evaluated so far with ``interrupted=True``."""
+    returns the best design evaluated so far with ``interrupted=True``.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.general import load_case
+    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> res = ms.synthesize_mechanism(case, seed=0, time_limit=20, restarts=1)
+    >>> res.feasible, res.error < res.start_error
+    (True, True)
+    """
     from mechsyn.parallel import run_tasks
     from mechsyn.synthesis.optimize import OPTIMIZERS, restart_seeds
 
     if optimizer not in OPTIMIZERS:
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     t0 = time.time()
     deadline = t0 + time_limit

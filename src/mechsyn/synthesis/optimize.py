@@ -282,13 +282,29 @@ def synthesize_path(
     and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
     with workers, the restarts finished so far); it propagates only when nothing was
     evaluated yet.
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> from mechsyn.synthesis.fourbar import fourbar_position
+    >>> from mechsyn.synthesis.path import PathCase
+    >>> th = [0.0, 0.4, 0.8, 1.2, 1.6]              # targets traced by a known four-bar
+    >>> C = fourbar_position(3.0, 1.0, 3.0, 2.5, np.array(th), branch=-1, rcx=1.0, rcy=1.0).C
+    >>> case = PathCase.from_dict({
+    ...     "id": "known", "targets": C.tolist(), "timing": {"type": "prescribed", "theta2": th},
+    ...     "fixed": {"x0": 0.0, "y0": 0.0, "theta0": 0.0},
+    ...     "variables": [{"name": n, "lower": lo, "upper": 6.0} for n, lo in
+    ...                   (("r1", 0.1), ("r2", 0.1), ("r3", 0.1), ("r4", 0.1), ("rcx", -6.0), ("rcy", -6.0))]})
+    >>> res = ms.synthesize_path(case, seed=0, time_limit=20, restarts=2)
+    >>> res.feasible, bool(res.error < 1e-6)       # sum of squared distances to the targets
+    (True, True)
     """
     from mechsyn.parallel import run_tasks
 
     if optimizer not in OPTIMIZERS:
         from mechsyn.errors import MechsynInputError
 
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", source="--optimizer",
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     options = dict(options or {})
     t0 = time.time()

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.synthesis.fourbar import (
     TWO_PI,
     arc_cos_extremes,
@@ -99,6 +99,7 @@ class PathCase:
         return {v.name: (v.lower, v.upper) for v in self.variables}
 
     @classmethod
+    @input_boundary("path-synthesis case")
     def from_dict(cls, data: Any, source: str | None = None) -> "PathCase":
         """Validate a case object; :class:`MechsynInputError` naming the field on bad input."""
 

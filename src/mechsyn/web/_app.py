@@ -263,7 +263,7 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     @api
     async def read_file(request: Request) -> Any:
         path = _files.resolve_inside(root, request.query_params.get("path"))
-        _files.mechanism_suffix(path)
+        _files.mechanism_suffix(path, suffixes=_files.READABLE_SUFFIXES)
         if not path.is_file():
             raise MechsynInputError(f"{request.query_params.get('path')}: no such file", field="path")
         return {"mechanism": await run_in_threadpool(_service.read_mechanism, path),

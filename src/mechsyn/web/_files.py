@@ -14,6 +14,7 @@ from pathlib import Path, PurePosixPath
 from mechsyn.errors import MechsynInputError
 
 MECHANISM_SUFFIXES = (".yaml", ".yml", ".json")
+READABLE_SUFFIXES = MECHANISM_SUFFIXES + (".pyslvs",)  # opened, not written
 MAX_LISTED = 500
 
 
@@ -49,22 +50,22 @@ def resolve_inside(root: Path, name: object, field: str = "path") -> Path:
     return target
 
 
-def mechanism_suffix(path: Path, field: str = "path") -> str:
+def mechanism_suffix(path: Path, field: str = "path", suffixes: tuple[str, ...] = MECHANISM_SUFFIXES) -> str:
     """The suffix of a mechanism file name, or an input error."""
-    if path.suffix.lower() not in MECHANISM_SUFFIXES:
+    if path.suffix.lower() not in suffixes:
         raise MechsynInputError(f"{path.name}: not a mechanism file name", field=field,
                                 hint="end it in .yaml, .yml or .json")
     return path.suffix.lower()
 
 
 def list_mechanism_files(root: Path) -> list[str]:
-    """Relative names of the YAML/JSON files under ``root`` (not following symlinks out, no hidden)."""
+    """Relative names of the YAML/JSON/Pyslvs files under ``root`` (not following symlinks out, no hidden)."""
     base = root.resolve()
     out: list[str] = []
     for dirpath, dirnames, filenames in os.walk(base):
         dirnames[:] = sorted(d for d in dirnames if not d.startswith(".") and d not in ("node_modules", "__pycache__"))
         for f in sorted(filenames):
-            if f.startswith(".") or Path(f).suffix.lower() not in MECHANISM_SUFFIXES:
+            if f.startswith(".") or Path(f).suffix.lower() not in READABLE_SUFFIXES:
                 continue
             full = Path(dirpath) / f
             if full.resolve() != full and base not in full.resolve().parents:

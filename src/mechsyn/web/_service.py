@@ -78,13 +78,21 @@ def read_mechanism(path: Path) -> dict[str, Any]:
     """A mechanism file read, validated and returned in the file format (dict)."""
     from mechsyn.io import load_mechanism, mechanism_to_dict
 
+    if path.suffix.lower() == ".pyslvs":
+        return parse_mechanism_text(path.read_text(encoding="utf-8"), path.name)
     return mechanism_to_dict(load_mechanism(path))
 
 
 def parse_mechanism_text(text: str, filename: str) -> dict[str, Any]:
-    """An uploaded mechanism file's text (YAML or JSON) → file-format dict."""
-    from mechsyn.io import mechanism_from_text, mechanism_to_dict
+    """An uploaded file's text → file-format dict: a mechanism file (YAML or JSON) or a
+    Pyslvs expression (``.pyslvs``, :mod:`mechsyn.io.pyslvs`)."""
+    from mechsyn.io import mechanism_from_dict, mechanism_from_text, mechanism_to_dict
 
+    if filename.lower().endswith(".pyslvs"):
+        from mechsyn.io.pyslvs import read_pyslvs
+
+        data, _notes = read_pyslvs(text, filename)
+        return mechanism_to_dict(mechanism_from_dict(data, source=filename))
     return mechanism_to_dict(mechanism_from_text(text, source=filename))
 
 
@@ -289,21 +297,21 @@ def animation_gif(data: Any, frames: int = 72) -> bytes:
 
 # --------------------------------------------------------------------------- structure
 def analyze(data: Any) -> dict[str, Any]:
-    """Mobility formulas with their numbers, the rank result, Assur groups, Grashof."""
+    """The structure report (``mechsyn analyze --json``: formulas with their numbers, the rank
+    result), its rank summary lines, the Assur groups and, for a four-bar, Grashof."""
     from mechsyn.kinematics import derived
-    from mechsyn.structure.analysis import analyze_structure
     from mechsyn.structure.assur import assur_decomposition
-    from mechsyn.structure.rank import analyze_rank, missing_geometry, rank_summary_lines
+    from mechsyn.structure.rank import rank_summary_lines
+    from mechsyn.structure.report import analyze as structure_report
 
     mech = build(data)
-    out: dict[str, Any] = {"structure": to_jsonable(analyze_structure(mech))}
-    problems = missing_geometry(mech)
-    if problems:
-        out["rank"], out["rank_unavailable"] = None, "; ".join(problems)
+    report = structure_report(mech)
+    out: dict[str, Any] = {"structure": report.to_dict()}
+    out["rank"] = out["structure"]["rank"]
+    if report.rank is not None:
+        out["rank_summary"] = rank_summary_lines(report.rank)
     else:
-        ra = analyze_rank(mech)
-        out["rank"] = ra.to_dict()
-        out["rank_summary"] = rank_summary_lines(ra)
+        out["rank_unavailable"] = out["structure"].get("rank_unavailable", "the joints' geometry is incomplete")
     try:
         out["assur"] = to_jsonable(assur_decomposition(mech))
     except MechsynInputError as err:

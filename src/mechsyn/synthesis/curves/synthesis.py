@@ -142,8 +142,8 @@ class CurveSynthesisResult:
         return "\n".join(lines)
 
     def plot(self, ax=None, top: int = 3):
-        """Target and the best candidates' paths (see :func:`.plot.plot_curve_result`)."""
-        from mechsyn.synthesis.curves.plot import plot_curve_result
+        """Target and the best candidates' paths (see :func:`mechsyn.plot.curves.plot_curve_result`)."""
+        from mechsyn.plot.curves import plot_curve_result
 
         return plot_curve_result(self, ax=ax, top=top)
 

@@ -358,7 +358,7 @@ function renderAnalysis() {
   if (a && a.error) out.push(h("p", `${a.error}${a.hint ? " — fix: " + a.hint : ""}`, { className: "muted" }));
   if (a && a.structure) {
     const st = a.structure;
-    out.push(h("h3", `Mobility (formulas): W = ${st.mobility}`));
+    out.push(h("h3", `Mobility: W = ${st.mobility}` + (st.mobility_source ? ` (${st.mobility_source})` : " (formulas)")));
     const t = h("table");
     for (const [name, f] of Object.entries(st.formulas)) {
       const tr = h("tr");

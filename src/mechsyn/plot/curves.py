@@ -11,11 +11,9 @@ __all__ = ["plot_curve_result", "plot_candidate"]
 
 
 def _axes(ax):
-    if ax is None:
-        import matplotlib.pyplot as plt
+    from mechsyn.plot._base import axes
 
-        _, ax = plt.subplots(figsize=(6, 5))
-    return ax
+    return axes(ax, (6, 5))
 
 
 def plot_candidate(candidate, target, ax=None, linkage: bool = True, color: str = "tab:blue",
