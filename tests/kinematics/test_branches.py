@@ -12,7 +12,7 @@ from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.dyads import decompose
 from mechsyn.kinematics.system import build_system
 
-from kinematics_helpers import ex  # noqa: F401
+from kinematics_helpers import EX, ex  # noqa: F401
 
 KINDS = ("dead point", "reassembled", "singular")
 
@@ -65,14 +65,15 @@ def compare(a, b, singular_tol=1e-5):
     """Same assembled rows, same positions (1e-9; 1e-5 at singular rows, where Newton's
     positions are only as accurate as the square root of its tolerance), same events."""
     assert np.array_equal(a.assembled, b.assembled)
+    inp = next(iter(a.inputs))
     regular = a.assembled & np.isfinite(a.links[next(iter(a.links))].angular_velocity)
     for p in a.points:
         d = np.abs(a.points[p].position - b.points[p].position).max(axis=1)
-        assert d[regular].max(initial=0) < 1e-9, (p, a.inputs["A"][regular][np.argmax(d[regular])])
+        assert d[regular].max(initial=0) < 1e-9, (p, a.inputs[inp][regular][np.argmax(d[regular])])
         assert d[a.assembled].max(initial=0) < singular_tol
     assert key_events(a) == key_events(b)
-    da = [e["input"]["A"] for e in a.events if e["kind"] == "dead point"]
-    db = [e["input"]["A"] for e in b.events if e["kind"] == "dead point"]
+    da = [e["input"][inp] for e in a.events if e["kind"] == "dead point"]
+    db = [e["input"][inp] for e in b.events if e["kind"] == "dead point"]
     assert np.allclose(da, db, atol=1e-6, rtol=0)
 
 
@@ -176,3 +177,96 @@ def test_option_switches_to_the_other_branch_at_change_points():
     assert any("other branch" in e["message"] for e in other.events if e["kind"] == "singular")
     with pytest.raises(Exception):
         simulate(m, {"A": x}, method="newton", change_points="switch")
+
+
+def fold_input(mech, crank=("A", "B"), rocker=("C", "D"), coupler=("B", "C")):
+    """The crank angle (degrees) at which the coupler and the rocker of a four-bar lie
+    stretched along one line (a dead point of the crank), by the law of cosines."""
+    P = {j.id: np.asarray(j.point, float) for j in mech.joints}
+    a = np.linalg.norm(P[crank[1]] - P[crank[0]])
+    b = np.linalg.norm(P[coupler[1]] - P[coupler[0]])
+    c = np.linalg.norm(P[rocker[1]] - P[rocker[0]])
+    g = np.linalg.norm(P[rocker[1]] - P[crank[0]])
+    return float(np.degrees(np.arccos((a * a + g * g - (b + c) ** 2) / (2 * a * g))))
+
+
+@pytest.mark.parametrize("method", ["assur", "newton"])
+@pytest.mark.parametrize("side", ["starts", "ends"])
+def test_sweep_at_its_dead_point(ex, method, side):
+    """A sweep that starts (or ends) exactly at the dead point: the sample there is singular,
+    an event says so, and its rates are undefined (NaN), never 1e5 from a nearly singular
+    Jacobian; the closed form and Newton agree."""
+    m = ex("textbook/fourbar.yaml")
+    th = fold_input(m)
+    x = input_grid(th, th + 40, 5) if side == "starts" else input_grid(th - 40, th, 5)
+    k = 0 if side == "starts" else len(x) - 1
+    assert x[k] == th
+    sim = simulate(m, {"A": x}, points=["B", "C", "M"], method=method)
+    assert sim.assembled[k]
+    sing = [e for e in sim.events if e["kind"] == "singular" and e["index"] == k]
+    assert sing and abs(sing[0]["input"]["A"] - th) < 1e-9
+    for lk in sim.links.values():
+        assert np.isnan(lk.angular_velocity[k]) and np.isnan(lk.angular_acceleration[k])
+    for p in sim.points.values():
+        assert np.isnan(p.velocity[k]).all() and np.isnan(p.acceleration[k]).all()
+        regular = sim.assembled.copy()
+        regular[k] = False
+        assert np.isfinite(p.velocity[regular]).all() and np.abs(p.velocity[regular]).max(initial=0) < 1e3
+    if side == "starts":
+        dead = [e for e in sim.events if e["kind"] == "dead point"]
+        assert len(dead) == 1 and abs(dead[0]["input"]["A"] - th) < 1e-9
+    other = simulate(m, {"A": x}, points=["B", "C", "M"], method="assur" if method == "newton" else "newton")
+    compare(sim, other)
+
+
+def test_cli_sweep_at_its_dead_point_gives_null_rates(ex, cli_json):
+    """The same through ``simulate --json``: the flagged row's rates are null, and no value
+    of a numerical blow-up (above 1e6) is presented as a number anywhere."""
+    th = fold_input(ex("textbook/fourbar.yaml"))
+    for method in ("assur", "newton"):
+        d = cli_json("simulate", EX / "textbook/fourbar.yaml", "--input", f"A={th!r}:{th + 40!r}:5",
+                     "--points", "M,C", "--method", method)
+        assert d["input"]["values"][0] == pytest.approx(th, abs=1e-12)
+        flagged = {e["index"] for e in d["events"] if e["kind"] == "singular"}
+        assert 0 in flagged, method
+        for series in list(d["points"].values()) + list(d["links"].values()):
+            for key, rows in series.items():
+                if key in ("velocity", "acceleration", "angular_velocity", "angular_acceleration"):
+                    assert rows[0] is None or all(v is None for v in rows[0]), (method, key)
+                flat = np.array([v for r in rows if r is not None
+                                 for v in (r if isinstance(r, list) else [r]) if v is not None], float)
+                assert np.abs(flat).max(initial=0) < 1e6, (method, key)
+
+
+@pytest.mark.parametrize("grid", ["between", "on"])
+def test_peaucellier_cell_through_its_flat_rhombus(ex, grid):
+    """The Peaucellier-Lipkin cell passes its flat rhombus (Q coincides with P, the dyad
+    A-Q-B's two modes meet: a bifurcation) at crank angles +-2 acos(sqrt(21)/6): both
+    methods report it as singular (refined input), agree on every position (1e-9 away from
+    a singular sample), keep Q on its straight line x = 3.5 (the smooth branch, not the
+    branch Q = P) and give null rates only at a sample that is the singular position."""
+    m = ex("kinematics/peaucellier.yaml")
+    P = {j.id: np.asarray(j.point, float) for j in m.joints}
+    ell, s = np.linalg.norm(P["A1"] - P["O1"]), np.linalg.norm(P["A1"] - P["P1"])
+    r = np.linalg.norm(P["P1"] - P["E"])
+    k2 = ell ** 2 - s ** 2  # the inversion: OP * OQ = l^2 - s^2
+    flat = float(np.degrees(2 * np.arccos(np.sqrt(k2) / (2 * r))))  # where OP = sqrt(l^2 - s^2)
+    x = input_grid(-100, 100, 5) if grid == "between" else input_grid(-flat, flat, flat / 5)
+    sims = {meth: simulate(m, {"E": x}, points=["P1", "A1", "B1", "Q"], method=meth)
+            for meth in ("assur", "newton")}
+    for meth, sim in sims.items():
+        assert sim.method == meth and sim.assembled.all()
+        sing = sorted(e["input"]["E"] for e in sim.events if e["kind"] == "singular")
+        assert np.allclose(sing, [-flat, flat], atol=1e-9 if meth == "assur" else 1e-6, rtol=0), (meth, sing)
+        assert not [e for e in sim.events if e["kind"] in ("dead point", "reassembled")]
+        on = np.isin(np.arange(len(x)), [e["index"] for e in sim.events if e["kind"] == "singular"]) & (
+            np.isclose(np.abs(x), flat, atol=1e-12))
+        assert on.any() == (grid == "on")
+        Q, Pp = sim.points["Q"].position, sim.points["P1"].position
+        line = np.abs(Q[:, 0] - k2 / (2 * r))
+        assert line[~on].max() < 1e-9 and line[on].max(initial=0) < 1e-6
+        assert np.allclose(np.linalg.norm(Q, axis=1) * np.linalg.norm(Pp, axis=1), k2, atol=1e-6)
+        v = sim.points["Q"].velocity
+        assert np.isnan(v[on]).all() and np.isfinite(v[~on]).all() and np.abs(v[~on]).max() < 10
+        assert np.allclose(v[~on, 0], 0, atol=1e-8)  # Q moves along its line
+    compare(sims["assur"], sims["newton"])

@@ -268,6 +268,31 @@ def _rates_from(S: PlanarSystem, q: np.ndarray, fac: tuple, X: np.ndarray,
     return qd, qdd
 
 
+def _settle(S: PlanarSystem, q: np.ndarray, u: np.ndarray, fac: tuple) -> tuple[np.ndarray, tuple]:
+    """Near a singular configuration (pivot ratio below 1e-3), Newton's iterations continued
+    to round-off: at a fold Newton converges only linearly, so the sweep's tolerance leaves
+    the position about the square root of it away (a pivot ratio near 1e-6 at an exact dead
+    point, rates of 1e5 presented as numbers); continued until the residual stops
+    decreasing, the pivot ratio is as small as floats can resolve, and a sample at a
+    singular position is recognised as one (the closed form's test: within 1e-12 of it)."""
+    if fac[3] >= 1e-3:
+        return q, fac
+    u2 = u[None]
+    best = float(np.abs(S.residual(q[None], u2)[0]).max())
+    for _ in range(60):
+        if best == 0.0:
+            break
+        dq = _solve_lin(S.jacobian(q[None])[0], -S.residual(q[None], u2)[0])
+        if not np.all(np.isfinite(dq)) or float(np.abs(dq).max()) > 1e-4 * S.scale:
+            break
+        q2 = q + dq
+        r2 = float(np.abs(S.residual(q2[None], u2)[0]).max())
+        if r2 >= best:
+            break
+        q, best = q2, r2
+    return q, _factor(S, q)
+
+
 def _step_ok(S: PlanarSystem, q_old: np.ndarray, q_new: np.ndarray, q_pred: np.ndarray) -> bool:
     """Reject a Newton correction much larger than the predicted step (a branch jump)."""
     nl = 3 * len(S.links)
@@ -442,6 +467,27 @@ def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> list:
     return []
 
 
+def _crossing(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, det: float,
+              iters: int = 40) -> np.ndarray:
+    """Bisection for the input between ``ua`` (configuration ``q``, ``det Phi_q`` of sign
+    ``det``) and ``ub`` where ``det Phi_q`` changes sign along the branch (a change or
+    branch point); ``ub`` when the branch cannot be followed there. Next to the singular
+    point the sign of ``det`` is decided by round-off, so the result is accurate to about
+    1e-8 rad, not to the closed form's 1e-13."""
+    for _ in range(iters):
+        if np.abs(ub - ua).max() < 1e-13:
+            break
+        um = (ua + ub) / 2
+        qm = _track(S, q, ua, um, depth=4)
+        if qm is None:
+            return ub
+        if _factor(S, qm)[2] * det > 0:
+            q, ua = qm, um
+        else:
+            ub = um
+    return (ua + ub) / 2
+
+
 def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
     for _ in range(iters):
@@ -552,9 +598,12 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                     nb = _track(S, bq, bu, inputs[j])
                     if nb is None:
                         break
+                    nb, f_j = _settle(S, nb, inputs[j], _factor(S, nb))
                     q[j] = nb
-                    fac_j, X_j, det_sign[j], sig[j] = _factor(S, nb)
+                    fac_j, X_j, det_sign[j], sig[j] = f_j
                     qd[j], qdd[j] = _rates_from(S, nb, fac_j, X_j, speeds)
+                    if sig[j] < 1e-6:  # singular: the rates are not defined here
+                        qd[j] = qdd[j] = np.nan
                     bq, bu, j = nb, inputs[j], j - 1
                 if refine_limits and j >= 0:
                     ul, _ = _limit(S, bq, bu, inputs[j])
@@ -564,8 +613,8 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                                "message": "assembles again after a gap, in the assembly mode of the drawn "
                                               "configuration (the mode nearest the drawn one)"})
         if cur is not None:
+            cur, f = _settle(S, cur, u, _factor(S, cur))
             q[i] = cur
-            f = _factor(S, cur)
             fac, X, det_sign[i], sig[i] = f
             if i > 0 and np.isfinite(q[i - 1, 0]):
                 hist.append((u, cur, f))
@@ -576,9 +625,10 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                 qdd[i] = np.nan
             if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
                     and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
-                events.append({"index": i, "kind": "singular", "input": u.tolist(), "crossed": True,
+                uc = _crossing(S, q[i - 1], inputs[i - 1], u, det_sign[i - 1]) if refine_limits else u
+                events.append({"index": i, "kind": "singular", "input": uc.tolist(), "crossed": True,
                                "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
-                                          "crossed between this input and the previous"})
+                                          "crossed between this input and the previous (at the input given)"})
         if progress is not None:
             progress()
     assembled = np.all(np.isfinite(q), axis=1)
