@@ -59,6 +59,18 @@ def check_parallel_options(workers: int, scheduler: Any) -> None:
                                 hint="the cluster's own workers run the tasks with --scheduler")
 
 
+def connect_timeout() -> float:
+    """Seconds to wait for a Dask scheduler: ``MECHSYN_SCHEDULER_TIMEOUT``, default 10."""
+    import os
+
+    try:
+        value = float(os.environ.get("MECHSYN_SCHEDULER_TIMEOUT", "10"))
+    except ValueError:
+        raise MechsynInputError("MECHSYN_SCHEDULER_TIMEOUT is not a number of seconds",
+                                source="MECHSYN_SCHEDULER_TIMEOUT", hint="e.g. 10") from None
+    return value if value > 0 else 10.0
+
+
 def dask_client(scheduler: Any):
     """A ``dask.distributed.Client`` for ``scheduler`` (an address or a Client), and
     whether the caller owns it (must close it). Clear errors without Dask or cluster."""
@@ -70,7 +82,7 @@ def dask_client(scheduler: Any):
     if isinstance(scheduler, Client):
         return scheduler, False
     try:
-        return Client(scheduler, timeout=10), True
+        return Client(scheduler, timeout=connect_timeout()), True
     except (OSError, TimeoutError, ValueError) as exc:
         raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
                                 hint="give the address printed by dask-scheduler, "

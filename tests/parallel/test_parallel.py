@@ -84,8 +84,9 @@ def test_dask_local_cluster_equals_one_process(client):
     np.testing.assert_array_equal(a.q, b.q)
 
 
-def test_unreachable_scheduler_is_one_clear_error():
+def test_unreachable_scheduler_is_one_clear_error(monkeypatch):
     pytest.importorskip("dask.distributed")
+    monkeypatch.setenv("MECHSYN_SCHEDULER_TIMEOUT", "1")
     with pytest.raises(MechsynInputError) as exc:
         run_tasks(operator.mul, TASKS, scheduler="tcp://127.0.0.1:9")
     assert "--scheduler" in str(exc.value.format())
