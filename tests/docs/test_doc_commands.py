@@ -60,7 +60,9 @@ def _params():
         long = any(k in cmd for k in LONG)
         if long and not RUN_ALL:
             continue
-        yield pytest.param(page, cmd, id=f"{page}:{cmd[:60]}", marks=[pytest.mark.slow] if long else [])
+        # one page's commands run in order on one worker (a later one may read an earlier one's output)
+        marks = [pytest.mark.xdist_group(page)] + ([pytest.mark.slow] if long else [])
+        yield pytest.param(page, cmd, id=f"{page}:{cmd[:60]}", marks=marks)
 
 
 @pytest.fixture(scope="module")
