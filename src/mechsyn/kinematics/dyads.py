@@ -468,8 +468,14 @@ def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
     out_sig = []
     for k, step in enumerate(plan.steps):
         out_sig.append(_solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
+    return _pose_rows(S, st, plan), out_sig
+
+
+def _pose_rows(S: PlanarSystem, st: _State, plan: Plan) -> np.ndarray:
+    """The solved state as pose rows ``q`` (x, y, angle of every link), the dyads' link
+    angles unwrapped to turn continuously from the file's configuration."""
     nl = len(S.links)
-    q = np.empty((inputs.shape[0], S.n))
+    q = np.empty((st.phi.shape[0], S.n))
     q[:, 0:3 * nl:3] = st.r[:, :, 0]
     q[:, 1:3 * nl:3] = st.r[:, :, 1]
     phi = st.phi.copy()
@@ -478,7 +484,7 @@ def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
     if dyad_links and ok.any():
         phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
     q[:, 2:3 * nl:3] = phi
-    return q, out_sig
+    return q
 
 
 def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
@@ -909,16 +915,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
             return sig
 
         sigmas.append(_solve_step(S, st, step, X, choose))
-    nl = len(S.links)
-    q = np.empty((M, S.n))
-    q[:, 0:3 * nl:3] = st.r[:, :, 0]
-    q[:, 1:3 * nl:3] = st.r[:, :, 1]
-    phi = st.phi.copy()
-    dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
-    ok = np.all(np.isfinite(phi), axis=1)
-    if dyad_links and ok.any():
-        phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
-    q[:, 2:3 * nl:3] = phi
+    q = _pose_rows(S, st, plan)
     for step in plan.steps:  # a link driven from the frame takes the input's own turn count
         if step.kind == "drive_R" and step.known[0] < 0:
             con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
