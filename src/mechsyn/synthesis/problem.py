@@ -156,6 +156,9 @@ class Progress:
     def keys(self) -> Iterator[str]:
         return iter(self._KEYS)
 
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._KEYS)
+
 
 #: ``callback(state)`` of a search.
 ProgressCallback = Callable[[Progress], None]
