@@ -164,7 +164,7 @@ def _quality_table(q: dict[str, PathQuality]) -> Table:
     caption = (f"segment Δφ = {qc.segment_deg[0]:g}…{qc.segment_deg[1]:g}°, tol = "
                f"{qc.translation_tol_deg:g}° (Δφ {qc.translation_dphi_deg[0]:.2f}…"
                f"{qc.translation_dphi_deg[1]:.2f}°)")
-    return Table("straight-line quality of the paths", ("", "C", "H"), rows, caption)
+    return Table("straight-line quality of the paths", ("", "C", "H"), rows, caption, labels=True)
 
 
 def _comparison_table(comparison: dict[str, Any]) -> Table:
@@ -178,7 +178,7 @@ def _comparison_table(comparison: dict[str, Any]) -> Table:
                      fmt(e["H"]["translation_length"])))
     return Table("belt mechanism vs. its equivalent four-bar A0-A-B-B0",
                  ("", "assembles over Δφ°", "C above line (machine side)", "C above line (other side)",
-                  "H travel |θ| ≤ tol"), rows)
+                  "H travel |θ| ≤ tol"), rows, labels=True)
 
 
 def analyze_case(

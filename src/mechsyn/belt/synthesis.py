@@ -93,7 +93,23 @@ class BeltSynthesis(SynthesisResult):
             "a", "c", "h", "r", "b0", "l0", "alpha0_deg", "k_m", "min_d_minus_r", "Hf_miss")]
         rows += [(k, ", ".join(f"{v:.4f}" for v in d[k]))  # type: ignore[union-attr]
                  for k in ("A", "B0", "H0", "Hf", "Hf1", "M", "H_at_phi_of")]
-        return Table("belt manipulator synthesis (paper 001), A0's frame", ("quantity", "value"), rows)
+        return Table("belt manipulator synthesis (paper 001), A0's frame", ("quantity", "value"), rows, labels=True)
+
+
+def _check_inputs(H0: tuple[float, float], Hf: tuple[float, float], A0: tuple[float, float],
+                  phi_of: float, r: float) -> None:
+    """Raise :class:`MechsynInputError` on inputs no construction can use."""
+    if len(H0) != 2 or len(Hf) != 2 or len(A0) != 2:
+        raise MechsynInputError("H0, Hf and A0 are points: two numbers each")
+    if not all(math.isfinite(float(v)) for v in [*H0, *Hf, *A0, phi_of, r]):
+        raise MechsynInputError("every input of the synthesis must be a finite number")
+    if r <= 0:
+        raise MechsynInputError(f"pulley radius r must be positive, got {r:g}", field="r")
+    if abs(phi_of) < 1e-12:
+        raise MechsynInputError("φ_of must not be zero: lever 1 has to turn between H0 and Hf",
+                                field="phi")
+    if abs(phi_of) >= math.pi:
+        raise MechsynInputError("|φ_of| must be below 180°", field="phi")
 
 
 def synthesize_belt(
@@ -122,18 +138,7 @@ def synthesize_belt(
     (True, 75.0)
     """
     t0 = time.perf_counter()
-    vals = [*H0, *Hf, *A0, phi_of, r]
-    if len(H0) != 2 or len(Hf) != 2 or len(A0) != 2:
-        raise MechsynInputError("H0, Hf and A0 are points: two numbers each")
-    if not all(math.isfinite(float(v)) for v in vals):
-        raise MechsynInputError("every input of the synthesis must be a finite number")
-    if r <= 0:
-        raise MechsynInputError(f"pulley radius r must be positive, got {r:g}", field="r")
-    if abs(phi_of) < 1e-12:
-        raise MechsynInputError("φ_of must not be zero: lever 1 has to turn between H0 and Hf",
-                                field="phi")
-    if abs(phi_of) >= math.pi:
-        raise MechsynInputError("|φ_of| must be below 180°", field="phi")
+    _check_inputs(H0, Hf, A0, phi_of, r)
     x0, y0 = float(H0[0]) - A0[0], float(H0[1]) - A0[1]
     xf, yf = float(Hf[0]) - A0[0], float(Hf[1]) - A0[1]
     cf, sf = math.cos(phi_of), math.sin(phi_of)

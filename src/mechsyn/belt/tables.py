@@ -16,6 +16,8 @@ class Table(NamedTuple):
     columns: tuple[str, ...]
     rows: list[tuple[str, ...]]
     caption: str = ""
+    #: the first column holds labels (left-aligned), not numbers
+    labels: bool = False
 
     def markdown(self) -> str:
         """The table in Markdown (title in bold, caption in italics under it)."""

@@ -234,7 +234,7 @@ def _table(t: Any) -> Table:
     """A report's :class:`mechsyn.belt.report.Table` as a rich Table."""
     out = Table(title=t.title, caption=t.caption or None)
     for i, col in enumerate(t.columns):
-        out.add_column(col, justify="left" if i == 0 and not col else "right")
+        out.add_column(col, justify="left" if i == 0 and t.labels else "right")
     for row in t.rows:
         out.add_row(*row)
     return out
