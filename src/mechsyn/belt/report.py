@@ -68,6 +68,16 @@ class BeltReport(Result):
     arrays for plotting; ``paths`` holds the straightness of C's and H's paths,
     ``four_bar_comparison`` the belt mechanism against its equivalent four-bar, and
     ``warnings`` what the numbers alone would not say (slack belt positions).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> rep = ms.belt.analyze_case(ms.BeltDesign(a=100, c=300, h=0, r=200),
+    ...                            ms.belt.phi_range(-30, 40, 1))
+    >>> rep.valid_positions, len(rep.warnings)      # slack positions are said, not hidden
+    (46, 1)
+    >>> sorted(rep.to_dict())[:4]
+    ['B0', 'alpha0_deg', 'b0', 'design']
     """
 
     name: str

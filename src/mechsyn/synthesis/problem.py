@@ -81,7 +81,14 @@ class SynthesisResult(Result):
 
     Subclass it with ``@dataclass(repr=False)``: the common fields are keyword-only, so a
     subclass's own fields may be positional. A subclass keeps its own ``to_dict`` keys and
-    adds the common ones with :meth:`common`.
+    adds the common ones with :meth:`common` (``{**own, **self.common()}``). Subclasses:
+    :class:`mechsyn.synthesis.optimize.PathSynthesisResult`,
+    :class:`mechsyn.synthesis.general.MechanismSynthesisResult`,
+    :class:`mechsyn.synthesis.curves.synthesis.CurveSynthesisResult`,
+    :class:`mechsyn.belt.BeltSynthesis`; the finger-design result (``synthesis/finger/``)
+    is to extend it the same way: drop its own ``error``/``design``/``feasible``/
+    ``seconds``/``seed``/``nfev``/``reason``/``interrupted`` fields (inherited), pass them
+    by keyword, and end its ``to_dict`` with ``**self.common()``.
 
     Examples
     --------
@@ -130,6 +137,15 @@ class Progress:
     ``done`` of ``total`` steps (restarts, refinements; ``total`` None when unknown),
     ``best_error`` the best feasible error so far (``inf`` before the first), ``message``
     what runs now (a stage name), ``nfev`` the evaluations so far when known.
+
+    Examples
+    --------
+    >>> from mechsyn.synthesis.problem import Progress
+    >>> seen = []
+    >>> callback = seen.append                     # e.g. synthesize_path(case, callback=...)
+    >>> callback(Progress(done=1, total=4, best_error=0.02, message="restarts"))
+    >>> seen[0].fraction, seen[0]["best"]          # also reads like the curve database's dict
+    (0.25, 0.02)
     """
 
     done: int
@@ -170,6 +186,15 @@ def resolve_seed(seed: SeedLike) -> int:
     An int is itself; ``None`` draws fresh entropy (recorded, so the run can be repeated);
     a :class:`numpy.random.Generator` gives its next 63-bit integer (the same generator
     state gives the same run).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.synthesis.problem import resolve_seed
+    >>> resolve_seed(42)
+    42
+    >>> resolve_seed(np.random.default_rng(1)) == resolve_seed(np.random.default_rng(1))
+    True
     """
     if isinstance(seed, np.random.Generator):
         return int(seed.integers(2**63))
@@ -182,7 +207,16 @@ def resolve_seed(seed: SeedLike) -> int:
 
 
 def as_generator(seed: SeedLike) -> np.random.Generator:
-    """The random generator of ``seed`` (a Generator is returned as it is)."""
+    """The random generator of ``seed`` (a Generator is returned as it is).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.synthesis.problem import as_generator
+    >>> g = np.random.default_rng(0)
+    >>> as_generator(g) is g, int(as_generator(3).integers(10)) == int(np.random.default_rng(3).integers(10))
+    (True, True)
+    """
     if isinstance(seed, np.random.Generator):
         return seed
     return np.random.default_rng(resolve_seed(seed))
