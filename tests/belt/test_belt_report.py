@@ -153,3 +153,25 @@ def test_belt_synthesis_is_a_synthesis_result():
     assert d["design"]["a"] == s.design.a and d["nfev"] == 0 and d["seed"] is None
     assert s.error == pytest.approx(d["Hf_miss"]) and s.feasible and s.reason == ""
     assert s.x.tolist() == pytest.approx([s.design.a, s.design.c, s.design.h])
+
+
+def test_case_file_through_the_library_is_the_command(run_cli):
+    from mechsyn.belt import case_inputs, load_belt_case
+
+    path = ms.examples.path("paper001")
+    code, out, err = run_cli("belt", "analyze", "--file", path, "--json")
+    assert code == 0, err
+    args, kwargs = case_inputs(load_belt_case(str(path)))
+    _same(out, analyze_case(*args, **kwargs))
+
+
+def test_motion_law_names_what_is_missing():
+    from mechsyn.belt import motion_law
+
+    with pytest.raises(ms.MechsynInputError) as e:
+        motion_law("trapezoidal", np.radians([0, 10]), omega_max_deg_s=90)
+    assert e.value.field == "accel_deg_s2"
+    with pytest.raises(ms.MechsynInputError, match="unknown law"):
+        motion_law("wobble", np.radians([0, 10]))
+    law = motion_law("constant", np.radians([10, 0]))
+    assert law.evaluate([0.0])[1][0] == pytest.approx(-math.radians(60))

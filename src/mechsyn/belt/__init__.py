@@ -55,7 +55,8 @@ _LAZY: dict[str, str] = {
     "compare_with_four_bar": "four_bar", "four_bar_mechanism_dict": "four_bar",
     "belt_mechanism_dict": "four_bar",
     "BeltSynthesis": "synthesis", "synthesize_belt": "synthesis",
-    "BeltCase": "case_file", "load_belt_case": "case_file",
+    "BeltCase": "case_file", "load_belt_case": "case_file", "case_inputs": "case_file",
+    "motion_law": "case_file",
     "BeltReport": "report", "analyze_case": "report", "phi_range": "report",
 }
 

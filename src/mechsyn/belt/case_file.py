@@ -14,15 +14,24 @@ Schema, e.g. ``examples/belt/paper001.yaml``::
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
+import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from mechsyn.belt.design import BeltDesign
+from mechsyn.belt.kinematics import ConstantSpeedLaw, MotionLaw, TableLaw, TrapezoidalLaw
 from mechsyn.errors import MechsynInputError
 
+if TYPE_CHECKING:
+    from mechsyn.belt.synthesis import BeltSynthesis
+
 __all__ = ["BeltCase", "DesignSpec", "MotionSpec", "PathsSpec", "RangeSpec", "SynthesisSpec",
-           "load_belt_case", "read_motion_table"]
+           "case_inputs", "load_belt_case", "motion_law", "read_motion_table"]
 
 
 class _Strict(BaseModel):
@@ -149,3 +158,70 @@ def read_motion_table(path: str | Path) -> tuple[list[float], list[float]]:
         t.append(vals[0])
         phi.append(vals[1])
     return t, phi
+
+
+def motion_law(law: str, dphi: NDArray[np.float64], *, omega_deg_s: float | None = None,
+               omega_max_deg_s: float | None = None, accel_deg_s2: float | None = None,
+               t: Sequence[float] | None = None, phi_deg: Sequence[float] | None = None) -> MotionLaw:
+    """The input law named ``law`` over the lever rotations ``dphi`` (radians, first to last),
+    from the values of a case file's ``motion`` block (degrees, seconds).
+
+    ``constant`` runs at ``omega_deg_s`` (default 60 °/s); ``trapezoidal`` needs
+    ``omega_max_deg_s`` and ``accel_deg_s2``; ``table`` interpolates ``t``, ``phi_deg``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.belt.case_file import motion_law
+    >>> law = motion_law("trapezoidal", np.radians([-73, 0]), omega_max_deg_s=90, accel_deg_s2=200)
+    >>> round(law.duration(), 4)
+    1.2611
+    """
+    start, stop = float(dphi[0]), float(dphi[-1])
+    if law == "constant":
+        return ConstantSpeedLaw(start, stop, math.radians(60.0 if omega_deg_s is None else omega_deg_s))
+    if law == "trapezoidal":
+        if omega_max_deg_s is None or accel_deg_s2 is None:
+            raise MechsynInputError("the trapezoidal law needs a top speed and an acceleration",
+                                    field="omega_max_deg_s" if omega_max_deg_s is None else "accel_deg_s2")
+        return TrapezoidalLaw(start, stop, math.radians(omega_max_deg_s), math.radians(accel_deg_s2))
+    if law == "table":
+        if t is None or phi_deg is None:
+            raise MechsynInputError("the table law needs a table of t (s) and Δφ (deg)", field="table")
+        return TableLaw(tuple(t), tuple(math.radians(p) for p in phi_deg))
+    raise MechsynInputError(f"unknown law {law!r}", field="law", hint="constant, trapezoidal or table")
+
+
+def case_inputs(case: BeltCase) -> tuple[tuple[BeltDesign | BeltSynthesis, NDArray[np.float64]], dict[str, Any]]:
+    """The arguments of :func:`mechsyn.belt.analyze_case` for a case: ``(design, dphi)``
+    and the keywords (segment, tolerance, input law, name). A case with synthesis data is
+    synthesised first (the report then carries the synthesis).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> case = ms.belt.load_belt_case(ms.examples.path("paper001"))
+    >>> args, kwargs = ms.belt.case_inputs(case)
+    >>> rep = ms.belt.analyze_case(*args, **kwargs)       # == mechsyn belt analyze --file ...
+    >>> type(rep.law).__name__, round(rep.paths["C"].extent_x, 1)
+    ('TrapezoidalLaw', 1228.5)
+    """
+    from mechsyn.belt.report import phi_range
+    from mechsyn.belt.synthesis import synthesize_belt
+
+    if case.synthesis is not None:
+        s = case.synthesis
+        design: BeltDesign | BeltSynthesis = synthesize_belt(s.h0, s.hf, math.radians(s.phi_of_deg), s.r, A0=s.a0)
+    else:
+        design = BeltDesign(**case.design.model_dump())  # type: ignore[union-attr]
+    if case.phi_deg is None:
+        raise MechsynInputError("the case gives no range of Δφ", field="phi_deg",
+                                hint="add phi_deg: {start: -73, stop: 85, step: 1}")
+    dphi = phi_range(case.phi_deg.start, case.phi_deg.stop, case.phi_deg.step)
+    m = case.motion or MotionSpec()
+    law = motion_law(m.law, dphi, omega_deg_s=m.omega_deg_s, omega_max_deg_s=m.omega_max_deg_s,
+                     accel_deg_s2=m.accel_deg_s2, t=m.t, phi_deg=m.phi_deg)
+    seg = case.paths.segment_deg
+    return (design, dphi), {"segment": None if seg is None else tuple(math.radians(v) for v in seg),
+                            "translation_tol": math.radians(case.paths.translation_tol_deg),
+                            "law": law, "name": case.name}

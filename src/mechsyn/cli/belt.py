@@ -17,10 +17,9 @@ from typing import Any, Optional
 import numpy as np
 import typer
 
-from mechsyn.belt.case_file import BeltCase, load_belt_case, read_motion_table
+from mechsyn.belt.case_file import BeltCase, MotionSpec, load_belt_case, motion_law, read_motion_table
 from mechsyn.belt.design import BeltDesign
-from mechsyn.belt.kinematics import (ConstantSpeedLaw, InverseResult, MotionLaw, TableLaw,
-                                     TrapezoidalLaw, analyze, inverse_input)
+from mechsyn.belt.kinematics import InverseResult, MotionLaw, analyze, inverse_input
 from mechsyn.belt.report import BeltReport, analyze_case, phi_range
 from mechsyn.belt.synthesis import BeltSynthesis, synthesize_belt
 from mechsyn.cli.app import app
@@ -95,43 +94,24 @@ def _design(a: float | None, c: float | None, h: float | None, r: float | None,
 
 def _law(law: str, dphi: np.ndarray, omega: float | None, omega_max: float | None,
          accel: float | None, table: Path | None, case: BeltCase | None) -> MotionLaw:
-    spec = case.motion if case is not None else None
-    law = law or (spec.law if spec is not None else "constant")
-    start, stop = float(dphi[0]), float(dphi[-1])
+    """The input law from the options, over the case file's ``motion`` block."""
+    spec = case.motion if case is not None and case.motion is not None else MotionSpec()
+    for value, option in ((omega, "--omega"), (omega_max, "--omega-max"), (accel, "--accel")):
+        _number(value, option, positive=True)
+    t, phi, src = spec.t, spec.phi_deg, "motion"
+    if table is not None:
+        (t, phi), src = read_motion_table(table), str(table)
+    pick = lambda given, filed: given if given is not None else filed  # noqa: E731
     try:
-        if law == "constant":
-            w = omega if omega is not None else (spec.omega_deg_s if spec and spec.omega_deg_s
-                                                 else 60.0)
-            _number(w, "--omega", positive=True)
-            return ConstantSpeedLaw(start, stop, math.radians(w))
-        if law == "trapezoidal":
-            wm = omega_max if omega_max is not None else (spec.omega_max_deg_s if spec else None)
-            ac = accel if accel is not None else (spec.accel_deg_s2 if spec else None)
-            if wm is None or ac is None:
-                raise MechsynInputError("the trapezoidal law needs --omega-max and --accel",
-                                        source="--law")
-            _number(wm, "--omega-max", positive=True)
-            _number(ac, "--accel", positive=True)
-            return TrapezoidalLaw(start, stop, math.radians(wm), math.radians(ac))
-        if law == "table":
-            if table is not None:
-                t, phi = read_motion_table(table)
-                src = str(table)
-            elif spec is not None and spec.t is not None and spec.phi_deg is not None:
-                t, phi, src = spec.t, spec.phi_deg, "motion"
-            else:
-                raise MechsynInputError("the table law needs --table FILE (t, dphi_deg)",
-                                        source="--law")
-            try:
-                return TableLaw(tuple(t), tuple(math.radians(p) for p in phi))
-            except MechsynInputError as exc:
-                raise exc.with_source(src) from None
+        return motion_law(law or spec.law, dphi, omega_deg_s=pick(omega, spec.omega_deg_s),
+                          omega_max_deg_s=pick(omega_max, spec.omega_max_deg_s),
+                          accel_deg_s2=pick(accel, spec.accel_deg_s2), t=t, phi_deg=phi)
     except MechsynInputError as exc:
-        if exc.source:
-            raise
-        raise exc.with_source(f"--{exc.field}" if exc.field else "--law") from None
-    raise MechsynInputError(f"unknown law {law!r}", source="--law",
-                            hint="constant, trapezoidal or table")
+        if exc.field is not None and exc.field.startswith("table"):
+            raise exc.with_source(src if t is not None else "--table") from None
+        if exc.field in ("omega_max_deg_s", "accel_deg_s2"):
+            raise MechsynInputError("the trapezoidal law needs --omega-max and --accel", source="--law") from None
+        raise MechsynInputError(exc.message, source="--law", hint=exc.hint) from None
 
 
 def _lib(call: Any, *args: Any, **kwargs: Any) -> Any:
