@@ -183,9 +183,9 @@ ProgressCallback = Callable[[Progress], None]
 def resolve_seed(seed: SeedLike) -> int:
     """The integer that reproduces a run started with ``seed``.
 
-    An int is itself; ``None`` draws fresh entropy (recorded, so the run can be repeated);
-    a :class:`numpy.random.Generator` gives its next 63-bit integer (the same generator
-    state gives the same run).
+    An int is itself; ``None`` draws a fresh 32-bit seed (recorded, so the run can be
+    repeated, and exact in JSON for JavaScript too); a :class:`numpy.random.Generator`
+    gives its next 32-bit integer (the same generator state gives the same run).
 
     Examples
     --------
@@ -197,9 +197,9 @@ def resolve_seed(seed: SeedLike) -> int:
     True
     """
     if isinstance(seed, np.random.Generator):
-        return int(seed.integers(2**63))
+        return int(seed.integers(2**32))
     if seed is None:
-        return int(np.random.SeedSequence().entropy)
+        return int(np.random.default_rng().integers(2**32))
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise MechsynInputError(f"a seed is a non-negative integer, None or a numpy Generator, got {seed!r}",
                                 field="seed")
