@@ -13,7 +13,7 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
-from mechsyn.kinematics.belt import BeltDesign, analyze, path_quality
+from mechsyn.belt import BeltDesign, analyze, path_quality
 
 D = BeltDesign(500.0, 350.0, 100.0, 75.0)
 

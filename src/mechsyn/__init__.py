@@ -19,6 +19,7 @@ Subpackages, one per concept:
 - :mod:`mechsyn.kinematics` planar positions, velocities, accelerations, forces
 - :mod:`mechsyn.capability` velocity capability of redundant manipulators
 - :mod:`mechsyn.synthesis`  structural and dimensional synthesis
+- :mod:`mechsyn.belt`       paper 001's manipulator with a belt on a pulley
 - :mod:`mechsyn.plot`       every figure (Matplotlib), drawn on the Axes you give
 - :mod:`mechsyn.examples`   the example files shipped with the package
 - :mod:`mechsyn.cli`        the ``mechsyn`` command line (a thin layer)
@@ -53,9 +54,10 @@ _LAZY: dict[str, str] = {
     "design_finger": "mechsyn.synthesis.finger_design", "synthesize_path": "mechsyn.synthesis.optimize",
     "synthesize_mechanism": "mechsyn.synthesis.general", "motion_synthesis": "mechsyn.synthesis.exact",
     # paper 001's belt manipulator
-    "BeltDesign": "mechsyn.kinematics.belt", "synthesize_belt": "mechsyn.synthesis.belt",
+    "BeltDesign": "mechsyn.belt.design", "synthesize_belt": "mechsyn.belt.synthesis",
 }
-_SUBMODULES = ("examples", "plot", "io", "model", "structure", "kinematics", "capability", "synthesis")
+_SUBMODULES = ("examples", "plot", "io", "model", "structure", "kinematics", "capability", "synthesis",
+               "belt")
 
 __all__ = sorted([*_LAZY, *_SUBMODULES, "MechsynError", "MechsynInputError", "__version__"])
 

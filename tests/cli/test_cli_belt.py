@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from mechsyn.cli.main import main
-from mechsyn.kinematics.belt import BeltDesign, analyze, load_belt_case
+from mechsyn.belt import BeltDesign, analyze, load_belt_case
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "belt" / "paper001.yaml"

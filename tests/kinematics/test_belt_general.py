@@ -19,7 +19,7 @@ from mechsyn.cli.main import main
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism, mechanism_from_dict, mechanism_to_dict
 from mechsyn.kinematics.analysis import simulate
-from mechsyn.kinematics.belt import BeltDesign, analyze
+from mechsyn.belt import BeltDesign, analyze
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.pairs import PAIR_KINDS, belt_tangent, canonical_pair_type
 from mechsyn.structure.analysis import analyze_structure
@@ -388,7 +388,7 @@ joints:
 
 
 def test_belt_mechanism_dict_is_the_example_file_and_the_cli_writes_it(capsys, tmp_path):
-    from mechsyn.kinematics.belt import belt_mechanism_dict
+    from mechsyn.belt import belt_mechanism_dict
 
     ex = load_mechanism(FILE)
     gen = mechanism_from_dict(belt_mechanism_dict(PAPER))

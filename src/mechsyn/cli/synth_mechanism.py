@@ -47,11 +47,11 @@ def synth_mechanism(
                       console=err_console, transient=True) as prog:
             task = prog.add_task("synth mechanism", total=restarts, best="-")
 
-            def progress(done: int, total: int, best: float) -> None:
-                prog.update(task, completed=done, best=f"{best:.6g}")
+            def progress(state) -> None:
+                prog.update(task, completed=state.done, best=f"{state.best_error:.6g}")
 
             res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,
-                                       optimizer=optimizer, progress=progress, workers=workers,
+                                       optimizer=optimizer, callback=progress, workers=workers,
                                        scheduler=scheduler)
     else:
         res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,

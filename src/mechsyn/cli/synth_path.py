@@ -83,11 +83,12 @@ def synth_path(
                       console=err_console, transient=True) as prog:
             task = prog.add_task(f"synth path {case.id}", total=restarts, best="-")
 
-            def progress(done, total, best):
-                prog.update(task, completed=done, best=f"{best:.6g}" if np.isfinite(best) else "-")
+            def progress(state):
+                best = state.best_error
+                prog.update(task, completed=state.done, best=f"{best:.6g}" if np.isfinite(best) else "-")
 
             res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                                  optimizer=optimizer, progress=progress, scheduler=scheduler,
+                                  optimizer=optimizer, callback=progress, scheduler=scheduler,
                                   target_error=target_error)
     else:
         res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,

@@ -4,7 +4,7 @@ Modules: ``analysis`` (:func:`simulate`, :func:`forces`: the entry points), ``sy
 (link poses and constraint equations, analytic Jacobian), ``solve`` (Newton continuation,
 velocities, accelerations), ``dyads`` (closed-form Assur dyads, vectorised), ``forces``
 (kinetostatics), ``derived`` (transmission angle, mechanical advantage, Grashof, path
-extent, straightness); ``belt`` (paper 001's belt drive, separately). Figures and the
+extent, straightness). Paper 001's belt drive is :mod:`mechsyn.belt`. Figures and the
 animation: :mod:`mechsyn.plot.kinematics`.
 """
 

@@ -23,7 +23,7 @@ from typing import Any
 _WHERE = {
     "animate_simulation": "kinematics", "draw_mechanism": "kinematics", "plot_forces": "kinematics",
     "plot_paths": "kinematics", "plot_simulation": "kinematics",
-    "animate_belt": "belt", "draw_belt": "belt", "plot_belt": "belt",
+    "animate_belt": "belt", "draw_belt": "belt", "plot_belt": "belt", "plot_belt_report": "belt",
     "plot_capability_map": "capability",
     "plot_fourbar_path": "synthesis", "plot_mechanism_synthesis": "synthesis",
     "plot_motion_synthesis": "synthesis",

@@ -1,14 +1,16 @@
 """Figures of paper 001's belt manipulator.
 
-``plot_belt`` draws the mechanism in its design and extreme positions with the
+``plot_belt_report`` draws a :class:`mechsyn.belt.BeltReport`'s mechanism and paths on
+one Axes (``report.plot()``); ``plot_belt`` draws the mechanism in its design and extreme positions with the
 paths of C and H (as the paper's fig. 4), the equivalent four-bar's coupler paths for
 comparison, and the speed and acceleration curves of C and H; ``animate_belt`` returns
 an animation of the motion. Nothing here writes a file or chooses a backend.
 
 References
 ----------
-Paper 001 (seed 001) of /work/shared/seeds: the belt manipulator; see
-:mod:`mechsyn.kinematics.belt` for the full reference.
+.. [1] Paper 001 (seed 001): a manipulator mechanism with a flexible element (belt on a
+   pulley), in Bulgarian; the stored copy gives no authors, title, journal or year (see
+   :mod:`mechsyn.belt`).
 """
 
 from __future__ import annotations
@@ -19,17 +21,12 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.plot._base import figure
-from mechsyn.kinematics.belt import (
-    BeltDesign,
-    BeltState,
-    FourBarState,
-    MotionResult,
-    analyze,
-    equivalent_four_bar,
-)
+from mechsyn.plot._base import axes, figure
+from mechsyn.belt.design import BeltDesign
+from mechsyn.belt.four_bar import FourBarState, equivalent_four_bar
+from mechsyn.belt.kinematics import BeltState, MotionResult, analyze
 
-__all__ = ["animate_belt", "draw_belt", "plot_belt"]
+__all__ = ["animate_belt", "draw_belt", "plot_belt", "plot_belt_report"]
 
 
 def _dense(design: BeltDesign, state: BeltState, n: int = 1500) -> BeltState:
@@ -84,18 +81,11 @@ def draw_belt(ax: Any, design: BeltDesign, state: BeltState, i: int, alpha: floa
     return art
 
 
-def plot_belt(design: BeltDesign, state: BeltState, four_bar: FourBarState | None = None,
-              motion: MotionResult | None = None, title: str = "", fig: Any = None) -> Any:
-    """Figure like paper 001's fig. 4 (left) with speed/acceleration curves (right).
-    Returns the Figure."""
-    fig = figure(fig, (15, 8))
-    fig.set_layout_engine("constrained")
-    gs = fig.add_gridspec(2, 2, width_ratios=[1.35, 1])
-    ax = fig.add_subplot(gs[:, 0])
+def _draw_paths(ax: Any, design: BeltDesign, state: BeltState, four_bar: bool, title: str) -> None:
+    """Design and extreme positions, the paths of C and H (and the four-bar's) on ``ax``."""
     valid = np.nonzero(state.valid)[0]
     i0 = int(np.argmin(np.abs(state.dphi)))
-    ends = [int(valid[0]), int(valid[-1])] if valid.size else []
-    for i in ends:
+    for i in ([int(valid[0]), int(valid[-1])] if valid.size else []):
         draw_belt(ax, design, state, i, alpha=0.45)
     draw_belt(ax, design, state, i0, labels=True)
     _ground(ax, np.zeros(2), 0.035 * design.a)
@@ -104,11 +94,11 @@ def plot_belt(design: BeltDesign, state: BeltState, four_bar: FourBarState | Non
     ax.plot(fine.C[:, 0], fine.C[:, 1], color=_COLOURS["C"], lw=1.8, label="path of C (h = 0)")
     ax.plot(fine.H[:, 0], fine.H[:, 1], color=_COLOURS["H"], lw=1.8,
             label=f"path of H (h = {design.h:g})")
-    if four_bar is not None and np.any(four_bar.valid):
-        four_bar = equivalent_four_bar(design, fine.dphi)
-        ax.plot(four_bar.C[:, 0], four_bar.C[:, 1], "--", color=_COLOURS["fb"], lw=1.1,
+    fb = equivalent_four_bar(design, fine.dphi) if four_bar else None
+    if fb is not None and np.any(fb.valid):
+        ax.plot(fb.C[:, 0], fb.C[:, 1], "--", color=_COLOURS["fb"], lw=1.1,
                 label="equivalent four-bar A0-A-B-B0: C")
-        ax.plot(four_bar.H[:, 0], four_bar.H[:, 1], ":", color=_COLOURS["fb"], lw=1.3,
+        ax.plot(fb.H[:, 0], fb.H[:, 1], ":", color=_COLOURS["fb"], lw=1.3,
                 label="equivalent four-bar: H")
     for P, name in ((state.C, "C"), (state.H, "H")):
         ax.axhline(P[i0, 1], color=_COLOURS[name], lw=0.6, ls=(0, (6, 4)), alpha=0.6)
@@ -123,31 +113,63 @@ def plot_belt(design: BeltDesign, state: BeltState, four_bar: FourBarState | Non
                  f"design (solid) and extreme positions (faded), {rng}", fontsize=10)
     ax.legend(loc="center", bbox_to_anchor=(0.38, 0.45), fontsize=8, framealpha=0.9)
 
+
+def _draw_motion(axv: Any, axa: Any, motion: MotionResult) -> None:
+    """Speeds (with the input speed φ̇ on a second axis) and accelerations over Δφ."""
+    x = np.degrees(motion.dphi)
+    for name, pm in (("C", motion.C), ("H", motion.H)):
+        axv.plot(x, pm.speed, color=_COLOURS[name], label=f"speed of {name}")
+        axa.plot(x, pm.accel, color=_COLOURS[name], label=f"|a| of {name}")
+        axa.plot(x, pm.accel_tangential, color=_COLOURS[name], ls="--", lw=1,
+                 label=f"tangential a of {name}")
+        if np.any(motion.phidd != 0):
+            axa.plot(x, pm.accel_paper, color=_COLOURS[name], ls=":", lw=1,
+                     label=f"paper's (19) for {name}")
+    axv2 = axv.twinx()
+    axv2.plot(x, np.degrees(motion.phid), color="k", lw=0.8, alpha=0.6)
+    axv2.set_ylabel("input φ̇ (°/s)", fontsize=9)
+    axv.set_ylabel("speed (unit/s)")
+    axa.set_ylabel("acceleration (unit/s²)")
+    axv.legend(fontsize=8, loc="upper left")
+    axa.legend(fontsize=8, loc="upper left", ncol=2)
+    axv.set_title("speeds and accelerations for the input law φ(t) (black: φ̇)", fontsize=10)
+
+
+def plot_belt(design: BeltDesign, state: BeltState, four_bar: FourBarState | None = None,
+              motion: MotionResult | None = None, title: str = "", fig: Any = None) -> Any:
+    """Figure like paper 001's fig. 4 (left) with speed/acceleration curves (right).
+    Returns the Figure."""
+    fig = figure(fig, (15, 8))
+    fig.set_layout_engine("constrained")
+    gs = fig.add_gridspec(2, 2, width_ratios=[1.35, 1])
+    _draw_paths(fig.add_subplot(gs[:, 0]), design, state, four_bar is not None, title)
     axv = fig.add_subplot(gs[0, 1])
     axa = fig.add_subplot(gs[1, 1], sharex=axv)
     if motion is not None:
-        x = np.degrees(motion.dphi)
-        for name, pm in (("C", motion.C), ("H", motion.H)):
-            axv.plot(x, pm.speed, color=_COLOURS[name], label=f"speed of {name}")
-            axa.plot(x, pm.accel, color=_COLOURS[name], label=f"|a| of {name}")
-            axa.plot(x, pm.accel_tangential, color=_COLOURS[name], ls="--", lw=1,
-                     label=f"tangential a of {name}")
-            if np.any(motion.phidd != 0):
-                axa.plot(x, pm.accel_paper, color=_COLOURS[name], ls=":", lw=1,
-                         label=f"paper's (19) for {name}")
-        axv2 = axv.twinx()
-        axv2.plot(x, np.degrees(motion.phid), color="k", lw=0.8, alpha=0.6)
-        axv2.set_ylabel("input φ̇ (°/s)", fontsize=9)
-        axv.set_ylabel("speed (unit/s)")
-        axa.set_ylabel("acceleration (unit/s²)")
-        axv.legend(fontsize=8, loc="upper left")
-        axa.legend(fontsize=8, loc="upper left", ncol=2)
-        axv.set_title("speeds and accelerations for the input law φ(t) (black: φ̇)",
-                      fontsize=10)
+        _draw_motion(axv, axa, motion)
     axa.set_xlabel("Δφ (°)")
     for a_ in (axv, axa):
         a_.grid(alpha=0.3)
     return fig
+
+
+def plot_belt_report(report: Any, ax: Any = None, four_bar: bool = True) -> Any:
+    """The mechanism of a :class:`mechsyn.belt.BeltReport` in its design and extreme
+    positions with the paths of C and H (and, with ``four_bar``, the equivalent four-bar's)
+    on ``ax`` (a new Figure's Axes when None). Returns the Axes.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.belt import analyze_case, phi_range
+    >>> rep = analyze_case(ms.BeltDesign(a=500, c=350, h=100, r=75), phi_range(-73, 85, 1))
+    >>> ax = rep.plot()
+    >>> len(ax.lines) > 4
+    True
+    """
+    ax = axes(ax, (9, 8))
+    _draw_paths(ax, report.design, report.state, four_bar, report.name)
+    return ax
 
 
 def animate_belt(design: BeltDesign, state: BeltState, max_frames: int = 160, title: str = "",

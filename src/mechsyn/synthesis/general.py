@@ -46,6 +46,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.interrupt import BestSoFar
 from mechsyn.limits import limit, limit_hint
+from mechsyn.synthesis.problem import Progress, ProgressCallback, SeedLike, SynthesisResult, resolve_seed
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
@@ -515,23 +516,22 @@ class _EvalList(list):
         return np.array([e.feasible for e in self])
 
 
-@dataclass
-class MechanismSynthesisResult:
-    """Outcome of :func:`synthesize_mechanism`; ``to_dict`` gives the CLI JSON."""
+@dataclass(repr=False)
+class MechanismSynthesisResult(SynthesisResult):
+    """Outcome of :func:`synthesize_mechanism`; ``to_dict`` gives the CLI JSON.
+
+    A :class:`~mechsyn.synthesis.problem.SynthesisResult`: ``design`` names the case's
+    variables, ``x`` is the same vector, ``reason`` says why the best design is
+    infeasible ("" when feasible), ``seed`` the integer that repeats the run.
+    """
 
     case: str
     problem: str
-    error: float
-    design: dict[str, float]
     start_design: dict[str, float]
     start_error: float | None
-    feasible: bool
     assembled_at_all_targets: bool
     method: str
-    seconds: float
-    seed: int
     restarts: int
-    nfev: int
     inputs_deg: np.ndarray
     targets: np.ndarray
     achieved: np.ndarray
@@ -541,8 +541,6 @@ class MechanismSynthesisResult:
     mechanism: dict = field(repr=False, default_factory=dict)
     restart_errors: list[float] = field(default_factory=list)
     stopped_by_time_limit: bool = False
-    reason: str = ""                   # why the best design is infeasible ("" when feasible)
-    interrupted: bool = False          # Ctrl-C ended the search: the best design so far
 
     def to_dict(self) -> dict[str, Any]:
         out = {k: getattr(self, k) for k in (
@@ -552,7 +550,7 @@ class MechanismSynthesisResult:
         if self.problem == "motion":
             out["achieved_angles_deg"] = self.achieved_angles_deg
             out["target_angles_deg"] = self.target_angles_deg
-        return out
+        return {**out, **self.common()}
 
 
 def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, opts: dict[str, Any],
@@ -594,9 +592,9 @@ def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, o
     return best_z, best_f, prob.n_evaluations
 
 
-def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 3,
+def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 3,
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
-                         progress: Callable[[int, int, float], None] | None = None,
+                         callback: ProgressCallback | None = None,
                          workers: int = 1, scheduler: Any = None,
                          batch: bool = True) -> MechanismSynthesisResult:
     """Optimise the case: per restart (child seeds of ``seed``, as in
@@ -610,7 +608,10 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     ``batch``: evaluate populations through the batch engine where the case allows
     (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
 
-    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
+    ``seed``: an int, ``None`` or a ``numpy.random.Generator`` (the result's ``seed`` is
+    the int that repeats the run). ``callback(state)`` gets a
+    :class:`~mechsyn.synthesis.problem.Progress` (restarts done, the best fitness so far).
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``callback``) ends the search and
     returns the best design evaluated so far with ``interrupted=True``.
 
     Examples
@@ -629,6 +630,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
         raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     t0 = time.time()
+    seed = resolve_seed(seed)
     deadline = t0 + time_limit
     opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
     opts.update(options or {})
@@ -644,14 +646,14 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     outs: dict[int, tuple] = {}
 
     def report(r: int, f: float) -> None:
-        if progress is not None:
-            progress(r, restarts, min(best[0], f))
+        if callback is not None:
+            callback(Progress(done=r, total=restarts, best_error=min(best[0], f), message="restarts"))
 
     def finished(done: int, total: int, index: int, out) -> None:
         outs[index] = out
         best[0] = min(best[0], out[1])
-        if progress is not None:
-            progress(done, restarts, best[0])
+        if callback is not None:
+            callback(Progress(done=done, total=restarts, best_error=best[0], message="restarts"))
 
     seeds = restart_seeds(seed, restarts)
     trackers = [BestSoFar() if local else None for _ in seeds]
@@ -686,6 +688,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     N = case.n_targets
     return MechanismSynthesisResult(
         case=case.name, problem=case.problem, error=ev.error if ok else float("inf"), design=design,
+        x=np.asarray(best_z, float),
         start_design={n: float(v) for n, v in zip(names, start_vector(case))},
         start_error=start_f if start_f < prob.penalty_base else None, feasible=ok,
         assembled_at_all_targets=ok, method=ev.method, seconds=time.time() - t0, seed=seed,

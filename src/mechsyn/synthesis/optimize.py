@@ -41,6 +41,7 @@ from scipy.optimize import differential_evolution, least_squares
 
 from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design
+from mechsyn.synthesis.problem import Progress, ProgressCallback, SeedLike, SynthesisResult, as_generator, resolve_seed
 
 
 @dataclass
@@ -101,7 +102,7 @@ def scipy_de(fitness, lower, upper, *, seed: int, should_stop, options: dict[str
 
 def random_search(fitness, lower, upper, *, seed: int, should_stop, options: dict[str, Any]) -> GlobalResult:
     """Uniform random sampling (a baseline showing the interface; not for real use)."""
-    rng = np.random.default_rng(seed)
+    rng = as_generator(seed)
     batch, rounds = int(options.get("popsize", 10)) * len(lower) * 10, int(options.get("maxiter", 100))
     best_x, best_f, nfev = None, np.inf, 0
     for _ in range(rounds):
@@ -202,27 +203,25 @@ def _run_restart(case: PathCase, index: int, seed: int, optimizer: str, options:
                          seconds=time.monotonic() - t0)
 
 
-@dataclass
-class PathSynthesisResult:
-    """Outcome of :func:`synthesize_path` (serialisable; ``to_dict`` gives the CLI JSON)."""
+@dataclass(repr=False)
+class PathSynthesisResult(SynthesisResult):
+    """Outcome of :func:`synthesize_path` (serialisable; ``to_dict`` gives the CLI JSON).
 
-    case_id: str
-    error: float
-    design: dict[str, float]
-    assembled_at_all_targets: bool
-    feasible: bool
-    seconds: float
-    seed: int
-    restarts: int
-    nfev: int
-    optimizer: str
-    branch: int
-    targets: np.ndarray
-    path: np.ndarray
-    theta2: np.ndarray
+    A :class:`~mechsyn.synthesis.problem.SynthesisResult`: ``error`` is the sum of squared
+    distances to the targets, ``design`` the case's variables, ``x`` the optimiser's vector
+    of the winning restart, ``seed`` the integer that repeats the run.
+    """
+
+    case_id: str = ""
+    assembled_at_all_targets: bool = False
+    restarts: int = 0
+    optimizer: str = "de"
+    branch: int = 1
+    targets: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    path: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    theta2: np.ndarray = field(default_factory=lambda: np.zeros(0))
     restart_errors: list[float] = field(default_factory=list)
     best_known: float | None = None
-    interrupted: bool = False
     target_error: float | None = None
     worst_transmission_angle_deg: float | None = None
     fold_distance_deg: float | None = None
@@ -245,13 +244,24 @@ class PathSynthesisResult:
             "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
             "ratio_to_best_known": (self.error / self.best_known) if self.best_known else None,
             "restart_errors": self.restart_errors, "theta2": self.theta2, "path": self.path,
-            "targets": self.targets,
+            "targets": self.targets, **self.common(),
         }
 
 
-def restart_seeds(seed: int, restarts: int) -> list[int]:
-    """Reproducible child seeds of ``seed`` (``numpy.random.SeedSequence.spawn``)."""
-    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(restarts)]
+def _path_reason(check: dict[str, Any], case: PathCase) -> str:
+    """Why a path design is infeasible ("" when it is feasible)."""
+    if check["feasible"]:
+        return ""
+    if not check["assembled_at_all_targets"]:
+        return "the linkage cannot be assembled at every target"
+    return (f"a constraint is violated (transmission angle >= {case.transmission_angle_min_deg}°, "
+            f"fold margin {case.fold_margin_deg}°, bounds or timing order)")
+
+
+def restart_seeds(seed: SeedLike, restarts: int) -> list[int]:
+    """Reproducible child seeds of ``seed`` (``numpy.random.SeedSequence.spawn`` of
+    :func:`~mechsyn.synthesis.problem.resolve_seed`)."""
+    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(resolve_seed(seed)).spawn(restarts)]
 
 
 def default_target_error(case: PathCase) -> float | None:
@@ -261,14 +271,17 @@ def default_target_error(case: PathCase) -> float | None:
 
 
 def synthesize_path(
-    case: PathCase, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
+    case: PathCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
     optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
-    progress: Callable[[int, int, float], None] | None = None, scheduler: Any = None,
+    callback: ProgressCallback | None = None, scheduler: Any = None,
     target_error: float | None = None,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
 
-    ``progress(restarts_done, restarts, best_error_so_far)`` is called as the run goes.
+    ``seed``: an int, ``None`` or a ``numpy.random.Generator``; the result's ``seed`` is
+    the int that repeats the run. ``callback(state)`` is called as the run goes, with a
+    :class:`~mechsyn.synthesis.problem.Progress` (restarts done of ``restarts``, the best
+    feasible error so far).
     With ``workers > 1`` restarts run in that many local processes, with ``scheduler``
     (a ``dask.distributed`` scheduler address, or a ``Client``) on a Dask cluster
     (:func:`mechsyn.parallel.run_tasks`); the result equals the single-process one (same
@@ -278,7 +291,7 @@ def synthesize_path(
     as soon as its best feasible error is at most this, and the run ends after the first
     restart (in seed order) whose result reaches it.
 
-    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``progress``) ends the search
+    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``callback``) ends the search
     and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
     with workers, the restarts finished so far); it propagates only when nothing was
     evaluated yet.
@@ -308,6 +321,7 @@ def synthesize_path(
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
     options = dict(options or {})
     t0 = time.time()
+    seed = resolve_seed(seed)
     deadline = t0 + time_limit
     reserve = min(4.0, 0.07 * time_limit)
     seeds = restart_seeds(seed, restarts)
@@ -317,8 +331,8 @@ def synthesize_path(
     def note(done, f):
         if f < problem.penalty_base:  # feasible score
             best[0] = min(best[0], f)
-        if progress is not None:
-            progress(done, restarts, best[0])
+        if callback is not None:
+            callback(Progress(done=done, total=restarts, best_error=best[0], message="restarts"))
 
     local = workers <= 1 and scheduler is None
     done = [0]
@@ -357,7 +371,8 @@ def synthesize_path(
     design = problem.design(win.z)
     check = evaluate_design(case, design)
     return PathSynthesisResult(
-        case_id=case.id, error=check["error"], design=design,
+        case_id=case.id, error=check["error"], design=design, x=np.asarray(win.z, float),
+        reason=_path_reason(check, case),
         assembled_at_all_targets=check["assembled_at_all_targets"], feasible=check["feasible"],
         seconds=time.time() - t0, seed=seed, restarts=len(results), nfev=sum(r.nfev for r in results),
         optimizer=optimizer, branch=case.branch, targets=case.targets, path=check["path"],

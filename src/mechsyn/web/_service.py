@@ -393,12 +393,13 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
     for b, branch in enumerate(branches):
         bcase = _with_branch(case, branch)
 
-        def report(done, total, best, b=b):
-            progress({"done": b * total + done, "total": len(branches) * total,
+        def report(state, b=b):
+            best, total = state.best_error, state.total
+            progress({"done": b * total + state.done, "total": len(branches) * total,
                       "best": None if not math.isfinite(best) else float(best)})
 
         res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
-                              progress=report)
+                              callback=report)
         d = {**bcase.fixed, **res.design}
         item = {"error": float(res.error), "feasible": bool(res.feasible), "branch": branch,
                 "label": f"error {res.error:.4g} (sum of squared distances), branch {branch:+d}, "

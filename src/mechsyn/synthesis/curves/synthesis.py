@@ -54,6 +54,7 @@ from mechsyn.synthesis.curves.database import CurveDatabase, load_database
 from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
 from mechsyn.synthesis.curves.target import TargetCurve, target_from_points
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
+from mechsyn.synthesis.problem import Progress, SynthesisResult
 
 __all__ = ["CurveCandidate", "CurveSynthesisResult", "synthesize_curve", "curve_errors"]
 
@@ -113,16 +114,20 @@ class CurveCandidate:
         }
 
 
-@dataclass
-class CurveSynthesisResult:
-    """Ranked candidates, best first (``to_dict()`` is the ``--json`` output)."""
+@dataclass(repr=False)
+class CurveSynthesisResult(SynthesisResult):
+    """Ranked candidates, best first (``to_dict()`` is the ``--json`` output).
+
+    A :class:`~mechsyn.synthesis.problem.SynthesisResult` for the best candidate:
+    ``error`` its chamfer error (in target diagonals; NaN without a candidate),
+    ``design`` and ``x`` its parameters, ``nfev`` the refinements' evaluations, ``seed``
+    None (the search is deterministic).
+    """
 
     target: TargetCurve
     candidates: list[CurveCandidate]
-    seconds: float
     retrieved: int
     refined: int
-    interrupted: bool = False
     notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
@@ -130,7 +135,7 @@ class CurveSynthesisResult:
                 "target": {"points": self.target.points, "closed": self.target.closed,
                            "diagonal": self.target.diagonal},
                 "seconds": self.seconds, "retrieved": self.retrieved, "refined": self.refined,
-                "interrupted": self.interrupted, "notes": self.notes}
+                "interrupted": self.interrupted, "notes": self.notes, **self.common()}
 
     def __str__(self) -> str:
         lines = [f"curve synthesis: {len(self.candidates)} candidates, {self.refined} refined of "
@@ -486,8 +491,10 @@ def synthesize_curve(
         The search ends early once ``top`` candidates have a chamfer error at most this
         (in target diagonals; default 0.1 %).
     callback : callable, optional
-        ``callback(state)`` with ``state = {"stage", "done", "total", "best", "nfev"}``
-        (``best``: the best chamfer error so far, in target diagonals).
+        ``callback(state)`` with a :class:`~mechsyn.synthesis.problem.Progress`
+        (``message`` the stage, ``best_error`` the best chamfer error so far in target
+        diagonals, ``nfev``); it also reads as the dict ``{"stage", "done", "total",
+        "best", "nfev"}`` the curve database's callback gets.
 
     Returns
     -------
@@ -528,7 +535,7 @@ def synthesize_curve(
 
     def report(stage, done, total, best, nfev):
         if callback is not None:
-            callback({"stage": stage, "done": done, "total": total, "best": best, "nfev": nfev})
+            callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
 
     report("retrieve", 0, 1, float("nan"), 0)
     seeds = _retrieve(database, target, retrieve, max_links, crank)
@@ -592,7 +599,21 @@ def synthesize_curve(
         if len(out) >= top:
             break
     report("done", 1, 1, out[0].chamfer if out else float("nan"), nfev)
-    return CurveSynthesisResult(target, out, time.perf_counter() - t0, len(seeds), done, interrupted, notes)
+    return _result(target, out, time.perf_counter() - t0, len(seeds), done, nfev, interrupted, notes)
+
+
+def _result(target: TargetCurve, out: list[CurveCandidate], seconds: float, retrieved: int, refined: int,
+            nfev: int, interrupted: bool, notes: list[str]) -> CurveSynthesisResult:
+    """The result, its common synthesis fields from the best candidate."""
+    best = out[0] if out else None
+    names = [f"{n}_{xy}" for n in best.topology.plan.names for xy in "xy"] if best is not None else []
+    x = np.asarray(best.params, float) if best is not None else np.zeros(0)
+    return CurveSynthesisResult(
+        target=target, candidates=out, retrieved=retrieved, refined=refined, notes=notes,
+        seconds=seconds, interrupted=interrupted, nfev=nfev, x=x,
+        design=dict(zip(names, map(float, x))),  # the points' coordinates, target frame
+        error=best.chamfer if best is not None else float("nan"), feasible=best is not None,
+        reason="" if best is not None else "no verified candidate: " + "; ".join(notes[-2:]))
 
 
 def _in_region(c: CurveCandidate, box) -> bool:

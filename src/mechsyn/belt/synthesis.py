@@ -12,29 +12,44 @@ and the pulley radius r, paper 001 (section 2, fig. 2; corrected per the spec
    k_m = -(x_H0 - x_Hf(1)) / (y_H0 - y_Hf(1))   (the printed fraction is OCR-garbled);
 4. A = (0, y_M - k_m x_M) where the bisector meets the y axis; a = y_A;
 5. c = -x_H0, h = y_H0 - y_A  (legs of the right triangle with hypotenuse A H0);
-6. b0, l0, α0 from (1)-(3) (``mechsyn.kinematics.belt.design_constants``).
+6. b0, l0, α0 from (1)-(3) (:func:`mechsyn.belt.design.design_constants`).
 
 Why it works: H lies at the fixed distance sqrt(c^2 + h^2) from A on link 2, whatever
 link 2's rotation, so A (fixed on lever 1) is equidistant from H0 and Hf(1).
+
+References
+----------
+.. [1] Paper 001 (seed 001), the belt manipulator: the reference in :mod:`mechsyn.belt`.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from mechsyn.belt.design import BeltDesign
+from mechsyn.belt.kinematics import analyze
+from mechsyn.belt.tables import Table, fmt
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.belt import BeltDesign, analyze
+from mechsyn.synthesis.problem import SynthesisResult
 
 __all__ = ["BeltSynthesis", "synthesize_belt"]
 
 
-@dataclass
-class BeltSynthesis:
-    """Result of the synthesis: the design (in A0's frame), intermediate points of the
-    construction (all in A0's frame) and the checks made on the motion H0 -> Hf."""
+@dataclass(repr=False)
+class BeltSynthesis(SynthesisResult):
+    """Result of :func:`synthesize_belt`: the design (in A0's frame), intermediate points of
+    the construction (all in A0's frame) and the checks made on the motion H0 -> Hf.
+
+    A :class:`~mechsyn.synthesis.problem.SynthesisResult`: ``design`` is the
+    :class:`BeltDesign` (its named values in ``to_dict()["design"]``), ``x`` = (a, c, h),
+    ``error`` the distance from Hf at which the belt mechanism puts H at Δφ = φ_of,
+    ``feasible`` whether every check passed (``reason`` names those that did not),
+    ``nfev`` 0 (a closed-form construction) and ``seed`` None.
+    """
 
     design: BeltDesign
     A0: tuple[float, float]
@@ -50,6 +65,8 @@ class BeltSynthesis:
     notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, object]:
+        """The ``mechsyn belt synthesize --json`` contract: the dimensions flat, the
+        construction's points, the checks, and the common synthesis keys."""
         d = self.design
         return {
             "a": d.a, "c": d.c, "h": d.h, "r": d.r,
@@ -59,8 +76,40 @@ class BeltSynthesis:
             "Hf1": list(self.Hf1), "M": list(self.M), "k_m": self.k_m,
             "min_d_minus_r": self.min_d_minus_r, "H_at_phi_of": list(self.H_at_phi_of),
             "Hf_miss": math.dist(self.H_at_phi_of, self.Hf), "checks": self.checks,
-            "notes": self.notes,
+            "notes": self.notes, **self.common(),
         }
+
+    def _summary(self) -> list[tuple[str, str]]:
+        d = self.design
+        rows = [("design", f"a={d.a:.6g} c={d.c:.6g} h={d.h:.6g} r={d.r:g}, b0={d.b0:.6g} l0={d.l0:.6g}"),
+                ("Hf miss", f"{self.error:.6g}"), ("feasible", str(self.feasible))]
+        rows += [("reason", self.reason)] if self.reason else []
+        return rows + [("note", n) for n in self.notes]
+
+    def table(self) -> Table:
+        """The dimensions and the construction's points as text cells."""
+        d = self.to_dict()
+        rows = [(k, fmt(d[k], 6) if d[k] is not None else "∞") for k in (
+            "a", "c", "h", "r", "b0", "l0", "alpha0_deg", "k_m", "min_d_minus_r", "Hf_miss")]
+        rows += [(k, ", ".join(f"{v:.4f}" for v in d[k]))  # type: ignore[union-attr]
+                 for k in ("A", "B0", "H0", "Hf", "Hf1", "M", "H_at_phi_of")]
+        return Table("belt manipulator synthesis (paper 001), A0's frame", ("quantity", "value"), rows, labels=True)
+
+
+def _check_inputs(H0: tuple[float, float], Hf: tuple[float, float], A0: tuple[float, float],
+                  phi_of: float, r: float) -> None:
+    """Raise :class:`MechsynInputError` on inputs no construction can use."""
+    if len(H0) != 2 or len(Hf) != 2 or len(A0) != 2:
+        raise MechsynInputError("H0, Hf and A0 are points: two numbers each")
+    if not all(math.isfinite(float(v)) for v in [*H0, *Hf, *A0, phi_of, r]):
+        raise MechsynInputError("every input of the synthesis must be a finite number")
+    if r <= 0:
+        raise MechsynInputError(f"pulley radius r must be positive, got {r:g}", field="r")
+    if abs(phi_of) < 1e-12:
+        raise MechsynInputError("φ_of must not be zero: lever 1 has to turn between H0 and Hf",
+                                field="phi")
+    if abs(phi_of) >= math.pi:
+        raise MechsynInputError("|φ_of| must be below 180°", field="phi")
 
 
 def synthesize_belt(
@@ -88,18 +137,8 @@ def synthesize_belt(
     >>> bool(s.design.a > 0 and s.design.c > 0), s.design.r
     (True, 75.0)
     """
-    vals = [*H0, *Hf, *A0, phi_of, r]
-    if len(H0) != 2 or len(Hf) != 2 or len(A0) != 2:
-        raise MechsynInputError("H0, Hf and A0 are points: two numbers each")
-    if not all(math.isfinite(float(v)) for v in vals):
-        raise MechsynInputError("every input of the synthesis must be a finite number")
-    if r <= 0:
-        raise MechsynInputError(f"pulley radius r must be positive, got {r:g}", field="r")
-    if abs(phi_of) < 1e-12:
-        raise MechsynInputError("φ_of must not be zero: lever 1 has to turn between H0 and Hf",
-                                field="phi")
-    if abs(phi_of) >= math.pi:
-        raise MechsynInputError("|φ_of| must be below 180°", field="phi")
+    t0 = time.perf_counter()
+    _check_inputs(H0, Hf, A0, phi_of, r)
     x0, y0 = float(H0[0]) - A0[0], float(H0[1]) - A0[1]
     xf, yf = float(Hf[0]) - A0[0], float(Hf[1]) - A0[1]
     cf, sf = math.cos(phi_of), math.sin(phi_of)
@@ -152,9 +191,12 @@ def synthesize_belt(
             f"at Δφ = φ_of the belt mechanism puts H {miss:.6g} from Hf: the primary-chain "
             "synthesis fixes a, c, h (A is equidistant from H0 and Hf(1)); link 2's "
             "rotation Δψ relative to lever 1 is then set by the belt")
+    H_end = (float(st.H[-1, 0]), float(st.H[-1, 1]))
+    failed = [k for k, ok in checks.items() if not ok]
     return BeltSynthesis(
         design=design, A0=(float(A0[0]), float(A0[1])), H0=(x0, y0), Hf=(xf, yf),
         phi_of_deg=math.degrees(phi_of), Hf1=(xf1, yf1), M=(xm, ym), k_m=k_m,
-        min_d_minus_r=margin, H_at_phi_of=(float(st.H[-1, 0]), float(st.H[-1, 1])),
-        checks=checks, notes=notes,
+        min_d_minus_r=margin, H_at_phi_of=H_end, checks=checks, notes=notes,
+        x=np.array([a, c, h]), error=math.dist(H_end, (xf, yf)), feasible=not failed,
+        reason="; ".join(f"check failed: {k}" for k in failed), seconds=time.perf_counter() - t0,
     )

@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.belt import BeltDesign, analyze
-from mechsyn.synthesis.belt import synthesize_belt
+from mechsyn.belt import BeltDesign, analyze
+from mechsyn.belt import synthesize_belt
 
 
 def _positions(design: BeltDesign, phi_of: float, A0=(0.0, 0.0)):

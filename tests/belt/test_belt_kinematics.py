@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.belt import (
+from mechsyn.belt import (
     BeltDesign,
     ConstantSpeedLaw,
     TableLaw,
@@ -327,7 +327,7 @@ def test_inverse_constant_speed_duration_is_path_length_over_speed():
 
 
 def test_four_bar_mechanism_dict_geometry():
-    from mechsyn.kinematics.belt import four_bar_mechanism_dict
+    from mechsyn.belt import four_bar_mechanism_dict
 
     m = four_bar_mechanism_dict(PAPER)
     P = {j["id"]: np.array(j["point"]) for j in m["joints"]}
