@@ -12,14 +12,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import networkx as nx
 import numpy as np
 import yaml
 from pydantic import ValidationError
 
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import files
-from mechsyn.io.checks import check_counts, check_geometry
+from mechsyn.io.checks import check_counts, check_geometry, link_components
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -547,11 +546,8 @@ class _Builder:
         return tuple(out)
 
     def check_connected(self, links: Sequence[Link], joints: Sequence[Joint], path: list[Any]) -> None:
-        g = nx.MultiGraph()
-        g.add_nodes_from(link.name for link in links)
-        g.add_edges_from(j.links for j in joints)
-        if g.number_of_nodes() and not nx.is_connected(g):
-            parts = sorted((sorted(c) for c in nx.connected_components(g)), key=len)
+        parts = link_components([link.name for link in links], [j.links for j in joints])
+        if len(parts) > 1:
             raise self.error(
                 path, f"the mechanism is disconnected: {', '.join(parts[0])} "
                 f"{'is' if len(parts[0]) == 1 else 'are'} joined to no other part",
