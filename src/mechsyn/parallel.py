@@ -148,9 +148,12 @@ def _run_pool(fn, tasks, results, workers, progress, deadline, stop) -> list[Any
     try:
         queue = list(range(len(tasks)))
         running: dict[Any, int] = {}
+        # with a deadline or a stop: the pool just full, so later tasks stay unstarted;
+        # otherwise a task more per worker waits queued, so that no worker waits while
+        # this process takes in a result
+        depth = workers if deadline is not None or stop is not None else 2 * workers
         while queue or running:
-            # keep the pool just full, so a deadline or stop leaves later tasks unstarted
-            while queue and len(running) < workers:
+            while queue and len(running) < depth:
                 i = queue.pop(0)
                 if i >= book.limit or (deadline is not None and time.time() >= deadline
                                        and i > 0):
