@@ -674,7 +674,8 @@ def _enumerate_units(
     from mechsyn.parallel import run_tasks
 
     backend = canonical.get_backend()
-    canonical.preload()  # forked local workers inherit the graph back end's import
+    if scheduler is None:
+        canonical.preload()  # forked local workers inherit the graph back end's import
     graphs = run_tasks(_unit_graphs, [(n_links, mobility, a, include_degenerate, backend)
                                       for _, a in units], workers=workers, scheduler=scheduler)
     parts = _split_tasks(units, graphs, workers)
