@@ -60,16 +60,21 @@ def parse_text(text: str, source: str) -> Any:
 
 
 def _line_finder(text: str | None, source: str) -> Any:
-    """A function mapping a data path (keys and indices) to its 1-based line."""
-    root = None
-    if text is not None:
-        try:
-            root = yaml.compose(text, Loader=files._YAML_LOADER)
-        except yaml.YAMLError:
-            root = None
+    """A function mapping a data path (keys and indices) to its 1-based line (the text is
+    parsed again, into YAML nodes with their marks, only when a line is asked for: a valid
+    file is parsed once)."""
+    composed: list[Any] = []
+
+    def document() -> Any:
+        if not composed:
+            try:
+                composed.append(None if text is None else yaml.compose(text, Loader=files._YAML_LOADER))
+            except yaml.YAMLError:
+                composed.append(None)
+        return composed[0]
 
     def find(path: Sequence[Any]) -> int | None:
-        node = root
+        node = document()
         line = None
         for key in path:
             if node is None:
