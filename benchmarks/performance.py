@@ -1,190 +1,245 @@
-"""Issue 17's targets in one run: today's figures beside those before the work, and ratios.
+"""Issue 17's targets in one run: each figure beside the earlier one, the target, met or not.
 
-Every figure is the minimum over ``--runs`` runs (the machine is shared: the minimum is
-the least disturbed run). Whole commands are timed from outside (process start to exit,
-start-up included); the rank and atlas figures in-process, each in a fresh subprocess.
-"Before" runs the same measurement on a ``git worktree`` of ``--baseline`` (default: the
-commit before this work, acd6d94); answers are compared where both give one.
+    python benchmarks/performance.py [--runs 5] [--atlas-links 14] [--suite] [--no-nauty]
 
-    python benchmarks/performance.py [--runs 3] [--baseline REV] [--atlas-links 14]
+Whole commands are timed from outside (process start to exit, start-up included), each
+paired with ``python -c "import numpy"`` run just before it (A B A B ...): the ratio is
+taken pair by pair and the median quoted, so a machine whose speed drifts (shared with
+other jobs) still gives a meaningful ratio. Every figure shows the wall time and the CPU
+time (user + system, the process and its children); on a loaded machine the wall time of
+a run can be several times its CPU time, and the verdict reads the CPU time then (on an
+idle machine the two agree). In-process figures (rank, atlas) run in a fresh subprocess.
+Answers are checked: rank m and q against the formulas' ladder, the atlas count against
+the literature (318,162 for 14 links: OEIS A233288, Tuttle 1996) and its chains' nauty
+certificates (pynauty) for pairwise distinctness, both runs of the atlas chain for chain.
 
-Targets (issue 17): ``mechsyn --help`` <= 2.5x and ``mechsyn analyze fourbar`` <= 4x
-``python -c "import numpy"``; rank: 199-joint ladder <= 0.4 s in-process whatever the
-BLAS threads, 2,000 joints <= 10 s; UR5 25-point map <= 1.5 s whole process; ``--csv``
-adds <= 30 % to a dense planar map; atlas of 14-link chains faster with ``--workers 2``
-than in one process (count 318,162).
+Bytecode is compiled first (``compileall``), as a pip install does: a checkout run with
+``PYTHONDONTWRITEBYTECODE=1`` would otherwise compile every module at every start.
+
+"Earlier" is the figure at the previous stop (2026-11-24, see docs/performance.md).
 """
 
 from __future__ import annotations
 
 import argparse
+import compileall
 import json
+import math
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
+SRC = ROOT / "src"
 PY = sys.executable
 UR5 = ["capability", "examples/capability/ur5_dh.yaml", "--grid", "200:600:100,-200:200:100",
        "--z", "300", "--direction", "1,0,0"]
 DENSE = ["capability", "examples/capability/paper004_3r.yaml", "--grid", "0:2600:10,0:2600:10",
          "--direction", "1,0"]
 CASES = str((ROOT / "../shared/spec/data/synthesis_cases_public.json").resolve())
+LITERATURE = {(8, 1): 16, (10, 1): 230, (12, 1): 6856, (14, 1): 318162}
+
+#: figures at the previous stop (docs/performance.md, 2026-11-24, CPU unless said)
+EARLIER = {
+    "help": "2.0x", "analyze": "6.4x", "ur5": "0.97 s", "csv": "+18 %", "rank199": "0.22-0.28 s",
+    "rank1999": "1.8-2.6 s", "growth": "-", "suite": "2 min 10 s", "atlas": "not faster",
+    "synth": "2.8 s",
+}
 
 RANK = """
 import json, sys, time
 from mechsyn.io import mechanism_from_dict
 from mechsyn.structure.rank import analyze_rank
 mech = mechanism_from_dict(json.load(open(sys.argv[1])))
-t = time.perf_counter(); r = analyze_rank(mech); t = time.perf_counter() - t
-print(json.dumps({"s": t, "m": r.mobility, "q": r.redundant_constraints}))
+t, c = time.perf_counter(), time.process_time()
+r = analyze_rank(mech)
+print(json.dumps({"s": time.perf_counter() - t, "cpu": time.process_time() - c,
+                  "m": r.mobility, "q": r.redundant_constraints}))
 """
 ATLAS = """
-import json, sys, time
-from mechsyn.synthesis.chains import synthesize_chains
+import hashlib, json, os, sys, time
+from mechsyn.synthesis.chains import n_units, synthesize_chains
 n, w = int(sys.argv[1]), int(sys.argv[2])
-t = time.perf_counter()
-c = synthesize_chains(n, 1) if w == 1 else synthesize_chains(n, 1, workers=w)
-print(json.dumps({"s": time.perf_counter() - t, "count": len(c)}))
+ticks = []
+t, c0 = time.perf_counter(), os.times()
+chains = synthesize_chains(n, 1, workers=w, progress=ticks.append)
+s, c1 = time.perf_counter() - t, os.times()
+digest = hashlib.sha256("".join(c.certificate for c in chains).encode()).hexdigest()
+print(json.dumps({"s": s, "cpu": c1.user - c0.user + c1.system - c0.system,
+                  "children": c1.children_user - c0.children_user + c1.children_system - c0.children_system,
+                  "count": len(chains), "sha": digest, "ticks": len(ticks), "ticked": sum(ticks),
+                  "units": n_units(n, 1)}))
+if len(sys.argv) > 3:  # nauty's certificates of the chains found: pairwise distinct?
+    import pynauty
+    from mechsyn.synthesis import canonical
+    canonical.set_backend("pynauty")
+    distinct = len({canonical.certificate(c.n_links, list(c.edges)) for c in chains})
+    sys.stderr.write(json.dumps({"nauty_distinct": distinct}) + "\\n")
 """
 
 
-CPU: dict[str, float] = {}  # CPU seconds (user + system) of the last run() call
-
-
-def run(cmd: list[str], src: Path, runs: int) -> tuple[float, str]:
-    """Minimum wall time of a whole command with ``src`` on PYTHONPATH, and its stdout;
-    the minimum CPU time (user + system, the process and its children) goes to CPU["last"]
-    (on a machine shared with others the CPU time moves less than the wall time)."""
-    env = {**os.environ, "PYTHONPATH": str(src)}
-    best, cpu, text = float("inf"), float("inf"), ""
-    for _ in range(runs):
-        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        t = time.perf_counter()
-        p = subprocess.run(cmd, cwd=src.parent, env=env, capture_output=True, text=True)
-        best = min(best, time.perf_counter() - t)
-        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        cpu = min(cpu, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
-        if p.returncode != 0:
-            raise RuntimeError(f"{' '.join(cmd)} failed ({src}):\n{p.stderr[-2000:]}")
-        text = p.stdout
-    CPU["last"] = cpu
-    return best, text
+def run(cmd: list[str], env: dict[str, str] | None = None) -> tuple[float, float, str, str]:
+    """Wall and CPU seconds (user + system of the process and its children), stdout, stderr."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    p = subprocess.run(cmd, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(SRC), **(env or {})},
+                       capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stderr[-2000:]}")
+    return wall, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, p.stdout, p.stderr
 
 
 def mechsyn(args: list[str]) -> list[str]:
     return [PY, "-m", "mechsyn", *args]
 
 
-def baseline_tree(rev: str) -> Path:
-    path = Path(tempfile.gettempdir()) / f"mechsyn-baseline-{rev[:10]}"
-    if not path.exists():
-        subprocess.run(["git", "worktree", "add", "--detach", str(path), rev], cwd=ROOT, check=True,
-                       capture_output=True)
-    return path / "src"
+def paired(cmd: list[str], base: list[str], runs: int) -> dict[str, float]:
+    """Median wall and CPU of ``cmd`` and of ``base``, and the medians of the pairwise ratios."""
+    a, b = [], []
+    for _ in range(runs):
+        b.append(run(base)[:2])
+        a.append(run(cmd)[:2])
+    return {"wall": statistics.median(x[0] for x in a), "cpu": statistics.median(x[1] for x in a),
+            "base_wall": statistics.median(x[0] for x in b), "base_cpu": statistics.median(x[1] for x in b),
+            "wall_ratio": statistics.median(x[0] / y[0] for x, y in zip(a, b)),
+            "cpu_ratio": statistics.median(x[1] / y[1] for x, y in zip(a, b))}
 
 
-def row(name: str, old: float | None, new: float, note: str = "",
-        cpu: tuple[float | None, float | None] = (None, None)) -> None:
-    ratio = f"{old / new:7.1f}x" if old else "       "
-    olds = f"{old:9.2f}" if old is not None else "        -"
-    cpus = " / ".join("-" if c is None else f"{c:.2f}" for c in cpu)
-    print(f"{name:44} {olds} {new:9.2f} {ratio}  cpu {cpus}  {note}")
+def best(cmd: list[str], runs: int, env: dict[str, str] | None = None) -> tuple[float, float, str]:
+    """Minimum wall and CPU over ``runs`` (the least disturbed run) and the last stdout."""
+    out = [run(cmd, env) for _ in range(runs)]
+    return min(o[0] for o in out), min(o[1] for o in out), out[-1][2]
+
+
+def row(name: str, earlier: str, now: str, target: str, met: bool | None, note: str = "") -> None:
+    verdict = {True: "met", False: "NOT MET", None: "-"}[met]
+    print(f"{name:40} {earlier:>12} {now:>24} {target:>16} {verdict:>8}  {note}".rstrip(), flush=True)
+
+
+def startup(runs: int) -> None:
+    numpy = [PY, "-c", "import numpy"]
+    for key, label, cmd, target in (("help", "mechsyn --help", ["--help"], 2.5),
+                                    ("analyze", "mechsyn analyze textbook/fourbar.yaml",
+                                     ["analyze", "examples/textbook/fourbar.yaml"], 4.0)):
+        r = paired(mechsyn(cmd), numpy, runs)
+        row(label, EARLIER[key], f"{r['cpu_ratio']:.1f}x cpu {r['wall_ratio']:.1f}x wall",
+            f"<= {target}x numpy", r["cpu_ratio"] <= target,
+            f"{r['cpu']:.2f} s cpu, {r['wall']:.2f} s wall; numpy {r['base_cpu']:.2f} / {r['base_wall']:.2f} s")
+
+
+def maps(runs: int, tmp: str) -> None:
+    wall, cpu, text = best(mechsyn(UR5 + ["--json"]), runs)
+    v = [x for r in json.loads(text)["v_max"] for x in r]
+    row("UR5 map, 25 points, whole process", EARLIER["ur5"], f"{cpu:.2f} s cpu {wall:.2f} wall",
+        "<= 1.5 s", cpu <= 1.5, f"{sum(x is not None for x in v)} of {len(v)} points reachable")
+    plain = best(mechsyn(DENSE), runs)
+    csv = best(mechsyn(DENSE + ["--csv", f"{tmp}/dense.csv"]), runs)
+    extra = 100 * (csv[1] / plain[1] - 1)
+    row("--csv on a dense planar map (68,121)", EARLIER["csv"], f"+{extra:.0f} % cpu", "<= +30 %",
+        extra <= 30, f"{plain[1]:.2f} -> {csv[1]:.2f} s cpu")
+
+
+def rank(runs: int, tmp: str) -> None:
+    sys.path[:0] = [str(HERE), str(SRC)]
+    from rank import ladder  # the ladder of four-bars of benchmarks/rank.py
+
+    res = {}
+    for loops in (66, 666):
+        f = Path(tmp) / f"ladder{loops}.json"
+        f.write_text(json.dumps(ladder(loops)))
+        for threads in ("default", "1", "2"):
+            env = {} if threads == "default" else {"OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
+            outs = [json.loads(run([PY, "-c", RANK, str(f)], env)[2]) for _ in range(runs if loops < 100 else 1)]
+            res[loops, threads] = min(outs, key=lambda o: o["cpu"])
+    for loops, key, target in ((66, "rank199", 0.4), (666, "rank1999", 10.0)):
+        worst = max((res[loops, t] for t in ("default", "1", "2")), key=lambda o: o["cpu"])
+        walls = "/".join(f"{res[loops, t]['s']:.2f}" for t in ("default", "1", "2"))
+        ok = all((res[loops, t]["m"], res[loops, t]["q"]) == (1, 0) for t in ("default", "1", "2"))
+        row(f"rank, ladder of {1 + 3 * loops} joints, in-process", EARLIER[key],
+            f"{worst['cpu']:.2f} s cpu (worst)", f"<= {target:g} s", worst["cpu"] <= target and ok,
+            f"wall {walls} s with default/1/2 BLAS threads; m = 1, q = 0: {ok}")
+    t1 = max(res[66, t]["cpu"] for t in ("default", "1", "2"))
+    t2 = max(res[666, t]["cpu"] for t in ("default", "1", "2"))
+    growth = math.log(t2 / t1) / math.log(1999 / 199)
+    row("rank, growth exponent 199 -> 1,999 joints", EARLIER["growth"], f"{growth:.2f}", "<= 1.3",
+        growth <= 1.3, "time ~ joints^exponent, from the two ladders' CPU times")
+
+
+def synth() -> None:
+    wall, cpu, text = best(mechsyn(["synth", "path", CASES, "--case", "P2_kk5_timing", "--json"]), 1)
+    out = json.loads(text)
+    row("synth path P2 (default options)", EARLIER["synth"], f"{cpu:.2f} s cpu {wall:.1f} wall", "-",
+        None, f"error {out['error']:.3g}; stopped at the target: {out['target_reached']}")
+
+
+def suite() -> None:
+    t = time.perf_counter()
+    subprocess.run([PY, "-m", "pytest", "-q", "-p", "no:cacheprovider"], cwd=ROOT, capture_output=True)
+    s = time.perf_counter() - t
+    row("test suite (pytest, -n auto)", EARLIER["suite"], f"{s / 60:.1f} min wall", "< 2 min", s < 120)
+
+
+def atlas(n: int, nauty: bool) -> None:
+    env = {"MECHSYN_LIMIT_ATLAS_LINKS": str(max(n, 12))}
+    w1, c1, t1, _ = run([PY, "-c", ATLAS, str(n), "1"], env)
+    w2, c2, t2, err = run([PY, "-c", ATLAS, str(n), "2"] + (["nauty"] if nauty else []), env)
+    one, two = json.loads(t1), json.loads(t2)
+    known = LITERATURE.get((n, 1))
+    same = one["sha"] == two["sha"] and one["count"] == two["count"]
+    checks = [f"{two['count']:,} chains" + (f" (literature {known:,})" if known else ""),
+              f"same chains in the same order: {same}",
+              f"progress: {two['ticks']} calls from the workers adding up to {two['ticked']:.0f} of "
+              f"{two['units']} assortments"]
+    if nauty:
+        distinct = json.loads(err.strip().splitlines()[-1])["nauty_distinct"]
+        checks.append(f"nauty certificates pairwise distinct: {distinct == two['count']}")
+    print(f"  atlas, {n} links: one process {one['s']:.1f} s wall, {one['cpu']:.1f} s cpu; --workers 2 "
+          f"{two['s']:.1f} s wall, cpu {two['cpu']:.1f} s here + {two['children']:.1f} s in the workers")
+    ok = same and (known is None or two["count"] == known)
+    speed = one["s"] / two["s"]
+    # Linux shares the CPU between sessions (autogroups), not processes: with other
+    # sessions keeping the cores busy, the workers of one session share that session's
+    # part and cannot be faster than one process. There the CPU time tells: the work of
+    # the split (workers + this process) spread over 2 idle cores, against one process's.
+    overhead = (two["cpu"] + two["children"]) / one["cpu"]
+    estimate = 2 / overhead
+    idle = os.getloadavg()[0] < 1.5
+    row(f"atlas {n} links, --workers 2 vs one process", EARLIER["atlas"],
+        f"{speed:.2f}x wall" if idle else f"{estimate:.2f}x est.", "> 1x",
+        ok and (speed if idle else estimate) > 1,
+        (f"measured {speed:.2f}x wall under load {os.getloadavg()[0]:.0f}; " if not idle else "")
+        + f"cpu of the split {overhead:.2f}x one process's; " + "; ".join(checks))
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--runs", type=int, default=3)
-    ap.add_argument("--baseline", default="acd6d94")
+    ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--atlas-links", type=int, default=14)
+    ap.add_argument("--suite", action="store_true", help="also time the whole test suite (minutes)")
+    ap.add_argument("--no-nauty", action="store_true", help="skip the nauty check of the atlas")
     args = ap.parse_args()
-    new, old = ROOT / "src", baseline_tree(args.baseline)
-    R = args.runs
-    print(f"{'figure (seconds, min of %d runs)' % R:44} {'before':>9} {'now':>9} {'speed-up':>8}")
-
-    numpy_s, _ = run([PY, "-c", "import numpy"], new, R)
-    numpy_cpu = CPU["last"]
-    row('python -c "import numpy" (the yardstick)', None, numpy_s, cpu=(None, numpy_cpu))
-    for label, cmd, target in (("mechsyn --help", ["--help"], 2.5),
-                               ("mechsyn analyze textbook/fourbar.yaml",
-                                ["analyze", "examples/textbook/fourbar.yaml"], 4.0)):
-        a, _ = run(mechsyn(cmd), old, R)
-        ca = CPU["last"]
-        b, _ = run(mechsyn(cmd), new, R)
-        row(label, a, b, f"{b / numpy_s:.1f}x numpy by wall, {CPU['last'] / numpy_cpu:.1f}x by cpu "
-            f"(target <= {target}x; before {a / numpy_s:.1f}x, {ca / numpy_cpu:.1f}x)", (ca, CPU["last"]))
-
-    for label, extra in (("UR5 map, 25 points", []), ("UR5 map, 25 points, --continuous", ["--continuous"])):
-        a, ta = run(mechsyn(UR5 + extra + ["--json"]), old, R)
-        ca = CPU["last"]
-        b, tb = run(mechsyn(UR5 + extra + ["--json"]), new, R)
-        va = np.array(json.loads(ta)["v_max"], float)
-        vb = np.array(json.loads(tb)["v_max"], float)
-        row(label, a, b, f"target <= 1.5 s; V_max now - before: {np.nanmin(vb - va):+.1e} .. "
-                         f"{np.nanmax(vb - va):+.1e} mm/s", (ca, CPU["last"]))
-
+    compileall.compile_dir(str(SRC), quiet=1)
+    print(f"load average at the start: {os.getloadavg()[0]:.1f} ({os.cpu_count()} cores)")
+    print(f"{'figure':40} {'earlier':>12} {'now':>24} {'target':>16} {'verdict':>8}")
+    startup(args.runs)
     with tempfile.TemporaryDirectory() as tmp:
-        cpu = {}
-        for key, src, extra in (("plain_a", old, []), ("plain_b", new, []),
-                                ("csv_a", old, ["--csv", f"{tmp}/a.csv"]),
-                                ("csv_b", new, ["--csv", f"{tmp}/b.csv"])):
-            cpu[key + "_wall"], _ = run(mechsyn(DENSE + extra), src, R)
-            cpu[key] = CPU["last"]
-        same = Path(f"{tmp}/a.csv").read_bytes() == Path(f"{tmp}/b.csv").read_bytes()
-        row("dense planar map, 68,121 points", cpu["plain_a_wall"], cpu["plain_b_wall"],
-            cpu=(cpu["plain_a"], cpu["plain_b"]))
-        row("  the same with --csv", cpu["csv_a_wall"], cpu["csv_b_wall"],
-            f"--csv adds {100 * (cpu['csv_b'] / cpu['plain_b'] - 1):.0f} % cpu (target <= 30 %; "
-            f"before {100 * (cpu['csv_a'] / cpu['plain_a'] - 1):.0f} %); files identical: {same}",
-            (cpu["csv_a"], cpu["csv_b"]))
-
-        sys.path.insert(0, str(HERE))
-        sys.path.insert(0, str(new))
-        from rank import ladder  # the ladder of four-bars of benchmarks/rank.py
-
-        env_threads = {k: os.environ.pop(k) for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
-                       if k in os.environ}
-        for loops in (66, 666):
-            f = Path(tmp) / f"ladder{loops}.json"
-            f.write_text(json.dumps(ladder(loops)))
-            res = {}
-            for tag, src in (("old", old), ("new", new)):
-                if tag == "old" and loops > 100:
-                    continue  # minutes before the work
-                t, out = run([PY, "-c", RANK, str(f)], src, R if loops < 100 else 1)
-                res[tag] = json.loads(out)
-            target = "0.4" if loops < 100 else "10"
-            agree = "old" not in res or (res["old"]["m"], res["old"]["q"]) == (res["new"]["m"], res["new"]["q"])
-            row(f"rank, ladder of {1 + 3 * loops} joints (in-process)",
-                res["old"]["s"] if "old" in res else None, res["new"]["s"],
-                f"target <= {target} s, default BLAS threads; m, q agree: {agree}")
-        os.environ.update(env_threads)
-
-    a, ta = run(mechsyn(["synth", "path", CASES, "--case", "P2_kk5_timing", "--json"]), old, 1)
-    ca = CPU["last"]
-    b, tb = run(mechsyn(["synth", "path", CASES, "--case", "P2_kk5_timing", "--json"]), new, 1)
-    ea, eb = json.loads(ta)["error"], json.loads(tb)
-    row("synth path P2 (default options)", a, b,
-        f"error {eb['error']:.3g} (before {ea:.3g}); stopped at the target: {eb['target_reached']}",
-        (ca, CPU["last"]))
-
-    n = args.atlas_links
-    os.environ["MECHSYN_LIMIT_ATLAS_LINKS"] = str(max(n, 12))  # beyond the CLI's default limit
-    one, t1 = run([PY, "-c", ATLAS, str(n), "1"], new, 1)
-    two, t2 = run([PY, "-c", ATLAS, str(n), "2"], new, 1)
-    c1, c2 = json.loads(t1), json.loads(t2)
-    print(f"atlas of {n}-link 1-DOF chains: one process {c1['s']:.1f} s, --workers 2 "
-          f"{c2['s']:.1f} s ({c1['s'] / c2['s']:.2f}x; cpu of the run with 2 workers "
-          f"{CPU['last']:.1f} s); chains {c1['count']} and {c2['count']}"
-          + (" (literature: 318,162)" if n == 14 else ""))
-    print(f"machine load at the end: {os.getloadavg()[0]:.1f} (2 cores)")
+        maps(args.runs, tmp)
+        rank(args.runs, tmp)
+    synth()
+    if args.suite:
+        suite()
+    else:
+        row("test suite", EARLIER["suite"], "not run", "< 2 min", None, "give --suite to time it")
+    atlas(args.atlas_links, not args.no_nauty)
+    print(f"load average at the end: {os.getloadavg()[0]:.1f} ({os.cpu_count()} cores)")
 
 
 if __name__ == "__main__":

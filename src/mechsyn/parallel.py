@@ -22,8 +22,13 @@ The contract, the same on every back end:
   started (their result is ``None``); running tasks finish, so a task that can run long
   takes the deadline among its arguments and honours it itself.
 * **Early stop.** ``stop(index, result)`` returning true (e.g. the target error is
-  reached) cancels the tasks after ``index``; the tasks before it still run, so the
-  kept results are the same as in one process, where the run ends at that task.
+  reached) means no task after ``index`` is started any more; the tasks before it all
+  run. So ``results[:index + 1]`` are exactly the single-process ones (where the run
+  ends at that task). A later task that had already started (with several workers it
+  may even have finished first) runs to its end and its result is kept: finished work
+  is worth keeping, and it is that task's true result, never a different value. Tasks
+  not started are ``None``. A caller that needs the single-process answer bit for bit
+  uses ``results[:index + 1]``.
 * **Ctrl-C.** ``KeyboardInterrupt`` cancels what has not run (local processes are shut
   down, cluster futures cancelled) and is raised again.
 
@@ -122,17 +127,16 @@ class _Book:
 
     def __init__(self, n: int, progress: ProgressFn | None, stop: StopFn | None):
         self.n, self.progress, self.stop = n, progress, stop
-        self.limit = n  # tasks at index >= limit are cancelled (early stop)
+        self.limit = n  # tasks at index >= limit are not started any more (early stop)
         self.done = 0
 
     def finished(self, i: int, result: Any, results: list[Any]) -> None:
-        if i >= self.limit:
-            return
+        """Keep a finished task's result (whatever its index), report it, apply ``stop``."""
         results[i] = result
         self.done += 1
         if self.progress is not None:
             self.progress(self.done, self.n, i, result)
-        if self.stop is not None and self.stop(i, result):
+        if i < self.limit and self.stop is not None and self.stop(i, result):
             self.limit = i + 1
 
 
@@ -144,9 +148,12 @@ def _run_pool(fn, tasks, results, workers, progress, deadline, stop) -> list[Any
     try:
         queue = list(range(len(tasks)))
         running: dict[Any, int] = {}
+        # with a deadline or a stop: the pool just full, so later tasks stay unstarted;
+        # otherwise a task more per worker waits queued, so that no worker waits while
+        # this process takes in a result
+        depth = workers if deadline is not None or stop is not None else 2 * workers
         while queue or running:
-            # keep the pool just full, so a deadline or stop leaves later tasks unstarted
-            while queue and len(running) < workers:
+            while queue and len(running) < depth:
                 i = queue.pop(0)
                 if i >= book.limit or (deadline is not None and time.time() >= deadline
                                        and i > 0):
@@ -186,7 +193,7 @@ def _run_dask(fn, tasks, results, scheduler, progress, deadline, stop) -> list[A
         index = {f.key: i for i, f in enumerate(futures)}
         for fut in as_completed(futures):
             i = index[fut.key]
-            if i >= book.limit or fut.cancelled():
+            if fut.cancelled():
                 continue
             result = fut.result()
             if isinstance(result, str) and result == _SKIPPED:

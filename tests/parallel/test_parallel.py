@@ -33,11 +33,33 @@ def test_deadline_runs_the_first_task_only():
     assert run_tasks(operator.mul, TASKS, deadline=time.time() - 1) == [0] + [None] * 6
 
 
+def assert_early_stop_contract(stopped, stop_index=2):
+    """Up to the stopping task: the one-process results; after it: a task that was
+    started keeps its own true result, a task not started is None (never another value)."""
+    full = [i * (i + 1) for i in range(7)]
+    assert stopped[:stop_index + 1] == full[:stop_index + 1]
+    assert all(r is None or r == full[i] for i, r in enumerate(stopped) if i > stop_index)
+
+
 def test_local_processes_equal_one_process():
     out = run_tasks(operator.mul, TASKS, workers=2)
     assert out == [i * (i + 1) for i in range(7)]
-    stopped = run_tasks(operator.mul, TASKS, workers=2, stop=lambda i, r: r >= 6)
-    assert stopped[:3] == [0, 2, 6] and stopped[3:] == [None] * 4
+    seen = []
+    stopped = run_tasks(operator.mul, TASKS, workers=2, stop=lambda i, r: r >= 6,
+                        progress=lambda d, t, i, r: seen.append(i))
+    assert_early_stop_contract(stopped)
+    assert sorted(seen) == [i for i, r in enumerate(stopped) if r is not None]  # each once
+
+
+def test_early_stop_keeps_later_results_that_finished_first():
+    from mechsyn.parallel import _Book
+
+    results, seen = [None] * 7, []
+    book = _Book(7, lambda d, t, i, r: seen.append((d, i)), lambda i, r: r >= 6)
+    for i in (0, 1, 3, 2):  # task 3 finishes before the stopping task 2
+        book.finished(i, i * (i + 1), results)
+    assert results == [0, 2, 6, 12, None, None, None] and book.limit == 3
+    assert seen == [(1, 0), (2, 1), (3, 3), (4, 2)]
 
 
 def test_options_checked():
@@ -53,7 +75,8 @@ def test_atlas_with_local_processes_is_the_same_atlas(tmp_path):
     two = synthesize_chains(10, 1, workers=2, progress=ticks.append)
     assert [c.edges for c in one] == [c.edges for c in two] and len(two) == 230
     assert [c.certificate for c in one] == [c.certificate for c in two]
-    assert len(ticks) == n_units(10, 1)  # one per assortment
+    assert sum(ticks) == pytest.approx(n_units(10, 1))  # shares of the assortments, from the workers
+    assert len(ticks) >= n_units(10, 1) and all(0 < t <= 1 for t in ticks)
     streamed = synthesize_chains_to_file(tmp_path / "c.jsonl", 10, 1, workers=2)
     assert [c.edges for c in streamed] == [c.edges for c in one]
 
@@ -73,7 +96,7 @@ def test_dask_local_cluster_equals_one_process(client):
                     progress=lambda d, t, i, r: seen.append(i))
     assert out == [i * (i + 1) for i in range(7)] and sorted(seen) == list(range(7))
     stopped = run_tasks(operator.mul, TASKS, scheduler=client, stop=lambda i, r: r >= 6)
-    assert stopped[:3] == [0, 2, 6] and stopped[3:] == [None] * 4
+    assert_early_stop_contract(stopped)
     atlas = synthesize_chains(8, 1, scheduler=client)
     assert [c.edges for c in atlas] == [c.edges for c in synthesize_chains(8, 1)]
     arm = load_arm(UR5)

@@ -334,12 +334,23 @@ class CapabilityMap(Result):
         0.0,2.0,0.5,0.1
         1.0,2.0,,
         """
-        cells = self.table().astype(str)
-        cells[cells == "nan"] = ""
+        table = self.table()
         head = ["x", "y", f"v_max_{self.measure}", *[f"{n}_opt" for n in self.joint_names]]
-        lines = [",".join(head)]
-        lines.extend(",".join(row) for row in cells.tolist())
-        return "\n".join(lines) + "\n"
+        columns = [_csv_column(table[:, j]) for j in range(table.shape[1])]
+        return "\n".join([",".join(head), *map(",".join, zip(*columns))]) + "\n"
+
+
+def _csv_column(values: np.ndarray) -> list[str]:
+    """A column's numbers as CSV cells: Python's shortest round-trip text of each float (the
+    text NumPy's ``astype(str)`` gives, at less than half its cost), empty for NaN.
+
+    >>> _csv_column(np.array([0.1, np.nan, 1e-05, 2600.0]))
+    ['0.1', '', '1e-05', '2600.0']
+    """
+    cells = list(map(float.__repr__, values.tolist()))
+    for i in np.flatnonzero(np.isnan(values)).tolist():
+        cells[i] = ""
+    return cells
 
 
 def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,

@@ -17,7 +17,6 @@ import typer
 from rich.console import Console
 from rich.table import Table as RichTable
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import dumps, write_atomic
@@ -284,6 +283,8 @@ def progress_bar(description: str, total: int | None, enabled: bool = True) -> I
     if not enabled or not err_console.is_terminal:
         yield lambda n=1: None
         return
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
     with Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
         TimeRemainingColumn(), console=err_console, transient=True,

@@ -35,7 +35,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["check_geometry", "check_counts", "COINCIDENT_REL", "numbers"]
+__all__ = ["check_geometry", "check_counts", "COINCIDENT_REL", "numbers", "link_components"]
 
 #: Joints closer than this times the file's extent are at one point.
 COINCIDENT_REL = 1e-12
@@ -149,3 +149,37 @@ def numbers(value: Any, source: str | None, field: str) -> np.ndarray:
         raise MechsynInputError(f"values beyond ±{limit('coordinate'):g} would overflow", source=source,
                                 field=field, hint="use a unit that keeps the values below 1e100")
     return a
+
+
+def link_components(names: list[str], pairs: list[tuple[str, str]]) -> list[list[str]]:
+    """The connected parts of the link graph (links joined by joints), smallest first.
+
+    Each part is its links sorted by name; parts of one size come in the order of their
+    first link in ``names`` (links named only by ``pairs`` count after ``names``). A
+    union-find over the joints: linear, and reading a file needs no graph library.
+
+    Examples
+    --------
+    >>> link_components(["frame", "crank", "stray", "rocker"], [("frame", "crank"), ("crank", "rocker")])
+    [['stray'], ['crank', 'frame', 'rocker']]
+    >>> link_components(["a", "b"], [("a", "b")])
+    [['a', 'b']]
+    """
+    parent: dict[str, str] = {}
+
+    def root(x: str) -> str:
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for name in [*names, *(x for pair in pairs for x in pair)]:
+        parent.setdefault(name, name)
+    for a, b in pairs:
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[rb] = ra
+    parts: dict[str, list[str]] = {}
+    for name in parent:  # insertion order: names first
+        parts.setdefault(root(name), []).append(name)
+    return sorted((sorted(p) for p in parts.values()), key=len)

@@ -12,14 +12,13 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import networkx as nx
 import numpy as np
 import yaml
 from pydantic import ValidationError
 
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import files
-from mechsyn.io.checks import check_counts, check_geometry
+from mechsyn.io.checks import check_counts, check_geometry, link_components
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -61,16 +60,21 @@ def parse_text(text: str, source: str) -> Any:
 
 
 def _line_finder(text: str | None, source: str) -> Any:
-    """A function mapping a data path (keys and indices) to its 1-based line."""
-    root = None
-    if text is not None:
-        try:
-            root = yaml.compose(text, Loader=files._YAML_LOADER)
-        except yaml.YAMLError:
-            root = None
+    """A function mapping a data path (keys and indices) to its 1-based line (the text is
+    parsed again, into YAML nodes with their marks, only when a line is asked for: a valid
+    file is parsed once)."""
+    composed: list[Any] = []
+
+    def document() -> Any:
+        if not composed:
+            try:
+                composed.append(None if text is None else yaml.compose(text, Loader=files._YAML_LOADER))
+            except yaml.YAMLError:
+                composed.append(None)
+        return composed[0]
 
     def find(path: Sequence[Any]) -> int | None:
-        node = root
+        node = document()
         line = None
         for key in path:
             if node is None:
@@ -547,11 +551,8 @@ class _Builder:
         return tuple(out)
 
     def check_connected(self, links: Sequence[Link], joints: Sequence[Joint], path: list[Any]) -> None:
-        g = nx.MultiGraph()
-        g.add_nodes_from(link.name for link in links)
-        g.add_edges_from(j.links for j in joints)
-        if g.number_of_nodes() and not nx.is_connected(g):
-            parts = sorted((sorted(c) for c in nx.connected_components(g)), key=len)
+        parts = link_components([link.name for link in links], [j.links for j in joints])
+        if len(parts) > 1:
             raise self.error(
                 path, f"the mechanism is disconnected: {', '.join(parts[0])} "
                 f"{'is' if len(parts[0]) == 1 else 'are'} joined to no other part",

@@ -8,12 +8,14 @@ NetworkX multigraph whose nodes are link names and whose edges are the joints.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-import networkx as nx
 import numpy as np
 
 from mechsyn.model.pairs import PAIR_KINDS
+
+if TYPE_CHECKING:  # NetworkX is imported by graph() only: reading and analysing a file need not load it
+    import networkx as nx
 
 Kind = Literal["planar", "spatial"]
 VLLMode = Literal["active", "passive", "locked"]
@@ -203,6 +205,8 @@ class Mechanism:
 
     def graph(self) -> nx.MultiGraph:
         """Link graph: nodes are link names, each joint an edge keyed by its id."""
+        import networkx as nx
+
         g = nx.MultiGraph()
         g.add_nodes_from(self.link_names)
         for j in self.joints:

@@ -74,6 +74,7 @@ from mechsyn.structure.screws import (  # noqa: F401  (re-exported: the names us
     _unit,
     _vec,
     as_spatial,
+    cross_rows,
     describe_wrenches,
     missing_geometry,
     pair_twists,
@@ -244,7 +245,7 @@ class _System:
             xi = self.twists[c] * sg[:, None]
             R, p = g[k, :3, :3], g[k, :3, 3]
             w = np.einsum("kij,kj->ki", R, xi[:, :3])
-            v = np.einsum("kij,kj->ki", R, xi[:, 3:]) + np.cross(p, w)
+            v = np.einsum("kij,kj->ki", R, xi[:, 3:]) + cross_rows(p, w)
             blocks[k, :, where[k, t]] = np.concatenate([w, v], axis=1)[:, rows]
             g[k] = g[k] @ exps[np.where(sg > 0, c, c + F)]
         R, p = g[:, :3, :3], g[:, :3, 3]
@@ -544,10 +545,18 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     >>> [(i.links, i.family, [round(x, 4) for x in i.axis["direction"]]) for i in r.idle_mobilities]
     [(['rod'], 'group', [0.6376, 0.3188, 0.7013])]
     """
+    if len(mech.joints) < SMALL_JOINTS:  # BLAS does not thread matrices this small
+        return _analyze_rank(mech, planar, tol, check_singular, seed, progress or (lambda stage: None))
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
         return _analyze_rank(mech, planar, tol, check_singular, seed, progress or (lambda stage: None))
+
+
+#: Below this many joints :func:`analyze_rank` leaves the BLAS threads alone: its matrices
+#: are too small for BLAS to thread, and finding the BLAS libraries (threadpoolctl) would
+#: cost more than the analysis of a four-bar.
+SMALL_JOINTS = 24
 
 
 def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check_singular: bool, seed: int,

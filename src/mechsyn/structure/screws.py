@@ -313,12 +313,23 @@ def _exp(xi: np.ndarray, theta: np.ndarray) -> np.ndarray:
         K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = wr[:, 2], -wr[:, 1], wr[:, 0]
         s, c = np.sin(t)[:, None, None], np.cos(t)[:, None, None]
         R = np.eye(3) + s * K + (1 - c) * (K @ K)
-        wxv = np.cross(wr, vr)
+        wxv = cross_rows(wr, vr)
         p = np.einsum("nij,nj->ni", np.eye(3) - R, wxv) + wr * np.sum(wr * vr, axis=1, keepdims=True) * t[:, None]
         idx = np.flatnonzero(rotating)
         g[idx, :3, :3] = R
         g[idx, :3, 3] = p
     return g
+
+
+def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of two (n, 3) arrays: ``np.cross(a, b)``'s numbers (the same
+    operations), without its axis handling, which costs more than the product for a few rows.
+
+    >>> cross_rows(np.array([[1.0, 0, 0]]), np.array([[0.0, 1, 0]]))
+    array([[0., 0., 1.]])
+    """
+    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

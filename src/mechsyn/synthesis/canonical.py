@@ -40,7 +40,7 @@ from collections.abc import Sequence
 BACKENDS = ("igraph", "pynauty")
 _state = {"backend": os.environ.get("MECHSYN_GRAPH_BACKEND", "igraph")}
 
-__all__ = ["BACKENDS", "get_backend", "set_backend", "certificate", "generators", "orbits"]
+__all__ = ["BACKENDS", "get_backend", "set_backend", "preload", "certificate", "generators", "orbits"]
 
 
 def get_backend() -> str:
@@ -73,6 +73,13 @@ def _module(name: str):
         raise ImportError(f"the graph back end {name!r} needs `pip install {package}`") from None
 
 
+def preload() -> None:
+    """Import the back end in use now (before local worker processes are forked, which
+    then inherit it: igraph's import, with the Matplotlib it loads, costs each process
+    about a second)."""
+    _module(get_backend())
+
+
 def _colour_classes(n: int, colours: Sequence[int] | None) -> list[int]:
     """Colours as small integers 0..k-1 in order of first value (both back ends)."""
     if colours is None:
@@ -95,9 +102,11 @@ def _nauty_graph(n: int, edges, colours):
 
 
 def _igraph(n: int, edges):
+    """igraph's C graph (``GraphBase``: the Python ``Graph`` wrapper's set-up costs more
+    than bliss on these small graphs), loops left out."""
     ig = _module("igraph")
-    return ig.Graph(n=n, edges=edges if all(a != b for a, b in edges) else
-                    [(a, b) for a, b in edges if a != b])
+    return ig.GraphBase(n, edges if all(a != b for a, b in edges) else
+                        [(a, b) for a, b in edges if a != b])
 
 
 def certificate(n: int, edges: Sequence[tuple[int, int]],
@@ -108,11 +117,14 @@ def certificate(n: int, edges: Sequence[tuple[int, int]],
     col = _colour_classes(n, colours)
     if get_backend() == "pynauty":
         return _module("pynauty").certificate(_nauty_graph(n, edges, col))
-    g = _igraph(n, edges)
-    order = g.canonical_permutation(color=col if colours is not None else None)
+    simple = [(a, b) for a, b in edges if a != b]
+    order = _igraph(n, simple).canonical_permutation(color=col if colours is not None else None)
     # igraph's vector: the vertex that takes canonical label i is order[i]
-    canon = g.permute_vertices(order).get_edgelist()
-    flat = bytes(v for e in sorted(tuple(sorted(e)) for e in canon) for v in e)
+    label = [0] * n
+    for i, v in enumerate(order):
+        label[v] = i
+    flat = bytes(v for e in sorted((min(label[a], label[b]), max(label[a], label[b])) for a, b in simple)
+                 for v in e)
     labels = bytes(col[v] for v in order) if colours is not None else b""
     return bytes([n & 255, n >> 8, len(labels) > 0]) + labels + flat
 

@@ -613,69 +613,115 @@ def _unit_chains(
     return _graph_chains(n_links, mobility, assortment, include_degenerate, graphs)
 
 
-GRAPHS_PER_TASK = 4  # contracted graphs per parallel task
+#: Parallel tasks per worker (about): enough that the last tasks are short, so the two
+#: workers end together; few enough that sending tasks and results costs little.
+TASKS_PER_WORKER = 24
+
+
+def _graph_cost(cg: ContractedGraph | None, n_binary: int) -> int:
+    """The work of one contracted graph, about: its distributions of the binary links
+    (every one is masked; the chains kept grow with them); the single loop: 1."""
+    if cg is None:
+        return 1
+    from math import comb
+
+    ne = len(cg.edges)
+    return comb(n_binary + ne - 1, ne - 1) + 1
+
+
+def _split_tasks(units, graphs, workers: int) -> list[tuple[int, list]]:
+    """Each unit's contracted graphs cut into tasks of about equal work (in the graphs'
+    order, so a unit's chains are its tasks' chains in turn): ``(unit, graphs)`` pairs."""
+    costs = [[_graph_cost(cg, a.get(2, 0)) for cg in gs] for (_, a), gs in zip(units, graphs)]
+    target = max(1, sum(map(sum, costs)) // max(1, workers * TASKS_PER_WORKER))
+    out: list[tuple[int, list]] = []
+    for u, (gs, cs) in enumerate(zip(graphs, costs)):
+        part, load = [], 0
+        for cg, c in zip(gs, cs):
+            part.append(cg)
+            load += c
+            if load >= target:
+                out.append((u, part))
+                part, load = [], 0
+        if part:
+            out.append((u, part))
+    return out
 
 
 def _enumerate_units(
     n_links: int, mobility: int, include_degenerate: bool,
     units: Sequence[tuple[str, dict[int, int]]],
     unit_done: Callable[[str, list[KinematicChain]], None],
-    workers: int = 1, scheduler=None,
+    workers: int = 1, scheduler=None, progress: Callable[[float], None] | None = None,
 ) -> None:
-    """Chains of ``units``: ``unit_done(key, chains)`` for each unit, in the units' order.
+    """Chains of ``units``: ``unit_done(key, chains)`` for each unit, in the units' order;
+    ``progress(fraction)`` as the work goes (the fractions add up to one per unit).
 
-    In one process: unit after unit. With ``workers`` or ``scheduler``
-    (:func:`mechsyn.parallel.run_tasks`): the contracted graphs of all units in parallel,
-    then their chains in tasks of :data:`GRAPHS_PER_TASK` graphs; a unit is handed on as
-    soon as it and every unit before it are complete, so the chains and their order are
-    those of the single-process run.
+    In one process: unit after unit, ``progress(1)`` after each. With ``workers`` or
+    ``scheduler`` (:func:`mechsyn.parallel.run_tasks`): the contracted graphs of all units
+    in parallel, then their chains in tasks of about equal work (:func:`_split_tasks`),
+    the largest first, so that the workers end together; each finished task advances
+    ``progress`` by its share of its unit. A unit is handed on as soon as it and every
+    unit before it are complete, so the chains and their order are those of the
+    single-process run.
     """
+    tick = progress if progress is not None else (lambda fraction: None)
     if workers <= 1 and scheduler is None:
         for key, assortment in units:
             unit_done(key, _unit_chains(n_links, mobility, assortment, include_degenerate))
+            tick(1)
         return
     from mechsyn.parallel import run_tasks
 
     backend = canonical.get_backend()
+    if scheduler is None:
+        canonical.preload()  # forked local workers inherit the graph back end's import
     graphs = run_tasks(_unit_graphs, [(n_links, mobility, a, include_degenerate, backend)
                                       for _, a in units], workers=workers, scheduler=scheduler)
-    tasks, first = [], []
-    for (_, a), gs in zip(units, graphs):
-        first.append(len(tasks))
-        tasks.extend((n_links, mobility, a, include_degenerate, gs[k:k + GRAPHS_PER_TASK], backend)
-                     for k in range(0, len(gs), GRAPHS_PER_TASK))
-    first.append(len(tasks))
+    parts = _split_tasks(units, graphs, workers)
+    cost = [sum(_graph_cost(cg, units[u][1].get(2, 0)) for cg in gs) for u, gs in parts]
+    order = sorted(range(len(parts)), key=lambda t: -cost[t])  # largest first
+    share = [1 / sum(1 for v, _ in parts if v == u) for u, _ in parts]
+    pending = [sum(1 for v, _ in parts if v == u) for u in range(len(units))]
     found: dict[int, list[KinematicChain]] = {}
     flushed = [0]  # units handed on so far
 
-    def finished(done: int, total: int, index: int, chains: list[KinematicChain]) -> None:
-        found[index] = chains
-        while flushed[0] < len(units):
+    def flush() -> None:
+        while flushed[0] < len(units) and pending[flushed[0]] == 0:
             u = flushed[0]
-            if any(k not in found for k in range(first[u], first[u + 1])):
-                break
-            unit_done(units[u][0], [c for k in range(first[u], first[u + 1]) for c in found.pop(k)])
+            unit_done(units[u][0], [c for t, (v, _) in enumerate(parts) if v == u for c in found.pop(t)])
+            if not any(v == u for v, _ in parts):
+                tick(1)  # a unit without contracted graphs: done at once
             flushed[0] += 1
 
-    while flushed[0] < len(units) and first[flushed[0]] == first[flushed[0] + 1]:
-        unit_done(units[flushed[0]][0], [])  # leading units without graphs
-        flushed[0] += 1
-    run_tasks(_graph_chains, tasks, workers=workers, scheduler=scheduler, progress=finished)
+    def finished(done: int, total: int, index: int, chains: list[KinematicChain]) -> None:
+        t = order[index]
+        found[t] = chains
+        pending[parts[t][0]] -= 1
+        tick(share[t])
+        flush()
+
+    flush()
+    run_tasks(_graph_chains, [(n_links, mobility, units[parts[t][0]][1], include_degenerate, parts[t][1],
+                               backend) for t in order], workers=workers, scheduler=scheduler,
+              progress=finished)
 
 
 def synthesize_chains(
     n_links: int,
     mobility: int = 1,
     include_degenerate: bool = False,
-    progress: Callable[[int], None] | None = None,
+    progress: Callable[[float], None] | None = None,
     workers: int = 1,
     scheduler=None,
 ) -> list[KinematicChain]:
     """Topological synthesis: all non-isomorphic planar chains with ``n`` links.
 
     Non-degenerate chains only, unless ``include_degenerate`` (then flagged). Fractionated
-    chains and chains with non-planar graphs are included and flagged. ``progress`` is
-    called with 1 after each assortment. Chains are ordered by assortment, then by
+    chains and chains with non-planar graphs are included and flagged. ``progress(x)``
+    is called as the work goes, the ``x`` adding up to one per assortment (in one
+    process 1 after each; with workers each finished task's share, from wherever it
+    ran, :func:`n_units` in all). Chains are ordered by assortment, then by
     contracted graph. ``workers`` (local processes) or ``scheduler`` (a Dask cluster)
     share the work (:func:`mechsyn.parallel.run_tasks`); the chains are the same, in the
     same order.
@@ -689,13 +735,8 @@ def synthesize_chains(
     _check_request(n_links, mobility)
     chains: list[KinematicChain] = []
 
-    def unit_done(key: str, found: list[KinematicChain]) -> None:
-        chains.extend(found)
-        if progress is not None:
-            progress(1)
-
     _enumerate_units(n_links, mobility, include_degenerate, _units(n_links, mobility),
-                     unit_done, workers, scheduler)
+                     lambda key, found: chains.extend(found), workers, scheduler, progress)
     _check_distinct(chains)
     return chains
 
@@ -719,7 +760,7 @@ def synthesize_chains_to_file(
     n_links: int,
     mobility: int = 1,
     include_degenerate: bool = False,
-    progress: Callable[[int], None] | None = None,
+    progress: Callable[[float], None] | None = None,
     force: bool = False,
     workers: int = 1,
     scheduler=None,
@@ -766,11 +807,10 @@ def synthesize_chains_to_file(
             fh.write(json.dumps({"done": key}) + "\n")
             fh.flush()
             computed[key] = found
-            if progress is not None:
-                progress(1)
 
         _enumerate_units(n_links, mobility, include_degenerate,
-                         [(k, a) for k, a in units if k not in done], unit_done, workers, scheduler)
+                         [(k, a) for k, a in units if k not in done], unit_done, workers, scheduler,
+                         progress)
     chains = [c for key, _ in units for c in (done[key] if key in done else computed[key])]
     _check_distinct(chains)
     return chains
