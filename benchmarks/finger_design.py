@@ -17,7 +17,8 @@ import numpy as np
 from mechsyn.io import mechanism_from_dict
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.system import build_system
-from mechsyn.synthesis.finger_design import apply_design, design_finger, evaluate_locked, load_case
+from mechsyn.synthesis.finger.cases import load_case
+from mechsyn.synthesis.finger.design import apply_design, design_finger, evaluate_locked
 
 CASE = Path(__file__).resolve().parents[1] / "examples" / "fingers" / "finger_design_case.yaml"
 

@@ -1,4 +1,4 @@
-"""Paper 000's parametric steps 8-13 (issue 8 item 5): ``synthesis.finger_design``.
+"""Paper 000's parametric steps 8-13 (issue 8 item 5): ``synthesis.finger``.
 
 Small optimiser budgets keep these fast; the bundled case's targets come from a
 reference finger, so an exact solution exists and the tolerance below is meaningful.
@@ -19,9 +19,10 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism, mechanism_from_dict
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.system import build_system
-from mechsyn.synthesis.finger_design import (
-    INFEASIBLE, case_from_dict, design_finger, evaluate_locked, force_objective, load_case,
-    points_in_region, stage1_objective)
+from mechsyn.synthesis.finger.cases import case_from_dict, load_case
+from mechsyn.synthesis.finger.design import (
+    INFEASIBLE, design_finger, evaluate_locked, force_objective, stage1_objective)
+from mechsyn.synthesis.finger.vll import points_in_region
 
 EX = Path(__file__).resolve().parents[2] / "examples" / "fingers"
 CASE = EX / "finger_design_case.yaml"
@@ -263,3 +264,24 @@ def test_three_phalanx_every_vll_combination(tmp_path):
                 assert length == pytest.approx(case.vll_limits(jid)[0])
             else:
                 assert length > case.vll_limits(jid)[0] + 1.0           # drawn length, not the minimum
+
+
+def test_cli_json_is_the_result_to_dict(tmp_path, capsys):
+    """``synth finger-design --json`` prints the library result's ``to_dict()`` (the
+    run's seconds aside), with the common fields of a synthesis result."""
+    from mechsyn.results import to_jsonable
+
+    data = yaml.safe_load(CASE.read_text())
+    data["mechanism"] = str(EX / data["mechanism"])
+    data["optimizer"] = {"maxiter": 4, "popsize": 5, "force_maxiter": 1, "vll_steps": 3, "candidates": 1}
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["synth", "finger-design", str(path), "--seed", "4", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    res = design_finger(load_case(path), seed=4)
+    expected = json.loads(json.dumps(to_jsonable(res.to_dict())))
+    js.pop("seconds"), expected.pop("seconds")
+    assert js == expected
+    assert js["design"] == js["best"]["design"] and js["x"] == list(js["design"].values())
+    assert js["error"] == js["best"]["error_rms_deg"] and js["seed"] == 4 and js["nfev"] > 0
+    assert js["feasible"] == (js["reason"] == "")
