@@ -285,3 +285,37 @@ def test_cli_json_is_the_result_to_dict(tmp_path, capsys):
     assert js["design"] == js["best"]["design"] and js["x"] == list(js["design"].values())
     assert js["error"] == js["best"]["error_rms_deg"] and js["seed"] == 4 and js["nfev"] > 0
     assert js["feasible"] == (js["reason"] == "")
+
+
+@pytest.mark.parametrize("name", ["finger_design_case.yaml", "finger_design_three_phalanx.yaml"])
+def test_population_evaluation_equals_one_design_evaluation(name):
+    """The compiled locked model (kinematics.batch, K designs at once) gives
+    evaluate_locked's answers: assembly, violation, target errors, paths (issue 14 §3)."""
+    from mechsyn.synthesis.finger.design import force_population, stage1_population
+    from mechsyn.synthesis.finger.population import locked_population
+
+    case = load_case(EX / name)
+    rng = np.random.default_rng(5)
+    lo, hi = np.array([v.bounds for v in case.variables]).T
+    X = lo + rng.random((40, len(lo))) * (hi - lo)
+    for combo in case.combinations:
+        pop = locked_population(case, combo)
+        assert pop is not None
+        ev = pop.evaluate(X)
+        kinds = set()
+        for k, x in enumerate(X):
+            one = evaluate_locked(case, x, combo)
+            kinds.add((one.q is not None, one.feasible))
+            assert bool(ev.feasible[k]) == one.feasible
+            assert ev.violation[k] == pytest.approx(one.violation, rel=1e-9, abs=1e-9)
+            if one.q is not None:
+                assert ev.error_rms[k] == pytest.approx(one.error_rms, rel=1e-9, abs=1e-9)
+                assert ev.error_max[k] == pytest.approx(one.error_max, rel=1e-9, abs=1e-9)
+                for p, P in one.paths.items():
+                    np.testing.assert_allclose(ev.paths[p][k], P, atol=1e-9)
+        assert len(kinds) >= 2          # the sample holds feasible and infeasible designs
+    combo = case.combinations[0]
+    f1, g1 = stage1_objective(case, combo), stage1_population(case, combo)
+    np.testing.assert_allclose(g1(X[:8]), [f1(x) for x in X[:8]], rtol=1e-9)
+    f2, g2 = force_objective(case, combo, 5.0), force_population(case, combo, 5.0)
+    np.testing.assert_allclose(g2(X[:8]), [f2(x) for x in X[:8]], rtol=1e-9)

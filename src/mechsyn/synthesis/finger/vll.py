@@ -7,13 +7,37 @@ A VLL is a P pair between a *cylinder* link (pivoted at ``K``) and a *piston* li
 
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["vll_ends", "locked_model", "points_in_region", "region_excess"]
+__all__ = ["vll_ends", "locked_model", "points_in_region", "region_excess", "copy_mechanism"]
+
+
+def copy_mechanism(d: dict) -> dict:
+    """A copy of a mechanism file dict for this package's edits, without a deep copy:
+    every link, joint, point and load entry is a new dict and joint points and point
+    coordinates are new lists; the other values are shared (the edits here replace them,
+    never change them in place).
+
+    Examples
+    --------
+    >>> d = {"links": ["f", {"name": "c", "mass": 1.0}], "joints": [{"id": "A", "point": [0, 0]}],
+    ...      "points": {"tip": {"link": "c", "at": [1, 2]}}}
+    >>> e = copy_mechanism(d)
+    >>> e["joints"][0]["point"][0] = 5.0; e["points"]["tip"]["at"][1] = 7.0; e["links"][1]["mass"] = 2.0
+    >>> d["joints"][0]["point"], d["points"]["tip"]["at"], d["links"][1]["mass"]
+    ([0, 0], [1, 2], 1.0)
+    """
+    out = dict(d)
+    out["links"] = [dict(e) if isinstance(e, dict) else e for e in d["links"]]
+    out["joints"] = [dict(j, point=list(j["point"])) if j.get("point") is not None else dict(j)
+                     for j in d["joints"]]
+    if d.get("points"):
+        out["points"] = {k: dict(p, at=list(p["at"])) for k, p in d["points"].items()}
+    if d.get("loads"):
+        out["loads"] = [dict(ld) for ld in d["loads"]]
+    return out
 
 
 def vll_ends(md: dict, jid: str, src: str = "<case>") -> tuple[str, str, str, str]:
@@ -43,7 +67,7 @@ def locked_model(d: dict, vlls: list[str], source: str = "<case>") -> dict:
     """The fully actuated model: each locked VLL's cylinder and piston merged into one
     rigid binary link (mass summed, centre of mass mass-weighted; inertia summed about
     the combined centre, parallel-axis theorem)."""
-    d = copy.deepcopy(d)
+    d = copy_mechanism(d)
     for jid in vlls:
         cyl, L, K, pis = vll_ends(d, jid, source)
         pts = {j["id"]: np.asarray(j["point"], float) for j in d["joints"]}
