@@ -640,6 +640,7 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     >>> res.best_variant.error_rms < 1.0       # degrees, on the case's target positions
     True
     """
+    import scipy.linalg  # noqa: F401 - SciPy's own BLAS: loaded before the limit, which applies to loaded ones
     from threadpoolctl import threadpool_limits
 
     # every linear solve of the search is of a few tens of unknowns: BLAS threads only cost
