@@ -182,7 +182,20 @@ def stage1_objective(case: FingerCase, combo: tuple[str, ...]) -> Objective:
 def stage1_population(case: FingerCase, combo: tuple[str, ...]) -> Callable[[np.ndarray], np.ndarray]:
     """:func:`stage1_objective` of a population ``X`` (K, n) at once: through the
     compiled locked model (:mod:`~mechsyn.synthesis.finger.population`) where the case
-    allows it, else design by design."""
+    allows it, else design by design.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.finger.cases import load_case
+    >>> case = load_case(ms.examples.path("finger_design_case"))
+    >>> f = stage1_population(case, ("S",))
+    >>> X = np.array([[14.0, 6.0, 8.0, 48.0, 123.69006753], [20.0, 12.0, 3.0, 42.0, 150.0]])
+    >>> values = f(X)                      # RMS error (deg); INFEASIBLE + violation
+    >>> bool(values[0] < 0.01), bool(values[1] >= INFEASIBLE)
+    (True, True)
+    """
     from mechsyn.synthesis.finger.population import locked_population
 
     pop = locked_population(case, combo)

@@ -123,7 +123,32 @@ class LockedPopulation:
 
 def locked_population(case: Any, combo: tuple[str, ...]) -> LockedPopulation | None:
     """The compiled locked model of ``case`` for the VLL combination ``combo`` (empty:
-    every VLL at its minimum), or None when the case needs the one-design path."""
+    every VLL at its minimum), or None when the case needs the one-design path.
+
+    Parameters
+    ----------
+    case : FingerCase
+        From :func:`mechsyn.synthesis.finger.cases.load_case`.
+    combo : tuple of str
+        The VLL held at their minimum constructible length.
+
+    Returns
+    -------
+    LockedPopulation or None
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.finger.cases import load_case
+    >>> case = load_case(ms.examples.path("finger_design_case"))
+    >>> pop = locked_population(case, ("S",))
+    >>> X = np.array([[14.0, 6.0, 8.0, 48.0, 123.69006753],   # the reference finger
+    ...               [20.0, 12.0, 3.0, 42.0, 150.0]])        # does not assemble
+    >>> ev = pop.evaluate(X)
+    >>> ev.feasible.tolist(), bool(ev.error_rms[0] < 0.01), bool(ev.violation[1] > 0)
+    ([True, False], True, True)
+    """
     from mechsyn.io import mechanism_from_dict
     from mechsyn.kinematics.batch import compile_plan
     from mechsyn.synthesis.finger.design import apply_design
