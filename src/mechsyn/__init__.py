@@ -50,8 +50,8 @@ _LAZY: dict[str, str] = {
     "capability_map": "mechsyn.capability.maps", "CapabilityMap": "mechsyn.capability.maps",
     "capability_at": "mechsyn.capability.point", "PointCapability": "mechsyn.capability.point",
     # synthesis
-    "synthesize_chains": "mechsyn.synthesis.chains", "synthesize_fingers": "mechsyn.synthesis.finger",
-    "design_finger": "mechsyn.synthesis.finger_design", "synthesize_path": "mechsyn.synthesis.optimize",
+    "synthesize_chains": "mechsyn.synthesis.chains", "synthesize_fingers": "mechsyn.synthesis.finger.candidates",
+    "design_finger": "mechsyn.synthesis.finger.design", "synthesize_path": "mechsyn.synthesis.optimize",
     "synthesize_mechanism": "mechsyn.synthesis.general", "motion_synthesis": "mechsyn.synthesis.exact",
     # paper 001's belt manipulator
     "BeltDesign": "mechsyn.belt.design", "synthesize_belt": "mechsyn.belt.synthesis",

@@ -80,7 +80,8 @@ def test_mechanism_search_interrupted_by_callback_returns_best_so_far():
 
 
 def test_finger_design_interrupted_keeps_stage1_best():
-    from mechsyn.synthesis.finger_design import design_finger, load_case
+    from mechsyn.synthesis.finger.cases import load_case
+    from mechsyn.synthesis.finger.design import design_finger
 
     case = load_case(FINGER_CASE)
     case.maxiter, case.popsize, case.force_maxiter = 200, 8, 4

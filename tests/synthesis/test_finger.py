@@ -11,7 +11,7 @@ from mechsyn.cli.main import main
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 from mechsyn.synthesis.chains import rigid_subchain
-from mechsyn.synthesis.finger import synthesize_fingers
+from mechsyn.synthesis.finger.candidates import synthesize_fingers
 
 EX = Path(__file__).resolve().parents[2] / "examples" / "fingers"
 
@@ -109,3 +109,21 @@ def test_three_phalanx_two_separate_groups():
     for r in s.results:
         assert len(r.groups) == 2 and r.mobility_locked == 1
         assert sum(3 * n - 2 * p for n, p in r.groups) == -2
+
+
+def test_finger_cli_json_is_the_result_to_dict(cli_json):
+    """``synth finger --json`` prints the library result's ``to_dict()``, nothing added."""
+    from mechsyn.results import to_jsonable
+
+    base = EX / "two_phalanx_base_000.yaml"
+    js = cli_json("synth", "finger", base, "--max-links", "3")
+    expected = synthesize_fingers(load_mechanism(base), 1, 3).to_dict()
+    assert js == json.loads(json.dumps(to_jsonable(expected)))
+    assert js["results"] and {"W0", "W_f", "m_0", "groups", "results", "notes"} <= set(js)
+
+
+def test_finger_cli_plain_output_at_80_columns(run_cli, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "80")
+    code, out, err = run_cli("synth", "finger", EX / "two_phalanx_base_000.yaml", "--max-links", "3")
+    assert code == 0, err
+    assert "W0 = 2" in out and "distinct fingers" in out

@@ -1,4 +1,4 @@
-"""Paper 000's parametric steps 8-13 (issue 8 item 5): ``synthesis.finger_design``.
+"""Paper 000's parametric steps 8-13 (issue 8 item 5): ``synthesis.finger``.
 
 Small optimiser budgets keep these fast; the bundled case's targets come from a
 reference finger, so an exact solution exists and the tolerance below is meaningful.
@@ -19,9 +19,10 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism, mechanism_from_dict
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.system import build_system
-from mechsyn.synthesis.finger_design import (
-    INFEASIBLE, case_from_dict, design_finger, evaluate_locked, force_objective, load_case,
-    points_in_region, stage1_objective)
+from mechsyn.synthesis.finger.cases import case_from_dict, load_case
+from mechsyn.synthesis.finger.design import (
+    INFEASIBLE, design_finger, evaluate_locked, force_objective, stage1_objective)
+from mechsyn.synthesis.finger.vll import points_in_region
 
 EX = Path(__file__).resolve().parents[2] / "examples" / "fingers"
 CASE = EX / "finger_design_case.yaml"
@@ -263,3 +264,58 @@ def test_three_phalanx_every_vll_combination(tmp_path):
                 assert length == pytest.approx(case.vll_limits(jid)[0])
             else:
                 assert length > case.vll_limits(jid)[0] + 1.0           # drawn length, not the minimum
+
+
+def test_cli_json_is_the_result_to_dict(tmp_path, capsys):
+    """``synth finger-design --json`` prints the library result's ``to_dict()`` (the
+    run's seconds aside), with the common fields of a synthesis result."""
+    from mechsyn.results import to_jsonable
+
+    data = yaml.safe_load(CASE.read_text())
+    data["mechanism"] = str(EX / data["mechanism"])
+    data["optimizer"] = {"maxiter": 4, "popsize": 5, "force_maxiter": 1, "vll_steps": 3, "candidates": 1}
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["synth", "finger-design", str(path), "--seed", "4", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    res = design_finger(load_case(path), seed=4)
+    expected = json.loads(json.dumps(to_jsonable(res.to_dict())))
+    js.pop("seconds"), expected.pop("seconds")
+    assert js == expected
+    assert js["design"] == js["best"]["design"] and js["x"] == list(js["design"].values())
+    assert js["error"] == js["best"]["error_rms_deg"] and js["seed"] == 4 and js["nfev"] > 0
+    assert js["feasible"] == (js["reason"] == "")
+
+
+@pytest.mark.parametrize("name", ["finger_design_case.yaml", "finger_design_three_phalanx.yaml"])
+def test_population_evaluation_equals_one_design_evaluation(name):
+    """The compiled locked model (kinematics.batch, K designs at once) gives
+    evaluate_locked's answers: assembly, violation, target errors, paths (issue 14 §3)."""
+    from mechsyn.synthesis.finger.design import force_population, stage1_population
+    from mechsyn.synthesis.finger.population import locked_population
+
+    case = load_case(EX / name)
+    rng = np.random.default_rng(5)
+    lo, hi = np.array([v.bounds for v in case.variables]).T
+    X = lo + rng.random((40, len(lo))) * (hi - lo)
+    for combo in case.combinations:
+        pop = locked_population(case, combo)
+        assert pop is not None
+        ev = pop.evaluate(X)
+        kinds = set()
+        for k, x in enumerate(X):
+            one = evaluate_locked(case, x, combo)
+            kinds.add((one.q is not None, one.feasible))
+            assert bool(ev.feasible[k]) == one.feasible
+            assert ev.violation[k] == pytest.approx(one.violation, rel=1e-9, abs=1e-9)
+            if one.q is not None:
+                assert ev.error_rms[k] == pytest.approx(one.error_rms, rel=1e-9, abs=1e-9)
+                assert ev.error_max[k] == pytest.approx(one.error_max, rel=1e-9, abs=1e-9)
+                for p, P in one.paths.items():
+                    np.testing.assert_allclose(ev.paths[p][k], P, atol=1e-9)
+        assert len(kinds) >= 2          # the sample holds feasible and infeasible designs
+    combo = case.combinations[0]
+    f1, g1 = stage1_objective(case, combo), stage1_population(case, combo)
+    np.testing.assert_allclose(g1(X[:8]), [f1(x) for x in X[:8]], rtol=1e-9)
+    f2, g2 = force_objective(case, combo, 5.0), force_population(case, combo, 5.0)
+    np.testing.assert_allclose(g2(X[:8]), [f2(x) for x in X[:8]], rtol=1e-9)

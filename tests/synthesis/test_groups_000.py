@@ -3,7 +3,7 @@
 import pytest
 
 from conftest import EXAMPLES
-from mechsyn.synthesis.groups import group_table
+from mechsyn.synthesis.finger.groups import group_table
 
 
 def test_two_phalanx_table(cli_json):

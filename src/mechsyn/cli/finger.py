@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import typer
-from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import console, emit_json
+from mechsyn.cli.common import Table, console, emit_json  # Table: cells fold, numbers never cut
 
 
 @synth_app.command("finger")
@@ -25,31 +24,41 @@ def finger(
 ) -> None:
     """Attach a group of links to the finger's free leashes so that it is fully actuated
     with its variable-length links (VLL) locked; list VLL candidates (paper 000)."""
-    from mechsyn.io import load_mechanism, mechanism_to_dict, write_mechanism
-    from mechsyn.synthesis.finger import synthesize_fingers
+    from mechsyn.io import load_mechanism
+    from mechsyn.synthesis.finger.candidates import synthesize_fingers
 
     mech = load_mechanism(base)
     synth = synthesize_fingers(mech, actuators, max_links, separate=separate)
-    files = []
     if out is not None:
-        from dataclasses import replace
-
-        from mechsyn.cli.common import save_plot
-        from mechsyn.plot.finger import plot_fingers
-
-        new = []
-        for r in synth.results:
-            path = out / f"finger_{r.number:03d}_nf{r.n_f}.yaml"
-            write_mechanism(r.mechanism, path)
-            new.append(replace(r, file=str(path)))
-            files.append(path)
-        synth.results[:] = new
-        save_plot(out / "fingers.png", plot_fingers, synth.results[:39], mechanism_to_dict(mech),
-                  f"{mech.name}: W0 = {synth.W0}, A = {actuators}")
+        synth = _write_files(synth, mech, out)
     if json_out:
         emit_json(synth)
         return
-    console.print(f"[bold]{synth.base_name}[/]: W0 = {synth.W0}, A = {actuators}, "
+    _render(synth)
+    if out is not None:
+        console.print(f"{len(synth.results)} mechanism files and fingers.png written to {out}/")
+
+
+def _write_files(synth: Any, mech: Any, out: Path) -> Any:
+    """One mechanism file per finger and their drawing in ``out``; the results with their files."""
+    from dataclasses import replace
+
+    from mechsyn.cli.common import save_plot
+    from mechsyn.io import mechanism_to_dict, write_mechanism
+    from mechsyn.plot.finger import plot_fingers
+
+    new = []
+    for r in synth.results:
+        path = out / f"finger_{r.number:03d}_nf{r.n_f}.yaml"
+        write_mechanism(r.mechanism, path)
+        new.append(replace(r, file=str(path)))
+    save_plot(out / "fingers.png", plot_fingers, new[:39], mechanism_to_dict(mech),
+              f"{mech.name}: W0 = {synth.W0}, A = {synth.actuators}")
+    return replace(synth, results=new)
+
+
+def _render(synth: Any) -> None:
+    console.print(f"[bold]{synth.base_name}[/]: W0 = {synth.W0}, A = {synth.actuators}, "
                   f"W_f = -(W0 - A) = {synth.W_f}, m_0 = 2(W0 - 1) = {synth.m_0}", highlight=False)
     console.print(f"base structure: {synth.base_formula}", highlight=False)
     console.print("admissible groups: " + ", ".join(
@@ -67,5 +76,3 @@ def finger(
     console.print(t)
     for note in synth.notes:
         console.print(f"note: {note}", highlight=False)
-    if out is not None:
-        console.print(f"{len(files)} mechanism files and fingers.png written to {out}/")

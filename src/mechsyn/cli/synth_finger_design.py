@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import typer
 from rich.markup import escape
@@ -26,7 +26,8 @@ def finger_design(
     """Optimise a finger's link lengths on discrete positions with its VLL locked, find
     each VLL's length range keeping the paths in the working region, minimise joint
     reactions and input moment in both modes; best VLL combination (paper 000, steps 8-13)."""
-    from mechsyn.synthesis.finger_design import design_finger, load_case
+    from mechsyn.synthesis.finger.cases import load_case
+    from mechsyn.synthesis.finger.design import design_finger
 
     if time_limit <= 0:
         raise MechsynInputError("--time-limit must be positive", source="--time-limit")
@@ -39,12 +40,21 @@ def finger_design(
         with err_console.status("finger design") as status:
             res = design_finger(case, seed=seed, time_limit=time_limit,
                                 progress=lambda msg: status.update(escape(msg)))
-    best = res.best_variant
+    _write(case, res, out, plot)
+    if json_out:
+        emit_json(res)
+    else:
+        _render(case_file.name, res, time_limit, out, plot)
+    stop_if_interrupted(res)
+
+
+def _write(case: Any, res: Any, out: Optional[Path], plot: Optional[Path]) -> None:
+    """The best design as a mechanism file (``--out``) and the three-panel plot (``--plot``)."""
     if out is not None:
         from mechsyn.io import write_mechanism
 
-        mech = dict(best.mechanism)
-        mech["name"] = (f"{mech.get('name', 'finger')} (finger-design, seed {seed}"
+        mech = dict(res.best_variant.mechanism)
+        mech["name"] = (f"{mech.get('name', 'finger')} (finger-design, seed {res.seed}"
                         + (", interrupted: best so far)" if res.interrupted else ")"))
         write_mechanism(mech, out)
     if plot is not None:
@@ -52,18 +62,15 @@ def finger_design(
         from mechsyn.plot.finger import plot_finger_design
 
         save_plot(plot, plot_finger_design, case, res)
-    if json_out:
-        emit_json(res)
-        stop_if_interrupted(res)
-        return
-    t = Table(title=f"Finger design: {case_file.name} (seed {seed}, {res.seconds:.1f} s"
+
+
+def _render(name: str, res: Any, time_limit: float, out: Optional[Path], plot: Optional[Path]) -> None:
+    best = res.best_variant
+    t = Table(title=f"Finger design: {name} (seed {res.seed}, {res.seconds:.1f} s"
               + (", interrupted: best so far)" if res.interrupted else ")"))
-    t.add_column("VLL")
-    t.add_column("stage-1 RMS err (deg)")
-    t.add_column("final RMS / max err (deg)")
-    t.add_column("VLL range")
-    t.add_column("peak |R| (joint) stage 1 -> final")
-    t.add_column("peak |M_in| stage 1 -> final")
+    for col in ("VLL", "stage-1 RMS err (deg)", "final RMS / max err (deg)", "VLL range",
+                "peak |R| (joint) stage 1 -> final", "peak |M_in| stage 1 -> final"):
+        t.add_column(col)
     for k, v in enumerate(res.variants):
         fa = v.forces
         t.add_row(("* " if k == res.best else "") + "+".join(v.combination), f"{v.stage1_error_rms:.4g}",
@@ -74,12 +81,26 @@ def finger_design(
                   f"{v.stage1_forces['peak_input_moment']:.4g} -> {fa['peak_input_moment']:.4g}")
     console.print(t)
     d = Table(title="Best design (drawn, open configuration)")
-    d.add_column("variable")
-    d.add_column("stage 1")
-    d.add_column("final")
-    for name, val in best.design.items():
-        d.add_row(name, f"{best.stage1_design[name]:.5g}", f"{val:.5g}")
+    for col in ("variable", "stage 1", "final"):
+        d.add_column(col)
+    for var, val in best.design.items():
+        d.add_row(var, f"{best.stage1_design[var]:.5g}", f"{val:.5g}")
     console.print(d)
+    _render_targets(res)
+    if not best.force_stage_improved:
+        console.print("force stage: no design found with lower reactions and input moment at the same accuracy; "
+                      "the stage-1 design is kept", highlight=False)
+    for note in res.notes:
+        console.print(f"note: {note}", highlight=False)
+    if res.stopped_by_time_limit:
+        console.print(f"note: stopped by the time limit ({time_limit:g} s)", highlight=False)
+    for path, what in ((out, "mechanism file"), (plot, "plot")):
+        if path is not None:
+            console.print(f"{what} written to {path}", highlight=False)
+
+
+def _render_targets(res: Any) -> None:
+    best = res.best_variant
     tg = Table(title="Targets: phalanx rotation (deg) at crank rotation (deg)")
     tg.add_column("crank")
     for link in best.achieved:
@@ -91,14 +112,3 @@ def finger_design(
             row += [f"{res.targets['rotations'][link][k]:.4g}", f"{ach[k]:.4g}"]
         tg.add_row(*row)
     console.print(tg)
-    if not best.force_stage_improved:
-        console.print("force stage: no design found with lower reactions and input moment at the same accuracy; "
-                      "the stage-1 design is kept", highlight=False)
-    for note in res.notes:
-        console.print(f"note: {note}", highlight=False)
-    if res.stopped_by_time_limit:
-        console.print(f"note: stopped by the time limit ({time_limit:g} s)", highlight=False)
-    for path, what in ((out, "mechanism file"), (plot, "plot")):
-        if path is not None:
-            console.print(f"{what} written to {path}", highlight=False)
-    stop_if_interrupted(res)

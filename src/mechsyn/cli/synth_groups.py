@@ -13,7 +13,7 @@ from mechsyn.cli.common import console, emit_json
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 from mechsyn.structure.analysis import analyze_structure
-from mechsyn.synthesis.groups import group_table
+from mechsyn.synthesis.finger.groups import group_table
 
 
 @synth_app.command("groups")

@@ -281,6 +281,8 @@ class PlanarSystem:
     # -- equations -----------------------------------------------------------------
     def residual(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
         """``Phi(q, u)``, shape (N, m); ``u`` has shape (N, n_inputs)."""
+        if q.shape[0] == 1 and (one := _one(self)) is not None:  # Newton's one configuration
+            return one.residual(q[0], u[0])[None]
         out = np.empty((q.shape[0], self.m))
         row = 0
         for con in self.cons:
@@ -290,6 +292,8 @@ class PlanarSystem:
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """``Phi_q``, shape (N, m, n)."""
+        if q.shape[0] == 1 and (one := _one(self)) is not None:
+            return one.jacobian(q[0])[None]
         J = np.zeros((q.shape[0], self.m, self.n))
         row = 0
         for con in self.cons:
@@ -325,6 +329,12 @@ class PlanarSystem:
                 rows.extend(range(row, row + con.rows))
             row += con.rows
         return rows
+
+
+def _one(S: PlanarSystem) -> Any:
+    from mechsyn.kinematics.compiled import one_configuration
+
+    return one_configuration(S)
 
 
 def _axis(j: Joint) -> np.ndarray:

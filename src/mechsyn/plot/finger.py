@@ -108,7 +108,7 @@ def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
     Figure."""
     from matplotlib import cm
 
-    from mechsyn.synthesis.finger_design import apply_design, evaluate_drawn, redraw
+    from mechsyn.synthesis.finger.design import apply_design, evaluate_drawn, redraw
 
     v = result.best_variant
     combo = v.combination

@@ -287,9 +287,9 @@ def start_vector(case: MechanismCase) -> np.ndarray:
         elif v.kind == "point":
             x.append(float(md["points"][v.target]["at"][v.coord]))
         else:
-            from mechsyn.synthesis.finger_design import _vll_ends
+            from mechsyn.synthesis.finger.vll import vll_ends
 
-            _c, _L, K, _p = _vll_ends(md, v.target, case.source)
+            _c, _L, K, _p = vll_ends(md, v.target, case.source)
             x.append(float(np.linalg.norm(np.subtract(joints[v.target]["point"], joints[K]["point"]))))
     if case.free:
         x += list(case.values_deg)
@@ -299,7 +299,7 @@ def start_vector(case: MechanismCase) -> np.ndarray:
 def apply_design(case: MechanismCase, x: np.ndarray) -> dict:
     """The mechanism dict of design vector ``x`` (design part; timing values ignored).
     A VLL's length moves its piston pivot along the cylinder's direction (paper 000's
-    drawing, as in :func:`mechsyn.synthesis.finger_design.apply_design`)."""
+    drawing, as in :func:`mechsyn.synthesis.finger.design.apply_design`)."""
     d = copy.deepcopy(case.mech_dict)
     joints = {j["id"]: j for j in d["joints"]}
     for v, val in zip(case.variables, np.asarray(x, float)):
@@ -309,9 +309,9 @@ def apply_design(case: MechanismCase, x: np.ndarray) -> dict:
             d["points"][v.target]["at"][v.coord] = float(val)
     for v, val in zip(case.variables, np.asarray(x, float)):
         if v.kind == "length":
-            from mechsyn.synthesis.finger_design import _vll_ends
+            from mechsyn.synthesis.finger.vll import vll_ends
 
-            _c, L, K, _p = _vll_ends(d, v.target, case.source)
+            _c, L, K, _p = vll_ends(d, v.target, case.source)
             pk = np.asarray(joints[K]["point"], float)
             u = np.asarray(joints[v.target]["point"], float) - pk
             u = u / np.linalg.norm(u)
@@ -360,7 +360,7 @@ def _build(case: MechanismCase, x: np.ndarray) -> tuple[Any, Any, Any, dict]:
     d = apply_design(case, x)
     ev_d = d
     if any(j.get("vll") == "locked" for j in d["joints"]):
-        from mechsyn.synthesis.finger_design import locked_model
+        from mechsyn.synthesis.finger.vll import locked_model
 
         ev_d = locked_model(d, [j["id"] for j in d["joints"] if j.get("vll") == "locked"], case.source)
     mech = mechanism_from_dict(ev_d, source=case.source)

@@ -3,7 +3,7 @@
 Steps (spec ``structural.md`` section 4, paper 000 steps 1-7):
 
 1. ``W0 = 3 n - 2 P5 - P4`` of the base; the group has ``W_f = -(W0 - A)``; the admissible
-   ``(n_f, P_f, m_f)`` are :func:`mechsyn.synthesis.groups.group_table`'s rows that meet
+   ``(n_f, P_f, m_f)`` are :func:`mechsyn.synthesis.finger.groups.group_table`'s rows that meet
    the conditions ``P_f >= 2 (W0 - 1) + (n_f - 1)`` and ``m_f >= m_0``.
 2. The base is split into Assur groups (:func:`mechsyn.structure.assur.assur_decomposition`);
    its *leash sites* are the binary links that are neither input (actuated), output nor
@@ -40,7 +40,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.structure.assur import assur_decomposition
 from mechsyn.synthesis import canonical
 from mechsyn.synthesis.chains import rigid_subchain
-from mechsyn.synthesis.groups import group_table
+from mechsyn.synthesis.finger.groups import group_table
 from mechsyn.synthesis.mechanisms import instantaneous_mobility
 
 __all__ = ["FingerResult", "FingerSynthesis", "synthesize_fingers"]
@@ -48,6 +48,8 @@ __all__ = ["FingerResult", "FingerSynthesis", "synthesize_fingers"]
 
 @dataclass(frozen=True)
 class VLLCombination:
+    """VLL freed together and the finger's mobility with them free (underactuated)."""
+
     links: tuple[str, ...]
     underactuated_mobility: int
     expression: str
@@ -77,6 +79,8 @@ class FingerResult:
 
 @dataclass(frozen=True)
 class FingerSynthesis:
+    """Every distinct finger of :func:`synthesize_fingers`, with the base's figures."""
+
     base_name: str
     W0: int
     actuators: int
@@ -87,6 +91,14 @@ class FingerSynthesis:
     groups: list  # the admissible (n_f, P_f, m_f) rows
     results: list[FingerResult]
     notes: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict:
+        """The synthesis as JSON-ready data (``mechsyn synth finger --json``)."""
+        from dataclasses import asdict
+
+        out = asdict(self)
+        out["groups"] = [asdict(r) for r in self.groups]
+        return out
 
 
 def _trees(n: int) -> list[list[tuple[int, int]]]:
@@ -128,8 +140,23 @@ def synthesize_fingers(
     """Every distinct way to make the finger ``mech`` fully actuated by ``actuators`` drives
     by attaching one group of links to its free leashes (paper 000), with VLL candidates.
 
-    ``separate``: attach ``W0 - A`` groups of ``W_f = -1`` each instead (``max_links``
-    then bounds their total number of links).
+    Parameters
+    ----------
+    mech : Mechanism
+        The base finger: planar, lower pairs only, mobility ``W0 > actuators``.
+    actuators : int
+        Drives ``A``.
+    max_links : int
+        Largest group ``n_f``.
+    max_results : int
+        Stop after this many distinct fingers (a note says so).
+    separate : bool
+        Attach ``W0 - A`` groups of ``W_f = -1`` each instead (``max_links`` then bounds
+        their total number of links).
+
+    Returns
+    -------
+    FingerSynthesis
 
     Examples
     --------
@@ -153,6 +180,51 @@ def synthesize_fingers(
             field="actuators")
     table = group_table(w0, actuators, max_links)
     rows = [r for r in table.rows if r.meets_conditions]
+    sites = _leash_sites(mech, dec)
+    notes = [f"leash sites (one new pair each): {', '.join(sites) or 'none'}; "
+             f"the frame {mech.ground} takes the group's other leashes",
+             "one group attached (--separate: W0 - A groups of W_f = -1)"]
+    if len(sites) < table.m_0:
+        notes.append(f"the base offers {len(sites)} leash site(s), fewer than m_0 = {table.m_0}")
+    plans: list[tuple] = [(row,) for row in rows]
+    if separate and w0 - actuators >= 2:
+        unit = list(group_table(actuators + 1, actuators, max_links).rows)
+        plans = [plan for plan in itertools.combinations_with_replacement(unit, w0 - actuators)
+                 if sum(r.n_f for r in plan) <= max_links]
+        notes[1] = f"{w0 - actuators} separate groups of W_f = -1 attached"
+    base = mechanism_to_dict(mech)
+    actuated_links = {x for j in mech.joints if j.actuated for x in j.links} - {mech.ground}
+    colours = [{mech.ground}, actuated_links, set(dec.output_links) - actuated_links]
+    seen: dict[bytes, FingerResult | None] = {}
+    results: list[FingerResult] = []
+    for plan in plans:
+        for names, tree_edges, ext, deg in _attachments(mech, plan, sites):
+            all_names = list(mech.link_names) + names
+            edges = [tuple(j.links) for j in mech.joints] + tree_edges + ext
+            cert = _certificate(all_names, edges, colours)
+            if cert in seen:
+                continue
+            idx = {n: i for i, n in enumerate(all_names)}
+            seen[cert] = None
+            if rigid_subchain([(idx[a], idx[b]) for a, b in edges], len(all_names)):
+                continue
+            result = _build(mech, base, names, tree_edges, ext, plan, deg, actuators, len(results) + 1, cert)
+            seen[cert] = result
+            if result is not None:
+                results.append(result)
+                if len(results) >= max_results:
+                    notes.append(f"stopped after {max_results} results")
+                    break
+        else:
+            continue
+        break
+    return FingerSynthesis(mech.name, w0, actuators, table.W_f, table.m_0, tuple(sites),
+                           dec.structural_formula, rows, results, tuple(notes))
+
+
+def _leash_sites(mech, dec) -> list[str]:
+    """Binary links that take one new pair each: the decomposition's leash candidates,
+    plus imaginary input links with a single pair (e.g. a distal phalanx)."""
     degree = {n: 0 for n in mech.link_names}
     for j in mech.joints:
         for x in j.links:
@@ -161,77 +233,47 @@ def synthesize_fingers(
     for link in dec.imaginary_input_links:
         if link not in sites and degree[link] <= 2:
             sites.append(link)
-    notes = [f"leash sites (one new pair each): {', '.join(sites) or 'none'}; "
-             f"the frame {mech.ground} takes the group's other leashes",
-             "one group attached (--separate: W0 - A groups of W_f = -1)"]
-    if len(sites) < table.m_0:
-        notes.append(f"the base offers {len(sites)} leash site(s), fewer than m_0 = {table.m_0}")
-    base = mechanism_to_dict(mech)
-    base_edges = [tuple(j.links) for j in mech.joints]
-    actuated_links = {x for j in mech.joints if j.actuated for x in j.links} - {mech.ground}
-    outputs = set(dec.output_links)
-    plans: list[tuple] = [(row,) for row in rows]
-    if separate and w0 - actuators >= 2:
-        unit = [r for r in group_table(actuators + 1, actuators, max_links).rows]
-        plans = [plan for plan in itertools.combinations_with_replacement(unit, w0 - actuators)
-                 if sum(r.n_f for r in plan) <= max_links]
-        notes[1] = f"{w0 - actuators} separate groups of W_f = -1 attached"
-    seen: dict[bytes, FingerResult | None] = {}
-    results: list[FingerResult] = []
-    for plan in plans:
-        sizes = [r.n_f for r in plan]
-        leashes = [r.m_f for r in plan]
-        n_f, P_f, m_f = sum(sizes), sum(r.P_f for r in plan), sum(leashes)
-        names = [f"g{i + 1}" for i in range(n_f)]
-        starts = list(itertools.accumulate([0] + sizes))
-        component = [c for c, n in enumerate(sizes) for _ in range(n)]
-        k = min(m_f, len(sites))
-        forests = [sum(([(names[starts[c] + a], names[starts[c] + b]) for a, b in t]
-                        for c, t in enumerate(trees)), [])
-                   for trees in itertools.product(*[_trees(n) for n in sizes])]
-        for used in itertools.combinations(sites, k):
-            targets = list(used) + [mech.ground] * (m_f - k)
-            for tree_edges in forests:
-                for assign in itertools.product(range(n_f), repeat=m_f):
-                    if len(plan) > 1 and any(
-                            sum(component[g] == c for g in assign) != leashes[c]
-                            for c in range(len(plan))):
-                        continue  # each group keeps its own number of leashes
-                    ext = [(targets[t], names[g]) for t, g in enumerate(assign)]
-                    edges = base_edges + tree_edges + ext
-                    if len({frozenset(e) for e in edges}) < len(edges):
-                        continue  # two pairs between the same links
-                    deg = dict(degree)
-                    for g in names:
-                        deg[g] = 0
-                    for a, b in tree_edges + ext:
-                        deg[a] += 1
-                        deg[b] += 1
-                    if any(deg[g] < 2 for g in names) or any(
-                            deg[x] < 2 for x in mech.link_names if x != mech.ground):
-                        continue
-                    all_names = list(mech.link_names) + names
-                    cert = _certificate(all_names, edges,
-                                        [{mech.ground}, actuated_links, outputs - actuated_links])
-                    if cert in seen:
-                        continue
-                    idx = {n: i for i, n in enumerate(all_names)}
-                    if rigid_subchain([(idx[a], idx[b]) for a, b in edges], len(all_names)):
-                        seen[cert] = None
-                        continue
-                    result = _build(mech, base, names, tree_edges, ext, plan, deg,
-                                    actuators, len(results) + 1, cert)
-                    seen[cert] = result
-                    if result is not None:
-                        results.append(result)
-                        if len(results) >= max_results:
-                            notes.append(f"stopped after {max_results} results")
-                            return FingerSynthesis(mech.name, w0, actuators, table.W_f,
-                                                   table.m_0, tuple(sites),
-                                                   dec.structural_formula, rows, results,
-                                                   tuple(notes))
-    return FingerSynthesis(mech.name, w0, actuators, table.W_f, table.m_0, tuple(sites),
-                           dec.structural_formula, rows, results, tuple(notes))
+    return sites
+
+
+def _attachments(mech, plan: tuple, sites: list[str]):
+    """Every attachment of the plan's groups (trees of their links, leashes to the sites
+    and the frame) with no double pair and every link at least binary:
+    ``(group link names, tree pairs, leash pairs, link degrees)``."""
+    degree = {n: 0 for n in mech.link_names}
+    for j in mech.joints:
+        for x in j.links:
+            degree[x] += 1
+    base_pairs = {frozenset(j.links) for j in mech.joints}
+    sizes = [r.n_f for r in plan]
+    leashes = [r.m_f for r in plan]
+    n_f, m_f = sum(sizes), sum(leashes)
+    names = [f"g{i + 1}" for i in range(n_f)]
+    starts = list(itertools.accumulate([0] + sizes))
+    component = [c for c, n in enumerate(sizes) for _ in range(n)]
+    k = min(m_f, len(sites))
+    forests = [sum(([(names[starts[c] + a], names[starts[c] + b]) for a, b in t]
+                    for c, t in enumerate(trees)), [])
+               for trees in itertools.product(*[_trees(n) for n in sizes])]
+    for used in itertools.combinations(sites, k):
+        targets = list(used) + [mech.ground] * (m_f - k)
+        for tree_edges in forests:
+            for assign in itertools.product(range(n_f), repeat=m_f):
+                if len(plan) > 1 and any(sum(component[g] == c for g in assign) != leashes[c]
+                                         for c in range(len(plan))):
+                    continue  # each group keeps its own number of leashes
+                ext = [(targets[t], names[g]) for t, g in enumerate(assign)]
+                new = [frozenset(e) for e in tree_edges + ext]
+                if len(set(new)) < len(new) or base_pairs & set(new):
+                    continue  # two pairs between the same links
+                deg = dict(degree, **{g: 0 for g in names})
+                for a, b in tree_edges + ext:
+                    deg[a] += 1
+                    deg[b] += 1
+                if any(deg[g] < 2 for g in names) or any(
+                        deg[x] < 2 for x in mech.link_names if x != mech.ground):
+                    continue
+                yield names, tree_edges, ext, deg
 
 
 def _build(mech, base, names, tree_edges, ext, plan, deg, actuators, number, cert):

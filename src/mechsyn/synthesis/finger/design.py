@@ -35,264 +35,32 @@ the locked model merges the two (masses and centres of mass combined), which mak
 finger a chain of driver + RRR dyads solved in closed form by ``kinematics.dyads``. The
 VLL range and the final checks use the full file in the kinematics engine's passive
 mode (Newton continuation), an independent method.
+
+References
+----------
+Paper 000 of the project's seeds (``structural.md`` section 4 of the spec restates it
+with its worked examples).
 """
 
 from __future__ import annotations
 
-import copy
-import itertools
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError, input_boundary
+from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
+from mechsyn.synthesis.finger.cases import FingerCase
+from mechsyn.synthesis.finger.vll import copy_mechanism, locked_model, points_in_region, region_excess, vll_ends
 
-__all__ = ["FingerCase", "Variable", "load_case", "case_from_dict", "apply_design", "locked_model",
-           "Evaluation", "evaluate_locked", "stage1_objective", "vll_range", "mode_forces",
-           "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE", "points_in_region",
-           "underactuated_paths", "redraw", "evaluate_drawn"]
+__all__ = ["apply_design", "Evaluation", "evaluate_locked", "evaluate_drawn", "stage1_objective",
+           "stage1_population", "force_objective", "force_population", "redraw", "underactuated_paths",
+           "vll_range", "mode_forces", "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE"]
 
 INFEASIBLE = 1e6
 Objective = Callable[[np.ndarray], float]
-
-
-# --------------------------------------------------------------------------- case
-@dataclass(frozen=True)
-class Variable:
-    """One design variable: ``kind`` joint (a joint point's x or y), point (a named
-    point's x or y) or vll_angle (the VLL's direction in the drawn configuration, deg)."""
-
-    name: str
-    kind: str
-    target: str
-    coord: int          # 0: x, 1: y (unused for vll_angle)
-    bounds: tuple[float, float]
-
-
-@dataclass
-class FingerCase:
-    source: str
-    mech_dict: dict
-    input: str
-    variables: list[Variable]
-    target_inputs: np.ndarray             # crank rotation from the drawn configuration, deg
-    target_angles: dict[str, np.ndarray]  # link -> rotation from the drawn configuration, deg
-    region: np.ndarray                    # (k, 2) polygon
-    points: list[str]
-    combinations: list[tuple[str, ...]]
-    gravity: float = 9.81
-    weight_moment: float = 1.0
-    tolerance_deg: float = 1.0
-    step_deg: float = 2.0
-    vll_steps: int = 20
-    maxiter: int = 60
-    popsize: int = 12
-    force_maxiter: int = 15
-    candidates: int = 3
-
-    @property
-    def sweep_inputs(self) -> np.ndarray:
-        """Dense crank grid over the targets' range, the targets included."""
-        lo, hi = min(0.0, float(self.target_inputs.min())), max(0.0, float(self.target_inputs.max()))
-        n = max(2, int(np.ceil((hi - lo) / self.step_deg)) + 1)
-        return np.unique(np.concatenate([np.linspace(lo, hi, n), self.target_inputs, [0.0]]))
-
-    def vll_limits(self, jid: str) -> tuple[float, float]:
-        j = next(j for j in self.mech_dict["joints"] if j["id"] == jid)
-        return float(j["limits"][0]), float(j["limits"][1])
-
-
-def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None) -> MechsynInputError:
-    return MechsynInputError(msg, source=source, field=fld, hint=hint)
-
-
-def load_case(path: str | Path) -> FingerCase:
-    """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    from mechsyn.io.files import read_data
-
-    path = Path(path)
-    data, _text = read_data(path, "case file")
-    return case_from_dict(data, str(path), base_dir=path.parent)
-
-
-def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
-    from mechsyn.io.checks import numbers
-
-    if not isinstance(v, (list, tuple)):
-        raise _err(f"{fld} must be a list of numbers", src, fld)
-    out = numbers(v, src, fld).reshape(-1).tolist()
-    if n is not None and len(out) != n:
-        raise _err(f"{fld} must have {n} numbers", src, fld)
-    if not all(np.isfinite(out)):
-        raise _err(f"{fld} must be finite", src, fld)
-    return out
-
-
-@input_boundary("finger-design case")
-def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> FingerCase:
-    """Validate a case (see ``docs/finger_design.md``); MechsynInputError on bad input."""
-    from mechsyn.io import load_mechanism, mechanism_to_dict
-
-    src = source
-    if not isinstance(data, dict):
-        raise _err("the case must be a mapping", src)
-    for key in ("mechanism", "input", "variables", "targets", "region"):
-        if key not in data:
-            raise _err(f"missing field {key!r}", src, key, hint="see docs/finger_design.md")
-    mpath = Path(str(data["mechanism"]))
-    if not mpath.is_absolute() and base_dir is not None:
-        mpath = base_dir / mpath
-    if not mpath.is_file():
-        raise _err(f"mechanism file not found: {mpath}", src, "mechanism")
-    mech = load_mechanism(mpath)
-    md = mechanism_to_dict(mech)
-    joints = {j["id"]: j for j in md["joints"]}
-    names = [x if isinstance(x, str) else x["name"] for x in md["links"]]
-    masses = data.get("masses") or {}
-    if not isinstance(masses, dict):
-        raise _err("masses must map link names to {mass, com, inertia}", src, "masses")
-    for name, attrs in masses.items():
-        if name not in names or name == md["ground"] or not isinstance(attrs, dict) \
-                or set(attrs) - {"mass", "com", "inertia"}:
-            raise _err(f"masses.{name}: a moving link of the mechanism with mass, com, inertia", src,
-                       f"masses.{name}", hint=f"links: {', '.join(n for n in names if n != md['ground'])}")
-        k = names.index(name)
-        entry = {"name": name} if isinstance(md["links"][k], str) else md["links"][k]
-        for key, val in attrs.items():
-            entry[key] = _floats(val, 2, src, f"masses.{name}.com") if key == "com" else \
-                _floats([val], 1, src, f"masses.{name}.{key}")[0]
-        md["links"][k] = entry
-    if "loads" in data:
-        loads = data["loads"] or []
-        if not isinstance(loads, list):
-            raise _err("loads must be a list like the mechanism file's", src, "loads")
-        out_loads = []
-        for k, ld in enumerate(loads):
-            if not isinstance(ld, dict) or ld.get("link") not in names:
-                raise _err("each load names a link of the mechanism", src, f"loads[{k}]")
-            ld = dict(ld)
-            if "point" in ld:  # a named point: its drawn coordinates
-                pt = (md.get("points") or {}).get(ld["point"])
-                if pt is None or pt["link"] != ld["link"]:
-                    raise _err(f"loads[{k}].point must be a point of link {ld['link']}", src, f"loads[{k}]")
-            if "force" in ld:
-                ld["force"] = _floats(ld["force"], 2, src, f"loads[{k}].force")
-            if "at" in ld:
-                ld["at"] = _floats(ld["at"], 2, src, f"loads[{k}].at")
-            out_loads.append(ld)
-        md["loads"] = out_loads
-    inp = str(data["input"])
-    if inp not in joints or not joints[inp].get("actuated") or joints[inp]["type"] != "R":
-        raise _err(f"input {inp!r} is not an actuated R joint of {mpath.name}", src, "input")
-    vll_all = [j["id"] for j in md["joints"] if j.get("vll")]
-    if not vll_all:
-        raise _err(f"{mpath.name} has no variable-length link (a P joint with vll:)", src, "mechanism")
-    for jid in vll_all:
-        _vll_ends(md, jid, src)
-        lim = joints[jid].get("limits")
-        if lim is None or not (0 < lim[0] < lim[1]):
-            raise _err(f"VLL {jid} needs limits [min, max] with 0 < min < max", src, "mechanism",
-                       hint="the min is the minimum constructible length (paper 000, step 7)")
-    combos_raw = data.get("combinations") or [list(c) for r in range(1, len(vll_all) + 1)
-                                              for c in itertools.combinations(vll_all, r)]
-    combos = []
-    for c in combos_raw:
-        c = [c] if isinstance(c, str) else list(c)
-        for jid in c:
-            if jid not in vll_all:
-                raise _err(f"combination names {jid!r}, not a VLL of the mechanism", src, "combinations",
-                           hint=f"VLL joints: {', '.join(vll_all)}")
-        combos.append(tuple(c))
-    variables = []
-    if not isinstance(data["variables"], list) or not data["variables"]:
-        raise _err("variables must be a non-empty list", src, "variables")
-    for k, v in enumerate(data["variables"]):
-        fld = f"variables[{k}]"
-        if not isinstance(v, dict) or "bounds" not in v:
-            raise _err("each variable needs bounds: [lo, hi]", src, fld)
-        b = _floats(v["bounds"], 2, src, fld + ".bounds")
-        if not b[0] < b[1]:
-            raise _err("bounds must be [lo, hi] with lo < hi", src, fld + ".bounds")
-        if "joint" in v or "point" in v:
-            kind = "joint" if "joint" in v else "point"
-            tgt = str(v[kind])
-            if kind == "joint" and tgt not in joints:
-                raise _err(f"no joint {tgt!r}", src, fld)
-            if kind == "point" and tgt not in (md.get("points") or {}):
-                raise _err(f"no point {tgt!r}", src, fld)
-            if kind == "joint" and any(tgt == _vll_ends(md, c, src)[1] for c in vll_all):
-                raise _err(f"joint {tgt} is a VLL's piston pivot: vary the VLL's angle instead", src, fld,
-                           hint=f"write {{vll_angle: <VLL>, bounds: [lo, hi]}}")
-            coord = v.get("coord", "x")
-            if coord not in ("x", "y"):
-                raise _err("coord must be x or y", src, fld)
-            variables.append(Variable(f"{tgt}.{coord}", kind, tgt, 0 if coord == "x" else 1, (b[0], b[1])))
-        elif "vll_angle" in v:
-            tgt = str(v["vll_angle"])
-            if tgt not in vll_all:
-                raise _err(f"no VLL {tgt!r}", src, fld)
-            variables.append(Variable(f"{tgt}.angle", "vll_angle", tgt, 0, (b[0], b[1])))
-        else:
-            raise _err("a variable names a joint, a point or a vll_angle", src, fld)
-    tg = data["targets"]
-    if not isinstance(tg, list) or len(tg) < 2:
-        raise _err("targets must list at least two positions (the extremes)", src, "targets")
-    links = [lk for lk in tg[0] if lk != "input"]
-    if not links:
-        raise _err("a target gives the input and at least one link's rotation", src, "targets[0]")
-    tin, tang = [], {lk: [] for lk in links}
-    for k, t in enumerate(tg):
-        if not isinstance(t, dict) or "input" not in t or set(t) - {"input"} != set(links):
-            raise _err(f"each target gives input and rotations of {', '.join(links)}", src, f"targets[{k}]")
-        tin.append(_floats([t["input"]], 1, src, f"targets[{k}].input")[0])
-        for lk in links:
-            if lk not in [x if isinstance(x, str) else x["name"] for x in md["links"]]:
-                raise _err(f"no link {lk!r}", src, f"targets[{k}]")
-            tang[lk].append(_floats([t[lk]], 1, src, f"targets[{k}].{lk}")[0])
-    region = np.array([_floats(p, 2, src, "region") for p in data["region"]]) if isinstance(
-        data["region"], list) else None
-    if region is None or len(region) < 3:
-        raise _err("region must be a polygon of at least 3 [x, y] points", src, "region")
-    pts = data.get("points") or list(md.get("points") or {})
-    if not pts:
-        raise _err("name the output points whose paths must stay in the region", src, "points")
-    for p in pts:
-        if p not in (md.get("points") or {}) and p not in joints:
-            raise _err(f"no point or joint {p!r}", src, "points")
-    opt = data.get("optimizer") or {}
-    case = FingerCase(src, md, inp, variables, np.array(tin), {k: np.array(v) for k, v in tang.items()},
-                      region, list(pts), combos)
-    for key, typ in (("gravity", float), ("weight_moment", float), ("tolerance_deg", float),
-                     ("step_deg", float)):
-        if key in data:
-            setattr(case, key, typ(data[key]))
-    for key in ("maxiter", "popsize", "force_maxiter", "vll_steps", "candidates"):
-        if key in opt:
-            val = int(opt[key])
-            if val < 1:
-                raise _err(f"optimizer.{key} must be >= 1", src, f"optimizer.{key}")
-            setattr(case, key, val)
-    if case.step_deg <= 0 or case.tolerance_deg <= 0:
-        raise _err("step_deg and tolerance_deg must be positive", src)
-    return case
-
-
-def _vll_ends(md: dict, jid: str, src: str) -> tuple[str, str, str, str]:
-    """(cylinder link, piston pivot joint L, cylinder pivot joint K, piston link) of a VLL."""
-    joints = md["joints"]
-    j = next(x for x in joints if x["id"] == jid)
-    cyl, pis = j["links"]
-    k_j = [x for x in joints if cyl in x["links"] and x["id"] != jid]
-    l_j = [x for x in joints if pis in x["links"] and x["id"] != jid]
-    if len(k_j) != 1 or len(l_j) != 1 or k_j[0]["type"] != "R" or l_j[0]["type"] != "R" \
-            or np.linalg.norm(np.subtract(l_j[0]["point"], j["point"])) > 1e-9:
-        raise _err(f"VLL {jid}: expected a cylinder and a piston, each binary with one R pivot, the P "
-                   "point at the piston's pivot", src, f"joints.{jid}")
-    return cyl, l_j[0]["id"], k_j[0]["id"], pis
 
 
 # --------------------------------------------------------------------------- designs
@@ -301,7 +69,7 @@ def apply_design(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] | None 
     combination ``combo`` (default: every VLL) drawn at its minimum constructible length
     along its direction, the other VLL (plain rigid links in this variant) at their drawn
     length."""
-    d = copy.deepcopy(case.mech_dict)
+    d = copy_mechanism(case.mech_dict)
     joints = {j["id"]: j for j in d["joints"]}
     angles: dict[str, float] = {}
     for v, val in zip(case.variables, np.asarray(x, float)):
@@ -314,7 +82,7 @@ def apply_design(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] | None 
     for jid, j in joints.items():
         if not j.get("vll"):
             continue
-        _cyl, L, K, _pis = _vll_ends(d, jid, case.source)
+        _cyl, L, K, _pis = vll_ends(d, jid, case.source)
         pk = np.asarray(joints[K]["point"], float)
         u = np.asarray(j["point"], float) - pk
         ang = np.radians(angles[jid]) if jid in angles else np.arctan2(u[1], u[0])
@@ -325,84 +93,6 @@ def apply_design(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] | None 
         j["axis"] = u.tolist()
         joints[L]["point"] = p.tolist()
     return d
-
-
-def _link_entry(d: dict, name: str) -> dict:
-    for k, e in enumerate(d["links"]):
-        if (e if isinstance(e, str) else e["name"]) == name:
-            if isinstance(e, str):
-                d["links"][k] = {"name": e}
-            return d["links"][k]
-    raise KeyError(name)
-
-
-def locked_model(d: dict, vlls: list[str], source: str = "<case>") -> dict:
-    """The fully actuated model: each locked VLL's cylinder and piston merged into one
-    rigid binary link (mass summed, centre of mass mass-weighted; inertia summed about
-    the combined centre, parallel-axis theorem)."""
-    d = copy.deepcopy(d)
-    for jid in vlls:
-        cyl, L, K, pis = _vll_ends(d, jid, source)
-        pts = {j["id"]: np.asarray(j["point"], float) for j in d["joints"]}
-        ec, ep = _link_entry(d, cyl), _link_entry(d, pis)
-        mc, mp = float(ec.get("mass") or 0.0), float(ep.get("mass") or 0.0)
-        cc = np.asarray(ec.get("com", (pts[K] + pts[jid]) / 2), float)
-        cp = np.asarray(ep.get("com", (pts[jid] + pts[L]) / 2), float)
-        m = mc + mp
-        if m > 0:
-            com = (mc * cc + mp * cp) / m
-            ec["mass"] = m
-            ec["com"] = com.tolist()
-            ec["inertia"] = float(ec.get("inertia") or 0.0) + float(ep.get("inertia") or 0.0) \
-                + mc * float(np.sum((cc - com) ** 2)) + mp * float(np.sum((cp - com) ** 2))
-        d["links"] = [e for e in d["links"] if (e if isinstance(e, str) else e["name"]) != pis]
-        d["joints"] = [j for j in d["joints"] if j["id"] != jid]
-        for j in d["joints"]:
-            if j["id"] == L:
-                j["links"] = [cyl if lk == pis else lk for lk in j["links"]]
-        for p in (d.get("points") or {}).values():
-            if p["link"] == pis:
-                p["link"] = cyl
-        for ld in d.get("loads") or []:
-            if ld.get("link") == pis:
-                ld["link"] = cyl
-    return d
-
-
-def points_in_region(P: np.ndarray, region: np.ndarray, tol: float = 1e-9) -> np.ndarray:
-    """Which points (N, 2) lie inside the polygon or within ``tol`` of its boundary (NaN rows:
-    outside). Even-odd ray casting, vectorised over points and edges."""
-    P = np.asarray(P, float).reshape(-1, 2)
-    region = np.asarray(region, float)
-    ok = np.all(np.isfinite(P), axis=1)
-    out = np.zeros(len(P), bool)
-    if not ok.any():
-        return out
-    Q = P[ok]
-    a, b = region, np.roll(region, -1, axis=0)
-    x, y = Q[:, :1], Q[:, 1:]
-    crosses = (a[:, 1] > y) != (b[:, 1] > y)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xc = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    inside = np.count_nonzero(crosses & (x < xc), axis=1) % 2 == 1
-    ab = b - a
-    t = np.clip(np.einsum("nkj,kj->nk", Q[:, None] - a[None], ab) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0, 1)
-    dist = np.linalg.norm(Q[:, None] - (a[None] + t[..., None] * ab[None]), axis=2).min(axis=1)
-    out[ok] = inside | (dist <= tol)
-    return out
-
-
-def _region_excess(P: np.ndarray, region: np.ndarray) -> float:
-    """Sum of distances of the points outside the polygon to it (0 when all inside)."""
-    inside = points_in_region(P, region)
-    bad = P[~inside & np.all(np.isfinite(P), axis=1)]
-    if not len(bad):
-        return 0.0
-    a, b = region, np.roll(region, -1, axis=0)
-    ab = b - a
-    t = np.clip(np.einsum("nkj,kj->nk", bad[:, None] - a[None], ab) / np.sum(ab * ab, axis=1), 0, 1)
-    proj = a[None] + t[..., None] * ab[None]
-    return float(np.sum(np.min(np.linalg.norm(bad[:, None] - proj, axis=2), axis=1)))
 
 
 @dataclass
@@ -475,7 +165,7 @@ def evaluate_drawn(case: FingerCase, d: dict) -> Evaluation:
     for name, (link, at) in resolve_points(mech, case.points).items():
         P = S.point(q, S.index(link), S.to_local(link, at))
         ev.paths[name] = P
-        viol += _region_excess(P, case.region)
+        viol += region_excess(P, case.region)
     if viol > 0:
         ev.feasible, ev.reason, ev.violation = False, "a path leaves the working region", viol
     return ev
@@ -489,6 +179,64 @@ def stage1_objective(case: FingerCase, combo: tuple[str, ...]) -> Objective:
     return f
 
 
+def stage1_population(case: FingerCase, combo: tuple[str, ...]) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`stage1_objective` of a population ``X`` (K, n) at once: through the
+    compiled locked model (:mod:`~mechsyn.synthesis.finger.population`) where the case
+    allows it, else design by design.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.finger.cases import load_case
+    >>> case = load_case(ms.examples.path("finger_design_case"))
+    >>> f = stage1_population(case, ("S",))
+    >>> X = np.array([[14.0, 6.0, 8.0, 48.0, 123.69006753], [20.0, 12.0, 3.0, 42.0, 150.0]])
+    >>> values = f(X)                      # RMS error (deg); INFEASIBLE + violation
+    >>> bool(values[0] < 0.01), bool(values[1] >= INFEASIBLE)
+    (True, True)
+    """
+    from mechsyn.synthesis.finger.population import locked_population
+
+    pop = locked_population(case, combo)
+    if pop is None:
+        return _each(stage1_objective(case, combo))
+
+    def f(X: np.ndarray) -> np.ndarray:
+        ev = pop.evaluate(X)
+        return np.where(ev.feasible, ev.error_rms, INFEASIBLE + ev.violation)
+    return f
+
+
+def force_population(case: FingerCase, combo: tuple[str, ...], tol: float,
+                     hold: dict[str, float] | None = None, bound: float = np.inf
+                     ) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`force_objective` of a population ``X`` (K, n): the compiled locked model
+    sorts out the designs that do not assemble, leave the region or miss the accuracy
+    ``tol`` (their values as the one-design objective's); the others get the force
+    analysis design by design."""
+    from mechsyn.synthesis.finger.population import locked_population
+
+    one = force_objective(case, combo, tol, hold, bound)
+    pop = locked_population(case, combo)
+    if pop is None:
+        return _each(one)
+
+    def f(X: np.ndarray) -> np.ndarray:
+        ev = pop.evaluate(X)
+        with np.errstate(invalid="ignore"):
+            out = np.where(ev.feasible, INFEASIBLE + (ev.error_rms - tol), INFEASIBLE + ev.violation)
+            for k in np.flatnonzero(ev.feasible & (ev.error_rms <= tol)):
+                out[k] = one(X[k])
+        return out
+    return f
+
+
+def _each(f: Objective) -> Callable[[np.ndarray], np.ndarray]:
+    """A population objective from a one-design objective."""
+    return lambda X: np.array([f(x) for x in np.atleast_2d(X)])
+
+
 # --------------------------------------------------------------------------- VLL range
 def redraw(case: FingerCase, design: dict, lengths: dict[str, float]) -> dict | None:
     """The mechanism dict redrawn at the same crank angle with the VLL lengths
@@ -500,7 +248,7 @@ def redraw(case: FingerCase, design: dict, lengths: dict[str, float]) -> dict | 
     from mechsyn.kinematics.solve import assemble
     from mechsyn.kinematics.system import _rot, build_system
 
-    d = copy.deepcopy(design)
+    d = copy_mechanism(design)
     for j in d["joints"]:  # the engine refuses lengths outside limits: widen them for the solve
         if j["id"] in lengths:
             lim = j.get("limits") or [lengths[j["id"]]] * 2
@@ -662,7 +410,7 @@ def _static_summary(case: FingerCase, d: dict, vlls: tuple[str, ...]) -> dict[st
     out = {"peak_reaction": mags[j], "peak_joint": j,
            "peak_input_moment": float(np.max(np.abs(R.effort[case.input]))), "assembled": True}
     for jid in vlls:  # axial force in the merged VLL link, at the piston's pivot L
-        _cyl, L, K, _pis = _vll_ends(case.mech_dict, jid, case.source)
+        _cyl, L, K, _pis = vll_ends(case.mech_dict, jid, case.source)
         jl, jk = S.mech.joint(L), S.mech.joint(K)
         cyl = jl.links[0]
         pl = S.point(q, S.index(cyl), S.to_local(cyl, jl.point))
@@ -670,13 +418,6 @@ def _static_summary(case: FingerCase, d: dict, vlls: tuple[str, ...]) -> dict[st
         u = (pl - pk) / np.linalg.norm(pl - pk, axis=1)[:, None]
         out["vll_force_peak"] = float(np.max(np.abs(np.sum(R.force[L] * u, axis=1))))
     return out
-
-
-def _drawn_input(case: FingerCase, mech: Any) -> float:
-    from mechsyn.kinematics.system import build_system
-
-    S = build_system(mech)
-    return float(np.degrees(next(dr.assembled for dr in S.drivers if dr.joint == case.input)))
 
 
 def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float,
@@ -718,9 +459,13 @@ def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float,
     return f
 
 
+
+
 # --------------------------------------------------------------------------- driver
 @dataclass
 class VariantResult:
+    """One VLL combination's design: stage 1 (targets), VLL ranges, forces, final design."""
+
     combination: tuple[str, ...]
     stage1_design: dict[str, float]
     stage1_error_rms: float
@@ -738,6 +483,11 @@ class VariantResult:
     underactuated: dict[str, Any] = field(repr=False, default_factory=dict)
     evaluations: int = 0
 
+    @property
+    def adaptive(self) -> bool:
+        """Every VLL of the combination has a length range (``l_max > l_min``)."""
+        return all(r[1] > r[0] for r in self.vll_ranges.values())
+
     def to_dict(self) -> dict[str, Any]:
         return {k: getattr(self, k) for k in (
             "combination", "stage1_design", "stage1_error_rms", "stage1_error_max", "design", "error_rms",
@@ -747,6 +497,15 @@ class VariantResult:
 
 @dataclass
 class FingerDesign:
+    """Result of :func:`design_finger`: every searched VLL combination, the best one.
+
+    The common fields of a synthesis result describe the best variant: ``x`` (its
+    design vector, in the case's variable order), ``design`` (name -> value), ``error``
+    (RMS target error, deg), ``feasible`` (assembled at every target and adaptive: a
+    VLL range ``l_max > l_min``), ``reason`` (why not, else ``""``), ``nfev`` (objective
+    evaluations of every variant), ``seconds`` and ``seed``.
+    """
+
     case: str
     seed: int
     variants: list[VariantResult]
@@ -757,6 +516,12 @@ class FingerDesign:
     stopped_by_time_limit: bool = False
     notes: list[str] = field(default_factory=list)
     interrupted: bool = False    # Ctrl-C ended the search: the best design so far
+    x: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    design: dict[str, float] = field(default_factory=dict)
+    error: float = np.inf
+    feasible: bool = False
+    reason: str = ""
+    nfev: int = 0
 
     @property
     def best_variant(self) -> VariantResult:
@@ -764,7 +529,9 @@ class FingerDesign:
 
     def to_dict(self) -> dict[str, Any]:
         b = self.best_variant
-        return {"case": self.case, "seed": self.seed, "best": {
+        return {"case": self.case, "seed": self.seed, "x": self.x.tolist(), "design": self.design,
+                "error": self.error, "feasible": self.feasible, "reason": self.reason, "nfev": self.nfev,
+                "best": {
                     "combination": b.combination, "design": b.design, "error_rms_deg": b.error_rms,
                     "error_max_deg": b.error_max, "vll_ranges": b.vll_ranges,
                     "peak_reaction": b.forces["peak_reaction"], "peak_input_moment": b.forces["peak_input_moment"],
@@ -777,10 +544,40 @@ class FingerDesign:
                           "moments": "force x length"}}
 
 
-def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int, popsize: int,
-        deadline: float, init: Any = "latinhypercube", report: Callable[[int, float], None] | None = None,
+@dataclass
+class _Run:
+    """State of one :func:`design_finger` run shared by its variants."""
+
+    case: FingerCase
+    seed: int
+    deadline: float
+    progress: Callable[[str], None] | None
+    notes: list[str] = field(default_factory=list)
+    stopped: bool = False
+    state: dict = field(default_factory=lambda: {"interrupted": False})
+
+    def say(self, msg: str) -> None:
+        if self.progress:
+            self.progress(msg)
+
+    def reporter(self, label: str, stage: str, maxiter: int, what: str) -> Callable[[int, float], None] | None:
+        """``report(generation, best)`` for :func:`_de`: a progress line, ``what`` formats the best."""
+        if not self.progress:
+            return None
+
+        def report(g: int, best: float) -> None:
+            self.say(f"VLL {label}: {stage}, generation {g}/{maxiter}, best " + (
+                what.format(best) if best < INFEASIBLE else "design still infeasible"))
+        return report
+
+
+def _de(f: Callable[[np.ndarray], np.ndarray], bounds: list[tuple[float, float]], seed: int, maxiter: int,
+        popsize: int, deadline: float, init: Any = "latinhypercube",
+        report: Callable[[int, float], None] | None = None,
         state: dict | None = None) -> tuple[np.ndarray, float, int, bool, list]:
-    """Seeded differential evolution; stops at ``deadline``; ``report(generation, best)``.
+    """Seeded differential evolution of a population objective ``f(X (K, n)) -> (K,)``
+    (SciPy's ``vectorized``, deferred updating); stops at ``deadline``;
+    ``report(generation, best)``.
 
     Ctrl-C (:class:`KeyboardInterrupt`) ends it with the best design evaluated so far and
     sets ``state["interrupted"]``; it propagates when nothing was evaluated yet.
@@ -788,13 +585,15 @@ def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int
     from scipy.optimize import differential_evolution
 
     stopped = [False]
-    gen = [0]
+    gen = [0, 0]  # generations, designs evaluated
     best = BestSoFar()
 
-    def tracked(x: np.ndarray) -> float:
-        value = f(x)
-        best.offer(np.atleast_2d(x), np.array([value]))
-        return value
+    def tracked(XT: np.ndarray) -> np.ndarray:
+        X = np.atleast_2d(XT.T)
+        gen[1] += len(X)
+        values = np.asarray(f(X), float)
+        best.offer(X, values)
+        return values
 
     def cb(intermediate_result: Any) -> bool:
         gen[0] += 1
@@ -808,14 +607,14 @@ def _de(f: Objective, bounds: list[tuple[float, float]], seed: int, maxiter: int
     try:
         r = differential_evolution(tracked, bounds, seed=seed, maxiter=maxiter, popsize=popsize, tol=1e-10,
                                    mutation=(0.5, 1.0), recombination=0.9, polish=False, init=init,
-                                   callback=cb, updating="deferred")
+                                   callback=cb, updating="deferred", vectorized=True)
     except KeyboardInterrupt:
         if best.x is None or state is None:
             raise
         state["interrupted"] = True
-        return best.x, best.f, 0, False, [(best.x, best.f)]
+        return best.x, best.f, gen[1], False, [(best.x, best.f)]
     pop = sorted(zip(np.asarray(r.population), np.asarray(r.population_energies)), key=lambda t: t[1])
-    return np.asarray(r.x), float(r.fun), int(r.nfev), stopped[0], pop
+    return np.asarray(r.x), float(r.fun), gen[1], stopped[0], pop
 
 
 def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
@@ -826,114 +625,169 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     variant being searched keeps its best design so far (its force stage is skipped),
     later variants are not searched, and the result has ``interrupted=True``.
 
+    Parameters
+    ----------
+    case : FingerCase
+        From :func:`mechsyn.synthesis.finger.cases.load_case`.
+    seed : int
+        Seed of the differential evolution (same seed, same design).
+    time_limit : float
+        Seconds for the optimisation stages; the final checks still run.
+    progress : callable, optional
+        ``progress(message)`` with the stage and the best value so far.
+
+    Returns
+    -------
+    FingerDesign
+
+    Raises
+    ------
+    MechsynInputError
+        When no VLL combination has a feasible design.
+
     Examples
     --------
     >>> import mechsyn as ms
-    >>> from mechsyn.synthesis.finger_design import load_case
+    >>> from mechsyn.synthesis.finger.cases import load_case
     >>> res = ms.design_finger(load_case(ms.examples.path("finger_design_case")), seed=1, time_limit=20)
     >>> res.best_variant.error_rms < 1.0       # degrees, on the case's target positions
     True
     """
+    import scipy.linalg  # noqa: F401 - SciPy's own BLAS: loaded before the limit, which applies to loaded ones
+    from threadpoolctl import threadpool_limits
+
+    # every linear solve of the search is of a few tens of unknowns: BLAS threads only cost
+    # (on a loaded machine an 18 x 18 LU solve took 20 ms with them, 0.16 ms without)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _design(case, seed, time_limit, progress)
+
+
+def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[str], None] | None
+            ) -> FingerDesign:
     t0 = time.monotonic()
-    deadline = t0 + time_limit
-    bounds = [v.bounds for v in case.variables]
-    names = [v.name for v in case.variables]
+    run = _Run(case, seed, t0 + time_limit, progress)
     variants = []
-    notes: list[str] = []
-    stopped = False
-    state = {"interrupted": False}
     for combo in case.combinations:
-        if state["interrupted"]:
-            notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
+        if run.state["interrupted"]:
+            run.notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
             continue
-        if progress:
-            progress(f"VLL {'+'.join(combo)}: stage 1 (targets, VLL locked at l_min)")
-        label = "+".join(combo)
-
-        def report1(g: int, best: float, label: str = label) -> None:
-            if progress:
-                progress(f"VLL {label}: stage 1, generation {g}/{case.maxiter}, best " + (
-                    f"RMS error {best:.4g} deg" if best < INFEASIBLE else "design still infeasible"))
-
-        x1, f1, n1, st1, _ = _de(stage1_objective(case, combo), bounds, seed, case.maxiter, case.popsize,
-                                 deadline, report=report1, state=state)
-        if f1 >= INFEASIBLE:
-            notes.append(f"VLL {'+'.join(combo)}: no feasible design (every tried design fails to assemble over "
-                         "the crank range or leaves the region)")
-            continue
-        ev1 = evaluate_locked(case, x1, combo)
-        tol = max(case.tolerance_deg, ev1.error_rms)  # stage 2 keeps stage 1's accuracy
-        d1 = apply_design(case, x1, combo)
-        if progress:
-            progress("VLL ranges and forces of the stage-1 design")
-        ranges1 = {j: vll_range(case, d1, j)[:2] for j in combo}
-        forces1 = mode_forces(case, d1, combo, ranges1)
-        # stage 2: forces, starting from a population that holds the stage-1 design
-        rng = np.random.default_rng(seed)
-        npop = max(5, case.popsize * len(bounds))
-        lo, hi = np.array(bounds).T
-        init = lo + rng.random((npop, len(bounds))) * (hi - lo)
-        init[0] = x1
-        for k in range(1, min(npop, 1 + npop // 3)):  # a third of it near the stage-1 design
-            init[k] = np.clip(x1 + 0.05 * (hi - lo) * rng.standard_normal(len(bounds)), lo, hi)
-        if progress:
-            progress("stage 2: forces (both modes)")
-        x2, f2, n2, st2, pop = (x1, f1, 0, False, []) if state["interrupted"] else _de(force_objective(case, combo, tol, {j: r[1] for j, r in ranges1.items()},
-                                                   forces1["criterion"]), bounds, seed, case.force_maxiter,
-                                   case.popsize, deadline, init=init,
-                                   report=(lambda g, best: progress(
-                                       f"VLL {label}: force stage, generation {g}/{case.force_maxiter}, best "
-                                       f"criterion {best:.4g}")) if progress else None, state=state)
-        stopped = stopped or st1 or st2
-        chosen, ranges, forces_, improved = x1, ranges1, forces1, False
-        # the locked-mode criterion steers the search; the best few distinct members are
-        # then checked in both modes (VLL range and forces) and one is accepted only if
-        # the peak reaction does not rise and the criterion falls
-        uniq: list[np.ndarray] = []
-        for x, e in pop:
-            if e < INFEASIBLE and not np.allclose(x, x1) and not any(
-                    np.allclose(x, u, rtol=0, atol=1e-6) for u in uniq):
-                uniq.append(x)
-        for x in uniq[:case.candidates]:
-            if time.monotonic() > deadline:
-                stopped = True
-                break
-            d2 = apply_design(case, x, combo)
-            try:
-                ranges2 = {j: vll_range(case, d2, j)[:2] for j in combo}
-                forces2 = mode_forces(case, d2, combo, ranges2)
-            except MechsynInputError:
-                continue
-            if all(r[1] > r[0] for r in ranges2.values()) and forces2["peak_reaction"] <= forces_["peak_reaction"] \
-                    and forces2["criterion"] < forces_["criterion"]:
-                chosen, ranges, forces_, improved = x, ranges2, forces2, True
-        ev = evaluate_locked(case, chosen, combo)
-        d = apply_design(case, chosen, combo)
-        for j in d["joints"]:
-            if j["id"] in ranges:
-                j["limits"] = list(ranges[j["id"]])
-        under = {}
-        for jid in combo:
-            lens = np.linspace(ranges[jid][0], ranges[jid][1], 5)
-            under[jid] = {"lengths": lens, "paths": underactuated_paths(case, d, jid, lens)}
-        variants.append(VariantResult(
-            combination=combo, stage1_design=dict(zip(names, x1.tolist())), stage1_error_rms=ev1.error_rms,
-            stage1_error_max=ev1.error_max, design=dict(zip(names, chosen.tolist())), error_rms=ev.error_rms,
-            error_max=ev.error_max, achieved={k: v.tolist() for k, v in ev.achieved.items()},
-            vll_ranges=ranges, stage1_forces=forces1, forces=forces_, force_stage_improved=improved,
-            assembled_at_all_targets=bool(ev.q is not None and np.isfinite(ev.q).all()),
-            mechanism=d, underactuated=under, evaluations=n1 + n2))
-    if not variants and state["interrupted"]:
+        v = _design_variant(run, combo)
+        if v is not None:
+            variants.append(v)
+    if not variants and run.state["interrupted"]:
         raise KeyboardInterrupt  # nothing feasible to keep
     if not variants:
         raise MechsynInputError(
-            "no feasible design: " + "; ".join(notes), source=case.source, field="variables",
+            "no feasible design: " + "; ".join(run.notes), source=case.source, field="variables",
             hint="widen the bounds or the region, or move the targets")
-    crit = [v.forces["criterion"] if all(r[1] > r[0] for r in v.vll_ranges.values()) else np.inf
-            for v in variants]
-    best = int(np.argmin(crit))
+    best = int(np.argmin([v.forces["criterion"] if v.adaptive else np.inf for v in variants]))
+    b = variants[best]
+    reason = "" if b.adaptive and b.assembled_at_all_targets else (
+        "not assembled at every target" if not b.assembled_at_all_targets
+        else "no VLL length range keeps the paths in the region (l_max = l_min)")
     return FingerDesign(case.source, seed, variants, best,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
-                        case.tolerance_deg, time.monotonic() - t0, stopped, notes,
-                        interrupted=state["interrupted"])
+                        case.tolerance_deg, time.monotonic() - t0, run.stopped, run.notes,
+                        interrupted=run.state["interrupted"], x=np.array(list(b.design.values())),
+                        design=dict(b.design), error=b.error_rms, feasible=not reason, reason=reason,
+                        nfev=sum(v.evaluations for v in variants))
+
+
+def _design_variant(run: _Run, combo: tuple[str, ...]) -> VariantResult | None:
+    """Stage 1, the stage-1 design's VLL ranges and forces, the force stage, the checks."""
+    case, label = run.case, "+".join(combo)
+    bounds = [v.bounds for v in case.variables]
+    run.say(f"VLL {label}: stage 1 (targets, VLL locked at l_min)")
+    x1, f1, n1, st1, _ = _de(stage1_population(case, combo), bounds, run.seed, case.maxiter, case.popsize,
+                             run.deadline, report=run.reporter(label, "stage 1", case.maxiter, "RMS error {:.4g} deg"),
+                             state=run.state)
+    run.stopped = run.stopped or st1
+    if f1 >= INFEASIBLE:
+        run.notes.append(f"VLL {label}: no feasible design (every tried design fails to assemble over "
+                         "the crank range or leaves the region)")
+        return None
+    ev1 = evaluate_locked(case, x1, combo)
+    d1 = apply_design(case, x1, combo)
+    run.say("VLL ranges and forces of the stage-1 design")
+    ranges1 = {j: vll_range(case, d1, j)[:2] for j in combo}
+    forces1 = mode_forces(case, d1, combo, ranges1)
+    pop, n2 = _force_stage(run, combo, x1, f1, max(case.tolerance_deg, ev1.error_rms), ranges1, forces1)
+    chosen, ranges, forces_, improved = _pick(run, combo, x1, pop, ranges1, forces1)
+    return _variant(case, combo, x1, ev1, chosen, ranges, forces1, forces_, improved, n1 + n2)
+
+
+def _force_stage(run: _Run, combo: tuple[str, ...], x1: np.ndarray, f1: float, tol: float,
+                 ranges1: dict, forces1: dict) -> tuple[list, int]:
+    """Stage 2 (forces, both modes) from a population holding the stage-1 design: its
+    final population, best first, and its number of evaluations."""
+    case = run.case
+    if run.state["interrupted"]:
+        return [], 0
+    bounds = [v.bounds for v in case.variables]
+    rng = np.random.default_rng(run.seed)
+    npop = max(5, case.popsize * len(bounds))
+    lo, hi = np.array(bounds).T
+    init = lo + rng.random((npop, len(bounds))) * (hi - lo)
+    init[0] = x1
+    for k in range(1, min(npop, 1 + npop // 3)):  # a third of it near the stage-1 design
+        init[k] = np.clip(x1 + 0.05 * (hi - lo) * rng.standard_normal(len(bounds)), lo, hi)
+    run.say("stage 2: forces (both modes)")
+    f = force_population(case, combo, tol, {j: r[1] for j, r in ranges1.items()}, forces1["criterion"])
+    _x2, _f2, n2, st2, pop = _de(f, bounds, run.seed, case.force_maxiter, case.popsize, run.deadline,
+                                 init=init, state=run.state,
+                                 report=run.reporter("+".join(combo), "force stage", case.force_maxiter,
+                                                     "criterion {:.4g}"))
+    run.stopped = run.stopped or st2
+    return pop, n2
+
+
+def _pick(run: _Run, combo: tuple[str, ...], x1: np.ndarray, pop: list, ranges1: dict, forces1: dict
+          ) -> tuple[np.ndarray, dict, dict, bool]:
+    """The locked-mode criterion steers the force stage; its best few distinct members
+    are checked in both modes (VLL range and forces) and one is accepted only if the
+    peak reaction does not rise and the criterion falls."""
+    case = run.case
+    chosen, ranges, forces_, improved = x1, ranges1, forces1, False
+    uniq: list[np.ndarray] = []
+    for x, e in pop:
+        if e < INFEASIBLE and not np.allclose(x, x1) and not any(
+                np.allclose(x, u, rtol=0, atol=1e-6) for u in uniq):
+            uniq.append(x)
+    for x in uniq[:case.candidates]:
+        if time.monotonic() > run.deadline:
+            run.stopped = True
+            break
+        d2 = apply_design(case, x, combo)
+        try:
+            ranges2 = {j: vll_range(case, d2, j)[:2] for j in combo}
+            forces2 = mode_forces(case, d2, combo, ranges2)
+        except MechsynInputError:
+            continue
+        if all(r[1] > r[0] for r in ranges2.values()) and forces2["peak_reaction"] <= forces_["peak_reaction"] \
+                and forces2["criterion"] < forces_["criterion"]:
+            chosen, ranges, forces_, improved = x, ranges2, forces2, True
+    return chosen, ranges, forces_, improved
+
+
+def _variant(case: FingerCase, combo: tuple[str, ...], x1: np.ndarray, ev1: Evaluation, chosen: np.ndarray,
+             ranges: dict, forces1: dict, forces_: dict, improved: bool, nfev: int) -> VariantResult:
+    """The variant's result: the chosen design drawn with its VLL ranges as limits, and
+    its output paths at five lengths across each range."""
+    names = [v.name for v in case.variables]
+    ev = evaluate_locked(case, chosen, combo)
+    d = apply_design(case, chosen, combo)
+    for j in d["joints"]:
+        if j["id"] in ranges:
+            j["limits"] = list(ranges[j["id"]])
+    under = {}
+    for jid in combo:
+        lens = np.linspace(ranges[jid][0], ranges[jid][1], 5)
+        under[jid] = {"lengths": lens, "paths": underactuated_paths(case, d, jid, lens)}
+    return VariantResult(
+        combination=combo, stage1_design=dict(zip(names, x1.tolist())), stage1_error_rms=ev1.error_rms,
+        stage1_error_max=ev1.error_max, design=dict(zip(names, chosen.tolist())), error_rms=ev.error_rms,
+        error_max=ev.error_max, achieved={k: v.tolist() for k, v in ev.achieved.items()},
+        vll_ranges=ranges, stage1_forces=forces1, forces=forces_, force_stage_improved=improved,
+        assembled_at_all_targets=bool(ev.q is not None and np.isfinite(ev.q).all()),
+        mechanism=d, underactuated=under, evaluations=nfev)
