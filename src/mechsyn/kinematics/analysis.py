@@ -14,6 +14,7 @@ P inputs and lengths in the file's length unit.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -28,7 +29,7 @@ from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
-           "KinematicPlan", "compile_plan",
+           "KinematicPlan", "compile_plan", "cached_plan",
            "ForceAnalysis", "forces"]
 
 
@@ -255,8 +256,50 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
-    return compile_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
+    return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
+
+
+#: Compiled plans of the mechanisms simulated lately, by mechanism (weakly: a plan lives
+#: as long as its mechanism) and then by the geometry and options it was compiled for.
+_PLANS: "weakref.WeakKeyDictionary[Mechanism, dict]" = weakref.WeakKeyDictionary()
+
+
+def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> tuple:
+    """What a compiled plan depends on besides the (frozen) topology: the joint points and
+    axes, joint attributes (cam profiles, belts), named points, VLL modes, prescribed
+    inputs. The arrays are mutable, so their bytes are part of the key."""
+    def arr(a: Any) -> bytes | None:
+        return None if a is None else np.asarray(a, float).tobytes()
+
+    joints = tuple((arr(j.point), arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints)
+    named = tuple((k, p.link, arr(p.at)) for k, p in mech.points.items())
+    return joints, named, tuple(sorted((vll or {}).items())), prescribed
+
+
+def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
+    """:func:`compile_plan`, reusing the plan compiled for the same mechanism object with
+    the same geometry and options (a moved joint point or a new VLL mode compiles anew).
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism
+    >>> m = load_mechanism("examples/kinematics/crank_rocker.yaml")
+    >>> cached_plan(m, inputs=("A",)) is cached_plan(m, inputs=("A",))
+    True
+    """
+    prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    key = _geometry_key(mech, vll, prescribed)
+    try:
+        plans = _PLANS.setdefault(mech, {})
+    except TypeError:  # not weakly referenceable: no cache
+        return compile_plan(mech, vll=vll, inputs=inputs)
+    kp = plans.get(key)
+    if kp is None:
+        if len(plans) >= 8:
+            plans.pop(next(iter(plans)))
+        kp = plans[key] = compile_plan(mech, vll=vll, inputs=inputs)
+    return kp
 
 
 @dataclass(frozen=True, eq=False)

@@ -593,7 +593,8 @@ def chain_supported(plan: Plan | None) -> bool:
 
 def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
                rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
-               rotations: bool = True, sigmas: list | None = None) -> ChainResult:
+               rotations: bool = True, sigmas: list | None = None,
+               discs: dict | None = None) -> ChainResult:
     """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
 
     Every link is carried by an *anchor* (the joint that placed it: its position,
@@ -605,12 +606,41 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     and likewise for the accelerations. The work is done
     in chunks that stay in the processor's cache. ``sigmas``: the assembly sign of every
     step per input row (from :func:`solve_tracked`); default: the drawn modes.
+    ``discs``: when a dict, it receives every RRR step's normalised discriminant
+    ``g^2 |d|^2 / L1^2`` (``h^2 / L1^2`` of :func:`solve_tracked`) per row, by step index.
     """
     U = np.atleast_2d(np.asarray(U, float))
     N = U.shape[0]
     nl = len(S.links)
     speeds = np.ones(U.shape[1]) if speeds is None else np.asarray(speeds, float)
     want = joints if joints is not None else [j.id for j in S.mech.joints]
+    prog, anchor = _chain_program(S, plan, sigmas)
+    # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
+    # that every chunk writes contiguous memory
+    out = ChainResult({j: np.empty((2, N)).T for j in want},
+                      {j: np.empty((2, N)).T for j in want} if rates else None,
+                      {j: np.empty((2, N)).T for j in want} if rates else None,
+                      np.empty((nl, N)).T if rotations else None, np.empty((nl, N)).T if rotations else None,
+                      np.empty((nl, N)).T if rates else None, np.empty((nl, N)).T if rates else None, anchor)
+    if discs is not None:
+        discs.update({op[1]: np.empty(N) for op in prog if op[0] == "RRR"})
+    fixed = {j.id: j.point for j in S.mech.joints}
+    filled: set[str] = set()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for start in range(0, N, chunk):
+            sl = slice(start, min(N, start + chunk))
+            ch = _Chunk(S, anchor, rates, out, sl, discs)
+            for op in prog:
+                if op[0] == "drive":
+                    ch.drive(op, U[sl], speeds, fixed)
+                else:
+                    ch.rrr(op, want)
+            ch.write(nl, want, rotations, filled)
+    return out
+
+
+def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list, dict]:
+    """The chain's steps as kernels' arguments, and every link's anchor joint."""
     prog = []
     anchor: dict[int, tuple[str, np.ndarray]] = {}
     for si, step in enumerate(plan.steps):
@@ -620,200 +650,204 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
             sgn = 1.0 if con.b == new else -1.0
             anchor[new] = (jid, _local(S, new, jid))
             prog.append(("drive", new, k, jid, con.driver, sgn))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+        A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
+        sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
+        if sigmas is not None and isinstance(sigmas[si], np.ndarray):
+            sigma = np.asarray(sigmas[si], float)
+        anchor[b1] = (J1, s1)
+        anchor[b2] = (J3, t3)
+        prog.append(("RRR", si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
+                     (s2 - s1) / L1s, (t2 - t3) / L2s))
+    return prog, anchor
+
+
+class _Chunk:
+    """One chunk of rows of :func:`fast_chain`: the joints' states and the links'
+    rotations and rates found so far, and the kernels that extend them."""
+
+    def __init__(self, S: PlanarSystem, anchor: dict, rates: bool, out: "ChainResult", sl: slice,
+                 discs: dict | None) -> None:
+        self.S, self.anchor, self.rates, self.out, self.sl, self.discs = S, anchor, rates, out, sl, discs
+        self.written: set[str] = set()    # joints whose outputs were computed in place
+        self.rot: dict[int, tuple] = {}   # link -> ("cs", c, s) or ("vec", ex, ey, local / L^2)
+        self.rate: dict[int, tuple] = {}  # link -> (omega, alpha)
+        self.jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
+
+    def rotation(self, i: int) -> tuple:
+        r = self.rot[i]
+        if r[0] == "vec":  # from a joint-to-joint vector e and its local vector / L^2
+            _, ex, ey, bv = r
+            c = ex * bv[0] + ey * bv[1]
+            sn = ey * bv[0] - ex * bv[1]
+            self.rot[i] = ("cs", c, sn)
+            return c, sn
+        return r[1], r[2]
+
+    def point(self, i: int, jid: str | None, s: np.ndarray) -> tuple:
+        """State of the point ``s`` (local) of link ``i`` (of joint ``jid`` when known)."""
+        if jid is not None and jid in self.jst:
+            return self.jst[jid]
+        if i < 0:
+            return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if self.rates else (s[0], s[1])
+        ajid, sa = self.anchor[i]
+        A = self.jst[ajid]
+        dxl, dyl = float(s[0] - sa[0]), float(s[1] - sa[1])
+        c, sn = self.rotation(i)
+        if dyl == 0.0:
+            dx, dy = c * dxl, sn * dxl
+        elif dxl == 0.0:
+            dx, dy = sn * -dyl, c * dyl
         else:
-            (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-            s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-            t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-            L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
-            A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
-            sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
-            if sigmas is not None and isinstance(sigmas[si], np.ndarray):
-                sigma = np.asarray(sigmas[si], float)
-            anchor[b1] = (J1, s1)
-            anchor[b2] = (J3, t3)
-            prog.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
-                         (s2 - s1) / L1s, (t2 - t3) / L2s))
-    # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
-    # that every chunk writes contiguous memory
-    jpos = {j: np.empty((2, N)).T for j in want}
-    jvel = {j: np.empty((2, N)).T for j in want} if rates else None
-    jacc = {j: np.empty((2, N)).T for j in want} if rates else None
-    cos_out = np.empty((nl, N)).T if rotations else None
-    sin_out = np.empty((nl, N)).T if rotations else None
-    w_out = np.empty((nl, N)).T if rates else None
-    al_out = np.empty((nl, N)).T if rates else None
-    fixed = {}
-    for j in S.mech.joints:
-        fixed[j.id] = j.point
-    filled: set[str] = set()
-    err = np.seterr(invalid="ignore", divide="ignore")
-    try:
-        for start in range(0, N, chunk):
-            sl = slice(start, min(N, start + chunk))
-            n = sl.stop - sl.start
-            written: set[str] = set()    # joints whose outputs were computed in place
-            rot: dict[int, list] = {}    # link -> [c, s] (lazy) or a recipe
-            rate: dict[int, tuple] = {}  # link -> (omega, alpha)
-            jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
+            dx = c * dxl - sn * dyl
+            dy = sn * dxl + c * dyl
+        if not self.rates:
+            return (A[0] + dx, A[1] + dy)
+        w, al = self.rate[i]
+        w2 = w * w
+        wdx, wdy = w * dx, w * dy
+        if isinstance(al, float) and al == 0.0:  # a driver at constant speed
+            return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx, A[4] - w * wdx, A[5] - w * wdy)
+        return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
+                A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
 
-            def rotation(i: int) -> tuple:
-                r = rot[i]
-                if r[0] == "vec":  # from a joint-to-joint vector e and its local vector / L^2
-                    _, ex, ey, bv = r
-                    c = ex * bv[0] + ey * bv[1]
-                    sn = ey * bv[0] - ex * bv[1]
-                    rot[i] = ("cs", c, sn)
-                    return c, sn
-                return r[1], r[2]
+    def drive(self, op: tuple, U: np.ndarray, speeds: np.ndarray, fixed: dict) -> None:
+        _, new, k, jid, di, sgn = op
+        th = U[:, di]
+        ct, st = np.cos(th), np.sin(th)
+        if sgn < 0:
+            st = -st
+        if k < 0:
+            self.rot[new] = ("cs", ct, st)
+            if self.rates:
+                self.rate[new] = (sgn * speeds[di], 0.0)
+            P = fixed[jid]
+            self.jst[jid] = (P[0], P[1], 0.0, 0.0, 0.0, 0.0) if self.rates else (P[0], P[1])
+        else:
+            ck, sk = self.rotation(k)
+            self.rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
+            if self.rates:
+                self.rate[new] = (self.rate[k][0] + sgn * speeds[di], self.rate[k][1])
+            self.jst[jid] = self.point(k, jid, _local(self.S, k, jid))
 
-            def point(i: int, jid: str | None, s: np.ndarray) -> tuple:
-                if jid is not None and jid in jst and (i < 0 or _on(i, jid)):
-                    return jst[jid]
-                if i < 0:
-                    return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if rates else (s[0], s[1])
-                ajid, sa = anchor[i]
-                A = jst[ajid]
-                dxl, dyl = float(s[0] - sa[0]), float(s[1] - sa[1])
-                c, sn = rotation(i)
-                if dyl == 0.0:
-                    dx, dy = c * dxl, sn * dxl
-                elif dxl == 0.0:
-                    dx, dy = sn * -dyl, c * dyl
-                else:
-                    dx = c * dxl - sn * dyl
-                    dy = sn * dxl + c * dyl
-                if not rates:
-                    return (A[0] + dx, A[1] + dy)
-                w, al = rate[i]
-                w2 = w * w
-                wdx, wdy = w * dx, w * dy
-                if isinstance(al, float) and al == 0.0:  # a driver at constant speed
-                    return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx, A[4] - w * wdx, A[5] - w * wdy)
-                return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
-                        A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
+    def rrr(self, op: tuple, want: list) -> None:
+        """The RRR kernel: ``B = A + f d + sigma g R90 d`` (see :func:`fast_chain`)."""
+        _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
+        S, sl, jst = self.S, self.sl, self.jst
+        A = self.point(k1, J1, _local(S, k1, J1))
+        C = self.point(k3, J3, _local(S, k3, J3))
+        jst[J1], jst[J3] = A, C
+        dx = C[0] - A[0]
+        dy = C[1] - A[1]
+        inv = dx * dx
+        inv += dy * dy
+        np.divide(1.0, inv, out=inv)
+        f = inv * (0.5 * (L1s - L2s))
+        f += 0.5
+        g = inv * L1s
+        g -= f * f
+        if self.discs is not None:
+            d = np.divide(g, inv, out=self.discs[si][sl])
+            d *= 1.0 / L1s
+        np.maximum(g, 0.0, out=g, where=g > -1e-12)
+        np.sqrt(g, out=g)
+        if isinstance(sigma, np.ndarray):
+            g *= sigma[sl]
+        elif sigma < 0:
+            np.negative(g, out=g)
+        e1x = f * dx
+        e1x -= g * dy
+        e1y = f * dy
+        e1y += g * dx
+        pos = self.out.points
+        if J2 in pos:  # straight into the output buffers
+            Bx = np.add(e1x, A[0], out=pos[J2][sl, 0])
+            By = np.add(e1y, A[1], out=pos[J2][sl, 1])
+            self.written.add(J2)
+        else:
+            Bx = e1x + A[0]
+            By = e1y + A[1]
+        e2x = Bx - C[0]
+        e2y = By - C[1]
+        self.rot[b1] = ("vec", e1x, e1y, bv1)
+        self.rot[b2] = ("vec", e2x, e2y, bv2)
+        if self.rates:
+            jst[J2] = self._rrr_rates(A, C, (e1x, e1y, e2x, e2y), (Bx, By), (b1, b2), J2)
+        else:
+            jst[J2] = (Bx, By)
 
-            def _on(i: int, jid: str) -> bool:
-                return True
+    def _rrr_rates(self, A: tuple, C: tuple, e: tuple, B: tuple, links: tuple, J2: str) -> tuple:
+        """Rates of an RRR dyad: ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``,
+        ``omega_2 = (v_C - v_A) . e1 / (e1 x e2)``, and likewise the accelerations."""
+        e1x, e1y, e2x, e2y = e
+        den = e1x * e2y
+        den -= e1y * e2x
+        np.divide(1.0, den, out=den)
+        dvx, dvy = C[2] - A[2], C[3] - A[3]
+        w1 = dvx * e2x
+        w1 += dvy * e2y
+        w1 *= den
+        w2 = dvx * e1x
+        w2 += dvy * e1y
+        w2 *= den
+        w1s, w2s = w1 * w1, w2 * w2
+        dax = C[4] - A[4]
+        dax -= w2s * e2x
+        dax += w1s * e1x
+        day = C[5] - A[5]
+        day -= w2s * e2y
+        day += w1s * e1y
+        a1 = dax * e2x
+        a1 += day * e2y
+        a1 *= den
+        a2 = dax * e1x
+        a2 += day * e1y
+        a2 *= den
+        self.rate[links[0]], self.rate[links[1]] = (w1, a1), (w2, a2)
+        sl, o = self.sl, self.out
+        outs = ((o.velocities[J2][sl, 0], o.velocities[J2][sl, 1], o.accelerations[J2][sl, 0],
+                 o.accelerations[J2][sl, 1]) if J2 in o.points else (None,) * 4)
+        VBx = np.subtract(A[2], w1 * e1y, out=outs[0])
+        VBy = np.add(A[3], w1 * e1x, out=outs[1])
+        ABx = np.subtract(A[4], a1 * e1y, out=outs[2])
+        ABx -= w1s * e1x
+        ABy = np.add(A[5], a1 * e1x, out=outs[3])
+        ABy -= w1s * e1y
+        return (B[0], B[1], VBx, VBy, ABx, ABy)
 
-            for op in prog:
-                if op[0] == "drive":
-                    _, new, k, jid, di, sgn = op
-                    th = U[sl, di]
-                    ct, st = np.cos(th), np.sin(th)
-                    if sgn < 0:
-                        st = -st
-                    if k < 0:
-                        rot[new] = ("cs", ct, st)
-                        if rates:
-                            rate[new] = (sgn * speeds[di], 0.0)
-                        P = fixed[jid]
-                        jst[jid] = (P[0], P[1], 0.0, 0.0, 0.0, 0.0) if rates else (P[0], P[1])
-                    else:
-                        ck, sk = rotation(k)
-                        rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
-                        if rates:
-                            rate[new] = (rate[k][0] + sgn * speeds[di], rate[k][1])
-                        jst[jid] = point(k, jid, _local(S, k, jid))
-                else:
-                    _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
-                    A = point(k1, J1, _local(S, k1, J1))
-                    C = point(k3, J3, _local(S, k3, J3))
-                    jst[J1], jst[J3] = A, C
-                    dx = C[0] - A[0]
-                    dy = C[1] - A[1]
-                    inv = dx * dx
-                    inv += dy * dy
-                    np.divide(1.0, inv, out=inv)
-                    f = inv * (0.5 * (L1s - L2s))
-                    f += 0.5
-                    g = inv * L1s
-                    g -= f * f
-                    np.maximum(g, 0.0, out=g, where=g > -1e-12)
-                    np.sqrt(g, out=g)
-                    if isinstance(sigma, np.ndarray):
-                        g *= sigma[sl]
-                    elif sigma < 0:
-                        np.negative(g, out=g)
-                    e1x = f * dx
-                    e1x -= g * dy
-                    e1y = f * dy
-                    e1y += g * dx
-                    if J2 in jpos:  # straight into the output buffers
-                        Bx = np.add(e1x, A[0], out=jpos[J2][sl, 0])
-                        By = np.add(e1y, A[1], out=jpos[J2][sl, 1])
-                        written.add(J2)
-                    else:
-                        Bx = e1x + A[0]
-                        By = e1y + A[1]
-                    e2x = Bx - C[0]
-                    e2y = By - C[1]
-                    rot[b1] = ("vec", e1x, e1y, bv1)
-                    rot[b2] = ("vec", e2x, e2y, bv2)
+    def write(self, nl: int, want: list, rotations: bool, filled: set) -> None:
+        """The chunk's rotations, rates and joint states into the outputs."""
+        o, sl, rates = self.out, self.sl, self.rates
+        if rotations:
+            for i in range(nl):
+                o.cos[sl, i], o.sin[sl, i] = self.rotation(i)
+        if rates:
+            for i in range(nl):
+                o.omega[sl, i], o.alpha[sl, i] = self.rate[i]
+        for jid in want:
+            if jid in self.written or jid in filled:
+                continue
+            if jid in self.jst:
+                P = self.jst[jid]
+                if not isinstance(P[0], np.ndarray):  # a point of the frame: fill once
+                    o.points[jid][:, 0], o.points[jid][:, 1] = P[0], P[1]
                     if rates:
-                        den = e1x * e2y
-                        den -= e1y * e2x
-                        np.divide(1.0, den, out=den)
-                        dvx, dvy = C[2] - A[2], C[3] - A[3]
-                        w1 = dvx * e2x
-                        w1 += dvy * e2y
-                        w1 *= den
-                        w2 = dvx * e1x
-                        w2 += dvy * e1y
-                        w2 *= den
-                        w1s, w2s = w1 * w1, w2 * w2
-                        dax = C[4] - A[4]
-                        dax -= w2s * e2x
-                        dax += w1s * e1x
-                        day = C[5] - A[5]
-                        day -= w2s * e2y
-                        day += w1s * e1y
-                        a1 = dax * e2x
-                        a1 += day * e2y
-                        a1 *= den
-                        a2 = dax * e1x
-                        a2 += day * e1y
-                        a2 *= den
-                        rate[b1], rate[b2] = (w1, a1), (w2, a2)
-                        outs = ((jvel[J2][sl, 0], jvel[J2][sl, 1], jacc[J2][sl, 0], jacc[J2][sl, 1])
-                                if J2 in jpos else (None,) * 4)
-                        VBx = np.subtract(A[2], w1 * e1y, out=outs[0])
-                        VBy = np.add(A[3], w1 * e1x, out=outs[1])
-                        ABx = np.subtract(A[4], a1 * e1y, out=outs[2])
-                        ABx -= w1s * e1x
-                        ABy = np.add(A[5], a1 * e1x, out=outs[3])
-                        ABy -= w1s * e1y
-                        jst[J2] = (Bx, By, VBx, VBy, ABx, ABy)
-                    else:
-                        jst[J2] = (Bx, By)
-            if rotations:
-                for i in range(nl):
-                    cos_out[sl, i], sin_out[sl, i] = rotation(i)
-            if rates:
-                for i in range(nl):
-                    w_out[sl, i], al_out[sl, i] = rate[i]
-            for jid in want:
-                if jid in written or jid in filled:
+                        o.velocities[jid][:] = 0.0
+                        o.accelerations[jid][:] = 0.0
+                    filled.add(jid)
                     continue
-                if jid in jst:
-                    P = jst[jid]
-                    if not isinstance(P[0], np.ndarray):  # a point of the frame: fill once
-                        jpos[jid][:, 0], jpos[jid][:, 1] = P[0], P[1]
-                        if rates:
-                            jvel[jid][:] = 0.0
-                            jacc[jid][:] = 0.0
-                        filled.add(jid)
-                        continue
-                else:
-                    j = S.mech.joint(jid)
-                    side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
-                    P = point(side, None, _local(S, side, jid))
-                jpos[jid][sl, 0], jpos[jid][sl, 1] = P[0], P[1]
-                if rates:
-                    jvel[jid][sl, 0], jvel[jid][sl, 1] = P[2], P[3]
-                    jacc[jid][sl, 0], jacc[jid][sl, 1] = P[4], P[5]
-    finally:
-        np.seterr(**err)
-    return ChainResult(jpos, jvel, jacc, cos_out, sin_out, w_out, al_out, anchor)
+            else:
+                j = self.S.mech.joint(jid)
+                side = self.S.index(j.links[1]) if self.S.index(j.links[1]) >= 0 else self.S.index(j.links[0])
+                P = self.point(side, None, _local(self.S, side, jid))
+            o.points[jid][sl, 0], o.points[jid][sl, 1] = P[0], P[1]
+            if rates:
+                o.velocities[jid][sl, 0], o.velocities[jid][sl, 1] = P[2], P[3]
+                o.accelerations[jid][sl, 0], o.accelerations[jid][sl, 1] = P[4], P[5]
 
 
 # --------------------------------------------------------------------------- branches
