@@ -419,7 +419,9 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-    sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress, change_points == "switch"))
+    sw = _one_pass(S, plan, U, sp, progress) if change_points == "keep" else None
+    if sw is None:
+        sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress, change_points == "switch"))
     events = sw.events
     used = sw.method
     ok = sw.assembled
@@ -465,16 +467,37 @@ def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarr
     N = U.shape[0]
     if plan is None:
         return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-    tracked = dyads.solve_tracked(S, plan, U, switch=switch)
-    q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-    qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
-    qdd[tracked.singular] = np.nan
+    if plan.closed_form_rates:
+        q, qd, qdd, singular, tr_events = dyads.solve_tracked_rates(S, plan, U, sp, switch=switch)
+    else:
+        tracked = dyads.solve_tracked(S, plan, U, switch=switch)
+        q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
+        singular, tr_events = tracked.singular, tracked.events
+    qd[singular] = np.nan  # a group folded flat: rates not defined here
+    qdd[singular] = np.nan
     ok = np.all(np.isfinite(q), axis=1)
     sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
-    sw.events = _fast_events(tracked, sw)
+    sw.events = _fast_events(tr_events, sw)
     if progress is not None:
         progress(N)
     return sw
+
+
+def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray,
+              progress: Any) -> Sweep | None:
+    """The sweep of a chain whose groups stay clear of folds and change points, in one
+    array pass (:func:`dyads.solve_regular`); None when the branch rules are needed."""
+    if plan is None:
+        return None
+    res = dyads.solve_regular(S, plan, U, sp, _drawn_row(S, U))
+    if res is None:
+        return None
+    q, qd, qdd = res
+    N = U.shape[0]
+    if progress is not None:
+        progress(N)
+    ok = np.all(np.isfinite(q), axis=1)
+    return Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
 
 
 def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
@@ -556,11 +579,11 @@ def _event_units(S: PlanarSystem, e: dict) -> dict:
     return e
 
 
-def _fast_events(tracked: "dyads.TrackedPositions", sw: Sweep) -> list[dict]:
+def _fast_events(tracked_events: list, sw: Sweep) -> list[dict]:
     """Events of the closed-form sweep: dead points, reassembly and change / branch points
     found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
     out, seen = [], set()
-    for e in tracked.events:  # a gap of an upstream group is one reassembly of the mechanism
+    for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
         if e["kind"] == "reassembled":
             if e["index"] in seen:
                 continue

@@ -25,6 +25,7 @@ chains use batched linear solves of the differentiated constraints.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -248,10 +249,19 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
-def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray) -> np.ndarray:
+def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray, split: int | None = None) -> np.ndarray:
     """Link angles made continuous along a sweep: start near the file's angles ``ref``,
-    unwrap each run of assembled rows and keep the turn count across gaps."""
+    unwrap each run of assembled rows and keep the turn count across gaps.
+
+    ``split``: the sweep (assembled throughout) was run outwards from the drawn
+    configuration, between rows ``split - 1`` and ``split``: both rows start near
+    ``ref`` and the angles are unwrapped away from them (as two runs would be)."""
     sub = ref + _wrap(phi - ref)
+    if split is not None and ok.all():
+        block = np.unwrap(sub, axis=0)
+        block[split:] -= 2 * np.pi * np.round((block[split] - sub[split]) / (2 * np.pi))
+        block[:split] -= 2 * np.pi * np.round((block[split - 1] - sub[split - 1]) / (2 * np.pi))
+        return block
     idx = np.flatnonzero(ok)
     runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
     prev = None
@@ -512,13 +522,15 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     return q, qd, qdd
 
 
-def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
-    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
+def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult",
+                      split: int | None = None) -> tuple:
+    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations
+    (``split``: see :func:`_continuous_angles`)."""
     with np.errstate(invalid="ignore", over="ignore"):  # inf rates at singular rows become NaN
-        return _poses_from_chain_(S, plan, U, r)
+        return _poses_from_chain_(S, plan, U, r, split)
 
 
-def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None) -> tuple:
     N, nl = r.cos.shape
     # component-major buffers (returned transposed): every column written is contiguous
     q = np.empty((S.n, N)).T
@@ -553,7 +565,7 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
             phi[:, i] = sgn * U[:, k]
     others = [i for i in range(nl) if i not in drive_links]
     if others and ok.any():
-        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok)
+        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
     q[:, 2:3 * nl:3] = phi
     if not ok.all():
         for a in (q, qd, qdd):
@@ -659,6 +671,8 @@ def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[li
         sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
         if sigmas is not None and isinstance(sigmas[si], np.ndarray):
             sigma = np.asarray(sigmas[si], float)
+        elif sigmas is not None and callable(sigmas[si]):
+            sigma = (sigmas[si], (L1s ** 0.5, L2s ** 0.5), B0)
         anchor[b1] = (J1, s1)
         anchor[b2] = (J3, t3)
         prog.append(("RRR", si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
@@ -753,6 +767,8 @@ class _Chunk:
         if self.discs is not None:
             d = np.divide(g, inv, out=self.discs[si][sl])
             d *= 1.0 / L1s
+        if isinstance(sigma, tuple):  # a chooser: the signs from the discriminant of _solve_step
+            sigma = self._choose(sigma, A, dx, dy, inv)
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
         if isinstance(sigma, np.ndarray):
@@ -779,6 +795,18 @@ class _Chunk:
             jst[J2] = self._rrr_rates(A, C, (e1x, e1y, e2x, e2y), (Bx, By), (b1, b2), J2)
         else:
             jst[J2] = (Bx, By)
+
+    def _choose(self, chooser: tuple, A: tuple, dx: np.ndarray, dy: np.ndarray, inv: np.ndarray) -> np.ndarray:
+        """Signs of an RRR group from its chooser (``solve_tracked_rates``), given the
+        discriminant ``h^2 / L1^2`` as :func:`_solve_step` computes it (the same numbers,
+        so the same decisions) and the drawn mode read at the first row."""
+        choose, (L1, L2), B0 = chooser
+        D2 = 1.0 / inv
+        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * np.sqrt(D2))
+        h2 = L1 ** 2 - a ** 2
+        ax, ay = (float(np.ravel(c)[0]) for c in A[:2])  # a frame joint's are numbers
+        s_file = 1.0 if dx[0] * (B0[1] - ay) - dy[0] * (B0[0] - ax) >= 0 else -1.0
+        return choose(h2 / L1 ** 2, s_file)
 
     def _rrr_rates(self, A: tuple, C: tuple, e: tuple, B: tuple, links: tuple, J2: str) -> tuple:
         """Rates of an RRR dyad: ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``,
@@ -897,6 +925,42 @@ def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: 
     return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
 
 
+#: Smallest normalised discriminant of every group over a sweep for which
+#: :func:`solve_regular` answers (below it :func:`solve_tracked` looks for folds and
+#: change points: its candidates are local minima under 0.05).
+REGULAR_DISC = 0.05 + 1e-9
+
+
+def solve_regular(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
+                  split: int | None) -> tuple | None:
+    """Poses and rates (N, n) of a driver-R + RRR chain in one array pass, or None when
+    the sweep needs the branch rules of :func:`solve_tracked`.
+
+    The rows ``U`` and the connecting paths from the drawn input values to the sweep
+    (to row ``split`` and ``split - 1`` when the drawn values lie between them, else to
+    row 0) are evaluated together with every group's discriminant; when each stays at
+    least :data:`REGULAR_DISC` no group folds, touches a change point or reassembles,
+    every group keeps its drawn mode and the answer is that of the outward sweeps of
+    :func:`solve_tracked` (no events), at the cost of one pass.
+    """
+    if not plan.closed_form_rates:
+        return None
+    N = U.shape[0]
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    ends = [U[0]] if split is None else [U[split], U[split - 1]]
+    X = np.vstack([U] + [_connecting_path(S, u0, _shifted_start(S, u0, e)) for e in ends])
+    discs: dict = {}
+    r = fast_chain(S, plan, X, speeds, rates=True, discs=discs)
+    for d in discs.values():
+        if not d.min() >= REGULAR_DISC:  # NaN too
+            return None
+    if X.shape[0] > N:
+        r = ChainResult({j: v[:N] for j, v in r.points.items()}, {j: v[:N] for j, v in r.velocities.items()},
+                        {j: v[:N] for j, v in r.accelerations.items()}, r.cos[:N], r.sin[:N], r.omega[:N],
+                        r.alpha[:N], r.anchor)
+    return _poses_from_chain(S, plan, U, r, split)
+
+
 def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
     """Poses for all inputs on the branch of the drawn configuration, with branch events.
 
@@ -921,15 +985,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     take the other branch instead (``sigma`` kept: a parallelogram becomes an
     anti-parallelogram there); the events say so.
     """
-    U = np.atleast_2d(np.asarray(inputs, float))
-    N = U.shape[0]
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    # R inputs a whole number of turns from the drawn values are the same configurations:
-    # track the sweep shifted next to the drawn values (its rows then follow each other)
-    shift = U[0] - _shifted_start(S, u0, U[0])
-    path = _connecting_path(S, u0, U[0] - shift)
-    n0 = path.shape[0]
-    X = np.vstack([path, U - shift])
+    X, n0, shift = _tracking_rows(S, inputs)
     M = X.shape[0]
     st = _State(S, M)
     sigmas: list = []
@@ -940,14 +996,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
         if step.kind not in BRANCHED:
             sigmas.append(_solve_step(S, st, step, X, None))
             continue
-
-        def choose(disc: np.ndarray, s_file: float, k: int = k) -> np.ndarray:
-            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
-            discs[k] = disc
-            raw_events.extend(evs)
-            singular[sing] = True
-            return sig
-
+        choose = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular)
         sigmas.append(_solve_step(S, st, step, X, choose))
     q = _pose_rows(S, st, plan)
     for step in plan.steps:  # a link driven from the frame takes the input's own turn count
@@ -955,6 +1004,78 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
             con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
             sgn = 1.0 if con.b == step.links[0] else -1.0
             q[n0:, 3 * step.links[0] + 2] += sgn * shift[con.driver]
+    sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
+    return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:],
+                            _sweep_events(raw_events, n0, shift))
+
+
+def solve_tracked_rates(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
+                        switch: bool = False) -> tuple:
+    """:func:`solve_tracked` and :func:`solve_all` of a driver-R + RRR chain in one array
+    pass of :func:`fast_chain`: each group's signs are chosen by the branch rules on its
+    discriminant as the pass reaches it. Returns ``q, qd, qdd`` (N, n), the singular rows
+    and the events."""
+    X, n0, shift = _tracking_rows(S, inputs)
+    M = X.shape[0]
+    sigmas: list = [1.0] * len(plan.steps)
+    discs: dict = {}
+    singular = np.zeros(M, bool)
+    raw_events: list = []
+    for k, step in enumerate(plan.steps):
+        if step.kind in BRANCHED:
+            sigmas[k] = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular,
+                                 store=True)
+    U = np.atleast_2d(np.asarray(inputs, float))
+    # the sweep's own rows (not shifted by turns: the same numbers as an untracked pass);
+    # the choosers' events and root searches use the shifted rows X
+    r = fast_chain(S, plan, np.vstack([X[:n0], U]), speeds, rates=True, sigmas=sigmas, chunk=max(M, 1))
+    if n0:
+        r = _chain_rows(r, slice(n0, None))
+    q, qd, qdd = _poses_from_chain(S, plan, U, r)
+    return q, qd, qdd, singular[n0:], _sweep_events(raw_events, n0, shift)
+
+
+def _chain_rows(r: "ChainResult", rows: slice) -> "ChainResult":
+    """The rows ``rows`` of a chain's result (views)."""
+    return ChainResult({j: v[rows] for j, v in r.points.items()},
+                       {j: v[rows] for j, v in r.velocities.items()} if r.velocities is not None else None,
+                       {j: v[rows] for j, v in r.accelerations.items()} if r.accelerations is not None else None,
+                       r.cos[rows] if r.cos is not None else None, r.sin[rows] if r.sin is not None else None,
+                       r.omega[rows] if r.omega is not None else None,
+                       r.alpha[rows] if r.alpha is not None else None, r.anchor)
+
+
+def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
+    """The rows a tracked sweep evaluates: the connecting path from the drawn input
+    values (``n0`` rows), then the sweep shifted by whole turns next to them."""
+    U = np.atleast_2d(np.asarray(inputs, float))
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    # R inputs a whole number of turns from the drawn values are the same configurations:
+    # track the sweep shifted next to the drawn values (its rows then follow each other)
+    shift = U[0] - _shifted_start(S, u0, U[0])
+    path = _connecting_path(S, u0, U[0] - shift)
+    return np.vstack([path, U - shift]), path.shape[0], shift
+
+
+def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
+             discs: dict, raw_events: list, singular: np.ndarray, store: bool = False):
+    """The sign chooser of branched step ``k``: called with the step's normalised
+    discriminant and the drawn mode, it applies the branch rules (:func:`_branch_signs`),
+    records the discriminant, events and singular rows, and returns the signs (also put
+    in ``sigmas[k]`` when ``store``)."""
+    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
+        sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
+        discs[k] = disc
+        raw_events.extend(evs)
+        singular[sing] = True
+        if store:
+            sigmas[k] = sig
+        return sig
+    return choose
+
+
+def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
+    """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
     events = []
     for e in raw_events:
         e = dict(e)
@@ -965,8 +1086,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
         if not e.get("before_sweep"):
             e["input"] = (np.asarray(e["input"]) + shift).tolist()
         events.append(e)
-    sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
-    return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:], events)
+    return events
 
 
 def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -987,6 +1107,86 @@ def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray
     return out[0]
 
 
+def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
+    """A driver-R + RRR chain as plain numbers for :func:`_scalar_disc` (built once per
+    system and plan)."""
+    memo = _memo(S)
+    key = ("scalar", id(plan))
+    prog = memo.get(key)
+    if prog is not None:
+        return prog
+    prog = []
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            prog.append(("drive", new, k, tuple(_local(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
+                         tuple(_local(S, new, jid))))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1, L2 = float(np.linalg.norm(s2 - s1)), float(np.linalg.norm(t2 - t3))
+        prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
+                     L1, L2, tuple(s1), tuple(t3), tuple((s2 - s1) / L1 ** 2), tuple((t2 - t3) / L2 ** 2)))
+    memo[key] = prog
+    return prog
+
+
+def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
+    """Normalised discriminant ``h^2 / L1^2`` of RRR step ``k`` of a driver-R + RRR chain
+    at one input ``u``, the upstream groups in the modes ``sigmas`` (floats): the
+    formulas of :func:`_solve_step` in plain floats (a root search calls it a few times
+    per event; an array pass would cost a hundred times more per call)."""
+    pose: dict[int, tuple] = {}  # link -> (anchor x, y, local x, y, cos, sin)
+
+    def point(i: int, s: tuple) -> tuple:
+        if i < 0:
+            return s
+        ax, ay, lx, ly, c, sn = pose[i]
+        dx, dy = s[0] - lx, s[1] - ly
+        return ax + c * dx - sn * dy, ay + sn * dx + c * dy
+
+    for j, op in enumerate(prog):
+        if op[0] == "drive":
+            _, new, kk, sk, di, sgn, snew = op
+            P = point(kk, sk)
+            ck, sk_ = (1.0, 0.0) if kk < 0 else pose[kk][4:]
+            ct, st = math.cos(u[di]), sgn * math.sin(u[di])
+            pose[new] = (P[0], P[1], snew[0], snew[1], ck * ct - sk_ * st, sk_ * ct + ck * st)
+            continue
+        _, (k1, sa), (k3, sc), (b1, b2), L1, L2, s1, t3, bv1, bv2 = op
+        A, C = point(k1, sa), point(k3, sc)
+        dx, dy = C[0] - A[0], C[1] - A[1]
+        D2 = dx * dx + dy * dy
+        D = math.sqrt(D2)
+        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D) if D > 0 else math.nan
+        h2 = L1 ** 2 - a ** 2
+        if j == k:
+            return h2 / L1 ** 2
+        if not h2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
+            h2 = 0.0 if h2 > -1e-12 * L1 ** 2 else math.nan
+        h = float(sigmas[j]) * (math.sqrt(h2) if h2 >= 0 else math.nan)
+        ex, ey = dx / D, dy / D
+        Bx, By = A[0] + a * ex - h * ey, A[1] + a * ey + h * ex
+        for link, P, loc, bv in ((b1, A, s1, bv1), (b2, C, t3, bv2)):
+            vx, vy = Bx - P[0], By - P[1]
+            pose[link] = (P[0], P[1], loc[0], loc[1], vx * bv[0] + vy * bv[1], vy * bv[0] - vx * bv[1])
+    return math.nan
+
+
+def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i0: int, i1: int):
+    """Discriminant of step ``k`` on the segment of inputs from row ``i0`` (t = 0) to row
+    ``i1`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar function."""
+    if plan.closed_form_rates:
+        prog = _scalar_program(S, plan)
+        sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
+        x0, dx = X[i0], X[i1] - X[i0]
+        return lambda t: _scalar_disc(prog, k, sig, x0 + t * dx)
+    rows = np.array([i0])
+    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
+
+
 def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
                   s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
     """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
@@ -999,11 +1199,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
     d = np.where(ok, np.maximum(disc, 0.0), np.nan)
 
     def f_line(i0: int, i1: int):
-        rows = np.array([i0])
-
-        def f(t: float) -> float:
-            return float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
-        return f
+        return _disc_line(S, plan, k, sigmas, X, i0, i1)
 
     events: list = []
     singular = np.zeros(M, bool)
