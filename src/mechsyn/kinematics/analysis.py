@@ -270,6 +270,8 @@ def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple
     axes, joint attributes (cam profiles, belts), named points, VLL modes, prescribed
     inputs. The arrays are mutable, so their bytes are part of the key."""
     def arr(a: Any) -> bytes | None:
+        if isinstance(a, np.ndarray) and a.dtype == float:
+            return a.tobytes()
         return None if a is None else np.asarray(a, float).tobytes()
 
     joints = tuple((arr(j.point), arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints)
@@ -421,7 +423,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         assemble(S)  # checks the file configuration and the mobility
     sw = _one_pass(S, plan, U, sp, progress) if change_points == "keep" else None
     if sw is None:
-        sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress, change_points == "switch"))
+        sw = _outward(S, U, lambda parts: _run(S, plan, parts, sp, progress, change_points == "switch"))
     events = sw.events
     used = sw.method
     ok = sw.assembled
@@ -437,16 +439,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     links = {}
     for i, name in enumerate(S.links):
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
-    pm = {}
-    for name, (link, at) in pts.items():
-        i = S.index(link)
-        s = S.to_local(link, at)
-        P, V, A = S.point_state(np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd), i, s)
-        for arr in (P, V, A):
-            arr[~ok] = np.nan
-        V[~rates_ok] = np.nan
-        A[~rates_ok] = np.nan
-        pm[name] = PointMotion(P, V, A, link)
+    pm = _point_motions(S, sw, pts, ok, rates_ok)
     events = [_event_units(S, e) for e in events]
     from mechsyn.kinematics.solve import singular_configuration
 
@@ -461,26 +454,54 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
-def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
-         switch: bool = False) -> Sweep:
-    """One sweep from the drawn configuration through the rows of ``U`` in order."""
-    N = U.shape[0]
+def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
+    """Position, velocity, acceleration of every named point (NaN where not assembled;
+    rates NaN where not defined)."""
+    q, qd, qdd = np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd)
+    pm = {}
+    for name, (link, at) in pts.items():
+        P, V, A = S.point_state(q, qd, qdd, S.index(link), S.to_local(link, at))
+        for arr in (P, V, A):
+            arr[~ok] = np.nan
+        V[~rates_ok] = np.nan
+        A[~rates_ok] = np.nan
+        pm[name] = PointMotion(P, V, A, link)
+    return pm
+
+
+def _run(S: PlanarSystem, plan: "dyads.Plan | None", parts: list, sp: np.ndarray, progress: Any,
+         switch: bool = False) -> list[Sweep]:
+    """Sweeps from the drawn configuration through the rows of each of ``parts`` in order
+    (a driver-R + RRR chain: all in one array pass)."""
+    if plan is not None and plan.closed_form_rates:
+        res = dyads.solve_tracked_rates(S, plan, parts, sp, switch=switch)
+    else:
+        res = [_run_one(S, plan, U, sp, progress, switch) for U in parts]
+        if plan is None:
+            return res
+    out = []
+    for U, (q, qd, qdd, singular, tr_events) in zip(parts, res):
+        N = U.shape[0]
+        qd[singular] = np.nan  # a group folded flat: rates not defined here
+        qdd[singular] = np.nan
+        ok = np.all(np.isfinite(q), axis=1)
+        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
+        sw.events = _fast_events(tr_events, sw)
+        if progress is not None:
+            progress(N)
+        out.append(sw)
+    return out
+
+
+def _run_one(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
+             switch: bool) -> Any:
+    """One sweep by Newton continuation (a Sweep), or by the tracked closed form (its
+    arrays, singular rows and events)."""
     if plan is None:
         return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-    if plan.closed_form_rates:
-        q, qd, qdd, singular, tr_events = dyads.solve_tracked_rates(S, plan, U, sp, switch=switch)
-    else:
-        tracked = dyads.solve_tracked(S, plan, U, switch=switch)
-        q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-        singular, tr_events = tracked.singular, tracked.events
-    qd[singular] = np.nan  # a group folded flat: rates not defined here
-    qdd[singular] = np.nan
-    ok = np.all(np.isfinite(q), axis=1)
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
-    sw.events = _fast_events(tr_events, sw)
-    if progress is not None:
-        progress(N)
-    return sw
+    tracked = dyads.solve_tracked(S, plan, U, switch=switch)
+    q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
+    return q, qd, qdd, tracked.singular, tracked.events
 
 
 def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray,
@@ -526,9 +547,8 @@ def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
     contains the drawn input passes through the drawn configuration; else one run."""
     k = _drawn_row(S, U)
     if k is None:
-        return run(U)
-    fwd = run(U[k:])
-    bwd = run(U[:k][::-1].copy())
+        return run([U])[0]
+    fwd, bwd = run([U[k:], U[:k][::-1].copy()])
     events = []
     for e in bwd.events:
         e = dict(e)

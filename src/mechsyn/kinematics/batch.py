@@ -147,20 +147,7 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
         When the mechanism is not of this kind (the message names what is not).
     """
     src = mech.source or mech.name
-    if mech.kind != "planar":
-        raise MechsynInputError("the batch engine handles planar mechanisms", source=src, field="kind")
-    bad = [j.id for j in mech.joints if j.type != "R"]
-    if bad:
-        raise MechsynInputError(f"joint {bad[0]} is {mech.joint(bad[0]).type}: the batch engine handles R pairs",
-                                source=src, field="joints", hint="use simulate for this mechanism")
-    drivers = [j for j in mech.joints if j.actuated]
-    if len(drivers) != 1:
-        raise MechsynInputError(f"{len(drivers)} actuated joints: the batch engine needs exactly one",
-                                source=src, field="joints")
-    drv = drivers[0]
-    if mech.ground not in drv.links:
-        raise MechsynInputError(f"the actuated joint {drv.id} is not on the frame {mech.ground}",
-                                source=src, field="joints", hint="drive a crank jointed to the frame")
+    drv = _batch_driver(mech, src)
     names = tuple([j.id for j in mech.joints] + [p for p in mech.points if p not in {j.id for j in mech.joints}])
     index = {n: i for i, n in enumerate(names)}
     on_link: dict[str, list[str]] = {ln.name: [] for ln in mech.links}
@@ -187,6 +174,54 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
             have.add(p)
 
     joints = {j.id: j for j in mech.joints}
+    dyads = _dyad_ops(mech, joints, on_link, index, known, used, have, ops, need)
+    missing = [ln.name for ln in mech.links if ln.name not in known]
+    if missing:
+        raise MechsynInputError(
+            f"links {', '.join(missing)} are not found by a crank and RRR dyads", source=src, field="joints",
+            hint="the batch engine needs a dyad-decomposable mechanism; use simulate")
+    if set(joints) - used:
+        raise MechsynInputError(
+            f"joints {', '.join(sorted(set(joints) - used))} close extra loops (overconstrained here)",
+            source=src, field="joints", hint="use simulate")
+    points = _output_points(mech, points, joints, index, names, need)
+    ref = _reference_input(mech)
+    # the crank's reference line (simulate's link frame): first joint of the crank in file
+    # order to the first other joint point
+    cj = [j for j in mech.joints if crank in j.links]
+    p0 = np.asarray(cj[0].point, float)
+    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
+    line = (index[cj[0].id], index[other.id]) if other is not None else None
+    return BatchPlan(names=names, ops=tuple([("ground", ground_pts)] + ops), outputs=tuple(points),
+                     input_joint=drv.id, input_sign=sign, n_dyads=len(dyads),
+                     links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref,
+                     crank_line=line)
+
+
+def _batch_driver(mech: Mechanism, src: str):
+    """The one actuated joint, on the frame, of a planar mechanism of R pairs (else the
+    error naming what is not so)."""
+    if mech.kind != "planar":
+        raise MechsynInputError("the batch engine handles planar mechanisms", source=src, field="kind")
+    bad = [j.id for j in mech.joints if j.type != "R"]
+    if bad:
+        raise MechsynInputError(f"joint {bad[0]} is {mech.joint(bad[0]).type}: the batch engine handles R pairs",
+                                source=src, field="joints", hint="use simulate for this mechanism")
+    drivers = [j for j in mech.joints if j.actuated]
+    if len(drivers) != 1:
+        raise MechsynInputError(f"{len(drivers)} actuated joints: the batch engine needs exactly one",
+                                source=src, field="joints")
+    drv = drivers[0]
+    if mech.ground not in drv.links:
+        raise MechsynInputError(f"the actuated joint {drv.id} is not on the frame {mech.ground}",
+                                source=src, field="joints", hint="drive a crank jointed to the frame")
+    return drv
+
+
+def _dyad_ops(mech: Mechanism, joints: dict, on_link: dict, index: dict, known: dict, used: set, have: set,
+              ops: list, need) -> list[tuple[str, str, str]]:
+    """RRR dyads in solving order (appended to ``ops``): links ``b1``, ``b2`` not yet
+    known, joined by ``J2`` and to known links by ``J1``, ``J3``."""
     dyads: list[tuple[str, str, str]] = []
     progress = True
     while progress:
@@ -214,37 +249,25 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
             dyads.append((J1, J2.id, J3))
             progress = True
             break
-    missing = [ln.name for ln in mech.links if ln.name not in known]
-    if missing:
-        raise MechsynInputError(
-            f"links {', '.join(missing)} are not found by a crank and RRR dyads", source=src, field="joints",
-            hint="the batch engine needs a dyad-decomposable mechanism; use simulate")
-    if set(joints) - used:
-        raise MechsynInputError(
-            f"joints {', '.join(sorted(set(joints) - used))} close extra loops (overconstrained here)",
-            source=src, field="joints", hint="use simulate")
+    return dyads
+
+
+def _output_points(mech: Mechanism, points: list[str] | None, joints: dict, index: dict, names: tuple,
+                   need) -> list[str]:
+    """The points whose paths are returned (default: the named points, else every joint),
+    each placed on its link (``need``)."""
     if points is None:
         points = list(mech.points) or [j.id for j in mech.joints]
     for p in points:
         if p not in index:
-            raise MechsynInputError(f"no point or joint named {p!r}", source="points",
+            raise MechsynInputError(f"no point or joint named {p!r}", field="points",
                                     hint=f"known: {', '.join(names)}")
         link = mech.points[p].link if p in mech.points else next(
             ln for ln in joints[p].links if ln != mech.ground) if p in joints else None
         if p in joints and mech.ground in joints[p].links:
             continue  # a frame pivot: fixed
         need(index[p], link)
-    ref = _reference_input(mech)
-    # the crank's reference line (simulate's link frame): first joint of the crank in file
-    # order to the first other joint point
-    cj = [j for j in mech.joints if crank in j.links]
-    p0 = np.asarray(cj[0].point, float)
-    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
-    line = (index[cj[0].id], index[other.id]) if other is not None else None
-    return BatchPlan(names=names, ops=tuple([("ground", ground_pts)] + ops), outputs=tuple(points),
-                     input_joint=drv.id, input_sign=sign, n_dyads=len(dyads),
-                     links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref,
-                     crank_line=line)
+    return points
 
 
 def _reference_input(mech: Mechanism) -> float:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -283,155 +284,198 @@ def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray
     st.set(i, P - _apply(c, sn, s_local), phi)
 
 
-def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: float | None) -> float:
-    """Solve one step in place; return its assembly sign (sigma) for the branch."""
-    if step.kind == "drive_R":
-        (new,), (k,), (jid,) = step.links, step.known, step.joints
-        con = next(c for c in _cons_of(S, jid) if c.role == "drive")
-        th = u[:, con.driver]
-        _, phik = st.pose(k)
-        phi = phik + th if con.b == new else phik - th
-        P = st.point(k, _local(S, k, jid))
-        _pin(st, new, P, _local(S, new, jid), phi)
-        return 1.0
-    if step.kind == "drive_P":
-        (new,), (k,), (jid,) = step.links, step.known, step.joints
-        drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
-        line = _line(S, jid)
-        val = u[:, drive.driver]
-        if drive.a == k:
-            ra, pa = st.pose(k)
-            ca, sa_ = _rot(pa)
-            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
-            Pa = st.point(k, line.sa)
-            Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
-            _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
-        else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
-            pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
-            ca, sa_ = _rot(pa)
-            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
-            Pb = st.point(k, drive.sb)
-            Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
-            st.set(new, Oa, pa)
-        return 1.0
+def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """Solve one step in place; return its assembly sign (sigma) for the branch: ``sigma``
+    given (a number or one per row), None (the drawn mode) or a chooser called with the
+    normalised discriminant and the drawn mode."""
+    kernel = _STEP_KERNELS.get(step.kind)
+    if kernel is None:
+        raise _NotHandled
+    return kernel(S, st, step, u, sigma)
+
+
+def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """A link turned by an R drive about a known link."""
+    (new,), (k,), (jid,) = step.links, step.known, step.joints
+    con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    th = u[:, con.driver]
+    _, phik = st.pose(k)
+    phi = phik + th if con.b == new else phik - th
+    P = st.point(k, _local(S, k, jid))
+    _pin(st, new, P, _local(S, new, jid), phi)
+    return 1.0
+
+
+def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """A link slid by a P drive along a known link."""
+    (new,), (k,), (jid,) = step.links, step.known, step.joints
+    drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    line = _line(S, jid)
+    val = u[:, drive.driver]
+    if drive.a == k:
+        ra, pa = st.pose(k)
+        ca, sa_ = _rot(pa)
+        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        Pa = st.point(k, line.sa)
+        Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
+        _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
+    else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
+        pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
+        ca, sa_ = _rot(pa)
+        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        Pb = st.point(k, drive.sb)
+        Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
+        st.set(new, Oa, pa)
+    return 1.0
+
+
+def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RRR dyad: the intersection of two circles."""
     A_s, B_s = step.known
     b1, b2 = step.links
     J1, J2, J3 = step.joints
-    if step.kind == "RRR":
-        A = st.point(A_s, _local(S, A_s, J1))
-        C = st.point(B_s, _local(S, B_s, J3))
-        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-        L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
-        d = C - A
-        D2 = _dot(d, d)
-        D = np.sqrt(D2)
-        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
-        h2 = L1 ** 2 - a ** 2
-        if sigma is None or callable(sigma):
-            s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
-            sigma = s_file if sigma is None else sigma(h2 / L1 ** 2, s_file)
-        h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
-        h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
-        e = d / D[:, None]
-        B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
-        beta1 = np.arctan2(*(s2 - s1)[::-1])
-        beta2 = np.arctan2(*(t2 - t3)[::-1])
-        phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
-        phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
-        _pin(st, b1, A, s1, phi1)
-        _pin(st, b2, C, t3, phi2)
-        return sigma
-    if step.kind in ("RRP", "PRR"):
-        # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
-        if step.kind == "RRP":
-            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
-        else:
-            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
-        A = st.point(kr, _local(S, kr, Jr))
-        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
-        line = _line(S, Jp)
-        # the P joint's point on lp and the known line through kp's joint point
-        t_p = line.sb if line.b == lp else line.sa
-        s_k = line.sa if line.a == kp else line.sb
-        Pk = st.point(kp, s_k)
-        phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
-        ca, sa_ = _rot(phi_axis)
-        w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
-        cp, sp = _rot(phi_p)
-        tB = _local(S, lp, J2)
-        Q = Pk + _apply(cp, sp, tB - t_p)
-        L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
-        p = _dot(w, Q - A)
-        cc = _dot(Q - A, Q - A) - L1 ** 2
-        disc = p ** 2 - cc
-        if sigma is None or callable(sigma):
-            lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
-            s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
-            sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
-        disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
-        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        lam = -p + sigma * root
-        B = Q + lam[:, None] * w
-        sr = _local(S, lr, Jr)
-        beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
-        phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
-        _pin(st, lr, A, sr, phi_r)
-        _pin(st, lp, B, tB, phi_p)
-        return sigma
-    if step.kind == "RPR":
-        A = st.point(A_s, _local(S, A_s, J1))
-        C = st.point(B_s, _local(S, B_s, J3))
-        c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
-        line = _line(S, J2)
-        n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
-                                                      np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
-        # n_loc: the slide normal in b1's frame
-        sA, sP = _local(S, b1, J1), _local(S, b1, J2)
-        tC, tP = _local(S, b2, J3), _local(S, b2, J2)
-        cc, sc = np.cos(c), np.sin(c)
-        Rc = np.array([[cc, -sc], [sc, cc]])
-        e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
-        d = C - A
-        D = np.sqrt(_dot(d, d))
-        delta = np.arctan2(d[:, 1], d[:, 0])
-        nu = np.arctan2(n_loc[1], n_loc[0])
-        ratio = e / D
-        if sigma is None or callable(sigma):
-            phi0 = float(st.S.q0[3 * b1 + 2])
-            s_file = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
-            sigma = s_file if sigma is None else sigma(1.0 - ratio ** 2, s_file)
-        ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
-        ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
-        phi1 = delta - nu + sigma * ac
-        _pin(st, b1, A, sA, phi1)
-        _pin(st, b2, C, tC, phi1 + c)
-        return sigma
-    if step.kind in ("RPP", "PPR"):
-        # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
-        if step.kind == "RPP":
-            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
-        else:
-            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
-        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
-        phi_r = phi_p + _rel_angle(S, J2, lp, lr)
-        A = st.point(kr, _local(S, kr, Jr))
-        _pin(st, lr, A, _local(S, lr, Jr), phi_r)
-        w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
-        w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
-        st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
-        return 1.0
-    if step.kind == "PRP":
-        phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
-        phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
-        sB, tB = _local(S, b1, J2), _local(S, b2, J2)
-        w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
-        w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
-        B = _solve2(w1, h1, w2, h2)
-        _pin(st, b1, B, sB, phi1)
-        _pin(st, b2, B, tB, phi2)
-        return 1.0
-    raise _NotHandled
+    A = st.point(A_s, _local(S, A_s, J1))
+    C = st.point(B_s, _local(S, B_s, J3))
+    s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+    t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+    L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
+    d = C - A
+    D2 = _dot(d, d)
+    D = np.sqrt(D2)
+    a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
+    h2 = L1 ** 2 - a ** 2
+    if sigma is None or callable(sigma):
+        s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(h2 / L1 ** 2, s_file)
+    h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
+    h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
+    e = d / D[:, None]
+    B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
+    beta1 = np.arctan2(*(s2 - s1)[::-1])
+    beta2 = np.arctan2(*(t2 - t3)[::-1])
+    phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
+    phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
+    _pin(st, b1, A, s1, phi1)
+    _pin(st, b2, C, t3, phi2)
+    return sigma
+
+
+def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RRP / PRR dyad: the intersection of a circle and a line."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
+    if step.kind == "RRP":
+        lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
+    else:
+        lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+    A = st.point(kr, _local(S, kr, Jr))
+    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+    line = _line(S, Jp)
+    # the P joint's point on lp and the known line through kp's joint point
+    t_p = line.sb if line.b == lp else line.sa
+    s_k = line.sa if line.a == kp else line.sb
+    Pk = st.point(kp, s_k)
+    phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
+    ca, sa_ = _rot(phi_axis)
+    w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
+    cp, sp = _rot(phi_p)
+    tB = _local(S, lp, J2)
+    Q = Pk + _apply(cp, sp, tB - t_p)
+    L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
+    p = _dot(w, Q - A)
+    cc = _dot(Q - A, Q - A) - L1 ** 2
+    disc = p ** 2 - cc
+    if sigma is None or callable(sigma):
+        lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+        s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
+    disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
+    root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    lam = -p + sigma * root
+    B = Q + lam[:, None] * w
+    sr = _local(S, lr, Jr)
+    beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
+    phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
+    _pin(st, lr, A, sr, phi_r)
+    _pin(st, lp, B, tB, phi_p)
+    return sigma
+
+
+def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RPR dyad: the slide line keeps its offset from both pivots."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    A = st.point(A_s, _local(S, A_s, J1))
+    C = st.point(B_s, _local(S, B_s, J3))
+    c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
+    line = _line(S, J2)
+    n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
+                                                  np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
+    # n_loc: the slide normal in b1's frame
+    sA, sP = _local(S, b1, J1), _local(S, b1, J2)
+    tC, tP = _local(S, b2, J3), _local(S, b2, J2)
+    cc, sc = np.cos(c), np.sin(c)
+    Rc = np.array([[cc, -sc], [sc, cc]])
+    e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
+    d = C - A
+    D = np.sqrt(_dot(d, d))
+    delta = np.arctan2(d[:, 1], d[:, 0])
+    nu = np.arctan2(n_loc[1], n_loc[0])
+    ratio = e / D
+    if sigma is None or callable(sigma):
+        phi0 = float(st.S.q0[3 * b1 + 2])
+        s_file = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(1.0 - ratio ** 2, s_file)
+    ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
+    ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
+    phi1 = delta - nu + sigma * ac
+    _pin(st, b1, A, sA, phi1)
+    _pin(st, b2, C, tC, phi1 + c)
+    return sigma
+
+
+def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RPP / PPR dyad: orientations from the P pairs, position from two lines."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
+    if step.kind == "RPP":
+        lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
+    else:
+        lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+    phi_r = phi_p + _rel_angle(S, J2, lp, lr)
+    A = st.point(kr, _local(S, kr, Jr))
+    _pin(st, lr, A, _local(S, lr, Jr), phi_r)
+    w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
+    w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
+    st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
+    return 1.0
+
+
+def _step_PRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """PRP dyad: the intersection of two slide lines."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
+    phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
+    sB, tB = _local(S, b1, J2), _local(S, b2, J2)
+    w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
+    w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
+    B = _solve2(w1, h1, w2, h2)
+    _pin(st, b1, B, sB, phi1)
+    _pin(st, b2, B, tB, phi2)
+    return 1.0
+
+
+_STEP_KERNELS = {"drive_R": _step_drive_R, "drive_P": _step_drive_P, "RRR": _step_RRR, "RRP": _step_RRP,
+                 "PRR": _step_RRP, "RPR": _step_RPR, "RPP": _step_RPP, "PPR": _step_RPP, "PRP": _step_PRP}
+
 
 
 def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.ndarray,
@@ -606,7 +650,7 @@ def chain_supported(plan: Plan | None) -> bool:
 def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
                rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
                rotations: bool = True, sigmas: list | None = None,
-               discs: dict | None = None) -> ChainResult:
+               discs: dict | None = None, least: float | None = None) -> ChainResult:
     """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
 
     Every link is carried by an *anchor* (the joint that placed it: its position,
@@ -619,7 +663,9 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     in chunks that stay in the processor's cache. ``sigmas``: the assembly sign of every
     step per input row (from :func:`solve_tracked`); default: the drawn modes.
     ``discs``: when a dict, it receives every RRR step's normalised discriminant
-    ``g^2 |d|^2 / L1^2`` (``h^2 / L1^2`` of :func:`solve_tracked`) per row, by step index.
+    ``g^2 |d|^2 / L1^2`` (``h^2 / L1^2`` of :func:`solve_tracked`) per row, by step index;
+    ``least``: with ``discs``, stop (raising ``_Irregular``) as soon as a discriminant
+    falls below it.
     """
     U = np.atleast_2d(np.asarray(U, float))
     N = U.shape[0]
@@ -641,7 +687,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     with np.errstate(invalid="ignore", divide="ignore"):
         for start in range(0, N, chunk):
             sl = slice(start, min(N, start + chunk))
-            ch = _Chunk(S, anchor, rates, out, sl, discs)
+            ch = _Chunk(S, anchor, rates, out, sl, discs, least)
             for op in prog:
                 if op[0] == "drive":
                     ch.drive(op, U[sl], speeds, fixed)
@@ -652,7 +698,27 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
 
 
 def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list, dict]:
-    """The chain's steps as kernels' arguments, and every link's anchor joint."""
+    """The chain's steps as kernels' arguments, and every link's anchor joint (built once
+    per system and plan; the signs ``sigmas`` put in per call)."""
+    memo = _memo(S)
+    key = ("chain", id(plan))
+    if key not in memo:
+        memo[key] = _chain_program_(S, plan)
+    prog, anchor = memo[key]
+    if sigmas is None:
+        return prog, anchor
+    out = []
+    for op in prog:
+        sg = sigmas[op[1]] if op[0] == "RRR" else None
+        if isinstance(sg, np.ndarray):
+            op = op[:7] + (np.asarray(sg, float),) + op[8:]
+        elif callable(sg):
+            op = op[:7] + ((sg, (op[5] ** 0.5, op[6] ** 0.5), S.mech.joint(op[4][1]).point),) + op[8:]
+        out.append(op)
+    return out, anchor
+
+
+def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
     prog = []
     anchor: dict[int, tuple[str, np.ndarray]] = {}
     for si, step in enumerate(plan.steps):
@@ -669,10 +735,6 @@ def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[li
         L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
         A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
         sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
-        if sigmas is not None and isinstance(sigmas[si], np.ndarray):
-            sigma = np.asarray(sigmas[si], float)
-        elif sigmas is not None and callable(sigmas[si]):
-            sigma = (sigmas[si], (L1s ** 0.5, L2s ** 0.5), B0)
         anchor[b1] = (J1, s1)
         anchor[b2] = (J3, t3)
         prog.append(("RRR", si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
@@ -680,13 +742,18 @@ def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[li
     return prog, anchor
 
 
+class _Irregular(Exception):
+    """A group's discriminant fell below the bound of a regular sweep (:func:`solve_regular`)."""
+
+
 class _Chunk:
     """One chunk of rows of :func:`fast_chain`: the joints' states and the links'
     rotations and rates found so far, and the kernels that extend them."""
 
     def __init__(self, S: PlanarSystem, anchor: dict, rates: bool, out: "ChainResult", sl: slice,
-                 discs: dict | None) -> None:
+                 discs: dict | None, least: float | None = None) -> None:
         self.S, self.anchor, self.rates, self.out, self.sl, self.discs = S, anchor, rates, out, sl, discs
+        self.least = least
         self.written: set[str] = set()    # joints whose outputs were computed in place
         self.rot: dict[int, tuple] = {}   # link -> ("cs", c, s) or ("vec", ex, ey, local / L^2)
         self.rate: dict[int, tuple] = {}  # link -> (omega, alpha)
@@ -767,6 +834,8 @@ class _Chunk:
         if self.discs is not None:
             d = np.divide(g, inv, out=self.discs[si][sl])
             d *= 1.0 / L1s
+            if self.least is not None and not d.min() >= self.least:  # NaN too
+                raise _Irregular
         if isinstance(sigma, tuple):  # a chooser: the signs from the discriminant of _solve_step
             sigma = self._choose(sigma, A, dx, dy, inv)
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
@@ -949,11 +1018,10 @@ def solve_regular(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     u0 = np.array([d.assembled for d in S.drivers], float)
     ends = [U[0]] if split is None else [U[split], U[split - 1]]
     X = np.vstack([U] + [_connecting_path(S, u0, _shifted_start(S, u0, e)) for e in ends])
-    discs: dict = {}
-    r = fast_chain(S, plan, X, speeds, rates=True, discs=discs)
-    for d in discs.values():
-        if not d.min() >= REGULAR_DISC:  # NaN too
-            return None
+    try:  # stops at the first group that comes near a fold (little work wasted)
+        r = fast_chain(S, plan, X, speeds, rates=True, discs={}, least=REGULAR_DISC)
+    except _Irregular:
+        return None
     if X.shape[0] > N:
         r = ChainResult({j: v[:N] for j, v in r.points.items()}, {j: v[:N] for j, v in r.velocities.items()},
                         {j: v[:N] for j, v in r.accelerations.items()}, r.cos[:N], r.sin[:N], r.omega[:N],
@@ -1009,30 +1077,50 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
                             _sweep_events(raw_events, n0, shift))
 
 
-def solve_tracked_rates(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarray,
-                        switch: bool = False) -> tuple:
-    """:func:`solve_tracked` and :func:`solve_all` of a driver-R + RRR chain in one array
-    pass of :func:`fast_chain`: each group's signs are chosen by the branch rules on its
-    discriminant as the pass reaches it. Returns ``q, qd, qdd`` (N, n), the singular rows
-    and the events."""
-    X, n0, shift = _tracking_rows(S, inputs)
-    M = X.shape[0]
+def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray,
+                        switch: bool = False) -> list[tuple]:
+    """:func:`solve_tracked` and :func:`solve_all` of a driver-R + RRR chain for several
+    sweeps (``parts``: arrays of input rows, each reached from the drawn configuration on
+    its own) in one array pass of :func:`fast_chain`: each group's signs are chosen by
+    the branch rules on its discriminant, sweep by sweep, as the pass reaches the group.
+    Returns per sweep ``q, qd, qdd`` (N, n), its singular rows and its events."""
+    parts = [np.atleast_2d(np.asarray(p, float)) for p in parts]
+    rows = [_tracking_rows(S, p) for p in parts]
+    starts = np.cumsum([0] + [X.shape[0] for X, _, _ in rows])
+    segs = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
     sigmas: list = [1.0] * len(plan.steps)
-    discs: dict = {}
-    singular = np.zeros(M, bool)
-    raw_events: list = []
+    singular = np.zeros(int(starts[-1]), bool)
+    raw_events: list = [[] for _ in parts]
     for k, step in enumerate(plan.steps):
         if step.kind in BRANCHED:
-            sigmas[k] = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular,
-                                 store=True)
-    U = np.atleast_2d(np.asarray(inputs, float))
-    # the sweep's own rows (not shifted by turns: the same numbers as an untracked pass);
-    # the choosers' events and root searches use the shifted rows X
-    r = fast_chain(S, plan, np.vstack([X[:n0], U]), speeds, rates=True, sigmas=sigmas, chunk=max(M, 1))
-    if n0:
-        r = _chain_rows(r, slice(n0, None))
-    q, qd, qdd = _poses_from_chain(S, plan, U, r)
-    return q, qd, qdd, singular[n0:], _sweep_events(raw_events, n0, shift)
+            sigmas[k] = _parts_chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
+    # the sweeps' own rows (not shifted by turns: the same numbers as an untracked pass);
+    # the choosers' events and root searches use the shifted rows
+    E = np.vstack([blk for (X, n0, _), U in zip(rows, parts) for blk in (X[:n0], U)])
+    r = fast_chain(S, plan, E, speeds, rates=True, sigmas=sigmas, chunk=max(E.shape[0], 1))
+    out = []
+    for (X, n0, shift), U, seg, evs in zip(rows, parts, segs, raw_events):
+        sweep_rows = slice(seg.start + n0, seg.stop)
+        q, qd, qdd = _poses_from_chain(S, plan, U, _chain_rows(r, sweep_rows))
+        out.append((q, qd, qdd, singular[sweep_rows], _sweep_events(evs, n0, shift)))
+    return out
+
+
+def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
+                   raw_events: list, singular: np.ndarray):
+    """The sign chooser of branched step ``k`` over several sweeps' rows (``segs`` of the
+    pass): the branch rules (:func:`_branch_signs`) applied to each sweep's rows alone;
+    the signs are also put in ``sigmas[k]``."""
+    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
+        sig = np.empty(len(disc))
+        for (X, n0, _), seg, evs in zip(rows, segs, raw_events):
+            up = [s[seg] if isinstance(s, np.ndarray) else s for s in sigmas[:k]]
+            sig[seg], found, sing = _branch_signs(S, plan, k, up, X, disc[seg], s_file, n0, switch)
+            evs.extend(found)
+            singular[seg][sing] = True
+        sigmas[k] = sig
+        return sig
+    return choose
 
 
 def _chain_rows(r: "ChainResult", rows: slice) -> "ChainResult":
@@ -1058,18 +1146,15 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
 
 
 def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
-             discs: dict, raw_events: list, singular: np.ndarray, store: bool = False):
+             discs: dict, raw_events: list, singular: np.ndarray):
     """The sign chooser of branched step ``k``: called with the step's normalised
     discriminant and the drawn mode, it applies the branch rules (:func:`_branch_signs`),
-    records the discriminant, events and singular rows, and returns the signs (also put
-    in ``sigmas[k]`` when ``store``)."""
+    records the discriminant, events and singular rows, and returns the signs."""
     def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
         sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
         discs[k] = disc
         raw_events.extend(evs)
         singular[sing] = True
-        if store:
-            sigmas[k] = sig
         return sig
     return choose
 
