@@ -360,16 +360,20 @@ def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any
     return sigma
 
 
+def _oriented(step: Step, kind: str) -> tuple:
+    """A dyad's links, known links and end joints in the order of ``kind`` (the step's
+    own order, or reversed for its mirror kind, e.g. PRR as RRP)."""
+    (A_s, B_s), (b1, b2), (J1, _, J3) = step.known, step.links, step.joints
+    if step.kind == kind:
+        return b1, b2, A_s, B_s, J1, J3
+    return b2, b1, B_s, A_s, J3, J1
+
+
 def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
     """RRP / PRR dyad: the intersection of a circle and a line."""
-    A_s, B_s = step.known
-    b1, b2 = step.links
-    J1, J2, J3 = step.joints
     # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
-    if step.kind == "RRP":
-        lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
-    else:
-        lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+    lr, lp, kr, kp, Jr, Jp = _oriented(step, "RRP")
+    J2 = step.joints[1]
     A = st.point(kr, _local(S, kr, Jr))
     phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
     line = _line(S, Jp)
@@ -439,14 +443,9 @@ def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any
 
 def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
     """RPP / PPR dyad: orientations from the P pairs, position from two lines."""
-    A_s, B_s = step.known
-    b1, b2 = step.links
-    J1, J2, J3 = step.joints
     # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
-    if step.kind == "RPP":
-        lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
-    else:
-        lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
+    lr, lp, kr, kp, Jr, Jp = _oriented(step, "RPP")
+    J2 = step.joints[1]
     phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
     phi_r = phi_p + _rel_angle(S, J2, lp, lr)
     A = st.point(kr, _local(S, kr, Jr))
