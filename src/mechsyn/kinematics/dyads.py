@@ -580,21 +580,23 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
     qd = np.empty((S.n, N)).T
     qdd = np.empty((S.n, N)).T
     phi = np.arctan2(r.sin, r.cos)
-    for i in range(nl):
-        jid, sa = r.anchor[i]
-        c, s = r.cos[:, i], r.sin[:, i]
-        relx = -(c * sa[0] - s * sa[1])  # r - P_anchor
-        rely = -(s * sa[0] + c * sa[1])
-        P, V, A = r.points[jid], r.velocities[jid], r.accelerations[jid]
-        w, al = r.omega[:, i], r.alpha[:, i]
-        w2 = w * w
-        q[:, 3 * i] = P[:, 0] + relx
-        q[:, 3 * i + 1] = P[:, 1] + rely
-        qd[:, 3 * i] = V[:, 0] - w * rely
-        qd[:, 3 * i + 1] = V[:, 1] + w * relx
-        qdd[:, 3 * i] = A[:, 0] - al * rely - w2 * relx
-        qdd[:, 3 * i + 1] = A[:, 1] + al * relx - w2 * rely
-        qd[:, 3 * i + 2], qdd[:, 3 * i + 2] = w, al
+    # all links at once: (N, nl) arrays, the anchors' states gathered per link
+    jids = [r.anchor[i][0] for i in range(nl)]
+    sa = np.array([r.anchor[i][1] for i in range(nl)], float).reshape(nl, 2)
+    c, s = r.cos, r.sin
+    relx = -(c * sa[:, 0] - s * sa[:, 1])  # r - P_anchor
+    rely = -(s * sa[:, 0] + c * sa[:, 1])
+    P, V, A = (np.stack([d[j] for j in jids], axis=2) if nl else np.empty((N, 2, 0))
+               for d in (r.points, r.velocities, r.accelerations))  # (N, 2, nl)
+    w, al = r.omega, r.alpha
+    w2 = w * w
+    q[:, 0:3 * nl:3] = P[:, 0] + relx
+    q[:, 1:3 * nl:3] = P[:, 1] + rely
+    qd[:, 0:3 * nl:3] = V[:, 0] - w * rely
+    qd[:, 1:3 * nl:3] = V[:, 1] + w * relx
+    qdd[:, 0:3 * nl:3] = A[:, 0] - al * rely - w2 * relx
+    qdd[:, 1:3 * nl:3] = A[:, 1] + al * relx - w2 * rely
+    qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
     # angles: drivers' links take the input itself, dyad links are made continuous
     drive_links = {}
     for step in plan.steps:
