@@ -351,25 +351,14 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
             d0 = X[:, p3] - X[:, p1]
             sigma = np.where((d0.conj() * r1).imag >= 0, 1.0, -1.0)
             sigmas.append(sigma)
-            d = C - A
-            t = d.real ** 2 + d.imag ** 2
-            with np.errstate(divide="ignore", invalid="ignore"):
-                alpha = 0.5 + ((L1s - L2s)[:, None] * 0.5) / t
-                beta2 = L1s[:, None] / t - alpha * alpha
-                beta = np.sqrt(beta2)          # NaN where the dyad does not assemble
-            good = beta2 >= 0
+            B, dw, beta, inv, good = _rrr(A, C, L1s, L2s, sigma, flags and N >= 3, jump)
             ok &= good
-            w = alpha + 1j * (sigma[:, None] * beta)
-            dw = d * w                         # B - A
-            B = A + dw
             pos[p2] = B
             links[b1] = (A, dw, p1, r1)
             links[b2] = (C, (lambda B=B, C=C: B - C), p3, r3)
-            if flags and N >= 3:
-                jump |= _stepped_over(beta2 * t / np.maximum(L1s, 1e-300)[:, None])
             if transmission:
-                with np.errstate(invalid="ignore"):
-                    s = t * beta / np.sqrt(L1s * L2s)[:, None]
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    s = beta / (inv * np.sqrt(L1s * L2s)[:, None])
                 sin_mu = np.fmin(sin_mu, np.nanmin(np.where(good, s, np.inf), axis=1))
     paths = {}
     for name in plan.outputs:
@@ -384,6 +373,32 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     return BatchResult(inputs=np.asarray(inputs, float), paths=paths, assembled=ok,
                        dead_point=~ok.all(axis=1), branch_jump=jump, min_transmission_angle=mu,
                        sigmas=np.stack(sigmas, axis=1) if sigmas else np.zeros((K, 0)))
+
+
+def _rrr(A: np.ndarray, C: np.ndarray, L1s: np.ndarray, L2s: np.ndarray, sigma: np.ndarray, flags: bool,
+         jump: np.ndarray) -> tuple:
+    """The RRR kernel on (K, N) complex end points: ``B``, ``B - A``, the height ratio
+    ``sigma beta`` (NaN where the dyad does not assemble), ``1 / |d|^2`` and the mask of
+    assembled samples; ``jump`` or-ed with the stepped-over dead points when ``flags``.
+    Written with few temporaries: each is a (K, N) array pass."""
+    d = C - A
+    inv = d.real * d.real
+    inv += d.imag * d.imag
+    with np.errstate(divide="ignore", invalid="ignore"):
+        np.divide(1.0, inv, out=inv)
+        alpha = inv * (0.5 * (L1s - L2s))[:, None]
+        alpha += 0.5
+        beta = inv * L1s[:, None]
+        beta -= alpha * alpha                  # beta^2
+        good = beta >= 0
+        if flags:
+            jump |= _stepped_over(beta / (inv * np.maximum(L1s, 1e-300)[:, None]))
+        np.sqrt(beta, out=beta)                # NaN where the dyad does not assemble
+    beta *= sigma[:, None]
+    w = np.empty(d.shape, complex)
+    w.real, w.imag = alpha, beta
+    dw = np.multiply(d, w, out=w)              # B - A
+    return A + dw, dw, beta, inv, good
 
 
 def _stepped_over(b: np.ndarray) -> np.ndarray:
