@@ -23,8 +23,10 @@ Optionally pylinkage (numba; in its own virtual environment, never a mechsyn dep
 runs build + compile + ``step_fast_with_kinematics`` for the same crank-rocker in a
 subprocess; its time is printed beside mechsyn's and its positions are checked equal.
 
-Times are the minimum of ``--repeats`` runs (the machine is shared: minima are the
-least noisy statistic).
+Times are minima (``3 x --repeats`` runs; the bare reference ``10 x``): on a shared
+machine minima are the least noisy statistic of each. ``x med`` is a second estimate of
+the ratio: the case and the reference timed alternately (``--repeats`` rounds, the median
+of 10 calls each), the median of the rounds' ratios (both see the same load in a round).
 """
 
 from __future__ import annotations
@@ -97,6 +99,36 @@ def best_of(f, repeats: int) -> float:
     return best
 
 
+def paired(f, ref, repeats: int, inner: int = 10) -> tuple[float, float, float]:
+    """Median time of ``f``, median time of ``ref`` (each a median of ``inner`` calls) and
+    the median of their ratios, the two timed alternately ``repeats`` times: on a shared
+    machine both see the same load, so the ratio is steadier than either time."""
+    f()
+    ref()
+
+    def med(g) -> float:
+        ts = []
+        for _ in range(inner):
+            t = time.perf_counter()
+            g()
+            ts.append(time.perf_counter() - t)
+        return float(np.median(ts))
+
+    tf, tr = [], []
+    for _ in range(repeats):
+        tf.append(med(f))
+        tr.append(med(ref))
+    tf_, tr_ = np.array(tf), np.array(tr)
+    return float(np.median(tf_)), float(np.median(tr_)), float(np.median(tf_ / tr_))
+
+
+def both(f, ref, repeats: int, t_ref_min: float) -> tuple[float, float, float]:
+    """(minimum time of ``f``, its ratio to the reference's minimum ``t_ref_min``, the
+    median ratio of :func:`paired`)."""
+    t = best_of(f, repeats * 3)
+    return t, t / t_ref_min, paired(f, ref, repeats)[2]
+
+
 def jansen(writing: str):
     import yaml
 
@@ -151,17 +183,20 @@ def main() -> None:
              ("Jansen leg (double joint on the foot)", jansen("third"), "P0"),
              ("Jansen leg (chain)", jansen("chain"), "P0"),
              ("Jansen leg (star)", jansen("star"), "P0")]
-    print(f"# mechsyn simulate, {N} inputs, min of {args.repeats} runs; bare NumPy four-bar "
-          f"(positions only): {t_bare * 1e6:.0f} us")
+    print(f"# mechsyn simulate, {N} inputs; 'ms' and 'x bare': minimum of {args.repeats * 3} runs over the "
+          f"minimum of the bare NumPy four-bar (positions only, {t_bare * 1e6:.0f} us); 'x med': median ratio of "
+          f"{args.repeats} rounds of 10 calls each, the case and the bare reference alternately")
     print(f"# checks: crank-rocker = bare NumPy to {err:.1e}; textbook four-bar dead points to "
           f"{dead_err:.1e} deg")
-    print(f"{'case':<40s} {'method':>7s} {'events':>6s} {'ms':>8s} {'x bare':>8s} {'target':>7s}")
+    print(f"{'case':<40s} {'method':>7s} {'events':>6s} {'ms':>8s} {'x bare':>8s} {'x med':>7s} {'target':>7s}")
+    def bare() -> None:
+        bare_fourbar(th0 + th, P["A"], P["D"], a, b, c, sigma)
+
     for name, mech, joint in cases:
-        t = best_of(lambda: simulate(mech, {joint: x}), args.repeats)
+        t, ratio, med = both(lambda: simulate(mech, {joint: x}), bare, args.repeats, t_bare)
         s = simulate(mech, {joint: x})
-        ratio = t / t_bare
         tgt = TARGETS[name]
-        print(f"{name:<40s} {s.method:>7s} {len(s.events):>6d} {t * 1e3:8.2f} {ratio:8.1f} "
+        print(f"{name:<40s} {s.method:>7s} {len(s.events):>6d} {t * 1e3:8.2f} {ratio:8.1f} {med:7.1f} "
               f"{'<=' + str(tgt):>5s} {'ok' if ratio <= tgt else 'MISS'}")
     watt = compile_plan(load_mechanism(ROOT / "examples/textbook/watt_sixbar.yaml"), inputs=("A",))
     k = [0]
@@ -170,9 +205,9 @@ def main() -> None:
         k[0] += 1
         watt.with_joint_points({"G": (5.0 + 0.001 * (k[0] % 7), 6.0)}).simulate({"A": x})
 
-    t = best_of(drag, args.repeats)
+    t, ratio, med = both(drag, bare, args.repeats, t_bare)
     print(f"{'drag (with_joint_points + simulate), Watt':<40s} {'assur':>7s} {'':>6s} {t * 1e3:8.2f} "
-          f"{t / t_bare:8.1f}")
+          f"{ratio:8.1f} {med:7.1f}")
     py = Path(args.pylinkage)
     if py.exists():
         out = str(Path("/tmp") / f"pylinkage_bench_{os.getpid()}")

@@ -10,7 +10,7 @@ animation: :mod:`mechsyn.plot.kinematics`.
 
 from typing import Any
 
-__all__ = ["simulate", "forces", "input_grid", "compile_plan", "KinematicPlan"]
+__all__ = ["simulate", "forces", "input_grid", "compile_plan", "cached_plan", "KinematicPlan"]
 
 
 def __getattr__(name: str) -> Any:  # lazy: importing the package stays cheap

@@ -14,6 +14,7 @@ P inputs and lengths in the file's length unit.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -28,7 +29,7 @@ from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
-           "KinematicPlan", "compile_plan",
+           "KinematicPlan", "compile_plan", "cached_plan",
            "ForceAnalysis", "forces"]
 
 
@@ -255,8 +256,52 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
-    return compile_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
+    return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
+
+
+#: Compiled plans of the mechanisms simulated lately, by mechanism (weakly: a plan lives
+#: as long as its mechanism) and then by the geometry and options it was compiled for.
+_PLANS: "weakref.WeakKeyDictionary[Mechanism, dict]" = weakref.WeakKeyDictionary()
+
+
+def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> tuple:
+    """What a compiled plan depends on besides the (frozen) topology: the joint points and
+    axes, joint attributes (cam profiles, belts), named points, VLL modes, prescribed
+    inputs. The arrays are mutable, so their bytes are part of the key."""
+    def arr(a: Any) -> bytes | None:
+        if isinstance(a, np.ndarray) and a.dtype == float:
+            return a.tobytes()
+        return None if a is None else np.asarray(a, float).tobytes()
+
+    joints = tuple((arr(j.point), arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints)
+    named = tuple((k, p.link, arr(p.at)) for k, p in mech.points.items())
+    return joints, named, tuple(sorted((vll or {}).items())), prescribed
+
+
+def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
+    """:func:`compile_plan`, reusing the plan compiled for the same mechanism object with
+    the same geometry and options (a moved joint point or a new VLL mode compiles anew).
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism
+    >>> m = load_mechanism("examples/kinematics/crank_rocker.yaml")
+    >>> cached_plan(m, inputs=("A",)) is cached_plan(m, inputs=("A",))
+    True
+    """
+    prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    key = _geometry_key(mech, vll, prescribed)
+    try:
+        plans = _PLANS.setdefault(mech, {})
+    except TypeError:  # not weakly referenceable: no cache
+        return compile_plan(mech, vll=vll, inputs=inputs)
+    kp = plans.get(key)
+    if kp is None:
+        if len(plans) >= 8:
+            plans.pop(next(iter(plans)))
+        kp = plans[key] = compile_plan(mech, vll=vll, inputs=inputs)
+    return kp
 
 
 @dataclass(frozen=True, eq=False)
@@ -376,7 +421,9 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-    sw = _outward(S, U, lambda part: _run(S, plan, part, sp, progress, change_points == "switch"))
+    sw = _one_pass(S, plan, U, sp, progress) if change_points == "keep" else None
+    if sw is None:
+        sw = _outward(S, U, lambda parts: _run(S, plan, parts, sp, progress, change_points == "switch"))
     events = sw.events
     used = sw.method
     ok = sw.assembled
@@ -392,16 +439,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     links = {}
     for i, name in enumerate(S.links):
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
-    pm = {}
-    for name, (link, at) in pts.items():
-        i = S.index(link)
-        s = S.to_local(link, at)
-        P, V, A = S.point_state(np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd), i, s)
-        for arr in (P, V, A):
-            arr[~ok] = np.nan
-        V[~rates_ok] = np.nan
-        A[~rates_ok] = np.nan
-        pm[name] = PointMotion(P, V, A, link)
+    pm = _point_motions(S, sw, pts, ok, rates_ok)
     events = [_event_units(S, e) for e in events]
     from mechsyn.kinematics.solve import singular_configuration
 
@@ -416,22 +454,71 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
-def _run(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
-         switch: bool = False) -> Sweep:
-    """One sweep from the drawn configuration through the rows of ``U`` in order."""
-    N = U.shape[0]
+def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
+    """Position, velocity, acceleration of every named point (NaN where not assembled;
+    rates NaN where not defined)."""
+    q, qd, qdd = np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd)
+    pm = {}
+    for name, (link, at) in pts.items():
+        P, V, A = S.point_state(q, qd, qdd, S.index(link), S.to_local(link, at))
+        for arr in (P, V, A):
+            arr[~ok] = np.nan
+        V[~rates_ok] = np.nan
+        A[~rates_ok] = np.nan
+        pm[name] = PointMotion(P, V, A, link)
+    return pm
+
+
+def _run(S: PlanarSystem, plan: "dyads.Plan | None", parts: list, sp: np.ndarray, progress: Any,
+         switch: bool = False) -> list[Sweep]:
+    """Sweeps from the drawn configuration through the rows of each of ``parts`` in order
+    (a driver-R + RRR chain: all in one array pass)."""
+    if plan is not None and plan.closed_form_rates:
+        res = dyads.solve_tracked_rates(S, plan, parts, sp, switch=switch)
+    else:
+        res = [_run_one(S, plan, U, sp, progress, switch) for U in parts]
+        if plan is None:
+            return res
+    out = []
+    for U, (q, qd, qdd, singular, tr_events) in zip(parts, res):
+        N = U.shape[0]
+        qd[singular] = np.nan  # a group folded flat: rates not defined here
+        qdd[singular] = np.nan
+        ok = np.all(np.isfinite(q), axis=1)
+        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
+        sw.events = _fast_events(tr_events, sw)
+        if progress is not None:
+            progress(N)
+        out.append(sw)
+    return out
+
+
+def _run_one(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
+             switch: bool) -> Any:
+    """One sweep by Newton continuation (a Sweep), or by the tracked closed form (its
+    arrays, singular rows and events)."""
     if plan is None:
         return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
     tracked = dyads.solve_tracked(S, plan, U, switch=switch)
     q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-    qd[tracked.singular] = np.nan  # a group folded flat: rates not defined here
-    qdd[tracked.singular] = np.nan
-    ok = np.all(np.isfinite(q), axis=1)
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
-    sw.events = _fast_events(tracked, sw)
+    return q, qd, qdd, tracked.singular, tracked.events
+
+
+def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray,
+              progress: Any) -> Sweep | None:
+    """The sweep of a chain whose groups stay clear of folds and change points, in one
+    array pass (:func:`dyads.solve_regular`); None when the branch rules are needed."""
+    if plan is None:
+        return None
+    res = dyads.solve_regular(S, plan, U, sp, _drawn_row(S, U))
+    if res is None:
+        return None
+    q, qd, qdd = res
+    N = U.shape[0]
     if progress is not None:
         progress(N)
-    return sw
+    ok = np.all(np.isfinite(q), axis=1)
+    return Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
 
 
 def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
@@ -460,9 +547,8 @@ def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
     contains the drawn input passes through the drawn configuration; else one run."""
     k = _drawn_row(S, U)
     if k is None:
-        return run(U)
-    fwd = run(U[k:])
-    bwd = run(U[:k][::-1].copy())
+        return run([U])[0]
+    fwd, bwd = run([U[k:], U[:k][::-1].copy()])
     events = []
     for e in bwd.events:
         e = dict(e)
@@ -513,11 +599,11 @@ def _event_units(S: PlanarSystem, e: dict) -> dict:
     return e
 
 
-def _fast_events(tracked: "dyads.TrackedPositions", sw: Sweep) -> list[dict]:
+def _fast_events(tracked_events: list, sw: Sweep) -> list[dict]:
     """Events of the closed-form sweep: dead points, reassembly and change / branch points
     found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
     out, seen = [], set()
-    for e in tracked.events:  # a gap of an upstream group is one reassembly of the mechanism
+    for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
         if e["kind"] == "reassembled":
             if e["index"] in seen:
                 continue

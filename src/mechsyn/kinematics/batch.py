@@ -147,20 +147,7 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
         When the mechanism is not of this kind (the message names what is not).
     """
     src = mech.source or mech.name
-    if mech.kind != "planar":
-        raise MechsynInputError("the batch engine handles planar mechanisms", source=src, field="kind")
-    bad = [j.id for j in mech.joints if j.type != "R"]
-    if bad:
-        raise MechsynInputError(f"joint {bad[0]} is {mech.joint(bad[0]).type}: the batch engine handles R pairs",
-                                source=src, field="joints", hint="use simulate for this mechanism")
-    drivers = [j for j in mech.joints if j.actuated]
-    if len(drivers) != 1:
-        raise MechsynInputError(f"{len(drivers)} actuated joints: the batch engine needs exactly one",
-                                source=src, field="joints")
-    drv = drivers[0]
-    if mech.ground not in drv.links:
-        raise MechsynInputError(f"the actuated joint {drv.id} is not on the frame {mech.ground}",
-                                source=src, field="joints", hint="drive a crank jointed to the frame")
+    drv = _batch_driver(mech, src)
     names = tuple([j.id for j in mech.joints] + [p for p in mech.points if p not in {j.id for j in mech.joints}])
     index = {n: i for i, n in enumerate(names)}
     on_link: dict[str, list[str]] = {ln.name: [] for ln in mech.links}
@@ -187,6 +174,54 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
             have.add(p)
 
     joints = {j.id: j for j in mech.joints}
+    dyads = _dyad_ops(mech, joints, on_link, index, known, used, have, ops, need)
+    missing = [ln.name for ln in mech.links if ln.name not in known]
+    if missing:
+        raise MechsynInputError(
+            f"links {', '.join(missing)} are not found by a crank and RRR dyads", source=src, field="joints",
+            hint="the batch engine needs a dyad-decomposable mechanism; use simulate")
+    if set(joints) - used:
+        raise MechsynInputError(
+            f"joints {', '.join(sorted(set(joints) - used))} close extra loops (overconstrained here)",
+            source=src, field="joints", hint="use simulate")
+    points = _output_points(mech, points, joints, index, names, need)
+    ref = _reference_input(mech)
+    # the crank's reference line (simulate's link frame): first joint of the crank in file
+    # order to the first other joint point
+    cj = [j for j in mech.joints if crank in j.links]
+    p0 = np.asarray(cj[0].point, float)
+    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
+    line = (index[cj[0].id], index[other.id]) if other is not None else None
+    return BatchPlan(names=names, ops=tuple([("ground", ground_pts)] + ops), outputs=tuple(points),
+                     input_joint=drv.id, input_sign=sign, n_dyads=len(dyads),
+                     links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref,
+                     crank_line=line)
+
+
+def _batch_driver(mech: Mechanism, src: str):
+    """The one actuated joint, on the frame, of a planar mechanism of R pairs (else the
+    error naming what is not so)."""
+    if mech.kind != "planar":
+        raise MechsynInputError("the batch engine handles planar mechanisms", source=src, field="kind")
+    bad = [j.id for j in mech.joints if j.type != "R"]
+    if bad:
+        raise MechsynInputError(f"joint {bad[0]} is {mech.joint(bad[0]).type}: the batch engine handles R pairs",
+                                source=src, field="joints", hint="use simulate for this mechanism")
+    drivers = [j for j in mech.joints if j.actuated]
+    if len(drivers) != 1:
+        raise MechsynInputError(f"{len(drivers)} actuated joints: the batch engine needs exactly one",
+                                source=src, field="joints")
+    drv = drivers[0]
+    if mech.ground not in drv.links:
+        raise MechsynInputError(f"the actuated joint {drv.id} is not on the frame {mech.ground}",
+                                source=src, field="joints", hint="drive a crank jointed to the frame")
+    return drv
+
+
+def _dyad_ops(mech: Mechanism, joints: dict, on_link: dict, index: dict, known: dict, used: set, have: set,
+              ops: list, need) -> list[tuple[str, str, str]]:
+    """RRR dyads in solving order (appended to ``ops``): links ``b1``, ``b2`` not yet
+    known, joined by ``J2`` and to known links by ``J1``, ``J3``."""
     dyads: list[tuple[str, str, str]] = []
     progress = True
     while progress:
@@ -214,37 +249,25 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
             dyads.append((J1, J2.id, J3))
             progress = True
             break
-    missing = [ln.name for ln in mech.links if ln.name not in known]
-    if missing:
-        raise MechsynInputError(
-            f"links {', '.join(missing)} are not found by a crank and RRR dyads", source=src, field="joints",
-            hint="the batch engine needs a dyad-decomposable mechanism; use simulate")
-    if set(joints) - used:
-        raise MechsynInputError(
-            f"joints {', '.join(sorted(set(joints) - used))} close extra loops (overconstrained here)",
-            source=src, field="joints", hint="use simulate")
+    return dyads
+
+
+def _output_points(mech: Mechanism, points: list[str] | None, joints: dict, index: dict, names: tuple,
+                   need) -> list[str]:
+    """The points whose paths are returned (default: the named points, else every joint),
+    each placed on its link (``need``)."""
     if points is None:
         points = list(mech.points) or [j.id for j in mech.joints]
     for p in points:
         if p not in index:
-            raise MechsynInputError(f"no point or joint named {p!r}", source="points",
+            raise MechsynInputError(f"no point or joint named {p!r}", field="points",
                                     hint=f"known: {', '.join(names)}")
         link = mech.points[p].link if p in mech.points else next(
             ln for ln in joints[p].links if ln != mech.ground) if p in joints else None
         if p in joints and mech.ground in joints[p].links:
             continue  # a frame pivot: fixed
         need(index[p], link)
-    ref = _reference_input(mech)
-    # the crank's reference line (simulate's link frame): first joint of the crank in file
-    # order to the first other joint point
-    cj = [j for j in mech.joints if crank in j.links]
-    p0 = np.asarray(cj[0].point, float)
-    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
-    line = (index[cj[0].id], index[other.id]) if other is not None else None
-    return BatchPlan(names=names, ops=tuple([("ground", ground_pts)] + ops), outputs=tuple(points),
-                     input_joint=drv.id, input_sign=sign, n_dyads=len(dyads),
-                     links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref,
-                     crank_line=line)
+    return points
 
 
 def _reference_input(mech: Mechanism) -> float:
@@ -328,25 +351,14 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
             d0 = X[:, p3] - X[:, p1]
             sigma = np.where((d0.conj() * r1).imag >= 0, 1.0, -1.0)
             sigmas.append(sigma)
-            d = C - A
-            t = d.real ** 2 + d.imag ** 2
-            with np.errstate(divide="ignore", invalid="ignore"):
-                alpha = 0.5 + ((L1s - L2s)[:, None] * 0.5) / t
-                beta2 = L1s[:, None] / t - alpha * alpha
-                beta = np.sqrt(beta2)          # NaN where the dyad does not assemble
-            good = beta2 >= 0
+            B, dw, beta, inv, good = _rrr(A, C, L1s, L2s, sigma, flags and N >= 3, jump)
             ok &= good
-            w = alpha + 1j * (sigma[:, None] * beta)
-            dw = d * w                         # B - A
-            B = A + dw
             pos[p2] = B
             links[b1] = (A, dw, p1, r1)
             links[b2] = (C, (lambda B=B, C=C: B - C), p3, r3)
-            if flags and N >= 3:
-                jump |= _stepped_over(beta2 * t / np.maximum(L1s, 1e-300)[:, None])
             if transmission:
-                with np.errstate(invalid="ignore"):
-                    s = t * beta / np.sqrt(L1s * L2s)[:, None]
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    s = beta / (inv * np.sqrt(L1s * L2s)[:, None])
                 sin_mu = np.fmin(sin_mu, np.nanmin(np.where(good, s, np.inf), axis=1))
     paths = {}
     for name in plan.outputs:
@@ -361,6 +373,32 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     return BatchResult(inputs=np.asarray(inputs, float), paths=paths, assembled=ok,
                        dead_point=~ok.all(axis=1), branch_jump=jump, min_transmission_angle=mu,
                        sigmas=np.stack(sigmas, axis=1) if sigmas else np.zeros((K, 0)))
+
+
+def _rrr(A: np.ndarray, C: np.ndarray, L1s: np.ndarray, L2s: np.ndarray, sigma: np.ndarray, flags: bool,
+         jump: np.ndarray) -> tuple:
+    """The RRR kernel on (K, N) complex end points: ``B``, ``B - A``, the height ratio
+    ``sigma beta`` (NaN where the dyad does not assemble), ``1 / |d|^2`` and the mask of
+    assembled samples; ``jump`` or-ed with the stepped-over dead points when ``flags``.
+    Written with few temporaries: each is a (K, N) array pass."""
+    d = C - A
+    inv = d.real * d.real
+    inv += d.imag * d.imag
+    with np.errstate(divide="ignore", invalid="ignore"):
+        np.divide(1.0, inv, out=inv)
+        alpha = inv * (0.5 * (L1s - L2s))[:, None]
+        alpha += 0.5
+        beta = inv * L1s[:, None]
+        beta -= alpha * alpha                  # beta^2
+        good = beta >= 0
+        if flags:
+            jump |= _stepped_over(beta / (inv * np.maximum(L1s, 1e-300)[:, None]))
+        np.sqrt(beta, out=beta)                # NaN where the dyad does not assemble
+    beta *= sigma[:, None]
+    w = np.empty(d.shape, complex)
+    w.real, w.imag = alpha, beta
+    dw = np.multiply(d, w, out=w)              # B - A
+    return A + dw, dw, beta, inv, good
 
 
 def _stepped_over(b: np.ndarray) -> np.ndarray:

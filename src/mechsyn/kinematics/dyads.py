@@ -25,7 +25,9 @@ chains use batched linear solves of the differentiated constraints.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -248,10 +250,19 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
-def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray) -> np.ndarray:
+def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray, split: int | None = None) -> np.ndarray:
     """Link angles made continuous along a sweep: start near the file's angles ``ref``,
-    unwrap each run of assembled rows and keep the turn count across gaps."""
+    unwrap each run of assembled rows and keep the turn count across gaps.
+
+    ``split``: the sweep (assembled throughout) was run outwards from the drawn
+    configuration, between rows ``split - 1`` and ``split``: both rows start near
+    ``ref`` and the angles are unwrapped away from them (as two runs would be)."""
     sub = ref + _wrap(phi - ref)
+    if split is not None and ok.all():
+        block = np.unwrap(sub, axis=0)
+        block[split:] -= 2 * np.pi * np.round((block[split] - sub[split]) / (2 * np.pi))
+        block[:split] -= 2 * np.pi * np.round((block[split - 1] - sub[split - 1]) / (2 * np.pi))
+        return block
     idx = np.flatnonzero(ok)
     runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
     prev = None
@@ -273,155 +284,197 @@ def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray
     st.set(i, P - _apply(c, sn, s_local), phi)
 
 
-def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: float | None) -> float:
-    """Solve one step in place; return its assembly sign (sigma) for the branch."""
-    if step.kind == "drive_R":
-        (new,), (k,), (jid,) = step.links, step.known, step.joints
-        con = next(c for c in _cons_of(S, jid) if c.role == "drive")
-        th = u[:, con.driver]
-        _, phik = st.pose(k)
-        phi = phik + th if con.b == new else phik - th
-        P = st.point(k, _local(S, k, jid))
-        _pin(st, new, P, _local(S, new, jid), phi)
-        return 1.0
-    if step.kind == "drive_P":
-        (new,), (k,), (jid,) = step.links, step.known, step.joints
-        drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
-        line = _line(S, jid)
-        val = u[:, drive.driver]
-        if drive.a == k:
-            ra, pa = st.pose(k)
-            ca, sa_ = _rot(pa)
-            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
-            Pa = st.point(k, line.sa)
-            Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
-            _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
-        else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
-            pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
-            ca, sa_ = _rot(pa)
-            w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
-            Pb = st.point(k, drive.sb)
-            Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
-            st.set(new, Oa, pa)
-        return 1.0
+def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """Solve one step in place; return its assembly sign (sigma) for the branch: ``sigma``
+    given (a number or one per row), None (the drawn mode) or a chooser called with the
+    normalised discriminant and the drawn mode."""
+    kernel = _STEP_KERNELS.get(step.kind)
+    if kernel is None:
+        raise _NotHandled
+    return kernel(S, st, step, u, sigma)
+
+
+def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """A link turned by an R drive about a known link."""
+    (new,), (k,), (jid,) = step.links, step.known, step.joints
+    con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    th = u[:, con.driver]
+    _, phik = st.pose(k)
+    phi = phik + th if con.b == new else phik - th
+    P = st.point(k, _local(S, k, jid))
+    _pin(st, new, P, _local(S, new, jid), phi)
+    return 1.0
+
+
+def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """A link slid by a P drive along a known link."""
+    (new,), (k,), (jid,) = step.links, step.known, step.joints
+    drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    line = _line(S, jid)
+    val = u[:, drive.driver]
+    if drive.a == k:
+        ra, pa = st.pose(k)
+        ca, sa_ = _rot(pa)
+        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        Pa = st.point(k, line.sa)
+        Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
+        _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
+    else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
+        pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
+        ca, sa_ = _rot(pa)
+        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        Pb = st.point(k, drive.sb)
+        Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
+        st.set(new, Oa, pa)
+    return 1.0
+
+
+def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RRR dyad: the intersection of two circles."""
     A_s, B_s = step.known
     b1, b2 = step.links
     J1, J2, J3 = step.joints
-    if step.kind == "RRR":
-        A = st.point(A_s, _local(S, A_s, J1))
-        C = st.point(B_s, _local(S, B_s, J3))
-        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-        L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
-        d = C - A
-        D2 = _dot(d, d)
-        D = np.sqrt(D2)
-        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
-        h2 = L1 ** 2 - a ** 2
-        if sigma is None or callable(sigma):
-            s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
-            sigma = s_file if sigma is None else sigma(h2 / L1 ** 2, s_file)
-        h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
-        h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
-        e = d / D[:, None]
-        B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
-        beta1 = np.arctan2(*(s2 - s1)[::-1])
-        beta2 = np.arctan2(*(t2 - t3)[::-1])
-        phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
-        phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
-        _pin(st, b1, A, s1, phi1)
-        _pin(st, b2, C, t3, phi2)
-        return sigma
-    if step.kind in ("RRP", "PRR"):
-        # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
-        if step.kind == "RRP":
-            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
-        else:
-            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
-        A = st.point(kr, _local(S, kr, Jr))
-        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
-        line = _line(S, Jp)
-        # the P joint's point on lp and the known line through kp's joint point
-        t_p = line.sb if line.b == lp else line.sa
-        s_k = line.sa if line.a == kp else line.sb
-        Pk = st.point(kp, s_k)
-        phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
-        ca, sa_ = _rot(phi_axis)
-        w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
-        cp, sp = _rot(phi_p)
-        tB = _local(S, lp, J2)
-        Q = Pk + _apply(cp, sp, tB - t_p)
-        L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
-        p = _dot(w, Q - A)
-        cc = _dot(Q - A, Q - A) - L1 ** 2
-        disc = p ** 2 - cc
-        if sigma is None or callable(sigma):
-            lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
-            s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
-            sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
-        disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
-        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        lam = -p + sigma * root
-        B = Q + lam[:, None] * w
-        sr = _local(S, lr, Jr)
-        beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
-        phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
-        _pin(st, lr, A, sr, phi_r)
-        _pin(st, lp, B, tB, phi_p)
-        return sigma
-    if step.kind == "RPR":
-        A = st.point(A_s, _local(S, A_s, J1))
-        C = st.point(B_s, _local(S, B_s, J3))
-        c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
-        line = _line(S, J2)
-        n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
-                                                      np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
-        # n_loc: the slide normal in b1's frame
-        sA, sP = _local(S, b1, J1), _local(S, b1, J2)
-        tC, tP = _local(S, b2, J3), _local(S, b2, J2)
-        cc, sc = np.cos(c), np.sin(c)
-        Rc = np.array([[cc, -sc], [sc, cc]])
-        e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
-        d = C - A
-        D = np.sqrt(_dot(d, d))
-        delta = np.arctan2(d[:, 1], d[:, 0])
-        nu = np.arctan2(n_loc[1], n_loc[0])
-        ratio = e / D
-        if sigma is None or callable(sigma):
-            phi0 = float(st.S.q0[3 * b1 + 2])
-            s_file = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
-            sigma = s_file if sigma is None else sigma(1.0 - ratio ** 2, s_file)
-        ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
-        ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
-        phi1 = delta - nu + sigma * ac
-        _pin(st, b1, A, sA, phi1)
-        _pin(st, b2, C, tC, phi1 + c)
-        return sigma
-    if step.kind in ("RPP", "PPR"):
-        # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
-        if step.kind == "RPP":
-            lr, lp, kr, kp, Jr, Jp = b1, b2, A_s, B_s, J1, J3
-        else:
-            lr, lp, kr, kp, Jr, Jp = b2, b1, B_s, A_s, J3, J1
-        phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
-        phi_r = phi_p + _rel_angle(S, J2, lp, lr)
-        A = st.point(kr, _local(S, kr, Jr))
-        _pin(st, lr, A, _local(S, lr, Jr), phi_r)
-        w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
-        w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
-        st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
-        return 1.0
-    if step.kind == "PRP":
-        phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
-        phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
-        sB, tB = _local(S, b1, J2), _local(S, b2, J2)
-        w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
-        w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
-        B = _solve2(w1, h1, w2, h2)
-        _pin(st, b1, B, sB, phi1)
-        _pin(st, b2, B, tB, phi2)
-        return 1.0
-    raise _NotHandled
+    A = st.point(A_s, _local(S, A_s, J1))
+    C = st.point(B_s, _local(S, B_s, J3))
+    s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+    t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+    L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
+    d = C - A
+    D2 = _dot(d, d)
+    D = np.sqrt(D2)
+    a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
+    h2 = L1 ** 2 - a ** 2
+    if sigma is None or callable(sigma):
+        s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(h2 / L1 ** 2, s_file)
+    h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
+    h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
+    e = d / D[:, None]
+    B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
+    beta1 = np.arctan2(*(s2 - s1)[::-1])
+    beta2 = np.arctan2(*(t2 - t3)[::-1])
+    phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
+    phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
+    _pin(st, b1, A, s1, phi1)
+    _pin(st, b2, C, t3, phi2)
+    return sigma
+
+
+def _oriented(step: Step, kind: str) -> tuple:
+    """A dyad's links, known links and end joints in the order of ``kind`` (the step's
+    own order, or reversed for its mirror kind, e.g. PRR as RRP)."""
+    (A_s, B_s), (b1, b2), (J1, _, J3) = step.known, step.links, step.joints
+    if step.kind == kind:
+        return b1, b2, A_s, B_s, J1, J3
+    return b2, b1, B_s, A_s, J3, J1
+
+
+def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RRP / PRR dyad: the intersection of a circle and a line."""
+    # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
+    lr, lp, kr, kp, Jr, Jp = _oriented(step, "RRP")
+    J2 = step.joints[1]
+    A = st.point(kr, _local(S, kr, Jr))
+    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+    line = _line(S, Jp)
+    # the P joint's point on lp and the known line through kp's joint point
+    t_p = line.sb if line.b == lp else line.sa
+    s_k = line.sa if line.a == kp else line.sb
+    Pk = st.point(kp, s_k)
+    phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
+    ca, sa_ = _rot(phi_axis)
+    w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
+    cp, sp = _rot(phi_p)
+    tB = _local(S, lp, J2)
+    Q = Pk + _apply(cp, sp, tB - t_p)
+    L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
+    p = _dot(w, Q - A)
+    cc = _dot(Q - A, Q - A) - L1 ** 2
+    disc = p ** 2 - cc
+    if sigma is None or callable(sigma):
+        lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+        s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
+    disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
+    root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    lam = -p + sigma * root
+    B = Q + lam[:, None] * w
+    sr = _local(S, lr, Jr)
+    beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
+    phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
+    _pin(st, lr, A, sr, phi_r)
+    _pin(st, lp, B, tB, phi_p)
+    return sigma
+
+
+def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RPR dyad: the slide line keeps its offset from both pivots."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    A = st.point(A_s, _local(S, A_s, J1))
+    C = st.point(B_s, _local(S, B_s, J3))
+    c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
+    line = _line(S, J2)
+    n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
+                                                  np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
+    # n_loc: the slide normal in b1's frame
+    sA, sP = _local(S, b1, J1), _local(S, b1, J2)
+    tC, tP = _local(S, b2, J3), _local(S, b2, J2)
+    cc, sc = np.cos(c), np.sin(c)
+    Rc = np.array([[cc, -sc], [sc, cc]])
+    e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
+    d = C - A
+    D = np.sqrt(_dot(d, d))
+    delta = np.arctan2(d[:, 1], d[:, 0])
+    nu = np.arctan2(n_loc[1], n_loc[0])
+    ratio = e / D
+    if sigma is None or callable(sigma):
+        phi0 = float(st.S.q0[3 * b1 + 2])
+        s_file = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(1.0 - ratio ** 2, s_file)
+    ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
+    ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
+    phi1 = delta - nu + sigma * ac
+    _pin(st, b1, A, sA, phi1)
+    _pin(st, b2, C, tC, phi1 + c)
+    return sigma
+
+
+def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """RPP / PPR dyad: orientations from the P pairs, position from two lines."""
+    # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
+    lr, lp, kr, kp, Jr, Jp = _oriented(step, "RPP")
+    J2 = step.joints[1]
+    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+    phi_r = phi_p + _rel_angle(S, J2, lp, lr)
+    A = st.point(kr, _local(S, kr, Jr))
+    _pin(st, lr, A, _local(S, lr, Jr), phi_r)
+    w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
+    w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
+    st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
+    return 1.0
+
+
+def _step_PRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+    """PRP dyad: the intersection of two slide lines."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
+    phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
+    sB, tB = _local(S, b1, J2), _local(S, b2, J2)
+    w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
+    w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
+    B = _solve2(w1, h1, w2, h2)
+    _pin(st, b1, B, sB, phi1)
+    _pin(st, b2, B, tB, phi2)
+    return 1.0
+
+
+_STEP_KERNELS = {"drive_R": _step_drive_R, "drive_P": _step_drive_P, "RRR": _step_RRR, "RRP": _step_RRP,
+                 "PRR": _step_RRP, "RPR": _step_RPR, "RPP": _step_RPP, "PPR": _step_RPP, "PRP": _step_PRP}
+
 
 
 def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.ndarray,
@@ -512,34 +565,38 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     return q, qd, qdd
 
 
-def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
-    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
+def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult",
+                      split: int | None = None) -> tuple:
+    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations
+    (``split``: see :func:`_continuous_angles`)."""
     with np.errstate(invalid="ignore", over="ignore"):  # inf rates at singular rows become NaN
-        return _poses_from_chain_(S, plan, U, r)
+        return _poses_from_chain_(S, plan, U, r, split)
 
 
-def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None) -> tuple:
     N, nl = r.cos.shape
     # component-major buffers (returned transposed): every column written is contiguous
     q = np.empty((S.n, N)).T
     qd = np.empty((S.n, N)).T
     qdd = np.empty((S.n, N)).T
     phi = np.arctan2(r.sin, r.cos)
-    for i in range(nl):
-        jid, sa = r.anchor[i]
-        c, s = r.cos[:, i], r.sin[:, i]
-        relx = -(c * sa[0] - s * sa[1])  # r - P_anchor
-        rely = -(s * sa[0] + c * sa[1])
-        P, V, A = r.points[jid], r.velocities[jid], r.accelerations[jid]
-        w, al = r.omega[:, i], r.alpha[:, i]
-        w2 = w * w
-        q[:, 3 * i] = P[:, 0] + relx
-        q[:, 3 * i + 1] = P[:, 1] + rely
-        qd[:, 3 * i] = V[:, 0] - w * rely
-        qd[:, 3 * i + 1] = V[:, 1] + w * relx
-        qdd[:, 3 * i] = A[:, 0] - al * rely - w2 * relx
-        qdd[:, 3 * i + 1] = A[:, 1] + al * relx - w2 * rely
-        qd[:, 3 * i + 2], qdd[:, 3 * i + 2] = w, al
+    # all links at once: (N, nl) arrays, the anchors' states gathered per link
+    jids = [r.anchor[i][0] for i in range(nl)]
+    sa = np.array([r.anchor[i][1] for i in range(nl)], float).reshape(nl, 2)
+    c, s = r.cos, r.sin
+    relx = -(c * sa[:, 0] - s * sa[:, 1])  # r - P_anchor
+    rely = -(s * sa[:, 0] + c * sa[:, 1])
+    P, V, A = (np.stack([d[j] for j in jids], axis=2) if nl else np.empty((N, 2, 0))
+               for d in (r.points, r.velocities, r.accelerations))  # (N, 2, nl)
+    w, al = r.omega, r.alpha
+    w2 = w * w
+    q[:, 0:3 * nl:3] = P[:, 0] + relx
+    q[:, 1:3 * nl:3] = P[:, 1] + rely
+    qd[:, 0:3 * nl:3] = V[:, 0] - w * rely
+    qd[:, 1:3 * nl:3] = V[:, 1] + w * relx
+    qdd[:, 0:3 * nl:3] = A[:, 0] - al * rely - w2 * relx
+    qdd[:, 1:3 * nl:3] = A[:, 1] + al * relx - w2 * rely
+    qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
     # angles: drivers' links take the input itself, dyad links are made continuous
     drive_links = {}
     for step in plan.steps:
@@ -553,7 +610,7 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
             phi[:, i] = sgn * U[:, k]
     others = [i for i in range(nl) if i not in drive_links]
     if others and ok.any():
-        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok)
+        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
     q[:, 2:3 * nl:3] = phi
     if not ok.all():
         for a in (q, qd, qdd):
@@ -593,7 +650,8 @@ def chain_supported(plan: Plan | None) -> bool:
 
 def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
                rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
-               rotations: bool = True, sigmas: list | None = None) -> ChainResult:
+               rotations: bool = True, sigmas: list | None = None,
+               discs: dict | None = None, least: float | None = None) -> ChainResult:
     """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
 
     Every link is carried by an *anchor* (the joint that placed it: its position,
@@ -605,12 +663,63 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     and likewise for the accelerations. The work is done
     in chunks that stay in the processor's cache. ``sigmas``: the assembly sign of every
     step per input row (from :func:`solve_tracked`); default: the drawn modes.
+    ``discs``: when a dict, it receives every RRR step's normalised discriminant
+    ``g^2 |d|^2 / L1^2`` (``h^2 / L1^2`` of :func:`solve_tracked`) per row, by step index;
+    ``least``: with ``discs``, stop (raising ``_Irregular``) as soon as a discriminant
+    falls below it.
     """
     U = np.atleast_2d(np.asarray(U, float))
     N = U.shape[0]
     nl = len(S.links)
     speeds = np.ones(U.shape[1]) if speeds is None else np.asarray(speeds, float)
     want = joints if joints is not None else [j.id for j in S.mech.joints]
+    prog, anchor = _chain_program(S, plan, sigmas)
+    # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
+    # that every chunk writes contiguous memory
+    out = ChainResult({j: np.empty((2, N)).T for j in want},
+                      {j: np.empty((2, N)).T for j in want} if rates else None,
+                      {j: np.empty((2, N)).T for j in want} if rates else None,
+                      np.empty((nl, N)).T if rotations else None, np.empty((nl, N)).T if rotations else None,
+                      np.empty((nl, N)).T if rates else None, np.empty((nl, N)).T if rates else None, anchor)
+    if discs is not None:
+        discs.update({op[1]: np.empty(N) for op in prog if op[0] == "RRR"})
+    fixed = {j.id: j.point for j in S.mech.joints}
+    filled: set[str] = set()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for start in range(0, N, chunk):
+            sl = slice(start, min(N, start + chunk))
+            ch = _Chunk(S, anchor, rates, out, sl, discs, least)
+            for op in prog:
+                if op[0] == "drive":
+                    ch.drive(op, U[sl], speeds, fixed)
+                else:
+                    ch.rrr(op, want)
+            ch.write(nl, want, rotations, filled)
+    return out
+
+
+def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list, dict]:
+    """The chain's steps as kernels' arguments, and every link's anchor joint (built once
+    per system and plan; the signs ``sigmas`` put in per call)."""
+    memo = _memo(S)
+    key = ("chain", id(plan))
+    if key not in memo:
+        memo[key] = _chain_program_(S, plan)
+    prog, anchor = memo[key]
+    if sigmas is None:
+        return prog, anchor
+    out = []
+    for op in prog:
+        sg = sigmas[op[1]] if op[0] == "RRR" else None
+        if isinstance(sg, np.ndarray):
+            op = op[:7] + (np.asarray(sg, float),) + op[8:]
+        elif callable(sg):
+            op = op[:7] + ((sg, (op[5] ** 0.5, op[6] ** 0.5), S.mech.joint(op[4][1]).point),) + op[8:]
+        out.append(op)
+    return out, anchor
+
+
+def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
     prog = []
     anchor: dict[int, tuple[str, np.ndarray]] = {}
     for si, step in enumerate(plan.steps):
@@ -620,200 +729,223 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
             sgn = 1.0 if con.b == new else -1.0
             anchor[new] = (jid, _local(S, new, jid))
             prog.append(("drive", new, k, jid, con.driver, sgn))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+        A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
+        sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
+        anchor[b1] = (J1, s1)
+        anchor[b2] = (J3, t3)
+        prog.append(("RRR", si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
+                     (s2 - s1) / L1s, (t2 - t3) / L2s))
+    return prog, anchor
+
+
+class _Irregular(Exception):
+    """A group's discriminant fell below the bound of a regular sweep (:func:`solve_regular`)."""
+
+
+class _Chunk:
+    """One chunk of rows of :func:`fast_chain`: the joints' states and the links'
+    rotations and rates found so far, and the kernels that extend them."""
+
+    def __init__(self, S: PlanarSystem, anchor: dict, rates: bool, out: "ChainResult", sl: slice,
+                 discs: dict | None, least: float | None = None) -> None:
+        self.S, self.anchor, self.rates, self.out, self.sl, self.discs = S, anchor, rates, out, sl, discs
+        self.least = least
+        self.written: set[str] = set()    # joints whose outputs were computed in place
+        self.rot: dict[int, tuple] = {}   # link -> ("cs", c, s) or ("vec", ex, ey, local / L^2)
+        self.rate: dict[int, tuple] = {}  # link -> (omega, alpha)
+        self.jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
+
+    def rotation(self, i: int) -> tuple:
+        r = self.rot[i]
+        if r[0] == "vec":  # from a joint-to-joint vector e and its local vector / L^2
+            _, ex, ey, bv = r
+            c = ex * bv[0] + ey * bv[1]
+            sn = ey * bv[0] - ex * bv[1]
+            self.rot[i] = ("cs", c, sn)
+            return c, sn
+        return r[1], r[2]
+
+    def point(self, i: int, jid: str | None, s: np.ndarray) -> tuple:
+        """State of the point ``s`` (local) of link ``i`` (of joint ``jid`` when known)."""
+        if jid is not None and jid in self.jst:
+            return self.jst[jid]
+        if i < 0:
+            return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if self.rates else (s[0], s[1])
+        ajid, sa = self.anchor[i]
+        A = self.jst[ajid]
+        dxl, dyl = float(s[0] - sa[0]), float(s[1] - sa[1])
+        c, sn = self.rotation(i)
+        if dyl == 0.0:
+            dx, dy = c * dxl, sn * dxl
+        elif dxl == 0.0:
+            dx, dy = sn * -dyl, c * dyl
         else:
-            (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-            s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-            t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-            L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
-            A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
-            sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
-            if sigmas is not None and isinstance(sigmas[si], np.ndarray):
-                sigma = np.asarray(sigmas[si], float)
-            anchor[b1] = (J1, s1)
-            anchor[b2] = (J3, t3)
-            prog.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
-                         (s2 - s1) / L1s, (t2 - t3) / L2s))
-    # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
-    # that every chunk writes contiguous memory
-    jpos = {j: np.empty((2, N)).T for j in want}
-    jvel = {j: np.empty((2, N)).T for j in want} if rates else None
-    jacc = {j: np.empty((2, N)).T for j in want} if rates else None
-    cos_out = np.empty((nl, N)).T if rotations else None
-    sin_out = np.empty((nl, N)).T if rotations else None
-    w_out = np.empty((nl, N)).T if rates else None
-    al_out = np.empty((nl, N)).T if rates else None
-    fixed = {}
-    for j in S.mech.joints:
-        fixed[j.id] = j.point
-    filled: set[str] = set()
-    err = np.seterr(invalid="ignore", divide="ignore")
-    try:
-        for start in range(0, N, chunk):
-            sl = slice(start, min(N, start + chunk))
-            n = sl.stop - sl.start
-            written: set[str] = set()    # joints whose outputs were computed in place
-            rot: dict[int, list] = {}    # link -> [c, s] (lazy) or a recipe
-            rate: dict[int, tuple] = {}  # link -> (omega, alpha)
-            jst: dict[str, tuple] = {}   # joint -> (Px, Py[, Vx, Vy, Ax, Ay])
+            dx = c * dxl - sn * dyl
+            dy = sn * dxl + c * dyl
+        if not self.rates:
+            return (A[0] + dx, A[1] + dy)
+        w, al = self.rate[i]
+        w2 = w * w
+        wdx, wdy = w * dx, w * dy
+        if isinstance(al, float) and al == 0.0:  # a driver at constant speed
+            return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx, A[4] - w * wdx, A[5] - w * wdy)
+        return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
+                A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
 
-            def rotation(i: int) -> tuple:
-                r = rot[i]
-                if r[0] == "vec":  # from a joint-to-joint vector e and its local vector / L^2
-                    _, ex, ey, bv = r
-                    c = ex * bv[0] + ey * bv[1]
-                    sn = ey * bv[0] - ex * bv[1]
-                    rot[i] = ("cs", c, sn)
-                    return c, sn
-                return r[1], r[2]
+    def drive(self, op: tuple, U: np.ndarray, speeds: np.ndarray, fixed: dict) -> None:
+        _, new, k, jid, di, sgn = op
+        th = U[:, di]
+        ct, st = np.cos(th), np.sin(th)
+        if sgn < 0:
+            st = -st
+        if k < 0:
+            self.rot[new] = ("cs", ct, st)
+            if self.rates:
+                self.rate[new] = (sgn * speeds[di], 0.0)
+            P = fixed[jid]
+            self.jst[jid] = (P[0], P[1], 0.0, 0.0, 0.0, 0.0) if self.rates else (P[0], P[1])
+        else:
+            ck, sk = self.rotation(k)
+            self.rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
+            if self.rates:
+                self.rate[new] = (self.rate[k][0] + sgn * speeds[di], self.rate[k][1])
+            self.jst[jid] = self.point(k, jid, _local(self.S, k, jid))
 
-            def point(i: int, jid: str | None, s: np.ndarray) -> tuple:
-                if jid is not None and jid in jst and (i < 0 or _on(i, jid)):
-                    return jst[jid]
-                if i < 0:
-                    return (s[0], s[1], 0.0, 0.0, 0.0, 0.0) if rates else (s[0], s[1])
-                ajid, sa = anchor[i]
-                A = jst[ajid]
-                dxl, dyl = float(s[0] - sa[0]), float(s[1] - sa[1])
-                c, sn = rotation(i)
-                if dyl == 0.0:
-                    dx, dy = c * dxl, sn * dxl
-                elif dxl == 0.0:
-                    dx, dy = sn * -dyl, c * dyl
-                else:
-                    dx = c * dxl - sn * dyl
-                    dy = sn * dxl + c * dyl
-                if not rates:
-                    return (A[0] + dx, A[1] + dy)
-                w, al = rate[i]
-                w2 = w * w
-                wdx, wdy = w * dx, w * dy
-                if isinstance(al, float) and al == 0.0:  # a driver at constant speed
-                    return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx, A[4] - w * wdx, A[5] - w * wdy)
-                return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
-                        A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
+    def rrr(self, op: tuple, want: list) -> None:
+        """The RRR kernel: ``B = A + f d + sigma g R90 d`` (see :func:`fast_chain`)."""
+        _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
+        S, sl, jst = self.S, self.sl, self.jst
+        A = self.point(k1, J1, _local(S, k1, J1))
+        C = self.point(k3, J3, _local(S, k3, J3))
+        jst[J1], jst[J3] = A, C
+        dx = C[0] - A[0]
+        dy = C[1] - A[1]
+        inv = dx * dx
+        inv += dy * dy
+        np.divide(1.0, inv, out=inv)
+        f = inv * (0.5 * (L1s - L2s))
+        f += 0.5
+        g = inv * L1s
+        g -= f * f
+        if self.discs is not None:
+            d = np.divide(g, inv, out=self.discs[si][sl])
+            d *= 1.0 / L1s
+            if self.least is not None and not d.min() >= self.least:  # NaN too
+                raise _Irregular
+        if isinstance(sigma, tuple):  # a chooser: the signs from the discriminant of _solve_step
+            sigma = self._choose(sigma, A, dx, dy, inv)
+        np.maximum(g, 0.0, out=g, where=g > -1e-12)
+        np.sqrt(g, out=g)
+        if isinstance(sigma, np.ndarray):
+            g *= sigma[sl]
+        elif sigma < 0:
+            np.negative(g, out=g)
+        e1x = f * dx
+        e1x -= g * dy
+        e1y = f * dy
+        e1y += g * dx
+        pos = self.out.points
+        if J2 in pos:  # straight into the output buffers
+            Bx = np.add(e1x, A[0], out=pos[J2][sl, 0])
+            By = np.add(e1y, A[1], out=pos[J2][sl, 1])
+            self.written.add(J2)
+        else:
+            Bx = e1x + A[0]
+            By = e1y + A[1]
+        e2x = Bx - C[0]
+        e2y = By - C[1]
+        self.rot[b1] = ("vec", e1x, e1y, bv1)
+        self.rot[b2] = ("vec", e2x, e2y, bv2)
+        if self.rates:
+            jst[J2] = self._rrr_rates(A, C, (e1x, e1y, e2x, e2y), (Bx, By), (b1, b2), J2)
+        else:
+            jst[J2] = (Bx, By)
 
-            def _on(i: int, jid: str) -> bool:
-                return True
+    def _choose(self, chooser: tuple, A: tuple, dx: np.ndarray, dy: np.ndarray, inv: np.ndarray) -> np.ndarray:
+        """Signs of an RRR group from its chooser (``solve_tracked_rates``), given the
+        discriminant ``h^2 / L1^2`` as :func:`_solve_step` computes it (the same numbers,
+        so the same decisions) and the drawn mode read at the first row."""
+        choose, (L1, L2), B0 = chooser
+        D2 = 1.0 / inv
+        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * np.sqrt(D2))
+        h2 = L1 ** 2 - a ** 2
+        ax, ay = (float(np.ravel(c)[0]) for c in A[:2])  # a frame joint's are numbers
+        s_file = 1.0 if dx[0] * (B0[1] - ay) - dy[0] * (B0[0] - ax) >= 0 else -1.0
+        return choose(h2 / L1 ** 2, s_file)
 
-            for op in prog:
-                if op[0] == "drive":
-                    _, new, k, jid, di, sgn = op
-                    th = U[sl, di]
-                    ct, st = np.cos(th), np.sin(th)
-                    if sgn < 0:
-                        st = -st
-                    if k < 0:
-                        rot[new] = ("cs", ct, st)
-                        if rates:
-                            rate[new] = (sgn * speeds[di], 0.0)
-                        P = fixed[jid]
-                        jst[jid] = (P[0], P[1], 0.0, 0.0, 0.0, 0.0) if rates else (P[0], P[1])
-                    else:
-                        ck, sk = rotation(k)
-                        rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
-                        if rates:
-                            rate[new] = (rate[k][0] + sgn * speeds[di], rate[k][1])
-                        jst[jid] = point(k, jid, _local(S, k, jid))
-                else:
-                    _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
-                    A = point(k1, J1, _local(S, k1, J1))
-                    C = point(k3, J3, _local(S, k3, J3))
-                    jst[J1], jst[J3] = A, C
-                    dx = C[0] - A[0]
-                    dy = C[1] - A[1]
-                    inv = dx * dx
-                    inv += dy * dy
-                    np.divide(1.0, inv, out=inv)
-                    f = inv * (0.5 * (L1s - L2s))
-                    f += 0.5
-                    g = inv * L1s
-                    g -= f * f
-                    np.maximum(g, 0.0, out=g, where=g > -1e-12)
-                    np.sqrt(g, out=g)
-                    if isinstance(sigma, np.ndarray):
-                        g *= sigma[sl]
-                    elif sigma < 0:
-                        np.negative(g, out=g)
-                    e1x = f * dx
-                    e1x -= g * dy
-                    e1y = f * dy
-                    e1y += g * dx
-                    if J2 in jpos:  # straight into the output buffers
-                        Bx = np.add(e1x, A[0], out=jpos[J2][sl, 0])
-                        By = np.add(e1y, A[1], out=jpos[J2][sl, 1])
-                        written.add(J2)
-                    else:
-                        Bx = e1x + A[0]
-                        By = e1y + A[1]
-                    e2x = Bx - C[0]
-                    e2y = By - C[1]
-                    rot[b1] = ("vec", e1x, e1y, bv1)
-                    rot[b2] = ("vec", e2x, e2y, bv2)
+    def _rrr_rates(self, A: tuple, C: tuple, e: tuple, B: tuple, links: tuple, J2: str) -> tuple:
+        """Rates of an RRR dyad: ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``,
+        ``omega_2 = (v_C - v_A) . e1 / (e1 x e2)``, and likewise the accelerations."""
+        e1x, e1y, e2x, e2y = e
+        den = e1x * e2y
+        den -= e1y * e2x
+        np.divide(1.0, den, out=den)
+        dvx, dvy = C[2] - A[2], C[3] - A[3]
+        w1 = dvx * e2x
+        w1 += dvy * e2y
+        w1 *= den
+        w2 = dvx * e1x
+        w2 += dvy * e1y
+        w2 *= den
+        w1s, w2s = w1 * w1, w2 * w2
+        dax = C[4] - A[4]
+        dax -= w2s * e2x
+        dax += w1s * e1x
+        day = C[5] - A[5]
+        day -= w2s * e2y
+        day += w1s * e1y
+        a1 = dax * e2x
+        a1 += day * e2y
+        a1 *= den
+        a2 = dax * e1x
+        a2 += day * e1y
+        a2 *= den
+        self.rate[links[0]], self.rate[links[1]] = (w1, a1), (w2, a2)
+        sl, o = self.sl, self.out
+        outs = ((o.velocities[J2][sl, 0], o.velocities[J2][sl, 1], o.accelerations[J2][sl, 0],
+                 o.accelerations[J2][sl, 1]) if J2 in o.points else (None,) * 4)
+        VBx = np.subtract(A[2], w1 * e1y, out=outs[0])
+        VBy = np.add(A[3], w1 * e1x, out=outs[1])
+        ABx = np.subtract(A[4], a1 * e1y, out=outs[2])
+        ABx -= w1s * e1x
+        ABy = np.add(A[5], a1 * e1x, out=outs[3])
+        ABy -= w1s * e1y
+        return (B[0], B[1], VBx, VBy, ABx, ABy)
+
+    def write(self, nl: int, want: list, rotations: bool, filled: set) -> None:
+        """The chunk's rotations, rates and joint states into the outputs."""
+        o, sl, rates = self.out, self.sl, self.rates
+        if rotations:
+            for i in range(nl):
+                o.cos[sl, i], o.sin[sl, i] = self.rotation(i)
+        if rates:
+            for i in range(nl):
+                o.omega[sl, i], o.alpha[sl, i] = self.rate[i]
+        for jid in want:
+            if jid in self.written or jid in filled:
+                continue
+            if jid in self.jst:
+                P = self.jst[jid]
+                if not isinstance(P[0], np.ndarray):  # a point of the frame: fill once
+                    o.points[jid][:, 0], o.points[jid][:, 1] = P[0], P[1]
                     if rates:
-                        den = e1x * e2y
-                        den -= e1y * e2x
-                        np.divide(1.0, den, out=den)
-                        dvx, dvy = C[2] - A[2], C[3] - A[3]
-                        w1 = dvx * e2x
-                        w1 += dvy * e2y
-                        w1 *= den
-                        w2 = dvx * e1x
-                        w2 += dvy * e1y
-                        w2 *= den
-                        w1s, w2s = w1 * w1, w2 * w2
-                        dax = C[4] - A[4]
-                        dax -= w2s * e2x
-                        dax += w1s * e1x
-                        day = C[5] - A[5]
-                        day -= w2s * e2y
-                        day += w1s * e1y
-                        a1 = dax * e2x
-                        a1 += day * e2y
-                        a1 *= den
-                        a2 = dax * e1x
-                        a2 += day * e1y
-                        a2 *= den
-                        rate[b1], rate[b2] = (w1, a1), (w2, a2)
-                        outs = ((jvel[J2][sl, 0], jvel[J2][sl, 1], jacc[J2][sl, 0], jacc[J2][sl, 1])
-                                if J2 in jpos else (None,) * 4)
-                        VBx = np.subtract(A[2], w1 * e1y, out=outs[0])
-                        VBy = np.add(A[3], w1 * e1x, out=outs[1])
-                        ABx = np.subtract(A[4], a1 * e1y, out=outs[2])
-                        ABx -= w1s * e1x
-                        ABy = np.add(A[5], a1 * e1x, out=outs[3])
-                        ABy -= w1s * e1y
-                        jst[J2] = (Bx, By, VBx, VBy, ABx, ABy)
-                    else:
-                        jst[J2] = (Bx, By)
-            if rotations:
-                for i in range(nl):
-                    cos_out[sl, i], sin_out[sl, i] = rotation(i)
-            if rates:
-                for i in range(nl):
-                    w_out[sl, i], al_out[sl, i] = rate[i]
-            for jid in want:
-                if jid in written or jid in filled:
+                        o.velocities[jid][:] = 0.0
+                        o.accelerations[jid][:] = 0.0
+                    filled.add(jid)
                     continue
-                if jid in jst:
-                    P = jst[jid]
-                    if not isinstance(P[0], np.ndarray):  # a point of the frame: fill once
-                        jpos[jid][:, 0], jpos[jid][:, 1] = P[0], P[1]
-                        if rates:
-                            jvel[jid][:] = 0.0
-                            jacc[jid][:] = 0.0
-                        filled.add(jid)
-                        continue
-                else:
-                    j = S.mech.joint(jid)
-                    side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
-                    P = point(side, None, _local(S, side, jid))
-                jpos[jid][sl, 0], jpos[jid][sl, 1] = P[0], P[1]
-                if rates:
-                    jvel[jid][sl, 0], jvel[jid][sl, 1] = P[2], P[3]
-                    jacc[jid][sl, 0], jacc[jid][sl, 1] = P[4], P[5]
-    finally:
-        np.seterr(**err)
-    return ChainResult(jpos, jvel, jacc, cos_out, sin_out, w_out, al_out, anchor)
+            else:
+                j = self.S.mech.joint(jid)
+                side = self.S.index(j.links[1]) if self.S.index(j.links[1]) >= 0 else self.S.index(j.links[0])
+                P = self.point(side, None, _local(self.S, side, jid))
+            o.points[jid][sl, 0], o.points[jid][sl, 1] = P[0], P[1]
+            if rates:
+                o.velocities[jid][sl, 0], o.velocities[jid][sl, 1] = P[2], P[3]
+                o.accelerations[jid][sl, 0], o.accelerations[jid][sl, 1] = P[4], P[5]
 
 
 # --------------------------------------------------------------------------- branches
@@ -863,6 +995,41 @@ def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: 
     return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
 
 
+#: Smallest normalised discriminant of every group over a sweep for which
+#: :func:`solve_regular` answers (below it :func:`solve_tracked` looks for folds and
+#: change points: its candidates are local minima under 0.05).
+REGULAR_DISC = 0.05 + 1e-9
+
+
+def solve_regular(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
+                  split: int | None) -> tuple | None:
+    """Poses and rates (N, n) of a driver-R + RRR chain in one array pass, or None when
+    the sweep needs the branch rules of :func:`solve_tracked`.
+
+    The rows ``U`` and the connecting paths from the drawn input values to the sweep
+    (to row ``split`` and ``split - 1`` when the drawn values lie between them, else to
+    row 0) are evaluated together with every group's discriminant; when each stays at
+    least :data:`REGULAR_DISC` no group folds, touches a change point or reassembles,
+    every group keeps its drawn mode and the answer is that of the outward sweeps of
+    :func:`solve_tracked` (no events), at the cost of one pass.
+    """
+    if not plan.closed_form_rates:
+        return None
+    N = U.shape[0]
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    ends = [U[0]] if split is None else [U[split], U[split - 1]]
+    X = np.vstack([U] + [_connecting_path(S, u0, _shifted_start(S, u0, e)) for e in ends])
+    try:  # stops at the first group that comes near a fold (little work wasted)
+        r = fast_chain(S, plan, X, speeds, rates=True, discs={}, least=REGULAR_DISC)
+    except _Irregular:
+        return None
+    if X.shape[0] > N:
+        r = ChainResult({j: v[:N] for j, v in r.points.items()}, {j: v[:N] for j, v in r.velocities.items()},
+                        {j: v[:N] for j, v in r.accelerations.items()}, r.cos[:N], r.sin[:N], r.omega[:N],
+                        r.alpha[:N], r.anchor)
+    return _poses_from_chain(S, plan, U, r, split)
+
+
 def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
     """Poses for all inputs on the branch of the drawn configuration, with branch events.
 
@@ -887,15 +1054,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     take the other branch instead (``sigma`` kept: a parallelogram becomes an
     anti-parallelogram there); the events say so.
     """
-    U = np.atleast_2d(np.asarray(inputs, float))
-    N = U.shape[0]
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    # R inputs a whole number of turns from the drawn values are the same configurations:
-    # track the sweep shifted next to the drawn values (its rows then follow each other)
-    shift = U[0] - _shifted_start(S, u0, U[0])
-    path = _connecting_path(S, u0, U[0] - shift)
-    n0 = path.shape[0]
-    X = np.vstack([path, U - shift])
+    X, n0, shift = _tracking_rows(S, inputs)
     M = X.shape[0]
     st = _State(S, M)
     sigmas: list = []
@@ -906,14 +1065,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
         if step.kind not in BRANCHED:
             sigmas.append(_solve_step(S, st, step, X, None))
             continue
-
-        def choose(disc: np.ndarray, s_file: float, k: int = k) -> np.ndarray:
-            sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
-            discs[k] = disc
-            raw_events.extend(evs)
-            singular[sing] = True
-            return sig
-
+        choose = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular)
         sigmas.append(_solve_step(S, st, step, X, choose))
     q = _pose_rows(S, st, plan)
     for step in plan.steps:  # a link driven from the frame takes the input's own turn count
@@ -921,6 +1073,95 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
             con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
             sgn = 1.0 if con.b == step.links[0] else -1.0
             q[n0:, 3 * step.links[0] + 2] += sgn * shift[con.driver]
+    sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
+    return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:],
+                            _sweep_events(raw_events, n0, shift))
+
+
+def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray,
+                        switch: bool = False) -> list[tuple]:
+    """:func:`solve_tracked` and :func:`solve_all` of a driver-R + RRR chain for several
+    sweeps (``parts``: arrays of input rows, each reached from the drawn configuration on
+    its own) in one array pass of :func:`fast_chain`: each group's signs are chosen by
+    the branch rules on its discriminant, sweep by sweep, as the pass reaches the group.
+    Returns per sweep ``q, qd, qdd`` (N, n), its singular rows and its events."""
+    parts = [np.atleast_2d(np.asarray(p, float)) for p in parts]
+    rows = [_tracking_rows(S, p) for p in parts]
+    starts = np.cumsum([0] + [X.shape[0] for X, _, _ in rows])
+    segs = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
+    sigmas: list = [1.0] * len(plan.steps)
+    singular = np.zeros(int(starts[-1]), bool)
+    raw_events: list = [[] for _ in parts]
+    for k, step in enumerate(plan.steps):
+        if step.kind in BRANCHED:
+            sigmas[k] = _parts_chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
+    # the sweeps' own rows (not shifted by turns: the same numbers as an untracked pass);
+    # the choosers' events and root searches use the shifted rows
+    E = np.vstack([blk for (X, n0, _), U in zip(rows, parts) for blk in (X[:n0], U)])
+    r = fast_chain(S, plan, E, speeds, rates=True, sigmas=sigmas, chunk=max(E.shape[0], 1))
+    out = []
+    for (X, n0, shift), U, seg, evs in zip(rows, parts, segs, raw_events):
+        sweep_rows = slice(seg.start + n0, seg.stop)
+        q, qd, qdd = _poses_from_chain(S, plan, U, _chain_rows(r, sweep_rows))
+        out.append((q, qd, qdd, singular[sweep_rows], _sweep_events(evs, n0, shift)))
+    return out
+
+
+def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
+                   raw_events: list, singular: np.ndarray):
+    """The sign chooser of branched step ``k`` over several sweeps' rows (``segs`` of the
+    pass): the branch rules (:func:`_branch_signs`) applied to each sweep's rows alone;
+    the signs are also put in ``sigmas[k]``."""
+    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
+        sig = np.empty(len(disc))
+        for (X, n0, _), seg, evs in zip(rows, segs, raw_events):
+            up = [s[seg] if isinstance(s, np.ndarray) else s for s in sigmas[:k]]
+            sig[seg], found, sing = _branch_signs(S, plan, k, up, X, disc[seg], s_file, n0, switch)
+            evs.extend(found)
+            singular[seg][sing] = True
+        sigmas[k] = sig
+        return sig
+    return choose
+
+
+def _chain_rows(r: "ChainResult", rows: slice) -> "ChainResult":
+    """The rows ``rows`` of a chain's result (views)."""
+    return ChainResult({j: v[rows] for j, v in r.points.items()},
+                       {j: v[rows] for j, v in r.velocities.items()} if r.velocities is not None else None,
+                       {j: v[rows] for j, v in r.accelerations.items()} if r.accelerations is not None else None,
+                       r.cos[rows] if r.cos is not None else None, r.sin[rows] if r.sin is not None else None,
+                       r.omega[rows] if r.omega is not None else None,
+                       r.alpha[rows] if r.alpha is not None else None, r.anchor)
+
+
+def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
+    """The rows a tracked sweep evaluates: the connecting path from the drawn input
+    values (``n0`` rows), then the sweep shifted by whole turns next to them."""
+    U = np.atleast_2d(np.asarray(inputs, float))
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    # R inputs a whole number of turns from the drawn values are the same configurations:
+    # track the sweep shifted next to the drawn values (its rows then follow each other)
+    shift = U[0] - _shifted_start(S, u0, U[0])
+    path = _connecting_path(S, u0, U[0] - shift)
+    return np.vstack([path, U - shift]), path.shape[0], shift
+
+
+def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
+             discs: dict, raw_events: list, singular: np.ndarray):
+    """The sign chooser of branched step ``k``: called with the step's normalised
+    discriminant and the drawn mode, it applies the branch rules (:func:`_branch_signs`),
+    records the discriminant, events and singular rows, and returns the signs."""
+    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
+        sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
+        discs[k] = disc
+        raw_events.extend(evs)
+        singular[sing] = True
+        return sig
+    return choose
+
+
+def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
+    """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
     events = []
     for e in raw_events:
         e = dict(e)
@@ -931,8 +1172,7 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
         if not e.get("before_sweep"):
             e["input"] = (np.asarray(e["input"]) + shift).tolist()
         events.append(e)
-    sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
-    return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:], events)
+    return events
 
 
 def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -953,6 +1193,86 @@ def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray
     return out[0]
 
 
+def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
+    """A driver-R + RRR chain as plain numbers for :func:`_scalar_disc` (built once per
+    system and plan)."""
+    memo = _memo(S)
+    key = ("scalar", id(plan))
+    prog = memo.get(key)
+    if prog is not None:
+        return prog
+    prog = []
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            prog.append(("drive", new, k, tuple(_local(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
+                         tuple(_local(S, new, jid))))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1, L2 = float(np.linalg.norm(s2 - s1)), float(np.linalg.norm(t2 - t3))
+        prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
+                     L1, L2, tuple(s1), tuple(t3), tuple((s2 - s1) / L1 ** 2), tuple((t2 - t3) / L2 ** 2)))
+    memo[key] = prog
+    return prog
+
+
+def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
+    """Normalised discriminant ``h^2 / L1^2`` of RRR step ``k`` of a driver-R + RRR chain
+    at one input ``u``, the upstream groups in the modes ``sigmas`` (floats): the
+    formulas of :func:`_solve_step` in plain floats (a root search calls it a few times
+    per event; an array pass would cost a hundred times more per call)."""
+    pose: dict[int, tuple] = {}  # link -> (anchor x, y, local x, y, cos, sin)
+
+    def point(i: int, s: tuple) -> tuple:
+        if i < 0:
+            return s
+        ax, ay, lx, ly, c, sn = pose[i]
+        dx, dy = s[0] - lx, s[1] - ly
+        return ax + c * dx - sn * dy, ay + sn * dx + c * dy
+
+    for j, op in enumerate(prog):
+        if op[0] == "drive":
+            _, new, kk, sk, di, sgn, snew = op
+            P = point(kk, sk)
+            ck, sk_ = (1.0, 0.0) if kk < 0 else pose[kk][4:]
+            ct, st = math.cos(u[di]), sgn * math.sin(u[di])
+            pose[new] = (P[0], P[1], snew[0], snew[1], ck * ct - sk_ * st, sk_ * ct + ck * st)
+            continue
+        _, (k1, sa), (k3, sc), (b1, b2), L1, L2, s1, t3, bv1, bv2 = op
+        A, C = point(k1, sa), point(k3, sc)
+        dx, dy = C[0] - A[0], C[1] - A[1]
+        D2 = dx * dx + dy * dy
+        D = math.sqrt(D2)
+        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D) if D > 0 else math.nan
+        h2 = L1 ** 2 - a ** 2
+        if j == k:
+            return h2 / L1 ** 2
+        if not h2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
+            h2 = 0.0 if h2 > -1e-12 * L1 ** 2 else math.nan
+        h = float(sigmas[j]) * (math.sqrt(h2) if h2 >= 0 else math.nan)
+        ex, ey = dx / D, dy / D
+        Bx, By = A[0] + a * ex - h * ey, A[1] + a * ey + h * ex
+        for link, P, loc, bv in ((b1, A, s1, bv1), (b2, C, t3, bv2)):
+            vx, vy = Bx - P[0], By - P[1]
+            pose[link] = (P[0], P[1], loc[0], loc[1], vx * bv[0] + vy * bv[1], vy * bv[0] - vx * bv[1])
+    return math.nan
+
+
+def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i0: int, i1: int):
+    """Discriminant of step ``k`` on the segment of inputs from row ``i0`` (t = 0) to row
+    ``i1`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar function."""
+    if plan.closed_form_rates:
+        prog = _scalar_program(S, plan)
+        sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
+        x0, dx = X[i0], X[i1] - X[i0]
+        return lambda t: _scalar_disc(prog, k, sig, x0 + t * dx)
+    rows = np.array([i0])
+    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
+
+
 def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
                   s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
     """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
@@ -965,11 +1285,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
     d = np.where(ok, np.maximum(disc, 0.0), np.nan)
 
     def f_line(i0: int, i1: int):
-        rows = np.array([i0])
-
-        def f(t: float) -> float:
-            return float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
-        return f
+        return _disc_line(S, plan, k, sigmas, X, i0, i1)
 
     events: list = []
     singular = np.zeros(M, bool)

@@ -14,6 +14,7 @@ Velocities: ``Phi_q q' = B u'``; accelerations: ``Phi_q q'' = gamma + B u''``
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -217,7 +218,7 @@ def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
     qq = _track(S, q, u_asm, np.asarray(u, float), depth=14)
     if qq is None:
         raise MechsynInputError("the mechanism cannot reach the requested input from its file configuration",
-                                source="--input")
+                                field="inputs")
     return qq
 
 
@@ -524,18 +525,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     # start from the equivalent value nearest the file's (a full turn could cross a toggle)
     shift = _turns(S, inputs[0])
     if np.any(shift):
-        sw = sweep(S, inputs - shift, speeds, progress, refine_limits)
-        sw.inputs = inputs
-        # a link driven from the frame takes the input's own turn count (same positions)
-        for con in S.cons:
-            if con.role == "drive" and con.kind == "angle" and shift[con.driver]:
-                if con.a < 0 and con.b >= 0:
-                    sw.q[:, 3 * con.b + 2] += shift[con.driver]
-                elif con.b < 0 and con.a >= 0:
-                    sw.q[:, 3 * con.a + 2] -= shift[con.driver]
-        for e in sw.events:
-            e["input"] = (np.asarray(e["input"]) + shift).tolist()
-        return sw
+        return _sweep_shifted(S, inputs, shift, speeds, progress, refine_limits)
     speeds = np.ones(k) if speeds is None else np.asarray(speeds, float)
     q_start = assemble(S)
     q = np.full((N, S.n), np.nan)
@@ -543,35 +533,19 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     qdd = np.full((N, S.n), np.nan)
     det_sign = np.full(N, np.nan)
     sig = np.full(N, np.nan)
+    out = (q, qd, qdd, det_sign, sig)
     events: list[dict] = []
     u_asm = np.array([d.assembled for d in S.drivers])
-    # from the drawn configuration to the first input, on the smooth branch
-    hist = [(u_asm, q_start, _factor(S, q_start))]
+    hist, cur = _approach(S, q_start, u_asm, inputs[0], refine_limits, events)
     drawn_det = hist[0][2][2]
-    for u in list(_newton_path(S, u_asm, inputs[0])) + [inputs[0]]:
-        nxt = _continue(S, hist, u)
-        if nxt is None:
-            break
-        hist.append((u, nxt, _factor(S, nxt)))
-    cur = hist[-1][1] if nxt is not None else None
     cur_u = inputs[0]
-    X = None
     last_good: tuple[np.ndarray, np.ndarray] | None = (q_start, u_asm)
-    if cur is None:
-        if refine_limits:
-            ul, _ = _limit(S, hist[-1][1], hist[-1][0], inputs[0])
-            events.append({"index": 0, "kind": "dead point", "input": ul.tolist(),
-                           "before_sweep": True,
-                           "message": "the mechanism cannot move from its file configuration to the first input"})
     for i in range(N):
         u = inputs[i]
         if cur is not None and i > 0:
             nxt = _continue(S, hist, u)
             if nxt is None:
-                if refine_limits:
-                    ul, _ = _limit(S, cur, cur_u, u)
-                else:
-                    ul = cur_u
+                ul = _limit(S, cur, cur_u, u)[0] if refine_limits else cur_u
                 events.append({"index": i, "kind": "dead point", "input": ul.tolist(),
                                "message": "assembly ends: the Jacobian becomes singular (dead point / "
                                           "limit of the working range)"})
@@ -579,56 +553,11 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             cur = nxt
             cur_u = u
         elif cur is None and last_good is not None:
-            # reassemble in the mode nearest the drawn one: of the configurations Newton
-            # reaches from the drawn and from the last one, the one whose det(Phi_q) has
-            # the drawn configuration's sign (the same assembly mode), else the first
-            cands = []
-            for guess in (q_start, last_good[0]):
-                c, good = newton(S, guess, u, max_iter=15)
-                if good:
-                    cands.append(c)
-            ok = bool(cands)
-            if ok:
-                cand = _nearest_mode(S, cands, u, q_start, drawn_det)
-                cur, cur_u = cand, u
-                hist = [(u, cand, _factor(S, cand))]
-                # follow the new branch backwards into the gap as far as it assembles
-                bq, bu, j = cand, u, i - 1
-                while j >= 0 and not np.isfinite(q[j, 0]):
-                    nb = _track(S, bq, bu, inputs[j])
-                    if nb is None:
-                        break
-                    nb, f_j = _settle(S, nb, inputs[j], _factor(S, nb))
-                    q[j] = nb
-                    fac_j, X_j, det_sign[j], sig[j] = f_j
-                    qd[j], qdd[j] = _rates_from(S, nb, fac_j, X_j, speeds)
-                    if sig[j] < 1e-6:  # singular: the rates are not defined here
-                        qd[j] = qdd[j] = np.nan
-                    bq, bu, j = nb, inputs[j], j - 1
-                if refine_limits and j >= 0:
-                    ul, _ = _limit(S, bq, bu, inputs[j])
-                    events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
-                                   "message": "assembly starts again here: the other limit of a working range"})
-                events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
-                               "message": "assembles again after a gap, in the assembly mode of the drawn "
-                                              "configuration (the mode nearest the drawn one)"})
+            got = _reassemble(S, out, inputs, i, q_start, last_good[0], drawn_det, speeds, refine_limits, events)
+            if got is not None:
+                cur, cur_u, hist = got, u, [(u, got, _factor(S, got))]
         if cur is not None:
-            cur, f = _settle(S, cur, u, _factor(S, cur))
-            q[i] = cur
-            fac, X, det_sign[i], sig[i] = f
-            if i > 0 and np.isfinite(q[i - 1, 0]):
-                hist.append((u, cur, f))
-                hist = hist[-3:]
-            qd[i], qdd[i] = _rates_from(S, cur, fac, X, speeds)
-            if sig[i] < 1e-6:  # singular: the rates are not defined here
-                qd[i] = np.nan
-                qdd[i] = np.nan
-            if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
-                    and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
-                uc = _crossing(S, q[i - 1], inputs[i - 1], u, det_sign[i - 1]) if refine_limits else u
-                events.append({"index": i, "kind": "singular", "input": uc.tolist(), "crossed": True,
-                               "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
-                                          "crossed between this input and the previous (at the input given)"})
+            cur, hist = _store(S, out, inputs, i, cur, hist, speeds, refine_limits, events)
         if progress is not None:
             progress()
     assembled = np.all(np.isfinite(q), axis=1)
@@ -639,3 +568,106 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                                   "about the square root of the solver tolerance"})
     events.sort(key=lambda e: e["index"])
     return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)
+
+
+def _sweep_shifted(S: PlanarSystem, inputs: np.ndarray, shift: np.ndarray, speeds: np.ndarray | None,
+                   progress: Any, refine_limits: bool) -> Sweep:
+    """The sweep of inputs shifted by whole turns ``shift`` next to the file's values,
+    given back at the inputs' own values."""
+    sw = sweep(S, inputs - shift, speeds, progress, refine_limits)
+    sw.inputs = inputs
+    # a link driven from the frame takes the input's own turn count (same positions)
+    for con in S.cons:
+        if con.role == "drive" and con.kind == "angle" and shift[con.driver]:
+            if con.a < 0 and con.b >= 0:
+                sw.q[:, 3 * con.b + 2] += shift[con.driver]
+            elif con.b < 0 and con.a >= 0:
+                sw.q[:, 3 * con.a + 2] -= shift[con.driver]
+    for e in sw.events:
+        e["input"] = (np.asarray(e["input"]) + shift).tolist()
+    return sw
+
+
+def _approach(S: PlanarSystem, q_start: np.ndarray, u_asm: np.ndarray, u_first: np.ndarray,
+              refine_limits: bool, events: list) -> tuple[list, np.ndarray | None]:
+    """From the drawn configuration to the first input on the smooth branch: the run's
+    history and the configuration there (None, with a dead-point event, when it cannot
+    be reached)."""
+    hist = [(u_asm, q_start, _factor(S, q_start))]
+    nxt = None
+    for u in list(_newton_path(S, u_asm, u_first)) + [u_first]:
+        nxt = _continue(S, hist, u)
+        if nxt is None:
+            break
+        hist.append((u, nxt, _factor(S, nxt)))
+    if nxt is not None:
+        return hist, hist[-1][1]
+    if refine_limits:
+        ul, _ = _limit(S, hist[-1][1], hist[-1][0], u_first)
+        events.append({"index": 0, "kind": "dead point", "input": ul.tolist(), "before_sweep": True,
+                       "message": "the mechanism cannot move from its file configuration to the first input"})
+    return hist, None
+
+
+def _fill(S: PlanarSystem, out: tuple, j: int, qj: np.ndarray, f: tuple, speeds: np.ndarray) -> None:
+    """Row ``j`` of the sweep's arrays from a configuration and its factors."""
+    q, qd, qdd, det_sign, sig = out
+    q[j] = qj
+    fac, X, det_sign[j], sig[j] = f
+    qd[j], qdd[j] = _rates_from(S, qj, fac, X, speeds)
+    if sig[j] < 1e-6:  # singular: the rates are not defined here
+        qd[j] = qdd[j] = np.nan
+
+
+def _reassemble(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, q_start: np.ndarray,
+                q_last: np.ndarray, drawn_det: float, speeds: np.ndarray, refine_limits: bool,
+                events: list) -> np.ndarray | None:
+    """After a gap: the configuration at row ``i`` in the mode nearest the drawn one (of
+    those Newton reaches from the drawn and from the last one), the branch followed
+    backwards into the gap as far as it assembles; None when none is found."""
+    u = inputs[i]
+    cands = []
+    for guess in (q_start, q_last):
+        c, good = newton(S, guess, u, max_iter=15)
+        if good:
+            cands.append(c)
+    if not cands:
+        return None
+    cand = _nearest_mode(S, cands, u, q_start, drawn_det)
+    q = out[0]
+    bq, bu, j = cand, u, i - 1
+    while j >= 0 and not np.isfinite(q[j, 0]):
+        nb = _track(S, bq, bu, inputs[j])
+        if nb is None:
+            break
+        nb, f_j = _settle(S, nb, inputs[j], _factor(S, nb))
+        _fill(S, out, j, nb, f_j, speeds)
+        bq, bu, j = nb, inputs[j], j - 1
+    if refine_limits and j >= 0:
+        ul, _ = _limit(S, bq, bu, inputs[j])
+        events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
+                       "message": "assembly starts again here: the other limit of a working range"})
+    events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
+                   "message": "assembles again after a gap, in the assembly mode of the drawn "
+                              "configuration (the mode nearest the drawn one)"})
+    return cand
+
+
+def _store(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, cur: np.ndarray, hist: list,
+           speeds: np.ndarray, refine_limits: bool, events: list) -> tuple[np.ndarray, list]:
+    """Row ``i`` of the sweep from the configuration ``cur`` (settled near a singular
+    point), the run's history extended, a det-sign change reported as a crossing."""
+    q, det_sign, sig = out[0], out[3], out[4]
+    u = inputs[i]
+    cur, f = _settle(S, cur, u, _factor(S, cur))
+    _fill(S, out, i, cur, f, speeds)
+    if i > 0 and np.isfinite(q[i - 1, 0]):
+        hist.append((u, cur, f))
+        hist = hist[-3:]
+    if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
+            and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
+        uc = _crossing(S, q[i - 1], inputs[i - 1], u, det_sign[i - 1]) if refine_limits else u
+        events.append({"index": i, "kind": "singular", "input": uc.tolist(), "crossed": True,
+                       "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
+                                  "crossed between this input and the previous (at the input given)"})
+    return cur, hist

@@ -555,6 +555,30 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
         actuator force is then reported as the force a spring or stop must supply).
     """
     src = mech.source or "<mechanism>"
+    _check_joints(mech, src)
+    modes = _vll_modes(mech, vll)
+    moving = mech.moving_links
+    origin0, angle0, scale = _link_frames(mech)
+    n_links = len(moving)
+    partial = PlanarSystem(mech, tuple(moving), origin0, angle0, (), (), 3 * n_links, 0,
+                           np.zeros(3 * n_links), scale)
+    q0 = np.zeros(3 * n_links)
+    q0[0::3], q0[1::3], q0[2::3] = origin0[:, 0], origin0[:, 1], angle0
+    b = _Builder(partial, q0, modes, prescribed, src)
+    for j in mech.joints:
+        b.add(j)
+    for jid in prescribed:
+        if jid not in [d.joint for d in b.drivers]:
+            raise MechsynInputError(f"joint {jid} cannot be given an input", field="inputs",
+                                    hint="inputs go to actuated joints and to free (passive) VLL joints")
+    q0 = np.concatenate([q0, b.extra_q])
+    m = sum(c.rows for c in b.cons)
+    return PlanarSystem(mech, tuple(moving), origin0, angle0, tuple(b.cons), tuple(b.drivers), len(q0), m, q0,
+                        scale, vll=modes, notes=tuple(b.notes))
+
+
+def _check_joints(mech: Mechanism, src: str) -> None:
+    """A planar mechanism whose joints have points (and P joints axes) of known types."""
     if mech.kind != "planar":
         raise MechsynInputError("kinematics needs a planar mechanism", source=src, field="kind",
                                 hint="set kind: planar (spatial kinematics is not implemented)")
@@ -569,22 +593,30 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
         if j.type not in ("R", "P", "cam", "gear", "belt"):
             raise MechsynInputError(f"joint {j.id}: pair type {j.type} is not supported by planar kinematics",
                                     source=src, field=f"joints.{j.id}.type", hint="use R, P, cam, gear or belt")
+
+
+def _vll_modes(mech: Mechanism, vll: dict[str, str] | None) -> dict[str, str]:
+    """The VLL mode of every P joint that has one: the file's, overridden by ``vll``."""
     modes: dict[str, str] = {j.id: j.vll for j in mech.joints if j.vll}
     for jid, mode in (vll or {}).items():
         try:
             j = mech.joint(jid)
         except KeyError:
-            raise MechsynInputError(f"no joint {jid!r}", source="--vll",
+            raise MechsynInputError(f"no joint {jid!r}", field="vll",
                                     hint=f"joints are: {', '.join(x.id for x in mech.joints)}") from None
         if j.type != "P":
             raise MechsynInputError(f"joint {jid} is a {j.type} pair; a variable-length link is a P pair",
-                                    source="--vll")
+                                    field="vll")
         if mode not in VLL_MODES:
-            raise MechsynInputError(f"unknown VLL mode {mode!r}", source="--vll",
+            raise MechsynInputError(f"unknown VLL mode {mode!r}", field="vll",
                                     hint="use locked, free (passive) or active")
         modes[jid] = VLL_MODES[mode]
+    return modes
 
-    ground = mech.ground
+
+def _link_frames(mech: Mechanism) -> tuple[np.ndarray, np.ndarray, float]:
+    """Every moving link's frame in the drawn configuration (origin at its first joint,
+    x axis towards its first other joint) and the mechanism's size."""
     moving = mech.moving_links
     origin0 = np.zeros((len(moving), 2))
     angle0 = np.zeros(len(moving))
@@ -600,131 +632,137 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
     allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()]
                       + [np.asarray(j.attrs["anchor"], float) for j in mech.joints if j.type == "belt"])
     scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
+    return origin0, angle0, scale
 
-    n_links = len(moving)
-    partial = PlanarSystem(mech, tuple(moving), origin0, angle0, (), (), 3 * n_links, 0,
-                           np.zeros(3 * n_links), scale)
-    idx = partial.index
-    loc = partial.to_local
-    cons: list[Con] = []
-    drivers: list[Driver] = []
-    notes: list[str] = []
-    n = 3 * n_links
-    q0 = np.zeros(n)
-    for i in range(n_links):
-        q0[3 * i:3 * i + 2] = origin0[i]
-        q0[3 * i + 2] = angle0[i]
-    extra_q: list[float] = []
 
-    def add_driver(j: Joint, typ: str, value: float, role: str) -> int:
-        drivers.append(Driver(j.id, typ, value, role))
-        return len(drivers) - 1
+class _Builder:
+    """The constraints, drivers, extra unknowns and notes of :func:`build_system`, joint by
+    joint."""
 
-    for j in mech.joints:
+    def __init__(self, partial: PlanarSystem, q0: np.ndarray, modes: dict, prescribed: tuple, src: str) -> None:
+        self.partial, self.q0, self.modes, self.prescribed, self.src = partial, q0, modes, prescribed, src
+        self.mech = partial.mech
+        self.cons: list[Con] = []
+        self.drivers: list[Driver] = []
+        self.notes: list[str] = []
+        self.extra_q: list[float] = []
+
+    def add_driver(self, j: Joint, typ: str, value: float, role: str) -> int:
+        self.drivers.append(Driver(j.id, typ, value, role))
+        return len(self.drivers) - 1
+
+    def angle(self, b: int, a: int) -> float:
+        """``phi_b - phi_a`` in the drawn configuration."""
+        p, q0 = self.partial, self.q0[None]
+        return float(p.link_angle_i(q0, b)[0] - p.link_angle_i(q0, a)[0])
+
+    def add(self, j: Joint) -> None:
+        getattr(self, "_" + j.type)(j)
+
+    def _R(self, j: Joint) -> None:
         a_name, b_name = j.links
+        idx, loc = self.partial.index, self.partial.to_local
         a, b = idx(a_name), idx(b_name)
-        if j.type == "R":
-            cons.append(Con("R", j.id, 2, a, b, sa=loc(a_name, j.point), sb=loc(b_name, j.point), role="pair"))
-            if j.actuated:
-                ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], a)[0]
-                k = add_driver(j, "R", float(ang), "drive")
-                cons.append(Con("angle", j.id, 1, a, b, driver=k, role="drive"))
-        elif j.type == "P":
-            u = _axis(j)
-            u_loc = partial.to_local_dir(a_name, u)
-            n_loc = np.array([-u_loc[1], u_loc[0]])
-            ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], a)[0]
-            cons.append(Con("angle", j.id, 1, a, b, c0=float(ang), role="rotation"))
-            cons.append(Con("line", j.id, 1, a, b, sa=loc(a_name, j.point), sb=loc(b_name, j.point),
-                            w=n_loc, role="pair"))
-            o_a = np.zeros(2) if a < 0 else origin0[a]
-            s0 = float(u @ (j.point - o_a))
-            mode = modes.get(j.id)
-            if mode is None:
-                mode = "active" if j.actuated else None
-            if mode == "active" or (mode == "passive" and j.id in prescribed):
-                k = add_driver(j, "P", s0, "drive" if mode == "active" else "prescribed")
-                cons.append(Con("line", j.id, 1, a, b, sa=np.zeros(2), sb=loc(b_name, j.point), w=u_loc,
-                                driver=k, role="drive"))
-            elif mode == "locked":
-                cons.append(Con("line", j.id, 1, a, b, sa=np.zeros(2), sb=loc(b_name, j.point), w=u_loc,
-                                c0=s0, role="lock"))
-            elif j.actuated and mode == "passive":
-                notes.append(f"joint {j.id} is marked actuated but its VLL is free (passive)")
-        elif j.type == "gear":
-            carriers = [c for c in mech.link_names
-                        if any(x.type == "R" and set(x.links) == {c, a_name} for x in mech.joints)
-                        and any(x.type == "R" and set(x.links) == {c, b_name} for x in mech.joints)]
-            if not carriers:
-                raise MechsynInputError(f"gear pair {j.id}: no link carries both gears' axes", source=src,
-                                        field=f"joints.{j.id}", hint="join both gears by R pairs to one carrier link")
-            cname = carriers[0]
-            ra = next(x for x in mech.joints if x.type == "R" and set(x.links) == {cname, a_name})
-            rb = next(x for x in mech.joints if x.type == "R" and set(x.links) == {cname, b_name})
-            if j.ratio is not None:
-                ratio = float(j.ratio)
-            else:
-                r1 = float(np.linalg.norm(j.point - ra.point))
-                r2 = float(np.linalg.norm(j.point - rb.point))
-                if r2 < 1e-12:
-                    raise MechsynInputError(f"gear pair {j.id}: the pitch point is on a gear's axis",
-                                            source=src, field=f"joints.{j.id}.point", hint="give ratio")
-                between = (j.point - ra.point) @ (j.point - rb.point) < 0
-                ratio = -r1 / r2 if between else r1 / r2
-            c = idx(cname)
-            q0a = q0[None]
-            pa_, pb_, pc_ = (partial.link_angle_i(q0a, i)[0] for i in (a, b, c))
-            cons.append(Con("gear", j.id, 1, a, b, c=c, k=ratio,
-                            c0=float((pb_ - pc_) - ratio * (pa_ - pc_)), role="pair"))
-        elif j.type == "cam":
-            profile = j.attrs.get("profile")
-            if profile is None:
-                raise MechsynInputError(
-                    f"cam joint {j.id} has no profile", source=src, field=f"joints.{j.id}.profile",
-                    hint="add e.g. profile: {center: [0, 0], radius: 1}, or a polar function r(t), or a list "
-                         f"of points [[1, 0], [0, 1], [-1, 0], [0, -1]] on the cam link {a_name}")
-            others = [x for x in mech.joints_of(b_name) if x.id != j.id and x.type == "R"]
-            if others:
-                centre = others[0].point
-                rho = float(np.linalg.norm(centre - j.point))
-            else:
-                centre, rho = j.point, 0.0
-            tvar = n + len(extra_q)
-            curve = _cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
-                               lambda p, _a=a_name: loc(_a, p), src, j.id)
-            extra_q.append(curve.closest(loc(a_name, centre)))
-            cons.append(Con("curve", j.id, 2, a, b, sb=loc(b_name, centre), tvar=tvar, curve=curve,
-                            role="pair"))
-            if others and len(mech.joints_of(b_name)) == 2 and not any(
-                    p.link == b_name for p in mech.points.values()):
-                f_name = others[0].other(b_name)
-                f = idx(f_name)
-                ang = partial.link_angle_i(q0[None], b)[0] - partial.link_angle_i(q0[None], f)[0]
-                cons.append(Con("angle", j.id, 1, f, b, c0=float(ang), role="idle"))
-                notes.append(f"roller {b_name}: its spin about {others[0].id} is an idle mobility, held fixed")
-        elif j.type == "belt":
-            sa, sb = loc(a_name, np.asarray(j.attrs["anchor"], float)), loc(b_name, j.point)
-            sigma = BELT_WRAPS[j.attrs["wrap"]]
-            r = float(j.attrs["radius"])
-            con = Con("belt", j.id, 1, a, b, sa=sa, sb=sb, radius=r, sigma=sigma, role="pair")
-            D = j.point - np.asarray(j.attrs["anchor"], float)
-            ref = float(partial.link_angle_i(q0[None], b)[0] - np.arctan2(D[1], D[0]))
-            con = replace(con, ref=ref)
-            c0 = float(_residual(partial, con, q0[None], np.zeros((1, 0)))[0, 0])
-            cons.append(replace(con, c0=c0))
-            if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id
-                       and np.linalg.norm(x.point - j.point) < 1e-9 * scale for x in mech.joints):
-                notes.append(f"belt {j.id}: the pulley centre is on no R pair of {b_name} "
-                             "(a pulley usually turns on its carrier there)")
-    for jid in prescribed:
-        if jid not in [d.joint for d in drivers]:
-            raise MechsynInputError(f"joint {jid} cannot be given an input", source="--input",
-                                    hint="inputs go to actuated joints and to free (passive) VLL joints")
-    q0 = np.concatenate([q0, extra_q])
-    n = len(q0)
-    m = sum(c.rows for c in cons)
-    return PlanarSystem(mech, tuple(moving), origin0, angle0, tuple(cons), tuple(drivers), n, m, q0,
-                        scale, vll=modes, notes=tuple(notes))
+        self.cons.append(Con("R", j.id, 2, a, b, sa=loc(a_name, j.point), sb=loc(b_name, j.point), role="pair"))
+        if j.actuated:
+            k = self.add_driver(j, "R", self.angle(b, a), "drive")
+            self.cons.append(Con("angle", j.id, 1, a, b, driver=k, role="drive"))
+
+    def _P(self, j: Joint) -> None:
+        a_name, b_name = j.links
+        p = self.partial
+        a, b = p.index(a_name), p.index(b_name)
+        u = _axis(j)
+        u_loc = p.to_local_dir(a_name, u)
+        n_loc = np.array([-u_loc[1], u_loc[0]])
+        self.cons.append(Con("angle", j.id, 1, a, b, c0=self.angle(b, a), role="rotation"))
+        self.cons.append(Con("line", j.id, 1, a, b, sa=p.to_local(a_name, j.point), sb=p.to_local(b_name, j.point),
+                             w=n_loc, role="pair"))
+        o_a = np.zeros(2) if a < 0 else p.origin0[a]
+        s0 = float(u @ (j.point - o_a))
+        mode = self.modes.get(j.id)
+        if mode is None:
+            mode = "active" if j.actuated else None
+        if mode == "active" or (mode == "passive" and j.id in self.prescribed):
+            k = self.add_driver(j, "P", s0, "drive" if mode == "active" else "prescribed")
+            self.cons.append(Con("line", j.id, 1, a, b, sa=np.zeros(2), sb=p.to_local(b_name, j.point), w=u_loc,
+                                 driver=k, role="drive"))
+        elif mode == "locked":
+            self.cons.append(Con("line", j.id, 1, a, b, sa=np.zeros(2), sb=p.to_local(b_name, j.point), w=u_loc,
+                                 c0=s0, role="lock"))
+        elif j.actuated and mode == "passive":
+            self.notes.append(f"joint {j.id} is marked actuated but its VLL is free (passive)")
+
+    def _gear(self, j: Joint) -> None:
+        a_name, b_name = j.links
+        mech, idx = self.mech, self.partial.index
+        carriers = [c for c in mech.link_names
+                    if any(x.type == "R" and set(x.links) == {c, a_name} for x in mech.joints)
+                    and any(x.type == "R" and set(x.links) == {c, b_name} for x in mech.joints)]
+        if not carriers:
+            raise MechsynInputError(f"gear pair {j.id}: no link carries both gears' axes", source=self.src,
+                                    field=f"joints.{j.id}", hint="join both gears by R pairs to one carrier link")
+        cname = carriers[0]
+        ra = next(x for x in mech.joints if x.type == "R" and set(x.links) == {cname, a_name})
+        rb = next(x for x in mech.joints if x.type == "R" and set(x.links) == {cname, b_name})
+        if j.ratio is not None:
+            ratio = float(j.ratio)
+        else:
+            r1 = float(np.linalg.norm(j.point - ra.point))
+            r2 = float(np.linalg.norm(j.point - rb.point))
+            if r2 < 1e-12:
+                raise MechsynInputError(f"gear pair {j.id}: the pitch point is on a gear's axis",
+                                        source=self.src, field=f"joints.{j.id}.point", hint="give ratio")
+            between = (j.point - ra.point) @ (j.point - rb.point) < 0
+            ratio = -r1 / r2 if between else r1 / r2
+        a, b, c = idx(a_name), idx(b_name), idx(cname)
+        q0a = self.q0[None]
+        pa_, pb_, pc_ = (self.partial.link_angle_i(q0a, i)[0] for i in (a, b, c))
+        self.cons.append(Con("gear", j.id, 1, a, b, c=c, k=ratio,
+                             c0=float((pb_ - pc_) - ratio * (pa_ - pc_)), role="pair"))
+
+    def _cam(self, j: Joint) -> None:
+        a_name, b_name = j.links
+        mech, idx, loc = self.mech, self.partial.index, self.partial.to_local
+        a, b = idx(a_name), idx(b_name)
+        profile = j.attrs.get("profile")
+        if profile is None:
+            raise MechsynInputError(
+                f"cam joint {j.id} has no profile", source=self.src, field=f"joints.{j.id}.profile",
+                hint="add e.g. profile: {center: [0, 0], radius: 1}, or a polar function r(t), or a list "
+                     f"of points [[1, 0], [0, 1], [-1, 0], [0, -1]] on the cam link {a_name}")
+        others = [x for x in mech.joints_of(b_name) if x.id != j.id and x.type == "R"]
+        if others:
+            centre = others[0].point
+            rho = float(np.linalg.norm(centre - j.point))
+        else:
+            centre, rho = j.point, 0.0
+        tvar = len(self.q0) + len(self.extra_q)
+        curve = _cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
+                           lambda p, _a=a_name: loc(_a, p), self.src, j.id)
+        self.extra_q.append(curve.closest(loc(a_name, centre)))
+        self.cons.append(Con("curve", j.id, 2, a, b, sb=loc(b_name, centre), tvar=tvar, curve=curve, role="pair"))
+        if others and len(mech.joints_of(b_name)) == 2 and not any(
+                p.link == b_name for p in mech.points.values()):
+            f = idx(others[0].other(b_name))
+            self.cons.append(Con("angle", j.id, 1, f, b, c0=self.angle(b, f), role="idle"))
+            self.notes.append(f"roller {b_name}: its spin about {others[0].id} is an idle mobility, held fixed")
+
+    def _belt(self, j: Joint) -> None:
+        a_name, b_name = j.links
+        p = self.partial
+        a, b = p.index(a_name), p.index(b_name)
+        sa, sb = p.to_local(a_name, np.asarray(j.attrs["anchor"], float)), p.to_local(b_name, j.point)
+        con = Con("belt", j.id, 1, a, b, sa=sa, sb=sb, radius=float(j.attrs["radius"]),
+                  sigma=BELT_WRAPS[j.attrs["wrap"]], role="pair")
+        D = j.point - np.asarray(j.attrs["anchor"], float)
+        con = replace(con, ref=float(p.link_angle_i(self.q0[None], b)[0] - np.arctan2(D[1], D[0])))
+        c0 = float(_residual(p, con, self.q0[None], np.zeros((1, 0)))[0, 0])
+        self.cons.append(replace(con, c0=c0))
+        if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id
+                   and np.linalg.norm(x.point - j.point) < 1e-9 * p.scale for x in self.mech.joints):
+            self.notes.append(f"belt {j.id}: the pulley centre is on no R pair of {b_name} "
+                              "(a pulley usually turns on its carrier there)")
 
 
 def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
