@@ -2,6 +2,13 @@
 
 Thin layer over :mod:`mechsyn.kinematics.belt` and :mod:`mechsyn.synthesis.belt`.
 Angles in degrees on the command line; lengths in the user's unit (mm in the paper).
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

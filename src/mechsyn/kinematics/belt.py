@@ -1,6 +1,6 @@
 """Closed-form kinematics of paper 001's manipulator with a flexible element.
 
-Paper 001 (Galabov et al., Bulgarian; spec ``flexible-manipulator.md``): lever 1 pivots
+Paper 001 [1]_ (Bulgarian; spec ``flexible-manipulator.md``): lever 1 pivots
 on the frame at A0; link 2 (the "hand", carrying the gripper point H) pivots on lever 1
 at A and carries a pulley of radius r centred on A; a belt (toothed belt, chain, band or
 rope) is pinned to the frame at B0 and wraps the pulley counter-clockwise.
@@ -17,6 +17,13 @@ of link 2. Derivatives ``1`` and ``2`` are first and second derivatives with res
 The equations are the spec's corrected set (the paper's printed (4), (9), (13), (14) and
 (19) carry sign slips or are wrong; see the function docstrings). Every function takes
 NumPy arrays of Δφ and is vectorised; no loops over positions.
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

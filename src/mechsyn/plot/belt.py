@@ -7,8 +7,10 @@ an animation of the motion. Nothing here writes a file or chooses a backend.
 
 References
 ----------
-Paper 001 (seed 001) of /work/shared/seeds: the belt manipulator; see
-:mod:`mechsyn.kinematics.belt` for the full reference.
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

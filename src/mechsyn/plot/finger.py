@@ -1,5 +1,13 @@
 """Drawings of the fingers of paper 000's synthesis: base links grey, attached group
-orange, VLL candidates dashed red, frame pairs hatched."""
+orange, VLL candidates dashed red, frame pairs hatched.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
+"""
 
 from __future__ import annotations
 

@@ -16,6 +16,13 @@ and the pulley radius r, paper 001 (section 2, fig. 2; corrected per the spec
 
 Why it works: H lies at the fixed distance sqrt(c^2 + h^2) from A on link 2, whatever
 link 2's rotation, so A (fixed on lever 1) is equidistant from H0 and Hf(1).
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

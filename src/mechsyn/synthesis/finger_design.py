@@ -35,6 +35,13 @@ the locked model merges the two (masses and centres of mass combined), which mak
 finger a chain of driver + RRR dyads solved in closed form by ``kinematics.dyads``. The
 VLL range and the final checks use the full file in the kinematics engine's passive
 mode (Newton continuation), an independent method.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations
