@@ -439,10 +439,10 @@ def _print_analysis(result: dict[str, Any], state: kb.BeltState,
 @belt_app.command("inverse")
 def inverse_cmd(
     file: Optional[Path] = typer.Option(None, "--file", "-f", help="case file (YAML/JSON)"),
-    a: Optional[float] = typer.Option(None, "--a"),
-    c: Optional[float] = typer.Option(None, "--c"),
-    h: Optional[float] = typer.Option(None, "--h"),
-    r: Optional[float] = typer.Option(None, "--r"),
+    a: Optional[float] = typer.Option(None, "--a", help="lever length |A0 A|"),
+    c: Optional[float] = typer.Option(None, "--c", help="x offset of C left of A"),
+    h: Optional[float] = typer.Option(None, "--h", help="height of H above C"),
+    r: Optional[float] = typer.Option(None, "--r", help="pulley radius"),
     phi: Optional[str] = typer.Option(None, "--phi",
                                       help="Δφ range START:STOP:STEP, deg, in the direction "
                                            "of the motion"),
