@@ -622,6 +622,12 @@ class _Builder:
             )
         attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
                                    ("units", spec.units)) if v}
+        for key in spec.colors:
+            if key not in by_id and key not in points:
+                raise self.error(["colors", key], f"colour given for {key!r}, which is no joint or point",
+                                 "key colours by joint id or point name")
+        if spec.colors:
+            attrs["colors"] = dict(spec.colors)
         if spec.loads:
             attrs["loads"] = self.loads(spec.loads, names, ids, points)
         return Mechanism(
@@ -673,7 +679,7 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
         d["contours"] = [list(c) for c in mech.contours]
     if mech.mobility is not None:
         d["mobility"] = mech.mobility
-    for key in ("description", "source", "units"):
+    for key in ("description", "source", "units", "colors"):
         if mech.attrs.get(key):
             d[key] = mech.attrs[key]
     if mech.attrs.get("loads"):

@@ -194,6 +194,11 @@ class MechanismFile(_Strict):
     description: str | None = None
     source: str | None = Field(None, description="Where the mechanism comes from (paper, figure).")
     units: str | None = None
+    colors: dict[str, str] = Field(
+        default_factory=dict,
+        description="Display colours by joint id or point name, as Pyslvs writes them (Green, "
+                    "dark-blue, (255, 0, 0)) or any Matplotlib colour; kept by Pyslvs round trips.",
+    )
 
     @field_validator("contours", mode="before")
     @classmethod
