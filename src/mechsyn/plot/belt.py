@@ -116,8 +116,8 @@ def plot_belt(design: BeltDesign, state: BeltState, four_bar: FourBarState | Non
         ax.axhline(P[i0, 1], color=_COLOURS[name], lw=0.6, ls=(0, (6, 4)), alpha=0.6)
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
-    ax.set_xlabel("x (machine plane)")
-    ax.set_ylabel("y (machine axis)")
+    ax.set_xlabel("x, machine plane (unit)")
+    ax.set_ylabel("y, machine axis (unit)")
     rng = f"Δφ = {math.degrees(state.dphi[0]):g}° … {math.degrees(state.dphi[-1]):g}°"
     ax.set_title(f"{title}\na = {design.a:g}, c = {design.c:g}, h = {design.h:g}, "
                  f"r = {design.r:g};  b0 = {design.b0:.3f}, l0 = {design.l0:.3f}, "
