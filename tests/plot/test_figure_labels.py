@@ -56,3 +56,14 @@ def test_belt_figure_is_labelled():
     state = kb.analyze(design, np.radians(np.arange(-60.0, 61.0, 5.0)))
     fig = plot_belt(design, state)
     assert _labelled(fig.axes[0])
+
+
+def test_forces_figure_names_units_and_gravity():
+    import mechsyn as ms
+    from mechsyn.plot.kinematics import plot_forces
+
+    mech = ms.load_mechanism(ROOT / "examples" / "kinematics" / "crank_rocker.yaml")
+    fa = ms.forces(mech, {"A": np.arange(0.0, 361.0, 30.0)})
+    fig = plot_forces(fa)
+    assert "/s²)" in fig.axes[0].get_ylabel() and "moment" in fig.axes[1].get_ylabel()
+    assert "-0.0" not in fig._suptitle.get_text()

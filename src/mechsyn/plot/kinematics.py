@@ -248,7 +248,8 @@ def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
         axs[0].plot(x, np.linalg.norm(F, axis=1), label=j)
     axs[0].set_title("joint reactions |F|")
     axs[0].set_xlabel(xlabel)
-    axs[0].set_ylabel("force")
+    unit = _length_unit(sim)
+    axs[0].set_ylabel(f"force (mass·{unit}/s²)")
     axs[0].grid(alpha=0.3)
     axs[0].legend(fontsize=8, ncol=2)
     for j, e in fa.reactions.effort.items():
@@ -256,10 +257,15 @@ def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
     axs[1].axhline(0, color="0.5", lw=0.8)
     axs[1].set_title("balancing moment / force at the driven joints")
     axs[1].set_xlabel(xlabel)
+    kinds = set(fa.reactions.effort_kind.values())
+    axs[1].set_ylabel(" or ".join(f"{k} (force·{unit})" if k == "moment" else f"{k}" for k in sorted(kinds))
+                      or "effort")
     axs[1].grid(alpha=0.3)
     axs[1].legend(fontsize=8)
     kind = "static" if fa.static else "kinetostatic"
-    fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, gravity {fa.gravity}")
+    g = np.asarray(fa.gravity, float) + 0.0  # + 0.0: no "-0.0" in the title
+    gravity = f"gravity ({g[0]:g}, {g[1]:g})" if np.any(g) else "no gravity"
+    fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, {gravity}")
     fig.tight_layout()
     return fig
 
