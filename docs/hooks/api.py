@@ -10,6 +10,7 @@ render fails the ``--strict`` build.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from mkdocs.structure.files import File
@@ -81,3 +82,20 @@ def on_files(files, config):
             files.remove(old)
         files.append(File.generated(config, path, content=_page(title, modules)))
     return files
+
+
+_CITATION = re.compile(r"(<p>|\n)\.\. \[(\d+)\] ")
+_REFERENCES = re.compile(r'(<details class="references"[^>]*>.*?</details>)', re.S)
+
+
+def citations_as_list(html: str) -> str:
+    """numpydoc's ``.. [1] ...`` entries of a References section as numbered lines
+    (``[1] ...``, one a line) instead of one run-on paragraph."""
+    def fix(m: re.Match) -> str:
+        return _CITATION.sub(lambda c: ("<p>" if c.group(1) == "<p>" else "<br>\n") + f"[{c.group(2)}] ",
+                             m.group(1))
+    return _REFERENCES.sub(fix, html)
+
+
+def on_page_content(html, page, config, files):
+    return citations_as_list(html) if page.file.src_uri.startswith("api/") else html

@@ -42,3 +42,12 @@ def test_navigation_lists_every_page():
     config = {"nav": [{"Home": "index.md"}, {"API reference": []}]}
     nav = api_hook.on_config(config)["nav"]
     assert [next(iter(e.values())) for e in nav[1]["API reference"]] == list(api_hook.pages())
+
+
+def test_references_read_as_numbered_lines():
+    html = ('<details class="references" open>\n  <summary>References</summary>\n'
+            '  <p>.. [1] First, "A title"\n   more.\n.. [2] Second.</p>\n</details>')
+    out = api_hook.citations_as_list(html)
+    assert ".. [" not in out
+    assert "<p>[1] First" in out and "<br>\n[2] Second." in out
+    assert api_hook.citations_as_list("<p>.. [1] outside a References section</p>").startswith("<p>.. [1]")
