@@ -622,12 +622,11 @@ class _Builder:
             )
         attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
                                    ("units", spec.units)) if v}
-        for key in spec.colors:
-            if key not in by_id and key not in points:
-                raise self.error(["colors", key], f"colour given for {key!r}, which is no joint or point",
-                                 "key colours by joint id or point name")
-        if spec.colors:
-            attrs["colors"] = dict(spec.colors)
+        # display only: the colour of a joint or point the file no longer has (deleted in the
+        # studio, dropped by a synthesis) is let go rather than refusing the whole mechanism
+        colors = {k: v for k, v in spec.colors.items() if k in by_id or k in points}
+        if colors:
+            attrs["colors"] = colors
         if spec.loads:
             attrs["loads"] = self.loads(spec.loads, names, ids, points)
         return Mechanism(
