@@ -219,7 +219,7 @@ def _figure(directory: Path, name: str, tgt, best, fb, fb_path, fb_closed) -> No
     import matplotlib.pyplot as plt
 
     from mechsyn.results import save_figure_atomic
-    from mechsyn.synthesis.curves.plot import plot_candidate
+    from mechsyn.plot.curves import plot_candidate
 
     directory.mkdir(parents=True, exist_ok=True)
     ns = [n for n in best if best[n][1] is not None]
@@ -230,6 +230,8 @@ def _figure(directory: Path, name: str, tgt, best, fb, fb_path, fb_closed) -> No
     P = np.vstack([fb_path, fb_path[:1]]) if fb_closed else fb_path
     ax.plot(P[:, 0], P[:, 1], "-", color="tab:red", lw=1.4, label=f"synth path 4-bar: {100 * fb:.2f} %")
     ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (target's length unit)")
+    ax.set_ylabel("y (target's length unit)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper right")
     ax.set_title(f"{name}: best four-bar of synth path", fontsize=9)

@@ -42,7 +42,7 @@ UR5 = ["capability", "examples/capability/ur5_dh.yaml", "--grid", "200:600:100,-
        "--z", "300", "--direction", "1,0,0"]
 DENSE = ["capability", "examples/capability/paper004_3r.yaml", "--grid", "0:2600:10,0:2600:10",
          "--direction", "1,0"]
-CASES = str((ROOT / "../shared/spec/data/synthesis_cases_public.json").resolve())
+CASES = str(ROOT / "tests" / "synthesis" / "data" / "synthesis_cases_public.json")
 LITERATURE = {(8, 1): 16, (10, 1): 230, (12, 1): 6856, (14, 1): 318162}
 
 #: figures at the previous stop (docs/performance.md, 2026-11-24, CPU unless said)

@@ -31,8 +31,7 @@ from scipy.optimize import differential_evolution  # noqa: E402
 from mechsyn.synthesis.optimize import synthesize_path  # noqa: E402
 from mechsyn.synthesis.path import PathProblem, evaluate_design, load_cases  # noqa: E402
 
-SPEC_CANDIDATES = [ROOT / "tests" / "synthesis" / "data" / "synthesis_cases_public.json",
-                   Path("/work/shared/spec/data/synthesis_cases_public.json")]
+SPEC_CANDIDATES = [ROOT / "tests" / "synthesis" / "data" / "synthesis_cases_public.json"]
 
 
 def baseline(case, seed: int, time_limit: float) -> tuple[float, float]:

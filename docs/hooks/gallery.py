@@ -36,6 +36,14 @@ GALLERY = [
     ("capability", "Paper 004's 3R arm: largest speed along +x over the working region",
      ["mechsyn capability examples/capability/paper004_3r.yaml --grid 1300:2100:100,100:900:100 "
       "--direction 1,0 --map capability.png"], "capability.png"),
+    ("burmester", "Burmester motion generation through four poses: centre-point curve and best linkage",
+     ["mechsyn synth motion examples/synthesis/poses_4.json --plot burmester.png"], "burmester.png"),
+    ("path", "Path generation: a four-bar through five targets (a published case)",
+     ["mechsyn synth path examples/synthesis/path_cases_public.json --case P2_kk5_timing --time-limit 5 "
+      "--restarts 2 --plot path.png"], "path.png"),
+    ("fingers", "Paper 000: groups attached to a two-phalanx finger, with its VLL candidates",
+     ["mechsyn synth finger examples/fingers/two_phalanx_base_000.yaml --max-links 3 --out fingers/"],
+     "fingers/fingers.png"),
     ("atlas", "The atlas of six-link chains of mobility 1",
      ["mechsyn atlas --links 6 --mobility 1 --out atlas6.png"], "atlas6.png"),
 ]

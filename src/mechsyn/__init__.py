@@ -23,6 +23,13 @@ Subpackages, one per concept:
 - :mod:`mechsyn.plot`       every figure (Matplotlib), drawn on the Axes you give
 - :mod:`mechsyn.examples`   the example files shipped with the package
 - :mod:`mechsyn.cli`        the ``mechsyn`` command line (a thin layer)
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

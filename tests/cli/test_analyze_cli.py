@@ -56,3 +56,18 @@ def test_schema(run_cli):
     schema = json.loads(out)
     assert {"name", "ground", "links", "joints"} <= set(schema["required"])
     assert "class" in json.dumps(schema)
+
+
+def test_formulas_table_reads_at_80_columns(run_cli):
+    """The value column never wraps: its header and every number stand whole at 80 columns
+    (the clamped state's long Ozol expression wraps inside its own column instead)."""
+    from mechsyn.cli.common import console
+
+    assert console.width == 80  # captured output: Rich's default width
+    code, out, _ = run_cli("analyze", S / "gripper_002_fig1_spatial.yaml")
+    assert code == 0
+    heads = [ln for ln in out.splitlines() if "formula" in ln and "expression" in ln]
+    assert len(heads) == 2 and all(ln.rstrip(" ┃").endswith("value") for ln in heads)
+    rows = [ln for ln in out.splitlines() if ln.startswith("│ Malyshev (spatial)")]
+    assert [ln.rstrip(" │").split()[-1] for ln in rows] == ["-10", "-15"]
+    assert all(len(ln) <= 80 for ln in out.splitlines() if ln[:1] in "┏┃│└")

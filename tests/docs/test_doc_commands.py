@@ -65,8 +65,8 @@ def _params():
         yield pytest.param(page, cmd, id=f"{page}:{cmd[:60]}", marks=marks)
 
 
-@pytest.fixture(scope="module")
-def page_dirs(tmp_path_factory):
+@pytest.fixture(scope="session")  # not module: a worker may run another module's tests between
+def page_dirs(tmp_path_factory):  # two commands of a page, which would tear a module fixture down
     dirs: dict[str, Path] = {}
 
     def get(page: str) -> Path:

@@ -7,15 +7,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.io import load_mechanism
-from mechsyn.io.pyslvs import data_to_expression, expression_to_data, parse_expression
+from mechsyn.io import load_mechanism, mechanism_to_dict
+from mechsyn.io.pyslvs import (color_rgb, data_to_expression, expression_to_data, parse_expression,
+                               pyslvs_text)
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.structure.analysis import analyze_structure
 
 ROOT = Path(__file__).resolve().parents[2]
 PYSLVS = sorted((ROOT / "examples" / "pyslvs").glob("*.pyslvs"))
+EX = ROOT / "examples"
 
 
 def test_a_dozen_classic_linkages():
@@ -194,3 +197,47 @@ def test_spatial_and_higher_pairs_are_refused():
             {"id": "G", "type": "gear", "links": ["a", "b"], "point": [1, 0]}]})
     with pytest.raises(MechsynInputError, match="spatial"):
         data_to_expression({"name": "x", "kind": "spatial", "ground": "f", "links": ["f"], "joints": []})
+
+
+COLOURED = """M[
+  J[R, color[Red], P[0.0, 0.0], L[ground, link_1]],
+  J[R, color[dark-blue], P[10.0, 0.0], L[link_1, link_2]],
+  J[RP, color[(10, 200, 30)], P[40.0, 0.0], A[0.0], L[ground, link_2]],
+  J[R, color[Orange], P[20.0, 5.0], L[link_2]],
+]"""
+
+
+def test_colours_survive_the_round_trip(tmp_path, run_cli):
+    """Pyslvs colours go into the file's ``colors`` block (by the P<i> made from point i)
+    and come back on the same points, the non-default ones included."""
+    src = tmp_path / "c.pyslvs"
+    src.write_text(COLOURED)
+    code, _, err = run_cli("convert", src, "-o", tmp_path / "c.yaml")
+    assert code == 0, err
+    data = yaml.safe_load((tmp_path / "c.yaml").read_text())
+    assert data["colors"] == {"P0": "Red", "P1": "dark-blue", "P2": "(10, 200, 30)", "P3": "Orange"}
+    code, _, err = run_cli("convert", tmp_path / "c.yaml", "-o", tmp_path / "back.pyslvs")
+    assert code == 0, err
+    back = parse_expression((tmp_path / "back.pyslvs").read_text())
+    assert [j.color for j in back.joints] == ["Red", "dark-blue", "(10, 200, 30)", "Orange"]
+    assert [j.color for j in parse_expression(COLOURED).joints] == [j.color for j in back.joints]
+
+
+def test_colour_edited_in_the_file_is_written_and_a_stale_one_let_go(tmp_path):
+    data = yaml.safe_load((EX / "kinematics" / "crank_rocker.yaml").read_text())
+    first = data["joints"][0]["id"]
+    data["colors"] = {first: "tab:purple"}
+    f = tmp_path / "m.yaml"
+    f.write_text(yaml.safe_dump(data))
+    text, _ = pyslvs_text(mechanism_to_dict(load_mechanism(f)))
+    assert text.count("color[tab:purple]") == 1
+    data["colors"] = {"nowhere": "Red", first: "Red"}  # e.g. a joint deleted in the studio
+    f.write_text(yaml.safe_dump(data))
+    assert mechanism_to_dict(load_mechanism(f))["colors"] == {first: "Red"}
+
+
+def test_colour_names_to_rgb():
+    assert color_rgb("Green") == pytest.approx((0, 128 / 255, 0))
+    assert color_rgb("brick-red") == color_rgb("firebrick")
+    assert color_rgb("(0, 0, 255)") == (0.0, 0.0, 1.0)
+    assert color_rgb("(0, 0, 256)") is None and color_rgb("not a colour") is None

@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[2]
 EX = ROOT / "examples"
 FOURBAR = yaml.safe_load((EX / "kinematics" / "crank_rocker.yaml").read_text())
 CAM = yaml.safe_load((EX / "kinematics" / "cam_polar.yaml").read_text())
-PATH_CASES = ROOT.parent / "shared" / "spec" / "data" / "synthesis_cases_public.json"
+PATH_CASES = ROOT / "tests" / "synthesis" / "data" / "synthesis_cases_public.json"
 MECH_CASE = EX / "synthesis" / "slider_crank_path_case.yaml"
 
 

@@ -224,7 +224,7 @@ def test_broken_synthesis_cases_api(data):
 def test_broken_path_cases_api(data):
     from mechsyn.synthesis.path import PathCase
 
-    cases = json.loads((ROOT.parent / "shared" / "spec" / "data" / "synthesis_cases_public.json").read_text())
+    cases = json.loads((ROOT / "tests" / "synthesis" / "data" / "synthesis_cases_public.json").read_text())
     _api_contract(PathCase.from_dict, data.draw(broken(cases["cases"][0])), "case.json")
 
 

@@ -22,7 +22,7 @@ from mechsyn.synthesis.optimize import OPTIMIZERS, synthesize_path
 from mechsyn.synthesis.path import evaluate_design, load_cases
 
 ROOT = Path(__file__).resolve().parents[2]
-CASES = ROOT.parent / "shared" / "spec" / "data" / "synthesis_cases_public.json"
+CASES = ROOT / "tests" / "synthesis" / "data" / "synthesis_cases_public.json"
 SLIDER_CASE = ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml"
 FINGER_CASE = ROOT / "examples" / "fingers" / "finger_design_case.yaml"
 

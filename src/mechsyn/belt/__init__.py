@@ -34,6 +34,10 @@ References
    A0-A-B-B0 and on Beyer (1953) and Geronimus (1962) for synthesis by infinitely close
    positions. Its equations are restated, with the OCR's and the paper's slips corrected,
    in ``shared/spec/flexible-manipulator.md``.
+.. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

@@ -10,6 +10,13 @@ Schema, e.g. ``examples/belt/paper001.yaml``::
   paths: {segment_deg: [-73, 0], translation_tol_deg: 3}
 
   synthesis: {h0: [-350, 600], hf: [324.6, 597.5], phi_of_deg: -60, r: 75, a0: [0, 0]}
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

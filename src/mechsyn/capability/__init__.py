@@ -9,6 +9,13 @@ Paper 004 (mobility of a redundant planar manipulator), done exactly and vectori
   velocity polytope and ellipse;
 * :mod:`~mechsyn.capability.maps` -- best configuration over the self-motion, maps over
   grids, interpolation of the optimal configuration (figures: :mod:`mechsyn.plot.capability`).
+
+References
+----------
+.. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
 """
 
 from mechsyn.capability.arm import (

@@ -17,6 +17,13 @@ Three kinds of arm files (YAML or JSON), validated with pydantic:
 Angles are degrees in files (R joints; P joint values and limits are lengths), lengths in
 any unit (mm in the paper); speeds are then length/s. Inside, every function works on
 arrays of many configurations at once: ``q`` has shape ``(N, n)`` in radians.
+
+References
+----------
+.. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -5,6 +5,13 @@ sampled (q1 in 20 deg steps, the other joints by inverse kinematics); the best o
 V_max(A_i); tables over the region give maps of V_max and of the optimal joint angles, to
 be interpolated for motion planning. Here the search is also continuous (a dense q1 scan
 refined by golden-section search), vectorised over all points of a grid at once.
+
+References
+----------
+.. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

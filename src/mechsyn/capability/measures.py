@@ -20,6 +20,13 @@ For a unit direction ``d`` (paper 004, "mobility"):
 
 All functions take stacks: ``J`` of shape (N, m, n); ``w`` (n,) or (N, n); ``d`` (m,) or
 (N, m) (normalised inside). Singular configurations give finite values, never NaN.
+
+References
+----------
+.. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -7,9 +7,10 @@ a continuous search over the self-motion.
 
 References
 ----------
-Seed paper 004 (velocity capability of a redundant planar manipulator under joint speed
-limits); the measures and their exact closed forms are described in
-:mod:`mechsyn.capability.measures`.
+.. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

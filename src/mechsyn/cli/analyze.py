@@ -1,4 +1,14 @@
-"""``mechsyn analyze FILE``: structural analysis by the papers' formulas, and ``mechsyn schema``."""
+"""``mechsyn analyze FILE``: structural analysis by the papers' formulas, and ``mechsyn schema``.
+
+References
+----------
+.. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
+   devices" (in Ukrainian, with an English abstract); authors, journal and year are
+   not in the project's copy ("paper 002"; see docs/references.md).
+.. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
+"""
 
 from __future__ import annotations
 
@@ -40,12 +50,13 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
         f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
     ))
+    values = {key: _fmt(f.value) for key, f in a.formulas.items()}
     t = Table(title="Formulas", show_lines=False)
     t.add_column("formula", no_wrap=True)
-    t.add_column("expression", no_wrap=True)
-    t.add_column("value", justify="right")
+    t.add_column("expression", overflow="fold")  # the long expressions wrap, numbers never do
+    t.add_column("value", justify="right", no_wrap=True, min_width=max(map(len, ["value", *values.values()])))
     for key, f in a.formulas.items():
-        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, _fmt(f.value))
+        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, values[key])
     console.print(t)
     if a.contours:
         c = Table(title=f"Contours (paper 003, sequential reading{CONTOUR_READING[a.kind]})")
@@ -112,9 +123,13 @@ def render_rank(ra: RankAnalysis, comparisons: list[Comparison] | None, title: s
             t.add_row(str(c.index), " ".join(c.joints), str(c.redundant), "\n".join(c.directions), c.reason)
         console.print(t)
     if comparisons:
-        t = Table(title="Formulas and rank side by side")
-        for col in ("quantity", "formula", "formula", "rank", "why they differ"):
-            t.add_column(col, justify="right" if col in ("rank",) else "left")
+        t = Table(title="Formulas and rank side by side", expand=True)
+        words = max(len(w) for c in comparisons for w in c.quantity.split())
+        t.add_column("quantity", width=words)  # words whole; text columns share the rest, numbers never wrap
+        t.add_column("formula", ratio=2)
+        t.add_column("formula", no_wrap=True)
+        t.add_column("rank", justify="right", no_wrap=True)
+        t.add_column("why they differ", ratio=3)
         for c in comparisons:
             fv = "n/a" if c.formula_value is None else _fmt(c.formula_value)
             mark = "" if c.agree else "[yellow]≠[/] "

@@ -18,7 +18,8 @@ app = typer.Typer(
 )
 
 synth_app = typer.Typer(
-    help="Synthesis: structural (groups, fingers) and dimensional (path, function, motion).",
+    help="Synthesis: structural (groups, fingers), dimensional (path, function, motion) and "
+         "curve to mechanism.",
     rich_markup_mode=None,
     no_args_is_help=True,
     add_completion=False,

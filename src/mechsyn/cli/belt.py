@@ -4,6 +4,13 @@ Thin layer over :mod:`mechsyn.belt`: each command parses its options, makes one 
 call (:func:`~mechsyn.belt.synthesize_belt`, :func:`~mechsyn.belt.analyze_case`,
 :func:`~mechsyn.belt.inverse_input`) and renders the result (``--json``: its ``to_dict()``).
 Angles in degrees on the command line; lengths in the user's unit (mm in the paper).
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations
@@ -327,10 +334,10 @@ def analyze_cmd(
 @belt_app.command("inverse")
 def inverse_cmd(
     file: OptPath = Opt(None, "--file", "-f", help="case file (YAML/JSON)"),
-    a: OptFloat = Opt(None, "--a"),
-    c: OptFloat = Opt(None, "--c"),
-    h: OptFloat = Opt(None, "--h"),
-    r: OptFloat = Opt(None, "--r"),
+    a: OptFloat = Opt(None, "--a", help="lever length |A0 A|"),
+    c: OptFloat = Opt(None, "--c", help="x offset of C left of A"),
+    h: OptFloat = Opt(None, "--h", help="height of H above C"),
+    r: OptFloat = Opt(None, "--r", help="pulley radius"),
     phi: OptStr = Opt(None, "--phi", help="Δφ range START:STOP:STEP, deg, in the direction of the motion"),
     speed: float = Opt(..., "--speed", help="required speed of the point along its path (unit/s)"),
     accel: float = Opt(0.0, "--accel", help="required tangential acceleration (unit/s²)"),

@@ -1,4 +1,12 @@
-"""``mechsyn synth groups``: paper 000's tables of groups to attach to a finger."""
+"""``mechsyn synth groups``: paper 000's tables of groups to attach to a finger.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
+"""
 
 from __future__ import annotations
 

@@ -156,7 +156,7 @@ def synth_function(
     phi: str = typer.Option(..., "--phi", help="Three crank angles [deg], from the ground line, e.g. 30,60,90."),
     psi: str = typer.Option(..., "--psi", help="Three rocker angles [deg], e.g. 100,120,135."),
     ground: float = typer.Option(1.0, "--ground", help="Ground link length."),
-    as_json: bool = typer.Option(False, "--json"),
+    as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file."),
 ) -> None:
     """Function generation by Freudenstein's equation (3 precision positions), verified by simulation."""
@@ -224,7 +224,7 @@ def synth_motion(
     circle_points: Optional[str] = typer.Option(None, "--circle-points", help="3 poses: two moving pivots in the coupler frame: x1,y1,x2,y2."),
     center_points: Optional[str] = typer.Option(None, "--center-points", help="3 poses: two ground pivots: x1,y1,x2,y2."),
     top: int = typer.Option(5, "--top", help="How many solutions to list."),
-    as_json: bool = typer.Option(False, "--json"),
+    as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Centre-point curve / solution plot (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the best linkage as a mechanism file."),
 ) -> None:

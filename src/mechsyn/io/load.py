@@ -623,6 +623,11 @@ class _Builder:
             )
         attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
                                    ("units", spec.units)) if v}
+        # display only: the colour of a joint or point the file no longer has (deleted in the
+        # studio, dropped by a synthesis) is let go rather than refusing the whole mechanism
+        colors = {k: v for k, v in spec.colors.items() if k in by_id or k in points}
+        if colors:
+            attrs["colors"] = colors
         if spec.loads:
             attrs["loads"] = self.loads(spec.loads, names, ids, points)
         return Mechanism(
@@ -674,7 +679,7 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
         d["contours"] = [list(c) for c in mech.contours]
     if mech.mobility is not None:
         d["mobility"] = mech.mobility
-    for key in ("description", "source", "units"):
+    for key in ("description", "source", "units", "colors"):
         if mech.attrs.get(key):
             d[key] = mech.attrs[key]
     if mech.attrs.get("loads"):

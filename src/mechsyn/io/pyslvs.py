@@ -35,7 +35,9 @@ Mapping to mechsyn's model (every pair joins two links):
 
 Writing back recognises those blocks (a link ``block<i>`` with one P joint and R
 joints at one point) and coincident R joints that share links, so expression -> file -> expression
-gives the same expression.
+gives the same expression. Colours (``color[...]``) are kept in the file's ``colors``
+block, keyed by the joint or point ``P<i>`` made from point ``i``, and written back;
+:func:`color_rgb` reads them for the plots.
 
 References
 ----------
@@ -48,7 +50,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import networkx as nx
@@ -58,7 +60,7 @@ from mechsyn.errors import MechsynInputError
 
 __all__ = [
     "PyslvsJoint", "PyslvsMechanism", "parse_expression", "format_expression",
-    "expression_to_data", "data_to_expression", "read_pyslvs", "pyslvs_text",
+    "expression_to_data", "data_to_expression", "read_pyslvs", "pyslvs_text", "color_rgb",
 ]
 
 FRAME = "ground"
@@ -336,6 +338,7 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
     taken = set(links)
     joints: list[dict[str, Any]] = []
     points: dict[str, dict[str, Any]] = {}
+    colors: dict[str, str] = {}
     # joints[...] of each point, and the link pairs each point joins (for the drivers)
     at_point: dict[int, list[dict[str, Any]]] = {}
     for i, j in enumerate(expr.joints):
@@ -374,6 +377,8 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
                     made.append({"id": f"{pid}_{k}", "type": "R", "links": [block, lk], "point": xy})
         at_point[i] = made
         joints += made
+        if j.color and (made or pid in points):
+            colors[pid] = j.color
     n_moving = len(links) - 1
     mobility = 3 * n_moving - 2 * len(joints)
     chosen = list(inputs) if inputs else list(expr.inputs)
@@ -393,6 +398,8 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
                             "joints": joints}
     if points:
         data["points"] = points
+    if colors:
+        data["colors"] = colors
     data["source"] = f"converted from the Pyslvs expression {source}"
     return data, notes
 
@@ -559,7 +566,8 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
         groups.sort(key=lambda gr: int(_PID.match(gr[2][0]).group(1)))  # type: ignore[union-attr]
     else:
         groups.sort(key=lambda gr: gr[0])
-    out = [gj for _, gj, _ in groups]
+    colors = data.get("colors") or {}
+    out = [replace(gj, color=next((colors[i] for i in ids if i in colors), None)) for _, gj, ids in groups]
     where = {jid: k for k, (_, _, ids) in enumerate(groups) for jid in ids}
     inputs: list[tuple[int, int]] = []
     notes: list[str] = []
@@ -596,3 +604,36 @@ def pyslvs_text(data: dict[str, Any], source: str = "<mechanism>") -> tuple[str,
     """The text of a Pyslvs expression file (with an ``# inputs:`` line) and notes."""
     expr = data_to_expression(data, source)
     return format_expression(expr.joints, expr.inputs) + "\n", expr.notes
+
+
+#: Pyslvs' colour names that are not Matplotlib's
+_COLOR_NAMES = {"brick-red": "firebrick", "dark-gray": "dimgray", "dark-yellow": "olive",
+                "dark-pink": "mediumvioletred", "dark-orange": "darkorange"}
+_RGB = re.compile(r"^\(?\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)\s*\)?$")
+
+
+def color_rgb(color: str) -> tuple[float, float, float] | None:
+    """RGB in [0, 1] of a colour as Pyslvs writes it (``Green``, ``dark-blue``,
+    ``(255, 0, 0)``) or as Matplotlib names it (``tab:blue``, ``#1f77b4``); None if unknown.
+
+    Examples
+    --------
+    >>> color_rgb("Green"), color_rgb("(255, 128, 0)")
+    ((0.0, 0.5019607843137255, 0.0), (1.0, 0.5019607843137255, 0.0))
+    >>> color_rgb("dark-blue"), color_rgb("no such colour")
+    ((0.0, 0.0, 0.5450980392156862), None)
+    """
+    from matplotlib.colors import to_rgb
+
+    text = color.strip()
+    m = _RGB.match(text)
+    if m:
+        rgb = tuple(int(g) for g in m.groups())
+        return tuple(v / 255 for v in rgb) if max(rgb) <= 255 else None  # type: ignore[return-value]
+    name = _COLOR_NAMES.get(text.lower(), text.lower().replace("-", ""))
+    for candidate in (text, name):
+        try:
+            return to_rgb(candidate)
+        except ValueError:
+            continue
+    return None

@@ -11,6 +11,19 @@
       - {id: B, type: R, links: [crank, coupler], point: [1, 2]}
       - {id: C, type: R, links: [coupler, rocker], point: [4, 3]}
       - {id: D, type: R, links: [rocker, frame], point: [5, 0]}
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
+.. [2] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
+   devices" (in Ukrainian, with an English abstract); authors, journal and year are
+   not in the project's copy ("paper 002"; see docs/references.md).
+.. [3] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations
@@ -181,6 +194,11 @@ class MechanismFile(_Strict):
     description: str | None = None
     source: str | None = Field(None, description="Where the mechanism comes from (paper, figure).")
     units: str | None = None
+    colors: dict[str, str] = Field(
+        default_factory=dict,
+        description="Display colours by joint id or point name, as Pyslvs writes them (Green, "
+                    "dark-blue, (255, 0, 0)) or any Matplotlib colour; kept by Pyslvs round trips.",
+    )
 
     @field_validator("contours", mode="before")
     @classmethod

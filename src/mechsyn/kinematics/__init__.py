@@ -6,6 +6,13 @@ velocities, accelerations), ``dyads`` (closed-form Assur dyads, vectorised), ``f
 (kinetostatics), ``derived`` (transmission angle, mechanical advantage, Grashof, path
 extent, straightness). Paper 001's belt drive is :mod:`mechsyn.belt`. Figures and the
 animation: :mod:`mechsyn.plot.kinematics`.
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from typing import Any

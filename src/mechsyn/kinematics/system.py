@@ -32,6 +32,17 @@ Joints become constraint rows ``Phi(q, u) = 0`` (``u``: the input coordinates):
 The Jacobian ``Phi_q`` is analytic; ``gamma`` is the right-hand side of the
 acceleration equation ``Phi_q q'' = gamma`` (Haug eq. 3.3.11). All functions work on a
 batch of configurations: ``q`` has shape ``(N, n)``.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
+.. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations

@@ -13,6 +13,16 @@ non-slipping belt keeps ``b + r·(wrapped angle)`` constant: one constraint on t
 relative motion in the plane, so it counts like a higher pair, class 4 (``p4``). Its
 instantaneous equivalent is a contact whose normal is the straight belt run through the
 tangent point (the tension's line of action): :func:`belt_tangent`.
+
+References
+----------
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
+.. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations

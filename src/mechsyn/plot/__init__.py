@@ -13,6 +13,21 @@ a new pyplot figure, and returns it; none writes a file or chooses a backend.
 - :mod:`mechsyn.plot.curves` -- curve synthesis: target and traced paths
 - :mod:`mechsyn.plot.atlas` -- atlases of kinematic chains
 - :mod:`mechsyn.plot.finger` -- paper 000's fingers and finger designs
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
+.. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
+.. [3] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

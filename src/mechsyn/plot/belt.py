@@ -8,9 +8,10 @@ an animation of the motion. Nothing here writes a file or chooses a backend.
 
 References
 ----------
-.. [1] Paper 001 (seed 001): a manipulator mechanism with a flexible element (belt on a
-   pulley), in Bulgarian; the stored copy gives no authors, title, journal or year (see
-   :mod:`mechsyn.belt`).
+.. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
+   Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
+   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   see docs/references.md).
 """
 
 from __future__ import annotations
@@ -104,8 +105,8 @@ def _draw_paths(ax: Any, design: BeltDesign, state: BeltState, four_bar: bool, t
         ax.axhline(P[i0, 1], color=_COLOURS[name], lw=0.6, ls=(0, (6, 4)), alpha=0.6)
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
-    ax.set_xlabel("x (machine plane)")
-    ax.set_ylabel("y (machine axis)")
+    ax.set_xlabel("x, machine plane (unit)")
+    ax.set_ylabel("y, machine axis (unit)")
     rng = f"Δφ = {math.degrees(state.dphi[0]):g}° … {math.degrees(state.dphi[-1]):g}°"
     ax.set_title(f"{title}\na = {design.a:g}, c = {design.c:g}, h = {design.h:g}, "
                  f"r = {design.r:g};  b0 = {design.b0:.3f}, l0 = {design.l0:.3f}, "

@@ -1,4 +1,12 @@
-"""Figures of a velocity-capability map (paper 004): V_max and the optimal joint values."""
+"""Figures of a velocity-capability map (paper 004): V_max and the optimal joint values.
+
+References
+----------
+.. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
+   method of studying the mobility of planar manipulator mechanisms" (in Russian),
+   Omsk State Technical University; journal and year are not in the project's copy
+   ("paper 004"; see docs/references.md).
+"""
 
 from __future__ import annotations
 
@@ -50,13 +58,13 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
     qu = cmap.q_user()
     fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
                f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
-               f"[{units}]" + ("" if cmap.z is None else f" in z = {cmap.z:g}")
+               f"({units})" + ("" if cmap.z is None else f" in z = {cmap.z:g}")
                + f"\n{cmap.measure}, {cmap.search} self-motion", "viridis")]
     for k in range(n):
-        data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else ""
+        data, unit = qu[..., k], "deg" if cmap.joint_is_revolute[k] else units.split("/")[0]
         if cmap.joint_is_revolute[k] and np.nanmax(np.abs(data), initial=0.0) > 180:
             data, unit = (data + 180) % 360 - 180, "deg, shown mod 360"  # same pose
-        fields.append((data, f"optimal {cmap.joint_names[k]} [{unit}]", "coolwarm"))
+        fields.append((data, f"optimal {cmap.joint_names[k]} ({unit})", "coolwarm"))
     for idx, (data, title, cm) in enumerate(fields):
         ax = axs[idx // cols][idx % cols]
         mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
@@ -71,8 +79,8 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
                                 color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
         ax.set_title(title, fontsize=9)
         length = units.split("/")[0]
-        ax.set_xlabel(f"x [{length}]")
-        ax.set_ylabel(f"y [{length}]")
+        ax.set_xlabel(f"x ({length})")
+        ax.set_ylabel(f"y ({length})")
         ax.set_aspect("equal")
     for idx in range(panels, rows_ * cols):
         axs[idx // cols][idx % cols].axis("off")

@@ -64,6 +64,8 @@ def plot_candidate(candidate, target, ax=None, linkage: bool = True, color: str 
     ax.set_xlim(lo[0] - pad, hi[0] + pad)
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
     ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x (target's length unit)")
+    ax.set_ylabel("y (target's length unit)")
     ax.grid(True, alpha=0.3)
     return drawn
 

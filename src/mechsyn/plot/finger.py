@@ -1,5 +1,13 @@
 """Drawings of the fingers of paper 000's synthesis: base links grey, attached group
-orange, VLL candidates dashed red, frame pairs hatched."""
+orange, VLL candidates dashed red, frame pairs hatched.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
+"""
 
 from __future__ import annotations
 
@@ -117,6 +125,7 @@ def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
     fig = figure(fig, (17, 7.2))
     axes = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1, 1, 1.3]})
     S = ev.system
+    unit = S.mech.attrs.get("units") or "length"
     idx = np.searchsorted(ev.inputs, case.target_inputs)
     reg = np.vstack([case.region, case.region[:1]])
     for ax in axes:
@@ -124,8 +133,8 @@ def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
         ax.plot(reg[:, 0], reg[:, 1], color="#1b7837", lw=1.2, zorder=1)
         ax.set_aspect("equal")
         ax.grid(alpha=0.3)
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
+        ax.set_xlabel(f"x ({unit})")
+        ax.set_ylabel(f"y ({unit})")
     gp = np.array([j.point for j in S.mech.joints if S.mech.ground in j.links])
     # 1: fully actuated
     ax = axes[0]

@@ -49,12 +49,11 @@ def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
     S = sim.system
     arts = []
     outl = link_outlines(sim, k)
-    cmap = matplotlib.colormaps["tab10"]
-    for n, (name, pts) in enumerate(outl.items()):
+    for name, pts in outl.items():
         if name == S.mech.ground:
             arts += ax.plot(pts[:, 0], pts[:, 1], "^", ms=10, color="0.35", alpha=alpha, zorder=3)
             continue
-        c = cmap(n % 10)
+        c = link_colour(sim, name)
         if len(pts) >= 3:
             centre = pts.mean(axis=0)
             order = np.argsort(np.arctan2(pts[:, 1] - centre[1], pts[:, 0] - centre[0]))
@@ -117,7 +116,32 @@ def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
             b = j.links[1]
             P = outl[b][[x.id for x in S.mech.joints_of(b)].index(j.id)]
             arts += ax.plot([P[0]], [P[1]], "s", ms=11, mfc="none", mec="0.1", alpha=alpha, zorder=5)
+    for xy, rgb in _file_colours(sim, k):  # the file's own colours (e.g. Pyslvs') fill the pins
+        arts += ax.plot([xy[0]], [xy[1]], "o", ms=6, mfc=rgb, mec="0.1", mew=0.6, alpha=alpha, zorder=6)
     return arts
+
+
+def _file_colours(sim: Any, k: int) -> list[tuple[np.ndarray, tuple[float, float, float]]]:
+    """(position at step ``k``, RGB) of each joint and point the file's ``colors`` names."""
+    from mechsyn.io.pyslvs import color_rgb
+
+    S = sim.system
+    colours = S.mech.attrs.get("colors") or {}
+    q = sim.sweep.q[k:k + 1]
+    out = []
+    for key, colour in colours.items():
+        rgb = color_rgb(colour)
+        if rgb is None:
+            continue
+        if key in S.mech.points:
+            link, at = S.mech.points[key].link, S.mech.points[key].at
+        else:
+            j = next((j for j in S.mech.joints if j.id == key and j.point is not None), None)
+            if j is None:
+                continue
+            link, at = j.links[1], _joint_point_on(j, j.links[1])
+        out.append((S.point(q, S.index(link), S.to_local(link, at))[0], rgb))
+    return out
 
 
 def link_colour(sim: Any, link: str) -> Any:
@@ -224,7 +248,8 @@ def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
         axs[0].plot(x, np.linalg.norm(F, axis=1), label=j)
     axs[0].set_title("joint reactions |F|")
     axs[0].set_xlabel(xlabel)
-    axs[0].set_ylabel("force")
+    unit = _length_unit(sim)
+    axs[0].set_ylabel(f"force (mass·{unit}/s²)")
     axs[0].grid(alpha=0.3)
     axs[0].legend(fontsize=8, ncol=2)
     for j, e in fa.reactions.effort.items():
@@ -232,10 +257,15 @@ def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
     axs[1].axhline(0, color="0.5", lw=0.8)
     axs[1].set_title("balancing moment / force at the driven joints")
     axs[1].set_xlabel(xlabel)
+    kinds = set(fa.reactions.effort_kind.values())
+    axs[1].set_ylabel(" or ".join(f"{k} (force·{unit})" if k == "moment" else f"{k}" for k in sorted(kinds))
+                      or "effort")
     axs[1].grid(alpha=0.3)
     axs[1].legend(fontsize=8)
     kind = "static" if fa.static else "kinetostatic"
-    fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, gravity {fa.gravity}")
+    g = np.asarray(fa.gravity, float) + 0.0  # + 0.0: no "-0.0" in the title
+    gravity = f"gravity ({g[0]:g}, {g[1]:g})" if np.any(g) else "no gravity"
+    fig.suptitle(title or f"{sim.mechanism}: {kind} analysis, {gravity}")
     fig.tight_layout()
     return fig
 
@@ -311,7 +341,6 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
         return _redraw_animation(sim, fig, ax, frames, x, xlabel, interval)
     # the artists are made once and moved at each frame (no clearing, no re-layout)
     S = sim.system
-    cmap = matplotlib.colormaps["tab10"]
     trails = []
     styles = _point_styles(sim)
     for name, pm in sim.points.items():
@@ -320,8 +349,8 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
         dot, = ax.plot([], [], "o", ms=4, color="k")
         trails.append((pm.position, trail, dot))
     links = []
-    for n, name in enumerate(S.mech.link_names):
-        c = cmap(n % 10)
+    for name in S.mech.link_names:
+        c = link_colour(sim, name)
         if name == S.mech.ground:
             links.append((name, None, ax.plot([], [], "^", ms=10, color="0.35", zorder=3)[0], None))
             continue

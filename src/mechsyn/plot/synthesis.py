@@ -37,6 +37,8 @@ def plot_fourbar_path(design: dict[str, float], targets: np.ndarray, theta2: np.
     ax.fill(tri[:, 0], tri[:, 1], color="tab:orange", alpha=0.3)
     ax.plot([O2[0], O4[0]], [O2[1], O4[1]], "k--", lw=1)
     ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (length)")
+    ax.set_ylabel("y (length)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     if title:
@@ -69,6 +71,9 @@ def plot_mechanism_synthesis(case: Any, res: Any, ax: Any = None) -> Any:
     J = np.array(list(pts.values()))
     ax.plot(J[:, 0], J[:, 1], "o", color="k", ms=4, label="design (file configuration)")
     ax.set_aspect("equal")
+    unit = res.mechanism.get("units") or "length"
+    ax.set_xlabel(f"x ({unit})")
+    ax.set_ylabel(f"y ({unit})")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
     ax.set_title(f"{case.name} ({case.problem} generation): error {res.error:.4g}", fontsize=10)
@@ -108,7 +113,9 @@ def plot_motion_synthesis(P: np.ndarray, sols: list, ax: Any = None) -> Any:
     for j, (x, y, a) in enumerate(P):
         ax.annotate("", (x + L * np.cos(a), y + L * np.sin(a)), (x, y),
                     arrowprops={"arrowstyle": "->", "color": "tab:red", "lw": 2})
-        ax.text(x, y, f" {j + 1}", color="tab:red")
+        # the number behind the arrow's tail, clear of the arrow
+        ax.text(x - 0.3 * L * np.cos(a), y - 0.3 * L * np.sin(a), str(j + 1), color="tab:red",
+                ha="center", va="center", fontsize=10, fontweight="bold")
     for s in sols[:1]:
         pose = fourbar_position(s.r1, s.r2, s.r3, s.r4, s.theta2[0], branch=s.branch,
                                 x0=s.O2[0], y0=s.O2[1], theta0=s.theta0)

@@ -18,6 +18,15 @@ first contour that contains it (the *sequential reading*):
 - ``S_Σ = Σ S_j``, ``G_Σ = Σ T_j + Σ Z_j``, ``W = 6n - Σ i·p_i + S_Σ + G_Σ``.
 - ``H = n - Σ A_j``: several contours ``A_j = 2`` if ``n_k >= 2``, ``1`` if ``n_k = 1``;
   one contour ``A = 2`` if ``n_j >= 3`` else 1.
+
+References
+----------
+.. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
+   devices" (in Ukrainian, with an English abstract); authors, journal and year are
+   not in the project's copy ("paper 002"; see docs/references.md).
+.. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations

@@ -26,6 +26,13 @@ the missing inputs are *imaginary input links*: links jointed to the frame chose
 that the rest decomposes into groups (paper 000, step 5). Paper 000 turns the binary
 imaginary input links and the binary links of class II groups that are neither output
 nor frame links into ternary links to obtain free leashes: :attr:`leash_candidates`.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

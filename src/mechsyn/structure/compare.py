@@ -7,10 +7,14 @@ remedy (paper 003) with the rank method; :func:`rank_to_markdown` writes both as
 
 References
 ----------
-Paper 002: Ozol's formula and external constraints; paper 003: per-contour redundant
-constraints and idle mobilities (see ``../shared/spec/structural.md``).
-Gogu, G. (2005). Mobility of mechanisms: a critical review. *Mechanism and Machine
-Theory*, 40(9), 1068-1097.
+.. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
+   devices" (in Ukrainian, with an English abstract); authors, journal and year are
+   not in the project's copy ("paper 002"; see docs/references.md).
+.. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
+.. [3] G. Gogu, "Mobility of mechanisms: a critical review", *Mechanism and Machine
+   Theory*, 40(9), 1068-1097, 2005.
 """
 
 from __future__ import annotations

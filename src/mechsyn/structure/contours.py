@@ -4,6 +4,12 @@ Paper 003's per-contour results depend on the contours and their order, so a fil
 give them; otherwise :func:`independent_contours` chooses a set: the file's contours
 first, then the shortest fundamental cycles of a breadth-first spanning tree rooted at
 the frame, kept when independent over GF(2) (cycle space of the graph).
+
+References
+----------
+.. [1] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations

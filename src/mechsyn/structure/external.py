@@ -12,6 +12,12 @@ A gripper before clamping has internal constraints only; after clamping, the obj
 External redundant constraints: ``σ_a = S_a - [(W_f - W_rob) + W_a - S_ai]``.
 Whole system: ``σ = S - {[6(N - 1) - W_rob] + W_a - S_ai}``, ``S = S_i + S_a``,
 ``S_i`` the sum of the internal pairs' classes, ``N`` the links with the frame.
+
+References
+----------
+.. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
+   devices" (in Ukrainian, with an English abstract); authors, journal and year are
+   not in the project's copy ("paper 002"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -44,6 +44,12 @@ curvature is not in the file).
 Pair twists and the linear algebra live in :mod:`mechsyn.structure.screws`, idle
 mobilities in :mod:`mechsyn.structure.idle`, the formulas side by side and the remedy
 checks in :mod:`mechsyn.structure.compare`.
+
+References
+----------
+.. [1] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations

@@ -10,6 +10,12 @@ removes one from ``S_j``, the mobility ``W`` is unchanged; each variant is re-an
 confirm it.
 
 Variants are listed fewest changed pairs first, then smallest total class change.
+
+References
+----------
+.. [1] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations

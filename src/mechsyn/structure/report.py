@@ -6,6 +6,15 @@ the rank method where the file gives the joints' geometry
 request, lists pair-class remedies re-checked by the rank method. The
 :class:`StructureReport` it returns gives the same dict as ``mechsyn analyze --json``
 (``to_dict()``) and the same Markdown as ``--markdown`` (``to_markdown()``, shown by Jupyter).
+
+References
+----------
+.. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
+   devices" (in Ukrainian, with an English abstract); authors, journal and year are
+   not in the project's copy ("paper 002"; see docs/references.md).
+.. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations

@@ -30,6 +30,13 @@ use the engine's vectorised closed form (:func:`mechsyn.kinematics.dyads.solve_p
 for the whole sweep at once; others the engine's Newton continuation
 (:func:`mechsyn.kinematics.solve.sweep`). Optimiser: :mod:`mechsyn.synthesis.optimize`
 (its pluggable ``OPTIMIZERS``, reproducible restart seeds and least-squares ``polish``).
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

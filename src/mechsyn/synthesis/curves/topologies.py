@@ -106,6 +106,8 @@ def curve_topologies(max_links: int = 8) -> tuple[CurveTopology, ...]:
     """Every inequivalent (chain, frame, input, tracer) with 4..``max_links`` links whose
     mechanism is solved by a crank and RRR dyads (see the module doc).
 
+    Examples
+    --------
     >>> [t.name for t in curve_topologies(4)]
     ['four-bar']
     >>> sorted({t.name for t in curve_topologies(6)} - {'four-bar'})

@@ -27,6 +27,13 @@ Steps (spec ``structural.md`` section 4, paper 000 steps 1-7):
 
 One group is attached, or with ``separate`` the paper's alternative of ``W0 - A``
 groups of ``W_f = -1`` each (``W0 - 1`` for one drive).
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -3,6 +3,13 @@
 A case names a mechanism file with variable-length links (VLL), the input joint, the
 design variables with their bounds, the discrete target positions, the working region
 and the output points; ``docs/finger_design.md`` describes every field.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

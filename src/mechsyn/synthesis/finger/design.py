@@ -38,8 +38,10 @@ mode (Newton continuation), an independent method.
 
 References
 ----------
-Paper 000 of the project's seeds (``structural.md`` section 4 of the spec restates it
-with its worked examples).
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

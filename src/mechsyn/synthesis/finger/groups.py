@@ -10,6 +10,13 @@ fully actuated:
 4. free leashes of the group ``m_f = P_f - (n_f - 1)``;
 5. the base needs ``m_0 = 2 (W0 - 1)`` free leashes;
 6. conditions: ``P_f >= 2 (W0 - 1) + (n_f - 1)`` and ``m_f >= m_0``.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -3,6 +3,13 @@ of a VLL, the locked (fully actuated) model and the working-region test, in NumP
 
 A VLL is a P pair between a *cylinder* link (pivoted at ``K``) and a *piston* link
 (pivoted at ``L``, the P pair's point); locked, the two are one rigid binary link.
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations

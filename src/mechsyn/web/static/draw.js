@@ -12,6 +12,23 @@ export function el(tag, attrs = {}, parent = null, text = null) {
 
 export const linkName = (l) => (typeof l === "string" ? l : l.name);
 
+// A file colour (the mechanism's `colors`, e.g. from Pyslvs: Green, dark-blue, (255, 0, 0))
+// as a CSS colour, or null for none / a name CSS does not know (e.g. tab:purple). It is set
+// through the CSSOM (element.style), which the page's CSP allows, unlike style attributes.
+export function fileColour(mech, key) {
+  const c = ((mech.colors || {})[key] || "").trim();
+  const rgb = c.match(/^\(?\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)\s*\)?$/);
+  if (rgb) return `rgb(${rgb[1]}, ${rgb[2]}, ${rgb[3]})`;
+  const PYSLVS = { "brick-red": "firebrick", "dark-gray": "dimgray", "dark-yellow": "olive", "dark-pink": "mediumvioletred" };
+  const name = PYSLVS[c.toLowerCase()] || c.toLowerCase().replace(/-/g, "");
+  return /^[a-z]+$/.test(name) || /^#[0-9a-f]{3,8}$/.test(name) ? name : null;
+}
+
+function fillWith(e, colour) {
+  if (colour) e.style.fill = colour;
+  return e;
+}
+
 export function makeView(svg, view) {
   const r = svg.getBoundingClientRect();
   const W = r.width || 800, H = r.height || 600;
@@ -169,15 +186,16 @@ export function draw(svg, state) {
         el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
       }
     } else {
-      joints[j.id] = el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 6.5, class: cls, "data-joint": j.id,
-        "data-x": p[0], "data-y": p[1] }, layers.joints);
+      joints[j.id] = fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 6.5, class: cls, "data-joint": j.id,
+        "data-x": p[0], "data-y": p[1] }, layers.joints), fileColour(mech, j.id));
     }
     el("text", { x: px + 9, y: py - 9, class: "label" }, layers.labels, j.id);
   }
   for (const [n, p] of Object.entries(pos.points)) {
     if (!p) continue;
     const [px, py] = P(p);
-    el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n }, layers.points);
+    fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n },
+      layers.points), fileColour(mech, n));
     el("text", { x: px + 8, y: py + 14, class: "label" }, layers.labels, n);
   }
   // dead points: × on every path where a working range ends
