@@ -337,3 +337,31 @@ def test_four_bar_mechanism_dict_geometry():
     assert np.linalg.norm(P["B0"] - P["A0"]) == pytest.approx(PAPER.l0)
     assert (P["A"] - P["B"]) @ (P["B0"] - P["B"]) == pytest.approx(0.0, abs=1e-9)
     assert m["points"]["H"]["at"] == pytest.approx([-350.0, 600.0])
+
+
+def _narrowest_strip_brute(P):
+    """Every hull edge against every hull vertex: O(h^2), the reference."""
+    from scipy.spatial import ConvexHull
+
+    V = P[ConvexHull(P).vertices]
+    E = np.roll(V, -1, axis=0) - V
+    E /= np.hypot(E[:, 0], E[:, 1])[:, None]
+    proj = V @ np.stack([-E[:, 1], E[:, 0]], axis=-1).T
+    return float((proj.max(axis=0) - proj.min(axis=0)).min() / 2)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_best_line_rotating_calipers_match_every_pair(seed):
+    rng = np.random.default_rng(seed)
+    n = [5, 40, 400, 3000, 50, 8][seed]
+    P = rng.normal(size=(n, 2)) * rng.uniform(0.1, 10, size=2) @ np.array([[1, 0.3], [0.2, 1]])
+    if seed == 5:                                        # a path like the belt's: many hull points
+        t = np.linspace(0, 3, 4000)
+        P = np.c_[t * 300, 40 * np.sin(t) + 0.01 * t ** 3]
+    dev, point, direction = best_line_deviation(P)
+    assert dev == pytest.approx(_narrowest_strip_brute(P), rel=1e-12, abs=1e-12)
+    # every point lies within dev of the returned line, and some on both sides reach it
+    nrm = np.array([-direction[1], direction[0]])
+    dist = (P - point) @ nrm
+    assert np.max(np.abs(dist)) == pytest.approx(dev, rel=1e-9)
+    assert dist.max() == pytest.approx(dev, rel=1e-9) and dist.min() == pytest.approx(-dev, rel=1e-9)

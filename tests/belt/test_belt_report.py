@@ -146,13 +146,17 @@ def test_computing_modules_import_no_presentation():
 def test_belt_synthesis_is_a_synthesis_result():
     from mechsyn.synthesis.problem import COMMON_KEYS, SynthesisResult
 
-    s = synthesize_belt((-350, 600), (300, 560), math.radians(-55), 75)
+    s = synthesize_belt((-350, 600), (324.62, 597.49), math.radians(-60), 75)   # the spec's scene
     assert isinstance(s, BeltSynthesis) and isinstance(s, SynthesisResult)
     d = s.to_dict()
     assert set(COMMON_KEYS) <= set(d)
     assert d["design"]["a"] == s.design.a and d["nfev"] == 0 and d["seed"] is None
     assert s.error == pytest.approx(d["Hf_miss"]) and s.feasible and s.reason == ""
     assert s.x.tolist() == pytest.approx([s.design.a, s.design.c, s.design.h])
+    # a scene the belt cannot serve: the checks pass, but H misses Hf by half a metre
+    far = synthesize_belt((-350, 600), (300, 560), math.radians(-55), 75)
+    assert all(far.checks.values()) and not far.feasible and far.error > 500
+    assert "H misses Hf by 508.9" in far.reason
 
 
 def test_case_file_through_the_library_is_the_command(run_cli):

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mechsyn.belt.design import BeltDesign
-from mechsyn.belt.kinematics import analyze
+from mechsyn.belt.kinematics import BeltState, analyze
 from mechsyn.belt.tables import Table, fmt
 from mechsyn.errors import MechsynInputError
 from mechsyn.synthesis.problem import SynthesisResult
@@ -115,6 +115,17 @@ def _check_inputs(H0: tuple[float, float], Hf: tuple[float, float], A0: tuple[fl
         raise MechsynInputError("|φ_of| must be below 180°", field="phi")
 
 
+def _checks(design: BeltDesign, st: BeltState, scale: float) -> dict[str, bool]:
+    """What the construction must give over the motion ``st`` from H0 to Hf."""
+    return {
+        "belt_taut_and_straight (d > r)": bool(np.all(st.valid)),
+        "lever_and_belt_parallel_at_design": bool(
+            abs(design.B0[0] - design.r) < 1e-9 * scale and abs(math.degrees(st.beta[0]) - 90) < 1e-9
+        ),
+        "b0_below_a": bool(design.b0 < design.a),
+    }
+
+
 def synthesize_belt(
     H0: tuple[float, float],
     Hf: tuple[float, float],
@@ -122,6 +133,7 @@ def synthesize_belt(
     r: float,
     A0: tuple[float, float] = (0.0, 0.0),
     samples: int = 721,
+    hf_tol: float = 1e-3,
 ) -> BeltSynthesis:
     """Primary chain (a, c, h) and belt (b0, l0, α0) from H0, Hf, φ_of (rad), r and A0.
 
@@ -133,12 +145,22 @@ def synthesize_belt(
     Checked by construction: lever 1 and the belt are parallel (both along y) in the
     design position, with the belt at distance r from the lever's axis.
 
+    The construction fixes a, c, h so that *some* rotation of link 2 brings H to Hf; the
+    belt then sets that rotation, so H reaches Hf at Δφ = φ_of only when the scene suits
+    the belt. ``error`` is H's miss of Hf there; the result is ``feasible`` only when the
+    miss is at most ``hf_tol`` times the scene's size (``reason`` says otherwise).
+
     Examples
     --------
     >>> import math, mechsyn as ms
-    >>> s = ms.synthesize_belt(H0=(-350, 600), Hf=(300, 560), phi_of=math.radians(-55), r=75)
-    >>> bool(s.design.a > 0 and s.design.c > 0), s.design.r
-    (True, 75.0)
+    >>> s = ms.synthesize_belt(H0=(-350, 600), Hf=(324.62, 597.49), phi_of=math.radians(-60), r=75)
+    >>> round(s.design.a, 2), round(s.design.c, 2), round(s.design.h, 2)   # paper 001's 500, 350, 100
+    (500.04, 350.0, 99.96)
+    >>> s.feasible, round(s.error, 3)                    # Hf given to 0.01: H misses it by 0.019
+    (True, 0.019)
+    >>> far = ms.synthesize_belt(H0=(-350, 600), Hf=(300, 560), phi_of=math.radians(-55), r=75)
+    >>> far.feasible, round(far.error)                   # a scene the belt cannot serve
+    (False, 509)
     """
     t0 = time.perf_counter()
     _check_inputs(H0, Hf, A0, phi_of, r)
@@ -176,13 +198,7 @@ def synthesize_belt(
     # check the belt stays taut and straight (d > r) over the motion H0 -> Hf
     st = analyze(design, np.linspace(0.0, phi_of, samples))
     margin = float(np.nanmin(st.d) - r) if np.any(np.isfinite(st.d)) else -math.inf
-    checks = {
-        "belt_taut_and_straight (d > r)": bool(np.all(st.valid)),
-        "lever_and_belt_parallel_at_design": bool(
-            abs(design.B0[0] - r) < 1e-9 * scale and abs(math.degrees(st.beta[0]) - 90) < 1e-9
-        ),
-        "b0_below_a": bool(design.b0 < a),
-    }
+    checks = _checks(design, st, scale)
     notes: list[str] = []
     if not checks["belt_taut_and_straight (d > r)"]:
         raise MechsynInputError(
@@ -195,11 +211,16 @@ def synthesize_belt(
             "synthesis fixes a, c, h (A is equidistant from H0 and Hf(1)); link 2's "
             "rotation Δψ relative to lever 1 is then set by the belt")
     H_end = (float(st.H[-1, 0]), float(st.H[-1, 1]))
-    failed = [k for k, ok in checks.items() if not ok]
+    miss = math.dist(H_end, (xf, yf))
+    failed = [f"check failed: {k}" for k, ok in checks.items() if not ok]
+    if miss > hf_tol * scale:
+        failed.append(f"H misses Hf by {miss:.6g} at Δφ = φ_of (more than {hf_tol:g} of the scene's size "
+                      f"{scale:.6g}): the belt, not this construction, sets link 2's rotation; "
+                      "change Hf, φ_of or A0")
     return BeltSynthesis(
         design=design, A0=(float(A0[0]), float(A0[1])), H0=(x0, y0), Hf=(xf, yf),
         phi_of_deg=math.degrees(phi_of), Hf1=(xf1, yf1), M=(xm, ym), k_m=k_m,
         min_d_minus_r=margin, H_at_phi_of=H_end, checks=checks, notes=notes,
-        x=np.array([a, c, h]), error=math.dist(H_end, (xf, yf)), feasible=not failed,
-        reason="; ".join(f"check failed: {k}" for k in failed), seconds=time.perf_counter() - t0,
+        x=np.array([a, c, h]), error=miss, feasible=not failed, reason="; ".join(failed),
+        seconds=time.perf_counter() - t0,
     )

@@ -243,6 +243,8 @@ def _render_synthesis(res: BeltSynthesis) -> None:
         console.print(f"  [{'green' if ok else 'yellow'}]{'ok ' if ok else 'NO '}[/] {k}")
     for note in res.notes:
         console.print(f"  note: {note}")
+    if not res.feasible:
+        console.print(f"[yellow]not feasible:[/] {res.reason}")
 
 
 def _render_inverse(res: InverseResult, speed: float, accel: float) -> None:
