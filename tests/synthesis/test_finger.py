@@ -127,3 +127,4 @@ def test_finger_cli_plain_output_at_80_columns(run_cli, monkeypatch):
     code, out, err = run_cli("synth", "finger", EX / "two_phalanx_base_000.yaml", "--max-links", "3")
     assert code == 0, err
     assert "W0 = 2" in out and "distinct fingers" in out
+    assert "admissible groups: (n_f=1, P_f=2, m_f=2); (n_f=3, P_f=5, m_f=3)" in out

@@ -69,8 +69,8 @@ def _render(synth: Any) -> None:
     console.print(f"[bold]{synth.base_name}[/]: W0 = {synth.W0}, A = {synth.actuators}, "
                   f"W_f = -(W0 - A) = {synth.W_f}, m_0 = 2(W0 - 1) = {synth.m_0}", highlight=False)
     console.print(f"base structure: {synth.base_formula}", highlight=False)
-    console.print("admissible groups: " + ", ".join(
-        f"n_f={r.n_f}, P_f={r.P_f}, m_f={r.m_f}" for r in synth.groups), highlight=False)
+    console.print("admissible groups: " + "; ".join(
+        f"(n_f={r.n_f}, P_f={r.P_f}, m_f={r.m_f})" for r in synth.groups), highlight=False)
     t = Table(title=f"{len(synth.results)} distinct fingers")
     for col in ("#", "groups (n_f, P_f)", "attached to", "structure (VLL locked)", "VLL candidates",
                 "W with VLL free"):

@@ -48,8 +48,8 @@ class PopulationEvaluation:
 class _Vll:
     """Columns of one VLL's cylinder pivot K and piston pivot L in the plan's parameters."""
 
-    k: int
-    l: int
+    pivot_k: int
+    pivot_l: int
     drawn: np.ndarray          # the file's P point (direction and drawn length from K)
     angle: int                 # design-vector column of its direction, -1: the drawn one
     minimum: float | None      # l_min when the combination holds it, None: the drawn length
@@ -74,12 +74,12 @@ class LockedPopulation:
         for i, col in self.columns:
             P[:, col] = X[:, i]
         for v in self.vlls:
-            pk = P[:, 2 * v.k:2 * v.k + 2]
+            pk = P[:, 2 * v.pivot_k:2 * v.pivot_k + 2]
             u = v.drawn[None, :] - pk
             ang = np.radians(X[:, v.angle]) if v.angle >= 0 else np.arctan2(u[:, 1], u[:, 0])
             length = v.minimum if v.minimum is not None else np.linalg.norm(u, axis=1)
-            P[:, 2 * v.l] = pk[:, 0] + length * np.cos(ang)
-            P[:, 2 * v.l + 1] = pk[:, 1] + length * np.sin(ang)
+            P[:, 2 * v.pivot_l] = pk[:, 0] + length * np.cos(ang)
+            P[:, 2 * v.pivot_l + 1] = pk[:, 1] + length * np.sin(ang)
         return P
 
     def evaluate(self, X: np.ndarray) -> PopulationEvaluation:
