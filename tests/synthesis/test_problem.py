@@ -18,6 +18,8 @@ from mechsyn.synthesis.optimize import PathSynthesisResult, restart_seeds, synth
 from mechsyn.synthesis.path import PathCase
 from mechsyn.synthesis.problem import COMMON_KEYS, Progress, SynthesisResult, as_generator, resolve_seed
 
+from mechsyn.synthesis.finger.design import FingerDesign  # noqa: E402
+
 FAST = {"maxiter": 6, "popsize": 6}
 
 
@@ -36,7 +38,7 @@ def _path(seed, **kw):
 
 
 @pytest.mark.parametrize("cls", [PathSynthesisResult, MechanismSynthesisResult, CurveSynthesisResult,
-                                 BeltSynthesis])
+                                 BeltSynthesis, FingerDesign])
 def test_every_synthesis_result_is_one(cls):
     assert issubclass(cls, SynthesisResult) and issubclass(cls, Result)
 

@@ -85,10 +85,8 @@ class SynthesisResult(Result):
     :class:`mechsyn.synthesis.optimize.PathSynthesisResult`,
     :class:`mechsyn.synthesis.general.MechanismSynthesisResult`,
     :class:`mechsyn.synthesis.curves.synthesis.CurveSynthesisResult`,
-    :class:`mechsyn.belt.BeltSynthesis`; the finger-design result (``synthesis/finger/``)
-    is to extend it the same way: drop its own ``error``/``design``/``feasible``/
-    ``seconds``/``seed``/``nfev``/``reason``/``interrupted`` fields (inherited), pass them
-    by keyword, and end its ``to_dict`` with ``**self.common()``.
+    :class:`mechsyn.belt.BeltSynthesis`,
+    :class:`mechsyn.synthesis.finger.design.FingerDesign`.
 
     Examples
     --------

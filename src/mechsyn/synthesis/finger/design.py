@@ -55,6 +55,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.finger.cases import FingerCase
+from mechsyn.synthesis.problem import SynthesisResult
 from mechsyn.synthesis.finger.vll import copy_mechanism, locked_model, points_in_region, region_excess, vll_ends
 
 __all__ = ["apply_design", "Evaluation", "evaluate_locked", "evaluate_drawn", "stage1_objective",
@@ -495,33 +496,25 @@ class VariantResult:
             "assembled_at_all_targets", "evaluations")}
 
 
-@dataclass
-class FingerDesign:
+@dataclass(repr=False)
+class FingerDesign(SynthesisResult):
     """Result of :func:`design_finger`: every searched VLL combination, the best one.
 
-    The common fields of a synthesis result describe the best variant: ``x`` (its
-    design vector, in the case's variable order), ``design`` (name -> value), ``error``
-    (RMS target error, deg), ``feasible`` (assembled at every target and adaptive: a
-    VLL range ``l_max > l_min``), ``reason`` (why not, else ``""``), ``nfev`` (objective
-    evaluations of every variant), ``seconds`` and ``seed``.
+    A :class:`~mechsyn.synthesis.problem.SynthesisResult`: the common fields describe the
+    best variant: ``x`` (its design vector, in the case's variable order), ``design``
+    (name -> value), ``error`` (RMS target error, deg), ``feasible`` (assembled at every
+    target and adaptive: a VLL range ``l_max > l_min``), ``reason`` (why not, else
+    ``""``), ``nfev`` (objective evaluations of every variant), ``seconds``, ``seed`` and
+    ``interrupted`` (Ctrl-C ended the search: the best design so far).
     """
 
     case: str
-    seed: int
     variants: list[VariantResult]
     best: int
     targets: dict[str, Any]
     tolerance_deg: float
-    seconds: float
     stopped_by_time_limit: bool = False
     notes: list[str] = field(default_factory=list)
-    interrupted: bool = False    # Ctrl-C ended the search: the best design so far
-    x: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    design: dict[str, float] = field(default_factory=dict)
-    error: float = np.inf
-    feasible: bool = False
-    reason: str = ""
-    nfev: int = 0
 
     @property
     def best_variant(self) -> VariantResult:
@@ -685,10 +678,11 @@ def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[
     reason = "" if b.adaptive and b.assembled_at_all_targets else (
         "not assembled at every target" if not b.assembled_at_all_targets
         else "no VLL length range keeps the paths in the region (l_max = l_min)")
-    return FingerDesign(case.source, seed, variants, best,
+    return FingerDesign(case.source, variants, best,
                         {"inputs": case.target_inputs.tolist(),
                          "rotations": {k: v.tolist() for k, v in case.target_angles.items()}},
-                        case.tolerance_deg, time.monotonic() - t0, run.stopped, run.notes,
+                        case.tolerance_deg, run.stopped, run.notes, seed=seed,
+                        seconds=time.monotonic() - t0,
                         interrupted=run.state["interrupted"], x=np.array(list(b.design.values())),
                         design=dict(b.design), error=b.error_rms, feasible=not reason, reason=reason,
                         nfev=sum(v.evaluations for v in variants))
