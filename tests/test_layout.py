@@ -27,13 +27,10 @@ LIBRARY_EXCEPTIONS: dict[str, int] = {
     "export/plates.py:link_plates": 150,
     "synthesis/curves/synthesis.py:synthesize_curve": 155,
     "structure/analysis.py:analyze_structure": 135,
-    "synthesis/general.py:case_from_dict": 133,
-    "synthesis/path.py:from_dict": 116,
     "io/load.py:joint": 123,
     "io/pyslvs.py:data_to_expression": 120,
     "structure/assur.py:assur_decomposition": 119,
     "structure/screws.py:pair_twists": 113,
-    "synthesis/optimize.py:synthesize_path": 109,
     # kinematics (branch kin)
     "kinematics/batch.py:compile_plan": 116,
     "kinematics/dyads.py:_solve_step": 149,
