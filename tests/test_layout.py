@@ -24,13 +24,7 @@ CLI_MAX = 40
 LIBRARY_EXCEPTIONS: dict[str, int] = {
     # issue 13 (branch split)
     "web/_app.py:create_app": 205,
-    "export/plates.py:link_plates": 150,
     "synthesis/curves/synthesis.py:synthesize_curve": 155,
-    "structure/analysis.py:analyze_structure": 135,
-    "io/load.py:joint": 123,
-    "io/pyslvs.py:data_to_expression": 120,
-    "structure/assur.py:assur_decomposition": 119,
-    "structure/screws.py:pair_twists": 113,
     # kinematics (branch kin)
     "kinematics/batch.py:compile_plan": 116,
     "kinematics/dyads.py:_solve_step": 149,
