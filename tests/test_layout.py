@@ -22,9 +22,6 @@ CLI_MAX = 40
 
 # "module path relative to src/mechsyn: qualified function name" -> lines when listed
 LIBRARY_EXCEPTIONS: dict[str, int] = {
-    # issue 13 (branch split)
-    "web/_app.py:create_app": 205,
-    "synthesis/curves/synthesis.py:synthesize_curve": 155,
     # kinematics (branch kin)
     "kinematics/batch.py:compile_plan": 116,
     "kinematics/dyads.py:_solve_step": 149,
