@@ -198,6 +198,13 @@ def assur_decomposition(
     links carrying the file's named points). Raises :class:`MechsynInputError` for a
     spatial mechanism, or when no choice of inputs decomposes it (e.g. redundant
     constraints making the mobility differ from Chebyshev's).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> d = assur_decomposition(ms.examples.load("fourbar"))
+    >>> d.structural_formula, d.mechanism_class
+    ('I(frame,crank) -> II(coupler,rocker)', 2)
     """
     if mech.kind != "planar":
         raise MechsynInputError(

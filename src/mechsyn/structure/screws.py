@@ -145,6 +145,15 @@ def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np
     the plane; ``line_contact`` rotations about ``normal`` and the contact line ``axis``,
     slides along the line and across it; ``point_contact`` three rotations about the
     contact point and two slides perpendicular to ``normal``.
+
+    Examples
+    --------
+    A planar slider (P pair along x) permits one translation:
+
+    >>> import mechsyn as ms
+    >>> slider = ms.examples.load("slider_crank").joint("D")
+    >>> pair_twists(slider, planar=True).tolist()
+    [[0.0, 0.0, 0.0, 1.0, 0.0, 0.0]]
     """
     t = joint.type
     p = _pad3(joint.point)
