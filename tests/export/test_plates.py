@@ -91,3 +91,15 @@ def test_holes_too_big_are_refused(run_cli):
     code, _, err = run_cli("export", ROOT / "examples/kinematics/crank_rocker.yaml", "--dxf", "x.dxf",
                            "--width", "2", "--hole", "1.5")
     assert code == 2 and "too close" in err
+
+
+def test_a_point_at_a_hole_gives_a_round_plate_not_nan():
+    """cam_polar's follower: its named point F is the centre of its only hole R."""
+    lay = link_plates(load_mechanism(ROOT / "examples" / "kinematics" / "cam_polar.yaml"), width=3.0,
+                      hole_diameter=1.0)
+    plate = next(p for p in lay.plates if p.link == "follower")
+    outline = np.array(plate.outline)
+    assert np.all(np.isfinite(outline))
+    centre = plate.holes[0]
+    assert np.allclose(np.hypot(*(outline[:, :2] - centre).T), 1.5)   # a circle of the half width
+    assert plate_outline(np.array([[1.0, 2.0], [1.0, 2.0], [1.0, 2.0]]), 2.0) == [(-1.0, 2.0, 1.0), (3.0, 2.0, 1.0)]

@@ -81,7 +81,10 @@ class PlateLayout:
 
 
 def _hull(points: np.ndarray) -> np.ndarray:
-    """Counter-clockwise hull vertices (two extreme points for collinear input)."""
+    """Counter-clockwise hull vertices (two extreme points for collinear input, one for
+    coincident points: a named point at a hole's centre adds no vertex)."""
+    scale = max(1.0, float(np.abs(points).max())) if len(points) else 1.0
+    points = points[_distinct(points, 1e-12 * scale)]
     if len(points) >= 3:
         try:
             return points[ConvexHull(points).vertices]
@@ -93,6 +96,15 @@ def _hull(points: np.ndarray) -> np.ndarray:
     direction = np.linalg.svd(centred)[2][0]
     s = centred @ direction
     return points[[int(np.argmin(s)), int(np.argmax(s))]]
+
+
+def _distinct(points: np.ndarray, tol: float) -> list[int]:
+    """Indices of the first of each group of points closer than ``tol``."""
+    keep: list[int] = []
+    for i, p in enumerate(points):
+        if all(np.linalg.norm(p - points[k]) > tol for k in keep):
+            keep.append(i)
+    return keep
 
 
 def plate_outline(points: np.ndarray, radius: float) -> list[tuple[float, float, float]]:
@@ -189,21 +201,47 @@ def link_plates(mech: Mechanism, width: float | None = None, hole_diameter: floa
     if not mech.has_geometry:
         raise MechsynInputError("the joints have no points to place the holes", field="joints[].point",
                                 hint="give every joint its point [x, y]")
+    holes_of, markers_of, notes = _holes_and_markers(mech)
+    links = [n for n in mech.link_names if frame or n != mech.ground]
+    width, hole_diameter = _plate_sizes([holes_of[n] for n in links], width, hole_diameter, clearance)
+    cut = hole_diameter + clearance
+    plates: list[Plate] = []
+    for n in links:
+        if not holes_of[n] and not markers_of[n]:
+            notes.append(f"link {n} has no pin or point: no plate")
+            continue
+        plates.append(_plate(n, holes_of[n], markers_of[n], cut, width))
+    sheet = _shelf_layout(plates, mech, width, width if gap is None else gap, sheet_width)
+    return PlateLayout(mech.name, plates, float(width), float(hole_diameter), float(clearance),
+                       sheet, mech.attrs.get("units"), notes)
+
+
+_Marks = list[tuple[str, np.ndarray]]
+
+
+def _holes_and_markers(mech: Mechanism) -> tuple[dict[str, _Marks], dict[str, _Marks], list[str]]:
+    """Per link: its pins (R joints) and its named points, and notes on joints that are no pin."""
     notes: list[str] = []
-    holes_of: dict[str, list[tuple[str, np.ndarray]]] = {name: [] for name in mech.link_names}
+    holes_of: dict[str, _Marks] = {name: [] for name in mech.link_names}
     for j in mech.joints:
         if j.type == "R":
             for link in j.links:
                 holes_of[link].append((j.id, np.asarray(j.point, float)))
         else:
             notes.append(f"joint {j.id} ({j.type}) is not a pin: no hole cut for it")
-    markers_of: dict[str, list[tuple[str, np.ndarray]]] = {name: [] for name in mech.link_names}
+    markers_of: dict[str, _Marks] = {name: [] for name in mech.link_names}
     for name, p in mech.points.items():
         markers_of[p.link].append((name, np.asarray(p.at, float)))
-    links = [n for n in mech.link_names if frame or n != mech.ground]
+    return holes_of, markers_of, notes
+
+
+def _plate_sizes(holes: list[_Marks], width: float | None, hole_diameter: float | None,
+                 clearance: float) -> tuple[float, float]:
+    """Width (default: a fifth of the shortest distance between two holes of one link) and
+    pin diameter (default: 40 % of the width); refused when the holes leave too little material."""
     spans = []
-    for n in links:
-        pts = np.array([p for _, p in holes_of[n]]) if holes_of[n] else np.zeros((0, 2))
+    for hp in holes:
+        pts = np.array([p for _, p in hp]) if hp else np.zeros((0, 2))
         if len(pts) >= 2:
             d = np.linalg.norm(pts[:, None] - pts[None], axis=2)
             spans.append(d[np.triu_indices(len(pts), 1)].min())
@@ -223,40 +261,42 @@ def link_plates(mech: Mechanism, width: float | None = None, hole_diameter: floa
         raise MechsynInputError(
             f"holes of {cut:g} leave less than a tenth of the width {width:g} of material", source="--hole",
             hint=f"make the width more than {cut / 0.9:.4g} or the hole smaller")
-    plates: list[Plate] = []
-    for n in links:
-        hp = holes_of[n]
-        mk = markers_of[n]
-        if not hp and not mk:
-            notes.append(f"link {n} has no pin or point: no plate")
-            continue
-        scale = max(1.0, float(np.abs(np.array([q for _, q in hp + mk])).max()))
-        groups: list[tuple[list[str], np.ndarray]] = []
-        for jid, q in hp:  # several joints at one point of this link (a shared pin): one hole
-            for g in groups:
-                if np.linalg.norm(g[1] - q) <= 1e-9 * scale:
-                    g[0].append(jid)
-                    break
-            else:
-                groups.append(([jid], q))
-        names = ["+".join(g[0]) for g in groups]
-        holes = np.array([g[1] for g in groups]).reshape(-1, 2)
-        if len(holes) >= 2:
-            d = np.linalg.norm(holes[:, None] - holes[None], axis=2) + np.diag(np.full(len(holes), np.inf))
-            i, k = np.unravel_index(np.argmin(d), d.shape)
-            if d[i, k] < cut + 0.1 * width:
-                raise MechsynInputError(
-                    f"link {n}: holes {names[i]} and {names[k]} are {d[i, k]:.6g} apart, too close for "
-                    f"holes of {cut:g} in a plate {width:g} wide", source="--hole",
-                    hint="use smaller holes or a narrower plate")
-        pts = np.vstack([holes, np.array([q for _, q in mk]).reshape(-1, 2)])
-        R = _rotation_to_x(pts)
-        local = (pts - pts.mean(axis=0)) @ R.T
-        plates.append(Plate(n, local[:len(holes)], names, local[len(holes):], [m for m, _ in mk], [], "", (0, 0),
-                            (0.0, 0.0)))
-    # shelf layout: rows left to right
+    return width, hole_diameter
+
+
+def _plate(n: str, hp: _Marks, mk: _Marks, cut: float, width: float) -> Plate:
+    """Link ``n``'s plate in its own frame (centred, longest direction along x): one hole
+    per pin point, refused when two holes are too close for holes of diameter ``cut``."""
+    scale = max(1.0, float(np.abs(np.array([q for _, q in hp + mk])).max()))
+    groups: list[tuple[list[str], np.ndarray]] = []
+    for jid, q in hp:  # several joints at one point of this link (a shared pin): one hole
+        for g in groups:
+            if np.linalg.norm(g[1] - q) <= 1e-9 * scale:
+                g[0].append(jid)
+                break
+        else:
+            groups.append(([jid], q))
+    names = ["+".join(g[0]) for g in groups]
+    holes = np.array([g[1] for g in groups]).reshape(-1, 2)
+    if len(holes) >= 2:
+        d = np.linalg.norm(holes[:, None] - holes[None], axis=2) + np.diag(np.full(len(holes), np.inf))
+        i, k = np.unravel_index(np.argmin(d), d.shape)
+        if d[i, k] < cut + 0.1 * width:
+            raise MechsynInputError(
+                f"link {n}: holes {names[i]} and {names[k]} are {d[i, k]:.6g} apart, too close for "
+                f"holes of {cut:g} in a plate {width:g} wide", source="--hole",
+                hint="use smaller holes or a narrower plate")
+    pts = np.vstack([holes, np.array([q for _, q in mk]).reshape(-1, 2)])
+    R = _rotation_to_x(pts)
+    local = (pts - pts.mean(axis=0)) @ R.T
+    return Plate(n, local[:len(holes)], names, local[len(holes):], [m for m, _ in mk], [], "", (0, 0), (0.0, 0.0))
+
+
+def _shelf_layout(plates: list[Plate], mech: Mechanism, width: float, gap: float,
+                  sheet_width: float | None) -> tuple[float, float]:
+    """Place the plates in rows, left to right (moves them, sets outline, size and label);
+    returns the sheet's size."""
     r = width / 2
-    gap = width if gap is None else gap
     sizes = []
     for p in plates:
         allp = np.vstack([p.holes, p.markers])
@@ -286,8 +326,7 @@ def link_plates(mech: Mechanism, width: float | None = None, hole_diameter: floa
         row_h = max(row_h, h)
         sheet_w = max(sheet_w, x - gap)
     sheet_h = -(y - row_h - 1.5 * label_h) if plates else 0.0
-    return PlateLayout(mech.name, plates, float(width), float(hole_diameter), float(clearance),
-                       (float(sheet_w), float(sheet_h)), mech.attrs.get("units"), notes)
+    return float(sheet_w), float(sheet_h)
 
 
 def _label(p: Plate, mech: Mechanism) -> str:

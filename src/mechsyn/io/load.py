@@ -378,6 +378,49 @@ class _Builder:
 
     # joints ----------------------------------------------------------------------------
     def joint(self, entry: JointEntry, path: list[Any], names: dict[str, str], ids: dict[int, str]) -> Joint:
+        jtype, kind = self.pair_type(entry, path)
+        if len(entry.links) != 2:
+            raise self.error(path + ["links"], f"a pair joins exactly two links, {len(entry.links)} given",
+                             "write links: [a, b]")
+        a = self.resolve_link(entry.links[0], path + ["links", 0], names, ids)
+        b = self.resolve_link(entry.links[1], path + ["links", 1], names, ids)
+        if a == b:
+            raise self.error(path + ["links"], f"a pair must join two different links, both are {a!r}")
+        given = entry.pair_class
+        if given is not None and not 1 <= given <= 5:
+            raise self.error(path + ["class"], f"class {given} is out of 1..5",
+                             "the class is the number of constraints: 1 (point contact) .. 5 (R, P, H)")
+        if self.kind == "planar":
+            pair_class, higher_override = self.planar_class(path, jtype, kind, given)
+        else:
+            pair_class, higher_override = self.spatial_class(path, jtype, kind, given)
+        point, axis, axis2, normal = self.joint_geometry(entry, path, jtype)
+        self.check_type_fields(entry, path, jtype)
+        limits = None
+        if entry.limits is not None:
+            if len(entry.limits) != 2 or entry.limits[0] > entry.limits[1]:
+                raise self.error(path + ["limits"], "limits must be [min, max] with min <= max")
+            limits = (float(entry.limits[0]), float(entry.limits[1]))
+        attrs = {"description": entry.description} if entry.description else {}
+        if entry.profile is not None:
+            if jtype != "cam":
+                raise self.error(path + ["profile"], "only a cam pair has a profile", "remove `profile`")
+            attrs["profile"] = self.profile(entry.profile, path + ["profile"])
+        belt_fields = {"anchor": entry.anchor, "radius": entry.radius, "wrap": entry.wrap}
+        if jtype != "belt":
+            for key, v in belt_fields.items():
+                if v is not None:
+                    raise self.error(path + [key], f"only a belt pair has `{key}`", f"remove `{key}` or set type: belt")
+        else:
+            attrs.update(self.belt(entry, path, point))
+        return Joint(
+            id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
+            axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
+            vll=entry.vll, limits=limits, attrs=attrs, higher_override=higher_override,
+        )
+
+    def pair_type(self, entry: JointEntry, path: list[Any]) -> tuple[str, Any]:
+        """The catalogue type of a joint and its kind; a spatial pair in a planar file is refused."""
         jtype = canonical_pair_type(entry.type)
         if jtype is None:
             raise self.error(
@@ -391,63 +434,58 @@ class _Builder:
                 f"pair {jtype} ({kind.title}) is spatial and cannot appear in a planar mechanism",
                 "use R, P, cam, gear, belt or generic, or set `kind: spatial`",
             )
-        if len(entry.links) != 2:
-            raise self.error(path + ["links"], f"a pair joins exactly two links, {len(entry.links)} given",
-                             "write links: [a, b]")
-        a = self.resolve_link(entry.links[0], path + ["links", 0], names, ids)
-        b = self.resolve_link(entry.links[1], path + ["links", 1], names, ids)
-        if a == b:
-            raise self.error(path + ["links"], f"a pair must join two different links, both are {a!r}")
-        given = entry.pair_class
-        if given is not None and not 1 <= given <= 5:
-            raise self.error(path + ["class"], f"class {given} is out of 1..5",
-                             "the class is the number of constraints: 1 (point contact) .. 5 (R, P, H)")
-        higher_override = None
-        if self.kind == "planar":
-            if jtype == "generic":
-                if given is None:
-                    raise self.error(path, "a generic pair needs `class`", "add class: 5 (lower) or 4 (higher)")
-                if given not in (4, 5):
-                    raise self.error(path + ["class"], f"class {given} is not a planar pair class",
-                                     "in a planar mechanism use 5 (lower pair) or 4 (higher pair)")
-                pair_class = given
-                higher_override = given == 4
-            else:
-                pair_class = 4 if kind.higher else 5
-                if given is not None and given != pair_class:
-                    raise self.error(path + ["class"],
-                                     f"a planar {jtype} pair counts as class {pair_class}, not {given}",
-                                     "remove `class`")
+        return jtype, kind
+
+    def planar_class(self, path: list[Any], jtype: str, kind: Any, given: int | None) -> tuple[int, bool | None]:
+        """Class of a planar pair (5 lower, 4 higher) and the generic pair's higher flag."""
+        if jtype == "generic":
+            if given is None:
+                raise self.error(path, "a generic pair needs `class`", "add class: 5 (lower) or 4 (higher)")
+            if given not in (4, 5):
+                raise self.error(path + ["class"], f"class {given} is not a planar pair class",
+                                 "in a planar mechanism use 5 (lower pair) or 4 (higher pair)")
+            return given, given == 4
+        pair_class = 4 if kind.higher else 5
+        if given is not None and given != pair_class:
+            raise self.error(path + ["class"],
+                             f"a planar {jtype} pair counts as class {pair_class}, not {given}",
+                             "remove `class`")
+        return pair_class, None
+
+    def spatial_class(self, path: list[Any], jtype: str, kind: Any, given: int | None) -> tuple[int, bool | None]:
+        """Class of a spatial pair (the catalogue's, or the file's for generic, cam and gear)."""
+        if kind.pair_class is None:
+            if jtype == "generic" and given is None:
+                raise self.error(path, "a generic pair needs `class`", "add class: 1..5")
+            pair_class = given if given is not None else 2  # cam/gear: line contact
         else:
-            if kind.pair_class is None:
-                if jtype == "generic" and given is None:
-                    raise self.error(path, "a generic pair needs `class`", "add class: 1..5")
-                pair_class = given if given is not None else 2  # cam/gear: line contact
-            else:
-                pair_class = kind.pair_class
-                if given is not None and given != pair_class:
-                    raise self.error(
-                        path + ["class"], f"a {jtype} pair ({kind.title}) is class {pair_class}, not {given}",
-                        "remove `class`, or use type: generic to give any class",
-                    )
-            if jtype == "generic":
-                higher_override = pair_class <= 2
+            pair_class = kind.pair_class
+            if given is not None and given != pair_class:
+                raise self.error(
+                    path + ["class"], f"a {jtype} pair ({kind.title}) is class {pair_class}, not {given}",
+                    "remove `class`, or use type: generic to give any class",
+                )
+        return pair_class, (pair_class <= 2 if jtype == "generic" else None)
+
+    def joint_geometry(self, entry: JointEntry, path: list[Any], jtype: str) -> tuple[np.ndarray | None, ...]:
+        """Point, axis, axis2 and normal of a joint (directions as unit vectors)."""
         point = self.vector(entry.point, path + ["point"], "point")
         axis = None
         if entry.axis is not None:
-            if self.kind == "planar":
-                if jtype == "R":
-                    raise self.error(path + ["axis"],
-                                     "an R pair in a planar mechanism turns about the plane's normal",
-                                     "remove `axis`")
-                axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
-            else:
-                axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
+            if self.kind == "planar" and jtype == "R":
+                raise self.error(path + ["axis"],
+                                 "an R pair in a planar mechanism turns about the plane's normal",
+                                 "remove `axis`")
+            axis = self.vector(entry.axis, path + ["axis"], "axis", unit=True)
         if self.kind == "planar" and jtype == "P" and axis is None and point is not None:
             raise self.error(path + ["axis"], f"planar P pair {entry.id} has no axis: its sliding direction "
                              "is not assumed", "add axis: [dx, dy], e.g. axis: [1, 0] to slide along x")
         axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
         normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
+        return point, axis, axis2, normal
+
+    def check_type_fields(self, entry: JointEntry, path: list[Any], jtype: str) -> None:
+        """Pitch, ratio and vll belong to H, gear and prismatic pairs only."""
         if entry.pitch is not None and jtype != "H":
             raise self.error(path + ["pitch"], "only a helical (H) pair has a pitch", "remove `pitch`")
         if entry.ratio is not None and jtype != "gear":
@@ -455,51 +493,28 @@ class _Builder:
         if entry.vll is not None and jtype not in ("P", "C", "generic"):
             raise self.error(path + ["vll"], "a variable-length link is a prismatic (P) pair",
                              "set type: P or remove `vll`")
-        limits = None
-        if entry.limits is not None:
-            if len(entry.limits) != 2 or entry.limits[0] > entry.limits[1]:
-                raise self.error(path + ["limits"], "limits must be [min, max] with min <= max")
-            limits = (float(entry.limits[0]), float(entry.limits[1]))
-        attrs = {"description": entry.description} if entry.description else {}
-        if entry.profile is not None:
-            if jtype != "cam":
-                raise self.error(path + ["profile"], "only a cam pair has a profile", "remove `profile`")
-            if isinstance(entry.profile, list):
-                pts = [self.vector(p, path + ["profile", k], "profile point") for k, p in enumerate(entry.profile)]
-                if len(pts) < 4:
-                    raise self.error(path + ["profile"], "a cam profile needs at least 4 points",
-                                     "list points round the whole cam")
-                attrs["profile"] = [[float(x) for x in p] for p in pts]
-            else:
-                prof = entry.profile
-                c = self.vector(prof.center, path + ["profile", "center"], "profile centre")
-                if (prof.radius is None) == (prof.polar is None):
-                    raise self.error(path + ["profile"], "a cam profile needs either radius or polar",
-                                     "write {center: [x, y], radius: r} or {center: [x, y], polar: '1 + 0.2*cos(t)'}")
-                if prof.radius is not None:
-                    attrs["profile"] = {"center": [float(x) for x in c], "radius": float(prof.radius)}
-                else:
-                    from mechsyn.kinematics.expr import ExpressionError, polar_points
 
-                    try:
-                        pts = polar_points(prof.polar, c)
-                    except ExpressionError as exc:
-                        raise self.error(path + ["profile", "polar"], str(exc),
-                                         "use t, pi, numbers, + - * / **, sin, cos, tan, exp, sqrt, abs") from None
-                    attrs["profile"] = {"center": [float(x) for x in c], "polar": prof.polar,
-                                        "points": pts.tolist()}
-        belt_fields = {"anchor": entry.anchor, "radius": entry.radius, "wrap": entry.wrap}
-        if jtype != "belt":
-            for key, v in belt_fields.items():
-                if v is not None:
-                    raise self.error(path + [key], f"only a belt pair has `{key}`", f"remove `{key}` or set type: belt")
-        else:
-            attrs.update(self.belt(entry, path, point))
-        return Joint(
-            id=entry.id, type=jtype, links=(a, b), pair_class=pair_class, point=point, axis=axis,
-            axis2=axis2, normal=normal, pitch=entry.pitch, ratio=entry.ratio, actuated=entry.actuated,
-            vll=entry.vll, limits=limits, attrs=attrs, higher_override=higher_override,
-        )
+    def profile(self, prof: Any, path: list[Any]) -> Any:
+        """A cam profile: a list of at least 4 points, or a circle, or a polar curve r(t)."""
+        if isinstance(prof, list):
+            pts = [self.vector(p, path + [k], "profile point") for k, p in enumerate(prof)]
+            if len(pts) < 4:
+                raise self.error(path, "a cam profile needs at least 4 points", "list points round the whole cam")
+            return [[float(x) for x in p] for p in pts]
+        c = self.vector(prof.center, path + ["center"], "profile centre")
+        if (prof.radius is None) == (prof.polar is None):
+            raise self.error(path, "a cam profile needs either radius or polar",
+                             "write {center: [x, y], radius: r} or {center: [x, y], polar: '1 + 0.2*cos(t)'}")
+        if prof.radius is not None:
+            return {"center": [float(x) for x in c], "radius": float(prof.radius)}
+        from mechsyn.kinematics.expr import ExpressionError, polar_points
+
+        try:
+            pts = polar_points(prof.polar, c)
+        except ExpressionError as exc:
+            raise self.error(path + ["polar"], str(exc),
+                             "use t, pi, numbers, + - * / **, sin, cos, tan, exp, sqrt, abs") from None
+        return {"center": [float(x) for x in c], "polar": prof.polar, "points": pts.tolist()}
 
     def belt(self, entry: JointEntry, path: list[Any], point: np.ndarray | None) -> dict[str, Any]:
         """Check a belt pair's fields: anchor (on the first link), radius, wrap, point (the

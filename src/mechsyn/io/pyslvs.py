@@ -485,6 +485,41 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
     >>> [(j.type, j.links) for j in data_to_expression(d).joints]
     [('R', ('ground', 'a')), ('R', ('a',))]
     """
+    ground, names, joints = _expressible(data, source)
+
+    def nm(link: Any) -> str:
+        return FRAME if str(link) == ground else str(link)
+
+    pts = [jd["point"] for jd in joints] + [p["at"] for p in data.get("points", {}).values()]
+    scale = float(np.max(np.abs(pts))) if pts else 1.0
+    loads = {str(ld.get("link")) for ld in data.get("loads", [])}
+    linked = {str(p["link"]) for p in data.get("points", {}).values()} | loads
+    blocks = _blocks(names, joints, linked, scale)
+    in_block = {id(jd) for p, rs in blocks.values() for jd in [p, *rs]}
+    # groups: (order key, PyslvsJoint, member ids)
+    groups = _block_groups(blocks, joints, nm, source) + _pin_groups(joints, in_block, nm, scale)
+    for jd in joints:
+        if jd["type"] == "P" and id(jd) not in in_block:
+            ax = jd.get("axis") or [1.0, 0.0]
+            groups.append(((joints.index(jd),), PyslvsJoint(
+                "P", *map(float, jd["point"]), tuple(nm(x) for x in jd["links"]),
+                math.degrees(math.atan2(ax[1], ax[0]))), [jd["id"]]))
+    for k, (pname, p) in enumerate(data.get("points", {}).items()):
+        groups.append(((len(joints) + k,), PyslvsJoint("R", *map(float, p["at"]), (nm(p["link"]),)), [pname]))
+    _pyslvs_order(groups)
+    colors = data.get("colors") or {}
+    out = [replace(gj, color=next((colors[i] for i in ids if i in colors), None)) for _, gj, ids in groups]
+    where = {jid: k for k, (_, _, ids) in enumerate(groups) for jid in ids}
+    inputs, notes = _inputs(joints, in_block, ground, out, where, nm)
+    return PyslvsMechanism(out, inputs, notes)
+
+
+_Group = tuple[tuple[int, ...], PyslvsJoint, list[str]]
+
+
+def _expressible(data: dict[str, Any], source: str) -> tuple[str, list[str], list[dict[str, Any]]]:
+    """The frame, the link names and the joints of a planar file of R and P pairs with
+    points; anything Pyslvs cannot express is refused, naming the field."""
     if data.get("kind", "planar") != "planar":
         raise MechsynInputError("a Pyslvs expression is planar; this mechanism is spatial", source=source,
                                 field="kind")
@@ -493,11 +528,6 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
     if FRAME in names and ground != FRAME:
         raise MechsynInputError(f"link named {FRAME!r} is not the frame ({ground})", source=source,
                                 field="links", hint=f"rename it: Pyslvs calls the frame {FRAME!r}")
-    rename = {ground: FRAME}
-
-    def nm(link: Any) -> str:
-        return rename.get(str(link), str(link))
-
     joints = data.get("joints", [])
     for k, jd in enumerate(joints):
         if jd["type"] not in ("R", "P"):
@@ -506,11 +536,13 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
         if jd.get("point") is None:
             raise MechsynInputError(f"joint {jd['id']} has no point", source=source, field=f"joints[{k}].point",
                                     hint="give every joint its point [x, y]")
-    pts = [jd["point"] for jd in joints] + [p["at"] for p in data.get("points", {}).values()]
-    scale = float(np.max(np.abs(pts))) if pts else 1.0
-    loads = {str(ld.get("link")) for ld in data.get("loads", [])}
-    linked = {str(p["link"]) for p in data.get("points", {}).values()} | loads
-    # blocks: one P joint plus R joints at its point, nothing else on the link
+    return ground, names, joints
+
+
+def _blocks(names: list[str], joints: list[dict[str, Any]], linked: set[str],
+            scale: float) -> dict[str, tuple[dict[str, Any], list[dict[str, Any]]]]:
+    """Links ``block<i>`` made by :func:`expression_to_data`: one P joint plus R joints at
+    its point, nothing else on the link."""
     blocks: dict[str, tuple[dict[str, Any], list[dict[str, Any]]]] = {}
     for name in names:
         own = [jd for jd in joints if name in [str(x) for x in jd["links"]]]
@@ -519,9 +551,12 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
         if (re.fullmatch(r"block\d+(_\d+)?", name) and name not in linked and len(ps) == 1 and rs and len(ps) + len(rs) == len(own)
                 and all(_close(r["point"], ps[0]["point"], scale) for r in rs)):
             blocks[name] = (ps[0], rs)
-    in_block = {id(jd) for p, rs in blocks.values() for jd in [p, *rs]}
-    # groups: (order key, PyslvsJoint, member ids)
-    groups: list[tuple[tuple[int, ...], PyslvsJoint, list[str]]] = []
+    return blocks
+
+
+def _block_groups(blocks: dict, joints: list[dict[str, Any]], nm: Any, source: str) -> list[_Group]:
+    """Each block as one RP point: its guide link first, then the links turning on it."""
+    groups: list[_Group] = []
     for bname, (p, rs) in blocks.items():
         guide = next(str(x) for x in p["links"] if str(x) != bname)
         others = [next(str(x) for x in r["links"] if str(x) != bname) for r in rs]
@@ -531,6 +566,11 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
         groups.append(((joints.index(p),), PyslvsJoint(
             "RP", *map(float, p["point"]), tuple(nm(x) for x in [guide, *others]),
             math.degrees(math.atan2(ax[1], ax[0]))), [p["id"], *[r["id"] for r in rs]]))
+    return groups
+
+
+def _pin_groups(joints: list[dict[str, Any]], in_block: set[int], nm: Any, scale: float) -> list[_Group]:
+    """Coincident R joints sharing links as one R point of all their links (frame first)."""
     g = nx.Graph()
     rjs = [jd for jd in joints if jd["type"] == "R" and id(jd) not in in_block]
     g.add_nodes_from(range(len(rjs)))
@@ -539,6 +579,7 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
             if (_close(rjs[a]["point"], rjs[b]["point"], scale)
                     and set(map(str, rjs[a]["links"])) & set(map(str, rjs[b]["links"]))):
                 g.add_edge(a, b)
+    groups: list[_Group] = []
     for comp in nx.connected_components(g):
         members = [rjs[k] for k in sorted(comp)]
         order: list[str] = []
@@ -551,24 +592,23 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
             order.insert(0, FRAME)
         groups.append(((joints.index(members[0]),), PyslvsJoint("R", *map(float, members[0]["point"]),
                                                                 tuple(order)), [m["id"] for m in members]))
-    for jd in joints:
-        if jd["type"] == "P" and id(jd) not in in_block:
-            ax = jd.get("axis") or [1.0, 0.0]
-            groups.append(((joints.index(jd),), PyslvsJoint(
-                "P", *map(float, jd["point"]), tuple(nm(x) for x in jd["links"]),
-                math.degrees(math.atan2(ax[1], ax[0]))), [jd["id"]]))
-    for k, (pname, p) in enumerate(data.get("points", {}).items()):
-        groups.append(((len(joints) + k,), PyslvsJoint("R", *map(float, p["at"]), (nm(p["link"]),)), [pname]))
-    # Pyslvs order: by P<i> ids where every group has them, else by first appearance
+    return groups
+
+
+def _pyslvs_order(groups: list[_Group]) -> None:
+    """Sort in place: by P<i> ids where every group has them, else by first appearance."""
     idx = [[int(m.group(1)) for m in map(_PID.match, ids) if m] for _, _, ids in groups]
     if all(len(i) == len(ids) and len(set(i)) == 1 for i, (_, _, ids) in zip(idx, groups)) and \
             len({i[0] for i in idx}) == len(idx):
         groups.sort(key=lambda gr: int(_PID.match(gr[2][0]).group(1)))  # type: ignore[union-attr]
     else:
         groups.sort(key=lambda gr: gr[0])
-    colors = data.get("colors") or {}
-    out = [replace(gj, color=next((colors[i] for i in ids if i in colors), None)) for _, gj, ids in groups]
-    where = {jid: k for k, (_, _, ids) in enumerate(groups) for jid in ids}
+
+
+def _inputs(joints: list[dict[str, Any]], in_block: set[int], ground: str, out: list[PyslvsJoint],
+            where: dict[str, int], nm: Any) -> tuple[list[tuple[int, int]], list[str]]:
+    """Pyslvs input pairs (base point, drive point) of the driven R joints, and notes on
+    the driven joints an input cannot express."""
     inputs: list[tuple[int, int]] = []
     notes: list[str] = []
     for jd in joints:
@@ -588,7 +628,7 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
             notes.append(f"driven joint {jd['id']}: {moving} has no other point to make an input pair")
             continue
         inputs.append((base, drive))
-    return PyslvsMechanism(out, inputs, notes)
+    return inputs, notes
 
 
 # --------------------------------------------------------------------------- files

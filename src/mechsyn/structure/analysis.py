@@ -251,12 +251,40 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
     N = len(mech.links)
     planar = mech.kind == "planar"
     pbc = mech.pairs_by_class()
-    p_total = len(mech.joints)
     K = cycle_rank(mech)
     contours, from_file = independent_contours(mech)
     rows = contour_table(mech, contours, from_file)
-    notes: list[str] = []
+    s_sum, t_sum, z_sum = (sum(getattr(r, k) for r in rows) for k in ("S", "T", "Z"))
+    g_sum = t_sum + z_sum
+    forms = _mobility_formulas(mech, pbc, K, s_sum, g_sum)
+    if planar:
+        mobility, source = forms["chebyshev"].value, "chebyshev"
+    else:
+        mobility = forms["somov_malyshev"].value
+        source = "somov_malyshev (paper 003: W = 6n - Σ i·p_i + S_Σ + G_Σ)"
+    h, h_ex, h_expr = _degrees_of_mobility(n, K, rows)
+    actuated = [j.id for j in mech.actuated_joints]
+    notes = _notes(mech, forms, rows, from_file, K, h, h_ex, mobility)
+    result = StructuralAnalysis(
+        name=mech.name, kind=mech.kind, moving_links=n, moving_link_names=list(mech.moving_links),
+        links_with_frame=N, pairs=len(mech.joints), pairs_by_class=pbc, independent_contours=K,
+        formulas=forms, contours=rows, contours_chosen_by_program=not all(from_file),
+        structural_redundancy=s_sum, redundant_constraints=sum(r.redundant_constraints for r in rows),
+        idle_mobilities=sum(r.idle_mobilities for r in rows),
+        metric_constraints=t_sum, redundant_links=z_sum, constructive_redundancy=g_sum,
+        degrees_of_mobility=h, degrees_of_mobility_exclusive=h_ex, degrees_of_mobility_expression=h_expr,
+        mobility=mobility, mobility_source=source, declared_mobility=mech.mobility, actuated=actuated,
+        notes=notes,
+    )
+    if _with_states and mech.states:
+        result = _replace(result, states=_state_analyses(mech, mobility))
+    return result
 
+
+def _mobility_formulas(mech: Mechanism, pbc: dict, K: int, s_sum: int, g_sum: float) -> dict[str, F.Formula]:
+    """Every mobility and redundancy formula of papers 002 and 003, numbers substituted."""
+    n, N, p_total = mech.n_moving, len(mech.links), len(mech.joints)
+    planar = mech.kind == "planar"
     p4 = sum(1 for j in mech.joints if j.is_higher)
     p5 = p_total - p4
     forms: dict[str, F.Formula] = {}
@@ -267,38 +295,42 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
         forms["chebyshev"] = F.Formula(None, "n/a: spatial mechanism")
         forms["grubler"] = F.Formula(None, "n/a: spatial mechanism")
     forms["malyshev"] = F.malyshev(n, pbc)
-    s_sum = sum(r.S for r in rows)
-    t_sum = sum(r.T for r in rows)
-    z_sum = sum(r.Z for r in rows)
-    g_sum = t_sum + z_sum
     forms["somov_malyshev"] = F.somov_malyshev(n, pbc, s_sum, g_sum)
     forms["gokhman_contours"] = F.gokhman(n, p_total)
     forms["scheme_check"] = F.scheme_check(N, K, p_total)
-
-    if planar:
-        mobility = forms["chebyshev"].value
-        source = "chebyshev"
-    else:
-        mobility = forms["somov_malyshev"].value
-        source = "somov_malyshev (paper 003: W = 6n - Σ i·p_i + S_Σ + G_Σ)"
-    w_for_ozol = mech.mobility if mech.mobility is not None else mobility
+    w = _ozol_mobility(mech, forms)
     freedoms = [_freedom(j, planar) for j in mech.joints]
-    forms["ozol_redundant"] = F.ozol(int(w_for_ozol), K, freedoms, planar=planar)
-    forms["redundant_from_mobility"] = F.redundant_from_mobility(int(w_for_ozol), n, pbc, planar=planar)
-    if mech.mobility is not None:
-        notes.append(f"W = {mech.mobility} as declared in the file is used by Ozol's formula and "
-                     f"Somov-Malyshev solved for S.")
+    forms["ozol_redundant"] = F.ozol(int(w), K, freedoms, planar=planar)
+    forms["redundant_from_mobility"] = F.redundant_from_mobility(int(w), n, pbc, planar=planar)
+    return forms
 
+
+def _ozol_mobility(mech: Mechanism, forms: dict[str, F.Formula]) -> Any:
+    """The W Ozol's formula uses: the file's declared mobility, else the formulas' own."""
+    if mech.mobility is not None:
+        return mech.mobility
+    return forms["chebyshev" if mech.kind == "planar" else "somov_malyshev"].value
+
+
+def _degrees_of_mobility(n: int, K: int, rows: list) -> tuple[int, int, str]:
+    """Paper 003's degrees of mobility H, sequential and by exclusive links, and its expression."""
     if K > 1:
         h = n - sum(r.A for r in rows)
         h_ex = n - sum(r.A_exclusive for r in rows)
-        h_expr = f"H = {n} - ({' + '.join(str(r.A) for r in rows)}) = {h}"
-    elif K == 1:
-        h = h_ex = n - rows[0].A
-        h_expr = f"H = {n} - {rows[0].A} = {h}"
-    else:
-        h = h_ex = n
-        h_expr = f"H = {n} (no closed contour)"
+        return h, h_ex, f"H = {n} - ({' + '.join(str(r.A) for r in rows)}) = {h}"
+    if K == 1:
+        h = n - rows[0].A
+        return h, h, f"H = {n} - {rows[0].A} = {h}"
+    return n, n, f"H = {n} (no closed contour)"
+
+
+def _notes(mech: Mechanism, forms: dict[str, F.Formula], rows: list, from_file: list[bool], K: int, h: int,
+           h_ex: int, mobility: Any) -> list[str]:
+    """What the numbers mean where readings differ or the file leaves a choice to the program."""
+    notes: list[str] = []
+    if mech.mobility is not None:
+        notes.append(f"W = {mech.mobility} as declared in the file is used by Ozol's formula and "
+                     f"Somov-Malyshev solved for S.")
     if h != h_ex:
         notes.append(
             f"degrees of mobility: the sequential reading of A_j gives H = {h}, the reading by links "
@@ -315,59 +347,63 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
                      f"per-contour results depend on the contours and their order: give `contours` to fix them.")
     idle = sum(r.idle_mobilities for r in rows)
     red = sum(r.redundant_constraints for r in rows)
+    s_sum = sum(r.S for r in rows)
     if idle and red:
         notes.append(f"S_Σ = {s_sum} nets {red} redundant constraint(s) against {idle} idle mobility(ies).")
-    q = forms["ozol_redundant"].value
-    if q != s_sum:
-        if mech.mobility is not None:
-            notes.append(f"Ozol's q = {q} differs from the per-contour S_Σ = {s_sum}: q uses the declared "
-                         f"W = {mech.mobility} (idle mobilities included), the per-contour count nets idle "
-                         f"mobilities against redundant constraints.")
-        elif q == s_sum + g_sum and not planar:
-            notes.append(f"Ozol's q = {q} = S_Σ + G_Σ = {s_sum} + {g_sum:g}: it also counts the metric "
-                         f"constraints and redundant links of paper 003 as redundant constraints.")
-        elif planar:
-            notes.append(f"Ozol's q = {q} is the planar reading (q = W + 3K - f); paper 003's per-contour "
-                         f"S_Σ = {s_sum} and G_Σ = {g_sum:g} are the spatial reading (each contour against "
-                         f"6 freedoms): they count different constraints and need not agree.")
-        else:
-            notes.append(f"Ozol's q = {q} differs from S_Σ + G_Σ = {s_sum} + {g_sum:g} = {s_sum + g_sum:g}: "
-                         f"q counts every redundant constraint of the W it is given (W = {w_for_ozol}), "
-                         f"the per-contour S_j nets idle mobilities against redundant constraints.")
+    notes += _ozol_notes(mech, forms, rows)
+    planar = mech.kind == "planar"
     if planar and forms["chebyshev"].value is not None and forms["chebyshev"].value <= 0 and K:
         notes.append(f"Chebyshev's W = {forms['chebyshev'].value}: a structure (no motion) unless the "
                      f"geometry is special (e.g. parallel links).")
     actuated = [j.id for j in mech.actuated_joints]
     if actuated and isinstance(mobility, (int, float)) and len(actuated) != h:
         notes.append(f"{len(actuated)} drive(s) declared ({', '.join(actuated)}); the formulas give H = {h}.")
+    return notes
 
-    result = StructuralAnalysis(
-        name=mech.name, kind=mech.kind, moving_links=n, moving_link_names=list(mech.moving_links),
-        links_with_frame=N, pairs=p_total, pairs_by_class=pbc, independent_contours=K,
-        formulas=forms, contours=rows, contours_chosen_by_program=not all(from_file),
-        structural_redundancy=s_sum, redundant_constraints=red, idle_mobilities=idle,
-        metric_constraints=t_sum, redundant_links=z_sum, constructive_redundancy=g_sum,
-        degrees_of_mobility=h, degrees_of_mobility_exclusive=h_ex, degrees_of_mobility_expression=h_expr,
-        mobility=mobility, mobility_source=source, declared_mobility=mech.mobility, actuated=actuated,
-        notes=notes,
-    )
-    if _with_states and mech.states:
-        states = {}
-        for name, spec in mech.states.items():
-            sub = analyze_structure(mech.in_state(name), _with_states=False)
-            ext = None
-            if spec.external is not None:
-                e = spec.external
-                s_a = e.S_a if e.S_a is not None else sum(
-                    (j.pair_class - 3 if planar else j.pair_class) for j in spec.add_joints)
-                w_f = e.W_f if e.W_f is not None else int(mobility)
-                s_i = sum((j.pair_class - 3 if planar else j.pair_class) for j in mech.joints)
-                w_a = e.W_a if not planar else min(e.W_a, 3)
-                ext = external_analysis(S_a=s_a, W_f=w_f, W_rob=e.W_rob, W_a=w_a, S_ai=e.S_ai,
-                                        S_i=s_i, N=N, lam=3 if planar else 6)
-            states[name] = _with_external(sub, ext, spec.description)
-        result = _replace(result, states=states)
-    return result
+
+def _ozol_notes(mech: Mechanism, forms: dict[str, F.Formula], rows: list) -> list[str]:
+    """Why Ozol's q and the per-contour S_Σ differ, when they do."""
+    s_sum = sum(r.S for r in rows)
+    g_sum = sum(r.T for r in rows) + sum(r.Z for r in rows)
+    q = forms["ozol_redundant"].value
+    if q == s_sum:
+        return []
+    if mech.mobility is not None:
+        return [f"Ozol's q = {q} differs from the per-contour S_Σ = {s_sum}: q uses the declared "
+                f"W = {mech.mobility} (idle mobilities included), the per-contour count nets idle "
+                f"mobilities against redundant constraints."]
+    planar = mech.kind == "planar"
+    if q == s_sum + g_sum and not planar:
+        return [f"Ozol's q = {q} = S_Σ + G_Σ = {s_sum} + {g_sum:g}: it also counts the metric "
+                f"constraints and redundant links of paper 003 as redundant constraints."]
+    if planar:
+        return [f"Ozol's q = {q} is the planar reading (q = W + 3K - f); paper 003's per-contour "
+                f"S_Σ = {s_sum} and G_Σ = {g_sum:g} are the spatial reading (each contour against "
+                f"6 freedoms): they count different constraints and need not agree."]
+    return [f"Ozol's q = {q} differs from S_Σ + G_Σ = {s_sum} + {g_sum:g} = {s_sum + g_sum:g}: "
+            f"q counts every redundant constraint of the W it is given (W = {_ozol_mobility(mech, forms)}), "
+            f"the per-contour S_j nets idle mobilities against redundant constraints."]
+
+
+def _state_analyses(mech: Mechanism, mobility: Any) -> dict[str, StructuralAnalysis]:
+    """Each state of a variable-structure mechanism, with paper 002's external constraints
+    where the state declares them."""
+    planar = mech.kind == "planar"
+    states = {}
+    for name, spec in mech.states.items():
+        sub = analyze_structure(mech.in_state(name), _with_states=False)
+        ext = None
+        if spec.external is not None:
+            e = spec.external
+            s_a = e.S_a if e.S_a is not None else sum(
+                (j.pair_class - 3 if planar else j.pair_class) for j in spec.add_joints)
+            w_f = e.W_f if e.W_f is not None else int(mobility)
+            s_i = sum((j.pair_class - 3 if planar else j.pair_class) for j in mech.joints)
+            w_a = e.W_a if not planar else min(e.W_a, 3)
+            ext = external_analysis(S_a=s_a, W_f=w_f, W_rob=e.W_rob, W_a=w_a, S_ai=e.S_ai,
+                                    S_i=s_i, N=len(mech.links), lam=3 if planar else 6)
+        states[name] = _with_external(sub, ext, spec.description)
+    return states
 
 
 def _replace(obj: StructuralAnalysis, **kw: Any) -> StructuralAnalysis:

@@ -205,6 +205,13 @@ def assur_decomposition(
     links carrying the file's named points). Raises :class:`MechsynInputError` for a
     spatial mechanism, or when no choice of inputs decomposes it (e.g. redundant
     constraints making the mobility differ from Chebyshev's).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> d = assur_decomposition(ms.examples.load("fourbar"))
+    >>> d.structural_formula, d.mechanism_class
+    ('I(frame,crank) -> II(coupler,rocker)', 2)
     """
     if mech.kind != "planar":
         raise MechsynInputError(
@@ -212,18 +219,33 @@ def assur_decomposition(
             source=mech.name, field="kind", hint="give a planar mechanism file")
     frame = mech.ground
     links, pairs, replaced = _pairs_of(mech)
-    p5 = sum(1 for j in mech.joints if not j.is_higher)
-    p4 = sum(1 for j in mech.joints if j.is_higher)
-    w = 3 * mech.n_moving - 2 * p5 - p4
     if output_links is None:
         output_links = tuple(dict.fromkeys(p.link for p in mech.points.values()))
     output_links = tuple(output_links)
+    w = _mobility(mech, pairs, output_links)
+    choice, result, trial = _best_inputs(mech, frame, links, pairs, w, output_links, max_group)
+    groups, inputs, imaginary_links, notes = _groups_of(frame, result, trial, {p.id for p in choice})
+    return AssurDecomposition(
+        name=mech.name, frame=frame, mobility=w, input_links=tuple(inputs),
+        imaginary_input_links=tuple(imaginary_links), output_links=output_links,
+        groups=tuple(groups), mechanism_class=max(g.group_class for g in groups),
+        structural_formula=" -> ".join(g.label for g in groups),
+        leash_candidates=tuple(_leash_candidates(mech, groups, output_links)),
+        replaced_higher_pairs=tuple(replaced), notes=tuple(notes),
+    )
+
+
+def _mobility(mech, pairs: list[_Pair], output_links: tuple[str, ...]) -> int:
+    """Chebyshev's W, refused when it is no mechanism's or below the driven pairs; the
+    output links must be the file's."""
+    p5 = sum(1 for j in mech.joints if not j.is_higher)
+    p4 = sum(1 for j in mech.joints if j.is_higher)
+    w = 3 * mech.n_moving - 2 * p5 - p4
     for o in output_links:
         if o not in mech.link_names:
             raise MechsynInputError(f"unknown output link {o!r}", field="output",
                                     hint="name a link of the file")
     driven = [p for p in pairs if p.weight == 3]
-    notes: list[str] = []
     if w <= 0:
         raise MechsynInputError(
             f"mobility W = 3·{mech.n_moving} - 2·{p5} - {p4} = {w}: a structure, not a "
@@ -232,7 +254,14 @@ def assur_decomposition(
         raise MechsynInputError(
             f"{len(driven)} driven pairs for mobility {w}", source=mech.name,
             hint="mark at most W joints actuated")
-    # imaginary inputs: undriven lower pairs, those to the frame preferred
+    return w
+
+
+def _best_inputs(mech, frame: str, links, pairs: list[_Pair], w: int, output_links: tuple[str, ...],
+                 max_group: int) -> tuple[tuple[_Pair, ...], list, list[_Pair]]:
+    """The imaginary inputs (undriven lower pairs, those to the frame and away from the
+    outputs preferred) giving the lowest-class decomposition: (choice, groups, pairs)."""
+    driven = [p for p in pairs if p.weight == 3]
     candidates = [p for p in pairs if p.weight == 2 and not p.id.count(".")]
 
     def score(choice):
@@ -260,11 +289,16 @@ def assur_decomposition(
             f"{w - len(driven)} imaginary input(s)",
             source=mech.name,
             hint="check the actuated joints and that the mobility W is the real one")
-    _, choice, result, trial = best
-    imaginary_ids = {p.id for p in choice}
+    return best[1], best[2], best[3]
+
+
+def _groups_of(frame: str, result: list, trial: list[_Pair],
+               imaginary_ids: set[str]) -> tuple[list[AssurGroup], list[str], list[str], list[str]]:
+    """The groups in the order they are formed, the input links, the imaginary ones and notes."""
     groups: list[AssurGroup] = []
     inputs: list[str] = []
     imaginary_links: list[str] = []
+    notes: list[str] = []
     formed = {frame}
     for subset, weight, need in result:
         s = set(subset)
@@ -291,11 +325,16 @@ def assur_decomposition(
     if imaginary_links:
         notes.append("imaginary input link(s) (mobility 1, no actuator of their own; "
                      f"paper 000 step 5): {', '.join(imaginary_links)}")
+    return groups, inputs, imaginary_links, notes
+
+
+def _leash_candidates(mech, groups: list[AssurGroup], output_links: tuple[str, ...]) -> list[str]:
+    """Binary links of class 1 (imaginary) and 2 groups that are not outputs."""
     degree = {name: 0 for name in mech.link_names}
     for j in mech.joints:
         for x in j.links:
             degree[x] += 1
-    candidates_out: list[str] = []
+    out: list[str] = []
     for g in groups:
         if g.group_class == 1 and not g.imaginary_input:
             continue
@@ -303,16 +342,9 @@ def assur_decomposition(
             continue
         for link in g.links:
             if (link in mech.link_names and degree[link] == 2 and link not in output_links
-                    and link != frame):
-                candidates_out.append(link)
-    formula = " -> ".join(g.label for g in groups)
-    return AssurDecomposition(
-        name=mech.name, frame=frame, mobility=w, input_links=tuple(inputs),
-        imaginary_input_links=tuple(imaginary_links), output_links=output_links,
-        groups=tuple(groups), mechanism_class=max(g.group_class for g in groups),
-        structural_formula=formula, leash_candidates=tuple(candidates_out),
-        replaced_higher_pairs=tuple(replaced), notes=tuple(notes),
-    )
+                    and link != mech.ground):
+                out.append(link)
+    return out
 
 
 def _class_of(subset, pairs) -> int:

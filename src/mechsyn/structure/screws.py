@@ -145,6 +145,15 @@ def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np
     the plane; ``line_contact`` rotations about ``normal`` and the contact line ``axis``,
     slides along the line and across it; ``point_contact`` three rotations about the
     contact point and two slides perpendicular to ``normal``.
+
+    Examples
+    --------
+    A planar slider (P pair along x) permits one translation:
+
+    >>> import mechsyn as ms
+    >>> slider = ms.examples.load("slider_crank").joint("D")
+    >>> pair_twists(slider, planar=True).tolist()
+    [[0.0, 0.0, 0.0, 1.0, 0.0, 0.0]]
     """
     t = joint.type
     p = _pad3(joint.point)
@@ -160,63 +169,56 @@ def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np
         p, n = _belt_geometry(joint)
         if planar:
             return np.array([_rot(p, z), _tr(np.cross(z, n))])
-        t = "line_contact" if joint.pair_class == 2 else ("point_contact" if joint.pair_class == 1 else "generic")
-        if t == "generic":
-            raise InsufficientGeometry(f"joint {joint.id}: a spatial belt of class {joint.pair_class} "
-                                       "has unknown permitted motions", field=f"joints[{joint.id}]",
-                                       hint="use class 2 (the belt's instantaneous line contact along z)")
+        t = _spatial_contact(joint, "use class 2 (the belt's instantaneous line contact along z)")
         if a is None:
             a = z
         joint = replace(joint, normal=n)
     if planar:
-        if t in ("cam", "gear"):
-            if t == "gear" and joint.normal is None:
-                p, n = _gear_geometry(joint, mech)
-            else:
-                if p is None:
-                    raise _need(joint, "point", "give point: the contact point")
-                if joint.normal is None:
-                    raise _need(joint, "normal", "give normal: the contact normal")
-                n = _unit(_pad3(joint.normal))
-            return np.array([_rot(p, z), _tr(np.cross(z, n))])
-        if t == "R":
-            if p is None:
-                raise _need(joint, "point", "give point: [x, y]")
-            return np.array([_rot(p, z)])
-        if t == "P":
-            if a is None:
-                raise _need(joint, "axis", "give axis: the sliding direction [dx, dy]")
-            return np.array([_tr(a)])
-        raise _need(joint, "planar twist", "use R, P, cam, gear or belt in a planar file")
+        return _planar_twists(joint, t, p, a, mech)
     if t in ("cam", "gear"):
-        t = "line_contact" if joint.pair_class == 2 else ("point_contact" if joint.pair_class == 1 else "generic")
-        if t == "generic":
-            raise InsufficientGeometry(f"joint {joint.id}: a spatial {joint.type} of class {joint.pair_class} "
-                                       "has unknown permitted motions", field=f"joints[{joint.id}]",
-                                       hint="use class 2 (line contact, with axis) or 1 (point contact)")
+        t = _spatial_contact(joint, "use class 2 (line contact, with axis) or 1 (point contact)")
     if t != "P" and p is None:
         raise _need(joint, "point", "give point: [x, y, z]")
+    if t in ("line_contact", "point_contact"):
+        return _contact_twists(joint, t, p, a)
+    return _lower_pair_twists(joint, t, p, a)
+
+
+def _spatial_contact(joint: Joint, hint: str) -> str:
+    """A spatial cam, gear or belt as the contact its class stands for (2: line, 1: point)."""
+    if joint.pair_class in (1, 2):
+        return "line_contact" if joint.pair_class == 2 else "point_contact"
+    raise InsufficientGeometry(f"joint {joint.id}: a spatial {joint.type} of class {joint.pair_class} "
+                               "has unknown permitted motions", field=f"joints[{joint.id}]", hint=hint)
+
+
+def _planar_twists(joint: Joint, t: str, p: np.ndarray | None, a: np.ndarray | None,
+                   mech: Mechanism | None) -> np.ndarray:
+    """Twists of a pair of a planar file, embedded in the plane ``z = 0``."""
+    z = np.array([0.0, 0.0, 1.0])
+    if t in ("cam", "gear"):
+        if t == "gear" and joint.normal is None:
+            p, n = _gear_geometry(joint, mech)
+        else:
+            if p is None:
+                raise _need(joint, "point", "give point: the contact point")
+            if joint.normal is None:
+                raise _need(joint, "normal", "give normal: the contact normal")
+            n = _unit(_pad3(joint.normal))
+        return np.array([_rot(p, z), _tr(np.cross(z, n))])
     if t == "R":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the rotation axis")
-        return np.array([_rot(p, a)])
+        if p is None:
+            raise _need(joint, "point", "give point: [x, y]")
+        return np.array([_rot(p, z)])
     if t == "P":
         if a is None:
-            raise _need(joint, "axis", "give axis: the sliding direction")
+            raise _need(joint, "axis", "give axis: the sliding direction [dx, dy]")
         return np.array([_tr(a)])
-    if t == "H":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the screw axis")
-        h = joint.pitch or 0.0
-        return np.array([_rot(p, a) + _tr(h * a)])
-    if t == "C":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the cylinder axis")
-        return np.array([_rot(p, a), _tr(a)])
-    if t == "U":
-        if a is None or joint.axis2 is None:
-            raise _need(joint, "axis and axis2", "give axis (fixed in the first link) and axis2 (in the second)")
-        return np.array([_rot(p, a), _rot(p, _unit(_pad3(joint.axis2)))])
+    raise _need(joint, "planar twist", "use R, P, cam, gear or belt in a planar file")
+
+
+def _lower_pair_twists(joint: Joint, t: str, p: np.ndarray | None, a: np.ndarray | None) -> np.ndarray:
+    """Twists of a spatial lower pair (R, P, H, C, U, S, S_pin, E)."""
     if t == "S":
         return np.array([_rot(p, e) for e in _E])
     if t == "S_pin":
@@ -227,23 +229,41 @@ def pair_twists(joint: Joint, planar: bool, mech: Mechanism | None = None) -> np
             return np.array([_rot(p, t1), _rot(p, t2)])
         raise _need(joint, "axis and axis2 (or normal)",
                     "give axis and axis2 (the two permitted rotations) or normal (the blocked rotation)")
+    what = {"R": "the rotation axis", "P": "the sliding direction", "H": "the screw axis",
+            "C": "the cylinder axis", "E": "the normal of the contact plane"}
+    if t in what and a is None:
+        raise _need(joint, "axis", f"give axis: {what[t]}")
+    if t == "R":
+        return np.array([_rot(p, a)])
+    if t == "P":
+        return np.array([_tr(a)])
+    if t == "H":
+        h = joint.pitch or 0.0
+        return np.array([_rot(p, a) + _tr(h * a)])
+    if t == "C":
+        return np.array([_rot(p, a), _tr(a)])
+    if t == "U":
+        if a is None or joint.axis2 is None:
+            raise _need(joint, "axis and axis2", "give axis (fixed in the first link) and axis2 (in the second)")
+        return np.array([_rot(p, a), _rot(p, _unit(_pad3(joint.axis2)))])
     if t == "E":
-        if a is None:
-            raise _need(joint, "axis", "give axis: the normal of the contact plane")
         t1, t2 = _perp_basis(a)
         return np.array([_rot(p, a), _tr(t1), _tr(t2)])
+    raise _need(joint, "known twists", "use a catalogue pair type")
+
+
+def _contact_twists(joint: Joint, t: str, p: np.ndarray, a: np.ndarray | None) -> np.ndarray:
+    """Twists of a spatial line or point contact."""
     if t == "line_contact":
         if joint.normal is None or a is None:
             raise _need(joint, "normal and axis", "give normal (contact normal) and axis (contact line)")
         n = _unit(_pad3(joint.normal))
         lin = _unit(a - n * (a @ n))
         return np.array([_rot(p, n), _rot(p, lin), _tr(lin), _tr(np.cross(lin, n))])
-    if t == "point_contact":
-        if joint.normal is None:
-            raise _need(joint, "normal", "give normal: the contact normal")
-        t1, t2 = _perp_basis(_unit(_pad3(joint.normal)))
-        return np.array([_rot(p, e) for e in _E] + [_tr(t1), _tr(t2)])
-    raise _need(joint, "known twists", "use a catalogue pair type")
+    if joint.normal is None:
+        raise _need(joint, "normal", "give normal: the contact normal")
+    t1, t2 = _perp_basis(_unit(_pad3(joint.normal)))
+    return np.array([_rot(p, e) for e in _E] + [_tr(t1), _tr(t2)])
 
 
 def missing_geometry(mech: Mechanism, planar: bool | None = None) -> list[str]:

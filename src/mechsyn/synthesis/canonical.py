@@ -118,14 +118,15 @@ def certificate(n: int, edges: Sequence[tuple[int, int]],
     if get_backend() == "pynauty":
         return _module("pynauty").certificate(_nauty_graph(n, edges, col))
     simple = [(a, b) for a, b in edges if a != b]
-    order = _igraph(n, simple).canonical_permutation(color=col if colours is not None else None)
-    # igraph's vector: the vertex that takes canonical label i is order[i]
-    label = [0] * n
-    for i, v in enumerate(order):
-        label[v] = i
-    flat = bytes(v for e in sorted((min(label[a], label[b]), max(label[a], label[b])) for a, b in simple)
-                 for v in e)
-    labels = bytes(col[v] for v in order) if colours is not None else b""
+    g = _igraph(n, simple)
+    g.vs["colour"] = col
+    order = g.canonical_permutation(color=col if colours is not None else None)
+    # the colours travel with the vertices: igraph 1.0 reversed the meaning of the
+    # permutation vector (python-igraph 0.10/0.11: vertex v goes to order[v]; 1.0: the
+    # vertex at i is order[i]), and permute_vertices(canonical_permutation()) is canonical in both
+    canonical = g.permute_vertices(order)
+    flat = bytes(v for e in sorted(tuple(sorted(e)) for e in canonical.get_edgelist()) for v in e)
+    labels = bytes(canonical.vs["colour"]) if colours is not None else b""
     return bytes([n & 255, n >> 8, len(labels) > 0]) + labels + flat
 
 

@@ -45,241 +45,18 @@ import copy
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError, input_boundary
+from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
-from mechsyn.limits import limit, limit_hint
+from mechsyn.synthesis.cases import DesignVariable, MechanismCase, case_from_dict, load_case
 from mechsyn.synthesis.problem import Progress, ProgressCallback, SeedLike, SynthesisResult, resolve_seed
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
            "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
-           "synthesize_mechanism", "start_vector"]
-
-
-@dataclass(frozen=True)
-class DesignVariable:
-    """One coordinate of the drawn configuration: ``kind`` is ``joint`` / ``point`` (x or
-    y: ``coord`` 0 / 1) or ``length`` (a VLL's length, ``coord`` None)."""
-
-    kind: str
-    target: str
-    coord: int | None
-    lower: float
-    upper: float
-
-    @property
-    def name(self) -> str:
-        return f"{self.target}.length" if self.kind == "length" else f"{self.target}.{'xy'[self.coord]}"
-
-
-@dataclass
-class MechanismCase:
-    source: str
-    mechanism_path: str
-    mech_dict: dict
-    input_joint: str
-    values_deg: np.ndarray
-    variables: list[DesignVariable]
-    problem: str                       # "path" | "motion"
-    targets: np.ndarray                # (N, 2) positions
-    point: str | None = None
-    link: str | None = None
-    angles_deg: np.ndarray | None = None   # motion: (N,)
-    angle_weight: float = 1.0
-    free: bool = False
-    range_deg: tuple[float, float] | None = None
-    step_deg: float = 2.0
-    name: str = "mechanism synthesis"
-    method: str = "auto"                   # "auto" (closed form when it decomposes) | "newton"
-
-    @property
-    def n_targets(self) -> int:
-        return len(self.values_deg)
-
-    @property
-    def n_design(self) -> int:
-        return len(self.variables)
-
-    @property
-    def lower(self) -> np.ndarray:
-        lo = [v.lower for v in self.variables]
-        if self.free:
-            lo += [self.range_deg[0]] * self.n_targets
-        return np.array(lo, float)
-
-    @property
-    def upper(self) -> np.ndarray:
-        hi = [v.upper for v in self.variables]
-        if self.free:
-            hi += [self.range_deg[1]] * self.n_targets
-        return np.array(hi, float)
-
-    @property
-    def names(self) -> list[str]:
-        return [v.name for v in self.variables] + (
-            [f"{self.input_joint}_{i + 1}" for i in range(self.n_targets)] if self.free else [])
-
-
-def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None) -> MechsynInputError:
-    return MechsynInputError(msg, source=source, field=fld, hint=hint)
-
-
-def load_case(path: str | Path) -> MechanismCase:
-    """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism")."""
-    from mechsyn.io.files import read_data
-
-    p = Path(path)
-    data, _ = read_data(p, "case file", fmt="yaml")
-    return case_from_dict(data, source=str(p), base_dir=p.parent)
-
-
-def _floats(v: Any, src: str, fld: str, n: int | None = None) -> np.ndarray:
-    from mechsyn.io.checks import numbers
-
-    a = numbers(v, src, fld)
-    if n is not None and a.shape[-1:] != (n,):
-        raise _err(f"{fld} must be finite numbers" + (f", {n} per entry" if n else ""), src, fld)
-    return a
-
-
-@input_boundary("synthesis case")
-def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
-    """Validate a case mapping; the mechanism file path is relative to ``base_dir``."""
-    from mechsyn.io import load_mechanism, mechanism_to_dict
-
-    src = source
-    if not isinstance(data, dict):
-        raise _err("the case must be a mapping", src)
-    known = {"name", "mechanism", "input", "point", "targets", "link", "poses", "variables",
-             "angle_weight", "step_deg", "method"}
-    extra = sorted(set(data) - known)
-    if extra:
-        raise _err(f"unknown key(s): {', '.join(extra)}", src, extra[0], hint="keys: " + ", ".join(sorted(known)))
-    if "mechanism" not in data:
-        raise _err("missing `mechanism:` (path to a planar mechanism file)", src, "mechanism")
-    mpath = Path(str(data["mechanism"]))
-    if not mpath.is_absolute() and base_dir is not None:
-        mpath = base_dir / mpath
-    mech = load_mechanism(mpath)
-    if mech.kind != "planar":
-        raise _err(f"{mpath}: a planar mechanism is needed", src, "mechanism")
-    md = mechanism_to_dict(mech)
-    inp = data.get("input")
-    if not isinstance(inp, dict) or "joint" not in inp or "values_deg" not in inp:
-        raise _err("`input:` needs `joint` and `values_deg`", src, "input",
-                   hint="input: {joint: A, values_deg: [0, 30, 60]}")
-    jid = str(inp["joint"])
-    try:
-        j = mech.joint(jid)
-    except KeyError:
-        raise _err(f"no joint {jid!r} in the mechanism", src, "input.joint") from None
-    if j.type != "R" or not j.actuated:
-        raise _err(f"input joint {jid} must be an actuated R pair", src, "input.joint",
-                   hint="mark it `actuated: true` in the mechanism file")
-    values = _floats(inp["values_deg"], src, "input.values_deg").ravel()
-    if len(values) < 1:
-        raise _err("input.values_deg is empty", src, "input.values_deg")
-    free = bool(inp.get("free", False))
-    rng = None
-    if free:
-        r = _floats(inp.get("range_deg", [float(values.min()), float(values.max())]), src, "input.range_deg")
-        if r.shape != (2,) or not r[0] < r[1]:
-            raise _err("input.range_deg must be [lower, upper] with lower < upper", src, "input.range_deg")
-        rng = (float(r[0]), float(r[1]))
-    step = _floats(data.get("step_deg", 2.0), src, "step_deg").reshape(-1)
-    if step.shape != (1,) or not step[0] > 0:
-        raise _err("step_deg must be a positive number", src, "step_deg")
-    step = float(step[0])
-    sweep = (float(np.sum(np.abs(np.diff(values)))) + 360.0) / step  # at most this many positions
-    if sweep > limit("sweep_points"):
-        raise _err(f"step_deg {step:g} makes a sweep of up to {sweep:,.0f} positions per design, more than "
-                   f"the limit of {limit('sweep_points'):,}", src, "step_deg",
-                   "use step_deg of about 0.5 to 5; " + limit_hint("sweep_points"))
-    method = str(data.get("method", "auto"))
-    if method not in ("auto", "newton"):
-        raise _err("method must be auto or newton", src, "method")
-    if ("point" in data or "targets" in data) == ("link" in data or "poses" in data):
-        raise _err("give either `point` + `targets` (path) or `link` + `poses` (motion)", src,
-                   hint="path: point: P, targets: [[x, y], ...]")
-    names_pts = set(md.get("points") or {})
-    joint_ids = {x["id"] for x in md["joints"]}
-    link_names = {(e if isinstance(e, str) else e["name"]) for e in md["links"]}
-    kw: dict[str, Any] = {}
-    if "point" in data:
-        pt = str(data.get("point"))
-        if pt not in names_pts and pt not in joint_ids:
-            raise _err(f"no point or joint {pt!r} in the mechanism", src, "point",
-                       hint="points: " + ", ".join(sorted(names_pts) or ["(none)"]))
-        T = _floats(data.get("targets"), src, "targets", 2)
-        if T.ndim != 2:
-            raise _err("targets must be [[x, y], ...]", src, "targets")
-        kw.update(problem="path", point=pt, targets=T)
-    else:
-        lk = str(data.get("link"))
-        if lk not in link_names or lk == md["ground"]:
-            raise _err(f"no moving link {lk!r} in the mechanism", src, "link")
-        P = _floats(data.get("poses"), src, "poses", 3)
-        if P.ndim != 2:
-            raise _err("poses must be [[x, y, angle_deg], ...]", src, "poses")
-        pt = data.get("point")
-        kw.update(problem="motion", link=lk, targets=P[:, :2], angles_deg=P[:, 2], point=None)
-        w = float(data.get("angle_weight", 1.0))
-        if not w >= 0:
-            raise _err("angle_weight must be >= 0", src, "angle_weight")
-        kw["angle_weight"] = w
-    if len(kw["targets"]) != len(values):
-        raise _err(f"{len(values)} input values but {len(kw['targets'])} targets", src, "input.values_deg",
-                   hint="one input value per target (the start values with free: true)")
-    vs = data.get("variables")
-    if not isinstance(vs, list) or not vs:
-        raise _err("`variables:` must be a non-empty list", src, "variables",
-                   hint="- {joint: B, coord: x, lower: 0, upper: 2}")
-    variables = []
-    for k, v in enumerate(vs):
-        f = f"variables[{k}]"
-        if not isinstance(v, dict) or "lower" not in v or "upper" not in v:
-            raise _err("a variable needs `lower` and `upper`", src, f)
-        lo, hi = _floats([v["lower"], v["upper"]], src, f)
-        if not lo < hi:
-            raise _err("a variable needs finite bounds with lower < upper", src, f)
-        if max(abs(lo), abs(hi)) > limit("coordinate"):
-            raise _err(f"bounds [{lo:g}, {hi:g}] are beyond ±{limit('coordinate'):g}: distances would overflow",
-                       src, f, "give bounds of the size of the mechanism")
-        if "point" in v:
-            kind, tgt = "point", str(v["point"])
-            if tgt not in names_pts:
-                raise _err(f"no point {tgt!r} in the mechanism", src, f)
-        elif "joint" in v:
-            tgt = str(v["joint"])
-            if tgt not in joint_ids:
-                raise _err(f"no joint {tgt!r} in the mechanism", src, f)
-            kind = "length" if v.get("length") else "joint"
-            jj = next(x for x in md["joints"] if x["id"] == tgt)
-            if kind == "length" and not jj.get("vll"):
-                raise _err(f"joint {tgt} is not a variable-length link (vll)", src, f,
-                           hint="`length: true` needs a P pair with `vll:`")
-            if kind == "joint" and jj.get("point") is None:
-                raise _err(f"joint {tgt} has no point", src, f)
-        else:
-            raise _err("a variable names a `joint` or a `point`", src, f)
-        coord = None
-        if kind != "length":
-            c = str(v.get("coord", ""))
-            if c not in ("x", "y"):
-                raise _err("coord must be x or y", src, f)
-            coord = "xy".index(c)
-        variables.append(DesignVariable(kind, tgt, coord, lo, hi))
-    if len({x.name for x in variables}) != len(variables):
-        raise _err("a coordinate is listed twice in variables", src, "variables")
-    case = MechanismCase(source=src, mechanism_path=str(mpath), mech_dict=md, input_joint=jid,
-                         values_deg=values, variables=variables, free=free, range_deg=rng, step_deg=step,
-                         name=str(data.get("name", mech.name)), method=method, **kw)
-    case._reference = _reference_branch(case)  # type: ignore[attr-defined]
-    return case
+           "synthesize_mechanism", "start_vector", "reference_branch"]
 
 
 # --------------------------------------------------------------------------- designs
@@ -375,8 +152,26 @@ def _build(case: MechanismCase, x: np.ndarray) -> tuple[Any, Any, Any, dict]:
     return mech, S, dyads.decompose(S), d
 
 
-def _reference_branch(case: MechanismCase) -> list[float] | None:
-    """Assembly modes (one sign per closed-form dyad) of the file's own drawing."""
+def reference_branch(case: MechanismCase) -> list[float] | None:
+    """Assembly modes (one sign per closed-form dyad) of the file's own drawing: the branch
+    every design must keep. Found on first use and kept in ``case.reference`` (loading a
+    case runs no solver); None when the mechanism does not decompose into closed-form dyads.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> case.reference is None
+    True
+    >>> reference_branch(case) == case.reference, len(case.reference)  # two dyads
+    (True, 2)
+    """
+    if case.reference is None:
+        case.reference = _drawing_branch(case)
+    return case.reference
+
+
+def _drawing_branch(case: MechanismCase) -> list[float] | None:
     from mechsyn.kinematics import dyads
 
     _m, S, plan, _d = _build(case, start_vector(case))
@@ -412,8 +207,8 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
     grid, idx = _sweep_grid(float(np.degrees(S.drivers[k].assembled)), values, case.step_deg)
     U = np.tile([dr.assembled for dr in S.drivers], (len(grid), 1)).astype(float)
     U[:, k] = np.radians(grid)
-    ref = getattr(case, "_reference", None)
     if plan is not None and case.method != "newton":
+        ref = reference_branch(case)
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             q, sig = dyads.solve_positions(S, plan, U)
         ok = np.all(np.isfinite(q), axis=1)
@@ -641,6 +436,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     deadline = t0 + time_limit
     opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
     opts.update(options or {})
+    reference_branch(case)  # once here, not in every worker
     prob = MechanismProblem(case, batch=batch)
     x0 = np.clip(start_vector(case), prob.lower, prob.upper)
     best_z, best_f = x0, float(prob.fitness(x0[None, :])[0])
@@ -684,7 +480,15 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
         nfev += n
         if f < best_f:
             best_z, best_f = z, f
-    stopped = done < restarts and not interrupted
+    return _mechanism_result(case, best_z, start_f, prob.penalty_base, t0=t0, seed=seed, restarts=done, nfev=nfev,
+                             errs=errs, stopped=done < restarts and not interrupted, interrupted=interrupted)
+
+
+def _mechanism_result(case: MechanismCase, best_z: np.ndarray, start_f: float, penalty_base: float, *,
+                      t0: float, seed: int, restarts: int, nfev: int, errs: list[float], stopped: bool,
+                      interrupted: bool) -> MechanismSynthesisResult:
+    """The result of the best design ``best_z``, evaluated again (the file's own design
+    scored ``start_f``; scores from ``penalty_base`` up are infeasible)."""
     ev = evaluate_design(case, best_z)
     names = case.names
     design = {n: float(v) for n, v in zip(names, best_z)}
@@ -697,9 +501,9 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
         case=case.name, problem=case.problem, error=ev.error if ok else float("inf"), design=design,
         x=np.asarray(best_z, float),
         start_design={n: float(v) for n, v in zip(names, start_vector(case))},
-        start_error=start_f if start_f < prob.penalty_base else None, feasible=ok,
+        start_error=start_f if start_f < penalty_base else None, feasible=ok,
         assembled_at_all_targets=ok, method=ev.method, seconds=time.time() - t0, seed=seed,
-        restarts=done, nfev=nfev, inputs_deg=ev.inputs_deg if ok else case.values_deg, targets=case.targets,
+        restarts=restarts, nfev=nfev, inputs_deg=ev.inputs_deg if ok else case.values_deg, targets=case.targets,
         achieved=ev.achieved if ok else np.full((N, 2), np.nan),
         achieved_angles_deg=ev.achieved_angles_deg, target_angles_deg=case.angles_deg,
         path=ev.path if ok else np.zeros((0, 2)), mechanism=d, restart_errors=errs,

@@ -358,14 +358,28 @@ def synthesize_path(
                   stop=None if target_error is None else (lambda i, r: r.fitness <= target_error))
     except KeyboardInterrupt:
         interrupted = True
-        have = {r.index for r in results}
-        for i, t in enumerate(trackers):
-            if t is not None and t.x is not None and i not in have:
-                results.append(RestartResult(index=i, seed=seeds[i], z=problem.expand(t.x[None, :])[0],
-                                             fitness=t.f, nfev=0, seconds=0.0))
-                break
+        _keep_best_so_far(problem, trackers, seeds, results)
         if not results:
             raise
+    return _path_result(case, problem, results, t0=t0, seed=seed, optimizer=optimizer,
+                        interrupted=interrupted, target_error=target_error)
+
+
+def _keep_best_so_far(problem: PathProblem, trackers: list, seeds: list[int], results: list[RestartResult]) -> None:
+    """After Ctrl-C: the best design of the first restart cut short joins ``results``."""
+    have = {r.index for r in results}
+    for i, t in enumerate(trackers):
+        if t is not None and t.x is not None and i not in have:
+            results.append(RestartResult(index=i, seed=seeds[i], z=problem.expand(t.x[None, :])[0],
+                                         fitness=t.f, nfev=0, seconds=0.0))
+            break
+
+
+def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResult], *, t0: float,
+                 seed: int, optimizer: str, interrupted: bool,
+                 target_error: float | None) -> PathSynthesisResult:
+    """The best restart (lowest fitness, then first in seed order), checked by
+    :func:`~mechsyn.synthesis.path.evaluate_design`."""
     results.sort(key=lambda r: r.index)
     win = min(results, key=lambda r: (r.fitness, r.index))
     design = problem.design(win.z)

@@ -1,6 +1,6 @@
-"""Four-bar path generation: the case, its objective and its constraints.
+"""Four-bar path generation: the case's objective and its constraints.
 
-A case follows the schema of ``spec/data/synthesis_cases_public.json``: ``targets``
+A case (:class:`~mechsyn.synthesis.cases.PathCase`, read by :mod:`mechsyn.synthesis.cases`) follows the schema of ``spec/data/synthesis_cases_public.json``: ``targets``
 (``n`` points), ``timing`` (``prescribed``: a fixed ``theta2`` list; ``prescribed_increment``:
 ``theta2_1`` is a variable and ``theta2_i = theta2_1 + (i - 1) step`` with ``timing.step``
 or ``timing.increments``; ``free``: one variable ``theta2_i`` per target), ``fixed`` values,
@@ -38,13 +38,21 @@ ever rank better than a feasible one (Deb's rule as a penalty).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError, input_boundary
+from mechsyn.synthesis.cases import (  # noqa: F401  (the case format lives in cases.py)
+    FOLD_MARGIN_DEG,
+    LENGTHS,
+    LINKAGE_NAMES,
+    TIMING_TYPES,
+    TRANSMISSION_ANGLE_MIN_DEG,
+    PathCase,
+    Variable,
+    load_cases,
+)
 from mechsyn.synthesis.fourbar import (
     TWO_PI,
     arc_cos_extremes,
@@ -54,180 +62,8 @@ from mechsyn.synthesis.fourbar import (
     grashof_excess,
 )
 
-LINKAGE_NAMES = ("x0", "y0", "theta0", "r1", "r2", "r3", "r4", "rcx", "rcy")
-LENGTHS = ("r1", "r2", "r3", "r4")
-TIMING_TYPES = ("prescribed", "prescribed_increment", "free")
 _TOL = 1e-9  # rad: allowed overlap of the first and last crank angle (free timing)
-TRANSMISSION_ANGLE_MIN_DEG = 20.0  # default margin of force transmission over the motion
-FOLD_MARGIN_DEG = 5.0  # default distance of a Grashof design from folding flat
 FEASIBILITY_TOL = 1e-12  # total violation treated as numerically zero
-
-
-@dataclass(frozen=True)
-class Variable:
-    name: str
-    lower: float
-    upper: float
-
-
-@dataclass(frozen=True)
-class PathCase:
-    """A path-generation case (see the module docstring for the schema)."""
-
-    id: str
-    targets: np.ndarray
-    timing: str
-    theta2: np.ndarray | None  # prescribed angles, or increments from theta2_1
-    fixed: dict[str, float]
-    variables: tuple[Variable, ...]
-    branch: int = -1
-    grashof: bool | str = False
-    order: str = "ccw"
-    transmission_angle_min_deg: float | None = TRANSMISSION_ANGLE_MIN_DEG
-    fold_margin_deg: float = FOLD_MARGIN_DEG
-    link_ratio_max: float | None = None
-    title: str = ""
-    published: tuple[dict, ...] = ()
-    best_known: float | None = None
-    raw: dict = field(default_factory=dict, repr=False, compare=False)
-
-    @property
-    def n(self) -> int:
-        return len(self.targets)
-
-    def bounds(self) -> dict[str, tuple[float, float]]:
-        return {v.name: (v.lower, v.upper) for v in self.variables}
-
-    @classmethod
-    @input_boundary("path-synthesis case")
-    def from_dict(cls, data: Any, source: str | None = None) -> "PathCase":
-        """Validate a case object; :class:`MechsynInputError` naming the field on bad input."""
-
-        def bad(msg: str, fld: str, hint: str | None = None) -> MechsynInputError:
-            return MechsynInputError(msg, source=source, field=fld, hint=hint)
-
-        if not isinstance(data, dict):
-            raise bad("a case must be a JSON object", "(top level)")
-        from mechsyn.io.checks import numbers
-
-        if "targets" not in data:
-            raise bad("missing", "targets", "give a list of [x, y] points")
-        targets = numbers(data["targets"], source, "targets")
-        if targets.ndim != 2 or targets.shape[1] != 2 or len(targets) < 1:
-            raise bad(f"must be a list of [x, y] points, got shape {targets.shape}", "targets")
-        if not np.all(np.isfinite(targets)):
-            raise bad("must be finite numbers", "targets")
-        n = len(targets)
-        timing = data.get("timing") or {}
-        ttype = timing.get("type") if isinstance(timing, dict) else None
-        if ttype not in TIMING_TYPES:
-            raise bad(f"unknown timing type {ttype!r}", "timing.type", "one of " + ", ".join(TIMING_TYPES))
-        theta2 = None
-        if ttype == "prescribed":
-            try:
-                theta2 = np.asarray(timing["theta2"], dtype=float)
-            except (KeyError, TypeError, ValueError):
-                raise bad("prescribed timing needs a list of n angles [rad]", "timing.theta2") from None
-            if theta2.shape != (n,):
-                raise bad(f"expected {n} angles, got {theta2.size}", "timing.theta2")
-        elif ttype == "prescribed_increment":
-            if "increments" in timing:
-                inc = np.asarray(timing["increments"], dtype=float)
-                if inc.shape != (n - 1,):
-                    raise bad(f"expected {n - 1} increments", "timing.increments")
-            elif "step" in timing:
-                inc = np.full(n - 1, float(timing["step"]))
-            else:
-                raise bad("needs 'step' or 'increments' [rad]", "timing")
-            theta2 = np.concatenate([[0.0], np.cumsum(inc)])
-        fixed_raw = data.get("fixed") or {}
-        if not isinstance(fixed_raw, dict):
-            raise bad("must be an object name -> value", "fixed")
-        fixed: dict[str, float] = {}
-        for k, v in fixed_raw.items():
-            if k not in LINKAGE_NAMES:
-                raise bad(f"unknown design name {k!r}", f"fixed.{k}", "one of " + ", ".join(LINKAGE_NAMES))
-            fixed[k] = float(numbers(v, source, f"fixed.{k}").reshape(-1)[0]) if np.ndim(v) == 0 else None
-            if fixed[k] is None:
-                raise bad("must be a number", f"fixed.{k}")
-        allowed = set(LINKAGE_NAMES)
-        if ttype == "free":
-            allowed |= {f"theta2_{i + 1}" for i in range(n)}
-        elif ttype == "prescribed_increment":
-            allowed.add("theta2_1")
-        variables = []
-        for i, v in enumerate(data.get("variables") or []):
-            if not isinstance(v, dict) or not {"name", "lower", "upper"} <= set(v):
-                raise bad("needs name, lower and upper", f"variables[{i}]")
-            name = v["name"]
-            lo, hi = (float(b) for b in numbers([v["lower"], v["upper"]], source, f"variables[{i}]"))
-            if name not in allowed:
-                raise bad(f"unknown or unusable variable {name!r} for timing {ttype!r}", f"variables[{i}].name")
-            if name in fixed:
-                raise bad(f"{name!r} is both fixed and variable", f"variables[{i}].name")
-            if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
-                raise bad(f"bounds [{lo}, {hi}] are not an interval", f"variables[{i}]")
-            variables.append(Variable(name, lo, hi))
-        names = [v.name for v in variables]
-        if len(set(names)) != len(names):
-            raise bad("a variable is listed twice", "variables")
-        defaults = {"x0": 0.0, "y0": 0.0, "theta0": 0.0}
-        for k in LINKAGE_NAMES:
-            if k not in fixed and k not in names:
-                if k in defaults:
-                    fixed[k] = defaults[k]
-                else:
-                    raise bad(f"{k!r} is neither fixed nor a variable", "variables", f"add {k} with bounds")
-        needed = {f"theta2_{i + 1}" for i in range(n)} if ttype == "free" else (
-            {"theta2_1"} if ttype == "prescribed_increment" else set())
-        missing = sorted(needed - set(names))
-        if missing:
-            raise bad(f"timing {ttype!r} needs variables {missing}", "variables")
-        kin = data.get("kinematics") or {}
-        branch = kin.get("branch", -1)
-        if branch not in (-1, 1):
-            raise bad("must be -1 or +1", "kinematics.branch")
-        options = data.get("options") or {}
-        grashof: bool | str = any(str(c).strip().lower().startswith("grashof") for c in data.get("constraints") or [])
-        if "grashof" in options:
-            grashof = options["grashof"]
-            if grashof not in (True, False, "crank-rocker"):
-                raise bad("must be true, false or \"crank-rocker\"", "options.grashof")
-        order = options.get("order", "ccw")
-        if order not in ("ccw", "cw"):
-            raise bad("must be \"ccw\" or \"cw\"", "options.order")
-        margins = {}
-        for key, default in (("transmission_angle_min_deg", TRANSMISSION_ANGLE_MIN_DEG),
-                             ("fold_margin_deg", FOLD_MARGIN_DEG)):
-            value = options.get(key, default)
-            if value is None and key == "transmission_angle_min_deg":
-                value = 0.0
-            if not isinstance(value, (int, float)) or not 0.0 <= float(value) < 90.0:
-                raise bad("must be an angle in degrees in [0, 90)", f"options.{key}")
-            margins[key] = float(value)
-        best = data.get("best_known", {})
-        return cls(
-            id=str(data.get("id", "case")), title=str(data.get("title", "")), targets=targets,
-            timing=ttype, theta2=theta2, fixed=fixed, variables=tuple(variables), branch=int(branch),
-            grashof=grashof, order=order,
-            transmission_angle_min_deg=margins["transmission_angle_min_deg"],
-            fold_margin_deg=margins["fold_margin_deg"],
-            link_ratio_max=options.get("link_ratio_max"),
-            published=tuple(data.get("published_solutions") or ()),
-            best_known=best.get("value") if isinstance(best, dict) else None, raw=data,
-        )
-
-
-def load_cases(path: str | Path) -> list[PathCase]:
-    """Load one case object, or every case of a ``{"cases": [...]}`` collection."""
-    from mechsyn.io.files import read_data
-
-    path = Path(path)
-    data, _ = read_data(path, "case file", fmt="json")
-    if isinstance(data, dict) and "cases" in data:
-        items = data["cases"]
-        return [PathCase.from_dict(c, source=f"{path}#cases[{i}]") for i, c in enumerate(items)]
-    return [PathCase.from_dict(data, source=str(path))]
 
 
 @dataclass(frozen=True)

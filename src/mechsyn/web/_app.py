@@ -198,6 +198,194 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
     return route
 
 
+# each route reads the app's state (root, start, start_name, jobs) from request.app.state
+async def _index(request: Request) -> Response:
+    return FileResponse(STATIC / "index.html", media_type="text/html")
+
+
+@api
+async def _start_route(request: Request) -> Any:
+    state = request.app.state
+    return {"mechanism": state.start, "name": state.start_name, "root": state.root.name,
+            "synthesis_kinds": {k: v[0] for k, v in _service.SYNTHESIS_KINDS.items()}}
+
+
+@api
+async def _examples(request: Request) -> Any:
+    return {"examples": await run_in_threadpool(_service.examples)}
+
+
+@api
+async def _example(request: Request) -> Any:
+    path = _service.example_path(request.path_params["name"])
+    return {"mechanism": await run_in_threadpool(_service.read_mechanism, path), "name": path.name}
+
+
+@api
+async def _simulate(request: Request) -> Any:
+    data = await _body(request)
+    steps = _int(data.get("steps", 180), "steps")
+    rates = data.get("rates", True)
+    if not isinstance(rates, bool):
+        raise MechsynInputError("must be true or false", field="rates")
+    return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps, None, rates)
+
+
+@api
+async def _file_list(request: Request) -> Any:
+    return {"files": await run_in_threadpool(_files.list_mechanism_files, request.app.state.root)}
+
+
+@api
+async def _read_file(request: Request) -> Any:
+    root = request.app.state.root
+    path = _files.resolve_inside(root, request.query_params.get("path"))
+    _files.mechanism_suffix(path, suffixes=_files.READABLE_SUFFIXES)
+    if not path.is_file():
+        raise MechsynInputError(f"{request.query_params.get('path')}: no such file", field="path")
+    return {"mechanism": await run_in_threadpool(_service.read_mechanism, path),
+            "name": path.relative_to(root).as_posix()}
+
+
+@api
+async def _save_file(request: Request) -> Any:
+    data = await _body(request)
+    root = request.app.state.root
+    name = _need(data, "path")
+    path = _files.resolve_inside(root, name)
+    suffix = _files.mechanism_suffix(path)
+    if path.exists() and not data.get("overwrite", False):
+        raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
+    if not path.parent.is_dir():
+        raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
+    text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), suffix)
+    await run_in_threadpool(write_atomic, path, text)
+    return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
+
+
+@api
+async def _import_text(request: Request) -> Any:
+    data = await _body(request)
+    text, name = _need(data, "text"), str(data.get("filename", "upload.yaml"))
+    if not isinstance(text, str):
+        raise MechsynInputError("must be the file's text", field="text")
+    return {"mechanism": await run_in_threadpool(_service.parse_mechanism_text, text, name), "name": name}
+
+
+@api
+async def _export_text(request: Request) -> Any:
+    data = await _body(request)
+    fmt = data.get("format", "yaml")
+    if fmt == "csv":
+        text = await run_in_threadpool(_service.simulation_csv, _need(data, "mechanism"),
+                                       _int(data.get("steps", 180), "steps"))
+        return Response(text, media_type="text/csv")
+    if fmt == "gif":
+        frames = _int(data.get("frames", 72), "frames")
+        if not 2 <= frames <= 360:
+            raise MechsynInputError("frames must be within 2..360", field="frames")
+        gif = await run_in_threadpool(_service.animation_gif, _need(data, "mechanism"), frames)
+        return Response(gif, media_type="image/gif")
+    if fmt not in ("yaml", "json"):
+        raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json, csv or gif")
+    text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), "." + fmt)
+    return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
+
+
+@api
+async def _atlas(request: Request) -> Any:
+    q = request.query_params
+    try:
+        n, f = int(q.get("links", "6")), int(q.get("mobility", "1"))
+    except ValueError:
+        raise MechsynInputError("links and mobility must be whole numbers", field="links") from None
+    return {"chains": await run_in_threadpool(_service.atlas, n, f)}
+
+
+@api
+async def _atlas_mechanism(request: Request) -> Any:
+    data = await _body(request)
+    frame = data.get("frame")
+    inp = data.get("input")
+    mech = await run_in_threadpool(_service.atlas_mechanism, _need(data, "chain"),
+                                   None if frame is None else _int(frame, "frame"),
+                                   None if inp is None else _int(inp, "input"))
+    return {"mechanism": mech}
+
+
+@api
+async def _synth_start(request: Request) -> Any:
+    data = await _body(request)
+    kind = request.path_params["kind"]
+    if kind not in _service.SYNTHESIS_KINDS:
+        raise MechsynInputError(f"unknown synthesis kind {kind!r}", field="kind",
+                                hint="one of " + ", ".join(_service.SYNTHESIS_KINDS))
+    fn = _service.SYNTHESIS_KINDS[kind][1]
+    return request.app.state.jobs.submit(kind, fn, data).snapshot()
+
+
+@api
+async def _job_state(request: Request) -> Any:
+    return request.app.state.jobs.get(request.path_params["job"]).snapshot()
+
+
+@api
+async def _job_cancel(request: Request) -> Any:
+    job = request.app.state.jobs.get(request.path_params["job"])
+    job.cancel()
+    return job.snapshot()
+
+
+@api
+async def _job_events(request: Request) -> Any:
+    job = request.app.state.jobs.get(request.path_params["job"])
+
+    async def stream():
+        seen = -1
+        while True:
+            if await request.is_disconnected():
+                return
+            if job.version != seen:
+                seen = job.version
+                snap = job.snapshot()
+                yield f"event: {'progress' if snap['state'] == 'running' else 'end'}\ndata: {json.dumps(snap)}\n\n"
+                if snap["state"] != "running":
+                    return
+            await asyncio.sleep(0.1)
+
+    return StreamingResponse(stream(), media_type="text/event-stream", headers={"cache-control": "no-store"})
+
+
+async def _not_found(request: Request, exc: Exception) -> Response:
+    status = getattr(exc, "status_code", 404)
+    return _json_error(status, str(getattr(exc, "detail", "not found")))
+
+
+def _routes() -> list:
+    """The studio's routes: the page, the JSON API and the static assets."""
+    return [
+        Route("/", _index),
+        Route("/api/start", _start_route),
+        Route("/api/examples", _examples),
+        Route("/api/examples/{name}", _example),
+        Route("/api/validate", _on_mechanism("validate"), methods=["POST"]),
+        Route("/api/simulate", _simulate, methods=["POST"]),
+        Route("/api/analyze", _on_mechanism("analyze"), methods=["POST"]),
+        Route("/api/files", _file_list),
+        Route("/api/file", _read_file),
+        Route("/api/file", _save_file, methods=["POST"]),
+        Route("/api/import", _import_text, methods=["POST"]),
+        Route("/api/export", _export_text, methods=["POST"]),
+        Route("/api/atlas", _atlas),
+        Route("/api/atlas/mechanism", _atlas_mechanism, methods=["POST"]),
+        Route("/api/synth/{kind}", _synth_start, methods=["POST"]),
+        Route("/api/jobs/{job}", _job_state),
+        Route("/api/jobs/{job}/cancel", _job_cancel, methods=["POST"]),
+        Route("/api/jobs/{job}/events", _job_events),
+        Mount("/static", StaticFiles(directory=STATIC), name="static"),
+    ]
+
+
 def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, token: str | None = None,
                allowed_hosts: Iterable[str] = LOCAL_HOSTS, start_name: str = "") -> Starlette:
     """The studio as an ASGI app.
@@ -226,183 +414,19 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     >>> client.get("/api/examples", headers={"X-Mechsyn-Token": "t"}).status_code
     200
     """
-    root = Path(root).resolve()
-    token = token or secrets.token_urlsafe(24)
-    jobs = JobTable()
-
-    async def index(request: Request) -> Response:
-        return FileResponse(STATIC / "index.html", media_type="text/html")
-
-    @api
-    async def start_route(request: Request) -> Any:
-        return {"mechanism": start, "name": start_name, "root": root.name,
-                "synthesis_kinds": {k: v[0] for k, v in _service.SYNTHESIS_KINDS.items()}}
-
-    @api
-    async def examples(request: Request) -> Any:
-        return {"examples": await run_in_threadpool(_service.examples)}
-
-    @api
-    async def example(request: Request) -> Any:
-        path = _service.example_path(request.path_params["name"])
-        return {"mechanism": await run_in_threadpool(_service.read_mechanism, path), "name": path.name}
-
-    @api
-    async def simulate(request: Request) -> Any:
-        data = await _body(request)
-        steps = _int(data.get("steps", 180), "steps")
-        rates = data.get("rates", True)
-        if not isinstance(rates, bool):
-            raise MechsynInputError("must be true or false", field="rates")
-        return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps, None, rates)
-
-    @api
-    async def files(request: Request) -> Any:
-        return {"files": await run_in_threadpool(_files.list_mechanism_files, root)}
-
-    @api
-    async def read_file(request: Request) -> Any:
-        path = _files.resolve_inside(root, request.query_params.get("path"))
-        _files.mechanism_suffix(path, suffixes=_files.READABLE_SUFFIXES)
-        if not path.is_file():
-            raise MechsynInputError(f"{request.query_params.get('path')}: no such file", field="path")
-        return {"mechanism": await run_in_threadpool(_service.read_mechanism, path),
-                "name": path.relative_to(root).as_posix()}
-
-    @api
-    async def save_file(request: Request) -> Any:
-        data = await _body(request)
-        name = _need(data, "path")
-        path = _files.resolve_inside(root, name)
-        suffix = _files.mechanism_suffix(path)
-        if path.exists() and not data.get("overwrite", False):
-            raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
-        if not path.parent.is_dir():
-            raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
-        text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), suffix)
-        await run_in_threadpool(write_atomic, path, text)
-        return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
-
-    @api
-    async def import_text(request: Request) -> Any:
-        data = await _body(request)
-        text, name = _need(data, "text"), str(data.get("filename", "upload.yaml"))
-        if not isinstance(text, str):
-            raise MechsynInputError("must be the file's text", field="text")
-        return {"mechanism": await run_in_threadpool(_service.parse_mechanism_text, text, name), "name": name}
-
-    @api
-    async def export_text(request: Request) -> Any:
-        data = await _body(request)
-        fmt = data.get("format", "yaml")
-        if fmt == "csv":
-            text = await run_in_threadpool(_service.simulation_csv, _need(data, "mechanism"),
-                                           _int(data.get("steps", 180), "steps"))
-            return Response(text, media_type="text/csv")
-        if fmt == "gif":
-            frames = _int(data.get("frames", 72), "frames")
-            if not 2 <= frames <= 360:
-                raise MechsynInputError("frames must be within 2..360", field="frames")
-            gif = await run_in_threadpool(_service.animation_gif, _need(data, "mechanism"), frames)
-            return Response(gif, media_type="image/gif")
-        if fmt not in ("yaml", "json"):
-            raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json, csv or gif")
-        text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), "." + fmt)
-        return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
-
-    @api
-    async def atlas(request: Request) -> Any:
-        q = request.query_params
-        try:
-            n, f = int(q.get("links", "6")), int(q.get("mobility", "1"))
-        except ValueError:
-            raise MechsynInputError("links and mobility must be whole numbers", field="links") from None
-        return {"chains": await run_in_threadpool(_service.atlas, n, f)}
-
-    @api
-    async def atlas_mechanism(request: Request) -> Any:
-        data = await _body(request)
-        frame = data.get("frame")
-        inp = data.get("input")
-        mech = await run_in_threadpool(_service.atlas_mechanism, _need(data, "chain"),
-                                       None if frame is None else _int(frame, "frame"),
-                                       None if inp is None else _int(inp, "input"))
-        return {"mechanism": mech}
-
-    @api
-    async def synth_start(request: Request) -> Any:
-        data = await _body(request)
-        kind = request.path_params["kind"]
-        if kind not in _service.SYNTHESIS_KINDS:
-            raise MechsynInputError(f"unknown synthesis kind {kind!r}", field="kind",
-                                    hint="one of " + ", ".join(_service.SYNTHESIS_KINDS))
-        fn = _service.SYNTHESIS_KINDS[kind][1]
-        return jobs.submit(kind, fn, data).snapshot()
-
-    @api
-    async def job_state(request: Request) -> Any:
-        return jobs.get(request.path_params["job"]).snapshot()
-
-    @api
-    async def job_cancel(request: Request) -> Any:
-        job = jobs.get(request.path_params["job"])
-        job.cancel()
-        return job.snapshot()
-
-    @api
-    async def job_events(request: Request) -> Any:
-        job = jobs.get(request.path_params["job"])
-
-        async def stream():
-            seen = -1
-            while True:
-                if await request.is_disconnected():
-                    return
-                if job.version != seen:
-                    seen = job.version
-                    snap = job.snapshot()
-                    yield f"event: {'progress' if snap['state'] == 'running' else 'end'}\ndata: {json.dumps(snap)}\n\n"
-                    if snap["state"] != "running":
-                        return
-                await asyncio.sleep(0.1)
-
-        return StreamingResponse(stream(), media_type="text/event-stream", headers={"cache-control": "no-store"})
-
-    async def not_found(request: Request, exc: Exception) -> Response:
-        status = getattr(exc, "status_code", 404)
-        return _json_error(status, str(getattr(exc, "detail", "not found")))
-
-    routes = [
-        Route("/", index),
-        Route("/api/start", start_route),
-        Route("/api/examples", examples),
-        Route("/api/examples/{name}", example),
-        Route("/api/validate", _on_mechanism("validate"), methods=["POST"]),
-        Route("/api/simulate", simulate, methods=["POST"]),
-        Route("/api/analyze", _on_mechanism("analyze"), methods=["POST"]),
-        Route("/api/files", files),
-        Route("/api/file", read_file),
-        Route("/api/file", save_file, methods=["POST"]),
-        Route("/api/import", import_text, methods=["POST"]),
-        Route("/api/export", export_text, methods=["POST"]),
-        Route("/api/atlas", atlas),
-        Route("/api/atlas/mechanism", atlas_mechanism, methods=["POST"]),
-        Route("/api/synth/{kind}", synth_start, methods=["POST"]),
-        Route("/api/jobs/{job}", job_state),
-        Route("/api/jobs/{job}/cancel", job_cancel, methods=["POST"]),
-        Route("/api/jobs/{job}/events", job_events),
-        Mount("/static", StaticFiles(directory=STATIC), name="static"),
-    ]
-    @contextlib.asynccontextmanager
-    async def lifespan(app: Starlette):
-        yield
-        jobs.cancel_all()
-
-    app = Starlette(routes=routes, exception_handlers={HTTPException: not_found}, lifespan=lifespan)
-    app.state.token = token
-    app.state.root = root
-    app.add_middleware(Guard, token=token, allowed_hosts=allowed_hosts)
+    app = Starlette(routes=_routes(), exception_handlers={HTTPException: _not_found}, lifespan=_lifespan)
+    app.state.token = token or secrets.token_urlsafe(24)
+    app.state.root = Path(root).resolve()
+    app.state.start, app.state.start_name = start, start_name
+    app.state.jobs = JobTable()
+    app.add_middleware(Guard, token=app.state.token, allowed_hosts=allowed_hosts)
     return app
+
+
+@contextlib.asynccontextmanager
+async def _lifespan(app: Starlette):
+    yield
+    app.state.jobs.cancel_all()
 
 
 def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> None:

@@ -517,6 +517,31 @@ def synthesize_curve(
     ('four-bar', True, True)
     """
     t0 = time.perf_counter()
+    target = _checked_target(target, max_links, time_limit, top, max_link_ratio, crank)
+    if database is None or isinstance(database, (str, os.PathLike)):
+        database = load_database(database, max_links=max_links, callback=callback)
+
+    def report(stage, done, total, best, nfev):
+        if callback is not None:
+            callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
+
+    report("retrieve", 0, 1, float("nan"), 0)
+    seeds = _retrieve(database, target, retrieve, max_links, crank)
+    report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
+    picked = _diverse(seeds, n_refine)
+    run = _Refinement(target, ground_region, max_link_ratio, max_nfev, min_transmission, report)
+    run.all(picked, t0 + time_limit, top, tolerance)
+    if not picked:
+        run.notes.append("no database design matched the options (crank, links, open/closed)")
+    out = _ranked(run.cands, top, tolerance, run.notes)
+    report("done", 1, 1, out[0].chamfer if out else float("nan"), run.nfev)
+    return _result(target, out, time.perf_counter() - t0, len(seeds), run.done, run.nfev, run.interrupted,
+                   run.notes)
+
+
+def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit: float, top: int,
+                    max_link_ratio: float | None, crank: bool) -> TargetCurve:
+    """The target as a :class:`TargetCurve`; options no search can meet are refused."""
     if not isinstance(target, TargetCurve):
         target = target_from_points(target)
     if max_links not in (4, 6, 8):
@@ -530,18 +555,11 @@ def synthesize_curve(
     if crank and not target.closed:
         raise MechsynInputError("a crank (full turn) traces a closed curve; the target is open",
                                 source="--crank", hint="drop --crank or close the target")
-    if database is None or isinstance(database, (str, os.PathLike)):
-        database = load_database(database, max_links=max_links, callback=callback)
+    return target
 
-    def report(stage, done, total, best, nfev):
-        if callback is not None:
-            callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
 
-    report("retrieve", 0, 1, float("nan"), 0)
-    seeds = _retrieve(database, target, retrieve, max_links, crank)
-    report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
-    notes: list[str] = []
-    # diversity: at most a third of the refinements from one topology, then fill up
+def _diverse(seeds: list[_Seed], n_refine: int) -> list[_Seed]:
+    """The seeds to refine: at most a third from one topology, then filled up by score."""
     picked: list[_Seed] = []
     per: dict[str, int] = {}
     cap = max(2, n_refine // 3)
@@ -555,37 +573,62 @@ def synthesize_curve(
         chosen = {id(s) for s in picked}
         picked += [s for s in seeds if id(s) not in chosen][:n_refine - len(picked)]
         picked.sort(key=lambda s: s.score)
-    cands: list[CurveCandidate] = []
-    done = 0
-    nfev = 0
-    interrupted = False
-    best = float("inf")
-    longest = 0.0
-    try:
-        for i, s in enumerate(picked):
-            now = time.perf_counter()
-            if now - t0 + longest > time_limit:
-                notes.append(f"time limit: {i} of {len(picked)} refinements done")
-                break
-            if sum(c.chamfer <= tolerance for c in cands) >= top:
-                notes.append(f"{top} candidate(s) within {100 * tolerance:g} % after {i} refinements")
-                break
-            c = _refine(s, target, ground_region, max_link_ratio, max_nfev, min_transmission)
-            longest = max(longest, time.perf_counter() - now)
-            done += 1
-            if c is not None:
-                nfev += c.nfev
-                if (max_link_ratio is None or c.link_length_ratio <= max_link_ratio * (1 + 1e-6)) and \
-                        (ground_region is None or _in_region(c, ground_region)):
-                    cands.append(c)
-                    best = min(best, c.chamfer)
-            report("refine", i + 1, len(picked), best, nfev)
-    except KeyboardInterrupt:
-        interrupted = True
-        notes.append("interrupted: the best found so far")
-    if not picked:
-        notes.append("no database design matched the options (crank, links, open/closed)")
-    # best first; within the tolerance the simpler linkage first
+    return picked
+
+
+@dataclass
+class _Refinement:
+    """The refinement stage: candidates kept, refinements done, evaluations, notes."""
+
+    target: TargetCurve
+    ground_region: Any
+    max_link_ratio: float | None
+    max_nfev: int
+    min_transmission: float
+    report: Callable[..., None]
+    cands: list[CurveCandidate] = field(default_factory=list)
+    done: int = 0
+    nfev: int = 0
+    interrupted: bool = False
+    notes: list[str] = field(default_factory=list)
+
+    def all(self, picked: list[_Seed], deadline: float, top: int, tolerance: float) -> None:
+        """Refine ``picked`` in order until the deadline (a refinement starts only if the
+        longest so far still fits), ``top`` candidates within ``tolerance``, or Ctrl-C."""
+        best = float("inf")
+        longest = 0.0
+        try:
+            for i, s in enumerate(picked):
+                now = time.perf_counter()
+                if now + longest > deadline:
+                    self.notes.append(f"time limit: {i} of {len(picked)} refinements done")
+                    break
+                if sum(c.chamfer <= tolerance for c in self.cands) >= top:
+                    self.notes.append(f"{top} candidate(s) within {100 * tolerance:g} % after {i} refinements")
+                    break
+                c = _refine(s, self.target, self.ground_region, self.max_link_ratio, self.max_nfev,
+                            self.min_transmission)
+                longest = max(longest, time.perf_counter() - now)
+                self.done += 1
+                if c is not None:
+                    self.nfev += c.nfev
+                    if self.keeps(c):
+                        self.cands.append(c)
+                        best = min(best, c.chamfer)
+                self.report("refine", i + 1, len(picked), best, self.nfev)
+        except KeyboardInterrupt:
+            self.interrupted = True
+            self.notes.append("interrupted: the best found so far")
+
+    def keeps(self, c: CurveCandidate) -> bool:
+        """Within the link-ratio limit and the ground region."""
+        return (self.max_link_ratio is None or c.link_length_ratio <= self.max_link_ratio * (1 + 1e-6)) and \
+            (self.ground_region is None or _in_region(c, self.ground_region))
+
+
+def _ranked(cands: list[CurveCandidate], top: int, tolerance: float, notes: list[str]) -> list[CurveCandidate]:
+    """Best first (within the tolerance the simpler linkage first), distinct, each verified
+    by ``simulate``; at most ``top``."""
     cands.sort(key=lambda c: (max(c.chamfer, tolerance), c.topology.n_links, c.chamfer))
     out: list[CurveCandidate] = []
     for c in cands:
@@ -598,8 +641,7 @@ def synthesize_curve(
             notes.append(f"{c.topology.key}: dropped, {c.verification}")
         if len(out) >= top:
             break
-    report("done", 1, 1, out[0].chamfer if out else float("nan"), nfev)
-    return _result(target, out, time.perf_counter() - t0, len(seeds), done, nfev, interrupted, notes)
+    return out
 
 
 def _result(target: TargetCurve, out: list[CurveCandidate], seconds: float, retrieved: int, refined: int,
