@@ -34,6 +34,8 @@ True
 
 from __future__ import annotations
 
+import functools
+
 import os
 from collections.abc import Sequence
 
@@ -109,6 +111,14 @@ def _igraph(n: int, edges):
                         [(a, b) for a, b in edges if a != b])
 
 
+@functools.lru_cache(maxsize=1)
+def _moves_to_index() -> bool:
+    """True when igraph's ``permute_vertices(p)`` sends vertex ``v`` to ``p[v]`` (0.10,
+    0.11), False when vertex ``p[i]`` becomes ``i`` (1.0): probed once on a tiny graph."""
+    h = _igraph(3, [(0, 1)]).permute_vertices([2, 0, 1])
+    return sorted(h.get_edgelist()[0]) == [0, 2]
+
+
 def certificate(n: int, edges: Sequence[tuple[int, int]],
                 colours: Sequence[int] | None = None) -> bytes:
     """Canonical certificate of a simple graph on ``0..n-1`` (edges undirected, no
@@ -117,16 +127,22 @@ def certificate(n: int, edges: Sequence[tuple[int, int]],
     col = _colour_classes(n, colours)
     if get_backend() == "pynauty":
         return _module("pynauty").certificate(_nauty_graph(n, edges, col))
-    simple = [(a, b) for a, b in edges if a != b]
-    g = _igraph(n, simple)
-    g.vs["colour"] = col
+    g = _igraph(n, edges)
     order = g.canonical_permutation(color=col if colours is not None else None)
-    # the colours travel with the vertices: igraph 1.0 reversed the meaning of the
-    # permutation vector (python-igraph 0.10/0.11: vertex v goes to order[v]; 1.0: the
-    # vertex at i is order[i]), and permute_vertices(canonical_permutation()) is canonical in both
+    # permute_vertices(canonical_permutation()) is canonical in every igraph version; the
+    # colours travel with the vertices, and igraph 1.0 reversed the meaning of the
+    # permutation vector (0.10/0.11: vertex v goes to order[v]; 1.0: the vertex at i is order[i])
     canonical = g.permute_vertices(order)
     flat = bytes(v for e in sorted(tuple(sorted(e)) for e in canonical.get_edgelist()) for v in e)
-    labels = bytes(canonical.vs["colour"]) if colours is not None else b""
+    if colours is None:
+        labels = b""
+    elif _moves_to_index():
+        new = [0] * n
+        for v, i in enumerate(order):
+            new[i] = col[v]
+        labels = bytes(new)
+    else:
+        labels = bytes(col[v] for v in order)
     return bytes([n & 255, n >> 8, len(labels) > 0]) + labels + flat
 
 
