@@ -1,0 +1,156 @@
+"""Rich rendering of the library's reports for the terminal: one function per report.
+
+The commands parse options, make one library call and hand its report to a function here;
+``--json`` prints the report's ``to_dict()`` instead.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from rich.markup import escape
+
+from mechsyn.cli.common import Table, console, fmt_number
+
+
+def table_rows(n: int, max_rows: int = 25) -> list[int]:
+    """Indices of at most ``max_rows`` evenly spaced rows of ``n``."""
+    if n <= max_rows:
+        return list(range(n))
+    return sorted(set(np.linspace(0, n - 1, max_rows).astype(int).tolist()))
+
+
+def say_rows_shown(shown: int, total: int) -> None:
+    """Say when the tables show a subset of the positions, and how to see them all."""
+    if shown < total:
+        console.print(f"(tables show {shown} of {total} positions, evenly spaced; all of them with --json "
+                      "or --csv FILE)", highlight=False)
+
+
+def _events(sim: Any) -> None:
+    for e in sim.events:
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in e["input"].items()) if isinstance(e.get("input"), dict) else ""
+        console.print(f"[yellow]{e['kind']}[/] {where}: {escape(e['message'])}", highlight=False)
+
+
+def _point_tables(sim: Any, rows: list[int], head: str) -> None:
+    x = sim.inputs[sim.main_input]
+    for name, pm in sim.points.items():
+        t = Table(title=f"point {name} (on {pm.link})")
+        for col in (head, "x", "y", "vx", "vy", "ax", "ay"):
+            t.add_column(col, justify="right")
+        for k in rows:
+            if not sim.assembled[k]:
+                t.add_row(f"{x[k]:g}", "not assembled", *[""] * 5)
+                continue
+            t.add_row(f"{x[k]:g}", *(fmt_number(v) for v in (*pm.position[k], *pm.velocity[k],
+                                                               *pm.acceleration[k])))
+        console.print(t)
+
+
+def _link_table(sim: Any, rows: list[int], head: str) -> None:
+    x = sim.inputs[sim.main_input]
+    t = Table(title="links: angle (deg), angular velocity (rad/s), angular acceleration (rad/s²)")
+    t.add_column(head, justify="right")
+    names = list(sim.links)[:4]
+    for name in names:
+        t.add_column(f"{name} θ, ω, α", justify="right")
+    for k in rows:
+        t.add_row(f"{x[k]:g}", *(("—" if not sim.assembled[k] else
+                                  f"{sim.links[n].angle[k]:.4f}, {fmt_number(sim.links[n].angular_velocity[k])}, "
+                                  f"{fmt_number(sim.links[n].angular_acceleration[k])}") for n in names))
+    console.print(t)
+    if len(sim.links) > 4:
+        console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
+
+
+def _derived_lines(d: dict[str, Any]) -> None:
+    if "grashof" in d:
+        console.print(f"Grashof: {d['grashof']['expression']} → {d['grashof']['classification']}", highlight=False)
+    for k, v in d.get("transmission_angle", {}).items():
+        console.print(f"transmission angle of dyad {k}: {fmt_number(v['min'])} .. {fmt_number(v['max'])} deg",
+                      highlight=False)
+    for name, e in d.get("extent", {}).items():
+        if e["width"] is not None:
+            console.print(f"path of {name}: x {e['x_min']:.6g} .. {e['x_max']:.6g}, y {e['y_min']:.6g} .. "
+                          f"{e['y_max']:.6g} (width {e['width']:.6g}, height {e['height']:.6g})", highlight=False)
+    for name, s in d.get("straightness", {}).items():
+        console.print(f"straightness of {name} over {s['range'][0]:g}..{s['range'][1]:g}: largest deviation "
+                      f"{s['max_deviation']:.6g} over a length {s['length']:.6g}", highlight=False)
+
+
+def render_simulation(report: Any) -> None:
+    """``mechsyn simulate``: point and link tables, working ranges, events, derived quantities."""
+    sim = report.simulation
+    main = sim.main_input
+    x = sim.inputs[main]
+    unit = "deg" if sim.input_types[main] == "R" else ""
+    head = f"{main} {unit}".strip()
+    rows = table_rows(len(x))
+    console.print(f"[bold]{escape(sim.mechanism)}[/]: {len(x)} input values, {int(sim.assembled.sum())} assembled "
+                  f"(method: {sim.method})", highlight=False)
+    _point_tables(sim, rows, head)
+    _link_table(sim, rows, head)
+    say_rows_shown(len(rows), len(x))
+    for r in sim.working_ranges():
+        console.print(f"working range of {main}: {r[0]:g} .. {r[1]:g} {unit}", highlight=False)
+    _events(sim)
+    for note in sim.notes:
+        console.print(f"note: {escape(note)}", highlight=False)
+    _derived_lines(report.derived)
+
+
+def _effort_table(fa: Any, rows: list[int]) -> None:
+    sim, R = fa.simulation, fa.reactions
+    x = sim.inputs[sim.main_input]
+    per_input = list(R.force) if len(R.force) <= 5 else []
+    t = Table(title="balancing efforts at the drives" + (" and reactions |F| (on each joint's second link)"
+                                                         if per_input else ""))
+    t.add_column(sim.main_input, justify="right")
+    for j in R.effort:
+        t.add_column(f"{R.effort_kind[j]} at {j}", justify="right")
+    for j in per_input:
+        t.add_column(f"|F_{j}|", justify="right")
+    for k in rows:
+        row = [f"{x[k]:g}"] + [fmt_number(float(e[k])) for e in R.effort.values()]
+        row += [fmt_number(float(np.linalg.norm(R.force[j][k]))) for j in per_input]
+        t.add_row(*row)
+    console.print(t)
+
+
+def _reaction_table(fa: Any) -> None:
+    sim, R = fa.simulation, fa.reactions
+    x = sim.inputs[sim.main_input]
+    mech_joints = {j.id: j for j in sim.system.mech.joints}
+    t = Table(title="joint reactions over the sweep (force of the first link on the second)")
+    for col in ("joint", "links", "max |F|", f"at {sim.main_input}", "min |F|", "max |M|"):
+        t.add_column(col, justify="left" if col in ("joint", "links") else "right")
+    for j in R.force:
+        mag = np.linalg.norm(R.force[j], axis=1)
+        if not np.isfinite(mag).any():
+            t.add_row(j, " - ".join(mech_joints[j].links), "—", "—", "—", "—")
+            continue
+        k = int(np.nanargmax(mag))
+        t.add_row(j, " → ".join(mech_joints[j].links), fmt_number(float(mag[k])), f"{x[k]:g}",
+                  fmt_number(float(np.nanmin(mag))), fmt_number(float(np.nanmax(np.abs(R.moment[j])))))
+    console.print(t)
+
+
+def render_forces(fa: Any) -> None:
+    """``mechsyn forces``: balancing efforts, reactions, notes and events."""
+    sim = fa.simulation
+    x = sim.inputs[sim.main_input]
+    rows = table_rows(len(x))
+    kind = "static" if fa.static else "kinetostatic"
+    console.print(f"[bold]{escape(sim.mechanism)}[/]: {kind} analysis, gravity {0.0 - fa.gravity[1]:g} along -y, "
+                  f"{int(sim.assembled.sum())} of {len(x)} inputs assembled", highlight=False)
+    _effort_table(fa, rows)
+    say_rows_shown(len(rows), len(x))
+    _reaction_table(fa)
+    if fa.reactions.indeterminate:
+        console.print("[yellow]note:[/] redundant constraints: the reactions are statically indeterminate; "
+                      "minimum-norm values shown", highlight=False)
+    for note in fa.notes():
+        console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
+    _events(sim)
