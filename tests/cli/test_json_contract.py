@@ -28,9 +28,9 @@ def test_simulate_json_is_the_report(cli_json):
     from mechsyn.kinematics.report import simulation_report
 
     report = simulation_report(load_mechanism(CRANK_ROCKER), {"A": input_grid(0, 360, 30)},
-                               straight={"C": (0.0, 90.0)})
+                               straight={"M": (0.0, 90.0)})
     assert "straightness" in report.derived
-    same_json(cli_json, ["simulate", CRANK_ROCKER, "-i", "A=0:360:30", "--straight", "C=0:90"], report)
+    same_json(cli_json, ["simulate", CRANK_ROCKER, "-i", "A=0:360:30", "--straight", "M=0:90"], report)
 
 
 def test_forces_json_is_the_report(cli_json):

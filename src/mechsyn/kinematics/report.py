@@ -191,7 +191,7 @@ def simulation_csv(sim: Simulation) -> str:
     >>> from mechsyn.kinematics.report import simulation_csv
     >>> s = ms.simulate(ms.examples.load("crank_rocker"), {"A": np.array([0.0, 90.0])})
     >>> simulation_csv(s).splitlines()[0].split(",")[:3]
-    ['input_A', 'assembled', 'A_x']
+    ['input_A', 'assembled', 'M_x']
     """
     header, cols = _input_columns(sim)
     for name, pm in sim.points.items():
