@@ -38,3 +38,11 @@ def test_forces_json_is_the_report(cli_json):
 
     fa = forces(load_mechanism(CRANK_ROCKER), {"A": input_grid(0, 360, 45)}, gravity=(0.0, -9.81))
     same_json(cli_json, ["forces", CRANK_ROCKER, "-i", "A=0:360:45", "--gravity", "9.81"], fa)
+
+
+def test_atlas_json_is_the_report(cli_json):
+    from mechsyn.synthesis.atlas import chain_atlas
+
+    report = chain_atlas(7, 2, include_degenerate=True, inputs=True)
+    assert report.degenerate_listed > 0
+    same_json(cli_json, ["atlas", "-n", "7", "-F", "2", "--include-degenerate", "--inputs"], report)

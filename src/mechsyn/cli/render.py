@@ -154,3 +154,27 @@ def render_forces(fa: Any) -> None:
     for note in fa.notes():
         console.print(f"[yellow]note:[/] {escape(note)}", highlight=False)
     _events(sim)
+
+
+def render_atlas(atlas: Any, include_degenerate: bool = False) -> None:
+    """``mechsyn atlas``: one row per link assortment, then each chain's joints (up to 40)."""
+    by_input = atlas.mechanisms_by != "frame"
+    table = Table(title=f"{atlas.n_links} links, mobility {atlas.mobility}, "
+                  f"{atlas.n_joints} joints: {atlas.count} chains")
+    for col in ("assortment", "chains", "non-planar", "fractionated",
+                "mechanisms" + (" (frame, input)" if by_input else " (frames)")):
+        table.add_column(col, justify="right" if col != "assortment" else "left")
+    if include_degenerate:
+        table.add_column("degenerate", justify="right")
+    realised = [row for row in atlas.assortments if row["chains"] or row["degenerate"]]
+    empty = [row["label"] for row in atlas.assortments if row not in realised]
+    for row in realised:
+        cells = [row["label"], *(str(row[k]) for k in ("chains", "non_planar", "fractionated", "mechanisms"))]
+        table.add_row(*cells, *([str(row["degenerate"])] if include_degenerate else []))
+    console.print(table)
+    if empty:
+        console.print("assortments without a non-degenerate chain: " + ", ".join(empty), highlight=False)
+    if len(atlas.kinematic_chains) <= 40:
+        for rec, chain in zip(atlas.chains, atlas.kinematic_chains):
+            console.print(f"#{rec['number']} {chain.assortment_label()}: joints "
+                          + " ".join(f"{a}-{b}" for a, b in chain.edges), highlight=False)
