@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from mechsyn.io import load_mechanism
 from mechsyn.results import dumps
@@ -46,3 +47,32 @@ def test_atlas_json_is_the_report(cli_json):
     report = chain_atlas(7, 2, include_degenerate=True, inputs=True)
     assert report.degenerate_listed > 0
     same_json(cli_json, ["atlas", "-n", "7", "-F", "2", "--include-degenerate", "--inputs"], report)
+
+
+def _without(d: dict, *keys: str) -> dict:
+    return {k: v for k, v in d.items() if k not in keys}
+
+
+@pytest.mark.slow
+def test_synth_path_json_is_the_report(cli_json):
+    """Equal but for the wall-clock time (``seconds``), which no two runs share."""
+    from mechsyn.synthesis.path import load_cases
+    from mechsyn.synthesis.reports import path_synthesis, select_case
+
+    cases = EXAMPLES / "synthesis/path_cases_public.json"
+    res = path_synthesis(select_case(load_cases(cases), "P2_kk5_timing"), restarts=1, time_limit=20,
+                         min_transmission=25.0)
+    got = cli_json("synth", "path", cases, "--case", "P2_kk5_timing", "--restarts", "1", "--time-limit", "20",
+                   "--min-transmission-angle", "25")
+    assert _without(got, "seconds") == _without(json.loads(dumps(res.to_dict())), "seconds")
+    assert got["transmission_angle_min_deg"] == 25.0
+
+
+def test_synth_motion_json_is_the_report(cli_json):
+    from mechsyn.synthesis.reports import motion_report
+
+    poses = json.loads((EXAMPLES / "synthesis/poses_4.json").read_text())["poses"]
+    P = np.array(poses, float)
+    P[:, 2] = np.radians(P[:, 2])
+    same_json(cli_json, ["synth", "motion", EXAMPLES / "synthesis/poses_4.json", "--top", "2"],
+              motion_report(P, top=2))

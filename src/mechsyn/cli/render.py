@@ -178,3 +178,43 @@ def render_atlas(atlas: Any, include_degenerate: bool = False) -> None:
         for rec, chain in zip(atlas.chains, atlas.kinematic_chains):
             console.print(f"#{rec['number']} {chain.assortment_label()}: joints "
                           + " ".join(f"{a}-{b}" for a, b in chain.edges), highlight=False)
+
+
+def _transmission_line(res: Any) -> str:
+    mu = res.worst_transmission_angle_deg
+    text = (f"worst transmission angle over the motion: {mu:.2f} deg"
+            + (f" (limit {res.transmission_angle_min_deg:g})" if res.transmission_angle_min_deg else ""))
+    if res.fold_distance_deg is not None:
+        text += f"\nnearest approach to folding flat: {res.fold_distance_deg:.2f} deg"
+        text += f" (limit {res.fold_margin_deg:g})" if res.fold_margin_deg else ""
+    return text
+
+
+def render_path_synthesis(case: Any, res: Any) -> None:
+    """``mechsyn synth path``: the design, its error against the published best, feasibility."""
+    t = Table(title=f"Path synthesis {case.id}" + (" (interrupted: best so far)" if res.interrupted else ""))
+    t.add_column("variable")
+    t.add_column("value", justify="right")
+    for k, v in res.design.items():
+        t.add_row(k, f"{v:.8g}")
+    console.print(t)
+    console.print(f"error (sum of squared distances): [bold]{res.error:.8g}[/]"
+                  + (f"   published best: {case.best_known:.8g}" if case.best_known else ""))
+    console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
+                  f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
+                  + ("   (target error reached)" if res.target_reached else ""))
+    console.print(_transmission_line(res))
+
+
+def render_motion(report: Any) -> None:
+    """``mechsyn synth motion``: the best linkages, their pivots, lengths, defects and errors."""
+    t = Table(title=f"Burmester motion generation, {len(report.poses)} poses ({report.verified_count} of "
+              f"{report.count} verified)")
+    for c in ("O2", "O4", "r1", "r2", "r3", "r4", "type", "min mu [deg]", "defects", "pos. error"):
+        t.add_column(c, justify="right")
+    for s in report.solutions:
+        defects = ", ".join(k for k, v in (("branch", s.branch_defect), ("order", s.order_defect)) if v) or "none"
+        t.add_row(f"({s.O2[0]:.4g}, {s.O2[1]:.4g})", f"({s.O4[0]:.4g}, {s.O4[1]:.4g})", f"{s.r1:.4g}", f"{s.r2:.4g}",
+                  f"{s.r3:.4g}", f"{s.r4:.4g}", s.grashof, f"{s.min_transmission_deg:.1f}", defects,
+                  f"{s.position_error:.2e}")
+    console.print(t)
