@@ -89,17 +89,10 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
 
     Examples
     --------
-    >>> import numpy as np
-    >>> from mechsyn.synthesis.fourbar import fourbar_position
-    >>> from mechsyn.synthesis.path import PathCase
-    >>> from mechsyn.synthesis.reports import path_synthesis
-    >>> th = [0.0, 0.4, 0.8, 1.2, 1.6]
-    >>> C = fourbar_position(3.0, 1.0, 3.0, 2.5, np.array(th), branch=-1, rcx=1.0, rcy=1.0).C
-    >>> case = PathCase.from_dict({
-    ...     "id": "known", "targets": C.tolist(), "timing": {"type": "prescribed", "theta2": th},
-    ...     "fixed": {"x0": 0.0, "y0": 0.0, "theta0": 0.0},
-    ...     "variables": [{"name": n, "lower": lo, "upper": 6.0} for n, lo in
-    ...                   (("r1", 0.1), ("r2", 0.1), ("r3", 0.1), ("r4", 0.1), ("rcx", -6.0), ("rcy", -6.0))]})
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.path import load_cases
+    >>> from mechsyn.synthesis.reports import path_synthesis, select_case
+    >>> case = select_case(load_cases(ms.examples.path("path_cases_public")), "P2_kk5_timing")
     >>> res = path_synthesis(case, time_limit=20, restarts=1, min_transmission=10.0)
     >>> res.feasible, res.transmission_angle_min_deg
     (True, 10.0)
