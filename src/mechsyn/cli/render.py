@@ -218,3 +218,23 @@ def render_motion(report: Any) -> None:
                   f"{s.r3:.4g}", f"{s.r4:.4g}", s.grashof, f"{s.min_transmission_deg:.1f}", defects,
                   f"{s.position_error:.2e}")
     console.print(t)
+
+
+def render_mechanism_synthesis(case: Any, res: Any) -> None:
+    """``mechsyn synth mechanism``: start and final design, errors, feasibility."""
+    t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}"
+              + (" (interrupted: best so far)" if res.interrupted else ""))
+    t.add_column("variable")
+    t.add_column("start", justify="right")
+    t.add_column("design", justify="right")
+    for k, v in res.design.items():
+        t.add_row(k, f"{res.start_design[k]:.6g}", f"{v:.8g}")
+    console.print(t)
+    se = "infeasible" if res.start_error is None else f"{res.start_error:.6g}"
+    console.print(f"error ({'sum of squared distances' if case.problem == 'path' else 'pose error'}): "
+                  f"[bold]{res.error:.8g}[/]   (start design: {se})")
+    console.print(f"feasible: {res.feasible}   evaluation: {res.method}   {res.restarts} restarts, "
+                  f"{res.nfev} evaluations, {res.seconds:.1f} s"
+                  + ("   (time limit reached)" if res.stopped_by_time_limit else ""))
+    if not res.feasible:
+        console.print(f"[bold red]no feasible design found[/]: {res.reason}")

@@ -22,7 +22,7 @@ import numpy as np
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["select_case", "path_synthesis", "path_mechanism_dict", "MotionReport", "motion_report",
+__all__ = ["select_case", "path_synthesis", "mechanism_synthesis", "path_mechanism_dict", "MotionReport", "motion_report",
            "motion_mechanism_dict", "curve_candidate_files"]
 
 C = TypeVar("C")
@@ -99,16 +99,43 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     """
     from mechsyn.synthesis.optimize import default_target_error, synthesize_path
 
-    if not time_limit > 0:
-        raise MechsynInputError("must be positive", field="time_limit")
-    if restarts < 1:
-        raise MechsynInputError("must be at least 1", field="restarts")
+    _check_budget(time_limit, restarts)
     if target_error is not None and not target_error >= 0:
         raise MechsynInputError("must be >= 0 (0: use the whole budget)", field="target_error")
     case = _with_margins(case, min_transmission, fold_margin)
     stop_at = default_target_error(case) if target_error is None else (target_error or None)
     return synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                            optimizer=optimizer, progress=progress, scheduler=scheduler, target_error=stop_at)
+
+
+def _check_budget(time_limit: float, restarts: int) -> None:
+    if not time_limit > 0:
+        raise MechsynInputError("must be positive", field="time_limit")
+    if restarts < 1:
+        raise MechsynInputError("must be at least 1", field="restarts")
+
+
+def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, restarts: int = 3,
+                        optimizer: str = "de", workers: int = 1, scheduler: Any = None,
+                        progress: Callable[..., None] | None = None) -> Any:
+    """Synthesis of any planar mechanism file (see
+    :func:`mechsyn.synthesis.general.synthesize_mechanism`), its budget checked first.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.general import load_case
+    >>> from mechsyn.synthesis.reports import mechanism_synthesis
+    >>> mechanism_synthesis(load_case(ms.examples.path("slider_crank_path_case")), time_limit=0)
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: time_limit: must be positive
+    """
+    from mechsyn.synthesis.general import synthesize_mechanism
+
+    _check_budget(time_limit, restarts)
+    return synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
+                                progress=progress, workers=workers, scheduler=scheduler)
 
 
 def _fourbar_dict(design: dict[str, float], theta2: float, branch: int, name: str) -> dict[str, Any]:
