@@ -99,3 +99,17 @@ def test_synth_mechanism_json_is_the_report(cli_json, monkeypatch):
     got = cli_json("synth", "mechanism", EXAMPLES / "synthesis/slider_crank_path_case.yaml", "--restarts", "1",
                    "--time-limit", "3")
     assert len(seen) == 1 and got == json.loads(dumps(seen[0].to_dict()))
+
+
+def test_curves_build_and_synth_curve_json_are_the_reports(cli_json, monkeypatch, tmp_path):
+    from mechsyn.synthesis.reports import curve_database
+
+    db = tmp_path / "db"
+    got = cli_json("curves", "build", "--links", "4", "--per-topology", "30", "--database", db)
+    assert got == json.loads(dumps(curve_database(db, max_links=4, per_topology=30).to_dict()))
+    seen = spy(monkeypatch, "mechsyn.synthesis.curves.synthesis", "synthesize_curve")
+    t = np.linspace(0, 2 * np.pi, 30, endpoint=False)
+    target = tmp_path / "ellipse.json"
+    target.write_text(json.dumps({"points": np.c_[3 * np.cos(t), np.sin(t)].tolist(), "closed": True}))
+    got = cli_json("synth", "curve", target, "--max-links", "4", "--top", "1", "--time-limit", "3", "--database", db)
+    assert len(seen) == 1 and got == json.loads(dumps(seen[0].to_dict()))

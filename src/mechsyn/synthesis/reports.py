@@ -23,7 +23,7 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 
 __all__ = ["select_case", "path_synthesis", "mechanism_synthesis", "path_mechanism_dict", "MotionReport", "motion_report",
-           "motion_mechanism_dict", "curve_candidate_files"]
+           "motion_mechanism_dict", "curve_candidate_files", "CurveDatabaseReport", "curve_database"]
 
 C = TypeVar("C")
 
@@ -241,3 +241,44 @@ def curve_candidate_files(res: Any) -> list[tuple[str, dict[str, Any], str]]:
             f"input {d['input']['joint']} from {d['input']['start']:.3f} to {d['input']['stop']:.3f} deg; "
             f"chamfer {100 * c.chamfer:.3f} %, ordered {100 * c.ordered:.3f} % of the target's diagonal")))
     return out
+
+
+@dataclass(repr=False)
+class CurveDatabaseReport(Result):
+    """What a curve database holds: its directory, topologies, curves (closed curves and
+    open arcs) and size on disk."""
+
+    database: str
+    topologies: int
+    curves: int
+    closed: int
+    open: int
+    bytes: int
+
+
+def curve_database(directory: Any = None, *, max_links: int = 6, per_topology: int = 3000, seed: int = 0,
+                   scheduler: Any = None, callback: Callable[[dict], None] | None = None) -> CurveDatabaseReport:
+    """Build or extend the curve database of :func:`mechsyn.synthesis.curves.synthesis.synthesize_curve`
+    (see :func:`mechsyn.synthesis.curves.database.build_database`) and say what it holds.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from mechsyn.synthesis.reports import curve_database
+    >>> r = curve_database(tempfile.mkdtemp(), max_links=4, per_topology=20)
+    >>> r.topologies, r.curves, r.closed + r.open
+    (1, 20, 20)
+    """
+    from pathlib import Path
+
+    from mechsyn.synthesis.curves.database import build_database, load_database
+
+    if max_links not in (4, 6, 8):
+        raise MechsynInputError(f"{max_links} links: choose 4, 6 or 8", field="max_links")
+    if per_topology < 1:
+        raise MechsynInputError("must be at least 1", field="per_topology")
+    path = build_database(directory, max_links=max_links, per_topology=per_topology, seed=seed,
+                          callback=callback, scheduler=scheduler)
+    db = load_database(path, max_links=max_links, build_if_missing=False)
+    return CurveDatabaseReport(str(path), len(db.topologies), len(db), int(db.closed.sum()),
+                               int((~db.closed).sum()), sum(f.stat().st_size for f in Path(path).glob("*.npz")))
