@@ -113,3 +113,25 @@ def test_curves_build_and_synth_curve_json_are_the_reports(cli_json, monkeypatch
     target.write_text(json.dumps({"points": np.c_[3 * np.cos(t), np.sin(t)].tolist(), "closed": True}))
     got = cli_json("synth", "curve", target, "--max-links", "4", "--top", "1", "--time-limit", "3", "--database", db)
     assert len(seen) == 1 and got == json.loads(dumps(seen[0].to_dict()))
+
+
+ARM = EXAMPLES / "capability/paper004_3r.yaml"
+
+
+def test_capability_point_json_is_the_report(cli_json):
+    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.point import capability_at
+
+    report = capability_at(load_arm(ARM), [1300.0, 900.0], [2.0, 1.0], polytope=True)
+    same_json(cli_json, ["capability", ARM, "--point", "1300,900", "--direction", "2,1", "--polytope"], report)
+
+
+def test_capability_grid_json_is_the_report(cli_json):
+    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.maps import capability_grid
+
+    grid = np.arange(900.0, 1301.0, 100.0)
+    report = capability_grid(load_arm(ARM), grid, grid, [2.0, 1.0], interpolate=(1050.0, 1010.0))
+    assert report.interpolated["q_deg"] is not None
+    same_json(cli_json, ["capability", ARM, "--grid", "900:1300:100,900:1300:100", "--direction", "2,1",
+                         "--interpolate", "1050,1010"], report)

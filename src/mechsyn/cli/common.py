@@ -146,7 +146,7 @@ PARAMETER_OPTIONS: dict[str, str] = {
     "crank": "--crank", "database": "--database", "scheduler": "--scheduler", "pose": "--pose", "paths": "--path",
     "sweep": "--sweep", "width": "--width", "hole_diameter": "--hole", "clearance": "--clearance",
     "width/hole_diameter/clearance": "--width/--hole/--clearance", "dxf": "--dxf", "vll_modes": "--vll",
-    "per_topology": "--per-topology",
+    "per_topology": "--per-topology", "interpolate": "--interpolate", "z": "--z", "grid": "--grid",
 }
 
 

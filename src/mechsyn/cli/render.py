@@ -258,3 +258,86 @@ def render_curve_synthesis(res: Any) -> None:
                   + ("; interrupted: best so far" if res.interrupted else ""))
     for n in res.notes:
         console.print(f"note: {n}")
+
+
+def _configuration_table(arm: Any, res: Any) -> tuple[Any, list[int]]:
+    """The table of configurations (the best 12 of many) and the indices shown."""
+    from rich import box
+
+    from mechsyn.capability.measures import MEASURES
+
+    configs = res.configurations
+    table = Table(box=box.SIMPLE_HEAD, pad_edge=False, title=f"{arm.name}: speed along "
+                  f"({', '.join(f'{c:g}' for c in np.round(res.direction, 4))}) at ({', '.join(f'{c:g}' for c in res.point)})")
+    table.add_column("")
+    for name in arm.joint_names:
+        table.add_column(name, justify="right", no_wrap=True, min_width=6)
+    for head in ("exact", "compon.", "min-nrm", "st.mn", "stepped"):
+        table.add_column(head, justify="right", no_wrap=True)
+    shown = list(range(len(configs)))
+    if len(configs) > 15:  # many IK solutions (spatial arms): the best ones
+        shown = sorted(np.argsort([-c[res.measure] for c in configs], kind="stable")[:12].tolist())
+    for k in shown:
+        c, best = configs[k], k == res.best_index
+        table.add_row("best" if best else "", *[f"{v:.1f}" for v in c["q_deg"]],
+                      *[f"{c[mn]:.2f}" for mn in MEASURES], style="bold green" if best else None)
+    if res.continuous_best:
+        cb = res.continuous_best
+        table.add_row("cont", *[f"{v:.1f}" for v in cb["q_deg"]], *[f"{cb[mn]:.2f}" for mn in MEASURES], style="cyan")
+    return table, shown
+
+
+def render_point_capability(arm: Any, res: Any, step: float) -> None:
+    """``mechsyn capability --point``: every configuration's joints and measures, the best marked."""
+    from rich.console import Console
+
+    from mechsyn.capability.point import MEASURE_HELP
+
+    measure, configs, cb = res.measure, res.configurations, res.continuous_best
+    table, shown = _configuration_table(arm, res)
+    need = 12 + 8 * arm.n + 50
+    (console if console.is_terminal or console.width >= need else Console(width=need)).print(table)
+    if len(shown) < len(configs):
+        console.print(f"showing the best {len(shown)} of {len(configs)} configurations (all with --json)")
+    if not configs:
+        console.print("[yellow]no allowed configuration reaches this point[/]")
+    else:
+        console.print(f"best sampled ({measure}): {configs[res.best_index][measure]:.3f}"
+                      + (f"; continuous search over the self-motion (cont): {cb[measure]:.3f}" if cb else ""))
+    for r in res.rejected:
+        console.print(f"rejected q = ({', '.join(f'{v:.2f}' for v in r['q_deg'])}): {r['reason']}")
+    console.print("[dim]exact: " + MEASURE_HELP["exact"] + "; compon.: " + MEASURE_HELP["component"]
+                  + "; min-nrm: " + MEASURE_HELP["min_norm"] + "; st.mn / stepped: the paper's "
+                  f"{step:g}-step raise with minimum-norm rates / with the null space in full[/]")
+
+
+def render_capability_map(cmap: Any) -> None:
+    """``mechsyn capability --grid``: the map as a table (up to 144 points), its range, the
+    interpolated configuration."""
+    xs, ys, measure = cmap.xs, cmap.ys, cmap.measure
+    v = np.where(np.isfinite(cmap.value), cmap.value, np.nan)
+    total = xs.size * ys.size
+    if total <= 144:
+        table = Table(title=f"V_max ({measure}, {cmap.search}); rows x, columns y")
+        table.add_column("x \\ y")
+        for y in ys:
+            table.add_column(f"{y:g}", justify="right")
+        for i, x in enumerate(xs):
+            table.add_row(f"{x:g}", *["-" if not np.isfinite(c) else f"{c:.2f}" for c in v[i]])
+        console.print(table)
+    if np.isfinite(v).any():
+        i, j = np.unravel_index(np.nanargmax(v), v.shape)
+        console.print(f"{total} points, {int(np.isfinite(v).sum())} reachable; V_max from "
+                      f"{np.nanmin(v):.3f} to {np.nanmax(v):.3f} (at x={xs[i]:g}, y={ys[j]:g})")
+    else:
+        console.print(f"{total} points, none reachable with the allowed configurations")
+    interp = cmap.interpolated
+    if interp is not None:
+        at = interp["point"]
+        if interp["q_deg"] is None:
+            console.print("interpolation: no optimal configuration near this point")
+        else:
+            console.print(f"interpolated optimal configuration at ({at[0]:g}, {at[1]:g}) "
+                          f"({interp['method']}): q = ({', '.join(f'{c:.3f}' for c in interp['q_deg'])})"
+                          f"; tool {interp['tool_error']:.3g} from the point (correct with IK); "
+                          f"{measure} {interp[measure]:.3f}")
