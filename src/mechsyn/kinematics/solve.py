@@ -217,7 +217,7 @@ def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
     qq = _track(S, q, u_asm, np.asarray(u, float), depth=14)
     if qq is None:
         raise MechsynInputError("the mechanism cannot reach the requested input from its file configuration",
-                                source="--input")
+                                field="inputs")
     return qq
 
 

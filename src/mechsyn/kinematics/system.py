@@ -564,13 +564,13 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
         try:
             j = mech.joint(jid)
         except KeyError:
-            raise MechsynInputError(f"no joint {jid!r}", source="--vll",
+            raise MechsynInputError(f"no joint {jid!r}", field="vll",
                                     hint=f"joints are: {', '.join(x.id for x in mech.joints)}") from None
         if j.type != "P":
             raise MechsynInputError(f"joint {jid} is a {j.type} pair; a variable-length link is a P pair",
-                                    source="--vll")
+                                    field="vll")
         if mode not in VLL_MODES:
-            raise MechsynInputError(f"unknown VLL mode {mode!r}", source="--vll",
+            raise MechsynInputError(f"unknown VLL mode {mode!r}", field="vll",
                                     hint="use locked, free (passive) or active")
         modes[jid] = VLL_MODES[mode]
 
@@ -708,7 +708,7 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
                              "(a pulley usually turns on its carrier there)")
     for jid in prescribed:
         if jid not in [d.joint for d in drivers]:
-            raise MechsynInputError(f"joint {jid} cannot be given an input", source="--input",
+            raise MechsynInputError(f"joint {jid} cannot be given an input", field="inputs",
                                     hint="inputs go to actuated joints and to free (passive) VLL joints")
     q0 = np.concatenate([q0, extra_q])
     n = len(q0)

@@ -226,7 +226,7 @@ def _dask_client(scheduler):
         from dask.distributed import Client
     except ImportError:
         raise MechsynInputError("dask.distributed is not installed", field="scheduler",
-                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+                                hint="pip install 'mechsyn[dask]' or run without a scheduler") from None
     if isinstance(scheduler, Client):
         return scheduler
     try:
