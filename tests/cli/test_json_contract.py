@@ -135,3 +135,37 @@ def test_capability_grid_json_is_the_report(cli_json):
     assert report.interpolated["q_deg"] is not None
     same_json(cli_json, ["capability", ARM, "--grid", "900:1300:100,900:1300:100", "--direction", "2,1",
                          "--interpolate", "1050,1010"], report)
+
+
+def test_analyze_json_is_the_report(cli_json):
+    from mechsyn.structure.report import analyze
+
+    report = analyze(load_mechanism(CRANK_ROCKER), remedies=True)
+    same_json(cli_json, ["analyze", CRANK_ROCKER, "--remedies"], report)
+
+
+def test_structure_json_is_the_report(cli_json):
+    from mechsyn.structure.assur import assur_decomposition
+
+    same_json(cli_json, ["structure", CRANK_ROCKER], assur_decomposition(load_mechanism(CRANK_ROCKER)))
+
+
+def test_export_json_is_the_plate_layout(cli_json):
+    from mechsyn.export.plates import link_plates
+
+    layout = link_plates(load_mechanism(CRANK_ROCKER), width=0.2, clearance=0.01, frame=False)
+    same_json(cli_json, ["export", CRANK_ROCKER, "--width", "0.2", "--clearance", "0.01", "--no-frame"], layout)
+
+
+def test_synth_groups_json_is_the_table(cli_json):
+    from mechsyn.synthesis.reports import finger_groups
+
+    same_json(cli_json, ["synth", "groups", "--base-mobility", "3", "--actuators", "1", "--max-links", "6"],
+              finger_groups(1, 6, base_mobility=3))
+
+
+def test_synth_function_json_is_the_result(cli_json):
+    from mechsyn.synthesis.exact import freudenstein_synthesis
+
+    r = freudenstein_synthesis(np.radians([30.0, 60.0, 90.0]), np.radians([100.0, 120.0, 135.0]), 2.0)
+    same_json(cli_json, ["synth", "function", "--phi", "30,60,90", "--psi", "100,120,135", "--ground", "2"], r)

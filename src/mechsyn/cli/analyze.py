@@ -48,17 +48,7 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
         t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, _fmt(f.value))
     console.print(t)
     if a.contours:
-        c = Table(title=f"Contours (paper 003, sequential reading{CONTOUR_READING[a.kind]})")
-        for col in ("#", "joints", "new pairs", "n_j", "n_k", "S_j", "idle", "T_j", "Z_j", "A_j"):
-            c.add_column(col, justify="right" if col not in ("joints", "new pairs") else "left")
-        for r in a.contours:
-            c.add_row(f"{r.index}{'' if r.from_file else '*'}", " ".join(r.joints), pair_list(r.new_pairs),
-                      str(r.n_j), str(r.n_k), str(r.S), str(r.idle_mobilities), _fmt(r.T), str(r.Z), str(r.A))
-        console.print(c)
-        if a.contours_chosen_by_program:
-            console.print("  * contour chosen by the program")
-        for r in a.contours:
-            console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
+        _render_contours(a)
     console.print(
         f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
@@ -76,6 +66,20 @@ def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
     for name, sub in a.states.items():
         console.print()
         render(sub, title_prefix=f"state '{safe(name)}': ")
+
+
+def _render_contours(a: StructuralAnalysis) -> None:
+    c = Table(title=f"Contours (paper 003, sequential reading{CONTOUR_READING[a.kind]})")
+    for col in ("#", "joints", "new pairs", "n_j", "n_k", "S_j", "idle", "T_j", "Z_j", "A_j"):
+        c.add_column(col, justify="right" if col not in ("joints", "new pairs") else "left")
+    for r in a.contours:
+        c.add_row(f"{r.index}{'' if r.from_file else '*'}", " ".join(r.joints), pair_list(r.new_pairs),
+                  str(r.n_j), str(r.n_k), str(r.S), str(r.idle_mobilities), _fmt(r.T), str(r.Z), str(r.A))
+    console.print(c)
+    if a.contours_chosen_by_program:
+        console.print("  * contour chosen by the program")
+    for r in a.contours:
+        console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
 
 
 def render_remedies(remedies: list[Remedy]) -> None:

@@ -78,7 +78,11 @@ def atlas(
         emit_json(result.to_dict())
         return
     render_atlas(result, include_degenerate)
+    _say_written(result, out, mechanisms)
+
+
+def _say_written(atlas: Any, out: Path | None, mechanisms: Path | None) -> None:
     if out is not None:
         console.print(f"atlas drawn to {out}")
     if mechanisms is not None:
-        console.print(f"{result.count} mechanism files written to {mechanisms}/")
+        console.print(f"{atlas.count} mechanism files written to {mechanisms}/")

@@ -147,6 +147,7 @@ PARAMETER_OPTIONS: dict[str, str] = {
     "sweep": "--sweep", "width": "--width", "hole_diameter": "--hole", "clearance": "--clearance",
     "width/hole_diameter/clearance": "--width/--hole/--clearance", "dxf": "--dxf", "vll_modes": "--vll",
     "per_topology": "--per-topology", "interpolate": "--interpolate", "z": "--z", "grid": "--grid",
+    "base_mobility": "--base-mobility", "base": "--base",
 }
 
 

@@ -341,3 +341,37 @@ def render_capability_map(cmap: Any) -> None:
                           f"({interp['method']}): q = ({', '.join(f'{c:.3f}' for c in interp['q_deg'])})"
                           f"; tool {interp['tool_error']:.3g} from the point (correct with IK); "
                           f"{measure} {interp[measure]:.3f}")
+
+
+def render_plates(layout: Any) -> None:
+    """``mechsyn export``: one row per plate (its holes and size), then the layout's notes."""
+    from mechsyn.cli.common import err_console
+
+    t = Table(title=f"{escape(layout.mechanism)}: {len(layout.plates)} plates, width {layout.width:.4g}, "
+                    f"holes {layout.cut_diameter:.4g} (pin {layout.hole_diameter:.4g} + {layout.clearance:.4g})")
+    for col in ("link", "holes", "size"):
+        t.add_column(col)
+    for p in layout.plates:
+        t.add_row(escape(p.link), escape(", ".join(p.hole_names)), f"{p.size[0]:.4g} x {p.size[1]:.4g}")
+    console.print(t)
+    for note in layout.notes:
+        err_console.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
+
+
+def render_groups(table: Any, max_links: int) -> None:
+    """``mechsyn synth groups``: paper 000's table, one row per group size n_f."""
+    console.print(f"W0 = {table.W0}, A = {table.actuators}: W_f = -(W0 - A) = {table.W_f}; "
+                  f"the base needs m_0 = 2(W0 - 1) = {table.m_0} free leashes", highlight=False)
+    t = Table(title="Groups to attach (paper 000)")
+    for col in ("n_f", "P_f", "m_f"):
+        t.add_column(col, justify="right")
+    t.add_column("conditions")
+    by_n = {r.n_f: r for r in table.rows}
+    for n in range(1, max_links + 1):
+        r = by_n.get(n)
+        if r is None:
+            t.add_row(str(n), "-", "-", "no integer P_f")
+        else:
+            needs = f"not met (needs P_f >= {2 * (table.W0 - 1) + n - 1}, m_f >= {table.m_0})"
+            t.add_row(str(n), str(r.P_f), str(r.m_f), "met" if r.meets_conditions else needs)
+    console.print(t)

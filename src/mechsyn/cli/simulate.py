@@ -112,7 +112,7 @@ def simulate_cmd(
 ) -> None:
     """Positions, velocities and accelerations of a planar mechanism over its input."""
     from mechsyn.cli.render import render_simulation
-    from mechsyn.kinematics.report import simulation_csv, simulation_report
+    from mechsyn.kinematics.report import simulation_report
 
     _check_outputs(plot, csv_out, json_, animate)
     if method not in ("auto", "assur", "newton"):
@@ -125,20 +125,28 @@ def simulate_cmd(
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
                                    vll=_parse_pairs(vll, "--vll", False), method=method, output=output,
                                    straight=_parse_straight(straight), progress=advance)
-    if csv_out is not None:
-        write_output(csv_out, simulation_csv(report.simulation))
-    if plot is not None:
-        from mechsyn.plot.kinematics import plot_simulation
-        save_plot(plot, plot_simulation, report.simulation)
-    if animate is not None:
-        from mechsyn.plot.kinematics import animate_simulation
-        save_animation(animate, animate_simulation, report.simulation, dpi=100)
+    _write_simulation_files(report.simulation, csv_out, plot, animate)
     if is_stdout(csv_out):
         return
     if json_:
         emit_json(report.to_dict())
         return
     render_simulation(report)
+
+
+def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
+    from mechsyn.kinematics.report import simulation_csv
+
+    if csv_out is not None:
+        write_output(csv_out, simulation_csv(sim))
+    if plot is not None:
+        from mechsyn.plot.kinematics import plot_simulation
+
+        save_plot(plot, plot_simulation, sim)
+    if animate is not None:
+        from mechsyn.plot.kinematics import animate_simulation
+
+        save_animation(animate, animate_simulation, sim, dpi=100)
 
 
 @app.command("forces")

@@ -100,16 +100,11 @@ def synth_function(
     if not ground > 0:
         raise MechsynInputError("must be positive", source="--ground")
     r = freudenstein_synthesis(ph, ps, ground)
-    data = {"design": r.design, "K": r.K, "branch": r.branch, "phi_deg": np.degrees(r.phi),
-            "psi_deg": np.degrees(r.psi), "psi_simulated_deg": np.degrees(r.psi_simulated),
-            "max_error_deg": np.degrees(r.max_error), "branch_defect": r.branch_defect,
-            "order_defect": r.order_defect, "grashof": r.grashof, "notes": r.notes,
-            "verified": bool(r.max_error < 1e-8 and not r.branch_defect and not r.order_defect)}
     if out is not None:
         write_mechanism_file(fourbar_mechanism_dict(r.r1, r.r2, r.r3, r.r4, float(r.phi[0]), branch=r.branch,
                                                     name="Four-bar function generator (Freudenstein)"), out)
     if as_json:
-        emit_json(data)
+        emit_json(r.to_dict())
         return
     t = Table(title="Freudenstein 3-position function generation")
     for c in ("position", "phi [deg]", "psi required", "psi simulated"):

@@ -23,7 +23,7 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 
 __all__ = ["select_case", "path_synthesis", "mechanism_synthesis", "path_mechanism_dict", "MotionReport", "motion_report",
-           "motion_mechanism_dict", "curve_candidate_files", "CurveDatabaseReport", "curve_database"]
+           "motion_mechanism_dict", "finger_groups", "curve_candidate_files", "CurveDatabaseReport", "curve_database"]
 
 C = TypeVar("C")
 
@@ -282,3 +282,36 @@ def curve_database(directory: Any = None, *, max_links: int = 6, per_topology: i
     db = load_database(path, max_links=max_links, build_if_missing=False)
     return CurveDatabaseReport(str(path), len(db.topologies), len(db), int(db.closed.sum()),
                                int((~db.closed).sum()), sum(f.stat().st_size for f in Path(path).glob("*.npz")))
+
+
+def finger_groups(actuators: int = 1, max_links: int = 5, *, base_mobility: int | None = None,
+                  base: Any = None) -> Any:
+    """Paper 000's table of groups to attach to a finger whose base has mobility
+    ``base_mobility`` (or that of the planar mechanism ``base``, by Chebyshev's formula) to
+    make it fully actuated by ``actuators`` drives (see :func:`mechsyn.synthesis.groups.group_table`).
+
+    Examples
+    --------
+    >>> from mechsyn.synthesis.reports import finger_groups
+    >>> [(r.n_f, r.P_f, r.m_f) for r in finger_groups(1, 3, base_mobility=2).rows]
+    [(1, 2, 2), (3, 5, 3)]
+    >>> finger_groups(2, base_mobility=2)
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: base_mobility: W0 = 2 is not larger than the 2 drive(s): the finger is already fully actuated, nothing to attach
+    """
+    from mechsyn.structure.analysis import analyze_structure
+    from mechsyn.synthesis.groups import group_table
+
+    if (base_mobility is None) == (base is None):
+        raise MechsynInputError("give exactly one of base_mobility and base", field="base_mobility",
+                                hint="e.g. base_mobility = 2")
+    w0 = base_mobility
+    if base is not None:
+        if base.kind != "planar":
+            raise MechsynInputError("paper 000's count is for planar fingers", field="base")
+        w0 = int(analyze_structure(base).formulas["chebyshev"].value)
+    if w0 <= actuators:
+        raise MechsynInputError(f"W0 = {w0} is not larger than the {actuators} drive(s): the finger is "
+                                "already fully actuated, nothing to attach", field="base_mobility")
+    return group_table(w0, actuators, max_links)
