@@ -22,23 +22,7 @@ CLI_MAX = 40
 
 # "module path relative to src/mechsyn: qualified function name" -> lines when listed
 LIBRARY_EXCEPTIONS: dict[str, int] = {}
-CLI_EXCEPTIONS: dict[str, int] = {
-    # the command line (branch cli)
-    "cli/analyze.py:render": 43,
-    "cli/atlas.py:atlas": 136,
-    "cli/capability.py:_grid": 77,
-    "cli/capability.py:capability": 75,
-    "cli/export.py:export_cmd": 73,
-    "cli/main.py:main": 48,
-    "cli/simulate.py:_render_simulation": 49,
-    "cli/simulate.py:forces_cmd": 89,
-    "cli/simulate.py:simulate_cmd": 91,
-    "cli/synth_curve.py:synth_curve": 74,
-    "cli/synth_groups.py:groups": 42,
-    "cli/synth_mechanism.py:synth_mechanism": 75,
-    "cli/synth_path.py:synth_motion": 46,
-    "cli/synth_path.py:synth_path": 94,
-}
+CLI_EXCEPTIONS: dict[str, int] = {}
 
 
 def function_lengths(root: Path = PACKAGE) -> dict[str, int]:

@@ -58,10 +58,10 @@ __all__ = ["run_tasks", "dask_client", "check_parallel_options"]
 def check_parallel_options(workers: int, scheduler: Any) -> None:
     """The CLI's check of ``--workers`` / ``--scheduler`` (one clear line on bad input)."""
     if workers < 1:
-        raise MechsynInputError("must be at least 1", source="--workers")
+        raise MechsynInputError("must be at least 1", field="workers")
     if scheduler is not None and workers > 1:
-        raise MechsynInputError("give --workers or --scheduler, not both", source="--workers",
-                                hint="the cluster's own workers run the tasks with --scheduler")
+        raise MechsynInputError("give workers or a scheduler, not both", field="workers",
+                                hint="the cluster's own workers run the tasks with a scheduler")
 
 
 def connect_timeout() -> float:
@@ -82,14 +82,14 @@ def dask_client(scheduler: Any):
     try:
         from dask.distributed import Client
     except ImportError:
-        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
-                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+        raise MechsynInputError("dask.distributed is not installed", field="scheduler",
+                                hint="pip install 'mechsyn[dask]' or run without a scheduler") from None
     if isinstance(scheduler, Client):
         return scheduler, False
     try:
         return Client(scheduler, timeout=connect_timeout()), True
     except (OSError, TimeoutError, ValueError) as exc:
-        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", field="scheduler",
                                 hint="give the address printed by dask-scheduler, "
                                      "e.g. tcp://127.0.0.1:8786") from None
 

@@ -18,11 +18,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from mechsyn._result import Result
+from mechsyn.errors import MechsynInputError
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
 from mechsyn.capability.measures import (
     MEASURES, component_limit, exact_limit, min_norm_limit, stepped_limit,
@@ -303,6 +305,8 @@ class CapabilityMap(Result):
     q: np.ndarray
     joint_names: tuple[str, ...]
     joint_is_revolute: np.ndarray
+    #: the optimal configuration interpolated at a point (see :func:`capability_grid`)
+    interpolated: dict[str, Any] | None = field(default=None, repr=False)
 
     def q_user(self) -> np.ndarray:
         """Optimal joint values in file units (degrees for R joints)."""
@@ -312,7 +316,8 @@ class CapabilityMap(Result):
         v = np.where(np.isfinite(self.value), self.value, np.nan)
         return {"x": self.xs, "y": self.ys, "z": self.z, "direction": self.direction,
                 "measure": self.measure, "search": self.search,
-                "v_max": v, "q_opt": self.q_user(), "joints": list(self.joint_names)}
+                "v_max": v, "q_opt": self.q_user(), "joints": list(self.joint_names),
+                **({} if self.interpolated is None else {"interpolated": self.interpolated})}
 
     def table(self) -> np.ndarray:
         """Rows ``x, y, v_max, q...`` (x outer, y inner), shape (P, 3 + n); NaN where no
@@ -489,3 +494,76 @@ def interpolate_configuration(cmap: CapabilityMap, method: str = "cubic"
         return interp(np.stack([x.ravel(), y.ravel()], -1)).reshape(*x.shape, q.shape[-1])
 
     return at
+
+
+def _interpolated(arm: SerialArm, cmap: CapabilityMap, at: np.ndarray) -> dict[str, Any]:
+    """The optimal configuration interpolated at ``at`` = (x, y), its tool error and measure."""
+    xs, ys = cmap.xs, cmap.ys
+    if not (xs.min() <= at[0] <= xs.max() and ys.min() <= at[1] <= ys.max()):
+        raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid", field="interpolate")
+    method = "cubic" if xs.size >= 4 and ys.size >= 4 else "linear"
+    qi = interpolate_configuration(cmap, method)(at[0], at[1])
+    target = at if arm.kind == "planar" else np.array([at[0], at[1], cmap.z])
+    out: dict[str, Any] = {"point": target, "method": method, "q_deg": None, "tool_error": None,
+                           cmap.measure: None}
+    if np.all(np.isfinite(qi)):
+        out.update({"q_deg": arm.to_user(qi), "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
+                    cmap.measure: float(measure_values(arm, qi[None], cmap.direction, cmap.measure)[0])})
+    return out
+
+
+def capability_grid(arm: SerialArm, xs, ys, direction, *, z: float | None = None, measure: str = "exact",
+                    q1: np.ndarray | None = None, branch: str = "negative", respect_limits: bool = True,
+                    continuous: bool = False, interpolate: Any = None,
+                    advance: Callable[[int], None] | None = None, workers: int = 1,
+                    scheduler: Any = None) -> CapabilityMap:
+    """:func:`capability_map` with its inputs checked, the chunk size fit to the inverse
+    kinematics (closed form or numeric), and the optimal configuration interpolated at
+    ``interpolate`` = (x, y) when given (``CapabilityMap.interpolated``).
+
+    Parameters
+    ----------
+    arm : SerialArm
+    xs, ys : array_like
+        The grid (finite; at most 5,000,000 points).
+    direction : array_like
+        Direction of motion, finite and non-zero.
+    z : float, optional
+        The grid's plane z = const; required for spatial arms.
+    measure, q1, branch, respect_limits, continuous, advance, workers, scheduler
+        As for :func:`capability_map`.
+    interpolate : array_like, optional
+        A point (x, y) inside the grid.
+
+    Returns
+    -------
+    CapabilityMap
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.capability.maps import capability_grid
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> m = capability_grid(arm, [900.0, 1000.0], [900.0, 1000.0], [1, 0], interpolate=(950, 950))
+    >>> m.interpolated["method"], m.interpolated["tool_error"] < 50
+    ('linear', True)
+    """
+    xs, ys, d = (np.asarray(v, float) for v in (xs, ys, direction))
+    if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(ys))):
+        raise MechsynInputError("values must be finite", field="grid")
+    if xs.size * ys.size > 5_000_000:
+        raise MechsynInputError("more than 5,000,000 grid points", field="grid")
+    if arm.kind == "spatial" and z is None:
+        raise MechsynInputError("a spatial arm's grid needs its plane", field="z",
+                                hint="give the plane of the grid, e.g. z = 400")
+    if not np.all(np.isfinite(d)) or not np.linalg.norm(d) > 0:
+        raise MechsynInputError("the direction must be a finite, non-zero vector", field="direction")
+    if measure not in MEASURES:
+        raise MechsynInputError(f"unknown measure {measure!r}", field="measure", hint=", ".join(MEASURES))
+    cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1, branch=branch,
+                          respect_limits=respect_limits, continuous=continuous,
+                          chunk=2048 if is_closed_form(arm) else 64, advance=advance,
+                          workers=workers, scheduler=scheduler)
+    if interpolate is not None:
+        cmap.interpolated = _interpolated(arm, cmap, np.asarray(interpolate, float))
+    return cmap

@@ -10,7 +10,7 @@ import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Annotated, Any, Optional, TypeVar
 
 import numpy as np
 import typer
@@ -22,6 +22,15 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.results import dumps, write_atomic
 
 T = TypeVar("T")
+
+# Options shared by several commands (the default is given where the option is used).
+SeedOpt = Annotated[int, typer.Option("--seed", help="Seed of the reproducible multi-start.")]
+TimeLimitOpt = Annotated[float, typer.Option("--time-limit", help="Wall-clock budget in seconds.")]
+RestartsOpt = Annotated[int, typer.Option("--restarts", help="Number of restarts (child seeds of --seed).")]
+OptimizerOpt = Annotated[str, typer.Option("--optimizer", help="Global optimiser (de | random | registered).")]
+WorkersOpt = Annotated[int, typer.Option("--workers", help="Run restarts in N local processes.")]
+SchedulerOpt = Annotated[Optional[str], typer.Option(
+    "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask]).")]
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 _LINK_TAG = re.compile(r"(?<!\\)\[(/?link\b)", re.IGNORECASE)  # not already escaped
@@ -130,7 +139,14 @@ PARAMETER_OPTIONS: dict[str, str] = {
     "restarts": "--restarts", "workers": "--workers", "optimizer": "--optimizer", "direction": "--direction",
     "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output",
     "output": "--output", "straight": "--straight", "n_links": "--links", "mobility": "--mobility",
-    "actuators": "--actuators", "phi/psi": "--phi/--psi",
+    "actuators": "--actuators", "phi/psi": "--phi/--psi", "case_id": "--case", "target_error": "--target-error",
+    "min_transmission": "--min-transmission-angle", "fold_margin": "--fold-margin", "top": "--top",
+    "circle_points": "--circle-points", "max_links": "--max-links", "max_link_ratio": "--max-link-ratio",
+    "crank": "--crank", "database": "--database", "scheduler": "--scheduler", "pose": "--pose", "paths": "--path",
+    "sweep": "--sweep", "width": "--width", "hole_diameter": "--hole", "clearance": "--clearance",
+    "width/hole_diameter/clearance": "--width/--hole/--clearance", "dxf": "--dxf", "vll_modes": "--vll",
+    "per_topology": "--per-topology", "interpolate": "--interpolate", "z": "--z", "grid": "--grid",
+    "base_mobility": "--base-mobility", "base": "--base",
 }
 
 
@@ -291,6 +307,28 @@ def progress_bar(description: str, total: int | None, enabled: bool = True) -> I
     ) as progress:
         task = progress.add_task(description, total=total)
         yield lambda n=1: progress.advance(task, n)
+
+
+@contextmanager
+def restart_progress(description: str, total: int, enabled: bool = True) -> Iterator[Any]:
+    """A progress bar of a multi-start search on stderr (restarts done, best error so far),
+    when ``enabled`` and stderr is a terminal. Yields ``callback(state)`` (a
+    :class:`mechsyn.synthesis.problem.Progress`) or None."""
+    if not enabled or not err_console.is_terminal:
+        yield None
+        return
+    from rich.progress import TimeElapsedColumn
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} restarts"),
+                  TextColumn("best error {task.fields[best]}"), TimeElapsedColumn(),
+                  console=err_console, transient=True) as prog:
+        task = prog.add_task(description, total=total, best="-")
+
+        def progress(state: Any) -> None:
+            best = state.best_error
+            prog.update(task, completed=state.done, best=f"{best:.6g}" if np.isfinite(best) else "-")
+
+        yield progress
 
 
 def track(items: Iterable[T], description: str, total: int | None = None) -> Iterator[T]:

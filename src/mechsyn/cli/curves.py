@@ -25,29 +25,22 @@ def curves_build(
     as_json: bool = typer.Option(False, "--json", help="Print a summary as JSON."),
 ) -> None:
     """Build or extend the curve database; rerun to resume or to add curves."""
-    from mechsyn.synthesis.curves.database import build_database, load_database
     from mechsyn.synthesis.curves.topologies import curve_topologies
+    from mechsyn.synthesis.reports import curve_database
 
-    if links not in (4, 6, 8):
+    if links not in (4, 6, 8):  # --links here, --max-links in synth curve
         raise MechsynInputError(f"{links} links: choose 4, 6 or 8", source="--links")
-    if per_topology < 1:
-        raise MechsynInputError("must be at least 1", source="--per-topology")
-    total = len(curve_topologies(links))
-    with progress_bar("curves build", total, enabled=not as_json) as advance:
+    with progress_bar("curves build", len(curve_topologies(links)), enabled=not as_json) as advance:
         seen = {"done": 0}
 
         def callback(state: dict) -> None:
             advance(state["done"] - seen["done"])
             seen["done"] = state["done"]
 
-        path = build_database(database, max_links=links, per_topology=per_topology, seed=seed,
-                              callback=callback, scheduler=scheduler)
-    db = load_database(path, max_links=links, build_if_missing=False)
-    summary = {"database": str(path), "topologies": len(db.topologies), "curves": len(db),
-               "closed": int(db.closed.sum()), "open": int((~db.closed).sum()),
-               "bytes": sum(f.stat().st_size for f in Path(path).glob("*.npz"))}
+        report = curve_database(database, max_links=links, per_topology=per_topology, seed=seed,
+                                scheduler=scheduler, callback=callback)
     if as_json:
-        emit_json(summary)
+        emit_json(report.to_dict())
         return
-    console.print(f"{summary['curves']} curves ({summary['closed']} closed, {summary['open']} open arcs) of "
-                  f"{summary['topologies']} topologies in {path} ({summary['bytes'] / 1e6:.1f} MB)")
+    console.print(f"{report.curves} curves ({report.closed} closed, {report.open} open arcs) of "
+                  f"{report.topologies} topologies in {report.database} ({report.bytes / 1e6:.1f} MB)")

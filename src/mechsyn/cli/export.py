@@ -7,7 +7,6 @@ from typing import Annotated, Optional
 
 import typer
 from rich.markup import escape
-from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import app
 from mechsyn.cli.common import (check_output_suffix, console, emit_json, err_console, is_stdout, one_stdout,
@@ -37,38 +36,75 @@ def _sweep(text: str | None):
     return {jid.strip(): input_grid(start, stop, step)}
 
 
+FileArg = Annotated[Path, typer.Argument(help="Planar mechanism file (YAML, JSON or a Pyslvs .pyslvs) with joint points.")]
+DxfOpt = Annotated[Optional[Path], typer.Option("--dxf", help="Write the link plates as DXF (needs the "
+    "`cad` extra: ezdxf).")]
+WidthOpt = Annotated[Optional[float], typer.Option("--width", help="Plate width (default: a fifth of the "
+    "shortest hole spacing).")]
+HoleOpt = Annotated[Optional[float], typer.Option("--hole", help="Pin diameter (default: 40% of the "
+    "width).")]
+ClearanceOpt = Annotated[float, typer.Option("--clearance", help="Added to the pin diameter for the cut "
+    "holes.")]
+FrameOpt = Annotated[bool, typer.Option("--frame/--no-frame", help="Cut the frame's plate too.")]
+SheetWidthOpt = Annotated[Optional[float], typer.Option("--sheet-width", help="Width of the sheet the rows "
+    "of plates fill.")]
+SvgOpt = Annotated[Optional[Path], typer.Option("--svg", help="Write the plates as SVG (cut lines, holes, "
+    "labels; - for stdout).")]
+DrawingOpt = Annotated[Optional[Path], typer.Option("--drawing", help="Write an SVG drawing of the mechanism at "
+    "a pose, with --path and --dimensions.")]
+PoseOpt = Annotated[Optional[list[str]], typer.Option("--pose", help="Driven joint value of the drawing: J=V "
+    "(deg for R, length for P; default: the file's).")]
+PathOpt = Annotated[Optional[list[str]], typer.Option("--path", help="Draw the path of this point (a name from "
+    "`points:` or a joint id) over --sweep.")]
+SweepOpt = Annotated[Optional[str], typer.Option("--sweep", help="Input range of the paths: "
+    "J=START:STOP:STEP.")]
+DimensionsOpt = Annotated[bool, typer.Option("--dimensions", help="Write the bar lengths on the drawing.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print the plates (hole centres, sizes) as JSON.")]
+
+
 @app.command("export")
 def export_cmd(
-    file: Annotated[Path, typer.Argument(help="Planar mechanism file (YAML, JSON or a Pyslvs .pyslvs) with joint points.")],
-    dxf: Annotated[Optional[Path], typer.Option("--dxf", help="Write the link plates as DXF (needs the "
-                                                "`cad` extra: ezdxf).")] = None,
-    width: Annotated[Optional[float], typer.Option("--width", help="Plate width (default: a fifth of the "
-                                                   "shortest hole spacing).")] = None,
-    hole: Annotated[Optional[float], typer.Option("--hole", help="Pin diameter (default: 40% of the "
-                                                  "width).")] = None,
-    clearance: Annotated[float, typer.Option("--clearance", help="Added to the pin diameter for the cut "
-                                             "holes.")] = 0.0,
-    frame: Annotated[bool, typer.Option("--frame/--no-frame", help="Cut the frame's plate too.")] = True,
-    sheet_width: Annotated[Optional[float], typer.Option("--sheet-width", help="Width of the sheet the rows "
-                                                         "of plates fill.")] = None,
-    svg: Annotated[Optional[Path], typer.Option("--svg", help="Write the plates as SVG (cut lines, holes, "
-                                                "labels; - for stdout).")] = None,
-    drawing: Annotated[Optional[Path], typer.Option("--drawing", help="Write an SVG drawing of the mechanism at "
-                                                    "a pose, with --path and --dimensions.")] = None,
-    pose: Annotated[Optional[list[str]], typer.Option("--pose", help="Driven joint value of the drawing: J=V "
-                                                      "(deg for R, length for P; default: the file's).")] = None,
-    path: Annotated[Optional[list[str]], typer.Option("--path", help="Draw the path of this point (a name from "
-                                                      "`points:` or a joint id) over --sweep.")] = None,
-    sweep: Annotated[Optional[str], typer.Option("--sweep", help="Input range of the paths: "
-                                                 "J=START:STOP:STEP.")] = None,
-    dimensions: Annotated[bool, typer.Option("--dimensions", help="Write the bar lengths on the drawing.")] = False,
-    json_: Annotated[bool, typer.Option("--json", help="Print the plates (hole centres, sizes) as JSON.")] = False,
+    file: FileArg,
+    dxf: DxfOpt = None,
+    width: WidthOpt = None,
+    hole: HoleOpt = None,
+    clearance: ClearanceOpt = 0.0,
+    frame: FrameOpt = True,
+    sheet_width: SheetWidthOpt = None,
+    svg: SvgOpt = None,
+    drawing: DrawingOpt = None,
+    pose: PoseOpt = None,
+    path: PathOpt = None,
+    sweep: SweepOpt = None,
+    dimensions: DimensionsOpt = False,
+    json_: JsonOpt = False,
 ) -> None:
     """Link plates with joint holes, laid out flat on a sheet, for a laser cutter or CNC; a
     vector drawing of the mechanism at a pose with its paths."""
+    from mechsyn.cli.render import render_plates
     from mechsyn.export.plates import link_plates
     from mechsyn.io.convert import load_any
 
+    _check_outputs(dxf, svg, drawing, json_)
+    mech = load_any(file)
+    if drawing is not None:
+        _write_drawing(mech, drawing, pose, path, sweep, dimensions)
+        if dxf is None and svg is None and not json_:
+            return
+    layout = link_plates(mech, width=width, hole_diameter=hole, clearance=clearance, frame=frame,
+                         sheet_width=sheet_width)
+    _write_plates(layout, dxf, svg)
+    if is_stdout(svg):
+        return
+    if json_:
+        emit_json(layout.to_dict())
+        return
+    render_plates(layout)
+    if dxf is not None:
+        console.print(f"wrote {escape(str(dxf))} (sheet {layout.sheet[0]:.4g} x {layout.sheet[1]:.4g})")
+
+
+def _check_outputs(dxf: Optional[Path], svg: Optional[Path], drawing: Optional[Path], json_: bool) -> None:
     check_output_suffix(dxf, (".dxf",), "--dxf")
     check_output_suffix(svg, (".svg",), "--svg")
     check_output_suffix(drawing, (".svg",), "--drawing")
@@ -76,17 +112,17 @@ def export_cmd(
     if dxf is None and svg is None and drawing is None and not json_:
         raise MechsynInputError("nothing to export", source="--dxf",
                                 hint="add --dxf parts.dxf, --svg parts.svg, --drawing mech.svg or --json")
-    mech = load_any(file)
-    if drawing is not None:
-        from mechsyn.export.drawing import drawing_of
 
-        write_output(drawing, drawing_of(mech, _values(pose), path or [], _sweep(sweep), dimensions))
-        if not is_stdout(drawing):
-            err_console.print(f"wrote {escape(str(drawing))}", highlight=False)
-        if dxf is None and svg is None and not json_:
-            return
-    layout = link_plates(mech, width=width, hole_diameter=hole, clearance=clearance, frame=frame,
-                         sheet_width=sheet_width)
+
+def _write_drawing(mech, drawing: Path, pose, path, sweep, dimensions: bool) -> None:
+    from mechsyn.export.drawing import drawing_of
+
+    write_output(drawing, drawing_of(mech, _values(pose), path or [], _sweep(sweep), dimensions))
+    if not is_stdout(drawing):
+        err_console.print(f"wrote {escape(str(drawing))}", highlight=False)
+
+
+def _write_plates(layout, dxf: Optional[Path], svg: Optional[Path]) -> None:
     if dxf is not None:
         from mechsyn.export.dxf import write_dxf
 
@@ -95,19 +131,3 @@ def export_cmd(
         from mechsyn.export.svg import plates_svg
 
         write_output(svg, plates_svg(layout))
-    if is_stdout(svg):
-        return
-    if json_:
-        emit_json(layout)
-        return
-    t = Table(title=f"{escape(layout.mechanism)}: {len(layout.plates)} plates, width {layout.width:.4g}, "
-                    f"holes {layout.cut_diameter:.4g} (pin {layout.hole_diameter:.4g} + {layout.clearance:.4g})")
-    for col in ("link", "holes", "size"):
-        t.add_column(col)
-    for p in layout.plates:
-        t.add_row(escape(p.link), escape(", ".join(p.hole_names)), f"{p.size[0]:.4g} x {p.size[1]:.4g}")
-    console.print(t)
-    for note in layout.notes:
-        err_console.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
-    if dxf is not None:
-        console.print(f"wrote {escape(str(dxf))} (sheet {layout.sheet[0]:.4g} x {layout.sheet[1]:.4g})")

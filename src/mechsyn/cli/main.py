@@ -110,26 +110,9 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:  # typer.Exit inside commands
         return _exit(int(exc.code or 0), argv)
     except Exception as exc:  # click's (typer's vendored click's) own exceptions
-        name = type(exc).__name__
-        if name == "Abort":  # click's wrapping of Ctrl-C
-            status = _INTERRUPTED
-        elif hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
-            if name == "NoArgsIsHelpError" or not hasattr(exc, "format_message"):
-                exc.show()  # the help text itself
-            else:  # one line: where, what, and the fix
-                from rich.markup import escape
-
-                from mechsyn.cli.common import err_console
-
-                ctx = getattr(exc, "ctx", None)
-                where = ctx.command_path if ctx is not None else "mechsyn"
-                err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(exc.format_message())} "
-                                  f"(fix: see '{escape(where)} -h')", highlight=False, soft_wrap=True)
-            return _exit(int(exc.exit_code), argv)
-        elif hasattr(exc, "exit_code"):  # Exit
-            return _exit(int(exc.exit_code), argv)
-        else:
-            raise
+        if type(exc).__name__ != "Abort":  # Abort: click's wrapping of Ctrl-C
+            return _exit(_click_error(exc), argv)
+        status = _INTERRUPTED
     if isinstance(status, int) and not isinstance(status, bool) and status != 0:
         if status == _INTERRUPTED:  # searches wrote their best so far before this
             from mechsyn.cli.common import err_console
@@ -137,6 +120,27 @@ def main(argv: list[str] | None = None) -> int:
             err_console.print("interrupted", highlight=False)
         return _exit(status, argv)
     return _exit(0, argv)
+
+
+def _click_error(exc: Exception) -> int:
+    """Show one of click's exceptions (usage errors in one line: where, what, the fix) and
+    return its exit status; re-raise anything else."""
+    if hasattr(exc, "exit_code") and hasattr(exc, "show"):  # UsageError and friends
+        if type(exc).__name__ == "NoArgsIsHelpError" or not hasattr(exc, "format_message"):
+            exc.show()  # the help text itself
+        else:
+            from rich.markup import escape
+
+            from mechsyn.cli.common import err_console
+
+            ctx = getattr(exc, "ctx", None)
+            where = ctx.command_path if ctx is not None else "mechsyn"
+            err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(exc.format_message())} "
+                              f"(fix: see '{escape(where)} -h')", highlight=False, soft_wrap=True)
+        return int(exc.exit_code)
+    if hasattr(exc, "exit_code"):  # Exit
+        return int(exc.exit_code)
+    raise exc
 
 
 def _exit(code: int, argv: list[str] | None) -> int:

@@ -3,152 +3,83 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
+from typing import Annotated, Optional
 
 import numpy as np
 import typer
-from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, check_writable, console, emit_json, err_console, parse_floats, save_plot, stop_if_interrupted
+from mechsyn.cli.common import (OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, Table, TimeLimitOpt, WorkersOpt,
+                                check_output_suffix, check_writable, console, emit_json, parse_floats,
+                                restart_progress, save_plot, stop_if_interrupted)
 from mechsyn.errors import MechsynInputError
 
-
-def _pick_case(file: Path, case_id: Optional[str]):
-    from mechsyn.synthesis.path import load_cases
-
-    cases = load_cases(file)
-    if case_id is None:
-        if len(cases) == 1:
-            return cases[0]
-        raise MechsynInputError(
-            f"the file holds {len(cases)} cases", source=str(file),
-            hint="choose one with --case " + " | ".join(c.id for c in cases))
-    for c in cases:
-        if c.id == case_id:
-            return c
-    raise MechsynInputError(f"no case {case_id!r}", source="--case",
-                            hint="one of " + ", ".join(c.id for c in cases))
+TargetErrorOpt = Annotated[Optional[float], typer.Option(
+    "--target-error", help="Stop once a design reaches this error (default: the case's best known error + 1 %, "
+    "if it has one; 0: use the whole budget).")]
+MinTransmissionOpt = Annotated[Optional[float], typer.Option(
+    "--min-transmission-angle", help="Smallest transmission angle [deg] allowed over the motion (default: the "
+    "case's, else 20; 0: no limit).")]
+FoldMarginOpt = Annotated[Optional[float], typer.Option(
+    "--fold-margin", help="Grashof cases: how far [deg] the linkage must stay from folding flat anywhere in the "
+    "turn (default: the case's, else 5).")]
 
 
 @synth_app.command("path")
 def synth_path(
     case_file: Path = typer.Argument(..., help="Case JSON (schema of synthesis_cases_public.json): one case, or a file of cases with --case."),
     case_id: Optional[str] = typer.Option(None, "--case", help="Case id when the file holds several."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the reproducible multi-start."),
-    time_limit: float = typer.Option(60.0, "--time-limit", help="Wall-clock budget in seconds."),
-    restarts: int = typer.Option(10, "--restarts", help="Number of restarts (child seeds of --seed)."),
-    workers: int = typer.Option(1, "--workers", help="Run restarts in N local processes."),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask])."),
-    optimizer: str = typer.Option("de", "--optimizer", help="Global optimiser (de | random | registered)."),
-    target_error: Optional[float] = typer.Option(
-        None, "--target-error", help="Stop once a design reaches this error (default: the case's "
-        "best known error + 1 %, if it has one; 0: use the whole budget)."),
-    min_transmission: Optional[float] = typer.Option(
-        None, "--min-transmission-angle", help="Smallest transmission angle [deg] allowed over "
-        "the motion (default: the case's, else 20; 0: no limit)."),
-    fold_margin: Optional[float] = typer.Option(
-        None, "--fold-margin", help="Grashof cases: how far [deg] the linkage must stay from "
-        "folding flat anywhere in the turn (default: the case's, else 5)."),
+    seed: SeedOpt = 0,
+    time_limit: TimeLimitOpt = 60.0,
+    restarts: RestartsOpt = 10,
+    workers: WorkersOpt = 1,
+    scheduler: SchedulerOpt = None,
+    optimizer: OptimizerOpt = "de",
+    target_error: TargetErrorOpt = None,
+    min_transmission: MinTransmissionOpt = None,
+    fold_margin: FoldMarginOpt = None,
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
 ) -> None:
     """Path generation: a four-bar whose coupler point passes through the targets."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
+    from mechsyn.cli.render import render_path_synthesis
     from mechsyn.parallel import check_parallel_options
-    from mechsyn.plot.synthesis import plot_fourbar_path
-    from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
-    from mechsyn.synthesis.optimize import default_target_error, synthesize_path
+    from mechsyn.synthesis.path import load_cases
+    from mechsyn.synthesis.reports import path_synthesis, select_case
 
-    if time_limit <= 0:
-        raise MechsynInputError("must be positive", source="--time-limit")
-    if restarts < 1:
-        raise MechsynInputError("must be at least 1", source="--restarts")
     check_parallel_options(workers, scheduler)
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
-    case = _pick_case(case_file, case_id)
-    case = _with_margins(case, min_transmission, fold_margin)
-    if target_error is None:
-        target_error = default_target_error(case)
-    elif target_error < 0:
-        raise MechsynInputError("must be >= 0 (0: use the whole budget)", source="--target-error")
-    target_error = target_error or None
-    show = err_console.is_terminal
-    if show:
-        with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} restarts"),
-                      TextColumn("best error {task.fields[best]}"), TimeElapsedColumn(),
-                      console=err_console, transient=True) as prog:
-            task = prog.add_task(f"synth path {case.id}", total=restarts, best="-")
-
-            def progress(state):
-                best = state.best_error
-                prog.update(task, completed=state.done, best=f"{best:.6g}" if np.isfinite(best) else "-")
-
-            res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                                  optimizer=optimizer, callback=progress, scheduler=scheduler,
-                                  target_error=target_error)
-    else:
-        res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                              optimizer=optimizer, scheduler=scheduler, target_error=target_error)
-    d = {**case.fixed, **res.design}
-    if out is not None:
-        if not res.feasible:
-            raise MechsynInputError("no feasible design found; nothing written", source="--out",
-                                    hint="raise --time-limit or --restarts, or widen the bounds")
-        mech = fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(res.theta2[0]), branch=case.branch,
-                                      rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
-                                      name=f"Four-bar for path case {case.id}")
-        write_mechanism_file(mech, out, header=(
-            ("INTERRUPTED (Ctrl-C): the best design found before the interrupt\n" if res.interrupted else "")
-            + f"mechsyn synth path {case.id}: error {res.error:.6g} (sum of squared distances), seed {seed}\n"
-            f"joint points at target 1 (crank angle {np.degrees(res.theta2[0]):.4f} deg), branch {case.branch}"))
-    if plot is not None:
-        save_plot(plot, plot_fourbar_path, d, case.targets, res.theta2, case.branch, dpi=120,
-                  title=f"{case.id}: error {res.error:.4g}"
-                  + (f" (published best {case.best_known:.4g})" if case.best_known else ""))
+    case = select_case(load_cases(case_file), case_id, source=str(case_file))
+    with restart_progress(f"synth path {case.id}", restarts) as progress:
+        res = path_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
+                             scheduler=scheduler, optimizer=optimizer, target_error=target_error,
+                             min_transmission=min_transmission, fold_margin=fold_margin, callback=progress)
+    _write_path_files(case, res, out, plot)
     if as_json:
-        emit_json(res)
-        stop_if_interrupted(res)
-        return
-    t = Table(title=f"Path synthesis {case.id}" + (" (interrupted: best so far)" if res.interrupted else ""))
-    t.add_column("variable")
-    t.add_column("value", justify="right")
-    for k, v in res.design.items():
-        t.add_row(k, f"{v:.8g}")
-    console.print(t)
-    console.print(f"error (sum of squared distances): [bold]{res.error:.8g}[/]"
-                  + (f"   published best: {case.best_known:.8g}" if case.best_known else ""))
-    console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
-                  f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
-                  + ("   (target error reached)" if res.target_reached else ""))
-    console.print(_transmission_line(res))
+        emit_json(res.to_dict())
+    else:
+        render_path_synthesis(case, res)
     stop_if_interrupted(res)
 
 
-def _with_margins(case, min_transmission: Optional[float], fold_margin: Optional[float]):
-    from dataclasses import replace
+def _write_path_files(case, res, out: Optional[Path], plot: Optional[Path]) -> None:
+    from mechsyn.synthesis.export import write_mechanism_file
+    from mechsyn.synthesis.reports import path_mechanism_dict
 
-    for value, option in ((min_transmission, "--min-transmission-angle"), (fold_margin, "--fold-margin")):
-        if value is not None and not 0.0 <= value < 90.0:
-            raise MechsynInputError("must be an angle in degrees in [0, 90)", source=option)
-    if min_transmission is not None:
-        case = replace(case, transmission_angle_min_deg=min_transmission)
-    if fold_margin is not None:
-        case = replace(case, fold_margin_deg=fold_margin)
-    return case
+    if out is not None:
+        try:
+            mech, header = path_mechanism_dict(case, res)
+        except MechsynInputError as exc:
+            raise exc.with_source("--out") from None
+        write_mechanism_file(mech, out, header=header)
+    if plot is not None:
+        from mechsyn.plot.synthesis import plot_fourbar_path
 
-
-def _transmission_line(res) -> str:
-    mu = res.worst_transmission_angle_deg
-    text = (f"worst transmission angle over the motion: {mu:.2f} deg"
-            + (f" (limit {res.transmission_angle_min_deg:g})" if res.transmission_angle_min_deg else ""))
-    if res.fold_distance_deg is not None:
-        text += f"\nnearest approach to folding flat: {res.fold_distance_deg:.2f} deg"
-        text += f" (limit {res.fold_margin_deg:g})" if res.fold_margin_deg else ""
-    return text
+        save_plot(plot, plot_fourbar_path, {**case.fixed, **res.design}, case.targets, res.theta2, case.branch,
+                  dpi=120, title=f"{case.id}: error {res.error:.4g}"
+                  + (f" (published best {case.best_known:.4g})" if case.best_known else ""))
 
 
 @synth_app.command("function")
@@ -169,16 +100,11 @@ def synth_function(
     if not ground > 0:
         raise MechsynInputError("must be positive", source="--ground")
     r = freudenstein_synthesis(ph, ps, ground)
-    data = {"design": r.design, "K": r.K, "branch": r.branch, "phi_deg": np.degrees(r.phi),
-            "psi_deg": np.degrees(r.psi), "psi_simulated_deg": np.degrees(r.psi_simulated),
-            "max_error_deg": np.degrees(r.max_error), "branch_defect": r.branch_defect,
-            "order_defect": r.order_defect, "grashof": r.grashof, "notes": r.notes,
-            "verified": bool(r.max_error < 1e-8 and not r.branch_defect and not r.order_defect)}
     if out is not None:
         write_mechanism_file(fourbar_mechanism_dict(r.r1, r.r2, r.r3, r.r4, float(r.phi[0]), branch=r.branch,
                                                     name="Four-bar function generator (Freudenstein)"), out)
     if as_json:
-        emit_json(data)
+        emit_json(r.to_dict())
         return
     t = Table(title="Freudenstein 3-position function generation")
     for c in ("position", "phi [deg]", "psi required", "psi simulated"):
@@ -229,38 +155,22 @@ def synth_motion(
     out: Optional[Path] = typer.Option(None, "--out", help="Write the best linkage as a mechanism file."),
 ) -> None:
     """Motion generation by Burmester theory (3, 4 or 5 poses), each linkage verified by simulation."""
-    from mechsyn.plot.synthesis import plot_motion_synthesis
-    from mechsyn.synthesis.exact import motion_synthesis, to_jsonable_motion
-    from mechsyn.synthesis.export import fourbar_mechanism_dict, write_mechanism_file
+    from mechsyn.cli.render import render_motion
+    from mechsyn.synthesis.export import write_mechanism_file
+    from mechsyn.synthesis.reports import motion_mechanism_dict, motion_report
 
     check_writable(out, "--out")
     check_writable(plot, "--plot")
     P = _read_poses(poses_file, poses)
     cp = np.array(parse_floats(circle_points, "--circle-points", 4)).reshape(2, 2) if circle_points else None
     mp = np.array(parse_floats(center_points, "--center-points", 4)).reshape(2, 2) if center_points else None
-    if (cp is not None or mp is not None) and len(P) != 3:
-        raise MechsynInputError("circle/centre points are chosen only for 3 poses", source="--circle-points")
-    sols = motion_synthesis(P, circle_points=cp, center_points=mp)
-    if not sols:
-        raise MechsynInputError("no linkage found for these poses", source="poses")
-    best = sols[0]
+    report = motion_report(P, circle_points=cp, center_points=mp, top=top)
     if out is not None:
-        d = best.design()
-        write_mechanism_file(fourbar_mechanism_dict(
-            d["r1"], d["r2"], d["r3"], d["r4"], float(best.theta2[0]), branch=best.branch, rcx=d["rcx"], rcy=d["rcy"],
-            x0=d["x0"], y0=d["y0"], theta0=d["theta0"], name="Four-bar motion generator (Burmester)"), out,
-            header="coupler point P = origin of the guided body's frame; joints at pose 1")
+        mech, header = motion_mechanism_dict(report)
+        write_mechanism_file(mech, out, header=header)
     if plot is not None:
-        save_plot(plot, plot_motion_synthesis, P, sols, dpi=120)
+        save_plot(plot, lambda ax: report.plot(ax=ax), dpi=120)
     if as_json:
-        emit_json({"solutions": [to_jsonable_motion(s) for s in sols[:top]], "count": len(sols),
-                   "verified_count": sum(s.ok for s in sols)})
+        emit_json(report.to_dict())
         return
-    t = Table(title=f"Burmester motion generation, {len(P)} poses ({sum(s.ok for s in sols)} of {len(sols)} verified)")
-    for c in ("O2", "O4", "r1", "r2", "r3", "r4", "type", "min mu [deg]", "defects", "pos. error"):
-        t.add_column(c, justify="right")
-    for s in sols[:top]:
-        defects = ", ".join(k for k, v in (("branch", s.branch_defect), ("order", s.order_defect)) if v) or "none"
-        t.add_row(f"({s.O2[0]:.4g}, {s.O2[1]:.4g})", f"({s.O4[0]:.4g}, {s.O4[1]:.4g})", f"{s.r1:.4g}", f"{s.r2:.4g}",
-                  f"{s.r3:.4g}", f"{s.r4:.4g}", s.grashof, f"{s.min_transmission_deg:.1f}", defects, f"{s.position_error:.2e}")
-    console.print(t)
+    render_motion(report)

@@ -30,16 +30,17 @@ def drawing_of(mech: Mechanism, pose: dict[str, float] | None = None, paths: lis
 
     drivers = build_system(mech).drivers
     if not drivers:
-        raise MechsynInputError("the mechanism has no driven joint to pose it", source="--pose",
+        raise MechsynInputError("the mechanism has no driven joint to pose it", field="pose",
                                 hint="mark a joint `actuated: true`")
     home = {d.joint: (np.degrees(d.assembled) if d.type == "R" else d.assembled) for d in drivers}
     pose = dict(pose or {})
     for j in pose:
         if j not in home:
-            raise MechsynInputError(f"joint {j} is not driven", source="--pose",
+            raise MechsynInputError(f"joint {j} is not driven", field="pose",
                                     hint=f"driven joints: {', '.join(home)}")
     if paths and not sweep:
-        raise MechsynInputError("paths need an input range", source="--path", hint="add --sweep A=0:360:2")
+        raise MechsynInputError("the paths need an input range", field="sweep",
+                                hint="sweep the driven joint, e.g. A from 0 to 360 deg")
     if sweep:
         n = len(next(iter(sweep.values())))
         first = next(iter(sweep))
@@ -54,6 +55,6 @@ def drawing_of(mech: Mechanism, pose: dict[str, float] | None = None, paths: lis
         k = 0
     sim = simulate(mech, inputs, points=paths or None)
     if not sim.assembled[k]:
-        raise MechsynInputError("the mechanism does not assemble at that pose", source="--pose",
+        raise MechsynInputError("the mechanism does not assemble at that pose", field="pose",
                                 hint="choose an input inside its working range")
     return mechanism_svg(sim, k, paths, dimensions, title=mech.name)

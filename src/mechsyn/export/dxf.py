@@ -28,7 +28,7 @@ def _ezdxf():
     try:
         import ezdxf
     except ImportError:
-        raise MechsynInputError("DXF export needs ezdxf", source="--dxf",
+        raise MechsynInputError("DXF export needs ezdxf", field="dxf",
                                 hint="pip install 'mechsyn[cad]'") from None
     return ezdxf
 

@@ -248,18 +248,18 @@ def _plate_sizes(holes: list[_Marks], width: float | None, hole_diameter: float 
     if width is None:
         positive = [s for s in spans if s > 0]
         if not positive:
-            raise MechsynInputError("no link has two holes to size the plates from", source="--width",
-                                    hint="give --width")
+            raise MechsynInputError("no link has two holes to size the plates from", field="width",
+                                    hint="give the plate width")
         width = min(positive) / 5
     if hole_diameter is None:
         hole_diameter = 0.4 * width
     if width <= 0 or hole_diameter <= 0 or clearance < 0:
         raise MechsynInputError("width and hole diameter must be positive, clearance not negative",
-                                source="--width/--hole/--clearance")
+                                field="width/hole_diameter/clearance")
     cut = hole_diameter + clearance
     if cut >= 0.9 * width:
         raise MechsynInputError(
-            f"holes of {cut:g} leave less than a tenth of the width {width:g} of material", source="--hole",
+            f"holes of {cut:g} leave less than a tenth of the width {width:g} of material", field="hole_diameter",
             hint=f"make the width more than {cut / 0.9:.4g} or the hole smaller")
     return width, hole_diameter
 
@@ -284,7 +284,7 @@ def _plate(n: str, hp: _Marks, mk: _Marks, cut: float, width: float) -> Plate:
         if d[i, k] < cut + 0.1 * width:
             raise MechsynInputError(
                 f"link {n}: holes {names[i]} and {names[k]} are {d[i, k]:.6g} apart, too close for "
-                f"holes of {cut:g} in a plate {width:g} wide", source="--hole",
+                f"holes of {cut:g} in a plate {width:g} wide", field="hole_diameter",
                 hint="use smaller holes or a narrower plate")
     pts = np.vstack([holes, np.array([q for _, q in mk]).reshape(-1, 2)])
     R = _rotation_to_x(pts)

@@ -72,7 +72,7 @@ def convert_file(path: str | os.PathLike[str], to: str, inputs: list[tuple[int, 
         return Conversion(str(p), to.lstrip("."), mechanism_text(mech, to == ".json"), notes)
     if src in MECHSYN_SUFFIXES and to in PYSLVS_SUFFIXES:
         if inputs:
-            raise MechsynInputError("input pairs apply to Pyslvs files being read", source="--input",
+            raise MechsynInputError("input pairs apply to Pyslvs files being read", field="inputs",
                                     hint="mark the driven joints `actuated: true` in the mechanism file")
         text, notes = pyslvs_text(mechanism_to_dict(load_mechanism(p)), str(p))
         return Conversion(str(p), "pyslvs", text, notes)

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["animation_frames"]
+__all__ = ["animation_frames", "figure_frames"]
 
 
 def animation_frames(anim: Any, dpi: float = 100) -> Iterator[np.ndarray]:
@@ -43,3 +43,24 @@ def animation_frames(anim: Any, dpi: float = 100) -> Iterator[np.ndarray]:
         for a in sorted(moving, key=lambda a: a.get_zorder()):  # stable: as a full draw orders them
             fig.draw_artist(a)
         yield np.asarray(canvas.buffer_rgba())[..., :3].copy()
+
+
+def figure_frames(animate: Any, *args: Any, dpi: float = 100, **kwargs: Any) -> Iterator[np.ndarray]:
+    """Build an animation with a :mod:`mechsyn.plot` function (``animate(*args, fig=...,
+    **kwargs)``) on a bare Figure (no pyplot, no backend) and yield its frames as RGB
+    arrays (see :func:`animation_frames`): what a server or a file writer needs, with
+    Matplotlib imported here only.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.plot.frames import figure_frames
+    >>> from mechsyn.plot.kinematics import animate_simulation
+    >>> sim = ms.simulate(ms.examples.load("crank_rocker"), {"A": ms.input_grid(0, 360, 30)})
+    >>> frames = list(figure_frames(animate_simulation, sim, dpi=20, max_frames=4))
+    >>> len(frames), frames[0].shape[2]
+    (4, 3)
+    """
+    from matplotlib.figure import Figure
+
+    yield from animation_frames(animate(*args, fig=Figure(), **kwargs), dpi)

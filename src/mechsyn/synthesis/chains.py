@@ -107,7 +107,7 @@ def _check_request(n_links: int, mobility: int) -> int:
         took = f" (roughly {minutes:.2g} CPU minutes)" if np.isfinite(minutes) else ""
         raise MechsynInputError(
             f"an atlas of {n_links} links has {about}{took}; beyond {limit('atlas_links')} links "
-            "the enumeration grows about 46-fold per two links", source="--links",
+            "the enumeration grows about 46-fold per two links", field="n_links",
             hint=f"use at most {limit('atlas_links')} links; {limit_hint('atlas_links')}")
     if n_links < 2:
         raise MechsynInputError(

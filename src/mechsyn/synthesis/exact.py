@@ -95,6 +95,21 @@ class FunctionSynthesisResult:
     def design(self) -> dict[str, float]:
         return {"r1": self.r1, "r2": self.r2, "r3": self.r3, "r4": self.r4}
 
+    @property
+    def verified(self) -> bool:
+        """Simulation meets every precision position (1e-8 rad) with neither a branch nor an
+        order defect."""
+        return bool(self.max_error < 1e-8 and not self.branch_defect and not self.order_defect)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Design, Freudenstein coefficients, the angles in degrees, defects and notes
+        (``mechsyn synth function --json``)."""
+        return {"design": self.design, "K": self.K, "branch": self.branch, "phi_deg": np.degrees(self.phi),
+                "psi_deg": np.degrees(self.psi), "psi_simulated_deg": np.degrees(self.psi_simulated),
+                "max_error_deg": np.degrees(self.max_error), "branch_defect": self.branch_defect,
+                "order_defect": self.order_defect, "grashof": self.grashof, "notes": self.notes,
+                "verified": self.verified}
+
 
 def freudenstein_coefficients(phi, psi) -> np.ndarray:
     """Solve Freudenstein's equation at three precision positions.

@@ -275,23 +275,21 @@ def simulation_csv(data: Any, steps: int = 180) -> str:
 
 
 def animation_gif(data: Any, frames: int = 72) -> bytes:
-    """The mechanism moving over its sweep as a GIF (``mechsyn.plot.animate_simulation``)."""
+    """The mechanism moving over its sweep as a GIF (``mechsyn.plot.animate_simulation``,
+    drawn by :mod:`mechsyn.plot` and written by :mod:`mechsyn.export.movie`)."""
     import tempfile
 
-    from matplotlib.animation import PillowWriter
-    from matplotlib.figure import Figure
-
+    from mechsyn.export.movie import write_gif
     from mechsyn.kinematics.analysis import simulate as _simulate
+    from mechsyn.plot.frames import figure_frames
     from mechsyn.plot.kinematics import animate_simulation
 
     mech = build(data)
     drive, values = _sweep(mech, 180, None)
     sim = _simulate(mech, {drive.id: values})
-    fig = Figure(figsize=(6, 4.5))
-    anim = animate_simulation(sim, fig=fig, max_frames=frames)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "animation.gif"
-        anim.save(str(path), writer=PillowWriter(fps=15), dpi=80)
+        write_gif(figure_frames(animate_simulation, sim, dpi=80, max_frames=frames), path, fps=15)
         return path.read_bytes()
 
 

@@ -225,14 +225,14 @@ def _dask_client(scheduler):
     try:
         from dask.distributed import Client
     except ImportError:
-        raise MechsynInputError("dask.distributed is not installed", source="--scheduler",
-                                hint="pip install 'mechsyn[dask]' or drop --scheduler") from None
+        raise MechsynInputError("dask.distributed is not installed", field="scheduler",
+                                hint="pip install 'mechsyn[dask]' or run without a scheduler") from None
     if isinstance(scheduler, Client):
         return scheduler
     try:
         return Client(scheduler, timeout=10)
     except (OSError, TimeoutError) as exc:
-        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", source="--scheduler",
+        raise MechsynInputError(f"cannot reach the Dask scheduler: {exc}", field="scheduler",
                                 hint="give the address printed by dask-scheduler, e.g. tcp://host:8786") from None
 
 
@@ -292,7 +292,7 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
     if not rows_t:
         from mechsyn.errors import MechsynInputError
 
-        raise MechsynInputError(f"no curve database in {directory}", source="--database",
+        raise MechsynInputError(f"no curve database in {directory}", field="database",
                                 hint="run `mechsyn curves build`")
     return CurveDatabase(tuple(present), np.concatenate(rows_t), designs, np.concatenate(ranges).astype(float),
                          np.concatenate(closed).astype(bool), np.concatenate(desc).astype(np.float32))

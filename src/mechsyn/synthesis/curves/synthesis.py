@@ -545,16 +545,16 @@ def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit
     if not isinstance(target, TargetCurve):
         target = target_from_points(target)
     if max_links not in (4, 6, 8):
-        raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", source="--max-links")
+        raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", field="max_links")
     if time_limit <= 0:
-        raise MechsynInputError("must be positive", source="--time-limit")
+        raise MechsynInputError("must be positive", field="time_limit")
     if top < 1:
-        raise MechsynInputError("must be at least 1", source="--top")
+        raise MechsynInputError("must be at least 1", field="top")
     if max_link_ratio is not None and not max_link_ratio > 1:
-        raise MechsynInputError("must be greater than 1", source="--max-link-ratio")
+        raise MechsynInputError("must be greater than 1", field="max_link_ratio")
     if crank and not target.closed:
         raise MechsynInputError("a crank (full turn) traces a closed curve; the target is open",
-                                source="--crank", hint="drop --crank or close the target")
+                                field="crank", hint="drop --crank or close the target")
     return target
 
 

@@ -114,7 +114,7 @@ def curve_topologies(max_links: int = 8) -> tuple[CurveTopology, ...]:
     ['Stephenson I', 'Stephenson III', 'Watt I', 'Watt II']
     """
     if max_links not in (4, 6, 8):
-        raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", source="--max-links")
+        raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", field="max_links")
     out: list[CurveTopology] = []
     for n in range(4, max_links + 1, 2):
         for ci, chain in enumerate(synthesize_chains(n, 1)):

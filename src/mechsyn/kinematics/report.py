@@ -1,0 +1,227 @@
+"""The simulation report: a :class:`~mechsyn.kinematics.analysis.Simulation` with the
+quantities a designer reads off it (transmission angles, mechanical advantage, Grashof's
+class, path extents, straightness of a path segment), and the CSV tables of a simulation
+and of a force analysis.
+
+``mechsyn simulate --json`` prints :meth:`SimulationReport.to_dict`; ``mechsyn simulate
+--csv`` writes :func:`simulation_csv`, ``mechsyn forces --csv`` :func:`forces_csv`.
+
+References
+----------
+Transmission angle, mechanical advantage and Grashof's criterion as in
+J. J. Uicker, G. R. Pennock, J. E. Shigley, *Theory of Machines and Mechanisms*, 5th ed.,
+Oxford University Press, 2017, ch. 1 and 3 (see :mod:`mechsyn.kinematics.derived`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mechsyn._result import Result
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics import derived
+from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
+from mechsyn.model.mechanism import Mechanism
+from mechsyn.results import to_jsonable
+
+__all__ = ["SimulationReport", "simulation_report", "simulation_csv", "forces_csv", "csv_text"]
+
+
+@dataclass(repr=False)
+class SimulationReport(Result):
+    """A simulation and its derived quantities.
+
+    ``derived`` holds, where they apply: ``transmission_angle`` (per dyad: values, min,
+    max in degrees), ``mechanical_advantage`` (one input: output link and values),
+    ``grashof`` (a four-bar of revolute pairs), ``extent`` (bounding box of each reported
+    point's path) and ``straightness`` (per point asked for).
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> from mechsyn.kinematics.report import simulation_report
+    >>> r = simulation_report(ms.examples.load("crank_rocker"), {"A": np.linspace(0, 360, 13)})
+    >>> r.derived["grashof"]["classification"]
+    'crank-rocker'
+    >>> sorted(r.to_dict())[:3]
+    ['assembled', 'derived', 'events']
+    """
+
+    simulation: Simulation = field(metadata={"json": False})
+    derived: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The simulation's dict with the derived quantities under ``derived``."""
+        return {**self.simulation.to_dict(), "derived": self.derived}
+
+    def plot(self, ax: Any = None, **kwargs: Any) -> Any:
+        """Draw the simulation (see :func:`mechsyn.plot.kinematics.plot_simulation`)."""
+        return self.simulation.plot(ax=ax, **kwargs)
+
+
+def _finite_or_none(values: np.ndarray) -> list[float | None]:
+    return [None if not np.isfinite(x) else float(x) for x in values]
+
+
+def _nan_stat(f: Any, values: np.ndarray) -> float | None:
+    v = np.asarray(values, float)
+    return None if not np.isfinite(v).any() else float(f(v))
+
+
+def _straightness(sim: Simulation, straight: dict[str, tuple[float, float]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    x = sim.inputs[sim.main_input]
+    for name, (a, b) in straight.items():
+        if name not in sim.points:
+            raise MechsynInputError(f"no reported point {name!r}", field="straight",
+                                    hint=f"points: {', '.join(sim.points)}")
+        sel = (x >= min(a, b)) & (x <= max(a, b))
+        out[name] = {"range": [a, b], **derived.straightness(sim.points[name].position[sel])}
+    return out
+
+
+def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = None,
+                       straight: dict[str, tuple[float, float]] | None = None) -> dict[str, Any]:
+    """Transmission angles, mechanical advantage, Grashof's class, path extents and the
+    straightness of path segments of ``sim`` (see :class:`SimulationReport`).
+
+    ``output``: the output link of the mechanical advantage (default: the last link
+    pivoted on the frame); ``straight``: point name -> (first, last) main input value.
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> from mechsyn.kinematics.report import derived_quantities
+    >>> m = ms.examples.load("crank_rocker")
+    >>> d = derived_quantities(m, ms.simulate(m, {"A": np.linspace(0, 90, 4)}))
+    >>> sorted(d)
+    ['extent', 'grashof', 'mechanical_advantage', 'transmission_angle']
+    """
+    out: dict[str, Any] = {}
+    mu = derived.transmission_angles(sim)
+    if mu:
+        out["transmission_angle"] = {k: {"values": _finite_or_none(v), "min": _nan_stat(np.nanmin, v),
+                                         "max": _nan_stat(np.nanmax, v)} for k, v in mu.items()}
+    out_link = output or derived.default_output_link(mech, list(sim.inputs))
+    if out_link is not None and len(sim.inputs) == 1:
+        ma = derived.mechanical_advantage(sim, out_link)
+        out["mechanical_advantage"] = {"output": out_link, "values": _finite_or_none(ma)}
+    if len(mech.links) == 4 and len(mech.joints) == 4 and all(j.type == "R" for j in mech.joints):
+        out["grashof"] = to_jsonable(derived.grashof(mech))
+    out["extent"] = {name: derived.path_extent(pm.position) for name, pm in sim.points.items()}
+    if straight:
+        out["straightness"] = _straightness(sim, straight)
+    return out
+
+
+def simulation_report(mech: Mechanism, inputs: dict[str, np.ndarray], *, speeds: dict[str, float] | None = None,
+                      points: list[str] | None = None, vll: dict[str, str] | None = None, method: str = "auto",
+                      output: str | None = None, straight: dict[str, tuple[float, float]] | None = None,
+                      progress: Any = None) -> SimulationReport:
+    """Simulate ``mech`` over ``inputs`` (see :func:`mechsyn.simulate`) and derive what a
+    designer reads off the motion (see :func:`derived_quantities`).
+
+    Parameters
+    ----------
+    mech : Mechanism
+        The mechanism, with joint points.
+    inputs : dict of str to ndarray
+        Driven joint id -> values (degrees for R, length for P), all of one length.
+    speeds, points, vll, method, progress
+        As for :func:`mechsyn.simulate`.
+    output : str, optional
+        Output link of the mechanical advantage.
+    straight : dict of str to (float, float), optional
+        Point name -> the main input's range over which to measure straightness.
+
+    Returns
+    -------
+    SimulationReport
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> from mechsyn.kinematics.report import simulation_report
+    >>> r = simulation_report(ms.examples.load("crank_rocker"), {"A": np.linspace(0, 90, 4)})
+    >>> r.simulation.link("crank").angle.round(6).tolist()
+    [0.0, 30.0, 60.0, 90.0]
+    """
+    sim = simulate(mech, inputs, speeds=speeds, points=points, vll=vll, method=method, progress=progress)
+    return SimulationReport(sim, derived_quantities(mech, sim, output, straight))
+
+
+def csv_text(header: list[str], columns: list[np.ndarray]) -> str:
+    """A CSV table (``repr`` of floats, so no digit is lost; empty cells where not finite).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.kinematics.report import csv_text
+    >>> print(csv_text(["x", "y"], [np.array([1.5, np.nan]), np.array([2.0, 3.0])]), end="")
+    x,y
+    1.5,2.0
+    ,3.0
+    """
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for row in zip(*columns):
+        w.writerow(["" if (isinstance(v, float) and not np.isfinite(v)) else
+                    (repr(float(v)) if isinstance(v, (float, np.floating)) else v) for v in row])
+    return buf.getvalue()
+
+
+def _input_columns(sim: Simulation) -> tuple[list[str], list[np.ndarray]]:
+    header = [f"input_{j}" for j in sim.inputs] + ["assembled"]
+    return header, [sim.inputs[j] for j in sim.inputs] + [sim.assembled.astype(int)]
+
+
+def simulation_csv(sim: Simulation) -> str:
+    """The simulation as a CSV table: inputs, assembled, each point's position, velocity and
+    acceleration, each link's angle, angular velocity and acceleration.
+
+    Examples
+    --------
+    >>> import numpy as np, mechsyn as ms
+    >>> from mechsyn.kinematics.report import simulation_csv
+    >>> s = ms.simulate(ms.examples.load("crank_rocker"), {"A": np.array([0.0, 90.0])})
+    >>> simulation_csv(s).splitlines()[0].split(",")[:3]
+    ['input_A', 'assembled', 'M_x']
+    """
+    header, cols = _input_columns(sim)
+    for name, pm in sim.points.items():
+        for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
+            header += [f"{name}_{key}x", f"{name}_{key}y"]
+            cols += [arr[:, 0], arr[:, 1]]
+    for name, lm in sim.links.items():
+        header += [f"{name}_angle", f"{name}_omega", f"{name}_alpha"]
+        cols += [lm.angle, lm.angular_velocity, lm.angular_acceleration]
+    return csv_text(header, cols)
+
+
+def forces_csv(fa: ForceAnalysis) -> str:
+    """A force analysis as a CSV table: inputs, assembled, each joint's reaction (Fx, Fy,
+    |F|, M) and each drive's balancing effort.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.report import forces_csv
+    >>> f = ms.forces(ms.examples.load("crank_rocker"), {"A": ms.input_grid(0, 90, 45)}, static=True)
+    >>> forces_csv(f).splitlines()[0].split(",")[:4]
+    ['input_A', 'assembled', 'A_Fx', 'A_Fy']
+    """
+    R = fa.reactions
+    header, cols = _input_columns(fa.simulation)
+    for j, F in R.force.items():
+        header += [f"{j}_Fx", f"{j}_Fy", f"{j}_F", f"{j}_M"]
+        cols += [F[:, 0], F[:, 1], np.linalg.norm(F, axis=1), R.moment[j]]
+    for j, e in R.effort.items():
+        header.append(f"drive_{j}_{R.effort_kind[j]}")
+        cols.append(e)
+    return csv_text(header, cols)
