@@ -130,3 +130,19 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
                    for i in range(len(X))]
             got = np.array([dyads._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
             assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
+
+
+def test_cached_plans_do_not_keep_mechanisms_alive(ex):
+    import gc
+    import weakref
+
+    from mechsyn.kinematics import analysis
+
+    m = ex("kinematics/crank_rocker.yaml")
+    simulate(m, {"A": input_grid(0, 90, 30)})
+    ref = weakref.ref(m)
+    for _ in range(analysis._PLANS_MAX):  # later mechanisms push it out of the bounded cache
+        simulate(ex("kinematics/crank_rocker.yaml"), {"A": input_grid(0, 90, 30)})
+    del m
+    gc.collect()
+    assert ref() is None
