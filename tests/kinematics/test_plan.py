@@ -56,3 +56,93 @@ def test_double_joints_decompose_however_written():
         assert sim.method == "assur" and sim.assembled.all() and not sim.events
         assert np.abs(sim.points["foot"].position - ref.points["foot"].position).max() < 1e-9
         assert np.abs(sim.points["foot"].velocity - ref.points["foot"].velocity).max() < 1e-8
+
+
+def test_cached_plan_is_reused_and_recompiled_when_a_joint_moves(ex):
+    from mechsyn.kinematics.analysis import cached_plan
+
+    m = ex("kinematics/crank_rocker.yaml")
+    first = cached_plan(m, inputs=("A",))
+    assert cached_plan(m, inputs=("A",)) is first
+    x = {"A": input_grid(0, 360, 30)}
+    before = simulate(m, x).point("M").copy()
+    m.joint("C").point[:] = (3.2, 3.0)  # moved in place: the plan must not be reused
+    moved = cached_plan(m, inputs=("A",))
+    assert moved is not first
+    after = simulate(m, x).point("M")
+    fresh = compile_plan(m, inputs=("A",)).simulate(x).point("M")
+    assert np.allclose(after, fresh, equal_nan=True, atol=1e-12)
+    assert not np.allclose(after, before, equal_nan=True)
+
+
+def _same(a, b):
+    assert np.array_equal(a.assembled, b.assembled)
+    for p in b.points:
+        for k in ("position", "velocity", "acceleration"):
+            assert np.allclose(getattr(a.points[p], k), getattr(b.points[p], k), equal_nan=True, atol=1e-12), (p, k)
+    for n in b.links:
+        assert np.allclose(a.links[n].angle, b.links[n].angle, equal_nan=True, atol=1e-9), n
+    assert [(e["index"], e["kind"]) for e in a.events] == [(e["index"], e["kind"]) for e in b.events]
+
+
+def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
+    """Where no group comes near a fold, the one array pass is taken and gives what the
+    tracked outward sweeps give; with dead points it declines (the tracked sweep runs)."""
+    from mechsyn.kinematics import analysis, dyads
+    from mechsyn.kinematics.analysis import cached_plan
+
+    cases = [("kinematics/crank_rocker.yaml", "A", True), ("kinematics/jansen_leg.yaml", "P0", True),
+             ("textbook/fourbar.yaml", "A", False), ("textbook/watt_sixbar.yaml", "A", False)]
+    for f, j, regular in cases:
+        m = ex(f)
+        kp = cached_plan(m, inputs=(j,))
+        for grid in ((0, 360, 1), (-90, 500, 7), (200, 260, 0.5)):
+            x = input_grid(*grid)
+            U = np.radians(x)[:, None]
+            got = dyads.solve_regular(kp.system, kp.groups, U, np.ones(1), analysis._drawn_row(kp.system, U))
+            assert (got is not None) == regular or grid[1] - grid[0] < 360, (f, grid)
+            fast = simulate(m, {j: x})
+            with monkeypatch.context() as mp:
+                mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
+                tracked = simulate(m, {j: x})
+            _same(fast, tracked)
+
+
+def test_scalar_discriminant_equals_the_array_pass(ex):
+    """The one-input evaluation used by the dead-point root search gives the array pass's
+    discriminant of every group."""
+    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics.analysis import cached_plan
+
+    for f in ("textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "kinematics/peaucellier.yaml"):
+        m = ex(f)
+        j = next(jj.id for jj in m.joints if jj.actuated)
+        kp = cached_plan(m, inputs=(j,))
+        S, plan = kp.system, kp.groups
+        X = np.radians(input_grid(0, 350, 10))[:, None]
+        tp = dyads.solve_tracked(S, plan, X)
+        prog = dyads._scalar_program(S, plan)
+        for k, step in enumerate(plan.steps):
+            if step.kind != "RRR":
+                continue
+            ref = dyads._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
+            sig = [[float(s[i]) if isinstance(s, np.ndarray) else float(s) for s in tp.sigmas[:k]]
+                   for i in range(len(X))]
+            got = np.array([dyads._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
+            assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
+
+
+def test_cached_plans_do_not_keep_mechanisms_alive(ex):
+    import gc
+    import weakref
+
+    from mechsyn.kinematics import analysis
+
+    m = ex("kinematics/crank_rocker.yaml")
+    simulate(m, {"A": input_grid(0, 90, 30)})
+    ref = weakref.ref(m)
+    for _ in range(analysis._PLANS_MAX):  # later mechanisms push it out of the bounded cache
+        simulate(ex("kinematics/crank_rocker.yaml"), {"A": input_grid(0, 90, 30)})
+    del m
+    gc.collect()
+    assert ref() is None

@@ -14,7 +14,8 @@ P inputs and lengths in the file's length unit.
 
 from __future__ import annotations
 
-import weakref
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -260,9 +261,12 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
 
 
-#: Compiled plans of the mechanisms simulated lately, by mechanism (weakly: a plan lives
-#: as long as its mechanism) and then by the geometry and options it was compiled for.
-_PLANS: "weakref.WeakKeyDictionary[Mechanism, dict]" = weakref.WeakKeyDictionary()
+#: Compiled plans of the last few mechanisms simulated (a plan holds its mechanism, so a
+#: weak mapping would keep every mechanism alive: the cache is bounded instead), by the
+#: mechanism's identity and then by the geometry and options they were compiled for.
+_PLANS: "OrderedDict[int, tuple[Mechanism, dict]]" = OrderedDict()
+_PLANS_LOCK = threading.Lock()
+_PLANS_MAX = 8
 
 
 def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> tuple:
@@ -281,7 +285,8 @@ def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple
 
 def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
     """:func:`compile_plan`, reusing the plan compiled for the same mechanism object with
-    the same geometry and options (a moved joint point or a new VLL mode compiles anew).
+    the same geometry and options (a moved joint point or a new VLL mode compiles anew);
+    the plans of the last eight mechanisms are kept.
 
     Examples
     --------
@@ -292,15 +297,24 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
     """
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
     key = _geometry_key(mech, vll, prescribed)
-    try:
-        plans = _PLANS.setdefault(mech, {})
-    except TypeError:  # not weakly referenceable: no cache
-        return compile_plan(mech, vll=vll, inputs=inputs)
-    kp = plans.get(key)
-    if kp is None:
-        if len(plans) >= 8:
-            plans.pop(next(iter(plans)))
-        kp = plans[key] = compile_plan(mech, vll=vll, inputs=inputs)
+    with _PLANS_LOCK:
+        entry = _PLANS.get(id(mech))
+        if entry is not None and entry[0] is mech:
+            _PLANS.move_to_end(id(mech))
+            kp = entry[1].get(key)
+            if kp is not None:
+                return kp
+    kp = compile_plan(mech, vll=vll, inputs=inputs)
+    with _PLANS_LOCK:
+        entry = _PLANS.get(id(mech))
+        if entry is None or entry[0] is not mech:
+            entry = _PLANS[id(mech)] = (mech, {})
+        if len(entry[1]) >= _PLANS_MAX:
+            entry[1].pop(next(iter(entry[1])))
+        entry[1][key] = kp
+        _PLANS.move_to_end(id(mech))
+        while len(_PLANS) > _PLANS_MAX:
+            _PLANS.popitem(last=False)
     return kp
 
 
