@@ -108,3 +108,14 @@ def test_target_error_ends_the_run_at_the_first_restart_reaching_it(public_cases
     assert res.to_dict()["target_reached"] and res.to_dict()["target_error"] == loose
     assert res.worst_transmission_angle_deg >= case.transmission_angle_min_deg - 1e-6  # feasibility tol
     assert res.fold_distance_deg >= case.fold_margin_deg
+
+
+@pytest.mark.slow
+def test_target_error_with_workers_is_the_single_process_result(public_cases):
+    # restart 0 reaches the loose target; restart 1, run beside it, may finish first: it is
+    # left out, as in one process, where the run ends at restart 0
+    case = public_cases["P2_kk5_timing"]
+    kw = dict(seed=1, restarts=4, time_limit=60, options=FAST, n_polish=1, target_error=1e-3)
+    one, two = synthesize_path(case, **kw), synthesize_path(case, workers=2, **kw)
+    assert two.restarts == one.restarts == 1 and two.design == one.design
+    assert two.restart_errors == one.restart_errors

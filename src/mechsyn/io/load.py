@@ -19,6 +19,7 @@ from pydantic import ValidationError
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import files
 from mechsyn.io.checks import check_counts, check_geometry, link_components
+from mechsyn.io.plain import plain_spec
 from mechsyn.io.schema import JointEntry, LinkEntry, MechanismFile, StateEntry
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import (
@@ -187,8 +188,10 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
             source=source, line=1, hint="see `mechsyn schema` and the files in examples/",
         )
     check_counts(data, source)
-    try:
-        spec = MechanismFile.model_validate(data)
+    try:  # a plain file without building pydantic's validators (the same models)
+        spec = plain_spec(data)
+        if spec is None:
+            spec = MechanismFile.model_validate(data)
     except ValidationError as exc:
         raise _validation_error(exc, data, source, text) from None
     return check_geometry(_Builder(spec, source, _line_finder(text, source)).build(), source)

@@ -54,14 +54,16 @@ def _finite(v: float) -> float:
 Number = Annotated[float, BeforeValidator(_not_bool), AfterValidator(_finite)]
 
 
+# defer_build: the validators are built on first validation, not on import (a plain file
+# needs none: mechsyn.io.plain)
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+    model_config = ConfigDict(extra="forbid", populate_by_name=True, defer_build=True)
 
 
 class LinkEntry(BaseModel):
     """A link given as an object: a name (or an integer id) and extra attributes."""
 
-    model_config = ConfigDict(extra="allow")
+    model_config = ConfigDict(extra="allow", defer_build=True)
 
     name: str | None = Field(None, description="Link name; defaults to the id as text.")
     id: int | None = Field(None, description="Integer id that joints may use instead of the name.")
@@ -215,5 +217,3 @@ def json_schema() -> dict[str, Any]:
     schema["title"] = "mechsyn mechanism file"
     return schema
 
-
-JointEntry.model_rebuild()

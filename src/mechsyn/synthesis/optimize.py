@@ -289,7 +289,8 @@ def synthesize_path(
 
     ``target_error`` (e.g. :func:`default_target_error`): a restart's global search ends
     as soon as its best feasible error is at most this, and the run ends after the first
-    restart (in seed order) whose result reaches it.
+    restart (in seed order) whose result reaches it; with workers, a later restart that had
+    already finished is left out too, so the result is the single-process one.
 
     Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``callback``) ends the search
     and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
@@ -381,6 +382,9 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
     """The best restart (lowest fitness, then first in seed order), checked by
     :func:`~mechsyn.synthesis.path.evaluate_design`."""
     results.sort(key=lambda r: r.index)
+    reached = [r.index for r in results if target_error is not None and r.fitness <= target_error]
+    if reached and not interrupted:  # the restarts one process runs: up to the first that reached
+        results = [r for r in results if r.index <= reached[0]]  # (a later one may have finished first)
     win = min(results, key=lambda r: (r.fitness, r.index))
     design = problem.design(win.z)
     check = evaluate_design(case, design)
