@@ -10,7 +10,8 @@ import typer
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, check_writable, console, emit_json, err_console, parse_floats, save_plot, stop_if_interrupted
+from mechsyn.cli.common import check_output_suffix, check_writable, console, emit_json, err_console, parse_floats, save_plot
+from mechsyn.cli.resume import checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -53,6 +54,8 @@ def synth_path(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
+    checkpoint: Optional[Path] = typer.Option(None, "--checkpoint", help="Save finished restarts to this file as the run goes."),
+    resume: Optional[Path] = typer.Option(None, "--resume", help="Continue the run saved in this checkpoint (same options)."),
 ) -> None:
     """Path generation: a four-bar whose coupler point passes through the targets."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -69,6 +72,7 @@ def synth_path(
     check_parallel_options(workers, scheduler)
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
+    ck = checkpoint_options(checkpoint, resume)
     case = _pick_case(case_file, case_id)
     case = _with_margins(case, min_transmission, fold_margin)
     if target_error is None:
@@ -88,10 +92,10 @@ def synth_path(
 
             res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                                   optimizer=optimizer, progress=progress, scheduler=scheduler,
-                                  target_error=target_error)
+                                  target_error=target_error, **ck)
     else:
         res = synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                              optimizer=optimizer, scheduler=scheduler, target_error=target_error)
+                              optimizer=optimizer, scheduler=scheduler, target_error=target_error, **ck)
     d = {**case.fixed, **res.design}
     if out is not None:
         if not res.feasible:
@@ -110,7 +114,7 @@ def synth_path(
                   + (f" (published best {case.best_known:.4g})" if case.best_known else ""))
     if as_json:
         emit_json(res)
-        stop_if_interrupted(res)
+        stop_if_interrupted(res, ck)
         return
     t = Table(title=f"Path synthesis {case.id}" + (" (interrupted: best so far)" if res.interrupted else ""))
     t.add_column("variable")
@@ -124,7 +128,7 @@ def synth_path(
                   f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
                   + ("   (target error reached)" if res.target_reached else ""))
     console.print(_transmission_line(res))
-    stop_if_interrupted(res)
+    stop_if_interrupted(res, ck)
 
 
 def _with_margins(case, min_transmission: Optional[float], fold_margin: Optional[float]):
