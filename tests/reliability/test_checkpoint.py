@@ -178,3 +178,25 @@ def test_cli_checkpoint_options_checked_before_work(run_cli, tmp_path, monkeypat
     monkeypatch.chdir(tmp_path)
     code, out, err = run_cli("synth", "path", CASES, "--case", "P2_kk5_timing", *args)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+def test_mechanism_search_interrupted_then_resumed_gives_the_uninterrupted_design(tmp_path):
+    from mechsyn.synthesis.general import load_case, synthesize_mechanism
+
+    case = load_case(ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml")
+    args = {"seed": 1, "restarts": 2, "time_limit": 120, "n_polish": 1,
+            "options": {"maxiter": 5, "popsize": 4, "init_oversample": 1}}
+    full = synthesize_mechanism(case, **args)
+    ck = tmp_path / "m.ckpt.json"
+    first = synthesize_mechanism(case, checkpoint=ck, progress=_stop_after_first, **args)
+    assert first.interrupted and list(read_checkpoint(ck)["finished"]) == ["0"]
+    resumed = synthesize_mechanism(case, checkpoint=ck, resume=True, **args)
+    assert not resumed.interrupted and resumed.design == full.design and resumed.error == full.error
+    with pytest.raises(MechsynInputError, match="synth mechanism"):
+        synthesize_path(load_cases_p2(), checkpoint=ck, resume=True)
+
+
+def load_cases_p2():
+    from mechsyn.synthesis.path import load_cases
+
+    return load_cases(CASES)[0]

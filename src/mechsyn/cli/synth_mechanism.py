@@ -9,7 +9,8 @@ import typer
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console, stop_if_interrupted
+from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.resume import checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -25,6 +26,8 @@ def synth_mechanism(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+    checkpoint: Optional[Path] = typer.Option(None, "--checkpoint", help="Save finished restarts to this file as the run goes."),
+    resume: Optional[Path] = typer.Option(None, "--resume", help="Continue the run saved in this checkpoint (same options)."),
 ) -> None:
     """Move chosen joint / point coordinates and VLL lengths of a planar mechanism file so
     a point follows target positions (or a link target poses) at given input angles."""
@@ -38,6 +41,7 @@ def synth_mechanism(
         raise MechsynInputError("must be at least 1", source="--restarts")
     check_output_suffix(plot, (".png",), "--plot")
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    ck = checkpoint_options(checkpoint, resume)
     case = load_case(case_file)
     if err_console.is_terminal and not as_json:
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -52,10 +56,10 @@ def synth_mechanism(
 
             res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,
                                        optimizer=optimizer, progress=progress, workers=workers,
-                                       scheduler=scheduler)
+                                       scheduler=scheduler, **ck)
     else:
         res = synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts,
-                                   optimizer=optimizer, workers=workers, scheduler=scheduler)
+                                   optimizer=optimizer, workers=workers, scheduler=scheduler, **ck)
     if (out is not None or plot is not None) and not res.feasible:
         raise MechsynInputError("no feasible design found; nothing written", source=str(case_file),
                                 hint="raise --time-limit or --restarts, or widen the variable bounds")
@@ -70,7 +74,7 @@ def synth_mechanism(
         save_plot(plot, plot_mechanism_synthesis, case, res, dpi=120)
     if as_json:
         emit_json(res)
-        stop_if_interrupted(res)
+        stop_if_interrupted(res, ck)
         return
     t = Table(title=f"{case.problem.capitalize()} synthesis: {case.name}"
               + (" (interrupted: best so far)" if res.interrupted else ""))
@@ -88,4 +92,4 @@ def synth_mechanism(
                   + ("   (time limit reached)" if res.stopped_by_time_limit else ""))
     if not res.feasible:
         console.print(f"[bold red]no feasible design found[/]: {res.reason}")
-    stop_if_interrupted(res)
+    stop_if_interrupted(res, ck)
