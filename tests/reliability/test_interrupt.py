@@ -186,3 +186,44 @@ def test_cli_interrupted_curve_synthesis_writes_best_and_exits_130(run_cli, tmp_
     assert err.strip().splitlines()[-1] == "interrupted"
     res = json.loads(out)
     assert res["interrupted"] is True
+
+
+CAPABILITY_ARM = ROOT / "examples" / "capability" / "paper004_3r.yaml"
+
+
+def test_capability_map_interrupted_keeps_the_finished_chunks():
+    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.maps import capability_map
+
+    arm = load_arm(CAPABILITY_ARM)
+    xs, ys = np.linspace(1300, 2100, 5), np.linspace(100, 900, 4)
+    full = capability_map(arm, xs, ys, [1, 0])
+    part = capability_map(arm, xs, ys, [1, 0], chunk=6, advance=_interrupt_after(2))
+    assert part.interrupted and part.done().sum() == 12  # two chunks of 6 points (x outer)
+    done = part.done()
+    assert np.array_equal(part.value[done], full.value[done], equal_nan=True)
+    assert np.isnan(part.value[~done]).all() and len(part.table()) == 12
+    assert part.to_dict()["computed_points"] == 12 and not full.to_dict()["interrupted"]
+    # the chunk whose progress call was interrupted is kept too
+    assert capability_map(arm, xs, ys, [1, 0], chunk=6, advance=_interrupt_after(1)).done().sum() == 6
+
+
+def test_cli_capability_map_interrupted_writes_solved_points_and_exits_130(run_cli, tmp_path, monkeypatch):
+    import mechsyn.capability.maps as maps
+
+    real, calls = maps._map_chunk, [0]
+
+    def second_chunk_interrupts(*args):
+        calls[0] += 1
+        if calls[0] == 2:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(maps, "_map_chunk", second_chunk_interrupts)
+    csv = tmp_path / "map.csv"
+    code, out, err = run_cli("capability", CAPABILITY_ARM, "--grid", "1300:2100:10,100:900:10",
+                             "--direction", "1,0", "--csv", csv)
+    assert code == INTERRUPT_EXIT_CODE and err.strip().splitlines()[-1] == "interrupted"
+    assert "interrupted: 2048 of 6561 points solved" in out
+    lines = csv.read_text().splitlines()
+    assert len(lines) == 1 + 2048 and lines[-1].count(",") == lines[0].count(",")

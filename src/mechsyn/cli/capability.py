@@ -20,7 +20,7 @@ from mechsyn.capability.maps import capability_map, interpolate_configuration, i
 from mechsyn.capability.measures import MEASURES
 from mechsyn.capability.point import MEASURE_HELP, PointCapability, capability_at
 from mechsyn.cli.app import app
-from mechsyn.cli.common import check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, write_output
+from mechsyn.cli.common import check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range, progress_bar, stop_if_interrupted, write_output
 from mechsyn.errors import MechsynInputError
 
 _BRANCH_ALIASES = {"negative": "negative", "neg": "negative", "-": "negative", "down": "negative",
@@ -217,20 +217,21 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
                 "tool_error": float(np.linalg.norm(arm.fk(qi)[0] - target)),
                 measure: float(measure_values(arm, qi[None], d, measure)[0])})
     if is_stdout(csv_out):
-        return
+        return stop_if_interrupted(cmap)
     if json_out:
         out = cmap.to_dict()
         if interp is not None:
             out["interpolated"] = interp
         emit_json(out)
-        return
+        return stop_if_interrupted(cmap)
     if total <= 144:
         table = Table(title=f"V_max ({measure}, {cmap.search}); rows x, columns y")
         table.add_column("x \\ y")
         for y in ys:
             table.add_column(f"{y:g}", justify="right")
         for i, x in enumerate(xs):
-            table.add_row(f"{x:g}", *["-" if not np.isfinite(c) else f"{c:.2f}" for c in v[i]])
+            table.add_row(f"{x:g}", *["?" if not ok else "-" if not np.isfinite(c) else f"{c:.2f}"
+                                      for c, ok in zip(v[i], cmap.done()[i])])
         console.print(table)
     reach = np.isfinite(v)
     if reach.any():
@@ -250,3 +251,6 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
     for what, path in (("map", map_png), ("csv", csv_out)):
         if path is not None:
             console.print(f"wrote {what}: {path}")
+    if cmap.interrupted:
+        console.print(f"interrupted: {int(cmap.done().sum())} of {total} points solved (? in the table); the outputs hold those")
+    stop_if_interrupted(cmap)
