@@ -250,6 +250,41 @@ def test_names_printed_as_text(run_cli, tmp_path, command):
     assert code == 0 and "[link=https://evil.example]click[/link]" in out and "\x1b" not in out
 
 
+MARKUP_NAMES = ["[/]", "a[/bold]b", "[crank]", "[@click=app.quit]x", "[bold]bold", "x\\", "[red]r[/red][/]"]
+
+
+@pytest.mark.parametrize("command", ["analyze", "structure", "simulate --input A=0:360:90",
+                                     "forces --input A=0:360:90", "export --svg {tmp}/m.svg --drawing {tmp}/d.svg"])
+def test_markup_in_link_and_joint_names_is_text_not_a_crash(run_cli, tmp_path, command):
+    """A link called "[/]" closed the command's own [bold] tag: rich raised MarkupError."""
+    d = copy.deepcopy(FOURBAR)
+    rename = dict(zip(["crank", "coupler", "rocker"], MARKUP_NAMES))
+    d["name"] = MARKUP_NAMES[-1]
+    for link in d["links"][1:]:
+        link["name"] = rename[link["name"]]
+    for j, new in zip(d["joints"], MARKUP_NAMES[3:]):
+        j["id"] = new
+    for j in d["joints"]:
+        j["links"] = [rename.get(x, x) for x in j["links"]]
+    for p in d.get("points", {}).values():
+        p["link"] = rename.get(p["link"], p["link"])
+    for load in d.get("loads", []):
+        load["link"] = rename.get(load["link"], load["link"])
+    d["joints"][0]["id"] = "A"
+    words = command.replace("{tmp}", str(tmp_path)).split()
+    code, out, err = run_cli(words[0], write(tmp_path, "m.yaml", d), *words[1:])
+    assert "Traceback" not in err and "MarkupError" not in err, err
+    assert code == 0, err
+    assert "[/]" in out or command.startswith(("simulate", "export"))
+
+
+def test_guard_markup_keeps_styles_escapes_the_rest():
+    from mechsyn.cli.common import guard_markup
+
+    assert guard_markup("[bold red]e[/] [/bold]") == "[bold red]e[/] [/bold]"
+    assert guard_markup("[crank] [@click=x] [link=y]") == "\\[crank] \\[@click=x] \\[link=y]"
+
+
 def test_numbers_never_cut_at_80_columns(run_cli):
     from mechsyn.cli.common import console
 

@@ -9,6 +9,7 @@ import sys
 import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -25,7 +26,6 @@ from mechsyn.results import dumps, write_atomic
 T = TypeVar("T")
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
-_LINK_TAG = re.compile(r"(?<!\\)\[(/?link\b)", re.IGNORECASE)  # not already escaped
 
 
 def strip_control(text: str) -> str:
@@ -53,6 +53,37 @@ def safe(text: object, limit: int = 120) -> str:
     return escape(text)
 
 
+_TAG = re.compile(r"(?<!\\)\[([a-zA-Z#/@][^\[\]]*)\]")
+
+
+@lru_cache(maxsize=512)
+def _is_style(body: str) -> bool:
+    from rich.errors import StyleSyntaxError
+    from rich.style import Style
+
+    name = body[1:] if body.startswith("/") else body
+    if body == "/" or (body.startswith("/") and not name):
+        return True
+    if name.startswith("@") or "link" in name.lower():
+        return False
+    try:
+        Style.parse(name)
+    except (StyleSyntaxError, ValueError):
+        return False
+    return True
+
+
+def guard_markup(text: str) -> str:
+    r"""``text`` with every ``[tag]`` that is not a plain style escaped: a file's
+    ``[link=...]``, ``[@click]`` or ``[crank]`` prints as text (``[bold]``, ``[red]``, ``[/]``
+    still style the commands' own messages).
+
+    >>> print(guard_markup("[bold]link[/] [crank] [link=https://x.example]x[/link]"))
+    [bold]link[/] \[crank] \[link=https://x.example]x\[/link]
+    """
+    return _TAG.sub(lambda m: m.group(0) if _is_style(m.group(1)) else "\\" + m.group(0), text)
+
+
 class SafeConsole(Console):
     """A rich Console that never sends a file's control characters to the terminal and
     never turns text into a hyperlink: every string it renders (messages and table cells,
@@ -60,7 +91,13 @@ class SafeConsole(Console):
     shown as text. The commands' own styles ([bold], [red]...) still work."""
 
     def render_str(self, text: str, *args: Any, **kwargs: Any) -> Any:
-        return super().render_str(_LINK_TAG.sub(r"\\[\1", strip_control(text)), *args, **kwargs)
+        from rich.errors import MarkupError, MissingStyle
+
+        text = guard_markup(strip_control(text))
+        try:
+            return super().render_str(text, *args, **kwargs)
+        except (MarkupError, MissingStyle):  # a file's "[/]" closed a tag: show it all as text
+            return super().render_str(text, *args, **{**kwargs, "markup": False})
 
 
 class Table(RichTable):
