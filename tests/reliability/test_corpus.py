@@ -242,11 +242,12 @@ def test_markup_and_escapes_in_names_never_reach_the_terminal(tmp_path):
     assert "[link=https://evil.example]" in out
 
 
-@pytest.mark.parametrize("command", ["analyze", "structure"])
+@pytest.mark.parametrize("command", ["analyze", "structure", "analyze --markdown"])
 def test_names_printed_as_text(run_cli, tmp_path, command):
     d = copy.deepcopy(FOURBAR)
     d["name"] = "[link=https://evil.example]click[/link] \x1b[31mred"
-    code, out, _ = run_cli(command, write(tmp_path, "m.yaml", d))
+    words = command.split()
+    code, out, _ = run_cli(words[0], write(tmp_path, "m.yaml", d), *words[1:])
     assert code == 0 and "[link=https://evil.example]click[/link]" in out and "\x1b" not in out
 
 

@@ -10,7 +10,7 @@ import typer
 from rich.panel import Panel
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import Table, console, emit_json, err_console, safe  # Table: cells fold
+from mechsyn.cli.common import Table, console, emit_json, err_console, safe, strip_control  # Table: cells fold
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.analysis import StructuralAnalysis
@@ -178,7 +178,7 @@ def analyze(
         emit_json(report.to_dict(), out)
     elif markdown:
         if out is None:
-            typer.echo(report.to_markdown(), nl=False)
+            typer.echo(strip_control(report.to_markdown()), nl=False)  # a file's escapes never reach the terminal
         else:
             write_atomic(out, report.to_markdown())
     else:

@@ -12,7 +12,7 @@ from typing import Optional
 import numpy as np
 import typer
 from rich import box
-from rich.console import Console
+from mechsyn.cli.common import SafeConsole
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.capability.arm import SerialArm, load_arm
@@ -155,7 +155,7 @@ def _render_point(arm: SerialArm, res: PointCapability, step: float) -> None:
         table.add_row("cont", *[f"{v:.1f}" for v in cb["q_deg"]],
                       *[f"{cb[mn]:.2f}" for mn in MEASURES], style="cyan")
     need = 12 + 8 * arm.n + 50
-    out = console if console.is_terminal or console.width >= need else Console(width=need)
+    out = console if console.is_terminal or console.width >= need else SafeConsole(width=need)
     out.print(table)
     if len(shown) < len(configs):
         console.print(f"showing the best {len(shown)} of {len(configs)} configurations "
