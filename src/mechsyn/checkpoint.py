@@ -57,17 +57,20 @@ def digest(obj: Any) -> str:
     return hashlib.sha256(dumps(obj, indent=None).encode()).hexdigest()[:16]
 
 
-def _record(data: Any, source: str, where: str) -> dict[str, Any]:
+_AFRESH = "start afresh with --checkpoint (the file is not usable)"
+
+
+def _record(data: Any, source: str, where: str, dim: int | None) -> dict[str, Any]:
     try:
         rec = {"seed": int(data["seed"]), "x": np.asarray(data["x"], float),
                "fitness": float("inf") if data["fitness"] is None else float(data["fitness"]),
                "nfev": int(data.get("nfev", 0)), "seconds": float(data.get("seconds", 0.0))}
-    except (TypeError, KeyError, ValueError):
-        raise MechsynInputError("damaged restart record", source=source, field=where,
-                                hint="start afresh with --checkpoint (the file is not usable)") from None
-    if rec["x"].ndim != 1:
-        raise MechsynInputError("damaged restart record", source=source, field=f"{where}.x",
-                                hint="start afresh with --checkpoint (the file is not usable)")
+    except (TypeError, KeyError, ValueError, AttributeError, OverflowError):
+        raise MechsynInputError("damaged restart record", source=source, field=where, hint=_AFRESH) from None
+    x = rec["x"]
+    if x.ndim != 1 or not np.isfinite(x).all() or (dim is not None and x.size != dim) or rec["fitness"] != rec["fitness"]:
+        raise MechsynInputError("damaged restart record (design vector or fitness)", source=source,
+                                field=f"{where}.x", hint=_AFRESH)
     return rec
 
 
@@ -109,9 +112,10 @@ class RestartCheckpoint:
 
     @classmethod
     def open(cls, path: str | os.PathLike[str], kind: str, key: dict[str, Any], *,
-             resume: bool = False, interval: float = 5.0) -> "RestartCheckpoint":
+             resume: bool = False, interval: float = 5.0, dim: int | None = None) -> "RestartCheckpoint":
         """A new checkpoint at ``path`` or, with ``resume``, the one it holds (same kind
-        and key, else :class:`MechsynInputError` naming the field that differs).
+        and key, else :class:`MechsynInputError` naming the field that differs). ``dim``:
+        the length of the design vectors, checked.
 
         A new checkpoint never replaces a file that is not a checkpoint.
         """
@@ -131,15 +135,22 @@ class RestartCheckpoint:
         if data.get("kind") != kind:
             raise MechsynInputError(f"a checkpoint of {data.get('kind')!r}, not of {kind!r}", source=str(path),
                                     field="kind", hint=f"resume it with mechsyn {data.get('kind')}")
-        ck._check_key(data.get("key") or {})
-        ck.finished = {int(i): _record(r, str(path), f"finished[{i}]")
-                       for i, r in (data.get("finished") or {}).items()}
-        if data.get("partial"):
-            ck.partial = {**_record(data["partial"], str(path), "partial"),
-                          "index": int(data["partial"].get("index", -1))}
+        ck._check_key(data.get("key"))
+        try:
+            ck.finished = {int(i): _record(r, str(path), f"finished[{i}]", dim)
+                           for i, r in (data.get("finished") or {}).items()}
+            if data.get("partial"):
+                ck.partial = {**_record(data["partial"], str(path), "partial", dim),
+                              "index": int(data["partial"]["index"])}
+        except (TypeError, KeyError, ValueError, AttributeError, OverflowError) as exc:
+            raise MechsynInputError(f"damaged checkpoint ({type(exc).__name__})", source=str(path),
+                                    field="finished", hint=_AFRESH) from None
         return ck
 
-    def _check_key(self, saved: dict[str, Any]) -> None:
+    def _check_key(self, saved: Any) -> None:
+        if not isinstance(saved, dict):
+            raise MechsynInputError("damaged checkpoint: no key", source=str(self.path), field="key",
+                                    hint=_AFRESH)
         mine = json.loads(dumps(self.key, indent=None))
         for name in sorted(set(mine) | set(saved)):
             if mine.get(name) == saved.get(name):
@@ -193,7 +204,7 @@ class RestartCheckpoint:
 
 
 def open_search_checkpoint(path: str | os.PathLike[str] | None, kind: str, case: Any, *, resume: bool = False,
-                           **key: Any) -> RestartCheckpoint | None:
+                           dim: int | None = None, **key: Any) -> RestartCheckpoint | None:
     """The checkpoint of a search of ``case`` (``None`` without ``path``): its key is a
     digest of the case and the ``key`` settings (see :meth:`RestartCheckpoint.open`)."""
     if path is None:
@@ -201,4 +212,4 @@ def open_search_checkpoint(path: str | os.PathLike[str] | None, kind: str, case:
             raise MechsynInputError("resume needs the checkpoint file", field="checkpoint",
                                     hint="give checkpoint=<the file written by the interrupted run>")
         return None
-    return RestartCheckpoint.open(path, kind, {"case": digest(case), **key}, resume=resume)
+    return RestartCheckpoint.open(path, kind, {"case": digest(case), **key}, resume=resume, dim=dim)

@@ -594,13 +594,13 @@ def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, o
     return best_z, best_f, prob.n_evaluations
 
 
-def _mechanism_checkpoint(path, resume, case, seed, restarts, optimizer, opts, f_atol, batch):
+def _mechanism_checkpoint(path, resume, case, dim, seed, restarts, optimizer, opts, f_atol, batch):
     from mechsyn.checkpoint import open_search_checkpoint
 
     from dataclasses import fields
 
     content = {f.name: getattr(case, f.name) for f in fields(case) if f.name not in ("source", "mechanism_path")}
-    return open_search_checkpoint(path, "synth mechanism", content, resume=resume, seed=seed, restarts=restarts,
+    return open_search_checkpoint(path, "synth mechanism", content, resume=resume, dim=dim, seed=seed, restarts=restarts,
                                   optimizer=optimizer, options=opts, f_atol=f_atol, batch=batch)
 
 
@@ -653,7 +653,8 @@ def synthesize_mechanism(case: MechanismCase, *, seed: int = 0, time_limit: floa
     f_atol = float(opts.pop("f_atol", 1e-18 * prob.penalty_base))
     local = workers <= 1 and scheduler is None
     best = [best_f]
-    ck = _mechanism_checkpoint(checkpoint, resume, case, seed, restarts, optimizer, opts, f_atol, batch)
+    ck = _mechanism_checkpoint(checkpoint, resume, case, len(prob.lower), seed, restarts, optimizer, opts, f_atol,
+                               batch)
     outs: dict[int, tuple] = {} if ck is None else {i: (r["x"], r["fitness"], r["nfev"]) for i, r in ck.finished.items()}
 
     def report(r: int, f: float) -> None:

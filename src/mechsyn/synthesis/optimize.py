@@ -320,7 +320,7 @@ def synthesize_path(
     seeds = restart_seeds(seed, restarts)
     best = [np.inf]
     problem = PathProblem(case)
-    ck = _path_checkpoint(checkpoint, resume, case, seed, restarts, optimizer, options, target_error)
+    ck = _path_checkpoint(checkpoint, resume, case, len(problem.lower), seed, restarts, optimizer, options, target_error)
     results: list[RestartResult] = [] if ck is None else [
         RestartResult(index=i, seed=r["seed"], z=r["x"], fitness=r["fitness"], nfev=r["nfev"], seconds=r["seconds"])
         for i, r in sorted(ck.finished.items())]
@@ -397,10 +397,10 @@ def synthesize_path(
     )
 
 
-def _path_checkpoint(path, resume, case, seed, restarts, optimizer, options, target_error):
+def _path_checkpoint(path, resume, case, dim, seed, restarts, optimizer, options, target_error):
     from mechsyn.checkpoint import open_search_checkpoint
 
-    return open_search_checkpoint(path, "synth path", case, resume=resume, seed=seed, restarts=restarts,
+    return open_search_checkpoint(path, "synth path", case, resume=resume, dim=dim, seed=seed, restarts=restarts,
                                   optimizer=optimizer, options=options, target_error=target_error)
 
 
