@@ -109,6 +109,46 @@ def test_degenerate_geometry_is_an_error(run_cli, tmp_path, data, expect, comman
     assert expect in msg and "actuated" not in msg   # not "mark more joints actuated"
 
 
+RSSR = yaml.safe_load((EX / "textbook" / "rssr.yaml").read_text())
+
+
+def rssr(**edits) -> dict:
+    d = copy.deepcopy(RSSR)
+    for jid, fields in edits.items():
+        next(j for j in d["joints"] if j["id"] == jid).update(fields)
+    return d
+
+
+@pytest.mark.parametrize("data,expect", [
+    (rssr(C={"point": [1, 0, 0]}), "link 'rod' has zero length: its joints B, C are at one point"),
+    (rssr(B={"type": "U", "axis": [0, 0, 1], "axis2": [0, 1, 0]}, C={"point": [1, 0, 0]}),
+     "link 'rod' has zero length"),
+    ({**fourbar(), "joints": fourbar()["joints"] + [{**fourbar()["joints"][1], "id": "B2"}]},
+     "joints B and B2 are the same R pair"),
+], ids=["S-S rod", "U-S rod", "doubled pair"])
+def test_degenerate_geometry_of_other_pairs(run_cli, tmp_path, data, expect):
+    code, _, err = run_cli("analyze", write(tmp_path, "m.yaml", data))
+    assert code == 2 and expect in one_error_line(err)
+
+
+def test_crossed_hinges_at_one_point_are_a_hooke_cross_not_a_zero_length_link():
+    from mechsyn.io import mechanism_from_dict
+
+    d = rssr(B={"links": ["crank", "cross"], "type": "R", "axis": [0, 0, 1]})
+    d["links"].append("cross")
+    d["joints"].append({"id": "B2", "type": "R", "links": ["cross", "rod"], "point": [1, 0, 0], "axis": [0, 1, 0]})
+    assert len(mechanism_from_dict(d, "m.yaml").joints) == 5
+    d["joints"][-1]["axis"] = [0, 0, -1]  # parallel hinges at one point: the cross has zero length
+    with pytest.raises(MechsynInputError, match="link 'cross' has zero length"):
+        mechanism_from_dict(d, "m.yaml")
+
+
+def test_slider_on_its_pivot_is_not_degenerate():
+    from mechsyn.io import load_mechanism
+
+    assert load_mechanism(EX / "textbook" / "slider_crank.yaml")  # the block's R and P at one point
+
+
 def test_negative_mass_names_the_field(run_cli, tmp_path):
     d = copy.deepcopy(FOURBAR)
     d["links"][1]["mass"] = -0.5
