@@ -363,3 +363,21 @@ def test_usage_errors_are_one_line(run_cli, args, expect):
     msg = one_error_line(err)
     assert code == 2 and expect in msg and "-h" in msg
     assert len(err.strip().splitlines()) <= 2
+
+
+@pytest.mark.parametrize("command, shows", [("structure", "Assur groups of 4 links"), ("analyze", "reading m.yaml")])
+def test_long_steps_of_big_files_show_a_spinner(run_cli, tmp_path, monkeypatch, command, shows):
+    """Reading a big file and decomposing a large mechanism take seconds: the terminal shows
+    the step (thresholds lowered here so a four-bar counts as large)."""
+    import mechsyn.cli.working as working
+    from mechsyn.cli.common import err_console
+
+    monkeypatch.setattr(working, "BIG_FILE_BYTES", 10)
+    monkeypatch.setattr(working, "LARGE_JOINTS", 2)
+    from contextlib import nullcontext
+
+    shown = []
+    monkeypatch.setattr(err_console, "_force_terminal", True)
+    monkeypatch.setattr(err_console, "status", lambda what, **kw: shown.append(what) or nullcontext())
+    code, out, err = run_cli(command, write(tmp_path, "m.yaml", FOURBAR))
+    assert code == 0 and any(shows in s for s in shown), shown

@@ -172,7 +172,11 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
-    report = _analyze_reporting(load_mechanism(file), method=method, remedies=remedies,
+    from mechsyn.cli.working import reading
+
+    with reading(file):
+        mech = load_mechanism(file)
+    report = _analyze_reporting(mech, method=method, remedies=remedies,
                                 max_variants=max_variants, tol=tol, as_spatial=spatial)
     if json_out:
         emit_json(report.to_dict(), out)
