@@ -149,6 +149,14 @@ def test_slider_on_its_pivot_is_not_degenerate():
     assert load_mechanism(EX / "textbook" / "slider_crank.yaml")  # the block's R and P at one point
 
 
+def test_an_unforeseen_os_error_is_one_line(run_cli, tmp_path):
+    """`schema --out` in a folder that cannot be made: the OSError net of the command line."""
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    code, _, err = run_cli("schema", "--out", blocker / "sub" / "s.json")
+    assert code == 2 and "fix: check the path" in one_error_line(err)
+
+
 def test_negative_mass_names_the_field(run_cli, tmp_path):
     d = copy.deepcopy(FOURBAR)
     d["links"][1]["mass"] = -0.5
@@ -252,7 +260,9 @@ def test_atlas_stream_never_overwrites_foreign_file(run_cli, tmp_path):
     ["synth", "mechanism", str(MECH_CASE), "--out", "{bad}/x.yaml"],
     ["simulate", str(EX / "kinematics" / "crank_rocker.yaml"), "--input", "A=0:10:5", "--csv", "{bad}/x.csv"],
     ["atlas", "--links", "6", "--out", "{bad}/x.svg"],
-], ids=["synth-path", "synth-mechanism", "simulate", "atlas"])
+    ["analyze", str(EX / "kinematics" / "crank_rocker.yaml"), "--json", "--out", "{bad}/x.json"],
+    ["synth", "path", str(PATH_CASES), "--case", "P2_kk5_timing", "--checkpoint", "{bad}/ck.json"],
+], ids=["synth-path", "synth-mechanism", "simulate", "atlas", "analyze", "checkpoint"])
 def test_unwritable_output_checked_before_computing(run_cli, tmp_path, args):
     blocker = tmp_path / "file"
     blocker.write_text("")

@@ -172,8 +172,10 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
+    from mechsyn.cli.common import check_writable
     from mechsyn.cli.working import reading
 
+    check_writable(out, "--out")
     with reading(file):
         mech = load_mechanism(file)
     report = _analyze_reporting(mech, method=method, remedies=remedies,
