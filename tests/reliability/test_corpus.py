@@ -391,3 +391,34 @@ def test_long_steps_of_big_files_show_a_spinner(run_cli, tmp_path, monkeypatch, 
     monkeypatch.setattr(err_console, "status", lambda what, **kw: shown.append(what) or nullcontext())
     code, out, err = run_cli(command, write(tmp_path, "m.yaml", FOURBAR))
     assert code == 0 and any(shows in s for s in shown), shown
+
+
+ARM_FILE = EX / "capability" / "paper004_3r.yaml"
+
+
+@pytest.mark.parametrize("args", [
+    ["--point", "1300,900", "--direction", "0,0"],
+    ["--point", "1300,900", "--direction", "1,0", "--step", "0"],
+    ["--point", "1300,900", "--direction", "1,0", "--measure", "fastest"],
+    ["--point", "1300,900", "--direction", "1,0", "--csv", "x.csv"],
+    ["--grid", "1300:2100:200", "--direction", "1,0"],
+    ["--grid", "0:1e9:1,0:1:1", "--direction", "1,0"],
+    ["--grid", "0:3000:1,0:3000:1", "--direction", "1,0"],
+    ["--grid", "1300:1700:100,300:700:100", "--direction", "1,0", "--interpolate", "0,0"],
+    ["--grid", "1300:1700:100,300:700:100"],
+])
+def test_capability_errors_name_the_fix(run_cli, tmp_path, monkeypatch, args):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli("capability", ARM_FILE, *args)
+    assert code == 2 and "(fix:" in one_error_line(err), err
+
+
+@pytest.mark.parametrize("edit, fix", [
+    ({"link_lengths": [1000, -1, 500]}, ": link_lengths must be finite and >= 0 (fix: correct the value named"),
+    ({"kind": "scara"}, "kind: planar_serial"),
+    ({"bogus": 1}, "delete it or check its spelling"),
+])
+def test_arm_file_errors_name_the_fix(run_cli, tmp_path, edit, fix):
+    data = {**yaml.safe_load(ARM_FILE.read_text()), **edit}
+    code, _, err = run_cli("capability", write(tmp_path, "arm.yaml", data), "--point", "1300,900", "--direction", "1,0")
+    assert code == 2 and fix in one_error_line(err), err

@@ -34,14 +34,15 @@ def _values(text: str, option: str) -> np.ndarray:
         a, b, s = parse_range(text, option)
         n = int(math.floor((b - a) / s + 1e-9)) + 1
         if n > 100_000:
-            raise MechsynInputError(f"{n} values is too many", source=option)
+            raise MechsynInputError(f"{n:,} values is too many (at most 100,000 per axis)", source=option,
+                                    hint="use a larger step or a shorter range")
         return a + s * np.arange(n)
     return np.array(parse_floats(text, option))
 
 
 def _check_finite(values, option: str) -> None:
     if not np.all(np.isfinite(values)):
-        raise MechsynInputError("values must be finite", source=option)
+        raise MechsynInputError("values must be finite", source=option, hint="give finite numbers")
 
 
 @app.command("capability")
@@ -85,18 +86,20 @@ def capability(
     d = np.array(parse_floats(direction, "--direction", m))
     _check_finite(d, "--direction")
     if not np.any(d):
-        raise MechsynInputError("the direction must not be zero", source="--direction")
+        raise MechsynInputError("the direction must not be zero", source="--direction",
+                                hint="e.g. --direction 1,0 (along x)")
     if measure not in MEASURES:
         raise MechsynInputError(f"unknown measure {measure!r}", source="--measure",
                                 hint="one of " + ", ".join(MEASURES))
     if not (step > 0 and math.isfinite(step)):
-        raise MechsynInputError("step must be positive", source="--step")
+        raise MechsynInputError("step must be positive", source="--step", hint="e.g. --step 1")
     if branch is not None:
         if branch.lower() not in _BRANCH_ALIASES:
             raise MechsynInputError(f"unknown branch {branch!r}", source="--branch",
                                     hint="negative (q3 < 0), positive or both")
         if not is_closed_form(arm):
-            raise MechsynInputError("--branch applies to planar 3R arms only", source="--branch")
+            raise MechsynInputError("--branch applies to planar 3R arms only", source="--branch",
+                                    hint="drop --branch: this arm's configurations are all searched")
     br = _BRANCH_ALIASES[(branch or "negative").lower()]
     q1_vals = None
     if q1 is not None:
@@ -110,7 +113,7 @@ def capability(
         if map_png or csv_out or interpolate:
             raise MechsynInputError("--map, --csv and --interpolate go with --grid",
                                     source="--map" if map_png else "--csv" if csv_out
-                                    else "--interpolate")
+                                    else "--interpolate", hint="give --grid X0:X1:DX,Y0:Y1:DY instead of --point")
         _point(arm, np.array(parse_floats(point, "--point", m)), d, q1_vals, br,
                not ignore_limits, measure, step, polytope, json_out)
     else:
@@ -177,12 +180,14 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
           json_out, at=None, parallel=None) -> None:
     parts = grid.split(",")
     if len(parts) != 2:
-        raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
+        raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid",
+                                hint="e.g. --grid 1300:2100:200,100:900:200")
     xs, ys = _values(parts[0], "--grid"), _values(parts[1], "--grid")
     for v in (xs, ys):
         _check_finite(v, "--grid")
     if xs.size * ys.size > 5_000_000:
-        raise MechsynInputError("more than 5,000,000 grid points", source="--grid")
+        raise MechsynInputError(f"{xs.size * ys.size:,} grid points are more than 5,000,000", source="--grid",
+                                hint="use larger steps or a smaller area")
     if arm.kind == "spatial" and z is None:
         raise MechsynInputError("a spatial arm's grid needs its plane", source="--z",
                                 hint="add --z 400 (the grid lies in z = 400)")
@@ -204,8 +209,9 @@ def _grid(arm, grid, z, d, q1_vals, br, respect, measure, continuous, map_png, c
     interp = None
     if at is not None:
         if not (xs.min() <= at[0] <= xs.max() and ys.min() <= at[1] <= ys.max()):
-            raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid",
-                                    source="--interpolate")
+            raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid", source="--interpolate",
+                                    hint=f"give a point with x in [{xs.min():g}, {xs.max():g}] and y in "
+                                         f"[{ys.min():g}, {ys.max():g}]")
         method = "cubic" if xs.size >= 4 and ys.size >= 4 else "linear"
         qi = interpolate_configuration(cmap, method)(at[0], at[1])
         target = at if arm.kind == "planar" else np.array([at[0], at[1], z])
