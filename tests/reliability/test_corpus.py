@@ -422,3 +422,13 @@ def test_arm_file_errors_name_the_fix(run_cli, tmp_path, edit, fix):
     data = {**yaml.safe_load(ARM_FILE.read_text()), **edit}
     code, _, err = run_cli("capability", write(tmp_path, "arm.yaml", data), "--point", "1300,900", "--direction", "1,0")
     assert code == 2 and fix in one_error_line(err), err
+
+
+def test_float_noise_is_zero_in_every_table_and_path_extent(run_cli):
+    """A fixed pivot's path extent printed 'y -1.38778e-15 .. 9.71445e-16'; a unit vector's
+    component printed '-0.0000'."""
+    code, out, _ = run_cli("simulate", EX / "kinematics" / "triple_rocker.yaml", "--input", "A=0:360:2")
+    assert code == 0 and "path of D: x 4.5 .. 4.5, y 0 .. 0 (width 0, height 0)" in " ".join(out.split())
+    code, out, _ = run_cli("simulate", EX / "fingers" / "two_phalanx_vll_000.yaml", "--input", "E=-15:60:1",
+                           "--points", "tip")
+    assert code == 0 and "-0.0000" not in out and "0.0000" in out

@@ -100,13 +100,30 @@ class SafeConsole(Console):
             return super().render_str(text, *args, **{**kwargs, "markup": False})
 
 
+_NEGATIVE_ZERO = re.compile(r"(?<![\w.])-(0(?:\.0+)?)(?![\w.])")
+
+
+def no_negative_zero(text: str) -> str:
+    """``text`` with every number shown as a negative zero (``-0``, ``-0.0000``: float noise
+    rounded) written without its sign.
+
+    >>> no_negative_zero("-0.0000, -1, 0, -0.5, x-0")
+    '0.0000, -1, 0, -0.5, x-0'
+    """
+    return _NEGATIVE_ZERO.sub(r"\1", text)
+
+
 class Table(RichTable):
     """A rich Table whose cells wrap (fold) instead of being cut with an ellipsis: at 80
-    columns a number is never shown truncated (1.60e-15 never becomes "1.60e…")."""
+    columns a number is never shown truncated (1.60e-15 never becomes "1.60e…"); a number
+    rounded to a negative zero (``-0.0000``) is shown as ``0.0000`` in every cell."""
 
     def add_column(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("overflow", "fold")
         super().add_column(*args, **kwargs)
+
+    def add_row(self, *cells: Any, **kwargs: Any) -> None:
+        super().add_row(*(no_negative_zero(c) if isinstance(c, str) else c for c in cells), **kwargs)
 
 
 def fmt_number(value: Any, spec: str = ".6g", scale: float = 1.0) -> str:
@@ -123,7 +140,7 @@ def fmt_number(value: Any, spec: str = ".6g", scale: float = 1.0) -> str:
         return "—"
     if abs(v) <= 1e-12 * abs(scale):
         v = 0.0
-    return format(v, spec)
+    return no_negative_zero(format(v, spec))
 
 
 console = SafeConsole()

@@ -247,8 +247,10 @@ def _render_simulation(sim, derived_d: dict) -> None:
         console.print(f"transmission angle of dyad {k}: {_fmt(v['min'])} .. {_fmt(v['max'])} deg", highlight=False)
     for name, e in derived_d.get("extent", {}).items():
         if e["width"] is not None:
-            console.print(f"path of {name}: x {e['x_min']:.6g} .. {e['x_max']:.6g}, y {e['y_min']:.6g} .. "
-                          f"{e['y_max']:.6g} (width {e['width']:.6g}, height {e['height']:.6g})", highlight=False)
+            size = max(abs(e[k]) for k in ("x_min", "x_max", "y_min", "y_max"))  # noise: below 1e-12 of it
+            x0, x1, y0, y1, w, h = (fmt_number(e[k], scale=size) for k in ("x_min", "x_max", "y_min", "y_max",
+                                                                          "width", "height"))
+            console.print(f"path of {name}: x {x0} .. {x1}, y {y0} .. {y1} (width {w}, height {h})", highlight=False)
     for name, s in derived_d.get("straightness", {}).items():
         console.print(f"straightness of {name} over {s['range'][0]:g}..{s['range'][1]:g}: largest deviation "
                       f"{s['max_deviation']:.6g} over a length {s['length']:.6g}", highlight=False)
