@@ -134,6 +134,8 @@ def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
                 mark = exc.problem_mark or exc.context_mark
                 line = mark.line + 1 if mark is not None else None
                 problem = exc.problem or exc.context or "cannot parse"
+                if "nesting depth" in problem:  # LibYAML's own limit on block nesting (1,000)
+                    raise _too_deep(source) from None
                 column = f" (column {mark.column + 1})" if mark is not None else ""
                 raise MechsynInputError(
                     f"YAML syntax error: {problem}{column}", source=source, line=line,
