@@ -125,13 +125,17 @@ def test_cli_interrupted_json_says_so(cli_json, run_cli, monkeypatch):
     assert code == INTERRUPT_EXIT_CODE and json.loads(stdout)["interrupted"] is True
 
 
-def _sigint_subprocess(args: list[str], delay: float, cwd: Path) -> subprocess.CompletedProcess:
+def _sigint_subprocess(args: list[str], delay: float, cwd: Path, ready: Path | None = None) -> subprocess.CompletedProcess:
+    """Run mechsyn, send SIGINT ``delay`` s after ``ready`` exists (or after start), collect."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     # a child of a non-interactive shell may inherit SIGINT ignored: restore the default so
     # Python installs its KeyboardInterrupt handler, as in a terminal
     p = subprocess.Popen([sys.executable, "-m", "mechsyn", *args], env=env, cwd=cwd, text=True,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    end = time.monotonic() + 240  # a loaded machine may take long to start
+    while ready is not None and not ready.exists() and p.poll() is None and time.monotonic() < end:
+        time.sleep(0.2)
     time.sleep(delay)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=60)
@@ -140,9 +144,12 @@ def _sigint_subprocess(args: list[str], delay: float, cwd: Path) -> subprocess.C
 
 @pytest.mark.slow
 def test_real_sigint_to_synth_path_keeps_best(tmp_path):
+    # SIGINT once the search has saved its first checkpoint (it has evaluated designs)
     r = _sigint_subprocess(["synth", "path", str(CASES), "--case", "P5_ellipse10_notiming",
-                            "--time-limit", "300", "--target-error", "0", "--out", "x.yaml"], delay=8.0, cwd=tmp_path)
+                            "--time-limit", "300", "--target-error", "0", "--out", "x.yaml",
+                            "--checkpoint", "ck.json"], delay=0.5, cwd=tmp_path, ready=tmp_path / "ck.json")
     assert r.returncode == INTERRUPT_EXIT_CODE, r.stderr
+    assert "continue with --resume ck.json" in " ".join(r.stderr.split())
     assert r.stderr.strip().splitlines()[-1] == "interrupted"
     assert "Traceback" not in r.stderr
     assert (tmp_path / "x.yaml").read_text().startswith("# INTERRUPTED")
