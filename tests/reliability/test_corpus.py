@@ -432,3 +432,13 @@ def test_float_noise_is_zero_in_every_table_and_path_extent(run_cli):
     code, out, _ = run_cli("simulate", EX / "fingers" / "two_phalanx_vll_000.yaml", "--input", "E=-15:60:1",
                            "--points", "tip")
     assert code == 0 and "-0.0000" not in out and "0.0000" in out
+
+
+def test_a_name_too_long_for_the_file_system_is_one_clear_error(run_cli):
+    """Found by the fuzzing suite: a case's `mechanism: xxx...` (300 characters) raised OSError."""
+    with pytest.raises(MechsynInputError, match="File name too long"):
+        from mechsyn.io import load_mechanism
+
+        load_mechanism("x" * 300)
+    code, _, err = run_cli("analyze", "y" * 300)
+    assert code == 2 and "each name at most 255 bytes" in one_error_line(err)
