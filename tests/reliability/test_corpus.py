@@ -109,6 +109,54 @@ def test_degenerate_geometry_is_an_error(run_cli, tmp_path, data, expect, comman
     assert expect in msg and "actuated" not in msg   # not "mark more joints actuated"
 
 
+RSSR = yaml.safe_load((EX / "textbook" / "rssr.yaml").read_text())
+
+
+def rssr(**edits) -> dict:
+    d = copy.deepcopy(RSSR)
+    for jid, fields in edits.items():
+        next(j for j in d["joints"] if j["id"] == jid).update(fields)
+    return d
+
+
+@pytest.mark.parametrize("data,expect", [
+    (rssr(C={"point": [1, 0, 0]}), "link 'rod' has zero length: its joints B, C are at one point"),
+    (rssr(B={"type": "U", "axis": [0, 0, 1], "axis2": [0, 1, 0]}, C={"point": [1, 0, 0]}),
+     "link 'rod' has zero length"),
+    ({**fourbar(), "joints": fourbar()["joints"] + [{**fourbar()["joints"][1], "id": "B2"}]},
+     "joints B and B2 are the same R pair"),
+], ids=["S-S rod", "U-S rod", "doubled pair"])
+def test_degenerate_geometry_of_other_pairs(run_cli, tmp_path, data, expect):
+    code, _, err = run_cli("analyze", write(tmp_path, "m.yaml", data))
+    assert code == 2 and expect in one_error_line(err)
+
+
+def test_crossed_hinges_at_one_point_are_a_hooke_cross_not_a_zero_length_link():
+    from mechsyn.io import mechanism_from_dict
+
+    d = rssr(B={"links": ["crank", "cross"], "type": "R", "axis": [0, 0, 1]})
+    d["links"].append("cross")
+    d["joints"].append({"id": "B2", "type": "R", "links": ["cross", "rod"], "point": [1, 0, 0], "axis": [0, 1, 0]})
+    assert len(mechanism_from_dict(d, "m.yaml").joints) == 5
+    d["joints"][-1]["axis"] = [0, 0, -1]  # parallel hinges at one point: the cross has zero length
+    with pytest.raises(MechsynInputError, match="link 'cross' has zero length"):
+        mechanism_from_dict(d, "m.yaml")
+
+
+def test_slider_on_its_pivot_is_not_degenerate():
+    from mechsyn.io import load_mechanism
+
+    assert load_mechanism(EX / "textbook" / "slider_crank.yaml")  # the block's R and P at one point
+
+
+def test_an_unforeseen_os_error_is_one_line(run_cli, tmp_path):
+    """`schema --out` in a folder that cannot be made: the OSError net of the command line."""
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    code, _, err = run_cli("schema", "--out", blocker / "sub" / "s.json")
+    assert code == 2 and "fix: check the path" in one_error_line(err)
+
+
 def test_negative_mass_names_the_field(run_cli, tmp_path):
     d = copy.deepcopy(FOURBAR)
     d["links"][1]["mass"] = -0.5
@@ -212,7 +260,9 @@ def test_atlas_stream_never_overwrites_foreign_file(run_cli, tmp_path):
     ["synth", "mechanism", str(MECH_CASE), "--out", "{bad}/x.yaml"],
     ["simulate", str(EX / "kinematics" / "crank_rocker.yaml"), "--input", "A=0:10:5", "--csv", "{bad}/x.csv"],
     ["atlas", "--links", "6", "--out", "{bad}/x.svg"],
-], ids=["synth-path", "synth-mechanism", "simulate", "atlas"])
+    ["analyze", str(EX / "kinematics" / "crank_rocker.yaml"), "--json", "--out", "{bad}/x.json"],
+    ["synth", "path", str(PATH_CASES), "--case", "P2_kk5_timing", "--checkpoint", "{bad}/ck.json"],
+], ids=["synth-path", "synth-mechanism", "simulate", "atlas", "analyze", "checkpoint"])
 def test_unwritable_output_checked_before_computing(run_cli, tmp_path, args):
     blocker = tmp_path / "file"
     blocker.write_text("")
@@ -242,12 +292,48 @@ def test_markup_and_escapes_in_names_never_reach_the_terminal(tmp_path):
     assert "[link=https://evil.example]" in out
 
 
-@pytest.mark.parametrize("command", ["analyze", "structure"])
+@pytest.mark.parametrize("command", ["analyze", "structure", "analyze --markdown"])
 def test_names_printed_as_text(run_cli, tmp_path, command):
     d = copy.deepcopy(FOURBAR)
     d["name"] = "[link=https://evil.example]click[/link] \x1b[31mred"
-    code, out, _ = run_cli(command, write(tmp_path, "m.yaml", d))
+    words = command.split()
+    code, out, _ = run_cli(words[0], write(tmp_path, "m.yaml", d), *words[1:])
     assert code == 0 and "[link=https://evil.example]click[/link]" in out and "\x1b" not in out
+
+
+MARKUP_NAMES = ["[/]", "a[/bold]b", "[crank]", "[@click=app.quit]x", "[bold]bold", "x\\", "[red]r[/red][/]"]
+
+
+@pytest.mark.parametrize("command", ["analyze", "structure", "simulate --input A=0:360:90",
+                                     "forces --input A=0:360:90", "export --svg {tmp}/m.svg --drawing {tmp}/d.svg"])
+def test_markup_in_link_and_joint_names_is_text_not_a_crash(run_cli, tmp_path, command):
+    """A link called "[/]" closed the command's own [bold] tag: rich raised MarkupError."""
+    d = copy.deepcopy(FOURBAR)
+    rename = dict(zip(["crank", "coupler", "rocker"], MARKUP_NAMES))
+    d["name"] = MARKUP_NAMES[-1]
+    for link in d["links"][1:]:
+        link["name"] = rename[link["name"]]
+    for j, new in zip(d["joints"], MARKUP_NAMES[3:]):
+        j["id"] = new
+    for j in d["joints"]:
+        j["links"] = [rename.get(x, x) for x in j["links"]]
+    for p in d.get("points", {}).values():
+        p["link"] = rename.get(p["link"], p["link"])
+    for load in d.get("loads", []):
+        load["link"] = rename.get(load["link"], load["link"])
+    d["joints"][0]["id"] = "A"
+    words = command.replace("{tmp}", str(tmp_path)).split()
+    code, out, err = run_cli(words[0], write(tmp_path, "m.yaml", d), *words[1:])
+    assert "Traceback" not in err and "MarkupError" not in err, err
+    assert code == 0, err
+    assert "[/]" in out or command.startswith(("simulate", "export"))
+
+
+def test_guard_markup_keeps_styles_escapes_the_rest():
+    from mechsyn.cli.common import guard_markup
+
+    assert guard_markup("[bold red]e[/] [/bold]") == "[bold red]e[/] [/bold]"
+    assert guard_markup("[crank] [@click=x] [link=y]") == "\\[crank] \\[@click=x] \\[link=y]"
 
 
 def test_numbers_never_cut_at_80_columns(run_cli):
@@ -287,3 +373,72 @@ def test_usage_errors_are_one_line(run_cli, args, expect):
     msg = one_error_line(err)
     assert code == 2 and expect in msg and "-h" in msg
     assert len(err.strip().splitlines()) <= 2
+
+
+@pytest.mark.parametrize("command, shows", [("structure", "Assur groups of 4 links"), ("analyze", "reading m.yaml")])
+def test_long_steps_of_big_files_show_a_spinner(run_cli, tmp_path, monkeypatch, command, shows):
+    """Reading a big file and decomposing a large mechanism take seconds: the terminal shows
+    the step (thresholds lowered here so a four-bar counts as large)."""
+    import mechsyn.cli.working as working
+    from mechsyn.cli.common import err_console
+
+    monkeypatch.setattr(working, "BIG_FILE_BYTES", 10)
+    monkeypatch.setattr(working, "LARGE_JOINTS", 2)
+    from contextlib import nullcontext
+
+    shown = []
+    monkeypatch.setattr(err_console, "_force_terminal", True)
+    monkeypatch.setattr(err_console, "status", lambda what, **kw: shown.append(what) or nullcontext())
+    code, out, err = run_cli(command, write(tmp_path, "m.yaml", FOURBAR))
+    assert code == 0 and any(shows in s for s in shown), shown
+
+
+ARM_FILE = EX / "capability" / "paper004_3r.yaml"
+
+
+@pytest.mark.parametrize("args", [
+    ["--point", "1300,900", "--direction", "0,0"],
+    ["--point", "1300,900", "--direction", "1,0", "--step", "0"],
+    ["--point", "1300,900", "--direction", "1,0", "--measure", "fastest"],
+    ["--point", "1300,900", "--direction", "1,0", "--csv", "x.csv"],
+    ["--grid", "1300:2100:200", "--direction", "1,0"],
+    ["--grid", "0:1e9:1,0:1:1", "--direction", "1,0"],
+    ["--grid", "0:3000:1,0:3000:1", "--direction", "1,0"],
+    ["--grid", "1300:1700:100,300:700:100", "--direction", "1,0", "--interpolate", "0,0"],
+    ["--grid", "1300:1700:100,300:700:100"],
+])
+def test_capability_errors_name_the_fix(run_cli, tmp_path, monkeypatch, args):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli("capability", ARM_FILE, *args)
+    assert code == 2 and "(fix:" in one_error_line(err), err
+
+
+@pytest.mark.parametrize("edit, fix", [
+    ({"link_lengths": [1000, -1, 500]}, ": link_lengths must be finite and >= 0 (fix: correct the value named"),
+    ({"kind": "scara"}, "kind: planar_serial"),
+    ({"bogus": 1}, "delete it or check its spelling"),
+])
+def test_arm_file_errors_name_the_fix(run_cli, tmp_path, edit, fix):
+    data = {**yaml.safe_load(ARM_FILE.read_text()), **edit}
+    code, _, err = run_cli("capability", write(tmp_path, "arm.yaml", data), "--point", "1300,900", "--direction", "1,0")
+    assert code == 2 and fix in one_error_line(err), err
+
+
+def test_float_noise_is_zero_in_every_table_and_path_extent(run_cli):
+    """A fixed pivot's path extent printed 'y -1.38778e-15 .. 9.71445e-16'; a unit vector's
+    component printed '-0.0000'."""
+    code, out, _ = run_cli("simulate", EX / "kinematics" / "triple_rocker.yaml", "--input", "A=0:360:2")
+    assert code == 0 and "path of D: x 4.5 .. 4.5, y 0 .. 0 (width 0, height 0)" in " ".join(out.split())
+    code, out, _ = run_cli("simulate", EX / "fingers" / "two_phalanx_vll_000.yaml", "--input", "E=-15:60:1",
+                           "--points", "tip")
+    assert code == 0 and "-0.0000" not in out and "0.0000" in out
+
+
+def test_a_name_too_long_for_the_file_system_is_one_clear_error(run_cli):
+    """Found by the fuzzing suite: a case's `mechanism: xxx...` (300 characters) raised OSError."""
+    with pytest.raises(MechsynInputError, match="File name too long"):
+        from mechsyn.io import load_mechanism
+
+        load_mechanism("x" * 300)
+    code, _, err = run_cli("analyze", "y" * 300)
+    assert code == 2 and "each name at most 255 bytes" in one_error_line(err)

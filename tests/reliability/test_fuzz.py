@@ -5,6 +5,8 @@ the Python API the same inputs raise MechsynInputError, never a bare TypeError,
 LinAlgError or RecursionError.
 
 The default run is short (a few seconds of examples); ``-m slow`` runs a deeper one.
+``MECHSYN_FUZZ_SCALE=20`` multiplies every example count by 20 and draws new random
+examples (the default run is derandomised, so CI is reproducible), for a long local hunt.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import os
 import signal
 import tempfile
 from contextlib import contextmanager
@@ -36,6 +39,8 @@ SEEDS = {
 ARM = EX / "capability" / "paper004_3r.yaml"
 CASE = EX / "synthesis" / "slider_crank_path_case.yaml"
 HANG_SECONDS = 60   # an example running longer than this is a hang, not slowness
+SCALE = max(1, int(os.environ.get("MECHSYN_FUZZ_SCALE", "1")))
+FIXED = SCALE == 1  # derandomised in CI; a scaled local run draws new examples
 
 
 @contextmanager
@@ -55,7 +60,7 @@ def hang_guard(seconds: int = HANG_SECONDS):
 
 # ----------------------------------------------------------------------- strategies
 NASTY_TEXT = st.sampled_from(["", "x" * 300, "\x1b[31mred\x1b[0m", "[link=https://e.example]l[/link]",
-                              "A", "frame", "R", "P", "0", "nan", "-", "é"])
+                              "A", "frame", "R", "P", "0", "nan", "-", "é", "[/]", "[bold]", "[crank]"])
 SCALARS = st.one_of(
     st.none(), st.booleans(), st.integers(-10**6, 10**6),
     st.floats(allow_nan=True, allow_infinity=True),
@@ -169,9 +174,9 @@ def _api_contract(call, *args, **kwargs):
 
 
 # ----------------------------------------------------------------------- mechanism files
-FAST = settings(max_examples=5, deadline=None, derandomize=True,
+FAST = settings(max_examples=5 * SCALE, deadline=None, derandomize=FIXED,
                 suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
-DEEP = settings(max_examples=25, deadline=None, derandomize=True,
+DEEP = settings(max_examples=25 * SCALE, deadline=None, derandomize=FIXED,
                 suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 
 
@@ -182,6 +187,8 @@ def _mechanism_files_through_cli(capsys, data):
         for cmd in (["analyze"], ["structure"], ["simulate", "--input", "A=0:360:45"]):
             argv = [cmd[0], str(f), *cmd[1:], "--json"]
             _check_cli(capsys, argv)
+        for cmd in ("analyze", "structure"):  # the terminal tables too (names with markup)
+            _check_cli(capsys, [cmd, str(f)])
 
 
 def _mechanism_data_through_api(data):
@@ -197,21 +204,21 @@ def test_broken_mechanism_files_cli(capsys, seed, data):
     _mechanism_files_through_cli(capsys, data.draw(broken(_load(SEEDS[seed]))))
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_mechanism_data_api(data):
     seed = data.draw(st.sampled_from(sorted(SEEDS)))
     _mechanism_data_through_api(data.draw(broken(_load(SEEDS[seed]))))
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(value=VALUES)
 def test_any_data_as_mechanism_api(value):
     _mechanism_data_through_api(value)
 
 
 # ----------------------------------------------------------------------- case and arm files
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_synthesis_cases_api(data):
     from mechsyn.synthesis.general import case_from_dict
@@ -219,7 +226,7 @@ def test_broken_synthesis_cases_api(data):
     _api_contract(case_from_dict, data.draw(broken(_load(CASE))), str(CASE), base_dir=CASE.parent)
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_path_cases_api(data):
     from mechsyn.synthesis.path import PathCase
@@ -228,12 +235,37 @@ def test_broken_path_cases_api(data):
     _api_contract(PathCase.from_dict, data.draw(broken(cases["cases"][0])), "case.json")
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_arm_files_api(data):
     from mechsyn.capability.arm import arm_from_dict
 
     _api_contract(arm_from_dict, data.draw(broken(_load(ARM))), str(ARM), base_dir=ARM.parent)
+
+
+@FAST
+@given(data=st.data())
+def test_broken_arm_files_cli(capsys, data):
+    with tempfile.TemporaryDirectory() as tmp:
+        f = Path(tmp) / "arm.yaml"
+        f.write_text(_dump(data.draw(broken(_load(ARM)))), encoding="utf-8")
+        _check_cli(capsys, ["capability", str(f), "--point", "1300,900", "--direction", "1,0"])
+        _check_cli(capsys, ["capability", str(f), "--grid", "1300:1500:100,500:700:100", "--direction",
+                            "1,0", "--json"])
+
+
+@settings(max_examples=40 * SCALE, deadline=None, derandomize=FIXED)
+@given(data=st.data())
+def test_broken_checkpoints_api(data):
+    from mechsyn.checkpoint import RestartCheckpoint
+
+    seed = {"format": "mechsyn-checkpoint", "version": 1, "kind": "k", "key": {"seed": 0},
+            "finished": {"0": {"seed": 1, "x": [1.0, 2.0], "fitness": 0.5, "nfev": 3, "seconds": 1.0}},
+            "partial": {"index": 1, "seed": 2, "x": [0.0, 1.0], "fitness": 2.0}}
+    with tempfile.TemporaryDirectory() as tmp:
+        f = Path(tmp) / "ck.json"
+        f.write_text(json.dumps(data.draw(broken(seed))), encoding="utf-8")
+        _api_contract(RestartCheckpoint.open, f, "k", {"seed": 0}, resume=True)
 
 
 # ----------------------------------------------------------------------- command lines
@@ -245,7 +277,7 @@ WORDS = st.sampled_from([
 ])
 
 
-@settings(max_examples=20, deadline=None, derandomize=True,
+@settings(max_examples=20 * SCALE, deadline=None, derandomize=FIXED,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(argv=st.lists(WORDS, min_size=1, max_size=6))
 def test_random_command_lines(capsys, argv):
@@ -274,7 +306,7 @@ def test_broken_mechanism_files_cli_deep(capsys, seed, data):
 
 
 @pytest.mark.slow
-@settings(max_examples=300, deadline=None, derandomize=True)
+@settings(max_examples=300 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_mechanism_data_api_deep(data):
     seed = data.draw(st.sampled_from(sorted(SEEDS)))

@@ -126,13 +126,17 @@ def test_cli_interrupted_json_says_so(cli_json, run_cli, monkeypatch):
     assert code == INTERRUPT_EXIT_CODE and json.loads(stdout)["interrupted"] is True
 
 
-def _sigint_subprocess(args: list[str], delay: float, cwd: Path) -> subprocess.CompletedProcess:
+def _sigint_subprocess(args: list[str], delay: float, cwd: Path, ready: Path | None = None) -> subprocess.CompletedProcess:
+    """Run mechsyn, send SIGINT ``delay`` s after ``ready`` exists (or after start), collect."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     # a child of a non-interactive shell may inherit SIGINT ignored: restore the default so
     # Python installs its KeyboardInterrupt handler, as in a terminal
     p = subprocess.Popen([sys.executable, "-m", "mechsyn", *args], env=env, cwd=cwd, text=True,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    end = time.monotonic() + 240  # a loaded machine may take long to start
+    while ready is not None and not ready.exists() and p.poll() is None and time.monotonic() < end:
+        time.sleep(0.2)
     time.sleep(delay)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=60)
@@ -141,9 +145,12 @@ def _sigint_subprocess(args: list[str], delay: float, cwd: Path) -> subprocess.C
 
 @pytest.mark.slow
 def test_real_sigint_to_synth_path_keeps_best(tmp_path):
+    # SIGINT once the search has saved its first checkpoint (it has evaluated designs)
     r = _sigint_subprocess(["synth", "path", str(CASES), "--case", "P5_ellipse10_notiming",
-                            "--time-limit", "300", "--target-error", "0", "--out", "x.yaml"], delay=8.0, cwd=tmp_path)
+                            "--time-limit", "300", "--target-error", "0", "--out", "x.yaml",
+                            "--checkpoint", "ck.json"], delay=0.5, cwd=tmp_path, ready=tmp_path / "ck.json")
     assert r.returncode == INTERRUPT_EXIT_CODE, r.stderr
+    assert "continue with --resume ck.json" in " ".join(r.stderr.split())
     assert r.stderr.strip().splitlines()[-1] == "interrupted"
     assert "Traceback" not in r.stderr
     assert (tmp_path / "x.yaml").read_text().startswith("# INTERRUPTED")
@@ -187,3 +194,44 @@ def test_cli_interrupted_curve_synthesis_writes_best_and_exits_130(run_cli, tmp_
     assert err.strip().splitlines()[-1] == "interrupted"
     res = json.loads(out)
     assert res["interrupted"] is True
+
+
+CAPABILITY_ARM = ROOT / "examples" / "capability" / "paper004_3r.yaml"
+
+
+def test_capability_map_interrupted_keeps_the_finished_chunks():
+    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.maps import capability_map
+
+    arm = load_arm(CAPABILITY_ARM)
+    xs, ys = np.linspace(1300, 2100, 5), np.linspace(100, 900, 4)
+    full = capability_map(arm, xs, ys, [1, 0])
+    part = capability_map(arm, xs, ys, [1, 0], chunk=6, advance=_interrupt_after(2))
+    assert part.interrupted and part.done().sum() == 12  # two chunks of 6 points (x outer)
+    done = part.done()
+    assert np.array_equal(part.value[done], full.value[done], equal_nan=True)
+    assert np.isnan(part.value[~done]).all() and len(part.table()) == 12
+    assert part.to_dict()["computed_points"] == 12 and not full.to_dict()["interrupted"]
+    # the chunk whose progress call was interrupted is kept too
+    assert capability_map(arm, xs, ys, [1, 0], chunk=6, advance=_interrupt_after(1)).done().sum() == 6
+
+
+def test_cli_capability_map_interrupted_writes_solved_points_and_exits_130(run_cli, tmp_path, monkeypatch):
+    import mechsyn.capability.maps as maps
+
+    real, calls = maps._map_chunk, [0]
+
+    def second_chunk_interrupts(*args):
+        calls[0] += 1
+        if calls[0] == 2:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(maps, "_map_chunk", second_chunk_interrupts)
+    csv = tmp_path / "map.csv"
+    code, out, err = run_cli("capability", CAPABILITY_ARM, "--grid", "1300:2100:10,100:900:10",
+                             "--direction", "1,0", "--csv", csv)
+    assert code == INTERRUPT_EXIT_CODE and err.strip().splitlines()[-1] == "interrupted"
+    assert "interrupted: 2048 of 6561 points solved" in out
+    lines = csv.read_text().splitlines()
+    assert len(lines) == 1 + 2048 and lines[-1].count(",") == lines[0].count(",")

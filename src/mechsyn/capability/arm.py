@@ -126,6 +126,10 @@ ArmSpec = Annotated[Union[PlanarSerialSpec, DHSpec, URDFSpec], Field(discriminat
 _ADAPTER: TypeAdapter = TypeAdapter(ArmSpec)
 
 
+#: The fix of an arm-file error no check names more precisely.
+ARM_HINT = "check the arm file against docs/capability.md (examples/capability/ has one of each kind)"
+
+
 # --------------------------------------------------------------------------- runtime model
 def _rot(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rotation matrices (N, 3, 3) about unit ``axis`` by ``angle`` (N,) (Rodrigues)."""
@@ -343,15 +347,17 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
         err = exc.errors()[0]
         loc = ".".join(str(p) for p in err["loc"] if not (isinstance(p, str) and p in (
             "planar_serial", "dh", "urdf")))
-        msg = err["msg"]
+        msg = err["msg"].removeprefix("Value error, ")
+        hint = f"correct {loc or 'the value named'}: " + {
+            "missing": "add it", "extra_forbidden": "delete it or check its spelling"}.get(
+            err["type"], "see docs/capability.md and examples/capability/")
         if err["type"] == "union_tag_invalid" or err["type"] == "union_tag_not_found":
             msg = "unknown or missing 'kind'"
             loc = "kind"
-        raise MechsynInputError(msg, source=source, field=loc or None,
-                                hint="kind: planar_serial (link_lengths), dh (dh rows) or urdf (urdf path)"
-                                ) from None
+            hint = "kind: planar_serial (link_lengths), dh (dh rows) or urdf (urdf path)"
+        raise MechsynInputError(msg, source=source, field=loc or None, hint=hint) from None
     except ValueError as exc:
-        raise MechsynInputError(str(exc), source=source) from None
+        raise MechsynInputError(str(exc), source=source, hint=ARM_HINT) from None
     try:
         if isinstance(spec, PlanarSerialSpec):
             return _build_planar(spec)
@@ -361,7 +367,7 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
     except MechsynInputError as exc:
         raise exc.with_source(source) if source else exc from None
     except ValueError as exc:  # e.g. a URDF chain whose lengths do not fit the file's lists
-        raise MechsynInputError(str(exc), source=source) from None
+        raise MechsynInputError(str(exc), source=source, hint=ARM_HINT) from None
 
 
 def load_arm(path: str | Path) -> SerialArm:
@@ -442,31 +448,36 @@ def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm
     try:
         root = ET.parse(path).getroot()
     except (OSError, ET.ParseError) as exc:
-        raise MechsynInputError(f"cannot read URDF: {exc}", source=src) from None
+        raise MechsynInputError(f"cannot read URDF: {exc}", source=src,
+                                hint="give a well-formed URDF file (its path is relative to the arm file)") from None
     joints = {}
     children = {}
     for j in root.findall("joint"):
         parent, child = j.find("parent"), j.find("child")
         if parent is None or child is None:
-            raise MechsynInputError(f"joint {j.get('name')!r} lacks parent or child", source=src)
+            raise MechsynInputError(f"joint {j.get('name')!r} lacks parent or child", source=src,
+                                    hint="give the joint <parent link=\"...\"/> and <child link=\"...\"/>")
         joints[child.get("link")] = j
         children.setdefault(parent.get("link"), []).append(child.get("link"))
     links = [lk.get("name") for lk in root.findall("link")]
     base = spec.base_link or next((lk for lk in links if lk not in joints), None)
     if base is None:
-        raise MechsynInputError("no base link (every link has a parent joint)", source=src)
+        raise MechsynInputError("no base link (every link has a parent joint)", source=src,
+                                hint="a URDF is a tree: remove the joint that closes a loop")
     tip = spec.tip_link
     if tip is None:  # follow the only chain
         tip = base
         while children.get(tip):
             if len(children[tip]) > 1:
-                raise MechsynInputError(f"link {tip!r} branches; give tip_link", source=source)
+                raise MechsynInputError(f"link {tip!r} branches", source=source, field="tip_link",
+                                        hint="give tip_link: the URDF link that carries the tool")
             tip = children[tip][0]
     chain = []
     link = tip
     while link != base:
         if link not in joints:
-            raise MechsynInputError(f"no chain from {base!r} to {tip!r}", source=src)
+            raise MechsynInputError(f"no chain from {base!r} to {tip!r}", source=src,
+                                    hint=f"give as tip_link a link below {base!r} in the URDF")
         chain.append(joints[link])
         link = joints[link].find("parent").get("link")
     chain.reverse()
@@ -501,7 +512,8 @@ def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm
     fixed[-1] = fixed[-1] @ _homog(p=spec.tool)
     n = len(types)
     if n == 0:
-        raise MechsynInputError("the URDF chain has no moving joint", source=src)
+        raise MechsynInputError("the URDF chain has no moving joint", source=src,
+                                hint="the chain to tip_link needs revolute, continuous or prismatic joints")
     rev = np.array([t == "R" for t in types])
     if spec.joint_limits_deg is not None or spec.joint_speed_limits_deg_s is not None:
         spec._check_lengths(n)

@@ -307,6 +307,12 @@ class CapabilityMap(Result):
     joint_is_revolute: np.ndarray
     #: the optimal configuration interpolated at a point (see :func:`capability_grid`)
     interpolated: dict[str, Any] | None = field(default=None, repr=False)
+    interrupted: bool = False          # Ctrl-C: only the points of ``computed`` were solved
+    computed: np.ndarray | None = None  # (len(xs), len(ys)) bool; None: every point
+
+    def done(self) -> np.ndarray:
+        """Which grid points were solved (all, unless Ctrl-C interrupted the map)."""
+        return np.ones(self.value.shape, bool) if self.computed is None else self.computed
 
     def q_user(self) -> np.ndarray:
         """Optimal joint values in file units (degrees for R joints)."""
@@ -317,15 +323,18 @@ class CapabilityMap(Result):
         return {"x": self.xs, "y": self.ys, "z": self.z, "direction": self.direction,
                 "measure": self.measure, "search": self.search,
                 "v_max": v, "q_opt": self.q_user(), "joints": list(self.joint_names),
+                "interrupted": self.interrupted, "computed_points": int(self.done().sum()),
+                **({"computed": self.done()} if self.interrupted else {}),
                 **({} if self.interpolated is None else {"interpolated": self.interpolated})}
 
     def table(self) -> np.ndarray:
         """Rows ``x, y, v_max, q...`` (x outer, y inner), shape (P, 3 + n); NaN where no
-        allowed configuration reaches."""
+        allowed configuration reaches. Points not solved (Ctrl-C) have no row."""
         X, Y = np.meshgrid(self.xs, self.ys, indexing="ij")
         v = np.where(np.isfinite(self.value), self.value, np.nan)
         n = self.q.shape[-1]
-        return np.column_stack([X.ravel(), Y.ravel(), v.ravel(), self.q_user().reshape(-1, n)])
+        rows = np.column_stack([X.ravel(), Y.ravel(), v.ravel(), self.q_user().reshape(-1, n)])
+        return rows if self.computed is None else rows[self.computed.ravel()]
 
     def rows(self) -> list[list[float]]:
         """:meth:`table` as a list of rows."""
@@ -381,6 +390,9 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     ``scheduler`` (a Dask cluster) solve the chunks in parallel
     (:func:`mechsyn.parallel.run_tasks`): every point's answer depends only on the point,
     so the map is the same. Spatial arms need ``z`` (the grid lies in the plane z = const).
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``advance``) returns the chunks
+    finished so far, ``interrupted=True`` and ``computed`` marking their points (NaN
+    elsewhere); it propagates when no chunk had finished.
 
     Examples
     --------
@@ -401,20 +413,30 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     tasks = [(arm, pts[start:start + chunk], direction, measure, q1, branch, respect_limits,
               continuous) for start in range(0, P, chunk)]
 
+    got: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
     def progress(done: int, total: int, index: int, result) -> None:
+        got[index] = result  # kept before the callback, which may raise Ctrl-C
         if advance is not None:
             advance(len(result[0]))
 
-    parts = run_tasks(_map_chunk, tasks, workers=workers, scheduler=scheduler,
-                      progress=progress)
-    value = np.concatenate([v for v, _ in parts])
-    qopt = np.concatenate([q for _, q in parts])
+    interrupted = False
+    try:
+        run_tasks(_map_chunk, tasks, workers=workers, scheduler=scheduler, progress=progress)
+    except KeyboardInterrupt:
+        if not got:
+            raise
+        interrupted = True
+    size = [len(t[1]) for t in tasks]
+    value = np.concatenate([got[i][0] if i in got else np.full(k, np.nan) for i, k in enumerate(size)])
+    qopt = np.concatenate([got[i][1] if i in got else np.full((k, arm.n), np.nan) for i, k in enumerate(size)])
     qopt[~np.isfinite(value)] = np.nan
     d = np.asarray(direction, float)
+    computed = np.repeat([i in got for i in range(len(tasks))], size).reshape(X.shape) if interrupted else None
     return CapabilityMap(xs, ys, z, d / np.linalg.norm(d), measure,
                          "continuous" if continuous else "sampled",
                          value.reshape(X.shape), qopt.reshape(*X.shape, arm.n),
-                         arm.joint_names, arm.is_revolute)
+                         arm.joint_names, arm.is_revolute, interrupted, computed)
 
 
 def _map_chunk(arm: SerialArm, pts: np.ndarray, direction, measure: str, q1, branch: str,

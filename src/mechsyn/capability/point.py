@@ -167,11 +167,12 @@ def capability_at(arm: SerialArm, point: Any, direction: Any, *, measure: str = 
     point = np.asarray(point, float)
     d = np.asarray(direction, float)
     if measure not in MEASURES:
-        raise MechsynInputError(f"unknown measure {measure!r}", field="measure", hint=", ".join(MEASURES))
+        raise MechsynInputError(f"unknown measure {measure!r}", field="measure", hint="one of " + ", ".join(MEASURES))
     if not np.all(np.isfinite(point)):
-        raise MechsynInputError("values must be finite", field="point")
+        raise MechsynInputError("values must be finite", field="point", hint="give finite coordinates, e.g. [1300, 900]")
     if not np.all(np.isfinite(d)) or not np.linalg.norm(d) > 0:
-        raise MechsynInputError("the direction must be a finite, non-zero vector", field="direction")
+        raise MechsynInputError("the direction must be a finite, non-zero vector", field="direction",
+                                hint="e.g. [1, 0] for +x")
     dn = d / np.linalg.norm(d)
     q, valid = self_motion(arm, point, q1, branch, respect_limits=respect_limits)
     qv = q[valid]

@@ -19,7 +19,7 @@ from typing import Annotated, Optional
 import typer
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import emit_json, err_console
+from mechsyn.cli.common import emit_json, err_console, strip_control
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.results import write_atomic
 from mechsyn.structure.report import analyze as structure_report
@@ -60,13 +60,19 @@ def analyze(
     variable-structure mechanism with paper 002's external constraints.
 
     When the file gives the joints' geometry, the rank method (screw theory) answers exactly: instantaneous mobility, useful and idle mobilities, redundant constraints per contour and their directions, drives, singularity; each formula is shown next to it."""
-    report = _analyze_reporting(load_mechanism(file), method=method, remedies=remedies,
+    from mechsyn.cli.common import check_writable
+    from mechsyn.cli.working import reading
+
+    check_writable(out, "--out")
+    with reading(file):
+        mech = load_mechanism(file)
+    report = _analyze_reporting(mech, method=method, remedies=remedies,
                                 max_variants=max_variants, tol=tol, as_spatial=spatial)
     if json_out:
         emit_json(report.to_dict(), out)
     elif markdown:
         if out is None:
-            typer.echo(report.to_markdown(), nl=False)
+            typer.echo(strip_control(report.to_markdown()), nl=False)  # a file's escapes never reach the terminal
         else:
             write_atomic(out, report.to_markdown())
     else:

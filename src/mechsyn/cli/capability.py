@@ -25,7 +25,7 @@ from mechsyn.capability.measures import MEASURES
 from mechsyn.capability.point import capability_at
 from mechsyn.cli.app import app
 from mechsyn.cli.common import (check_writable, console, emit_json, is_stdout, one_stdout, parse_floats, parse_range,
-                                progress_bar, write_output)
+                                progress_bar, stop_if_interrupted, write_output)
 from mechsyn.cli.render import render_capability_map, render_point_capability
 from mechsyn.errors import MechsynInputError
 
@@ -40,14 +40,15 @@ def _values(text: str, option: str) -> np.ndarray:
         a, b, s = parse_range(text, option)
         n = int(math.floor((b - a) / s + 1e-9)) + 1
         if n > 100_000:
-            raise MechsynInputError(f"{n} values is too many", source=option)
+            raise MechsynInputError(f"{n:,} values is too many (at most 100,000 per axis)", source=option,
+                                    hint="use a larger step or a shorter range")
         return a + s * np.arange(n)
     return np.array(parse_floats(text, option))
 
 
 def _check_finite(values, option: str) -> None:
     if not np.all(np.isfinite(values)):
-        raise MechsynInputError("values must be finite", source=option)
+        raise MechsynInputError("values must be finite", source=option, hint="give finite numbers")
 
 
 PointOpt = Annotated[Optional[str], typer.Option("--point", help="tool point X,Y (X,Y,Z for spatial arms)")]
@@ -103,7 +104,8 @@ def capability(
     if point is not None:
         if map_png or csv_out or interpolate:
             raise MechsynInputError("--map, --csv and --interpolate go with --grid",
-                                    source="--map" if map_png else "--csv" if csv_out else "--interpolate")
+                                    source="--map" if map_png else "--csv" if csv_out else "--interpolate",
+                                    hint="give --grid X0:X1:DX,Y0:Y1:DY instead of --point")
         _point(arm, parse_floats(point, "--point", arm.task_dim), common, step, polytope, json_out)
     else:
         at = None if interpolate is None else parse_floats(interpolate, "--interpolate", 2)
@@ -116,13 +118,14 @@ def _common_options(arm: SerialArm, direction: str, q1: Optional[str], branch: O
     """The options of a point and a grid as the library's keyword arguments."""
     d = parse_floats(direction, "--direction", arm.task_dim)
     if not (step > 0 and math.isfinite(step)):
-        raise MechsynInputError("step must be positive", source="--step")
+        raise MechsynInputError("step must be positive", source="--step", hint="e.g. --step 1")
     if branch is not None:
         if branch.lower() not in _BRANCH_ALIASES:
             raise MechsynInputError(f"unknown branch {branch!r}", source="--branch",
                                     hint="negative (q3 < 0), positive or both")
         if not is_closed_form(arm):
-            raise MechsynInputError("--branch applies to planar 3R arms only", source="--branch")
+            raise MechsynInputError("--branch applies to planar 3R arms only", source="--branch",
+                                    hint="drop --branch: this arm's configurations are all searched")
     q1_vals = None
     if q1 is not None:
         q1_vals = _values(q1, "--q1")
@@ -144,7 +147,8 @@ def _point(arm, p, common: dict, step: float, polytope: bool, json_out: bool) ->
 def _grid(arm, grid: str, options: dict, map_png: Optional[Path], csv_out: Optional[Path], json_out: bool) -> None:
     parts = grid.split(",")
     if len(parts) != 2:
-        raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid")
+        raise MechsynInputError(f"expected X0:X1:DX,Y0:Y1:DY, got {grid!r}", source="--grid",
+                                hint="e.g. --grid 1300:2100:200,100:900:200")
     xs, ys = _values(parts[0], "--grid"), _values(parts[1], "--grid")
     total = xs.size * ys.size
     with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as advance:
@@ -158,11 +162,14 @@ def _grid(arm, grid: str, options: dict, map_png: Optional[Path], csv_out: Optio
 
         save_plot(map_png, plot_capability_map, cmap)
     if is_stdout(csv_out):
-        return
+        return stop_if_interrupted(cmap)
     if json_out:
         emit_json(cmap.to_dict())
-        return
+        return stop_if_interrupted(cmap)
     render_capability_map(cmap)
     for what, path in (("map", map_png), ("csv", csv_out)):
         if path is not None:
             console.print(f"wrote {what}: {path}")
+    if cmap.interrupted:
+        console.print(f"interrupted: {int(cmap.done().sum())} of {total} points solved (? in the table); the outputs hold those")
+    stop_if_interrupted(cmap)

@@ -9,6 +9,7 @@ import sys
 import tempfile
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
+from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Optional, TypeVar
 
@@ -33,7 +34,6 @@ SchedulerOpt = Annotated[Optional[str], typer.Option(
     "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask]).")]
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
-_LINK_TAG = re.compile(r"(?<!\\)\[(/?link\b)", re.IGNORECASE)  # not already escaped
 
 
 def strip_control(text: str) -> str:
@@ -61,6 +61,37 @@ def safe(text: object, limit: int = 120) -> str:
     return escape(text)
 
 
+_TAG = re.compile(r"(?<!\\)\[([a-zA-Z#/@][^\[\]]*)\]")
+
+
+@lru_cache(maxsize=512)
+def _is_style(body: str) -> bool:
+    from rich.errors import StyleSyntaxError
+    from rich.style import Style
+
+    name = body[1:] if body.startswith("/") else body
+    if body == "/" or (body.startswith("/") and not name):
+        return True
+    if name.startswith("@") or "link" in name.lower():
+        return False
+    try:
+        Style.parse(name)
+    except (StyleSyntaxError, ValueError):
+        return False
+    return True
+
+
+def guard_markup(text: str) -> str:
+    r"""``text`` with every ``[tag]`` that is not a plain style escaped: a file's
+    ``[link=...]``, ``[@click]`` or ``[crank]`` prints as text (``[bold]``, ``[red]``, ``[/]``
+    still style the commands' own messages).
+
+    >>> print(guard_markup("[bold]link[/] [crank] [link=https://x.example]x[/link]"))
+    [bold]link[/] \[crank] \[link=https://x.example]x\[/link]
+    """
+    return _TAG.sub(lambda m: m.group(0) if _is_style(m.group(1)) else "\\" + m.group(0), text)
+
+
 class SafeConsole(Console):
     """A rich Console that never sends a file's control characters to the terminal and
     never turns text into a hyperlink: every string it renders (messages and table cells,
@@ -68,16 +99,39 @@ class SafeConsole(Console):
     shown as text. The commands' own styles ([bold], [red]...) still work."""
 
     def render_str(self, text: str, *args: Any, **kwargs: Any) -> Any:
-        return super().render_str(_LINK_TAG.sub(r"\\[\1", strip_control(text)), *args, **kwargs)
+        from rich.errors import MarkupError, MissingStyle
+
+        text = guard_markup(strip_control(text))
+        try:
+            return super().render_str(text, *args, **kwargs)
+        except (MarkupError, MissingStyle):  # a file's "[/]" closed a tag: show it all as text
+            return super().render_str(text, *args, **{**kwargs, "markup": False})
+
+
+_NEGATIVE_ZERO = re.compile(r"(?<![\w.])-(0(?:\.0+)?)(?![\w.])")
+
+
+def no_negative_zero(text: str) -> str:
+    """``text`` with every number shown as a negative zero (``-0``, ``-0.0000``: float noise
+    rounded) written without its sign.
+
+    >>> no_negative_zero("-0.0000, -1, 0, -0.5, x-0")
+    '0.0000, -1, 0, -0.5, x-0'
+    """
+    return _NEGATIVE_ZERO.sub(r"\1", text)
 
 
 class Table(RichTable):
     """A rich Table whose cells wrap (fold) instead of being cut with an ellipsis: at 80
-    columns a number is never shown truncated (1.60e-15 never becomes "1.60e…")."""
+    columns a number is never shown truncated (1.60e-15 never becomes "1.60e…"); a number
+    rounded to a negative zero (``-0.0000``) is shown as ``0.0000`` in every cell."""
 
     def add_column(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("overflow", "fold")
         super().add_column(*args, **kwargs)
+
+    def add_row(self, *cells: Any, **kwargs: Any) -> None:
+        super().add_row(*(no_negative_zero(c) if isinstance(c, str) else c for c in cells), **kwargs)
 
 
 def fmt_number(value: Any, spec: str = ".6g", scale: float = 1.0) -> str:
@@ -94,7 +148,7 @@ def fmt_number(value: Any, spec: str = ".6g", scale: float = 1.0) -> str:
         return "—"
     if abs(v) <= 1e-12 * abs(scale):
         v = 0.0
-    return format(v, spec)
+    return no_negative_zero(format(v, spec))
 
 
 console = SafeConsole()

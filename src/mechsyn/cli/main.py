@@ -109,6 +109,13 @@ def main(argv: list[str] | None = None) -> int:
         return _exit(2, argv)
     except SystemExit as exc:  # typer.Exit inside commands
         return _exit(int(exc.code or 0), argv)
+    except OSError as exc:  # a file the checks before the work could not foresee (disk full...)
+        from mechsyn.cli.common import err_console, safe
+
+        where = f"{safe(exc.filename)}: " if exc.filename else ""
+        err_console.print(f"[bold red]error:[/] {where}{safe(exc.strerror or exc)} (fix: check the path, its "
+                          "folder's permissions and the free space)", highlight=False, soft_wrap=True)
+        return _exit(2, argv)
     except Exception as exc:  # click's (typer's vendored click's) own exceptions
         if type(exc).__name__ != "Abort":  # Abort: click's wrapping of Ctrl-C
             return _exit(_click_error(exc), argv)

@@ -88,8 +88,10 @@ def _derived_lines(d: dict[str, Any]) -> None:
                       highlight=False)
     for name, e in d.get("extent", {}).items():
         if e["width"] is not None:
-            console.print(f"path of {name}: x {e['x_min']:.6g} .. {e['x_max']:.6g}, y {e['y_min']:.6g} .. "
-                          f"{e['y_max']:.6g} (width {e['width']:.6g}, height {e['height']:.6g})", highlight=False)
+            size = max(abs(e[k]) for k in ("x_min", "x_max", "y_min", "y_max"))  # noise: below 1e-12 of it
+            x0, x1, y0, y1, w, h = (fmt_number(e[k], scale=size) for k in ("x_min", "x_max", "y_min", "y_max",
+                                                                          "width", "height"))
+            console.print(f"path of {name}: x {x0} .. {x1}, y {y0} .. {y1} (width {w}, height {h})", highlight=False)
     for name, s in d.get("straightness", {}).items():
         console.print(f"straightness of {name} over {s['range'][0]:g}..{s['range'][1]:g}: largest deviation "
                       f"{s['max_deviation']:.6g} over a length {s['length']:.6g}", highlight=False)
@@ -304,14 +306,14 @@ def _configuration_table(arm: Any, res: Any) -> tuple[Any, list[int]]:
 
 def render_point_capability(arm: Any, res: Any, step: float) -> None:
     """``mechsyn capability --point``: every configuration's joints and measures, the best marked."""
-    from rich.console import Console
+    from mechsyn.cli.common import SafeConsole
 
     from mechsyn.capability.point import MEASURE_HELP
 
     measure, configs, cb = res.measure, res.configurations, res.continuous_best
     table, shown = _configuration_table(arm, res)
     need = 12 + 8 * arm.n + 50
-    (console if console.is_terminal or console.width >= need else Console(width=need)).print(table)
+    (console if console.is_terminal or console.width >= need else SafeConsole(width=need)).print(table)
     if len(shown) < len(configs):
         console.print(f"showing the best {len(shown)} of {len(configs)} configurations (all with --json)")
     if not configs:
@@ -338,7 +340,8 @@ def render_capability_map(cmap: Any) -> None:
         for y in ys:
             table.add_column(f"{y:g}", justify="right")
         for i, x in enumerate(xs):
-            table.add_row(f"{x:g}", *["-" if not np.isfinite(c) else f"{c:.2f}" for c in v[i]])
+            table.add_row(f"{x:g}", *["?" if not ok else "-" if not np.isfinite(c) else f"{c:.2f}"
+                                      for c, ok in zip(v[i], cmap.done()[i])])
         console.print(table)
     if np.isfinite(v).any():
         i, j = np.unravel_index(np.nanargmax(v), v.shape)

@@ -32,8 +32,12 @@ def structure(
     from mechsyn.io import load_mechanism
     from mechsyn.structure.assur import assur_decomposition, roman
 
-    mech = load_mechanism(file)
-    result = assur_decomposition(mech, output_links=output or None)
+    from mechsyn.cli.working import LARGE_JOINTS, reading, working
+
+    with reading(file):
+        mech = load_mechanism(file)
+    with working(f"Assur groups of {len(mech.links):,} links", len(mech.joints) >= LARGE_JOINTS):
+        result = assur_decomposition(mech, output_links=output or None)
     if json_out:
         emit_json(result)
         return

@@ -9,7 +9,8 @@ import typer
 
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import (OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, TimeLimitOpt, WorkersOpt,
-                                check_output_suffix, emit_json, restart_progress, stop_if_interrupted)
+                                check_output_suffix, emit_json, restart_progress)
+from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -40,6 +41,8 @@ def synth_mechanism(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+    checkpoint: CheckpointOpt = None,
+    resume: ResumeOpt = None,
 ) -> None:
     """Move chosen joint / point coordinates and VLL lengths of a planar mechanism file so
     a point follows target positions (or a link target poses) at given input angles."""
@@ -51,13 +54,14 @@ def synth_mechanism(
     check_parallel_options(workers, scheduler)
     check_output_suffix(plot, (".png",), "--plot")
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    ck = checkpoint_options(checkpoint, resume)
     case = load_case(case_file)
     with restart_progress("synth mechanism", restarts, enabled=not as_json) as progress:
         res = mechanism_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
-                                  workers=workers, scheduler=scheduler, callback=progress)
+                                  workers=workers, scheduler=scheduler, callback=progress, **ck)
     _write_files(case_file, case, res, out, plot)
     if as_json:
         emit_json(res.to_dict())
     else:
         render_mechanism_synthesis(case, res)
-    stop_if_interrupted(res)
+    stop_if_interrupted(res, ck)

@@ -11,7 +11,8 @@ import typer
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import (OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, Table, TimeLimitOpt, WorkersOpt,
                                 check_output_suffix, check_writable, console, emit_json, parse_floats,
-                                restart_progress, save_plot, stop_if_interrupted)
+                                restart_progress, save_plot)
+from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 TargetErrorOpt = Annotated[Optional[float], typer.Option(
@@ -41,6 +42,8 @@ def synth_path(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
+    checkpoint: CheckpointOpt = None,
+    resume: ResumeOpt = None,
 ) -> None:
     """Path generation: a four-bar whose coupler point passes through the targets."""
     from mechsyn.cli.render import render_path_synthesis
@@ -51,17 +54,18 @@ def synth_path(
     check_parallel_options(workers, scheduler)
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
+    ck = checkpoint_options(checkpoint, resume)
     case = select_case(load_cases(case_file), case_id, source=str(case_file))
     with restart_progress(f"synth path {case.id}", restarts) as progress:
         res = path_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                              scheduler=scheduler, optimizer=optimizer, target_error=target_error,
-                             min_transmission=min_transmission, fold_margin=fold_margin, callback=progress)
+                             min_transmission=min_transmission, fold_margin=fold_margin, callback=progress, **ck)
     _write_path_files(case, res, out, plot)
     if as_json:
         emit_json(res.to_dict())
     else:
         render_path_synthesis(case, res)
-    stop_if_interrupted(res)
+    stop_if_interrupted(res, ck)
 
 
 def _write_path_files(case, res, out: Optional[Path], plot: Optional[Path]) -> None:

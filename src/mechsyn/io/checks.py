@@ -5,9 +5,12 @@ A silent wrong answer is worse than an error, so :func:`check_geometry` refuses
 * coordinates so large that squared distances overflow (beyond the limit ``coordinate``
   of :mod:`mechsyn.limits`, 1e100):
   every length, angle and Jacobian computed from them would be ``inf`` or ``nan``;
-* a zero-length link: a moving link with two or more revolute joints, all at one point
-  (a crank whose both pivots coincide "assembles" everywhere and never moves; all the
-  joints of a file at one point make every link zero-length);
+* a zero-length link: a moving link with two or more pivots (revolute, spherical,
+  universal pairs), all at one point (a crank whose both pivots coincide "assembles"
+  everywhere and never moves; all the joints of a file at one point make every link
+  zero-length). Revolute pairs at one point with crossed axes (a Hooke joint's cross)
+  are allowed; slides, cylinders and contacts act along lines and are not pivots;
+* one pair written twice: two joints of one type between the same links at one point;
 * a gear pair of ratio 0 (the second link could never turn).
 
 Each error names the file, the joints or links and the fix.
@@ -73,8 +76,21 @@ def _xyz(p: Any) -> np.ndarray:
     return np.pad(v, (0, 3 - v.size))
 
 
+#: Pairs that act about a point of the link (a pivot): two of them at one point leave a
+#: link of zero length. A slide (P), a cylinder (C), a screw (H) or a contact pair acts
+#: along a line or a surface: its ``point`` is any point of it, and may lie on a pivot.
+PIVOT_PAIRS = ("R", "S", "U", "S_pin")
+
+
+def _located(j: Any) -> bool:
+    return j.point is not None and 1 <= np.size(j.point) <= 3
+
+
 def check_geometry(mech: Any, source: str | None = None) -> Any:
-    """Raise :class:`MechsynInputError` for geometry no mechanism can have; return ``mech``."""
+    """Raise :class:`MechsynInputError` for geometry no mechanism can have; return ``mech``.
+
+    Work grows linearly with the joints (a 2,000-link file is checked in milliseconds).
+    """
     big = limit("coordinate")
     for what, v in _vectors(mech):
         if v.size and np.max(np.abs(v)) > big:
@@ -87,22 +103,14 @@ def check_geometry(mech: Any, source: str | None = None) -> Any:
             raise MechsynInputError(
                 f"gear {j.id}: ratio 0 would hold link {j.links[1]!r} still", source=source,
                 field="joints", hint="give the nonzero angular velocity ratio of the second link to the first")
-    P = np.array([_xyz(j.point) for j in mech.joints if j.point is not None and 1 <= np.size(j.point) <= 3])
-    if len(P) < 2:
+    located = [j for j in mech.joints if _located(j)]
+    if len(located) < 2:
         return mech
+    P = np.array([_xyz(j.point) for j in located])
     scale = float(np.max(np.ptp(P, axis=0)))
     tol = COINCIDENT_REL * scale
-    bad = []
-    for link in mech.link_names:
-        if link == mech.ground:
-            continue
-        revolute = [j for j in mech.joints if link in j.links and j.type == "R" and j.point is not None
-                    and 1 <= np.size(j.point) <= 3]
-        if len(revolute) < 2:
-            continue
-        pts = np.array([_xyz(j.point) for j in revolute])
-        if np.max(np.ptp(pts, axis=0)) <= tol:
-            bad.append((link, [j.id for j in revolute]))
+    _check_duplicates(located, P, tol, source)
+    bad = _zero_length_links(mech, located, P, tol)
     if bad:
         if scale == 0:
             what = "all joints are at one point, so every link has zero length"
@@ -113,6 +121,50 @@ def check_geometry(mech: Any, source: str | None = None) -> Any:
             what, source=source, field="joints",
             hint="give the joints of each link their own points in the assembled configuration")
     return mech
+
+
+def _parallel(axes: list[Any]) -> bool:
+    """Whether the given axes (``None``: the plane's normal) are all parallel."""
+    A = np.array([[0.0, 0.0, 1.0] if a is None else _xyz(a) for a in axes])
+    A /= np.maximum(np.linalg.norm(A, axis=1, keepdims=True), 1e-300)
+    return bool(np.all(np.linalg.norm(np.cross(A, A[0]), axis=1) <= 1e-9))
+
+
+def _zero_length_links(mech: Any, located: list[Any], P: np.ndarray, tol: float) -> list[tuple[str, list[str]]]:
+    """Moving links whose two or more pivots (:data:`PIVOT_PAIRS`) are all at one point.
+
+    Two revolute pairs at one point with crossed axes are a Hooke joint's cross, not a
+    zero-length link."""
+    on: dict[str, list[int]] = {}
+    for k, j in enumerate(located):
+        if j.type in PIVOT_PAIRS:
+            for link in dict.fromkeys(j.links):
+                on.setdefault(link, []).append(k)
+    bad = []
+    for link in mech.link_names:
+        rows = on.get(link, [])
+        if link == mech.ground or len(rows) < 2 or np.max(np.ptp(P[rows], axis=0)) > tol:
+            continue
+        pivots = [located[k] for k in rows]
+        if all(j.type == "R" for j in pivots) and not _parallel([j.axis for j in pivots]):
+            continue
+        bad.append((link, [j.id for j in pivots]))
+    return bad
+
+
+def _check_duplicates(located: list[Any], P: np.ndarray, tol: float, source: str | None) -> None:
+    """Two joints of one type between the same two links at one point: one pair written twice."""
+    seen: dict[tuple, int] = {}
+    for k, j in enumerate(located):
+        key = (j.type, frozenset(j.links))
+        if key in seen and np.max(np.abs(P[k] - P[seen[key]])) <= tol and (
+                j.type != "R" or _parallel([j.axis, located[seen[key]].axis])):
+            other = located[seen[key]].id
+            raise MechsynInputError(
+                f"joints {other} and {j.id} are the same {j.type} pair: both join links "
+                f"{' and '.join(repr(x) for x in j.links)} at one point", source=source, field="joints",
+                hint=f"delete one of them (a second bearing of one hinge goes at its own point on the axis)")
+        seen.setdefault(key, k)
 
 
 def has_bool(value: Any) -> bool:

@@ -45,8 +45,13 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
     """
     from mechsyn.examples import resolve
 
-    p = resolve(path)  # a bundled example's name stands for its file
-    if not p.exists():
+    try:
+        p = resolve(path)  # a bundled example's name stands for its file
+        exists = p.exists()
+    except OSError as exc:  # e.g. a name longer than the file system allows
+        raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path)[:200],
+                                hint="check the path (each name at most 255 bytes)") from None
+    if not exists:
         raise MechsynInputError(f"no such {what}", source=str(p),
                                 hint="check the path (mechsyn.examples.names() lists the bundled examples)")
     if p.is_dir():

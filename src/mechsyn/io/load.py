@@ -52,7 +52,11 @@ def read_data(path: str | os.PathLike[str]) -> tuple[Any, str]:
     with its text (:func:`mechsyn.io.files.read_data`, the one reader of every input file)."""
     from mechsyn.examples import resolve
 
-    return files.read_data(resolve(path))
+    try:
+        path = resolve(path)
+    except OSError:  # e.g. a name too long for the file system: the reader says so
+        pass
+    return files.read_data(path)
 
 
 def parse_text(text: str, source: str) -> Any:

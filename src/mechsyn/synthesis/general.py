@@ -394,11 +394,21 @@ def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, o
     return best_z, best_f, prob.n_evaluations
 
 
+def _mechanism_checkpoint(path, resume, case, dim, seed, restarts, optimizer, opts, f_atol, batch):
+    from mechsyn.checkpoint import open_search_checkpoint
+
+    from dataclasses import fields
+
+    content = {f.name: getattr(case, f.name) for f in fields(case) if f.name not in ("source", "mechanism_path")}
+    return open_search_checkpoint(path, "synth mechanism", content, resume=resume, dim=dim, seed=seed, restarts=restarts,
+                                  optimizer=optimizer, options=opts, f_atol=f_atol, batch=batch)
+
+
 def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 3,
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
                          callback: ProgressCallback | None = None,
                          workers: int = 1, scheduler: Any = None,
-                         batch: bool = True) -> MechanismSynthesisResult:
+                         batch: bool = True, checkpoint: Any = None, resume: bool = False) -> MechanismSynthesisResult:
     """Optimise the case: per restart (child seeds of ``seed``, as in
     :func:`mechsyn.synthesis.optimize.restart_seeds`) the registered global optimiser on
     the feasibility-first fitness, then a least-squares polish of the best few members
@@ -414,7 +424,9 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     the int that repeats the run). ``callback(state)`` gets a
     :class:`~mechsyn.synthesis.problem.Progress` (restarts done, the best fitness so far).
     Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``callback``) ends the search and
-    returns the best design evaluated so far with ``interrupted=True``.
+    returns the best design evaluated so far with ``interrupted=True``. ``checkpoint``
+    (a file) saves the finished restarts as the run goes; ``resume=True`` runs only the
+    others (as :func:`mechsyn.synthesis.optimize.synthesize_path`).
 
     Examples
     --------
@@ -446,32 +458,43 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     f_atol = float(opts.pop("f_atol", 1e-18 * prob.penalty_base))
     local = workers <= 1 and scheduler is None
     best = [best_f]
-    outs: dict[int, tuple] = {}
+    ck = _mechanism_checkpoint(checkpoint, resume, case, len(prob.lower), seed, restarts, optimizer, opts, f_atol,
+                               batch)
+    outs: dict[int, tuple] = {} if ck is None else {i: (r["x"], r["fitness"], r["nfev"]) for i, r in ck.finished.items()}
 
     def report(r: int, f: float) -> None:
         if callback is not None:
             callback(Progress(done=r, total=restarts, best_error=min(best[0], f), message="restarts"))
 
     def finished(done: int, total: int, index: int, out) -> None:
-        outs[index] = out
+        r = tasks[index][1]
+        outs[r] = out
         best[0] = min(best[0], out[1])
+        if ck is not None:  # saved before the progress callback, which may raise Ctrl-C
+            ck.finish(r, seed=seeds[r], x=out[0], fitness=out[1], nfev=out[2])
         if callback is not None:
-            callback(Progress(done=done, total=restarts, best_error=best[0], message="restarts"))
+            callback(Progress(done=len(outs), total=restarts, best_error=best[0], message="restarts"))
 
     seeds = restart_seeds(seed, restarts)
     trackers = [BestSoFar() if local else None for _ in seeds]
     tasks = [(case, r, s, optimizer, opts, n_polish, t0 + time_limit * (0.85 * (r + 1) / restarts),
               deadline, f_atol, report if local else None, batch, trackers[r])
-             for r, s in enumerate(seeds)]
+             for r, s in enumerate(seeds) if r not in outs]
     interrupted = False
     try:
         run_tasks(_mechanism_restart, tasks, workers=workers, scheduler=scheduler,
                   progress=finished, deadline=deadline - 0.1 * time_limit)
     except KeyboardInterrupt:  # Ctrl-C: keep the best design evaluated so far
         interrupted = True
-        for t in trackers:
+        for r, t in enumerate(trackers):
             if t is not None and t.x is not None and t.f < best_f:
                 best_z, best_f = t.x, t.f
+            if ck is not None and t is not None and t.x is not None and r not in outs:
+                ck.offer(r, seeds[r], t.x, t.f)
+        if ck is not None:  # the checkpoint's partial best (this run's or an earlier one's)
+            if ck.partial is not None and ck.partial["fitness"] < best_f:
+                best_z, best_f = ck.partial["x"], ck.partial["fitness"]
+            ck.save()
     errs, done, nfev = [], 0, prob.n_evaluations
     for r in sorted(outs):
         z, f, n = outs[r]

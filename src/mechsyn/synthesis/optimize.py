@@ -227,6 +227,7 @@ class PathSynthesisResult(SynthesisResult):
     fold_distance_deg: float | None = None
     transmission_angle_min_deg: float | None = None
     fold_margin_deg: float | None = None
+    resumed: int = 0
 
     @property
     def target_reached(self) -> bool:
@@ -243,8 +244,8 @@ class PathSynthesisResult(SynthesisResult):
             "seconds": self.seconds, "seed": self.seed, "restarts": self.restarts, "nfev": self.nfev,
             "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
             "ratio_to_best_known": (self.error / self.best_known) if self.best_known else None,
-            "restart_errors": self.restart_errors, "theta2": self.theta2, "path": self.path,
-            "targets": self.targets, **self.common(),
+            "restart_errors": self.restart_errors, "resumed_restarts": self.resumed, "theta2": self.theta2,
+            "path": self.path, "targets": self.targets, **self.common(),
         }
 
 
@@ -274,7 +275,7 @@ def synthesize_path(
     case: PathCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
     optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
     callback: ProgressCallback | None = None, scheduler: Any = None,
-    target_error: float | None = None,
+    target_error: float | None = None, checkpoint: Any = None, resume: bool = False,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
 
@@ -296,6 +297,12 @@ def synthesize_path(
     and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
     with workers, the restarts finished so far); it propagates only when nothing was
     evaluated yet.
+
+    ``checkpoint`` (a file path): the finished restarts and the running one's best are saved
+    there as the run goes (:class:`mechsyn.checkpoint.RestartCheckpoint`); ``resume=True``
+    reads it and runs only the restarts not finished (same seeds: the result is the one
+    an uninterrupted run gives, unless the time limit cut a restart short). The time
+    limit counts from the resumed start.
 
     Examples
     --------
@@ -328,6 +335,11 @@ def synthesize_path(
     seeds = restart_seeds(seed, restarts)
     best = [np.inf]
     problem = PathProblem(case)
+    ck = _path_checkpoint(checkpoint, resume, case, len(problem.lower), seed, restarts, optimizer, options, target_error)
+    results: list[RestartResult] = [] if ck is None else [
+        RestartResult(index=i, seed=r["seed"], z=r["x"], fitness=r["fitness"], nfev=r["nfev"], seconds=r["seconds"])
+        for i, r in sorted(ck.finished.items())]
+    pending, loaded = _pending(results, restarts, target_error), len(results)
 
     def note(done, f):
         if f < problem.penalty_base:  # feasible score
@@ -336,49 +348,66 @@ def synthesize_path(
             callback(Progress(done=done, total=restarts, best_error=best[0], message="restarts"))
 
     local = workers <= 1 and scheduler is None
-    done = [0]
+    done = [len(results)]
 
     def report(index, f):  # within a restart: only where it runs in this process
         note(done[0], f)
-
-    results: list[RestartResult] = []
+        t = trackers[index]
+        if ck is not None and t is not None and t.x is not None and ck.due():
+            ck.offer(index, seeds[index], problem.expand(t.x[None, :])[0], t.f, force=True)
 
     def finished(count, total, index, r):
-        done[0] = count
+        done[0] = len(results) + 1
         results.append(r)
-        note(count, r.fitness)
+        if ck is not None:  # saved before the progress callback, which may raise Ctrl-C
+            ck.finish(r.index, seed=r.seed, x=r.z, fitness=r.fitness, nfev=r.nfev, seconds=r.seconds)
+        note(done[0], r.fitness)
 
     # in this process each restart records its best candidate, kept if Ctrl-C cuts it short
     trackers = [BestSoFar() if local else None for _ in seeds]
     jobs = [(case, i, s, optimizer, options, deadline, n_polish, report if local else None,
-             reserve, target_error, trackers[i]) for i, s in enumerate(seeds)]
+             reserve, target_error, trackers[i]) for i, s in enumerate(seeds) if i in pending]
     interrupted = False
     try:
+        if results and callback is not None:
+            note(len(results), min(r.fitness for r in results))
         run_tasks(_run_restart, jobs, workers=workers, scheduler=scheduler,
                   progress=finished, deadline=deadline - reserve,
                   stop=None if target_error is None else (lambda i, r: r.fitness <= target_error))
     except KeyboardInterrupt:
         interrupted = True
-        _keep_best_so_far(problem, trackers, seeds, results)
+        results = _keep_best_so_far(problem, trackers, seeds, results, ck)
         if not results:
             raise
     return _path_result(case, problem, results, t0=t0, seed=seed, optimizer=optimizer,
-                        interrupted=interrupted, target_error=target_error)
+                        interrupted=interrupted, target_error=target_error, resumed=loaded)
 
 
-def _keep_best_so_far(problem: PathProblem, trackers: list, seeds: list[int], results: list[RestartResult]) -> None:
-    """After Ctrl-C: the best design of the first restart cut short joins ``results``."""
+def _keep_best_so_far(problem: PathProblem, trackers: list, seeds: list[int], results: list[RestartResult],
+                      ck: Any = None) -> list[RestartResult]:
+    """After Ctrl-C: the best design of the first restart cut short joins ``results``; with
+    a checkpoint, the running restart's best (or an earlier interrupted run's) competes and
+    the checkpoint is saved."""
     have = {r.index for r in results}
     for i, t in enumerate(trackers):
         if t is not None and t.x is not None and i not in have:
             results.append(RestartResult(index=i, seed=seeds[i], z=problem.expand(t.x[None, :])[0],
                                          fitness=t.f, nfev=0, seconds=0.0))
+            if ck is not None:
+                ck.offer(i, seeds[i], results[-1].z, t.f)
             break
+    if ck is not None:
+        p = ck.partial
+        if p is not None and p["index"] not in have:
+            results = [r for r in results if r.index != p["index"]] + [RestartResult(
+                index=p["index"], seed=p["seed"], z=p["x"], fitness=p["fitness"], nfev=0, seconds=0.0)]
+        ck.save()
+    return results
 
 
 def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResult], *, t0: float,
                  seed: int, optimizer: str, interrupted: bool,
-                 target_error: float | None) -> PathSynthesisResult:
+                 target_error: float | None, resumed: int = 0) -> PathSynthesisResult:
     """The best restart (lowest fitness, then first in seed order), checked by
     :func:`~mechsyn.synthesis.path.evaluate_design`."""
     results.sort(key=lambda r: r.index)
@@ -401,4 +430,21 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
         fold_distance_deg=check["fold_distance_deg"],
         transmission_angle_min_deg=case.transmission_angle_min_deg,
         fold_margin_deg=case.fold_margin_deg if case.grashof else None,
+        resumed=resumed,
     )
+
+
+def _path_checkpoint(path, resume, case, dim, seed, restarts, optimizer, options, target_error):
+    from mechsyn.checkpoint import open_search_checkpoint
+
+    return open_search_checkpoint(path, "synth path", case, resume=resume, dim=dim, seed=seed, restarts=restarts,
+                                  optimizer=optimizer, options=options, target_error=target_error)
+
+
+def _pending(results: list[RestartResult], restarts: int, target_error: float | None) -> set[int]:
+    """Restarts still to run: not finished, and (with a target error) not after the first
+    finished one that reached it (the uninterrupted run ends there)."""
+    have = {r.index for r in results}
+    reached = [r.index for r in results if target_error is not None and r.fitness <= target_error]
+    end = min(reached, default=restarts)
+    return {i for i in range(restarts) if i not in have and i < end}

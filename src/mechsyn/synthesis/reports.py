@@ -71,7 +71,8 @@ def _with_margins(case: Any, min_transmission: float | None, fold_margin: float 
 def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10,
                    workers: int = 1, scheduler: Any = None, optimizer: str = "de",
                    target_error: float | None = None, min_transmission: float | None = None,
-                   fold_margin: float | None = None, callback: Callable[..., None] | None = None) -> Any:
+                   fold_margin: float | None = None, callback: Callable[..., None] | None = None,
+                   **search: Any) -> Any:
     """Path generation of ``case`` with the designer's margins (see
     :func:`mechsyn.synthesis.optimize.synthesize_path`).
 
@@ -86,6 +87,8 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     min_transmission, fold_margin : float, optional
         Smallest transmission angle over the motion and the least distance from folding
         flat [deg], replacing the case's.
+    **search
+        Passed on (``checkpoint=``, ``resume=``).
 
     Returns
     -------
@@ -109,7 +112,8 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     case = _with_margins(case, min_transmission, fold_margin)
     stop_at = default_target_error(case) if target_error is None else (target_error or None)
     return synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                           optimizer=optimizer, callback=callback, scheduler=scheduler, target_error=stop_at)
+                           optimizer=optimizer, callback=callback, scheduler=scheduler, target_error=stop_at,
+                           **search)
 
 
 def _check_budget(time_limit: float, restarts: int) -> None:
@@ -121,7 +125,7 @@ def _check_budget(time_limit: float, restarts: int) -> None:
 
 def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, restarts: int = 3,
                         optimizer: str = "de", workers: int = 1, scheduler: Any = None,
-                        callback: Callable[..., None] | None = None) -> Any:
+                        callback: Callable[..., None] | None = None, **search: Any) -> Any:
     """Synthesis of any planar mechanism file (see
     :func:`mechsyn.synthesis.general.synthesize_mechanism`), its budget checked first.
 
@@ -139,7 +143,7 @@ def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, r
 
     _check_budget(time_limit, restarts)
     return synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
-                                callback=callback, workers=workers, scheduler=scheduler)
+                                callback=callback, workers=workers, scheduler=scheduler, **search)
 
 
 def _fourbar_dict(design: dict[str, float], theta2: float, branch: int, name: str) -> dict[str, Any]:
