@@ -41,15 +41,15 @@ def uninterrupted(case):
 
 
 def _run(case, path, resume=False, progress=None):
-    return synthesize_path(case, seed=3, restarts=3, time_limit=120, options=OPTS, progress=progress,
+    return synthesize_path(case, seed=3, restarts=3, time_limit=120, options=OPTS, callback=progress,
                            checkpoint=path, resume=resume)
 
 
 def test_interrupt_after_a_restart_then_resume_gives_the_uninterrupted_design(case, uninterrupted, tmp_path):
     ck = tmp_path / "run.ckpt.json"
 
-    def stop_after_first(done, total, best):
-        if done >= 1:
+    def stop_after_first(state):
+        if state.done >= 1:
             raise KeyboardInterrupt
 
     first = _run(case, ck, progress=stop_after_first)
@@ -68,8 +68,8 @@ def test_interrupt_inside_a_restart_keeps_its_best_in_the_checkpoint(case, unint
     ck = tmp_path / "run.ckpt.json"
     calls = [0]
 
-    def stop_inside_second(done, total, best):
-        calls[0] += done >= 1
+    def stop_inside_second(state):
+        calls[0] += state.done >= 1
         if calls[0] >= 4:  # a few generations into restart 2
             raise KeyboardInterrupt
 
@@ -100,8 +100,8 @@ def saved(case, tmp_path_factory) -> Path:
     return ck
 
 
-def _stop_after_first(done, total, best):
-    if done >= 1:
+def _stop_after_first(state):
+    if state.done >= 1:
         raise KeyboardInterrupt
 
 
@@ -188,7 +188,7 @@ def test_mechanism_search_interrupted_then_resumed_gives_the_uninterrupted_desig
             "options": {"maxiter": 5, "popsize": 4, "init_oversample": 1}}
     full = synthesize_mechanism(case, **args)
     ck = tmp_path / "m.ckpt.json"
-    first = synthesize_mechanism(case, checkpoint=ck, progress=_stop_after_first, **args)
+    first = synthesize_mechanism(case, checkpoint=ck, callback=_stop_after_first, **args)
     assert first.interrupted and list(read_checkpoint(ck)["finished"]) == ["0"]
     resumed = synthesize_mechanism(case, checkpoint=ck, resume=True, **args)
     assert not resumed.interrupted and resumed.design == full.design and resumed.error == full.error

@@ -436,7 +436,7 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     return CapabilityMap(xs, ys, z, d / np.linalg.norm(d), measure,
                          "continuous" if continuous else "sampled",
                          value.reshape(X.shape), qopt.reshape(*X.shape, arm.n),
-                         arm.joint_names, arm.is_revolute, interrupted, computed)
+                         arm.joint_names, arm.is_revolute, interrupted=interrupted, computed=computed)
 
 
 def _map_chunk(arm: SerialArm, pts: np.ndarray, direction, measure: str, q1, branch: str,
@@ -522,7 +522,9 @@ def _interpolated(arm: SerialArm, cmap: CapabilityMap, at: np.ndarray) -> dict[s
     """The optimal configuration interpolated at ``at`` = (x, y), its tool error and measure."""
     xs, ys = cmap.xs, cmap.ys
     if not (xs.min() <= at[0] <= xs.max() and ys.min() <= at[1] <= ys.max()):
-        raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid", field="interpolate")
+        raise MechsynInputError(f"({at[0]:g}, {at[1]:g}) lies outside the grid", field="interpolate",
+                                hint=f"give a point with x in [{xs.min():g}, {xs.max():g}] and y in "
+                                     f"[{ys.min():g}, {ys.max():g}]")
     method = "cubic" if xs.size >= 4 and ys.size >= 4 else "linear"
     qi = interpolate_configuration(cmap, method)(at[0], at[1])
     target = at if arm.kind == "planar" else np.array([at[0], at[1], cmap.z])
@@ -574,7 +576,8 @@ def capability_grid(arm: SerialArm, xs, ys, direction, *, z: float | None = None
     if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(ys))):
         raise MechsynInputError("values must be finite", field="grid")
     if xs.size * ys.size > 5_000_000:
-        raise MechsynInputError("more than 5,000,000 grid points", field="grid")
+        raise MechsynInputError(f"{xs.size * ys.size:,} grid points are more than 5,000,000", field="grid",
+                                hint="use larger steps or a smaller area")
     if arm.kind == "spatial" and z is None:
         raise MechsynInputError("a spatial arm's grid needs its plane", field="z",
                                 hint="give the plane of the grid, e.g. z = 400")

@@ -438,11 +438,9 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     (True, True)
     """
     from mechsyn.parallel import run_tasks
-    from mechsyn.synthesis.optimize import OPTIMIZERS, restart_seeds
+    from mechsyn.synthesis.optimize import check_optimizer, restart_seeds
 
-    if optimizer not in OPTIMIZERS:
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
-                                hint="one of " + ", ".join(sorted(OPTIMIZERS)))
+    check_optimizer(optimizer)
     t0 = time.time()
     seed = resolve_seed(seed)
     deadline = t0 + time_limit

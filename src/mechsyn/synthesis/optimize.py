@@ -322,28 +322,19 @@ def synthesize_path(
     """
     from mechsyn.parallel import run_tasks
 
-    if optimizer not in OPTIMIZERS:
-        from mechsyn.errors import MechsynInputError
-
-        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
-                                hint="one of " + ", ".join(sorted(OPTIMIZERS)))
+    check_optimizer(optimizer)
     options = dict(options or {})
     t0 = time.time()
     seed = resolve_seed(seed)
-    deadline = t0 + time_limit
-    reserve = min(4.0, 0.07 * time_limit)
+    deadline, reserve = t0 + time_limit, min(4.0, 0.07 * time_limit)
     seeds = restart_seeds(seed, restarts)
-    best = [np.inf]
-    problem = PathProblem(case)
+    best, problem = [np.inf], PathProblem(case)
     ck = _path_checkpoint(checkpoint, resume, case, len(problem.lower), seed, restarts, optimizer, options, target_error)
-    results: list[RestartResult] = [] if ck is None else [
-        RestartResult(index=i, seed=r["seed"], z=r["x"], fitness=r["fitness"], nfev=r["nfev"], seconds=r["seconds"])
-        for i, r in sorted(ck.finished.items())]
+    results = _finished_restarts(ck)
     pending, loaded = _pending(results, restarts, target_error), len(results)
 
     def note(done, f):
-        if f < problem.penalty_base:  # feasible score
-            best[0] = min(best[0], f)
+        best[0] = min(best[0], f) if f < problem.penalty_base else best[0]  # feasible scores only
         if callback is not None:
             callback(Progress(done=done, total=restarts, best_error=best[0], message="restarts"))
 
@@ -363,8 +354,7 @@ def synthesize_path(
             ck.finish(r.index, seed=r.seed, x=r.z, fitness=r.fitness, nfev=r.nfev, seconds=r.seconds)
         note(done[0], r.fitness)
 
-    # in this process each restart records its best candidate, kept if Ctrl-C cuts it short
-    trackers = [BestSoFar() if local else None for _ in seeds]
+    trackers = [BestSoFar() if local else None for _ in seeds]  # in this process: kept if Ctrl-C cuts it short
     jobs = [(case, i, s, optimizer, options, deadline, n_polish, report if local else None,
              reserve, target_error, trackers[i]) for i, s in enumerate(seeds) if i in pending]
     interrupted = False
@@ -381,6 +371,22 @@ def synthesize_path(
             raise
     return _path_result(case, problem, results, t0=t0, seed=seed, optimizer=optimizer,
                         interrupted=interrupted, target_error=target_error, resumed=loaded)
+
+
+def check_optimizer(optimizer: str) -> None:
+    """Refuse an optimiser name that is not registered in :data:`OPTIMIZERS`."""
+    if optimizer not in OPTIMIZERS:
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError(f"unknown optimiser {optimizer!r}", field="optimizer",
+                                hint="one of " + ", ".join(sorted(OPTIMIZERS)))
+
+
+def _finished_restarts(ck: Any) -> list[RestartResult]:
+    """The restarts a checkpoint holds as finished (none without a checkpoint)."""
+    return [] if ck is None else [
+        RestartResult(index=i, seed=r["seed"], z=r["x"], fitness=r["fitness"], nfev=r["nfev"], seconds=r["seconds"])
+        for i, r in sorted(ck.finished.items())]
 
 
 def _keep_best_so_far(problem: PathProblem, trackers: list, seeds: list[int], results: list[RestartResult],
