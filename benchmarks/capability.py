@@ -30,7 +30,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(ROOT / "src"))
 
-from mechsyn.capability.arm import load_arm  # noqa: E402
+from mechsyn.capability.arm_file import load_arm  # noqa: E402
 from mechsyn.capability.measures import exact_limit  # noqa: E402
 
 ENV = HERE / ".env-capability"

@@ -53,7 +53,7 @@ _LAZY: dict[str, str] = {
     "input_grid": "mechsyn.kinematics.analysis", "Simulation": "mechsyn.kinematics.analysis",
     "ForceAnalysis": "mechsyn.kinematics.analysis",
     # capability (paper 004)
-    "SerialArm": "mechsyn.capability.arm", "load_arm": "mechsyn.capability.arm",
+    "SerialArm": "mechsyn.capability.arm", "load_arm": "mechsyn.capability.arm_file",
     "capability_map": "mechsyn.capability.maps", "CapabilityMap": "mechsyn.capability.maps",
     "capability_at": "mechsyn.capability.point", "PointCapability": "mechsyn.capability.point",
     # synthesis

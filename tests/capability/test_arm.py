@@ -7,7 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechsyn.capability.arm import arm_from_dict, ik_numeric, ik_planar_3r, load_arm
+from mechsyn.capability.arm import ik_numeric, ik_planar_3r
+from mechsyn.capability.arm_file import arm_from_dict, load_arm
 from mechsyn.capability.maps import interpolate_configuration, capability_map, self_motion
 from mechsyn.errors import MechsynInputError
 

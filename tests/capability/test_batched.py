@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechsyn.capability.arm import ik_numeric, load_arm
+from mechsyn.capability.arm import ik_numeric
+from mechsyn.capability.arm_file import load_arm
 from mechsyn.capability.maps import (
     capability_map, halton, measure_values, refine_over_self_motion, self_motion, self_motions,
 )

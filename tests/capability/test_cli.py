@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechsyn.capability.arm import load_arm
+from mechsyn.capability.arm_file import load_arm
 from mechsyn.capability.measures import exact_limit
 from mechsyn.cli.main import main
 

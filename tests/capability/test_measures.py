@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from mechsyn.capability.arm import arm_from_dict
+from mechsyn.capability.arm_file import arm_from_dict
 from mechsyn.capability.measures import (
     all_measures, component_limit, exact_limit, exact_limit_lp, min_norm_limit,
     min_norm_rates, stepped_limit, velocity_ellipse, velocity_polytope,

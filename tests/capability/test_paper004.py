@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechsyn.capability.arm import ik_planar_3r, load_arm
+from mechsyn.capability.arm import ik_planar_3r
+from mechsyn.capability.arm_file import load_arm
 from mechsyn.capability.maps import capability_map, continuous_best, self_motion
 from mechsyn.capability.measures import (
     exact_limit, exact_limit_lp, min_norm_limit, stepped_limit,

@@ -119,7 +119,7 @@ ARM = EXAMPLES / "capability/paper004_3r.yaml"
 
 
 def test_capability_point_json_is_the_report(cli_json):
-    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.arm_file import load_arm
     from mechsyn.capability.point import capability_at
 
     report = capability_at(load_arm(ARM), [1300.0, 900.0], [2.0, 1.0], polytope=True)
@@ -127,7 +127,7 @@ def test_capability_point_json_is_the_report(cli_json):
 
 
 def test_capability_grid_json_is_the_report(cli_json):
-    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.arm_file import load_arm
     from mechsyn.capability.maps import capability_grid
 
     grid = np.arange(900.0, 1301.0, 100.0)

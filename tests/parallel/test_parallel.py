@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mechsyn.capability.arm import load_arm
+from mechsyn.capability.arm_file import load_arm
 from mechsyn.capability.maps import capability_map
 from mechsyn.errors import MechsynInputError
 from mechsyn.parallel import check_parallel_options, run_tasks

@@ -238,7 +238,7 @@ def test_broken_path_cases_api(data):
 @settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_arm_files_api(data):
-    from mechsyn.capability.arm import arm_from_dict
+    from mechsyn.capability.arm_file import arm_from_dict
 
     _api_contract(arm_from_dict, data.draw(broken(_load(ARM))), str(ARM), base_dir=ARM.parent)
 

@@ -200,7 +200,7 @@ CAPABILITY_ARM = ROOT / "examples" / "capability" / "paper004_3r.yaml"
 
 
 def test_capability_map_interrupted_keeps_the_finished_chunks():
-    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.arm_file import load_arm
     from mechsyn.capability.maps import capability_map
 
     arm = load_arm(CAPABILITY_ARM)

@@ -19,7 +19,8 @@ from typing import Annotated, Optional
 import numpy as np
 import typer
 
-from mechsyn.capability.arm import SerialArm, load_arm
+from mechsyn.capability.arm import SerialArm
+from mechsyn.capability.arm_file import load_arm
 from mechsyn.capability.maps import capability_grid, is_closed_form
 from mechsyn.capability.measures import MEASURES
 from mechsyn.capability.point import capability_at

@@ -194,7 +194,7 @@ def load(name: str) -> Any:
 
         return load_mechanism(p)
     if kind == "arm":
-        from mechsyn.capability.arm import load_arm
+        from mechsyn.capability.arm_file import load_arm
 
         return load_arm(p)
     raise MechsynInputError(f"example {name!r} is a {kind}, not a mechanism or an arm", field="name",
