@@ -13,7 +13,6 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from mkdocs.structure.files import File
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "src" / "mechsyn"
@@ -80,6 +79,8 @@ def on_files(files, config):
         old = files.get_file_from_path(path)
         if old is not None:
             files.remove(old)
+        from mkdocs.structure.files import File  # here: the tests import this hook without mkdocs
+
         files.append(File.generated(config, path, content=_page(title, modules)))
     return files
 

@@ -35,6 +35,17 @@ class _NotPlain(Exception):
     """The value needs pydantic's validation (coercion, an error message, or a rare field)."""
 
 
+
+def _construct(cls: Any, **values: Any) -> Any:
+    """``cls.model_construct(**values)`` with the fields in the model's order, as validation
+    gives them (pydantic before 2.6 puts the given fields first, the defaults after)."""
+    m = cls.model_construct(**values)
+    d = m.__dict__
+    ordered = {k: d[k] for k in cls.model_fields if k in d}
+    if list(ordered) != list(d):
+        object.__setattr__(m, "__dict__", {**ordered, **{k: v for k, v in d.items() if k not in ordered}})
+    return m
+
 def _text(v: Any) -> str:
     if type(v) is not str:
         raise _NotPlain
@@ -119,7 +130,7 @@ def _link(v: Any) -> str | LinkEntry:
     if type(v) is not dict or any(type(k) is not str for k in v):
         raise _NotPlain
     known = _fields({k: x for k, x in v.items() if k in _LINK}, _LINK)
-    return LinkEntry.model_construct(**known, **{k: x for k, x in v.items() if k not in _LINK})
+    return _construct(LinkEntry, **known, **{k: x for k, x in v.items() if k not in _LINK})
 
 
 def _joint(v: Any) -> JointEntry:
@@ -128,7 +139,7 @@ def _joint(v: Any) -> JointEntry:
         raise _NotPlain  # a bool field: null is an error
     if "class" in fields:
         fields["pair_class"] = fields.pop("class")
-    return JointEntry.model_construct(**fields)
+    return _construct(JointEntry, **fields)
 
 
 def _contours(v: Any) -> list[list[str]]:
@@ -143,11 +154,11 @@ _LOAD = {"link": _ref, "force": _numbers, "at": _numbers, "point": _text, "momen
 def _points(v: Any) -> dict[str, PointEntry]:
     if type(v) is not dict:
         raise _NotPlain
-    return {_text(k): PointEntry.model_construct(**_fields(p, _POINT, ("link", "at"))) for k, p in v.items()}
+    return {_text(k): _construct(PointEntry, **_fields(p, _POINT, ("link", "at"))) for k, p in v.items()}
 
 
 def _loads(v: Any) -> list[LoadEntry]:
-    return [LoadEntry.model_construct(**_fields(x, _LOAD, ("link",))) for x in _list(v)]
+    return [_construct(LoadEntry, **_fields(x, _LOAD, ("link",))) for x in _list(v)]
 
 
 _FILE = {"name": _text, "kind": _one_of("planar", "spatial"), "ground": _ref,
@@ -161,6 +172,6 @@ def plain_spec(data: Any) -> MechanismFile | None:
         fields = _fields(data, _FILE, ("name", "ground", "links", "joints"))
         if not fields["links"] or any(fields.get(k, "") is None for k in ("kind", "points", "loads")):
             raise _NotPlain
-        return MechanismFile.model_construct(**fields)
+        return _construct(MechanismFile, **fields)
     except _NotPlain:
         return None
