@@ -18,7 +18,7 @@ from rich.markup import escape
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console
+from mechsyn.cli.common import ForceOpt, check_output_suffix, check_overwrite, console, emit_json, err_console
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
@@ -31,6 +31,7 @@ def finger_design(
     json_out: bool = typer.Option(False, "--json", help="Print JSON on stdout."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="PNG: both modes' motion and the region."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+    force: ForceOpt = False,
     checkpoint: CheckpointOpt = None,
     resume: ResumeOpt = None,
 ) -> None:
@@ -44,6 +45,7 @@ def finger_design(
         raise MechsynInputError("--time-limit must be positive", source="--time-limit")
     check_output_suffix(plot, (".png",), "--plot")
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    check_overwrite(out, "--out", force)
     ck = checkpoint_options(checkpoint, resume)
     case = load_case(case_file)
     if json_out or not err_console.is_terminal:
