@@ -65,6 +65,18 @@ def test_interrupted_in_the_second_variant_then_resumed_gives_the_uninterrupted_
     assert searched == [("S2",), ("S1", "S2")] and _same(again, uninterrupted)
 
 
+def test_interrupt_before_a_variant_evaluated_anything_keeps_the_earlier_ones(case, uninterrupted, tmp_path):
+    def stop(msg):
+        if msg.startswith("VLL S2: stage 1 (targets"):
+            raise KeyboardInterrupt
+
+    ck = tmp_path / "ck.json"
+    first = fd.design_finger(case, seed=0, progress=stop, checkpoint=ck)
+    assert first.interrupted and [v.combination for v in first.variants] == [("S1",)]
+    assert "VLL S2: not searched (interrupted)" in first.notes
+    assert _same(fd.design_finger(case, seed=0, checkpoint=ck, resume=True), uninterrupted)
+
+
 def test_read_back_variant_keeps_its_paths_and_mechanism(case, uninterrupted, saved):
     resumed = fd.design_finger(case, seed=0, checkpoint=saved, resume=True)
     a, b = uninterrupted.variants[0], resumed.variants[0]

@@ -722,7 +722,14 @@ def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[
         if run.state["interrupted"]:
             run.notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
             continue
-        v = _run_variant(run, combo, ck)
+        try:
+            v = _run_variant(run, combo, ck)
+        except KeyboardInterrupt:  # before the variant evaluated anything: the earlier ones are kept
+            if not variants:
+                raise
+            run.state["interrupted"] = True
+            run.notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
+            continue
         if v is not None:
             variants.append(v)
     if not variants and run.state["interrupted"]:
