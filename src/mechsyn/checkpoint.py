@@ -108,6 +108,9 @@ class RestartCheckpoint:
         self.path, self.kind, self.key, self.interval = Path(path), kind, dict(key), interval
         self.finished: dict[int, dict[str, Any]] = {}
         self.partial: dict[str, Any] | None = None
+        #: finished stages kept as data (name -> JSON value), for searches whose units are
+        #: not restarts (``synth finger-design``: one record per VLL variant)
+        self.done: dict[str, Any] = {}
         self._saved = time.monotonic()
 
     @classmethod
@@ -142,6 +145,8 @@ class RestartCheckpoint:
             if data.get("partial"):
                 ck.partial = {**_record(data["partial"], str(path), "partial", dim),
                               "index": int(data["partial"]["index"])}
+            done = data.get("done") or {}
+            ck.done = {str(k): v for k, v in done.items()}
         except (TypeError, KeyError, ValueError, AttributeError, OverflowError) as exc:
             raise MechsynInputError(f"damaged checkpoint ({type(exc).__name__})", source=str(path),
                                     field="finished", hint=_AFRESH) from None
@@ -179,6 +184,11 @@ class RestartCheckpoint:
             self.partial = None
         self.save()
 
+    def finish_stage(self, name: str, data: Any) -> None:
+        """Record the finished stage ``name`` with its result ``data`` (JSON-able) and save."""
+        self.done[str(name)] = json.loads(dumps(data, indent=None))
+        self.save()
+
     def offer(self, index: int, seed: int, x: Any, fitness: float, *, force: bool = False) -> None:
         """The running restart's best so far; saved if ``interval`` seconds passed (or ``force``)."""
         if x is None or index in self.finished:
@@ -195,7 +205,7 @@ class RestartCheckpoint:
             "format": FORMAT, "version": VERSION, "kind": self.kind, "key": self.key,
             "written": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
             "finished": {str(i): r for i, r in sorted(self.finished.items())},
-            "partial": self.partial}, indent=None) + "\n")
+            "partial": self.partial, "done": self.done}, indent=None) + "\n")
         self._saved = time.monotonic()
 
     def due(self) -> bool:

@@ -33,6 +33,9 @@ WorkersOpt = Annotated[int, typer.Option("--workers", help="Run restarts in N lo
 SchedulerOpt = Annotated[Optional[str], typer.Option(
     "--scheduler", help="Run restarts on a Dask cluster (scheduler address; extra mechsyn[dask]).")]
 
+ForceOpt = Annotated[bool, typer.Option(
+    "--force", help="Replace an existing output file even when it is not a mechanism file.")]
+
 _CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 
 
@@ -269,6 +272,38 @@ def check_writable(path: Path | None, option: str, directory: bool = False) -> N
     except OSError as exc:
         raise MechsynInputError(f"cannot write {path}: {exc.strerror or exc}", source=option,
                                 hint="give a path in a folder you can write to") from None
+
+
+def is_mechanism_file(path: Path) -> bool:
+    """Whether ``path`` holds what a mechsyn command writes as a mechanism: an empty
+    file, a YAML/JSON mapping with ``links`` and ``joints``, or a Pyslvs expression
+    (``M[...]`` after ``#`` comment lines, for ``.pyslvs``/``.txt``). Anything
+    unreadable is not."""
+    from mechsyn.io.files import parse_data, read_text
+
+    try:
+        if path.stat().st_size == 0:
+            return True
+        text = read_text(path)
+        if path.suffix.lower() in (".pyslvs", ".txt"):  # comment lines (#), then M[...]
+            expr = "".join(ln for ln in text.splitlines() if not ln.lstrip().startswith("#")).strip()
+            return expr.startswith("M[") and expr.endswith("]")
+        data = parse_data(text, str(path))
+    except (MechsynInputError, OSError):
+        return False
+    return isinstance(data, dict) and isinstance(data.get("links"), list) and isinstance(data.get("joints"), list)
+
+
+def check_overwrite(path: Path | str | None, option: str, force: bool = False) -> None:
+    """Refuse, before any work, to replace an existing file that is not a mechanism file
+    (:func:`is_mechanism_file`: a case file, notes, an image...) unless ``force``
+    (``--force``). A mechanism file, e.g. the previous run's output, is replaced."""
+    if path is None or force or is_stdout(path):
+        return
+    path = Path(path)
+    if path.is_file() and not is_mechanism_file(path):
+        raise MechsynInputError(f"{path} exists and is not a mechanism file; not overwritten", source=option,
+                                hint="give another file, or add --force to replace it")
 
 
 def save_plot(path: Path, draw: Any, *args: Any, dpi: int = 110, figsize: tuple[float, float] = (7, 6),

@@ -9,7 +9,7 @@ import typer
 from rich.markup import escape
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import check_output_suffix, err_console, is_stdout, write_output
+from mechsyn.cli.common import ForceOpt, check_output_suffix, check_overwrite, err_console, is_stdout, write_output
 from mechsyn.errors import MechsynInputError
 
 _SUFFIXES = (".yaml", ".yml", ".json", ".pyslvs", ".txt")
@@ -35,6 +35,7 @@ def convert_cmd(
         "--input", "-i", help="Pyslvs input pair BASE,DRIVE (point indices; the link through both turns "
                               "about BASE). Repeat for several; default: ground cranks.")] = None,
     name: Annotated[Optional[str], typer.Option("--name", help="Mechanism name (default: the file's stem).")] = None,
+    force: ForceOpt = False,
 ) -> None:
     """Convert a Pyslvs mechanism expression into a mechanism file, or back."""
     from mechsyn.io.convert import convert_file
@@ -47,6 +48,7 @@ def convert_cmd(
     else:
         suffix = Path(out).suffix.lower()
     check_output_suffix(Path(f"x{suffix}"), _SUFFIXES, "--out", ".yaml, .json or .pyslvs")
+    check_overwrite(out, "--out", force)
     result = convert_file(file, suffix, [_pair(t) for t in input or []] or None, name)
     write_output(out, result.text)
     for note in result.notes:

@@ -18,7 +18,8 @@ from rich.markup import escape
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_output_suffix, console, emit_json, err_console, stop_if_interrupted
+from mechsyn.cli.common import ForceOpt, check_output_suffix, check_overwrite, console, emit_json, err_console
+from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -30,6 +31,9 @@ def finger_design(
     json_out: bool = typer.Option(False, "--json", help="Print JSON on stdout."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="PNG: both modes' motion and the region."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+    force: ForceOpt = False,
+    checkpoint: CheckpointOpt = None,
+    resume: ResumeOpt = None,
 ) -> None:
     """Optimise a finger's link lengths on discrete positions with its VLL locked, find
     each VLL's length range keeping the paths in the working region, minimise joint
@@ -41,19 +45,21 @@ def finger_design(
         raise MechsynInputError("--time-limit must be positive", source="--time-limit")
     check_output_suffix(plot, (".png",), "--plot")
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    check_overwrite(out, "--out", force)
+    ck = checkpoint_options(checkpoint, resume)
     case = load_case(case_file)
     if json_out or not err_console.is_terminal:
-        res = design_finger(case, seed=seed, time_limit=time_limit)
+        res = design_finger(case, seed=seed, time_limit=time_limit, **ck)
     else:  # a status line on stderr with the stage and the best value so far
         with err_console.status("finger design") as status:
-            res = design_finger(case, seed=seed, time_limit=time_limit,
+            res = design_finger(case, seed=seed, time_limit=time_limit, **ck,
                                 progress=lambda msg: status.update(escape(msg)))
     _write(case, res, out, plot)
     if json_out:
         emit_json(res)
     else:
         _render(case_file.name, res, time_limit, out, plot)
-    stop_if_interrupted(res)
+    stop_if_interrupted(res, ck)
 
 
 def _write(case: Any, res: Any, out: Optional[Path], plot: Optional[Path]) -> None:

@@ -8,8 +8,8 @@ from typing import Optional
 import typer
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import (OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, TimeLimitOpt, WorkersOpt,
-                                check_output_suffix, emit_json, restart_progress)
+from mechsyn.cli.common import (ForceOpt, OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, TimeLimitOpt, WorkersOpt,
+                                check_output_suffix, check_overwrite, emit_json, restart_progress)
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
@@ -41,6 +41,7 @@ def synth_mechanism(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the design as a mechanism file (.yaml/.json)."),
+    force: ForceOpt = False,
     checkpoint: CheckpointOpt = None,
     resume: ResumeOpt = None,
 ) -> None:
@@ -54,6 +55,7 @@ def synth_mechanism(
     check_parallel_options(workers, scheduler)
     check_output_suffix(plot, (".png",), "--plot")
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    check_overwrite(out, "--out", force)
     ck = checkpoint_options(checkpoint, resume)
     case = load_case(case_file)
     with restart_progress("synth mechanism", restarts, enabled=not as_json) as progress:

@@ -9,8 +9,8 @@ import numpy as np
 import typer
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import (OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, Table, TimeLimitOpt, WorkersOpt,
-                                check_output_suffix, check_writable, console, emit_json, parse_floats,
+from mechsyn.cli.common import (ForceOpt, OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, Table, TimeLimitOpt, WorkersOpt,
+                                check_output_suffix, check_overwrite, check_writable, console, emit_json, parse_floats,
                                 restart_progress, save_plot)
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
@@ -42,6 +42,7 @@ def synth_path(
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
+    force: ForceOpt = False,
     checkpoint: CheckpointOpt = None,
     resume: ResumeOpt = None,
 ) -> None:
@@ -52,8 +53,7 @@ def synth_path(
     from mechsyn.synthesis.reports import path_synthesis, select_case
 
     check_parallel_options(workers, scheduler)
-    check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
-    check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
+    _check_outputs(out, plot, force)
     ck = checkpoint_options(checkpoint, resume)
     case = select_case(load_cases(case_file), case_id, source=str(case_file))
     with restart_progress(f"synth path {case.id}", restarts) as progress:
@@ -66,6 +66,14 @@ def synth_path(
     else:
         render_path_synthesis(case, res)
     stop_if_interrupted(res, ck)
+
+
+def _check_outputs(out: Optional[Path], plot: Optional[Path], force: bool) -> None:
+    """``--out`` and ``--plot`` checked before any work (suffix, writable, not replacing
+    a file that is not a mechanism file without ``--force``)."""
+    check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
+    check_overwrite(out, "--out", force)
+    check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
 
 
 def _write_path_files(case, res, out: Optional[Path], plot: Optional[Path]) -> None:

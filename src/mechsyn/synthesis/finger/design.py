@@ -47,7 +47,7 @@ References
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -611,12 +611,20 @@ def _de(f: Callable[[np.ndarray], np.ndarray], bounds: list[tuple[float, float]]
 
 
 def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
-                  progress: Callable[[str], None] | None = None) -> FingerDesign:
+                  progress: Callable[[str], None] | None = None, checkpoint: Any = None,
+                  resume: bool = False) -> FingerDesign:
     """Run paper 000's steps 8-13 on ``case`` (see the module doc).
 
     Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search: the
     variant being searched keeps its best design so far (its force stage is skipped),
     later variants are not searched, and the result has ``interrupted=True``.
+
+    ``checkpoint`` (a file path): each finished VLL variant (its :class:`VariantResult`)
+    is saved there as the run goes (:class:`mechsyn.checkpoint.RestartCheckpoint`);
+    ``resume=True`` continues the run saved in it (same case and seed, else
+    :class:`MechsynInputError`): finished variants are read back, only the others are
+    searched, so the answer is the uninterrupted run's (unless a time limit cut a variant
+    short: a variant is kept as its time limit left it).
 
     Parameters
     ----------
@@ -628,6 +636,10 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
         Seconds for the optimisation stages; the final checks still run.
     progress : callable, optional
         ``progress(message)`` with the stage and the best value so far.
+    checkpoint : path-like, optional
+        Checkpoint file, written whole after each finished variant.
+    resume : bool
+        Continue the run saved in ``checkpoint``.
 
     Returns
     -------
@@ -652,11 +664,57 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     # every linear solve of the search is of a few tens of unknowns: BLAS threads only cost
     # (on a loaded machine an 18 x 18 LU solve took 20 ms with them, 0.16 ms without)
     with threadpool_limits(limits=1, user_api="blas"):
-        return _design(case, seed, time_limit, progress)
+        return _design(case, seed, time_limit, progress, checkpoint, resume)
 
 
-def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[str], None] | None
-            ) -> FingerDesign:
+def _finger_checkpoint(path: Any, resume: bool, case: FingerCase, seed: int) -> Any:
+    """The run's checkpoint (``None`` without ``path``); its key: the case (its content,
+    not its file name) and the seed."""
+    from mechsyn.checkpoint import open_search_checkpoint
+
+    return open_search_checkpoint(path, "synth finger-design", replace(case, source=""), resume=resume,
+                                  seed=seed)
+
+
+def _variant_record(v: VariantResult | None, notes: list[str], stopped: bool) -> dict[str, Any]:
+    """A finished variant as checkpoint data: its result (every field), its notes and
+    whether the time limit cut it short."""
+    data = None if v is None else {f.name: getattr(v, f.name) for f in fields(v)}
+    return {"variant": data, "notes": notes, "stopped": stopped}
+
+
+def _variant_from(data: dict[str, Any]) -> VariantResult:
+    """The :class:`VariantResult` a checkpoint record holds (NaN saved as null)."""
+    d = dict(data)
+    d["combination"] = tuple(d["combination"])
+    d["vll_ranges"] = {j: tuple(r) for j, r in d["vll_ranges"].items()}
+    d["underactuated"] = {j: {"lengths": np.array(u["lengths"], float),
+                              "paths": {p: np.array(P, float) for p, P in u["paths"].items()}}
+                          for j, u in d["underactuated"].items()}
+    return VariantResult(**d)
+
+
+def _run_variant(run: _Run, combo: tuple[str, ...], ck: Any) -> VariantResult | None:
+    """One variant: read back from the checkpoint when it holds it finished, else searched
+    (and saved to the checkpoint unless Ctrl-C cut it short)."""
+    label = "+".join(combo)
+    if ck is not None and label in ck.done:
+        rec = ck.done[label]
+        run.notes.extend(rec["notes"])
+        run.stopped = run.stopped or bool(rec["stopped"])
+        return None if rec["variant"] is None else _variant_from(rec["variant"])
+    n0, st0 = len(run.notes), run.stopped
+    run.stopped = False
+    v = _design_variant(run, combo)
+    if ck is not None and not run.state["interrupted"]:
+        ck.finish_stage(label, _variant_record(v, run.notes[n0:], run.stopped))
+    run.stopped = run.stopped or st0
+    return v
+
+
+def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[str], None] | None,
+            checkpoint: Any = None, resume: bool = False) -> FingerDesign:
+    ck = _finger_checkpoint(checkpoint, resume, case, seed)
     t0 = time.monotonic()
     run = _Run(case, seed, t0 + time_limit, progress)
     variants = []
@@ -664,7 +722,14 @@ def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[
         if run.state["interrupted"]:
             run.notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
             continue
-        v = _design_variant(run, combo)
+        try:
+            v = _run_variant(run, combo, ck)
+        except KeyboardInterrupt:  # before the variant evaluated anything: the earlier ones are kept
+            if not variants:
+                raise
+            run.state["interrupted"] = True
+            run.notes.append(f"VLL {'+'.join(combo)}: not searched (interrupted)")
+            continue
         if v is not None:
             variants.append(v)
     if not variants and run.state["interrupted"]:
