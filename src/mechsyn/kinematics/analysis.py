@@ -471,14 +471,18 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
 def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
     """Position, velocity, acceleration of every named point (NaN where not assembled;
     rates NaN where not defined)."""
-    q, qd, qdd = np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd)
+    whole = bool(ok.all()), bool(rates_ok.all())  # no NaN to clear or to restore
+    q = sw.q if whole[0] else np.nan_to_num(sw.q)
+    qd, qdd = (sw.qd, sw.qdd) if all(whole) else (np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd))
     pm = {}
     for name, (link, at) in pts.items():
         P, V, A = S.point_state(q, qd, qdd, S.index(link), S.to_local(link, at))
-        for arr in (P, V, A):
-            arr[~ok] = np.nan
-        V[~rates_ok] = np.nan
-        A[~rates_ok] = np.nan
+        if not whole[0]:
+            for arr in (P, V, A):
+                arr[~ok] = np.nan
+        if not whole[1]:
+            V[~rates_ok] = np.nan
+            A[~rates_ok] = np.nan
         pm[name] = PointMotion(P, V, A, link)
     return pm
 

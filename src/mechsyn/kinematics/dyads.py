@@ -579,7 +579,6 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
     q = np.empty((S.n, N)).T
     qd = np.empty((S.n, N)).T
     qdd = np.empty((S.n, N)).T
-    phi = np.arctan2(r.sin, r.cos)
     # all links at once: (N, nl) arrays, the anchors' states gathered per link
     jids = [r.anchor[i][0] for i in range(nl)]
     sa = np.array([r.anchor[i][1] for i in range(nl)], float).reshape(nl, 2)
@@ -603,14 +602,15 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
         if step.kind == "drive_R" and step.known[0] < 0:
             con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
             drive_links[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
-    ok = np.all(np.isfinite(r.cos), axis=1)
-    for i in range(nl):
-        if i in drive_links:
-            k, sgn = drive_links[i]
-            phi[:, i] = sgn * U[:, k]
+    ok = np.all(np.isfinite(c), axis=1)
+    phi = np.empty((N, nl))
+    for i, (k, sgn) in drive_links.items():
+        phi[:, i] = sgn * U[:, k]
     others = [i for i in range(nl) if i not in drive_links]
-    if others and ok.any():
-        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
+    if others:  # atan2 only for the links not driven directly
+        phi[:, others] = np.arctan2(s[:, others], c[:, others])
+        if ok.any():
+            phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
     q[:, 2:3 * nl:3] = phi
     if not ok.all():
         for a in (q, qd, qdd):
