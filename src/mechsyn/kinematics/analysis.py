@@ -548,8 +548,9 @@ def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     isR = np.array([d.type == "R" for d in S.drivers])
     a, d = U[:-1], np.diff(U, axis=0)
     dd = np.einsum("ij,ij->i", d, d)
+    turns = u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi))  # (N-1, k)
     for shift in (0.0, 2 * np.pi, -2 * np.pi):
-        v = np.where(isR, u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi)) + shift, u0)  # (N-1, k)
+        v = np.where(isR, turns + shift if shift else turns, u0)
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.einsum("ij,ij->i", v - a, d) / dd
         off = np.abs(a + t[:, None] * d - v).max(axis=1)

@@ -573,6 +573,22 @@ def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResul
         return _poses_from_chain_(S, plan, U, r, split)
 
 
+def _drive_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
+    """Links turned by a frame driver: link -> (driver index, sign of the input), kept
+    in the system's memo for the plan (a sweep's angles of these links are the inputs)."""
+    memo = _memo(S)
+    hit = memo.get(("drive_links", id(plan)))
+    if hit is not None and hit[0] is plan:
+        return hit[1]
+    out = {}
+    for step in plan.steps:
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            out[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
+    memo[("drive_links", id(plan))] = (plan, out)
+    return out
+
+
 def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None) -> tuple:
     N, nl = r.cos.shape
     # component-major buffers (returned transposed): every column written is contiguous
@@ -597,11 +613,7 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
     qdd[:, 1:3 * nl:3] = A[:, 1] + al * relx - w2 * rely
     qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
     # angles: drivers' links take the input itself, dyad links are made continuous
-    drive_links = {}
-    for step in plan.steps:
-        if step.kind == "drive_R" and step.known[0] < 0:
-            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
-            drive_links[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
+    drive_links = _drive_links(S, plan)
     ok = np.all(np.isfinite(c), axis=1)
     phi = np.empty((N, nl))
     for i, (k, sgn) in drive_links.items():
