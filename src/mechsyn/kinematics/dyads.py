@@ -605,12 +605,13 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
                for d in (r.points, r.velocities, r.accelerations))  # (N, 2, nl)
     w, al = r.omega, r.alpha
     w2 = w * w
-    q[:, 0:3 * nl:3] = P[:, 0] + relx
-    q[:, 1:3 * nl:3] = P[:, 1] + rely
-    qd[:, 0:3 * nl:3] = V[:, 0] - w * rely
-    qd[:, 1:3 * nl:3] = V[:, 1] + w * relx
-    qdd[:, 0:3 * nl:3] = A[:, 0] - al * rely - w2 * relx
-    qdd[:, 1:3 * nl:3] = A[:, 1] + al * relx - w2 * rely
+    x, y = slice(0, 3 * nl, 3), slice(1, 3 * nl, 3)  # written in place (no temporaries)
+    np.add(P[:, 0], relx, out=q[:, x])
+    np.add(P[:, 1], rely, out=q[:, y])
+    np.subtract(V[:, 0], w * rely, out=qd[:, x])
+    np.add(V[:, 1], w * relx, out=qd[:, y])
+    np.subtract(A[:, 0] - al * rely, w2 * relx, out=qdd[:, x])
+    np.subtract(A[:, 1] + al * relx, w2 * rely, out=qdd[:, y])
     qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
     # angles: drivers' links take the input itself, dyad links are made continuous
     drive_links = _drive_links(S, plan)
