@@ -471,14 +471,18 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
 def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
     """Position, velocity, acceleration of every named point (NaN where not assembled;
     rates NaN where not defined)."""
-    q, qd, qdd = np.nan_to_num(sw.q), np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd)
+    whole = bool(ok.all()), bool(rates_ok.all())  # no NaN to clear or to restore
+    q = sw.q if whole[0] else np.nan_to_num(sw.q)
+    qd, qdd = (sw.qd, sw.qdd) if all(whole) else (np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd))
     pm = {}
     for name, (link, at) in pts.items():
         P, V, A = S.point_state(q, qd, qdd, S.index(link), S.to_local(link, at))
-        for arr in (P, V, A):
-            arr[~ok] = np.nan
-        V[~rates_ok] = np.nan
-        A[~rates_ok] = np.nan
+        if not whole[0]:
+            for arr in (P, V, A):
+                arr[~ok] = np.nan
+        if not whole[1]:
+            V[~rates_ok] = np.nan
+            A[~rates_ok] = np.nan
         pm[name] = PointMotion(P, V, A, link)
     return pm
 
@@ -544,8 +548,9 @@ def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     isR = np.array([d.type == "R" for d in S.drivers])
     a, d = U[:-1], np.diff(U, axis=0)
     dd = np.einsum("ij,ij->i", d, d)
+    turns = u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi))  # (N-1, k)
     for shift in (0.0, 2 * np.pi, -2 * np.pi):
-        v = np.where(isR, u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi)) + shift, u0)  # (N-1, k)
+        v = np.where(isR, turns + shift if shift else turns, u0)
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.einsum("ij,ij->i", v - a, d) / dd
         off = np.abs(a + t[:, None] * d - v).max(axis=1)

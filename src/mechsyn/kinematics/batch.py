@@ -342,7 +342,9 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
             if callable(vec):
                 vec = vec()
                 links[link] = (anchor, vec, a, ref)
-            pos[p] = anchor + vec * ((X[:, p] - X[:, a]) / ref)[:, None]
+            P = vec * ((X[:, p] - X[:, a]) / ref)[:, None]  # (K, N): the anchor added in place
+            P += anchor
+            pos[p] = P
         else:  # rrr
             _, p1, p2, p3, b1, b2 = op
             A, C = pos[p1], pos[p3]
@@ -383,13 +385,14 @@ def _rrr(A: np.ndarray, C: np.ndarray, L1s: np.ndarray, L2s: np.ndarray, sigma: 
     Written with few temporaries: each is a (K, N) array pass."""
     d = C - A
     inv = d.real * d.real
-    inv += d.imag * d.imag
+    tmp = d.imag * d.imag                      # a (K, N) scratch array, used twice
+    inv += tmp
     with np.errstate(divide="ignore", invalid="ignore"):
         np.divide(1.0, inv, out=inv)
         alpha = inv * (0.5 * (L1s - L2s))[:, None]
         alpha += 0.5
         beta = inv * L1s[:, None]
-        beta -= alpha * alpha                  # beta^2
+        beta -= np.multiply(alpha, alpha, out=tmp)  # beta^2
         good = beta >= 0
         if flags:
             jump |= _stepped_over(beta / (inv * np.maximum(L1s, 1e-300)[:, None]))

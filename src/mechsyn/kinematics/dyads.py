@@ -573,13 +573,28 @@ def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResul
         return _poses_from_chain_(S, plan, U, r, split)
 
 
+def _drive_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
+    """Links turned by a frame driver: link -> (driver index, sign of the input), kept
+    in the system's memo for the plan (a sweep's angles of these links are the inputs)."""
+    memo = _memo(S)
+    hit = memo.get(("drive_links", id(plan)))
+    if hit is not None and hit[0] is plan:
+        return hit[1]
+    out = {}
+    for step in plan.steps:
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            out[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
+    memo[("drive_links", id(plan))] = (plan, out)
+    return out
+
+
 def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None) -> tuple:
     N, nl = r.cos.shape
     # component-major buffers (returned transposed): every column written is contiguous
     q = np.empty((S.n, N)).T
     qd = np.empty((S.n, N)).T
     qdd = np.empty((S.n, N)).T
-    phi = np.arctan2(r.sin, r.cos)
     # all links at once: (N, nl) arrays, the anchors' states gathered per link
     jids = [r.anchor[i][0] for i in range(nl)]
     sa = np.array([r.anchor[i][1] for i in range(nl)], float).reshape(nl, 2)
@@ -590,27 +605,25 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
                for d in (r.points, r.velocities, r.accelerations))  # (N, 2, nl)
     w, al = r.omega, r.alpha
     w2 = w * w
-    q[:, 0:3 * nl:3] = P[:, 0] + relx
-    q[:, 1:3 * nl:3] = P[:, 1] + rely
-    qd[:, 0:3 * nl:3] = V[:, 0] - w * rely
-    qd[:, 1:3 * nl:3] = V[:, 1] + w * relx
-    qdd[:, 0:3 * nl:3] = A[:, 0] - al * rely - w2 * relx
-    qdd[:, 1:3 * nl:3] = A[:, 1] + al * relx - w2 * rely
+    x, y = slice(0, 3 * nl, 3), slice(1, 3 * nl, 3)  # written in place (no temporaries)
+    np.add(P[:, 0], relx, out=q[:, x])
+    np.add(P[:, 1], rely, out=q[:, y])
+    np.subtract(V[:, 0], w * rely, out=qd[:, x])
+    np.add(V[:, 1], w * relx, out=qd[:, y])
+    np.subtract(A[:, 0] - al * rely, w2 * relx, out=qdd[:, x])
+    np.subtract(A[:, 1] + al * relx, w2 * rely, out=qdd[:, y])
     qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
     # angles: drivers' links take the input itself, dyad links are made continuous
-    drive_links = {}
-    for step in plan.steps:
-        if step.kind == "drive_R" and step.known[0] < 0:
-            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
-            drive_links[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
-    ok = np.all(np.isfinite(r.cos), axis=1)
-    for i in range(nl):
-        if i in drive_links:
-            k, sgn = drive_links[i]
-            phi[:, i] = sgn * U[:, k]
+    drive_links = _drive_links(S, plan)
+    ok = np.all(np.isfinite(c), axis=1)
+    phi = np.empty((N, nl))
+    for i, (k, sgn) in drive_links.items():
+        phi[:, i] = sgn * U[:, k]
     others = [i for i in range(nl) if i not in drive_links]
-    if others and ok.any():
-        phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
+    if others:  # atan2 only for the links not driven directly
+        phi[:, others] = np.arctan2(s[:, others], c[:, others])
+        if ok.any():
+            phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
     q[:, 2:3 * nl:3] = phi
     if not ok.all():
         for a in (q, qd, qdd):
