@@ -85,10 +85,13 @@ def _is_style(body: str) -> bool:
 
 
 def guard_markup(text: str) -> str:
-    r"""``text`` with every ``[tag]`` that is not a plain style escaped: a file's
-    ``[link=...]``, ``[@click]`` or ``[crank]`` prints as text (``[bold]``, ``[red]``, ``[/]``
-    still style the commands' own messages).
+    r"""``text`` with every markup tag that is not a plain style escaped: a file's
+    link, click or unknown tags (``[link=...]``, ``[@click]``, a link named in brackets)
+    print as text; plain styles (bold, red, the closing tag) still style the commands' own
+    messages.
 
+    Examples
+    --------
     >>> print(guard_markup("[bold]link[/] [crank] [link=https://x.example]x[/link]"))
     [bold]link[/] \[crank] \[link=https://x.example]x\[/link]
     """
