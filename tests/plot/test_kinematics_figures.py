@@ -46,3 +46,24 @@ def test_pyslvs_colours_fill_the_pins(jansen):
     x0, y0 = green[0].get_xydata()[0]
     assert any(np.allclose(j.point, (x0, y0)) for j in jansen.system.mech.joints if j.id == "P0") or \
         any(np.allclose(ln.get_xydata()[0], [0, 0]) for ln in green)
+
+
+@pytest.mark.filterwarnings("ignore:Animation was deleted")
+def test_animation_frames_use_the_file_colours(jansen):
+    """Each frame fills the pins with the file's ``colors:`` at the pins' moved places, as the static figure."""
+    from mechsyn.plot.kinematics import _file_colours, animate_simulation
+
+    anim = animate_simulation(jansen, max_frames=5)
+    draw, frames = anim.mechsyn_blit
+    colours = jansen.system.mech.attrs["colors"]
+    for k in (frames[0], frames[len(frames) // 2]):
+        moving = draw(k)
+        pins = [a for a in moving if getattr(a, "get_marker", lambda: None)() == "o"
+                and a.get_markerfacecolor() != "white" and a.get_markerfacecolor() != "k"]
+        assert len(pins) == len(colours)
+        want = _file_colours(jansen, k)
+        for pin, (xy, rgb) in zip(pins, want):
+            assert np.allclose(to_rgb(pin.get_markerfacecolor()), rgb)
+            assert np.allclose(pin.get_xydata()[0], xy)
+    first, middle = _file_colours(jansen, frames[0]), _file_colours(jansen, frames[len(frames) // 2])
+    assert any(not np.allclose(a[0], b[0]) for a, b in zip(first, middle))  # the pins move with the links
