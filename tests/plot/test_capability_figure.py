@@ -53,3 +53,17 @@ def test_dense_grid_draws_no_cell_values():
     xs, ys = np.arange(1300, 2101, 50.0), np.arange(100, 901, 50.0)
     _, ax, cells, labels = _drawn(_map(xs, ys))
     assert not cells and labels
+
+
+def test_every_panel_annotated_or_none():
+    """One decision for the figure: a panel with shorter numbers is not annotated alone."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from mechsyn.plot.capability import plot_capability_map
+
+    for step in (200.0, 100.0):
+        cmap = _map(np.arange(1300, 2101, step), np.arange(100, 901, step))
+        fig = plot_capability_map(cmap, fig=Figure())
+        FigureCanvasAgg(fig).draw()
+        counts = {sum(t.get_color() == "white" for t in ax.texts) for ax in fig.axes if ax.get_title()}
+        assert len(counts) == 1, counts

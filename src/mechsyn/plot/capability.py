@@ -54,17 +54,20 @@ def _text_size(ax: Any, text: str, fontsize: float) -> tuple[float, float]:
     return 0.5 * (0.62 * fontsize * len(text) + 2) * per_pt_x, 0.5 * (1.2 * fontsize + 2) * per_pt_y
 
 
+def _values_fit(ax: Any, xs: np.ndarray, ys: np.ndarray, fields: list, fontsize: float = 8) -> bool:
+    """Whether the widest cell value of any panel fits its cell on ``ax`` (one answer for
+    every panel: all annotated or none)."""
+    values = np.concatenate([d[np.isfinite(d)] for d, _, _ in fields])
+    if not values.size or xs.size < 2 or ys.size < 2:
+        return False
+    hw, hh = _text_size(ax, max((f"{v:.1f}" for v in values), key=len), fontsize)
+    return 2 * hw <= 0.8 * np.min(np.diff(xs)) and 2 * hh <= 0.6 * np.min(np.diff(ys))
+
+
 def _cell_values(ax: Any, xs: np.ndarray, ys: np.ndarray, data: np.ndarray,
                  fontsize: float = 8) -> list:
-    """Write each finite cell value at its node when the cells are large enough for the text
-    (else nothing). Returns the Texts written."""
+    """Write each finite cell value at its node. Returns the Texts written."""
     finite = np.isfinite(data)
-    if not finite.any() or xs.size < 2 or ys.size < 2:
-        return []
-    widest = max((f"{v:.1f}" for v in data[finite]), key=len)
-    hw, hh = _text_size(ax, widest, fontsize)
-    if 2 * hw > 0.9 * np.min(np.diff(xs)) or 2 * hh > 0.6 * np.min(np.diff(ys)):
-        return []
     return [ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=fontsize,
                     color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
             for i, x in enumerate(xs) for j, y in enumerate(ys) if finite[i, j]]
@@ -136,9 +139,10 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
         axs[idx // cols][idx % cols].axis("off")
     fig.tight_layout()
     # texts last, on the final layout: cell values where they fit, contour labels clear of them
+    fit = _values_fit(axs[0][0], cmap.xs, cmap.ys, fields)
     for idx, (data, _, _) in enumerate(fields):
         ax = axs[idx // cols][idx % cols]
-        texts = _cell_values(ax, cmap.xs, cmap.ys, data)
+        texts = _cell_values(ax, cmap.xs, cmap.ys, data) if fit else []
         cs = _labelled_contours(ax, cmap.xs, cmap.ys, data) if idx == 0 else None
         if cs is not None:
             _label_contours(ax, cs, texts)
