@@ -67,3 +67,24 @@ def test_animation_frames_use_the_file_colours(jansen):
             assert np.allclose(pin.get_xydata()[0], xy)
     first, middle = _file_colours(jansen, frames[0]), _file_colours(jansen, frames[len(frames) // 2])
     assert any(not np.allclose(a[0], b[0]) for a, b in zip(first, middle))  # the pins move with the links
+
+
+@pytest.mark.filterwarnings("ignore:Animation was deleted")
+def test_redrawn_animation_uses_the_file_colours_and_link_colours():
+    """Cams are redrawn whole at each frame: the file's colours fill the pins there too, and
+    each point's trail has its link's colour (as in the static figure)."""
+    from matplotlib.figure import Figure
+
+    from mechsyn.plot.kinematics import animate_simulation
+
+    mech = ms.load_mechanism(ROOT / "examples" / "kinematics" / "cam_roller.yaml")
+    mech.attrs["colors"] = {"O": "Red"}
+    sim = ms.simulate(mech, {"O": np.arange(0.0, 361.0, 30.0)}, points=["F"])
+    anim = animate_simulation(sim, fig=Figure(), max_frames=4)
+    anim._draw_frame(0)  # the first frame, as a writer draws it
+    ax = anim._fig.axes[0]
+    red = [ln for ln in ax.get_lines() if ln.get_marker() == "o"
+           and np.allclose(to_rgb(ln.get_markerfacecolor()), (1, 0, 0))]
+    assert len(red) == 1 and np.allclose(red[0].get_xydata()[0], (0, 0))
+    trail = [ln for ln in ax.get_lines() if ln.get_label() == "F"]
+    assert trail and np.allclose(to_rgb(trail[0].get_color()), to_rgb(link_colour(sim, "follower")))

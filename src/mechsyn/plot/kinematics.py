@@ -283,6 +283,8 @@ def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.nda
     xlim, ylim = ax.get_xlim(), ax.get_ylim()
     unit = _length_unit(sim)
 
+    styles = _point_styles(sim)
+
     def draw(k):
         ax.clear()
         ax.set_xlim(*xlim)
@@ -293,7 +295,8 @@ def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.nda
         ax.set_ylabel(f"y ({unit})")
         for name, pm in sim.points.items():
             ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
-            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
+            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], styles[name][1], color=styles[name][0],
+                    lw=1.8, label=name)
             ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
         arts = draw_mechanism(ax, sim, k)
         ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
