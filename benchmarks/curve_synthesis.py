@@ -223,7 +223,7 @@ def _figure(directory: Path, name: str, tgt, best, fb, fb_path, fb_closed) -> No
 
     directory.mkdir(parents=True, exist_ok=True)
     ns = [n for n in best if best[n][1] is not None]
-    fig, axes = plt.subplots(1, len(ns) + 1, figsize=(4.2 * (len(ns) + 1), 4.2), dpi=100)
+    fig, axes = plt.subplots(1, len(ns) + 1, figsize=(4.2 * (len(ns) + 1), 5.0), dpi=100)
     T = np.vstack([tgt.points, tgt.points[:1]])
     ax = axes[0]
     ax.plot(T[:, 0], T[:, 1], "-", color="0.2", lw=2.5, alpha=0.35, label="target")
@@ -233,12 +233,12 @@ def _figure(directory: Path, name: str, tgt, best, fb, fb_path, fb_closed) -> No
     ax.set_xlabel("x (target's length unit)")
     ax.set_ylabel("y (target's length unit)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16))  # clear of the drawing
     ax.set_title(f"{name}: best four-bar of synth path", fontsize=9)
     for ax, n in zip(axes[1:], ns):
         c = best[n][1]
         plot_candidate(c, tgt, ax=ax)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16))  # clear of the drawing
         ax.set_title(f"synth curve, up to {n} links: {c.topology.name or c.topology.key}", fontsize=9)
     fig.tight_layout()
     save_figure_atomic(fig, directory / f"curve_{name.replace(' ', '_')}.png")

@@ -20,6 +20,14 @@ def test_literal_brackets_in_help(run_cli):
     assert "--frame / --no-frame" in out and "--dimensions" in out
 
 
+def test_repeatable_options_show_their_form(run_cli, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "80")
+    code, out, _ = run_cli("simulate", "--help")
+    assert "-i, --input J=A:B:S" in out and "--straight P=A:B" in out
+    code, out, _ = run_cli("export", "--help")
+    assert "--pose J=V" in out
+
+
 def _all_commands() -> list[list[str]]:
     from mechsyn.cli.main import COMMANDS, _load
 
@@ -38,6 +46,7 @@ def test_every_help_reads_at_80_columns(command, run_cli, monkeypatch):
     code, out, err = run_cli(*command, "--help")
     assert code == 0, err
     assert "<bool>" not in out
+    assert "<list[" not in out  # repeatable options read as the field writes them (metavar=)
     wide = [ln for ln in out.splitlines() if len(ln) > 80]
     assert not wide, wide
     lines = out.splitlines()

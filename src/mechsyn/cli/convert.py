@@ -32,7 +32,7 @@ def convert_cmd(
     to: Annotated[Optional[str], typer.Option("--to", help="Output format when writing to stdout: "
                                               "yaml, json or pyslvs.")] = None,
     input: Annotated[Optional[list[str]], typer.Option(
-        "--input", "-i", help="Pyslvs input pair BASE,DRIVE (point indices; the link through both turns "
+        "--input", "-i", metavar="BASE,DRIVE", help="Pyslvs input pair BASE,DRIVE (point indices; the link through both turns "
                               "about BASE). Repeat for several; default: ground cranks.")] = None,
     name: Annotated[Optional[str], typer.Option("--name", help="Mechanism name (default: the file's stem).")] = None,
     force: ForceOpt = False,

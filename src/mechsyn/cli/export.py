@@ -52,9 +52,9 @@ SvgOpt = Annotated[Optional[Path], typer.Option("--svg", help="Write the plates 
     "labels; - for stdout).")]
 DrawingOpt = Annotated[Optional[Path], typer.Option("--drawing", help="Write an SVG drawing of the mechanism at "
     "a pose, with --path and --dimensions.")]
-PoseOpt = Annotated[Optional[list[str]], typer.Option("--pose", help="Driven joint value of the drawing: J=V "
+PoseOpt = Annotated[Optional[list[str]], typer.Option("--pose", metavar="J=V", help="Driven joint value of the drawing: J=V "
     "(deg for R, length for P; default: the file's).")]
-PathOpt = Annotated[Optional[list[str]], typer.Option("--path", help="Draw the path of this point (a name from "
+PathOpt = Annotated[Optional[list[str]], typer.Option("--path", metavar="POINT", help="Draw the path of this point (a name from "
     "`points:` or a joint id) over --sweep.")]
 SweepOpt = Annotated[Optional[str], typer.Option("--sweep", help="Input range of the paths: "
     "J=START:STOP:STEP.")]

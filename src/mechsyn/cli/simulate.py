@@ -22,12 +22,12 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 
 InputOpt = Annotated[list[str], typer.Option(
-    "--input", "-i", help="Driven joint and its values: J=START:STOP:STEP (deg for R, length for P), "
+    "--input", "-i", metavar="J=A:B:S", help="Driven joint and its values: J=START:STOP:STEP (deg for R, length for P), "
                           "or J=V1,V2,... Repeat for several inputs (same number of values).")]
 SpeedOpt = Annotated[Optional[list[str]], typer.Option(
-    "--speed", help="Input rate J=V (rad/s for R, length/s for P; default 1).")]
+    "--speed", metavar="J=V", help="Input rate J=V (rad/s for R, length/s for P; default 1).")]
 VllOpt = Annotated[Optional[list[str]], typer.Option(
-    "--vll", help="Variable-length link mode J=locked|free|active (paper 000's two modes).")]
+    "--vll", metavar="J=MODE", help="Variable-length link mode J=locked|free|active (paper 000's two modes).")]
 MethodOpt = Annotated[str, typer.Option("--method", help="auto | assur | newton")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON on stdout.")]
 CsvOpt = Annotated[Optional[Path], typer.Option("--csv", help="Write a CSV table.")]
@@ -112,7 +112,7 @@ def simulate_cmd(
     output: Annotated[Optional[str], typer.Option("--output", help="Output link for the mechanical "
                                                   "advantage (default: the last link pivoted on the frame).")] = None,
     straight: Annotated[Optional[list[str]], typer.Option(
-        "--straight", help="Straightness of a path segment: P=START:STOP (input values).")] = None,
+        "--straight", metavar="P=A:B", help="Straightness of a path segment: P=START:STOP (input values).")] = None,
     json_: JsonOpt = False,
     csv_out: CsvOpt = None,
     plot: PlotOpt = None,

@@ -25,7 +25,7 @@ def structure(
     file: Path = typer.Argument(..., help="Planar mechanism file (YAML or JSON)."),
     json_out: bool = typer.Option(False, "--json", help="Print JSON."),
     output: Optional[list[str]] = typer.Option(
-        None, "--output", help="Output link (repeatable; default: links carrying points)."),
+        None, "--output", metavar="LINK", help="Output link (repeatable; default: links carrying points)."),
 ) -> None:
     """Input links, Assur groups (class and order, Artobolevsky), structural formula and
     class of a planar mechanism; the binary links paper 000 may turn into ternary ones."""

@@ -38,11 +38,73 @@ def _labelled_contours(ax: Any, xs: np.ndarray, ys: np.ndarray, data: np.ndarray
         gx, gy = np.meshgrid(fx, fy, indexing="ij")
         fine = RegularGridInterpolator((xs, ys), data, bounds_error=False)(np.stack([gx, gy], -1))
     try:
-        cs = ax.contour(fx, fy, fine.T, levels=8, colors="k", linewidths=0.7)
-        ax.clabel(cs, fontsize=8, fmt="%.4g", inline=True)
+        return ax.contour(fx, fy, fine.T, levels=8, colors="k", linewidths=0.7)
     except (ValueError, TypeError):  # no level inside the range
         return None
-    return cs
+
+
+def _text_size(ax: Any, text: str, fontsize: float) -> tuple[float, float]:
+    """Approximate half width and half height of ``text`` in data units of ``ax`` (its
+    final, equal-aspect position)."""
+    ax.apply_aspect()
+    pos, (w_in, h_in) = ax.get_position(), ax.figure.get_size_inches()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    per_pt_x = abs(x1 - x0) / (pos.width * w_in * 72)
+    per_pt_y = abs(y1 - y0) / (pos.height * h_in * 72)
+    return 0.5 * (0.62 * fontsize * len(text) + 2) * per_pt_x, 0.5 * (1.2 * fontsize + 2) * per_pt_y
+
+
+def _values_fit(ax: Any, xs: np.ndarray, ys: np.ndarray, fields: list, fontsize: float = 8) -> bool:
+    """Whether the widest cell value of any panel fits its cell on ``ax`` (one answer for
+    every panel: all annotated or none)."""
+    values = np.concatenate([d[np.isfinite(d)] for d, _, _ in fields])
+    if not values.size or xs.size < 2 or ys.size < 2:
+        return False
+    hw, hh = _text_size(ax, max((f"{v:.1f}" for v in values), key=len), fontsize)
+    return 2 * hw <= 0.8 * np.min(np.diff(xs)) and 2 * hh <= 0.6 * np.min(np.diff(ys))
+
+
+def _cell_values(ax: Any, xs: np.ndarray, ys: np.ndarray, data: np.ndarray,
+                 fontsize: float = 8) -> list:
+    """Write each finite cell value at its node. Returns the Texts written."""
+    finite = np.isfinite(data)
+    return [ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=fontsize,
+                    color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
+            for i, x in enumerate(xs) for j, y in enumerate(ys) if finite[i, j]]
+
+
+def _label_contours(ax: Any, cs: Any, texts: list, fontsize: float = 8) -> list:
+    """Label each contour level once, inline on a light box, at the point of its line
+    farthest from the cell-value texts (a level whose every point is under a text is left
+    unlabelled rather than written over one). Returns the label Texts."""
+    if not texts:
+        labels = ax.clabel(cs, fontsize=fontsize, fmt="%.4g", inline=True)
+    else:
+        centres = np.array([t.get_position() for t in texts])
+        thw, thh = _text_size(ax, max((t.get_text() for t in texts), key=len), fontsize)
+        (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+        levels, spots = [], []
+        for level, segs in zip(cs.levels, cs.allsegs):
+            pts = np.vstack([s for s in segs if len(s)] or [np.empty((0, 2))])
+            if not len(pts):
+                continue
+            lhw, lhh = _text_size(ax, f"{level:.4g}", fontsize)
+            dx = np.abs(pts[:, None, 0] - centres[None, :, 0]) / (thw + lhw)
+            dy = np.abs(pts[:, None, 1] - centres[None, :, 1]) / (thh + lhh)
+            clear = np.maximum(dx, dy).min(axis=1)
+            inside = ((pts[:, 0] - lhw > x0) & (pts[:, 0] + lhw < x1)
+                      & (pts[:, 1] - lhh > y0) & (pts[:, 1] + lhh < y1))
+            clear = np.where(inside, clear, -1.0)
+            k = int(np.argmax(clear))
+            if clear[k] > 1.05:
+                levels.append(level)
+                spots.append(tuple(pts[k]))
+        if not spots:
+            return []
+        labels = ax.clabel(cs, levels, fontsize=fontsize, fmt="%.4g", inline=True, manual=spots)
+    for t in labels:
+        t.set_bbox(dict(fc="white", alpha=0.75, lw=0, pad=0.6))
+    return labels
 
 
 def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
@@ -54,7 +116,6 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
     rows_ = math.ceil(panels / cols)
     fig = figure(fig, (5.2 * cols, 4.4 * rows_))
     axs = fig.subplots(rows_, cols, squeeze=False)
-    small = cmap.xs.size * cmap.ys.size <= 144
     qu = cmap.q_user()
     fields = [(np.where(np.isfinite(cmap.value), cmap.value, np.nan),
                f"V_max along ({', '.join(f'{c:g}' for c in np.round(cmap.direction, 3))}) "
@@ -69,14 +130,6 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
         ax = axs[idx // cols][idx % cols]
         mesh = ax.pcolormesh(cmap.xs, cmap.ys, data.T, shading="nearest", cmap=cm)
         fig.colorbar(mesh, ax=ax, shrink=0.85)
-        if idx == 0:
-            _labelled_contours(ax, cmap.xs, cmap.ys, data)
-        if small:
-            for i, x in enumerate(cmap.xs):
-                for j, y in enumerate(cmap.ys):
-                    if np.isfinite(data[i, j]):
-                        ax.text(x, y, f"{data[i, j]:.1f}", ha="center", va="center", fontsize=8,
-                                color="white", bbox=dict(fc="black", alpha=0.35, lw=0, pad=1))
         ax.set_title(title, fontsize=9)
         length = units.split("/")[0]
         ax.set_xlabel(f"x ({length})")
@@ -85,4 +138,12 @@ def plot_capability_map(cmap: Any, units: str = "mm/s", fig: Any = None) -> Any:
     for idx in range(panels, rows_ * cols):
         axs[idx // cols][idx % cols].axis("off")
     fig.tight_layout()
+    # texts last, on the final layout: cell values where they fit, contour labels clear of them
+    fit = _values_fit(axs[0][0], cmap.xs, cmap.ys, fields)
+    for idx, (data, _, _) in enumerate(fields):
+        ax = axs[idx // cols][idx % cols]
+        texts = _cell_values(ax, cmap.xs, cmap.ys, data) if fit else []
+        cs = _labelled_contours(ax, cmap.xs, cmap.ys, data) if idx == 0 else None
+        if cs is not None:
+            _label_contours(ax, cs, texts)
     return fig

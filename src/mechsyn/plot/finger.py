@@ -66,10 +66,15 @@ def sketch_mechanism(data: dict, ax: Any = None, title: str = "", vll: tuple[str
         q = pts[j["id"]]
         ax.plot(q[0], q[1], "o", ms=5, mfc="#ffd92f" if j.get("actuated") else "white",
                 mec="black", mew=0.8, zorder=5)
+    unit = data.get("units") or "length"
     ax.set_title(title, fontsize=7)
     ax.set_aspect("equal")
     ax.margins(0.12)
-    ax.axis("off")
+    ax.set_xlabel(f"x ({unit})", fontsize=6, labelpad=1)
+    ax.set_ylabel(f"y ({unit})", fontsize=6, labelpad=1)
+    ax.tick_params(labelsize=5, length=2, pad=1)
+    for spine in ax.spines.values():
+        spine.set_color("0.75")
     return ax
 
 
@@ -93,8 +98,8 @@ def plot_fingers(results: Any, base_data: dict, title: str = "", fig: Any = None
         ax.axis("off")
     fig.suptitle(title + "\n(grey: base, orange: attached group, dashed red: VLL "
                  "candidates, yellow: actuated pair)", fontsize=9, y=1 - 0.08 / height, va="top")
-    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.1 / height, top=1 - 1.15 / height,
-                        wspace=0.1, hspace=0.45)
+    fig.subplots_adjust(left=0.05, right=0.99, bottom=0.45 / height, top=1 - 1.15 / height,
+                        wspace=0.3, hspace=0.55)
     return fig
 
 
@@ -107,6 +112,12 @@ def _draw_finger(ax: Any, S: Any, q: np.ndarray, color: Any, lw: float = 1.6, ls
         if len(pts) >= 2:
             P = np.array(pts + pts[:1]) if len(pts) > 2 else np.array(pts)
             ax.plot(P[:, 0], P[:, 1], ls, marker="o", color=color, lw=lw, ms=2.5, alpha=alpha)
+
+
+def _legend_below(ax: Any) -> Any:
+    """The legend under the axes (outside the drawn mechanism, which fills the panel)."""
+    return ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
+                     framealpha=0.9)
 
 
 def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
@@ -147,7 +158,7 @@ def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
     ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7, label="palm pivots")
     ax.set_title(f"1. Fully actuated: VLL {'+'.join(combo)} locked at its minimum\n"
                  f"target error RMS {v.error_rms:.3g}°, max {v.error_max:.3g}°", fontsize=11)
-    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
+    _legend_below(ax)
     # 2: underactuated, the finger at the ends of the VLL range
     ax = axes[1]
     rng = ", ".join(f"{j} in [{a:.4g}, {b:.4g}]" for j, (a, b) in v.vll_ranges.items())
@@ -169,7 +180,7 @@ def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
     ax.plot(gp[:, 0], gp[:, 1], "ks", ms=7)
     ax.set_title(f"2. Underactuated: VLL free, {rng}\npeak reaction {v.forces['peak_reaction']:.3g}, "
                  f"peak input moment {v.forces['peak_input_moment']:.3g} (both modes)", fontsize=11)
-    ax.legend(fontsize=8, loc="center right", framealpha=0.9)
+    _legend_below(ax)
     xs = axes[0].get_xlim() + axes[1].get_xlim()
     ys = axes[0].get_ylim() + axes[1].get_ylim()
     for ax in axes[:2]:

@@ -283,6 +283,8 @@ def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.nda
     xlim, ylim = ax.get_xlim(), ax.get_ylim()
     unit = _length_unit(sim)
 
+    styles = _point_styles(sim)
+
     def draw(k):
         ax.clear()
         ax.set_xlim(*xlim)
@@ -293,7 +295,8 @@ def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.nda
         ax.set_ylabel(f"y ({unit})")
         for name, pm in sim.points.items():
             ax.plot(pm.position[:, 0], pm.position[:, 1], "-", lw=1, color="0.7")
-            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], "-", lw=1.8, label=name)
+            ax.plot(pm.position[:k + 1, 0], pm.position[:k + 1, 1], styles[name][1], color=styles[name][0],
+                    lw=1.8, label=name)
             ax.plot([pm.position[k, 0]], [pm.position[k, 1]], "o", ms=4, color="k")
         arts = draw_mechanism(ax, sim, k)
         ax.set_title(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}", fontsize=10)
@@ -361,6 +364,9 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
     sliders = [(j.links[1], [x.id for x in S.mech.joints_of(j.links[1])].index(j.id))
                for j in S.mech.joints if j.type == "P"]
     squares, = ax.plot([], [], "s", ms=11, mfc="none", mec="0.1", zorder=5)
+    # the file's own colours (``colors:``) fill the pins, as in the static figure
+    file_pins = [ax.plot([], [], "o", ms=6, mfc=rgb, mec="0.1", mew=0.6, zorder=6)[0]
+                 for _, rgb in _file_colours(sim, frames[0])]
     title = ax.set_title("", fontsize=10)
     if sim.points:
         ax.legend(fontsize=8, loc="upper right")
@@ -391,9 +397,11 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
         if sliders:
             sq = np.array([outl[b][i] for b, i in sliders])
             squares.set_data(sq[:, 0], sq[:, 1])
+        for pin, (xy, _) in zip(file_pins, _file_colours(sim, k)):
+            pin.set_data([xy[0]], [xy[1]])
         title.set_text(f"{sim.mechanism}\n{xlabel.split(' (')[0]} = {x[k]:.4g}")
         return ([a for _, trail, dot in trails for a in (trail, dot)]
-                + [a for _, f, e, p in links for a in (f, e, p) if a is not None] + [squares, title])
+                + [a for _, f, e, p in links for a in (f, e, p) if a is not None] + file_pins + [squares, title])
 
     anim = FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
     anim.mechsyn_blit = (draw, list(frames))  # what moves: see mechsyn.plot.frames
