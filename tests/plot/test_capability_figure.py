@@ -16,7 +16,7 @@ PAPER = ROOT / "examples" / "capability" / "paper004_3r.yaml"
 
 
 def _map(xs, ys):
-    from mechsyn.capability.arm import load_arm
+    from mechsyn.capability.arm_file import load_arm
     from mechsyn.capability.maps import capability_map
 
     return capability_map(load_arm(PAPER), xs, ys, (1, 0))
