@@ -9,11 +9,10 @@ the notebook and the browser app give the same answers. Every edit is synced bac
 
 Examples
 --------
->>> from mechsyn.io import load_mechanism
+>>> import mechsyn as ms
 >>> from mechsyn.web.widget import MechanismWidget
->>> w = MechanismWidget(load_mechanism("examples/textbook/fourbar.yaml"))  # doctest: +SKIP
->>> w  # in a notebook: the editor                                          # doctest: +SKIP
->>> w.mechanism.name                                                         # doctest: +SKIP
+>>> w = MechanismWidget(ms.load("fourbar"))  # the last line of a cell shows the editor
+>>> w.mechanism.name
 'Four-bar linkage'
 """
 
