@@ -101,7 +101,10 @@ def _label_contours(ax: Any, cs: Any, texts: list, fontsize: float = 8) -> list:
                 spots.append(tuple(pts[k]))
         if not spots:
             return []
-        labels = ax.clabel(cs, levels, fontsize=fontsize, fmt="%.4g", inline=True, manual=spots)
+        # written at the chosen points (clabel's manual placement of a subset of levels
+        # fails in Matplotlib 3.8): the light box below keeps the line from the digits
+        labels = [ax.text(x, y, f"{level:.4g}", fontsize=fontsize, ha="center", va="center", zorder=3)
+                  for level, (x, y) in zip(levels, spots)]
     for t in labels:
         t.set_bbox(dict(fc="white", alpha=0.75, lw=0, pad=0.6))
     return labels
