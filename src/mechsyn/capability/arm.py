@@ -1,19 +1,9 @@
 """Serial arm models: forward kinematics, Jacobians, inverse kinematics.
 
-The arm files are read by :mod:`mechsyn.capability.arm_file` (three kinds, validated
-there with pydantic; this module computes on arrays and imports none of it):
-
-* ``kind: planar_serial`` -- a planar chain of R (and P) joints given by link lengths, base
-  at the origin, *relative* joint angles (paper 004: 3R arm, l1 = l2 = l3 = 900 mm)::
-
-      {name: paper004, kind: planar_serial, link_lengths: [900, 900, 900],
-       joint_limits_deg: [[0, 120], [-120, 120], [-120, 120]],
-       joint_speed_limits_deg_s: [4, 4, 4]}
-
-* ``kind: dh`` -- a spatial chain by classic Denavit-Hartenberg parameters, joint i
-  contributing ``Rz(theta_i + q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)`` (``d_i + q_i`` for P).
-* ``kind: urdf`` -- a simple chain read from a URDF file (revolute, continuous,
-  prismatic and fixed joints between ``base_link`` and ``tip_link``).
+The arm files (planar_serial, dh, urdf) are read by :mod:`mechsyn.capability.arm_file`,
+which validates them with pydantic; this module computes on arrays and imports none of it.
+Joint i of a ``dh`` arm contributes ``Rz(theta_i + q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``
+(``d_i + q_i`` for P).
 
 Angles are degrees in files (R joints; P joint values and limits are lengths), lengths in
 any unit (mm in the paper); speeds are then length/s. Inside, every function works on
