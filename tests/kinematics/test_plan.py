@@ -3,6 +3,7 @@
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from mechsyn.kinematics.analysis import compile_plan, input_grid, simulate
 
@@ -88,8 +89,9 @@ def _same(a, b):
 def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
     """Where no group comes near a fold, the one array pass is taken and gives what the
     tracked outward sweeps give; with dead points it declines (the tracked sweep runs)."""
-    from mechsyn.kinematics import analysis, dyads
+    from mechsyn.kinematics import analysis
     from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.regular import regular_sweep
 
     cases = [("kinematics/crank_rocker.yaml", "A", True), ("kinematics/jansen_leg.yaml", "P0", True),
              ("textbook/fourbar.yaml", "A", False), ("textbook/watt_sixbar.yaml", "A", False)]
@@ -99,8 +101,11 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
         for grid in ((0, 360, 1), (-90, 500, 7), (200, 260, 0.5)):
             x = input_grid(*grid)
             U = np.radians(x)[:, None]
-            got = dyads.solve_regular(kp.system, kp.groups, U, np.ones(1), analysis._drawn_row(kp.system, U))
+            got = regular_sweep(kp.system, kp.groups, U, np.ones(1), analysis._drawn_row(kp.system, U))
             assert (got is not None) == regular or grid[1] - grid[0] < 360, (f, grid)
+            if got is not None:
+                q, _, _, (c, s) = got
+                assert np.allclose(c, np.cos(q[:, 2::3].T), atol=1e-12) and np.allclose(s, np.sin(q[:, 2::3].T), atol=1e-12)
             fast = simulate(m, {j: x})
             with monkeypatch.context() as mp:
                 mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
@@ -146,3 +151,15 @@ def test_cached_plans_do_not_keep_mechanisms_alive(ex):
     del m
     gc.collect()
     assert ref() is None
+
+
+def test_a_speed_that_is_not_a_number_is_refused(ex):
+    """The one pass trusts every row to have finite rates: a NaN or infinite input speed is
+    refused with the field named, never swept into NaN rates."""
+    from mechsyn.errors import MechsynInputError
+
+    m = ex("kinematics/crank_rocker.yaml")
+    for bad in (float("nan"), float("inf")):
+        with pytest.raises(MechsynInputError, match="finite") as err:
+            simulate(m, {"A": input_grid(0, 90, 1)}, speeds={"A": bad})
+        assert err.value.field == "speeds"

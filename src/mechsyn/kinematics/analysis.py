@@ -25,6 +25,7 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import dyads
 from mechsyn.kinematics.forces import Reactions, kinetostatics
+from mechsyn.kinematics.regular import regular_sweep
 from mechsyn.kinematics.solve import Sweep, assemble, sweep
 from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
@@ -394,7 +395,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     N = lengths.pop()
     if N == 0:
         raise MechsynInputError("the input range is empty", field="inputs")
-    U = np.tile([d.assembled for d in S.drivers], (N, 1)).astype(float)
+    U = np.empty((N, len(S.drivers)))
+    U[:] = [d.assembled for d in S.drivers]
     types: dict[str, str] = {}
     for jid, vals in inputs.items():
         if jid not in drivers:
@@ -425,6 +427,9 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
             raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
     for jid in inputs:
         sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
+    if not np.all(np.isfinite(sp)):
+        raise MechsynInputError("input speeds must be finite numbers", field="speeds",
+                                hint="give each driven joint's speed in rad/s (R) or length/s (P)")
     pts = resolve_points(mech, points)
     plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
@@ -441,7 +446,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     events = sw.events
     used = sw.method
     ok = sw.assembled
-    rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+    rates_ok = ok if sw.rotations is not None else (np.all(np.isfinite(sw.qd), axis=1)
+                                                     & np.all(np.isfinite(sw.qdd), axis=1))
     flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
     for k in np.flatnonzero(ok & ~rates_ok).tolist():
         if k in flagged:
@@ -476,7 +482,9 @@ def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_
     qd, qdd = (sw.qd, sw.qdd) if all(whole) else (np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd))
     pm = {}
     for name, (link, at) in pts.items():
-        P, V, A = S.point_state(q, qd, qdd, S.index(link), S.to_local(link, at))
+        i = S.index(link)
+        rot = (sw.rotations[0][i], sw.rotations[1][i]) if sw.rotations is not None and i >= 0 else None
+        P, V, A = S.point_state(q, qd, qdd, i, S.to_local(link, at), rot)
         if not whole[0]:
             for arr in (P, V, A):
                 arr[~ok] = np.nan
@@ -525,18 +533,18 @@ def _run_one(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.n
 def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray,
               progress: Any) -> Sweep | None:
     """The sweep of a chain whose groups stay clear of folds and change points, in one
-    array pass (:func:`dyads.solve_regular`); None when the branch rules are needed."""
+    array pass (:func:`~mechsyn.kinematics.regular.regular_sweep`); None when the branch rules are needed."""
     if plan is None:
         return None
-    res = dyads.solve_regular(S, plan, U, sp, _drawn_row(S, U))
+    res = regular_sweep(S, plan, U, sp, _drawn_row(S, U))
     if res is None:
         return None
-    q, qd, qdd = res
+    q, qd, qdd, rot = res
     N = U.shape[0]
     if progress is not None:
         progress(N)
-    ok = np.all(np.isfinite(q), axis=1)
-    return Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
+    nan = np.full(N, np.nan)
+    return Sweep(S, U, sp, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur", rotations=rot)
 
 
 def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
@@ -544,6 +552,8 @@ def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
     if U.shape[0] < 2:
         return None
+    if U.shape[1] == 1:
+        return _drawn_row_1(S.drivers[0], U[:, 0])
     u0 = np.array([d.assembled for d in S.drivers], float)
     isR = np.array([d.type == "R" for d in S.drivers])
     a, d = U[:-1], np.diff(U, axis=0)
@@ -557,6 +567,34 @@ def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
         hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
         if hit.any():
             return int(np.argmax(hit)) + 1
+    return None
+
+
+def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
+    """:func:`_drawn_row` of one input (the same numbers on 1-D arrays: a point of a
+    segment is always on its line, so only the segment parameter is tested)."""
+    u0 = float(driver.assembled)
+    a = u[:-1]
+    d = u[1:] - a
+    dd = d * d
+    v = a - u0
+    if driver.type == "R":
+        v /= 2 * np.pi
+        np.rint(v, out=v)
+        v *= 2 * np.pi
+        v += u0
+        shifts = (0.0, 2 * np.pi, -2 * np.pi)
+    else:
+        v[:] = u0
+        shifts = (0.0,)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for shift in shifts:
+            t = (v + shift - a) if shift else v - a
+            t *= d
+            t /= dd
+            hit = (t > 0.0) & (t <= 1.0)
+            if hit.any():
+                return int(np.argmax(hit)) + 1
     return None
 
 

@@ -250,28 +250,58 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
-def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray, split: int | None = None) -> np.ndarray:
+def _unwrap_rows(p: np.ndarray) -> np.ndarray:
+    """``np.unwrap(p, axis=-1)`` for angles whose steps stay below a whole turn (as those of
+    ``atan2`` do): the whole turns removed are counted exactly (a step of exactly half a
+    turn is kept, as ``np.unwrap`` keeps it)."""
+    out = np.array(p, float)
+    if p.shape[-1] > 1:
+        k = np.subtract(p[..., 1:], p[..., :-1])
+        k /= 2 * np.pi
+        np.rint(k, out=k)
+        jumps = np.flatnonzero(k)
+        if len(jumps) > 16:  # many turns: count them all at once
+            np.cumsum(k, axis=-1, out=k)
+            k *= 2 * np.pi
+            out[..., 1:] -= k
+        else:  # a few: each shifts the rest of its row
+            o2, k2 = out.reshape(-1, out.shape[-1]), k.reshape(-1, k.shape[-1])
+            for j in jumps.tolist():
+                row, col = divmod(j, k2.shape[1])
+                o2[row, col + 1:] -= 2 * np.pi * k2[row, col]
+    return out
+
+
+def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None) -> np.ndarray:
     """Link angles made continuous along a sweep: start near the file's angles ``ref``,
-    unwrap each run of assembled rows and keep the turn count across gaps.
+    unwrap each run of assembled rows and keep the turn count across gaps (``phi`` (N,
+    m), or (m, N) with ``ref`` (m, 1); ``ok`` None: every row assembled).
 
     ``split``: the sweep (assembled throughout) was run outwards from the drawn
     configuration, between rows ``split - 1`` and ``split``: both rows start near
     ``ref`` and the angles are unwrapped away from them (as two runs would be)."""
-    sub = ref + _wrap(phi - ref)
-    if split is not None and ok.all():
-        block = np.unwrap(sub, axis=0)
-        block[split:] -= 2 * np.pi * np.round((block[split] - sub[split]) / (2 * np.pi))
-        block[:split] -= 2 * np.pi * np.round((block[split - 1] - sub[split - 1]) / (2 * np.pi))
+    if ref.ndim == 1:
+        return _continuous_angles(phi.T, ref[:, None], ok, split).T
+    if ok is None or ok.all():  # one run: unwrap, then put the start row(s) next to ref
+        block = _unwrap_rows(phi)
+        parts = ((0, slice(None)),) if split is None else ((split, slice(split, None)), (split - 1, slice(0, split)))
+        for row, rows in parts:  # the few start values on floats (the numbers of _wrap)
+            for i, (a, b, r0) in enumerate(zip(phi[:, row].tolist(), block[:, row].tolist(), ref[:, 0].tolist())):
+                near = r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi)
+                turns = round((b - near) / (2 * math.pi))
+                if turns:
+                    block[i, rows] -= 2 * math.pi * turns
         return block
+    sub = ref + _wrap(phi - ref)
     idx = np.flatnonzero(ok)
     runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
     prev = None
     for run in runs:
-        block = np.unwrap(sub[run], axis=0)
+        block = _unwrap_rows(sub[:, run])
         if prev is not None:
-            block -= 2 * np.pi * np.round((block[0] - prev) / (2 * np.pi))
-        sub[run] = block
-        prev = block[-1]
+            block -= 2 * np.pi * np.round((block[:, :1] - prev) / (2 * np.pi))
+        sub[:, run] = block
+        prev = block[:, -1:]
     return sub
 
 
@@ -565,12 +595,10 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     return q, qd, qdd
 
 
-def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult",
-                      split: int | None = None) -> tuple:
-    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations
-    (``split``: see :func:`_continuous_angles`)."""
+def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+    """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
     with np.errstate(invalid="ignore", over="ignore"):  # inf rates at singular rows become NaN
-        return _poses_from_chain_(S, plan, U, r, split)
+        return _poses_from_chain_(S, plan, U, r)
 
 
 def _drive_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
@@ -589,42 +617,46 @@ def _drive_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
     return out
 
 
-def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None) -> tuple:
-    N, nl = r.cos.shape
+def _anchor_states(r: "ChainResult", jids: list[str], N: int) -> tuple:
+    """Position, velocity, acceleration of the anchor joint of every link in the first
+    ``N`` rows, each (2, N, nl): one take from the chain's buffers when it has them."""
+    if r.buffers is not None:
+        index, bufs = r.buffers
+        idx = [index[j] for j in jids]
+        return tuple(b[idx, :, :N].transpose(1, 2, 0) for b in bufs)
+    out = (np.stack([d[j][:N] for j in jids], axis=2) for d in (r.points, r.velocities, r.accelerations))
+    return tuple(a.transpose(1, 0, 2) for a in out)
+
+
+def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+    N, nl = U.shape[0], r.cos.shape[1]
     # component-major buffers (returned transposed): every column written is contiguous
     q = np.empty((S.n, N)).T
     qd = np.empty((S.n, N)).T
     qdd = np.empty((S.n, N)).T
-    # all links at once: (N, nl) arrays, the anchors' states gathered per link
-    jids = [r.anchor[i][0] for i in range(nl)]
-    sa = np.array([r.anchor[i][1] for i in range(nl)], float).reshape(nl, 2)
-    c, s = r.cos, r.sin
-    relx = -(c * sa[:, 0] - s * sa[:, 1])  # r - P_anchor
-    rely = -(s * sa[:, 0] + c * sa[:, 1])
-    P, V, A = (np.stack([d[j] for j in jids], axis=2) if nl else np.empty((N, 2, 0))
-               for d in (r.points, r.velocities, r.accelerations))  # (N, 2, nl)
-    w, al = r.omega, r.alpha
-    w2 = w * w
-    x, y = slice(0, 3 * nl, 3), slice(1, 3 * nl, 3)  # written in place (no temporaries)
-    np.add(P[:, 0], relx, out=q[:, x])
-    np.add(P[:, 1], rely, out=q[:, y])
-    np.subtract(V[:, 0], w * rely, out=qd[:, x])
-    np.add(V[:, 1], w * relx, out=qd[:, y])
-    np.subtract(A[:, 0] - al * rely, w2 * relx, out=qdd[:, x])
-    np.subtract(A[:, 1] + al * relx, w2 * rely, out=qdd[:, y])
-    qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
-    # angles: drivers' links take the input itself, dyad links are made continuous
-    drive_links = _drive_links(S, plan)
-    ok = np.all(np.isfinite(c), axis=1)
-    phi = np.empty((N, nl))
-    for i, (k, sgn) in drive_links.items():
-        phi[:, i] = sgn * U[:, k]
-    others = [i for i in range(nl) if i not in drive_links]
-    if others:  # atan2 only for the links not driven directly
-        phi[:, others] = np.arctan2(s[:, others], c[:, others])
-        if ok.any():
-            phi[:, others] = _continuous_angles(phi[:, others], S.q0[[3 * i + 2 for i in others]], ok, split)
-    q[:, 2:3 * nl:3] = phi
+    if nl:  # all links at once: (N, nl) arrays, the anchors' states gathered per link
+        jids = [r.anchor[i][0] for i in range(nl)]
+        msa = -np.array([r.anchor[i][1] for i in range(nl)], float).reshape(nl, 2)  # r - P_anchor, local
+        c, s = r.cos[:N], r.sin[:N]
+        relx = c * msa[:, 0]
+        relx -= s * msa[:, 1]
+        rely = s * msa[:, 0]
+        rely += c * msa[:, 1]
+        P, V, A = _anchor_states(r, jids, N)  # (2, N, nl)
+        w, al = r.omega[:N], r.alpha[:N]
+        x, y = slice(0, 3 * nl, 3), slice(1, 3 * nl, 3)  # written in place (no temporaries)
+        np.add(P[0], relx, out=q[:, x])
+        np.add(P[1], rely, out=q[:, y])
+        wx, wy = w * relx, w * rely
+        np.subtract(V[0], wy, out=qd[:, x])
+        np.add(V[1], wx, out=qd[:, y])
+        ax = np.subtract(A[0], w * wx, out=qdd[:, x])
+        ax -= al * rely
+        ay = np.subtract(A[1], w * wy, out=qdd[:, y])
+        ay += al * relx
+        qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
+    ok = np.all(np.isfinite(r.cos[:N]), axis=1)
+    _link_angles(S, plan, U, r, None, ok, q.T[2:3 * nl:3])
     if not ok.all():
         for a in (q, qd, qdd):
             a[~ok] = np.nan
@@ -635,6 +667,23 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
         qd[bad] = np.nan
         qdd[bad] = np.nan
     return q, qd, qdd
+
+
+def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None,
+                 ok: np.ndarray | None, out: np.ndarray) -> None:
+    """Continuous angles of the chain's links into ``out`` (nl, N): the links of frame
+    drivers take the input itself, the others ``atan2`` made continuous (``ok`` None:
+    every row assembled)."""
+    nl, N = out.shape
+    drive_links = _drive_links(S, plan)
+    for i, (k, sgn) in drive_links.items():
+        np.multiply(U[:N, k], sgn, out=out[i])
+    others = [i for i in range(nl) if i not in drive_links]
+    if others:  # atan2 only for the links not driven directly
+        ang = np.arctan2(r.sin.T[others, :N], r.cos.T[others, :N])
+        if ok is None or ok.any():
+            ang = _continuous_angles(ang, S.q0[[3 * i + 2 for i in others]][:, None], ok, split)
+        out[others] = ang
 
 
 # --------------------------------------------------------------------------- fast chains
@@ -655,6 +704,21 @@ class ChainResult:
     omega: np.ndarray | None
     alpha: np.ndarray | None
     anchor: dict[int, tuple[str, np.ndarray]]
+    #: ``(index, buffers)``: the joints' row in the (joints, 2, N) buffers behind
+    #: ``points`` (and ``velocities``, ``accelerations``), when they are laid out so
+    buffers: tuple | None = None
+
+    def rows(self, rows: slice) -> "ChainResult":
+        """The rows ``rows`` of the result (views)."""
+        def part(d: dict | None) -> dict | None:
+            return None if d is None else {j: v[rows] for j, v in d.items()}
+
+        def arr(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else a[rows]
+
+        bufs = None if self.buffers is None else (self.buffers[0], tuple(b[:, :, rows] for b in self.buffers[1]))
+        return ChainResult(part(self.points), part(self.velocities), part(self.accelerations), arr(self.cos),
+                           arr(self.sin), arr(self.omega), arr(self.alpha), self.anchor, bufs)
 
 
 def chain_supported(plan: Plan | None) -> bool:
@@ -663,8 +727,7 @@ def chain_supported(plan: Plan | None) -> bool:
 
 def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | None = None,
                rates: bool = False, chunk: int = 1 << 13, joints: list[str] | None = None,
-               rotations: bool = True, sigmas: list | None = None,
-               discs: dict | None = None, least: float | None = None) -> ChainResult:
+               rotations: bool = True, sigmas: list | None = None) -> ChainResult:
     """Closed-form positions (and rates) of a driver-R + RRR chain, without angles.
 
     Every link is carried by an *anchor* (the joint that placed it: its position,
@@ -676,10 +739,6 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     and likewise for the accelerations. The work is done
     in chunks that stay in the processor's cache. ``sigmas``: the assembly sign of every
     step per input row (from :func:`solve_tracked`); default: the drawn modes.
-    ``discs``: when a dict, it receives every RRR step's normalised discriminant
-    ``g^2 |d|^2 / L1^2`` (``h^2 / L1^2`` of :func:`solve_tracked`) per row, by step index;
-    ``least``: with ``discs``, stop (raising ``_Irregular``) as soon as a discriminant
-    falls below it.
     """
     U = np.atleast_2d(np.asarray(U, float))
     N = U.shape[0]
@@ -689,19 +748,23 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     prog, anchor = _chain_program(S, plan, sigmas)
     # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
     # that every chunk writes contiguous memory
-    out = ChainResult({j: np.empty((2, N)).T for j in want},
-                      {j: np.empty((2, N)).T for j in want} if rates else None,
-                      {j: np.empty((2, N)).T for j in want} if rates else None,
+    # outputs stored component-major (one (joints, 2, N) buffer per kind and (nl, N)
+    # buffers, returned transposed) so that every chunk writes contiguous memory and the
+    # anchors of all links are gathered in one take
+    index = {j: k for k, j in enumerate(want)}
+    bufs = tuple(np.empty((len(want), 2, N)) for _ in range(3 if rates else 1))
+    out = ChainResult({j: bufs[0][k].T for j, k in index.items()},
+                      {j: bufs[1][k].T for j, k in index.items()} if rates else None,
+                      {j: bufs[2][k].T for j, k in index.items()} if rates else None,
                       np.empty((nl, N)).T if rotations else None, np.empty((nl, N)).T if rotations else None,
-                      np.empty((nl, N)).T if rates else None, np.empty((nl, N)).T if rates else None, anchor)
-    if discs is not None:
-        discs.update({op[1]: np.empty(N) for op in prog if op[0] == "RRR"})
+                      np.empty((nl, N)).T if rates else None, np.empty((nl, N)).T if rates else None, anchor,
+                      (index, bufs))
     fixed = {j.id: j.point for j in S.mech.joints}
     filled: set[str] = set()
     with np.errstate(invalid="ignore", divide="ignore"):
         for start in range(0, N, chunk):
             sl = slice(start, min(N, start + chunk))
-            ch = _Chunk(S, anchor, rates, out, sl, discs, least)
+            ch = _Chunk(S, anchor, rates, out, sl)
             for op in prog:
                 if op[0] == "drive":
                     ch.drive(op, U[sl], speeds, fixed)
@@ -756,18 +819,12 @@ def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
     return prog, anchor
 
 
-class _Irregular(Exception):
-    """A group's discriminant fell below the bound of a regular sweep (:func:`solve_regular`)."""
-
-
 class _Chunk:
     """One chunk of rows of :func:`fast_chain`: the joints' states and the links'
     rotations and rates found so far, and the kernels that extend them."""
 
-    def __init__(self, S: PlanarSystem, anchor: dict, rates: bool, out: "ChainResult", sl: slice,
-                 discs: dict | None, least: float | None = None) -> None:
-        self.S, self.anchor, self.rates, self.out, self.sl, self.discs = S, anchor, rates, out, sl, discs
-        self.least = least
+    def __init__(self, S: PlanarSystem, anchor: dict, rates: bool, out: "ChainResult", sl: slice) -> None:
+        self.S, self.anchor, self.rates, self.out, self.sl = S, anchor, rates, out, sl
         self.written: set[str] = set()    # joints whose outputs were computed in place
         self.rot: dict[int, tuple] = {}   # link -> ("cs", c, s) or ("vec", ex, ey, local / L^2)
         self.rate: dict[int, tuple] = {}  # link -> (omega, alpha)
@@ -845,11 +902,6 @@ class _Chunk:
         f += 0.5
         g = inv * L1s
         g -= f * f
-        if self.discs is not None:
-            d = np.divide(g, inv, out=self.discs[si][sl])
-            d *= 1.0 / L1s
-            if self.least is not None and not d.min() >= self.least:  # NaN too
-                raise _Irregular
         if isinstance(sigma, tuple):  # a chooser: the signs from the discriminant of _solve_step
             sigma = self._choose(sigma, A, dx, dy, inv)
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
@@ -1008,39 +1060,38 @@ def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: 
     return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
 
 
+def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
+    """The rows ``U`` followed by the connecting paths of a regular sweep
+    (:func:`mechsyn.kinematics.regular.regular_sweep`; the numbers
+    of :func:`_connecting_path` and :func:`_shifted_start`, with the few per-driver
+    decisions taken on Python floats)."""
+    N, k = U.shape
+    u0 = [float(d.assembled) for d in S.drivers]
+    h = [math.radians(1.0) if d.type == "R" else 0.01 * S.scale for d in S.drivers]
+    isR = [d.type == "R" for d in S.drivers]
+    paths = []
+    for e in ([0] if split is None else [split, split - 1]):
+        u1 = U[e].tolist()
+        for i in range(k):
+            if isR[i]:
+                u1[i] -= 2 * math.pi * round((u1[i] - u0[i]) / (2 * math.pi))
+        n = int(min(4000, max(1, math.ceil(max(abs(b - a) / s for a, b, s in zip(u0, u1, h))))))
+        paths.append((n, u1))
+    X = np.empty((N + sum(n for n, _ in paths), k))
+    X[:N] = U
+    row = N
+    a = np.array(u0)
+    for n, u1 in paths:
+        t = np.arange(n) / n
+        np.add(a, t[:, None] * (np.array(u1) - a), out=X[row:row + n])
+        row += n
+    return X
+
+
 #: Smallest normalised discriminant of every group over a sweep for which
-#: :func:`solve_regular` answers (below it :func:`solve_tracked` looks for folds and
+#: :func:`mechsyn.kinematics.regular.regular_sweep` answers (below it :func:`solve_tracked` looks for folds and
 #: change points: its candidates are local minima under 0.05).
 REGULAR_DISC = 0.05 + 1e-9
-
-
-def solve_regular(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
-                  split: int | None) -> tuple | None:
-    """Poses and rates (N, n) of a driver-R + RRR chain in one array pass, or None when
-    the sweep needs the branch rules of :func:`solve_tracked`.
-
-    The rows ``U`` and the connecting paths from the drawn input values to the sweep
-    (to row ``split`` and ``split - 1`` when the drawn values lie between them, else to
-    row 0) are evaluated together with every group's discriminant; when each stays at
-    least :data:`REGULAR_DISC` no group folds, touches a change point or reassembles,
-    every group keeps its drawn mode and the answer is that of the outward sweeps of
-    :func:`solve_tracked` (no events), at the cost of one pass.
-    """
-    if not plan.closed_form_rates:
-        return None
-    N = U.shape[0]
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    ends = [U[0]] if split is None else [U[split], U[split - 1]]
-    X = np.vstack([U] + [_connecting_path(S, u0, _shifted_start(S, u0, e)) for e in ends])
-    try:  # stops at the first group that comes near a fold (little work wasted)
-        r = fast_chain(S, plan, X, speeds, rates=True, discs={}, least=REGULAR_DISC)
-    except _Irregular:
-        return None
-    if X.shape[0] > N:
-        r = ChainResult({j: v[:N] for j, v in r.points.items()}, {j: v[:N] for j, v in r.velocities.items()},
-                        {j: v[:N] for j, v in r.accelerations.items()}, r.cos[:N], r.sin[:N], r.omega[:N],
-                        r.alpha[:N], r.anchor)
-    return _poses_from_chain(S, plan, U, r, split)
 
 
 def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
@@ -1115,7 +1166,7 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     out = []
     for (X, n0, shift), U, seg, evs in zip(rows, parts, segs, raw_events):
         sweep_rows = slice(seg.start + n0, seg.stop)
-        q, qd, qdd = _poses_from_chain(S, plan, U, _chain_rows(r, sweep_rows))
+        q, qd, qdd = _poses_from_chain(S, plan, U, r.rows(sweep_rows))
         out.append((q, qd, qdd, singular[sweep_rows], _sweep_events(evs, n0, shift)))
     return out
 
@@ -1135,16 +1186,6 @@ def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list
         sigmas[k] = sig
         return sig
     return choose
-
-
-def _chain_rows(r: "ChainResult", rows: slice) -> "ChainResult":
-    """The rows ``rows`` of a chain's result (views)."""
-    return ChainResult({j: v[rows] for j, v in r.points.items()},
-                       {j: v[rows] for j, v in r.velocities.items()} if r.velocities is not None else None,
-                       {j: v[rows] for j, v in r.accelerations.items()} if r.accelerations is not None else None,
-                       r.cos[rows] if r.cos is not None else None, r.sin[rows] if r.sin is not None else None,
-                       r.omega[rows] if r.omega is not None else None,
-                       r.alpha[rows] if r.alpha is not None else None, r.anchor)
 
 
 def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:

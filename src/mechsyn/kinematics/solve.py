@@ -30,7 +30,9 @@ class Sweep:
     """Result of a sweep: poses and their rates at every input value.
 
     ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
-    ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates.
+    ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates;
+    ``rotations``: ``(cos, sin)`` of every link's angle, each (n_links, N), when the
+    closed form computed them (every row assembled with finite rates), else None.
     """
 
     system: PlanarSystem
@@ -44,6 +46,7 @@ class Sweep:
     sigma_min: np.ndarray
     events: list[dict] = field(default_factory=list)
     method: str = "newton"
+    rotations: tuple | None = None
 
     @property
     def n(self) -> int:

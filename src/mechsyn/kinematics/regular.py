@@ -1,0 +1,229 @@
+"""The regular sweep: a chain of a driver and RRR dyads clear of folds, in one pass of
+complex arithmetic.
+
+Points of the plane are complex numbers ``z = x + i y`` (the vector-loop notation of
+Raven, "Velocity and acceleration analysis of plane and space mechanisms by means of
+independent-position equations", *Journal of Applied Mechanics* 25, 1958; Erdman and
+Sandor, *Mechanism Design*, 1984, ch. 3), so a rotation is one product and a vector
+equation one array operation instead of two:
+
+* a link ``i`` turned by ``e^{i phi_i}`` carries its local point ``s`` to
+  ``P = P_a + e^{i phi_i} (s - s_a)`` from its anchor joint ``a``, with
+  ``V = V_a + i omega_i (P - P_a)`` and ``A = A_a + (i alpha_i - omega_i^2) (P - P_a)``;
+* an RRR dyad with known joints ``A``, ``C`` (``d = C - A``) places its middle joint at
+  ``B = A + d (f + i sigma g)``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``,
+  ``g = sqrt(L1^2 / |d|^2 - f^2)`` (``g^2 |d|^2 / L1^2`` is the group's normalised
+  discriminant of :func:`mechsyn.kinematics.dyads.solve_tracked`); with ``e1 = B - A``,
+  ``e2 = B - C`` its links turn at ``omega_1 = Re((v_C - v_A) conj(e2)) / (e1 x e2)``,
+  ``omega_2 = Re((v_C - v_A) conj(e1)) / (e1 x e2)`` and likewise for the accelerations.
+
+:func:`regular_sweep` evaluates the sweep and the connecting paths from the drawn input
+values together and gives up (None) as soon as a group's discriminant falls below
+:data:`mechsyn.kinematics.dyads.REGULAR_DISC`: no group then folds, touches a change
+point or reassembles, every group keeps its drawn mode and the answer is that of the
+tracked outward sweeps (tests check both agree), at the cost of one pass.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mechsyn.kinematics import dyads
+from mechsyn.kinematics.system import PlanarSystem
+
+__all__ = ["regular_sweep"]
+
+
+def _program(S: PlanarSystem, plan: dyads.Plan) -> tuple:
+    """The chain's steps with complex constants, every link's anchor and origin joint
+    (built once per system and plan)."""
+    memo = dyads._memo(S)
+    key = ("regular", id(plan))
+    hit = memo.get(key)
+    if hit is not None and hit[0] is plan:
+        return hit[1]
+    prog, anchor = dyads._chain_program(S, plan, None)
+    cx = {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
+    steps = []
+    for op in prog:
+        if op[0] == "drive":
+            _, new, k, jid, di, sgn = op
+            steps.append(("drive", new, k, jid, di, sgn, complex(*dyads._local(S, k, jid))))
+        else:
+            _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
+            steps.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, complex(*bv1).conjugate(),
+                          complex(*bv2).conjugate(), complex(*dyads._local(S, k1, J1)),
+                          complex(*dyads._local(S, k3, J3))))
+    origin = []  # the joint at every link's origin (its first joint), by link
+    for i, name in enumerate(S.links):
+        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(dyads._local(S, i, j.id))), None)
+        origin.append(j0)
+    out = (steps, cx, origin)
+    memo[key] = (plan, out)
+    return out
+
+
+class _Pass:
+    """The joints' and links' states of one regular pass (rows ``M``)."""
+
+    def __init__(self, M: int, anchor: dict) -> None:
+        self.M, self.anchor = M, anchor
+        self.joint: dict[str, tuple] = {}  # id -> (P, V, A): complex arrays or numbers
+        self.link: dict[int, tuple] = {}   # link -> (e^{i phi}, omega, alpha)
+
+    def point(self, i: int, s: complex) -> tuple:
+        """State of the local point ``s`` of link ``i`` (the frame: -1)."""
+        if i < 0:
+            return s, 0j, 0j
+        jid, sa = self.anchor[i]
+        P, V, A = self.joint[jid]
+        z, w, al = self.link[i]
+        rel = z * (s - sa)
+        iw_rel = rel * 1j
+        acc = iw_rel * al if not isinstance(al, float) or al != 0.0 else None
+        iw_rel *= w
+        Pn = rel + P
+        Vn = iw_rel + V
+        rel *= w * w
+        An = A - rel if acc is None else (acc - rel) + A
+        return Pn, Vn, An
+
+    def drive(self, step: tuple, U: np.ndarray, speeds: np.ndarray, fixed: dict) -> None:
+        _, new, k, jid, di, sgn, s_k = step
+        z = np.empty(self.M, complex)
+        th = U[:, di]
+        np.cos(th, out=z.real)
+        np.sin(th, out=z.imag)
+        if sgn < 0:
+            np.negative(z.imag, out=z.imag)
+        if k < 0:
+            self.joint[jid] = (complex(*fixed[jid]), 0j, 0j)
+            self.link[new] = (z, sgn * float(speeds[di]), 0.0)
+        else:
+            zk, wk, alk = self.link[k]
+            self.joint.setdefault(jid, self.point(k, s_k))
+            self.link[new] = (z * zk, wk + sgn * float(speeds[di]), alk)
+
+    def rrr(self, step: tuple, least: float) -> bool:
+        """Place one RRR dyad; False when its discriminant falls below ``least``."""
+        _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, cbv1, cbv2, s1, s3 = step
+        A = self.joint.get(J1) or self.point(k1, s1)
+        C = self.joint.get(J3) or self.point(k3, s3)
+        self.joint[J1], self.joint[J3] = A, C
+        d = np.subtract(C[0], A[0]) if isinstance(C[0], np.ndarray) or isinstance(A[0], np.ndarray) \
+            else np.full(self.M, C[0] - A[0])
+        dx, dy = d.real, d.imag
+        inv = dx * dx
+        inv += dy * dy
+        np.divide(1.0, inv, out=inv)
+        f = inv * (0.5 * (L1s - L2s))
+        f += 0.5
+        g = inv * L1s
+        g -= f * f
+        disc = g / inv
+        disc *= 1.0 / L1s
+        if not disc.min() >= least:  # NaN too
+            return False
+        np.sqrt(g, out=g)
+        if sigma < 0:
+            np.negative(g, out=g)
+        u = np.empty(self.M, complex)
+        u.real, u.imag = f, g
+        e1 = d * u
+        B = e1 + A[0]
+        e2 = B - C[0]
+        self.joint[J2] = (B,) + self._rates(A, C, e1, e2, (b1, b2), (cbv1, cbv2))
+        return True
+
+    def _rates(self, A: tuple, C: tuple, e1: np.ndarray, e2: np.ndarray, links: tuple, cbv: tuple) -> tuple:
+        """The dyad's link rotations and rates; the middle joint's velocity, acceleration."""
+        ce1, ce2 = e1.conjugate(), e2.conjugate()
+        den = (ce1 * e2).imag  # e1 x e2
+        np.divide(1.0, den, out=den)
+        dv = C[1] - A[1]
+        w1 = (dv * ce2).real
+        w1 *= den
+        w2 = (dv * ce1).real
+        w2 *= den
+        w1s = w1 * w1
+        da = (C[2] - A[2]) + w1s * e1
+        da -= (w2 * w2) * e2
+        a1 = (da * ce2).real
+        a1 *= den
+        a2 = (da * ce1).real
+        a2 *= den
+        self.link[links[0]] = (e1 * cbv[0], w1, a1)
+        self.link[links[1]] = (e2 * cbv[1], w2, a2)
+        ie1 = e1 * 1j
+        VB = ie1 * w1
+        VB += A[1]
+        AB = ie1 * a1
+        AB -= w1s * e1
+        AB += A[2]
+        return VB, AB
+
+
+def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.ndarray,
+                  split: int | None) -> tuple | None:
+    """Poses and rates (N, n) of a driver-R + RRR chain over the inputs ``U`` (N, k) in
+    one pass, with the links' rotations ``(cos, sin)`` (n_links, N); None when a group
+    comes near a fold on the sweep or on the way to it from the drawn configuration
+    (``split``: the row after the drawn input values, see
+    :func:`mechsyn.kinematics.analysis._drawn_row`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.io import load_mechanism
+    >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
+    >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
+    >>> U = np.radians(input_grid(0, 360, 1))[:, None]
+    >>> q, qd, qdd, (c, s) = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
+    >>> q.shape, bool(np.allclose(c, np.cos(q[:, 2::3].T)))
+    ((361, 9), True)
+    """
+    if not plan.closed_form_rates or S.n != 3 * len(S.links):
+        return None
+    steps, anchor, origin = _program(S, plan)
+    X = dyads._regular_rows(S, U, split)
+    st = _Pass(X.shape[0], anchor)
+    fixed = {j.id: j.point for j in S.mech.joints}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for step in steps:
+            if step[0] == "drive":
+                st.drive(step, X, speeds, fixed)
+            elif not st.rrr(step, dyads.REGULAR_DISC):
+                return None
+    return _poses(S, plan, U, st, origin, split)
+
+
+def _poses(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
+    """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass: every link's
+    origin is its first joint, its angle continuous from the drawn one."""
+    N, nl = U.shape[0], len(S.links)
+    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
+    rot = np.empty((nl, N), complex)
+    for i in range(nl):
+        z, w, al = st.link[i]
+        j = origin[i]
+        P, V, A = st.joint[j] if j in st.joint else st.point(i, 0j)
+        for buf, x in ((q, P), (qd, V), (qdd, A)):
+            if isinstance(x, np.ndarray):
+                buf[3 * i] = x.real[:N]
+                buf[3 * i + 1] = x.imag[:N]
+            else:
+                buf[3 * i], buf[3 * i + 1] = x.real, x.imag
+        rot[i] = z[:N]
+        qd[3 * i + 2] = w if not isinstance(w, np.ndarray) else w[:N]
+        qdd[3 * i + 2] = al if not isinstance(al, np.ndarray) else al[:N]
+    r = _Rot(rot)
+    dyads._link_angles(S, plan, U, r, split, None, q[2:3 * nl:3])
+    return q.T, qd.T, qdd.T, (rot.real, rot.imag)
+
+
+class _Rot:
+    """``cos``, ``sin`` (N, nl) views of the links' rotations, as :func:`dyads._link_angles`
+    reads them from a chain's result."""
+
+    def __init__(self, rot: np.ndarray) -> None:
+        self.cos, self.sin = rot.real.T, rot.imag.T
