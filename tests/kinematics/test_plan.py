@@ -104,8 +104,11 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
             got = regular_sweep(kp.system, kp.groups, U, np.ones(1), analysis._drawn_row(kp.system, U))
             assert (got is not None) == regular or grid[1] - grid[0] < 360, (f, grid)
             if got is not None:
-                q, _, _, (c, s) = got
-                assert np.allclose(c, np.cos(q[:, 2::3].T), atol=1e-12) and np.allclose(s, np.sin(q[:, 2::3].T), atol=1e-12)
+                q, qd, qdd, links = got
+                assert np.allclose(links.z, np.exp(1j * q[:, 2::3].T), atol=1e-12)
+                for i in range(len(kp.system.links)):  # a link's origin seen from its complex state
+                    for k, arr in enumerate((q, qd, qdd)):
+                        assert np.allclose(links.point(i, np.zeros(2))[k], arr[:, 3 * i:3 * i + 2], atol=1e-12)
             fast = simulate(m, {j: x})
             with monkeypatch.context() as mp:
                 mp.setattr(analysis, "_one_pass", lambda *a, **k: None)

@@ -446,7 +446,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     events = sw.events
     used = sw.method
     ok = sw.assembled
-    rates_ok = ok if sw.rotations is not None else (np.all(np.isfinite(sw.qd), axis=1)
+    rates_ok = ok if sw.links is not None else (np.all(np.isfinite(sw.qd), axis=1)
                                                      & np.all(np.isfinite(sw.qdd), axis=1))
     flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
     for k in np.flatnonzero(ok & ~rates_ok).tolist():
@@ -483,8 +483,10 @@ def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_
     pm = {}
     for name, (link, at) in pts.items():
         i = S.index(link)
-        rot = (sw.rotations[0][i], sw.rotations[1][i]) if sw.rotations is not None and i >= 0 else None
-        P, V, A = S.point_state(q, qd, qdd, i, S.to_local(link, at), rot)
+        if sw.links is not None and i >= 0:  # the regular pass: complex states of the links
+            P, V, A = sw.links.point(i, S.to_local(link, at))
+        else:
+            P, V, A = S.point_state(q, qd, qdd, i, S.to_local(link, at))
         if not whole[0]:
             for arr in (P, V, A):
                 arr[~ok] = np.nan
@@ -539,12 +541,12 @@ def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.
     res = regular_sweep(S, plan, U, sp, _drawn_row(S, U))
     if res is None:
         return None
-    q, qd, qdd, rot = res
+    q, qd, qdd, links = res
     N = U.shape[0]
     if progress is not None:
         progress(N)
     nan = np.full(N, np.nan)
-    return Sweep(S, U, sp, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur", rotations=rot)
+    return Sweep(S, U, sp, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur", links=links)
 
 
 def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:

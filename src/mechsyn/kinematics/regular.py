@@ -31,7 +31,7 @@ import numpy as np
 from mechsyn.kinematics import dyads
 from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["regular_sweep"]
+__all__ = ["regular_sweep", "LinkStates"]
 
 
 def _program(S: PlanarSystem, plan: dyads.Plan) -> tuple:
@@ -166,7 +166,7 @@ class _Pass:
 def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.ndarray,
                   split: int | None) -> tuple | None:
     """Poses and rates (N, n) of a driver-R + RRR chain over the inputs ``U`` (N, k) in
-    one pass, with the links' rotations ``(cos, sin)`` (n_links, N); None when a group
+    one pass, with the links' complex states (:class:`LinkStates`); None when a group
     comes near a fold on the sweep or on the way to it from the drawn configuration
     (``split``: the row after the drawn input values, see
     :func:`mechsyn.kinematics.analysis._drawn_row`).
@@ -178,8 +178,8 @@ def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.n
     >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
     >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
     >>> U = np.radians(input_grid(0, 360, 1))[:, None]
-    >>> q, qd, qdd, (c, s) = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
-    >>> q.shape, bool(np.allclose(c, np.cos(q[:, 2::3].T)))
+    >>> q, qd, qdd, links = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
+    >>> q.shape, bool(np.allclose(links.z, np.exp(1j * q[:, 2::3].T)))
     ((361, 9), True)
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
@@ -198,27 +198,24 @@ def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.n
 
 
 def _poses(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
-    """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass: every link's
-    origin is its first joint, its angle continuous from the drawn one."""
+    """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
+    origin is its first joint, its angle continuous from the drawn one) and the links'
+    complex states."""
     N, nl = U.shape[0], len(S.links)
-    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
-    rot = np.empty((nl, N), complex)
+    z, P, V, A = (np.empty((nl, N), complex) for _ in range(4))
+    w, al = np.empty((nl, N)), np.empty((nl, N))
     for i in range(nl):
-        z, w, al = st.link[i]
+        zi, wi, ali = st.link[i]
         j = origin[i]
-        P, V, A = st.joint[j] if j in st.joint else st.point(i, 0j)
-        for buf, x in ((q, P), (qd, V), (qdd, A)):
-            if isinstance(x, np.ndarray):
-                buf[3 * i] = x.real[:N]
-                buf[3 * i + 1] = x.imag[:N]
-            else:
-                buf[3 * i], buf[3 * i + 1] = x.real, x.imag
-        rot[i] = z[:N]
-        qd[3 * i + 2] = w if not isinstance(w, np.ndarray) else w[:N]
-        qdd[3 * i + 2] = al if not isinstance(al, np.ndarray) else al[:N]
-    r = _Rot(rot)
-    dyads._link_angles(S, plan, U, r, split, None, q[2:3 * nl:3])
-    return q.T, qd.T, qdd.T, (rot.real, rot.imag)
+        Pi, Vi, Ai = st.joint[j] if j in st.joint else st.point(i, 0j)
+        for buf, x in ((z, zi), (P, Pi), (V, Vi), (A, Ai), (w, wi), (al, ali)):
+            buf[i] = x[:N] if isinstance(x, np.ndarray) else x
+    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
+    for buf, x in ((q, P), (qd, V), (qdd, A)):
+        buf[0::3], buf[1::3] = x.real, x.imag
+    qd[2::3], qdd[2::3] = w, al
+    dyads._link_angles(S, plan, U, _Rot(z), split, None, q[2::3])
+    return q.T, qd.T, qdd.T, LinkStates(z, P, V, A, w, al)
 
 
 class _Rot:
@@ -227,3 +224,26 @@ class _Rot:
 
     def __init__(self, rot: np.ndarray) -> None:
         self.cos, self.sin = rot.real.T, rot.imag.T
+
+
+class LinkStates:
+    """Every link's rotation ``e^{i phi}`` and the complex position, velocity and
+    acceleration of its origin, each (n_links, N), with its angular velocity and
+    acceleration (n_links, N): the motion of any point of a link in a few products."""
+
+    def __init__(self, z: np.ndarray, P: np.ndarray, V: np.ndarray, A: np.ndarray, w: np.ndarray,
+                 al: np.ndarray) -> None:
+        self.z, self.P, self.V, self.A, self.w, self.al = z, P, V, A, w, al
+
+    def point(self, i: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity, acceleration (N, 2) of the local point ``s`` of link ``i``."""
+        rel = self.z[i] * complex(s[0], s[1])
+        P = rel + self.P[i]
+        irel = rel * 1j
+        A = irel * self.al[i]
+        irel *= self.w[i]
+        V = irel + self.V[i]
+        rel *= self.w[i] ** 2
+        A -= rel
+        A += self.A[i]
+        return tuple(x.view(float).reshape(-1, 2) for x in (P, V, A))

@@ -31,8 +31,9 @@ class Sweep:
 
     ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
     ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates;
-    ``rotations``: ``(cos, sin)`` of every link's angle, each (n_links, N), when the
-    closed form computed them (every row assembled with finite rates), else None.
+    ``links``: the links' complex states (:class:`mechsyn.kinematics.regular.LinkStates`)
+    when the one regular pass computed the sweep (every row assembled with finite
+    rates), else None.
     """
 
     system: PlanarSystem
@@ -46,7 +47,7 @@ class Sweep:
     sigma_min: np.ndarray
     events: list[dict] = field(default_factory=list)
     method: str = "newton"
-    rotations: tuple | None = None
+    links: Any = None
 
     @property
     def n(self) -> int:

@@ -236,11 +236,10 @@ class PlanarSystem:
         return r + _apply(c, sn, s)
 
     def point_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, i: int,
-                    s: np.ndarray, rot: tuple | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity, acceleration of the local point ``s`` on link ``i``
-        (``rot``: the link's ``(cos phi, sin phi)`` when already known)."""
+                    s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity, acceleration of the local point ``s`` on link ``i``."""
         r, phi = self.pose(q, i)
-        c, sn = _rot(phi) if rot is None else rot
+        c, sn = _rot(phi)
         As = _apply(c, sn, s)
         if i < 0:
             z = np.zeros_like(As)
