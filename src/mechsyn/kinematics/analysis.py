@@ -14,6 +14,7 @@ P inputs and lengths in the file's length unit.
 
 from __future__ import annotations
 
+import math
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass, field, replace
@@ -26,7 +27,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import dyads
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.regular import regular_sweep
-from mechsyn.kinematics.solve import Sweep, assemble, sweep
+from mechsyn.kinematics.solve import Sweep, assemble, singular_configuration, sweep
 from mechsyn.kinematics.system import PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
@@ -410,7 +411,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
                 hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
         k = drivers.index(jid)
         vals = np.asarray(vals, float)
-        if not np.all(np.isfinite(vals)):
+        if not np.isfinite(vals).all():
             raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
         d = S.drivers[k]
         U[:, k] = np.radians(vals) if d.type == "R" else vals
@@ -427,7 +428,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
             raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
     for jid in inputs:
         sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
-    if not np.all(np.isfinite(sp)):
+    if not all(math.isfinite(v) for v in sp.tolist()):
         raise MechsynInputError("input speeds must be finite numbers", field="speeds",
                                 hint="give each driven joint's speed in rad/s (R) or length/s (P)")
     pts = resolve_points(mech, points)
@@ -449,7 +450,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     rates_ok = ok if sw.links is not None else (np.all(np.isfinite(sw.qd), axis=1)
                                                      & np.all(np.isfinite(sw.qdd), axis=1))
     flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
-    for k in np.flatnonzero(ok & ~rates_ok).tolist():
+    for k in [] if sw.links is not None else np.flatnonzero(ok & ~rates_ok).tolist():
         if k in flagged:
             continue
         events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
@@ -461,8 +462,6 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
     pm = _point_motions(S, sw, pts, ok, rates_ok)
     events = [_event_units(S, e) for e in events]
-    from mechsyn.kinematics.solve import singular_configuration
-
     notes = list(S.notes)
     if singular_configuration(S):
         notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
@@ -477,7 +476,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
 def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
     """Position, velocity, acceleration of every named point (NaN where not assembled;
     rates NaN where not defined)."""
-    whole = bool(ok.all()), bool(rates_ok.all())  # no NaN to clear or to restore
+    # no NaN to clear or to restore (the regular pass assembles every row with rates)
+    whole = (True, True) if sw.links is not None else (bool(ok.all()), bool(rates_ok.all()))
     q = sw.q if whole[0] else np.nan_to_num(sw.q)
     qd, qdd = (sw.qd, sw.qdd) if all(whole) else (np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd))
     pm = {}

@@ -1082,8 +1082,11 @@ def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarr
     row = N
     a = np.array(u0)
     for n, u1 in paths:
-        t = np.arange(n) / n
-        np.add(a, t[:, None] * (np.array(u1) - a), out=X[row:row + n])
+        if n == 1:  # the drawn values themselves (t = 0)
+            X[row] = a
+        else:
+            t = np.arange(n) / n
+            np.add(a, t[:, None] * (np.array(u1) - a), out=X[row:row + n])
         row += n
     return X
 
