@@ -28,7 +28,7 @@ from mechsyn.kinematics import dyads
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.regular import regular_sweep
 from mechsyn.kinematics.solve import Sweep, assemble, singular_configuration, sweep
-from mechsyn.kinematics.system import PlanarSystem, build_system
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
@@ -573,8 +573,9 @@ def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
 
 
 def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
-    """:func:`_drawn_row` of one input (the same numbers on 1-D arrays: a point of a
-    segment is always on its line, so only the segment parameter is tested)."""
+    """:func:`_drawn_row` of one input (the same decisions on 1-D arrays: a point of a
+    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
+    ``0 < p <= d^2``, division being monotone)."""
     u0 = float(driver.assembled)
     a = u[:-1]
     d = u[1:] - a
@@ -589,14 +590,13 @@ def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
     else:
         v[:] = u0
         shifts = (0.0,)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        for shift in shifts:
-            t = (v + shift - a) if shift else v - a
-            t *= d
-            t /= dd
-            hit = (t > 0.0) & (t <= 1.0)
-            if hit.any():
-                return int(np.argmax(hit)) + 1
+    for shift in shifts:
+        p = (v + shift - a) if shift else v - a
+        p *= d
+        hit = p > 0.0
+        hit &= p <= dd
+        if hit.any():
+            return int(hit.argmax()) + 1
     return None
 
 
@@ -638,8 +638,6 @@ def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
-    from mechsyn.kinematics.system import VLL_MODES
-
     mode = (vll or {}).get(jid)
     if mode is not None:
         return VLL_MODES.get(mode) == "passive"
