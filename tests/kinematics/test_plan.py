@@ -166,3 +166,20 @@ def test_a_speed_that_is_not_a_number_is_refused(ex):
         with pytest.raises(MechsynInputError, match="finite") as err:
             simulate(m, {"A": input_grid(0, 90, 1)}, speeds={"A": bad})
         assert err.value.field == "speeds"
+
+
+def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex, monkeypatch):
+    """A five-bar driven at the frame and between two moving links (B): the one pass turns
+    the second link with the first and gives what the tracked sweep gives."""
+    from mechsyn.kinematics import analysis
+
+    m = ex("textbook/five_bar_5r.yaml")
+    m = m.with_joints(tuple(replace(j, actuated=j.id in ("A", "B")) for j in m.joints))
+    x = input_grid(-5, 5, 1)
+    inp, speeds = {"A": x, "B": 0.5 * x}, {"A": 1.0, "B": 0.7}
+    fast = simulate(m, inp, speeds=speeds)
+    assert fast.sweep.links is not None and not fast.events
+    with monkeypatch.context() as mp:
+        mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
+        tracked = simulate(m, inp, speeds=speeds)
+    _same(fast, tracked)

@@ -79,6 +79,10 @@ class _Pass:
         P, V, A = self.joint[jid]
         z, w, al = self.link[i]
         rel = z * (s - sa)
+        if (not isinstance(w, np.ndarray) and isinstance(al, float) and al == 0.0
+                and not isinstance(V, np.ndarray) and V == 0 and not isinstance(A, np.ndarray) and A == 0):
+            # a link turned at constant speed about a frame pivot (a crank): two products
+            return rel + P, rel * (1j * w), rel * (-w * w)
         iw_rel = rel * 1j
         acc = iw_rel * al if not isinstance(al, float) or al != 0.0 else None
         iw_rel *= w
