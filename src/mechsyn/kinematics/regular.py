@@ -206,25 +206,22 @@ def _poses(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, st: _Pass, origin: 
     origin is its first joint, its angle continuous from the drawn one) and the links'
     complex states."""
     N, nl = U.shape[0], len(S.links)
+    C = np.empty((4, nl, N), complex)  # rotation, origin position, velocity, acceleration
     q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
-    states = []
     for i in range(nl):
         zi, wi, ali = st.link[i]
         j = origin[i]
-        Pi, Vi, Ai = st.joint[j] if j in st.joint else st.point(i, 0j)
-        for buf, x in ((q, Pi), (qd, Vi), (qdd, Ai)):
-            if isinstance(x, np.ndarray):
-                buf[3 * i], buf[3 * i + 1] = x.real[:N], x.imag[:N]
-            else:
-                buf[3 * i], buf[3 * i + 1] = x.real, x.imag
-        qd[3 * i + 2], qdd[3 * i + 2] = wi[:N] if isinstance(wi, np.ndarray) else wi, \
-            ali[:N] if isinstance(ali, np.ndarray) else ali
-        states.append(tuple(x[:N] if isinstance(x, np.ndarray) else x for x in (zi, Pi, Vi, Ai)))
-    _angles(S, plan, U, [s[0] for s in states], split, q[2::3])
-    return q.T, qd.T, qdd.T, LinkStates(states, qd[2::3], qdd[2::3])
+        for k, x in enumerate((zi,) + (st.joint[j] if j in st.joint else st.point(i, 0j))):
+            C[k, i] = x[:N] if isinstance(x, np.ndarray) else x
+        qd[3 * i + 2] = wi[:N] if isinstance(wi, np.ndarray) else wi
+        qdd[3 * i + 2] = ali[:N] if isinstance(ali, np.ndarray) else ali
+    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
+        buf[0::3], buf[1::3] = x.real, x.imag
+    _angles(S, plan, U, C[0], split, q[2::3])
+    return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
 
 
-def _angles(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, z: list, split: int | None,
+def _angles(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, z: np.ndarray, split: int | None,
             out: np.ndarray) -> None:
     """Continuous link angles (nl, N) into ``out``: a frame driver's link takes the input
     itself, every other link the argument of its rotation, unwrapped and started next to
@@ -234,28 +231,27 @@ def _angles(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, z: list, split: in
         np.multiply(U[:, k], sgn, out=out[i])
     others = [i for i in range(len(S.links)) if i not in drive_links]
     if others:
-        zo = np.array([z[i] for i in others])
+        zo = z[others]
         ang = np.arctan2(zo.imag, zo.real)
         out[others] = dyads._continuous_angles(ang, S.q0[[3 * i + 2 for i in others]][:, None], None, split)
 
 
 class LinkStates:
     """Every link's rotation ``e^{i phi}`` and the complex position, velocity and
-    acceleration of its origin (arrays (N,), or numbers for a point of the frame), with
-    its angular velocity and acceleration (n_links, N): the motion of any point of a
-    link in a few products."""
+    acceleration of its origin (``C`` (4, n_links, N)), with its angular velocity and
+    acceleration (n_links, N): the motion of any point of a link in a few products."""
 
-    def __init__(self, states: list, w: np.ndarray, al: np.ndarray) -> None:
-        self.states, self.w, self.al = states, w, al
+    def __init__(self, C: np.ndarray, w: np.ndarray, al: np.ndarray) -> None:
+        self.C, self.w, self.al = C, w, al
 
     @property
     def z(self) -> np.ndarray:
         """The links' rotations ``e^{i phi}`` (n_links, N)."""
-        return np.array([s[0] for s in self.states])
+        return self.C[0]
 
     def point(self, i: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (N, 2) of the local point ``s`` of link ``i``."""
-        z, P0, V0, A0 = self.states[i]
+        z, P0, V0, A0 = self.C[:, i]
         rel = z * complex(s[0], s[1])
         P = rel + P0
         irel = rel * 1j
