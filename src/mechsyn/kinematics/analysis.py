@@ -414,10 +414,13 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         if not np.isfinite(vals).all():
             raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
         d = S.drivers[k]
-        U[:, k] = np.radians(vals) if d.type == "R" else vals
+        if d.type == "R":
+            np.radians(vals, out=U[:, k])
+        else:
+            U[:, k] = vals
         types[jid] = d.type
-        lim = mech.joint(jid).limits
-        if lim is not None and d.type == "P" and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
+        lim = mech.joint(jid).limits if d.type == "P" else None
+        if lim is not None and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
             raise MechsynInputError(
                 f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
                 hint="keep the VLL length within its limits")
