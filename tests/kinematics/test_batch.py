@@ -107,3 +107,52 @@ def test_reference_inputs_match_simulate_measure_and_2d_inputs():
             one = simulate_batch(t.plan, X[k], rows[k]).paths["T"][0]
             np.testing.assert_array_equal(np.isnan(one), np.isnan(two[k]))
             np.testing.assert_allclose(one[np.isfinite(one)], two[k][np.isfinite(two[k])])
+
+
+def test_program_places_only_the_points_the_outputs_need():
+    watt = load_mechanism(EX / "textbook/watt_sixbar.yaml")
+    one = compile_plan(watt, points=["P"])
+    # F (the second dyad's end on the rocker) is not placed: that dyad's d comes from the first dyad's
+    assert one.describe() == ["crank A: places B", "RRR (B, C, D): places E",
+                              "RRR (E, G, F), d from the ends on dyad 1: places P"]
+    every = compile_plan(watt, points=[j.id for j in watt.joints] + ["P"])
+    rng = np.random.default_rng(8)
+    X = one.parameters(watt) + rng.normal(scale=0.1, size=(5, one.n_parameters))
+    off = np.arange(0.0, 360.0, 2.0)
+    a, b = simulate_batch(one, X, off), simulate_batch(every, X, off)
+    np.testing.assert_array_equal(a.assembled, b.assembled)
+    np.testing.assert_allclose(a.paths["P"], b.paths["P"], atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["watt_sixbar", "stephenson_sixbar"])
+def test_every_joint_equals_simulate_where_some_dyad_fails(name):
+    """Frame points and points upstream of the dyad that fails are NaN where the
+    mechanism is not assembled, as in simulate (NaN does not reach them by itself)."""
+    mech = load_mechanism(EX / f"textbook/{name}.yaml")
+    names = [j.id for j in mech.joints] + list(mech.points)
+    plan = compile_plan(mech, points=names)
+    off = np.arange(0.0, 360.0, 3.0)
+    res = simulate_batch(plan, plan.parameters(mech), off)
+    sim = simulate(mech, {plan.input_joint: plan.reference_input + off}, points=names)
+    assert 0 < res.assembled.sum() < len(off)              # the six-bar locks over part of the turn
+    np.testing.assert_array_equal(res.assembled[0], sim.assembled)
+    for n in names:
+        np.testing.assert_allclose(res.paths[n][0], sim.points[n].position, atol=1e-9)
+
+
+def test_transmission_angle_does_not_depend_on_the_assembly_mode():
+    mech = load_mechanism(EX / "kinematics/crank_rocker.yaml")
+    mirror = mechanism_to_dict(mech)                        # the same linkage reflected in the x axis
+    mirror["joints"] = [{**j, "point": [j["point"][0], -j["point"][1]]} for j in mirror["joints"]]
+    mirror["points"] = {n: {**p, "at": [p["at"][0], -p["at"][1]]} for n, p in mirror["points"].items()}
+    off = np.arange(0.0, 360.0, 1.0)
+    mu = []
+    for m in (mech, mechanism_from_dict(mirror)):
+        plan = compile_plan(m)
+        res = simulate_batch(plan, plan.parameters(m), off, transmission=True)
+        mu.append((res.sigmas[0, 0], res.min_transmission_angle[0]))
+    assert mu[0][0] == -mu[1][0]
+    # Norton's crank-rocker: mu_min = acos((b^2 + c^2 - (d - a)^2) / (2 b c)), coupler b, rocker c
+    a, b, c, d = 1.0, 3.5, 3.0, 4.0
+    want = np.degrees(np.arccos((b * b + c * c - (d - a) ** 2) / (2 * b * c)))
+    assert abs(mu[0][1] - want) < 1e-6 and abs(mu[1][1] - want) < 1e-6

@@ -105,8 +105,20 @@ class BatchPlan:
         return design_parameters(self, mech)
 
     def describe(self) -> list[str]:
-        out = [f"crank {self.input_joint}"]
-        out += [f"RRR ({', '.join(d)})" for d in self.dyads]
+        """The program's steps in words, each with the points it places (the others are
+        not computed)."""
+        out = []
+        for st in self.ops:
+            placed = ", ".join(self.names[p] for p in _placed(st)) if st[0] != "mask" else ""
+            if st[0] == "crank":
+                out.append(f"crank {self.input_joint}")
+            elif st[0] == "rrr":
+                out.append(f"RRR ({', '.join(self.dyads[len(out) - 1])})")
+                if st[4] is not None:
+                    out[-1] += f", d from the ends on dyad {st[4][0] + 1}"
+            else:
+                continue
+            out[-1] += f": places {placed}" if placed else ""
         return out
 
 
