@@ -311,9 +311,11 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
     dyad's ``d`` and ``w`` (``d_j = d_i (a + b w_i)``) without placing its ends, unless
     something else uses them.
 
-    Returns ``(("crank", O, points), ("rrr", p1, p2, p3, fuse, points)..., ("mask",
-    outputs))``: ``points`` are ``(p, side)`` for a dyad; ``fuse`` is ``(i, side1,
-    side3)`` or None; ``mask`` lists the frame points among the outputs and the outputs
+    Returns ``(("crank", O, points), ("rrr", p1, p2, p3, fuse, points, shift)...,
+    ("mask", outputs))``: ``points`` are ``(p, side)`` for a dyad; ``fuse`` is ``(i,
+    side1, side3)`` or None; ``shift``: the dyad places only points of its second link
+    and no later dyad uses its ``w``, so it keeps ``w - 1`` (``a + b w = 1 + b (w - 1)``
+    there, a scalar instead of a per-design addition); ``mask`` lists the frame points among the outputs and the outputs
     that do not depend on every dyad (NaN does not reach them by itself where another
     dyad fails): they are set to NaN where the mechanism is not assembled.
     """
@@ -343,7 +345,7 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
             needed.update(p for p in (p1, p3) if src[p][0] != "ground")
         elif pts:
             needed.add(p1)                       # the base of this dyad's points
-        steps.append(("rrr", p1, p2, p3, fuse, pts))
+        steps.append(["rrr", p1, p2, p3, fuse, pts, bool(pts) and all(sd == 2 for _, sd in pts)])
     crank_pts = tuple(sorted(p for p in needed if src[p][0] == "crank"))
 
     def depends(p: int) -> frozenset:
@@ -354,7 +356,10 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
 
     every = frozenset(range(len(dyads)))
     mask = tuple(p for p in outputs if depends(p) != every or src[p][0] == "ground")
-    return (("crank", crank_joint, crank_pts),) + tuple(reversed(steps)) + (("mask", mask),)
+    for st in steps:                             # w of a dyad used by a later one stays w
+        if st[4] is not None:
+            steps[len(dyads) - 1 - st[4][0]][6] = False
+    return (("crank", crank_joint, crank_pts),) + tuple(tuple(st) for st in reversed(steps)) + (("mask", mask),)
 
 
 def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
@@ -474,21 +479,39 @@ class _Run:
                     z[~ok] = complex(np.nan, np.nan)
 
     def _dyad(self, st: tuple, j: int, k0: int, k1: int, at, dest) -> None:
-        """One RRR dyad on a block: ``d``, ``w = alpha + i sigma beta``, the assembled
-        mask, the flags, then the points of its links as ``A + d (a + b w)``."""
-        _, p1, p2, p3, fuse, pts = st
+        """One RRR dyad on a block: ``d``, then ``w``, then the points of its links."""
+        _, p1, p2, p3, fuse, pts, shift = st
         n = k1 - k0
-        h, L1s, sigma, L12 = (c[k0:k1] for c in self.dyad_consts[j])
-        d, w = self.d[j][:n], self.w[j][:n]
+        d = self.d[j][:n]
         if fuse is None:
             np.subtract(at(p3), at(p1), out=d)
-        else:
-            i = fuse[0]
+        else:                                     # d = d_i (a + b w_i)
             a, b = self.point_consts[("d", j)]
-            np.multiply(self.w[i][:n], b[k0:k1], out=d)
+            np.multiply(self.w[fuse[0]][:n], b[k0:k1], out=d)
             d += a[k0:k1]
-            d *= self.d[i][:n]
-        t, s, al, be = self.t[:n], self.s[:n], self.al[:n], self.be[:n]
+            d *= self.d[fuse[0]][:n]
+        w = self._w(j, d, k0, k1, shift)
+        A = at(p1)
+        for p, side in pts:                       # p = A + d (a + b w)
+            z = dest(p)
+            if side == 0:
+                np.multiply(d, w, out=z)          # B - A
+            else:
+                a, b = self.point_consts[p]
+                np.multiply(w, b[k0:k1], out=z)
+                if shift:                         # a + b w = 1 + b (w - 1) on the second link
+                    z += 1.0
+                elif side == 2:
+                    z += a[k0:k1]
+                z *= d
+            z += A
+
+    def _w(self, j: int, d: np.ndarray, k0: int, k1: int, shift: bool) -> np.ndarray:
+        """``w = alpha + i sigma beta`` of dyad ``j`` (``w - 1`` when ``shift``) from ``d``
+        on a block; the assembled mask, the flags and the transmission angle on the way."""
+        n = k1 - k0
+        h, L1s, sigma, L12 = (c[k0:k1] for c in self.dyad_consts[j])
+        w, t, s, al, be = self.w[j][:n], self.t[:n], self.s[:n], self.al[:n], self.be[:n]
         sq = w.view(float)                        # w is free until the end: scratch for d^2
         np.square(d.view(float), out=sq)
         np.add(sq[:, 0::2], sq[:, 1::2], out=t)   # t = |d|^2
@@ -503,24 +526,20 @@ class _Run:
             ok &= np.greater_equal(be, 0, out=self.good[:n])
         if self.flags:
             self.jump[k0:k1] |= _stepped_over(be * t / np.maximum(L1s, 1e-300))
-        np.sqrt(be, out=be)                       # NaN where the dyad does not assemble
+        one = sigma[0, 0] if np.all(sigma == sigma[0, 0]) else 0.0   # one assembly mode in the block
+        beta = np.sqrt(be, out=w.imag if one else be)   # NaN where the dyad does not assemble
         if self.sin_mu is not None:
-            sm = np.fmin.reduce(np.multiply(be, t, out=s) / L12, axis=1)   # sin mu = t beta / (L1 L2)
+            sm = np.fmin.reduce(np.multiply(beta, t, out=s) / L12, axis=1)   # sin mu = t beta / (L1 L2)
             self.sin_mu[k0:k1] = np.fmin(self.sin_mu[k0:k1], sm)
-        np.copyto(w.real, al)                     # alpha, beta worked contiguous, then w built
-        np.multiply(be, sigma, out=w.imag)
-        A = at(p1)
-        for p, side in pts:
-            z = dest(p)
-            if side == 0:
-                np.multiply(d, w, out=z)          # B - A
-            else:
-                a, b = self.point_consts[p]
-                np.multiply(w, b[k0:k1], out=z)
-                if side == 2:
-                    z += a[k0:k1]
-                z *= d
-            z += A
+        if not one:
+            np.multiply(be, sigma, out=w.imag)
+        elif one < 0:
+            np.negative(w.imag, out=w.imag)
+        if shift:
+            np.subtract(al, 1.0, out=w.real)
+        else:
+            np.copyto(w.real, al)                 # alpha, beta worked contiguous, then w built
+        return w
 
 
 def _placed(step: tuple) -> list[int]:
@@ -542,7 +561,7 @@ def _constants(program: tuple, X: np.ndarray) -> tuple[list, dict]:
             for p in st[2]:
                 points[p] = (None, (X[:, p] - X[:, st[1]])[:, None])
         elif st[0] == "rrr":
-            _, p1, p2, p3, fuse, pts = st
+            p1, p2, p3, fuse, pts = st[1:6]
             r1, r3 = X[:, p2] - X[:, p1], X[:, p2] - X[:, p3]
             L1s, L2s = (r1 * r1.conj()).real, (r3 * r3.conj()).real
             sigma = np.where(((X[:, p3] - X[:, p1]).conj() * r1).imag >= 0, 1.0, -1.0)
