@@ -439,6 +439,9 @@ class _Run:
         self.u = u if u.ndim == 2 else None
         with np.errstate(divide="ignore", invalid="ignore"):
             self.dyad_consts, self.point_consts = _constants(plan.ops, X)
+        # per dyad: the number of assembly-mode changes up to each design (a block has one mode
+        # when the count does not change inside it)
+        self.flips = [np.concatenate([[0], np.cumsum(c[2][1:, 0] != c[2][:-1, 0])]) for c in self.dyad_consts]
         kc = min(K, max(1, _BLOCK // max(N, 1)))
         steps = [st for st in plan.ops if st[0] == "rrr"]
         placed = [p for st in plan.ops if st[0] != "mask" for p in _placed(st) if p not in out]
@@ -526,7 +529,8 @@ class _Run:
             ok &= np.greater_equal(be, 0, out=self.good[:n])
         if self.flags:
             self.jump[k0:k1] |= _stepped_over(be * t / np.maximum(L1s, 1e-300))
-        one = sigma[0, 0] if np.all(sigma == sigma[0, 0]) else 0.0   # one assembly mode in the block
+        flips = self.flips[j]
+        one = sigma[0, 0] if flips[k1 - 1] == flips[k0] else 0.0   # one assembly mode in the block
         beta = np.sqrt(be, out=w.imag if one else be)   # NaN where the dyad does not assemble
         if self.sin_mu is not None:
             sm = np.fmin.reduce(np.multiply(beta, t, out=s) / L12, axis=1)   # sin mu = t beta / (L1 L2)
