@@ -156,3 +156,25 @@ def test_transmission_angle_does_not_depend_on_the_assembly_mode():
     a, b, c, d = 1.0, 3.5, 3.0, 4.0
     want = np.degrees(np.arccos((b * b + c * c - (d - a) ** 2) / (2 * b * c)))
     assert abs(mu[0][1] - want) < 1e-6 and abs(mu[1][1] - want) < 1e-6
+
+
+def test_blocks_of_designs_give_the_answers_of_one_block(monkeypatch):
+    """Designs run in blocks (mixed assembly modes in a block, a short last block): the
+    answers and flags are those of one block, sample for sample."""
+    import mechsyn.kinematics.batch as batch
+
+    mech = load_mechanism(EX / "textbook/watt_sixbar.yaml")
+    plan = compile_plan(mech, points=["P", "E", "B", "D"])
+    rng = np.random.default_rng(11)
+    x0 = plan.parameters(mech)
+    X = x0 + rng.normal(scale=0.1, size=(7, len(x0)))
+    X[::3, 1::2] *= -1.0                     # mirrored designs: the other assembly mode of every dyad
+    off = np.arange(0.0, 360.0, 5.0)
+    one = simulate_batch(plan, X, off, transmission=True)
+    assert len(np.unique(one.sigmas[:, 0])) == 2
+    monkeypatch.setattr(batch, "_BLOCK", 2 * len(off))        # blocks of 2 designs, the last of 1
+    many = simulate_batch(plan, X, off, transmission=True)
+    for n in plan.outputs:
+        np.testing.assert_array_equal(one.paths[n], many.paths[n])
+    for f in ("assembled", "dead_point", "branch_jump", "min_transmission_angle", "sigmas"):
+        np.testing.assert_array_equal(getattr(one, f), getattr(many, f))
