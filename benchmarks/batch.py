@@ -191,9 +191,10 @@ def check_answers(mech, plan, designs, offsets, fourbar_args, six, rng) -> int:
     P, fin = res.paths["M"], np.isfinite(mx)
     diff = float(np.nanmax(np.abs(P[fin] - np.stack([mx, my], -1)[fin]))) if fin.any() else 0.0
     same = bool(np.array_equal(fin, res.assembled))
+    picks = rng.choice(len(designs), 8, replace=False)
     lines = [("four-bars vs bare NumPy, every design", verdict(diff, same)),
              ("four-bars vs simulate, 8 sampled designs",
-              verdict(check_against_simulate(mech, plan, designs, offsets, rng.choice(len(designs), 8, replace=False))))]
+              verdict(check_against_simulate(mech, plan, designs, offsets, picks)))]
     for f, (m6, p6, d6) in six.items():
         lines.append((f"{f} vs simulate, 6 sampled designs",
                       verdict(check_against_simulate(m6, p6, d6, offsets, rng.choice(len(d6), 6, replace=False)))))

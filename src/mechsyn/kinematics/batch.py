@@ -528,7 +528,7 @@ class _Run:
         else:
             ok &= np.greater_equal(be, 0, out=self.good[:n])
         if self.flags:
-            self.jump[k0:k1] |= _stepped_over(be * t / np.maximum(L1s, 1e-300))
+            self.jump[k0:k1] |= _stepped_over(np.divide(np.multiply(be, t, out=s), np.maximum(L1s, 1e-300), out=s))
         flips = self.flips[j]
         one = sigma[0, 0] if flips[k1 - 1] == flips[k0] else 0.0   # one assembly mode in the block
         beta = np.sqrt(be, out=w.imag if one else be)   # NaN where the dyad does not assemble
@@ -597,10 +597,20 @@ def _side(X: np.ndarray, geo: tuple, p: int, side: int) -> tuple[np.ndarray, np.
 
 def _stepped_over(b: np.ndarray) -> np.ndarray:
     """Per row: a local minimum of ``b`` whose parabola through it and its two
-    neighbours goes below zero (a zero of the discriminant between samples)."""
+    neighbours goes below zero (a zero of the discriminant between samples).
+
+    The parabola is evaluated at the positive local minima only (a few per row), not
+    over the whole array.
+    """
     lo, mid, hi = b[:, :-2], b[:, 1:-1], b[:, 2:]
+    cand = np.less_equal(mid, lo)
+    cand &= np.less_equal(mid, hi)
+    cand &= np.greater(mid, 0)
+    r, c = np.nonzero(cand)
+    lo, mid, hi = b[r, c], b[r, c + 1], b[r, c + 2]
     curv = hi - 2 * mid + lo
     with np.errstate(invalid="ignore", divide="ignore"):
         vmin = mid - (hi - lo) ** 2 / (8 * curv)
-        hit = (mid <= lo) & (mid <= hi) & (curv > 0) & (vmin < 0) & (mid > 0)
-    return hit.any(axis=1)
+    out = np.zeros(len(b), dtype=bool)
+    out[r[(curv > 0) & (vmin < 0)]] = True
+    return out
