@@ -327,11 +327,13 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
     dyad's ``d`` and ``w`` (``d_j = d_i (a + b w_i)``) without placing its ends, unless
     something else uses them.
 
-    Returns ``(("crank", O, points), ("rrr", p1, p2, p3, fuse, points, shift)...,
+    Returns ``(("crank", O, points), ("rrr", p1, p2, p3, fuse, points, shift, ok)...,
     ("mask", outputs))``: ``points`` are ``(p, side)`` for a dyad; ``fuse`` is ``(i,
     side1, side3)`` or None; ``shift``: the dyad places only points of its second link
     and no later dyad uses its ``w``, so it keeps ``w - 1`` (``a + b w = 1 + b (w - 1)``
-    there, a scalar instead of a per-design addition); ``mask`` lists the frame points among the outputs and the outputs
+    there, a scalar instead of a per-design addition); ``ok``: 1 writes the assembled
+    mask, 2 and-s into it, 0 leaves it to a later dyad whose ``d`` depends on this one
+    (and is NaN where this one does not assemble); ``mask`` lists the frame points among the outputs and the outputs
     that do not depend on every dyad (NaN does not reach them by itself where another
     dyad fails): they are set to NaN where the mechanism is not assembled.
     """
@@ -375,6 +377,12 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
     for st in steps:                             # w of a dyad used by a later one stays w
         if st[4] is not None:
             steps[len(dyads) - 1 - st[4][0]][6] = False
+    # a dyad whose d depends on an earlier one gets NaN where that one does not assemble, so
+    # the assembled mask needs the last dyads of each chain only: 1 writes it, 2 and-s into it
+    upstream = frozenset().union(*(depends(p1) | depends(p3) for p1, _, p3 in dyads))
+    leaves = [j for j in range(len(dyads)) if j not in upstream]
+    for j in range(len(dyads)):
+        steps[len(dyads) - 1 - j].append(0 if j in upstream else 1 if j == leaves[0] else 2)
     return (("crank", crank_joint, crank_pts),) + tuple(tuple(st) for st in reversed(steps)) + (("mask", mask),)
 
 
@@ -499,7 +507,7 @@ class _Run:
 
     def _dyad(self, st: tuple, j: int, k0: int, k1: int, at, dest) -> None:
         """One RRR dyad on a block: ``d``, then ``w``, then the points of its links."""
-        _, p1, p2, p3, fuse, pts, shift = st
+        _, p1, p2, p3, fuse, pts, shift, mode = st
         n = k1 - k0
         d = self.d[j][:n]
         if fuse is None:
@@ -509,7 +517,7 @@ class _Run:
             np.multiply(self.w[fuse[0]][:n], b[k0:k1], out=d)
             d += a[k0:k1]
             d *= self.d[fuse[0]][:n]
-        w = self._w(j, d, k0, k1, shift)
+        w = self._w(j, d, k0, k1, shift, mode)
         A = at(p1)
         for p, side in pts:                       # p = A + d (a + b w)
             z = dest(p)
@@ -525,7 +533,7 @@ class _Run:
                 z *= d
             z += A
 
-    def _w(self, j: int, d: np.ndarray, k0: int, k1: int, shift: bool) -> np.ndarray:
+    def _w(self, j: int, d: np.ndarray, k0: int, k1: int, shift: bool, mode: int) -> np.ndarray:
         """``w = alpha + i sigma beta`` of dyad ``j`` (``w - 1`` when ``shift``) from ``d``
         on a block; the assembled mask, the flags and the transmission angle on the way."""
         n = k1 - k0
@@ -539,9 +547,9 @@ class _Run:
         np.divide(L1s, t, out=be)
         be -= np.multiply(al, al, out=s)          # beta^2
         ok = self.ok[k0:k1]
-        if j == 0:
+        if mode == 1:
             np.greater_equal(be, 0, out=ok)
-        else:
+        elif mode == 2:
             ok &= np.greater_equal(be, 0, out=self.good[:n])
         if self.flags:
             self.jump[k0:k1] |= _stepped_over(np.divide(np.multiply(be, t, out=s), np.maximum(L1s, 1e-300), out=s))
