@@ -35,7 +35,7 @@ outputs and the later dyads use (a dependency pass at compile time, see
 ``b``, so it is placed straight from the dyad's ``d`` and ``w``; a dyad whose two end
 joints lie on the links of one earlier dyad (the second dyad of a Watt six-bar) takes
 ``d = d_i (a + b w_i)`` without placing its ends. The designs run in blocks of about
-32,000 samples whose work arrays are reused from block to block and stay in the
+16,000 samples whose work arrays are reused from block to block and stay in the
 processor's cache (a fresh ``K x N`` temporary costs more in page faults than in
 arithmetic). Where a dyad does not assemble ``beta`` is NaN and the NaN reaches every
 point placed from it; outputs that do not depend on every dyad (and frame points) are
@@ -441,9 +441,12 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
                        sigmas=sig)
 
 
-_BLOCK = 1 << 15
+_BLOCK = 1 << 14
 """Samples (designs x inputs) per block of :func:`simulate_batch`: a complex work array
-of a block is 512 kB, so the few a dyad uses stay in a 2 MB level-2 cache."""
+of a block is 256 kB, so the arrays of a six-bar (two dyads' ``d`` and ``w``, a placed
+point, four real scratch arrays, the output) stay near a 2 MB level-2 cache. Measured
+(benchmarks/batch.py cases, load 2): 16k samples ran the Watt six-bar 4-7 % faster than
+32k and the four-bar as fast; 8k and 64k were slower."""
 
 
 class _Run:
