@@ -475,7 +475,7 @@ class _Run:
         self.d = [np.empty((kc, N), complex) for _ in steps]
         self.w = [np.empty((kc, N), complex) for _ in steps]
         self.pts = {p: np.empty((kc, N), complex) for p in placed}
-        self.t, self.s, self.al, self.be = (np.empty((kc, N)) for _ in range(4))
+        self.t, self.al, self.be = (np.empty((kc, N)) for _ in range(3))
         self.good = np.empty((kc, N), dtype=bool)
 
     def block(self, k0: int, k1: int) -> None:
@@ -541,8 +541,9 @@ class _Run:
         on a block; the assembled mask, the flags and the transmission angle on the way."""
         n = k1 - k0
         h, L1s, sigma, L12 = (c[k0:k1] for c in self.dyad_consts[j])
-        w, t, s, al, be = self.w[j][:n], self.t[:n], self.s[:n], self.al[:n], self.be[:n]
-        sq = w.view(float)                        # w is free until the end: scratch for d^2
+        w, t, al, be = self.w[j][:n], self.t[:n], self.al[:n], self.be[:n]
+        sq = w.view(float)                        # w is free until it is built: scratch
+        s = sq.reshape(-1)[:t.size].reshape(t.shape)
         np.square(d.view(float), out=sq)
         np.add(sq[:, 0::2], sq[:, 1::2], out=t)   # t = |d|^2
         np.divide(h, t, out=al)
@@ -560,7 +561,7 @@ class _Run:
         one = sigma[0, 0] if flips[k1 - 1] == flips[k0] else 0.0   # one assembly mode in the block
         beta = np.sqrt(be, out=w.imag if one else be)   # NaN where the dyad does not assemble
         if self.sin_mu is not None:
-            sm = np.fmin.reduce(np.multiply(beta, t, out=s) / L12, axis=1)   # sin mu = t beta / (L1 L2)
+            sm = np.fmin.reduce(np.divide(np.multiply(beta, t, out=t), L12, out=t), axis=1)  # sin mu = t beta / (L1 L2)
             self.sin_mu[k0:k1] = np.fmin(self.sin_mu[k0:k1], sm)
         if not one:
             np.multiply(be, sigma, out=w.imag)
