@@ -178,3 +178,22 @@ def test_blocks_of_designs_give_the_answers_of_one_block(monkeypatch):
         np.testing.assert_array_equal(one.paths[n], many.paths[n])
     for f in ("assembled", "dead_point", "branch_jump", "min_transmission_angle", "sigmas"):
         np.testing.assert_array_equal(getattr(one, f), getattr(many, f))
+
+
+def test_two_dyads_taking_d_from_one_earlier_dyad_equal_simulate():
+    """An eight-bar whose second and third dyads both take ``d`` from the first one (the
+    work arrays of a dyad are reused once no later dyad reads them)."""
+    from mechsyn.synthesis.curves.database import sample_designs
+    from mechsyn.synthesis.curves.topologies import curve_topologies
+
+    topo = next(t for t in curve_topologies(8)
+                if sum(st[0] == "rrr" and st[4] is not None for st in t.plan.ops) >= 2)
+    X = sample_designs(topo, 3, np.random.default_rng(4))
+    off = np.arange(0.0, 360.0, 4.0)
+    res = simulate_batch(topo.plan, X, off)
+    for k, x in enumerate(X):
+        m = mechanism_from_dict(topo.mechanism(x))
+        ref = compile_plan(m, points=["T"]).reference_input
+        sim = simulate(m, {topo.plan.input_joint: ref + off}, points=["T"])
+        np.testing.assert_array_equal(res.assembled[k], sim.assembled)
+        np.testing.assert_allclose(res.paths["T"][k], sim.points["T"].position, atol=1e-9)

@@ -327,13 +327,14 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
     dyad's ``d`` and ``w`` (``d_j = d_i (a + b w_i)``) without placing its ends, unless
     something else uses them.
 
-    Returns ``(("crank", O, points), ("rrr", p1, p2, p3, fuse, points, shift, ok)...,
+    Returns ``(("crank", O, points), ("rrr", p1, p2, p3, fuse, points, shift, ok, slots)...,
     ("mask", outputs))``: ``points`` are ``(p, side)`` for a dyad; ``fuse`` is ``(i,
     side1, side3)`` or None; ``shift``: the dyad places only points of its second link
     and no later dyad uses its ``w``, so it keeps ``w - 1`` (``a + b w = 1 + b (w - 1)``
     there, a scalar instead of a per-design addition); ``ok``: 1 writes the assembled
     mask, 2 and-s into it, 0 leaves it to a later dyad whose ``d`` depends on this one
-    (and is NaN where this one does not assemble); ``mask`` lists the frame points among the outputs and the outputs
+    (and is NaN where this one does not assemble); ``slots``: the work arrays of its ``d``
+    and ``w`` (:func:`_buffer_slots`); ``mask`` lists the frame points among the outputs and the outputs
     that do not depend on every dyad (NaN does not reach them by itself where another
     dyad fails): they are set to NaN where the mechanism is not assembled.
     """
@@ -383,7 +384,41 @@ def _schedule(ops: list[tuple], ground: tuple[int, ...], outputs: tuple[int, ...
     leaves = [j for j in range(len(dyads)) if j not in upstream]
     for j in range(len(dyads)):
         steps[len(dyads) - 1 - j].append(0 if j in upstream else 1 if j == leaves[0] else 2)
-    return (("crank", crank_joint, crank_pts),) + tuple(tuple(st) for st in reversed(steps)) + (("mask", mask),)
+    steps.reverse()
+    for st, slots in zip(steps, _buffer_slots([st[4] for st in steps])):
+        st.append(slots)
+    return (("crank", crank_joint, crank_pts),) + tuple(tuple(st) for st in steps) + (("mask", mask),)
+
+
+def _buffer_slots(fuses: list) -> list[tuple[int, int]]:
+    """Work-array slots ``(d, w)`` of each dyad (``fuses``: each dyad's ``fuse``, in
+    solving order): a dyad's ``d`` and ``w`` live until the last dyad that takes its ``d``
+    from them has its own ``d``; then their slots serve later dyads (fewer arrays in the
+    cache)."""
+    last = list(range(len(fuses)))
+    for j, fuse in enumerate(fuses):
+        if fuse is not None:
+            last[fuse[0]] = max(last[fuse[0]], j)
+    free: list[int] = []
+    n_slots = 0
+    slots: list[tuple[int, int]] = []
+
+    def take() -> int:
+        nonlocal n_slots
+        if free:
+            return free.pop()
+        n_slots += 1
+        return n_slots - 1
+
+    for j in range(len(fuses)):
+        d = take()
+        for i in range(j):                    # read by this d for the last time
+            if last[i] == j:
+                free.extend(slots[i])
+        slots.append((d, take()))
+        if last[j] == j:
+            free.extend(slots[j])
+    return slots
 
 
 def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
@@ -470,10 +505,11 @@ class _Run:
         # when the count does not change inside it)
         self.flips = [np.concatenate([[0], np.cumsum(c[2][1:, 0] != c[2][:-1, 0])]) for c in self.dyad_consts]
         kc = min(K, max(1, _BLOCK // max(N, 1)))
-        steps = [st for st in plan.ops if st[0] == "rrr"]
+        n_slots = 1 + max((max(st[8]) for st in plan.ops if st[0] == "rrr"), default=-1)
         placed = [p for st in plan.ops if st[0] != "mask" for p in _placed(st) if p not in out]
-        self.d = [np.empty((kc, N), complex) for _ in steps]
-        self.w = [np.empty((kc, N), complex) for _ in steps]
+        pool = [np.empty((kc, N), complex) for _ in range(n_slots)]
+        self.d = [pool[st[8][0]] for st in plan.ops if st[0] == "rrr"]
+        self.w = [pool[st[8][1]] for st in plan.ops if st[0] == "rrr"]
         self.pts = {p: np.empty((kc, N), complex) for p in placed}
         self.t, self.al, self.be = (np.empty((kc, N)) for _ in range(3))
         self.good = np.empty((kc, N), dtype=bool)
@@ -510,7 +546,7 @@ class _Run:
 
     def _dyad(self, st: tuple, j: int, k0: int, k1: int, at, dest) -> None:
         """One RRR dyad on a block: ``d``, then ``w``, then the points of its links."""
-        _, p1, p2, p3, fuse, pts, shift, mode = st
+        _, p1, p2, p3, fuse, pts, shift, mode, _ = st
         n = k1 - k0
         d = self.d[j][:n]
         if fuse is None:
