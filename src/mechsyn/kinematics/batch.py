@@ -478,8 +478,9 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
 
 _BLOCK = 1 << 14
 """Samples (designs x inputs) per block of :func:`simulate_batch`: a complex work array
-of a block is 256 kB, so the arrays of a six-bar (two dyads' ``d`` and ``w``, a placed
-point, four real scratch arrays, the output) stay near a 2 MB level-2 cache. Measured
+of a block is 256 kB, so the arrays of a six-bar (three for the two dyads' ``d`` and
+``w``, a placed point, three real work arrays, the output) stay within a 2 MB level-2
+cache. Measured
 (benchmarks/batch.py cases, load 2): 16k samples ran the Watt six-bar 4-7 % faster than
 32k and the four-bar as fast; 8k and 64k were slower."""
 
