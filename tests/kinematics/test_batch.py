@@ -197,3 +197,12 @@ def test_two_dyads_taking_d_from_one_earlier_dyad_equal_simulate():
         sim = simulate(m, {topo.plan.input_joint: ref + off}, points=["T"])
         np.testing.assert_array_equal(res.assembled[k], sim.assembled)
         np.testing.assert_allclose(res.paths["T"][k], sim.points["T"].position, atol=1e-9)
+
+
+def test_no_inputs_or_no_designs():
+    mech = load_mechanism(EX / "textbook/watt_sixbar.yaml")
+    plan = compile_plan(mech)
+    none = simulate_batch(plan, np.zeros((0, plan.n_parameters)), np.arange(0.0, 360.0, 10.0))
+    assert none.paths["P"].shape == (0, 36, 2) and none.sigmas.shape == (0, 2)
+    empty = simulate_batch(plan, plan.parameters(mech), np.array([]), transmission=True)
+    assert empty.paths["P"].shape == (1, 0, 2) and np.isnan(empty.min_transmission_angle[0])

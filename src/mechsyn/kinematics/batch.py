@@ -598,7 +598,8 @@ class _Run:
         one = sigma[0, 0] if flips[k1 - 1] == flips[k0] else 0.0   # one assembly mode in the block
         beta = np.sqrt(be, out=w.imag if one else be)   # NaN where the dyad does not assemble
         if self.sin_mu is not None:
-            sm = np.fmin.reduce(np.divide(np.multiply(beta, t, out=t), L12, out=t), axis=1)  # sin mu = t beta / (L1 L2)
+            sin_mu = np.divide(np.multiply(beta, t, out=t), L12, out=t)   # sin mu = t beta / (L1 L2)
+            sm = np.fmin.reduce(sin_mu, axis=1, initial=np.inf)        # NaN samples left out
             self.sin_mu[k0:k1] = np.fmin(self.sin_mu[k0:k1], sm)
         if not one:
             np.multiply(be, sigma, out=w.imag)
