@@ -107,3 +107,102 @@ def test_reference_inputs_match_simulate_measure_and_2d_inputs():
             one = simulate_batch(t.plan, X[k], rows[k]).paths["T"][0]
             np.testing.assert_array_equal(np.isnan(one), np.isnan(two[k]))
             np.testing.assert_allclose(one[np.isfinite(one)], two[k][np.isfinite(two[k])])
+
+
+def test_program_places_only_the_points_the_outputs_need():
+    watt = load_mechanism(EX / "textbook/watt_sixbar.yaml")
+    one = compile_plan(watt, points=["P"])
+    # F (the second dyad's end on the rocker) is not placed: that dyad's d comes from the first dyad's
+    assert one.describe() == ["crank A: places B", "RRR (B, C, D): places E",
+                              "RRR (E, G, F), d from the ends on dyad 1: places P"]
+    every = compile_plan(watt, points=[j.id for j in watt.joints] + ["P"])
+    rng = np.random.default_rng(8)
+    X = one.parameters(watt) + rng.normal(scale=0.1, size=(5, one.n_parameters))
+    off = np.arange(0.0, 360.0, 2.0)
+    a, b = simulate_batch(one, X, off), simulate_batch(every, X, off)
+    np.testing.assert_array_equal(a.assembled, b.assembled)
+    np.testing.assert_allclose(a.paths["P"], b.paths["P"], atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["watt_sixbar", "stephenson_sixbar"])
+def test_every_joint_equals_simulate_where_some_dyad_fails(name):
+    """Frame points and points upstream of the dyad that fails are NaN where the
+    mechanism is not assembled, as in simulate (NaN does not reach them by itself)."""
+    mech = load_mechanism(EX / f"textbook/{name}.yaml")
+    names = [j.id for j in mech.joints] + list(mech.points)
+    plan = compile_plan(mech, points=names)
+    off = np.arange(0.0, 360.0, 3.0)
+    res = simulate_batch(plan, plan.parameters(mech), off)
+    sim = simulate(mech, {plan.input_joint: plan.reference_input + off}, points=names)
+    assert 0 < res.assembled.sum() < len(off)              # the six-bar locks over part of the turn
+    np.testing.assert_array_equal(res.assembled[0], sim.assembled)
+    for n in names:
+        np.testing.assert_allclose(res.paths[n][0], sim.points[n].position, atol=1e-9)
+
+
+def test_transmission_angle_does_not_depend_on_the_assembly_mode():
+    mech = load_mechanism(EX / "kinematics/crank_rocker.yaml")
+    mirror = mechanism_to_dict(mech)                        # the same linkage reflected in the x axis
+    mirror["joints"] = [{**j, "point": [j["point"][0], -j["point"][1]]} for j in mirror["joints"]]
+    mirror["points"] = {n: {**p, "at": [p["at"][0], -p["at"][1]]} for n, p in mirror["points"].items()}
+    off = np.arange(0.0, 360.0, 1.0)
+    mu = []
+    for m in (mech, mechanism_from_dict(mirror)):
+        plan = compile_plan(m)
+        res = simulate_batch(plan, plan.parameters(m), off, transmission=True)
+        mu.append((res.sigmas[0, 0], res.min_transmission_angle[0]))
+    assert mu[0][0] == -mu[1][0]
+    # Norton's crank-rocker: mu_min = acos((b^2 + c^2 - (d - a)^2) / (2 b c)), coupler b, rocker c
+    a, b, c, d = 1.0, 3.5, 3.0, 4.0
+    want = np.degrees(np.arccos((b * b + c * c - (d - a) ** 2) / (2 * b * c)))
+    assert abs(mu[0][1] - want) < 1e-6 and abs(mu[1][1] - want) < 1e-6
+
+
+def test_blocks_of_designs_give_the_answers_of_one_block(monkeypatch):
+    """Designs run in blocks (mixed assembly modes in a block, a short last block): the
+    answers and flags are those of one block, sample for sample."""
+    import mechsyn.kinematics.batch as batch
+
+    mech = load_mechanism(EX / "textbook/watt_sixbar.yaml")
+    plan = compile_plan(mech, points=["P", "E", "B", "D"])
+    rng = np.random.default_rng(11)
+    x0 = plan.parameters(mech)
+    X = x0 + rng.normal(scale=0.1, size=(7, len(x0)))
+    X[::3, 1::2] *= -1.0                     # mirrored designs: the other assembly mode of every dyad
+    off = np.arange(0.0, 360.0, 5.0)
+    one = simulate_batch(plan, X, off, transmission=True)
+    assert len(np.unique(one.sigmas[:, 0])) == 2
+    monkeypatch.setattr(batch, "_BLOCK", 2 * len(off))        # blocks of 2 designs, the last of 1
+    many = simulate_batch(plan, X, off, transmission=True)
+    for n in plan.outputs:
+        np.testing.assert_array_equal(one.paths[n], many.paths[n])
+    for f in ("assembled", "dead_point", "branch_jump", "min_transmission_angle", "sigmas"):
+        np.testing.assert_array_equal(getattr(one, f), getattr(many, f))
+
+
+def test_two_dyads_taking_d_from_one_earlier_dyad_equal_simulate():
+    """An eight-bar whose second and third dyads both take ``d`` from the first one (the
+    work arrays of a dyad are reused once no later dyad reads them)."""
+    from mechsyn.synthesis.curves.database import sample_designs
+    from mechsyn.synthesis.curves.topologies import curve_topologies
+
+    topo = next(t for t in curve_topologies(8)
+                if sum(st[0] == "rrr" and st[4] is not None for st in t.plan.ops) >= 2)
+    X = sample_designs(topo, 3, np.random.default_rng(4))
+    off = np.arange(0.0, 360.0, 4.0)
+    res = simulate_batch(topo.plan, X, off)
+    for k, x in enumerate(X):
+        m = mechanism_from_dict(topo.mechanism(x))
+        ref = compile_plan(m, points=["T"]).reference_input
+        sim = simulate(m, {topo.plan.input_joint: ref + off}, points=["T"])
+        np.testing.assert_array_equal(res.assembled[k], sim.assembled)
+        np.testing.assert_allclose(res.paths["T"][k], sim.points["T"].position, atol=1e-9)
+
+
+def test_no_inputs_or_no_designs():
+    mech = load_mechanism(EX / "textbook/watt_sixbar.yaml")
+    plan = compile_plan(mech)
+    none = simulate_batch(plan, np.zeros((0, plan.n_parameters)), np.arange(0.0, 360.0, 10.0))
+    assert none.paths["P"].shape == (0, 36, 2) and none.sigmas.shape == (0, 2)
+    empty = simulate_batch(plan, plan.parameters(mech), np.array([]), transmission=True)
+    assert empty.paths["P"].shape == (1, 0, 2) and np.isnan(empty.min_transmission_angle[0])
