@@ -209,8 +209,9 @@ def main() -> None:
     def bare() -> None:
         bare_fourbar(th0 + th, P["A"], P["D"], a, b, c, sigma)
 
+    figures = {}
     for name, mech, joint in cases:
-        t, ratio, med = both(lambda: simulate(mech, {joint: x}), bare, args.repeats, t_bare)
+        t, ratio, med = figures[name] = both(lambda: simulate(mech, {joint: x}), bare, args.repeats, t_bare)
         s = simulate(mech, {joint: x})
         tgt = TARGETS[name]
         print(f"{name:<40s} {s.method:>7s} {len(s.events):>6d} {t * 1e3:8.2f} {ratio:8.1f} {med:7.1f} "
@@ -241,7 +242,7 @@ def main() -> None:
         ang = np.unwrap(np.arctan2(pos[:, 2, 1] - P["A"][1], pos[:, 2, 0] - P["A"][0]))
         s2 = simulate(cr, {"A": np.degrees(ang)}, points=["C"])
         dpl = np.abs(s2.points["C"].position - pos[:, 3]).max()
-        t_cr, ratio_cr, med_cr = both(lambda: simulate(cr, {"A": x}), bare, args.repeats, t_bare)
+        t_cr, ratio_cr, med_cr = figures["crank-rocker"]
         py_ratio = r["build_compile_kinematics"] / r["bare"]
         print(f"pylinkage {r['version']} build + compile + step_fast_with_kinematics ({N} steps): "
               f"{r['build_compile_kinematics'] * 1e3:.2f} ms = {py_ratio:.1f}x its bare NumPy four-bar "
