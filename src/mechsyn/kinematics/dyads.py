@@ -250,11 +250,11 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
-def _unwrap_rows(p: np.ndarray) -> np.ndarray:
+def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
     """``np.unwrap(p, axis=-1)`` for angles whose steps stay below a whole turn (as those of
     ``atan2`` do): the whole turns removed are counted exactly (a step of exactly half a
-    turn is kept, as ``np.unwrap`` keeps it)."""
-    out = np.array(p, float)
+    turn is kept, as ``np.unwrap`` keeps it); ``inplace``: into ``p`` itself."""
+    out = p if inplace else np.array(p, float)
     if p.shape[-1] > 1:
         k = np.subtract(p[..., 1:], p[..., :-1])
         k /= 2 * np.pi
@@ -272,18 +272,20 @@ def _unwrap_rows(p: np.ndarray) -> np.ndarray:
     return out
 
 
-def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None) -> np.ndarray:
+def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None,
+                       fresh: bool = False) -> np.ndarray:
     """Link angles made continuous along a sweep: start near the file's angles ``ref``,
     unwrap each run of assembled rows and keep the turn count across gaps (``phi`` (N,
     m), or (m, N) with ``ref`` (m, 1); ``ok`` None: every row assembled).
 
     ``split``: the sweep (assembled throughout) was run outwards from the drawn
     configuration, between rows ``split - 1`` and ``split``: both rows start near
-    ``ref`` and the angles are unwrapped away from them (as two runs would be)."""
+    ``ref`` and the angles are unwrapped away from them (as two runs would be).
+    ``fresh``: ``phi`` (m, N) is a work array the angles may be written into."""
     if ref.ndim == 1:
         return _continuous_angles(phi.T, ref[:, None], ok, split).T
     if ok is None or ok.all():  # one run: unwrap, then put the start row(s) next to ref
-        block = _unwrap_rows(phi)
+        block = _unwrap_rows(phi, inplace=fresh)
         parts = ((0, slice(None)),) if split is None else ((split, slice(split, None)), (split - 1, slice(0, split)))
         for row, rows in parts:  # the few start values on floats (the numbers of _wrap)
             for i, (a, b, r0) in enumerate(zip(phi[:, row].tolist(), block[:, row].tolist(), ref[:, 0].tolist())):

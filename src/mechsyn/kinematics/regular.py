@@ -226,14 +226,25 @@ def _angles(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, z: np.ndarray, spl
     """Continuous link angles (nl, N) into ``out``: a frame driver's link takes the input
     itself, every other link the argument of its rotation, unwrapped and started next to
     its drawn angle (both rows next to the drawn input when the sweep passes it)."""
-    drive_links = dyads._drive_links(S, plan)
+    drive_links, others, ref = _angle_plan(S, plan)
     for i, (k, sgn) in drive_links.items():
         np.multiply(U[:, k], sgn, out=out[i])
-    others = [i for i in range(len(S.links)) if i not in drive_links]
     if others:
         zo = z[others]
         ang = np.arctan2(zo.imag, zo.real)
-        out[others] = dyads._continuous_angles(ang, S.q0[[3 * i + 2 for i in others]][:, None], None, split)
+        out[others] = dyads._continuous_angles(ang, ref, None, split, fresh=True)
+
+
+def _angle_plan(S: PlanarSystem, plan: dyads.Plan) -> tuple:
+    """The links turned by frame drivers, the others and their drawn angles (m, 1), kept
+    with the system."""
+    memo = dyads._memo(S)
+    hit = memo.get(("angles", id(plan)))
+    if hit is None or hit[0] is not plan:
+        drive_links = dyads._drive_links(S, plan)
+        others = [i for i in range(len(S.links)) if i not in drive_links]
+        hit = memo[("angles", id(plan))] = (plan, (drive_links, others, S.q0[[3 * i + 2 for i in others]][:, None]))
+    return hit[1]
 
 
 class LinkStates:
