@@ -131,3 +131,32 @@ def test_bad_files_exit_2(capsys, tmp_path):
     code, _, err = run(capsys, "forces", EX / "kinematics/crank_rocker.yaml", "--input", "A=0:1:1",
                        "--gravity", "nan")
     assert code == 2
+
+
+@pytest.mark.parametrize("case", ["kinematics/crank_rocker.yaml", "textbook/fourbar.yaml"])
+def test_point_table_numbers_stand_whole_at_80_columns(capsys, case):
+    """At 80 columns (captured output: Rich's default width) the point table keeps every
+    number on one line, with fewer significant digits if need be, and equals the JSON to
+    those digits; positions not assembled say so."""
+    from mechsyn.cli.common import console
+
+    assert console.width == 80
+    code, out, _ = run(capsys, "simulate", EX / case, "--input", "A=0:360:1")
+    assert code == 0
+    table = out.split("point M")[1].split("links:")[0]
+    rows = [ln for ln in table.splitlines() if ln.startswith("│")]
+    assert rows and all(len(ln) <= 80 for ln in table.splitlines())
+    code, js, _ = run(capsys, "simulate", EX / case, "--input", "A=0:360:1", "--json")
+    d = json.loads(js)
+    x = d["input"]["values"]
+    for ln in rows:
+        cells = [c.strip() for c in ln.strip("│").split("│")]
+        assert cells[0] != ""  # no continuation line: nothing was wrapped
+        k = x.index(float(cells[0]))
+        if cells[1] == "not assembled":
+            assert d["assembled"][k] is False
+            continue
+        p = d["points"]["M"]
+        want = [*p["position"][k], *p["velocity"][k], *p["acceleration"][k]]
+        got = [float(c) for c in cells[1:]]
+        assert np.allclose(got, want, rtol=1e-4, atol=1e-9), (ln, want)

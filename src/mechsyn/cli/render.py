@@ -52,16 +52,30 @@ def _events(sim: Any) -> None:
 def _point_tables(sim: Any, rows: list[int], head: str) -> None:
     x = sim.inputs[sim.main_input]
     for name, pm in sim.points.items():
+        values = [(*pm.position[k], *pm.velocity[k], *pm.acceleration[k]) if sim.assembled[k] else None
+                  for k in rows]
+        heads = (head, "x", "y", "vx", "vy", "ax", "ay")
         t = Table(title=f"point {name} (on {pm.link})")
-        for col in (head, "x", "y", "vx", "vy", "ax", "ay"):
-            t.add_column(col, justify="right")
-        for k in rows:
-            if not sim.assembled[k]:
-                t.add_row(f"{x[k]:g}", "not assembled", *[""] * 5)
-                continue
-            t.add_row(f"{x[k]:g}", *(fmt_number(v) for v in (*pm.position[k], *pm.velocity[k],
-                                                               *pm.acceleration[k])))
+        for col in heads:
+            t.add_column(col, justify="right", no_wrap=True, overflow="ellipsis")
+        for row in _fitting_cells(values, [f"{x[k]:g}" for k in rows], heads, console.width):
+            t.add_row(*row)
         console.print(t)
+
+
+def _fitting_cells(values: list, first: list[str], heads: tuple, width: int) -> list[list[str]]:
+    """Table rows of numbers (``None``: a position not assembled) with the most significant
+    digits (6 down to 3) for which the table, with its column ``heads``, fits ``width``
+    columns (a rich table takes 3 characters per column and 1 more): a number is never
+    split over two lines."""
+    blank = ["not assembled"] + [""] * (len(heads) - 2)
+    for digits in (6, 5, 4, 3):
+        cells = [[f0, *(blank if row is None else (fmt_number(v, f".{digits}g") for v in row))]
+                 for f0, row in zip(first, values)]
+        need = 1 + sum(max([len(h)] + [len(r[i]) for r in cells]) + 3 for i, h in enumerate(heads))
+        if need <= width:
+            break
+    return cells
 
 
 def _link_table(sim: Any, rows: list[int], head: str) -> None:
