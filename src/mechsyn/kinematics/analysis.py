@@ -450,10 +450,13 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     events = sw.events
     used = sw.method
     ok = sw.assembled
-    rates_ok = ok if sw.links is not None else (np.all(np.isfinite(sw.qd), axis=1)
-                                                     & np.all(np.isfinite(sw.qdd), axis=1))
+    if sw.links is not None:  # the regular pass: every row assembled with finite rates
+        rates_ok, singular_rows = ok, []
+    else:
+        rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+        singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
     flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
-    for k in [] if sw.links is not None else np.flatnonzero(ok & ~rates_ok).tolist():
+    for k in singular_rows:
         if k in flagged:
             continue
         events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),

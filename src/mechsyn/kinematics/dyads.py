@@ -658,7 +658,7 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
         ay += al * relx
         qd[:, 2:3 * nl:3], qdd[:, 2:3 * nl:3] = w, al
     ok = np.all(np.isfinite(r.cos[:N]), axis=1)
-    _link_angles(S, plan, U, r, None, ok, q.T[2:3 * nl:3])
+    _link_angles(S, plan, U, r.cos.T, r.sin.T, ok, q.T[2:3 * nl:3])
     if not ok.all():
         for a in (q, qd, qdd):
             a[~ok] = np.nan
@@ -671,21 +671,33 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
     return q, qd, qdd
 
 
-def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult", split: int | None,
-                 ok: np.ndarray | None, out: np.ndarray) -> None:
-    """Continuous angles of the chain's links into ``out`` (nl, N): the links of frame
-    drivers take the input itself, the others ``atan2`` made continuous (``ok`` None:
-    every row assembled)."""
-    nl, N = out.shape
-    drive_links = _drive_links(S, plan)
+def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, cos: np.ndarray, sin: np.ndarray,
+                 ok: np.ndarray | None, out: np.ndarray, split: int | None = None) -> None:
+    """Continuous angles of the chain's links into ``out`` (nl, N) from their rotations
+    ``cos``, ``sin`` (nl, N or more rows): the links of frame drivers take the input
+    itself, the others ``atan2`` made continuous (``ok`` None: every row assembled;
+    ``split``: see :func:`_continuous_angles`)."""
+    drive_links, others, ref = _angle_plan(S, plan)
+    N = out.shape[1]
     for i, (k, sgn) in drive_links.items():
         np.multiply(U[:N, k], sgn, out=out[i])
-    others = [i for i in range(nl) if i not in drive_links]
     if others:  # atan2 only for the links not driven directly
-        ang = np.arctan2(r.sin.T[others, :N], r.cos.T[others, :N])
+        ang = np.arctan2(sin[others, :N], cos[others, :N])
         if ok is None or ok.any():
-            ang = _continuous_angles(ang, S.q0[[3 * i + 2 for i in others]][:, None], ok, split)
+            ang = _continuous_angles(ang, ref, ok, split, fresh=True)
         out[others] = ang
+
+
+def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
+    """The links turned by frame drivers, the others and their drawn angles (m, 1), kept
+    with the system."""
+    memo = _memo(S)
+    hit = memo.get(("angles", id(plan)))
+    if hit is None or hit[0] is not plan:
+        drive_links = _drive_links(S, plan)
+        others = [i for i in range(len(S.links)) if i not in drive_links]
+        hit = memo[("angles", id(plan))] = (plan, (drive_links, others, S.q0[[3 * i + 2 for i in others]][:, None]))
+    return hit[1]
 
 
 # --------------------------------------------------------------------------- fast chains
@@ -821,6 +833,21 @@ def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
     return prog, anchor
 
 
+def circle_circle(dx: np.ndarray, dy: np.ndarray, L1s: float, L2s: float) -> tuple:
+    """The RRR dyad's intersection of the circles ``|B - A| = L1``, ``|B - C| = L2`` with
+    ``d = C - A = (dx, dy)``: ``1/|d|^2``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)`` and
+    ``g^2 = L1^2 / |d|^2 - f^2`` (``B = A + f d + sigma g R90 d``; ``g^2 |d|^2 / L1^2`` is
+    the group's normalised discriminant)."""
+    inv = dx * dx
+    inv += dy * dy
+    np.divide(1.0, inv, out=inv)
+    f = inv * (0.5 * (L1s - L2s))
+    f += 0.5
+    g = inv * L1s
+    g -= f * f
+    return inv, f, g
+
+
 class _Chunk:
     """One chunk of rows of :func:`fast_chain`: the joints' states and the links'
     rotations and rates found so far, and the kernels that extend them."""
@@ -897,13 +924,7 @@ class _Chunk:
         jst[J1], jst[J3] = A, C
         dx = C[0] - A[0]
         dy = C[1] - A[1]
-        inv = dx * dx
-        inv += dy * dy
-        np.divide(1.0, inv, out=inv)
-        f = inv * (0.5 * (L1s - L2s))
-        f += 0.5
-        g = inv * L1s
-        g -= f * f
+        inv, f, g = circle_circle(dx, dy, L1s, L2s)
         if isinstance(sigma, tuple):  # a chooser: the signs from the discriminant of _solve_step
             sigma = self._choose(sigma, A, dx, dy, inv)
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
@@ -1048,49 +1069,30 @@ def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.n
     """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
     out = np.array(u_first, float)
     for k, d in enumerate(S.drivers):
-        if d.type == "R":
-            out[k] -= 2 * np.pi * np.round((u_first[k] - u0[k]) / (2 * np.pi))
+        if d.type == "R":  # a decision per driver: on floats
+            out[k] -= 2 * math.pi * round((float(u_first[k]) - float(u0[k])) / (2 * math.pi))
     return out
 
 
 def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: int = 4000) -> np.ndarray:
     """Inputs from the drawn values ``u0`` towards ``u1`` (excluded) in steps of at most
     1 degree (R) or 1 % of the mechanism's size (P)."""
-    h = np.array([np.radians(1.0) if d.type == "R" else 0.01 * S.scale for d in S.drivers])
-    n = int(min(max_rows, max(1, np.ceil(np.max(np.abs(u1 - u0) / h)))))
+    steps = (abs(float(b) - float(a)) / (math.radians(1.0) if d.type == "R" else 0.01 * S.scale)
+             for a, b, d in zip(u0, u1, S.drivers))
+    n = int(min(max_rows, max(1, math.ceil(max(steps)))))
+    if n == 1:  # the drawn values themselves (t = 0)
+        return np.array(u0, float)[None, :]
     t = np.arange(n) / n
     return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
 
 
 def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
-    """The rows ``U`` followed by the connecting paths of a regular sweep
-    (:func:`mechsyn.kinematics.regular.regular_sweep`; the numbers
-    of :func:`_connecting_path` and :func:`_shifted_start`, with the few per-driver
-    decisions taken on Python floats)."""
-    N, k = U.shape
-    u0 = [float(d.assembled) for d in S.drivers]
-    h = [math.radians(1.0) if d.type == "R" else 0.01 * S.scale for d in S.drivers]
-    isR = [d.type == "R" for d in S.drivers]
-    paths = []
-    for e in ([0] if split is None else [split, split - 1]):
-        u1 = U[e].tolist()
-        for i in range(k):
-            if isR[i]:
-                u1[i] -= 2 * math.pi * round((u1[i] - u0[i]) / (2 * math.pi))
-        n = int(min(4000, max(1, math.ceil(max(abs(b - a) / s for a, b, s in zip(u0, u1, h))))))
-        paths.append((n, u1))
-    X = np.empty((N + sum(n for n, _ in paths), k))
-    X[:N] = U
-    row = N
-    a = np.array(u0)
-    for n, u1 in paths:
-        if n == 1:  # the drawn values themselves (t = 0)
-            X[row] = a
-        else:
-            t = np.arange(n) / n
-            np.add(a, t[:, None] * (np.array(u1) - a), out=X[row:row + n])
-        row += n
-    return X
+    """The rows ``U`` followed by the connecting paths from the drawn input values to the
+    sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
+    else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    ends = [0] if split is None else [split, split - 1]
+    return np.concatenate([U] + [_connecting_path(S, u0, _shifted_start(S, u0, U[e])) for e in ends])
 
 
 #: Smallest normalised discriminant of every group over a sweep for which

@@ -47,7 +47,7 @@ def _program(S: PlanarSystem, plan: dyads.Plan) -> tuple:
     steps = []
     for op in prog:
         if op[0] == "drive":
-            _, new, k, jid, di, sgn = op
+            _, new, k, jid, di, sgn = op  # the joint's local point on k (the frame: its fixed point)
             steps.append(("drive", new, k, jid, di, sgn, complex(*dyads._local(S, k, jid))))
         else:
             _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
@@ -92,7 +92,7 @@ class _Pass:
         An = A - rel if acc is None else (acc - rel) + A
         return Pn, Vn, An
 
-    def drive(self, step: tuple, U: np.ndarray, speeds: np.ndarray, fixed: dict) -> None:
+    def drive(self, step: tuple, U: np.ndarray, speeds: np.ndarray) -> None:
         _, new, k, jid, di, sgn, s_k = step
         z = np.empty(self.M, complex)
         th = U[:, di]
@@ -101,7 +101,7 @@ class _Pass:
         if sgn < 0:
             np.negative(z.imag, out=z.imag)
         if k < 0:
-            self.joint[jid] = (complex(*fixed[jid]), 0j, 0j)
+            self.joint[jid] = (s_k, 0j, 0j)
             self.link[new] = (z, sgn * float(speeds[di]), 0.0)
         else:
             zk, wk, alk = self.link[k]
@@ -116,14 +116,7 @@ class _Pass:
         self.joint[J1], self.joint[J3] = A, C
         d = np.subtract(C[0], A[0]) if isinstance(C[0], np.ndarray) or isinstance(A[0], np.ndarray) \
             else np.full(self.M, C[0] - A[0])
-        dx, dy = d.real, d.imag
-        inv = dx * dx
-        inv += dy * dy
-        np.divide(1.0, inv, out=inv)
-        f = inv * (0.5 * (L1s - L2s))
-        f += 0.5
-        g = inv * L1s
-        g -= f * f
+        inv, f, g = dyads.circle_circle(d.real, d.imag, L1s, L2s)
         disc = g / inv
         disc *= 1.0 / L1s
         if not disc.min() >= least:  # NaN too
@@ -191,11 +184,10 @@ def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.n
     steps, anchor, origin = _program(S, plan)
     X = dyads._regular_rows(S, U, split)
     st = _Pass(X.shape[0], anchor)
-    fixed = {j.id: j.point for j in S.mech.joints}
     with np.errstate(invalid="ignore", divide="ignore"):
         for step in steps:
             if step[0] == "drive":
-                st.drive(step, X, speeds, fixed)
+                st.drive(step, X, speeds)
             elif not st.rrr(step, dyads.REGULAR_DISC):
                 return None
     return _poses(S, plan, U, st, origin, split)
@@ -217,34 +209,8 @@ def _poses(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, st: _Pass, origin: 
         qdd[3 * i + 2] = ali[:N] if isinstance(ali, np.ndarray) else ali
     for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
         buf[0::3], buf[1::3] = x.real, x.imag
-    _angles(S, plan, U, C[0], split, q[2::3])
+    dyads._link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
     return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
-
-
-def _angles(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, z: np.ndarray, split: int | None,
-            out: np.ndarray) -> None:
-    """Continuous link angles (nl, N) into ``out``: a frame driver's link takes the input
-    itself, every other link the argument of its rotation, unwrapped and started next to
-    its drawn angle (both rows next to the drawn input when the sweep passes it)."""
-    drive_links, others, ref = _angle_plan(S, plan)
-    for i, (k, sgn) in drive_links.items():
-        np.multiply(U[:, k], sgn, out=out[i])
-    if others:
-        zo = z[others]
-        ang = np.arctan2(zo.imag, zo.real)
-        out[others] = dyads._continuous_angles(ang, ref, None, split, fresh=True)
-
-
-def _angle_plan(S: PlanarSystem, plan: dyads.Plan) -> tuple:
-    """The links turned by frame drivers, the others and their drawn angles (m, 1), kept
-    with the system."""
-    memo = dyads._memo(S)
-    hit = memo.get(("angles", id(plan)))
-    if hit is None or hit[0] is not plan:
-        drive_links = dyads._drive_links(S, plan)
-        others = [i for i in range(len(S.links)) if i not in drive_links]
-        hit = memo[("angles", id(plan))] = (plan, (drive_links, others, S.q0[[3 * i + 2 for i in others]][:, None]))
-    return hit[1]
 
 
 class LinkStates:
