@@ -8,8 +8,12 @@ A silent wrong answer is worse than an error, so :func:`check_geometry` refuses
 * a zero-length link: a moving link with two or more pivots (revolute, spherical,
   universal pairs), all at one point (a crank whose both pivots coincide "assembles"
   everywhere and never moves; all the joints of a file at one point make every link
-  zero-length). Revolute pairs at one point with crossed axes (a Hooke joint's cross)
-  are allowed; slides, cylinders and contacts act along lines and are not pivots;
+  zero-length). Each pivot is a hinge of the link along its own arm (an R pair's axis,
+  the U pair's arm fixed in that link): hinges at one point with crossed arms (a Hooke
+  joint's cross, the shafts of a Hooke coupling written R + U at one point, a spherical
+  linkage written at its centre) are allowed; slides, cylinders and contacts act along
+  lines and are not pivots, and a link that has one is never refused for its pins
+  (a slider block carrying two pins at one point);
 * one pair written twice: two joints of one type between the same links at one point;
 * a gear pair of ratio 0 (the second link could never turn).
 
@@ -112,7 +116,7 @@ def check_geometry(mech: Any, source: str | None = None) -> Any:
     _check_duplicates(located, P, tol, source)
     bad = _zero_length_links(mech, located, P, tol)
     if bad:
-        if scale == 0:
+        if scale == 0 and len(bad) == len(mech.link_names) - 1:
             what = "all joints are at one point, so every link has zero length"
         else:
             what = "; ".join(f"link {link!r} has zero length: its joints {', '.join(ids)} are at one point"
@@ -130,12 +134,30 @@ def _parallel(axes: list[Any]) -> bool:
     return bool(np.all(np.linalg.norm(np.cross(A, A[0]), axis=1) <= 1e-9))
 
 
+def _arm(j: Any, link: str) -> Any:
+    """The axis a pivot lets ``link`` turn about, as a hinge: an R pair's axis (``None``,
+    the plane's normal, in a planar file), a U pair's arm fixed in that link (``axis`` in
+    its first link, ``axis2`` in its second); ``False`` for a ball (S, S_pin), which
+    lets the link turn about every axis through the point."""
+    if j.type == "R":
+        return j.axis
+    if j.type == "U":
+        return j.axis if link == j.links[0] else j.axis2
+    return False
+
+
 def _zero_length_links(mech: Any, located: list[Any], P: np.ndarray, tol: float) -> list[tuple[str, list[str]]]:
     """Moving links whose two or more pivots (:data:`PIVOT_PAIRS`) are all at one point.
 
-    Two revolute pairs at one point with crossed axes are a Hooke joint's cross, not a
-    zero-length link."""
+    Each pivot is a hinge of the link along its arm (:func:`_arm`): hinges at one point
+    with crossed arms are a Hooke joint's cross or a shaft of a Hooke coupling, not a
+    zero-length link. A link that also has a slide, a cylinder, a screw or a contact is
+    placed by it and never refused for its pins."""
     on: dict[str, list[int]] = {}
+    placed: set[str] = set()
+    for j in mech.joints:
+        if j.type not in PIVOT_PAIRS:
+            placed.update(j.links)
     for k, j in enumerate(located):
         if j.type in PIVOT_PAIRS:
             for link in dict.fromkeys(j.links):
@@ -143,10 +165,11 @@ def _zero_length_links(mech: Any, located: list[Any], P: np.ndarray, tol: float)
     bad = []
     for link in mech.link_names:
         rows = on.get(link, [])
-        if link == mech.ground or len(rows) < 2 or np.max(np.ptp(P[rows], axis=0)) > tol:
+        if link == mech.ground or link in placed or len(rows) < 2 or np.max(np.ptp(P[rows], axis=0)) > tol:
             continue
         pivots = [located[k] for k in rows]
-        if all(j.type == "R" for j in pivots) and not _parallel([j.axis for j in pivots]):
+        arms = [_arm(j, link) for j in pivots]
+        if all(a is not False for a in arms) and not _parallel(arms):
             continue
         bad.append((link, [j.id for j in pivots]))
     return bad

@@ -5,11 +5,14 @@ subspace ``Z0`` of the null space of the loop-closure matrix. An **idle** motion
 
 (a) a motion of one link or of a connected group of links moving as ONE rigid body
     (one twist ``t``) while every other link stays, that moves no named point; or
-(b) a motion that keeps every joint centre of a lower pair (R, H, C, U, S, S_pin) and
-    every named point at rest and turns no output (a link joined to one neighbour only
-    keeps its place on it). When the file declares no drive, a motion carried through a
-    higher pair (the contact point's velocity along the contact normal not zero: a gear
-    train turning, a cam turning its follower) is the function, not idle (a note says so).
+(b) a motion in which every link joined to the frame stays at rest, every S, U and
+    S_pin centre and every named point stays at rest, every R, C and H axis stays in
+    place as a line (whatever point of it the file gives), every slide (P) keeps its
+    direction and every plane pair (E) its plane, and no output turns (a link joined to
+    one neighbour only keeps its place on it). Nothing in this family depends on which
+    point of an axis the file writes. When the file declares no drive, a motion carried
+    through a higher pair (the contact point's velocity along the contact normal not
+    zero: a cam turning its follower) is the function, not idle (a note says so).
 
 The idle count is the dimension of the span of both families (they overlap: a rod
 spinning between two ball joints is in both); the useful mobility is ``m`` minus it.
@@ -49,8 +52,9 @@ class IdleMobility:
 
     ``link`` is the moved links joined with ``+`` (one name for a single link);
     ``family`` is ``"group"`` (one rigid body: a link or a connected group of links),
-    ``"centres"`` (every lower-pair centre and named point at rest, links turning with
-    different twists) or ``"cancelling"`` (pair rates that cancel: no link moves).
+    ``"centres"`` (family (b): the links joined to the frame at rest, every joint axis in
+    place and every ball centre and named point at rest, links turning with different
+    twists) or ``"cancelling"`` (pair rates that cancel: no link moves).
     ``axis`` is the common screw axis of the moved links (``direction``, ``point`` (None
     for a slide), ``pitch`` (length per radian; None for a slide)), or None when the
     links move with different twists; ``axes`` gives each link's.
@@ -96,6 +100,9 @@ class IdleInputs:
     centre: np.ndarray
     scale: float
     drives: bool = True
+    lines: list[tuple[int, np.ndarray, np.ndarray]] = field(default_factory=list)
+    slides: list[tuple[int, np.ndarray]] = field(default_factory=list)
+    planes: list[tuple[int, np.ndarray, np.ndarray]] = field(default_factory=list)
 
 
 def _skew(p: np.ndarray) -> np.ndarray:
@@ -202,7 +209,8 @@ def _describe(links: list[str], joints: list[str], axis: dict[str, Any] | None, 
     if family == "cancelling":
         return f"joint rates of {', '.join(joints)} cancel: no link moves (coaxial or duplicated pairs)"
     if axis is None:
-        return f"{who} turn about their own axes through their joint centres, every joint centre at rest{pairs}"
+        return (f"{who} turn with different twists, every joint axis in place and every ball centre at rest, "
+                f"the links joined to the frame at rest{pairs}")
     together = "" if len(links) == 1 else " together as one body"
     if axis["point"] is None:
         return f"{who} slide{'s' if len(links) == 1 else ''}{together} along {_vec(axis['direction'])}{pairs}"
@@ -225,6 +233,31 @@ def _dir(v: list[float]) -> str:
         if abs(abs(v[k]) - 1.0) < 1e-6:
             return name
     return _vec(v)
+
+
+def _family_b_rows(inp: IdleInputs, neighbours: dict[int, set[int]]) -> list[np.ndarray]:
+    """The linear conditions (rows, each ``k × d``) of family (b).
+
+    A line through ``p`` along unit ``a`` stays in place under a twist ``[ω; v]`` exactly
+    when ``ω ∥ a`` and the velocity of ``p`` is along ``a``: ``(I - aaᵀ) ω = 0`` and
+    ``(I - aaᵀ) v(p) = 0``. Both hold for every point ``p + s a`` of the line
+    (``v(p + s a) = v(p) + s ω × a``), so the rows do not depend on the point written."""
+    A = inp.A
+    rows = [_point_velocity(A[li], p) for li, p in inp.centres + inp.named]
+    for li, p, a in inp.lines:
+        P = np.eye(3) - np.outer(a, a)
+        rows += [P @ A[li, :3], P @ _point_velocity(A[li], p)]
+    for li, a in inp.slides:
+        rows.append((np.eye(3) - np.outer(a, a)) @ A[li, :3])
+    for li, p, nrm in inp.planes:
+        rows += [(np.eye(3) - np.outer(nrm, nrm)) @ A[li, :3], (nrm @ _point_velocity(A[li], p))[None]]
+    for i in range(A.shape[0]):
+        if -1 in neighbours[i]:
+            rows.append(A[i])  # joined to the frame: at rest
+        elif len(neighbours[i]) < 2:
+            (other,) = neighbours[i] or {-1}
+            rows.append(A[i] - A[other])
+    return rows
 
 
 def find_idle_mobilities(inp: IdleInputs, tol: float) -> tuple[list[IdleMobility], np.ndarray, list[str]]:
@@ -295,13 +328,9 @@ def find_idle_mobilities(inp: IdleInputs, tol: float) -> tuple[list[IdleMobility
         notes.append(f"idle motions of link groups larger than {MAX_GROUP_LINKS} links were not searched: "
                      "family (b) (joint centres at rest) still counts them when they keep the centres at rest")
 
-    # -- family (b): lower-pair centres and named points at rest, nothing transmitted
-    # through a higher pair, outputs (links joined to one neighbour) in their place
-    rows = [_point_velocity(A[li], p) for li, p in inp.centres + inp.named]
-    for i in range(n):
-        if len(neighbours[i]) < 2:
-            (other,) = neighbours[i] or {-1}
-            rows.append(A[i] - (A[other] if other >= 0 else 0.0))
+    # -- family (b): the frame's neighbours at rest, joint axes in place, ball centres and
+    # named points at rest, nothing transmitted through a higher pair, outputs in place
+    rows = _family_b_rows(inp, neighbours)
     Zb = _null_basis(np.concatenate(rows, axis=0) if rows else np.zeros((0, d)), d, tol)
     if not inp.drives and inp.contacts and Zb.shape[1]:
         # no drive declared: a motion carried through a cam or gear contact (a gear train's,

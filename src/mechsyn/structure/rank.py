@@ -352,7 +352,10 @@ def _link_twists(mech: Mechanism, sysm: _System, N: np.ndarray) -> tuple[list[st
     return names, np.array([tw[n] for n in names]) if names else np.zeros((0, 6, N.shape[1]))
 
 
-_CENTRED_PAIRS = ("R", "H", "C", "U", "S", "S_pin")
+#: Family (b) of the idle rule: the centres of these pairs stay at rest, the axes of
+#: those stay in place as lines (see :mod:`mechsyn.structure.idle`).
+_POINT_PAIRS = ("U", "S", "S_pin")
+_LINE_PAIRS = ("R", "H", "C")
 _HIGHER_PAIRS = ("cam", "gear", "belt", "line_contact", "point_contact")
 
 
@@ -375,11 +378,19 @@ def _idle_inputs(mech: Mechanism, sysm: _System, N: np.ndarray, Z0: np.ndarray) 
     def norm(p: Any) -> np.ndarray:
         return (_pad3(p) - sysm.centre) / sysm.scale
 
-    centres, contacts = [], []
+    centres, contacts, lines, slides, planes = [], [], [], [], []
+    z = np.array([0.0, 0.0, 1.0])
     for j in mech.joints:
         on = [index[x] for x in j.links if x in index]
-        if j.type in _CENTRED_PAIRS and j.point is not None:
+        axis = z if (j.axis is None or sysm.planar and j.type != "P") else _unit(_pad3(j.axis))
+        if j.type in _POINT_PAIRS and j.point is not None:
             centres += [(i, norm(j.point)) for i in on]
+        elif j.type in _LINE_PAIRS and j.point is not None:
+            lines += [(i, norm(j.point), axis) for i in on]
+        elif j.type == "P" and j.axis is not None:
+            slides += [(i, axis) for i in on]
+        elif j.type == "E" and j.point is not None:
+            planes += [(i, norm(j.point), axis) for i in on]
         elif j.type in _HIGHER_PAIRS:
             pn = _contact(j, mech)
             if pn is not None:
@@ -388,7 +399,8 @@ def _idle_inputs(mech: Mechanism, sysm: _System, N: np.ndarray, Z0: np.ndarray) 
     edges = [tuple(index.get(x, -1) for x in j.links) for j in mech.joints]
     return IdleInputs(A=LT @ Z0, rates=N @ Z0, col_joint=sysm.col_joint, links=names, edges=edges,  # type: ignore[arg-type]
                       centres=centres, named=named, contacts=contacts, joint_ids=[j.id for j in mech.joints],
-                      centre=sysm.centre, scale=sysm.scale, drives=any(j.actuated for j in mech.joints))
+                      centre=sysm.centre, scale=sysm.scale, drives=any(j.actuated for j in mech.joints),
+                      lines=lines, slides=slides, planes=planes)
 
 
 def _contour_reason(sysm: _System, idx: int, Wj: np.ndarray) -> str:
