@@ -63,6 +63,7 @@ import numpy as np
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.structure.contours import independent_contours
+from mechsyn.structure.finite import LocalMobility, local_mobility
 from mechsyn.structure.idle import IdleInputs, IdleMobility, find_idle_mobilities
 from mechsyn.structure.screws import (  # noqa: F401  (re-exported: the names users import from here)
     _AXIS_NAMES,
@@ -145,6 +146,9 @@ class RankAnalysis:
     smallest_singular_values: list[float]
     near_singular: bool
     notes: list[str] = field(default_factory=list)
+    shaky: bool = False
+    configuration: str = "not checked"
+    mobility_reading: str = ""
 
     @property
     def redundant_by_contour(self) -> list[int]:
@@ -169,6 +173,7 @@ class RankAnalysis:
             "pair_freedoms": self.pair_freedoms, "equations": self.equations, "rank": self.rank,
             "smallest_singular_values": self.smallest_singular_values,
             "near_singular": self.near_singular, "notes": self.notes,
+            "shaky": self.shaky, "configuration": self.configuration, "mobility_reading": self.mobility_reading,
         }
 
 
@@ -493,39 +498,6 @@ def _gauss_newton_step(sysm: "_System", theta: np.ndarray, tol: float) -> tuple[
     return err, A.T @ spsolve((A @ A.T + tol * tol * identity(A.shape[0], format="csc")).tocsc(), err)
 
 
-def _follow(sysm: _System, N: np.ndarray, tol: float, rank0: int, samples: int = 3,
-            step: float = 0.05, seed: int = 0) -> tuple[int | None, list[str]]:
-    """Rank at nearby assembled configurations along random null-space directions."""
-    rng = np.random.default_rng(seed)
-    notes = []
-    ranks = []
-    returned = 0
-    for _ in range(samples):
-        d = N @ rng.standard_normal(N.shape[1])
-        d *= step / max(np.max(np.abs(d)), 1e-300)
-        theta = d.copy()
-        ok = False
-        for _it in range(60):
-            err, delta = _gauss_newton_step(sysm, theta, tol)
-            if np.linalg.norm(err) < max(1e-11, 10.0 * tol * step):
-                ok = True
-                break
-            theta = theta - delta
-        if not ok:
-            continue
-        if np.max(np.abs(theta)) < 0.2 * step:
-            returned += 1
-            continue
-        ranks.append(_reduce(sysm, theta, tol).rank)
-    if not ranks:
-        if returned:
-            notes.append("the instantaneous motions do not extend to finite motions (a shaky configuration)")
-            return rank0 + N.shape[1], notes  # no finite motion: rank 'full'
-        notes.append("the motion could not be followed numerically (closure did not converge)")
-        return None, notes
-    return max(ranks), notes
-
-
 def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None = None,
                  check_singular: bool = True, seed: int = 0,
                  progress: Callable[[str], None] | None = None) -> RankAnalysis:
@@ -600,16 +572,18 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     notes.extend(idle_notes)
     useful = mobility - len(idle)
     determined, anote = _actuation(sysm, N, Z0, acols, anames, len(idle), tol)
-    singular, finite = False, (0 if mobility == 0 else None)
+    lm = LocalMobility(0, 0, "regular", 0, red.rank) if mobility == 0 else \
+        LocalMobility(mobility, None, "not checked", None, None)
     if check_singular and mobility > 0:
         progress("singularity")
-        singular, finite, contours = _singularity(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
+        lm, contours = _local(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
     sv = red.singular_values
     return RankAnalysis(
         motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
         idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
-        actuated=anames, actuation_determined=determined, actuation_note=anote, singular=singular,
-        finite_mobility=finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
+        actuated=anames, actuation_determined=determined, actuation_note=anote,
+        singular=lm.configuration == "singular", shaky=lm.configuration == "shaky", configuration=lm.configuration,
+        mobility_reading=mobility_reading(lm.configuration, mobility, lm.finite), finite_mobility=lm.finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
         equations=lam * K, rank=red.rank, smallest_singular_values=sorted(float(x) for x in sv)[: min(4, len(sv))],
         near_singular=near, notes=notes,
     )
@@ -680,27 +654,56 @@ def _actuation(sysm: _System, N: np.ndarray, Z0: np.ndarray, acols: list[int], a
     return True, f"the drives at {', '.join(anames)} determine the motion"
 
 
-def _singularity(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, contours: list[ContourRank],
-                 notes: list[str], seed: int) -> tuple[bool, int | None, list[ContourRank]]:
-    """Singular when the rank at nearby assembled configurations is larger; the finite
-    mobility there, and the contours' reasons amended."""
+def _local(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, contours: list[ContourRank],
+           notes: list[str], seed: int) -> tuple[LocalMobility, list[ContourRank]]:
+    """Finite mobility and kind of configuration (:mod:`mechsyn.structure.finite`), with
+    the notes and the contours' reasons amended."""
     F, equations = sysm.twists.shape[0], sysm.lam * len(sysm.contours)
-    r_near, fnotes = _follow(sysm, N, tol, rank, seed=seed)
-    notes.extend(fnotes)
-    if r_near is None:
-        return False, None, contours
-    finite = F - r_near
-    if r_near == rank:
-        return False, finite, contours
-    notes.append(f"singular configuration: {N.shape[1]} instantaneous freedom(s) but {max(finite, 0)} "
-                 f"finite one(s) at nearby assembled configurations; away from it "
-                 f"{max(finite - idle, 0)} drive(s) and {equations - r_near} redundant constraint(s)")
+    if not sysm.contours:  # an open chain: every pair freedom is a finite motion
+        return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
+
+    def null(theta: np.ndarray) -> tuple[int, np.ndarray]:
+        red = _reduce(sysm, theta, tol)
+        return red.rank, red.null
+
+    lm = local_mobility(lambda th: _gauss_newton_step(sysm, th, tol), null, N, rank, tol, seed=seed)
+    notes.extend(lm.notes)
+    if lm.configuration in ("regular", "not followed") or lm.rank_nearby is None:
+        return lm, contours
+    r_near = lm.rank_nearby
+    notes.append(f"{lm.configuration} configuration: {N.shape[1]} instantaneous freedom(s) but {lm.finite} "
+                 f"finite one(s); at nearby assembled configurations {max(F - r_near - idle, 0)} drive(s) and "
+                 f"{equations - r_near} redundant constraint(s)")
+    if lm.configuration != "singular":
+        return lm, contours
     lead = "singular configuration (pairs lined up): "
     if equations - r_near == 0:
         lead += "every redundant constraint vanishes at nearby configurations"
-        return True, finite, [replace(c, reason=lead) if c.redundant else c for c in contours]
+        return lm, [replace(c, reason=lead) if c.redundant else c for c in contours]
     lead += f"{r_near - rank} redundant constraint(s) vanish at nearby configurations; otherwise "
-    return True, finite, [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
+    return lm, [replace(c, reason=lead + c.reason) if c.redundant else c for c in contours]
+
+
+def mobility_reading(configuration: str, instantaneous: int, finite: int | None) -> str:
+    """The kind of configuration in words: which of instantaneous / finite / singular /
+    shaky holds.
+
+    >>> mobility_reading("shaky", 2, 0)
+    'shaky: instantaneous mobility 2 but finite mobility 0 at a regular configuration (2 instantaneous motion(s) do not extend to finite ones; the configuration space is smooth here)'
+    """
+    if configuration == "not checked":
+        return f"instantaneous mobility {instantaneous}; the finite mobility was not checked"
+    if finite is None:
+        return f"instantaneous mobility {instantaneous}; the finite mobility is unknown (the motion could not be followed)"
+    if configuration == "regular":
+        return (f"regular: instantaneous mobility {instantaneous} = finite mobility {finite} (every instantaneous "
+                "motion extends to a finite one)")
+    if configuration == "singular":
+        return (f"singular: instantaneous mobility {instantaneous} but finite mobility {finite} (branches of the "
+                "motion meet here)")
+    return (f"shaky: instantaneous mobility {instantaneous} but finite mobility {finite} at a regular configuration "
+            f"({instantaneous - finite} instantaneous motion(s) do not extend to finite ones; the configuration "
+            "space is smooth here)")
 
 
 # --------------------------------------------------------------------------- report
@@ -717,11 +720,8 @@ def rank_summary_lines(ra: RankAnalysis) -> list[str]:
     ]
     for i in ra.idle_mobilities:
         lines.append(f"idle mobility: {i.description}")
-    if ra.singular:
-        lines.append(f"SINGULAR configuration: finite mobility nearby {ra.finite_mobility} "
-                     f"(instantaneous {ra.mobility})")
-    elif ra.finite_mobility is not None:
-        lines.append(f"not singular: finite mobility at nearby assembled configurations {ra.finite_mobility}")
+    if ra.mobility_reading:
+        lines.append(ra.mobility_reading[0].upper() + ra.mobility_reading[1:])
     return lines
 
 
