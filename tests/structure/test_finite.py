@@ -1,0 +1,120 @@
+"""Issue 25 item 3: finite (local) mobility, singular and shaky configurations.
+
+Expected values from the mechanisms' geometry, not from the program:
+- Bennett's linkage moves (Bennett 1903): finite mobility 1 although Malyshev gives -2;
+  with one axis tilted by 1 degree the 4R loop is generic and rigid (finite 0);
+- a change-point four-bar folded flat: instantaneous 2, two branches cross, finite 1,
+  singular;
+- a taut four-bar (crank + coupler + rocker = frame) stretched flat: its only assembly is
+  this one, so finite 0; instantaneous 2: shaky;
+- a four-bar with a straight dyad between two coupler points: finite 1 (Chebyshev),
+  instantaneous 2 at every pose: shaky (Müller 2016's permanently shaky linkages);
+- the Delta robot with its drives free: 3 translations + 6 bar spins, all finite: 9.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mechsyn.io import load_mechanism
+from mechsyn.structure.analysis import analyze_structure
+from mechsyn.structure.finite import local_mobility
+from mechsyn.structure.rank import analyze_rank
+
+EX = Path(__file__).resolve().parents[2] / "examples"
+SEEDS = (0, 1, 2)
+
+
+def load(rel: str):
+    return load_mechanism(EX / rel)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_bennett_moves_finitely(seed):
+    mech = load("textbook/bennett.yaml")
+    r = analyze_rank(mech, seed=seed)
+    assert analyze_structure(mech).formulas["malyshev"].value == -2
+    assert (r.mobility, r.finite_mobility, r.configuration) == (1, 1, "regular")
+    assert not r.singular and not r.shaky
+
+
+def test_bennett_with_one_axis_tilted_is_rigid():
+    r = analyze_rank(load("spatial/bennett_tilted.yaml"))
+    assert (r.mobility, r.finite_mobility, r.singular, r.shaky) == (0, 0, False, False)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_change_point_fourbar_folded_flat_is_singular(seed):
+    r = analyze_rank(load("textbook/fourbar_folded.yaml"), seed=seed)
+    assert (r.mobility, r.finite_mobility, r.configuration) == (2, 1, "singular")
+    assert r.singular and not r.shaky
+    assert r.mobility_reading.startswith("singular: instantaneous mobility 2 but finite mobility 1")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_taut_fourbar_is_shaky_and_finitely_rigid(seed):
+    mech = load("textbook/fourbar_taut.yaml")
+    r = analyze_rank(mech, seed=seed)
+    assert analyze_structure(mech).formulas["chebyshev"].value == 1
+    assert (r.mobility, r.finite_mobility, r.configuration) == (2, 0, "shaky")
+    assert r.shaky and not r.singular
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_straight_dyad_on_a_coupler_is_shaky(seed):
+    r = analyze_rank(load("textbook/fourbar_shaky_dyad.yaml"), seed=seed)
+    assert (r.mobility, r.finite_mobility, r.configuration) == (2, 1, "shaky")
+    assert "shaky: instantaneous mobility 2 but finite mobility 1" in r.mobility_reading
+
+
+def test_delta_finite_mobility_with_drives_free():
+    r = analyze_rank(load("textbook/delta.yaml"))
+    assert (r.mobility, r.useful_mobility, len(r.idle_mobilities)) == (9, 3, 6)
+    assert (r.finite_mobility, r.configuration) == (9, "regular")
+
+
+@pytest.mark.parametrize("rel", ["textbook/fourbar.yaml", "textbook/bennett_4dp.yaml", "textbook/sarrus.yaml",
+                                 "spatial/spherical_3rrr.yaml", "spatial/hooke_coupling_ru.yaml",
+                                 "structural/gough_stewart_6sps.yaml"])
+def test_ordinary_mechanisms_are_regular(rel):
+    r = analyze_rank(load(rel))
+    assert r.finite_mobility == r.mobility and r.configuration == "regular"
+
+
+def test_to_dict_says_which_reading_holds():
+    d = analyze_rank(load("textbook/fourbar_taut.yaml")).to_dict()
+    assert (d["finite_mobility"], d["singular"], d["shaky"], d["configuration"]) == (0, False, True, "shaky")
+    assert d["mobility_reading"].startswith("shaky: instantaneous mobility 2 but finite mobility 0")
+    d = analyze_rank(load("textbook/fourbar.yaml"), check_singular=False).to_dict()
+    assert d["finite_mobility"] is None and d["configuration"] == "not checked"
+
+
+def test_local_mobility_on_a_toy_system():
+    """Two constraints in the plane, ``y = x²`` and ``y = 0``, meet at the origin only; at
+    the origin the Jacobian has rank 1. Doubling the line (``y = 0`` twice) keeps the
+    whole line: finite 1, regular."""
+    import numpy as np
+
+    def make(rows):
+        def closure(t):
+            return np.array([f(t) for f, _ in rows]), np.array([g(t) for _, g in rows])
+
+        def step(t):
+            err, J = closure(t)
+            return err, np.linalg.lstsq(J, err, rcond=1e-9)[0]
+
+        def null(t):
+            _, s, vt = np.linalg.svd(closure(t)[1])
+            r = int(np.sum(s > 1e-6))
+            return r, vt[r:].T
+        return step, null
+
+    parabola = (lambda t: t[1] - t[0] ** 2, lambda t: [-2 * t[0], 1.0])
+    line = (lambda t: t[1], lambda t: [0.0, 1.0])
+    N = np.array([[1.0], [0.0]])
+    lm = local_mobility(*make([parabola, line]), N, 1, 1e-6)
+    assert (lm.finite, lm.configuration) == (0, "shaky")
+    lm = local_mobility(*make([line, line]), N, 1, 1e-6)
+    assert (lm.finite, lm.configuration) == (1, "regular")
