@@ -27,11 +27,12 @@ in radians):
    few samples decide.)
 2. Otherwise, ``m + 4`` directions are projected at ``ε/4``; those that stay away from
    ``θ0`` (``|θ - θ0| > 0.2 ε/4``) land on branches of ``V`` through ``θ0``. At up to three
-   landing points with the most different directions (generic, smooth points of their
-   branches) the same test gives the branch's dimension: ``dim ker M`` there when it is
-   regular, else the number of independent directions in which its own projected
-   neighbours lie (a smooth point's tangent space). The finite mobility is the largest.
-   No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility 0).
+   landing points ``θ_i`` with the most different directions (generic, smooth points of
+   their branches), steps ``η d`` with ``η = |θ_i|/8`` and ``d`` from ``ker M(θ0)`` are
+   projected again: the number of independent directions in which they land is the
+   branch's dimension (a smooth point's tangent space; this also holds where the
+   instantaneous mobility stays higher along the branch). The finite mobility is the
+   largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility 0).
 3. **Smooth or singular.** The tangent directions found (landing directions from ``θ0``
    and the branches' tangent spaces) span a space of dimension equal to the finite
    mobility exactly when the tangent cone is one linear space, i.e. ``V`` is a smooth
@@ -40,12 +41,12 @@ in radians):
    second branch the first samples missed. Branches crossing at less than about 17°
    can be taken for one.
 
-Tolerances: the Gauss-Newton target is ``max(1e-13, min(10 tol ε, (ε/20)²))`` with
+Tolerances: the Gauss-Newton target is ``max(1e-14, min(10 tol ε, (ε/1000)²))`` with
 ``tol`` the rank tolerance (relative to the length scale, see
 :mod:`mechsyn.structure.rank`): the closure error of coordinates rounded in the file is
-accepted, and a motion obstructed at second order (error growing as the square of the
-step) is still undone to within a twentieth of the step;
-``ρ`` below ``max(1e-6, 100 tol)`` counts as zero.
+accepted (an iteration that stalls below ``10 tol ε`` stops there), and a motion
+obstructed at second order (error growing as the square of the step) is undone to a
+thousandth of the step; ``ρ`` below ``max(1e-6, 100 tol)`` counts as zero.
 
 References
 ----------

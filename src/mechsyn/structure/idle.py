@@ -326,7 +326,7 @@ def find_idle_mobilities(inp: IdleInputs, tol: float) -> tuple[list[IdleMobility
         basis = np.concatenate([basis, z], axis=1)
     if truncated and basis.shape[1] < d:
         notes.append(f"idle motions of link groups larger than {MAX_GROUP_LINKS} links were not searched: "
-                     "family (b) (joint centres at rest) still counts them when they keep the centres at rest")
+                     "family (b) (frame's neighbours at rest, joint axes in place) still counts them when they keep to it")
 
     # -- family (b): the frame's neighbours at rest, joint axes in place, ball centres and
     # named points at rest, nothing transmitted through a higher pair, outputs in place

@@ -33,13 +33,14 @@ file gives (half a unit in the last decimal written, when coordinates are writte
 (Bennett's linkage, 4 decimals) is still recognised. Singular values between ``tol`` and
 ``1e-2`` are reported as a near-singularity.
 
-**Singularity check.** The configuration is followed numerically along a few random
-null-space directions (step ``0.05`` rad / ``0.05 L``, seeded), re-assembled by
-Gauss-Newton on the product-of-exponentials loop closure, and the rank recomputed at
-the nearby assembled configurations: if the rank there is larger, the given
-configuration is singular (instantaneous mobility > finite mobility). Higher pairs are
-followed as their instantaneously equivalent chain of lower pairs (the contact surfaces'
-curvature is not in the file).
+**Finite mobility.** The local dimension of the configuration space with every drive
+free (:mod:`mechsyn.structure.finite`): tangent steps projected back onto the loop
+closure (Gauss-Newton on the product-of-exponentials closure) at two shrinking scales
+tell whether every instantaneous motion extends to a finite one (a regular
+configuration); otherwise the branches through the configuration are found and measured,
+and the configuration is **singular** (branches meet) or **shaky** (smooth, with fewer
+finite than instantaneous freedoms). Higher pairs are followed as their instantaneously
+equivalent chain of lower pairs (the contact surfaces' curvature is not in the file).
 
 Pair twists and the linear algebra live in :mod:`mechsyn.structure.screws`, idle
 mobilities in :mod:`mechsyn.structure.idle`, the formulas side by side and the remedy
