@@ -86,7 +86,8 @@ class LocalMobility:
     ``"shaky"`` (smooth, instantaneous mobility above the finite one) or
     ``"not followed"`` (the projection did not converge; ``finite`` is None).
     ``tangent_span``: dimension of the span of the finite motions' directions;
-    ``rank_nearby``: rank of the loop-closure matrix at nearby assembled configurations.
+    ``rank_nearby``: rank of the loop-closure matrix at nearby assembled configurations
+    (None when there are none).
     """
 
     instantaneous: int
@@ -245,9 +246,7 @@ def local_mobility(step: Step, null: Null, N: np.ndarray, rank0: int, tol: float
         if failed:
             return LocalMobility(m, None, "not followed", None, None,
                                  ["the motion could not be followed numerically (closure did not converge)"])
-        return LocalMobility(m, 0, "shaky", 0, rank0 + m,
-                             [f"no assembled configuration near this one: the {m} instantaneous motion(s) "
-                              "do not extend to finite ones (finitely rigid)"])
+        return LocalMobility(m, 0, "shaky", 0, None)  # isolated: no assembly near it
     dims, dirs, ranks = [], [v / e for v in moved], []
     for i in _diverse(moved, 3):
         k, T, r = _branch(proj, null, moved[i], N, rng)

@@ -669,14 +669,18 @@ def _local(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, conto
 
     lm = local_mobility(lambda th: _gauss_newton_step(sysm, th, tol), null, N, rank, tol, seed=seed)
     notes.extend(lm.notes)
-    if lm.configuration in ("regular", "not followed") or lm.rank_nearby is None:
+    if lm.configuration in ("regular", "not followed"):
         return lm, contours
-    r_near = lm.rank_nearby
-    notes.append(f"{lm.configuration} configuration: {N.shape[1]} instantaneous freedom(s) but {lm.finite} "
-                 f"finite one(s); at nearby assembled configurations {max(F - r_near - idle, 0)} drive(s) and "
-                 f"{equations - r_near} redundant constraint(s)")
-    if lm.configuration != "singular":
+    m, r_near = N.shape[1], lm.rank_nearby or rank
+    if lm.configuration == "shaky":
+        notes.append(f"shaky configuration: {m} instantaneous freedom(s) but {lm.finite} finite one(s): "
+                     f"{m - lm.finite} instantaneous motion(s) that no finite motion follows"
+                     + (" (the pose is isolated: no other assembly near it)" if lm.finite == 0 else "")
+                     + "; no first-order stiffness holds them, so the linkage gives under load")
         return lm, contours
+    notes.append(f"singular configuration: {m} instantaneous freedom(s) but {lm.finite} finite one(s); at nearby "
+                 f"assembled configurations {max(F - r_near - idle, 0)} drive(s) and {equations - r_near} "
+                 "redundant constraint(s)")
     lead = "singular configuration (pairs lined up): "
     if equations - r_near == 0:
         lead += "every redundant constraint vanishes at nearby configurations"
