@@ -21,7 +21,7 @@ import pytest
 from mechsyn.io import load_mechanism
 from mechsyn.structure.analysis import analyze_structure
 from mechsyn.structure.finite import local_mobility
-from mechsyn.structure.rank import analyze_rank
+from mechsyn.structure.rank import analyze_rank, as_spatial
 
 EX = Path(__file__).resolve().parents[2] / "examples"
 SEEDS = (0, 1, 2)
@@ -67,6 +67,15 @@ def test_straight_dyad_on_a_coupler_is_shaky(seed):
     r = analyze_rank(load("textbook/fourbar_shaky_dyad.yaml"), seed=seed)
     assert (r.mobility, r.finite_mobility, r.configuration) == (2, 1, "shaky")
     assert "shaky: instantaneous mobility 2 but finite mobility 1" in r.mobility_reading
+
+
+@pytest.mark.parametrize("name, finite, configuration", [("fourbar_taut", 0, "shaky"),
+                                                         ("fourbar_folded", 1, "singular"),
+                                                         ("fourbar_shaky_dyad", 1, "shaky")])
+def test_the_same_readings_in_space(name, finite, configuration):
+    # the planar files seen in 3-D (R axes along z): six closure equations per contour
+    r = analyze_rank(as_spatial(load(f"textbook/{name}.yaml")))
+    assert (r.motion, r.mobility, r.finite_mobility, r.configuration) == ("spatial", 2, finite, configuration)
 
 
 def test_delta_finite_mobility_with_drives_free():
