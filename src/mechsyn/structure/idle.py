@@ -209,7 +209,7 @@ def _describe(links: list[str], joints: list[str], axis: dict[str, Any] | None, 
     if family == "cancelling":
         return f"joint rates of {', '.join(joints)} cancel: no link moves (coaxial or duplicated pairs)"
     if axis is None:
-        return (f"{who} turn with different twists, every joint axis in place and every ball centre at rest, "
+        return (f"{who} turn with different twists, each about its own joint axis (every joint axis in place), "
                 f"the links joined to the frame at rest{pairs}")
     together = "" if len(links) == 1 else " together as one body"
     if axis["point"] is None:
