@@ -154,3 +154,25 @@ def test_a_block_without_its_slide_is_refused_for_its_two_pins():
     d["joints"] = [j for j in d["joints"] if j["id"] != "S"]
     with pytest.raises(MechsynInputError, match="link 'block' has zero length"):
         mechanism_from_dict(d, "s.yaml")
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_spherical_fourbars_move_without_idle_motion(seed):
+    """Any four axes through one point make a spherical four-bar at a configuration: one
+    freedom, three redundant constraints, no idle motion, wherever on its axis each
+    joint's point is written."""
+    rng = np.random.default_rng(seed)
+    axes = rng.standard_normal((4, 3))
+    links = ["frame", "crank", "coupler", "rocker", "frame"]
+
+    def mech(points):
+        return mechanism_from_dict({"name": "sph", "kind": "spatial", "ground": "frame", "links": links[:4],
+                                    "joints": [{"id": f"J{k}", "type": "R", "links": links[k:k + 2],
+                                                "point": points[k].tolist(), "axis": axes[k].tolist()}
+                                               for k in range(4)]})
+
+    at_centre = analyze_rank(mech(np.zeros((4, 3))))
+    slid = analyze_rank(mech(axes * rng.uniform(-2, 2, (4, 1))), tol=at_centre.tolerance)
+    for r in (at_centre, slid):
+        assert counts(r) == (1, 3, 0)
+        assert (r.finite_mobility, r.configuration) == (1, "regular")
