@@ -518,6 +518,10 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     >>> ra = ms.analyze_rank(ms.examples.load("bennett"))    # mobile although Grübler says -2
     >>> ra.mobility, ra.redundant_constraints
     (1, 3)
+    >>> ra.finite_mobility, ra.configuration                # and the motion is finite
+    (1, 'regular')
+    >>> ms.analyze_rank(ms.examples.load("fourbar_taut")).mobility_reading[:53]
+    'shaky: instantaneous mobility 2 but finite mobility 0'
 
     A spatial RSSR linkage: two instantaneous freedoms, one of them the rod's idle spin
     between its ball joints, about the line B-C (direction (2, 1, 2.2) normalised).
@@ -725,8 +729,9 @@ def rank_summary_lines(ra: RankAnalysis) -> list[str]:
     ]
     for i in ra.idle_mobilities:
         lines.append(f"idle mobility: {i.description}")
-    if ra.mobility_reading:
-        lines.append(ra.mobility_reading[0].upper() + ra.mobility_reading[1:])
+    if ra.mobility_reading:  # "SINGULAR: ..." and "SHAKY: ..." stand out; "Regular: ..."
+        head, _, rest = ra.mobility_reading.partition(":")
+        lines.append((head.upper() if ra.singular or ra.shaky else head.capitalize()) + ":" + rest)
     return lines
 
 
