@@ -48,139 +48,15 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.analysis import PointMotion, resolve_points
-from mechsyn.kinematics.spatial_model import (SpatialModel, compile_spatial, convective, frame, jacobian,
-                                              measures, move, residual, wrap)
+from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
+from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["SpatialEngine", "simulate_spatial", "RANK_TOL", "CLOSURE_TOL"]
 
-#: A singular value below this fraction of the largest is a lost direction (rank decisions).
-RANK_TOL = 1e-8
-#: Residual (in units of the length scale) at which the corrector accepts a pose.
-NEWTON_TOL = 1e-12
 #: Largest residual of an accepted row that the result may carry (the issue's bound).
 CLOSURE_TOL = 1e-9
-MAX_HALVINGS = 12
-
-
-@dataclass
-class _Local:
-    """The Jacobian at a pose and its pseudo-inverse at rank ``r``."""
-
-    J: np.ndarray
-    U: np.ndarray
-    s: np.ndarray
-    Vt: np.ndarray
-    r: int
-
-    @property
-    def ratio(self) -> float:
-        """``r``-th singular value over the largest (0: the rank has dropped)."""
-        return float(self.s[self.r - 1] / self.s[0]) if self.r and len(self.s) >= self.r and self.s[0] > 0 else 0.0
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        r = self.r
-        return self.Vt[:r].T @ ((self.U[:, :r].T @ b) / self.s[:r])
-
-
-@dataclass
-class _State:
-    """An assembled pose: link poses, unwrapped H angles, the model's frame and Jacobian."""
-
-    R: np.ndarray
-    p: np.ndarray
-    href: np.ndarray
-    F: Any
-    lin: _Local
-    g: np.ndarray
-
-
-class _Tracker:
-    """Predictor-corrector continuation of one model (see the module doc)."""
-
-    def __init__(self, M: SpatialModel, rank: int | None = None) -> None:
-        self.M = M
-        self.m_c = M.n_constraints
-        self.rank = rank
-        self.halvings = 0
-
-    def local(self, F: Any) -> _Local:
-        J = jacobian(self.M, F)
-        U, s, Vt = np.linalg.svd(J, full_matrices=False)
-        if self.rank is None:
-            self.rank = int(np.count_nonzero(s > RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
-        return _Local(J, U, s, Vt, self.rank)
-
-    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> _State:
-        F = frame(self.M, R, p)
-        th, s = measures(self.M, R, p)
-        g = residual(self.M, F, th, s, href, target)
-        if self.M.helix:
-            ia = np.array([h[0] for h in self.M.helix])
-            href = href + wrap(th[ia] - href)
-        return _State(R, p, href, F, self.local(F), g)
-
-    def rates(self, st: _State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Twists of the links per ``du`` of the inputs (first and second derivatives)."""
-        b = np.zeros(len(st.g))
-        b[self.m_c:] = du
-        x1 = st.lin.solve(b)
-        x2 = st.lin.solve(-convective(self.M, st.F, x1))
-        return x1, x2
-
-    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, lin: _Local,
-                limit: float, chord: int = 8, full: int = 8) -> tuple[np.ndarray, np.ndarray] | None:
-        """Newton corrections (chord steps with ``lin``, then fresh Jacobians) to the pose
-        of the inputs ``target``; None when they fail or move further than ``limit``."""
-        moved = 0.0
-        last = np.inf
-        for it in range(chord + full):
-            F = frame(self.M, R, p)
-            th, s = measures(self.M, R, p)
-            g = residual(self.M, F, th, s, href, target)
-            err = float(np.abs(g).max(initial=0.0))
-            if err < NEWTON_TOL:
-                return R, p
-            if it >= chord or err > 0.5 * last:  # chord steps stalled: a fresh Jacobian
-                dx = -np.linalg.lstsq(jacobian(self.M, F), g, rcond=RANK_TOL)[0]
-            else:
-                dx = -lin.solve(g)
-            last = err
-            moved += float(np.abs(dx).max(initial=0.0))
-            if moved > limit:
-                return None
-            R, p = move(R, p, dx)
-        return None
-
-    def step(self, st: _State, du: np.ndarray, target: np.ndarray) -> _State | None:
-        x1, x2 = self.rates(st, du)
-        R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        size = float(np.abs(x1).max(initial=0.0))
-        out = self.correct(R, p, st.href, target, st.lin, limit=0.5 * size + 1e-9)
-        return None if out is None else self.state(*out, st.href, target)
-
-    def advance(self, st: _State, u0: np.ndarray, u1: np.ndarray) -> tuple[_State, bool, _State]:
-        """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble: (the state at
-        ``u1`` or the furthest reached, whether ``u1`` was reached, the last state)."""
-        t, h = 0.0, 1.0
-        while t < 1.0:
-            h = min(h, 1.0 - t)
-            nxt = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
-            if nxt is None:
-                if h < 0.5 ** MAX_HALVINGS:
-                    return st, False, st
-                h *= 0.5
-                self.halvings += 1
-                continue
-            st, t = nxt, t + h
-            h = min(1.0, 2 * h)
-        return st, True, st
-
-    def reassemble(self, st: _State, target: np.ndarray) -> _State | None:
-        """Newton from the last assembled pose at the inputs ``target`` (after a gap)."""
-        out = self.correct(st.R, st.p, st.href, target, st.lin, limit=np.inf, chord=0, full=30)
-        return None if out is None else self.state(*out, st.href, target)
 
 
 class SpatialEngine:
@@ -244,10 +120,10 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
     return U
 
 
-def _check_determined(M: SpatialModel, st: _State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
+def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
     """Refuse drives that leave a joint point or a named point free to move."""
     lin = st.lin
-    N = lin.Vt[lin.r:].T  # the motions with every drive at rest
+    N = lin.Vt[0, lin.r:].T  # the motions with every drive at rest
     if N.size == 0:
         return
     X = N.reshape(M.n, 6, -1)
@@ -285,15 +161,30 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
     """
     inputs = _check_inputs(mech, inputs)
     M = compile_spatial(mech, _drives(mech, inputs))
+    if M.n < SMALL_LINKS:  # BLAS does not thread matrices this small
+        return _simulate(mech, M, inputs, speeds, points, progress)
+    from threadpoolctl import threadpool_limits  # deferred: finding the BLAS costs more than a small sweep
+
+    with threadpool_limits(limits=1, user_api="blas"):  # many small SVDs: threads only contend
+        return _simulate(mech, M, inputs, speeds, points, progress)
+
+
+#: From this many moving links the sweep runs with one BLAS thread (its Jacobians are
+#: big enough for BLAS to start threads, which only slow the many small SVDs down).
+SMALL_LINKS = 5
+
+
+def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
+              points: list[str] | None, progress: Any) -> SpatialSimulation:
     if points is None and not mech.points:
         points = [j.id for j in mech.joints if j.point is not None]
     pts = resolve_points(mech, points)
     sp = np.array([float((speeds or {}).get(d[0], 1.0)) for d in M.drives])
     sp = np.where([d[1] == "slide" for d in M.drives], sp / M.scale, sp)
-    tr = _Tracker(M)
+    tr = Tracker(M)
     n = M.n
-    R0, p0 = np.tile(np.eye(3), (n + 1, 1, 1)), np.zeros((n + 1, 3))
-    start = tr.state(R0, p0, np.zeros(len(M.helix)), np.zeros(len(M.drives)))
+    R0, p0 = np.tile(np.eye(3), (1, n + 1, 1, 1)), np.zeros((1, n + 1, 3))
+    start = tr.state(R0, p0, np.zeros((1, len(M.helix))), np.zeros((1, len(M.drives))))
     _check_determined(M, start, pts)
     U = _input_matrix(M, inputs)
     rows = _sweep_rows(tr, start, U, sp, progress)
@@ -316,88 +207,55 @@ class _Rows:
     events: list
 
 
-def _empty_rows(M: SpatialModel, N: int) -> _Rows:
-    n = M.n
-    nan = np.nan
-    return _Rows(np.full((N, n, 3, 3), nan), np.full((N, n, 3), nan), np.full((N, 6 * n), nan),
-                 np.full((N, 6 * n), nan), np.zeros(N, bool), np.full(N, nan), np.full(N, nan),
-                 np.full((N, M.angles.size), nan), np.full((N, M.slides.size), nan), [])
-
-
-def _store(tr: _Tracker, out: _Rows, k: int, st: _State, sp: np.ndarray, U: np.ndarray) -> None:
-    M = tr.M
-    out.R[k], out.p[k] = st.R[:-1], st.p[:-1]
-    out.ok[k] = True
-    out.res[k] = float(np.abs(st.g[:tr.m_c]).max(initial=0.0))
-    out.ratio[k] = st.lin.ratio
-    th, s = measures(M, st.R, st.p)
-    out.theta[k], out.slide[k] = th, s
-    if st.lin.ratio < RANK_TOL:
-        out.events.append({"index": k, "kind": "singular", "input": _input_dict(M, U[k]),
-                           "message": f"singular configuration: the Jacobian's rank drops below {st.lin.r} "
-                                      f"(singular value ratio {st.lin.ratio:.2g}); rates not defined here (null)"})
-        return
-    x1, x2 = tr.rates(st, sp)
-    out.xi[k], out.xid[k] = x1, x2
-
-
 def _input_dict(M: SpatialModel, u: np.ndarray) -> dict[str, float]:
     return {jid: float(np.degrees(v)) if kind == "angle" else float(v * M.scale)
             for (jid, kind, _), v in zip(M.drives, u)}
 
 
-def _sweep_rows(tr: _Tracker, start: _State, U: np.ndarray, sp: np.ndarray, progress: Any) -> _Rows:
-    """Every row from the drawn assembly: to the nearest row, then outwards both ways."""
-    N = U.shape[0]
-    out = _empty_rows(tr.M, N)
-    k0 = int(np.argmin(np.abs(U).max(axis=1)))
-    zero = np.zeros(U.shape[1])
-    st, ok, _ = tr.advance(start, zero, U[k0])
-    if not ok:
-        out.events.append({"index": k0, "kind": "not assembled", "input": _input_dict(tr.M, U[k0]),
-                           "message": "the drawn assembly cannot be moved to this input (a dead point or a "
-                                      "singular configuration lies between)"})
-        if progress is not None:
-            progress(N)
-        return out
-    _store(tr, out, k0, st, sp, U)
-    for order in (range(k0 + 1, N), range(k0 - 1, -1, -1)):
-        _walk(tr, out, st, U, k0, list(order), sp)
+_MESSAGES = {
+    "not assembled": "the drawn assembly cannot be moved to this input (a dead point or a singular "
+                     "configuration lies between)",
+    "dead point": "a limit of the working range: the drive cannot reach this value from the previous row "
+                  "(singular value ratio {:.2g} where the continuation stopped)",
+    "reassembled": "assembles again after a gap (Newton from the last assembled pose; the assembly branch "
+                   "may differ from the drawn one)",
+}
+
+
+def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progress: Any) -> _Rows:
+    """Poses of every row by continuation from the drawn assembly, then the closure residual,
+    the rank test and the rates of all assembled rows at once."""
+    M = tr.M
+
+    def event(k: int, kind: str, detail: Any) -> dict:
+        return {"index": k, "kind": kind, "input": _input_dict(M, U[k]), "message": _MESSAGES[kind].format(detail)}
+
+    w = walk(tr, start, U, event)
+    N, n = len(U), M.n
+    out = _Rows(w.R[:, :-1], w.p[:, :-1], np.full((N, 6 * n), np.nan), np.full((N, 6 * n), np.nan), w.ok,
+                np.full(N, np.nan), np.full(N, np.nan), np.full((N, M.angles.size), np.nan),
+                np.full((N, M.slides.size), np.nan), w.events)
+    idx = np.flatnonzero(w.ok)
+    if len(idx):
+        st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
+        out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
+        out.ratio[idx] = st.lin.ratio
+        out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
+        x1, x2 = tr.rates(st, np.broadcast_to(sp, (len(idx), len(sp))))
+        regular = st.lin.ratio >= RANK_TOL
+        out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
+        for k, r in zip(idx[~regular], st.lin.ratio[~regular]):
+            out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, U[k]),
+                               "message": f"singular configuration: the Jacobian's rank drops below {st.lin.r} "
+                                          f"(singular value ratio {r:.2g}); rates not defined here (null)"})
+        out.events.sort(key=lambda e: e["index"])
     if progress is not None:
         progress(N)
-    out.events.sort(key=lambda e: e["index"])
     return out
 
 
-def _walk(tr: _Tracker, out: _Rows, st: _State, U: np.ndarray, k0: int, order: list[int],
-          sp: np.ndarray) -> None:
-    """Continue from row ``k0`` (state ``st``) through the rows of ``order``."""
-    prev, gap = k0, False
-    for k in order:
-        if gap:
-            nxt = tr.reassemble(st, U[k])
-            if nxt is None:
-                continue
-            out.events.append({"index": k, "kind": "reassembled", "input": _input_dict(tr.M, U[k]),
-                               "message": "assembles again after a gap (Newton from the last assembled pose; "
-                                          "the assembly branch may differ from the drawn one)"})
-            st, gap = nxt, False
-        else:
-            nxt, ok, last = tr.advance(st, U[prev], U[k])
-            if not ok:
-                out.events.append({"index": k, "kind": "dead point", "input": _input_dict(tr.M, U[k]),
-                                   "message": "a limit of the working range: the drive cannot reach this value "
-                                              f"from the previous row (singular value ratio "
-                                              f"{last.lin.ratio:.2g} where the continuation stopped)"})
-                st, gap = last, True
-                continue
-            st = nxt
-        _store(tr, out, k, st, sp, U)
-        prev = k
-
-
-def _result(mech: Mechanism, M: SpatialModel, tr: _Tracker, inputs: dict[str, np.ndarray], sp: np.ndarray,
-            pts: dict, U: np.ndarray, rows: _Rows, start: _State) -> SpatialSimulation:
+def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.ndarray], sp: np.ndarray,
+            pts: dict, U: np.ndarray, rows: _Rows, start: State) -> SpatialSimulation:
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok

@@ -47,7 +47,7 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -65,10 +65,16 @@ _EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
 _EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 
 
+_I1, _I2 = [1, 2, 0], [2, 0, 1]
+
+
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross product of (k, 3) arrays."""
-    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], axis=1)
+    """Cross product over the last axis (fewer NumPy calls than ``np.cross``)."""
+    return a[..., _I1] * b[..., _I2] - a[..., _I2] * b[..., _I1]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return (a * b).sum(axis=-1)
 
 
 def _rows(x: np.ndarray) -> np.ndarray:
@@ -124,6 +130,7 @@ class SpatialModel:
     slide_joints: tuple[str, ...]
     helix: tuple[tuple[int, int, float], ...]
     drives: tuple[tuple[str, str, int], ...]
+    lay: "_Layout | None" = None
 
     @property
     def n(self) -> int:
@@ -219,12 +226,83 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
             drive_rows.append((jid, "angle", rows["angle_joints"].index(jid)))
         else:
             drive_rows.append((jid, "slide", rows["slide_joints"].index(jid)))
-    return SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
-                        _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
-                        tuple(rows["slide_joints"]), helix, tuple(drive_rows))
+    M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
+                     _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
+                     tuple(rows["slide_joints"]), helix, tuple(drive_rows))
+    return replace(M, lay=_layout(M))
+
+
+# --------------------------------------------------------------------------- layout
+@dataclass(frozen=True, eq=False)
+class _Layout:
+    """Gather and scatter indices of the equations, built once per model: every link-fixed
+    point (``pidx``, ``ploc``) and vector (``vidx``, ``vloc``) transformed in one product,
+    every variable Jacobian entry written in one scatter (``ri``, ``ci``) over a template
+    holding the constant ones, the scalar rows' links (``sa``, ``sb``)."""
+
+    pidx: np.ndarray
+    ploc: np.ndarray
+    vidx: np.ndarray
+    vloc: np.ndarray
+    psl: dict
+    vsl: dict
+    J0: np.ndarray
+    ri: np.ndarray
+    ci: np.ndarray
+    h_ang: np.ndarray
+    h_sl: np.ndarray
+    h_pitch: np.ndarray
+    d_meas: np.ndarray
+    d_angle: np.ndarray
+
+
+def _slices(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, dict]:
+    sl, start = {}, 0
+    for name, idx, _ in parts:
+        sl[name] = slice(start, start + len(idx))
+        start += len(idx)
+    idx = np.concatenate([p[1] for p in parts]).astype(int)
+    loc = np.concatenate([p[2].reshape(-1, 3) for p in parts])
+    return idx, loc, sl
+
+
+def _layout(M: SpatialModel) -> _Layout:
+    pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
+    pidx, ploc, psl = _slices([("xa", pc.ia, pc.va), ("xb", pc.ib, pc.vb), ("la", ln.ia, ln.va),
+                               ("lb", ln.ib, ln.vb), ("sa", sl.ia, sl.va), ("sb", sl.ib, sl.vb)])
+    vidx, vloc, vsl = _slices([("u", dt.ia, dt.va), ("w", dt.ib, dt.vb), ("ln", ln.ia, ln.n),
+                               ("aa", an.ia, an.va), ("e1b", an.ib, an.vb), ("e1a", an.ia, an.n),
+                               ("e2a", an.ia, an.m), ("sn", sl.ia, sl.n)])
+    n, k = M.n, pc.size
+    m = M.n_constraints + len(M.drives)
+    J0 = np.zeros((m, 6 * (n + 1)))
+    rows = np.arange(3 * k).reshape(k, 3)
+    ar = np.arange(3)
+    J0[rows, 6 * pc.ia[:, None] + 3 + ar] = 1.0
+    J0[rows, 6 * pc.ib[:, None] + 3 + ar] = -1.0
+    ri, ci = [], []
+    for links in (pc.ia, pc.ib):  # the 3 x 3 blocks d(x)/dω of the coincidences
+        ri.append(np.broadcast_to(rows[:, :, None], (k, 3, 3)).ravel())
+        ci.append(np.broadcast_to((6 * links[:, None] + ar)[:, None, :], (k, 3, 3)).ravel())
+    h = np.array(M.helix, float).reshape(-1, 3)
+    d_angle = np.array([kind == "angle" for _, kind, _ in M.drives], bool)
+    d_meas = np.array([kk if kind == "angle" else an.size + kk for _, kind, kk in M.drives], int)
+    d_links = [(an.ia[kk], an.ib[kk]) if kind == "angle" else (sl.ia[kk], sl.ib[kk]) for _, kind, kk in M.drives]
+    h_sl = h[:, 1].astype(int)
+    sa = np.concatenate([dt.ia, ln.ia, sl.ia[h_sl], [a for a, _ in d_links]]).astype(int)
+    sb = np.concatenate([dt.ib, ln.ib, sl.ib[h_sl], [b for _, b in d_links]]).astype(int)
+    srow = 3 * k + np.arange(len(sa))
+    for links in (sa, sb, sa, sb):  # c at a, -c at b, -n at a, +n at b
+        ri.append(np.repeat(srow, 3))
+        ci.append((6 * links[:, None] + ar).ravel())
+    ci[-2:] = [c + 3 for c in ci[-2:]]
+    return _Layout(pidx, ploc, vidx, vloc, psl, vsl, J0, np.concatenate(ri), np.concatenate(ci),
+                   h[:, 0].astype(int), h[:, 1].astype(int), h[:, 2], d_meas, d_angle)
 
 
 # --------------------------------------------------------------------------- poses
+# Every function below works on a batch of B poses at once: rotations R (B, n + 1, 3, 3),
+# positions p (B, n + 1, 3) (the frame last, at rest), twists (B, 6 n), targets (B, drives).
 def exp_twists(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rotations ``E`` (k, 3, 3) and translations ``t`` (k, 3) of ``exp`` of the twists
     ``x`` (k, 6) = ``(ω, v)``: the displacement ``y = E y + t`` (Murray et al. [2]_, eq. 2.36).
@@ -232,36 +310,37 @@ def exp_twists(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Examples
     --------
     >>> E, t = exp_twists(np.array([[0, 0, np.pi / 2, 1.0, 0, 0]]))
-    >>> np.round(E[0] @ [1.0, 0, 0], 12).tolist(), np.round(t[0], 12).tolist()
+    >>> np.round(E[0] @ [1.0, 0, 0], 12).tolist(), np.round(t[0], 6).tolist()
     ([0.0, 1.0, 0.0], [0.63662, 0.63662, 0.0])
     """
     w, v = x[:, :3], x[:, 3:]
-    th = np.sqrt(np.einsum("ij,ij->i", w, w))
-    K = np.einsum("ijk,nk->nij", -_EPS, w)
+    th2 = (w * w).sum(axis=1)
+    th = np.sqrt(th2)
+    K = np.zeros((len(x), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
     K2 = K @ K
-    small = th < 1e-8
+    a = np.sinc(th / np.pi)                       # sin θ / θ
+    b = 0.5 * np.sinc(th / (2 * np.pi)) ** 2      # (1 - cos θ) / θ²
+    small = th < 1e-2
     ths = np.where(small, 1.0, th)
-    a = np.where(small, 1.0 - th ** 2 / 6, np.sin(ths) / ths)
-    b = np.where(small, 0.5 - th ** 2 / 24, (1 - np.cos(ths)) / ths ** 2)
-    c = np.where(small, 1.0 / 6 - th ** 2 / 120, (ths - np.sin(ths)) / ths ** 3)
-    eye = np.eye(3)
-    E = eye + a[:, None, None] * K + b[:, None, None] * K2
-    V = eye + b[:, None, None] * K + c[:, None, None] * K2
-    return E, np.einsum("nij,nj->ni", V, v)
+    c = np.where(small, 1.0 / 6 - th2 / 120 + th2 * th2 / 5040, (ths - np.sin(ths)) / ths ** 3)
+    E = K * a[:, None, None] + K2 * b[:, None, None]
+    V = K * b[:, None, None] + K2 * c[:, None, None]
+    E[:, [0, 1, 2], [0, 1, 2]] += 1.0
+    t = v + (V @ v[:, :, None])[:, :, 0]
+    return E, t
 
 
 def move(R: np.ndarray, p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Poses ``(R, p)`` of all links (frame last) displaced by the twists ``x`` (6 n,)."""
+    """Poses ``(R, p)`` displaced by the twists ``x`` (B, 6 n) of the moving links."""
+    B, n1 = p.shape[:2]
     E, t = exp_twists(x.reshape(-1, 6))
+    E = E.reshape(B, n1 - 1, 3, 3)
     R2, p2 = R.copy(), p.copy()
-    R2[:-1] = E @ R[:-1]
-    p2[:-1] = np.einsum("nij,nj->ni", E, p[:-1]) + t
+    R2[:, :-1] = E @ R[:, :-1]
+    p2[:, :-1] = (E @ p[:, :-1, :, None])[..., 0] + t.reshape(B, n1 - 1, 3)
     return R2, p2
-
-
-def _apply(R: np.ndarray, p: np.ndarray | None, idx: np.ndarray, v: np.ndarray) -> np.ndarray:
-    out = np.einsum("kij,kj->ki", R[idx], v)
-    return out if p is None else out + p[idx]
 
 
 def wrap(a: np.ndarray) -> np.ndarray:
@@ -269,152 +348,114 @@ def wrap(a: np.ndarray) -> np.ndarray:
     return np.pi - np.mod(np.pi - a, 2 * np.pi)
 
 
-def measures(M: SpatialModel, R: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation angles (rad, in (-π, π], from the drawn assembly) of ``M.angle_joints``
-    and slides (model units) of ``M.slide_joints``."""
-    A, S = M.angles, M.slides
-    e1b = _apply(R, None, A.ib, A.vb)
-    th = np.arctan2(np.einsum("ij,ij->i", e1b, _apply(R, None, A.ia, A.m)),
-                    np.einsum("ij,ij->i", e1b, _apply(R, None, A.ia, A.n)))
-    d = _apply(R, p, S.ib, S.vb) - _apply(R, p, S.ia, S.va)
-    s = np.einsum("ij,ij->i", d, _apply(R, None, S.ia, S.n))
-    return th, s
-
-
-# --------------------------------------------------------------------------- equations
-@dataclass
 class Frame:
-    """World coordinates of the model's link-fixed points and vectors at one pose."""
+    """World coordinates of the model's link-fixed points and vectors at poses ``(R, p)``,
+    and the pairs' rotations ``theta`` (rad, from the drawn assembly, in (-π, π]) and slides
+    ``s`` (model units), each with the batch axis first. Attributes are views of two arrays
+    (see :class:`_Layout`)."""
 
-    xa: np.ndarray    # coincidences
-    xb: np.ndarray
-    u: np.ndarray     # dot
-    w: np.ndarray
-    la: np.ndarray    # line
-    lb: np.ndarray
-    ln: np.ndarray
-    aa: np.ndarray    # angle axes
-    sa: np.ndarray    # slides
-    sb: np.ndarray
-    sn: np.ndarray
+    def __init__(self, M: SpatialModel, R: np.ndarray, p: np.ndarray) -> None:
+        lay = M.lay
+        P = (R[:, lay.pidx] @ lay.ploc[:, :, None])[..., 0] + p[:, lay.pidx]
+        V = (R[:, lay.vidx] @ lay.vloc[:, :, None])[..., 0]
+        for name, sl in lay.psl.items():
+            setattr(self, name, P[:, sl])
+        for name, sl in lay.vsl.items():
+            setattr(self, name, V[:, sl])
+        self.theta = np.arctan2(_dot(self.e1b, self.e2a), _dot(self.e1b, self.e1a))
+        self.s = _dot(self.sb - self.sa, self.sn)
+
+    def take(self, idx: np.ndarray) -> "Frame":
+        """The frame of the poses ``idx`` of the batch."""
+        out = object.__new__(Frame)
+        out.__dict__.update({k: v[idx] for k, v in vars(self).items()})
+        return out
 
 
 def frame(M: SpatialModel, R: np.ndarray, p: np.ndarray) -> Frame:
-    """The model's points and vectors at poses ``(R, p)``."""
-    pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
-    return Frame(_apply(R, p, pc.ia, pc.va), _apply(R, p, pc.ib, pc.vb), _apply(R, None, dt.ia, dt.va),
-                 _apply(R, None, dt.ib, dt.vb), _apply(R, p, ln.ia, ln.va), _apply(R, p, ln.ib, ln.vb),
-                 _apply(R, None, ln.ia, ln.n), _apply(R, None, an.ia, an.va), _apply(R, p, sl.ia, sl.va),
-                 _apply(R, p, sl.ib, sl.vb), _apply(R, None, sl.ia, sl.n))
+    """The model's points, vectors and pair coordinates at poses ``(R, p)``."""
+    return Frame(M, R, p)
 
 
-def residual(M: SpatialModel, F: Frame, theta: np.ndarray, s: np.ndarray, helix_ref: np.ndarray,
-             target: np.ndarray) -> np.ndarray:
-    """Residuals of the constraint equations, then of the drives (``target``: input values,
-    rad or model units). ``helix_ref``: the H pairs' unwrapped angles at the previous pose."""
-    parts = [(F.xa - F.xb).ravel(), np.einsum("ij,ij->i", F.u, F.w) - M.dot.c0,
-             np.einsum("ij,ij->i", F.lb - F.la, F.ln) - M.line.c0]
+# --------------------------------------------------------------------------- equations
+def helix_angles(M: SpatialModel, F: Frame, helix_ref: np.ndarray) -> np.ndarray:
+    """The H pairs' rotations unwrapped next to ``helix_ref`` (their previous values)."""
+    return helix_ref + wrap(F.theta[:, M.lay.h_ang] - helix_ref)
+
+
+def residual(M: SpatialModel, F: Frame, helix_ref: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Residuals (B, m) of the constraint equations, then of the drives (``target``: input
+    values, rad or model units). ``helix_ref``: the H pairs' unwrapped angles before."""
+    lay = M.lay
+    B = len(target)
+    d = np.concatenate([F.theta, F.s], axis=1)[:, lay.d_meas] - target
+    d[:, lay.d_angle] = wrap(d[:, lay.d_angle])
+    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0]
     if M.helix:
-        ia, isl, h = (np.array(c) for c in zip(*M.helix))
-        th = helix_ref + wrap(theta[ia] - helix_ref)
-        parts.append(s[isl] - h * th)
-    drive = [wrap(theta[k] - u) if kind == "angle" else s[k] - u for (_, kind, k), u in zip(M.drives, target)]
-    parts.append(np.array(drive, float))
-    return np.concatenate(parts)
+        parts.append(F.s[:, lay.h_sl] - lay.h_pitch * helix_angles(M, F, helix_ref))
+    parts.append(d)
+    return np.concatenate(parts, axis=1)
+
+
+def _scalar_coefficients(M: SpatialModel, F: Frame) -> tuple[np.ndarray, np.ndarray]:
+    """``c`` and ``n`` of the scalar rows, each ``c · (ω_a - ω_b) + n · (v_b - v_a)``."""
+    lay = M.lay
+    c_slide = _cross(F.sn, F.sb)
+    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb)]
+    ns = [np.zeros_like(F.u), F.ln]
+    if M.helix:
+        cs.append(c_slide[:, lay.h_sl] + lay.h_pitch[:, None] * F.aa[:, lay.h_ang])
+        ns.append(F.sn[:, lay.h_sl])
+    if M.drives:
+        cs.append(np.concatenate([-F.aa, c_slide], axis=1)[:, lay.d_meas])
+        ns.append(np.concatenate([np.zeros_like(F.aa), F.sn], axis=1)[:, lay.d_meas])
+    return np.concatenate(cs, axis=1), np.concatenate(ns, axis=1)
 
 
 def jacobian(M: SpatialModel, F: Frame) -> np.ndarray:
-    """Jacobian of :func:`residual` in the links' twists ``(ω_i, v_i)`` (columns ``6 i .. 6 i + 5``)."""
-    n = M.n
-    J = np.zeros((M.n_constraints + len(M.drives), 6 * (n + 1)))
-    r = 0
-    k = M.pc.size
-    if k:
-        rows = r + np.arange(3 * k).reshape(k, 3)
-        for links, x, sign in ((M.pc.ia, F.xa, 1.0), (M.pc.ib, F.xb, -1.0)):
-            cols = 6 * links[:, None] + np.arange(3)
-            # d(x)/dω = -[x]x, the matrix of y -> y x x
-            J[rows[:, :, None], cols[:, None, :]] = sign * np.einsum("ijk,nk->nij", _EPS, x)
-            J[rows[:, :, None], cols[:, None, :] + 3] = sign * np.eye(3)
-        r += 3 * k
-    r = _scalar_rows(J, r, M.dot.ia, M.dot.ib, _cross(F.u, F.w), None)
-    r = _scalar_rows(J, r, M.line.ia, M.line.ib, _cross(F.ln, F.lb), F.ln)
-    for ia_, isl, h in M.helix:
-        J[r] = _slide_row(M, F, isl, n) - h * _angle_row(M, F, ia_, n)
-        r += 1
-    for _, kind, k in M.drives:
-        J[r] = _angle_row(M, F, k, n) if kind == "angle" else _slide_row(M, F, k, n)
-        r += 1
-    return J[:, :6 * n]
-
-
-def _scalar_rows(J: np.ndarray, r: int, ia: np.ndarray, ib: np.ndarray, c: np.ndarray,
-                 nv: np.ndarray | None) -> int:
-    """Rows ``c · (ω_a - ω_b) + n · (v_b - v_a)`` (the dot and line kinds)."""
-    k = len(ia)
-    if not k:
-        return r
-    rows = (r + np.arange(k))[:, None]
-    ar = np.arange(3)
-    J[rows, 6 * ia[:, None] + ar] += c
-    J[rows, 6 * ib[:, None] + ar] -= c
-    if nv is not None:
-        J[rows, 6 * ia[:, None] + 3 + ar] -= nv
-        J[rows, 6 * ib[:, None] + 3 + ar] += nv
-    return r + k
-
-
-def _angle_row(M: SpatialModel, F: Frame, k: int, n: int) -> np.ndarray:
-    row = np.zeros(6 * (n + 1))
-    a = F.aa[k]
-    row[6 * M.angles.ib[k]:6 * M.angles.ib[k] + 3] += a
-    row[6 * M.angles.ia[k]:6 * M.angles.ia[k] + 3] -= a
-    return row
-
-
-def _slide_row(M: SpatialModel, F: Frame, k: int, n: int) -> np.ndarray:
-    row = np.zeros(6 * (n + 1))
-    a, b = 6 * M.slides.ia[k], 6 * M.slides.ib[k]
-    c = np.cross(F.sn[k], F.sb[k])
-    row[a:a + 3] += c
-    row[b:b + 3] -= c
-    row[a + 3:a + 6] -= F.sn[k]
-    row[b + 3:b + 6] += F.sn[k]
-    return row
+    """Jacobians (B, m, 6 n) of :func:`residual` in the links' twists ``(ω_i, v_i)``
+    (columns ``6 i .. 6 i + 5``)."""
+    lay = M.lay
+    B = F.xa.shape[0]
+    J = np.repeat(lay.J0[None], B, axis=0)
+    c, nv = _scalar_coefficients(M, F)
+    # d(x)/dω = -[x]x, the matrix of y -> y x x: ε_ijk x_k
+    Sa = np.einsum("ijk,bnk->bnij", _EPS, F.xa)
+    Sb = np.einsum("ijk,bnk->bnij", _EPS, F.xb)
+    J[:, lay.ri, lay.ci] = np.concatenate([Sa.reshape(B, -1), -Sb.reshape(B, -1), c.reshape(B, -1),
+                                           -c.reshape(B, -1), -nv.reshape(B, -1), nv.reshape(B, -1)], axis=1)
+    return J[:, :, :6 * M.n]
 
 
 def convective(M: SpatialModel, F: Frame, xi: np.ndarray) -> np.ndarray:
-    """``γ``: the second time derivative of every residual at the twists ``xi`` (6 n,)
-    with ``ξ̇ = 0``, so that the accelerations solve ``J ξ̇ = ü - γ``."""
-    X = np.vstack([xi.reshape(-1, 6), np.zeros((1, 6))])
-    w, v = X[:, :3], X[:, 3:]
-
-    def vel(idx: np.ndarray, x: np.ndarray) -> np.ndarray:
-        return v[idx] + _cross(w[idx], x)
-
+    """``γ`` (B, m): the second time derivative of every residual at the twists ``xi``
+    (B, 6 n) with ``ξ̇ = 0``, so that the accelerations solve ``J ξ̇ = ü - γ``."""
+    lay = M.lay
+    B = xi.shape[0]
+    X = np.zeros((B, M.n + 1, 6))
+    X[:, :-1] = xi.reshape(B, -1, 6)
+    w, v = X[..., :3], X[..., 3:]
     pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
-    g_pc = _cross(w[pc.ia], vel(pc.ia, F.xa)) - _cross(w[pc.ib], vel(pc.ib, F.xb))
-    wa, wb = w[dt.ia], w[dt.ib]
+    wa, wb = w[:, pc.ia], w[:, pc.ib]
+    g_pc = _cross(wa, v[:, pc.ia] + _cross(wa, F.xa)) - _cross(wb, v[:, pc.ib] + _cross(wb, F.xb))
+    wa, wb = w[:, dt.ia], w[:, dt.ib]
     ud, wd = _cross(wa, F.u), _cross(wb, F.w)
-    g_dot = (np.einsum("ij,ij->i", _cross(wa, ud), F.w) + 2 * np.einsum("ij,ij->i", ud, wd)
-             + np.einsum("ij,ij->i", F.u, _cross(wb, wd)))
-    g_line = _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln)
-    g_slide = _line_gamma(w, v, sl.ia, sl.ib, F.sa, F.sb, F.sn)
-    g_angle = np.einsum("ij,ij->i", w[an.ib] - w[an.ia], _cross(w[an.ia], F.aa))
-    parts = [g_pc.ravel(), g_dot, g_line]
-    if M.helix:
-        parts.append(np.array([g_slide[isl] - h * g_angle[ia_] for ia_, isl, h in M.helix]))
-    parts.append(np.array([g_angle[k] if kind == "angle" else g_slide[k] for _, kind, k in M.drives], float))
-    return np.concatenate(parts)
+    g_dot = _dot(_cross(wa, ud), F.w) + 2 * _dot(ud, wd) + _dot(F.u, _cross(wb, wd))
+    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln)]
+    if M.helix or M.drives:
+        g_slide = _line_gamma(w, v, sl.ia, sl.ib, F.sa, F.sb, F.sn)
+        g_angle = _dot(w[:, an.ib] - w[:, an.ia], _cross(w[:, an.ia], F.aa))
+        if M.helix:
+            parts.append(g_slide[:, lay.h_sl] - lay.h_pitch * g_angle[:, lay.h_ang])
+        parts.append(np.concatenate([g_angle, g_slide], axis=1)[:, lay.d_meas])
+    return np.concatenate(parts, axis=1)
 
 
 def _line_gamma(w: np.ndarray, v: np.ndarray, ia: np.ndarray, ib: np.ndarray, xa: np.ndarray,
                 xb: np.ndarray, nv: np.ndarray) -> np.ndarray:
     """``γ`` of ``(x_b - x_a) · n_a``."""
-    wa, wb = w[ia], w[ib]
-    va, vb = v[ia] + _cross(wa, xa), v[ib] + _cross(wb, xb)
-    dd = vb - va
-    ddd = _cross(wb, vb) - _cross(wa, va)
+    wa, wb = w[:, ia], w[:, ib]
+    va, vb = v[:, ia] + _cross(wa, xa), v[:, ib] + _cross(wb, xb)
     nd = _cross(wa, nv)
-    return (np.einsum("ij,ij->i", ddd, nv) + 2 * np.einsum("ij,ij->i", dd, nd)
-            + np.einsum("ij,ij->i", xb - xa, _cross(wa, nd)))
+    return (_dot(_cross(wb, vb) - _cross(wa, va), nv) + 2 * _dot(vb - va, nd)
+            + _dot(xb - xa, _cross(wa, nd)))

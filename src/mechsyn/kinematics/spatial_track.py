@@ -1,0 +1,299 @@
+"""Continuation of a spatial mechanism's poses over a sweep (used by
+:mod:`mechsyn.kinematics.spatial`; the equations are :mod:`mechsyn.kinematics.spatial_model`).
+
+The walk goes outwards from the drawn assembly along the sweep's rows. It moves from one
+*anchor* row to the next by a second-order predictor (the twists' first and second
+derivatives along the input step, through the exponential of a twist) and Newton
+corrections ``δξ = -J⁺ g`` (the pseudo-inverse at the regular rank ``r``: least-squares for
+redundant constraints, minimum-norm for idle motions). A step is refused when the
+corrector fails or moves the links further than half the predictor did (a jump to another
+branch); then the stride is halved, down to a single row and then to ``1/4096`` of a row.
+The stride doubles after easy steps while the predictor's step stays under
+``MAX_STEP`` (radians, or lengths in units of the length scale), so the Taylor predictor
+stays accurate. The rows between anchors are then predicted from the anchor before them
+and corrected all at once (one batch of Newton steps over every row), each with the same
+branch guard; a row the batch cannot settle is walked to on its own from the row before.
+
+References
+----------
+.. [1] E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*, SIAM,
+   2003, ch. 2 and 6 (predictor-corrector continuation, step-length control).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mechsyn.kinematics.spatial_model import (SpatialModel, convective, frame, helix_angles, jacobian, move,
+                                              residual)
+
+__all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
+
+#: A singular value below this fraction of the largest is a lost direction (rank decisions).
+RANK_TOL = 1e-8
+#: Residual (in units of the length scale) at which the corrector accepts a pose.
+NEWTON_TOL = 1e-12
+#: Largest predictor step between anchors (radians; lengths in units of the length scale).
+MAX_STEP = 0.25
+MAX_HALVINGS = 12
+MAX_STRIDE = 64
+
+
+@dataclass
+class Lin:
+    """Jacobians (B, m, 6 n) at B poses and their pseudo-inverses at rank ``r``."""
+
+    U: np.ndarray
+    s: np.ndarray
+    Vt: np.ndarray
+    r: int
+
+    @property
+    def ratio(self) -> np.ndarray:
+        """``r``-th singular value over the largest, per pose (0: the rank has dropped)."""
+        if self.r == 0:
+            return np.ones(len(self.s))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.nan_to_num(self.s[:, self.r - 1] / self.s[:, 0])
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        r = self.r
+        c = np.einsum("bmk,bm->bk", self.U[:, :, :r], b) / self.s[:, :r]
+        return np.einsum("bkj,bk->bj", self.Vt[:, :r], c)
+
+    def take(self, idx: np.ndarray) -> "Lin":
+        return Lin(self.U[idx], self.s[idx], self.Vt[idx], self.r)
+
+
+@dataclass
+class State:
+    """B assembled poses: link poses, unwrapped H angles, frame, linearisation, residuals."""
+
+    R: np.ndarray
+    p: np.ndarray
+    href: np.ndarray
+    F: Any
+    lin: Lin
+    g: np.ndarray
+
+    def take(self, idx: Any) -> "State":
+        idx = np.atleast_1d(idx)
+        return State(self.R[idx], self.p[idx], self.href[idx], None, self.lin.take(idx), self.g[idx])
+
+
+class Tracker:
+    """Predictor-corrector continuation of one model (see the module doc)."""
+
+    def __init__(self, M: SpatialModel) -> None:
+        self.M = M
+        self.m_c = M.n_constraints
+        self.rank: int | None = None
+        self.halvings = 0
+
+    def lin(self, J: np.ndarray) -> Lin:
+        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+        if self.rank is None:  # the regular rank: at the drawn assembly
+            s0 = s[0]
+            self.rank = int(np.count_nonzero(s0 > RANK_TOL * s0[0])) if s0.size and s0[0] > 0 else 0
+        return Lin(U, s, Vt, self.rank)
+
+    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
+        F = frame(self.M, R, p)
+        g = residual(self.M, F, href, target)
+        if self.M.helix:
+            href = helix_angles(self.M, F, href)
+        return State(R, p, href, F, self.lin(jacobian(self.M, F)), g)
+
+    def rates(self, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
+        derivatives (``J ξ' = du``, ``J ξ'' = -γ(ξ')``)."""
+        F = st.F if st.F is not None else frame(self.M, st.R, st.p)
+        b = np.zeros(st.g.shape)
+        b[:, self.m_c:] = du
+        x1 = st.lin.solve(b)
+        return x1, st.lin.solve(-convective(self.M, F, x1))
+
+    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
+                limit: np.ndarray, iters: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Newton corrections of B poses to the inputs ``target``: the poses and a mask of
+        those that converged without moving further than ``limit``. The Jacobian of the
+        first iterate is kept while the residuals fall at least tenfold per step (the
+        predictor lands close, so that is most steps) and taken afresh otherwise."""
+        B = len(R)
+        moved = np.zeros(B)
+        done = np.zeros(B, bool)
+        failed = np.zeros(B, bool)
+        lin, rows, last = None, None, np.full(B, np.inf)
+        for it in range(iters):
+            F = frame(self.M, R, p)
+            g = residual(self.M, F, href, target)
+            err = np.abs(g).max(axis=1)
+            done |= err < NEWTON_TOL
+            if it >= 10:  # no longer converging: give up on those
+                failed |= ~done & (err > 0.5 * last)
+            active = ~done & ~failed
+            if not active.any():
+                break
+            idx = np.flatnonzero(active)
+            if lin is None or np.any(err[idx] > 0.1 * last[idx]) or not np.isin(idx, rows).all():
+                lin, rows = self.lin(jacobian(self.M, F.take(idx))), idx
+            last = err
+            dx = np.zeros((B, 6 * self.M.n))
+            dx[idx] = -lin.take(np.searchsorted(rows, idx)).solve(g[idx])
+            moved += np.abs(dx).max(axis=1)
+            failed |= moved > limit
+            dx[failed] = 0.0
+            R, p = move(R, p, dx)
+        return R, p, done & ~failed
+
+    def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
+        """One predictor-corrector step of a single pose; (the new state or None, the
+        predictor's step size)."""
+        x1, x2 = self.rates(st, du[None])
+        R, p = move(st.R, st.p, x1 + 0.5 * x2)
+        size = float(np.abs(x1).max(initial=0.0))
+        R, p, ok = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        return (self.state(R, p, st.href, target[None]) if ok[0] else None), size
+
+    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+        """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
+        ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
+        t, h = 0.0, 1.0
+        while t < 1.0:
+            h = min(h, 1.0 - t)
+            nxt, _ = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
+            if nxt is None:
+                if h < 0.5 ** MAX_HALVINGS:
+                    return None
+                h *= 0.5
+                self.halvings += 1
+                continue
+            st, t = nxt, t + h
+            h = min(1.0, 2 * h)
+        return st
+
+    def reassemble(self, st: State, U: np.ndarray, rows: np.ndarray) -> tuple[int, State] | None:
+        """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges,
+        and its state; all rows tried in one batch."""
+        B = len(rows)
+        rep = np.zeros(B, int)
+        R, p, ok = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
+        if not ok.any():
+            return None
+        j = int(np.argmax(ok))
+        return int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None])
+
+
+# --------------------------------------------------------------------------- the walk
+@dataclass
+class Walk:
+    """Poses of every row (NaN where not reached) and the events met on the way."""
+
+    R: np.ndarray
+    p: np.ndarray
+    href: np.ndarray
+    ok: np.ndarray
+    events: list
+
+    def put(self, k: int | np.ndarray, st: State) -> None:
+        self.R[k], self.p[k], self.href[k] = st.R, st.p, st.href
+        self.ok[k] = True
+
+    def at(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.R[k:k + 1], self.p[k:k + 1], self.href[k:k + 1]
+
+
+def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
+    """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
+    inputs): to the row nearest it, then outwards both ways (anchors, then the rows between
+    them in one batch). ``event(index, kind, detail)`` makes the event dicts."""
+    M = tr.M
+    N = len(U)
+    w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
+             np.zeros((N, len(M.helix))), np.zeros(N, bool), [])
+    k0 = int(np.argmin(np.abs(U).max(axis=1)))
+    st = tr.advance(start, np.zeros(U.shape[1]), U[k0])
+    if st is None:
+        w.events.append(event(k0, "not assembled", None))
+        return w
+    w.put(k0, st)
+    for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1)):
+        anchors, gaps = _anchors(tr, w, st, U, k0, order, event)
+        _fill(tr, w, U, k0, order, anchors, gaps)
+    w.events.sort(key=lambda e: e["index"])
+    return w
+
+
+def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray,
+             event: Any) -> tuple[set, set]:
+    """Walk along ``order`` by adaptive strides; the rows reached (anchors) go into ``w``.
+    Returns the anchors and the rows of the gaps (not assembled on the way)."""
+    anchors, gaps = {k0}, set()
+    prev, i, stride, gap = k0, 0, 1, False
+    while i < len(order):
+        if gap:  # the first row after the gap where Newton from the last pose converges
+            k = tr.reassemble(st, U, order[i:])
+            if k is None:
+                gaps.update(int(r) for r in order[i:])
+                break
+            where = i + int(np.flatnonzero(order[i:] == k[0])[0])
+            gaps.update(int(r) for r in order[i:where])
+            w.events.append(event(k[0], "reassembled", None))
+            st, prev, gap, i = k[1], k[0], False, where + 1
+            w.put(prev, st)
+            anchors.add(prev)
+            continue
+        j = min(i + stride, len(order)) - 1
+        k = int(order[j])
+        nxt, size = tr.step(st, U[k] - U[prev], U[k])
+        if nxt is None and j == i:  # a single row: halve within it
+            nxt = tr.advance(st, U[prev], U[k])
+            if nxt is None:
+                w.events.append(event(k, "dead point", st.lin.ratio[0]))
+                i, gap = i + 1, True
+                gaps.add(k)
+                continue
+        if nxt is None:
+            stride = max(1, stride // 2)
+            continue
+        per_row = size / (j + 1 - i)
+        st, prev, i = nxt, k, j + 1
+        w.put(k, st)
+        anchors.add(k)
+        stride = int(max(1, min(2 * stride, MAX_STRIDE, MAX_STEP / max(per_row, 1e-300))))
+    return anchors, gaps
+
+
+def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, anchors: set, gaps: set) -> None:
+    """The rows of ``order`` between anchors, from the anchor before each, in one batch;
+    rows the batch cannot settle are walked to one by one."""
+    seq = np.concatenate([[k0], order])
+    reached = np.array([int(k) in anchors for k in seq])
+    src = np.maximum.accumulate(np.where(reached, np.arange(len(seq)), -1))
+    in_gap = np.array([int(k) in gaps for k in seq])
+    todo = np.flatnonzero(~reached & ~in_gap & (src >= 0))
+    if not len(todo):
+        return
+    rows, base = seq[todo], seq[src[todo]]
+    st = tr.state(w.R[base], w.p[base], w.href[base], U[base])
+    du = U[rows] - U[base]
+    x1, x2 = tr.rates(st, du)
+    R, p = move(st.R, st.p, x1 + 0.5 * x2)
+    limit = 0.5 * np.abs(x1).max(axis=1) + 1e-9
+    R, p, ok = tr.correct(R, p, st.href, U[rows], limit)
+    good = rows[ok]
+    F = frame(tr.M, R[ok], p[ok])
+    href = helix_angles(tr.M, F, st.href[ok]) if tr.M.helix else st.href[ok]
+    w.R[good], w.p[good], w.href[good] = R[ok], p[ok], href
+    w.ok[good] = True
+    for t in todo[~ok]:  # on its own, from the row before it in the walk
+        k, before = int(seq[t]), int(seq[t - 1])
+        if not w.ok[before]:
+            continue
+        prev = tr.state(*w.at(before), U[before][None])
+        nxt = tr.advance(prev, U[before], U[k])
+        if nxt is not None:
+            w.put(k, nxt)
