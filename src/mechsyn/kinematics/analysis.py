@@ -259,6 +259,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
+    if mech.kind == "spatial":  # hook (issue 25): the spatial engine; to be registered in the engine list
+        from mechsyn.kinematics.spatial import SpatialEngine
+
+        return SpatialEngine().sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
     return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
 

@@ -118,26 +118,31 @@ class SpatialSimulation(Result):
         return rows
 
     def table(self, points: list[str] | None = None, rows: int = 13, width: int = 80) -> str:
-        """Point positions at ``rows`` evenly spread inputs, as many points as fit ``width``."""
+        """Point positions at ``rows`` evenly spread inputs, as many points as fit ``width``
+        (coordinates under ``1e-10`` of the length scale print as 0)."""
         x = self.inputs[self.main_input]
-        names = list(points or self.points)
-        head = [f"{self.main_input} {_unit(self.input_types[self.main_input])}"]
+        names = list(points or sorted(self.points, key=lambda n: -self._travel(n)))
         cols: list[tuple[str, np.ndarray]] = []
-        used = 10
         for name in names:
-            if used + 3 * 11 > width:
+            if 8 + 11 * (len(cols) + 3) > width:
                 break
-            P = self.point(name)
+            P = np.where(np.abs(self.point(name)) < 1e-10 * self.length_scale, 0.0, self.point(name))
             cols += [(f"{name}.{c}", P[:, k]) for k, c in enumerate("xyz")]
-            used += 3 * 11
         ks = np.unique(np.linspace(0, len(x) - 1, min(rows, len(x))).round().astype(int))
-        lines = ["".join([f"{head[0]:>10}"] + [f"{h:>11}" for h, _ in cols])]
+        head = f"{self.main_input} {_unit(self.input_types[self.main_input])}"
+        lines = [f"{head:>8}" + "".join(f" {h:>10}" for h, _ in cols)]
         for k in ks:
-            vals = [f"{'-':>11}" if not np.isfinite(v[k]) else f"{v[k]:>11.5g}" for _, v in cols]
-            lines.append("".join([f"{x[k]:>10.4g}"] + vals))
-        if len(ks) < len(x):
-            lines.append(f"({len(ks)} of {len(x)} rows; --json or --csv for all)")
+            vals = "".join(f" {'-':>10}" if not np.isfinite(v[k]) else f" {v[k]:>10.4g}" for _, v in cols)
+            lines.append(f"{x[k]:>8.4g}" + vals)
+        shown = len(cols) // 3
+        if len(ks) < len(x) or shown < len(names):
+            lines.append(f"({len(ks)} of {len(x)} rows, {shown} of {len(names)} points; --json or --csv for all)")
         return "\n".join(lines)
+
+    def _travel(self, name: str) -> float:
+        """How far point ``name`` moves over the sweep (the diagonal of its path's box)."""
+        P = self.point(name)[self.assembled]
+        return float(np.linalg.norm(np.ptp(P, axis=0))) if len(P) else 0.0
 
     def csv(self) -> str:
         """Every row: the inputs, assembled, residual, every point's x, y, z."""
