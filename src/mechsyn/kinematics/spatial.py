@@ -123,7 +123,8 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
 def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
     """Refuse drives that leave a joint point or a named point free to move."""
     lin = st.lin
-    N = lin.Vt[0, lin.r:].T  # the motions with every drive at rest
+    _, _, Vt = np.linalg.svd(lin.U[0] @ (lin.s[0][:, None] * lin.Vt[0]), full_matrices=True)
+    N = lin.twists(Vt[lin.r:].T[None])[0]  # the motions with every drive at rest, as (ω, v)
     if N.size == 0:
         return
     X = N.reshape(M.n, 6, -1)
@@ -179,7 +180,8 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
     if points is None and not mech.points:
         points = [j.id for j in mech.joints if j.point is not None]
     pts = resolve_points(mech, points)
-    sp = np.array([float((speeds or {}).get(d[0], 1.0)) for d in M.drives])
+    # input rates (default 1); the drives held at their drawn value do not move
+    sp = np.array([float((speeds or {}).get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives])
     sp = np.where([d[1] == "slide" for d in M.drives], sp / M.scale, sp)
     tr = Tracker(M)
     n = M.n

@@ -44,12 +44,14 @@ MAX_STRIDE = 64
 
 @dataclass
 class Lin:
-    """Jacobians (B, m, 6 n) at B poses and their pseudo-inverses at rank ``r``."""
+    """Jacobians (B, m, 6 n) at B poses and their pseudo-inverses at rank ``r``, in twists
+    taken at the links' centres ``C`` (B, n, 3) (see :meth:`Tracker.lin`)."""
 
     U: np.ndarray
     s: np.ndarray
     Vt: np.ndarray
     r: int
+    C: np.ndarray
 
     @property
     def ratio(self) -> np.ndarray:
@@ -59,13 +61,28 @@ class Lin:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.nan_to_num(self.s[:, self.r - 1] / self.s[:, 0])
 
+    def twists(self, y: np.ndarray) -> np.ndarray:
+        """Twists ``(ω, u)`` at the centres (B, 6 n, ...) -> ``(ω, v)`` at the origin: ``v = u + c × ω``."""
+        B = len(y)
+        Y = y.reshape(B, self.C.shape[1], 6, -1)
+        X = Y.copy()
+        X[:, :, 3:] += _cross_cols(self.C, Y[:, :, :3])
+        return X.reshape(y.shape)
+
     def solve(self, b: np.ndarray) -> np.ndarray:
         r = self.r
         c = np.einsum("bmk,bm->bk", self.U[:, :, :r], b) / self.s[:, :r]
-        return np.einsum("bkj,bk->bj", self.Vt[:, :r], c)
+        return self.twists(np.einsum("bkj,bk->bj", self.Vt[:, :r], c)[..., None])[..., 0]
 
     def take(self, idx: np.ndarray) -> "Lin":
-        return Lin(self.U[idx], self.s[idx], self.Vt[idx], self.r)
+        return Lin(self.U[idx], self.s[idx], self.Vt[idx], self.r, self.C[idx])
+
+
+def _cross_cols(c: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``c × w`` for ``c`` (B, n, 3) and columns ``w`` (B, n, 3, k)."""
+    c = c[..., None]
+    return np.stack([c[:, :, 1] * w[:, :, 2] - c[:, :, 2] * w[:, :, 1], c[:, :, 2] * w[:, :, 0] - c[:, :, 0] * w[:, :, 2],
+                     c[:, :, 0] * w[:, :, 1] - c[:, :, 1] * w[:, :, 0]], axis=2)
 
 
 @dataclass
@@ -84,6 +101,24 @@ class State:
         return State(self.R[idx], self.p[idx], self.href[idx], None, self.lin.take(idx), self.g[idx])
 
 
+def link_centres(M: SpatialModel) -> np.ndarray:
+    """Centre of each moving link (n, 3, model units): the mean of its joints' points."""
+    c = np.zeros((M.n, 3))
+    for i, link in enumerate(M.links):
+        pts = [M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
+        if pts:
+            c[i] = np.mean(pts, axis=0)
+    return c
+
+
+def _skew(c: np.ndarray) -> np.ndarray:
+    """``[c]x`` (..., 3, 3): ``[c]x w = c × w``."""
+    K = np.zeros(c.shape + (3,))
+    K[..., 0, 1], K[..., 0, 2], K[..., 1, 2] = -c[..., 2], c[..., 1], -c[..., 0]
+    K[..., 1, 0], K[..., 2, 0], K[..., 2, 1] = c[..., 2], -c[..., 1], c[..., 0]
+    return K
+
+
 class Tracker:
     """Predictor-corrector continuation of one model (see the module doc)."""
 
@@ -92,20 +127,33 @@ class Tracker:
         self.m_c = M.n_constraints
         self.rank: int | None = None
         self.halvings = 0
+        self.c0 = link_centres(M)
 
-    def lin(self, J: np.ndarray) -> Lin:
-        U, s, Vt = np.linalg.svd(J, full_matrices=False)
+    def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
+        """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
+        ``(ω, u)`` with ``u`` the velocity of each link's centre ``c`` (``v = u + c × ω``).
+
+        A minimum-norm solution in these coordinates is orthogonal to the idle motions,
+        and an idle spin of a link about a line through its centre is ``(a, 0)`` there
+        (a rod between two ball joints has its centre on its line), so minimum-norm rates
+        and steps give the spin no component: idle spins stay at rest, whichever point the
+        file measures from."""
+        B, n = len(J), self.M.n
+        C = (R[:, :-1] @ self.c0[:, :, None])[..., 0] + p[:, :-1]
+        Jr = J.reshape(B, -1, n, 6).copy()
+        Jr[..., :3] += np.einsum("bmnk,bnkj->bmnj", Jr[..., 3:], _skew(C))  # J_v [c]x: the ω columns
+        U, s, Vt = np.linalg.svd(Jr.reshape(J.shape), full_matrices=False)
         if self.rank is None:  # the regular rank: at the drawn assembly
             s0 = s[0]
             self.rank = int(np.count_nonzero(s0 > RANK_TOL * s0[0])) if s0.size and s0[0] > 0 else 0
-        return Lin(U, s, Vt, self.rank)
+        return Lin(U, s, Vt, self.rank, C)
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
         F = frame(self.M, R, p)
         g = residual(self.M, F, href, target)
         if self.M.helix:
             href = helix_angles(self.M, F, href)
-        return State(R, p, href, F, self.lin(jacobian(self.M, F)), g)
+        return State(R, p, href, F, self.lin(jacobian(self.M, F), R, p), g)
 
     def rates(self, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
@@ -139,7 +187,7 @@ class Tracker:
                 break
             idx = np.flatnonzero(active)
             if lin is None or np.any(err[idx] > 0.1 * last[idx]) or not np.isin(idx, rows).all():
-                lin, rows = self.lin(jacobian(self.M, F.take(idx))), idx
+                lin, rows = self.lin(jacobian(self.M, F.take(idx)), R[idx], p[idx]), idx
             last = err
             dx = np.zeros((B, 6 * self.M.n))
             dx[idx] = -lin.take(np.searchsorted(rows, idx)).solve(g[idx])
@@ -240,11 +288,10 @@ def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.
                 gaps.update(int(r) for r in order[i:])
                 break
             where = i + int(np.flatnonzero(order[i:] == k[0])[0])
-            gaps.update(int(r) for r in order[i:where])
-            w.events.append(event(k[0], "reassembled", None))
+            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1], anchors)
+            gaps.update(int(r) for r in order[i:where] if r not in anchors)
+            w.events.append(event(first, "reassembled", None))
             st, prev, gap, i = k[1], k[0], False, where + 1
-            w.put(prev, st)
-            anchors.add(prev)
             continue
         j = min(i + stride, len(order)) - 1
         k = int(order[j])
@@ -265,6 +312,21 @@ def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.
         anchors.add(k)
         stride = int(max(1, min(2 * stride, MAX_STRIDE, MAX_STEP / max(per_row, 1e-300))))
     return anchors, gaps
+
+
+def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray, anchors: set) -> int:
+    """From the reassembled row ``rows[0]`` (state ``st``) back through the gap's rows while
+    the mechanism follows (so the gap ends where the mechanism stops assembling, not where
+    Newton first converged); returns the first row of the assembled stretch."""
+    w.put(int(rows[0]), st)
+    anchors.add(int(rows[0]))
+    for prev, k in zip(rows[:-1], rows[1:]):
+        st = tr.advance(st, U[prev], U[k])
+        if st is None:
+            return int(prev)
+        w.put(int(k), st)
+        anchors.add(int(k))
+    return int(rows[-1])
 
 
 def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, anchors: set, gaps: set) -> None:
