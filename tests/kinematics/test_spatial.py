@@ -252,6 +252,9 @@ def test_bad_inputs_name_the_fix():
     m = ms.examples.load("rssr")
     with pytest.raises(MechsynInputError, match="only R, P and H"):
         ms.simulate(m, {"B": np.array([0.0, 1.0])})
+    cam = replace(m, joints=tuple(replace(j, type="E") if j.id == "C" else j for j in m.joints))
+    with pytest.raises(MechsynInputError, match="R, P, C, U, S and H pairs"):
+        ms.simulate(cam, {"A": np.array([0.0, 1.0])})
     with pytest.raises(MechsynInputError, match="no joint 'Q'"):
         ms.simulate(m, {"Q": np.array([0.0])})
     # a cylindrical rocker bearing frees a slide the drive does not determine

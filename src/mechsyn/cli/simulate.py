@@ -130,8 +130,7 @@ def simulate_cmd(
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
         return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
-    n = len(next(iter(inputs.values())))
-    with progress_bar("simulating", n, enabled=n >= 200) as advance:
+    with progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance:
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
                                    vll=_parse_pairs(vll, "--vll", False), method=method, output=output,
                                    straight=_parse_straight(straight), progress=advance)

@@ -92,7 +92,7 @@ def _check_inputs(mech: Mechanism, inputs: dict[str, Any]) -> dict[str, np.ndarr
             raise MechsynInputError(f"no joint {jid!r} to drive", source=mech.source, field="inputs",
                                     hint="one of " + ", ".join(j.id for j in mech.joints)) from None
         if j.type not in ("R", "P", "H"):
-            raise MechsynInputError(f"joint {jid} is a {j.type} pair: only R, P and H pairs take an input",
+            raise MechsynInputError(f"joint {jid} ({j.type} pair) cannot take an input: only R, P and H pairs do",
                                     source=mech.source, field="inputs", hint="drive an R, P or H pair")
         out[jid] = np.atleast_1d(np.asarray(v, float))
     sizes = {len(v) for v in out.values()}
