@@ -123,7 +123,7 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
 def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
     """Refuse drives that leave a joint point or a named point free to move."""
     lin = st.lin
-    _, _, Vt = np.linalg.svd(lin.U[0] @ (lin.s[0][:, None] * lin.Vt[0]), full_matrices=True)
+    _, _, Vt = np.linalg.svd(lin.Jc[0], full_matrices=True)
     N = lin.twists(Vt[lin.r:].T[None])[0]  # the motions with every drive at rest, as (ω, v)
     if N.size == 0:
         return
@@ -243,7 +243,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
         out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
-        x1, x2 = tr.rates(st, np.broadcast_to(sp, (len(idx), len(sp))))
+        x1, x2 = tr.rates(st, np.broadcast_to(sp, (len(idx), len(sp))), refine=2)
         regular = st.lin.ratio >= RANK_TOL
         out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
         for k, r in zip(idx[~regular], st.lin.ratio[~regular]):
