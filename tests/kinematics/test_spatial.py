@@ -64,18 +64,17 @@ def test_closure_from_the_reported_poses(name, joint, rng):
 @pytest.mark.parametrize("name,joint,rng", SWEEPS[:4])
 def test_velocities_and_accelerations_match_finite_differences(name, joint, rng):
     a, b, _ = rng
-    h = 1e-3  # degrees
     x = np.linspace(a + 1, b - 1, 7)
-    grid = np.sort(np.concatenate([x - h, x, x + h]))
+    hv, ha = 1e-3, 0.05  # degrees: rounding (1e-12 / h, 1e-12 / h^2) and truncation (h^2) balanced
+    grid = np.concatenate([x, x - hv, x + hv, x - ha, x + ha])
     s = sim(name, joint, grid, speeds={joint: 1.0})  # 1 rad/s: d/dt = d/d(input in rad)
-    dt = np.radians(h)
+    n = len(x)
     for pname, pm in s.points.items():
         P, V, A = pm.position, pm.velocity, pm.acceleration
-        fd_v = (P[2::3] - P[0::3]) / (2 * dt)
-        fd_a = (P[2::3] - 2 * P[1::3] + P[0::3]) / dt ** 2
-        scale = s.length_scale
-        assert np.abs(V[1::3] - fd_v).max() < 1e-6 * scale, pname
-        assert np.abs(A[1::3] - fd_a).max() < 1e-3 * scale, pname
+        fd_v = (P[2 * n:3 * n] - P[n:2 * n]) / (2 * np.radians(hv))
+        fd_a = (P[4 * n:] - 2 * P[:n] + P[3 * n:4 * n]) / np.radians(ha) ** 2
+        assert np.abs(V[:n] - fd_v).max() < 1e-6 * s.length_scale, pname
+        assert np.abs(A[:n] - fd_a).max() < 1e-4 * s.length_scale, pname
 
 
 def dh_angles(s, mech, k, order):
@@ -138,6 +137,11 @@ def test_spherical_four_bar_freudenstein():
     assert np.abs(np.sin(phi - expected)).max() < 1e-9
     assert np.abs(np.sin(theta - np.radians(40 + s.inputs["A"]))).max() < 1e-9
     assert np.allclose(np.linalg.norm(C_, axis=1), 1.0, atol=1e-12)  # on the unit sphere
+    # inputs in any order (long jumps between rows): the same branch at every row
+    grid = np.random.default_rng(1).permutation(s.inputs["A"])
+    t = sim("spherical_fourbar", "A", grid, points=["C"])
+    k = np.searchsorted(s.inputs["A"], grid)
+    assert np.abs(t.point("C") - C_[k]).max() < 1e-9
 
 
 def delta_arm_angle(mech, i, platform_shift):

@@ -170,9 +170,11 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
         return _simulate(mech, M, inputs, speeds, points, progress)
 
 
-#: From this many moving links the sweep runs with one BLAS thread (its Jacobians are
-#: big enough for BLAS to start threads, which only slow the many small SVDs down).
-SMALL_LINKS = 5
+#: From this many moving links the sweep runs with one BLAS thread: BLAS threads only slow
+#: its many small products and solves down (a Bennett sweep: 74 ms with one thread, 156 ms
+#: with two on a busy machine); below it (no links: never) finding the BLAS libraries
+#: would cost more than it saves.
+SMALL_LINKS = 0
 
 
 def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,

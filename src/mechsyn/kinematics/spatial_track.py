@@ -63,14 +63,31 @@ class Lin:
     C: np.ndarray
 
     @functools.cached_property
+    def Ginv(self) -> np.ndarray:
+        """The inverse of the damped Gram matrix (one inversion serves every solve)."""
+        return np.linalg.inv(self.G)
+
+    @functools.cached_property
     def ratio(self) -> np.ndarray:
-        """``σ_r / σ_1`` per pose from the Gram matrix's eigenvalues (0: the rank has dropped;
-        resolved down to about ``1e-8``, the square root of the rounding of ``σ²``)."""
+        """``σ_r / σ_1`` per pose, 0 where the rank has dropped: exact (the Gram matrix's
+        eigenvalues, resolved down to about ``1e-8``, the square root of the rounding of
+        ``σ²``) where it is under ``1e-3``; elsewhere a lower bound within a factor ``√k``
+        (``1 / √(‖G‖_F ‖G⁻¹‖_F)`` for a Gram matrix of rank ``k = r``), which is enough to
+        tell a regular pose."""
+        B, k = self.G.shape[:2]
         if self.r == 0:
-            return np.ones(len(self.G))
-        lam = np.linalg.eigvalsh(self.G)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.nan_to_num(np.sqrt(np.maximum(lam[:, -self.r], 0.0) / lam[:, -1]))
+            return np.ones(B)
+        out = np.zeros(B)
+        if k == self.r:
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                out = 1.0 / np.sqrt(np.linalg.norm(self.G, axis=(1, 2)) * np.linalg.norm(self.Ginv, axis=(1, 2)))
+            out = np.nan_to_num(out)
+        exact = out < 1e-3
+        if exact.any():
+            lam = np.linalg.eigvalsh(self.G[exact])
+            with np.errstate(invalid="ignore", divide="ignore"):
+                out[exact] = np.nan_to_num(np.sqrt(np.maximum(lam[:, -self.r], 0.0) / lam[:, -1]))
+        return out
 
     def twists(self, y: np.ndarray) -> np.ndarray:
         """Twists ``(ω, u)`` at the centres (B, 6 n, ...) -> ``(ω, v)`` at the origin: ``v = u + c × ω``."""
@@ -83,8 +100,8 @@ class Lin:
     def _once(self, b: np.ndarray) -> np.ndarray:
         JT = self.Jc.transpose(0, 2, 1)
         if self.rows:
-            return JT @ np.linalg.solve(self.G, b)
-        return np.linalg.solve(self.G, JT @ b)
+            return JT @ (self.Ginv @ b)
+        return self.Ginv @ (JT @ b)
 
     def solve(self, b: np.ndarray, refine: int = 0) -> np.ndarray:
         b = b[..., None]
@@ -94,7 +111,9 @@ class Lin:
         return self.twists(y)[..., 0]
 
     def take(self, idx: np.ndarray) -> "Lin":
-        return Lin(self.Jc[idx], self.G[idx], self.rows, self.r, self.C[idx])
+        out = Lin(self.Jc[idx], self.G[idx], self.rows, self.r, self.C[idx])
+        out.__dict__["Ginv"] = self.Ginv[idx]
+        return out
 
 
 def _cross_cols(c: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -117,7 +136,8 @@ class State:
 
     def take(self, idx: Any) -> "State":
         idx = np.atleast_1d(idx)
-        return State(self.R[idx], self.p[idx], self.href[idx], None, self.lin.take(idx), self.g[idx])
+        F = None if self.F is None else self.F.take(idx)
+        return State(self.R[idx], self.p[idx], self.href[idx], F, self.lin.take(idx), self.g[idx])
 
 
 def link_centres(M: SpatialModel) -> np.ndarray:
@@ -130,6 +150,16 @@ def link_centres(M: SpatialModel) -> np.ndarray:
     return c
 
 
+def _blocks(M: SpatialModel) -> tuple[np.ndarray, np.ndarray]:
+    """(row, moving link) of every block of the Jacobian that may be non-zero."""
+    lay = M.lay
+    r0, c0 = np.nonzero(lay.J0)
+    rows = np.concatenate([lay.ri, r0])
+    links = np.concatenate([lay.ci, c0]) // 6
+    pairs = np.unique(np.stack([rows, links], axis=1)[links < M.n], axis=0)
+    return pairs[:, 0], pairs[:, 1]
+
+
 class Tracker:
     """Predictor-corrector continuation of one model (see the module doc)."""
 
@@ -139,6 +169,7 @@ class Tracker:
         self.rank: int | None = None
         self.halvings = 0
         self.c0 = link_centres(M)
+        self.blocks = _blocks(M)
 
     def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
         """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
@@ -152,7 +183,8 @@ class Tracker:
         B, n = len(J), self.M.n
         C = (R[:, :-1] @ self.c0[:, :, None])[..., 0] + p[:, :-1]
         Jr = J.reshape(B, -1, n, 6).copy()
-        Jr[..., :3] += _cross(Jr[..., 3:], C[:, None])  # J_v (c × ω) = (J_v × c) · ω: the ω columns
+        rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
+        Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
         Jc = Jr.reshape(J.shape)
         if self.rank is None:  # the regular rank: at the drawn assembly, by an SVD
             s0 = np.linalg.svd(Jc[0], compute_uv=False)
@@ -181,16 +213,18 @@ class Tracker:
         return x1, st.lin.solve(-convective(self.M, F, x1), refine)
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
-                limit: np.ndarray, iters: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Newton corrections of B poses to the inputs ``target``: the poses and a mask of
-        those that converged without moving further than ``limit``. The Jacobian of the
-        first iterate is kept while the residuals fall at least tenfold per step (the
-        predictor lands close, so that is most steps) and taken afresh otherwise."""
+                limit: np.ndarray, iters: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+        """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
+        those that converged without moving further than ``limit``, and ``(frame,
+        residuals, linearisation)`` of the last iterate (the linearisation is that of an
+        earlier iterate, None when none was needed). The Jacobian of the first iterate is
+        kept while the residuals fall at least tenfold per step (the predictor lands
+        close, so that is most steps) and taken afresh otherwise."""
         B = len(R)
         moved = np.zeros(B)
         done = np.zeros(B, bool)
         failed = np.zeros(B, bool)
-        lin, rows, last = None, None, np.full(B, np.inf)
+        lin, rows, last = None, np.zeros(B, bool), np.full(B, np.inf)
         for it in range(iters):
             F = frame(self.M, R, p)
             g = residual(self.M, F, href, target)
@@ -201,26 +235,37 @@ class Tracker:
             active = ~done & ~failed
             if not active.any():
                 break
-            idx = np.flatnonzero(active)
-            if lin is None or np.any(err[idx] > 0.1 * last[idx]) or not np.isin(idx, rows).all():
-                lin, rows = self.lin(jacobian(self.M, F.take(idx)), R[idx], p[idx]), idx
+            if lin is None or np.any(err[active] > 0.1 * last[active]) or not rows[active].all():
+                idx = np.flatnonzero(active)
+                lin = self.lin(jacobian(self.M, F.take(idx) if len(idx) < B else F), R[idx], p[idx])
+                rows = active.copy()
             last = err
             dx = np.zeros((B, 6 * self.M.n))
-            dx[idx] = -lin.take(np.searchsorted(rows, idx)).solve(g[idx])
+            dx[rows] = -lin.solve(g[rows])
+            dx[~active] = 0.0
             moved += np.abs(dx).max(axis=1)
             failed |= moved > limit
             dx[failed] = 0.0
             R, p = move(R, p, dx)
-        return R, p, done & ~failed
+        return R, p, done & ~failed, (F, g, lin if lin is not None and rows.all() else None)
 
     def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
         """One predictor-corrector step of a single pose; (the new state or None, the
-        predictor's step size)."""
+        predictor's step size). The new state keeps the corrector's linearisation (of
+        the predicted pose): good for the next predictor; the rates reported are
+        computed afresh at every row (:func:`mechsyn.kinematics.spatial._sweep_rows`)."""
         x1, x2 = self.rates(st, du[None])
-        R, p = move(st.R, st.p, x1 + 0.5 * x2)
         size = float(np.abs(x1).max(initial=0.0))
-        R, p, ok = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
-        return (self.state(R, p, st.href, target[None]) if ok[0] else None), size
+        if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
+            return None, size
+        R, p = move(st.R, st.p, x1 + 0.5 * x2)
+        R, p, ok, (F, g, lin) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        if not ok[0]:
+            return None, size
+        if lin is None:
+            return self.state(R, p, st.href, target[None]), size
+        href = helix_angles(self.M, F, st.href) if self.M.helix else st.href
+        return State(R, p, href, F, lin, g), size
 
     def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
         """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
@@ -228,12 +273,12 @@ class Tracker:
         t, h = 0.0, 1.0
         while t < 1.0:
             h = min(h, 1.0 - t)
-            nxt, _ = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
+            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
             if nxt is None:
                 if h < 0.5 ** MAX_HALVINGS:
                     return None
                 h *= 0.5
-                self.halvings += 1
+                self.halvings += size <= MAX_STEP  # trouble, not a long step
                 continue
             st, t = nxt, t + h
             h = min(1.0, 2 * h)
@@ -244,7 +289,7 @@ class Tracker:
         and its state; all rows tried in one batch."""
         B = len(rows)
         rep = np.zeros(B, int)
-        R, p, ok = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
+        R, p, ok, _ = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
         if not ok.any():
             return None
         j = int(np.argmax(ok))
@@ -356,12 +401,14 @@ def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, ancho
     if not len(todo):
         return
     rows, base = seq[todo], seq[src[todo]]
-    st = tr.state(w.R[base], w.p[base], w.href[base], U[base])
+    ub, which = np.unique(base, return_inverse=True)  # each anchor's state once
+    st = tr.state(w.R[ub], w.p[ub], w.href[ub], U[ub]).take(which)
     du = U[rows] - U[base]
     x1, x2 = tr.rates(st, du)
     R, p = move(st.R, st.p, x1 + 0.5 * x2)
-    limit = 0.5 * np.abs(x1).max(axis=1) + 1e-9
-    R, p, ok = tr.correct(R, p, st.href, U[rows], limit)
+    size = np.abs(x1).max(axis=1)
+    limit = np.where(size <= MAX_STEP, 0.5 * size + 1e-9, -1.0)  # too far: walked to on its own
+    R, p, ok, _ = tr.correct(R, p, st.href, U[rows], limit)
     good = rows[ok]
     F = frame(tr.M, R[ok], p[ok])
     href = helix_angles(tr.M, F, st.href[ok]) if tr.M.helix else st.href[ok]
