@@ -105,14 +105,15 @@ def _equal_box(ax: Any, P: np.ndarray, unit: str) -> None:
     ax.set_ylim(mid[1] - half, mid[1] + half)
     ax.set_zlim(mid[2] - half, mid[2] + half)
     ax.set_box_aspect((1, 1, 1))
+    ax.tick_params(labelsize=7)
     ax.set_xlabel(f"x ({unit})")
     ax.set_ylabel(f"y ({unit})")
     ax.set_zlabel(f"z ({unit})")
 
 
 def _all_points(sim: Any, rows: np.ndarray) -> np.ndarray:
-    P = [x for k in rows for _, x, _ in joint_frames(sim, k)]
-    P += [pm.position[rows] for pm in sim.points.values()]
+    P = [x for k in rows[:: max(1, len(rows) // 24)] for _, x, _ in joint_frames(sim, k)]
+    P += [pm.position[rows] for pm in sim.points.values()]  # every row: the paths stay inside
     return np.vstack([np.atleast_2d(p) for p in P])
 
 
@@ -174,7 +175,7 @@ def _scene(ax: Any, sim: Any, idx: np.ndarray) -> None:
     for pm in sim.points.values():
         P = pm.position
         ax.plot(P[:, 0], P[:, 1], P[:, 2], "-", lw=1.2, color=link_colour(sim, pm.link), alpha=0.8)
-    _equal_box(ax, _all_points(sim, idx[:: max(1, len(idx) // 24)]), _unit(sim))
+    _equal_box(ax, _all_points(sim, idx), _unit(sim))
     _legend(ax, sim)
 
 
