@@ -277,7 +277,7 @@ def test_cli_json_is_to_dict_and_text_fits_80_columns(capsys, monkeypatch):
     assert main(["simulate", "rssr", "-i", "A=0:360:5"]) == 0
     out = capsys.readouterr().out
     assert "dead point" in out and "reassembled" in out
-    assert max(len(line) for line in out.splitlines()) <= 80 or "note" in out
+    assert max(len(line) for line in out.splitlines()) <= 80
 
 
 def test_plot_and_animation_on_3d_axes():

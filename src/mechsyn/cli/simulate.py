@@ -148,6 +148,7 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
     """``mechsyn simulate`` on a spatial file: one call of the spatial engine, its result's own
     summary, events and table (``--json``: its ``to_dict()``)."""
     import shutil
+    import textwrap
 
     from mechsyn.kinematics.analysis import simulate
     from mechsyn.plot.spatial import animate_spatial, plot_spatial
@@ -166,10 +167,12 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
     if json_:
         emit_json(sim.to_dict())
         return
-    typer.echo(str(sim))
-    for e in sim.events:
-        typer.echo(f"{e['kind']} at {', '.join(f'{j} = {v:.6g}' for j, v in e['input'].items())}: {e['message']}")
-    typer.echo(sim.table(width=shutil.get_terminal_size().columns))
+    width = shutil.get_terminal_size().columns
+    lines = str(sim).splitlines() + [f"{e['kind']} at {', '.join(f'{j} = {v:.6g}' for j, v in e['input'].items())}: "
+                                     f"{e['message']}" for e in sim.events]
+    for line in lines:
+        typer.echo(textwrap.fill(line, width, subsequent_indent=" " * 13))
+    typer.echo(sim.table(width=width))
 
 
 def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
