@@ -17,8 +17,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn._result import Result
-from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.analysis import PointMotion
+from mechsyn.kinematics.analysis import PointMotion, Simulation
 
 __all__ = ["SpatialSimulation", "LinkPose"]
 
@@ -81,23 +80,16 @@ class SpatialSimulation(Result):
     method: str = "spatial continuation"
     model: Any = field(default=None, repr=False, metadata={"json": False})
 
-    @property
-    def main_input(self) -> str:
-        return next(iter(self.inputs))
+    main_input = Simulation.main_input
+    working_ranges = Simulation.working_ranges
 
     def point(self, name: str) -> np.ndarray:
         """Positions (N, 3) of the named point ``name`` (NaN where not assembled)."""
-        if name not in self.points:
-            raise MechsynInputError(f"no point {name!r} in this simulation", field="points",
-                                    hint="one of " + (", ".join(self.points) or "none: pass points=[...]"))
-        return self.points[name].position
+        return Simulation.point(self, name)  # type: ignore[arg-type]
 
     def link(self, name: str) -> LinkPose:
         """Rotation, translation, angular velocity and acceleration of link ``name``."""
-        if name not in self.links:
-            raise MechsynInputError(f"no link {name!r} in this simulation", field="link",
-                                    hint="one of " + ", ".join(self.links))
-        return self.links[name]
+        return Simulation.link(self, name)  # type: ignore[arg-type,return-value]
 
     def _summary(self) -> list[tuple[str, str]]:
         x = self.inputs[self.main_input]
@@ -174,7 +166,7 @@ class SpatialSimulation(Result):
             "assembled": ok,
             "points": {n: {k: mask(v) for k, v in pm.to_dict().items()} for n, pm in self.points.items()},
             "links": {n: {k: mask(v) for k, v in lp.to_dict().items()} for n, lp in self.links.items()},
-            "joints": {j: mask(v) for j, v in self.joints.items()},
+            "joints": {j: mask(v) for j, v in self.joints.items()}, "working_ranges": self.working_ranges(),
             "residual": mask(self.residual), "length_scale": self.length_scale,
             "rank": self.rank, "idle": self.idle, "events": self.events, "notes": self.notes,
             "units": {"input": "deg (R, H) or length (P) from the drawn assembly", "angular_velocity": "rad/s",
