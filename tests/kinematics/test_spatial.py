@@ -262,6 +262,8 @@ def test_bad_inputs_name_the_fix():
     with pytest.raises(MechsynInputError, match="no joint 'Q'"):
         ms.simulate(m, {"Q": np.array([0.0])})
     # a cylindrical rocker bearing frees a slide the drive does not determine
+    with pytest.raises(MechsynInputError, match="force analysis needs a planar"):
+        ms.forces(m, {"A": np.array([0.0, 1.0])})
     free = replace(m, joints=tuple(replace(j, type="C", pair_class=4) if j.id == "D" else j for j in m.joints))
     with pytest.raises(MechsynInputError, match="not determined"):
         ms.simulate(free, {"A": np.array([0.0, 1.0])})

@@ -785,6 +785,9 @@ def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, flo
     >>> f.reactions.effort["A"].shape
     (3,)
     """
+    if mech.kind == "spatial":  # hook (issue 25): spatial kinematics exists, spatial forces do not yet
+        raise MechsynInputError("force analysis needs a planar mechanism", source=mech.source, field="kind",
+                                hint="simulate gives the motion of a spatial file; forces are computed for planar files only")
     sim = simulate(mech, inputs, speeds=speeds, points=[], vll=vll, method=method, progress=progress)
     sw = sim.sweep
     R = kinetostatics(sim.system, sw.q, None if static else sw.qd, None if static else sw.qdd,
