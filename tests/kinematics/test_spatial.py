@@ -45,11 +45,24 @@ def closure_error(s, mech, k):
             err = max(err, np.linalg.norm(pa - pb) / s.length_scale)
         if j.type == "R":
             err = max(err, np.linalg.norm(np.cross(aa, ab)) / np.linalg.norm(aa) ** 2)
+        if j.type == "U":  # the cross keeps its right angle (or its drawn angle)
+            Ra, _ = pose(s, j.links[0], k)
+            Rb, _ = pose(s, j.links[1], k)
+            a1, a2 = np.asarray(j.axis, float), np.asarray(j.axis2, float)
+            a1, a2 = a1 / np.linalg.norm(a1), a2 / np.linalg.norm(a2)
+            err = max(err, abs((Ra @ a1) @ (Rb @ a2) - a1 @ a2))
+        if j.type == "P":  # no relative rotation; the slide along the first link's axis
+            Ra, ta = pose(s, j.links[0], k)
+            Rb, tb = pose(s, j.links[1], k)
+            err = max(err, np.abs(Ra - Rb).max())
+            x0 = np.zeros(3) if j.point is None else np.asarray(j.point, float)
+            d = (Rb @ x0 + tb) - (Ra @ x0 + ta)
+            err = max(err, np.linalg.norm(np.cross(d, Ra @ j.axis)) / np.linalg.norm(j.axis) / s.length_scale)
     return err
 
 
 SWEEPS = [("bennett", "R1", (0, 360, 1)), ("spherical_fourbar", "A", (0, 360, 1)), ("rssr", "A", (0, 90, 1)),
-          ("delta", "R1", (-30, 30, 1)), ("rps3", "P1", (-0.2, 0.2, 0.01))]
+          ("delta", "R1", (-30, 30, 1)), ("rps3", "P1", (-0.2, 0.2, 0.01)), ("stewart_6ups", "P1", (-0.1, 0.1, 0.01))]
 
 
 @pytest.mark.parametrize("name,joint,rng", SWEEPS)
@@ -244,6 +257,27 @@ def test_gough_stewart_one_leg_moves_with_its_leg_spins_idle():
             np.linspace(0, 0.05, 11))
     assert s.assembled.all() and np.nanmax(s.residual) < 1e-9
     assert s.idle == 6
+
+
+def test_helical_rocker_keeps_its_pitch():
+    """An RSSH loop (the RSSR with its rocker on a screw of pitch 0.2 per radian): the screw's
+    slide is the pitch times its rotation at every row, closure holds, and the rates match
+    finite differences."""
+    m = ms.examples.load("rssr")
+    pitch = 0.2
+    screw = replace(m, joints=tuple(replace(j, type="H", pitch=pitch) if j.id == "D" else j for j in m.joints))
+    s = ms.simulate(screw, {"A": ms.input_grid(0, 80, 1)}, points=["C"])
+    assert s.assembled.all() and np.nanmax(s.residual) < 1e-9
+    assert np.allclose(s.joints["D/slide"], pitch * np.radians(s.joints["D"]), rtol=0, atol=1e-9)
+    assert np.abs(s.joints["D/slide"]).max() > 0.01  # it does slide
+    # the rocker (D's first link) moves along D's axis x by minus the slide (the slide is the
+    # second link's, the frame's, relative to the first)
+    P = s.point("C")
+    assert np.allclose(P[:, 0] - P[0, 0], -(s.joints["D/slide"] - s.joints["D/slide"][0]), atol=1e-9)
+    h = np.radians(1e-3)
+    t = ms.simulate(screw, {"A": np.array([40 - 1e-3, 40, 40 + 1e-3])}, points=["C"])
+    fd = (t.point("C")[2] - t.point("C")[0]) / (2 * h)
+    assert np.abs(t.points["C"].velocity[1] - fd).max() < 1e-6
 
 
 def test_spatial_engine_answers_spatial_files_only():

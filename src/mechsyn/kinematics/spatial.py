@@ -274,7 +274,8 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     for name, (link, at) in pts.items():
         pm[name] = _point_motion(M, rows, X, Xd, link, M.local(at))
     joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok)) for k, jid in enumerate(M.angle_joints)}
-    joints.update({jid: rows.slide[:, k] * L for k, jid in enumerate(M.slide_joints) if jid not in joints})
+    joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
+                   for k, jid in enumerate(M.slide_joints)})
     notes = []
     idle = M.n * 6 - start.lin.r
     if idle:

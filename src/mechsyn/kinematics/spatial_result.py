@@ -47,7 +47,7 @@ class SpatialSimulation(Result):
 
     ``s.point("P")`` gives (N, 3) positions, ``s.link("platform").rotation`` (N, 3, 3)
     rotations, ``s.joints["R2"]`` the rotation (deg) or slide of a pair from the drawn
-    assembly, ``s.residual`` the closure residual of every row in units of
+    assembly (a C or H pair's slide under ``"<id>/slide"``), ``s.residual`` the closure residual of every row in units of
     ``s.length_scale``; ``print(s)`` a summary, ``s.table()`` the points row by row,
     ``s.plot()`` a 3-D view, ``s.animate()`` the motion.
 
