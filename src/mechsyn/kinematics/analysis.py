@@ -249,6 +249,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     velocity is continuous, through change and branch points: a parallelogram stays a
     parallelogram) or ``"switch"`` (the other branch there; closed form only).
 
+    A ``kind: spatial`` file goes to the spatial engine
+    (:func:`mechsyn.kinematics.spatial.simulate_spatial`: inputs measured from the drawn
+    assembly, a :class:`~mechsyn.kinematics.spatial_result.SpatialSimulation` back).
+
     Examples
     --------
     >>> import numpy as np, mechsyn as ms
