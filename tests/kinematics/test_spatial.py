@@ -69,7 +69,7 @@ SWEEPS = [("bennett", "R1", (0, 360, 1)), ("spherical_fourbar", "A", (0, 360, 1)
 def test_closure_from_the_reported_poses(name, joint, rng):
     s = sim(name, joint, ms.input_grid(*rng))
     mech = ms.examples.load(name)
-    assert s.engine == "spatial" and s.assembled.all()
+    assert s.engine == "spatial" and s.assembled.all() and s.events == []  # no false alarm
     assert np.nanmax(s.residual) < 1e-9
     assert max(closure_error(s, mech, k) for k in range(len(s.assembled))) < 1e-9
 
@@ -278,6 +278,36 @@ def test_helical_rocker_keeps_its_pitch():
     t = ms.simulate(screw, {"A": np.array([40 - 1e-3, 40, 40 + 1e-3])}, points=["C"])
     fd = (t.point("C")[2] - t.point("C")[0]) / (2 * h)
     assert np.abs(t.points["C"].velocity[1] - fd).max() < 1e-6
+
+
+def parallelogram_3d(theta=60.0):
+    """A parallelogram four-bar (crank 1, coupler 4) written as a spatial file, drawn at θ."""
+    from mechsyn.io import mechanism_from_dict
+
+    t = np.radians(theta)
+    B = [np.cos(t), np.sin(t), 0.0]
+    z = [0, 0, 1]
+    return mechanism_from_dict({"name": "parallelogram 3-D", "kind": "spatial", "ground": "frame",
+                                "links": ["frame", "crank", "coupler", "rocker"], "joints": [
+        {"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0, 0], "axis": z, "actuated": True},
+        {"id": "B", "type": "R", "links": ["crank", "coupler"], "point": B, "axis": z},
+        {"id": "C", "type": "R", "links": ["coupler", "rocker"], "point": [4 + B[0], B[1], 0], "axis": z},
+        {"id": "D", "type": "R", "links": ["rocker", "frame"], "point": [4, 0, 0], "axis": z}]}, "parallelogram")
+
+
+def test_change_points_reported_and_passed_on_the_drawn_branch():
+    """The parallelogram's change points (crank at 0, 180, 360 degrees, where it could turn
+    into an anti-parallelogram) are singular: reported at the row that hits one (rates null)
+    and, between rows, located by the search; the sweep stays a parallelogram throughout."""
+    g = np.arange(-90, 330, 0.7)  # crank = 60 + input: 180 is a row, 0 and 360 fall between rows
+    s = ms.simulate(parallelogram_3d(), {"A": g}, points=["B", "C"])
+    assert s.assembled.all() and np.nanmax(s.residual) < 1e-9
+    assert np.abs(s.point("C") - s.point("B") - [4, 0, 0]).max() < 1e-6
+    sing = [e for e in s.events if e["kind"] == "singular"]
+    crank = sorted(round(e["input"]["A"] + 60, 6) for e in sing)
+    assert crank == [0.0, 180.0, 360.0]
+    at_row = [e for e in sing if not e.get("crossed")]
+    assert len(at_row) == 1 and np.isnan(s.points["C"].velocity[at_row[0]["index"]]).all()
 
 
 def test_spatial_engine_answers_spatial_files_only():

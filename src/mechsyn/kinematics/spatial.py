@@ -25,7 +25,9 @@ more equation each); it
   a named point free are refused at the start (the motion would be arbitrary);
 * reports, never hides: the closure residual of every row (``residual``, in units of the
   length scale), rows where the Jacobian's regular rank drops (``singular``: its ``r``-th
-  singular value below ``1e-8`` of the largest; rates NaN there), the end of an assembled
+  singular value below ``1e-8`` of the largest; rates NaN there), singular configurations
+  passed between rows (``singular`` with ``crossed``:
+  :func:`~mechsyn.kinematics.spatial_track.crossings`), the end of an assembled
   range (``dead point``: the drive cannot go on), reassembly after a gap and rows not
   assembled (NaN).
 
@@ -49,7 +51,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.analysis import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
-from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, walk
+from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, crossings, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
 from mechsyn.model.mechanism import Mechanism
 
@@ -252,6 +254,11 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
             out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, U[k]),
                                "message": f"singular configuration: the Jacobian's rank drops below {st.lin.r} "
                                           f"(singular value ratio {r:.2g}); rates not defined here (null)"})
+        for k, u, r in crossings(tr, w, U, out.ratio):
+            out.events.append({"index": k, "kind": "singular", "crossed": True, "input": _input_dict(M, u),
+                               "message": f"a singular configuration lies between rows {k - 1} and {k + 1} "
+                                          f"(singular value ratio {r:.2g} there): the sweep passes it on the "
+                                          "branch it was on (the predictor's tangent)"})
         out.events.sort(key=lambda e: e["index"])
     if progress is not None:
         progress(N)

@@ -69,9 +69,8 @@ class Lin:
 
     @functools.cached_property
     def ratio(self) -> np.ndarray:
-        """``σ_r / σ_1`` per pose, 0 where the rank has dropped: exact (the Gram matrix's
-        eigenvalues, resolved down to about ``1e-8``, the square root of the rounding of
-        ``σ²``) where it is under ``1e-3``; elsewhere a lower bound within a factor ``√k``
+        """``σ_r / σ_1`` per pose, 0 where the rank has dropped: exact (an SVD) where it is
+        under ``1e-3``; elsewhere a lower bound within a factor ``√k``
         (``1 / √(‖G‖_F ‖G⁻¹‖_F)`` for a Gram matrix of rank ``k = r``), which is enough to
         tell a regular pose."""
         B, k = self.G.shape[:2]
@@ -84,9 +83,7 @@ class Lin:
             out = np.nan_to_num(out)
         exact = out < 1e-3
         if exact.any():
-            lam = np.linalg.eigvalsh(self.G[exact])
-            with np.errstate(invalid="ignore", divide="ignore"):
-                out[exact] = np.nan_to_num(np.sqrt(np.maximum(lam[:, -self.r], 0.0) / lam[:, -1]))
+            out[exact] = svd_ratio(self.Jc[exact], self.r)
         return out
 
     def twists(self, y: np.ndarray) -> np.ndarray:
@@ -114,6 +111,13 @@ class Lin:
         out = Lin(self.Jc[idx], self.G[idx], self.rows, self.r, self.C[idx])
         out.__dict__["Ginv"] = self.Ginv[idx]
         return out
+
+
+def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
+    """``σ_r / σ_1`` of each of the matrices ``Jc`` (B, m, k) by an SVD (0 where ``σ_1 = 0``)."""
+    sv = np.linalg.svd(Jc, compute_uv=False)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.nan_to_num(sv[:, r - 1] / sv[:, 0])
 
 
 def _cross_cols(c: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -422,3 +426,66 @@ def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, ancho
         nxt = tr.advance(prev, U[before], U[k])
         if nxt is not None:
             w.put(k, nxt)
+
+
+# --------------------------------------------------------------------------- crossings
+GOLDEN_STEPS = 40
+
+
+def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list[tuple[int, np.ndarray, float]]:
+    """Singular configurations the sweep passes between rows: ``(row, inputs, ratio)``.
+
+    ``σ_r / σ_1`` is zero at a singular configuration and, along a motion through it,
+    grows like the distance ``|t - t*|`` on both sides (a V), while a regular minimum is
+    smooth (``a + c t²``). A row whose ratio is a local minimum with its two neighbours'
+    sum at least four times its own (every V passes: ``2 Δ / |δ| >= 4`` for a zero at
+    ``δ`` within half a row; a smooth minimum passes only when it is sharp for its depth,
+    ``c Δ² >= a``, i.e. near-singular) is refined by a golden-section search of the ratio
+    over the inputs between its neighbours, each pose reached by continuation from the
+    row; it is a crossing when the smallest ratio found is under ``RANK_TOL``."""
+    out = []
+    N = len(U)
+    for k in range(1, N - 1):
+        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]):
+            continue
+        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
+        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= RANK_TOL):
+            continue
+        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
+        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
+            continue  # not on one straight stretch of the sweep
+        found = _golden(tr, w, U, k)
+        if found is not None and found[1] < RANK_TOL:
+            out.append((k, found[0], found[1]))
+    return out
+
+
+def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, float] | None:
+    """The least ``σ_r / σ_1`` between rows ``k - 1`` and ``k + 1`` (golden section)."""
+    st = tr.state(*w.at(k), U[k][None])
+    lo, hi = U[k - 1], U[k + 1]
+
+    def f(t: float) -> float:
+        u = lo + t * (hi - lo)
+        nxt = tr.advance(st, U[k], u)
+        if nxt is None:
+            return np.inf
+        return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
+
+    halvings = tr.halvings  # the search's own step halvings are not the sweep's trouble
+    g = (np.sqrt(5) - 1) / 2
+    a, b = 0.0, 1.0
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(GOLDEN_STEPS):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    tr.halvings = halvings
+    t, best = (c, fc) if fc < fd else (d, fd)
+    return (lo + t * (hi - lo), best) if np.isfinite(best) else None
