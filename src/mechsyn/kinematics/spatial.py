@@ -123,7 +123,8 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
 
 
 def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
-    """Refuse drives that leave a joint point or a named point free to move."""
+    """Refuse drives that leave a joint point or a named point free to move at the pose
+    ``st`` (one pose)."""
     lin = st.lin
     _, _, Vt = np.linalg.svd(lin.Jc[0], full_matrices=True)
     N = lin.twists(Vt[lin.r:].T[None])[0]  # the motions with every drive at rest, as (ω, v)
@@ -134,8 +135,9 @@ def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.n
     checks = [(M.index(j.links[k]), M.local(j.point)) for j in M.mech.joints if j.point is not None
               for k in (0, 1)]
     checks += [(M.index(link), M.local(at)) for link, at in pts.values()]
-    for i, x in checks:
+    for i, x0 in checks:
         if i < M.n:
+            x = st.R[0, i] @ x0 + st.p[0, i]
             w, v = X[i, :3], X[i, 3:]
             worst = max(worst, float(np.abs(v + np.cross(w.T, x).T).max(initial=0.0)))
     if worst > 1e-6:
@@ -191,9 +193,23 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
     n = M.n
     R0, p0 = np.tile(np.eye(3), (1, n + 1, 1, 1)), np.zeros((1, n + 1, 3))
     start = tr.state(R0, p0, np.zeros((1, len(M.helix))), np.zeros((1, len(M.drives))))
-    _check_determined(M, start, pts)
+    try:
+        _check_determined(M, start, pts)
+        later = None
+    except MechsynInputError as exc:  # perhaps only the drawn assembly is singular: judge on the sweep
+        later = exc
     U = _input_matrix(M, inputs)
     rows = _sweep_rows(tr, start, U, sp, progress)
+    if later is not None:
+        if not rows.ok.any():
+            raise MechsynInputError(
+                f"{later.message}, or the drawn assembly is singular (e.g. a change point, where "
+                "branches meet) and the sweep cannot leave it", source=M.mech.source, field=later.field,
+                hint=f"{later.hint}, or draw the mechanism away from the singular position")
+        k = int(np.argmax(np.where(rows.ok, rows.ratio, -1.0)))  # the most regular row
+        R = np.concatenate([rows.R[k], np.eye(3)[None]])[None]
+        p = np.vstack([rows.p[k], np.zeros((1, 3))])[None]
+        _check_determined(M, tr.state(R, p, np.zeros((1, len(M.helix))), U[k][None]), pts)
     return _result(mech, M, tr, inputs, sp, pts, U, rows, start)
 
 
@@ -228,6 +244,18 @@ _MESSAGES = {
 }
 
 
+def _regular_rank(tr: Tracker, st: State) -> None:
+    """The regular rank: the drawn assembly's, unless rows of the sweep (its first, middle
+    and last assembled rows, by SVD) have a higher one: then the drawn assembly is
+    singular, ``tr.rank`` becomes the higher rank and ``tr.drawn_singular`` is set."""
+    rows = np.unique([0, len(st.g) // 2, len(st.g) - 1])
+    sv = np.linalg.svd(st.lin.Jc[rows], compute_uv=False)
+    rank = int(np.max(np.count_nonzero(sv > RANK_TOL * sv[:, :1], axis=1)))
+    if rank > (tr.rank or 0):
+        tr.drawn_singular, tr.rank, st.lin.r = tr.rank, rank, rank
+        st.lin.__dict__.pop("ratio", None)
+
+
 def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progress: Any) -> _Rows:
     """Poses of every row by continuation from the drawn assembly, then the closure residual,
     the rank test and the rates of all assembled rows at once."""
@@ -244,6 +272,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
     idx = np.flatnonzero(w.ok)
     if len(idx):
         st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
+        _regular_rank(tr, st)
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
         out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
@@ -284,7 +313,10 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
                    for k, jid in enumerate(M.slide_joints)})
     notes = []
-    idle = M.n * 6 - start.lin.r
+    idle = M.n * 6 - tr.rank
+    if tr.drawn_singular is not None:
+        notes.append(f"the file's configuration is singular (rank {tr.drawn_singular} there, {tr.rank} along the "
+                     "sweep): the branch chosen from it is arbitrary")
     if idle:
         notes.append(f"{idle} idle motion(s) with the drives at rest (e.g. a rod spinning between ball joints): "
                      "held at their drawn position (minimum-norm steps and rates)")
@@ -298,7 +330,7 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     return SpatialSimulation(
         mechanism=mech.name, inputs=inputs, input_types=types, speeds=speeds, assembled=ok, points=pm,
         links=links, joints=joints, residual=rows.res, singular_ratio=rows.ratio, length_scale=L,
-        rank=start.lin.r, idle=idle, events=rows.events, notes=notes, model=M)
+        rank=tr.rank, idle=idle, events=rows.events, notes=notes, model=M)
 
 
 def _point_motion(M: SpatialModel, rows: _Rows, X: np.ndarray, Xd: np.ndarray, link: str,

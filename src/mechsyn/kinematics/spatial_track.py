@@ -171,6 +171,7 @@ class Tracker:
         self.M = M
         self.m_c = M.n_constraints
         self.rank: int | None = None
+        self.drawn_singular: int | None = None  # the drawn assembly's rank when below the sweep's
         self.halvings = 0
         self.c0 = link_centres(M)
         self.blocks = _blocks(M)
