@@ -9,7 +9,7 @@ the field and the fix):
   ``{"cases": [...]}`` collection.
 * :class:`MechanismCase` -- path or motion generation with any planar mechanism file
   (``mechsyn synth mechanism``, docs/synthesis.md "Any planar mechanism"); solved by
-  :mod:`mechsyn.synthesis.general`. :func:`load_case` reads a YAML/JSON case.
+  :mod:`mechsyn.synthesis.general`. :func:`load_mechanism_case` reads a YAML/JSON case.
 
 Loading validates and returns data only: the assembly modes of the file's drawing (the
 branch a design must keep) are found by the solver when it first needs them
@@ -39,8 +39,8 @@ import numpy as np
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["Variable", "PathCase", "load_cases", "DesignVariable", "MechanismCase", "load_case",
-           "case_from_dict", "LINKAGE_NAMES", "LENGTHS", "TIMING_TYPES"]
+__all__ = ["Variable", "PathCase", "load_cases", "DesignVariable", "MechanismCase", "load_mechanism_case",
+           "mechanism_case_from_dict", "LINKAGE_NAMES", "LENGTHS", "TIMING_TYPES"]
 
 LINKAGE_NAMES = ("x0", "y0", "theta0", "r1", "r2", "r3", "r4", "rcx", "rcy")
 LENGTHS = ("r1", "r2", "r3", "r4")
@@ -278,7 +278,7 @@ class DesignVariable:
 
 @dataclass
 class MechanismCase:
-    """A synthesis case of any planar mechanism file (see :func:`case_from_dict`).
+    """A synthesis case of any planar mechanism file (see :func:`mechanism_case_from_dict`).
 
     ``reference``: the assembly modes (one sign per closed-form dyad) of the file's drawing,
     the branch every design must keep; None until the solver first needs it
@@ -332,13 +332,13 @@ class MechanismCase:
             [f"{self.input_joint}_{i + 1}" for i in range(self.n_targets)] if self.free else [])
 
 
-def load_case(path: str | Path) -> MechanismCase:
+def load_mechanism_case(path: str | Path) -> MechanismCase:
     """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism").
 
     Examples
     --------
     >>> import mechsyn as ms
-    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
     >>> case.problem, case.n_targets, case.names
     ('path', 8, ['B.x', 'B.y', 'C.x', 'C.y', 'M.x', 'M.y'])
     """
@@ -346,7 +346,7 @@ def load_case(path: str | Path) -> MechanismCase:
 
     p = Path(path)
     data, _ = read_data(p, "case file", fmt="yaml")
-    return case_from_dict(data, source=str(p), base_dir=p.parent)
+    return mechanism_case_from_dict(data, source=str(p), base_dir=p.parent)
 
 
 _CASE_KEYS = {"name", "mechanism", "input", "point", "targets", "link", "poses", "variables",
@@ -354,7 +354,7 @@ _CASE_KEYS = {"name", "mechanism", "input", "point", "targets", "link", "poses",
 
 
 @input_boundary("synthesis case")
-def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
+def mechanism_case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
     """Validate a case mapping; the mechanism file path is relative to ``base_dir``."""
     src = source
     if not isinstance(data, dict):

@@ -97,7 +97,7 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     Examples
     --------
     >>> import mechsyn as ms
-    >>> from mechsyn.synthesis.path import load_cases
+    >>> from mechsyn.synthesis.path import load_mechanism_cases
     >>> from mechsyn.synthesis.reports import path_synthesis, select_case
     >>> case = select_case(load_cases(ms.examples.path("path_cases_public")), "P2_kk5_timing")
     >>> res = path_synthesis(case, time_limit=20, restarts=1, min_transmission=10.0)
@@ -132,9 +132,9 @@ def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, r
     Examples
     --------
     >>> import mechsyn as ms
-    >>> from mechsyn.synthesis.general import load_case
+    >>> from mechsyn.synthesis.general import load_mechanism_case
     >>> from mechsyn.synthesis.reports import mechanism_synthesis
-    >>> mechanism_synthesis(load_case(ms.examples.path("slider_crank_path_case")), time_limit=0)
+    >>> mechanism_synthesis(load_mechanism_case(ms.examples.path("slider_crank_path_case")), time_limit=0)
     Traceback (most recent call last):
     ...
     mechsyn.errors.MechsynInputError: time_limit: must be positive
