@@ -22,6 +22,9 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError, input_boundary
+from mechsyn.io import load_mechanism, mechanism_to_dict
+from mechsyn.io.checks import numbers
+from mechsyn.io.files import read_data
 from mechsyn.synthesis.finger.vll import vll_ends
 
 __all__ = ["FingerVariable", "FingerCase", "load_case", "case_from_dict"]
@@ -84,16 +87,12 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> FingerCase:
     """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    from mechsyn.io.files import read_data
-
     path = Path(path)
     data, _text = read_data(path, "case file")
     return case_from_dict(data, str(path), base_dir=path.parent)
 
 
 def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
-    from mechsyn.io.checks import numbers
-
     if not isinstance(v, (list, tuple)):
         raise _err(f"{fld} must be a list of numbers", src, fld)
     out = numbers(v, src, fld).reshape(-1).tolist()
@@ -161,8 +160,6 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
 
 def _mechanism(data: dict, src: str, base_dir: Path | None) -> tuple[dict, str]:
     """The case's mechanism file as a dict, and its file name."""
-    from mechsyn.io import load_mechanism, mechanism_to_dict
-
     mpath = Path(str(data["mechanism"]))
     if not mpath.is_absolute() and base_dir is not None:
         mpath = base_dir / mpath
