@@ -104,7 +104,7 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     Examples
     --------
     >>> import mechsyn as ms
-    >>> from mechsyn.synthesis.path import load_mechanism_cases
+    >>> from mechsyn.synthesis.path import load_cases
     >>> from mechsyn.synthesis.reports import path_synthesis, select_case
     >>> case = select_case(load_cases(ms.examples.path("path_cases_public")), "P2_kk5_timing")
     >>> res = path_synthesis(case, time_limit=20, restarts=1, min_transmission=10.0)
