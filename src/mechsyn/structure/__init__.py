@@ -4,7 +4,7 @@
   Malyshev, Somov-Malyshev, ...) with the numbers substituted;
 * :mod:`~mechsyn.structure.analysis`: the papers' per-contour analysis
   (:func:`analyze_structure`), with :mod:`~mechsyn.structure.contours` (independent
-  contours) and :mod:`~mechsyn.structure.external` (external constraints, paper 002);
+  contours) and :mod:`~mechsyn.structure.external` (external constraints of variable-structure mechanisms);
 * :mod:`~mechsyn.structure.rank`: exact mobility from the joints' geometry (screw-theory
   rank), on :mod:`~mechsyn.structure.screws` (pair twists, linear algebra) and
   :mod:`~mechsyn.structure.idle` (idle mobilities);

@@ -14,6 +14,13 @@ Examples
 >>> x = start_vector(case)
 >>> apply_mechanism_design(case, x) == case.mech_dict
 True
+
+References
+----------
+.. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
+   structural-parametric synthesis of adaptive gripper mechanisms with variable-length
+   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
+   not in the project's copy ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations
