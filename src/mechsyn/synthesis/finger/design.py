@@ -20,7 +20,8 @@ Steps 8-13 of paper 000 (spec ``structural.md`` section 4), for every VLL combin
    accuracy ``max(tolerance_deg, stage-1 RMS error)``, the region and the stage-1 VLL
    range (see :func:`~mechsyn.synthesis.finger.modes.force_objective`); its best few
    distinct designs are then checked in both modes (VLL range found again, forces at
-   ``l_min`` and ``l_max``) and one replaces the stage-1 design only if its peak reaction is not higher and its criterion lower.
+   ``l_min`` and ``l_max``) and one replaces the stage-1 design only if its peak reaction
+   is not higher and its criterion lower.
 4. **Best variant (step 13)**: the combination with the smallest force criterion.
 
 **Objective interface** (``scipy.optimize.differential_evolution``, seeded): a design
