@@ -30,7 +30,9 @@ from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger.cases import load_case
-from mechsyn.synthesis.finger.design import apply_design, design_finger, evaluate_locked, redraw
+from mechsyn.synthesis.finger.design import design_finger
+from mechsyn.synthesis.finger.evaluation import apply_design, evaluate_locked
+from mechsyn.synthesis.finger.modes import redraw
 from mechsyn.synthesis.finger.population import locked_population
 
 CASE = Path(__file__).resolve().parents[1] / "examples" / "fingers" / "finger_design_case.yaml"

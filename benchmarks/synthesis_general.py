@@ -22,7 +22,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from mechsyn.synthesis.general import (MechanismProblem, case_from_dict, load_case,  # noqa: E402
+from mechsyn.synthesis.general import (MechanismProblem, mechanism_case_from_dict, load_mechanism_case,  # noqa: E402
                                        start_vector, synthesize_mechanism)
 from mechsyn.synthesis.path import PathCase, PathProblem  # noqa: E402
 
@@ -39,14 +39,14 @@ def per_design(f, X, repeat=3):
 def main() -> None:
     rng = np.random.default_rng(0)
     values = [40, 50, 60, 70, 80, 90]
-    fb = case_from_dict({
+    fb = mechanism_case_from_dict({
         "mechanism": str(ROOT / "examples/textbook/fourbar.yaml"), "input": {"joint": "A", "values_deg": values},
         "point": "M", "targets": [[3, 4]] * 6,
         "variables": [{"joint": "B", "coord": "x", "lower": 0.8, "upper": 1.2},
                       {"joint": "C", "coord": "x", "lower": 3.8, "upper": 4.2},
                       {"joint": "D", "coord": "x", "lower": 4.8, "upper": 5.2},
                       {"point": "M", "coord": "y", "lower": 3.8, "upper": 4.2}]}, "<bench>")
-    six = load_case(ROOT / "examples/synthesis/sixbar_path_case.yaml")
+    six = load_mechanism_case(ROOT / "examples/synthesis/sixbar_path_case.yaml")
     rows = []
     for name, case in (("four-bar (general)", fb), ("Watt six-bar (general)", six)):
         p = MechanismProblem(case, batch=False)
@@ -76,7 +76,7 @@ def main() -> None:
         print(f"  {name:60s} {t * 1e6:9.1f} us   ({t / ref:.1f}x the closed-form module)")
     print("\nsynthesis of the bundled cases (1 restart, default options, 5 seeds)")
     for f in ("sixbar_path_case.yaml", "slider_crank_path_case.yaml"):
-        case = load_case(ROOT / "examples/synthesis" / f)
+        case = load_mechanism_case(ROOT / "examples/synthesis" / f)
         start = MechanismProblem(case).fitness(start_vector(case)[None, :])[0]
         for batch in (False, True):
             errs, secs = [], []

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import os
 
+from mechsyn.errors import MechsynInputError
+
 __all__ = ["DEFAULTS", "limit", "set_limit", "limit_hint"]
 
 #: name -> (default, what it bounds)
@@ -53,8 +55,6 @@ def limit(name: str) -> float:
         try:
             value = float(text)
         except ValueError:
-            from mechsyn.errors import MechsynInputError
-
             raise MechsynInputError(f"expected a number, got {text!r}", source=_env_name(name)) from None
         return int(value) if isinstance(default, int) and value.is_integer() else value
     return default

@@ -119,9 +119,9 @@ def test_unreachable_scheduler_is_one_clear_error(monkeypatch):
 
 
 def test_synth_mechanism_restarts_in_processes_equal_one_process():
-    from mechsyn.synthesis.general import load_case, synthesize_mechanism
+    from mechsyn.synthesis.general import load_mechanism_case, synthesize_mechanism
 
-    case = load_case(ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml")
+    case = load_mechanism_case(ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml")
     fast = {"maxiter": 15, "popsize": 5}  # generation budgets: no timing decides the result
     one = synthesize_mechanism(case, seed=2, restarts=2, time_limit=300, options=fast, n_polish=1)
     two = synthesize_mechanism(case, seed=2, restarts=2, time_limit=300, options=fast, n_polish=1,

@@ -181,9 +181,9 @@ def test_cli_checkpoint_options_checked_before_work(run_cli, tmp_path, monkeypat
 
 
 def test_mechanism_search_interrupted_then_resumed_gives_the_uninterrupted_design(tmp_path):
-    from mechsyn.synthesis.general import load_case, synthesize_mechanism
+    from mechsyn.synthesis.general import load_mechanism_case, synthesize_mechanism
 
-    case = load_case(ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml")
+    case = load_mechanism_case(ROOT / "examples" / "synthesis" / "slider_crank_path_case.yaml")
     args = {"seed": 1, "restarts": 2, "time_limit": 120, "n_polish": 1,
             "options": {"maxiter": 5, "popsize": 4, "init_oversample": 1}}
     full = synthesize_mechanism(case, **args)

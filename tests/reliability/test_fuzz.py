@@ -221,9 +221,9 @@ def test_any_data_as_mechanism_api(value):
 @settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)
 @given(data=st.data())
 def test_broken_synthesis_cases_api(data):
-    from mechsyn.synthesis.general import case_from_dict
+    from mechsyn.synthesis.general import mechanism_case_from_dict
 
-    _api_contract(case_from_dict, data.draw(broken(_load(CASE))), str(CASE), base_dir=CASE.parent)
+    _api_contract(mechanism_case_from_dict, data.draw(broken(_load(CASE))), str(CASE), base_dir=CASE.parent)
 
 
 @settings(max_examples=60 * SCALE, deadline=None, derandomize=FIXED)

@@ -67,10 +67,10 @@ def test_path_search_interrupted_before_any_evaluation_propagates(monkeypatch):
 
 
 def test_mechanism_search_interrupted_by_callback_returns_best_so_far():
-    from mechsyn.synthesis.general import evaluate_design as evaluate_mechanism
-    from mechsyn.synthesis.general import load_case, synthesize_mechanism
+    from mechsyn.synthesis.general import evaluate_mechanism_design as evaluate_mechanism
+    from mechsyn.synthesis.general import load_mechanism_case, synthesize_mechanism
 
-    case = load_case(SLIDER_CASE)
+    case = load_mechanism_case(SLIDER_CASE)
     res = synthesize_mechanism(case, seed=0, time_limit=60, restarts=2, callback=_interrupt_after(5))
     assert res.interrupted and res.feasible
     x = np.array([res.design[n] for n in case.names])

@@ -7,7 +7,7 @@ import pytest
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.synthesis import cases, general, path
-from mechsyn.synthesis.cases import PathCase, case_from_dict, load_case
+from mechsyn.synthesis.cases import PathCase, mechanism_case_from_dict, load_mechanism_case
 
 ROOT = Path(__file__).resolve().parents[2]
 FOURBAR = ROOT / "examples" / "textbook" / "fourbar.yaml"
@@ -16,7 +16,7 @@ SIXBAR_CASE = ROOT / "examples" / "synthesis" / "sixbar_path_case.yaml"
 
 def test_one_case_format_per_concept():
     assert path.PathCase is cases.PathCase and path.load_cases is cases.load_cases
-    assert general.MechanismCase is cases.MechanismCase and general.load_case is cases.load_case
+    assert general.MechanismCase is cases.MechanismCase and general.load_mechanism_case is cases.load_mechanism_case
     assert not hasattr(general, "_err") and not hasattr(general, "_floats")
 
 
@@ -25,22 +25,22 @@ def test_loading_runs_no_solver(monkeypatch):
         raise AssertionError("the solver ran while a case was loaded")
 
     monkeypatch.setattr(general, "_drawing_branch", solver)
-    case = load_case(SIXBAR_CASE)
+    case = load_mechanism_case(SIXBAR_CASE)
     assert case.reference is None
     monkeypatch.undo()
     signs = general.reference_branch(case)
     assert signs is case.reference and len(signs) >= 1 and all(abs(s) == 1 for s in signs)
     # the design the file draws keeps its own branch
-    assert general.evaluate_design(case, general.start_vector(case)).feasible
+    assert general.evaluate_mechanism_design(case, general.start_vector(case)).feasible
 
 
 def test_a_design_off_the_drawn_branch_is_refused_without_synthesize():
-    """evaluate_design alone (no synthesize_mechanism) still checks the drawing's branch."""
-    case = load_case(SIXBAR_CASE)
-    ev = general.evaluate_design(case, general.start_vector(case))
+    """evaluate_mechanism_design alone (no synthesize_mechanism) still checks the drawing's branch."""
+    case = load_mechanism_case(SIXBAR_CASE)
+    ev = general.evaluate_mechanism_design(case, general.start_vector(case))
     flipped = list(-np.asarray(general.reference_branch(case)))
     case.reference = flipped
-    bad = general.evaluate_design(case, general.start_vector(case))
+    bad = general.evaluate_mechanism_design(case, general.start_vector(case))
     assert ev.feasible and not bad.feasible and "branch" in bad.reason
 
 
@@ -85,5 +85,5 @@ def test_mechanism_case_errors_name_the_field(change, field):
             "targets": [[0, 0], [1, 0]], "variables": [{"joint": "B", "coord": "x", "lower": 0, "upper": 1}]}
     data.update(change)
     with pytest.raises(MechsynInputError) as exc:
-        case_from_dict(data, "case.yaml")
+        mechanism_case_from_dict(data, "case.yaml")
     assert exc.value.field == field and "case.yaml" in str(exc.value)

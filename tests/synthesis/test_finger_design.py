@@ -20,8 +20,9 @@ from mechsyn.io import load_mechanism, mechanism_from_dict
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger.cases import case_from_dict, load_case
-from mechsyn.synthesis.finger.design import (
-    INFEASIBLE, design_finger, evaluate_locked, force_objective, stage1_objective)
+from mechsyn.synthesis.finger.design import design_finger, stage1_objective
+from mechsyn.synthesis.finger.evaluation import INFEASIBLE, evaluate_locked
+from mechsyn.synthesis.finger.modes import force_objective
 from mechsyn.synthesis.finger.vll import points_in_region
 
 EX = Path(__file__).resolve().parents[2] / "examples" / "fingers"

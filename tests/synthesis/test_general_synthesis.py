@@ -10,8 +10,8 @@ import pytest
 import yaml
 
 from mechsyn.cli.main import main
-from mechsyn.synthesis.general import (MechanismProblem, case_from_dict, evaluate_design, load_case,
-                                       start_vector, synthesize_mechanism)
+from mechsyn.synthesis.general import (MechanismProblem, evaluate_mechanism_design, load_mechanism_case,
+                                       mechanism_case_from_dict, start_vector, synthesize_mechanism)
 from mechsyn.synthesis.path import PathCase
 from mechsyn.synthesis.path import evaluate_design as fourbar_evaluate
 
@@ -32,11 +32,11 @@ def fourbar_case(targets=None, variables=None, **extra):
                                        {"joint": "D", "coord": "x", "lower": 4.5, "upper": 5.5},
                                        {"point": "M", "coord": "y", "lower": 3.5, "upper": 4.5}]}
     data.update(extra)
-    return case_from_dict(data, source="<test>")
+    return mechanism_case_from_dict(data, source="<test>")
 
 
 def targets_of(case, x):
-    ev = evaluate_design(case, x)
+    ev = evaluate_mechanism_design(case, x)
     assert ev.feasible, ev.reason
     return ev.achieved.tolist()
 
@@ -44,7 +44,7 @@ def targets_of(case, x):
 def test_recovers_known_fourbar_design():
     c0 = fourbar_case()
     case = fourbar_case(targets_of(c0, X_TRUE))
-    assert evaluate_design(case, start_vector(case)).error > 0.1        # the file's design is off
+    assert evaluate_mechanism_design(case, start_vector(case)).error > 0.1        # the file's design is off
     res = synthesize_mechanism(case, seed=1, time_limit=120, restarts=1, options=FAST)
     assert res.feasible and res.method == "assur"
     assert res.error < 1e-12
@@ -73,11 +73,11 @@ def _fourbar_pathcase(d, case):
 
 @pytest.mark.parametrize("x", [X_TRUE, np.array([1.0, 4.0, 5.0, 4.0]), np.array([1.3, 3.7, 4.8, 3.6])])
 def test_error_agrees_with_closed_form_fourbar_module(x):
-    from mechsyn.synthesis.general import apply_design
+    from mechsyn.synthesis.general import apply_mechanism_design
 
     case = fourbar_case(targets_of(fourbar_case(), X_TRUE + [0.05, -0.1, 0.1, 0.2]))
-    ev = evaluate_design(case, x)
-    pc = _fourbar_pathcase(apply_design(case, x), case)
+    ev = evaluate_mechanism_design(case, x)
+    pc = _fourbar_pathcase(apply_mechanism_design(case, x), case)
     ref = fourbar_evaluate(pc, {})
     assert ev.feasible and ref["feasible"]
     assert ev.error == pytest.approx(ref["error"], rel=1e-9, abs=1e-14)
@@ -85,25 +85,25 @@ def test_error_agrees_with_closed_form_fourbar_module(x):
 
 
 def test_sixbar_reaches_small_error_from_perturbed_design_targets():
-    case = load_case(SIXBAR_CASE)
-    assert evaluate_design(case, start_vector(case)).error == pytest.approx(0.7122631869, rel=1e-6)
+    case = load_mechanism_case(SIXBAR_CASE)
+    assert evaluate_mechanism_design(case, start_vector(case)).error == pytest.approx(0.7122631869, rel=1e-6)
     res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.feasible and res.method == "assur"
     assert res.error < 1e-10
 
 
 def test_newton_and_closed_form_evaluations_agree_on_the_sixbar():
-    case = load_case(SIXBAR_CASE)
+    case = load_mechanism_case(SIXBAR_CASE)
     newton = dataclasses.replace(case, method="newton")
     for x in (start_vector(case), np.array([5.3, 5.8, 6.7, 6.2, 4.8]), np.array([4.6, 6.4, 7.0, 5.5, 4.5])):
-        a, b = evaluate_design(case, x), evaluate_design(newton, x)
+        a, b = evaluate_mechanism_design(case, x), evaluate_mechanism_design(newton, x)
         assert (a.method, b.method) == ("assur", "newton")
         assert a.feasible and b.feasible
         assert b.error == pytest.approx(a.error, rel=1e-8, abs=1e-14)
 
 
 def test_slider_crank_path_synthesis_closed_form():
-    case = load_case(SLIDER_CASE)
+    case = load_mechanism_case(SLIDER_CASE)
     res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.feasible and res.method == "assur"
     assert res.error < 1e-10
@@ -112,16 +112,16 @@ def test_slider_crank_path_synthesis_closed_form():
 
 
 def test_motion_generation_recovers_coupler_poses():
-    c0 = case_from_dict({"mechanism": str(FOURBAR), "input": {"joint": "A", "values_deg": VALUES},
+    c0 = mechanism_case_from_dict({"mechanism": str(FOURBAR), "input": {"joint": "A", "values_deg": VALUES},
                          "link": "coupler", "poses": [[0, 0, 0]] * len(VALUES),
                          "variables": [{"joint": "C", "coord": "x", "lower": 3.5, "upper": 4.5},
                                        {"joint": "D", "coord": "x", "lower": 4.5, "upper": 5.5}]}, "<test>")
     xt = np.array([4.2, 5.2])
-    ev = evaluate_design(c0, xt)
+    ev = evaluate_mechanism_design(c0, xt)
     poses = np.column_stack([ev.achieved, ev.achieved_angles_deg]).tolist()
     case = dataclasses.replace(c0, targets=np.array(poses)[:, :2], angles_deg=np.array(poses)[:, 2])
-    assert evaluate_design(case, xt).error < 1e-20
-    assert evaluate_design(case, start_vector(case)).error > 1e-3
+    assert evaluate_mechanism_design(case, xt).error < 1e-20
+    assert evaluate_mechanism_design(case, start_vector(case)).error > 1e-3
     res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.error < 1e-12 and np.allclose(list(res.design.values()), xt, atol=1e-5)
 
@@ -146,12 +146,12 @@ def test_dead_point_between_targets_is_infeasible():
     # the file's four-bar is a triple rocker: one full crank turn from 60 to 420 deg passes
     # its dead points, although it assembles at both targets (the same position)
     case = fourbar_case(input={"joint": "A", "values_deg": [60, 420]}, targets=[[0, 0], [0, 0]])
-    ev = evaluate_design(case, start_vector(case))
+    ev = evaluate_mechanism_design(case, start_vector(case))
     assert not ev.feasible and "not assembled" in ev.reason
     case1 = fourbar_case(input={"joint": "A", "values_deg": [60]}, targets=[[0, 0]])
     case2 = fourbar_case(input={"joint": "A", "values_deg": [420]}, targets=[[0, 0]])
-    assert evaluate_design(case1, start_vector(case1)).feasible
-    assert evaluate_design(case2, start_vector(case2)).feasible
+    assert evaluate_mechanism_design(case1, start_vector(case1)).feasible
+    assert evaluate_mechanism_design(case2, start_vector(case2)).feasible
 
 
 def test_other_assembly_branch_is_infeasible():
@@ -160,8 +160,8 @@ def test_other_assembly_branch_is_infeasible():
     B, D, C = np.array([1.0, 2.0]), np.array([5.0, 0.0]), np.array([4.0, 3.0])
     u = (D - B) / np.linalg.norm(D - B)
     mirror = B + 2 * ((C - B) @ u) * u - (C - B)        # C reflected in the line B-D: same lengths
-    assert evaluate_design(case, C).feasible
-    ev = evaluate_design(case, mirror)
+    assert evaluate_mechanism_design(case, C).feasible
+    ev = evaluate_mechanism_design(case, mirror)
     assert not ev.feasible and "branch" in ev.reason
     assert MechanismProblem(case).fitness(mirror[None, :])[0] > MechanismProblem(case).penalty_base
 
@@ -174,15 +174,15 @@ def test_free_timing_keeps_order_and_fits():
                                "range_deg": [30, 100]})
     assert case.names[-1] == "A_6" and len(case.lower) == 1 + len(VALUES)
     x = np.concatenate([[3.8], VALUES])
-    assert evaluate_design(case, x).feasible
+    assert evaluate_mechanism_design(case, x).feasible
     x_bad = np.concatenate([[3.8], VALUES[::-1][:1] + VALUES[1:-1] + VALUES[:1]])  # out of order
-    ev = evaluate_design(case, x_bad)
+    ev = evaluate_mechanism_design(case, x_bad)
     assert not ev.feasible and "order" in ev.reason
     res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
     assert res.feasible
     th = np.array([res.design[f"A_{i + 1}"] for i in range(len(VALUES))])
     assert np.all(np.diff(th) > 0)
-    assert res.error < evaluate_design(case, np.concatenate([[3.8], [v + 4 for v in VALUES]])).error
+    assert res.error < evaluate_mechanism_design(case, np.concatenate([[3.8], [v + 4 for v in VALUES]])).error
 
 
 def test_cli_writes_file_that_simulate_reproduces(tmp_path, capsys):
@@ -200,7 +200,8 @@ def test_cli_writes_file_that_simulate_reproduces(tmp_path, capsys):
     for key in ("error", "design", "feasible", "assembled_at_all_targets", "seconds", "achieved", "targets"):
         assert key in data
     assert data["feasible"] and set(data["design"]) == {"D.x", "M.x"}
-    assert 1e-8 < data["error"] < evaluate_design(load_case(f), start_vector(load_case(f))).error
+    case = load_mechanism_case(f)
+    assert 1e-8 < data["error"] < evaluate_mechanism_design(case, start_vector(case)).error
     assert png.stat().st_size > 1000
     assert main(["simulate", str(out), "-i", "A=" + ",".join(map(str, VALUES)), "--points", "M", "--json"]) == 0
     sim = json.loads(capsys.readouterr().out)
@@ -253,12 +254,12 @@ def test_vll_length_variable_on_paper_000_finger():
             "point": "tip", "targets": [[0, 0]] * 5,
             "variables": [{"joint": "S", "length": True, "lower": 24, "upper": 34},
                           {"joint": "C", "coord": "x", "lower": 4, "upper": 12}]}
-    c0 = case_from_dict(data, "<test>")
+    c0 = mechanism_case_from_dict(data, "<test>")
     assert start_vector(c0)[0] == pytest.approx(np.hypot(16, 24))     # |KL| of the file
     data["targets"] = targets_of(c0, [30.0, 9.0])
-    case = case_from_dict(data, "<test>")
+    case = mechanism_case_from_dict(data, "<test>")
     newton = dataclasses.replace(case, method="newton")
-    a, b = evaluate_design(case, [29.0, 8.0]), evaluate_design(newton, [29.0, 8.0])
+    a, b = evaluate_mechanism_design(case, [29.0, 8.0]), evaluate_mechanism_design(newton, [29.0, 8.0])
     assert (a.method, b.method) == ("assur", "newton")
     assert b.error == pytest.approx(a.error, rel=1e-8)
     res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)
@@ -310,12 +311,12 @@ def _population(case, rng, spread):
 
 
 def test_batch_population_evaluation_equals_the_engine():
-    case = load_case(SIXBAR_CASE)
+    case = load_mechanism_case(SIXBAR_CASE)
     _batch_equals_engine(case, _population(case, np.random.default_rng(0), 1.5))
 
 
 def test_batch_equals_the_engine_when_the_crank_moves():
-    case = case_from_dict({
+    case = mechanism_case_from_dict({
         "mechanism": str(FOURBAR), "input": {"joint": "A", "values_deg": [40, 50, 60, 70, 80, 90]},
         "point": "M", "targets": [[3, 4]] * 6,
         "variables": [{"joint": "B", "coord": "x", "lower": 0.5, "upper": 1.5},

@@ -13,7 +13,7 @@ from mechsyn.belt import BeltSynthesis, synthesize_belt
 from mechsyn.synthesis.curves.synthesis import CurveSynthesisResult, _result
 from mechsyn.synthesis.curves.target import target_from_points
 from mechsyn.synthesis.fourbar import fourbar_position
-from mechsyn.synthesis.general import MechanismSynthesisResult, load_case, synthesize_mechanism
+from mechsyn.synthesis.general import MechanismSynthesisResult, load_mechanism_case, synthesize_mechanism
 from mechsyn.synthesis.optimize import PathSynthesisResult, restart_seeds, synthesize_path
 from mechsyn.synthesis.path import PathCase
 from mechsyn.synthesis.problem import COMMON_KEYS, Progress, SynthesisResult, as_generator, resolve_seed
@@ -58,7 +58,7 @@ def test_path_result_has_the_common_keys_and_repeats_with_int_and_generator():
 
 
 def test_mechanism_result_has_the_common_keys_and_repeats():
-    case = load_case(ms.examples.path("slider_crank_path_case"))
+    case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
     states: list[Progress] = []
     run = lambda seed, **kw: synthesize_mechanism(case, seed=seed, time_limit=60, restarts=1,  # noqa: E731
                                                   options=FAST, n_polish=1, **kw)

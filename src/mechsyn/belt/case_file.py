@@ -32,7 +32,10 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from mechsyn.belt.design import BeltDesign
 from mechsyn.belt.kinematics import ConstantSpeedLaw, MotionLaw, TableLaw, TrapezoidalLaw
+from mechsyn.belt.report import phi_range
+from mechsyn.belt.synthesis import synthesize_belt
 from mechsyn.errors import MechsynInputError
+from mechsyn.io.files import read_data, read_text
 
 if TYPE_CHECKING:
     from mechsyn.belt.synthesis import BeltSynthesis
@@ -113,8 +116,6 @@ class BeltCase(_Strict):
 def load_belt_case(path: str) -> BeltCase:
     """Read and validate a belt case file (YAML or JSON); MechsynInputError on bad input
     (naming the file, the line of a syntax error, or the offending field)."""
-    from mechsyn.io.files import read_data
-
     data, _ = read_data(path, "belt case file")
     if not isinstance(data, dict):
         raise MechsynInputError("expected a mapping (name, design, phi_deg, ...) at the top",
@@ -141,8 +142,6 @@ def read_motion_table(path: str | Path) -> tuple[list[float], list[float]]:
     >>> read_motion_table(f)
     ([0.0, 0.5, 1.0], [-73.0, -20.0, 0.0])
     """
-    from mechsyn.io.files import read_text
-
     text = read_text(path, "table")
     t: list[float] = []
     phi: list[float] = []
@@ -213,8 +212,6 @@ def case_inputs(case: BeltCase) -> tuple[tuple[BeltDesign | BeltSynthesis, NDArr
     >>> type(rep.law).__name__, round(rep.paths["C"].extent_x, 1)
     ('TrapezoidalLaw', 1228.5)
     """
-    from mechsyn.belt.report import phi_range
-    from mechsyn.belt.synthesis import synthesize_belt
 
     if case.synthesis is not None:
         s = case.synthesis

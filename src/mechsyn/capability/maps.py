@@ -24,11 +24,12 @@ from typing import Any
 import numpy as np
 
 from mechsyn._result import Result
-from mechsyn.errors import MechsynInputError
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
 from mechsyn.capability.measures import (
     MEASURES, component_limit, exact_limit, min_norm_limit, stepped_limit,
 )
+from mechsyn.errors import MechsynInputError
+from mechsyn.parallel import run_tasks
 
 BRANCHES = {"negative": (-1,), "positive": (1,), "both": (-1, 1)}
 
@@ -402,8 +403,6 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
     >>> bool(np.isfinite(cmap.value).all())
     True
     """
-    from mechsyn.parallel import run_tasks
-
     xs, ys = np.asarray(xs, float), np.asarray(ys, float)
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     pts = np.stack([X.ravel(), Y.ravel()], 1)

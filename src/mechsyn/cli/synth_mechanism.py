@@ -49,7 +49,7 @@ def synth_mechanism(
     a point follows target positions (or a link target poses) at given input angles."""
     from mechsyn.cli.render import render_mechanism_synthesis
     from mechsyn.parallel import check_parallel_options
-    from mechsyn.synthesis.general import load_case
+    from mechsyn.synthesis.general import load_mechanism_case
     from mechsyn.synthesis.reports import mechanism_synthesis
 
     check_parallel_options(workers, scheduler)
@@ -57,7 +57,7 @@ def synth_mechanism(
     check_output_suffix(out, (".yaml", ".yml", ".json"), "--out", what=".yaml or .json")
     check_overwrite(out, "--out", force)
     ck = checkpoint_options(checkpoint, resume)
-    case = load_case(case_file)
+    case = load_mechanism_case(case_file)
     with restart_progress("synth mechanism", restarts, enabled=not as_json) as progress:
         res = mechanism_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
                                   workers=workers, scheduler=scheduler, callback=progress, **ck)

@@ -27,6 +27,6 @@ def root(
 @app.command("version")
 def version() -> None:
     """Print mechsyn's version."""
-    from mechsyn import __version__
+    from mechsyn._version import __version__
 
     typer.echo(f"mechsyn {__version__}")

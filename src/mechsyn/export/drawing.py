@@ -6,6 +6,8 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.export.svg import mechanism_svg
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["drawing_of"]
@@ -25,8 +27,6 @@ def drawing_of(mech: Mechanism, pose: dict[str, float] | None = None, paths: lis
     >>> svg = drawing_of(load_mechanism("examples/kinematics/crank_rocker.yaml"), paths=["M"],
     ...                  sweep={"A": np.arange(0.0, 361.0, 10.0)})  # doctest: +SKIP
     """
-    from mechsyn.kinematics.analysis import simulate
-    from mechsyn.kinematics.system import build_system
 
     drivers = build_system(mech).drivers
     if not drivers:

@@ -21,10 +21,17 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from mechsyn.errors import MechsynInputError
 from mechsyn.model.pairs import PAIR_KINDS
 
 if TYPE_CHECKING:  # NetworkX is imported by graph() only: reading and analysing a file need not load it
     import networkx as nx
+
+    # The facade methods below return the upper layers' results: named here for the types only;
+    # the methods import their module when called (the facade edges of tests/test_layout.py).
+    from mechsyn.kinematics.analysis import ForceAnalysis, Simulation
+    from mechsyn.structure.report import StructureReport
+    from mechsyn.web.widget import MechanismWidget
 
 Kind = Literal["planar", "spatial"]
 VLLMode = Literal["active", "passive", "locked"]
@@ -265,7 +272,7 @@ class Mechanism:
         return mechanism_to_dict(self)
 
     # -- analyses (the library's entry points, as methods) ---------------------------
-    def analyze(self, method: str | None = None, remedies: bool = False, **kwargs: Any) -> Any:
+    def analyze(self, method: str | None = None, remedies: bool = False, **kwargs: Any) -> StructureReport:
         """Structural analysis: :func:`mechsyn.analyze` (formulas, rank method, remedies)."""
         from mechsyn.structure.report import analyze
 
@@ -273,7 +280,7 @@ class Mechanism:
 
     def simulate(self, inputs: dict[str, Any] | None = None, *, points: list[str] | None = None,
                  speeds: dict[str, float] | None = None, vll: dict[str, str] | None = None,
-                 method: str = "auto", **joint_inputs: Any) -> Any:
+                 method: str = "auto", **joint_inputs: Any) -> Simulation:
         """Kinematics over a sweep: :func:`mechsyn.simulate`, inputs given per joint.
 
         Each input is ``(start, stop, step)`` (a tuple: a range, ends included) or the values
@@ -287,7 +294,7 @@ class Mechanism:
 
     def forces(self, inputs: dict[str, Any] | None = None, *, gravity: tuple[float, float] = (0.0, 0.0),
                static: bool = False, speeds: dict[str, float] | None = None, vll: dict[str, str] | None = None,
-               method: str = "auto", **joint_inputs: Any) -> Any:
+               method: str = "auto", **joint_inputs: Any) -> ForceAnalysis:
         """Joint reactions and drive efforts over a sweep: :func:`mechsyn.forces`, inputs as
         in :meth:`simulate`."""
         from mechsyn.kinematics.analysis import forces
@@ -299,7 +306,7 @@ class Mechanism:
     def with_joints(self, joints: tuple[Joint, ...], name: str | None = None) -> "Mechanism":
         return replace(self, joints=joints, name=name or self.name)
 
-    def widget(self, root: str = "."):
+    def widget(self, root: str = ".") -> MechanismWidget:
         """This mechanism in mechsyn studio's editor as a Jupyter widget (``mechsyn[web,notebook]``);
         the widget's ``mechanism`` follows every edit (see :mod:`mechsyn.web.widget`)."""
         from mechsyn.web.widget import MechanismWidget
@@ -327,7 +334,6 @@ class Mechanism:
 def _inputs(inputs: dict[str, Any] | None, joint_inputs: dict[str, Any]) -> dict[str, np.ndarray]:
     """Joint -> values: a tuple ``(start, stop, step)`` is a range with both ends, anything
     else the values themselves."""
-    from mechsyn.errors import MechsynInputError
     from mechsyn.kinematics.analysis import input_grid
 
     out: dict[str, np.ndarray] = {}

@@ -7,12 +7,12 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn.plot._base import axes
+
 __all__ = ["plot_curve_result", "plot_candidate"]
 
 
 def _axes(ax):
-    from mechsyn.plot._base import axes
-
     return axes(ax, (6, 5))
 
 

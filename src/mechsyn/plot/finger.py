@@ -18,6 +18,8 @@ import numpy as np
 from matplotlib.patches import Polygon
 
 from mechsyn.plot._base import axes, figure
+from mechsyn.synthesis.finger.evaluation import apply_design, evaluate_drawn
+from mechsyn.synthesis.finger.modes import redraw
 
 __all__ = ["plot_finger_design", "plot_fingers", "sketch_mechanism"]
 
@@ -126,8 +128,6 @@ def plot_finger_design(case: Any, result: Any, fig: Any = None) -> Any:
     crank angles); a zoom on the output paths for VLL lengths across the range. Returns the
     Figure."""
     from matplotlib import cm
-
-    from mechsyn.synthesis.finger.design import apply_design, evaluate_drawn, redraw
 
     v = result.best_variant
     combo = v.combination

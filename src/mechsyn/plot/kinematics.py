@@ -13,6 +13,8 @@ import matplotlib
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io.pyslvs import color_rgb
+from mechsyn.model.pairs import belt_tangent
 from mechsyn.plot._base import axes, figure
 
 __all__ = ["animate_simulation", "draw_mechanism", "link_outlines", "plot_forces", "plot_paths",
@@ -94,8 +96,6 @@ def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
         if con.kind != "belt":
             continue
         # the pulley, the straight run from the anchor to the tangent point, the wrapped arc
-        from mechsyn.model.pairs import belt_tangent
-
         j = S.mech.joint(con.joint)
         q = sim.sweep.q[k:k + 1]
         centre, anchor = S.point(q, con.b, con.sb)[0], S.point(q, con.a, con.sa)[0]
@@ -123,8 +123,6 @@ def draw_mechanism(ax: Any, sim: Any, k: int, alpha: float = 1.0) -> list:
 
 def _file_colours(sim: Any, k: int) -> list[tuple[np.ndarray, tuple[float, float, float]]]:
     """(position at step ``k``, RGB) of each joint and point the file's ``colors`` names."""
-    from mechsyn.io.pyslvs import color_rgb
-
     S = sim.system
     colours = S.mech.attrs.get("colors") or {}
     q = sim.sweep.q[k:k + 1]

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.plot._base import axes
+from mechsyn.synthesis.exact import center_point_curve
 from mechsyn.synthesis.fourbar import fourbar_position, rotate
 
 __all__ = ["plot_fourbar_path", "plot_mechanism_synthesis", "plot_motion_synthesis"]
@@ -84,7 +85,6 @@ def plot_motion_synthesis(P: np.ndarray, sols: list, ax: Any = None) -> Any:
     """Burmester motion generation: the required poses (red arrows), the centre-point curve
     (4 poses) and the best linkage at pose 1. ``P`` is (n, 3) x, y, angle (rad); ``sols``
     from :func:`mechsyn.synthesis.exact.motion_synthesis`, best first. Returns the Axes."""
-    from mechsyn.synthesis.exact import center_point_curve
 
     ax = axes(ax, (7, 6))
     best = sols[0]

@@ -734,15 +734,3 @@ def rank_summary_lines(ra: RankAnalysis) -> list[str]:
         lines.append((head.upper() if ra.singular or ra.shaky else head.capitalize()) + ":" + rest)
     return lines
 
-
-_MOVED_TO_COMPARE = ("Comparison", "compare_with_formulas", "RemedyCheck", "check_remedy", "rank_to_markdown")
-
-
-def __getattr__(name: str) -> Any:
-    """The comparison with the formulas and the remedy checks live in
-    :mod:`mechsyn.structure.compare`; importing them from here still works."""
-    if name in _MOVED_TO_COMPARE:
-        from mechsyn.structure import compare
-
-        return getattr(compare, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -9,7 +9,7 @@ the field and the fix):
   ``{"cases": [...]}`` collection.
 * :class:`MechanismCase` -- path or motion generation with any planar mechanism file
   (``mechsyn synth mechanism``, docs/synthesis.md "Any planar mechanism"); solved by
-  :mod:`mechsyn.synthesis.general`. :func:`load_case` reads a YAML/JSON case.
+  :mod:`mechsyn.synthesis.general`. :func:`load_mechanism_case` reads a YAML/JSON case.
 
 Loading validates and returns data only: the assembly modes of the file's drawing (the
 branch a design must keep) are found by the solver when it first needs them
@@ -37,10 +37,13 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError, input_boundary
+from mechsyn.io import load_mechanism, mechanism_to_dict
+from mechsyn.io.checks import numbers
+from mechsyn.io.files import read_data
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["Variable", "PathCase", "load_cases", "DesignVariable", "MechanismCase", "load_case",
-           "case_from_dict", "LINKAGE_NAMES", "LENGTHS", "TIMING_TYPES"]
+__all__ = ["Variable", "PathCase", "load_cases", "DesignVariable", "MechanismCase", "load_mechanism_case",
+           "mechanism_case_from_dict", "LINKAGE_NAMES", "LENGTHS", "TIMING_TYPES"]
 
 LINKAGE_NAMES = ("x0", "y0", "theta0", "r1", "r2", "r3", "r4", "rcx", "rcy")
 LENGTHS = ("r1", "r2", "r3", "r4")
@@ -56,8 +59,6 @@ def _err(msg: str, source: str | None, fld: str | None = None, hint: str | None 
 
 def _floats(v: Any, src: str | None, fld: str, n: int | None = None) -> np.ndarray:
     """Finite numbers of field ``fld`` as an array (``n`` per entry when given)."""
-    from mechsyn.io.checks import numbers
-
     a = numbers(v, src, fld)
     if n is not None and a.shape[-1:] != (n,):
         raise _err(f"{fld} must be finite numbers" + (f", {n} per entry" if n else ""), src, fld)
@@ -123,8 +124,6 @@ class PathCase:
 
 
 def _path_targets(data: dict, source: str | None) -> np.ndarray:
-    from mechsyn.io.checks import numbers
-
     if "targets" not in data:
         raise _err("missing", source, "targets", "give a list of [x, y] points")
     targets = numbers(data["targets"], source, "targets")
@@ -163,8 +162,6 @@ def _path_timing(timing: Any, n: int, source: str | None) -> tuple[str, np.ndarr
 
 
 def _path_fixed(fixed_raw: Any, source: str | None) -> dict[str, float]:
-    from mechsyn.io.checks import numbers
-
     if not isinstance(fixed_raw, dict):
         raise _err("must be an object name -> value", source, "fixed")
     fixed: dict[str, float] = {}
@@ -188,8 +185,6 @@ def _path_variables(items: Any, ttype: str, n: int, fixed: dict[str, float],
                     source: str | None) -> tuple[Variable, ...]:
     """The variables with their bounds; completes ``fixed`` with the pivot's defaults
     (``x0 = y0 = theta0 = 0``) and refuses a linkage name that is neither."""
-    from mechsyn.io.checks import numbers
-
     allowed = set(LINKAGE_NAMES) | _timing_names(ttype, n)
     variables = []
     for i, v in enumerate(items):
@@ -249,8 +244,6 @@ def _path_options(data: dict, source: str | None) -> dict[str, Any]:
 
 def load_cases(path: str | Path) -> list[PathCase]:
     """Load one case object, or every case of a ``{"cases": [...]}`` collection."""
-    from mechsyn.io.files import read_data
-
     path = Path(path)
     data, _ = read_data(path, "case file", fmt="json")
     if isinstance(data, dict) and "cases" in data:
@@ -278,7 +271,7 @@ class DesignVariable:
 
 @dataclass
 class MechanismCase:
-    """A synthesis case of any planar mechanism file (see :func:`case_from_dict`).
+    """A synthesis case of any planar mechanism file (see :func:`mechanism_case_from_dict`).
 
     ``reference``: the assembly modes (one sign per closed-form dyad) of the file's drawing,
     the branch every design must keep; None until the solver first needs it
@@ -332,21 +325,19 @@ class MechanismCase:
             [f"{self.input_joint}_{i + 1}" for i in range(self.n_targets)] if self.free else [])
 
 
-def load_case(path: str | Path) -> MechanismCase:
+def load_mechanism_case(path: str | Path) -> MechanismCase:
     """Read a case YAML/JSON (see docs/synthesis.md, "Any planar mechanism").
 
     Examples
     --------
     >>> import mechsyn as ms
-    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
     >>> case.problem, case.n_targets, case.names
     ('path', 8, ['B.x', 'B.y', 'C.x', 'C.y', 'M.x', 'M.y'])
     """
-    from mechsyn.io.files import read_data
-
     p = Path(path)
     data, _ = read_data(p, "case file", fmt="yaml")
-    return case_from_dict(data, source=str(p), base_dir=p.parent)
+    return mechanism_case_from_dict(data, source=str(p), base_dir=p.parent)
 
 
 _CASE_KEYS = {"name", "mechanism", "input", "point", "targets", "link", "poses", "variables",
@@ -354,7 +345,7 @@ _CASE_KEYS = {"name", "mechanism", "input", "point", "targets", "link", "poses",
 
 
 @input_boundary("synthesis case")
-def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
+def mechanism_case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = None) -> MechanismCase:
     """Validate a case mapping; the mechanism file path is relative to ``base_dir``."""
     src = source
     if not isinstance(data, dict):
@@ -380,8 +371,6 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
 
 def _case_mechanism(data: dict, src: str, base_dir: Path | None) -> tuple[Path, Any, dict]:
     """The case's planar mechanism: its path, the model and its dict."""
-    from mechsyn.io import load_mechanism, mechanism_to_dict
-
     if "mechanism" not in data:
         raise _err("missing `mechanism:` (path to a planar mechanism file)", src, "mechanism")
     mpath = Path(str(data["mechanism"]))

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from mechsyn.io import mechanism_from_dict
+from mechsyn.results import dumps, write_atomic
 from mechsyn.synthesis.fourbar import fourbar_position, rotate
 
 
@@ -58,17 +61,8 @@ def write_mechanism_file(mech: dict[str, Any], path, header: str = "") -> None:
     The dict is validated by :func:`mechsyn.io.mechanism_from_dict` first; the YAML keeps
     a comment header (how the linkage was obtained).
     """
-    from pathlib import Path
-
-    from mechsyn.results import dumps, write_atomic
-
     path = Path(path)
-    try:  # validate against the mechanism model when it is available
-        from mechsyn.io import mechanism_from_dict
-    except ImportError:  # pragma: no cover - older model package
-        mechanism_from_dict = None
-    if mechanism_from_dict is not None:
-        mechanism_from_dict(mech)
+    mechanism_from_dict(mech)
     if path.suffix.lower() == ".json":
         write_atomic(path, dumps(mech) + "\n")
     else:

@@ -41,69 +41,33 @@ References
 
 from __future__ import annotations
 
-import copy
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
+from mechsyn.checkpoint import open_search_checkpoint
 from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
-from mechsyn.synthesis.cases import DesignVariable, MechanismCase, case_from_dict, load_case
+from mechsyn.io import mechanism_from_dict
+from mechsyn.kinematics import dyads
+from mechsyn.kinematics.analysis import resolve_points
+from mechsyn.kinematics.solve import sweep
+from mechsyn.kinematics.system import build_system
+from mechsyn.parallel import run_tasks
+from mechsyn.synthesis.cases import DesignVariable, MechanismCase, mechanism_case_from_dict, load_mechanism_case
+from mechsyn.synthesis.designs import MechanismEvaluation, apply_mechanism_design, infeasibility, start_vector
+from mechsyn.synthesis.finger.vll import locked_model
+from mechsyn.synthesis.general_batch import batch_evaluator
+from mechsyn.synthesis.optimize import OPTIMIZERS, check_optimizer, polish, restart_seeds
 from mechsyn.synthesis.problem import Progress, ProgressCallback, SeedLike, SynthesisResult, resolve_seed
 
 __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismProblem",
-           "MechanismSynthesisResult", "load_case", "case_from_dict", "apply_design", "evaluate_design",
+           "MechanismSynthesisResult", "load_mechanism_case", "mechanism_case_from_dict", "apply_mechanism_design",
+           "evaluate_mechanism_design",
            "synthesize_mechanism", "start_vector", "reference_branch"]
-
-
-# --------------------------------------------------------------------------- designs
-def start_vector(case: MechanismCase) -> np.ndarray:
-    """The file's geometry as a design vector (the starting design)."""
-    md = case.mech_dict
-    joints = {j["id"]: j for j in md["joints"]}
-    x = []
-    for v in case.variables:
-        if v.kind == "joint":
-            x.append(float(joints[v.target]["point"][v.coord]))
-        elif v.kind == "point":
-            x.append(float(md["points"][v.target]["at"][v.coord]))
-        else:
-            from mechsyn.synthesis.finger.vll import vll_ends
-
-            _c, _L, K, _p = vll_ends(md, v.target, case.source)
-            x.append(float(np.linalg.norm(np.subtract(joints[v.target]["point"], joints[K]["point"]))))
-    if case.free:
-        x += list(case.values_deg)
-    return np.array(x, float)
-
-
-def apply_design(case: MechanismCase, x: np.ndarray) -> dict:
-    """The mechanism dict of design vector ``x`` (design part; timing values ignored).
-    A VLL's length moves its piston pivot along the cylinder's direction (paper 000's
-    drawing, as in :func:`mechsyn.synthesis.finger.design.apply_design`)."""
-    d = copy.deepcopy(case.mech_dict)
-    joints = {j["id"]: j for j in d["joints"]}
-    for v, val in zip(case.variables, np.asarray(x, float)):
-        if v.kind == "joint":
-            joints[v.target]["point"][v.coord] = float(val)
-        elif v.kind == "point":
-            d["points"][v.target]["at"][v.coord] = float(val)
-    for v, val in zip(case.variables, np.asarray(x, float)):
-        if v.kind == "length":
-            from mechsyn.synthesis.finger.vll import vll_ends
-
-            _c, L, K, _p = vll_ends(d, v.target, case.source)
-            pk = np.asarray(joints[K]["point"], float)
-            u = np.asarray(joints[v.target]["point"], float) - pk
-            u = u / np.linalg.norm(u)
-            p = (pk + float(val) * u).tolist()
-            joints[v.target]["point"] = p
-            joints[v.target]["axis"] = u.tolist()
-            joints[L]["point"] = p
-    return d
 
 
 def _sweep_grid(u0_deg: float, values: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
@@ -120,32 +84,10 @@ def _sweep_grid(u0_deg: float, values: np.ndarray, step: float) -> tuple[np.ndar
     return np.concatenate(parts), np.array(idx)
 
 
-@dataclass
-class MechanismEvaluation:
-    """One design: feasibility, error and the achieved path / angles at the targets."""
-
-    feasible: bool
-    reason: str
-    error: float = np.inf
-    violation: float = 0.0
-    achieved: np.ndarray | None = None         # (N, 2)
-    achieved_angles_deg: np.ndarray | None = None
-    path: np.ndarray | None = None             # dense sweep path of the point
-    inputs_deg: np.ndarray | None = None       # the target inputs used
-    method: str = ""
-    sigmas: list[float] | None = None
-
-
 def _build(case: MechanismCase, x: np.ndarray) -> tuple[Any, Any, Any, dict]:
-    from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics import dyads
-    from mechsyn.kinematics.system import build_system
-
-    d = apply_design(case, x)
+    d = apply_mechanism_design(case, x)
     ev_d = d
     if any(j.get("vll") == "locked" for j in d["joints"]):
-        from mechsyn.synthesis.finger.vll import locked_model
-
         ev_d = locked_model(d, [j["id"] for j in d["joints"] if j.get("vll") == "locked"], case.source)
     mech = mechanism_from_dict(ev_d, source=case.source)
     S = build_system(mech)
@@ -160,7 +102,7 @@ def reference_branch(case: MechanismCase) -> list[float] | None:
     Examples
     --------
     >>> import mechsyn as ms
-    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
     >>> case.reference is None
     True
     >>> reference_branch(case) == case.reference, len(case.reference)  # two dyads
@@ -172,8 +114,6 @@ def reference_branch(case: MechanismCase) -> list[float] | None:
 
 
 def _drawing_branch(case: MechanismCase) -> list[float] | None:
-    from mechsyn.kinematics import dyads
-
     _m, S, plan, _d = _build(case, start_vector(case))
     if plan is None:
         return None
@@ -185,12 +125,8 @@ def _drawing_branch(case: MechanismCase) -> list[float] | None:
     return [float(s) for s in sig]
 
 
-def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
+def evaluate_mechanism_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
     """Sweep design ``x`` with the engine and compute the case's objective."""
-    from mechsyn.kinematics import dyads
-    from mechsyn.kinematics.analysis import resolve_points
-    from mechsyn.kinematics.solve import sweep
-
     x = np.asarray(x, float)
     nd = case.n_design
     values = x[nd:] if case.free else case.values_deg
@@ -247,22 +183,6 @@ def evaluate_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
                                sigmas=sig)
 
 
-def infeasibility(n_bad: int, n_grid: int, branch_viol: float, viol_order: float,
-                  method: str) -> MechanismEvaluation | None:
-    """The infeasible evaluation (violation and reasons) of a swept design, or None."""
-    viol = n_bad / n_grid + branch_viol + viol_order
-    if viol <= 0:
-        return None
-    why = []
-    if n_bad:
-        why.append(f"not assembled at {n_bad} of {n_grid} inputs of the sweep")
-    if branch_viol:
-        why.append("off the file's assembly branch")
-    if viol_order:
-        why.append("input angles out of order")
-    return MechanismEvaluation(False, "; ".join(why), violation=1.0 + viol, method=method)
-
-
 class MechanismProblem:
     """Feasibility-first fitness over populations, and least-squares residuals, in the
     interface :func:`mechsyn.synthesis.optimize.polish` expects."""
@@ -280,15 +200,13 @@ class MechanismProblem:
         # U: feasible scores are capped at U, infeasible ones are U + violation (>= 1)
         self.penalty_base = 1e6 * case.n_targets * (max(1.0, ext) ** 2 + w ** 2)
         self.n_evaluations = 0   # designs swept
-        from mechsyn.synthesis.general_batch import batch_evaluator
-
         self.batch = batch_evaluator(case) if batch else None  # whole populations at once
 
     def evaluate(self, Z: np.ndarray) -> list[MechanismEvaluation]:
         self.n_evaluations += len(np.atleast_2d(Z))
         if self.batch is not None:
             return _EvalList(self.batch.evaluate(Z))
-        return _EvalList([evaluate_design(self.case, z) for z in np.atleast_2d(Z)])
+        return _EvalList([evaluate_mechanism_design(self.case, z) for z in np.atleast_2d(Z)])
 
     def score(self, ev: MechanismEvaluation) -> float:
         if ev.feasible and np.isfinite(ev.error):
@@ -301,7 +219,7 @@ class MechanismProblem:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         c = self.case
         self.n_evaluations += 1
-        ev = self.batch.evaluate(z)[0] if self.batch is not None else evaluate_design(c, z)
+        ev = self.batch.evaluate(z)[0] if self.batch is not None else evaluate_mechanism_design(c, z)
         n = 2 * c.n_targets + (c.n_targets if c.problem == "motion" else 0)
         if not ev.feasible:
             return np.full(n, np.sqrt(self.penalty_base / n) * (1.0 + ev.violation))
@@ -363,8 +281,6 @@ def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, o
     the global search until ``search_end`` (``time.time()``), then the polish of the best few
     members. Returns the best vector, its fitness and the number of evaluations. ``tracker``
     (in this process only) records the best design evaluated, for Ctrl-C."""
-    from mechsyn.synthesis.optimize import OPTIMIZERS, polish
-
     prob = MechanismProblem(case, batch=batch)
     width = prob.upper - prob.lower
 
@@ -395,10 +311,6 @@ def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, o
 
 
 def _mechanism_checkpoint(path, resume, case, dim, seed, restarts, optimizer, opts, f_atol, batch):
-    from mechsyn.checkpoint import open_search_checkpoint
-
-    from dataclasses import fields
-
     content = {f.name: getattr(case, f.name) for f in fields(case) if f.name not in ("source", "mechanism_path")}
     return open_search_checkpoint(path, "synth mechanism", content, resume=resume, dim=dim, seed=seed, restarts=restarts,
                                   optimizer=optimizer, options=opts, f_atol=f_atol, batch=batch)
@@ -431,15 +343,12 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     Examples
     --------
     >>> import mechsyn as ms
-    >>> from mechsyn.synthesis.general import load_case
-    >>> case = load_case(ms.examples.path("slider_crank_path_case"))
+    >>> from mechsyn.synthesis.general import load_mechanism_case
+    >>> case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
     >>> res = ms.synthesize_mechanism(case, seed=0, time_limit=20, restarts=1)
     >>> res.feasible, res.error < res.start_error
     (True, True)
     """
-    from mechsyn.parallel import run_tasks
-    from mechsyn.synthesis.optimize import check_optimizer, restart_seeds
-
     check_optimizer(optimizer)
     t0 = time.time()
     seed = resolve_seed(seed)
@@ -510,10 +419,10 @@ def _mechanism_result(case: MechanismCase, best_z: np.ndarray, start_f: float, p
                       interrupted: bool) -> MechanismSynthesisResult:
     """The result of the best design ``best_z``, evaluated again (the file's own design
     scored ``start_f``; scores from ``penalty_base`` up are infeasible)."""
-    ev = evaluate_design(case, best_z)
+    ev = evaluate_mechanism_design(case, best_z)
     names = case.names
     design = {n: float(v) for n, v in zip(names, best_z)}
-    d = apply_design(case, best_z[:case.n_design])
+    d = apply_mechanism_design(case, best_z[:case.n_design])
     d["name"] = (f"{d.get('name', 'mechanism')} (synthesised, seed {seed}"
                  + (", interrupted: best so far)" if interrupted else ")"))
     ok = bool(ev.feasible)

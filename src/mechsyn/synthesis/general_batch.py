@@ -4,7 +4,7 @@ When a path-generation case's mechanism is a crank and RRR dyads (R pairs only, 
 design variables are joint or point coordinates), a whole population of designs is
 evaluated by :func:`mechsyn.kinematics.batch.simulate_batch` in a few array passes
 instead of one engine sweep per design. The evaluation is the one of
-:func:`mechsyn.synthesis.general.evaluate_design`, term for term: the same dense input
+:func:`mechsyn.synthesis.general.evaluate_mechanism_design`, term for term: the same dense input
 grid from each design's drawn input value through the target inputs (padded to a common
 length by repeating segment ends, which are not counted twice), assembly at every grid point, the assembly mode of
 every dyad equal to the file's drawing, free-timing order, and the sum of squared
@@ -17,12 +17,15 @@ from __future__ import annotations
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import mechanism_from_dict
+from mechsyn.kinematics.batch import compile_plan, simulate_batch
+from mechsyn.synthesis.designs import MechanismEvaluation, infeasibility, start_vector
 
 __all__ = ["BatchEvaluator", "batch_evaluator"]
 
 
 class BatchEvaluator:
-    """Evaluates populations of a :class:`~mechsyn.synthesis.general.MechanismCase`."""
+    """Evaluates populations of a :class:`~mechsyn.synthesis.cases.MechanismCase`."""
 
     def __init__(self, case, plan, base: np.ndarray, columns: np.ndarray, reference_sigmas: np.ndarray) -> None:
         self.case = case
@@ -38,9 +41,6 @@ class BatchEvaluator:
         return P
 
     def evaluate(self, Z: np.ndarray) -> list:
-        from mechsyn.kinematics.batch import simulate_batch
-        from mechsyn.synthesis.general import MechanismEvaluation, infeasibility
-
         case = self.case
         Z = np.atleast_2d(np.asarray(Z, float))
         K, nd = len(Z), case.n_design
@@ -92,10 +92,6 @@ class BatchEvaluator:
 
 def batch_evaluator(case) -> BatchEvaluator | None:
     """A batch evaluator for the case, or None when it needs the engine path."""
-    from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics.batch import compile_plan, simulate_batch
-    from mechsyn.synthesis.general import start_vector
-
     if case.problem != "path" or case.method == "newton" or case.point is None:
         return None
     if any(v.kind not in ("joint", "point") for v in case.variables):

@@ -25,6 +25,13 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
+from mechsyn.structure.analysis import analyze_structure
+from mechsyn.synthesis.curves.database import build_database, load_database
+from mechsyn.synthesis.exact import motion_synthesis, to_jsonable_motion
+from mechsyn.synthesis.export import fourbar_mechanism_dict
+from mechsyn.synthesis.finger.groups import group_table
+from mechsyn.synthesis.general import synthesize_mechanism
+from mechsyn.synthesis.optimize import default_target_error, synthesize_path
 
 __all__ = ["select_case", "path_synthesis", "mechanism_synthesis", "path_mechanism_dict", "MotionReport", "motion_report",
            "motion_mechanism_dict", "finger_groups", "curve_candidate_files", "CurveDatabaseReport", "curve_database"]
@@ -104,8 +111,6 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     >>> res.feasible, res.transmission_angle_min_deg
     (True, 10.0)
     """
-    from mechsyn.synthesis.optimize import default_target_error, synthesize_path
-
     _check_budget(time_limit, restarts)
     if target_error is not None and not target_error >= 0:
         raise MechsynInputError("must be >= 0 (0: use the whole budget)", field="target_error")
@@ -132,23 +137,19 @@ def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, r
     Examples
     --------
     >>> import mechsyn as ms
-    >>> from mechsyn.synthesis.general import load_case
+    >>> from mechsyn.synthesis.general import load_mechanism_case
     >>> from mechsyn.synthesis.reports import mechanism_synthesis
-    >>> mechanism_synthesis(load_case(ms.examples.path("slider_crank_path_case")), time_limit=0)
+    >>> mechanism_synthesis(load_mechanism_case(ms.examples.path("slider_crank_path_case")), time_limit=0)
     Traceback (most recent call last):
     ...
     mechsyn.errors.MechsynInputError: time_limit: must be positive
     """
-    from mechsyn.synthesis.general import synthesize_mechanism
-
     _check_budget(time_limit, restarts)
     return synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
                                 callback=callback, workers=workers, scheduler=scheduler, **search)
 
 
 def _fourbar_dict(design: dict[str, float], theta2: float, branch: int, name: str) -> dict[str, Any]:
-    from mechsyn.synthesis.export import fourbar_mechanism_dict
-
     d = design
     return fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], theta2, branch=branch, rcx=d["rcx"],
                                   rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"], name=name)
@@ -195,8 +196,6 @@ class MotionReport(Result):
         return self.all_solutions[: self.top]
 
     def to_dict(self) -> dict[str, Any]:
-        from mechsyn.synthesis.exact import to_jsonable_motion
-
         return {"solutions": [to_jsonable_motion(s) for s in self.solutions], "count": self.count,
                 "verified_count": self.verified_count}
 
@@ -221,8 +220,6 @@ def motion_report(poses: np.ndarray, *, circle_points: np.ndarray | None = None,
     >>> r.count, r.verified_count, r.to_dict()["count"]
     (1, 1, 1)
     """
-    from mechsyn.synthesis.exact import motion_synthesis
-
     poses = np.asarray(poses, float)
     if (circle_points is not None or center_points is not None) and len(poses) != 3:
         raise MechsynInputError("circle/centre points are chosen only for 3 poses", field="circle_points")
@@ -279,8 +276,6 @@ def curve_database(directory: Any = None, *, max_links: int = 6, per_topology: i
     """
     from pathlib import Path
 
-    from mechsyn.synthesis.curves.database import build_database, load_database
-
     if max_links not in (4, 6, 8):
         raise MechsynInputError(f"{max_links} links: choose 4, 6 or 8", field="max_links")
     if per_topology < 1:
@@ -308,8 +303,6 @@ def finger_groups(actuators: int = 1, max_links: int = 5, *, base_mobility: int 
     ...
     mechsyn.errors.MechsynInputError: base_mobility: W0 = 2 is not larger than the 2 drive(s): the finger is already fully actuated, nothing to attach
     """
-    from mechsyn.structure.analysis import analyze_structure
-    from mechsyn.synthesis.finger.groups import group_table
 
     if (base_mobility is None) == (base is None):
         raise MechsynInputError("give exactly one of base_mobility and base", field="base_mobility",

@@ -5,20 +5,26 @@ variable-length links (VLL).
   (``mechsyn synth groups``);
 * :mod:`~mechsyn.synthesis.finger.candidates`: every distinct finger made fully actuated
   by attaching a group, with its VLL candidates (``mechsyn synth finger``);
-* :mod:`~mechsyn.synthesis.finger.cases`: finger-design case files;
 * :mod:`~mechsyn.synthesis.finger.vll`: the cylinder-piston pair of a VLL, the locked
   model, the working-region test;
-* :mod:`~mechsyn.synthesis.finger.design`: the parametric steps 8-13
-  (``mechsyn synth finger-design``).
+* :mod:`~mechsyn.synthesis.finger.cases`: finger-design case files;
+* :mod:`~mechsyn.synthesis.finger.evaluation`: a design vector drawn as a mechanism and
+  evaluated with its VLL locked (step 8's objective terms);
+* :mod:`~mechsyn.synthesis.finger.population`: the same evaluation for a population at
+  once, through the batch kinematics;
+* :mod:`~mechsyn.synthesis.finger.modes`: the VLL range and the static forces in both
+  modes (steps 9-12);
+* :mod:`~mechsyn.synthesis.finger.design`: the parametric steps 8-13 driven end to end
+  (:func:`~mechsyn.synthesis.finger.design.design_finger`, ``mechsyn synth finger-design``).
+
+Each module imports only the ones listed before it (and the kinematics), so the design
+driver sits on top.
 
 References
 ----------
-*Algorithm of structural-parametric synthesis of mechanisms of fingers of universal
-gripping devices with variable-length links* (in Russian; ITMO University); paper 000 of
-the project's seeds, restated in the spec's ``structural.md`` section 4. Authors, journal
-and year are not in the project's copy (see ``docs/references.md``).
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
    links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   not in the project's copy ("paper 000"; see docs/references.md). Restated in the
+   spec's ``structural.md`` section 4.
 """

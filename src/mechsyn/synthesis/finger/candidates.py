@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import mechanism_from_dict, mechanism_to_dict
 from mechsyn.structure.assur import assur_decomposition
 from mechsyn.synthesis import canonical
 from mechsyn.synthesis.chains import rigid_subchain
@@ -172,8 +173,6 @@ def synthesize_fingers(
     >>> syn.W0, syn.W_f, len(syn.results) > 0
     (2, -1, True)
     """
-    from mechsyn.io import mechanism_to_dict
-
     if mech.kind != "planar":
         raise MechsynInputError("paper 000's synthesis is for planar fingers", source=mech.name)
     if any(j.is_higher for j in mech.joints):
@@ -285,8 +284,6 @@ def _attachments(mech, plan: tuple, sites: list[str]):
 
 def _build(mech, base, names, tree_edges, ext, plan, deg, actuators, number, cert):
     """The mechanism data of one attachment, or None when it is not fully actuated."""
-    from mechsyn.io import mechanism_from_dict
-
     pts = _points(mech, names, tree_edges, ext)
     joints = list(base["joints"])
     new_pairs = tree_edges + ext

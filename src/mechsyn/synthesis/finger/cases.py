@@ -22,13 +22,16 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError, input_boundary
+from mechsyn.io import load_mechanism, mechanism_to_dict
+from mechsyn.io.checks import numbers
+from mechsyn.io.files import read_data
 from mechsyn.synthesis.finger.vll import vll_ends
 
-__all__ = ["Variable", "FingerCase", "load_case", "case_from_dict"]
+__all__ = ["FingerVariable", "FingerCase", "load_case", "case_from_dict"]
 
 
 @dataclass(frozen=True)
-class Variable:
+class FingerVariable:
     """One design variable: ``kind`` joint (a joint point's x or y), point (a named
     point's x or y) or vll_angle (the VLL's direction in the drawn configuration, deg)."""
 
@@ -49,7 +52,7 @@ class FingerCase:
     source: str
     mech_dict: dict
     input: str
-    variables: list[Variable]
+    variables: list[FingerVariable]
     target_inputs: np.ndarray             # crank rotation from the drawn configuration, deg
     target_angles: dict[str, np.ndarray]  # link -> rotation from the drawn configuration, deg
     region: np.ndarray                    # (k, 2) polygon
@@ -84,16 +87,12 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> FingerCase:
     """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    from mechsyn.io.files import read_data
-
     path = Path(path)
     data, _text = read_data(path, "case file")
     return case_from_dict(data, str(path), base_dir=path.parent)
 
 
 def _floats(v: Any, n: int | None, src: str, fld: str) -> list[float]:
-    from mechsyn.io.checks import numbers
-
     if not isinstance(v, (list, tuple)):
         raise _err(f"{fld} must be a list of numbers", src, fld)
     out = numbers(v, src, fld).reshape(-1).tolist()
@@ -161,8 +160,6 @@ def case_from_dict(data: Any, source: str = "<case>", base_dir: Path | None = No
 
 def _mechanism(data: dict, src: str, base_dir: Path | None) -> tuple[dict, str]:
     """The case's mechanism file as a dict, and its file name."""
-    from mechsyn.io import load_mechanism, mechanism_to_dict
-
     mpath = Path(str(data["mechanism"]))
     if not mpath.is_absolute() and base_dir is not None:
         mpath = base_dir / mpath
@@ -243,14 +240,14 @@ def _combinations(raw: Any, vll_all: list[str], src: str) -> list[tuple[str, ...
     return combos
 
 
-def _variables(raw: Any, md: dict, vll_all: list[str], src: str) -> list[Variable]:
+def _variables(raw: Any, md: dict, vll_all: list[str], src: str) -> list[FingerVariable]:
     """The design variables: joint or point coordinates, VLL directions."""
     if not isinstance(raw, list) or not raw:
         raise _err("variables must be a non-empty list", src, "variables")
     return [_variable(v, f"variables[{k}]", md, vll_all, src) for k, v in enumerate(raw)]
 
 
-def _variable(v: Any, fld: str, md: dict, vll_all: list[str], src: str) -> Variable:
+def _variable(v: Any, fld: str, md: dict, vll_all: list[str], src: str) -> FingerVariable:
     joints = {j["id"]: j for j in md["joints"]}
     if not isinstance(v, dict) or "bounds" not in v:
         raise _err("each variable needs bounds: [lo, hi]", src, fld)
@@ -261,7 +258,7 @@ def _variable(v: Any, fld: str, md: dict, vll_all: list[str], src: str) -> Varia
         tgt = str(v["vll_angle"])
         if tgt not in vll_all:
             raise _err(f"no VLL {tgt!r}", src, fld)
-        return Variable(f"{tgt}.angle", "vll_angle", tgt, 0, (b[0], b[1]))
+        return FingerVariable(f"{tgt}.angle", "vll_angle", tgt, 0, (b[0], b[1]))
     if "joint" not in v and "point" not in v:
         raise _err("a variable names a joint, a point or a vll_angle", src, fld)
     kind = "joint" if "joint" in v else "point"
@@ -276,7 +273,7 @@ def _variable(v: Any, fld: str, md: dict, vll_all: list[str], src: str) -> Varia
     coord = v.get("coord", "x")
     if coord not in ("x", "y"):
         raise _err("coord must be x or y", src, fld)
-    return Variable(f"{tgt}.{coord}", kind, tgt, 0 if coord == "x" else 1, (b[0], b[1]))
+    return FingerVariable(f"{tgt}.{coord}", kind, tgt, 0 if coord == "x" else 1, (b[0], b[1]))
 
 
 def _targets(tg: Any, md: dict, src: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:

@@ -18,9 +18,10 @@ Steps 8-13 of paper 000 (spec ``structural.md`` section 4), for every VLL combin
    ``peak |R| + w * peak |M_in|`` (largest joint reaction and balancing moment over the
    crank range) of both modes (the VLL held at stage 1's ``l_max``) subject to the
    accuracy ``max(tolerance_deg, stage-1 RMS error)``, the region and the stage-1 VLL
-   range (see :func:`force_objective`); its best few distinct designs are then checked in both
-   modes (VLL range found again, forces at ``l_min`` and ``l_max``) and one replaces the
-   stage-1 design only if its peak reaction is not higher and its criterion lower.
+   range (see :func:`~mechsyn.synthesis.finger.modes.force_objective`); its best few
+   distinct designs are then checked in both modes (VLL range found again, forces at
+   ``l_min`` and ``l_max``) and one replaces the stage-1 design only if its peak reaction
+   is not higher and its criterion lower.
 4. **Best variant (step 13)**: the combination with the smallest force criterion.
 
 **Objective interface** (``scipy.optimize.differential_evolution``, seeded): a design
@@ -52,128 +53,20 @@ from typing import Any, Callable
 
 import numpy as np
 
+from mechsyn.checkpoint import open_search_checkpoint
 from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.finger.cases import FingerCase
+from mechsyn.synthesis.finger.evaluation import INFEASIBLE, FingerEvaluation, Objective, apply_design, evaluate_locked
+from mechsyn.synthesis.finger.modes import force_objective, mode_forces, underactuated_paths, vll_range
+from mechsyn.synthesis.finger.population import locked_population
 from mechsyn.synthesis.problem import SynthesisResult
-from mechsyn.synthesis.finger.vll import copy_mechanism, locked_model, points_in_region, region_excess, vll_ends
 
-__all__ = ["apply_design", "Evaluation", "evaluate_locked", "evaluate_drawn", "stage1_objective",
-           "stage1_population", "force_objective", "force_population", "redraw", "underactuated_paths",
-           "vll_range", "mode_forces", "design_finger", "FingerDesign", "VariantResult", "INFEASIBLE"]
-
-INFEASIBLE = 1e6
-Objective = Callable[[np.ndarray], float]
+__all__ = ["stage1_objective", "stage1_population", "force_population", "design_finger", "FingerDesign",
+           "VariantResult"]
 
 
-# --------------------------------------------------------------------------- designs
-def apply_design(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] | None = None) -> dict:
-    """The mechanism dict of design ``x``: joint / point coordinates set; each VLL of the
-    combination ``combo`` (default: every VLL) drawn at its minimum constructible length
-    along its direction, the other VLL (plain rigid links in this variant) at their drawn
-    length."""
-    d = copy_mechanism(case.mech_dict)
-    joints = {j["id"]: j for j in d["joints"]}
-    angles: dict[str, float] = {}
-    for v, val in zip(case.variables, np.asarray(x, float)):
-        if v.kind == "joint":
-            joints[v.target]["point"][v.coord] = float(val)
-        elif v.kind == "point":
-            d["points"][v.target]["at"][v.coord] = float(val)
-        else:
-            angles[v.target] = float(val)
-    for jid, j in joints.items():
-        if not j.get("vll"):
-            continue
-        _cyl, L, K, _pis = vll_ends(d, jid, case.source)
-        pk = np.asarray(joints[K]["point"], float)
-        u = np.asarray(j["point"], float) - pk
-        ang = np.radians(angles[jid]) if jid in angles else np.arctan2(u[1], u[0])
-        length = case.vll_limits(jid)[0] if combo is None or jid in combo else float(np.linalg.norm(u))
-        u = np.array([np.cos(ang), np.sin(ang)])
-        p = pk + length * u
-        j["point"] = p.tolist()
-        j["axis"] = u.tolist()
-        joints[L]["point"] = p.tolist()
-    return d
-
-
-@dataclass
-class Evaluation:
-    """A design in the fully actuated (VLL locked) mode over the dense crank grid."""
-
-    feasible: bool
-    reason: str
-    error_rms: float = np.inf          # deg, over targets and links
-    error_max: float = np.inf
-    achieved: dict[str, np.ndarray] = field(default_factory=dict)
-    paths: dict[str, np.ndarray] = field(default_factory=dict)
-    inputs: np.ndarray | None = None
-    q: np.ndarray | None = None
-    system: Any = None
-    violation: float = 0.0
-
-
-def evaluate_locked(case: FingerCase, x: np.ndarray, combo: tuple[str, ...] = ()) -> Evaluation:
-    """Closed-form positions of design ``x`` (VLL locked at their minimum) over
-    ``case.sweep_inputs``, with the target errors and the region check."""
-    try:
-        d = apply_design(case, x, combo or None)
-    except (MechsynInputError, ValueError, KeyError) as exc:
-        return Evaluation(False, f"cannot build: {exc}", violation=1e3)
-    return evaluate_drawn(case, d)
-
-
-def evaluate_drawn(case: FingerCase, d: dict) -> Evaluation:
-    """Closed-form positions of the mechanism dict ``d`` with every VLL locked at its
-    drawn length (the locked model), over the crank grid ``case.sweep_inputs``."""
-    from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics import dyads
-    from mechsyn.kinematics.system import build_system
-
-    vlls = [j["id"] for j in case.mech_dict["joints"] if j.get("vll")]
-    try:
-        d = locked_model(d, vlls, case.source)
-        mech = mechanism_from_dict(d, source=case.source)
-        S = build_system(mech)
-        plan = dyads.decompose(S)
-    except (MechsynInputError, ValueError, KeyError, ZeroDivisionError) as exc:
-        return Evaluation(False, f"cannot build: {exc}", violation=1e3)
-    if plan is None:
-        return Evaluation(False, "the locked model does not decompose into dyads", violation=1e3)
-    k = [dr.joint for dr in S.drivers].index(case.input)
-    grid = case.sweep_inputs
-    U = np.tile([dr.assembled for dr in S.drivers], (len(grid), 1)).astype(float)
-    U[:, k] = S.drivers[k].assembled + np.radians(grid)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        q, _ = dyads.solve_positions(S, plan, U)
-    ok = np.all(np.isfinite(q), axis=1)
-    if not ok.all():
-        return Evaluation(False, f"not assembled at {int((~ok).sum())} of {len(grid)} crank angles "
-                                 "(dead point between the targets)", violation=float((~ok).sum()))
-    ev = Evaluation(True, "", inputs=grid, q=q, system=S)
-    idx = np.searchsorted(grid, case.target_inputs)
-    errs = []
-    for link, tgt in case.target_angles.items():
-        i = S.index(link)
-        rot = np.degrees(q[:, 3 * i + 2] - S.q0[3 * i + 2])
-        ev.achieved[link] = rot[idx]
-        errs.append(rot[idx] - tgt)
-    e = np.concatenate(errs)
-    ev.error_rms = float(np.sqrt(np.mean(e ** 2)))
-    ev.error_max = float(np.max(np.abs(e)))
-    from mechsyn.kinematics.analysis import resolve_points
-
-    viol = 0.0
-    for name, (link, at) in resolve_points(mech, case.points).items():
-        P = S.point(q, S.index(link), S.to_local(link, at))
-        ev.paths[name] = P
-        viol += region_excess(P, case.region)
-    if viol > 0:
-        ev.feasible, ev.reason, ev.violation = False, "a path leaves the working region", viol
-    return ev
-
-
+# --------------------------------------------------------------------------- objectives
 def stage1_objective(case: FingerCase, combo: tuple[str, ...]) -> Objective:
     """RMS target error (deg) of a feasible design; ``INFEASIBLE + violation`` otherwise."""
     def f(x: np.ndarray) -> float:
@@ -197,8 +90,6 @@ def stage1_population(case: FingerCase, combo: tuple[str, ...]) -> Callable[[np.
     >>> [round(v, 9) for v in stage1_population(case, ("S",))(designs)] == [round(one(x), 9) for x in designs]
     True
     """
-    from mechsyn.synthesis.finger.population import locked_population
-
     pop = locked_population(case, combo)
     if pop is None:
         return _each(stage1_objective(case, combo))
@@ -216,8 +107,6 @@ def force_population(case: FingerCase, combo: tuple[str, ...], tol: float,
     sorts out the designs that do not assemble, leave the region or miss the accuracy
     ``tol`` (their values as the one-design objective's); the others get the force
     analysis design by design."""
-    from mechsyn.synthesis.finger.population import locked_population
-
     one = force_objective(case, combo, tol, hold, bound)
     pop = locked_population(case, combo)
     if pop is None:
@@ -236,230 +125,6 @@ def force_population(case: FingerCase, combo: tuple[str, ...], tol: float,
 def _each(f: Objective) -> Callable[[np.ndarray], np.ndarray]:
     """A population objective from a one-design objective."""
     return lambda X: np.array([f(x) for x in np.atleast_2d(X)])
-
-
-# --------------------------------------------------------------------------- VLL range
-def redraw(case: FingerCase, design: dict, lengths: dict[str, float]) -> dict | None:
-    """The mechanism dict redrawn at the same crank angle with the VLL lengths
-    ``lengths``: the underactuated mode (VLL free, length prescribed) solved by the
-    kinematics engine's Newton continuation from the drawn lengths; None when it cannot
-    be assembled. Joint points, named points, centres of mass and P axes follow their
-    links; a VLL's ``limits`` are kept."""
-    from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics.solve import assemble
-    from mechsyn.kinematics.system import _rot, build_system
-
-    d = copy_mechanism(design)
-    for j in d["joints"]:  # the engine refuses lengths outside limits: widen them for the solve
-        if j["id"] in lengths:
-            lim = j.get("limits") or [lengths[j["id"]]] * 2
-            j["limits"] = [min(lim[0], lengths[j["id"]]), max(lim[1], lengths[j["id"]])]
-    mech = mechanism_from_dict(d, source=case.source)
-    free = tuple(lengths)
-    try:
-        S = build_system(mech, vll={jid: "free" for jid in free}, prescribed=free)
-        u = np.array([lengths[dr.joint] if dr.joint in lengths else dr.assembled for dr in S.drivers])
-        q = assemble(S, u)[None]  # Newton continuation from the drawn lengths (crank held)
-    except MechsynInputError:
-        return None
-    ground = mech.ground
-
-    def moved(link: str, p: Any) -> list[float]:
-        if link == ground:
-            return [float(v) for v in p]
-        return S.point(q, S.index(link), S.to_local(link, np.asarray(p, float)))[0].tolist()
-
-    def turned(link: str, u: Any) -> list[float]:
-        if link == ground:
-            return [float(v) for v in u]
-        i = S.index(link)
-        c, sn = _rot(q[:, 3 * i + 2] - S.q0[3 * i + 2])
-        u = np.asarray(u, float)
-        return [float(c[0] * u[0] - sn[0] * u[1]), float(sn[0] * u[0] + c[0] * u[1])]
-
-    for j in d["joints"]:
-        link = j["links"][1] if j["links"][1] != ground else j["links"][0]
-        if j.get("axis") is not None:
-            j["axis"] = turned(j["links"][0], j["axis"])
-        j["point"] = moved(link, j["point"])
-    for p in (d.get("points") or {}).values():
-        p["at"] = moved(p["link"], p["at"])
-    for k, e in enumerate(d["links"]):
-        name = e if isinstance(e, str) else e["name"]
-        if name == ground:
-            continue
-        if isinstance(e, str):
-            e = d["links"][k] = {"name": e}
-        if e.get("com") is None:  # the file's default (its joints' mean, drawn), fixed on the link
-            e["com"] = np.mean([j["point"] for j in design["joints"] if name in j["links"]], axis=0).tolist()
-        e["com"] = moved(name, e["com"])
-    for ld in d.get("loads") or []:
-        if ld.get("at") is not None:
-            ld["at"] = moved(ld["link"], ld["at"])
-    for j in d["joints"]:
-        if j["id"] in lengths:
-            j["limits"] = next(x for x in design["joints"] if x["id"] == j["id"]).get("limits")
-    return d
-
-
-def underactuated_paths(case: FingerCase, design: dict, jid: str, lengths: np.ndarray
-                        ) -> dict[str, np.ndarray]:
-    """Output paths over the crank grid in the underactuated mode with VLL ``jid`` held
-    at each length: point -> (n_lengths, n_inputs, 2), NaN where not assembled. Each
-    length: :func:`redraw`, then the closed-form locked model."""
-    n = len(case.sweep_inputs)
-    out = {p: np.full((len(lengths), n, 2), np.nan) for p in case.points}
-    for r, length in enumerate(lengths):
-        d = redraw(case, design, {jid: float(length)})
-        if d is None:
-            continue
-        ev = evaluate_drawn(case, d)
-        for p, P in ev.paths.items():
-            out[p][r] = P
-    return out
-
-
-def vll_range(case: FingerCase, design: dict, jid: str, rel_tol: float = 1e-3
-              ) -> tuple[float, float, dict[str, np.ndarray], np.ndarray]:
-    """(l_min, l_max, paths, lengths): the largest ``l_max`` in the VLL's limits such that
-    every output path (whole crank range) for the lengths ``l_min ... l_max`` is
-    assembled and inside the region (grid of ``case.vll_steps`` lengths, then bisection
-    to ``rel_tol`` of the limits' range)."""
-    lo, hi = case.vll_limits(jid)
-    lengths = np.linspace(lo, hi, case.vll_steps + 1)
-    paths = underactuated_paths(case, design, jid, lengths)
-
-    def inside(P: dict[str, np.ndarray], r: int) -> bool:
-        return all(points_in_region(arr[r], case.region).all() for arr in P.values())
-
-    ok = np.array([inside(paths, r) for r in range(len(lengths))])
-    if not ok[0]:
-        return lo, lo, paths, lengths
-    last = int(np.argmin(ok)) - 1 if not ok.all() else len(ok) - 1
-    l_max = float(lengths[last])
-    if last < len(lengths) - 1:  # bisection between the last good and the first bad length
-        a, b = l_max, float(lengths[last + 1])
-        while b - a > rel_tol * (hi - lo):
-            m = 0.5 * (a + b)
-            if inside(underactuated_paths(case, design, jid, np.array([m])), 0):
-                a = m
-            else:
-                b = m
-        l_max = a
-    return lo, l_max, paths, lengths
-
-
-# --------------------------------------------------------------------------- forces
-def _peaks(S: Any, q: np.ndarray, case: FingerCase, skip: tuple[str, ...] = ()) -> tuple[float, float, str]:
-    from mechsyn.kinematics.forces import kinetostatics
-
-    R = kinetostatics(S, q, None, None, gravity=(0.0, -case.gravity))
-    peak, where = 0.0, ""
-    for j, F in R.force.items():
-        if j in skip:
-            continue
-        m = float(np.nanmax(np.linalg.norm(F, axis=1)))
-        if m > peak:
-            peak, where = m, j
-    return peak, float(np.nanmax(np.abs(R.effort[case.input]))), where
-
-
-def mode_forces(case: FingerCase, design: dict, combo: tuple[str, ...],
-                ranges: dict[str, tuple[float, float]]) -> dict[str, Any]:
-    """Peak joint reaction and peak balancing moment at the input over the crank range,
-    statically (gravity along -y, the file's loads), in the fully actuated mode (VLL
-    locked at ``l_min``) and in the underactuated mode (VLL free, held at each end of
-    its range by a spring or stop: the axial force at the piston's pivot is reported as
-    ``vll_force_peak``; the spring force differs from it by at most the piston's weight). Closed-form locked models (``kinetostatics`` on the merged
-    cylinder-piston link); the tests compare them with the engine's Newton solution of
-    the full file in both modes."""
-    out: dict[str, Any] = {"fully_actuated": _static_summary(case, design, ())}
-    if not out["fully_actuated"]["assembled"]:
-        raise MechsynInputError("the design does not assemble over the crank range", source=case.source)
-    worst = {"peak_reaction": out["fully_actuated"]["peak_reaction"],
-             "peak_input_moment": out["fully_actuated"]["peak_input_moment"]}
-    out["underactuated"] = []
-    for jid in combo:
-        lo, hi = ranges[jid]
-        for length in sorted({lo, hi}):
-            d = design if length == lo else redraw(case, design, {jid: length})
-            s = _static_summary(case, d, (jid,)) if d is not None else {"assembled": False}
-            if not s["assembled"]:
-                raise MechsynInputError(f"the design does not assemble with {jid} = {length:g}",
-                                        source=case.source)
-            s["vll_length"] = length
-            out["underactuated"].append(s)
-            for k in worst:
-                worst[k] = max(worst[k], s[k])
-    out.update(worst)
-    modes = [out["fully_actuated"]] + out["underactuated"]
-    out["peak_joint"] = max(modes, key=lambda m: m["peak_reaction"])["peak_joint"]
-    out["criterion"] = out["peak_reaction"] + case.weight_moment * out["peak_input_moment"]
-    return out
-
-
-def _static_summary(case: FingerCase, d: dict, vlls: tuple[str, ...]) -> dict[str, Any]:
-    from mechsyn.kinematics.forces import kinetostatics
-
-    ev = evaluate_drawn(case, d)
-    if ev.q is None:
-        return {"assembled": False}
-    S, q = ev.system, ev.q
-    R = kinetostatics(S, q, None, None, gravity=(0.0, -case.gravity))
-    mags = {j: float(np.max(np.linalg.norm(F, axis=1))) for j, F in R.force.items()}
-    j = max(mags, key=mags.get)
-    out = {"peak_reaction": mags[j], "peak_joint": j,
-           "peak_input_moment": float(np.max(np.abs(R.effort[case.input]))), "assembled": True}
-    for jid in vlls:  # axial force in the merged VLL link, at the piston's pivot L
-        _cyl, L, K, _pis = vll_ends(case.mech_dict, jid, case.source)
-        jl, jk = S.mech.joint(L), S.mech.joint(K)
-        cyl = jl.links[0]
-        pl = S.point(q, S.index(cyl), S.to_local(cyl, jl.point))
-        pk = S.point(q, S.index(cyl), S.to_local(cyl, jk.point))
-        u = (pl - pk) / np.linalg.norm(pl - pk, axis=1)[:, None]
-        out["vll_force_peak"] = float(np.max(np.abs(np.sum(R.force[L] * u, axis=1))))
-    return out
-
-
-def force_objective(case: FingerCase, combo: tuple[str, ...], tol: float,
-                    hold: dict[str, float] | None = None, bound: float = np.inf) -> Objective:
-    """Stage 2: ``peak |R| + w peak |M_in|`` (static, closed form), feasible only when the
-    target error stays within ``tol`` (deg RMS) and the paths in the region.
-
-    The locked mode is evaluated first; its value is a lower bound of the both-mode
-    criterion, so only a design whose locked value is below ``bound`` (the stage-1
-    design's both-mode criterion) is also evaluated in the underactuated mode with the
-    VLL held at ``hold`` (stage 1's ``l_max``): there it must assemble over the crank
-    range and keep the paths in the region (the force stage keeps the adaptive range),
-    and its value becomes the both-mode criterion.
-    """
-    def f(x: np.ndarray) -> float:
-        ev = evaluate_locked(case, x, combo)
-        if not ev.feasible:
-            return INFEASIBLE + ev.violation
-        if ev.error_rms > tol:
-            return INFEASIBLE + (ev.error_rms - tol)
-        try:
-            pr, pm, _ = _peaks(ev.system, ev.q, case)
-        except Exception:  # noqa: BLE001 - a singular design is infeasible, never rewarded
-            return INFEASIBLE + 1.0
-        if not (np.isfinite(pr) and np.isfinite(pm)):
-            return INFEASIBLE + 1.0
-        value = pr + case.weight_moment * pm
-        if not hold or value >= bound:
-            return value
-        d = redraw(case, apply_design(case, x, combo), hold)
-        ev2 = evaluate_drawn(case, d) if d is not None else None
-        if ev2 is None or not ev2.feasible:
-            return INFEASIBLE + (ev2.violation if ev2 is not None else 1.0)
-        try:
-            pr2, pm2, _ = _peaks(ev2.system, ev2.q, case)
-        except Exception:  # noqa: BLE001
-            return INFEASIBLE + 1.0
-        return max(pr, pr2) + case.weight_moment * max(pm, pm2)
-    return f
-
-
 
 
 # --------------------------------------------------------------------------- driver
@@ -670,8 +335,6 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
 def _finger_checkpoint(path: Any, resume: bool, case: FingerCase, seed: int) -> Any:
     """The run's checkpoint (``None`` without ``path``); its key: the case (its content,
     not its file name) and the seed."""
-    from mechsyn.checkpoint import open_search_checkpoint
-
     return open_search_checkpoint(path, "synth finger-design", replace(case, source=""), resume=resume,
                                   seed=seed)
 
@@ -829,7 +492,7 @@ def _pick(run: _Run, combo: tuple[str, ...], x1: np.ndarray, pop: list, ranges1:
     return chosen, ranges, forces_, improved
 
 
-def _variant(case: FingerCase, combo: tuple[str, ...], x1: np.ndarray, ev1: Evaluation, chosen: np.ndarray,
+def _variant(case: FingerCase, combo: tuple[str, ...], x1: np.ndarray, ev1: FingerEvaluation, chosen: np.ndarray,
              ranges: dict, forces1: dict, forces_: dict, improved: bool, nfev: int) -> VariantResult:
     """The variant's result: the chosen design drawn with its VLL ranges as limits, and
     its output paths at five lengths across each range."""

@@ -6,12 +6,12 @@ dyads: the topology is the same for every design of a case, only the drawn coord
 change. :func:`locked_population` compiles it once with
 :func:`mechsyn.kinematics.batch.compile_plan`; :meth:`LockedPopulation.evaluate` maps
 ``K`` design vectors to the plan's parameters (joint and point coordinates, each VLL's
-piston pivot ``L = K + l (cos a, sin a)`` as :func:`~mechsyn.synthesis.finger.design.apply_design`
+piston pivot ``L = K + l (cos a, sin a)`` as :func:`~mechsyn.synthesis.finger.evaluation.apply_design`
 draws it) and solves all of them over the crank grid in whole-array passes
 (:func:`mechsyn.kinematics.batch.simulate_batch`, assembly modes of the drawn
 configuration, as the one-design closed form).
 
-The evaluation is :func:`~mechsyn.synthesis.finger.design.evaluate_locked`'s, term for
+The evaluation is :func:`~mechsyn.synthesis.finger.evaluation.evaluate_locked`'s, term for
 term: not assembled at ``n`` crank angles gives violation ``n``; otherwise the phalanx
 rotations from the drawn configuration at the targets (each link's rotation from two of
 its points, followed continuously along the crank grid), their RMS and largest error
@@ -28,6 +28,9 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import mechanism_from_dict
+from mechsyn.kinematics.batch import compile_plan, simulate_batch
+from mechsyn.synthesis.finger.evaluation import apply_design
 from mechsyn.synthesis.finger.vll import locked_model, points_in_region, region_excess, vll_ends
 
 __all__ = ["LockedPopulation", "PopulationEvaluation", "locked_population"]
@@ -84,8 +87,6 @@ class LockedPopulation:
 
     def evaluate(self, X: np.ndarray) -> PopulationEvaluation:
         """Assembly, target errors and region of every design of ``X`` (K, n_variables)."""
-        from mechsyn.kinematics.batch import simulate_batch
-
         P = self.designs(X)
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             res = simulate_batch(self.plan, P, self.grid, flags=False)
@@ -149,10 +150,6 @@ def locked_population(case: Any, combo: tuple[str, ...]) -> LockedPopulation | N
     >>> ev.feasible.tolist(), bool(ev.error_rms[0] < 0.01), bool(ev.violation[1] > 0)
     ([True, False], True, True)
     """
-    from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics.batch import compile_plan
-    from mechsyn.synthesis.finger.design import apply_design
-
     x0 = np.array([0.5 * (v.bounds[0] + v.bounds[1]) for v in case.variables])
     vll_ids = [j["id"] for j in case.mech_dict["joints"] if j.get("vll")]
     if any(v.kind == "joint" and v.target in vll_ids for v in case.variables):
