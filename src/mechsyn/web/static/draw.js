@@ -116,6 +116,24 @@ function sliderAxis(mech, sim, j, k) {
   return { ax, ay, moving };
 }
 
+// The elements an error or warning names: {element: {kind, id}} or {elements: [...]} → ["kind:id"].
+function elementKeys(e) {
+  return (e.elements || (e.element ? [e.element] : [])).map((x) => `${x.kind}:${x.id}`);
+}
+
+// A label writer that moves a label down until it overlaps none placed before (coincident
+// joints, e.g. a slider's R and P joints or Jansen's P1 and P1_2, get labels one under the other).
+function placeLabels() {
+  const placed = [];
+  return (layer, x, y, text) => {
+    const w = 7 * String(text).length + 4, hgt = 13;
+    let yy = y;
+    for (let guard = 0; guard < 12 && placed.some((b) => x < b.x + b.w && b.x < x + w && yy - hgt < b.y && b.y - hgt < yy); guard++) yy += hgt;
+    placed.push({ x, y: yy, w });
+    return el("text", { x, y: yy, class: "label" }, layer, text);
+  };
+}
+
 // Draw everything into svg; returns {joints, paths} element maps (the contract: data-joint, data-path).
 export function draw(svg, state) {
   const { mech, sim, frame: k, view, opts } = state;
@@ -129,7 +147,9 @@ export function draw(svg, state) {
   if (!mech) return { joints: {}, paths: {} };
   const pos = positions(mech, state.poseFromFile ? null : sim, k);
   const P = (p) => v.toScreen(p);
-  const invalid = new Set((state.errors || []).map((e) => e.element && `${e.element.kind}:${e.element.id}`));
+  const invalid = new Set((state.errors || []).concat(state.diagnostics || []).flatMap(elementKeys));
+  const sel = state.selected ? `${state.selected.kind}:${state.selected.id}` : null;
+  const labels = placeLabels();
   const groupOf = (opts.assurColours && state.analysis && state.analysis.groupOf) || {};
   const muAt = {};
   if (sim && sim.transmission_angle)
@@ -158,13 +178,15 @@ export function draw(svg, state) {
     const colour = groupOf[name] !== undefined ? GROUP_COLOURS[groupOf[name] % GROUP_COLOURS.length] : null;
     if (!colour) for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
     if (invalid.has(`link:${name}`)) cls += " invalid";
-    const g = el("g", { "data-link": name }, layers.links);
+    const g = el("g", { "data-link": name, "data-group": groupOf[name] }, layers.links);
+    // a group colour is set through the CSSOM: a presentation attribute loses to the class rules
+    const paint = (e, fill) => { if (colour && !cls.includes("invalid")) { e.style.stroke = colour; if (fill) e.style.fill = colour; } return e; };
     if (pts.length === 2) {
-      el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar" + cls, stroke: colour }, g);
+      paint(el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar" + cls }, g));
       el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-hit" }, g);
     } else {
       const poly = order(pts).map((p) => p.map((c) => c.toFixed(1)).join(",")).join(" ");
-      el("polygon", { points: poly, class: "link-plate" + cls, fill: colour, stroke: colour }, g);
+      paint(el("polygon", { points: poly, class: "link-plate" + cls }, g), true);
     }
   }
   // joints
@@ -178,25 +200,28 @@ export function draw(svg, state) {
     if (j.type === "P") {
       const { ax, ay } = sliderAxis(mech, sim, j, k);
       const ang = (Math.atan2(-ay, ax) * 180) / Math.PI;
-      joints[j.id] = el("rect", { x: -14, y: -8, width: 28, height: 16, rx: 2, class: "slider-block" + (j.actuated ? " drive" : ""),
+      joints[j.id] = el("rect", { x: -14, y: -8, width: 28, height: 16, rx: 2,
+        class: "slider-block" + (j.actuated ? " drive" : "") + (invalid.has(`joint:${j.id}`) ? " invalid" : ""),
         transform: `translate(${px.toFixed(1)} ${py.toFixed(1)}) rotate(${ang.toFixed(1)})`, "data-joint": j.id,
         "data-x": p[0], "data-y": p[1] }, layers.sliders);
-      if (!onGround) {
-        const L = 40;
-        el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
-      }
+      const L = onGround ? 60 : 40;
+      if (!onGround) el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
+      // the handle that turns the guide (dragged in Select)
+      el("circle", { cx: (px + ax * L).toFixed(1), cy: (py - ay * L).toFixed(1), r: 5, class: "guide-handle", "data-handle": j.id }, layers.marks);
     } else {
       joints[j.id] = fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 6.5, class: cls, "data-joint": j.id,
         "data-x": p[0], "data-y": p[1] }, layers.joints), fileColour(mech, j.id));
     }
-    el("text", { x: px + 9, y: py - 9, class: "label" }, layers.labels, j.id);
+    if (sel === `joint:${j.id}`) joints[j.id].setAttribute("data-selected", "true");
+    labels(layers.labels, px + 9, py - 9, j.id);
   }
   for (const [n, p] of Object.entries(pos.points)) {
     if (!p) continue;
     const [px, py] = P(p);
-    fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n },
+    const c = fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n },
       layers.points), fileColour(mech, n));
-    el("text", { x: px + 8, y: py + 14, class: "label" }, layers.labels, n);
+    if (sel === `point:${n}`) c.setAttribute("data-selected", "true");
+    labels(layers.labels, px + 8, py + 14, n);
   }
   // dead points: × on every path where a working range ends
   if (sim) for (const ev of sim.events) {
@@ -213,7 +238,7 @@ export function draw(svg, state) {
   (state.targets || []).forEach((t, i) => {
     const [px, py] = P(t);
     el("circle", { cx: px, cy: py, r: 7, class: "target", "data-target": i }, layers.marks);
-    el("text", { x: px + 9, y: py + 4, class: "label" }, layers.labels, `T${i + 1}`);
+    labels(layers.labels, px + 9, py + 4, `T${i + 1}`);
   });
   if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);
   // the link being built
@@ -223,15 +248,16 @@ export function draw(svg, state) {
     for (const p of pts) el("circle", { cx: p[0], cy: p[1], r: 9, class: "pending" }, layers.marks);
   }
   // errors next to their element
-  for (const e of state.errors || []) {
-    if (!e.element) continue;
+  for (const e of (state.errors || []).concat(state.diagnostics || [])) {
+    const at = e.element || (e.elements || [])[0];
+    if (!at) continue;
     let p = null;
-    if (e.element.kind === "joint") p = pos.joints[e.element.id];
-    if (e.element.kind === "point") p = pos.points[e.element.id];
-    if (e.element.kind === "link" && mem[e.element.id]) p = pos.joints[mem[e.element.id].joints[0]];
+    if (at.kind === "joint") p = pos.joints[at.id];
+    if (at.kind === "point") p = pos.points[at.id];
+    if (at.kind === "link" && mem[at.id]) p = pos.joints[mem[at.id].joints[0]];
     if (!p) continue;
     const [px, py] = P(p);
-    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": e.element.id }, layers.labels, e.message);
+    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": at.id }, layers.labels, e.short || e.message);
   }
   return { joints, paths };
 }

@@ -1,6 +1,9 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
 import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
+import { geometryChecks, tidy, topologyKey } from "./checks.js";
+import { bindKeys } from "./keys.js";
+import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -14,7 +17,7 @@ const state = {
   mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
   opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
   targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
-  renders: 0, simulations: 0, latencies: [],
+  renders: 0, simulations: 0, latencies: [], diagnostics: [], check: null,
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
 
@@ -34,11 +37,18 @@ function render() {
 
 function div(cls, text) { const d = document.createElement("div"); d.className = cls; d.textContent = text; return d; }
 
+// The banner: the current errors first (each outlines the element it names), then warnings, notes.
 function renderBanner() {
   const items = state.errors.map((e) => div("err", e.message + (e.hint ? ` — fix: ${e.hint}` : "")));
+  for (const d of state.diagnostics) items.push(div(d.level === "error" ? "err" : d.level === "warning" ? "warn" : "note", d.message));
+  const sim = state.sim;
+  if (sim && !sim.assembled[0] && state.simFor === state.mech)
+    items.push(div("err", "not assembled at the drawn pose: the links cannot meet where they are drawn. Drag a joint until they do, or type its x and y in the Element tab"));
+  else if (sim && !sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
   for (const n of state.notes) items.push(div("note", n));
-  if (state.sim && !state.sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
-  $("banner").replaceChildren(...items);
+  const b = $("banner");
+  b.replaceChildren(...items);
+  b.dataset.level = items.length ? items[0].className : "";
 }
 
 function renderPlayer() {
@@ -113,12 +123,37 @@ function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
   if (!keepFrame) state.frame = 0;
   if (fit) fitView();
   state.errors = [];
-  if (mech.joints.some((j) => j.actuated)) simulateSoon({ mech });
-  else { state.sim = null; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
+  const key = topologyKey(mech);
+  if (state.check && state.check.key === key) afterCheck(mech, state.check.result);
+  else {
+    // the topology changed: the server's check (mobility, drives, connections) first, at once
+    state.diagnostics = geometryChecks(mech); state.check = null;
+    call("/api/studio/check", { mechanism: mech }).then((result) => {
+      if (mech !== state.mech) return;
+      state.check = { key, result }; afterCheck(mech, result); render();
+    }, (e) => {
+      if (mech !== state.mech) return;
+      state.sim = null; state.simFor = mech; state.notes = [];
+      state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
+      render(); renderAnalysis();
+    });
+  }
   analyseSoon();
   render();
   renderElement();
 }
+
+// Simulate unless the checks say it is pointless (a structure, drives that fight, loose parts).
+function afterCheck(mech, result) {
+  state.diagnostics = result.diagnostics.concat(geometryChecks(mech));
+  state.notes = [];
+  if (result.diagnostics.some((d) => d.blocks)) { state.sim = null; state.simFor = mech; renderAnalysis(); }
+  else if (mech.joints.some((j) => j.actuated)) simulateSoon({ mech });
+  else { state.sim = null; state.simFor = mech; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
+}
+
+// One numeric edit: fn changes a copy of the mechanism (at the drawn pose); re-simulated, one undo step.
+function edit(fn) { const m = rebase(); fn(m); setMech(m); }
 
 // The drawn pose becomes the file's pose (the branch drawn is the one kept).
 function rebase() {
@@ -148,7 +183,7 @@ function worldAt(ev) {
   const r = svg.getBoundingClientRect();
   let p = makeView(svg, state.view).toWorld([ev.clientX - r.left, ev.clientY - r.top]);
   if (state.opts.snap) { const g = gridStep(state.view); p = p.map((c) => Math.round(c / g) * g); }
-  return p.map((c) => +c.toPrecision(10));
+  return p.map((c) => tidy(c, state.view.s));
 }
 
 // ------------------------------------------------------------------ naming
@@ -251,15 +286,46 @@ function undo() { if (!state.undo.length) return; state.redo.push(JSON.stringify
 function redo() { if (!state.redo.length) return; state.undo.push(JSON.stringify(state.mech)); setMech(JSON.parse(state.redo.pop()), { record: false }); }
 
 // ------------------------------------------------------------------ pointer interaction
+// The joints drawn within 8 px of the pointer, topmost first (a slider's R joint over its P joint).
+function jointsAt(ev) {
+  const r = svg.getBoundingClientRect(), v = makeView(svg, state.view), pos = positions(state.mech, state.sim, state.frame);
+  const near = state.mech.joints.filter((j) => {
+    const q = v.toScreen(pos.joints[j.id]);
+    return Math.hypot(q[0] - (ev.clientX - r.left), q[1] - (ev.clientY - r.top)) <= 8;
+  });
+  return near.sort((a, b) => (a.type === "P") - (b.type === "P")).map((j) => j.id);
+}
+// The joint a click means: where several coincide, the next after the selected one (clicks cycle);
+// in Drive and Delete, the selected one of them.
+function pickJoint(ev, hitId, cycle) {
+  const ids = jointsAt(ev);
+  if (hitId && !ids.includes(hitId)) ids.unshift(hitId);
+  if (ids.length < 2) return hitId || ids[0] || null;
+  const cur = state.selected && state.selected.kind === "joint" ? ids.indexOf(state.selected.id) : -1;
+  if (cur < 0) return hitId || ids[0];
+  return cycle ? ids[(cur + 1) % ids.length] : ids[cur];
+}
+
 let gesture = null;
 svg.addEventListener("pointerdown", (ev) => {
   if (!state.mech) return;
   const t = ev.target;
   const jointEl = t.closest("[data-joint]"), pointEl = t.closest("[data-point]"), linkEl = t.closest("[data-link]");
+  const handleEl = t.closest("[data-handle]");
   const p = worldAt(ev);
   const mode = state.mode;
-  if (mode === "select" && (jointEl || pointEl)) {
-    const kind = jointEl ? "joint" : "point", id = jointEl ? jointEl.dataset.joint : pointEl.dataset.point;
+  const jointId = jointEl || (!pointEl && !handleEl) ? pickJoint(ev, jointEl && jointEl.dataset.joint, mode === "select") : null;
+  if (mode === "select" && handleEl) { // turning a slider's guide
+    state.selected = { kind: "joint", id: handleEl.dataset.handle };
+    state.undo.push(JSON.stringify(state.mech)); state.redo = [];
+    state.mech = rebase(); state.dragging = true;
+    gesture = { kind: "drag", what: "axis", id: handleEl.dataset.handle, moved: false };
+    svg.setPointerCapture(ev.pointerId);
+    renderElement();
+    return;
+  }
+  if (mode === "select" && (jointId || pointEl)) {
+    const kind = jointId ? "joint" : "point", id = jointId || pointEl.dataset.point;
     state.selected = { kind, id };
     const before = JSON.stringify(state.mech);
     const m = rebase();
@@ -284,9 +350,9 @@ svg.addEventListener("pointerdown", (ev) => {
     $("finish-link").disabled = state.building.length < 2;
     render();
   } else if (mode === "point") addPoint(p);
-  else if (mode === "drive" && jointEl) toggleDrive(jointEl.dataset.joint);
+  else if (mode === "drive" && jointId) toggleDrive(jointId);
   else if (mode === "delete") {
-    if (jointEl) deleteJoint(jointEl.dataset.joint);
+    if (jointId) deleteJoint(jointId);
     else if (pointEl) deletePoint(pointEl.dataset.point);
     else if (linkEl) deleteLink(linkEl.dataset.link);
   } else if (mode === "target") {
@@ -316,10 +382,15 @@ svg.addEventListener("pointermove", (ev) => {
   }
   const p = worldAt(ev);
   const m = clone(state.mech);
-  if (gesture.what === "joint") for (const j of m.joints) { if (gesture.together.includes(j.id)) j.point = p.slice(); }
+  if (gesture.what === "axis") {
+    const j = m.joints.find((q) => q.id === gesture.id);
+    const deg = (Math.atan2(p[1] - j.point[1], p[0] - j.point[0]) * 180) / Math.PI;
+    j.axis = axisOf(Math.round(deg * 10) / 10);
+  } else if (gesture.what === "joint") for (const j of m.joints) { if (gesture.together.includes(j.id)) j.point = p.slice(); }
   else m.points[gesture.id].at = p;
   gesture.moved = true;
   state.mech = m;
+  if (state.check) state.diagnostics = state.check.result.diagnostics.concat(geometryChecks(m));
   render();
   simulateSoon({ mech: m, drag: true, t0: ev.timeStamp });
 });
@@ -348,7 +419,6 @@ svg.addEventListener("wheel", (ev) => {
 }, { passive: false });
 
 // ------------------------------------------------------------------ side panels
-function h(tag, text, attrs = {}) { const e = document.createElement(tag); if (text !== undefined && text !== null) e.textContent = text; Object.assign(e, attrs); return e; }
 
 function renderAnalysis() {
   const box = $("tab-analysis");
@@ -397,30 +467,38 @@ function renderAnalysis() {
 }
 
 function renderElement() {
+  renderJoints();
   const box = $("tab-element"), sel = state.selected, m = state.mech;
-  if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it.", { className: "muted" })); return; }
+  if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it (clicking again where joints coincide selects the next).", { className: "muted" })); return; }
   const out = [];
   if (sel.kind === "joint") {
     const j = m.joints.find((x) => x.id === sel.id);
     if (!j) { state.selected = null; return renderElement(); }
-    out.push(h("h3", `Joint ${j.id}`));
+    out.push(h("h3", `Joint ${j.id} (${j.type === "P" ? "slider, P" : "pin, R"})`));
     const type = h("select"); for (const t of ["R", "P"]) type.append(h("option", t, { value: t, selected: j.type === t }));
     type.id = "joint-type";
-    type.onchange = () => { const n = rebase(); const x = n.joints.find((q) => q.id === j.id); x.type = type.value; if (x.type === "P" && !x.axis) x.axis = [1, 0]; if (x.type === "R") delete x.axis; setMech(n); };
+    type.onchange = () => edit((n) => setType(n.joints.find((q) => q.id === j.id), type.value));
     const drive = h("input", null, { type: "checkbox", checked: !!j.actuated, id: "joint-drive" });
     drive.onchange = () => toggleDrive(j.id);
     const links = h("input", null, { value: j.links.join(", "), id: "joint-links", size: 20 });
-    links.onchange = () => { const n = rebase(); n.joints.find((q) => q.id === j.id).links = links.value.split(",").map((s) => s.trim()).filter(Boolean); for (const l of n.joints.find((q) => q.id === j.id).links) if (!n.links.map(linkName).includes(l)) n.links.push(l); setMech(n); };
-    out.push(h("p", "pair type "), type, h("p", "links "), links, h("p", ""), drive, " drive");
-    out.push(h("p", `at (${j.point.map((c) => (+c).toFixed(4)).join(", ")})`));
+    links.onchange = () => edit((n) => setLinks(n, j.id, links.value));
+    const row = (label, ...els) => { const p = h("p"); p.append(h("label", label + " "), ...els); return p; };
+    out.push(...jointFields(j, edit), row("pair type", type), row("links", links), row("drive", drive));
     const del = h("button", "Delete joint"); del.onclick = () => deleteJoint(j.id); out.push(del);
   } else {
     const p = (m.points || {})[sel.id];
     if (!p) { state.selected = null; return renderElement(); }
-    out.push(h("h3", `Point ${sel.id} on ${p.link}`), h("p", `at (${p.at.map((c) => (+c).toFixed(4)).join(", ")})`));
+    out.push(h("h3", `Point ${sel.id} on ${p.link}`), ...pointFields(sel.id, p, edit));
     const del = h("button", "Delete point"); del.onclick = () => deletePoint(sel.id); out.push(del);
   }
   box.replaceChildren(...out);
+}
+
+function renderJoints() {
+  const m = state.mech;
+  if (!m) return;
+  const sel = state.selected && state.selected.kind === "joint" ? state.selected.id : null;
+  $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }));
 }
 
 function renderPlots() {
@@ -695,20 +773,11 @@ $("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
 $("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
 $("plot-what").onchange = renderPlots;
 window.addEventListener("resize", render);
-(root.addEventListener ? root : document).addEventListener("keydown", (ev) => {
-  if (ev.target.matches("input, select, textarea")) return;
-  const k = ev.key;
-  if ((ev.ctrlKey || ev.metaKey) && k === "z") { ev.preventDefault(); undo(); }
-  else if ((ev.ctrlKey || ev.metaKey) && (k === "y" || k === "Z")) { ev.preventDefault(); redo(); }
-  else if (k === "Enter" && state.mode === "link") finishLink();
-  else if (k === "Escape") { state.building = []; setMode("select"); }
-  else if (k === " ") { ev.preventDefault(); setPlaying(!state.playing); }
-  else if (!ev.ctrlKey && !ev.metaKey) {
-    const m = { v: "select", g: "pivot", l: "link", p: "point", d: "drive", x: "delete", t: "target" }[k.toLowerCase()];
-    if (m) setMode(m);
-    if (k === "f") { fitView(); render(); }
-  }
-});
+bindKeys(root, {
+  undo, redo, finishLink, setMode, play: () => setPlaying(!state.playing), fit: () => { fitView(); render(); },
+  escape: () => { state.building = []; setMode("select"); }, linkMode: () => state.mode === "link",
+  deleteSelection: () => { const sel = state.selected; if (!sel) return; state.selected = null; (sel.kind === "joint" ? deleteJoint : deletePoint)(sel.id); },
+}, { contained: root !== document });
 
 (async function start() {
   try {

@@ -1,0 +1,175 @@
+"""Server-side logic of the studio's editor: invalid states in the studio's words, and the
+DXF plates / SVG drawing exports.
+
+The routes are registered by :func:`routes` (one line in :mod:`mechsyn.web._app`). Every
+function takes and returns plain JSON-able data, like :mod:`mechsyn.web._service`.
+
+Diagnostics are ``{"level", "message", "elements", "blocks"}``: ``level`` is ``error``,
+``warning`` or ``note``; ``elements`` the ``{"kind", "id"}`` the message names (outlined on
+the canvas); ``blocks`` true when simulating would be pointless (a structure, drives that
+fight, parts joined to nothing, a spatial file).
+
+Examples
+--------
+>>> from mechsyn.io import load_mechanism, mechanism_to_dict
+>>> from mechsyn.web._service import example_path
+>>> d = mechanism_to_dict(load_mechanism(example_path("fourbar")))
+>>> check(d)["mobility"], check(d)["diagnostics"]
+(1, [])
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.web import _service
+
+
+def _names(ids: list[str]) -> str:
+    return ids[0] if len(ids) == 1 else ", ".join(ids[:-1]) + " and " + ids[-1]
+
+
+def _diag(level: str, message: str, elements: list[tuple[str, str]], blocks: bool) -> dict[str, Any]:
+    return {"level": level, "message": message, "blocks": blocks,
+            "elements": [{"kind": k, "id": i} for k, i in elements]}
+
+
+def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
+    """Links joined to nothing, links with one joint (dangling) and parts not connected to the
+    frame of a mechanism dict (checked before it is validated: the file loader refuses a
+    disconnected mechanism), in the studio's words: what to do on the canvas, not in the file."""
+    ground = data.get("ground", "frame")
+    names = [link if isinstance(link, str) else str(link.get("name")) for link in data.get("links", [])]
+    joints = [j for j in data.get("joints", []) if isinstance(j, dict)]
+    joints_of: dict[str, list] = {n: [] for n in names}
+    for j in joints:
+        for link in j.get("links", []):
+            joints_of.setdefault(str(link), []).append(j)
+    out = []
+    for name, js in joints_of.items():
+        if name == ground:
+            continue
+        if not js:
+            out.append(_diag("error", f"link {name} is joined to nothing: join it with Link or delete it",
+                             [("link", name)], True))
+        elif len(js) == 1 and not (js[0].get("actuated") and ground in js[0].get("links", [])):
+            out.append(_diag("error", f"link {name} has one joint ({js[0].get('id')}): join it to another "
+                             "link with Link, or delete it", [("link", name)], True))
+    seen, todo = {ground}, [ground]
+    while todo:
+        link = todo.pop()
+        for j in joints_of.get(link, []):
+            for other in map(str, j.get("links", [])):
+                if other not in seen:
+                    seen.add(other)
+                    todo.append(other)
+    loose = [n for n in joints_of if n not in seen and joints_of[n]]
+    if loose:
+        many = len(loose) > 1
+        out.append(_diag("error", f"link{'s' if many else ''} {_names(loose)} {'are' if many else 'is'} not "
+                         "connected to the frame: add a Pivot and join it to them with Link",
+                         [("link", n) for n in loose], True))
+    return out
+
+
+def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
+    """A structure with a drive, more drives than the mobility, fewer (motion undetermined)."""
+    drives = [j.id for j in mech.joints if j.actuated]
+    els = [("joint", d) for d in drives]
+    n = len(drives)
+    if mobility <= 0 and drives:
+        return [_diag("error", f"this is a structure, not a mechanism (mobility W = {mobility}): nothing can "
+                      f"move, so the drive on {_names(drives)} cannot turn it. Delete a link or a joint, or "
+                      "remove the drive", els, True)]
+    if n > mobility >= 1:
+        return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
+                      f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True)]
+    if 0 < n < mobility:
+        return [_diag("warning", f"mobility W = {mobility} with {n} drive{'s' if n > 1 else ''}: the motion is "
+                      f"not determined. Mark {mobility - n} more joint{'s' if mobility - n > 1 else ''} with "
+                      "Drive", els, True)]
+    return []
+
+
+def check(data: Any) -> dict[str, Any]:
+    """The editor's checks of a mechanism dict, fast enough for every edit of its topology.
+
+    Returns ``{"mobility", "mobility_source", "drives", "spatial", "diagnostics"}``. The
+    mobility is the structure report's (the rank method where the geometry allows it).
+    A file that does not validate raises :class:`~mechsyn.errors.MechsynInputError`
+    (shown by the studio next to the element its field names).
+    """
+    from mechsyn.structure.report import analyze as structure_report
+
+    if not isinstance(data, dict):
+        raise MechsynInputError("the mechanism must be a JSON object", field="mechanism")
+    problems = connection_problems(data)
+    drives = [str(j.get("id")) for j in data.get("joints", []) if isinstance(j, dict) and j.get("actuated")]
+    out: dict[str, Any] = {"mobility": None, "mobility_source": None, "drives": drives,
+                           "spatial": data.get("kind", "planar") != "planar", "diagnostics": problems}
+    if problems:
+        return out
+    mech = _service.build(data)
+    if out["spatial"]:
+        out["diagnostics"].append(_diag("note", "spatial mechanism: structure and rank analysis only (see "
+                                        "the Analysis tab); the drawing is its top view", [], True))
+    try:
+        report = structure_report(mech)
+    except MechsynInputError as err:
+        out["diagnostics"].append(_diag("warning", f"mobility not known: {err.message}", [], False))
+        return out
+    out["mobility"], out["mobility_source"] = int(report.mobility), report.to_dict().get("mobility_source")
+    if not out["spatial"] and not any(d["blocks"] for d in out["diagnostics"]):
+        out["diagnostics"] += drive_problems(mech, out["mobility"])
+    return out
+
+
+def export_drawing(data: Any) -> str:
+    """The mechanism's SVG drawing in model units at the drawn pose, with the paths of its
+    named points over a full input turn (``mechsyn export --drawing``)."""
+    import numpy as np
+
+    from mechsyn.export.drawing import drawing_of
+
+    mech = _service.build(data)
+    drives = [j for j in mech.joints if j.actuated]
+    sweep = None
+    if drives and drives[0].type == "R" and mech.points:
+        start = _service._driver_start(mech, drives[0].id)
+        sweep = {drives[0].id: start + np.linspace(0.0, 360.0, 181)}
+    return drawing_of(mech, None, list(mech.points) if sweep else [], sweep, dimensions=True)
+
+
+def export_dxf(data: Any) -> str:
+    """The link plates laid out on a sheet as DXF text (``mechsyn export --dxf``; needs ezdxf,
+    else a :class:`~mechsyn.errors.MechsynInputError` saying how to install it)."""
+    import io
+
+    from mechsyn.export.dxf import layout_to_dxf
+    from mechsyn.export.plates import link_plates
+
+    doc = layout_to_dxf(link_plates(_service.build(data)))
+    buf = io.StringIO()
+    doc.write(buf)
+    return buf.getvalue()
+
+
+def routes() -> list:
+    """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`)."""
+    from starlette.concurrency import run_in_threadpool
+    from starlette.responses import Response
+    from starlette.routing import Route
+
+    from mechsyn.web._app import _body, _need, api
+
+    def on_mechanism(fn, media_type=None):
+        @api
+        async def route(request) -> Any:
+            out = await run_in_threadpool(fn, _need(await _body(request), "mechanism"))
+            return Response(out, media_type=media_type) if media_type else out
+        return route
+
+    return [Route("/api/studio/check", on_mechanism(check), methods=["POST"]),
+            Route("/api/studio/drawing", on_mechanism(export_drawing, "image/svg+xml"), methods=["POST"]),
+            Route("/api/studio/dxf", on_mechanism(export_dxf, "application/dxf"), methods=["POST"])]
