@@ -20,6 +20,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from mechsyn.errors import MechsynInputError
@@ -155,6 +156,30 @@ def export_dxf(data: Any) -> str:
     return buf.getvalue()
 
 
+def examples() -> list[dict[str, str]]:
+    """The Examples menu: the planar examples (:func:`mechsyn.web._service.examples`), then the
+    spatial ones with joint points (opened for structure and rank analysis), each with its ``kind``."""
+    planar = [{**e, "kind": "planar"} for e in _service.examples()]
+    return planar + [dict(e) for e in _spatial_examples(_service._examples_dir())]
+
+
+@functools.lru_cache(maxsize=4)
+def _spatial_examples(root) -> tuple[dict[str, str], ...]:
+    from mechsyn.io import load_mechanism
+
+    out = []
+    for p in sorted(root.rglob("*")) if root is not None else []:
+        if p.suffix not in _service.EXAMPLE_SUFFIXES or not p.is_file():
+            continue
+        try:
+            mech = load_mechanism(p)
+        except Exception:  # case files and arms are not mechanisms: not listed
+            continue
+        if mech.kind != "planar" and all(j.point is not None for j in mech.joints):
+            out.append({"name": p.stem, "title": mech.name, "group": p.parent.name, "kind": mech.kind})
+    return tuple(out)
+
+
 def routes() -> list:
     """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`)."""
     from starlette.concurrency import run_in_threadpool
@@ -170,6 +195,11 @@ def routes() -> list:
             return Response(out, media_type=media_type) if media_type else out
         return route
 
-    return [Route("/api/studio/check", on_mechanism(check), methods=["POST"]),
+    @api
+    async def examples_route(request) -> Any:
+        return {"examples": await run_in_threadpool(examples)}
+
+    return [Route("/api/studio/examples", examples_route),
+            Route("/api/studio/check", on_mechanism(check), methods=["POST"]),
             Route("/api/studio/drawing", on_mechanism(export_drawing, "image/svg+xml"), methods=["POST"]),
             Route("/api/studio/dxf", on_mechanism(export_dxf, "application/dxf"), methods=["POST"])]

@@ -28,7 +28,7 @@ import anywidget
 import traitlets
 
 STATIC = Path(__file__).parent / "static"
-MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "studio.js")
+MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "studio.js")
 
 
 def _body_markup() -> str:

@@ -262,17 +262,30 @@ export function draw(svg, state) {
   return { joints, paths };
 }
 
-// A small line plot (input on x) with a cursor at index k; returns the svg.
-export function plot(svg, xs, series, k, ranges = []) {
+// The y-range of a plot: the full range, unless spikes (near dead points, where velocities and
+// accelerations grow without bound) would flatten the rest: then the 2nd to 98th percentile
+// widened by 15 %, and `clipped` says so.
+export function robustRange(vals) {
+  const v = vals.slice().sort((a, b) => a - b), n = v.length, q = (f) => v[Math.min(n - 1, Math.max(0, Math.round(f * (n - 1))))];
+  let lo = v[0], hi = v[n - 1];
+  const core = q(0.98) - q(0.02);
+  const clipped = n >= 20 && core > 0 && hi - lo > 4 * core;
+  if (clipped) { lo = Math.max(lo, q(0.02) - 0.15 * core); hi = Math.min(hi, q(0.98) + 0.15 * core); }
+  if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { lo -= 1; hi += 1; }
+  return { lo, hi, clipped, min: v[0], max: v[n - 1] };
+}
+
+// A small line plot (input on x) with a cursor at index k; returns the svg. `labels`: {x, y} units.
+export function plot(svg, xs, series, k, ranges = [], labels = {}) {
   svg.replaceChildren();
-  const W = 300, H = 150, m = 28;
+  const W = 300, H = 150, m = 34;
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const vals = series.flatMap((s) => s.values).filter((y) => y !== null && Number.isFinite(y));
   if (!vals.length) { el("text", { x: 10, y: 20, class: "label" }, svg, "not defined over the sweep"); return svg; }
-  let lo = Math.min(...vals), hi = Math.max(...vals);
-  if (hi - lo < 1e-12) { lo -= 1; hi += 1; }
+  const R = robustRange(vals), { lo, hi } = R;
   const x0 = xs[0], x1 = xs[xs.length - 1] || x0 + 1;
-  const X = (x) => m + ((x - x0) / (x1 - x0 || 1)) * (W - m - 6), Y = (y) => H - 16 - ((y - lo) / (hi - lo)) * (H - 26);
+  const X = (x) => m + ((x - x0) / (x1 - x0 || 1)) * (W - m - 6);
+  const Y = (y) => H - 16 - ((Math.min(hi, Math.max(lo, y)) - lo) / (hi - lo)) * (H - 26);
   for (const [a, b] of ranges) el("rect", { x: X(a), y: 4, width: Math.max(1, X(b) - X(a)), height: H - 20, class: "range" }, svg);
   el("line", { x1: m, y1: H - 16, x2: W - 6, y2: H - 16, class: "axis" }, svg);
   el("line", { x1: m, y1: 4, x2: m, y2: H - 16, class: "axis" }, svg);
@@ -280,12 +293,17 @@ export function plot(svg, xs, series, k, ranges = []) {
   el("text", { x: 2, y: H - 18, class: "label" }, svg, lo.toPrecision(3));
   el("text", { x: m, y: H - 3, class: "label" }, svg, x0.toFixed(0));
   el("text", { x: W - 40, y: H - 3, class: "label" }, svg, x1.toFixed(0));
+  if (labels.x) el("text", { x: W / 2 - 20, y: H - 3, class: "label unit" }, svg, labels.x);
+  if (labels.y) el("text", { x: m + 4, y: 12, class: "label unit" }, svg, labels.y);
+  if (R.clipped) el("text", { x: m + 4, y: 24, class: "label clipped", "data-clipped": `${R.min} ${R.max}` }, svg,
+    `clipped (▲▼): full range ${R.min.toPrecision(3)} … ${R.max.toPrecision(3)}`);
   series.forEach((s, i) => {
     let d = "", pen = false;
     xs.forEach((x, n) => {
       const y = s.values[n];
       if (y === null || !Number.isFinite(y)) { pen = false; return; }
       d += `${pen ? "L" : "M"}${X(x).toFixed(1)} ${Y(y).toFixed(1)}`; pen = true;
+      if (y > hi || y < lo) el("path", { d: y > hi ? `M${X(x) - 3} ${Y(y) + 4}l3 -5l3 5z` : `M${X(x) - 3} ${Y(y) - 4}l3 5l3 -5z`, class: "clip-mark" }, svg);
     });
     el("path", { d, class: i ? "plotline y" : "plotline", "data-series": s.name }, svg);
     el("text", { x: W - 60, y: 14 + 12 * i, class: "label" }, svg, s.name);

@@ -3,6 +3,7 @@ import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
 import { geometryChecks, tidy, topologyKey } from "./checks.js";
 import { bindKeys } from "./keys.js";
+import { autosave, errorText, forgetWork, guardUnload, savedWork } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
@@ -17,7 +18,7 @@ const state = {
   mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
   opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
   targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
-  renders: 0, simulations: 0, latencies: [], diagnostics: [], check: null,
+  renders: 0, simulations: 0, latencies: [], diagnostics: [], check: null, home: 0, dirty: false, offer: null,
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
 
@@ -40,9 +41,18 @@ function div(cls, text) { const d = document.createElement("div"); d.className =
 // The banner: the current errors first (each outlines the element it names), then warnings, notes.
 function renderBanner() {
   const items = state.errors.map((e) => div("err", e.message + (e.hint ? ` — fix: ${e.hint}` : "")));
+  if (state.offer) {
+    const o = div("note", `unsaved work from ${state.offer.saved.replace("T", " ").slice(0, 16)} UTC (${state.offer.mechanism.name}) `);
+    const yes = h("button", "Restore"), no = h("button", "Dismiss");
+    yes.dataset.restore = ""; no.dataset.dismiss = "";
+    yes.onclick = () => { const w = state.offer; state.offer = null; state.fileName = w.name || ""; setMech(w.mechanism, { fit: true }); };
+    no.onclick = () => { state.offer = null; forgetWork(); render(); };
+    o.append(yes, no);
+    items.unshift(o);
+  }
   for (const d of state.diagnostics) items.push(div(d.level === "error" ? "err" : d.level === "warning" ? "warn" : "note", d.message));
   const sim = state.sim;
-  if (sim && !sim.assembled[0] && state.simFor === state.mech)
+  if (sim && !sim.assembled[state.home] && state.simFor === state.mech)
     items.push(div("err", "not assembled at the drawn pose: the links cannot meet where they are drawn. Drag a joint until they do, or type its x and y in the Element tab"));
   else if (sim && !sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
   for (const n of state.notes) items.push(div("note", n));
@@ -76,15 +86,28 @@ function statusLine() {
 }
 
 // ------------------------------------------------------------------ simulation and analysis
+// The sweep of an R drive starts at the drawn pose (index 0, a full turn of 180 steps); a P drive
+// is swept by ± half the length scale around it, in 181 steps so the middle one (90) is the drawn pose.
+const firstDrive = (m) => m.joints.find((j) => j.actuated);
+const stepsFor = (m) => (firstDrive(m) && firstDrive(m).type === "P" ? 181 : 180);
+const homeOf = (sim) => (sim.input.type === "P" ? (sim.assembled.length - 1) / 2 : 0);
+// The assembled frame nearest to k (the slider and the plots never show an unassembled input).
+function assembledNear(k) {
+  const ok = state.sim ? state.sim.assembled : [];
+  for (let d = 0; d < ok.length; d++) { if (ok[k - d]) return k - d; if (ok[k + d]) return k + d; }
+  return k;
+}
 const simulateSoon = coalescing(
   // while dragging: without velocities and accelerations (a smaller answer); on release: all
-  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
+  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: stepsFor(req.mech), rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
   ({ r, ms }, { mech, t0 }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
     if ((mech !== state.mech || !r.rates) && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
-    if (state.frame >= r.assembled.length) state.frame = 0;
+    const home = homeOf(r);
+    if (state.frame === state.home || state.frame >= r.assembled.length) state.frame = home;
+    state.home = home;
     render();
     // drag-to-repaint latency: from the pointer event to the frame that shows its simulation
     if (t0 !== undefined) requestAnimationFrame(() => state.latencies.push(performance.now() - t0));
@@ -116,11 +139,13 @@ function analyseSoon() {
   }, 250);
 }
 
-function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
+function setMech(mech, { record = true, fit = false, keepFrame = false, opened = false } = {}) {
   if (record && state.mech) { state.undo.push(JSON.stringify(state.mech)); state.redo = []; }
+  if (opened) state.dirty = false;
+  else if (state.mech && mech.joints.length) { state.dirty = true; if (root === document) autosave(mech, state.fileName); }
   state.mech = mech;
   if (onChange) onChange(mech);
-  if (!keepFrame) state.frame = 0;
+  if (!keepFrame) state.frame = state.home;
   if (fit) fitView();
   state.errors = [];
   const key = topologyKey(mech);
@@ -158,11 +183,11 @@ function edit(fn) { const m = rebase(); fn(m); setMech(m); }
 // The drawn pose becomes the file's pose (the branch drawn is the one kept).
 function rebase() {
   const { sim, frame: k } = state;
-  if (!sim || k === 0 || !sim.assembled[k]) return clone(state.mech);
+  if (!sim || k === state.home || !sim.assembled[k]) return clone(state.mech);
   const m = clone(state.mech);
   for (const j of m.joints) if (sim.joints[j.id] && sim.joints[j.id][k]) j.point = sim.joints[j.id][k].slice();
   for (const [n, p] of Object.entries(m.points || {})) if (sim.points[n] && sim.points[n][k]) p.at = sim.points[n][k].slice();
-  state.frame = 0;
+  state.frame = state.home;
   return m;
 }
 
@@ -451,12 +476,13 @@ function renderAnalysis() {
     });
     out.push(ul);
   } else if (a && a.assur_unavailable) out.push(h("p", `Assur groups: ${a.assur_unavailable}`, { className: "muted" }));
-  const gr = (sim && sim.grashof) || (a && a.grashof);
+  const gr = state.mech && state.mech.kind === "planar" ? (sim && sim.grashof) || (a && a.grashof) : null;
   if (gr) { out.push(h("h3", `Grashof: ${gr.classification}`)); out.push(h("p", gr.expression, { className: "formula" })); }
   if (sim) {
     out.push(h("h3", "Motion"));
     const u = sim.input.unit === "deg" ? "°" : "";
-    out.push(h("p", `working range of ${sim.input.joint}: ` + (sim.working_ranges.map(([x, y]) => `${x.toFixed(1)}${u} … ${y.toFixed(1)}${u}`).join(", ") || "none")));
+    const full = sim.input.type === "R" && sim.assembled.every(Boolean);
+    out.push(h("p", `working range of ${sim.input.joint}: ` + (full ? "full turn (360°)" : sim.working_ranges.map(([x, y]) => `${x.toFixed(1)}${u} … ${y.toFixed(1)}${u}`).join(", ") || "none")));
     for (const [key, t] of Object.entries(sim.transmission_angle || {}))
       if (t.min !== null) out.push(h("p", `transmission angle ${key}: ${t.min.toFixed(1)}° … ${t.max.toFixed(1)}°`));
     const dead = sim.events.filter((e) => e.kind === "dead point");
@@ -513,25 +539,31 @@ function renderPlots() {
   if (!$("tab-plots").classList.contains("on")) return;
   const [kind, name] = (sel.value || "").split(":");
   const xs = sim.input.values, k = state.frame, R = sim.working_ranges;
+  // the library's rates are at a drive speed of 1 rad/s (R) or 1 length unit/s (P), held constant:
+  // velocities scale with the speed, accelerations with its square
+  const w = Number($("drive-speed").value) || 1, rot = sim.input.type === "R";
+  const at = `at ${sim.input.joint} = ${w} ${rot ? "rad/s" : "units/s"}`;
+  const scale = (vals, f) => vals.map((v) => (v === null ? null : v * f));
   let pairs;
   if (kind === "point") {
-    const comp = (arr, i) => arr.map((v) => (v ? v[i] : null));
-    pairs = [[`velocity of ${name}`, [{ name: "vx", values: comp(sim.velocity[name], 0) }, { name: "vy", values: comp(sim.velocity[name], 1) }]],
-      [`acceleration of ${name}`, [{ name: "ax", values: comp(sim.acceleration[name], 0) }, { name: "ay", values: comp(sim.acceleration[name], 1) }]]];
+    const comp = (arr, i, f) => arr.map((v) => (v ? v[i] * f : null));
+    pairs = [[`velocity of ${name}`, "units/s", [{ name: "vx", values: comp(sim.velocity[name], 0, w) }, { name: "vy", values: comp(sim.velocity[name], 1, w) }]],
+      [`acceleration of ${name}`, "units/s²", [{ name: "ax", values: comp(sim.acceleration[name], 0, w * w) }, { name: "ay", values: comp(sim.acceleration[name], 1, w * w) }]]];
   } else if (kind === "link") {
-    pairs = [[`angular velocity of ${name} (rad/s)`, [{ name: "ω", values: sim.links[name].angular_velocity }]],
-      [`angular acceleration of ${name} (rad/s²)`, [{ name: "α", values: sim.links[name].angular_acceleration }]]];
+    pairs = [[`angular velocity of ${name}`, "rad/s", [{ name: "ω", values: scale(sim.links[name].angular_velocity, w) }]],
+      [`angular acceleration of ${name}`, "rad/s²", [{ name: "α", values: scale(sim.links[name].angular_acceleration, w * w) }]]];
   } else return;
   const out = [];
-  for (const [title, series] of pairs) {
-    out.push(h("p", `${title} against ${sim.input.joint} (${sim.input.unit})`));
+  const xunit = sim.input.unit === "deg" ? "°" : "units";
+  for (const [title, unit, series] of pairs) {
+    out.push(h("p", `${title} (${unit}, ${at}) against ${sim.input.joint} (${xunit})`));
     const s = el("svg", { "data-plot": title });
-    plot(s, xs, series, k, R);
+    plot(s, xs, series, k, R, { x: `${sim.input.joint} (${xunit})`, y: unit });
     s.addEventListener("click", (ev) => {
       const r = s.getBoundingClientRect(), mp = s.__map, x = ((ev.clientX - r.left) / r.width) * mp.W;
       const u = mp.x0 + ((x - mp.m) / (mp.W - mp.m - 6)) * (mp.x1 - mp.x0);
       let best = 0; xs.forEach((v, i) => { if (Math.abs(v - u) < Math.abs(xs[best] - u)) best = i; });
-      state.frame = best; render();
+      state.frame = assembledNear(best); render();
     });
     out.push(s);
   }
@@ -563,7 +595,7 @@ function setPlaying(on) {
 }
 $("play").onclick = () => setPlaying(!state.playing);
 $("direction").onclick = () => { state.dir = -state.dir; };
-$("input-slider").oninput = (ev) => { state.frame = +ev.target.value; render(); };
+$("input-slider").oninput = (ev) => { state.frame = assembledNear(+ev.target.value); render(); };
 
 // ------------------------------------------------------------------ synthesis
 let source = null, job = null;
@@ -574,17 +606,25 @@ $("synth-run").onclick = async () => {
     job = await call(`/api/synth/${$("synth-kind").value || "fourbar_path"}`, { targets: state.targets, time_limit: +$("synth-time").value });
   } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
   $("synth-run").disabled = true; $("synth-cancel").disabled = false;
-  $("synth-results").replaceChildren();
+  $("synth-results").replaceChildren(); $("synth-notes").replaceChildren();
   const show = (snap) => {
     const p = snap.progress;
     $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
-    $("synth-status").textContent = `${snap.state}${p.stage ? " (" + p.stage + ")" : ""}: ${p.done}/${p.total}, best ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
+    const stage = p.stage && p.stage !== snap.state ? ` (${p.stage})` : "";
+    $("synth-status").textContent = `${snap.state}${stage}: ${p.done}/${p.total}, best so far ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
   };
   const end = (snap) => {
     show(snap);
     $("synth-run").disabled = false; $("synth-cancel").disabled = true;
     if (snap.error) $("synth-status").textContent = `failed: ${snap.error.message}`;
-    if (snap.result) showResults(snap.result.results);
+    if (snap.result) {
+      const rs = snap.result.results, errs = rs.map((r) => r.error).filter(Number.isFinite);
+      // the status line tells what the list shows: its best error, not the search's internal one
+      $("synth-status").textContent = `${snap.state}: ${rs.length} result${rs.length === 1 ? "" : "s"}` +
+        (errs.length ? `, best error ${Math.min(...errs).toPrecision(4)}` : "") + ` in ${snap.seconds} s`;
+      showResults(rs);
+      $("synth-notes").replaceChildren(...(snap.result.notes || []).map((n) => h("li", n)));
+    }
   };
   if (transport.events) {
     source = new EventSource(eventsUrl(job.id));
@@ -603,6 +643,8 @@ function showResults(results) {
     const li = h("li");
     li.dataset.result = i;
     li.append(`${r.label} `);
+    const q = r.quality || (r.candidate && r.candidate.quality);
+    if (q) li.append(h("span", ` size ${(+q.size).toPrecision(3)} (${(+q.size_ratio).toFixed(1)}× the target), links ${(+q.link_ratio).toFixed(1)}:1, min μ ${(+q.min_transmission_angle).toFixed(0)}°${q.full_turn ? ", full turn" : ""} `, { className: "quality" }));
     if (r.mechanism) {
       const b = h("button", "Apply"); b.dataset.apply = i;
       b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
@@ -657,19 +699,19 @@ function chainFigure(c) {
 }
 
 // ------------------------------------------------------------------ files
-async function openFrom(promise) {
+async function openFrom(promise, from = "") {
   try {
     const r = await promise;
     state.fileName = r.name || "";
     $("save-name").value = state.fileName.includes("/") || !state.fileName ? state.fileName : state.fileName;
     state.selected = null;
-    setMech(r.mechanism, { fit: true });
+    setMech(r.mechanism, { fit: true, opened: true });
     // fit again once the paths are known
     const n = state.simulations;
     const wait = () => (state.simulations > n ? (fitView(), render()) : setTimeout(wait, 30));
     wait();
   } catch (e) {
-    state.errors = [{ message: e.error || String(e), hint: e.hint }]; render();
+    state.errors = [{ message: errorText(e, from ? `${from}: ` : "") }]; render();
   }
 }
 
@@ -679,7 +721,7 @@ $("files").onchange = (ev) => { if (ev.target.value) openFrom(call(`/api/file?pa
 $("upload").onchange = async (ev) => {
   const f = ev.target.files[0];
   if (!f) return;
-  openFrom(call("/api/import", { text: await f.text(), filename: f.name }));
+  openFrom(call("/api/import", { text: await f.text(), filename: f.name }), f.name);
   ev.target.value = "";
 };
 $("save").onclick = async () => {
@@ -691,7 +733,7 @@ $("save").onclick = async () => {
       if (!/exists/.test(e.error || "") || !confirm(`${name} exists: overwrite it?`)) throw e;
       r = await call("/api/file", { path: name, mechanism: state.mech, overwrite: true });
     }
-    state.notes = [`saved ${r.saved} (${r.bytes} bytes)`]; state.fileName = r.saved; render(); refreshFiles();
+    state.notes = [`saved ${r.saved} (${r.bytes} bytes)`]; state.fileName = r.saved; state.dirty = false; render(); refreshFiles();
   } catch (e) { state.errors = [{ message: `not saved: ${e.error || e}`, hint: e.hint }]; render(); }
 };
 
@@ -719,6 +761,10 @@ $("export").onchange = async (ev) => {
   if (!fmt || !state.mech) return;
   try {
     if (fmt === "svg") download(`${base()}.svg`, new Blob([await svgText()], { type: "image/svg+xml" }));
+    else if (fmt === "drawing" || fmt === "dxf") { // the library's drawing in model units / plates to cut
+      const text = await call(`/api/studio/${fmt}`, { mechanism: state.mech }, { raw: true });
+      download(`${base()}${fmt === "dxf" ? "_plates.dxf" : "_drawing.svg"}`, new Blob([text], { type: fmt === "dxf" ? "application/dxf" : "image/svg+xml" }));
+    }
     else if (fmt === "png") {
       const url = URL.createObjectURL(new Blob([await svgText()], { type: "image/svg+xml" }));
       const img = new Image();
@@ -736,7 +782,7 @@ $("export").onchange = async (ev) => {
       const text = await call("/api/export", { mechanism: state.mech, format: fmt }, { raw: true });
       download(`${base()}.${fmt}`, new Blob([text], { type: "text/plain" }));
     }
-  } catch (e) { state.errors = [{ message: `export failed: ${e.error || e}` }]; render(); }
+  } catch (e) { state.errors = [{ message: errorText(e, "export failed: ") }]; render(); }
 };
 
 async function refreshFiles() {
@@ -767,11 +813,13 @@ $("finish-link").onclick = finishLink;
 $("undo").onclick = undo;
 $("redo").onclick = redo;
 $("new").onclick = () => { state.fileName = ""; state.selected = null; setMech(EMPTY(), { fit: true }); };
+if (root === document) guardUnload(() => state.dirty);
 $("fit").onclick = () => { fitView(); render(); };
 $("grid").onchange = (ev) => { state.opts.grid = ev.target.checked; render(); };
 $("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
 $("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
 $("plot-what").onchange = renderPlots;
+$("drive-speed").onchange = renderPlots;
 window.addEventListener("resize", render);
 bindKeys(root, {
   undo, redo, finishLink, setMode, play: () => setPlaying(!state.playing), fit: () => { fitView(); render(); },
@@ -784,11 +832,13 @@ bindKeys(root, {
     const s = await call("/api/start");
     $("save-name").value = s.name || "";
     for (const [k, title] of Object.entries(s.synthesis_kinds || {})) $("synth-kind").append(h("option", title, { value: k }));
-    const ex = await call("/api/examples");
-    for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}`, { value: e.name }));
+    const ex = await call("/api/studio/examples");
+    for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}${e.kind === "planar" ? "" : ` (${e.kind})`}`, { value: e.name }));
     refreshFiles();
     if (s.mechanism) openFrom(Promise.resolve({ mechanism: s.mechanism, name: s.name }));
     else setMech(EMPTY(), { record: false, fit: true });
+    const w = root === document ? savedWork() : null;
+    if (w && JSON.stringify(w.mechanism) !== JSON.stringify(s.mechanism)) { state.offer = w; render(); }
   } catch (e) {
     $("banner").replaceChildren(div("err", `${e.error || e}${e.hint ? " — fix: " + e.hint : ""}`));
     state.mech = EMPTY(); render();
