@@ -54,7 +54,7 @@ def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
         if not js:
             out.append(_diag("error", f"link {name} is joined to nothing: join it with Link or delete it",
                              [("link", name)], True))
-        elif len(js) == 1 and not (js[0].get("actuated") and ground in js[0].get("links", [])):
+        elif len(js) == 1 and not js[0].get("actuated"):  # a driven end link (a crank, a serial end) is fine
             out.append(_diag("error", f"link {name} has one joint ({js[0].get('id')}): join it to another "
                              "link with Link, or delete it", [("link", name)], True))
     seen, todo = {ground}, [ground]
@@ -86,7 +86,7 @@ def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
     if n > mobility >= 1:
         return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
                       f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True)]
-    if 0 < n < mobility:
+    if 0 < n < mobility and not any(j.vll for j in mech.joints):  # a locked VLL joint takes up a freedom
         return [_diag("warning", f"mobility W = {mobility} with {n} drive{'s' if n > 1 else ''}: the motion is "
                       f"not determined. Mark {mobility - n} more joint{'s' if mobility - n > 1 else ''} with "
                       "Drive", els, True)]

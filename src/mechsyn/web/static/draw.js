@@ -126,7 +126,7 @@ function elementKeys(e) {
 function placeLabels() {
   const placed = [];
   return (layer, x, y, text) => {
-    const w = 7 * String(text).length + 4, hgt = 13;
+    const w = 7 * String(text).length + 4, hgt = 15;
     let yy = y;
     for (let guard = 0; guard < 12 && placed.some((b) => x < b.x + b.w && b.x < x + w && yy - hgt < b.y && b.y - hgt < yy); guard++) yy += hgt;
     placed.push({ x, y: yy, w });
