@@ -18,7 +18,7 @@ const state = {
   mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
   opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
   targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
-  renders: 0, simulations: 0, latencies: [], diagnostics: [], check: null, home: 0, dirty: false, offer: null,
+  renders: 0, simulations: 0, latencies: [], editLatencies: [], diagnostics: [], check: null, home: 0, dirty: false, offer: null,
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
 
@@ -100,10 +100,10 @@ function assembledNear(k) {
 const simulateSoon = coalescing(
   // while dragging: without velocities and accelerations (a smaller answer); on release: all
   (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: stepsFor(req.mech), rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
-  ({ r, ms }, { mech, t0 }) => {
+  ({ r, ms }, { mech, t0, edited }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
-    if ((mech !== state.mech || !r.rates) && !state.dragging) return; // a newer mechanism is on its way
+    if (mech !== state.mech && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
     const home = homeOf(r);
     if (state.frame === state.home || state.frame >= r.assembled.length) state.frame = home;
@@ -111,6 +111,7 @@ const simulateSoon = coalescing(
     render();
     // drag-to-repaint latency: from the pointer event to the frame that shows its simulation
     if (t0 !== undefined) requestAnimationFrame(() => state.latencies.push(performance.now() - t0));
+    if (edited !== undefined) requestAnimationFrame(() => state.editLatencies.push(performance.now() - edited));
     if (!state.dragging) renderAnalysis();
   },
   (e, { mech }) => {
@@ -139,7 +140,7 @@ function analyseSoon() {
   }, 250);
 }
 
-function setMech(mech, { record = true, fit = false, keepFrame = false, opened = false } = {}) {
+function setMech(mech, { record = true, fit = false, keepFrame = false, opened = false, edited } = {}) {
   if (record && state.mech) { state.undo.push(JSON.stringify(state.mech)); state.redo = []; }
   if (opened) state.dirty = false;
   else if (state.mech && mech.joints.length) { state.dirty = true; if (root === document) autosave(mech, state.fileName); }
@@ -149,7 +150,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   if (fit) fitView();
   state.errors = [];
   const key = topologyKey(mech);
-  if (state.check && state.check.key === key) afterCheck(mech, state.check.result);
+  if (state.check && state.check.key === key) afterCheck(mech, state.check.result, edited);
   else {
     // the topology changed: the server's check (mobility, drives, connections) first, at once
     state.diagnostics = geometryChecks(mech); state.check = null;
@@ -169,16 +170,21 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
 }
 
 // Simulate unless the checks say it is pointless (a structure, drives that fight, loose parts).
-function afterCheck(mech, result) {
+// An edit's first answer leaves out the rates (the repaint comes sooner, as in a drag); the full
+// simulation follows it.
+function afterCheck(mech, result, edited) {
   state.diagnostics = result.diagnostics.concat(geometryChecks(mech));
   state.notes = [];
   if (result.diagnostics.some((d) => d.blocks)) { state.sim = null; state.simFor = mech; renderAnalysis(); }
-  else if (mech.joints.some((j) => j.actuated)) simulateSoon({ mech });
+  else if (mech.joints.some((j) => j.actuated)) {
+    if (edited !== undefined) simulateSoon({ mech, drag: true, edited });
+    simulateSoon({ mech });
+  }
   else { state.sim = null; state.simFor = mech; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
 }
 
 // One numeric edit: fn changes a copy of the mechanism (at the drawn pose); re-simulated, one undo step.
-function edit(fn) { const m = rebase(); fn(m); setMech(m); }
+function edit(fn) { const t0 = performance.now(); const m = rebase(); fn(m); setMech(m, { edited: t0 }); }
 
 // The drawn pose becomes the file's pose (the branch drawn is the one kept).
 function rebase() {
@@ -530,6 +536,7 @@ function renderJoints() {
 function renderPlots() {
   const sim = state.sim, sel = $("plot-what");
   if (!sim) { $("plots").replaceChildren(h("p", "no simulation", { className: "muted" })); return; }
+  if (!sim.rates) return; // an edit's first answer: the plots wait for the rates
   const opts = Object.keys(sim.velocity).map((n) => `point:${n}`).concat(Object.keys(sim.links).map((n) => `link:${n}`));
   if ([...sel.options].map((o) => o.value).join() !== opts.join()) {
     const keep = sel.value;
