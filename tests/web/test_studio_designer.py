@@ -174,6 +174,11 @@ def test_slider_angle_typed_and_turned_by_its_handle(serve, page):
     wait_simulated(page)
     axis = page.evaluate("window.__studio.mech.joints.find(j => j.id === 'D').axis")
     assert np.allclose(axis, [0, 1], atol=2e-3), axis
+    page.click("#undo")  # back to 30 degrees for the picture, with the table of joints
+    wait_simulated(page)
+    page.click('#tabs [data-tab="joints"]')
+    page.wait_for_timeout(300)
+    shot(page, "studio_joints.png")
     assert page.console_errors == []
 
 
@@ -216,6 +221,7 @@ def test_two_drives_and_coincident_joints_are_reported(serve, page):
     page.mouse.click(*center(page, '[data-joint="D"]'))
     banner_has(page, "2 drives for mobility W = 1")
     assert page.locator('[data-joint="D"].invalid').count() == 1
+    shot(page, "studio_mistake.png")
     page.click("#undo")
     wait_simulated(page)
     wait_js(page, "() => !document.querySelector('[data-banner]').innerText.includes('drives')")
@@ -396,6 +402,7 @@ def test_plots_units_spikes_full_turn_and_assembled_slider(serve, page):
     assert spread > 4 * core  # the case of the issue
     clipped = page.locator('#plots [data-plot="acceleration of M"] [data-clipped]')
     assert clipped.count() == 1 and "full range" in clipped.text_content()
+    shot(page, "studio_plots.png")
     # a crank that turns fully reads "full turn"
     page.select_option("#examples", "crank_rocker")
     wait_js(page, "() => window.__studio.fileName.startsWith('crank_rocker') && window.__studio.simFor === window.__studio.mech && window.__studio.sim")

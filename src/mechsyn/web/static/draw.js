@@ -257,7 +257,7 @@ export function draw(svg, state) {
     if (at.kind === "link" && mem[at.id]) p = pos.joints[mem[at.id].joints[0]];
     if (!p) continue;
     const [px, py] = P(p);
-    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": at.id }, layers.labels, e.short || e.message);
+    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": at.id }, layers.labels, e.short || e.message.split(":")[0]);
   }
   return { joints, paths };
 }

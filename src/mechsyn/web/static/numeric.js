@@ -33,12 +33,13 @@ function together(m, id) {
 
 export function moveJoint(m, id, axis, v) { for (const j of together(m, id)) j.point[axis] = v; }
 
-// Length of a link with two joints; setting it moves the second joint along the line from the first.
+// Length of a bar (a link with two R joints); setting it moves the second joint along the line from the first.
 export function twoJointLinks(m) {
   const out = [];
   for (const [name, g] of Object.entries(membership(m))) {
     if (name === m.ground || g.joints.length !== 2) continue;
     const [a, b] = g.joints.map((id) => m.joints.find((j) => j.id === id));
+    if (a.type !== "R" || b.type !== "R") continue; // a slider block: its joints' distance is no length
     out.push({ name, a: a.id, b: b.id, length: Math.hypot(b.point[0] - a.point[0], b.point[1] - a.point[1]) });
   }
   return out;
