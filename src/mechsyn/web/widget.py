@@ -29,7 +29,8 @@ import anywidget
 import traitlets
 
 STATIC = Path(__file__).parent / "static"
-MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "studio.js")
+MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
+           "atlas.js", "studio.js")
 
 
 def _body_markup() -> str:

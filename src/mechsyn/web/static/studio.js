@@ -3,6 +3,9 @@ import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
 import { geometryChecks, tidy, topologyKey } from "./checks.js";
 import { bindKeys } from "./keys.js";
+import { mountPlayer } from "./player.js";
+import { mountSynthesis } from "./synthesis.js";
+import { mountAtlas } from "./atlas.js";
 import { autosave, errorText, forgetWork, guardUnload, savedWork } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
 
@@ -577,133 +580,10 @@ function renderPlots() {
   $("plots").replaceChildren(...out);
 }
 
-// ------------------------------------------------------------------ player
-let timer = null, lastTick = 0;
-function tick(t) {
-  if (!state.playing) return;
-  const fps = +$("speed").value;
-  if (t - lastTick >= 1000 / fps && state.sim) {
-    lastTick = t;
-    const n = state.sim.assembled.length, ok = state.sim.assembled;
-    let next = state.frame + state.dir;
-    const full = ok.every(Boolean);
-    if (full) next = (next + n) % n;
-    else if (next < 0 || next >= n || !ok[next]) { state.dir = -state.dir; next = state.frame + state.dir; if (next < 0 || next >= n || !ok[next]) next = state.frame; }
-    state.frame = next;
-    render();
-  }
-  timer = requestAnimationFrame(tick);
-}
-function setPlaying(on) {
-  state.playing = on && !!state.sim;
-  $("play").textContent = state.playing ? "❚❚" : "▶";
-  cancelAnimationFrame(timer);
-  if (state.playing) timer = requestAnimationFrame(tick);
-}
-$("play").onclick = () => setPlaying(!state.playing);
-$("direction").onclick = () => { state.dir = -state.dir; };
-$("input-slider").oninput = (ev) => { state.frame = assembledNear(+ev.target.value); render(); };
-
-// ------------------------------------------------------------------ synthesis
-let source = null, job = null;
-$("clear-targets").onclick = () => { state.targets = []; state.preview = null; $("target-count").textContent = 0; render(); };
-$("synth-run").onclick = async () => {
-  $("synth-status").textContent = "";
-  try {
-    job = await call(`/api/synth/${$("synth-kind").value || "fourbar_path"}`, { targets: state.targets, time_limit: +$("synth-time").value });
-  } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
-  $("synth-run").disabled = true; $("synth-cancel").disabled = false;
-  $("synth-results").replaceChildren(); $("synth-notes").replaceChildren();
-  const show = (snap) => {
-    const p = snap.progress;
-    $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
-    const stage = p.stage && p.stage !== snap.state ? ` (${p.stage})` : "";
-    $("synth-status").textContent = `${snap.state}${stage}: ${p.done}/${p.total}, best so far ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
-  };
-  const end = (snap) => {
-    show(snap);
-    $("synth-run").disabled = false; $("synth-cancel").disabled = true;
-    if (snap.error) $("synth-status").textContent = `failed: ${snap.error.message}`;
-    if (snap.result) {
-      const rs = snap.result.results, errs = rs.map((r) => r.error).filter(Number.isFinite);
-      // the status line tells what the list shows: its best error, not the search's internal one
-      $("synth-status").textContent = `${snap.state}: ${rs.length} result${rs.length === 1 ? "" : "s"}` +
-        (errs.length ? `, best error ${Math.min(...errs).toPrecision(4)}` : "") + ` in ${snap.seconds} s`;
-      showResults(rs);
-      $("synth-notes").replaceChildren(...(snap.result.notes || []).map((n) => h("li", n)));
-    }
-  };
-  if (transport.events) {
-    source = new EventSource(eventsUrl(job.id));
-    source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
-    source.addEventListener("end", (e) => { source.close(); end(JSON.parse(e.data)); });
-    source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
-  } else { // no event stream (notebook widget): poll the job
-    const poll = async () => { const snap = await call(`/api/jobs/${job.id}`); if (snap.state === "running") { show(snap); setTimeout(poll, 300); } else end(snap); };
-    poll();
-  }
-};
-$("synth-cancel").onclick = async () => { if (job) await call(`/api/jobs/${job.id}/cancel`, {}); };
-
-function showResults(results) {
-  const items = results.map((r, i) => {
-    const li = h("li");
-    li.dataset.result = i;
-    li.append(`${r.label} `);
-    const q = r.quality || (r.candidate && r.candidate.quality);
-    if (q) li.append(h("span", ` size ${(+q.size).toPrecision(3)} (${(+q.size_ratio).toFixed(1)}× the target), links ${(+q.link_ratio).toFixed(1)}:1, min μ ${(+q.min_transmission_angle).toFixed(0)}°${q.full_turn ? ", full turn" : ""} `, { className: "quality" }));
-    if (r.mechanism) {
-      const b = h("button", "Apply"); b.dataset.apply = i;
-      b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
-      li.append(b);
-    }
-    li.onmouseenter = () => { state.preview = r.path; render(); };
-    return li;
-  });
-  $("synth-results").replaceChildren(...items);
-  if (results.length) { state.preview = results[0].path; render(); }
-}
-
-// ------------------------------------------------------------------ atlas
-$("atlas-go").onclick = async () => {
-  $("atlas").replaceChildren(h("p", "listing…", { className: "muted" }));
-  try {
-    const { chains } = await call(`/api/atlas?links=${$("atlas-links").value}&mobility=${$("atlas-mobility").value}`);
-    $("atlas").replaceChildren(...chains.map(chainFigure));
-    if (!chains.length) $("atlas").replaceChildren(h("p", "no chains", { className: "muted" }));
-  } catch (e) { $("atlas").replaceChildren(h("p", e.error || String(e), { className: "err" })); }
-};
-
-function chainFigure(c) {
-  const fig = h("figure");
-  const s = el("svg", { viewBox: "-70 -70 140 140", "data-chain": c.index });
-  const jx = c.joint_xy, xs = jx.map((p) => p[0]), ys = jx.map((p) => p[1]);
-  const cx = (Math.min(...xs) + Math.max(...xs)) / 2, cy = (Math.min(...ys) + Math.max(...ys)) / 2;
-  const sc = 110 / Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys), 1e-9);
-  const P = (p) => [(p[0] - cx) * sc, -(p[1] - cy) * sc];
-  const frame = c.mechanisms.length ? c.mechanisms[0].frame : 0;
-  for (let l = 0; l < c.chain.n_links; l++) {
-    const pts = c.chain.edges.map((e, k) => (e.includes(l) ? P(jx[k]) : null)).filter(Boolean);
-    if (pts.length === 2) el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar", "stroke-width": 3, stroke: l === frame ? "#999" : null }, s);
-    else {
-      const cxy = pts.reduce((a, p) => [a[0] + p[0] / pts.length, a[1] + p[1] / pts.length], [0, 0]);
-      pts.sort((a, b) => Math.atan2(a[1] - cxy[1], a[0] - cxy[0]) - Math.atan2(b[1] - cxy[1], b[0] - cxy[0]));
-      el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "link-plate", fill: l === frame ? "#ccc" : null }, s);
-    }
-  }
-  for (const p of jx.map(P)) el("circle", { cx: p[0], cy: p[1], r: 3, class: "joint" }, s);
-  fig.append(s, h("figcaption", `#${c.index + 1} ${c.label}`));
-  const b = h("button", "Open"); b.dataset.openChain = c.index;
-  b.onclick = async () => {
-    try {
-      const ch = c.mechanisms[0] || {};
-      const r = await call("/api/atlas/mechanism", { chain: c.chain, frame: ch.frame, input: ch.input });
-      state.fileName = ""; setMech(r.mechanism, { fit: true });
-    } catch (e) { state.errors = [{ message: e.error }]; render(); }
-  };
-  fig.append(b);
-  return fig;
-}
+// ------------------------------------------------------------------ player, synthesis, atlas
+const setPlaying = mountPlayer({ $, state, render, assembledNear });
+mountSynthesis({ $, state, render, setMech });
+mountAtlas({ $, state, render, setMech });
 
 // ------------------------------------------------------------------ files
 async function openFrom(promise, from = "") {
