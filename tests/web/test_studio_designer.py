@@ -410,3 +410,40 @@ def test_plots_units_spikes_full_turn_and_assembled_slider(serve, page):
     wait_js(page, "() => document.querySelector('#tab-analysis').innerText.includes('working range')")
     assert "full turn" in page.locator("#tab-analysis").inner_text()
     assert page.console_errors == []
+
+
+# 8 (stretch) ------------------------------------------------------------------------------
+def test_forces_tab_equals_the_library(serve, page):
+    mech = example("crank_rocker")
+    srv = serve(mech, "crank_rocker.yaml")
+    open_studio(page, srv)
+    wait_settled(page)
+    page.click('#tabs [data-tab="forces"]')
+    wait_js(page, "() => window.__studio.forces && window.__studio.forces.mech === window.__studio.mech && window.__studio.forces.r")
+    from mechsyn.io import mechanism_from_dict
+    from mechsyn.kinematics.analysis import forces
+
+    def library(m, gravity):
+        r = page.evaluate("window.__studio.forces.r")
+        lib = forces(mechanism_from_dict(m), {"A": np.array(r["input"]["values"])}, speeds={"A": 1.0}, gravity=gravity)
+        got = np.array([np.nan if v is None else v for v in r["drives"]["A"]["value"]], float)
+        return got, lib.reactions.effort["A"]
+
+    got, ref = library(mech, (0.0, 0.0))
+    assert np.allclose(got, ref, equal_nan=True)
+    assert page.locator("[data-force]").count() == 4  # a reaction arrow at each joint
+    # a mass typed is kept in the file and the torque follows; gravity too
+    page.fill('[data-table="masses"] [data-row="rocker"] input[data-field="mass"]', "3")
+    page.press('[data-table="masses"] [data-row="rocker"] input[data-field="mass"]', "Enter")
+    page.check("#forces-gravity")
+    wait_js(page, """() => { const s = window.__studio; return s.forces && s.forces.mech === s.mech && s.forces.r
+        && s.forces.r.gravity[1] < 0 && s.mech.links.find(l => l.name === 'rocker').mass === 3; }""")
+    got, ref = library(page.evaluate("window.__studio.mech"), (0.0, -9.81))
+    assert np.allclose(got, ref, equal_nan=True)
+    page.fill("#load-fx", "2")
+    page.click("#load-add")
+    wait_js(page, "() => (window.__studio.mech.loads || []).length === 3")
+    wait_js(page, "() => window.__studio.forces && window.__studio.forces.mech === window.__studio.mech && window.__studio.forces.r")
+    page.locator("#input-slider").fill("40")
+    shot(page, "studio_forces.png")
+    assert page.console_errors == []

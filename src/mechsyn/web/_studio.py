@@ -156,6 +156,33 @@ def export_dxf(data: Any) -> str:
     return buf.getvalue()
 
 
+def _finite_number(value: Any, field: str) -> float:
+    import math
+
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise MechsynInputError(f"expected a number, got {value!r}", field=field)
+    return float(value)
+
+
+def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 180) -> dict[str, Any]:
+    """Drive torque (or force) and joint reactions over the studio's sweep of the first drive
+    (``mechsyn forces``: kinetostatics with the file's link masses, inertias and loads, the
+    drive turning at ``speed`` rad/s, or moving at ``speed`` units/s, held constant).
+
+    Returns the library's :meth:`~mechsyn.kinematics.analysis.ForceAnalysis.to_dict`.
+    """
+    from mechsyn.kinematics.analysis import forces as _forces
+    from mechsyn.results import to_jsonable
+
+    if not isinstance(gravity, (list, tuple)) or len(gravity) != 2:
+        raise MechsynInputError("gravity must be [gx, gy]", field="gravity")
+    g = (_finite_number(gravity[0], "gravity"), _finite_number(gravity[1], "gravity"))
+    w = _finite_number(speed, "speed")
+    mech = _service.build(data)
+    drive, values = _service._sweep(mech, steps, None)
+    return to_jsonable(_forces(mech, {drive.id: values}, speeds={drive.id: w}, gravity=g).to_dict())
+
+
 def examples() -> list[dict[str, str]]:
     """The Examples menu: the planar examples (:func:`mechsyn.web._service.examples`), then the
     spatial ones with joint points (opened for structure and rank analysis), each with its ``kind``."""
@@ -186,7 +213,7 @@ def routes() -> list:
     from starlette.responses import Response
     from starlette.routing import Route
 
-    from mechsyn.web._app import _body, _need, api
+    from mechsyn.web._app import _body, _int, _need, api
 
     def on_mechanism(fn, media_type=None):
         @api
@@ -199,7 +226,14 @@ def routes() -> list:
     async def examples_route(request) -> Any:
         return {"examples": await run_in_threadpool(examples)}
 
+    @api
+    async def forces_route(request) -> Any:
+        body = await _body(request)
+        return await run_in_threadpool(forces, _need(body, "mechanism"), body.get("gravity", [0.0, 0.0]),
+                                       body.get("speed", 1.0), _int(body.get("steps", 180), "steps"))
+
     return [Route("/api/studio/examples", examples_route),
+            Route("/api/studio/forces", forces_route, methods=["POST"]),
             Route("/api/studio/check", on_mechanism(check), methods=["POST"]),
             Route("/api/studio/drawing", on_mechanism(export_drawing, "image/svg+xml"), methods=["POST"]),
             Route("/api/studio/dxf", on_mechanism(export_dxf, "application/dxf"), methods=["POST"])]

@@ -30,7 +30,7 @@ import traitlets
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
-           "atlas.js", "studio.js")
+           "atlas.js", "forces.js", "studio.js")
 
 
 def _body_markup() -> str:

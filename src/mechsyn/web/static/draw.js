@@ -234,6 +234,15 @@ export function draw(svg, state) {
         class: "deadpoint", "data-deadpoint": ev.index }, layers.marks);
     }
   }
+  // joint reactions at this frame (Forces tab): arrows from the joint, the largest a quarter of the length scale
+  for (const a of state.arrows || []) {
+    const [x1, y1] = P(a.at), [x2, y2] = P([a.at[0] + a.vec[0], a.at[1] + a.vec[1]]);
+    const L = Math.hypot(x2 - x1, y2 - y1);
+    if (L < 2) continue;
+    const ux = (x2 - x1) / L, uy = (y2 - y1) / L;
+    el("path", { d: `M${x1.toFixed(1)} ${y1.toFixed(1)}L${x2.toFixed(1)} ${y2.toFixed(1)}M${(x2 - 9 * ux - 4 * uy).toFixed(1)} ${(y2 - 9 * uy + 4 * ux).toFixed(1)}L${x2.toFixed(1)} ${y2.toFixed(1)}L${(x2 - 9 * ux + 4 * uy).toFixed(1)} ${(y2 - 9 * uy - 4 * ux).toFixed(1)}`,
+      class: "force-arrow", "data-force": a.id }, layers.marks);
+  }
   // synthesis targets and a previewed path
   (state.targets || []).forEach((t, i) => {
     const [px, py] = P(t);

@@ -6,6 +6,7 @@ import { bindKeys } from "./keys.js";
 import { mountPlayer } from "./player.js";
 import { mountSynthesis } from "./synthesis.js";
 import { mountAtlas } from "./atlas.js";
+import { mountForces } from "./forces.js";
 import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
 
@@ -28,7 +29,8 @@ window.__studio = state; // for tests and the benchmark (read-only use)
 // ------------------------------------------------------------------ rendering
 function render() {
   try {
-    draw(svg, { ...state, poseFromFile: state.dragging });
+    const arrows = forcesUi.arrows(state.frame, () => positions(state.mech, state.dragging ? null : state.sim, state.frame).joints);
+    draw(svg, { ...state, poseFromFile: state.dragging, arrows });
     state.renders += 1;
     renderBanner();
     renderPlayer();
@@ -170,6 +172,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   analyseSoon();
   render();
   renderElement();
+  if ($("tab-forces").classList.contains("on")) { forcesUi.renderForces(); forcesUi.forcesSoon(); }
 }
 
 // Simulate unless the checks say it is pointless (a structure, drives that fight, loose parts).
@@ -584,6 +587,7 @@ function renderPlots() {
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
 mountSynthesis({ $, state, render, setMech });
 mountAtlas({ $, state, render, setMech });
+const forcesUi = mountForces({ $, state, render, edit, stepsFor });
 
 // ------------------------------------------------------------------ files
 const { openFrom, refreshFiles } = mountFiles({ $, svg, state, render, setMech, fitView });
@@ -600,6 +604,8 @@ function showTab(name) {
   for (const b of root.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
   for (const t of root.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
   if (name === "plots") renderPlots();
+  if (name === "forces") { forcesUi.renderForces(); forcesUi.compute(); }
+  render();
 }
 for (const b of root.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
 for (const b of root.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
@@ -613,7 +619,7 @@ $("grid").onchange = (ev) => { state.opts.grid = ev.target.checked; render(); };
 $("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
 $("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
 $("plot-what").onchange = renderPlots;
-$("drive-speed").onchange = renderPlots;
+$("drive-speed").onchange = () => { renderPlots(); forcesUi.forcesSoon(); };
 window.addEventListener("resize", render);
 bindKeys(root, {
   undo, redo, finishLink, setMode, play: () => setPlaying(!state.playing), fit: () => { fitView(); render(); },
