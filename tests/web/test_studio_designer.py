@@ -14,7 +14,7 @@ import pytest
 from mechsyn.io import load_mechanism, mechanism_to_dict
 from mechsyn.web._service import example_path
 
-from test_browser import center, click_world, example, open_studio, screen, shot, wait_js, wait_settled, wait_simulated
+from test_browser import center, click_world, example, new_canvas, open_studio, screen, shot, wait_js, wait_settled, wait_simulated
 
 BANNER = "() => document.querySelector('[data-banner]').innerText"
 
@@ -184,9 +184,7 @@ def test_slider_angle_typed_and_turned_by_its_handle(serve, page):
 
 def test_clicked_coordinates_are_rounded(serve, page):
     srv = serve(None)
-    page.goto(srv.url)
-    wait_js(page, "() => window.__studio && window.__studio.mech")
-    page.click("#new")
+    new_canvas(page, srv)
     page.click("text=Pivot")
     click_world(page, 0.0000000255, 1.23456789)
     p = page.evaluate("window.__studio.mech.joints[0].point")
@@ -364,9 +362,7 @@ def test_export_drawing_in_model_units_and_dxf(serve, page):
 # 10 ---------------------------------------------------------------------------------------
 def test_synthesis_status_is_the_best_listed_result(serve, page):
     srv = serve(None)
-    page.goto(srv.url)
-    wait_js(page, "() => window.__studio && window.__studio.mech")
-    page.click("#new")
+    new_canvas(page, srv)
     page.click("text=Targets")
     for p in [(1.0, 3.0), (2.0, 3.6), (3.0, 3.8), (4.0, 3.5), (4.8, 2.8)]:
         click_world(page, *p)
@@ -446,4 +442,36 @@ def test_forces_tab_equals_the_library(serve, page):
     wait_js(page, "() => window.__studio.forces && window.__studio.forces.mech === window.__studio.mech && window.__studio.forces.r")
     page.locator("#input-slider").fill("40")
     shot(page, "studio_forces.png")
+    assert page.console_errors == []
+
+
+def test_motion_through_three_poses(serve, page):
+    srv = serve(None)
+    new_canvas(page, srv)
+    page.click('#tabs [data-tab="synthesis"]')
+    page.select_option("#synth-kind", "motion")
+    page.click("text=Targets")
+    poses = [(0.0, 0.0, 0.0), (1.0, 0.5, 20.0), (2.0, 0.7, 45.0)]
+    for x, y, _ in poses:
+        click_world(page, x, y)
+    targets = page.evaluate("window.__studio.targets")
+    for i, (_, _, a) in enumerate(poses):
+        page.fill(f'[data-table="poses"] input[data-pose="{i}"]', str(a))
+        page.press(f'[data-table="poses"] input[data-pose="{i}"]', "Enter")
+    assert page.locator("[data-pose]").count() == 3 + 3  # the inputs and the ticks on the canvas
+    page.click("#synth-run")
+    page.wait_for_selector("[data-apply]", timeout=60000)
+    assert "verified" in page.locator("#synth-notes").inner_text()
+    page.locator("[data-apply='0']").click()
+    wait_js(page, "() => window.__studio.sim && window.__studio.simFor === window.__studio.mech && window.__studio.mech.name.includes('Burmester')")
+    # the guided body's origin (point P) passes through every pose, at the pose's angle
+    from mechsyn.synthesis.reports import motion_report
+
+    ref = motion_report(np.column_stack([np.array(targets), np.radians([p[2] for p in poses])]), top=1)
+    assert ref.all_solutions[0].position_error < 1e-9
+    mech = page.evaluate("window.__studio.mech")
+    assert np.allclose(mech["points"]["P"]["at"], targets[0], atol=1e-9)
+    path = np.array([p for p in page.evaluate("window.__studio.sim.points.P") if p is not None])
+    step = np.max(np.linalg.norm(np.diff(path, axis=0), axis=1))
+    assert max(np.min(np.linalg.norm(path - t, axis=1)) for t in targets) <= step
     assert page.console_errors == []

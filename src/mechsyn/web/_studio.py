@@ -183,6 +183,44 @@ def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 
     return to_jsonable(_forces(mech, {drive.id: values}, speeds={drive.id: w}, gravity=g).to_dict())
 
 
+def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
+    """Motion generation through 3 to 5 clicked poses (``params["targets"]`` [x, y] and
+    ``params["angles"]`` in degrees): Burmester theory (``mechsyn synth motion``:
+    :func:`mechsyn.synthesis.reports.motion_report`), each four-bar verified by simulation,
+    ranked defect-free first, then by the smallest transmission angle."""
+    import numpy as np
+
+    from mechsyn.synthesis.export import fourbar_mechanism_dict
+    from mechsyn.synthesis.reports import motion_report
+
+    T = np.asarray(params.get("targets"), float)
+    A = np.asarray(params.get("angles", [0.0] * len(T)), float)
+    if T.ndim != 2 or T.shape[1:] != (2,) or not 3 <= len(T) <= 5 or not np.isfinite(T).all():
+        raise MechsynInputError("give 3 to 5 poses: click 3 to 5 target points", field="targets",
+                                hint="then type each pose's angle in the Synthesis tab")
+    if A.shape != (len(T),) or not np.isfinite(A).all():
+        raise MechsynInputError("give one angle (degrees) per pose", field="angles")
+    progress({"done": 0, "total": 1, "best": None})
+    report = motion_report(np.column_stack([T, np.radians(A)]), top=5)
+    results = []
+    for r in report.all_solutions[:5]:
+        d = r.design()
+        mech = fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(r.theta2[0]), branch=r.branch,
+                                      rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
+                                      name="Four-bar motion generator (Burmester)")
+        err = float(r.position_error)
+        results.append({"error": err, "feasible": bool(r.ok), "mechanism": mech, "path": T.tolist(),
+                        "label": f"error {err:.3g} (largest distance at a pose), min μ {r.min_transmission_deg:.0f}°"
+                                 + ("" if r.ok else ", not verified: a branch or order defect")})
+    progress({"done": 1, "total": 1, "best": min((x["error"] for x in results), default=None)})
+    return {"kind": "motion", "targets": T.tolist(), "results": results,
+            "notes": [f"{report.count} linkages found, {report.verified_count} verified by simulation"]}
+
+
+# the documented extension point of the studio's synthesis kinds
+_service.SYNTHESIS_KINDS.setdefault("motion", ("Motion through 3-5 poses (Burmester)", synthesize_motion))
+
+
 def examples() -> list[dict[str, str]]:
     """The Examples menu: the planar examples (:func:`mechsyn.web._service.examples`), then the
     spatial ones with joint points (opened for structure and rank analysis), each with its ``kind``."""

@@ -247,6 +247,10 @@ export function draw(svg, state) {
   (state.targets || []).forEach((t, i) => {
     const [px, py] = P(t);
     el("circle", { cx: px, cy: py, r: 7, class: "target", "data-target": i }, layers.marks);
+    if (state.showPoses) { // a pose of the guided body: its angle as a tick
+      const a = (((state.targetAngles || [])[i] || 0) * Math.PI) / 180;
+      el("line", { x1: px, y1: py, x2: px + 26 * Math.cos(a), y2: py - 26 * Math.sin(a), class: "pose-tick", "data-pose": i }, layers.marks);
+    }
     labels(layers.labels, px + 9, py + 4, `T${i + 1}`);
   });
   if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);

@@ -394,7 +394,7 @@ svg.addEventListener("pointerdown", (ev) => {
     else if (linkEl) deleteLink(linkEl.dataset.link);
   } else if (mode === "target") {
     state.targets.push(p);
-    $("target-count").textContent = state.targets.length;
+    $("target-count").textContent = state.targets.length; synthUi.renderPoses();
     gesture = { kind: "draw", last: [ev.clientX, ev.clientY] };
     svg.setPointerCapture(ev.pointerId);
     render();
@@ -407,7 +407,7 @@ svg.addEventListener("pointermove", (ev) => {
     if (Math.hypot(ev.clientX - gesture.last[0], ev.clientY - gesture.last[1]) < 12) return;
     gesture.last = [ev.clientX, ev.clientY];
     state.targets.push(worldAt(ev));
-    $("target-count").textContent = state.targets.length;
+    $("target-count").textContent = state.targets.length; synthUi.renderPoses();
     render();
     return;
   }
@@ -585,7 +585,7 @@ function renderPlots() {
 
 // ------------------------------------------------------------------ player, synthesis, atlas
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
-mountSynthesis({ $, state, render, setMech });
+const synthUi = mountSynthesis({ $, state, render, setMech });
 mountAtlas({ $, state, render, setMech });
 const forcesUi = mountForces({ $, state, render, edit, stepsFor });
 

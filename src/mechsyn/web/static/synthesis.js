@@ -3,14 +3,38 @@
 import { call, eventsUrl, transport } from "./api.js";
 import { h } from "./numeric.js";
 
-// `ctx`: {$, state, render, setMech}.
+// `ctx`: {$, state, render, setMech}; returns {renderPoses} (called when a target is added).
 export function mountSynthesis({ $, state, render, setMech }) {
   let source = null, job = null;
-  $("clear-targets").onclick = () => { state.targets = []; state.preview = null; $("target-count").textContent = 0; render(); };
+  $("clear-targets").onclick = () => { state.targets = []; state.targetAngles = []; state.preview = null; $("target-count").textContent = 0; renderPoses(); render(); };
+
+  // Motion through poses: each clicked target is a pose of the guided body, its angle typed here
+  // (degrees, counter-clockwise from x) and drawn as a tick on the canvas.
+  const poseAngles = () => state.targets.map((_, i) => (state.targetAngles || [])[i] || 0);
+  function renderPoses() {
+    const on = $("synth-kind").value === "motion";
+    state.showPoses = on;
+    if (!on) { $("synth-poses").replaceChildren(); return; }
+    const t = h("table", null, { className: "numtable" });
+    t.dataset.table = "poses";
+    const head = h("tr"); for (const c of ["pose", "x", "y", "angle °"]) head.append(h("th", c)); t.append(head);
+    state.targets.forEach((p, i) => {
+      const a = h("input", null, { value: String(poseAngles()[i]), size: 5 });
+      a.dataset.pose = i;
+      a.onchange = () => { const v = Number(a.value); if (!Number.isFinite(v)) return; state.targetAngles = poseAngles(); state.targetAngles[i] = v; render(); };
+      const td = h("td"); td.append(a);
+      const tr = h("tr"); tr.append(h("td", `T${i + 1}`), h("td", String(p[0])), h("td", String(p[1])), td);
+      t.append(tr);
+    });
+    $("synth-poses").replaceChildren(h("p", "Click 3 to 5 poses (Targets), then type each pose's angle.", { className: "muted" }), t);
+  }
+  $("synth-kind").addEventListener("change", () => { renderPoses(); render(); });
   $("synth-run").onclick = async () => {
     $("synth-status").textContent = "";
     try {
-      job = await call(`/api/synth/${$("synth-kind").value || "fourbar_path"}`, { targets: state.targets, time_limit: +$("synth-time").value });
+      const kind = $("synth-kind").value || "fourbar_path";
+      job = await call(`/api/synth/${kind}`, { targets: state.targets, time_limit: +$("synth-time").value,
+        ...(kind === "motion" ? { angles: poseAngles() } : {}) });
     } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
     $("synth-run").disabled = true; $("synth-cancel").disabled = false;
     $("synth-results").replaceChildren(); $("synth-notes").replaceChildren();
@@ -63,4 +87,5 @@ export function mountSynthesis({ $, state, render, setMech }) {
     $("synth-results").replaceChildren(...items);
     if (results.length) { state.preview = results[0].path; render(); }
   }
+  return { renderPoses };
 }
