@@ -6,15 +6,11 @@ Each test drives Debian's Chromium as a designer would and checks what the page 
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
-import pytest
 
-from mechsyn.io import load_mechanism, mechanism_to_dict
 from mechsyn.web._service import example_path
 
-from test_browser import center, click_world, example, new_canvas, open_studio, screen, shot, wait_js, wait_settled, wait_simulated
+from test_browser import center, click_world, example, new_canvas, open_studio, shot, wait_js, wait_settled, wait_simulated
 
 BANNER = "() => document.querySelector('[data-banner]').innerText"
 
