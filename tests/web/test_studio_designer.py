@@ -437,6 +437,7 @@ def test_forces_tab_equals_the_library(serve, page):
     wait_js(page, "() => (window.__studio.mech.loads || []).length === 3")
     wait_js(page, "() => window.__studio.forces && window.__studio.forces.mech === window.__studio.mech && window.__studio.forces.r")
     page.locator("#input-slider").fill("40")
+    assert page.locator('#tab-forces [data-plot="reactions"] [data-cursor="40"]').count() == 1
     shot(page, "studio_forces.png")
     assert page.console_errors == []
 

@@ -9,7 +9,7 @@ import { lengthScale } from "./checks.js";
 
 const num = (text) => { const v = Number(String(text).trim().replace(",", ".")); return String(text).trim() !== "" && Number.isFinite(v) ? v : null; };
 
-// `ctx`: {$, state, render, edit, stepsFor}; returns {renderForces, forcesSoon, arrows(k)}.
+// `ctx`: {$, state, render, edit, stepsFor}; returns {renderForces, forcesSoon, compute, arrows, cursor}.
 export function mountForces({ $, state, render, edit, stepsFor }) {
   const box = $("tab-forces");
   let timer = null;
@@ -132,5 +132,18 @@ export function mountForces({ $, state, render, edit, stepsFor }) {
     return out;
   }
 
-  return { renderForces, forcesSoon, compute, arrows };
+  // The plots' cursors follow the frame shown (the tab itself is redrawn only when the mechanism changes).
+  function cursor(k) {
+    const f = state.forces;
+    if (!f || !f.r || !box.classList.contains("on")) return;
+    const x = f.r.input.values[k];
+    for (const s of box.querySelectorAll("svg")) {
+      const c = s.querySelector("[data-cursor]");
+      if (!c || !s.__map || x === undefined) continue;
+      const px = s.__map.X(x).toFixed(1);
+      c.setAttribute("x1", px); c.setAttribute("x2", px); c.setAttribute("data-cursor", k);
+    }
+  }
+
+  return { renderForces, forcesSoon, compute, arrows, cursor };
 }

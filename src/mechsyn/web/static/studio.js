@@ -35,6 +35,7 @@ function render() {
     renderBanner();
     renderPlayer();
     renderPlots();
+    forcesUi.cursor(state.frame);
   } catch (e) {
     console.error(e);
     $("banner").replaceChildren(div("err", `drawing failed: ${e.message || e}`));
