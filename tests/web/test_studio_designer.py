@@ -297,7 +297,7 @@ def test_every_example_opens_and_simulates(serve, page):
     wait_js(page, "() => window.__studio.fileName.startsWith('bennett.') && window.__studio.analysis && window.__studio.analysis.structure")
     page.click('#tabs [data-tab="analysis"]')
     text = page.locator("#tab-analysis").inner_text()
-    assert "Mobility" in text and "Grashof" not in text
+    assert "Mobility" in text and "Grashof" not in text and "(spatial formula)" not in text
     assert page.console_errors == []
 
 
@@ -395,6 +395,10 @@ def test_plots_units_spikes_full_turn_and_assembled_slider(serve, page):
     clipped = page.locator('#plots [data-plot="acceleration of M"] [data-clipped]')
     assert clipped.count() == 1 and "full range" in clipped.text_content()
     shot(page, "studio_plots.png")
+    # the formulas by their names in the literature, the spatial ones marked for a planar file
+    page.click('#tabs [data-tab="analysis"]')
+    text = page.locator("#tab-analysis").inner_text()
+    assert "Grübler" in text and "Chebyshev" in text and "Somov–Malyshev (spatial formula)" in text
     # a crank that turns fully reads "full turn"
     page.select_option("#examples", "crank_rocker")
     wait_js(page, "() => window.__studio.fileName.startsWith('crank_rocker') && window.__studio.simFor === window.__studio.mech && window.__studio.sim")

@@ -31,8 +31,9 @@ def _names(ids: list[str]) -> str:
     return ids[0] if len(ids) == 1 else ", ".join(ids[:-1]) + " and " + ids[-1]
 
 
-def _diag(level: str, message: str, elements: list[tuple[str, str]], blocks: bool) -> dict[str, Any]:
-    return {"level": level, "message": message, "blocks": blocks,
+def _diag(level: str, message: str, elements: list[tuple[str, str]], blocks: bool, short: str = "") -> dict[str, Any]:
+    """One diagnostic; ``short`` is the few words written next to the element on the canvas."""
+    return {"level": level, "message": message, "blocks": blocks, "short": short or message.split(":")[0],
             "elements": [{"kind": k, "id": i} for k, i in elements]}
 
 
@@ -53,10 +54,10 @@ def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
             continue
         if not js:
             out.append(_diag("error", f"link {name} is joined to nothing: join it with Link or delete it",
-                             [("link", name)], True))
+                             [("link", name)], True, "joined to nothing"))
         elif len(js) == 1 and not js[0].get("actuated"):  # a driven end link (a crank, a serial end) is fine
             out.append(_diag("error", f"link {name} has one joint ({js[0].get('id')}): join it to another "
-                             "link with Link, or delete it", [("link", name)], True))
+                             "link with Link, or delete it", [("link", name)], True, "one joint only"))
     seen, todo = {ground}, [ground]
     while todo:
         link = todo.pop()
@@ -70,7 +71,7 @@ def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
         many = len(loose) > 1
         out.append(_diag("error", f"link{'s' if many else ''} {_names(loose)} {'are' if many else 'is'} not "
                          "connected to the frame: add a Pivot and join it to them with Link",
-                         [("link", n) for n in loose], True))
+                         [("link", n) for n in loose], True, "not connected to the frame"))
     return out
 
 
@@ -82,14 +83,14 @@ def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
     if mobility <= 0 and drives:
         return [_diag("error", f"this is a structure, not a mechanism (mobility W = {mobility}): nothing can "
                       f"move, so the drive on {_names(drives)} cannot turn it. Delete a link or a joint, or "
-                      "remove the drive", els, True)]
+                      "remove the drive", els, True, "a structure: cannot turn")]
     if n > mobility >= 1:
         return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
-                      f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True)]
+                      f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True, "one drive too many")]
     if 0 < n < mobility and not any(j.vll for j in mech.joints):  # a locked VLL joint takes up a freedom
         return [_diag("warning", f"mobility W = {mobility} with {n} drive{'s' if n > 1 else ''}: the motion is "
                       f"not determined. Mark {mobility - n} more joint{'s' if mobility - n > 1 else ''} with "
-                      "Drive", els, True)]
+                      "Drive", els, True, "more drives needed")]
     return []
 
 

@@ -270,7 +270,9 @@ export function draw(svg, state) {
     if (at.kind === "link" && mem[at.id]) p = pos.joints[mem[at.id].joints[0]];
     if (!p) continue;
     const [px, py] = P(p);
-    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": at.id }, layers.labels, e.short || e.message.split(":")[0]);
+    const text = e.short || e.message.split(":")[0], right = px + 10 + 7.5 * text.length > v.W; // kept inside the canvas
+    el("text", { x: right ? px - 10 : px + 10, y: py + 26, class: "label err", "text-anchor": right ? "end" : "start", "data-error": at.id },
+      layers.labels, text);
   }
   return { joints, paths };
 }

@@ -458,6 +458,13 @@ svg.addEventListener("wheel", (ev) => {
 
 // ------------------------------------------------------------------ side panels
 
+// The structure report's formulas by the names of the literature; the spatial ones are marked
+// when read for a planar file.
+const FORMULA_NAMES = { chebyshev: "Chebyshev", grubler: "Grübler", malyshev: "Malyshev", somov_malyshev: "Somov–Malyshev",
+  gokhman_contours: "Gokhman (contours)", scheme_check: "scheme check", ozol_redundant: "Ozol (redundant constraints)",
+  redundant_from_mobility: "redundant constraints from the mobility" };
+const SPATIAL_FORMULAS = new Set(["malyshev", "somov_malyshev"]);
+
 function renderAnalysis() {
   const box = $("tab-analysis");
   const a = state.analysis, sim = state.sim;
@@ -468,12 +475,16 @@ function renderAnalysis() {
     const st = a.structure;
     out.push(h("h3", `Mobility: W = ${st.mobility}` + (st.mobility_source ? ` (${st.mobility_source})` : " (formulas)")));
     const t = h("table");
+    const planar = state.mech && state.mech.kind === "planar";
     for (const [name, f] of Object.entries(st.formulas)) {
       const tr = h("tr");
-      tr.append(h("td", name.replace(/_/g, " ")), h("td", f.expression, { className: "formula" }));
+      let title = FORMULA_NAMES[name] || name.replace(/_/g, " ");
+      if (planar && SPATIAL_FORMULAS.has(name)) title += " (spatial formula)"; // 6 freedoms per contour
+      tr.append(h("td", title), h("td", f.expression, { className: "formula" }));
       t.append(tr);
     }
     out.push(t);
+    for (const n of st.notes || []) out.push(h("p", n, { className: "muted" }));
   }
   if (a && a.rank_summary) { out.push(h("h3", "Rank method (exact)")); for (const l of a.rank_summary) out.push(h("p", l, { className: "formula" })); }
   else if (a && a.rank_unavailable) out.push(h("p", `rank method: ${a.rank_unavailable}`, { className: "muted" }));
