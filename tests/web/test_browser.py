@@ -81,6 +81,13 @@ def save_gif(pngs, name):
     seq[0].save(IMAGES / name, save_all=True, append_images=seq[1:], duration=120, loop=0, optimize=True)
 
 
+def new_canvas(page, srv):
+    """Open the studio on an empty canvas (New)."""
+    page.goto(srv.url)
+    wait_js(page, "() => window.__studio && window.__studio.mech")
+    page.click("#new")
+
+
 def open_studio(page, srv):
     page.goto(srv.url)
     wait_js(page, "() => window.__studio && window.__studio.simulations > 0", timeout=30)
@@ -206,9 +213,7 @@ def test_build_a_sixbar_from_nothing(serve, page):
 
 def test_synthesise_fourbar_through_five_points(serve, page):
     srv = serve(None)
-    page.goto(srv.url)
-    wait_js(page, "() => window.__studio && window.__studio.mech")
-    page.click("#new")
+    new_canvas(page, srv)
     page.click("text=Targets")
     # five points on a smooth arc
     targets = [(1.0, 3.0), (2.0, 3.6), (3.0, 3.8), (4.0, 3.5), (4.8, 2.8)]
@@ -296,6 +301,6 @@ def test_draw_a_target_curve(serve, page):
     page.mouse.up()
     n = page.evaluate("window.__studio.targets.length")
     assert 10 <= n <= 21 and page.locator("[data-target]").count() == n
-    assert page.locator("#synth-kind option").count() == 2
+    assert page.locator("#synth-kind option").count() == 3  # path, curve, motion
     page.click("#clear-targets")
     assert page.locator("[data-target]").count() == 0

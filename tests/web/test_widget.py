@@ -70,3 +70,46 @@ __widget.render({ model, el: document.body });
     b = widget.mechanism.joint("B").point[:2]
     assert b[0] < 1 and b[1] > 2 and not np.allclose(b, [1, 2])
     assert page.console_errors == []
+
+
+def test_widget_keeps_keys_and_styles_to_itself(widget, page):
+    """Issue 24, 13: in a notebook, a studio shortcut (X) must not reach JupyterLab (which cuts
+    the cell), and the widget's CSS must not restyle the notebook's own buttons."""
+    esm = widget_esm().replace("export default {", "const __widget = {")
+    harness = esm + """
+const model = { handlers: [], values: {}, on(ev, f) { this.handlers.push(f); },
+  send(msg) { window.kernelSend(msg).then((r) => this.handlers.forEach((h) => h(r))); },
+  set(k, v) { this.values[k] = v; }, save_changes() {} };
+window.outerKeys = [];
+document.addEventListener("keydown", (e) => window.outerKeys.push(e.key));
+const cell = document.getElementById("cell");
+__widget.render({ model, el: cell });
+"""
+    page.expose_function("kernelSend", widget.answer)
+    page.set_content('<!doctype html><html><body><button id="notebook-button">Run</button><div id="cell"></div></body></html>')
+    outside = page.evaluate("() => getComputedStyle(document.getElementById('notebook-button')).padding")
+    page.add_style_tag(content=widget.get_state()["_css"])
+    page.add_script_tag(content=harness, type="module")
+    page.wait_for_selector('[data-path="M"]', timeout=30000)
+    assert page.evaluate("() => getComputedStyle(document.getElementById('notebook-button')).padding") == outside
+    page.click(".mechsyn-studio #canvas")
+    page.keyboard.press("x")
+    assert page.evaluate("window.__studio.mode") == "delete"  # the studio heard it
+    assert page.evaluate("window.outerKeys") == []  # the notebook did not
+    assert page.get_attribute(".mechsyn-studio", "data-lm-suppress-shortcuts") == "true"
+
+
+def test_widget_shows_no_deprecation_warning():
+    """Every widget cell showed starlette's StarletteDeprecationWarning about its test client."""
+    import subprocess
+    import sys
+
+    code = ("import warnings; warnings.simplefilter('always')\n"
+            "with warnings.catch_warnings(record=True) as w:\n"
+            "    warnings.simplefilter('always')\n"
+            "    from mechsyn.web.widget import MechanismWidget\n"
+            "    import mechsyn as ms\n"
+            "    MechanismWidget(ms.load('fourbar'))\n"
+            "print([str(x.message) for x in w if 'starlette' in str(x.message).lower() or 'Starlette' in type(x.message).__name__])\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout

@@ -42,7 +42,7 @@ from starlette.staticfiles import StaticFiles
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
-from mechsyn.web import _files, _service
+from mechsyn.web import _files, _service, _studio
 from mechsyn.web._jobs import JobTable
 
 log = logging.getLogger("mechsyn.web")
@@ -382,6 +382,7 @@ def _routes() -> list:
         Route("/api/jobs/{job}", _job_state),
         Route("/api/jobs/{job}/cancel", _job_cancel, methods=["POST"]),
         Route("/api/jobs/{job}/events", _job_events),
+        *_studio.routes(),
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import re
 import secrets
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +29,8 @@ import anywidget
 import traitlets
 
 STATIC = Path(__file__).parent / "static"
-MODULES = ("api.js", "draw.js", "studio.js")
+MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
+           "atlas.js", "forces.js", "studio.js")
 
 
 def _body_markup() -> str:
@@ -65,6 +67,7 @@ export default {
     const root = document.createElement("div");
     root.className = "mechsyn-studio";
     root.tabIndex = 0;
+    root.dataset.lmSuppressShortcuts = "true"; // JupyterLab (Lumino) leaves keys pressed here alone
     root.innerHTML = MARKUP;
     el.appendChild(root);
     useTransport(kernelTransport(model));
@@ -76,11 +79,18 @@ export default {
 
 
 def widget_css() -> str:
-    """The studio's style sheet, scoped to the widget (the page's html/body rules left out)."""
+    """The studio's style sheet scoped to the widget: every selector prefixed with
+    ``.mechsyn-studio`` (the page's html/body rules left out), so nothing of it reaches the
+    notebook's own toolbar, buttons or inputs."""
     css = (STATIC / "studio.css").read_text(encoding="utf-8")
-    css = re.sub(r"^(html, body|body) \{[^}]*\}\n", "", css, flags=re.M)
-    return css + (".mechsyn-studio { display: grid; grid-template-rows: auto 1fr auto; height: 640px; "
-                  "font: 13px system-ui, sans-serif; color: #222; background: #fafafa; border: 1px solid #ccd; }\n")
+    css = re.sub(r"/\*.*?\*/", "", css, flags=re.S)
+    rules = []
+    for selectors, body in re.findall(r"([^{}]+)\{([^}]*)\}", css):
+        sels = [x.strip() for x in selectors.split(",") if x.strip() not in ("html", "body", "")]
+        if sels:
+            rules.append(", ".join(f".mechsyn-studio {x}" for x in sels) + " {" + body + "}")
+    return "\n".join(rules) + ("\n.mechsyn-studio { display: grid; grid-template-rows: auto 1fr auto; height: 640px; "
+                              "font: 13px system-ui, sans-serif; color: #222; background: #fafafa; border: 1px solid #ccd; }\n")
 
 
 class MechanismWidget(anywidget.AnyWidget):
@@ -99,7 +109,9 @@ class MechanismWidget(anywidget.AnyWidget):
     value = traitlets.Dict().tag(sync=True)
 
     def __init__(self, mechanism: Any = None, root: str | Path = ".", **kwargs: Any) -> None:
-        from starlette.testclient import TestClient
+        with warnings.catch_warnings():  # starlette's notice about its httpx client, shown in every cell
+            warnings.filterwarnings("ignore", message=".*starlette.testclient.*")
+            from starlette.testclient import TestClient
 
         from mechsyn.io import mechanism_to_dict
         from mechsyn.web import create_app

@@ -116,6 +116,24 @@ function sliderAxis(mech, sim, j, k) {
   return { ax, ay, moving };
 }
 
+// The elements an error or warning names: {element: {kind, id}} or {elements: [...]} → ["kind:id"].
+function elementKeys(e) {
+  return (e.elements || (e.element ? [e.element] : [])).map((x) => `${x.kind}:${x.id}`);
+}
+
+// A label writer that moves a label down until it overlaps none placed before (coincident
+// joints, e.g. a slider's R and P joints or Jansen's P1 and P1_2, get labels one under the other).
+function placeLabels() {
+  const placed = [];
+  return (layer, x, y, text) => {
+    const w = 7 * String(text).length + 4, hgt = 15;
+    let yy = y;
+    for (let guard = 0; guard < 12 && placed.some((b) => x < b.x + b.w && b.x < x + w && yy - hgt < b.y && b.y - hgt < yy); guard++) yy += hgt;
+    placed.push({ x, y: yy, w });
+    return el("text", { x, y: yy, class: "label" }, layer, text);
+  };
+}
+
 // Draw everything into svg; returns {joints, paths} element maps (the contract: data-joint, data-path).
 export function draw(svg, state) {
   const { mech, sim, frame: k, view, opts } = state;
@@ -129,7 +147,9 @@ export function draw(svg, state) {
   if (!mech) return { joints: {}, paths: {} };
   const pos = positions(mech, state.poseFromFile ? null : sim, k);
   const P = (p) => v.toScreen(p);
-  const invalid = new Set((state.errors || []).map((e) => e.element && `${e.element.kind}:${e.element.id}`));
+  const invalid = new Set((state.errors || []).concat(state.diagnostics || []).flatMap(elementKeys));
+  const sel = state.selected ? `${state.selected.kind}:${state.selected.id}` : null;
+  const labels = placeLabels();
   const groupOf = (opts.assurColours && state.analysis && state.analysis.groupOf) || {};
   const muAt = {};
   if (sim && sim.transmission_angle)
@@ -158,13 +178,15 @@ export function draw(svg, state) {
     const colour = groupOf[name] !== undefined ? GROUP_COLOURS[groupOf[name] % GROUP_COLOURS.length] : null;
     if (!colour) for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
     if (invalid.has(`link:${name}`)) cls += " invalid";
-    const g = el("g", { "data-link": name }, layers.links);
+    const g = el("g", { "data-link": name, "data-group": groupOf[name] }, layers.links);
+    // a group colour is set through the CSSOM: a presentation attribute loses to the class rules
+    const paint = (e, fill) => { if (colour && !cls.includes("invalid")) { e.style.stroke = colour; if (fill) e.style.fill = colour; } return e; };
     if (pts.length === 2) {
-      el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar" + cls, stroke: colour }, g);
+      paint(el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar" + cls }, g));
       el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-hit" }, g);
     } else {
       const poly = order(pts).map((p) => p.map((c) => c.toFixed(1)).join(",")).join(" ");
-      el("polygon", { points: poly, class: "link-plate" + cls, fill: colour, stroke: colour }, g);
+      paint(el("polygon", { points: poly, class: "link-plate" + cls }, g), true);
     }
   }
   // joints
@@ -178,25 +200,28 @@ export function draw(svg, state) {
     if (j.type === "P") {
       const { ax, ay } = sliderAxis(mech, sim, j, k);
       const ang = (Math.atan2(-ay, ax) * 180) / Math.PI;
-      joints[j.id] = el("rect", { x: -14, y: -8, width: 28, height: 16, rx: 2, class: "slider-block" + (j.actuated ? " drive" : ""),
+      joints[j.id] = el("rect", { x: -14, y: -8, width: 28, height: 16, rx: 2,
+        class: "slider-block" + (j.actuated ? " drive" : "") + (invalid.has(`joint:${j.id}`) ? " invalid" : ""),
         transform: `translate(${px.toFixed(1)} ${py.toFixed(1)}) rotate(${ang.toFixed(1)})`, "data-joint": j.id,
         "data-x": p[0], "data-y": p[1] }, layers.sliders);
-      if (!onGround) {
-        const L = 40;
-        el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
-      }
+      const L = onGround ? 60 : 40;
+      if (!onGround) el("line", { x1: px - ax * L, y1: py + ay * L, x2: px + ax * L, y2: py - ay * L, class: "guide" }, layers.ground);
+      // the handle that turns the guide (dragged in Select)
+      el("circle", { cx: (px + ax * L).toFixed(1), cy: (py - ay * L).toFixed(1), r: 5, class: "guide-handle", "data-handle": j.id }, layers.marks);
     } else {
       joints[j.id] = fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 6.5, class: cls, "data-joint": j.id,
         "data-x": p[0], "data-y": p[1] }, layers.joints), fileColour(mech, j.id));
     }
-    el("text", { x: px + 9, y: py - 9, class: "label" }, layers.labels, j.id);
+    if (sel === `joint:${j.id}`) joints[j.id].setAttribute("data-selected", "true");
+    labels(layers.labels, px + 9, py - 9, j.id);
   }
   for (const [n, p] of Object.entries(pos.points)) {
     if (!p) continue;
     const [px, py] = P(p);
-    fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n },
+    const c = fillWith(el("circle", { cx: px.toFixed(1), cy: py.toFixed(1), r: 5, class: "point", "data-point": n },
       layers.points), fileColour(mech, n));
-    el("text", { x: px + 8, y: py + 14, class: "label" }, layers.labels, n);
+    if (sel === `point:${n}`) c.setAttribute("data-selected", "true");
+    labels(layers.labels, px + 8, py + 14, n);
   }
   // dead points: × on every path where a working range ends
   if (sim) for (const ev of sim.events) {
@@ -209,11 +234,24 @@ export function draw(svg, state) {
         class: "deadpoint", "data-deadpoint": ev.index }, layers.marks);
     }
   }
+  // joint reactions at this frame (Forces tab): arrows from the joint, the largest a quarter of the length scale
+  for (const a of state.arrows || []) {
+    const [x1, y1] = P(a.at), [x2, y2] = P([a.at[0] + a.vec[0], a.at[1] + a.vec[1]]);
+    const L = Math.hypot(x2 - x1, y2 - y1);
+    if (L < 2) continue;
+    const ux = (x2 - x1) / L, uy = (y2 - y1) / L;
+    el("path", { d: `M${x1.toFixed(1)} ${y1.toFixed(1)}L${x2.toFixed(1)} ${y2.toFixed(1)}M${(x2 - 9 * ux - 4 * uy).toFixed(1)} ${(y2 - 9 * uy + 4 * ux).toFixed(1)}L${x2.toFixed(1)} ${y2.toFixed(1)}L${(x2 - 9 * ux + 4 * uy).toFixed(1)} ${(y2 - 9 * uy - 4 * ux).toFixed(1)}`,
+      class: "force-arrow", "data-force": a.id }, layers.marks);
+  }
   // synthesis targets and a previewed path
   (state.targets || []).forEach((t, i) => {
     const [px, py] = P(t);
     el("circle", { cx: px, cy: py, r: 7, class: "target", "data-target": i }, layers.marks);
-    el("text", { x: px + 9, y: py + 4, class: "label" }, layers.labels, `T${i + 1}`);
+    if (state.showPoses) { // a pose of the guided body: its angle as a tick
+      const a = (((state.targetAngles || [])[i] || 0) * Math.PI) / 180;
+      el("line", { x1: px, y1: py, x2: px + 26 * Math.cos(a), y2: py - 26 * Math.sin(a), class: "pose-tick", "data-pose": i }, layers.marks);
+    }
+    labels(layers.labels, px + 9, py + 4, `T${i + 1}`);
   });
   if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);
   // the link being built
@@ -223,30 +261,46 @@ export function draw(svg, state) {
     for (const p of pts) el("circle", { cx: p[0], cy: p[1], r: 9, class: "pending" }, layers.marks);
   }
   // errors next to their element
-  for (const e of state.errors || []) {
-    if (!e.element) continue;
+  for (const e of (state.errors || []).concat(state.diagnostics || [])) {
+    const at = e.element || (e.elements || [])[0];
+    if (!at) continue;
     let p = null;
-    if (e.element.kind === "joint") p = pos.joints[e.element.id];
-    if (e.element.kind === "point") p = pos.points[e.element.id];
-    if (e.element.kind === "link" && mem[e.element.id]) p = pos.joints[mem[e.element.id].joints[0]];
+    if (at.kind === "joint") p = pos.joints[at.id];
+    if (at.kind === "point") p = pos.points[at.id];
+    if (at.kind === "link" && mem[at.id]) p = pos.joints[mem[at.id].joints[0]];
     if (!p) continue;
     const [px, py] = P(p);
-    el("text", { x: px + 10, y: py + 26, class: "label err", "data-error": e.element.id }, layers.labels, e.message);
+    const text = e.short || e.message.split(":")[0], right = px + 10 + 7.5 * text.length > v.W; // kept inside the canvas
+    el("text", { x: right ? px - 10 : px + 10, y: py + 26, class: "label err", "text-anchor": right ? "end" : "start", "data-error": at.id },
+      layers.labels, text);
   }
   return { joints, paths };
 }
 
-// A small line plot (input on x) with a cursor at index k; returns the svg.
-export function plot(svg, xs, series, k, ranges = []) {
+// The y-range of a plot: the full range, unless spikes (near dead points, where velocities and
+// accelerations grow without bound) would flatten the rest: then the 2nd to 98th percentile
+// widened by 15 %, and `clipped` says so.
+export function robustRange(vals) {
+  const v = vals.slice().sort((a, b) => a - b), n = v.length, q = (f) => v[Math.min(n - 1, Math.max(0, Math.round(f * (n - 1))))];
+  let lo = v[0], hi = v[n - 1];
+  const core = q(0.98) - q(0.02);
+  const clipped = n >= 20 && core > 0 && hi - lo > 4 * core;
+  if (clipped) { lo = Math.max(lo, q(0.02) - 0.15 * core); hi = Math.min(hi, q(0.98) + 0.15 * core); }
+  if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { lo -= 1; hi += 1; }
+  return { lo, hi, clipped, min: v[0], max: v[n - 1] };
+}
+
+// A small line plot (input on x) with a cursor at index k; returns the svg. `labels`: {x, y} units.
+export function plot(svg, xs, series, k, ranges = [], labels = {}) {
   svg.replaceChildren();
-  const W = 300, H = 150, m = 28;
+  const W = 300, H = 150, m = 34;
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const vals = series.flatMap((s) => s.values).filter((y) => y !== null && Number.isFinite(y));
   if (!vals.length) { el("text", { x: 10, y: 20, class: "label" }, svg, "not defined over the sweep"); return svg; }
-  let lo = Math.min(...vals), hi = Math.max(...vals);
-  if (hi - lo < 1e-12) { lo -= 1; hi += 1; }
+  const R = robustRange(vals), { lo, hi } = R;
   const x0 = xs[0], x1 = xs[xs.length - 1] || x0 + 1;
-  const X = (x) => m + ((x - x0) / (x1 - x0 || 1)) * (W - m - 6), Y = (y) => H - 16 - ((y - lo) / (hi - lo)) * (H - 26);
+  const X = (x) => m + ((x - x0) / (x1 - x0 || 1)) * (W - m - 6);
+  const Y = (y) => H - 16 - ((Math.min(hi, Math.max(lo, y)) - lo) / (hi - lo)) * (H - 26);
   for (const [a, b] of ranges) el("rect", { x: X(a), y: 4, width: Math.max(1, X(b) - X(a)), height: H - 20, class: "range" }, svg);
   el("line", { x1: m, y1: H - 16, x2: W - 6, y2: H - 16, class: "axis" }, svg);
   el("line", { x1: m, y1: 4, x2: m, y2: H - 16, class: "axis" }, svg);
@@ -254,12 +308,17 @@ export function plot(svg, xs, series, k, ranges = []) {
   el("text", { x: 2, y: H - 18, class: "label" }, svg, lo.toPrecision(3));
   el("text", { x: m, y: H - 3, class: "label" }, svg, x0.toFixed(0));
   el("text", { x: W - 40, y: H - 3, class: "label" }, svg, x1.toFixed(0));
+  if (labels.x) el("text", { x: W / 2 - 20, y: H - 3, class: "label unit" }, svg, labels.x);
+  if (labels.y) el("text", { x: m + 4, y: 12, class: "label unit" }, svg, labels.y);
+  if (R.clipped) el("text", { x: m + 4, y: 24, class: "label clipped", "data-clipped": `${R.min} ${R.max}` }, svg,
+    `clipped (▲▼): full range ${R.min.toPrecision(3)} … ${R.max.toPrecision(3)}`);
   series.forEach((s, i) => {
     let d = "", pen = false;
     xs.forEach((x, n) => {
       const y = s.values[n];
       if (y === null || !Number.isFinite(y)) { pen = false; return; }
       d += `${pen ? "L" : "M"}${X(x).toFixed(1)} ${Y(y).toFixed(1)}`; pen = true;
+      if (y > hi || y < lo) el("path", { d: y > hi ? `M${X(x) - 3} ${Y(y) + 4}l3 -5l3 5z` : `M${X(x) - 3} ${Y(y) - 4}l3 5l3 -5z`, class: "clip-mark" }, svg);
     });
     el("path", { d, class: i ? "plotline y" : "plotline", "data-series": s.name }, svg);
     el("text", { x: W - 60, y: 14 + 12 * i, class: "label" }, svg, s.name);

@@ -1,6 +1,14 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
 import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
+import { geometryChecks, tidy, topologyKey } from "./checks.js";
+import { bindKeys } from "./keys.js";
+import { mountPlayer } from "./player.js";
+import { mountSynthesis } from "./synthesis.js";
+import { mountAtlas } from "./atlas.js";
+import { mountForces } from "./forces.js";
+import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
+import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -14,18 +22,20 @@ const state = {
   mech: null, sim: null, frame: 0, view: { s: 60, ox: 0, oy: 0 }, errors: [], notes: [], analysis: null,
   opts: { grid: true, snap: false, assurColours: false }, mode: "select", selected: null, building: [],
   targets: [], preview: null, undo: [], redo: [], playing: false, dir: 1, fileName: "", dragging: false,
-  renders: 0, simulations: 0, latencies: [],
+  renders: 0, simulations: 0, latencies: [], editLatencies: [], diagnostics: [], check: null, home: 0, dirty: false, offer: null,
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
 
 // ------------------------------------------------------------------ rendering
 function render() {
   try {
-    draw(svg, { ...state, poseFromFile: state.dragging });
+    const arrows = forcesUi.arrows(state.frame, () => positions(state.mech, state.dragging ? null : state.sim, state.frame).joints);
+    draw(svg, { ...state, poseFromFile: state.dragging, arrows });
     state.renders += 1;
     renderBanner();
     renderPlayer();
     renderPlots();
+    forcesUi.cursor(state.frame);
   } catch (e) {
     console.error(e);
     $("banner").replaceChildren(div("err", `drawing failed: ${e.message || e}`));
@@ -34,11 +44,27 @@ function render() {
 
 function div(cls, text) { const d = document.createElement("div"); d.className = cls; d.textContent = text; return d; }
 
+// The banner: the current errors first (each outlines the element it names), then warnings, notes.
 function renderBanner() {
   const items = state.errors.map((e) => div("err", e.message + (e.hint ? ` — fix: ${e.hint}` : "")));
+  if (state.offer) {
+    const o = div("note", `unsaved work from ${state.offer.saved.replace("T", " ").slice(0, 16)} UTC (${state.offer.mechanism.name}) `);
+    const yes = h("button", "Restore"), no = h("button", "Dismiss");
+    yes.dataset.restore = ""; no.dataset.dismiss = "";
+    yes.onclick = () => { const w = state.offer; state.offer = null; state.fileName = w.name || ""; setMech(w.mechanism, { fit: true }); };
+    no.onclick = () => { state.offer = null; forgetWork(); render(); };
+    o.append(yes, no);
+    items.unshift(o);
+  }
+  for (const d of state.diagnostics) items.push(div(d.level === "error" ? "err" : d.level === "warning" ? "warn" : "note", d.message));
+  const sim = state.sim;
+  if (sim && !sim.assembled[state.home] && state.simFor === state.mech)
+    items.push(div("err", "not assembled at the drawn pose: the links cannot meet where they are drawn. Drag a joint until they do, or type its x and y in the Element tab"));
+  else if (sim && !sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
   for (const n of state.notes) items.push(div("note", n));
-  if (state.sim && !state.sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
-  $("banner").replaceChildren(...items);
+  const b = $("banner");
+  b.replaceChildren(...items);
+  b.dataset.level = items.length ? items[0].className : "";
 }
 
 function renderPlayer() {
@@ -66,18 +92,32 @@ function statusLine() {
 }
 
 // ------------------------------------------------------------------ simulation and analysis
+// The sweep of an R drive starts at the drawn pose (index 0, a full turn of 180 steps); a P drive
+// is swept by ± half the length scale around it, in 181 steps so the middle one (90) is the drawn pose.
+const firstDrive = (m) => m.joints.find((j) => j.actuated);
+const stepsFor = (m) => (firstDrive(m) && firstDrive(m).type === "P" ? 181 : 180);
+const homeOf = (sim) => (sim.input.type === "P" ? (sim.assembled.length - 1) / 2 : 0);
+// The assembled frame nearest to k (the slider and the plots never show an unassembled input).
+function assembledNear(k) {
+  const ok = state.sim ? state.sim.assembled : [];
+  for (let d = 0; d < ok.length; d++) { if (ok[k - d]) return k - d; if (ok[k + d]) return k + d; }
+  return k;
+}
 const simulateSoon = coalescing(
   // while dragging: without velocities and accelerations (a smaller answer); on release: all
-  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: 180, rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
-  ({ r, ms }, { mech, t0 }) => {
+  (req) => { const t0 = performance.now(); return call("/api/simulate", { mechanism: req.mech, steps: stepsFor(req.mech), rates: !req.drag }).then((r) => ({ r, ms: performance.now() - t0 })); },
+  ({ r, ms }, { mech, t0, edited }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
-    if ((mech !== state.mech || !r.rates) && !state.dragging) return; // a newer mechanism is on its way
+    if (mech !== state.mech && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
-    if (state.frame >= r.assembled.length) state.frame = 0;
+    const home = homeOf(r);
+    if (state.frame === state.home || state.frame >= r.assembled.length) state.frame = home;
+    state.home = home;
     render();
     // drag-to-repaint latency: from the pointer event to the frame that shows its simulation
     if (t0 !== undefined) requestAnimationFrame(() => state.latencies.push(performance.now() - t0));
+    if (edited !== undefined) requestAnimationFrame(() => state.editLatencies.push(performance.now() - edited));
     if (!state.dragging) renderAnalysis();
   },
   (e, { mech }) => {
@@ -106,28 +146,61 @@ function analyseSoon() {
   }, 250);
 }
 
-function setMech(mech, { record = true, fit = false, keepFrame = false } = {}) {
+function setMech(mech, { record = true, fit = false, keepFrame = false, opened = false, edited } = {}) {
   if (record && state.mech) { state.undo.push(JSON.stringify(state.mech)); state.redo = []; }
+  if (opened) state.dirty = false;
+  else if (state.mech && mech.joints.length) { state.dirty = true; if (root === document) autosave(mech, state.fileName); }
   state.mech = mech;
   if (onChange) onChange(mech);
-  if (!keepFrame) state.frame = 0;
+  if (!keepFrame) state.frame = state.home;
   if (fit) fitView();
   state.errors = [];
-  if (mech.joints.some((j) => j.actuated)) simulateSoon({ mech });
-  else { state.sim = null; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
+  const key = topologyKey(mech);
+  if (state.check && state.check.key === key) afterCheck(mech, state.check.result, edited);
+  else {
+    // the topology changed: the server's check (mobility, drives, connections) first, at once
+    state.diagnostics = geometryChecks(mech); state.check = null;
+    call("/api/studio/check", { mechanism: mech }).then((result) => {
+      if (mech !== state.mech) return;
+      state.check = { key, result }; afterCheck(mech, result); render();
+    }, (e) => {
+      if (mech !== state.mech) return;
+      state.sim = null; state.simFor = mech; state.notes = [];
+      state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
+      render(); renderAnalysis();
+    });
+  }
   analyseSoon();
   render();
   renderElement();
+  if ($("tab-forces").classList.contains("on")) { forcesUi.renderForces(); forcesUi.forcesSoon(); }
 }
+
+// Simulate unless the checks say it is pointless (a structure, drives that fight, loose parts).
+// An edit's first answer leaves out the rates (the repaint comes sooner, as in a drag); the full
+// simulation follows it.
+function afterCheck(mech, result, edited) {
+  state.diagnostics = result.diagnostics.concat(geometryChecks(mech));
+  state.notes = [];
+  if (result.diagnostics.some((d) => d.blocks)) { state.sim = null; state.simFor = mech; renderAnalysis(); }
+  else if (mech.joints.some((j) => j.actuated)) {
+    if (edited !== undefined) simulateSoon({ mech, drag: true, edited });
+    simulateSoon({ mech });
+  }
+  else { state.sim = null; state.simFor = mech; state.notes = mech.joints.length ? ["no drive yet: mark a joint with Drive to move it"] : ["empty: add ground pivots, then links"]; }
+}
+
+// One numeric edit: fn changes a copy of the mechanism (at the drawn pose); re-simulated, one undo step.
+function edit(fn) { const t0 = performance.now(); const m = rebase(); fn(m); setMech(m, { edited: t0 }); }
 
 // The drawn pose becomes the file's pose (the branch drawn is the one kept).
 function rebase() {
   const { sim, frame: k } = state;
-  if (!sim || k === 0 || !sim.assembled[k]) return clone(state.mech);
+  if (!sim || k === state.home || !sim.assembled[k]) return clone(state.mech);
   const m = clone(state.mech);
   for (const j of m.joints) if (sim.joints[j.id] && sim.joints[j.id][k]) j.point = sim.joints[j.id][k].slice();
   for (const [n, p] of Object.entries(m.points || {})) if (sim.points[n] && sim.points[n][k]) p.at = sim.points[n][k].slice();
-  state.frame = 0;
+  state.frame = state.home;
   return m;
 }
 
@@ -148,7 +221,7 @@ function worldAt(ev) {
   const r = svg.getBoundingClientRect();
   let p = makeView(svg, state.view).toWorld([ev.clientX - r.left, ev.clientY - r.top]);
   if (state.opts.snap) { const g = gridStep(state.view); p = p.map((c) => Math.round(c / g) * g); }
-  return p.map((c) => +c.toPrecision(10));
+  return p.map((c) => tidy(c, state.view.s));
 }
 
 // ------------------------------------------------------------------ naming
@@ -251,15 +324,46 @@ function undo() { if (!state.undo.length) return; state.redo.push(JSON.stringify
 function redo() { if (!state.redo.length) return; state.undo.push(JSON.stringify(state.mech)); setMech(JSON.parse(state.redo.pop()), { record: false }); }
 
 // ------------------------------------------------------------------ pointer interaction
+// The joints drawn within 8 px of the pointer, topmost first (a slider's R joint over its P joint).
+function jointsAt(ev) {
+  const r = svg.getBoundingClientRect(), v = makeView(svg, state.view), pos = positions(state.mech, state.sim, state.frame);
+  const near = state.mech.joints.filter((j) => {
+    const q = v.toScreen(pos.joints[j.id]);
+    return Math.hypot(q[0] - (ev.clientX - r.left), q[1] - (ev.clientY - r.top)) <= 8;
+  });
+  return near.sort((a, b) => (a.type === "P") - (b.type === "P")).map((j) => j.id);
+}
+// The joint a click means: where several coincide, the next after the selected one (clicks cycle);
+// in Drive and Delete, the selected one of them.
+function pickJoint(ev, hitId, cycle) {
+  const ids = jointsAt(ev);
+  if (hitId && !ids.includes(hitId)) ids.unshift(hitId);
+  if (ids.length < 2) return hitId || ids[0] || null;
+  const cur = state.selected && state.selected.kind === "joint" ? ids.indexOf(state.selected.id) : -1;
+  if (cur < 0) return hitId || ids[0];
+  return cycle ? ids[(cur + 1) % ids.length] : ids[cur];
+}
+
 let gesture = null;
 svg.addEventListener("pointerdown", (ev) => {
   if (!state.mech) return;
   const t = ev.target;
   const jointEl = t.closest("[data-joint]"), pointEl = t.closest("[data-point]"), linkEl = t.closest("[data-link]");
+  const handleEl = t.closest("[data-handle]");
   const p = worldAt(ev);
   const mode = state.mode;
-  if (mode === "select" && (jointEl || pointEl)) {
-    const kind = jointEl ? "joint" : "point", id = jointEl ? jointEl.dataset.joint : pointEl.dataset.point;
+  const jointId = jointEl || (!pointEl && !handleEl) ? pickJoint(ev, jointEl && jointEl.dataset.joint, mode === "select") : null;
+  if (mode === "select" && handleEl) { // turning a slider's guide
+    state.selected = { kind: "joint", id: handleEl.dataset.handle };
+    state.undo.push(JSON.stringify(state.mech)); state.redo = [];
+    state.mech = rebase(); state.dragging = true;
+    gesture = { kind: "drag", what: "axis", id: handleEl.dataset.handle, moved: false };
+    svg.setPointerCapture(ev.pointerId);
+    renderElement();
+    return;
+  }
+  if (mode === "select" && (jointId || pointEl)) {
+    const kind = jointId ? "joint" : "point", id = jointId || pointEl.dataset.point;
     state.selected = { kind, id };
     const before = JSON.stringify(state.mech);
     const m = rebase();
@@ -284,14 +388,14 @@ svg.addEventListener("pointerdown", (ev) => {
     $("finish-link").disabled = state.building.length < 2;
     render();
   } else if (mode === "point") addPoint(p);
-  else if (mode === "drive" && jointEl) toggleDrive(jointEl.dataset.joint);
+  else if (mode === "drive" && jointId) toggleDrive(jointId);
   else if (mode === "delete") {
-    if (jointEl) deleteJoint(jointEl.dataset.joint);
+    if (jointId) deleteJoint(jointId);
     else if (pointEl) deletePoint(pointEl.dataset.point);
     else if (linkEl) deleteLink(linkEl.dataset.link);
   } else if (mode === "target") {
     state.targets.push(p);
-    $("target-count").textContent = state.targets.length;
+    $("target-count").textContent = state.targets.length; synthUi.renderPoses();
     gesture = { kind: "draw", last: [ev.clientX, ev.clientY] };
     svg.setPointerCapture(ev.pointerId);
     render();
@@ -304,7 +408,7 @@ svg.addEventListener("pointermove", (ev) => {
     if (Math.hypot(ev.clientX - gesture.last[0], ev.clientY - gesture.last[1]) < 12) return;
     gesture.last = [ev.clientX, ev.clientY];
     state.targets.push(worldAt(ev));
-    $("target-count").textContent = state.targets.length;
+    $("target-count").textContent = state.targets.length; synthUi.renderPoses();
     render();
     return;
   }
@@ -316,10 +420,15 @@ svg.addEventListener("pointermove", (ev) => {
   }
   const p = worldAt(ev);
   const m = clone(state.mech);
-  if (gesture.what === "joint") for (const j of m.joints) { if (gesture.together.includes(j.id)) j.point = p.slice(); }
+  if (gesture.what === "axis") {
+    const j = m.joints.find((q) => q.id === gesture.id);
+    const deg = (Math.atan2(p[1] - j.point[1], p[0] - j.point[0]) * 180) / Math.PI;
+    j.axis = axisOf(Math.round(deg * 10) / 10);
+  } else if (gesture.what === "joint") for (const j of m.joints) { if (gesture.together.includes(j.id)) j.point = p.slice(); }
   else m.points[gesture.id].at = p;
   gesture.moved = true;
   state.mech = m;
+  if (state.check) state.diagnostics = state.check.result.diagnostics.concat(geometryChecks(m));
   render();
   simulateSoon({ mech: m, drag: true, t0: ev.timeStamp });
 });
@@ -348,7 +457,13 @@ svg.addEventListener("wheel", (ev) => {
 }, { passive: false });
 
 // ------------------------------------------------------------------ side panels
-function h(tag, text, attrs = {}) { const e = document.createElement(tag); if (text !== undefined && text !== null) e.textContent = text; Object.assign(e, attrs); return e; }
+
+// The structure report's formulas by the names of the literature; the spatial ones are marked
+// when read for a planar file.
+const FORMULA_NAMES = { chebyshev: "Chebyshev", grubler: "Grübler", malyshev: "Malyshev", somov_malyshev: "Somov–Malyshev",
+  gokhman_contours: "Gokhman (contours)", scheme_check: "scheme check", ozol_redundant: "Ozol (redundant constraints)",
+  redundant_from_mobility: "redundant constraints from the mobility" };
+const SPATIAL_FORMULAS = new Set(["malyshev", "somov_malyshev"]);
 
 function renderAnalysis() {
   const box = $("tab-analysis");
@@ -360,12 +475,16 @@ function renderAnalysis() {
     const st = a.structure;
     out.push(h("h3", `Mobility: W = ${st.mobility}` + (st.mobility_source ? ` (${st.mobility_source})` : " (formulas)")));
     const t = h("table");
+    const planar = state.mech && state.mech.kind === "planar";
     for (const [name, f] of Object.entries(st.formulas)) {
       const tr = h("tr");
-      tr.append(h("td", name.replace(/_/g, " ")), h("td", f.expression, { className: "formula" }));
+      let title = FORMULA_NAMES[name] || name.replace(/_/g, " ");
+      if (planar && SPATIAL_FORMULAS.has(name)) title += " (spatial formula)"; // 6 freedoms per contour
+      tr.append(h("td", title), h("td", f.expression, { className: "formula" }));
       t.append(tr);
     }
     out.push(t);
+    for (const n of st.notes || []) out.push(h("p", n, { className: "muted" }));
   }
   if (a && a.rank_summary) { out.push(h("h3", "Rank method (exact)")); for (const l of a.rank_summary) out.push(h("p", l, { className: "formula" })); }
   else if (a && a.rank_unavailable) out.push(h("p", `rank method: ${a.rank_unavailable}`, { className: "muted" }));
@@ -381,12 +500,13 @@ function renderAnalysis() {
     });
     out.push(ul);
   } else if (a && a.assur_unavailable) out.push(h("p", `Assur groups: ${a.assur_unavailable}`, { className: "muted" }));
-  const gr = (sim && sim.grashof) || (a && a.grashof);
+  const gr = state.mech && state.mech.kind === "planar" ? (sim && sim.grashof) || (a && a.grashof) : null;
   if (gr) { out.push(h("h3", `Grashof: ${gr.classification}`)); out.push(h("p", gr.expression, { className: "formula" })); }
   if (sim) {
     out.push(h("h3", "Motion"));
     const u = sim.input.unit === "deg" ? "°" : "";
-    out.push(h("p", `working range of ${sim.input.joint}: ` + (sim.working_ranges.map(([x, y]) => `${x.toFixed(1)}${u} … ${y.toFixed(1)}${u}`).join(", ") || "none")));
+    const full = sim.input.type === "R" && sim.assembled.every(Boolean);
+    out.push(h("p", `working range of ${sim.input.joint}: ` + (full ? "full turn (360°)" : sim.working_ranges.map(([x, y]) => `${x.toFixed(1)}${u} … ${y.toFixed(1)}${u}`).join(", ") || "none")));
     for (const [key, t] of Object.entries(sim.transmission_angle || {}))
       if (t.min !== null) out.push(h("p", `transmission angle ${key}: ${t.min.toFixed(1)}° … ${t.max.toFixed(1)}°`));
     const dead = sim.events.filter((e) => e.kind === "dead point");
@@ -397,35 +517,44 @@ function renderAnalysis() {
 }
 
 function renderElement() {
+  renderJoints();
   const box = $("tab-element"), sel = state.selected, m = state.mech;
-  if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it.", { className: "muted" })); return; }
+  if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it (clicking again where joints coincide selects the next).", { className: "muted" })); return; }
   const out = [];
   if (sel.kind === "joint") {
     const j = m.joints.find((x) => x.id === sel.id);
     if (!j) { state.selected = null; return renderElement(); }
-    out.push(h("h3", `Joint ${j.id}`));
+    out.push(h("h3", `Joint ${j.id} (${j.type === "P" ? "slider, P" : "pin, R"})`));
     const type = h("select"); for (const t of ["R", "P"]) type.append(h("option", t, { value: t, selected: j.type === t }));
     type.id = "joint-type";
-    type.onchange = () => { const n = rebase(); const x = n.joints.find((q) => q.id === j.id); x.type = type.value; if (x.type === "P" && !x.axis) x.axis = [1, 0]; if (x.type === "R") delete x.axis; setMech(n); };
+    type.onchange = () => edit((n) => setType(n.joints.find((q) => q.id === j.id), type.value));
     const drive = h("input", null, { type: "checkbox", checked: !!j.actuated, id: "joint-drive" });
     drive.onchange = () => toggleDrive(j.id);
     const links = h("input", null, { value: j.links.join(", "), id: "joint-links", size: 20 });
-    links.onchange = () => { const n = rebase(); n.joints.find((q) => q.id === j.id).links = links.value.split(",").map((s) => s.trim()).filter(Boolean); for (const l of n.joints.find((q) => q.id === j.id).links) if (!n.links.map(linkName).includes(l)) n.links.push(l); setMech(n); };
-    out.push(h("p", "pair type "), type, h("p", "links "), links, h("p", ""), drive, " drive");
-    out.push(h("p", `at (${j.point.map((c) => (+c).toFixed(4)).join(", ")})`));
+    links.onchange = () => edit((n) => setLinks(n, j.id, links.value));
+    const row = (label, ...els) => { const p = h("p"); p.append(h("label", label + " "), ...els); return p; };
+    out.push(...jointFields(j, edit), row("pair type", type), row("links", links), row("drive", drive));
     const del = h("button", "Delete joint"); del.onclick = () => deleteJoint(j.id); out.push(del);
   } else {
     const p = (m.points || {})[sel.id];
     if (!p) { state.selected = null; return renderElement(); }
-    out.push(h("h3", `Point ${sel.id} on ${p.link}`), h("p", `at (${p.at.map((c) => (+c).toFixed(4)).join(", ")})`));
+    out.push(h("h3", `Point ${sel.id} on ${p.link}`), ...pointFields(sel.id, p, edit));
     const del = h("button", "Delete point"); del.onclick = () => deletePoint(sel.id); out.push(del);
   }
   box.replaceChildren(...out);
 }
 
+function renderJoints() {
+  const m = state.mech;
+  if (!m) return;
+  const sel = state.selected && state.selected.kind === "joint" ? state.selected.id : null;
+  $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }));
+}
+
 function renderPlots() {
   const sim = state.sim, sel = $("plot-what");
   if (!sim) { $("plots").replaceChildren(h("p", "no simulation", { className: "muted" })); return; }
+  if (!sim.rates) return; // an edit's first answer: the plots wait for the rates
   const opts = Object.keys(sim.velocity).map((n) => `point:${n}`).concat(Object.keys(sim.links).map((n) => `link:${n}`));
   if ([...sel.options].map((o) => o.value).join() !== opts.join()) {
     const keep = sel.value;
@@ -435,240 +564,45 @@ function renderPlots() {
   if (!$("tab-plots").classList.contains("on")) return;
   const [kind, name] = (sel.value || "").split(":");
   const xs = sim.input.values, k = state.frame, R = sim.working_ranges;
+  // the library's rates are at a drive speed of 1 rad/s (R) or 1 length unit/s (P), held constant:
+  // velocities scale with the speed, accelerations with its square
+  const w = Number($("drive-speed").value) || 1, rot = sim.input.type === "R";
+  const at = `at ${sim.input.joint} = ${w} ${rot ? "rad/s" : "units/s"}`;
+  const scale = (vals, f) => vals.map((v) => (v === null ? null : v * f));
   let pairs;
   if (kind === "point") {
-    const comp = (arr, i) => arr.map((v) => (v ? v[i] : null));
-    pairs = [[`velocity of ${name}`, [{ name: "vx", values: comp(sim.velocity[name], 0) }, { name: "vy", values: comp(sim.velocity[name], 1) }]],
-      [`acceleration of ${name}`, [{ name: "ax", values: comp(sim.acceleration[name], 0) }, { name: "ay", values: comp(sim.acceleration[name], 1) }]]];
+    const comp = (arr, i, f) => arr.map((v) => (v ? v[i] * f : null));
+    pairs = [[`velocity of ${name}`, "units/s", [{ name: "vx", values: comp(sim.velocity[name], 0, w) }, { name: "vy", values: comp(sim.velocity[name], 1, w) }]],
+      [`acceleration of ${name}`, "units/s²", [{ name: "ax", values: comp(sim.acceleration[name], 0, w * w) }, { name: "ay", values: comp(sim.acceleration[name], 1, w * w) }]]];
   } else if (kind === "link") {
-    pairs = [[`angular velocity of ${name} (rad/s)`, [{ name: "ω", values: sim.links[name].angular_velocity }]],
-      [`angular acceleration of ${name} (rad/s²)`, [{ name: "α", values: sim.links[name].angular_acceleration }]]];
+    pairs = [[`angular velocity of ${name}`, "rad/s", [{ name: "ω", values: scale(sim.links[name].angular_velocity, w) }]],
+      [`angular acceleration of ${name}`, "rad/s²", [{ name: "α", values: scale(sim.links[name].angular_acceleration, w * w) }]]];
   } else return;
   const out = [];
-  for (const [title, series] of pairs) {
-    out.push(h("p", `${title} against ${sim.input.joint} (${sim.input.unit})`));
+  const xunit = sim.input.unit === "deg" ? "°" : "units";
+  for (const [title, unit, series] of pairs) {
+    out.push(h("p", `${title} (${unit}, ${at}) against ${sim.input.joint} (${xunit})`));
     const s = el("svg", { "data-plot": title });
-    plot(s, xs, series, k, R);
+    plot(s, xs, series, k, R, { x: `${sim.input.joint} (${xunit})`, y: unit });
     s.addEventListener("click", (ev) => {
       const r = s.getBoundingClientRect(), mp = s.__map, x = ((ev.clientX - r.left) / r.width) * mp.W;
       const u = mp.x0 + ((x - mp.m) / (mp.W - mp.m - 6)) * (mp.x1 - mp.x0);
       let best = 0; xs.forEach((v, i) => { if (Math.abs(v - u) < Math.abs(xs[best] - u)) best = i; });
-      state.frame = best; render();
+      state.frame = assembledNear(best); render();
     });
     out.push(s);
   }
   $("plots").replaceChildren(...out);
 }
 
-// ------------------------------------------------------------------ player
-let timer = null, lastTick = 0;
-function tick(t) {
-  if (!state.playing) return;
-  const fps = +$("speed").value;
-  if (t - lastTick >= 1000 / fps && state.sim) {
-    lastTick = t;
-    const n = state.sim.assembled.length, ok = state.sim.assembled;
-    let next = state.frame + state.dir;
-    const full = ok.every(Boolean);
-    if (full) next = (next + n) % n;
-    else if (next < 0 || next >= n || !ok[next]) { state.dir = -state.dir; next = state.frame + state.dir; if (next < 0 || next >= n || !ok[next]) next = state.frame; }
-    state.frame = next;
-    render();
-  }
-  timer = requestAnimationFrame(tick);
-}
-function setPlaying(on) {
-  state.playing = on && !!state.sim;
-  $("play").textContent = state.playing ? "❚❚" : "▶";
-  cancelAnimationFrame(timer);
-  if (state.playing) timer = requestAnimationFrame(tick);
-}
-$("play").onclick = () => setPlaying(!state.playing);
-$("direction").onclick = () => { state.dir = -state.dir; };
-$("input-slider").oninput = (ev) => { state.frame = +ev.target.value; render(); };
-
-// ------------------------------------------------------------------ synthesis
-let source = null, job = null;
-$("clear-targets").onclick = () => { state.targets = []; state.preview = null; $("target-count").textContent = 0; render(); };
-$("synth-run").onclick = async () => {
-  $("synth-status").textContent = "";
-  try {
-    job = await call(`/api/synth/${$("synth-kind").value || "fourbar_path"}`, { targets: state.targets, time_limit: +$("synth-time").value });
-  } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
-  $("synth-run").disabled = true; $("synth-cancel").disabled = false;
-  $("synth-results").replaceChildren();
-  const show = (snap) => {
-    const p = snap.progress;
-    $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
-    $("synth-status").textContent = `${snap.state}${p.stage ? " (" + p.stage + ")" : ""}: ${p.done}/${p.total}, best ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
-  };
-  const end = (snap) => {
-    show(snap);
-    $("synth-run").disabled = false; $("synth-cancel").disabled = true;
-    if (snap.error) $("synth-status").textContent = `failed: ${snap.error.message}`;
-    if (snap.result) showResults(snap.result.results);
-  };
-  if (transport.events) {
-    source = new EventSource(eventsUrl(job.id));
-    source.addEventListener("progress", (e) => show(JSON.parse(e.data)));
-    source.addEventListener("end", (e) => { source.close(); end(JSON.parse(e.data)); });
-    source.onerror = () => { if (source.readyState === 2) { $("synth-run").disabled = false; $("synth-cancel").disabled = true; } };
-  } else { // no event stream (notebook widget): poll the job
-    const poll = async () => { const snap = await call(`/api/jobs/${job.id}`); if (snap.state === "running") { show(snap); setTimeout(poll, 300); } else end(snap); };
-    poll();
-  }
-};
-$("synth-cancel").onclick = async () => { if (job) await call(`/api/jobs/${job.id}/cancel`, {}); };
-
-function showResults(results) {
-  const items = results.map((r, i) => {
-    const li = h("li");
-    li.dataset.result = i;
-    li.append(`${r.label} `);
-    if (r.mechanism) {
-      const b = h("button", "Apply"); b.dataset.apply = i;
-      b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
-      li.append(b);
-    }
-    li.onmouseenter = () => { state.preview = r.path; render(); };
-    return li;
-  });
-  $("synth-results").replaceChildren(...items);
-  if (results.length) { state.preview = results[0].path; render(); }
-}
-
-// ------------------------------------------------------------------ atlas
-$("atlas-go").onclick = async () => {
-  $("atlas").replaceChildren(h("p", "listing…", { className: "muted" }));
-  try {
-    const { chains } = await call(`/api/atlas?links=${$("atlas-links").value}&mobility=${$("atlas-mobility").value}`);
-    $("atlas").replaceChildren(...chains.map(chainFigure));
-    if (!chains.length) $("atlas").replaceChildren(h("p", "no chains", { className: "muted" }));
-  } catch (e) { $("atlas").replaceChildren(h("p", e.error || String(e), { className: "err" })); }
-};
-
-function chainFigure(c) {
-  const fig = h("figure");
-  const s = el("svg", { viewBox: "-70 -70 140 140", "data-chain": c.index });
-  const jx = c.joint_xy, xs = jx.map((p) => p[0]), ys = jx.map((p) => p[1]);
-  const cx = (Math.min(...xs) + Math.max(...xs)) / 2, cy = (Math.min(...ys) + Math.max(...ys)) / 2;
-  const sc = 110 / Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys), 1e-9);
-  const P = (p) => [(p[0] - cx) * sc, -(p[1] - cy) * sc];
-  const frame = c.mechanisms.length ? c.mechanisms[0].frame : 0;
-  for (let l = 0; l < c.chain.n_links; l++) {
-    const pts = c.chain.edges.map((e, k) => (e.includes(l) ? P(jx[k]) : null)).filter(Boolean);
-    if (pts.length === 2) el("line", { x1: pts[0][0], y1: pts[0][1], x2: pts[1][0], y2: pts[1][1], class: "link-bar", "stroke-width": 3, stroke: l === frame ? "#999" : null }, s);
-    else {
-      const cxy = pts.reduce((a, p) => [a[0] + p[0] / pts.length, a[1] + p[1] / pts.length], [0, 0]);
-      pts.sort((a, b) => Math.atan2(a[1] - cxy[1], a[0] - cxy[0]) - Math.atan2(b[1] - cxy[1], b[0] - cxy[0]));
-      el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "link-plate", fill: l === frame ? "#ccc" : null }, s);
-    }
-  }
-  for (const p of jx.map(P)) el("circle", { cx: p[0], cy: p[1], r: 3, class: "joint" }, s);
-  fig.append(s, h("figcaption", `#${c.index + 1} ${c.label}`));
-  const b = h("button", "Open"); b.dataset.openChain = c.index;
-  b.onclick = async () => {
-    try {
-      const ch = c.mechanisms[0] || {};
-      const r = await call("/api/atlas/mechanism", { chain: c.chain, frame: ch.frame, input: ch.input });
-      state.fileName = ""; setMech(r.mechanism, { fit: true });
-    } catch (e) { state.errors = [{ message: e.error }]; render(); }
-  };
-  fig.append(b);
-  return fig;
-}
+// ------------------------------------------------------------------ player, synthesis, atlas
+const setPlaying = mountPlayer({ $, state, render, assembledNear });
+const synthUi = mountSynthesis({ $, state, render, setMech });
+mountAtlas({ $, state, render, setMech });
+const forcesUi = mountForces({ $, state, render, edit, stepsFor });
 
 // ------------------------------------------------------------------ files
-async function openFrom(promise) {
-  try {
-    const r = await promise;
-    state.fileName = r.name || "";
-    $("save-name").value = state.fileName.includes("/") || !state.fileName ? state.fileName : state.fileName;
-    state.selected = null;
-    setMech(r.mechanism, { fit: true });
-    // fit again once the paths are known
-    const n = state.simulations;
-    const wait = () => (state.simulations > n ? (fitView(), render()) : setTimeout(wait, 30));
-    wait();
-  } catch (e) {
-    state.errors = [{ message: e.error || String(e), hint: e.hint }]; render();
-  }
-}
-
-$("examples").onchange = (ev) => { if (ev.target.value) openFrom(call(`/api/examples/${encodeURIComponent(ev.target.value)}`)); ev.target.value = ""; };
-$("files").onfocus = refreshFiles;
-$("files").onchange = (ev) => { if (ev.target.value) openFrom(call(`/api/file?path=${encodeURIComponent(ev.target.value)}`)); ev.target.value = ""; };
-$("upload").onchange = async (ev) => {
-  const f = ev.target.files[0];
-  if (!f) return;
-  openFrom(call("/api/import", { text: await f.text(), filename: f.name }));
-  ev.target.value = "";
-};
-$("save").onclick = async () => {
-  const name = $("save-name").value.trim() || "mechanism.yaml";
-  try {
-    let r;
-    try { r = await call("/api/file", { path: name, mechanism: state.mech }); }
-    catch (e) {
-      if (!/exists/.test(e.error || "") || !confirm(`${name} exists: overwrite it?`)) throw e;
-      r = await call("/api/file", { path: name, mechanism: state.mech, overwrite: true });
-    }
-    state.notes = [`saved ${r.saved} (${r.bytes} bytes)`]; state.fileName = r.saved; render(); refreshFiles();
-  } catch (e) { state.errors = [{ message: `not saved: ${e.error || e}`, hint: e.hint }]; render(); }
-};
-
-function download(name, blob) {
-  const a = document.createElement("a");
-  a.href = URL.createObjectURL(blob); a.download = name;
-  document.body.append(a); a.click(); a.remove();
-  setTimeout(() => URL.revokeObjectURL(a.href), 5000);
-}
-async function svgText() {
-  const css = await fetch("/static/studio.css").then((r) => r.text());
-  const c = svg.cloneNode(true);
-  c.setAttribute("xmlns", "http://www.w3.org/2000/svg");
-  const style = document.createElementNS("http://www.w3.org/2000/svg", "style");
-  style.textContent = css;
-  c.insertBefore(style, c.firstChild);
-  const bg = document.createElementNS("http://www.w3.org/2000/svg", "rect");
-  bg.setAttribute("width", "100%"); bg.setAttribute("height", "100%"); bg.setAttribute("fill", "#fff");
-  c.insertBefore(bg, style.nextSibling);
-  return new XMLSerializer().serializeToString(c);
-}
-const base = () => (state.fileName || state.mech.name || "mechanism").replace(/\.[a-z]+$/i, "").replace(/[^\w.-]+/g, "_");
-$("export").onchange = async (ev) => {
-  const fmt = ev.target.value; ev.target.value = "";
-  if (!fmt || !state.mech) return;
-  try {
-    if (fmt === "svg") download(`${base()}.svg`, new Blob([await svgText()], { type: "image/svg+xml" }));
-    else if (fmt === "png") {
-      const url = URL.createObjectURL(new Blob([await svgText()], { type: "image/svg+xml" }));
-      const img = new Image();
-      await new Promise((ok, bad) => { img.onload = ok; img.onerror = bad; img.src = url; });
-      const r = svg.getBoundingClientRect(), cv = document.createElement("canvas");
-      cv.width = r.width * 2; cv.height = r.height * 2;
-      const ctx = cv.getContext("2d"); ctx.scale(2, 2); ctx.drawImage(img, 0, 0, r.width, r.height);
-      URL.revokeObjectURL(url);
-      cv.toBlob((b) => download(`${base()}.png`, b), "image/png");
-    } else if (fmt === "gif") {
-      state.notes = ["making the animation…"]; render();
-      download(`${base()}.gif`, await call("/api/export", { mechanism: state.mech, format: "gif" }, { blob: true }));
-      state.notes = []; render();
-    } else {
-      const text = await call("/api/export", { mechanism: state.mech, format: fmt }, { raw: true });
-      download(`${base()}.${fmt}`, new Blob([text], { type: "text/plain" }));
-    }
-  } catch (e) { state.errors = [{ message: `export failed: ${e.error || e}` }]; render(); }
-};
-
-async function refreshFiles() {
-  try {
-    const { files } = await call("/api/files");
-    const keep = $("files").value;
-    $("files").replaceChildren(h("option", "Files…", { value: "" }), ...files.map((f) => h("option", f, { value: f })));
-    $("files").value = keep;
-  } catch (e) { /* the list stays as it was */ }
-}
+const { openFrom, refreshFiles } = mountFiles({ $, svg, state, render, setMech, fitView });
 
 // ------------------------------------------------------------------ toolbar, keys, start
 function setMode(mode) {
@@ -682,6 +616,8 @@ function showTab(name) {
   for (const b of root.querySelectorAll("#tabs button")) b.classList.toggle("on", b.dataset.tab === name);
   for (const t of root.querySelectorAll(".tab")) t.classList.toggle("on", t.id === `tab-${name}`);
   if (name === "plots") renderPlots();
+  if (name === "forces") { forcesUi.renderForces(); forcesUi.compute(); }
+  render();
 }
 for (const b of root.querySelectorAll("#modes button")) b.onclick = () => setMode(b.dataset.mode);
 for (const b of root.querySelectorAll("#tabs button")) b.onclick = () => showTab(b.dataset.tab);
@@ -689,37 +625,32 @@ $("finish-link").onclick = finishLink;
 $("undo").onclick = undo;
 $("redo").onclick = redo;
 $("new").onclick = () => { state.fileName = ""; state.selected = null; setMech(EMPTY(), { fit: true }); };
+if (root === document) guardUnload(() => state.dirty);
 $("fit").onclick = () => { fitView(); render(); };
 $("grid").onchange = (ev) => { state.opts.grid = ev.target.checked; render(); };
 $("snap").onchange = (ev) => { state.opts.snap = ev.target.checked; };
 $("assur-colours").onchange = (ev) => { state.opts.assurColours = ev.target.checked; render(); };
 $("plot-what").onchange = renderPlots;
+$("drive-speed").onchange = () => { renderPlots(); forcesUi.forcesSoon(); };
 window.addEventListener("resize", render);
-(root.addEventListener ? root : document).addEventListener("keydown", (ev) => {
-  if (ev.target.matches("input, select, textarea")) return;
-  const k = ev.key;
-  if ((ev.ctrlKey || ev.metaKey) && k === "z") { ev.preventDefault(); undo(); }
-  else if ((ev.ctrlKey || ev.metaKey) && (k === "y" || k === "Z")) { ev.preventDefault(); redo(); }
-  else if (k === "Enter" && state.mode === "link") finishLink();
-  else if (k === "Escape") { state.building = []; setMode("select"); }
-  else if (k === " ") { ev.preventDefault(); setPlaying(!state.playing); }
-  else if (!ev.ctrlKey && !ev.metaKey) {
-    const m = { v: "select", g: "pivot", l: "link", p: "point", d: "drive", x: "delete", t: "target" }[k.toLowerCase()];
-    if (m) setMode(m);
-    if (k === "f") { fitView(); render(); }
-  }
-});
+bindKeys(root, {
+  undo, redo, finishLink, setMode, play: () => setPlaying(!state.playing), fit: () => { fitView(); render(); },
+  escape: () => { state.building = []; setMode("select"); }, linkMode: () => state.mode === "link",
+  deleteSelection: () => { const sel = state.selected; if (!sel) return; state.selected = null; (sel.kind === "joint" ? deleteJoint : deletePoint)(sel.id); },
+}, { contained: root !== document });
 
 (async function start() {
   try {
     const s = await call("/api/start");
     $("save-name").value = s.name || "";
     for (const [k, title] of Object.entries(s.synthesis_kinds || {})) $("synth-kind").append(h("option", title, { value: k }));
-    const ex = await call("/api/examples");
-    for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}`, { value: e.name }));
+    const ex = await call("/api/studio/examples");
+    for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}${e.kind === "planar" ? "" : ` (${e.kind})`}`, { value: e.name }));
     refreshFiles();
     if (s.mechanism) openFrom(Promise.resolve({ mechanism: s.mechanism, name: s.name }));
     else setMech(EMPTY(), { record: false, fit: true });
+    const w = root === document ? savedWork() : null;
+    if (w && JSON.stringify(w.mechanism) !== JSON.stringify(s.mechanism)) { state.offer = w; render(); }
   } catch (e) {
     $("banner").replaceChildren(div("err", `${e.error || e}${e.hint ? " — fix: " + e.hint : ""}`));
     state.mech = EMPTY(); render();

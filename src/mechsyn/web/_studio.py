@@ -1,0 +1,278 @@
+"""Server-side logic of the studio's editor: invalid states in the studio's words, and the
+DXF plates / SVG drawing exports.
+
+The routes are registered by :func:`routes` (one line in :mod:`mechsyn.web._app`). Every
+function takes and returns plain JSON-able data, like :mod:`mechsyn.web._service`.
+
+Diagnostics are ``{"level", "message", "elements", "blocks"}``: ``level`` is ``error``,
+``warning`` or ``note``; ``elements`` the ``{"kind", "id"}`` the message names (outlined on
+the canvas); ``blocks`` true when simulating would be pointless (a structure, drives that
+fight, parts joined to nothing, a spatial file).
+
+Examples
+--------
+>>> from mechsyn.io import load_mechanism, mechanism_to_dict
+>>> from mechsyn.web._service import example_path
+>>> d = mechanism_to_dict(load_mechanism(example_path("fourbar")))
+>>> check(d)["mobility"], check(d)["diagnostics"]
+(1, [])
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.web import _service
+
+
+def _names(ids: list[str]) -> str:
+    return ids[0] if len(ids) == 1 else ", ".join(ids[:-1]) + " and " + ids[-1]
+
+
+def _diag(level: str, message: str, elements: list[tuple[str, str]], blocks: bool, short: str = "") -> dict[str, Any]:
+    """One diagnostic; ``short`` is the few words written next to the element on the canvas."""
+    return {"level": level, "message": message, "blocks": blocks, "short": short or message.split(":")[0],
+            "elements": [{"kind": k, "id": i} for k, i in elements]}
+
+
+def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
+    """Links joined to nothing, links with one joint (dangling) and parts not connected to the
+    frame of a mechanism dict (checked before it is validated: the file loader refuses a
+    disconnected mechanism), in the studio's words: what to do on the canvas, not in the file."""
+    ground = data.get("ground", "frame")
+    names = [link if isinstance(link, str) else str(link.get("name")) for link in data.get("links", [])]
+    joints = [j for j in data.get("joints", []) if isinstance(j, dict)]
+    joints_of: dict[str, list] = {n: [] for n in names}
+    for j in joints:
+        for link in j.get("links", []):
+            joints_of.setdefault(str(link), []).append(j)
+    out = []
+    for name, js in joints_of.items():
+        if name == ground:
+            continue
+        if not js:
+            out.append(_diag("error", f"link {name} is joined to nothing: join it with Link or delete it",
+                             [("link", name)], True, "joined to nothing"))
+        elif len(js) == 1 and not js[0].get("actuated"):  # a driven end link (a crank, a serial end) is fine
+            out.append(_diag("error", f"link {name} has one joint ({js[0].get('id')}): join it to another "
+                             "link with Link, or delete it", [("link", name)], True, "one joint only"))
+    seen, todo = {ground}, [ground]
+    while todo:
+        link = todo.pop()
+        for j in joints_of.get(link, []):
+            for other in map(str, j.get("links", [])):
+                if other not in seen:
+                    seen.add(other)
+                    todo.append(other)
+    loose = [n for n in joints_of if n not in seen and joints_of[n]]
+    if loose:
+        many = len(loose) > 1
+        out.append(_diag("error", f"link{'s' if many else ''} {_names(loose)} {'are' if many else 'is'} not "
+                         "connected to the frame: add a Pivot and join it to them with Link",
+                         [("link", n) for n in loose], True, "not connected to the frame"))
+    return out
+
+
+def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
+    """A structure with a drive, more drives than the mobility, fewer (motion undetermined)."""
+    drives = [j.id for j in mech.joints if j.actuated]
+    els = [("joint", d) for d in drives]
+    n = len(drives)
+    if mobility <= 0 and drives:
+        return [_diag("error", f"this is a structure, not a mechanism (mobility W = {mobility}): nothing can "
+                      f"move, so the drive on {_names(drives)} cannot turn it. Delete a link or a joint, or "
+                      "remove the drive", els, True, "a structure: cannot turn")]
+    if n > mobility >= 1:
+        return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
+                      f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True, "one drive too many")]
+    if 0 < n < mobility and not any(j.vll for j in mech.joints):  # a locked VLL joint takes up a freedom
+        return [_diag("warning", f"mobility W = {mobility} with {n} drive{'s' if n > 1 else ''}: the motion is "
+                      f"not determined. Mark {mobility - n} more joint{'s' if mobility - n > 1 else ''} with "
+                      "Drive", els, True, "more drives needed")]
+    return []
+
+
+def check(data: Any) -> dict[str, Any]:
+    """The editor's checks of a mechanism dict, fast enough for every edit of its topology.
+
+    Returns ``{"mobility", "mobility_source", "drives", "spatial", "diagnostics"}``. The
+    mobility is the structure report's (the rank method where the geometry allows it).
+    A file that does not validate raises :class:`~mechsyn.errors.MechsynInputError`
+    (shown by the studio next to the element its field names).
+    """
+    from mechsyn.structure.report import analyze as structure_report
+
+    if not isinstance(data, dict):
+        raise MechsynInputError("the mechanism must be a JSON object", field="mechanism")
+    problems = connection_problems(data)
+    drives = [str(j.get("id")) for j in data.get("joints", []) if isinstance(j, dict) and j.get("actuated")]
+    out: dict[str, Any] = {"mobility": None, "mobility_source": None, "drives": drives,
+                           "spatial": data.get("kind", "planar") != "planar", "diagnostics": problems}
+    if problems:
+        return out
+    mech = _service.build(data)
+    if out["spatial"]:
+        out["diagnostics"].append(_diag("note", "spatial mechanism: structure and rank analysis only (see "
+                                        "the Analysis tab); the drawing is its top view", [], True))
+    try:
+        report = structure_report(mech)
+    except MechsynInputError as err:
+        out["diagnostics"].append(_diag("warning", f"mobility not known: {err.message}", [], False))
+        return out
+    out["mobility"], out["mobility_source"] = int(report.mobility), report.to_dict().get("mobility_source")
+    if not out["spatial"] and not any(d["blocks"] for d in out["diagnostics"]):
+        out["diagnostics"] += drive_problems(mech, out["mobility"])
+    return out
+
+
+def export_drawing(data: Any) -> str:
+    """The mechanism's SVG drawing in model units at the drawn pose, with the paths of its
+    named points over a full input turn (``mechsyn export --drawing``)."""
+    import numpy as np
+
+    from mechsyn.export.drawing import drawing_of
+
+    mech = _service.build(data)
+    drives = [j for j in mech.joints if j.actuated]
+    sweep = None
+    if drives and drives[0].type == "R" and mech.points:
+        start = _service._driver_start(mech, drives[0].id)
+        sweep = {drives[0].id: start + np.linspace(0.0, 360.0, 181)}
+    return drawing_of(mech, None, list(mech.points) if sweep else [], sweep, dimensions=True)
+
+
+def export_dxf(data: Any) -> str:
+    """The link plates laid out on a sheet as DXF text (``mechsyn export --dxf``; needs ezdxf,
+    else a :class:`~mechsyn.errors.MechsynInputError` saying how to install it)."""
+    import io
+
+    from mechsyn.export.dxf import layout_to_dxf
+    from mechsyn.export.plates import link_plates
+
+    doc = layout_to_dxf(link_plates(_service.build(data)))
+    buf = io.StringIO()
+    doc.write(buf)
+    return buf.getvalue()
+
+
+def _finite_number(value: Any, field: str) -> float:
+    import math
+
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise MechsynInputError(f"expected a number, got {value!r}", field=field)
+    return float(value)
+
+
+def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 180) -> dict[str, Any]:
+    """Drive torque (or force) and joint reactions over the studio's sweep of the first drive
+    (``mechsyn forces``: kinetostatics with the file's link masses, inertias and loads, the
+    drive turning at ``speed`` rad/s, or moving at ``speed`` units/s, held constant).
+
+    Returns the library's :meth:`~mechsyn.kinematics.analysis.ForceAnalysis.to_dict`.
+    """
+    from mechsyn.kinematics.analysis import forces as _forces
+    from mechsyn.results import to_jsonable
+
+    if not isinstance(gravity, (list, tuple)) or len(gravity) != 2:
+        raise MechsynInputError("gravity must be [gx, gy]", field="gravity")
+    g = (_finite_number(gravity[0], "gravity"), _finite_number(gravity[1], "gravity"))
+    w = _finite_number(speed, "speed")
+    mech = _service.build(data)
+    drive, values = _service._sweep(mech, steps, None)
+    return to_jsonable(_forces(mech, {drive.id: values}, speeds={drive.id: w}, gravity=g).to_dict())
+
+
+def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
+    """Motion generation through 3 to 5 clicked poses (``params["targets"]`` [x, y] and
+    ``params["angles"]`` in degrees): Burmester theory (``mechsyn synth motion``:
+    :func:`mechsyn.synthesis.reports.motion_report`), each four-bar verified by simulation,
+    ranked defect-free first, then by the smallest transmission angle."""
+    import numpy as np
+
+    from mechsyn.synthesis.export import fourbar_mechanism_dict
+    from mechsyn.synthesis.reports import motion_report
+
+    T = np.asarray(params.get("targets"), float)
+    A = np.asarray(params.get("angles", [0.0] * len(T)), float)
+    if T.ndim != 2 or T.shape[1:] != (2,) or not 3 <= len(T) <= 5 or not np.isfinite(T).all():
+        raise MechsynInputError("give 3 to 5 poses: click 3 to 5 target points", field="targets",
+                                hint="then type each pose's angle in the Synthesis tab")
+    if A.shape != (len(T),) or not np.isfinite(A).all():
+        raise MechsynInputError("give one angle (degrees) per pose", field="angles")
+    progress({"done": 0, "total": 1, "best": None})
+    report = motion_report(np.column_stack([T, np.radians(A)]), top=5)
+    results = []
+    for r in report.all_solutions[:5]:
+        d = r.design()
+        mech = fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(r.theta2[0]), branch=r.branch,
+                                      rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
+                                      name="Four-bar motion generator (Burmester)")
+        err = float(r.position_error)
+        results.append({"error": err, "feasible": bool(r.ok), "mechanism": mech, "path": T.tolist(),
+                        "label": f"error {err:.3g} (largest distance at a pose), min μ {r.min_transmission_deg:.0f}°"
+                                 + ("" if r.ok else ", not verified: a branch or order defect")})
+    progress({"done": 1, "total": 1, "best": min((x["error"] for x in results), default=None)})
+    return {"kind": "motion", "targets": T.tolist(), "results": results,
+            "notes": [f"{report.count} linkages found, {report.verified_count} verified by simulation"]}
+
+
+# the documented extension point of the studio's synthesis kinds
+_service.SYNTHESIS_KINDS.setdefault("motion", ("Motion through 3-5 poses (Burmester)", synthesize_motion))
+
+
+def examples() -> list[dict[str, str]]:
+    """The Examples menu: the planar examples (:func:`mechsyn.web._service.examples`), then the
+    spatial ones with joint points (opened for structure and rank analysis), each with its ``kind``."""
+    planar = [{**e, "kind": "planar"} for e in _service.examples()]
+    return planar + [dict(e) for e in _spatial_examples(_service._examples_dir())]
+
+
+@functools.lru_cache(maxsize=4)
+def _spatial_examples(root) -> tuple[dict[str, str], ...]:
+    from mechsyn.io import load_mechanism
+
+    out = []
+    for p in sorted(root.rglob("*")) if root is not None else []:
+        if p.suffix not in _service.EXAMPLE_SUFFIXES or not p.is_file():
+            continue
+        try:
+            mech = load_mechanism(p)
+        except Exception:  # case files and arms are not mechanisms: not listed
+            continue
+        if mech.kind != "planar" and all(j.point is not None for j in mech.joints):
+            out.append({"name": p.stem, "title": mech.name, "group": p.parent.name, "kind": mech.kind})
+    return tuple(out)
+
+
+def routes() -> list:
+    """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`)."""
+    from starlette.concurrency import run_in_threadpool
+    from starlette.responses import Response
+    from starlette.routing import Route
+
+    from mechsyn.web._app import _body, _int, _need, api
+
+    def on_mechanism(fn, media_type=None):
+        @api
+        async def route(request) -> Any:
+            out = await run_in_threadpool(fn, _need(await _body(request), "mechanism"))
+            return Response(out, media_type=media_type) if media_type else out
+        return route
+
+    @api
+    async def examples_route(request) -> Any:
+        return {"examples": await run_in_threadpool(examples)}
+
+    @api
+    async def forces_route(request) -> Any:
+        body = await _body(request)
+        return await run_in_threadpool(forces, _need(body, "mechanism"), body.get("gravity", [0.0, 0.0]),
+                                       body.get("speed", 1.0), _int(body.get("steps", 180), "steps"))
+
+    return [Route("/api/studio/examples", examples_route),
+            Route("/api/studio/forces", forces_route, methods=["POST"]),
+            Route("/api/studio/check", on_mechanism(check), methods=["POST"]),
+            Route("/api/studio/drawing", on_mechanism(export_drawing, "image/svg+xml"), methods=["POST"]),
+            Route("/api/studio/dxf", on_mechanism(export_dxf, "application/dxf"), methods=["POST"])]
