@@ -121,11 +121,9 @@ class Simulation(Result):
     def to_pandas(self) -> Any:
         """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
         every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
-        try:
-            import pandas as pd
-        except ImportError:
-            raise ImportError("Simulation.to_pandas needs pandas: pip install pandas "
-                              "(or use to_dict(), which needs nothing)") from None
+        from mechsyn._extras import require
+
+        pd = require("pandas", "Simulation.to_pandas() (to_dict() needs nothing)")
         cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
         cols["assembled"] = self.assembled
         for name, pm in self.points.items():

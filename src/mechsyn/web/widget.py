@@ -24,8 +24,11 @@ import secrets
 from pathlib import Path
 from typing import Any
 
-import anywidget
-import traitlets
+from mechsyn._extras import require
+
+anywidget = require("anywidget", "Mechanism.widget()", "notebook")
+require("httpx", "Mechanism.widget()", "notebook")  # the in-process app answers through starlette's TestClient
+import traitlets  # noqa: E402  (installed with anywidget)
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "studio.js")
