@@ -422,38 +422,75 @@ def _fmt(x: float | None) -> str:
     return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
-def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
-    """``mechsyn analyze``: the formulas, contours, redundancy and mobility of one analysis."""
-    from mechsyn.structure.report import CONTOUR_READING, formula_title
-    pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
-    console.print(Panel.fit(
-        f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
-        f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
-    ))
-    values = {key: _fmt(f.value) for key, f in a.formulas.items()}
-    t = Table(title="Formulas", show_lines=False)
+def _formula_table(a: StructuralAnalysis, keys: list[str], title: str, rank: Any = None) -> None:
+    from mechsyn.structure.report import explain_negative, formula_title
+
+    values = {key: _fmt(a.formulas[key].value) for key in keys}
+    t = Table(title=title, show_lines=False)
     t.add_column("formula", no_wrap=True)
     t.add_column("expression", overflow="fold")  # the long expressions wrap, numbers never do
     t.add_column("value", justify="right", no_wrap=True, min_width=max(map(len, ["value", *values.values()])))
-    for key, f in a.formulas.items():
-        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, values[key])
+    for key in keys:
+        t.add_row(formula_title(SHORT_TITLES.get(key, key), a.formulas[key]), a.formulas[key].expression, values[key])
     console.print(t)
+    for key in keys:
+        why = explain_negative(key, a, rank)
+        if why:
+            note(f"{SHORT_TITLES.get(key, key)}: {why}")
+
+
+def note(text: str, label: str = "note:") -> None:
+    """A note wrapped at word boundaries to the console's width (80 columns in a pipe), its
+    continuation lines indented under the text; a word longer than a line is cut."""
+    lead = f"{label} " if label else ""
+    lines = wrap_lines(text, lead, " " * len(lead))
+    body = escape("\n".join(lines))
+    if label:
+        body = f"[dim]{escape(label)}[/]" + body[len(escape(label)):]
+    console.print(body, highlight=False, soft_wrap=True)
+
+
+def wrap_lines(text: str, first: str = "", rest: str = "") -> list[str]:
+    """``text`` in lines of the console's width, broken at spaces only (not at hyphens)."""
+    import textwrap
+
+    return textwrap.wrap(text, width=max(console.width, 20), initial_indent=first, subsequent_indent=rest,
+                         break_on_hyphens=False)
+
+
+def render(a: StructuralAnalysis, title_prefix: str = "", rank: Any = None, verdict_text: str | None = None) -> None:
+    """``mechsyn analyze``: the verdict, the formulas of the file's own kind, then (planar
+    files) their spatial reading with paper 003's contours, redundancy and drives."""
+    from mechsyn.structure.report import CONTOUR_READING, READINGS, SPATIAL_OF_PLANAR, formula_sections
+
+    pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
+    head = (f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
+            f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours")
+    if verdict_text:
+        head += f"\n[bold]verdict:[/] {escape(verdict_text)}"
+    console.print(Panel(head, expand=False))
+    own, spatial = formula_sections(a)
+    _formula_table(a, own, f"Formulas ({READINGS['planar' if a.kind == 'planar' else 'spatial']})", rank)
+    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({a.mobility_source});  "
+                  f"drives: {a.degrees_of_mobility_expression}", highlight=False)
+    if spatial:
+        console.print()
+        console.print(f"[bold]{SPATIAL_OF_PLANAR[0]}[/]", highlight=False)
+        note(SPATIAL_OF_PLANAR[1], "")
+        _formula_table(a, spatial, "Formulas (spatial reading)", rank)
     if a.contours:
         _render_contours(a)
     console.print(
         f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
-        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
-        soft_wrap=True)
-    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({a.mobility_source});  "
-                  f"drives: {a.degrees_of_mobility_expression}", highlight=False, soft_wrap=True)
+        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False)
     if a.external is not None:
         e = a.external
         console.print(f"external (paper 002): S_a = {e.S_a}, W_f = {e.W_f}, W_rob = {e.W_rob}, "
                       f"W_a = {e.W_a}, S_ai = {e.S_ai}", highlight=False)
         console.print(f"  {e.external_redundant.expression}\n  {e.system_redundant.expression}", highlight=False)
     for n in a.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False, soft_wrap=True)
+        note(n)
     for name, sub in a.states.items():
         console.print()
         render(sub, title_prefix=f"state '{safe(name)}': ")
@@ -471,7 +508,8 @@ def _render_contours(a: StructuralAnalysis) -> None:
     if a.contours_chosen_by_program:
         console.print("  * contour chosen by the program")
     for r in a.contours:
-        console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
+        console.print(escape("\n".join(wrap_lines(f"{r.S_expression};  {r.T_expression}", "  ", "    "))),
+                      highlight=False, soft_wrap=True)
 
 
 def render_remedies(remedies: list[Remedy]) -> None:
@@ -513,7 +551,7 @@ def render_rank(ra: RankAnalysis, comparisons: list[Comparison] | None, title: s
         words = max(len(w) for c in comparisons for w in c.quantity.split())
         t.add_column("quantity", width=words)  # words whole; text columns share the rest, numbers never wrap
         t.add_column("formula", ratio=2)
-        t.add_column("formula", no_wrap=True)
+        t.add_column("value", no_wrap=True)
         t.add_column("rank", justify="right", no_wrap=True)
         t.add_column("why they differ", ratio=3)
         for c in comparisons:
@@ -522,7 +560,7 @@ def render_rank(ra: RankAnalysis, comparisons: list[Comparison] | None, title: s
             t.add_row(c.quantity, c.formula, fv, f"{mark}{c.rank_value}", c.why)
         console.print(t)
     for n in ra.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False)
+        note(n)
 
 
 def render_remedy_checks(checks: list[tuple[int, Remedy, RemedyCheck]]) -> None:
@@ -544,9 +582,12 @@ def render_report(report: StructureReport) -> None:
     """The terminal tables of a structural report."""
     ra, method = report.rank, report.method
     if method != "rank":
-        render(report.analysis)
+        render(report.analysis, rank=ra, verdict_text=report.verdict["text"])
+    else:
+        console.print(Panel(f"[bold]{safe(report.analysis.name)}[/]\n[bold]verdict:[/] "
+                            f"{escape(report.verdict['text'])}", expand=False))
     for n in report.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False)
+        note(n)
     if ra is not None:
         console.print()
         render_rank(ra, report.comparisons if method == "both" else None)

@@ -123,7 +123,7 @@ class Simulation(Result):
         every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
         from mechsyn._extras import require
 
-        pd = require("pandas", "Simulation.to_pandas() (to_dict() needs nothing)")
+        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
         cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
         cols["assembled"] = self.assembled
         for name, pm in self.points.items():
