@@ -19,9 +19,8 @@ from typing import Annotated, Optional
 import typer
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import emit_json, err_console, strip_control
+from mechsyn.cli.common import emit_json, err_console, strip_control, write_output
 from mechsyn.io import json_schema, load_mechanism
-from mechsyn.results import write_atomic
 from mechsyn.structure.report import analyze as structure_report
 
 
@@ -74,7 +73,7 @@ def analyze(
         if out is None:
             typer.echo(strip_control(report.to_markdown()), nl=False)  # a file's escapes never reach the terminal
         else:
-            write_atomic(out, report.to_markdown())
+            write_output(out, report.to_markdown())
     else:
         from mechsyn.cli.render import render_report
 
@@ -90,4 +89,4 @@ def schema(
     if out is None:
         typer.echo(text)
     else:
-        write_atomic(out, text + "\n")
+        write_output(out, text + "\n")

@@ -32,8 +32,12 @@ def _write_files(atlas: Any, out: Path | None, mechanisms: Path | None) -> None:
     if mechanisms is not None:
         import yaml
 
-        for name, doc in atlas.mechanism_files().items():
+        from mechsyn.cli.common import say_written
+
+        files = atlas.mechanism_files()
+        for name, doc in files.items():
             write_atomic(mechanisms / name, yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
+        say_written(mechanisms, f"{len(files)} mechanism files")
     if out is not None:
         from mechsyn.cli.common import save_plot
 

@@ -168,9 +168,6 @@ def _grid(arm, grid: str, options: dict, map_png: Optional[Path], csv_out: Optio
         emit_json(cmap.to_dict())
         return stop_if_interrupted(cmap)
     render_capability_map(cmap)
-    for what, path in (("map", map_png), ("csv", csv_out)):
-        if path is not None:
-            console.print(f"wrote {what}: {path}")
     if cmap.interrupted:
         console.print(f"interrupted: {int(cmap.done().sum())} of {total} points solved (? in the table); the outputs hold those")
     stop_if_interrupted(cmap)

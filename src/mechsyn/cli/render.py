@@ -72,26 +72,45 @@ def _fitting_cells(values: list, first: list[str], heads: tuple, width: int) -> 
     for digits in (6, 5, 4, 3):
         cells = [[f0, *(blank if row is None else (fmt_number(v, f".{digits}g") for v in row))]
                  for f0, row in zip(first, values)]
-        need = 1 + sum(max([len(h)] + [len(r[i]) for r in cells]) + 3 for i, h in enumerate(heads))
-        if need <= width:
+        if _table_width(cells, heads) <= width:
             break
     return cells
 
 
-def _link_table(sim: Any, rows: list[int], head: str) -> None:
+def _table_width(cells: list[list[str]], heads: tuple) -> int:
+    """Columns a rich table of ``cells`` under ``heads`` takes (3 per column and 1 more)."""
+    return 1 + sum(max([len(h)] + [len(r[i]) for r in cells]) + 3 for i, h in enumerate(heads))
+
+
+def _link_table(sim: Any, rows: list[int], head: str, most: int = 4) -> None:
+    """The links' angle θ, angular velocity ω and acceleration α, each in a column of its own,
+    as many links to a table as fit the console's width (up to ``most`` links shown)."""
     x = sim.inputs[sim.main_input]
-    t = Table(title="links: angle (deg), angular velocity (rad/s), angular acceleration (rad/s²)")
-    t.add_column(head, justify="right")
-    names = list(sim.links)[:4]
-    for name in names:
-        t.add_column(f"{name} θ, ω, α", justify="right")
-    for k in rows:
-        t.add_row(f"{x[k]:g}", *(("—" if not sim.assembled[k] else
-                                  f"{sim.links[n].angle[k]:.4f}, {fmt_number(sim.links[n].angular_velocity[k])}, "
-                                  f"{fmt_number(sim.links[n].angular_acceleration[k])}") for n in names))
-    console.print(t)
-    if len(sim.links) > 4:
-        console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
+    names = list(sim.links)[:most]
+    first = [f"{x[k]:g}" for k in rows]
+
+    def cells(group: list[str]) -> tuple[list[list[str]], tuple]:
+        heads = (head, *(f"{n} {q}" for n in group for q in ("θ", "ω", "α")))
+        values = [None if not sim.assembled[k] else
+                  [v for n in group for v in (sim.links[n].angle[k], sim.links[n].angular_velocity[k],
+                                              sim.links[n].angular_acceleration[k])] for k in rows]
+        return _fitting_cells(values, first, heads, console.width), heads
+
+    title = "links: angle θ (deg), angular velocity ω (rad/s), acceleration α (rad/s²)"
+    while names:
+        size = len(names)
+        while size > 1 and _table_width(*cells(names[:size])) > console.width:
+            size -= 1
+        body, heads = cells(names[:size])
+        t = Table(title=title)
+        for col in heads:
+            t.add_column(col, justify="right", no_wrap=True, overflow="ellipsis")
+        for row in body:
+            t.add_row(*row)
+        console.print(t)
+        names, title = names[size:], None
+    if len(sim.links) > most:
+        console.print(f"({len(sim.links) - most} more links in --json / --csv)", highlight=False)
 
 
 def _derived_lines(d: dict[str, Any]) -> None:
