@@ -101,18 +101,13 @@ def _catalogue() -> Catalogue:
     files = sorted((p for p in base.rglob("*") if p.suffix in _SUFFIXES and p.is_file()),
                    key=lambda p: (p.parent.as_posix(), p.stem, p.suffix == ".urdf", p.suffix))
     out = Catalogue()
-    seen: set[tuple[str, str]] = set()
     for p in files:
         try:
             data = safe_load_yaml(p.read_text(encoding="utf-8")) if p.suffix != ".urdf" else None
         except Exception:  # noqa: BLE001 -- a catalogue lists what it cannot parse too
             data = None
         kind, title = _kind(p, data)
-        folder = p.parent.relative_to(base).as_posix()
-        if (folder, p.stem) in seen:  # one example, two files (paper004_3r.yaml and .urdf): listed once
-            continue
-        seen.add((folder, p.stem))
-        out.append(Example(p.stem, folder, kind, title, p))
+        out.append(Example(p.stem, p.parent.relative_to(base).as_posix(), kind, title, p))
     return out
 
 
@@ -126,7 +121,13 @@ def list() -> Catalogue:  # noqa: A001 -- ms.examples.list() reads as the field'
     >>> sorted({e.kind for e in table})[:3]
     ['arm', 'belt case', 'finger-design case']
     """
-    return Catalogue(_catalogue())
+    seen: set[tuple[str, str]] = set()
+    out = Catalogue()
+    for e in _catalogue():  # one example in two files (paper004_3r.yaml and .urdf): listed once, as path() finds it
+        if (e.folder, e.name) not in seen:
+            seen.add((e.folder, e.name))
+            out.append(e)
+    return out
 
 
 def did_you_mean(name: str, choices: builtins.list[str] | None = None) -> builtins.list[str]:
