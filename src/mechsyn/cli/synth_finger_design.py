@@ -70,6 +70,9 @@ def _write(case: Any, res: Any, out: Optional[Path], plot: Optional[Path]) -> No
         mech["name"] = (f"{mech.get('name', 'finger')} (finger-design, seed {res.seed}"
                         + (", interrupted: best so far)" if res.interrupted else ")"))
         write_mechanism(mech, out)
+        from mechsyn.cli.common import say_written
+
+        say_written(out)
     if plot is not None:
         from mechsyn.cli.common import save_plot
         from mechsyn.plot.finger import plot_finger_design
