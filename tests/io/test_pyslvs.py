@@ -418,3 +418,39 @@ def test_link_limit_is_checked_before_the_conversion(monkeypatch):
     finally:
         set_limit("links", None)
     assert "MECHSYN_LIMIT_LINKS" in str(info.value)
+
+
+def test_rp_point_of_three_links_is_one_pin_not_a_zero_length_block(tmp_path, run_cli):
+    """Pyslvs' RP point on L[ground, L2, L3]: L2 and L3 turn on one pin that slides in the
+    frame's slot. Made as a block with one pin (L3 turns on L2 there): it loads, moves,
+    and writes back as the same RP point."""
+    text = ("M[J[R, color[Green], P[0.0, 0.0], L[ground, L1]], J[R, color[Green], P[-2.0, 20.0], L[L1, L2]], "
+            "J[RP, A[0.0], color[Orange], P[40.0, 0.0], L[ground, L2, L3]], "
+            "J[R, color[Blue], P[70.0, 30.0], L[L3, L4]], J[R, color[Green], P[90.0, 0.0], L[ground, L4]]]")
+    src = tmp_path / "rp3.pyslvs"
+    src.write_text(text)
+    _convert(run_cli, src, tmp_path / "m.yaml", "--input", "0,1")
+    mech = load_mechanism(tmp_path / "m.yaml")
+    assert analyze_structure(mech).mobility == 1
+    assert mech.joint("P2_1").links == ("block2", "L2") and mech.joint("P2_2").links == ("L2", "L3")
+    sim = simulate(mech, {"P0": np.arange(90.0, 131.0, 10.0)}, points=["P2_1"])
+    assert sim.assembled.all() and np.allclose(sim.points["P2_1"].position[:, 1], 0.0, atol=1e-9)  # in the slot
+    _convert(run_cli, tmp_path / "m.yaml", tmp_path / "back.pyslvs")
+    back = parse_expression((tmp_path / "back.pyslvs").read_text())
+    assert [(j.type, j.links) for j in back.joints] == [(j.type, j.links) for j in parse_expression(text).joints]
+
+
+def test_slider_input_drives_its_travel_both_ways():
+    """Pyslvs' input (i, i) on a slider point drives the slider along its slot."""
+    e = parse_expression("M[J[RP, A[0.0], color[Green], P[0.0, 0.0], L[ground, L2]], "
+                         "J[R, color[Green], P[50.0, 0.0], L[ground, L1]], "
+                         "J[R, color[Green], P[25.0, 27.0], L[L1, L2]]]")
+    data, _ = expression_to_data(e, inputs=[(0, 0)])
+    assert [j["id"] for j in data["joints"] if j.get("actuated")] == ["P0"]
+    from mechsyn.io import mechanism_from_dict
+
+    mech = mechanism_from_dict(data)
+    assert mech.joint("P0").type == "P" and analyze_structure(mech).mobility == 1
+    assert data_to_expression(mechanism_to_dict(mech)).inputs == [(0, 0)]
+    with pytest.raises(MechsynInputError, match="no slider"):
+        expression_to_data(e, inputs=[(1, 1)])

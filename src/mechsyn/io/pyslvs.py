@@ -33,7 +33,9 @@ Mapping to mechsyn's model (every pair joins two links):
   from the frame (or the first link) to each of the others;
 * an R point on one link becomes a named point ``P<i>`` of that link;
 * an RP point becomes a block link ``block<i>`` with a P joint ``P<i>`` along the first
-  link and R joints ``P<i>_1``, ``P<i>_2``, ... to the others;
+  link and an R joint ``P<i>_1`` to the second; a third, fourth... link turns on the same
+  pin, joined to the second by R joints ``P<i>_2``, ``P<i>_3``, ... (a block with two pins
+  at one point would be a link of zero length);
 * a P point with two links becomes a P joint ``P<i>``.
 
 Writing back recognises those blocks (a link ``block<i>`` with one P joint and R
@@ -387,8 +389,11 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
                 taken.add(block)
                 links.append(block)
                 made.append({"id": pid, "type": "P", "links": [j.links[0], block], "point": xy, "axis": axis})
-                for k, lk in enumerate(j.links[1:], start=1):
-                    made.append({"id": f"{pid}_{k}", "type": "R", "links": [block, lk], "point": xy})
+                turning = j.links[1:]  # one pin: the block turns on the first, the others on it
+                if turning:
+                    made.append({"id": f"{pid}_1", "type": "R", "links": [block, turning[0]], "point": xy})
+                for k, lk in enumerate(turning[1:], start=2):
+                    made.append({"id": f"{pid}_{k}", "type": "R", "links": [turning[0], lk], "point": xy})
         at_point[i] = made
         joints += made
         if j.color and (made or pid in points):
@@ -441,6 +446,12 @@ def _driver_joint(expr: PyslvsMechanism, at_point: dict[int, list[dict[str, Any]
         if not 0 <= k < n:
             raise MechsynInputError(f"input ({base}, {drive}): no point {k} (points are 0..{n - 1})",
                                     source=source, hint="give input pairs as BASE,DRIVE point indices")
+    if base == drive:  # Pyslvs' input of a slider: its travel along the slot
+        slide = [jd for jd in at_point[base] if jd["type"] == "P"]
+        if not slide:
+            raise MechsynInputError(f"input ({base}, {base}): point {base} is no slider",
+                                    source=source, hint="an input (i, i) drives the P or RP joint at point i")
+        return slide[0]["id"]
     common = [lk for lk in expr.joints[base].links if lk in expr.joints[drive].links]
     if not common:
         raise MechsynInputError(f"input ({base}, {drive}): no link joins points {base} and {drive}",
@@ -529,6 +540,7 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
     loads = {str(ld.get("link")) for ld in data.get("loads", [])}
     linked = {str(p["link"]) for p in data.get("points", {}).values()} | loads
     blocks = _blocks(names, joints, linked, scale)
+    _absorb_pins(blocks, joints, scale)
     in_block = {id(jd) for p, rs in blocks.values() for jd in [p, *rs]}
     order = {id(jd): k for k, jd in enumerate(joints)}
     # groups: (order key, PyslvsJoint, member ids)
@@ -595,12 +607,32 @@ def _blocks(names: list[str], joints: list[dict[str, Any]], linked: set[str],
     return blocks
 
 
+def _absorb_pins(blocks: dict, joints: list[dict[str, Any]], scale: float) -> None:
+    """Add to each block the R joints at its point that join the links turning on it to
+    others (the third, fourth... link of a Pyslvs RP point): one RP point again."""
+    on: dict[str, list[dict[str, Any]]] = {}
+    for jd in joints:
+        if jd["type"] == "R":
+            for x in dict.fromkeys(map(str, jd["links"])):
+                on.setdefault(x, []).append(jd)
+    used = {id(jd) for p, rs in blocks.values() for jd in [p, *rs]}
+    for bname, (p, rs) in blocks.items():
+        todo = [str(x) for r in rs for x in r["links"] if str(x) != bname]
+        while todo:
+            link = todo.pop()
+            for jd in on.get(link, []):
+                if id(jd) not in used and _close(jd["point"], p["point"], scale):
+                    used.add(id(jd))
+                    rs.append(jd)
+                    todo += [str(x) for x in jd["links"] if str(x) != link]
+
+
 def _block_groups(blocks: dict, order: dict[int, int], nm: Any, source: str) -> list[_Group]:
     """Each block as one RP point: its guide link first, then the links turning on it."""
     groups: list[_Group] = []
     for bname, (p, rs) in blocks.items():
         guide = next(str(x) for x in p["links"] if str(x) != bname)
-        others = [next(str(x) for x in r["links"] if str(x) != bname) for r in rs]
+        others = list(dict.fromkeys(str(x) for r in rs for x in r["links"] if str(x) != bname))
         if guide in others:
             raise MechsynInputError(f"block {bname} slides along and turns on {guide}", source=source)
         ax = p.get("axis") or [1.0, 0.0]
@@ -668,6 +700,9 @@ def _inputs(joints: list[dict[str, Any]], in_block: set[int], ground: str, out: 
                 points_of[lk].append(k)
     for jd in joints:
         if not jd.get("actuated"):
+            continue
+        if jd["type"] == "P" and jd["id"] in where:  # a slider's travel: Pyslvs' input (i, i)
+            inputs.append((where[jd["id"]], where[jd["id"]]))
             continue
         if jd["type"] != "R" or id(jd) in in_block:
             notes.append(f"driven joint {jd['id']} is not a pin Pyslvs can drive: left out of the inputs")
