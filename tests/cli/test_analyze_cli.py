@@ -171,3 +171,11 @@ def test_no_grashof_class_for_a_spatial_four_r_mechanism():
     sim = ms.simulate(planar, {"A": np.linspace(0, 90, 4)})
     assert "grashof" in derived_quantities(planar, sim)
     assert "grashof" not in derived_quantities(as_spatial(planar), sim)
+
+
+def test_every_printed_formula_names_its_reading(run_cli):
+    for target in ("fourbar", S / "gough_stewart_6sps.yaml"):
+        out = run_cli("analyze", target)[1]
+        titles = [ln.split("│")[1].strip() for ln in out.split("Contours")[0].splitlines()
+                  if ln.startswith("│") and ln.count("│") == 4 and ln.split("│")[1].strip()]
+        assert titles and all(t.endswith(("(planar)", "(spatial)", "(topology)")) for t in titles), titles

@@ -138,9 +138,10 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
 
 
 def formula_title(title: str, f: object) -> str:
-    """``title`` with the formula's planar/spatial reading, when it has one."""
+    """``title`` with the formula's reading (planar, spatial, topology, or a family's), when
+    it has one: every printed formula says what it counts."""
     reading = getattr(f, "reading", "")
-    return f"{title} ({reading})" if reading in ("planar", "spatial") and reading not in title else title
+    return f"{title} ({reading})" if reading and reading not in title else title
 
 
 def pair_list(row_pairs: Sequence[object]) -> str:
