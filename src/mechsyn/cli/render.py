@@ -492,8 +492,8 @@ def render(a: StructuralAnalysis, title_prefix: str = "", rank: Any = None, verd
     console.print(Panel(head, expand=False))
     own, spatial = formula_sections(a)
     _formula_table(a, own, f"Formulas ({READINGS['planar' if a.kind == 'planar' else 'spatial']})", rank)
-    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({a.mobility_source});  "
-                  f"drives: {a.degrees_of_mobility_expression}", highlight=False)
+    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({escape(a.mobility_source)})", highlight=False)
+    console.print(f"drives: {escape(a.degrees_of_mobility_expression)}", highlight=False)
     if spatial:
         console.print()
         console.print(f"[bold]{SPATIAL_OF_PLANAR[0]}[/]", highlight=False)
