@@ -1,11 +1,12 @@
 """MkDocs hook: the tutorials show what their commands print and draw, run at build time.
 
-Every ``mechsyn`` command in a ``bash`` block of ``tutorials/*.md`` runs in-process, in
+Every ``mechsyn`` command in a ``bash`` block of ``getting-started.md`` and
+``tutorials/*.md`` runs in-process, in
 order, in one temporary directory per page that sees the repository's ``examples/`` (so a
 command reads what an earlier one wrote), with the terminal 80 columns wide. Under each
 block the page then shows, for each command, what it printed (its first lines and how
 many more there are, when long) and the figures it wrote (PNG, GIF and SVG files, added to
-the site under ``tutorials/run/<page>/``). A command that fails fails the build: a
+the site under ``run/<page>/``). A command that fails fails the build: a
 tutorial cannot drift from what mechsyn does.
 """
 
@@ -56,7 +57,8 @@ def run_command(cmd: str, where: Path) -> tuple[str, list[Path]]:
         raise RuntimeError(f"tutorial command failed ({code}): {cmd}\n{err.getvalue()}")
     if redirect:
         (where / redirect).write_text(out.getvalue())
-        printed = err.getvalue()
+        lines = out.getvalue().count("\n")
+        printed = err.getvalue() + f"({lines} lines written to {redirect}; its first ones:)\n" + out.getvalue()
     else:
         printed = out.getvalue() + err.getvalue()
     after = [p for p in where.rglob("*") if p.is_file() and "examples" not in p.parts]
@@ -90,7 +92,7 @@ def on_files(files, config):
 
     matplotlib.use("Agg")
     docs = Path(config["docs_dir"])
-    for page in sorted((docs / "tutorials").glob("*.md")):
+    for page in [docs / "getting-started.md", *sorted((docs / "tutorials").glob("*.md"))]:
         where = Path(tempfile.mkdtemp(prefix=f"mechsyn-tutorial-{page.stem}-"))
         (where / "examples").symlink_to(ROOT / "examples")
         runs = []
@@ -100,19 +102,20 @@ def on_files(files, config):
                 printed, figures = run_command(cmd, where)
                 uris = []
                 for fig in figures:
-                    uri = f"tutorials/run/{page.stem}/{fig.relative_to(where).as_posix()}"
+                    uri = f"run/{page.stem}/{fig.relative_to(where).as_posix()}"
                     if files.get_file_from_path(uri) is not None:
                         files.remove(files.get_file_from_path(uri))
                     files.append(File.generated(config, uri, content=fig.read_bytes()))
                     uris.append(uri)
                 done.append((cmd, printed, uris))
             runs.append((m.group(0), done))
-        _RUNS[f"tutorials/{page.name}"] = runs
+        _RUNS[page.relative_to(docs).as_posix()] = runs
     return files
 
 
-def with_output(markdown: str, runs: list) -> str:
-    """``markdown`` with each block's commands followed by what they printed and drew."""
+def with_output(markdown: str, runs: list, prefix: int = 0) -> str:
+    """``markdown`` with each block's commands followed by what they printed and drew
+    (``prefix``: how many folders deep the page is, for the figures' relative links)."""
     for block, done in runs:
         if not done:
             continue
@@ -120,11 +123,11 @@ def with_output(markdown: str, runs: list) -> str:
         for cmd, printed, uris in done:
             parts.append(f"Output of `{cmd if len(cmd) <= 70 else cmd[:67] + '...'}`:")
             parts += ["", "```text", shown(printed) or "(nothing printed)", "```", ""]
-            parts += [f"![{Path(u).name}](run/{u.split('/', 2)[2]})" for u in uris] + [""]
+            parts += [f"![{Path(u).name}]({'../' * prefix}{u})" for u in uris] + [""]
         markdown = markdown.replace(block, "\n".join(parts), 1)
     return markdown
 
 
 def on_page_markdown(markdown, page, config, files):
     runs = _RUNS.get(page.file.src_uri)
-    return with_output(markdown, runs) if runs else markdown
+    return with_output(markdown, runs, page.file.src_uri.count("/")) if runs else markdown

@@ -64,3 +64,9 @@ def test_built_site_has_links_not_raw_roles(tmp_path):
     assert not [p for p, t in pages.items() if INTERNAL in t]
     links = sum(t.count('class="autorefs autorefs-internal"') for p, t in pages.items() if "/api/" in str(p))
     assert links > 300
+    # the tutorials and the first steps show what their commands print and draw, run at build
+    for page in ("getting-started", "tutorials/sixbar-path", "tutorials/gripper"):
+        text = (tmp_path / "site" / page / "index.html").read_text(encoding="utf-8")
+        assert text.count("Output of") >= 2, page
+    assert 'src="../run/getting-started/crank_rocker.svg"' in (tmp_path / "site" / "getting-started"
+                                                                / "index.html").read_text(encoding="utf-8")
