@@ -110,9 +110,6 @@ def _render(name: str, res: Any, time_limit: float, out: Optional[Path], plot: O
         console.print(f"note: {note}", highlight=False)
     if res.stopped_by_time_limit:
         console.print(f"note: stopped by the time limit ({time_limit:g} s)", highlight=False)
-    for path, what in ((out, "mechanism file"), (plot, "plot")):
-        if path is not None:
-            console.print(f"{what} written to {path}", highlight=False)
 
 
 def _render_targets(res: Any) -> None:
