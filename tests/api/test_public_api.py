@@ -88,7 +88,7 @@ def test_simulate_inputs_are_checked():
 def test_to_pandas_without_pandas(monkeypatch):
     s = ms.examples.load("crank_rocker").simulate(A=(0, 10, 5))
     monkeypatch.setitem(sys.modules, "pandas", None)
-    with pytest.raises(ImportError, match="pip install pandas"):
+    with pytest.raises(ImportError, match=r"pip install \"mechsyn\[pandas\]\""):
         s.to_pandas()
 
 

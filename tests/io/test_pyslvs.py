@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import re
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -171,7 +173,7 @@ def test_mechsyn_file_to_pyslvs_keeps_plain_sliders(run_cli):
 @pytest.mark.parametrize("text, message", [
     ("M[J[R, P[0, 0], L[ground, a]]", "not closed"),
     ("M[J[X, P[0, 0], L[ground, a]]]", "unknown joint type"),
-    ("M[J[RP, P[0, 0], L[ground, a]]]", "slot angle"),
+    ("M[J[RP, A[1], P[0, 0], A[2], L[ground, a]]]", "second slot angle"),
     ("M[J[R, P[0, zero], L[ground, a]]]", "expected a number"),
     ("M[J[R, P[0, 0], L[a, b]]]", "no joint on the frame"),
     ("J[R, P[0, 0]]", "no mechanism expression"),
@@ -202,7 +204,7 @@ def test_spatial_and_higher_pairs_are_refused():
 COLOURED = """M[
   J[R, color[Red], P[0.0, 0.0], L[ground, link_1]],
   J[R, color[dark-blue], P[10.0, 0.0], L[link_1, link_2]],
-  J[RP, color[(10, 200, 30)], P[40.0, 0.0], A[0.0], L[ground, link_2]],
+  J[RP, A[0.0], color[(10, 200, 30)], P[40.0, 0.0], L[ground, link_2]],
   J[R, color[Orange], P[20.0, 5.0], L[link_2]],
 ]"""
 
@@ -241,3 +243,214 @@ def test_colour_names_to_rgb():
     assert color_rgb("brick-red") == color_rgb("firebrick")
     assert color_rgb("(0, 0, 255)") == (0.0, 0.0, 1.0)
     assert color_rgb("(0, 0, 256)") is None and color_rgb("not a colour") is None
+
+
+# --------------------------------------------------------------------------- Pyslvs' own form (issue 26)
+def _pyslvs_num(v: float) -> str:
+    """A number as Pyslvs' VPoint.expr writes it: four decimals, trailing zeros dropped."""
+    return f"{v:.4f}".rstrip("0").rstrip(".")
+
+
+def _slider_crank(angle: float, kind: str, color: str, offset: float = 5.0) -> str:
+    """A slider-crank whose slot runs at ``angle`` degrees, written as Pyslvs writes it
+    (``J[type, A[deg], color[...], P[x, y], L[...]]``), with a coupler point. ``kind``
+    RP: the coupler's pin slides in the frame's slot; P: a block slides on the frame and
+    the coupler turns on it at a second point of the block."""
+    a = math.radians(angle)
+    u, n = np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
+    crank = np.array([10.0 * math.cos(a + 1.0), 10.0 * math.sin(a + 1.0)])
+    # the slider on the slot line s * u + offset * n, 40 from the crank pin
+    d = crank - offset * n
+    s = float(d @ u + math.sqrt(40.0 ** 2 - (d @ n) ** 2))
+    slider = s * u + offset * n
+    coupler_pt = (crank + slider) / 2 + 8.0 * n
+    def j(t, xy, links, c="Blue"):
+        head = f"{t}, A[{angle}]" if t != "R" else "R"
+        return f"J[{head}, color[{c}], P[{_pyslvs_num(xy[0])}, {_pyslvs_num(xy[1])}], L[{links}]]"
+    pts = [j("R", (0.0, 0.0), "ground, link_1", "Green"), j("R", crank, "link_1, link_2")]
+    if kind == "RP":
+        pts.append(j("RP", slider, "ground, link_2", color))
+    else:  # P: the block (link_3) slides on the frame; the coupler turns on it
+        pts += [j("P", slider, "ground, link_3", color), j("R", slider + 3.0 * n, "link_2, link_3")]
+    pts.append(j("R", coupler_pt, "link_2", "Red"))
+    return "M[" + ", ".join(pts) + "]"
+
+
+PYSLVS_FORM = [pytest.param(_slider_crank(a, k, c), id=f"{k}-{a:g}deg")
+               for a, k, c in [(0.0, "RP", "Green"), (30.0, "RP", "Orange"), (90.0, "RP", "dark-blue"),
+                               (-45.0, "RP", "(10, 200, 30)"), (135.0, "P", "Green"), (30.0, "P", "Red"),
+                               (0.0, "P", "Orange")]]
+
+
+@pytest.mark.parametrize("text", PYSLVS_FORM)
+def test_expressions_as_pyslvs_writes_them_round_trip(text, tmp_path, run_cli):
+    """Type, A[...], color[...], P[...], L[...] (Pyslvs' grammar): read, moved, written back
+    in the same order with the same joints, angles, colours and coupler point."""
+    expr = parse_expression(text)
+    assert all(j.angle is not None for j in expr.joints if j.type != "R") and not expr.notes
+    src = tmp_path / "m.pyslvs"
+    src.write_text(text)
+    _convert(run_cli, src, tmp_path / "m.yaml", "--input", "0,1")
+    mech = load_mechanism(tmp_path / "m.yaml")
+    assert analyze_structure(mech).mobility == 1
+    sim = simulate(mech, {"P0": np.arange(0.0, 360.0, 30.0)}, points=[f"P{len(expr.joints) - 1}"])
+    assert sim.assembled.all(), sim.events
+    _convert(run_cli, tmp_path / "m.yaml", tmp_path / "back.pyslvs")
+    written = (tmp_path / "back.pyslvs").read_text()
+    # the slot angle right after the type, as Pyslvs writes it
+    sliders = [line for line in written.splitlines() if line.strip().startswith(("J[P,", "J[RP,"))]
+    assert sliders and all(re.match(r"\s*J\[(RP|P), A\[[-0-9.e]+\], color\[", line) for line in sliders)
+    again = parse_expression(written)
+    assert [(j.type, j.links, j.color) for j in again.joints] == [(j.type, j.links, j.color) for j in expr.joints]
+    assert [j.angle for j in again.joints] == pytest.approx([j.angle for j in expr.joints], abs=1e-9)
+    np.testing.assert_allclose([(j.x, j.y) for j in again.joints], [(j.x, j.y) for j in expr.joints], atol=1e-9)
+
+
+def test_slot_angle_read_in_either_place():
+    pyslvs = "M[J[R, P[0, 0], L[ground, a]], J[RP, A[30], color[Green], P[5, 0], L[ground, a]]]"
+    older = "M[J[R, P[0, 0], L[ground, a]], J[RP, color[Green], P[5, 0], A[30], L[ground, a]]]"
+    assert parse_expression(pyslvs).joints == parse_expression(older).joints
+    assert parse_expression(pyslvs).joints[1].angle == 30.0
+
+
+def test_slider_without_angle_gets_pyslvs_default_and_says_so():
+    e = parse_expression("M[J[R, P[0, 0], L[ground, a]], J[RP, P[5, 0], L[ground, a]]]")
+    assert e.joints[1].angle == 0.0
+    data, notes = expression_to_data(e)
+    assert any("point 1" in n and "slot angle" in n for n in notes)
+
+
+def test_block_comments_and_trailing_commas_of_pyslvs():
+    e = parse_expression("#[ a block comment\nJ[R, P[9, 9], L[x]]\n#] end\n"
+                         "M[J[R, P[0, 0], L[ground, a,]], J[R, P[1, 0], L[a]],]")
+    assert [j.links for j in e.joints] == [("ground", "a"), ("a",)]
+
+
+def test_examples_are_written_in_pyslvs_order():
+    for path in PYSLVS:
+        for line in path.read_text().splitlines():
+            if line.strip().startswith(("J[P,", "J[RP,")):
+                assert re.match(r"\s*J\[(RP|P), A\[", line), f"{path.name}: {line}"
+
+
+def _ladder(k: int) -> str:
+    """k four-bars side by side (every third a slider-crank with a slot at 30 deg), each
+    with a coupler point, in Pyslvs' form: about 290 bytes and 3 links a loop."""
+    out = ["M["]
+    for i in range(k):
+        x, c, r, q = 100.0 * i, f"crank_{i}", f"coupler_{i}", f"rocker_{i}"
+        out += [f"  J[R, color[Green], P[{x}, 0.0], L[ground, {c}]],",
+                f"  J[R, color[Blue], P[{x + 10.0}, 20.0], L[{c}, {r}]],"]
+        if i % 3 == 2:
+            out.append(f"  J[RP, A[30.0], color[Orange], P[{x + 60.0}, 30.0], L[ground, {r}]],")
+        else:
+            out += [f"  J[R, color[Blue], P[{x + 60.0}, 40.0], L[{r}, {q}]],",
+                    f"  J[R, color[Green], P[{x + 70.0}, 0.0], L[ground, {q}]],"]
+        out.append(f"  J[R, color[Red], P[{x + 30.0}, 50.0], L[{r}]],")
+    return "\n".join(out + ["]"]) + "\n"
+
+
+def _steps(fn, *args) -> int:
+    """Python lines run by ``fn(*args)`` in mechsyn.io.pyslvs (a count, not a time)."""
+    import mechsyn.io.pyslvs as mod
+
+    count = 0
+
+    def tracer(frame, event, arg):
+        nonlocal count
+        if frame.f_code.co_filename != mod.__file__:
+            return None
+        count += event == "line"
+        return tracer
+
+    sys.settrace(tracer)
+    try:
+        fn(*args)
+    finally:
+        sys.settrace(None)
+    return count
+
+
+def test_conversion_is_linear_in_the_file():
+    """Four times the loops, about four times the work both ways (a scan of joints x joints,
+    as before issue 26, makes it sixteen)."""
+    def both(k):
+        data, _ = expression_to_data(parse_expression(_ladder(k)))
+        return lambda: data_to_expression(mechanism_to_dict(load_mechanism_dict(data)))
+
+    small, large = 30, 120
+    fwd = _steps(lambda k: expression_to_data(parse_expression(_ladder(k))), large) / \
+        _steps(lambda k: expression_to_data(parse_expression(_ladder(k))), small)
+    back = _steps(both(large)) / _steps(both(small))
+    assert fwd < 4.5 and back < 4.5, (fwd, back)  # measured 4.0 and 4.0; before: 5.5 and 14.7
+
+
+def load_mechanism_dict(data):
+    from mechsyn.io import mechanism_from_dict
+
+    return mechanism_from_dict(data)
+
+
+def test_large_generated_file_converts_and_keeps_its_mobility(tmp_path, run_cli):
+    """620 loops (1,860 links, 180 KB): converted both ways, mobility = its cranks."""
+    src = tmp_path / "big.pyslvs"
+    src.write_text(_ladder(620))
+    assert src.stat().st_size > 149_000
+    _convert(run_cli, src, tmp_path / "big.yaml")
+    mech = load_mechanism(tmp_path / "big.yaml")
+    assert analyze_structure(mech).mobility == len(mech.actuated_joints) == 620
+    _convert(run_cli, tmp_path / "big.yaml", tmp_path / "back.pyslvs")
+    assert parse_expression((tmp_path / "back.pyslvs").read_text()).joints == parse_expression(_ladder(620)).joints
+
+
+def test_link_limit_is_checked_before_the_conversion(monkeypatch):
+    import mechsyn.io.pyslvs as mod
+    from mechsyn.limits import set_limit
+
+    def never(*args, **kwargs):
+        raise AssertionError("the conversion ran before the limit was checked")
+
+    monkeypatch.setattr(mod, "_ground_cranks", never)
+    set_limit("links", 100)
+    try:
+        with pytest.raises(MechsynInputError, match="limit") as info:
+            expression_to_data(parse_expression(_ladder(40)), source="big.pyslvs")
+    finally:
+        set_limit("links", None)
+    assert "MECHSYN_LIMIT_LINKS" in str(info.value)
+
+
+def test_rp_point_of_three_links_is_one_pin_not_a_zero_length_block(tmp_path, run_cli):
+    """Pyslvs' RP point on L[ground, L2, L3]: L2 and L3 turn on one pin that slides in the
+    frame's slot. Made as a block with one pin (L3 turns on L2 there): it loads, moves,
+    and writes back as the same RP point."""
+    text = ("M[J[R, color[Green], P[0.0, 0.0], L[ground, L1]], J[R, color[Green], P[-2.0, 20.0], L[L1, L2]], "
+            "J[RP, A[0.0], color[Orange], P[40.0, 0.0], L[ground, L2, L3]], "
+            "J[R, color[Blue], P[70.0, 30.0], L[L3, L4]], J[R, color[Green], P[90.0, 0.0], L[ground, L4]]]")
+    src = tmp_path / "rp3.pyslvs"
+    src.write_text(text)
+    _convert(run_cli, src, tmp_path / "m.yaml", "--input", "0,1")
+    mech = load_mechanism(tmp_path / "m.yaml")
+    assert analyze_structure(mech).mobility == 1
+    assert mech.joint("P2_1").links == ("block2", "L2") and mech.joint("P2_2").links == ("L2", "L3")
+    sim = simulate(mech, {"P0": np.arange(90.0, 131.0, 10.0)}, points=["P2_1"])
+    assert sim.assembled.all() and np.allclose(sim.points["P2_1"].position[:, 1], 0.0, atol=1e-9)  # in the slot
+    _convert(run_cli, tmp_path / "m.yaml", tmp_path / "back.pyslvs")
+    back = parse_expression((tmp_path / "back.pyslvs").read_text())
+    assert [(j.type, j.links) for j in back.joints] == [(j.type, j.links) for j in parse_expression(text).joints]
+
+
+def test_slider_input_drives_its_travel_both_ways():
+    """Pyslvs' input (i, i) on a slider point drives the slider along its slot."""
+    e = parse_expression("M[J[RP, A[0.0], color[Green], P[0.0, 0.0], L[ground, L2]], "
+                         "J[R, color[Green], P[50.0, 0.0], L[ground, L1]], "
+                         "J[R, color[Green], P[25.0, 27.0], L[L1, L2]]]")
+    data, _ = expression_to_data(e, inputs=[(0, 0)])
+    assert [j["id"] for j in data["joints"] if j.get("actuated")] == ["P0"]
+    from mechsyn.io import mechanism_from_dict
+
+    mech = mechanism_from_dict(data)
+    assert mech.joint("P0").type == "P" and analyze_structure(mech).mobility == 1
+    assert data_to_expression(mechanism_to_dict(mech)).inputs == [(0, 0)]
+    with pytest.raises(MechsynInputError, match="no slider"):
+        expression_to_data(e, inputs=[(1, 1)])

@@ -13,7 +13,7 @@ References
 .. [1] Paper 001 (seed 001), the belt manipulator: the reference in :mod:`mechsyn.belt`.
 .. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
    Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
-   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   al., 2012) ("paper 001";
    see docs/references.md).
 """
 
@@ -142,10 +142,14 @@ class BeltReport(Result):
         return [_transfer_table(self.state), _path_table(self.state), _quality_table(self.paths),
                 _comparison_table(self.four_bar_comparison)]
 
+    #: rows of a long table a notebook shows (its head and tail; the size is said)
+    NOTEBOOK_ROWS: ClassVar[int] = 10
+
     def _repr_markdown_(self) -> str:
+        """The report in a notebook: long tables show their first and last rows and their size."""
         parts = [f"**{self.headline()}**", *(f"> warning: {w}" for w in self.warnings)]
-        parts += [t.markdown() for t in self.tables()] + [self.motion_line()]
-        return "\n\n".join(parts)
+        parts += [t.markdown(self.NOTEBOOK_ROWS, "in .to_dict()['rows'] and .tables()") for t in self.tables()]
+        return "\n\n".join(parts + [self.motion_line()])
 
 
 def _transfer_table(st: BeltState) -> Table:

@@ -8,7 +8,7 @@ References
 .. [1] Paper 001 (seed 001), the belt manipulator: the reference in :mod:`mechsyn.belt`.
 .. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
    Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
-   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   al., 2012) ("paper 001";
    see docs/references.md).
 """
 

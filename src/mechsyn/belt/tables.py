@@ -19,13 +19,40 @@ class Table(NamedTuple):
     #: the first column holds labels (left-aligned), not numbers
     labels: bool = False
 
-    def markdown(self) -> str:
-        """The table in Markdown (title in bold, caption in italics under it)."""
+    def markdown(self, max_rows: int | None = None, where: str = "") -> str:
+        """The table in Markdown (title in bold, caption in italics under it).
+
+        With ``max_rows``, a longer table shows its first and last rows, a row saying how
+        many are left out between them, and its size under the title (``where`` says where
+        the full table is).
+
+        Examples
+        --------
+        >>> t = Table("squares", ("n", "n²"), [(str(k), str(k * k)) for k in range(100)])
+        >>> print(t.markdown(max_rows=4, where="in to_dict()"))
+        **squares** (100 rows: the first 2 and the last 2 shown; all in to_dict())
+        <BLANKLINE>
+        | n | n² |
+        |---|---|
+        | 0 | 0 |
+        | 1 | 1 |
+        | … 96 rows … |  |
+        | 98 | 9604 |
+        | 99 | 9801 |
+        """
         head = "| " + " | ".join(c or " " for c in self.columns) + " |"
         rule = "|" + "|".join("---" for _ in self.columns) + "|"
-        body = ["| " + " | ".join(c.replace("|", "/") for c in r) + " |" for r in self.rows]
+        rows, title = list(self.rows), f"**{self.title}**"
+        if max_rows is not None and len(rows) > max_rows:
+            first = (max_rows + 1) // 2
+            last = max_rows - first
+            title += (f" ({len(rows)} rows: the first {first} and the last {last} shown"
+                      + (f"; all {where}" if where else "") + ")")
+            gap = (f"… {len(rows) - max_rows} rows …",) + ("",) * (len(self.columns) - 1)
+            rows = rows[:first] + [gap] + rows[len(rows) - last:]
+        body = ["| " + " | ".join(c.replace("|", "/") for c in r) + " |" for r in rows]
         tail = ["", f"*{self.caption}*"] if self.caption else []
-        return "\n".join([f"**{self.title}**", "", head, rule, *body, *tail])
+        return "\n".join([title, "", head, rule, *body, *tail])
 
 
 def fmt(v: Any, nd: int = 3) -> str:

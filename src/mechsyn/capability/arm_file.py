@@ -22,8 +22,7 @@ References
 ----------
 .. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
    method of studying the mobility of planar manipulator mechanisms" (in Russian),
-   Omsk State Technical University; journal and year are not in the project's copy
-   ("paper 004"; see docs/references.md).
+   Omsk State Technical University ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

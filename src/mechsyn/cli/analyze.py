@@ -3,8 +3,7 @@
 References
 ----------
 .. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
-   devices" (in Ukrainian, with an English abstract); authors, journal and year are
-   not in the project's copy ("paper 002"; see docs/references.md).
+   devices" (in Ukrainian, with an English abstract) ("paper 002"; see docs/references.md).
 .. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
    mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
    Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
@@ -19,9 +18,8 @@ from typing import Annotated, Optional
 import typer
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import emit_json, err_console, strip_control
+from mechsyn.cli.common import emit_json, err_console, strip_control, write_output
 from mechsyn.io import json_schema, load_mechanism
-from mechsyn.results import write_atomic
 from mechsyn.structure.report import analyze as structure_report
 
 
@@ -74,7 +72,7 @@ def analyze(
         if out is None:
             typer.echo(strip_control(report.to_markdown()), nl=False)  # a file's escapes never reach the terminal
         else:
-            write_atomic(out, report.to_markdown())
+            write_output(out, report.to_markdown())
     else:
         from mechsyn.cli.render import render_report
 
@@ -90,4 +88,4 @@ def schema(
     if out is None:
         typer.echo(text)
     else:
-        write_atomic(out, text + "\n")
+        write_output(out, text + "\n")

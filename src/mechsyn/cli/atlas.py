@@ -8,7 +8,7 @@ from typing import Any, Optional
 import typer
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import check_writable, console, emit_json, progress_bar
+from mechsyn.cli.common import check_writable, emit_json, progress_bar, say_written
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 
@@ -24,7 +24,7 @@ def _check_files(out: Path | None, stream: Path | None, mechanisms: Path | None)
     check_writable(mechanisms, "--mechanisms", directory=True)
 
 
-def _write_files(atlas: Any, out: Path | None, mechanisms: Path | None) -> None:
+def _write_files(atlas: Any, out: Path | None, mechanisms: Path | None, stream: Path | None = None) -> None:
     if out is not None and len(atlas.kinematic_chains) > MAX_DRAWN:
         raise MechsynInputError(
             f"{len(atlas.kinematic_chains)} chains are too many to draw on one sheet (limit {MAX_DRAWN})",
@@ -32,12 +32,16 @@ def _write_files(atlas: Any, out: Path | None, mechanisms: Path | None) -> None:
     if mechanisms is not None:
         import yaml
 
-        for name, doc in atlas.mechanism_files().items():
+        files = atlas.mechanism_files()
+        for name, doc in files.items():
             write_atomic(mechanisms / name, yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
+        say_written(mechanisms, f"{len(files)} mechanism files")
     if out is not None:
         from mechsyn.cli.common import save_plot
 
         save_plot(out, lambda fig: atlas.plot(fig=fig))
+    if stream is not None:
+        say_written(stream, "chain stream")
 
 
 @app.command("atlas")
@@ -73,16 +77,8 @@ def atlas(
     with progress_bar(f"{links}-link chains, F={mobility}", n_units(links, mobility)) as advance:
         result = chain_atlas(links, mobility, include_degenerate=include_degenerate, inputs=inputs,
                              stream=stream, force=force, workers=workers, scheduler=scheduler, progress=advance)
-    _write_files(result, out, mechanisms)
+    _write_files(result, out, mechanisms, stream)
     if json_out:
         emit_json(result.to_dict())
         return
     render_atlas(result, include_degenerate)
-    _say_written(result, out, mechanisms)
-
-
-def _say_written(atlas: Any, out: Path | None, mechanisms: Path | None) -> None:
-    if out is not None:
-        console.print(f"atlas drawn to {out}")
-    if mechanisms is not None:
-        console.print(f"{atlas.count} mechanism files written to {mechanisms}/")

@@ -9,7 +9,7 @@ References
 ----------
 .. [1] "A new basic mechanism of a manipulator for servicing technological machines" (in
    Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
-   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   al., 2012) ("paper 001";
    see docs/references.md).
 """
 

@@ -6,8 +6,7 @@ References
 ----------
 .. [1] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
    method of studying the mobility of planar manipulator mechanisms" (in Russian),
-   Omsk State Technical University; journal and year are not in the project's copy
-   ("paper 004"; see docs/references.md).
+   Omsk State Technical University ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations
@@ -168,9 +167,6 @@ def _grid(arm, grid: str, options: dict, map_png: Optional[Path], csv_out: Optio
         emit_json(cmap.to_dict())
         return stop_if_interrupted(cmap)
     render_capability_map(cmap)
-    for what, path in (("map", map_png), ("csv", csv_out)):
-        if path is not None:
-            console.print(f"wrote {what}: {path}")
     if cmap.interrupted:
         console.print(f"interrupted: {int(cmap.done().sum())} of {total} points solved (? in the table); the outputs hold those")
     stop_if_interrupted(cmap)

@@ -169,13 +169,19 @@ def is_stdout(path: Path | str | None) -> bool:
     return path is not None and str(path) == STDOUT
 
 
+def say_written(path: Path | str, what: str = "") -> None:
+    """``wrote PATH`` on stderr: every file a command writes is named (stdout stays the report's)."""
+    err_console.print(f"wrote {escape(str(path))}{f' ({what})' if what else ''}", highlight=False, soft_wrap=True)
+
+
 def write_output(out: Path | str, text: str) -> None:
-    """Write ``text`` whole to the file ``out``, or to stdout when ``out`` is ``-``."""
+    """Write ``text`` whole to the file ``out`` and say so on stderr, or to stdout when ``out`` is ``-``."""
     if is_stdout(out):
         sys.stdout.write(text)
         sys.stdout.flush()
     else:
         write_atomic(out, text)
+        say_written(out)
 
 
 def one_stdout(json_: bool, *outs: Path | str | None) -> None:
@@ -324,6 +330,7 @@ def save_plot(path: Path, draw: Any, *args: Any, dpi: int = 110, figsize: tuple[
         draw(*args, ax=fig.add_subplot(), **kwargs)
         fig.tight_layout()
     save_figure_atomic(fig, path, dpi=dpi)
+    say_written(path)
 
 
 def check_animation_target(path: Path, option: str = "--animate") -> Path:
@@ -358,6 +365,7 @@ def save_animation(path: Path, animate: Any, *args: Any, fps: int = 15, dpi: int
         raise exc.with_source(option) from None
     title = kwargs.get("title") or getattr(args[0], "mechanism", None) or "mechsyn animation"
     write_animation(animation_frames(anim, dpi), path, fps=fps, title=str(title))
+    say_written(path)
 
 
 def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float, float, float]:

@@ -53,5 +53,3 @@ def convert_cmd(
     write_output(out, result.text)
     for note in result.notes:
         err_console.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
-    if not is_stdout(out):
-        err_console.print(f"wrote {escape(str(out))}", highlight=False)

@@ -6,11 +6,10 @@ from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
-from rich.markup import escape
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import (check_output_suffix, console, emit_json, err_console, is_stdout, one_stdout,
-                                parse_range, write_output)
+from mechsyn.cli.common import (check_output_suffix, emit_json, is_stdout, one_stdout, parse_range, say_written,
+                                write_output)
 from mechsyn.errors import MechsynInputError
 
 
@@ -100,8 +99,7 @@ def export_cmd(
         emit_json(layout.to_dict())
         return
     render_plates(layout)
-    if dxf is not None:
-        console.print(f"wrote {escape(str(dxf))} (sheet {layout.sheet[0]:.4g} x {layout.sheet[1]:.4g})")
+
 
 
 def _check_outputs(dxf: Optional[Path], svg: Optional[Path], drawing: Optional[Path], json_: bool) -> None:
@@ -118,8 +116,6 @@ def _write_drawing(mech, drawing: Path, pose, path, sweep, dimensions: bool) -> 
     from mechsyn.export.drawing import drawing_of
 
     write_output(drawing, drawing_of(mech, _values(pose), path or [], _sweep(sweep), dimensions))
-    if not is_stdout(drawing):
-        err_console.print(f"wrote {escape(str(drawing))}", highlight=False)
 
 
 def _write_plates(layout, dxf: Optional[Path], svg: Optional[Path]) -> None:
@@ -127,6 +123,7 @@ def _write_plates(layout, dxf: Optional[Path], svg: Optional[Path]) -> None:
         from mechsyn.export.dxf import write_dxf
 
         write_dxf(layout, dxf)
+        say_written(dxf, f"sheet {layout.sheet[0]:.4g} x {layout.sheet[1]:.4g}")
     if svg is not None:
         from mechsyn.export.svg import plates_svg
 

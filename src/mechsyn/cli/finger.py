@@ -4,8 +4,7 @@ References
 ----------
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations
@@ -43,15 +42,13 @@ def finger(
         emit_json(synth)
         return
     _render(synth)
-    if out is not None:
-        console.print(f"{len(synth.results)} mechanism files and fingers.png written to {out}/")
 
 
 def _write_files(synth: Any, mech: Any, out: Path) -> Any:
     """One mechanism file per finger and their drawing in ``out``; the results with their files."""
     from dataclasses import replace
 
-    from mechsyn.cli.common import save_plot
+    from mechsyn.cli.common import save_plot, say_written
     from mechsyn.io import mechanism_to_dict, write_mechanism
     from mechsyn.plot.finger import plot_fingers
 
@@ -60,6 +57,7 @@ def _write_files(synth: Any, mech: Any, out: Path) -> Any:
         path = out / f"finger_{r.number:03d}_nf{r.n_f}.yaml"
         write_mechanism(r.mechanism, path)
         new.append(replace(r, file=str(path)))
+    say_written(out, f"{len(new)} mechanism files")
     save_plot(out / "fingers.png", plot_fingers, new[:39], mechanism_to_dict(mech),
               f"{mech.name}: W0 = {synth.W0}, A = {synth.actuators}")
     return replace(synth, results=new)

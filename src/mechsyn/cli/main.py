@@ -107,6 +107,8 @@ def main(argv: list[str] | None = None) -> int:
         err_console.print(f"[bold red]error:[/] {escape(option_error(error).format())}", highlight=False,
                           soft_wrap=True)
         return _exit(2, argv)
+    except ModuleNotFoundError as exc:  # an optional feature's package: one line naming its extra
+        return _exit(_missing_extra(exc), argv)
     except SystemExit as exc:  # typer.Exit inside commands
         return _exit(int(exc.code or 0), argv)
     except OSError as exc:  # a file the checks before the work could not foresee (disk full...)
@@ -127,6 +129,22 @@ def main(argv: list[str] | None = None) -> int:
             err_console.print("interrupted", highlight=False)
         return _exit(status, argv)
     return _exit(0, argv)
+
+
+def _missing_extra(exc: ModuleNotFoundError) -> int:
+    """Show a missing optional package as one line naming its extra (status 2); re-raise a
+    missing module that no extra installs (a broken install: the traceback helps)."""
+    from mechsyn._extras import extra_for, missing
+
+    if extra_for(exc.name or "") is None:
+        raise exc
+    from rich.markup import escape
+
+    from mechsyn.cli.common import err_console
+
+    err_console.print(f"[bold red]error:[/] {escape(missing(exc.name or '', 'this command').format())}",
+                      highlight=False, soft_wrap=True)
+    return 2
 
 
 def _click_error(exc: Exception) -> int:

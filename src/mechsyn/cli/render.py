@@ -7,8 +7,10 @@ References
 ----------
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
+.. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
+   mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
+   Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
 """
 
 from __future__ import annotations
@@ -72,26 +74,45 @@ def _fitting_cells(values: list, first: list[str], heads: tuple, width: int) -> 
     for digits in (6, 5, 4, 3):
         cells = [[f0, *(blank if row is None else (fmt_number(v, f".{digits}g") for v in row))]
                  for f0, row in zip(first, values)]
-        need = 1 + sum(max([len(h)] + [len(r[i]) for r in cells]) + 3 for i, h in enumerate(heads))
-        if need <= width:
+        if _table_width(cells, heads) <= width:
             break
     return cells
 
 
-def _link_table(sim: Any, rows: list[int], head: str) -> None:
+def _table_width(cells: list[list[str]], heads: tuple) -> int:
+    """Columns a rich table of ``cells`` under ``heads`` takes (3 per column and 1 more)."""
+    return 1 + sum(max([len(h)] + [len(r[i]) for r in cells]) + 3 for i, h in enumerate(heads))
+
+
+def _link_table(sim: Any, rows: list[int], head: str, most: int = 4) -> None:
+    """The links' angle θ, angular velocity ω and acceleration α, each in a column of its own,
+    as many links to a table as fit the console's width (up to ``most`` links shown)."""
     x = sim.inputs[sim.main_input]
-    t = Table(title="links: angle (deg), angular velocity (rad/s), angular acceleration (rad/s²)")
-    t.add_column(head, justify="right")
-    names = list(sim.links)[:4]
-    for name in names:
-        t.add_column(f"{name} θ, ω, α", justify="right")
-    for k in rows:
-        t.add_row(f"{x[k]:g}", *(("—" if not sim.assembled[k] else
-                                  f"{sim.links[n].angle[k]:.4f}, {fmt_number(sim.links[n].angular_velocity[k])}, "
-                                  f"{fmt_number(sim.links[n].angular_acceleration[k])}") for n in names))
-    console.print(t)
-    if len(sim.links) > 4:
-        console.print(f"({len(sim.links) - 4} more links in --json / --csv)", highlight=False)
+    names = list(sim.links)[:most]
+    first = [f"{x[k]:g}" for k in rows]
+
+    def cells(group: list[str]) -> tuple[list[list[str]], tuple]:
+        heads = (head, *(f"{n} {q}" for n in group for q in ("θ", "ω", "α")))
+        values = [None if not sim.assembled[k] else
+                  [v for n in group for v in (sim.links[n].angle[k], sim.links[n].angular_velocity[k],
+                                              sim.links[n].angular_acceleration[k])] for k in rows]
+        return _fitting_cells(values, first, heads, console.width), heads
+
+    title = "links: angle θ (deg), angular velocity ω (rad/s), acceleration α (rad/s²)"
+    while names:
+        size = len(names)
+        while size > 1 and _table_width(*cells(names[:size])) > console.width:
+            size -= 1
+        body, heads = cells(names[:size])
+        t = Table(title=title)
+        for col in heads:
+            t.add_column(col, justify="right", no_wrap=True, overflow="ellipsis")
+        for row in body:
+            t.add_row(*row)
+        console.print(t)
+        names, title = names[size:], None
+    if len(sim.links) > most:
+        console.print(f"({len(sim.links) - most} more links in --json / --csv)", highlight=False)
 
 
 def _derived_lines(d: dict[str, Any]) -> None:
@@ -422,38 +443,75 @@ def _fmt(x: float | None) -> str:
     return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
-def render(a: StructuralAnalysis, title_prefix: str = "") -> None:
-    """``mechsyn analyze``: the formulas, contours, redundancy and mobility of one analysis."""
-    from mechsyn.structure.report import CONTOUR_READING, formula_title
-    pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
-    console.print(Panel.fit(
-        f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
-        f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours",
-    ))
-    values = {key: _fmt(f.value) for key, f in a.formulas.items()}
-    t = Table(title="Formulas", show_lines=False)
+def _formula_table(a: StructuralAnalysis, keys: list[str], title: str, rank: Any = None) -> None:
+    from mechsyn.structure.report import explain_negative, formula_title
+
+    values = {key: _fmt(a.formulas[key].value) for key in keys}
+    t = Table(title=title, show_lines=False)
     t.add_column("formula", no_wrap=True)
     t.add_column("expression", overflow="fold")  # the long expressions wrap, numbers never do
     t.add_column("value", justify="right", no_wrap=True, min_width=max(map(len, ["value", *values.values()])))
-    for key, f in a.formulas.items():
-        t.add_row(formula_title(SHORT_TITLES.get(key, key), f), f.expression, values[key])
+    for key in keys:
+        t.add_row(formula_title(SHORT_TITLES.get(key, key), a.formulas[key]), a.formulas[key].expression, values[key])
     console.print(t)
+    for key in keys:
+        why = explain_negative(key, a, rank)
+        if why:
+            note(f"{SHORT_TITLES.get(key, key)}: {why}")
+
+
+def note(text: str, label: str = "note:") -> None:
+    """A note wrapped at word boundaries to the console's width (80 columns in a pipe), its
+    continuation lines indented under the text; a word longer than a line is cut."""
+    lead = f"{label} " if label else ""
+    lines = wrap_lines(text, lead, " " * len(lead))
+    body = escape("\n".join(lines))
+    if label:
+        body = f"[dim]{escape(label)}[/]" + body[len(escape(label)):]
+    console.print(body, highlight=False, soft_wrap=True)
+
+
+def wrap_lines(text: str, first: str = "", rest: str = "") -> list[str]:
+    """``text`` in lines of the console's width, broken at spaces only (not at hyphens)."""
+    import textwrap
+
+    return textwrap.wrap(text, width=max(console.width, 20), initial_indent=first, subsequent_indent=rest,
+                         break_on_hyphens=False)
+
+
+def render(a: StructuralAnalysis, title_prefix: str = "", rank: Any = None, verdict_text: str | None = None) -> None:
+    """``mechsyn analyze``: the verdict, the formulas of the file's own kind, then (planar
+    files) their spatial reading with paper 003's contours, redundancy and drives."""
+    from mechsyn.structure.report import CONTOUR_READING, READINGS, SPATIAL_OF_PLANAR, formula_sections
+
+    pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
+    head = (f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
+            f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours")
+    if verdict_text:
+        head += f"\n[bold]verdict:[/] {escape(verdict_text)}"
+    console.print(Panel(head, expand=False))
+    own, spatial = formula_sections(a)
+    _formula_table(a, own, f"Formulas ({READINGS['planar' if a.kind == 'planar' else 'spatial']})", rank)
+    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({escape(a.mobility_source)})", highlight=False)
+    console.print(f"drives: {escape(a.degrees_of_mobility_expression)}", highlight=False)
+    if spatial:
+        console.print()
+        console.print(f"[bold]{SPATIAL_OF_PLANAR[0]}[/]", highlight=False)
+        note(SPATIAL_OF_PLANAR[1], "")
+        _formula_table(a, spatial, "Formulas (spatial reading)", rank)
     if a.contours:
         _render_contours(a)
     console.print(
         f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
         f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
-        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False,
-        soft_wrap=True)
-    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({a.mobility_source});  "
-                  f"drives: {a.degrees_of_mobility_expression}", highlight=False, soft_wrap=True)
+        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False)
     if a.external is not None:
         e = a.external
         console.print(f"external (paper 002): S_a = {e.S_a}, W_f = {e.W_f}, W_rob = {e.W_rob}, "
                       f"W_a = {e.W_a}, S_ai = {e.S_ai}", highlight=False)
         console.print(f"  {e.external_redundant.expression}\n  {e.system_redundant.expression}", highlight=False)
     for n in a.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False, soft_wrap=True)
+        note(n)
     for name, sub in a.states.items():
         console.print()
         render(sub, title_prefix=f"state '{safe(name)}': ")
@@ -471,7 +529,8 @@ def _render_contours(a: StructuralAnalysis) -> None:
     if a.contours_chosen_by_program:
         console.print("  * contour chosen by the program")
     for r in a.contours:
-        console.print(f"  {r.S_expression};  {r.T_expression}", highlight=False, soft_wrap=True)
+        console.print(escape("\n".join(wrap_lines(f"{r.S_expression};  {r.T_expression}", "  ", "    "))),
+                      highlight=False, soft_wrap=True)
 
 
 def render_remedies(remedies: list[Remedy]) -> None:
@@ -513,7 +572,7 @@ def render_rank(ra: RankAnalysis, comparisons: list[Comparison] | None, title: s
         words = max(len(w) for c in comparisons for w in c.quantity.split())
         t.add_column("quantity", width=words)  # words whole; text columns share the rest, numbers never wrap
         t.add_column("formula", ratio=2)
-        t.add_column("formula", no_wrap=True)
+        t.add_column("value", no_wrap=True)
         t.add_column("rank", justify="right", no_wrap=True)
         t.add_column("why they differ", ratio=3)
         for c in comparisons:
@@ -522,7 +581,7 @@ def render_rank(ra: RankAnalysis, comparisons: list[Comparison] | None, title: s
             t.add_row(c.quantity, c.formula, fv, f"{mark}{c.rank_value}", c.why)
         console.print(t)
     for n in ra.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False)
+        note(n)
 
 
 def render_remedy_checks(checks: list[tuple[int, Remedy, RemedyCheck]]) -> None:
@@ -544,9 +603,12 @@ def render_report(report: StructureReport) -> None:
     """The terminal tables of a structural report."""
     ra, method = report.rank, report.method
     if method != "rank":
-        render(report.analysis)
+        render(report.analysis, rank=ra, verdict_text=report.verdict["text"])
+    else:
+        console.print(Panel(f"[bold]{safe(report.analysis.name)}[/]\n[bold]verdict:[/] "
+                            f"{escape(report.verdict['text'])}", expand=False))
     for n in report.notes:
-        console.print(f"[dim]note:[/] {n}", highlight=False)
+        note(n)
     if ra is not None:
         console.print()
         render_rank(ra, report.comparisons if method == "both" else None)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import secrets
 import webbrowser
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
@@ -25,17 +25,8 @@ def serve(
     """Start mechsyn studio: draw, drag, analyse, animate and synthesise mechanisms in the browser."""
     from mechsyn.web import create_app, run_server
     from mechsyn.web._app import LOCAL_HOSTS
-    from mechsyn.web._service import example_path, read_mechanism
 
-    start, name = None, ""
-    if target:
-        path = Path(target)
-        if not path.exists() and path.suffix == "":
-            path = example_path(target)
-        elif not path.is_file():
-            raise MechsynInputError(f"{target}: no such file or example", source="FILE",
-                                    hint="give a mechanism file or an example name such as fourbar")
-        start, name = read_mechanism(path), path.name
+    start, name = _start(target) if target else (None, "")
     if host not in LOCAL_HOSTS:
         err_console.print(f"[bold yellow]warning:[/] serving on {host}: anyone who can reach this address and "
                           "has the URL's token can use the studio and write files in this directory")
@@ -49,6 +40,35 @@ def serve(
     if not no_browser:
         webbrowser.open(url)
     run_server(app_, host=host, port=port)
+
+
+def _start(target: str) -> tuple[Any, str]:
+    """The mechanism a file or an example name opens with, and its name ("did you mean"
+    for a mistyped example)."""
+    from mechsyn.web._service import example_path, read_mechanism
+
+    path = Path(target)
+    if not path.exists() and path.suffix == "":
+        try:
+            path = example_path(target)
+        except MechsynInputError:
+            from mechsyn.examples import did_you_mean
+
+            close = did_you_mean(target, _studio_examples())
+            if not close:
+                raise
+            raise MechsynInputError(f"{target}: no such file or example", source="FILE",
+                                    hint=f"did you mean {' or '.join(map(repr, close))}?") from None
+    elif not path.is_file():
+        raise MechsynInputError(f"{target}: no such file or example", source="FILE",
+                                hint="give a mechanism file or an example name such as fourbar")
+    return read_mechanism(path), path.name
+
+
+def _studio_examples() -> list[str]:
+    from mechsyn.web._service import examples
+
+    return [e["name"] for e in examples()]
 
 
 def _free_port(host: str) -> int:

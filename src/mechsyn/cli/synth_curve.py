@@ -81,7 +81,7 @@ def _curve_progress() -> Iterator[Any]:
 
 
 def _write_out(out: Path, res) -> None:
-    from mechsyn.cli.common import save_plot
+    from mechsyn.cli.common import save_plot, say_written
     from mechsyn.synthesis.export import write_mechanism_file
     from mechsyn.synthesis.reports import curve_candidate_files
 
@@ -89,6 +89,7 @@ def _write_out(out: Path, res) -> None:
     for i, (c, (name, mech, header)) in enumerate(zip(res.candidates, curve_candidate_files(res)), 1):
         d = c.to_dict()
         write_mechanism_file(mech, out / name, header=header)
+        say_written(out / name)
         save_plot(out / f"candidate_{i}.png", _draw_candidate, c, res.target,
                   f"candidate {i}: {d['topology'] or c.topology.key}", figsize=(6, 5))
 

@@ -4,8 +4,7 @@ References
 ----------
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 """
 
 from __future__ import annotations
@@ -71,6 +70,9 @@ def _write(case: Any, res: Any, out: Optional[Path], plot: Optional[Path]) -> No
         mech["name"] = (f"{mech.get('name', 'finger')} (finger-design, seed {res.seed}"
                         + (", interrupted: best so far)" if res.interrupted else ")"))
         write_mechanism(mech, out)
+        from mechsyn.cli.common import say_written
+
+        say_written(out)
     if plot is not None:
         from mechsyn.cli.common import save_plot
         from mechsyn.plot.finger import plot_finger_design
@@ -108,9 +110,6 @@ def _render(name: str, res: Any, time_limit: float, out: Optional[Path], plot: O
         console.print(f"note: {note}", highlight=False)
     if res.stopped_by_time_limit:
         console.print(f"note: stopped by the time limit ({time_limit:g} s)", highlight=False)
-    for path, what in ((out, "mechanism file"), (plot, "plot")):
-        if path is not None:
-            console.print(f"{what} written to {path}", highlight=False)
 
 
 def _render_targets(res: Any) -> None:

@@ -22,6 +22,9 @@ def _write_files(case_file: Path, case, res, out: Optional[Path], plot: Optional
         from mechsyn.io import write_mechanism
 
         write_mechanism(res.mechanism, out)
+        from mechsyn.cli.common import say_written
+
+        say_written(out)
     if plot is not None:
         from mechsyn.cli.common import save_plot
         from mechsyn.plot.synthesis import plot_mechanism_synthesis

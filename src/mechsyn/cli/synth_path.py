@@ -11,7 +11,7 @@ import typer
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import (ForceOpt, OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, Table, TimeLimitOpt, WorkersOpt,
                                 check_output_suffix, check_overwrite, check_writable, console, emit_json, parse_floats,
-                                restart_progress, save_plot)
+                                restart_progress, save_plot, say_written)
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
@@ -86,6 +86,7 @@ def _write_path_files(case, res, out: Optional[Path], plot: Optional[Path]) -> N
         except MechsynInputError as exc:
             raise exc.with_source("--out") from None
         write_mechanism_file(mech, out, header=header)
+        say_written(out)
     if plot is not None:
         from mechsyn.plot.synthesis import plot_fourbar_path
 

@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["Example", "list", "load", "names", "path", "resolve", "root"]
+__all__ = ["Example", "list", "load", "names", "path", "resolve", "root", "did_you_mean", "missing_hint"]
 
 _SUFFIXES = (".yaml", ".yml", ".json", ".urdf")
 
@@ -98,7 +98,8 @@ def _catalogue() -> Catalogue:
     from mechsyn.io.load import safe_load_yaml
 
     base = root()
-    files = sorted(p for p in base.rglob("*") if p.suffix in _SUFFIXES and p.is_file())
+    files = sorted((p for p in base.rglob("*") if p.suffix in _SUFFIXES and p.is_file()),
+                   key=lambda p: (p.parent.as_posix(), p.stem, p.suffix == ".urdf", p.suffix))
     out = Catalogue()
     for p in files:
         try:
@@ -120,7 +121,42 @@ def list() -> Catalogue:  # noqa: A001 -- ms.examples.list() reads as the field'
     >>> sorted({e.kind for e in table})[:3]
     ['arm', 'belt case', 'finger-design case']
     """
-    return Catalogue(_catalogue())
+    seen: set[tuple[str, str]] = set()
+    out = Catalogue()
+    for e in _catalogue():  # one example in two files (paper004_3r.yaml and .urdf): listed once, as path() finds it
+        if (e.folder, e.name) not in seen:
+            seen.add((e.folder, e.name))
+            out.append(e)
+    return out
+
+
+def did_you_mean(name: str, choices: builtins.list[str] | None = None) -> builtins.list[str]:
+    """The example names (or ``choices``) closest to a mistyped ``name``, best first.
+
+    Examples
+    --------
+    >>> did_you_mean("fourbarr")
+    ['fourbar']
+    """
+    import difflib
+
+    return difflib.get_close_matches(str(name), choices if choices is not None else names(), n=3, cutoff=0.75)
+
+
+def missing_hint(file: str | Path) -> str:
+    """The fix of a "no such file" message: the example names close to ``file``, if any.
+
+    Examples
+    --------
+    >>> missing_hint("fourbarr")
+    "did you mean the example 'fourbar'? (mechsyn.examples.names() lists them all)"
+    """
+    p = Path(file)
+    close = did_you_mean(p.stem) if len(p.parts) == 1 and p.suffix in ("", *_SUFFIXES) else []
+    if close:
+        return ("did you mean the example " + " or ".join(repr(c) for c in close)
+                + "? (mechsyn.examples.names() lists them all)")
+    return "check the path (mechsyn.examples.names() lists the bundled examples)"
 
 
 def names() -> builtins.list[str]:
@@ -152,8 +188,10 @@ def path(name: str) -> Path:
     same = [e for e in _catalogue() if e.name == name]
     if same:
         return min(same, key=lambda e: e.path.suffix == ".urdf").path
+    close = did_you_mean(name)
     raise MechsynInputError(f"no example {name!r}", field="name",
-                            hint="see mechsyn.examples.names(): e.g. " + ", ".join(names()[:4]))
+                            hint=(f"did you mean {' or '.join(map(repr, close))}? " if close else "")
+                            + "see mechsyn.examples.names(): e.g. " + ", ".join(names()[:4]))
 
 
 def resolve(file: str | Path) -> Path:

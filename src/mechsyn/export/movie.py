@@ -18,7 +18,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import atomic_output, write_atomic
 
-__all__ = ["ANIMATION_SUFFIXES", "write_animation", "write_gif", "write_mp4", "write_html"]
+__all__ = ["ANIMATION_SUFFIXES", "write_animation", "write_gif", "write_mp4", "write_html", "palette_images"]
 
 ANIMATION_SUFFIXES = (".gif", ".mp4", ".html")
 
@@ -31,9 +31,9 @@ def _pil():
     return Image
 
 
-def write_gif(frames: Iterable[np.ndarray], path: str | os.PathLike[str], fps: float = 15) -> None:
-    """A looping GIF; one 255-colour palette for all frames (taken from the first, middle
-    and last frames), no dithering: flat colours stay flat and encoding is fast."""
+def palette_images(frames: Iterable[np.ndarray]) -> list:
+    """Pillow images of ``frames`` on one 255-colour palette (taken from the first, middle and
+    last frames), no dithering: flat colours stay flat and encoding is fast."""
     Image = _pil()
     images = [Image.fromarray(f) for f in frames]
     if not images:
@@ -43,7 +43,12 @@ def write_gif(frames: Iterable[np.ndarray], path: str | os.PathLike[str], fps: f
     for i, im in enumerate(sample):
         montage.paste(im, (0, i * im.height))
     palette = montage.quantize(colors=255, method=Image.Quantize.MEDIANCUT)
-    q = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    return [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+
+
+def write_gif(frames: Iterable[np.ndarray], path: str | os.PathLike[str], fps: float = 15) -> None:
+    """A looping GIF of :func:`palette_images` (one palette for all frames)."""
+    q = palette_images(frames)
     with atomic_output(path) as tmp:
         q[0].save(tmp, format="GIF", save_all=True, append_images=q[1:], duration=round(1000 / fps), loop=0)
 

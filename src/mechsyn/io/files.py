@@ -52,8 +52,9 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path)[:200],
                                 hint="check the path (each name at most 255 bytes)") from None
     if not exists:
-        raise MechsynInputError(f"no such {what}", source=str(p),
-                                hint="check the path (mechsyn.examples.names() lists the bundled examples)")
+        from mechsyn.examples import missing_hint
+
+        raise MechsynInputError(f"no such {what}", source=str(p), hint=missing_hint(p))
     if p.is_dir():
         raise MechsynInputError(f"is a directory, not a {what}", source=str(p))
     try:

@@ -5,12 +5,15 @@ Pyslvs-UI users keep and share planar linkages as *mechanism expressions*::
     M[
       J[R, color[Green], P[0.0, 0.0], L[ground, link_1]],
       J[R, color[Blue], P[10.0, 0.0], L[link_1, link_2]],
-      J[RP, color[Orange], P[40.0, 0.0], A[0.0], L[ground, link_2]],
+      J[RP, A[30.0], color[Orange], P[40.0, 0.0], L[ground, link_2]],
     ]
 
-Each ``J[...]`` is a point (Pyslvs numbers them 0, 1, 2, ... in order) with a type,
-an optional colour, its position ``P[x, y]``, for sliders the slot angle ``A[deg]``
-(from the x axis) and the links ``L[...]`` it joins (``ground`` is the frame):
+Each ``J[...]`` is a point (Pyslvs numbers them 0, 1, 2, ... in order) with a type, for
+sliders the slot angle ``A[deg]`` (from the x axis), an optional colour, its position
+``P[x, y]`` and the links ``L[...]`` it joins (``ground`` is the frame), in that order,
+Pyslvs' grammar ``J[type (, A[deg])? (, color[...])?, P[x, y], L[links]]`` [1]_. The slot
+angle is also read after ``P[...]`` (mechsyn wrote it there before); it is written where
+Pyslvs writes it. A slider without ``A[...]`` gets Pyslvs' default 0, with a note.
 
 * ``R``: a pin shared by every listed link (one link: a point fixed on that link; no
   link: a free point);
@@ -30,7 +33,9 @@ Mapping to mechsyn's model (every pair joins two links):
   from the frame (or the first link) to each of the others;
 * an R point on one link becomes a named point ``P<i>`` of that link;
 * an RP point becomes a block link ``block<i>`` with a P joint ``P<i>`` along the first
-  link and R joints ``P<i>_1``, ``P<i>_2``, ... to the others;
+  link and an R joint ``P<i>_1`` to the second; a third, fourth... link turns on the same
+  pin, joined to the second by R joints ``P<i>_2``, ``P<i>_3``, ... (a block with two pins
+  at one point would be a link of zero length);
 * a P point with two links becomes a P joint ``P<i>``.
 
 Writing back recognises those blocks (a link ``block<i>`` with one P joint and R
@@ -110,6 +115,8 @@ class _Parser:
             self.tokens.append((tok, m.start("sym") if m.group("sym") else m.start("word")))
             pos = m.end()
         self.i = 0
+        self.notes: list[str] = []
+        self.count = 0  # joints read so far
 
     def error(self, message: str, hint: str | None = None) -> MechsynInputError:
         pos = self.tokens[self.i][1] if self.i < len(self.tokens) else len(self.text)
@@ -162,6 +169,10 @@ class _Parser:
         return joints
 
     def joint(self) -> PyslvsJoint:
+        """``J[type, A[deg], color[...], P[x, y], L[...]]`` as Pyslvs writes it (``A`` and
+        ``color`` optional); ``A[deg]`` after ``P[...]`` (mechsyn's order before issue 26)
+        is read too."""
+        index, self.count = self.count, self.count + 1
         self.take("J")
         self.take("[")
         jtype = self.take()
@@ -169,6 +180,7 @@ class _Parser:
             self.i -= 1
             raise self.error(f"unknown joint type {jtype!r}", hint="use R, P or RP")
         self.take(",")
+        angle = self.angle() if self.peek() == "A" else None
         color = None
         if self.peek() == "color":
             color = self.color()
@@ -180,15 +192,14 @@ class _Parser:
         y = self.number()
         self.take("]")
         self.take(",")
-        angle = None
         if self.peek() == "A":
-            self.take("A")
-            self.take("[")
-            angle = self.number()
-            self.take("]")
-            self.take(",")
-        elif jtype != "R":
-            raise self.error(f"a {jtype} joint needs its slot angle A[degrees] before L[...]")
+            if angle is not None:
+                raise self.error("a second slot angle A[...] in one joint")
+            angle = self.angle()
+        if angle is None and jtype != "R":
+            angle = 0.0
+            self.notes.append(f"point {index}: a {jtype} joint without its slot angle A[degrees]: 0 "
+                              "(along x, Pyslvs' default)")
         self.take("L")
         self.take("[")
         links: list[str] = []
@@ -205,7 +216,16 @@ class _Parser:
                 self.take(",")
         self.take("]")
         self.take("]")
-        return PyslvsJoint(jtype, x, y, tuple(links), angle, color)
+        return PyslvsJoint(jtype, x, y, tuple(links), angle if jtype != "R" else None, color)
+
+    def angle(self) -> float:
+        """``A[deg], `` (the comma after it included)."""
+        self.take("A")
+        self.take("[")
+        value = self.number()
+        self.take("]")
+        self.take(",")
+        return value
 
     def color(self) -> str:
         self.take("color")
@@ -224,8 +244,10 @@ _PAIR = re.compile(r"\(\s*(-?\d+)\s*,\s*(-?\d+)\s*\)")
 
 
 def _strip_comments(text: str) -> str:
-    """The text with ``#`` comments blanked out (offsets and lines kept)."""
-    return re.sub(r"#[^\n]*", lambda m: " " * len(m.group()), text)
+    """The text with ``#[ ... #]`` block comments and ``#`` line comments blanked out
+    (offsets and lines kept)."""
+    blank = lambda m: re.sub(r"[^\n]", " ", m.group())  # noqa: E731
+    return re.sub(r"#[^\n]*", blank, re.sub(r"#\[[\s\S]*?#\][^\n]*", blank, text))
 
 
 def parse_expression(text: str, source: str = "<expression>") -> PyslvsMechanism:
@@ -255,8 +277,9 @@ def parse_expression(text: str, source: str = "<expression>") -> PyslvsMechanism
         raise MechsynInputError("the M[ ... ] brackets are not closed", source=source, line=line,
                                 hint="close every J[...] and the final ]")
     body = re.sub(r"[^\n]", " ", clean[:start.start()]) + clean[start.start():end + 1]
-    joints = _Parser(body, source).mechanism()
-    return PyslvsMechanism(joints, inputs)
+    parser = _Parser(body, source)
+    joints = parser.mechanism()
+    return PyslvsMechanism(joints, inputs, parser.notes)
 
 
 def _matching_bracket(text: str, open_at: int) -> int | None:
@@ -292,8 +315,8 @@ def format_expression(joints: list[PyslvsJoint], inputs: list[tuple[int, int]] |
     lines.append("M[")
     for j in joints:
         color = j.color or ("Green" if FRAME in j.links else ("Orange" if j.type != "R" else "Blue"))
-        angle = f"A[{_num(j.angle)}], " if j.angle is not None else ""
-        lines.append(f"  J[{j.type}, color[{color}], P[{_num(j.x)}, {_num(j.y)}], {angle}"
+        angle = f"A[{_num(j.angle or 0.0)}], " if j.type != "R" else ""
+        lines.append(f"  J[{j.type}, {angle}color[{color}], P[{_num(j.x)}, {_num(j.y)}], "
                      f"L[{', '.join(j.links)}]],")
     lines.append("]")
     return "\n".join(lines)
@@ -326,15 +349,8 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
     >>> [(j["id"], j["links"], j.get("actuated", False)) for j in data["joints"]][:2]
     [('P0', ['ground', 'a'], True), ('P1', ['a', 'b'], False)]
     """
-    notes: list[str] = []
-    links: list[str] = [FRAME]
-    for j in expr.joints:
-        for lk in j.links:
-            if lk not in links:
-                links.append(lk)
-    if not any(FRAME in j.links for j in expr.joints):
-        raise MechsynInputError("no joint on the frame: no L[...] names 'ground'", source=source,
-                                hint="pin at least one joint to ground, e.g. L[ground, link_1]")
+    notes: list[str] = list(expr.notes)
+    links = _link_names(expr, source)
     taken = set(links)
     joints: list[dict[str, Any]] = []
     points: dict[str, dict[str, Any]] = {}
@@ -373,8 +389,11 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
                 taken.add(block)
                 links.append(block)
                 made.append({"id": pid, "type": "P", "links": [j.links[0], block], "point": xy, "axis": axis})
-                for k, lk in enumerate(j.links[1:], start=1):
-                    made.append({"id": f"{pid}_{k}", "type": "R", "links": [block, lk], "point": xy})
+                turning = j.links[1:]  # one pin: the block turns on the first, the others on it
+                if turning:
+                    made.append({"id": f"{pid}_1", "type": "R", "links": [block, turning[0]], "point": xy})
+                for k, lk in enumerate(turning[1:], start=2):
+                    made.append({"id": f"{pid}_{k}", "type": "R", "links": [turning[0], lk], "point": xy})
         at_point[i] = made
         joints += made
         if j.color and (made or pid in points):
@@ -383,11 +402,9 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
     mobility = 3 * n_moving - 2 * len(joints)
     chosen = list(inputs) if inputs else list(expr.inputs)
     if chosen:
+        by_id = {jd["id"]: jd for jd in joints}
         for base, drive in chosen:
-            jid = _driver_joint(expr, at_point, base, drive, source, notes)
-            for jd in joints:
-                if jd["id"] == jid:
-                    jd["actuated"] = True
+            by_id[_driver_joint(expr, at_point, base, drive, source, notes)]["actuated"] = True
     else:
         for jd in _ground_cranks(joints, mobility, notes):
             jd["actuated"] = True
@@ -404,6 +421,24 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
     return data, notes
 
 
+def _link_names(expr: PyslvsMechanism, source: str) -> list[str]:
+    """The frame, then every link in order of appearance; refused before any other work
+    when there are more than the ``links`` or ``joints`` limits (:mod:`mechsyn.limits`)."""
+    from mechsyn.limits import limit, limit_hint
+
+    if len(expr.joints) > limit("joints"):
+        raise MechsynInputError(f"{len(expr.joints):,} points are more than the limit of {limit('joints'):,} "
+                                "joints", source=source, hint=limit_hint("joints"))
+    names = dict.fromkeys([FRAME, *(lk for j in expr.joints for lk in j.links)])
+    if len(names) > limit("links"):
+        raise MechsynInputError(f"{len(names):,} links are more than the limit of {limit('links'):,} (the "
+                                "analyses would run for hours or longer)", source=source, hint=limit_hint("links"))
+    if not any(FRAME in j.links for j in expr.joints):
+        raise MechsynInputError("no joint on the frame: no L[...] names 'ground'", source=source,
+                                hint="pin at least one joint to ground, e.g. L[ground, link_1]")
+    return list(names)
+
+
 def _driver_joint(expr: PyslvsMechanism, at_point: dict[int, list[dict[str, Any]]], base: int, drive: int,
                   source: str, notes: list[str]) -> str:
     n = len(expr.joints)
@@ -411,6 +446,12 @@ def _driver_joint(expr: PyslvsMechanism, at_point: dict[int, list[dict[str, Any]
         if not 0 <= k < n:
             raise MechsynInputError(f"input ({base}, {drive}): no point {k} (points are 0..{n - 1})",
                                     source=source, hint="give input pairs as BASE,DRIVE point indices")
+    if base == drive:  # Pyslvs' input of a slider: its travel along the slot
+        slide = [jd for jd in at_point[base] if jd["type"] == "P"]
+        if not slide:
+            raise MechsynInputError(f"input ({base}, {base}): point {base} is no slider",
+                                    source=source, hint="an input (i, i) drives the P or RP joint at point i")
+        return slide[0]["id"]
     common = [lk for lk in expr.joints[base].links if lk in expr.joints[drive].links]
     if not common:
         raise MechsynInputError(f"input ({base}, {drive}): no link joins points {base} and {drive}",
@@ -433,15 +474,19 @@ def _ground_cranks(joints: list[dict[str, Any]], mobility: int, notes: list[str]
     if mobility <= 0:
         notes.append(f"mobility 3n - 2p5 = {mobility}: no input chosen")
         return []
+    on: dict[str, list[dict[str, Any]]] = {}  # link -> its joints (one pass: linear time)
+    for jd in joints:
+        for lk in jd["links"]:
+            on.setdefault(lk, []).append(jd)
     cand = []
     for jd in joints:
         if jd["type"] != "R" or FRAME not in jd["links"]:
             continue
         link = next(lk for lk in jd["links"] if lk != FRAME)
-        if link.startswith("block") and any(o["type"] == "P" and link in o["links"] for o in joints):
+        if link.startswith("block") and any(o["type"] == "P" for o in on[link]):
             continue
-        far = [np.hypot(*(np.subtract(o["point"], jd["point"]))) for o in joints
-               if o is not jd and link in o["links"]]
+        far = [math.hypot(o["point"][0] - jd["point"][0], o["point"][1] - jd["point"][1])
+               for o in on[link] if o is not jd]
         reach = max(far) if far else math.inf
         cand.append((reach, len(cand), jd, link))
     cand.sort(key=lambda c: (c[0], c[1]))
@@ -495,13 +540,15 @@ def data_to_expression(data: dict[str, Any], source: str = "<mechanism>") -> Pys
     loads = {str(ld.get("link")) for ld in data.get("loads", [])}
     linked = {str(p["link"]) for p in data.get("points", {}).values()} | loads
     blocks = _blocks(names, joints, linked, scale)
+    _absorb_pins(blocks, joints, scale)
     in_block = {id(jd) for p, rs in blocks.values() for jd in [p, *rs]}
+    order = {id(jd): k for k, jd in enumerate(joints)}
     # groups: (order key, PyslvsJoint, member ids)
-    groups = _block_groups(blocks, joints, nm, source) + _pin_groups(joints, in_block, nm, scale)
-    for jd in joints:
+    groups = _block_groups(blocks, order, nm, source) + _pin_groups(joints, in_block, order, nm, scale)
+    for k, jd in enumerate(joints):
         if jd["type"] == "P" and id(jd) not in in_block:
             ax = jd.get("axis") or [1.0, 0.0]
-            groups.append(((joints.index(jd),), PyslvsJoint(
+            groups.append(((k,), PyslvsJoint(
                 "P", *map(float, jd["point"]), tuple(nm(x) for x in jd["links"]),
                 math.degrees(math.atan2(ax[1], ax[0]))), [jd["id"]]))
     for k, (pname, p) in enumerate(data.get("points", {}).items()):
@@ -544,54 +591,89 @@ def _blocks(names: list[str], joints: list[dict[str, Any]], linked: set[str],
     """Links ``block<i>`` made by :func:`expression_to_data`: one P joint plus R joints at
     its point, nothing else on the link."""
     blocks: dict[str, tuple[dict[str, Any], list[dict[str, Any]]]] = {}
+    on: dict[str, list[dict[str, Any]]] = {}  # link -> its joints (one pass: linear time)
+    for jd in joints:
+        for x in dict.fromkeys(map(str, jd["links"])):
+            on.setdefault(x, []).append(jd)
     for name in names:
-        own = [jd for jd in joints if name in [str(x) for x in jd["links"]]]
+        if not re.fullmatch(r"block\d+(_\d+)?", name):
+            continue
+        own = on.get(name, [])
         ps = [jd for jd in own if jd["type"] == "P"]
         rs = [jd for jd in own if jd["type"] == "R"]
-        if (re.fullmatch(r"block\d+(_\d+)?", name) and name not in linked and len(ps) == 1 and rs and len(ps) + len(rs) == len(own)
+        if (name not in linked and len(ps) == 1 and rs and len(ps) + len(rs) == len(own)
                 and all(_close(r["point"], ps[0]["point"], scale) for r in rs)):
             blocks[name] = (ps[0], rs)
     return blocks
 
 
-def _block_groups(blocks: dict, joints: list[dict[str, Any]], nm: Any, source: str) -> list[_Group]:
+def _absorb_pins(blocks: dict, joints: list[dict[str, Any]], scale: float) -> None:
+    """Add to each block the R joints at its point that join the links turning on it to
+    others (the third, fourth... link of a Pyslvs RP point): one RP point again."""
+    on: dict[str, list[dict[str, Any]]] = {}
+    for jd in joints:
+        if jd["type"] == "R":
+            for x in dict.fromkeys(map(str, jd["links"])):
+                on.setdefault(x, []).append(jd)
+    used = {id(jd) for p, rs in blocks.values() for jd in [p, *rs]}
+    for bname, (p, rs) in blocks.items():
+        todo = [str(x) for r in rs for x in r["links"] if str(x) != bname]
+        while todo:
+            link = todo.pop()
+            for jd in on.get(link, []):
+                if id(jd) not in used and _close(jd["point"], p["point"], scale):
+                    used.add(id(jd))
+                    rs.append(jd)
+                    todo += [str(x) for x in jd["links"] if str(x) != link]
+
+
+def _block_groups(blocks: dict, order: dict[int, int], nm: Any, source: str) -> list[_Group]:
     """Each block as one RP point: its guide link first, then the links turning on it."""
     groups: list[_Group] = []
     for bname, (p, rs) in blocks.items():
         guide = next(str(x) for x in p["links"] if str(x) != bname)
-        others = [next(str(x) for x in r["links"] if str(x) != bname) for r in rs]
+        others = list(dict.fromkeys(str(x) for r in rs for x in r["links"] if str(x) != bname))
         if guide in others:
             raise MechsynInputError(f"block {bname} slides along and turns on {guide}", source=source)
         ax = p.get("axis") or [1.0, 0.0]
-        groups.append(((joints.index(p),), PyslvsJoint(
+        groups.append(((order[id(p)],), PyslvsJoint(
             "RP", *map(float, p["point"]), tuple(nm(x) for x in [guide, *others]),
             math.degrees(math.atan2(ax[1], ax[0]))), [p["id"], *[r["id"] for r in rs]]))
     return groups
 
 
-def _pin_groups(joints: list[dict[str, Any]], in_block: set[int], nm: Any, scale: float) -> list[_Group]:
-    """Coincident R joints sharing links as one R point of all their links (frame first)."""
+def _pin_groups(joints: list[dict[str, Any]], in_block: set[int], order: dict[int, int], nm: Any,
+                scale: float) -> list[_Group]:
+    """Coincident R joints sharing links as one R point of all their links (frame first).
+
+    Coincident joints are found through a grid of cells the size of the tolerance (each
+    joint compared with those of its 3 x 3 cells only): linear time."""
     g = nx.Graph()
     rjs = [jd for jd in joints if jd["type"] == "R" and id(jd) not in in_block]
     g.add_nodes_from(range(len(rjs)))
-    for a in range(len(rjs)):
-        for b in range(a + 1, len(rjs)):
+    cell = 1e-9 * max(scale, 1.0)
+    grid: dict[tuple[int, int], list[int]] = {}
+    for a, jd in enumerate(rjs):
+        cx, cy = (math.floor(float(v) / cell) for v in jd["point"][:2])
+        near = [b for dx in (-1, 0, 1) for dy in (-1, 0, 1) for b in grid.get((cx + dx, cy + dy), ())]
+        for b in near:
             if (_close(rjs[a]["point"], rjs[b]["point"], scale)
                     and set(map(str, rjs[a]["links"])) & set(map(str, rjs[b]["links"]))):
                 g.add_edge(a, b)
+        grid.setdefault((cx, cy), []).append(a)
     groups: list[_Group] = []
     for comp in nx.connected_components(g):
         members = [rjs[k] for k in sorted(comp)]
-        order: list[str] = []
+        names: list[str] = []
         for jd in members:
             for x in jd["links"]:
-                if nm(x) not in order:
-                    order.append(nm(x))
-        if FRAME in order:
-            order.remove(FRAME)
-            order.insert(0, FRAME)
-        groups.append(((joints.index(members[0]),), PyslvsJoint("R", *map(float, members[0]["point"]),
-                                                                tuple(order)), [m["id"] for m in members]))
+                if nm(x) not in names:
+                    names.append(nm(x))
+        if FRAME in names:
+            names.remove(FRAME)
+            names.insert(0, FRAME)
+        groups.append(((order[id(members[0])],), PyslvsJoint("R", *map(float, members[0]["point"]),
+                                                             tuple(names)), [m["id"] for m in members]))
     return groups
 
 
@@ -611,8 +693,16 @@ def _inputs(joints: list[dict[str, Any]], in_block: set[int], ground: str, out: 
     the driven joints an input cannot express."""
     inputs: list[tuple[int, int]] = []
     notes: list[str] = []
+    points_of: dict[str, list[int]] = {}  # link -> the first two points on it
+    for k, gj in enumerate(out):
+        for lk in gj.links:
+            if len(points_of.setdefault(lk, [])) < 2:
+                points_of[lk].append(k)
     for jd in joints:
         if not jd.get("actuated"):
+            continue
+        if jd["type"] == "P" and jd["id"] in where:  # a slider's travel: Pyslvs' input (i, i)
+            inputs.append((where[jd["id"]], where[jd["id"]]))
             continue
         if jd["type"] != "R" or id(jd) in in_block:
             notes.append(f"driven joint {jd['id']} is not a pin Pyslvs can drive: left out of the inputs")
@@ -623,7 +713,7 @@ def _inputs(joints: list[dict[str, Any]], in_block: set[int], ground: str, out: 
             notes.append(f"driven joint {jd['id']} turns {moving} relative to {jd['links'][0]}; a Pyslvs "
                          "input turns it relative to the frame")
         base = where[jd["id"]]
-        drive = next((k for k, gj in enumerate(out) if k != base and nm(moving) in gj.links), None)
+        drive = next((k for k in points_of.get(nm(moving), []) if k != base), None)
         if drive is None:
             notes.append(f"driven joint {jd['id']}: {moving} has no other point to make an input pair")
             continue

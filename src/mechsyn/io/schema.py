@@ -16,11 +16,9 @@ References
 ----------
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 .. [2] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
-   devices" (in Ukrainian, with an English abstract); authors, journal and year are
-   not in the project's copy ("paper 002"; see docs/references.md).
+   devices" (in Ukrainian, with an English abstract) ("paper 002"; see docs/references.md).
 .. [3] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
    mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
    Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").

@@ -121,11 +121,9 @@ class Simulation(Result):
     def to_pandas(self) -> Any:
         """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
         every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
-        try:
-            import pandas as pd
-        except ImportError:
-            raise ImportError("Simulation.to_pandas needs pandas: pip install pandas "
-                              "(or use to_dict(), which needs nothing)") from None
+        from mechsyn._extras import require
+
+        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
         cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
         cols["assembled"] = self.assembled
         for name, pm in self.points.items():
@@ -137,11 +135,19 @@ class Simulation(Result):
         return pd.DataFrame(cols)
 
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:
-        """The mechanism moving over the sweep: a Matplotlib ``FuncAnimation``
-        (``anim.save("m.gif", writer="pillow")``, or ``anim.to_jshtml()`` in a notebook)."""
+        """The mechanism moving over the sweep: a
+        :class:`~mechsyn.plot.animation.MechanismAnimation` that plays when it is a notebook
+        cell's value and saves with ``anim.save("m.gif")`` (``.mp4``, ``.html``).
+
+        Without ``fig`` it is drawn on a bare Matplotlib Figure (no pyplot, so a notebook
+        shows the player, not a still frame); pass ``fig=plt.figure()`` to play it in a
+        Matplotlib window with ``plt.show()``. ``kwargs`` go to
+        :func:`mechsyn.plot.kinematics.animate_simulation` (``max_frames``, ``interval``)."""
+        from matplotlib.figure import Figure
+
         from mechsyn.plot.kinematics import animate_simulation
 
-        return animate_simulation(self, fig=fig, **kwargs)
+        return animate_simulation(self, fig=Figure() if fig is None else fig, **kwargs)
 
     def working_ranges(self) -> list[list[float]]:
         """Runs of consecutive assembled inputs, as [first, last] values of the main input."""

@@ -18,16 +18,14 @@ References
 ----------
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md).
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 .. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
    Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
-   al., 2012); authors, journal and year are not in the project's copy ("paper 001";
+   al., 2012) ("paper 001";
    see docs/references.md).
 .. [3] F. N. Pritykin, D. I. Nefedov, V. A. Zakharov and A. V. Rinsel'man, "A generalised
    method of studying the mobility of planar manipulator mechanisms" (in Russian),
-   Omsk State Technical University; journal and year are not in the project's copy
-   ("paper 004"; see docs/references.md).
+   Omsk State Technical University ("paper 004"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -276,7 +276,7 @@ def _length_unit(sim: Any) -> str:
 def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.ndarray, xlabel: str,
                       interval: float) -> Any:
     """An animation redrawn whole at each frame (cams and belts change shape as they move)."""
-    from matplotlib.animation import FuncAnimation
+    from mechsyn.plot.animation import MechanismAnimation
 
     xlim, ylim = ax.get_xlim(), ax.get_ylim()
     unit = _length_unit(sim)
@@ -302,17 +302,18 @@ def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.nda
             ax.legend(fontsize=8, loc="upper right")
         return arts
 
-    return FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+    return MechanismAnimation(fig, draw, frames=list(frames), blit=False, interval=interval, title=sim.mechanism)
 
 
 def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval: float = 1000 / 15) -> Any:
     """The mechanism moving over the assembled inputs, tracing its points' paths.
 
-    Returns a :class:`matplotlib.animation.FuncAnimation` (save it with a writer, e.g.
-    ``anim.save("m.gif", writer="pillow")``, or show it with ``anim.to_jshtml()``).
+    Returns a :class:`~mechsyn.plot.animation.MechanismAnimation`, a ``FuncAnimation`` that
+    plays when it is a notebook cell's value and saves with ``anim.save("m.gif")`` (or
+    ``.mp4``, ``.html``), drawing only what moves.
     Raises :class:`~mechsyn.errors.MechsynInputError` when no input is assembled.
     """
-    from matplotlib.animation import FuncAnimation
+    from mechsyn.plot.animation import MechanismAnimation
 
     idx = np.flatnonzero(sim.assembled)
     if len(idx) == 0:
@@ -401,6 +402,6 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
         return ([a for _, trail, dot in trails for a in (trail, dot)]
                 + [a for _, f, e, p in links for a in (f, e, p) if a is not None] + file_pins + [squares, title])
 
-    anim = FuncAnimation(fig, draw, frames=list(frames), blit=False, interval=interval)
+    anim = MechanismAnimation(fig, draw, frames=list(frames), blit=False, interval=interval, title=sim.mechanism)
     anim.mechsyn_blit = (draw, list(frames))  # what moves: see mechsyn.plot.frames
     return anim

@@ -8,8 +8,7 @@ remedy (paper 003) with the rank method; :func:`rank_to_markdown` writes both as
 References
 ----------
 .. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
-   devices" (in Ukrainian, with an English abstract); authors, journal and year are
-   not in the project's copy ("paper 002"; see docs/references.md).
+   devices" (in Ukrainian, with an English abstract) ("paper 002"; see docs/references.md).
 .. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
    mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
    Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").

@@ -16,8 +16,7 @@ Whole system: ``σ = S - {[6(N - 1) - W_rob] + W_a - S_ai}``, ``S = S_i + S_a``,
 References
 ----------
 .. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
-   devices" (in Ukrainian, with an English abstract); authors, journal and year are
-   not in the project's copy ("paper 002"; see docs/references.md).
+   devices" (in Ukrainian, with an English abstract) ("paper 002"; see docs/references.md).
 """
 
 from __future__ import annotations

@@ -10,8 +10,7 @@ request, lists pair-class remedies re-checked by the rank method. The
 References
 ----------
 .. [1] "Rational structural synthesis of schemes of crank-slider mechanisms of gripping
-   devices" (in Ukrainian, with an English abstract); authors, journal and year are
-   not in the project's copy ("paper 002"; see docs/references.md).
+   devices" (in Ukrainian, with an English abstract) ("paper 002"; see docs/references.md).
 .. [2] O. D. Egorov and M. A. Buynov, "Structural analysis of the mechanisms of the
    mechatronic and robotic devices" (in Russian), *Mekhatronika, Avtomatizatsiya,
    Upravlenie*, 17(4), 239-244, 2016. doi:10.17587/mau.17.239-244 ("paper 003").
@@ -30,7 +29,7 @@ from mechsyn.results import to_jsonable
 from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
 from mechsyn.structure.remedies import Remedy, find_remedies
 
-__all__ = ["StructureReport", "analyze", "to_markdown"]
+__all__ = ["StructureReport", "analyze", "to_markdown", "verdict", "formula_sections", "explain_negative"]
 
 FORMULA_TITLES = {
     "chebyshev": "Chebyshev (planar)",
@@ -47,11 +46,102 @@ FORMULA_TITLES = {
 #: paper 003's per-contour counts are the spatial reading (each contour against 6 freedoms)
 CONTOUR_READING = {"planar": ", spatial reading", "spatial": ""}
 
+#: what each reading of a formula counts
+READINGS = {
+    "planar": "planar reading: 3 freedoms per free link, 3 closure equations per contour",
+    "spatial": "spatial reading: 6 freedoms per free link, 6 closure equations per contour",
+    "topology": "counts of links, pairs and contours only",
+}
+
+#: the section of the spatial readings of a planar file: its title and what it says
+SPATIAL_OF_PLANAR = (
+    "Spatial reading of this planar mechanism (paper 003)",
+    "Counted as if each link had 6 freedoms: the out-of-plane conditions a planar loop repeats "
+    "count as redundant, 3 per contour. They say what a 3-D build must hold (parallel axes), "
+    "not how the planar mechanism moves: that is the verdict above.")
+
+
+def formula_sections(a: StructuralAnalysis) -> tuple[list[str], list[str]]:
+    """The formula keys of the file's own kind (with the topology counts), and the spatial
+    readings of a planar file (empty for a spatial one). A planar formula that does not apply
+    to a spatial file (value None) is left out of both."""
+    if a.kind == "planar":
+        own = [k for k, f in a.formulas.items() if getattr(f, "reading", "") != "spatial"]
+        return own, [k for k in a.formulas if k not in own]
+    return [k for k, f in a.formulas.items() if f.value is not None or getattr(f, "reading", "") == "spatial"], []
+
+
+def _used_mobility(a: StructuralAnalysis) -> Any:
+    """The W Ozol's q and S-from-W use: the file's declared mobility, else the formulas' own."""
+    if a.declared_mobility is not None:
+        return a.declared_mobility
+    return a.formulas["chebyshev" if a.kind == "planar" else "somov_malyshev"].value
+
+
+def explain_negative(key: str, a: StructuralAnalysis, rank: Any = None) -> str | None:
+    """One line on what a negative W, q or S of formula ``key`` means (None if not negative)."""
+    f = a.formulas[key]
+    if f.value is None or f.value >= 0 or getattr(f, "reading", "") == "topology":
+        return None
+    v = _fmt(f.value)
+    if key in ("ozol_redundant", "redundant_from_mobility"):
+        exact = (f"; the rank method's instantaneous mobility is {rank.mobility} ({rank.useful_mobility} useful "
+                 f"+ {len(rank.idle_mobilities)} idle) and {rank.redundant_constraints} redundant constraints"
+                 if rank is not None else "")
+        return (f"{v} < 0: a count of redundant constraints is never negative for the true mobility, so the "
+                f"W = {_fmt(_used_mobility(a))} put into it is below the mechanism's instantaneous mobility "
+                f"(idle mobilities count there){exact}.")
+    if a.kind == "planar" and getattr(f, "reading", "") == "spatial":
+        return (f"W = {v} < 0 in the spatial reading: a planar loop repeats 3 of its 6 closure conditions and "
+                "this count takes them as independent; the planar mechanism still moves (see the verdict).")
+    return (f"W = {v} < 0: the formula takes every pair's constraints as independent; some repeat (redundant "
+            "constraints), so it does not mean the mechanism cannot move (see the verdict).")
+
+
+def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
+    """The answer first: mobility, useful and idle, redundant constraints and where they come
+    from (the exact rank method at the drawn pose where the file gives the geometry, else the
+    formulas of the file's own kind), with one sentence saying it.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> v = verdict(ms.analyze(ms.examples.load("fourbar")).analysis)
+    >>> v["mobility"], v["redundant_constraints"], v["source"]
+    (1, 0, 'formulas, planar reading (no rank method)')
+    """
+    if rank is not None:
+        out: dict[str, Any] = {
+            "mobility": rank.useful_mobility, "instantaneous_mobility": rank.mobility,
+            "idle_mobilities": len(rank.idle_mobilities), "redundant_constraints": rank.redundant_constraints,
+            "singular": bool(rank.singular), "finite_mobility": rank.finite_mobility,
+            "source": "exact rank method at the drawn pose"}
+        pose = (f"SINGULAR at the drawn pose (finite mobility nearby {rank.finite_mobility})" if rank.singular
+                else "not singular")
+        idle = len(rank.idle_mobilities)
+        split = (f" (instantaneous {rank.mobility} = {rank.useful_mobility} useful + {idle} idle)" if idle
+                 else " (no idle mobility)")
+        out["text"] = (f"mobility {rank.useful_mobility}{split}, {rank.redundant_constraints} redundant "
+                       f"constraints, {pose}; from the {out['source']}")
+        return out
+    planar = a.kind == "planar"
+    q = a.formulas["ozol_redundant"].value if planar else a.redundant_constraints
+    idle = None if planar else a.idle_mobilities
+    out = {"mobility": a.mobility, "instantaneous_mobility": None, "idle_mobilities": idle,
+           "redundant_constraints": q, "singular": None, "finite_mobility": None,
+           "source": f"formulas, {a.kind} reading (no rank method)"}
+    idle_text = "idle mobilities unknown without the joints' geometry" if idle is None else f"{idle} idle"
+    out["text"] = (f"mobility W = {_fmt(a.mobility)}, {_fmt(q) if q is not None else 'n/a'} redundant "
+                   f"constraints, {idle_text}; from the {out['source']}: give each joint's point and axis "
+                   "for the exact rank method")
+    return out
+
 
 def formula_title(title: str, f: object) -> str:
-    """``title`` with the formula's planar/spatial reading, when it has one."""
+    """``title`` with the formula's reading (planar, spatial, topology, or a family's), when
+    it has one: every printed formula says what it counts."""
     reading = getattr(f, "reading", "")
-    return f"{title} ({reading})" if reading in ("planar", "spatial") and reading not in title else title
+    return f"{title} ({reading})" if reading and reading not in title else title
 
 
 def pair_list(row_pairs: Sequence[object]) -> str:
@@ -62,20 +152,39 @@ def _fmt(x: float) -> str:
     return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
-def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None, level: int = 1) -> str:
+def _formula_rows(a: StructuralAnalysis, keys: list[str], rank: Any = None) -> list[str]:
+    rows = ["| formula | expression | value |", "|---|---|---|"]
+    for key in keys:
+        f = a.formulas[key]
+        val = "n/a" if f.value is None else _fmt(f.value)
+        rows.append(f"| {formula_title(FORMULA_TITLES.get(key, key), f)} | `{f.expression}` | {val} |")
+    why = [line for line in (explain_negative(k, a, rank) for k in keys) if line]
+    return rows + ([""] + [f"- {line}" for line in why] if why else [])
+
+
+def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None, level: int = 1,
+                rank: Any = None) -> str:
+    """The Markdown report of ``a``: the verdict, the formulas of the file's own kind, then
+    (for a planar file) its spatial readings in a section of their own."""
     h = "#" * level
     pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
+    own, spatial = formula_sections(a)
     out = [
         f"{h} {a.name}", "",
         f"{a.kind} mechanism: n = {a.moving_links} moving links (N = {a.links_with_frame} with the frame), "
         f"{a.pairs} pairs ({pbc}), K = {a.independent_contours} independent contours.", "",
-        f"{h}# Formulas", "", "| formula | expression | value |", "|---|---|---|",
+        f"**Verdict**: {verdict(a, rank)['text']}.", "",
+        f"{h}# Formulas ({READINGS['planar' if a.kind == 'planar' else 'spatial']})", "",
+        *_formula_rows(a, own, rank),
+        "", f"- mobility W = {_fmt(a.mobility)} ({a.mobility_source})",
+        f"- degrees of mobility (drives): `{a.degrees_of_mobility_expression}`"
+        + (f" (reading by exclusive links: {a.degrees_of_mobility_exclusive})"
+           if a.degrees_of_mobility_exclusive != a.degrees_of_mobility else ""),
     ]
-    for key, f in a.formulas.items():
-        val = "n/a" if f.value is None else _fmt(f.value)
-        out.append(f"| {formula_title(FORMULA_TITLES.get(key, key), f)} | `{f.expression}` | {val} |")
+    if spatial:
+        out += ["", f"{h}# {SPATIAL_OF_PLANAR[0]}", "", SPATIAL_OF_PLANAR[1], "", *_formula_rows(a, spatial, rank)]
     if a.contours:
-        out += ["", f"{h}# Contours (paper 003{CONTOUR_READING[a.kind]})", "",
+        out += ["", f"{h}{'#' if spatial else ''}# Contours (paper 003{CONTOUR_READING[a.kind]})", "",
                 "| # | joints | new pairs | n_j | n_k | S_j | idle | T_j | Z_j | A_j |",
                 "|---|---|---|---|---|---|---|---|---|---|"]
         for r in a.contours:
@@ -88,10 +197,6 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
         f"({a.redundant_constraints} redundant constraints, {a.idle_mobilities} idle mobilities)",
         f"- constructive redundancy G_Σ = {_fmt(a.constructive_redundancy)} "
         f"(metric constraints {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})",
-        f"- mobility W = {_fmt(a.mobility)} ({a.mobility_source})",
-        f"- degrees of mobility (drives): `{a.degrees_of_mobility_expression}`"
-        + (f" (reading by exclusive links: {a.degrees_of_mobility_exclusive})"
-           if a.degrees_of_mobility_exclusive != a.degrees_of_mobility else ""),
     ]
     if a.external is not None:
         e = a.external
@@ -165,16 +270,23 @@ class StructureReport(Result):
         return self.analysis.formulas
 
     @property
+    def verdict(self) -> dict[str, Any]:
+        """The answer first (:func:`verdict`): mobility, useful/idle, redundant constraints, source."""
+        return verdict(self.analysis, self.rank)
+
+    @property
     def rejected(self) -> list:
         return [(k, r, c) for k, r, c in self.checks if not c.accepted]
 
     def _summary(self) -> list[tuple[str, str]]:
         a = self.analysis
+        v = self.verdict
         rows = [("mechanism", self.mechanism.name), ("method", self.method),
                 ("mobility W", f"{self.mobility:g}"),
-                ("redundant constraints", str(self.rank.redundant_constraints if self.rank is not None
-                                              else a.redundant_constraints)),
-                ("idle mobilities", str(len(self.rank.idle_mobilities) if self.rank is not None else a.idle_mobilities))]
+                ("redundant constraints", "n/a" if v["redundant_constraints"] is None else
+                 _fmt(v["redundant_constraints"])),
+                ("idle mobilities", "unknown" if v["idle_mobilities"] is None else str(v["idle_mobilities"])),
+                ("from", v["source"])]
         if self.remedies is not None:
             rows.append(("remedies", str(len(self.remedies))))
         return rows
@@ -183,6 +295,12 @@ class StructureReport(Result):
         ra = self.rank
         data = to_jsonable(self.analysis)
         data["method"] = self.method
+        data["verdict"] = self.verdict
+        own, spatial = formula_sections(self.analysis)
+        data["formula_readings"] = {k: getattr(f, "reading", "") or None for k, f in self.analysis.formulas.items()}
+        data["formula_sections"] = {"own": own, "spatial_reading_of_planar": spatial}
+        data["formula_explanations"] = {k: e for k in self.analysis.formulas
+                                        if (e := explain_negative(k, self.analysis, ra))}
         data["rank"] = ra.to_dict() if ra is not None else None
         if ra is None and self.rank_unavailable:
             data["rank_unavailable"] = self.rank_unavailable
@@ -211,7 +329,8 @@ class StructureReport(Result):
         """The Markdown report (``mechsyn analyze --markdown``)."""
         from mechsyn.structure.compare import rank_to_markdown
 
-        text = to_markdown(self.analysis, self.remedies) if self.method != "rank" else ""
+        text = (to_markdown(self.analysis, self.remedies, rank=self.rank) if self.method != "rank"
+                else f"# {self.analysis.name}\n\n**Verdict**: {self.verdict['text']}.\n")
         if self.rank is not None:
             text += "\n" + rank_to_markdown(self.rank, self.comparisons if self.method == "both" else None)
             if self.checks:

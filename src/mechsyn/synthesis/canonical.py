@@ -71,8 +71,10 @@ def _module(name: str):
 
         return pynauty
     except ImportError:
+        from mechsyn._extras import missing
+
         package = "python-igraph" if name == "igraph" else "pynauty"
-        raise ImportError(f"the graph back end {name!r} needs `pip install {package}`") from None
+        raise missing(package if name == "igraph" else "pynauty", f"the graph back end {name!r}") from None
 
 
 def preload() -> None:

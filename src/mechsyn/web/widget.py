@@ -25,8 +25,11 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-import anywidget
-import traitlets
+from mechsyn._extras import require
+
+anywidget = require("anywidget", "Mechanism.widget()", "notebook")
+require("httpx", "Mechanism.widget()", "notebook")  # the in-process app answers through starlette's TestClient
+import traitlets  # noqa: E402  (installed with anywidget)
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",

@@ -24,7 +24,5 @@ References
 ----------
 .. [1] I. I. Borisov, R. A. Zashchitin, O. V. Borisova and S. A. Kolyubin, "Algorithm of
    structural-parametric synthesis of adaptive gripper mechanisms with variable-length
-   links" (in Russian), ITMO University, St. Petersburg; journal, volume and year are
-   not in the project's copy ("paper 000"; see docs/references.md). Restated in the
-   spec's ``structural.md`` section 4.
+   links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 """
