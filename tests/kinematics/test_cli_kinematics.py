@@ -128,7 +128,10 @@ def test_bad_files_exit_2(capsys, tmp_path):
     f.write_text("name: x\nkind: spatial\nground: f\nlinks: [f, a]\njoints:\n"
                  "  - {id: A, type: R, links: [f, a], point: [0, 0, 0], axis: [0, 0, 1], actuated: true}\n")
     code, _, err = run(capsys, "simulate", f, "--input", "A=0:1:1")
-    assert code == 2 and "planar" in err
+    assert code == 0  # issue 25: spatial files are simulated (tests/kinematics/test_spatial.py)
+    f.write_text(f.read_text().replace("type: R", "type: E"))
+    code, _, err = run(capsys, "simulate", f, "--input", "A=0:1:1")
+    assert code == 2 and "only R, P and H" in err
     code, _, err = run(capsys, "forces", EX / "kinematics/crank_rocker.yaml", "--input", "A=0:1:1",
                        "--gravity", "nan")
     assert code == 2

@@ -128,8 +128,9 @@ def simulate_cmd(
     mech = load_mechanism(file)
     inputs = _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
-    n = len(next(iter(inputs.values())))
-    with progress_bar("simulating", n, enabled=n >= 200) as advance:
+    if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
+        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
+    with progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance:
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
                                    vll=_parse_pairs(vll, "--vll", False), method=method, output=output,
                                    straight=_parse_straight(straight), progress=advance)
@@ -140,6 +141,38 @@ def simulate_cmd(
         emit_json(report.to_dict())
         return
     render_simulation(report)
+
+
+def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str] | None, speed: list[str] | None,
+                      json_: bool, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
+    """``mechsyn simulate`` on a spatial file: one call of the spatial engine, its result's own
+    summary, events and table (``--json``: its ``to_dict()``)."""
+    import shutil
+    import textwrap
+
+    from mechsyn.kinematics.analysis import simulate
+    from mechsyn.plot.spatial import animate_spatial, plot_spatial
+
+    n = len(next(iter(inputs.values())))
+    with progress_bar("simulating", n, enabled=n >= 200) as advance:
+        sim = simulate(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names, progress=advance)
+    if csv_out is not None:
+        write_output(csv_out, sim.csv())
+    if plot is not None:
+        save_plot(plot, plot_spatial, sim)
+    if animate is not None:
+        save_animation(animate, animate_spatial, sim, dpi=100)
+    if is_stdout(csv_out):
+        return
+    if json_:
+        emit_json(sim.to_dict())
+        return
+    width = shutil.get_terminal_size().columns
+    lines = str(sim).splitlines() + [f"{e['kind']} at {', '.join(f'{j} = {v:.6g}' for j, v in e['input'].items())}: "
+                                     f"{e['message']}" for e in sim.events]
+    for line in lines:
+        typer.echo(textwrap.fill(line, width, subsequent_indent=" " * 13))
+    typer.echo(sim.table(width=width))
 
 
 def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:

@@ -249,6 +249,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     velocity is continuous, through change and branch points: a parallelogram stays a
     parallelogram) or ``"switch"`` (the other branch there; closed form only).
 
+    A ``kind: spatial`` file goes to the spatial engine
+    (:func:`mechsyn.kinematics.spatial.simulate_spatial`: inputs measured from the drawn
+    assembly, a :class:`~mechsyn.kinematics.spatial_result.SpatialSimulation` back).
+
     Examples
     --------
     >>> import numpy as np, mechsyn as ms
@@ -259,6 +263,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
+    if mech.kind == "spatial":  # hook (issue 25): the spatial engine; to be registered in the engine list
+        from mechsyn.kinematics.spatial import SpatialEngine
+
+        return SpatialEngine().sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
     return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
 
@@ -781,6 +789,9 @@ def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, flo
     >>> f.reactions.effort["A"].shape
     (3,)
     """
+    if mech.kind == "spatial":  # hook (issue 25): spatial kinematics exists, spatial forces do not yet
+        raise MechsynInputError("force analysis needs a planar mechanism", source=mech.source, field="kind",
+                                hint="simulate gives the motion of a spatial file; forces are computed for planar files only")
     sim = simulate(mech, inputs, speeds=speeds, points=[], vll=vll, method=method, progress=progress)
     sw = sim.sweep
     R = kinetostatics(sim.system, sw.q, None if static else sw.qd, None if static else sw.qdd,

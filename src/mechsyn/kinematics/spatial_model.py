@@ -1,0 +1,461 @@
+"""The constraint equations of a spatial mechanism in link poses, their Jacobian in twist
+form and the convective terms of the accelerations (used by :mod:`mechsyn.kinematics.spatial`).
+
+Every moving link ``i`` carries a pose ``(R_i, p_i)`` (``x = R_i x_0 + p_i`` maps its points
+from the drawn assembly to where they are now; all poses are the identity in the drawn
+assembly, so a point or axis of the file is its own link-fixed coordinate). A motion of the
+link is the spatial twist ``ξ_i = (ω_i, v_i)`` (``v_i``: velocity of the point at the
+origin), so a point fixed on it moves at ``ẋ = v_i + ω_i × x`` and a vector at ``u̇ = ω_i × u``.
+Each pair is written as a few scalar equations of four kinds, each with its exact
+Jacobian row in the twists of its two links and its convective term
+``γ = d²g/dt²`` at ``ξ̇ = 0`` (so ``J ξ̇ = g̈ - γ``):
+
+========================  =====================================  =============================
+kind                      equation                               pairs
+========================  =====================================  =============================
+coincidence (3 rows)      ``x_a - x_b = 0``                      R, U, S
+dot (1 row)               ``u_a · w_b = u_0 · w_0``              R (2), U (1), C, H (2), P (3)
+line (1 row)              ``(x_b - x_a) · n_a = 0``              C, H, P (2 each)
+angle / slide (drives)    ``θ = θ_in``, ``(x_b - x_a) · a = s``  R, H (angle); P (slide)
+helix (1 row)             ``s - h θ = 0``                        H
+========================  =====================================  =============================
+
+with ``x_a``, ``u_a``, ``n_a`` fixed on the pair's first link and ``x_b``, ``w_b`` on its
+second. A revolute pair keeps its point and two vectors of the second link perpendicular
+to the axis of the first (five equations, the five constraints of a class-5 pair); a
+prismatic pair keeps the three frame vectors of the links perpendicular as drawn
+(no relative rotation) and the second link's point on the first link's line; and so on.
+The equations of a pair are exactly its class, so the rank of the stacked Jacobian is the
+rank method's (:mod:`mechsyn.structure.rank`), and redundant constraints only add rows:
+the solver takes least-squares, minimum-norm steps.
+
+Lengths are measured from the centre of the joint points in units of the mechanism's
+length scale (the largest distance of a joint point from that centre), so every equation
+is dimensionless, the solver's tolerances are relative to the length scale, and a
+mechanism scaled by 1e-3 or 1e4 gives the same numbers.
+
+References
+----------
+.. [1] J. M. McCarthy and G. S. Soh, *Geometric Design of Linkages*, 2nd ed., Springer,
+   2011, ch. 2-3 (spatial displacements, twists, constraint equations of the pairs).
+.. [2] R. M. Murray, Z. Li and S. S. Sastry, *A Mathematical Introduction to Robotic
+   Manipulation*, CRC Press, 1994, sec. 2.3-2.4 (the exponential of a twist).
+.. [3] E. J. Haug, *Computer Aided Kinematics and Dynamics of Mechanical Systems*, Allyn
+   and Bacon, 1989, ch. 9 (constraint equations of spatial joints in absolute coordinates;
+   the right-hand side ``γ`` of the acceleration equations).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.model.mechanism import Joint, Mechanism
+from mechsyn.structure.screws import _perp_basis, _unit
+
+__all__ = ["SpatialModel", "compile_spatial", "SPATIAL_PAIRS", "exp_twists"]
+
+#: Pair types the spatial engine moves.
+SPATIAL_PAIRS = ("R", "P", "C", "U", "S", "H")
+
+_EPS = np.zeros((3, 3, 3))
+_EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
+_EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
+
+
+_I1, _I2 = [1, 2, 0], [2, 0, 1]
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product over the last axis (fewer NumPy calls than ``np.cross``)."""
+    return a[..., _I1] * b[..., _I2] - a[..., _I2] * b[..., _I1]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return (a * b).sum(axis=-1)
+
+
+def _rows(x: np.ndarray) -> np.ndarray:
+    return np.asarray(x, float).reshape(-1, 3)
+
+
+@dataclass(frozen=True, eq=False)
+class _Kind:
+    """The equations of one kind: link indices ``ia``, ``ib`` and link-fixed vectors."""
+
+    ia: np.ndarray
+    ib: np.ndarray
+    va: np.ndarray        # x_a (coincidence, line, slide) or u_a (dot, angle axis)
+    vb: np.ndarray        # x_b or w_b
+    n: np.ndarray         # n_a (line, slide); e1 of the first link (angle)
+    m: np.ndarray         # e2 of the first link (angle)
+    c0: np.ndarray
+
+    @property
+    def size(self) -> int:
+        return len(self.ia)
+
+
+def _kind(rows: list[tuple]) -> _Kind:
+    z = np.zeros((0, 3))
+    if not rows:
+        return _Kind(np.zeros(0, int), np.zeros(0, int), z, z, z, z, np.zeros(0))
+    ia, ib, va, vb, n, m, c0 = zip(*rows)
+    return _Kind(np.array(ia), np.array(ib), _rows(va), _rows(vb), _rows(n), _rows(m), np.array(c0, float))
+
+
+@dataclass(frozen=True, eq=False)
+class SpatialModel:
+    """A spatial mechanism compiled into its constraint equations (see the module doc).
+
+    ``links`` are the moving links (pose ``k``); the frame is pose ``len(links)``.
+    ``angles`` and ``slides`` measure the R/H/C rotations and P/H/C slides of the pairs
+    named in ``angle_joints`` and ``slide_joints`` (drives and the coordinates reported);
+    ``drives`` lists ``(joint id, "angle" | "slide", index)`` in the order of the inputs;
+    ``helix`` holds ``(angle index, slide index, pitch / scale)`` of the H pairs.
+    """
+
+    mech: Mechanism
+    links: tuple[str, ...]
+    centre: np.ndarray
+    scale: float
+    pc: _Kind
+    dot: _Kind
+    line: _Kind
+    angles: _Kind
+    slides: _Kind
+    angle_joints: tuple[str, ...]
+    slide_joints: tuple[str, ...]
+    helix: tuple[tuple[int, int, float], ...]
+    drives: tuple[tuple[str, str, int], ...]
+    lay: "_Layout | None" = None
+
+    @property
+    def n(self) -> int:
+        return len(self.links)
+
+    @property
+    def n_constraints(self) -> int:
+        return 3 * self.pc.size + self.dot.size + self.line.size + len(self.helix)
+
+    def local(self, x: np.ndarray) -> np.ndarray:
+        """File coordinates -> the model's (centred, in units of the length scale)."""
+        return (np.asarray(x, float) - self.centre) / self.scale
+
+    def index(self, link: str) -> int:
+        return self.n if link == self.mech.ground else self.links.index(link)
+
+
+def _pair_rows(j: Joint, ia: int, ib: int, x: np.ndarray | None, rows: dict[str, list]) -> None:
+    """Append the equations of pair ``j`` (between poses ``ia`` and ``ib``) to ``rows``."""
+    z = np.zeros(3)
+    t = j.type
+    a = _unit(np.asarray(j.axis, float)) if j.axis is not None else None
+    if t in ("R", "U", "S"):
+        rows["pc"].append((ia, ib, x, x, z, z, 0.0))
+    if t in ("R", "C", "H"):
+        n1, n2 = _perp_basis(a)
+        rows["dot"] += [(ia, ib, a, n1, z, z, 0.0), (ia, ib, a, n2, z, z, 0.0)]
+    if t == "U":
+        a2 = _unit(np.asarray(j.axis2, float))
+        rows["dot"].append((ia, ib, a, a2, z, z, float(a @ a2)))
+    if t == "P":
+        e = np.eye(3)
+        rows["dot"] += [(ia, ib, e[0], e[1], z, z, 0.0), (ia, ib, e[1], e[2], z, z, 0.0),
+                        (ia, ib, e[2], e[0], z, z, 0.0)]
+    if t in ("P", "C", "H"):
+        n1, n2 = _perp_basis(a)
+        rows["line"] += [(ia, ib, x, x, n1, z, 0.0), (ia, ib, x, x, n2, z, 0.0)]
+    if t in ("R", "C", "H"):
+        e1, e2 = _perp_basis(a)
+        rows["angle"].append((ia, ib, a, e1, e1, e2, 0.0))
+        rows["angle_joints"].append(j.id)
+    if t in ("P", "C", "H"):
+        rows["slide"].append((ia, ib, x, x, a, z, 0.0))
+        rows["slide_joints"].append(j.id)
+
+
+def _check_joint(mech: Mechanism, j: Joint) -> None:
+    src = mech.source
+    if j.type not in SPATIAL_PAIRS:
+        raise MechsynInputError(
+            f"joint {j.id} is a {j.type} pair: spatial kinematics moves R, P, C, U, S and H pairs",
+            source=src, field=f"joints[{j.id}].type", hint="model the pair with R, P, C, U, S or H pairs")
+    if j.type != "P" and j.point is None:
+        raise MechsynInputError(f"joint {j.id} ({j.type}) has no point", source=src,
+                                field=f"joints[{j.id}].point", hint="give point: [x, y, z]")
+    if j.type != "S" and j.axis is None:
+        raise MechsynInputError(f"joint {j.id} ({j.type}) has no axis", source=src,
+                                field=f"joints[{j.id}].axis", hint="give axis: [dx, dy, dz]")
+    if j.type == "U" and j.axis2 is None:
+        raise MechsynInputError(f"joint {j.id} (U) has no axis2", source=src, field=f"joints[{j.id}].axis2",
+                                hint="give axis2: the cross's arm fixed in the second link")
+    if j.actuated and j.type not in ("R", "P", "H"):
+        raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P and H pairs can be driven "
+                                "(one input each)", source=src, field=f"joints[{j.id}].actuated",
+                                hint="drive an R, P or H pair (split a C pair into R + P)")
+
+
+def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
+    """The constraint equations of ``mech`` with the pairs ``drives`` driven.
+
+    Raises :class:`~mechsyn.errors.MechsynInputError` naming the joint and the fix for a
+    pair the engine does not move, missing geometry or an input on an undriven pair.
+    """
+    for j in mech.joints:
+        _check_joint(mech, j)
+    pts = np.array([np.asarray(j.point, float) for j in mech.joints if j.point is not None]).reshape(-1, 3)
+    centre = pts.mean(axis=0) if len(pts) else np.zeros(3)
+    spread = float(np.max(np.linalg.norm(pts - centre, axis=1))) if len(pts) else 0.0
+    scale = spread if spread > 0 else max(1.0, float(np.abs(centre).max(initial=0.0)))
+    links = tuple(mech.moving_links)
+    index = {name: k for k, name in enumerate(links)}
+    index[mech.ground] = len(links)
+    rows: dict[str, list] = {k: [] for k in ("pc", "dot", "line", "angle", "slide", "angle_joints", "slide_joints")}
+    for j in mech.joints:
+        x = (np.asarray(j.point, float) - centre) / scale if j.point is not None else np.zeros(3)
+        _pair_rows(j, index[j.links[0]], index[j.links[1]], x, rows)
+    helix = tuple((rows["angle_joints"].index(j.id), rows["slide_joints"].index(j.id), (j.pitch or 0.0) / scale)
+                  for j in mech.joints if j.type == "H")
+    drive_rows = []
+    for jid in drives:
+        j = mech.joint(jid)
+        if j.type in ("R", "H"):
+            drive_rows.append((jid, "angle", rows["angle_joints"].index(jid)))
+        else:
+            drive_rows.append((jid, "slide", rows["slide_joints"].index(jid)))
+    M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
+                     _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
+                     tuple(rows["slide_joints"]), helix, tuple(drive_rows))
+    return replace(M, lay=_layout(M))
+
+
+# --------------------------------------------------------------------------- layout
+@dataclass(frozen=True, eq=False)
+class _Layout:
+    """Gather and scatter indices of the equations, built once per model: every link-fixed
+    point (``pidx``, ``ploc``) and vector (``vidx``, ``vloc``) transformed in one product,
+    every variable Jacobian entry written in one scatter (``ri``, ``ci``) over a template
+    holding the constant ones, the scalar rows' links (``sa``, ``sb``)."""
+
+    pidx: np.ndarray
+    ploc: np.ndarray
+    vidx: np.ndarray
+    vloc: np.ndarray
+    psl: dict
+    vsl: dict
+    J0: np.ndarray
+    ri: np.ndarray
+    ci: np.ndarray
+    h_ang: np.ndarray
+    h_sl: np.ndarray
+    h_pitch: np.ndarray
+    d_meas: np.ndarray
+    d_angle: np.ndarray
+
+
+def _slices(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, dict]:
+    sl, start = {}, 0
+    for name, idx, _ in parts:
+        sl[name] = slice(start, start + len(idx))
+        start += len(idx)
+    idx = np.concatenate([p[1] for p in parts]).astype(int)
+    loc = np.concatenate([p[2].reshape(-1, 3) for p in parts])
+    return idx, loc, sl
+
+
+def _layout(M: SpatialModel) -> _Layout:
+    pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
+    pidx, ploc, psl = _slices([("xa", pc.ia, pc.va), ("xb", pc.ib, pc.vb), ("la", ln.ia, ln.va),
+                               ("lb", ln.ib, ln.vb), ("sa", sl.ia, sl.va), ("sb", sl.ib, sl.vb)])
+    vidx, vloc, vsl = _slices([("u", dt.ia, dt.va), ("w", dt.ib, dt.vb), ("ln", ln.ia, ln.n),
+                               ("aa", an.ia, an.va), ("e1b", an.ib, an.vb), ("e1a", an.ia, an.n),
+                               ("e2a", an.ia, an.m), ("sn", sl.ia, sl.n)])
+    n, k = M.n, pc.size
+    m = M.n_constraints + len(M.drives)
+    J0 = np.zeros((m, 6 * (n + 1)))
+    rows = np.arange(3 * k).reshape(k, 3)
+    ar = np.arange(3)
+    J0[rows, 6 * pc.ia[:, None] + 3 + ar] = 1.0
+    J0[rows, 6 * pc.ib[:, None] + 3 + ar] = -1.0
+    ri, ci = [], []
+    for links in (pc.ia, pc.ib):  # the 3 x 3 blocks d(x)/dω of the coincidences
+        ri.append(np.broadcast_to(rows[:, :, None], (k, 3, 3)).ravel())
+        ci.append(np.broadcast_to((6 * links[:, None] + ar)[:, None, :], (k, 3, 3)).ravel())
+    h = np.array(M.helix, float).reshape(-1, 3)
+    d_angle = np.array([kind == "angle" for _, kind, _ in M.drives], bool)
+    d_meas = np.array([kk if kind == "angle" else an.size + kk for _, kind, kk in M.drives], int)
+    d_links = [(an.ia[kk], an.ib[kk]) if kind == "angle" else (sl.ia[kk], sl.ib[kk]) for _, kind, kk in M.drives]
+    h_sl = h[:, 1].astype(int)
+    sa = np.concatenate([dt.ia, ln.ia, sl.ia[h_sl], [a for a, _ in d_links]]).astype(int)
+    sb = np.concatenate([dt.ib, ln.ib, sl.ib[h_sl], [b for _, b in d_links]]).astype(int)
+    srow = 3 * k + np.arange(len(sa))
+    for links in (sa, sb, sa, sb):  # c at a, -c at b, -n at a, +n at b
+        ri.append(np.repeat(srow, 3))
+        ci.append((6 * links[:, None] + ar).ravel())
+    ci[-2:] = [c + 3 for c in ci[-2:]]
+    return _Layout(pidx, ploc, vidx, vloc, psl, vsl, J0, np.concatenate(ri), np.concatenate(ci),
+                   h[:, 0].astype(int), h[:, 1].astype(int), h[:, 2], d_meas, d_angle)
+
+
+# --------------------------------------------------------------------------- poses
+# Every function below works on a batch of B poses at once: rotations R (B, n + 1, 3, 3),
+# positions p (B, n + 1, 3) (the frame last, at rest), twists (B, 6 n), targets (B, drives).
+def exp_twists(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotations ``E`` (k, 3, 3) and translations ``t`` (k, 3) of ``exp`` of the twists
+    ``x`` (k, 6) = ``(ω, v)``: the displacement ``y = E y + t`` (Murray et al. [2]_, eq. 2.36).
+
+    Examples
+    --------
+    >>> E, t = exp_twists(np.array([[0, 0, np.pi / 2, 1.0, 0, 0]]))
+    >>> np.round(E[0] @ [1.0, 0, 0], 12).tolist(), np.round(t[0], 6).tolist()
+    ([0.0, 1.0, 0.0], [0.63662, 0.63662, 0.0])
+    """
+    w, v = x[:, :3], x[:, 3:]
+    th2 = (w * w).sum(axis=1)
+    th = np.sqrt(th2)
+    K = np.zeros((len(x), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
+    K2 = K @ K
+    a = np.sinc(th / np.pi)                       # sin θ / θ
+    b = 0.5 * np.sinc(th / (2 * np.pi)) ** 2      # (1 - cos θ) / θ²
+    small = th < 1e-2
+    ths = np.where(small, 1.0, th)
+    c = np.where(small, 1.0 / 6 - th2 / 120 + th2 * th2 / 5040, (ths - np.sin(ths)) / ths ** 3)
+    E = K * a[:, None, None] + K2 * b[:, None, None]
+    V = K * b[:, None, None] + K2 * c[:, None, None]
+    E[:, [0, 1, 2], [0, 1, 2]] += 1.0
+    t = v + (V @ v[:, :, None])[:, :, 0]
+    return E, t
+
+
+def move(R: np.ndarray, p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Poses ``(R, p)`` displaced by the twists ``x`` (B, 6 n) of the moving links."""
+    B, n1 = p.shape[:2]
+    E, t = exp_twists(x.reshape(-1, 6))
+    E = E.reshape(B, n1 - 1, 3, 3)
+    R2, p2 = R.copy(), p.copy()
+    R2[:, :-1] = E @ R[:, :-1]
+    p2[:, :-1] = (E @ p[:, :-1, :, None])[..., 0] + t.reshape(B, n1 - 1, 3)
+    return R2, p2
+
+
+def wrap(a: np.ndarray) -> np.ndarray:
+    """Angles to (-π, π]."""
+    return np.pi - np.mod(np.pi - a, 2 * np.pi)
+
+
+class Frame:
+    """World coordinates of the model's link-fixed points and vectors at poses ``(R, p)``,
+    and the pairs' rotations ``theta`` (rad, from the drawn assembly, in (-π, π]) and slides
+    ``s`` (model units), each with the batch axis first. Attributes are views of two arrays
+    (see :class:`_Layout`)."""
+
+    def __init__(self, M: SpatialModel, R: np.ndarray, p: np.ndarray) -> None:
+        lay = M.lay
+        P = (R[:, lay.pidx] @ lay.ploc[:, :, None])[..., 0] + p[:, lay.pidx]
+        V = (R[:, lay.vidx] @ lay.vloc[:, :, None])[..., 0]
+        for name, sl in lay.psl.items():
+            setattr(self, name, P[:, sl])
+        for name, sl in lay.vsl.items():
+            setattr(self, name, V[:, sl])
+        self.theta = np.arctan2(_dot(self.e1b, self.e2a), _dot(self.e1b, self.e1a))
+        self.s = _dot(self.sb - self.sa, self.sn)
+
+    def take(self, idx: np.ndarray) -> "Frame":
+        """The frame of the poses ``idx`` of the batch."""
+        out = object.__new__(Frame)
+        out.__dict__.update({k: v[idx] for k, v in vars(self).items()})
+        return out
+
+
+def frame(M: SpatialModel, R: np.ndarray, p: np.ndarray) -> Frame:
+    """The model's points, vectors and pair coordinates at poses ``(R, p)``."""
+    return Frame(M, R, p)
+
+
+# --------------------------------------------------------------------------- equations
+def helix_angles(M: SpatialModel, F: Frame, helix_ref: np.ndarray) -> np.ndarray:
+    """The H pairs' rotations unwrapped next to ``helix_ref`` (their previous values)."""
+    return helix_ref + wrap(F.theta[:, M.lay.h_ang] - helix_ref)
+
+
+def residual(M: SpatialModel, F: Frame, helix_ref: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Residuals (B, m) of the constraint equations, then of the drives (``target``: input
+    values, rad or model units). ``helix_ref``: the H pairs' unwrapped angles before."""
+    lay = M.lay
+    B = len(target)
+    d = np.concatenate([F.theta, F.s], axis=1)[:, lay.d_meas] - target
+    d[:, lay.d_angle] = wrap(d[:, lay.d_angle])
+    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0]
+    if M.helix:
+        parts.append(F.s[:, lay.h_sl] - lay.h_pitch * helix_angles(M, F, helix_ref))
+    parts.append(d)
+    return np.concatenate(parts, axis=1)
+
+
+def _scalar_coefficients(M: SpatialModel, F: Frame) -> tuple[np.ndarray, np.ndarray]:
+    """``c`` and ``n`` of the scalar rows, each ``c · (ω_a - ω_b) + n · (v_b - v_a)``."""
+    lay = M.lay
+    c_slide = _cross(F.sn, F.sb)
+    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb)]
+    ns = [np.zeros_like(F.u), F.ln]
+    if M.helix:
+        cs.append(c_slide[:, lay.h_sl] + lay.h_pitch[:, None] * F.aa[:, lay.h_ang])
+        ns.append(F.sn[:, lay.h_sl])
+    if M.drives:
+        cs.append(np.concatenate([-F.aa, c_slide], axis=1)[:, lay.d_meas])
+        ns.append(np.concatenate([np.zeros_like(F.aa), F.sn], axis=1)[:, lay.d_meas])
+    return np.concatenate(cs, axis=1), np.concatenate(ns, axis=1)
+
+
+def jacobian(M: SpatialModel, F: Frame) -> np.ndarray:
+    """Jacobians (B, m, 6 n) of :func:`residual` in the links' twists ``(ω_i, v_i)``
+    (columns ``6 i .. 6 i + 5``)."""
+    lay = M.lay
+    B = F.xa.shape[0]
+    J = np.repeat(lay.J0[None], B, axis=0)
+    c, nv = _scalar_coefficients(M, F)
+    # d(x)/dω = -[x]x, the matrix of y -> y x x: ε_ijk x_k
+    Sa = np.einsum("ijk,bnk->bnij", _EPS, F.xa)
+    Sb = np.einsum("ijk,bnk->bnij", _EPS, F.xb)
+    J[:, lay.ri, lay.ci] = np.concatenate([Sa.reshape(B, -1), -Sb.reshape(B, -1), c.reshape(B, -1),
+                                           -c.reshape(B, -1), -nv.reshape(B, -1), nv.reshape(B, -1)], axis=1)
+    return J[:, :, :6 * M.n]
+
+
+def convective(M: SpatialModel, F: Frame, xi: np.ndarray) -> np.ndarray:
+    """``γ`` (B, m): the second time derivative of every residual at the twists ``xi``
+    (B, 6 n) with ``ξ̇ = 0``, so that the accelerations solve ``J ξ̇ = ü - γ``."""
+    lay = M.lay
+    B = xi.shape[0]
+    X = np.zeros((B, M.n + 1, 6))
+    X[:, :-1] = xi.reshape(B, -1, 6)
+    w, v = X[..., :3], X[..., 3:]
+    pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
+    wa, wb = w[:, pc.ia], w[:, pc.ib]
+    g_pc = _cross(wa, v[:, pc.ia] + _cross(wa, F.xa)) - _cross(wb, v[:, pc.ib] + _cross(wb, F.xb))
+    wa, wb = w[:, dt.ia], w[:, dt.ib]
+    ud, wd = _cross(wa, F.u), _cross(wb, F.w)
+    g_dot = _dot(_cross(wa, ud), F.w) + 2 * _dot(ud, wd) + _dot(F.u, _cross(wb, wd))
+    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln)]
+    if M.helix or M.drives:
+        g_slide = _line_gamma(w, v, sl.ia, sl.ib, F.sa, F.sb, F.sn)
+        g_angle = _dot(w[:, an.ib] - w[:, an.ia], _cross(w[:, an.ia], F.aa))
+        if M.helix:
+            parts.append(g_slide[:, lay.h_sl] - lay.h_pitch * g_angle[:, lay.h_ang])
+        parts.append(np.concatenate([g_angle, g_slide], axis=1)[:, lay.d_meas])
+    return np.concatenate(parts, axis=1)
+
+
+def _line_gamma(w: np.ndarray, v: np.ndarray, ia: np.ndarray, ib: np.ndarray, xa: np.ndarray,
+                xb: np.ndarray, nv: np.ndarray) -> np.ndarray:
+    """``γ`` of ``(x_b - x_a) · n_a``."""
+    wa, wb = w[:, ia], w[:, ib]
+    va, vb = v[:, ia] + _cross(wa, xa), v[:, ib] + _cross(wb, xb)
+    nd = _cross(wa, nv)
+    return (_dot(_cross(wb, vb) - _cross(wa, va), nv) + 2 * _dot(vb - va, nd)
+            + _dot(xb - xa, _cross(wa, nd)))

@@ -1,0 +1,492 @@
+"""Continuation of a spatial mechanism's poses over a sweep (used by
+:mod:`mechsyn.kinematics.spatial`; the equations are :mod:`mechsyn.kinematics.spatial_model`).
+
+The walk goes outwards from the drawn assembly along the sweep's rows. It moves from one
+*anchor* row to the next by a second-order predictor (the twists' first and second
+derivatives along the input step, through the exponential of a twist) and Newton
+corrections ``δξ = -J⁺ g`` (the pseudo-inverse at the regular rank ``r``: least-squares for
+redundant constraints, minimum-norm for idle motions). A step is refused when the
+corrector fails or moves the links further than half the predictor did (a jump to another
+branch); then the stride is halved, down to a single row and then to ``1/4096`` of a row.
+The stride doubles after easy steps while the predictor's step stays under
+``MAX_STEP`` (radians, or lengths in units of the length scale), so the Taylor predictor
+stays accurate. The rows between anchors are then predicted from the anchor before them
+and corrected all at once (one batch of Newton steps over every row), each with the same
+branch guard; a row the batch cannot settle is walked to on its own from the row before.
+
+References
+----------
+.. [1] E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*, SIAM,
+   2003, ch. 2 and 6 (predictor-corrector continuation, step-length control).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mechsyn.kinematics.spatial_model import (SpatialModel, _cross, convective, frame, helix_angles, jacobian, move,
+                                              residual)
+
+__all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
+
+#: A singular value below this fraction of the largest is a lost direction (rank decisions).
+RANK_TOL = 1e-8
+#: Residual (in units of the length scale) at which the corrector accepts a pose.
+NEWTON_TOL = 1e-12
+#: Largest predictor step between anchors (radians; lengths in units of the length scale).
+MAX_STEP = 0.5
+MAX_HALVINGS = 12
+MAX_STRIDE = 64
+
+
+@dataclass
+class Lin:
+    """Jacobians ``Jc`` (B, m, 6 n) at B poses, in twists taken at the links' centres ``C``
+    (B, n, 3) (see :meth:`Tracker.lin`), and their minimum-norm least-squares solutions.
+
+    The solutions use the smaller Gram matrix (``Jc^T Jc`` or ``Jc Jc^T``) with a damping
+    ``μ = 1e-14`` of its largest diagonal entry, then two steps of iterative refinement
+    (iterated Tikhonov: each step multiplies the damping's error by ``μ / (σ² + μ)``), so
+    the answer is the pseudo-inverse's to rounding wherever ``σ_r / σ_1`` is above about
+    ``1e-5``; the solution stays in the row space of ``Jc`` (no idle component) by
+    construction. A batched linear solve costs a few percent of a batched SVD.
+    """
+
+    Jc: np.ndarray
+    G: np.ndarray
+    rows: bool
+    r: int
+    C: np.ndarray
+
+    @functools.cached_property
+    def Ginv(self) -> np.ndarray:
+        """The inverse of the damped Gram matrix (one inversion serves every solve)."""
+        return np.linalg.inv(self.G)
+
+    @functools.cached_property
+    def ratio(self) -> np.ndarray:
+        """``σ_r / σ_1`` per pose, 0 where the rank has dropped: exact (an SVD) where it is
+        under ``1e-3``; elsewhere a lower bound within a factor ``√k``
+        (``1 / √(‖G‖_F ‖G⁻¹‖_F)`` for a Gram matrix of rank ``k = r``), which is enough to
+        tell a regular pose."""
+        B, k = self.G.shape[:2]
+        if self.r == 0:
+            return np.ones(B)
+        out = np.zeros(B)
+        if k == self.r:
+            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+                out = 1.0 / np.sqrt(np.linalg.norm(self.G, axis=(1, 2)) * np.linalg.norm(self.Ginv, axis=(1, 2)))
+            out = np.nan_to_num(out)
+        exact = out < 1e-3
+        if exact.any():
+            out[exact] = svd_ratio(self.Jc[exact], self.r)
+        return out
+
+    def twists(self, y: np.ndarray) -> np.ndarray:
+        """Twists ``(ω, u)`` at the centres (B, 6 n, ...) -> ``(ω, v)`` at the origin: ``v = u + c × ω``."""
+        B = len(y)
+        Y = y.reshape(B, self.C.shape[1], 6, -1)
+        X = Y.copy()
+        X[:, :, 3:] += _cross_cols(self.C, Y[:, :, :3])
+        return X.reshape(y.shape)
+
+    def _once(self, b: np.ndarray) -> np.ndarray:
+        JT = self.Jc.transpose(0, 2, 1)
+        if self.rows:
+            return JT @ (self.Ginv @ b)
+        return self.Ginv @ (JT @ b)
+
+    def solve(self, b: np.ndarray, refine: int = 0) -> np.ndarray:
+        b = b[..., None]
+        y = self._once(b)
+        for _ in range(refine):
+            y += self._once(b - self.Jc @ y)
+        return self.twists(y)[..., 0]
+
+    def take(self, idx: np.ndarray) -> "Lin":
+        out = Lin(self.Jc[idx], self.G[idx], self.rows, self.r, self.C[idx])
+        out.__dict__["Ginv"] = self.Ginv[idx]
+        return out
+
+
+def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
+    """``σ_r / σ_1`` of each of the matrices ``Jc`` (B, m, k) by an SVD (0 where ``σ_1 = 0``)."""
+    sv = np.linalg.svd(Jc, compute_uv=False)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.nan_to_num(sv[:, r - 1] / sv[:, 0])
+
+
+def _cross_cols(c: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``c × w`` for ``c`` (B, n, 3) and columns ``w`` (B, n, 3, k)."""
+    c = c[..., None]
+    return np.stack([c[:, :, 1] * w[:, :, 2] - c[:, :, 2] * w[:, :, 1], c[:, :, 2] * w[:, :, 0] - c[:, :, 0] * w[:, :, 2],
+                     c[:, :, 0] * w[:, :, 1] - c[:, :, 1] * w[:, :, 0]], axis=2)
+
+
+@dataclass
+class State:
+    """B assembled poses: link poses, unwrapped H angles, frame, linearisation, residuals."""
+
+    R: np.ndarray
+    p: np.ndarray
+    href: np.ndarray
+    F: Any
+    lin: Lin
+    g: np.ndarray
+
+    def take(self, idx: Any) -> "State":
+        idx = np.atleast_1d(idx)
+        F = None if self.F is None else self.F.take(idx)
+        return State(self.R[idx], self.p[idx], self.href[idx], F, self.lin.take(idx), self.g[idx])
+
+
+def link_centres(M: SpatialModel) -> np.ndarray:
+    """Centre of each moving link (n, 3, model units): the mean of its joints' points."""
+    c = np.zeros((M.n, 3))
+    for i, link in enumerate(M.links):
+        pts = [M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
+        if pts:
+            c[i] = np.mean(pts, axis=0)
+    return c
+
+
+def _blocks(M: SpatialModel) -> tuple[np.ndarray, np.ndarray]:
+    """(row, moving link) of every block of the Jacobian that may be non-zero."""
+    lay = M.lay
+    r0, c0 = np.nonzero(lay.J0)
+    rows = np.concatenate([lay.ri, r0])
+    links = np.concatenate([lay.ci, c0]) // 6
+    pairs = np.unique(np.stack([rows, links], axis=1)[links < M.n], axis=0)
+    return pairs[:, 0], pairs[:, 1]
+
+
+class Tracker:
+    """Predictor-corrector continuation of one model (see the module doc)."""
+
+    def __init__(self, M: SpatialModel) -> None:
+        self.M = M
+        self.m_c = M.n_constraints
+        self.rank: int | None = None
+        self.drawn_singular: int | None = None  # the drawn assembly's rank when below the sweep's
+        self.halvings = 0
+        self.c0 = link_centres(M)
+        self.blocks = _blocks(M)
+
+    def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
+        """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
+        ``(ω, u)`` with ``u`` the velocity of each link's centre ``c`` (``v = u + c × ω``).
+
+        A minimum-norm solution in these coordinates is orthogonal to the idle motions,
+        and an idle spin of a link about a line through its centre is ``(a, 0)`` there
+        (a rod between two ball joints has its centre on its line), so minimum-norm rates
+        and steps give the spin no component: idle spins stay at rest, whichever point the
+        file measures from."""
+        B, n = len(J), self.M.n
+        C = (R[:, :-1] @ self.c0[:, :, None])[..., 0] + p[:, :-1]
+        Jr = J.reshape(B, -1, n, 6).copy()
+        rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
+        Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
+        Jc = Jr.reshape(J.shape)
+        if self.rank is None:  # the regular rank: at the drawn assembly, by an SVD
+            s0 = np.linalg.svd(Jc[0], compute_uv=False)
+            self.rank = int(np.count_nonzero(s0 > RANK_TOL * s0[0])) if s0.size and s0[0] > 0 else 0
+        rows = J.shape[1] < J.shape[2]
+        G = Jc @ Jc.transpose(0, 2, 1) if rows else Jc.transpose(0, 2, 1) @ Jc
+        k = G.shape[1]
+        G[:, np.arange(k), np.arange(k)] += 1e-14 * np.abs(G).max(axis=(1, 2))[:, None] + 1e-300
+        return Lin(Jc, G, rows, self.rank, C)
+
+    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
+        F = frame(self.M, R, p)
+        g = residual(self.M, F, href, target)
+        if self.M.helix:
+            href = helix_angles(self.M, F, href)
+        return State(R, p, href, F, self.lin(jacobian(self.M, F), R, p), g)
+
+    def rates(self, st: State, du: np.ndarray, refine: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
+        derivatives (``J ξ' = du``, ``J ξ'' = -γ(ξ')``); ``refine``: steps of iterative
+        refinement (2 for the rates reported, none for a predictor)."""
+        F = st.F if st.F is not None else frame(self.M, st.R, st.p)
+        b = np.zeros(st.g.shape)
+        b[:, self.m_c:] = du
+        x1 = st.lin.solve(b, refine)
+        return x1, st.lin.solve(-convective(self.M, F, x1), refine)
+
+    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
+                limit: np.ndarray, iters: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+        """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
+        those that converged without moving further than ``limit``, and ``(frame,
+        residuals, linearisation)`` of the last iterate (the linearisation is that of an
+        earlier iterate, None when none was needed). The Jacobian of the first iterate is
+        kept while the residuals fall at least tenfold per step (the predictor lands
+        close, so that is most steps) and taken afresh otherwise."""
+        B = len(R)
+        moved = np.zeros(B)
+        done = np.zeros(B, bool)
+        failed = np.zeros(B, bool)
+        lin, rows, last = None, np.zeros(B, bool), np.full(B, np.inf)
+        for it in range(iters):
+            F = frame(self.M, R, p)
+            g = residual(self.M, F, href, target)
+            err = np.abs(g).max(axis=1)
+            done |= err < NEWTON_TOL
+            if it >= 10:  # no longer converging: give up on those
+                failed |= ~done & (err > 0.5 * last)
+            active = ~done & ~failed
+            if not active.any():
+                break
+            if lin is None or np.any(err[active] > 0.1 * last[active]) or not rows[active].all():
+                idx = np.flatnonzero(active)
+                lin = self.lin(jacobian(self.M, F.take(idx) if len(idx) < B else F), R[idx], p[idx])
+                rows = active.copy()
+            last = err
+            dx = np.zeros((B, 6 * self.M.n))
+            dx[rows] = -lin.solve(g[rows])
+            dx[~active] = 0.0
+            moved += np.abs(dx).max(axis=1)
+            failed |= moved > limit
+            dx[failed] = 0.0
+            R, p = move(R, p, dx)
+        return R, p, done & ~failed, (F, g, lin if lin is not None and rows.all() else None)
+
+    def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
+        """One predictor-corrector step of a single pose; (the new state or None, the
+        predictor's step size). The new state keeps the corrector's linearisation (of
+        the predicted pose): good for the next predictor; the rates reported are
+        computed afresh at every row (:func:`mechsyn.kinematics.spatial._sweep_rows`)."""
+        x1, x2 = self.rates(st, du[None])
+        size = float(np.abs(x1).max(initial=0.0))
+        if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
+            return None, size
+        R, p = move(st.R, st.p, x1 + 0.5 * x2)
+        R, p, ok, (F, g, lin) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        if not ok[0]:
+            return None, size
+        if lin is None:
+            return self.state(R, p, st.href, target[None]), size
+        href = helix_angles(self.M, F, st.href) if self.M.helix else st.href
+        return State(R, p, href, F, lin, g), size
+
+    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+        """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
+        ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
+        t, h = 0.0, 1.0
+        while t < 1.0:
+            h = min(h, 1.0 - t)
+            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
+            if nxt is None:
+                if h < 0.5 ** MAX_HALVINGS:
+                    return None
+                h *= 0.5
+                self.halvings += size <= MAX_STEP  # trouble, not a long step
+                continue
+            st, t = nxt, t + h
+            h = min(1.0, 2 * h)
+        return st
+
+    def reassemble(self, st: State, U: np.ndarray, rows: np.ndarray) -> tuple[int, State] | None:
+        """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges,
+        and its state; all rows tried in one batch."""
+        B = len(rows)
+        rep = np.zeros(B, int)
+        R, p, ok, _ = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
+        if not ok.any():
+            return None
+        j = int(np.argmax(ok))
+        return int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None])
+
+
+# --------------------------------------------------------------------------- the walk
+@dataclass
+class Walk:
+    """Poses of every row (NaN where not reached) and the events met on the way."""
+
+    R: np.ndarray
+    p: np.ndarray
+    href: np.ndarray
+    ok: np.ndarray
+    events: list
+
+    def put(self, k: int | np.ndarray, st: State) -> None:
+        self.R[k], self.p[k], self.href[k] = st.R, st.p, st.href
+        self.ok[k] = True
+
+    def at(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.R[k:k + 1], self.p[k:k + 1], self.href[k:k + 1]
+
+
+def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
+    """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
+    inputs): to the row nearest it, then outwards both ways (anchors, then the rows between
+    them in one batch). ``event(index, kind, detail)`` makes the event dicts."""
+    M = tr.M
+    N = len(U)
+    w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
+             np.zeros((N, len(M.helix))), np.zeros(N, bool), [])
+    k0 = int(np.argmin(np.abs(U).max(axis=1)))
+    st = tr.advance(start, np.zeros(U.shape[1]), U[k0])
+    if st is None:
+        w.events.append(event(k0, "not assembled", None))
+        return w
+    w.put(k0, st)
+    for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1)):
+        anchors, gaps = _anchors(tr, w, st, U, k0, order, event)
+        _fill(tr, w, U, k0, order, anchors, gaps)
+    w.events.sort(key=lambda e: e["index"])
+    return w
+
+
+def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray,
+             event: Any) -> tuple[set, set]:
+    """Walk along ``order`` by adaptive strides; the rows reached (anchors) go into ``w``.
+    Returns the anchors and the rows of the gaps (not assembled on the way)."""
+    anchors, gaps = {k0}, set()
+    prev, i, stride, gap = k0, 0, 1, False
+    while i < len(order):
+        if gap:  # the first row after the gap where Newton from the last pose converges
+            k = tr.reassemble(st, U, order[i:])
+            if k is None:
+                gaps.update(int(r) for r in order[i:])
+                break
+            where = i + int(np.flatnonzero(order[i:] == k[0])[0])
+            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1], anchors)
+            gaps.update(int(r) for r in order[i:where] if r not in anchors)
+            w.events.append(event(first, "reassembled", None))
+            st, prev, gap, i = k[1], k[0], False, where + 1
+            continue
+        j = min(i + stride, len(order)) - 1
+        k = int(order[j])
+        nxt, size = tr.step(st, U[k] - U[prev], U[k])
+        if nxt is None and j == i:  # a single row: halve within it
+            nxt = tr.advance(st, U[prev], U[k])
+            if nxt is None:
+                w.events.append(event(k, "dead point", st.lin.ratio[0]))
+                i, gap = i + 1, True
+                gaps.add(k)
+                continue
+        if nxt is None:
+            stride = max(1, stride // 2)
+            continue
+        per_row = size / (j + 1 - i)
+        st, prev, i = nxt, k, j + 1
+        w.put(k, st)
+        anchors.add(k)
+        stride = int(max(1, min(2 * stride, MAX_STRIDE, MAX_STEP / max(per_row, 1e-300))))
+    return anchors, gaps
+
+
+def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray, anchors: set) -> int:
+    """From the reassembled row ``rows[0]`` (state ``st``) back through the gap's rows while
+    the mechanism follows (so the gap ends where the mechanism stops assembling, not where
+    Newton first converged); returns the first row of the assembled stretch."""
+    w.put(int(rows[0]), st)
+    anchors.add(int(rows[0]))
+    for prev, k in zip(rows[:-1], rows[1:]):
+        st = tr.advance(st, U[prev], U[k])
+        if st is None:
+            return int(prev)
+        w.put(int(k), st)
+        anchors.add(int(k))
+    return int(rows[-1])
+
+
+def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, anchors: set, gaps: set) -> None:
+    """The rows of ``order`` between anchors, from the anchor before each, in one batch;
+    rows the batch cannot settle are walked to one by one."""
+    seq = np.concatenate([[k0], order])
+    reached = np.array([int(k) in anchors for k in seq])
+    src = np.maximum.accumulate(np.where(reached, np.arange(len(seq)), -1))
+    in_gap = np.array([int(k) in gaps for k in seq])
+    todo = np.flatnonzero(~reached & ~in_gap & (src >= 0))
+    if not len(todo):
+        return
+    rows, base = seq[todo], seq[src[todo]]
+    ub, which = np.unique(base, return_inverse=True)  # each anchor's state once
+    st = tr.state(w.R[ub], w.p[ub], w.href[ub], U[ub]).take(which)
+    du = U[rows] - U[base]
+    x1, x2 = tr.rates(st, du)
+    R, p = move(st.R, st.p, x1 + 0.5 * x2)
+    size = np.abs(x1).max(axis=1)
+    limit = np.where(size <= MAX_STEP, 0.5 * size + 1e-9, -1.0)  # too far: walked to on its own
+    R, p, ok, _ = tr.correct(R, p, st.href, U[rows], limit)
+    good = rows[ok]
+    F = frame(tr.M, R[ok], p[ok])
+    href = helix_angles(tr.M, F, st.href[ok]) if tr.M.helix else st.href[ok]
+    w.R[good], w.p[good], w.href[good] = R[ok], p[ok], href
+    w.ok[good] = True
+    for t in todo[~ok]:  # on its own, from the row before it in the walk
+        k, before = int(seq[t]), int(seq[t - 1])
+        if not w.ok[before]:
+            continue
+        prev = tr.state(*w.at(before), U[before][None])
+        nxt = tr.advance(prev, U[before], U[k])
+        if nxt is not None:
+            w.put(k, nxt)
+
+
+# --------------------------------------------------------------------------- crossings
+GOLDEN_STEPS = 40
+
+
+def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list[tuple[int, np.ndarray, float]]:
+    """Singular configurations the sweep passes between rows: ``(row, inputs, ratio)``.
+
+    ``σ_r / σ_1`` is zero at a singular configuration and, along a motion through it,
+    grows like the distance ``|t - t*|`` on both sides (a V), while a regular minimum is
+    smooth (``a + c t²``). A row whose ratio is a local minimum with its two neighbours'
+    sum at least four times its own (every V passes: ``2 Δ / |δ| >= 4`` for a zero at
+    ``δ`` within half a row; a smooth minimum passes only when it is sharp for its depth,
+    ``c Δ² >= a``, i.e. near-singular) is refined by a golden-section search of the ratio
+    over the inputs between its neighbours, each pose reached by continuation from the
+    row; it is a crossing when the smallest ratio found is under ``RANK_TOL``."""
+    out = []
+    N = len(U)
+    for k in range(1, N - 1):
+        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]):
+            continue
+        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
+        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= RANK_TOL):
+            continue
+        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
+        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
+            continue  # not on one straight stretch of the sweep
+        found = _golden(tr, w, U, k)
+        if found is not None and found[1] < RANK_TOL:
+            out.append((k, found[0], found[1]))
+    return out
+
+
+def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, float] | None:
+    """The least ``σ_r / σ_1`` between rows ``k - 1`` and ``k + 1`` (golden section)."""
+    st = tr.state(*w.at(k), U[k][None])
+    lo, hi = U[k - 1], U[k + 1]
+
+    def f(t: float) -> float:
+        u = lo + t * (hi - lo)
+        nxt = tr.advance(st, U[k], u)
+        if nxt is None:
+            return np.inf
+        return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
+
+    halvings = tr.halvings  # the search's own step halvings are not the sweep's trouble
+    g = (np.sqrt(5) - 1) / 2
+    a, b = 0.0, 1.0
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(GOLDEN_STEPS):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    tr.halvings = halvings
+    t, best = (c, fc) if fc < fd else (d, fd)
+    return (lo + t * (hi - lo), best) if np.isfinite(best) else None
