@@ -30,7 +30,7 @@ import traitlets
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
-           "atlas.js", "forces.js", "studio.js")
+           "atlas.js", "forces.js", "view3d.js", "studio.js")  # view3d.js: the 3-D view
 
 
 def _body_markup() -> str:
