@@ -43,7 +43,7 @@ def widget_esm() -> str:
     parts = []
     for name in MODULES:
         text = (STATIC / name).read_text(encoding="utf-8")
-        text = re.sub(r"^import .*? from \"\./[a-z]+\.js\";\n", "", text, flags=re.M)
+        text = re.sub(r"^import .*? from \"\./[a-z0-9]+\.js\";.*\n", "", text, flags=re.M)  # view3d: digits, comments
         parts.append(f"// ---- {name}\n{text}")
     render = """
 // ---- the widget: the studio's markup in the cell, requests as messages to the kernel
