@@ -136,6 +136,11 @@ def test_bennett_and_delta_open_in_3d(serve, page):
         set_slider(page, 0)
         page.click("#view3d-reset")
         assert moved(before, joint_centres(page)) < 1.0
+        set_slider(page, 20)  # the picture for docs/studio.md: 40 degrees on, seen from higher up
+        page.mouse.move(box["x"] + 30, box["y"] + box["height"] - 80)
+        page.mouse.down()
+        page.mouse.move(box["x"] + 10, box["y"] + box["height"] - 50, steps=3)
+        page.mouse.up()
         shot(page, f"studio_3d_{name}.png")
     # a planar example brings the editor's canvas back
     page.select_option("#examples", "fourbar")

@@ -50,12 +50,16 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   Object.assign(svg.style, { width: "100%", height: "100%", display: "none", background: "#fff", touchAction: "none", userSelect: "none", cursor: "move" });
   canvas.after(svg);
   const bar = document.createElement("div");
-  Object.assign(bar.style, { position: "absolute", right: "8px", top: "8px", display: "none", gap: "6px", alignItems: "center" });
+  Object.assign(bar.style, { position: "absolute", right: "8px", bottom: "8px", display: "none", gap: "6px", alignItems: "center" });
   const reset = document.createElement("button"), persp = document.createElement("input"), lab = document.createElement("label");
   reset.textContent = "Reset view"; reset.id = "view3d-reset"; reset.title = "Back to the first view (double-click)";
   persp.type = "checkbox"; persp.id = "view3d-perspective";
   lab.append(persp, " perspective");
-  bar.append(lab, reset);
+  const axesBox = document.createElement("input"), axesLab = document.createElement("label");
+  axesBox.type = "checkbox"; axesBox.id = "view3d-axes"; axesBox.checked = true;
+  axesLab.append(axesBox, " axis lines");
+  axesLab.title = "Draw the axes of the R, C and H pairs as lines (a spherical linkage's meet at its centre)";
+  bar.append(axesLab, lab, reset);
   canvas.parentNode.append(bar);
 
   const v3 = { view: null, mech: null, key: "", error: null, loading: false, cam: null, gesture: null, draws: 0 };
@@ -176,8 +180,9 @@ export function mountView3d({ $, state, svg: canvas, render }) {
     } else if (j.type === "U") {
       for (const a of axes) line(P(add(p, a, -h)), P(add(p, a, h)), { stroke: ink, "stroke-width": 5, "stroke-linecap": "round" });
       el("circle", { cx: c[0].toFixed(1), cy: c[1].toFixed(1), r: 4, fill: "#fff", stroke: ink, "stroke-width": 2 }, g);
-    } else { // R, C, H: a shaft along the axis (H dashed)
+    } else { // R, C, H: a shaft along the axis (H dashed), the axis as a thin line
       const a = P(add(p, axes[0], -h)), b = P(add(p, axes[0], h));
+      if (axesBox.checked) line(P(add(p, axes[0], -2 * v3.cam.radius)), P(add(p, axes[0], 2 * v3.cam.radius)), { stroke: "#99a", "stroke-width": 1, "stroke-dasharray": "8 3 2 3", class: "axis-line" });
       line(a, b, { stroke: ink, "stroke-width": 13, "stroke-linecap": "butt" });
       line(a, b, { stroke: j.type === "C" ? "#c9d6e6" : "#fff", "stroke-width": 9, "stroke-linecap": "butt", "stroke-dasharray": j.type === "H" ? "3 2" : null });
     }
@@ -268,6 +273,7 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   const home = () => { if (shown()) { fit(); draw(); } };
   svg.addEventListener("dblclick", home);
   reset.onclick = home;
+  axesBox.onchange = () => { if (shown()) draw(); };
   persp.onchange = () => { if (v3.cam) { v3.cam.perspective = persp.checked; draw(); } };
 
   return { open, shown, update };
