@@ -78,10 +78,42 @@ def test_check_note_says_3d_where_the_engine_moves_the_file(client):
     assert "line_contact" in refused[0]["message"]
 
 
+def test_view_route_loads_no_matplotlib(tmp_path):
+    """The 3-D view is drawn by the page: the route and the check load no Matplotlib."""
+    import os
+    import subprocess
+    import sys
+    import textwrap
+    from pathlib import Path
+
+    code = textwrap.dedent(f"""
+        import sys
+        from starlette.testclient import TestClient
+        from mechsyn.io import load_mechanism, mechanism_to_dict
+        from mechsyn.web._app import create_app
+        from mechsyn.web._service import example_path
+
+        app = create_app({str(tmp_path)!r}, token="t")
+        with TestClient(app, base_url="http://127.0.0.1", headers={{"X-Mechsyn-Token": "t"}}) as c:
+            for name in ("bennett", "delta"):
+                m = mechanism_to_dict(load_mechanism(example_path(name)))
+                for path in ("/api/spatial/view", "/api/studio/check"):
+                    r = c.post(path, json={{"mechanism": m, "steps": 12}})
+                    assert r.status_code == 200, (path, r.text)
+        assert "matplotlib" not in sys.modules, "a 3-D view route imported matplotlib"
+        print("ok")
+    """)
+    src = str(Path(__file__).resolve().parents[2] / "src")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([src, os.environ.get("PYTHONPATH", "")])}
+    run = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True, timeout=300,
+                         env=env)
+    assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr[-2000:]
+
+
 # ------------------------------------------------------------------------------ browser
 def open_example(page, name):
     page.select_option("#examples", name)
-    wait_js(page, "n => window.__studio.fileName.startsWith(n + '.') && window.__view3d.view"
+    wait_js(page, "n => window.__studio.fileName.startsWith(n + '.') && window.__view3d.view && !window.__view3d.loading"
                   " && window.__view3d.mech === window.__studio.mech && window.__view3d.draws > 0", name, timeout=60)
 
 
@@ -151,7 +183,7 @@ def test_bennett_and_delta_open_in_3d(serve, page):
 
 
 @pytest.mark.slow
-def test_spherical_fourbar_turned_and_refused_file_keeps_top_view(serve, page):
+def test_spherical_fourbar_rssr_dead_point_and_refused_file_keeps_top_view(serve, page):
     srv = serve(None)
     page.goto(srv.url)
     wait_js(page, "() => document.querySelectorAll('#examples option').length > 20")
@@ -164,9 +196,28 @@ def test_spherical_fourbar_turned_and_refused_file_keeps_top_view(serve, page):
     set_slider(page, 30)
     wait_js(page, "() => window.__studio.frame === 30")
     shot(page, "studio_3d_spherical_fourbar.png")
+    # the RSSR crank does not turn fully: beyond its dead point the banner says so, and the
+    # view stays at the last assembled input (the engine's rows, never extrapolated)
+    open_example(page, "rssr")
+    v = page.evaluate("() => window.__view3d.view")
+    dead = next(e for e in v["events"] if e["kind"] == "dead point")
+    k = max(i for i in range(dead["index"] + 1) if v["assembled"][i])  # the last row the crank reaches
+    assert 0 < k and not v["assembled"][k + 5]
+    set_slider(page, k + 5)
+    wait_js(page, "k => window.__studio.frame === k", k + 5)
+    text = page.locator("[data-banner]").inner_text()
+    u = v["input"]["values"]
+    assert f"not assembled at A = {u[k + 5]:.1f}°" in text and f"shown at A = {u[k]:.1f}°" in text
+    assert f"dead point at A = {dead['input']['A']:.2f}" in text
+    at_dead = joint_centres(page)
+    set_slider(page, k)
+    wait_js(page, "k => window.__studio.frame === k", k)
+    assert moved(at_dead, joint_centres(page)) < 0.5
+    assert "not assembled" not in page.locator("[data-banner]").inner_text()
     # a cam gripper (line contact): the engine cannot move it, the top view and the note stay
     page.select_option("#examples", "gripper_003")
-    wait_js(page, "() => window.__studio.fileName.startsWith('gripper_003.') && window.__view3d.error")
+    wait_js(page, "() => window.__studio.fileName.startsWith('gripper_003.') && window.__view3d.error"
+                  " && window.__studio.check")
     assert page.locator("#canvas").is_visible() and not page.locator("#view3d").is_visible()
     text = page.locator("[data-banner]").inner_text()
     assert "structure and rank analysis only" in text and text.count("line_contact") == 1

@@ -81,7 +81,9 @@ export function mountView3d({ $, state, svg: canvas, render }) {
     if (!mech || mech.kind === "planar") { v3.key = ""; v3.view = null; v3.error = null; show(false); return; }
     const key = JSON.stringify(mech);
     if (key === v3.key) { v3.mech = mech; return; }
-    const same = v3.view && v3.mech && v3.mech.joints.map((j) => j.id).join() === mech.joints.map((j) => j.id).join();
+    // an edit of the mechanism shown keeps its picture (and the camera) until the new sweep comes
+    const ids = (m) => m.name + ":" + m.joints.map((j) => j.id).join();
+    const same = !!(v3.view && v3.mech && ids(v3.mech) === ids(mech));
     v3.key = key; v3.error = null; v3.loading = true;
     if (!same) v3.view = null;
     v3.mech = mech;
@@ -211,8 +213,9 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   function banner() {
     const b = $("banner"), items = [];
     const msg = v3.error ? String(v3.error.error || v3.error) : "";
-    // the engine's refusal is told once: by the check's note (web/_spatial.py check_note) when it has it
-    if (v3.error && !(state.diagnostics || []).some((d) => d.message.includes(msg)))
+    // the engine's refusal is told once: by the check's note (web/_spatial.py check_note) when it has
+    // it, else here once the check has answered
+    if (v3.error && state.check && !(state.diagnostics || []).some((d) => d.message.includes(msg)))
       items.push(div("warn", `3-D view: ${msg}${v3.error.hint ? " — fix: " + v3.error.hint : ""}`));
     else if (v3.loading && !shown()) items.push(div("note", "3-D view: simulating the spatial mechanism…"));
     if (shown()) {
