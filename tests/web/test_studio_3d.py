@@ -63,6 +63,10 @@ def test_view_route_rows_not_assembled_are_null_and_refusals_name_the_fix(client
     assert planar.status_code == 400 and planar.json()["field"] == "kind"
     contact = client.post("/api/spatial/view", json={"mechanism": spatial_dict("gripper_003")})
     assert contact.status_code == 400 and "line_contact" in contact.json()["error"] and contact.json()["hint"]
+    # a P drive: the drawn pose is the middle row, input 0 exactly
+    p = client.post("/api/spatial/view", json={"mechanism": spatial_dict("stewart_6ups"), "steps": 180}).json()
+    assert len(p["assembled"]) == 181 and p["home"] == 90 and p["input"]["values"][90] == 0.0
+    assert p["assembled"][90] and p["input"]["type"] == "P"
     bad = client.post("/api/spatial/view", json={"mechanism": spatial_dict("bennett"), "steps": 1})
     assert bad.status_code == 400 and bad.json()["field"] == "steps"
 

@@ -40,7 +40,7 @@ MAX_STEPS = _service.MAX_STEPS
 def _sweep_of(mech, steps: int) -> tuple[str, np.ndarray, int]:
     """The first drive, its inputs from the drawn assembly and the row of the drawn pose: a
     full turn for an R or H drive (row 0), ± half the length scale for a P drive (the middle
-    row)."""
+    row of an odd number of rows: ``steps`` or one more)."""
     drives = [j for j in mech.joints if j.actuated]
     if not drives:
         raise MechsynInputError("no drive: nothing moves", field="joints",
@@ -51,7 +51,8 @@ def _sweep_of(mech, steps: int) -> tuple[str, np.ndarray, int]:
     if drive.type == "P":
         pts = np.array([j.point for j in mech.joints if j.point is not None], float)
         span = float(np.ptp(pts, axis=0).max()) if len(pts) > 1 else 1.0
-        return drive.id, np.linspace(-span / 2, span / 2, n), (n - 1) // 2
+        n |= 1
+        return drive.id, span * (np.arange(n) - n // 2) / (n - 1), n // 2  # the middle one exactly 0
     return drive.id, np.linspace(0.0, 360.0, n + 1)[:n], 0
 
 
