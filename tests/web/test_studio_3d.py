@@ -200,6 +200,16 @@ def test_spherical_fourbar_rssr_dead_point_and_refused_file_keeps_top_view(serve
     set_slider(page, 30)
     wait_js(page, "() => window.__studio.frame === 30")
     shot(page, "studio_3d_spherical_fourbar.png")
+    # the studio's ▶ (and Space) play the 3-D view through the sweep
+    page.click("#play")
+    wait_js(page, "() => window.__view3d.playing && window.__studio.frame !== 30")
+    assert page.locator("#play").inner_text() == "❚❚"
+    page.click("#play")
+    assert not page.evaluate("() => window.__view3d.playing") and page.locator("#play").inner_text() == "▶"
+    page.keyboard.press(" ")
+    wait_js(page, "() => window.__view3d.playing")
+    page.keyboard.press(" ")
+    assert not page.evaluate("() => window.__view3d.playing")
     # the RSSR crank does not turn fully: beyond its dead point the banner says so, and the
     # view stays at the last assembled input (the engine's rows, never extrapolated)
     open_example(page, "rssr")

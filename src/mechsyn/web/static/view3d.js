@@ -62,7 +62,7 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   bar.append(axesLab, lab, reset);
   canvas.parentNode.append(bar);
 
-  const v3 = { view: null, mech: null, key: "", error: null, loading: false, cam: null, gesture: null, draws: 0 };
+  const v3 = { view: null, mech: null, key: "", error: null, loading: false, cam: null, gesture: null, draws: 0, playing: false };
   window.__view3d = v3; // for tests (read-only use)
   const shown = () => !!(v3.view && state.mech === v3.mech && state.mech.kind !== "planar");
 
@@ -245,7 +245,7 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   // Called by the studio's render() after its banner and player: draws the view when shown.
   function update() {
     if (shown()) { show(true); draw(); player(); }
-    else if (svg.style.display !== "none") show(false);
+    else if (svg.style.display !== "none") { show(false); play(false); }
     banner();
   }
 
@@ -278,6 +278,34 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   reset.onclick = home;
   axesBox.onchange = () => { if (shown()) draw(); };
   persp.onchange = () => { if (v3.cam) { v3.cam.perspective = persp.checked; draw(); } };
+
+  // ---- play (the studio's ▶ button, Space, its speed and ⇄): through the assembled rows, turning
+  // round at the ends of a working range, round and round over a full turn
+  let timer = null, last = 0;
+  function tick(t) {
+    if (!v3.playing) return;
+    if (t - last >= 1000 / +$("speed").value) {
+      last = t;
+      const ok = v3.view.assembled, n = ok.length, full = v3.view.input.type !== "P" && ok.every(Boolean);
+      let next = state.frame + state.dir;
+      if (full) next = (next + n) % n;
+      else if (!ok[next]) { state.dir = -state.dir; next = ok[state.frame + state.dir] ? state.frame + state.dir : state.frame; }
+      state.frame = next;
+      render();
+    }
+    timer = requestAnimationFrame(tick);
+  }
+  function play(on) {
+    v3.playing = on && shown();
+    $("play").textContent = v3.playing ? "❚❚" : "▶";
+    cancelAnimationFrame(timer);
+    if (v3.playing) timer = requestAnimationFrame(tick);
+  }
+  $("play").addEventListener("click", (ev) => { if (shown()) { ev.stopImmediatePropagation(); play(!v3.playing); } }, true);
+  (canvas.closest(".mechsyn-studio") || document).addEventListener("keydown", (ev) => {
+    if (ev.key !== " " || !shown() || (ev.target.matches && ev.target.matches("input:not([type=checkbox]):not([type=range]), textarea, select"))) return;
+    ev.preventDefault(); ev.stopImmediatePropagation(); play(!v3.playing);
+  }, true);
 
   return { open, shown, update };
 }
