@@ -256,7 +256,7 @@ def test_mistakes_said_in_the_studio_words_next_to_the_element(serve, page, tmp_
     banner_has(page, "ground")
     assert "noground.yaml" in page.evaluate(BANNER)
     page.set_input_files("#upload", str(example_path("bennett")))
-    banner_has(page, "spatial mechanism: structure and rank analysis only")
+    banner_has(page, "spatial mechanism: 3-D view")  # issue 25: shown in 3-D (test_studio_3d.py)
     assert page.locator("[data-banner] .err").count() == 0
     assert page.console_errors == []
 

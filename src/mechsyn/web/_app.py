@@ -42,7 +42,7 @@ from starlette.staticfiles import StaticFiles
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
-from mechsyn.web import _files, _service, _studio
+from mechsyn.web import _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
 from mechsyn.web._jobs import JobTable
 
 log = logging.getLogger("mechsyn.web")
@@ -383,6 +383,7 @@ def _routes() -> list:
         Route("/api/jobs/{job}/cancel", _job_cancel, methods=["POST"]),
         Route("/api/jobs/{job}/events", _job_events),
         *_studio.routes(),
+        *_spatial.routes(),  # view3d: POST /api/spatial/view
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
 

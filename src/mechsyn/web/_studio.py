@@ -113,9 +113,9 @@ def check(data: Any) -> dict[str, Any]:
     if problems:
         return out
     mech = _service.build(data)
-    if out["spatial"]:
-        out["diagnostics"].append(_diag("note", "spatial mechanism: structure and rank analysis only (see "
-                                        "the Analysis tab); the drawing is its top view", [], True))
+    if out["spatial"]:  # view3d: the 3-D view where the spatial engine moves the file, else the old note
+        from mechsyn.web._spatial import check_note
+        out["diagnostics"].append(check_note(data))
     try:
         report = structure_report(mech)
     except MechsynInputError as err:

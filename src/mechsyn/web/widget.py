@@ -33,7 +33,7 @@ import traitlets  # noqa: E402  (installed with anywidget)
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
-           "atlas.js", "forces.js", "studio.js")
+           "atlas.js", "forces.js", "view3d.js", "studio.js")  # view3d.js: the 3-D view
 
 
 def _body_markup() -> str:
@@ -46,7 +46,7 @@ def widget_esm() -> str:
     parts = []
     for name in MODULES:
         text = (STATIC / name).read_text(encoding="utf-8")
-        text = re.sub(r"^import .*? from \"\./[a-z]+\.js\";\n", "", text, flags=re.M)
+        text = re.sub(r"^import .*? from \"\./[a-z0-9]+\.js\";.*\n", "", text, flags=re.M)  # view3d: digits, comments
         parts.append(f"// ---- {name}\n{text}")
     render = """
 // ---- the widget: the studio's markup in the cell, requests as messages to the kernel

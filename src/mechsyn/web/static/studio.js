@@ -9,6 +9,7 @@ import { mountAtlas } from "./atlas.js";
 import { mountForces } from "./forces.js";
 import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
+import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -25,15 +26,17 @@ const state = {
   renders: 0, simulations: 0, latencies: [], editLatencies: [], diagnostics: [], check: null, home: 0, dirty: false, offer: null,
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
+const view3d = mountView3d({ $, state, svg, render }); // view3d: shown instead of the canvas for spatial files
 
 // ------------------------------------------------------------------ rendering
 function render() {
   try {
     const arrows = forcesUi.arrows(state.frame, () => positions(state.mech, state.dragging ? null : state.sim, state.frame).joints);
-    draw(svg, { ...state, poseFromFile: state.dragging, arrows });
+    if (!view3d.shown()) draw(svg, { ...state, poseFromFile: state.dragging, arrows }); // view3d
     state.renders += 1;
     renderBanner();
     renderPlayer();
+    view3d.update(); // view3d: the 3-D view, its slider range and banner lines
     renderPlots();
     forcesUi.cursor(state.frame);
   } catch (e) {
@@ -151,6 +154,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   if (opened) state.dirty = false;
   else if (state.mech && mech.joints.length) { state.dirty = true; if (root === document) autosave(mech, state.fileName); }
   state.mech = mech;
+  view3d.open(mech); // view3d: a spatial file's sweep for the 3-D view
   if (onChange) onChange(mech);
   if (!keepFrame) state.frame = state.home;
   if (fit) fitView();
