@@ -76,7 +76,8 @@ def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
-    """A structure with a drive, more drives than the mobility, fewer (motion undetermined)."""
+    """A structure with a drive, more drives than the mobility, fewer (motion undetermined),
+    none at all."""
     drives = [j.id for j in mech.joints if j.actuated]
     els = [("joint", d) for d in drives]
     n = len(drives)
@@ -87,6 +88,9 @@ def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
     if n > mobility >= 1:
         return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
                       f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True, "one drive too many")]
+    if n == 0 and mobility >= 1:
+        return [_diag("warning", f"no drive yet (mobility W = {mobility}): select the input joint and press "
+                      "Drive to move the mechanism", [], True, "no drive yet")]
     if 0 < n < mobility and not any(j.vll for j in mech.joints):  # a locked VLL joint takes up a freedom
         return [_diag("warning", f"mobility W = {mobility} with {n} drive{'s' if n > 1 else ''}: the motion is "
                       f"not determined. Mark {mobility - n} more joint{'s' if mobility - n > 1 else ''} with "
