@@ -91,6 +91,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
     tracked outward sweeps give; with dead points it declines (the tracked sweep runs)."""
     from mechsyn.kinematics import analysis
     from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.engines import drawn_row
     from mechsyn.kinematics.regular import regular_sweep
 
     cases = [("kinematics/crank_rocker.yaml", "A", True), ("kinematics/jansen_leg.yaml", "P0", True),
@@ -101,7 +102,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
         for grid in ((0, 360, 1), (-90, 500, 7), (200, 260, 0.5)):
             x = input_grid(*grid)
             U = np.radians(x)[:, None]
-            got = regular_sweep(kp.system, kp.groups, U, np.ones(1), analysis._drawn_row(kp.system, U))
+            got = regular_sweep(kp.system, kp.groups, U, np.ones(1), drawn_row(kp.system, U))
             assert (got is not None) == regular or grid[1] - grid[0] < 360, (f, grid)
             if got is not None:
                 q, qd, qdd, links = got
@@ -110,9 +111,11 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
                     for k, arr in enumerate((q, qd, qdd)):
                         assert np.allclose(links.point(i, np.zeros(2))[k], arr[:, 3 * i:3 * i + 2], atol=1e-12)
             fast = simulate(m, {j: x})
-            with monkeypatch.context() as mp:
-                mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
+            assert (fast.engine == "regular pass") == (got is not None), (f, grid, fast.engine)
+            with monkeypatch.context() as mp:  # without the regular pass: the tracked chain
+                mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
                 tracked = simulate(m, {j: x})
+            assert tracked.engine == "tracked chain"
             _same(fast, tracked)
 
 
@@ -180,6 +183,6 @@ def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex,
     fast = simulate(m, inp, speeds=speeds)
     assert fast.sweep.links is not None and not fast.events
     with monkeypatch.context() as mp:
-        mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
+        mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
         tracked = simulate(m, inp, speeds=speeds)
     _same(fast, tracked)

@@ -25,9 +25,10 @@ import numpy as np
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import dyads
+from mechsyn.kinematics.engines import PLANAR_ENGINES, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
-from mechsyn.kinematics.regular import regular_sweep
-from mechsyn.kinematics.solve import Sweep, assemble, singular_configuration, sweep
+from mechsyn.kinematics.solve import assemble, singular_configuration
+from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
@@ -82,8 +83,9 @@ class Simulation(Result):
     assembled: np.ndarray
     points: dict[str, PointMotion]
     links: dict[str, LinkMotion]
-    events: list[dict] = field(default_factory=list)
+    events: list[Event] = field(default_factory=list)
     method: str = "newton"
+    engine: str = "newton"
     notes: list[str] = field(default_factory=list)
     vll: dict[str, str] = field(default_factory=dict)
     sweep: Sweep | None = field(default=None, repr=False)
@@ -96,7 +98,7 @@ class Simulation(Result):
     def _summary(self) -> list[tuple[str, str]]:
         x = self.inputs[self.main_input]
         unit = _unit(self.input_types[self.main_input])
-        rows = [("mechanism", self.mechanism), ("method", self.method),
+        rows = [("mechanism", self.mechanism), ("method", f"{self.method} ({self.engine})"),
                 ("input", f"{self.main_input}: {len(x)} values, {x[0]:g} to {x[-1]:g} {unit}" if len(x) else "none"),
                 ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
                 ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
@@ -174,8 +176,9 @@ class Simulation(Result):
             "points": {name: {k: mask(v) for k, v in pm.to_dict().items()} for name, pm in self.points.items()},
             "links": {name: {k: mask(v) for k, v in lm.to_dict().items()} for name, lm in self.links.items()},
             "working_ranges": self.working_ranges(),
-            "events": self.events,
+            "events": [e.to_dict() for e in self.events],
             "method": self.method,
+            "engine": self.engine,
             "vll": self.vll,
             "notes": self.notes,
             "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"},
@@ -444,10 +447,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-    sw = _one_pass(S, plan, U, sp, progress) if change_points == "keep" else None
-    if sw is None:
-        sw = _outward(S, U, lambda parts: _run(S, plan, parts, sp, progress, change_points == "switch"))
-    events = sw.events
+    sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
+    events = list(sw.events)
     used = sw.method
     ok = sw.assembled
     if sw.links is not None:  # the regular pass: every row assembled with finite rates
@@ -455,14 +456,13 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     else:
         rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
         singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
-    flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
+    flagged = {e.index for e in events if e.kind == "singular" and not e.before_sweep}
     for k in singular_rows:
         if k in flagged:
             continue
-        events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
-                       "message": "singular configuration: assembled, but the velocities and accelerations "
-                                  "are not defined here (null)"})
-    events.sort(key=lambda e: e["index"])
+        events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
+                            "accelerations are not defined here (null)", sw.inputs[k].tolist()))
+    events.sort(key=lambda e: e.index)
     links = {}
     for i, name in enumerate(S.links):
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
@@ -476,7 +476,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     return Simulation(
         mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
         speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
-        events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+        events=events, method=used, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
 def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
@@ -503,146 +503,6 @@ def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_
     return pm
 
 
-def _run(S: PlanarSystem, plan: "dyads.Plan | None", parts: list, sp: np.ndarray, progress: Any,
-         switch: bool = False) -> list[Sweep]:
-    """Sweeps from the drawn configuration through the rows of each of ``parts`` in order
-    (a driver-R + RRR chain: all in one array pass)."""
-    if plan is not None and plan.closed_form_rates:
-        res = dyads.solve_tracked_rates(S, plan, parts, sp, switch=switch)
-    else:
-        res = [_run_one(S, plan, U, sp, progress, switch) for U in parts]
-        if plan is None:
-            return res
-    out = []
-    for U, (q, qd, qdd, singular, tr_events) in zip(parts, res):
-        N = U.shape[0]
-        qd[singular] = np.nan  # a group folded flat: rates not defined here
-        qdd[singular] = np.nan
-        ok = np.all(np.isfinite(q), axis=1)
-        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
-        sw.events = _fast_events(tr_events, sw)
-        if progress is not None:
-            progress(N)
-        out.append(sw)
-    return out
-
-
-def _run_one(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
-             switch: bool) -> Any:
-    """One sweep by Newton continuation (a Sweep), or by the tracked closed form (its
-    arrays, singular rows and events)."""
-    if plan is None:
-        return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-    tracked = dyads.solve_tracked(S, plan, U, switch=switch)
-    q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-    return q, qd, qdd, tracked.singular, tracked.events
-
-
-def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray,
-              progress: Any) -> Sweep | None:
-    """The sweep of a chain whose groups stay clear of folds and change points, in one
-    array pass (:func:`~mechsyn.kinematics.regular.regular_sweep`); None when the branch rules are needed."""
-    if plan is None:
-        return None
-    res = regular_sweep(S, plan, U, sp, _drawn_row(S, U))
-    if res is None:
-        return None
-    q, qd, qdd, links = res
-    N = U.shape[0]
-    if progress is not None:
-        progress(N)
-    nan = np.full(N, np.nan)
-    return Sweep(S, U, sp, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur", links=links)
-
-
-def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
-    """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
-    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
-    if U.shape[0] < 2:
-        return None
-    if U.shape[1] == 1:
-        return _drawn_row_1(S.drivers[0], U[:, 0])
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    isR = np.array([d.type == "R" for d in S.drivers])
-    a, d = U[:-1], np.diff(U, axis=0)
-    dd = np.einsum("ij,ij->i", d, d)
-    turns = u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi))  # (N-1, k)
-    for shift in (0.0, 2 * np.pi, -2 * np.pi):
-        v = np.where(isR, turns + shift if shift else turns, u0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.einsum("ij,ij->i", v - a, d) / dd
-        off = np.abs(a + t[:, None] * d - v).max(axis=1)
-        hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
-        if hit.any():
-            return int(np.argmax(hit)) + 1
-    return None
-
-
-def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
-    """:func:`_drawn_row` of one input (the same decisions on 1-D arrays: a point of a
-    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
-    ``0 < p <= d^2``, division being monotone)."""
-    u0 = float(driver.assembled)
-    a = u[:-1]
-    d = u[1:] - a
-    dd = d * d
-    v = a - u0
-    if driver.type == "R":
-        v /= 2 * np.pi
-        np.rint(v, out=v)
-        v *= 2 * np.pi
-        v += u0
-        shifts = (0.0, 2 * np.pi, -2 * np.pi)
-    else:
-        v[:] = u0
-        shifts = (0.0,)
-    for shift in shifts:
-        p = (v + shift - a) if shift else v - a
-        p *= d
-        hit = p > 0.0
-        hit &= p <= dd
-        if hit.any():
-            return int(hit.argmax()) + 1
-    return None
-
-
-def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
-    """The sweep computed outwards from the drawn configuration when the drawn input lies
-    inside it (rows after it forwards, rows before it backwards), so every sweep that
-    contains the drawn input passes through the drawn configuration; else one run."""
-    k = _drawn_row(S, U)
-    if k is None:
-        return run([U])[0]
-    fwd, bwd = run([U[k:], U[:k][::-1].copy()])
-    events = []
-    for e in bwd.events:
-        e = dict(e)
-        ib = e["index"]
-        at_row = e["kind"] == "singular" and not e.get("crossed")
-        e["index"] = (k - 1 - ib) if at_row else max(0, k - ib)
-        e.pop("before_sweep", None)
-        if e["kind"] == "dead point":
-            e["message"] = "a limit of the working range: the Jacobian is singular (dead point)"
-        elif e["kind"] == "reassembled":
-            e["message"] = ("assembles again (going back from the drawn configuration) after a gap, in the "
-                            "assembly mode nearest the drawn one")
-        events.append(e)
-    for e in fwd.events:
-        e = dict(e)
-        if e.get("before_sweep"):
-            e.pop("before_sweep")
-        e["index"] += k
-        events.append(e)
-    events.sort(key=lambda e: e["index"])
-
-    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return np.concatenate([a[::-1], b])
-
-    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
-                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
-                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method)
-
-
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
     mode = (vll or {}).get(jid)
     if mode is not None:
@@ -653,32 +513,15 @@ def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
         return False
 
 
-def _event_units(S: PlanarSystem, e: dict) -> dict:
-    e = dict(e)
-    vals = e.get("input")
-    if vals is not None:
-        e["input"] = {d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
-                      for d, v in zip(S.drivers, vals)}
-    return e
+def _event_units(S: PlanarSystem, e: Event) -> Event:
+    """The event's input values by joint, in degrees (R) or lengths (P)."""
+    if e.input is None:
+        return e
+    return e.with_(input={d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
+                          for d, v in zip(S.drivers, e.input)})
 
 
-def _fast_events(tracked_events: list, sw: Sweep) -> list[dict]:
-    """Events of the closed-form sweep: dead points, reassembly and change / branch points
-    found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
-    out, seen = [], set()
-    for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
-        if e["kind"] == "reassembled":
-            if e["index"] in seen:
-                continue
-            seen.add(e["index"])
-        out.append(e)
-    if not sw.assembled[0] and not any(e["index"] == 0 and e["kind"] == "dead point" for e in out):
-        out.insert(0, {"index": 0, "kind": "not assembled", "input": sw.inputs[0].tolist(),
-                       "message": "the mechanism cannot be assembled at the first input"})
-    return out
-
-
-def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
+def _limit_events(S: PlanarSystem, sw: Sweep) -> list[Event]:
     """Where a VLL's length leaves its limits."""
     out = []
     for j in S.mech.joints:
@@ -688,9 +531,9 @@ def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
         bad = sw.assembled & ((s < j.limits[0] - 1e-9) | (s > j.limits[1] + 1e-9))
         if bad.any():
             k = int(np.argmax(bad))
-            out.append({"index": k, "kind": "limit", "joint": j.id, "value": float(s[k]),
-                        "message": f"VLL {j.id} length {s[k]:.6g} is outside its limits "
-                                   f"[{j.limits[0]:g}, {j.limits[1]:g}] at {int(bad.sum())} input value(s)"})
+            out.append(Event(k, "limit", f"VLL {j.id} length {s[k]:.6g} is outside its limits "
+                             f"[{j.limits[0]:g}, {j.limits[1]:g}] at {int(bad.sum())} input value(s)",
+                             joint=j.id, value=float(s[k])))
     return out
 
 
@@ -745,7 +588,7 @@ class ForceAnalysis(Result):
             "indeterminate": r.indeterminate,
             **({"belts": {j: {"tension": mask(t)} for j, t in r.tension.items()}} if r.tension else {}),
             "notes": self.notes(),
-            "events": sim.events,
+            "events": [e.to_dict() for e in sim.events],
             "method": sim.method,
             "convention": "force: exerted by the joint's first link on its second; drive value: moment (R) "
                           "or force (P) the actuator applies to the second link",

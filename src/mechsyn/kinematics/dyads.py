@@ -31,6 +31,8 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn.kinematics.rates import batch_rates
+from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
 
 __all__ = ["Plan", "decompose", "solve_positions", "solve_all", "fast_chain", "ChainResult"]
@@ -580,8 +582,6 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     ``tracked``: the sweep's positions and modes from :func:`solve_tracked` (the drawn
     branch followed through bifurcations); without it every group keeps its drawn mode.
     """
-    from mechsyn.kinematics.solve import batch_rates
-
     inputs = np.atleast_2d(np.asarray(inputs, float))
     if plan.closed_form_rates:
         sig = tracked.sigmas if tracked is not None else None
@@ -1225,13 +1225,12 @@ def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
     """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
     events = []
     for e in raw_events:
-        e = dict(e)
-        if e["index"] < n0:  # on the way from the drawn configuration to the sweep
-            e["message"] = "between the drawn configuration and the first input: " + e["message"]
-            e["before_sweep"] = True
-        e["index"] = max(0, e["index"] - n0)
-        if not e.get("before_sweep"):
-            e["input"] = (np.asarray(e["input"]) + shift).tolist()
+        if e.index < n0:  # on the way from the drawn configuration to the sweep
+            e = e.with_(message="between the drawn configuration and the first input: " + e.message,
+                        before_sweep=True)
+        e = e.with_(index=max(0, e.index - n0))
+        if not e.before_sweep:
+            e = e.with_(input=(np.asarray(e.input) + shift).tolist())
         events.append(e)
     return events
 
@@ -1364,19 +1363,18 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
             t = 0.0 if inside == i - 1 else 1.0
         u = X[i - 1] + t * (X[i] - X[i - 1])
         if ok[i - 1]:
-            events.append({"index": i, "kind": "dead point", "input": u.tolist(), "group": group,
-                           "message": f"assembly ends: the group {group} folds flat (its discriminant "
-                                      "changes sign: a dead point / limit of the working range)"})
+            events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
+                                "changes sign: a dead point / limit of the working range)", u.tolist(), group))
         else:
-            events.append({"index": i, "kind": "dead point", "input": u.tolist(), "group": group,
-                           "message": "assembly starts again here: the other limit of a working range"})
+            events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working range",
+                                u.tolist(), group))
     # reassembly after a gap (own or upstream): the drawn mode
     for i in np.flatnonzero(ok[1:] & ~ok[:-1]) + 1:
         breaks.append((int(i), "reset"))
         if i >= n0:
-            events.append({"index": int(i), "kind": "reassembled", "input": X[i].tolist(), "group": group,
-                           "message": f"assembles again after a gap, in the assembly mode of the drawn "
-                                      f"configuration for the group {group} (the mode nearest the drawn one)"})
+            events.append(Event(int(i), "reassembled", f"assembles again after a gap, in the assembly mode of the "
+                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
+                                X[i].tolist(), group))
     # bifurcations: local minima of the discriminant at zero
     touched: list = []
     cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
@@ -1385,9 +1383,9 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         if dmin > 1e-10:
             continue  # a sharp but regular turn
         if dmin < -1e-10:  # the group folds and unfolds within one step: a short gap
-            events.append({"index": i, "kind": "dead point", "input": X[i].tolist(), "group": group,
-                           "message": f"the group {group} cannot be assembled in a short interval near this "
-                                      "input (it folds and unfolds within one step): refine the input step"})
+            events.append(Event(i, "dead point", f"the group {group} cannot be assembled in a short interval near "
+                                "this input (it folds and unfolds within one step): refine the input step",
+                                X[i].tolist(), group))
             breaks.append((i + 1, "reset"))
             continue
         # where the crossing lies: at row i (|t| tiny), or between i and a neighbour
@@ -1404,15 +1402,14 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         touched.append((i, u))
         if not switch:
             breaks.append((row, "flip"))
-        events.append({"index": at, "kind": "singular", "input": u.tolist(), "group": group,
-                       "crossed": not singular[i],
-                       "message": f"change / branch point: the group {group} is folded flat here (its two "
+        events.append(Event(at, "singular", input=u.tolist(), group=group, crossed=bool(not singular[i]),
+                       message=f"change / branch point: the group {group} is folded flat here (its two "
                                   "assembly modes meet); "
                                   + ("the motion switches to the other branch (change_points='switch')" if switch
                                      else "the motion continues on the branch whose velocity is continuous "
                                           "(the drawn branch)")
                                   + ("; velocities and accelerations are not defined at this input (null)"
-                                     if singular[i] else "")})
+                                     if singular[i] else "")))
     sig = np.full(M, s_file)
     cur = s_file
     last = 0

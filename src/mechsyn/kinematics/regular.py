@@ -166,7 +166,7 @@ def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.n
     one pass, with the links' complex states (:class:`LinkStates`); None when a group
     comes near a fold on the sweep or on the way to it from the drawn configuration
     (``split``: the row after the drawn input values, see
-    :func:`mechsyn.kinematics.analysis._drawn_row`).
+    :func:`mechsyn.kinematics.engines.drawn_row`).
 
     Examples
     --------

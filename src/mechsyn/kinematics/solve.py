@@ -13,45 +13,17 @@ Velocities: ``Phi_q q' = B u'``; accelerations: ``Phi_q q'' = gamma + B u''``
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics import dyads
+from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton"]
-
-
-@dataclass
-class Sweep:
-    """Result of a sweep: poses and their rates at every input value.
-
-    ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
-    ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates;
-    ``links``: the links' complex states (:class:`mechsyn.kinematics.regular.LinkStates`)
-    when the one regular pass computed the sweep (every row assembled with finite
-    rates), else None.
-    """
-
-    system: PlanarSystem
-    inputs: np.ndarray
-    speeds: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    assembled: np.ndarray
-    det_sign: np.ndarray
-    sigma_min: np.ndarray
-    events: list[dict] = field(default_factory=list)
-    method: str = "newton"
-    links: Any = None
-
-    @property
-    def n(self) -> int:
-        return self.q.shape[0]
 
 
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -114,22 +86,6 @@ def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
     else:
         qd = sla.lstsq(J, B @ ud, check_finite=False)[0]
         qdd = sla.lstsq(J, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)[0]
-    return qd, qdd
-
-
-def batch_rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Velocities and accelerations for a batch of configurations (N, n), vectorised."""
-    N = q.shape[0]
-    J = S.jacobian(q)
-    B = S.input_matrix()
-    rhs = np.broadcast_to(B @ np.asarray(speeds, float), (N, S.m))
-    if S.m == S.n:
-        qd = np.linalg.solve(J, rhs[..., None])[..., 0]
-        qdd = np.linalg.solve(J, S.gamma(q, qd)[..., None])[..., 0]
-    else:
-        pinv = np.linalg.pinv(J)
-        qd = np.einsum("nij,nj->ni", pinv, rhs)
-        qdd = np.einsum("nij,nj->ni", pinv, S.gamma(q, qd))
     return qd, qdd
 
 
@@ -434,8 +390,6 @@ def _nearest_mode(S: PlanarSystem, cands: list, u: np.ndarray, q_drawn: np.ndarr
     along the nearest-singular direction of each) whose elbow signature
     (:func:`_elbows`) matches the drawn one most, then whose ``det Phi_q`` has the drawn
     sign."""
-    from mechsyn.kinematics import dyads
-
     plan = dyads.decompose(S)
     if plan is not None:
         u_asm = np.array([d.assembled for d in S.drivers])
@@ -538,7 +492,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     det_sign = np.full(N, np.nan)
     sig = np.full(N, np.nan)
     out = (q, qd, qdd, det_sign, sig)
-    events: list[dict] = []
+    events: list[Event] = []
     u_asm = np.array([d.assembled for d in S.drivers])
     hist, cur = _approach(S, q_start, u_asm, inputs[0], refine_limits, events)
     drawn_det = hist[0][2][2]
@@ -550,9 +504,8 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             nxt = _continue(S, hist, u)
             if nxt is None:
                 ul = _limit(S, cur, cur_u, u)[0] if refine_limits else cur_u
-                events.append({"index": i, "kind": "dead point", "input": ul.tolist(),
-                               "message": "assembly ends: the Jacobian becomes singular (dead point / "
-                                          "limit of the working range)"})
+                events.append(Event(i, "dead point", "assembly ends: the Jacobian becomes singular (dead point / "
+                                                     "limit of the working range)", ul.tolist()))
                 last_good = (cur, cur_u)
             cur = nxt
             cur_u = u
@@ -566,11 +519,11 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             progress()
     assembled = np.all(np.isfinite(q), axis=1)
     for i in np.flatnonzero(np.isfinite(sig) & (sig < 1e-6)).tolist():
-        events.append({"index": i, "kind": "singular", "input": inputs[i].tolist(),
-                       "message": f"near-singular configuration (pivot ratio {sig[i]:.1e}): a change, branch or "
+        events.append(Event(i, "singular", input=inputs[i].tolist(),
+                       message=f"near-singular configuration (pivot ratio {sig[i]:.1e}): a change, branch or "
                                   "dead point; the branch may switch here and positions are accurate only to "
-                                  "about the square root of the solver tolerance"})
-    events.sort(key=lambda e: e["index"])
+                                  "about the square root of the solver tolerance"))
+    events.sort(key=lambda e: e.index)
     return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)
 
 
@@ -587,8 +540,7 @@ def _sweep_shifted(S: PlanarSystem, inputs: np.ndarray, shift: np.ndarray, speed
                 sw.q[:, 3 * con.b + 2] += shift[con.driver]
             elif con.b < 0 and con.a >= 0:
                 sw.q[:, 3 * con.a + 2] -= shift[con.driver]
-    for e in sw.events:
-        e["input"] = (np.asarray(e["input"]) + shift).tolist()
+    sw.events = [e.with_(input=(np.asarray(e.input) + shift).tolist()) for e in sw.events]
     return sw
 
 
@@ -608,8 +560,8 @@ def _approach(S: PlanarSystem, q_start: np.ndarray, u_asm: np.ndarray, u_first: 
         return hist, hist[-1][1]
     if refine_limits:
         ul, _ = _limit(S, hist[-1][1], hist[-1][0], u_first)
-        events.append({"index": 0, "kind": "dead point", "input": ul.tolist(), "before_sweep": True,
-                       "message": "the mechanism cannot move from its file configuration to the first input"})
+        events.append(Event(0, "dead point", "the mechanism cannot move from its file configuration to the first "
+                            "input", ul.tolist(), before_sweep=True))
     return hist, None
 
 
@@ -649,11 +601,10 @@ def _reassemble(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, q_start
         bq, bu, j = nb, inputs[j], j - 1
     if refine_limits and j >= 0:
         ul, _ = _limit(S, bq, bu, inputs[j])
-        events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
-                       "message": "assembly starts again here: the other limit of a working range"})
-    events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
-                   "message": "assembles again after a gap, in the assembly mode of the drawn "
-                              "configuration (the mode nearest the drawn one)"})
+        events.append(Event(j + 1, "dead point", "assembly starts again here: the other limit of a working range",
+                            ul.tolist()))
+    events.append(Event(j + 1, "reassembled", "assembles again after a gap, in the assembly mode of the drawn "
+                        "configuration (the mode nearest the drawn one)", bu.tolist()))
     return cand
 
 
@@ -671,7 +622,7 @@ def _store(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, cur: np.ndar
     if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
             and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
         uc = _crossing(S, q[i - 1], inputs[i - 1], u, det_sign[i - 1]) if refine_limits else u
-        events.append({"index": i, "kind": "singular", "input": uc.tolist(), "crossed": True,
-                       "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
-                                  "crossed between this input and the previous (at the input given)"})
+        events.append(Event(i, "singular", "det(Phi_q) changed sign: a singular (branch/change) point was "
+                            "crossed between this input and the previous (at the input given)", uc.tolist(),
+                            crossed=True))
     return cur, hist
