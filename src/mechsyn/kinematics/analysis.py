@@ -423,7 +423,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
             U[:, k] = vals
         types[jid] = d.type
         lim = mech.joint(jid).limits if d.type == "P" else None
-        if lim is not None and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
+        if lim is not None and (vals.min() < lim[0] - 1e-12 * S.scale or vals.max() > lim[1] + 1e-12 * S.scale):
             raise MechsynInputError(
                 f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
                 hint="keep the VLL length within its limits")
@@ -528,7 +528,7 @@ def _limit_events(S: PlanarSystem, sw: Sweep) -> list[Event]:
         if j.type != "P" or j.limits is None:
             continue
         s = S.coordinate(np.nan_to_num(sw.q), j.id)
-        bad = sw.assembled & ((s < j.limits[0] - 1e-9) | (s > j.limits[1] + 1e-9))
+        bad = sw.assembled & ((s < j.limits[0] - 1e-9 * S.scale) | (s > j.limits[1] + 1e-9 * S.scale))
         if bad.any():
             k = int(np.argmax(bad))
             out.append(Event(k, "limit", f"VLL {j.id} length {s[k]:.6g} is outside its limits "

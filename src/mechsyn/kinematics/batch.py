@@ -218,7 +218,8 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     # order to the first other joint point
     cj = [j for j in mech.joints if crank in j.links]
     p0 = np.asarray(cj[0].point, float)
-    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
+    size = float(np.ptp(np.array([j.point for j in mech.joints], float), axis=0).max())
+    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12 * size), None)
     line = (index[cj[0].id], index[other.id]) if other is not None else None
     program = _schedule(ops, ground_pts, tuple(index[p] for p in points))
     return BatchPlan(names=names, ops=program, outputs=tuple(points),

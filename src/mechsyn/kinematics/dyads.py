@@ -1341,6 +1341,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
     M = len(disc)
     step = plan.steps[k]
     group = "-".join(step.joints)
+    size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])  # inputs relative to the size
     ok = disc > -_ZERO_DISC
     d = np.where(ok, np.maximum(disc, 0.0), np.nan)
 
@@ -1397,7 +1398,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
         else:
             row, at = i, i
         u = X[i] + t_star * (X[i + 1] - X[i]) if t_star >= 0 else X[i] + t_star * (X[i] - X[i - 1])
-        if any(abs(i - j) <= 2 and np.abs(u - v).max() < 1e-8 for j, v in touched):
+        if any(abs(i - j) <= 2 and np.abs((u - v) / size).max() < 1e-8 for j, v in touched):
             continue  # the same crossing seen from the neighbouring sample
         touched.append((i, u))
         if not switch:

@@ -43,14 +43,16 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
     """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged).
 
     ``polish``: one more step after convergence where the Jacobian is well conditioned
-    (the sweep's positions then agree with the closed form to round-off)."""
-    tol = tol if tol is not None else 1e-12 * S.scale
+    (the sweep's positions then agree with the closed form to round-off). ``tol`` bounds
+    the residual of every equation relative to its size (lengths over the mechanism's
+    size, angles in radians): the decisions do not change when the mechanism is scaled."""
+    tol = tol if tol is not None else 1e-12
     q = q.copy()
     u2 = u[None]
     prev = np.inf
     for _ in range(max_iter):
         r = S.residual(q[None], u2)[0]
-        norm = float(np.abs(r).max()) if r.size else 0.0
+        norm = _norm(S, r)
         if not np.isfinite(norm):
             return q, False
         if norm < tol:
@@ -58,18 +60,28 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
                 dq = _solve_lin(S.jacobian(q[None])[0], -r)
                 if np.all(np.isfinite(dq)) and float(np.abs(dq).max()) <= 1e2 * norm:  # well conditioned
                     q2 = q + dq
-                    if float(np.abs(S.residual(q2[None], u2)[0]).max()) <= norm:
+                    if _norm(S, S.residual(q2[None], u2)[0]) <= norm:
                         q = q2
             return q, True
-        if norm > 4 * prev and prev < 1e-3 * S.scale:
+        if norm > 4 * prev and prev < 1e-3:
             return q, False
         prev = norm
         dq = _solve_lin(S.jacobian(q[None])[0], -r)
         if not np.all(np.isfinite(dq)):
             return q, False
         q += dq
-    r = S.residual(q[None], u2)[0]
-    return q, bool(np.abs(r).max() < tol * 10)
+    return q, bool(_norm(S, S.residual(q[None], u2)[0]) < tol * 10)
+
+
+def _norm(S: PlanarSystem, r: np.ndarray) -> float:
+    """The largest residual of the equations ``r`` (m,), each relative to its size."""
+    return float(np.abs(r / S.row_scale).max()) if r.size else 0.0
+
+
+def _rel_step(S: PlanarSystem, dq: np.ndarray) -> float:
+    """The largest change of ``dq`` (the first unknowns, or all n) relative to the
+    mechanism's size (lengths) or in radians (angles)."""
+    return float(np.abs(dq / S.col_scale[:len(dq)]).max()) if dq.size else 0.0
 
 
 def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
@@ -92,7 +104,7 @@ def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
 def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
     """Rank of ``Phi_q`` at ``q``: free coordinates beyond the inputs, redundant constraints."""
     q = S.q0 if q is None else q
-    J = S.jacobian(q[None])[0]
+    J = S.unit_jacobian(S.jacobian(q[None])[0])  # dimensionless: the same rank at any scale
     sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
     tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
     rank = int(np.sum(sv > tol))
@@ -159,11 +171,11 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
         raise MechsynInputError(
             f"the joint points of the file do not assemble (largest error at joint {worst})", source=src,
             hint="check the joint points: each link's joints must keep their distances")
-    moved = float(np.abs(q - S.q0)[:3 * len(S.links)].max()) if S.links else 0.0
-    if moved > 1e-6 * S.scale:
+    moved = _rel_step(S, (q - S.q0)[:3 * len(S.links)]) if S.links else 0.0
+    if moved > 1e-6:
         raise MechsynInputError(
             f"the file's configuration is not assembled: joint {_worst_joint(S, S.q0, u_asm)} is off "
-            f"by up to {moved:.3g}", source=src,
+            f"by up to {moved * S.scale:.3g}", source=src,
             hint="give joint points of one consistent configuration")
     _require_determined(S, q)
     object.__setattr__(S, "_assembled", q.copy())
@@ -183,7 +195,7 @@ def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 
 def _worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
-    r = np.abs(S.residual(q[None], u[None])[0])
+    r = np.abs(S.residual(q[None], u[None])[0] / S.row_scale)
     row, best, worst = 0, -1.0, "?"
     for con in S.cons:
         v = float(r[row:row + con.rows].max())
@@ -196,10 +208,12 @@ def _worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
 def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, float]:
     """LU of ``Phi_q`` at q, ``dq/du`` (n, k), det sign and a singularity measure.
 
-    The measure is min |U_ii| / max |U_ii| of the LU factors (0 at a singular point).
+    ``Phi_q`` is factored made dimensionless (:meth:`PlanarSystem.unit_jacobian`), so the
+    measure, min |U_ii| / max |U_ii| of its LU factors (0 at a singular point), is the
+    same at any scale of the mechanism.
     """
-    J = S.jacobian(q[None])[0]
-    B = S.input_matrix()
+    J = S.unit_jacobian(S.jacobian(q[None])[0])
+    B = S.input_matrix() / S.row_scale[:, None]
     if J.shape[0] == J.shape[1]:
         try:
             lu = sla.lu_factor(J, check_finite=False)
@@ -208,18 +222,20 @@ def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, 
             piv = int(np.sum(lu[1] != np.arange(len(lu[1]))))
             sign = float(np.prod(np.sign(np.diag(lu[0]))) * (-1) ** piv)
             if np.all(np.isfinite(X)):
-                return lu, X, sign, float(d.min() / max(d.max(), 1e-300))
+                return lu, X * S.col_scale[:, None], sign, float(d.min() / max(d.max(), 1e-300))
         except (sla.LinAlgError, ValueError):
             pass
-    X = sla.lstsq(J, B, check_finite=False)[0]
+    X = sla.lstsq(J, B, check_finite=False)[0] * S.col_scale[:, None]
     sv = np.linalg.svd(J, compute_uv=False)
     return (J,), X, 0.0, float(sv[min(J.shape) - 1] / max(sv.max(), 1e-300)) if sv.size else 1.0
 
 
 def _solve_with(S: PlanarSystem, fac: tuple, rhs: np.ndarray) -> np.ndarray:
+    """``Phi_q x = rhs`` with the factors of :func:`_factor` (of the dimensionless ``Phi_q``)."""
+    rhs = rhs / S.row_scale
     if len(fac) == 2:
-        return sla.lu_solve(fac, rhs, check_finite=False)
-    return sla.lstsq(fac[0], rhs, check_finite=False)[0]
+        return sla.lu_solve(fac, rhs, check_finite=False) * S.col_scale
+    return sla.lstsq(fac[0], rhs, check_finite=False)[0] * S.col_scale
 
 
 def _rates_from(S: PlanarSystem, q: np.ndarray, fac: tuple, X: np.ndarray,
@@ -239,15 +255,15 @@ def _settle(S: PlanarSystem, q: np.ndarray, u: np.ndarray, fac: tuple) -> tuple[
     if fac[3] >= 1e-3:
         return q, fac
     u2 = u[None]
-    best = float(np.abs(S.residual(q[None], u2)[0]).max())
+    best = _norm(S, S.residual(q[None], u2)[0])
     for _ in range(60):
         if best == 0.0:
             break
         dq = _solve_lin(S.jacobian(q[None])[0], -S.residual(q[None], u2)[0])
-        if not np.all(np.isfinite(dq)) or float(np.abs(dq).max()) > 1e-4 * S.scale:
+        if not np.all(np.isfinite(dq)) or _rel_step(S, dq) > 1e-4:
             break
         q2 = q + dq
-        r2 = float(np.abs(S.residual(q2[None], u2)[0]).max())
+        r2 = _norm(S, S.residual(q2[None], u2)[0])
         if r2 >= best:
             break
         q, best = q2, r2
@@ -415,13 +431,13 @@ def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> list:
     """Configurations at ``u`` other than ``q``, searched from ``q`` along the direction in
     which ``Phi_q`` is nearest singular (where two assembly modes meet near a fold, they
     differ along it)."""
-    J = S.jacobian(q[None])[0]
+    J = S.unit_jacobian(S.jacobian(q[None])[0])
     v = np.linalg.svd(J)[2][-1]
-    v = v / max(float(np.abs(v).max()), 1e-300)
+    v = v / max(float(np.abs(v).max()), 1e-300) * S.col_scale  # lengths in the mechanism's size
     for a in (0.05, 0.2, 0.5, 1.0):
         for sgn in (1.0, -1.0):
-            c, good = newton(S, q + sgn * a * S.scale * v, u, max_iter=30)
-            if good and np.abs(c - q).max() > 1e-6 * S.scale:
+            c, good = newton(S, q + sgn * a * v, u, max_iter=30)
+            if good and _rel_step(S, c - q) > 1e-6:
                 return [c]
     return []
 
@@ -433,8 +449,9 @@ def _crossing(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, de
     branch point); ``ub`` when the branch cannot be followed there. Next to the singular
     point the sign of ``det`` is decided by round-off, so the result is accurate to about
     1e-8 rad, not to the closed form's 1e-13."""
+    size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])
     for _ in range(iters):
-        if np.abs(ub - ua).max() < 1e-13:
+        if np.abs((ub - ua) / size).max() < 1e-13:
             break
         um = (ua + ub) / 2
         qm = _track(S, q, ua, um, depth=4)
