@@ -12,6 +12,7 @@ test too, so the lists only shrink.
 from __future__ import annotations
 
 import ast
+import sys
 from pathlib import Path
 
 import pytest
@@ -79,3 +80,80 @@ def test_the_measure_counts_a_long_function(tmp_path):
 def test_exceptions_are_of_their_kind(is_cli):
     listed = CLI_EXCEPTIONS if is_cli else LIBRARY_EXCEPTIONS
     assert all(k.startswith("cli/") == is_cli for k in listed)
+
+
+# --------------------------------------------------------------------------- kinematics
+KINEMATICS = PACKAGE / "kinematics"
+KINEMATICS_FILE_MAX = 800
+#: packages a computing module of kinematics/ never imports (reading, drawing, terminal)
+KINEMATICS_FORBIDDEN = ("matplotlib", "pydantic", "yaml", "typer", "rich")
+
+
+def mechsyn_imports(path: Path) -> set[str]:
+    """The mechsyn modules ``path`` imports, at module level and inside functions
+    (``from mechsyn.a import b`` counts ``mechsyn.a.b`` when that is a module)."""
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names if a.name.startswith("mechsyn"))
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("mechsyn"):
+            out.add(node.module)
+            for a in node.names:
+                sub = PACKAGE.parent / (node.module + "." + a.name).replace(".", "/")
+                if sub.with_suffix(".py").exists() or (sub / "__init__.py").exists():
+                    out.add(f"{node.module}.{a.name}")
+    return out
+
+
+def third_party_imports(path: Path) -> set[str]:
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out.update(a.name.split(".")[0] for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            out.add(node.module.split(".")[0])
+    return out
+
+
+def test_no_kinematics_file_over_800_lines():
+    long = {p.name: n for p in KINEMATICS.rglob("*.py")
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > KINEMATICS_FILE_MAX}
+    assert not long, f"kinematics files over {KINEMATICS_FILE_MAX} lines (split them by concern): {long}"
+
+
+def test_kinematics_imports_no_cycle():
+    """The modules of kinematics/ import each other without a cycle, counting the imports
+    inside functions (a cycle makes the import order decide what works)."""
+    mods = {f"mechsyn.kinematics.{p.stem}": p for p in KINEMATICS.glob("*.py") if p.stem != "__init__"}
+    graph = {m: {d for d in mechsyn_imports(p) if d in mods and d != m} for m, p in mods.items()}
+    state: dict[str, int] = {}
+
+    def visit(m: str, stack: list[str]) -> None:
+        state[m] = 1
+        for d in sorted(graph[m]):
+            if state.get(d) == 1:
+                raise AssertionError("import cycle: " + " -> ".join(stack[stack.index(d):] + [d]))
+            if d not in state:
+                visit(d, stack + [d])
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m, [m])
+
+
+def test_kinematics_computes_without_reading_drawing_or_terminal_packages():
+    bad = {p.name: sorted(third_party_imports(p) & set(KINEMATICS_FORBIDDEN)) for p in KINEMATICS.rglob("*.py")}
+    bad = {k: v for k, v in bad.items() if v}
+    assert not bad, f"kinematics modules importing {KINEMATICS_FORBIDDEN}: {bad}"
+
+
+def test_the_cycle_check_finds_a_cycle(tmp_path, monkeypatch):
+    pkg = tmp_path / "mechsyn" / "kinematics"
+    pkg.mkdir(parents=True)
+    (pkg / "a.py").write_text("def f():\n    from mechsyn.kinematics import b\n")
+    (pkg / "b.py").write_text("from mechsyn.kinematics.a import f\n")
+    monkeypatch.setattr(sys.modules[__name__], "PACKAGE", tmp_path / "mechsyn")
+    monkeypatch.setattr(sys.modules[__name__], "KINEMATICS", pkg)
+    with pytest.raises(AssertionError, match="import cycle"):
+        test_kinematics_imports_no_cycle()

@@ -122,7 +122,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
 def test_scalar_discriminant_equals_the_array_pass(ex):
     """The one-input evaluation used by the dead-point root search gives the array pass's
     discriminant of every group."""
-    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics import dyads, tracking
     from mechsyn.kinematics.analysis import cached_plan
 
     for f in ("textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "kinematics/peaucellier.yaml"):
@@ -132,14 +132,14 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
         S, plan = kp.system, kp.groups
         X = np.radians(input_grid(0, 350, 10))[:, None]
         tp = dyads.solve_tracked(S, plan, X)
-        prog = dyads._scalar_program(S, plan)
+        prog = tracking._scalar_program(S, plan)
         for k, step in enumerate(plan.steps):
             if step.kind != "RRR":
                 continue
-            ref = dyads._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
+            ref = tracking._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
             sig = [[float(s[i]) if isinstance(s, np.ndarray) else float(s) for s in tp.sigmas[:k]]
                    for i in range(len(X))]
-            got = np.array([dyads._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
+            got = np.array([tracking._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
             assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
 
 

@@ -24,9 +24,9 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics import dyads
 from mechsyn.kinematics.engines import PLANAR_ENGINES, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
+from mechsyn.kinematics.groups import Plan, decompose
 from mechsyn.kinematics.solve import assemble, singular_configuration
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
@@ -349,7 +349,7 @@ class KinematicPlan:
 
     mechanism: Mechanism
     system: PlanarSystem
-    groups: "dyads.Plan | None"
+    groups: "Plan | None"
     vll: dict | None = None
     prescribed: tuple = ()
 
@@ -378,7 +378,7 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
     input values, which decides whether a passive VLL is prescribed)."""
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
     S = build_system(mech, vll=vll, prescribed=prescribed)
-    return KinematicPlan(mech, S, dyads.decompose(S), vll, prescribed)
+    return KinematicPlan(mech, S, decompose(S), vll, prescribed)
 
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,

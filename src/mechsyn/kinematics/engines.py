@@ -13,10 +13,10 @@ The planar engines, in the order they are tried:
    chain whose groups stay clear of folds and change points, in one array pass of complex
    arithmetic; declines as soon as a group comes near a fold (or for
    ``change_points="switch"``).
-2. ``tracked chain`` (:func:`mechsyn.kinematics.dyads.solve_tracked_rates`): the same
+2. ``tracked chain`` (:func:`mechsyn.kinematics.tracking.solve_tracked_rates`): the same
    chains through folds, change and branch points, every group's assembly mode tracked on
    its discriminant, rates in closed form.
-3. ``tracked groups`` (:func:`mechsyn.kinematics.dyads.solve_tracked`): any mechanism of
+3. ``tracked groups`` (:func:`mechsyn.kinematics.tracking.solve_tracked`): any mechanism of
    drivers and dyads (RRR, RRP, PRR, RPR, RPP, PRP), rates by batched linear solves.
 4. ``newton`` (:func:`mechsyn.kinematics.solve.sweep`): Newton continuation of the
    constraint equations, for every mechanism (gears, cams, belts, closed loops that do
@@ -42,11 +42,13 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from mechsyn.kinematics import dyads
+from mechsyn.kinematics.chain import solve_all
+from mechsyn.kinematics.groups import Plan
 from mechsyn.kinematics.regular import regular_sweep
 from mechsyn.kinematics.solve import sweep as newton_sweep
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
+from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
 
 __all__ = ["Engine", "PLANAR_ENGINES", "RegularPass", "TrackedChain", "TrackedGroups", "Newton",
            "first_sweep", "drawn_row", "outward"]
@@ -58,7 +60,7 @@ class Engine(Protocol):
     engine cannot answer for this mechanism or these options (the next one is tried).
 
     ``plan``: the mechanism's decomposition into drivers and Assur groups
-    (:class:`mechsyn.kinematics.dyads.Plan`), None when it has none or Newton is asked
+    (:class:`mechsyn.kinematics.groups.Plan`), None when it has none or Newton is asked
     for; ``change_points``: ``"keep"`` or ``"switch"``; ``progress``: called with the
     number of rows done, or None.
     """
@@ -75,7 +77,7 @@ class RegularPass:
 
     name = "regular pass"
 
-    def sweep(self, system: PlanarSystem, plan: dyads.Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
               change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
         if plan is None or change_points != "keep":
             return None
@@ -96,14 +98,14 @@ class TrackedChain:
 
     name = "tracked chain"
 
-    def sweep(self, system: PlanarSystem, plan: dyads.Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
               change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
         if plan is None or not plan.closed_form_rates:
             return None
         switch = change_points == "switch"
 
         def run(parts: list) -> list[Sweep]:
-            res = dyads.solve_tracked_rates(system, plan, parts, speeds, switch=switch)
+            res = solve_tracked_rates(system, plan, parts, speeds, switch=switch)
             return [_tracked_sweep(system, U, speeds, r, self.name, progress) for U, r in zip(parts, res)]
 
         return outward(system, inputs, run)
@@ -114,7 +116,7 @@ class TrackedGroups:
 
     name = "tracked groups"
 
-    def sweep(self, system: PlanarSystem, plan: dyads.Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
               change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
         if plan is None:
             return None
@@ -123,8 +125,8 @@ class TrackedGroups:
         def run(parts: list) -> list[Sweep]:
             out = []
             for U in parts:
-                tracked = dyads.solve_tracked(system, plan, U, switch=switch)
-                q, qd, qdd = dyads.solve_all(system, plan, U, speeds, tracked=tracked)
+                tracked = solve_tracked(system, plan, U, switch=switch)
+                q, qd, qdd = solve_all(system, plan, U, speeds, tracked=tracked)
                 res = (q, qd, qdd, tracked.singular, tracked.events)
                 out.append(_tracked_sweep(system, U, speeds, res, self.name, progress))
             return out
@@ -137,7 +139,7 @@ class Newton:
 
     name = "newton"
 
-    def sweep(self, system: PlanarSystem, plan: dyads.Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
               change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
         if change_points != "keep":
             return None
@@ -185,7 +187,7 @@ def _tracked_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, res: tuple, e
 
 def _tracked_events(tracked_events: list[Event], sw: Sweep) -> list[Event]:
     """Events of the closed-form sweep: dead points, reassembly and change / branch points
-    found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
+    found and refined on the groups' discriminants (:func:`solve_tracked`)."""
     out, seen = [], set()
     for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
         if e.kind == "reassembled":

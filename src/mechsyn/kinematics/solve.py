@@ -19,7 +19,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics import dyads
+from mechsyn.kinematics.groups import decompose
+from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -406,12 +407,12 @@ def _nearest_mode(S: PlanarSystem, cands: list, u: np.ndarray, q_drawn: np.ndarr
     along the nearest-singular direction of each) whose elbow signature
     (:func:`_elbows`) matches the drawn one most, then whose ``det Phi_q`` has the drawn
     sign."""
-    plan = dyads.decompose(S)
+    plan = decompose(S)
     if plan is not None:
         u_asm = np.array([d.assembled for d in S.drivers])
-        _, sig = dyads.solve_positions(S, plan, u_asm[None])
+        _, sig = solve_positions(S, plan, u_asm[None])
         with np.errstate(invalid="ignore"):
-            qc = dyads.solve_positions(S, plan, u[None], sigmas=sig)[0][0]
+            qc = solve_positions(S, plan, u[None], sigmas=sig)[0][0]
         if np.all(np.isfinite(qc)):
             qc, good = newton(S, qc, u, max_iter=10)
             if good:
