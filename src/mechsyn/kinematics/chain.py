@@ -12,11 +12,11 @@ of Mechanisms and Machines*, ch. 4).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mechsyn.kinematics.groups import Plan, _cons_of, _cross, _local, _memo, circle_circle
+from mechsyn.kinematics.groups import DriveOp, Plan, RRRChooser, RRROp, _cons_of, _cross, _local, _memo, circle_circle
 from mechsyn.kinematics.positions import TrackedPositions, _continuous_angles, solve_positions
 from mechsyn.kinematics.rates import batch_rates
 from mechsyn.kinematics.system import PlanarSystem
@@ -229,7 +229,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
             sl = slice(start, min(N, start + chunk))
             ch = _Chunk(S, anchor, rates, out, sl)
             for op in prog:
-                if op[0] == "drive":
+                if isinstance(op, DriveOp):
                     ch.drive(op, U[sl], speeds, fixed)
                 else:
                     ch.rrr(op, want)
@@ -237,9 +237,9 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     return out
 
 
-def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list, dict]:
-    """The chain's steps as kernels' arguments, and every link's anchor joint (built once
-    per system and plan; the signs ``sigmas`` put in per call)."""
+def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list[DriveOp | RRROp], dict]:
+    """The chain's steps as typed ops, and every link's anchor joint (built once per
+    system and plan; the signs ``sigmas`` put in per call)."""
     memo = _memo(S)
     key = ("chain", id(plan))
     if key not in memo:
@@ -249,17 +249,17 @@ def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[li
         return prog, anchor
     out = []
     for op in prog:
-        sg = sigmas[op[1]] if op[0] == "RRR" else None
+        sg = sigmas[op.step] if isinstance(op, RRROp) else None
         if isinstance(sg, np.ndarray):
-            op = op[:7] + (np.asarray(sg, float),) + op[8:]
+            op = replace(op, sigma=np.asarray(sg, float))
         elif callable(sg):
-            op = op[:7] + ((sg, (op[5] ** 0.5, op[6] ** 0.5), S.mech.joint(op[4][1]).point),) + op[8:]
+            op = replace(op, sigma=RRRChooser(sg, (op.L1s ** 0.5, op.L2s ** 0.5), S.mech.joint(op.joints[1]).point))
         out.append(op)
     return out, anchor
 
 
-def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
-    prog = []
+def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list[DriveOp | RRROp], dict]:
+    prog: list[DriveOp | RRROp] = []
     anchor: dict[int, tuple[str, np.ndarray]] = {}
     for si, step in enumerate(plan.steps):
         if step.kind == "drive_R":
@@ -267,7 +267,7 @@ def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
             con = next(c for c in _cons_of(S, jid) if c.role == "drive")
             sgn = 1.0 if con.b == new else -1.0
             anchor[new] = (jid, _local(S, new, jid))
-            prog.append(("drive", new, k, jid, con.driver, sgn))
+            prog.append(DriveOp(new, k, jid, con.driver, sgn))
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
         s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
@@ -277,8 +277,7 @@ def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list, dict]:
         sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
         anchor[b1] = (J1, s1)
         anchor[b2] = (J3, t3)
-        prog.append(("RRR", si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma,
-                     (s2 - s1) / L1s, (t2 - t3) / L2s))
+        prog.append(RRROp(si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, (s2 - s1) / L1s, (t2 - t3) / L2s))
     return prog, anchor
 
 
@@ -330,8 +329,8 @@ class _Chunk:
         return (A[0] + dx, A[1] + dy, A[2] - wdy, A[3] + wdx,
                 A[4] - al * dy - w2 * dx, A[5] + al * dx - w2 * dy)
 
-    def drive(self, op: tuple, U: np.ndarray, speeds: np.ndarray, fixed: dict) -> None:
-        _, new, k, jid, di, sgn = op
+    def drive(self, op: DriveOp, U: np.ndarray, speeds: np.ndarray, fixed: dict) -> None:
+        new, k, jid, di, sgn = op.new, op.known, op.joint, op.driver, op.sign
         th = U[:, di]
         ct, st = np.cos(th), np.sin(th)
         if sgn < 0:
@@ -349,9 +348,10 @@ class _Chunk:
                 self.rate[new] = (self.rate[k][0] + sgn * speeds[di], self.rate[k][1])
             self.jst[jid] = self.point(k, jid, _local(self.S, k, jid))
 
-    def rrr(self, op: tuple, want: list) -> None:
+    def rrr(self, op: RRROp, want: list) -> None:
         """The RRR kernel: ``B = A + f d + sigma g R90 d`` (see :func:`fast_chain`)."""
-        _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
+        (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s = op.known, op.links, op.joints, op.L1s, op.L2s
+        sigma, bv1, bv2 = op.sigma, op.bv1, op.bv2
         S, sl, jst = self.S, self.sl, self.jst
         A = self.point(k1, J1, _local(S, k1, J1))
         C = self.point(k3, J3, _local(S, k3, J3))
@@ -359,7 +359,7 @@ class _Chunk:
         dx = C[0] - A[0]
         dy = C[1] - A[1]
         inv, f, g = circle_circle(dx, dy, L1s, L2s)
-        if isinstance(sigma, tuple):  # a chooser: the signs from the discriminant of positions._solve_step
+        if isinstance(sigma, RRRChooser):  # a chooser: the signs from the discriminant of positions._solve_step
             sigma = self._choose(sigma, A, dx, dy, inv)
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
@@ -388,11 +388,11 @@ class _Chunk:
         else:
             jst[J2] = (Bx, By)
 
-    def _choose(self, chooser: tuple, A: tuple, dx: np.ndarray, dy: np.ndarray, inv: np.ndarray) -> np.ndarray:
+    def _choose(self, chooser: RRRChooser, A: tuple, dx: np.ndarray, dy: np.ndarray, inv: np.ndarray) -> np.ndarray:
         """Signs of an RRR group from its chooser (``solve_tracked_rates``), given the
         discriminant ``h^2 / L1^2`` as :func:`mechsyn.kinematics.positions._solve_step` computes it (the same numbers,
         so the same decisions) and the drawn mode read at the first row."""
-        choose, (L1, L2), B0 = chooser
+        choose, (L1, L2), B0 = chooser.choose, chooser.lengths, chooser.drawn_b
         D2 = 1.0 / inv
         a = (L1 ** 2 - L2 ** 2 + D2) / (2 * np.sqrt(D2))
         h2 = L1 ** 2 - a ** 2

@@ -19,13 +19,64 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from mechsyn.kinematics.system import Con, PlanarSystem
 
-__all__ = ["Plan", "Step", "circle_circle", "decompose"]
+__all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose"]
+
+
+#: Chooses the assembly sign of a branched group per input row from the group's
+#: normalised discriminant (per row) and its drawn mode (+1 or -1).
+Chooser = Callable[[np.ndarray, float], np.ndarray | float]
+#: The assembly mode asked of a branched group: one sign for every row (+1 or -1), one
+#: sign per row (an array), the drawn mode (None) or a :data:`Chooser`.
+Sigma = float | np.ndarray | Chooser | None
+
+
+@dataclass(frozen=True)
+class RRRChooser:
+    """A chooser of an RRR group in a chain program, with what it needs to evaluate the
+    discriminant as the generic step does: the link lengths and the drawn middle joint."""
+
+    choose: Chooser
+    lengths: tuple[float, float]
+    drawn_b: np.ndarray
+
+
+@dataclass(frozen=True)
+class DriveOp:
+    """A chain program's drive: link ``new`` turned by the R drive at joint ``joint``
+    (input ``driver``, ``sign`` +1 when ``new`` is the pair's second link) about the
+    known link ``known`` (-1: the frame)."""
+
+    new: int
+    known: int
+    joint: str
+    driver: int
+    sign: float
+
+
+@dataclass(frozen=True)
+class RRROp:
+    """A chain program's RRR group (plan step ``step``): middle joint ``joints[1]`` found
+    from the known end joints ``joints[0]`` (on link ``known[0]``) and ``joints[2]`` (on
+    ``known[1]``); ``L1s``, ``L2s`` the squared lengths of its links ``links``; ``sigma``
+    its assembly mode; ``bv1``, ``bv2`` each link's local end-to-middle vector over its
+    squared length (the link's rotation from the joint-to-joint vector)."""
+
+    step: int
+    known: tuple[int, int]
+    links: tuple[int, int]
+    joints: tuple[str, str, str]
+    L1s: float
+    L2s: float
+    sigma: float | np.ndarray | RRRChooser
+    bv1: np.ndarray
+    bv2: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -185,11 +236,7 @@ def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, lin
 def _memo(S: PlanarSystem) -> dict:
     """Per-system cache of look-ups that depend only on the system (local joint points,
     constraints of a joint): a plan evaluated many times (events, drags) reuses them."""
-    memo = S.__dict__.get("_dyads_memo")
-    if memo is None:
-        memo = {}
-        object.__setattr__(S, "_dyads_memo", memo)
-    return memo
+    return S.cache.setdefault("groups", {})
 
 
 def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:

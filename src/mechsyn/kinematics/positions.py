@@ -27,11 +27,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.groups import Plan, Step, _cons_of, _cross, _dot, _line, _local, _rel_angle
+from mechsyn.kinematics.groups import Plan, Sigma, Step, _cons_of, _cross, _dot, _line, _local, _rel_angle
 from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
 
 __all__ = ["TrackedPositions", "solve_positions"]
@@ -127,7 +126,7 @@ def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray
     st.set(i, P - _apply(c, sn, s_local), phi)
 
 
-def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """Solve one step in place; return its assembly sign (sigma) for the branch: ``sigma``
     given (a number or one per row), None (the drawn mode) or a chooser called with the
     normalised discriminant and the drawn mode."""
@@ -137,7 +136,7 @@ def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: A
     return kernel(S, st, step, u, sigma)
 
 
-def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """A link turned by an R drive about a known link."""
     (new,), (k,), (jid,) = step.links, step.known, step.joints
     con = next(c for c in _cons_of(S, jid) if c.role == "drive")
@@ -149,7 +148,7 @@ def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma:
     return 1.0
 
 
-def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """A link slid by a P drive along a known link."""
     (new,), (k,), (jid,) = step.links, step.known, step.joints
     drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
@@ -172,7 +171,7 @@ def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma:
     return 1.0
 
 
-def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RRR dyad: the intersection of two circles."""
     A_s, B_s = step.known
     b1, b2 = step.links
@@ -212,7 +211,7 @@ def _oriented(step: Step, kind: str) -> tuple:
     return b2, b1, B_s, A_s, J3, J1
 
 
-def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RRP / PRR dyad: the intersection of a circle and a line."""
     # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
     lr, lp, kr, kp, Jr, Jp = _oriented(step, "RRP")
@@ -250,7 +249,7 @@ def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any
     return sigma
 
 
-def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RPR dyad: the slide line keeps its offset from both pivots."""
     A_s, B_s = step.known
     b1, b2 = step.links
@@ -284,7 +283,7 @@ def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any
     return sigma
 
 
-def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RPP / PPR dyad: orientations from the P pairs, position from two lines."""
     # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
     lr, lp, kr, kp, Jr, Jp = _oriented(step, "RPP")
@@ -299,7 +298,7 @@ def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any
     return 1.0
 
 
-def _step_PRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Any) -> Any:
+def _step_PRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """PRP dyad: the intersection of two slide lines."""
     A_s, B_s = step.known
     b1, b2 = step.links

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from mechsyn.kinematics.chain import _chain_program, _link_angles
-from mechsyn.kinematics.groups import Plan, _local, _memo, circle_circle
+from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle
 from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -48,14 +48,14 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
     cx = {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
     steps = []
     for op in prog:
-        if op[0] == "drive":
-            _, new, k, jid, di, sgn = op  # the joint's local point on k (the frame: its fixed point)
-            steps.append(("drive", new, k, jid, di, sgn, complex(*_local(S, k, jid))))
+        if isinstance(op, DriveOp):  # the joint's local point on k (the frame: its fixed point)
+            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
+                          complex(*_local(S, op.known, op.joint))))
         else:
-            _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
-            steps.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, complex(*bv1).conjugate(),
-                          complex(*bv2).conjugate(), complex(*_local(S, k1, J1)),
-                          complex(*_local(S, k3, J3))))
+            (k1, k3), (J1, _, J3) = op.known, op.joints
+            steps.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
+                          complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
+                          complex(*_local(S, k1, J1)), complex(*_local(S, k3, J3))))
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)

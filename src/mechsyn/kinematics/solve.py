@@ -130,10 +130,9 @@ def generic_free(S: PlanarSystem, q: np.ndarray | None = None, trials: int = 3) 
 def singular_configuration(S: PlanarSystem, q: np.ndarray | None = None) -> bool:
     """``Phi_q`` loses rank at ``q`` though the mechanism is determined in general position."""
     if q is None:
-        memo = S.__dict__.get("_singular_drawn")
+        memo = S.cache.get("singular_drawn")
         if memo is None:
-            memo = singular_configuration(S, S.q0)
-            object.__setattr__(S, "_singular_drawn", memo)
+            memo = S.cache["singular_drawn"] = singular_configuration(S, S.q0)
         return memo
     return check_mobility(S, q)["free"] > 0 and generic_free(S, q) == 0
 
@@ -161,7 +160,7 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
     The file's configuration is first made exact by Newton, then followed continuously
     from its own input values to ``u`` (so the file chooses the assembly branch).
     """
-    memo = S.__dict__.get("_assembled")
+    memo = S.cache.get("assembled")
     if memo is not None:  # the checks below depend on the system only: done once per system
         return memo.copy() if u is None else _reach(S, memo, u)
     u_asm = np.array([d.assembled for d in S.drivers])
@@ -179,7 +178,7 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
             f"by up to {moved * S.scale:.3g}", source=src,
             hint="give joint points of one consistent configuration")
     _require_determined(S, q)
-    object.__setattr__(S, "_assembled", q.copy())
+    S.cache["assembled"] = q.copy()
     if u is None:
         return q
     return _reach(S, q, u)

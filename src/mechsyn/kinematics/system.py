@@ -53,6 +53,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
 
@@ -215,6 +216,10 @@ class PlanarSystem:
     #: angles and cam parameters): ``Phi_q * col_scale / row_scale`` is dimensionless
     row_scale: np.ndarray | None = None
     col_scale: np.ndarray | None = None
+    #: what the engines compute once per system and reuse (the assembled configuration,
+    #: the groups' look-ups and programs, the compiled one-configuration equations): a
+    #: field of the compiled system, so a new geometry starts with an empty one
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def unit_jacobian(self, J: np.ndarray) -> np.ndarray:
         """``Phi_q`` (..., m, n) made dimensionless by the mechanism's length scale: rows of
@@ -355,8 +360,6 @@ class PlanarSystem:
 
 
 def _one(S: PlanarSystem) -> Any:
-    from mechsyn.kinematics.compiled import one_configuration
-
     return one_configuration(S)
 
 
