@@ -16,7 +16,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mechsyn.kinematics.groups import DriveOp, Plan, RRRChooser, RRROp, _cons_of, _cross, _local, _memo, circle_circle
+from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, _cons_of, _cross, _local, _memo, circle_circle,
+                                       normalised_disc)
 from mechsyn.kinematics.positions import TrackedPositions, _continuous_angles, solve_positions
 from mechsyn.kinematics.rates import batch_rates
 from mechsyn.kinematics.system import PlanarSystem
@@ -253,7 +254,7 @@ def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[li
         if isinstance(sg, np.ndarray):
             op = replace(op, sigma=np.asarray(sg, float))
         elif callable(sg):
-            op = replace(op, sigma=RRRChooser(sg, (op.L1s ** 0.5, op.L2s ** 0.5), S.mech.joint(op.joints[1]).point))
+            op = replace(op, sigma=RRRChooser(sg, S.mech.joint(op.joints[1]).point))
         out.append(op)
     return out, anchor
 
@@ -360,7 +361,7 @@ class _Chunk:
         dy = C[1] - A[1]
         inv, f, g = circle_circle(dx, dy, L1s, L2s)
         if isinstance(sigma, RRRChooser):  # a chooser: the signs from the discriminant of positions._solve_step
-            sigma = self._choose(sigma, A, dx, dy, inv)
+            sigma = self._choose(sigma, A, dx, dy, normalised_disc(inv, g, L1s))
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
         if isinstance(sigma, np.ndarray):
@@ -388,17 +389,15 @@ class _Chunk:
         else:
             jst[J2] = (Bx, By)
 
-    def _choose(self, chooser: RRRChooser, A: tuple, dx: np.ndarray, dy: np.ndarray, inv: np.ndarray) -> np.ndarray:
+    def _choose(self, chooser: RRRChooser, A: tuple, dx: np.ndarray, dy: np.ndarray, disc: np.ndarray) -> np.ndarray:
         """Signs of an RRR group from its chooser (``solve_tracked_rates``), given the
-        discriminant ``h^2 / L1^2`` as :func:`mechsyn.kinematics.positions._solve_step` computes it (the same numbers,
-        so the same decisions) and the drawn mode read at the first row."""
-        choose, (L1, L2), B0 = chooser.choose, chooser.lengths, chooser.drawn_b
-        D2 = 1.0 / inv
-        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * np.sqrt(D2))
-        h2 = L1 ** 2 - a ** 2
+        normalised discriminant from the kernel :func:`~mechsyn.kinematics.groups.circle_circle`
+        as the generic step computes it (the same numbers, so the same decisions) and the
+        drawn mode read at the first row."""
+        choose, B0 = chooser.choose, chooser.drawn_b
         ax, ay = (float(np.ravel(c)[0]) for c in A[:2])  # a frame joint's are numbers
         s_file = 1.0 if dx[0] * (B0[1] - ay) - dy[0] * (B0[0] - ax) >= 0 else -1.0
-        return choose(h2 / L1 ** 2, s_file)
+        return choose(disc, s_file)
 
     def _rrr_rates(self, A: tuple, C: tuple, e: tuple, B: tuple, links: tuple, J2: str) -> tuple:
         """Rates of an RRR dyad: ``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``,

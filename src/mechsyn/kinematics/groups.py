@@ -19,6 +19,7 @@ References
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -26,7 +27,7 @@ import numpy as np
 
 from mechsyn.kinematics.system import Con, PlanarSystem
 
-__all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose"]
+__all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose", "normalised_disc"]
 
 
 #: Chooses the assembly sign of a branched group per input row from the group's
@@ -39,11 +40,10 @@ Sigma = float | np.ndarray | Chooser | None
 
 @dataclass(frozen=True)
 class RRRChooser:
-    """A chooser of an RRR group in a chain program, with what it needs to evaluate the
-    discriminant as the generic step does: the link lengths and the drawn middle joint."""
+    """A chooser of an RRR group in a chain program, with the drawn middle joint (which
+    gives the drawn mode)."""
 
     choose: Chooser
-    lengths: tuple[float, float]
     drawn_b: np.ndarray
 
 
@@ -268,16 +268,39 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
-def circle_circle(dx: np.ndarray, dy: np.ndarray, L1s: float, L2s: float) -> tuple:
-    """The RRR dyad's intersection of the circles ``|B - A| = L1``, ``|B - C| = L2`` with
-    ``d = C - A = (dx, dy)``: ``1/|d|^2``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)`` and
-    ``g^2 = L1^2 / |d|^2 - f^2`` (``B = A + f d + sigma g R90 d``; ``g^2 |d|^2 / L1^2`` is
-    the group's normalised discriminant)."""
+def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: float, L2s: float) -> tuple:
+    """The RRR group's kernel: the intersection of the circles ``|B - A| = L1``,
+    ``|B - C| = L2`` with ``d = C - A = (dx, dy)`` (arrays, or floats for the scalar root
+    searches of the branch tracking; the same operations, so the same numbers).
+
+    Returns ``1/|d|^2``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)`` and
+    ``g^2 = L1^2 / |d|^2 - f^2``: ``B = A + f d + sigma g R90 d`` and
+    ``g^2 |d|^2 / L1^2 = g^2 / (1/|d|^2 L1^2)`` is the group's normalised discriminant
+    (:func:`normalised_disc`; below zero the circles do not meet). Every engine that
+    places an RRR group calls it: the generic step, the fast chain, the regular pass and
+    the scalar discriminant of the tracking.
+
+    Examples
+    --------
+    >>> inv, f, g2 = circle_circle(4.0, 0.0, 9.0, 9.0)   # |d| = 4, L1 = L2 = 3
+    >>> f, round(g2 * 16, 12), round(normalised_disc(inv, g2, 9.0), 6)
+    (0.5, 5.0, 0.555556)
+    """
     inv = dx * dx
     inv += dy * dy
-    np.divide(1.0, inv, out=inv)
+    if isinstance(inv, np.ndarray):
+        np.divide(1.0, inv, out=inv)
+    else:
+        inv = 1.0 / inv if inv > 0 else math.inf
     f = inv * (0.5 * (L1s - L2s))
     f += 0.5
     g = inv * L1s
     g -= f * f
     return inv, f, g
+
+
+def normalised_disc(inv: np.ndarray | float, g2: np.ndarray | float, L1s: float) -> np.ndarray | float:
+    """The RRR group's normalised discriminant ``h^2 / L1^2`` (``h`` the height of the
+    middle joint over ``d``) from :func:`circle_circle`'s ``1/|d|^2`` and ``g^2``: 1 when
+    the first link stands square on ``d``, 0 when the group is folded flat."""
+    return g2 / (inv * L1s)

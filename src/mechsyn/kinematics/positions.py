@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import Plan, Sigma, Step, _cons_of, _cross, _dot, _line, _local, _rel_angle
+from mechsyn.kinematics.groups import Plan, Sigma, Step, circle_circle, normalised_disc, _cons_of, _cross, _dot, _line, _local, _rel_angle
 from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
 
 __all__ = ["TrackedPositions", "solve_positions"]
@@ -180,19 +180,16 @@ def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     C = st.point(B_s, _local(S, B_s, J3))
     s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
     t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-    L1, L2 = np.linalg.norm(s2 - s1), np.linalg.norm(t2 - t3)
+    L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
     d = C - A
-    D2 = _dot(d, d)
-    D = np.sqrt(D2)
-    a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D)
-    h2 = L1 ** 2 - a ** 2
+    inv, f, g2 = circle_circle(d[:, 0], d[:, 1], L1s, L2s)
+    disc = normalised_disc(inv, g2, L1s)
     if sigma is None or callable(sigma):
         s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
-        sigma = s_file if sigma is None else sigma(h2 / L1 ** 2, s_file)
-    h2 = np.where((h2 < 0) & (h2 > -1e-12 * L1 ** 2), 0.0, h2)
-    h = np.sqrt(np.where(h2 >= 0, h2, np.nan))
-    e = d / D[:, None]
-    B = A + a[:, None] * e + (sigma * h)[:, None] * _perp(e)
+        sigma = s_file if sigma is None else sigma(disc, s_file)
+    g2 = np.where((g2 < 0) & (disc > -1e-12), 0.0, g2)  # a fold within round-off
+    g = np.sqrt(np.where(g2 >= 0, g2, np.nan))
+    B = A + f[:, None] * d + (sigma * g)[:, None] * _perp(d)
     beta1 = np.arctan2(*(s2 - s1)[::-1])
     beta2 = np.arctan2(*(t2 - t3)[::-1])
     phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1

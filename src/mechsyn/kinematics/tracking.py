@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from mechsyn.kinematics.chain import _poses_from_chain, fast_chain
-from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo
+from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, circle_circle, normalised_disc
 from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _solve_step
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
@@ -243,9 +243,9 @@ def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
         s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
         t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-        L1, L2 = float(np.linalg.norm(s2 - s1)), float(np.linalg.norm(t2 - t3))
+        L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
         prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
-                     L1, L2, tuple(s1), tuple(t3), tuple((s2 - s1) / L1 ** 2), tuple((t2 - t3) / L2 ** 2)))
+                     L1s, L2s, tuple(s1), tuple(t3), tuple((s2 - s1) / L1s), tuple((t2 - t3) / L2s)))
     memo[key] = prog
     return prog
 
@@ -272,20 +272,17 @@ def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
             ct, st = math.cos(u[di]), sgn * math.sin(u[di])
             pose[new] = (P[0], P[1], snew[0], snew[1], ck * ct - sk_ * st, sk_ * ct + ck * st)
             continue
-        _, (k1, sa), (k3, sc), (b1, b2), L1, L2, s1, t3, bv1, bv2 = op
+        _, (k1, sa), (k3, sc), (b1, b2), L1s, L2s, s1, t3, bv1, bv2 = op
         A, C = point(k1, sa), point(k3, sc)
         dx, dy = C[0] - A[0], C[1] - A[1]
-        D2 = dx * dx + dy * dy
-        D = math.sqrt(D2)
-        a = (L1 ** 2 - L2 ** 2 + D2) / (2 * D) if D > 0 else math.nan
-        h2 = L1 ** 2 - a ** 2
+        inv, f, g2 = circle_circle(dx, dy, L1s, L2s)  # the kernel of the array passes, on floats
+        disc = normalised_disc(inv, g2, L1s) if inv < math.inf else math.nan
         if j == k:
-            return h2 / L1 ** 2
-        if not h2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
-            h2 = 0.0 if h2 > -1e-12 * L1 ** 2 else math.nan
-        h = float(sigmas[j]) * (math.sqrt(h2) if h2 >= 0 else math.nan)
-        ex, ey = dx / D, dy / D
-        Bx, By = A[0] + a * ex - h * ey, A[1] + a * ey + h * ex
+            return disc
+        if not g2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
+            g2 = 0.0 if disc > -1e-12 else math.nan
+        g = float(sigmas[j]) * (math.sqrt(g2) if g2 >= 0 else math.nan)
+        Bx, By = A[0] + f * dx - g * dy, A[1] + f * dy + g * dx
         for link, P, loc, bv in ((b1, A, s1, bv1), (b2, C, t3, bv2)):
             vx, vy = Bx - P[0], By - P[1]
             pose[link] = (P[0], P[1], loc[0], loc[1], vx * bv[0] + vy * bv[1], vy * bv[0] - vx * bv[1])
