@@ -12,7 +12,7 @@ of Mechanisms and Machines*, ch. 4).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -252,9 +252,9 @@ def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[li
     for op in prog:
         sg = sigmas[op.step] if isinstance(op, RRROp) else None
         if isinstance(sg, np.ndarray):
-            op = replace(op, sigma=np.asarray(sg, float))
+            op = op.with_sigma(np.asarray(sg, float))
         elif callable(sg):
-            op = replace(op, sigma=RRRChooser(sg, S.mech.joint(op.joints[1]).point))
+            op = op.with_sigma(RRRChooser(sg, S.mech.joint(op.joints[1]).point))
         out.append(op)
     return out, anchor
 

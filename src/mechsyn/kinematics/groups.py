@@ -78,6 +78,10 @@ class RRROp:
     bv1: np.ndarray
     bv2: np.ndarray
 
+    def with_sigma(self, sigma: float | np.ndarray | RRRChooser) -> "RRROp":
+        """The same group in another assembly mode (the signs of one sweep)."""
+        return RRROp(self.step, self.known, self.links, self.joints, self.L1s, self.L2s, sigma, self.bv1, self.bv2)
+
 
 @dataclass(frozen=True)
 class Step:
