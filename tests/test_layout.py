@@ -157,3 +157,28 @@ def test_the_cycle_check_finds_a_cycle(tmp_path, monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "KINEMATICS", pkg)
     with pytest.raises(AssertionError, match="import cycle"):
         test_kinematics_imports_no_cycle()
+
+
+#: function-level imports of mechsyn modules allowed in kinematics/ (by name): the lazy
+#: package attribute and the Result's drawing delegation
+KINEMATICS_DEFERRED = {"__init__.py": {"mechsyn.kinematics"}, "analysis.py": {"mechsyn.plot.kinematics"}}
+
+
+def test_kinematics_imports_its_own_modules_at_module_level():
+    """Own modules imported inside functions hide the import graph (issue 28): only the
+    named delegations are deferred."""
+    bad = {}
+    for p in KINEMATICS.glob("*.py"):
+        tree = ast.parse(p.read_text(encoding="utf-8"))
+        inner = set()
+        for fn in ast.walk(tree):
+            if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for node in ast.walk(fn):
+                    if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("mechsyn"):
+                        inner.add(node.module)
+                    elif isinstance(node, ast.Import):
+                        inner.update(a.name for a in node.names if a.name.startswith("mechsyn"))
+        extra = inner - KINEMATICS_DEFERRED.get(p.name, set())
+        if extra:
+            bad[p.name] = sorted(extra)
+    assert not bad, f"import these at module level: {bad}"

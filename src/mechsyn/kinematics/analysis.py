@@ -30,6 +30,7 @@ from mechsyn.kinematics.groups import Plan, decompose
 from mechsyn.kinematics.solve import assemble, singular_configuration
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
+from mechsyn.limits import limit, limit_hint
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
@@ -201,9 +202,6 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
     >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
     ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
     """
-    from mechsyn.errors import MechsynInputError
-    from mechsyn.limits import limit, limit_hint
-
     if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
         raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", field="inputs",
                                 hint="e.g. A=0:360:1 on the command line")

@@ -70,6 +70,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["BatchPlan", "BatchResult", "compile_plan", "simulate_batch", "design_parameters"]
@@ -302,8 +303,6 @@ def _output_points(mech: Mechanism, points: list[str] | None, joints: dict, inde
 
 def _reference_input(mech: Mechanism) -> float:
     """The input value of the file's configuration as :func:`simulate` measures it."""
-    from mechsyn.kinematics.system import build_system
-
     S = build_system(mech)
     return float(np.degrees(S.drivers[0].assembled))
 
