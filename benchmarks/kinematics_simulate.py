@@ -16,6 +16,11 @@ Cases (361 inputs, 0..360 degrees):
 * ``drag``: :meth:`KinematicPlan.with_joint_points` + ``simulate`` of the Watt six-bar (the
   editor's drag loop; no target in the issue, reported for the web app).
 
+Then the fixed costs of one call for the crank-rocker, the Watt six-bar and the Jansen leg
+(issue 30): a new geometry (``with_joints``), its constraint system, the decomposition,
+the engine's sweep, and the rest of ``simulate`` (events, points, result), plan cached
+and fresh.
+
 The bare NumPy reference computes the crank-rocker's joint positions B, C for the same
 361 angles in five array expressions; mechsyn's answers are checked against it (1e-12),
 and the dead points of the textbook four-bar against the law of cosines (1e-6 degree).
@@ -167,6 +172,58 @@ def jansen(writing: str):
     return mechanism_from_dict(d, f"jansen-{writing}")
 
 
+def fixed_costs(mech, joint: str, x: np.ndarray, repeats: int) -> dict[str, float]:
+    """Where one ``simulate`` call of a freshly built geometry spends its time (minima in
+    seconds): a new mechanism with one joint moved (``with_joints``), its constraint
+    system (``build_system``), the decomposition into Assur groups (``decompose``), the
+    input checks and the sweep of the engine that answers (``first_sweep``), and the rest
+    of ``simulate`` (events in input units, named points, link motions, the result)."""
+    from dataclasses import replace
+
+    from mechsyn.kinematics.analysis import compile_plan
+    from mechsyn.kinematics.engines import PLANAR_ENGINES, first_sweep
+    from mechsyn.kinematics.groups import decompose
+    from mechsyn.kinematics.solve import assemble, singular_configuration
+    from mechsyn.kinematics.system import build_system
+
+    j0 = next(j for j in mech.joints if not j.actuated and j.links[0] != mech.ground)
+    k = [0]
+
+    def moved():
+        k[0] += 1
+        p = np.asarray(j0.point, float) + 1e-9 * (k[0] % 7)
+        return mech.with_joints(tuple(replace(j, point=p) if j.id == j0.id else j for j in mech.joints))
+
+    m1 = moved()
+    S = build_system(m1)
+    kp = compile_plan(m1, inputs=(joint,))
+    d = next(dd for dd in S.drivers if dd.joint == joint)
+    U = (np.radians(x) if d.type == "R" else x)[:, None]
+    sp = np.ones(1)
+    out = {"with_joints": best_of(moved, repeats),
+           "build_system": best_of(lambda: build_system(m1), repeats),
+           "decompose": best_of(lambda: decompose(S), repeats),
+           "assemble + mobility": best_of(lambda: assemble(build_system(m1)), repeats),
+           "singular drawn config?": best_of(lambda: singular_configuration(build_system(m1)), repeats),
+           "sweep (engine)": best_of(lambda: first_sweep(PLANAR_ENGINES, kp.system, kp.groups, U, sp), repeats),
+           "simulate, plan cached": best_of(lambda: kp.simulate({joint: x}), repeats),
+           "simulate, fresh geometry": best_of(lambda: moved().simulate({joint: x}), repeats)}
+    out["events, points, result"] = out["simulate, plan cached"] - out["sweep (engine)"]
+    out["assemble + mobility"] -= out["build_system"]
+    out["singular drawn config?"] -= out["build_system"]
+    return out
+
+
+def print_fixed_costs(cases: list, x: np.ndarray, repeats: int) -> None:
+    """The table of :func:`fixed_costs` for each case (milliseconds, 80 columns)."""
+    rows = {name: fixed_costs(m, j, x, repeats) for name, m, j in cases}
+    keys = list(next(iter(rows.values())))
+    print("\n# fixed costs per call, ms (minima; 'events, points, result' = cached simulate - sweep)")
+    print(f"{'':26s}" + "".join(f"{n[:12]:>14s}" for n in rows))
+    for key in keys:
+        print(f"{key:26s}" + "".join(f"{rows[n][key] * 1e3:14.3f}" for n in rows))
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeats", type=int, default=30)
@@ -233,6 +290,8 @@ def main() -> None:
     t, ratio, med = both(drag, bare, args.repeats, t_bare)
     print(f"{'drag (with_joint_points + simulate), Watt':<40s} {'assur':>7s} {'':>6s} {t * 1e3:8.2f} "
           f"{ratio:8.1f} {med:7.1f}")
+    print_fixed_costs([(n, m, j) for n, m, j in cases if n in ("crank-rocker", "Watt six-bar", "Jansen leg (chain)")],
+                      x, args.repeats)
     py = Path(args.pylinkage)
     if py.exists():
         out = str(Path("/tmp") / f"pylinkage_bench_{os.getpid()}")

@@ -390,3 +390,25 @@ def test_the_contract_sees_function_level_and_relative_imports(tmp_path):
     layers = (("pkg.low",), ("pkg",))
     assert [layer_of(m, layers) for m in ("pkg.low", "pkg.high", "pkg.sub.mod")] == [0, 1, 1]
 
+
+
+# --------------------------------------------------------------------------- kinematics
+KINEMATICS = PACKAGE / "kinematics"
+#: packages a computing module of kinematics/ never imports (reading, drawing, terminal)
+KINEMATICS_FORBIDDEN = ("matplotlib", "pydantic", "yaml", "typer", "rich")
+
+
+def third_party_imports(path: Path) -> set[str]:
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out.update(a.name.split(".")[0] for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            out.add(node.module.split(".")[0])
+    return out
+
+
+def test_kinematics_computes_without_reading_drawing_or_terminal_packages():
+    bad = {p.name: sorted(third_party_imports(p) & set(KINEMATICS_FORBIDDEN)) for p in KINEMATICS.rglob("*.py")}
+    bad = {k: v for k, v in bad.items() if v}
+    assert not bad, f"kinematics modules importing {KINEMATICS_FORBIDDEN}: {bad}"

@@ -91,6 +91,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
     tracked outward sweeps give; with dead points it declines (the tracked sweep runs)."""
     from mechsyn.kinematics import analysis
     from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.engines import drawn_row
     from mechsyn.kinematics.regular import regular_sweep
 
     cases = [("kinematics/crank_rocker.yaml", "A", True), ("kinematics/jansen_leg.yaml", "P0", True),
@@ -101,7 +102,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
         for grid in ((0, 360, 1), (-90, 500, 7), (200, 260, 0.5)):
             x = input_grid(*grid)
             U = np.radians(x)[:, None]
-            got = regular_sweep(kp.system, kp.groups, U, np.ones(1), analysis._drawn_row(kp.system, U))
+            got = regular_sweep(kp.system, kp.groups, U, np.ones(1), drawn_row(kp.system, U))
             assert (got is not None) == regular or grid[1] - grid[0] < 360, (f, grid)
             if got is not None:
                 q, qd, qdd, links = got
@@ -110,16 +111,18 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
                     for k, arr in enumerate((q, qd, qdd)):
                         assert np.allclose(links.point(i, np.zeros(2))[k], arr[:, 3 * i:3 * i + 2], atol=1e-12)
             fast = simulate(m, {j: x})
-            with monkeypatch.context() as mp:
-                mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
+            assert (fast.engine == "regular pass") == (got is not None), (f, grid, fast.engine)
+            with monkeypatch.context() as mp:  # without the regular pass: the tracked chain
+                mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
                 tracked = simulate(m, {j: x})
+            assert tracked.engine == "tracked chain"
             _same(fast, tracked)
 
 
 def test_scalar_discriminant_equals_the_array_pass(ex):
     """The one-input evaluation used by the dead-point root search gives the array pass's
     discriminant of every group."""
-    from mechsyn.kinematics import dyads
+    from mechsyn.kinematics import dyads, tracking
     from mechsyn.kinematics.analysis import cached_plan
 
     for f in ("textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "kinematics/peaucellier.yaml"):
@@ -129,14 +132,14 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
         S, plan = kp.system, kp.groups
         X = np.radians(input_grid(0, 350, 10))[:, None]
         tp = dyads.solve_tracked(S, plan, X)
-        prog = dyads._scalar_program(S, plan)
+        prog = tracking._scalar_program(S, plan)
         for k, step in enumerate(plan.steps):
             if step.kind != "RRR":
                 continue
-            ref = dyads._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
+            ref = tracking._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
             sig = [[float(s[i]) if isinstance(s, np.ndarray) else float(s) for s in tp.sigmas[:k]]
                    for i in range(len(X))]
-            got = np.array([dyads._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
+            got = np.array([tracking._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
             assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
 
 
@@ -180,6 +183,6 @@ def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex,
     fast = simulate(m, inp, speeds=speeds)
     assert fast.sweep.links is not None and not fast.events
     with monkeypatch.context() as mp:
-        mp.setattr(analysis, "_one_pass", lambda *a, **k: None)
+        mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
         tracked = simulate(m, inp, speeds=speeds)
     _same(fast, tracked)

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from mechsyn.belt.design import BeltDesign
 from mechsyn.belt.kinematics import analyze
 from mechsyn.belt.straightness import tangent_deviation
+from mechsyn.kinematics.groups import circle_circle
 
 Array = NDArray[np.float64]
 
@@ -57,22 +58,16 @@ def equivalent_four_bar(design: BeltDesign, dphi: ArrayLike) -> FourBarState:
     B0 = design.B0
     A = np.stack([-a * np.sin(dphi), a * np.cos(dphi)], axis=-1)
     D = B0[None, :] - A
-    dist = np.hypot(D[:, 0], D[:, 1])
-    u = D / dist[:, None]
-    along = (dist**2 + r**2 - b0**2) / (2 * dist)
+    # the RRR kernel: B = A + f D + sign g R90 D (circles (A, r) and (B0, b0))
+    _, f, g2 = circle_circle(D[:, 0], D[:, 1], r**2, b0**2)
     with np.errstate(invalid="ignore"):
-        perp = np.sqrt(r**2 - along**2)
-    # design position: A=(0,a), B0=(r, a-b0); B=(r, a) lies on the left-hand normal side?
-    nrm = np.stack([-u[:, 1], u[:, 0]], axis=-1)
-    # choose the branch sign from the design position
+        perp = np.sqrt(g2)
+    # the branch sign from the design position: A=(0,a), B=(r, a) on which side of A B0
     D0 = B0 - np.array([0.0, a])
-    d0 = math.hypot(*D0)
-    u0 = D0 / d0
-    n0 = np.array([-u0[1], u0[0]])
-    al0 = (d0**2 + r**2 - b0**2) / (2 * d0)
-    Bdesign = np.array([0.0, a]) + al0 * u0
-    sign = 1.0 if (np.array([r, a]) - Bdesign) @ n0 > 0 else -1.0
-    B = A + along[:, None] * u + sign * perp[:, None] * nrm
+    _, f0, _ = circle_circle(float(D0[0]), float(D0[1]), r**2, b0**2)
+    Bdesign = np.array([0.0, a]) + f0 * D0
+    sign = 1.0 if (np.array([r, a]) - Bdesign) @ np.array([-D0[1], D0[0]]) > 0 else -1.0
+    B = A + f[:, None] * D + (sign * perp)[:, None] * np.stack([-D[:, 1], D[:, 0]], axis=-1)
     AB = B - A
     theta = np.arctan2(AB[:, 1], AB[:, 0])
     st, ct = np.sin(theta), np.cos(theta)

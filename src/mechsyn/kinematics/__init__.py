@@ -1,11 +1,21 @@
 """Planar kinematics and force analysis.
 
-Modules: ``analysis`` (:func:`simulate`, :func:`forces`: the entry points), ``system``
-(link poses and constraint equations, analytic Jacobian), ``solve`` (Newton continuation,
-velocities, accelerations), ``dyads`` (closed-form Assur dyads, vectorised), ``forces``
-(kinetostatics), ``derived`` (transmission angle, mechanical advantage, Grashof, path
-extent, straightness). Paper 001's belt drive is :mod:`mechsyn.belt`. Figures and the
-animation: :mod:`mechsyn.plot.kinematics`.
+Modules, from the entry points down (docs/architecture.md):
+
+* ``analysis``: :func:`simulate`, :func:`forces`, the compiled plan and its cache;
+* ``engines``: the ``Engine`` protocol and the planar engines tried in order (regular
+  pass, tracked chain, tracked groups, Newton); ``sweep``: ``Sweep`` and ``Event``;
+* ``regular`` (one-pass regular sweep), ``tracking`` (assembly modes through folds and
+  change points), ``chain`` (driver-R + RRR chains, closed-form rates), ``positions``
+  (generic group steps), ``groups`` (plan, decomposition, the RRR kernel),
+  ``solve`` (Newton continuation, assembly, mobility), ``rates`` (batched rates),
+  ``system`` (link poses, constraint equations, analytic and dimensionless Jacobian);
+* ``batch`` (many designs of one topology), ``forces`` (kinetostatics), ``derived``
+  (transmission angle, mechanical advantage, Grashof, path extent, straightness),
+  ``report``; ``dyads`` keeps the Assur-group names for callers outside the package.
+
+Paper 001's belt drive is :mod:`mechsyn.belt`. Figures and the animation:
+:mod:`mechsyn.plot.kinematics`.
 
 References
 ----------

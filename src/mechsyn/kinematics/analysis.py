@@ -17,230 +17,26 @@ from __future__ import annotations
 import math
 import threading
 from collections import OrderedDict
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics import dyads
+from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
-from mechsyn.kinematics.regular import regular_sweep
-from mechsyn.kinematics.solve import Sweep, assemble, singular_configuration, sweep
+from mechsyn.kinematics.groups import Plan, decompose
+from mechsyn.kinematics.solve import assemble, singular_configuration
+from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
+                                          input_grid, resolve_points)
+from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan",
            "ForceAnalysis", "forces"]
-
-
-@dataclass
-class PointMotion:
-    position: np.ndarray       # (N, 2)
-    velocity: np.ndarray
-    acceleration: np.ndarray
-    link: str = ""
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"position": self.position, "velocity": self.velocity, "acceleration": self.acceleration}
-
-
-@dataclass
-class LinkMotion:
-    angle: np.ndarray                 # (N,) degrees
-    angular_velocity: np.ndarray      # rad/s
-    angular_acceleration: np.ndarray  # rad/s^2
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"angle": self.angle, "angular_velocity": self.angular_velocity,
-                "angular_acceleration": self.angular_acceleration}
-
-
-@dataclass(repr=False)
-class Simulation(Result):
-    """Motion of a mechanism over a sweep of input values (see the module doc).
-
-    ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
-    table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
-
-    Examples
-    --------
-    >>> import mechsyn as ms
-    >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 360, 10))
-    >>> s.point("M").shape, bool(s.assembled.all())
-    ((37, 2), True)
-    """
-
-    _plot = "kinematics:plot_paths"
-
-    mechanism: str
-    inputs: dict[str, np.ndarray]         # joint -> values (deg for R, length for P)
-    input_types: dict[str, str]
-    speeds: dict[str, float]
-    assembled: np.ndarray
-    points: dict[str, PointMotion]
-    links: dict[str, LinkMotion]
-    events: list[dict] = field(default_factory=list)
-    method: str = "newton"
-    notes: list[str] = field(default_factory=list)
-    vll: dict[str, str] = field(default_factory=dict)
-    sweep: Sweep | None = field(default=None, repr=False)
-    system: PlanarSystem | None = field(default=None, repr=False)
-
-    @property
-    def main_input(self) -> str:
-        return next(iter(self.inputs))
-
-    def _summary(self) -> list[tuple[str, str]]:
-        x = self.inputs[self.main_input]
-        unit = _unit(self.input_types[self.main_input])
-        rows = [("mechanism", self.mechanism), ("method", self.method),
-                ("input", f"{self.main_input}: {len(x)} values, {x[0]:g} to {x[-1]:g} {unit}" if len(x) else "none"),
-                ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
-                ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
-        if self.events:
-            rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
-        return rows
-
-    def point(self, name: str) -> np.ndarray:
-        """Positions (N, 2) of named point ``name`` over the sweep (NaN where not assembled)."""
-        if name not in self.points:
-            raise MechsynInputError(f"no point {name!r} in this simulation", field="points",
-                                    hint="one of " + (", ".join(self.points) or "none: pass points=[...]"))
-        return self.points[name].position
-
-    def link(self, name: str) -> LinkMotion:
-        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
-        if name not in self.links:
-            raise MechsynInputError(f"no link {name!r} in this simulation", field="link",
-                                    hint="one of " + ", ".join(self.links))
-        return self.links[name]
-
-    def to_pandas(self) -> Any:
-        """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
-        every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
-        from mechsyn._extras import require
-
-        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
-        cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
-        cols["assembled"] = self.assembled
-        for name, pm in self.points.items():
-            for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
-                cols[f"{name}_{key}x"], cols[f"{name}_{key}y"] = arr[:, 0], arr[:, 1]
-        for name, lm in self.links.items():
-            cols[f"{name}_angle"], cols[f"{name}_omega"] = lm.angle, lm.angular_velocity
-            cols[f"{name}_alpha"] = lm.angular_acceleration
-        return pd.DataFrame(cols)
-
-    def animate(self, fig: Any = None, **kwargs: Any) -> Any:
-        """The mechanism moving over the sweep: a
-        :class:`~mechsyn.plot.animation.MechanismAnimation` that plays when it is a notebook
-        cell's value and saves with ``anim.save("m.gif")`` (``.mp4``, ``.html``).
-
-        Without ``fig`` it is drawn on a bare Matplotlib Figure (no pyplot, so a notebook
-        shows the player, not a still frame); pass ``fig=plt.figure()`` to play it in a
-        Matplotlib window with ``plt.show()``. ``kwargs`` go to
-        :func:`mechsyn.plot.kinematics.animate_simulation` (``max_frames``, ``interval``)."""
-        from matplotlib.figure import Figure
-
-        from mechsyn.plot.kinematics import animate_simulation
-
-        return animate_simulation(self, fig=Figure() if fig is None else fig, **kwargs)
-
-    def working_ranges(self) -> list[list[float]]:
-        """Runs of consecutive assembled inputs, as [first, last] values of the main input."""
-        vals = self.inputs[self.main_input]
-        out, start = [], None
-        for k, ok in enumerate(self.assembled):
-            if ok and start is None:
-                start = k
-            if (not ok or k == len(vals) - 1) and start is not None:
-                end = k if ok else k - 1
-                out.append([float(vals[start]), float(vals[end])])
-                start = None
-        return out
-
-    def to_dict(self) -> dict[str, Any]:
-        ok = self.assembled
-
-        def mask(a: np.ndarray) -> list:
-            out = np.asarray(a, float).tolist()
-            return [v if good else None for v, good in zip(out, ok)]
-
-        main = self.main_input
-        return {
-            "mechanism": self.mechanism,
-            "input": {"joint": main, "values": self.inputs[main], "unit": _unit(self.input_types[main]),
-                      "speed": self.speeds[main]},
-            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": _unit(self.input_types[j]),
-                           "speed": self.speeds[j]} for j, v in self.inputs.items()},
-            "assembled": ok,
-            "points": {name: {k: mask(v) for k, v in pm.to_dict().items()} for name, pm in self.points.items()},
-            "links": {name: {k: mask(v) for k, v in lm.to_dict().items()} for name, lm in self.links.items()},
-            "working_ranges": self.working_ranges(),
-            "events": self.events,
-            "method": self.method,
-            "vll": self.vll,
-            "notes": self.notes,
-            "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"},
-        }
-
-
-def _unit(t: str) -> str:
-    return "deg" if t == "R" else "length"
-
-
-def input_grid(start: float, stop: float, step: float) -> np.ndarray:
-    """``start, start + step, ..., stop`` (stop included when on the grid).
-
-    More positions than the limit ``sweep_points`` (:mod:`mechsyn.limits`) raise
-    :class:`~mechsyn.errors.MechsynInputError` before any memory is taken.
-
-    Examples
-    --------
-    >>> from mechsyn.kinematics.analysis import input_grid
-    >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
-    ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
-    """
-    from mechsyn.errors import MechsynInputError
-    from mechsyn.limits import limit, limit_hint
-
-    if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
-        raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", field="inputs",
-                                hint="e.g. A=0:360:1 on the command line")
-    count = np.floor((stop - start) / step + 1e-9) + 1
-    if count > limit("sweep_points"):
-        raise MechsynInputError(
-            f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "
-            f"{limit('sweep_points'):,}", field="inputs",
-            hint="use a larger step or a shorter range; " + limit_hint("sweep_points"))
-    return start + step * np.arange(int(count))
-
-
-def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:
-    """Named points (file ``points`` or joint ids) -> (link, assembled coordinates)."""
-    out: dict[str, tuple[str, np.ndarray]] = {}
-    if names is None:
-        if mech.points:
-            names = list(mech.points)
-        else:
-            names = [j.id for j in mech.joints]
-    for name in names:
-        if name in mech.points:
-            p = mech.points[name]
-            out[name] = (p.link, np.asarray(p.at, float))
-            continue
-        try:
-            j = mech.joint(name)
-        except KeyError:
-            known = list(mech.points) + [j.id for j in mech.joints]
-            raise MechsynInputError(f"no point or joint named {name!r}", field="points",
-                                    hint=f"known: {', '.join(known)}") from None
-        link = j.links[1] if j.links[1] != mech.ground else j.links[0]
-        out[name] = (link, np.asarray(j.point, float))
-    return out
 
 
 def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
@@ -269,10 +65,8 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
-    if mech.kind == "spatial":  # hook (issue 25): the spatial engine; to be registered in the engine list
-        from mechsyn.kinematics.spatial import SpatialEngine
-
-        return SpatialEngine().sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
+    if mech.kind == "spatial":
+        return SPATIAL_ENGINE.sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
     return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
         inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
 
@@ -360,7 +154,7 @@ class KinematicPlan:
 
     mechanism: Mechanism
     system: PlanarSystem
-    groups: "dyads.Plan | None"
+    groups: "Plan | None"
     vll: dict | None = None
     prescribed: tuple = ()
 
@@ -389,7 +183,7 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
     input values, which decides whether a passive VLL is prescribed)."""
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
     S = build_system(mech, vll=vll, prescribed=prescribed)
-    return KinematicPlan(mech, S, dyads.decompose(S), vll, prescribed)
+    return KinematicPlan(mech, S, decompose(S), vll, prescribed)
 
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
@@ -434,7 +228,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
             U[:, k] = vals
         types[jid] = d.type
         lim = mech.joint(jid).limits if d.type == "P" else None
-        if lim is not None and (vals.min() < lim[0] - 1e-12 or vals.max() > lim[1] + 1e-12):
+        if lim is not None and (vals.min() < lim[0] - 1e-12 * S.scale or vals.max() > lim[1] + 1e-12 * S.scale):
             raise MechsynInputError(
                 f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
                 hint="keep the VLL length within its limits")
@@ -458,10 +252,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None:
         assemble(S)  # checks the file configuration and the mobility
-    sw = _one_pass(S, plan, U, sp, progress) if change_points == "keep" else None
-    if sw is None:
-        sw = _outward(S, U, lambda parts: _run(S, plan, parts, sp, progress, change_points == "switch"))
-    events = sw.events
+    sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
+    events = list(sw.events)
     used = sw.method
     ok = sw.assembled
     if sw.links is not None:  # the regular pass: every row assembled with finite rates
@@ -469,14 +261,13 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     else:
         rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
         singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
-    flagged = {e["index"] for e in events if e["kind"] == "singular" and not e.get("before_sweep")}
+    flagged = {e.index for e in events if e.kind == "singular" and not e.before_sweep}
     for k in singular_rows:
         if k in flagged:
             continue
-        events.append({"index": k, "kind": "singular", "input": sw.inputs[k].tolist(),
-                       "message": "singular configuration: assembled, but the velocities and accelerations "
-                                  "are not defined here (null)"})
-    events.sort(key=lambda e: e["index"])
+        events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
+                            "accelerations are not defined here (null)", sw.inputs[k].tolist()))
+    events.sort(key=lambda e: e.index)
     links = {}
     for i, name in enumerate(S.links):
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
@@ -490,7 +281,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     return Simulation(
         mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
         speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
-        events=events, method=used, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+        events=events, method=used, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
 def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
@@ -517,146 +308,6 @@ def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_
     return pm
 
 
-def _run(S: PlanarSystem, plan: "dyads.Plan | None", parts: list, sp: np.ndarray, progress: Any,
-         switch: bool = False) -> list[Sweep]:
-    """Sweeps from the drawn configuration through the rows of each of ``parts`` in order
-    (a driver-R + RRR chain: all in one array pass)."""
-    if plan is not None and plan.closed_form_rates:
-        res = dyads.solve_tracked_rates(S, plan, parts, sp, switch=switch)
-    else:
-        res = [_run_one(S, plan, U, sp, progress, switch) for U in parts]
-        if plan is None:
-            return res
-    out = []
-    for U, (q, qd, qdd, singular, tr_events) in zip(parts, res):
-        N = U.shape[0]
-        qd[singular] = np.nan  # a group folded flat: rates not defined here
-        qdd[singular] = np.nan
-        ok = np.all(np.isfinite(q), axis=1)
-        sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur")
-        sw.events = _fast_events(tr_events, sw)
-        if progress is not None:
-            progress(N)
-        out.append(sw)
-    return out
-
-
-def _run_one(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray, progress: Any,
-             switch: bool) -> Any:
-    """One sweep by Newton continuation (a Sweep), or by the tracked closed form (its
-    arrays, singular rows and events)."""
-    if plan is None:
-        return sweep(S, U, sp, progress=(lambda: progress(1)) if progress is not None else None)
-    tracked = dyads.solve_tracked(S, plan, U, switch=switch)
-    q, qd, qdd = dyads.solve_all(S, plan, U, sp, tracked=tracked)
-    return q, qd, qdd, tracked.singular, tracked.events
-
-
-def _one_pass(S: PlanarSystem, plan: "dyads.Plan | None", U: np.ndarray, sp: np.ndarray,
-              progress: Any) -> Sweep | None:
-    """The sweep of a chain whose groups stay clear of folds and change points, in one
-    array pass (:func:`~mechsyn.kinematics.regular.regular_sweep`); None when the branch rules are needed."""
-    if plan is None:
-        return None
-    res = regular_sweep(S, plan, U, sp, _drawn_row(S, U))
-    if res is None:
-        return None
-    q, qd, qdd, links = res
-    N = U.shape[0]
-    if progress is not None:
-        progress(N)
-    nan = np.full(N, np.nan)
-    return Sweep(S, U, sp, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur", links=links)
-
-
-def _drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
-    """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
-    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
-    if U.shape[0] < 2:
-        return None
-    if U.shape[1] == 1:
-        return _drawn_row_1(S.drivers[0], U[:, 0])
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    isR = np.array([d.type == "R" for d in S.drivers])
-    a, d = U[:-1], np.diff(U, axis=0)
-    dd = np.einsum("ij,ij->i", d, d)
-    turns = u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi))  # (N-1, k)
-    for shift in (0.0, 2 * np.pi, -2 * np.pi):
-        v = np.where(isR, turns + shift if shift else turns, u0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.einsum("ij,ij->i", v - a, d) / dd
-        off = np.abs(a + t[:, None] * d - v).max(axis=1)
-        hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
-        if hit.any():
-            return int(np.argmax(hit)) + 1
-    return None
-
-
-def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
-    """:func:`_drawn_row` of one input (the same decisions on 1-D arrays: a point of a
-    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
-    ``0 < p <= d^2``, division being monotone)."""
-    u0 = float(driver.assembled)
-    a = u[:-1]
-    d = u[1:] - a
-    dd = d * d
-    v = a - u0
-    if driver.type == "R":
-        v /= 2 * np.pi
-        np.rint(v, out=v)
-        v *= 2 * np.pi
-        v += u0
-        shifts = (0.0, 2 * np.pi, -2 * np.pi)
-    else:
-        v[:] = u0
-        shifts = (0.0,)
-    for shift in shifts:
-        p = (v + shift - a) if shift else v - a
-        p *= d
-        hit = p > 0.0
-        hit &= p <= dd
-        if hit.any():
-            return int(hit.argmax()) + 1
-    return None
-
-
-def _outward(S: PlanarSystem, U: np.ndarray, run: Any) -> Sweep:
-    """The sweep computed outwards from the drawn configuration when the drawn input lies
-    inside it (rows after it forwards, rows before it backwards), so every sweep that
-    contains the drawn input passes through the drawn configuration; else one run."""
-    k = _drawn_row(S, U)
-    if k is None:
-        return run([U])[0]
-    fwd, bwd = run([U[k:], U[:k][::-1].copy()])
-    events = []
-    for e in bwd.events:
-        e = dict(e)
-        ib = e["index"]
-        at_row = e["kind"] == "singular" and not e.get("crossed")
-        e["index"] = (k - 1 - ib) if at_row else max(0, k - ib)
-        e.pop("before_sweep", None)
-        if e["kind"] == "dead point":
-            e["message"] = "a limit of the working range: the Jacobian is singular (dead point)"
-        elif e["kind"] == "reassembled":
-            e["message"] = ("assembles again (going back from the drawn configuration) after a gap, in the "
-                            "assembly mode nearest the drawn one")
-        events.append(e)
-    for e in fwd.events:
-        e = dict(e)
-        if e.get("before_sweep"):
-            e.pop("before_sweep")
-        e["index"] += k
-        events.append(e)
-    events.sort(key=lambda e: e["index"])
-
-    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return np.concatenate([a[::-1], b])
-
-    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
-                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
-                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method)
-
-
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
     mode = (vll or {}).get(jid)
     if mode is not None:
@@ -667,44 +318,27 @@ def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
         return False
 
 
-def _event_units(S: PlanarSystem, e: dict) -> dict:
-    e = dict(e)
-    vals = e.get("input")
-    if vals is not None:
-        e["input"] = {d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
-                      for d, v in zip(S.drivers, vals)}
-    return e
+def _event_units(S: PlanarSystem, e: Event) -> Event:
+    """The event's input values by joint, in degrees (R) or lengths (P)."""
+    if e.input is None:
+        return e
+    return e.with_(input={d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
+                          for d, v in zip(S.drivers, e.input)})
 
 
-def _fast_events(tracked_events: list, sw: Sweep) -> list[dict]:
-    """Events of the closed-form sweep: dead points, reassembly and change / branch points
-    found and refined on the groups' discriminants (:func:`dyads.solve_tracked`)."""
-    out, seen = [], set()
-    for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
-        if e["kind"] == "reassembled":
-            if e["index"] in seen:
-                continue
-            seen.add(e["index"])
-        out.append(e)
-    if not sw.assembled[0] and not any(e["index"] == 0 and e["kind"] == "dead point" for e in out):
-        out.insert(0, {"index": 0, "kind": "not assembled", "input": sw.inputs[0].tolist(),
-                       "message": "the mechanism cannot be assembled at the first input"})
-    return out
-
-
-def _limit_events(S: PlanarSystem, sw: Sweep) -> list[dict]:
+def _limit_events(S: PlanarSystem, sw: Sweep) -> list[Event]:
     """Where a VLL's length leaves its limits."""
     out = []
     for j in S.mech.joints:
         if j.type != "P" or j.limits is None:
             continue
         s = S.coordinate(np.nan_to_num(sw.q), j.id)
-        bad = sw.assembled & ((s < j.limits[0] - 1e-9) | (s > j.limits[1] + 1e-9))
+        bad = sw.assembled & ((s < j.limits[0] - 1e-9 * S.scale) | (s > j.limits[1] + 1e-9 * S.scale))
         if bad.any():
             k = int(np.argmax(bad))
-            out.append({"index": k, "kind": "limit", "joint": j.id, "value": float(s[k]),
-                        "message": f"VLL {j.id} length {s[k]:.6g} is outside its limits "
-                                   f"[{j.limits[0]:g}, {j.limits[1]:g}] at {int(bad.sum())} input value(s)"})
+            out.append(Event(k, "limit", f"VLL {j.id} length {s[k]:.6g} is outside its limits "
+                             f"[{j.limits[0]:g}, {j.limits[1]:g}] at {int(bad.sum())} input value(s)",
+                             joint=j.id, value=float(s[k])))
     return out
 
 
@@ -759,7 +393,7 @@ class ForceAnalysis(Result):
             "indeterminate": r.indeterminate,
             **({"belts": {j: {"tension": mask(t)} for j, t in r.tension.items()}} if r.tension else {}),
             "notes": self.notes(),
-            "events": sim.events,
+            "events": [e.to_dict() for e in sim.events],
             "method": sim.method,
             "convention": "force: exerted by the joint's first link on its second; drive value: moment (R) "
                           "or force (P) the actuator applies to the second link",

@@ -70,6 +70,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["BatchPlan", "BatchResult", "compile_plan", "simulate_batch", "design_parameters"]
@@ -218,7 +219,8 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     # order to the first other joint point
     cj = [j for j in mech.joints if crank in j.links]
     p0 = np.asarray(cj[0].point, float)
-    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12), None)
+    size = float(np.ptp(np.array([j.point for j in mech.joints], float), axis=0).max())
+    other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12 * size), None)
     line = (index[cj[0].id], index[other.id]) if other is not None else None
     program = _schedule(ops, ground_pts, tuple(index[p] for p in points))
     return BatchPlan(names=names, ops=program, outputs=tuple(points),
@@ -301,8 +303,6 @@ def _output_points(mech: Mechanism, points: list[str] | None, joints: dict, inde
 
 def _reference_input(mech: Mechanism) -> float:
     """The input value of the file's configuration as :func:`simulate` measures it."""
-    from mechsyn.kinematics.system import build_system
-
     S = build_system(mech)
     return float(np.degrees(S.drivers[0].assembled))
 

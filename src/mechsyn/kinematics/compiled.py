@@ -162,10 +162,9 @@ class OneConfiguration:
 def one_configuration(S: Any) -> OneConfiguration | None:
     """The compiled one-configuration equations of ``S`` (cached on it), or None when it
     has blocks other than R pairs, angles and lines, or unknowns other than link poses."""
-    memo = S.__dict__.get("_one_configuration", False)
+    memo = S.cache.get("one_configuration", False)
     if memo is not False:
         return memo
     ok = S.n == 3 * len(S.links) and all(c.kind in _KINDS for c in S.cons)
-    one = OneConfiguration(S) if ok else None
-    object.__setattr__(S, "_one_configuration", one)
+    one = S.cache["one_configuration"] = OneConfiguration(S) if ok else None
     return one

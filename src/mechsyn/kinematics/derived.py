@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.groups import decompose
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["transmission_angles", "mechanical_advantage", "grashof", "Grashof", "path_extent",
@@ -35,10 +36,8 @@ def transmission_angles(sim) -> dict[str, np.ndarray]:
 
     Keys name the dyad by its joints, e.g. ``"B-C-D"``. Needs the Assur decomposition.
     """
-    from mechsyn.kinematics import dyads
-
     S = sim.system
-    plan = dyads.decompose(S)
+    plan = decompose(S)
     out: dict[str, np.ndarray] = {}
     if plan is None:
         return out

@@ -6,6 +6,8 @@ import ast
 
 import numpy as np
 
+from mechsyn.limits import limit
+
 __all__ = ["ExpressionError", "evaluate", "polar_points"]
 
 _FUNCS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "sqrt": np.sqrt, "abs": np.abs}
@@ -23,8 +25,6 @@ def evaluate(text: str, t: np.ndarray) -> np.ndarray:
     Expressions longer than the limit ``expression_chars`` (:mod:`mechsyn.limits`) or
     nested too deeply for Python's parser raise :class:`ExpressionError`.
     """
-    from mechsyn.limits import limit
-
     text = str(text)
     if len(text) > limit("expression_chars"):
         raise ExpressionError(f"the expression has {len(text):,} characters, more than the limit of "

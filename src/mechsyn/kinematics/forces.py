@@ -175,14 +175,15 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
             except np.linalg.LinAlgError:
                 # singular positions (e.g. a flat, collinear linkage): the reactions are
                 # not determined there; they stay NaN and the position counts as singular
-                sv = np.linalg.svd(JT, compute_uv=False)
+                # (singular values of the dimensionless Jacobian: the same at any scale)
+                sv = np.linalg.svd(S.unit_jacobian(np.transpose(JT, (0, 2, 1))), compute_uv=False)
                 regular = sv[:, -1] > 1e-12 * np.maximum(sv[:, 0], 1e-300)
                 if np.any(regular):
                     lam[idx[regular]] = np.linalg.solve(JT[regular], Q[regular][..., None])[..., 0]
                 ok[idx[~regular]] = False
         else:
             lam[idx] = np.einsum("nij,nj->ni", np.linalg.pinv(JT), Q)
-        sv = np.linalg.svd(JT[0], compute_uv=False)
+        sv = np.linalg.svd(S.unit_jacobian(JT[0].T), compute_uv=False)
         indeterminate = bool(np.sum(sv > 1e-9 * sv.max()) < S.m)
     J = np.zeros((N, S.m, S.n))
     if len(idx):

@@ -13,13 +13,13 @@ equation one array operation instead of two:
 * an RRR dyad with known joints ``A``, ``C`` (``d = C - A``) places its middle joint at
   ``B = A + d (f + i sigma g)``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``,
   ``g = sqrt(L1^2 / |d|^2 - f^2)`` (``g^2 |d|^2 / L1^2`` is the group's normalised
-  discriminant of :func:`mechsyn.kinematics.dyads.solve_tracked`); with ``e1 = B - A``,
+  discriminant of :func:`mechsyn.kinematics.tracking.solve_tracked`); with ``e1 = B - A``,
   ``e2 = B - C`` its links turn at ``omega_1 = Re((v_C - v_A) conj(e2)) / (e1 x e2)``,
   ``omega_2 = Re((v_C - v_A) conj(e1)) / (e1 x e2)`` and likewise for the accelerations.
 
 :func:`regular_sweep` evaluates the sweep and the connecting paths from the drawn input
 values together and gives up (None) as soon as a group's discriminant falls below
-:data:`mechsyn.kinematics.dyads.REGULAR_DISC`: no group then folds, touches a change
+:data:`mechsyn.kinematics.tracking.REGULAR_DISC`: no group then folds, touches a change
 point or reassembles, every group keeps its drawn mode and the answer is that of the
 tracked outward sweeps (tests check both agree), at the cost of one pass.
 """
@@ -28,35 +28,37 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechsyn.kinematics import dyads
+from mechsyn.kinematics.chain import _chain_program, _link_angles
+from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle
+from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["regular_sweep", "LinkStates"]
 
 
-def _program(S: PlanarSystem, plan: dyads.Plan) -> tuple:
+def _program(S: PlanarSystem, plan: Plan) -> tuple:
     """The chain's steps with complex constants, every link's anchor and origin joint
     (built once per system and plan)."""
-    memo = dyads._memo(S)
+    memo = _memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
-    prog, anchor = dyads._chain_program(S, plan, None)
+    prog, anchor = _chain_program(S, plan, None)
     cx = {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
     steps = []
     for op in prog:
-        if op[0] == "drive":
-            _, new, k, jid, di, sgn = op  # the joint's local point on k (the frame: its fixed point)
-            steps.append(("drive", new, k, jid, di, sgn, complex(*dyads._local(S, k, jid))))
+        if isinstance(op, DriveOp):  # the joint's local point on k (the frame: its fixed point)
+            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
+                          complex(*_local(S, op.known, op.joint))))
         else:
-            _, si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, bv1, bv2 = op
-            steps.append(("RRR", (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, complex(*bv1).conjugate(),
-                          complex(*bv2).conjugate(), complex(*dyads._local(S, k1, J1)),
-                          complex(*dyads._local(S, k3, J3))))
+            (k1, k3), (J1, _, J3) = op.known, op.joints
+            steps.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
+                          complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
+                          complex(*_local(S, k1, J1)), complex(*_local(S, k3, J3))))
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
-        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(dyads._local(S, i, j.id))), None)
+        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)
         origin.append(j0)
     out = (steps, cx, origin)
     memo[key] = (plan, out)
@@ -116,7 +118,7 @@ class _Pass:
         self.joint[J1], self.joint[J3] = A, C
         d = np.subtract(C[0], A[0]) if isinstance(C[0], np.ndarray) or isinstance(A[0], np.ndarray) \
             else np.full(self.M, C[0] - A[0])
-        inv, f, g = dyads.circle_circle(d.real, d.imag, L1s, L2s)
+        inv, f, g = circle_circle(d.real, d.imag, L1s, L2s)
         disc = g / inv
         disc *= 1.0 / L1s
         if not disc.min() >= least:  # NaN too
@@ -160,13 +162,13 @@ class _Pass:
         return VB, AB
 
 
-def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.ndarray,
+def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
                   split: int | None) -> tuple | None:
     """Poses and rates (N, n) of a driver-R + RRR chain over the inputs ``U`` (N, k) in
     one pass, with the links' complex states (:class:`LinkStates`); None when a group
     comes near a fold on the sweep or on the way to it from the drawn configuration
     (``split``: the row after the drawn input values, see
-    :func:`mechsyn.kinematics.analysis._drawn_row`).
+    :func:`mechsyn.kinematics.engines.drawn_row`).
 
     Examples
     --------
@@ -182,18 +184,18 @@ def regular_sweep(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, speeds: np.n
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
     steps, anchor, origin = _program(S, plan)
-    X = dyads._regular_rows(S, U, split)
+    X = _regular_rows(S, U, split)
     st = _Pass(X.shape[0], anchor)
     with np.errstate(invalid="ignore", divide="ignore"):
         for step in steps:
             if step[0] == "drive":
                 st.drive(step, X, speeds)
-            elif not st.rrr(step, dyads.REGULAR_DISC):
+            elif not st.rrr(step, REGULAR_DISC):
                 return None
     return _poses(S, plan, U, st, origin, split)
 
 
-def _poses(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
+def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
     origin is its first joint, its angle continuous from the drawn one) and the links'
     complex states."""
@@ -209,7 +211,7 @@ def _poses(S: PlanarSystem, plan: dyads.Plan, U: np.ndarray, st: _Pass, origin: 
         qdd[3 * i + 2] = ali[:N] if isinstance(ali, np.ndarray) else ali
     for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
         buf[0::3], buf[1::3] = x.real, x.imag
-    dyads._link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
+    _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
     return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
 
 

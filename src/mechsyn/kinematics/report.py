@@ -48,8 +48,8 @@ class SimulationReport(Result):
     >>> r = simulation_report(ms.examples.load("crank_rocker"), {"A": np.linspace(0, 360, 13)})
     >>> r.derived["grashof"]["classification"]
     'crank-rocker'
-    >>> sorted(r.to_dict())[:3]
-    ['assembled', 'derived', 'events']
+    >>> sorted(r.to_dict())[:4]
+    ['assembled', 'derived', 'engine', 'events']
     """
 
     simulation: Simulation = field(metadata={"json": False})

@@ -13,45 +13,18 @@ Velocities: ``Phi_q q' = B u'``; accelerations: ``Phi_q q'' = gamma + B u''``
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.groups import decompose
+from mechsyn.kinematics.positions import solve_positions
+from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton"]
-
-
-@dataclass
-class Sweep:
-    """Result of a sweep: poses and their rates at every input value.
-
-    ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
-    ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates;
-    ``links``: the links' complex states (:class:`mechsyn.kinematics.regular.LinkStates`)
-    when the one regular pass computed the sweep (every row assembled with finite
-    rates), else None.
-    """
-
-    system: PlanarSystem
-    inputs: np.ndarray
-    speeds: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    assembled: np.ndarray
-    det_sign: np.ndarray
-    sigma_min: np.ndarray
-    events: list[dict] = field(default_factory=list)
-    method: str = "newton"
-    links: Any = None
-
-    @property
-    def n(self) -> int:
-        return self.q.shape[0]
 
 
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -71,14 +44,16 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
     """Newton-Raphson from ``q`` (n,) at inputs ``u`` (n_inputs,); returns (q, converged).
 
     ``polish``: one more step after convergence where the Jacobian is well conditioned
-    (the sweep's positions then agree with the closed form to round-off)."""
-    tol = tol if tol is not None else 1e-12 * S.scale
+    (the sweep's positions then agree with the closed form to round-off). ``tol`` bounds
+    the residual of every equation relative to its size (lengths over the mechanism's
+    size, angles in radians): the decisions do not change when the mechanism is scaled."""
+    tol = tol if tol is not None else 1e-12
     q = q.copy()
     u2 = u[None]
     prev = np.inf
     for _ in range(max_iter):
         r = S.residual(q[None], u2)[0]
-        norm = float(np.abs(r).max()) if r.size else 0.0
+        norm = _norm(S, r)
         if not np.isfinite(norm):
             return q, False
         if norm < tol:
@@ -86,18 +61,28 @@ def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = No
                 dq = _solve_lin(S.jacobian(q[None])[0], -r)
                 if np.all(np.isfinite(dq)) and float(np.abs(dq).max()) <= 1e2 * norm:  # well conditioned
                     q2 = q + dq
-                    if float(np.abs(S.residual(q2[None], u2)[0]).max()) <= norm:
+                    if _norm(S, S.residual(q2[None], u2)[0]) <= norm:
                         q = q2
             return q, True
-        if norm > 4 * prev and prev < 1e-3 * S.scale:
+        if norm > 4 * prev and prev < 1e-3:
             return q, False
         prev = norm
         dq = _solve_lin(S.jacobian(q[None])[0], -r)
         if not np.all(np.isfinite(dq)):
             return q, False
         q += dq
-    r = S.residual(q[None], u2)[0]
-    return q, bool(np.abs(r).max() < tol * 10)
+    return q, bool(_norm(S, S.residual(q[None], u2)[0]) < tol * 10)
+
+
+def _norm(S: PlanarSystem, r: np.ndarray) -> float:
+    """The largest residual of the equations ``r`` (m,), each relative to its size."""
+    return float(np.abs(r / S.row_scale).max()) if r.size else 0.0
+
+
+def _rel_step(S: PlanarSystem, dq: np.ndarray) -> float:
+    """The largest change of ``dq`` (the first unknowns, or all n) relative to the
+    mechanism's size (lengths) or in radians (angles)."""
+    return float(np.abs(dq / S.col_scale[:len(dq)]).max()) if dq.size else 0.0
 
 
 def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
@@ -117,26 +102,10 @@ def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
     return qd, qdd
 
 
-def batch_rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Velocities and accelerations for a batch of configurations (N, n), vectorised."""
-    N = q.shape[0]
-    J = S.jacobian(q)
-    B = S.input_matrix()
-    rhs = np.broadcast_to(B @ np.asarray(speeds, float), (N, S.m))
-    if S.m == S.n:
-        qd = np.linalg.solve(J, rhs[..., None])[..., 0]
-        qdd = np.linalg.solve(J, S.gamma(q, qd)[..., None])[..., 0]
-    else:
-        pinv = np.linalg.pinv(J)
-        qd = np.einsum("nij,nj->ni", pinv, rhs)
-        qdd = np.einsum("nij,nj->ni", pinv, S.gamma(q, qd))
-    return qd, qdd
-
-
 def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
     """Rank of ``Phi_q`` at ``q``: free coordinates beyond the inputs, redundant constraints."""
     q = S.q0 if q is None else q
-    J = S.jacobian(q[None])[0]
+    J = S.unit_jacobian(S.jacobian(q[None])[0])  # dimensionless: the same rank at any scale
     sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
     tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
     rank = int(np.sum(sv > tol))
@@ -161,10 +130,9 @@ def generic_free(S: PlanarSystem, q: np.ndarray | None = None, trials: int = 3) 
 def singular_configuration(S: PlanarSystem, q: np.ndarray | None = None) -> bool:
     """``Phi_q`` loses rank at ``q`` though the mechanism is determined in general position."""
     if q is None:
-        memo = S.__dict__.get("_singular_drawn")
+        memo = S.cache.get("singular_drawn")
         if memo is None:
-            memo = singular_configuration(S, S.q0)
-            object.__setattr__(S, "_singular_drawn", memo)
+            memo = S.cache["singular_drawn"] = singular_configuration(S, S.q0)
         return memo
     return check_mobility(S, q)["free"] > 0 and generic_free(S, q) == 0
 
@@ -192,7 +160,7 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
     The file's configuration is first made exact by Newton, then followed continuously
     from its own input values to ``u`` (so the file chooses the assembly branch).
     """
-    memo = S.__dict__.get("_assembled")
+    memo = S.cache.get("assembled")
     if memo is not None:  # the checks below depend on the system only: done once per system
         return memo.copy() if u is None else _reach(S, memo, u)
     u_asm = np.array([d.assembled for d in S.drivers])
@@ -203,14 +171,14 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
         raise MechsynInputError(
             f"the joint points of the file do not assemble (largest error at joint {worst})", source=src,
             hint="check the joint points: each link's joints must keep their distances")
-    moved = float(np.abs(q - S.q0)[:3 * len(S.links)].max()) if S.links else 0.0
-    if moved > 1e-6 * S.scale:
+    moved = _rel_step(S, (q - S.q0)[:3 * len(S.links)]) if S.links else 0.0
+    if moved > 1e-6:
         raise MechsynInputError(
             f"the file's configuration is not assembled: joint {_worst_joint(S, S.q0, u_asm)} is off "
-            f"by up to {moved:.3g}", source=src,
+            f"by up to {moved * S.scale:.3g}", source=src,
             hint="give joint points of one consistent configuration")
     _require_determined(S, q)
-    object.__setattr__(S, "_assembled", q.copy())
+    S.cache["assembled"] = q.copy()
     if u is None:
         return q
     return _reach(S, q, u)
@@ -227,7 +195,7 @@ def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
 
 
 def _worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
-    r = np.abs(S.residual(q[None], u[None])[0])
+    r = np.abs(S.residual(q[None], u[None])[0] / S.row_scale)
     row, best, worst = 0, -1.0, "?"
     for con in S.cons:
         v = float(r[row:row + con.rows].max())
@@ -240,10 +208,12 @@ def _worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
 def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, float]:
     """LU of ``Phi_q`` at q, ``dq/du`` (n, k), det sign and a singularity measure.
 
-    The measure is min |U_ii| / max |U_ii| of the LU factors (0 at a singular point).
+    ``Phi_q`` is factored made dimensionless (:meth:`PlanarSystem.unit_jacobian`), so the
+    measure, min |U_ii| / max |U_ii| of its LU factors (0 at a singular point), is the
+    same at any scale of the mechanism.
     """
-    J = S.jacobian(q[None])[0]
-    B = S.input_matrix()
+    J = S.unit_jacobian(S.jacobian(q[None])[0])
+    B = S.input_matrix() / S.row_scale[:, None]
     if J.shape[0] == J.shape[1]:
         try:
             lu = sla.lu_factor(J, check_finite=False)
@@ -252,18 +222,20 @@ def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, 
             piv = int(np.sum(lu[1] != np.arange(len(lu[1]))))
             sign = float(np.prod(np.sign(np.diag(lu[0]))) * (-1) ** piv)
             if np.all(np.isfinite(X)):
-                return lu, X, sign, float(d.min() / max(d.max(), 1e-300))
+                return lu, X * S.col_scale[:, None], sign, float(d.min() / max(d.max(), 1e-300))
         except (sla.LinAlgError, ValueError):
             pass
-    X = sla.lstsq(J, B, check_finite=False)[0]
+    X = sla.lstsq(J, B, check_finite=False)[0] * S.col_scale[:, None]
     sv = np.linalg.svd(J, compute_uv=False)
     return (J,), X, 0.0, float(sv[min(J.shape) - 1] / max(sv.max(), 1e-300)) if sv.size else 1.0
 
 
 def _solve_with(S: PlanarSystem, fac: tuple, rhs: np.ndarray) -> np.ndarray:
+    """``Phi_q x = rhs`` with the factors of :func:`_factor` (of the dimensionless ``Phi_q``)."""
+    rhs = rhs / S.row_scale
     if len(fac) == 2:
-        return sla.lu_solve(fac, rhs, check_finite=False)
-    return sla.lstsq(fac[0], rhs, check_finite=False)[0]
+        return sla.lu_solve(fac, rhs, check_finite=False) * S.col_scale
+    return sla.lstsq(fac[0], rhs, check_finite=False)[0] * S.col_scale
 
 
 def _rates_from(S: PlanarSystem, q: np.ndarray, fac: tuple, X: np.ndarray,
@@ -283,15 +255,15 @@ def _settle(S: PlanarSystem, q: np.ndarray, u: np.ndarray, fac: tuple) -> tuple[
     if fac[3] >= 1e-3:
         return q, fac
     u2 = u[None]
-    best = float(np.abs(S.residual(q[None], u2)[0]).max())
+    best = _norm(S, S.residual(q[None], u2)[0])
     for _ in range(60):
         if best == 0.0:
             break
         dq = _solve_lin(S.jacobian(q[None])[0], -S.residual(q[None], u2)[0])
-        if not np.all(np.isfinite(dq)) or float(np.abs(dq).max()) > 1e-4 * S.scale:
+        if not np.all(np.isfinite(dq)) or _rel_step(S, dq) > 1e-4:
             break
         q2 = q + dq
-        r2 = float(np.abs(S.residual(q2[None], u2)[0]).max())
+        r2 = _norm(S, S.residual(q2[None], u2)[0])
         if r2 >= best:
             break
         q, best = q2, r2
@@ -434,14 +406,12 @@ def _nearest_mode(S: PlanarSystem, cands: list, u: np.ndarray, q_drawn: np.ndarr
     along the nearest-singular direction of each) whose elbow signature
     (:func:`_elbows`) matches the drawn one most, then whose ``det Phi_q`` has the drawn
     sign."""
-    from mechsyn.kinematics import dyads
-
-    plan = dyads.decompose(S)
+    plan = decompose(S)
     if plan is not None:
         u_asm = np.array([d.assembled for d in S.drivers])
-        _, sig = dyads.solve_positions(S, plan, u_asm[None])
+        _, sig = solve_positions(S, plan, u_asm[None])
         with np.errstate(invalid="ignore"):
-            qc = dyads.solve_positions(S, plan, u[None], sigmas=sig)[0][0]
+            qc = solve_positions(S, plan, u[None], sigmas=sig)[0][0]
         if np.all(np.isfinite(qc)):
             qc, good = newton(S, qc, u, max_iter=10)
             if good:
@@ -461,13 +431,13 @@ def _other_mode(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> list:
     """Configurations at ``u`` other than ``q``, searched from ``q`` along the direction in
     which ``Phi_q`` is nearest singular (where two assembly modes meet near a fold, they
     differ along it)."""
-    J = S.jacobian(q[None])[0]
+    J = S.unit_jacobian(S.jacobian(q[None])[0])
     v = np.linalg.svd(J)[2][-1]
-    v = v / max(float(np.abs(v).max()), 1e-300)
+    v = v / max(float(np.abs(v).max()), 1e-300) * S.col_scale  # lengths in the mechanism's size
     for a in (0.05, 0.2, 0.5, 1.0):
         for sgn in (1.0, -1.0):
-            c, good = newton(S, q + sgn * a * S.scale * v, u, max_iter=30)
-            if good and np.abs(c - q).max() > 1e-6 * S.scale:
+            c, good = newton(S, q + sgn * a * v, u, max_iter=30)
+            if good and _rel_step(S, c - q) > 1e-6:
                 return [c]
     return []
 
@@ -479,8 +449,9 @@ def _crossing(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, de
     branch point); ``ub`` when the branch cannot be followed there. Next to the singular
     point the sign of ``det`` is decided by round-off, so the result is accurate to about
     1e-8 rad, not to the closed form's 1e-13."""
+    size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])
     for _ in range(iters):
-        if np.abs(ub - ua).max() < 1e-13:
+        if np.abs((ub - ua) / size).max() < 1e-13:
             break
         um = (ua + ub) / 2
         qm = _track(S, q, ua, um, depth=4)
@@ -538,7 +509,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
     det_sign = np.full(N, np.nan)
     sig = np.full(N, np.nan)
     out = (q, qd, qdd, det_sign, sig)
-    events: list[dict] = []
+    events: list[Event] = []
     u_asm = np.array([d.assembled for d in S.drivers])
     hist, cur = _approach(S, q_start, u_asm, inputs[0], refine_limits, events)
     drawn_det = hist[0][2][2]
@@ -550,9 +521,8 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             nxt = _continue(S, hist, u)
             if nxt is None:
                 ul = _limit(S, cur, cur_u, u)[0] if refine_limits else cur_u
-                events.append({"index": i, "kind": "dead point", "input": ul.tolist(),
-                               "message": "assembly ends: the Jacobian becomes singular (dead point / "
-                                          "limit of the working range)"})
+                events.append(Event(i, "dead point", "assembly ends: the Jacobian becomes singular (dead point / "
+                                                     "limit of the working range)", ul.tolist()))
                 last_good = (cur, cur_u)
             cur = nxt
             cur_u = u
@@ -566,11 +536,11 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
             progress()
     assembled = np.all(np.isfinite(q), axis=1)
     for i in np.flatnonzero(np.isfinite(sig) & (sig < 1e-6)).tolist():
-        events.append({"index": i, "kind": "singular", "input": inputs[i].tolist(),
-                       "message": f"near-singular configuration (pivot ratio {sig[i]:.1e}): a change, branch or "
+        events.append(Event(i, "singular", input=inputs[i].tolist(),
+                       message=f"near-singular configuration (pivot ratio {sig[i]:.1e}): a change, branch or "
                                   "dead point; the branch may switch here and positions are accurate only to "
-                                  "about the square root of the solver tolerance"})
-    events.sort(key=lambda e: e["index"])
+                                  "about the square root of the solver tolerance"))
+    events.sort(key=lambda e: e.index)
     return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)
 
 
@@ -587,8 +557,7 @@ def _sweep_shifted(S: PlanarSystem, inputs: np.ndarray, shift: np.ndarray, speed
                 sw.q[:, 3 * con.b + 2] += shift[con.driver]
             elif con.b < 0 and con.a >= 0:
                 sw.q[:, 3 * con.a + 2] -= shift[con.driver]
-    for e in sw.events:
-        e["input"] = (np.asarray(e["input"]) + shift).tolist()
+    sw.events = [e.with_(input=(np.asarray(e.input) + shift).tolist()) for e in sw.events]
     return sw
 
 
@@ -608,8 +577,8 @@ def _approach(S: PlanarSystem, q_start: np.ndarray, u_asm: np.ndarray, u_first: 
         return hist, hist[-1][1]
     if refine_limits:
         ul, _ = _limit(S, hist[-1][1], hist[-1][0], u_first)
-        events.append({"index": 0, "kind": "dead point", "input": ul.tolist(), "before_sweep": True,
-                       "message": "the mechanism cannot move from its file configuration to the first input"})
+        events.append(Event(0, "dead point", "the mechanism cannot move from its file configuration to the first "
+                            "input", ul.tolist(), before_sweep=True))
     return hist, None
 
 
@@ -649,11 +618,10 @@ def _reassemble(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, q_start
         bq, bu, j = nb, inputs[j], j - 1
     if refine_limits and j >= 0:
         ul, _ = _limit(S, bq, bu, inputs[j])
-        events.append({"index": j + 1, "kind": "dead point", "input": ul.tolist(),
-                       "message": "assembly starts again here: the other limit of a working range"})
-    events.append({"index": j + 1, "kind": "reassembled", "input": bu.tolist(),
-                   "message": "assembles again after a gap, in the assembly mode of the drawn "
-                              "configuration (the mode nearest the drawn one)"})
+        events.append(Event(j + 1, "dead point", "assembly starts again here: the other limit of a working range",
+                            ul.tolist()))
+    events.append(Event(j + 1, "reassembled", "assembles again after a gap, in the assembly mode of the drawn "
+                        "configuration (the mode nearest the drawn one)", bu.tolist()))
     return cand
 
 
@@ -671,7 +639,7 @@ def _store(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, cur: np.ndar
     if (i > 0 and np.isfinite(det_sign[i - 1]) and det_sign[i] * det_sign[i - 1] < 0
             and sig[i - 1] >= 1e-6 and sig[i] >= 1e-6):  # (a singular sample is reported itself)
         uc = _crossing(S, q[i - 1], inputs[i - 1], u, det_sign[i - 1]) if refine_limits else u
-        events.append({"index": i, "kind": "singular", "input": uc.tolist(), "crossed": True,
-                       "message": "det(Phi_q) changed sign: a singular (branch/change) point was "
-                                  "crossed between this input and the previous (at the input given)"})
+        events.append(Event(i, "singular", "det(Phi_q) changed sign: a singular (branch/change) point was "
+                            "crossed between this input and the previous (at the input given)", uc.tolist(),
+                            crossed=True))
     return cur, hist

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.analysis import PointMotion, resolve_points
+from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
 from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, crossings, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn._result import Result
-from mechsyn.kinematics.analysis import PointMotion, Simulation
+from mechsyn.kinematics.simulation import PointMotion, Simulation
 
 __all__ = ["SpatialSimulation", "LinkPose"]
 

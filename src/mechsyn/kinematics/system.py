@@ -52,6 +52,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
 
@@ -209,6 +210,22 @@ class PlanarSystem:
     scale: float                       # characteristic length
     vll: dict[str, str] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    #: the length of every equation (``scale`` for the rows of point and line constraints,
+    #: 1 for angle and gear rows) and of every unknown (``scale`` for link origins, 1 for
+    #: angles and cam parameters): ``Phi_q * col_scale / row_scale`` is dimensionless
+    row_scale: np.ndarray | None = None
+    col_scale: np.ndarray | None = None
+    #: what the engines compute once per system and reuse (the assembled configuration,
+    #: the groups' look-ups and programs, the compiled one-configuration equations): a
+    #: field of the compiled system, so a new geometry starts with an empty one
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def unit_jacobian(self, J: np.ndarray) -> np.ndarray:
+        """``Phi_q`` (..., m, n) made dimensionless by the mechanism's length scale: rows of
+        length equations divided by ``scale``, columns of link origins multiplied by it.
+        Its rank, singular values and pivots do not change when the mechanism is scaled, so
+        tolerances on them are relative to the mechanism's size."""
+        return J * (self.col_scale / self.row_scale[:, None])
 
     # -- geometry helpers ----------------------------------------------------------
     def index(self, link: str) -> int:
@@ -342,8 +359,6 @@ class PlanarSystem:
 
 
 def _one(S: PlanarSystem) -> Any:
-    from mechsyn.kinematics.compiled import one_configuration
-
     return one_configuration(S)
 
 
@@ -583,8 +598,12 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
                                     hint="inputs go to actuated joints and to free (passive) VLL joints")
     q0 = np.concatenate([q0, b.extra_q])
     m = sum(c.rows for c in b.cons)
+    rows = np.concatenate([np.full(c.rows, 1.0 if c.kind in ("angle", "gear") else scale) for c in b.cons]
+                          ) if b.cons else np.zeros(0)
+    cols = np.ones(len(q0))
+    cols[0:3 * n_links:3] = cols[1:3 * n_links:3] = scale
     return PlanarSystem(mech, tuple(moving), origin0, angle0, tuple(b.cons), tuple(b.drivers), len(q0), m, q0,
-                        scale, vll=modes, notes=tuple(b.notes))
+                        scale, vll=modes, notes=tuple(b.notes), row_scale=rows, col_scale=cols)
 
 
 def _check_joints(mech: Mechanism, src: str) -> None:
@@ -630,18 +649,18 @@ def _link_frames(mech: Mechanism) -> tuple[np.ndarray, np.ndarray, float]:
     moving = mech.moving_links
     origin0 = np.zeros((len(moving), 2))
     angle0 = np.zeros(len(moving))
+    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()]
+                      + [np.asarray(j.attrs["anchor"], float) for j in mech.joints if j.type == "belt"])
+    scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
     for i, name in enumerate(moving):
         # a belt's point (the pulley centre) is on its second link; its first has the anchor
         pts = [np.asarray(j.attrs["anchor"], float) if j.type == "belt" and j.links[0] == name else j.point
                for j in mech.joints_of(name)]
         origin0[i] = pts[0]
         for p in pts[1:]:
-            if np.linalg.norm(p - pts[0]) > 1e-12:
+            if np.linalg.norm(p - pts[0]) > 1e-12 * scale:
                 angle0[i] = _dir_angle(p - pts[0])
                 break
-    allpts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()]
-                      + [np.asarray(j.attrs["anchor"], float) for j in mech.joints if j.type == "belt"])
-    scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
     return origin0, angle0, scale
 
 
@@ -720,7 +739,7 @@ class _Builder:
         else:
             r1 = float(np.linalg.norm(j.point - ra.point))
             r2 = float(np.linalg.norm(j.point - rb.point))
-            if r2 < 1e-12:
+            if r2 <= 1e-12 * (r1 + r2):
                 raise MechsynInputError(f"gear pair {j.id}: the pitch point is on a gear's axis",
                                         source=self.src, field=f"joints.{j.id}.point", hint="give ratio")
             between = (j.point - ra.point) @ (j.point - rb.point) < 0

@@ -28,6 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechsyn.kinematics.groups import circle_circle
+
 TWO_PI = 2.0 * np.pi
 
 
@@ -98,22 +100,20 @@ def fourbar_position(
 def coupler_point(r1, r2, r3, r4, theta2, branch: int = -1, rcx=0.0, rcy=0.0, x0=0.0, y0=0.0, theta0=0.0):
     """Coupler point only, ``(Cx, Cy, assembled)``: the lean form of :func:`fourbar_position`.
 
-    Same geometry without inverse trigonometry: with ``g = (O4 - A) / d`` and
-    ``cos(alpha)``, ``sin(alpha) = sqrt(1 - cos^2)``, the coupler direction is
-    ``u = (g_x cos a + branch g_y sin a, g_y cos a - branch g_x sin a)``.
-    NaN where the linkage cannot be assembled.
+    Same geometry without inverse trigonometry, by the RRR kernel
+    :func:`mechsyn.kinematics.groups.circle_circle`: with ``d = O4 - A``, the coupler
+    direction is ``u = (f d - branch g R90 d) / r3`` (``f d`` and ``g |d|`` are the coupler's
+    components along and across ``d``). NaN where the linkage cannot be assembled.
     """
     ax, ay = r2 * np.cos(theta2), r2 * np.sin(theta2)
     dx, dy = r1 - ax, -ay
-    d2 = dx * dx + dy * dy
     with np.errstate(divide="ignore", invalid="ignore"):
-        d = np.sqrt(d2)
-        ca = (r3 * r3 + d2 - r4 * r4) / (2.0 * r3 * d)
-        assembled = np.abs(ca) <= 1.0
-        sa = np.sqrt(1.0 - ca * ca)
-        gx, gy = dx / d, dy / d
-        ux = gx * ca + branch * gy * sa
-        uy = gy * ca - branch * gx * sa
+        # the RRR kernel: B - A = f d - branch g R90 d (circles (A, r3) and (O4, r4))
+        _, f, g2 = circle_circle(np.asarray(dx, float), np.asarray(dy, float), r3 * r3, r4 * r4)
+        assembled = g2 >= 0
+        g = np.sqrt(g2)
+        ux = (f * dx + branch * g * dy) / r3
+        uy = (f * dy - branch * g * dx) / r3
         cx = ax + rcx * ux - rcy * uy
         cy = ay + rcx * uy + rcy * ux
     c0, s0 = np.cos(theta0), np.sin(theta0)

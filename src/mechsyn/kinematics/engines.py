@@ -1,0 +1,294 @@
+"""The kinematics engines behind :func:`mechsyn.kinematics.analysis.simulate`.
+
+An engine computes a sweep (:class:`~mechsyn.kinematics.sweep.Sweep`: poses, rates and
+events over the input values) or says it cannot (returns None), and ``simulate`` takes the
+first engine of :data:`PLANAR_ENGINES` that answers. Each is an object with a ``name``
+and a ``sweep`` method (the :class:`Engine` protocol); a new engine (the spatial one, a
+compiled one) is written against that protocol and put in the list at the place where it
+should be tried.
+
+The planar engines, in the order they are tried:
+
+1. ``regular pass`` (:func:`mechsyn.kinematics.regular.regular_sweep`): a driver-R + RRR
+   chain whose groups stay clear of folds and change points, in one array pass of complex
+   arithmetic; declines as soon as a group comes near a fold (or for
+   ``change_points="switch"``).
+2. ``tracked chain`` (:func:`mechsyn.kinematics.tracking.solve_tracked_rates`): the same
+   chains through folds, change and branch points, every group's assembly mode tracked on
+   its discriminant, rates in closed form.
+3. ``tracked groups`` (:func:`mechsyn.kinematics.tracking.solve_tracked`): any mechanism of
+   drivers and dyads (RRR, RRP, PRR, RPR, RPP, PRP), rates by batched linear solves.
+4. ``newton`` (:func:`mechsyn.kinematics.solve.sweep`): Newton continuation of the
+   constraint equations, for every mechanism (gears, cams, belts, closed loops that do
+   not split into dyads).
+
+A ``kind: spatial`` mechanism goes to :data:`SPATIAL_ENGINE` (``spatial``,
+:mod:`mechsyn.kinematics.spatial`): the pairs' constraint equations on the link poses,
+predictor-corrector continuation from the drawn assembly.
+
+The tracked engines and Newton sweep outwards from the drawn configuration when the
+drawn input lies inside the sweep (:func:`outward`), so every sweep that contains the
+drawn input passes through the drawn configuration.
+
+Examples
+--------
+>>> import mechsyn as ms
+>>> [e.name for e in PLANAR_ENGINES]
+['regular pass', 'tracked chain', 'tracked groups', 'newton']
+>>> ms.examples.load("crank_rocker").simulate(A=(0, 360, 10)).engine
+'regular pass'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, Protocol
+
+import numpy as np
+
+from mechsyn.kinematics.chain import solve_all
+from mechsyn.kinematics.groups import Plan
+from mechsyn.kinematics.regular import regular_sweep
+from mechsyn.kinematics.solve import sweep as newton_sweep
+from mechsyn.kinematics.spatial import SpatialEngine
+from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.system import PlanarSystem
+from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
+
+__all__ = ["Engine", "PLANAR_ENGINES", "SPATIAL_ENGINE", "RegularPass", "TrackedChain", "TrackedGroups", "Newton",
+           "first_sweep", "drawn_row", "outward"]
+
+
+class Engine(Protocol):
+    """A kinematics engine: ``sweep`` gives the :class:`Sweep` of ``system`` over the inputs
+    (N, k) (radians for R, lengths for P) at the input ``speeds`` (k,), or None when the
+    engine cannot answer for this mechanism or these options (the next one is tried).
+
+    ``plan``: the mechanism's decomposition into drivers and Assur groups
+    (:class:`mechsyn.kinematics.groups.Plan`), None when it has none or Newton is asked
+    for; ``change_points``: ``"keep"`` or ``"switch"``; ``progress``: called with the
+    number of rows done, or None.
+    """
+
+    name: str
+
+    def sweep(self, system: Any, plan: Any, inputs: np.ndarray, speeds: np.ndarray, *,
+              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+        ...
+
+
+class RegularPass:
+    """A driver-R + RRR chain clear of folds, in one pass (see the module doc)."""
+
+    name = "regular pass"
+
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+        if plan is None or change_points != "keep":
+            return None
+        res = regular_sweep(system, plan, inputs, speeds, drawn_row(system, inputs))
+        if res is None:
+            return None
+        q, qd, qdd, links = res
+        N = inputs.shape[0]
+        if progress is not None:
+            progress(N)
+        nan = np.full(N, np.nan)
+        return Sweep(system, inputs, speeds, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur",
+                     links=links, engine=self.name)
+
+
+class TrackedChain:
+    """A driver-R + RRR chain through folds and change points, rates in closed form."""
+
+    name = "tracked chain"
+
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+        if plan is None or not plan.closed_form_rates:
+            return None
+        switch = change_points == "switch"
+
+        def run(parts: list) -> list[Sweep]:
+            res = solve_tracked_rates(system, plan, parts, speeds, switch=switch)
+            return [_tracked_sweep(system, U, speeds, r, self.name, progress) for U, r in zip(parts, res)]
+
+        return outward(system, inputs, run)
+
+
+class TrackedGroups:
+    """Any mechanism of drivers and dyads, rates by batched linear solves."""
+
+    name = "tracked groups"
+
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+        if plan is None:
+            return None
+        switch = change_points == "switch"
+
+        def run(parts: list) -> list[Sweep]:
+            out = []
+            for U in parts:
+                tracked = solve_tracked(system, plan, U, switch=switch)
+                q, qd, qdd = solve_all(system, plan, U, speeds, tracked=tracked)
+                res = (q, qd, qdd, tracked.singular, tracked.events)
+                out.append(_tracked_sweep(system, U, speeds, res, self.name, progress))
+            return out
+
+        return outward(system, inputs, run)
+
+
+class Newton:
+    """Newton continuation of the constraint equations: every planar mechanism."""
+
+    name = "newton"
+
+    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
+              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+        if change_points != "keep":
+            return None
+        tick = (lambda: progress(1)) if progress is not None else None
+
+        def run(parts: list) -> list[Sweep]:
+            out = []
+            for U in parts:
+                sw = newton_sweep(system, U, speeds, progress=tick)
+                sw.engine = self.name
+                out.append(sw)
+            return out
+
+        return outward(system, inputs, run)
+
+
+#: The planar engines in the order :func:`first_sweep` tries them.
+PLANAR_ENGINES: tuple[Engine, ...] = (RegularPass(), TrackedChain(), TrackedGroups(), Newton())
+
+#: The engine of ``kind: spatial`` mechanisms (:class:`mechsyn.kinematics.spatial.SpatialEngine`).
+#: A spatial mechanism has no planar system and no Assur plan, so it takes the mechanism
+#: itself and answers with a :class:`~mechsyn.kinematics.spatial_result.SpatialSimulation`
+#: (``engine == "spatial"``): the same result interface as the planar engines' ``Simulation``.
+SPATIAL_ENGINE = SpatialEngine()
+
+
+def first_sweep(engines: tuple[Engine, ...], system: Any, plan: Any, inputs: np.ndarray, speeds: np.ndarray, *,
+                change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+    """The sweep of the first of ``engines`` that answers (None when none does)."""
+    for engine in engines:
+        sw = engine.sweep(system, plan, inputs, speeds, change_points=change_points, progress=progress)
+        if sw is not None:
+            return sw
+    return None
+
+
+def _tracked_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, res: tuple, engine: str,
+                   progress: Callable[[int], Any] | None) -> Sweep:
+    """A tracked engine's arrays, singular rows and group events as a Sweep."""
+    q, qd, qdd, singular, tr_events = res
+    N = U.shape[0]
+    qd[singular] = np.nan  # a group folded flat: rates not defined here
+    qdd[singular] = np.nan
+    ok = np.all(np.isfinite(q), axis=1)
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
+    sw.events = _tracked_events(tr_events, sw)
+    if progress is not None:
+        progress(N)
+    return sw
+
+
+def _tracked_events(tracked_events: list[Event], sw: Sweep) -> list[Event]:
+    """Events of the closed-form sweep: dead points, reassembly and change / branch points
+    found and refined on the groups' discriminants (:func:`solve_tracked`)."""
+    out, seen = [], set()
+    for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
+        if e.kind == "reassembled":
+            if e.index in seen:
+                continue
+            seen.add(e.index)
+        out.append(e)
+    if not sw.assembled[0] and not any(e.index == 0 and e.kind == "dead point" for e in out):
+        out.insert(0, Event(0, "not assembled", "the mechanism cannot be assembled at the first input",
+                            sw.inputs[0].tolist()))
+    return out
+
+
+def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
+    """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
+    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
+    if U.shape[0] < 2:
+        return None
+    if U.shape[1] == 1:
+        return _drawn_row_1(S.drivers[0], U[:, 0])
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    isR = np.array([d.type == "R" for d in S.drivers])
+    a, d = U[:-1], np.diff(U, axis=0)
+    dd = np.einsum("ij,ij->i", d, d)
+    turns = u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi))  # (N-1, k)
+    for shift in (0.0, 2 * np.pi, -2 * np.pi):
+        v = np.where(isR, turns + shift if shift else turns, u0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.einsum("ij,ij->i", v - a, d) / dd
+        off = np.abs(a + t[:, None] * d - v).max(axis=1)
+        hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
+        if hit.any():
+            return int(np.argmax(hit)) + 1
+    return None
+
+
+def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
+    """:func:`drawn_row` of one input (the same decisions on 1-D arrays: a point of a
+    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
+    ``0 < p <= d^2``, division being monotone)."""
+    u0 = float(driver.assembled)
+    a = u[:-1]
+    d = u[1:] - a
+    dd = d * d
+    v = a - u0
+    if driver.type == "R":
+        v /= 2 * np.pi
+        np.rint(v, out=v)
+        v *= 2 * np.pi
+        v += u0
+        shifts = (0.0, 2 * np.pi, -2 * np.pi)
+    else:
+        v[:] = u0
+        shifts = (0.0,)
+    for shift in shifts:
+        p = (v + shift - a) if shift else v - a
+        p *= d
+        hit = p > 0.0
+        hit &= p <= dd
+        if hit.any():
+            return int(hit.argmax()) + 1
+    return None
+
+
+def outward(S: PlanarSystem, U: np.ndarray, run: Callable[[list], list[Sweep]]) -> Sweep:
+    """The sweep computed outwards from the drawn configuration when the drawn input lies
+    inside it (rows after it forwards, rows before it backwards), so every sweep that
+    contains the drawn input passes through the drawn configuration; else one run.
+    ``run(parts)`` sweeps each of ``parts`` from the drawn configuration."""
+    k = drawn_row(S, U)
+    if k is None:
+        return run([U])[0]
+    fwd, bwd = run([U[k:], U[:k][::-1].copy()])
+    events = []
+    for e in bwd.events:
+        at_row = e.kind == "singular" and not e.crossed
+        e = e.with_(index=(k - 1 - e.index) if at_row else max(0, k - e.index), before_sweep=None)
+        if e.kind == "dead point":
+            e = e.with_(message="a limit of the working range: the Jacobian is singular (dead point)")
+        elif e.kind == "reassembled":
+            e = e.with_(message="assembles again (going back from the drawn configuration) after a gap, in the "
+                                "assembly mode nearest the drawn one")
+        events.append(e)
+    for e in fwd.events:
+        events.append(e.with_(index=e.index + k, before_sweep=None))
+    events.sort(key=lambda e: e.index)
+
+    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[::-1], b])
+
+    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
+                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
+                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method, engine=fwd.engine)

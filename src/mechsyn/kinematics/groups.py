@@ -1,0 +1,310 @@
+"""Assur groups of class II (dyads): the plan of a mechanism (drivers, then groups in
+solving order), its decomposition, the look-ups every engine shares, and the kernels of
+the group kinds written once.
+
+A mechanism of R and P pairs whose links can be found one driver at a time and then two
+at a time (a *dyad*: two links, three pairs, joined to links already known) is solved in
+closed form (Artobolevsky, *Theory of Mechanisms and Machines*, ch. 4; the dyads RRR,
+RRP, PRR, RPR, RPP, PRP). :func:`decompose` finds the plan; :func:`circle_circle` is the
+RRR group's kernel (the intersection of two circles, with its normalised discriminant)
+used by every engine that places an RRR group: the generic steps
+(:mod:`mechsyn.kinematics.positions`), the fast chain (:mod:`mechsyn.kinematics.chain`),
+the regular pass (:mod:`mechsyn.kinematics.regular`) and the branch tracking
+(:mod:`mechsyn.kinematics.tracking`).
+
+References
+----------
+.. [1] I. I. Artobolevsky, *Theory of Mechanisms and Machines*, Nauka, Moscow, 1988, ch. 4.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechsyn.kinematics.system import Con, PlanarSystem
+
+__all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose", "normalised_disc"]
+
+
+#: Chooses the assembly sign of a branched group per input row from the group's
+#: normalised discriminant (per row) and its drawn mode (+1 or -1).
+Chooser = Callable[[np.ndarray, float], np.ndarray | float]
+#: The assembly mode asked of a branched group: one sign for every row (+1 or -1), one
+#: sign per row (an array), the drawn mode (None) or a :data:`Chooser`.
+Sigma = float | np.ndarray | Chooser | None
+
+
+@dataclass(frozen=True)
+class RRRChooser:
+    """A chooser of an RRR group in a chain program, with the drawn middle joint (which
+    gives the drawn mode)."""
+
+    choose: Chooser
+    drawn_b: np.ndarray
+
+
+@dataclass(frozen=True)
+class DriveOp:
+    """A chain program's drive: link ``new`` turned by the R drive at joint ``joint``
+    (input ``driver``, ``sign`` +1 when ``new`` is the pair's second link) about the
+    known link ``known`` (-1: the frame)."""
+
+    new: int
+    known: int
+    joint: str
+    driver: int
+    sign: float
+
+
+@dataclass(frozen=True)
+class RRROp:
+    """A chain program's RRR group (plan step ``step``): middle joint ``joints[1]`` found
+    from the known end joints ``joints[0]`` (on link ``known[0]``) and ``joints[2]`` (on
+    ``known[1]``); ``L1s``, ``L2s`` the squared lengths of its links ``links``; ``sigma``
+    its assembly mode; ``bv1``, ``bv2`` each link's local end-to-middle vector over its
+    squared length (the link's rotation from the joint-to-joint vector)."""
+
+    step: int
+    known: tuple[int, int]
+    links: tuple[int, int]
+    joints: tuple[str, str, str]
+    L1s: float
+    L2s: float
+    sigma: float | np.ndarray | RRRChooser
+    bv1: np.ndarray
+    bv2: np.ndarray
+
+    def with_sigma(self, sigma: float | np.ndarray | RRRChooser) -> "RRROp":
+        """The same group in another assembly mode (the signs of one sweep)."""
+        return RRROp(self.step, self.known, self.links, self.joints, self.L1s, self.L2s, sigma, self.bv1, self.bv2)
+
+
+@dataclass(frozen=True)
+class Step:
+    kind: str                 # "drive_R", "drive_P", "RRR", "RRP", "RPR", "RPP", "PRP"
+    links: tuple[int, ...]    # new links
+    known: tuple[int, ...]    # known links used
+    joints: tuple[str, ...]
+    data: dict
+    sigma: float = 1.0
+
+
+@dataclass(frozen=True)
+class Plan:
+    steps: tuple[Step, ...]
+
+    @property
+    def closed_form_rates(self) -> bool:
+        return all(s.kind in ("drive_R", "RRR") for s in self.steps)
+
+    def describe(self) -> list[str]:
+        return [f"{s.kind} ({', '.join(s.joints)})" for s in self.steps]
+
+
+def _cons_of(S: PlanarSystem, jid: str) -> list[Con]:
+    memo = _memo(S)
+    key = ("cons", jid)
+    out = memo.get(key)
+    if out is None:
+        out = memo[key] = [c for c in S.cons if c.joint == jid]
+    return out
+
+
+def _jtype(S: PlanarSystem, jid: str) -> str:
+    return S.mech.joint(jid).type
+
+
+def decompose(S: PlanarSystem) -> Plan | None:
+    """Drivers and dyads in solving order, or None when the mechanism does not decompose."""
+    mech = S.mech
+    if any(c.kind in ("gear", "curve", "belt") or c.role in ("lock", "idle") for c in S.cons):
+        return None
+    known = {-1}
+    steps: list[Step] = []
+    used: set[str] = set()
+    joints = {j.id: j for j in mech.joints}
+    link_joints: dict[int, list[str]] = {}
+    for j in mech.joints:
+        for ln in j.links:
+            link_joints.setdefault(S.index(ln), []).append(j.id)
+    drivers = {d.joint for d in S.drivers}
+
+    def ends(jid: str) -> tuple[int, int]:
+        a, b = joints[jid].links
+        return S.index(a), S.index(b)
+
+    progress = True
+    while progress and len(known) < len(S.links) + 1:
+        progress = False
+        for jid in drivers - used:
+            a, b = ends(jid)
+            if (a in known) == (b in known):
+                continue
+            k, new = (a, b) if a in known else (b, a)
+            steps.append(Step("drive_" + _jtype(S, jid), (new,), (k,), (jid,), {}))
+            known.add(new)
+            used.add(jid)
+            progress = True
+        if progress:
+            continue
+        # dyads: b1, b2 unknown, J2 between them, J1: known-b1, J3: b2-known
+        for b1 in range(len(S.links)):
+            if b1 in known:
+                continue
+            j1s = [j for j in link_joints.get(b1, []) if j not in used and (set(ends(j)) - {b1}) <= known
+                   and j not in drivers]
+            if len(j1s) != 1:
+                continue
+            J1 = j1s[0]
+            for J2 in link_joints.get(b1, []):
+                if J2 in used or J2 == J1 or J2 in drivers:
+                    continue
+                a2, c2 = ends(J2)
+                b2 = c2 if a2 == b1 else a2
+                if b2 in known:
+                    continue
+                j3s = [j for j in link_joints.get(b2, []) if j not in used and j != J2
+                       and (set(ends(j)) - {b2}) <= known and j not in drivers]
+                if len(j3s) != 1:
+                    continue
+                J3 = j3s[0]
+                types = "".join(_jtype(S, j) for j in (J1, J2, J3))
+                if types not in ("RRR", "RRP", "PRR", "RPR", "RPP", "PPR", "PRP"):
+                    continue  # PPP: not a dyad of a planar mechanism
+                k1 = (set(ends(J1)) - {b1}).pop()
+                k3 = (set(ends(J3)) - {b2}).pop()
+                steps.append(Step(types, (b1, b2), (k1, k3), (J1, J2, J3), {}))
+                known.update((b1, b2))
+                used.update((J1, J2, J3))
+                progress = True
+                break
+            if progress:
+                break
+        if not progress:
+            progress = _double_joint_dyad(S, known, used, drivers, link_joints, ends, steps)
+    if len(known) < len(S.links) + 1:
+        return None
+    if set(j.id for j in mech.joints) - used:
+        return None  # closing constraints left over (redundant): Newton handles them
+    return Plan(tuple(steps))
+
+
+def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, link_joints: dict, ends,
+                       steps: list) -> bool:
+    """A dyad whose middle joint is a *double joint*: links ``b1`` and ``b2`` both pinned to
+    a third link ``m`` at one point (two R pairs ``b1-m``, ``b2-m`` at the same place).
+
+    The point is the intersection of the circles about ``b1``'s and ``b2``'s known joints,
+    as in an RRR dyad; ``m`` is placed later through the pair ``b1-m`` (the pair ``b2-m``
+    is then satisfied, being at the same point). Appends the step and returns True when
+    one is found."""
+    mech = S.mech
+    pts = {j.id: np.asarray(j.point, float) for j in mech.joints}
+    for b1 in range(len(S.links)):
+        if b1 in known:
+            continue
+        j1s = [j for j in link_joints.get(b1, []) if j not in used and j not in drivers
+               and (set(ends(j)) - {b1}) <= known]
+        if len(j1s) != 1 or _jtype(S, j1s[0]) != "R":
+            continue
+        for J2a in link_joints.get(b1, []):
+            if J2a in used or J2a in drivers or _jtype(S, J2a) != "R":
+                continue
+            m = (set(ends(J2a)) - {b1}).pop()
+            if m in known:
+                continue
+            for J2b in link_joints.get(m, []):
+                if J2b == J2a or J2b in used or J2b in drivers or _jtype(S, J2b) != "R":
+                    continue
+                b2 = (set(ends(J2b)) - {m}).pop()
+                if b2 in known or b2 == b1 or np.abs(pts[J2a] - pts[J2b]).max() > 1e-9 * S.scale:
+                    continue
+                j3s = [j for j in link_joints.get(b2, []) if j not in used and j not in drivers and j != J2b
+                       and (set(ends(j)) - {b2}) <= known]
+                if len(j3s) != 1 or _jtype(S, j3s[0]) != "R":
+                    continue
+                J1, J3 = j1s[0], j3s[0]
+                k1 = (set(ends(J1)) - {b1}).pop()
+                k3 = (set(ends(J3)) - {b2}).pop()
+                steps.append(Step("RRR", (b1, b2), (k1, k3), (J1, J2a, J3), {"double": J2b}))
+                known.update((b1, b2))
+                used.update((J1, J3, J2b))
+                return True
+    return False
+
+
+def _memo(S: PlanarSystem) -> dict:
+    """Per-system cache of look-ups that depend only on the system (local joint points,
+    constraints of a joint): a plan evaluated many times (events, drags) reuses them."""
+    return S.cache.setdefault("groups", {})
+
+
+def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
+    memo = _memo(S)
+    key = ("local", i, jid)
+    out = memo.get(key)
+    if out is None:
+        j = S.mech.joint(jid)
+        name = S.mech.ground if i < 0 else S.links[i]
+        out = memo[key] = S.to_local(name, j.point)
+    return out
+
+
+def _rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:
+    """Constant ``phi_to - phi_from`` of a P joint between links frm and to."""
+    con = next(c for c in _cons_of(S, jid) if c.kind == "angle" and c.role == "rotation")
+    return con.c0 if (con.a, con.b) == (frm, to) else -con.c0
+
+
+def _line(S: PlanarSystem, jid: str) -> Con:
+    return next(c for c in _cons_of(S, jid) if c.kind == "line" and c.role == "pair")
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
+
+
+def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: float, L2s: float) -> tuple:
+    """The RRR group's kernel: the intersection of the circles ``|B - A| = L1``,
+    ``|B - C| = L2`` with ``d = C - A = (dx, dy)`` (arrays, or floats for the scalar root
+    searches of the branch tracking; the same operations, so the same numbers).
+
+    Returns ``1/|d|^2``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)`` and
+    ``g^2 = L1^2 / |d|^2 - f^2``: ``B = A + f d + sigma g R90 d`` and
+    ``g^2 |d|^2 / L1^2 = g^2 / (1/|d|^2 L1^2)`` is the group's normalised discriminant
+    (:func:`normalised_disc`; below zero the circles do not meet). Every engine that
+    places an RRR group calls it: the generic step, the fast chain, the regular pass and
+    the scalar discriminant of the tracking.
+
+    Examples
+    --------
+    >>> inv, f, g2 = circle_circle(4.0, 0.0, 9.0, 9.0)   # |d| = 4, L1 = L2 = 3
+    >>> f, round(g2 * 16, 12), round(normalised_disc(inv, g2, 9.0), 6)
+    (0.5, 5.0, 0.555556)
+    """
+    inv = dx * dx
+    inv += dy * dy
+    if isinstance(inv, np.ndarray):
+        np.divide(1.0, inv, out=inv)
+    else:
+        inv = 1.0 / inv if inv > 0 else math.inf
+    f = inv * (0.5 * (L1s - L2s))
+    f += 0.5
+    g = inv * L1s
+    g -= f * f
+    return inv, f, g
+
+
+def normalised_disc(inv: np.ndarray | float, g2: np.ndarray | float, L1s: float) -> np.ndarray | float:
+    """The RRR group's normalised discriminant ``h^2 / L1^2`` (``h`` the height of the
+    middle joint over ``d``) from :func:`circle_circle`'s ``1/|d|^2`` and ``g^2``: 1 when
+    the first link stands square on ``d``, 0 when the group is folded flat."""
+    return g2 / (inv * L1s)

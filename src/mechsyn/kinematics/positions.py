@@ -1,0 +1,393 @@
+"""Closed-form position analysis by Assur groups of class II (dyads), vectorised.
+
+A mechanism of R and P pairs whose links can be found one driver at a time and then
+two at a time (a *dyad*: two links, three pairs, joined to links already known) is
+solved in closed form for all input values at once (Artobolevsky, *Theory of
+Mechanisms and Machines*, ch. 4; the dyads RRR, RRP, PRR, RPR, RPP, PRP):
+
+* RRR: the middle joint ``B`` is the intersection of the circles ``|B - A| = L1`` and
+  ``|B - C| = L2``: with ``d = C - A``, ``a = (L1^2 - L2^2 + |d|^2) / (2|d|)``,
+  ``h = sqrt(L1^2 - a^2)``, ``B = A + a d/|d| + sigma h R90 d/|d|``;
+* RRP / PRR: the intersection of a circle and a line, ``lambda^2 + 2 p lambda + c = 0``;
+* RPR: the slide line keeps the offset ``e`` from both pivots:
+  ``cos(phi + nu - delta) = e / |C - A|``;
+* RPP / PRP: the orientations follow from the P pairs, the positions from two linear
+  equations ``n_1 . X = h_1``, ``n_2 . X = h_2`` (the two slide lines).
+
+The assembly mode ``sigma`` of each dyad is taken from the file's configuration, so the
+result equals the continuation of :func:`mechsyn.kinematics.solve.sweep` on that branch
+(tests check both agree). Where a square root is negative the dyad cannot be assembled:
+the row is NaN and ``assembled`` is false (dead points are then located by the Newton
+path). Velocities and accelerations of driver + RRR chains are in closed form
+(``omega_1 = (v_C - v_A) . e2 / (e1 x e2)``, ``e1 = B - A``, ``e2 = B - C``); other
+chains use batched linear solves of the differentiated constraints.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechsyn.kinematics.groups import Plan, Sigma, Step, circle_circle, normalised_disc, _cons_of, _cross, _dot, _line, _local, _rel_angle
+from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
+
+__all__ = ["TrackedPositions", "solve_positions"]
+
+
+class _State:
+    """Poses of the links known so far, for all N inputs."""
+
+    def __init__(self, S: PlanarSystem, N: int) -> None:
+        self.S = S
+        self.r = np.full((N, len(S.links), 2), np.nan)
+        self.phi = np.full((N, len(S.links)), np.nan)
+        self.N = N
+
+    def pose(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        if i < 0:
+            return np.zeros((self.N, 2)), np.zeros(self.N)
+        return self.r[:, i], self.phi[:, i]
+
+    def point(self, i: int, s: np.ndarray) -> np.ndarray:
+        r, phi = self.pose(i)
+        c, sn = _rot(phi)
+        return r + _apply(c, sn, s)
+
+    def set(self, i: int, r: np.ndarray, phi: np.ndarray) -> None:
+        self.r[:, i] = r
+        self.phi[:, i] = phi
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    return (x + np.pi) % (2 * np.pi) - np.pi
+
+
+def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
+    """``np.unwrap(p, axis=-1)`` for angles whose steps stay below a whole turn (as those of
+    ``atan2`` do): the whole turns removed are counted exactly (a step of exactly half a
+    turn is kept, as ``np.unwrap`` keeps it); ``inplace``: into ``p`` itself."""
+    out = p if inplace else np.array(p, float)
+    if p.shape[-1] > 1:
+        k = np.subtract(p[..., 1:], p[..., :-1])
+        k /= 2 * np.pi
+        np.rint(k, out=k)
+        jumps = np.flatnonzero(k)
+        if len(jumps) > 16:  # many turns: count them all at once
+            np.cumsum(k, axis=-1, out=k)
+            k *= 2 * np.pi
+            out[..., 1:] -= k
+        else:  # a few: each shifts the rest of its row
+            o2, k2 = out.reshape(-1, out.shape[-1]), k.reshape(-1, k.shape[-1])
+            for j in jumps.tolist():
+                row, col = divmod(j, k2.shape[1])
+                o2[row, col + 1:] -= 2 * np.pi * k2[row, col]
+    return out
+
+
+def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None,
+                       fresh: bool = False) -> np.ndarray:
+    """Link angles made continuous along a sweep: start near the file's angles ``ref``,
+    unwrap each run of assembled rows and keep the turn count across gaps (``phi`` (N,
+    m), or (m, N) with ``ref`` (m, 1); ``ok`` None: every row assembled).
+
+    ``split``: the sweep (assembled throughout) was run outwards from the drawn
+    configuration, between rows ``split - 1`` and ``split``: both rows start near
+    ``ref`` and the angles are unwrapped away from them (as two runs would be).
+    ``fresh``: ``phi`` (m, N) is a work array the angles may be written into."""
+    if ref.ndim == 1:
+        return _continuous_angles(phi.T, ref[:, None], ok, split).T
+    if ok is None or ok.all():  # one run: unwrap, then put the start row(s) next to ref
+        block = _unwrap_rows(phi, inplace=fresh)
+        parts = ((0, slice(None)),) if split is None else ((split, slice(split, None)), (split - 1, slice(0, split)))
+        for row, rows in parts:  # the few start values on floats (the numbers of _wrap)
+            for i, (a, b, r0) in enumerate(zip(phi[:, row].tolist(), block[:, row].tolist(), ref[:, 0].tolist())):
+                near = r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi)
+                turns = round((b - near) / (2 * math.pi))
+                if turns:
+                    block[i, rows] -= 2 * math.pi * turns
+        return block
+    sub = ref + _wrap(phi - ref)
+    idx = np.flatnonzero(ok)
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    prev = None
+    for run in runs:
+        block = _unwrap_rows(sub[:, run])
+        if prev is not None:
+            block -= 2 * np.pi * np.round((block[:, :1] - prev) / (2 * np.pi))
+        sub[:, run] = block
+        prev = block[:, -1:]
+    return sub
+
+
+def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
+    c, sn = _rot(phi)
+    st.set(i, P - _apply(c, sn, s_local), phi)
+
+
+def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """Solve one step in place; return its assembly sign (sigma) for the branch: ``sigma``
+    given (a number or one per row), None (the drawn mode) or a chooser called with the
+    normalised discriminant and the drawn mode."""
+    kernel = _STEP_KERNELS.get(step.kind)
+    if kernel is None:
+        raise _NotHandled
+    return kernel(S, st, step, u, sigma)
+
+
+def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """A link turned by an R drive about a known link."""
+    (new,), (k,), (jid,) = step.links, step.known, step.joints
+    con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    th = u[:, con.driver]
+    _, phik = st.pose(k)
+    phi = phik + th if con.b == new else phik - th
+    P = st.point(k, _local(S, k, jid))
+    _pin(st, new, P, _local(S, new, jid), phi)
+    return 1.0
+
+
+def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """A link slid by a P drive along a known link."""
+    (new,), (k,), (jid,) = step.links, step.known, step.joints
+    drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    line = _line(S, jid)
+    val = u[:, drive.driver]
+    if drive.a == k:
+        ra, pa = st.pose(k)
+        ca, sa_ = _rot(pa)
+        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        Pa = st.point(k, line.sa)
+        Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
+        _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
+    else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
+        pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
+        ca, sa_ = _rot(pa)
+        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        Pb = st.point(k, drive.sb)
+        Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
+        st.set(new, Oa, pa)
+    return 1.0
+
+
+def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """RRR dyad: the intersection of two circles."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    A = st.point(A_s, _local(S, A_s, J1))
+    C = st.point(B_s, _local(S, B_s, J3))
+    s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+    t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+    L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+    d = C - A
+    inv, f, g2 = circle_circle(d[:, 0], d[:, 1], L1s, L2s)
+    disc = normalised_disc(inv, g2, L1s)
+    if sigma is None or callable(sigma):
+        s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(disc, s_file)
+    g2 = np.where((g2 < 0) & (disc > -1e-12), 0.0, g2)  # a fold within round-off
+    g = np.sqrt(np.where(g2 >= 0, g2, np.nan))
+    B = A + f[:, None] * d + (sigma * g)[:, None] * _perp(d)
+    beta1 = np.arctan2(*(s2 - s1)[::-1])
+    beta2 = np.arctan2(*(t2 - t3)[::-1])
+    phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
+    phi2 = np.arctan2((B - C)[:, 1], (B - C)[:, 0]) - beta2
+    _pin(st, b1, A, s1, phi1)
+    _pin(st, b2, C, t3, phi2)
+    return sigma
+
+
+def _oriented(step: Step, kind: str) -> tuple:
+    """A dyad's links, known links and end joints in the order of ``kind`` (the step's
+    own order, or reversed for its mirror kind, e.g. PRR as RRP)."""
+    (A_s, B_s), (b1, b2), (J1, _, J3) = step.known, step.links, step.joints
+    if step.kind == kind:
+        return b1, b2, A_s, B_s, J1, J3
+    return b2, b1, B_s, A_s, J3, J1
+
+
+def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """RRP / PRR dyad: the intersection of a circle and a line."""
+    # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
+    lr, lp, kr, kp, Jr, Jp = _oriented(step, "RRP")
+    J2 = step.joints[1]
+    A = st.point(kr, _local(S, kr, Jr))
+    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+    line = _line(S, Jp)
+    # the P joint's point on lp and the known line through kp's joint point
+    t_p = line.sb if line.b == lp else line.sa
+    s_k = line.sa if line.a == kp else line.sb
+    Pk = st.point(kp, s_k)
+    phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
+    ca, sa_ = _rot(phi_axis)
+    w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
+    cp, sp = _rot(phi_p)
+    tB = _local(S, lp, J2)
+    Q = Pk + _apply(cp, sp, tB - t_p)
+    L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
+    p = _dot(w, Q - A)
+    cc = _dot(Q - A, Q - A) - L1 ** 2
+    disc = p ** 2 - cc
+    if sigma is None or callable(sigma):
+        lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+        s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
+    disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
+    root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    lam = -p + sigma * root
+    B = Q + lam[:, None] * w
+    sr = _local(S, lr, Jr)
+    beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
+    phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
+    _pin(st, lr, A, sr, phi_r)
+    _pin(st, lp, B, tB, phi_p)
+    return sigma
+
+
+def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """RPR dyad: the slide line keeps its offset from both pivots."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    A = st.point(A_s, _local(S, A_s, J1))
+    C = st.point(B_s, _local(S, B_s, J3))
+    c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
+    line = _line(S, J2)
+    n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
+                                                  np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
+    # n_loc: the slide normal in b1's frame
+    sA, sP = _local(S, b1, J1), _local(S, b1, J2)
+    tC, tP = _local(S, b2, J3), _local(S, b2, J2)
+    cc, sc = np.cos(c), np.sin(c)
+    Rc = np.array([[cc, -sc], [sc, cc]])
+    e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
+    d = C - A
+    D = np.sqrt(_dot(d, d))
+    delta = np.arctan2(d[:, 1], d[:, 0])
+    nu = np.arctan2(n_loc[1], n_loc[0])
+    ratio = e / D
+    if sigma is None or callable(sigma):
+        phi0 = float(st.S.q0[3 * b1 + 2])
+        s_file = 1.0 if _wrap(phi0 + nu - delta[0]) >= 0 else -1.0
+        sigma = s_file if sigma is None else sigma(1.0 - ratio ** 2, s_file)
+    ratio = np.where((np.abs(ratio) > 1) & (np.abs(ratio) < 1 + 1e-12), np.sign(ratio), ratio)
+    ac = np.arccos(np.where(np.abs(ratio) <= 1, ratio, np.nan))
+    phi1 = delta - nu + sigma * ac
+    _pin(st, b1, A, sA, phi1)
+    _pin(st, b2, C, tC, phi1 + c)
+    return sigma
+
+
+def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """RPP / PPR dyad: orientations from the P pairs, position from two lines."""
+    # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
+    lr, lp, kr, kp, Jr, Jp = _oriented(step, "RPP")
+    J2 = step.joints[1]
+    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
+    phi_r = phi_p + _rel_angle(S, J2, lp, lr)
+    A = st.point(kr, _local(S, kr, Jr))
+    _pin(st, lr, A, _local(S, lr, Jr), phi_r)
+    w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
+    w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
+    st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
+    return 1.0
+
+
+def _step_PRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """PRP dyad: the intersection of two slide lines."""
+    A_s, B_s = step.known
+    b1, b2 = step.links
+    J1, J2, J3 = step.joints
+    phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
+    phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
+    sB, tB = _local(S, b1, J2), _local(S, b2, J2)
+    w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
+    w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
+    B = _solve2(w1, h1, w2, h2)
+    _pin(st, b1, B, sB, phi1)
+    _pin(st, b2, B, tB, phi2)
+    return 1.0
+
+
+_STEP_KERNELS = {"drive_R": _step_drive_R, "drive_P": _step_drive_P, "RRR": _step_RRR, "RRP": _step_RRP,
+                 "PRR": _step_RRP, "RPR": _step_RPR, "RPP": _step_RPP, "PPR": _step_RPP, "PRP": _step_PRP}
+
+
+def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.ndarray,
+             s_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A P pair's line condition ``n . (P_b - P_a) = 0`` as ``n . X = h`` for the unknown
+    position ``X`` of the local point ``s_ref`` of a link whose angle ``phi_u`` is known."""
+    cu, su = _rot(phi_u)
+    if con.b == unknown:
+        _, pa = st.pose(con.a)
+        ca, sa_ = _rot(pa)
+        n = _apply(ca, sa_, con.w)
+        Pa = st.point(con.a, con.sa)
+        return n, _dot(n, Pa - _apply(cu, su, con.sb - s_ref))
+    n = _apply(cu, su, con.w)
+    Pb = st.point(con.b, con.sb)
+    return n, _dot(n, Pb - _apply(cu, su, con.sa - s_ref))
+
+
+def _solve2(w1: np.ndarray, h1: np.ndarray, w2: np.ndarray, h2: np.ndarray) -> np.ndarray:
+    """Solve ``w1 . X = h1``, ``w2 . X = h2`` (NaN where the two lines are parallel)."""
+    det = w1[:, 0] * w2[:, 1] - w1[:, 1] * w2[:, 0]
+    det = np.where(np.abs(det) < 1e-12, np.nan, det)
+    return np.stack([(h1 * w2[:, 1] - h2 * w1[:, 1]) / det, (w1[:, 0] * h2 - w2[:, 0] * h1) / det], axis=1)
+
+
+class _NotHandled(Exception):
+    pass
+
+
+def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
+                    sigmas: list[float] | None = None) -> tuple[np.ndarray, list[float]]:
+    """Poses ``q`` (N, n) for all inputs, NaN rows where a dyad cannot be assembled.
+
+    Angles of links placed by a dyad come from ``atan2``; they are made continuous along
+    each run of assembled inputs, and each run is shifted by whole turns to follow the
+    previous one (links turned by a driver keep the input's own value).
+    """
+    inputs = np.atleast_2d(np.asarray(inputs, float))
+    st = _State(S, inputs.shape[0])
+    out_sig = []
+    for k, step in enumerate(plan.steps):
+        out_sig.append(_solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
+    return _pose_rows(S, st, plan), out_sig
+
+
+def _pose_rows(S: PlanarSystem, st: _State, plan: Plan) -> np.ndarray:
+    """The solved state as pose rows ``q`` (x, y, angle of every link), the dyads' link
+    angles unwrapped to turn continuously from the file's configuration."""
+    nl = len(S.links)
+    q = np.empty((st.phi.shape[0], S.n))
+    q[:, 0:3 * nl:3] = st.r[:, :, 0]
+    q[:, 1:3 * nl:3] = st.r[:, :, 1]
+    phi = st.phi.copy()
+    dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
+    ok = np.all(np.isfinite(phi), axis=1)
+    if dyad_links and ok.any():
+        phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
+    q[:, 2:3 * nl:3] = phi
+    return q
+
+
+@dataclass
+class TrackedPositions:
+    """Positions of a sweep on the drawn branch (see :func:`solve_tracked`).
+
+    ``q`` (N, n) poses (NaN rows: not assembled); ``sigmas`` the assembly sign of every
+    step per row (``None`` for steps without one); ``discs`` the normalised
+    discriminant of every branched step per row; ``singular`` rows where a group is
+    folded flat (rates undefined); ``events`` dead points, reassembly and singular
+    crossings with their input refined on the group's discriminant (input units:
+    radians for R, length for P).
+    """
+
+    q: np.ndarray
+    sigmas: list
+    discs: dict
+    singular: np.ndarray
+    events: list

@@ -1,0 +1,232 @@
+"""The result of a kinematic simulation: :class:`Simulation` (every link's angle and rates,
+every named point's position and rates over the input values, the events of the sweep),
+its parts (:class:`PointMotion`, :class:`LinkMotion`) and the input helpers shared by the
+planar and spatial engines (:func:`input_grid`, :func:`resolve_points`).
+
+Kept apart from :mod:`mechsyn.kinematics.analysis` (which runs the engines) so that every
+engine, planar or spatial, can build its result without importing the entry point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from mechsyn._result import Result
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.limits import limit, limit_hint
+from mechsyn.model.mechanism import Mechanism
+
+if TYPE_CHECKING:
+    from mechsyn.kinematics.system import PlanarSystem
+
+__all__ = ["Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points"]
+
+
+@dataclass
+class PointMotion:
+    position: np.ndarray       # (N, 2)
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    link: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"position": self.position, "velocity": self.velocity, "acceleration": self.acceleration}
+
+
+@dataclass
+class LinkMotion:
+    angle: np.ndarray                 # (N,) degrees
+    angular_velocity: np.ndarray      # rad/s
+    angular_acceleration: np.ndarray  # rad/s^2
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"angle": self.angle, "angular_velocity": self.angular_velocity,
+                "angular_acceleration": self.angular_acceleration}
+
+
+@dataclass(repr=False)
+class Simulation(Result):
+    """Motion of a mechanism over a sweep of input values (see the module doc).
+
+    ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
+    table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 360, 10))
+    >>> s.point("M").shape, bool(s.assembled.all())
+    ((37, 2), True)
+    """
+
+    _plot = "kinematics:plot_paths"
+
+    mechanism: str
+    inputs: dict[str, np.ndarray]         # joint -> values (deg for R, length for P)
+    input_types: dict[str, str]
+    speeds: dict[str, float]
+    assembled: np.ndarray
+    points: dict[str, PointMotion]
+    links: dict[str, LinkMotion]
+    events: list[Event] = field(default_factory=list)
+    method: str = "newton"
+    engine: str = "newton"
+    notes: list[str] = field(default_factory=list)
+    vll: dict[str, str] = field(default_factory=dict)
+    sweep: Sweep | None = field(default=None, repr=False)
+    system: PlanarSystem | None = field(default=None, repr=False)
+
+    @property
+    def main_input(self) -> str:
+        return next(iter(self.inputs))
+
+    def _summary(self) -> list[tuple[str, str]]:
+        x = self.inputs[self.main_input]
+        unit = _unit(self.input_types[self.main_input])
+        rows = [("mechanism", self.mechanism), ("method", f"{self.method} ({self.engine})"),
+                ("input", f"{self.main_input}: {len(x)} values, {x[0]:g} to {x[-1]:g} {unit}" if len(x) else "none"),
+                ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
+                ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
+        if self.events:
+            rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
+        return rows
+
+    def point(self, name: str) -> np.ndarray:
+        """Positions (N, 2) of named point ``name`` over the sweep (NaN where not assembled)."""
+        if name not in self.points:
+            raise MechsynInputError(f"no point {name!r} in this simulation", field="points",
+                                    hint="one of " + (", ".join(self.points) or "none: pass points=[...]"))
+        return self.points[name].position
+
+    def link(self, name: str) -> LinkMotion:
+        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
+        if name not in self.links:
+            raise MechsynInputError(f"no link {name!r} in this simulation", field="link",
+                                    hint="one of " + ", ".join(self.links))
+        return self.links[name]
+
+    def to_pandas(self) -> Any:
+        """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
+        every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
+        from mechsyn._extras import require
+
+        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
+        cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
+        cols["assembled"] = self.assembled
+        for name, pm in self.points.items():
+            for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
+                cols[f"{name}_{key}x"], cols[f"{name}_{key}y"] = arr[:, 0], arr[:, 1]
+        for name, lm in self.links.items():
+            cols[f"{name}_angle"], cols[f"{name}_omega"] = lm.angle, lm.angular_velocity
+            cols[f"{name}_alpha"] = lm.angular_acceleration
+        return pd.DataFrame(cols)
+
+    def animate(self, fig: Any = None, **kwargs: Any) -> Any:
+        """The mechanism moving over the sweep: a
+        :class:`~mechsyn.plot.animation.MechanismAnimation` that plays when it is a notebook
+        cell's value and saves with ``anim.save("m.gif")`` (``.mp4``, ``.html``).
+
+        Without ``fig`` it is drawn on a bare Matplotlib Figure (no pyplot, so a notebook
+        shows the player, not a still frame); pass ``fig=plt.figure()`` to play it in a
+        Matplotlib window with ``plt.show()``. ``kwargs`` go to
+        :func:`mechsyn.plot.kinematics.animate_simulation` (``max_frames``, ``interval``)."""
+        from matplotlib.figure import Figure
+
+        from mechsyn.plot.kinematics import animate_simulation
+
+        return animate_simulation(self, fig=Figure() if fig is None else fig, **kwargs)
+
+    def working_ranges(self) -> list[list[float]]:
+        """Runs of consecutive assembled inputs, as [first, last] values of the main input."""
+        vals = self.inputs[self.main_input]
+        out, start = [], None
+        for k, ok in enumerate(self.assembled):
+            if ok and start is None:
+                start = k
+            if (not ok or k == len(vals) - 1) and start is not None:
+                end = k if ok else k - 1
+                out.append([float(vals[start]), float(vals[end])])
+                start = None
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        ok = self.assembled
+
+        def mask(a: np.ndarray) -> list:
+            out = np.asarray(a, float).tolist()
+            return [v if good else None for v, good in zip(out, ok)]
+
+        main = self.main_input
+        return {
+            "mechanism": self.mechanism,
+            "input": {"joint": main, "values": self.inputs[main], "unit": _unit(self.input_types[main]),
+                      "speed": self.speeds[main]},
+            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": _unit(self.input_types[j]),
+                           "speed": self.speeds[j]} for j, v in self.inputs.items()},
+            "assembled": ok,
+            "points": {name: {k: mask(v) for k, v in pm.to_dict().items()} for name, pm in self.points.items()},
+            "links": {name: {k: mask(v) for k, v in lm.to_dict().items()} for name, lm in self.links.items()},
+            "working_ranges": self.working_ranges(),
+            "events": [e.to_dict() for e in self.events],
+            "method": self.method,
+            "engine": self.engine,
+            "vll": self.vll,
+            "notes": self.notes,
+            "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"},
+        }
+
+
+def _unit(t: str) -> str:
+    return "deg" if t == "R" else "length"
+
+
+def input_grid(start: float, stop: float, step: float) -> np.ndarray:
+    """``start, start + step, ..., stop`` (stop included when on the grid).
+
+    More positions than the limit ``sweep_points`` (:mod:`mechsyn.limits`) raise
+    :class:`~mechsyn.errors.MechsynInputError` before any memory is taken.
+
+    Examples
+    --------
+    >>> from mechsyn.kinematics.analysis import input_grid
+    >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
+    ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
+    """
+    if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
+        raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", field="inputs",
+                                hint="e.g. A=0:360:1 on the command line")
+    count = np.floor((stop - start) / step + 1e-9) + 1
+    if count > limit("sweep_points"):
+        raise MechsynInputError(
+            f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "
+            f"{limit('sweep_points'):,}", field="inputs",
+            hint="use a larger step or a shorter range; " + limit_hint("sweep_points"))
+    return start + step * np.arange(int(count))
+
+
+def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:
+    """Named points (file ``points`` or joint ids) -> (link, assembled coordinates)."""
+    out: dict[str, tuple[str, np.ndarray]] = {}
+    if names is None:
+        if mech.points:
+            names = list(mech.points)
+        else:
+            names = [j.id for j in mech.joints]
+    for name in names:
+        if name in mech.points:
+            p = mech.points[name]
+            out[name] = (p.link, np.asarray(p.at, float))
+            continue
+        try:
+            j = mech.joint(name)
+        except KeyError:
+            known = list(mech.points) + [j.id for j in mech.joints]
+            raise MechsynInputError(f"no point or joint named {name!r}", field="points",
+                                    hint=f"known: {', '.join(known)}") from None
+        link = j.links[1] if j.links[1] != mech.ground else j.links[0]
+        out[name] = (link, np.asarray(j.point, float))
+    return out

@@ -1,0 +1,126 @@
+"""What every kinematics engine returns: a :class:`Sweep` (poses and their rates over the
+input values, the engine that computed them) and its :class:`Event` records.
+
+An engine (:mod:`mechsyn.kinematics.engines`) fills ``q, qd, qdd`` (N, n) with NaN rows
+where the mechanism is not assembled, and lists what happened on the way as events: a
+dead point (assembly ends or starts), a reassembly after a gap, a singular configuration
+(a change or branch point, rates undefined), the mechanism not assembled at the first
+input, a VLL outside its limits. Events are typed records; :meth:`Event.to_dict` is their
+JSON form (the keys of the former event dictionaries, in the same order), and an event
+reads like that dictionary (``e["kind"]``, ``e.get("input")``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any, Literal
+
+import numpy as np
+
+__all__ = ["Sweep", "Event", "EventKind"]
+
+#: What an event reports.
+EventKind = Literal["dead point", "reassembled", "singular", "not assembled", "branch point", "limit"]
+
+
+@dataclass(frozen=True)
+class Event(Mapping):
+    """One event of a sweep.
+
+    ``index``: the row of the sweep it belongs to; ``input``: the input values where it
+    happens (inside an engine a sequence in radians / lengths, in a
+    :class:`~mechsyn.kinematics.analysis.Simulation` a mapping joint -> degrees or length);
+    ``group``: the Assur group concerned (its joints, e.g. ``"B-C-D"``); ``crossed``: a
+    singular point passed between two rows (not at a row); ``before_sweep``: the event lies
+    between the drawn configuration and the first row; ``joint``, ``value``: a VLL and its
+    length (``limit``).
+
+    Examples
+    --------
+    >>> e = Event(3, "dead point", "assembly ends", input={"A": 101.5}, group="B-C-D")
+    >>> e["kind"], e.get("crossed"), list(e.to_dict())
+    ('dead point', None, ['index', 'kind', 'input', 'group', 'message'])
+    """
+
+    index: int
+    kind: EventKind
+    message: str
+    input: Any = None
+    group: str | None = None
+    crossed: bool | None = None
+    before_sweep: bool | None = None
+    joint: str | None = None
+    value: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: only the fields that are set, in a fixed order."""
+        out: dict[str, Any] = {"index": self.index, "kind": self.kind}
+        if self.input is not None:
+            out["input"] = self.input
+        if self.joint is not None:
+            out["joint"] = self.joint
+            out["value"] = self.value
+        if self.group is not None:
+            out["group"] = self.group
+        if self.crossed is not None:
+            out["crossed"] = self.crossed
+        out["message"] = self.message
+        if self.before_sweep is not None:
+            out["before_sweep"] = self.before_sweep
+        return out
+
+    def with_(self, **changes: Any) -> "Event":
+        """A copy with some fields changed (``dataclasses.replace`` without its checks:
+        an engine makes a few of these per event, on every sweep)."""
+        new = object.__new__(Event)
+        new.__dict__.update(self.__dict__)
+        for key, value in changes.items():
+            if key not in _FIELDS:
+                raise TypeError(f"Event has no field {key!r}")
+            new.__dict__[key] = value
+        return new
+
+    def __getitem__(self, key: str) -> Any:
+        return self.to_dict()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_dict())
+
+    def __len__(self) -> int:
+        return len(self.to_dict())
+
+
+_FIELDS = frozenset(f.name for f in fields(Event))
+
+
+@dataclass
+class Sweep:
+    """Result of an engine: poses and their rates at every input value.
+
+    ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
+    ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates;
+    ``det_sign``, ``sigma_min``: the sign of ``det Phi_q`` and the pivot ratio (Newton;
+    NaN otherwise); ``method``: ``"assur"`` (closed form) or ``"newton"``; ``engine``: the
+    name of the engine that computed it; ``links``: the links' complex states
+    (:class:`mechsyn.kinematics.regular.LinkStates`) when the one regular pass computed the
+    sweep (every row assembled with finite rates), else None.
+    """
+
+    system: Any
+    inputs: np.ndarray
+    speeds: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    assembled: np.ndarray
+    det_sign: np.ndarray
+    sigma_min: np.ndarray
+    events: list[Event] = field(default_factory=list)
+    method: str = "newton"
+    links: Any = None
+    engine: str = "newton"
+
+    @property
+    def n(self) -> int:
+        return self.q.shape[0]

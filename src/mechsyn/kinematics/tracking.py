@@ -1,0 +1,438 @@
+"""Branch tracking of Assur groups over a sweep: every branched group's assembly mode
+followed on its discriminant through folds (dead points), change and branch points and
+gaps (reassembly in the drawn mode), with the events refined by root finding on the
+discriminant (:func:`solve_tracked`, :func:`solve_tracked_rates`).
+
+At a change or branch point (the discriminant touches zero) the motion keeps the branch
+whose velocity is continuous (``change_points="keep"``) or takes the other one
+(``"switch"``); see docs/kinematics.md.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mechsyn.kinematics.chain import _poses_from_chain, fast_chain
+from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, circle_circle, normalised_disc
+from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _solve_step
+from mechsyn.kinematics.sweep import Event
+from mechsyn.kinematics.system import PlanarSystem
+
+__all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates"]
+
+
+#: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
+BRANCHED = ("RRR", "RRP", "PRR", "RPR")
+
+
+#: Normalised discriminant below which a group counts as folded (tangent circles,
+#: collinear links): its rates there are not defined.
+SINGULAR_DISC = 1e-12
+
+
+#: Relative size of the negative discriminant still taken as zero (round-off).
+_ZERO_DISC = 1e-12
+
+
+def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.ndarray:
+    """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
+    out = np.array(u_first, float)
+    for k, d in enumerate(S.drivers):
+        if d.type == "R":  # a decision per driver: on floats
+            out[k] -= 2 * math.pi * round((float(u_first[k]) - float(u0[k])) / (2 * math.pi))
+    return out
+
+
+def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: int = 4000) -> np.ndarray:
+    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded) in steps of at most
+    1 degree (R) or 1 % of the mechanism's size (P)."""
+    steps = (abs(float(b) - float(a)) / (math.radians(1.0) if d.type == "R" else 0.01 * S.scale)
+             for a, b, d in zip(u0, u1, S.drivers))
+    n = int(min(max_rows, max(1, math.ceil(max(steps)))))
+    if n == 1:  # the drawn values themselves (t = 0)
+        return np.array(u0, float)[None, :]
+    t = np.arange(n) / n
+    return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
+
+
+def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
+    """The rows ``U`` followed by the connecting paths from the drawn input values to the
+    sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
+    else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    ends = [0] if split is None else [split, split - 1]
+    return np.concatenate([U] + [_connecting_path(S, u0, _shifted_start(S, u0, U[e])) for e in ends])
+
+
+#: Smallest normalised discriminant of every group over a sweep for which
+#: :func:`mechsyn.kinematics.regular.regular_sweep` answers (below it :func:`solve_tracked` looks for folds and
+#: change points: its candidates are local minima under 0.05).
+REGULAR_DISC = 0.05 + 1e-9
+
+
+def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
+    """Poses for all inputs on the branch of the drawn configuration, with branch events.
+
+    The branch rules (docs/kinematics.md, "Branches"):
+
+    1. The drawn (file) configuration decides every group's assembly mode. The sweep is
+       reached from the drawn input values along a straight path of inputs (backwards if
+       the sweep starts below them), so the mode at the first input is the drawn mode
+       continued, not the mode re-read there.
+    2. A group's normalised discriminant ``Delta`` (RRR: ``h^2 / L1^2``; RRP: the
+       circle-line discriminant over ``L1^2``; RPR: ``1 - (e/|AC|)^2``) crossing zero is a
+       *fold* (dead point): the group cannot be assembled beyond it; the input is found by
+       Brent's method on ``Delta`` of that group alone (upstream groups re-evaluated at the
+       trial input), to 1e-12 of the step.
+    3. ``Delta`` touching zero without changing sign (a local minimum at zero, found by
+       Brent's method on ``dDelta/du``) is a *bifurcation* (change point, flat rhombus):
+       both modes meet, and the motion whose velocity is continuous is the one on which
+       the signed height ``sigma sqrt(Delta)`` changes sign, so ``sigma`` flips there.
+    4. After a gap the group reassembles in the drawn mode.
+
+    ``inputs`` (N, n_inputs) in radians / length. ``switch``: at change / branch points
+    take the other branch instead (``sigma`` kept: a parallelogram becomes an
+    anti-parallelogram there); the events say so.
+    """
+    X, n0, shift = _tracking_rows(S, inputs)
+    M = X.shape[0]
+    st = _State(S, M)
+    sigmas: list = []
+    discs: dict = {}
+    singular = np.zeros(M, bool)
+    raw_events: list = []
+    for k, step in enumerate(plan.steps):
+        if step.kind not in BRANCHED:
+            sigmas.append(_solve_step(S, st, step, X, None))
+            continue
+        choose = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular)
+        sigmas.append(_solve_step(S, st, step, X, choose))
+    q = _pose_rows(S, st, plan)
+    for step in plan.steps:  # a link driven from the frame takes the input's own turn count
+        if step.kind == "drive_R" and step.known[0] < 0:
+            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            sgn = 1.0 if con.b == step.links[0] else -1.0
+            q[n0:, 3 * step.links[0] + 2] += sgn * shift[con.driver]
+    sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]
+    return TrackedPositions(q[n0:], sig_out, {k: v[n0:] for k, v in discs.items()}, singular[n0:],
+                            _sweep_events(raw_events, n0, shift))
+
+
+def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray,
+                        switch: bool = False) -> list[tuple]:
+    """:func:`solve_tracked` and :func:`mechsyn.kinematics.chain.solve_all` of a driver-R + RRR chain for several
+    sweeps (``parts``: arrays of input rows, each reached from the drawn configuration on
+    its own) in one array pass of :func:`fast_chain`: each group's signs are chosen by
+    the branch rules on its discriminant, sweep by sweep, as the pass reaches the group.
+    Returns per sweep ``q, qd, qdd`` (N, n), its singular rows and its events."""
+    parts = [np.atleast_2d(np.asarray(p, float)) for p in parts]
+    rows = [_tracking_rows(S, p) for p in parts]
+    starts = np.cumsum([0] + [X.shape[0] for X, _, _ in rows])
+    segs = [slice(int(a), int(b)) for a, b in zip(starts[:-1], starts[1:])]
+    sigmas: list = [1.0] * len(plan.steps)
+    singular = np.zeros(int(starts[-1]), bool)
+    raw_events: list = [[] for _ in parts]
+    for k, step in enumerate(plan.steps):
+        if step.kind in BRANCHED:
+            sigmas[k] = _parts_chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
+    # the sweeps' own rows (not shifted by turns: the same numbers as an untracked pass);
+    # the choosers' events and root searches use the shifted rows
+    E = np.vstack([blk for (X, n0, _), U in zip(rows, parts) for blk in (X[:n0], U)])
+    r = fast_chain(S, plan, E, speeds, rates=True, sigmas=sigmas, chunk=max(E.shape[0], 1))
+    out = []
+    for (X, n0, shift), U, seg, evs in zip(rows, parts, segs, raw_events):
+        sweep_rows = slice(seg.start + n0, seg.stop)
+        q, qd, qdd = _poses_from_chain(S, plan, U, r.rows(sweep_rows))
+        out.append((q, qd, qdd, singular[sweep_rows], _sweep_events(evs, n0, shift)))
+    return out
+
+
+def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
+                   raw_events: list, singular: np.ndarray):
+    """The sign chooser of branched step ``k`` over several sweeps' rows (``segs`` of the
+    pass): the branch rules (:func:`_branch_signs`) applied to each sweep's rows alone;
+    the signs are also put in ``sigmas[k]``."""
+    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
+        sig = np.empty(len(disc))
+        for (X, n0, _), seg, evs in zip(rows, segs, raw_events):
+            up = [s[seg] if isinstance(s, np.ndarray) else s for s in sigmas[:k]]
+            sig[seg], found, sing = _branch_signs(S, plan, k, up, X, disc[seg], s_file, n0, switch)
+            evs.extend(found)
+            singular[seg][sing] = True
+        sigmas[k] = sig
+        return sig
+    return choose
+
+
+def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
+    """The rows a tracked sweep evaluates: the connecting path from the drawn input
+    values (``n0`` rows), then the sweep shifted by whole turns next to them."""
+    U = np.atleast_2d(np.asarray(inputs, float))
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    # R inputs a whole number of turns from the drawn values are the same configurations:
+    # track the sweep shifted next to the drawn values (its rows then follow each other)
+    shift = U[0] - _shifted_start(S, u0, U[0])
+    path = _connecting_path(S, u0, U[0] - shift)
+    return np.vstack([path, U - shift]), path.shape[0], shift
+
+
+def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
+             discs: dict, raw_events: list, singular: np.ndarray):
+    """The sign chooser of branched step ``k``: called with the step's normalised
+    discriminant and the drawn mode, it applies the branch rules (:func:`_branch_signs`),
+    records the discriminant, events and singular rows, and returns the signs."""
+    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
+        sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
+        discs[k] = disc
+        raw_events.extend(evs)
+        singular[sing] = True
+        return sig
+    return choose
+
+
+def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
+    """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
+    events = []
+    for e in raw_events:
+        if e.index < n0:  # on the way from the drawn configuration to the sweep
+            e = e.with_(message="between the drawn configuration and the first input: " + e.message,
+                        before_sweep=True)
+        e = e.with_(index=max(0, e.index - n0))
+        if not e.before_sweep:
+            e = e.with_(input=(np.asarray(e.input) + shift).tolist())
+        events.append(e)
+    return events
+
+
+def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Normalised discriminant of step ``k`` at the inputs ``X`` (M, n_inputs), upstream
+    steps solved with their modes of the sweep rows ``rows`` (M,)."""
+    st = _State(S, X.shape[0])
+    for j in range(k):
+        s = sigmas[j]
+        _solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
+    out = []
+
+    def capture(disc: np.ndarray, s_file: float) -> float:
+        out.append(disc)
+        return 1.0
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        _solve_step(S, st, plan.steps[k], X, capture)
+    return out[0]
+
+
+def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
+    """A driver-R + RRR chain as plain numbers for :func:`_scalar_disc` (built once per
+    system and plan)."""
+    memo = _memo(S)
+    key = ("scalar", id(plan))
+    prog = memo.get(key)
+    if prog is not None:
+        return prog
+    prog = []
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            prog.append(("drive", new, k, tuple(_local(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
+                         tuple(_local(S, new, jid))))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+        prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
+                     L1s, L2s, tuple(s1), tuple(t3), tuple((s2 - s1) / L1s), tuple((t2 - t3) / L2s)))
+    memo[key] = prog
+    return prog
+
+
+def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
+    """Normalised discriminant ``h^2 / L1^2`` of RRR step ``k`` of a driver-R + RRR chain
+    at one input ``u``, the upstream groups in the modes ``sigmas`` (floats): the
+    formulas of :func:`_solve_step` in plain floats (a root search calls it a few times
+    per event; an array pass would cost a hundred times more per call)."""
+    pose: dict[int, tuple] = {}  # link -> (anchor x, y, local x, y, cos, sin)
+
+    def point(i: int, s: tuple) -> tuple:
+        if i < 0:
+            return s
+        ax, ay, lx, ly, c, sn = pose[i]
+        dx, dy = s[0] - lx, s[1] - ly
+        return ax + c * dx - sn * dy, ay + sn * dx + c * dy
+
+    for j, op in enumerate(prog):
+        if op[0] == "drive":
+            _, new, kk, sk, di, sgn, snew = op
+            P = point(kk, sk)
+            ck, sk_ = (1.0, 0.0) if kk < 0 else pose[kk][4:]
+            ct, st = math.cos(u[di]), sgn * math.sin(u[di])
+            pose[new] = (P[0], P[1], snew[0], snew[1], ck * ct - sk_ * st, sk_ * ct + ck * st)
+            continue
+        _, (k1, sa), (k3, sc), (b1, b2), L1s, L2s, s1, t3, bv1, bv2 = op
+        A, C = point(k1, sa), point(k3, sc)
+        dx, dy = C[0] - A[0], C[1] - A[1]
+        inv, f, g2 = circle_circle(dx, dy, L1s, L2s)  # the kernel of the array passes, on floats
+        disc = normalised_disc(inv, g2, L1s) if inv < math.inf else math.nan
+        if j == k:
+            return disc
+        if not g2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
+            g2 = 0.0 if disc > -1e-12 else math.nan
+        g = float(sigmas[j]) * (math.sqrt(g2) if g2 >= 0 else math.nan)
+        Bx, By = A[0] + f * dx - g * dy, A[1] + f * dy + g * dx
+        for link, P, loc, bv in ((b1, A, s1, bv1), (b2, C, t3, bv2)):
+            vx, vy = Bx - P[0], By - P[1]
+            pose[link] = (P[0], P[1], loc[0], loc[1], vx * bv[0] + vy * bv[1], vy * bv[0] - vx * bv[1])
+    return math.nan
+
+
+def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i0: int, i1: int):
+    """Discriminant of step ``k`` on the segment of inputs from row ``i0`` (t = 0) to row
+    ``i1`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar function."""
+    if plan.closed_form_rates:
+        prog = _scalar_program(S, plan)
+        sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
+        x0, dx = X[i0], X[i1] - X[i0]
+        return lambda t: _scalar_disc(prog, k, sig, x0 + t * dx)
+    rows = np.array([i0])
+    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
+
+
+def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
+                  s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
+    """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
+    from scipy.optimize import brentq
+
+    M = len(disc)
+    step = plan.steps[k]
+    group = "-".join(step.joints)
+    size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])  # inputs relative to the size
+    ok = disc > -_ZERO_DISC
+    d = np.where(ok, np.maximum(disc, 0.0), np.nan)
+
+    def f_line(i0: int, i1: int):
+        return _disc_line(S, plan, k, sigmas, X, i0, i1)
+
+    events: list = []
+    singular = np.zeros(M, bool)
+    singular[ok & (d < SINGULAR_DISC)] = True
+    breaks: list[tuple[int, str]] = []  # (row, "flip" | "reset")
+    finite = np.isfinite(disc)
+    # folds: the group's own discriminant changes sign between two rows
+    for i in np.flatnonzero(ok[1:] != ok[:-1]) + 1:
+        if not (finite[i] and finite[i - 1]):
+            continue
+        inside = i - 1 if ok[i - 1] else i
+        try:
+            t = brentq(f_line(i - 1, i), 0.0, 1.0, xtol=1e-13, rtol=4 * np.finfo(float).eps)
+        except ValueError:
+            t = 0.0 if inside == i - 1 else 1.0
+        u = X[i - 1] + t * (X[i] - X[i - 1])
+        if ok[i - 1]:
+            events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
+                                "changes sign: a dead point / limit of the working range)", u.tolist(), group))
+        else:
+            events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working range",
+                                u.tolist(), group))
+    # reassembly after a gap (own or upstream): the drawn mode
+    for i in np.flatnonzero(ok[1:] & ~ok[:-1]) + 1:
+        breaks.append((int(i), "reset"))
+        if i >= n0:
+            events.append(Event(int(i), "reassembled", f"assembles again after a gap, in the assembly mode of the "
+                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
+                                X[i].tolist(), group))
+    # bifurcations: local minima of the discriminant at zero
+    touched: list = []
+    cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
+    for i in cand.tolist():
+        t_star, dmin = _touch(S, plan, k, sigmas, X, i)
+        if dmin > 1e-10:
+            continue  # a sharp but regular turn
+        if dmin < -1e-10:  # the group folds and unfolds within one step: a short gap
+            events.append(Event(i, "dead point", f"the group {group} cannot be assembled in a short interval near "
+                                "this input (it folds and unfolds within one step): refine the input step",
+                                X[i].tolist(), group))
+            breaks.append((i + 1, "reset"))
+            continue
+        # where the crossing lies: at row i (|t| tiny), or between i and a neighbour
+        if abs(t_star) < 1e-7:
+            row, at = i + 1, i
+            singular[i] = True
+        elif t_star > 0:
+            row, at = i + 1, i + 1
+        else:
+            row, at = i, i
+        u = X[i] + t_star * (X[i + 1] - X[i]) if t_star >= 0 else X[i] + t_star * (X[i] - X[i - 1])
+        if any(abs(i - j) <= 2 and np.abs((u - v) / size).max() < 1e-8 for j, v in touched):
+            continue  # the same crossing seen from the neighbouring sample
+        touched.append((i, u))
+        if not switch:
+            breaks.append((row, "flip"))
+        events.append(Event(at, "singular", input=u.tolist(), group=group, crossed=bool(not singular[i]),
+                       message=f"change / branch point: the group {group} is folded flat here (its two "
+                                  "assembly modes meet); "
+                                  + ("the motion switches to the other branch (change_points='switch')" if switch
+                                     else "the motion continues on the branch whose velocity is continuous "
+                                          "(the drawn branch)")
+                                  + ("; velocities and accelerations are not defined at this input (null)"
+                                     if singular[i] else "")))
+    sig = np.full(M, s_file)
+    cur = s_file
+    last = 0
+    for row, kind in sorted(breaks):
+        sig[last:row] = cur
+        cur = -cur if kind == "flip" else s_file
+        last = row
+    sig[last:] = cur
+    return sig, events, singular
+
+
+def _touch(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i: int) -> tuple[float, float]:
+    """Where the discriminant of step ``k`` is least near row ``i``: (t, value), with ``t``
+    in [-1, 1] (``t < 0`` towards row i-1, ``t > 0`` towards row i+1), by Brent's method on
+    the central difference of the discriminant."""
+    from scipy.optimize import brentq
+
+    da, db = X[i] - X[i - 1], X[i + 1] - X[i]
+
+    def at(t: np.ndarray) -> np.ndarray:
+        t = np.asarray(t, float)
+        P = X[i] + np.where(t[:, None] >= 0, t[:, None] * db, t[:, None] * da)
+        return _disc_at(S, plan, k, sigmas, np.full(len(t), i), P)
+
+    h = 1e-6
+
+    def slope(t: float) -> float:
+        v = at(np.array([t - h, t + h]))
+        return float(v[1] - v[0])
+
+    ts = np.linspace(-1, 1, 9)
+    vals = at(ts)
+    j = int(np.nanargmin(vals))
+    lo, hi = ts[max(0, j - 1)], ts[min(8, j + 1)]
+    try:
+        t = brentq(slope, lo + h, hi - h, xtol=1e-12)
+    except ValueError:
+        t = float(ts[j])
+    dmin = float(at(np.array([t]))[0])
+    if abs(dmin) <= 1e-10:
+        # the minimum of a quadratic is found by its slope only to about sqrt(eps): at a
+        # tangency the signed height sqrt(Delta) is linear on each side, so the secants
+        # of sqrt(Delta) from both sides, extrapolated to zero spacing (Richardson),
+        # give its zero to round-off
+        def secant_roots(dt: float) -> float:
+            ts_ = t + np.array([-2 * dt, -dt, dt, 2 * dt])
+            f = np.sqrt(np.maximum(at(ts_), 0.0))
+            left = ts_[1] - f[1] * (ts_[1] - ts_[0]) / (f[1] - f[0])
+            right = ts_[2] - f[2] * (ts_[3] - ts_[2]) / (f[3] - f[2])
+            return 0.5 * (left + right)
+
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r1, r2 = secant_roots(1e-2), secant_roots(2e-2)
+        t_fine = (4 * r1 - r2) / 3
+        if np.isfinite(t_fine) and abs(t_fine - t) < 0.1:
+            t = float(t_fine)
+    return t, dmin

@@ -1,0 +1,105 @@
+"""The engine protocol: every planar example names the engine that ran; events are typed
+records whose JSON form is that of the former event dictionaries."""
+
+import json
+
+import numpy as np
+import pytest
+
+import mechsyn as ms
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics import engines
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.engines import PLANAR_ENGINES, Engine, first_sweep
+from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.model.mechanism import Mechanism
+from mechsyn.results import to_jsonable
+
+from kinematics_helpers import ex  # noqa: F401
+
+
+def _planar_examples():
+    out = []
+    for name in ms.examples.names():
+        try:
+            m = ms.examples.load(name)
+        except Exception:  # noqa: BLE001  (not a mechanism file)
+            continue
+        if isinstance(m, Mechanism) and m.kind == "planar" and any(j.actuated for j in m.joints):
+            out.append((name, m))
+    return out
+
+
+EXAMPLES = _planar_examples()
+
+
+def test_the_planar_engines_in_order():
+    assert [e.name for e in PLANAR_ENGINES] == ["regular pass", "tracked chain", "tracked groups", "newton"]
+    for e in PLANAR_ENGINES:
+        assert isinstance(e.name, str) and callable(e.sweep)
+
+
+@pytest.mark.parametrize("name,m", EXAMPLES, ids=[n for n, _ in EXAMPLES])
+def test_every_example_names_its_engine(name, m):
+    """``Simulation.engine`` is the engine that computed the sweep: the first of the list
+    that answers, run here by hand on the same inputs."""
+    from mechsyn.kinematics.analysis import cached_plan
+
+    j = next(j for j in m.joints if j.actuated)
+    try:
+        kp = cached_plan(m, inputs=(j.id,))
+        d = next(d for d in kp.system.drivers if d.joint == j.id)
+        x = np.linspace(0.0, 90.0, 19) if j.type == "R" else d.assembled + np.linspace(-0.02, 0.02, 9)
+        S = m.simulate({j.id: x})
+    except MechsynInputError as e:  # the file needs all its inputs (or is refused): said in one line
+        assert str(e)
+        pytest.skip(f"{name}: refused with one input")
+    assert S.engine in {e.name for e in PLANAR_ENGINES}
+    assert S.sweep.engine == S.engine
+    assert S.to_dict()["engine"] == S.engine
+    plan, U = kp.groups, S.sweep.inputs
+    tried = [e.name for e in PLANAR_ENGINES if e.sweep(S.system, plan, U, S.sweep.speeds) is not None]
+    assert tried and tried[0] == S.engine
+    assert (plan is None) == (S.engine == "newton")
+
+
+def test_an_engine_that_declines_passes_to_the_next(ex):
+    class Never:
+        name = "never"
+
+        def sweep(self, system, plan, inputs, speeds, *, change_points="keep", progress=None):
+            return None
+
+    never: Engine = Never()
+    from mechsyn.kinematics.analysis import cached_plan
+
+    kp = cached_plan(ex("kinematics/crank_rocker.yaml"), inputs=("A",))
+    U = np.radians(np.linspace(0, 360, 37))[:, None]
+    sw = first_sweep((never,) + PLANAR_ENGINES, kp.system, kp.groups, U, np.ones(1))
+    assert isinstance(sw, Sweep) and sw.engine == "regular pass"
+    assert first_sweep((never,), kp.system, kp.groups, U, np.ones(1)) is None
+    # a textbook four-bar with dead points: the regular pass declines, the tracked chain answers
+    kp = cached_plan(ex("textbook/fourbar.yaml"), inputs=("A",))
+    assert engines.RegularPass().sweep(kp.system, kp.groups, U, np.ones(1)) is None
+    assert first_sweep(PLANAR_ENGINES, kp.system, kp.groups, U, np.ones(1)).engine == "tracked chain"
+
+
+def test_events_are_typed_and_their_json_is_the_former_dicts(ex):
+    s = simulate(ex("textbook/fourbar.yaml"), {"A": np.arange(0.0, 361.0, 1.0)})
+    assert s.events and all(isinstance(e, Event) for e in s.events)
+    kinds = [e.kind for e in s.events]
+    assert kinds.count("dead point") == 2
+    d = json.loads(json.dumps(to_jsonable(s.to_dict())))
+    for e, j in zip(s.events, d["events"]):
+        assert list(j) == list(e.to_dict()) and j["kind"] == e["kind"] == e.kind
+        assert set(j) <= {"index", "kind", "input", "group", "crossed", "message", "before_sweep"}
+        assert isinstance(j["input"], dict) and set(j["input"]) == {"A"}
+    assert d["events"][0]["kind"] == "dead point" and d["events"][0]["group"] == "B-C-D"
+
+
+def test_event_json_keys():
+    e = Event(2, "limit", "too long", joint="V", value=3.5)
+    assert e.to_dict() == {"index": 2, "kind": "limit", "joint": "V", "value": 3.5, "message": "too long"}
+    e = Event(0, "singular", "folded", input=[0.1], crossed=False)
+    assert list(e.to_dict()) == ["index", "kind", "input", "crossed", "message"]
+    assert e.get("group") is None and e["crossed"] is False
