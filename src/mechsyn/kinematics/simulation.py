@@ -134,11 +134,9 @@ class Simulation(Result):
         shows the player, not a still frame); pass ``fig=plt.figure()`` to play it in a
         Matplotlib window with ``plt.show()``. ``kwargs`` go to
         :func:`mechsyn.plot.kinematics.animate_simulation` (``max_frames``, ``interval``)."""
-        from matplotlib.figure import Figure
-
         from mechsyn.plot.kinematics import animate_simulation
 
-        return animate_simulation(self, fig=Figure() if fig is None else fig, **kwargs)
+        return animate_simulation(self, fig=fig, bare=True, **kwargs)
 
     def working_ranges(self) -> list[list[float]]:
         """Runs of consecutive assembled inputs, as [first, last] values of the main input."""

@@ -305,8 +305,39 @@ def _redraw_animation(sim: Any, fig: Any, ax: Any, frames: np.ndarray, x: np.nda
     return MechanismAnimation(fig, draw, frames=list(frames), blit=False, interval=interval, title=sim.mechanism)
 
 
-def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval: float = 1000 / 15) -> Any:
+def _bare_figure() -> Any:
+    """A Matplotlib Figure outside pyplot (a notebook shows the animation's player, not a
+    still frame of it)."""
+    from matplotlib.figure import Figure
+
+    return Figure()
+
+
+def _animation_view(ax: Any, sim: Any, frames: np.ndarray, idx: np.ndarray) -> None:
+    """Fix the animation's view: everything drawn at a dozen frames, with the point paths,
+    then cleared, the limits kept (padded), equal aspect, labelled axes."""
+    for k in frames[:: max(1, len(frames) // 12)]:
+        draw_mechanism(ax, sim, k)
+    for pm in sim.points.values():
+        ax.plot(pm.position[idx, 0], pm.position[idx, 1])
+    ax.relim()
+    lo = np.array([ax.dataLim.x0, ax.dataLim.y0])
+    hi = np.array([ax.dataLim.x1, ax.dataLim.y1])
+    pad = 0.08 * max(hi - lo) + 1e-9
+    ax.clear()
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_xlabel(f"x ({_length_unit(sim)})")
+    ax.set_ylabel(f"y ({_length_unit(sim)})")
+
+
+def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval: float = 1000 / 15,
+                       bare: bool = False) -> Any:
     """The mechanism moving over the assembled inputs, tracing its points' paths.
+
+    ``bare``: without ``fig``, a bare Figure (no pyplot: a notebook shows the player).
 
     Returns a :class:`~mechsyn.plot.animation.MechanismAnimation`, a ``FuncAnimation`` that
     plays when it is a notebook cell's value and saves with ``anim.save("m.gif")`` (or
@@ -320,25 +351,10 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
         raise MechsynInputError("nothing to animate: the mechanism is not assembled at any input",
                                 hint="widen the input range")
     frames = idx[np.unique(np.linspace(0, len(idx) - 1, min(max_frames, len(idx))).astype(int))]
-    fig = figure(fig, (6.4, 5.6))
+    fig = figure(_bare_figure() if fig is None and bare else fig, (6.4, 5.6))
     ax = fig.add_subplot()
-    # the view: everything drawn at a dozen frames, with the point paths
-    for k in frames[:: max(1, len(frames) // 12)]:
-        draw_mechanism(ax, sim, k)
-    for pm in sim.points.values():
-        ax.plot(pm.position[idx, 0], pm.position[idx, 1])
-    ax.relim()
-    lo = np.array([ax.dataLim.x0, ax.dataLim.y0])
-    hi = np.array([ax.dataLim.x1, ax.dataLim.y1])
-    pad = 0.08 * max(hi - lo) + 1e-9
+    _animation_view(ax, sim, frames, idx)
     x, xlabel = _input_axis(sim)
-    ax.clear()
-    ax.set_xlim(lo[0] - pad, hi[0] + pad)
-    ax.set_ylim(lo[1] - pad, hi[1] + pad)
-    ax.set_aspect("equal")
-    ax.grid(alpha=0.3)
-    ax.set_xlabel(f"x ({_length_unit(sim)})")
-    ax.set_ylabel(f"y ({_length_unit(sim)})")
     if any(c.kind in ("curve", "belt") for c in sim.system.cons):
         return _redraw_animation(sim, fig, ax, frames, x, xlabel, interval)
     # the artists are made once and moved at each frame (no clearing, no re-layout)
