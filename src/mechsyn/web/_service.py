@@ -336,14 +336,22 @@ def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
 
 
 def atlas_mechanism(chain: dict[str, Any], frame: int | None = None, input_link: int | None = None) -> dict:
-    """A chain of the atlas as a mechanism file dict (frame and input chosen)."""
+    """A chain of the atlas as a mechanism file dict (frame and input chosen).
+
+    The chain is checked before any work (:func:`mechsyn.synthesis.chains.check_chain_dict`),
+    the frame must be one of its links and the input a link jointed to the frame.
+    """
     from mechsyn.synthesis.chains import KinematicChain
     from mechsyn.synthesis.mechanisms import mechanism_dict
 
-    try:
-        kc = KinematicChain.from_dict(chain)
-    except (KeyError, TypeError, ValueError):
-        raise MechsynInputError("not a chain of the atlas", field="chain") from None
+    kc = KinematicChain.from_dict(chain, field="chain")
+    if frame is not None and not 0 <= frame < kc.n_links:
+        raise MechsynInputError(f"link {frame} is not one of the chain's links 0..{kc.n_links - 1}", field="frame")
+    if input_link is not None:
+        beside = sorted({b if a == frame else a for a, b in kc.edges if frame in (a, b)}) if frame is not None else None
+        if not 0 <= input_link < kc.n_links or (beside is not None and input_link not in beside):
+            raise MechsynInputError(f"link {input_link} is not jointed to the frame", field="input",
+                                    hint=f"one of {beside}" if beside else None)
     return mechanism_dict(kc, frame=frame, input_link=input_link)
 
 
