@@ -54,7 +54,7 @@ _YAML_LOADER = _StrictLoader
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
+__all__ = ["is_mechanism_file", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
            "check_id_text"]
 
 #: Bidirectional controls and zero-width characters: they make two ids that look alike
@@ -310,3 +310,21 @@ def read_data(path: str | os.PathLike[str], what: str = "file",
 
     text = read_text(path, what)
     return parse_data(text, str(resolve(path)), fmt), text
+
+
+def is_mechanism_file(path: Path) -> bool:
+    """Whether ``path`` holds what a mechsyn command writes as a mechanism: an empty
+    file, a YAML/JSON mapping with ``links`` and ``joints``, or a Pyslvs expression
+    (``M[...]`` after ``#`` comment lines, for ``.pyslvs``/``.txt``). Anything
+    unreadable is not."""
+    try:
+        if path.stat().st_size == 0:
+            return True
+        text = read_text(path)
+        if path.suffix.lower() in (".pyslvs", ".txt"):  # comment lines (#), then M[...]
+            expr = "".join(ln for ln in text.splitlines() if not ln.lstrip().startswith("#")).strip()
+            return expr.startswith("M[") and expr.endswith("]")
+        data = parse_data(text, str(path))
+    except (MechsynInputError, OSError):
+        return False
+    return isinstance(data, dict) and isinstance(data.get("links"), list) and isinstance(data.get("joints"), list)

@@ -13,7 +13,13 @@ Safety of a local server (issue 15):
 * request bodies limited to :data:`MAX_BODY` bytes;
 * a Content-Security-Policy allowing only the server's own scripts, styles and data;
 * malformed requests answer 4xx with a JSON ``{"error", "field", "hint"}``; a bug answers
-  500 ``internal server error`` and the trace goes to the server's log only.
+  500 ``internal server error`` and the trace goes to the server's log only;
+* request bodies parsed strictly before any work (:func:`_body`: no NaN/Infinity, no key
+  twice, no number of thousands of digits, no lone surrogate, nesting within the limit),
+  booleans are booleans (:func:`_bool`);
+* heavy work (analyze, simulate, import, export, atlas, reading a file) runs in worker
+  processes, capped per client and in all, killed when the client disconnects
+  (:class:`mechsyn.web._jobs.HeavyRunner`, issue 27).
 
 References
 ----------
@@ -35,7 +41,7 @@ from typing import Any, Awaitable, Callable, Iterable
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
@@ -43,7 +49,8 @@ from starlette.staticfiles import StaticFiles
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 from mechsyn.web import _files, _service
-from mechsyn.web._jobs import JobTable
+from mechsyn.io.files import check_data_size, loads_json
+from mechsyn.web._jobs import Busy, ClientGone, HeavyRunner, JobTable, WorkerCrashed
 
 log = logging.getLogger("mechsyn.web")
 STATIC = Path(__file__).parent / "static"
@@ -155,6 +162,14 @@ def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitabl
                                  "element": getattr(err, "element", None)}, status_code=400)
         except HTTPException as exc:
             return _json_error(exc.status_code, str(exc.detail))
+        except Busy as exc:
+            return _json_error(429, f"busy: {exc}", hint="wait for the running computation to finish")
+        except (ClientDisconnect, ClientGone):  # nobody reads the answer: one line, no trace
+            log.info("%s %s: the client left; its work was stopped", request.method, request.url.path)
+            return _json_error(499, "client disconnected")
+        except WorkerCrashed as exc:
+            log.warning("%s %s: %s", request.method, request.url.path, exc)
+            return _json_error(500, "internal server error (the server's log has the details)")
         except Exception:
             log.exception("%s %s failed", request.method, request.url.path)
             return _json_error(500, "internal server error (the server's log has the details)")
@@ -164,12 +179,14 @@ def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitabl
 
 
 async def _body(request: Request) -> dict[str, Any]:
+    """The request's JSON object, parsed strictly (:func:`mechsyn.io.files.loads_json` with
+    finite numbers, :func:`mechsyn.io.files.check_data_size`), before any work."""
     raw = await request.body()
     try:
-        data = json.loads(raw or b"null")
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise MechsynInputError(f"the request body is not JSON ({exc})", field="body",
-                                hint="send a JSON object") from None
+        data = check_data_size(loads_json(raw or b"null", "request body", finite=True), "request body")
+    except MechsynInputError as err:
+        raise MechsynInputError(f"the request body is not acceptable JSON: {err.message}", field=err.field or "body",
+                                hint=err.hint or "send a JSON object") from None
     if not isinstance(data, dict):
         raise MechsynInputError("the request body must be a JSON object", field="body")
     return data
@@ -183,8 +200,29 @@ def _need(data: dict, key: str) -> Any:
 
 def _int(value: Any, field: str) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
-        raise MechsynInputError(f"expected a whole number, got {value!r}", field=field)
+        raise MechsynInputError(f"expected a whole number, got {str(value)[:40]!r}", field=field)
     return int(value)
+
+
+def _bool(data: dict, key: str, default: bool) -> bool:
+    """``data[key]`` when it is true or false (JSON booleans; the string "false" is refused)."""
+    value = data.get(key, default)
+    if not isinstance(value, bool):
+        raise MechsynInputError(f"must be true or false, got {str(value)[:40]!r}", field=key)
+    return value
+
+
+def _client(request: Request) -> str:
+    """Who asks, for the per-client caps: the page's ``X-Mechsyn-Client`` id, else the
+    connection (address and port)."""
+    given = request.headers.get("x-mechsyn-client", "")[:64]
+    peer = request.client
+    return given or (f"{peer.host}:{peer.port}" if peer else "?")
+
+
+async def _heavy(request: Request, name: str, *args: Any) -> Any:
+    """``_service.<name>(*args)`` as capped, cancellable work (:class:`HeavyRunner`)."""
+    return await request.app.state.heavy.call(_client(request), request.is_disconnected, name, *args)
 
 
 def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
@@ -193,9 +231,16 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
     @api
     async def route(request: Request) -> Any:
         data = await _body(request)
+        if service in HEAVY:
+            return await _heavy(request, service, _need(data, "mechanism"))
         return await run_in_threadpool(getattr(_service, service), _need(data, "mechanism"))
 
     return route
+
+
+#: Services run as capped, cancellable worker processes; the others are quick.
+HEAVY = frozenset({"analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
+                   "simulation_csv", "animation_gif", "atlas", "atlas_mechanism"})
 
 
 # each route reads the app's state (root, start, start_name, jobs) from request.app.state
@@ -225,10 +270,7 @@ async def _example(request: Request) -> Any:
 async def _simulate(request: Request) -> Any:
     data = await _body(request)
     steps = _int(data.get("steps", 180), "steps")
-    rates = data.get("rates", True)
-    if not isinstance(rates, bool):
-        raise MechsynInputError("must be true or false", field="rates")
-    return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps, None, rates)
+    return await _heavy(request, "simulate", _need(data, "mechanism"), steps, None, _bool(data, "rates", True))
 
 
 @api
@@ -242,9 +284,8 @@ async def _read_file(request: Request) -> Any:
     path = _files.resolve_inside(root, request.query_params.get("path"))
     _files.mechanism_suffix(path, suffixes=_files.READABLE_SUFFIXES)
     if not path.is_file():
-        raise MechsynInputError(f"{request.query_params.get('path')}: no such file", field="path")
-    return {"mechanism": await run_in_threadpool(_service.read_mechanism, path),
-            "name": path.relative_to(root).as_posix()}
+        raise MechsynInputError(f"{request.query_params.get('path', '')[:200]}: no such file", field="path")
+    return {"mechanism": await _heavy(request, "read_mechanism", path), "name": path.relative_to(root).as_posix()}
 
 
 @api
@@ -254,22 +295,26 @@ async def _save_file(request: Request) -> Any:
     name = _need(data, "path")
     path = _files.resolve_inside(root, name)
     suffix = _files.mechanism_suffix(path)
-    if path.exists() and not data.get("overwrite", False):
+    overwrite = _bool(data, "overwrite", False)
+    if (path.exists() or path.is_symlink()) and not overwrite:
         raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
+    mode = await run_in_threadpool(_files.may_replace, path)
     if not path.parent.is_dir():
         raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
-    text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), suffix)
-    await run_in_threadpool(write_atomic, path, text)
+    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), suffix)
+    await run_in_threadpool(write_atomic, path, text, mode)
     return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
 
 
 @api
 async def _import_text(request: Request) -> Any:
     data = await _body(request)
-    text, name = _need(data, "text"), str(data.get("filename", "upload.yaml"))
+    text, name = _need(data, "text"), data.get("filename", "upload.yaml")
     if not isinstance(text, str):
         raise MechsynInputError("must be the file's text", field="text")
-    return {"mechanism": await run_in_threadpool(_service.parse_mechanism_text, text, name), "name": name}
+    if not isinstance(name, str) or len(name) > _files.MAX_NAME:
+        raise MechsynInputError(f"must be a file name of at most {_files.MAX_NAME} characters", field="filename")
+    return {"mechanism": await _heavy(request, "parse_mechanism_text", text, name), "name": name}
 
 
 @api
@@ -277,29 +322,31 @@ async def _export_text(request: Request) -> Any:
     data = await _body(request)
     fmt = data.get("format", "yaml")
     if fmt == "csv":
-        text = await run_in_threadpool(_service.simulation_csv, _need(data, "mechanism"),
-                                       _int(data.get("steps", 180), "steps"))
+        text = await _heavy(request, "simulation_csv", _need(data, "mechanism"), _int(data.get("steps", 180), "steps"))
         return Response(text, media_type="text/csv")
     if fmt == "gif":
         frames = _int(data.get("frames", 72), "frames")
         if not 2 <= frames <= 360:
             raise MechsynInputError("frames must be within 2..360", field="frames")
-        gif = await run_in_threadpool(_service.animation_gif, _need(data, "mechanism"), frames)
+        gif = await _heavy(request, "animation_gif", _need(data, "mechanism"), frames)
         return Response(gif, media_type="image/gif")
     if fmt not in ("yaml", "json"):
-        raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json, csv or gif")
-    text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), "." + fmt)
+        raise MechsynInputError(f"unknown format {str(fmt)[:20]!r}", field="format", hint="yaml, json, csv or gif")
+    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), "." + fmt)
     return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
 
 
 @api
 async def _atlas(request: Request) -> Any:
     q = request.query_params
-    try:
-        n, f = int(q.get("links", "6")), int(q.get("mobility", "1"))
-    except ValueError:
-        raise MechsynInputError("links and mobility must be whole numbers", field="links") from None
-    return {"chains": await run_in_threadpool(_service.atlas, n, f)}
+    n, f = _query_int(q.get("links", "6"), "links"), _query_int(q.get("mobility", "1"), "mobility")
+    return {"chains": await _heavy(request, "atlas", n, f)}
+
+
+def _query_int(text: str, field: str) -> int:
+    if not (text.isascii() and text.lstrip("-").isdigit() and len(text) <= 6):
+        raise MechsynInputError(f"expected a whole number, got {text[:20]!r}", field=field)
+    return int(text)
 
 
 @api
@@ -307,9 +354,8 @@ async def _atlas_mechanism(request: Request) -> Any:
     data = await _body(request)
     frame = data.get("frame")
     inp = data.get("input")
-    mech = await run_in_threadpool(_service.atlas_mechanism, _need(data, "chain"),
-                                   None if frame is None else _int(frame, "frame"),
-                                   None if inp is None else _int(inp, "input"))
+    mech = await _heavy(request, "atlas_mechanism", _need(data, "chain"),
+                        None if frame is None else _int(frame, "frame"), None if inp is None else _int(inp, "input"))
     return {"mechanism": mech}
 
 
@@ -387,7 +433,7 @@ def _routes() -> list:
 
 
 def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, token: str | None = None,
-               allowed_hosts: Iterable[str] = LOCAL_HOSTS, start_name: str = "") -> Starlette:
+               allowed_hosts: Iterable[str] = LOCAL_HOSTS, start_name: str = "", isolate: bool = True) -> Starlette:
     """The studio as an ASGI app.
 
     Parameters
@@ -403,6 +449,9 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
         Host names this server answers to (the Host header check).
     start_name
         The file name the start mechanism came from (offered when saving).
+    isolate
+        Heavy work in worker processes (True), or in threads (False: tests that patch
+        :mod:`mechsyn.web._service`), see :class:`mechsyn.web._jobs.HeavyRunner`.
 
     Examples
     --------
@@ -419,12 +468,14 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     app.state.root = Path(root).resolve()
     app.state.start, app.state.start_name = start, start_name
     app.state.jobs = JobTable()
+    app.state.heavy = HeavyRunner(isolate=isolate)
     app.add_middleware(Guard, token=app.state.token, allowed_hosts=allowed_hosts)
     return app
 
 
 @contextlib.asynccontextmanager
 async def _lifespan(app: Starlette):
+    await asyncio.get_running_loop().run_in_executor(None, app.state.heavy.warm)
     yield
     app.state.jobs.cancel_all()
 

@@ -11,6 +11,7 @@ import csv
 import functools
 import io
 import math
+import re
 from pathlib import Path
 from typing import Any, Callable
 
@@ -64,7 +65,11 @@ def _examples(root: Path | None) -> tuple[dict[str, str], ...]:
 
 
 def example_path(name: str) -> Path:
-    """The file of example ``name`` (its file stem, e.g. ``fourbar``)."""
+    """The file of example ``name`` (its file stem, e.g. ``fourbar``: letters, digits, ``_``
+    and ``-`` only, so that a name is never a glob pattern such as ``*``)."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_-]{1,80}", name):
+        raise MechsynInputError(f"no example named {name[:80]!r}", field="example",
+                                hint="an example's name has letters, digits, _ and - only, e.g. fourbar")
     root = _examples_dir()
     hits = [p for p in root.rglob(f"{name}.*") if p.suffix in EXAMPLE_SUFFIXES] if root else []
     if not hits:
