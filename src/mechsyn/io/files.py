@@ -140,9 +140,11 @@ def _bracket_depth(text: str) -> int:
     return deepest
 
 
-def check_data_size(data: Any, source: str) -> Any:
+def check_data_size(data: Any, source: str, hidden: bool = True) -> Any:
     """Refuse data nested deeper than the limit ``nesting`` or with more than
-    ``values`` values (counted through shared YAML aliases); return ``data``."""
+    ``values`` values (counted through shared YAML aliases), and strings that are not text
+    (lone surrogates) or, with ``hidden``, ids holding invisible characters
+    (:func:`check_id_text`); return ``data``."""
     deepest, budget = limit("nesting"), limit("values")
     stack: list[tuple[Any, int, str]] = [(data, 1, "")]
     seen = 0
@@ -154,7 +156,7 @@ def check_data_size(data: Any, source: str) -> Any:
                 f"more than {budget:,} values (YAML aliases expanding into too many items?)",
                 source=source, hint="write the data out without aliases; " + limit_hint("values"))
         if isinstance(node, str):
-            check_id_text(node, source, key, free=key in FREE_TEXT_KEYS)
+            check_id_text(node, source, key, free=not hidden or key in FREE_TEXT_KEYS)
             continue
         if isinstance(node, dict):
             children = [(k, depth + 1, key) for k in node] + [(v, depth + 1, str(k)) for k, v in node.items()]

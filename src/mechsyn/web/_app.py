@@ -183,7 +183,7 @@ async def _body(request: Request) -> dict[str, Any]:
     finite numbers, :func:`mechsyn.io.files.check_data_size`), before any work."""
     raw = await request.body()
     try:
-        data = check_data_size(loads_json(raw or b"null", "request body", finite=True), "request body")
+        data = check_data_size(loads_json(raw or b"null", "request body", finite=True), "request body", hidden=False)
     except MechsynInputError as err:
         raise MechsynInputError(f"the request body is not acceptable JSON: {err.message}", field=err.field or "body",
                                 hint=err.hint or "send a JSON object") from None

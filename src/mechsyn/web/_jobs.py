@@ -192,8 +192,9 @@ class HeavyRunner:
         self.per_client, self.queue, self.isolate = per_client, queue, isolate
         self.running: dict[str, int] = {}
         self.waiting: dict[str, int] = {}
-        self.started = 0  # workers started since launch (the tests read it)
-        self._cond: asyncio.Condition | None = None
+        self.started = 0  # workers started since launch
+        self.procs: set = set()  # the worker processes running now
+        self._lock = threading.Lock()
         self._ctx = _context() if isolate else None
 
     def warm(self) -> None:
@@ -203,31 +204,32 @@ class HeavyRunner:
 
             forkserver.ensure_running()
 
+    def _take(self, client: str) -> bool:
+        with self._lock:
+            if self.running.get(client, 0) >= self.per_client or sum(self.running.values()) >= self.total:
+                return False
+            self.running[client] = self.running.get(client, 0) + 1
+            return True
+
     async def call(self, client: str, gone: Callable[[], Any], name: str, *args: Any) -> Any:
         """``_service.<name>(*args)`` for ``client``; ``gone()`` (awaitable) tells a disconnect."""
-        if self._cond is None:
-            self._cond = asyncio.Condition()
-        if self.waiting.get(client, 0) + self.running.get(client, 0) >= self.queue:
-            raise Busy(f"{self.queue} computations of this client are waiting or running already")
-        self.waiting[client] = self.waiting.get(client, 0) + 1
+        with self._lock:
+            if self.waiting.get(client, 0) + self.running.get(client, 0) >= self.queue:
+                raise Busy(f"{self.queue} computations of this client are waiting or running already")
+            self.waiting[client] = self.waiting.get(client, 0) + 1
         try:
-            async with self._cond:
-                while self.running.get(client, 0) >= self.per_client or sum(self.running.values()) >= self.total:
-                    if await gone():
-                        raise ClientGone(name)
-                    try:
-                        await asyncio.wait_for(self._cond.wait(), 0.25)
-                    except asyncio.TimeoutError:
-                        pass
-                self.running[client] = self.running.get(client, 0) + 1
+            while not self._take(client):  # a free slot is polled: no event-loop-bound primitive
+                if await gone():
+                    raise ClientGone(name)
+                await asyncio.sleep(0.05)
         finally:
-            self.waiting[client] -= 1
+            with self._lock:
+                self.waiting[client] -= 1
         try:
             return await (self._in_process(gone, name, args) if self.isolate else self._in_thread(name, args))
         finally:
-            self.running[client] -= 1
-            async with self._cond:
-                self._cond.notify_all()
+            with self._lock:
+                self.running[client] -= 1
 
     async def _in_thread(self, name: str, args: tuple) -> Any:
         from starlette.concurrency import run_in_threadpool
@@ -242,6 +244,7 @@ class HeavyRunner:
         proc = self._ctx.Process(target=_worker, args=(child, name, args), daemon=True, name=f"mechsyn-{name}")
         await loop.run_in_executor(None, proc.start)
         self.started += 1
+        self.procs.add(proc)
         child.close()
         ready = asyncio.Event()
         loop.add_reader(parent.fileno(), ready.set)
@@ -264,6 +267,7 @@ class HeavyRunner:
             if proc.is_alive():
                 proc.kill()
             await loop.run_in_executor(None, proc.join, 5)
+            self.procs.discard(proc)
         return _unpack(kind, payload, name)
 
 
