@@ -35,6 +35,7 @@ import functools
 import json
 import logging
 import secrets
+import threading
 from pathlib import Path
 from typing import Any, Awaitable, Callable, Iterable
 
@@ -59,6 +60,8 @@ LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
        "connect-src 'self'; font-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'")
 TOKEN_HEADER = "x-mechsyn-token"
+#: Seconds the server waits for each part of a request body.
+BODY_TIMEOUT = 30
 
 
 # --------------------------------------------------------------------------- middleware
@@ -111,13 +114,19 @@ class Guard:
         return None
 
     def _limited(self, receive: Callable) -> Callable:
-        seen = 0
+        seen, complete = 0, False
 
         async def wrapped() -> dict:
-            nonlocal seen
-            message = await receive()
+            nonlocal seen, complete
+            if complete:  # waiting for a disconnect (event streams): no deadline
+                return await receive()
+            try:  # the body within BODY_TIMEOUT s of each part (a trickling client is dropped)
+                message = await asyncio.wait_for(receive(), BODY_TIMEOUT)
+            except asyncio.TimeoutError:
+                raise ClientDisconnect() from None
             if message["type"] == "http.request":
                 seen += len(message.get("body", b""))
+                complete = not message.get("more_body", False)
                 if seen > self.max_body:
                     raise HTTPException(413, f"request body over {self.max_body // 1024} KiB")
             return message
@@ -389,7 +398,7 @@ async def _job_events(request: Request) -> Any:
     async def stream():
         seen = -1
         while True:
-            if await request.is_disconnected():
+            if await request.is_disconnected() or request.app.state.stopping.is_set():
                 return
             if job.version != seen:
                 seen = job.version
@@ -469,6 +478,7 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     app.state.start, app.state.start_name = start, start_name
     app.state.jobs = JobTable()
     app.state.heavy = HeavyRunner(isolate=isolate)
+    app.state.stopping = threading.Event()  # set by the first SIGINT/SIGTERM (run_server)
     app.add_middleware(Guard, token=app.state.token, allowed_hosts=allowed_hosts)
     return app
 
@@ -480,8 +490,64 @@ async def _lifespan(app: Starlette):
     app.state.jobs.cancel_all()
 
 
-def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> None:
-    """Serve ``app`` with uvicorn until interrupted."""
+#: Seconds a client may take to send its request head (and to keep an idle connection).
+HEADER_TIMEOUT = 10
+#: Connections and requests at once; uvicorn answers 503 beyond (descriptors stay free).
+MAX_CONNECTIONS = 200
+
+
+def _header_timeout_protocol():
+    """uvicorn's h11 protocol closing a connection whose request head has not arrived
+    within :data:`HEADER_TIMEOUT` s (uvicorn's own keep-alive timer starts only after a
+    first response: about 1,100 silent connections locked a studio out)."""
+    from uvicorn.protocols.http.h11_impl import H11Protocol
+
+    class Protocol(H11Protocol):
+        def connection_made(self, transport: Any) -> None:
+            super().connection_made(transport)
+            self._head_timer = self.loop.call_later(HEADER_TIMEOUT, self._head_late)
+
+        def _head_late(self) -> None:
+            if self.cycle is None and not self.transport.is_closing():
+                self.transport.close()
+
+        def handle_events(self) -> None:
+            super().handle_events()
+            if self.cycle is not None:
+                self._head_timer.cancel()
+
+        def connection_lost(self, exc: Exception | None) -> None:
+            self._head_timer.cancel()
+            super().connection_lost(exc)
+
+    return Protocol
+
+
+def server_config(app: Starlette, host: str = "127.0.0.1", port: int = 8765):
+    """uvicorn's settings for the studio: the request head within :data:`HEADER_TIMEOUT` s
+    (the body: :data:`BODY_TIMEOUT`, in :class:`Guard`), idle connections closed after as
+    long, at most :data:`MAX_CONNECTIONS` at once, one second to finish on exit."""
     import uvicorn
 
-    uvicorn.run(app, host=host, port=port, log_level="warning")
+    return uvicorn.Config(app, host=host, port=port, log_level="warning", http=_header_timeout_protocol(),
+                          timeout_keep_alive=HEADER_TIMEOUT, limit_concurrency=MAX_CONNECTIONS,
+                          timeout_graceful_shutdown=1, h11_max_incomplete_event_size=64 * 1024)
+
+
+def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> None:
+    """Serve ``app`` with uvicorn until SIGINT or SIGTERM.
+
+    The first signal stops the server at once, whatever is open (event streams, long
+    requests, worker processes: cancelled), and is raised again once uvicorn has
+    restored the previous handlers: Ctrl-C becomes ``KeyboardInterrupt`` (exit 130 on
+    the command line), SIGTERM the command line's 143.
+    """
+    import uvicorn
+
+    class _Server(uvicorn.Server):
+        def handle_exit(self, sig: int, frame: Any) -> None:
+            super().handle_exit(sig, frame)
+            app.state.stopping.set()  # event streams end now; other requests get 1 s, then are cancelled
+            app.state.jobs.cancel_all()
+
+    _Server(server_config(app, host, port)).run()
