@@ -340,3 +340,33 @@ def test_a_dropped_upload_logs_one_line(tmp_path, caplog, fourbar):
     finally:
         srv.stop()
     assert not [r for r in caplog.records if r.exc_info], [r.getMessage() for r in caplog.records if r.exc_info]
+
+
+def test_a_silent_connection_is_closed_and_others_served(tmp_path, monkeypatch):
+    """No header read timeout before: about 1,100 half-open connections locked a studio out."""
+    import threading
+
+    import httpx
+    import uvicorn
+
+    from mechsyn.web import _app, create_app
+    from web_helpers import free_port
+
+    monkeypatch.setattr(_app, "HEADER_TIMEOUT", 0.5)
+    port = free_port()
+    server = uvicorn.Server(_app.server_config(create_app(tmp_path, token=TOKEN), port=port))
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    try:
+        _wait_for(lambda: server.started, "the server listens")
+        silent = [socket.create_connection(("127.0.0.1", port)) for _ in range(3)]
+        silent[0].sendall(b"GET /api/examples HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # a head never finished
+        for s in silent:
+            s.settimeout(60)  # only ends a broken run
+            assert s.recv(1024) == b""  # closed by the server
+            s.close()
+        r = httpx.get(f"http://127.0.0.1:{port}/api/examples", headers={"X-Mechsyn-Token": TOKEN}, timeout=60)
+        assert r.status_code == 200
+    finally:
+        server.should_exit = True
+        thread.join(timeout=30)

@@ -95,7 +95,11 @@ class Guard:
         await self.app(scope, self._limited(receive), _secure_send(send, scope))
 
     def _check(self, scope: dict, headers: dict[str, str]) -> Response | None:
-        if _hostname(headers.get("host", "")) not in self.hosts:
+        host = _hostname(headers.get("host", ""))
+        server = (scope.get("server") or ("",))[0] or ""
+        # the address the connection came in on is this server's own (--host 0.0.0.0 reached
+        # at 192.168.1.5); a name is accepted only when listed (DNS rebinding uses names)
+        if host not in self.hosts and not (host and host == server.lower().strip("[]")):
             return _json_error(403, "this server answers only to its own address (Host header refused)",
                                hint="open the URL that `mechsyn serve` printed")
         if scope["path"].startswith("/api/"):
