@@ -84,7 +84,9 @@ def read_mechanism(path: Path) -> dict[str, Any]:
     from mechsyn.io import load_mechanism, mechanism_to_dict
 
     if path.suffix.lower() == ".pyslvs":
-        return parse_mechanism_text(path.read_text(encoding="utf-8"), path.name)
+        from mechsyn.io.files import read_text
+
+        return parse_mechanism_text(read_text(path, "Pyslvs file"), path.name)
     return mechanism_to_dict(load_mechanism(path))
 
 
