@@ -918,6 +918,8 @@ def _read_done(path: Path, header: dict) -> dict[str, list[KinematicChain]]:
                 record = json.loads(line)
             except json.JSONDecodeError:
                 break  # torn last line of an interrupted run
+            if not isinstance(record, dict):
+                raise _damaged_line(path, number, "not a JSON object")
             if number == 1:
                 if record != header:
                     raise MechsynInputError(
@@ -927,17 +929,30 @@ def _read_done(path: Path, header: dict) -> dict[str, list[KinematicChain]]:
                     )
                 continue
             if "done" in record:
+                if not isinstance(record["done"], str):
+                    raise _damaged_line(path, number, "'done' names no assortment")
                 done[record["done"]] = pending
                 pending = []
             else:
-                pending.append(KinematicChain.from_dict(record))
+                try:
+                    pending.append(KinematicChain.from_dict(record, field=f"line {number}"))
+                except MechsynInputError as err:
+                    raise _damaged_line(path, number, f"{err.field}: {err.message}") from None
     return done
+
+
+def _damaged_line(path: Path, number: int, what: str) -> MechsynInputError:
+    return MechsynInputError(f"damaged chain stream: {what}", source=str(path), line=number,
+                             hint="delete the file (or give another) and run the enumeration again")
 
 
 def read_chain_stream(path: str | os.PathLike[str]) -> list[KinematicChain]:
     """Chains of a (possibly partial) stream file, completed assortments only."""
     path = Path(path)
-    with open(path, encoding="utf-8") as fh:
-        header = json.loads(fh.readline())
+    try:
+        with open(path, encoding="utf-8") as fh:
+            header = json.loads(fh.readline())
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise _damaged_line(path, 1, "the header is not JSON") from None
     done = _read_done(path, header)
     return [c for cs in done.values() for c in cs]
