@@ -172,3 +172,12 @@ def test_a_truncated_curve_cache_file_is_one_error_then_rebuilt(tmp_path):
         load_database(tmp_path, max_links=4)
     build_database(tmp_path, max_links=4, per_topology=30)  # builds it again
     assert len(load_database(tmp_path, max_links=4)) > 0
+
+
+def test_hidden_characters_are_stripped_from_displayed_names(run_cli, tmp_path):
+    """A right-to-left override in a name reordered the terminal's line."""
+    f = tmp_path / "m.yaml"
+    f.write_text(yaml.safe_dump({**FOURBAR, "name": "four\u202e bar\u200b"}, allow_unicode=True))
+    code, out, err = run_cli("analyze", f)
+    assert code == 0 and "four bar" in out
+    assert not any(c in out for c in "\u202e\u200b")

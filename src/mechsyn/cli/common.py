@@ -20,7 +20,7 @@ from rich.table import Table as RichTable
 from rich.markup import escape
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.io.files import is_mechanism_file
+from mechsyn.io.files import HIDDEN_CHARS, is_mechanism_file
 from mechsyn.results import dumps, write_atomic
 
 T = TypeVar("T")
@@ -37,12 +37,14 @@ SchedulerOpt = Annotated[Optional[str], typer.Option(
 ForceOpt = Annotated[bool, typer.Option(
     "--force", help="Replace an existing output file even when it is not a mechanism file.")]
 
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+#: control characters, and the bidirectional controls and zero-width characters that
+#: reorder or hide what a terminal shows (a name could show a μ of 90.0° as "0.09°")
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]|" + HIDDEN_CHARS.pattern)
 
 
 def strip_control(text: str) -> str:
-    """``text`` without control characters (escape sequences, bells, backspaces...);
-    newlines and tabs are kept.
+    """``text`` without control characters (escape sequences, bells, backspaces...) nor
+    bidirectional controls and zero-width characters; newlines and tabs are kept.
 
     >>> strip_control("a\x1b[31mred\x07")
     'a[31mred'
