@@ -554,4 +554,7 @@ def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> Non
             app.state.stopping.set()  # event streams end now; other requests get 1 s, then are cancelled
             app.state.jobs.cancel_all()
 
-    _Server(server_config(app, host, port)).run()
+    try:
+        _Server(server_config(app, host, port)).run()
+    finally:
+        app.state.heavy.stop()

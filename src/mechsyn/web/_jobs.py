@@ -211,6 +211,21 @@ class HeavyRunner:
             self.running[client] = self.running.get(client, 0) + 1
             return True
 
+    def stop(self) -> None:
+        """Stop the fork server now (SIGKILL: it holds no state, and its own exit, with the
+        preloaded modules, took seconds on a loaded machine while it kept the terminal's
+        pipes open). The next :meth:`warm` or call starts a new one."""
+        if self._ctx is None or self._ctx.get_start_method() != "forkserver":
+            return
+        from multiprocessing import forkserver
+
+        pid = getattr(forkserver._forkserver, "_forkserver_pid", None)  # CPython's private state
+        if pid:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
     async def call(self, client: str, gone: Callable[[], Any], name: str, *args: Any) -> Any:
         """``_service.<name>(*args)`` for ``client``; ``gone()`` (awaitable) tells a disconnect."""
         with self._lock:
