@@ -170,6 +170,7 @@ def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitabl
     async def wrapped(request: Request) -> Response:
         try:
             out = await fn(request)
+            return out if isinstance(out, Response) else _json_response(out)
         except MechsynInputError as err:
             return JSONResponse({"error": err.message, "field": err.field, "hint": err.hint,
                                  "element": getattr(err, "element", None)}, status_code=400)
@@ -186,9 +187,17 @@ def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitabl
         except Exception:
             log.exception("%s %s failed", request.method, request.url.path)
             return _json_error(500, "internal server error (the server's log has the details)")
-        return out if isinstance(out, Response) else JSONResponse(out)
 
     return wrapped
+
+
+def _json_response(out: Any) -> Response:
+    """``out`` as JSON; text that is not valid UTF-8 (a lone surrogate echoed from a URL)
+    escaped as ``\\uXXXX`` instead of failing outside the route's error handling."""
+    try:
+        return JSONResponse(out)
+    except UnicodeEncodeError:
+        return Response(json.dumps(out, ensure_ascii=True, allow_nan=False), media_type="application/json")
 
 
 async def _body(request: Request) -> dict[str, Any]:

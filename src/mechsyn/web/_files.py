@@ -38,7 +38,7 @@ def resolve_inside(root: Path, name: object, field: str = "path") -> Path:
     if len(name) > MAX_NAME or any(len(part.encode("utf-8", "surrogatepass")) > 255 for part in name.split("/")):
         raise MechsynInputError(f"the name is too long (at most {MAX_NAME} characters, 255 bytes a part)",
                                 field=field, hint="give a shorter name")
-    if "\x00" in name or "\\" in name:
+    if "\x00" in name or "\\" in name or any("\ud800" <= c <= "\udfff" for c in name):
         raise MechsynInputError("the name has a forbidden character", field=field, hint="use / between folders")
     p = PurePosixPath(name)
     if p.is_absolute() or (len(name) > 1 and name[1] == ":"):
