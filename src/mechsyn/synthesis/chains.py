@@ -372,8 +372,8 @@ def _assortment(d: dict, n: int, edges: list, field: str) -> dict[int, int]:
         counts[v] = counts.get(v, 0) + 1
     given = d["assortment"]
     if not isinstance(given, dict) or {str(k): v for k, v in given.items()} != {str(k): v for k, v in counts.items()}:
-        raise MechsynInputError(f"does not match the joints (links by number of joints: {dict(sorted(counts.items()))})",
-                                field=f"{field}.assortment")
+        raise MechsynInputError("does not match the joints (links by number of joints: "
+                                f"{dict(sorted(counts.items()))})", field=f"{field}.assortment")
     return dict(sorted(counts.items()))
 
 
