@@ -370,3 +370,22 @@ def test_a_silent_connection_is_closed_and_others_served(tmp_path, monkeypatch):
     finally:
         server.should_exit = True
         thread.join(timeout=30)
+
+
+def test_a_worker_that_dies_is_a_500_and_the_server_lives(client):
+    """A crash in native code (bliss aborted the whole studio) now ends one worker only."""
+    import threading
+
+    runner = client.app.state.heavy
+    six = mechanism_to_dict(load_mechanism(example_path("watt_sixbar")))
+    answer = {}
+    t = threading.Thread(target=lambda: answer.setdefault("r", client.post(
+        "/api/export", json={"mechanism": six, "format": "gif", "frames": 360})))
+    t.start()
+    _wait_for(lambda: len(runner.procs) == 1, "the GIF worker started")
+    (worker,) = runner.procs
+    os.kill(worker.pid, signal.SIGKILL)  # as an abort in native code would end it
+    t.join()
+    r = answer["r"]
+    assert r.status_code == 500 and r.json()["error"].startswith("internal server error")
+    assert client.get("/api/examples").status_code == 200
