@@ -143,6 +143,8 @@ def _worker(conn, name: str, args: tuple) -> None:
     ("input", error fields) or ("bug", traceback text)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the server's to handle
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(os, "nice"):
+        os.nice(10)  # the server's own process (answering other clients) goes first for the CPU
     from mechsyn.web import _service
 
     try:
