@@ -251,7 +251,11 @@ def test_a_finished_jobs_seconds_stay(monkeypatch):
     from mechsyn.web import _jobs
 
     now = [100.0]
-    monkeypatch.setattr(_jobs.time, "monotonic", lambda: now[0])
+
+    class Clock:  # every clock the jobs may read, stopped at now[0]
+        time = monotonic = staticmethod(lambda: now[0])
+
+    monkeypatch.setattr(_jobs, "time", Clock)
     job = _jobs.Job("1", "k", lambda params, progress: {"ok": True}, {})
     job._run(lambda params, progress: {"ok": True}, {})  # finished at t = 100
     now[0] = 250.0
