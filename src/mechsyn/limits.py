@@ -36,6 +36,7 @@ DEFAULTS: dict[str, tuple[float, str]] = {
     "links": (2_000, "links of a mechanism file (analysis time grows as the cube)"),
     "joints": (4_000, "joints of a mechanism file"),
     "atlas_links": (14, "links of an atlas enumeration (the count grows ~46-fold per 2 links)"),
+    "arm_joints": (100, "joints of an arm file (capability maps grow with the joints squared)"),
 }
 
 _overrides: dict[str, float] = {}

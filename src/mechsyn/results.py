@@ -67,11 +67,11 @@ def _umask_mode() -> int:
     return 0o666 & ~mask
 
 
-def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
+def write_atomic(path: str | os.PathLike[str], data: str | bytes, permissions: int | None = None) -> None:
     """Write ``data`` to ``path`` whole or not at all (temporary file, then rename).
 
     The file gets the permissions an ordinary new file would (the umask's), not the
-    temporary file's 0600.
+    temporary file's 0600, or ``permissions`` when given (e.g. the replaced file's own).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -80,7 +80,7 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     try:
         with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8"})) as fh:
             fh.write(data)
-        os.chmod(tmp, _umask_mode())
+        os.chmod(tmp, _umask_mode() if permissions is None else permissions)
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -135,3 +135,39 @@ def test_cli_checkpoint_then_resume(run_cli, case, uninterrupted, tmp_path, monk
     assert code == 0, err
     resumed = json.loads(out)
     assert resumed["design"] == json.loads(dumps(uninterrupted))["design"]
+
+
+@pytest.mark.parametrize("damage", ["no_notes", "design_text", "stopped_text", "variant_list"])
+def test_a_damaged_variant_record_is_one_error_naming_it(case, saved, damage):
+    """Issue 27: a damaged record gave a traceback (KeyError, TypeError) on --resume."""
+    data = json.loads(saved.read_text())
+    rec = data["done"]["S1"]
+    if damage == "no_notes":
+        del rec["notes"]
+    elif damage == "design_text":
+        rec["variant"]["design"] = "oops"
+    elif damage == "stopped_text":
+        rec["stopped"] = "no"
+    else:
+        rec["variant"] = [1, 2]
+    saved.write_text(json.dumps(data))
+    with pytest.raises(MechsynInputError, match="damaged record of VLL S1") as err:
+        fd.design_finger(case, seed=0, checkpoint=saved, resume=True)
+    assert err.value.field == "done.S1"
+
+
+def test_a_forged_variant_record_is_not_believed(case, uninterrupted, saved):
+    """Issue 27: forged results in a checkpoint were reported as feasible: now only the design
+    vectors are read back and every claim is computed again from them."""
+    data = json.loads(saved.read_text())
+    rec = data["done"]["S1"]["variant"]
+    rec.update(error_rms=0.0, error_max=0.0, assembled_at_all_targets=True,
+               vll_ranges={j: [0.0, 1e9] for j in rec["vll_ranges"]})
+    rec["forces"]["criterion"] = -1e9
+    saved.write_text(json.dumps(data))
+    resumed = fd.design_finger(case, seed=0, checkpoint=saved, resume=True)
+    assert _same(resumed, uninterrupted)  # the forged numbers are gone
+    rec["design"] = {k: 1e12 for k in rec["design"]}  # outside the bounds
+    saved.write_text(json.dumps(data))
+    with pytest.raises(MechsynInputError, match="outside the case's bounds"):
+        fd.design_finger(case, seed=0, checkpoint=saved, resume=True)

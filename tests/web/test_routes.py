@@ -141,13 +141,17 @@ def test_unknown_route_is_json_404(client):
     assert r.status_code == 404 and r.headers["content-type"].startswith("application/json")
 
 
-def test_a_bug_answers_500_without_trace(client, monkeypatch):
-    from mechsyn.web import _service
+def test_a_bug_answers_500_without_trace(tmp_path, monkeypatch):
+    from starlette.testclient import TestClient
+
+    from mechsyn.web import _service, create_app
 
     def boom(*a, **k):
         raise RuntimeError("secret internals")
 
     monkeypatch.setattr(_service, "analyze", boom)
+    client = TestClient(create_app(tmp_path, token=TOKEN, isolate=False), base_url="http://127.0.0.1",
+                        headers={"X-Mechsyn-Token": TOKEN})  # threads: the patch is seen
     r = client.post("/api/analyze", json={"mechanism": {}})
     assert r.status_code == 500 and "secret" not in r.text and "Traceback" not in r.text
 

@@ -153,6 +153,8 @@ def arm_from_dict(data: dict, source: str | None = None, base_dir: Path | None =
     except ValueError as exc:
         raise MechsynInputError(str(exc), source=source, hint=ARM_HINT) from None
     try:
+        _check_joint_count(len(spec.link_lengths) if isinstance(spec, PlanarSerialSpec)
+                           else len(spec.dh) if isinstance(spec, DHSpec) else 0)
         if isinstance(spec, PlanarSerialSpec):
             return _build_planar(spec)
         if isinstance(spec, DHSpec):
@@ -182,6 +184,75 @@ def load_arm(path: str | Path) -> SerialArm:
                              source=str(path), base_dir=path.parent)
     data = parse_data(text, str(path), fmt="yaml")
     return arm_from_dict(data, source=str(path), base_dir=path.parent)
+
+
+def _check_joint_count(n: int, source: str | None = None) -> None:
+    """Refuse more joints than the limit ``arm_joints`` before any array is built (10^4
+    joints tried to allocate 95 GiB)."""
+    from mechsyn.limits import limit, limit_hint
+
+    if n > limit("arm_joints"):
+        raise MechsynInputError(f"{n:,} joints: more than the limit of {limit('arm_joints'):,}", source=source,
+                                hint=limit_hint("arm_joints"))
+
+
+def _urdf_root(path: Path) -> ET.Element:
+    """The URDF's XML root: a regular file within ``file_bytes`` (:func:`mechsyn.io.files.read_limited`)."""
+    from mechsyn.io.files import read_limited
+
+    data = read_limited(path, "URDF file")
+    try:
+        return ET.fromstring(data)
+    except ET.ParseError as exc:
+        raise MechsynInputError(f"cannot read URDF: {exc}", source=str(path),
+                                hint="give a well-formed URDF file (its path is relative to the arm file)") from None
+
+
+def _urdf_chain(joints: dict, children: dict, base: str | None, tip: str | None, src: str,
+                source: str | None) -> list:
+    """The joints from ``base`` to ``tip`` (the only chain when ``tip`` is None); a joint
+    cycle is refused naming the joint that closes it (it looped forever before)."""
+    if tip is None:  # follow the only chain
+        tip, seen = base, {base}
+        while children.get(tip):
+            if len(children[tip]) > 1:
+                raise MechsynInputError(f"link {tip!r} branches", source=source, field="tip_link",
+                                        hint="give tip_link: the URDF link that carries the tool")
+            nxt = children[tip][0]
+            if nxt in seen:
+                raise _cycle(joints[nxt], src)
+            tip = nxt
+            seen.add(tip)
+    chain, link, seen = [], tip, {tip}
+    while link != base:
+        if link not in joints and base is None:
+            break
+        if link not in joints:
+            raise MechsynInputError(f"no chain from {base!r} to {tip!r}", source=src,
+                                    hint=f"give as tip_link a link below {base!r} in the URDF")
+        chain.append(joints[link])
+        link = joints[link].find("parent").get("link")
+        if link in seen:
+            raise _cycle(chain[-1], src)
+        seen.add(link)
+    chain.reverse()
+    return chain
+
+
+def _cycle(joint: ET.Element, src: str) -> MechsynInputError:
+    return MechsynInputError(f"joint {joint.get('name')!r} closes a cycle of joints", source=src,
+                             hint="a URDF is a tree: remove the joint that closes the loop")
+
+
+def _urdf_axis(joint: ET.Element, src: str) -> np.ndarray:
+    """The unit axis of a URDF joint (default x); a zero or non-finite axis is refused."""
+    ax = joint.find("axis")
+    axis = np.array([float(v) for v in (ax.get("xyz", "1 0 0") if ax is not None else "1 0 0").split()])
+    norm = float(np.linalg.norm(axis)) if axis.shape == (3,) else 0.0
+    if not (math.isfinite(norm) and norm > 0):
+        raise MechsynInputError(f"joint {joint.get('name')!r}: axis {' '.join(map(str, axis))!r} has no direction",
+                                source=src, hint="give <axis xyz=\"x y z\"/> with three numbers, not all zero")
+    return axis / norm
 
 
 def _limits(spec: _Spec, rev: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -239,11 +310,8 @@ def _build_dh(spec: DHSpec) -> SerialArm:
 def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm:
     path = (base_dir / spec.urdf) if not Path(spec.urdf).is_absolute() else Path(spec.urdf)
     src = str(path)
-    try:
-        root = ET.parse(path).getroot()
-    except (OSError, ET.ParseError) as exc:
-        raise MechsynInputError(f"cannot read URDF: {exc}", source=src,
-                                hint="give a well-formed URDF file (its path is relative to the arm file)") from None
+    root = _urdf_root(path)
+    _check_joint_count(len(root.findall("joint")), src)
     joints = {}
     children = {}
     for j in root.findall("joint"):
@@ -255,26 +323,12 @@ def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm
         children.setdefault(parent.get("link"), []).append(child.get("link"))
     links = [lk.get("name") for lk in root.findall("link")]
     base = spec.base_link or next((lk for lk in links if lk not in joints), None)
+    if base is None and joints:  # every link has a parent: the chain of parents cycles
+        _urdf_chain(joints, children, None, next(iter(joints)), src, source)
     if base is None:
         raise MechsynInputError("no base link (every link has a parent joint)", source=src,
                                 hint="a URDF is a tree: remove the joint that closes a loop")
-    tip = spec.tip_link
-    if tip is None:  # follow the only chain
-        tip = base
-        while children.get(tip):
-            if len(children[tip]) > 1:
-                raise MechsynInputError(f"link {tip!r} branches", source=source, field="tip_link",
-                                        hint="give tip_link: the URDF link that carries the tool")
-            tip = children[tip][0]
-    chain = []
-    link = tip
-    while link != base:
-        if link not in joints:
-            raise MechsynInputError(f"no chain from {base!r} to {tip!r}", source=src,
-                                    hint=f"give as tip_link a link below {base!r} in the URDF")
-        chain.append(joints[link])
-        link = joints[link].find("parent").get("link")
-    chain.reverse()
+    chain = _urdf_chain(joints, children, base, spec.tip_link, src, source)
     s = spec.length_scale
     fixed = [np.eye(4)]
     axes, types, names, lims, vels = [], [], [], [], []
@@ -289,9 +343,7 @@ def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm
         if jtype not in ("revolute", "continuous", "prismatic"):
             raise MechsynInputError(f"joint {j.get('name')!r}: type {jtype!r} not supported",
                                     source=src, hint="revolute, continuous, prismatic or fixed")
-        ax = j.find("axis")
-        axis = np.array([float(v) for v in (ax.get("xyz") if ax is not None else "1 0 0").split()])
-        axes.append(axis / np.linalg.norm(axis))
+        axes.append(_urdf_axis(j, src))
         rev = jtype != "prismatic"
         types.append("R" if rev else "P")
         names.append(j.get("name"))

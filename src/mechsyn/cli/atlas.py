@@ -15,10 +15,16 @@ from mechsyn.results import write_atomic
 MAX_DRAWN = 600
 
 
-def _check_files(out: Path | None, stream: Path | None, mechanisms: Path | None) -> None:
+def _check_files(out: Path | None, stream: Path | None, mechanisms: Path | None, links: int, mobility: int) -> None:
+    from mechsyn.synthesis.chains import estimated_chains
+
     if out is not None and out.suffix.lower() not in (".svg", ".png", ".pdf"):
         raise MechsynInputError(f"cannot draw to {out.name!r}", source="--out",
                                 hint="give a file ending in .svg, .png or .pdf")
+    if out is not None and estimated_chains(links, mobility) > MAX_DRAWN:  # before, not after, the enumeration
+        raise MechsynInputError(f"about {estimated_chains(links, mobility):,.0f} chains are too many to draw on "
+                                f"one sheet (limit {MAX_DRAWN})", source="--out",
+                                hint="use --json or --mechanisms DIR for this many chains")
     check_writable(out, "--out")
     check_writable(stream, "--stream")
     check_writable(mechanisms, "--mechanisms", directory=True)
@@ -72,7 +78,7 @@ def atlas(
     from mechsyn.synthesis.atlas import chain_atlas
     from mechsyn.synthesis.chains import n_units
 
-    _check_files(out, stream, mechanisms)
+    _check_files(out, stream, mechanisms, links, mobility)
     check_parallel_options(workers, scheduler)
     with progress_bar(f"{links}-link chains, F={mobility}", n_units(links, mobility)) as advance:
         result = chain_atlas(links, mobility, include_degenerate=include_degenerate, inputs=inputs,

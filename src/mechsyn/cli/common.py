@@ -20,6 +20,7 @@ from rich.table import Table as RichTable
 from rich.markup import escape
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io.files import HIDDEN_CHARS, is_mechanism_file
 from mechsyn.results import dumps, write_atomic
 
 T = TypeVar("T")
@@ -36,12 +37,14 @@ SchedulerOpt = Annotated[Optional[str], typer.Option(
 ForceOpt = Annotated[bool, typer.Option(
     "--force", help="Replace an existing output file even when it is not a mechanism file.")]
 
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+#: control characters, and the bidirectional controls and zero-width characters that
+#: reorder or hide what a terminal shows (a name could show a μ of 90.0° as "0.09°")
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]|" + HIDDEN_CHARS.pattern)
 
 
 def strip_control(text: str) -> str:
-    """``text`` without control characters (escape sequences, bells, backspaces...);
-    newlines and tabs are kept.
+    """``text`` without control characters (escape sequences, bells, backspaces...) nor
+    bidirectional controls and zero-width characters; newlines and tabs are kept.
 
     >>> strip_control("a\x1b[31mred\x07")
     'a[31mred'
@@ -281,26 +284,6 @@ def check_writable(path: Path | None, option: str, directory: bool = False) -> N
     except OSError as exc:
         raise MechsynInputError(f"cannot write {path}: {exc.strerror or exc}", source=option,
                                 hint="give a path in a folder you can write to") from None
-
-
-def is_mechanism_file(path: Path) -> bool:
-    """Whether ``path`` holds what a mechsyn command writes as a mechanism: an empty
-    file, a YAML/JSON mapping with ``links`` and ``joints``, or a Pyslvs expression
-    (``M[...]`` after ``#`` comment lines, for ``.pyslvs``/``.txt``). Anything
-    unreadable is not."""
-    from mechsyn.io.files import parse_data, read_text
-
-    try:
-        if path.stat().st_size == 0:
-            return True
-        text = read_text(path)
-        if path.suffix.lower() in (".pyslvs", ".txt"):  # comment lines (#), then M[...]
-            expr = "".join(ln for ln in text.splitlines() if not ln.lstrip().startswith("#")).strip()
-            return expr.startswith("M[") and expr.endswith("]")
-        data = parse_data(text, str(path))
-    except (MechsynInputError, OSError):
-        return False
-    return isinstance(data, dict) and isinstance(data.get("links"), list) and isinstance(data.get("joints"), list)
 
 
 def check_overwrite(path: Path | str | None, option: str, force: bool = False) -> None:

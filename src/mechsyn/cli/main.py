@@ -10,7 +10,9 @@ imported; a module imported eagerly here is picked up the same way.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
+import threading
 from typing import Any
 
 import typer
@@ -87,14 +89,48 @@ def build_cli() -> Any:
 
 #: exit status of Ctrl-C (128 + SIGINT), as :data:`mechsyn.interrupt.INTERRUPT_EXIT_CODE`
 _INTERRUPTED = 130
+#: exit status of SIGTERM (128 + 15), handled like Ctrl-C
+_TERMINATED = 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where Ctrl-C's KeyboardInterrupt would be: every search keeps its
+    best so far, temporary files are removed, and the command exits with 143."""
+
+
+_term = {"seen": False}
+
+
+def _on_sigterm(signum: int, frame: Any) -> None:
+    _term["seen"] = True
+    raise Terminated()
+
+
+def handle_sigterm() -> Any:
+    """Handle SIGTERM like SIGINT (main thread only; elsewhere a no-op): the handler it
+    replaced, for :func:`main` to restore."""
+    _term["seen"] = False
+    if threading.current_thread() is threading.main_thread():
+        return signal.signal(signal.SIGTERM, _on_sigterm)
+    return None
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; bad input exits with status 2 and one message.
 
-    Ctrl-C exits with status 130 and prints ``interrupted`` (searches have written their
-    best result so far, marked as interrupted, before that).
+    Ctrl-C exits with status 130 and prints ``interrupted``, SIGTERM the same with status
+    143 and ``terminated`` (searches have written their best result so far, marked as
+    interrupted, before that).
     """
+    previous = handle_sigterm()
+    try:
+        return _main(argv)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
     except KeyboardInterrupt:
@@ -126,7 +162,8 @@ def main(argv: list[str] | None = None) -> int:
         if status == _INTERRUPTED:  # searches wrote their best so far before this
             from mechsyn.cli.common import err_console
 
-            err_console.print("interrupted", highlight=False)
+            status = _TERMINATED if _term["seen"] else status
+            err_console.print("terminated" if _term["seen"] else "interrupted", highlight=False)
         return _exit(status, argv)
     return _exit(0, argv)
 

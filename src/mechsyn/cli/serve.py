@@ -28,18 +28,48 @@ def serve(
 
     start, name = _start(target) if target else (None, "")
     if host not in LOCAL_HOSTS:
-        err_console.print(f"[bold yellow]warning:[/] serving on {host}: anyone who can reach this address and "
-                          "has the URL's token can use the studio and write files in this directory")
+        err_console.print(f"[bold yellow]warning:[/] serving on {host} without TLS: anyone on the network who "
+                          "sees the URL's token can use the studio and write files here (see docs/reliability.md: "
+                          "a reverse proxy with TLS)", highlight=False, soft_wrap=True)
     port = port or _free_port(host)
     token = secrets.token_urlsafe(24)
     shown = "127.0.0.1" if host in ("0.0.0.0", "::") else host
     app_ = create_app(Path.cwd(), start=start, token=token, start_name=name,
-                      allowed_hosts=set(LOCAL_HOSTS) | {host, shown})
+                      allowed_hosts=set(LOCAL_HOSTS) | {host, shown} | _own_names(host))
     url = f"http://{'[' + shown + ']' if ':' in shown else shown}:{port}/?token={token}"
     console.print(f"mechsyn studio at [bold]{url}[/]  (Ctrl+C stops it)", highlight=False, soft_wrap=True)
-    if not no_browser:
-        webbrowser.open(url)
-    run_server(app_, host=host, port=port)
+    opener = None if no_browser else _open_browser(url)
+    try:
+        run_server(app_, host=host, port=port)
+    finally:
+        if opener is not None:
+            opener.unlink(missing_ok=True)
+
+
+def _own_names(host: str) -> set[str]:
+    """This machine's names, accepted in the Host header when serving on all addresses
+    (the addresses themselves are accepted as the connection's own, see ``Guard``)."""
+    import socket
+
+    if host not in ("0.0.0.0", "::"):
+        return set()
+    return {n.lower() for n in (socket.gethostname(), socket.getfqdn()) if n}
+
+
+def _open_browser(url: str) -> Path | None:
+    """Open ``url`` in the browser without the token on any command line (``ps`` shows
+    those): through a redirecting page only this user can read (0600), as Jupyter does.
+    Returns that page, removed when the server stops."""
+    import html
+    import os
+    import tempfile
+
+    fd, name = tempfile.mkstemp(prefix="mechsyn-open-", suffix=".html")  # 0600
+    with os.fdopen(fd, "w", encoding="utf-8") as fh:
+        fh.write(f'<!doctype html><meta http-equiv="refresh" content="0;url={html.escape(url)}">'
+                 f'<a href="{html.escape(url)}">mechsyn studio</a>\n')
+    webbrowser.open(Path(name).as_uri())
+    return Path(name)
 
 
 def _start(target: str) -> tuple[Any, str]:

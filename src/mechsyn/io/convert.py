@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io.files import read_text
 from mechsyn.io.load import load_mechanism, mechanism_from_dict, mechanism_text, mechanism_to_dict
 from mechsyn.io.pyslvs import pyslvs_text, read_pyslvs
 from mechsyn.model.mechanism import Mechanism
@@ -41,7 +42,7 @@ def load_any(path: str | os.PathLike[str]) -> Mechanism:
         return load_mechanism(p)
     if not p.is_file():
         raise MechsynInputError("no such file", source=str(p), hint="check the path")
-    data, _ = read_pyslvs(p.read_text(encoding="utf-8"), str(p))
+    data, _ = read_pyslvs(read_text(p, "Pyslvs file"), str(p))  # regular file, size limit (issue 27)
     return mechanism_from_dict(data, str(p))
 
 
@@ -63,10 +64,7 @@ def convert_file(path: str | os.PathLike[str], to: str, inputs: list[tuple[int, 
     if src in PYSLVS_SUFFIXES and to in MECHSYN_SUFFIXES:
         if not p.is_file():
             raise MechsynInputError("no such file", source=str(p), hint="check the path")
-        try:
-            text = p.read_text(encoding="utf-8")
-        except UnicodeDecodeError:
-            raise MechsynInputError("not UTF-8 text", source=str(p)) from None
+        text = read_text(p, "Pyslvs file")  # regular file, size limit, UTF-8 (issue 27)
         data, notes = read_pyslvs(text, str(p), inputs, name)
         mech = mechanism_from_dict(data, str(p))
         return Conversion(str(p), to.lstrip("."), mechanism_text(mech, to == ".json"), notes)

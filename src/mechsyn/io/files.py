@@ -22,18 +22,48 @@ from __future__ import annotations
 import json
 import os
 import re
+import stat
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-#: LibYAML's safe parser where PyYAML was built with it (several times faster), else PyYAML's own.
-_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+_FAST_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+_MERGE = "tag:yaml.org,2002:merge"
+
+
+class _StrictLoader(_FAST_LOADER):  # type: ignore[misc, valid-type]
+    """The safe loader refusing a key written twice in one mapping (PyYAML keeps the last)."""
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+        if isinstance(node, yaml.MappingNode):
+            seen: set[tuple[str, str]] = set()
+            for key, _ in node.value:
+                if isinstance(key, yaml.ScalarNode) and key.tag != _MERGE:
+                    if (key.tag, key.value) in seen:
+                        raise yaml.constructor.ConstructorError(
+                            None, None, f"duplicate key {key.value[:80]!r}", key.start_mark)
+                    seen.add((key.tag, key.value))
+        return super().construct_mapping(node, deep)
+
+
+#: LibYAML's safe parser where PyYAML was built with it (several times faster), else
+#: PyYAML's own; a key written twice in one mapping is refused.
+_YAML_LOADER = _StrictLoader
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["read_text", "parse_data", "read_data", "check_data_size"]
+__all__ = ["is_mechanism_file", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
+           "check_id_text"]
+
+#: Bidirectional controls and zero-width characters: they make two ids that look alike
+#: differ, or reorder what a terminal shows ("Trojan Source", CVE-2021-42574).
+HIDDEN_CHARS = re.compile("[\u061c\u200b-\u200f\u202a-\u202e\u2060-\u2064\u2066-\u2069\ufeff]")
+_SURROGATE = re.compile("[\ud800-\udfff]")
+#: Keys whose strings are free text, shown with hidden characters stripped; every other
+#: string of a file (ids, references, keys) refuses them.
+FREE_TEXT_KEYS = frozenset({"name", "title", "description", "notes", "note", "comment", "label", "text"})
 
 _BRACKETS = re.compile(r"[\[\]{}]")
 
@@ -57,16 +87,7 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         raise MechsynInputError(f"no such {what}", source=str(p), hint=missing_hint(p))
     if p.is_dir():
         raise MechsynInputError(f"is a directory, not a {what}", source=str(p))
-    try:
-        size = p.stat().st_size
-        if size > limit("file_bytes"):
-            raise MechsynInputError(
-                f"{what} of {size:,} bytes is larger than the limit of {limit('file_bytes'):,}",
-                source=str(p), hint=limit_hint("file_bytes"))
-        data = p.read_bytes()
-    except OSError as exc:
-        raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(p),
-                                hint="check the path and its permissions") from None
+    data = read_limited(p, what)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -74,6 +95,41 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
             f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=str(p),
             hint="save the file as UTF-8 text",
         ) from None
+
+
+def read_limited(path: str | os.PathLike[str], what: str = "file") -> bytes:
+    """The bytes of ``path``: a regular file (not a device such as ``/dev/zero``, a FIFO or
+    a socket, refused at once) of at most ``file_bytes`` bytes (the size is checked before
+    reading and the read stops one byte past the limit, so a file growing meanwhile is
+    refused too).
+
+    >>> read_limited("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: /dev/zero: not a regular file (a device, FIFO or socket) (fix: give the path of a file)
+    """
+    cap = int(limit("file_bytes"))
+    too_big = f"{what} larger than the limit of {cap:,} bytes"
+    try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise MechsynInputError("not a regular file (a device, FIFO or socket)", source=str(path),
+                                    hint="give the path of a file")
+        if info.st_size > cap:
+            raise MechsynInputError(f"{what} of {info.st_size:,} bytes is larger than the limit of {cap:,}",
+                                    source=str(path), hint=limit_hint("file_bytes"))
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO swapped in never blocks
+        with os.fdopen(fd, "rb") as fh:
+            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+                raise MechsynInputError("not a regular file (a device, FIFO or socket)", source=str(path),
+                                        hint="give the path of a file")
+            data = fh.read(cap + 1)
+    except OSError as exc:
+        raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path),
+                                hint="check the path and its permissions") from None
+    if len(data) > cap:
+        raise MechsynInputError(too_big, source=str(path), hint=limit_hint("file_bytes"))
+    return data
 
 
 def _bracket_depth(text: str) -> int:
@@ -85,29 +141,125 @@ def _bracket_depth(text: str) -> int:
     return deepest
 
 
-def check_data_size(data: Any, source: str) -> Any:
+def check_data_size(data: Any, source: str, hidden: bool = True) -> Any:
     """Refuse data nested deeper than the limit ``nesting`` or with more than
-    ``values`` values (counted through shared YAML aliases); return ``data``."""
+    ``values`` values (counted through shared YAML aliases), and strings that are not text
+    (lone surrogates) or, with ``hidden``, ids holding invisible characters
+    (:func:`check_id_text`); return ``data``."""
     deepest, budget = limit("nesting"), limit("values")
-    stack = [(data, 1)]
+    stack: list[tuple[Any, int, str]] = [(data, 1, "")]
     seen = 0
     while stack:
-        node, depth = stack.pop()
+        node, depth, key = stack.pop()
         seen += 1
         if seen > budget:
             raise MechsynInputError(
                 f"more than {budget:,} values (YAML aliases expanding into too many items?)",
                 source=source, hint="write the data out without aliases; " + limit_hint("values"))
+        if isinstance(node, str):
+            check_id_text(node, source, key, free=not hidden or key in FREE_TEXT_KEYS)
+            continue
         if isinstance(node, dict):
-            children = list(node.keys()) + list(node.values())
+            children = [(k, depth + 1, key) for k in node] + [(v, depth + 1, str(k)) for k, v in node.items()]
         elif isinstance(node, (list, tuple)):
-            children = node
+            children = [(c, depth + 1, key) for c in node]
         else:
             continue
         if depth > deepest and children:
             raise _too_deep(source)
-        stack.extend((c, depth + 1) for c in children)
+        stack.extend(children)
     return data
+
+
+def check_id_text(text: str, source: str, field: str = "", free: bool = False) -> str:
+    r"""Refuse a lone surrogate (not text: it cannot be printed or written as UTF-8) and, unless
+    ``free`` (a name shown with them stripped), bidirectional controls and zero-width characters.
+
+    >>> check_id_text("A\u200b", "m.yaml", "joints")
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: m.yaml: joints: 'A\u200b' holds the invisible character U+200B (fix: type the id again without it; ids may not hold bidirectional controls or zero-width characters)
+    """
+    if text.isascii():
+        return text
+    if _SURROGATE.search(text):
+        raise MechsynInputError(f"{text[:40]!r} holds a lone surrogate (not text)", source=source,
+                                field=field or None, hint="save the file as UTF-8 text")
+    hidden = None if free else HIDDEN_CHARS.search(text)
+    if hidden:
+        raise MechsynInputError(f"{text[:40]!r} holds the invisible character U+{ord(hidden.group()):04X}",
+                                source=source, field=field or None,
+                                hint="type the id again without it; ids may not hold bidirectional "
+                                     "controls or zero-width characters")
+    return text
+
+
+class _JSONDuplicate(ValueError):
+    pass
+
+
+def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in out:
+            raise _JSONDuplicate(k)
+        out[k] = v
+    return out
+
+
+class _JSONConstant(ValueError):
+    pass
+
+
+def _refuse_constant(name: str) -> Any:
+    raise _JSONConstant(name)
+
+
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if value in (float("inf"), float("-inf")):
+        raise _JSONConstant(text[:40])
+    return value
+
+
+def loads_json(text: str | bytes, source: str, finite: bool = False) -> Any:
+    r"""Parse JSON: a key written twice in one object refused (with its line), numbers over
+    4,300 digits and nesting beyond ``nesting`` refused, and with ``finite`` also ``NaN``
+    and ``Infinity``; every problem a :class:`MechsynInputError` naming ``source``.
+
+    >>> loads_json('{"a": 1,\n "a": 2}', "case.json")
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: case.json:2: the key 'a' is written twice (fix: keep one of them)
+    """
+    if isinstance(text, bytes):
+        try:
+            text = text.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise MechsynInputError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", source=source,
+                                    hint="send UTF-8 text") from None
+    if _bracket_depth(text) > limit("nesting"):
+        raise _too_deep(source)
+    try:
+        return json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_refuse_constant if finite else None,
+                          parse_float=_finite_float if finite else None)
+    except json.JSONDecodeError as exc:
+        raise MechsynInputError(f"JSON syntax error: {exc.msg} (column {exc.colno})", source=source,
+                                line=exc.lineno, hint="fix the JSON syntax at that line") from None
+    except _JSONConstant as exc:
+        raise MechsynInputError(f"{exc.args[0]} is not a number mechsyn takes", source=source,
+                                hint="give a finite number") from None
+    except _JSONDuplicate as exc:
+        word = str(exc.args[0])
+        at = [m.start() for m in re.finditer(re.escape(json.dumps(word)) + r"\s*:", text)]
+        line = text.count("\n", 0, at[-1]) + 1 if at else None
+        raise MechsynInputError(f"the key {word[:80]!r} is written twice", source=source, line=line,
+                                hint="keep one of them") from None
+    except ValueError as exc:  # an integer of more than 4,300 digits (CVE-2020-10735 guard)
+        raise MechsynInputError(f"a number too long to read ({str(exc)[:80]})", source=source,
+                                hint="write numbers with at most a few dozen digits") from None
+    except RecursionError:
+        raise _too_deep(source) from None
 
 
 def _too_deep(source: str) -> MechsynInputError:
@@ -126,13 +278,7 @@ def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
     as_json = fmt == "json" or (fmt is None and source.lower().endswith(".json"))
     try:
         if as_json:
-            try:
-                data = json.loads(text)
-            except json.JSONDecodeError as exc:
-                raise MechsynInputError(
-                    f"JSON syntax error: {exc.msg} (column {exc.colno})", source=source,
-                    line=exc.lineno, hint="fix the JSON syntax at that line",
-                ) from None
+            data = loads_json(text, source)
         else:
             try:
                 data = yaml.load(text, Loader=_YAML_LOADER)  # noqa: S506 (a safe loader)
@@ -143,12 +289,18 @@ def parse_data(text: str, source: str, fmt: str | None = None) -> Any:
                 if "nesting depth" in problem:  # PyYAML >= 6.0.3 refuses deep nesting itself
                     raise _too_deep(source) from None
                 column = f" (column {mark.column + 1})" if mark is not None else ""
+                if problem.startswith("duplicate key"):
+                    raise MechsynInputError(f"{problem} in one mapping{column}", source=source, line=line,
+                                            hint="keep one of them (YAML would silently use the last)") from None
                 raise MechsynInputError(
                     f"YAML syntax error: {problem}{column}", source=source, line=line,
                     hint="fix the YAML syntax at that line (indentation, brackets, colons)",
                 ) from None
             except yaml.YAMLError as exc:
                 raise MechsynInputError(f"YAML syntax error: {exc}", source=source) from None
+            except ValueError as exc:  # an integer of more than 4,300 digits
+                raise MechsynInputError(f"a number too long to read ({str(exc)[:80]})", source=source,
+                                        hint="write numbers with at most a few dozen digits") from None
     except RecursionError:  # block-style nesting (indentation) thousands deep
         raise _too_deep(source) from None
     return check_data_size(data, source)
@@ -161,3 +313,21 @@ def read_data(path: str | os.PathLike[str], what: str = "file",
 
     text = read_text(path, what)
     return parse_data(text, str(resolve(path)), fmt), text
+
+
+def is_mechanism_file(path: Path) -> bool:
+    """Whether ``path`` holds what a mechsyn command writes as a mechanism: an empty
+    file, a YAML/JSON mapping with ``links`` and ``joints``, or a Pyslvs expression
+    (``M[...]`` after ``#`` comment lines, for ``.pyslvs``/``.txt``). Anything
+    unreadable is not."""
+    try:
+        if path.stat().st_size == 0:
+            return True
+        text = read_text(path)
+        if path.suffix.lower() in (".pyslvs", ".txt"):  # comment lines (#), then M[...]
+            expr = "".join(ln for ln in text.splitlines() if not ln.lstrip().startswith("#")).strip()
+            return expr.startswith("M[") and expr.endswith("]")
+        data = parse_data(text, str(path))
+    except (MechsynInputError, OSError):
+        return False
+    return isinstance(data, dict) and isinstance(data.get("links"), list) and isinstance(data.get("joints"), list)

@@ -192,6 +192,7 @@ def mechanism_from_dict(data: Any, source: str = "<data>", text: str | None = No
             source=source, line=1, hint="see `mechsyn schema` and the files in examples/",
         )
     check_counts(data, source)
+    files.check_data_size(data, source)  # nesting, size, hidden characters in ids (issue 27)
     try:  # a plain file without building pydantic's validators (the same models)
         spec = plain_spec(data)
         if spec is None:

@@ -35,14 +35,21 @@ True
 from __future__ import annotations
 
 import functools
-
 import os
+import threading
 from collections.abc import Sequence
 
 BACKENDS = ("igraph", "pynauty")
 _state = {"backend": os.environ.get("MECHSYN_GRAPH_BACKEND", "igraph")}
 
-__all__ = ["BACKENDS", "get_backend", "set_backend", "preload", "certificate", "generators", "orbits"]
+__all__ = ["BACKENDS", "NATIVE_LOCK", "get_backend", "set_backend", "preload", "certificate", "generators",
+           "orbits"]
+
+#: One process-wide lock around every call into bliss (igraph) and nauty: neither is
+#: documented as thread-safe, and bliss aborts the whole process (SIGABRT) on an error
+#: raised while another thread is inside it (issue 27: a bad chain sent to the studio
+#: while its atlas list ran killed the server).
+NATIVE_LOCK = threading.RLock()
 
 
 def get_backend() -> str:
@@ -84,8 +91,16 @@ def preload() -> None:
     _module(get_backend())
 
 
+def _check_colours(n: int, colours: Sequence[int] | None) -> None:
+    """One colour per vertex, else ``ValueError`` (bliss aborts the process on a colour
+    vector of another length)."""
+    if colours is not None and len(colours) != n:
+        raise ValueError(f"{len(colours)} colours for {n} vertices")
+
+
 def _colour_classes(n: int, colours: Sequence[int] | None) -> list[int]:
     """Colours as small integers 0..k-1 in order of first value (both back ends)."""
+    _check_colours(n, colours)
     if colours is None:
         return [0] * n
     order = {c: i for i, c in enumerate(sorted(set(colours)))}
@@ -96,6 +111,8 @@ def _nauty_graph(n: int, edges, colours):
     pynauty = _module("pynauty")
     adj: dict[int, list[int]] = {v: [] for v in range(n)}
     for a, b in edges:
+        if not (0 <= a < n and 0 <= b < n):
+            raise ValueError(f"edge {(a, b)!r} names a vertex outside 0..{n - 1}")
         if a != b:
             adj[a].append(b)
     classes: dict[int, set[int]] = {}
@@ -109,15 +126,19 @@ def _igraph(n: int, edges):
     """igraph's C graph (``GraphBase``: the Python ``Graph`` wrapper's set-up costs more
     than bliss on these small graphs), loops left out."""
     ig = _module("igraph")
-    return ig.GraphBase(n, edges if all(a != b for a, b in edges) else
-                        [(a, b) for a, b in edges if a != b])
+    g = ig.GraphBase(n, edges if all(a != b for a, b in edges) else
+                     [(a, b) for a, b in edges if a != b])
+    if g.vcount() != n:  # igraph adds the vertices an edge names beyond n - 1
+        raise ValueError(f"an edge names a vertex outside 0..{n - 1}")
+    return g
 
 
 @functools.lru_cache(maxsize=1)
 def _moves_to_index() -> bool:
     """True when igraph's ``permute_vertices(p)`` sends vertex ``v`` to ``p[v]`` (0.10,
     0.11), False when vertex ``p[i]`` becomes ``i`` (1.0): probed once on a tiny graph."""
-    h = _igraph(3, [(0, 1)]).permute_vertices([2, 0, 1])
+    with NATIVE_LOCK:
+        h = _igraph(3, [(0, 1)]).permute_vertices([2, 0, 1])
     return sorted(h.get_edgelist()[0]) == [0, 2]
 
 
@@ -128,17 +149,20 @@ def certificate(n: int, edges: Sequence[tuple[int, int]],
     keeps the colours (compare certificates of one back end only)."""
     col = _colour_classes(n, colours)
     if get_backend() == "pynauty":
-        return _module("pynauty").certificate(_nauty_graph(n, edges, col))
-    g = _igraph(n, edges)
-    order = g.canonical_permutation(color=col if colours is not None else None)
-    # permute_vertices(canonical_permutation()) is canonical in every igraph version; the
-    # colours travel with the vertices, and igraph 1.0 reversed the meaning of the
-    # permutation vector (0.10/0.11: vertex v goes to order[v]; 1.0: the vertex at i is order[i])
-    canonical = g.permute_vertices(order)
+        with NATIVE_LOCK:
+            return _module("pynauty").certificate(_nauty_graph(n, edges, col))
+    moves = _moves_to_index()
+    with NATIVE_LOCK:
+        g = _igraph(n, edges)
+        order = g.canonical_permutation(color=col if colours is not None else None)
+        # permute_vertices(canonical_permutation()) is canonical in every igraph version; the
+        # colours travel with the vertices, and igraph 1.0 reversed the meaning of the
+        # permutation vector (0.10/0.11: vertex v goes to order[v]; 1.0: the vertex at i is order[i])
+        canonical = g.permute_vertices(order)
     flat = bytes(v for e in sorted(tuple(sorted(e)) for e in canonical.get_edgelist()) for v in e)
     if colours is None:
         labels = b""
-    elif _moves_to_index():
+    elif moves:
         new = [0] * n
         for v, i in enumerate(order):
             new[i] = col[v]
@@ -153,10 +177,11 @@ def generators(n: int, edges: Sequence[tuple[int, int]],
     """Generators of the colour-preserving automorphism group, each a list ``g`` with
     vertex ``v`` mapped to ``g[v]`` (the identity group: an empty list)."""
     col = _colour_classes(n, colours)
-    if get_backend() == "pynauty":
-        gens = _module("pynauty").autgrp(_nauty_graph(n, edges, col))[0]
-    else:
-        gens = _igraph(n, edges).automorphism_group(color=col)
+    with NATIVE_LOCK:
+        if get_backend() == "pynauty":
+            gens = _module("pynauty").autgrp(_nauty_graph(n, edges, col))[0]
+        else:
+            gens = _igraph(n, edges).automorphism_group(color=col)
     identity = list(range(n))
     return [list(map(int, g)) for g in gens if list(g) != identity]
 

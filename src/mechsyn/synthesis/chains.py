@@ -60,6 +60,7 @@ from mechsyn.synthesis.contracted import (ContractedGraph, compositions, contrac
 __all__ = [
     "KinematicChain",
     "chain_mobility",
+    "check_chain_dict",
     "link_assortments",
     "rigid_subchain",
     "is_degenerate",
@@ -283,17 +284,99 @@ class KinematicChain:
         }
 
     @classmethod
-    def from_dict(cls, d: dict) -> "KinematicChain":
-        return cls(
-            n_links=int(d["n_links"]),
-            mobility=int(d["mobility"]),
-            edges=tuple(tuple(int(v) for v in e) for e in d["edges"]),  # type: ignore[misc]
-            assortment={int(k): int(v) for k, v in d["assortment"].items()},
-            degenerate=bool(d["degenerate"]),
-            fractionated=bool(d["fractionated"]),
-            planar_graph=bool(d["planar_graph"]),
-            certificate=str(d.get("certificate", "")),
-        )
+    def from_dict(cls, d: dict, field: str = "chain") -> "KinematicChain":
+        """The chain of :meth:`to_dict`, checked first (:func:`check_chain_dict`)."""
+        n, mobility, edges, assortment = check_chain_dict(d, field)
+        return cls(n_links=n, mobility=mobility, edges=edges, assortment=assortment,
+                   degenerate=d["degenerate"], fractionated=d["fractionated"],
+                   planar_graph=d["planar_graph"], certificate=d.get("certificate", ""))
+
+
+def _whole(value: object, field: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise MechsynInputError(f"expected a whole number, got {type(value).__name__}", field=field)
+    return value
+
+
+def check_chain_dict(d: object, field: str = "chain") -> tuple[int, int, tuple, dict[int, int]]:
+    """Check a chain's dict (as :meth:`KinematicChain.to_dict` writes it) before any work.
+
+    Links within 2..``atlas_links`` (:mod:`mechsyn.limits`), every joint a pair of two
+    different links in range, the chain connected, its mobility and assortment those of
+    its joints, the flags booleans: else a :class:`~mechsyn.errors.MechsynInputError`
+    naming the field (bliss aborts the process on a joint naming a link out of range).
+    Returns ``(n_links, mobility, edges, assortment)``.
+
+    >>> check_chain_dict({"n_links": 4, "mobility": 1, "edges": [[0, 1], [1, 2], [2, 3], [3, 0]],
+    ...     "assortment": {"2": 4}, "degenerate": False, "fractionated": False, "planar_graph": True})[:2]
+    (4, 1)
+    >>> check_chain_dict({"n_links": 4, "mobility": 1, "edges": [[0, 1], [1, 2], [2, 3], [3, 99]],
+    ...     "assortment": {"2": 4}, "degenerate": False, "fractionated": False, "planar_graph": True})
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: chain.edges[3]: link 99 is not one of the chain's links 0..3
+    """
+    from mechsyn.limits import limit, limit_hint
+
+    if not isinstance(d, dict):
+        raise MechsynInputError("a chain must be an object", field=field)
+    for key in ("n_links", "mobility", "edges", "assortment", "degenerate", "fractionated", "planar_graph"):
+        if key not in d:
+            raise MechsynInputError("missing", field=f"{field}.{key}")
+    n = _whole(d["n_links"], f"{field}.n_links")
+    if not 2 <= n <= limit("atlas_links"):
+        raise MechsynInputError(f"{n} links: a chain has 2 to {limit('atlas_links'):,}", field=f"{field}.n_links",
+                                hint=limit_hint("atlas_links"))
+    raw = d["edges"]
+    if not isinstance(raw, list) or len(raw) > n * (n - 1) // 2:
+        raise MechsynInputError(f"expected a list of at most {n * (n - 1) // 2} joints [a, b]", field=f"{field}.edges")
+    edges = []
+    for k, e in enumerate(raw):
+        if not isinstance(e, list) or len(e) != 2:
+            raise MechsynInputError("a joint is a pair of links [a, b]", field=f"{field}.edges[{k}]")
+        a, b = (_whole(v, f"{field}.edges[{k}]") for v in e)
+        for v in (a, b):
+            if not 0 <= v < n:
+                raise MechsynInputError(f"link {v} is not one of the chain's links 0..{n - 1}",
+                                        field=f"{field}.edges[{k}]")
+        if a == b:
+            raise MechsynInputError(f"a joint of link {a} with itself", field=f"{field}.edges[{k}]")
+        edges.append((a, b))
+    return n, _check_chain_counts(d, n, edges, field), tuple(edges), _assortment(d, n, edges, field)
+
+
+def _check_chain_counts(d: dict, n: int, edges: list, field: str) -> int:
+    """The mobility (3 (n - 1) - 2 j), the connectedness and the flags of a chain dict."""
+    mobility = _whole(d["mobility"], f"{field}.mobility")
+    if mobility != 3 * (n - 1) - 2 * len(edges):
+        raise MechsynInputError(f"mobility {mobility}, but {n} links and {len(edges)} joints give "
+                                f"{3 * (n - 1) - 2 * len(edges)}", field=f"{field}.mobility")
+    g = nx.Graph(edges)
+    g.add_nodes_from(range(n))
+    if not nx.is_connected(g):
+        raise MechsynInputError("the links do not form one chain (not connected)", field=f"{field}.edges")
+    for key in ("degenerate", "fractionated", "planar_graph"):
+        if not isinstance(d[key], bool):
+            raise MechsynInputError("must be true or false", field=f"{field}.{key}")
+    if not isinstance(d.get("certificate", ""), str):
+        raise MechsynInputError("must be a string", field=f"{field}.certificate")
+    return mobility
+
+
+def _assortment(d: dict, n: int, edges: list, field: str) -> dict[int, int]:
+    """The assortment of the chain's joints, which the dict's must equal."""
+    deg = [0] * n
+    for a, b in edges:
+        deg[a] += 1
+        deg[b] += 1
+    counts: dict[int, int] = {}
+    for v in deg:
+        counts[v] = counts.get(v, 0) + 1
+    given = d["assortment"]
+    if not isinstance(given, dict) or {str(k): v for k, v in given.items()} != {str(k): v for k, v in counts.items()}:
+        raise MechsynInputError("does not match the joints (links by number of joints: "
+                                f"{dict(sorted(counts.items()))})", field=f"{field}.assortment")
+    return dict(sorted(counts.items()))
 
 
 # ------------------------------------------------------------------ the enumeration
@@ -601,6 +684,8 @@ def _read_done(path: Path, header: dict) -> dict[str, list[KinematicChain]]:
                 record = json.loads(line)
             except json.JSONDecodeError:
                 break  # torn last line of an interrupted run
+            if not isinstance(record, dict):
+                raise _damaged_line(path, number, "not a JSON object")
             if number == 1:
                 if record != header:
                     raise MechsynInputError(
@@ -610,17 +695,30 @@ def _read_done(path: Path, header: dict) -> dict[str, list[KinematicChain]]:
                     )
                 continue
             if "done" in record:
+                if not isinstance(record["done"], str):
+                    raise _damaged_line(path, number, "'done' names no assortment")
                 done[record["done"]] = pending
                 pending = []
             else:
-                pending.append(KinematicChain.from_dict(record))
+                try:
+                    pending.append(KinematicChain.from_dict(record, field=f"line {number}"))
+                except MechsynInputError as err:
+                    raise _damaged_line(path, number, f"{err.field}: {err.message}") from None
     return done
+
+
+def _damaged_line(path: Path, number: int, what: str) -> MechsynInputError:
+    return MechsynInputError(f"damaged chain stream: {what}", source=str(path), line=number,
+                             hint="delete the file (or give another) and run the enumeration again")
 
 
 def read_chain_stream(path: str | os.PathLike[str]) -> list[KinematicChain]:
     """Chains of a (possibly partial) stream file, completed assortments only."""
     path = Path(path)
-    with open(path, encoding="utf-8") as fh:
-        header = json.loads(fh.readline())
+    try:
+        with open(path, encoding="utf-8") as fh:
+            header = json.loads(fh.readline())
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise _damaged_line(path, 1, "the header is not JSON") from None
     done = _read_done(path, header)
     return [c for cs in done.values() for c in cs]

@@ -13,7 +13,13 @@ Safety of a local server (issue 15):
 * request bodies limited to :data:`MAX_BODY` bytes;
 * a Content-Security-Policy allowing only the server's own scripts, styles and data;
 * malformed requests answer 4xx with a JSON ``{"error", "field", "hint"}``; a bug answers
-  500 ``internal server error`` and the trace goes to the server's log only.
+  500 ``internal server error`` and the trace goes to the server's log only;
+* request bodies parsed strictly before any work (:func:`_body`: no NaN/Infinity, no key
+  twice, no number of thousands of digits, no lone surrogate, nesting within the limit),
+  booleans are booleans (:func:`_bool`);
+* heavy work (analyze, simulate, import, export, atlas, reading a file) runs in worker
+  processes, capped per client and in all, killed when the client disconnects
+  (:class:`mechsyn.web._jobs.HeavyRunner`, issue 27).
 
 References
 ----------
@@ -25,25 +31,26 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import functools
 import json
 import logging
 import secrets
+import threading
 from pathlib import Path
 from typing import Any, Awaitable, Callable, Iterable
 
 from starlette.applications import Starlette
 from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException
-from starlette.requests import Request
-from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
+from starlette.requests import ClientDisconnect, Request
+from starlette.responses import FileResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 from mechsyn.web import _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
-from mechsyn.web._jobs import JobTable
+from mechsyn.web._jobs import HeavyRunner, JobTable
+from mechsyn.web._routing import _body, _bool, _heavy, _int, _json_error, _need, api
 
 log = logging.getLogger("mechsyn.web")
 STATIC = Path(__file__).parent / "static"
@@ -52,11 +59,11 @@ LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' data: blob:; "
        "connect-src 'self'; font-src 'self'; base-uri 'none'; form-action 'none'; frame-ancestors 'none'")
 TOKEN_HEADER = "x-mechsyn-token"
+#: Seconds the server waits for each part of a request body.
+BODY_TIMEOUT = 30
 
 
 # --------------------------------------------------------------------------- middleware
-def _json_error(status: int, message: str, **extra: Any) -> JSONResponse:
-    return JSONResponse({"error": message, **extra}, status_code=status)
 
 
 def _hostname(host: str) -> str:
@@ -85,7 +92,11 @@ class Guard:
         await self.app(scope, self._limited(receive), _secure_send(send, scope))
 
     def _check(self, scope: dict, headers: dict[str, str]) -> Response | None:
-        if _hostname(headers.get("host", "")) not in self.hosts:
+        host = _hostname(headers.get("host", ""))
+        server = (scope.get("server") or ("",))[0] or ""
+        # the address the connection came in on is this server's own (--host 0.0.0.0 reached
+        # at 192.168.1.5); a name is accepted only when listed (DNS rebinding uses names)
+        if host not in self.hosts and not (host and host == server.lower().strip("[]")):
             return _json_error(403, "this server answers only to its own address (Host header refused)",
                                hint="open the URL that `mechsyn serve` printed")
         if scope["path"].startswith("/api/"):
@@ -104,13 +115,19 @@ class Guard:
         return None
 
     def _limited(self, receive: Callable) -> Callable:
-        seen = 0
+        seen, complete = 0, False
 
         async def wrapped() -> dict:
-            nonlocal seen
-            message = await receive()
+            nonlocal seen, complete
+            if complete:  # waiting for a disconnect (event streams): no deadline
+                return await receive()
+            try:  # the body within BODY_TIMEOUT s of each part (a trickling client is dropped)
+                message = await asyncio.wait_for(receive(), BODY_TIMEOUT)
+            except asyncio.TimeoutError:
+                raise ClientDisconnect() from None
             if message["type"] == "http.request":
                 seen += len(message.get("body", b""))
+                complete = not message.get("more_body", False)
                 if seen > self.max_body:
                     raise HTTPException(413, f"request body over {self.max_body // 1024} KiB")
             return message
@@ -143,48 +160,6 @@ def _with_headers(response: Response, scope: dict) -> Callable:
 
 
 # --------------------------------------------------------------------------- routes
-def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitable[Response]]:
-    """JSON in and out; input errors → 400 naming the field, bugs → 500 without a trace."""
-
-    @functools.wraps(fn)
-    async def wrapped(request: Request) -> Response:
-        try:
-            out = await fn(request)
-        except MechsynInputError as err:
-            return JSONResponse({"error": err.message, "field": err.field, "hint": err.hint,
-                                 "element": getattr(err, "element", None)}, status_code=400)
-        except HTTPException as exc:
-            return _json_error(exc.status_code, str(exc.detail))
-        except Exception:
-            log.exception("%s %s failed", request.method, request.url.path)
-            return _json_error(500, "internal server error (the server's log has the details)")
-        return out if isinstance(out, Response) else JSONResponse(out)
-
-    return wrapped
-
-
-async def _body(request: Request) -> dict[str, Any]:
-    raw = await request.body()
-    try:
-        data = json.loads(raw or b"null")
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise MechsynInputError(f"the request body is not JSON ({exc})", field="body",
-                                hint="send a JSON object") from None
-    if not isinstance(data, dict):
-        raise MechsynInputError("the request body must be a JSON object", field="body")
-    return data
-
-
-def _need(data: dict, key: str) -> Any:
-    if key not in data:
-        raise MechsynInputError("missing", field=key)
-    return data[key]
-
-
-def _int(value: Any, field: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
-        raise MechsynInputError(f"expected a whole number, got {value!r}", field=field)
-    return int(value)
 
 
 def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
@@ -193,9 +168,16 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
     @api
     async def route(request: Request) -> Any:
         data = await _body(request)
+        if service in HEAVY:
+            return await _heavy(request, service, _need(data, "mechanism"))
         return await run_in_threadpool(getattr(_service, service), _need(data, "mechanism"))
 
     return route
+
+
+#: Services run as capped, cancellable worker processes; the others are quick.
+HEAVY = frozenset({"analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
+                   "simulation_csv", "animation_gif", "atlas", "atlas_mechanism"})
 
 
 # each route reads the app's state (root, start, start_name, jobs) from request.app.state
@@ -225,10 +207,7 @@ async def _example(request: Request) -> Any:
 async def _simulate(request: Request) -> Any:
     data = await _body(request)
     steps = _int(data.get("steps", 180), "steps")
-    rates = data.get("rates", True)
-    if not isinstance(rates, bool):
-        raise MechsynInputError("must be true or false", field="rates")
-    return await run_in_threadpool(_service.simulate, _need(data, "mechanism"), steps, None, rates)
+    return await _heavy(request, "simulate", _need(data, "mechanism"), steps, None, _bool(data, "rates", True))
 
 
 @api
@@ -242,9 +221,8 @@ async def _read_file(request: Request) -> Any:
     path = _files.resolve_inside(root, request.query_params.get("path"))
     _files.mechanism_suffix(path, suffixes=_files.READABLE_SUFFIXES)
     if not path.is_file():
-        raise MechsynInputError(f"{request.query_params.get('path')}: no such file", field="path")
-    return {"mechanism": await run_in_threadpool(_service.read_mechanism, path),
-            "name": path.relative_to(root).as_posix()}
+        raise MechsynInputError(f"{request.query_params.get('path', '')[:200]}: no such file", field="path")
+    return {"mechanism": await _heavy(request, "read_mechanism", path), "name": path.relative_to(root).as_posix()}
 
 
 @api
@@ -254,22 +232,26 @@ async def _save_file(request: Request) -> Any:
     name = _need(data, "path")
     path = _files.resolve_inside(root, name)
     suffix = _files.mechanism_suffix(path)
-    if path.exists() and not data.get("overwrite", False):
+    overwrite = _bool(data, "overwrite", False)
+    if (path.exists() or path.is_symlink()) and not overwrite:
         raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
+    mode = await run_in_threadpool(_files.may_replace, path)
     if not path.parent.is_dir():
         raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
-    text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), suffix)
-    await run_in_threadpool(write_atomic, path, text)
+    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), suffix)
+    await run_in_threadpool(write_atomic, path, text, mode)
     return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
 
 
 @api
 async def _import_text(request: Request) -> Any:
     data = await _body(request)
-    text, name = _need(data, "text"), str(data.get("filename", "upload.yaml"))
+    text, name = _need(data, "text"), data.get("filename", "upload.yaml")
     if not isinstance(text, str):
         raise MechsynInputError("must be the file's text", field="text")
-    return {"mechanism": await run_in_threadpool(_service.parse_mechanism_text, text, name), "name": name}
+    if not isinstance(name, str) or len(name) > _files.MAX_NAME:
+        raise MechsynInputError(f"must be a file name of at most {_files.MAX_NAME} characters", field="filename")
+    return {"mechanism": await _heavy(request, "parse_mechanism_text", text, name), "name": name}
 
 
 @api
@@ -277,29 +259,31 @@ async def _export_text(request: Request) -> Any:
     data = await _body(request)
     fmt = data.get("format", "yaml")
     if fmt == "csv":
-        text = await run_in_threadpool(_service.simulation_csv, _need(data, "mechanism"),
-                                       _int(data.get("steps", 180), "steps"))
+        text = await _heavy(request, "simulation_csv", _need(data, "mechanism"), _int(data.get("steps", 180), "steps"))
         return Response(text, media_type="text/csv")
     if fmt == "gif":
         frames = _int(data.get("frames", 72), "frames")
         if not 2 <= frames <= 360:
             raise MechsynInputError("frames must be within 2..360", field="frames")
-        gif = await run_in_threadpool(_service.animation_gif, _need(data, "mechanism"), frames)
+        gif = await _heavy(request, "animation_gif", _need(data, "mechanism"), frames)
         return Response(gif, media_type="image/gif")
     if fmt not in ("yaml", "json"):
-        raise MechsynInputError(f"unknown format {fmt!r}", field="format", hint="yaml, json, csv or gif")
-    text = await run_in_threadpool(_service.mechanism_text, _need(data, "mechanism"), "." + fmt)
+        raise MechsynInputError(f"unknown format {str(fmt)[:20]!r}", field="format", hint="yaml, json, csv or gif")
+    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), "." + fmt)
     return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
 
 
 @api
 async def _atlas(request: Request) -> Any:
     q = request.query_params
-    try:
-        n, f = int(q.get("links", "6")), int(q.get("mobility", "1"))
-    except ValueError:
-        raise MechsynInputError("links and mobility must be whole numbers", field="links") from None
-    return {"chains": await run_in_threadpool(_service.atlas, n, f)}
+    n, f = _query_int(q.get("links", "6"), "links"), _query_int(q.get("mobility", "1"), "mobility")
+    return {"chains": await _heavy(request, "atlas", n, f)}
+
+
+def _query_int(text: str, field: str) -> int:
+    if not (text.isascii() and text.lstrip("-").isdigit() and len(text) <= 6):
+        raise MechsynInputError(f"expected a whole number, got {text[:20]!r}", field=field)
+    return int(text)
 
 
 @api
@@ -307,9 +291,8 @@ async def _atlas_mechanism(request: Request) -> Any:
     data = await _body(request)
     frame = data.get("frame")
     inp = data.get("input")
-    mech = await run_in_threadpool(_service.atlas_mechanism, _need(data, "chain"),
-                                   None if frame is None else _int(frame, "frame"),
-                                   None if inp is None else _int(inp, "input"))
+    mech = await _heavy(request, "atlas_mechanism", _need(data, "chain"),
+                        None if frame is None else _int(frame, "frame"), None if inp is None else _int(inp, "input"))
     return {"mechanism": mech}
 
 
@@ -343,7 +326,7 @@ async def _job_events(request: Request) -> Any:
     async def stream():
         seen = -1
         while True:
-            if await request.is_disconnected():
+            if await request.is_disconnected() or request.app.state.stopping.is_set():
                 return
             if job.version != seen:
                 seen = job.version
@@ -389,7 +372,7 @@ def _routes() -> list:
 
 
 def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, token: str | None = None,
-               allowed_hosts: Iterable[str] = LOCAL_HOSTS, start_name: str = "") -> Starlette:
+               allowed_hosts: Iterable[str] = LOCAL_HOSTS, start_name: str = "", isolate: bool = True) -> Starlette:
     """The studio as an ASGI app.
 
     Parameters
@@ -405,6 +388,9 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
         Host names this server answers to (the Host header check).
     start_name
         The file name the start mechanism came from (offered when saving).
+    isolate
+        Heavy work in worker processes (True), or in threads (False: tests that patch
+        :mod:`mechsyn.web._service`), see :class:`mechsyn.web._jobs.HeavyRunner`.
 
     Examples
     --------
@@ -421,18 +407,80 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
     app.state.root = Path(root).resolve()
     app.state.start, app.state.start_name = start, start_name
     app.state.jobs = JobTable()
+    app.state.heavy = HeavyRunner(isolate=isolate)
+    app.state.stopping = threading.Event()  # set by the first SIGINT/SIGTERM (run_server)
     app.add_middleware(Guard, token=app.state.token, allowed_hosts=allowed_hosts)
     return app
 
 
 @contextlib.asynccontextmanager
 async def _lifespan(app: Starlette):
+    await asyncio.get_running_loop().run_in_executor(None, app.state.heavy.warm)
     yield
     app.state.jobs.cancel_all()
 
 
-def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> None:
-    """Serve ``app`` with uvicorn until interrupted."""
+#: Seconds a client may take to send its request head (and to keep an idle connection).
+HEADER_TIMEOUT = 10
+#: Connections and requests at once; uvicorn answers 503 beyond (descriptors stay free).
+MAX_CONNECTIONS = 200
+
+
+def _header_timeout_protocol():
+    """uvicorn's h11 protocol closing a connection whose request head has not arrived
+    within :data:`HEADER_TIMEOUT` s (uvicorn's own keep-alive timer starts only after a
+    first response: about 1,100 silent connections locked a studio out)."""
+    from uvicorn.protocols.http.h11_impl import H11Protocol
+
+    class Protocol(H11Protocol):
+        def connection_made(self, transport: Any) -> None:
+            super().connection_made(transport)
+            self._head_timer = self.loop.call_later(HEADER_TIMEOUT, self._head_late)
+
+        def _head_late(self) -> None:
+            if self.cycle is None and not self.transport.is_closing():
+                self.transport.close()
+
+        def handle_events(self) -> None:
+            super().handle_events()
+            if self.cycle is not None:
+                self._head_timer.cancel()
+
+        def connection_lost(self, exc: Exception | None) -> None:
+            self._head_timer.cancel()
+            super().connection_lost(exc)
+
+    return Protocol
+
+
+def server_config(app: Starlette, host: str = "127.0.0.1", port: int = 8765):
+    """uvicorn's settings for the studio: the request head within :data:`HEADER_TIMEOUT` s
+    (the body: :data:`BODY_TIMEOUT`, in :class:`Guard`), idle connections closed after as
+    long, at most :data:`MAX_CONNECTIONS` at once, one second to finish on exit."""
     import uvicorn
 
-    uvicorn.run(app, host=host, port=port, log_level="warning")
+    return uvicorn.Config(app, host=host, port=port, log_level="warning", http=_header_timeout_protocol(),
+                          timeout_keep_alive=HEADER_TIMEOUT, limit_concurrency=MAX_CONNECTIONS,
+                          timeout_graceful_shutdown=1, h11_max_incomplete_event_size=64 * 1024)
+
+
+def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> None:
+    """Serve ``app`` with uvicorn until SIGINT or SIGTERM.
+
+    The first signal stops the server at once, whatever is open (event streams, long
+    requests, worker processes: cancelled), and is raised again once uvicorn has
+    restored the previous handlers: Ctrl-C becomes ``KeyboardInterrupt`` (exit 130 on
+    the command line), SIGTERM the command line's 143.
+    """
+    import uvicorn
+
+    class _Server(uvicorn.Server):
+        def handle_exit(self, sig: int, frame: Any) -> None:
+            super().handle_exit(sig, frame)
+            app.state.stopping.set()  # event streams end now; other requests get 1 s, then are cancelled
+            app.state.jobs.cancel_all()
+
+    try:
+        _Server(server_config(app, host, port)).run()
+    finally:
+        app.state.heavy.stop()

@@ -2,8 +2,9 @@
 
 A request names a file by a relative path. :func:`resolve_inside` refuses absolute
 paths, drive letters, ``..`` components, hidden names and anything that resolves
-(through symlinks) outside the root, with a :class:`~mechsyn.errors.MechsynInputError`
-naming the field and the fix.
+(through symlinks) outside the root or to a hidden name inside it, with a
+:class:`~mechsyn.errors.MechsynInputError` naming the field and the fix. Symlink loops
+are refused as such (:func:`resolve_inside`) and skipped by the list.
 """
 
 from __future__ import annotations
@@ -16,6 +17,8 @@ from mechsyn.errors import MechsynInputError
 MECHANISM_SUFFIXES = (".yaml", ".yml", ".json")
 READABLE_SUFFIXES = MECHANISM_SUFFIXES + (".pyslvs",)  # opened, not written
 MAX_LISTED = 500
+MAX_NAME = 1024  # characters of a relative path (a part: 255 bytes, the usual file-system limit)
+SKIPPED_DIRS = ("node_modules", "__pycache__")
 
 
 def resolve_inside(root: Path, name: object, field: str = "path") -> Path:
@@ -32,7 +35,10 @@ def resolve_inside(root: Path, name: object, field: str = "path") -> Path:
     """
     if not isinstance(name, str) or not name.strip():
         raise MechsynInputError("a relative file name is needed", field=field, hint="e.g. mechanism.yaml")
-    if "\x00" in name or "\\" in name:
+    if len(name) > MAX_NAME or any(len(part.encode("utf-8", "surrogatepass")) > 255 for part in name.split("/")):
+        raise MechsynInputError(f"the name is too long (at most {MAX_NAME} characters, 255 bytes a part)",
+                                field=field, hint="give a shorter name")
+    if "\x00" in name or "\\" in name or any("\ud800" <= c <= "\udfff" for c in name):
         raise MechsynInputError("the name has a forbidden character", field=field, hint="use / between folders")
     p = PurePosixPath(name)
     if p.is_absolute() or (len(name) > 1 and name[1] == ":"):
@@ -43,10 +49,15 @@ def resolve_inside(root: Path, name: object, field: str = "path") -> Path:
     if any(part.startswith(".") for part in p.parts):
         raise MechsynInputError("hidden files are not served", field=field, hint="name a visible file")
     base = root.resolve()
-    target = (base / p).resolve()
+    try:
+        target = (base / p).resolve()
+    except (OSError, RuntimeError):  # a symlink loop
+        raise MechsynInputError("the path is a symlink loop", field=field, hint="name a file") from None
     if target != base and base not in target.parents:
         raise MechsynInputError("the path leads outside the start directory (symlink)", field=field,
                                 hint="name a file inside the start directory")
+    if any(part.startswith(".") for part in target.relative_to(base).parts):
+        raise MechsynInputError("the path leads to a hidden file (symlink)", field=field, hint="name a visible file")
     return target
 
 
@@ -59,18 +70,51 @@ def mechanism_suffix(path: Path, field: str = "path", suffixes: tuple[str, ...] 
 
 
 def list_mechanism_files(root: Path) -> list[str]:
-    """Relative names of the YAML/JSON/Pyslvs files under ``root`` (not following symlinks out, no hidden)."""
+    """Relative names of the YAML/JSON/Pyslvs files under ``root``: regular files whose
+    resolved path stays inside ``root`` and is not hidden (symlink loops and dangling links
+    skipped, symlinked folders not followed)."""
     base = root.resolve()
     out: list[str] = []
-    for dirpath, dirnames, filenames in os.walk(base):
-        dirnames[:] = sorted(d for d in dirnames if not d.startswith(".") and d not in ("node_modules", "__pycache__"))
+    for dirpath, dirnames, filenames in os.walk(base, onerror=lambda err: None):
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith(".") and d not in SKIPPED_DIRS)
         for f in sorted(filenames):
             if f.startswith(".") or Path(f).suffix.lower() not in READABLE_SUFFIXES:
                 continue
             full = Path(dirpath) / f
-            if full.resolve() != full and base not in full.resolve().parents:
-                continue
-            out.append(full.relative_to(base).as_posix())
-            if len(out) >= MAX_LISTED:
-                return out
+            if _listable(base, full):
+                out.append(full.relative_to(base).as_posix())
+                if len(out) >= MAX_LISTED:
+                    return out
     return out
+
+
+def _listable(base: Path, full: Path) -> bool:
+    """A regular file whose resolved path is inside ``base`` and not hidden there."""
+    try:
+        real = full.resolve(strict=True)
+        if not real.is_file():
+            return False
+    except (OSError, RuntimeError):  # dangling link, symlink loop, no permission
+        return False
+    if base not in real.parents:
+        return False
+    return not any(part.startswith(".") for part in real.relative_to(base).parts)
+
+
+def may_replace(path: Path, field: str = "path") -> int | None:
+    """Before Save replaces ``path``: its permission bits to keep, or None for a new
+    file; an input error unless it is a regular file holding a mechanism
+    (:func:`mechsyn.io.files.is_mechanism_file`): a ``package.json`` or a
+    ``docker-compose.yml`` is not replaced."""
+    import stat
+
+    from mechsyn.io.files import is_mechanism_file
+
+    try:
+        info = path.lstat()
+    except FileNotFoundError:
+        return None
+    if not stat.S_ISREG(path.stat().st_mode) or not is_mechanism_file(path):
+        raise MechsynInputError(f"{path.name} exists and is not a mechanism file; not replaced", field=field,
+                                hint="save under another name")
+    return stat.S_IMODE(path.stat().st_mode if stat.S_ISLNK(info.st_mode) else info.st_mode)

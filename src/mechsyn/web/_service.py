@@ -11,6 +11,7 @@ import csv
 import functools
 import io
 import math
+import re
 from pathlib import Path
 from typing import Any, Callable
 
@@ -64,7 +65,11 @@ def _examples(root: Path | None) -> tuple[dict[str, str], ...]:
 
 
 def example_path(name: str) -> Path:
-    """The file of example ``name`` (its file stem, e.g. ``fourbar``)."""
+    """The file of example ``name`` (its file stem, e.g. ``fourbar``: letters, digits, ``_``
+    and ``-`` only, so that a name is never a glob pattern such as ``*``)."""
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_-]{1,80}", name):
+        raise MechsynInputError(f"no example named {name[:80]!r}", field="example",
+                                hint="an example's name has letters, digits, _ and - only, e.g. fourbar")
     root = _examples_dir()
     hits = [p for p in root.rglob(f"{name}.*") if p.suffix in EXAMPLE_SUFFIXES] if root else []
     if not hits:
@@ -79,7 +84,9 @@ def read_mechanism(path: Path) -> dict[str, Any]:
     from mechsyn.io import load_mechanism, mechanism_to_dict
 
     if path.suffix.lower() == ".pyslvs":
-        return parse_mechanism_text(path.read_text(encoding="utf-8"), path.name)
+        from mechsyn.io.files import read_text
+
+        return parse_mechanism_text(read_text(path, "Pyslvs file"), path.name)
     return mechanism_to_dict(load_mechanism(path))
 
 
@@ -250,7 +257,10 @@ def _nan_stat(f: Callable, v: np.ndarray) -> float | None:
 
 
 def _is_four_bar(mech) -> bool:
-    return len(mech.links) == 4 and len(mech.joints) == 4 and all(j.type == "R" for j in mech.joints)
+    """A planar four-bar of revolute pairs (the only linkage a Grashof class describes; a
+    spatial Bennett linkage has four R pairs too)."""
+    return (mech.kind == "planar" and len(mech.links) == 4 and len(mech.joints) == 4
+            and all(j.type == "R" for j in mech.joints))
 
 
 def _scale(mech) -> float:
@@ -336,14 +346,22 @@ def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
 
 
 def atlas_mechanism(chain: dict[str, Any], frame: int | None = None, input_link: int | None = None) -> dict:
-    """A chain of the atlas as a mechanism file dict (frame and input chosen)."""
+    """A chain of the atlas as a mechanism file dict (frame and input chosen).
+
+    The chain is checked before any work (:func:`mechsyn.synthesis.chains.check_chain_dict`),
+    the frame must be one of its links and the input a link jointed to the frame.
+    """
     from mechsyn.synthesis.chains import KinematicChain
     from mechsyn.synthesis.mechanisms import mechanism_dict
 
-    try:
-        kc = KinematicChain.from_dict(chain)
-    except (KeyError, TypeError, ValueError):
-        raise MechsynInputError("not a chain of the atlas", field="chain") from None
+    kc = KinematicChain.from_dict(chain, field="chain")
+    if frame is not None and not 0 <= frame < kc.n_links:
+        raise MechsynInputError(f"link {frame} is not one of the chain's links 0..{kc.n_links - 1}", field="frame")
+    if input_link is not None:
+        beside = sorted({b if a == frame else a for a, b in kc.edges if frame in (a, b)}) if frame is not None else None
+        if not 0 <= input_link < kc.n_links or (beside is not None and input_link not in beside):
+            raise MechsynInputError(f"link {input_link} is not jointed to the frame", field="input",
+                                    hint=f"one of {beside}" if beside else None)
     return mechanism_dict(kc, frame=frame, input_link=input_link)
 
 

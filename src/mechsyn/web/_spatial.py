@@ -29,9 +29,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from starlette.routing import Route
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.results import to_jsonable
 from mechsyn.web import _service
+from mechsyn.web._routing import _body, _heavy, _int, _need, api
 
 #: Largest number of rows of one sweep (the planar routes' limit).
 MAX_STEPS = _service.MAX_STEPS
@@ -62,7 +66,6 @@ def engine_problem(data: Any) -> str | None:
     Runs the engine on the drawn pose only (one row: the pair types, the drive and whether
     the drives determine the motion), which costs a few tens of milliseconds.
     """
-    from mechsyn.kinematics.analysis import simulate
 
     mech = _service.build(data)
     try:
@@ -132,8 +135,6 @@ def view(data: Any, steps: int = 180) -> dict[str, Any]:
     numbers. Raises :class:`~mechsyn.errors.MechsynInputError` for a planar file, a file
     without a drive, or one the engine cannot move (its message names the pair or drive).
     """
-    from mechsyn.kinematics.analysis import simulate
-    from mechsyn.results import to_jsonable
 
     mech = _service.build(data)
     if mech.kind != "spatial":
@@ -162,15 +163,12 @@ def view(data: Any, steps: int = 180) -> dict[str, Any]:
 
 def routes() -> list:
     """The 3-D view's route, ``POST /api/spatial/view`` ``{"mechanism", "steps"?}``
-    (registered by :func:`mechsyn.web._app._routes`; the sweep runs in the worker threads)."""
-    from starlette.concurrency import run_in_threadpool
-    from starlette.routing import Route
-
-    from mechsyn.web._app import _body, _int, _need, api
+    (registered by :func:`mechsyn.web._app._routes`; the sweep runs as a capped,
+    cancellable worker process, :func:`mechsyn.web._routing._heavy`)."""
 
     @api
     async def view_route(request) -> Any:
         body = await _body(request)
-        return await run_in_threadpool(view, _need(body, "mechanism"), _int(body.get("steps", 180), "steps"))
+        return await _heavy(request, "_spatial:view", _need(body, "mechanism"), _int(body.get("steps", 180), "steps"))
 
     return [Route("/api/spatial/view", view_route, methods=["POST"])]

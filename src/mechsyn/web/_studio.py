@@ -21,10 +21,28 @@ Examples
 from __future__ import annotations
 
 import functools
+import io
+import math
 from typing import Any
 
+import numpy as np
+from starlette.concurrency import run_in_threadpool
+from starlette.responses import Response
+from starlette.routing import Route
+
 from mechsyn.errors import MechsynInputError
+from mechsyn.export.drawing import drawing_of
+from mechsyn.export.dxf import layout_to_dxf
+from mechsyn.export.plates import link_plates
+from mechsyn.io import load_mechanism
+from mechsyn.kinematics.analysis import forces as _forces
+from mechsyn.results import to_jsonable
+from mechsyn.structure.report import analyze as structure_report
+from mechsyn.synthesis.export import fourbar_mechanism_dict
+from mechsyn.synthesis.reports import motion_report
 from mechsyn.web import _service
+from mechsyn.web._routing import _body, _heavy, _int, _need, api
+from mechsyn.web._spatial import check_note
 
 
 def _names(ids: list[str]) -> str:
@@ -89,7 +107,7 @@ def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
         return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
                       f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True, "one drive too many")]
     if n == 0 and mobility >= 1:
-        return [_diag("warning", f"no drive yet (mobility W = {mobility}): select the input joint and press "
+        return [_diag("note", f"no drive yet (mobility W = {mobility}): select the input joint and press "
                       "Drive to move the mechanism", [], True, "no drive yet")]
     if 0 < n < mobility and not any(j.vll for j in mech.joints):  # a locked VLL joint takes up a freedom
         return [_diag("warning", f"mobility W = {mobility} with {n} drive{'s' if n > 1 else ''}: the motion is "
@@ -106,7 +124,6 @@ def check(data: Any) -> dict[str, Any]:
     A file that does not validate raises :class:`~mechsyn.errors.MechsynInputError`
     (shown by the studio next to the element its field names).
     """
-    from mechsyn.structure.report import analyze as structure_report
 
     if not isinstance(data, dict):
         raise MechsynInputError("the mechanism must be a JSON object", field="mechanism")
@@ -118,7 +135,6 @@ def check(data: Any) -> dict[str, Any]:
         return out
     mech = _service.build(data)
     if out["spatial"]:  # view3d: the 3-D view where the spatial engine moves the file, else the old note
-        from mechsyn.web._spatial import check_note
         out["diagnostics"].append(check_note(data))
     try:
         report = structure_report(mech)
@@ -134,9 +150,6 @@ def check(data: Any) -> dict[str, Any]:
 def export_drawing(data: Any) -> str:
     """The mechanism's SVG drawing in model units at the drawn pose, with the paths of its
     named points over a full input turn (``mechsyn export --drawing``)."""
-    import numpy as np
-
-    from mechsyn.export.drawing import drawing_of
 
     mech = _service.build(data)
     drives = [j for j in mech.joints if j.actuated]
@@ -150,10 +163,6 @@ def export_drawing(data: Any) -> str:
 def export_dxf(data: Any) -> str:
     """The link plates laid out on a sheet as DXF text (``mechsyn export --dxf``; needs ezdxf,
     else a :class:`~mechsyn.errors.MechsynInputError` saying how to install it)."""
-    import io
-
-    from mechsyn.export.dxf import layout_to_dxf
-    from mechsyn.export.plates import link_plates
 
     doc = layout_to_dxf(link_plates(_service.build(data)))
     buf = io.StringIO()
@@ -162,7 +171,6 @@ def export_dxf(data: Any) -> str:
 
 
 def _finite_number(value: Any, field: str) -> float:
-    import math
 
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise MechsynInputError(f"expected a number, got {value!r}", field=field)
@@ -176,8 +184,6 @@ def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 
 
     Returns the library's :meth:`~mechsyn.kinematics.analysis.ForceAnalysis.to_dict`.
     """
-    from mechsyn.kinematics.analysis import forces as _forces
-    from mechsyn.results import to_jsonable
 
     if not isinstance(gravity, (list, tuple)) or len(gravity) != 2:
         raise MechsynInputError("gravity must be [gx, gy]", field="gravity")
@@ -193,10 +199,6 @@ def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
     ``params["angles"]`` in degrees): Burmester theory (``mechsyn synth motion``:
     :func:`mechsyn.synthesis.reports.motion_report`), each four-bar verified by simulation,
     ranked defect-free first, then by the smallest transmission angle."""
-    import numpy as np
-
-    from mechsyn.synthesis.export import fourbar_mechanism_dict
-    from mechsyn.synthesis.reports import motion_report
 
     T = np.asarray(params.get("targets"), float)
     A = np.asarray(params.get("angles", [0.0] * len(T)), float)
@@ -235,7 +237,6 @@ def examples() -> list[dict[str, str]]:
 
 @functools.lru_cache(maxsize=4)
 def _spatial_examples(root) -> tuple[dict[str, str], ...]:
-    from mechsyn.io import load_mechanism
 
     out = []
     for p in sorted(root.rglob("*")) if root is not None else []:
@@ -251,17 +252,16 @@ def _spatial_examples(root) -> tuple[dict[str, str], ...]:
 
 
 def routes() -> list:
-    """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`)."""
-    from starlette.concurrency import run_in_threadpool
-    from starlette.responses import Response
-    from starlette.routing import Route
+    """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`). The
+    check is quick and runs in the server's threads; forces and the exports are heavy and
+    run as capped, cancellable worker processes (:func:`mechsyn.web._routing._heavy`)."""
 
-    from mechsyn.web._app import _body, _int, _need, api
-
-    def on_mechanism(fn, media_type=None):
+    def on_mechanism(name, media_type=None, heavy=True):
         @api
         async def route(request) -> Any:
-            out = await run_in_threadpool(fn, _need(await _body(request), "mechanism"))
+            mech = _need(await _body(request), "mechanism")
+            out = await (_heavy(request, f"_studio:{name}", mech) if heavy
+                         else run_in_threadpool(globals()[name], mech))
             return Response(out, media_type=media_type) if media_type else out
         return route
 
@@ -272,11 +272,11 @@ def routes() -> list:
     @api
     async def forces_route(request) -> Any:
         body = await _body(request)
-        return await run_in_threadpool(forces, _need(body, "mechanism"), body.get("gravity", [0.0, 0.0]),
-                                       body.get("speed", 1.0), _int(body.get("steps", 180), "steps"))
+        return await _heavy(request, "_studio:forces", _need(body, "mechanism"), body.get("gravity", [0.0, 0.0]),
+                            body.get("speed", 1.0), _int(body.get("steps", 180), "steps"))
 
     return [Route("/api/studio/examples", examples_route),
             Route("/api/studio/forces", forces_route, methods=["POST"]),
-            Route("/api/studio/check", on_mechanism(check), methods=["POST"]),
-            Route("/api/studio/drawing", on_mechanism(export_drawing, "image/svg+xml"), methods=["POST"]),
-            Route("/api/studio/dxf", on_mechanism(export_dxf, "application/dxf"), methods=["POST"])]
+            Route("/api/studio/check", on_mechanism("check", heavy=False), methods=["POST"]),
+            Route("/api/studio/drawing", on_mechanism("export_drawing", "image/svg+xml"), methods=["POST"]),
+            Route("/api/studio/dxf", on_mechanism("export_dxf", "application/dxf"), methods=["POST"])]

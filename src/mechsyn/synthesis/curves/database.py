@@ -161,10 +161,14 @@ def _file(directory: Path, topo: CurveTopology) -> Path:
 
 
 def _read(path: Path) -> dict | None:
+    """A topology's arrays, or None when its file is missing or damaged (a truncated or
+    corrupted .npz is built again instead of stopping with a traceback, issue 27)."""
+    import zipfile
+
     try:
-        with np.load(path) as f:
+        with np.load(path, allow_pickle=False) as f:
             return {k: f[k] for k in f.files}
-    except (OSError, ValueError):
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile):
         return None
 
 
@@ -281,7 +285,12 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
     rows_t, designs, ranges, closed, desc = [], [], [], [], []
     for ti, t in enumerate(present):
         data = _read(_file(directory, t))
-        if data is None or len(data["ranges"]) == 0:
+        if data is None or not {"ranges", "designs", "closed", "descriptors"} <= set(data):
+            from mechsyn.errors import MechsynInputError
+
+            raise MechsynInputError(f"damaged curve database file {_file(directory, t).name}", source=str(directory),
+                                    field="database", hint="run `mechsyn curves build` (it builds damaged files again)")
+        if len(data["ranges"]) == 0:
             continue
         m = len(data["ranges"])
         rows_t.append(np.full(m, ti))

@@ -345,15 +345,42 @@ def _variant_record(v: VariantResult | None, notes: list[str], stopped: bool) ->
     return {"variant": data, "notes": notes, "stopped": stopped}
 
 
-def _variant_from(data: dict[str, Any]) -> VariantResult:
-    """The :class:`VariantResult` a checkpoint record holds (NaN saved as null)."""
-    d = dict(data)
-    d["combination"] = tuple(d["combination"])
-    d["vll_ranges"] = {j: tuple(r) for j, r in d["vll_ranges"].items()}
-    d["underactuated"] = {j: {"lengths": np.array(u["lengths"], float),
-                              "paths": {p: np.array(P, float) for p, P in u["paths"].items()}}
-                          for j, u in d["underactuated"].items()}
-    return VariantResult(**d)
+def _restored_variant(run: _Run, combo: tuple[str, ...], rec: Any, source: str) -> VariantResult | None:
+    """A finished variant read back from a checkpoint: only its two design vectors are
+    taken, within the case's bounds, and everything else is computed again from them
+    (:func:`_variant`), so a damaged record is one error naming it and a forged one
+    (an error or a feasibility it does not have) cannot pass (issue 27)."""
+    label = "+".join(combo)
+    names = [v.name for v in run.case.variables]
+    try:
+        notes, stopped, data = list(map(str, rec["notes"])), rec["stopped"], rec["variant"]
+        if not isinstance(stopped, bool):
+            raise TypeError("stopped")
+        if data is not None:
+            x1 = np.array([float(data["stage1_design"][n]) for n in names])
+            chosen = np.array([float(data["design"][n]) for n in names])
+            nfev = int(data["evaluations"])
+    except (TypeError, KeyError, ValueError, AttributeError, OverflowError):
+        raise MechsynInputError(f"damaged record of VLL {label}", source=source, field=f"done.{label}",
+                                hint="start afresh with --checkpoint (the file is not usable)") from None
+    if data is not None:
+        lo, hi = np.array([v.bounds for v in run.case.variables], float).T
+        if not all(np.isfinite(x).all() and (x >= lo).all() and (x <= hi).all() for x in (x1, chosen)):
+            raise MechsynInputError(f"the record of VLL {label} holds a design outside the case's bounds",
+                                    source=source, field=f"done.{label}.design",
+                                    hint="start afresh with --checkpoint (the file is not usable)")
+    run.notes.extend(notes)
+    run.stopped = run.stopped or stopped
+    if data is None:
+        return None
+    d1, d = apply_design(run.case, x1, combo), apply_design(run.case, chosen, combo)
+    ranges1 = {j: vll_range(run.case, d1, j)[:2] for j in combo}
+    ranges = {j: vll_range(run.case, d, j)[:2] for j in combo}
+    forces1 = mode_forces(run.case, d1, combo, ranges1)
+    same = bool(np.array_equal(x1, chosen))
+    forces_ = forces1 if same else mode_forces(run.case, d, combo, ranges)
+    return _variant(run.case, combo, x1, evaluate_locked(run.case, x1, combo), chosen, ranges, forces1,
+                    forces_, not same, nfev)
 
 
 def _run_variant(run: _Run, combo: tuple[str, ...], ck: Any) -> VariantResult | None:
@@ -361,10 +388,7 @@ def _run_variant(run: _Run, combo: tuple[str, ...], ck: Any) -> VariantResult | 
     (and saved to the checkpoint unless Ctrl-C cut it short)."""
     label = "+".join(combo)
     if ck is not None and label in ck.done:
-        rec = ck.done[label]
-        run.notes.extend(rec["notes"])
-        run.stopped = run.stopped or bool(rec["stopped"])
-        return None if rec["variant"] is None else _variant_from(rec["variant"])
+        return _restored_variant(run, combo, ck.done[label], str(ck.path))
     n0, st0 = len(run.notes), run.stopped
     run.stopped = False
     v = _design_variant(run, combo)

@@ -1,0 +1,113 @@
+"""The plumbing every studio route shares: JSON in and out (:func:`api`), the request body
+parsed strictly before any work (:func:`_body`), typed fields (:func:`_need`, :func:`_int`,
+:func:`_bool`) and heavy calls as capped, cancellable worker processes (:func:`_heavy`).
+
+Kept apart from :mod:`mechsyn.web._app` (the app factory and its route table) so that the
+route modules (:mod:`mechsyn.web._studio`, :mod:`mechsyn.web._spatial`) use it without
+importing the app that registers them.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import logging
+from typing import Any, Awaitable, Callable
+
+from starlette.exceptions import HTTPException
+from starlette.requests import ClientDisconnect, Request
+from starlette.responses import JSONResponse, Response
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.io.files import check_data_size, loads_json
+from mechsyn.web._jobs import Busy, ClientGone, WorkerCrashed
+
+log = logging.getLogger("mechsyn.web")
+
+
+def _json_error(status: int, message: str, **extra: Any) -> JSONResponse:
+    return JSONResponse({"error": message, **extra}, status_code=status)
+
+
+def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitable[Response]]:
+    """JSON in and out; input errors → 400 naming the field, bugs → 500 without a trace."""
+
+    @functools.wraps(fn)
+    async def wrapped(request: Request) -> Response:
+        try:
+            out = await fn(request)
+            return out if isinstance(out, Response) else _json_response(out)
+        except MechsynInputError as err:
+            return JSONResponse({"error": err.message, "field": err.field, "hint": err.hint,
+                                 "element": getattr(err, "element", None)}, status_code=400)
+        except HTTPException as exc:
+            return _json_error(exc.status_code, str(exc.detail))
+        except Busy as exc:
+            return _json_error(429, f"busy: {exc}", hint="wait for the running computation to finish")
+        except (ClientDisconnect, ClientGone):  # nobody reads the answer: one line, no trace
+            log.info("%s %s: the client left; its work was stopped", request.method, request.url.path)
+            return _json_error(499, "client disconnected")
+        except WorkerCrashed as exc:
+            log.warning("%s %s: %s", request.method, request.url.path, exc)
+            return _json_error(500, "internal server error (the server's log has the details)")
+        except Exception:
+            log.exception("%s %s failed", request.method, request.url.path)
+            return _json_error(500, "internal server error (the server's log has the details)")
+
+    return wrapped
+
+
+def _json_response(out: Any) -> Response:
+    """``out`` as JSON; text that is not valid UTF-8 (a lone surrogate echoed from a URL)
+    escaped as ``\\uXXXX`` instead of failing outside the route's error handling."""
+    try:
+        return JSONResponse(out)
+    except UnicodeEncodeError:
+        return Response(json.dumps(out, ensure_ascii=True, allow_nan=False), media_type="application/json")
+
+
+async def _body(request: Request) -> dict[str, Any]:
+    """The request's JSON object, parsed strictly (:func:`mechsyn.io.files.loads_json` with
+    finite numbers, :func:`mechsyn.io.files.check_data_size`), before any work."""
+    raw = await request.body()
+    try:
+        data = check_data_size(loads_json(raw or b"null", "request body", finite=True), "request body", hidden=False)
+    except MechsynInputError as err:
+        raise MechsynInputError(f"the request body is not acceptable JSON: {err.message}", field=err.field or "body",
+                                hint=err.hint or "send a JSON object") from None
+    if not isinstance(data, dict):
+        raise MechsynInputError("the request body must be a JSON object", field="body")
+    return data
+
+
+def _need(data: dict, key: str) -> Any:
+    if key not in data:
+        raise MechsynInputError("missing", field=key)
+    return data[key]
+
+
+def _int(value: Any, field: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
+        raise MechsynInputError(f"expected a whole number, got {str(value)[:40]!r}", field=field)
+    return int(value)
+
+
+def _bool(data: dict, key: str, default: bool) -> bool:
+    """``data[key]`` when it is true or false (JSON booleans; the string "false" is refused)."""
+    value = data.get(key, default)
+    if not isinstance(value, bool):
+        raise MechsynInputError(f"must be true or false, got {str(value)[:40]!r}", field=key)
+    return value
+
+
+def _client(request: Request) -> str:
+    """Who asks, for the per-client caps: the page's ``X-Mechsyn-Client`` id, else the
+    connection (address and port)."""
+    given = request.headers.get("x-mechsyn-client", "")[:64]
+    peer = request.client
+    return given or (f"{peer.host}:{peer.port}" if peer else "?")
+
+
+async def _heavy(request: Request, name: str, *args: Any) -> Any:
+    """``_service.<name>(*args)`` as capped, cancellable work (:class:`HeavyRunner`)."""
+    return await request.app.state.heavy.call(_client(request), request.is_disconnected, name, *args)
