@@ -391,6 +391,7 @@ def load_mechanism_dict(data):
     return mechanism_from_dict(data)
 
 
+@pytest.mark.slow
 def test_large_generated_file_converts_and_keeps_its_mobility(tmp_path, run_cli):
     """620 loops (1,860 links, 180 KB): converted both ways, mobility = its cranks."""
     src = tmp_path / "big.pyslvs"

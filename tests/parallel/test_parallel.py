@@ -118,6 +118,7 @@ def test_unreachable_scheduler_is_one_clear_error(monkeypatch):
     assert option_error(exc.value).format().startswith("--scheduler: cannot reach the Dask scheduler")
 
 
+@pytest.mark.slow
 def test_synth_mechanism_restarts_in_processes_equal_one_process():
     from mechsyn.synthesis.general import load_mechanism_case, synthesize_mechanism
 

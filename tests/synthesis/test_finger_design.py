@@ -70,6 +70,7 @@ def test_design_assembles_on_one_branch_and_meets_targets(result):
         assert np.max(np.abs(rot - target)) <= TOL_DEG
 
 
+@pytest.mark.slow
 def test_vll_range_keeps_paths_in_region_dense_resimulation(result):
     case, res = result
     v = res.best_variant

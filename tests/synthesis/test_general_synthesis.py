@@ -102,6 +102,7 @@ def test_newton_and_closed_form_evaluations_agree_on_the_sixbar():
         assert b.error == pytest.approx(a.error, rel=1e-8, abs=1e-14)
 
 
+@pytest.mark.slow
 def test_slider_crank_path_synthesis_closed_form():
     case = load_mechanism_case(SLIDER_CASE)
     res = synthesize_mechanism(case, seed=0, time_limit=120, restarts=1, options=FAST)

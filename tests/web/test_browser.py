@@ -211,6 +211,7 @@ def test_build_a_sixbar_from_nothing(serve, page):
     assert page.console_errors == []
 
 
+@pytest.mark.slow
 def test_synthesise_fourbar_through_five_points(serve, page):
     srv = serve(None)
     new_canvas(page, srv)

@@ -44,6 +44,7 @@ def _run_python(code: str, timeout: float = 300) -> subprocess.CompletedProcess:
 
 
 # ------------------------------------------------------------------ chains: the SIGABRT of bliss
+@pytest.mark.slow
 def test_bad_chain_during_an_atlas_list_does_not_abort_the_process():
     """Issue 27's high finding: a chain naming link 99 sent while another igraph call ran
     aborted the studio (SIGABRT, exit 134). Everything in one process here (threads), the

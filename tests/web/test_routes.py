@@ -227,6 +227,7 @@ def test_import_and_export(client, fourbar):
     assert client.post("/api/export", json={"mechanism": fourbar, "format": "pdf"}).status_code == 400
 
 
+@pytest.mark.slow
 def test_export_animation(client):
     import io
 
@@ -259,6 +260,7 @@ def _wait(client, job, timeout=120):
     raise AssertionError("job did not finish")
 
 
+@pytest.mark.slow
 def test_fourbar_path_synthesis_job(client):
     from mechsyn.synthesis.fourbar import coupler_point  # noqa: F401  (library present)
 

@@ -52,6 +52,7 @@ def test_view_route_bennett_rigid_and_from_the_drawn_pose(client):
     assert v["residual"] < 1e-9 and set(v["paths"]) == {"R2", "R3"}
 
 
+@pytest.mark.slow
 def test_view_route_rows_not_assembled_are_null_and_refusals_name_the_fix(client):
     v = client.post("/api/spatial/view", json={"mechanism": spatial_dict("rssr"), "steps": 180}).json()
     ok = np.array(v["assembled"])

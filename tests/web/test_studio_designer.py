@@ -10,6 +10,7 @@ import math
 import re
 
 import numpy as np
+import pytest
 
 from mechsyn.web._service import example_path
 
@@ -265,6 +266,7 @@ def test_mistakes_said_in_the_studio_words_next_to_the_element(serve, page, tmp_
 
 
 # 7 and 12 ---------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_every_example_opens_and_simulates(serve, page):
     """Each example of the Examples menu opens: assembled at its drawn pose and simulated, or
     (a structure, an under-actuated finger, a spatial file) with the reason in the banner."""
