@@ -92,11 +92,7 @@ class CurveCandidate:
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.reference_input):
-            from mechsyn.io.load import mechanism_from_dict
-            from mechsyn.kinematics.batch import compile_plan
-
-            self.reference_input = compile_plan(mechanism_from_dict(self.mechanism()),
-                                                points=[TRACER]).reference_input
+            self.reference_input = float(self.topology.plan.reference_inputs(self.params)[0])
 
     @property
     def full_turn(self) -> bool:
@@ -220,14 +216,17 @@ def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
     return -np.take_along_axis(diff, k[..., None, None], axis=-2)[..., 0, :], k
 
 
-def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[float, float]:
-    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals."""
+def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
+                 unit: float | None = None) -> tuple[float, float]:
+    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals
+    (or in ``unit``)."""
+    unit = target.diagonal if unit is None else unit
     T = target.points
     ts, tv = _polyline(T, target.closed)
     ps, pv = _polyline(path, closed_path)
     a = np.linalg.norm(_to_polyline(T, ps, pv)[0], axis=-1).mean()
     b = np.linalg.norm(_to_polyline(path, ts, tv)[0], axis=-1).mean()
-    chamfer = 0.5 * (a + b) / target.diagonal
+    chamfer = 0.5 * (a + b) / unit
     m = 128
     w = resample(T, m, closed=target.closed)
     z = resample(path, m, closed=closed_path)
@@ -235,7 +234,7 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tu
     for zz in (z, z[::-1]):
         for s in range(m):
             best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
-    return float(chamfer), best / target.diagonal
+    return float(chamfer), best / unit
 
 
 # ---------------------------------------------------------------------------- evaluation
@@ -264,18 +263,20 @@ def _full_plan(topo: CurveTopology):
     return plan
 
 
-def _sizes(paths: dict[str, np.ndarray]) -> np.ndarray:
-    """Largest distance ``(K,)`` of any point from the origin (the target's centre in the
-    working frame) over the motion; NaN samples ignored."""
-    R = np.stack([np.hypot(P[..., 0], P[..., 1]) for P in paths.values()], axis=-1)   # (K, N, M)
+def _sizes(paths: dict[str, np.ndarray], centre: tuple[float, float]) -> np.ndarray:
+    """Largest distance ``(K,)`` of any point from ``centre`` over the motion; NaN
+    samples ignored."""
+    R = np.stack([np.hypot(P[..., 0] - centre[0], P[..., 1] - centre[1]) for P in paths.values()], axis=-1)
     return np.nanmax(np.where(np.isfinite(R), R, np.nan), axis=(1, 2))
 
 
 @dataclass(frozen=True)
 class _Bounds:
-    """Design bounds in the working frame (target centred at 0, diagonal 1); ``None`` or
-    0 where lifted."""
+    """Design bounds in the working frame: ``centre`` the target's bounding-box centre,
+    ``unit`` its diagonal, ``radius`` the size bound (``None`` or 0 where lifted)."""
 
+    centre: tuple[float, float]
+    unit: float
     radius: float | None
     link_ratio: float | None
     transmission: float
@@ -312,7 +313,7 @@ class _Problem:
         self.T = np.stack([self.T.real, self.T.imag], axis=-1)
         self.ts, self.tv = _polyline(self.target.points, self.target.closed)
         self.features = sharp_features(self.target.points, self.target.closed)
-        self.diag = self.target.diagonal
+        self.diag = 1.0   # the working frame's length unit
         self.plan = _full_plan(self.topo)
         names = self.topo.plan.names
         self.frame_pts = [i for i, n in enumerate(names) if n != TRACER and any(
@@ -349,7 +350,7 @@ class _Problem:
         r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1), r3.reshape(len(X), -1)],
                            axis=1) / self.diag
         r[bad] = PENALTY                 # off its branch or not assembled: never accepted
-        size = _sizes(res.paths)
+        size = _sizes(res.paths, self.bounds.centre)
         mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(X), 90.0)
         pen = [self.bounds.excess(size, _link_ratio(X, self.link_pairs), mu, MARGIN) * BOUND_WEIGHT]
         if self.bounds.region is not None:
@@ -372,7 +373,7 @@ class _Problem:
 
 
 FEATURE_WEIGHT = 1.0   # the sharp-feature residuals against the chamfer's (both /sqrt(count))
-BOUND_WEIGHT = 0.05    # residual per unit of relative bound violation
+BOUND_WEIGHT = 1.0     # residual per unit of relative bound violation (aimed at MARGIN inside)
 
 
 def sharp_features(points: np.ndarray, closed: bool, angle: float = 50.0) -> np.ndarray:
@@ -485,7 +486,7 @@ def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, cr
     for r in rows_a.tolist():
         by_topo.setdefault(int(db.topology[r]), []).append(r)
     for ti, rs in by_topo.items():
-        seeds += _topology_seeds(db, db.topologies[ti], rs, w, target.diagonal, bounds)
+        seeds += _topology_seeds(db, db.topologies[ti], rs, w, bounds.unit, bounds)
     seeds.sort(key=lambda s: (s.rank, s.row))
     return seeds
 
@@ -521,7 +522,7 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
         res = simulate_batch(_full_plan(topo), Xs, np.array([_offsets(s.start, s.stop, s.closed, 48) for s in out]),
                              transmission=bounds.transmission > 0, flags=False)
         mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(out), 90.0)
-        exc = bounds.excess(_sizes(res.paths), _link_ratio(Xs, _link_pairs(topo)), mu).sum(axis=1)
+        exc = bounds.excess(_sizes(res.paths, bounds.centre), _link_ratio(Xs, _link_pairs(topo)), mu).sum(axis=1)
         for s, e in zip(out, exc):
             s.excess = float(e)
     return out
@@ -531,34 +532,36 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
 
 
 def _refine(seed: _Seed, target: TargetCurve, bounds: _Bounds, max_nfev: int) -> CurveCandidate | None:
+    """The seed refined in the working frame (None when it does not assemble)."""
     prob = _Problem(seed.topo, target, seed.closed, seed.start, seed.stop, bounds)
     x0 = seed.params
     prob.fun(x0)
     if prob.last_bad[0]:  # does not assemble over the range after the mapping
         return None
     try:
-        sol = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=target.diagonal,
+        sol = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=1.0,
                             max_nfev=max_nfev, xtol=1e-10, ftol=1e-10)
         x = sol.x
     except np.linalg.LinAlgError:  # a singular step: keep the retrieved design
         x = x0
-    return _candidate(seed.topo, x, seed.start, seed.stop, seed.closed, target, prob.nfev)
+    return _candidate(seed.topo, x, seed.start, seed.stop, seed.closed, target, prob.nfev, bounds)
 
 
 def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, closed: bool,
-               target: TargetCurve, nfev: int) -> CurveCandidate | None:
-    """The design's candidate in the working frame (target centred at 0), with its errors
-    and quality over :data:`N_FINAL` input samples; None when it is not assembled."""
+               target: TargetCurve, nfev: int, bounds: _Bounds) -> CurveCandidate | None:
+    """The design's candidate in the working frame, with its errors and quality over
+    :data:`N_FINAL` input samples (lengths in ``bounds.unit``); None when it is not
+    assembled."""
     off = _offsets(start, stop, closed, N_FINAL)
     res = simulate_batch(_full_plan(topo), x[None], off, transmission=True)
     if not res.assembled.all() or res.branch_jump[0]:
         return None
     path = res.paths[TRACER][0]
-    ch, od = curve_errors(path, target, closed)
-    size = float(_sizes(res.paths)[0])
+    ch, od = curve_errors(path, target, closed, bounds.unit)
+    size = float(_sizes(res.paths, bounds.centre)[0])
     return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
                           float(res.min_transmission_angle[0]), float(_link_ratio(x, _link_pairs(topo))[0]),
-                          path, nfev=nfev, size=size, size_ratio=size / target.diagonal)
+                          path, nfev=nfev, size=size, size_ratio=size / bounds.unit)
 
 
 def _verify(c: CurveCandidate) -> None:
@@ -589,34 +592,79 @@ def _verify(c: CurveCandidate) -> None:
 
 @dataclass(frozen=True)
 class _Frame:
-    """The working frame: the target's bounding-box centre at the origin, its diagonal 1
-    (translation and scale only, so input angles and assembly modes are unchanged).
-    The search runs there, so its tolerances mean the same at every scale."""
+    """The working frame, a similarity ``w = R((z - c) / r)`` of the target's plane: ``c``
+    and ``r`` the centroid and RMS radius of the target (equally spaced in arc length),
+    ``R`` the rotation to its principal axes (the long axis along x, its third moment
+    positive) followed, when the curve then runs clockwise, by the mirror in the x axis.
+    Each part is computed from the curve itself, so a translated, scaled, rotated or
+    mirrored target has the same working coordinates (rounded to ``1e-9``: the same
+    numbers, not merely close ones) and the search the same course. A linkage mapped by a
+    similarity traces the curve so mapped, on the same assembly branch; a mirrored one
+    with its input reversed. With a ground region (an axis-parallel box) rotation and
+    mirror are left out."""
 
-    centre: np.ndarray
+    centre: complex
     scale: float
+    turn: complex          # e^{i phi}: working x axis in target coordinates
+    mirror: bool
 
     @classmethod
-    def of(cls, target: TargetCurve) -> _Frame:
-        P = target.points
-        return cls(0.5 * (P.min(axis=0) + P.max(axis=0)), target.diagonal)
+    def of(cls, target: TargetCurve, rotate: bool = True) -> _Frame:
+        w = resample(target.points, 256, closed=target.closed)
+        c = complex(w.mean())
+        r = float(np.sqrt(np.mean(np.abs(w - c) ** 2)))
+        turn, mirror = 1.0 + 0j, False
+        if rotate:
+            u = (w - c) / r
+            m2 = np.sum(u ** 2)
+            turn = complex(np.exp(0.5j * np.angle(m2))) if abs(m2) > 1e-6 * len(u) else 1.0 + 0j
+            if np.sum(((u / turn).real) ** 3) < 0:
+                turn = -turn
+            v = u / turn
+            mirror = bool(np.sum(v.real * np.roll(v.imag, -1) - np.roll(v.real, -1) * v.imag) < 0)
+        return cls(c, r, turn, mirror)
+
+    def inward_points(self, P: np.ndarray) -> np.ndarray:
+        w = (P[..., 0] + 1j * P[..., 1] - self.centre) / (self.scale * self.turn)
+        w = np.conj(w) if self.mirror else w
+        return np.round(np.stack([w.real, w.imag], axis=-1), 9)
+
+    def outward_points(self, W: np.ndarray) -> np.ndarray:
+        w = W[..., 0] + 1j * W[..., 1]
+        z = self.centre + self.scale * self.turn * (np.conj(w) if self.mirror else w)
+        return np.stack([z.real, z.imag], axis=-1)
 
     def inward(self, target: TargetCurve) -> TargetCurve:
-        return TargetCurve((target.points - self.centre) / self.scale, target.closed, target.source)
+        return TargetCurve(self.inward_points(target.points), target.closed, target.source)
+
+    def bounds(self, user: TargetCurve, max_size, max_link_ratio, min_transmission, region) -> _Bounds:
+        """The design bounds in working coordinates (disc about the target's bounding-box
+        centre, radius in its diagonals)."""
+        P = user.points
+        centre = self.inward_points(0.5 * (P.min(axis=0) + P.max(axis=0)))
+        unit = user.diagonal / self.scale
+        box = None
+        if region is not None:
+            lo, hi = self.inward_points(np.array(region[:2])), self.inward_points(np.array(region[2:]))
+            box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+        return _Bounds((float(centre[0]), float(centre[1])), unit, None if max_size is None else max_size * unit,
+                       max_link_ratio, float(min_transmission), box)
 
     def outward(self, c: CurveCandidate) -> CurveCandidate:
-        """The candidate in the target's coordinates (errors and ratios unchanged)."""
+        """The candidate in the target's coordinates (errors and ratios unchanged; a
+        mirrored design runs its input the other way)."""
         import dataclasses
 
-        x = (c.params.reshape(-1, 2) * self.scale + self.centre).reshape(-1)
-        return dataclasses.replace(c, params=x, path=c.path * self.scale + self.centre, size=c.size * self.scale)
-
-    def box(self, region):
-        if region is None:
-            return None
-        x0, y0, x1, y1 = region
-        (a, b), (c, d) = (np.array([x0, y0]) - self.centre) / self.scale, (np.array([x1, y1]) - self.centre) / self.scale
-        return (float(a), float(b), float(c), float(d))
+        x = self.outward_points(c.params.reshape(-1, 2)).reshape(-1)
+        path = self.outward_points(c.path)
+        start, stop = c.start, c.stop
+        if self.mirror:
+            start, stop = -stop, -start
+            n = len(path)
+            path = path[(-np.arange(n)) % n] if c.full_turn else path[::-1]
+        ref = float(c.topology.plan.reference_inputs(x)[0])
+        return dataclasses.replace(c, params=x, path=path, start=start, stop=stop, size=c.size * self.scale,
+                                   reference_input=ref)
 
 
 def synthesize_curve(
@@ -725,9 +773,9 @@ def synthesize_curve(
         notes.append(f"{len(user.points)} points read as samples of a smooth curve (a "
                      f"{'periodic ' if user.closed else ''}spline through them), not a polygon")
         user = smooth_samples(user)
-    frame = _Frame.of(user)
+    frame = _Frame.of(user, rotate=ground_region is None)
     work = frame.inward(user)
-    bounds = _Bounds(max_size, max_link_ratio, float(min_transmission), frame.box(ground_region))
+    bounds = frame.bounds(user, max_size, max_link_ratio, min_transmission, ground_region)
     if database is None or isinstance(database, (str, os.PathLike)):
         database = load_database(database, max_links=max_links, callback=callback)
 
@@ -911,8 +959,8 @@ def _nearest_miss(misses: list[CurveCandidate], bounds: _Bounds, notes: list[str
 def _miss_reason(c: CurveCandidate, bounds: _Bounds) -> str:
     """``no candidate within the bounds; nearest miss: ...`` with the options that lift them."""
     out = []
-    if bounds.radius is not None and c.size_ratio > bounds.radius * (1 + 1e-9):
-        out.append(f"size {c.size_ratio:.2f} diagonals > {bounds.radius:g} (--max-size)")
+    if bounds.radius is not None and c.size > bounds.radius * (1 + 1e-9):
+        out.append(f"size {c.size_ratio:.2f} diagonals > {bounds.radius / bounds.unit:g} (--max-size)")
     if bounds.link_ratio is not None and c.link_length_ratio > bounds.link_ratio * (1 + 1e-9):
         out.append(f"link ratio {c.link_length_ratio:.1f} > {bounds.link_ratio:g} (--max-link-ratio)")
     if c.min_transmission_angle < bounds.transmission:

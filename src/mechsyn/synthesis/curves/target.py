@@ -39,7 +39,9 @@ class TargetCurve:
 
 def target_from_points(points, closed: bool | None = None, source: str = "<points>") -> TargetCurve:
     """Check and wrap points; ``closed=None`` decides by the gap between the ends
-    (closed when it is under 5 % of the bounding-box diagonal)."""
+    (closed when it is under 5 % of the bounding-box diagonal or, for fewer than
+    :data:`SPARSE_POINTS` points, at most 1.5 times the median distance between
+    neighbours)."""
     try:
         P = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
@@ -58,8 +60,9 @@ def target_from_points(points, closed: bool | None = None, source: str = "<point
     P = P[keep]
     diag = float(np.hypot(*np.ptp(P, axis=0))) if len(P) else 0.0
     gap = float(np.hypot(*(P[-1] - P[0]))) if len(P) else 0.0
-    if closed is None:
-        closed = gap < 0.05 * diag
+    if closed is None:  # a few samples of a loop: the ends are as far apart as neighbours
+        steps = np.hypot(*np.diff(P, axis=0).T) if len(P) > 1 else np.zeros(1)
+        closed = gap < 0.05 * diag or (len(P) < SPARSE_POINTS and gap <= 1.5 * float(np.median(steps)))
     if closed and len(P) > 1 and gap <= 1e-9 * diag:
         P = P[:-1]
     if len(P) < 3:
