@@ -696,13 +696,12 @@ def synthesize_curve(
         :data:`~mechsyn.synthesis.curves.target.SPARSE_POINTS` points are read as samples
         of a smooth curve (:func:`~mechsyn.synthesis.curves.target.smooth_samples`).
     max_links : {4, 6, 8}
-        Largest linkage considered.
+        Largest linkage.
     time_limit : float
-        Seconds for retrieval and refinement: a refinement is not started when the
-        longest one so far would overrun it; the best found so far is returned.
+        Seconds for retrieval and refinement (no refinement starts that the longest so
+        far says would overrun it).
     top : int
-        Candidates returned (see ``prefer``; the first three of distinct topologies
-        where candidates of three topologies are within ``tolerance``).
+        Candidates returned (see ``prefer``; the first three of distinct topologies).
     n_refine, retrieve : int
         Designs refined, and nearest descriptors retrieved per query.
     crank : bool
@@ -723,33 +722,27 @@ def synthesize_curve(
         turn, then the larger transmission angle (in 5° steps), then the error; the
         others after them by error. ``"accuracy"``: by error alone.
     database : CurveDatabase or directory, optional
-        Default: the local database (built on first use).
+        Default: the local one (built on first use).
     tolerance : float
         Chamfer error (in target diagonals, default 0.5 %) within which a candidate counts
         as tracing the curve; the search ends early once three topologies (or ``top``,
         if fewer) have a candidate within it.
     callback : callable, optional
-        ``callback(state)`` with a :class:`~mechsyn.synthesis.problem.Progress`
-        (``message`` the stage, ``best_error`` the best chamfer error so far in target
-        diagonals, ``nfev``); it also reads as the dict ``{"stage", "done", "total",
-        "best", "nfev"}`` the curve database's callback gets.
+        ``callback(state)`` with a :class:`~mechsyn.synthesis.problem.Progress` (stage,
+        best chamfer error so far, ``nfev``; it reads as the database build's dict too).
 
     Returns
     -------
     CurveSynthesisResult
-        Candidates best first, each within the bounds and re-simulated through
-        ``simulate``; without one, ``candidates`` is empty, ``feasible`` false, and
-        ``nearest_miss`` the best design found outside the bounds (its violations in
-        ``reason``). Ctrl-C during refinement returns what was found so far
-        (``interrupted``).
+        Candidates best first, within the bounds, re-simulated by ``simulate``; with none,
+        ``feasible`` false and ``nearest_miss`` the design closest to the bounds (named in
+        ``reason``). Ctrl-C returns the best so far (``interrupted``).
 
     Notes
     -----
-    The search runs in a working frame (the target's bounding-box centre at the origin,
-    its diagonal 1) and the designs are mapped back, so a translated or scaled target
-    gives the same design translated or scaled; a rotated or mirrored one the same
-    design rotated or mirrored wherever the bounds, measured on the bounding box, do not
-    decide between candidates.
+    The search runs in a working frame fixed by the curve itself (:class:`_Frame`), so a
+    similar target gives the same design transformed; only the size bound, measured on
+    the bounding box as drawn, changes with a rotation other than by quarter turns.
 
     Examples
     --------
@@ -768,38 +761,48 @@ def synthesize_curve(
     t0 = time.perf_counter()
     user = _checked_target(target, max_links, time_limit, top, max_link_ratio, crank)
     _checked_bounds(max_size, min_transmission, prefer, tolerance)
+    if database is None or isinstance(database, (str, os.PathLike)):
+        database = load_database(database, max_links=max_links, callback=callback)
+    o = dict(max_links=max_links, time_limit=time_limit, top=top, n_refine=n_refine, retrieve=retrieve, crank=crank,
+             ground_region=ground_region, max_size=max_size, max_link_ratio=max_link_ratio,
+             min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance)
+    return _search(user, database, t0, o, callback)
+
+
+def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, Any],
+            callback: Callable[[dict], None] | None) -> CurveSynthesisResult:
+    """The search of :func:`synthesize_curve` (options ``o`` checked): sparse targets
+    smoothed, the working frame, retrieval, refinement in order, ranking, mapping back."""
     notes: list[str] = []
     if len(user.points) < SPARSE_POINTS:
         notes.append(f"{len(user.points)} points read as samples of a smooth curve (a "
                      f"{'periodic ' if user.closed else ''}spline through them), not a polygon")
         user = smooth_samples(user)
-    frame = _Frame.of(user, rotate=ground_region is None)
+    frame = _Frame.of(user, rotate=o["ground_region"] is None)
     work = frame.inward(user)
-    bounds = frame.bounds(user, max_size, max_link_ratio, min_transmission, ground_region)
-    if database is None or isinstance(database, (str, os.PathLike)):
-        database = load_database(database, max_links=max_links, callback=callback)
+    bounds = frame.bounds(user, o["max_size"], o["max_link_ratio"], o["min_transmission"], o["ground_region"])
 
     def report(stage, done, total, best, nfev):
         if callback is not None:
             callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
 
     report("retrieve", 0, 1, float("nan"), 0)
-    seeds = _retrieve(database, work, retrieve, max_links, crank, bounds)
+    seeds = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
-    picked = _diverse(seeds, n_refine)
-    if prefer == "simple":  # the fewest links first: a four-bar within tolerance is never missed
+    picked = _diverse(seeds, o["n_refine"])
+    if o["prefer"] == "simple":  # the fewest links first: a four-bar within tolerance is never missed
         picked.sort(key=lambda s: (s.topo.n_links, s.rank, s.row))
-    run = _Refinement(work, bounds, max_nfev, report, notes=notes)
-    run.all(picked, t0 + time_limit, min(top, 3), tolerance)
+    run = _Refinement(work, bounds, o["max_nfev"], report, notes=notes)
+    run.all(picked, t0 + o["time_limit"], min(o["top"], 3), o["tolerance"])
     if not picked:
         run.notes.append("no database design matched the options (crank, links, open/closed)")
-    out = _ranked(run.cands, top, tolerance, prefer, run.notes)
+    out = _ranked(run.cands, o["top"], o["tolerance"], o["prefer"], run.notes)
     miss = _nearest_miss(run.misses, bounds, run.notes) if not out else None
     report("done", 1, 1, out[0].chamfer if out else float("nan"), run.nfev)
     res = _result(user, [frame.outward(c) for c in out], time.perf_counter() - t0, len(seeds), run.done,
                   run.nfev, run.interrupted, run.notes)
-    res.bounds = {"max_size": max_size, "max_link_ratio": max_link_ratio, "min_transmission_angle": min_transmission,
-                  "tolerance": tolerance, "prefer": prefer}
+    res.bounds = {"max_size": o["max_size"], "max_link_ratio": o["max_link_ratio"], "tolerance": o["tolerance"],
+                  "min_transmission_angle": o["min_transmission"], "prefer": o["prefer"]}
     res.nearest_miss = frame.outward(miss) if miss is not None else None
     if miss is not None:
         res.reason = _miss_reason(miss, bounds)
