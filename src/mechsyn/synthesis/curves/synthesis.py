@@ -372,7 +372,7 @@ class _Problem:
         return (R[1:] - R[0]).T / h
 
 
-FEATURE_WEIGHT = 1.0   # the sharp-feature residuals against the chamfer's (both /sqrt(count))
+FEATURE_WEIGHT = 0.25  # the sharp-feature residuals against the chamfer's (both /sqrt(count))
 BOUND_WEIGHT = 1.0     # residual per unit of relative bound violation (aimed at MARGIN inside)
 
 
