@@ -264,10 +264,11 @@ def _full_plan(topo: CurveTopology):
 
 
 def _sizes(paths: dict[str, np.ndarray], centre: tuple[float, float]) -> np.ndarray:
-    """Largest distance ``(K,)`` of any point from ``centre`` over the motion; NaN
-    samples ignored."""
+    """Largest distance ``(K,)`` of any point from ``centre`` over the motion; samples
+    not placed are ignored (inf when none is)."""
     R = np.stack([np.hypot(P[..., 0] - centre[0], P[..., 1] - centre[1]) for P in paths.values()], axis=-1)
-    return np.nanmax(np.where(np.isfinite(R), R, np.nan), axis=(1, 2))
+    m = np.max(np.where(np.isfinite(R), R, -np.inf), axis=(1, 2))
+    return np.where(np.isfinite(m), m, np.inf)          # nothing placed: no size to speak of
 
 
 @dataclass(frozen=True)
@@ -595,7 +596,8 @@ class _Frame:
     """The working frame, a similarity ``w = R((z - c) / r)`` of the target's plane: ``c``
     and ``r`` the centroid and RMS radius of the target (equally spaced in arc length),
     ``R`` the rotation to its principal axes (the long axis along x, its third moment
-    positive) followed, when the curve then runs clockwise, by the mirror in the x axis.
+    positive) followed, when the curve then runs clockwise (closed by its chord if open;
+    without enclosed area, when its y skew is negative), by the mirror in the x axis.
     Each part is computed from the curve itself, so a translated, scaled, rotated or
     mirrored target has the same working coordinates (rounded to ``1e-9``: the same
     numbers, not merely close ones) and the search the same course. A linkage mapped by a
@@ -620,8 +622,10 @@ class _Frame:
             turn = complex(np.exp(0.5j * np.angle(m2))) if abs(m2) > 1e-6 * len(u) else 1.0 + 0j
             if np.sum(((u / turn).real) ** 3) < 0:
                 turn = -turn
-            v = u / turn
-            mirror = bool(np.sum(v.real * np.roll(v.imag, -1) - np.roll(v.real, -1) * v.imag) < 0)
+            v = (resample(target.points, 256, closed=True) - c) / (r * turn)   # an open curve: closed by its chord
+            area = 0.5 * np.sum(v.real * np.roll(v.imag, -1) - np.roll(v.real, -1) * v.imag)
+            # clockwise: mirror; no area to speak of (a figure eight): the side the y skew points to
+            mirror = bool(area < 0) if abs(area) > 1e-3 else bool(np.sum(v.imag ** 3) < 0)
         return cls(c, r, turn, mirror)
 
     def inward_points(self, P: np.ndarray) -> np.ndarray:
@@ -789,7 +793,7 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
     report("retrieve", 0, 1, float("nan"), 0)
     seeds = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
-    picked = _diverse(seeds, o["n_refine"])
+    picked = _diverse(seeds, o["n_refine"], simple=o["prefer"] == "simple")
     if o["prefer"] == "simple":  # the fewest links first: a four-bar within tolerance is never missed
         picked.sort(key=lambda s: (s.topo.n_links, s.rank, s.row))
     run = _Refinement(work, bounds, o["max_nfev"], report, notes=notes)
@@ -840,17 +844,22 @@ def _checked_bounds(max_size: float | None, min_transmission: float, prefer: str
         raise MechsynInputError("must be a fraction of the diagonal in (0, 1)", field="tolerance")
 
 
-def _diverse(seeds: list[_Seed], n_refine: int) -> list[_Seed]:
-    """The seeds to refine: at most a third from one topology, then filled up by rank."""
+def _diverse(seeds: list[_Seed], n_refine: int, simple: bool = False) -> list[_Seed]:
+    """The seeds to refine: at most a third from one topology, then filled up by rank;
+    with ``simple`` the best four-bars (a third of ``n_refine``) and six-bars (a quarter)
+    are picked first, by rank: the simplest linkages are always tried, however well the
+    larger ones were retrieved."""
     picked: list[_Seed] = []
     per: dict[str, int] = {}
     cap = max(2, n_refine // 3)
-    for s in seeds:
-        if per.get(s.topo.key, 0) < cap:
-            picked.append(s)
-            per[s.topo.key] = per.get(s.topo.key, 0) + 1
-        if len(picked) >= n_refine:
-            break
+    quota = {4: cap, 6: max(1, n_refine // 4)} if simple else {}
+    for group in ([[s for s in seeds if s.topo.n_links == n][:q] for n, q in quota.items()] + [seeds]):
+        for s in group:
+            if len(picked) >= n_refine:
+                break
+            if per.get(s.topo.key, 0) < cap and all(s is not p for p in picked):
+                picked.append(s)
+                per[s.topo.key] = per.get(s.topo.key, 0) + 1
     if len(picked) < n_refine:
         chosen = {id(s) for s in picked}
         picked += [s for s in seeds if id(s) not in chosen][:n_refine - len(picked)]
