@@ -106,6 +106,7 @@ def test_no_candidate_within_the_bounds_reports_the_nearest_miss(db, db_path, tm
     assert code == 1 and "nearest miss" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_fewest_links_first_within_the_tolerance_and_distinct_topologies(db):
     P = _fourbar_curve(8)
     res = synthesize_curve(P, max_links=6, top=4, n_refine=16, database=db, time_limit=300)
@@ -150,6 +151,7 @@ def test_similar_targets_give_the_same_design_transformed(db):
                 assert gap < 1e-6 * res.target.diagonal
 
 
+@pytest.mark.slow
 def test_scaled_targets_keep_their_answer_with_the_default_bounds(db):
     """x1e-3 and x1e4, turned by 90 degrees and mirrored: the bounding box maps exactly,
     so even the size bound is the same and the answer is the same design transformed."""
