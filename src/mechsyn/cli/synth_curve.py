@@ -23,7 +23,7 @@ def synth_curve(
     top: int = typer.Option(5, "--top", help="How many candidates to list."),
     crank: bool = typer.Option(False, "--crank", help="Only fully rotating inputs (closed targets)."),
     ground_region: Optional[str] = typer.Option(None, "--ground-region", help="Box x0,y0,x1,y1 the frame pivots must stay in."),
-    max_size: float = typer.Option(1.5, "--max-size", help="Every joint within this many target diagonals of the target's centre over the motion (0: no bound)."),
+    max_size: float = typer.Option(1.5, "--max-size", help="Every joint within this many target diagonals of the target's bounding-box centre over the motion (0: no bound)."),
     max_link_ratio: float = typer.Option(10.0, "--max-link-ratio", help="Largest longest/shortest link length (0: no bound)."),
     min_transmission: float = typer.Option(30.0, "--min-transmission-angle", "--min-transmission", help="Smallest transmission angle [deg] over the motion (0: no bound)."),
     prefer: str = typer.Option("simple", "--prefer", help="simple: fewest links within the tolerance, then quality, then error; accuracy: error alone."),
@@ -43,13 +43,19 @@ def synth_curve(
     with _curve_progress() as callback:
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
                                ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
-                               min_transmission=min_transmission, prefer=prefer, tolerance=tolerance / 100.0,
+                               min_transmission=min_transmission, prefer=prefer, tolerance=_fraction(tolerance),
                                database=database, callback=callback)
     if out is not None:
         _write_out(out, res)
     emit_json(res.to_dict()) if as_json else render_curve_synthesis(res)
     stop_if_interrupted(res)
     _fail_if_empty(res)
+
+
+def _fraction(percent: float) -> float:
+    if not 0 < percent < 100:
+        raise MechsynInputError(f"{percent:g}: give a percentage of the diagonal in (0, 100)", source="--tolerance")
+    return percent / 100.0
 
 
 def _fail_if_empty(res) -> None:
