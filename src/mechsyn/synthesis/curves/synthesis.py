@@ -794,8 +794,8 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
     seeds = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
     picked = _diverse(seeds, o["n_refine"], simple=o["prefer"] == "simple")
-    if o["prefer"] == "simple":  # the fewest links first: a four-bar within tolerance is never missed
-        picked.sort(key=lambda s: (s.topo.n_links, s.rank, s.row))
+    if o["prefer"] == "simple":  # four-bars first (one within tolerance is never missed), then by rank
+        picked.sort(key=lambda s: (s.topo.n_links != 4, s.rank, s.row))
     run = _Refinement(work, bounds, o["max_nfev"], report, notes=notes)
     run.all(picked, t0 + o["time_limit"], min(o["top"], 3), o["tolerance"])
     if not picked:
