@@ -2,7 +2,7 @@
 
 Run from the repository root::
 
-    python benchmarks/curve_alphabet.py [--letters ABC...] [--time-limit 120] [--max-links 8]
+    python benchmarks/curve_alphabet.py [--letters ABC...] [--time-limit 120] [--max-links 8] [--refine 32]
                                         [--database DIR] [--figure docs/figures/curve_alphabet.png]
                                         [--json out.json]
 
@@ -61,14 +61,14 @@ def letter_outline(letter: str, n: int = 200) -> np.ndarray:
     return np.c_[z.real, z.imag]
 
 
-def run(letters: str, db, time_limit: float, max_links: int) -> list[dict]:
+def run(letters: str, db, time_limit: float, max_links: int, n_refine: int = 32) -> list[dict]:
     rows = []
     print(f"{'letter':>6} {'best':>24} {'chamfer %':>10} {'size':>5} {'ratio':>6} {'mu':>4} {'time s':>7}")
     for ch in letters:
         P = letter_outline(ch)
         t0 = time.perf_counter()
         res = synthesize_curve(target_from_points(P, closed=True), max_links=max_links, time_limit=time_limit,
-                               top=1, database=db)
+                               top=1, database=db, n_refine=n_refine)
         dt = time.perf_counter() - t0
         c = res.candidates[0] if res.candidates else None
         row = {"letter": ch, "seconds": dt, "chamfer": c.chamfer if c else None,
@@ -129,6 +129,7 @@ def main() -> None:
     ap.add_argument("--letters", default=string.ascii_uppercase)
     ap.add_argument("--time-limit", type=float, default=120.0)
     ap.add_argument("--max-links", type=int, default=8)
+    ap.add_argument("--refine", type=int, default=32, help="designs refined per letter (synthesize_curve's n_refine)")
     ap.add_argument("--database", default=None)
     ap.add_argument("--figure", default=None)
     ap.add_argument("--json", default=None)
@@ -137,7 +138,7 @@ def main() -> None:
     db = load_database(args.database, max_links=args.max_links)
     print(f"database: {len(db)} curves of {len(db.topologies)} topologies, loaded in "
           f"{time.perf_counter() - t0:.1f} s; time limit {args.time_limit:g} s per letter")
-    rows = run(args.letters, db, args.time_limit, args.max_links)
+    rows = run(args.letters, db, args.time_limit, args.max_links, args.refine)
     if args.json:
         Path(args.json).write_text(json.dumps(rows))
     if args.figure:
