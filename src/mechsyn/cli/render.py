@@ -296,16 +296,19 @@ def render_curve_synthesis(res: Any) -> None:
     """``mechsyn synth curve``: the ranked candidates, their errors and the run's notes."""
     tgt = res.target
     t = Table(title=f"Curve synthesis: {tgt.source} ({'closed' if tgt.closed else 'open'}, {len(tgt.points)} points)")
-    for c in ("#", "topology", "links", "chamfer", "ordered", "min mu", "ratio", "input [deg]"):
-        t.add_column(c, justify="right" if c not in ("topology",) else "left")
+    for c in ("#", "topology", "links", "chamfer", "ordered", "size", "min mu", "ratio", "input"):
+        t.add_column(c, justify="right" if c not in ("topology",) else "left", no_wrap=c != "topology")
     for i, c in enumerate(res.candidates, 1):
         d = c.to_dict()
         inp = d["input"]
-        t.add_row(str(i), d["topology"] or c.topology.key, str(d["links"]), f"{100 * c.chamfer:.2f} %",
-                  f"{100 * c.ordered:.2f} %", f"{c.min_transmission_angle:.0f}", f"{c.link_length_ratio:.1f}",
-                  f"{inp['joint']} {inp['start']:.0f}..{inp['stop']:.0f}")
-    console.print(t)
-    console.print(f"errors per bounding-box diagonal ({tgt.diagonal:.4g}); {res.refined} refined of "
+        turn = "full turn" if c.full_turn else f"{inp['start']:.0f}..{inp['stop']:.0f}°"
+        t.add_row(str(i), d["topology"], str(d["links"]), f"{100 * c.chamfer:.2f} %",
+                  f"{100 * c.ordered:.2f} %", f"{c.size_ratio:.2f}", f"{c.min_transmission_angle:.0f}",
+                  f"{c.link_length_ratio:.1f}", f"{inp['joint']} {turn}")
+    if res.candidates:
+        console.print(t)
+    console.print(f"errors and size (radius about the target's centre) per bounding-box diagonal "
+                  f"({tgt.diagonal:.4g}); {res.refined} refined of "
                   f"{res.retrieved} retrieved in {res.seconds:.1f} s; every candidate re-simulated by simulate"
                   + ("; interrupted: best so far" if res.interrupted else ""))
     for n in res.notes:

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 import typer
+from rich.markup import escape
 
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import check_writable, emit_json, err_console, parse_floats, stop_if_interrupted
@@ -22,13 +23,16 @@ def synth_curve(
     top: int = typer.Option(5, "--top", help="How many candidates to list."),
     crank: bool = typer.Option(False, "--crank", help="Only fully rotating inputs (closed targets)."),
     ground_region: Optional[str] = typer.Option(None, "--ground-region", help="Box x0,y0,x1,y1 the frame pivots must stay in."),
-    max_link_ratio: Optional[float] = typer.Option(None, "--max-link-ratio", help="Largest longest/shortest link length."),
-    min_transmission: float = typer.Option(15.0, "--min-transmission", help="Transmission angles below this (deg) are penalised."),
+    max_size: float = typer.Option(1.5, "--max-size", help="Every joint within this many target diagonals of the target's bounding-box centre over the motion (0: no bound)."),
+    max_link_ratio: float = typer.Option(10.0, "--max-link-ratio", help="Largest longest/shortest link length (0: no bound)."),
+    min_transmission: float = typer.Option(30.0, "--min-transmission-angle", "--min-transmission", help="Smallest transmission angle [deg] over the motion (0: no bound)."),
+    prefer: str = typer.Option("simple", "--prefer", help="simple: fewest links within the tolerance, then quality, then error; accuracy: error alone."),
+    tolerance: float = typer.Option(0.5, "--tolerance", help="Chamfer error [% of the diagonal] within which fewer links rank first."),
     database: Optional[Path] = typer.Option(None, "--database", help="Curve database directory (default: the local one, built on first use)."),
     as_json: bool = typer.Option(False, "--json", help="Print {\"candidates\": [...]} as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write each candidate's mechanism file and figure into DIR."),
 ) -> None:
-    """Curve to mechanism: ranked 4-, 6- and 8-bar linkages tracing the target, each re-simulated."""
+    """Curve to mechanism: ranked 4-, 6- and 8-bar linkages tracing the target, sized to it, each re-simulated."""
     from mechsyn.cli.render import render_curve_synthesis
     from mechsyn.synthesis.curves.synthesis import synthesize_curve
     from mechsyn.synthesis.curves.target import read_target
@@ -38,15 +42,27 @@ def synth_curve(
     tgt = read_target(target)
     with _curve_progress() as callback:
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
-                               ground_region=box, max_link_ratio=max_link_ratio, min_transmission=min_transmission,
+                               ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
+                               min_transmission=min_transmission, prefer=prefer, tolerance=_fraction(tolerance),
                                database=database, callback=callback)
     if out is not None:
         _write_out(out, res)
-    if as_json:
-        emit_json(res.to_dict())
-    else:
-        render_curve_synthesis(res)
+    emit_json(res.to_dict()) if as_json else render_curve_synthesis(res)
     stop_if_interrupted(res)
+    _fail_if_empty(res)
+
+
+def _fraction(percent: float) -> float:
+    if not 0 < percent < 100:
+        raise MechsynInputError(f"{percent:g}: give a percentage of the diagonal in (0, 100)", source="--tolerance")
+    return percent / 100.0
+
+
+def _fail_if_empty(res) -> None:
+    """No candidate within the bounds is an error (exit status 1), the nearest miss named."""
+    if not res.candidates:
+        err_console.print(f"[bold red]error:[/] {escape(res.reason)}", highlight=False, soft_wrap=True)
+        raise typer.Exit(1)
 
 
 def _ground_region(text: Optional[str]) -> Optional[tuple[float, ...]]:

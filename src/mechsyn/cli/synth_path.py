@@ -21,6 +21,9 @@ TargetErrorOpt = Annotated[Optional[float], typer.Option(
 MinTransmissionOpt = Annotated[Optional[float], typer.Option(
     "--min-transmission-angle", help="Smallest transmission angle [deg] allowed over the motion (default: the "
     "case's, else 20; 0: no limit).")]
+MaxSizeOpt = Annotated[Optional[float], typer.Option(
+    "--max-size", help="Pivots and pin circles within this many target diagonals of the targets' centre "
+    "(default: the case's, else 1.5; 0: no bound).")]
 FoldMarginOpt = Annotated[Optional[float], typer.Option(
     "--fold-margin", help="Grashof cases: how far [deg] the linkage must stay from folding flat anywhere in the "
     "turn (default: the case's, else 5).")]
@@ -39,6 +42,7 @@ def synth_path(
     target_error: TargetErrorOpt = None,
     min_transmission: MinTransmissionOpt = None,
     fold_margin: FoldMarginOpt = None,
+    max_size: MaxSizeOpt = None,
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     plot: Optional[Path] = typer.Option(None, "--plot", help="Write targets vs achieved path (PNG)."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file (.yaml/.json)."),
@@ -59,7 +63,7 @@ def synth_path(
     with restart_progress(f"synth path {case.id}", restarts) as progress:
         res = path_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                              scheduler=scheduler, optimizer=optimizer, target_error=target_error,
-                             min_transmission=min_transmission, fold_margin=fold_margin, callback=progress, **ck)
+                             min_transmission=min_transmission, fold_margin=fold_margin, max_size=max_size, callback=progress, **ck)
     _write_path_files(case, res, out, plot)
     if as_json:
         emit_json(res.to_dict())

@@ -50,6 +50,7 @@ LENGTHS = ("r1", "r2", "r3", "r4")
 TIMING_TYPES = ("prescribed", "prescribed_increment", "free")
 TRANSMISSION_ANGLE_MIN_DEG = 20.0  # default margin of force transmission over the motion
 FOLD_MARGIN_DEG = 5.0  # default distance of a Grashof design from folding flat
+MAX_SIZE = 1.5  # synthesize_path's default: pivots and pin circles within this many target diagonals of the targets' centre
 
 
 def _err(msg: str, source: str | None, fld: str | None = None, hint: str | None = None) -> MechsynInputError:
@@ -91,6 +92,7 @@ class PathCase:
     transmission_angle_min_deg: float | None = TRANSMISSION_ANGLE_MIN_DEG
     fold_margin_deg: float = FOLD_MARGIN_DEG
     link_ratio_max: float | None = None
+    max_size: float | None = None  # as the case states it (None: not stated; 0: no bound)
     title: str = ""
     published: tuple[dict, ...] = ()
     best_known: float | None = None
@@ -230,7 +232,10 @@ def _path_options(data: dict, source: str | None) -> dict[str, Any]:
     if order not in ("ccw", "cw"):
         raise _err("must be \"ccw\" or \"cw\"", source, "options.order")
     out = {"branch": int(branch), "grashof": grashof, "order": order,
-           "link_ratio_max": options.get("link_ratio_max")}
+           "link_ratio_max": options.get("link_ratio_max"), "max_size": options.get("max_size")}
+    size = out["max_size"]
+    if size is not None and (isinstance(size, bool) or not isinstance(size, (int, float)) or not size >= 0):
+        raise _err("must be a number of target diagonals >= 0 (0: no bound)", source, "options.max_size")
     for key, default in (("transmission_angle_min_deg", TRANSMISSION_ANGLE_MIN_DEG),
                          ("fold_margin_deg", FOLD_MARGIN_DEG)):
         value = options.get(key, default)

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import differential_evolution, least_squares
 
+from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
 from mechsyn.synthesis.path import PathCase, PathProblem, evaluate_design
 from mechsyn.synthesis.problem import Progress, ProgressCallback, SeedLike, SynthesisResult, as_generator, resolve_seed
@@ -228,6 +229,9 @@ class PathSynthesisResult(SynthesisResult):
     transmission_angle_min_deg: float | None = None
     fold_margin_deg: float | None = None
     resumed: int = 0
+    size: float | None = None          # radius of the disc about the targets' centre holding the linkage
+    size_ratio: float | None = None    # size / the targets' bounding-box diagonal
+    max_size: float | None = None      # the bound on size_ratio (None: lifted)
 
     @property
     def target_reached(self) -> bool:
@@ -240,6 +244,7 @@ class PathSynthesisResult(SynthesisResult):
             "worst_transmission_angle_deg": self.worst_transmission_angle_deg,
             "transmission_angle_min_deg": self.transmission_angle_min_deg,
             "fold_distance_deg": self.fold_distance_deg, "fold_margin_deg": self.fold_margin_deg,
+            "size": self.size, "size_ratio": self.size_ratio, "max_size": self.max_size,
             "target_error": self.target_error, "target_reached": self.target_reached,
             "seconds": self.seconds, "seed": self.seed, "restarts": self.restarts, "nfev": self.nfev,
             "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
@@ -249,6 +254,30 @@ class PathSynthesisResult(SynthesisResult):
         }
 
 
+def with_size_bound(case: PathCase, max_size: float | None = None) -> PathCase:
+    """The case with the size bound the search keeps: ``max_size`` when given (0: none),
+    else the case's own ``options.max_size``, else :data:`~mechsyn.synthesis.cases.MAX_SIZE`
+    (1.5 target diagonals) -- except for a literature case (one with published
+    solutions), which keeps the design space it was published with.
+
+    >>> import dataclasses, mechsyn as ms
+    >>> from mechsyn.synthesis.path import load_cases
+    >>> lit = load_cases(ms.examples.path("path_cases_public"))[0]      # published solutions
+    >>> mine = dataclasses.replace(lit, published=())
+    >>> with_size_bound(lit).max_size, with_size_bound(mine).max_size, with_size_bound(mine, 0).max_size
+    (None, 1.5, None)
+    """
+    import dataclasses
+
+    from mechsyn.synthesis.cases import MAX_SIZE
+
+    if max_size is not None and not max_size >= 0:
+        raise MechsynInputError("must be >= 0 target diagonals (0: no bound)", field="max_size")
+    if max_size is None:
+        max_size = case.max_size if case.max_size is not None else (None if case.published else MAX_SIZE)
+    return dataclasses.replace(case, max_size=max_size or None)
+
+
 def _path_reason(check: dict[str, Any], case: PathCase) -> str:
     """Why a path design is infeasible ("" when it is feasible)."""
     if check["feasible"]:
@@ -256,7 +285,9 @@ def _path_reason(check: dict[str, Any], case: PathCase) -> str:
     if not check["assembled_at_all_targets"]:
         return "the linkage cannot be assembled at every target"
     return (f"a constraint is violated (transmission angle >= {case.transmission_angle_min_deg}°, "
-            f"fold margin {case.fold_margin_deg}°, bounds or timing order)")
+            f"fold margin {case.fold_margin_deg}°, "
+            + (f"size <= {case.max_size} diagonals (--max-size), " if case.max_size else "")
+            + "bounds or timing order)")
 
 
 def restart_seeds(seed: SeedLike, restarts: int) -> list[int]:
@@ -275,7 +306,7 @@ def synthesize_path(
     case: PathCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
     optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
     callback: ProgressCallback | None = None, scheduler: Any = None,
-    target_error: float | None = None, checkpoint: Any = None, resume: bool = False,
+    target_error: float | None = None, checkpoint: Any = None, resume: bool = False, max_size: float | None = None,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
 
@@ -316,14 +347,14 @@ def synthesize_path(
     ...     "fixed": {"x0": 0.0, "y0": 0.0, "theta0": 0.0},
     ...     "variables": [{"name": n, "lower": lo, "upper": 6.0} for n, lo in
     ...                   (("r1", 0.1), ("r2", 0.1), ("r3", 0.1), ("r4", 0.1), ("rcx", -6.0), ("rcy", -6.0))]})
-    >>> res = ms.synthesize_path(case, seed=0, time_limit=20, restarts=2)
-    >>> res.feasible, bool(res.error < 1e-6)       # sum of squared distances to the targets
-    (True, True)
+    >>> res = ms.synthesize_path(case, seed=0, time_limit=20, restarts=2, max_size=0)  # no size bound
+    >>> res.feasible, bool(res.error < 1e-6), bool(res.size_ratio > 1.5)  # error: sum of squared distances
+    (True, True, True)
     """
     from mechsyn.parallel import run_tasks
 
     check_optimizer(optimizer)
-    options = dict(options or {})
+    case, options = with_size_bound(case, max_size), dict(options or {})
     t0 = time.time()
     seed = resolve_seed(seed)
     deadline, reserve = t0 + time_limit, min(4.0, 0.07 * time_limit)
@@ -423,6 +454,8 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
     win = min(results, key=lambda r: (r.fitness, r.index))
     design = problem.design(win.z)
     check = evaluate_design(case, design)
+    size = float(problem.size(problem.unpack(np.asarray(win.z, float)[None])[0])[0])
+    diag = float(np.hypot(*np.ptp(case.targets, axis=0)))
     return PathSynthesisResult(
         case_id=case.id, error=check["error"], design=design, x=np.asarray(win.z, float),
         reason=_path_reason(check, case),
@@ -436,7 +469,7 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
         fold_distance_deg=check["fold_distance_deg"],
         transmission_angle_min_deg=case.transmission_angle_min_deg,
         fold_margin_deg=case.fold_margin_deg if case.grashof else None,
-        resumed=resumed,
+        resumed=resumed, size=size, size_ratio=size / diag if diag > 0 else None, max_size=case.max_size,
     )
 
 

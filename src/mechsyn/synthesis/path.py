@@ -29,6 +29,12 @@ Constraints (all must hold; see :meth:`PathProblem.evaluate`):
   ``mu`` between coupler and rocker must stay within ``[min, 180 - min]``);
 * input angles cyclically ordered (counter-clockwise, at most one turn) for free timing;
 * optional ``options.link_ratio_max`` (longest / shortest of ``r1..r4``);
+* a size bound ``options.max_size`` (0 or absent: none here; :func:`synthesize_path`
+  puts 1.5 where the case states none): both frame pivots and the whole circles the
+  crank and rocker pins move on lie within ``max_size`` times the targets'
+  bounding-box diagonal of the box's centre (the linkage, pivots included, fits in a
+  disc ``2 max_size`` diagonals across; the pins' circles are a safe over-estimate of
+  the arcs they sweep);
 * variable bounds.
 
 Feasibility first: an infeasible design scores ``U + violation`` where ``U`` is an upper
@@ -300,11 +306,29 @@ class PathProblem:
         if case.link_ratio_max is not None:
             ratio = np.max(rmat, axis=1) / np.maximum(np.min(rmat, axis=1), 1e-300)
             viol += np.maximum(0.0, ratio - case.link_ratio_max) / case.link_ratio_max
+        if case.max_size:
+            viol += self._size_violation(vals)
         # bounds of the case's own variables (internal bounds hold by construction except
         # reported angles whose bounds are narrower than a turn)
         viol += self._bound_violation(z, vals, th)
         error = np.where(np.isfinite(error), error, np.inf)
         return Evaluation(error=error, violation=viol, assembled_at_all_targets=assembled_all)
+
+    def size(self, vals: dict[str, np.ndarray]) -> np.ndarray:
+        """Radius ``(P,)`` about the targets' bounding-box centre of the disc holding both
+        frame pivots and the circles of the crank and rocker pins."""
+        T = self.case.targets
+        c = 0.5 * (T.min(axis=0) + T.max(axis=0))
+        a0 = np.hypot(vals["x0"] - c[0], vals["y0"] - c[1])
+        bx = vals["x0"] + vals["r1"] * np.cos(vals["theta0"])
+        by = vals["y0"] + vals["r1"] * np.sin(vals["theta0"])
+        b0 = np.hypot(bx - c[0], by - c[1])
+        return np.maximum(a0 + np.abs(vals["r2"]), b0 + np.abs(vals["r4"]))
+
+    def _size_violation(self, vals: dict[str, np.ndarray]) -> np.ndarray:
+        T = self.case.targets
+        limit = self.case.max_size * max(float(np.hypot(*np.ptp(T, axis=0))), 1e-300)
+        return np.maximum(0.0, self.size(vals) / limit - 1.0)
 
     def _bound_violation(self, z, vals, th) -> np.ndarray:
         v = np.sum(np.maximum(0.0, self.lower - z) + np.maximum(0.0, z - self.upper), axis=1)

@@ -78,7 +78,7 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
                    workers: int = 1, scheduler: Any = None, optimizer: str = "de",
                    target_error: float | None = None, min_transmission: float | None = None,
                    fold_margin: float | None = None, callback: Callable[..., None] | None = None,
-                   **search: Any) -> Any:
+                   max_size: float | None = None, **search: Any) -> Any:
     """Path generation of ``case`` with the designer's margins (see
     :func:`mechsyn.synthesis.optimize.synthesize_path`).
 
@@ -93,6 +93,11 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     min_transmission, fold_margin : float, optional
         Smallest transmission angle over the motion and the least distance from folding
         flat [deg], replacing the case's.
+    max_size : float, optional
+        Size bound in target diagonals replacing the case's (default: the case's, else
+        1.5 except for literature cases; 0 lifts it): frame pivots and the crank and
+        rocker pins' circles within this many diagonals of the targets' bounding-box
+        centre (:func:`~mechsyn.synthesis.optimize.with_size_bound`).
     **search
         Passed on (``checkpoint=``, ``resume=``).
 
@@ -117,7 +122,7 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     stop_at = default_target_error(case) if target_error is None else (target_error or None)
     return synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                            optimizer=optimizer, callback=callback, scheduler=scheduler, target_error=stop_at,
-                           **search)
+                           max_size=max_size, **search)
 
 
 def _check_budget(time_limit: float, restarts: int) -> None:

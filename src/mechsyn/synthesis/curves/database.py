@@ -160,16 +160,23 @@ def _file(directory: Path, topo: CurveTopology) -> Path:
     return directory / f"{topo.key}.npz"
 
 
+_KEYS = ("designs", "ranges", "closed", "descriptors", "drawn")
+
+
 def _read(path: Path) -> dict | None:
-    """A topology's arrays, or None when its file is missing or damaged (a truncated or
-    corrupted .npz is built again instead of stopping with a traceback, issue 27)."""
+    """A topology's file, or None when it is missing or damaged (truncated, not an
+    ``.npz``, arrays missing or of mismatched lengths): it is then rebuilt."""
     import zipfile
 
     try:
         with np.load(path, allow_pickle=False) as f:
-            return {k: f[k] for k in f.files}
+            data = {k: f[k] for k in _KEYS}
     except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile):
         return None
+    n = len(data["ranges"])
+    if any(len(data[k]) != n for k in ("designs", "closed", "descriptors")) or data["drawn"].shape != ():
+        return None
+    return data
 
 
 def build_database(directory: str | os.PathLike[str] | None = None, max_links: int = DEFAULT_LINKS,
@@ -285,11 +292,12 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
     rows_t, designs, ranges, closed, desc = [], [], [], [], []
     for ti, t in enumerate(present):
         data = _read(_file(directory, t))
-        if data is None or not {"ranges", "designs", "closed", "descriptors"} <= set(data):
+        if data is None:
             from mechsyn.errors import MechsynInputError
 
-            raise MechsynInputError(f"damaged curve database file {_file(directory, t).name}", source=str(directory),
-                                    field="database", hint="run `mechsyn curves build` (it builds damaged files again)")
+            raise MechsynInputError("the curve database file is damaged", source=str(_file(directory, t)),
+                                    hint=f"rebuild it: mechsyn curves build --links {t.n_links} --database {directory} "
+                                         "(with the --per-topology it was built with)")
         if len(data["ranges"]) == 0:
             continue
         m = len(data["ranges"])

@@ -52,7 +52,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import simulate_batch
 from mechsyn.synthesis.curves.database import CurveDatabase, load_database
 from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
-from mechsyn.synthesis.curves.target import TargetCurve, target_from_points
+from mechsyn.synthesis.curves.target import SPARSE_POINTS, TargetCurve, smooth_samples, target_from_points
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
 from mechsyn.synthesis.problem import Progress, SynthesisResult
 
@@ -62,6 +62,12 @@ M_TARGET = 64          # target points for the residuals
 N_TRACE = 96           # input samples along the range (refinement)
 N_FINAL = 360          # input samples of the reported path and errors
 PENALTY = 1.0          # residual (in target diagonals) of an unassembled design
+
+DEFAULT_MAX_SIZE = 1.5            # every point inside this many diagonals of the target's centre
+DEFAULT_MAX_LINK_RATIO = 10.0     # longest / shortest link length
+DEFAULT_MIN_TRANSMISSION = 30.0   # degrees, worst over the motion
+DEFAULT_TOLERANCE = 5e-3          # chamfer / diagonal within which fewer links rank first
+MARGIN = 0.97                     # the refinement aims this far inside each bound
 
 
 @dataclass
@@ -81,14 +87,27 @@ class CurveCandidate:
     verification: str = ""
     nfev: int = 0
     reference_input: float = float("nan")   # input angle (deg) of the design's configuration
+    size: float = float("nan")              # radius about the target's centre holding every point
+    size_ratio: float = float("nan")        # size / target diagonal
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.reference_input):
-            from mechsyn.io.load import mechanism_from_dict
-            from mechsyn.kinematics.batch import compile_plan
+            self.reference_input = float(self.topology.plan.reference_inputs(self.params)[0])
 
-            self.reference_input = compile_plan(mechanism_from_dict(self.mechanism()),
-                                                points=[TRACER]).reference_input
+    @property
+    def full_turn(self) -> bool:
+        """The input turns fully (a crank)."""
+        return bool(self.stop - self.start >= 360.0 - 1e-9)
+
+    def quality(self) -> dict[str, Any]:
+        """The design-quality fields: ``size`` (radius of the disc about the target's
+        bounding-box centre that holds every joint and the tracer over the whole motion,
+        target units), ``size_ratio`` (that over the target's diagonal), ``link_ratio``
+        (longest over shortest link length), ``min_transmission_angle`` (degrees, worst
+        RRR dyad over the motion) and ``full_turn``."""
+        return {"size": float(self.size), "size_ratio": float(self.size_ratio),
+                "link_ratio": float(self.link_length_ratio),
+                "min_transmission_angle": float(self.min_transmission_angle), "full_turn": self.full_turn}
 
     def mechanism(self) -> dict:
         t = self.topology
@@ -103,12 +122,13 @@ class CurveCandidate:
             "tracer": TRACER,
             "input": {"joint": t.plan.input_joint, "start": ref + self.start, "stop": ref + self.stop},
             "links": t.n_links,
-            "topology": t.name,
+            "topology": t.label,
             "topology_key": t.key,
             "error": {"chamfer": self.chamfer, "ordered": self.ordered},
+            "quality": self.quality(),
             "min_transmission_angle": self.min_transmission_angle,
             "link_length_ratio": self.link_length_ratio,
-            "crank": bool(self.stop - self.start >= 360.0 - 1e-9),
+            "crank": self.full_turn,
             "verified": self.verified,
             "verification": self.verification,
         }
@@ -129,11 +149,15 @@ class CurveSynthesisResult(SynthesisResult):
     retrieved: int
     refined: int
     notes: list[str] = field(default_factory=list)
+    bounds: dict[str, Any] = field(default_factory=dict)
+    nearest_miss: CurveCandidate | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        miss = self.nearest_miss.to_dict() if self.nearest_miss is not None else None
         return {"candidates": [c.to_dict() for c in self.candidates],
                 "target": {"points": self.target.points, "closed": self.target.closed,
                            "diagonal": self.target.diagonal},
+                "bounds": self.bounds, "nearest_miss": miss,
                 "seconds": self.seconds, "retrieved": self.retrieved, "refined": self.refined,
                 "interrupted": self.interrupted, "notes": self.notes, **self.common()}
 
@@ -141,10 +165,13 @@ class CurveSynthesisResult(SynthesisResult):
         lines = [f"curve synthesis: {len(self.candidates)} candidates, {self.refined} refined of "
                  f"{self.retrieved} retrieved, {self.seconds:.1f} s" + (" (interrupted)" if self.interrupted else "")]
         for i, c in enumerate(self.candidates, 1):
-            lines.append(f"{i}. {c.topology.name or str(c.topology.n_links) + '-bar'} [{c.topology.key}]: "
+            lines.append(f"{i}. {c.topology.label} [{c.topology.key}]: "
                          f"chamfer {100 * c.chamfer:.2f} %, ordered {100 * c.ordered:.2f} %, "
+                         f"size {c.size_ratio:.2f} diagonals, link ratio {c.link_length_ratio:.1f}, "
                          f"min transmission {c.min_transmission_angle:.0f} deg"
-                         + ("" if c.verified else "  NOT VERIFIED"))
+                         + (", full turn" if c.full_turn else "") + ("" if c.verified else "  NOT VERIFIED"))
+        if not self.candidates:
+            lines.append(self.reason)
         return "\n".join(lines)
 
     def plot(self, ax=None, top: int = 3):
@@ -189,14 +216,17 @@ def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
     return -np.take_along_axis(diff, k[..., None, None], axis=-2)[..., 0, :], k
 
 
-def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[float, float]:
-    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals."""
+def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
+                 unit: float | None = None) -> tuple[float, float]:
+    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals
+    (or in ``unit``)."""
+    unit = target.diagonal if unit is None else unit
     T = target.points
     ts, tv = _polyline(T, target.closed)
     ps, pv = _polyline(path, closed_path)
     a = np.linalg.norm(_to_polyline(T, ps, pv)[0], axis=-1).mean()
     b = np.linalg.norm(_to_polyline(path, ts, tv)[0], axis=-1).mean()
-    chamfer = 0.5 * (a + b) / target.diagonal
+    chamfer = 0.5 * (a + b) / unit
     m = 128
     w = resample(T, m, closed=target.closed)
     z = resample(path, m, closed=closed_path)
@@ -204,7 +234,7 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tu
     for zz in (z, z[::-1]):
         for s in range(m):
             best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
-    return float(chamfer), best / target.diagonal
+    return float(chamfer), best / unit
 
 
 # ---------------------------------------------------------------------------- evaluation
@@ -216,6 +246,57 @@ def _offsets(start: float, stop: float, closed: bool, n: int = N_TRACE) -> np.nd
     return np.linspace(start, stop, n)
 
 
+_FULL_PLANS: dict[str, Any] = {}
+
+
+def _full_plan(topo: CurveTopology):
+    """The topology's batch plan with every joint (and the tracer) as an output."""
+    plan = _FULL_PLANS.get(topo.key)
+    if plan is None:
+        from mechsyn.io.load import mechanism_from_dict
+        from mechsyn.kinematics.batch import compile_plan
+
+        plan = compile_plan(mechanism_from_dict(topo.template), points=list(topo.plan.names))
+        if list(plan.names) != list(topo.plan.names):  # the parameters must mean the same
+            raise RuntimeError(f"{topo.key}: the full plan orders its points differently")
+        _FULL_PLANS[topo.key] = plan
+    return plan
+
+
+def _sizes(paths: dict[str, np.ndarray], centre: tuple[float, float]) -> np.ndarray:
+    """Largest distance ``(K,)`` of any point from ``centre`` over the motion; samples
+    not placed are ignored (inf when none is)."""
+    R = np.stack([np.hypot(P[..., 0] - centre[0], P[..., 1] - centre[1]) for P in paths.values()], axis=-1)
+    m = np.max(np.where(np.isfinite(R), R, -np.inf), axis=(1, 2))
+    return np.where(np.isfinite(m), m, np.inf)          # nothing placed: no size to speak of
+
+
+@dataclass(frozen=True)
+class _Bounds:
+    """Design bounds in the working frame: ``centre`` the target's bounding-box centre,
+    ``unit`` its diagonal, ``radius`` the size bound (``None`` or 0 where lifted)."""
+
+    centre: tuple[float, float]
+    unit: float
+    radius: float | None
+    link_ratio: float | None
+    transmission: float
+    region: tuple[float, float, float, float] | None
+
+    def excess(self, size: np.ndarray, ratio: np.ndarray, mu: np.ndarray, margin: float = 1.0) -> np.ndarray:
+        """Relative violations ``(K, 3)`` (size, link ratio, transmission), 0 inside the
+        bounds each scaled by ``margin`` (the transmission bound divided by it)."""
+        out = np.zeros((len(size), 3))
+        if self.radius is not None:
+            out[:, 0] = np.maximum(0.0, np.nan_to_num(size, nan=np.inf) / (margin * self.radius) - 1.0)
+        if self.link_ratio is not None:
+            out[:, 1] = np.maximum(0.0, ratio / (margin * self.link_ratio) - 1.0)
+        if self.transmission > 0:
+            need = min(89.0, self.transmission / margin)
+            out[:, 2] = np.maximum(0.0, 1.0 - np.nan_to_num(mu, nan=0.0) / need)
+        return np.minimum(out, 1e3)
+
+
 @dataclass
 class _Problem:
     topo: CurveTopology
@@ -223,19 +304,18 @@ class _Problem:
     closed_path: bool
     start: float
     stop: float
-    ground_region: tuple[float, float, float, float] | None
-    max_link_ratio: float | None
-    min_transmission: float = 0.0
+    bounds: _Bounds
 
     def __post_init__(self) -> None:
         self.off = _offsets(self.start, self.stop, self.closed_path)
         self.T = resample(self.target.points, M_TARGET, closed=self.target.closed)
-        self.T = np.stack([self.T.real, self.T.imag], axis=-1)
         if not self.target.closed:  # resample there and back: keep the way there
             self.T = resample(self.target.points, 2 * M_TARGET - 2, closed=False)[:M_TARGET]
-            self.T = np.stack([self.T.real, self.T.imag], axis=-1)
+        self.T = np.stack([self.T.real, self.T.imag], axis=-1)
         self.ts, self.tv = _polyline(self.target.points, self.target.closed)
-        self.diag = self.target.diagonal
+        self.features = sharp_features(self.target.points, self.target.closed)
+        self.diag = 1.0   # the working frame's length unit
+        self.plan = _full_plan(self.topo)
         names = self.topo.plan.names
         self.frame_pts = [i for i, n in enumerate(names) if n != TRACER and any(
             j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
@@ -247,33 +327,35 @@ class _Problem:
         segments of the first design are used for all (the Jacobian's perturbations)."""
         X = np.atleast_2d(X)
         self.nfev += len(X)
-        res = simulate_batch(self.topo.plan, X, self.off, transmission=self.min_transmission > 0)
+        res = simulate_batch(self.plan, X, self.off, transmission=self.bounds.transmission > 0)
         P = res.paths[TRACER]
         bad = ~res.assembled.all(axis=1) | res.branch_jump
         P = np.where(np.isfinite(P), P, 0.0)
         starts = P if self.closed_path else P[:, :-1]
         vecs = (np.roll(P, -1, axis=1) if self.closed_path else P[:, 1:]) - starts
+        F = self.features
         if keep:
             r1, k1 = _to_polyline(self.T[None], starts[:1], vecs[:1])
             r2, k2 = _to_polyline(P[:1], self.ts[None], self.tv[None])
+            r3, k3 = _to_polyline(F[None], starts[:1], vecs[:1])
             r1 = np.concatenate([r1, _to_polyline(self.T[None], starts[1:], vecs[1:], k1)[0]])
             r2 = np.concatenate([r2, _to_polyline(P[1:], self.ts[None], self.tv[None], k2)[0]])
+            r3 = np.concatenate([r3, _to_polyline(F[None], starts[1:], vecs[1:], k3)[0]])
         else:
             r1 = _to_polyline(self.T[None], starts, vecs)[0]        # target -> path
             r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
+            r3 = _to_polyline(F[None], starts, vecs)[0]             # sharp features -> path
         r1 = r1 / np.sqrt(len(self.T))
         r2 = r2 / np.sqrt(P.shape[1])
-        r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1)], axis=1) / self.diag
+        r3 = r3 * (FEATURE_WEIGHT / np.sqrt(max(len(F), 1)))
+        r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1), r3.reshape(len(X), -1)],
+                           axis=1) / self.diag
         r[bad] = PENALTY                 # off its branch or not assembled: never accepted
-        pen = []
-        if self.min_transmission > 0:
-            mu = np.nan_to_num(res.min_transmission_angle, nan=0.0)
-            pen.append(np.maximum(0.0, 1.0 - mu / self.min_transmission)[:, None] * 0.05)
-        if self.max_link_ratio is not None:
-            lr = _link_ratio(X, self.link_pairs)
-            pen.append(np.maximum(0.0, lr / self.max_link_ratio - 1.0)[:, None])
-        if self.ground_region is not None:
-            x0, y0, x1, y1 = self.ground_region
+        size = _sizes(res.paths, self.bounds.centre)
+        mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(X), 90.0)
+        pen = [self.bounds.excess(size, _link_ratio(X, self.link_pairs), mu, MARGIN) * BOUND_WEIGHT]
+        if self.bounds.region is not None:
+            x0, y0, x1, y1 = self.bounds.region
             G = X.reshape(len(X), -1, 2)[:, self.frame_pts]
             out = (np.maximum(0, x0 - G[..., 0]) + np.maximum(0, G[..., 0] - x1)
                    + np.maximum(0, y0 - G[..., 1]) + np.maximum(0, G[..., 1] - y1)) / self.diag
@@ -289,6 +371,46 @@ class _Problem:
         X = np.vstack([x, x + h * np.eye(len(x))])
         R = self.residuals(X, keep=True)
         return (R[1:] - R[0]).T / h
+
+
+FEATURE_WEIGHT = 0.25  # the sharp-feature residuals against the chamfer's (both /sqrt(count))
+BOUND_WEIGHT = 1.0     # residual per unit of relative bound violation (aimed at MARGIN inside)
+
+
+def sharp_features(points: np.ndarray, closed: bool, angle: float = 50.0) -> np.ndarray:
+    """Corners, cusps and sharp bends of a curve ``(n, 2)``: the points where the
+    direction turns by more than ``angle`` degrees within 2 % of the curve's length
+    either side (local maxima of that turn), as ``(k, 2)``; an open curve's ends are
+    features too. They are fitted point to path in the refinement beside the chamfer,
+    so a corner is not rounded off for the sake of the mean distance.
+
+    >>> sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]])
+    >>> sharp_features(sq, closed=True).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    """
+    m = 200
+    z = resample(points, m, closed=True) if closed else resample(points, 2 * m - 2, closed=False)[:m]
+    k = max(2, int(round(0.02 * m)))
+    if closed:
+        d_in, d_out = z - np.roll(z, k), np.roll(z, -k) - z
+    else:
+        zi = np.arange(m)
+        d_in = z - z[np.maximum(zi - k, 0)]
+        d_out = z[np.minimum(zi + k, m - 1)] - z
+    turn = np.degrees(np.abs(np.angle(d_out * np.conj(d_in))))
+    turn = np.where((np.abs(d_in) > 0) & (np.abs(d_out) > 0), turn, 0.0)
+    nb = [np.roll(turn, s) for s in range(-k, k + 1) if s]
+    peak = (turn > angle) & np.all([turn >= b for b in nb], axis=0)
+    if not closed:
+        peak[:k + 1] = peak[-k - 1:] = False
+        peak[0] = peak[-1] = True
+    idx = np.flatnonzero(peak)
+    keep = [i for j, i in enumerate(idx) if j == 0 or i - idx[j - 1] > k]   # one per plateau
+    # the exact corner: the input point nearest the resampled peak
+    P = np.asarray(points, float)
+    pz = P[:, 0] + 1j * P[:, 1]
+    near = [int(np.argmin(np.abs(pz - z[i]))) for i in keep]
+    return P[sorted(set(near))] if near else np.zeros((0, 2))
 
 
 def _link_pairs(topo: CurveTopology) -> list[tuple[int, int]]:
@@ -319,11 +441,17 @@ def _link_ratio(X: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
 class _Seed:
     row: int
     topo: CurveTopology
-    params: np.ndarray      # in the target's frame
+    params: np.ndarray      # in the working frame
     start: float
     stop: float
     closed: bool
-    score: float
+    score: float            # alignment RMS / diagonal
+    excess: float = 0.0     # summed relative bound violations of the mapped design
+
+    @property
+    def rank(self) -> float:
+        """Retrieval order: the alignment error, worse the further outside the bounds."""
+        return self.score * (1.0 + 4.0 * self.excess)
 
 
 def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) -> np.ndarray:
@@ -336,7 +464,8 @@ def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) 
     return out
 
 
-def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool) -> list[_Seed]:
+def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool,
+              bounds: _Bounds) -> list[_Seed]:
     w = resample(target.points, 64, closed=target.closed)
     d = fourier_descriptor(w)
     rows: set[int] = set()
@@ -358,62 +487,82 @@ def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, cr
     for r in rows_a.tolist():
         by_topo.setdefault(int(db.topology[r]), []).append(r)
     for ti, rs in by_topo.items():
-        topo = db.topologies[ti]
-        rs_a = np.array(rs)
-        offs = np.array([_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
-        P = simulate_batch(topo.plan, np.array([db.designs[r] for r in rs]), offs, flags=False).paths[TRACER]
-        fine = np.all(np.isfinite(P), axis=(1, 2))
-        if not fine.any():
-            continue
-        ok = np.flatnonzero(fine)
-        closed_rows = db.closed[rs_a[ok]]
-        curves = [resample(P[i], 64, closed=bool(c)) for i, c in zip(ok, closed_rows)]
-        al = align(np.array(curves), w)
-        for j, i in enumerate(ok):
-            r = rs[i]
-            a, b = (float(v) for v in db.ranges[r])
-            if not db.closed[r]:  # keep clear of the dead points that end the range
-                a, b = a + 0.04 * (b - a), b - 0.04 * (b - a)
-            mir = bool(al.mirror[j])
-            if mir:  # a mirrored linkage runs its input the other way
-                a, b = -b, -a
-            params = _transform_design(np.asarray(db.designs[r], float), complex(al.c[j]), complex(al.t[j]), mir)
-            seeds.append(_Seed(r, topo, params, a, b, bool(db.closed[r]), float(al.rms[j]) / target.diagonal))
-    seeds.sort(key=lambda s: s.score)
+        seeds += _topology_seeds(db, db.topologies[ti], rs, w, bounds.unit, bounds)
+    seeds.sort(key=lambda s: (s.rank, s.row))
     return seeds
+
+
+def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np.ndarray, diag: float,
+                    bounds: _Bounds) -> list[_Seed]:
+    """The retrieved rows of one topology aligned onto the target ``w`` and mapped into
+    its frame, each with its alignment error and bound violations."""
+    rs_a = np.array(rs)
+    offs = np.array([_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
+    X = np.array([db.designs[r] for r in rs])
+    P = simulate_batch(topo.plan, X, offs, flags=False).paths[TRACER]
+    fine = np.all(np.isfinite(P), axis=(1, 2))
+    if not fine.any():
+        return []
+    ok = np.flatnonzero(fine)
+    closed_rows = db.closed[rs_a[ok]]
+    curves = [resample(P[i], 64, closed=bool(c)) for i, c in zip(ok, closed_rows)]
+    al = align(np.array(curves), w)
+    out: list[_Seed] = []
+    for j, i in enumerate(ok):
+        r = rs[i]
+        a, b = (float(v) for v in db.ranges[r])
+        if not db.closed[r]:  # keep clear of the dead points that end the range
+            a, b = a + 0.04 * (b - a), b - 0.04 * (b - a)
+        mir = bool(al.mirror[j])
+        if mir:  # a mirrored linkage runs its input the other way
+            a, b = -b, -a
+        params = _transform_design(np.asarray(db.designs[r], float), complex(al.c[j]), complex(al.t[j]), mir)
+        out.append(_Seed(r, topo, params, a, b, bool(db.closed[r]), float(al.rms[j]) / diag))
+    if out:  # the mapped designs' size, link ratio and transmission angle over their range
+        Xs = np.array([s.params for s in out])
+        res = simulate_batch(_full_plan(topo), Xs, np.array([_offsets(s.start, s.stop, s.closed, 48) for s in out]),
+                             transmission=bounds.transmission > 0, flags=False)
+        mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(out), 90.0)
+        exc = bounds.excess(_sizes(res.paths, bounds.centre), _link_ratio(Xs, _link_pairs(topo)), mu).sum(axis=1)
+        for s, e in zip(out, exc):
+            s.excess = float(e)
+    return out
 
 
 # ----------------------------------------------------------------------------- refinement
 
 
-def _refine(seed: _Seed, target: TargetCurve, ground_region, max_link_ratio, max_nfev: int,
-            min_transmission: float = 0.0) -> CurveCandidate | None:
-    prob = _Problem(seed.topo, target, seed.closed, seed.start, seed.stop, ground_region, max_link_ratio,
-                    min_transmission)
+def _refine(seed: _Seed, target: TargetCurve, bounds: _Bounds, max_nfev: int) -> CurveCandidate | None:
+    """The seed refined in the working frame (None when it does not assemble)."""
+    prob = _Problem(seed.topo, target, seed.closed, seed.start, seed.stop, bounds)
     x0 = seed.params
     prob.fun(x0)
     if prob.last_bad[0]:  # does not assemble over the range after the mapping
         return None
     try:
-        sol = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=target.diagonal,
+        sol = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=1.0,
                             max_nfev=max_nfev, xtol=1e-10, ftol=1e-10)
         x = sol.x
     except np.linalg.LinAlgError:  # a singular step: keep the retrieved design
         x = x0
-    return _candidate(seed.topo, x, seed.start, seed.stop, seed.closed, target, prob.nfev)
+    return _candidate(seed.topo, x, seed.start, seed.stop, seed.closed, target, prob.nfev, bounds)
 
 
 def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, closed: bool,
-               target: TargetCurve, nfev: int) -> CurveCandidate | None:
+               target: TargetCurve, nfev: int, bounds: _Bounds) -> CurveCandidate | None:
+    """The design's candidate in the working frame, with its errors and quality over
+    :data:`N_FINAL` input samples (lengths in ``bounds.unit``); None when it is not
+    assembled."""
     off = _offsets(start, stop, closed, N_FINAL)
-    res = simulate_batch(topo.plan, x[None], off, transmission=True)
+    res = simulate_batch(_full_plan(topo), x[None], off, transmission=True)
     if not res.assembled.all() or res.branch_jump[0]:
         return None
     path = res.paths[TRACER][0]
-    ch, od = curve_errors(path, target, closed)
+    ch, od = curve_errors(path, target, closed, bounds.unit)
+    size = float(_sizes(res.paths, bounds.centre)[0])
     return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
                           float(res.min_transmission_angle[0]), float(_link_ratio(x, _link_pairs(topo))[0]),
-                          path, nfev=nfev)
+                          path, nfev=nfev, size=size, size_ratio=size / bounds.unit)
 
 
 def _verify(c: CurveCandidate) -> None:
@@ -422,8 +571,7 @@ def _verify(c: CurveCandidate) -> None:
     from mechsyn.kinematics import simulate
 
     t = c.topology
-    closed = c.stop - c.start >= 360.0 - 1e-9
-    off = _offsets(c.start, c.stop, closed, N_FINAL)
+    off = _offsets(c.start, c.stop, c.full_turn, N_FINAL)
     try:
         mech = mechanism_from_dict(c.mechanism())
         # the reference configuration first: simulate takes the assembly mode from it
@@ -439,8 +587,88 @@ def _verify(c: CurveCandidate) -> None:
     err = float(np.max(np.abs(P - c.path)))
     scale = float(np.abs(c.path).max()) + 1.0
     c.verified = err <= 1e-7 * scale
-    c.verification = f"simulate reproduces the path to {err:.1e}" if c.verified else \
+    c.verification = f"simulate reproduces the path to {err / c.size:.1e} of its size" if c.verified else \
         f"simulate differs from the batch path by {err:.3g}"
+
+
+@dataclass(frozen=True)
+class _Frame:
+    """The working frame, a similarity ``w = R((z - c) / r)`` of the target's plane: ``c``
+    and ``r`` the centroid and RMS radius of the target (equally spaced in arc length),
+    ``R`` the rotation to its principal axes (the long axis along x, its third moment
+    positive) followed, when the curve then runs clockwise (closed by its chord if open;
+    without enclosed area, when its y skew is negative), by the mirror in the x axis.
+    Each part is computed from the curve itself, so a translated, scaled, rotated or
+    mirrored target has the same working coordinates (rounded to ``1e-9``: the same
+    numbers, not merely close ones) and the search the same course. A linkage mapped by a
+    similarity traces the curve so mapped, on the same assembly branch; a mirrored one
+    with its input reversed. With a ground region (an axis-parallel box) rotation and
+    mirror are left out."""
+
+    centre: complex
+    scale: float
+    turn: complex          # e^{i phi}: working x axis in target coordinates
+    mirror: bool
+
+    @classmethod
+    def of(cls, target: TargetCurve, rotate: bool = True) -> _Frame:
+        w = resample(target.points, 256, closed=target.closed)
+        c = complex(w.mean())
+        r = float(np.sqrt(np.mean(np.abs(w - c) ** 2)))
+        turn, mirror = 1.0 + 0j, False
+        if rotate:
+            u = (w - c) / r
+            m2 = np.sum(u ** 2)
+            turn = complex(np.exp(0.5j * np.angle(m2))) if abs(m2) > 1e-6 * len(u) else 1.0 + 0j
+            if np.sum(((u / turn).real) ** 3) < 0:
+                turn = -turn
+            v = (resample(target.points, 256, closed=True) - c) / (r * turn)   # an open curve: closed by its chord
+            area = 0.5 * np.sum(v.real * np.roll(v.imag, -1) - np.roll(v.real, -1) * v.imag)
+            # clockwise: mirror; no area to speak of (a figure eight): the side the y skew points to
+            mirror = bool(area < 0) if abs(area) > 1e-3 else bool(np.sum(v.imag ** 3) < 0)
+        return cls(c, r, turn, mirror)
+
+    def inward_points(self, P: np.ndarray) -> np.ndarray:
+        w = (P[..., 0] + 1j * P[..., 1] - self.centre) / (self.scale * self.turn)
+        w = np.conj(w) if self.mirror else w
+        return np.round(np.stack([w.real, w.imag], axis=-1), 9)
+
+    def outward_points(self, W: np.ndarray) -> np.ndarray:
+        w = W[..., 0] + 1j * W[..., 1]
+        z = self.centre + self.scale * self.turn * (np.conj(w) if self.mirror else w)
+        return np.stack([z.real, z.imag], axis=-1)
+
+    def inward(self, target: TargetCurve) -> TargetCurve:
+        return TargetCurve(self.inward_points(target.points), target.closed, target.source)
+
+    def bounds(self, user: TargetCurve, max_size, max_link_ratio, min_transmission, region) -> _Bounds:
+        """The design bounds in working coordinates (disc about the target's bounding-box
+        centre, radius in its diagonals)."""
+        P = user.points
+        centre = self.inward_points(0.5 * (P.min(axis=0) + P.max(axis=0)))
+        unit = user.diagonal / self.scale
+        box = None
+        if region is not None:
+            lo, hi = self.inward_points(np.array(region[:2])), self.inward_points(np.array(region[2:]))
+            box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+        return _Bounds((float(centre[0]), float(centre[1])), unit, None if max_size is None else max_size * unit,
+                       max_link_ratio, float(min_transmission), box)
+
+    def outward(self, c: CurveCandidate) -> CurveCandidate:
+        """The candidate in the target's coordinates (errors and ratios unchanged; a
+        mirrored design runs its input the other way)."""
+        import dataclasses
+
+        x = self.outward_points(c.params.reshape(-1, 2)).reshape(-1)
+        path = self.outward_points(c.path)
+        start, stop = c.start, c.stop
+        if self.mirror:
+            start, stop = -stop, -start
+            n = len(path)
+            path = path[(-np.arange(n)) % n] if c.full_turn else path[::-1]
+        ref = float(c.topology.plan.reference_inputs(x)[0])
+        return dataclasses.replace(c, params=x, path=path, start=start, stop=stop, size=c.size * self.scale,
+                                   reference_input=ref)
 
 
 def synthesize_curve(
@@ -453,54 +681,72 @@ def synthesize_curve(
     retrieve: int = 300,
     crank: bool = False,
     ground_region: tuple[float, float, float, float] | None = None,
-    max_link_ratio: float | None = None,
-    min_transmission: float = 15.0,
+    max_size: float | None = DEFAULT_MAX_SIZE,
+    max_link_ratio: float | None = DEFAULT_MAX_LINK_RATIO,
+    min_transmission: float = DEFAULT_MIN_TRANSMISSION,
+    prefer: str = "simple",
     database: CurveDatabase | str | os.PathLike[str] | None = None,
     callback: Callable[[dict], None] | None = None,
     max_nfev: int = 60,
-    tolerance: float = 1e-3,
+    tolerance: float = DEFAULT_TOLERANCE,
 ) -> CurveSynthesisResult:
-    """Ranked linkages (4 to ``max_links`` links) whose tracing point follows a curve.
+    """Ranked linkages (4 to ``max_links`` links) a designer can build whose tracing
+    point follows a curve.
 
     Parameters
     ----------
     target : TargetCurve or (n, 2) array
-        The curve (arrays: closed when the ends nearly meet).
+        The curve (arrays: closed when the ends nearly meet). Fewer than
+        :data:`~mechsyn.synthesis.curves.target.SPARSE_POINTS` points are read as samples
+        of a smooth curve (:func:`~mechsyn.synthesis.curves.target.smooth_samples`).
     max_links : {4, 6, 8}
-        Largest linkage considered.
+        Largest linkage.
     time_limit : float
-        Seconds for retrieval and refinement: a refinement is not started when the
-        longest one so far would overrun it; the best found so far is returned.
+        Seconds for retrieval and refinement (no refinement starts that the longest so
+        far says would overrun it).
     top : int
-        Candidates returned (distinct designs, best chamfer error first; among those
-        within ``tolerance``, fewer links first).
+        Candidates returned (see ``prefer``; the first three of distinct topologies).
     n_refine, retrieve : int
         Designs refined, and nearest descriptors retrieved per query.
     crank : bool
-        Only fully rotating inputs.
+        Only fully rotating inputs (without it a full turn is preferred, not required).
     ground_region : (x0, y0, x1, y1), optional
         Box (target coordinates) the frame pivots must stay in.
-    max_link_ratio : float, optional
-        Largest ratio of the longest to the shortest link length.
+    max_size : float or None
+        Every joint, frame pivots included, and the tracer stay over the whole motion
+        within this many target diagonals of the centre of the target's bounding box
+        (default 1.5: the linkage fits in a disc three diagonals across); None lifts it.
+    max_link_ratio : float or None
+        Largest ratio of the longest to the shortest link length (default 10); None lifts it.
     min_transmission : float
-        Transmission angles (degrees, of every RRR dyad over the range) below this are
-        penalised in the refinement (0: no penalty); reported for every candidate.
+        Smallest transmission angle (degrees, of every RRR dyad over the input range;
+        default 30); 0 lifts it.
+    prefer : {"simple", "accuracy"}
+        ``"simple"``: among candidates within ``tolerance`` fewer links first, then a full
+        turn, then the larger transmission angle (in 5° steps), then the error; the
+        others after them by error. ``"accuracy"``: by error alone.
     database : CurveDatabase or directory, optional
-        Default: the local database (built on first use).
+        Default: the local one (built on first use).
     tolerance : float
-        The search ends early once ``top`` candidates have a chamfer error at most this
-        (in target diagonals; default 0.1 %).
+        Chamfer error (in target diagonals, default 0.5 %) within which a candidate counts
+        as tracing the curve; the search ends early once three topologies (or ``top``,
+        if fewer) have a candidate within it.
     callback : callable, optional
-        ``callback(state)`` with a :class:`~mechsyn.synthesis.problem.Progress`
-        (``message`` the stage, ``best_error`` the best chamfer error so far in target
-        diagonals, ``nfev``); it also reads as the dict ``{"stage", "done", "total",
-        "best", "nfev"}`` the curve database's callback gets.
+        ``callback(state)`` with a :class:`~mechsyn.synthesis.problem.Progress` (stage,
+        best chamfer error so far, ``nfev``; it reads as the database build's dict too).
 
     Returns
     -------
     CurveSynthesisResult
-        Candidates best first, each re-simulated through ``simulate``; Ctrl-C during
-        refinement returns what was found so far (``interrupted``).
+        Candidates best first, within the bounds, re-simulated by ``simulate``; with none,
+        ``feasible`` false and ``nearest_miss`` the design closest to the bounds (named in
+        ``reason``). Ctrl-C returns the best so far (``interrupted``).
+
+    Notes
+    -----
+    The search runs in a working frame fixed by the curve itself (:class:`_Frame`), so a
+    similar target gives the same design transformed; only the size bound, measured on
+    the bounding box as drawn, changes with a rotation other than by quarter turns.
 
     Examples
     --------
@@ -513,30 +759,58 @@ def synthesize_curve(
     >>> ellipse = np.c_[3 * np.cos(t), np.sin(t)]
     >>> res = synthesize_curve(ellipse, max_links=4, top=1, n_refine=3, database=load_database(d))
     >>> c = res.candidates[0]
-    >>> c.topology.name, c.verified, c.chamfer < 0.02
-    ('four-bar', True, True)
+    >>> c.topology.label, c.verified, c.chamfer < 0.02, c.size_ratio <= 1.5
+    ('four-bar', True, True, True)
     """
     t0 = time.perf_counter()
-    target = _checked_target(target, max_links, time_limit, top, max_link_ratio, crank)
+    user = _checked_target(target, max_links, time_limit, top, max_link_ratio, crank)
+    _checked_bounds(max_size, min_transmission, prefer, tolerance)
     if database is None or isinstance(database, (str, os.PathLike)):
         database = load_database(database, max_links=max_links, callback=callback)
+    o = dict(max_links=max_links, time_limit=time_limit, top=top, n_refine=n_refine, retrieve=retrieve, crank=crank,
+             ground_region=ground_region, max_size=max_size, max_link_ratio=max_link_ratio,
+             min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance)
+    return _search(user, database, t0, o, callback)
+
+
+def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, Any],
+            callback: Callable[[dict], None] | None) -> CurveSynthesisResult:
+    """The search of :func:`synthesize_curve` (options ``o`` checked): sparse targets
+    smoothed, the working frame, retrieval, refinement in order, ranking, mapping back."""
+    notes: list[str] = []
+    if len(user.points) < SPARSE_POINTS:
+        notes.append(f"{len(user.points)} points read as samples of a smooth curve (a "
+                     f"{'periodic ' if user.closed else ''}spline through them), not a polygon")
+        user = smooth_samples(user)
+    frame = _Frame.of(user, rotate=o["ground_region"] is None)
+    work = frame.inward(user)
+    bounds = frame.bounds(user, o["max_size"], o["max_link_ratio"], o["min_transmission"], o["ground_region"])
 
     def report(stage, done, total, best, nfev):
         if callback is not None:
             callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
 
     report("retrieve", 0, 1, float("nan"), 0)
-    seeds = _retrieve(database, target, retrieve, max_links, crank)
+    seeds = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
-    picked = _diverse(seeds, n_refine)
-    run = _Refinement(target, ground_region, max_link_ratio, max_nfev, min_transmission, report)
-    run.all(picked, t0 + time_limit, top, tolerance)
+    picked = _diverse(seeds, o["n_refine"], simple=o["prefer"] == "simple")
+    if o["prefer"] == "simple":  # four-bars first (one within tolerance is never missed), then by rank
+        picked.sort(key=lambda s: (s.topo.n_links != 4, s.rank, s.row))
+    run = _Refinement(work, bounds, o["max_nfev"], report, notes=notes)
+    run.all(picked, t0 + o["time_limit"], min(o["top"], 3), o["tolerance"])
     if not picked:
         run.notes.append("no database design matched the options (crank, links, open/closed)")
-    out = _ranked(run.cands, top, tolerance, run.notes)
+    out = _ranked(run.cands, o["top"], o["tolerance"], o["prefer"], run.notes)
+    miss = _nearest_miss(run.misses, bounds, run.notes) if not out else None
     report("done", 1, 1, out[0].chamfer if out else float("nan"), run.nfev)
-    return _result(target, out, time.perf_counter() - t0, len(seeds), run.done, run.nfev, run.interrupted,
-                   run.notes)
+    res = _result(user, [frame.outward(c) for c in out], time.perf_counter() - t0, len(seeds), run.done,
+                  run.nfev, run.interrupted, run.notes)
+    res.bounds = {"max_size": o["max_size"], "max_link_ratio": o["max_link_ratio"], "tolerance": o["tolerance"],
+                  "min_transmission_angle": o["min_transmission"], "prefer": o["prefer"]}
+    res.nearest_miss = frame.outward(miss) if miss is not None else None
+    if miss is not None:
+        res.reason = _miss_reason(miss, bounds)
+    return res
 
 
 def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit: float, top: int,
@@ -546,7 +820,7 @@ def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit
         target = target_from_points(target)
     if max_links not in (4, 6, 8):
         raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", field="max_links")
-    if time_limit <= 0:
+    if not time_limit > 0:
         raise MechsynInputError("must be positive", field="time_limit")
     if top < 1:
         raise MechsynInputError("must be at least 1", field="top")
@@ -558,43 +832,61 @@ def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit
     return target
 
 
-def _diverse(seeds: list[_Seed], n_refine: int) -> list[_Seed]:
-    """The seeds to refine: at most a third from one topology, then filled up by score."""
+def _checked_bounds(max_size: float | None, min_transmission: float, prefer: str, tolerance: float) -> None:
+    if max_size is not None and not max_size >= 0.5:
+        raise MechsynInputError(f"{max_size}: the disc must hold the target itself (at least 0.5 diagonals)",
+                                field="max_size", hint="give a value of at least 0.5, or lift it")
+    if not 0 <= min_transmission < 90:
+        raise MechsynInputError("must be an angle in degrees in [0, 90)", field="min_transmission")
+    if prefer not in ("simple", "accuracy"):
+        raise MechsynInputError(f"{prefer!r}: choose simple or accuracy", field="prefer")
+    if not 0 < tolerance < 1:
+        raise MechsynInputError("must be a fraction of the diagonal in (0, 1)", field="tolerance")
+
+
+def _diverse(seeds: list[_Seed], n_refine: int, simple: bool = False) -> list[_Seed]:
+    """The seeds to refine: at most a third from one topology, then filled up by rank;
+    with ``simple`` the best four-bars (a third of ``n_refine``) and six-bars (a quarter)
+    are picked first, by rank: the simplest linkages are always tried, however well the
+    larger ones were retrieved."""
     picked: list[_Seed] = []
     per: dict[str, int] = {}
     cap = max(2, n_refine // 3)
-    for s in seeds:
-        if per.get(s.topo.key, 0) < cap:
-            picked.append(s)
-            per[s.topo.key] = per.get(s.topo.key, 0) + 1
-        if len(picked) >= n_refine:
-            break
+    quota = {4: cap, 6: max(1, n_refine // 4)} if simple else {}
+    for group in ([[s for s in seeds if s.topo.n_links == n][:q] for n, q in quota.items()] + [seeds]):
+        for s in group:
+            if len(picked) >= n_refine:
+                break
+            if per.get(s.topo.key, 0) < cap and all(s is not p for p in picked):
+                picked.append(s)
+                per[s.topo.key] = per.get(s.topo.key, 0) + 1
     if len(picked) < n_refine:
         chosen = {id(s) for s in picked}
         picked += [s for s in seeds if id(s) not in chosen][:n_refine - len(picked)]
-        picked.sort(key=lambda s: s.score)
+        picked.sort(key=lambda s: (s.rank, s.row))
     return picked
 
 
 @dataclass
 class _Refinement:
-    """The refinement stage: candidates kept, refinements done, evaluations, notes."""
+    """The refinement stage: candidates kept (within the bounds), misses (outside),
+    refinements done, evaluations, notes."""
 
     target: TargetCurve
-    ground_region: Any
-    max_link_ratio: float | None
+    bounds: _Bounds
     max_nfev: int
-    min_transmission: float
     report: Callable[..., None]
     cands: list[CurveCandidate] = field(default_factory=list)
+    misses: list[CurveCandidate] = field(default_factory=list)
     done: int = 0
     nfev: int = 0
     interrupted: bool = False
     notes: list[str] = field(default_factory=list)
 
-    def all(self, picked: list[_Seed], deadline: float, top: int, tolerance: float) -> None:
+    def all(self, picked: list[_Seed], deadline: float, need: int, tolerance: float) -> None:
         """Refine ``picked`` in order until the deadline (a refinement starts only if the
-        longest so far still fits), ``top`` candidates within ``tolerance``, or Ctrl-C."""
+        longest so far still fits), ``need`` topologies with a candidate within
+        ``tolerance``, or Ctrl-C."""
         best = float("inf")
         longest = 0.0
         try:
@@ -603,11 +895,10 @@ class _Refinement:
                 if now + longest > deadline:
                     self.notes.append(f"time limit: {i} of {len(picked)} refinements done")
                     break
-                if sum(c.chamfer <= tolerance for c in self.cands) >= top:
-                    self.notes.append(f"{top} candidate(s) within {100 * tolerance:g} % after {i} refinements")
+                if len({c.topology.key for c in self.cands if c.chamfer <= tolerance}) >= need:
+                    self.notes.append(f"{need} topologies within {100 * tolerance:g} % after {i} refinements")
                     break
-                c = _refine(s, self.target, self.ground_region, self.max_link_ratio, self.max_nfev,
-                            self.min_transmission)
+                c = _refine(s, self.target, self.bounds, self.max_nfev)
                 longest = max(longest, time.perf_counter() - now)
                 self.done += 1
                 if c is not None:
@@ -615,24 +906,43 @@ class _Refinement:
                     if self.keeps(c):
                         self.cands.append(c)
                         best = min(best, c.chamfer)
+                    else:
+                        self.misses.append(c)
                 self.report("refine", i + 1, len(picked), best, self.nfev)
         except KeyboardInterrupt:
             self.interrupted = True
             self.notes.append("interrupted: the best found so far")
 
     def keeps(self, c: CurveCandidate) -> bool:
-        """Within the link-ratio limit and the ground region."""
-        return (self.max_link_ratio is None or c.link_length_ratio <= self.max_link_ratio * (1 + 1e-6)) and \
-            (self.ground_region is None or _in_region(c, self.ground_region))
+        """Within the size, link-ratio and transmission bounds and the ground region."""
+        exc = self.bounds.excess(np.array([c.size]), np.array([c.link_length_ratio]),
+                                 np.array([c.min_transmission_angle]))
+        return bool(exc.max() <= 1e-9) and (self.bounds.region is None or _in_region(c, self.bounds.region))
 
 
-def _ranked(cands: list[CurveCandidate], top: int, tolerance: float, notes: list[str]) -> list[CurveCandidate]:
-    """Best first (within the tolerance the simpler linkage first), distinct, each verified
-    by ``simulate``; at most ``top``."""
-    cands.sort(key=lambda c: (max(c.chamfer, tolerance), c.topology.n_links, c.chamfer))
+def _rank_key(c: CurveCandidate, tolerance: float, prefer: str) -> tuple:
+    if prefer == "accuracy" or c.chamfer > tolerance:
+        return (1 if prefer != "accuracy" else 0, 0, 0, 0, c.chamfer)
+    return (0, c.topology.n_links, not c.full_turn, -np.floor(c.min_transmission_angle / 5.0), c.chamfer)
+
+
+def _ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
+            notes: list[str]) -> list[CurveCandidate]:
+    """Best first (see :func:`synthesize_curve`'s ``prefer``), distinct, each verified by
+    ``simulate``; with ``prefer="simple"`` the first three of distinct topologies where
+    that many are within the tolerance; at most ``top``."""
+    cands.sort(key=lambda c: _rank_key(c, tolerance, prefer))
+    order = cands
+    if prefer == "simple":
+        first: list[CurveCandidate] = []
+        for c in cands:
+            if c.chamfer <= tolerance and len(first) < 3 and all(o.topology.key != c.topology.key for o in first):
+                first.append(c)
+        order = first + [c for c in cands if all(c is not o for o in first)]
     out: list[CurveCandidate] = []
-    for c in cands:
-        if any(o.topology.key == c.topology.key and abs(o.chamfer - c.chamfer) < 1e-6 for o in out):
+    for c in order:
+        if any(o.topology.key == c.topology.key and abs(o.chamfer - c.chamfer) < 1e-5
+               and abs(o.link_length_ratio - c.link_length_ratio) < 1e-3 * c.link_length_ratio for o in out):
             continue
         _verify(c)
         if c.verified:
@@ -642,6 +952,36 @@ def _ranked(cands: list[CurveCandidate], top: int, tolerance: float, notes: list
         if len(out) >= top:
             break
     return out
+
+
+def _nearest_miss(misses: list[CurveCandidate], bounds: _Bounds, notes: list[str]) -> CurveCandidate | None:
+    """The design found closest to the bounds (then the most accurate), verified."""
+    def key(c):
+        e = bounds.excess(np.array([c.size]), np.array([c.link_length_ratio]), np.array([c.min_transmission_angle]))
+        return (float(e.sum()), c.chamfer)
+
+    for c in sorted(misses, key=key):
+        _verify(c)
+        if c.verified:
+            return c
+    notes.append("no design assembled over its range was found")
+    return None
+
+
+def _miss_reason(c: CurveCandidate, bounds: _Bounds) -> str:
+    """``no candidate within the bounds; nearest miss: ...`` with the options that lift them."""
+    out = []
+    if bounds.radius is not None and c.size > bounds.radius * (1 + 1e-9):
+        out.append(f"size {c.size_ratio:.2f} diagonals > {bounds.radius / bounds.unit:g} (--max-size)")
+    if bounds.link_ratio is not None and c.link_length_ratio > bounds.link_ratio * (1 + 1e-9):
+        out.append(f"link ratio {c.link_length_ratio:.1f} > {bounds.link_ratio:g} (--max-link-ratio)")
+    if c.min_transmission_angle < bounds.transmission:
+        out.append(f"transmission angle {c.min_transmission_angle:.1f}° < {bounds.transmission:g}° "
+                   "(--min-transmission-angle)")
+    if not out:
+        out.append("frame pivots outside the ground region (--ground-region)")
+    return (f"no candidate within the bounds; nearest miss: {c.topology.label}, chamfer {100 * c.chamfer:.2f} %, "
+            + ", ".join(out) + "; lift the bound named to accept it")
 
 
 def _result(target: TargetCurve, out: list[CurveCandidate], seconds: float, retrieved: int, refined: int,

@@ -14,7 +14,13 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["TargetCurve", "read_target", "target_from_points"]
+__all__ = ["TargetCurve", "read_target", "target_from_points", "smooth_samples", "MAX_TARGET_BYTES",
+           "MAX_TARGET_POINTS", "SPARSE_POINTS"]
+
+MAX_TARGET_BYTES = 20_000_000    # a target file larger than this is refused (a drawing is far smaller)
+MAX_TARGET_POINTS = 200_000      # points of a target (after reading an SVG's curves)
+MAX_COORDINATE = 1e12            # |x|, |y| of a target point
+SPARSE_POINTS = 24               # fewer points than this: samples of a smooth curve (see smooth_samples)
 
 
 @dataclass(frozen=True)
@@ -33,7 +39,9 @@ class TargetCurve:
 
 def target_from_points(points, closed: bool | None = None, source: str = "<points>") -> TargetCurve:
     """Check and wrap points; ``closed=None`` decides by the gap between the ends
-    (closed when it is under 5 % of the bounding-box diagonal)."""
+    (closed when it is under 5 % of the bounding-box diagonal or, for fewer than
+    :data:`SPARSE_POINTS` points, at most 1.5 times the median distance between
+    neighbours)."""
     try:
         P = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
@@ -42,20 +50,56 @@ def target_from_points(points, closed: bool | None = None, source: str = "<point
         raise MechsynInputError("points must be [x, y] pairs", source=source, field="points")
     if not np.all(np.isfinite(P)):
         raise MechsynInputError("points must be finite numbers", source=source, field="points")
+    if len(P) > MAX_TARGET_POINTS:
+        raise MechsynInputError(f"{len(P)} points: at most {MAX_TARGET_POINTS:,} are read", source=source,
+                                field="points", hint="resample the curve to fewer points")
+    if P.size and np.abs(P).max() > MAX_COORDINATE:
+        raise MechsynInputError(f"coordinates beyond {MAX_COORDINATE:g} in magnitude", source=source,
+                                field="points", hint="give the curve in a unit where it spans ordinary numbers")
     keep = np.concatenate([[True], np.any(np.abs(np.diff(P, axis=0)) > 0, axis=1)])
     P = P[keep]
+    diag = float(np.hypot(*np.ptp(P, axis=0))) if len(P) else 0.0
+    gap = float(np.hypot(*(P[-1] - P[0]))) if len(P) else 0.0
+    if closed is None:  # a few samples of a loop: the ends are as far apart as neighbours
+        steps = np.hypot(*np.diff(P, axis=0).T) if len(P) > 1 else np.zeros(1)
+        closed = gap < 0.05 * diag or (len(P) < SPARSE_POINTS and gap <= 1.5 * float(np.median(steps)))
+    if closed and len(P) > 1 and gap <= 1e-9 * diag:
+        P = P[:-1]
     if len(P) < 3:
         raise MechsynInputError(f"a curve needs at least 3 distinct points, got {len(P)}", source=source,
                                 field="points")
-    diag = float(np.hypot(*np.ptp(P, axis=0)))
-    if diag == 0:
-        raise MechsynInputError("all points coincide", source=source, field="points")
-    gap = float(np.hypot(*(P[-1] - P[0])))
-    if closed is None:
-        closed = gap < 0.05 * diag
-    if closed and gap < 1e-9 * diag:
-        P = P[:-1]
+    if not diag > 1e-9 * np.abs(P).max():
+        raise MechsynInputError("the points (nearly) coincide: the curve has no extent", source=source,
+                                field="points")
     return TargetCurve(P, bool(closed), source)
+
+
+def smooth_samples(target: TargetCurve, m: int = 256) -> TargetCurve:
+    """A few points read as samples of a smooth curve, never as a polygon.
+
+    A target of fewer than :data:`SPARSE_POINTS` points is interpolated by a cubic
+    spline through them in the centripetal parametrisation (periodic for a closed
+    curve, not-a-knot for an open one), which neither overshoots between unevenly spaced
+    points nor loops at close ones (E. T. Y. Lee, "Choosing nodes in parametric curve
+    interpolation", *Computer-Aided Design* 21(6), 363-370, 1989), and resampled at
+    ``m`` points; a denser target is returned as it is.
+
+    >>> t = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    >>> sparse = target_from_points(np.c_[np.cos(t), np.sin(t)], closed=True)
+    >>> dense = smooth_samples(sparse)
+    >>> len(dense.points), bool(np.allclose(np.hypot(*dense.points.T), 1, atol=2e-3))
+    (256, True)
+    """
+    P = target.points
+    if len(P) >= SPARSE_POINTS:
+        return target
+    from scipy.interpolate import CubicSpline
+
+    Q = np.vstack([P, P[:1]]) if target.closed else P
+    u = np.concatenate([[0.0], np.cumsum(np.sqrt(np.linalg.norm(np.diff(Q, axis=0), axis=1)))])
+    spline = CubicSpline(u, Q, axis=0, bc_type="periodic" if target.closed else "not-a-knot")
+    s = np.linspace(0.0, u[-1], m, endpoint=not target.closed)
+    return TargetCurve(spline(s), target.closed, target.source)
 
 
 def read_target(path: str | os.PathLike[str]) -> TargetCurve:
@@ -63,6 +107,9 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
     p = Path(path)
     src = str(p)
     try:
+        if p.stat().st_size > MAX_TARGET_BYTES:
+            raise MechsynInputError(f"the file is larger than {MAX_TARGET_BYTES // 1_000_000} MB", source=src,
+                                    hint="a drawn target needs a few thousand points at most")
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise MechsynInputError("file not found", source=src) from None
@@ -74,6 +121,8 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
             raise MechsynInputError(f"invalid JSON: {exc.msg}", source=src, line=exc.lineno) from None
+        except (ValueError, RecursionError) as exc:  # a huge integer, deep nesting
+            raise MechsynInputError(f"invalid JSON: {str(exc)[:80]}", source=src) from None
         if not isinstance(data, dict) or "points" not in data:
             raise MechsynInputError('expected {"points": [[x, y], ...], "closed": true}', source=src,
                                     field="points")
@@ -82,10 +131,10 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
             raise MechsynInputError("closed must be true or false", source=src, field="closed")
         return target_from_points(data["points"], closed, src)
     if suffix == ".svg":
-        m = re.search(r"<path[^>]*\sd\s*=\s*(['\"])(.*?)\1", text, re.S)
-        if not m:
+        d = _first_path_data(text)
+        if d is None:
             raise MechsynInputError("no <path d=...> in the SVG", source=src, field="path")
-        pts, closed = _svg_path(m.group(2), src)
+        pts, closed = _svg_path(d, src)
         pts[:, 1] *= -1.0  # SVG's y axis points down
         return target_from_points(pts, closed, src)
     if suffix in (".csv", ".txt"):
@@ -104,6 +153,26 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
         return target_from_points(rows, None, src)
     raise MechsynInputError(f"unknown target format {suffix or '(no suffix)'}", source=src,
                             hint="give a .csv (x,y rows), .json ({\"points\": ...}) or .svg (a path)")
+
+
+_D_ATTR = re.compile(r"\sd\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
+
+
+def _first_path_data(text: str) -> str | None:
+    """The ``d`` attribute of the first ``<path>`` element that has one, in one linear
+    pass (each tag is scanned once from ``<path`` to its ``>``)."""
+    pos = 0
+    while True:
+        i = text.find("<path", pos)
+        if i < 0:
+            return None
+        j = text.find(">", i)
+        if j < 0:
+            return None
+        m = _D_ATTR.search(text, i + 5, j)
+        if m:
+            return m.group(1) if m.group(1) is not None else m.group(2)
+        pos = j
 
 
 _TOKEN = re.compile(r"([MmLlHhVvCcSsQqTtZzAa])|([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
@@ -130,6 +199,9 @@ def _svg_path(d: str, src: str, per_segment: int = 24) -> tuple[np.ndarray, bool
         return out
 
     while i < len(toks):
+        if len(pts) > MAX_TARGET_POINTS:
+            raise MechsynInputError(f"the SVG path gives more than {MAX_TARGET_POINTS:,} points", source=src,
+                                    field="d", hint="simplify the path")
         if toks[i][0]:
             cmd = toks[i][0]
             i += 1

@@ -56,6 +56,16 @@ class CurveTopology:
     def n_links(self) -> int:
         return self.chain.n_links
 
+    @property
+    def label(self) -> str:
+        """The topology's name: four-bar, Watt I/II, Stephenson I/III, or for an
+        eight-bar its atlas chain and link assortment (e.g. ``8-bar chain 3 (4B+4T)``).
+
+        >>> sorted({t.label for t in curve_topologies(6)})[:2]
+        ['Stephenson I', 'Stephenson III']
+        """
+        return self.name or str(self.template["name"]).split(", frame")[0]
+
     def mechanism(self, params: np.ndarray, name: str | None = None) -> dict:
         """The mechanism-file dict of a design (parameters in ``plan.names`` order)."""
         xy = np.asarray(params, float).reshape(-1, 2)

@@ -1,0 +1,75 @@
+"""The size bound of ``synth path`` (issue 29 / issue 24 item 4): by default a four-bar's
+frame pivots and pin circles stay within 1.5 target diagonals of the targets' centre;
+``--max-size`` / ``max_size`` lifts or changes it; literature cases keep their space."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from dimsynth_data import public_cases, public_data  # noqa: F401  (fixtures)
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.synthesis.fourbar import fourbar_position
+from mechsyn.synthesis.optimize import synthesize_path, with_size_bound
+from mechsyn.synthesis.path import PathCase, PathProblem
+
+
+def _known_case(r=(3.0, 1.0, 3.0, 2.5), rc=(1.0, 1.0)) -> tuple[PathCase, np.ndarray]:
+    th = [0.0, 0.4, 0.8, 1.2, 1.6]
+    C = fourbar_position(*r, np.array(th), branch=-1, rcx=rc[0], rcy=rc[1]).C
+    case = PathCase.from_dict({
+        "id": "known", "targets": C.tolist(), "timing": {"type": "prescribed", "theta2": th},
+        "fixed": {"x0": 0.0, "y0": 0.0, "theta0": 0.0},
+        "variables": [{"name": n, "lower": lo, "upper": 6.0} for n, lo in
+                      (("r1", 0.1), ("r2", 0.1), ("r3", 0.1), ("r4", 0.1), ("rcx", -6.0), ("rcy", -6.0))]})
+    return case, np.array([*r, *rc])
+
+
+def test_the_known_large_linkage_is_outside_the_default_bound_and_inside_when_lifted():
+    case, x = _known_case()
+    bounded = PathProblem(with_size_bound(case))
+    lifted = PathProblem(with_size_bound(case, 0))
+    assert with_size_bound(case).max_size == 1.5 and lifted.case.max_size is None
+    vals = bounded.unpack(x[None])[0]
+    T = case.targets
+    diag = np.hypot(*np.ptp(T, axis=0))
+    centre = 0.5 * (T.min(axis=0) + T.max(axis=0))
+    # independently: pivot O2 at the origin, O4 at (r1, 0); crank and rocker circles
+    expect = max(np.hypot(*centre) + x[1], np.hypot(*(centre - [x[0], 0])) + x[3])
+    assert bounded.size(vals)[0] == pytest.approx(expect)
+    assert expect / diag > 1.5
+    assert lifted.evaluate(x[None]).feasible[0] and not bounded.evaluate(x[None]).feasible[0]
+    assert PathProblem(with_size_bound(case, expect / diag * 1.01)).evaluate(x[None]).feasible[0]
+
+
+def test_synth_path_keeps_the_default_size_bound():
+    case, _ = _known_case()
+    res = synthesize_path(case, seed=0, time_limit=60, restarts=1)
+    d = res.to_dict()
+    assert d["max_size"] == 1.5 and d["size_ratio"] is not None
+    if res.feasible:
+        assert d["size_ratio"] <= 1.5 + 1e-9
+    with pytest.raises(MechsynInputError, match="max_size"):
+        with_size_bound(case, -1.0)
+
+
+def test_literature_cases_keep_their_design_space(public_cases):
+    lit = public_cases["P2_kk5_timing"]
+    assert with_size_bound(lit).max_size is None
+    assert with_size_bound(dataclasses.replace(lit, published=())).max_size == 1.5
+    assert with_size_bound(lit, 2.0).max_size == 2.0
+
+
+def test_case_option_and_cli_option(tmp_path, cli_json):
+    case, _ = _known_case()
+    raw = dict(case.raw, options={"max_size": 0})
+    assert PathCase.from_dict(raw).max_size == 0 and with_size_bound(PathCase.from_dict(raw)).max_size is None
+    with pytest.raises(MechsynInputError, match="options.max_size"):
+        PathCase.from_dict(dict(case.raw, options={"max_size": "big"}))
+    f = tmp_path / "case.json"
+    f.write_text(json.dumps(case.raw))
+    data = cli_json("synth", "path", f, "--restarts", "1", "--time-limit", "30", "--max-size", "0")
+    assert data["max_size"] is None and data["feasible"]
