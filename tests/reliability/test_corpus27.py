@@ -168,8 +168,9 @@ def test_a_truncated_curve_cache_file_is_one_error_then_rebuilt(tmp_path):
     build_database(tmp_path, max_links=4, per_topology=30)
     f = sorted(tmp_path.glob("*.npz"))[0]
     f.write_bytes(f.read_bytes()[: f.stat().st_size // 2])
-    with pytest.raises(MechsynInputError, match=f"damaged curve database file {f.name}"):
+    with pytest.raises(MechsynInputError, match="the curve database file is damaged") as err:
         load_database(tmp_path, max_links=4)
+    assert err.value.source.endswith(f.name) and "mechsyn curves build" in err.value.hint
     build_database(tmp_path, max_links=4, per_topology=30)  # builds it again
     assert len(load_database(tmp_path, max_links=4)) > 0
 

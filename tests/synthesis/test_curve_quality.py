@@ -13,7 +13,8 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io.load import mechanism_from_dict
 from mechsyn.kinematics import simulate
 from mechsyn.synthesis.curves.database import build_database, load_database
-from mechsyn.synthesis.curves.synthesis import sharp_features, synthesize_curve
+from mechsyn.synthesis.curves.fitting import sharp_features
+from mechsyn.synthesis.curves.synthesis import synthesize_curve
 from mechsyn.synthesis.curves.target import read_target, smooth_samples, target_from_points
 from mechsyn.synthesis.curves.topologies import curve_topologies
 

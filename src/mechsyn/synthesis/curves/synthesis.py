@@ -52,22 +52,15 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import simulate_batch
 from mechsyn.synthesis.curves.database import CurveDatabase, load_database
 from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
+from mechsyn.synthesis.curves.fitting import (DEFAULT_MAX_LINK_RATIO, DEFAULT_MAX_SIZE, DEFAULT_MIN_TRANSMISSION,
+                                               DEFAULT_TOLERANCE, N_FINAL, Bounds, FitProblem, curve_errors,
+                                               full_plan, input_offsets, link_pairs, link_ratio, path_sizes)
 from mechsyn.synthesis.curves.target import SPARSE_POINTS, TargetCurve, smooth_samples, target_from_points
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
 from mechsyn.synthesis.problem import Progress, SynthesisResult
 
 __all__ = ["CurveCandidate", "CurveSynthesisResult", "synthesize_curve", "curve_errors"]
 
-M_TARGET = 64          # target points for the residuals
-N_TRACE = 96           # input samples along the range (refinement)
-N_FINAL = 360          # input samples of the reported path and errors
-PENALTY = 1.0          # residual (in target diagonals) of an unassembled design
-
-DEFAULT_MAX_SIZE = 1.5            # every point inside this many diagonals of the target's centre
-DEFAULT_MAX_LINK_RATIO = 10.0     # longest / shortest link length
-DEFAULT_MIN_TRANSMISSION = 30.0   # degrees, worst over the motion
-DEFAULT_TOLERANCE = 5e-3          # chamfer / diagonal within which fewer links rank first
-MARGIN = 0.97                     # the refinement aims this far inside each bound
 
 
 @dataclass
@@ -181,259 +174,6 @@ class CurveSynthesisResult(SynthesisResult):
         return plot_curve_result(self, ax=ax, top=top)
 
 
-# ----------------------------------------------------------------------------- distances
-
-
-def _polyline(points: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Segment starts and vectors ``(S, 2)`` of a polyline."""
-    P = points
-    Q = np.roll(P, -1, axis=0) if closed else P[1:]
-    P = P if closed else P[:-1]
-    return P, Q - P
-
-
-def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
-                 k: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Vectors from points ``X (..., n, 2)`` to their nearest point on the polyline
-    (``starts``, ``vecs`` ``(..., S, 2)``), and the index of that segment ``(..., n)``.
-    With ``k`` given, the segments are those (fixed correspondences, for Jacobians)."""
-    if k is not None:
-        shape = np.broadcast_shapes(X.shape[:-1], k.shape, starts.shape[:-2] + k.shape[-1:])
-        st = np.take_along_axis(np.broadcast_to(starts, shape[:-1] + starts.shape[-2:]),
-                                np.broadcast_to(k, shape)[..., None], axis=-2)
-        ve = np.take_along_axis(np.broadcast_to(vecs, shape[:-1] + vecs.shape[-2:]),
-                                np.broadcast_to(k, shape)[..., None], axis=-2)
-        d = X - st
-        L2 = np.sum(ve ** 2, axis=-1)
-        t = np.clip(np.sum(d * ve, axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
-        return t[..., None] * ve - d, k
-    d = X[..., :, None, :] - starts[..., None, :, :]                   # (..., n, S, 2)
-    L2 = np.sum(vecs ** 2, axis=-1)[..., None, :]
-    t = np.clip(np.sum(d * vecs[..., None, :, :], axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
-    diff = d - t[..., None] * vecs[..., None, :, :]
-    dist2 = np.sum(diff ** 2, axis=-1)
-    k = np.argmin(dist2, axis=-1)
-    return -np.take_along_axis(diff, k[..., None, None], axis=-2)[..., 0, :], k
-
-
-def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
-                 unit: float | None = None) -> tuple[float, float]:
-    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals
-    (or in ``unit``)."""
-    unit = target.diagonal if unit is None else unit
-    T = target.points
-    ts, tv = _polyline(T, target.closed)
-    ps, pv = _polyline(path, closed_path)
-    a = np.linalg.norm(_to_polyline(T, ps, pv)[0], axis=-1).mean()
-    b = np.linalg.norm(_to_polyline(path, ts, tv)[0], axis=-1).mean()
-    chamfer = 0.5 * (a + b) / unit
-    m = 128
-    w = resample(T, m, closed=target.closed)
-    z = resample(path, m, closed=closed_path)
-    best = np.inf
-    for zz in (z, z[::-1]):
-        for s in range(m):
-            best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
-    return float(chamfer), best / unit
-
-
-# ---------------------------------------------------------------------------- evaluation
-
-
-def _offsets(start: float, stop: float, closed: bool, n: int = N_TRACE) -> np.ndarray:
-    if closed:
-        return start + np.arange(n) * (360.0 / n)
-    return np.linspace(start, stop, n)
-
-
-_FULL_PLANS: dict[str, Any] = {}
-
-
-def _full_plan(topo: CurveTopology):
-    """The topology's batch plan with every joint (and the tracer) as an output."""
-    plan = _FULL_PLANS.get(topo.key)
-    if plan is None:
-        from mechsyn.io.load import mechanism_from_dict
-        from mechsyn.kinematics.batch import compile_plan
-
-        plan = compile_plan(mechanism_from_dict(topo.template), points=list(topo.plan.names))
-        if list(plan.names) != list(topo.plan.names):  # the parameters must mean the same
-            raise RuntimeError(f"{topo.key}: the full plan orders its points differently")
-        _FULL_PLANS[topo.key] = plan
-    return plan
-
-
-def _sizes(paths: dict[str, np.ndarray], centre: tuple[float, float]) -> np.ndarray:
-    """Largest distance ``(K,)`` of any point from ``centre`` over the motion; samples
-    not placed are ignored (inf when none is)."""
-    R = np.stack([np.hypot(P[..., 0] - centre[0], P[..., 1] - centre[1]) for P in paths.values()], axis=-1)
-    m = np.max(np.where(np.isfinite(R), R, -np.inf), axis=(1, 2))
-    return np.where(np.isfinite(m), m, np.inf)          # nothing placed: no size to speak of
-
-
-@dataclass(frozen=True)
-class _Bounds:
-    """Design bounds in the working frame: ``centre`` the target's bounding-box centre,
-    ``unit`` its diagonal, ``radius`` the size bound (``None`` or 0 where lifted)."""
-
-    centre: tuple[float, float]
-    unit: float
-    radius: float | None
-    link_ratio: float | None
-    transmission: float
-    region: tuple[float, float, float, float] | None
-
-    def excess(self, size: np.ndarray, ratio: np.ndarray, mu: np.ndarray, margin: float = 1.0) -> np.ndarray:
-        """Relative violations ``(K, 3)`` (size, link ratio, transmission), 0 inside the
-        bounds each scaled by ``margin`` (the transmission bound divided by it)."""
-        out = np.zeros((len(size), 3))
-        if self.radius is not None:
-            out[:, 0] = np.maximum(0.0, np.nan_to_num(size, nan=np.inf) / (margin * self.radius) - 1.0)
-        if self.link_ratio is not None:
-            out[:, 1] = np.maximum(0.0, ratio / (margin * self.link_ratio) - 1.0)
-        if self.transmission > 0:
-            need = min(89.0, self.transmission / margin)
-            out[:, 2] = np.maximum(0.0, 1.0 - np.nan_to_num(mu, nan=0.0) / need)
-        return np.minimum(out, 1e3)
-
-
-@dataclass
-class _Problem:
-    topo: CurveTopology
-    target: TargetCurve
-    closed_path: bool
-    start: float
-    stop: float
-    bounds: _Bounds
-
-    def __post_init__(self) -> None:
-        self.off = _offsets(self.start, self.stop, self.closed_path)
-        self.T = resample(self.target.points, M_TARGET, closed=self.target.closed)
-        if not self.target.closed:  # resample there and back: keep the way there
-            self.T = resample(self.target.points, 2 * M_TARGET - 2, closed=False)[:M_TARGET]
-        self.T = np.stack([self.T.real, self.T.imag], axis=-1)
-        self.ts, self.tv = _polyline(self.target.points, self.target.closed)
-        self.features = sharp_features(self.target.points, self.target.closed)
-        self.diag = 1.0   # the working frame's length unit
-        self.plan = _full_plan(self.topo)
-        names = self.topo.plan.names
-        self.frame_pts = [i for i, n in enumerate(names) if n != TRACER and any(
-            j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
-        self.link_pairs = _link_pairs(self.topo)
-        self.nfev = 0
-
-    def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
-        """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
-        segments of the first design are used for all (the Jacobian's perturbations)."""
-        X = np.atleast_2d(X)
-        self.nfev += len(X)
-        res = simulate_batch(self.plan, X, self.off, transmission=self.bounds.transmission > 0)
-        P = res.paths[TRACER]
-        bad = ~res.assembled.all(axis=1) | res.branch_jump
-        P = np.where(np.isfinite(P), P, 0.0)
-        starts = P if self.closed_path else P[:, :-1]
-        vecs = (np.roll(P, -1, axis=1) if self.closed_path else P[:, 1:]) - starts
-        F = self.features
-        if keep:
-            r1, k1 = _to_polyline(self.T[None], starts[:1], vecs[:1])
-            r2, k2 = _to_polyline(P[:1], self.ts[None], self.tv[None])
-            r3, k3 = _to_polyline(F[None], starts[:1], vecs[:1])
-            r1 = np.concatenate([r1, _to_polyline(self.T[None], starts[1:], vecs[1:], k1)[0]])
-            r2 = np.concatenate([r2, _to_polyline(P[1:], self.ts[None], self.tv[None], k2)[0]])
-            r3 = np.concatenate([r3, _to_polyline(F[None], starts[1:], vecs[1:], k3)[0]])
-        else:
-            r1 = _to_polyline(self.T[None], starts, vecs)[0]        # target -> path
-            r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
-            r3 = _to_polyline(F[None], starts, vecs)[0]             # sharp features -> path
-        r1 = r1 / np.sqrt(len(self.T))
-        r2 = r2 / np.sqrt(P.shape[1])
-        r3 = r3 * (FEATURE_WEIGHT / np.sqrt(max(len(F), 1)))
-        r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1), r3.reshape(len(X), -1)],
-                           axis=1) / self.diag
-        r[bad] = PENALTY                 # off its branch or not assembled: never accepted
-        size = _sizes(res.paths, self.bounds.centre)
-        mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(X), 90.0)
-        pen = [self.bounds.excess(size, _link_ratio(X, self.link_pairs), mu, MARGIN) * BOUND_WEIGHT]
-        if self.bounds.region is not None:
-            x0, y0, x1, y1 = self.bounds.region
-            G = X.reshape(len(X), -1, 2)[:, self.frame_pts]
-            out = (np.maximum(0, x0 - G[..., 0]) + np.maximum(0, G[..., 0] - x1)
-                   + np.maximum(0, y0 - G[..., 1]) + np.maximum(0, G[..., 1] - y1)) / self.diag
-            pen.append(out * 10.0)
-        self.last_bad = bad
-        return np.concatenate([r] + pen, axis=1)
-
-    def fun(self, x: np.ndarray) -> np.ndarray:
-        return self.residuals(x[None])[0]
-
-    def jac(self, x: np.ndarray) -> np.ndarray:
-        h = 1e-7 * self.diag
-        X = np.vstack([x, x + h * np.eye(len(x))])
-        R = self.residuals(X, keep=True)
-        return (R[1:] - R[0]).T / h
-
-
-FEATURE_WEIGHT = 0.25  # the sharp-feature residuals against the chamfer's (both /sqrt(count))
-BOUND_WEIGHT = 1.0     # residual per unit of relative bound violation (aimed at MARGIN inside)
-
-
-def sharp_features(points: np.ndarray, closed: bool, angle: float = 50.0) -> np.ndarray:
-    """Corners, cusps and sharp bends of a curve ``(n, 2)``: the points where the
-    direction turns by more than ``angle`` degrees within 2 % of the curve's length
-    either side (local maxima of that turn), as ``(k, 2)``; an open curve's ends are
-    features too. They are fitted point to path in the refinement beside the chamfer,
-    so a corner is not rounded off for the sake of the mean distance.
-
-    >>> sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]])
-    >>> sharp_features(sq, closed=True).tolist()
-    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
-    """
-    m = 200
-    z = resample(points, m, closed=True) if closed else resample(points, 2 * m - 2, closed=False)[:m]
-    k = max(2, int(round(0.02 * m)))
-    if closed:
-        d_in, d_out = z - np.roll(z, k), np.roll(z, -k) - z
-    else:
-        zi = np.arange(m)
-        d_in = z - z[np.maximum(zi - k, 0)]
-        d_out = z[np.minimum(zi + k, m - 1)] - z
-    turn = np.degrees(np.abs(np.angle(d_out * np.conj(d_in))))
-    turn = np.where((np.abs(d_in) > 0) & (np.abs(d_out) > 0), turn, 0.0)
-    nb = [np.roll(turn, s) for s in range(-k, k + 1) if s]
-    peak = (turn > angle) & np.all([turn >= b for b in nb], axis=0)
-    if not closed:
-        peak[:k + 1] = peak[-k - 1:] = False
-        peak[0] = peak[-1] = True
-    idx = np.flatnonzero(peak)
-    keep = [i for j, i in enumerate(idx) if j == 0 or i - idx[j - 1] > k]   # one per plateau
-    # the exact corner: the input point nearest the resampled peak
-    P = np.asarray(points, float)
-    pz = P[:, 0] + 1j * P[:, 1]
-    near = [int(np.argmin(np.abs(pz - z[i]))) for i in keep]
-    return P[sorted(set(near))] if near else np.zeros((0, 2))
-
-
-def _link_pairs(topo: CurveTopology) -> list[tuple[int, int]]:
-    """Index pairs of joints (and tracer) on the same link: the link lengths."""
-    names = topo.plan.names
-    idx = {n: i for i, n in enumerate(names)}
-    pairs = []
-    for link, pts in topo.links_of().items():
-        pts = [p for p in pts if p != TRACER]
-        for a in range(len(pts)):
-            for b in range(a + 1, len(pts)):
-                pairs.append((idx[pts[a]], idx[pts[b]]))
-    return pairs
-
-
-def _link_ratio(X: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
-    P = np.atleast_2d(X).reshape(len(np.atleast_2d(X)), -1, 2)
-    a = np.array([p[0] for p in pairs])
-    b = np.array([p[1] for p in pairs])
-    L = np.linalg.norm(P[:, a] - P[:, b], axis=-1)
-    return L.max(axis=1) / np.maximum(L.min(axis=1), 1e-300)
-
-
 # ------------------------------------------------------------------------------ retrieval
 
 
@@ -465,7 +205,7 @@ def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) 
 
 
 def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool,
-              bounds: _Bounds) -> list[_Seed]:
+              bounds: Bounds) -> list[_Seed]:
     w = resample(target.points, 64, closed=target.closed)
     d = fourier_descriptor(w)
     rows: set[int] = set()
@@ -493,11 +233,11 @@ def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, cr
 
 
 def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np.ndarray, diag: float,
-                    bounds: _Bounds) -> list[_Seed]:
+                    bounds: Bounds) -> list[_Seed]:
     """The retrieved rows of one topology aligned onto the target ``w`` and mapped into
     its frame, each with its alignment error and bound violations."""
     rs_a = np.array(rs)
-    offs = np.array([_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
+    offs = np.array([input_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
     X = np.array([db.designs[r] for r in rs])
     P = simulate_batch(topo.plan, X, offs, flags=False).paths[TRACER]
     fine = np.all(np.isfinite(P), axis=(1, 2))
@@ -520,10 +260,10 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
         out.append(_Seed(r, topo, params, a, b, bool(db.closed[r]), float(al.rms[j]) / diag))
     if out:  # the mapped designs' size, link ratio and transmission angle over their range
         Xs = np.array([s.params for s in out])
-        res = simulate_batch(_full_plan(topo), Xs, np.array([_offsets(s.start, s.stop, s.closed, 48) for s in out]),
+        res = simulate_batch(full_plan(topo), Xs, np.array([input_offsets(s.start, s.stop, s.closed, 48) for s in out]),
                              transmission=bounds.transmission > 0, flags=False)
         mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(out), 90.0)
-        exc = bounds.excess(_sizes(res.paths, bounds.centre), _link_ratio(Xs, _link_pairs(topo)), mu).sum(axis=1)
+        exc = bounds.excess(path_sizes(res.paths, bounds.centre), link_ratio(Xs, link_pairs(topo)), mu).sum(axis=1)
         for s, e in zip(out, exc):
             s.excess = float(e)
     return out
@@ -532,9 +272,9 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
 # ----------------------------------------------------------------------------- refinement
 
 
-def _refine(seed: _Seed, target: TargetCurve, bounds: _Bounds, max_nfev: int) -> CurveCandidate | None:
+def _refine(seed: _Seed, target: TargetCurve, bounds: Bounds, max_nfev: int) -> CurveCandidate | None:
     """The seed refined in the working frame (None when it does not assemble)."""
-    prob = _Problem(seed.topo, target, seed.closed, seed.start, seed.stop, bounds)
+    prob = FitProblem(seed.topo, target, seed.closed, seed.start, seed.stop, bounds)
     x0 = seed.params
     prob.fun(x0)
     if prob.last_bad[0]:  # does not assemble over the range after the mapping
@@ -549,19 +289,19 @@ def _refine(seed: _Seed, target: TargetCurve, bounds: _Bounds, max_nfev: int) ->
 
 
 def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, closed: bool,
-               target: TargetCurve, nfev: int, bounds: _Bounds) -> CurveCandidate | None:
+               target: TargetCurve, nfev: int, bounds: Bounds) -> CurveCandidate | None:
     """The design's candidate in the working frame, with its errors and quality over
     :data:`N_FINAL` input samples (lengths in ``bounds.unit``); None when it is not
     assembled."""
-    off = _offsets(start, stop, closed, N_FINAL)
-    res = simulate_batch(_full_plan(topo), x[None], off, transmission=True)
+    off = input_offsets(start, stop, closed, N_FINAL)
+    res = simulate_batch(full_plan(topo), x[None], off, transmission=True)
     if not res.assembled.all() or res.branch_jump[0]:
         return None
     path = res.paths[TRACER][0]
     ch, od = curve_errors(path, target, closed, bounds.unit)
-    size = float(_sizes(res.paths, bounds.centre)[0])
+    size = float(path_sizes(res.paths, bounds.centre)[0])
     return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
-                          float(res.min_transmission_angle[0]), float(_link_ratio(x, _link_pairs(topo))[0]),
+                          float(res.min_transmission_angle[0]), float(link_ratio(x, link_pairs(topo))[0]),
                           path, nfev=nfev, size=size, size_ratio=size / bounds.unit)
 
 
@@ -571,7 +311,7 @@ def _verify(c: CurveCandidate) -> None:
     from mechsyn.kinematics import simulate
 
     t = c.topology
-    off = _offsets(c.start, c.stop, c.full_turn, N_FINAL)
+    off = input_offsets(c.start, c.stop, c.full_turn, N_FINAL)
     try:
         mech = mechanism_from_dict(c.mechanism())
         # the reference configuration first: simulate takes the assembly mode from it
@@ -641,7 +381,7 @@ class _Frame:
     def inward(self, target: TargetCurve) -> TargetCurve:
         return TargetCurve(self.inward_points(target.points), target.closed, target.source)
 
-    def bounds(self, user: TargetCurve, max_size, max_link_ratio, min_transmission, region) -> _Bounds:
+    def bounds(self, user: TargetCurve, max_size, max_link_ratio, min_transmission, region) -> Bounds:
         """The design bounds in working coordinates (disc about the target's bounding-box
         centre, radius in its diagonals)."""
         P = user.points
@@ -651,7 +391,7 @@ class _Frame:
         if region is not None:
             lo, hi = self.inward_points(np.array(region[:2])), self.inward_points(np.array(region[2:]))
             box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
-        return _Bounds((float(centre[0]), float(centre[1])), unit, None if max_size is None else max_size * unit,
+        return Bounds((float(centre[0]), float(centre[1])), unit, None if max_size is None else max_size * unit,
                        max_link_ratio, float(min_transmission), box)
 
     def outward(self, c: CurveCandidate) -> CurveCandidate:
@@ -873,7 +613,7 @@ class _Refinement:
     refinements done, evaluations, notes."""
 
     target: TargetCurve
-    bounds: _Bounds
+    bounds: Bounds
     max_nfev: int
     report: Callable[..., None]
     cands: list[CurveCandidate] = field(default_factory=list)
@@ -954,7 +694,7 @@ def _ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str
     return out
 
 
-def _nearest_miss(misses: list[CurveCandidate], bounds: _Bounds, notes: list[str]) -> CurveCandidate | None:
+def _nearest_miss(misses: list[CurveCandidate], bounds: Bounds, notes: list[str]) -> CurveCandidate | None:
     """The design found closest to the bounds (then the most accurate), verified."""
     def key(c):
         e = bounds.excess(np.array([c.size]), np.array([c.link_length_ratio]), np.array([c.min_transmission_angle]))
@@ -968,7 +708,7 @@ def _nearest_miss(misses: list[CurveCandidate], bounds: _Bounds, notes: list[str
     return None
 
 
-def _miss_reason(c: CurveCandidate, bounds: _Bounds) -> str:
+def _miss_reason(c: CurveCandidate, bounds: Bounds) -> str:
     """``no candidate within the bounds; nearest miss: ...`` with the options that lift them."""
     out = []
     if bounds.radius is not None and c.size > bounds.radius * (1 + 1e-9):

@@ -1,0 +1,282 @@
+"""The objective of curve synthesis: how far a linkage's path is from the target (the
+chamfer distance both ways, :func:`curve_errors`), the sharp features of a target (cusps and
+corners, :func:`sharp_features`), the designer's bounds (size, link ratio, transmission
+angle) and the least-squares problem that the refinement of
+:mod:`mechsyn.synthesis.curves.synthesis` solves for one topology.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mechsyn.kinematics.batch import simulate_batch
+from mechsyn.synthesis.curves.descriptors import resample
+from mechsyn.synthesis.curves.target import TargetCurve
+from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
+
+M_TARGET = 64          # target points for the residuals
+N_TRACE = 96           # input samples along the range (refinement)
+N_FINAL = 360          # input samples of the reported path and errors
+PENALTY = 1.0          # residual (in target diagonals) of an unassembled design
+
+DEFAULT_MAX_SIZE = 1.5            # every point inside this many diagonals of the target's centre
+DEFAULT_MAX_LINK_RATIO = 10.0     # longest / shortest link length
+DEFAULT_MIN_TRANSMISSION = 30.0   # degrees, worst over the motion
+DEFAULT_TOLERANCE = 5e-3          # chamfer / diagonal within which fewer links rank first
+MARGIN = 0.97                     # the refinement aims this far inside each bound
+
+
+# ----------------------------------------------------------------------------- distances
+
+
+def _polyline(points: np.ndarray, closed: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Segment starts and vectors ``(S, 2)`` of a polyline."""
+    P = points
+    Q = np.roll(P, -1, axis=0) if closed else P[1:]
+    P = P if closed else P[:-1]
+    return P, Q - P
+
+
+def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
+                 k: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Vectors from points ``X (..., n, 2)`` to their nearest point on the polyline
+    (``starts``, ``vecs`` ``(..., S, 2)``), and the index of that segment ``(..., n)``.
+    With ``k`` given, the segments are those (fixed correspondences, for Jacobians)."""
+    if k is not None:
+        shape = np.broadcast_shapes(X.shape[:-1], k.shape, starts.shape[:-2] + k.shape[-1:])
+        st = np.take_along_axis(np.broadcast_to(starts, shape[:-1] + starts.shape[-2:]),
+                                np.broadcast_to(k, shape)[..., None], axis=-2)
+        ve = np.take_along_axis(np.broadcast_to(vecs, shape[:-1] + vecs.shape[-2:]),
+                                np.broadcast_to(k, shape)[..., None], axis=-2)
+        d = X - st
+        L2 = np.sum(ve ** 2, axis=-1)
+        t = np.clip(np.sum(d * ve, axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+        return t[..., None] * ve - d, k
+    d = X[..., :, None, :] - starts[..., None, :, :]                   # (..., n, S, 2)
+    L2 = np.sum(vecs ** 2, axis=-1)[..., None, :]
+    t = np.clip(np.sum(d * vecs[..., None, :, :], axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
+    diff = d - t[..., None] * vecs[..., None, :, :]
+    dist2 = np.sum(diff ** 2, axis=-1)
+    k = np.argmin(dist2, axis=-1)
+    return -np.take_along_axis(diff, k[..., None, None], axis=-2)[..., 0, :], k
+
+
+def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
+                 unit: float | None = None) -> tuple[float, float]:
+    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals
+    (or in ``unit``)."""
+    unit = target.diagonal if unit is None else unit
+    T = target.points
+    ts, tv = _polyline(T, target.closed)
+    ps, pv = _polyline(path, closed_path)
+    a = np.linalg.norm(_to_polyline(T, ps, pv)[0], axis=-1).mean()
+    b = np.linalg.norm(_to_polyline(path, ts, tv)[0], axis=-1).mean()
+    chamfer = 0.5 * (a + b) / unit
+    m = 128
+    w = resample(T, m, closed=target.closed)
+    z = resample(path, m, closed=closed_path)
+    best = np.inf
+    for zz in (z, z[::-1]):
+        for s in range(m):
+            best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
+    return float(chamfer), best / unit
+
+
+# ---------------------------------------------------------------------------- evaluation
+
+
+def input_offsets(start: float, stop: float, closed: bool, n: int = N_TRACE) -> np.ndarray:
+    if closed:
+        return start + np.arange(n) * (360.0 / n)
+    return np.linspace(start, stop, n)
+
+
+_FULL_PLANS: dict[str, Any] = {}
+
+
+def full_plan(topo: CurveTopology):
+    """The topology's batch plan with every joint (and the tracer) as an output."""
+    plan = _FULL_PLANS.get(topo.key)
+    if plan is None:
+        from mechsyn.io.load import mechanism_from_dict
+        from mechsyn.kinematics.batch import compile_plan
+
+        plan = compile_plan(mechanism_from_dict(topo.template), points=list(topo.plan.names))
+        if list(plan.names) != list(topo.plan.names):  # the parameters must mean the same
+            raise RuntimeError(f"{topo.key}: the full plan orders its points differently")
+        _FULL_PLANS[topo.key] = plan
+    return plan
+
+
+def path_sizes(paths: dict[str, np.ndarray], centre: tuple[float, float]) -> np.ndarray:
+    """Largest distance ``(K,)`` of any point from ``centre`` over the motion; samples
+    not placed are ignored (inf when none is)."""
+    R = np.stack([np.hypot(P[..., 0] - centre[0], P[..., 1] - centre[1]) for P in paths.values()], axis=-1)
+    m = np.max(np.where(np.isfinite(R), R, -np.inf), axis=(1, 2))
+    return np.where(np.isfinite(m), m, np.inf)          # nothing placed: no size to speak of
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """Design bounds in the working frame: ``centre`` the target's bounding-box centre,
+    ``unit`` its diagonal, ``radius`` the size bound (``None`` or 0 where lifted)."""
+
+    centre: tuple[float, float]
+    unit: float
+    radius: float | None
+    link_ratio: float | None
+    transmission: float
+    region: tuple[float, float, float, float] | None
+
+    def excess(self, size: np.ndarray, ratio: np.ndarray, mu: np.ndarray, margin: float = 1.0) -> np.ndarray:
+        """Relative violations ``(K, 3)`` (size, link ratio, transmission), 0 inside the
+        bounds each scaled by ``margin`` (the transmission bound divided by it)."""
+        out = np.zeros((len(size), 3))
+        if self.radius is not None:
+            out[:, 0] = np.maximum(0.0, np.nan_to_num(size, nan=np.inf) / (margin * self.radius) - 1.0)
+        if self.link_ratio is not None:
+            out[:, 1] = np.maximum(0.0, ratio / (margin * self.link_ratio) - 1.0)
+        if self.transmission > 0:
+            need = min(89.0, self.transmission / margin)
+            out[:, 2] = np.maximum(0.0, 1.0 - np.nan_to_num(mu, nan=0.0) / need)
+        return np.minimum(out, 1e3)
+
+
+@dataclass
+class FitProblem:
+    topo: CurveTopology
+    target: TargetCurve
+    closed_path: bool
+    start: float
+    stop: float
+    bounds: Bounds
+
+    def __post_init__(self) -> None:
+        self.off = input_offsets(self.start, self.stop, self.closed_path)
+        self.T = resample(self.target.points, M_TARGET, closed=self.target.closed)
+        if not self.target.closed:  # resample there and back: keep the way there
+            self.T = resample(self.target.points, 2 * M_TARGET - 2, closed=False)[:M_TARGET]
+        self.T = np.stack([self.T.real, self.T.imag], axis=-1)
+        self.ts, self.tv = _polyline(self.target.points, self.target.closed)
+        self.features = sharp_features(self.target.points, self.target.closed)
+        self.diag = 1.0   # the working frame's length unit
+        self.plan = full_plan(self.topo)
+        names = self.topo.plan.names
+        self.frame_pts = [i for i, n in enumerate(names) if n != TRACER and any(
+            j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
+        self.link_pairs = link_pairs(self.topo)
+        self.nfev = 0
+
+    def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
+        """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
+        segments of the first design are used for all (the Jacobian's perturbations)."""
+        X = np.atleast_2d(X)
+        self.nfev += len(X)
+        res = simulate_batch(self.plan, X, self.off, transmission=self.bounds.transmission > 0)
+        P = res.paths[TRACER]
+        bad = ~res.assembled.all(axis=1) | res.branch_jump
+        P = np.where(np.isfinite(P), P, 0.0)
+        starts = P if self.closed_path else P[:, :-1]
+        vecs = (np.roll(P, -1, axis=1) if self.closed_path else P[:, 1:]) - starts
+        F = self.features
+        if keep:
+            r1, k1 = _to_polyline(self.T[None], starts[:1], vecs[:1])
+            r2, k2 = _to_polyline(P[:1], self.ts[None], self.tv[None])
+            r3, k3 = _to_polyline(F[None], starts[:1], vecs[:1])
+            r1 = np.concatenate([r1, _to_polyline(self.T[None], starts[1:], vecs[1:], k1)[0]])
+            r2 = np.concatenate([r2, _to_polyline(P[1:], self.ts[None], self.tv[None], k2)[0]])
+            r3 = np.concatenate([r3, _to_polyline(F[None], starts[1:], vecs[1:], k3)[0]])
+        else:
+            r1 = _to_polyline(self.T[None], starts, vecs)[0]        # target -> path
+            r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
+            r3 = _to_polyline(F[None], starts, vecs)[0]             # sharp features -> path
+        r1 = r1 / np.sqrt(len(self.T))
+        r2 = r2 / np.sqrt(P.shape[1])
+        r3 = r3 * (FEATURE_WEIGHT / np.sqrt(max(len(F), 1)))
+        r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1), r3.reshape(len(X), -1)],
+                           axis=1) / self.diag
+        r[bad] = PENALTY                 # off its branch or not assembled: never accepted
+        size = path_sizes(res.paths, self.bounds.centre)
+        mu = res.min_transmission_angle if res.min_transmission_angle is not None else np.full(len(X), 90.0)
+        pen = [self.bounds.excess(size, link_ratio(X, self.link_pairs), mu, MARGIN) * BOUND_WEIGHT]
+        if self.bounds.region is not None:
+            x0, y0, x1, y1 = self.bounds.region
+            G = X.reshape(len(X), -1, 2)[:, self.frame_pts]
+            out = (np.maximum(0, x0 - G[..., 0]) + np.maximum(0, G[..., 0] - x1)
+                   + np.maximum(0, y0 - G[..., 1]) + np.maximum(0, G[..., 1] - y1)) / self.diag
+            pen.append(out * 10.0)
+        self.last_bad = bad
+        return np.concatenate([r] + pen, axis=1)
+
+    def fun(self, x: np.ndarray) -> np.ndarray:
+        return self.residuals(x[None])[0]
+
+    def jac(self, x: np.ndarray) -> np.ndarray:
+        h = 1e-7 * self.diag
+        X = np.vstack([x, x + h * np.eye(len(x))])
+        R = self.residuals(X, keep=True)
+        return (R[1:] - R[0]).T / h
+
+
+FEATURE_WEIGHT = 0.25  # the sharp-feature residuals against the chamfer's (both /sqrt(count))
+BOUND_WEIGHT = 1.0     # residual per unit of relative bound violation (aimed at MARGIN inside)
+
+
+def sharp_features(points: np.ndarray, closed: bool, angle: float = 50.0) -> np.ndarray:
+    """Corners, cusps and sharp bends of a curve ``(n, 2)``: the points where the
+    direction turns by more than ``angle`` degrees within 2 % of the curve's length
+    either side (local maxima of that turn), as ``(k, 2)``; an open curve's ends are
+    features too. They are fitted point to path in the refinement beside the chamfer,
+    so a corner is not rounded off for the sake of the mean distance.
+
+    >>> sq = np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]])
+    >>> sharp_features(sq, closed=True).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+    """
+    m = 200
+    z = resample(points, m, closed=True) if closed else resample(points, 2 * m - 2, closed=False)[:m]
+    k = max(2, int(round(0.02 * m)))
+    if closed:
+        d_in, d_out = z - np.roll(z, k), np.roll(z, -k) - z
+    else:
+        zi = np.arange(m)
+        d_in = z - z[np.maximum(zi - k, 0)]
+        d_out = z[np.minimum(zi + k, m - 1)] - z
+    turn = np.degrees(np.abs(np.angle(d_out * np.conj(d_in))))
+    turn = np.where((np.abs(d_in) > 0) & (np.abs(d_out) > 0), turn, 0.0)
+    nb = [np.roll(turn, s) for s in range(-k, k + 1) if s]
+    peak = (turn > angle) & np.all([turn >= b for b in nb], axis=0)
+    if not closed:
+        peak[:k + 1] = peak[-k - 1:] = False
+        peak[0] = peak[-1] = True
+    idx = np.flatnonzero(peak)
+    keep = [i for j, i in enumerate(idx) if j == 0 or i - idx[j - 1] > k]   # one per plateau
+    # the exact corner: the input point nearest the resampled peak
+    P = np.asarray(points, float)
+    pz = P[:, 0] + 1j * P[:, 1]
+    near = [int(np.argmin(np.abs(pz - z[i]))) for i in keep]
+    return P[sorted(set(near))] if near else np.zeros((0, 2))
+
+
+def link_pairs(topo: CurveTopology) -> list[tuple[int, int]]:
+    """Index pairs of joints (and tracer) on the same link: the link lengths."""
+    names = topo.plan.names
+    idx = {n: i for i, n in enumerate(names)}
+    pairs = []
+    for link, pts in topo.links_of().items():
+        pts = [p for p in pts if p != TRACER]
+        for a in range(len(pts)):
+            for b in range(a + 1, len(pts)):
+                pairs.append((idx[pts[a]], idx[pts[b]]))
+    return pairs
+
+
+def link_ratio(X: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
+    P = np.atleast_2d(X).reshape(len(np.atleast_2d(X)), -1, 2)
+    a = np.array([p[0] for p in pairs])
+    b = np.array([p[1] for p in pairs])
+    L = np.linalg.norm(P[:, a] - P[:, b], axis=-1)
+    return L.max(axis=1) / np.maximum(L.min(axis=1), 1e-300)
