@@ -283,6 +283,12 @@ def test_fourbar_path_synthesis_job(client):
     path = np.array([p for p in d["points"]["P"] if p is not None])
     gap = max(np.min(np.linalg.norm(path - t, axis=1)) for t in targets)
     assert gap < 0.05 * np.ptp(targets, axis=0).max()
+    # buildable: inside the default size bound, its quality listed; the transmission angle
+    # is the simulated one's worst (the crank-rocker's extremes in closed form)
+    q = best["quality"]
+    assert q["size_ratio"] <= 1.5 + 1e-9 and q["link_ratio"] >= 1 and q["full_turn"]
+    sim_mu = min(min(v["min"], 180 - v["max"]) for v in d["transmission_angle"].values())
+    assert abs(q["min_transmission_angle"] - sim_mu) < 1.0, (q, d["transmission_angle"])
 
 
 def test_synthesis_cancel_and_bad_input(client):

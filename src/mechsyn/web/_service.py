@@ -421,7 +421,8 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
                 "label": f"error {res.error:.4g} (sum of squared distances), branch {branch:+d}, "
                          f"{'feasible' if res.feasible else 'infeasible'}",
                 "design": {k: float(v) for k, v in d.items() if not k.startswith("theta2")},
-                "path": _xy(res.path), "seconds": float(res.seconds)}
+                "path": _xy(res.path), "seconds": float(res.seconds),
+                "quality": _fourbar_quality(d, res)}
         if res.feasible:
             item["mechanism"] = fourbar_mechanism_dict(
                 d["r1"], d["r2"], d["r3"], d["r4"], float(res.theta2[0]), branch=branch, rcx=d["rcx"],
@@ -429,6 +430,23 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
         results.append(item)
     results.sort(key=lambda r: (not r["feasible"], r["error"]))
     return {"kind": "fourbar_path", "targets": case.targets.tolist(), "results": results}
+
+
+def _fourbar_quality(d: dict[str, float], res: Any) -> dict[str, Any]:
+    """Size, link ratio and worst transmission angle of a path-synthesis four-bar (frame
+    r1, crank r2, coupler r3, rocker r4): the crank-rocker's transmission angle is extreme
+    where the crank lies along the frame, cos μ = (r3² + r4² - (r2 ∓ r1)²) / (2 r3 r4)."""
+    r1, r2, r3, r4 = (abs(float(d[k])) for k in ("r1", "r2", "r3", "r4"))
+    worst = 90.0
+    for s in (r2 - r1, r2 + r1):
+        c = (r3 * r3 + r4 * r4 - s * s) / (2 * r3 * r4) if r3 * r4 > 0 else 1.0
+        mu = math.degrees(math.acos(min(1.0, max(-1.0, c))))
+        worst = min(worst, mu, 180.0 - mu)
+    lengths = (r1, r2, r3, r4)
+    grashof = min(lengths) + max(lengths) <= sum(lengths) - min(lengths) - max(lengths)
+    return {"size": res.size, "size_ratio": res.size_ratio,
+            "link_ratio": max(lengths) / min(lengths) if min(lengths) > 0 else None,
+            "min_transmission_angle": worst, "full_turn": bool(grashof and min(lengths) in (r1, r2))}
 
 
 def _with_branch(case, branch: int):
@@ -475,8 +493,12 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
                         "path": _xy(c.path),
                         "label": f"{d['topology'] or d['topology_key']} ({d['links']} links): chamfer "
                                  f"{100 * c.chamfer:.2f} % of the diagonal, min μ {c.min_transmission_angle:.0f}°"
-                                 + ("" if c.verified else f", not verified: {c.verification}")})
-    return {"kind": "curve", "targets": T.tolist(), "results": results, "notes": list(res.notes)}
+                                 + ("" if c.verified else f", not verified: {c.verification}"),
+                        "quality": d.get("quality")})
+    notes = list(res.notes)
+    if not results and res.reason:  # nothing inside the bounds: say why, with the nearest miss
+        notes.insert(0, str(res.reason))
+    return {"kind": "curve", "targets": T.tolist(), "results": results, "notes": notes}
 
 
 # Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
