@@ -61,6 +61,8 @@ class CurveTopology:
         """The topology's name: four-bar, Watt I/II, Stephenson I/III, or for an
         eight-bar its atlas chain and link assortment (e.g. ``8-bar chain 3 (4B+4T)``).
 
+        Examples
+        --------
         >>> sorted({t.label for t in curve_topologies(6)})[:2]
         ['Stephenson I', 'Stephenson III']
         """
