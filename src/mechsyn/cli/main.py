@@ -10,6 +10,7 @@ imported; a module imported eagerly here is picked up the same way.
 from __future__ import annotations
 
 import importlib
+import re
 import signal
 import sys
 import threading
@@ -197,12 +198,25 @@ def _click_error(exc: Exception) -> int:
 
             ctx = getattr(exc, "ctx", None)
             where = ctx.command_path if ctx is not None else "mechsyn"
-            err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(exc.format_message())} "
+            err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(_suggested(exc, ctx))} "
                               f"(fix: see '{escape(where)} -h')", highlight=False, soft_wrap=True)
         return int(exc.exit_code)
     if hasattr(exc, "exit_code"):  # Exit
         return int(exc.exit_code)
     raise exc
+
+
+def _suggested(exc: Exception, ctx) -> str:
+    """click's message, with "Did you mean ...?" for a mistyped command where this click
+    does not add it itself (click < 8.3 suggests only in some versions)."""
+    import difflib
+
+    message = exc.format_message()
+    found = re.match(r"No such command '(.+)'\.?$", message)
+    if found is None or "Did you mean" in message or ctx is None or not hasattr(ctx.command, "list_commands"):
+        return message
+    close = difflib.get_close_matches(found.group(1), ctx.command.list_commands(ctx), n=1)
+    return f"{message.rstrip('.')}. Did you mean '{close[0]}'?" if close else message
 
 
 def _exit(code: int, argv: list[str] | None) -> int:
