@@ -48,3 +48,20 @@ def fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0, branch=1, extra=None):
 
 def fourbar(**kw):
     return mechanism_from_dict(fourbar_dict(**kw), "fourbar")
+
+
+def driven_planar_examples():
+    """(name, mechanism) of every bundled planar example with a drive (files that are not
+    mechanisms, such as arms and cases, left out)."""
+    import mechsyn as ms
+    from mechsyn.model.mechanism import Mechanism
+
+    out = []
+    for name in ms.examples.names():
+        try:
+            m = ms.examples.load(name)
+        except Exception:  # noqa: BLE001  (not a mechanism file)
+            continue
+        if isinstance(m, Mechanism) and m.kind == "planar" and any(j.actuated for j in m.joints):
+            out.append((name, m))
+    return out

@@ -6,31 +6,17 @@ import json
 import numpy as np
 import pytest
 
-import mechsyn as ms
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import engines
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.kinematics.engines import PLANAR_ENGINES, Engine, first_sweep
 from mechsyn.kinematics.sweep import Event, Sweep
-from mechsyn.model.mechanism import Mechanism
 from mechsyn.results import to_jsonable
 
-from kinematics_helpers import ex  # noqa: F401
+from kinematics_helpers import driven_planar_examples, ex  # noqa: F401
 
 
-def _planar_examples():
-    out = []
-    for name in ms.examples.names():
-        try:
-            m = ms.examples.load(name)
-        except Exception:  # noqa: BLE001  (not a mechanism file)
-            continue
-        if isinstance(m, Mechanism) and m.kind == "planar" and any(j.actuated for j in m.joints):
-            out.append((name, m))
-    return out
-
-
-EXAMPLES = _planar_examples()
+EXAMPLES = driven_planar_examples()
 
 
 def test_the_planar_engines_in_order():

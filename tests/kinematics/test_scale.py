@@ -7,12 +7,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-import mechsyn as ms
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.analysis import cached_plan, simulate
 from mechsyn.model.mechanism import Mechanism
 
-from kinematics_helpers import ex  # noqa: F401
+from kinematics_helpers import driven_planar_examples, ex  # noqa: F401
 
 
 def scaled(m: Mechanism, k: float) -> Mechanism:
@@ -43,21 +42,9 @@ def scaled(m: Mechanism, k: float) -> Mechanism:
     return replace(m, joints=joints, points=points, name=f"{m.name} x{k:g}")
 
 
-def _examples():
-    out = []
-    for name in ms.examples.names():
-        try:
-            m = ms.examples.load(name)
-        except Exception:  # noqa: BLE001  (not a mechanism file)
-            continue
-        if isinstance(m, Mechanism) and m.kind == "planar" and any(j.actuated for j in m.joints):
-            if any("polar" in (j.attrs or {}).get("profile", {}) for j in m.joints):
-                continue  # a cam profile given by a formula: no numbers to scale
-            out.append((name, m))
-    return out
-
-
-EXAMPLES = _examples()
+# a cam profile given by a formula has no numbers to scale
+EXAMPLES = [(name, m) for name, m in driven_planar_examples()
+            if not any("polar" in (j.attrs or {}).get("profile", {}) for j in m.joints)]
 
 
 def _inputs(m: Mechanism, k: float, grid: int) -> dict:
