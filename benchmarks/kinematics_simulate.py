@@ -1,9 +1,10 @@
 """Benchmark: one full ``simulate`` (positions, velocities, accelerations, events) per
-mechanism, as a ratio to a bare NumPy closed-form four-bar (positions only), in one process.
+mechanism, as a ratio to a bare NumPy closed-form four-bar (positions only), and against
+pylinkage in the same process (issue 30).
 
 Run from the repository root::
 
-    python benchmarks/kinematics_simulate.py [--repeats 30] [--pylinkage /work/venv-pylinkage/bin/python]
+    python benchmarks/kinematics_simulate.py [--repeats 30] [--big 1000000]
 
 Cases (361 inputs, 0..360 degrees):
 
@@ -13,37 +14,46 @@ Cases (361 inputs, 0..360 degrees):
   points (target <= 100x);
 * ``Jansen leg``: examples/kinematics/jansen_leg.yaml with its knee double joint written
   three ways (target <= 100x);
-* ``drag``: :meth:`KinematicPlan.with_joint_points` + ``simulate`` of the Watt six-bar (the
+* ``drag``: ``KinematicPlan.with_joint_points`` + ``simulate`` of the Watt six-bar (the
   editor's drag loop; no target in the issue, reported for the web app).
-
-Then the fixed costs of one call for the crank-rocker, the Watt six-bar and the Jansen leg
-(issue 30): a new geometry (``with_joints``), its constraint system, the decomposition,
-the engine's sweep, and the rest of ``simulate`` (events, points, result), plan cached
-and fresh.
 
 The bare NumPy reference computes the crank-rocker's joint positions B, C for the same
 361 angles in five array expressions; mechsyn's answers are checked against it (1e-12),
 and the dead points of the textbook four-bar against the law of cosines (1e-6 degree).
-Optionally pylinkage (numba; in its own virtual environment, never a mechsyn dependency)
-runs build + compile + ``step_fast_with_kinematics`` for the same crank-rocker in a
-subprocess, alternately with the same bare NumPy four-bar there; its positions are checked
-equal and the two are compared by their ratios to that bare four-bar, each timed in its own
-process (so the comparison holds when the load changes between the two processes).
+Times are minima (``3 x --repeats`` runs; the bare reference ``10 x``); ``x med`` is the
+median of ``--repeats`` rounds' ratios, the case and the reference timed alternately.
 
-Times are minima (``3 x --repeats`` runs; the bare reference ``10 x``): on a shared
-machine minima are the least noisy statistic of each. ``x med`` is a second estimate of
-the ratio: the case and the reference timed alternately (``--repeats`` rounds, the median
-of 10 calls each), the median of the rounds' ratios (both see the same load in a round).
+Then the fixed costs of one call for the crank-rocker, the Watt six-bar and the Jansen leg
+(issue 30), each stage looked up by name: a stage the code no longer has reads "n/a".
+
+Then, when pylinkage is importable (``pip install pylinkage numba`` in a virtual
+environment of its own, never a mechsyn dependency; without it one line says so), the
+crank-rocker, the Watt six-bar (a full turn through its dead points, and a range without
+them) and the Jansen leg are modelled in pylinkage from the same mechanisms
+(benchmarks/pylinkage_models.py) and timed in this process, rounds interleaved:
+
+* fresh, a joint moved each call: mechsyn ``Mechanism.with_joint_points`` (or, where it
+  does not exist, the studio's path: ``mechanism_from_dict`` of the edited dict) and
+  ``ms.simulate``; pylinkage build + ``compile`` + ``step_fast_with_kinematics``;
+* cached: ``ms.simulate`` of the same mechanism again; ``step_fast_with_kinematics`` of a
+  built, compiled linkage (numba compiled before any timing; the linkage put back to its
+  start with ``set_coords`` between calls, untimed).
+
+Positions, velocities and accelerations of every joint and named point are checked equal
+to 1e-9 of the length scale on the rows both answer, and the rows each leaves unanswered
+must be the same; the ratio mechsyn / pylinkage is the median of the rounds' ratios (and
+the ratio of the minima), printed beside issue 30's targets. The crank-rocker is also
+timed over ``--big`` inputs. Exit status 1 when an answer check fails.
 """
 
 from __future__ import annotations
 
 import argparse
-import inspect
-import json
-import os
-import subprocess
+import importlib
+import importlib.util
+import math
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -51,59 +61,12 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 N = 361
 TARGETS = {"crank-rocker": 15, "four-bar, 2 dead points": 50, "Watt six-bar": 100, "Stephenson six-bar": 100,
            "Jansen leg (double joint on the foot)": 100, "Jansen leg (chain)": 100, "Jansen leg (star)": 100}
-
-PYLINKAGE_SCRIPT = r"""
-import json, sys, time
-import numpy as np
-from pylinkage.components import Ground
-from pylinkage.actuators import Crank
-from pylinkage.dyads import RRRDyad
-from pylinkage.simulation import Linkage
-A0, D0, a, b, c, n, repeats, out = json.loads(sys.argv[1])
-
-def build():
-    A = Ground(A0[0], A0[1], name="A"); D = Ground(D0[0], D0[1], name="D")
-    crank = Crank(anchor=A, radius=a, angular_velocity=2 * np.pi / (n - 1))
-    rocker = RRRDyad(crank.output, D, distance1=b, distance2=c)
-    lk = Linkage([A, D, crank, rocker], name="crank-rocker")
-    lk.set_input_velocity(crank, omega=1.0)
-    return lk
-
-lk = build(); lk.compile(); lk.step_fast_with_kinematics(iterations=n)   # numba compile once
-th = np.linspace(0, 2 * np.pi, n)
-exec(BARE)  # the same bare NumPy four-bar as in mechsyn's process: ratios comparable under any load
-
-
-def run():
-    lk = build(); lk.compile(); return lk.step_fast_with_kinematics(iterations=n)
-
-
-def bare():
-    bare_fourbar(th, np.array(A0), np.array(D0), a, b, c, 1.0)
-
-
-def med(g):  # median of 10 calls, as mechsyn's paired rounds
-    ts = []
-    for _ in range(10):
-        t = time.perf_counter(); g(); ts.append(time.perf_counter() - t)
-    return float(np.median(ts)), min(ts)
-
-
-best, best_bare, ratios = np.inf, np.inf, []
-p, v, acc = run()
-for _ in range(repeats):
-    (t1, m1), (t2, m2) = med(run), med(bare)
-    best, best_bare = min(best, m1), min(best_bare, m2)
-    ratios.append(t1 / t2)
-import pylinkage
-np.save(out + ".npy", p)
-print(json.dumps({"build_compile_kinematics": best, "bare": best_bare, "median_ratio": float(np.median(ratios)),
-                  "version": pylinkage.__version__}))
-"""
+TOL = 1e-9  # answers equal to this fraction of the length scale
 
 
 def bare_fourbar(theta: np.ndarray, A: np.ndarray, D: np.ndarray, a: float, b: float, c: float,
@@ -172,68 +135,369 @@ def jansen(writing: str):
     return mechanism_from_dict(d, f"jansen-{writing}")
 
 
-def fixed_costs(mech, joint: str, x: np.ndarray, repeats: int) -> dict[str, float]:
+def lookup(module: str, name: str):
+    """``module.name``, or None where the code no longer has it (other branches rename
+    the kinematics' internals: the table then says "n/a" instead of breaking)."""
+    try:
+        return getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError):
+        return None
+
+
+def length_scale(mech) -> float:
+    """The largest extent of the drawn joints (the scale of the answer checks)."""
+    pts = np.array([np.asarray(j.point, float)[:2] for j in mech.joints])
+    return float(np.ptp(pts, axis=0).max())
+
+
+def fresh_maker(mech, joint: str):
+    """``(make, path, where)``: ``make(k)`` is ``mech`` with ``joint`` moved to ``where(k)``
+    (within 0.3 % of the length scale, seven positions in turn) by the public path a drag
+    takes: ``Mechanism.with_joint_points`` where it exists, otherwise the studio's path of
+    today (``mechanism_from_dict`` of the edited file dict, as ``mechsyn.web`` does on
+    every drag step); ``path`` names it."""
+    base = np.asarray(mech.joint(joint).point, float)[:2]
+    step = 1e-3 * length_scale(mech)
+
+    def where(k: int) -> np.ndarray:
+        return base + step * np.array([(k % 7) - 3, (k % 5) - 2], float)
+
+    wjp = getattr(mech, "with_joint_points", None)
+    if wjp is not None:
+        return (lambda k: wjp({joint: where(k)})), "Mechanism.with_joint_points", where
+    from mechsyn.io import mechanism_from_dict, mechanism_to_dict
+
+    d = mechanism_to_dict(mech)
+    i = next(n for n, j in enumerate(d["joints"]) if j["id"] == joint)
+
+    def rebuild(k: int):
+        joints = list(d["joints"])
+        joints[i] = {**joints[i], "point": where(k).tolist()}
+        return mechanism_from_dict({**d, "joints": joints}, source="mechanism")
+
+    return rebuild, "mechanism_from_dict (the studio's drag today)", where
+
+
+def fixed_costs(mech, joint: str, moved: str, x: np.ndarray, repeats: int) -> tuple[dict, list]:
     """Where one ``simulate`` call of a freshly built geometry spends its time (minima in
-    seconds): a new mechanism with one joint moved (``with_joints``), its constraint
-    system (``build_system``), the decomposition into Assur groups (``decompose``), the
-    input checks and the sweep of the engine that answers (``first_sweep``), and the rest
-    of ``simulate`` (events in input units, named points, link motions, the result)."""
-    from dataclasses import replace
+    seconds): a new mechanism with ``moved`` displaced (the public path of
+    :func:`fresh_maker`), its constraint system (``build_system``), the decomposition into
+    Assur groups (``decompose``), the compiled plan (``compile_plan``), the checks of the
+    drawn configuration, the engine's sweep (``first_sweep``), and the rest of ``simulate``
+    (events in input units, named points, link motions, the result). A stage the code
+    does not offer (renamed, or a changed signature) is NaN, with the reason in the list."""
+    import mechsyn as ms
 
-    from mechsyn.kinematics.analysis import compile_plan
-    from mechsyn.kinematics.engines import PLANAR_ENGINES, first_sweep
-    from mechsyn.kinematics.groups import decompose
-    from mechsyn.kinematics.solve import assemble, singular_configuration
-    from mechsyn.kinematics.system import build_system
-
-    j0 = next(j for j in mech.joints if not j.actuated and j.links[0] != mech.ground)
+    build_system = lookup("mechsyn.kinematics.system", "build_system")
+    decompose = lookup("mechsyn.kinematics.groups", "decompose")
+    compile_plan = lookup("mechsyn.kinematics.analysis", "compile_plan")
+    assemble = lookup("mechsyn.kinematics.solve", "assemble")
+    singular = lookup("mechsyn.kinematics.solve", "singular_configuration")
+    first_sweep = lookup("mechsyn.kinematics.engines", "first_sweep")
+    engines = lookup("mechsyn.kinematics.engines", "PLANAR_ENGINES")
+    make, _, _ = fresh_maker(mech, moved)
     k = [0]
 
-    def moved():
+    def fresh():
         k[0] += 1
-        p = np.asarray(j0.point, float) + 1e-9 * (k[0] % 7)
-        return mech.with_joints(tuple(replace(j, point=p) if j.id == j0.id else j for j in mech.joints))
+        return make(k[0])
 
-    m1 = moved()
-    S = build_system(m1)
-    kp = compile_plan(m1, inputs=(joint,))
-    d = next(dd for dd in S.drivers if dd.joint == joint)
-    U = (np.radians(x) if d.type == "R" else x)[:, None]
-    sp = np.ones(1)
-    out = {"with_joints": best_of(moved, repeats),
-           "build_system": best_of(lambda: build_system(m1), repeats),
-           "decompose": best_of(lambda: decompose(S), repeats),
-           "assemble + mobility": best_of(lambda: assemble(build_system(m1)), repeats),
-           "singular drawn config?": best_of(lambda: singular_configuration(build_system(m1)), repeats),
-           "sweep (engine)": best_of(lambda: first_sweep(PLANAR_ENGINES, kp.system, kp.groups, U, sp), repeats),
-           "simulate, plan cached": best_of(lambda: kp.simulate({joint: x}), repeats),
-           "simulate, fresh geometry": best_of(lambda: moved().simulate({joint: x}), repeats)}
+    m1, out, why = fresh(), {}, []
+    S1 = build_system(m1) if build_system is not None else None
+
+    def row(key: str, f, *needs) -> None:
+        out[key] = math.nan
+        if any(n is None for n in needs):
+            why.append(f"{key}: not in this code")
+            return
+        try:
+            out[key] = best_of(f, repeats)
+        except (TypeError, AttributeError, ValueError, KeyError) as err:
+            why.append(f"{key}: {type(err).__name__}: {err}")
+
+    def sweep():
+        kp = compile_plan(m1, inputs=(joint,))
+        d = next(dd for dd in kp.system.drivers if dd.joint == joint)
+        U = (np.radians(x) if d.type == "R" else x)[:, None]
+        return lambda: first_sweep(engines, kp.system, kp.groups, U, np.ones(1))
+
+    row("new geometry (public path)", fresh)
+    row("build_system", lambda: build_system(m1), build_system)
+    row("decompose", lambda: decompose(S1), S1, decompose)
+    row("compile_plan", lambda: compile_plan(m1, inputs=(joint,)), compile_plan)
+    row("assemble + mobility", lambda: assemble(build_system(m1)), build_system, assemble)
+    row("singular drawn config?", lambda: singular(build_system(m1)), build_system, singular)
+    try:
+        f_sweep = sweep() if None not in (compile_plan, first_sweep, engines) else None
+    except (TypeError, AttributeError, ValueError, KeyError, StopIteration) as err:
+        f_sweep = None
+        why.append(f"sweep (engine): {type(err).__name__}: {err}")
+    row("sweep (engine)", f_sweep, f_sweep)
+    row("simulate, plan cached", lambda: ms.simulate(mech, {joint: x}))
+    row("simulate, fresh geometry", lambda: ms.simulate(fresh(), {joint: x}))
     out["events, points, result"] = out["simulate, plan cached"] - out["sweep (engine)"]
-    out["assemble + mobility"] -= out["build_system"]
-    out["singular drawn config?"] -= out["build_system"]
-    return out
+    for key in ("assemble + mobility", "singular drawn config?"):
+        out[key] -= out["build_system"]
+    return out, why
 
 
 def print_fixed_costs(cases: list, x: np.ndarray, repeats: int) -> None:
     """The table of :func:`fixed_costs` for each case (milliseconds, 80 columns)."""
-    rows = {name: fixed_costs(m, j, x, repeats) for name, m, j in cases}
+    rows, why = {}, []
+    for name, m, j, moved in cases:
+        rows[name], w = fixed_costs(m, j, moved, x, repeats)
+        why += [f"{name}: {s}" for s in w]
     keys = list(next(iter(rows.values())))
-    print("\n# fixed costs per call, ms (minima; 'events, points, result' = cached simulate - sweep)")
+    _, path, _ = fresh_maker(cases[0][1], cases[0][3])
+    print(f"\n# fixed costs per call, ms (minima of {repeats}; a new geometry by {path}; assemble and "
+          "singular: less build_system; 'events, points, result' = cached simulate - sweep)")
     print(f"{'':26s}" + "".join(f"{n[:12]:>14s}" for n in rows))
     for key in keys:
-        print(f"{key:26s}" + "".join(f"{rows[n][key] * 1e3:14.3f}" for n in rows))
+        print(f"{key:26s}" + "".join(f"{rows[n][key] * 1e3:14.3f}" if math.isfinite(rows[n][key])
+                                     else f"{'n/a':>14s}" for n in rows))
+    for s in dict.fromkeys(why):
+        print(f"  n/a: {s}")
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--repeats", type=int, default=30)
-    ap.add_argument("--pylinkage", default=os.environ.get("PYLINKAGE_PYTHON", "/work/venv-pylinkage/bin/python"),
-                    help="python of a virtual environment with pylinkage and numba")
-    args = ap.parse_args()
+# --------------------------------------------------------------------------- pylinkage
+def interleaved(fns: dict, setups: dict, rounds: int, inner: int) -> tuple[dict, dict]:
+    """Each callable timed ``inner`` times in turn, ``rounds`` times over (so all see the
+    same load in a round): per-round medians and overall minima. ``setups[key]`` runs
+    before each call of ``fns[key]``, untimed."""
+    def nothing():
+        return None
+
+    for key, f in fns.items():
+        setups.get(key, nothing)()
+        f()
+    meds, mins = {k: [] for k in fns}, dict.fromkeys(fns, math.inf)
+    for _ in range(rounds):
+        for key, f in fns.items():
+            s, ts = setups.get(key, nothing), []
+            for _ in range(inner):
+                s()
+                t = time.perf_counter()
+                f()
+                ts.append(time.perf_counter() - t)
+            meds[key].append(float(np.median(ts)))
+            mins[key] = min(mins[key], min(ts))
+    return {k: np.array(v) for k, v in meds.items()}, mins
+
+
+def compare(sim, names: list, answer: tuple, scale: float) -> dict:
+    """mechsyn's simulation against pylinkage's ``(positions, velocities, accelerations)``:
+    the largest differences over the length scale on the rows both answer, and the rows
+    one answers and the other does not (none, for equal answers). A row has positions
+    (velocities, accelerations) when every point's are finite: mechsyn leaves a row it
+    cannot assemble (a singular one) blank as a whole, frame and crank included, where
+    pylinkage blanks only the joints it cannot place (whose rates it cannot give)."""
+    out = {"differ": []}
+    for key, q, attr in zip(("pos", "vel", "acc"), answer, ("position", "velocity", "acceleration")):
+        a = np.stack([getattr(sim.points[n], attr) for n in names], axis=1)
+        rows_m, rows_p = np.isfinite(a).all(axis=(1, 2)), np.isfinite(q).all(axis=(1, 2))
+        if not np.array_equal(rows_m, rows_p):
+            out["differ"].append(f"rows with {attr}s: mechsyn {int(rows_m.sum())}, pylinkage {int(rows_p.sum())}")
+        both = rows_m & rows_p
+        out[key] = float(np.abs(a[both] - q[both]).max()) / scale if both.any() else 0.0
+        out.setdefault("answered", int(both.sum()))
+    out["ok"] = not out["differ"] and max(out["pos"], out["vel"], out["acc"]) <= TOL
+    return out
+
+
+def runs(x: np.ndarray, rows: np.ndarray) -> str:
+    """Consecutive ``rows`` as input ranges, '117.4..242.4 deg (126 rows)'."""
+    k = np.flatnonzero(rows)
+    cuts = np.flatnonzero(np.diff(k) > 1)
+    parts = np.split(k, cuts + 1)
+    return ", ".join(f"{x[p[0]]:.2f}..{x[p[-1]]:.2f} deg ({len(p)} rows)" if len(p) > 1
+                     else f"{x[p[0]]:.2f} deg" for p in parts)
+
+
+def what_pylinkage_did(case: str, x: np.ndarray, names: list, answer: tuple, sim, caught: list) -> list[str]:
+    """What pylinkage answers on the rows it cannot assemble, beside mechsyn's report."""
+    pos, vel, _ = answer
+    bad = ~np.isfinite(pos).all(axis=2)
+    lines = []
+    if bad.any():
+        rows = bad.any(axis=1)
+        kept = [n for k, n in enumerate(names) if not bad[:, k].any()]
+        lines.append(f"{case}: pylinkage returns NaN positions of {', '.join(n for k, n in enumerate(names) if bad[:, k].any())}"
+                     f" on {runs(x, rows)} and numbers for {', '.join(kept) or 'none'}; "
+                     f"{'warnings: ' + '; '.join(caught) if caught else 'no exception, no warning'}")
+        lines.append(f"  mechsyn there: not assembled on {runs(x, ~sim.assembled)}; events: "
+                     + ", ".join(f"{e['kind']} at {e['input'][next(iter(e['input']))]:.2f}" for e in sim.events))
+    rates = np.isfinite(pos).all(axis=(1, 2)) & ~np.isfinite(vel).all(axis=(1, 2))
+    if rates.any():
+        same = all(not np.isfinite(sim.points[n].velocity[rates]).all() for n in names[2:])
+        lines.append(f"  pylinkage: positions but NaN velocities and accelerations at {runs(x, rates)}; "
+                     f"mechsyn: {'no velocities there either' if same else 'velocities there'}")
+    return lines
+
+
+def sweep_of(mech, drive: str, th0: float, kind: str, n: int) -> tuple[np.ndarray, float]:
+    """The inputs (degrees) and pylinkage's step (radians): a full turn from the drawn crank
+    angle ``th0`` (degrees), or (``clear``) 98 % of the longer run without dead points on
+    either side of it, from mechsyn's working ranges of a full turn in 0.1 degree steps."""
+    import mechsyn as ms
+
+    ext = 360.0
+    if kind == "clear":
+        wr = ms.simulate(mech, {drive: th0 + np.linspace(0, 360, 3601)}).working_ranges()
+        fwd = wr[0][1] - th0 if wr and abs(wr[0][0] - th0) < 1e-9 else 0.0
+        back = th0 + 360 - wr[-1][0] if wr and abs(wr[-1][1] - th0 - 360) < 1e-9 else 0.0
+        ext = 0.98 * (fwd if fwd >= back else -back)
+    return th0 + np.linspace(0.0, ext, n), math.radians(ext) / (n - 1)
+
+
+def pylinkage_case(mech, moved: str, kind: str, n: int, rounds: int, inner: int) -> dict:
+    """One case against pylinkage: the answers checked (cached and fresh geometry) and the
+    four calls timed interleaved."""
+    import warnings
+
+    import mechsyn as ms
+    import pylinkage_models as pm
+
+    model = pm.model_of(mech)
+    P = pm.drawn_points(mech, model)
+    x, step = sweep_of(mech, model.drive, math.degrees(pm.crank_angle(model, P)), kind, n)
+    names = [p[6:] if p.startswith("point:") else model.pins[p][0] for p in model.names]
+    scale, start, drive = length_scale(mech), math.radians(x[0]), model.drive
+    make, path, where = fresh_maker(mech, moved)
+    lk = pm.build(model, P, start, step)
+    coords0 = lk.get_coords()
+    lk.compile()
+
+    def moved_points(k: int) -> dict:
+        return {**P, moved: where(k)}
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lk.set_coords(coords0)
+        cached = lk.step_fast_with_kinematics(iterations=n)
+        fresh = pm.fresh(model, moved_points(0), start, step, n)
+    sim = ms.simulate(mech, {drive: x}, points=names)
+    checks = [compare(sim, names, cached, scale),
+              compare(ms.simulate(make(0), {drive: x}, points=names), names, fresh, scale)]
+    story = what_pylinkage_did("", x, names, cached, sim, sorted({str(w.message) for w in caught}))
+    k = {"m": 0, "p": 0}
+
+    def m_fresh():
+        k["m"] += 1
+        return ms.simulate(make(k["m"]), {drive: x}, points=names)
+
+    def p_fresh():
+        k["p"] += 1
+        return pm.fresh(model, moved_points(k["p"]), start, step, n)
+
+    fns = {"m fresh": m_fresh, "p fresh": p_fresh,
+           "m cached": lambda: ms.simulate(mech, {drive: x}, points=names),
+           "p cached": lambda: lk.step_fast_with_kinematics(iterations=n)}
+    meds, mins = interleaved(fns, {"p cached": lambda: lk.set_coords(coords0)}, rounds, inner)
+    return {"checks": checks, "story": story, "meds": meds, "mins": mins, "n": n, "path": path,
+            "events": len(sim.events)}
+
+
+PL_CASES = [  # (name, file, joint moved each fresh call, sweep, targets fresh and cached: (at most, goal))
+    ("crank-rocker", "examples/kinematics/crank_rocker.yaml", "D", "turn", (1.0, None), (0.5, None)),
+    ("Watt, full turn", "examples/textbook/watt_sixbar.yaml", "E", "turn", (1.0, 0.5), (1.0, 0.5)),
+    ("Watt, no dead points", "examples/textbook/watt_sixbar.yaml", "E", "clear", (1.0, 0.5), (1.0, 0.5)),
+    ("Jansen leg", "examples/kinematics/jansen_leg.yaml", "P5", "turn", (1.0, None), (1.0, None)),
+]
+
+
+def verdict(r: float, target: tuple) -> str:
+    at_most, goal = target
+    if at_most is None:
+        return f"{'-':>11s}"
+    state = "goal" if goal is not None and r <= goal else "ok" if r <= at_most else "MISS"
+    return f"{'<=' + format(at_most, 'g'):>6s} {state:>4s}"
+
+
+def note(text: str, indent: str = "# ") -> None:
+    """A comment line of the report, wrapped at 80 columns."""
+    print(textwrap.fill(text, 80, initial_indent=indent, subsequent_indent=indent))
+
+
+def ms_cell(t: float, lo: float) -> str:
+    """'median (minimum)' in milliseconds, three significant figures or more."""
+    def f(v: float) -> str:
+        return f"{v:.3f}" if v < 10 else f"{v:.1f}" if v < 1000 else f"{v:.0f}"
+
+    return f"{f(t * 1e3)} ({f(lo * 1e3)})"
+
+
+def print_pylinkage(results: list) -> bool:
+    """The three tables of the comparison (80 columns); True when every answer check passed."""
+    import numba
+    import pylinkage
+
+    print()
+    note(f"against pylinkage {pylinkage.__version__} (numba {numba.__version__}) in this process. fresh = a "
+         f"joint moved each call: mechsyn {results[0][1]['path']} + ms.simulate; pylinkage build + compile + "
+         "step_fast_with_kinematics. cached = ms.simulate of the same mechanism again; "
+         "step_fast_with_kinematics of a compiled linkage.")
+    note(f"answers (cached and fresh geometry): largest difference / length scale on the rows both answer, "
+         f"at most {TOL:g}; the rows answered must be the same. events: mechsyn's.")
+    print(f"{'case':22s} {'inputs':>7s} {'answered':>8s} {'events':>6s} {'position':>8s} {'velocity':>8s} "
+          f"{'accel.':>8s} {'check':>6s}")
+    ok = True
+    for name, r, _, _ in results:
+        c = {key: max(ch[key] for ch in r["checks"]) for key in ("pos", "vel", "acc")}
+        good = all(ch["ok"] for ch in r["checks"])
+        ok &= good
+        print(f"{name:22s} {r['n']:7d} {r['checks'][0]['answered']:8d} {r['events']:6d} {c['pos']:8.1e} "
+              f"{c['vel']:8.1e} {c['acc']:8.1e} {'ok' if good else 'FAILED':>6s}")
+        for ch in r["checks"]:
+            for d in ch["differ"]:
+                note(f"answers differ: {d}", "  ")
+    print()
+    note("ms per call, median of the rounds' medians (minimum)")
+    print(f"{'case':22s} {'mechsyn fresh':>14s} {'pyl. fresh':>14s} {'mechsyn cached':>14s} {'pyl. cached':>14s}")
+    for name, r, _, _ in results:
+        cells = [ms_cell(float(np.median(r["meds"][k])), r["mins"][k]) for k in ("m fresh", "p fresh", "m cached",
+                                                                               "p cached")]
+        print(f"{name:22s}" + "".join(f"{c:>15s}" for c in cells))
+    print()
+    note(f"mechsyn / pylinkage: median of the interleaved rounds' ratios ({len(results[0][1]['meds']['m fresh'])}"
+         f" rounds of 10 calls; 1e6 inputs: of 1 call), ratio of the minima in brackets; issue 30's targets, "
+         "'goal' when at most 0.5")
+    print(f"{'case':22s} {'fresh':>13s} {'target':>11s}  {'cached':>13s} {'target':>11s}")
+    for name, r, tf, tc in results:
+        m, lo = r["meds"], r["mins"]
+        rf, rc = float(np.median(m["m fresh"] / m["p fresh"])), float(np.median(m["m cached"] / m["p cached"]))
+        cf = f"{rf:.2f} ({lo['m fresh'] / lo['p fresh']:.2f})"
+        cc = f"{rc:.2f} ({lo['m cached'] / lo['p cached']:.2f})"
+        print(f"{name:22s} {cf:>13s} {verdict(rf, tf)}  {cc:>13s} {verdict(rc, tc)}")
+    for name, r, _, _ in results:
+        for line in r["story"]:
+            note(f"{name}{line}" if line.startswith(":") else line.strip(), "  " if line.startswith(" ") else "")
+    return ok
+
+
+def run_pylinkage(repeats: int, big: int) -> bool:
+    """The comparison with pylinkage, or one line on how to get it. False when an answer differs."""
+    if importlib.util.find_spec("pylinkage") is None or importlib.util.find_spec("numba") is None:
+        print("\npylinkage: comparison skipped (not importable here); run this script with the python of a "
+              "venv made with `pip install pylinkage numba`")
+        return True
     from mechsyn.io import load_mechanism
-    from mechsyn.kinematics.analysis import compile_plan, input_grid, simulate
 
-    x = input_grid(0, 360, 1)
+    results = []
+    for name, file, moved, kind, tf, tc in PL_CASES:
+        results.append((name, pylinkage_case(load_mechanism(ROOT / file), moved, kind, N, repeats, 10), tf, tc))
+    if big:
+        name, file, moved, kind, tf, tc = PL_CASES[0]
+        r = pylinkage_case(load_mechanism(ROOT / file), moved, kind, big, min(3, repeats), 1)
+        results.append((f"crank-rocker, {big:.0e}", r, (None, None), (None, None)))
+    return print_pylinkage(results)
+
+
+def mechsyn_tables(repeats: int) -> None:
+    """The tables of mechsyn against the bare NumPy four-bar, then the fixed costs."""
+    from mechsyn.io import load_mechanism
+    from mechsyn import simulate
+
+    x = np.linspace(0.0, 360.0, N)
     assert len(x) == N
     th = np.radians(x)
     cr = load_mechanism(ROOT / "examples/kinematics/crank_rocker.yaml")
@@ -243,7 +507,7 @@ def main() -> None:
     th0 = np.arctan2(B0[1], B0[0])
     dBD, dBC = P["D"] - P["B"], P["C"] - P["B"]
     sigma = 1.0 if dBD[0] * dBC[1] - dBD[1] * dBC[0] >= 0 else -1.0
-    t_bare = best_of(lambda: bare_fourbar(th0 + th, P["A"], P["D"], a, b, c, sigma), args.repeats * 10)
+    t_bare = best_of(lambda: bare_fourbar(th0 + th, P["A"], P["D"], a, b, c, sigma), repeats * 10)
 
     # answers checked: closed form equals the bare reference; dead points to 1e-6 degree
     sim = simulate(cr, {"A": np.degrees(th0 + th)}, points=["B", "C"])
@@ -264,9 +528,9 @@ def main() -> None:
              ("Jansen leg (double joint on the foot)", jansen("third"), "P0"),
              ("Jansen leg (chain)", jansen("chain"), "P0"),
              ("Jansen leg (star)", jansen("star"), "P0")]
-    print(f"# mechsyn simulate, {N} inputs; 'ms' and 'x bare': minimum of {args.repeats * 3} runs over the "
+    print(f"# mechsyn simulate, {N} inputs; 'ms' and 'x bare': minimum of {repeats * 3} runs over the "
           f"minimum of the bare NumPy four-bar (positions only, {t_bare * 1e6:.0f} us); 'x med': median ratio of "
-          f"{args.repeats} rounds of 10 calls each, the case and the bare reference alternately")
+          f"{repeats} rounds of 10 calls each, the case and the bare reference alternately")
     print(f"# checks: crank-rocker = bare NumPy to {err:.1e}; textbook four-bar dead points to "
           f"{dead_err:.1e} deg")
     print(f"{'case':<40s} {'method':>7s} {'events':>6s} {'ms':>8s} {'x bare':>8s} {'x med':>7s} {'target':>7s}")
@@ -275,50 +539,39 @@ def main() -> None:
 
     figures = {}
     for name, mech, joint in cases:
-        t, ratio, med = figures[name] = both(lambda: simulate(mech, {joint: x}), bare, args.repeats, t_bare)
+        t, ratio, med = figures[name] = both(lambda: simulate(mech, {joint: x}), bare, repeats, t_bare)
         s = simulate(mech, {joint: x})
         tgt = TARGETS[name]
         print(f"{name:<40s} {s.method:>7s} {len(s.events):>6d} {t * 1e3:8.2f} {ratio:8.1f} {med:7.1f} "
               f"{'<=' + str(tgt):>5s} {'ok' if ratio <= tgt else 'MISS'}")
-    watt = compile_plan(load_mechanism(ROOT / "examples/textbook/watt_sixbar.yaml"), inputs=("A",))
-    k = [0]
-
-    def drag():
-        k[0] += 1
-        watt.with_joint_points({"G": (5.0 + 0.001 * (k[0] % 7), 6.0)}).simulate({"A": x})
-
-    t, ratio, med = both(drag, bare, args.repeats, t_bare)
-    print(f"{'drag (with_joint_points + simulate), Watt':<40s} {'assur':>7s} {'':>6s} {t * 1e3:8.2f} "
-          f"{ratio:8.1f} {med:7.1f}")
-    print_fixed_costs([(n, m, j) for n, m, j in cases if n in ("crank-rocker", "Watt six-bar", "Jansen leg (chain)")],
-                      x, args.repeats)
-    py = Path(args.pylinkage)
-    if py.exists():
-        out = str(Path("/tmp") / f"pylinkage_bench_{os.getpid()}")
-        cfg = json.dumps([P["A"].tolist(), P["D"].tolist(), a, b, c, N, args.repeats, out])
-        # pylinkage starts its crank at the +x axis: compare at its own angles
-        script = PYLINKAGE_SCRIPT.replace("exec(BARE)", "exec(" + repr(inspect.getsource(bare_fourbar)) + ")")
-        res = subprocess.run([str(py), "-c", script, cfg], capture_output=True, text=True,
-                             env=dict(os.environ, PYTHONPATH=""))
-        if res.returncode != 0:
-            print(f"pylinkage: failed ({res.stderr.strip().splitlines()[-1] if res.stderr else '?'})")
-            return
-        r = json.loads(res.stdout.strip().splitlines()[-1])
-        pos = np.load(out + ".npy")
-        ang = np.unwrap(np.arctan2(pos[:, 2, 1] - P["A"][1], pos[:, 2, 0] - P["A"][0]))
-        s2 = simulate(cr, {"A": np.degrees(ang)}, points=["C"])
-        dpl = np.abs(s2.points["C"].position - pos[:, 3]).max()
-        t_cr, ratio_cr, med_cr = figures["crank-rocker"]
-        py_ratio = r["build_compile_kinematics"] / r["bare"]
-        print(f"pylinkage {r['version']} build + compile + step_fast_with_kinematics ({N} steps): "
-              f"{r['build_compile_kinematics'] * 1e3:.2f} ms = {py_ratio:.1f}x its bare NumPy four-bar "
-              f"({r['bare'] * 1e6:.0f} us, timed in its process), {r['median_ratio']:.1f}x median ratio; "
-              f"positions differ by {dpl:.1e}")
-        print(f"crank-rocker: mechsyn simulate / pylinkage = {ratio_cr / py_ratio:.2f} (minima, each over its "
-              f"process's bare four-bar), {med_cr / r['median_ratio']:.2f} (median ratios); "
-              f"{t_cr / r['build_compile_kinematics']:.2f} in milliseconds")
+    compile_plan = lookup("mechsyn.kinematics.analysis", "compile_plan")
+    watt = compile_plan(cases[2][1], inputs=("A",)) if compile_plan is not None else None
+    label = "drag (with_joint_points + simulate), Watt"
+    if watt is None or not hasattr(watt, "with_joint_points"):
+        print(f"{label:<40s} n/a (no KinematicPlan.with_joint_points in this code)")
     else:
-        print(f"pylinkage: not run ({py} not found; make a venv with `pip install pylinkage numba`)")
+        k = [0]
+
+        def drag():
+            k[0] += 1
+            watt.with_joint_points({"G": (5.0 + 0.001 * (k[0] % 7), 6.0)}).simulate({"A": x})
+
+        t, ratio, med = both(drag, bare, repeats, t_bare)
+        print(f"{label:<40s} {'assur':>7s} {'':>6s} {t * 1e3:8.2f} {ratio:8.1f} {med:7.1f}")
+    moved = {"crank-rocker": "D", "Watt six-bar": "E", "Jansen leg (chain)": "P5"}
+    print_fixed_costs([(n, m, j, moved[n]) for n, m, j in cases if n in moved], x, repeats)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeats", type=int, default=30, help="rounds (and minima over 3x as many runs)")
+    ap.add_argument("--big", type=int, default=10**6,
+                    help="inputs of the crank-rocker's long sweep against pylinkage (0: none)")
+    args = ap.parse_args()
+    mechsyn_tables(args.repeats)
+    if not run_pylinkage(args.repeats, args.big):
+        print("answers differ from pylinkage's: see the lines above")
+        raise SystemExit(1)
 
 
 if __name__ == "__main__":
