@@ -12,7 +12,8 @@ stamp to the animation frame after the repaint). Reported: median, 90th percenti
 the simulation request time measured in the page, for the four-bar
 (``examples/textbook/fourbar.yaml``) and the Watt six-bar (``watt_sixbar.yaml``).
 Targets of issue 15: median <= 50 ms (four-bar), <= 100 ms (six-bar); issue 24 adds
-numeric edits (the Element tab's x typed, Enter) within the same budgets.
+numeric edits (the Element tab's x typed, Enter) within the same budgets; issue 30: the
+Watt six-bar's drag at most 30 ms (in the page, the median).
 
 The answer is checked: after the drag, the path drawn equals the library's
 ``simulate`` of the dragged mechanism. On a shared machine the numbers are noisy:
@@ -39,8 +40,9 @@ from mechsyn.kinematics.analysis import simulate  # noqa: E402
 from mechsyn.web import create_app  # noqa: E402
 from web_helpers import CHROMIUM_ARGS, LiveServer  # noqa: E402
 
-CASES = [("four-bar", "examples/textbook/fourbar.yaml", "B", "M", 50.0),
-         ("Watt six-bar", "examples/textbook/watt_sixbar.yaml", "E", "P", 100.0)]
+# (title, file, joint dragged, point drawn, targets of the drag in the page: [(ms, issue)])
+CASES = [("four-bar", "examples/textbook/fourbar.yaml", "B", "M", [(50.0, 15)]),
+         ("Watt six-bar", "examples/textbook/watt_sixbar.yaml", "E", "P", [(100.0, 15), (30.0, 30)])]
 
 
 def wait(page, js, arg=None, timeout=30.0):
@@ -122,7 +124,7 @@ def main() -> None:
 
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
-        for title, file, joint, point, target in CASES:
+        for title, file, joint, point, targets in CASES:
             mech = mechanism_to_dict(load_mechanism(ROOT / file))
             srv = LiveServer(create_app(tempfile.mkdtemp(), start=mech, token="bench"))
             page = browser.new_page(viewport={"width": 1280, "height": 800})
@@ -140,8 +142,9 @@ def main() -> None:
             best = min(insides)
             print(f"{title:13s} drag of {joint} ({args.runs} runs of {args.moves} moves, min of the run medians):\n"
                   f"  in the page (pointer event -> repainted frame): median {best:5.1f} ms "
-                  f"(runs {', '.join(f'{m:.0f}' for m in insides)}); target <= {target:.0f} ms: "
-                  f"{'met' if best <= target else 'NOT met'}\n"
+                  f"(runs {', '.join(f'{m:.0f}' for m in insides)}); "
+                  + "; ".join(f"issue {i} target <= {t:.0f} ms: {'met' if best <= t else 'NOT met'}"
+                              for t, i in targets) + "\n"
                   f"  outside (Playwright mouse.move -> path changed): median {min(medians):5.1f} ms, "
                   f"p90 {min(p90s):5.1f} ms; simulate request {min(servers):5.1f} ms\n"
                   f"  numeric edit of {joint}'s x: in the page (change -> repainted frame) median "
