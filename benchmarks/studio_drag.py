@@ -85,7 +85,10 @@ def drag(page, joint: str, path: str, moves: int) -> tuple[list[float], list[flo
 
 def numeric(page, joint: str, path: str, edits: int) -> tuple[list[float], list[float]]:
     """Numeric edits of the joint's x in the Element tab: from Enter to the repainted path of
-    the re-simulated mechanism (each edit is one undo step, like a drag's release)."""
+    the re-simulated mechanism (each edit is one undo step, like a drag's release). Each
+    edit waits for its full answer and two animation frames (the page's measure is taken in
+    one); the page's measures are those it took: an edit whose first answer the page does
+    not time (it went through the server's check first) has none, and the caller says so."""
     page.mouse.click(*centre(page, joint))
     page.click('#tabs [data-tab="element"]')
     x0 = page.evaluate("j => window.__studio.mech.joints.find(q => q.id === j).point[0]", joint)
@@ -100,8 +103,9 @@ def numeric(page, joint: str, path: str, edits: int) -> tuple[list[float], list[
                       return s.simFor === s.mech && s.sim && e && e.getAttribute('d') !== d0; }""",
              [f'[data-path="{path}"]', d0])
         out.append(1000 * (time.perf_counter() - t0))
-        wait(page, "() => window.__studio.sim.rates")  # the full answer too, before the next edit
-    wait(page, "n => window.__studio.editLatencies.length >= n", edits)
+        # the full answer too, before the next edit
+        wait(page, "() => { const s = window.__studio; return s.simFor === s.mech && s.sim && s.sim.rates; }")
+        page.evaluate("() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
     return out, page.evaluate("window.__studio.editLatencies")
 
 
@@ -148,7 +152,9 @@ def main() -> None:
                   f"  outside (Playwright mouse.move -> path changed): median {min(medians):5.1f} ms, "
                   f"p90 {min(p90s):5.1f} ms; simulate request {min(servers):5.1f} ms\n"
                   f"  numeric edit of {joint}'s x: in the page (change -> repainted frame) median "
-                  f"{statistics.median(typed_inside):5.1f} ms; outside (Enter -> path changed) median "
+                  f"{f'{statistics.median(typed_inside):5.1f} ms' if typed_inside else 'n/a'} "
+                  f"({len(typed_inside)} of {len(typed)} edits timed "
+                  f"by the page); outside (Enter -> path changed) median "
                   f"{statistics.median(typed):5.1f} ms, p90 {float(np.percentile(typed, 90)):5.1f} ms\n"
                   f"  the drawn path = the library's simulate of the dragged mechanism (max diff {err:.1e})")
             page.close()
