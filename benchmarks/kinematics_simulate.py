@@ -65,7 +65,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 N = 361
 TARGETS = {"crank-rocker": 15, "four-bar, 2 dead points": 50, "Watt six-bar": 100, "Stephenson six-bar": 100,
-           "Jansen leg (double joint on the foot)": 100, "Jansen leg (chain)": 100, "Jansen leg (star)": 100}
+           "Jansen leg (double joint on foot)": 100, "Jansen leg (chain)": 100, "Jansen leg (star)": 100}
 TOL = 1e-9  # answers equal to this fraction of the length scale
 
 
@@ -249,9 +249,10 @@ def print_fixed_costs(cases: list, x: np.ndarray, repeats: int) -> None:
         why += [f"{name}: {s}" for s in w]
     keys = list(next(iter(rows.values())))
     _, path, _ = fresh_maker(cases[0][1], cases[0][3])
-    print(f"\n# fixed costs per call, ms (minima of {repeats}; a new geometry by {path}; assemble and "
-          "singular: less build_system; 'events, points, result' = cached simulate - sweep)")
-    print(f"{'':26s}" + "".join(f"{n[:12]:>14s}" for n in rows))
+    print()
+    note(f"fixed costs per call, ms (minima of {repeats}; a new geometry by {path}; assemble and singular: "
+         "less build_system; 'events, points, result' = cached simulate - sweep)")
+    print(f"{'':26s}" + "".join(f"{n.split(' (')[0][:13]:>14s}" for n in rows))
     for key in keys:
         print(f"{key:26s}" + "".join(f"{rows[n][key] * 1e3:14.3f}" if math.isfinite(rows[n][key])
                                      else f"{'n/a':>14s}" for n in rows))
@@ -452,11 +453,11 @@ def print_pylinkage(results: list) -> bool:
                 note(f"answers differ: {d}", "  ")
     print()
     note("ms per call, median of the rounds' medians (minimum)")
-    print(f"{'case':22s} {'mechsyn fresh':>14s} {'pyl. fresh':>14s} {'mechsyn cached':>14s} {'pyl. cached':>14s}")
+    print(f"{'case':20s} {'mechsyn fresh':>14s} {'pyl. fresh':>14s} {'mechsyn cached':>14s} {'pyl. cached':>14s}")
     for name, r, _, _ in results:
         cells = [ms_cell(float(np.median(r["meds"][k])), r["mins"][k]) for k in ("m fresh", "p fresh", "m cached",
                                                                                "p cached")]
-        print(f"{name:22s}" + "".join(f"{c:>15s}" for c in cells))
+        print(f"{name:20s}" + "".join(f"{c:>15s}" for c in cells))
     print()
     note(f"mechsyn / pylinkage: median of the interleaved rounds' ratios ({len(results[0][1]['meds']['m fresh'])}"
          f" rounds of 10 calls; 1e6 inputs: of 1 call), ratio of the minima in brackets; issue 30's targets, "
@@ -477,8 +478,7 @@ def print_pylinkage(results: list) -> bool:
 def run_pylinkage(repeats: int, big: int) -> bool:
     """The comparison with pylinkage, or one line on how to get it. False when an answer differs."""
     if importlib.util.find_spec("pylinkage") is None or importlib.util.find_spec("numba") is None:
-        print("\npylinkage: comparison skipped (not importable here); run this script with the python of a "
-              "venv made with `pip install pylinkage numba`")
+        print("\npylinkage: not importable, skipped (get it: pip install pylinkage numba)")
         return True
     from mechsyn.io import load_mechanism
 
@@ -525,15 +525,14 @@ def mechsyn_tables(repeats: int) -> None:
              ("four-bar, 2 dead points", load_mechanism(ROOT / "examples/textbook/fourbar.yaml"), "A"),
              ("Watt six-bar", load_mechanism(ROOT / "examples/textbook/watt_sixbar.yaml"), "A"),
              ("Stephenson six-bar", load_mechanism(ROOT / "examples/textbook/stephenson_sixbar.yaml"), "A"),
-             ("Jansen leg (double joint on the foot)", jansen("third"), "P0"),
+             ("Jansen leg (double joint on foot)", jansen("third"), "P0"),
              ("Jansen leg (chain)", jansen("chain"), "P0"),
              ("Jansen leg (star)", jansen("star"), "P0")]
-    print(f"# mechsyn simulate, {N} inputs; 'ms' and 'x bare': minimum of {repeats * 3} runs over the "
-          f"minimum of the bare NumPy four-bar (positions only, {t_bare * 1e6:.0f} us); 'x med': median ratio of "
-          f"{repeats} rounds of 10 calls each, the case and the bare reference alternately")
-    print(f"# checks: crank-rocker = bare NumPy to {err:.1e}; textbook four-bar dead points to "
-          f"{dead_err:.1e} deg")
-    print(f"{'case':<40s} {'method':>7s} {'events':>6s} {'ms':>8s} {'x bare':>8s} {'x med':>7s} {'target':>7s}")
+    note(f"mechsyn simulate, {N} inputs; 'ms' and 'x bare': minimum of {repeats * 3} runs over the "
+         f"minimum of the bare NumPy four-bar (positions only, {t_bare * 1e6:.0f} us); 'x med': median ratio of "
+         f"{repeats} rounds of 10 calls each, the case and the bare reference alternately")
+    note(f"checks: crank-rocker = bare NumPy to {err:.1e}; textbook four-bar dead points to {dead_err:.1e} deg")
+    print(f"{'case':<34s} {'method':>6s} {'evts':>4s} {'ms':>7s} {'x bare':>7s} {'x med':>6s} {'target':>7s}")
     def bare() -> None:
         bare_fourbar(th0 + th, P["A"], P["D"], a, b, c, sigma)
 
@@ -542,13 +541,13 @@ def mechsyn_tables(repeats: int) -> None:
         t, ratio, med = figures[name] = both(lambda: simulate(mech, {joint: x}), bare, repeats, t_bare)
         s = simulate(mech, {joint: x})
         tgt = TARGETS[name]
-        print(f"{name:<40s} {s.method:>7s} {len(s.events):>6d} {t * 1e3:8.2f} {ratio:8.1f} {med:7.1f} "
+        print(f"{name:<34s} {s.method:>6s} {len(s.events):>4d} {t * 1e3:7.2f} {ratio:7.1f} {med:6.1f} "
               f"{'<=' + str(tgt):>5s} {'ok' if ratio <= tgt else 'MISS'}")
     compile_plan = lookup("mechsyn.kinematics.analysis", "compile_plan")
     watt = compile_plan(cases[2][1], inputs=("A",)) if compile_plan is not None else None
-    label = "drag (with_joint_points + simulate), Watt"
+    label = "Watt drag (plan.with_joint_points)"
     if watt is None or not hasattr(watt, "with_joint_points"):
-        print(f"{label:<40s} n/a (no KinematicPlan.with_joint_points in this code)")
+        print(f"{label:<34s} n/a (no KinematicPlan.with_joint_points here)")
     else:
         k = [0]
 
@@ -557,7 +556,7 @@ def mechsyn_tables(repeats: int) -> None:
             watt.with_joint_points({"G": (5.0 + 0.001 * (k[0] % 7), 6.0)}).simulate({"A": x})
 
         t, ratio, med = both(drag, bare, repeats, t_bare)
-        print(f"{label:<40s} {'assur':>7s} {'':>6s} {t * 1e3:8.2f} {ratio:8.1f} {med:7.1f}")
+        print(f"{label:<34s} {'assur':>6s} {'':>4s} {t * 1e3:7.2f} {ratio:7.1f} {med:6.1f}")
     moved = {"crank-rocker": "D", "Watt six-bar": "E", "Jansen leg (chain)": "P5"}
     print_fixed_costs([(n, m, j, moved[n]) for n, m, j in cases if n in moved], x, repeats)
 

@@ -95,8 +95,7 @@ def test_reduced_run_checks_pass():
         _check_rows(out)
     else:
         assert [line for line in out.splitlines() if "pylinkage" in line] == [
-            "pylinkage: comparison skipped (not importable here); run this script with the python of a venv "
-            "made with `pip install pylinkage numba`"]
+            "pylinkage: not importable, skipped (get it: pip install pylinkage numba)"]
 
 
 @pytest.mark.slow
