@@ -87,8 +87,9 @@ def numeric(page, joint: str, path: str, edits: int) -> tuple[list[float], list[
     """Numeric edits of the joint's x in the Element tab: from Enter to the repainted path of
     the re-simulated mechanism (each edit is one undo step, like a drag's release). Each
     edit waits for its full answer and two animation frames (the page's measure is taken in
-    one); the page's measures are those it took: an edit whose first answer the page does
-    not time (it went through the server's check first) has none, and the caller says so."""
+    one); the page's measures are those it took: an edit that arrives while an earlier
+    simulation runs has none (the page's coalescing queue keeps only its full answer), and
+    the caller says how many were timed."""
     page.mouse.click(*centre(page, joint))
     page.click('#tabs [data-tab="element"]')
     x0 = page.evaluate("j => window.__studio.mech.joints.find(q => q.id === j).point[0]", joint)
