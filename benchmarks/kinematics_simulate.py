@@ -567,8 +567,15 @@ def main() -> None:
     ap.add_argument("--big", type=int, default=10**6,
                     help="inputs of the crank-rocker's long sweep against pylinkage (0: none)")
     args = ap.parse_args()
-    mechsyn_tables(args.repeats)
-    if not run_pylinkage(args.repeats, args.big):
+    if args.repeats < 1 or args.big == 1 or args.big < 0:
+        ap.error("--repeats must be at least 1, --big at least 2 (or 0: no long sweep)")
+    try:
+        mechsyn_tables(args.repeats)
+        ok = run_pylinkage(args.repeats, args.big)
+    except KeyboardInterrupt:
+        print("\ninterrupted: the rows printed above were measured, the rest was not", file=sys.stderr)
+        raise SystemExit(130) from None
+    if not ok:
         print("answers differ from pylinkage's: see the lines above")
         raise SystemExit(1)
 
