@@ -329,7 +329,8 @@ def what_pylinkage_did(case: str, x: np.ndarray, names: list, answer: tuple, sim
                      + ", ".join(f"{e['kind']} at {e['input'][next(iter(e['input']))]:.2f}" for e in sim.events))
     rates = np.isfinite(pos).all(axis=(1, 2)) & ~np.isfinite(vel).all(axis=(1, 2))
     if rates.any():
-        same = all(not np.isfinite(sim.points[n].velocity[rates]).all() for n in names[2:])
+        rows_m = np.all([np.isfinite(sim.points[n].velocity).all(axis=1) for n in names], axis=0)
+        same = not rows_m[rates].any()
         lines.append(f"  pylinkage: positions but NaN velocities and accelerations at {runs(x, rates)}; "
                      f"mechsyn: {'no velocities there either' if same else 'velocities there'}")
     return lines
@@ -359,6 +360,8 @@ def pylinkage_case(mech, moved: str, kind: str, n: int, rounds: int, inner: int)
     import pylinkage_models as pm
 
     model = pm.model_of(mech)
+    if moved not in model.pins or moved in model.crank:
+        raise ValueError(f"{moved} must name a pin off the crank: one of {', '.join(model.pins)}")
     P = pm.drawn_points(mech, model)
     x, step = sweep_of(mech, model.drive, math.degrees(pm.crank_angle(model, P)), kind, n)
     names = [p[6:] if p.startswith("point:") else model.pins[p][0] for p in model.names]

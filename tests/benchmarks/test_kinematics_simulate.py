@@ -102,3 +102,24 @@ def test_reduced_run_checks_pass():
 @pytest.mark.skipif(not os.environ.get("PYLINKAGE_PYTHON"), reason="PYLINKAGE_PYTHON (a python with pylinkage) not set")
 def test_reduced_run_against_pylinkage():
     _check_rows(_run(os.environ["PYLINKAGE_PYTHON"]))
+
+
+def test_fresh_geometry_takes_with_joint_points_where_it_exists():
+    m = load_mechanism(ROOT / "examples/kinematics/crank_rocker.yaml")
+    calls = []
+    fake = SimpleNamespace(joints=m.joints, joint=m.joint, with_joint_points=lambda pts: calls.append(pts) or m)
+    make, path, where = ks.fresh_maker(fake, "D")
+    assert path == "Mechanism.with_joint_points" and make(3) is m
+    assert list(calls[0]) == ["D"] and np.array_equal(calls[0]["D"], where(3))
+
+
+def test_fresh_geometry_otherwise_takes_the_studios_path():
+    m = load_mechanism(ROOT / "examples/kinematics/crank_rocker.yaml")
+    if hasattr(m, "with_joint_points"):
+        pytest.skip("Mechanism.with_joint_points exists: the studio's path is not taken")
+    make, path, where = ks.fresh_maker(m, "D")
+    assert path.startswith("mechanism_from_dict")
+    moved = make(1)
+    assert np.allclose(moved.joint("D").point[:2], where(1)) and not np.allclose(where(1), m.joint("D").point[:2])
+    assert [j.id for j in moved.joints] == [j.id for j in m.joints]
+    assert all(np.array_equal(a.point, b.point) for a, b in zip(moved.joints, m.joints) if a.id != "D")
