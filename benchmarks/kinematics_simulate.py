@@ -261,16 +261,17 @@ def print_fixed_costs(cases: list, x: np.ndarray, repeats: int) -> None:
 
 
 # --------------------------------------------------------------------------- pylinkage
-def interleaved(fns: dict, setups: dict, rounds: int, inner: int) -> tuple[dict, dict]:
+def interleaved(fns: dict, setups: dict, rounds: int, inner: int, warm: bool = True) -> tuple[dict, dict]:
     """Each callable timed ``inner`` times in turn, ``rounds`` times over (so all see the
     same load in a round): per-round medians and overall minima. ``setups[key]`` runs
-    before each call of ``fns[key]``, untimed."""
+    before each call of ``fns[key]``, untimed; ``warm``: one untimed call of each first."""
     def nothing():
         return None
 
     for key, f in fns.items():
-        setups.get(key, nothing)()
-        f()
+        if warm:
+            setups.get(key, nothing)()
+            f()
     meds, mins = {k: [] for k in fns}, dict.fromkeys(fns, math.inf)
     for _ in range(rounds):
         for key, f in fns.items():
@@ -396,7 +397,8 @@ def pylinkage_case(mech, moved: str, kind: str, n: int, rounds: int, inner: int)
     fns = {"m fresh": m_fresh, "p fresh": p_fresh,
            "m cached": lambda: ms.simulate(mech, {drive: x}, points=names),
            "p cached": lambda: lk.step_fast_with_kinematics(iterations=n)}
-    meds, mins = interleaved(fns, {"p cached": lambda: lk.set_coords(coords0)}, rounds, inner)
+    # a long sweep was just run by the checks (numba compiled): no untimed call of each first
+    meds, mins = interleaved(fns, {"p cached": lambda: lk.set_coords(coords0)}, rounds, inner, warm=inner > 1)
     return {"checks": checks, "story": story, "meds": meds, "mins": mins, "n": n, "path": path,
             "events": len(sim.events)}
 
