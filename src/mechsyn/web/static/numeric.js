@@ -25,9 +25,12 @@ function numberInput(value, onValue, attrs = {}) {
   return i;
 }
 
-// The joints moved with joint `id` (those drawn on the same place, e.g. a slider's R and P joints).
+// The joints moved with joint `id`: on a planar drawing those drawn on the same place (a slider's R
+// and P joints); in a spatial file the joint alone (the joints of a spherical linkage may all be
+// written at its centre, and moving them together would move their axes off it).
 function together(m, id) {
   const p = m.joints.find((j) => j.id === id).point;
+  if (m.kind !== "planar") return m.joints.filter((j) => j.id === id);
   return m.joints.filter((j) => j.point[0] === p[0] && j.point[1] === p[1]);
 }
 
@@ -40,16 +43,15 @@ export function twoJointLinks(m) {
     if (name === m.ground || g.joints.length !== 2) continue;
     const [a, b] = g.joints.map((id) => m.joints.find((j) => j.id === id));
     if (a.type !== "R" || b.type !== "R") continue; // a slider block: its joints' distance is no length
-    out.push({ name, a: a.id, b: b.id, length: Math.hypot(b.point[0] - a.point[0], b.point[1] - a.point[1]) });
+    out.push({ name, a: a.id, b: b.id, length: Math.hypot(...b.point.map((c, i) => c - a.point[i])) }); // 2-D or 3-D
   }
   return out;
 }
 export function setLength(m, name, L) {
   const row = twoJointLinks(m).find((r) => r.name === name);
   const a = m.joints.find((j) => j.id === row.a).point, b = m.joints.find((j) => j.id === row.b).point;
-  const d = row.length || 1, ux = row.length ? (b[0] - a[0]) / d : 1, uy = row.length ? (b[1] - a[1]) / d : 0;
-  const to = [a[0] + ux * L, a[1] + uy * L].map((c) => +c.toPrecision(12));
-  moveJoint(m, row.b, 0, to[0]); moveJoint(m, row.b, 1, to[1]);
+  const u = row.length ? b.map((c, i) => (c - a[i]) / row.length) : a.map((_, i) => +(i === 0));
+  a.map((c, i) => +(c + u[i] * L).toPrecision(12)).forEach((c, i) => moveJoint(m, row.b, i, c));
 }
 
 // The Element tab's fields of joint j: x, y (and the slide angle of a P joint).
@@ -63,8 +65,33 @@ export function jointFields(j, edit) {
   return out;
 }
 
+// The pair types of spatial files, in words (the Element tab's heading).
+export const PAIR_NAMES = { R: "revolute", P: "prismatic", C: "cylindrical", H: "helical", U: "universal (Hooke)",
+  S: "spherical (ball)", S_pin: "spherical with a pin" };
+
+// A direction typed as three numbers; refused (left as it was) when it is zero.
+function axisInputs(v, names, onAxis) {
+  return v.map((c, k) => numberInput(c, (x) => {
+    const a = v.slice(); a[k] = x;
+    if (a.every((q) => q === 0)) return;
+    onAxis(a);
+  }, { name: names[k], size: 7 }));
+}
+
+// The Element tab's fields of a spatial joint j: its point (x, y, z, at the drawn pose) and its
+// axis (and a U joint's second axis: the arm on its second link) as numbers.
+export function spatialJointFields(j, edit) {
+  const row = (label, ...inputs) => { const p = h("p"); p.append(h("label", label + " "), ...inputs); return p; };
+  const out = [row("point (x, y, z)", ...["x", "y", "z"].map((name, k) =>
+    numberInput(j.point[k], (v) => edit((m) => moveJoint(m, j.id, k, v)), { name, size: 7 })))];
+  const setAxis = (key) => (a) => edit((m) => { m.joints.find((q) => q.id === j.id)[key] = a; });
+  if (j.axis) out.push(row(j.type === "U" ? "axis on " + j.links[0] : "axis (direction)", ...axisInputs(j.axis, ["ax", "ay", "az"], setAxis("axis"))));
+  if (j.axis2) out.push(row("axis on " + j.links[1], ...axisInputs(j.axis2, ["bx", "by", "bz"], setAxis("axis2"))));
+  return out;
+}
+
 export function pointFields(name, p, edit) {
-  return ["x", "y"].map((axis, k) => {
+  return ["x", "y", "z"].slice(0, p.at.length).map((axis, k) => {
     const r = h("p");
     r.append(h("label", axis + " "), numberInput(p.at[k], (v) => edit((m) => { m.points[name].at[k] = v; }), { name: axis }));
     return r;
@@ -73,6 +100,7 @@ export function pointFields(name, p, edit) {
 
 // The Joints tab: every joint (id, x, y, type, links, drive, slide angle) and every bar's length.
 export function jointTable(m, selected, edit, select) {
+  if (m.kind !== "planar") return spatialJointTable(m, selected, edit, select);
   const t = h("table", null, { className: "numtable" });
   t.dataset.table = "joints";
   const head = h("tr");
@@ -95,6 +123,10 @@ export function jointTable(m, selected, edit, select) {
     for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
     t.append(tr);
   }
+  return [h("h3", "Joints"), t, h("h3", "Bar lengths (the second joint moves along the bar)"), barTable(m, edit)];
+}
+
+function barTable(m, edit) {
   const lt = h("table", null, { className: "numtable" });
   lt.dataset.table = "links";
   const lh = h("tr"); for (const c of ["link", "joints", "length"]) lh.append(h("th", c)); lt.append(lh);
@@ -106,7 +138,32 @@ export function jointTable(m, selected, edit, select) {
     tr.append(h("td", r.name), h("td", `${r.a}–${r.b}`), td);
     lt.append(tr);
   }
-  return [h("h3", "Joints"), t, h("h3", "Bar lengths (the second joint moves along the bar)"), lt];
+  return lt;
+}
+
+// The Joints tab of a spatial file: every joint's point (x, y, z at the drawn pose), type, links,
+// drive and axis; every bar's length in 3-D.
+function spatialJointTable(m, selected, edit, select) {
+  const t = h("table", null, { className: "numtable" });
+  t.dataset.table = "joints";
+  const head = h("tr");
+  for (const c of ["joint", "x", "y", "z", "type", "links", "drive", "axis"]) head.append(h("th", c));
+  t.append(head);
+  for (const j of m.joints) {
+    const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
+    tr.dataset.row = j.id;
+    const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
+    const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
+    drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
+    const coords = (j.point || []).map((c, k) => numberInput(c, (v) => edit((n) => moveJoint(n, j.id, k, v)), { size: 6 }));
+    const axis = h("span", j.axis ? j.axis.map((c) => String(+(+c).toPrecision(4))).join(", ") : "");
+    const cells = [id, ...coords, h("span", j.type), h("span", j.links.join(", ")), drive, axis];
+    cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = ["", "x", "y", "z", "type", "links", "drive", "axis"][k]; });
+    for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
+    t.append(tr);
+  }
+  return [h("h3", "Joints (at the drawn pose; axes are edited in the Element tab)"), t,
+    h("h3", "Bar lengths in 3-D (the second joint moves along the bar)"), barTable(m, edit)];
 }
 
 // A joint made a P joint slides along x until its angle is typed or its guide's handle turned.

@@ -45,7 +45,7 @@ function camera(cam, W, H) {
   };
 }
 
-export function mountView3d({ $, state, svg: canvas, render }) {
+export function mountView3d({ $, state, svg: canvas, render, select }) {
   const svg = el("svg", { id: "view3d", role: "img", "aria-label": "3-D view of the spatial mechanism" });
   Object.assign(svg.style, { width: "100%", height: "100%", display: "none", background: "#fff", touchAction: "none", userSelect: "none", cursor: "move" });
   canvas.after(svg);
@@ -253,7 +253,7 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   svg.addEventListener("pointerdown", (ev) => {
     if (!shown()) return;
     const j = ev.target.closest("[data-joint]");
-    if (j) { state.selected = { kind: "joint", id: j.dataset.joint }; render(); return; }
+    if (j) { select(j.dataset.joint); return; } // the studio's selection: data-selected and the Element tab
     v3.gesture = { x: ev.clientX, y: ev.clientY, az: v3.cam.az, el: v3.cam.el };
     svg.setPointerCapture(ev.pointerId);
   });
