@@ -66,8 +66,8 @@ export function jointFields(j, edit) {
 }
 
 // The pair types of spatial files, in words (the Element tab's heading).
-export const PAIR_NAMES = { R: "revolute", P: "prismatic", C: "cylindrical", H: "helical", U: "universal (Hooke)",
-  S: "spherical (ball)", S_pin: "spherical with a pin" };
+export const PAIR_NAMES = { R: "revolute", P: "prismatic", C: "cylindrical", H: "helical", U: "universal, Hooke",
+  S: "spherical, ball", S_pin: "spherical with a pin" };
 
 // A direction typed as three numbers; refused (left as it was) when it is zero.
 function axisInputs(v, names, onAxis) {
@@ -75,18 +75,18 @@ function axisInputs(v, names, onAxis) {
     const a = v.slice(); a[k] = x;
     if (a.every((q) => q === 0)) return;
     onAxis(a);
-  }, { name: names[k], size: 7 }));
+  }, { name: names[k] }));
 }
 
 // The Element tab's fields of a spatial joint j: its point (x, y, z, at the drawn pose) and its
 // axis (and a U joint's second axis: the arm on its second link) as numbers.
 export function spatialJointFields(j, edit) {
-  const row = (label, ...inputs) => { const p = h("p"); p.append(h("label", label + " "), ...inputs); return p; };
-  const out = [row("point (x, y, z)", ...["x", "y", "z"].map((name, k) =>
-    numberInput(j.point[k], (v) => edit((m) => moveJoint(m, j.id, k, v)), { name, size: 7 })))];
+  const row = (label, ...inputs) => { const p = h("p", null, { className: "xyz" }); p.append(h("label", label), ...inputs); return p; };
+  const out = [row("point (x, y, z) at the drawn pose", ...["x", "y", "z"].map((name, k) =>
+    numberInput(j.point[k], (v) => edit((m) => moveJoint(m, j.id, k, v)), { name })))];
   const setAxis = (key) => (a) => edit((m) => { m.joints.find((q) => q.id === j.id)[key] = a; });
-  if (j.axis) out.push(row(j.type === "U" ? "axis on " + j.links[0] : "axis (direction)", ...axisInputs(j.axis, ["ax", "ay", "az"], setAxis("axis"))));
-  if (j.axis2) out.push(row("axis on " + j.links[1], ...axisInputs(j.axis2, ["bx", "by", "bz"], setAxis("axis2"))));
+  if (j.axis) out.push(row(j.type === "U" ? `axis on ${j.links[0]} (direction)` : "axis (direction; its length does not matter)", ...axisInputs(j.axis, ["ax", "ay", "az"], setAxis("axis"))));
+  if (j.axis2) out.push(row(`axis on ${j.links[1]} (direction)`, ...axisInputs(j.axis2, ["bx", "by", "bz"], setAxis("axis2"))));
   return out;
 }
 

@@ -10,7 +10,7 @@ import { mountForces } from "./forces.js";
 import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
-import { mountSpatialTabs } from "./spatial_tabs.js"; // the Plots and Forces tabs of spatial files
+import { mountSpatialTabs } from "./tabs3d.js"; // the Plots and Forces tabs of spatial files
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -564,7 +564,7 @@ function spatialElement(box, m, j) {
   drive.onchange = () => toggleDrive(j.id);
   const out = [h("h3", `Joint ${j.id}: ${j.type} pair (${PAIR_NAMES[j.type] || j.type})`),
     row("joins", h("span", j.links.join(" and "), { id: "joint-links" })), ...spatialJointFields(j, edit), row("drive", drive),
-    h("p", "The point and axes are those of the drawn pose (the input slider at 0); an edit re-runs the sweep from there.", { className: "muted" })];
+    h("p", "The point and axes are those of the drawn pose (input 0 on the slider); an edit re-runs the sweep and the check from there.", { className: "muted" })];
   box.replaceChildren(...out);
 }
 
