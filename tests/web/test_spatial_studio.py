@@ -17,14 +17,9 @@ import numpy as np
 import pytest
 
 import mechsyn as ms
-from mechsyn.io import load_mechanism, mechanism_to_dict
-from mechsyn.web._service import example_path
-
 from test_browser import shot, wait_js
-
-
-def spatial_dict(name):
-    return mechanism_to_dict(load_mechanism(example_path(name)))
+from test_studio_3d import open_example as open_in_3d
+from test_studio_3d import set_slider, spatial_dict
 
 
 def column(rows, i=None):
@@ -69,7 +64,7 @@ def test_plots_route_marks_the_rssr_dead_point_and_slides_in_length(client):
 
 
 def _moved(jid, delta):
-    out = mechanism_to_dict(load_mechanism(example_path("bennett")))
+    out = spatial_dict("bennett")
     j = next(j for j in out["joints"] if j["id"] == jid)
     j["point"] = (np.asarray(j["point"]) + delta).tolist()
     return out
@@ -102,12 +97,12 @@ def test_check_calls_a_broken_bennett_rigid_with_the_finite_mobility_reading(cli
 
 
 # ------------------------------------------------------------------------------ browser
-def open_example(page, name):
-    page.select_option("#examples", name)
-    wait_js(page, "n => window.__studio.fileName.startsWith(n + '.') && window.__view3d.view && !window.__view3d.loading"
-                  " && window.__view3d.mech === window.__studio.mech && window.__view3d.draws > 0"
-                  " && window.__studio.check && window.__studio.analysis && !window.__studio.analysis.error", name,
-            timeout=60)
+def open_example(serve, page, name):
+    """The studio with example ``name`` in its 3-D view, checked and analysed."""
+    page.goto(serve(None).url)
+    wait_js(page, "() => document.querySelectorAll('#examples option').length > 20")
+    open_in_3d(page, name)
+    wait_js(page, "() => window.__studio.check && window.__studio.analysis && !window.__studio.analysis.error")
 
 
 def settled(page):
@@ -129,10 +124,7 @@ def path_vertices(d):
 
 @pytest.mark.slow
 def test_bennett_element_plots_forces_and_edits(serve, page):
-    srv = serve(None)
-    page.goto(srv.url)
-    wait_js(page, "() => document.querySelectorAll('#examples option').length > 20")
-    open_example(page, "bennett")
+    open_example(serve, page, "bennett")
     mech = spatial_dict("bennett")
     r2 = next(j for j in mech["joints"] if j["id"] == "R2")
     # a click on a joint in the 3-D view selects it and fills the Element tab with its values
@@ -204,8 +196,3 @@ def test_bennett_element_plots_forces_and_edits(serve, page):
     settled(page)
     wait_js(page, "() => !document.querySelector('[data-banner] .err')")
     assert page.outside_requests == [] and page.console_errors == []
-
-
-def set_slider(page, k):
-    page.evaluate("k => { const s = document.querySelector('#input-slider'); s.value = k;"
-                  " s.dispatchEvent(new Event('input', { bubbles: true })); }", k)

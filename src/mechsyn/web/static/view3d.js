@@ -167,7 +167,9 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
   function jointElement(j, p, axes, P, L, selected) {
     const g = el("g", { "data-joint": j.id, class: `view3d-joint type-${j.type}` });
     const ink = j.actuated ? "#e07000" : "#123";
-    const c = P(p), line = (a, b, attrs) => el("line", { x1: a[0].toFixed(1), y1: a[1].toFixed(1), x2: b[0].toFixed(1), y2: b[1].toFixed(1), ...attrs }, g);
+    const c = P(p);
+    if (selected) el("circle", { cx: c[0].toFixed(1), cy: c[1].toFixed(1), r: 16, class: "selection-ring" }, g);
+    const line = (a, b, attrs) => el("line", { x1: a[0].toFixed(1), y1: a[1].toFixed(1), x2: b[0].toFixed(1), y2: b[1].toFixed(1), ...attrs }, g);
     const h = 0.1 * L * (j.type === "C" ? 1.6 : 1);
     if (j.type === "S" || !axes.length) {
       const rad = Math.max(5, v3.cam.s * c[3] * 0.035 * L);
