@@ -100,7 +100,18 @@ def rigid_problem(data: Any) -> dict[str, Any] | None:
     mobility (the local dimension of the configuration space, idle motions left out) is 0,
     as for a Bennett linkage whose special geometry an edit broke. The message carries the
     rank method's reading (:func:`mechsyn.structure.rank.mobility_reading`). None when it
-    moves, has no drive, or the rank method cannot read its geometry."""
+    moves, has no drive, or the rank method cannot read its geometry.
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism, mechanism_to_dict
+    >>> from mechsyn.web._service import example_path
+    >>> rigid_problem(mechanism_to_dict(load_mechanism(example_path("bennett")))) is None
+    True
+    >>> d = rigid_problem(mechanism_to_dict(load_mechanism(example_path("spatial_4r_generic"))))
+    >>> d["level"], d["message"][:60]
+    ('error', 'spatial mechanism, rigid at the drawn pose: finite mobility 0')
+    """
     mech = _service.build(data)
     drives = [j.id for j in mech.joints if j.actuated]
     try:

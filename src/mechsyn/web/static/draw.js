@@ -310,8 +310,9 @@ export function plot(svg, xs, series, k, ranges = [], labels = {}) {
   el("line", { x1: m, y1: 4, x2: m, y2: H - 16, class: "axis" }, svg);
   el("text", { x: 2, y: 12, class: "label" }, svg, hi.toPrecision(3));
   el("text", { x: 2, y: H - 18, class: "label" }, svg, lo.toPrecision(3));
-  el("text", { x: m, y: H - 3, class: "label" }, svg, x0.toFixed(0));
-  el("text", { x: W - 40, y: H - 3, class: "label" }, svg, x1.toFixed(0));
+  const fx = (v) => (Math.abs(x1 - x0) >= 20 ? v.toFixed(0) : String(+v.toPrecision(3))); // a P drive's short sweep
+  el("text", { x: m, y: H - 3, class: "label" }, svg, fx(x0));
+  el("text", { x: W - 40, y: H - 3, class: "label" }, svg, fx(x1));
   if (labels.x) el("text", { x: W / 2 - 20, y: H - 3, class: "label unit" }, svg, labels.x);
   if (labels.y) el("text", { x: m + 4, y: 12, class: "label unit" }, svg, labels.y);
   if (R.clipped) el("text", { x: m + 4, y: 24, class: "label clipped", "data-clipped": `${R.min} ${R.max}` }, svg,
