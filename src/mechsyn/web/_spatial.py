@@ -109,7 +109,7 @@ def rigid_problem(data: Any) -> dict[str, Any] | None:
     >>> rigid_problem(mechanism_to_dict(load_mechanism(example_path("bennett")))) is None
     True
     >>> d = rigid_problem(mechanism_to_dict(load_mechanism(example_path("spatial_4r_generic"))))
-    >>> d["level"], d["message"][:60]
+    >>> d["level"], d["message"][:61]
     ('error', 'spatial mechanism, rigid at the drawn pose: finite mobility 0')
     """
     mech = _service.build(data)
