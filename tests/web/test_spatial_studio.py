@@ -196,3 +196,29 @@ def test_bennett_element_plots_forces_and_edits(serve, page):
     settled(page)
     wait_js(page, "() => !document.querySelector('[data-banner] .err')")
     assert page.outside_requests == [] and page.console_errors == []
+
+
+@pytest.mark.slow
+def test_rssr_plots_mark_the_dead_point_and_leave_gaps(serve, page):
+    open_example(serve, page, "rssr")
+    page.click("#tabs button[data-tab=plots]")
+    wait_js(page, "() => window.__spatialPlots.data && window.__spatialPlots.mech === window.__studio.mech"
+                  " && document.querySelectorAll('#plots path[data-series]').length > 0")
+    d = page.evaluate("() => window.__spatialPlots.data")
+    dead = [e for e in d["events"] if e["kind"] == "dead point"]
+    assert dead
+    marks = page.evaluate("""() => [...document.querySelectorAll('#plots svg')].map(s =>
+        [...s.querySelectorAll('[data-event]')].map(g => [g.dataset.event, +g.querySelector('line').getAttribute('x1')]))""")
+    X = page.evaluate("xs => { const m = document.querySelector('#plots svg').__map; return xs.map(x => m.X(x)); }",
+                      [d["input"]["values"][e["index"]] for e in dead])
+    assert marks
+    for drawn in marks:  # every plot marks every dead point where the engine found it
+        assert [x for kind, x in drawn if kind == "dead point"] == pytest.approx(X, abs=0.01)
+    # the working range stops at the dead point: the curve has a gap, never numbers across it
+    ok = np.asarray(d["assembled"])
+    runs = int(ok[0]) + int(np.count_nonzero(ok[1:] & ~ok[:-1]))
+    assert runs >= 2 and not ok.all()
+    assert page.get_attribute("#plots path[data-series='A']", "d").count("M") == runs
+    text = page.locator("#plots").inner_text()
+    assert f"dead point at A = {dead[0]['input']['A']:.2f}" in text
+    assert page.outside_requests == [] and page.console_errors == []
