@@ -69,9 +69,17 @@ export function jointFields(j, edit) {
 export const PAIR_NAMES = { R: "revolute", P: "prismatic", C: "cylindrical", H: "helical", U: "universal, Hooke",
   S: "spherical, ball", S_pin: "spherical with a pin" };
 
+// A spatial file's coordinates as shown: rounding noise under 1e-12 of its length scale (the diagonal
+// of its joints' box), e.g. 3.3e-16 left by a closure computation, shown as 0 (the file keeps it).
+function shownCoords(m) {
+  const pts = m.joints.map((j) => j.point).filter(Boolean);
+  const L = Math.hypot(...[0, 1, 2].map((i) => Math.max(...pts.map((p) => p[i] || 0)) - Math.min(...pts.map((p) => p[i] || 0)))) || 1;
+  return (v) => (Math.abs(v) < 1e-12 * L ? 0 : v);
+}
+
 // A direction typed as three numbers; refused (left as it was) when it is zero.
 function axisInputs(v, names, onAxis) {
-  return v.map((c, k) => numberInput(c, (x) => {
+  return v.map((c, k) => numberInput(Math.abs(c) < 1e-12 ? 0 : c, (x) => {
     const a = v.slice(); a[k] = x;
     if (a.every((q) => q === 0)) return;
     onAxis(a);
@@ -80,11 +88,12 @@ function axisInputs(v, names, onAxis) {
 
 // The Element tab's fields of a spatial joint j: its point (x, y, z, at the drawn pose) and its
 // axis (and a U joint's second axis: the arm on its second link) as numbers.
-export function spatialJointFields(j, edit) {
+export function spatialJointFields(m, j, edit) {
+  const shown = shownCoords(m);
   const row = (label, ...inputs) => { const p = h("p", null, { className: "xyz" }); p.append(h("label", label), ...inputs); return p; };
   const out = [row("point (x, y, z) at the drawn pose", ...["x", "y", "z"].map((name, k) =>
-    numberInput(j.point[k], (v) => edit((m) => moveJoint(m, j.id, k, v)), { name })))];
-  const setAxis = (key) => (a) => edit((m) => { m.joints.find((q) => q.id === j.id)[key] = a; });
+    numberInput(shown(j.point[k]), (v) => edit((n) => moveJoint(n, j.id, k, v)), { name })))];
+  const setAxis = (key) => (a) => edit((n) => { n.joints.find((q) => q.id === j.id)[key] = a; });
   if (j.axis) out.push(row(j.type === "U" ? `axis on ${j.links[0]} (direction)` : "axis (direction; its length does not matter)", ...axisInputs(j.axis, ["ax", "ay", "az"], setAxis("axis"))));
   if (j.axis2) out.push(row(`axis on ${j.links[1]} (direction)`, ...axisInputs(j.axis2, ["bx", "by", "bz"], setAxis("axis2"))));
   return out;
@@ -141,13 +150,14 @@ function barTable(m, edit) {
   return lt;
 }
 
-// The Joints tab of a spatial file: every joint's point (x, y, z at the drawn pose), type, links,
-// drive and axis; every bar's length in 3-D.
+// The Joints tab of a spatial file: every joint's point (x, y, z at the drawn pose), type, links
+// and drive (its axes in the Element tab: the side panel has no room for six more numbers); every
+// bar's length in 3-D.
 function spatialJointTable(m, selected, edit, select) {
-  const t = h("table", null, { className: "numtable" });
+  const shown = shownCoords(m), t = h("table", null, { className: "numtable" });
   t.dataset.table = "joints";
   const head = h("tr");
-  for (const c of ["joint", "x", "y", "z", "type", "links", "drive", "axis"]) head.append(h("th", c));
+  for (const c of ["joint", "x", "y", "z", "type", "links", "drive"]) head.append(h("th", c));
   t.append(head);
   for (const j of m.joints) {
     const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
@@ -155,15 +165,14 @@ function spatialJointTable(m, selected, edit, select) {
     const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
     const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
     drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
-    const coords = (j.point || []).map((c, k) => numberInput(c, (v) => edit((n) => moveJoint(n, j.id, k, v)), { size: 6 }));
-    const axis = h("span", j.axis ? j.axis.map((c) => String(+(+c).toPrecision(4))).join(", ") : "");
-    const cells = [id, ...coords, h("span", j.type), h("span", j.links.join(", ")), drive, axis];
-    cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = ["", "x", "y", "z", "type", "links", "drive", "axis"][k]; });
+    const coords = (j.point || []).map((c, k) => numberInput(shown(c), (v) => edit((n) => moveJoint(n, j.id, k, v)), { size: 6 }));
+    const cells = [id, ...coords, h("span", j.type), h("span", j.links.join(", ")), drive];
+    cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = ["", "x", "y", "z", "type", "links", "drive"][k]; });
     for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
     t.append(tr);
   }
-  return [h("h3", "Joints (at the drawn pose; axes are edited in the Element tab)"), t,
-    h("h3", "Bar lengths in 3-D (the second joint moves along the bar)"), barTable(m, edit)];
+  const bars = twoJointLinks(m).length ? [h("h3", "Bar lengths in 3-D (the second joint moves along the bar)"), barTable(m, edit)] : [];
+  return [h("h3", "Joints at the drawn pose (click a joint for its axes in the Element tab)"), t, ...bars];
 }
 
 // A joint made a P joint slides along x until its angle is typed or its guide's handle turned.

@@ -563,7 +563,7 @@ function spatialElement(box, m, j) {
   const drive = h("input", null, { type: "checkbox", checked: !!j.actuated, id: "joint-drive" });
   drive.onchange = () => toggleDrive(j.id);
   const out = [h("h3", `Joint ${j.id}: ${j.type} pair (${PAIR_NAMES[j.type] || j.type})`),
-    row("joins", h("span", j.links.join(" and "), { id: "joint-links" })), ...spatialJointFields(j, edit), row("drive", drive),
+    row("joins", h("span", j.links.join(" and "), { id: "joint-links" })), ...spatialJointFields(m, j, edit), row("drive", drive),
     h("p", "The point and axes are those of the drawn pose (input 0 on the slider); an edit re-runs the sweep and the check from there.", { className: "muted" })];
   box.replaceChildren(...out);
 }
