@@ -165,6 +165,12 @@ def test_bennett_element_plots_forces_and_edits(serve, page):
     assert "spatial statics are not in mechsyn yet" in text
     assert "finite mobility 1" in text and "3 redundant constraint(s)" in text
     assert page.locator("#tab-forces .err").count() == 0
+    # Joints: x, y, z of every joint; bar lengths in 3-D (Bennett's a1 = 1, a2 = sqrt(3), a3 = 1)
+    page.click("#tabs button[data-tab=joints]")
+    assert page.input_value('[data-table="joints"] [data-row="R3"] input[data-field="z"]') == "0.28725884"
+    bars = {b: float(page.input_value(f'[data-table="links"] [data-row="{b}"] input[data-field="length"]'))
+            for b in ("link1", "link2", "link3")}
+    assert bars == pytest.approx({"link1": 1.0, "link2": 3 ** 0.5, "link3": 1.0}, abs=1e-7)
     # a typed point moves the 3-D drawing: R1 along its own axis (z), the linkage still moves
     set_slider(page, 0)
     page.click("#tabs button[data-tab=element]")

@@ -110,29 +110,44 @@ export function pointFields(name, p, edit) {
 // The Joints tab: every joint (id, x, y, type, links, drive, slide angle) and every bar's length.
 export function jointTable(m, selected, edit, select) {
   if (m.kind !== "planar") return spatialJointTable(m, selected, edit, select);
-  const t = h("table", null, { className: "numtable" });
-  t.dataset.table = "joints";
-  const head = h("tr");
-  for (const c of ["joint", "x", "y", "type", "links", "drive", "angle °"]) head.append(h("th", c));
-  t.append(head);
+  const t = jointsHead(["joint", "x", "y", "type", "links", "drive", "angle °"]);
   for (const j of m.joints) {
-    const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
-    tr.dataset.row = j.id;
-    const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
+    const [tr, id] = jointRow(j, selected, select);
     const type = h("select"); for (const ty of ["R", "P"]) type.append(h("option", ty, { value: ty, selected: j.type === ty }));
     type.onchange = () => edit((n) => setType(n.joints.find((q) => q.id === j.id), type.value));
     const links = h("input", null, { value: j.links.join(", "), className: "links" });
     links.onchange = () => edit((n) => setLinks(n, j.id, links.value));
-    const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
-    drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
     const cells = [id, numberInput(j.point[0], (v) => edit((n) => moveJoint(n, j.id, 0, v))),
-      numberInput(j.point[1], (v) => edit((n) => moveJoint(n, j.id, 1, v))), type, links, drive,
+      numberInput(j.point[1], (v) => edit((n) => moveJoint(n, j.id, 1, v))), type, links, driveBox(j, edit),
       j.type === "P" ? numberInput(axisAngle(j), (v) => edit((n) => { n.joints.find((q) => q.id === j.id).axis = axisOf(v); })) : h("span", "")];
-    cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = ["", "x", "y", "type", "links", "drive", "angle"][k]; });
-    for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
-    t.append(tr);
+    t.append(withCells(tr, cells, ["", "x", "y", "type", "links", "drive", "angle"]));
   }
   return [h("h3", "Joints"), t, h("h3", "Bar lengths (the second joint moves along the bar)"), barTable(m, edit)];
+}
+
+// The joint table's head row, a joint's row (its name selects it), its drive box, its cells.
+function jointsHead(columns) {
+  const t = h("table", null, { className: "numtable" }), head = h("tr");
+  t.dataset.table = "joints";
+  for (const c of columns) head.append(h("th", c));
+  t.append(head);
+  return t;
+}
+function jointRow(j, selected, select) {
+  const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
+  tr.dataset.row = j.id;
+  const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
+  return [tr, id];
+}
+function driveBox(j, edit) {
+  const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
+  drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
+  return drive;
+}
+function withCells(tr, cells, fields) {
+  cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = fields[k]; });
+  for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
+  return tr;
 }
 
 function barTable(m, edit) {
@@ -154,22 +169,12 @@ function barTable(m, edit) {
 // and drive (its axes in the Element tab: the side panel has no room for six more numbers); every
 // bar's length in 3-D.
 function spatialJointTable(m, selected, edit, select) {
-  const shown = shownCoords(m), t = h("table", null, { className: "numtable" });
-  t.dataset.table = "joints";
-  const head = h("tr");
-  for (const c of ["joint", "x", "y", "z", "type", "links", "drive"]) head.append(h("th", c));
-  t.append(head);
+  const shown = shownCoords(m), t = jointsHead(["joint", "x", "y", "z", "type", "links", "drive"]);
   for (const j of m.joints) {
-    const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
-    tr.dataset.row = j.id;
-    const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
-    const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
-    drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
+    const [tr, id] = jointRow(j, selected, select);
     const coords = (j.point || []).map((c, k) => numberInput(shown(c), (v) => edit((n) => moveJoint(n, j.id, k, v)), { size: 6 }));
-    const cells = [id, ...coords, h("span", j.type), h("span", j.links.join(", ")), drive];
-    cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = ["", "x", "y", "z", "type", "links", "drive"][k]; });
-    for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
-    t.append(tr);
+    t.append(withCells(tr, [id, ...coords, h("span", j.type), h("span", j.links.join(", ")), driveBox(j, edit)],
+      ["", "x", "y", "z", "type", "links", "drive"]));
   }
   const bars = twoJointLinks(m).length ? [h("h3", "Bar lengths in 3-D (the second joint moves along the bar)"), barTable(m, edit)] : [];
   return [h("h3", "Joints at the drawn pose (click a joint for its axes in the Element tab)"), t, ...bars];
