@@ -52,7 +52,7 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
     }
     if (kind === "point") {
       const p = d.points[name];
-      return [[`position of ${name} (on ${p.link})`, "units", comp(p.position, 1)],
+      return [[`position of ${name} on ${p.link}`, "units", comp(p.position, 1)],
         [`velocity of ${name}, ${at}`, "units/s", comp(p.velocity, w)],
         [`acceleration of ${name}, ${at}`, "units/s²", comp(p.acceleration, w * w)]];
     }
