@@ -34,6 +34,7 @@ from starlette.routing import Route
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.analysis import simulate
 from mechsyn.results import to_jsonable
+from mechsyn.structure.rank import analyze_rank
 from mechsyn.web import _service
 from mechsyn.web._routing import _body, _heavy, _int, _need, api
 
@@ -78,8 +79,12 @@ def engine_problem(data: Any) -> str | None:
 
 def check_note(data: Any) -> dict[str, Any]:
     """The studio check's note on a spatial file: the 3-D view where the engine moves it,
-    else the structure-and-rank-only note with the engine's reason. Blocks the planar
+    else the structure-and-rank-only note with the engine's reason; an error naming the
+    drives when the file cannot move at all (:func:`rigid_problem`). Blocks the planar
     simulation either way (the 3-D view runs its own)."""
+    rigid = rigid_problem(data)
+    if rigid is not None:
+        return rigid
     problem = engine_problem(data)
     if problem is None:
         msg = ("spatial mechanism: 3-D view (drag to orbit, wheel to zoom, Reset; the input slider moves the "
@@ -88,6 +93,41 @@ def check_note(data: Any) -> dict[str, Any]:
         msg = ("spatial mechanism: structure and rank analysis only (see the Analysis tab); the drawing is its "
                f"top view. Spatial kinematics cannot move it: {problem}")
     return {"level": "note", "message": msg, "blocks": True, "elements": []}
+
+
+def rigid_problem(data: Any) -> dict[str, Any] | None:
+    """An error when a spatial file with drives cannot move at the drawn pose: its finite
+    mobility (the local dimension of the configuration space, idle motions left out) is 0,
+    as for a Bennett linkage whose special geometry an edit broke. The message carries the
+    rank method's reading (:func:`mechsyn.structure.rank.mobility_reading`). None when it
+    moves, has no drive, or the rank method cannot read its geometry.
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism, mechanism_to_dict
+    >>> from mechsyn.web._service import example_path
+    >>> rigid_problem(mechanism_to_dict(load_mechanism(example_path("bennett")))) is None
+    True
+    >>> d = rigid_problem(mechanism_to_dict(load_mechanism(example_path("spatial_4r_generic"))))
+    >>> d["level"], d["message"][:61]
+    ('error', 'spatial mechanism, rigid at the drawn pose: finite mobility 0')
+    """
+    mech = _service.build(data)
+    drives = [j.id for j in mech.joints if j.actuated]
+    try:
+        ra = analyze_rank(mech)
+    except MechsynInputError:  # the rank method cannot read the geometry (told in the Analysis tab)
+        return None
+    if not drives or ra.finite_mobility is None or ra.finite_mobility - len(ra.idle_mobilities) > 0:
+        return None
+    idle = f", {len(ra.idle_mobilities)} idle" if ra.idle_mobilities else ""
+    names = ", ".join(drives)
+    return {"level": "error", "blocks": True, "short": "rigid: cannot turn",
+            "message": (f"spatial mechanism, rigid at the drawn pose: finite mobility {ra.finite_mobility}{idle}, "
+                        f"so the drive on {names} cannot move it ({ra.mobility_reading}). If an edit made it rigid, "
+                        "a special geometry that let it move (e.g. Bennett's condition on the link lengths and "
+                        "twists) no longer holds: undo it (Ctrl+Z) or move the joint back"),
+            "elements": [{"kind": "joint", "id": d} for d in drives]}
 
 
 def _rows(a: np.ndarray, ok: np.ndarray, digits: int) -> list:
@@ -121,6 +161,31 @@ def _joint(j, poses, ok: np.ndarray, digits: int) -> dict[str, Any]:
     return out
 
 
+def _sweep(data: Any, steps: int):
+    """The spatial file's sweep of its first drive: ``(mech, drive, home, sim, ok, digits,
+    shown)``, ``digits`` the decimals of 1e-10 of the length scale, ``shown`` the named
+    points (every joint off the frame when the file names none)."""
+    mech = _service.build(data)
+    if mech.kind != "spatial":
+        raise MechsynInputError("the 3-D view is for spatial files", field="kind", hint="kind: spatial")
+    drive, values, home = _sweep_of(mech, steps)
+    named = list(mech.points)
+    sim = simulate(mech, {drive: values}, points=named or None)
+    L = float(sim.length_scale)
+    digits = int(max(0, 10 - np.floor(np.log10(L)))) if L > 0 else 10
+    shown = named or [j.id for j in mech.joints if j.point is not None and mech.ground not in j.links]
+    return mech, drive, home, sim, np.asarray(sim.assembled, bool), digits, shown
+
+
+def _common(mech, drive: str, home: int, sim) -> dict[str, Any]:
+    """The fields the view and the plots share: the input, the rows and what happened."""
+    d = sim.to_dict()
+    return {"mechanism": mech.name, "engine": sim.engine, "method": sim.method, "ground": mech.ground,
+            "input": {**d["input"], "type": sim.input_types[drive]}, "home": home,
+            "assembled": np.asarray(sim.assembled, bool).tolist(), "length_scale": float(sim.length_scale),
+            "working_ranges": d["working_ranges"], "events": d["events"], "notes": d["notes"]}
+
+
 def view(data: Any, steps: int = 180) -> dict[str, Any]:
     """The 3-D view of a spatial mechanism dict over a sweep of its first drive.
 
@@ -136,39 +201,85 @@ def view(data: Any, steps: int = 180) -> dict[str, Any]:
     without a drive, or one the engine cannot move (its message names the pair or drive).
     """
 
-    mech = _service.build(data)
-    if mech.kind != "spatial":
-        raise MechsynInputError("the 3-D view is for spatial files", field="kind", hint="kind: spatial")
-    drive, values, home = _sweep_of(mech, steps)
-    named = list(mech.points)
-    sim = simulate(mech, {drive: values}, points=named or None)
-    d = sim.to_dict()
-    ok = np.asarray(sim.assembled, bool)
-    L = float(sim.length_scale)
-    digits = int(max(0, 10 - np.floor(np.log10(L)))) if L > 0 else 10  # 1e-10 of the length scale
+    mech, drive, home, sim, ok, digits, shown = _sweep(data, steps)
     poses = _poses(sim, mech.link_names)
-    shown = named or [j.id for j in mech.joints if j.point is not None and mech.ground not in j.links]
     res = np.asarray(sim.residual, float)[ok]
     return to_jsonable({
-        "mechanism": mech.name, "engine": sim.engine, "method": sim.method, "ground": mech.ground,
-        "links": list(mech.link_names), "input": {**d["input"], "type": sim.input_types[drive]}, "home": home,
-        "assembled": ok.tolist(),
+        **_common(mech, drive, home, sim), "links": list(mech.link_names),
         "joints": [_joint(j, poses, ok, digits) for j in mech.joints if j.point is not None],
-        "paths": {n: {"link": mech.points[n].link if n in mech.points else mech.joint(n).links[1],
-                      "position": _rows(sim.point(n), ok, digits)} for n in shown},
-        "length_scale": L, "residual": float(res.max()) if res.size else None,
-        "working_ranges": d["working_ranges"], "events": d["events"], "notes": d["notes"],
+        "paths": {n: {"link": _link_of(mech, n), "position": _rows(sim.point(n), ok, digits)} for n in shown},
+        "residual": float(res.max()) if res.size else None,
     })
 
 
+def _link_of(mech, name: str) -> str:
+    """The link a shown point rides on: a named point's, or a joint's second link."""
+    return mech.points[name].link if name in mech.points else mech.joint(name).links[1]
+
+
+def _values(a: np.ndarray, ok: np.ndarray, significant: int = 10) -> list:
+    """Rows of ``a`` rounded to ``significant`` digits of its largest finite magnitude, None
+    where not assembled or not finite (the plots' values: rates grow large near a dead point)."""
+    a = np.asarray(a, float)
+    good = a[ok][np.isfinite(a[ok])]
+    big = float(np.abs(good).max()) if good.size else 0.0
+    digits = int(significant - 1 - np.floor(np.log10(big))) if big > 0 else significant
+    return _rows(a, ok, digits) if a.ndim > 1 else [
+        float(v) if g and np.isfinite(v) else None for v, g in zip(np.round(a, digits), ok)]
+
+
+def plots(data: Any, steps: int = 180) -> dict[str, Any]:
+    """What the studio's Plots tab draws for a spatial file, over the 3-D view's sweep (the
+    same rows, so its cursor is the view's input slider): ``ms.simulate``'s
+    ``SpatialSimulation`` at a drive speed of 1 (rad/s for an R or H drive, length unit/s
+    for a P drive; the page scales velocities by the speed typed, accelerations by its
+    square).
+
+    Returns the view's common fields (``input``, ``home``, ``assembled``, ``events``,
+    ``working_ranges``, ``notes``, ``length_scale``) and ``pairs`` (each pair's rotation in
+    degrees or slide in length units from the drawn assembly, ``{"joint", "kind": "angle" |
+    "slide", "unit", "values"}`` keyed as ``SpatialSimulation.joints``), ``points`` (the
+    view's points: ``link``, ``position``, ``velocity``, ``acceleration`` as [x, y, z] per
+    row) and ``links`` (every moving link's ``angular_velocity`` and
+    ``angular_acceleration``, [x, y, z] per row). Rows that are not assembled are None.
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism, mechanism_to_dict
+    >>> from mechsyn.web._service import example_path
+    >>> p = plots(mechanism_to_dict(load_mechanism(example_path("spherical_fourbar"))), steps=36)
+    >>> sorted(p["pairs"]), p["pairs"]["D"]["unit"], sorted(p["points"])
+    (['A', 'B', 'C', 'D'], 'deg', ['P'])
+    """
+
+    mech, drive, home, sim, ok, digits, shown = _sweep(data, steps)
+    pairs = {}
+    for key, v in sim.joints.items():
+        slide = key.endswith("/slide") or mech.joint(key.split("/")[0]).type == "P"
+        pairs[key] = {"joint": key.split("/")[0], "kind": "slide" if slide else "angle",
+                      "unit": "length" if slide else "deg", "values": _values(v, ok)}
+    points = {}
+    for n in shown:
+        pm = sim.points[n]
+        points[n] = {"link": _link_of(mech, n), "position": _rows(pm.position, ok, digits),
+                     "velocity": _values(pm.velocity, ok), "acceleration": _values(pm.acceleration, ok)}
+    links = {n: {"angular_velocity": _values(lp.angular_velocity, ok),
+                 "angular_acceleration": _values(lp.angular_acceleration, ok)} for n, lp in sim.links.items()}
+    return to_jsonable({**_common(mech, drive, home, sim), "pairs": pairs, "points": points, "links": links})
+
+
 def routes() -> list:
-    """The 3-D view's route, ``POST /api/spatial/view`` ``{"mechanism", "steps"?}``
-    (registered by :func:`mechsyn.web._app._routes`; the sweep runs as a capped,
-    cancellable worker process, :func:`mechsyn.web._routing._heavy`)."""
+    """The 3-D view's routes, ``POST /api/spatial/view`` and ``POST /api/spatial/plots``
+    ``{"mechanism", "steps"?}`` (registered by :func:`mechsyn.web._app._routes`; each sweep
+    runs as a capped, cancellable worker process, :func:`mechsyn.web._routing._heavy`)."""
 
-    @api
-    async def view_route(request) -> Any:
-        body = await _body(request)
-        return await _heavy(request, "_spatial:view", _need(body, "mechanism"), _int(body.get("steps", 180), "steps"))
+    def on_sweep(name: str):
+        @api
+        async def route(request) -> Any:
+            body = await _body(request)
+            return await _heavy(request, f"_spatial:{name}", _need(body, "mechanism"),
+                                _int(body.get("steps", 180), "steps"))
+        return route
 
-    return [Route("/api/spatial/view", view_route, methods=["POST"])]
+    return [Route("/api/spatial/view", on_sweep("view"), methods=["POST"]),
+            Route("/api/spatial/plots", on_sweep("plots"), methods=["POST"])]

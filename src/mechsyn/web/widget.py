@@ -33,7 +33,7 @@ import traitlets  # noqa: E402  (installed with anywidget)
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
-           "atlas.js", "forces.js", "view3d.js", "studio.js")  # view3d.js: the 3-D view
+           "atlas.js", "forces.js", "view3d.js", "tabs3d.js", "studio.js")  # view3d.js, tabs3d.js: spatial files
 
 
 def _body_markup() -> str:

@@ -3,9 +3,12 @@
 import { linkName, membership } from "./draw.js";
 
 // What the server's check depends on besides the joints' places: the links, joints, types, drives.
+// A spatial file's check also reads its geometry (whether it can move at all: a Bennett linkage
+// whose special geometry an edit broke is rigid), so there the points and axes count too.
 export function topologyKey(m) {
+  const geometry = (j) => (m.kind === "planar" ? [] : [j.point, j.axis, j.axis2]);
   return JSON.stringify([m.kind, m.ground, m.links.map(linkName),
-    m.joints.map((j) => [j.id, j.type, j.links, !!j.actuated])]);
+    m.joints.map((j) => [j.id, j.type, j.links, !!j.actuated, ...geometry(j)])]);
 }
 
 // The mechanism's length scale: the diagonal of its joints' bounding box (1 for fewer than two).

@@ -291,9 +291,13 @@ export function robustRange(vals) {
 }
 
 // A small line plot (input on x) with a cursor at index k; returns the svg. `labels`: {x, y} units.
+// `labels`: {x, y} axis units; `colours` (a colour per series, as GROUP_COLOURS, with the legend in
+// the same colour: more than two series); `marks` [{x, kind, text}] events drawn as dashed lines
+// (singular positions, dead points) with `data-event` and a title.
 export function plot(svg, xs, series, k, ranges = [], labels = {}) {
   svg.replaceChildren();
   const W = 300, H = 150, m = 34;
+  svg.__xs = xs;
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const vals = series.flatMap((s) => s.values).filter((y) => y !== null && Number.isFinite(y));
   if (!vals.length) { el("text", { x: 10, y: 20, class: "label" }, svg, "not defined over the sweep"); return svg; }
@@ -306,8 +310,9 @@ export function plot(svg, xs, series, k, ranges = [], labels = {}) {
   el("line", { x1: m, y1: 4, x2: m, y2: H - 16, class: "axis" }, svg);
   el("text", { x: 2, y: 12, class: "label" }, svg, hi.toPrecision(3));
   el("text", { x: 2, y: H - 18, class: "label" }, svg, lo.toPrecision(3));
-  el("text", { x: m, y: H - 3, class: "label" }, svg, x0.toFixed(0));
-  el("text", { x: W - 40, y: H - 3, class: "label" }, svg, x1.toFixed(0));
+  const fx = (v) => (Math.abs(x1 - x0) >= 20 ? v.toFixed(0) : String(+v.toPrecision(3))); // a P drive's short sweep
+  el("text", { x: m, y: H - 3, class: "label" }, svg, fx(x0));
+  el("text", { x: W - 40, y: H - 3, class: "label" }, svg, fx(x1));
   if (labels.x) el("text", { x: W / 2 - 20, y: H - 3, class: "label unit" }, svg, labels.x);
   if (labels.y) el("text", { x: m + 4, y: 12, class: "label unit" }, svg, labels.y);
   if (R.clipped) el("text", { x: m + 4, y: 24, class: "label clipped", "data-clipped": `${R.min} ${R.max}` }, svg,
@@ -320,10 +325,25 @@ export function plot(svg, xs, series, k, ranges = [], labels = {}) {
       d += `${pen ? "L" : "M"}${X(x).toFixed(1)} ${Y(y).toFixed(1)}`; pen = true;
       if (y > hi || y < lo) el("path", { d: y > hi ? `M${X(x) - 3} ${Y(y) + 4}l3 -5l3 5z` : `M${X(x) - 3} ${Y(y) - 4}l3 5l3 -5z`, class: "clip-mark" }, svg);
     });
-    el("path", { d, class: i ? "plotline y" : "plotline", "data-series": s.name }, svg);
-    el("text", { x: W - 60, y: 14 + 12 * i, class: "label" }, svg, s.name);
+    const colour = labels.colours ? GROUP_COLOURS[i % GROUP_COLOURS.length] : null;
+    el("path", { d, class: i ? "plotline y" : "plotline", "data-series": s.name, stroke: colour }, svg).style.stroke = colour || "";
+    el("text", { x: W - 60, y: 14 + 12 * i, class: "label", fill: colour }, svg, s.name).style.fill = colour || "";
   });
+  for (const e of labels.marks || []) {
+    const g = el("g", { class: "event", "data-event": e.kind }, svg);
+    el("line", { x1: X(e.x), y1: 4, x2: X(e.x), y2: H - 16, class: "event-line" }, g);
+    el("text", { x: X(e.x) - 3, y: H - 19, class: "event-mark" }, g, "×");
+    el("title", {}, g, e.text);
+  }
   el("line", { x1: X(xs[k]), y1: 4, x2: X(xs[k]), y2: H - 16, class: "cursor", "data-cursor": k }, svg);
-  svg.__map = { X, x0, x1, m, W };
+  svg.__map = { X, Y, x0, x1, m, W, lo, hi };
   return svg;
+}
+
+// The row of `xs` nearest to where the plot `svg` (drawn by plot()) was clicked.
+export function plotRowAt(svg, ev) {
+  const r = svg.getBoundingClientRect(), mp = svg.__map, xs = svg.__xs, x = ((ev.clientX - r.left) / r.width) * mp.W;
+  const u = mp.x0 + ((x - mp.m) / (mp.W - mp.m - 6)) * (mp.x1 - mp.x0);
+  let best = 0; xs.forEach((v, i) => { if (Math.abs(v - u) < Math.abs(xs[best] - u)) best = i; });
+  return best;
 }

@@ -9,8 +9,9 @@ import { lengthScale } from "./checks.js";
 
 const num = (text) => { const v = Number(String(text).trim().replace(",", ".")); return String(text).trim() !== "" && Number.isFinite(v) ? v : null; };
 
-// `ctx`: {$, state, render, edit, stepsFor}; returns {renderForces, forcesSoon, compute, arrows, cursor}.
-export function mountForces({ $, state, render, edit, stepsFor }) {
+// `ctx`: {$, state, render, edit, stepsFor, spatialLines}; returns {renderForces, forcesSoon, compute,
+// arrows, cursor}. A spatial file gets `spatialLines()` instead (spatial_tabs.js: no spatial statics).
+export function mountForces({ $, state, render, edit, stepsFor, spatialLines }) {
   const box = $("tab-forces");
   let timer = null;
 
@@ -74,7 +75,7 @@ export function mountForces({ $, state, render, edit, stepsFor }) {
 
   async function compute() {
     const mech = state.mech;
-    if (!mech || !mech.joints.some((j) => j.actuated)) { state.forces = null; return renderForces(); }
+    if (!mech || mech.kind !== "planar" || !mech.joints.some((j) => j.actuated)) { state.forces = null; return renderForces(); }
     try {
       const r = await call("/api/studio/forces", { mechanism: mech, steps: stepsFor(mech), speed: num($("drive-speed").value) ?? 1,
         gravity: $("forces-gravity").checked ? [0, -9.81] : [0, 0] });
@@ -88,6 +89,7 @@ export function mountForces({ $, state, render, edit, stepsFor }) {
   function renderForces() {
     const m = state.mech;
     if (!m) return;
+    if (m.kind !== "planar") { box.replaceChildren(...spatialLines()); return; }
     const out = [h("h3", "Masses (kg, kg·m² in SI)"), massTable(m), h("h3", "Loads (N, N·m in SI)"), ...loadList(m)];
     const opts = h("p");
     const g = $("forces-gravity") || h("input", null, { type: "checkbox", id: "forces-gravity" });

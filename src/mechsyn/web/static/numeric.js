@@ -25,9 +25,12 @@ function numberInput(value, onValue, attrs = {}) {
   return i;
 }
 
-// The joints moved with joint `id` (those drawn on the same place, e.g. a slider's R and P joints).
+// The joints moved with joint `id`: on a planar drawing those drawn on the same place (a slider's R
+// and P joints); in a spatial file the joint alone (the joints of a spherical linkage may all be
+// written at its centre, and moving them together would move their axes off it).
 function together(m, id) {
   const p = m.joints.find((j) => j.id === id).point;
+  if (m.kind !== "planar") return m.joints.filter((j) => j.id === id);
   return m.joints.filter((j) => j.point[0] === p[0] && j.point[1] === p[1]);
 }
 
@@ -40,16 +43,15 @@ export function twoJointLinks(m) {
     if (name === m.ground || g.joints.length !== 2) continue;
     const [a, b] = g.joints.map((id) => m.joints.find((j) => j.id === id));
     if (a.type !== "R" || b.type !== "R") continue; // a slider block: its joints' distance is no length
-    out.push({ name, a: a.id, b: b.id, length: Math.hypot(b.point[0] - a.point[0], b.point[1] - a.point[1]) });
+    out.push({ name, a: a.id, b: b.id, length: Math.hypot(...b.point.map((c, i) => c - a.point[i])) }); // 2-D or 3-D
   }
   return out;
 }
 export function setLength(m, name, L) {
   const row = twoJointLinks(m).find((r) => r.name === name);
   const a = m.joints.find((j) => j.id === row.a).point, b = m.joints.find((j) => j.id === row.b).point;
-  const d = row.length || 1, ux = row.length ? (b[0] - a[0]) / d : 1, uy = row.length ? (b[1] - a[1]) / d : 0;
-  const to = [a[0] + ux * L, a[1] + uy * L].map((c) => +c.toPrecision(12));
-  moveJoint(m, row.b, 0, to[0]); moveJoint(m, row.b, 1, to[1]);
+  const u = row.length ? b.map((c, i) => (c - a[i]) / row.length) : a.map((_, i) => +(i === 0));
+  a.map((c, i) => +(c + u[i] * L).toPrecision(12)).forEach((c, i) => moveJoint(m, row.b, i, c));
 }
 
 // The Element tab's fields of joint j: x, y (and the slide angle of a P joint).
@@ -63,8 +65,42 @@ export function jointFields(j, edit) {
   return out;
 }
 
+// The pair types of spatial files, in words (the Element tab's heading).
+export const PAIR_NAMES = { R: "revolute", P: "prismatic", C: "cylindrical", H: "helical", U: "universal, Hooke",
+  S: "spherical, ball", S_pin: "spherical with a pin" };
+
+// A spatial file's coordinates as shown: rounding noise under 1e-12 of its length scale (the diagonal
+// of its joints' box), e.g. 3.3e-16 left by a closure computation, shown as 0 (the file keeps it).
+function shownCoords(m) {
+  const pts = m.joints.map((j) => j.point).filter(Boolean);
+  const L = Math.hypot(...[0, 1, 2].map((i) => Math.max(...pts.map((p) => p[i] || 0)) - Math.min(...pts.map((p) => p[i] || 0)))) || 1;
+  return (v) => (Math.abs(v) < 1e-12 * L ? 0 : v);
+}
+
+// A direction typed as three numbers; refused (left as it was) when it is zero.
+function axisInputs(v, names, onAxis) {
+  return v.map((c, k) => numberInput(Math.abs(c) < 1e-12 ? 0 : c, (x) => {
+    const a = v.slice(); a[k] = x;
+    if (a.every((q) => q === 0)) return;
+    onAxis(a);
+  }, { name: names[k] }));
+}
+
+// The Element tab's fields of a spatial joint j: its point (x, y, z, at the drawn pose) and its
+// axis (and a U joint's second axis: the arm on its second link) as numbers.
+export function spatialJointFields(m, j, edit) {
+  const shown = shownCoords(m);
+  const row = (label, ...inputs) => { const p = h("p", null, { className: "xyz" }); p.append(h("label", label), ...inputs); return p; };
+  const out = [row("point (x, y, z) at the drawn pose", ...["x", "y", "z"].map((name, k) =>
+    numberInput(shown(j.point[k]), (v) => edit((n) => moveJoint(n, j.id, k, v)), { name })))];
+  const setAxis = (key) => (a) => edit((n) => { n.joints.find((q) => q.id === j.id)[key] = a; });
+  if (j.axis) out.push(row(j.type === "U" ? `axis on ${j.links[0]} (direction)` : "axis (direction; its length does not matter)", ...axisInputs(j.axis, ["ax", "ay", "az"], setAxis("axis"))));
+  if (j.axis2) out.push(row(`axis on ${j.links[1]} (direction)`, ...axisInputs(j.axis2, ["bx", "by", "bz"], setAxis("axis2"))));
+  return out;
+}
+
 export function pointFields(name, p, edit) {
-  return ["x", "y"].map((axis, k) => {
+  return ["x", "y", "z"].slice(0, p.at.length).map((axis, k) => {
     const r = h("p");
     r.append(h("label", axis + " "), numberInput(p.at[k], (v) => edit((m) => { m.points[name].at[k] = v; }), { name: axis }));
     return r;
@@ -73,28 +109,48 @@ export function pointFields(name, p, edit) {
 
 // The Joints tab: every joint (id, x, y, type, links, drive, slide angle) and every bar's length.
 export function jointTable(m, selected, edit, select) {
-  const t = h("table", null, { className: "numtable" });
-  t.dataset.table = "joints";
-  const head = h("tr");
-  for (const c of ["joint", "x", "y", "type", "links", "drive", "angle °"]) head.append(h("th", c));
-  t.append(head);
+  if (m.kind !== "planar") return spatialJointTable(m, selected, edit, select);
+  const t = jointsHead(["joint", "x", "y", "type", "links", "drive", "angle °"]);
   for (const j of m.joints) {
-    const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
-    tr.dataset.row = j.id;
-    const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
+    const [tr, id] = jointRow(j, selected, select);
     const type = h("select"); for (const ty of ["R", "P"]) type.append(h("option", ty, { value: ty, selected: j.type === ty }));
     type.onchange = () => edit((n) => setType(n.joints.find((q) => q.id === j.id), type.value));
     const links = h("input", null, { value: j.links.join(", "), className: "links" });
     links.onchange = () => edit((n) => setLinks(n, j.id, links.value));
-    const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
-    drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
     const cells = [id, numberInput(j.point[0], (v) => edit((n) => moveJoint(n, j.id, 0, v))),
-      numberInput(j.point[1], (v) => edit((n) => moveJoint(n, j.id, 1, v))), type, links, drive,
+      numberInput(j.point[1], (v) => edit((n) => moveJoint(n, j.id, 1, v))), type, links, driveBox(j, edit),
       j.type === "P" ? numberInput(axisAngle(j), (v) => edit((n) => { n.joints.find((q) => q.id === j.id).axis = axisOf(v); })) : h("span", "")];
-    cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = ["", "x", "y", "type", "links", "drive", "angle"][k]; });
-    for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
-    t.append(tr);
+    t.append(withCells(tr, cells, ["", "x", "y", "type", "links", "drive", "angle"]));
   }
+  return [h("h3", "Joints"), t, h("h3", "Bar lengths (the second joint moves along the bar)"), barTable(m, edit)];
+}
+
+// The joint table's head row, a joint's row (its name selects it), its drive box, its cells.
+function jointsHead(columns) {
+  const t = h("table", null, { className: "numtable" }), head = h("tr");
+  t.dataset.table = "joints";
+  for (const c of columns) head.append(h("th", c));
+  t.append(head);
+  return t;
+}
+function jointRow(j, selected, select) {
+  const tr = h("tr", null, { className: selected === j.id ? "selected" : "" });
+  tr.dataset.row = j.id;
+  const id = h("td", j.id); id.onclick = () => select(j.id); id.style.cursor = "pointer";
+  return [tr, id];
+}
+function driveBox(j, edit) {
+  const drive = h("input", null, { type: "checkbox", checked: !!j.actuated });
+  drive.onchange = () => edit((n) => { const q = n.joints.find((x) => x.id === j.id); if (drive.checked) q.actuated = true; else delete q.actuated; });
+  return drive;
+}
+function withCells(tr, cells, fields) {
+  cells.forEach((c, k) => { if (k && c.dataset) c.dataset.field = fields[k]; });
+  for (const c of cells) { const td = c.tagName === "TD" ? c : h("td"); if (td !== c) td.append(c); tr.append(td); }
+  return tr;
+}
+
+function barTable(m, edit) {
   const lt = h("table", null, { className: "numtable" });
   lt.dataset.table = "links";
   const lh = h("tr"); for (const c of ["link", "joints", "length"]) lh.append(h("th", c)); lt.append(lh);
@@ -106,7 +162,22 @@ export function jointTable(m, selected, edit, select) {
     tr.append(h("td", r.name), h("td", `${r.a}–${r.b}`), td);
     lt.append(tr);
   }
-  return [h("h3", "Joints"), t, h("h3", "Bar lengths (the second joint moves along the bar)"), lt];
+  return lt;
+}
+
+// The Joints tab of a spatial file: every joint's point (x, y, z at the drawn pose), type, links
+// and drive (its axes in the Element tab: the side panel has no room for six more numbers); every
+// bar's length in 3-D.
+function spatialJointTable(m, selected, edit, select) {
+  const shown = shownCoords(m), t = jointsHead(["joint", "x", "y", "z", "type", "links", "drive"]);
+  for (const j of m.joints) {
+    const [tr, id] = jointRow(j, selected, select);
+    const coords = (j.point || []).map((c, k) => numberInput(shown(c), (v) => edit((n) => moveJoint(n, j.id, k, v)), { size: 6 }));
+    t.append(withCells(tr, [id, ...coords, h("span", j.type), h("span", j.links.join(", ")), driveBox(j, edit)],
+      ["", "x", "y", "z", "type", "links", "drive"]));
+  }
+  const bars = twoJointLinks(m).length ? [h("h3", "Bar lengths in 3-D (the second joint moves along the bar)"), barTable(m, edit)] : [];
+  return [h("h3", "Joints at the drawn pose (click a joint for its axes in the Element tab)"), t, ...bars];
 }
 
 // A joint made a P joint slides along x until its angle is typed or its guide's handle turned.

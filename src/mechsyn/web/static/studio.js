@@ -1,6 +1,6 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
 import { call, coalescing, eventsUrl, transport } from "./api.js";
-import { draw, el, gridStep, linkName, makeView, membership, plot, positions, GROUP_COLOURS } from "./draw.js";
+import { draw, el, gridStep, linkName, makeView, membership, plot, plotRowAt, positions, GROUP_COLOURS } from "./draw.js";
 import { geometryChecks, tidy, topologyKey } from "./checks.js";
 import { bindKeys } from "./keys.js";
 import { mountPlayer } from "./player.js";
@@ -8,8 +8,9 @@ import { mountSynthesis } from "./synthesis.js";
 import { mountAtlas } from "./atlas.js";
 import { mountForces } from "./forces.js";
 import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
-import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType } from "./numeric.js";
+import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
+import { mountSpatialTabs } from "./tabs3d.js"; // the Plots and Forces tabs of spatial files
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -26,7 +27,8 @@ const state = {
   renders: 0, simulations: 0, latencies: [], editLatencies: [], diagnostics: [], check: null, home: 0, dirty: false, offer: null,
 };
 window.__studio = state; // for tests and the benchmark (read-only use)
-const view3d = mountView3d({ $, state, svg, render }); // view3d: shown instead of the canvas for spatial files
+// view3d: shown instead of the canvas for spatial files; a click on a joint selects it (Element tab)
+const view3d = mountView3d({ $, state, svg, render, select: (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); } });
 
 // ------------------------------------------------------------------ rendering
 function render() {
@@ -37,13 +39,15 @@ function render() {
     renderBanner();
     renderPlayer();
     view3d.update(); // view3d: the 3-D view, its slider range and banner lines
-    renderPlots();
+    if (spatial()) spatialUi.cursor(); else renderPlots();
     forcesUi.cursor(state.frame);
   } catch (e) {
     console.error(e);
     $("banner").replaceChildren(div("err", `drawing failed: ${e.message || e}`));
   }
 }
+
+const spatial = () => !!(state.mech && state.mech.kind !== "planar");
 
 function div(cls, text) { const d = document.createElement("div"); d.className = cls; d.textContent = text; return d; }
 
@@ -146,6 +150,7 @@ function analyseSoon() {
       state.analysis = { error: e.error || String(e), hint: e.hint };
     }
     renderAnalysis(); render();
+    if (spatial() && $("tab-forces").classList.contains("on")) forcesUi.renderForces(); // the rank reading
   }, 250);
 }
 
@@ -178,6 +183,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   render();
   renderElement();
   if ($("tab-forces").classList.contains("on")) { forcesUi.renderForces(); forcesUi.forcesSoon(); }
+  if (spatial()) renderPlots(); // the spatial plots' sweep (asked for while the Plots tab is shown)
 }
 
 // Simulate unless the checks say it is pointless (a structure, drives that fight, loose parts).
@@ -528,6 +534,7 @@ function renderElement() {
   if (sel.kind === "joint") {
     const j = m.joints.find((x) => x.id === sel.id);
     if (!j) { state.selected = null; return renderElement(); }
+    if (m.kind !== "planar") return spatialElement(box, m, j);
     out.push(h("h3", `Joint ${j.id} (${j.type === "P" ? "slider, P" : "pin, R"})`));
     const type = h("select"); for (const t of ["R", "P"]) type.append(h("option", t, { value: t, selected: j.type === t }));
     type.id = "joint-type";
@@ -548,6 +555,19 @@ function renderElement() {
   box.replaceChildren(...out);
 }
 
+// The Element tab of a spatial file's joint: its type, links and drive, its point and axis as
+// numbers (an edit re-runs the 3-D sweep and the check: a joint moved off a special geometry that
+// let the mechanism move is explained in the banner).
+function spatialElement(box, m, j) {
+  const row = (label, ...els) => { const p = h("p"); p.append(h("label", label + " "), ...els); return p; };
+  const drive = h("input", null, { type: "checkbox", checked: !!j.actuated, id: "joint-drive" });
+  drive.onchange = () => toggleDrive(j.id);
+  const out = [h("h3", `Joint ${j.id}: ${j.type} pair (${PAIR_NAMES[j.type] || j.type})`),
+    row("joins", h("span", j.links.join(" and "), { id: "joint-links" })), ...spatialJointFields(m, j, edit), row("drive", drive),
+    h("p", "The point and axes are those of the drawn pose (input 0 on the slider); an edit re-runs the sweep and the check from there.", { className: "muted" })];
+  box.replaceChildren(...out);
+}
+
 function renderJoints() {
   const m = state.mech;
   if (!m) return;
@@ -556,6 +576,7 @@ function renderJoints() {
 }
 
 function renderPlots() {
+  if (spatial()) return spatialUi.renderPlots();
   const sim = state.sim, sel = $("plot-what");
   if (!sim) { $("plots").replaceChildren(h("p", "no simulation", { className: "muted" })); return; }
   if (!sim.rates) return; // an edit's first answer: the plots wait for the rates
@@ -588,12 +609,7 @@ function renderPlots() {
     out.push(h("p", `${title} (${unit}, ${at}) against ${sim.input.joint} (${xunit})`));
     const s = el("svg", { "data-plot": title });
     plot(s, xs, series, k, R, { x: `${sim.input.joint} (${xunit})`, y: unit });
-    s.addEventListener("click", (ev) => {
-      const r = s.getBoundingClientRect(), mp = s.__map, x = ((ev.clientX - r.left) / r.width) * mp.W;
-      const u = mp.x0 + ((x - mp.m) / (mp.W - mp.m - 6)) * (mp.x1 - mp.x0);
-      let best = 0; xs.forEach((v, i) => { if (Math.abs(v - u) < Math.abs(xs[best] - u)) best = i; });
-      state.frame = assembledNear(best); render();
-    });
+    s.addEventListener("click", (ev) => { state.frame = assembledNear(plotRowAt(s, ev)); render(); });
     out.push(s);
   }
   $("plots").replaceChildren(...out);
@@ -603,7 +619,8 @@ function renderPlots() {
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
 const synthUi = mountSynthesis({ $, state, render, setMech });
 mountAtlas({ $, state, render, setMech });
-const forcesUi = mountForces({ $, state, render, edit, stepsFor });
+const spatialUi = mountSpatialTabs({ $, state, render, showTab });
+const forcesUi = mountForces({ $, state, render, edit, stepsFor, spatialLines: spatialUi.forcesLines });
 
 // ------------------------------------------------------------------ files
 const { openFrom, refreshFiles } = mountFiles({ $, svg, state, render, setMech, fitView });

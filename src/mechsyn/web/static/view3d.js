@@ -45,7 +45,7 @@ function camera(cam, W, H) {
   };
 }
 
-export function mountView3d({ $, state, svg: canvas, render }) {
+export function mountView3d({ $, state, svg: canvas, render, select }) {
   const svg = el("svg", { id: "view3d", role: "img", "aria-label": "3-D view of the spatial mechanism" });
   Object.assign(svg.style, { width: "100%", height: "100%", display: "none", background: "#fff", touchAction: "none", userSelect: "none", cursor: "move" });
   canvas.after(svg);
@@ -167,7 +167,9 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   function jointElement(j, p, axes, P, L, selected) {
     const g = el("g", { "data-joint": j.id, class: `view3d-joint type-${j.type}` });
     const ink = j.actuated ? "#e07000" : "#123";
-    const c = P(p), line = (a, b, attrs) => el("line", { x1: a[0].toFixed(1), y1: a[1].toFixed(1), x2: b[0].toFixed(1), y2: b[1].toFixed(1), ...attrs }, g);
+    const c = P(p);
+    if (selected) el("circle", { cx: c[0].toFixed(1), cy: c[1].toFixed(1), r: 16, class: "selection-ring" }, g);
+    const line = (a, b, attrs) => el("line", { x1: a[0].toFixed(1), y1: a[1].toFixed(1), x2: b[0].toFixed(1), y2: b[1].toFixed(1), ...attrs }, g);
     const h = 0.1 * L * (j.type === "C" ? 1.6 : 1);
     if (j.type === "S" || !axes.length) {
       const rad = Math.max(5, v3.cam.s * c[3] * 0.035 * L);
@@ -253,7 +255,7 @@ export function mountView3d({ $, state, svg: canvas, render }) {
   svg.addEventListener("pointerdown", (ev) => {
     if (!shown()) return;
     const j = ev.target.closest("[data-joint]");
-    if (j) { state.selected = { kind: "joint", id: j.dataset.joint }; render(); return; }
+    if (j) { select(j.dataset.joint); return; } // the studio's selection: data-selected and the Element tab
     v3.gesture = { x: ev.clientX, y: ev.clientY, az: v3.cam.az, el: v3.cam.el };
     svg.setPointerCapture(ev.pointerId);
   });
