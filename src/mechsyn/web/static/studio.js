@@ -171,7 +171,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
     state.diagnostics = geometryChecks(mech); state.check = null;
     call("/api/studio/check", { mechanism: mech }).then((result) => {
       if (mech !== state.mech) return;
-      state.check = { key, result }; afterCheck(mech, result); render();
+      state.check = { key, result }; afterCheck(mech, result, edited); render();
     }, (e) => {
       if (mech !== state.mech) return;
       state.sim = null; state.simFor = mech; state.notes = [];
