@@ -10,7 +10,8 @@ at most ``m`` and smaller at
   instantaneous 2, finite 1), and
 * a **shaky** one: ``V`` is smooth there, of a dimension below ``m`` (a taut four-bar:
   instantaneous 2, finite 0; Wohlhart's variant of Fayet's linkage, instantaneous 5,
-  finite 3, Müller 2016/2025).
+  finite 3, Müller 2016/2025; an octahedron whose alternate faces' planes meet in a
+  point, Blaschke 1920: its bars spin, the platform is held at second order).
 
 Method (shrinking scales; all lengths in units of the mechanism's length scale, angles
 in radians):
@@ -31,15 +32,19 @@ in radians):
    their branches), steps ``η d`` with ``η = |θ_i|/8`` and ``d`` from ``ker M(θ0)`` are
    projected again: the number of independent directions in which they land is the
    branch's dimension (a smooth point's tangent space; this also holds where the
-   instantaneous mobility stays higher along the branch). The finite mobility is the
-   largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility 0).
+   instantaneous mobility stays higher along the branch). Once every landing lies in the
+   tangent space of a branch measured (within about 3°), no other is measured: one smooth
+   branch. The finite mobility is the largest. No landing point at all: ``θ0`` is
+   isolated in ``V`` (finite mobility 0). A projection landing farther than ``3 ε`` from
+   its start jumped to a distant assembly (least-norm steps can spin a free bar by
+   radians): it counts as not followed, never as a landing.
 3. **Smooth or singular.** The tangent directions found (landing directions from ``θ0``
    and the branches' tangent spaces) span a space of dimension equal to the finite
    mobility exactly when the tangent cone is one linear space, i.e. ``V`` is a smooth
    manifold at ``θ0``; a larger span (two branches crossing) is a singular
-   configuration. Directions of ``ker M`` outside that span are probed too, to find a
-   second branch the first samples missed. Branches crossing at less than about 17°
-   can be taken for one.
+   configuration. Directions of ``ker M`` at more than about 17° from that span are
+   probed too, to find a second branch the first samples missed. Branches crossing at
+   less than about 17° can be taken for one.
 
 Tolerances: the Gauss-Newton target is ``max(1e-14, min(10 tol ε, (ε/1000)²))`` with
 ``tol`` the rank tolerance (relative to the length scale, see
@@ -73,6 +78,9 @@ __all__ = ["LocalMobility", "local_mobility"]
 STEP = 0.04
 _SPAN_EIG = 0.01  # an eigenvalue of Σ v vᵀ above this times the largest is a direction
 _MAX_ITER = 100
+_JUMP = 3.0  # a projection from a step ε lands within about 2ε of the base; farther, it jumped
+_MISSED = 0.3  # sine of the angle beyond which a direction of ker M is missed by the directions found
+_ON_BRANCH = 0.05  # a landing within about 3° of a measured branch's tangent space lies on that branch
 
 Step = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray]"]
 Null = Callable[[np.ndarray], "tuple[int, np.ndarray]"]
@@ -165,8 +173,8 @@ def _landings(proj: _Projector, base: np.ndarray, Nb: np.ndarray, eps: float, rn
     out, failed = [], 0
     for _ in range(samples):
         t = proj(base + eps * _direction(Nb, rng), eps)
-        if t is None:
-            failed += 1
+        if t is None or np.linalg.norm(t - base) > _JUMP * eps:
+            failed += 1  # diverged, or jumped to a distant assembly: nothing about this neighbourhood
         elif np.linalg.norm(t - base) > 0.2 * eps:
             out.append(t - base)
     return out, failed
@@ -253,12 +261,14 @@ def local_mobility(step: Step, null: Null, N: np.ndarray, rank0: int, tol: float
         dims.append(k)
         ranks.append(r)
         dirs.extend(T.T)  # unit tangents of the branch
+        if k and all(np.linalg.norm(v - T @ (T.T @ v)) <= _ON_BRANCH * np.linalg.norm(v) for v in moved):
+            break  # every landing lies in this branch's tangent space: one smooth branch, measured
     finite = max(dims)
     span, S = _span(dirs, F)
     if span <= finite and span < m:  # probe the directions the samples missed
         comp = N - S @ (S.T @ N)
         u, s, _ = np.linalg.svd(comp, full_matrices=False)
-        C = u[:, s > 1e-6]
+        C = u[:, s > _MISSED]  # directions of ker M at more than about 17° from every one found
         extra, _ = _landings(proj, zero, C, e, rng, 2 * C.shape[1] + 2) if C.shape[1] else ([], 0)
         outside = [v for v in extra if np.linalg.norm(v - S @ (S.T @ v)) > 0.3 * np.linalg.norm(v)]
         if outside:

@@ -117,7 +117,9 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
             "singular": bool(rank.singular), "finite_mobility": rank.finite_mobility,
             "source": "exact rank method at the drawn pose"}
         pose = (f"SINGULAR at the drawn pose (finite mobility nearby {rank.finite_mobility})" if rank.singular
-                else "not singular")
+                else f"not singular but SHAKY: finite mobility {rank.finite_mobility}, "
+                     f"{rank.mobility - rank.finite_mobility} instantaneous motion(s) do not extend"
+                if getattr(rank, "shaky", False) else "not singular")
         idle = len(rank.idle_mobilities)
         split = (f" (instantaneous {rank.mobility} = {rank.useful_mobility} useful + {idle} idle)" if idle
                  else " (no idle mobility)")
