@@ -11,7 +11,7 @@ at most ``m`` and smaller at
 * a **shaky** one: ``V`` is smooth there, of a dimension below ``m`` (a taut four-bar:
   instantaneous 2, finite 0; Wohlhart's variant of Fayet's linkage, instantaneous 5,
   finite 3, Müller 2016/2025; an octahedron whose alternate faces' planes meet in a
-  point, Blaschke 1920: its bars spin, the platform is held at second order).
+  point [4]_: its bars spin, the platform is held at second order).
 
 Method (shrinking scales; all lengths in units of the mechanism's length scale, angles
 in radians):
@@ -63,6 +63,8 @@ References
 .. [3] A. J. Sommese, J. Verschelde and C. W. Wampler, "Numerical decomposition of
    the solution sets of polynomial systems into irreducible components", *SIAM J.
    Numer. Anal.* 38(6), 2022-2046, 2001 (local dimension by nearby witness points).
+.. [4] W. Blaschke, "Wackelige Achtflache", *Math. Z.* 6, 85-93, 1920 (an octahedron is
+   infinitesimally movable when the planes of four alternate faces meet in a point).
 """
 
 from __future__ import annotations
