@@ -1,4 +1,4 @@
-"""Issue 25 item 3: a shaky spatial linkage, the nearest checkable stand-in for Wohlhart's
+"""Issue 25 item 3: shaky spatial linkages, the nearest checkable stand-ins for Wohlhart's
 three-loop linkage (whose joint geometry the sources at hand do not give).
 
 ``examples/spatial/octahedron_shaky.yaml``: the octahedral (3-3) platform with its six legs
@@ -17,6 +17,14 @@ So the instantaneous mobility is 6 spins + the flexes, the redundant constraints
 self-stresses, the finite mobility is the 6 spins, and the configuration space (the spins'
 torus, platform at rest) is smooth: a shaky configuration. Turned by a few degrees about
 its normal, the platform is rigid to first order: 6 spins, nothing redundant, regular.
+
+With R pairs only: a spherical four-bar stretched taut, its four axes through one centre
+and in one plane, crank 20° + coupler 30° + rocker 40° = frame 90°. Four coplanar
+rotation axes through a point span two rotations: instantaneous mobility 4 - 2 = 2 and
+6 - 2 = 4 redundant constraints; by the spherical triangle inequality the angle between
+the frame's two axes (90°) is at most crank + coupler + rocker (90°), with equality only
+when all four axes lie on one great circle in order, so this is the only assembly:
+finite mobility 0, an isolated (smooth, 0-dimensional) point: shaky.
 """
 
 from __future__ import annotations
@@ -162,3 +170,22 @@ def test_thirty_seeds_read_alike(rel, expected):
     runs = (analyze_rank(mech, seed=s) for s in range(30))
     readings = {(r.mobility, r.finite_mobility, r.configuration) for r in runs}
     assert readings == {expected}
+
+
+def _spherical_taut(points: str) -> dict:
+    """The taut spherical four-bar, its points at the centre or slid along the axes."""
+    axes = [[round(np.cos(np.radians(a)), 12), 0.0, round(np.sin(np.radians(a)), 12)] for a in (0, 20, 50, 90)]
+    slide = (0, 0, 0, 0) if points == "centre" else (1, 2, 1.5, 1)
+    links = ["frame", "crank", "coupler", "rocker", "frame"]
+    return {"name": "taut spherical four-bar", "kind": "spatial", "ground": "frame", "links": links[:4],
+            "joints": [{"id": "ABCD"[i], "type": "R", "links": links[i:i + 2], "axis": a,
+                        "point": [s * x for x in a]} for i, (a, s) in enumerate(zip(axes, slide))]}
+
+
+@pytest.mark.parametrize("points, seed", [("centre", 0), ("centre", 1), ("centre", 2), ("along the axes", 0)])
+def test_taut_spherical_fourbar_is_shaky_and_isolated(points, seed):
+    d = _spherical_taut(points)
+    rotations = np.linalg.matrix_rank(np.array([j["axis"] for j in d["joints"]]))  # 2: coplanar axes
+    r = analyze_rank(mechanism_from_dict(d, "taut.yaml"), seed=seed)
+    assert (r.mobility, r.redundant_constraints, len(r.idle_mobilities)) == (4 - rotations, 6 - rotations, 0)
+    assert (r.finite_mobility, r.configuration, r.shaky, r.singular) == (0, "shaky", True, False)
