@@ -32,12 +32,14 @@ in radians):
    their branches), steps ``η d`` with ``η = |θ_i|/8`` and ``d`` from ``ker M(θ0)`` are
    projected again: the number of independent directions in which they land is the
    branch's dimension (a smooth point's tangent space; this also holds where the
-   instantaneous mobility stays higher along the branch). Once every landing lies in the
-   tangent space of a branch measured (within about 3°), no other is measured: one smooth
-   branch. The finite mobility is the largest. No landing point at all: ``θ0`` is
-   isolated in ``V`` (finite mobility 0). A projection landing farther than ``3 ε`` from
-   its start jumped to a distant assembly (least-norm steps can spin a free bar by
-   radians): it counts as not followed, never as a landing.
+   instantaneous mobility stays higher along the branch), capped at ``dim ker M(θ_i)`` (a
+   landing near where two branches cross along a line would otherwise read both as one
+   wider branch). Once every landing lies in the tangent space of a branch measured
+   (within about 3°), no other is measured: one smooth branch. The finite mobility is
+   the largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility
+   0). A projection landing farther than ``3 ε`` from its start jumped to a distant
+   assembly (least-norm steps can spin a free bar by radians): it counts as not
+   followed, never as a landing.
 3. **Smooth or singular.** The tangent directions found (landing directions from ``θ0``
    and the branches' tangent spaces) span a space of dimension equal to the finite
    mobility exactly when the tangent cone is one linear space, i.e. ``V`` is a smooth
@@ -186,14 +188,19 @@ def _branch(proj: _Projector, null: Null, theta: np.ndarray, N: np.ndarray,
             rng: np.random.Generator) -> tuple[int, np.ndarray, int]:
     """Dimension and tangent basis of the branch of ``V`` through its smooth point
     ``theta`` (near ``θ0``), and the loop-closure rank there: the span of the directions in
-    which points ``theta + η d`` (``d`` from ``ker M(θ0)``, ``η = |theta|/8``) land."""
+    which points ``theta + η d`` (``d`` from ``ker M(θ0)``, ``η = |theta|/8``) land. A
+    branch is never wider than the instantaneous motions at ``theta`` (the tangent cone
+    lies in ``ker M(theta)``): steps that reach a second branch, when ``theta`` lies within
+    ``η`` of where two branches cross, count for the widest ``dim ker M(theta)`` only."""
     eta = float(np.linalg.norm(theta)) / 8
     theta = proj(theta, eta / 4)  # on V to within the accuracy the smaller steps need
     if theta is None:
         return 0, np.zeros((N.shape[0], 0)), 0
-    r, _ = null(theta)
+    r, Nt = null(theta)
     moved, _ = _landings(proj, theta, N, eta, rng, N.shape[1] + 4)
     k, T = _span([v / eta for v in moved], theta.size)
+    if k > Nt.shape[1]:  # eigenvectors come in ascending order: keep the widest
+        k, T = Nt.shape[1], T[:, k - Nt.shape[1]:]
     return k, T, r
 
 
