@@ -146,3 +146,15 @@ def test_two_branches_crossing_along_a_line(seed):
     step, null = make([(lambda t: t[0] * t[1], lambda t: [t[1], t[0], 0.0])])
     lm = local_mobility(step, null, np.eye(3), 0, 1e-9, seed=seed)
     assert (lm.instantaneous, lm.finite, lm.configuration) == (3, 2, "singular")
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_a_cusp_is_never_read_smooth(seed):
+    """``y² = x³``: one curve through the origin, but with a cusp there (its tangent cone is a
+    half-line, not a line): never shaky or regular; singular, or said not followed where
+    the steps towards ``x < 0``, which has no assembly near, fail."""
+    import numpy as np
+
+    step, null = make([(lambda t: t[1] ** 2 - t[0] ** 3, lambda t: [-3 * t[0] ** 2, 2 * t[1]])])
+    lm = local_mobility(step, null, np.eye(2), 0, 1e-9, seed=seed)
+    assert (lm.finite, lm.configuration) in ((1, "singular"), (None, "not followed"))

@@ -45,8 +45,10 @@ in radians):
    mobility exactly when the tangent cone is one linear space, i.e. ``V`` is a smooth
    manifold at ``θ0``; a larger span (two branches crossing) is a singular
    configuration. Directions of ``ker M`` at more than about 17° from that span are
-   probed too, to find a second branch the first samples missed. Branches crossing at
-   less than about 17° can be taken for one.
+   probed too, to find a second branch the first samples missed. A tangent cone that is
+   only half of its span (a step opposite a landing direction lands nowhere opposite: a
+   cusp's half-line) is singular too. Branches crossing at less than about 17° can be
+   taken for one.
 
 Tolerances: the Gauss-Newton target is ``max(1e-14, min(10 tol ε, (ε/1000)²))`` with
 ``tol`` the rank tolerance (relative to the length scale, see
@@ -84,6 +86,7 @@ _SPAN_EIG = 0.01  # an eigenvalue of Σ v vᵀ above this times the largest is a
 _MAX_ITER = 100
 _JUMP = 3.0  # a projection from a step ε lands within about 2ε of the base; farther, it jumped
 _MISSED = 0.3  # sine of the angle beyond which a direction of ker M is missed by the directions found
+_OPPOSITE = 0.87  # cos 30°: a step opposite a landing lands opposite it on a smooth branch
 _ON_BRANCH = 0.05  # a landing within about 3° of a measured branch's tangent space lies on that branch
 
 Step = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray]"]
@@ -204,6 +207,19 @@ def _branch(proj: _Projector, null: Null, theta: np.ndarray, N: np.ndarray,
     return k, T, r
 
 
+def _one_sided(proj: _Projector, moved: list[np.ndarray], eps: float) -> bool:
+    """Whether the motion leaves ``θ0`` one way only along a landing direction ``u``: the
+    step ``-ε u`` finds no assembly opposite (it fails, jumps, stays near ``θ0`` or lands
+    more than 30° off ``-u``), as on a cusp's half-line or Whitney's umbrella. On a smooth
+    branch both ways land, symmetric to first order."""
+    for i in _diverse(moved, 3):
+        u = moved[i] / np.linalg.norm(moved[i])
+        t = proj(-eps * u, eps)
+        if t is None or not 0.2 * eps < np.linalg.norm(t) <= _JUMP * eps or -(t @ u) < _OPPOSITE * np.linalg.norm(t):
+            return True
+    return False
+
+
 def _diverse(vectors: list[np.ndarray], k: int) -> list[int]:
     """Indices of up to ``k`` vectors with the most different directions (greedy)."""
     units = [v / np.linalg.norm(v) for v in vectors]
@@ -283,4 +299,6 @@ def local_mobility(step: Step, null: Null, N: np.ndarray, rank0: int, tol: float
         if outside:
             span = max(span, finite + 1)
     configuration = "singular" if span > finite else ("shaky" if finite < m else "regular")
+    if configuration == "shaky" and finite and _one_sided(proj, moved, e):
+        configuration = "singular"  # the tangent cone is a half-space of its span: not smooth
     return LocalMobility(m, finite, configuration, span, max(ranks) or None)
