@@ -25,7 +25,8 @@ in radians):
    for every sampled direction, every instantaneous motion extends to a finite one:
    the configuration is regular and the finite mobility is ``m``. (A random direction
    of ``ker M`` lies on a lower-dimensional tangent cone with probability zero, so a
-   few samples decide.)
+   few samples decide.) A step near which the projection finds no assembly (it fails:
+   a cusp's other side) does not extend either.
 2. Otherwise, ``m + 4`` directions are projected at ``ε/4``; those that stay away from
    ``θ0`` (``|θ - θ0| > 0.2 ε/4``) land on branches of ``V`` through ``θ0``. At up to three
    landing points ``θ_i`` with the most different directions (generic, smooth points of
@@ -37,7 +38,7 @@ in radians):
    wider branch). Once every landing lies in the tangent space of a branch measured
    (within about 3°), no other is measured: one smooth branch. The finite mobility is
    the largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility
-   0). A projection landing farther than ``3 ε`` from its start jumped to a distant
+   0), or, where projections failed, the motion is "not followed". A projection landing farther than ``3 ε`` from its start jumped to a distant
    assembly (least-norm steps can spin a free bar by radians): it counts as not
    followed, never as a landing.
 3. **Smooth or singular.** The tangent directions found (landing directions from ``θ0``
@@ -143,9 +144,10 @@ def _direction(Nb: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def _extends(proj: _Projector, base: np.ndarray, Nb: np.ndarray, eps: float, rng: np.random.Generator,
-             samples: int) -> bool | None:
-    """Whether random tangent directions at ``base`` extend to finite motions (step 1);
-    None when a projection fails."""
+             samples: int) -> bool:
+    """Whether random tangent directions at ``base`` extend to finite motions (step 1). A
+    projection that finds no assembly near the step (it fails) does not extend it: step 2
+    then says where the motion goes, or that it cannot be followed."""
     floor = max(1e-6, 100.0 * proj.tol)
     for _ in range(samples):
         d = _direction(Nb, rng)
@@ -153,7 +155,7 @@ def _extends(proj: _Projector, base: np.ndarray, Nb: np.ndarray, eps: float, rng
         for e in (eps, eps / 4):
             t = proj(base + e * d, e)
             if t is None:
-                return None
+                return False
             rho.append(float(np.linalg.norm(t - base - e * d)) / e)
         if rho[1] > max(0.6 * rho[0], floor):
             return False
@@ -267,11 +269,7 @@ def local_mobility(step: Step, null: Null, N: np.ndarray, rank0: int, tol: float
     rng = np.random.default_rng(seed)
     proj = _Projector(step, tol)
     zero = np.zeros(F)
-    ext = _extends(proj, zero, N, eps, rng, 3)
-    if ext is None:
-        return LocalMobility(m, None, "not followed", None, None,
-                             ["the motion could not be followed numerically (closure did not converge)"])
-    if ext:
+    if _extends(proj, zero, N, eps, rng, 3):
         return LocalMobility(m, m, "regular", m, rank0)
     e = eps / 4
     moved, failed = _landings(proj, zero, N, e, rng, min(m + 4, 24))
