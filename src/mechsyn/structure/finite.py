@@ -38,9 +38,9 @@ in radians):
    wider branch). Once every landing lies in the tangent space of a branch measured
    (within about 3°), no other is measured: one smooth branch. The finite mobility is
    the largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility
-   0), or, where projections failed, the motion is "not followed". A projection landing farther than ``3 ε`` from its start jumped to a distant
-   assembly (least-norm steps can spin a free bar by radians): it counts as not
-   followed, never as a landing.
+   0), or, where projections failed, the motion is "not followed". A projection landing
+   farther than ``3 ε`` from its start jumped to a distant assembly (least-norm steps
+   can spin a free bar by radians): it counts as failed, never as a landing.
 3. **Smooth or singular.** The tangent directions found (landing directions from ``θ0``
    and the branches' tangent spaces) span a space of dimension equal to the finite
    mobility exactly when the tangent cone is one linear space, i.e. ``V`` is a smooth
@@ -217,7 +217,8 @@ def _one_sided(proj: _Projector, moved: list[np.ndarray], eps: float) -> bool:
     for i in _diverse(moved, 3):
         u = moved[i] / np.linalg.norm(moved[i])
         t = proj(-eps * u, eps)
-        if t is None or not 0.2 * eps < np.linalg.norm(t) <= _JUMP * eps or -(t @ u) < _OPPOSITE * np.linalg.norm(t):
+        far = 0.0 if t is None else float(np.linalg.norm(t))
+        if not 0.2 * eps < far <= _JUMP * eps or -float(t @ u) < _OPPOSITE * far:
             return True
     return False
 
