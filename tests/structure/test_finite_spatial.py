@@ -153,7 +153,7 @@ def test_the_verdict_says_shaky():
     mech = load_mechanism(FILE)
     v = verdict(analyze_structure(mech), analyze_rank(mech))
     assert "not singular but SHAKY: finite mobility 6, 1 instantaneous motion(s) do not extend" in v["text"]
-    assert v["finite_mobility"] == 6
+    assert (v["finite_mobility"], v["shaky"], v["singular"]) == (6, True, False)
 
 
 @pytest.mark.slow
