@@ -43,18 +43,27 @@ def system(rel: str):
     return _Projector(lambda th: R._gauss_newton_step(sysm, th, tol), tol), N
 
 
-def corrections(ax) -> None:
+def rho_curves(ax, curves) -> None:
+    """``ρ(ε)`` along each tangent direction: ``curves`` of (projector, direction, label,
+    colour, marker); also used by shaky_octahedron.py."""
     eps = np.logspace(-3.3, -1, 12)
-    for (rel, label, colour), marker in zip(CASES, "osD^"):
-        proj, N = system(rel)
-        d = N @ np.array([1.0, 0.7])[: N.shape[1]]  # a direction between the basis motions
-        d /= np.linalg.norm(d)
+    for proj, d, label, colour, marker in curves:
+        d = d / np.linalg.norm(d)
         rho = [np.linalg.norm(proj(e * d, e) - e * d) / e for e in eps]
         ax.loglog(eps, rho, "-", marker=marker, color=colour, ms=4, lw=1.2, mfc="none", label=label)
     ax.loglog(eps, 0.5 * eps, ":", color="0.4", lw=1)
     ax.text(eps[3], 0.5 * eps[3] * 0.45, "slope 1", color="0.35", fontsize=8)
     ax.set_xlabel("tangent step ε (radians, lengths / length scale)")
     ax.set_ylabel("relative correction ρ(ε)")
+
+
+def corrections(ax) -> None:
+    curves = []
+    for (rel, label, colour), marker in zip(CASES, "osD^"):
+        proj, N = system(rel)
+        d = N @ np.array([1.0, 0.7])[: N.shape[1]]  # a direction between the basis motions
+        curves.append((proj, d, label, colour, marker))
+    rho_curves(ax, curves)
     ax.set_title("(a) does the step extend to a finite motion?", fontsize=10)
     ax.legend(fontsize=7.5, loc="lower right", frameon=False)
 

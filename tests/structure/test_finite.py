@@ -100,25 +100,30 @@ def test_to_dict_says_which_reading_holds():
     assert d["finite_mobility"] is None and d["configuration"] == "not checked"
 
 
+def make(rows):
+    """``step`` and ``null`` of :func:`local_mobility` for closure equations given as
+    (function, gradient) pairs."""
+    import numpy as np
+
+    def closure(t):
+        return np.array([f(t) for f, _ in rows]), np.array([g(t) for _, g in rows])
+
+    def step(t):
+        err, J = closure(t)
+        return err, np.linalg.lstsq(J, err, rcond=1e-9)[0]
+
+    def null(t):
+        _, s, vt = np.linalg.svd(closure(t)[1])
+        r = int(np.sum(s > 1e-6))
+        return r, vt[r:].T
+    return step, null
+
+
 def test_local_mobility_on_a_toy_system():
     """Two constraints in the plane, ``y = x²`` and ``y = 0``, meet at the origin only; at
     the origin the Jacobian has rank 1. Doubling the line (``y = 0`` twice) keeps the
     whole line: finite 1, regular."""
     import numpy as np
-
-    def make(rows):
-        def closure(t):
-            return np.array([f(t) for f, _ in rows]), np.array([g(t) for _, g in rows])
-
-        def step(t):
-            err, J = closure(t)
-            return err, np.linalg.lstsq(J, err, rcond=1e-9)[0]
-
-        def null(t):
-            _, s, vt = np.linalg.svd(closure(t)[1])
-            r = int(np.sum(s > 1e-6))
-            return r, vt[r:].T
-        return step, null
 
     parabola = (lambda t: t[1] - t[0] ** 2, lambda t: [-2 * t[0], 1.0])
     line = (lambda t: t[1], lambda t: [0.0, 1.0])
@@ -127,3 +132,29 @@ def test_local_mobility_on_a_toy_system():
     assert (lm.finite, lm.configuration) == (0, "shaky")
     lm = local_mobility(*make([line, line]), N, 1, 1e-6)
     assert (lm.finite, lm.configuration) == (1, "regular")
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_two_branches_crossing_along_a_line(seed):
+    """``x y = 0`` in space: the planes ``x = 0`` and ``y = 0`` cross along the z axis, and
+    the origin lies on that crossing. Each branch is 2-dimensional, the Jacobian is zero at
+    the origin (instantaneous 3): finite 2, singular. A landing point near the z axis sees
+    both planes within its probing distance; a branch is never wider than the
+    instantaneous motions at its point (2 off the axis), which keeps it from reading 3."""
+    import numpy as np
+
+    step, null = make([(lambda t: t[0] * t[1], lambda t: [t[1], t[0], 0.0])])
+    lm = local_mobility(step, null, np.eye(3), 0, 1e-9, seed=seed)
+    assert (lm.instantaneous, lm.finite, lm.configuration) == (3, 2, "singular")
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_a_cusp_is_never_read_smooth(seed):
+    """``y² = x³``: one curve through the origin, but with a cusp there (its tangent cone is a
+    half-line, not a line): never shaky or regular; singular, or said not followed where
+    the steps towards ``x < 0``, which has no assembly near, fail."""
+    import numpy as np
+
+    step, null = make([(lambda t: t[1] ** 2 - t[0] ** 3, lambda t: [-3 * t[0] ** 2, 2 * t[1]])])
+    lm = local_mobility(step, null, np.eye(2), 0, 1e-9, seed=seed)
+    assert (lm.finite, lm.configuration) in ((1, "singular"), (None, "not followed"))

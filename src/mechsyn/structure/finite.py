@@ -10,7 +10,8 @@ at most ``m`` and smaller at
   instantaneous 2, finite 1), and
 * a **shaky** one: ``V`` is smooth there, of a dimension below ``m`` (a taut four-bar:
   instantaneous 2, finite 0; Wohlhart's variant of Fayet's linkage, instantaneous 5,
-  finite 3, Müller 2016/2025).
+  finite 3, Müller 2016/2025; an octahedron whose alternate faces' planes meet in a
+  point [4]_: its bars spin, the platform is held at second order).
 
 Method (shrinking scales; all lengths in units of the mechanism's length scale, angles
 in radians):
@@ -24,22 +25,31 @@ in radians):
    for every sampled direction, every instantaneous motion extends to a finite one:
    the configuration is regular and the finite mobility is ``m``. (A random direction
    of ``ker M`` lies on a lower-dimensional tangent cone with probability zero, so a
-   few samples decide.)
+   few samples decide.) A step near which the projection finds no assembly (it fails:
+   a cusp's other side) does not extend either.
 2. Otherwise, ``m + 4`` directions are projected at ``ε/4``; those that stay away from
    ``θ0`` (``|θ - θ0| > 0.2 ε/4``) land on branches of ``V`` through ``θ0``. At up to three
    landing points ``θ_i`` with the most different directions (generic, smooth points of
    their branches), steps ``η d`` with ``η = |θ_i|/8`` and ``d`` from ``ker M(θ0)`` are
    projected again: the number of independent directions in which they land is the
    branch's dimension (a smooth point's tangent space; this also holds where the
-   instantaneous mobility stays higher along the branch). The finite mobility is the
-   largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility 0).
+   instantaneous mobility stays higher along the branch), capped at ``dim ker M(θ_i)`` (a
+   landing near where two branches cross along a line would otherwise read both as one
+   wider branch). Once every landing lies in the tangent space of a branch measured
+   (within about 3°), no other is measured: one smooth branch. The finite mobility is
+   the largest. No landing point at all: ``θ0`` is isolated in ``V`` (finite mobility
+   0), or, where projections failed, the motion is "not followed". A projection landing
+   farther than ``3 ε`` from its start jumped to a distant assembly (least-norm steps
+   can spin a free bar by radians): it counts as failed, never as a landing.
 3. **Smooth or singular.** The tangent directions found (landing directions from ``θ0``
    and the branches' tangent spaces) span a space of dimension equal to the finite
    mobility exactly when the tangent cone is one linear space, i.e. ``V`` is a smooth
    manifold at ``θ0``; a larger span (two branches crossing) is a singular
-   configuration. Directions of ``ker M`` outside that span are probed too, to find a
-   second branch the first samples missed. Branches crossing at less than about 17°
-   can be taken for one.
+   configuration. Directions of ``ker M`` at more than about 17° from that span are
+   probed too, to find a second branch the first samples missed. A tangent cone that is
+   only half of its span (a step opposite a landing direction lands nowhere opposite: a
+   cusp's half-line) is singular too. Branches crossing at less than about 17° can be
+   taken for one.
 
 Tolerances: the Gauss-Newton target is ``max(1e-14, min(10 tol ε, (ε/1000)²))`` with
 ``tol`` the rank tolerance (relative to the length scale, see
@@ -58,6 +68,8 @@ References
 .. [3] A. J. Sommese, J. Verschelde and C. W. Wampler, "Numerical decomposition of
    the solution sets of polynomial systems into irreducible components", *SIAM J.
    Numer. Anal.* 38(6), 2022-2046, 2001 (local dimension by nearby witness points).
+.. [4] W. Blaschke, "Wackelige Achtflache", *Math. Z.* 6, 85-93, 1920 (an octahedron is
+   infinitesimally movable when the planes of four alternate faces meet in a point).
 """
 
 from __future__ import annotations
@@ -73,6 +85,10 @@ __all__ = ["LocalMobility", "local_mobility"]
 STEP = 0.04
 _SPAN_EIG = 0.01  # an eigenvalue of Σ v vᵀ above this times the largest is a direction
 _MAX_ITER = 100
+_JUMP = 3.0  # a projection from a step ε lands within about 2ε of the base; farther, it jumped
+_MISSED = 0.3  # sine of the angle beyond which a direction of ker M is missed by the directions found
+_OPPOSITE = 0.87  # cos 30°: a step opposite a landing lands opposite it on a smooth branch
+_ON_BRANCH = 0.05  # a landing within about 3° of a measured branch's tangent space lies on that branch
 
 Step = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray]"]
 Null = Callable[[np.ndarray], "tuple[int, np.ndarray]"]
@@ -128,9 +144,10 @@ def _direction(Nb: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def _extends(proj: _Projector, base: np.ndarray, Nb: np.ndarray, eps: float, rng: np.random.Generator,
-             samples: int) -> bool | None:
-    """Whether random tangent directions at ``base`` extend to finite motions (step 1);
-    None when a projection fails."""
+             samples: int) -> bool:
+    """Whether random tangent directions at ``base`` extend to finite motions (step 1). A
+    projection that finds no assembly near the step (it fails) does not extend it: step 2
+    then says where the motion goes, or that it cannot be followed."""
     floor = max(1e-6, 100.0 * proj.tol)
     for _ in range(samples):
         d = _direction(Nb, rng)
@@ -138,7 +155,7 @@ def _extends(proj: _Projector, base: np.ndarray, Nb: np.ndarray, eps: float, rng
         for e in (eps, eps / 4):
             t = proj(base + e * d, e)
             if t is None:
-                return None
+                return False
             rho.append(float(np.linalg.norm(t - base - e * d)) / e)
         if rho[1] > max(0.6 * rho[0], floor):
             return False
@@ -165,8 +182,8 @@ def _landings(proj: _Projector, base: np.ndarray, Nb: np.ndarray, eps: float, rn
     out, failed = [], 0
     for _ in range(samples):
         t = proj(base + eps * _direction(Nb, rng), eps)
-        if t is None:
-            failed += 1
+        if t is None or np.linalg.norm(t - base) > _JUMP * eps:
+            failed += 1  # diverged, or jumped to a distant assembly: nothing about this neighbourhood
         elif np.linalg.norm(t - base) > 0.2 * eps:
             out.append(t - base)
     return out, failed
@@ -176,15 +193,34 @@ def _branch(proj: _Projector, null: Null, theta: np.ndarray, N: np.ndarray,
             rng: np.random.Generator) -> tuple[int, np.ndarray, int]:
     """Dimension and tangent basis of the branch of ``V`` through its smooth point
     ``theta`` (near ``θ0``), and the loop-closure rank there: the span of the directions in
-    which points ``theta + η d`` (``d`` from ``ker M(θ0)``, ``η = |theta|/8``) land."""
+    which points ``theta + η d`` (``d`` from ``ker M(θ0)``, ``η = |theta|/8``) land. A
+    branch is never wider than the instantaneous motions at ``theta`` (the tangent cone
+    lies in ``ker M(theta)``): steps that reach a second branch, when ``theta`` lies within
+    ``η`` of where two branches cross, count for the widest ``dim ker M(theta)`` only."""
     eta = float(np.linalg.norm(theta)) / 8
     theta = proj(theta, eta / 4)  # on V to within the accuracy the smaller steps need
     if theta is None:
         return 0, np.zeros((N.shape[0], 0)), 0
-    r, _ = null(theta)
+    r, Nt = null(theta)
     moved, _ = _landings(proj, theta, N, eta, rng, N.shape[1] + 4)
     k, T = _span([v / eta for v in moved], theta.size)
+    if k > Nt.shape[1]:  # eigenvectors come in ascending order: keep the widest
+        k, T = Nt.shape[1], T[:, k - Nt.shape[1]:]
     return k, T, r
+
+
+def _one_sided(proj: _Projector, moved: list[np.ndarray], eps: float) -> bool:
+    """Whether the motion leaves ``θ0`` one way only along a landing direction ``u``: the
+    step ``-ε u`` finds no assembly opposite (it fails, jumps, stays near ``θ0`` or lands
+    more than 30° off ``-u``), as on a cusp's half-line or Whitney's umbrella. On a smooth
+    branch both ways land, symmetric to first order."""
+    for i in _diverse(moved, 3):
+        u = moved[i] / np.linalg.norm(moved[i])
+        t = proj(-eps * u, eps)
+        far = 0.0 if t is None else float(np.linalg.norm(t))
+        if not 0.2 * eps < far <= _JUMP * eps or -float(t @ u) < _OPPOSITE * far:
+            return True
+    return False
 
 
 def _diverse(vectors: list[np.ndarray], k: int) -> list[int]:
@@ -234,11 +270,7 @@ def local_mobility(step: Step, null: Null, N: np.ndarray, rank0: int, tol: float
     rng = np.random.default_rng(seed)
     proj = _Projector(step, tol)
     zero = np.zeros(F)
-    ext = _extends(proj, zero, N, eps, rng, 3)
-    if ext is None:
-        return LocalMobility(m, None, "not followed", None, None,
-                             ["the motion could not be followed numerically (closure did not converge)"])
-    if ext:
+    if _extends(proj, zero, N, eps, rng, 3):
         return LocalMobility(m, m, "regular", m, rank0)
     e = eps / 4
     moved, failed = _landings(proj, zero, N, e, rng, min(m + 4, 24))
@@ -253,15 +285,19 @@ def local_mobility(step: Step, null: Null, N: np.ndarray, rank0: int, tol: float
         dims.append(k)
         ranks.append(r)
         dirs.extend(T.T)  # unit tangents of the branch
+        if k and all(np.linalg.norm(v - T @ (T.T @ v)) <= _ON_BRANCH * np.linalg.norm(v) for v in moved):
+            break  # every landing lies in this branch's tangent space: one smooth branch, measured
     finite = max(dims)
     span, S = _span(dirs, F)
     if span <= finite and span < m:  # probe the directions the samples missed
         comp = N - S @ (S.T @ N)
         u, s, _ = np.linalg.svd(comp, full_matrices=False)
-        C = u[:, s > 1e-6]
+        C = u[:, s > _MISSED]  # directions of ker M at more than about 17° from every one found
         extra, _ = _landings(proj, zero, C, e, rng, 2 * C.shape[1] + 2) if C.shape[1] else ([], 0)
         outside = [v for v in extra if np.linalg.norm(v - S @ (S.T @ v)) > 0.3 * np.linalg.norm(v)]
         if outside:
             span = max(span, finite + 1)
     configuration = "singular" if span > finite else ("shaky" if finite < m else "regular")
+    if configuration == "shaky" and finite and _one_sided(proj, moved, e):
+        configuration = "singular"  # the tangent cone is a half-space of its span: not smooth
     return LocalMobility(m, finite, configuration, span, max(ranks) or None)

@@ -114,10 +114,12 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
         out: dict[str, Any] = {
             "mobility": rank.useful_mobility, "instantaneous_mobility": rank.mobility,
             "idle_mobilities": len(rank.idle_mobilities), "redundant_constraints": rank.redundant_constraints,
-            "singular": bool(rank.singular), "finite_mobility": rank.finite_mobility,
-            "source": "exact rank method at the drawn pose"}
+            "singular": bool(rank.singular), "shaky": bool(getattr(rank, "shaky", False)),
+            "finite_mobility": rank.finite_mobility, "source": "exact rank method at the drawn pose"}
         pose = (f"SINGULAR at the drawn pose (finite mobility nearby {rank.finite_mobility})" if rank.singular
-                else "not singular")
+                else f"not singular but SHAKY: finite mobility {rank.finite_mobility}, "
+                     f"{rank.mobility - rank.finite_mobility} instantaneous motion(s) do not extend"
+                if getattr(rank, "shaky", False) else "not singular")
         idle = len(rank.idle_mobilities)
         split = (f" (instantaneous {rank.mobility} = {rank.useful_mobility} useful + {idle} idle)" if idle
                  else " (no idle mobility)")
@@ -128,7 +130,7 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
     q = a.formulas["ozol_redundant"].value if planar else a.redundant_constraints
     idle = None if planar else a.idle_mobilities
     out = {"mobility": a.mobility, "instantaneous_mobility": None, "idle_mobilities": idle,
-           "redundant_constraints": q, "singular": None, "finite_mobility": None,
+           "redundant_constraints": q, "singular": None, "shaky": None, "finite_mobility": None,
            "source": f"formulas, {a.kind} reading (no rank method)"}
     idle_text = "idle mobilities unknown without the joints' geometry" if idle is None else f"{idle} idle"
     out["text"] = (f"mobility W = {_fmt(a.mobility)}, {_fmt(q) if q is not None else 'n/a'} redundant "
