@@ -27,11 +27,11 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, decompose
-from mechsyn.kinematics.solve import assemble, singular_configuration
+from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
 from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
-from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system, topology_key, with_geometry
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
@@ -77,6 +77,11 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
 _PLANS: "OrderedDict[int, tuple[Mechanism, dict]]" = OrderedDict()
 _PLANS_LOCK = threading.Lock()
 _PLANS_MAX = 8
+#: A compiled plan of each of the last topologies simulated
+#: (:func:`~mechsyn.kinematics.system.topology_key`): a mechanism of the same topology
+#: with other numbers (a drag, a design loop) has its system refilled from it.
+_TOPOLOGIES: "OrderedDict[tuple, KinematicPlan]" = OrderedDict()
+_TOPOLOGIES_MAX = 32
 
 
 def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> tuple:
@@ -162,14 +167,22 @@ class KinematicPlan:
         """The same mechanism with some joints moved (``{joint id: (x, y)}``), reusing the
         solution plan: only the geometry (link frames, lengths, drawn configuration) is
         rebuilt. Named points keep their drawn positions."""
-        mech = self.mechanism
-        for jid in points:
-            mech.joint(jid)  # KeyError names an unknown joint
-        joints = tuple(replace(j, point=np.asarray(points[j.id], float)) if j.id in points else j
-                       for j in mech.joints)
-        new = mech.with_joints(joints)
-        S = build_system(new, vll=self.vll, prescribed=self.prescribed)
-        return KinematicPlan(new, S, self.groups, self.vll, self.prescribed)
+        return self.refilled(self.mechanism.with_joint_points(points))
+
+    def refilled(self, mech: Mechanism) -> "KinematicPlan":
+        """The plan of ``mech``, a mechanism of this plan's topology
+        (:func:`~mechsyn.kinematics.system.topology_key`) with other numbers: the
+        constraint system refilled with its geometry
+        (:func:`~mechsyn.kinematics.system.with_geometry`, built anew for cams, gears and
+        belts) and the same decomposition, found anew only where it depends on the
+        geometry (a double joint is two R pairs at one point)."""
+        S = with_geometry(self.system, mech)
+        if S is None:
+            S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
+        groups = self.groups
+        if groups is None or any(s.data for s in groups.steps):
+            groups = decompose(S)
+        return KinematicPlan(mech, S, groups, self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
                  points: list[str] | None = None, method: str = "auto", progress: Any = None,
@@ -182,8 +195,21 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
     """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
     input values, which decides whether a passive VLL is prescribed)."""
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    key = topology_key(mech, vll, prescribed)
+    with _PLANS_LOCK:
+        template = _TOPOLOGIES.get(key)
+        if template is not None:
+            _TOPOLOGIES.move_to_end(key)
+    if template is not None and all(j.point is not None and (j.type != "P" or j.axis is not None)
+                                    for j in mech.joints):
+        return template.refilled(mech)
     S = build_system(mech, vll=vll, prescribed=prescribed)
-    return KinematicPlan(mech, S, decompose(S), vll, prescribed)
+    kp = KinematicPlan(mech, S, decompose(S), vll, prescribed)
+    with _PLANS_LOCK:
+        _TOPOLOGIES[key] = kp
+        while len(_TOPOLOGIES) > _TOPOLOGIES_MAX:
+            _TOPOLOGIES.popitem(last=False)
+    return kp
 
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
@@ -250,7 +276,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if change_points == "switch" and plan is None:
         raise MechsynInputError("change_points='switch' needs the closed form (a mechanism of drivers and dyads)",
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
-    if plan is not None:
+    if plan is not None and not drawn_checks(S, plan):
         assemble(S)  # checks the file configuration and the mobility
     sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
     events = list(sw.events)
