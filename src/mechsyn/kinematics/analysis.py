@@ -180,6 +180,11 @@ class KinematicPlan:
         if S is None:
             S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
         groups = self.groups
+        if groups is not None and any(s.data for s in groups.steps):
+            new = KinematicPlan(mech, S, groups, self.vll, self.prescribed)
+            pairs = _joint_pairs(self)
+            if _coincident(new, pairs) == _coincident(self, pairs):
+                return new
         if groups is None or any(s.data for s in groups.steps):
             groups = decompose(S)
         return KinematicPlan(mech, S, groups, self.vll, self.prescribed)
@@ -189,6 +194,31 @@ class KinematicPlan:
                  change_points: str = "keep") -> Simulation:
         """The sweep of :func:`simulate` with this plan."""
         return _simulate_plan(self, inputs, speeds, points, method, progress, change_points)
+
+
+def _coincident(kp: "KinematicPlan", pairs: tuple[np.ndarray, np.ndarray]) -> bytes:
+    """Which of the pairs of R joints sharing a link (``pairs``: their indices, see
+    :func:`_joint_pairs`) are at one point (within 1e-9 of the size, as
+    :func:`~mechsyn.kinematics.groups.decompose` tests for a double joint): the only
+    geometry a decomposition depends on (kept with the plan's system)."""
+    memo = kp.system.cache.get("coincident")
+    if memo is None:
+        ia, ib = pairs
+        pts = np.array([j.point for j in kp.mechanism.joints], float)
+        memo = kp.system.cache["coincident"] = (
+            np.abs(pts[ia] - pts[ib]).max(axis=1) <= 1e-9 * kp.system.scale).tobytes()
+    return memo
+
+
+def _joint_pairs(kp: "KinematicPlan") -> tuple[np.ndarray, np.ndarray]:
+    """The indices of every pair of R joints that share a link (kept with the template)."""
+    memo = kp.system.cache.get("joint_pairs")
+    if memo is None:
+        joints = kp.mechanism.joints
+        r = [k for k, j in enumerate(joints) if j.type == "R"]
+        pairs = [(a, b) for i, a in enumerate(r) for b in r[i + 1:] if set(joints[a].links) & set(joints[b].links)]
+        memo = kp.system.cache["joint_pairs"] = tuple(np.array(pairs, int).reshape(-1, 2).T)
+    return memo
 
 
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
@@ -315,15 +345,13 @@ def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_
     rates NaN where not defined)."""
     # no NaN to clear or to restore (the regular pass assembles every row with rates)
     whole = (True, True) if sw.links is not None else (bool(ok.all()), bool(rates_ok.all()))
-    q = sw.q if whole[0] else np.nan_to_num(sw.q)
-    qd, qdd = (sw.qd, sw.qdd) if all(whole) else (np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd))
     pm = {}
     for name, (link, at) in pts.items():
         i = S.index(link)
         if sw.links is not None and i >= 0:  # the regular pass: complex states of the links
             P, V, A = sw.links.point(i, S.to_local(link, at))
-        else:
-            P, V, A = S.point_state(q, qd, qdd, i, S.to_local(link, at))
+        else:  # NaN rows stay NaN row by row (and are set NaN below)
+            P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, S.to_local(link, at))
         if not whole[0]:
             for arr in (P, V, A):
                 arr[~ok] = np.nan

@@ -153,7 +153,9 @@ def drawn_checks(S: PlanarSystem, plan: Any) -> bool:
     cases are settled here: the sine below 1e-13 (singular) or the sine times the shorter
     link above 1e-5 of the mechanism's size (regular), links not shorter than 1e-3 of it;
     a degenerate link (coincident joints), a group near a fold and every other plan go to
-    the general test, so the answers and messages are those of :func:`assemble`.
+    the general test, so the answers and messages are those of :func:`assemble`. A group
+    whose middle joint is a double joint (two R pairs at one point) is tested the same way
+    at that point.
 
     Examples
     --------
@@ -163,7 +165,8 @@ def drawn_checks(S: PlanarSystem, plan: Any) -> bool:
     >>> drawn_checks(kp.system, kp.groups), singular_configuration(kp.system)
     (True, False)
     """
-    if plan is None or S.m != S.n or not all(s.kind in ("drive_R", "RRR") and not s.data for s in plan.steps):
+    if plan is None or S.m != S.n or not all(s.kind in ("drive_R", "RRR") and set(s.data) <= {"double"}
+                                             for s in plan.steps):
         return False
     pts = {j.id: j.point for j in S.mech.joints}
     singular = False

@@ -46,6 +46,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -231,13 +232,21 @@ class PlanarSystem:
     def index(self, link: str) -> int:
         return -1 if link == self.mech.ground else self.links.index(link)
 
+    def frames(self) -> tuple[list, list, list]:
+        """``cos(-phi0)``, ``sin(-phi0)`` and the origin of every link's drawn frame, as
+        Python numbers (one point carried into a frame costs a few float products)."""
+        f = self.cache.get("frames")
+        if f is None:
+            f = self.cache["frames"] = (np.cos(-self.angle0).tolist(), np.sin(-self.angle0).tolist(),
+                                        self.origin0.tolist())
+        return f
+
     def to_local(self, link: str, p: np.ndarray) -> np.ndarray:
         i = self.index(link)
         if i < 0:
             return np.asarray(p, float)
-        c, s = np.cos(-self.angle0[i]), np.sin(-self.angle0[i])
-        d = np.asarray(p, float) - self.origin0[i]
-        return np.array([c * d[0] - s * d[1], s * d[0] + c * d[1]])
+        cos, sin, org = self.frames()
+        return _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
 
     def pose(self, q: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
         """(r (N,2), phi (N,)) of link ``i`` (frame: zeros)."""
@@ -302,8 +311,8 @@ class PlanarSystem:
         i = self.index(link)
         if i < 0:
             return np.asarray(u, float)
-        c, s = np.cos(-self.angle0[i]), np.sin(-self.angle0[i])
-        return np.array([c * u[0] - s * u[1], s * u[0] + c * u[1]])
+        cos, sin, _ = self.frames()
+        return _to_frame(cos[i], sin[i], u[0], u[1])
 
     # -- equations -----------------------------------------------------------------
     def residual(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -356,6 +365,11 @@ class PlanarSystem:
                 rows.extend(range(row, row + con.rows))
             row += con.rows
         return rows
+
+
+def _to_frame(c: float, s: float, dx: float, dy: float) -> np.ndarray:
+    """The vector ``(dx, dy)`` turned by the angle whose cosine and sine are ``c``, ``s``."""
+    return np.array([c * dx - s * dy, s * dx + c * dy], float)
 
 
 def _one(S: PlanarSystem) -> Any:
@@ -653,14 +667,14 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     joints = mech.joints
     pts = [j.point for j in joints]
     allpts = np.array(pts + [p.at for p in mech.points.values()], float)
-    scale = float(max(np.ptp(allpts, axis=0).max(), 1e-9)) if len(allpts) > 1 else 1.0
+    scale = float(max((allpts.max(axis=0) - allpts.min(axis=0)).max(), 1e-9)) if len(allpts) > 1 else 1.0
     nl = len(T.links)
     origin0 = allpts[first] if nl else np.zeros((0, 2))
     angle0 = np.zeros(nl)
     for i, ks in enumerate(other):  # towards the first other joint point (as _link_frames)
         for k in ks:
             d = pts[k] - origin0[i]
-            if np.linalg.norm(d) > 1e-12 * scale:
+            if math.hypot(d[0], d[1]) > 1e-12 * scale:
                 angle0[i] = _dir_angle(d)
                 break
     cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
@@ -669,8 +683,8 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     def loc(i: int, p: Any, direction: bool = False) -> np.ndarray:  # S.to_local / to_local_dir
         if i < 0:
             return np.asarray(p, float)
-        dx, dy = (p[0], p[1]) if direction else (p[0] - org[i][0], p[1] - org[i][1])
-        return np.array([cos[i] * dx - sin[i] * dy, sin[i] * dx + cos[i] * dy])
+        return _to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
+            _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
 
     cons, drivers = _refilled(T, mech, loc, ang, org)
     q0 = np.empty(3 * nl)
@@ -679,7 +693,7 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     cols = np.ones(len(q0))
     cols[0::3] = cols[1::3] = scale
     return PlanarSystem(mech, T.links, origin0, angle0, cons, drivers, T.n, T.m, q0, scale, vll=dict(T.vll),
-                        notes=T.notes, row_scale=rows, col_scale=cols)
+                        notes=T.notes, row_scale=rows, col_scale=cols, cache={"frames": (cos, sin, org)})
 
 
 def _layout(T: PlanarSystem) -> tuple | bool:
@@ -786,7 +800,7 @@ def _link_frames(mech: Mechanism) -> tuple[np.ndarray, np.ndarray, float]:
                for j in mech.joints_of(name)]
         origin0[i] = pts[0]
         for p in pts[1:]:
-            if np.linalg.norm(p - pts[0]) > 1e-12 * scale:
+            if math.hypot(*(p - pts[0])) > 1e-12 * scale:
                 angle0[i] = _dir_angle(p - pts[0])
                 break
     return origin0, angle0, scale
