@@ -13,10 +13,11 @@ import pytest
 from kinematics_helpers import driven_planar_examples, fourbar
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import analysis
-from mechsyn.kinematics import system as system_mod
+from mechsyn.kinematics import refill
 from mechsyn.kinematics.analysis import compile_plan, simulate
 from mechsyn.kinematics.solve import drawn_checks, singular_configuration
-from mechsyn.kinematics.system import build_system, topology_key
+from mechsyn.kinematics.refill import topology_key
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism, PointSpec
 
 SINGULAR_NOTE = "the file's configuration is singular"
@@ -137,7 +138,7 @@ def test_refilled_system_equals_a_built_one():
         except MechsynInputError:
             continue
         moved = _moved(m, rng)
-        S = system_mod.with_geometry(T, moved)
+        S = refill.with_geometry(T, moved)
         if S is None:  # cams, gears, belts: built anew
             assert any(c.kind not in ("R", "angle", "line") for c in T.cons)
             continue

@@ -31,7 +31,8 @@ from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configurat
 from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
-from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system, topology_key, with_geometry
+from mechsyn.kinematics.refill import topology_key, with_geometry
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
@@ -78,7 +79,7 @@ _PLANS: "OrderedDict[int, tuple[Mechanism, dict]]" = OrderedDict()
 _PLANS_LOCK = threading.Lock()
 _PLANS_MAX = 8
 #: A compiled plan of each of the last topologies simulated
-#: (:func:`~mechsyn.kinematics.system.topology_key`): a mechanism of the same topology
+#: (:func:`~mechsyn.kinematics.refill.topology_key`): a mechanism of the same topology
 #: with other numbers (a drag, a design loop) has its system refilled from it.
 _TOPOLOGIES: "OrderedDict[tuple, KinematicPlan]" = OrderedDict()
 _TOPOLOGIES_MAX = 32
@@ -171,9 +172,9 @@ class KinematicPlan:
 
     def refilled(self, mech: Mechanism) -> "KinematicPlan":
         """The plan of ``mech``, a mechanism of this plan's topology
-        (:func:`~mechsyn.kinematics.system.topology_key`) with other numbers: the
+        (:func:`~mechsyn.kinematics.refill.topology_key`) with other numbers: the
         constraint system refilled with its geometry
-        (:func:`~mechsyn.kinematics.system.with_geometry`, built anew for cams, gears and
+        (:func:`~mechsyn.kinematics.refill.with_geometry`, built anew for cams, gears and
         belts) and the same decomposition, found anew only where it depends on the
         geometry (a double joint is two R pairs at one point)."""
         S = with_geometry(self.system, mech)

@@ -53,11 +53,12 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.cams import CamCurve, _cam_curve
 from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
 
-__all__ = ["PlanarSystem", "build_system", "VLL_MODES", "CamCurve", "topology_key", "with_geometry"]
+__all__ = ["PlanarSystem", "build_system", "VLL_MODES", "CamCurve"]
 
 #: Accepted spellings of the VLL modes on the command line.
 VLL_MODES = {"active": "active", "driven": "active", "passive": "passive", "free": "passive",
@@ -88,76 +89,6 @@ def _perp(v: np.ndarray) -> np.ndarray:
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
-
-
-# --------------------------------------------------------------------------- cams
-@dataclass(frozen=True)
-class CamCurve:
-    """The curve the roller centre follows on the cam (profile offset by the roller radius).
-
-    ``kind`` is ``"circle"`` (an eccentric disc: exact) or ``"spline"`` (a periodic cubic
-    spline through the offset of the profile points), in the cam's local frame.
-    """
-
-    kind: str
-    center: np.ndarray | None = None
-    radius: float = 0.0
-    spline: Any = None
-    period: float = 2 * np.pi
-
-    def eval(self, t: np.ndarray, der: int = 0) -> np.ndarray:
-        if self.kind == "circle":
-            ang = t + der * np.pi / 2
-            out = self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
-            return out + (self.center if der == 0 else 0.0)
-        return self.spline(np.mod(t, self.period), der)
-
-    def closest(self, p: np.ndarray) -> float:
-        """Parameter of the curve point nearest ``p`` (local coordinates)."""
-        if self.kind == "circle":
-            d = p - self.center
-            return float(np.arctan2(d[1], d[0]))
-        ts = np.linspace(0, self.period, 4001)
-        pts = self.eval(ts)
-        return float(ts[np.argmin(np.sum((pts - p) ** 2, axis=1))])
-
-
-def _cam_curve(profile: Any, center_local: np.ndarray, rho: float, contact_local: np.ndarray,
-               to_local: Any, source: str, jid: str) -> CamCurve:
-    """Build the offset curve followed by the roller centre from the joint's profile."""
-    from scipy.interpolate import make_interp_spline
-
-    if isinstance(profile, dict) and "points" in profile:  # a polar function, sampled
-        profile = profile["points"]
-    if isinstance(profile, dict):
-        c = to_local(np.asarray(profile["center"], float))
-        r = float(profile["radius"])
-        d = float(np.linalg.norm(center_local - c))
-        # roller outside (r + rho) or inside (r - rho) the disc: whichever matches
-        r_off = r + rho if abs(d - (r + rho)) <= abs(d - abs(r - rho)) else abs(r - rho)
-        return CamCurve("circle", center=c, radius=r_off)
-    pts = np.array([to_local(np.asarray(p, float)) for p in profile])
-    if np.allclose(pts[0], pts[-1]):
-        pts = pts[:-1]
-    closed = np.vstack([pts, pts[:1]])
-    t = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
-    if np.any(np.diff(t) <= 0):
-        raise MechsynInputError(f"cam profile of joint {jid} repeats a point", source=source,
-                                field=f"joints.{jid}.profile", hint="list distinct points round the cam")
-    spl = make_interp_spline(t, closed, k=3, bc_type="periodic")
-    if rho == 0:
-        return CamCurve("spline", spline=spl, period=float(t[-1]))
-    ts = np.linspace(0, t[-1], 16 * len(pts) + 400, endpoint=False)
-    p, d1 = spl(ts), spl(ts, 1)
-    nrm = np.stack([d1[:, 1], -d1[:, 0]], axis=1) / np.linalg.norm(d1, axis=1)[:, None]
-    # offset to the side where the roller centre is
-    k = int(np.argmin(np.sum((p - contact_local) ** 2, axis=1)))
-    sign = 1.0 if _dot(nrm[k], center_local - p[k]) >= 0 else -1.0
-    off = p + sign * rho * nrm
-    off_closed = np.vstack([off, off[:1]])
-    to = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(off_closed, axis=0), axis=1))])
-    spl2 = make_interp_spline(to, off_closed, k=3, bc_type="periodic")
-    return CamCurve("spline", spline=spl2, period=float(to[-1]))
 
 
 # --------------------------------------------------------------------------- constraints
@@ -574,8 +505,6 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
     raise AssertionError(k)
 
 
-
-
 # --------------------------------------------------------------------------- building
 def _dir_angle(v: np.ndarray) -> float:
     return float(np.arctan2(v[1], v[0]))
@@ -618,134 +547,6 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
     cols[0:3 * n_links:3] = cols[1:3 * n_links:3] = scale
     return PlanarSystem(mech, tuple(moving), origin0, angle0, tuple(b.cons), tuple(b.drivers), len(q0), m, q0,
                         scale, vll=modes, notes=tuple(b.notes), row_scale=rows, col_scale=cols)
-
-
-def topology_key(mech: Mechanism, vll: dict[str, str] | None = None, prescribed: tuple[str, ...] = ()) -> tuple:
-    """What a compiled system depends on besides the numbers of the geometry: the kind,
-    the links (frame first), every joint's id, pair type, links, drive, VLL mode, ratio
-    and extra attributes, the VLL modes asked for and the prescribed inputs. Two
-    mechanisms with the same key differ only in their joint points, P axes and named
-    points, so :func:`with_geometry` fills one's numbers into the other's system.
-
-    Examples
-    --------
-    >>> import mechsyn as ms
-    >>> m = ms.examples.load("crank_rocker")
-    >>> moved = m.with_joint_points({"C": (3.1, 2.9)})
-    >>> topology_key(moved) == topology_key(m)
-    True
-    """
-    joints = tuple((j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "")
-                   for j in mech.joints)
-    named = tuple((k, p.link) for k, p in mech.points.items())
-    return (mech.kind, mech.ground, mech.link_names, joints, named, tuple(sorted((vll or {}).items())),
-            tuple(prescribed))
-
-
-def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
-    """The system of ``mech`` built from ``T``, the system of a mechanism of the same
-    :func:`topology_key`: the same constraints, drivers and notes with the numbers of
-    ``mech``'s joint points (link frames, local points, drawn angles and slide
-    coordinates, length scale), equal to :func:`build_system`'s; None when ``T`` has
-    blocks other than R pairs, angles and lines (cams, gears, belts: built anew).
-
-    Examples
-    --------
-    >>> import numpy as np, mechsyn as ms
-    >>> m = ms.examples.load("crank_rocker")
-    >>> moved = m.with_joint_points({"C": (3.1, 2.9)})
-    >>> S = with_geometry(build_system(m), moved)
-    >>> bool(np.array_equal(S.q0, build_system(moved).q0))
-    True
-    """
-    lay = T.cache.get("layout")
-    if lay is None:
-        lay = T.cache["layout"] = _layout(T)
-    if lay is False:
-        return None
-    first, other, lengths = lay
-    joints = mech.joints
-    pts = [j.point for j in joints]
-    allpts = np.array(pts + [p.at for p in mech.points.values()], float)
-    scale = float(max((allpts.max(axis=0) - allpts.min(axis=0)).max(), 1e-9)) if len(allpts) > 1 else 1.0
-    nl = len(T.links)
-    origin0 = allpts[first] if nl else np.zeros((0, 2))
-    angle0 = np.zeros(nl)
-    for i, ks in enumerate(other):  # towards the first other joint point (as _link_frames)
-        for k in ks:
-            d = pts[k] - origin0[i]
-            if math.hypot(d[0], d[1]) > 1e-12 * scale:
-                angle0[i] = _dir_angle(d)
-                break
-    cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
-    org, ang = origin0.tolist(), angle0.tolist()
-
-    def loc(i: int, p: Any, direction: bool = False) -> np.ndarray:  # S.to_local / to_local_dir
-        if i < 0:
-            return np.asarray(p, float)
-        return _to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
-            _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
-
-    cons, drivers = _refilled(T, mech, loc, ang, org)
-    q0 = np.empty(3 * nl)
-    q0[0::3], q0[1::3], q0[2::3] = origin0[:, 0], origin0[:, 1], angle0
-    rows = np.where(lengths, scale, 1.0)
-    cols = np.ones(len(q0))
-    cols[0::3] = cols[1::3] = scale
-    return PlanarSystem(mech, T.links, origin0, angle0, cons, drivers, T.n, T.m, q0, scale, vll=dict(T.vll),
-                        notes=T.notes, row_scale=rows, col_scale=cols, cache={"frames": (cos, sin, org)})
-
-
-def _layout(T: PlanarSystem) -> tuple | bool:
-    """Joint indices of every moving link's frame (its first joint, then the others in
-    file order), or False when ``T`` cannot be refilled (see :func:`with_geometry`)."""
-    mech = T.mech
-    if T.n != 3 * len(T.links) or any(c.kind not in ("R", "angle", "line") for c in T.cons):
-        return False
-    index = {j.id: k for k, j in enumerate(mech.joints)}
-    first, other = [], []
-    for name in T.links:
-        ks = [index[j.id] for j in mech.joints_of(name)]
-        first.append(ks[0])
-        other.append(ks[1:])
-    lengths = np.concatenate([np.full(c.rows, c.kind != "angle") for c in T.cons]) if T.cons else np.zeros(0, bool)
-    return first, other, lengths
-
-
-def _refilled(T: PlanarSystem, mech: Mechanism, loc: Any, ang: list, org: list) -> tuple[tuple, tuple]:
-    """``T``'s constraints and drivers with the numbers of ``mech`` (see :func:`_Builder`)."""
-    joint = {j.id: j for j in mech.joints}
-    drawn = {d.joint: d for d in T.drivers}
-    drivers = list(T.drivers)
-    cons = []
-
-    def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)
-        return float((0.0 if b < 0 else ang[b]) - (0.0 if a < 0 else ang[a]))
-
-    for c in T.cons:
-        j = joint[c.joint]
-        a, b = c.a, c.b
-        if c.kind == "R":
-            cons.append(Con("R", c.joint, 2, a, b, sa=loc(a, j.point), sb=loc(b, j.point), role=c.role))
-            continue
-        if c.kind == "angle":
-            if c.role == "drive":
-                drivers[c.driver] = replace(drawn[c.joint], assembled=rel(b, a))
-            cons.append(replace(c, c0=rel(b, a)) if c.role == "rotation" else c)
-            continue
-        u = _axis(j)
-        u_loc = loc(a, u, direction=True)
-        if c.role == "pair":
-            cons.append(Con("line", c.joint, 1, a, b, sa=loc(a, j.point), sb=loc(b, j.point),
-                            w=np.array([-u_loc[1], u_loc[0]]), role="pair"))
-            continue
-        o_a = np.zeros(2) if a < 0 else np.asarray(org[a])
-        s0 = float(u @ (j.point - o_a))
-        if c.driver is not None:
-            drivers[c.driver] = replace(drawn[c.joint], assembled=s0)
-        cons.append(Con("line", c.joint, 1, a, b, sa=np.zeros(2), sb=loc(b, j.point), w=u_loc,
-                        c0=s0 if c.role == "lock" else 0.0, driver=c.driver, role=c.role))
-    return tuple(cons), tuple(drivers)
 
 
 def _check_joints(mech: Mechanism, src: str) -> None:

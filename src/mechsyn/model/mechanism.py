@@ -309,7 +309,7 @@ class Mechanism:
         """The same mechanism with some joints moved (``{joint id: (x, y)}``): only
         numbers change (no parsing, no validation of the structure), so a simulation of
         the result reuses the compiled program of every mechanism of the same topology
-        (:func:`mechsyn.kinematics.system.topology_key`). Named points keep their drawn
+        (:func:`mechsyn.kinematics.refill.topology_key`). Named points keep their drawn
         positions. An unknown joint or a point that is not ``dim`` finite numbers raises
         :class:`~mechsyn.errors.MechsynInputError`.
 
