@@ -255,3 +255,66 @@ def test_with_joint_points_checks_its_numbers():
     moved = m.with_joint_points({"C": [3.0, 2.5]})
     assert moved.joint("C").point.tolist() == [3.0, 2.5] and m.joint("C").point.tolist() != [3.0, 2.5]
     assert topology_key(moved) == topology_key(m)
+
+
+# ------------------------------------------------------------------ the studio's drag
+def _drag_request(name: str = "watt_sixbar") -> dict:
+    import json
+
+    from mechsyn.io import load_mechanism, mechanism_to_dict
+    from mechsyn.web._service import example_path
+
+    return json.loads(json.dumps(mechanism_to_dict(load_mechanism(example_path(name)))))
+
+
+def _with_point(data: dict, jid: str, dx: float) -> dict:
+    import copy
+
+    out = copy.deepcopy(data)
+    j = next(j for j in out["joints"] if j["id"] == jid)
+    j["point"] = [j["point"][0] + dx, j["point"][1]]
+    return out
+
+
+def test_drag_request_skips_parsing_and_answers_as_the_worker(monkeypatch):
+    from mechsyn.web import _service
+
+    data = _drag_request()
+    first = _service.quick_simulate(data, 90, None, False)
+    assert first == _service.simulate(data, 90, None, False)
+    calls = []
+    real = _service.build
+    monkeypatch.setattr(_service, "build", lambda d: calls.append(1) or real(d))
+    for k in range(1, 4):
+        moved = _with_point(data, "E", 0.01 * k)
+        got = _service.quick_simulate(moved, 90, None, k % 2 == 0)
+        assert got == _service.simulate(moved, 90, None, k % 2 == 0)
+    assert len(calls) == 3  # the three reference simulate() calls: the quick path parsed nothing
+
+
+@pytest.mark.parametrize("case", ["boolean", "null", "zero-length link", "steps", "topology"])
+def test_drag_request_refusals_go_to_the_worker(case):
+    from mechsyn.web import _service
+
+    data = _drag_request("fourbar")
+    assert _service.quick_simulate(data, 36) is not None  # the topology is known
+    bad, steps = _with_point(data, "C", 0.0), 36
+    joint = next(j for j in bad["joints"] if j["id"] == "C")
+    if case == "boolean":
+        joint["point"] = [True, 1.0]
+    elif case == "null":
+        joint["point"] = None
+    elif case == "zero-length link":  # the coupler's joints B and C at one point
+        joint["point"] = next(j for j in bad["joints"] if j["id"] == "B")["point"]
+    elif case == "steps":
+        steps = 10 ** 6
+    else:  # another pair type: parsed anew, answered in-process when it has a plan
+        joint["type"] = "P"
+        joint["axis"] = [1.0, 0.0]
+    got = _service.quick_simulate(bad, steps)
+    if case == "topology":
+        assert got is None or got == _service.simulate(bad, steps)
+        return
+    assert got is None
+    with pytest.raises(MechsynInputError):
+        _service.simulate(bad, steps)
