@@ -165,6 +165,15 @@ def drawn_checks(S: PlanarSystem, plan: Any) -> bool:
     >>> drawn_checks(kp.system, kp.groups), singular_configuration(kp.system)
     (True, False)
     """
+    memo = S.cache.get("drawn_checks")
+    if memo is not None and memo[0] is plan:
+        return memo[1]
+    settled = _drawn_checks(S, plan)
+    S.cache["drawn_checks"] = (plan, settled)
+    return settled
+
+
+def _drawn_checks(S: PlanarSystem, plan: Any) -> bool:
     if plan is None or S.m != S.n or not all(s.kind in ("drive_R", "RRR") and set(s.data) <= {"double"}
                                              for s in plan.steps):
         return False
