@@ -25,6 +25,10 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.results import to_jsonable
 
 MAX_STEPS = 2000
+#: The largest mechanism :func:`quick_simulate` answers in the server's process (a
+#: linkage drawn by hand; larger files, whose parse and sweep take longer, go to a worker
+#: that is stopped when its client leaves).
+QUICK_JOINTS = 64
 EXAMPLE_SUFFIXES = (".yaml", ".yml", ".json")
 
 
@@ -279,8 +283,8 @@ def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
     """:func:`simulate` of a mechanism of drivers and dyads, fast enough to run in the
     server's own process (a drag's repaint); None where a worker process must run it
     (any input error, so that it is reported as by :func:`simulate`; a mechanism that
-    needs the Newton continuation, a cam, a gear or a belt; a topology whose numbers the
-    reader changes, e.g. units).
+    needs the Newton continuation, a cam, a gear or a belt; more than
+    :data:`QUICK_JOINTS` joints; a topology whose numbers the reader changes, e.g. units).
 
     A request whose topology was parsed before is not parsed again: its joint points and
     named points are put into the parsed mechanism
@@ -331,7 +335,7 @@ def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
 def _numbers(data: Any) -> tuple[str, dict, dict] | None:
     """(the request's topology as text, joint points, named points' coordinates), or None
     when the request is not a mechanism object of that shape."""
-    if not isinstance(data, dict) or not isinstance(data.get("joints"), list):
+    if not isinstance(data, dict) or not isinstance(data.get("joints"), list) or len(data["joints"]) > QUICK_JOINTS:
         return None
     named = data.get("points") or {}
     if not isinstance(named, dict) or not all(isinstance(j, dict) for j in data["joints"]) \
