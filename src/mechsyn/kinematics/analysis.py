@@ -27,10 +27,11 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, decompose
-from mechsyn.kinematics.solve import assemble, singular_configuration
+from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
 from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.refill import topology_key, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
 from mechsyn.model.mechanism import Mechanism
 
@@ -77,6 +78,11 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
 _PLANS: "OrderedDict[int, tuple[Mechanism, dict]]" = OrderedDict()
 _PLANS_LOCK = threading.Lock()
 _PLANS_MAX = 8
+#: A compiled plan of each of the last topologies simulated
+#: (:func:`~mechsyn.kinematics.refill.topology_key`): a mechanism of the same topology
+#: with other numbers (a drag, a design loop) has its system refilled from it.
+_TOPOLOGIES: "OrderedDict[tuple, KinematicPlan]" = OrderedDict()
+_TOPOLOGIES_MAX = 32
 
 
 def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> tuple:
@@ -162,14 +168,27 @@ class KinematicPlan:
         """The same mechanism with some joints moved (``{joint id: (x, y)}``), reusing the
         solution plan: only the geometry (link frames, lengths, drawn configuration) is
         rebuilt. Named points keep their drawn positions."""
-        mech = self.mechanism
-        for jid in points:
-            mech.joint(jid)  # KeyError names an unknown joint
-        joints = tuple(replace(j, point=np.asarray(points[j.id], float)) if j.id in points else j
-                       for j in mech.joints)
-        new = mech.with_joints(joints)
-        S = build_system(new, vll=self.vll, prescribed=self.prescribed)
-        return KinematicPlan(new, S, self.groups, self.vll, self.prescribed)
+        return self.refilled(self.mechanism.with_joint_points(points))
+
+    def refilled(self, mech: Mechanism) -> "KinematicPlan":
+        """The plan of ``mech``, a mechanism of this plan's topology
+        (:func:`~mechsyn.kinematics.refill.topology_key`) with other numbers: the
+        constraint system refilled with its geometry
+        (:func:`~mechsyn.kinematics.refill.with_geometry`, built anew for cams, gears and
+        belts) and the same decomposition, found anew only where it depends on the
+        geometry (a double joint is two R pairs at one point)."""
+        S = with_geometry(self.system, mech)
+        if S is None:
+            S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
+        groups = self.groups
+        if groups is not None and any(s.data for s in groups.steps):
+            new = KinematicPlan(mech, S, groups, self.vll, self.prescribed)
+            pairs = _joint_pairs(self)
+            if _coincident(new, pairs) == _coincident(self, pairs):
+                return new
+        if groups is None or any(s.data for s in groups.steps):
+            groups = decompose(S)
+        return KinematicPlan(mech, S, groups, self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
                  points: list[str] | None = None, method: str = "auto", progress: Any = None,
@@ -178,12 +197,50 @@ class KinematicPlan:
         return _simulate_plan(self, inputs, speeds, points, method, progress, change_points)
 
 
+def _coincident(kp: "KinematicPlan", pairs: tuple[np.ndarray, np.ndarray]) -> bytes:
+    """Which of the pairs of R joints sharing a link (``pairs``: their indices, see
+    :func:`_joint_pairs`) are at one point (within 1e-9 of the size, as
+    :func:`~mechsyn.kinematics.groups.decompose` tests for a double joint): the only
+    geometry a decomposition depends on (kept with the plan's system)."""
+    memo = kp.system.cache.get("coincident")
+    if memo is None:
+        ia, ib = pairs
+        pts = np.array([j.point for j in kp.mechanism.joints], float)
+        memo = kp.system.cache["coincident"] = (
+            np.abs(pts[ia] - pts[ib]).max(axis=1) <= 1e-9 * kp.system.scale).tobytes()
+    return memo
+
+
+def _joint_pairs(kp: "KinematicPlan") -> tuple[np.ndarray, np.ndarray]:
+    """The indices of every pair of R joints that share a link (kept with the template)."""
+    memo = kp.system.cache.get("joint_pairs")
+    if memo is None:
+        joints = kp.mechanism.joints
+        r = [k for k, j in enumerate(joints) if j.type == "R"]
+        pairs = [(a, b) for i, a in enumerate(r) for b in r[i + 1:] if set(joints[a].links) & set(joints[b].links)]
+        memo = kp.system.cache["joint_pairs"] = tuple(np.array(pairs, int).reshape(-1, 2).T)
+    return memo
+
+
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
     """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
     input values, which decides whether a passive VLL is prescribed)."""
     prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    key = topology_key(mech, vll, prescribed)
+    with _PLANS_LOCK:
+        template = _TOPOLOGIES.get(key)
+        if template is not None:
+            _TOPOLOGIES.move_to_end(key)
+    if template is not None and all(j.point is not None and (j.type != "P" or j.axis is not None)
+                                    for j in mech.joints):
+        return template.refilled(mech)
     S = build_system(mech, vll=vll, prescribed=prescribed)
-    return KinematicPlan(mech, S, decompose(S), vll, prescribed)
+    kp = KinematicPlan(mech, S, decompose(S), vll, prescribed)
+    with _PLANS_LOCK:
+        _TOPOLOGIES[key] = kp
+        while len(_TOPOLOGIES) > _TOPOLOGIES_MAX:
+            _TOPOLOGIES.popitem(last=False)
+    return kp
 
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
@@ -250,7 +307,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if change_points == "switch" and plan is None:
         raise MechsynInputError("change_points='switch' needs the closed form (a mechanism of drivers and dyads)",
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
-    if plan is not None:
+    if plan is not None and not drawn_checks(S, plan):
         assemble(S)  # checks the file configuration and the mobility
     sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
     events = list(sw.events)
@@ -289,15 +346,13 @@ def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_
     rates NaN where not defined)."""
     # no NaN to clear or to restore (the regular pass assembles every row with rates)
     whole = (True, True) if sw.links is not None else (bool(ok.all()), bool(rates_ok.all()))
-    q = sw.q if whole[0] else np.nan_to_num(sw.q)
-    qd, qdd = (sw.qd, sw.qdd) if all(whole) else (np.nan_to_num(sw.qd), np.nan_to_num(sw.qdd))
     pm = {}
     for name, (link, at) in pts.items():
         i = S.index(link)
         if sw.links is not None and i >= 0:  # the regular pass: complex states of the links
             P, V, A = sw.links.point(i, S.to_local(link, at))
-        else:
-            P, V, A = S.point_state(q, qd, qdd, i, S.to_local(link, at))
+        else:  # NaN rows stay NaN row by row (and are set NaN below)
+            P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, S.to_local(link, at))
         if not whole[0]:
             for arr in (P, V, A):
                 arr[~ok] = np.nan

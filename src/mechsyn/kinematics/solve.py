@@ -13,6 +13,7 @@ Velocities: ``Phi_q q' = B u'``; accelerations: ``Phi_q q'' = gamma + B u''``
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,7 @@ from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton"]
+__all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton", "drawn_checks"]
 
 
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -135,6 +136,65 @@ def singular_configuration(S: PlanarSystem, q: np.ndarray | None = None) -> bool
             memo = S.cache["singular_drawn"] = singular_configuration(S, S.q0)
         return memo
     return check_mobility(S, q)["free"] > 0 and generic_free(S, q) == 0
+
+
+def drawn_checks(S: PlanarSystem, plan: Any) -> bool:
+    """The checks of :func:`assemble` at the drawn configuration (assembled, determined,
+    singular or not) from the groups of a plan of R drives and RRR dyads, without the
+    rank machinery; True when they are settled (the verdict of
+    :func:`singular_configuration` is then kept with ``S``), False when the general
+    path must decide.
+
+    Each link's dimensions are read from its drawn joint points, so the drawn pose closes
+    every group by construction: what is left is each group's shape. An RRR group with
+    ends ``A``, ``C`` and middle joint ``B`` (``e1 = B - A``, ``e2 = B - C``) is folded
+    (the Jacobian's block of the group, and so ``Phi_q``, loses rank: Haug 1989, sec. 3.4)
+    when ``|e1 x e2| / (|e1| |e2|)``, the sine of the angle at ``B``, is zero. Only clear
+    cases are settled here: the sine below 1e-13 (singular) or the sine times the shorter
+    link above 1e-5 of the mechanism's size (regular), links not shorter than 1e-3 of it;
+    a degenerate link (coincident joints), a group near a fold and every other plan go to
+    the general test, so the answers and messages are those of :func:`assemble`. A group
+    whose middle joint is a double joint (two R pairs at one point) is tested the same way
+    at that point.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.analysis import compile_plan
+    >>> kp = compile_plan(ms.examples.load("crank_rocker"), inputs=("A",))
+    >>> drawn_checks(kp.system, kp.groups), singular_configuration(kp.system)
+    (True, False)
+    """
+    memo = S.cache.get("drawn_checks")
+    if memo is not None and memo[0] is plan:
+        return memo[1]
+    settled = _drawn_checks(S, plan)
+    S.cache["drawn_checks"] = (plan, settled)
+    return settled
+
+
+def _drawn_checks(S: PlanarSystem, plan: Any) -> bool:
+    if plan is None or S.m != S.n or not all(s.kind in ("drive_R", "RRR") and set(s.data) <= {"double"}
+                                             for s in plan.steps):
+        return False
+    pts = {j.id: j.point for j in S.mech.joints}
+    singular = False
+    for step in plan.steps:
+        if step.kind != "RRR":
+            continue
+        (ax, ay), (bx, by), (cx, cy) = (pts[j].tolist() for j in step.joints)
+        e1x, e1y, e2x, e2y = bx - ax, by - ay, bx - cx, by - cy
+        L1, L2 = math.hypot(e1x, e1y), math.hypot(e2x, e2y)
+        short = min(L1, L2)
+        if not short >= 1e-3 * S.scale:  # degenerate or short link, NaN: the general test
+            return False
+        sine = abs(e1x * e2y - e1y * e2x) / (L1 * L2)
+        if sine <= 1e-13:
+            singular = True
+        elif sine * short < 1e-5 * S.scale:
+            return False
+    S.cache["singular_drawn"] = singular
+    return True
 
 
 def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:

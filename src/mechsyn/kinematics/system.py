@@ -46,12 +46,14 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.cams import CamCurve, _cam_curve
 from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
@@ -87,76 +89,6 @@ def _perp(v: np.ndarray) -> np.ndarray:
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
-
-
-# --------------------------------------------------------------------------- cams
-@dataclass(frozen=True)
-class CamCurve:
-    """The curve the roller centre follows on the cam (profile offset by the roller radius).
-
-    ``kind`` is ``"circle"`` (an eccentric disc: exact) or ``"spline"`` (a periodic cubic
-    spline through the offset of the profile points), in the cam's local frame.
-    """
-
-    kind: str
-    center: np.ndarray | None = None
-    radius: float = 0.0
-    spline: Any = None
-    period: float = 2 * np.pi
-
-    def eval(self, t: np.ndarray, der: int = 0) -> np.ndarray:
-        if self.kind == "circle":
-            ang = t + der * np.pi / 2
-            out = self.radius * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
-            return out + (self.center if der == 0 else 0.0)
-        return self.spline(np.mod(t, self.period), der)
-
-    def closest(self, p: np.ndarray) -> float:
-        """Parameter of the curve point nearest ``p`` (local coordinates)."""
-        if self.kind == "circle":
-            d = p - self.center
-            return float(np.arctan2(d[1], d[0]))
-        ts = np.linspace(0, self.period, 4001)
-        pts = self.eval(ts)
-        return float(ts[np.argmin(np.sum((pts - p) ** 2, axis=1))])
-
-
-def _cam_curve(profile: Any, center_local: np.ndarray, rho: float, contact_local: np.ndarray,
-               to_local: Any, source: str, jid: str) -> CamCurve:
-    """Build the offset curve followed by the roller centre from the joint's profile."""
-    from scipy.interpolate import make_interp_spline
-
-    if isinstance(profile, dict) and "points" in profile:  # a polar function, sampled
-        profile = profile["points"]
-    if isinstance(profile, dict):
-        c = to_local(np.asarray(profile["center"], float))
-        r = float(profile["radius"])
-        d = float(np.linalg.norm(center_local - c))
-        # roller outside (r + rho) or inside (r - rho) the disc: whichever matches
-        r_off = r + rho if abs(d - (r + rho)) <= abs(d - abs(r - rho)) else abs(r - rho)
-        return CamCurve("circle", center=c, radius=r_off)
-    pts = np.array([to_local(np.asarray(p, float)) for p in profile])
-    if np.allclose(pts[0], pts[-1]):
-        pts = pts[:-1]
-    closed = np.vstack([pts, pts[:1]])
-    t = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(closed, axis=0), axis=1))])
-    if np.any(np.diff(t) <= 0):
-        raise MechsynInputError(f"cam profile of joint {jid} repeats a point", source=source,
-                                field=f"joints.{jid}.profile", hint="list distinct points round the cam")
-    spl = make_interp_spline(t, closed, k=3, bc_type="periodic")
-    if rho == 0:
-        return CamCurve("spline", spline=spl, period=float(t[-1]))
-    ts = np.linspace(0, t[-1], 16 * len(pts) + 400, endpoint=False)
-    p, d1 = spl(ts), spl(ts, 1)
-    nrm = np.stack([d1[:, 1], -d1[:, 0]], axis=1) / np.linalg.norm(d1, axis=1)[:, None]
-    # offset to the side where the roller centre is
-    k = int(np.argmin(np.sum((p - contact_local) ** 2, axis=1)))
-    sign = 1.0 if _dot(nrm[k], center_local - p[k]) >= 0 else -1.0
-    off = p + sign * rho * nrm
-    off_closed = np.vstack([off, off[:1]])
-    to = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(off_closed, axis=0), axis=1))])
-    spl2 = make_interp_spline(to, off_closed, k=3, bc_type="periodic")
-    return CamCurve("spline", spline=spl2, period=float(to[-1]))
 
 
 # --------------------------------------------------------------------------- constraints
@@ -231,13 +163,21 @@ class PlanarSystem:
     def index(self, link: str) -> int:
         return -1 if link == self.mech.ground else self.links.index(link)
 
+    def frames(self) -> tuple[list, list, list]:
+        """``cos(-phi0)``, ``sin(-phi0)`` and the origin of every link's drawn frame, as
+        Python numbers (one point carried into a frame costs a few float products)."""
+        f = self.cache.get("frames")
+        if f is None:
+            f = self.cache["frames"] = (np.cos(-self.angle0).tolist(), np.sin(-self.angle0).tolist(),
+                                        self.origin0.tolist())
+        return f
+
     def to_local(self, link: str, p: np.ndarray) -> np.ndarray:
         i = self.index(link)
         if i < 0:
             return np.asarray(p, float)
-        c, s = np.cos(-self.angle0[i]), np.sin(-self.angle0[i])
-        d = np.asarray(p, float) - self.origin0[i]
-        return np.array([c * d[0] - s * d[1], s * d[0] + c * d[1]])
+        cos, sin, org = self.frames()
+        return _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
 
     def pose(self, q: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
         """(r (N,2), phi (N,)) of link ``i`` (frame: zeros)."""
@@ -302,8 +242,8 @@ class PlanarSystem:
         i = self.index(link)
         if i < 0:
             return np.asarray(u, float)
-        c, s = np.cos(-self.angle0[i]), np.sin(-self.angle0[i])
-        return np.array([c * u[0] - s * u[1], s * u[0] + c * u[1]])
+        cos, sin, _ = self.frames()
+        return _to_frame(cos[i], sin[i], u[0], u[1])
 
     # -- equations -----------------------------------------------------------------
     def residual(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -356,6 +296,11 @@ class PlanarSystem:
                 rows.extend(range(row, row + con.rows))
             row += con.rows
         return rows
+
+
+def _to_frame(c: float, s: float, dx: float, dy: float) -> np.ndarray:
+    """The vector ``(dx, dy)`` turned by the angle whose cosine and sine are ``c``, ``s``."""
+    return np.array([c * dx - s * dy, s * dx + c * dy], float)
 
 
 def _one(S: PlanarSystem) -> Any:
@@ -560,8 +505,6 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
     raise AssertionError(k)
 
 
-
-
 # --------------------------------------------------------------------------- building
 def _dir_angle(v: np.ndarray) -> float:
     return float(np.arctan2(v[1], v[0]))
@@ -658,7 +601,7 @@ def _link_frames(mech: Mechanism) -> tuple[np.ndarray, np.ndarray, float]:
                for j in mech.joints_of(name)]
         origin0[i] = pts[0]
         for p in pts[1:]:
-            if np.linalg.norm(p - pts[0]) > 1e-12 * scale:
+            if math.hypot(*(p - pts[0])) > 1e-12 * scale:
                 angle0[i] = _dir_angle(p - pts[0])
                 break
     return origin0, angle0, scale

@@ -305,6 +305,39 @@ class Mechanism:
     def with_joints(self, joints: tuple[Joint, ...], name: str | None = None) -> "Mechanism":
         return replace(self, joints=joints, name=name or self.name)
 
+    def with_joint_points(self, points: dict[str, Any]) -> "Mechanism":
+        """The same mechanism with some joints moved (``{joint id: (x, y)}``): only
+        numbers change (no parsing, no validation of the structure), so a simulation of
+        the result reuses the compiled program of every mechanism of the same topology
+        (:func:`mechsyn.kinematics.refill.topology_key`). Named points keep their drawn
+        positions. An unknown joint or a point that is not ``dim`` finite numbers raises
+        :class:`~mechsyn.errors.MechsynInputError`.
+
+        Examples
+        --------
+        >>> import mechsyn as ms
+        >>> m = ms.examples.load("crank_rocker")
+        >>> m.with_joint_points({"C": (3.1, 2.9)}).joint("C").point.tolist()
+        [3.1, 2.9]
+        """
+        index = {j.id: k for k, j in enumerate(self.joints)}
+        joints = list(self.joints)
+        for jid, p in points.items():
+            k = index.get(jid)
+            if k is None:
+                raise MechsynInputError(f"no joint {jid!r}", source=self.source, field="joints",
+                                        hint=f"joints are: {', '.join(index)}")
+            try:
+                arr = np.array(p, float).reshape(self.dim)
+            except (TypeError, ValueError):
+                arr = np.full(self.dim, np.nan)
+            if not np.isfinite(arr).all():
+                raise MechsynInputError(f"the point of joint {jid} must be {self.dim} finite numbers, not {p!r}",
+                                        source=self.source, field=f"joints.{jid}.point",
+                                        hint="give e.g. (x, y) in the file's length unit")
+            joints[k] = replace(joints[k], point=arr)
+        return replace(self, joints=tuple(joints))
+
     def widget(self, root: str = ".") -> MechanismWidget:
         """This mechanism in mechsyn studio's editor as a Jupyter widget (``mechsyn[web,notebook]``);
         the widget's ``mechanism`` follows every edit (see :mod:`mechsyn.web.widget`)."""

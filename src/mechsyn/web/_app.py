@@ -207,7 +207,11 @@ async def _example(request: Request) -> Any:
 async def _simulate(request: Request) -> Any:
     data = await _body(request)
     steps = _int(data.get("steps", 180), "steps")
-    return await _heavy(request, "simulate", _need(data, "mechanism"), steps, None, _bool(data, "rates", True))
+    args = (_need(data, "mechanism"), steps, None, _bool(data, "rates", True))
+    # a mechanism of drivers and dyads (a drag's repaint: milliseconds of NumPy) in this
+    # process, with the plans compiled here; the rest, and every refusal, in a worker
+    quick = await run_in_threadpool(_service.quick_simulate, *args)
+    return quick if quick is not None else await _heavy(request, "simulate", *args)
 
 
 @api

@@ -10,8 +10,12 @@ from __future__ import annotations
 import csv
 import functools
 import io
+import json
 import math
 import re
+import threading
+from collections import OrderedDict
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -21,6 +25,10 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.results import to_jsonable
 
 MAX_STEPS = 2000
+#: The largest mechanism :func:`quick_simulate` answers in the server's process (a
+#: linkage drawn by hand; larger files, whose parse and sweep take longer, go to a worker
+#: that is stopped when its client leaves).
+QUICK_JOINTS = 64
 EXAMPLE_SUFFIXES = (".yaml", ".yml", ".json")
 
 
@@ -169,19 +177,28 @@ def validate(data: Any) -> dict[str, Any]:
 
 # --------------------------------------------------------------------------- simulation
 def _finite(a: np.ndarray) -> list:
-    return [None if not math.isfinite(v) else float(v) for v in np.asarray(a, float).ravel()]
+    """The numbers as a list, None where not finite (JSON null)."""
+    a = np.asarray(a, float).ravel()
+    out = a.tolist()
+    for k in np.flatnonzero(~np.isfinite(a)).tolist():
+        out[k] = None
+    return out
 
 
 def _xy(a: np.ndarray) -> list:
-    return [None if not (math.isfinite(p[0]) and math.isfinite(p[1])) else [float(p[0]), float(p[1])]
-            for p in np.asarray(a, float)]
+    """The points as [x, y] lists, None where a coordinate is not finite (not assembled)."""
+    a = np.asarray(a, float)
+    out = a.tolist()
+    for k in np.flatnonzero(~np.isfinite(a).all(axis=1)).tolist():
+        out[k] = None
+    return out
 
 
 def _driver_start(mech, jid: str) -> float:
     """The file's value of driven joint ``jid``: crank angle (deg) of an R, 0 for a P."""
-    from mechsyn.kinematics.system import build_system
+    from mechsyn.kinematics.analysis import cached_plan
 
-    S = build_system(mech)
+    S = cached_plan(mech, inputs=(jid,)).system  # the plan simulate() then uses
     for d in S.drivers:
         if d.joint == jid:
             return float(np.degrees(d.assembled)) if d.type == "R" else float(d.assembled)
@@ -217,10 +234,13 @@ def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool
     ``transmission_angle`` and, for a four-bar, ``grashof``. ``rates=False`` leaves out
     the velocities, accelerations and link angles (a smaller answer for the drag loop).
     """
+    return _simulated(build(data), steps, span, rates)
+
+
+def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, Any]:
     from mechsyn.kinematics import derived
     from mechsyn.kinematics.analysis import simulate as _simulate
 
-    mech = build(data)
     drive, values = _sweep(mech, steps, span)
     names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
     sim = _simulate(mech, {drive.id: values}, points=names)
@@ -249,6 +269,100 @@ def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool
     if _is_four_bar(mech):
         out["grashof"] = to_jsonable(derived.grashof(mech))
     return out
+
+
+#: Mechanisms parsed from the studio's requests, by the request's topology (the mechanism
+#: JSON without its joint points and named points' coordinates): a drag sends the same
+#: topology with other numbers, filled into the parsed mechanism without parsing again.
+_PARSED: "OrderedDict[str, Any]" = OrderedDict()
+_PARSED_LOCK = threading.Lock()
+
+
+def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
+                   rates: bool = True) -> dict[str, Any] | None:
+    """:func:`simulate` of a mechanism of drivers and dyads, fast enough to run in the
+    server's own process (a drag's repaint); None where a worker process must run it
+    (any input error, so that it is reported as by :func:`simulate`; a mechanism that
+    needs the Newton continuation, a cam, a gear or a belt; more than
+    :data:`QUICK_JOINTS` joints; a topology whose numbers the reader changes, e.g. units).
+
+    A request whose topology was parsed before is not parsed again: its joint points and
+    named points are put into the parsed mechanism
+    (:meth:`~mechsyn.model.mechanism.Mechanism.with_joint_points`), the reader's geometry
+    checks run on them (:func:`mechsyn.io.checks.check_geometry`) and the simulation reuses
+    the plan compiled for the topology. The answer is :func:`simulate`'s.
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism, mechanism_to_dict
+    >>> d = mechanism_to_dict(load_mechanism("examples/textbook/fourbar.yaml"))
+    >>> quick_simulate(d, 36) == simulate(d, 36)
+    True
+    """
+    from mechsyn.io.checks import check_geometry
+    from mechsyn.kinematics.analysis import cached_plan
+
+    split = _numbers(data)
+    if split is None:
+        return None
+    key, joints, points = split
+    with _PARSED_LOCK:
+        template = _PARSED.get(key)
+    try:
+        if template is None:
+            mech = build(data)
+            if _numbers_of(mech) != (joints, points):
+                return None  # the reader changed the numbers: no refill of this topology
+        else:
+            mech = template.with_joint_points(joints)
+            mech = replace(mech, points={n: replace(p, at=np.array(points[n], float)) for n, p in mech.points.items()})
+            check_geometry(mech, template.source)
+        drives = [j for j in mech.joints if j.actuated]
+        kp = cached_plan(mech, inputs=(drives[0].id,)) if drives and mech.kind == "planar" else None
+        if kp is None or kp.groups is None:
+            return None
+        out = _simulated(mech, steps, span, rates)
+    except (MechsynInputError, TypeError, ValueError):
+        return None  # reported by the worker's simulate, as without this path
+    if template is None:
+        with _PARSED_LOCK:
+            _PARSED[key] = mech
+            while len(_PARSED) > 16:
+                _PARSED.popitem(last=False)
+    return out
+
+
+def _numbers(data: Any) -> tuple[str, dict, dict] | None:
+    """(the request's topology as text, joint points, named points' coordinates), or None
+    when the request is not a mechanism object of that shape."""
+    if not isinstance(data, dict) or not isinstance(data.get("joints"), list) or len(data["joints"]) > QUICK_JOINTS:
+        return None
+    named = data.get("points") or {}
+    if not isinstance(named, dict) or not all(isinstance(j, dict) for j in data["joints"]) \
+            or not all(isinstance(p, dict) for p in named.values()):
+        return None
+    joints = {j.get("id"): j.get("point") for j in data["joints"]}
+    points = {n: p.get("at") for n, p in named.items()}
+    if not all(_plain_xy(v) for v in list(joints.values()) + list(points.values())):
+        return None  # the reader says what is wrong with them
+    bare = {**data, "joints": [{k: v for k, v in j.items() if k != "point"} for j in data["joints"]],
+            "points": {n: {k: v for k, v in p.items() if k != "at"} for n, p in named.items()}}
+    try:
+        return json.dumps(bare, sort_keys=True, allow_nan=False), joints, points
+    except (TypeError, ValueError):
+        return None
+
+
+def _plain_xy(v: Any) -> bool:
+    """Two finite numbers (no booleans, no strings), as a planar point."""
+    return isinstance(v, list) and len(v) == 2 and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
+
+
+def _numbers_of(mech: Any) -> tuple[dict, dict]:
+    """The joint points and named points of a parsed mechanism as a request gives them."""
+    return ({j.id: None if j.point is None else j.point.tolist() for j in mech.joints},
+            {n: p.at.tolist() for n, p in mech.points.items()})
 
 
 def _nan_stat(f: Callable, v: np.ndarray) -> float | None:
