@@ -20,7 +20,8 @@ from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates"]
+__all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates", "touch_candidates",
+           "fold_events"]
 
 
 #: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
@@ -84,8 +85,8 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     2. A group's normalised discriminant ``Delta`` (RRR: ``h^2 / L1^2``; RRP: the
        circle-line discriminant over ``L1^2``; RPR: ``1 - (e/|AC|)^2``) crossing zero is a
        *fold* (dead point): the group cannot be assembled beyond it; the input is found by
-       Brent's method on ``Delta`` of that group alone (upstream groups re-evaluated at the
-       trial input), to 1e-12 of the step.
+       regula falsi (Illinois, :func:`_fold_root`) on ``Delta`` of that group alone
+       (upstream groups re-evaluated at the trial input), to 1e-14 of the step.
     3. ``Delta`` touching zero without changing sign (a local minimum at zero, found by
        Brent's method on ``dDelta/du``) is a *bifurcation* (change point, flat rhombus):
        both modes meet, and the motion whose velocity is continuous is the one on which
@@ -301,53 +302,112 @@ def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray,
     return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
 
 
+def touch_candidates(disc: np.ndarray) -> np.ndarray:
+    """Rows where a group's normalised discriminant ``disc`` (per row, in sweep order) may
+    touch zero: its local minima under 0.05 among the rows where it is assembled (the
+    candidates of a change or branch point, decided by :func:`_touch`); of several groups
+    (rows of ``disc``): any candidate shows (the flat indices are not rows then)."""
+    d = np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan)
+    mid = d[..., 1:-1]
+    return np.flatnonzero((mid <= d[..., :-2]) & (mid <= d[..., 2:]) & (mid < 0.05)) + 1
+
+
+def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.ndarray, D: np.ndarray,
+                n0: int) -> tuple[list, np.ndarray, list]:
+    """Folds and reassembly of the branched steps ``ks`` on one sweep's rows ``X`` (M,
+    n_inputs; the first ``n0`` the connecting path) from their normalised discriminants
+    ``D`` (len(ks), M), all groups at once (branch rules 2 and 4 of :func:`solve_tracked`).
+
+    A fold (the group's own discriminant changes sign between two rows, both evaluated)
+    is a dead point, its input found on the discriminant along the segment between the
+    rows (:func:`_fold_root` on :func:`_disc_line`, upstream groups in their modes
+    ``sigmas`` of the earlier row; the ends' values are ``D``'s); a row where the group assembles after rows where it
+    (or an upstream group) did not is a reassembly. Returns the events (per group in the
+    order of ``ks``: its folds, then its reassemblies, each by row), the singular rows
+    (M,) (a group folded flat within :data:`SINGULAR_DISC`) and per group the rows where
+    it reassembles."""
+    ok = D > -_ZERO_DISC
+    singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
+    finite = np.isfinite(D)
+    fold = ok[:, 1:] != ok[:, :-1]
+    fold &= finite[:, 1:]
+    fold &= finite[:, :-1]
+    back = ok[:, 1:] & ~ok[:, :-1]
+    events: list = []
+    resets = []
+    for g, k in enumerate(ks):
+        group = "-".join(plan.steps[k].joints)
+        for i in (np.flatnonzero(fold[g]) + 1).tolist():
+            inside = ok[g, i - 1]
+            t = _fold_root(_disc_line(S, plan, k, sigmas, X, i - 1, i), float(D[g, i - 1]), float(D[g, i]))
+            if t is None:  # no sign change (a row inside by round-off only)
+                t = 0.0 if inside else 1.0
+            u = X[i - 1] + t * (X[i] - X[i - 1])
+            if inside:
+                events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its "
+                                    "discriminant changes sign: a dead point / limit of the working range)",
+                                    u.tolist(), group))
+            else:
+                events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working "
+                                    "range", u.tolist(), group))
+        rows = np.flatnonzero(back[g]) + 1
+        resets.append(rows)
+        for i in rows[rows >= n0].tolist():
+            events.append(Event(i, "reassembled", f"assembles again after a gap, in the assembly mode of the "
+                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
+                                X[i].tolist(), group))
+    return events, singular, resets
+
+
+def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14) -> float | None:
+    """The zero ``t`` in [0, 1] of the discriminant ``f(t)`` along a segment whose ends
+    have the values ``fa``, ``fb`` (known from the array pass, so not evaluated again):
+    secant steps through the last two iterates (order 1.6 on the smooth discriminant of
+    a fold), a regula falsi step of the bracket when one would leave it, stopped when the
+    next step is below ``xtol`` (about four evaluations from one input step to 1e-14 of
+    it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when the ends
+    do not bracket a zero."""
+    if fa == 0.0:
+        return 0.0
+    if fb == 0.0:
+        return 1.0
+    if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
+        return None
+    a, b = 0.0, 1.0           # the bracket (f(a) has the sign of fa)
+    x0, f0, x1, f1 = 0.0, fa, 1.0, fb
+    t = (a * fb - b * fa) / (fb - fa)
+    for _ in range(100):
+        if not a < t < b:
+            t = (a * fb - b * fa) / (fb - fa)
+            if not a < t < b:
+                t = 0.5 * (a + b)
+        ft = f(t)
+        if ft == 0.0 or not math.isfinite(ft):
+            return t
+        if (ft > 0.0) == (fa > 0.0):
+            a, fa = t, ft
+        else:
+            b, fb = t, ft
+        x0, f0, x1, f1 = x1, f1, t, ft
+        step = f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else 0.0
+        if abs(step) <= xtol or b - a <= xtol:
+            return min(max(x1 - step, a), b)
+        t = x1 - step
+    return t
+
+
 def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
                   s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
     """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
-    from scipy.optimize import brentq
-
     M = len(disc)
     step = plan.steps[k]
     group = "-".join(step.joints)
     size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])  # inputs relative to the size
-    ok = disc > -_ZERO_DISC
-    d = np.where(ok, np.maximum(disc, 0.0), np.nan)
-
-    def f_line(i0: int, i1: int):
-        return _disc_line(S, plan, k, sigmas, X, i0, i1)
-
-    events: list = []
-    singular = np.zeros(M, bool)
-    singular[ok & (d < SINGULAR_DISC)] = True
-    breaks: list[tuple[int, str]] = []  # (row, "flip" | "reset")
-    finite = np.isfinite(disc)
-    # folds: the group's own discriminant changes sign between two rows
-    for i in np.flatnonzero(ok[1:] != ok[:-1]) + 1:
-        if not (finite[i] and finite[i - 1]):
-            continue
-        inside = i - 1 if ok[i - 1] else i
-        try:
-            t = brentq(f_line(i - 1, i), 0.0, 1.0, xtol=1e-13, rtol=4 * np.finfo(float).eps)
-        except ValueError:
-            t = 0.0 if inside == i - 1 else 1.0
-        u = X[i - 1] + t * (X[i] - X[i - 1])
-        if ok[i - 1]:
-            events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
-                                "changes sign: a dead point / limit of the working range)", u.tolist(), group))
-        else:
-            events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working range",
-                                u.tolist(), group))
-    # reassembly after a gap (own or upstream): the drawn mode
-    for i in np.flatnonzero(ok[1:] & ~ok[:-1]) + 1:
-        breaks.append((int(i), "reset"))
-        if i >= n0:
-            events.append(Event(int(i), "reassembled", f"assembles again after a gap, in the assembly mode of the "
-                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
-                                X[i].tolist(), group))
+    events, singular, resets = fold_events(S, plan, [k], sigmas, X, disc[None], n0)
+    breaks: list[tuple[int, str]] = [(i, "reset") for i in resets[0].tolist()]  # (row, "flip" | "reset")
     # bifurcations: local minima of the discriminant at zero
     touched: list = []
-    cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
-    for i in cand.tolist():
+    for i in touch_candidates(disc).tolist():
         t_star, dmin = _touch(S, plan, k, sigmas, X, i)
         if dmin > 1e-10:
             continue  # a sharp but regular turn
