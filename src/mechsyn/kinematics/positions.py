@@ -108,11 +108,16 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
                 if turns:
                     block[i, rows] -= 2 * math.pi * turns
         return block
-    # the assembled rows in a row, gaps left out: each run unwrapped and the first of a run
-    # put within half a turn of the last of the run before (the turn count kept)
     sub = ref + _wrap(phi - ref)
     idx = np.flatnonzero(ok)
-    sub[:, idx] = _unwrap_rows(sub[:, idx], inplace=True)
+    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    prev = None
+    for run in runs:
+        block = _unwrap_rows(sub[:, run])
+        if prev is not None:
+            block -= 2 * np.pi * np.round((block[:, :1] - prev) / (2 * np.pi))
+        sub[:, run] = block
+        prev = block[:, -1:]
     return sub
 
 
