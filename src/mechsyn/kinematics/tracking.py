@@ -321,7 +321,10 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     A fold (the group's own discriminant changes sign between two rows, both evaluated)
     is a dead point, its input found on the discriminant along the segment between the
     rows (:func:`_fold_root` on :func:`_disc_line`, upstream groups in their modes
-    ``sigmas`` of the earlier row; the ends' values are ``D``'s); a row where the group assembles after rows where it
+    ``sigmas`` of the earlier row; the ends' values are ``D``'s). A group assembled at
+    one row and cut off at the next by an upstream group's fold may fold first between
+    the same rows: its discriminant at the upstream fold decides, and the earlier fold is
+    the limit of the working range (likewise where the assembly starts again). A row where the group assembles after rows where it
     (or an upstream group) did not is a reassembly. Returns the events (per group in the
     order of ``ks``: its folds, then its reassemblies, each by row), the singular rows
     (M,) (a group folded flat within :data:`SINGULAR_DISC`) and per group the rows where
@@ -333,15 +336,31 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     fold &= finite[:, 1:]
     fold &= finite[:, :-1]
     back = ok[:, 1:] & ~ok[:, :-1]
+    # a group assembled at one row and cut off by an upstream group at the next: its own
+    # fold may come first (between the same rows), hidden from the rows
+    cut = ok[:, :-1] & ~finite[:, 1:]
+    freed = ~finite[:, :-1] & ok[:, 1:]
     events: list = []
     resets = []
+    ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
+    starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
         group = "-".join(plan.steps[k].joints)
-        for i in (np.flatnonzero(fold[g]) + 1).tolist():
-            inside = ok[g, i - 1]
-            t = _fold_root(_disc_line(S, plan, k, sigmas, X, i - 1, i), float(D[g, i - 1]), float(D[g, i]))
-            if t is None:  # no sign change (a row inside by round-off only)
-                t = 0.0 if inside else 1.0
+        rows = [(i, 0) for i in (np.flatnonzero(fold[g]) + 1).tolist()]
+        if ends:
+            rows += [(i, 1) for i in (np.flatnonzero(cut[g]) + 1).tolist() if i in ends]
+        if starts:
+            rows += [(i, -1) for i in (np.flatnonzero(freed[g]) + 1).tolist() if i in starts]
+        for i, hidden in sorted(rows):
+            f = _disc_line(S, plan, k, sigmas, X, i - 1, i)
+            t = _hidden_fold(f, float(D[g, i - 1]), float(D[g, i]), ends, starts, i, hidden)
+            if t is None:
+                continue
+            inside = ok[g, i - 1] if not hidden else hidden > 0
+            if inside:
+                ends[i] = min(t, ends.get(i, 1.0))
+            else:
+                starts[i] = max(t, starts.get(i, 0.0))
             u = X[i - 1] + t * (X[i] - X[i - 1])
             if inside:
                 events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its "
@@ -359,22 +378,38 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     return events, singular, resets
 
 
-def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14) -> float | None:
-    """The zero ``t`` in [0, 1] of the discriminant ``f(t)`` along a segment whose ends
-    have the values ``fa``, ``fb`` (known from the array pass, so not evaluated again):
+def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidden: int) -> float | None:
+    """Where (t) a group folds between rows ``i - 1`` and ``i`` (``f`` its discriminant
+    along the segment, ``fa``, ``fb`` its values at the rows). ``hidden`` 0: its own
+    discriminant changes sign between the rows (t at the ends when the change is round-off
+    only); 1: it is assembled at row i - 1 and an upstream group ends the assembly at
+    ``ends[i]``: the group's own fold before that point, if its discriminant is negative
+    there (else None); -1: likewise after an upstream start at ``starts[i]``."""
+    if not hidden:
+        t = _fold_root(f, fa, fb)
+        return t if t is not None else (0.0 if fa > -_ZERO_DISC else 1.0)
+    tc = ends[i] if hidden > 0 else starts[i]
+    fc = f(tc)
+    if not fc <= -_ZERO_DISC:
+        return None
+    return _fold_root(f, fa, fc, b=tc) if hidden > 0 else _fold_root(f, fc, fb, a=tc)
+
+
+def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14, a: float = 0.0, b: float = 1.0) -> float | None:
+    """The zero ``t`` in [a, b] (default the segment [0, 1]) of the discriminant ``f(t)``
+    along a segment, ``f(a) = fa``, ``f(b) = fb`` (known, so not evaluated again):
     secant steps through the last two iterates (order 1.6 on the smooth discriminant of
     a fold), a regula falsi step of the bracket when one would leave it, stopped when the
     next step is below ``xtol`` (about four evaluations from one input step to 1e-14 of
     it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when the ends
     do not bracket a zero."""
     if fa == 0.0:
-        return 0.0
+        return a
     if fb == 0.0:
-        return 1.0
+        return b
     if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
         return None
-    a, b = 0.0, 1.0           # the bracket (f(a) has the sign of fa)
-    x0, f0, x1, f1 = 0.0, fa, 1.0, fb
+    x0, f0, x1, f1 = a, fa, b, fb  # the bracket [a, b] (f(a) has the sign of fa)
     t = (a * fb - b * fa) / (fb - fa)
     for _ in range(100):
         if not a < t < b:
