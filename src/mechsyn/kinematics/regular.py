@@ -22,6 +22,10 @@ values together and gives up (None) as soon as a group's discriminant falls belo
 :data:`mechsyn.kinematics.tracking.REGULAR_DISC`: no group then folds, touches a change
 point or reassembles, every group keeps its drawn mode and the answer is that of the
 tracked outward sweeps (tests check both agree), at the cost of one pass.
+:func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
+local minimum under 0.05 (no change or branch point near: every group keeps its drawn
+mode), and reads the folds, reassembly and singular rows of the tracked sweeps off the
+discriminant arrays (:func:`mechsyn.kinematics.tracking.fold_events`).
 """
 
 from __future__ import annotations
@@ -32,8 +36,8 @@ import numpy as np
 
 from mechsyn.kinematics.chain import _chain_program, _link_angles
 from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
-from mechsyn.kinematics.tracking import (REGULAR_DISC, _regular_rows, _sweep_events, _tracking_rows, fold_events,
-                                         touch_candidates)
+from mechsyn.kinematics.tracking import (REGULAR_DISC, _regular_rows, _sweep_events, fold_events, touch_candidates,
+                                         tracking_path)
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
@@ -227,11 +231,10 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     events of each sweep (the one sweep, or forwards and backwards from the drawn
     configuration when ``split`` is a row) come from the discriminants by the branch
     rules of :func:`mechsyn.kinematics.tracking.solve_tracked` (folds found and refined
-    on the group's discriminant, reassembly, singular rows): a list of ``(q, qd, qdd,
-    singular, events)`` per sweep with the poses (:class:`Folded`): the tracked chain's
-    answer. None when a group's
-    discriminant has such a minimum (the tracked chain decides what happens there) or the
-    plan is not such a chain.
+    on the group's discriminant, reassembly, singular rows): a :class:`Folded` (the
+    poses, and per sweep its singular rows and events), the tracked chain's answer. None
+    when a group's discriminant has such a minimum (the tracked chain decides what happens
+    there) or the plan is not such a chain.
 
     Examples
     --------
@@ -251,10 +254,12 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     N = U.shape[0]
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
     order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
-    tracks = [_tracking_rows(S, p) for p in parts]
-    st = _run(steps, anchor, np.concatenate([U] + [X[:n0] for X, n0, _ in tracks]), speeds, folds=True)
+    paths = [tracking_path(S, p[0]) for p in parts]
+    st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
     if all(d.min() >= REGULAR_DISC for d in st.discs.values()):
         return _poses(S, plan, U, st, origin, split)
+    # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
+    tracks = [(np.concatenate([path, p - shift]), path.shape[0], shift) for (path, shift), p in zip(paths, parts)]
     rows, start = [], N  # each sweep's rows of the pass: its connecting path, then its inputs
     for (_, n0, _), idx in zip(tracks, order):
         rows.append(np.concatenate([np.arange(start, start + n0), idx]))

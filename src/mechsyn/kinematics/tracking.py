@@ -21,7 +21,7 @@ from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates", "touch_candidates",
-           "fold_events"]
+           "fold_events", "tracking_path"]
 
 
 #: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
@@ -171,12 +171,19 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
     """The rows a tracked sweep evaluates: the connecting path from the drawn input
     values (``n0`` rows), then the sweep shifted by whole turns next to them."""
     U = np.atleast_2d(np.asarray(inputs, float))
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    # R inputs a whole number of turns from the drawn values are the same configurations:
-    # track the sweep shifted next to the drawn values (its rows then follow each other)
-    shift = U[0] - _shifted_start(S, u0, U[0])
-    path = _connecting_path(S, u0, U[0] - shift)
+    path, shift = tracking_path(S, U[0])
     return np.vstack([path, U - shift]), path.shape[0], shift
+
+
+def tracking_path(S: PlanarSystem, first: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The connecting path from the drawn input values to a tracked sweep whose first
+    input values are ``first``, and the whole turns ``shift`` the sweep is tracked
+    shifted by (R inputs a whole number of turns from the drawn values are the same
+    configurations: the sweep is tracked next to the drawn values, so that its rows
+    follow each other)."""
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    shift = first - _shifted_start(S, u0, first)
+    return _connecting_path(S, u0, first - shift), shift
 
 
 def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
@@ -336,21 +343,20 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     fold &= finite[:, 1:]
     fold &= finite[:, :-1]
     back = ok[:, 1:] & ~ok[:, :-1]
-    # a group assembled at one row and cut off by an upstream group at the next: its own
-    # fold may come first (between the same rows), hidden from the rows
-    cut = ok[:, :-1] & ~finite[:, 1:]
-    freed = ~finite[:, :-1] & ok[:, 1:]
+    folds = _rows_by_group(fold)
+    backs = _rows_by_group(back)
     events: list = []
     resets = []
     ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
     starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
         group = "-".join(plan.steps[k].joints)
-        rows = [(i, 0) for i in (np.flatnonzero(fold[g]) + 1).tolist()]
-        if ends:
-            rows += [(i, 1) for i in (np.flatnonzero(cut[g]) + 1).tolist() if i in ends]
-        if starts:
-            rows += [(i, -1) for i in (np.flatnonzero(freed[g]) + 1).tolist() if i in starts]
+        rows = [(i, 0) for i in folds[g]]
+        if ends or starts:
+            # assembled at one row and cut off by an upstream group at the next (or the
+            # other way round): its own fold may come first, hidden between the rows
+            rows += [(i, 1) for i in (np.flatnonzero(ok[g, :-1] & ~finite[g, 1:]) + 1).tolist() if i in ends]
+            rows += [(i, -1) for i in (np.flatnonzero(~finite[g, :-1] & ok[g, 1:]) + 1).tolist() if i in starts]
         for i, hidden in sorted(rows):
             f = _disc_line(S, plan, k, sigmas, X, i - 1, i)
             t = _hidden_fold(f, float(D[g, i - 1]), float(D[g, i]), ends, starts, i, hidden)
@@ -369,13 +375,24 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
             else:
                 events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working "
                                     "range", u.tolist(), group))
-        rows = np.flatnonzero(back[g]) + 1
-        resets.append(rows)
-        for i in rows[rows >= n0].tolist():
+        resets.append(backs[g])
+        for i in backs[g]:
+            if i < n0:
+                continue
             events.append(Event(i, "reassembled", f"assembles again after a gap, in the assembly mode of the "
                                 f"drawn configuration for the group {group} (the mode nearest the drawn one)",
                                 X[i].tolist(), group))
     return events, singular, resets
+
+
+def _rows_by_group(mask: np.ndarray) -> list[list[int]]:
+    """The rows ``i`` (of the step from row i - 1) where ``mask`` (groups, M - 1) holds,
+    per group, from one ``nonzero``."""
+    gs, js = np.nonzero(mask)
+    out: list[list[int]] = [[] for _ in range(mask.shape[0])]
+    for g, j in zip(gs.tolist(), js.tolist()):
+        out[g].append(j + 1)
+    return out
 
 
 def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidden: int) -> float | None:
@@ -439,7 +456,7 @@ def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarr
     group = "-".join(step.joints)
     size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])  # inputs relative to the size
     events, singular, resets = fold_events(S, plan, [k], sigmas, X, disc[None], n0)
-    breaks: list[tuple[int, str]] = [(i, "reset") for i in resets[0].tolist()]  # (row, "flip" | "reset")
+    breaks: list[tuple[int, str]] = [(i, "reset") for i in resets[0]]  # (row, "flip" | "reset")
     # bifurcations: local minima of the discriminant at zero
     touched: list = []
     for i in touch_candidates(disc).tolist():
