@@ -238,15 +238,22 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
 
     Examples
     --------
+    A textbook four-bar (crank sqrt(5), coupler and rocker sqrt(10), frame 5) from 100 to
+    260 degrees, one sweep (the drawn crank angle, 63.4 degrees, lies outside it): its
+    working range ends and starts again at the law-of-cosines angles 116.565 and 243.435
+    degrees, the 31 rows between them not assembled.
+
     >>> import numpy as np
-    >>> from mechsyn.io import load_mechanism
-    >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
-    >>> kp = compile_plan(load_mechanism("examples/textbook/fourbar.yaml"), inputs=("A",))
-    >>> U = np.radians(input_grid(0, 360, 1))[:, None]
-    >>> res = sweep_through_folds(kp.system, kp.groups, U, np.ones(1), None)
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.analysis import cached_plan
+    >>> kp = cached_plan(ms.examples.load("fourbar"), inputs=("A",))
+    >>> res = sweep_through_folds(kp.system, kp.groups, np.radians(np.arange(100.0, 261.0, 4.0))[:, None],
+    ...                           np.ones(1), None)
     >>> (singular, events), = res.parts
-    >>> [(e.index, e.kind) for e in events], int(np.isnan(res.q[:, 0]).sum())
-    ([(37, 'dead point'), (324, 'dead point'), (324, 'reassembled')], 287)
+    >>> [(e.kind, e.index, round(float(np.degrees(e.input[0])), 9)) for e in events]
+    [('dead point', 5, 116.565051177), ('dead point', 36, 243.434948823), ('reassembled', 36, 244.0)]
+    >>> int(np.isnan(res.q[:, 0]).sum())
+    31
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
@@ -296,12 +303,7 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     pass) through folds: NaN rows where a group is not assembled, NaN rates where they
     are not defined (inf at a group folded flat), each link's angle continuous along
     each tracked sweep from the drawn one."""
-    N, nl = U.shape[0], len(S.links)
-    C = _states(st, origin, N, nl)
-    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
-    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
-        buf[0::3], buf[1::3] = x.real, x.imag
-    qd[2::3], qdd[2::3] = _rates_of(st, N, nl)
+    C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     ok = np.isfinite(C[0]).all(axis=0)
     cos, sin, ang = C[0].real, C[0].imag, q[2::3]
     for rows in ((slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))):
@@ -311,6 +313,18 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     qd[:, bad] = np.nan
     qdd[:, bad] = np.nan
     return q.T, qd.T, qdd.T
+
+
+def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:
+    """The links' complex states (:func:`_states`) and the pose rows ``q, qd, qdd`` (n, N,
+    component-major) of the first N rows of a pass, the dyads' link angles left to fill."""
+    nl = len(S.links)
+    C = _states(st, origin, N, nl)
+    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))
+    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
+        buf[0::3], buf[1::3] = x.real, x.imag
+    qd[2::3], qdd[2::3] = _rates_of(st, N, nl)
+    return C, q, qd, qdd
 
 
 def _states(st: _Pass, origin: list, N: int, nl: int) -> np.ndarray:
@@ -338,12 +352,7 @@ def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, 
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
     origin is its first joint, its angle continuous from the drawn one) and the links'
     complex states."""
-    N, nl = U.shape[0], len(S.links)
-    C = _states(st, origin, N, nl)
-    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
-    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
-        buf[0::3], buf[1::3] = x.real, x.imag
-    qd[2::3], qdd[2::3] = _rates_of(st, N, nl)
+    C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
     return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
 
