@@ -211,7 +211,7 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     q, qd, qdd = res.q, res.qd, res.qdd
     qd[sing] = np.nan  # a group folded flat: rates not defined here
     qdd[sing] = np.nan
-    ok = ~np.isnan(q[:, 0])
+    ok = np.isfinite(q).all(axis=1)
     N = U.shape[0]
     sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
     if not back:

@@ -80,6 +80,7 @@ class _Pass:
         self.joint: dict[str, tuple] = {}  # id -> (P, V, A): complex arrays or numbers
         self.link: dict[int, tuple] = {}   # link -> (e^{i phi}, omega, alpha)
         self.discs: dict[int, np.ndarray] = {}  # step -> the group's normalised discriminant
+        self.near = False  # a group came near a fold (below REGULAR_DISC)
 
     def point(self, i: int, s: complex) -> tuple:
         """State of the local point ``s`` of link ``i`` (the frame: -1)."""
@@ -134,6 +135,7 @@ class _Pass:
         if not disc.min() >= least:  # NaN too
             if not folds:
                 return None
+            self.near = True
             np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
         if sigma < 0:
@@ -260,11 +262,12 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     steps, anchor, origin = _program(S, plan)
     N = U.shape[0]
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
-    order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
-    paths = [tracking_path(S, p[0]) for p in parts]
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    paths = [tracking_path(S, p[0], u0) for p in parts]
     st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
-    if all(d.min() >= REGULAR_DISC for d in st.discs.values()):
+    if not st.near:
         return _poses(S, plan, U, st, origin, split)
+    order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
     # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
     tracks = [(np.concatenate([path, p - shift]), path.shape[0], shift) for (path, shift), p in zip(paths, parts)]
     rows, start = [], N  # each sweep's rows of the pass: its connecting path, then its inputs
@@ -323,7 +326,9 @@ def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:
     q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))
     for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
         buf[0::3], buf[1::3] = x.real, x.imag
-    qd[2::3], qdd[2::3] = _rates_of(st, N, nl)
+    for i in range(nl):  # angular velocity and acceleration
+        for buf, x in ((qd, st.link[i][1]), (qdd, st.link[i][2])):
+            buf[3 * i + 2] = x[:N] if isinstance(x, np.ndarray) else x
     return C, q, qd, qdd
 
 
@@ -336,16 +341,6 @@ def _states(st: _Pass, origin: list, N: int, nl: int) -> np.ndarray:
         for k, x in enumerate((st.link[i][0],) + (st.joint[j] if j in st.joint else st.point(i, 0j))):
             C[k, i] = x[:N] if isinstance(x, np.ndarray) else x
     return C
-
-
-def _rates_of(st: _Pass, N: int, nl: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every link's angular velocity and acceleration in the first N rows of a pass (nl, N)."""
-    w, al = np.empty((nl, N)), np.empty((nl, N))
-    for i in range(nl):
-        _, wi, ali = st.link[i]
-        w[i] = wi[:N] if isinstance(wi, np.ndarray) else wi
-        al[i] = ali[:N] if isinstance(ali, np.ndarray) else ali
-    return w, al
 
 
 def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:

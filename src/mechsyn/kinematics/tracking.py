@@ -175,13 +175,14 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
     return np.vstack([path, U - shift]), path.shape[0], shift
 
 
-def tracking_path(S: PlanarSystem, first: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The connecting path from the drawn input values to a tracked sweep whose first
     input values are ``first``, and the whole turns ``shift`` the sweep is tracked
     shifted by (R inputs a whole number of turns from the drawn values are the same
     configurations: the sweep is tracked next to the drawn values, so that its rows
-    follow each other)."""
-    u0 = np.array([d.assembled for d in S.drivers], float)
+    follow each other); ``u0``: the drawn input values when known."""
+    if u0 is None:
+        u0 = np.array([d.assembled for d in S.drivers], float)
     shift = first - _shifted_start(S, u0, first)
     return _connecting_path(S, u0, first - shift), shift
 
