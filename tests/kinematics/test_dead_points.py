@@ -161,10 +161,11 @@ def test_dead_points_do_not_depend_on_the_scale(ex, k):
 
 
 def test_a_fold_costs_a_few_evaluations_of_its_dyad(ex, monkeypatch):
-    """Each dead point is refined from the discriminant's values at the two rows around
-    it (the array pass's), by secant steps: at most 6 evaluations of the one-input
-    discriminant per fold (Brent's method from scratch took 7.2 on these six-bars), for
-    every group of the six-bar; the rows themselves are never evaluated one by one."""
+    """A dead point of a four-bar loop (the first of each six-bar) is found in closed
+    form; any other is refined from the discriminant's values at the two rows around it
+    (the array pass's) by secant steps: at most 6 evaluations of the one-input
+    discriminant per fold in all (Brent's method from scratch took 7.2 per fold on these
+    six-bars); the rows themselves are never evaluated one by one."""
     calls = []
     real = tracking._scalar_disc
     monkeypatch.setattr(tracking, "_scalar_disc", lambda *a: calls.append(a[1]) or real(*a))
@@ -175,3 +176,21 @@ def test_a_fold_costs_a_few_evaluations_of_its_dyad(ex, monkeypatch):
         dead = [e for e in s.events if e.kind == "dead point"]
         assert len(dead) >= 4 and s.engine == "regular pass"
         assert len(calls) <= 6 * len(dead), (len(calls), len(dead))
+
+
+def test_four_bar_dead_points_in_closed_form(ex, monkeypatch):
+    """The textbook four-bar (crank sqrt(5), coupler = rocker = sqrt(10), frame 5) stands
+    stretched where |BD| = 2 sqrt(10): cos(theta) = -1/sqrt(5), theta = 180 deg - atan(2)
+    and its mirror, by the law of cosines on the crank's circle, without evaluating the
+    discriminant, on sweeps either way and from any turn."""
+    calls = []
+    real = tracking._scalar_disc
+    monkeypatch.setattr(tracking, "_scalar_disc", lambda *a: calls.append(1) or real(*a))
+    m = ex("textbook/fourbar.yaml")
+    exact = 180.0 - np.degrees(np.arctan(2.0))
+    for grid in ((0, 360, 1), (360, 0, -7), (-300, 60, 3)):
+        s = simulate(m, {"A": input_grid(*grid)})
+        dead = sorted(e.input["A"] % 360.0 for e in s.events if e.kind == "dead point")
+        assert len(dead) == 2 and s.engine == "regular pass"
+        assert abs(dead[0] - exact) < 1e-12 and abs(dead[1] - (360.0 - exact)) < 1e-12, (grid, dead)
+    assert not calls

@@ -359,8 +359,10 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
             rows += [(i, 1) for i in (np.flatnonzero(ok[g, :-1] & ~finite[g, 1:]) + 1).tolist() if i in ends]
             rows += [(i, -1) for i in (np.flatnonzero(~finite[g, :-1] & ok[g, 1:]) + 1).tolist() if i in starts]
         for i, hidden in sorted(rows):
-            f = _disc_line(S, plan, k, sigmas, X, i - 1, i)
-            t = _hidden_fold(f, float(D[g, i - 1]), float(D[g, i]), ends, starts, i, hidden)
+            t = _four_bar_fold(S, plan, k, X[i - 1], X[i]) if not hidden else None
+            if t is None:
+                f = _disc_line(S, plan, k, sigmas, X, i - 1, i)
+                t = _hidden_fold(f, float(D[g, i - 1]), float(D[g, i]), ends, starts, i, hidden)
             if t is None:
                 continue
             inside = ok[g, i - 1] if not hidden else hidden > 0
@@ -393,6 +395,62 @@ def _rows_by_group(mask: np.ndarray) -> list[list[int]]:
     out: list[list[int]] = [[] for _ in range(mask.shape[0])]
     for g, j in zip(gs.tolist(), js.tolist()):
         out[g].append(j + 1)
+    return out
+
+
+def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: np.ndarray, xb: np.ndarray) -> float | None:
+    """Where (t in [0, 1]) RRR step ``k`` folds on the segment of inputs from ``xa`` to
+    ``xb``, in closed form when the group closes a four-bar: one end joint on the frame,
+    the other on a crank turned by the only input about a frame pivot. The group folds
+    where ``|P(u) - C| = L1 + L2`` or ``|L1 - L2|``, ``P(u) = O + e^{i s u} w`` (``O``
+    the crank's pivot, ``w`` the joint's offset from it on the crank, ``s`` the input's
+    sign), by the law of cosines: ``|v|^2 + |w|^2 + 2 |v| |w| cos(s u + arg w - arg v) =
+    (L1 +- L2)^2`` with ``v = O - C``. None when the group is not such a four-bar or the
+    segment holds not exactly one such angle (the numerical search decides)."""
+    spec = _four_bar_spec(S, plan, k)
+    if spec is None:
+        return None
+    v, w, sgn, targets = spec
+    ua, ub = float(xa[0]), float(xb[0])
+    lo, hi = min(ua, ub), max(ua, ub)
+    av, aw = abs(v), abs(w)
+    beta = math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real)
+    slack = 1e-12 * (hi - lo)
+    found = []
+    for D2 in targets:
+        c = (D2 - av * av - aw * aw) / (2 * av * aw)
+        if not -1.0 < c < 1.0:
+            continue
+        ac = math.acos(c)
+        for psi in (ac - beta, -ac - beta):
+            u = sgn * psi
+            u += 2 * math.pi * round((0.5 * (lo + hi) - u) / (2 * math.pi))
+            if lo - slack <= u <= hi + slack:
+                found.append(u)
+    if len(found) != 1:
+        return None
+    return min(1.0, max(0.0, (found[0] - ua) / (ub - ua)))
+
+
+def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
+    """``(v, w, s, ((L1 + L2)^2, (L1 - L2)^2))`` of :func:`_four_bar_fold` for RRR step
+    ``k``, or None (kept with the system)."""
+    memo = _memo(S)
+    key = ("four-bar fold", id(plan), k)
+    if key in memo:
+        return memo[key]
+    out = None
+    if len(S.drivers) == 1 and plan.closed_form_rates:
+        prog = _scalar_program(S, plan)
+        cranks = {op[1]: op for op in prog if op[0] == "drive" and op[2] < 0}
+        _, (k1, sa), (k3, sc), _, L1s, L2s, *_ = prog[k]
+        ends = {kk: complex(*ss) for kk, ss in ((k1, sa), (k3, sc))}
+        crank = next((kk for kk in ends if kk in cranks), None)
+        if len(ends) == 2 and -1 in ends and crank is not None:
+            _, _, _, O, _, sgn, s_pivot = cranks[crank]
+            L1, L2 = math.sqrt(L1s), math.sqrt(L2s)
+            out = (complex(*O) - ends[-1], ends[crank] - complex(*s_pivot), sgn, ((L1 + L2) ** 2, (L1 - L2) ** 2))
+    memo[key] = out
     return out
 
 
