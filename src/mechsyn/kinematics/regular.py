@@ -308,9 +308,8 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     each tracked sweep from the drawn one."""
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     ok = np.isfinite(C[0]).all(axis=0)
-    cos, sin, ang = C[0].real, C[0].imag, q[2::3]
-    for rows in ((slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))):
-        _link_angles(S, plan, U[rows], cos[:, rows], sin[:, rows], ok[rows], ang[:, rows])
+    parts = (slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))
+    _link_angles(S, plan, U, C[0].real, C[0].imag, ok, q[2::3], parts=parts)
     bad = ~ok | ~(np.isfinite(qd).all(axis=0) & np.isfinite(qdd).all(axis=0))
     q[:, ~ok] = np.nan
     qd[:, bad] = np.nan
