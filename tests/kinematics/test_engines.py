@@ -64,10 +64,13 @@ def test_an_engine_that_declines_passes_to_the_next(ex):
     sw = first_sweep((never,) + PLANAR_ENGINES, kp.system, kp.groups, U, np.ones(1))
     assert isinstance(sw, Sweep) and sw.engine == "regular pass"
     assert first_sweep((never,), kp.system, kp.groups, U, np.ones(1)) is None
-    # a textbook four-bar with dead points: the regular pass declines, the tracked chain answers
-    kp = cached_plan(ex("textbook/fourbar.yaml"), inputs=("A",))
+    # a Peaucellier cell whose rhombus passes change points: the regular pass declines, the
+    # tracked chain answers (a textbook four-bar's dead points the regular pass goes through)
+    kp = cached_plan(ex("kinematics/peaucellier.yaml"), inputs=("E",))
     assert engines.RegularPass().sweep(kp.system, kp.groups, U, np.ones(1)) is None
     assert first_sweep(PLANAR_ENGINES, kp.system, kp.groups, U, np.ones(1)).engine == "tracked chain"
+    kp = cached_plan(ex("textbook/fourbar.yaml"), inputs=("A",))
+    assert first_sweep(PLANAR_ENGINES, kp.system, kp.groups, U, np.ones(1)).engine == "regular pass"
 
 
 def test_events_are_typed_and_their_json_is_the_former_dicts(ex):

@@ -123,18 +123,23 @@ def _poses_from_chain_(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResu
 
 
 def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, cos: np.ndarray, sin: np.ndarray,
-                 ok: np.ndarray | None, out: np.ndarray, split: int | None = None) -> None:
+                 ok: np.ndarray | None, out: np.ndarray, split: int | None = None, parts: tuple | None = None) -> None:
     """Continuous angles of the chain's links into ``out`` (nl, N) from their rotations
     ``cos``, ``sin`` (nl, N or more rows): the links of frame drivers take the input
     itself, the others ``atan2`` made continuous (``ok`` None: every row assembled;
-    ``split``: see :func:`_continuous_angles`)."""
+    ``split``: see :func:`_continuous_angles`; ``parts``: the rows (slices, in the
+    order swept) of sweeps tracked on their own, each made continuous from its start)."""
     drive_links, others, ref = _angle_plan(S, plan)
     N = out.shape[1]
     for i, (k, sgn) in drive_links.items():
         np.multiply(U[:N, k], sgn, out=out[i])
     if others:  # atan2 only for the links not driven directly
         ang = np.arctan2(sin[others, :N], cos[others, :N])
-        if ok is None or ok.any():
+        if parts is not None:
+            for rows in parts:
+                if ok[rows].any():
+                    ang[:, rows] = _continuous_angles(ang[:, rows], ref, ok[rows], None, fresh=True)
+        elif ok is None or ok.any():
             ang = _continuous_angles(ang, ref, ok, split, fresh=True)
         out[others] = ang
 

@@ -9,10 +9,11 @@ should be tried.
 
 The planar engines, in the order they are tried:
 
-1. ``regular pass`` (:func:`mechsyn.kinematics.regular.regular_sweep`): a driver-R + RRR
-   chain whose groups stay clear of folds and change points, in one array pass of complex
-   arithmetic; declines as soon as a group comes near a fold (or for
-   ``change_points="switch"``).
+1. ``regular pass`` (:func:`mechsyn.kinematics.regular.sweep_through_folds`): a driver-R +
+   RRR chain whose groups stay clear of change points, in one array pass of complex
+   arithmetic through its folds (dead points found on each group's discriminant array);
+   declines when a group's discriminant has a local minimum under 0.05 (a change or
+   branch point may be near) and for ``change_points="switch"``.
 2. ``tracked chain`` (:func:`mechsyn.kinematics.tracking.solve_tracked_rates`): the same
    chains through folds, change and branch points, every group's assembly mode tracked on
    its discriminant, rates in closed form.
@@ -48,7 +49,7 @@ import numpy as np
 
 from mechsyn.kinematics.chain import solve_all
 from mechsyn.kinematics.groups import Plan
-from mechsyn.kinematics.regular import regular_sweep
+from mechsyn.kinematics.regular import Folded, sweep_through_folds
 from mechsyn.kinematics.solve import sweep as newton_sweep
 from mechsyn.kinematics.spatial import SpatialEngine
 from mechsyn.kinematics.sweep import Event, Sweep
@@ -56,7 +57,7 @@ from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
 
 __all__ = ["Engine", "PLANAR_ENGINES", "SPATIAL_ENGINE", "RegularPass", "TrackedChain", "TrackedGroups", "Newton",
-           "first_sweep", "drawn_row", "outward"]
+           "first_sweep", "drawn_row", "outward", "merged", "merged_events"]
 
 
 class Engine(Protocol):
@@ -78,7 +79,8 @@ class Engine(Protocol):
 
 
 class RegularPass:
-    """A driver-R + RRR chain clear of folds, in one pass (see the module doc)."""
+    """A driver-R + RRR chain without change points, in one pass through its folds (see
+    the module doc)."""
 
     name = "regular pass"
 
@@ -86,14 +88,17 @@ class RegularPass:
               change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
         if plan is None or change_points != "keep":
             return None
-        res = regular_sweep(system, plan, inputs, speeds, drawn_row(system, inputs))
+        k = drawn_row(system, inputs)
+        res = sweep_through_folds(system, plan, inputs, speeds, k)
         if res is None:
             return None
-        q, qd, qdd, links = res
         N = inputs.shape[0]
         if progress is not None:
             progress(N)
         nan = np.full(N, np.nan)
+        if isinstance(res, Folded):  # through folds: the tracked sweeps' singular rows and events
+            return _folded_sweep(system, inputs, speeds, k, res, self.name)
+        q, qd, qdd, links = res
         return Sweep(system, inputs, speeds, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur",
                      links=links, engine=self.name)
 
@@ -190,15 +195,37 @@ def _tracked_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, res: tuple, e
     qdd[singular] = np.nan
     ok = np.all(np.isfinite(q), axis=1)
     sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
-    sw.events = _tracked_events(tr_events, sw)
+    sw.events = _tracked_events(tr_events, bool(ok[0]), U[0])
     if progress is not None:
         progress(N)
     return sw
 
 
-def _tracked_events(tracked_events: list[Event], sw: Sweep) -> list[Event]:
+def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None, res: Folded, engine: str) -> Sweep:
+    """The Sweep of the regular pass through folds: the tracked sweeps' singular rows
+    (rates not defined) and events, forwards and backwards from row ``k`` when the drawn
+    input values lie inside the sweep."""
+    (sing, ev), *back = res.parts
+    if back:
+        sing = np.concatenate([back[0][0][::-1], sing])
+    q, qd, qdd = res.q, res.qd, res.qdd
+    qd[sing] = np.nan  # a group folded flat: rates not defined here
+    qdd[sing] = np.nan
+    ok = np.isfinite(q).all(axis=1)
+    N = U.shape[0]
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
+    if not back:
+        sw.events = _tracked_events(ev, bool(ok[0]), U[0])
+    else:
+        sw.events = merged_events(k, _tracked_events(back[0][1], bool(ok[k - 1]), U[k - 1]),
+                                  _tracked_events(ev, bool(ok[k]), U[k]))
+    return sw
+
+
+def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_input: np.ndarray) -> list[Event]:
     """Events of the closed-form sweep: dead points, reassembly and change / branch points
-    found and refined on the groups' discriminants (:func:`solve_tracked`)."""
+    found and refined on the groups' discriminants (:func:`solve_tracked`); the sweep's
+    first row assembled or not, and its input values."""
     out, seen = [], set()
     for e in tracked_events:  # a gap of an upstream group is one reassembly of the mechanism
         if e.kind == "reassembled":
@@ -206,9 +233,9 @@ def _tracked_events(tracked_events: list[Event], sw: Sweep) -> list[Event]:
                 continue
             seen.add(e.index)
         out.append(e)
-    if not sw.assembled[0] and not any(e.index == 0 and e.kind == "dead point" for e in out):
+    if not first_assembled and not any(e.index == 0 and e.kind == "dead point" for e in out):
         out.insert(0, Event(0, "not assembled", "the mechanism cannot be assembled at the first input",
-                            sw.inputs[0].tolist()))
+                            first_input.tolist()))
     return out
 
 
@@ -271,9 +298,27 @@ def outward(S: PlanarSystem, U: np.ndarray, run: Callable[[list], list[Sweep]]) 
     k = drawn_row(S, U)
     if k is None:
         return run([U])[0]
-    fwd, bwd = run([U[k:], U[:k][::-1].copy()])
+    return merged(S, U, k, *run([U[k:], U[:k][::-1].copy()]))
+
+
+def merged(S: PlanarSystem, U: np.ndarray, k: int, fwd: Sweep, bwd: Sweep) -> Sweep:
+    """The sweep of the inputs ``U`` from its sweeps forwards from row ``k`` (``fwd``) and
+    backwards from row ``k - 1`` (``bwd``), events re-indexed and worded for the way back."""
+    events = merged_events(k, bwd.events, fwd.events)
+
+    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.concatenate([a[::-1], b])
+
+    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
+                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
+                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method, engine=fwd.engine)
+
+
+def merged_events(k: int, bwd: list[Event], fwd: list[Event]) -> list[Event]:
+    """The events of the sweeps backwards from row ``k - 1`` and forwards from row ``k``
+    as events of the whole sweep (re-indexed, worded for the way back, by row)."""
     events = []
-    for e in bwd.events:
+    for e in bwd:
         at_row = e.kind == "singular" and not e.crossed
         e = e.with_(index=(k - 1 - e.index) if at_row else max(0, k - e.index), before_sweep=None)
         if e.kind == "dead point":
@@ -282,13 +327,7 @@ def outward(S: PlanarSystem, U: np.ndarray, run: Callable[[list], list[Sweep]]) 
             e = e.with_(message="assembles again (going back from the drawn configuration) after a gap, in the "
                                 "assembly mode nearest the drawn one")
         events.append(e)
-    for e in fwd.events:
+    for e in fwd:
         events.append(e.with_(index=e.index + k, before_sweep=None))
     events.sort(key=lambda e: e.index)
-
-    def cat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return np.concatenate([a[::-1], b])
-
-    return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
-                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
-                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method, engine=fwd.engine)
+    return events

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -97,8 +98,9 @@ class Step:
 class Plan:
     steps: tuple[Step, ...]
 
-    @property
+    @cached_property
     def closed_form_rates(self) -> bool:
+        """A driver-R + RRR chain (asked on every sweep and per dead point: kept)."""
         return all(s.kind in ("drive_R", "RRR") for s in self.steps)
 
     def describe(self) -> list[str]:

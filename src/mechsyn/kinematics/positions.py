@@ -109,14 +109,15 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
                     block[i, rows] -= 2 * math.pi * turns
         return block
     sub = ref + _wrap(phi - ref)
-    idx = np.flatnonzero(ok)
-    runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1)
+    # the runs of assembled rows [a, b): each unwrapped in place, then shifted by whole
+    # turns to follow the run before
+    edges = np.flatnonzero(ok[1:] != ok[:-1])
+    bounds = ([0] if ok[0] else []) + (edges + 1).tolist() + ([len(ok)] if ok[-1] else [])
     prev = None
-    for run in runs:
-        block = _unwrap_rows(sub[:, run])
+    for a, b in zip(bounds[0::2], bounds[1::2]):
+        block = _unwrap_rows(sub[:, a:b], inplace=True)
         if prev is not None:
             block -= 2 * np.pi * np.round((block[:, :1] - prev) / (2 * np.pi))
-        sub[:, run] = block
         prev = block[:, -1:]
     return sub
 

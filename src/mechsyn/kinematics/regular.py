@@ -22,18 +22,25 @@ values together and gives up (None) as soon as a group's discriminant falls belo
 :data:`mechsyn.kinematics.tracking.REGULAR_DISC`: no group then folds, touches a change
 point or reassembles, every group keeps its drawn mode and the answer is that of the
 tracked outward sweeps (tests check both agree), at the cost of one pass.
+:func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
+local minimum under 0.05 (no change or branch point near: every group keeps its drawn
+mode), and reads the folds, reassembly and singular rows of the tracked sweeps off the
+discriminant arrays (:func:`mechsyn.kinematics.tracking.fold_events`).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from mechsyn.kinematics.chain import _chain_program, _link_angles
-from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle
-from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows
+from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
+from mechsyn.kinematics.tracking import (REGULAR_DISC, _regular_rows, _sweep_events, fold_events, touch_candidates,
+                                         tracking_path)
 from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["regular_sweep", "LinkStates"]
+__all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
 
 
 def _program(S: PlanarSystem, plan: Plan) -> tuple:
@@ -72,6 +79,8 @@ class _Pass:
         self.M, self.anchor = M, anchor
         self.joint: dict[str, tuple] = {}  # id -> (P, V, A): complex arrays or numbers
         self.link: dict[int, tuple] = {}   # link -> (e^{i phi}, omega, alpha)
+        self.discs: dict[int, np.ndarray] = {}  # step -> the group's normalised discriminant
+        self.near = False  # a group came near a fold (below REGULAR_DISC)
 
     def point(self, i: int, s: complex) -> tuple:
         """State of the local point ``s`` of link ``i`` (the frame: -1)."""
@@ -110,8 +119,11 @@ class _Pass:
             self.joint.setdefault(jid, self.point(k, s_k))
             self.link[new] = (z * zk, wk + sgn * float(speeds[di]), alk)
 
-    def rrr(self, step: tuple, least: float) -> bool:
-        """Place one RRR dyad; False when its discriminant falls below ``least``."""
+    def rrr(self, step: tuple, least: float, folds: bool) -> np.ndarray | None:
+        """Place one RRR dyad and return its normalised discriminant (per row); None when
+        it falls below ``least`` and ``folds`` is false. With ``folds`` a folded row is NaN
+        (a fold within round-off is taken flat, as :func:`mechsyn.kinematics.chain.fast_chain`
+        takes it) and NaN propagates downstream."""
         _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, cbv1, cbv2, s1, s3 = step
         A = self.joint.get(J1) or self.point(k1, s1)
         C = self.joint.get(J3) or self.point(k3, s3)
@@ -119,10 +131,12 @@ class _Pass:
         d = np.subtract(C[0], A[0]) if isinstance(C[0], np.ndarray) or isinstance(A[0], np.ndarray) \
             else np.full(self.M, C[0] - A[0])
         inv, f, g = circle_circle(d.real, d.imag, L1s, L2s)
-        disc = g / inv
-        disc *= 1.0 / L1s
+        disc = normalised_disc(inv, g, L1s)
         if not disc.min() >= least:  # NaN too
-            return False
+            if not folds:
+                return None
+            self.near = True
+            np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
         if sigma < 0:
             np.negative(g, out=g)
@@ -132,7 +146,7 @@ class _Pass:
         B = e1 + A[0]
         e2 = B - C[0]
         self.joint[J2] = (B,) + self._rates(A, C, e1, e2, (b1, b2), (cbv1, cbv2))
-        return True
+        return disc
 
     def _rates(self, A: tuple, C: tuple, e1: np.ndarray, e2: np.ndarray, links: tuple, cbv: tuple) -> tuple:
         """The dyad's link rotations and rates; the middle joint's velocity, acceleration."""
@@ -168,7 +182,8 @@ def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     one pass, with the links' complex states (:class:`LinkStates`); None when a group
     comes near a fold on the sweep or on the way to it from the drawn configuration
     (``split``: the row after the drawn input values, see
-    :func:`mechsyn.kinematics.engines.drawn_row`).
+    :func:`mechsyn.kinematics.engines.drawn_row`; :func:`sweep_through_folds` goes on
+    through folds).
 
     Examples
     --------
@@ -184,33 +199,154 @@ def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
     steps, anchor, origin = _program(S, plan)
-    X = _regular_rows(S, U, split)
+    st = _run(steps, anchor, _regular_rows(S, U, split), speeds, folds=False)
+    return None if st is None else _poses(S, plan, U, st, origin, split)
+
+
+def _run(steps: list, anchor: dict, X: np.ndarray, speeds: np.ndarray, folds: bool) -> _Pass | None:
+    """One pass of the chain's steps over the input rows ``X``; the groups' normalised
+    discriminants in ``discs`` (by step). None when a group comes near a fold and
+    ``folds`` is false."""
     st = _Pass(X.shape[0], anchor)
     with np.errstate(invalid="ignore", divide="ignore"):
-        for step in steps:
+        for k, step in enumerate(steps):
             if step[0] == "drive":
                 st.drive(step, X, speeds)
-            elif not st.rrr(step, REGULAR_DISC):
+                continue
+            disc = st.rrr(step, REGULAR_DISC, folds)
+            if disc is None:
                 return None
-    return _poses(S, plan, U, st, origin, split)
+            st.discs[k] = disc
+    return st
+
+
+def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
+                        split: int | None) -> tuple | Folded | None:
+    """The regular pass of a driver-R + RRR chain through its folds (dead points, gaps).
+
+    One pass over the sweep's rows and the connecting paths from the drawn input values
+    (those of :func:`mechsyn.kinematics.tracking.solve_tracked_rates`) gives every group's
+    normalised discriminant as an array. When no group comes near a fold the answer is
+    :func:`regular_sweep`'s ``(q, qd, qdd, links)``. Else, when no group's discriminant
+    has a local minimum under 0.05 (no change or branch point can be near, so every group
+    keeps its drawn mode on every row and the pass's rows are the tracked ones), the
+    events of each sweep (the one sweep, or forwards and backwards from the drawn
+    configuration when ``split`` is a row) come from the discriminants by the branch
+    rules of :func:`mechsyn.kinematics.tracking.solve_tracked` (folds found and refined
+    on the group's discriminant, reassembly, singular rows): a :class:`Folded` (the
+    poses, and per sweep its singular rows and events), the tracked chain's answer. None
+    when a group's discriminant has such a minimum (the tracked chain decides what happens
+    there) or the plan is not such a chain.
+
+    Examples
+    --------
+    A textbook four-bar (crank sqrt(5), coupler and rocker sqrt(10), frame 5) from 100 to
+    260 degrees, one sweep (the drawn crank angle, 63.4 degrees, lies outside it): its
+    working range ends and starts again at the law-of-cosines angles 116.565 and 243.435
+    degrees, the 31 rows between them not assembled.
+
+    >>> import numpy as np
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.analysis import cached_plan
+    >>> kp = cached_plan(ms.examples.load("fourbar"), inputs=("A",))
+    >>> res = sweep_through_folds(kp.system, kp.groups, np.radians(np.arange(100.0, 261.0, 4.0))[:, None],
+    ...                           np.ones(1), None)
+    >>> (singular, events), = res.parts
+    >>> [(e.kind, e.index, round(float(np.degrees(e.input[0])), 9)) for e in events]
+    [('dead point', 5, 116.565051177), ('dead point', 36, 243.434948823), ('reassembled', 36, 244.0)]
+    >>> int(np.isnan(res.q[:, 0]).sum())
+    31
+    """
+    if not plan.closed_form_rates or S.n != 3 * len(S.links):
+        return None
+    steps, anchor, origin = _program(S, plan)
+    N = U.shape[0]
+    parts = [U] if split is None else [U[split:], U[:split][::-1]]
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    paths = [tracking_path(S, p[0], u0) for p in parts]
+    st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
+    if not st.near:
+        return _poses(S, plan, U, st, origin, split)
+    order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
+    # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
+    tracks = [(np.concatenate([path, p - shift]), path.shape[0], shift) for (path, shift), p in zip(paths, parts)]
+    rows, start = [], N  # each sweep's rows of the pass: its connecting path, then its inputs
+    for (_, n0, _), idx in zip(tracks, order):
+        rows.append(np.concatenate([np.arange(start, start + n0), idx]))
+        start += n0
+    ks = sorted(st.discs)
+    D = np.stack([st.discs[k] for k in ks])
+    parts = [D[:, r] for r in rows]
+    if any(touch_candidates(P).size for P in parts):
+        return None
+    sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
+    out = []
+    for (X, n0, shift), P in zip(tracks, parts):
+        events, singular, _ = fold_events(S, plan, ks, sigmas, X, P, n0)
+        out.append((singular[n0:], _sweep_events(events, n0, shift)))
+    return Folded(*_fold_poses(S, plan, U, st, origin, split), out)
+
+
+@dataclass
+class Folded:
+    """A sweep through folds in one pass (:func:`sweep_through_folds`): poses and rates (N,
+    n) with NaN rows where the mechanism is not assembled and NaN rates where they are
+    not defined (the group folded flat), and per tracked sweep (the one sweep, or the
+    sweeps forwards from the drawn input values and backwards) its singular rows and
+    events (rows counted along that sweep)."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    parts: list
+
+
+def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
+    """The pose rows ``q, qd, qdd`` (N, n) of the sweep ``U`` (the first N rows of the
+    pass) through folds: NaN rows where a group is not assembled, NaN rates where they
+    are not defined (inf at a group folded flat), each link's angle continuous along
+    each tracked sweep from the drawn one."""
+    C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
+    ok = np.isfinite(C[0]).all(axis=0)
+    parts = (slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))
+    _link_angles(S, plan, U, C[0].real, C[0].imag, ok, q[2::3], parts=parts)
+    bad = ~ok | ~(np.isfinite(qd).all(axis=0) & np.isfinite(qdd).all(axis=0))
+    q[:, ~ok] = np.nan
+    qd[:, bad] = np.nan
+    qdd[:, bad] = np.nan
+    return q.T, qd.T, qdd.T
+
+
+def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:
+    """The links' complex states (:func:`_states`) and the pose rows ``q, qd, qdd`` (n, N,
+    component-major) of the first N rows of a pass, the dyads' link angles left to fill."""
+    nl = len(S.links)
+    C = _states(st, origin, N, nl)
+    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))
+    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
+        buf[0::3], buf[1::3] = x.real, x.imag
+    for i in range(nl):  # angular velocity and acceleration
+        for buf, x in ((qd, st.link[i][1]), (qdd, st.link[i][2])):
+            buf[3 * i + 2] = x[:N] if isinstance(x, np.ndarray) else x
+    return C, q, qd, qdd
+
+
+def _states(st: _Pass, origin: list, N: int, nl: int) -> np.ndarray:
+    """Every link's rotation and its origin's position, velocity, acceleration in the
+    first N rows of a pass (4, n_links, N)."""
+    C = np.empty((4, nl, N), complex)
+    for i in range(nl):
+        j = origin[i]
+        for k, x in enumerate((st.link[i][0],) + (st.joint[j] if j in st.joint else st.point(i, 0j))):
+            C[k, i] = x[:N] if isinstance(x, np.ndarray) else x
+    return C
 
 
 def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
     origin is its first joint, its angle continuous from the drawn one) and the links'
     complex states."""
-    N, nl = U.shape[0], len(S.links)
-    C = np.empty((4, nl, N), complex)  # rotation, origin position, velocity, acceleration
-    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))  # component-major, returned transposed
-    for i in range(nl):
-        zi, wi, ali = st.link[i]
-        j = origin[i]
-        for k, x in enumerate((zi,) + (st.joint[j] if j in st.joint else st.point(i, 0j))):
-            C[k, i] = x[:N] if isinstance(x, np.ndarray) else x
-        qd[3 * i + 2] = wi[:N] if isinstance(wi, np.ndarray) else wi
-        qdd[3 * i + 2] = ali[:N] if isinstance(ali, np.ndarray) else ali
-    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
-        buf[0::3], buf[1::3] = x.real, x.imag
+    C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
     return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
 

@@ -20,7 +20,8 @@ from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates"]
+__all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates", "touch_candidates",
+           "fold_events", "tracking_path"]
 
 
 #: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
@@ -84,8 +85,8 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     2. A group's normalised discriminant ``Delta`` (RRR: ``h^2 / L1^2``; RRP: the
        circle-line discriminant over ``L1^2``; RPR: ``1 - (e/|AC|)^2``) crossing zero is a
        *fold* (dead point): the group cannot be assembled beyond it; the input is found by
-       Brent's method on ``Delta`` of that group alone (upstream groups re-evaluated at the
-       trial input), to 1e-12 of the step.
+       regula falsi (Illinois, :func:`_fold_root`) on ``Delta`` of that group alone
+       (upstream groups re-evaluated at the trial input), to 1e-14 of the step.
     3. ``Delta`` touching zero without changing sign (a local minimum at zero, found by
        Brent's method on ``dDelta/du``) is a *bifurcation* (change point, flat rhombus):
        both modes meet, and the motion whose velocity is continuous is the one on which
@@ -170,12 +171,20 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
     """The rows a tracked sweep evaluates: the connecting path from the drawn input
     values (``n0`` rows), then the sweep shifted by whole turns next to them."""
     U = np.atleast_2d(np.asarray(inputs, float))
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    # R inputs a whole number of turns from the drawn values are the same configurations:
-    # track the sweep shifted next to the drawn values (its rows then follow each other)
-    shift = U[0] - _shifted_start(S, u0, U[0])
-    path = _connecting_path(S, u0, U[0] - shift)
+    path, shift = tracking_path(S, U[0])
     return np.vstack([path, U - shift]), path.shape[0], shift
+
+
+def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The connecting path from the drawn input values to a tracked sweep whose first
+    input values are ``first``, and the whole turns ``shift`` the sweep is tracked
+    shifted by (R inputs a whole number of turns from the drawn values are the same
+    configurations: the sweep is tracked next to the drawn values, so that its rows
+    follow each other); ``u0``: the drawn input values when known."""
+    if u0 is None:
+        u0 = np.array([d.assembled for d in S.drivers], float)
+    shift = first - _shifted_start(S, u0, first)
+    return _connecting_path(S, u0, first - shift), shift
 
 
 def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
@@ -301,53 +310,215 @@ def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray,
     return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
 
 
+def touch_candidates(disc: np.ndarray) -> np.ndarray:
+    """Rows where a group's normalised discriminant ``disc`` (per row, in sweep order) may
+    touch zero: its local minima under 0.05 among the rows where it is assembled (the
+    candidates of a change or branch point, decided by :func:`_touch`); of several groups
+    (rows of ``disc``): any candidate shows (the flat indices are not rows then)."""
+    d = np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan)
+    mid = d[..., 1:-1]
+    return np.flatnonzero((mid <= d[..., :-2]) & (mid <= d[..., 2:]) & (mid < 0.05)) + 1
+
+
+def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.ndarray, D: np.ndarray,
+                n0: int) -> tuple[list, np.ndarray, list]:
+    """Folds and reassembly of the branched steps ``ks`` on one sweep's rows ``X`` (M,
+    n_inputs; the first ``n0`` the connecting path) from their normalised discriminants
+    ``D`` (len(ks), M), all groups at once (branch rules 2 and 4 of :func:`solve_tracked`).
+
+    A fold (the group's own discriminant changes sign between two rows, both evaluated)
+    is a dead point, its input found on the discriminant along the segment between the
+    rows (:func:`_fold_root` on :func:`_disc_line`, upstream groups in their modes
+    ``sigmas`` of the earlier row; the ends' values are ``D``'s). A group assembled at
+    one row and cut off at the next by an upstream group's fold may fold first between
+    the same rows: its discriminant at the upstream fold decides, and the earlier fold is
+    the limit of the working range (likewise where the assembly starts again). A row where the group assembles after rows where it
+    (or an upstream group) did not is a reassembly. Returns the events (per group in the
+    order of ``ks``: its folds, then its reassemblies, each by row), the singular rows
+    (M,) (a group folded flat within :data:`SINGULAR_DISC`) and per group the rows where
+    it reassembles."""
+    ok = D > -_ZERO_DISC
+    singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
+    finite = np.isfinite(D)
+    fold = ok[:, 1:] != ok[:, :-1]
+    fold &= finite[:, 1:]
+    fold &= finite[:, :-1]
+    back = ok[:, 1:] & ~ok[:, :-1]
+    folds = _rows_by_group(fold)
+    backs = _rows_by_group(back)
+    events: list = []
+    resets = []
+    ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
+    starts: dict[int, float] = {}  # row -> where (t) it starts again before it
+    for g, k in enumerate(ks):
+        group = "-".join(plan.steps[k].joints)
+        rows = [(i, 0) for i in folds[g]]
+        if ends or starts:
+            # assembled at one row and cut off by an upstream group at the next (or the
+            # other way round): its own fold may come first, hidden between the rows
+            rows += [(i, 1) for i in (np.flatnonzero(ok[g, :-1] & ~finite[g, 1:]) + 1).tolist() if i in ends]
+            rows += [(i, -1) for i in (np.flatnonzero(~finite[g, :-1] & ok[g, 1:]) + 1).tolist() if i in starts]
+        for i, hidden in sorted(rows):
+            t = _four_bar_fold(S, plan, k, X[i - 1], X[i]) if not hidden else None
+            if t is None:
+                f = _disc_line(S, plan, k, sigmas, X, i - 1, i)
+                t = _hidden_fold(f, float(D[g, i - 1]), float(D[g, i]), ends, starts, i, hidden)
+            if t is None:
+                continue
+            inside = ok[g, i - 1] if not hidden else hidden > 0
+            if inside:
+                ends[i] = min(t, ends.get(i, 1.0))
+            else:
+                starts[i] = max(t, starts.get(i, 0.0))
+            u = X[i - 1] + t * (X[i] - X[i - 1])
+            if inside:
+                events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its "
+                                    "discriminant changes sign: a dead point / limit of the working range)",
+                                    u.tolist(), group))
+            else:
+                events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working "
+                                    "range", u.tolist(), group))
+        resets.append(backs[g])
+        for i in backs[g]:
+            if i < n0:
+                continue
+            events.append(Event(i, "reassembled", f"assembles again after a gap, in the assembly mode of the "
+                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
+                                X[i].tolist(), group))
+    return events, singular, resets
+
+
+def _rows_by_group(mask: np.ndarray) -> list[list[int]]:
+    """The rows ``i`` (of the step from row i - 1) where ``mask`` (groups, M - 1) holds,
+    per group, from one ``nonzero``."""
+    gs, js = np.nonzero(mask)
+    out: list[list[int]] = [[] for _ in range(mask.shape[0])]
+    for g, j in zip(gs.tolist(), js.tolist()):
+        out[g].append(j + 1)
+    return out
+
+
+def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: np.ndarray, xb: np.ndarray) -> float | None:
+    """Where (t in [0, 1]) RRR step ``k`` folds on the segment of inputs from ``xa`` to
+    ``xb``, in closed form when the group closes a four-bar: one end joint on the frame,
+    the other on a crank turned by the only input about a frame pivot. The group folds
+    where ``|P(u) - C| = L1 + L2`` or ``|L1 - L2|``, ``P(u) = O + e^{i s u} w`` (``O``
+    the crank's pivot, ``w`` the joint's offset from it on the crank, ``s`` the input's
+    sign), by the law of cosines: ``|v|^2 + |w|^2 + 2 |v| |w| cos(s u + arg w - arg v) =
+    (L1 +- L2)^2`` with ``v = O - C``. None when the group is not such a four-bar or the
+    segment holds not exactly one such angle (the numerical search decides)."""
+    spec = _four_bar_spec(S, plan, k)
+    if spec is None:
+        return None
+    v, w, sgn, targets = spec
+    ua, ub = float(xa[0]), float(xb[0])
+    lo, hi = min(ua, ub), max(ua, ub)
+    av, aw = abs(v), abs(w)
+    beta = math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real)
+    slack = 1e-12 * (hi - lo)
+    found = []
+    for D2 in targets:
+        c = (D2 - av * av - aw * aw) / (2 * av * aw)
+        if not -1.0 < c < 1.0:
+            continue
+        ac = math.acos(c)
+        for psi in (ac - beta, -ac - beta):
+            u = sgn * psi
+            u += 2 * math.pi * round((0.5 * (lo + hi) - u) / (2 * math.pi))
+            if lo - slack <= u <= hi + slack:
+                found.append(u)
+    if len(found) != 1:
+        return None
+    return min(1.0, max(0.0, (found[0] - ua) / (ub - ua)))
+
+
+def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
+    """``(v, w, s, ((L1 + L2)^2, (L1 - L2)^2))`` of :func:`_four_bar_fold` for RRR step
+    ``k``, or None (kept with the system)."""
+    memo = _memo(S)
+    key = ("four-bar fold", id(plan), k)
+    if key in memo:
+        return memo[key]
+    out = None
+    if len(S.drivers) == 1 and plan.closed_form_rates:
+        prog = _scalar_program(S, plan)
+        cranks = {op[1]: op for op in prog if op[0] == "drive" and op[2] < 0}
+        _, (k1, sa), (k3, sc), _, L1s, L2s, *_ = prog[k]
+        ends = {kk: complex(*ss) for kk, ss in ((k1, sa), (k3, sc))}
+        crank = next((kk for kk in ends if kk in cranks), None)
+        if len(ends) == 2 and -1 in ends and crank is not None:
+            _, _, _, O, _, sgn, s_pivot = cranks[crank]
+            L1, L2 = math.sqrt(L1s), math.sqrt(L2s)
+            out = (complex(*O) - ends[-1], ends[crank] - complex(*s_pivot), sgn, ((L1 + L2) ** 2, (L1 - L2) ** 2))
+    memo[key] = out
+    return out
+
+
+def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidden: int) -> float | None:
+    """Where (t) a group folds between rows ``i - 1`` and ``i`` (``f`` its discriminant
+    along the segment, ``fa``, ``fb`` its values at the rows). ``hidden`` 0: its own
+    discriminant changes sign between the rows (t at the ends when the change is round-off
+    only); 1: it is assembled at row i - 1 and an upstream group ends the assembly at
+    ``ends[i]``: the group's own fold before that point, if its discriminant is negative
+    there (else None); -1: likewise after an upstream start at ``starts[i]``."""
+    if not hidden:
+        t = _fold_root(f, fa, fb)
+        return t if t is not None else (0.0 if fa > -_ZERO_DISC else 1.0)
+    tc = ends[i] if hidden > 0 else starts[i]
+    fc = f(tc)
+    if not fc <= -_ZERO_DISC:
+        return None
+    return _fold_root(f, fa, fc, b=tc) if hidden > 0 else _fold_root(f, fc, fb, a=tc)
+
+
+def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14, a: float = 0.0, b: float = 1.0) -> float | None:
+    """The zero ``t`` in [a, b] (default the segment [0, 1]) of the discriminant ``f(t)``
+    along a segment, ``f(a) = fa``, ``f(b) = fb`` (known, so not evaluated again):
+    secant steps through the last two iterates (order 1.6 on the smooth discriminant of
+    a fold), a regula falsi step of the bracket when one would leave it, stopped when the
+    next step is below ``xtol`` (about four evaluations from one input step to 1e-14 of
+    it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when the ends
+    do not bracket a zero."""
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
+        return None
+    x0, f0, x1, f1 = a, fa, b, fb  # the bracket [a, b] (f(a) has the sign of fa)
+    t = (a * fb - b * fa) / (fb - fa)
+    for _ in range(100):
+        if not a < t < b:
+            t = (a * fb - b * fa) / (fb - fa)
+            if not a < t < b:
+                t = 0.5 * (a + b)
+        ft = f(t)
+        if ft == 0.0 or not math.isfinite(ft):
+            return t
+        if (ft > 0.0) == (fa > 0.0):
+            a, fa = t, ft
+        else:
+            b, fb = t, ft
+        x0, f0, x1, f1 = x1, f1, t, ft
+        step = f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else 0.0
+        if abs(step) <= xtol or b - a <= xtol:
+            return min(max(x1 - step, a), b)
+        t = x1 - step
+    return t
+
+
 def _branch_signs(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, disc: np.ndarray,
                   s_file: float, n0: int, switch: bool = False) -> tuple[np.ndarray, list, np.ndarray]:
     """Assembly sign per row of a branched step (rules of :func:`solve_tracked`)."""
-    from scipy.optimize import brentq
-
     M = len(disc)
     step = plan.steps[k]
     group = "-".join(step.joints)
     size = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])  # inputs relative to the size
-    ok = disc > -_ZERO_DISC
-    d = np.where(ok, np.maximum(disc, 0.0), np.nan)
-
-    def f_line(i0: int, i1: int):
-        return _disc_line(S, plan, k, sigmas, X, i0, i1)
-
-    events: list = []
-    singular = np.zeros(M, bool)
-    singular[ok & (d < SINGULAR_DISC)] = True
-    breaks: list[tuple[int, str]] = []  # (row, "flip" | "reset")
-    finite = np.isfinite(disc)
-    # folds: the group's own discriminant changes sign between two rows
-    for i in np.flatnonzero(ok[1:] != ok[:-1]) + 1:
-        if not (finite[i] and finite[i - 1]):
-            continue
-        inside = i - 1 if ok[i - 1] else i
-        try:
-            t = brentq(f_line(i - 1, i), 0.0, 1.0, xtol=1e-13, rtol=4 * np.finfo(float).eps)
-        except ValueError:
-            t = 0.0 if inside == i - 1 else 1.0
-        u = X[i - 1] + t * (X[i] - X[i - 1])
-        if ok[i - 1]:
-            events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
-                                "changes sign: a dead point / limit of the working range)", u.tolist(), group))
-        else:
-            events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working range",
-                                u.tolist(), group))
-    # reassembly after a gap (own or upstream): the drawn mode
-    for i in np.flatnonzero(ok[1:] & ~ok[:-1]) + 1:
-        breaks.append((int(i), "reset"))
-        if i >= n0:
-            events.append(Event(int(i), "reassembled", f"assembles again after a gap, in the assembly mode of the "
-                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
-                                X[i].tolist(), group))
+    events, singular, resets = fold_events(S, plan, [k], sigmas, X, disc[None], n0)
+    breaks: list[tuple[int, str]] = [(i, "reset") for i in resets[0]]  # (row, "flip" | "reset")
     # bifurcations: local minima of the discriminant at zero
     touched: list = []
-    cand = np.flatnonzero((d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] < 0.05)) + 1
-    for i in cand.tolist():
+    for i in touch_candidates(disc).tolist():
         t_star, dmin = _touch(S, plan, k, sigmas, X, i)
         if dmin > 1e-10:
             continue  # a sharp but regular turn
