@@ -75,16 +75,20 @@ __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismP
 
 def _sweep_grid(u0_deg: float, values: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
     """Dense input grid from the drawn value ``u0_deg`` (shifted by whole turns to the one
-    nearest ``values[0]``) through every value in order; returns (grid, target indices)."""
+    nearest ``values[0]``) through every value in order, each segment evenly divided in
+    steps of at most ``step`` (as :func:`numpy.linspace`); returns (grid, target indices)."""
     u0 = u0_deg + 360.0 * np.round((values[0] - u0_deg) / 360.0)
-    knots = np.concatenate([[u0], values])
-    parts, idx, n = [np.array([u0])], [], 1
-    for a, b in zip(knots[:-1], knots[1:]):
-        m = max(1, int(np.ceil(abs(b - a) / step)))
-        parts.append(np.linspace(a, b, m + 1)[1:])
-        n += m
-        idx.append(n - 1)
-    return np.concatenate(parts), np.array(idx)
+    a = np.concatenate([[u0], values[:-1]])
+    b = np.asarray(values, float)
+    m = np.maximum(1, np.ceil(np.abs(b - a) / step).astype(int))
+    idx = np.cumsum(m)
+    seg = np.repeat(np.arange(len(m)), m)
+    k = np.arange(1, idx[-1] + 1) - (idx - m)[seg]  # 1..m within each segment
+    grid = np.empty(idx[-1] + 1)
+    grid[0] = u0
+    grid[1:] = k * ((b - a) / m)[seg] + a[seg]
+    grid[idx] = b  # each segment ends exactly on its value
+    return grid, idx
 
 
 def _build(case: MechanismCase, x: np.ndarray, fast: bool = True) -> tuple[Any, Any, Any]:
@@ -121,28 +125,27 @@ class _Template:
         self.index = {j.id: k for k, j in enumerate(mech.joints)}
 
     def mechanism(self, case: MechanismCase, x: np.ndarray) -> Mechanism | None:
-        """The mechanism of design ``x``; None where the numbers are not finite or a
-        direction is zero (the general path's reader names the field)."""
+        """The mechanism of design ``x``; None where a number is not finite or a direction
+        is zero (the general path's reader names the field)."""
         pts, axes, named = design_numbers(case, x)
-        joints = list(self.mech.joints)
-        for jid, p in pts.items():
-            k = self.index.get(jid)  # a locked VLL's P joint is merged away
-            if k is not None:
-                joints[k] = replace(joints[k], point=np.asarray(p, float))
-        for jid, u in axes.items():
-            k = self.index.get(jid)
-            if k is not None:
-                a = np.asarray(u, float)
-                norm = float(np.linalg.norm(a))
-                if not norm >= 1e-12:
-                    return None
-                joints[k] = replace(joints[k], axis=a / norm)  # a unit vector, as the reader stores it
-        if not all(np.isfinite(joints[self.index[jid]].point).all() for jid in pts if jid in self.index):
+        if not all(np.isfinite(v).all() for v in (*pts.values(), *axes.values(), *named.values())):
             return None
-        points = self.mech.points
+        mech = self.mech.with_joint_points({jid: p for jid, p in pts.items() if jid in self.index})
+        if axes:  # a VLL's cylinder direction (its P joint is merged away when locked)
+            joints = list(mech.joints)
+            for jid, u in axes.items():
+                k = self.index.get(jid)
+                if k is not None:
+                    a = np.asarray(u, float)
+                    norm = float(np.linalg.norm(a))
+                    if norm < 1e-12:
+                        return None
+                    joints[k] = replace(joints[k], axis=a / norm)  # a unit vector, as the reader stores it
+            mech = replace(mech, joints=tuple(joints))
         if named:
-            points = {n: replace(q, at=np.asarray(named[n], float)) if n in named else q for n, q in points.items()}
-        return check_geometry(replace(self.mech, joints=tuple(joints), points=points), case.source)
+            mech = replace(mech, points={n: replace(q, at=np.asarray(named[n], float)) if n in named else q
+                                         for n, q in mech.points.items()})
+        return check_geometry(mech, case.source)
 
 
 #: The template of each of the last cases evaluated (keyed by the case object, kept with it).
