@@ -445,10 +445,9 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     budget either way (until ``0.85 (r + 1) / restarts`` of the limit), so the result is
     the single-process one unless the time limit cuts the searches short.
     ``batch``: evaluate populations through the batch engine where the case allows
-    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
-    ``fast``: each design's engine sweep on the case's parsed mechanism and compiled plan
-    with the design's numbers filled in (see :func:`evaluate_mechanism_design`); false:
-    each design parsed and built anew. The result is the same.
+    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design, on the
+    case's compiled plan with the design's numbers filled in (``fast``, see
+    :func:`evaluate_mechanism_design`) or parsed and built anew: the same result.
 
     ``seed``: an int, ``None`` or a ``numpy.random.Generator`` (the result's ``seed`` is
     the int that repeats the run). ``callback(state)`` gets a
