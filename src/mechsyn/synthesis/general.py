@@ -148,8 +148,10 @@ class _Template:
         return check_geometry(mech, case.source)
 
 
-#: The template of each of the last cases evaluated (keyed by the case object, kept with it).
-_TEMPLATES: "OrderedDict[int, tuple[MechanismCase, _Template | None]]" = OrderedDict()
+#: The template of each of the last eight cases evaluated, kept with the case object, its
+#: mechanism dict and its variables (a case given a new dict or new variables gets a new
+#: template; cases are not changed in place).
+_TEMPLATES: "OrderedDict[int, tuple[MechanismCase, dict, list, _Template | None]]" = OrderedDict()
 
 
 def _template(case: MechanismCase) -> _Template | None:
@@ -158,12 +160,13 @@ def _template(case: MechanismCase) -> _Template | None:
     variable moves a VLL's P joint or piston pivot (their coincidence, which the VLL
     needs, is then a property of the design, checked by the general path)."""
     entry = _TEMPLATES.get(id(case))
-    if entry is not None and entry[0] is case:
-        return entry[1]
-    _TEMPLATES[id(case)] = (case, _new_template(case))
+    if entry is not None and entry[0] is case and entry[1] is case.mech_dict and entry[2] is case.variables:
+        return entry[3]
+    tpl = _new_template(case)
+    _TEMPLATES[id(case)] = (case, case.mech_dict, case.variables, tpl)
     while len(_TEMPLATES) > 8:
         _TEMPLATES.popitem(last=False)
-    return _TEMPLATES[id(case)][1]
+    return tpl
 
 
 def _new_template(case: MechanismCase) -> _Template | None:
