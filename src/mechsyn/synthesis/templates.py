@@ -96,10 +96,11 @@ class DictTemplate:
             all(eq(p.at, m.points[n].at) for n, p in self.mech.points.items()) and \
             all(a.attrs == b.attrs for a, b in zip(self.mech.links, m.links)) and self.mech.attrs == m.attrs
 
-    def mechanism(self, d: dict) -> Mechanism | None:
-        """The mechanism of ``d`` (same structure) with its numbers, geometry-checked; None
-        where ``d`` must be parsed (another structure, a number the reader refuses)."""
-        if not self.usable or structure_key(d) != self.key:
+    def mechanism(self, d: dict, key: str | None = None) -> Mechanism | None:
+        """The mechanism of ``d`` (same structure; ``key``: its :func:`structure_key` when
+        known) with its numbers, geometry-checked; None where ``d`` must be parsed (another
+        structure, a number the reader refuses)."""
+        if not self.usable or (structure_key(d) if key is None else key) != self.key:
             return None
         m, dim = self.mech, self.mech.dim
         joints = list(m.joints)

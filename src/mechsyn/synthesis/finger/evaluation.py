@@ -45,7 +45,7 @@ from mechsyn.kinematics.analysis import resolve_points
 from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger.cases import FingerCase
 from mechsyn.synthesis.finger.vll import copy_mechanism, locked_model, region_excess, vll_ends
-from mechsyn.synthesis.templates import DictTemplate
+from mechsyn.synthesis.templates import DictTemplate, structure_key
 
 __all__ = ["INFEASIBLE", "Objective", "apply_design", "FingerEvaluation", "evaluate_locked", "evaluate_drawn"]
 
@@ -153,32 +153,36 @@ def evaluate_drawn(case: FingerCase, d: dict) -> FingerEvaluation:
     return ev
 
 
-#: The parsed locked model of each of the last eight cases (kept with the case object).
-_TEMPLATES: "OrderedDict[int, tuple[FingerCase, DictTemplate]]" = OrderedDict()
+#: The parsed locked models of the last cases and structures (kept with the case object).
+_TEMPLATES: "OrderedDict[tuple[int, str], tuple[FingerCase, DictTemplate]]" = OrderedDict()
 
 
 def _template(case: FingerCase, d: dict) -> DictTemplate | None:
-    """The case's parsed locked model (:class:`~mechsyn.synthesis.templates.DictTemplate`),
-    made from the first locked dict ``d`` that parses; None until then."""
-    entry = _TEMPLATES.get(id(case))
+    """The parsed locked model (:class:`~mechsyn.synthesis.templates.DictTemplate`) of
+    the case with the structure of the locked dict ``d``, made from the first such dict
+    that parses; None until then."""
+    key = structure_key(d)
+    if key is None:
+        return None
+    entry = _TEMPLATES.get((id(case), key))
     if entry is not None and entry[0] is case:
         return entry[1]
     try:
         tpl = DictTemplate(d, case.source)
     except MechsynInputError:
         return None
-    _TEMPLATES[id(case)] = (case, tpl)
-    while len(_TEMPLATES) > 8:
+    _TEMPLATES[(id(case), key)] = (case, tpl)
+    while len(_TEMPLATES) > 16:
         _TEMPLATES.popitem(last=False)
     return tpl
 
 
 def _locked_system(case: FingerCase, d: dict) -> tuple[Any, Any, Any]:
     """(mechanism, constraint system, decomposition) of the locked dict ``d``: its numbers
-    filled into the case's parsed locked model and compiled plan when ``d`` has its
-    structure (no parsing per design), else parsed and built."""
+    filled into the case's parsed locked model of its structure and the compiled plan (no
+    parsing per design), else parsed and built."""
     tpl = _template(case, d)
-    mech = tpl.mechanism(d) if tpl is not None else None
+    mech = tpl.mechanism(d, tpl.key) if tpl is not None else None
     if mech is not None:
         kp = tpl.plan(mech)
         return mech, kp.system, kp.groups
