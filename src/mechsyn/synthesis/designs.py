@@ -32,7 +32,7 @@ import numpy as np
 from mechsyn.synthesis.cases import MechanismCase
 from mechsyn.synthesis.finger.vll import vll_ends
 
-__all__ = ["start_vector", "apply_mechanism_design", "MechanismEvaluation", "infeasibility"]
+__all__ = ["start_vector", "design_numbers", "apply_mechanism_design", "MechanismEvaluation", "infeasibility"]
 
 
 def start_vector(case: MechanismCase) -> np.ndarray:
@@ -53,27 +53,57 @@ def start_vector(case: MechanismCase) -> np.ndarray:
     return np.array(x, float)
 
 
-def apply_mechanism_design(case: MechanismCase, x: np.ndarray) -> dict:
-    """The mechanism dict of design vector ``x`` (design part; timing values ignored).
-    A VLL's length moves its piston pivot along the cylinder's direction (paper 000's
-    drawing, as in :func:`mechsyn.synthesis.finger.design.apply_design`)."""
-    d = copy.deepcopy(case.mech_dict)
-    joints = {j["id"]: j for j in d["joints"]}
+def design_numbers(case: MechanismCase, x: np.ndarray) -> tuple[dict, dict, dict]:
+    """The numbers design vector ``x`` (design part) changes in the case's mechanism file:
+    joint points ``{id: [x, y]}``, P axes ``{id: [dx, dy]}`` (a VLL's cylinder direction)
+    and named points ``{name: [x, y]}``, the file's other numbers unchanged. A VLL's length
+    moves its piston pivot along the cylinder's direction (paper 000's drawing, as in
+    :func:`mechsyn.synthesis.finger.design.apply_design`).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.cases import load_mechanism_case
+    >>> case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
+    >>> pts, axes, named = design_numbers(case, start_vector(case))
+    >>> sorted(pts), axes, sorted(named)
+    (['B', 'C'], {}, ['M'])
+    """
+    md = case.mech_dict
+    base = {j["id"]: j for j in md["joints"]}
+    pts: dict[str, list] = {}
+    axes: dict[str, list] = {}
+    named: dict[str, list] = {}
     for v, val in zip(case.variables, np.asarray(x, float)):
         if v.kind == "joint":
-            joints[v.target]["point"][v.coord] = float(val)
+            pts.setdefault(v.target, list(base[v.target]["point"]))[v.coord] = float(val)
         elif v.kind == "point":
-            d["points"][v.target]["at"][v.coord] = float(val)
+            named.setdefault(v.target, list(md["points"][v.target]["at"]))[v.coord] = float(val)
     for v, val in zip(case.variables, np.asarray(x, float)):
         if v.kind == "length":
-            _c, L, K, _p = vll_ends(d, v.target, case.source)
-            pk = np.asarray(joints[K]["point"], float)
-            u = np.asarray(joints[v.target]["point"], float) - pk
+            view = {**md, "joints": [{**j, "point": pts.get(j["id"], j["point"])} for j in md["joints"]]}
+            _c, L, K, _p = vll_ends(view, v.target, case.source)
+            pk = np.asarray(pts.get(K, base[K]["point"]), float)
+            u = np.asarray(pts.get(v.target, base[v.target]["point"]), float) - pk
             u = u / np.linalg.norm(u)
             p = (pk + float(val) * u).tolist()
-            joints[v.target]["point"] = p
-            joints[v.target]["axis"] = u.tolist()
-            joints[L]["point"] = p
+            pts[v.target] = pts[L] = p
+            axes[v.target] = u.tolist()
+    return pts, axes, named
+
+
+def apply_mechanism_design(case: MechanismCase, x: np.ndarray) -> dict:
+    """The mechanism dict of design vector ``x`` (design part; timing values ignored):
+    the file's dict with the numbers of :func:`design_numbers`."""
+    pts, axes, named = design_numbers(case, x)
+    d = copy.deepcopy(case.mech_dict)
+    for j in d["joints"]:
+        if j["id"] in pts:
+            j["point"] = pts[j["id"]]
+        if j["id"] in axes:
+            j["axis"] = axes[j["id"]]
+    for n, at in named.items():
+        d["points"][n]["at"] = at
     return d
 
 

@@ -42,7 +42,8 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from collections import OrderedDict
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -51,14 +52,17 @@ from mechsyn.checkpoint import open_search_checkpoint
 from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
 from mechsyn.io import mechanism_from_dict
+from mechsyn.io.checks import check_geometry
 from mechsyn.kinematics import dyads
-from mechsyn.kinematics.analysis import resolve_points
+from mechsyn.kinematics.analysis import KinematicPlan, compile_plan, resolve_points
 from mechsyn.kinematics.solve import sweep
 from mechsyn.kinematics.system import build_system
+from mechsyn.model.mechanism import Mechanism
 from mechsyn.parallel import run_tasks
 from mechsyn.synthesis.cases import DesignVariable, MechanismCase, mechanism_case_from_dict, load_mechanism_case
-from mechsyn.synthesis.designs import MechanismEvaluation, apply_mechanism_design, infeasibility, start_vector
-from mechsyn.synthesis.finger.vll import locked_model
+from mechsyn.synthesis.designs import (MechanismEvaluation, apply_mechanism_design, design_numbers, infeasibility,
+                                      start_vector)
+from mechsyn.synthesis.finger.vll import locked_model, vll_ends
 from mechsyn.synthesis.general_batch import batch_evaluator
 from mechsyn.synthesis.optimize import OPTIMIZERS, check_optimizer, polish, restart_seeds
 from mechsyn.synthesis.problem import Progress, ProgressCallback, SeedLike, SynthesisResult, resolve_seed
@@ -71,26 +75,126 @@ __all__ = ["DesignVariable", "MechanismCase", "MechanismEvaluation", "MechanismP
 
 def _sweep_grid(u0_deg: float, values: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
     """Dense input grid from the drawn value ``u0_deg`` (shifted by whole turns to the one
-    nearest ``values[0]``) through every value in order; returns (grid, target indices)."""
+    nearest ``values[0]``) through every value in order, each segment evenly divided in
+    steps of at most ``step`` (as :func:`numpy.linspace`); returns (grid, target indices)."""
     u0 = u0_deg + 360.0 * np.round((values[0] - u0_deg) / 360.0)
-    knots = np.concatenate([[u0], values])
-    parts, idx, n = [np.array([u0])], [], 1
-    for a, b in zip(knots[:-1], knots[1:]):
-        m = max(1, int(np.ceil(abs(b - a) / step)))
-        parts.append(np.linspace(a, b, m + 1)[1:])
-        n += m
-        idx.append(n - 1)
-    return np.concatenate(parts), np.array(idx)
+    a = np.concatenate([[u0], values[:-1]])
+    b = np.asarray(values, float)
+    m = np.maximum(1, np.ceil(np.abs(b - a) / step).astype(int))
+    idx = np.cumsum(m)
+    seg = np.repeat(np.arange(len(m)), m)
+    k = np.arange(1, idx[-1] + 1) - (idx - m)[seg]  # 1..m within each segment
+    grid = np.empty(idx[-1] + 1)
+    grid[0] = u0
+    grid[1:] = k * ((b - a) / m)[seg] + a[seg]
+    grid[idx] = b  # each segment ends exactly on its value
+    return grid, idx
 
 
-def _build(case: MechanismCase, x: np.ndarray) -> tuple[Any, Any, Any, dict]:
+def _build(case: MechanismCase, x: np.ndarray, fast: bool = True) -> tuple[Any, Any, Any]:
+    """(mechanism, constraint system, decomposition) of design ``x``: on the case's
+    template (:func:`_template`, the topology-keyed fast path) when it has one and
+    ``fast``, else parsed and built from the design's dict (the general path)."""
+    tpl = _template(case) if fast else None
+    if tpl is not None:
+        mech = tpl.mechanism(case, x)
+        if mech is not None:
+            kp = tpl.plan.refilled(mech)
+            return mech, kp.system, kp.groups
     d = apply_mechanism_design(case, x)
-    ev_d = d
     if any(j.get("vll") == "locked" for j in d["joints"]):
-        ev_d = locked_model(d, [j["id"] for j in d["joints"] if j.get("vll") == "locked"], case.source)
-    mech = mechanism_from_dict(ev_d, source=case.source)
+        d = locked_model(d, [j["id"] for j in d["joints"] if j.get("vll") == "locked"], case.source)
+    mech = mechanism_from_dict(d, source=case.source)
     S = build_system(mech)
-    return mech, S, dyads.decompose(S), d
+    return mech, S, dyads.decompose(S)
+
+
+class _Template:
+    """A case's mechanism parsed once (the file's design, locked VLLs merged) and its
+    compiled plan: every design is the same topology
+    (:func:`~mechsyn.kinematics.refill.topology_key`) with other numbers, so its
+    mechanism is the template's with the design's joint points, P axes and named points
+    (:func:`~mechsyn.synthesis.designs.design_numbers`), checked by the reader's geometry
+    checks (:func:`~mechsyn.io.checks.check_geometry`), and its plan the template's
+    refilled (:meth:`~mechsyn.kinematics.analysis.KinematicPlan.refilled`): no parsing,
+    no pydantic, no graph work per design."""
+
+    def __init__(self, mech: Mechanism, plan: KinematicPlan) -> None:
+        self.mech = mech
+        self.plan = plan
+        self.index = {j.id: k for k, j in enumerate(mech.joints)}
+
+    def mechanism(self, case: MechanismCase, x: np.ndarray) -> Mechanism | None:
+        """The mechanism of design ``x``; None where a number is not finite or a direction
+        is zero (the general path's reader names the field)."""
+        pts, axes, named = design_numbers(case, x)
+        if not all(np.isfinite(v).all() for v in (*pts.values(), *axes.values(), *named.values())):
+            return None
+        mech = self.mech.with_joint_points({jid: p for jid, p in pts.items() if jid in self.index})
+        if axes:  # a VLL's cylinder direction (its P joint is merged away when locked)
+            joints = list(mech.joints)
+            for jid, u in axes.items():
+                k = self.index.get(jid)
+                if k is not None:
+                    a = np.asarray(u, float)
+                    norm = float(np.linalg.norm(a))
+                    if norm < 1e-12:
+                        return None
+                    joints[k] = replace(joints[k], axis=a / norm)  # a unit vector, as the reader stores it
+            mech = replace(mech, joints=tuple(joints))
+        if named:
+            mech = replace(mech, points={n: replace(q, at=np.asarray(named[n], float)) if n in named else q
+                                         for n, q in mech.points.items()})
+        return check_geometry(mech, case.source)
+
+
+#: The template of each of the last eight cases evaluated, kept with the case object, its
+#: mechanism dict and its variables (a case given a new dict or new variables gets a new
+#: template; cases are not changed in place).
+_TEMPLATES: "OrderedDict[int, tuple[MechanismCase, dict, list, _Template | None]]" = OrderedDict()
+
+
+def _template(case: MechanismCase) -> _Template | None:
+    """The case's :class:`_Template`, made on first use; None where a design cannot be a
+    refill of the file's: the file does not build, the reader changes its numbers, or a
+    variable moves a VLL's P joint or piston pivot (their coincidence, which the VLL
+    needs, is then a property of the design, checked by the general path)."""
+    entry = _TEMPLATES.get(id(case))
+    if entry is not None and entry[0] is case and entry[1] is case.mech_dict and entry[2] is case.variables:
+        return entry[3]
+    tpl = _new_template(case)
+    _TEMPLATES[id(case)] = (case, case.mech_dict, case.variables, tpl)
+    while len(_TEMPLATES) > 8:
+        _TEMPLATES.popitem(last=False)
+    return tpl
+
+
+def _new_template(case: MechanismCase) -> _Template | None:
+    md = case.mech_dict
+    if any(j.get("type") not in ("R", "P") for j in md["joints"]):
+        return None  # cams, gears, belts: the reader derives numbers from the points
+    vlls = [j["id"] for j in md["joints"] if j.get("vll") == "locked"]
+    vlls += [v.target for v in case.variables if v.kind == "length"]
+    moved = {v.target for v in case.variables if v.kind == "joint"}
+    try:
+        if any(jid in moved or vll_ends(md, jid, case.source)[1] in moved for jid in vlls):
+            return None
+        x0 = start_vector(case)[:case.n_design]
+        mech, _S, _plan = _build(case, x0, fast=False)
+        tpl = _Template(mech, compile_plan(mech))
+        filled = tpl.mechanism(case, x0)
+    except (MechsynInputError, ValueError, KeyError, ZeroDivisionError, np.linalg.LinAlgError):
+        return None
+
+    def same(a: Any, b: Any) -> bool:
+        return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
+
+    # the fill gives the reader's numbers (no units, no transforms of the file's numbers)
+    if filled is None or not all(same(j.point, f.point) and same(j.axis, f.axis)
+                                 for j, f in zip(mech.joints, filled.joints)) \
+            or not all(same(p.at, filled.points[n].at) for n, p in mech.points.items()):
+        return None
+    return tpl
 
 
 def reference_branch(case: MechanismCase) -> list[float] | None:
@@ -113,7 +217,7 @@ def reference_branch(case: MechanismCase) -> list[float] | None:
 
 
 def _drawing_branch(case: MechanismCase) -> list[float] | None:
-    _m, S, plan, _d = _build(case, start_vector(case))
+    _m, S, plan = _build(case, start_vector(case), fast=False)  # once per case
     if plan is None:
         return None
     k = S.driver_index(case.input_joint)
@@ -124,8 +228,21 @@ def _drawing_branch(case: MechanismCase) -> list[float] | None:
     return [float(s) for s in sig]
 
 
-def evaluate_mechanism_design(case: MechanismCase, x: np.ndarray) -> MechanismEvaluation:
-    """Sweep design ``x`` with the engine and compute the case's objective."""
+def evaluate_mechanism_design(case: MechanismCase, x: np.ndarray, fast: bool = True) -> MechanismEvaluation:
+    """Sweep design ``x`` with the engine and compute the case's objective. ``fast``: the
+    design's numbers filled into the case's parsed mechanism and compiled plan (the
+    topology-keyed fast path, see :func:`_template`); false: the design's dict parsed and
+    its constraint system built anew (the general path). Both give the same evaluation.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> case = load_mechanism_case(ms.examples.path("slider_crank_path_case"))
+    >>> x = start_vector(case) + 0.05
+    >>> a, b = evaluate_mechanism_design(case, x), evaluate_mechanism_design(case, x, fast=False)
+    >>> a.feasible, a.error == b.error, a.method
+    (True, True, 'assur')
+    """
     x = np.asarray(x, float)
     nd = case.n_design
     values = x[nd:] if case.free else case.values_deg
@@ -135,7 +252,7 @@ def evaluate_mechanism_design(case: MechanismCase, x: np.ndarray) -> MechanismEv
         sgn = 1.0 if values[-1] >= values[0] else -1.0
         viol_order = float(np.sum(np.maximum(0.0, -sgn * dv)))
     try:
-        mech, S, plan, d = _build(case, x[:nd])
+        mech, S, plan = _build(case, x[:nd], fast)
     except (MechsynInputError, ValueError, KeyError, ZeroDivisionError, np.linalg.LinAlgError) as exc:
         return MechanismEvaluation(False, f"cannot build: {exc}", violation=1e3)
     k = S.driver_index(case.input_joint)
@@ -186,8 +303,9 @@ class MechanismProblem:
     """Feasibility-first fitness over populations, and least-squares residuals, in the
     interface :func:`mechsyn.synthesis.optimize.polish` expects."""
 
-    def __init__(self, case: MechanismCase, batch: bool = True) -> None:
+    def __init__(self, case: MechanismCase, batch: bool = True, fast: bool = True) -> None:
         self.case = case
+        self.fast = fast  # designs evaluated on the topology-keyed fast path
         self.lower, self.upper = case.lower, case.upper
         pts = [case.targets]
         for j in case.mech_dict["joints"]:
@@ -205,7 +323,7 @@ class MechanismProblem:
         self.n_evaluations += len(np.atleast_2d(Z))
         if self.batch is not None:
             return _EvalList(self.batch.evaluate(Z))
-        return _EvalList([evaluate_mechanism_design(self.case, z) for z in np.atleast_2d(Z)])
+        return _EvalList([evaluate_mechanism_design(self.case, z, self.fast) for z in np.atleast_2d(Z)])
 
     def score(self, ev: MechanismEvaluation) -> float:
         if ev.feasible and np.isfinite(ev.error):
@@ -218,7 +336,7 @@ class MechanismProblem:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         c = self.case
         self.n_evaluations += 1
-        ev = self.batch.evaluate(z)[0] if self.batch is not None else evaluate_mechanism_design(c, z)
+        ev = self.batch.evaluate(z)[0] if self.batch is not None else evaluate_mechanism_design(c, z, self.fast)
         n = 2 * c.n_targets + (c.n_targets if c.problem == "motion" else 0)
         if not ev.feasible:
             return np.full(n, np.sqrt(self.penalty_base / n) * (1.0 + ev.violation))
@@ -275,12 +393,12 @@ class MechanismSynthesisResult(SynthesisResult):
 def _mechanism_restart(case: MechanismCase, r: int, seed: int, optimizer: str, opts: dict[str, Any],
                        n_polish: int, search_end: float, deadline: float, f_atol: float,
                        report: Callable[[int, float], None] | None = None, batch: bool = True,
-                       tracker: BestSoFar | None = None) -> tuple[np.ndarray, float, int]:
+                       tracker: BestSoFar | None = None, fast: bool = True) -> tuple[np.ndarray, float, int]:
     """One restart of :func:`synthesize_mechanism` (a task of :func:`mechsyn.parallel.run_tasks`):
     the global search until ``search_end`` (``time.time()``), then the polish of the best few
     members. Returns the best vector, its fitness and the number of evaluations. ``tracker``
     (in this process only) records the best design evaluated, for Ctrl-C."""
-    prob = MechanismProblem(case, batch=batch)
+    prob = MechanismProblem(case, batch=batch, fast=fast)
     width = prob.upper - prob.lower
 
     def should_stop(f: float) -> bool:
@@ -319,7 +437,8 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
                          callback: ProgressCallback | None = None,
                          workers: int = 1, scheduler: Any = None,
-                         batch: bool = True, checkpoint: Any = None, resume: bool = False) -> MechanismSynthesisResult:
+                         batch: bool = True, checkpoint: Any = None, resume: bool = False,
+                         fast: bool = True) -> MechanismSynthesisResult:
     """Optimise the case: per restart (child seeds of ``seed``, as in
     :func:`mechsyn.synthesis.optimize.restart_seeds`) the registered global optimiser on
     the feasibility-first fitness, then a least-squares polish of the best few members
@@ -329,7 +448,9 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     budget either way (until ``0.85 (r + 1) / restarts`` of the limit), so the result is
     the single-process one unless the time limit cuts the searches short.
     ``batch``: evaluate populations through the batch engine where the case allows
-    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design.
+    (:mod:`mechsyn.synthesis.general_batch`); false: one engine sweep per design, on the
+    case's compiled plan with the design's numbers filled in (``fast``, see
+    :func:`evaluate_mechanism_design`) or parsed and built anew: the same result.
 
     ``seed``: an int, ``None`` or a ``numpy.random.Generator`` (the result's ``seed`` is
     the int that repeats the run). ``callback(state)`` gets a
@@ -355,7 +476,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     opts = {"popsize": 8, "maxiter": 300, "stall": 60, "init_oversample": 5}
     opts.update(options or {})
     reference_branch(case)  # once here, not in every worker
-    prob = MechanismProblem(case, batch=batch)
+    prob = MechanismProblem(case, batch=batch, fast=fast)
     x0 = np.clip(start_vector(case), prob.lower, prob.upper)
     best_z, best_f = x0, float(prob.fitness(x0[None, :])[0])
     start_f = best_f
@@ -384,7 +505,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     seeds = restart_seeds(seed, restarts)
     trackers = [BestSoFar() if local else None for _ in seeds]
     tasks = [(case, r, s, optimizer, opts, n_polish, t0 + time_limit * (0.85 * (r + 1) / restarts),
-              deadline, f_atol, report if local else None, batch, trackers[r])
+              deadline, f_atol, report if local else None, batch, trackers[r], fast)
              for r, s in enumerate(seeds) if r not in outs]
     interrupted = False
     try:
@@ -410,15 +531,16 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
         if f < best_f:
             best_z, best_f = z, f
     return _mechanism_result(case, best_z, start_f, prob.penalty_base, t0=t0, seed=seed, restarts=done, nfev=nfev,
-                             errs=errs, stopped=done < restarts and not interrupted, interrupted=interrupted)
+                             errs=errs, stopped=done < restarts and not interrupted, interrupted=interrupted,
+                             fast=fast)
 
 
 def _mechanism_result(case: MechanismCase, best_z: np.ndarray, start_f: float, penalty_base: float, *,
                       t0: float, seed: int, restarts: int, nfev: int, errs: list[float], stopped: bool,
-                      interrupted: bool) -> MechanismSynthesisResult:
+                      interrupted: bool, fast: bool = True) -> MechanismSynthesisResult:
     """The result of the best design ``best_z``, evaluated again (the file's own design
     scored ``start_f``; scores from ``penalty_base`` up are infeasible)."""
-    ev = evaluate_mechanism_design(case, best_z)
+    ev = evaluate_mechanism_design(case, best_z, fast)
     names = case.names
     design = {n: float(v) for n, v in zip(names, best_z)}
     d = apply_mechanism_design(case, best_z[:case.n_design])

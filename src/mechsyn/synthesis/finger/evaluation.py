@@ -32,6 +32,7 @@ References
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -44,6 +45,7 @@ from mechsyn.kinematics.analysis import resolve_points
 from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger.cases import FingerCase
 from mechsyn.synthesis.finger.vll import copy_mechanism, locked_model, region_excess, vll_ends
+from mechsyn.synthesis.templates import DictTemplate, structure_key
 
 __all__ = ["INFEASIBLE", "Objective", "apply_design", "FingerEvaluation", "evaluate_locked", "evaluate_drawn"]
 
@@ -115,9 +117,7 @@ def evaluate_drawn(case: FingerCase, d: dict) -> FingerEvaluation:
     vlls = [j["id"] for j in case.mech_dict["joints"] if j.get("vll")]
     try:
         d = locked_model(d, vlls, case.source)
-        mech = mechanism_from_dict(d, source=case.source)
-        S = build_system(mech)
-        plan = dyads.decompose(S)
+        mech, S, plan = _locked_system(case, d)
     except (MechsynInputError, ValueError, KeyError, ZeroDivisionError) as exc:
         return FingerEvaluation(False, f"cannot build: {exc}", violation=1e3)
     if plan is None:
@@ -151,3 +151,41 @@ def evaluate_drawn(case: FingerCase, d: dict) -> FingerEvaluation:
     if viol > 0:
         ev.feasible, ev.reason, ev.violation = False, "a path leaves the working region", viol
     return ev
+
+
+#: The parsed locked models of the last cases and structures (kept with the case object).
+_TEMPLATES: "OrderedDict[tuple[int, str], tuple[FingerCase, DictTemplate]]" = OrderedDict()
+
+
+def _template(case: FingerCase, d: dict) -> DictTemplate | None:
+    """The parsed locked model (:class:`~mechsyn.synthesis.templates.DictTemplate`) of
+    the case with the structure of the locked dict ``d``, made from the first such dict
+    that parses; None until then."""
+    key = structure_key(d)
+    if key is None:
+        return None
+    entry = _TEMPLATES.get((id(case), key))
+    if entry is not None and entry[0] is case:
+        return entry[1]
+    try:
+        tpl = DictTemplate(d, case.source)
+    except MechsynInputError:
+        return None
+    _TEMPLATES[(id(case), key)] = (case, tpl)
+    while len(_TEMPLATES) > 16:
+        _TEMPLATES.popitem(last=False)
+    return tpl
+
+
+def _locked_system(case: FingerCase, d: dict) -> tuple[Any, Any, Any]:
+    """(mechanism, constraint system, decomposition) of the locked dict ``d``: its numbers
+    filled into the case's parsed locked model of its structure and the compiled plan (no
+    parsing per design), else parsed and built."""
+    tpl = _template(case, d)
+    mech = tpl.mechanism(d, tpl.key) if tpl is not None else None
+    if mech is not None:
+        kp = tpl.plan(mech)
+        return mech, kp.system, kp.groups
+    mech = mechanism_from_dict(d, source=case.source)
+    S = build_system(mech)
+    return mech, S, dyads.decompose(S)
