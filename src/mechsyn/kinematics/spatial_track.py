@@ -395,28 +395,60 @@ def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndar
     return int(rows[-1])
 
 
+def _taylor(tr: Tracker, st: State, which: np.ndarray, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The predictor's twists (first and second derivative) of B rows, each from the anchor
+    ``which`` (states ``st``) along its input step ``du`` (B, drives), without a solve per
+    row: the first derivative is linear in ``du`` and the second quadratic, so each anchor
+    solves for the unit step of every drive that moves and for the sums of two of them
+    (the cross terms by polarisation: ``x2(a + b) - x2(a) - x2(b)``)."""
+    cols = np.flatnonzero(np.any(du != 0, axis=0))
+    c, A = len(cols), len(st.R)
+    pairs = [(a, b) for a in range(c) for b in range(a + 1, c)]
+    D = np.zeros((c + len(pairs), du.shape[1]))
+    D[np.arange(c), cols] = 1.0
+    for q, (a, b) in enumerate(pairs):
+        D[c + q, cols[a]] = D[c + q, cols[b]] = 1.0
+    K = len(D)
+    X1, X2 = tr.rates(st.take(np.repeat(np.arange(A), K)), np.tile(D, (A, 1)))
+    X1, X2 = X1.reshape(A, K, -1)[which], X2.reshape(A, K, -1)[which]
+    d = du[:, cols]
+    x1 = np.einsum("bk,bkx->bx", d, X1[:, :c])
+    x2 = np.einsum("bk,bkx->bx", d * d, X2[:, :c])
+    for q, (a, b) in enumerate(pairs):
+        x2 += (d[:, a] * d[:, b])[:, None] * (X2[:, c + q] - X2[:, a] - X2[:, b])
+    return x1, x2
+
+
 def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, anchors: set, gaps: set) -> None:
-    """The rows of ``order`` between anchors, from the anchor before each, in one batch;
-    rows the batch cannot settle are walked to one by one."""
+    """The rows of ``order`` between anchors, each predicted from the nearer of the two
+    anchors around it (in inputs; the one before it when none follows) and all corrected in
+    one batch; rows the batch cannot settle are walked to one by one."""
     seq = np.concatenate([[k0], order])
     reached = np.array([int(k) in anchors for k in seq])
-    src = np.maximum.accumulate(np.where(reached, np.arange(len(seq)), -1))
+    at = np.arange(len(seq))
+    src = np.maximum.accumulate(np.where(reached, at, -1))
     in_gap = np.array([int(k) in gaps for k in seq])
     todo = np.flatnonzero(~reached & ~in_gap & (src >= 0))
     if not len(todo):
         return
-    rows, base = seq[todo], seq[src[todo]]
+    # the anchor after each row, when no gap lies between
+    after = np.minimum.accumulate(np.where(reached | in_gap, at, len(seq))[::-1])[::-1][todo]
+    after = np.where((after < len(seq)) & reached[np.minimum(after, len(seq) - 1)], after, src[todo])
+    rows, before = seq[todo], seq[src[todo]]
+    later = seq[after]
+    base = np.where(np.abs(U[later] - U[rows]).max(axis=1) < np.abs(U[before] - U[rows]).max(axis=1), later, before)
     ub, which = np.unique(base, return_inverse=True)  # each anchor's state once
-    st = tr.state(w.R[ub], w.p[ub], w.href[ub], U[ub]).take(which)
+    st = tr.state(w.R[ub], w.p[ub], w.href[ub], U[ub])
     du = U[rows] - U[base]
-    x1, x2 = tr.rates(st, du)
-    R, p = move(st.R, st.p, x1 + 0.5 * x2)
+    x1, x2 = _taylor(tr, st, which, du)
+    R, p = move(st.R[which], st.p[which], x1 + 0.5 * x2)
     size = np.abs(x1).max(axis=1)
     limit = np.where(size <= MAX_STEP, 0.5 * size + 1e-9, -1.0)  # too far: walked to on its own
-    R, p, ok, _ = tr.correct(R, p, st.href, U[rows], limit)
+    href = st.href[which]
+    R, p, ok, _ = tr.correct(R, p, href, U[rows], limit)
     good = rows[ok]
     F = frame(tr.M, R[ok], p[ok])
-    href = helix_angles(tr.M, F, st.href[ok]) if tr.M.helix else st.href[ok]
+    href = helix_angles(tr.M, F, href[ok]) if tr.M.helix else href[ok]
     w.R[good], w.p[good], w.href[good] = R[ok], p[ok], href
     w.ok[good] = True
     for t in todo[~ok]:  # on its own, from the row before it in the walk
