@@ -113,6 +113,29 @@ class Lin:
         return out
 
 
+class AnchorLin:
+    """The linearisations ``lin`` of a few anchors serving many rows (``which``: each row's
+    anchor), for the chord steps of the rows between anchors: each anchor's rows solved in
+    one product with its inverse Gram matrix (no copy of it per row)."""
+
+    def __init__(self, lin: Lin, which: np.ndarray) -> None:
+        self.lin = lin
+        order = np.argsort(which, kind="stable")
+        cut = np.flatnonzero(np.diff(which[order])) + 1
+        self.groups = [(int(which[g[0]]), g) for g in np.split(order, cut)]
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        L = self.lin
+        out = np.empty((len(b), L.Jc.shape[2]))
+        for a, g in self.groups:
+            J, Gi = L.Jc[a], L.Ginv[a]
+            y = (b[g] @ Gi.T) @ J if L.rows else (b[g] @ J) @ Gi.T  # (Gi symmetric to rounding)
+            Y = y.reshape(len(g), -1, 6)
+            Y[:, :, 3:] += _cross(L.C[a], Y[:, :, :3])
+            out[g] = y
+        return out
+
+
 def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
     """``σ_r / σ_1`` of each of the matrices ``Jc`` (B, m, k) by an SVD (0 where ``σ_1 = 0``)."""
     sv = np.linalg.svd(Jc, compute_uv=False)
@@ -218,7 +241,7 @@ class Tracker:
         return x1, st.lin.solve(-convective(self.M, F, x1), refine)
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
-                limit: np.ndarray, iters: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+                limit: np.ndarray, iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
         """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
         those that converged without moving further than ``limit``, and ``(frame,
         residuals, linearisation)`` of the last iterate (the linearisation is that of an
@@ -229,7 +252,7 @@ class Tracker:
         moved = np.zeros(B)
         done = np.zeros(B, bool)
         failed = np.zeros(B, bool)
-        lin, rows, last = None, np.zeros(B, bool), np.full(B, np.inf)
+        lin, rows, last = lin0, np.full(B, lin0 is not None), np.full(B, np.inf)
         for it in range(iters):
             F = frame(self.M, R, p)
             g = residual(self.M, F, href, target)
@@ -445,7 +468,7 @@ def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, ancho
     size = np.abs(x1).max(axis=1)
     limit = np.where(size <= MAX_STEP, 0.5 * size + 1e-9, -1.0)  # too far: walked to on its own
     href = st.href[which]
-    R, p, ok, _ = tr.correct(R, p, href, U[rows], limit)
+    R, p, ok, _ = tr.correct(R, p, href, U[rows], limit, lin0=AnchorLin(st.lin, which) if CHORD else None)
     good = rows[ok]
     F = frame(tr.M, R[ok], p[ok])
     href = helix_angles(tr.M, F, href[ok]) if tr.M.helix else href[ok]
@@ -463,6 +486,7 @@ def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, ancho
 
 # --------------------------------------------------------------------------- crossings
 GOLDEN_STEPS = 40
+CHORD = True
 
 
 def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list[tuple[int, np.ndarray, float]]:
