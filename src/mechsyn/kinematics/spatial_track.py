@@ -114,26 +114,19 @@ class Lin:
 
 
 class AnchorLin:
-    """The linearisations ``lin`` of a few anchors serving many rows (``which``: each row's
-    anchor), for the chord steps of the rows between anchors: each anchor's rows solved in
-    one product with its inverse Gram matrix (no copy of it per row)."""
+    """The linearisation ``lin`` of one pose serving many (the chord steps of a block of
+    rows): all of them solved in one product with its inverse Gram matrix."""
 
-    def __init__(self, lin: Lin, which: np.ndarray) -> None:
+    def __init__(self, lin: Lin) -> None:
         self.lin = lin
-        order = np.argsort(which, kind="stable")
-        cut = np.flatnonzero(np.diff(which[order])) + 1
-        self.groups = [(int(which[g[0]]), g) for g in np.split(order, cut)]
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         L = self.lin
-        out = np.empty((len(b), L.Jc.shape[2]))
-        for a, g in self.groups:
-            J, Gi = L.Jc[a], L.Ginv[a]
-            y = (b[g] @ Gi.T) @ J if L.rows else (b[g] @ J) @ Gi.T  # (Gi symmetric to rounding)
-            Y = y.reshape(len(g), -1, 6)
-            Y[:, :, 3:] += _cross(L.C[a], Y[:, :, :3])
-            out[g] = y
-        return out
+        J, Gi = L.Jc[0], L.Ginv[0]
+        y = (b @ Gi.T) @ J if L.rows else (b @ J) @ Gi.T  # (Gi is symmetric to rounding)
+        Y = y.reshape(len(b), -1, 6)
+        Y[:, :, 3:] += _cross(L.C[0], Y[:, :, :3])
+        return y
 
 
 def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
@@ -295,6 +288,38 @@ class Tracker:
         href = helix_angles(self.M, F, st.href) if self.M.helix else st.href
         return State(R, p, href, F, lin, g), size
 
+    def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
+        """The rows ``Ub`` (K, drives) after the pose ``st`` (at inputs ``u0``), predicted
+        from its tangents (:func:`_taylor`) and corrected in one batch, first by chord steps
+        with the linearisation of ``st`` (:class:`AnchorLin`). Returns the number ``n`` of
+        rows accepted from the first on (each converged without moving further than half
+        its predictor's step, which is at most ``MAX_STEP``), the predictor's step size of
+        every row, the accepted poses ``(R, p, href)`` and the state of the last of them
+        (its linearisation that of the corrector, as in :meth:`step`)."""
+        K = len(Ub)
+        zero = np.zeros(K, int)
+        x1, x2 = _taylor(self, st, Ub - u0)
+        size = np.abs(x1).max(axis=1)
+        K = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
+        if K == 0:
+            return 0, size, None, None
+        zero = zero[:K]
+        R, p = move(st.R[zero], st.p[zero], x1[:K] + 0.5 * x2[:K])
+        href = st.href[zero]
+        R, p, ok, (F, g, lin) = self.correct(R, p, href, Ub[:K], 0.5 * size[:K] + 1e-9, lin0=AnchorLin(st.lin))
+        n = int(np.argmin(np.append(ok, False)))
+        if n == 0:
+            return 0, size, None, None
+        if self.M.helix:
+            href = helix_angles(self.M, F, href)
+        last = slice(n - 1, n)
+        if isinstance(lin, Lin):
+            new = State(R[last], p[last], href[last], F.take(np.arange(n - 1, n)), lin.take(np.arange(n - 1, n)),
+                        g[last])
+        else:
+            new = self.state(R[last], p[last], href[last], Ub[last])
+        return n, size, (R[:n], p[:n], href[:n]), new
+
     def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
         """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
         ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
@@ -358,16 +383,14 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
         return w
     w.put(k0, st)
     for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1)):
-        anchors, gaps = _anchors(tr, w, st, U, k0, order, event)
-        _fill(tr, w, U, k0, order, anchors, gaps)
+        _blocks_along(tr, w, st, U, k0, order, event)
     w.events.sort(key=lambda e: e["index"])
     return w
 
 
-def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray,
-             event: Any) -> tuple[set, set]:
-    """Walk along ``order`` by adaptive strides; the rows reached (anchors) go into ``w``.
-    Returns the anchors and the rows of the gaps (not assembled on the way)."""
+def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any) -> None:
+    """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
+    each from the last row of the one before; the rows reached go into ``w``."""
     anchors, gaps = {k0}, set()
     prev, i, stride, gap = k0, 0, 1, False
     while i < len(order):
@@ -383,24 +406,30 @@ def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.
             st, prev, gap, i = k[1], k[0], False, where + 1
             continue
         j = min(i + stride, len(order)) - 1
-        k = int(order[j])
-        nxt, size = tr.step(st, U[k] - U[prev], U[k])
-        if nxt is None and j == i:  # a single row: halve within it
+        rows = order[i:j + 1]
+        n, size, poses, nxt = tr.block(st, U[prev], U[rows])
+        if n == 0 and j > i:  # not even the next row: from it on, one row at a time
+            stride = 1
+            continue
+        if n == 0:  # a single row: halve within it
+            k = int(rows[0])
             nxt = tr.advance(st, U[prev], U[k])
             if nxt is None:
                 w.events.append(event(k, "dead point", st.lin.ratio[0]))
                 i, gap = i + 1, True
                 gaps.add(k)
                 continue
-        if nxt is None:
+            n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
+        done = rows[:n]
+        w.R[done], w.p[done], w.href[done] = poses
+        w.ok[done] = True
+        anchors.update(int(k) for k in done)
+        st, prev, i = nxt, int(done[-1]), i + n
+        if n < len(rows):  # trouble (or the predictor's limit) after the accepted rows
             stride = max(1, stride // 2)
             continue
-        per_row = size / (j + 1 - i)
-        st, prev, i = nxt, k, j + 1
-        w.put(k, st)
-        anchors.add(k)
+        per_row = size[n - 1] / n
         stride = int(max(1, min(2 * stride, MAX_STRIDE, MAX_STEP / max(per_row, 1e-300))))
-    return anchors, gaps
 
 
 def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray, anchors: set) -> int:
@@ -418,75 +447,29 @@ def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndar
     return int(rows[-1])
 
 
-def _taylor(tr: Tracker, st: State, which: np.ndarray, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The predictor's twists (first and second derivative) of B rows, each from the anchor
-    ``which`` (states ``st``) along its input step ``du`` (B, drives), without a solve per
-    row: the first derivative is linear in ``du`` and the second quadratic, so each anchor
-    solves for the unit step of every drive that moves and for the sums of two of them
-    (the cross terms by polarisation: ``x2(a + b) - x2(a) - x2(b)``)."""
+def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The predictor's twists (first and second derivative) of B rows from the pose ``st``
+    along their input steps ``du`` (B, drives), without a solve per row: the first
+    derivative is linear in ``du`` and the second quadratic, so the pose solves for the unit
+    step of every drive that moves and for the sums of two of them (the cross terms by
+    polarisation: ``x2(a + b) - x2(a) - x2(b)``)."""
     cols = np.flatnonzero(np.any(du != 0, axis=0))
-    c, A = len(cols), len(st.R)
+    c = len(cols)
     pairs = [(a, b) for a in range(c) for b in range(a + 1, c)]
     D = np.zeros((c + len(pairs), du.shape[1]))
     D[np.arange(c), cols] = 1.0
     for q, (a, b) in enumerate(pairs):
         D[c + q, cols[a]] = D[c + q, cols[b]] = 1.0
-    K = len(D)
-    X1, X2 = tr.rates(st.take(np.repeat(np.arange(A), K)), np.tile(D, (A, 1)))
-    X1, X2 = X1.reshape(A, K, -1)[which], X2.reshape(A, K, -1)[which]
+    X1, X2 = tr.rates(st.take(np.zeros(len(D), int)), D)
     d = du[:, cols]
-    x1 = np.einsum("bk,bkx->bx", d, X1[:, :c])
-    x2 = np.einsum("bk,bkx->bx", d * d, X2[:, :c])
+    x1, x2 = d @ X1[:c], (d * d) @ X2[:c]
     for q, (a, b) in enumerate(pairs):
-        x2 += (d[:, a] * d[:, b])[:, None] * (X2[:, c + q] - X2[:, a] - X2[:, b])
+        x2 += np.outer(d[:, a] * d[:, b], X2[c + q] - X2[a] - X2[b])
     return x1, x2
-
-
-def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, anchors: set, gaps: set) -> None:
-    """The rows of ``order`` between anchors, each predicted from the nearer of the two
-    anchors around it (in inputs; the one before it when none follows) and all corrected in
-    one batch; rows the batch cannot settle are walked to one by one."""
-    seq = np.concatenate([[k0], order])
-    reached = np.array([int(k) in anchors for k in seq])
-    at = np.arange(len(seq))
-    src = np.maximum.accumulate(np.where(reached, at, -1))
-    in_gap = np.array([int(k) in gaps for k in seq])
-    todo = np.flatnonzero(~reached & ~in_gap & (src >= 0))
-    if not len(todo):
-        return
-    # the anchor after each row, when no gap lies between
-    after = np.minimum.accumulate(np.where(reached | in_gap, at, len(seq))[::-1])[::-1][todo]
-    after = np.where((after < len(seq)) & reached[np.minimum(after, len(seq) - 1)], after, src[todo])
-    rows, before = seq[todo], seq[src[todo]]
-    later = seq[after]
-    base = np.where(np.abs(U[later] - U[rows]).max(axis=1) < np.abs(U[before] - U[rows]).max(axis=1), later, before)
-    ub, which = np.unique(base, return_inverse=True)  # each anchor's state once
-    st = tr.state(w.R[ub], w.p[ub], w.href[ub], U[ub])
-    du = U[rows] - U[base]
-    x1, x2 = _taylor(tr, st, which, du)
-    R, p = move(st.R[which], st.p[which], x1 + 0.5 * x2)
-    size = np.abs(x1).max(axis=1)
-    limit = np.where(size <= MAX_STEP, 0.5 * size + 1e-9, -1.0)  # too far: walked to on its own
-    href = st.href[which]
-    R, p, ok, _ = tr.correct(R, p, href, U[rows], limit, lin0=AnchorLin(st.lin, which) if CHORD else None)
-    good = rows[ok]
-    F = frame(tr.M, R[ok], p[ok])
-    href = helix_angles(tr.M, F, href[ok]) if tr.M.helix else href[ok]
-    w.R[good], w.p[good], w.href[good] = R[ok], p[ok], href
-    w.ok[good] = True
-    for t in todo[~ok]:  # on its own, from the row before it in the walk
-        k, before = int(seq[t]), int(seq[t - 1])
-        if not w.ok[before]:
-            continue
-        prev = tr.state(*w.at(before), U[before][None])
-        nxt = tr.advance(prev, U[before], U[k])
-        if nxt is not None:
-            w.put(k, nxt)
 
 
 # --------------------------------------------------------------------------- crossings
 GOLDEN_STEPS = 40
-CHORD = True
 
 
 def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list[tuple[int, np.ndarray, float]]:
