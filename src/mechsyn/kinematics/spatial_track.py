@@ -392,7 +392,7 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
     """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
     each from the last row of the one before; the rows reached go into ``w``."""
     anchors, gaps = {k0}, set()
-    prev, i, stride, gap = k0, 0, 1, False
+    prev, i, stride, gap = k0, 0, MAX_STRIDE, False
     while i < len(order):
         if gap:  # the first row after the gap where Newton from the last pose converges
             k = tr.reassemble(st, U, order[i:])
@@ -425,11 +425,8 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
         w.ok[done] = True
         anchors.update(int(k) for k in done)
         st, prev, i = nxt, int(done[-1]), i + n
-        if n < len(rows):  # trouble (or the predictor's limit) after the accepted rows
-            stride = max(1, stride // 2)
-            continue
-        per_row = size[n - 1] / n
-        stride = int(max(1, min(2 * stride, MAX_STRIDE, MAX_STEP / max(per_row, 1e-300))))
+        reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
+        stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
 
 
 def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray, anchors: set) -> int:
