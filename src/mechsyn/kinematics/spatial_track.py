@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.spatial_model import (SpatialModel, _cross, convective, frame, helix_angles, jacobian, move,
-                                              residual)
+                                              residual, rotate)
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 
@@ -202,7 +202,7 @@ class Tracker:
         and steps give the spin no component: idle spins stay at rest, whichever point the
         file measures from."""
         B, n = len(J), self.M.n
-        C = (R[:, :-1] @ self.c0[:, :, None])[..., 0] + p[:, :-1]
+        C = rotate(R[:, :-1], self.c0) + p[:, :-1]
         Jr = J.reshape(B, -1, n, 6).copy()
         rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
         Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
