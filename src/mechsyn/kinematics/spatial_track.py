@@ -1,18 +1,24 @@
 """Continuation of a spatial mechanism's poses over a sweep (used by
 :mod:`mechsyn.kinematics.spatial`; the equations are :mod:`mechsyn.kinematics.spatial_model`).
 
-The walk goes outwards from the drawn assembly along the sweep's rows. It moves from one
-*anchor* row to the next by a second-order predictor (the twists' first and second
-derivatives along the input step, through the exponential of a twist) and Newton
-corrections ``δξ = -J⁺ g`` (the pseudo-inverse at the regular rank ``r``: least-squares for
-redundant constraints, minimum-norm for idle motions). A step is refused when the
-corrector fails or moves the links further than half the predictor did (a jump to another
-branch); then the stride is halved, down to a single row and then to ``1/4096`` of a row.
-The stride doubles after easy steps while the predictor's step stays under
-``MAX_STEP`` (radians, or lengths in units of the length scale), so the Taylor predictor
-stays accurate. The rows between anchors are then predicted from the anchor before them
-and corrected all at once (one batch of Newton steps over every row), each with the same
-branch guard; a row the batch cannot settle is walked to on its own from the row before.
+The walk goes outwards from the drawn assembly along the sweep's rows, by *blocks* of rows.
+Every row of a block is predicted from the block's first pose by a second-order predictor
+(the twists' first and second derivatives along the row's input step, through the
+exponential of a twist; the derivatives are solved once per block, for the unit step of
+each moving drive, and are linear and quadratic in the step), and all rows are corrected
+at once: chord steps ``δξ = -J⁺ g`` with the Jacobian of the block's first pose (one
+product per block for all rows), a fresh Jacobian of the current iterate wherever those do
+not shrink the residual tenfold per step (the pseudo-inverse at the regular rank ``r``:
+least-squares for redundant constraints, minimum-norm for idle motions). A row is accepted
+when its residual is under ``NEWTON_TOL`` without the corrector moving it further than half
+its predictor's step (else it may have jumped to another branch); the block's longest
+accepted run of rows from its first on is kept, and the next block starts from its last
+row. Blocks are cut where the predictor's step exceeds ``MAX_STEP`` (radians, or lengths in
+units of the length scale), so the Taylor predictor stays accurate, and are at most
+``MAX_STRIDE`` rows; after trouble the next block is half as long, down to one row, which is
+then reached by the single-pose predictor-corrector halving its step down to ``1/4096``
+of a row (and a dead point where even that fails). ``MAX_STRIDE = 1`` gives the per-row
+path (every row its own block), the reference of the tests.
 
 References
 ----------
@@ -37,7 +43,7 @@ __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 RANK_TOL = 1e-8
 #: Residual (in units of the length scale) at which the corrector accepts a pose.
 NEWTON_TOL = 1e-12
-#: Largest predictor step between anchors (radians; lengths in units of the length scale).
+#: Largest predictor step in a block (radians; lengths in units of the length scale).
 MAX_STEP = 0.5
 MAX_HALVINGS = 12
 MAX_STRIDE = 64
@@ -410,8 +416,8 @@ class Walk:
 
 def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
     """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
-    inputs): to the row nearest it, then outwards both ways (anchors, then the rows between
-    them in one batch). ``event(index, kind, detail)`` makes the event dicts."""
+    inputs): to the row nearest it, then outwards both ways by blocks of rows
+    (:func:`_blocks_along`). ``event(index, kind, detail)`` makes the event dicts."""
     M = tr.M
     N = len(U)
     w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
@@ -431,17 +437,14 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
 def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any) -> None:
     """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
     each from the last row of the one before; the rows reached go into ``w``."""
-    anchors, gaps = {k0}, set()
     prev, i, stride, gap = k0, 0, MAX_STRIDE, False
     while i < len(order):
         if gap:  # the first row after the gap where Newton from the last pose converges
             k = tr.reassemble(st, U, order[i:])
             if k is None:
-                gaps.update(int(r) for r in order[i:])
                 break
             where = i + int(np.flatnonzero(order[i:] == k[0])[0])
-            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1], anchors)
-            gaps.update(int(r) for r in order[i:where] if r not in anchors)
+            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1])
             w.events.append(event(first, "reassembled", None))
             st, prev, gap, i = k[1], k[0], False, where + 1
             continue
@@ -457,30 +460,26 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
             if nxt is None:
                 w.events.append(event(k, "dead point", st.lin.ratio[0]))
                 i, gap = i + 1, True
-                gaps.add(k)
                 continue
             n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
         done = rows[:n]
         w.R[done], w.p[done], w.href[done] = poses
         w.ok[done] = True
-        anchors.update(int(k) for k in done)
         st, prev, i = nxt, int(done[-1]), i + n
         reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
 
 
-def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray, anchors: set) -> int:
+def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray) -> int:
     """From the reassembled row ``rows[0]`` (state ``st``) back through the gap's rows while
     the mechanism follows (so the gap ends where the mechanism stops assembling, not where
     Newton first converged); returns the first row of the assembled stretch."""
     w.put(int(rows[0]), st)
-    anchors.add(int(rows[0]))
     for prev, k in zip(rows[:-1], rows[1:]):
         st = tr.advance(st, U[prev], U[k])
         if st is None:
             return int(prev)
         w.put(int(k), st)
-        anchors.add(int(k))
     return int(rows[-1])
 
 
