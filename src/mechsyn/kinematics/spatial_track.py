@@ -71,7 +71,7 @@ class Lin:
     @functools.cached_property
     def Ginv(self) -> np.ndarray:
         """The inverse of the damped Gram matrix (one inversion serves every solve)."""
-        return inv_spd(self.G)
+        return np.linalg.inv(self.G)
 
     @functools.cached_property
     def ratio(self) -> np.ndarray:
@@ -133,46 +133,6 @@ class AnchorLin:
         Y = y.reshape(len(b), -1, 6)
         Y[:, :, 3:] += _cross(L.C[0], Y[:, :, :3])
         return y
-
-
-def inv_spd(G: np.ndarray) -> np.ndarray:
-    """Inverses of the symmetric positive definite matrices ``G`` (B, k, k) by 2 x 2 blocks
-    (the Schur complement ``S = C - Bᵀ A⁻¹ B`` of the leading block ``A``, itself positive
-    definite: block Cholesky without pivoting, stable for these matrices [1]_), down to
-    blocks of ``BLOCK_INV`` rows inverted by LAPACK: about twice as fast as ``np.linalg.inv``
-    on a stack of 54 x 54 matrices, since most of the work becomes matrix products.
-
-    References
-    ----------
-    .. [1] N. J. Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., SIAM,
-       2002, sec. 13.3 (block LU factorization of symmetric positive definite matrices).
-
-    Examples
-    --------
-    >>> A = np.random.default_rng(0).standard_normal((2, 70, 70))
-    >>> G = A @ A.transpose(0, 2, 1)
-    >>> bool(np.abs(inv_spd(G) @ G - np.eye(70)).max() < 1e-8)
-    True
-    """
-    k = G.shape[-1]
-    if k <= BLOCK_INV:
-        return np.linalg.inv(G)
-    h = k // 2
-    A, Bm, C = G[:, :h, :h], G[:, :h, h:], G[:, h:, h:]
-    Ai = inv_spd(A)
-    X = Ai @ Bm
-    Si = inv_spd(C - Bm.transpose(0, 2, 1) @ X)
-    XS = X @ Si
-    out = np.empty_like(G)
-    out[:, :h, :h] = Ai + XS @ X.transpose(0, 2, 1)
-    out[:, :h, h:] = -XS
-    out[:, h:, :h] = -XS.transpose(0, 2, 1)
-    out[:, h:, h:] = Si
-    return out
-
-
-#: Largest Gram matrix inverted whole by :func:`inv_spd`.
-BLOCK_INV = 32
 
 
 def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
