@@ -35,7 +35,7 @@ accelerations, the closure residual and the rank test of every row, and (Delta) 
 all ten links (60 unknowns against the loop's 3).
 
 Where the time goes (cProfile; after the block continuation): the walk is about three
-quarters of a Bennett sweep (17 blocks of up to 28 rows, 5 to 6 Newton iterations each,
+quarters of a Bennett sweep (12 blocks of up to 42 rows, 5 to 8 Newton iterations each,
 every iteration some 100 NumPy calls on arrays of a few hundred numbers: NumPy's per-call
 cost, not arithmetic), the rates, rank test and Jacobians of all rows at once the rest; on
 the Delta the inverses of the 601 Gram matrices (54 x 54) of the rates and rank test are
