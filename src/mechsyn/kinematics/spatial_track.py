@@ -242,14 +242,16 @@ class Tracker:
         x1 = st.lin.solve(b, refine)
         return x1, st.lin.solve(-convective(self.M, F, x1), refine)
 
-    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
-                limit: np.ndarray, iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
+                iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
         """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
         those that converged without moving further than ``limit``, and ``(frame,
         residuals, linearisation)`` of the last iterate (the linearisation is that of an
-        earlier iterate, None when none was needed). The Jacobian of the first iterate is
-        kept while the residuals fall at least tenfold per step (the predictor lands
-        close, so that is most steps) and taken afresh otherwise."""
+        earlier iterate, ``lin0`` when it served throughout, None when none was needed or
+        the last one did not cover every pose). Chord steps: the linearisation ``lin0``
+        (when given) or else the Jacobian of the first iterate is kept while the residuals
+        fall at least tenfold per step (the predictor lands close, so that is most steps)
+        and taken afresh, at the current iterate, otherwise."""
         B = len(R)
         moved = np.zeros(B)
         done = np.zeros(B, bool)
