@@ -246,17 +246,20 @@ class Tracker:
                 iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
         """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
         those that converged without moving further than ``limit``, and ``(frame,
-        residuals, linearisation)`` of the last iterate (the linearisation is that of an
-        earlier iterate, ``lin0`` when it served throughout, None when none was needed or
-        the last one did not cover every pose). Chord steps: the linearisation ``lin0``
-        (when given) or else the Jacobian of the first iterate is kept while the residuals
-        fall at least tenfold per step (the predictor lands close, so that is most steps)
-        and taken afresh, at the current iterate, otherwise."""
+        residuals, fresh, rows)`` of the last iterate: ``fresh`` the last Jacobian taken
+        (of an earlier iterate), for the poses ``rows``; None and no rows when none was.
+
+        Chord steps: each pose keeps its linearisation (``lin0``'s for all, when given)
+        while its residual falls at least tenfold per step (the predictor lands close, so
+        that is most steps); the poses whose residual falls less, or that have none, get
+        the Jacobian of their current iterate (with those already on fresh ones), and all
+        of them do once a quarter of the poses still correcting would (rows next to slow
+        ones soon slow down too: measured on the examples, fewer instructions than
+        either always or never renewing all)."""
         B = len(R)
-        moved = np.zeros(B)
-        done = np.zeros(B, bool)
-        failed = np.zeros(B, bool)
-        lin, rows, last = lin0, np.full(B, lin0 is not None), np.full(B, np.inf)
+        moved, last = np.zeros(B), np.full(B, np.inf)
+        done, failed, on_fresh = np.zeros(B, bool), np.zeros(B, bool), np.zeros(B, bool)
+        fresh, fidx = None, np.zeros(0, int)
         for it in range(iters):
             F = frame(self.M, R, p)
             g = residual(self.M, F, href, target)
@@ -267,19 +270,24 @@ class Tracker:
             active = ~done & ~failed
             if not active.any():
                 break
-            if lin is None or np.any(err[active] > 0.1 * last[active]) or not rows[active].all():
-                idx = np.flatnonzero(active)
-                lin = self.lin(jacobian(self.M, F.take(idx) if len(idx) < B else F), R[idx], p[idx])
-                rows = active.copy()
+            renew = active & ((err > 0.1 * last) | (~on_fresh if lin0 is None else False))
+            if renew.any():
+                on_fresh = active if renew.sum() > 0.25 * active.sum() else active & (renew | on_fresh)
+                fidx = np.flatnonzero(on_fresh)
+                fresh = self.lin(jacobian(self.M, F.take(fidx) if len(fidx) < B else F), R[fidx], p[fidx])
             last = err
             dx = np.zeros((B, 6 * self.M.n))
-            dx[rows] = -lin.solve(g[rows])
+            if len(fidx):
+                dx[fidx] = -fresh.solve(g[fidx])
+            chord = active & ~on_fresh
+            if chord.any():
+                dx[chord] = -lin0.solve(g[chord])
             dx[~active] = 0.0
             moved += np.abs(dx).max(axis=1)
             failed |= moved > limit
             dx[failed] = 0.0
             R, p = move(R, p, dx)
-        return R, p, done & ~failed, (F, g, lin if lin is not None and rows.all() else None)
+        return R, p, done & ~failed, (F, g, fresh, fidx)
 
     def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
         """One predictor-corrector step of a single pose; (the new state or None, the
@@ -291,10 +299,10 @@ class Tracker:
         if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
             return None, size
         R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        R, p, ok, (F, g, lin) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
         if not ok[0]:
             return None, size
-        if lin is None:
+        if not len(rows):
             return self.state(R, p, st.href, target[None]), size
         href = helix_angles(self.M, F, st.href) if self.M.helix else st.href
         return State(R, p, href, F, lin, g), size
@@ -317,16 +325,17 @@ class Tracker:
         zero = zero[:K]
         R, p = move(st.R[zero], st.p[zero], x1[:K] + 0.5 * x2[:K])
         href = st.href[zero]
-        R, p, ok, (F, g, lin) = self.correct(R, p, href, Ub[:K], 0.5 * size[:K] + 1e-9, lin0=AnchorLin(st.lin))
+        R, p, ok, (F, g, lin, rows) = self.correct(R, p, href, Ub[:K], 0.5 * size[:K] + 1e-9,
+                                                   lin0=AnchorLin(st.lin))
         n = int(np.argmin(np.append(ok, False)))
         if n == 0:
             return 0, size, None, None
         if self.M.helix:
             href = helix_angles(self.M, F, href)
         last = slice(n - 1, n)
-        if isinstance(lin, Lin):
-            new = State(R[last], p[last], href[last], F.take(np.arange(n - 1, n)), lin.take(np.arange(n - 1, n)),
-                        g[last])
+        at = np.flatnonzero(rows == n - 1)
+        if len(at):  # the corrector's linearisation of the last row (as in step)
+            new = State(R[last], p[last], href[last], F.take(np.arange(n - 1, n)), lin.take(at), g[last])
         else:
             new = self.state(R[last], p[last], href[last], Ub[last])
         return n, size, (R[:n], p[:n], href[:n]), new
