@@ -9,30 +9,37 @@ Run from the repository root::
 Cases (issue 25 item 4):
 
 * ``Bennett``: examples/textbook/bennett.yaml, R1 over 0..360 deg, 361 inputs (target < 50 ms);
-* ``spherical four-bar``: examples/textbook/spherical_fourbar.yaml, A over 0..360 deg,
+* ``spherical 4-bar``: examples/textbook/spherical_fourbar.yaml, A over 0..360 deg,
   361 inputs (target < 50 ms);
-* ``Delta, one drive``: examples/textbook/delta.yaml, R1 over -30..30 deg in 0.1 deg
+* ``Delta, 1 drive``: examples/textbook/delta.yaml, R1 over -30..30 deg in 0.1 deg
   (601 inputs), the other two arms held (target < 200 ms).
 
 References, each a bare NumPy program written for the case, positions only:
 
-* Bennett: a per-input Newton loop on the loop closure in joint coordinates
-  (``exp(ξ1 θ1) exp(ξ2 θ2) exp(ξ3 θ3) exp(ξ4 θ4) = I``, product of exponentials, warm
-  start from the previous input), the "bare NumPy loop" a user would write;
-* spherical four-bar: the spherical Freudenstein equation solved in closed form for all
-  inputs at once (array expressions);
-* Delta: the closed-form forward kinematics (intersection of the three spheres about the
-  elbows), for all inputs at once.
+* for every case, a bare per-input Newton loop, warm-started from the previous input (the
+  "bare NumPy loop" a user would write): for the Bennett and spherical four-bar the loop
+  closure of the four R pairs in joint coordinates (``exp(ξ1 θ1) exp(ξ2 θ2) exp(ξ3 θ3)
+  exp(ξ4 θ4) = I``, product of exponentials, a least-squares step per iteration); for the
+  Delta the platform's shift ``x`` with ``|c_i(θ_i) - x| = ℓ`` for its three arms (a 3 x 3
+  step per iteration);
+* where one exists, the closed form for all inputs at once (array expressions): the
+  spherical Freudenstein equation; the Delta's forward kinematics (the intersection of the
+  three spheres about the elbows).
 
 mechsyn's positions are checked against each (1e-9 of the length scale). Times are minima
 over ``--repeats`` runs (the least noisy statistic on a shared machine), as wall time and
-as CPU time of the process (steadier when other processes compete for the cores);
-``ratio`` is mechsyn's CPU time over the reference's, both measured in this process.
+as CPU time of the process (steadier when other processes compete for the cores); the
+ratios are mechsyn's CPU time over the reference's, both measured in this process. The
+references compute positions only; mechsyn also gives every link's pose, velocities and
+accelerations, the closure residual and the rank test of every row, and (Delta) moves
+all ten links (60 unknowns against the loop's 3).
 
-Where the time goes (cProfile, Bennett): about half in the SVDs (the Jacobian's
-pseudo-inverse at every anchor and, in batches, at every row: the rank test and the
-minimum-norm rates need them), the rest in the NumPy calls of the equations (each a few
-microseconds on small arrays); the rows between anchors cost one batch, not a Python loop.
+Where the time goes (cProfile; after the block continuation): the walk is about three
+quarters of a Bennett sweep (12 blocks of up to 42 rows, 5 to 8 Newton iterations each,
+every iteration some 100 NumPy calls on arrays of a few hundred numbers: NumPy's per-call
+cost, not arithmetic), the rates, rank test and Jacobians of all rows at once the rest; on
+the Delta the inverses of the 601 Gram matrices (54 x 54) of the rates and rank test are
+the largest single cost.
 """
 
 from __future__ import annotations
@@ -49,7 +56,7 @@ sys.path.insert(0, str(ROOT / "src"))
 
 import mechsyn as ms  # noqa: E402
 
-TARGETS_MS = {"Bennett": 50.0, "spherical four-bar": 50.0, "Delta, one drive": 200.0}
+TARGETS_MS = {"Bennett": 50.0, "spherical 4-bar": 50.0, "Delta, 1 drive": 200.0}
 
 
 def _minimum(f, repeats: int) -> tuple[float, float]:
@@ -73,9 +80,10 @@ def _exp(w: np.ndarray, q: np.ndarray, th: float) -> np.ndarray:
     return T
 
 
-def bennett_bare(mech, theta1: np.ndarray) -> np.ndarray:
-    """Bare Newton loop: joint angles θ2..θ4 for each θ1, then the point of R3."""
-    J = [mech.joint(j) for j in ("R1", "R2", "R3", "R4")]
+def loop4r_bare(mech, theta1: np.ndarray, joints=("R1", "R2", "R3", "R4")) -> np.ndarray:
+    """Bare Newton loop on a single loop of four R pairs (Bennett, spherical four-bar):
+    joint angles θ2..θ4 for each θ1, then the point of the third pair."""
+    J = [mech.joint(j) for j in joints]
     w = [np.asarray(j.axis, float) / np.linalg.norm(j.axis) for j in J]
     q = [np.asarray(j.point, float) for j in J]
     x = np.zeros(3)
@@ -114,9 +122,10 @@ def spherical_bare(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return uB, v @ Ry.T
 
 
-def delta_bare(mech, q1: np.ndarray) -> np.ndarray:
-    """Closed-form forward kinematics: the platform's shift from the drawn assembly."""
-    E, P0, ell = [], [], []
+def _delta_spheres(mech, q1: np.ndarray) -> tuple[list, list]:
+    """The three sphere centres for the platform's shift (each elbow's centre minus the
+    platform's drawn ball centre) over the inputs, and the bar lengths."""
+    C, ell = [], []
     for i in (1, 2, 3):
         R = mech.joint(f"R{i}")
         A, u = np.asarray(R.point, float), np.asarray(R.axis, float) / np.linalg.norm(R.axis)
@@ -124,12 +133,35 @@ def delta_bare(mech, q1: np.ndarray) -> np.ndarray:
         p0 = (np.asarray(mech.joint(f"S{i}a2").point) + np.asarray(mech.joint(f"S{i}b2").point)) / 2
         ell.append(np.linalg.norm(e0 - p0))
         th = q1 if i == 1 else np.zeros_like(q1)
-        r = e0 - A
         K = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
-        Rk = (np.eye(3) + np.sin(th)[:, None, None] * K + (1 - np.cos(th))[:, None, None] * (K @ K))
-        E.append(A + Rk @ r - p0)  # the sphere centre for the platform's shift
-        P0.append(p0)
-    c1, c2, c3 = E
+        Rk = np.eye(3) + np.sin(th)[:, None, None] * K + (1 - np.cos(th))[:, None, None] * (K @ K)
+        C.append(A + Rk @ (e0 - A) - p0)
+    return C, ell
+
+
+def delta_newton_bare(mech, q1: np.ndarray) -> np.ndarray:
+    """Bare Newton loop: for each input, the platform's shift ``x`` with
+    ``|c_i - x|² = ℓ_i²`` for the three arms (3 x 3 Newton steps, warm start from the
+    previous input; the first from the drawn assembly)."""
+    C, ell = _delta_spheres(mech, q1)
+    C, ell2 = np.stack(C, axis=1), np.square(ell)
+    x = np.zeros(3)
+    out = np.empty((len(q1), 3))
+    for k in range(len(q1)):
+        for _ in range(30):
+            d = C[k] - x
+            f = (d * d).sum(axis=1) - ell2
+            if np.abs(f).max() < 1e-13:
+                break
+            x += np.linalg.solve(2 * d, f)
+        out[k] = x
+    return out
+
+
+def delta_bare(mech, q1: np.ndarray) -> np.ndarray:
+    """Closed-form forward kinematics: the platform's shift from the drawn assembly (the
+    intersection of the three spheres, for all inputs at once)."""
+    (c1, c2, c3), ell = _delta_spheres(mech, q1)
     r = ell[0]  # equal bar lengths: three spheres of radius r about c1, c2, c3
     ex = (c2 - c1) / np.linalg.norm(c2 - c1, axis=1)[:, None]
     i_ = np.einsum("ij,ij->i", ex, c3 - c1)
@@ -147,30 +179,35 @@ def delta_bare(mech, q1: np.ndarray) -> np.ndarray:
 
 # --------------------------------------------------------------------------- cases
 def cases():
+    """(name, mechsyn's run, its error against the references, the bare per-input Newton
+    loop, the closed form or None)."""
     ben = ms.examples.load("bennett")
     sph = ms.examples.load("spherical_fourbar")
     dlt = ms.examples.load("delta")
     g360 = ms.input_grid(0, 360, 1)
     gd = ms.input_grid(-30, 30, 0.1)
+    t360, td = np.radians(g360), np.radians(gd)
 
-    def check_bennett(s):
-        ref = bennett_bare(ben, np.radians(g360))
-        return np.abs(s.point("R3") - ref).max() / s.length_scale
+    def err_bennett(s):
+        return np.abs(s.point("R3") - loop4r_bare(ben, t360)).max() / s.length_scale
 
-    def check_spherical(s):
+    def err_spherical(s):
         uB, uC = spherical_bare(np.radians(40 + g360))
-        return max(np.abs(s.point("B") - uB).max(), np.abs(s.point("C") - uC).max()) / s.length_scale
+        loop = loop4r_bare(sph, t360, ("A", "B", "C", "D"))
+        return max(np.abs(s.point("B") - uB).max(), np.abs(s.point("C") - uC).max(),
+                   np.abs(s.point("C") - loop).max()) / s.length_scale
 
-    def check_delta(s):
-        return np.abs(s.link("platform").translation - delta_bare(dlt, np.radians(gd))).max() / s.length_scale
+    def err_delta(s):
+        x = s.link("platform").translation
+        return max(np.abs(x - delta_bare(dlt, td)).max(), np.abs(x - delta_newton_bare(dlt, td)).max()) / s.length_scale
 
     return [
-        ("Bennett", lambda: ms.simulate(ben, {"R1": g360}, points=["R3"]), check_bennett,
-         lambda: bennett_bare(ben, np.radians(g360)), "bare NumPy Newton loop"),
-        ("spherical four-bar", lambda: ms.simulate(sph, {"A": g360}, points=["B", "C", "P"]), check_spherical,
-         lambda: spherical_bare(np.radians(40 + g360)), "closed form, arrays"),
-        ("Delta, one drive", lambda: ms.simulate(dlt, {"R1": gd}, points=["S1a2"]), check_delta,
-         lambda: delta_bare(dlt, np.radians(gd)), "closed form, arrays"),
+        ("Bennett", lambda: ms.simulate(ben, {"R1": g360}, points=["R3"]), err_bennett,
+         lambda: loop4r_bare(ben, t360), None),
+        ("spherical 4-bar", lambda: ms.simulate(sph, {"A": g360}, points=["B", "C", "P"]), err_spherical,
+         lambda: loop4r_bare(sph, t360, ("A", "B", "C", "D")), lambda: spherical_bare(np.radians(40 + g360))),
+        ("Delta, 1 drive", lambda: ms.simulate(dlt, {"R1": gd}, points=["S1a2"]), err_delta,
+         lambda: delta_newton_bare(dlt, td), lambda: delta_bare(dlt, td)),
     ]
 
 
@@ -178,18 +215,23 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args(argv)
-    print(f"{'case':<20} {'rows':>5} {'wall ms':>8} {'cpu ms':>7} {'target':>6} {'reference':<24} "
-          f"{'ref ms':>7} {'ratio':>7} {'error':>8}")
+    print(f"{'case':<15} {'rows':>4} {'wall':>6} {'cpu':>6} {'target':>6} {'loop':>7} {'x loop':>6} "
+          f"{'closed':>7} {'x closed':>8} {'error':>7}")
     ok = True
-    for name, run, check, ref, ref_name in cases():
+    for name, run, check, loop, closed in cases():
         s = run()  # warm: imports, caches
         err = check(s)
         wall, cpu = _minimum(run, args.repeats)
-        wall_ref, cpu_ref = _minimum(ref, args.repeats)
+        cpu_loop = _minimum(loop, args.repeats)[1]
+        cpu_closed = _minimum(closed, args.repeats)[1] if closed else None
         good = err < 1e-9 and s.assembled.all() and np.nanmax(s.residual) < 1e-9
         ok &= good
-        print(f"{name:<20} {len(s.assembled):>5} {1e3 * wall:>8.1f} {1e3 * cpu:>7.1f} {TARGETS_MS[name]:>6.0f} "
-              f"{ref_name:<24} {1e3 * cpu_ref:>7.2f} {cpu / cpu_ref:>7.1f} {err:>8.1e}" + ("" if good else "  WRONG"))
+        vs_closed = f"{1e3 * cpu_closed:>7.2f} {cpu / cpu_closed:>8.0f}" if closed else f"{'-':>7} {'-':>8}"
+        print(f"{name:<15} {len(s.assembled):>4} {1e3 * wall:>6.1f} {1e3 * cpu:>6.1f} {TARGETS_MS[name]:>6.0f} "
+              f"{1e3 * cpu_loop:>7.1f} {cpu / cpu_loop:>6.2f} {vs_closed} {err:>7.1e}" + ("" if good else "  WRONG"))
+    print("(ms, minima of the runs; cpu: the process's CPU time; x loop, x closed: mechsyn's CPU\n"
+          " time over the bare per-input Newton loop's and over the closed form's; error: the\n"
+          " largest distance from them in units of the length scale)")
     return 0 if ok else 1
 
 

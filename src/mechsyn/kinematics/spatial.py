@@ -11,12 +11,14 @@ more equation each); it
   pair's rotation from the drawn position in degrees, right-handed about the file's axis;
   a P input its slide along the axis in the file's length unit), reaches the sweep's row
   nearest the drawn input and goes outwards from there, so the branch is the drawn one;
-* predicts each row from the previous one to second order (the velocity and acceleration
-  twists per unit input step, through the exponential of a twist) and corrects by Newton
-  steps ``δξ = -J⁺ g`` (the minimum-norm least-squares step with the pseudo-inverse of the
-  Jacobian at the regular rank ``r``), accepting a pose when every residual is under
-  ``1e-12`` of the length scale; the step is halved where the corrector fails or would move
-  further than the predictor did (a branch jump), down to ``1/4096`` of a row;
+* goes by blocks of rows (:mod:`mechsyn.kinematics.spatial_track`): predicts every row of
+  a block from its first pose to second order (the velocity and acceleration twists along
+  the input step, through the exponential of a twist) and corrects all rows at once by
+  Newton steps ``δξ = -J⁺ g`` (the minimum-norm least-squares step with the pseudo-inverse
+  of the Jacobian at the regular rank ``r``), accepting a pose when every residual is under
+  ``1e-12`` of the length scale and the corrector moved it less than half its predictor's
+  step (else a branch jump); blocks shorten after trouble, down to one row, whose step is
+  halved down to ``1/4096`` of a row;
 * takes velocities ``ξ = J⁺ b`` (``b``: the input rates on the drive rows) and accelerations
   ``ξ̇ = -J⁺ γ`` from the same Jacobian in twist form, never by differencing positions;
 * handles idle mobilities (a rod spinning between two ball joints, a Delta's bars): they

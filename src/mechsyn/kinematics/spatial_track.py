@@ -1,18 +1,24 @@
 """Continuation of a spatial mechanism's poses over a sweep (used by
 :mod:`mechsyn.kinematics.spatial`; the equations are :mod:`mechsyn.kinematics.spatial_model`).
 
-The walk goes outwards from the drawn assembly along the sweep's rows. It moves from one
-*anchor* row to the next by a second-order predictor (the twists' first and second
-derivatives along the input step, through the exponential of a twist) and Newton
-corrections ``δξ = -J⁺ g`` (the pseudo-inverse at the regular rank ``r``: least-squares for
-redundant constraints, minimum-norm for idle motions). A step is refused when the
-corrector fails or moves the links further than half the predictor did (a jump to another
-branch); then the stride is halved, down to a single row and then to ``1/4096`` of a row.
-The stride doubles after easy steps while the predictor's step stays under
-``MAX_STEP`` (radians, or lengths in units of the length scale), so the Taylor predictor
-stays accurate. The rows between anchors are then predicted from the anchor before them
-and corrected all at once (one batch of Newton steps over every row), each with the same
-branch guard; a row the batch cannot settle is walked to on its own from the row before.
+The walk goes outwards from the drawn assembly along the sweep's rows, by *blocks* of rows.
+Every row of a block is predicted from the block's first pose by a second-order predictor
+(the twists' first and second derivatives along the row's input step, through the
+exponential of a twist; the derivatives are solved once per block, for the unit step of
+each moving drive, and are linear and quadratic in the step), and all rows are corrected
+at once: chord steps ``δξ = -J⁺ g`` with the Jacobian of the block's first pose (one
+product per block for all rows), a fresh Jacobian of the current iterate wherever those do
+not shrink the residual tenfold per step (the pseudo-inverse at the regular rank ``r``:
+least-squares for redundant constraints, minimum-norm for idle motions). A row is accepted
+when its residual is under ``NEWTON_TOL`` without the corrector moving it further than half
+its predictor's step (else it may have jumped to another branch); the block's longest
+accepted run of rows from its first on is kept, and the next block starts from its last
+row. Blocks are cut where the predictor's step exceeds ``MAX_STEP`` (radians, or lengths in
+units of the length scale), so the Taylor predictor stays accurate, and are at most
+``MAX_STRIDE`` rows; after trouble the next block is half as long, down to one row, which is
+then reached by the single-pose predictor-corrector halving its step down to ``1/4096``
+of a row (and a dead point where even that fails). ``MAX_STRIDE = 1`` gives the per-row
+path (every row its own block), the reference of the tests.
 
 References
 ----------
@@ -29,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.spatial_model import (SpatialModel, _cross, convective, frame, helix_angles, jacobian, move,
-                                              residual)
+                                              residual, rotate)
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 
@@ -37,8 +43,11 @@ __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 RANK_TOL = 1e-8
 #: Residual (in units of the length scale) at which the corrector accepts a pose.
 NEWTON_TOL = 1e-12
-#: Largest predictor step between anchors (radians; lengths in units of the length scale).
-MAX_STEP = 0.5
+#: Largest predictor step in a block (radians; lengths in units of the length scale): the
+#: second-order predictor's error is then about ``MAX_STEP³ / 6`` of the twists' scale,
+#: well inside Newton's reach; every row is still checked on its own (residual and branch
+#: guard). Measured: 0.35 / 0.5 / 0.75 / 1.0 give Bennett sweeps of 52 / 48 / 41 / 39 ms.
+MAX_STEP = 0.75
 MAX_HALVINGS = 12
 MAX_STRIDE = 64
 
@@ -111,6 +120,22 @@ class Lin:
         out = Lin(self.Jc[idx], self.G[idx], self.rows, self.r, self.C[idx])
         out.__dict__["Ginv"] = self.Ginv[idx]
         return out
+
+
+class AnchorLin:
+    """The linearisation ``lin`` of one pose serving many (the chord steps of a block of
+    rows): all of them solved in one product with its inverse Gram matrix."""
+
+    def __init__(self, lin: Lin) -> None:
+        self.lin = lin
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        L = self.lin
+        J, Gi = L.Jc[0], L.Ginv[0]
+        y = (b @ Gi.T) @ J if L.rows else (b @ J) @ Gi.T  # (Gi is symmetric to rounding)
+        Y = y.reshape(len(b), -1, 6)
+        Y[:, :, 3:] += _cross(L.C[0], Y[:, :, :3])
+        return y
 
 
 def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
@@ -186,7 +211,7 @@ class Tracker:
         and steps give the spin no component: idle spins stay at rest, whichever point the
         file measures from."""
         B, n = len(J), self.M.n
-        C = (R[:, :-1] @ self.c0[:, :, None])[..., 0] + p[:, :-1]
+        C = rotate(R[:, :-1], self.c0) + p[:, :-1]
         Jr = J.reshape(B, -1, n, 6).copy()
         rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
         Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
@@ -217,19 +242,24 @@ class Tracker:
         x1 = st.lin.solve(b, refine)
         return x1, st.lin.solve(-convective(self.M, F, x1), refine)
 
-    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
-                limit: np.ndarray, iters: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+    def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
+                iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
         """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
         those that converged without moving further than ``limit``, and ``(frame,
-        residuals, linearisation)`` of the last iterate (the linearisation is that of an
-        earlier iterate, None when none was needed). The Jacobian of the first iterate is
-        kept while the residuals fall at least tenfold per step (the predictor lands
-        close, so that is most steps) and taken afresh otherwise."""
+        residuals, fresh, rows)`` of the last iterate: ``fresh`` the last Jacobian taken
+        (of an earlier iterate), for the poses ``rows``; None and no rows when none was.
+
+        Chord steps: each pose keeps its linearisation (``lin0``'s for all, when given)
+        while its residual falls at least tenfold per step (the predictor lands close, so
+        that is most steps); the poses whose residual falls less, or that have none, get
+        the Jacobian of their current iterate (with those already on fresh ones), and all
+        of them do once a quarter of the poses still correcting would (rows next to slow
+        ones soon slow down too: measured on the examples, fewer instructions than
+        either always or never renewing all)."""
         B = len(R)
-        moved = np.zeros(B)
-        done = np.zeros(B, bool)
-        failed = np.zeros(B, bool)
-        lin, rows, last = None, np.zeros(B, bool), np.full(B, np.inf)
+        moved, last = np.zeros(B), np.full(B, np.inf)
+        done, failed, on_fresh = np.zeros(B, bool), np.zeros(B, bool), np.zeros(B, bool)
+        fresh, fidx = None, np.zeros(0, int)
         for it in range(iters):
             F = frame(self.M, R, p)
             g = residual(self.M, F, href, target)
@@ -240,19 +270,24 @@ class Tracker:
             active = ~done & ~failed
             if not active.any():
                 break
-            if lin is None or np.any(err[active] > 0.1 * last[active]) or not rows[active].all():
-                idx = np.flatnonzero(active)
-                lin = self.lin(jacobian(self.M, F.take(idx) if len(idx) < B else F), R[idx], p[idx])
-                rows = active.copy()
+            renew = active & ((err > 0.1 * last) | (~on_fresh if lin0 is None else False))
+            if renew.any():
+                on_fresh = active if renew.sum() > 0.25 * active.sum() else active & (renew | on_fresh)
+                fidx = np.flatnonzero(on_fresh)
+                fresh = self.lin(jacobian(self.M, F.take(fidx) if len(fidx) < B else F), R[fidx], p[fidx])
             last = err
             dx = np.zeros((B, 6 * self.M.n))
-            dx[rows] = -lin.solve(g[rows])
+            if len(fidx):
+                dx[fidx] = -fresh.solve(g[fidx])
+            chord = active & ~on_fresh
+            if chord.any():
+                dx[chord] = -lin0.solve(g[chord])
             dx[~active] = 0.0
             moved += np.abs(dx).max(axis=1)
             failed |= moved > limit
             dx[failed] = 0.0
             R, p = move(R, p, dx)
-        return R, p, done & ~failed, (F, g, lin if lin is not None and rows.all() else None)
+        return R, p, done & ~failed, (F, g, fresh, fidx)
 
     def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
         """One predictor-corrector step of a single pose; (the new state or None, the
@@ -264,13 +299,46 @@ class Tracker:
         if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
             return None, size
         R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        R, p, ok, (F, g, lin) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
         if not ok[0]:
             return None, size
-        if lin is None:
+        if not len(rows):
             return self.state(R, p, st.href, target[None]), size
         href = helix_angles(self.M, F, st.href) if self.M.helix else st.href
         return State(R, p, href, F, lin, g), size
+
+    def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
+        """The rows ``Ub`` (K, drives) after the pose ``st`` (at inputs ``u0``), predicted
+        from its tangents (:func:`_taylor`) and corrected in one batch, first by chord steps
+        with the linearisation of ``st`` (:class:`AnchorLin`). Returns the number ``n`` of
+        rows accepted from the first on (each converged without moving further than half
+        its predictor's step, which is at most ``MAX_STEP``), the predictor's step size of
+        every row, the accepted poses ``(R, p, href)`` and the state of the last of them
+        (its linearisation that of the corrector, as in :meth:`step`)."""
+        K = len(Ub)
+        zero = np.zeros(K, int)
+        x1, x2 = _taylor(self, st, Ub - u0)
+        size = np.abs(x1).max(axis=1)
+        K = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
+        if K == 0:
+            return 0, size, None, None
+        zero = zero[:K]
+        R, p = move(st.R[zero], st.p[zero], x1[:K] + 0.5 * x2[:K])
+        href = st.href[zero]
+        R, p, ok, (F, g, lin, rows) = self.correct(R, p, href, Ub[:K], 0.5 * size[:K] + 1e-9,
+                                                   lin0=AnchorLin(st.lin))
+        n = int(np.argmin(np.append(ok, False)))
+        if n == 0:
+            return 0, size, None, None
+        if self.M.helix:
+            href = helix_angles(self.M, F, href)
+        last = slice(n - 1, n)
+        at = np.flatnonzero(rows == n - 1)
+        if len(at):  # the corrector's linearisation of the last row (as in step)
+            new = State(R[last], p[last], href[last], F.take(np.arange(n - 1, n)), lin.take(at), g[last])
+        else:
+            new = self.state(R[last], p[last], href[last], Ub[last])
+        return n, size, (R[:n], p[:n], href[:n]), new
 
     def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
         """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
@@ -322,8 +390,8 @@ class Walk:
 
 def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
     """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
-    inputs): to the row nearest it, then outwards both ways (anchors, then the rows between
-    them in one batch). ``event(index, kind, detail)`` makes the event dicts."""
+    inputs): to the row nearest it, then outwards both ways by blocks of rows
+    (:func:`_blocks_along`). ``event(index, kind, detail)`` makes the event dicts."""
     M = tr.M
     N = len(U)
     w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
@@ -335,98 +403,79 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
         return w
     w.put(k0, st)
     for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1)):
-        anchors, gaps = _anchors(tr, w, st, U, k0, order, event)
-        _fill(tr, w, U, k0, order, anchors, gaps)
+        _blocks_along(tr, w, st, U, k0, order, event)
     w.events.sort(key=lambda e: e["index"])
     return w
 
 
-def _anchors(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray,
-             event: Any) -> tuple[set, set]:
-    """Walk along ``order`` by adaptive strides; the rows reached (anchors) go into ``w``.
-    Returns the anchors and the rows of the gaps (not assembled on the way)."""
-    anchors, gaps = {k0}, set()
-    prev, i, stride, gap = k0, 0, 1, False
+def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any) -> None:
+    """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
+    each from the last row of the one before; the rows reached go into ``w``."""
+    prev, i, stride, gap = k0, 0, MAX_STRIDE, False
     while i < len(order):
         if gap:  # the first row after the gap where Newton from the last pose converges
             k = tr.reassemble(st, U, order[i:])
             if k is None:
-                gaps.update(int(r) for r in order[i:])
                 break
             where = i + int(np.flatnonzero(order[i:] == k[0])[0])
-            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1], anchors)
-            gaps.update(int(r) for r in order[i:where] if r not in anchors)
+            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1])
             w.events.append(event(first, "reassembled", None))
             st, prev, gap, i = k[1], k[0], False, where + 1
             continue
         j = min(i + stride, len(order)) - 1
-        k = int(order[j])
-        nxt, size = tr.step(st, U[k] - U[prev], U[k])
-        if nxt is None and j == i:  # a single row: halve within it
+        rows = order[i:j + 1]
+        n, size, poses, nxt = tr.block(st, U[prev], U[rows])
+        if n == 0 and j > i:  # not even the next row: from it on, one row at a time
+            stride = 1
+            continue
+        if n == 0:  # a single row: halve within it
+            k = int(rows[0])
             nxt = tr.advance(st, U[prev], U[k])
             if nxt is None:
                 w.events.append(event(k, "dead point", st.lin.ratio[0]))
                 i, gap = i + 1, True
-                gaps.add(k)
                 continue
-        if nxt is None:
-            stride = max(1, stride // 2)
-            continue
-        per_row = size / (j + 1 - i)
-        st, prev, i = nxt, k, j + 1
-        w.put(k, st)
-        anchors.add(k)
-        stride = int(max(1, min(2 * stride, MAX_STRIDE, MAX_STEP / max(per_row, 1e-300))))
-    return anchors, gaps
+            n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
+        done = rows[:n]
+        w.R[done], w.p[done], w.href[done] = poses
+        w.ok[done] = True
+        st, prev, i = nxt, int(done[-1]), i + n
+        reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
+        stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
 
 
-def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray, anchors: set) -> int:
+def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray) -> int:
     """From the reassembled row ``rows[0]`` (state ``st``) back through the gap's rows while
     the mechanism follows (so the gap ends where the mechanism stops assembling, not where
     Newton first converged); returns the first row of the assembled stretch."""
     w.put(int(rows[0]), st)
-    anchors.add(int(rows[0]))
     for prev, k in zip(rows[:-1], rows[1:]):
         st = tr.advance(st, U[prev], U[k])
         if st is None:
             return int(prev)
         w.put(int(k), st)
-        anchors.add(int(k))
     return int(rows[-1])
 
 
-def _fill(tr: Tracker, w: Walk, U: np.ndarray, k0: int, order: np.ndarray, anchors: set, gaps: set) -> None:
-    """The rows of ``order`` between anchors, from the anchor before each, in one batch;
-    rows the batch cannot settle are walked to one by one."""
-    seq = np.concatenate([[k0], order])
-    reached = np.array([int(k) in anchors for k in seq])
-    src = np.maximum.accumulate(np.where(reached, np.arange(len(seq)), -1))
-    in_gap = np.array([int(k) in gaps for k in seq])
-    todo = np.flatnonzero(~reached & ~in_gap & (src >= 0))
-    if not len(todo):
-        return
-    rows, base = seq[todo], seq[src[todo]]
-    ub, which = np.unique(base, return_inverse=True)  # each anchor's state once
-    st = tr.state(w.R[ub], w.p[ub], w.href[ub], U[ub]).take(which)
-    du = U[rows] - U[base]
-    x1, x2 = tr.rates(st, du)
-    R, p = move(st.R, st.p, x1 + 0.5 * x2)
-    size = np.abs(x1).max(axis=1)
-    limit = np.where(size <= MAX_STEP, 0.5 * size + 1e-9, -1.0)  # too far: walked to on its own
-    R, p, ok, _ = tr.correct(R, p, st.href, U[rows], limit)
-    good = rows[ok]
-    F = frame(tr.M, R[ok], p[ok])
-    href = helix_angles(tr.M, F, st.href[ok]) if tr.M.helix else st.href[ok]
-    w.R[good], w.p[good], w.href[good] = R[ok], p[ok], href
-    w.ok[good] = True
-    for t in todo[~ok]:  # on its own, from the row before it in the walk
-        k, before = int(seq[t]), int(seq[t - 1])
-        if not w.ok[before]:
-            continue
-        prev = tr.state(*w.at(before), U[before][None])
-        nxt = tr.advance(prev, U[before], U[k])
-        if nxt is not None:
-            w.put(k, nxt)
+def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The predictor's twists (first and second derivative) of B rows from the pose ``st``
+    along their input steps ``du`` (B, drives), without a solve per row: the first
+    derivative is linear in ``du`` and the second quadratic, so the pose solves for the unit
+    step of every drive that moves and for the sums of two of them (the cross terms by
+    polarisation: ``x2(a + b) - x2(a) - x2(b)``)."""
+    cols = np.flatnonzero(np.any(du != 0, axis=0))
+    c = len(cols)
+    pairs = [(a, b) for a in range(c) for b in range(a + 1, c)]
+    D = np.zeros((c + len(pairs), du.shape[1]))
+    D[np.arange(c), cols] = 1.0
+    for q, (a, b) in enumerate(pairs):
+        D[c + q, cols[a]] = D[c + q, cols[b]] = 1.0
+    X1, X2 = tr.rates(st.take(np.zeros(len(D), int)), D)
+    d = du[:, cols]
+    x1, x2 = d @ X1[:c], (d * d) @ X2[:c]
+    for q, (a, b) in enumerate(pairs):
+        x2 += np.outer(d[:, a] * d[:, b], X2[c + q] - X2[a] - X2[b])
+    return x1, x2
 
 
 # --------------------------------------------------------------------------- crossings
