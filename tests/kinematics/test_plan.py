@@ -196,3 +196,34 @@ def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex,
         mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
         tracked = simulate(m, inp, speeds=speeds)
     _same(fast, tracked)
+
+
+@pytest.mark.parametrize("f, j, grid", [("textbook/watt_sixbar.yaml", "A", (0, 360, 2)),     # through folds
+                                        ("kinematics/crank_rocker.yaml", "A", (0, 360, 5)),  # regular pass
+                                        ("textbook/watt_sixbar.yaml", "A", (100, 130, 0.5))])
+def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid, monkeypatch):
+    """Every named point (and joint) of a sweep, computed for all points at once, equals
+    :meth:`PlanarSystem.point_state` of that point alone with its rows not assembled (and
+    its rates where they are not defined) NaN, bit for bit; with the regular pass's link
+    states and without them (the tracked chain)."""
+    from mechsyn.kinematics import analysis
+
+    m = ex(f)
+    names = list(m.points) + [jj.id for jj in m.joints]
+    for engines in (analysis.PLANAR_ENGINES, analysis.PLANAR_ENGINES[1:]):
+        with monkeypatch.context() as mp:
+            mp.setattr(analysis, "PLANAR_ENGINES", engines)
+            s = simulate(m, {j: input_grid(*grid)}, points=names)
+        S, sw = s.system, s.sweep
+        ok = s.assembled
+        rates = ok & np.isfinite(sw.qd).all(axis=1) & np.isfinite(sw.qdd).all(axis=1)
+        for name, (link, at) in analysis.resolve_points(m, names).items():
+            want = S.point_state(sw.q, sw.qd, sw.qdd, S.index(link), S.to_local(link, at))
+            for k, (got, ref) in enumerate(zip((s.points[name].position, s.points[name].velocity,
+                                                s.points[name].acceleration), want)):
+                ref = ref.copy()
+                ref[~(ok if k == 0 else rates)] = np.nan
+                if sw.links is not None:  # the links' complex states: the same motion to round-off
+                    assert np.allclose(got, ref, rtol=1e-12, atol=1e-12 * S.scale * (1 + 10 * k), equal_nan=True)
+                else:
+                    assert np.array_equal(got, ref, equal_nan=True), (name, k)
