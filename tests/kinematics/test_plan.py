@@ -227,3 +227,41 @@ def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid, m
                     assert np.allclose(got, ref, rtol=1e-12, atol=1e-12 * S.scale * (1 + 10 * k), equal_nan=True)
                 else:
                     assert np.array_equal(got, ref, equal_nan=True), (name, k)
+
+
+@pytest.mark.parametrize("f, moved", [("textbook/watt_sixbar.yaml", {"E": (0.013, -0.021), "C": (-0.02, 0.01)}),
+                                      ("kinematics/jansen_leg.yaml", {"P5": (0.31, -0.17)}),
+                                      ("textbook/stephenson_sixbar.yaml", {})])
+def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(ex, f, moved):
+    """The regular pass's program of a refilled system (its topology's shape, the numbers
+    of the moved geometry put in) equals, number for number, the program built from the
+    chain's ops of that system (local points, squared lengths, drawn modes, rotation
+    vectors, anchors)."""
+    from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.chain import _chain_program_
+    from mechsyn.kinematics.groups import DriveOp, _local
+    from mechsyn.kinematics.regular import _program
+
+    m = ex(f)
+    j = next(jj.id for jj in m.joints if jj.actuated)
+    kp = cached_plan(m, inputs=(j,))
+    _program(kp.system, kp.groups)  # the shape, kept for the topology
+    pts = {k: np.asarray(m.joint(k).point, float) + np.asarray(v) for k, v in moved.items()}
+    kp2 = compile_plan(m.with_joint_points(pts), inputs=(j,))
+    S = kp2.system
+    assert S.cache["programs"] is kp.system.cache["programs"]  # shared by the topology
+    steps, cx, origin = _program(S, kp2.groups)
+    prog, anchor = _chain_program_(S, kp2.groups)
+    want = []
+    for op in prog:
+        if isinstance(op, DriveOp):
+            want.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
+                          complex(*_local(S, op.known, op.joint))))
+        else:
+            (k1, k3), (J1, _, J3) = op.known, op.joints
+            want.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
+                         complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
+                         complex(*_local(S, k1, J1)), complex(*_local(S, k3, J3))))
+    assert steps == want
+    assert cx == {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
+    assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
