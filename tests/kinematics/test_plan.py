@@ -265,3 +265,19 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     assert steps == want
     assert cx == {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
     assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
+
+
+def test_fold_search_program_read_off_the_regular_program_equals_the_groups(ex):
+    """The plain-number chain of the fold search, kept from the regular pass's program,
+    equals number for number the one built from the plan's groups."""
+    from mechsyn.kinematics import tracking
+    from mechsyn.kinematics.groups import _memo
+
+    m = ex("textbook/watt_sixbar.yaml")
+    m = m.with_joint_points({"E": np.asarray(m.joint("E").point, float) + 0.01})
+    s = simulate(m, {"A": input_grid(0, 360, 2)})
+    assert any(e.kind == "dead point" for e in s.events) and s.engine == "regular pass"
+    plan = compile_plan(m, inputs=("A",)).groups
+    memo = _memo(s.system)
+    kept = memo.pop(("scalar", id(plan)))
+    assert tracking._scalar_program(s.system, plan) == kept

@@ -330,6 +330,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
+    _scalar_memo(S, plan, steps, anchor)
     order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
     # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
     tracks = [(np.concatenate([path, p - shift]), path.shape[0], shift) for (path, shift), p in zip(paths, parts)]
@@ -348,6 +349,28 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
         events, singular, _ = fold_events(S, plan, ks, sigmas, X, P, n0)
         out.append((singular[n0:], _sweep_events(events, n0, shift)))
     return Folded(*_fold_poses(S, plan, U, st, origin, split), out)
+
+
+def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
+    """Keep with ``S`` the chain as plain numbers for the fold search
+    (:func:`mechsyn.kinematics.tracking._scalar_program`'s layout) read off the regular
+    program (the same local points, squared lengths and rotation vectors, so the same
+    numbers) instead of building it again from the groups."""
+    memo = _memo(S)
+    key = ("scalar", id(plan))
+    if key in memo:
+        return
+    prog = []
+    for st in steps:
+        if st[0] == "drive":
+            _, new, k, _jid, di, sgn, s_k = st
+            prog.append(("drive", new, k, (s_k.real, s_k.imag), di, sgn, (cx[new][1].real, cx[new][1].imag)))
+            continue
+        _, (k1, k3), (b1, b2), _j, L1s, L2s, _sigma, cbv1, cbv2, s1, s3 = st
+        prog.append(("RRR", (k1, (s1.real, s1.imag)), (k3, (s3.real, s3.imag)), (b1, b2), L1s, L2s,
+                     (cx[b1][1].real, cx[b1][1].imag), (cx[b2][1].real, cx[b2][1].imag),
+                     (cbv1.real, -cbv1.imag), (cbv2.real, -cbv2.imag)))
+    memo[key] = prog
 
 
 @dataclass

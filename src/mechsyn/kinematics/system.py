@@ -222,20 +222,23 @@ class PlanarSystem:
         ((2, 4, 2), True)
         """
         m, N = len(idx), q.shape[0]
-        phi = q[:, 3 * idx + 2].T
+        x, y, a = 3 * idx, 3 * idx + 1, 3 * idx + 2
+        qT, qdT, qddT = q.T, qd.T, qdd.T  # (n, N): rows are coordinates
+        phi = qT[a]
         c, sn = np.cos(phi), np.sin(phi)
         sx, sy = s[:, 0, None], s[:, 1, None]
-        As = np.empty((m, N, 2))
-        As[..., 0] = c * sx - sn * sy
-        As[..., 1] = sn * sx + c * sy
-        cols = np.stack([3 * idx, 3 * idx + 1], axis=1).ravel()
-
-        def pair(x: np.ndarray) -> np.ndarray:  # the origin columns as (m, N, 2)
-            return x[:, cols].reshape(N, m, 2).transpose(1, 0, 2)
-
-        pa = _perp(As)
-        w, al = qd[:, 3 * idx + 2].T[..., None], qdd[:, 3 * idx + 2].T[..., None]
-        return pair(q) + As, pair(qd) + w * pa, pair(qdd) + al * pa - (w ** 2) * As
+        ax_, ay_ = c * sx - sn * sy, sn * sx + c * sy  # A(phi) s, as _apply
+        nay = -ay_  # _perp(A s) = (-ay, ax)
+        w, al = qdT[a], qddT[a]
+        w2 = w ** 2
+        P, V, A = (np.empty((m, N, 2)) for _ in range(3))
+        np.add(qT[x], ax_, out=P[..., 0])
+        np.add(qT[y], ay_, out=P[..., 1])
+        np.add(qdT[x], w * nay, out=V[..., 0])
+        np.add(qdT[y], w * ax_, out=V[..., 1])
+        np.subtract(qddT[x] + al * nay, w2 * ax_, out=A[..., 0])
+        np.subtract(qddT[y] + al * ax_, w2 * ay_, out=A[..., 1])
+        return P, V, A
 
     def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
         """Angles (N,) of link index ``i`` (frame: zeros)."""
