@@ -350,8 +350,10 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     key = ("named points", None if names is None else tuple(names))
     hit = S.cache.get(key)
     if hit is None:
-        rows = [(name, link, S.index(link), S.to_local(link, at))
-                for name, (link, at) in resolve_points(mech, names).items()]
+        pts = resolve_points(mech, names)
+        li = np.array([S.index(link) for link, _ in pts.values()], int)
+        loc = S.to_locals(li, np.array([at for _, at in pts.values()], float).reshape(-1, 2))
+        rows = [(name, link, i, x) for (name, (link, _)), i, x in zip(pts.items(), li.tolist(), loc)]
         moving = [k for k, r in enumerate(rows) if r[2] >= 0]
         idx = np.array([rows[k][2] for k in moving], int)
         local = np.array([rows[k][3] for k in moving], float).reshape(-1, 2)

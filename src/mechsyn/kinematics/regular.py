@@ -96,19 +96,10 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
 
 def _locals(S: PlanarSystem, li: np.ndarray, pj: np.ndarray) -> tuple[list, list]:
     """The local points (x and y lists) of the joints ``pj`` (indices in the file) on the
-    links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_local` of
-    every pair in a few array operations (the same arithmetic, so the same numbers)."""
+    links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`."""
     joints = S.mech.joints
-    pts = np.array([joints[k].point for k in pj.tolist()], float).reshape(-1, 2)
-    cos, sin, org = S.frames()
-    mov = li >= 0
-    k = np.where(mov, li, 0)
-    c, sn = np.array(cos + [1.0])[k], np.array(sin + [0.0])[k]
-    o = np.array(org, float).reshape(-1, 2)[k] if len(org) else np.zeros((len(li), 2))
-    dx, dy = pts[:, 0] - o[:, 0], pts[:, 1] - o[:, 1]
-    x = np.where(mov, c * dx - sn * dy, pts[:, 0])
-    y = np.where(mov, sn * dx + c * dy, pts[:, 1])
-    return x.tolist(), y.tolist()
+    loc = S.to_locals(li, np.array([joints[k].point for k in pj.tolist()], float).reshape(-1, 2))
+    return loc[:, 0].tolist(), loc[:, 1].tolist()
 
 
 def _filled(S: PlanarSystem, shape: tuple) -> tuple:
