@@ -196,3 +196,88 @@ def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex,
         mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
         tracked = simulate(m, inp, speeds=speeds)
     _same(fast, tracked)
+
+
+@pytest.mark.parametrize("f, j, grid", [("textbook/watt_sixbar.yaml", "A", (0, 360, 2)),     # through folds
+                                        ("kinematics/crank_rocker.yaml", "A", (0, 360, 5)),  # regular pass
+                                        ("textbook/watt_sixbar.yaml", "A", (100, 130, 0.5))])
+def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid, monkeypatch):
+    """Every named point (and joint) of a sweep, computed for all points at once, equals
+    :meth:`PlanarSystem.point_state` of that point alone with its rows not assembled (and
+    its rates where they are not defined) NaN, bit for bit; with the regular pass's link
+    states and without them (the tracked chain)."""
+    from mechsyn.kinematics import analysis
+
+    m = ex(f)
+    names = list(m.points) + [jj.id for jj in m.joints]
+    for engines in (analysis.PLANAR_ENGINES, analysis.PLANAR_ENGINES[1:]):
+        with monkeypatch.context() as mp:
+            mp.setattr(analysis, "PLANAR_ENGINES", engines)
+            s = simulate(m, {j: input_grid(*grid)}, points=names)
+        S, sw = s.system, s.sweep
+        ok = s.assembled
+        rates = ok & np.isfinite(sw.qd).all(axis=1) & np.isfinite(sw.qdd).all(axis=1)
+        for name, (link, at) in analysis.resolve_points(m, names).items():
+            want = S.point_state(sw.q, sw.qd, sw.qdd, S.index(link), S.to_local(link, at))
+            for k, (got, ref) in enumerate(zip((s.points[name].position, s.points[name].velocity,
+                                                s.points[name].acceleration), want)):
+                ref = ref.copy()
+                ref[~(ok if k == 0 else rates)] = np.nan
+                if sw.links is not None:  # the links' complex states: the same motion to round-off
+                    assert np.allclose(got, ref, rtol=1e-12, atol=1e-12 * S.scale * (1 + 10 * k), equal_nan=True)
+                else:
+                    assert np.array_equal(got, ref, equal_nan=True), (name, k)
+
+
+@pytest.mark.parametrize("f, moved", [("textbook/watt_sixbar.yaml", {"E": (0.013, -0.021), "C": (-0.02, 0.01)}),
+                                      ("kinematics/jansen_leg.yaml", {"P5": (0.31, -0.17)}),
+                                      ("textbook/stephenson_sixbar.yaml", {})])
+def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(ex, f, moved):
+    """The regular pass's program of a refilled system (its topology's shape, the numbers
+    of the moved geometry put in) equals, number for number, the program built from the
+    chain's ops of that system (local points, squared lengths, drawn modes, rotation
+    vectors, anchors)."""
+    from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.chain import _chain_program_
+    from mechsyn.kinematics.groups import DriveOp, _local
+    from mechsyn.kinematics.regular import _program
+
+    m = ex(f)
+    j = next(jj.id for jj in m.joints if jj.actuated)
+    kp = cached_plan(m, inputs=(j,))
+    _program(kp.system, kp.groups)  # the shape, kept for the topology
+    pts = {k: np.asarray(m.joint(k).point, float) + np.asarray(v) for k, v in moved.items()}
+    kp2 = compile_plan(m.with_joint_points(pts), inputs=(j,))
+    S = kp2.system
+    assert S.cache["programs"] is kp.system.cache["programs"]  # shared by the topology
+    steps, cx, origin = _program(S, kp2.groups)
+    prog, anchor = _chain_program_(S, kp2.groups)
+    want = []
+    for op in prog:
+        if isinstance(op, DriveOp):
+            want.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
+                          complex(*_local(S, op.known, op.joint))))
+        else:
+            (k1, k3), (J1, _, J3) = op.known, op.joints
+            want.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
+                         complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
+                         complex(*_local(S, k1, J1)), complex(*_local(S, k3, J3))))
+    assert steps == want
+    assert cx == {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
+    assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
+
+
+def test_fold_search_program_read_off_the_regular_program_equals_the_groups(ex):
+    """The plain-number chain of the fold search, kept from the regular pass's program,
+    equals number for number the one built from the plan's groups."""
+    from mechsyn.kinematics import tracking
+    from mechsyn.kinematics.groups import _memo
+
+    m = ex("textbook/watt_sixbar.yaml")
+    m = m.with_joint_points({"E": np.asarray(m.joint("E").point, float) + 0.01})
+    s = simulate(m, {"A": input_grid(0, 360, 2)})
+    assert any(e.kind == "dead point" for e in s.events) and s.engine == "regular pass"
+    plan = compile_plan(m, inputs=("A",)).groups
+    memo = _memo(s.system)
+    kept = memo.pop(("scalar", id(plan)))
+    assert tracking._scalar_program(s.system, plan) == kept

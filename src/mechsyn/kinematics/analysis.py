@@ -299,7 +299,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if not all(math.isfinite(v) for v in sp.tolist()):
         raise MechsynInputError("input speeds must be finite numbers", field="speeds",
                                 hint="give each driven joint's speed in rad/s (R) or length/s (P)")
-    pts = resolve_points(mech, points)
+    named = _named_points(S, mech, points)
     plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
         raise MechsynInputError("the mechanism does not decompose into drivers and dyads", field="method",
@@ -313,7 +313,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     events = list(sw.events)
     used = sw.method
     ok = sw.assembled
-    if sw.links is not None:  # the regular pass: every row assembled with finite rates
+    complete = sw.links is not None
+    if complete:  # the regular pass without folds: every row assembled with finite rates
         rates_ok, singular_rows = ok, []
     else:
         rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
@@ -328,7 +329,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     links = {}
     for i, name in enumerate(S.links):
         links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
-    pm = _point_motions(S, sw, pts, ok, rates_ok)
+    pm = _point_motions(S, sw, named, ok, rates_ok, complete)
     events = [_event_units(S, e) for e in events]
     notes = list(S.notes)
     if singular_configuration(S):
@@ -341,18 +342,53 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events=events, method=used, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
 
 
-def _point_motions(S: PlanarSystem, sw: Sweep, pts: dict, ok: np.ndarray, rates_ok: np.ndarray) -> dict:
-    """Position, velocity, acceleration of every named point (NaN where not assembled;
-    rates NaN where not defined)."""
-    # no NaN to clear or to restore (the regular pass assembles every row with rates)
-    whole = (True, True) if sw.links is not None else (bool(ok.all()), bool(rates_ok.all()))
+def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
+    """The named points asked for (:func:`resolve_points`) as ``(rows, moving, idx,
+    local)``: rows ``(name, link, link index, local point)``, the rows on moving links,
+    their link indices and local points (m, 2), kept with the system (a cached plan's
+    call resolves them and carries them into the link frames once)."""
+    key = ("named points", None if names is None else tuple(names))
+    hit = S.cache.get(key)
+    if hit is None:
+        pts = resolve_points(mech, names)
+        li = np.array([S.index(link) for link, _ in pts.values()], int)
+        loc = S.to_locals(li, np.array([at for _, at in pts.values()], float).reshape(-1, 2))
+        rows = [(name, link, i, x) for (name, (link, _)), i, x in zip(pts.items(), li.tolist(), loc)]
+        moving = [k for k, r in enumerate(rows) if r[2] >= 0]
+        idx = np.array([rows[k][2] for k in moving], int)
+        local = np.array([rows[k][3] for k in moving], float).reshape(-1, 2)
+        hit = S.cache[key] = (rows, moving, idx, local)
+    return hit
+
+
+def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rates_ok: np.ndarray,
+                   complete: bool) -> dict:
+    """Position, velocity, acceleration of every named point (``named``: see
+    :func:`_named_points`; NaN where not assembled, rates NaN where not defined): the
+    points on moving links in one batch, from the links' complex states when the regular
+    pass gave them (``complete``: every row assembled with finite rates), else from the
+    poses (:meth:`~mechsyn.kinematics.system.PlanarSystem.points_state`)."""
+    rows, moving, idx, local = named
+    whole = (True, True) if complete else (bool(ok.all()), bool(rates_ok.all()))
+    states: dict[int, tuple] = {}
+    if moving:
+        if complete:
+            P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
+        else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
+            P, V, A = S.points_state(sw.q, sw.qd, sw.qdd, idx, local)
+            if not whole[0]:
+                for arr in (P, V, A):
+                    arr[:, ~ok] = np.nan
+            if not whole[1]:
+                V[:, ~rates_ok] = np.nan
+                A[:, ~rates_ok] = np.nan
+        states = dict(zip(moving, zip(P, V, A)))
     pm = {}
-    for name, (link, at) in pts.items():
-        i = S.index(link)
-        if sw.links is not None and i >= 0:  # the regular pass: complex states of the links
-            P, V, A = sw.links.point(i, S.to_local(link, at))
-        else:  # NaN rows stay NaN row by row (and are set NaN below)
-            P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, S.to_local(link, at))
+    for k, (name, link, i, at) in enumerate(rows):
+        if k in states:
+            pm[name] = PointMotion(*states[k], link)
+            continue
+        P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, at)  # NaN rows stay NaN (and are set NaN below)
         if not whole[0]:
             for arr in (P, V, A):
                 arr[~ok] = np.nan

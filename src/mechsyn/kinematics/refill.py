@@ -97,8 +97,10 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     rows = np.where(lengths, scale, 1.0)
     cols = np.ones(len(q0))
     cols[0::3] = cols[1::3] = scale
+    # the engines' programs by topology (regular._program's shapes), shared with T
+    cache = {"frames": (cos, sin, org), "programs": T.cache.setdefault("programs", {})}
     return PlanarSystem(mech, T.links, origin0, angle0, cons, drivers, T.n, T.m, q0, scale, vll=dict(T.vll),
-                        notes=T.notes, row_scale=rows, col_scale=cols, cache={"frames": (cos, sin, org)})
+                        notes=T.notes, row_scale=rows, col_scale=cols, cache=cache)
 
 
 def _layout(T: PlanarSystem) -> tuple | bool:

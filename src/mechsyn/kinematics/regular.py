@@ -45,31 +45,85 @@ __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
 
 def _program(S: PlanarSystem, plan: Plan) -> tuple:
     """The chain's steps with complex constants, every link's anchor and origin joint
-    (built once per system and plan)."""
+    (built once per system and plan). Its shape (:func:`_shape`: the steps' links,
+    joints, drivers and signs, and which local joint points they take) depends on the
+    topology only: it is kept in ``S.cache["programs"]``, which
+    :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of one
+    topology, so a refilled system's program is its numbers put in (:func:`_filled`)."""
     memo = _memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
+    shapes = S.cache.setdefault("programs", {})
+    shape = shapes.get(key)
+    if shape is None or shape[0] is not plan:
+        shape = shapes[key] = (plan, _shape(S, plan))
+    out = _filled(S, shape[1])
+    memo[key] = (plan, out)
+    return out
+
+
+def _shape(S: PlanarSystem, plan: Plan) -> tuple:
+    """The topology of :func:`_program`: its steps without numbers (a drive's links,
+    joint, driver and sign; an RRR group's known links, links and joints), each link's
+    anchor joint, origin joint, and the (link, joint) pairs whose local points the
+    numbers take, as index arrays (link, joint's index in the file)."""
     prog, anchor = _chain_program(S, plan, None)
-    cx = {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
+    pairs: dict[tuple[int, str], int] = {}
+
+    def at(i: int, jid: str) -> int:
+        return pairs.setdefault((i, jid), len(pairs))
+
     steps = []
     for op in prog:
         if isinstance(op, DriveOp):  # the joint's local point on k (the frame: its fixed point)
-            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
-                          complex(*_local(S, op.known, op.joint))))
+            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign, at(op.known, op.joint)))
         else:
-            (k1, k3), (J1, _, J3) = op.known, op.joints
-            steps.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
-                          complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
-                          complex(*_local(S, k1, J1)), complex(*_local(S, k3, J3))))
+            (k1, k3), (b1, b2), (J1, J2, J3) = op.known, op.links, op.joints
+            steps.append(("RRR", op.known, op.links, op.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
+                          at(k1, J1), at(k3, J3)))
+    anchors = {i: (jid, at(i, jid)) for i, (jid, _) in anchor.items()}
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)
         origin.append(j0)
-    out = (steps, cx, origin)
-    memo[key] = (plan, out)
-    return out
+    index = {j.id: k for k, j in enumerate(S.mech.joints)}
+    li = np.array([i for i, _ in pairs], int)
+    pj = np.array([index[jid] for _, jid in pairs], int)
+    return steps, anchors, origin, li, pj
+
+
+def _locals(S: PlanarSystem, li: np.ndarray, pj: np.ndarray) -> tuple[list, list]:
+    """The local points (x and y lists) of the joints ``pj`` (indices in the file) on the
+    links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`."""
+    joints = S.mech.joints
+    loc = S.to_locals(li, np.array([joints[k].point for k in pj.tolist()], float).reshape(-1, 2))
+    return loc[:, 0].tolist(), loc[:, 1].tolist()
+
+
+def _filled(S: PlanarSystem, shape: tuple) -> tuple:
+    """:func:`_program` of ``S`` from its topology's shape (:func:`_shape`): the local
+    points, squared link lengths, drawn assembly modes and rotation vectors of ``S``."""
+    steps_, anchors, origin, li, pj = shape
+    x, y = _locals(S, li, pj)
+    pt = {j.id: j.point for j in S.mech.joints}
+    steps = []
+    for st in steps_:
+        if st[0] == "drive":
+            steps.append(st[:6] + (complex(x[st[6]], y[st[6]]),))
+            continue
+        _, known, links, (J1, J2, J3), i1, i2, i3, i4, k1, k3 = st
+        ux, uy = x[i2] - x[i1], y[i2] - y[i1]  # s2 - s1 on the first link, t2 - t3 on the second
+        vx, vy = x[i3] - x[i4], y[i3] - y[i4]
+        L1s, L2s = ux * ux + uy * uy, vx * vx + vy * vy
+        A0, B0, C0 = pt[J1], pt[J2], pt[J3]
+        cross = (C0[0] - A0[0]) * (B0[1] - A0[1]) - (C0[1] - A0[1]) * (B0[0] - A0[0])
+        sigma = 1.0 if cross >= 0 else -1.0
+        steps.append(("RRR", known, links, (J1, J2, J3), L1s, L2s, sigma, complex(ux / L1s, -(uy / L1s)),
+                      complex(vx / L2s, -(vy / L2s)), complex(x[k1], y[k1]), complex(x[k3], y[k3])))
+    cx = {i: (jid, complex(x[k], y[k])) for i, (jid, k) in anchors.items()}
+    return steps, cx, origin
 
 
 class _Pass:
@@ -267,6 +321,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
+    _scalar_memo(S, plan, steps, anchor)
     order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
     # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
     tracks = [(np.concatenate([path, p - shift]), path.shape[0], shift) for (path, shift), p in zip(paths, parts)]
@@ -285,6 +340,28 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
         events, singular, _ = fold_events(S, plan, ks, sigmas, X, P, n0)
         out.append((singular[n0:], _sweep_events(events, n0, shift)))
     return Folded(*_fold_poses(S, plan, U, st, origin, split), out)
+
+
+def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
+    """Keep with ``S`` the chain as plain numbers for the fold search
+    (:func:`mechsyn.kinematics.tracking._scalar_program`'s layout) read off the regular
+    program (the same local points, squared lengths and rotation vectors, so the same
+    numbers) instead of building it again from the groups."""
+    memo = _memo(S)
+    key = ("scalar", id(plan))
+    if key in memo:
+        return
+    prog = []
+    for st in steps:
+        if st[0] == "drive":
+            _, new, k, _jid, di, sgn, s_k = st
+            prog.append(("drive", new, k, (s_k.real, s_k.imag), di, sgn, (cx[new][1].real, cx[new][1].imag)))
+            continue
+        _, (k1, k3), (b1, b2), _j, L1s, L2s, _sigma, cbv1, cbv2, s1, s3 = st
+        prog.append(("RRR", (k1, (s1.real, s1.imag)), (k3, (s3.real, s3.imag)), (b1, b2), L1s, L2s,
+                     (cx[b1][1].real, cx[b1][1].imag), (cx[b2][1].real, cx[b2][1].imag),
+                     (cbv1.real, -cbv1.imag), (cbv2.real, -cbv2.imag)))
+    memo[key] = prog
 
 
 @dataclass
@@ -377,3 +454,34 @@ class LinkStates:
         A -= rel
         A += A0
         return tuple(x.view(float).reshape(-1, 2) for x in (P, V, A))
+
+    def points(self, idx: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity, acceleration (m, N, 2) of the local points ``s`` (m,
+        complex) of the links ``idx`` (m,, moving links only): :meth:`point` for all of
+        them in the same few array operations (the same arithmetic, so the same bits).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from mechsyn.io import load_mechanism
+        >>> from mechsyn.kinematics.analysis import compile_plan
+        >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
+        >>> U = np.radians(np.arange(0.0, 360.0, 30.0))[:, None]
+        >>> *_, links = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
+        >>> P, V, A = links.points(np.array([0, 1]), np.array([1 + 0j, 0.5 + 0.2j]))
+        >>> P.shape, bool(np.array_equal(A[1], links.point(1, (0.5, 0.2))[2]))
+        ((2, 12, 2), True)
+        """
+        Z = self.C[:, idx]
+        rel = Z[0] * s[:, None]
+        P = rel + Z[1]
+        irel = rel * 1j
+        w = self.w[idx]
+        A = irel * self.al[idx]
+        irel *= w
+        V = irel + Z[2]
+        rel *= w ** 2
+        A -= rel
+        A += Z[3]
+        m, N = rel.shape
+        return tuple(x.view(float).reshape(m, N, 2) for x in (P, V, A))
