@@ -81,6 +81,15 @@ def bare_fourbar(theta: np.ndarray, A: np.ndarray, D: np.ndarray, a: float, b: f
     return B, C
 
 
+def read_all(sim):
+    """Every array a simulation answers (each point's position, velocity and acceleration,
+    each link's angle and rates), read: work a result defers until it is read is timed too,
+    as pylinkage's step hands back all its arrays."""
+    pts = [(p.position, p.velocity, p.acceleration) for p in sim.points.values()]
+    links = [(lm.angle, lm.angular_velocity, lm.angular_acceleration) for lm in sim.links.values()]
+    return sim, pts, links
+
+
 def best_of(f, repeats: int) -> float:
     f()
     best = np.inf
@@ -233,8 +242,8 @@ def fixed_costs(mech, joint: str, moved: str, x: np.ndarray, repeats: int) -> tu
         f_sweep = None
         why.append(f"sweep (engine): {type(err).__name__}: {err}")
     row("sweep (engine)", f_sweep, f_sweep)
-    row("simulate, plan cached", lambda: ms.simulate(mech, {joint: x}))
-    row("simulate, fresh geometry", lambda: ms.simulate(fresh(), {joint: x}))
+    row("simulate, plan cached", lambda: read_all(ms.simulate(mech, {joint: x})))
+    row("simulate, fresh geometry", lambda: read_all(ms.simulate(fresh(), {joint: x})))
     out["events, points, result"] = out["simulate, plan cached"] - out["sweep (engine)"]
     for key in ("assemble + mobility", "singular drawn config?"):
         out[key] -= out["build_system"]
@@ -388,14 +397,14 @@ def pylinkage_case(mech, moved: str, kind: str, n: int, rounds: int, inner: int)
 
     def m_fresh():
         k["m"] += 1
-        return ms.simulate(make(k["m"]), {drive: x}, points=names)
+        return read_all(ms.simulate(make(k["m"]), {drive: x}, points=names))
 
     def p_fresh():
         k["p"] += 1
         return pm.fresh(model, moved_points(k["p"]), start, step, n)
 
     fns = {"m fresh": m_fresh, "p fresh": p_fresh,
-           "m cached": lambda: ms.simulate(mech, {drive: x}, points=names),
+           "m cached": lambda: read_all(ms.simulate(mech, {drive: x}, points=names)),
            "p cached": lambda: lk.step_fast_with_kinematics(iterations=n)}
     # a long sweep was just run by the checks (numba compiled): no untimed call of each first
     meds, mins = interleaved(fns, {"p cached": lambda: lk.set_coords(coords0)}, rounds, inner, warm=inner > 1)
@@ -543,7 +552,7 @@ def mechsyn_tables(repeats: int) -> None:
 
     figures = {}
     for name, mech, joint in cases:
-        t, ratio, med = figures[name] = both(lambda: simulate(mech, {joint: x}), bare, repeats, t_bare)
+        t, ratio, med = figures[name] = both(lambda: read_all(simulate(mech, {joint: x})), bare, repeats, t_bare)
         s = simulate(mech, {joint: x})
         tgt = TARGETS[name]
         print(f"{name:<34s} {s.method:>6s} {len(s.events):>4d} {t * 1e3:7.2f} {ratio:7.1f} {med:6.1f} "
@@ -558,7 +567,7 @@ def mechsyn_tables(repeats: int) -> None:
 
         def drag():
             k[0] += 1
-            watt.with_joint_points({"G": (5.0 + 0.001 * (k[0] % 7), 6.0)}).simulate({"A": x})
+            read_all(watt.with_joint_points({"G": (5.0 + 0.001 * (k[0] % 7), 6.0)}).simulate({"A": x}))
 
         t, ratio, med = both(drag, bare, repeats, t_bare)
         print(f"{label:<34s} {'assur':>6s} {'':>4s} {t * 1e3:7.2f} {ratio:7.1f} {med:6.1f}")
