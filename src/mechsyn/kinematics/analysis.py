@@ -349,14 +349,22 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     key = ("named points", None if names is None else tuple(names))
     hit = S.cache.get(key)
     if hit is None:
-        pts = resolve_points(mech, names)
-        li = np.array([S.index(link) for link, _ in pts.values()], int)
-        loc = S.to_locals(li, np.array([at for _, at in pts.values()], float).reshape(-1, 2))
-        rows = [(name, link, i, x) for (name, (link, _)), i, x in zip(pts.items(), li.tolist(), loc)]
-        moving = [k for k, r in enumerate(rows) if r[2] >= 0]
-        idx = np.array([rows[k][2] for k in moving], int)
-        local = np.array([rows[k][3] for k in moving], float).reshape(-1, 2)
-        hit = S.cache[key] = (rows, moving, idx, local)
+        # names, links and link indices depend on the topology only: kept with the programs
+        # the systems of one topology share (refill.with_geometry); the points are this one's
+        shapes = S.cache.setdefault("programs", {})
+        shape = shapes.get(key)
+        if shape is None:
+            pts = resolve_points(mech, names)
+            li = np.array([S.index(link) for link, _ in pts.values()], int)
+            moving = np.flatnonzero(li >= 0).tolist()
+            shape = shapes[key] = ([(name, link, i) for (name, (link, _)), i in zip(pts.items(), li.tolist())],
+                                   li, moving, li[moving])
+        heads, li, moving, idx = shape
+        joint = {j.id: j for j in mech.joints}
+        at = [mech.points[n].at if n in mech.points else joint[n].point for n, _, _ in heads]
+        loc = S.to_locals(li, np.array(at, float).reshape(-1, 2))
+        rows = [h + (x,) for h, x in zip(heads, loc)]
+        hit = S.cache[key] = (rows, moving, idx, loc[moving].reshape(-1, 2))
     return hit
 
 
