@@ -91,3 +91,29 @@ def test_refilled_constraints_equal_replace():
         for f in fields(a):
             x, y = getattr(a, f.name), getattr(b, f.name)
             assert (np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y), f.name
+
+
+def _shifted_start_loop(S, u0, u_first):
+    """The per-driver loop :func:`tracking._shifted_start` replaced (the reference)."""
+    import math
+
+    out = np.array(u_first, float)
+    for k, d in enumerate(S.drivers):
+        if d.type == "R":
+            out[k] -= 2 * math.pi * round((float(u_first[k]) - float(u0[k])) / (2 * math.pi))
+    return out
+
+
+def test_shifted_start_and_path_bitwise_equal_to_the_loop():
+    from mechsyn.kinematics import tracking
+
+    S = build_system(ms.examples.load("crank_rocker"))
+    rng = np.random.default_rng(30)
+    u0 = np.array([S.drivers[0].assembled])
+    for u in rng.uniform(-40.0, 40.0, 500).tolist() + [np.pi, -np.pi, 3 * np.pi, 0.0]:
+        first = np.array([u])
+        got, want = tracking._shifted_start(S, u0, first), _shifted_start_loop(S, u0, first)
+        assert got.tobytes() == want.tobytes()
+        path, shift = tracking.tracking_path(S, first, u0)
+        n = max(1, int(np.ceil(abs(first[0] - shift[0] - u0[0]) / np.radians(1.0))))
+        assert path.shape == (n, 1) and path[0, 0] == u0[0]
