@@ -117,3 +117,19 @@ def test_shifted_start_and_path_bitwise_equal_to_the_loop():
         path, shift = tracking.tracking_path(S, first, u0)
         n = max(1, int(np.ceil(abs(first[0] - shift[0] - u0[0]) / np.radians(1.0))))
         assert path.shape == (n, 1) and path[0, 0] == u0[0]
+
+
+def test_points_to_frames_floats_and_arrays_bitwise_equal():
+    from mechsyn.kinematics import frames
+
+    S = build_system(ms.examples.load("jansen_leg"))
+    rng = np.random.default_rng(5)
+    idx = rng.integers(-1, len(S.links), 200)
+    pts = rng.normal(scale=S.scale, size=(200, 2))
+    pts[:5] = [[-0.0, -1.0], [0.0, -0.0], [np.nan, 1.0], [1e300, -1e-300], [-0.0, 0.0]]
+    many = frames.points_to_frames(S.frames(), idx, pts)  # over FEW: the array path
+    assert len(idx) > frames.FEW
+    few = np.concatenate([frames.points_to_frames(S.frames(), idx[k:k + 10], pts[k:k + 10]) for k in range(0, 200, 10)])
+    assert few.tobytes() == many.tobytes()  # NaN, signed zeros and all
+    for i, p, x in zip(idx[5:40], pts[5:40], few[5:40]):
+        assert np.array_equal(x, S.to_local(S.mech.ground if i < 0 else S.links[i], p))
