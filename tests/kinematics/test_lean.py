@@ -133,3 +133,26 @@ def test_points_to_frames_floats_and_arrays_bitwise_equal():
     assert few.tobytes() == many.tobytes()  # NaN, signed zeros and all
     for i, p, x in zip(idx[5:40], pts[5:40], few[5:40]):
         assert np.array_equal(x, S.to_local(S.mech.ground if i < 0 else S.links[i], p))
+
+
+def test_link_angles_filled_on_first_read_equal_the_eager_pass():
+    import pickle
+
+    from mechsyn.kinematics.engines import drawn_row
+    from mechsyn.kinematics.regular import regular_sweep
+    from mechsyn.kinematics.sweep import LazyAnglesSweep, Sweep
+
+    for name in ("crank_rocker", "jansen_leg"):
+        m = ms.examples.load(name)
+        drive = m.actuated_joints[0].id
+        x = np.linspace(-170.0, 190.0, 91)  # the drawn input inside the sweep: outwards from it
+        sim = ms.simulate(m, {drive: x})
+        sw = sim.sweep
+        assert isinstance(sw, LazyAnglesSweep) and sw._fill is not None  # nothing read yet
+        kp = cached_plan(m, inputs=(drive,))
+        q, *_ = regular_sweep(kp.system, kp.groups, sw.inputs, np.ones(1), drawn_row(kp.system, sw.inputs))
+        for i, link in enumerate(kp.system.links):
+            assert np.array_equal(sim.link(link).angle, np.degrees(q[:, 3 * i + 2]))
+        assert sw._fill is None and np.array_equal(sw.q, q)
+        back = pickle.loads(pickle.dumps(sw))
+        assert type(back) is Sweep and np.array_equal(back.q, q) and back.engine == sw.engine

@@ -28,8 +28,8 @@ from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_swe
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
-from mechsyn.kinematics.simulation import (LazyPointMotion, LinkMotion, PointMotion, Simulation, _Batch,  # noqa: F401
-                                          _unit, input_grid, resolve_points)
+from mechsyn.kinematics.simulation import (LazyLinkMotion, LazyPointMotion, LinkMotion,  # noqa: F401
+                                          PointMotion, Simulation, _Batch, _unit, input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.refill import topology_key, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
@@ -326,8 +326,9 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                             "accelerations are not defined here (null)", sw.inputs[k].tolist()))
     events.sort(key=lambda e: e.index)
-    angles = np.degrees(sw.q.T[2::3])  # every link's at once
-    links = {name: LinkMotion(angles[i], sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2]) for i, name in enumerate(S.links)}
+    angles = _Batch(lambda: np.degrees(sw.q.T[2::3]))  # every link's at once, when first read
+    links = {name: LazyLinkMotion(angles, i, sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
+             for i, name in enumerate(S.links)}
     pm = _point_motions(S, sw, named, ok, rates_ok, complete)
     events = [_event_units(S, e) for e in events]
     notes = list(S.notes)

@@ -101,6 +101,44 @@ class LinkMotion:
                 "angular_acceleration": self.angular_acceleration}
 
 
+class LazyLinkMotion(LinkMotion):
+    """A :class:`LinkMotion` whose angle (degrees) is computed on first access, every
+    link's of one result together (``batch()``: the angles (n_links, N); this link is row
+    ``k``), so that a result whose angles are not read does not compute them (see
+    :class:`~mechsyn.kinematics.sweep.LazyAnglesSweep`). Copied or pickled it is a plain
+    :class:`LinkMotion`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> lm = LazyLinkMotion(_Batch(lambda: np.array([[0.0, 90.0]])), 0, np.ones(2), np.zeros(2))
+    >>> import pickle
+    >>> lm.angle.tolist(), type(pickle.loads(pickle.dumps(lm))).__name__
+    ([0.0, 90.0], 'LinkMotion')
+    """
+
+    def __init__(self, batch: "_Batch", k: int, angular_velocity: np.ndarray,
+                 angular_acceleration: np.ndarray) -> None:
+        self._batch, self._k, self._angle = batch, k, None
+        self.angular_velocity, self.angular_acceleration = angular_velocity, angular_acceleration
+
+    @property  # type: ignore[override]
+    def angle(self) -> np.ndarray:
+        if self._angle is None:
+            self._angle = self._batch()[self._k]
+        return self._angle
+
+    @angle.setter
+    def angle(self, value: np.ndarray) -> None:
+        self._angle = value
+
+    def __repr__(self) -> str:
+        return repr(LinkMotion(self.angle, self.angular_velocity, self.angular_acceleration))
+
+    def __reduce__(self) -> tuple:
+        return LinkMotion, (self.angle, self.angular_velocity, self.angular_acceleration)
+
+
 @dataclass(repr=False)
 class Simulation(Result):
     """Motion of a mechanism over a sweep of input values (see the module doc).
