@@ -40,9 +40,9 @@ _ZERO_DISC = 1e-12
 def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.ndarray:
     """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
     tau = 2 * math.pi  # a decision per driver: on floats
+    first, drawn = np.asarray(u_first, float).tolist(), np.asarray(u0, float).tolist()
     return np.array([a - tau * round((a - b) / tau) if d.type == "R" else a
-                     for a, b, d in zip(np.asarray(u_first, float).tolist(), np.asarray(u0, float).tolist(), S.drivers)],
-                    float)
+                     for a, b, d in zip(first, drawn, S.drivers)], float)
 
 
 def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: int = 4000) -> np.ndarray:
