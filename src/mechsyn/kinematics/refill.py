@@ -75,11 +75,13 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     nl = len(T.links)
     origin0 = allpts[first] if nl else np.zeros((0, 2))
     angle0 = np.zeros(nl)
+    P = allpts.tolist()  # the differences on floats: the numbers of the arrays' subtraction
     for i, ks in enumerate(other):  # towards the first other joint point (as _link_frames)
+        ox, oy = P[first[i]]
         for k in ks:
-            d = pts[k] - origin0[i]
-            if math.hypot(d[0], d[1]) > 1e-12 * scale:
-                angle0[i] = _dir_angle(d)
+            dx, dy = P[k][0] - ox, P[k][1] - oy
+            if math.hypot(dx, dy) > 1e-12 * scale:
+                angle0[i] = _dir_angle((dx, dy))
                 break
     cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
     org, ang = origin0.tolist(), angle0.tolist()
