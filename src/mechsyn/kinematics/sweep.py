@@ -124,3 +124,43 @@ class Sweep:
     @property
     def n(self) -> int:
         return self.q.shape[0]
+
+
+class LazyAnglesSweep(Sweep):
+    """A :class:`Sweep` whose link angles (the angle rows of ``q``) are filled on the first
+    access of ``q``: ``fill()`` writes them into ``q`` (the regular pass's continuous
+    ``atan2`` of every link's rotation). A caller that reads no angle (positions and rates
+    of points come from the links' complex states) does not compute them. Copied or
+    pickled it is a plain, filled :class:`Sweep`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> q = np.zeros((2, 3))
+    >>> sw = LazyAnglesSweep(None, q[:, :1], np.ones(1), q, q, q, np.ones(2, bool), q[:, 0], q[:, 0],
+    ...                      fill=lambda: q[:, 2].__setitem__(slice(None), 7.0))
+    >>> float(q[0, 2]), sw.q[:, 2].tolist(), float(q[0, 2])
+    (0.0, [7.0, 7.0], 7.0)
+    """
+
+    def __init__(self, *args: Any, fill: Any, **kwargs: Any) -> None:
+        self._fill = fill
+        super().__init__(*args, **kwargs)
+
+    @property  # type: ignore[override]
+    def q(self) -> np.ndarray:
+        if self._fill is not None:
+            fill, self._fill = self._fill, None
+            fill()
+        return self._q
+
+    @q.setter
+    def q(self, value: np.ndarray) -> None:
+        self._q = value
+
+    def __reduce__(self) -> tuple:
+        return _plain_sweep, (tuple(getattr(self, f.name) for f in fields(Sweep)),)
+
+
+def _plain_sweep(values: tuple) -> Sweep:
+    return Sweep(*values)
