@@ -28,8 +28,8 @@ from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_swe
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
-from mechsyn.kinematics.simulation import (LazyLinkMotion, LazyPointMotion, LinkMotion,  # noqa: F401
-                                          PointMotion, Simulation, _Batch, _unit, input_grid, resolve_points)
+from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
+                                          input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.refill import topology_key, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
@@ -326,9 +326,9 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                             "accelerations are not defined here (null)", sw.inputs[k].tolist()))
     events.sort(key=lambda e: e.index)
-    angles = _Batch(lambda: np.degrees(sw.q.T[2::3]))  # every link's at once, when first read
-    links = {name: LazyLinkMotion(angles, i, sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
-             for i, name in enumerate(S.links)}
+    links = {}
+    for i, name in enumerate(S.links):
+        links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
     pm = _point_motions(S, sw, named, ok, rates_ok, complete)
     events = [_event_units(S, e) for e in events]
     notes = list(S.notes)
@@ -350,22 +350,14 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     key = ("named points", None if names is None else tuple(names))
     hit = S.cache.get(key)
     if hit is None:
-        # names, links and link indices depend on the topology only: kept with the programs
-        # the systems of one topology share (refill.with_geometry); the points are this one's
-        shapes = S.cache.setdefault("programs", {})
-        shape = shapes.get(key)
-        if shape is None:
-            pts = resolve_points(mech, names)
-            li = np.array([S.index(link) for link, _ in pts.values()], int)
-            moving = np.flatnonzero(li >= 0).tolist()
-            shape = shapes[key] = ([(name, link, i) for (name, (link, _)), i in zip(pts.items(), li.tolist())],
-                                   li, moving, li[moving])
-        heads, li, moving, idx = shape
-        joint = {j.id: j for j in mech.joints}
-        at = [mech.points[n].at if n in mech.points else joint[n].point for n, _, _ in heads]
-        loc = S.to_locals(li, np.array(at, float).reshape(-1, 2))
-        rows = [h + (x,) for h, x in zip(heads, loc)]
-        hit = S.cache[key] = (rows, moving, idx, loc[moving].reshape(-1, 2))
+        pts = resolve_points(mech, names)
+        li = np.array([S.index(link) for link, _ in pts.values()], int)
+        loc = S.to_locals(li, np.array([at for _, at in pts.values()], float).reshape(-1, 2))
+        rows = [(name, link, i, x) for (name, (link, _)), i, x in zip(pts.items(), li.tolist(), loc)]
+        moving = [k for k, r in enumerate(rows) if r[2] >= 0]
+        idx = np.array([rows[k][2] for k in moving], int)
+        local = np.array([rows[k][3] for k in moving], float).reshape(-1, 2)
+        hit = S.cache[key] = (rows, moving, idx, local)
     return hit
 
 
@@ -378,27 +370,23 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
     poses (:meth:`~mechsyn.kinematics.system.PlanarSystem.points_state`)."""
     rows, moving, idx, local = named
     whole = (True, True) if complete else (bool(ok.all()), bool(rates_ok.all()))
-
-    def batch() -> tuple:
+    states: dict[int, tuple] = {}
+    if moving:
         if complete:
-            return sw.links.points(idx, local.view(complex)[:, 0])
-        P, V, A = S.points_state(sw.q, sw.qd, sw.qdd, idx, local)  # NaN rows stay NaN row by row
-        if not whole[0]:  # rows not assembled or singular are set NaN
-            for arr in (P, V, A):
-                arr[:, ~ok] = np.nan
-        if not whole[1]:
-            V[:, ~rates_ok] = np.nan
-            A[:, ~rates_ok] = np.nan
-        return P, V, A
-
-    lazy = _Batch(batch)
-    if moving and not complete:  # computed now: the poses' arrays are the result's to change
-        lazy()
-    states = {k: n for n, k in enumerate(moving)}
+            P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
+        else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
+            P, V, A = S.points_state(sw.q, sw.qd, sw.qdd, idx, local)
+            if not whole[0]:
+                for arr in (P, V, A):
+                    arr[:, ~ok] = np.nan
+            if not whole[1]:
+                V[:, ~rates_ok] = np.nan
+                A[:, ~rates_ok] = np.nan
+        states = dict(zip(moving, zip(P, V, A)))
     pm = {}
     for k, (name, link, i, at) in enumerate(rows):
         if k in states:
-            pm[name] = LazyPointMotion(lazy, states[k], link)
+            pm[name] = PointMotion(*states[k], link)
             continue
         P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, at)  # NaN rows stay NaN (and are set NaN below)
         if not whole[0]:

@@ -150,16 +150,9 @@ def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
     memo = _memo(S)
     hit = memo.get(("angles", id(plan)))
     if hit is None or hit[0] is not plan:
-        # which links are driven depends on the topology only: kept with the programs that
-        # the systems of one topology share (refill.with_geometry)
-        shapes = S.cache.setdefault("programs", {})
-        shape = shapes.get(("angles", id(plan)))
-        if shape is None or shape[0] is not plan:
-            drive_links = _drive_links(S, plan)
-            others = [i for i in range(len(S.links)) if i not in drive_links]
-            shape = shapes[("angles", id(plan))] = (plan, drive_links, others, [3 * i + 2 for i in others])
-        _, drive_links, others, cols = shape
-        hit = memo[("angles", id(plan))] = (plan, (drive_links, others, S.q0[cols][:, None]))
+        drive_links = _drive_links(S, plan)
+        others = [i for i in range(len(S.links)) if i not in drive_links]
+        hit = memo[("angles", id(plan))] = (plan, (drive_links, others, S.q0[[3 * i + 2 for i in others]][:, None]))
     return hit[1]
 
 

@@ -52,7 +52,7 @@ from mechsyn.kinematics.groups import Plan
 from mechsyn.kinematics.regular import Folded, sweep_through_folds
 from mechsyn.kinematics.solve import sweep as newton_sweep
 from mechsyn.kinematics.spatial import SpatialEngine
-from mechsyn.kinematics.sweep import Event, LazyAnglesSweep, Sweep
+from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
 
@@ -89,7 +89,7 @@ class RegularPass:
         if plan is None or change_points != "keep":
             return None
         k = drawn_row(system, inputs)
-        res = sweep_through_folds(system, plan, inputs, speeds, k, lazy_angles=True)
+        res = sweep_through_folds(system, plan, inputs, speeds, k)
         if res is None:
             return None
         N = inputs.shape[0]
@@ -98,10 +98,9 @@ class RegularPass:
         nan = np.full(N, np.nan)
         if isinstance(res, Folded):  # through folds: the tracked sweeps' singular rows and events
             return _folded_sweep(system, inputs, speeds, k, res, self.name)
-        q, qd, qdd, links = res  # the link angles filled when q is first read
-        fill, links.pending = links.pending, None
-        return LazyAnglesSweep(system, inputs, speeds, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [],
-                               method="assur", links=links, engine=self.name, fill=fill)
+        q, qd, qdd, links = res
+        return Sweep(system, inputs, speeds, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur",
+                     links=links, engine=self.name)
 
 
 class TrackedChain:

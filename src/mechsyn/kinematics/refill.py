@@ -13,6 +13,7 @@ topology (see docs/kinematics.md, "The fresh-geometry fast path").
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -75,13 +76,11 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     nl = len(T.links)
     origin0 = allpts[first] if nl else np.zeros((0, 2))
     angle0 = np.zeros(nl)
-    P = allpts.tolist()  # the differences on floats: the numbers of the arrays' subtraction
     for i, ks in enumerate(other):  # towards the first other joint point (as _link_frames)
-        ox, oy = P[first[i]]
         for k in ks:
-            dx, dy = P[k][0] - ox, P[k][1] - oy
-            if math.hypot(dx, dy) > 1e-12 * scale:
-                angle0[i] = _dir_angle((dx, dy))
+            d = pts[k] - origin0[i]
+            if math.hypot(d[0], d[1]) > 1e-12 * scale:
+                angle0[i] = _dir_angle(d)
                 break
     cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
     org, ang = origin0.tolist(), angle0.tolist()
@@ -134,12 +133,12 @@ def _refilled(T: PlanarSystem, mech: Mechanism, loc: Any, ang: list, org: list) 
         j = joint[c.joint]
         a, b = c.a, c.b
         if c.kind == "R":
-            cons.append(_with(c, sa=loc(a, j.point), sb=loc(b, j.point)))
+            cons.append(Con("R", c.joint, 2, a, b, sa=loc(a, j.point), sb=loc(b, j.point), role=c.role))
             continue
         if c.kind == "angle":
             if c.role == "drive":
-                drivers[c.driver] = _with(drawn[c.joint], assembled=rel(b, a))
-            cons.append(_with(c, c0=rel(b, a)) if c.role == "rotation" else c)
+                drivers[c.driver] = replace(drawn[c.joint], assembled=rel(b, a))
+            cons.append(replace(c, c0=rel(b, a)) if c.role == "rotation" else c)
             continue
         u = _axis(j)
         u_loc = loc(a, u, direction=True)
@@ -150,29 +149,7 @@ def _refilled(T: PlanarSystem, mech: Mechanism, loc: Any, ang: list, org: list) 
         o_a = np.zeros(2) if a < 0 else np.asarray(org[a])
         s0 = float(u @ (j.point - o_a))
         if c.driver is not None:
-            drivers[c.driver] = _with(drawn[c.joint], assembled=s0)
+            drivers[c.driver] = replace(drawn[c.joint], assembled=s0)
         cons.append(Con("line", c.joint, 1, a, b, sa=np.zeros(2), sb=loc(b, j.point), w=u_loc,
                         c0=s0 if c.role == "lock" else 0.0, driver=c.driver, role=c.role))
     return tuple(cons), tuple(drivers)
-
-
-def _with(obj: Any, **changes: Any) -> Any:
-    """``dataclasses.replace(obj, **changes)`` for the frozen dataclasses of the system
-    (:class:`~mechsyn.kinematics.system.Con`, ``Driver``: plain fields, no
-    ``__post_init__``), by copying the instance's fields: a few hundred nanoseconds
-    instead of the generated ``__init__``'s 4 us, which a refilled system paid per
-    constraint and driver.
-
-    Examples
-    --------
-    >>> from dataclasses import replace
-    >>> from mechsyn.kinematics.system import Driver
-    >>> d = Driver("A", "R", 0.5, "drive")
-    >>> _with(d, assembled=1.0) == replace(d, assembled=1.0), d.assembled
-    (True, 0.5)
-    """
-    new = object.__new__(type(obj))
-    fields = new.__dict__
-    fields.update(obj.__dict__)
-    fields.update(changes)
-    return new

@@ -275,7 +275,7 @@ def _run(steps: list, anchor: dict, X: np.ndarray, speeds: np.ndarray, folds: bo
 
 
 def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
-                        split: int | None, lazy_angles: bool = False) -> tuple | Folded | None:
+                        split: int | None) -> tuple | Folded | None:
     """The regular pass of a driver-R + RRR chain through its folds (dead points, gaps).
 
     One pass over the sweep's rows and the connecting paths from the drawn input values
@@ -290,10 +290,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     on the group's discriminant, reassembly, singular rows): a :class:`Folded` (the
     poses, and per sweep its singular rows and events), the tracked chain's answer. None
     when a group's discriminant has such a minimum (the tracked chain decides what happens
-    there) or the plan is not such a chain. ``lazy_angles``: the link angles of the
-    answer without folds are left unfilled in ``q``, their filling kept in the
-    :class:`LinkStates` (``pending``) for the caller (a
-    :class:`~mechsyn.kinematics.sweep.LazyAnglesSweep`).
+    there) or the plan is not such a chain.
 
     Examples
     --------
@@ -323,7 +320,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     paths = [tracking_path(S, p[0], u0) for p in parts]
     st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
     if not st.near:
-        return _poses(S, plan, U, st, origin, split, lazy_angles)
+        return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
     order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
     # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
@@ -422,22 +419,13 @@ def _states(st: _Pass, origin: list, N: int, nl: int) -> np.ndarray:
     return C
 
 
-def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None,
-           lazy: bool = False) -> tuple:
+def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
     origin is its first joint, its angle continuous from the drawn one) and the links'
-    complex states; ``lazy``: the angles' filling left in the states' ``pending``."""
+    complex states."""
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
-    links = LinkStates(C, qd[2::3], qdd[2::3])
-
-    def fill() -> None:
-        _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
-
-    if lazy:
-        links.pending = fill
-    else:
-        fill()
-    return q.T, qd.T, qdd.T, links
+    _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
+    return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
 
 
 class LinkStates:
@@ -447,7 +435,6 @@ class LinkStates:
 
     def __init__(self, C: np.ndarray, w: np.ndarray, al: np.ndarray) -> None:
         self.C, self.w, self.al = C, w, al
-        self.pending = None  # the link angles' filling, when left to the sweep (see _poses)
 
     @property
     def z(self) -> np.ndarray:

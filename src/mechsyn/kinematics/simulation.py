@@ -37,59 +37,6 @@ class PointMotion:
         return {"position": self.position, "velocity": self.velocity, "acceleration": self.acceleration}
 
 
-class LazyPointMotion(PointMotion):
-    """A :class:`PointMotion` whose arrays are computed on first access, all the points of
-    one result together (``batch()``: positions, velocities, accelerations (m, N, 2),
-    called once; this point is row ``k``). A result whose points are not read does not
-    compute them; copied or pickled it is a plain :class:`PointMotion`.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> calls = []
-    >>> batch = _Batch(lambda: calls.append(1) or (np.zeros((2, 3, 2)), np.ones((2, 3, 2)), np.ones((2, 3, 2))))
-    >>> a, b = LazyPointMotion(batch, 0, "crank"), LazyPointMotion(batch, 1, "coupler")
-    >>> len(calls), a.position.shape, float(b.velocity[0, 0]), len(calls)
-    (0, (3, 2), 1.0, 1)
-    """
-
-    def __init__(self, batch: "_Batch", k: int, link: str = "") -> None:
-        self._batch, self._k, self.link, self._pva = batch, k, link, None
-
-    def _get(self, j: int) -> np.ndarray:
-        if self._pva is None:
-            self._pva = [x[self._k] for x in self._batch()]
-        return self._pva[j]
-
-    def _set(self, j: int, value: np.ndarray) -> None:
-        self._get(j)
-        self._pva[j] = value
-
-    position = property(lambda self: self._get(0), lambda self, v: self._set(0, v))  # type: ignore[assignment]
-    velocity = property(lambda self: self._get(1), lambda self, v: self._set(1, v))  # type: ignore[assignment]
-    acceleration = property(lambda self: self._get(2), lambda self, v: self._set(2, v))  # type: ignore[assignment]
-
-    def __repr__(self) -> str:
-        return repr(PointMotion(self.position, self.velocity, self.acceleration, self.link))
-
-    def __reduce__(self) -> tuple:
-        return PointMotion, (self.position, self.velocity, self.acceleration, self.link)
-
-
-class _Batch:
-    """``make()`` called once, on the first call, its value kept."""
-
-    __slots__ = ("_make", "_out")
-
-    def __init__(self, make: Any) -> None:
-        self._make, self._out = make, None
-
-    def __call__(self) -> Any:
-        if self._make is not None:
-            self._out, self._make = self._make(), None
-        return self._out
-
-
 @dataclass
 class LinkMotion:
     angle: np.ndarray                 # (N,) degrees
@@ -99,44 +46,6 @@ class LinkMotion:
     def to_dict(self) -> dict[str, Any]:
         return {"angle": self.angle, "angular_velocity": self.angular_velocity,
                 "angular_acceleration": self.angular_acceleration}
-
-
-class LazyLinkMotion(LinkMotion):
-    """A :class:`LinkMotion` whose angle (degrees) is computed on first access, every
-    link's of one result together (``batch()``: the angles (n_links, N); this link is row
-    ``k``), so that a result whose angles are not read does not compute them (see
-    :class:`~mechsyn.kinematics.sweep.LazyAnglesSweep`). Copied or pickled it is a plain
-    :class:`LinkMotion`.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> lm = LazyLinkMotion(_Batch(lambda: np.array([[0.0, 90.0]])), 0, np.ones(2), np.zeros(2))
-    >>> import pickle
-    >>> lm.angle.tolist(), type(pickle.loads(pickle.dumps(lm))).__name__
-    ([0.0, 90.0], 'LinkMotion')
-    """
-
-    def __init__(self, batch: "_Batch", k: int, angular_velocity: np.ndarray,
-                 angular_acceleration: np.ndarray) -> None:
-        self._batch, self._k, self._angle = batch, k, None
-        self.angular_velocity, self.angular_acceleration = angular_velocity, angular_acceleration
-
-    @property  # type: ignore[override]
-    def angle(self) -> np.ndarray:
-        if self._angle is None:
-            self._angle = self._batch()[self._k]
-        return self._angle
-
-    @angle.setter
-    def angle(self, value: np.ndarray) -> None:
-        self._angle = value
-
-    def __repr__(self) -> str:
-        return repr(LinkMotion(self.angle, self.angular_velocity, self.angular_acceleration))
-
-    def __reduce__(self) -> tuple:
-        return LinkMotion, (self.angle, self.angular_velocity, self.angular_acceleration)
 
 
 @dataclass(repr=False)

@@ -55,7 +55,6 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.cams import CamCurve, _cam_curve
 from mechsyn.kinematics.compiled import one_configuration
-from mechsyn.kinematics.frames import points_to_frames
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
 
@@ -193,7 +192,12 @@ class PlanarSystem:
         >>> bool(np.array_equal(loc[0], S.to_local(S.links[1], pts[0]))), loc[1].tolist()
         (True, [0.5, -0.3])
         """
-        return points_to_frames(self.frames(), idx, pts)  # a few on floats, many in arrays
+        cos, sin, org = self.frames()
+        mov, k = idx >= 0, np.where(idx >= 0, idx, 0)
+        c, sn = np.array(cos + [1.0])[k], np.array(sin + [0.0])[k]
+        o = np.array(org, float).reshape(-1, 2)[k] if len(org) else np.zeros((len(idx), 2))
+        dx, dy = pts[:, 0] - o[:, 0], pts[:, 1] - o[:, 1]
+        return np.stack([np.where(mov, c * dx - sn * dy, pts[:, 0]), np.where(mov, sn * dx + c * dy, pts[:, 1])], 1)
 
     def pose(self, q: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
         """(r (N,2), phi (N,)) of link ``i`` (frame: zeros)."""

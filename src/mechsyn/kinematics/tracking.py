@@ -39,18 +39,18 @@ _ZERO_DISC = 1e-12
 
 def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.ndarray:
     """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
-    tau = 2 * math.pi  # a decision per driver: on floats
-    first, drawn = np.asarray(u_first, float).tolist(), np.asarray(u0, float).tolist()
-    return np.array([a - tau * round((a - b) / tau) if d.type == "R" else a
-                     for a, b, d in zip(first, drawn, S.drivers)], float)
+    out = np.array(u_first, float)
+    for k, d in enumerate(S.drivers):
+        if d.type == "R":  # a decision per driver: on floats
+            out[k] -= 2 * math.pi * round((float(u_first[k]) - float(u0[k])) / (2 * math.pi))
+    return out
 
 
 def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: int = 4000) -> np.ndarray:
     """Inputs from the drawn values ``u0`` towards ``u1`` (excluded) in steps of at most
     1 degree (R) or 1 % of the mechanism's size (P)."""
-    deg = math.radians(1.0)
-    steps = [abs(b - a) / (deg if d.type == "R" else 0.01 * S.scale)
-             for a, b, d in zip(np.asarray(u0, float).tolist(), np.asarray(u1, float).tolist(), S.drivers)]
+    steps = (abs(float(b) - float(a)) / (math.radians(1.0) if d.type == "R" else 0.01 * S.scale)
+             for a, b, d in zip(u0, u1, S.drivers))
     n = int(min(max_rows, max(1, math.ceil(max(steps)))))
     if n == 1:  # the drawn values themselves (t = 0)
         return np.array(u0, float)[None, :]
