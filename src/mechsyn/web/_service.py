@@ -276,6 +276,7 @@ def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, A
 #: topology with other numbers, filled into the parsed mechanism without parsing again.
 _PARSED: "OrderedDict[str, Any]" = OrderedDict()
 _PARSED_LOCK = threading.Lock()
+_QUICK_LOCK = threading.Lock()
 
 
 def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
@@ -299,12 +300,18 @@ def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
     >>> quick_simulate(d, 36) == simulate(d, 36)
     True
     """
-    from mechsyn.io.checks import check_geometry
-    from mechsyn.kinematics.analysis import cached_plan
-
     split = _numbers(data)
     if split is None:
         return None
+    with _QUICK_LOCK:  # one at a time: the plan caches and their shared programs are not for threads
+        return _quick(data, steps, span, rates, split)
+
+
+def _quick(data: Any, steps: int, span: float | None, rates: bool, split: tuple) -> dict[str, Any] | None:
+    """:func:`quick_simulate`'s body (under its lock)."""
+    from mechsyn.io.checks import check_geometry
+    from mechsyn.kinematics.analysis import cached_plan
+
     key, joints, points = split
     with _PARSED_LOCK:
         template = _PARSED.get(key)
