@@ -10,12 +10,10 @@ from __future__ import annotations
 import csv
 import functools
 import io
-import json
 import math
 import re
 import threading
 from collections import OrderedDict
-from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -271,11 +269,10 @@ def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, A
     return out
 
 
-#: Mechanisms parsed from the studio's requests, by the request's topology (the mechanism
-#: JSON without its joint points and named points' coordinates): a drag sends the same
-#: topology with other numbers, filled into the parsed mechanism without parsing again.
+#: Templates of the mechanisms parsed from the studio's requests, by the request's
+#: structure (:func:`mechsyn.synthesis.templates.structure_key`): a drag sends the same
+#: structure with other numbers, filled into the parsed mechanism without parsing again.
 _PARSED: "OrderedDict[str, Any]" = OrderedDict()
-_PARSED_LOCK = threading.Lock()
 _QUICK_LOCK = threading.Lock()
 
 
@@ -287,11 +284,10 @@ def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
     needs the Newton continuation, a cam, a gear or a belt; more than
     :data:`QUICK_JOINTS` joints; a topology whose numbers the reader changes, e.g. units).
 
-    A request whose topology was parsed before is not parsed again: its joint points and
-    named points are put into the parsed mechanism
-    (:meth:`~mechsyn.model.mechanism.Mechanism.with_joint_points`), the reader's geometry
-    checks run on them (:func:`mechsyn.io.checks.check_geometry`) and the simulation reuses
-    the plan compiled for the topology. The answer is :func:`simulate`'s.
+    A request whose structure was parsed before is not parsed again: its numbers are put
+    into the parsed mechanism (:class:`mechsyn.synthesis.templates.DictTemplate`, with the
+    reader's geometry checks) and the simulation reuses the plan compiled for the topology.
+    The answer is :func:`simulate`'s.
 
     Examples
     --------
@@ -300,76 +296,39 @@ def quick_simulate(data: Any, steps: int = 180, span: float | None = None,
     >>> quick_simulate(d, 36) == simulate(d, 36)
     True
     """
-    split = _numbers(data)
-    if split is None:
+    from mechsyn.synthesis.templates import structure_key
+
+    if not isinstance(data, dict) or not isinstance(data.get("joints"), list) or len(data["joints"]) > QUICK_JOINTS:
+        return None
+    key = structure_key(data)
+    if key is None:
         return None
     with _QUICK_LOCK:  # one at a time: the plan caches and their shared programs are not for threads
-        return _quick(data, steps, span, rates, split)
+        return _quick(data, steps, span, rates, key)
 
 
-def _quick(data: Any, steps: int, span: float | None, rates: bool, split: tuple) -> dict[str, Any] | None:
+def _quick(data: dict, steps: int, span: float | None, rates: bool, key: str) -> dict[str, Any] | None:
     """:func:`quick_simulate`'s body (under its lock)."""
-    from mechsyn.io.checks import check_geometry
     from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.synthesis.templates import DictTemplate
 
-    key, joints, points = split
-    with _PARSED_LOCK:
-        template = _PARSED.get(key)
     try:
+        template = _PARSED.get(key)
         if template is None:
-            mech = build(data)
-            if _numbers_of(mech) != (joints, points):
-                return None  # the reader changed the numbers: no refill of this topology
-        else:
-            mech = template.with_joint_points(joints)
-            mech = replace(mech, points={n: replace(p, at=np.array(points[n], float)) for n, p in mech.points.items()})
-            check_geometry(mech, template.source)
+            template = DictTemplate(data, "mechanism")
+            _PARSED[key] = template
+            while len(_PARSED) > 16:
+                _PARSED.popitem(last=False)
+        mech = template.mechanism(data, key)
+        if mech is None:
+            return None  # the reader changes or refuses a number: a worker parses it
         drives = [j for j in mech.joints if j.actuated]
         kp = cached_plan(mech, inputs=(drives[0].id,)) if drives and mech.kind == "planar" else None
         if kp is None or kp.groups is None:
             return None
-        out = _simulated(mech, steps, span, rates)
-    except (MechsynInputError, TypeError, ValueError):
+        return _simulated(mech, steps, span, rates)
+    except (MechsynInputError, TypeError, ValueError, KeyError):
         return None  # reported by the worker's simulate, as without this path
-    if template is None:
-        with _PARSED_LOCK:
-            _PARSED[key] = mech
-            while len(_PARSED) > 16:
-                _PARSED.popitem(last=False)
-    return out
-
-
-def _numbers(data: Any) -> tuple[str, dict, dict] | None:
-    """(the request's topology as text, joint points, named points' coordinates), or None
-    when the request is not a mechanism object of that shape."""
-    if not isinstance(data, dict) or not isinstance(data.get("joints"), list) or len(data["joints"]) > QUICK_JOINTS:
-        return None
-    named = data.get("points") or {}
-    if not isinstance(named, dict) or not all(isinstance(j, dict) for j in data["joints"]) \
-            or not all(isinstance(p, dict) for p in named.values()):
-        return None
-    joints = {j.get("id"): j.get("point") for j in data["joints"]}
-    points = {n: p.get("at") for n, p in named.items()}
-    if not all(_plain_xy(v) for v in list(joints.values()) + list(points.values())):
-        return None  # the reader says what is wrong with them
-    bare = {**data, "joints": [{k: v for k, v in j.items() if k != "point"} for j in data["joints"]],
-            "points": {n: {k: v for k, v in p.items() if k != "at"} for n, p in named.items()}}
-    try:
-        return json.dumps(bare, sort_keys=True, allow_nan=False), joints, points
-    except (TypeError, ValueError):
-        return None
-
-
-def _plain_xy(v: Any) -> bool:
-    """Two finite numbers (no booleans, no strings), as a planar point."""
-    return isinstance(v, list) and len(v) == 2 and all(
-        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
-
-
-def _numbers_of(mech: Any) -> tuple[dict, dict]:
-    """The joint points and named points of a parsed mechanism as a request gives them."""
-    return ({j.id: None if j.point is None else j.point.tolist() for j in mech.joints},
-            {n: p.at.tolist() for n, p in mech.points.items()})
 
 
 def _nan_stat(f: Callable, v: np.ndarray) -> float | None:
