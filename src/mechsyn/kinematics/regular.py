@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _chain_program, _link_angles
 from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
 from mechsyn.kinematics.tracking import (REGULAR_DISC, _regular_rows, _sweep_events, fold_events, touch_candidates,
@@ -253,7 +254,7 @@ def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
     steps, anchor, origin = _program(S, plan)
-    st = _run(steps, anchor, _regular_rows(S, U, split), speeds, folds=False)
+    st = _pass(S, plan, _regular_rows(S, U, split), speeds, folds=False)
     return None if st is None else _poses(S, plan, U, st, origin, split)
 
 
@@ -272,6 +273,38 @@ def _run(steps: list, anchor: dict, X: np.ndarray, speeds: np.ndarray, folds: bo
                 return None
             st.discs[k] = disc
     return st
+
+
+def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray, speeds: np.ndarray, folds: bool) -> _Pass | _Compiled | None:
+    """One pass of the regular program over the input rows ``X``: compiled
+    (:mod:`mechsyn.kinematics.kernel`) when Numba is installed, else :func:`_run`; the
+    same states and discriminants either way. None when a group comes near a fold and
+    ``folds`` is false."""
+    steps, anchor, origin = _program(S, plan)
+    if not kernel.active():
+        return _run(steps, anchor, X, speeds, folds)
+    memo = _memo(S)
+    key = ("kernel", id(plan))
+    prog = memo.get(key)
+    if prog is None or prog[0] is not plan:
+        shapes = S.cache.setdefault("programs", {})
+        shape = shapes.get(key)
+        if shape is None or shape[0] is not plan:
+            shape = shapes[key] = (plan, kernel.program_arrays(steps, anchor, origin)[0])
+        prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape[1]))
+    C, W, AL, D, near = kernel.run(prog[1], X, speeds, REGULAR_DISC)
+    if near and not folds:
+        return None
+    return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near)
+
+
+class _Compiled:
+    """The compiled pass's answer (:func:`mechsyn.kinematics.kernel.run`) in the terms of
+    :class:`_Pass`: the links' states already gathered per link (``C``, ``W``, ``AL``),
+    the groups' discriminants by step, whether one came near a fold."""
+
+    def __init__(self, C: np.ndarray, W: np.ndarray, AL: np.ndarray, discs: dict, near: bool) -> None:
+        self.C, self.W, self.AL, self.discs, self.near = C, W, AL, discs, near
 
 
 def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
@@ -318,7 +351,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
     u0 = np.array([d.assembled for d in S.drivers], float)
     paths = [tracking_path(S, p[0], u0) for p in parts]
-    st = _run(steps, anchor, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
+    st = _pass(S, plan, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
@@ -398,10 +431,14 @@ def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:
     """The links' complex states (:func:`_states`) and the pose rows ``q, qd, qdd`` (n, N,
     component-major) of the first N rows of a pass, the dyads' link angles left to fill."""
     nl = len(S.links)
-    C = _states(st, origin, N, nl)
+    compiled = isinstance(st, _Compiled)
+    C = st.C[:, :, :N] if compiled else _states(st, origin, N, nl)
     q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))
     for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
         buf[0::3], buf[1::3] = x.real, x.imag
+    if compiled:
+        qd[2::3], qdd[2::3] = st.W[:, :N], st.AL[:, :N]
+        return C, q, qd, qdd
     for i in range(nl):  # angular velocity and acceleration
         for buf, x in ((qd, st.link[i][1]), (qdd, st.link[i][2])):
             buf[3 * i + 2] = x[:N] if isinstance(x, np.ndarray) else x

@@ -1,0 +1,134 @@
+"""The compiled kernel of the regular pass (issue 30): the same program and the same
+arithmetic as :class:`mechsyn.kinematics.regular._Pass`, row by row in compiled code
+instead of array by array, when Numba is installed (``pip install mechsyn[fast]``).
+
+The regular pass (:func:`mechsyn.kinematics.regular.sweep_through_folds`) spends, in
+NumPy, a few dozen array operations per group; on a sweep of a few hundred rows that is
+most of a ``simulate`` call. Compiled, one row of a six-bar is a few hundred floating-point
+operations with no temporaries. The kernel is not another engine: it runs the regular
+pass's own program (:func:`program_arrays` writes it as integer and complex arrays), gives
+the same discriminants, rotations and joint states, and the engine around it (fold
+events, angles, results) is unchanged. Without Numba, or with the environment variable
+``MECHSYN_KERNEL=numpy``, the NumPy pass runs; tests run both and compare them.
+
+Numba compiles the kernel on its first use on a machine (a few seconds) and keeps the
+machine code beside the module (``__pycache__``); later processes load it (about 0.1 s,
+plus 0.3 s to import Numba): a one-shot command pays that once, a studio or a synthesis
+loop over thousands of designs gains on every call.
+
+Examples
+--------
+The crank-rocker's program is a driver and one RRR group; run over two crank angles it
+gives the group's normalised discriminant per row (None when the kernel is off):
+
+>>> import numpy as np
+>>> import mechsyn as ms
+>>> from mechsyn.kinematics import regular
+>>> from mechsyn.kinematics.analysis import cached_plan
+>>> kp = cached_plan(ms.examples.load("crank_rocker"))
+>>> prog = program_arrays(*regular._program(kp.system, kp.groups))
+>>> prog[0][0][:, 0].tolist()  # the steps' ops: 0 a driver, 1 an RRR group
+[0, 1]
+>>> out = run(prog, np.radians([[0.0], [90.0]]), np.ones(1), 0.05)
+>>> out is None or (out[3].shape == (1, 2) and not out[4])
+True
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+from types import ModuleType
+
+import numpy as np
+
+__all__ = ["active", "program_arrays", "run"]
+
+_MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
+
+
+def _compiled() -> ModuleType | None:
+    """The Numba module (:mod:`mechsyn.kinematics._kernel_numba`), imported on first use;
+    None without Numba or with ``MECHSYN_KERNEL=numpy``."""
+    global _MODULE
+    if os.environ.get("MECHSYN_KERNEL", "auto").lower() == "numpy":
+        return None
+    if _MODULE is None:
+        try:
+            _MODULE = importlib.import_module("mechsyn.kinematics._kernel_numba")
+        except ImportError:
+            _MODULE = False
+    return _MODULE or None
+
+
+def active() -> bool:
+    """Whether the regular pass runs compiled (Numba installed, ``MECHSYN_KERNEL`` not
+    ``numpy``)."""
+    return _compiled() is not None
+
+
+def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
+    """The program's integers (they depend on the topology only): joint indices, per step
+    ``ip`` (op, links, joints, which joints to place from a link's point first, the
+    group's row in the discriminants), each link's anchor joint and origin joint (-1:
+    found from its anchor), the number of joints, and the steps of the RRR groups."""
+    index: dict[str, int] = {}
+
+    def jx(jid: str) -> int:
+        return index.setdefault(jid, len(index))
+
+    placed: set[str] = set()
+    ip = np.zeros((len(steps), 11), np.int64)
+    groups = []
+    for s, st in enumerate(steps):
+        if st[0] == "drive":
+            _, new, k, jid, di, _sgn = st[:6]
+            ip[s, :6] = (0, new, k, jx(jid), di, int(k >= 0 and jid not in placed))
+            placed.add(jid)
+            continue
+        _, (k1, k3), (b1, b2), (J1, J2, J3) = st[:4]
+        ip[s] = (1, k1, k3, b1, b2, jx(J1), jx(J2), jx(J3), int(J1 not in placed), int(J3 not in placed), len(groups))
+        placed.update((J1, J2, J3))
+        groups.append(s)
+    nl = len(origin)
+    anc_j = np.array([jx(anchor[i][0]) if i in anchor else -1 for i in range(nl)], np.int64)
+    org_j = np.array([jx(j) if j is not None and j in placed else -1 for j in origin], np.int64)
+    return ip, anc_j, org_j, len(index), groups
+
+
+def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None = None) -> tuple:
+    """The regular pass's program (:func:`mechsyn.kinematics.regular._program`: its steps,
+    the links' anchors as ``(joint, complex local point)``, the links' origin joints) as
+    the kernel's arrays: :func:`_shape_arrays`' integers (``shape`` when already known for
+    the topology) and the numbers ``fp`` (steps, 7) complex (a driver's sign and joint
+    point; a group's squared lengths, assembly mode, rotation vectors and known joints'
+    local points) and the anchors' local points."""
+    shape = shape or _shape_arrays(steps, anchor, origin)
+    fp = np.zeros((len(steps), 7), complex)
+    for s, st in enumerate(steps):
+        if st[0] == "drive":
+            fp[s, :2] = st[5], st[6]
+        else:
+            _, _, _, _, L1s, L2s, sigma, cbv1, cbv2, s1, s3 = st
+            fp[s] = complex(L1s, L2s), 0j, sigma, cbv1, cbv2, s1, s3
+    anc_s = np.array([anchor[i][1] if i in anchor else 0j for i in range(len(origin))], complex)
+    return shape, fp, anc_s
+
+
+def run(program: tuple, X: np.ndarray, speeds: np.ndarray, least: float) -> tuple | None:
+    """The compiled pass over the input rows ``X`` (M, k): ``(C, W, AL, D, near)``, every
+    link's rotation and its origin's position, velocity, acceleration (4, links, M), its
+    angular velocity and acceleration (links, M), the groups' normalised discriminants
+    (groups, M), and whether one falls below ``least``; None without the kernel."""
+    mod = _compiled()
+    if mod is None:
+        return None
+    (ip, anc_j, org_j, nj, groups), fp, anc_s = program
+    M, nl = X.shape[0], anc_j.shape[0]
+    C = np.empty((4, nl, M), complex)
+    W = np.empty((nl, M))
+    AL = np.empty((nl, M))
+    D = np.empty((len(groups), M))
+    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.ascontiguousarray(X, float),
+                            np.asarray(speeds, float), nj, least, C, W, AL, D)
+    return C, W, AL, D, bool(near)

@@ -1,0 +1,127 @@
+"""The compiled regular pass (mechsyn.kinematics.kernel, issue 30) against the NumPy pass it
+compiles: the same states, discriminants and fold flags on every planar example (and a
+moved copy of each) whose plan the regular pass takes, and the same simulations."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import mechsyn as ms
+from mechsyn.kinematics import kernel, regular
+from mechsyn.kinematics.analysis import cached_plan
+from mechsyn.model.mechanism import Mechanism
+
+pytest.importorskip("numba")
+
+
+def _scale(m: Mechanism) -> float:
+    pts = np.array([j.point for j in m.joints if j.point is not None and len(j.point) == 2], float)
+    return float(np.ptp(pts, axis=0).max())
+
+
+def _is_chain(m: Mechanism) -> bool:
+    try:
+        kp = cached_plan(m)
+    except Exception:  # noqa: BLE001  (no plan: Newton's)
+        return False
+    return kp.groups is not None and kp.groups.closed_form_rates and kp.system.n == 3 * len(kp.system.links)
+
+
+def _chains() -> list[tuple[str, Mechanism]]:
+    """Every planar example with drivers whose plan is a driver-R + RRR chain, and a copy
+    with its R joints moved by up to 2 % of its size (where that is still such a chain)."""
+    out = []
+    for name in ms.examples.names():
+        try:
+            m = ms.examples.load(name)
+        except Exception:  # noqa: BLE001  (not a mechanism)
+            continue
+        if not isinstance(m, Mechanism) or m.kind != "planar" or not any(j.actuated for j in m.joints):
+            continue
+        rng = np.random.default_rng(len(out))
+        moved = {j.id: np.asarray(j.point, float) + rng.uniform(-0.02, 0.02, 2) * _scale(m) for j in m.joints
+                 if j.type == "R" and j.point is not None and len(j.point) == 2}
+        copy = m.with_joints(tuple(replace(j, point=moved[j.id]) if j.id in moved else j for j in m.joints))
+        out += [(n, x) for n, x in ((name, m), (name + "~moved", copy)) if _is_chain(x)]
+    return out
+
+
+CHAINS = _chains()
+
+
+def test_the_examples_have_chains_with_folds_and_several_drivers():
+    """The comparison below covers four-bars, six-bars, several drivers and folds."""
+    names = {n for n, _ in CHAINS}
+    assert {"crank_rocker", "watt_sixbar", "fourbar"} <= names
+    assert any(len(cached_plan(m).system.drivers) > 1 for _, m in CHAINS)
+
+
+@pytest.mark.parametrize("name,mech", CHAINS, ids=[n for n, _ in CHAINS])
+def test_compiled_pass_equals_the_numpy_pass(name, mech):
+    kp = cached_plan(mech)
+    S, plan = kp.system, kp.groups
+    k = len(S.drivers)
+    u0 = np.array([d.assembled for d in S.drivers])
+    rng = np.random.default_rng(7)
+    wide = np.radians(np.arange(-180.0, 541.0, 0.5))  # a full turn and more: folds if the chain has any
+    X = np.column_stack([wide if i == 0 else u0[i] + rng.uniform(-0.3, 0.3, wide.size) for i in range(k)])
+    speeds = np.linspace(1.0, 2.0, k)
+    steps, anchor, origin = regular._program(S, plan)
+    st = regular._run(steps, anchor, X, speeds, folds=True)
+    C0 = regular._states(st, origin, X.shape[0], len(S.links))
+    C, W, AL, D, near = kernel.run(kernel.program_arrays(steps, anchor, origin), X, speeds, regular.REGULAR_DISC)
+    assert near == st.near
+    groups = sorted(st.discs)
+    D0 = np.stack([st.discs[g] for g in groups])
+    assert np.array_equal(np.isnan(D0), np.isnan(D))
+    assert np.allclose(D0, D, rtol=1e-12, atol=1e-12, equal_nan=True)
+    # rounding (NumPy's and libm's sines differ in the last place) grows as a group
+    # folds, as 1 / disc^2 for the accelerations: rows clear of folds agree to 1e-14
+    # relative times that, element by element
+    clear = (D0 > 1e-3).all(axis=0)
+    grow = 1.0 / D0[:, clear].min(axis=0) ** 2
+    size = _scale(mech)
+    pairs = [(C0[0], C[0], 1.0)] + [(C0[i], C[i], size) for i in (1, 2, 3)]
+    pairs += [(np.stack([np.broadcast_to(st.link[i][j], arr[i].shape) for i in range(len(S.links))]), arr, 1.0)
+              for arr, j in ((W, 1), (AL, 2))]
+    for a, b, unit in pairs:
+        assert np.array_equal(np.isnan(a[:, clear]), np.isnan(b[:, clear]))
+        a, b = a[:, clear], b[:, clear]
+        ok = np.isfinite(a)
+        tol = 1e-14 * (unit + np.abs(a)) * grow
+        assert np.all(np.abs(a[ok] - b[ok]) <= tol[ok])
+
+
+@pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar", "fourbar", "jansen_leg"])
+def test_simulations_are_the_same_with_and_without_the_kernel(name, monkeypatch):
+    """Poses, rates, named points and events of ``simulate`` (a full turn: the Watt six-bar
+    and the textbook four-bar through their dead points)."""
+    m = ms.examples.load(name)
+    drive = next(j.id for j in m.joints if j.actuated)
+    sims = {}
+    for mode in ("numpy", "auto"):
+        monkeypatch.setenv("MECHSYN_KERNEL", mode)
+        assert kernel.active() == (mode == "auto")
+        sims[mode] = m.simulate(**{drive: (0, 360, 1)})
+    a, b = sims["numpy"], sims["auto"]
+    assert a.engine == b.engine == "regular pass"
+    assert [(e.kind, e.index, e.message) for e in a.events] == [(e.kind, e.index, e.message) for e in b.events]
+    for e, f in zip(a.events, b.events):
+        assert np.allclose(list(e.input.values()), list(f.input.values()), rtol=1e-12, atol=1e-12)
+    for key in a.points:
+        for attr in ("position", "velocity", "acceleration"):
+            x, y = getattr(a.points[key], attr), getattr(b.points[key], attr)
+            assert np.allclose(x, y, rtol=1e-11, atol=1e-11 * _scale(m), equal_nan=True), (key, attr)
+
+
+def test_numpy_mode_turns_the_kernel_off(monkeypatch):
+    monkeypatch.setenv("MECHSYN_KERNEL", "numpy")
+    assert not kernel.active()
+    kp = cached_plan(ms.examples.load("crank_rocker"))
+    steps, anchor, origin = regular._program(kp.system, kp.groups)
+    prog = kernel.program_arrays(steps, anchor, origin)
+    assert kernel.run(prog, np.zeros((3, 1)), np.ones(1), 0.05) is None
+    assert isinstance(regular._pass(kp.system, kp.groups, np.zeros((3, 1)), np.ones(1), True), regular._Pass)
