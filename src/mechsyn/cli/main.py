@@ -10,6 +10,7 @@ imported; a module imported eagerly here is picked up the same way.
 from __future__ import annotations
 
 import importlib
+import os
 import re
 import signal
 import sys
@@ -116,6 +117,14 @@ def handle_sigterm() -> Any:
     return None
 
 
+#: Commands that run a sweep or a few: importing and loading Numba's compiled pass
+#: (:mod:`mechsyn.kinematics.kernel`, about 0.4 s) costs them more than it saves, so they
+#: run the NumPy pass unless ``MECHSYN_KERNEL`` says otherwise; ``serve``, ``synth`` and
+#: ``curves`` (thousands of sweeps) use the compiled one when Numba is installed.
+ONE_SHOT = frozenset({"analyze", "schema", "structure", "simulate", "forces", "capability", "atlas", "belt",
+                      "convert", "export"})
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; bad input exits with status 2 and one message.
 
@@ -124,9 +133,15 @@ def main(argv: list[str] | None = None) -> int:
     interrupted, before that).
     """
     previous = handle_sigterm()
+    args = sys.argv[1:] if argv is None else argv
+    pinned = "MECHSYN_KERNEL" not in os.environ and bool(args) and args[0] in ONE_SHOT
+    if pinned:  # for this command only (an in-process caller keeps its own setting)
+        os.environ["MECHSYN_KERNEL"] = "numpy"
     try:
         return _main(argv)
     finally:
+        if pinned:
+            os.environ.pop("MECHSYN_KERNEL", None)
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
