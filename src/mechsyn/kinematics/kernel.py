@@ -42,7 +42,7 @@ from types import ModuleType
 
 import numpy as np
 
-__all__ = ["active", "program_arrays", "run"]
+__all__ = ["active", "program_arrays", "run", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 
@@ -65,6 +65,20 @@ def active() -> bool:
     """Whether the regular pass runs compiled (Numba installed, ``MECHSYN_KERNEL`` not
     ``numpy``)."""
     return _compiled() is not None
+
+
+def warm() -> bool:
+    """Import Numba and compile (or load from its cache) the kernel now, on an empty
+    program of the argument types every pass uses, so the first sweep does not wait for
+    it (the studio calls this while it starts). False when the kernel is off."""
+    mod = _compiled()
+    if mod is None:
+        return False
+    ints, cplx, flt = np.zeros((0, 11), np.int64), np.zeros((0, 7), complex), np.zeros((1, 1))
+    mod.regular_pass(ints, cplx, np.zeros(0, np.int64), np.zeros(0, complex), np.zeros(0, np.int64), flt,
+                     np.ones(1), 0, 0.05, np.zeros((4, 0, 1), complex), np.zeros((0, 1)), np.zeros((0, 1)),
+                     np.zeros((0, 1)))
+    return True
 
 
 def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:

@@ -419,9 +419,17 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
 
 @contextlib.asynccontextmanager
 async def _lifespan(app: Starlette):
-    await asyncio.get_running_loop().run_in_executor(None, app.state.heavy.warm)
+    loop = asyncio.get_running_loop()
+    await loop.run_in_executor(None, app.state.heavy.warm)
+    await loop.run_in_executor(None, _warm_kernel)  # Numba's pass, when installed: not on the first drag
     yield
     app.state.jobs.cancel_all()
+
+
+def _warm_kernel() -> None:
+    from mechsyn.kinematics import kernel
+
+    kernel.warm()
 
 
 #: Seconds a client may take to send its request head (and to keep an idle connection).
