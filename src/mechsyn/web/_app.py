@@ -419,9 +419,10 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
 
 @contextlib.asynccontextmanager
 async def _lifespan(app: Starlette):
-    loop = asyncio.get_running_loop()
-    await loop.run_in_executor(None, app.state.heavy.warm)
-    await loop.run_in_executor(None, _warm_kernel)  # Numba's pass, when installed: not on the first drag
+    await asyncio.get_running_loop().run_in_executor(None, app.state.heavy.warm)
+    # Numba's compiled pass, when installed, loaded (or compiled, once per machine) beside
+    # the server's start rather than on the first drag
+    threading.Thread(target=_warm_kernel, name="mechsyn-kernel-warm", daemon=True).start()
     yield
     app.state.jobs.cancel_all()
 
