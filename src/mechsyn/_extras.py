@@ -41,6 +41,7 @@ EXTRAS: dict[str, str] = {
     "pynauty": "nauty",
     "ezdxf": "cad",
     "imageio_ffmpeg": "video",
+    "numba": "fast",
     "mkdocs": "docs",
     "starlette": "web",  # base dependencies today; an install older than issue 26 lacks them
     "uvicorn": "web",

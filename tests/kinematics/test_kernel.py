@@ -125,3 +125,40 @@ def test_numpy_mode_turns_the_kernel_off(monkeypatch):
     prog = kernel.program_arrays(steps, anchor, origin)
     assert kernel.run(prog, np.zeros((3, 1)), np.ones(1), 0.05) is None
     assert isinstance(regular._pass(kp.system, kp.groups, np.zeros((3, 1)), np.ones(1), True), regular._Pass)
+
+
+def test_a_wrong_mode_is_one_clear_error(monkeypatch):
+    from mechsyn.errors import MechsynInputError
+
+    monkeypatch.setenv("MECHSYN_KERNEL", "fastest")
+    with pytest.raises(MechsynInputError, match="MECHSYN_KERNEL='fastest' is not one of auto, numba, numpy"):
+        kernel.active()
+
+
+def test_numba_asked_for_without_numba_names_the_extra(monkeypatch):
+    monkeypatch.setenv("MECHSYN_KERNEL", "numba")
+    monkeypatch.setattr(kernel, "_MODULE", False)  # as after a failed import of Numba
+    with pytest.raises(ImportError, match=r'pip install "mechsyn\[fast\]"'):
+        kernel.active()
+
+
+def test_one_shot_commands_keep_the_numpy_pass(monkeypatch):
+    """``mechsyn simulate`` runs one sweep: Numba's load would cost it more than it saves;
+    the setting is the command's only (the caller's environment is as it was)."""
+    from mechsyn.cli.main import ONE_SHOT, main
+
+    monkeypatch.delenv("MECHSYN_KERNEL", raising=False)
+    seen = []
+    import mechsyn.kinematics.regular as reg
+
+    real = reg._pass
+
+    def spy(*a, **k):
+        seen.append(kernel.active())
+        return real(*a, **k)
+
+    monkeypatch.setattr(reg, "_pass", spy)
+    assert "simulate" in ONE_SHOT and "serve" not in ONE_SHOT and "synth" not in ONE_SHOT
+    assert main(["simulate", "examples/kinematics/crank_rocker.yaml", "-i", "A=0:360:10"]) == 0
+    assert seen and not any(seen)
+    assert kernel.active()

@@ -42,22 +42,36 @@ from types import ModuleType
 
 import numpy as np
 
+from mechsyn._extras import missing
+from mechsyn.errors import MechsynInputError
+
 __all__ = ["active", "program_arrays", "run", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 
 
+#: The values of ``MECHSYN_KERNEL``: ``auto`` (the default) compiled when Numba is
+#: installed, ``numba`` compiled or an error naming the extra, ``numpy`` never compiled.
+MODES = ("auto", "numba", "numpy")
+
+
 def _compiled() -> ModuleType | None:
     """The Numba module (:mod:`mechsyn.kinematics._kernel_numba`), imported on first use;
-    None without Numba or with ``MECHSYN_KERNEL=numpy``."""
+    None without Numba (``auto``) or with ``MECHSYN_KERNEL=numpy``."""
     global _MODULE
-    if os.environ.get("MECHSYN_KERNEL", "auto").lower() == "numpy":
+    mode = os.environ.get("MECHSYN_KERNEL", "auto").strip().lower() or "auto"
+    if mode == "numpy":
         return None
+    if mode not in MODES:
+        raise MechsynInputError(f"MECHSYN_KERNEL={mode!r} is not one of {', '.join(MODES)}",
+                                field="MECHSYN_KERNEL", hint="unset it, or set auto, numba or numpy")
     if _MODULE is None:
         try:
             _MODULE = importlib.import_module("mechsyn.kinematics._kernel_numba")
         except ImportError:
             _MODULE = False
+    if not _MODULE and mode == "numba":
+        raise missing("numba", "MECHSYN_KERNEL=numba (the compiled regular pass)")
     return _MODULE or None
 
 
