@@ -95,17 +95,19 @@ def test_compiled_pass_equals_the_numpy_pass(name, mech):
         assert np.all(np.abs(a[ok] - b[ok]) <= tol[ok])
 
 
-@pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar", "fourbar", "jansen_leg"])
-def test_simulations_are_the_same_with_and_without_the_kernel(name, monkeypatch):
-    """Poses, rates, named points and events of ``simulate`` (a full turn: the Watt six-bar
-    and the textbook four-bar through their dead points)."""
+@pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar", "stephenson_sixbar", "fourbar", "jansen_leg"])
+@pytest.mark.parametrize("grid", [(0, 360, 1), (-720, 720, 3), (400, 40, -2)])
+def test_simulations_are_the_same_with_and_without_the_kernel(name, grid, monkeypatch):
+    """Poses, rates, named points, link angles and events of ``simulate`` over several
+    turns, forwards and backwards, from inside and outside the drawn input (the Watt
+    six-bar and the textbook four-bar through their dead points)."""
     m = ms.examples.load(name)
     drive = next(j.id for j in m.joints if j.actuated)
     sims = {}
     for mode in ("numpy", "auto"):
         monkeypatch.setenv("MECHSYN_KERNEL", mode)
         assert kernel.active() == (mode == "auto")
-        sims[mode] = m.simulate(**{drive: (0, 360, 1)})
+        sims[mode] = m.simulate(**{drive: grid})
     a, b = sims["numpy"], sims["auto"]
     assert a.engine == b.engine == "regular pass"
     assert [(e.kind, e.index, e.message) for e in a.events] == [(e.kind, e.index, e.message) for e in b.events]
@@ -115,6 +117,11 @@ def test_simulations_are_the_same_with_and_without_the_kernel(name, monkeypatch)
         for attr in ("position", "velocity", "acceleration"):
             x, y = getattr(a.points[key], attr), getattr(b.points[key], attr)
             assert np.allclose(x, y, rtol=1e-11, atol=1e-11 * _scale(m), equal_nan=True), (key, attr)
+    for key in a.links:  # the angles continuous from the drawn ones (whole turns counted the same)
+        for attr in ("angle", "angular_velocity", "angular_acceleration"):
+            x, y = getattr(a.links[key], attr), getattr(b.links[key], attr)
+            assert np.allclose(x, y, rtol=1e-11, atol=1e-11, equal_nan=True), (key, attr)
+    assert np.array_equal(a.assembled, b.assembled)
 
 
 def test_numpy_mode_turns_the_kernel_off(monkeypatch):

@@ -148,3 +148,103 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, X, speeds, nj, least, C, W, AL, D)
         else:
             _point_rows(i, 0j, anc_j, anc_s, jP, jV, jA, lz, lw, lal, C[1, i], C[2, i], C[3, i], M)
     return near
+
+
+@njit(inline="always", **_OPTIONS)
+def _near(a, ref):  # pragma: no cover - compiled
+    """``ref + wrap(a - ref)``: the angle ``a`` moved by whole turns next to ``ref``
+    (``wrap`` to [-pi, pi) by the floored remainder, as ``np.remainder``)."""
+    return ref + ((a - ref + math.pi) % (2 * math.pi) - math.pi)
+
+
+@njit(**_OPTIONS)
+def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, q, qd, qdd):  # pragma: no cover - compiled
+    """The pose rows ``q, qd, qdd`` (3 links, N; component-major) of the first N rows of a
+    pass (``C``, ``W``, ``AL`` of :func:`regular_pass`): each link's origin, its angle and
+    their rates. A link turned by a frame driver (``dcol[i]`` its input's column, ``dsgn``
+    its sign) takes the input itself; the others ``atan2`` of their rotation, made
+    continuous and started next to their drawn angle ``ref[i]``
+    (:func:`mechsyn.kinematics.positions._continuous_angles`): without ``folds`` one
+    unwrapped run whose rows ``split`` and ``split - 1`` (when ``split`` >= 0) each start
+    next to ``ref``; with ``folds`` each tracked sweep (forwards from ``split``, backwards
+    from ``split - 1``, or the one sweep) on its own, its runs of assembled rows unwrapped
+    and each run following the run before by whole turns, the rows where a link is not
+    placed blanked (NaN) and the rates of rows where they are not finite blanked
+    (:func:`mechsyn.kinematics.regular._fold_poses`). Returns the rows assembled (N,)."""
+    nl = C.shape[1]
+    twopi = 2 * math.pi
+    ok = np.ones(N, np.bool_)
+    for i in range(nl):
+        for r in range(N):
+            p, v, a = C[1, i, r], C[2, i, r], C[3, i, r]
+            q[3 * i, r], q[3 * i + 1, r] = p.real, p.imag
+            qd[3 * i, r], qd[3 * i + 1, r], qd[3 * i + 2, r] = v.real, v.imag, W[i, r]
+            qdd[3 * i, r], qdd[3 * i + 1, r], qdd[3 * i + 2, r] = a.real, a.imag, AL[i, r]
+            if folds:
+                z = C[0, i, r]
+                if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+                    ok[r] = False
+    for i in range(nl):
+        out = q[3 * i + 2]
+        if dcol[i] >= 0:
+            for r in range(N):
+                out[r] = U[r, dcol[i]] * dsgn[i]
+            continue
+        for r in range(N):
+            z = C[0, i, r]
+            out[r] = math.atan2(z.imag, z.real)
+        if not folds:  # one run, unwrapped forwards, its start row(s) next to the drawn angle
+            raw = out[0]
+            K = 0.0
+            for r in range(1, N):
+                a = out[r]
+                K += np.rint((a - raw) / twopi)
+                raw = a
+                out[r] = a - twopi * K
+            for part in range(2 if split >= 0 else 1):
+                row = 0 if split < 0 else (split if part == 0 else split - 1)
+                lo, hi = (0, N) if split < 0 else ((split, N) if part == 0 else (0, split))
+                a0 = math.atan2(C[0, i, row].imag, C[0, i, row].real)
+                turns = np.rint((out[row] - _near(a0, ref[i])) / twopi)
+                if turns != 0.0:
+                    for r in range(lo, hi):
+                        out[r] -= twopi * turns
+            continue
+        for part in range(2 if split >= 0 else 1):  # each tracked sweep in its own order
+            start, n, step = (0, N, 1) if split < 0 else ((split, N - split, 1) if part == 0 else (split - 1, split, -1))
+            has_prev, in_run = False, False
+            prev, raw, K, shift = 0.0, 0.0, 0.0, 0.0
+            for t in range(n):
+                r = start + step * t
+                if not ok[r]:
+                    in_run = False
+                    continue
+                s = _near(out[r], ref[i])
+                if not in_run:
+                    in_run, raw, K = True, s, 0.0
+                    x = s
+                    shift = twopi * np.rint((x - prev) / twopi) if has_prev else 0.0
+                else:
+                    K += np.rint((s - raw) / twopi)
+                    raw = s
+                    x = s - twopi * K
+                out[r] = x - shift if shift != 0.0 else x
+                prev, has_prev = out[r], True
+    if folds:
+        for r in range(N):
+            if not ok[r]:
+                for c in range(3 * nl):
+                    q[c, r] = math.nan
+                    qd[c, r] = math.nan
+                    qdd[c, r] = math.nan
+                continue
+            rates = True
+            for c in range(3 * nl):
+                if not (math.isfinite(qd[c, r]) and math.isfinite(qdd[c, r])):
+                    rates = False
+                    break
+            if not rates:
+                for c in range(3 * nl):
+                    qd[c, r] = math.nan
+                    qdd[c, r] = math.nan
+    return ok

@@ -45,7 +45,7 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["active", "program_arrays", "run", "warm"]
+__all__ = ["active", "link_poses", "program_arrays", "run", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 
@@ -160,3 +160,20 @@ def run(program: tuple, X: np.ndarray, speeds: np.ndarray, least: float) -> tupl
     near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.ascontiguousarray(X, float),
                             np.asarray(speeds, float), nj, least, C, W, AL, D)
     return C, W, AL, D, bool(near)
+
+
+def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,
+               n: int) -> tuple:
+    """The pose rows ``q, qd, qdd`` (n, N; component-major) of the first N rows of a
+    compiled pass (``pass_``: ``(C, W, AL)`` of :func:`run`) and the rows assembled, the
+    links' angles continuous from the drawn ones (``angles``: each link's frame driver's
+    input column or -1, its sign, its drawn angle), compiled: see
+    :func:`mechsyn.kinematics._kernel_numba.link_poses`. ``folds``: the sweep went
+    through folds (its tracked sweeps made continuous on their own, rows not assembled
+    and rates not defined blanked)."""
+    C, W, AL = pass_
+    q, qd, qdd = np.empty((n, N)), np.empty((n, N)), np.empty((n, N))
+    dcol, dsgn, ref = angles
+    ok = _compiled().link_poses(C, W, AL, N, np.ascontiguousarray(U, float), dcol, dsgn, ref,
+                                -1 if split is None else split, folds, q, qd, qdd)
+    return q, qd, qdd, ok

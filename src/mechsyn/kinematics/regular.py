@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.chain import _chain_program, _link_angles
+from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
 from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
 from mechsyn.kinematics.tracking import (REGULAR_DISC, _regular_rows, _sweep_events, fold_events, touch_candidates,
                                          tracking_path)
@@ -298,6 +298,23 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray, speeds: np.ndarray, folds:
     return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near)
 
 
+def _compiled_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
+                    folds: bool) -> tuple:
+    """:func:`_poses` / :func:`_fold_poses` of a compiled pass, compiled
+    (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N) and the rows
+    assembled (N,). The links' drivers and drawn angles are kept with the system."""
+    memo = _memo(S)
+    hit = memo.get(("kernel-angles", id(plan)))
+    if hit is None or hit[0] is not plan:
+        drive = _drive_links(S, plan)
+        nl = len(S.links)
+        angles = (np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
+                  np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float),
+                  np.array([S.q0[3 * i + 2] for i in range(nl)], float))
+        hit = memo[("kernel-angles", id(plan))] = (plan, angles)
+    return kernel.link_poses((st.C, st.W, st.AL), U.shape[0], U, hit[1], split, folds, S.n)
+
+
 class _Compiled:
     """The compiled pass's answer (:func:`mechsyn.kinematics.kernel.run`) in the terms of
     :class:`_Pass`: the links' states already gathered per link (``C``, ``W``, ``AL``),
@@ -416,6 +433,9 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     pass) through folds: NaN rows where a group is not assembled, NaN rates where they
     are not defined (inf at a group folded flat), each link's angle continuous along
     each tracked sweep from the drawn one."""
+    if isinstance(st, _Compiled):
+        q, qd, qdd, _ = _compiled_poses(S, plan, U, st, split, True)
+        return q.T, qd.T, qdd.T
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     ok = np.isfinite(C[0]).all(axis=0)
     parts = (slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))
@@ -460,6 +480,9 @@ def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, 
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
     origin is its first joint, its angle continuous from the drawn one) and the links'
     complex states."""
+    if isinstance(st, _Compiled):
+        q, qd, qdd, _ = _compiled_poses(S, plan, U, st, split, False)
+        return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
     return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
