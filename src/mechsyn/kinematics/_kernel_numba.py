@@ -158,12 +158,13 @@ def _near(a, ref):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, q, qd, qdd):  # pragma: no cover - compiled
+def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  # pragma: no cover - compiled
     """The pose rows ``q, qd, qdd`` (3 links, N; component-major) of the first N rows of a
     pass (``C``, ``W``, ``AL`` of :func:`regular_pass`): each link's origin, its angle and
     their rates. A link turned by a frame driver (``dcol[i]`` its input's column, ``dsgn``
     its sign) takes the input itself; the others ``atan2`` of their rotation, made
-    continuous and started next to their drawn angle ``ref[i]``
+    continuous (``A``: the rotations' ``atan2``, links by rows, from NumPy, whose vector
+    loops take a third of libm's time) and started next to their drawn angle ``ref[i]``
     (:func:`mechsyn.kinematics.positions._continuous_angles`): without ``folds`` one
     unwrapped run whose rows ``split`` and ``split - 1`` (when ``split`` >= 0) each start
     next to ``ref``; with ``folds`` each tracked sweep (forwards from ``split``, backwards
@@ -191,8 +192,7 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, q, qd, qdd):  # pr
                 out[r] = U[r, dcol[i]] * dsgn[i]
             continue
         for r in range(N):
-            z = C[0, i, r]
-            out[r] = math.atan2(z.imag, z.real)
+            out[r] = A[i, r]
         if not folds:  # one run, unwrapped forwards, its start row(s) next to the drawn angle
             raw = out[0]
             K = 0.0
@@ -204,7 +204,7 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, q, qd, qdd):  # pr
             for part in range(2 if split >= 0 else 1):
                 row = 0 if split < 0 else (split if part == 0 else split - 1)
                 lo, hi = (0, N) if split < 0 else ((split, N) if part == 0 else (0, split))
-                a0 = math.atan2(C[0, i, row].imag, C[0, i, row].real)
+                a0 = A[i, row]
                 turns = np.rint((out[row] - _near(a0, ref[i])) / twopi)
                 if turns != 0.0:
                     for r in range(lo, hi):
