@@ -302,17 +302,17 @@ def _compiled_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled",
                     folds: bool) -> tuple:
     """:func:`_poses` / :func:`_fold_poses` of a compiled pass, compiled
     (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N) and the rows
-    assembled (N,). The links' drivers and drawn angles are kept with the system."""
-    memo = _memo(S)
-    hit = memo.get(("kernel-angles", id(plan)))
+    assembled (N,). Which links frame drivers turn is kept with the topology."""
+    shapes = S.cache.setdefault("programs", {})  # the drivers' links: the topology's, shared
+    hit = shapes.get(("kernel-angles", id(plan)))
     if hit is None or hit[0] is not plan:
         drive = _drive_links(S, plan)
         nl = len(S.links)
-        angles = (np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
-                  np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float),
-                  np.array([S.q0[3 * i + 2] for i in range(nl)], float))
-        hit = memo[("kernel-angles", id(plan))] = (plan, angles)
-    return kernel.link_poses((st.C, st.W, st.AL), U.shape[0], U, hit[1], split, folds, S.n)
+        hit = shapes[("kernel-angles", id(plan))] = (
+            plan, np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
+            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float))
+    angles = (hit[1], hit[2], np.ascontiguousarray(S.q0[2::3]))  # the drawn angles: this geometry's
+    return kernel.link_poses((st.C, st.W, st.AL), U.shape[0], U, angles, split, folds, S.n)
 
 
 class _Compiled:
