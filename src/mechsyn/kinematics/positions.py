@@ -95,8 +95,8 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
     ``split``: the sweep (assembled throughout) was run outwards from the drawn
     configuration, between rows ``split - 1`` and ``split``: both rows start near
     ``ref`` and the angles are unwrapped away from them (as two runs would be).
-    ``fresh``: ``phi`` (m, N) is a work array the angles are written into (the answer
-    is ``phi`` itself)."""
+    ``fresh``: ``phi`` (m, N) is a work array of ``atan2`` angles the answer is written
+    into (the answer is ``phi`` itself)."""
     if ref.ndim == 1:
         return _continuous_angles(phi.T, ref[:, None], ok, split).T
     refs = ref[:, 0].tolist()
@@ -114,7 +114,14 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
     if fresh:  # ref + _wrap(phi - ref), in place
         sub = np.subtract(phi, ref, out=phi)
         sub += np.pi
-        np.remainder(sub, 2 * np.pi, out=sub)
+        if all(-math.pi <= r <= math.pi for r in refs):
+            # phi of atan2 and ref within half a turn: sub in [-pi, 3 pi], so the remainder
+            # is one step of 2 pi or none (a step down exact: Sterbenz), as np.remainder
+            # takes it (fmod, then + 2 pi when negative), without its division
+            np.subtract(sub, 2 * np.pi, out=sub, where=sub >= 2 * np.pi)
+            np.add(sub, 2 * np.pi, out=sub, where=sub < 0.0)
+        else:
+            np.remainder(sub, 2 * np.pi, out=sub)
         sub -= np.pi
         np.add(ref, sub, out=sub)
     else:

@@ -367,14 +367,32 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     are not defined (inf at a group folded flat), each link's angle continuous along
     each tracked sweep from the drawn one."""
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
-    ok = np.isfinite(C[0]).all(axis=0)
+    fin = np.isfinite(C[0].view(float)).all(axis=0)  # every link's rotation: real and imaginary parts
+    ok = fin[0::2] & fin[1::2]
     parts = (slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))
     _link_angles(S, plan, U, C[0].real, C[0].imag, ok, q[2::3], parts=parts)
-    bad = ~ok | ~(np.isfinite(qd).all(axis=0) & np.isfinite(qdd).all(axis=0))
-    q[:, ~ok] = np.nan
-    qd[:, bad] = np.nan
-    qdd[:, bad] = np.nan
+    rates = np.isfinite(qd).all(axis=0)
+    rates &= np.isfinite(qdd).all(axis=0)
+    rates &= ok
+    _blank((q,), ok)
+    _blank((qd, qdd), rates)
     return q.T, qd.T, qdd.T
+
+
+def _blank(arrays: tuple, keep: np.ndarray) -> None:
+    """NaN into the columns of ``arrays`` (n, N) where ``keep`` (N,) is false: by runs of
+    columns (a sweep's gaps are a few runs), or all at once when there are many."""
+    if keep.all():
+        return
+    edges = np.flatnonzero(keep[1:] != keep[:-1]).tolist()
+    if len(edges) > 16:
+        for a in arrays:
+            np.copyto(a, np.nan, where=~keep)
+        return
+    bounds = ([] if keep[0] else [0]) + [e + 1 for e in edges] + ([] if keep[-1] else [len(keep)])
+    for a, b in zip(bounds[0::2], bounds[1::2]):
+        for x in arrays:
+            x[:, a:b] = np.nan
 
 
 def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:

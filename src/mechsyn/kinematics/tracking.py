@@ -313,18 +313,17 @@ def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
     return math.nan
 
 
-def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, xa: np.ndarray, xb: np.ndarray, i0: int):
+def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, xa: list, xb: list, i0: int):
     """Discriminant of step ``k`` on the segment of inputs from ``xa`` (t = 0, row ``i0``)
     to ``xb`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar
     function (on floats for a driver-R + RRR chain: the numbers of ``xa + t (xb - xa)``)."""
+    dx = [b - a for a, b in zip(xa, xb)]
     if plan.closed_form_rates:
         prog = _scalar_program(S, plan)
         sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
-        x0 = xa.tolist()
-        dx = [b - a for a, b in zip(x0, xb.tolist())]
-        return lambda t: _scalar_disc(prog, k, sig, [a + t * d for a, d in zip(x0, dx)])
+        return lambda t: _scalar_disc(prog, k, sig, [a + t * d for a, d in zip(xa, dx)])
     rows = np.array([i0])
-    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (xa + t * (xb - xa))[None])[0])
+    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, np.array([[a + t * d for a, d in zip(xa, dx)]]))[0])
 
 
 def touch_candidates(disc: np.ndarray) -> np.ndarray:
@@ -332,9 +331,17 @@ def touch_candidates(disc: np.ndarray) -> np.ndarray:
     touch zero: its local minima under 0.05 among the rows where it is assembled (the
     candidates of a change or branch point, decided by :func:`_touch`); of several groups
     (rows of ``disc``): any candidate shows (the flat indices are not rows then)."""
-    d = np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan)
+    return np.flatnonzero(_low_minima(np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan))) + 1
+
+
+def _low_minima(d: np.ndarray) -> np.ndarray:
+    """Where (the inner rows, ``d[..., 1:-1]``) the discriminants ``d`` (NaN where not
+    assembled, else at least 0) have a local minimum under 0.05."""
     mid = d[..., 1:-1]
-    return np.flatnonzero((mid <= d[..., :-2]) & (mid <= d[..., 2:]) & (mid < 0.05)) + 1
+    out = mid < 0.05
+    out &= mid <= d[..., :-2]
+    out &= mid <= d[..., 2:]
+    return out
 
 
 def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.ndarray, D: np.ndarray,
@@ -361,7 +368,8 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     gs, js = np.nonzero(ok[:, 1:] != ok[:, :-1])
     for g, j in zip(gs.tolist(), js.tolist()):
         changes[g].append(j + 1)
-    found, resets = _fold_scan(S, plan, ks, sigmas, X.__getitem__, lambda g, i: float(D[g, i]), changes, n0)
+    found, resets = _fold_scan(S, plan, ks, sigmas, lambda i: X[i].tolist(), lambda g, i: float(D[g, i]), changes,
+                               n0)
     return [Event(*e) for e in found], singular, resets
 
 
@@ -370,7 +378,7 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
     """:func:`fold_events` from the rows where each group's assembly changes
     (``changes[g]``: the rows ``i`` whose group ``g`` is assembled at ``i`` and not at
     ``i - 1`` or the other way round), its discriminant ``val(g, i)`` (a float) and the
-    input rows ``row(i)`` (arrays): the events as ``(row, kind, message, input, group)``
+    input rows ``row(i)`` (lists of floats): the events as ``(row, kind, message, input, group)``
     and per group the rows where it reassembles."""
     events: list = []
     resets = []
@@ -403,7 +411,7 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
                 ends[i] = min(t, ends.get(i, 1.0))
             else:
                 starts[i] = max(t, starts.get(i, 0.0))
-            u = (xa + t * (xb - xa)).tolist()
+            u = [a + t * (b - a) for a, b in zip(xa, xb)]  # the numbers of xa + t (xb - xa)
             if inside:
                 events.append((i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
                                "changes sign: a dead point / limit of the working range)", u, group))
@@ -416,7 +424,7 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
                 continue
             events.append((i, "reassembled", "assembles again after a gap, in the assembly mode of the drawn "
                            f"configuration for the group {group} (the mode nearest the drawn one)",
-                           row(i).tolist(), group))
+                           row(i), group))
     return events, resets
 
 
@@ -440,11 +448,13 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
     D = np.stack([discs[k] for k in ks])[:, perm]
-    L = D.shape[1]
-    if any((c - 1) % (L - 2) + 1 not in (b - 1, b) for c in touch_candidates(D).tolist()):
-        return None
     ok = D > -_ZERO_DISC
-    singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
+    d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
+    low = _low_minima(d)
+    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
+    if low.any():
+        return None
+    singular = (d < SINGULAR_DISC).any(axis=0)  # ok and D < SINGULAR_DISC
     # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
     sweeps = [(1, paths[0], U if split is None else U[split:])]
     if split is not None:
@@ -461,16 +471,15 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
             rows.reverse()
     out = []
     for (way, (path, shift), V), ch in zip(sweeps, changes):
-        n0 = path.shape[0]
+        n0, sh = path.shape[0], shift.tolist()
 
-        def row(i: int, path=path, shift=shift, V=V, n0=n0) -> np.ndarray:
-            return path[i] if i < n0 else V[i - n0] - shift
+        def row(i: int, path=path, sh=sh, V=V, n0=n0) -> list:  # the numbers of V[i - n0] - shift
+            return path[i].tolist() if i < n0 else [x - s for x, s in zip(V[i - n0].tolist(), sh)]
 
         def val(g: int, i: int, way=way) -> float:
             return float(D[g, b + i if way > 0 else b - 1 - i])
 
         found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0)
-        sh = shift.tolist()
         events = []
         for i, kind, message, u, group in found:
             index, message, u, before = _swept(i, message, u, n0, sh)
@@ -496,7 +505,7 @@ def _pass_layout(N: int, split: int | None, n0s: tuple) -> tuple[np.ndarray, int
     return perm, b
 
 
-def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: np.ndarray, xb: np.ndarray) -> float | None:
+def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: list, xb: list) -> float | None:
     """Where (t in [0, 1]) RRR step ``k`` folds on the segment of inputs from ``xa`` to
     ``xb``, in closed form when the group closes a four-bar: one end joint on the frame,
     the other on a crank turned by the only input about a frame pivot. The group folds
