@@ -73,12 +73,12 @@ def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
         k = np.subtract(p[..., 1:], p[..., :-1])
         k /= 2 * np.pi
         np.rint(k, out=k)
-        jumps = np.flatnonzero(k)
+        jumps = np.flatnonzero(k) if k.any() else np.empty(0, int)  # (NaN counts as a jump)
         if len(jumps) > 16:  # many turns: count them all at once
             np.cumsum(k, axis=-1, out=k)
             k *= 2 * np.pi
             out[..., 1:] -= k
-        else:  # a few: each shifts the rest of its row
+        elif len(jumps):  # a few: each shifts the rest of its row
             o2, k2 = out.reshape(-1, out.shape[-1]), k.reshape(-1, k.shape[-1])
             for j in jumps.tolist():
                 row, col = divmod(j, k2.shape[1])

@@ -373,8 +373,8 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     _link_angles(S, plan, U, C[0].real, C[0].imag, ok, q[2::3], parts=parts)
     rates = np.isfinite(qd).all(axis=0)
     rates &= np.isfinite(qdd).all(axis=0)
-    rates &= ok
-    _blank((q,), ok)
+    _blank((q, qd, qdd), ok)
+    rates |= ~ok  # the rows where rates are not defined though the group is assembled (folded flat)
     _blank((qd, qdd), rates)
     return q.T, qd.T, qdd.T
 

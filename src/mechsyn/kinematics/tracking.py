@@ -37,25 +37,22 @@ SINGULAR_DISC = 1e-12
 #: Relative size of the negative discriminant still taken as zero (round-off).
 _ZERO_DISC = 1e-12
 
-
-def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.ndarray:
-    """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
-    return np.array(_turned(S, u0.tolist(), u_first.tolist()), float)
+#: The longest step of a connecting path's R inputs.
+_DEGREE = math.radians(1.0)
 
 
-def _turned(S: PlanarSystem, u0: list, first: list) -> list:
-    """:func:`_shifted_start` on floats (a decision per driver, the same subtractions)."""
-    return [b - 2 * math.pi * round((b - a) / (2 * math.pi)) if d.type == "R" else b
-            for a, b, d in zip(u0, first, S.drivers)]
+def _turned(kinds: tuple, u0: list, first: list) -> list:
+    """The first input values ``first`` moved by whole turns (R inputs, ``kinds`` the
+    drivers' types) to the values nearest the drawn ones ``u0`` (lists of floats)."""
+    return [b - 2 * math.pi * round((b - a) / (2 * math.pi)) if kind == "R" else b
+            for a, b, kind in zip(u0, first, kinds)]
 
 
-def _connecting_path(S: PlanarSystem, u0, u1, max_rows: int = 4000) -> np.ndarray:
-    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded) in steps of at most
-    1 degree (R) or 1 % of the mechanism's size (P); ``u0``, ``u1`` sequences of floats."""
-    u0, u1 = list(map(float, u0)), list(map(float, u1))
-    steps = (abs(b - a) / (math.radians(1.0) if d.type == "R" else 0.01 * S.scale)
-             for a, b, d in zip(u0, u1, S.drivers))
-    n = int(min(max_rows, max(1, math.ceil(max(steps)))))
+def _connecting_path(kinds: tuple, scale: float, u0: list, u1: list, max_rows: int = 4000) -> np.ndarray:
+    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded; lists of floats) in
+    steps of at most 1 degree (R) or 1 % of the mechanism's size ``scale`` (P)."""
+    most = max(abs(b - a) / (_DEGREE if kind == "R" else 0.01 * scale) for a, b, kind in zip(u0, u1, kinds))
+    n = int(min(max_rows, max(1, math.ceil(most))))
     if n == 1:  # the drawn values themselves (t = 0)
         return np.array([u0])
     t = np.arange(n) / n
@@ -66,13 +63,20 @@ def _connecting_path(S: PlanarSystem, u0, u1, max_rows: int = 4000) -> np.ndarra
     return out
 
 
+def _kinds(S: PlanarSystem) -> tuple[tuple, float]:
+    """The drivers' types and the size the connecting paths' P steps are measured by."""
+    kinds = tuple(d.type for d in S.drivers)
+    return kinds, (S.scale if "P" in kinds else 1.0)
+
+
 def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
     """The rows ``U`` followed by the connecting paths from the drawn input values to the
     sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
     else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
-    u0 = np.array([d.assembled for d in S.drivers], float)
+    kinds, scale = _kinds(S)
+    u0 = [float(d.assembled) for d in S.drivers]
     ends = [0] if split is None else [split, split - 1]
-    return np.concatenate([U] + [_connecting_path(S, u0, _shifted_start(S, u0, U[e])) for e in ends])
+    return np.concatenate([U] + [_connecting_path(kinds, scale, u0, _turned(kinds, u0, U[e].tolist())) for e in ends])
 
 
 #: Smallest normalised discriminant of every group over a sweep for which
@@ -188,11 +192,22 @@ def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = No
     input values are ``first``, and the whole turns ``shift`` the sweep is tracked
     shifted by (R inputs a whole number of turns from the drawn values are the same
     configurations: the sweep is tracked next to the drawn values, so that its rows
-    follow each other); ``u0``: the drawn input values when known."""
+    follow each other); ``u0``: the drawn input values when known. Both arrays are
+    read-only: a sweep of the same first inputs from the same drawn values (a cached or
+    a refilled geometry: the path does not depend on the links) takes them again."""
     a = [float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist()
-    b = first.tolist()
-    shift = [x - y for x, y in zip(b, _turned(S, a, b))]  # the numbers of first - (first - turns)
-    return _connecting_path(S, a, [x - y for x, y in zip(b, shift)]), np.array(shift)
+    return _tracking_path(*_kinds(S), tuple(a), tuple(first.tolist()))
+
+
+@functools.lru_cache(maxsize=256)
+def _tracking_path(kinds: tuple, scale: float, u0: tuple, first: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`tracking_path` of the drivers' types ``kinds`` and the size ``scale``."""
+    shift = [b - c for b, c in zip(first, _turned(kinds, u0, first))]  # the numbers of first - (first - turns)
+    path = _connecting_path(kinds, scale, list(u0), [b - c for b, c in zip(first, shift)])
+    out = path, np.array(shift)
+    for x in out:
+        x.setflags(write=False)
+    return out
 
 
 def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
@@ -382,6 +397,8 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
     and per group the rows where it reassembles."""
     events: list = []
     resets = []
+    seen: dict[int, list] = {}
+    row = functools.partial(_row_once, seen, row)  # the groups' folds read the same rows
     ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
     starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
@@ -428,6 +445,14 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
     return events, resets
 
 
+def _row_once(seen: dict, row, i: int) -> list:
+    """``row(i)``, read once per row."""
+    x = seen.get(i)
+    if x is None:
+        x = seen[i] = row(i)
+    return x
+
+
 def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: np.ndarray, split: int | None,
                      paths: list) -> list | None:
     """:func:`fold_events` of the tracked sweeps of one regular pass (the sweep ``U`` (N,
@@ -447,14 +472,18 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    D = np.stack([discs[k] for k in ks])[:, perm]
+    D = np.empty((len(ks), len(perm)))
+    for g, k in enumerate(ks):
+        np.take(discs[k], perm, out=D[g])
     ok = D > -_ZERO_DISC
     d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
     low = _low_minima(d)
     low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
     if low.any():
         return None
-    singular = (d < SINGULAR_DISC).any(axis=0)  # ok and D < SINGULAR_DISC
+    singular = d[0] < SINGULAR_DISC  # some group assembled with D < SINGULAR_DISC
+    for row in d[1:]:
+        singular |= row < SINGULAR_DISC
     # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
     sweeps = [(1, paths[0], U if split is None else U[split:])]
     if split is not None:
