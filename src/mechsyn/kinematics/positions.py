@@ -111,8 +111,9 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
                 if turns:
                     block[i, rows] -= 2 * math.pi * turns
         return block
-    if fresh:  # ref + _wrap(phi - ref), in place
-        sub = np.subtract(phi, ref, out=phi)
+    if fresh:  # ref + _wrap(phi - ref), in place (elementwise: on a backward sweep's rows forwards)
+        sub = phi[:, ::-1] if phi.strides[1] < 0 else phi
+        np.subtract(sub, ref, out=sub)
         sub += np.pi
         if all(-math.pi <= r <= math.pi for r in refs):
             # phi of atan2 and ref within half a turn: sub in [-pi, 3 pi], so the remainder
@@ -124,6 +125,7 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
             np.remainder(sub, 2 * np.pi, out=sub)
         sub -= np.pi
         np.add(ref, sub, out=sub)
+        sub = phi
     else:
         sub = ref + _wrap(phi - ref)
     # the runs of assembled rows [a, b): each unwrapped in place, then shifted by whole
