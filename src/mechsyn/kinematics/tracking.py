@@ -402,8 +402,11 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
     ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
     starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
-        group = "-".join(plan.steps[k].joints)
         rows, backs = [], []
+        resets.append(backs)
+        if not changes[g]:
+            continue
+        group = "-".join(plan.steps[k].joints)
         for i in changes[g]:
             fa, fb = val(g, i - 1), val(g, i)
             if fb > -_ZERO_DISC:
@@ -416,7 +419,8 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
                 rows.append((i, 1, fa, fb))
             elif fb > -_ZERO_DISC and i in starts:
                 rows.append((i, -1, fa, fb))
-        for i, hidden, fa, fb in sorted(rows, key=lambda r: r[:2]):
+        rows.sort()  # by row (a row is one group's once)
+        for i, hidden, fa, fb in rows:
             xa, xb = row(i - 1), row(i)
             t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
             if t is None:
@@ -435,7 +439,6 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
             else:
                 events.append((i, "dead point", "assembly starts again here: the other limit of a working range",
                                u, group))
-        resets.append(backs)
         for i in backs:
             if i < n0:
                 continue
