@@ -119,8 +119,11 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
             # phi of atan2 and ref within half a turn: sub in [-pi, 3 pi], so the remainder
             # is one step of 2 pi or none (a step down exact: Sterbenz), as np.remainder
             # takes it (fmod, then + 2 pi when negative), without its division
-            np.subtract(sub, 2 * np.pi, out=sub, where=sub >= 2 * np.pi)
-            np.add(sub, 2 * np.pi, out=sub, where=sub < 0.0)
+            # (each step only when some angle needs it: fmax, fmin pass over NaN gaps)
+            if np.fmax.reduce(sub, axis=None) >= 2 * np.pi:
+                np.subtract(sub, 2 * np.pi, out=sub, where=sub >= 2 * np.pi)
+            if np.fmin.reduce(sub, axis=None) < 0.0:
+                np.add(sub, 2 * np.pi, out=sub, where=sub < 0.0)
         else:
             np.remainder(sub, 2 * np.pi, out=sub)
         sub -= np.pi
