@@ -71,9 +71,11 @@ def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
     out = p if inplace else np.array(p, float)
     if p.shape[-1] > 1:
         k = np.subtract(p[..., 1:], p[..., :-1])
+        if not k.size or (k.max() <= math.pi and k.min() >= -math.pi):  # no step over half a turn
+            return out
         k /= 2 * np.pi
         np.rint(k, out=k)
-        jumps = np.flatnonzero(k) if k.any() else np.empty(0, int)  # (NaN counts as a jump)
+        jumps = np.flatnonzero(k)  # (NaN counts as a jump)
         if len(jumps) > 16:  # many turns: count them all at once
             np.cumsum(k, axis=-1, out=k)
             k *= 2 * np.pi
