@@ -477,7 +477,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     ks = sorted(discs)
     D = np.empty((len(ks), len(perm)))
     for g, k in enumerate(ks):
-        np.take(discs[k], perm, out=D[g])
+        discs[k].take(perm, out=D[g])
     ok = D > -_ZERO_DISC
     d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
     low = _low_minima(d)
