@@ -133,26 +133,40 @@ def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, cos: np.ndarray, si
     N = out.shape[1]
     for i, (k, sgn) in drive_links.items():
         np.multiply(U[:N, k], sgn, out=out[i])
-    if others:  # atan2 only for the links not driven directly
-        ang = np.arctan2(sin[others, :N], cos[others, :N])
-        if parts is not None:
-            for rows in parts:
-                if ok[rows].any():
-                    ang[:, rows] = _continuous_angles(ang[:, rows], ref, ok[rows], None, fresh=True)
-        elif ok is None or ok.any():
-            ang = _continuous_angles(ang, ref, ok, split, fresh=True)
+    if not isinstance(others, slice) and not others:
+        return
+    # atan2 only for the links not driven directly (a range of links: into out itself)
+    ang = np.arctan2(sin[others, :N], cos[others, :N], out=out[others] if isinstance(others, slice) else None)
+    if parts is not None:
+        for rows in parts:
+            if ok[rows].any():
+                _continuous_angles(ang[:, rows], ref, ok[rows], None, fresh=True)
+    elif ok is None or ok.any():
+        _continuous_angles(ang, ref, ok, split, fresh=True)
+    if not isinstance(others, slice):
         out[others] = ang
 
 
 def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
-    """The links turned by frame drivers, the others and their drawn angles (m, 1), kept
-    with the system."""
+    """The links turned by frame drivers, the others (a slice when they are a range)
+    and their drawn angles (m, 1), kept with the system; the links (the topology's) in
+    ``S.cache["programs"]``, which a refilled geometry shares
+    (:func:`~mechsyn.kinematics.refill.with_geometry`)."""
     memo = _memo(S)
-    hit = memo.get(("angles", id(plan)))
+    key = ("angles", id(plan))
+    hit = memo.get(key)
     if hit is None or hit[0] is not plan:
-        drive_links = _drive_links(S, plan)
-        others = [i for i in range(len(S.links)) if i not in drive_links]
-        hit = memo[("angles", id(plan))] = (plan, (drive_links, others, S.q0[[3 * i + 2 for i in others]][:, None]))
+        shared = S.cache.setdefault("programs", {})
+        top = shared.get(key)
+        if top is None or top[0] is not plan:
+            drive_links = _drive_links(S, plan)
+            others = [i for i in range(len(S.links)) if i not in drive_links]
+            cols = [3 * i + 2 for i in others]
+            if others and others == list(range(others[0], others[-1] + 1)):
+                others = slice(others[0], others[-1] + 1)
+            top = shared[key] = (plan, drive_links, others, cols)
+        _, drive_links, others, cols = top
+        hit = memo[key] = (plan, (drive_links, others, S.q0[cols][:, None]))
     return hit[1]
 
 

@@ -71,14 +71,16 @@ def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
     out = p if inplace else np.array(p, float)
     if p.shape[-1] > 1:
         k = np.subtract(p[..., 1:], p[..., :-1])
+        if not k.size or (k.max() <= math.pi and k.min() >= -math.pi):  # no step over half a turn
+            return out
         k /= 2 * np.pi
         np.rint(k, out=k)
-        jumps = np.flatnonzero(k)
+        jumps = np.flatnonzero(k)  # (NaN counts as a jump)
         if len(jumps) > 16:  # many turns: count them all at once
             np.cumsum(k, axis=-1, out=k)
             k *= 2 * np.pi
             out[..., 1:] -= k
-        else:  # a few: each shifts the rest of its row
+        elif len(jumps):  # a few: each shifts the rest of its row
             o2, k2 = out.reshape(-1, out.shape[-1]), k.reshape(-1, k.shape[-1])
             for j in jumps.tolist():
                 row, col = divmod(j, k2.shape[1])
@@ -95,30 +97,56 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
     ``split``: the sweep (assembled throughout) was run outwards from the drawn
     configuration, between rows ``split - 1`` and ``split``: both rows start near
     ``ref`` and the angles are unwrapped away from them (as two runs would be).
-    ``fresh``: ``phi`` (m, N) is a work array the angles may be written into."""
+    ``fresh``: ``phi`` (m, N) is a work array of ``atan2`` angles the answer is written
+    into (the answer is ``phi`` itself)."""
     if ref.ndim == 1:
         return _continuous_angles(phi.T, ref[:, None], ok, split).T
+    refs = ref[:, 0].tolist()
     if ok is None or ok.all():  # one run: unwrap, then put the start row(s) next to ref
         block = _unwrap_rows(phi, inplace=fresh)
         parts = ((0, slice(None)),) if split is None else ((split, slice(split, None)), (split - 1, slice(0, split)))
         for row, rows in parts:  # the few start values on floats (the numbers of _wrap)
-            for i, (a, b, r0) in enumerate(zip(phi[:, row].tolist(), block[:, row].tolist(), ref[:, 0].tolist())):
+            got = block[:, row].tolist()
+            for i, (a, b, r0) in enumerate(zip(got if block is phi else phi[:, row].tolist(), got, refs)):
                 near = r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi)
                 turns = round((b - near) / (2 * math.pi))
                 if turns:
                     block[i, rows] -= 2 * math.pi * turns
         return block
-    sub = ref + _wrap(phi - ref)
+    if fresh:  # ref + _wrap(phi - ref), in place (elementwise: on a backward sweep's rows forwards)
+        sub = phi[:, ::-1] if phi.strides[1] < 0 else phi
+        np.subtract(sub, ref, out=sub)
+        sub += np.pi
+        if all(-math.pi <= r <= math.pi for r in refs):
+            # phi of atan2 and ref within half a turn: sub in [-pi, 3 pi], so the remainder
+            # is one step of 2 pi or none (a step down exact: Sterbenz), as np.remainder
+            # takes it (fmod, then + 2 pi when negative), without its division
+            # (each step only when some angle needs it: fmax, fmin pass over NaN gaps)
+            if np.fmax.reduce(sub, axis=None) >= 2 * np.pi:
+                np.subtract(sub, 2 * np.pi, out=sub, where=sub >= 2 * np.pi)
+            if np.fmin.reduce(sub, axis=None) < 0.0:
+                np.add(sub, 2 * np.pi, out=sub, where=sub < 0.0)
+        else:
+            np.remainder(sub, 2 * np.pi, out=sub)
+        sub -= np.pi
+        np.add(ref, sub, out=sub)
+        sub = phi
+    else:
+        sub = ref + _wrap(phi - ref)
     # the runs of assembled rows [a, b): each unwrapped in place, then shifted by whole
-    # turns to follow the run before
+    # turns to follow the run before (on floats: a run's first angles are not changed by
+    # its unwrapping)
     edges = np.flatnonzero(ok[1:] != ok[:-1])
     bounds = ([0] if ok[0] else []) + (edges + 1).tolist() + ([len(ok)] if ok[-1] else [])
     prev = None
     for a, b in zip(bounds[0::2], bounds[1::2]):
         block = _unwrap_rows(sub[:, a:b], inplace=True)
         if prev is not None:
-            block -= 2 * np.pi * np.round((block[:, :1] - prev) / (2 * np.pi))
-        prev = block[:, -1:]
+            for i, (x, y) in enumerate(zip(block[:, 0].tolist(), prev)):
+                turns = round((x - y) / (2 * math.pi))
+                if turns:
+                    block[i] -= 2 * math.pi * turns
+        prev = block[:, -1].tolist()
     return sub
 
 

@@ -25,7 +25,7 @@ tracked outward sweeps (tests check both agree), at the cost of one pass.
 :func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
 local minimum under 0.05 (no change or branch point near: every group keeps its drawn
 mode), and reads the folds, reassembly and singular rows of the tracked sweeps off the
-discriminant arrays (:func:`mechsyn.kinematics.tracking.fold_events`).
+discriminant arrays (:func:`mechsyn.kinematics.tracking.pass_fold_events`).
 """
 
 from __future__ import annotations
@@ -37,8 +37,7 @@ import numpy as np
 from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
 from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
-from mechsyn.kinematics.tracking import (REGULAR_DISC, _regular_rows, _sweep_events, fold_events, touch_candidates,
-                                         tracking_path)
+from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows, pass_fold_events, tracking_path
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
@@ -364,7 +363,6 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
     steps, anchor, origin = _program(S, plan)
-    N = U.shape[0]
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
     u0 = np.array([d.assembled for d in S.drivers], float)
     paths = [tracking_path(S, p[0], u0) for p in parts]
@@ -372,24 +370,9 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
-    order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
-    # the tracked sweeps' rows (:func:`mechsyn.kinematics.tracking._tracking_rows`)
-    tracks = [(np.concatenate([path, p - shift]), path.shape[0], shift) for (path, shift), p in zip(paths, parts)]
-    rows, start = [], N  # each sweep's rows of the pass: its connecting path, then its inputs
-    for (_, n0, _), idx in zip(tracks, order):
-        rows.append(np.concatenate([np.arange(start, start + n0), idx]))
-        start += n0
-    ks = sorted(st.discs)
-    D = np.stack([st.discs[k] for k in ks])
-    parts = [D[:, r] for r in rows]
-    if any(touch_candidates(P).size for P in parts):
-        return None
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = []
-    for (X, n0, shift), P in zip(tracks, parts):
-        events, singular, _ = fold_events(S, plan, ks, sigmas, X, P, n0)
-        out.append((singular[n0:], _sweep_events(events, n0, shift)))
-    return Folded(*_fold_poses(S, plan, U, st, origin, split), out)
+    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+    return None if out is None else Folded(*_fold_poses(S, plan, U, st, origin, split), out)
 
 
 def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
@@ -437,14 +420,32 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
         q, qd, qdd, _ = _compiled_poses(S, plan, U, st, split, True)
         return q.T, qd.T, qdd.T
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
-    ok = np.isfinite(C[0]).all(axis=0)
+    fin = np.isfinite(C[0].view(float)).all(axis=0)  # every link's rotation: real and imaginary parts
+    ok = fin[0::2] & fin[1::2]
     parts = (slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))
     _link_angles(S, plan, U, C[0].real, C[0].imag, ok, q[2::3], parts=parts)
-    bad = ~ok | ~(np.isfinite(qd).all(axis=0) & np.isfinite(qdd).all(axis=0))
-    q[:, ~ok] = np.nan
-    qd[:, bad] = np.nan
-    qdd[:, bad] = np.nan
+    rates = np.isfinite(qd).all(axis=0)
+    rates &= np.isfinite(qdd).all(axis=0)
+    _blank((q, qd, qdd), ok)
+    rates |= ~ok  # the rows where rates are not defined though the group is assembled (folded flat)
+    _blank((qd, qdd), rates)
     return q.T, qd.T, qdd.T
+
+
+def _blank(arrays: tuple, keep: np.ndarray) -> None:
+    """NaN into the columns of ``arrays`` (n, N) where ``keep`` (N,) is false: by runs of
+    columns (a sweep's gaps are a few runs), or all at once when there are many."""
+    if keep.all():
+        return
+    edges = np.flatnonzero(keep[1:] != keep[:-1]).tolist()
+    if len(edges) > 16:
+        for a in arrays:
+            np.copyto(a, np.nan, where=~keep)
+        return
+    bounds = ([] if keep[0] else [0]) + [e + 1 for e in edges] + ([] if keep[-1] else [len(keep)])
+    for a, b in zip(bounds[0::2], bounds[1::2]):
+        for x in arrays:
+            x[:, a:b] = np.nan
 
 
 def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:

@@ -10,6 +10,7 @@ whose velocity is continuous (``change_points="keep"``) or takes the other one
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -21,7 +22,7 @@ from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates", "touch_candidates",
-           "fold_events", "tracking_path"]
+           "fold_events", "pass_fold_events", "tracking_path"]
 
 
 #: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
@@ -36,35 +37,46 @@ SINGULAR_DISC = 1e-12
 #: Relative size of the negative discriminant still taken as zero (round-off).
 _ZERO_DISC = 1e-12
 
+#: The longest step of a connecting path's R inputs.
+_DEGREE = math.radians(1.0)
 
-def _shifted_start(S: PlanarSystem, u0: np.ndarray, u_first: np.ndarray) -> np.ndarray:
-    """The first input moved by whole turns (R inputs) to the value nearest the drawn one."""
-    out = np.array(u_first, float)
-    for k, d in enumerate(S.drivers):
-        if d.type == "R":  # a decision per driver: on floats
-            out[k] -= 2 * math.pi * round((float(u_first[k]) - float(u0[k])) / (2 * math.pi))
+
+def _turned(kinds: tuple, u0: list, first: list) -> list:
+    """The first input values ``first`` moved by whole turns (R inputs, ``kinds`` the
+    drivers' types) to the values nearest the drawn ones ``u0`` (lists of floats)."""
+    return [b - 2 * math.pi * round((b - a) / (2 * math.pi)) if kind == "R" else b
+            for a, b, kind in zip(u0, first, kinds)]
+
+
+def _connecting_path(kinds: tuple, scale: float, u0: list, u1: list, max_rows: int = 4000) -> np.ndarray:
+    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded; lists of floats) in
+    steps of at most 1 degree (R) or 1 % of the mechanism's size ``scale`` (P)."""
+    most = max(abs(b - a) / (_DEGREE if kind == "R" else 0.01 * scale) for a, b, kind in zip(u0, u1, kinds))
+    n = int(min(max_rows, max(1, math.ceil(most))))
+    if n == 1:  # the drawn values themselves (t = 0)
+        return np.array([u0])
+    t = np.arange(n) / n
+    out = np.empty((n, len(u0)))
+    for k, (a, b) in enumerate(zip(u0, u1)):  # u0 + t (u1 - u0), column by column
+        np.multiply(t, b - a, out=out[:, k])
+        out[:, k] += a
     return out
 
 
-def _connecting_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray, max_rows: int = 4000) -> np.ndarray:
-    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded) in steps of at most
-    1 degree (R) or 1 % of the mechanism's size (P)."""
-    steps = (abs(float(b) - float(a)) / (math.radians(1.0) if d.type == "R" else 0.01 * S.scale)
-             for a, b, d in zip(u0, u1, S.drivers))
-    n = int(min(max_rows, max(1, math.ceil(max(steps)))))
-    if n == 1:  # the drawn values themselves (t = 0)
-        return np.array(u0, float)[None, :]
-    t = np.arange(n) / n
-    return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
+def _kinds(S: PlanarSystem) -> tuple[tuple, float]:
+    """The drivers' types and the size the connecting paths' P steps are measured by."""
+    kinds = tuple(d.type for d in S.drivers)
+    return kinds, (S.scale if "P" in kinds else 1.0)
 
 
 def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
     """The rows ``U`` followed by the connecting paths from the drawn input values to the
     sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
     else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
-    u0 = np.array([d.assembled for d in S.drivers], float)
+    kinds, scale = _kinds(S)
+    u0 = [float(d.assembled) for d in S.drivers]
     ends = [0] if split is None else [split, split - 1]
-    return np.concatenate([U] + [_connecting_path(S, u0, _shifted_start(S, u0, U[e])) for e in ends])
+    return np.concatenate([U] + [_connecting_path(kinds, scale, u0, _turned(kinds, u0, U[e].tolist())) for e in ends])
 
 
 #: Smallest normalised discriminant of every group over a sweep for which
@@ -180,11 +192,22 @@ def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = No
     input values are ``first``, and the whole turns ``shift`` the sweep is tracked
     shifted by (R inputs a whole number of turns from the drawn values are the same
     configurations: the sweep is tracked next to the drawn values, so that its rows
-    follow each other); ``u0``: the drawn input values when known."""
-    if u0 is None:
-        u0 = np.array([d.assembled for d in S.drivers], float)
-    shift = first - _shifted_start(S, u0, first)
-    return _connecting_path(S, u0, first - shift), shift
+    follow each other); ``u0``: the drawn input values when known. Both arrays are
+    read-only: a sweep of the same first inputs from the same drawn values (a cached or
+    a refilled geometry: the path does not depend on the links) takes them again."""
+    a = [float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist()
+    return _tracking_path(*_kinds(S), tuple(a), tuple(first.tolist()))
+
+
+@functools.lru_cache(maxsize=256)
+def _tracking_path(kinds: tuple, scale: float, u0: tuple, first: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`tracking_path` of the drivers' types ``kinds`` and the size ``scale``."""
+    shift = [b - c for b, c in zip(first, _turned(kinds, u0, first))]  # the numbers of first - (first - turns)
+    path = _connecting_path(kinds, scale, list(u0), [b - c for b, c in zip(first, shift)])
+    out = path, np.array(shift)
+    for x in out:
+        x.setflags(write=False)
+    return out
 
 
 def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
@@ -203,16 +226,23 @@ def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n
 
 def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
     """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
-    events = []
+    sh = shift.tolist()
+    out = []
     for e in raw_events:
-        if e.index < n0:  # on the way from the drawn configuration to the sweep
-            e = e.with_(message="between the drawn configuration and the first input: " + e.message,
-                        before_sweep=True)
-        e = e.with_(index=max(0, e.index - n0))
-        if not e.before_sweep:
-            e = e.with_(input=(np.asarray(e.input) + shift).tolist())
-        events.append(e)
-    return events
+        index, message, u, before = _swept(e.index, e.message, e.input, n0, sh, e.before_sweep)
+        out.append(e.with_(index=index, message=message, input=u, before_sweep=before))
+    return out
+
+
+def _swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | None = None) -> tuple:
+    """An event's row, message, input and ``before_sweep`` along the sweep from its row
+    ``i`` of the tracked rows (the first ``n0`` the connecting path, the rest the sweep
+    shifted by the whole turns ``shift``): :func:`_sweep_events` of one event."""
+    if i < n0:  # on the way from the drawn configuration to the sweep
+        message, before = "between the drawn configuration and the first input: " + message, True
+    if not before:
+        u = [x + s for x, s in zip(u, shift)]
+    return max(0, i - n0), message, u, before
 
 
 def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -298,16 +328,17 @@ def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
     return math.nan
 
 
-def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i0: int, i1: int):
-    """Discriminant of step ``k`` on the segment of inputs from row ``i0`` (t = 0) to row
-    ``i1`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar function."""
+def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, xa: list, xb: list, i0: int):
+    """Discriminant of step ``k`` on the segment of inputs from ``xa`` (t = 0, row ``i0``)
+    to ``xb`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar
+    function (on floats for a driver-R + RRR chain: the numbers of ``xa + t (xb - xa)``)."""
+    dx = [b - a for a, b in zip(xa, xb)]
     if plan.closed_form_rates:
         prog = _scalar_program(S, plan)
         sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
-        x0, dx = X[i0], X[i1] - X[i0]
-        return lambda t: _scalar_disc(prog, k, sig, x0 + t * dx)
+        return lambda t: _scalar_disc(prog, k, sig, [a + t * d for a, d in zip(xa, dx)])
     rows = np.array([i0])
-    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, (X[i0] + t * (X[i1] - X[i0]))[None])[0])
+    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, np.array([[a + t * d for a, d in zip(xa, dx)]]))[0])
 
 
 def touch_candidates(disc: np.ndarray) -> np.ndarray:
@@ -315,9 +346,17 @@ def touch_candidates(disc: np.ndarray) -> np.ndarray:
     touch zero: its local minima under 0.05 among the rows where it is assembled (the
     candidates of a change or branch point, decided by :func:`_touch`); of several groups
     (rows of ``disc``): any candidate shows (the flat indices are not rows then)."""
-    d = np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan)
+    return np.flatnonzero(_low_minima(np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan))) + 1
+
+
+def _low_minima(d: np.ndarray) -> np.ndarray:
+    """Where (the inner rows, ``d[..., 1:-1]``) the discriminants ``d`` (NaN where not
+    assembled, else at least 0) have a local minimum under 0.05."""
     mid = d[..., 1:-1]
-    return np.flatnonzero((mid <= d[..., :-2]) & (mid <= d[..., 2:]) & (mid < 0.05)) + 1
+    out = mid < 0.05
+    out &= mid <= d[..., :-2]
+    out &= mid <= d[..., 2:]
+    return out
 
 
 def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.ndarray, D: np.ndarray,
@@ -332,73 +371,173 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     ``sigmas`` of the earlier row; the ends' values are ``D``'s). A group assembled at
     one row and cut off at the next by an upstream group's fold may fold first between
     the same rows: its discriminant at the upstream fold decides, and the earlier fold is
-    the limit of the working range (likewise where the assembly starts again). A row where the group assembles after rows where it
-    (or an upstream group) did not is a reassembly. Returns the events (per group in the
-    order of ``ks``: its folds, then its reassemblies, each by row), the singular rows
-    (M,) (a group folded flat within :data:`SINGULAR_DISC`) and per group the rows where
-    it reassembles."""
+    the limit of the working range (likewise where the assembly starts again). A row
+    where the group assembles after rows where it (or an upstream group) did not is a
+    reassembly. Returns the events (per group in the order of ``ks``: its folds, then its
+    reassemblies, each by row), the singular rows (M,) (a group folded flat within
+    :data:`SINGULAR_DISC`) and per group the rows where it reassembles. Every such row
+    is one where the group's assembly changes (:func:`_fold_scan`)."""
     ok = D > -_ZERO_DISC
     singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
-    finite = np.isfinite(D)
-    fold = ok[:, 1:] != ok[:, :-1]
-    fold &= finite[:, 1:]
-    fold &= finite[:, :-1]
-    back = ok[:, 1:] & ~ok[:, :-1]
-    folds = _rows_by_group(fold)
-    backs = _rows_by_group(back)
+    changes: list[list[int]] = [[] for _ in ks]
+    gs, js = np.nonzero(ok[:, 1:] != ok[:, :-1])
+    for g, j in zip(gs.tolist(), js.tolist()):
+        changes[g].append(j + 1)
+    found, resets = _fold_scan(S, plan, ks, sigmas, lambda i: X[i].tolist(), lambda g, i: float(D[g, i]), changes,
+                               n0)
+    return [Event(*e) for e in found], singular, resets
+
+
+def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, val, changes: list,
+               n0: int) -> tuple[list, list]:
+    """:func:`fold_events` from the rows where each group's assembly changes
+    (``changes[g]``: the rows ``i`` whose group ``g`` is assembled at ``i`` and not at
+    ``i - 1`` or the other way round), its discriminant ``val(g, i)`` (a float) and the
+    input rows ``row(i)`` (lists of floats): the events as ``(row, kind, message, input, group)``
+    and per group the rows where it reassembles."""
     events: list = []
     resets = []
+    seen: dict[int, list] = {}
+    row = functools.partial(_row_once, seen, row)  # the groups' folds read the same rows
     ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
     starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
+        rows, backs = [], []
+        resets.append(backs)
+        if not changes[g]:
+            continue
         group = "-".join(plan.steps[k].joints)
-        rows = [(i, 0) for i in folds[g]]
-        if ends or starts:
-            # assembled at one row and cut off by an upstream group at the next (or the
-            # other way round): its own fold may come first, hidden between the rows
-            rows += [(i, 1) for i in (np.flatnonzero(ok[g, :-1] & ~finite[g, 1:]) + 1).tolist() if i in ends]
-            rows += [(i, -1) for i in (np.flatnonzero(~finite[g, :-1] & ok[g, 1:]) + 1).tolist() if i in starts]
-        for i, hidden in sorted(rows):
-            t = _four_bar_fold(S, plan, k, X[i - 1], X[i]) if not hidden else None
+        for i in changes[g]:
+            fa, fb = val(g, i - 1), val(g, i)
+            if fb > -_ZERO_DISC:
+                backs.append(i)
+            if math.isfinite(fa) and math.isfinite(fb):  # its own fold
+                rows.append((i, 0, fa, fb))
+            elif fa > -_ZERO_DISC and i in ends:
+                # assembled at one row and cut off by an upstream group at the next (or the
+                # other way round): its own fold may come first, hidden between the rows
+                rows.append((i, 1, fa, fb))
+            elif fb > -_ZERO_DISC and i in starts:
+                rows.append((i, -1, fa, fb))
+        rows.sort()  # by row (a row is one group's once)
+        for i, hidden, fa, fb in rows:
+            xa, xb = row(i - 1), row(i)
+            t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
             if t is None:
-                f = _disc_line(S, plan, k, sigmas, X, i - 1, i)
-                t = _hidden_fold(f, float(D[g, i - 1]), float(D[g, i]), ends, starts, i, hidden)
+                t = _hidden_fold(_disc_line(S, plan, k, sigmas, xa, xb, i - 1), fa, fb, ends, starts, i, hidden)
             if t is None:
                 continue
-            inside = ok[g, i - 1] if not hidden else hidden > 0
+            inside = fa > -_ZERO_DISC if not hidden else hidden > 0
             if inside:
                 ends[i] = min(t, ends.get(i, 1.0))
             else:
                 starts[i] = max(t, starts.get(i, 0.0))
-            u = X[i - 1] + t * (X[i] - X[i - 1])
+            u = [a + t * (b - a) for a, b in zip(xa, xb)]  # the numbers of xa + t (xb - xa)
             if inside:
-                events.append(Event(i, "dead point", f"assembly ends: the group {group} folds flat (its "
-                                    "discriminant changes sign: a dead point / limit of the working range)",
-                                    u.tolist(), group))
+                events.append((i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
+                               "changes sign: a dead point / limit of the working range)", u, group))
             else:
-                events.append(Event(i, "dead point", "assembly starts again here: the other limit of a working "
-                                    "range", u.tolist(), group))
-        resets.append(backs[g])
-        for i in backs[g]:
+                events.append((i, "dead point", "assembly starts again here: the other limit of a working range",
+                               u, group))
+        for i in backs:
             if i < n0:
                 continue
-            events.append(Event(i, "reassembled", f"assembles again after a gap, in the assembly mode of the "
-                                f"drawn configuration for the group {group} (the mode nearest the drawn one)",
-                                X[i].tolist(), group))
-    return events, singular, resets
+            events.append((i, "reassembled", "assembles again after a gap, in the assembly mode of the drawn "
+                           f"configuration for the group {group} (the mode nearest the drawn one)",
+                           row(i), group))
+    return events, resets
 
 
-def _rows_by_group(mask: np.ndarray) -> list[list[int]]:
-    """The rows ``i`` (of the step from row i - 1) where ``mask`` (groups, M - 1) holds,
-    per group, from one ``nonzero``."""
-    gs, js = np.nonzero(mask)
-    out: list[list[int]] = [[] for _ in range(mask.shape[0])]
+def _row_once(seen: dict, row, i: int) -> list:
+    """``row(i)``, read once per row."""
+    x = seen.get(i)
+    if x is None:
+        x = seen[i] = row(i)
+    return x
+
+
+def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: np.ndarray, split: int | None,
+                     paths: list) -> list | None:
+    """:func:`fold_events` of the tracked sweeps of one regular pass (the sweep ``U`` (N,
+    n_inputs), then the connecting paths ``paths`` (``(path, shift)`` of
+    :func:`tracking_path`) of the one sweep, or of the sweeps forwards from row ``split``
+    and backwards from row ``split - 1``), from the groups' normalised discriminants
+    ``discs`` (step -> its values on the pass's rows), every group in its mode
+    ``sigmas``: per sweep its singular rows and events along it (:func:`_sweep_events`);
+    None when a discriminant has a local minimum under 0.05 (:func:`touch_candidates`:
+    a change point may be near).
+
+    The pass's rows are read once, laid out so that each sweep's rows follow each other
+    (the backward sweep from right to left, then the forward one): one comparison finds
+    every row where a group's assembly changes, and :func:`_fold_scan` reads only those.
+    """
+    N = U.shape[0]
+    n0s = tuple(path.shape[0] for path, _ in paths)
+    perm, b = _pass_layout(N, split, n0s)
+    ks = sorted(discs)
+    D = np.empty((len(ks), len(perm)))
+    for g, k in enumerate(ks):
+        discs[k].take(perm, out=D[g])
+    ok = D > -_ZERO_DISC
+    d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
+    low = _low_minima(d)
+    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
+    if low.any():
+        return None
+    singular = d[0] < SINGULAR_DISC  # some group assembled with D < SINGULAR_DISC
+    for row in d[1:]:
+        singular |= row < SINGULAR_DISC
+    # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
+    sweeps = [(1, paths[0], U if split is None else U[split:])]
+    if split is not None:
+        sweeps.append((-1, paths[1], U[split - 1::-1]))
+    changes: list = [[[] for _ in ks] for _ in sweeps]
+    gs, js = np.nonzero(ok[:, 1:] != ok[:, :-1])
     for g, j in zip(gs.tolist(), js.tolist()):
-        out[g].append(j + 1)
+        if j >= b:
+            changes[0][g].append(j + 1 - b)
+        elif j < b - 1:
+            changes[1][g].append(b - 1 - j)
+    for ch in changes[1:]:  # found right to left: the backward sweep's rows in its order
+        for rows in ch:
+            rows.reverse()
+    out = []
+    for (way, (path, shift), V), ch in zip(sweeps, changes):
+        n0, sh = path.shape[0], shift.tolist()
+
+        def row(i: int, path=path, sh=sh, V=V, n0=n0) -> list:  # the numbers of V[i - n0] - shift
+            return path[i].tolist() if i < n0 else [x - s for x, s in zip(V[i - n0].tolist(), sh)]
+
+        def val(g: int, i: int, way=way) -> float:
+            return float(D[g, b + i if way > 0 else b - 1 - i])
+
+        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0)
+        events = []
+        for i, kind, message, u, group in found:
+            index, message, u, before = _swept(i, message, u, n0, sh)
+            events.append(Event(index, kind, message, u, group, before_sweep=before))
+        out.append((singular[b + n0:] if way > 0 else singular[b - n0 - 1::-1], events))
     return out
 
 
-def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: np.ndarray, xb: np.ndarray) -> float | None:
+@functools.lru_cache(maxsize=64)
+def _pass_layout(N: int, split: int | None, n0s: tuple) -> tuple[np.ndarray, int]:
+    """The order of a pass's rows (the sweep's N, then the connecting paths of ``n0s``
+    rows) in which each tracked sweep's rows follow each other: ``[U[:split], path 2
+    reversed, path 1, U[split:]]`` (or ``[path, U]``), and where the forward sweep starts."""
+    if split is None:
+        perm = np.concatenate([np.arange(N, N + n0s[0]), np.arange(N)])
+        b = 0
+    else:
+        n1, n2 = n0s
+        perm = np.concatenate([np.arange(split), np.arange(N + n1 + n2 - 1, N + n1 - 1, -1), np.arange(N, N + n1),
+                               np.arange(split, N)])
+        b = split + n2
+    perm.setflags(write=False)
+    return perm, b
+
+
+def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: list, xb: list) -> float | None:
     """Where (t in [0, 1]) RRR step ``k`` folds on the segment of inputs from ``xa`` to
     ``xb``, in closed form when the group closes a four-bar: one end joint on the frame,
     the other on a crank turned by the only input about a frame pivot. The group folds

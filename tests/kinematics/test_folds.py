@@ -1,0 +1,151 @@
+"""The regular pass through folds: its fold search on the pass's rows, the link angles and
+the connecting paths give what the per-sweep computations give, to the bit."""
+
+import math
+
+import numpy as np
+import pytest
+
+from mechsyn.io import mechanism_from_dict
+from mechsyn.kinematics.analysis import cached_plan
+from mechsyn.kinematics.engines import drawn_row
+
+from kinematics_helpers import ex, fourbar_dict  # noqa: F401
+
+
+def _per_sweep(S, plan, st, U, split, paths, sigmas):
+    """The fold search sweep by sweep: each tracked sweep's rows gathered from the pass
+    (its connecting path, then its inputs shifted by whole turns), then
+    :func:`fold_events` on them (the computation ``pass_fold_events`` replaces)."""
+    from mechsyn.kinematics.tracking import _sweep_events, fold_events, touch_candidates
+
+    N = U.shape[0]
+    parts = [U] if split is None else [U[split:], U[:split][::-1]]
+    order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
+    start, out, ks = N, [], sorted(st.discs)
+    D = np.stack([st.discs[k] for k in ks])
+    tracks = []
+    for (path, shift), p, idx in zip(paths, parts, order):
+        n0 = path.shape[0]
+        tracks.append((np.concatenate([path, p - shift]), n0, shift, D[:, np.concatenate([np.arange(start, start + n0),
+                                                                                            idx])]))
+        start += n0
+    if any(touch_candidates(P).size for *_, P in tracks):
+        return None
+    for X, n0, shift, P in tracks:
+        events, singular, _ = fold_events(S, plan, ks, sigmas, X, P, n0)
+        out.append((singular[n0:], _sweep_events(events, n0, shift)))
+    return out
+
+
+def _cases(ex):
+    files = [ex("textbook/watt_sixbar.yaml"), ex("textbook/fourbar.yaml"), ex("textbook/stephenson_sixbar.yaml")]
+    # four-bars whose crank cannot turn fully (two dead points each way), drawn on both branches
+    files += [mechanism_from_dict(fourbar_dict(a=2.0, b=3.0, c=2.5, g=4.0, theta=th, branch=br))
+              for th, br in ((40.0, 1), (-30.0, -1), (100.0, 1))]
+    grids = [(0.0, 361.0, 1.0), (360.0, -1.0, -3.0), (-180.0, 541.0, 2.5), (100.0, 261.0, 4.0), (0.0, 361.0, 0.25),
+             (-800.0, 100.0, 2.5), (500.0, -300.0, -2.5)]
+    for m in files:
+        j = next(jj.id for jj in m.joints if jj.actuated)
+        kp = cached_plan(m, inputs=(j,))
+        for g in grids:
+            yield m.name, g, kp.system, kp.groups, np.radians(np.arange(*g))[:, None]
+
+
+def test_pass_fold_events_equals_the_sweeps_fold_events(ex):
+    """``pass_fold_events`` reads every tracked sweep's folds, reassembly, singular rows
+    and change-point candidates off the pass's rows laid out once; the sweep-by-sweep
+    search gives the same events (every field, every bit) and singular rows, forwards,
+    backwards, over several turns and where the drawn input lies outside the sweep."""
+    from mechsyn.kinematics import regular, tracking
+
+    folded = backward = 0
+    for name, g, S, plan, U in _cases(ex):
+        split = drawn_row(S, U)
+        steps, anchor, _ = regular._program(S, plan)
+        parts = [U] if split is None else [U[split:], U[:split][::-1]]
+        paths = [tracking.tracking_path(S, p[0]) for p in parts]
+        st = regular._run(steps, anchor, np.concatenate([U] + [p for p, _ in paths]), np.ones(1), folds=True)
+        regular._scalar_memo(S, plan, steps, anchor)
+        sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
+        got = tracking.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+        want = _per_sweep(S, plan, st, U, split, paths, sigmas)
+        assert (got is None) == (want is None), (name, g)
+        if got is None:
+            continue
+        folded += bool(sum(len(ev) for _, ev in got))
+        backward += split is not None and bool(got[1][1])
+        assert len(got) == len(want) == (1 if split is None else 2)
+        for (s1, e1), (s2, e2) in zip(got, want):
+            assert np.array_equal(s1, s2), (name, g)
+            assert [e.to_dict() for e in e1] == [e.to_dict() for e in e2], (name, g)
+    assert folded >= 20 and backward >= 5, (folded, backward)  # most pass dead points, some backwards
+
+
+def test_gap_angles_wrapped_as_np_remainder_wraps_them():
+    """The link angles of a sweep with gaps are wrapped next to the drawn angles in place
+    (``fresh``) without ``np.remainder``'s division when the drawn angles lie within half
+    a turn: the same numbers, bit for bit, as the wrap of the copying path, on atan2
+    angles including the edges (+-pi, +-0, the neighbours of pi) and NaN gaps; drawn
+    angles beyond half a turn take ``np.remainder`` itself."""
+    from mechsyn.kinematics.positions import _continuous_angles
+
+    rng = np.random.default_rng(7)
+    edges = np.array([math.pi, -math.pi, 0.0, -0.0, np.nextafter(math.pi, 0), np.nextafter(-math.pi, 0), 1e-300])
+    for trial in range(300):
+        m, n = 3, 80
+        phi = np.arctan2(rng.normal(size=(m, n)), rng.normal(size=(m, n)))
+        phi.flat[rng.integers(0, m * n, 25)] = rng.choice(edges, 25)
+        ok = np.ones(n, bool)
+        for a in rng.integers(1, n - 1, 3):  # gaps: their rows not assembled
+            ok[a:a + rng.integers(1, 9)] = False
+        phi[:, ~ok] = np.where(rng.random((m, 1)) < 0.5, np.nan, phi[:, ~ok])  # upstream links stay finite
+        ref = rng.choice(np.concatenate([rng.uniform(-math.pi, math.pi, 4), edges,
+                                         [4.0, -7.0] if trial % 3 == 0 else []]), (m, 1))
+        want = _continuous_angles(phi.T.copy(), ref[:, 0], ok).T  # the copying path (np.remainder)
+        got = _continuous_angles(phi.copy(), ref, ok, fresh=True)
+        runs = np.flatnonzero(ok)
+        assert np.array_equal(got[:, runs].view(np.int64), want[:, runs].view(np.int64)), trial
+
+
+def test_tracking_path_is_kept_and_read_only():
+    """A tracking path depends on the drivers' types, the drawn and the first input values
+    only: a refilled geometry takes the same (read-only) arrays; the path steps at most 1
+    degree towards the first inputs moved by whole turns next to the drawn ones."""
+    from mechsyn.kinematics.tracking import tracking_path
+
+    m = mechanism_from_dict(fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0))
+    S = cached_plan(m, inputs=("A",)).system
+    u0 = math.radians(60.0)
+    first = np.array([u0 + 4 * math.pi + 0.1])  # two turns on, 5.73 degrees beyond the drawn angle
+    path, shift = tracking_path(S, first)
+    assert shift.tolist() == [first[0] - (first[0] - 4 * math.pi)]
+    assert path.shape == (6, 1) and path[0, 0] == u0
+    assert np.all(np.diff(path[:, 0]) <= math.radians(1.0) + 1e-15)
+    assert abs(path[-1, 0] + (path[1, 0] - path[0, 0]) - (first[0] - shift[0])) < 1e-14
+    with pytest.raises(ValueError):
+        path[0, 0] = 0.0
+    moved = mechanism_from_dict(fourbar_dict(a=1.0, b=3.6, c=2.9, g=4.1, theta=60.0))
+    again = tracking_path(cached_plan(moved, inputs=("A",)).system, first)
+    assert again[0] is path and again[1] is shift
+    assert tracking_path(S, np.array([u0]))[0].shape == (1, 1)  # at the drawn input: the drawn values
+
+
+def test_blank_equals_mask_assignment():
+    """The gaps' NaN written by runs of columns (few runs) or by one masked copy (many):
+    what boolean-mask assignment writes."""
+    from mechsyn.kinematics.regular import _blank
+
+    rng = np.random.default_rng(3)
+    for runs in (0, 1, 3, 40):
+        keep = np.ones(200, bool)
+        for a in rng.integers(0, 200, runs):
+            keep[a:a + rng.integers(1, 4)] = False
+        for ends in ((), (0,), (199,), (0, 199)):
+            k = keep.copy()
+            k[list(ends)] = False
+            a, b = rng.normal(size=(5, 200)), rng.normal(size=(3, 200))
+            wa, wb = a.copy(), b.copy()
+            wa[:, ~k], wb[:, ~k] = np.nan, np.nan
+            _blank((a, b), k)
+            assert np.array_equal(a, wa, equal_nan=True) and np.array_equal(b, wb, equal_nan=True)
