@@ -169,3 +169,28 @@ def test_one_shot_commands_keep_the_numpy_pass(monkeypatch):
     assert main(["simulate", "examples/kinematics/crank_rocker.yaml", "-i", "A=0:360:10"]) == 0
     assert seen and not any(seen)
     assert kernel.active()
+
+
+@pytest.mark.parametrize("name", ["watt_sixbar", "fourbar", "stephenson_sixbar", "peaucellier", "crank_rocker"])
+def test_fold_masks_compiled_equal_numpy(name):
+    """The fold search's masks (layout, singular rows, assembly changes, a low minimum
+    that sends the chain to the tracked engine) compiled and in NumPy, on passes through
+    dead points, a cell whose change points the pass declines, and one without folds."""
+    from mechsyn.kinematics import tracking
+
+    m = ms.examples.load(name)
+    kp = cached_plan(m)
+    S, plan = kp.system, kp.groups
+    steps, anchor, origin = regular._program(S, plan)
+    for grid in (np.arange(0.0, 361.0), np.arange(-400.0, 400.0, 3.0)):
+        X = np.radians(grid)[:, None]
+        st = regular._run(steps, anchor, X, np.ones(1), folds=True)
+        ks = sorted(st.discs)
+        M = X.shape[0]
+        for split, n0s in ((None, (7,)), (M // 3, (5, 9))):
+            rows = M - sum(n0s)
+            perm, b = tracking._pass_layout(rows, split, n0s)
+            a = tracking._fold_rows(st.discs, ks, perm, b)
+            c = kernel.fold_rows([st.discs[k] for k in ks], perm, b, tracking._ZERO_DISC, tracking.SINGULAR_DISC)
+            assert np.array_equal(a[0], c[0], equal_nan=True) and np.array_equal(a[1], c[1])
+            assert all(np.array_equal(x, y) for x, y in zip(a[2], c[2])) and a[3] == c[3]

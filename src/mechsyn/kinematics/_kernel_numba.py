@@ -248,3 +248,42 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
                     qd[c, r] = math.nan
                     qdd[c, r] = math.nan
     return ok
+
+
+@njit(**_OPTIONS)
+def fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg):  # pragma: no cover - compiled
+    """The regular pass's discriminants ``Dp`` (groups, pass rows) laid out in the tracked
+    sweeps' order ``perm`` into ``Dl`` (groups, L), the rows where some assembled group is
+    within ``sing`` of folding flat (``singular`` (L,)), the rows after which a group's
+    assembly changes (``chg`` (groups, L - 1): assembled means ``D > -zero``), and whether
+    an assembled group's discriminant has a local minimum under 0.05 on an inner row of a
+    sweep (rows ``b - 1`` and ``b``, the sweeps' first, are not inner):
+    :func:`mechsyn.kinematics.tracking.pass_fold_events`'s masks in one loop."""
+    ng, L = Dl.shape
+    for t in range(L):
+        singular[t] = False
+    low = False
+    for g in range(ng):
+        for t in range(L):
+            Dl[g, t] = Dp[g, perm[t]]
+        prev_ok = False
+        for t in range(L):
+            x = Dl[g, t]
+            ok = x > -zero
+            if ok and max(x, 0.0) < sing:
+                singular[t] = True
+            if t >= 1:
+                chg[g, t - 1] = ok != prev_ok
+            prev_ok = ok
+        for t in range(1, L - 1):
+            if t == b - 1 or t == b:
+                continue
+            x = Dl[g, t]
+            if not x > -zero:
+                continue
+            m = max(x, 0.0)
+            if m < 0.05:
+                a, c = Dl[g, t - 1], Dl[g, t + 1]
+                if a > -zero and c > -zero and m <= max(a, 0.0) and m <= max(c, 0.0):
+                    low = True
+    return low

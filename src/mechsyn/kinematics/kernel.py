@@ -45,7 +45,7 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["active", "link_poses", "program_arrays", "run", "warm"]
+__all__ = ["active", "fold_rows", "link_poses", "program_arrays", "run", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 
@@ -179,3 +179,18 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
     ok = _compiled().link_poses(C, W, AL, N, np.ascontiguousarray(U, float), dcol, dsgn, ref,
                                 -1 if split is None else split, folds, A, q, qd, qdd)
     return q, qd, qdd, ok
+
+
+def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc: float) -> tuple | None:
+    """:func:`mechsyn.kinematics.tracking.pass_fold_events`'s masks compiled: the
+    discriminants ``discs`` (one array per group, the pass's rows) laid out by ``perm``
+    (groups, L), the singular rows (L,), the (group, row) pairs after which a group's
+    assembly changes, and whether a change point may be near (a low local minimum);
+    None without the kernel."""
+    mod = _compiled()
+    if mod is None:
+        return None
+    ng, L = len(discs), perm.shape[0]
+    Dl, singular, chg = np.empty((ng, L)), np.empty(L, np.bool_), np.empty((ng, max(L - 1, 0)), np.bool_)
+    low = mod.fold_rows(np.array(discs), perm, b, zero, singular_disc, Dl, singular, chg)
+    return Dl, singular, np.nonzero(chg), bool(low)

@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 
+from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _poses_from_chain, fast_chain
 from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, circle_circle, normalised_disc
 from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _solve_step
@@ -475,24 +476,18 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    D = np.empty((len(ks), len(perm)))
-    for g, k in enumerate(ks):
-        discs[k].take(perm, out=D[g])
-    ok = D > -_ZERO_DISC
-    d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
-    low = _low_minima(d)
-    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
-    if low.any():
+    masks = kernel.fold_rows([discs[k] for k in ks], perm, b, _ZERO_DISC, SINGULAR_DISC)  # compiled
+    if masks is None:
+        D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
+    else:
+        D, singular, (gs, js), low = masks
+    if low:
         return None
-    singular = d[0] < SINGULAR_DISC  # some group assembled with D < SINGULAR_DISC
-    for row in d[1:]:
-        singular |= row < SINGULAR_DISC
     # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
     sweeps = [(1, paths[0], U if split is None else U[split:])]
     if split is not None:
         sweeps.append((-1, paths[1], U[split - 1::-1]))
     changes: list = [[[] for _ in ks] for _ in sweeps]
-    gs, js = np.nonzero(ok[:, 1:] != ok[:, :-1])
     for g, j in zip(gs.tolist(), js.tolist()):
         if j >= b:
             changes[0][g].append(j + 1 - b)
@@ -518,6 +513,23 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
             events.append(Event(index, kind, message, u, group, before_sweep=before))
         out.append((singular[b + n0:] if way > 0 else singular[b - n0 - 1::-1], events))
     return out
+
+
+def _fold_rows(discs: dict, ks: list, perm: np.ndarray, b: int) -> tuple:
+    """The masks of :func:`pass_fold_events` in NumPy (:func:`mechsyn.kinematics.kernel.fold_rows`
+    compiled): the discriminants laid out (groups, L), the singular rows, the (group,
+    row) pairs after which a group's assembly changes, whether a change point may be near."""
+    D = np.empty((len(ks), len(perm)))
+    for g, k in enumerate(ks):
+        discs[k].take(perm, out=D[g])
+    ok = D > -_ZERO_DISC
+    d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
+    low = _low_minima(d)
+    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
+    singular = d[0] < SINGULAR_DISC  # some group assembled with D < SINGULAR_DISC
+    for row in d[1:]:
+        singular |= row < SINGULAR_DISC
+    return D, singular, np.nonzero(ok[:, 1:] != ok[:, :-1]), bool(low.any())
 
 
 @functools.lru_cache(maxsize=64)
