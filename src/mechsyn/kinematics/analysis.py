@@ -245,60 +245,18 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
                    points: list[str] | None, method: str, progress: Any, change_points: str = "keep") -> Simulation:
-    mech, S = kp.mechanism, kp.system
     if change_points not in ("keep", "switch"):
         raise MechsynInputError(f"change_points must be 'keep' or 'switch', not {change_points!r}",
                                 field="change_points")
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
-    if tuple(j for j in inputs if _is_passive(mech, j, kp.vll)) != kp.prescribed:
-        kp = compile_plan(mech, kp.vll, tuple(inputs))
-        S = kp.system
-    drivers = [d.joint for d in S.drivers]
-    lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
-    if len(lengths) != 1:
-        raise MechsynInputError("all inputs need the same number of values", field="inputs")
-    N = lengths.pop()
-    if N == 0:
-        raise MechsynInputError("the input range is empty", field="inputs")
-    U = np.empty((N, len(S.drivers)))
-    U[:] = [d.assembled for d in S.drivers]
-    types: dict[str, str] = {}
-    for jid, vals in inputs.items():
-        if jid not in drivers:
-            try:
-                j = mech.joint(jid)
-            except KeyError:
-                raise MechsynInputError(f"no joint {jid!r}", field="inputs",
-                                        hint=f"driven joints: {', '.join(drivers) or '(none)'}") from None
-            raise MechsynInputError(
-                f"joint {jid} ({j.type}) is not driven", field="inputs",
-                hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
-        k = drivers.index(jid)
-        vals = np.asarray(vals, float)
-        if not np.isfinite(vals).all():
-            raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
-        d = S.drivers[k]
-        if d.type == "R":
-            np.radians(vals, out=U[:, k])
-        else:
-            U[:, k] = vals
-        types[jid] = d.type
-        lim = mech.joint(jid).limits if d.type == "P" else None
-        if lim is not None and (vals.min() < lim[0] - 1e-12 * S.scale or vals.max() > lim[1] + 1e-12 * S.scale):
-            raise MechsynInputError(
-                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
-                hint="keep the VLL length within its limits")
-    sp = np.zeros(len(drivers))
-    speeds = dict(speeds or {})
-    for jid in speeds:
-        if jid not in inputs:
-            raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
-    for jid in inputs:
-        sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
-    if not all(math.isfinite(v) for v in sp.tolist()):
-        raise MechsynInputError("input speeds must be finite numbers", field="speeds",
-                                hint="give each driven joint's speed in rad/s (R) or length/s (P)")
+    spec = _input_spec(kp, tuple(inputs))
+    if spec.prescribed != kp.prescribed:
+        kp = compile_plan(kp.mechanism, kp.vll, tuple(inputs))
+        spec = _input_spec(kp, tuple(inputs))
+    mech, S = kp.mechanism, kp.system
+    vals, U = _input_rows(S, spec, inputs)
+    sp, speed_of = _input_speeds(spec, inputs, speeds)
     named = _named_points(S, mech, points)
     plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
@@ -310,8 +268,6 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if plan is not None and not drawn_checks(S, plan):
         assemble(S)  # checks the file configuration and the mobility
     sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
-    events = list(sw.events)
-    used = sw.method
     ok = sw.assembled
     complete = sw.links is not None
     if complete:  # the regular pass without folds: every row assembled with finite rates
@@ -319,6 +275,26 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     else:
         rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
         singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
+    events = _with_singular_rows(S, sw, singular_rows)
+    deg = np.degrees(sw.q.T[2::3], order="C")  # every link's angle in one call, rows contiguous
+    links = {name: LinkMotion(deg[i], sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2]) for i, name in enumerate(S.links)}
+    pm = _point_motions(S, sw, named, ok, rates_ok, complete)
+    notes = list(S.notes)
+    if singular_configuration(S):
+        notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
+                     "position): the assembly branch chosen from it is arbitrary")
+    if spec.limited:
+        events.extend(_limit_events(S, sw))
+    return Simulation(
+        mechanism=mech.name, inputs=vals, input_types=spec.types, speeds=speed_of, assembled=ok, points=pm,
+        links=links, events=events, method=sw.method, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw,
+        system=S)
+
+
+def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) -> list[Event]:
+    """The sweep's events, a ``singular`` event added at every assembled row whose rates
+    are not defined and that no event flags yet, by row, in input units."""
+    events = list(sw.events)
     flagged = {e.index for e in events if e.kind == "singular" and not e.before_sweep}
     for k in singular_rows:
         if k in flagged:
@@ -326,20 +302,131 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                             "accelerations are not defined here (null)", sw.inputs[k].tolist()))
     events.sort(key=lambda e: e.index)
-    links = {}
-    for i, name in enumerate(S.links):
-        links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
-    pm = _point_motions(S, sw, named, ok, rates_ok, complete)
-    events = [_event_units(S, e) for e in events]
-    notes = list(S.notes)
-    if singular_configuration(S):
-        notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
-                     "position): the assembly branch chosen from it is arbitrary")
-    events.extend(_limit_events(S, sw))
-    return Simulation(
-        mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
-        speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
-        events=events, method=used, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+    return [_event_units(S, e) for e in events]
+
+
+@dataclass(frozen=True)
+class _InputSpec:
+    """What a plan's sweep needs to know of the joints given input values (``names``),
+    found once per plan and names (:func:`_input_spec`): the prescribed passive VLLs among
+    them, each one's driver index, type and limits (P) or the error it is (not a joint,
+    not driven), the drivers' joints and drawn values; ``limited``: a P joint of the
+    mechanism has limits (its VLL events are looked for)."""
+
+    names: tuple
+    prescribed: tuple
+    index: tuple          # per name: driver index, or the MechsynInputError to raise
+    types: dict
+    limits: tuple         # per name: (lo, hi) of a P input with limits, else None
+    drivers: tuple
+    u0: tuple
+    limited: bool
+
+    @property
+    def driven(self) -> bool:
+        """Every input is a driven joint."""
+        return all(isinstance(k, int) for k in self.index)
+
+
+def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
+    """The :class:`_InputSpec` of ``kp`` for the inputs ``names``, kept with its system."""
+    mech, S = kp.mechanism, kp.system
+    key = ("input spec", names)
+    hit = S.cache.get(key)
+    if hit is not None and hit[0] is mech and hit[1] is kp.vll:
+        return hit[2]
+    drivers = tuple(d.joint for d in S.drivers)
+    index, types, limits = [], {}, []
+    for jid in names:
+        lim = None
+        if jid in drivers:
+            k = drivers.index(jid)
+            index.append(k)
+            types[jid] = S.drivers[k].type
+            if types[jid] == "P":
+                lim = mech.joint(jid).limits
+        else:
+            index.append(_not_driven(mech, jid, drivers))
+        limits.append(None if lim is None else (float(lim[0]), float(lim[1])))
+    spec = _InputSpec(names, tuple(j for j in names if _is_passive(mech, j, kp.vll)), tuple(index), types,
+                      tuple(limits), drivers, tuple(float(d.assembled) for d in S.drivers),
+                      any(j.type == "P" and j.limits is not None for j in mech.joints))
+    S.cache[key] = (mech, kp.vll, spec)
+    return spec
+
+
+def _not_driven(mech: Mechanism, jid: str, drivers: tuple) -> MechsynInputError:
+    """The error of an input given for ``jid``, which is not a driven joint."""
+    try:
+        j = mech.joint(jid)
+    except KeyError:
+        return MechsynInputError(f"no joint {jid!r}", field="inputs",
+                                 hint=f"driven joints: {', '.join(drivers) or '(none)'}")
+    return MechsynInputError(
+        f"joint {jid} ({j.type}) is not driven", field="inputs",
+        hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
+
+
+def _input_rows(S: PlanarSystem, spec: _InputSpec, inputs: dict) -> tuple[dict, np.ndarray]:
+    """The input values as float arrays by joint and the engines' input rows ``U`` (N, k):
+    radians (R) or lengths (P), drivers without input at their drawn value. Checks them
+    (the same number of values, not none, driven joints, finite, P within its limits)."""
+    vals = {jid: np.asarray(v, float) for jid, v in inputs.items()}
+    lengths = {a.shape[0] if a.ndim else 1 for a in vals.values()}
+    if len(lengths) != 1:
+        raise MechsynInputError("all inputs need the same number of values", field="inputs")
+    N = lengths.pop()
+    if N == 0:
+        raise MechsynInputError("the input range is empty", field="inputs")
+    if not spec.driven:
+        _check_inputs(S, spec, vals)  # raises: an input that is not a driven joint
+    if len(spec.drivers) == 1:  # the one driver's values
+        a = vals[spec.names[0]]
+        U = (np.radians(a) if spec.types[spec.names[0]] == "R" else a.copy()).reshape(N, 1)
+    else:
+        U = np.empty((N, len(spec.drivers)))
+        U[:] = spec.u0
+        for jid, k in zip(spec.names, spec.index):
+            if spec.types[jid] == "R":
+                np.radians(vals[jid], out=U[:, k])
+            else:
+                U[:, k] = vals[jid]
+    with np.errstate(over="ignore", invalid="ignore"):
+        finite = math.isfinite(U.sum())  # one call; an overflow or a NaN is looked at input by input
+    if not finite or any(lim is not None for lim in spec.limits):
+        _check_inputs(S, spec, vals)
+    return vals, U
+
+
+def _check_inputs(S: PlanarSystem, spec: _InputSpec, vals: dict) -> None:
+    """Raise the first input's error, input by input: not a driven joint, values not
+    finite, a P input outside its limits."""
+    for jid, k, lim in zip(spec.names, spec.index, spec.limits):
+        if not isinstance(k, int):
+            raise k
+        a = vals[jid]
+        if not np.isfinite(a).all():
+            raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
+        if lim is not None and (a.min() < lim[0] - 1e-12 * S.scale or a.max() > lim[1] + 1e-12 * S.scale):
+            raise MechsynInputError(
+                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
+                hint="keep the VLL length within its limits")
+
+
+def _input_speeds(spec: _InputSpec, inputs: dict, speeds: dict[str, float] | None) -> tuple[np.ndarray, dict]:
+    """The drivers' speeds (k,) (1 for an input without one, 0 for a driver without input)
+    and the inputs' speeds by joint."""
+    sp = [0.0] * len(spec.drivers)
+    given = dict(speeds or {})
+    for jid in given:
+        if jid not in inputs:
+            raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
+    for jid, k in zip(spec.names, spec.index):
+        sp[k] = float(given.get(jid, 1.0))
+    if not all(math.isfinite(v) for v in sp):
+        raise MechsynInputError("input speeds must be finite numbers", field="speeds",
+                                hint="give each driven joint's speed in rad/s (R) or length/s (P)")
+    return np.array(sp), {jid: sp[k] for jid, k in zip(spec.names, spec.index)}
 
 
 def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
@@ -369,34 +456,41 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
     pass gave them (``complete``: every row assembled with finite rates), else from the
     poses (:meth:`~mechsyn.kinematics.system.PlanarSystem.points_state`)."""
     rows, moving, idx, local = named
-    whole = (True, True) if complete else (bool(ok.all()), bool(rates_ok.all()))
+    N = sw.q.shape[0]
+    # rows where the positions (not assembled) or the rates (not defined) are NaN, if any
+    nok = None if complete or ok.all() else ~ok
+    bad = None if complete or rates_ok.all() else ~rates_ok
     states: dict[int, tuple] = {}
-    if moving:
+    if len(moving) == 1 and complete:
+        states[moving[0]] = sw.links.point(int(idx[0]), local[0])
+    elif moving:
         if complete:
             P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
         else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
             P, V, A = S.points_state(sw.q, sw.qd, sw.qdd, idx, local)
-            if not whole[0]:
-                for arr in (P, V, A):
-                    arr[:, ~ok] = np.nan
-            if not whole[1]:
-                V[:, ~rates_ok] = np.nan
-                A[:, ~rates_ok] = np.nan
+            _set_nan(P, V, A, nok, bad)
         states = dict(zip(moving, zip(P, V, A)))
     pm = {}
     for k, (name, link, i, at) in enumerate(rows):
         if k in states:
             pm[name] = PointMotion(*states[k], link)
             continue
-        P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, at)  # NaN rows stay NaN (and are set NaN below)
-        if not whole[0]:
-            for arr in (P, V, A):
-                arr[~ok] = np.nan
-        if not whole[1]:
-            V[~rates_ok] = np.nan
-            A[~rates_ok] = np.nan
+        # a point of the frame: at rest (A(0) at + 0: the point with -0 as +0, as point_state gives it)
+        P, V, A = np.zeros((3, N, 2))
+        P += at
+        _set_nan(P[None], V[None], A[None], nok, bad)
         pm[name] = PointMotion(P, V, A, link)
     return pm
+
+
+def _set_nan(P: np.ndarray, V: np.ndarray, A: np.ndarray, nok: np.ndarray | None, bad: np.ndarray | None) -> None:
+    """NaN the points' (m, N, 2) rows ``nok`` (not assembled) and their rates' rows ``bad``."""
+    if nok is not None:
+        for arr in (P, V, A):
+            arr[:, nok] = np.nan
+    if bad is not None:
+        V[:, bad] = np.nan
+        A[:, bad] = np.nan
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
@@ -413,7 +507,7 @@ def _event_units(S: PlanarSystem, e: Event) -> Event:
     """The event's input values by joint, in degrees (R) or lengths (P)."""
     if e.input is None:
         return e
-    return e.with_(input={d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
+    return e.with_(input={d.joint: (math.degrees(v) if d.type == "R" else float(v))  # np.degrees' product
                           for d, v in zip(S.drivers, e.input)})
 
 

@@ -9,6 +9,7 @@ engine, planar or spatial, can build its result without importing the entry poin
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -194,10 +195,12 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
     >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
     ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
     """
-    if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
+    if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)) or step == 0 \
+            or (stop - start) * step < 0:
         raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", field="inputs",
                                 hint="e.g. A=0:360:1 on the command line")
-    count = np.floor((stop - start) / step + 1e-9) + 1
+    c = (stop - start) / step + 1e-9  # on floats: np.floor's count without three NumPy scalar calls
+    count = float(math.floor(c)) + 1.0 if math.isfinite(c) else c + 1.0
     if count > limit("sweep_points"):
         raise MechsynInputError(
             f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "

@@ -242,22 +242,28 @@ class PlanarSystem:
         ((2, 4, 2), True)
         """
         m, N = len(idx), q.shape[0]
-        x, y, a = 3 * idx, 3 * idx + 1, 3 * idx + 2
         qT, qdT, qddT = q.T, qd.T, qdd.T  # (n, N): rows are coordinates
-        phi = qT[a]
+        if m == 1:  # one point: views of its link's rows, its local point as two floats
+            i = 3 * int(idx[0])
+            xy, a = (slice(i, i + 2), None), slice(i + 2, i + 3)
+            sx, sy = float(s[0, 0]), float(s[0, 1])
+        else:
+            i3 = 3 * np.asarray(idx)
+            xy, a = np.stack([i3, i3 + 1]), i3 + 2
+            sx, sy = s[:, 0, None], s[:, 1, None]
+        phi = qT[a]  # (m, N)
         c, sn = np.cos(phi), np.sin(phi)
-        sx, sy = s[:, 0, None], s[:, 1, None]
-        ax_, ay_ = c * sx - sn * sy, sn * sx + c * sy  # A(phi) s, as _apply
-        nay = -ay_  # _perp(A s) = (-ay, ax)
+        R = np.empty((3, m, N))  # -ay, ax, ay: _perp(A s) is R[:2], A(phi) s is R[1:]
+        np.subtract(c * sx, sn * sy, out=R[1])  # A(phi) s, as _apply
+        np.add(sn * sx, c * sy, out=R[2])
+        np.negative(R[2], out=R[0])
         w, al = qdT[a], qddT[a]
-        w2 = w ** 2
-        P, V, A = (np.empty((m, N, 2)) for _ in range(3))
-        np.add(qT[x], ax_, out=P[..., 0])
-        np.add(qT[y], ay_, out=P[..., 1])
-        np.add(qdT[x], w * nay, out=V[..., 0])
-        np.add(qdT[y], w * ax_, out=V[..., 1])
-        np.subtract(qddT[x] + al * nay, w2 * ax_, out=A[..., 0])
-        np.subtract(qddT[y] + al * ax_, w2 * ay_, out=A[..., 1])
+        out = np.empty((3, m, N, 2))
+        P, V, A = out
+        T = out.transpose(0, 3, 1, 2)  # (3, 2, m, N): x and y as rows
+        np.add(qT[xy], R[1:], out=T[0])
+        np.add(qdT[xy], w * R[:2], out=T[1])
+        np.subtract(qddT[xy] + al * R[:2], (w ** 2) * R[1:], out=T[2])
         return P, V, A
 
     def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
