@@ -98,9 +98,12 @@ class RegularPass:
         if isinstance(res, Folded):  # through folds: the tracked sweeps' singular rows and events
             return _folded_sweep(system, inputs, speeds, k, res, self.name)
         q, qd, qdd, links = res
-        det_sign, sigma_min = np.full((2, N), np.nan)  # Newton's; not computed here
-        return Sweep(system, inputs, speeds, q, qd, qdd, np.ones(N, bool), det_sign, sigma_min, [], method="assur",
-                     links=links, engine=self.name)
+        nan = np.empty((2, N))  # Newton's det_sign and sigma_min, not computed here (empty + fill:
+        nan.fill(np.nan)        # np.full and np.ones are Python functions around these two calls)
+        ok = np.empty(N, bool)
+        ok.fill(True)
+        return Sweep(system, inputs, speeds, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", links=links,
+                     engine=self.name)
 
 
 class TrackedChain:
@@ -212,8 +215,9 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     qd[sing] = np.nan  # a group folded flat: rates not defined here
     qdd[sing] = np.nan
     ok = np.isfinite(q.T).all(axis=0)  # q is a transposed view: rows of coordinates reduce fastest
-    det_sign, sigma_min = np.full((2, U.shape[0]), np.nan)
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, det_sign, sigma_min, [], method="assur", engine=engine)
+    nan = np.empty((2, U.shape[0]))
+    nan.fill(np.nan)
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine)
     if not back:
         sw.events = _tracked_events(ev, bool(ok[0]), U[0])
     else:
@@ -266,7 +270,10 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     """
     if U.shape[0] < 2:
         return None
-    key = (U.shape, U.dtype.str, tuple([(d.type, float(d.assembled)) for d in S.drivers]))
+    drawn = S.cache.get("drawn values")
+    if drawn is None:
+        drawn = S.cache["drawn values"] = tuple([(d.type, float(d.assembled)) for d in S.drivers])
+    key = (U.shape, U.dtype.str, drawn)
     data = U.tobytes()
     hit = _DRAWN.get(key)
     if hit is not None and hit[0] == data:
