@@ -32,7 +32,7 @@ from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, 
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.refill import topology_key, with_geometry
-from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
@@ -281,7 +281,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if complete:  # the regular pass without folds: every row assembled with finite rates
         rates_ok, singular_rows = ok, []
     else:
-        rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+        rates_ok = sw.rates_ok if sw.rates_ok is not None else _finite_rows(sw.qd) & _finite_rows(sw.qdd)
         singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
     events = _with_singular_rows(S, sw, singular_rows) if sw.events or singular_rows else []
     deg = np.multiply(sw.q.T[2::3], _DEG, order="C")  # np.degrees' product, every link in one call
@@ -297,6 +297,12 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         mechanism=mech.name, inputs=vals, input_types=spec.types, speeds=speed_of, assembled=ok, points=pm,
         links=links, events=events, method=sw.method, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw,
         system=S)
+
+
+def _finite_rows(x: np.ndarray) -> np.ndarray:
+    """The rows (N,) of ``x`` (N, n) whose entries are all finite, reduced along the axis
+    that is contiguous in memory (an engine's poses are often a transposed array)."""
+    return np.isfinite(x.T).all(axis=0) if x.T.flags.c_contiguous else np.isfinite(x).all(axis=1)
 
 
 def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) -> list[Event]:
@@ -474,8 +480,10 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
         if complete:
             P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
         else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
-            P, V, A = S.points_state(sw.q, sw.qd, sw.qdd, idx, local)
-            _set_nan(P, V, A, nok, bad)
+            PVA = _points_state(sw.q, sw.qd, sw.qdd, idx, local)
+            if not sw.nan_rows:  # else NaN already: every number of a point's row depends on its row
+                _set_nan(PVA, nok, bad)
+            P, V, A = PVA
         states = dict(zip(moving, zip(P, V, A)))
     pm = {}
     for k, (name, link, i, at) in enumerate(rows):
@@ -483,21 +491,20 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
             pm[name] = PointMotion(*states[k], link)
             continue
         # a point of the frame: at rest (A(0) at + 0: the point with -0 as +0, as point_state gives it)
-        P, V, A = np.zeros((3, N, 2))
-        P += at
-        _set_nan(P[None], V[None], A[None], nok, bad)
-        pm[name] = PointMotion(P, V, A, link)
+        PVA = np.zeros((3, N, 2))
+        PVA[0] += at
+        _set_nan(PVA, nok, bad)
+        pm[name] = PointMotion(*PVA, link)
     return pm
 
 
-def _set_nan(P: np.ndarray, V: np.ndarray, A: np.ndarray, nok: np.ndarray | None, bad: np.ndarray | None) -> None:
-    """NaN the points' (m, N, 2) rows ``nok`` (not assembled) and their rates' rows ``bad``."""
-    if nok is not None:
-        for arr in (P, V, A):
-            arr[:, nok] = np.nan
-    if bad is not None:
-        V[:, bad] = np.nan
-        A[:, bad] = np.nan
+def _set_nan(PVA: np.ndarray, nok: np.ndarray | None, bad: np.ndarray | None) -> None:
+    """NaN the rows ``nok`` (not assembled) of positions, velocities and accelerations
+    ``PVA`` (3, ..., N, 2) and the rows ``bad`` of the rates (one call each)."""
+    if nok is not None:  # through the transpose the rows are its second axis (the fastest mask)
+        PVA.T[:, nok] = np.nan
+    if bad is not None and (nok is None or bad.tobytes() != nok.tobytes()):  # often the same rows
+        PVA[1:].T[:, bad] = np.nan
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:

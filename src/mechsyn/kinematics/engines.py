@@ -215,9 +215,12 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     qd[sing] = np.nan  # a group folded flat: rates not defined here
     qdd[sing] = np.nan
     ok = np.isfinite(q.T).all(axis=0)  # q is a transposed view: rows of coordinates reduce fastest
+    # rates NaN on whole rows (Folded's rows, and sing above): one coordinate tells a row
+    rates_ok = np.isfinite(qd.T[0]) & np.isfinite(qdd.T[0])
     nan = np.empty((2, U.shape[0]))
     nan.fill(np.nan)
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine)
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine, rates_ok=rates_ok,
+               nan_rows=True)
     if not back:
         sw.events = _tracked_events(ev, bool(ok[0]), U[0])
     else:

@@ -241,30 +241,7 @@ class PlanarSystem:
         >>> P.shape, bool(np.array_equal(A[1], S.point_state(q, q, q, 1, np.array([0.5, 0.2]))[2]))
         ((2, 4, 2), True)
         """
-        m, N = len(idx), q.shape[0]
-        qT, qdT, qddT = q.T, qd.T, qdd.T  # (n, N): rows are coordinates
-        if m == 1:  # one point: views of its link's rows, its local point as two floats
-            i = 3 * int(idx[0])
-            xy, a = (slice(i, i + 2), None), slice(i + 2, i + 3)
-            sx, sy = float(s[0, 0]), float(s[0, 1])
-        else:
-            i3 = 3 * np.asarray(idx)
-            xy, a = np.stack([i3, i3 + 1]), i3 + 2
-            sx, sy = s[:, 0, None], s[:, 1, None]
-        phi = qT[a]  # (m, N)
-        c, sn = np.cos(phi), np.sin(phi)
-        R = np.empty((3, m, N))  # -ay, ax, ay: _perp(A s) is R[:2], A(phi) s is R[1:]
-        np.subtract(c * sx, sn * sy, out=R[1])  # A(phi) s, as _apply
-        np.add(sn * sx, c * sy, out=R[2])
-        np.negative(R[2], out=R[0])
-        w, al = qdT[a], qddT[a]
-        out = np.empty((3, m, N, 2))
-        P, V, A = out
-        T = out.transpose(0, 3, 1, 2)  # (3, 2, m, N): x and y as rows
-        np.add(qT[xy], R[1:], out=T[0])
-        np.add(qdT[xy], w * R[:2], out=T[1])
-        np.subtract(qddT[xy] + al * R[:2], (w ** 2) * R[1:], out=T[2])
-        return P, V, A
+        return tuple(_points_state(q, qd, qdd, idx, s))
 
     def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
         """Angles (N,) of link index ``i`` (frame: zeros)."""
@@ -801,3 +778,31 @@ class _Builder:
 def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """2-D cross product ``a x b`` (a scalar per row)."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """:meth:`PlanarSystem.points_state` as one array (3, m, N, 2): positions, velocities,
+    accelerations (a caller sets rows NaN in all three in one call)."""
+    m, N = len(idx), q.shape[0]
+    qT, qdT, qddT = q.T, qd.T, qdd.T  # (n, N): rows are coordinates
+    if m == 1:  # one point: views of its link's rows, its local point as two floats
+        i = 3 * int(idx[0])
+        xy, a = (slice(i, i + 2), None), slice(i + 2, i + 3)
+        sx, sy = float(s[0, 0]), float(s[0, 1])
+    else:
+        i3 = 3 * np.asarray(idx)
+        xy, a = np.stack([i3, i3 + 1]), i3 + 2
+        sx, sy = s[:, 0, None], s[:, 1, None]
+    phi = qT[a]  # (m, N)
+    c, sn = np.cos(phi), np.sin(phi)
+    R = np.empty((3, m, N))  # -ay, ax, ay: _perp(A s) is R[:2], A(phi) s is R[1:]
+    np.subtract(c * sx, sn * sy, out=R[1])  # A(phi) s, as _apply
+    np.add(sn * sx, c * sy, out=R[2])
+    np.negative(R[2], out=R[0])
+    w, al = qdT[a], qddT[a]
+    out = np.empty((3, m, N, 2))
+    T = out.transpose(0, 3, 1, 2)  # (3, 2, m, N): x and y as rows
+    np.add(qT[xy], R[1:], out=T[0])
+    np.add(qdT[xy], w * R[:2], out=T[1])
+    np.subtract(qddT[xy] + al * R[:2], (w ** 2) * R[1:], out=T[2])
+    return out
