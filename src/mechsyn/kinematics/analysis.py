@@ -470,9 +470,10 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
     poses (:meth:`~mechsyn.kinematics.system.PlanarSystem.points_state`)."""
     rows, moving, idx, local = named
     N = sw.q.shape[0]
-    # rows where the positions (not assembled) or the rates (not defined) are NaN, if any
-    nok = None if complete or ok.all() else ~ok
-    bad = None if complete or rates_ok.all() else ~rates_ok
+    nok = bad = None  # rows where the positions (not assembled) or the rates (not defined) are set NaN
+    if not complete and (len(moving) < len(rows) or not sw.nan_rows):
+        nok = None if ok.all() else ~ok
+        bad = None if rates_ok.all() else ~rates_ok
     states: dict[int, tuple] = {}
     if len(moving) == 1 and complete:
         states[moving[0]] = sw.links.point(int(idx[0]), local[0])

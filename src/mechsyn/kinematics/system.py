@@ -794,10 +794,13 @@ def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarra
         xy, a = np.stack([i3, i3 + 1]), i3 + 2
         sx, sy = s[:, 0, None], s[:, 1, None]
     phi = qT[a]  # (m, N)
-    c, sn = np.cos(phi), np.sin(phi)
+    cs = np.empty((2, m, N))  # cos, sin
+    np.cos(phi, out=cs[0])
+    np.sin(phi, out=cs[1])
+    X, Y = cs * sx, cs * sy  # (c sx, sn sx), (c sy, sn sy): the products of _apply
     R = np.empty((3, m, N))  # -ay, ax, ay: _perp(A s) is R[:2], A(phi) s is R[1:]
-    np.subtract(c * sx, sn * sy, out=R[1])  # A(phi) s, as _apply
-    np.add(sn * sx, c * sy, out=R[2])
+    np.subtract(X[0], Y[1], out=R[1])  # A(phi) s, as _apply
+    np.add(X[1], Y[0], out=R[2])
     np.negative(R[2], out=R[0])
     w, al = qdT[a], qddT[a]
     out = np.empty((3, m, N, 2))
