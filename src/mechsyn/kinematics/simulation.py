@@ -206,7 +206,10 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
             f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "
             f"{limit('sweep_points'):,}", field="inputs",
             hint="use a larger step or a shorter range; " + limit_hint("sweep_points"))
-    return start + step * np.arange(int(count))
+    grid = np.arange(int(count), dtype=float)  # start + step * k in place (exact k: the same numbers)
+    grid *= step
+    grid += start
+    return grid
 
 
 def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:

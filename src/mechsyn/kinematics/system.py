@@ -227,13 +227,9 @@ class PlanarSystem:
 
     def points_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray,
                      s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`point_state` of the local points ``s`` (m, 2) of the moving links ``idx``
-        (m,) at once: position, velocity, acceleration (m, N, 2), each point's the same
-        arithmetic as :meth:`point_state` (so the same numbers), in a few array
-        operations for all of them.
+        """:meth:`point_state` of the local points ``s`` (m, 2) of the moving links ``idx`` (m,)
+        at once (m, N, 2), the same arithmetic (so the same numbers) in a few array operations.
 
-        Examples
-        --------
         >>> import numpy as np, mechsyn as ms
         >>> S = build_system(ms.examples.load("crank_rocker"))
         >>> q = S.q0[None] + np.linspace(0, 0.1, 4)[:, None]
@@ -781,29 +777,22 @@ def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """:meth:`PlanarSystem.points_state` as one array (3, m, N, 2): positions, velocities,
-    accelerations (a caller sets rows NaN in all three in one call)."""
-    m, N = len(idx), q.shape[0]
-    qT, qdT, qddT = q.T, qd.T, qdd.T  # (n, N): rows are coordinates
+    """:meth:`PlanarSystem.points_state` as one array (3, m, N, 2) (a caller masks all three at once)."""
+    m, N, qT, qdT, qddT = len(idx), q.shape[0], q.T, qd.T, qdd.T  # q.T (n, N): rows are coordinates
     if m == 1:  # one point: views of its link's rows, its local point as two floats
         i = 3 * int(idx[0])
-        xy, a = (slice(i, i + 2), None), slice(i + 2, i + 3)
-        sx, sy = float(s[0, 0]), float(s[0, 1])
+        xy, a, sx, sy = (slice(i, i + 2), None), slice(i + 2, i + 3), float(s[0, 0]), float(s[0, 1])
     else:
         i3 = 3 * np.asarray(idx)
-        xy, a = np.stack([i3, i3 + 1]), i3 + 2
-        sx, sy = s[:, 0, None], s[:, 1, None]
-    phi = qT[a]  # (m, N)
-    cs = np.empty((2, m, N))  # cos, sin
-    np.cos(phi, out=cs[0])
-    np.sin(phi, out=cs[1])
+        xy, a, sx, sy = np.stack([i3, i3 + 1]), i3 + 2, s[:, 0, None], s[:, 1, None]
+    cs, R = np.empty((2, m, N)), np.empty((3, m, N))  # cos, sin; -ay, ax, ay: _perp(A s) is R[:2], A s R[1:]
+    np.cos(qT[a], out=cs[0])
+    np.sin(qT[a], out=cs[1])
     X, Y = cs * sx, cs * sy  # (c sx, sn sx), (c sy, sn sy): the products of _apply
-    R = np.empty((3, m, N))  # -ay, ax, ay: _perp(A s) is R[:2], A(phi) s is R[1:]
     np.subtract(X[0], Y[1], out=R[1])  # A(phi) s, as _apply
     np.add(X[1], Y[0], out=R[2])
     np.negative(R[2], out=R[0])
-    w, al = qdT[a], qddT[a]
-    out = np.empty((3, m, N, 2))
+    w, al, out = qdT[a], qddT[a], np.empty((3, m, N, 2))
     T = out.transpose(0, 3, 1, 2)  # (3, 2, m, N): x and y as rows
     np.add(qT[xy], R[1:], out=T[0])
     np.add(qdT[xy], w * R[:2], out=T[1])

@@ -15,7 +15,6 @@ References
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -287,8 +286,10 @@ class Mechanism:
         themselves (a list or array); degrees for R joints, lengths for P joints:
         ``m.simulate(A=(0, 360, 1))`` or ``m.simulate({"A": np.linspace(0, 90, 7)})``.
         """
-        return _analysis().simulate(self, _inputs(inputs, joint_inputs), speeds=speeds, points=points, vll=vll,
-                                    method=method)
+        from mechsyn.kinematics.analysis import simulate
+
+        return simulate(self, _inputs(inputs, joint_inputs), speeds=speeds, points=points, vll=vll,
+                        method=method)
 
     def forces(self, inputs: dict[str, Any] | None = None, *, gravity: tuple[float, float] = (0.0, 0.0),
                static: bool = False, speeds: dict[str, float] | None = None, vll: dict[str, str] | None = None,
@@ -365,9 +366,10 @@ class Mechanism:
 def _inputs(inputs: dict[str, Any] | None, joint_inputs: dict[str, Any]) -> dict[str, np.ndarray]:
     """Joint -> values: a tuple ``(start, stop, step)`` is a range with both ends, anything
     else the values themselves."""
-    input_grid = _analysis().input_grid
+    from mechsyn.kinematics.analysis import input_grid
+
     out: dict[str, np.ndarray] = {}
-    for jid, v in {**(inputs or {}), **joint_inputs}.items():
+    for jid, v in ({**inputs, **joint_inputs} if inputs else joint_inputs).items():
         if isinstance(v, tuple):
             if len(v) != 3:
                 raise MechsynInputError(f"{jid}: a range is (start, stop, step), got {v!r}", field="inputs",
@@ -380,13 +382,3 @@ def _inputs(inputs: dict[str, Any] | None, joint_inputs: dict[str, Any]) -> dict
         else:
             out[jid] = np.atleast_1d(np.asarray(v, float))
     return out
-
-
-def _analysis() -> Any:
-    """:mod:`mechsyn.kinematics.analysis` (it imports this module, so it is imported on first
-    use; then looked up, not imported again: an import statement in a function costs more
-    than a short simulation's Python)."""
-    mod = sys.modules.get("mechsyn.kinematics.analysis")
-    if mod is None:
-        import mechsyn.kinematics.analysis as mod
-    return mod
