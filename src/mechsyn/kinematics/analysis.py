@@ -285,7 +285,8 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
     events = _with_singular_rows(S, sw, singular_rows) if sw.events or singular_rows else []
     deg = np.multiply(sw.q.T[2::3], _DEG, order="C")  # np.degrees' product, every link in one call
-    links = {name: LinkMotion(deg[i], sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2]) for i, name in enumerate(S.links)}
+    qdT, qddT = sw.qd.T, sw.qdd.T  # rows of coordinates: a row is the view sw.qd[:, k]
+    links = {name: LinkMotion(deg[i], qdT[3 * i + 2], qddT[3 * i + 2]) for i, name in enumerate(S.links)}
     pm = _point_motions(S, sw, named, ok, rates_ok, complete)
     notes = list(S.notes)
     if singular_configuration(S):
@@ -336,6 +337,7 @@ class _InputSpec:
     u0: tuple
     limited: bool
     driven: bool          # every input is a driven joint
+    limited_inputs: bool  # an input is a P joint with limits
     unit_speeds: tuple    # the drivers' speeds when none is given: 1 for an input, else 0
 
 
@@ -362,7 +364,7 @@ def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
     spec = _InputSpec(names, tuple(j for j in names if _is_passive(mech, j, kp.vll)), tuple(index), types,
                       tuple(limits), drivers, tuple(float(d.assembled) for d in S.drivers),
                       any(j.type == "P" and j.limits is not None for j in mech.joints),
-                      all(isinstance(k, int) for k in index),
+                      all(isinstance(k, int) for k in index), any(lim is not None for lim in limits),
                       tuple(1.0 if k in index else 0.0 for k in range(len(drivers))))
     S.cache[key] = (mech, kp.vll, spec)
     return spec
@@ -395,7 +397,7 @@ def _input_rows(S: PlanarSystem, spec: _InputSpec, inputs: dict) -> tuple[dict, 
         _check_inputs(S, spec, vals)  # raises: an input that is not a driven joint
     if len(spec.drivers) == 1:  # the one driver's values (radians: np.radians' product, one call)
         a = vals[spec.names[0]]
-        U = (a * _RAD if spec.types[spec.names[0]] == "R" else a.copy()).reshape(N, 1)
+        U = (np.multiply(a, _RAD) if spec.types[spec.names[0]] == "R" else a.copy()).reshape(N, 1)
     else:
         U = np.empty((N, len(spec.drivers)))
         U[:] = spec.u0
@@ -404,7 +406,7 @@ def _input_rows(S: PlanarSystem, spec: _InputSpec, inputs: dict) -> tuple[dict, 
                 np.multiply(vals[jid], _RAD, out=U[:, k])
             else:
                 U[:, k] = vals[jid]
-    if not np.isfinite(U).all() or spec.limits != (None,) * len(spec.limits):
+    if np.count_nonzero(np.isfinite(U)) != U.size or spec.limited_inputs:  # (faster than .all())
         _check_inputs(S, spec, vals)
     return vals, U
 
@@ -476,7 +478,7 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
         bad = None if rates_ok.all() else ~rates_ok
     states: dict[int, tuple] = {}
     if len(moving) == 1 and complete:
-        states[moving[0]] = sw.links.point(int(idx[0]), local[0])
+        states[moving[0]] = sw.links.point(int(idx[0]), complex(*local[0].tolist()))
     elif moving:
         if complete:
             P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
