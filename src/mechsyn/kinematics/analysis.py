@@ -68,8 +68,8 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     if mech.kind == "spatial":
         return SPATIAL_ENGINE.sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
-    return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
-        inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
+    return _simulate_plan(cached_plan(mech, vll=vll, inputs=tuple(inputs)), inputs, speeds, points, method, progress,
+                          change_points)  # KinematicPlan.simulate without its call
 
 
 #: Compiled plans of the last few mechanisms simulated (a plan holds its mechanism, so a
