@@ -67,6 +67,9 @@ def test_drawn_row_remembered_equals_the_row_computed(ex, f, j):
         engines._DRAWN.clear()
         assert engines.drawn_row(S, U) == want  # computed
         assert engines.drawn_row(S, U.copy()) == want  # remembered
+    big = np.radians(input_grid(-180, 540, 0.005))[:, None]  # over 64 KiB: computed, not kept
+    engines._DRAWN.clear()
+    assert engines.drawn_row(S, big) == engines._drawn_row_1(S.drivers[0], big[:, 0].copy()) and not engines._DRAWN
     other = cached_plan(ex("textbook/stephenson_sixbar.yaml"), inputs=("A",)).system
     U = np.radians(u0 + input_grid(-30, 30, 0.5))[:, None]
     assert engines.drawn_row(S, U) is not None

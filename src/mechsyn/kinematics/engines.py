@@ -250,14 +250,15 @@ def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_in
 #: values and the inputs' shape: ``(the inputs' bytes, row)``. A drag or a design loop
 #: simulates the same grid again and again; equal bytes give the same row.
 _DRAWN: dict[tuple, tuple[bytes, int | None]] = {}
-_DRAWN_MAX = 16
+_DRAWN_MAX, _DRAWN_BYTES = 16, 1 << 16  # at most 16 sweeps of at most 64 KiB of inputs each
 
 
 def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
     row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None.
 
-    The row of the same inputs (byte for byte) with the same drawn values is remembered.
+    The row of the same inputs (byte for byte, up to 64 KiB of them) with the same drawn
+    values is remembered.
 
     Examples
     --------
@@ -273,6 +274,8 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     """
     if U.shape[0] < 2:
         return None
+    if U.nbytes > _DRAWN_BYTES:  # a long sweep: its own cost dwarfs the search, not kept
+        return _drawn_row_1(S.drivers[0], U[:, 0]) if U.shape[1] == 1 else _drawn_row_k(S, U)
     drawn = S.cache.get("drawn values")
     if drawn is None:
         drawn = S.cache["drawn values"] = tuple([(d.type, float(d.assembled)) for d in S.drivers])
