@@ -32,7 +32,7 @@ from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, 
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.refill import topology_key, with_geometry
-from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
@@ -68,8 +68,8 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     if mech.kind == "spatial":
         return SPATIAL_ENGINE.sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
-    return cached_plan(mech, vll=vll, inputs=tuple(inputs)).simulate(
-        inputs, speeds=speeds, points=points, method=method, progress=progress, change_points=change_points)
+    return _simulate_plan(cached_plan(mech, vll=vll, inputs=tuple(inputs)), inputs, speeds, points, method, progress,
+                          change_points)  # KinematicPlan.simulate without its call
 
 
 #: Compiled plans of the last few mechanisms simulated (a plan holds its mechanism, so a
@@ -89,14 +89,17 @@ def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple
     """What a compiled plan depends on besides the (frozen) topology: the joint points and
     axes, joint attributes (cam profiles, belts), named points, VLL modes, prescribed
     inputs. The arrays are mutable, so their bytes are part of the key."""
-    def arr(a: Any) -> bytes | None:
-        if isinstance(a, np.ndarray) and a.dtype == float:
+    def arr(a: Any) -> bytes | None:  # the bytes of the float64 array (a native one read as it is)
+        if a.__class__ is np.ndarray and a.dtype is _F64:
             return a.tobytes()
         return None if a is None else np.asarray(a, float).tobytes()
 
-    joints = tuple((arr(j.point), arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints)
-    named = tuple((k, p.link, arr(p.at)) for k, p in mech.points.items())
-    return joints, named, tuple(sorted((vll or {}).items())), prescribed
+    joints = tuple([(arr(j.point), arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints])
+    named = tuple([(k, p.link, arr(p.at)) for k, p in mech.points.items()])
+    return joints, named, tuple(sorted(vll.items())) if vll else (), prescribed
+
+
+_F64 = np.dtype(float)
 
 
 def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
@@ -243,62 +246,25 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
     return kp
 
 
+#: The factors of ``np.radians`` and ``np.degrees`` (a product by them is bit for bit
+#: theirs, and a plain multiplication is several times faster).
+_RAD, _DEG = math.pi / 180.0, 180.0 / math.pi
+
+
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
                    points: list[str] | None, method: str, progress: Any, change_points: str = "keep") -> Simulation:
-    mech, S = kp.mechanism, kp.system
     if change_points not in ("keep", "switch"):
         raise MechsynInputError(f"change_points must be 'keep' or 'switch', not {change_points!r}",
                                 field="change_points")
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
-    if tuple(j for j in inputs if _is_passive(mech, j, kp.vll)) != kp.prescribed:
-        kp = compile_plan(mech, kp.vll, tuple(inputs))
-        S = kp.system
-    drivers = [d.joint for d in S.drivers]
-    lengths = {len(np.atleast_1d(v)) for v in inputs.values()}
-    if len(lengths) != 1:
-        raise MechsynInputError("all inputs need the same number of values", field="inputs")
-    N = lengths.pop()
-    if N == 0:
-        raise MechsynInputError("the input range is empty", field="inputs")
-    U = np.empty((N, len(S.drivers)))
-    U[:] = [d.assembled for d in S.drivers]
-    types: dict[str, str] = {}
-    for jid, vals in inputs.items():
-        if jid not in drivers:
-            try:
-                j = mech.joint(jid)
-            except KeyError:
-                raise MechsynInputError(f"no joint {jid!r}", field="inputs",
-                                        hint=f"driven joints: {', '.join(drivers) or '(none)'}") from None
-            raise MechsynInputError(
-                f"joint {jid} ({j.type}) is not driven", field="inputs",
-                hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
-        k = drivers.index(jid)
-        vals = np.asarray(vals, float)
-        if not np.isfinite(vals).all():
-            raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
-        d = S.drivers[k]
-        if d.type == "R":
-            np.radians(vals, out=U[:, k])
-        else:
-            U[:, k] = vals
-        types[jid] = d.type
-        lim = mech.joint(jid).limits if d.type == "P" else None
-        if lim is not None and (vals.min() < lim[0] - 1e-12 * S.scale or vals.max() > lim[1] + 1e-12 * S.scale):
-            raise MechsynInputError(
-                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
-                hint="keep the VLL length within its limits")
-    sp = np.zeros(len(drivers))
-    speeds = dict(speeds or {})
-    for jid in speeds:
-        if jid not in inputs:
-            raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
-    for jid in inputs:
-        sp[drivers.index(jid)] = float(speeds.get(jid, 1.0))
-    if not all(math.isfinite(v) for v in sp.tolist()):
-        raise MechsynInputError("input speeds must be finite numbers", field="speeds",
-                                hint="give each driven joint's speed in rad/s (R) or length/s (P)")
+    spec = _input_spec(kp, tuple(inputs))
+    if spec.prescribed != kp.prescribed:
+        kp = compile_plan(kp.mechanism, kp.vll, tuple(inputs))
+        spec = _input_spec(kp, tuple(inputs))
+    mech, S = kp.mechanism, kp.system
+    vals, U = _input_rows(S, spec, inputs)
+    sp, speed_of = _input_speeds(spec, inputs, speeds)
     named = _named_points(S, mech, points)
     plan = kp.groups if method in ("auto", "assur") else None
     if method == "assur" and plan is None:
@@ -310,15 +276,40 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if plan is not None and not drawn_checks(S, plan):
         assemble(S)  # checks the file configuration and the mobility
     sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
-    events = list(sw.events)
-    used = sw.method
     ok = sw.assembled
     complete = sw.links is not None
     if complete:  # the regular pass without folds: every row assembled with finite rates
         rates_ok, singular_rows = ok, []
     else:
-        rates_ok = np.all(np.isfinite(sw.qd), axis=1) & np.all(np.isfinite(sw.qdd), axis=1)
+        rates_ok = sw.rates_ok if sw.rates_ok is not None else _finite_rows(sw.qd) & _finite_rows(sw.qdd)
         singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
+    events = _with_singular_rows(S, sw, singular_rows) if sw.events or singular_rows else []
+    deg = np.multiply(sw.q.T[2::3], _DEG, order="C")  # np.degrees' product, every link in one call
+    qdT, qddT = sw.qd.T, sw.qdd.T  # rows of coordinates: a row is the view sw.qd[:, k]
+    links = {name: LinkMotion(deg[i], qdT[3 * i + 2], qddT[3 * i + 2]) for i, name in enumerate(S.links)}
+    pm = _point_motions(S, sw, named, ok, rates_ok, complete)
+    notes = list(S.notes)
+    if singular_configuration(S):
+        notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
+                     "position): the assembly branch chosen from it is arbitrary")
+    if spec.limited:
+        events.extend(_limit_events(S, sw))
+    return Simulation(
+        mechanism=mech.name, inputs=vals, input_types=spec.types, speeds=speed_of, assembled=ok, points=pm,
+        links=links, events=events, method=sw.method, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw,
+        system=S)
+
+
+def _finite_rows(x: np.ndarray) -> np.ndarray:
+    """The rows (N,) of ``x`` (N, n) whose entries are all finite, reduced along the axis
+    that is contiguous in memory (an engine's poses are often a transposed array)."""
+    return np.isfinite(x.T).all(axis=0) if x.T.flags.c_contiguous else np.isfinite(x).all(axis=1)
+
+
+def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) -> list[Event]:
+    """The sweep's events, a ``singular`` event added at every assembled row whose rates
+    are not defined and that no event flags yet, by row, in input units."""
+    events = list(sw.events)
     flagged = {e.index for e in events if e.kind == "singular" and not e.before_sweep}
     for k in singular_rows:
         if k in flagged:
@@ -326,20 +317,131 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                             "accelerations are not defined here (null)", sw.inputs[k].tolist()))
     events.sort(key=lambda e: e.index)
-    links = {}
-    for i, name in enumerate(S.links):
-        links[name] = LinkMotion(np.degrees(sw.q[:, 3 * i + 2]), sw.qd[:, 3 * i + 2], sw.qdd[:, 3 * i + 2])
-    pm = _point_motions(S, sw, named, ok, rates_ok, complete)
-    events = [_event_units(S, e) for e in events]
-    notes = list(S.notes)
-    if singular_configuration(S):
-        notes.append("the file's configuration is singular (a dead centre or a folded / change-point "
-                     "position): the assembly branch chosen from it is arbitrary")
-    events.extend(_limit_events(S, sw))
-    return Simulation(
-        mechanism=mech.name, inputs={j: np.asarray(v, float) for j, v in inputs.items()}, input_types=types,
-        speeds={j: float(sp[drivers.index(j)]) for j in inputs}, assembled=ok, points=pm, links=links,
-        events=events, method=used, engine=sw.engine, notes=notes, vll=dict(S.vll), sweep=sw, system=S)
+    return [_event_units(S, e) for e in events]
+
+
+@dataclass(frozen=True)
+class _InputSpec:
+    """What a plan's sweep needs to know of the joints given input values (``names``),
+    found once per plan and names (:func:`_input_spec`): the prescribed passive VLLs among
+    them, each one's driver index, type and limits (P) or the error it is (not a joint,
+    not driven), the drivers' joints and drawn values; ``limited``: a P joint of the
+    mechanism has limits (its VLL events are looked for)."""
+
+    names: tuple
+    prescribed: tuple
+    index: tuple          # per name: driver index, or the MechsynInputError to raise
+    types: dict
+    limits: tuple         # per name: (lo, hi) of a P input with limits, else None
+    drivers: tuple
+    u0: tuple
+    limited: bool
+    driven: bool          # every input is a driven joint
+    limited_inputs: bool  # an input is a P joint with limits
+    unit_speeds: tuple    # the drivers' speeds when none is given: 1 for an input, else 0
+
+
+def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
+    """The :class:`_InputSpec` of ``kp`` for the inputs ``names``, kept with its system."""
+    mech, S = kp.mechanism, kp.system
+    key = ("input spec", names)
+    hit = S.cache.get(key)
+    if hit is not None and hit[0] is mech and hit[1] is kp.vll:
+        return hit[2]
+    drivers = tuple(d.joint for d in S.drivers)
+    index, types, limits = [], {}, []
+    for jid in names:
+        lim = None
+        if jid in drivers:
+            k = drivers.index(jid)
+            index.append(k)
+            types[jid] = S.drivers[k].type
+            if types[jid] == "P":
+                lim = mech.joint(jid).limits
+        else:
+            index.append(_not_driven(mech, jid, drivers))
+        limits.append(None if lim is None else (float(lim[0]), float(lim[1])))
+    spec = _InputSpec(names, tuple(j for j in names if _is_passive(mech, j, kp.vll)), tuple(index), types,
+                      tuple(limits), drivers, tuple(float(d.assembled) for d in S.drivers),
+                      any(j.type == "P" and j.limits is not None for j in mech.joints),
+                      all(isinstance(k, int) for k in index), any(lim is not None for lim in limits),
+                      tuple(1.0 if k in index else 0.0 for k in range(len(drivers))))
+    S.cache[key] = (mech, kp.vll, spec)
+    return spec
+
+
+def _not_driven(mech: Mechanism, jid: str, drivers: tuple) -> MechsynInputError:
+    """The error of an input given for ``jid``, which is not a driven joint."""
+    try:
+        j = mech.joint(jid)
+    except KeyError:
+        return MechsynInputError(f"no joint {jid!r}", field="inputs",
+                                 hint=f"driven joints: {', '.join(drivers) or '(none)'}")
+    return MechsynInputError(
+        f"joint {jid} ({j.type}) is not driven", field="inputs",
+        hint=f"mark it `actuated: true` in the file; driven joints: {', '.join(drivers) or '(none)'}")
+
+
+def _input_rows(S: PlanarSystem, spec: _InputSpec, inputs: dict) -> tuple[dict, np.ndarray]:
+    """The input values as float arrays by joint and the engines' input rows ``U`` (N, k):
+    radians (R) or lengths (P), drivers without input at their drawn value. Checks them
+    (the same number of values, not none, driven joints, finite, P within its limits)."""
+    vals = {jid: np.asarray(v, float) for jid, v in inputs.items()}
+    lengths = {a.shape[0] if a.ndim else 1 for a in vals.values()}
+    if len(lengths) != 1:
+        raise MechsynInputError("all inputs need the same number of values", field="inputs")
+    N = lengths.pop()
+    if N == 0:
+        raise MechsynInputError("the input range is empty", field="inputs")
+    if not spec.driven:
+        _check_inputs(S, spec, vals)  # raises: an input that is not a driven joint
+    if len(spec.drivers) == 1:  # the one driver's values (radians: np.radians' product, one call)
+        a = vals[spec.names[0]]
+        U = (np.multiply(a, _RAD) if spec.types[spec.names[0]] == "R" else a.copy()).reshape(N, 1)
+    else:
+        U = np.empty((N, len(spec.drivers)))
+        U[:] = spec.u0
+        for jid, k in zip(spec.names, spec.index):
+            if spec.types[jid] == "R":
+                np.multiply(vals[jid], _RAD, out=U[:, k])
+            else:
+                U[:, k] = vals[jid]
+    if np.count_nonzero(np.isfinite(U)) != U.size or spec.limited_inputs:  # (faster than .all())
+        _check_inputs(S, spec, vals)
+    return vals, U
+
+
+def _check_inputs(S: PlanarSystem, spec: _InputSpec, vals: dict) -> None:
+    """Raise the first input's error, input by input: not a driven joint, values not
+    finite, a P input outside its limits."""
+    for jid, k, lim in zip(spec.names, spec.index, spec.limits):
+        if not isinstance(k, int):
+            raise k
+        a = vals[jid]
+        if not np.isfinite(a).all():
+            raise MechsynInputError(f"input values of {jid} must be finite numbers", field="inputs")
+        if lim is not None and (a.min() < lim[0] - 1e-12 * S.scale or a.max() > lim[1] + 1e-12 * S.scale):
+            raise MechsynInputError(
+                f"input of {jid} goes outside its limits [{lim[0]:g}, {lim[1]:g}]", field="inputs",
+                hint="keep the VLL length within its limits")
+
+
+def _input_speeds(spec: _InputSpec, inputs: dict, speeds: dict[str, float] | None) -> tuple[np.ndarray, dict]:
+    """The drivers' speeds (k,) (1 for an input without one, 0 for a driver without input)
+    and the inputs' speeds by joint."""
+    if not speeds:
+        return np.array(spec.unit_speeds), dict.fromkeys(spec.names, 1.0)
+    sp = [0.0] * len(spec.drivers)
+    given = dict(speeds)
+    for jid in given:
+        if jid not in inputs:
+            raise MechsynInputError(f"a speed is given for {jid}, which has no input", field="speeds")
+    for jid, k in zip(spec.names, spec.index):
+        sp[k] = float(given.get(jid, 1.0))
+    if not all(math.isfinite(v) for v in sp):
+        raise MechsynInputError("input speeds must be finite numbers", field="speeds",
+                                hint="give each driven joint's speed in rad/s (R) or length/s (P)")
+    return np.array(sp), {jid: sp[k] for jid, k in zip(spec.names, spec.index)}
 
 
 def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
@@ -369,34 +471,43 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
     pass gave them (``complete``: every row assembled with finite rates), else from the
     poses (:meth:`~mechsyn.kinematics.system.PlanarSystem.points_state`)."""
     rows, moving, idx, local = named
-    whole = (True, True) if complete else (bool(ok.all()), bool(rates_ok.all()))
+    N = sw.q.shape[0]
+    nok = bad = None  # rows where the positions (not assembled) or the rates (not defined) are set NaN
+    if not complete and (len(moving) < len(rows) or not sw.nan_rows):
+        nok = None if ok.all() else ~ok
+        bad = None if rates_ok.all() else ~rates_ok
     states: dict[int, tuple] = {}
-    if moving:
+    if len(moving) == 1 and complete:
+        states[moving[0]] = sw.links.point(int(idx[0]), complex(*local[0].tolist()))
+    elif moving:
         if complete:
             P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
         else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
-            P, V, A = S.points_state(sw.q, sw.qd, sw.qdd, idx, local)
-            if not whole[0]:
-                for arr in (P, V, A):
-                    arr[:, ~ok] = np.nan
-            if not whole[1]:
-                V[:, ~rates_ok] = np.nan
-                A[:, ~rates_ok] = np.nan
+            PVA = _points_state(sw.q, sw.qd, sw.qdd, idx, local)
+            if not sw.nan_rows:  # else NaN already: every number of a point's row depends on its row
+                _set_nan(PVA, nok, bad)
+            P, V, A = PVA
         states = dict(zip(moving, zip(P, V, A)))
     pm = {}
     for k, (name, link, i, at) in enumerate(rows):
         if k in states:
             pm[name] = PointMotion(*states[k], link)
             continue
-        P, V, A = S.point_state(sw.q, sw.qd, sw.qdd, i, at)  # NaN rows stay NaN (and are set NaN below)
-        if not whole[0]:
-            for arr in (P, V, A):
-                arr[~ok] = np.nan
-        if not whole[1]:
-            V[~rates_ok] = np.nan
-            A[~rates_ok] = np.nan
-        pm[name] = PointMotion(P, V, A, link)
+        # a point of the frame: at rest (A(0) at + 0: the point with -0 as +0, as point_state gives it)
+        PVA = np.zeros((3, N, 2))
+        PVA[0] += at
+        _set_nan(PVA, nok, bad)
+        pm[name] = PointMotion(*PVA, link)
     return pm
+
+
+def _set_nan(PVA: np.ndarray, nok: np.ndarray | None, bad: np.ndarray | None) -> None:
+    """NaN the rows ``nok`` (not assembled) of positions, velocities and accelerations
+    ``PVA`` (3, ..., N, 2) and the rows ``bad`` of the rates (one call each)."""
+    if nok is not None:  # through the transpose the rows are its second axis (the fastest mask)
+        PVA.T[:, nok] = np.nan
+    if bad is not None and (nok is None or bad.tobytes() != nok.tobytes()):  # often the same rows
+        PVA[1:].T[:, bad] = np.nan
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
@@ -413,7 +524,7 @@ def _event_units(S: PlanarSystem, e: Event) -> Event:
     """The event's input values by joint, in degrees (R) or lengths (P)."""
     if e.input is None:
         return e
-    return e.with_(input={d.joint: (float(np.degrees(v)) if d.type == "R" else float(v))
+    return e.with_(input={d.joint: (math.degrees(v) if d.type == "R" else float(v))  # np.degrees' product
                           for d, v in zip(S.drivers, e.input)})
 
 

@@ -95,12 +95,15 @@ class RegularPass:
         N = inputs.shape[0]
         if progress is not None:
             progress(N)
-        nan = np.full(N, np.nan)
         if isinstance(res, Folded):  # through folds: the tracked sweeps' singular rows and events
             return _folded_sweep(system, inputs, speeds, k, res, self.name)
         q, qd, qdd, links = res
-        return Sweep(system, inputs, speeds, q, qd, qdd, np.ones(N, bool), nan, nan.copy(), [], method="assur",
-                     links=links, engine=self.name)
+        nan = np.empty((2, N))  # Newton's det_sign and sigma_min, not computed here (empty + fill:
+        nan.fill(np.nan)        # np.full and np.ones are Python functions around these two calls)
+        ok = np.empty(N, bool)
+        ok.fill(True)
+        return Sweep(system, inputs, speeds, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", links=links,
+                     engine=self.name)
 
 
 class TrackedChain:
@@ -211,9 +214,13 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     q, qd, qdd = res.q, res.qd, res.qdd
     qd[sing] = np.nan  # a group folded flat: rates not defined here
     qdd[sing] = np.nan
-    ok = np.isfinite(q).all(axis=1)
-    N = U.shape[0]
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
+    ok = np.isfinite(q.T).all(axis=0)  # q is a transposed view: rows of coordinates reduce fastest
+    # rates NaN on whole rows (Folded's rows, and sing above): one coordinate tells a row
+    rates_ok = np.isfinite(qd.T[0]) & np.isfinite(qdd.T[0])
+    nan = np.empty((2, U.shape[0]))
+    nan.fill(np.nan)
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine, rates_ok=rates_ok,
+               nan_rows=True)
     if not back:
         sw.events = _tracked_events(ev, bool(ok[0]), U[0])
     else:
@@ -239,13 +246,53 @@ def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_in
     return out
 
 
+#: The answers of :func:`drawn_row` for the last few sweeps, by the drivers' types and drawn
+#: values and the inputs' shape: ``(the inputs' bytes, row)``. A drag or a design loop
+#: simulates the same grid again and again; equal bytes give the same row.
+_DRAWN: dict[tuple, tuple[bytes, int | None]] = {}
+_DRAWN_MAX, _DRAWN_BYTES = 16, 1 << 16  # at most 16 sweeps of at most 64 KiB of inputs each
+
+
 def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     """Row ``k`` (0 < k < N) such that the drawn input values lie on the sweep's segment from
-    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None."""
+    row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None.
+
+    The row of the same inputs (byte for byte, up to 64 KiB of them) with the same drawn
+    values is remembered.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from mechsyn.kinematics.analysis import compile_plan
+    >>> from mechsyn.io import load_mechanism
+    >>> S = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",)).system
+    >>> u0 = float(np.degrees(S.drivers[0].assembled))
+    >>> U = np.radians(np.arange(0.0, 361.0))[:, None]
+    >>> k = drawn_row(S, U)
+    >>> bool(np.degrees(U[k - 1, 0]) < u0 <= np.degrees(U[k, 0])), drawn_row(S, U[:1]) is None
+    (True, True)
+    """
     if U.shape[0] < 2:
         return None
-    if U.shape[1] == 1:
-        return _drawn_row_1(S.drivers[0], U[:, 0])
+    if U.nbytes > _DRAWN_BYTES:  # a long sweep: its own cost dwarfs the search, not kept
+        return _drawn_row_1(S.drivers[0], U[:, 0]) if U.shape[1] == 1 else _drawn_row_k(S, U)
+    drawn = S.cache.get("drawn values")
+    if drawn is None:
+        drawn = S.cache["drawn values"] = tuple([(d.type, float(d.assembled)) for d in S.drivers])
+    key = (U.shape, U.dtype.str, drawn)
+    data = U.tobytes()
+    hit = _DRAWN.get(key)
+    if hit is not None and hit[0] == data:
+        return hit[1]
+    k = _drawn_row_1(S.drivers[0], U[:, 0]) if U.shape[1] == 1 else _drawn_row_k(S, U)
+    if len(_DRAWN) >= _DRAWN_MAX:
+        _DRAWN.clear()  # one call (threads share the cache), not an eviction order
+    _DRAWN[key] = (data, k)
+    return k
+
+
+def _drawn_row_k(S: PlanarSystem, U: np.ndarray) -> int | None:
+    """:func:`drawn_row` of several inputs."""
     u0 = np.array([d.assembled for d in S.drivers], float)
     isR = np.array([d.type == "R" for d in S.drivers])
     a, d = U[:-1], np.diff(U, axis=0)
@@ -314,19 +361,21 @@ def merged(S: PlanarSystem, U: np.ndarray, k: int, fwd: Sweep, bwd: Sweep) -> Sw
                  cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method, engine=fwd.engine)
 
 
+#: What a dead point and a reassembly found going back from the drawn configuration say.
+_BACK_MESSAGES = {
+    "dead point": "a limit of the working range: the Jacobian is singular (dead point)",
+    "reassembled": "assembles again (going back from the drawn configuration) after a gap, in the "
+                   "assembly mode nearest the drawn one"}
+
+
 def merged_events(k: int, bwd: list[Event], fwd: list[Event]) -> list[Event]:
     """The events of the sweeps backwards from row ``k - 1`` and forwards from row ``k``
     as events of the whole sweep (re-indexed, worded for the way back, by row)."""
     events = []
     for e in bwd:
         at_row = e.kind == "singular" and not e.crossed
-        e = e.with_(index=(k - 1 - e.index) if at_row else max(0, k - e.index), before_sweep=None)
-        if e.kind == "dead point":
-            e = e.with_(message="a limit of the working range: the Jacobian is singular (dead point)")
-        elif e.kind == "reassembled":
-            e = e.with_(message="assembles again (going back from the drawn configuration) after a gap, in the "
-                                "assembly mode nearest the drawn one")
-        events.append(e)
+        events.append(e.with_(index=(k - 1 - e.index) if at_row else max(0, k - e.index), before_sweep=None,
+                              message=_BACK_MESSAGES.get(e.kind, e.message)))
     for e in fwd:
         events.append(e.with_(index=e.index + k, before_sweep=None))
     events.sort(key=lambda e: e.index)

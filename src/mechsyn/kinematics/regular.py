@@ -502,19 +502,23 @@ class LinkStates:
         """The links' rotations ``e^{i phi}`` (n_links, N)."""
         return self.C[0]
 
-    def point(self, i: int, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity, acceleration (N, 2) of the local point ``s`` of link ``i``."""
-        z, P0, V0, A0 = self.C[:, i]
-        rel = z * complex(s[0], s[1])
-        P = rel + P0
+    def point(self, i: int, s: complex | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, velocity, acceleration (N, 2) of the local point ``s`` (x, y, or a
+        complex number) of link ``i``: views of one array (3, N, 2)."""
+        C = self.C
+        N, w = C.shape[2], self.w[i]
+        out = np.empty((3, N), complex)
+        rel = C[0, i] * (s if isinstance(s, complex) else complex(s[0], s[1]))
+        np.add(rel, C[1, i], out=out[0])
         irel = rel * 1j
-        A = irel * self.al[i]
-        irel *= self.w[i]
-        V = irel + V0
-        rel *= self.w[i] ** 2
-        A -= rel
-        A += A0
-        return tuple(x.view(float).reshape(-1, 2) for x in (P, V, A))
+        np.multiply(irel, self.al[i], out=out[2])
+        irel *= w
+        np.add(irel, C[2, i], out=out[1])
+        rel *= w ** 2
+        out[2] -= rel
+        out[2] += C[3, i]
+        P, V, A = out.view(float).reshape(3, N, 2)
+        return P, V, A
 
     def points(self, idx: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (m, N, 2) of the local points ``s`` (m,

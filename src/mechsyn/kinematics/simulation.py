@@ -9,6 +9,7 @@ engine, planar or spatial, can build its result without importing the entry poin
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -194,16 +195,21 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
     >>> input_grid(0.0, 90.0, 30.0).tolist(), input_grid(0.0, 100.0, 30.0).tolist()
     ([0.0, 30.0, 60.0, 90.0], [0.0, 30.0, 60.0, 90.0])
     """
-    if not all(np.isfinite(v) for v in (start, stop, step)) or step == 0 or (stop - start) * step < 0:
+    if not (math.isfinite(start) and math.isfinite(stop) and math.isfinite(step)) or step == 0 \
+            or (stop - start) * step < 0:
         raise MechsynInputError(f"no sweep from {start:g} to {stop:g} in steps of {step:g}", field="inputs",
                                 hint="e.g. A=0:360:1 on the command line")
-    count = np.floor((stop - start) / step + 1e-9) + 1
+    c = (stop - start) / step + 1e-9  # on floats: np.floor's count without three NumPy scalar calls
+    count = float(math.floor(c)) + 1.0 if math.isfinite(c) else c + 1.0
     if count > limit("sweep_points"):
         raise MechsynInputError(
             f"{start:g}:{stop:g}:{step:g} is {count:,.0f} positions, more than the limit of "
             f"{limit('sweep_points'):,}", field="inputs",
             hint="use a larger step or a shorter range; " + limit_hint("sweep_points"))
-    return start + step * np.arange(int(count))
+    grid = np.arange(int(count), dtype=float)  # start + step * k in place (exact k: the same numbers)
+    grid *= step
+    grid += start
+    return grid
 
 
 def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:

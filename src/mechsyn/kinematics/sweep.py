@@ -104,7 +104,11 @@ class Sweep:
     NaN otherwise); ``method``: ``"assur"`` (closed form) or ``"newton"``; ``engine``: the
     name of the engine that computed it; ``links``: the links' complex states
     (:class:`mechsyn.kinematics.regular.LinkStates`) when the one regular pass computed the
-    sweep (every row assembled with finite rates), else None.
+    sweep (every row assembled with finite rates), else None; ``rates_ok``: the rows whose
+    rates are all finite when the engine knows them (else None: read off ``qd, qdd``);
+    ``nan_rows``: every row of ``q`` where the mechanism is not assembled, and of ``qd``,
+    ``qdd`` where the rates are not defined, is NaN entirely (so anything computed from
+    such a row is NaN there without being set).
     """
 
     system: Any
@@ -120,6 +124,8 @@ class Sweep:
     method: str = "newton"
     links: Any = None
     engine: str = "newton"
+    rates_ok: Any = None
+    nan_rows: bool = False
 
     @property
     def n(self) -> int:

@@ -227,13 +227,9 @@ class PlanarSystem:
 
     def points_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray,
                      s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`point_state` of the local points ``s`` (m, 2) of the moving links ``idx``
-        (m,) at once: position, velocity, acceleration (m, N, 2), each point's the same
-        arithmetic as :meth:`point_state` (so the same numbers), in a few array
-        operations for all of them.
+        """:meth:`point_state` of the local points ``s`` (m, 2) of the moving links ``idx`` (m,)
+        at once (m, N, 2), the same arithmetic (so the same numbers) in a few array operations.
 
-        Examples
-        --------
         >>> import numpy as np, mechsyn as ms
         >>> S = build_system(ms.examples.load("crank_rocker"))
         >>> q = S.q0[None] + np.linspace(0, 0.1, 4)[:, None]
@@ -241,24 +237,7 @@ class PlanarSystem:
         >>> P.shape, bool(np.array_equal(A[1], S.point_state(q, q, q, 1, np.array([0.5, 0.2]))[2]))
         ((2, 4, 2), True)
         """
-        m, N = len(idx), q.shape[0]
-        x, y, a = 3 * idx, 3 * idx + 1, 3 * idx + 2
-        qT, qdT, qddT = q.T, qd.T, qdd.T  # (n, N): rows are coordinates
-        phi = qT[a]
-        c, sn = np.cos(phi), np.sin(phi)
-        sx, sy = s[:, 0, None], s[:, 1, None]
-        ax_, ay_ = c * sx - sn * sy, sn * sx + c * sy  # A(phi) s, as _apply
-        nay = -ay_  # _perp(A s) = (-ay, ax)
-        w, al = qdT[a], qddT[a]
-        w2 = w ** 2
-        P, V, A = (np.empty((m, N, 2)) for _ in range(3))
-        np.add(qT[x], ax_, out=P[..., 0])
-        np.add(qT[y], ay_, out=P[..., 1])
-        np.add(qdT[x], w * nay, out=V[..., 0])
-        np.add(qdT[y], w * ax_, out=V[..., 1])
-        np.subtract(qddT[x] + al * nay, w2 * ax_, out=A[..., 0])
-        np.subtract(qddT[y] + al * ax_, w2 * ay_, out=A[..., 1])
-        return P, V, A
+        return tuple(_points_state(q, qd, qdd, idx, s))
 
     def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
         """Angles (N,) of link index ``i`` (frame: zeros)."""
@@ -795,3 +774,27 @@ class _Builder:
 def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """2-D cross product ``a x b`` (a scalar per row)."""
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """:meth:`PlanarSystem.points_state` as one array (3, m, N, 2) (a caller masks all three at once)."""
+    m, N, qT, qdT, qddT = len(idx), q.shape[0], q.T, qd.T, qdd.T  # q.T (n, N): rows are coordinates
+    if m == 1:  # one point: views of its link's rows, its local point as two floats
+        i = 3 * int(idx[0])
+        xy, a, sx, sy = (slice(i, i + 2), None), slice(i + 2, i + 3), float(s[0, 0]), float(s[0, 1])
+    else:
+        i3 = 3 * np.asarray(idx)
+        xy, a, sx, sy = np.stack([i3, i3 + 1]), i3 + 2, s[:, 0, None], s[:, 1, None]
+    cs, R = np.empty((2, m, N)), np.empty((3, m, N))  # cos, sin; -ay, ax, ay: _perp(A s) is R[:2], A s R[1:]
+    np.cos(qT[a], out=cs[0])
+    np.sin(qT[a], out=cs[1])
+    X, Y = cs * sx, cs * sy  # (c sx, sn sx), (c sy, sn sy): the products of _apply
+    np.subtract(X[0], Y[1], out=R[1])  # A(phi) s, as _apply
+    np.add(X[1], Y[0], out=R[2])
+    np.negative(R[2], out=R[0])
+    w, al, out = qdT[a], qddT[a], np.empty((3, m, N, 2))
+    T = out.transpose(0, 3, 1, 2)  # (3, 2, m, N): x and y as rows
+    np.add(qT[xy], R[1:], out=T[0])
+    np.add(qdT[xy], w * R[:2], out=T[1])
+    np.subtract(qddT[xy] + al * R[:2], (w ** 2) * R[1:], out=T[2])
+    return out

@@ -286,9 +286,9 @@ class Mechanism:
         themselves (a list or array); degrees for R joints, lengths for P joints:
         ``m.simulate(A=(0, 360, 1))`` or ``m.simulate({"A": np.linspace(0, 90, 7)})``.
         """
-        from mechsyn.kinematics.analysis import simulate
+        from mechsyn.kinematics.analysis import input_grid, simulate  # one import statement per call
 
-        return simulate(self, _inputs(inputs, joint_inputs), speeds=speeds, points=points, vll=vll,
+        return simulate(self, _inputs(inputs, joint_inputs, input_grid), speeds=speeds, points=points, vll=vll,
                         method=method)
 
     def forces(self, inputs: dict[str, Any] | None = None, *, gravity: tuple[float, float] = (0.0, 0.0),
@@ -363,13 +363,16 @@ class Mechanism:
         )
 
 
-def _inputs(inputs: dict[str, Any] | None, joint_inputs: dict[str, Any]) -> dict[str, np.ndarray]:
+def _inputs(inputs: dict[str, Any] | None, joint_inputs: dict[str, Any],
+            input_grid: Any = None) -> dict[str, np.ndarray]:
     """Joint -> values: a tuple ``(start, stop, step)`` is a range with both ends, anything
-    else the values themselves."""
-    from mechsyn.kinematics.analysis import input_grid
+    else the values themselves (``input_grid``: :func:`mechsyn.kinematics.analysis.input_grid`,
+    imported here when not given)."""
+    if input_grid is None:
+        from mechsyn.kinematics.analysis import input_grid
 
     out: dict[str, np.ndarray] = {}
-    for jid, v in {**(inputs or {}), **joint_inputs}.items():
+    for jid, v in ({**inputs, **joint_inputs} if inputs else joint_inputs).items():
         if isinstance(v, tuple):
             if len(v) != 3:
                 raise MechsynInputError(f"{jid}: a range is (start, stop, step), got {v!r}", field="inputs",
