@@ -170,8 +170,9 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
     next to ``ref``; with ``folds`` each tracked sweep (forwards from ``split``, backwards
     from ``split - 1``, or the one sweep) on its own, its runs of assembled rows unwrapped
     and each run following the run before by whole turns, the rows where a link is not
-    placed blanked (NaN) and the rates of rows where they are not finite blanked
-    (:func:`mechsyn.kinematics.regular._fold_poses`). Returns the rows assembled (N,)."""
+    placed blanked (NaN) in the poses and in ``C`` and the rates of rows where they are
+    not finite blanked (:func:`mechsyn.kinematics.regular._fold_poses`). Returns the rows
+    assembled (N,)."""
     nl = C.shape[1]
     twopi = 2 * math.pi
     ok = np.ones(N, np.bool_)
@@ -237,6 +238,9 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
                     q[c, r] = math.nan
                     qd[c, r] = math.nan
                     qdd[c, r] = math.nan
+                for i in range(nl):  # the links' states too: a point of any link is not placed here
+                    for c in range(4):
+                        C[c, i, r] = complex(math.nan, math.nan)
                 continue
             rates = True
             for c in range(3 * nl):

@@ -277,7 +277,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         assemble(S)  # checks the file configuration and the mobility
     sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
     ok = sw.assembled
-    complete = sw.links is not None
+    complete = sw.links is not None and sw.rates_ok is None
     if complete:  # the regular pass without folds: every row assembled with finite rates
         rates_ok, singular_rows = ok, []
     else:
@@ -477,10 +477,10 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
         nok = None if ok.all() else ~ok
         bad = None if rates_ok.all() else ~rates_ok
     states: dict[int, tuple] = {}
-    if len(moving) == 1 and complete:
+    if len(moving) == 1 and sw.links is not None:  # the links' states: NaN where the poses are
         states[moving[0]] = sw.links.point(int(idx[0]), complex(*local[0].tolist()))
     elif moving:
-        if complete:
+        if sw.links is not None:
             P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
         else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
             PVA = _points_state(sw.q, sw.qd, sw.qdd, idx, local)

@@ -220,7 +220,7 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     nan = np.empty((2, U.shape[0]))
     nan.fill(np.nan)
     sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine, rates_ok=rates_ok,
-               nan_rows=True)
+               nan_rows=True, links=res.links)
     if not back:
         sw.events = _tracked_events(ev, bool(ok[0]), U[0])
     else:

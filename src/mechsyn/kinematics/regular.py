@@ -372,7 +372,10 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
     out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
-    return None if out is None else Folded(*_fold_poses(S, plan, U, st, origin, split), out)
+    if out is None:
+        return None
+    q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split)
+    return Folded(q, qd, qdd, out, *links)
 
 
 def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
@@ -403,12 +406,15 @@ class Folded:
     n) with NaN rows where the mechanism is not assembled and NaN rates where they are
     not defined (the group folded flat), and per tracked sweep (the one sweep, or the
     sweeps forwards from the drawn input values and backwards) its singular rows and
-    events (rows counted along that sweep)."""
+    events (rows counted along that sweep); from the compiled pass also the links'
+    states (:class:`LinkStates`, NaN where the poses are: ``qd``'s and ``qdd``'s angle
+    rows are its rates, so rows blanked later are blanked there too)."""
 
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
     parts: list
+    links: LinkStates | None = None
 
 
 def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
@@ -416,9 +422,9 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     pass) through folds: NaN rows where a group is not assembled, NaN rates where they
     are not defined (inf at a group folded flat), each link's angle continuous along
     each tracked sweep from the drawn one."""
-    if isinstance(st, _Compiled):
+    if isinstance(st, _Compiled):  # and the links' states, NaN where the poses are
         q, qd, qdd, _ = _compiled_poses(S, plan, U, st, split, True)
-        return q.T, qd.T, qdd.T
+        return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     fin = np.isfinite(C[0].view(float)).all(axis=0)  # every link's rotation: real and imaginary parts
     ok = fin[0::2] & fin[1::2]

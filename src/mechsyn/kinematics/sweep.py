@@ -104,7 +104,8 @@ class Sweep:
     NaN otherwise); ``method``: ``"assur"`` (closed form) or ``"newton"``; ``engine``: the
     name of the engine that computed it; ``links``: the links' complex states
     (:class:`mechsyn.kinematics.regular.LinkStates`) when the one regular pass computed the
-    sweep (every row assembled with finite rates), else None; ``rates_ok``: the rows whose
+    sweep (every row assembled with finite rates; through folds, from the compiled pass,
+    NaN where the poses are), else None; ``rates_ok``: the rows whose
     rates are all finite when the engine knows them (else None: read off ``qd, qdd``);
     ``nan_rows``: every row of ``q`` where the mechanism is not assembled, and of ``qd``,
     ``qdd`` where the rates are not defined, is NaN entirely (so anything computed from
