@@ -142,19 +142,19 @@ def _layout(T: PlanarSystem) -> tuple | bool:
         how = c.kind if c.kind != "angle" else ("drive" if c.role == "drive" else
                                                 "rotation" if c.role == "rotation" else "kept")
         recipe.append((how, c, index[c.joint]))
-    return first, other, rows, cols, recipe
+    pairs = [(i, index[c.joint]) for c in T.cons if c.kind == "R" for i in (c.a, c.b)]  # sa, sb of each R
+    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs])
 
 
 def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames: tuple,
               ang: list) -> tuple[tuple, tuple]:
     """``T``'s constraints and drivers with the numbers of ``mech``: an R pair's local
-    points (all of them in one array), a drive's or a P pair's drawn relative angle, a
+    points (all of them in one array; ``recipe``: :func:`_layout`'s), a drive's or a P pair's drawn relative angle, a
     line's local points, direction and drawn slide coordinate (see
     :class:`~mechsyn.kinematics.system._Builder`)."""
+    recipe, links, joints = recipe
     drivers = list(T.drivers)
-    R = [(c.a, c.b, k) for how, c, k in recipe if how == "R"]
-    locs = frame_points(frames, [i for a, b, _ in R for i in (a, b)], [pts[k] for _, _, k in R for _ in (0, 1)])
-    block = np.array(locs, float).reshape(-1, 2)
+    block = list(np.array(frame_points(frames, links, [pts[k] for k in joints]), float)) if links else []
     cons, r = [], 0
 
     def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)

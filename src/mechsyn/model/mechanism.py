@@ -401,11 +401,11 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     >>> moved.point.tolist(), j.point.tolist(), moved.links == replace(j, point=np.ones(2)).links
     ([1.0, 1.0], [0.0, 0.0], True)
     """
+    if not changes.keys() <= obj.__dataclass_fields__.keys():
+        bad = next(k for k in changes if k not in obj.__dataclass_fields__)
+        raise TypeError(f"{type(obj).__name__} has no field {bad!r}")
     new = object.__new__(type(obj))
     fields = new.__dict__
     fields.update(obj.__dict__)
-    for key, value in changes.items():
-        if key not in obj.__dataclass_fields__:
-            raise TypeError(f"{type(obj).__name__} has no field {key!r}")
-        fields[key] = value
+    fields.update(changes)
     return new
