@@ -5,6 +5,7 @@ the answers, events, notes and refusals of the general path."""
 
 from __future__ import annotations
 
+import dataclasses
 import zlib
 from dataclasses import replace
 
@@ -367,6 +368,17 @@ def test_fields_replaced_is_dataclasses_replace():
         fields_replaced(c, sc=np.zeros(2))
     with pytest.raises(AttributeError):
         new.c0 = 1.0  # still frozen
+
+    @dataclasses.dataclass(frozen=True)
+    class Checked:
+        x: float
+
+        def __post_init__(self) -> None:
+            if self.x < 0:
+                raise ValueError("x < 0")
+
+    with pytest.raises(TypeError, match="__post_init__"):  # its check would be skipped
+        fields_replaced(Checked(1.0), x=-1.0)
 
 
 # ------------------------------------------------------------------ the studio's drag

@@ -391,7 +391,8 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     kinematics' constraint blocks and systems), by copying the instance's fields: a few
     hundred nanoseconds instead of the generated ``__init__``'s microseconds, which a
     fresh geometry paid per joint, constraint and driver on every call of a drag. The
-    names are checked against the class's fields.
+    names are checked against the class's fields, and a class with a ``__post_init__``
+    (whose checks this would skip) is refused.
 
     Examples
     --------
@@ -401,10 +402,12 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     >>> moved.point.tolist(), j.point.tolist(), moved.links == replace(j, point=np.ones(2)).links
     ([1.0, 1.0], [0.0, 0.0], True)
     """
-    if not changes.keys() <= obj.__dataclass_fields__.keys():
-        bad = next(k for k in changes if k not in obj.__dataclass_fields__)
-        raise TypeError(f"{type(obj).__name__} has no field {bad!r}")
-    new = object.__new__(type(obj))
+    cls = type(obj)
+    if not changes.keys() <= obj.__dataclass_fields__.keys() or hasattr(cls, "__post_init__"):
+        bad = next((k for k in changes if k not in obj.__dataclass_fields__), None)
+        raise TypeError(f"{cls.__name__} has no field {bad!r}" if bad else
+                        f"{cls.__name__} checks its fields in __post_init__: use dataclasses.replace")
+    new = object.__new__(cls)
     fields = new.__dict__
     fields.update(obj.__dict__)
     fields.update(changes)
