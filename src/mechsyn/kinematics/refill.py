@@ -75,7 +75,7 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     if lay is False:
         return None
     first, other, rowmask, colmask, recipe = lay
-    pts = np.array([j.point for j in mech.joints] + [p.at for p in mech.points.values()], float).tolist()
+    pts = [_xy(j.point) for j in mech.joints] + [_xy(p.at) for p in mech.points.values()]
     xs, ys = [p[0] for p in pts], [p[1] for p in pts]
     if not all(map(math.isfinite, xs + ys)):
         return None
@@ -118,7 +118,15 @@ def _frame_angles(pts: list, org: list, other: list, tol: float) -> np.ndarray:
                 break
         dx.append(ex)
         dy.append(ey)
-    return np.arctan2(np.array(dy, float), np.array(dx, float))
+    return np.arctan2(dy, dx)
+
+
+def _xy(p: Any) -> list:
+    """A drawn point as ``[x, y]`` floats (one ``tolist`` of a float array)."""
+    return p.tolist() if type(p) is np.ndarray and p.dtype is _FLOAT else np.asarray(p, float).tolist()
+
+
+_FLOAT = np.dtype(float)
 
 
 def _layout(T: PlanarSystem) -> tuple | bool:
