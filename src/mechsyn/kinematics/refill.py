@@ -157,12 +157,12 @@ def _layout(T: PlanarSystem) -> tuple | bool:
 def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames: tuple,
               ang: list) -> tuple[tuple, tuple]:
     """``T``'s constraints and drivers with the numbers of ``mech``: an R pair's local
-    points (all of them in one array; ``recipe``: :func:`_layout`'s), a drive's or a P pair's drawn relative angle, a
+    points (:class:`_RPair`; ``recipe``: :func:`_layout`'s), a drive's or a P pair's drawn relative angle, a
     line's local points, direction and drawn slide coordinate (see
     :class:`~mechsyn.kinematics.system._Builder`)."""
     recipe, links, joints = recipe
     drivers = list(T.drivers)
-    block = list(np.array(frame_points(frames, links, [pts[k] for k in joints]), float)) if links else []
+    block = frame_points(frames, links, [pts[k] for k in joints])
     cons, r = [], 0
 
     def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)
@@ -170,7 +170,7 @@ def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames:
 
     for how, c, k in recipe:
         if how == "R":
-            cons.append(fields_replaced(c, sa=block[r], sb=block[r + 1]))
+            cons.append(_RPair.of(c, block[r], block[r + 1]))
             r += 2
         elif how == "drive":
             drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=rel(c.b, c.a))
@@ -207,3 +207,56 @@ def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
         drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=s0)
     return Con("line", c.joint, 1, a, b, sa=np.zeros(2), sb=loc(b, j.point), w=u_loc,
                c0=s0 if c.role == "lock" else 0.0, driver=c.driver, role=c.role)
+
+
+class _RPair(Con):
+    """An R pair's constraint in a refilled system: a :class:`Con` whose local points
+    ``sa``, ``sb`` are kept as floats and made arrays when first read. The regular pass
+    and the drawn checks never read them (they carry the points themselves); Newton's
+    continuation, the rank tests and the forces do, once per system. Equal field for
+    field to the constraint :func:`build_system` makes (a test).
+
+    Examples
+    --------
+    >>> c = _RPair.of(Con("R", "B", 2, 0, 1, role="pair"), (1.0, 0.0), (0.5, 0.25))
+    >>> c.sa.tolist(), c.sb.tolist(), c.kind, c.role
+    ([1.0, 0.0], [0.5, 0.25], 'R', 'pair')
+    """
+
+    @classmethod
+    def of(cls, c: Con, sa: tuple, sb: tuple) -> "_RPair":
+        """``c`` (an R pair's constraint) with the local points ``sa``, ``sb`` (floats)."""
+        new = object.__new__(cls)
+        fields = new.__dict__
+        fields.update(c.__dict__)
+        fields["sa"] = fields["sb"] = None  # (the property's; the points wait in _xy)
+        fields["_xy"] = (sa, sb)
+        return new
+
+    def _point(self, k: int) -> np.ndarray:
+        fields = self.__dict__
+        xy = fields.pop("_xy", None)
+        if xy is not None:  # both made at once (a copy or a pickle carries what is there)
+            fields["_sa"], fields["_sb"] = np.array(xy[0], float), np.array(xy[1], float)
+        return fields["_sb" if k else "_sa"]
+
+    def _set(self, k: int, value: Any) -> None:  # dataclasses.replace's __init__ (object.__setattr__)
+        if "_xy" in self.__dict__:
+            self._point(k)
+        self.__dict__["_sb" if k else "_sa"] = value
+
+    @property  # type: ignore[override]
+    def sa(self) -> np.ndarray:
+        return self._point(0)
+
+    @sa.setter
+    def sa(self, value: Any) -> None:
+        self._set(0, value)
+
+    @property  # type: ignore[override]
+    def sb(self) -> np.ndarray:
+        return self._point(1)
+
+    @sb.setter
+    def sb(self, value: Any) -> None:
+        self._set(1, value)
