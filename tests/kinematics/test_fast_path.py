@@ -357,6 +357,24 @@ def test_a_point_that_is_not_finite_is_refused_not_refilled():
         simulate(bad, {"A": np.linspace(0.0, 360.0, 5)})
 
 
+def test_a_refilled_r_pair_reads_as_a_built_one():
+    """A refilled R pair's local points (made arrays when first read) read, copy, pickle
+    and replace as build_system's constraint does."""
+    import copy
+    import pickle
+
+    m = fourbar()
+    moved = m.with_joint_points({"C": m.joint("C").point + [0.02, -0.01]})
+    S, ref = refill.with_geometry(build_system(m), moved), build_system(moved)
+    for c, r in zip(S.cons, ref.cons):
+        if c.kind != "R":
+            continue
+        for other in (copy.deepcopy(c), pickle.loads(pickle.dumps(c)), c, replace(c, c0=0.0)):
+            assert other.sa.tolist() == r.sa.tolist() and other.sb.tolist() == r.sb.tolist()
+        swapped = replace(c, sa=r.sb)
+        assert swapped.sa.tolist() == r.sb.tolist() and swapped.sb.tolist() == r.sb.tolist()
+
+
 def test_fields_replaced_is_dataclasses_replace():
     c = Con("R", "B", 2, 0, 1, sa=np.zeros(2), sb=np.ones(2), role="pair")
     new = fields_replaced(c, sb=np.full(2, 2.0), c0=0.5)
