@@ -5,6 +5,7 @@ the answers, events, notes and refusals of the general path."""
 
 from __future__ import annotations
 
+import dataclasses
 import zlib
 from dataclasses import replace
 
@@ -14,12 +15,12 @@ import pytest
 from kinematics_helpers import driven_planar_examples, fourbar
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import analysis
-from mechsyn.kinematics import refill
+from mechsyn.kinematics import refill, regular
 from mechsyn.kinematics.analysis import compile_plan, simulate
-from mechsyn.kinematics.solve import drawn_checks, singular_configuration
+from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
 from mechsyn.kinematics.refill import topology_key
-from mechsyn.kinematics.system import build_system
-from mechsyn.model.mechanism import Mechanism, PointSpec
+from mechsyn.kinematics.system import Con, build_system, frame_points
+from mechsyn.model.mechanism import Mechanism, PointSpec, fields_replaced
 
 SINGULAR_NOTE = "the file's configuration is singular"
 
@@ -131,32 +132,41 @@ def test_moved_geometry_takes_the_fast_path(monkeypatch):
         compile_plan(moved, inputs=("A",)).system.q0.tolist()
 
 
+def _same_numbers(x, y) -> None:
+    assert (x is None) == (y is None)
+    if x is not None:
+        assert np.asarray(x).tolist() == np.asarray(y).tolist()  # bit for bit
+
+
 def test_refilled_system_equals_a_built_one():
+    """Every number a refilled system holds (frames, drawn pose, scales, constraint
+    blocks, drivers' drawn values, the points it keeps) is build_system's to the last
+    bit: the fill on floats does the same products, sums and arctan2."""
     rng = np.random.default_rng(3)
     for _name, m in EXAMPLES:
         try:
             T = build_system(m)
         except MechsynInputError:
             continue
-        moved = _moved(m, rng)
-        S = refill.with_geometry(T, moved)
-        if S is None:  # cams, gears, belts: built anew
-            assert any(c.kind not in ("R", "angle", "line") for c in T.cons)
-            continue
-        ref = build_system(moved)
-        assert (S.n, S.m, S.links, S.notes, S.vll) == (ref.n, ref.m, ref.links, ref.notes, ref.vll)
-        np.testing.assert_allclose(S.q0, ref.q0, rtol=1e-14, atol=1e-14 * ref.scale)
-        np.testing.assert_array_equal(S.row_scale, ref.row_scale)
-        assert [(d.joint, d.type, d.role) for d in S.drivers] == [(d.joint, d.type, d.role) for d in ref.drivers]
-        np.testing.assert_allclose([d.assembled for d in S.drivers], [d.assembled for d in ref.drivers],
-                                   rtol=1e-14, atol=1e-14 * ref.scale)
-        for c, r in zip(S.cons, ref.cons):
-            assert (c.kind, c.joint, c.a, c.b, c.driver, c.role) == (r.kind, r.joint, r.a, r.b, r.driver, r.role)
-            for x, y in ((c.sa, r.sa), (c.sb, r.sb), (c.w, r.w)):
-                assert (x is None) == (y is None)
-                if x is not None:
-                    np.testing.assert_allclose(x, y, rtol=1e-14, atol=1e-14 * ref.scale)
-            assert c.c0 == pytest.approx(r.c0, rel=1e-14, abs=1e-14 * ref.scale)
+        for _ in range(2):
+            moved = _moved(m, rng)
+            S = refill.with_geometry(T, moved)
+            if S is None:  # cams, gears, belts: built anew
+                assert any(c.kind not in ("R", "angle", "line") for c in T.cons)
+                break
+            ref = build_system(moved)
+            assert S.mech is moved and S.scale == ref.scale
+            assert (S.n, S.m, S.links, S.notes, S.vll) == (ref.n, ref.m, ref.links, ref.notes, ref.vll)
+            for x, y in ((S.q0, ref.q0), (S.origin0, ref.origin0), (S.angle0, ref.angle0),
+                         (S.row_scale, ref.row_scale), (S.col_scale, ref.col_scale)):
+                _same_numbers(x, y)
+            assert S.frames() == ref.frames() and S.drivers == ref.drivers and len(S.cons) == len(ref.cons)
+            for c, r in zip(S.cons, ref.cons):
+                assert (c.kind, c.joint, c.rows, c.a, c.b, c.driver, c.role, c.c0) == \
+                    (r.kind, r.joint, r.rows, r.a, r.b, r.driver, r.role, r.c0)
+                for x, y in ((c.sa, r.sa), (c.sb, r.sb), (c.w, r.w)):
+                    _same_numbers(x, y)
+            assert refill.joint_points(S)[:len(moved.joints)] == refill.joint_points(ref)
 
 
 def _folded(m: Mechanism) -> Mechanism:
@@ -256,6 +266,137 @@ def test_with_joint_points_checks_its_numbers():
     moved = m.with_joint_points({"C": [3.0, 2.5]})
     assert moved.joint("C").point.tolist() == [3.0, 2.5] and m.joint("C").point.tolist() != [3.0, 2.5]
     assert topology_key(moved) == topology_key(m)
+
+
+# ------------------------------------------------------------------ the fill on floats
+def test_frame_points_are_to_local_bit_for_bit():
+    S = build_system(fourbar())
+    rng = np.random.default_rng(5)
+    idx = rng.integers(-1, len(S.links), 50)
+    pts = rng.normal(size=(50, 2)) * 3.0
+    got = frame_points(S.frames(), idx.tolist(), pts.tolist())
+    names = [S.mech.ground if i < 0 else S.links[i] for i in idx.tolist()]
+    assert [list(p) for p in got] == [S.to_local(n, p).tolist() for n, p in zip(names, pts)]
+    assert S.to_locals(idx, pts).tolist() == [list(p) for p in got]
+
+
+def test_regular_program_of_a_refilled_system_is_the_built_ones():
+    """The program's numbers filled from the topology's shape on floats are those of the
+    program of a system built for the moved geometry (which builds its own shape)."""
+    rng = np.random.default_rng(9)
+    compared = 0
+    for name, m in EXAMPLES:
+        kp = compile_plan(m, inputs=tuple(j.id for j in m.joints if j.actuated))
+        if kp.groups is None or not kp.groups.closed_form_rates:  # not a driver-R + RRR chain
+            continue
+        new = kp.refilled(_moved(m, rng, 0.005))
+        if new.groups is None:  # a double joint pulled apart: no longer that chain
+            continue
+        compared += 1
+        moved = new.mechanism
+        ref = build_system(moved)
+        assert regular._program(new.system, new.groups) == regular._program(ref, new.groups), name
+    assert compared >= 4
+
+
+def test_drawn_checks_fire_on_each_fresh_geometry_of_one_topology():
+    """The checks' topology part is shared by the systems of one topology; each fresh
+    geometry still gets its own verdict: settled regular, settled singular (the folded
+    four-bar), or left to the general test (a zero-length coupler, a near fold) whose
+    refusal or note is that of a system built anew."""
+    m = fourbar()
+    kp = compile_plan(m, inputs=("A",))
+    B, C, D = (m.joint(j).point for j in "BCD")
+    near = _folded(m).joint("C").point + 1e-7 * np.array([0.0, 1.0])
+    cases = [("regular", m.with_joint_points({"C": C + [0.03, -0.01]}), True, False),
+             ("folded", _folded(m), True, True),
+             ("zero-length coupler", m.with_joint_points({"C": B}), False, None),
+             ("near the fold", m.with_joint_points({"C": near}), False, None),
+             ("regular again", m.with_joint_points({"C": C + [-0.02, 0.01]}), True, False)]
+    for label, moved, settled, singular in cases:
+        new = kp.refilled(moved)
+        assert new.groups is kp.groups and new.system.cache["programs"] is kp.system.cache["programs"], label
+        assert drawn_checks(new.system, new.groups) is settled, label
+        fresh = build_system(moved)
+        if settled:
+            assert new.system.cache["singular_drawn"] is singular is singular_configuration(fresh), label
+            continue
+        try:  # the general test decides as for a system built anew
+            want = ("ok", assemble(fresh).tolist(), singular_configuration(fresh))
+        except MechsynInputError as e:
+            want = ("error", str(e), None)
+        try:
+            got = ("ok", assemble(new.system).tolist(), singular_configuration(new.system))
+        except MechsynInputError as e:
+            got = ("error", str(e), None)
+        assert got[0] == want[0] and got[2] == want[2], label
+        if got[0] == "error":
+            assert got[1] == want[1], label
+        else:
+            np.testing.assert_allclose(got[1], want[1], rtol=0, atol=1e-12 * 4.0)
+
+
+def test_a_plan_the_checks_do_not_cover_goes_to_the_general_test():
+    """A mechanism with a P pair: the group test does not apply on any geometry."""
+    name, m = next((n, mm) for n, mm in EXAMPLES if any(j.type == "P" for j in mm.joints) and
+                   compile_plan(mm, inputs=tuple(j.id for j in mm.joints if j.actuated)).groups is not None)
+    kp = compile_plan(m, inputs=tuple(j.id for j in m.joints if j.actuated))
+    new = kp.refilled(_moved(m, np.random.default_rng(2), 0.005))
+    assert not drawn_checks(kp.system, kp.groups) and not drawn_checks(new.system, new.groups), name
+
+
+def test_a_point_that_is_not_finite_is_refused_not_refilled():
+    """A mechanism whose point is NaN (not through with_joint_points, which refuses it)
+    is not refilled: the general path refuses it with its one line."""
+    m = fourbar()
+    T = build_system(m)
+    bad = m.with_joints(tuple(replace(j, point=np.array([np.nan, 1.0])) if j.id == "C" else j for j in m.joints))
+    assert refill.with_geometry(T, bad) is None
+    compile_plan(m, inputs=("A",))
+    with pytest.raises(MechsynInputError, match="do not assemble"):
+        simulate(bad, {"A": np.linspace(0.0, 360.0, 5)})
+
+
+def test_a_refilled_r_pair_reads_as_a_built_one():
+    """A refilled R pair's local points (made arrays when first read) read, copy, pickle
+    and replace as build_system's constraint does."""
+    import copy
+    import pickle
+
+    m = fourbar()
+    moved = m.with_joint_points({"C": m.joint("C").point + [0.02, -0.01]})
+    S, ref = refill.with_geometry(build_system(m), moved), build_system(moved)
+    for c, r in zip(S.cons, ref.cons):
+        if c.kind != "R":
+            continue
+        for other in (copy.deepcopy(c), pickle.loads(pickle.dumps(c)), c, replace(c, c0=0.0)):
+            assert other.sa.tolist() == r.sa.tolist() and other.sb.tolist() == r.sb.tolist()
+        swapped = replace(c, sa=r.sb)
+        assert swapped.sa.tolist() == r.sb.tolist() and swapped.sb.tolist() == r.sb.tolist()
+
+
+def test_fields_replaced_is_dataclasses_replace():
+    c = Con("R", "B", 2, 0, 1, sa=np.zeros(2), sb=np.ones(2), role="pair")
+    new = fields_replaced(c, sb=np.full(2, 2.0), c0=0.5)
+    ref = replace(c, sb=np.full(2, 2.0), c0=0.5)
+    assert (new.kind, new.joint, new.rows, new.a, new.b, new.c0, new.role) == \
+        (ref.kind, ref.joint, ref.rows, ref.a, ref.b, ref.c0, ref.role)
+    assert new.sb.tolist() == [2.0, 2.0] and c.sb.tolist() == [1.0, 1.0] and new.sa is c.sa
+    with pytest.raises(TypeError, match="no field 'sc'"):
+        fields_replaced(c, sc=np.zeros(2))
+    with pytest.raises(AttributeError):
+        new.c0 = 1.0  # still frozen
+
+    @dataclasses.dataclass(frozen=True)
+    class Checked:
+        x: float
+
+        def __post_init__(self) -> None:
+            if self.x < 0:
+                raise ValueError("x < 0")
+
+    with pytest.raises(TypeError, match="__post_init__"):  # its check would be skipped
+        fields_replaced(Checked(1.0), x=-1.0)
 
 
 # ------------------------------------------------------------------ the studio's drag

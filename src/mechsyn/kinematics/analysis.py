@@ -123,7 +123,7 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
             kp = entry[1].get(key)
             if kp is not None:
                 return kp
-    kp = compile_plan(mech, vll=vll, inputs=inputs)
+    kp = _compiled(mech, vll, prescribed)
     with _PLANS_LOCK:
         entry = _PLANS.get(id(mech))
         if entry is None or entry[0] is not mech:
@@ -228,7 +228,12 @@ def _joint_pairs(kp: "KinematicPlan") -> tuple[np.ndarray, np.ndarray]:
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
     """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
     input values, which decides whether a passive VLL is prescribed)."""
-    prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    return _compiled(mech, vll, tuple(j for j in inputs if _is_passive(mech, j, vll)))
+
+
+def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> KinematicPlan:
+    """:func:`compile_plan` with the prescribed inputs found: the template of the
+    mechanism's topology refilled with its numbers, or built and kept as the template."""
     key = topology_key(mech, vll, prescribed)
     with _PLANS_LOCK:
         template = _TOPOLOGIES.get(key)

@@ -13,15 +13,14 @@ topology (see docs/kinematics.md, "The fresh-geometry fast path").
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.system import Con, PlanarSystem, _axis, _dir_angle, _to_frame
-from mechsyn.model.mechanism import Mechanism
+from mechsyn.kinematics.system import Con, PlanarSystem, _axis, _to_frame, frame_points
+from mechsyn.model.mechanism import Mechanism, fields_replaced
 
-__all__ = ["topology_key", "with_geometry"]
+__all__ = ["joint_points", "topology_key", "with_geometry"]
 
 
 def topology_key(mech: Mechanism, vll: dict[str, str] | None = None, prescribed: tuple[str, ...] = ()) -> tuple:
@@ -51,7 +50,14 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     :func:`topology_key`: the same constraints, drivers and notes with the numbers of
     ``mech``'s joint points (link frames, local points, drawn angles and slide
     coordinates, length scale), equal to :func:`build_system`'s; None when ``T`` has
-    blocks other than R pairs, angles and lines (cams, gears, belts: built anew).
+    blocks other than R pairs, angles and lines (cams, gears, belts: built anew) or a
+    point is not finite (:func:`build_system` then reports it).
+
+    The numbers are worked out on Python floats from one ``tolist`` of the points (the
+    same products, sums and ``arctan2`` as :func:`build_system`'s, so the same bits), and
+    the link angles, their cosines and sines, the local points of the R pairs and the
+    scales of the rows and columns are each one NumPy call: a fresh geometry of a drag
+    or a design loop costs a few NumPy calls, not a few per joint.
 
     Examples
     --------
@@ -68,44 +74,66 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
         lay = T.cache["layout"] = _layout(T)
     if lay is False:
         return None
-    first, other, lengths = lay
-    joints = mech.joints
-    pts = [j.point for j in joints]
-    allpts = np.array(pts + [p.at for p in mech.points.values()], float)
-    scale = float(max((allpts.max(axis=0) - allpts.min(axis=0)).max(), 1e-9)) if len(allpts) > 1 else 1.0
-    nl = len(T.links)
-    origin0 = allpts[first] if nl else np.zeros((0, 2))
-    angle0 = np.zeros(nl)
-    for i, ks in enumerate(other):  # towards the first other joint point (as _link_frames)
-        for k in ks:
-            d = pts[k] - origin0[i]
-            if math.hypot(d[0], d[1]) > 1e-12 * scale:
-                angle0[i] = _dir_angle(d)
-                break
+    first, other, rowmask, colmask, recipe = lay
+    pts = [_xy(j.point) for j in mech.joints] + [_xy(p.at) for p in mech.points.values()]
+    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
+    if not all(map(math.isfinite, xs + ys)):
+        return None
+    scale = max(max(xs) - min(xs), max(ys) - min(ys), 1e-9) if len(pts) > 1 else 1.0
+    org = [pts[k] for k in first]
+    angle0 = _frame_angles(pts, org, other, 1e-12 * scale)
     cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
-    org, ang = origin0.tolist(), angle0.tolist()
-
-    def loc(i: int, p: Any, direction: bool = False) -> np.ndarray:  # S.to_local / to_local_dir
-        if i < 0:
-            return np.asarray(p, float)
-        return _to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
-            _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
-
-    cons, drivers = _refilled(T, mech, loc, ang, org)
-    q0 = np.empty(3 * nl)
-    q0[0::3], q0[1::3], q0[2::3] = origin0[:, 0], origin0[:, 1], angle0
-    rows = np.where(lengths, scale, 1.0)
-    cols = np.ones(len(q0))
-    cols[0::3] = cols[1::3] = scale
+    frames, ang = (cos, sin, org), angle0.tolist()
+    cons, drivers = _refilled(T, mech, recipe, pts, frames, ang)
+    q0 = np.array([v for (x, y), a in zip(org, ang) for v in (x, y, a)], float)
     # the engines' programs by topology (regular._program's shapes), shared with T
-    cache = {"frames": (cos, sin, org), "programs": T.cache.setdefault("programs", {})}
-    return PlanarSystem(mech, T.links, origin0, angle0, cons, drivers, T.n, T.m, q0, scale, vll=dict(T.vll),
-                        notes=T.notes, row_scale=rows, col_scale=cols, cache=cache)
+    cache = {"frames": frames, "joint_points": pts, "layout": lay, "programs": T.cache.setdefault("programs", {})}
+    return fields_replaced(T, mech=mech, origin0=np.array(org, float).reshape(-1, 2), angle0=angle0, cons=cons,
+                           drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll),
+                           row_scale=np.where(rowmask, scale, 1.0), col_scale=np.where(colmask, scale, 1.0),
+                           cache=cache)
+
+
+def joint_points(S: PlanarSystem) -> list:
+    """The drawn points of ``S``'s joints (file order; then its named points when ``S``
+    was refilled) as ``[x, y]`` lists of floats, kept with the system."""
+    pts = S.cache.get("joint_points")
+    if pts is None:
+        pts = S.cache["joint_points"] = np.array([j.point for j in S.mech.joints], float).reshape(-1, 2).tolist()
+    return pts
+
+
+def _frame_angles(pts: list, org: list, other: list, tol: float) -> np.ndarray:
+    """Every link frame's drawn angle (:func:`~mechsyn.kinematics.system._link_frames`):
+    towards the first other joint point farther than ``tol`` from the origin, else 0;
+    the directions' differences on floats (the numbers of the arrays' subtraction), the
+    angles in one ``arctan2`` (the same bits as its call per link)."""
+    dx, dy = [], []
+    for (ox, oy), ks in zip(org, other):
+        ex = ey = 0.0  # arctan2(0, 0) = 0: no other joint point away from the origin
+        for k in ks:
+            px, py = pts[k]
+            if math.hypot(px - ox, py - oy) > tol:
+                ex, ey = px - ox, py - oy
+                break
+        dx.append(ex)
+        dy.append(ey)
+    return np.arctan2(dy, dx)
+
+
+def _xy(p: Any) -> list:
+    """A drawn point as ``[x, y]`` floats (one ``tolist`` of a float array)."""
+    return p.tolist() if type(p) is np.ndarray and p.dtype is _FLOAT else np.asarray(p, float).tolist()
+
+
+_FLOAT = np.dtype(float)
 
 
 def _layout(T: PlanarSystem) -> tuple | bool:
-    """Joint indices of every moving link's frame (its first joint, then the others in
-    file order), or False when ``T`` cannot be refilled (see :func:`with_geometry`)."""
+    """What :func:`with_geometry` needs of ``T``'s topology, or False when ``T`` cannot be
+    refilled: the joint indices of every moving link's frame (its first joint, then the
+    others in file order), which rows and columns scale with the length, and per
+    constraint how its numbers are filled (:func:`_refilled`)."""
     mech = T.mech
     if T.n != 3 * len(T.links) or any(c.kind not in ("R", "angle", "line") for c in T.cons):
         return False
@@ -115,41 +143,120 @@ def _layout(T: PlanarSystem) -> tuple | bool:
         ks = [index[j.id] for j in mech.joints_of(name)]
         first.append(ks[0])
         other.append(ks[1:])
-    lengths = np.concatenate([np.full(c.rows, c.kind != "angle") for c in T.cons]) if T.cons else np.zeros(0, bool)
-    return first, other, lengths
+    rows = np.concatenate([np.full(c.rows, c.kind != "angle") for c in T.cons]) if T.cons else np.zeros(0, bool)
+    cols = np.arange(T.n) % 3 != 2
+    recipe = []
+    for c in T.cons:
+        how = c.kind if c.kind != "angle" else ("drive" if c.role == "drive" else
+                                                "rotation" if c.role == "rotation" else "kept")
+        recipe.append((how, c, index[c.joint]))
+    pairs = [(i, index[c.joint]) for c in T.cons if c.kind == "R" for i in (c.a, c.b)]  # sa, sb of each R
+    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs])
 
 
-def _refilled(T: PlanarSystem, mech: Mechanism, loc: Any, ang: list, org: list) -> tuple[tuple, tuple]:
-    """``T``'s constraints and drivers with the numbers of ``mech`` (see :func:`_Builder`)."""
-    joint = {j.id: j for j in mech.joints}
-    drawn = {d.joint: d for d in T.drivers}
+def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames: tuple,
+              ang: list) -> tuple[tuple, tuple]:
+    """``T``'s constraints and drivers with the numbers of ``mech``: an R pair's local
+    points (:class:`_RPair`; ``recipe``: :func:`_layout`'s), a drive's or a P pair's drawn relative angle, a
+    line's local points, direction and drawn slide coordinate (see
+    :class:`~mechsyn.kinematics.system._Builder`)."""
+    recipe, links, joints = recipe
     drivers = list(T.drivers)
-    cons = []
+    block = frame_points(frames, links, [pts[k] for k in joints])
+    cons, r = [], 0
 
     def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)
-        return float((0.0 if b < 0 else ang[b]) - (0.0 if a < 0 else ang[a]))
+        return (0.0 if b < 0 else ang[b]) - (0.0 if a < 0 else ang[a])
 
-    for c in T.cons:
-        j = joint[c.joint]
-        a, b = c.a, c.b
-        if c.kind == "R":
-            cons.append(Con("R", c.joint, 2, a, b, sa=loc(a, j.point), sb=loc(b, j.point), role=c.role))
-            continue
-        if c.kind == "angle":
-            if c.role == "drive":
-                drivers[c.driver] = replace(drawn[c.joint], assembled=rel(b, a))
-            cons.append(replace(c, c0=rel(b, a)) if c.role == "rotation" else c)
-            continue
-        u = _axis(j)
-        u_loc = loc(a, u, direction=True)
-        if c.role == "pair":
-            cons.append(Con("line", c.joint, 1, a, b, sa=loc(a, j.point), sb=loc(b, j.point),
-                            w=np.array([-u_loc[1], u_loc[0]]), role="pair"))
-            continue
-        o_a = np.zeros(2) if a < 0 else np.asarray(org[a])
-        s0 = float(u @ (j.point - o_a))
-        if c.driver is not None:
-            drivers[c.driver] = replace(drawn[c.joint], assembled=s0)
-        cons.append(Con("line", c.joint, 1, a, b, sa=np.zeros(2), sb=loc(b, j.point), w=u_loc,
-                        c0=s0 if c.role == "lock" else 0.0, driver=c.driver, role=c.role))
+    for how, c, k in recipe:
+        if how == "R":
+            cons.append(_RPair.of(c, block[r], block[r + 1]))
+            r += 2
+        elif how == "drive":
+            drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=rel(c.b, c.a))
+            cons.append(c)
+        elif how == "rotation":
+            cons.append(fields_replaced(c, c0=rel(c.b, c.a)))
+        elif how == "kept":
+            cons.append(c)
+        else:
+            cons.append(_line(c, mech.joints[k], frames, drivers))
     return tuple(cons), tuple(drivers)
+
+
+def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
+    """A line constraint of the P pair ``j`` refilled (its driver's drawn value set in
+    ``drivers``), by :meth:`PlanarSystem.to_local`'s arithmetic."""
+    cos, sin, org = frames
+    a, b = c.a, c.b
+
+    def loc(i: int, p: Any, direction: bool = False) -> np.ndarray:  # S.to_local / to_local_dir
+        if i < 0:
+            return np.asarray(p, float)
+        return _to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
+            _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
+
+    u = _axis(j)
+    u_loc = loc(a, u, direction=True)
+    if c.role == "pair":
+        return Con("line", c.joint, 1, a, b, sa=loc(a, j.point), sb=loc(b, j.point),
+                   w=np.array([-u_loc[1], u_loc[0]]), role="pair")
+    o_a = np.zeros(2) if a < 0 else np.asarray(org[a])
+    s0 = float(u @ (j.point - o_a))
+    if c.driver is not None:
+        drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=s0)
+    return Con("line", c.joint, 1, a, b, sa=np.zeros(2), sb=loc(b, j.point), w=u_loc,
+               c0=s0 if c.role == "lock" else 0.0, driver=c.driver, role=c.role)
+
+
+class _RPair(Con):
+    """An R pair's constraint in a refilled system: a :class:`Con` whose local points
+    ``sa``, ``sb`` are kept as floats and made arrays when first read. The regular pass
+    and the drawn checks never read them (they carry the points themselves); Newton's
+    continuation, the rank tests and the forces do, once per system. Equal field for
+    field to the constraint :func:`build_system` makes (a test).
+
+    Examples
+    --------
+    >>> c = _RPair.of(Con("R", "B", 2, 0, 1, role="pair"), (1.0, 0.0), (0.5, 0.25))
+    >>> c.sa.tolist(), c.sb.tolist(), c.kind, c.role
+    ([1.0, 0.0], [0.5, 0.25], 'R', 'pair')
+    """
+
+    @classmethod
+    def of(cls, c: Con, sa: tuple, sb: tuple) -> "_RPair":
+        """``c`` (an R pair's constraint) with the local points ``sa``, ``sb`` (floats)."""
+        new = object.__new__(cls)
+        fields = new.__dict__
+        fields.update(c.__dict__)
+        fields["sa"] = fields["sb"] = None  # (the property's; the points wait in _xy)
+        fields["_xy"] = (sa, sb)
+        return new
+
+    def _point(self, k: int) -> np.ndarray:
+        fields = self.__dict__
+        xy = fields.pop("_xy", None)
+        if xy is not None:  # both made at once (a copy or a pickle carries what is there)
+            fields["_sa"], fields["_sb"] = np.array(xy[0], float), np.array(xy[1], float)
+        return fields["_sb" if k else "_sa"]
+
+    def _set(self, k: int, value: Any) -> None:  # dataclasses.replace's __init__ (object.__setattr__)
+        if "_xy" in self.__dict__:
+            self._point(k)
+        self.__dict__["_sb" if k else "_sa"] = value
+
+    @property  # type: ignore[override]
+    def sa(self) -> np.ndarray:
+        return self._point(0)
+
+    @sa.setter
+    def sa(self, value: Any) -> None:
+        self._set(0, value)
+
+    @property  # type: ignore[override]
+    def sb(self) -> np.ndarray:
+        return self._point(1)
+
+    @sb.setter
+    def sb(self, value: Any) -> None:
+        self._set(1, value)

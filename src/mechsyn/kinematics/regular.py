@@ -37,8 +37,9 @@ import numpy as np
 from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
 from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
+from mechsyn.kinematics.refill import joint_points
+from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows, pass_fold_events, tracking_path
-from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
 
@@ -67,8 +68,9 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
 def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     """The topology of :func:`_program`: its steps without numbers (a drive's links,
     joint, driver and sign; an RRR group's known links, links and joints), each link's
-    anchor joint, origin joint, and the (link, joint) pairs whose local points the
-    numbers take, as index arrays (link, joint's index in the file)."""
+    anchor joint, origin joint, the (link, joint) pairs whose local points the numbers
+    take, as index lists (link, joint's index in the file), and the file indices of
+    every RRR group's joints (its drawn assembly mode)."""
     prog, anchor = _chain_program(S, plan, None)
     pairs: dict[tuple[int, str], int] = {}
 
@@ -89,38 +91,38 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)
         origin.append(j0)
     index = {j.id: k for k, j in enumerate(S.mech.joints)}
-    li = np.array([i for i, _ in pairs], int)
-    pj = np.array([index[jid] for _, jid in pairs], int)
-    return steps, anchors, origin, li, pj
+    drawn = [(index[st[3][0]], index[st[3][1]], index[st[3][2]]) if st[0] == "RRR" else None for st in steps]
+    return steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs], drawn
 
 
-def _locals(S: PlanarSystem, li: np.ndarray, pj: np.ndarray) -> tuple[list, list]:
+def _locals(S: PlanarSystem, li: list, pj: list) -> tuple[list, list]:
     """The local points (x and y lists) of the joints ``pj`` (indices in the file) on the
-    links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`."""
-    joints = S.mech.joints
-    loc = S.to_locals(li, np.array([joints[k].point for k in pj.tolist()], float).reshape(-1, 2))
-    return loc[:, 0].tolist(), loc[:, 1].tolist()
+    links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`'s
+    numbers, on floats."""
+    pts = joint_points(S)
+    loc = frame_points(S.frames(), li, [pts[k] for k in pj])
+    return [p[0] for p in loc], [p[1] for p in loc]
 
 
 def _filled(S: PlanarSystem, shape: tuple) -> tuple:
     """:func:`_program` of ``S`` from its topology's shape (:func:`_shape`): the local
     points, squared link lengths, drawn assembly modes and rotation vectors of ``S``."""
-    steps_, anchors, origin, li, pj = shape
+    steps_, anchors, origin, li, pj, drawn = shape
     x, y = _locals(S, li, pj)
-    pt = {j.id: j.point for j in S.mech.joints}
+    pt = joint_points(S)
     steps = []
-    for st in steps_:
+    for st, ks in zip(steps_, drawn):
         if st[0] == "drive":
             steps.append(st[:6] + (complex(x[st[6]], y[st[6]]),))
             continue
-        _, known, links, (J1, J2, J3), i1, i2, i3, i4, k1, k3 = st
+        _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
         ux, uy = x[i2] - x[i1], y[i2] - y[i1]  # s2 - s1 on the first link, t2 - t3 on the second
         vx, vy = x[i3] - x[i4], y[i3] - y[i4]
         L1s, L2s = ux * ux + uy * uy, vx * vx + vy * vy
-        A0, B0, C0 = pt[J1], pt[J2], pt[J3]
-        cross = (C0[0] - A0[0]) * (B0[1] - A0[1]) - (C0[1] - A0[1]) * (B0[0] - A0[0])
+        (ax, ay), (bx, by), (cx, cy) = pt[ks[0]], pt[ks[1]], pt[ks[2]]
+        cross = (cx - ax) * (by - ay) - (cy - ay) * (bx - ax)
         sigma = 1.0 if cross >= 0 else -1.0
-        steps.append(("RRR", known, links, (J1, J2, J3), L1s, L2s, sigma, complex(ux / L1s, -(uy / L1s)),
+        steps.append(("RRR", known, links, joints, L1s, L2s, sigma, complex(ux / L1s, -(uy / L1s)),
                       complex(vx / L2s, -(vy / L2s)), complex(x[k1], y[k1]), complex(x[k3], y[k3])))
     cx = {i: (jid, complex(x[k], y[k])) for i, (jid, k) in anchors.items()}
     return steps, cx, origin

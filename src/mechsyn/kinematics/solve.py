@@ -22,6 +22,7 @@ import scipy.linalg as sla
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.groups import decompose
 from mechsyn.kinematics.positions import solve_positions
+from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -174,15 +175,13 @@ def drawn_checks(S: PlanarSystem, plan: Any) -> bool:
 
 
 def _drawn_checks(S: PlanarSystem, plan: Any) -> bool:
-    if plan is None or S.m != S.n or not all(s.kind in ("drive_R", "RRR") and set(s.data) <= {"double"}
-                                             for s in plan.steps):
+    groups = _drawn_groups(S, plan)
+    if groups is None:
         return False
-    pts = {j.id: j.point for j in S.mech.joints}
+    pts = joint_points(S)
     singular = False
-    for step in plan.steps:
-        if step.kind != "RRR":
-            continue
-        (ax, ay), (bx, by), (cx, cy) = (pts[j].tolist() for j in step.joints)
+    for ia, ib, ic in groups:
+        (ax, ay), (bx, by), (cx, cy) = pts[ia], pts[ib], pts[ic]
         e1x, e1y, e2x, e2y = bx - ax, by - ay, bx - cx, by - cy
         L1, L2 = math.hypot(e1x, e1y), math.hypot(e2x, e2y)
         short = min(L1, L2)
@@ -195,6 +194,23 @@ def _drawn_checks(S: PlanarSystem, plan: Any) -> bool:
             return False
     S.cache["singular_drawn"] = singular
     return True
+
+
+def _drawn_groups(S: PlanarSystem, plan: Any) -> list | None:
+    """The file indices of the joints (ends, middle, end) of every RRR group of ``plan``,
+    or None when :func:`drawn_checks` does not apply (a plan other than R drives and RRR
+    dyads, or not as many equations as unknowns): the topology's part of the checks,
+    kept with the programs the systems of one topology share."""
+    shared = S.cache.setdefault("programs", {})
+    key = ("drawn checks", id(plan))
+    hit = shared.get(key)
+    if hit is None or hit[0] is not plan:
+        ok = plan is not None and S.m == S.n and all(s.kind in ("drive_R", "RRR") and set(s.data) <= {"double"}
+                                                     for s in plan.steps)
+        index = {j.id: k for k, j in enumerate(S.mech.joints)}
+        groups = [tuple(index[j] for j in s.joints) for s in plan.steps if s.kind == "RRR"] if ok else None
+        hit = shared[key] = (plan, groups)
+    return hit[1]
 
 
 def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:

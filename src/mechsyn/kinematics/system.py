@@ -40,8 +40,7 @@ References
    links" (in Russian), ITMO University, St. Petersburg ("paper 000"; see docs/references.md).
 .. [2] "A new basic mechanism of a manipulator for servicing technological machines" (in
    Bulgarian; a manipulator with a flexible element, by the method of V. Galabov et
-   al., 2012) ("paper 001";
-   see docs/references.md).
+   al., 2012) ("paper 001"; see docs/references.md).
 """
 
 from __future__ import annotations
@@ -181,7 +180,7 @@ class PlanarSystem:
 
     def to_locals(self, idx: np.ndarray, pts: np.ndarray) -> np.ndarray:
         """:meth:`to_local` of the points ``pts`` (m, 2) on the links ``idx`` (m,; -1: the
-        frame, the point itself) at once (m, 2): the same arithmetic, so the same numbers.
+        frame, the point itself) at once (m, 2): :func:`frame_points`, the same numbers.
 
         Examples
         --------
@@ -192,12 +191,7 @@ class PlanarSystem:
         >>> bool(np.array_equal(loc[0], S.to_local(S.links[1], pts[0]))), loc[1].tolist()
         (True, [0.5, -0.3])
         """
-        cos, sin, org = self.frames()
-        mov, k = idx >= 0, np.where(idx >= 0, idx, 0)
-        c, sn = np.array(cos + [1.0])[k], np.array(sin + [0.0])[k]
-        o = np.array(org, float).reshape(-1, 2)[k] if len(org) else np.zeros((len(idx), 2))
-        dx, dy = pts[:, 0] - o[:, 0], pts[:, 1] - o[:, 1]
-        return np.stack([np.where(mov, c * dx - sn * dy, pts[:, 0]), np.where(mov, sn * dx + c * dy, pts[:, 1])], 1)
+        return np.array(frame_points(self.frames(), idx.tolist(), pts.tolist()), float).reshape(-1, 2)
 
     def pose(self, q: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
         """(r (N,2), phi (N,)) of link ``i`` (frame: zeros)."""
@@ -330,6 +324,13 @@ class PlanarSystem:
                 rows.extend(range(row, row + con.rows))
             row += con.rows
         return rows
+
+
+def frame_points(frames: tuple, idx: list, xy: list) -> list:
+    """Points ``xy`` in the frames of links ``idx`` (-1: frame): :func:`_to_frame` on floats."""
+    cos, sin, org = frames  # (c dx - s dy, s dx + c dy), dx and dy named as they are first used
+    return [(x, y) if i < 0 else (cos[i] * (dx := x - org[i][0]) - sin[i] * (dy := y - org[i][1]),
+                                  sin[i] * dx + cos[i] * dy) for i, (x, y) in zip(idx, xy)]
 
 
 def _to_frame(c: float, s: float, dx: float, dy: float) -> np.ndarray:
