@@ -291,3 +291,21 @@ def fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg):  # pragma: no cover -
                 if a > -zero and c > -zero and m <= max(a, 0.0) and m <= max(c, 0.0):
                     low = True
     return low
+
+
+@njit(**_OPTIONS)
+def point_states(C, w, al, idx, s, out):  # pragma: no cover - compiled
+    """Position, velocity, acceleration ``out`` (3, m, N) complex of the local points ``s``
+    (m,) of the links ``idx`` (m,) from the links' states ``C`` (4, links, N) and rates
+    ``w``, ``al`` (links, N): :meth:`mechsyn.kinematics.regular.LinkStates.points`'
+    products in the same order, row by row."""
+    N = out.shape[2]
+    for k in range(idx.shape[0]):
+        i, sk = idx[k], s[k]
+        for r in range(N):
+            rel = C[0, i, r] * sk
+            wr = w[i, r]
+            irel = rel * 1j
+            out[0, k, r] = rel + C[1, i, r]
+            out[1, k, r] = irel * wr + C[2, i, r]
+            out[2, k, r] = ((irel * al[i, r]) - rel * (wr * wr)) + C[3, i, r]

@@ -45,7 +45,7 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["active", "fold_rows", "link_poses", "program_arrays", "run", "warm"]
+__all__ = ["active", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 
@@ -82,16 +82,16 @@ def active() -> bool:
 
 
 def warm() -> bool:
-    """Import Numba and compile (or load from its cache) the kernel now, on an empty
-    program of the argument types every pass uses, so the first sweep does not wait for
-    it (the studio calls this while it starts). False when the kernel is off."""
-    mod = _compiled()
-    if mod is None:
+    """Import Numba and compile (or load from its cache) the kernel's functions now, by
+    sweeping two bundled four-bars (one through its dead points), so that the first sweep
+    a user asks for does not wait for them (the studio calls this while it starts).
+    False when the kernel is off."""
+    if _compiled() is None:
         return False
-    ints, cplx, flt = np.zeros((0, 11), np.int64), np.zeros((0, 7), complex), np.zeros((1, 1))
-    mod.regular_pass(ints, cplx, np.zeros(0, np.int64), np.zeros(0, complex), np.zeros(0, np.int64), flt,
-                     np.ones(1), 0, 0.05, np.zeros((4, 0, 1), complex), np.zeros((0, 1)), np.zeros((0, 1)),
-                     np.zeros((0, 1)))
+    from mechsyn import examples
+
+    for name in ("crank_rocker", "fourbar"):
+        examples.load(name).simulate(A=(0, 360, 30))
     return True
 
 
@@ -194,3 +194,15 @@ def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc:
     Dl, singular, chg = np.empty((ng, L)), np.empty(L, np.bool_), np.empty((ng, max(L - 1, 0)), np.bool_)
     low = mod.fold_rows(np.array(discs), perm, b, zero, singular_disc, Dl, singular, chg)
     return Dl, singular, np.nonzero(chg), bool(low)
+
+
+def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray | None:
+    """Position, velocity, acceleration (3, m, N) complex of the local points ``s`` (m,
+    complex) of the links ``idx`` from the links' states (``C`` (4, links, N), rates ``w``,
+    ``al`` (links, N)), compiled; None without the kernel."""
+    mod = _compiled()
+    if mod is None:
+        return None
+    out = np.empty((3, idx.shape[0], C.shape[2]), complex)
+    mod.point_states(C, w, al, idx, s, out)
+    return out

@@ -514,7 +514,13 @@ class LinkStates:
         """Position, velocity, acceleration (N, 2) of the local point ``s`` (x, y, or a
         complex number) of link ``i``: views of one array (3, N, 2)."""
         C = self.C
-        N, w = C.shape[2], self.w[i]
+        N = C.shape[2]
+        got = kernel.point_states(C, self.w, self.al, np.array([i], np.int64),
+                                  np.array([s if isinstance(s, complex) else complex(s[0], s[1])]))
+        if got is not None:  # compiled
+            P, V, A = got[:, 0].view(float).reshape(3, N, 2)
+            return P, V, A
+        w = self.w[i]
         out = np.empty((3, N), complex)
         rel = C[0, i] * (s if isinstance(s, complex) else complex(s[0], s[1]))
         np.add(rel, C[1, i], out=out[0])
@@ -545,6 +551,10 @@ class LinkStates:
         >>> P.shape, bool(np.array_equal(A[1], links.point(1, (0.5, 0.2))[2]))
         ((2, 12, 2), True)
         """
+        got = kernel.point_states(self.C, self.w, self.al, np.asarray(idx, np.int64), np.asarray(s, complex))
+        if got is not None:  # compiled
+            m, N = got.shape[1:]
+            return tuple(x.view(float).reshape(m, N, 2) for x in got)
         Z = self.C[:, idx]
         rel = Z[0] * s[:, None]
         P = rel + Z[1]
