@@ -17,6 +17,13 @@ from mechsyn.model.mechanism import Mechanism
 pytest.importorskip("numba")
 
 
+@pytest.fixture(autouse=True)
+def _kernel_on(monkeypatch):
+    """These tests compare the compiled pass with the NumPy one: the kernel on, whatever
+    the environment says (CI runs the kinematics tests again with MECHSYN_KERNEL=numpy)."""
+    monkeypatch.setenv("MECHSYN_KERNEL", "auto")
+
+
 def _scale(m: Mechanism) -> float:
     pts = np.array([j.point for j in m.joints if j.point is not None and len(j.point) == 2], float)
     return float(np.ptp(pts, axis=0).max())
