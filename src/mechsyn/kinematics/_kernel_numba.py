@@ -49,13 +49,14 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
 
 
 @njit(**_OPTIONS)
-def regular_pass(ip, fp, anc_j, anc_s, org_j, X, speeds, nj, least, C, W, AL, D):  # pragma: no cover
+def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D):  # pragma: no cover
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
-    rows ``X`` (M, k); fill every link's rotation and its origin's position, velocity and
+    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's, as the NumPy pass
+    takes them, and as fast as libm's in the loop); fill every link's rotation and its origin's position, velocity and
     acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
     (links, M) and each RRR group's normalised discriminant ``D`` (groups, M). Returns
     True when a group's discriminant falls below ``least`` (or is NaN) on some row."""
-    M = X.shape[0]
+    M = CS.shape[0]
     ns = ip.shape[0]
     nl = anc_j.shape[0]
     jP = np.empty((nj, M), np.complex128)
@@ -73,8 +74,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, X, speeds, nj, least, C, W, AL, D)
             if k < 0:
                 sk = fp[s, 1]
                 for r in range(M):
-                    th = X[r, di]
-                    lz[new, r] = complex(math.cos(th), sgn * math.sin(th))
+                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di])
                     lw[new, r] = spd
                     lal[new, r] = 0.0
                     jP[j, r] = sk
@@ -84,8 +84,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, X, speeds, nj, least, C, W, AL, D)
                 if need:
                     _point_rows(k, fp[s, 1], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[j], jV[j], jA[j], M)
                 for r in range(M):
-                    th = X[r, di]
-                    lz[new, r] = complex(math.cos(th), sgn * math.sin(th)) * lz[k, r]
+                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di]) * lz[k, r]
                     lw[new, r] = lw[k, r] + spd
                     lal[new, r] = lal[k, r]
             continue

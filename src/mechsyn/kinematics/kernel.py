@@ -157,8 +157,9 @@ def run(program: tuple, X: np.ndarray, speeds: np.ndarray, least: float) -> tupl
     W = np.empty((nl, M))
     AL = np.empty((nl, M))
     D = np.empty((len(groups), M))
-    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.ascontiguousarray(X, float),
-                            np.asarray(speeds, float), nj, least, C, W, AL, D)
+    X = np.asarray(X, float)
+    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.cos(X), np.sin(X), np.asarray(speeds, float), nj, least,
+                            C, W, AL, D)
     return C, W, AL, D, bool(near)
 
 
