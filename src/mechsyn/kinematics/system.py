@@ -6,10 +6,9 @@ E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems*, 1989
 ch. 3). The frame is fixed at ``(0, 0, 0)``. A point with local coordinates ``s`` on
 link ``i`` is at ``P = r_i + A(phi_i) s``.
 
-Link frames come from the file's assembled configuration: the origin of a link is the
-point of its first joint (file order) and its reference line points to the first
-other joint point, so a crank's angle is the direction of the crank line. The frame
-link keeps the global frame.
+Link frames come from the file's assembled configuration: a link's origin is its first
+joint's point (file order), its reference line points to the first other joint point (a
+crank's angle is the crank line's direction); the frame keeps the global frame.
 
 Joints become constraint rows ``Phi(q, u) = 0`` (``u``: the input coordinates):
 
