@@ -4,6 +4,7 @@ moved copy of each) whose plan the regular pass takes, and the same simulations.
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import replace
 
 import numpy as np
@@ -14,7 +15,9 @@ from mechsyn.kinematics import kernel, regular
 from mechsyn.kinematics.analysis import cached_plan
 from mechsyn.model.mechanism import Mechanism
 
-pytest.importorskip("numba")
+#: the tests that run the compiled pass (Numba: the fast extra; CI's .ci/steps/25-kernel.sh)
+needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
+                                 reason="Numba not installed (pip install 'mechsyn[fast]')")
 
 
 @pytest.fixture(autouse=True)
@@ -66,6 +69,7 @@ def test_the_examples_have_chains_with_folds_and_several_drivers():
     assert any(len(cached_plan(m).system.drivers) > 1 for _, m in CHAINS)
 
 
+@needs_numba
 @pytest.mark.parametrize("name,mech", CHAINS, ids=[n for n, _ in CHAINS])
 def test_compiled_pass_equals_the_numpy_pass(name, mech):
     kp = cached_plan(mech)
@@ -102,6 +106,7 @@ def test_compiled_pass_equals_the_numpy_pass(name, mech):
         assert np.all(np.abs(a[ok] - b[ok]) <= tol[ok])
 
 
+@needs_numba
 @pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar", "stephenson_sixbar", "fourbar", "jansen_leg"])
 @pytest.mark.parametrize("grid", [(0, 360, 1), (-720, 720, 3), (400, 40, -2)])
 def test_simulations_are_the_same_with_and_without_the_kernel(name, grid, monkeypatch):
@@ -175,9 +180,10 @@ def test_one_shot_commands_keep_the_numpy_pass(monkeypatch):
     assert "simulate" in ONE_SHOT and "serve" not in ONE_SHOT and "synth" not in ONE_SHOT
     assert main(["simulate", "examples/kinematics/crank_rocker.yaml", "-i", "A=0:360:10"]) == 0
     assert seen and not any(seen)
-    assert kernel.active()
+    assert kernel.active() == (importlib.util.find_spec("numba") is not None)  # the caller's setting again
 
 
+@needs_numba
 @pytest.mark.parametrize("name", ["watt_sixbar", "fourbar", "stephenson_sixbar", "peaucellier", "crank_rocker"])
 def test_fold_masks_compiled_equal_numpy(name):
     """The fold search's masks (layout, singular rows, assembly changes, a low minimum
