@@ -152,8 +152,19 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
 @njit(inline="always", **_OPTIONS)
 def _near(a, ref):  # pragma: no cover - compiled
     """``ref + wrap(a - ref)``: the angle ``a`` moved by whole turns next to ``ref``
-    (``wrap`` to [-pi, pi) by the floored remainder, as ``np.remainder``)."""
-    return ref + ((a - ref + math.pi) % (2 * math.pi) - math.pi)
+    (``wrap`` to [-pi, pi) by the floored remainder, as ``np.remainder``). With ``a`` an
+    ``atan2`` and ``ref`` within half a turn, ``a - ref + pi`` lies in [-pi, 3 pi]: the
+    remainder is one exact step of 2 pi or none (a step down is exact by Sterbenz's lemma,
+    as ``fmod`` gives it), without the division."""
+    x = a - ref + math.pi
+    if -math.pi <= ref <= math.pi:
+        if x >= 2 * math.pi:
+            x -= 2 * math.pi
+        elif x < 0.0:
+            x += 2 * math.pi
+    else:
+        x %= 2 * math.pi
+    return ref + (x - math.pi)
 
 
 @njit(**_OPTIONS)
@@ -198,7 +209,9 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
             K = 0.0
             for r in range(1, N):
                 a = out[r]
-                K += np.rint((a - raw) / twopi)
+                d = a - raw
+                if d > 3.0 or d < -3.0:  # else |d / 2 pi| < 0.48: no whole turn (rint 0), no division
+                    K += np.rint(d / twopi)
                 raw = a
                 out[r] = a - twopi * K
             for part in range(2 if split >= 0 else 1):
@@ -225,7 +238,9 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
                     x = s
                     shift = twopi * np.rint((x - prev) / twopi) if has_prev else 0.0
                 else:
-                    K += np.rint((s - raw) / twopi)
+                    d = s - raw
+                    if d > 3.0 or d < -3.0:  # as above
+                        K += np.rint(d / twopi)
                     raw = s
                     x = s - twopi * K
                 out[r] = x - shift if shift != 0.0 else x
