@@ -21,10 +21,11 @@ needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
 
 
 @pytest.fixture(autouse=True)
-def _kernel_on(monkeypatch):
-    """These tests compare the compiled pass with the NumPy one: the kernel on, whatever
-    the environment says (CI runs the kinematics tests again with MECHSYN_KERNEL=numpy)."""
-    monkeypatch.setenv("MECHSYN_KERNEL", "auto")
+def _kernel_on():
+    """These tests compare the compiled pass with the NumPy one: the kernel in its
+    default mode, whatever the environment said."""
+    with kernel.use("auto"):
+        yield
 
 
 def _scale(m: Mechanism) -> float:
@@ -109,7 +110,7 @@ def test_compiled_pass_equals_the_numpy_pass(name, mech):
 @needs_numba
 @pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar", "stephenson_sixbar", "fourbar", "jansen_leg"])
 @pytest.mark.parametrize("grid", [(0, 360, 1), (-720, 720, 3), (400, 40, -2)])
-def test_simulations_are_the_same_with_and_without_the_kernel(name, grid, monkeypatch):
+def test_simulations_are_the_same_with_and_without_the_kernel(name, grid):
     """Poses, rates, named points, link angles and events of ``simulate`` over several
     turns, forwards and backwards, from inside and outside the drawn input (the Watt
     six-bar and the textbook four-bar through their dead points)."""
@@ -117,9 +118,9 @@ def test_simulations_are_the_same_with_and_without_the_kernel(name, grid, monkey
     drive = next(j.id for j in m.joints if j.actuated)
     sims = {}
     for mode in ("numpy", "auto"):
-        monkeypatch.setenv("MECHSYN_KERNEL", mode)
-        assert kernel.active() == (mode == "auto")
-        sims[mode] = m.simulate(**{drive: grid})
+        with kernel.use(mode):
+            assert kernel.active() == (mode == "auto")
+            sims[mode] = m.simulate(**{drive: grid})
     a, b = sims["numpy"], sims["auto"]
     assert a.engine == b.engine == "regular pass"
     assert [(e.kind, e.index, e.message) for e in a.events] == [(e.kind, e.index, e.message) for e in b.events]
@@ -136,34 +137,40 @@ def test_simulations_are_the_same_with_and_without_the_kernel(name, grid, monkey
     assert np.array_equal(a.assembled, b.assembled)
 
 
-def test_numpy_mode_turns_the_kernel_off(monkeypatch):
-    monkeypatch.setenv("MECHSYN_KERNEL", "numpy")
-    assert not kernel.active()
-    kp = cached_plan(ms.examples.load("crank_rocker"))
-    steps, anchor, origin = regular._program(kp.system, kp.groups)
-    prog = kernel.program_arrays(steps, anchor, origin)
-    assert kernel.run(prog, np.zeros((3, 1)), np.ones(1), 0.05) is None
-    assert isinstance(regular._pass(kp.system, kp.groups, np.zeros((3, 1)), np.ones(1), True), regular._Pass)
+def test_numpy_mode_turns_the_kernel_off():
+    with kernel.use("numpy"):
+        assert not kernel.active()
+        kp = cached_plan(ms.examples.load("crank_rocker"))
+        steps, anchor, origin = regular._program(kp.system, kp.groups)
+        prog = kernel.program_arrays(steps, anchor, origin)
+        assert kernel.run(prog, np.zeros((3, 1)), np.ones(1), 0.05) is None
+        assert isinstance(regular._pass(kp.system, kp.groups, np.zeros((3, 1)), np.ones(1), True), regular._Pass)
 
 
-def test_a_wrong_mode_is_one_clear_error(monkeypatch):
+def test_the_environment_is_read_once_and_a_wrong_mode_is_one_clear_error(monkeypatch):
     from mechsyn.errors import MechsynInputError
 
+    monkeypatch.setattr(kernel, "_MODE", None)  # as in a new process
     monkeypatch.setenv("MECHSYN_KERNEL", "fastest")
     with pytest.raises(MechsynInputError, match="MECHSYN_KERNEL='fastest' is not one of auto, numba, numpy"):
         kernel.active()
+    with pytest.raises(MechsynInputError, match="is not one of"):
+        kernel.use("fastest").__enter__()
+    monkeypatch.setenv("MECHSYN_KERNEL", " NumPy ")
+    assert not kernel.active() and kernel._MODE == "numpy"
+    monkeypatch.setenv("MECHSYN_KERNEL", "auto")  # read once: the first use decided
+    assert not kernel.active()
 
 
 def test_numba_asked_for_without_numba_names_the_extra(monkeypatch):
-    monkeypatch.setenv("MECHSYN_KERNEL", "numba")
     monkeypatch.setattr(kernel, "_MODULE", False)  # as after a failed import of Numba
-    with pytest.raises(ImportError, match=r'pip install "mechsyn\[fast\]"'):
+    with kernel.use("numba"), pytest.raises(ImportError, match=r'pip install "mechsyn\[fast\]"'):
         kernel.active()
 
 
 def test_one_shot_commands_keep_the_numpy_pass(monkeypatch):
     """``mechsyn simulate`` runs one sweep: Numba's load would cost it more than it saves;
-    the setting is the command's only (the caller's environment is as it was)."""
+    the setting is the command's only (the caller's mode is as it was)."""
     from mechsyn.cli.main import ONE_SHOT, main
 
     monkeypatch.delenv("MECHSYN_KERNEL", raising=False)

@@ -9,6 +9,7 @@ imported; a module imported eagerly here is picked up the same way.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import re
@@ -134,14 +135,15 @@ def main(argv: list[str] | None = None) -> int:
     """
     previous = handle_sigterm()
     args = sys.argv[1:] if argv is None else argv
-    pinned = "MECHSYN_KERNEL" not in os.environ and bool(args) and args[0] in ONE_SHOT
-    if pinned:  # for this command only (an in-process caller keeps its own setting)
-        os.environ["MECHSYN_KERNEL"] = "numpy"
+    pass_ = contextlib.nullcontext()
+    if "MECHSYN_KERNEL" not in os.environ and args and args[0] in ONE_SHOT:
+        from mechsyn.kinematics import kernel  # these commands import NumPy anyway
+
+        pass_ = kernel.use("numpy")  # for this command only (an in-process caller keeps its own)
     try:
-        return _main(argv)
+        with pass_:
+            return _main(argv)
     finally:
-        if pinned:
-            os.environ.pop("MECHSYN_KERNEL", None)
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 

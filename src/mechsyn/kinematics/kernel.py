@@ -9,7 +9,9 @@ operations with no temporaries. The kernel is not another engine: it runs the re
 pass's own program (:func:`program_arrays` writes it as integer and complex arrays), gives
 the same discriminants, rotations and joint states, and the engine around it (fold
 events, angles, results) is unchanged. Without Numba, or with the environment variable
-``MECHSYN_KERNEL=numpy``, the NumPy pass runs; tests run both and compare them.
+``MECHSYN_KERNEL=numpy`` (read at the first sweep of the process) or within
+:func:`use` ``("numpy")``, the NumPy pass runs; tests run both and compare them (they
+agree to round-off: a few units in the last place, more near a fold).
 
 Numba compiles the kernel on its first use on a machine (a few seconds) and keeps the
 machine code beside the module (``__pycache__``); later processes load it (about 0.1 s,
@@ -36,8 +38,10 @@ True
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
+from collections.abc import Iterator
 from types import ModuleType
 
 import numpy as np
@@ -45,9 +49,10 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["active", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "warm"]
+__all__ = ["MODES", "active", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "use", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
+_MODE: str | None = None  # the mode in force: MECHSYN_KERNEL read at the first use, or set by use()
 
 
 #: The values of ``MECHSYN_KERNEL``: ``auto`` (the default) compiled when Numba is
@@ -55,16 +60,25 @@ _MODULE: ModuleType | None | bool = None  # the compiled module; False: not avai
 MODES = ("auto", "numba", "numpy")
 
 
-def _compiled() -> ModuleType | None:
-    """The Numba module (:mod:`mechsyn.kinematics._kernel_numba`), imported on first use;
-    None without Numba (``auto``) or with ``MECHSYN_KERNEL=numpy``."""
-    global _MODULE
-    mode = os.environ.get("MECHSYN_KERNEL", "auto").strip().lower() or "auto"
-    if mode == "numpy":
-        return None
+def _checked(mode: str) -> str:
+    mode = mode.strip().lower() or "auto"
     if mode not in MODES:
         raise MechsynInputError(f"MECHSYN_KERNEL={mode!r} is not one of {', '.join(MODES)}",
                                 field="MECHSYN_KERNEL", hint="unset it, or set auto, numba or numpy")
+    return mode
+
+
+def _compiled() -> ModuleType | None:
+    """The Numba module (:mod:`mechsyn.kinematics._kernel_numba`), imported on first use;
+    None without Numba (``auto``) or in the mode ``numpy``. The mode is ``MECHSYN_KERNEL``
+    as it is at the first use in the process (read once: a sweep is microseconds), or
+    what :func:`use` sets."""
+    global _MODULE, _MODE
+    mode = _MODE
+    if mode is None:
+        mode = _MODE = _checked(os.environ.get("MECHSYN_KERNEL", "auto"))
+    if mode == "numpy":
+        return None
     if _MODULE is None:
         try:
             _MODULE = importlib.import_module("mechsyn.kinematics._kernel_numba")
@@ -75,9 +89,30 @@ def _compiled() -> ModuleType | None:
     return _MODULE or None
 
 
+@contextlib.contextmanager
+def use(mode: str) -> Iterator[None]:
+    """The regular pass compiled or not within the block (``mode``: auto, numba or numpy;
+    for the whole process, every thread), the mode before it after: one-shot commands
+    run the NumPy pass this way (:data:`mechsyn.cli.main.ONE_SHOT`).
+
+    Examples
+    --------
+    >>> with use("numpy"):
+    ...     active()
+    False
+    """
+    global _MODE
+    new = _checked(mode)
+    old = _MODE
+    _MODE = new
+    try:
+        yield
+    finally:
+        _MODE = old
+
+
 def active() -> bool:
-    """Whether the regular pass runs compiled (Numba installed, ``MECHSYN_KERNEL`` not
-    ``numpy``)."""
+    """Whether the regular pass runs compiled (Numba installed, the mode not ``numpy``)."""
     return _compiled() is not None
 
 
