@@ -212,9 +212,13 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     if back:
         sing = np.concatenate([back[0][0][::-1], sing])
     q, qd, qdd = res.q, res.qd, res.qdd
-    qd[sing] = np.nan  # a group folded flat: rates not defined here
-    qdd[sing] = np.nan
-    ok = np.isfinite(q.T).all(axis=0)  # q is a transposed view: rows of coordinates reduce fastest
+    rows = np.flatnonzero(sing)
+    if rows.size:  # a group folded flat: rates not defined here
+        qd[rows] = np.nan
+        qdd[rows] = np.nan
+    ok = res.assembled  # from the compiled pass; else rows of coordinates (q.T) reduce fastest
+    if ok is None:
+        ok = np.isfinite(q.T).all(axis=0)
     # rates NaN on whole rows (Folded's rows, and sing above): one coordinate tells a row
     rates_ok = np.isfinite(qd.T[0]) & np.isfinite(qdd.T[0])
     nan = np.empty((2, U.shape[0]))

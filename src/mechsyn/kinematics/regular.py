@@ -410,13 +410,15 @@ class Folded:
     sweeps forwards from the drawn input values and backwards) its singular rows and
     events (rows counted along that sweep); from the compiled pass also the links'
     states (:class:`LinkStates`, NaN where the poses are: ``qd``'s and ``qdd``'s angle
-    rows are its rates, so rows blanked later are blanked there too)."""
+    rows are its rates, so rows blanked later are blanked there too) and the rows
+    assembled (``assembled``, N)."""
 
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
     parts: list
     links: LinkStates | None = None
+    assembled: np.ndarray | None = None
 
 
 def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
@@ -424,9 +426,9 @@ def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: l
     pass) through folds: NaN rows where a group is not assembled, NaN rates where they
     are not defined (inf at a group folded flat), each link's angle continuous along
     each tracked sweep from the drawn one."""
-    if isinstance(st, _Compiled):  # and the links' states, NaN where the poses are
-        q, qd, qdd, _ = _compiled_poses(S, plan, U, st, split, True)
-        return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
+    if isinstance(st, _Compiled):  # and the links' states (NaN where the poses are), the rows assembled
+        q, qd, qdd, ok = _compiled_poses(S, plan, U, st, split, True)
+        return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     fin = np.isfinite(C[0].view(float)).all(axis=0)  # every link's rotation: real and imaginary parts
     ok = fin[0::2] & fin[1::2]
