@@ -200,12 +200,10 @@ def run(program: tuple, X: np.ndarray, speeds: np.ndarray, least: float) -> tupl
     (ip, anc_j, org_j, nj, groups), fp, anc_s = program
     M, nl = X.shape[0], anc_j.shape[0]
     C = np.empty((4, nl, M), complex)
-    W = np.empty((nl, M))
-    AL = np.empty((nl, M))
-    D = np.empty((len(groups), M))
-    X = np.asarray(X, float)
-    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.cos(X), np.sin(X), np.asarray(speeds, float), nj, least,
-                            C, W, AL, D)
+    R = np.empty((2 * nl + len(groups), M))  # W, AL and D: rows of one block (contiguous views)
+    W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
+    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.cos(X), np.sin(X), np.ascontiguousarray(speeds, float),
+                            nj, least, C, W, AL, D)
     return C, W, AL, D, bool(near)
 
 
@@ -219,7 +217,7 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
     through folds (its tracked sweeps made continuous on their own, rows not assembled
     and rates not defined blanked)."""
     C, W, AL = pass_
-    q, qd, qdd = np.empty((n, N)), np.empty((n, N)), np.empty((n, N))
+    q, qd, qdd = np.empty((3, n, N))  # one block, three contiguous views
     dcol, dsgn, ref = angles
     z = C[0, :, :N]
     A = np.arctan2(z.imag, z.real)  # NumPy's vector loops: a third of libm's time per angle
