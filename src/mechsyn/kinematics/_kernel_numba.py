@@ -323,3 +323,52 @@ def point_states(C, w, al, idx, s, out):  # pragma: no cover - compiled
             out[0, k, r] = rel + C[1, i, r]
             out[1, k, r] = irel * wr + C[2, i, r]
             out[2, k, r] = ((irel * al[i, r]) - rel * (wr * wr)) + C[3, i, r]
+
+
+@njit(**_OPTIONS)
+def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):  # pragma: no cover - compiled
+    """The normalised discriminant of step ``k`` (an RRR group) of the program at one input
+    ``u`` (k inputs), every group upstream in the program's (drawn) mode and placed as
+    :func:`mechsyn.kinematics.tracking._scalar_disc` places it (a group folded within
+    1e-12 taken flat, else NaN downstream): the fold search's function along a segment,
+    positions only."""
+    nl = anc_j.shape[0]
+    jP = np.zeros(nj, np.complex128)
+    lz = np.zeros(nl, np.complex128)
+    for s in range(k + 1):
+        if ip[s, 0] == 0:
+            new, kk, j, di, need = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4], ip[s, 5]
+            z = complex(math.cos(u[di]), fp[s, 0].real * math.sin(u[di]))
+            if kk < 0:
+                jP[j] = fp[s, 1]
+                lz[new] = z
+            else:
+                if need:
+                    jP[j] = lz[kk] * (fp[s, 1] - anc_s[kk]) + jP[anc_j[kk]]
+                lz[new] = z * lz[kk]
+            continue
+        k1, k3, b1, b2 = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
+        J1, J2, J3 = ip[s, 5], ip[s, 6], ip[s, 7]
+        if ip[s, 8]:
+            jP[J1] = fp[s, 5] if k1 < 0 else lz[k1] * (fp[s, 5] - anc_s[k1]) + jP[anc_j[k1]]
+        if ip[s, 9]:
+            jP[J3] = fp[s, 6] if k3 < 0 else lz[k3] * (fp[s, 6] - anc_s[k3]) + jP[anc_j[k3]]
+        L1s = fp[s, 0].real
+        d = jP[J3] - jP[J1]
+        inv = d.real * d.real + d.imag * d.imag
+        inv = 1.0 / inv if inv > 0 else math.inf
+        f = inv * (0.5 * (L1s - fp[s, 0].imag)) + 0.5
+        g = inv * L1s - f * f
+        disc = g / (inv * L1s) if inv < math.inf else math.nan
+        if s == k:
+            return disc
+        if not g >= 0:
+            g = 0.0 if disc > -1e-12 else math.nan
+        g = math.sqrt(g) if g >= 0.0 else math.nan
+        if fp[s, 2].real < 0:
+            g = -g
+        e1 = d * complex(f, g)
+        jP[J2] = e1 + jP[J1]
+        lz[b1] = e1 * fp[s, 3]
+        lz[b2] = (jP[J2] - jP[J3]) * fp[s, 4]
+    return math.nan

@@ -49,7 +49,8 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["MODES", "active", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "use", "warm"]
+__all__ = ["MODES", "active", "disc_line", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "use",
+           "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 _MODE: str | None = None  # the mode in force: MECHSYN_KERNEL read at the first use, or set by use()
@@ -251,3 +252,18 @@ def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, 
     out = np.empty((3, idx.shape[0], C.shape[2]), complex)
     mod.point_states(C, w, al, idx, s, out)
     return out
+
+
+def disc_line(program: tuple, k: int, xa: list, xb: list):
+    """The normalised discriminant of RRR step ``k`` along the segment of inputs from
+    ``xa`` (t = 0) to ``xb`` (t = 1), every group in the program's drawn mode, compiled
+    (:func:`mechsyn.kinematics._kernel_numba.scalar_disc`): the fold search's function on
+    the regular pass (:func:`mechsyn.kinematics.tracking._disc_line` in Python); None
+    without the kernel."""
+    mod = _compiled()
+    if mod is None:
+        return None
+    (ip, anc_j, _, nj, _), fp, anc_s = program
+    a, d = np.array(xa, float), np.array(xb, float) - np.array(xa, float)
+    f = mod.scalar_disc
+    return lambda t: f(ip, fp, anc_j, anc_s, a + t * d, nj, k)

@@ -390,12 +390,14 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
 
 
 def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, val, changes: list,
-               n0: int) -> tuple[list, list]:
+               n0: int, line=None) -> tuple[list, list]:
     """:func:`fold_events` from the rows where each group's assembly changes
     (``changes[g]``: the rows ``i`` whose group ``g`` is assembled at ``i`` and not at
     ``i - 1`` or the other way round), its discriminant ``val(g, i)`` (a float) and the
     input rows ``row(i)`` (lists of floats): the events as ``(row, kind, message, input, group)``
-    and per group the rows where it reassembles."""
+    and per group the rows where it reassembles. ``line(k, xa, xb)``: step ``k``'s
+    discriminant along a segment (the compiled pass's, every group in its drawn mode),
+    else :func:`_disc_line`'s."""
     events: list = []
     resets = []
     seen: dict[int, list] = {}
@@ -425,7 +427,8 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
             xa, xb = row(i - 1), row(i)
             t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
             if t is None:
-                t = _hidden_fold(_disc_line(S, plan, k, sigmas, xa, xb, i - 1), fa, fb, ends, starts, i, hidden)
+                f = line(k, xa, xb) if line is not None else _disc_line(S, plan, k, sigmas, xa, xb, i - 1)
+                t = _hidden_fold(f, fa, fb, ends, starts, i, hidden)
             if t is None:
                 continue
             inside = fa > -_ZERO_DISC if not hidden else hidden > 0
@@ -476,6 +479,11 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
+    compiled = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: its discriminant along a segment
+    line = None
+    if compiled is not None and compiled[0] is plan and kernel.active():
+        def line(k: int, xa: list, xb: list, prog=compiled[1]):
+            return kernel.disc_line(prog, k, xa, xb)
     masks = kernel.fold_rows([discs[k] for k in ks], perm, b, _ZERO_DISC, SINGULAR_DISC)  # compiled
     if masks is None:
         D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
@@ -506,7 +514,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
         def val(g: int, i: int, way=way) -> float:
             return float(D[g, b + i if way > 0 else b - 1 - i])
 
-        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0)
+        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0, line)
         events = []
         for i, kind, message, u, group in found:
             index, message, u, before = _swept(i, message, u, n0, sh)
