@@ -133,24 +133,31 @@ def main(argv: list[str] | None = None) -> int:
     143 and ``terminated`` (searches have written their best result so far, marked as
     interrupted, before that).
     """
+    pass_ = _pass_for(argv)  # its imports (NumPy) before the handlers: not cut in half by a signal
     previous = handle_sigterm()
-    args = sys.argv[1:] if argv is None else argv
-    pass_ = contextlib.nullcontext()
-    if "MECHSYN_KERNEL" not in os.environ and args and args[0] in ONE_SHOT:
-        from mechsyn.kinematics import kernel  # these commands import NumPy anyway
-
-        pass_ = kernel.use("numpy")  # for this command only (an in-process caller keeps its own)
     try:
-        with pass_:
-            return _main(argv)
+        return _main(argv, pass_)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
 
-def _main(argv: list[str] | None) -> int:
+def _pass_for(argv: list[str] | None) -> Any:
+    """The regular pass of this command: the NumPy one for the :data:`ONE_SHOT` commands
+    (for this command only: an in-process caller keeps its own), unless
+    ``MECHSYN_KERNEL`` says."""
+    args = sys.argv[1:] if argv is None else argv
+    if "MECHSYN_KERNEL" in os.environ or not args or args[0] not in ONE_SHOT:
+        return contextlib.nullcontext()
+    from mechsyn.kinematics import kernel  # these commands import NumPy anyway
+
+    return kernel.use("numpy")
+
+
+def _main(argv: list[str] | None, pass_: Any) -> int:
     try:
-        status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
+        with pass_:
+            status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
     except KeyboardInterrupt:
         status = _INTERRUPTED
     except MechsynInputError as error:
