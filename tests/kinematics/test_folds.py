@@ -120,7 +120,8 @@ def test_tracking_path_is_kept_and_read_only():
     first = np.array([u0 + 4 * math.pi + 0.1])  # two turns on, 5.73 degrees beyond the drawn angle
     path, shift = tracking_path(S, first)
     assert shift.tolist() == [first[0] - (first[0] - 4 * math.pi)]
-    assert path.shape == (6, 1) and path[0, 0] == u0
+    drawn = float(S.drivers[0].assembled)  # atan2 of the drawn crank: 60 degrees to the last place or two
+    assert path.shape == (6, 1) and path[0, 0] == drawn and abs(drawn - u0) < 1e-15
     assert np.all(np.diff(path[:, 0]) <= math.radians(1.0) + 1e-15)
     assert abs(path[-1, 0] + (path[1, 0] - path[0, 0]) - (first[0] - shift[0])) < 1e-14
     with pytest.raises(ValueError):
