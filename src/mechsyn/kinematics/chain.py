@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, _cons_of, _cross, _local, _memo, circle_circle,
-                                       normalised_disc)
+from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, _cons_of, _cross, _local, _memo, _topology,
+                                       circle_circle, normalised_disc)
 from mechsyn.kinematics.positions import TrackedPositions, _continuous_angles, solve_positions
 from mechsyn.kinematics.rates import batch_rates
 from mechsyn.kinematics.system import PlanarSystem
@@ -156,18 +156,20 @@ def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
     key = ("angles", id(plan))
     hit = memo.get(key)
     if hit is None or hit[0] is not plan:
-        shared = S.cache.setdefault("programs", {})
-        top = shared.get(key)
-        if top is None or top[0] is not plan:
-            drive_links = _drive_links(S, plan)
-            others = [i for i in range(len(S.links)) if i not in drive_links]
-            cols = [3 * i + 2 for i in others]
-            if others and others == list(range(others[0], others[-1] + 1)):
-                others = slice(others[0], others[-1] + 1)
-            top = shared[key] = (plan, drive_links, others, cols)
-        _, drive_links, others, cols = top
+        drive_links, others, cols = _topology(S, plan, "angles", lambda: _angle_links(S, plan))
         hit = memo[key] = (plan, (drive_links, others, S.q0[cols][:, None]))
     return hit[1]
+
+
+def _angle_links(S: PlanarSystem, plan: Plan) -> tuple:
+    """The links turned by frame drivers, the others (a slice when they are a range) and
+    the columns of their angles in ``q``."""
+    drive_links = _drive_links(S, plan)
+    others = [i for i in range(len(S.links)) if i not in drive_links]
+    cols = [3 * i + 2 for i in others]
+    if others and others == list(range(others[0], others[-1] + 1)):
+        others = slice(others[0], others[-1] + 1)
+    return drive_links, others, cols
 
 
 @dataclass

@@ -23,6 +23,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -243,6 +244,19 @@ def _memo(S: PlanarSystem) -> dict:
     """Per-system cache of look-ups that depend only on the system (local joint points,
     constraints of a joint): a plan evaluated many times (events, drags) reuses them."""
     return S.cache.setdefault("groups", {})
+
+
+def _topology(S: PlanarSystem, plan: Any, name: str, build: Callable[[], Any]) -> Any:
+    """``build()``, what ``plan``'s topology alone decides (steps, links, joints: no
+    number of the geometry), kept under ``(name, id(plan))`` in ``S.cache["programs"]``,
+    which :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of
+    one topology: a refilled geometry finds it built."""
+    shared = S.cache.setdefault("programs", {})
+    key = (name, id(plan))
+    hit = shared.get(key)
+    if hit is None or hit[0] is not plan:
+        hit = shared[key] = (plan, build())
+    return hit[1]
 
 
 def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:

@@ -36,7 +36,7 @@ import numpy as np
 
 from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
-from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, circle_circle, normalised_disc
+from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology, circle_circle, normalised_disc
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows, pass_fold_events, tracking_path
@@ -56,11 +56,7 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
-    shapes = S.cache.setdefault("programs", {})
-    shape = shapes.get(key)
-    if shape is None or shape[0] is not plan:
-        shape = shapes[key] = (plan, _shape(S, plan))
-    out = _filled(S, shape[1])
+    out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)))
     memo[key] = (plan, out)
     return out
 
@@ -288,11 +284,8 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray, speeds: np.ndarray, folds:
     key = ("kernel", id(plan))
     prog = memo.get(key)
     if prog is None or prog[0] is not plan:
-        shapes = S.cache.setdefault("programs", {})
-        shape = shapes.get(key)
-        if shape is None or shape[0] is not plan:
-            shape = shapes[key] = (plan, kernel.program_arrays(steps, anchor, origin)[0])
-        prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape[1]))
+        shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
+        prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape))
     C, W, AL, D, near = kernel.run(prog[1], X, speeds, REGULAR_DISC)
     if near and not folds:
         return None
@@ -304,16 +297,17 @@ def _compiled_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled",
     """:func:`_poses` / :func:`_fold_poses` of a compiled pass, compiled
     (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N) and the rows
     assembled (N,). Which links frame drivers turn is kept with the topology."""
-    shapes = S.cache.setdefault("programs", {})  # the drivers' links: the topology's, shared
-    hit = shapes.get(("kernel-angles", id(plan)))
-    if hit is None or hit[0] is not plan:
-        drive = _drive_links(S, plan)
-        nl = len(S.links)
-        hit = shapes[("kernel-angles", id(plan))] = (
-            plan, np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
-            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float))
-    angles = (hit[1], hit[2], np.ascontiguousarray(S.q0[2::3]))  # the drawn angles: this geometry's
+    dcol, dsgn = _topology(S, plan, "kernel-angles", lambda: _drive_arrays(S, plan))
+    angles = (dcol, dsgn, np.ascontiguousarray(S.q0[2::3]))  # the drawn angles: this geometry's
     return kernel.link_poses((st.C, st.W, st.AL), U.shape[0], U, angles, split, folds, S.n)
+
+
+def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
+    """Each link's frame driver's input column (-1: none) and the input's sign."""
+    drive = _drive_links(S, plan)
+    nl = len(S.links)
+    return (np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
+            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float))
 
 
 class _Compiled:

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.groups import decompose
+from mechsyn.kinematics.groups import _topology, decompose
 from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.sweep import Event, Sweep
@@ -201,16 +201,13 @@ def _drawn_groups(S: PlanarSystem, plan: Any) -> list | None:
     or None when :func:`drawn_checks` does not apply (a plan other than R drives and RRR
     dyads, or not as many equations as unknowns): the topology's part of the checks,
     kept with the programs the systems of one topology share."""
-    shared = S.cache.setdefault("programs", {})
-    key = ("drawn checks", id(plan))
-    hit = shared.get(key)
-    if hit is None or hit[0] is not plan:
+    def build() -> list | None:
         ok = plan is not None and S.m == S.n and all(s.kind in ("drive_R", "RRR") and set(s.data) <= {"double"}
                                                      for s in plan.steps)
         index = {j.id: k for k, j in enumerate(S.mech.joints)}
-        groups = [tuple(index[j] for j in s.joints) for s in plan.steps if s.kind == "RRR"] if ok else None
-        hit = shared[key] = (plan, groups)
-    return hit[1]
+        return [tuple(index[j] for j in s.joints) for s in plan.steps if s.kind == "RRR"] if ok else None
+
+    return _topology(S, plan, "drawn checks", build)
 
 
 def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:
