@@ -214,3 +214,24 @@ def test_fold_masks_compiled_equal_numpy(name):
             c = kernel.fold_rows([st.discs[k] for k in ks], perm, b, tracking._ZERO_DISC, tracking.SINGULAR_DISC)
             assert np.array_equal(a[0], c[0], equal_nan=True) and np.array_equal(a[1], c[1])
             assert all(np.array_equal(x, y) for x, y in zip(a[2], c[2])) and a[3] == c[3]
+
+
+def test_trig_is_numpys_and_follows_the_inputs() -> None:
+    """The inputs' cosines and sines the compiled pass turns its drivers by are NumPy's,
+    block by block, whether kept or not; a block changed in place, or the same bytes in
+    another shape, are other inputs (never the kept answer of the old ones)."""
+    X = np.radians(np.linspace(-720.0, 720.0, 97)).reshape(-1, 1)
+    path = np.radians([[10.0], [20.0]])
+    for _ in range(2):  # the second time from what is kept
+        c, s = kernel.trig([X, path])
+        assert np.array_equal(c, np.vstack([np.cos(X), np.cos(path)]))
+        assert np.array_equal(s, np.vstack([np.sin(X), np.sin(path)]))
+    X[5, 0] += 0.25  # the same array object, other numbers
+    c, s = kernel.trig([X, path])
+    assert c[5, 0] == np.cos(X[5, 0]) and s[5, 0] == np.sin(X[5, 0])
+    two = np.radians([[0.0, 90.0], [45.0, 30.0]])
+    c1, _ = kernel.trig([two])
+    c2, _ = kernel.trig([two.reshape(4, 1)])
+    assert c1.shape == (2, 2) and c2.shape == (4, 1)
+    big = np.zeros((kernel._TRIG_ROWS + 1, 1))  # not kept: computed each time
+    assert np.array_equal(kernel.trig([big, path])[0][-2:], np.cos(path))

@@ -41,6 +41,7 @@ from __future__ import annotations
 import contextlib
 import importlib
 import os
+import threading
 from collections.abc import Iterator
 from types import ModuleType
 
@@ -49,8 +50,8 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["MODES", "active", "disc_line", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "use",
-           "warm"]
+__all__ = ["MODES", "active", "disc_line", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "trig",
+           "use", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
 _MODE: str | None = None  # the mode in force: MECHSYN_KERNEL read at the first use, or set by use()
@@ -190,22 +191,77 @@ def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None 
     return shape, fp, anc_s
 
 
-def run(program: tuple, X: np.ndarray, speeds: np.ndarray, least: float) -> tuple | None:
-    """The compiled pass over the input rows ``X`` (M, k): ``(C, W, AL, D, near)``, every
-    link's rotation and its origin's position, velocity, acceleration (4, links, M), its
-    angular velocity and acceleration (links, M), the groups' normalised discriminants
-    (groups, M), and whether one falls below ``least``; None without the kernel."""
+def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float) -> tuple | None:
+    """The compiled pass over the input rows ``X`` (M, k), or over the blocks of rows
+    ``X`` (a list: the sweep, then the connecting paths) one after the other: ``(C, W,
+    AL, D, near)``, every link's rotation and its origin's position, velocity,
+    acceleration (4, links, M), its angular velocity and acceleration (links, M), the
+    groups' normalised discriminants (groups, M), and whether one falls below ``least``;
+    None without the kernel. The inputs' cosines and sines are :func:`trig`'s."""
     mod = _compiled()
     if mod is None:
         return None
     (ip, anc_j, org_j, nj, groups), fp, anc_s = program
-    M, nl = X.shape[0], anc_j.shape[0]
+    CS, SN = trig(X if isinstance(X, list) else [X])
+    M, nl = CS.shape[0], anc_j.shape[0]
     C = np.empty((4, nl, M), complex)
     R = np.empty((2 * nl + len(groups), M))  # W, AL and D: rows of one block (contiguous views)
     W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
-    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, np.cos(X), np.sin(X), np.ascontiguousarray(speeds, float),
+    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float),
                             nj, least, C, W, AL, D)
     return C, W, AL, D, bool(near)
+
+
+#: The cosines and sines of the last blocks of input rows and stacks of them
+#: (:func:`trig`), most recent first: ``(((bytes, shape) per block), (cos, sin))``; at
+#: most ``_TRIG_ROWS`` numbers.
+_TRIG: list = []
+_TRIG_MAX, _TRIG_ROWS = 16, 1 << 16
+_TRIG_LOCK = threading.Lock()
+
+
+def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
+    """NumPy's cosines and sines of the input rows ``blocks`` (float arrays (m, k))
+    stacked: the numbers the regular pass turns its drivers by. A studio's drag, a design
+    loop and a cached call sweep the same inputs again and again, with other link
+    lengths: the answers for the last 16 blocks of up to 65,536 numbers, and for the
+    last stacks of them, are kept, found again by the blocks' bytes and shapes, so only
+    new inputs cost their trigonometry (a tenth of a six-bar's compiled pass). Each
+    block's numbers are ``np.cos``, ``np.sin`` of that block, whatever is kept.
+
+    Examples
+    --------
+    >>> X = np.radians([[0.0], [30.0], [90.0]])
+    >>> c, s = trig([X[:2], X[2:]])
+    >>> bool(np.array_equal(c, np.cos(X)) and np.array_equal(s, np.sin(X)))
+    True
+    """
+    if blocks[0].size > _TRIG_ROWS:  # (the sweep's rows; the connecting paths after them are a few)
+        return tuple(np.concatenate([f(b) for b in blocks]) for f in (np.cos, np.sin))
+    keys = tuple([(b.tobytes(), b.shape) for b in blocks])
+    hit = _kept(keys)
+    if hit is not None:
+        return hit
+    if len(blocks) == 1:
+        out = np.cos(blocks[0]), np.sin(blocks[0])
+    else:
+        parts = [trig([b]) for b in blocks]
+        out = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
+    with _TRIG_LOCK:
+        _TRIG.insert(0, (keys, out))
+        del _TRIG[_TRIG_MAX:]
+    return out
+
+
+def _kept(keys: tuple) -> tuple | None:
+    """The kept cosines and sines of the blocks of ``keys`` (:func:`trig`), moved first."""
+    with _TRIG_LOCK:
+        for k, hit in enumerate(_TRIG):
+            if hit[0] == keys:
+                if k:
+                    _TRIG.insert(0, _TRIG.pop(k))
+                return hit[1]
+    return None
 
 
 def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,

@@ -272,14 +272,15 @@ def _run(steps: list, anchor: dict, X: np.ndarray, speeds: np.ndarray, folds: bo
     return st
 
 
-def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray, speeds: np.ndarray, folds: bool) -> _Pass | _Compiled | None:
-    """One pass of the regular program over the input rows ``X``: compiled
-    (:mod:`mechsyn.kinematics.kernel`) when Numba is installed, else :func:`_run`; the
-    same states and discriminants either way. None when a group comes near a fold and
-    ``folds`` is false."""
+def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
+          folds: bool) -> _Pass | _Compiled | None:
+    """One pass of the regular program over the input rows ``X`` (or the blocks of rows
+    ``X``, a list, one after the other): compiled (:mod:`mechsyn.kinematics.kernel`) when
+    Numba is installed, else :func:`_run`; the same states and discriminants either way.
+    None when a group comes near a fold and ``folds`` is false."""
     steps, anchor, origin = _program(S, plan)
     if not kernel.active():
-        return _run(steps, anchor, X, speeds, folds)
+        return _run(steps, anchor, np.concatenate(X) if isinstance(X, list) else X, speeds, folds)
     memo = _memo(S)
     key = ("kernel", id(plan))
     prog = memo.get(key)
@@ -362,7 +363,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
     u0 = np.array([d.assembled for d in S.drivers], float)
     paths = [tracking_path(S, p[0], u0) for p in parts]
-    st = _pass(S, plan, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
+    st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
