@@ -375,6 +375,39 @@ def test_a_refilled_r_pair_reads_as_a_built_one():
         assert swapped.sa.tolist() == r.sb.tolist() and swapped.sb.tolist() == r.sb.tolist()
 
 
+def test_a_refilled_system_reads_as_a_built_one_before_and_after_its_lazy_fields():
+    """The fields a refilled system makes when first read (its constraint blocks, its
+    link origins) read, copy, pickle and replace as build_system's, whether or not they
+    were read before; a system refilled from a refilled one too."""
+    import copy
+    import pickle
+
+    m = fourbar()
+    moved = m.with_joint_points({"C": m.joint("C").point + [0.02, -0.01]})
+    ref = build_system(moved)
+
+    def same(S) -> None:
+        _same_numbers(S.origin0, ref.origin0)
+        assert [(c.kind, c.joint, c.a, c.b, c.sa.tolist() if c.sa is not None else None,
+                 c.sb.tolist() if c.sb is not None else None) for c in S.cons] == \
+            [(c.kind, c.joint, c.a, c.b, c.sa.tolist() if c.sa is not None else None,
+              c.sb.tolist() if c.sb is not None else None) for c in ref.cons]
+        _same_numbers(S.row_scale, ref.row_scale)
+        _same_numbers(S.col_scale, ref.col_scale)
+
+    for read_first in (False, True):
+        S = refill.with_geometry(build_system(m), moved)
+        assert "cons" not in S.__dict__  # not made until read
+        if read_first:
+            same(S)
+        for other in (copy.deepcopy(S), pickle.loads(pickle.dumps(S)), copy.copy(S), replace(S, notes=("x",)), S,
+                      fields_replaced(S, scale=S.scale)):
+            same(other)
+    again = refill.with_geometry(refill.with_geometry(build_system(m), m), moved)  # from a refilled template
+    same(again)
+    assert not hasattr(S, "no_such_field")
+
+
 def test_fields_replaced_is_dataclasses_replace():
     c = Con("R", "B", 2, 0, 1, sa=np.zeros(2), sb=np.ones(2), role="pair")
     new = fields_replaced(c, sb=np.full(2, 2.0), c0=0.5)
