@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.system import Con, PlanarSystem, _axis, _to_frame, frame_points
-from mechsyn.model.mechanism import Mechanism, fields_replaced
+from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
 
 __all__ = ["joint_points", "topology_key", "with_geometry"]
 
@@ -38,11 +38,13 @@ def topology_key(mech: Mechanism, vll: dict[str, str] | None = None, prescribed:
     >>> topology_key(moved) == topology_key(m)
     True
     """
-    joints = tuple((j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "")
-                   for j in mech.joints)
-    named = tuple((k, p.link) for k, p in mech.points.items())
-    return (mech.kind, mech.ground, mech.link_names, joints, named, tuple(sorted((vll or {}).items())),
-            tuple(prescribed))
+    memo = topology_memo(mech)  # the links and joints part: computed once per topology
+    part = memo.get("topology key")
+    if part is None:
+        part = memo["topology key"] = (mech.kind, mech.ground, mech.link_names, tuple(
+            (j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "") for j in mech.joints))
+    named = tuple([(k, p.link) for k, p in mech.points.items()])  # (a dict: read each time)
+    return part + (named, tuple(sorted(vll.items())) if vll else (), tuple(prescribed))
 
 
 def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
@@ -261,8 +263,10 @@ class _Refilled(PlanarSystem):
         if pending is None or name not in ("cons", "origin0"):
             raise AttributeError(name)
         template, cons, pairs, pts, frames = pending
-        fields["cons"] = _r_pairs(template, cons, pairs, pts, frames)
-        fields["origin0"] = np.array(frames[2], float).reshape(-1, 2)
+        if "cons" not in fields:  # (one given to fields_replaced stays)
+            fields["cons"] = _r_pairs(template, cons, pairs, pts, frames)
+        if "origin0" not in fields:
+            fields["origin0"] = np.array(frames[2], float).reshape(-1, 2)
         del fields["_pending"]
         return fields[name]
 
