@@ -78,16 +78,19 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
         lay = T.cache["layout"] = _layout(T)
     if lay is False:
         return None
-    first, other, rowmask, colmask, recipe, scales = lay
-    pts = [_xy(j.point) for j in mech.joints] + [_xy(p.at) for p in mech.points.values()]
+    first, other, rowmask, colmask, recipe, scales, kept = lay
+    nd = np.ndarray  # a float64 point (the common case) read inline
+    pts = [p.tolist() if (p := j.point).__class__ is nd and p.dtype is _FLOAT else _xy(p) for j in mech.joints]
+    if mech.points:
+        pts += [_xy(p.at) for p in mech.points.values()]
     xs, ys = [p[0] for p in pts], [p[1] for p in pts]
     if not all(map(math.isfinite, xs + ys)):
         return None
     scale = max(max(xs) - min(xs), max(ys) - min(ys), 1e-9) if len(pts) > 1 else 1.0
     org = [pts[k] for k in first]
     angle0 = _frame_angles(pts, org, other, 1e-12 * scale)
-    cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
-    frames, ang = (cos, sin, org), angle0.tolist()
+    turn = -angle0
+    frames, ang = (np.cos(turn).tolist(), np.sin(turn).tolist(), org), angle0.tolist()
     cons, drivers = _refilled(T, mech, recipe, pts, frames, ang)
     q0 = np.array([v for (x, y), a in zip(org, ang) for v in (x, y, a)], float)
     sc = scales[0]  # the scales of the last size (read only: shared by its systems; one read, one write)
@@ -97,8 +100,7 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     cache = {"frames": frames, "joint_points": pts, "layout": lay, "programs": T.cache.setdefault("programs", {})}
     S = object.__new__(_Refilled)
     fields = S.__dict__
-    fields.update(T.__dict__)
-    fields.pop("cons", None), fields.pop("origin0", None)  # made when first read (_Refilled.__getattr__)
+    fields.update(kept)  # T's fields a geometry does not change; cons and origin0 made when first read
     fields.update(mech=mech, angle0=angle0, drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll), row_scale=sc[1],
                   col_scale=sc[2], cache=cache, _pending=(T.cons, cons, recipe[1:], pts, frames))
     return S
@@ -144,7 +146,8 @@ def _layout(T: PlanarSystem) -> tuple | bool:
     refilled: the joint indices of every moving link's frame (its first joint, then the
     others in file order), which rows and columns scale with the length, and per
     constraint how its numbers are filled (:func:`_refilled`); then the row and column
-    scales of the last size refilled, ``[(scale, rows, cols)]``."""
+    scales of the last size refilled, ``[(scale, rows, cols)]``, and ``T``'s fields that
+    no geometry changes (its links, unknowns, equations and notes)."""
     mech = T.mech
     if T.n != 3 * len(T.links) or any(c.kind not in ("R", "angle", "line") for c in T.cons):
         return False
@@ -162,7 +165,8 @@ def _layout(T: PlanarSystem) -> tuple | bool:
                                                 "rotation" if c.role == "rotation" else "kept")
         recipe.append((how, c, index[c.joint]))
     pairs = [(i, index[c.joint]) for c in T.cons if c.kind == "R" for i in (c.a, c.b)]  # sa, sb of each R
-    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs]), [(None,)]
+    kept = {k: v for k, v in T.__dict__.items() if k in ("links", "n", "m", "notes")}
+    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs]), [(None,)], kept
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
