@@ -186,14 +186,14 @@ class KinematicPlan:
         if S is None:
             S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
         groups = self.groups
-        if groups is not None and any(s.data for s in groups.steps):
+        if groups is not None and not any(s.data for s in groups.steps):  # it holds for any geometry
+            return fields_replaced(self, mechanism=mech, system=S)
+        if groups is not None:
             new = KinematicPlan(mech, S, groups, self.vll, self.prescribed)
             pairs = _joint_pairs(self)
             if _coincident(new, pairs) == _coincident(self, pairs):
                 return new
-        if groups is None or any(s.data for s in groups.steps):
-            groups = decompose(S)
-        return KinematicPlan(mech, S, groups, self.vll, self.prescribed)
+        return KinematicPlan(mech, S, decompose(S), self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
                  points: list[str] | None = None, method: str = "auto", progress: Any = None,
@@ -485,12 +485,16 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     if hit is None:
         labels, li, moving, idx, where = _topology(S, None, key, lambda: _named_shape(S, mech, names))
         joints, points = mech.joints, mech.points
-        xy = [_xy(points[k].at if j < 0 else joints[j].point) for k, j in where]
+        xy = [_xy(points[name].at if j < 0 else joints[j].point) for name, j in where]
         loc = frame_points(S.frames(), li, xy)
         local = np.array([loc[k] for k in moving], float).reshape(-1, 2)
-        at = dict(zip(moving, local))  # a moving row's point: its row of ``local``
-        rows = [(name, link, i, at[k] if k in at else np.array(loc[k], float))
-                for k, ((name, link), i) in enumerate(zip(labels, li))]
+        rows, r = [], 0
+        for k, ((name, link), i) in enumerate(zip(labels, li)):
+            if i >= 0:  # on a moving link: its row of ``local`` (in the same order)
+                at, r = local[r], r + 1
+            else:
+                at = np.array(loc[k], float)
+            rows.append((name, link, i, at))
         hit = S.cache[key] = (rows, moving, idx, local)
     return hit
 

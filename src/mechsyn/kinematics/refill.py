@@ -183,23 +183,23 @@ def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames:
     (:func:`_r_pairs`)."""
     recipe = recipe[0]
     drivers = list(T.drivers)
-    cons: list = []
+    cons: list = [None] * len(recipe)
 
     def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)
         return (0.0 if b < 0 else ang[b]) - (0.0 if a < 0 else ang[a])
 
-    for how, c, k in recipe:
+    for r, (how, c, k) in enumerate(recipe):
         if how == "R":
-            cons.append(None)
-        elif how == "drive":
+            continue
+        if how == "drive":
             drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=rel(c.b, c.a))
-            cons.append(c)
+            cons[r] = c
         elif how == "rotation":
-            cons.append(fields_replaced(c, c0=rel(c.b, c.a)))
+            cons[r] = fields_replaced(c, c0=rel(c.b, c.a))
         elif how == "kept":
-            cons.append(c)
+            cons[r] = c
         else:
-            cons.append(_line(c, mech.joints[k], frames, drivers))
+            cons[r] = _line(c, mech.joints[k], frames, drivers)
     return cons, tuple(drivers)
 
 

@@ -327,17 +327,18 @@ class Mechanism:
         index = memo.get("joint index")
         if index is None:
             index = memo["joint index"] = {j.id: k for k, j in enumerate(joints)}
+        dim = 2 if self.kind == "planar" else 3  # (self.dim)
         for jid, p in points.items():
             k = index.get(jid)
             if k is None:
                 raise MechsynInputError(f"no joint {jid!r}", source=self.source, field="joints",
                                         hint=f"joints are: {', '.join(index)}")
             try:
-                arr = np.array(p, float).reshape(self.dim)
+                arr = np.array(p, float).reshape(dim)
             except (TypeError, ValueError):
-                arr = np.full(self.dim, np.nan)
+                arr = np.full(dim, np.nan)
             if not all(map(math.isfinite, arr.tolist())):
-                raise MechsynInputError(f"the point of joint {jid} must be {self.dim} finite numbers, not {p!r}",
+                raise MechsynInputError(f"the point of joint {jid} must be {dim} finite numbers, not {p!r}",
                                         source=self.source, field=f"joints.{jid}.point",
                                         hint="give e.g. (x, y) in the file's length unit")
             joints[k] = fields_replaced(joints[k], point=arr)
