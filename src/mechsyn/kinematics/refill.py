@@ -271,7 +271,7 @@ class _Refilled(PlanarSystem):
             fields["cons"] = _r_pairs(template, cons, pairs, pts, frames)
         if "origin0" not in fields:
             fields["origin0"] = np.array(frames[2], float).reshape(-1, 2)
-        del fields["_pending"]
+        fields.pop("_pending", None)  # (a thread reading at the same time made the same)
         return fields[name]
 
 
