@@ -375,6 +375,78 @@ def test_a_refilled_r_pair_reads_as_a_built_one():
         assert swapped.sa.tolist() == r.sb.tolist() and swapped.sb.tolist() == r.sb.tolist()
 
 
+def test_a_refilled_system_reads_as_a_built_one_before_and_after_its_lazy_fields():
+    """The fields a refilled system makes when first read (its constraint blocks, its
+    link origins) read, copy, pickle and replace as build_system's, whether or not they
+    were read before; a system refilled from a refilled one too."""
+    import copy
+    import pickle
+
+    m = fourbar()
+    moved = m.with_joint_points({"C": m.joint("C").point + [0.02, -0.01]})
+    ref = build_system(moved)
+
+    def same(S) -> None:
+        _same_numbers(S.origin0, ref.origin0)
+        assert [(c.kind, c.joint, c.a, c.b, c.sa.tolist() if c.sa is not None else None,
+                 c.sb.tolist() if c.sb is not None else None) for c in S.cons] == \
+            [(c.kind, c.joint, c.a, c.b, c.sa.tolist() if c.sa is not None else None,
+              c.sb.tolist() if c.sb is not None else None) for c in ref.cons]
+        _same_numbers(S.row_scale, ref.row_scale)
+        _same_numbers(S.col_scale, ref.col_scale)
+
+    for read_first in (False, True):
+        S = refill.with_geometry(build_system(m), moved)
+        assert "cons" not in S.__dict__  # not made until read
+        if read_first:
+            same(S)
+        for other in (copy.deepcopy(S), pickle.loads(pickle.dumps(S)), copy.copy(S), replace(S, notes=("x",)), S,
+                      fields_replaced(S, scale=S.scale)):
+            same(other)
+    again = refill.with_geometry(refill.with_geometry(build_system(m), m), moved)  # from a refilled template
+    same(again)
+    given = fields_replaced(refill.with_geometry(build_system(m), moved), cons=ref.cons)
+    assert given.origin0.tolist() == ref.origin0.tolist() and given.cons is ref.cons  # a given field stays
+    assert not hasattr(S, "no_such_field")
+
+
+def test_topology_memo_goes_only_to_mechanisms_of_the_same_topology():
+    """What a mechanism's topology decides is shared with the mechanisms
+    with_joint_points makes of it (numbers only), and with no other: fields_replaced and
+    dataclasses.replace start without it, so a changed topology gets its own key."""
+    from mechsyn.model.mechanism import topology_memo
+
+    m = fourbar()
+    key = topology_key(m)
+    moved = m.with_joint_points({"C": m.joint("C").point + [0.05, 0.0]})
+    assert topology_memo(moved) is topology_memo(m) and topology_key(moved) == key
+    slider = fields_replaced(m, joints=tuple(replace(j, type="P", axis=np.array([1.0, 0.0])) if j.id == "C" else j
+                                            for j in m.joints))
+    renamed = replace(m, links=m.links[:-1] + (replace(m.links[-1], name="arm"),),
+                      joints=tuple(replace(j, links=tuple("arm" if x == m.links[-1].name else x for x in j.links))
+                                   for j in m.joints))
+    for other in (slider, renamed):
+        assert "_topology_memo" not in other.__dict__
+        assert topology_key(other) != key and topology_memo(other) is not topology_memo(m)
+
+
+def test_drawn_row_of_each_fresh_geometry_on_one_grid():
+    """A drag simulates one grid with a new drawn input each time: the row found for each
+    is the one computed from scratch (the grid's differences are kept with its bytes)."""
+    from mechsyn.kinematics import engines
+
+    m = fourbar()
+    kp = compile_plan(m, inputs=("A",))
+    U = np.radians(np.arange(-180.0, 541.0, 2.5))[:, None]
+    rng = np.random.default_rng(4)
+    engines._DRAWN.clear()
+    for _ in range(12):
+        S = kp.refilled(m.with_joint_points({"B": m.joint("B").point + rng.uniform(-0.3, 0.3, 2)})).system
+        want = engines._drawn_row_1(S.drivers[0], U[:, 0].copy())
+        assert engines.drawn_row(S, U) == want and engines.drawn_row(S, U.copy()) == want
+    assert len(engines._DRAWN) == 1 and len(next(iter(engines._DRAWN.values()))[2]) == 12
+
+
 def test_fields_replaced_is_dataclasses_replace():
     c = Con("R", "B", 2, 0, 1, sa=np.zeros(2), sb=np.ones(2), role="pair")
     new = fields_replaced(c, sb=np.full(2, 2.0), c0=0.5)

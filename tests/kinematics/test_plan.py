@@ -285,5 +285,32 @@ def test_fold_search_program_read_off_the_regular_program_equals_the_groups(ex):
     assert any(e.kind == "dead point" for e in s.events) and s.engine == "regular pass"
     plan = compile_plan(m, inputs=("A",)).groups
     memo = _memo(s.system)
-    kept = memo.pop(("scalar", id(plan)))
-    assert tracking._scalar_program(s.system, plan) == kept
+    kept = tracking._scalar_program(s.system, plan)  # the one read off the regular program
+    assert not callable(kept) and memo.pop(("scalar", id(plan))) is kept
+    assert tracking._scalar_program(s.system, plan) == kept  # built anew from the groups
+
+
+@pytest.mark.parametrize("f, joint", [("textbook/watt_sixbar.yaml", "E"), ("textbook/fourbar.yaml", "C"),
+                                      ("kinematics/crank_rocker.yaml", "C")])
+def test_four_bar_fold_spec_read_off_the_regular_program_equals_the_groups(ex, f, joint):
+    """The closed-form four-bar fold's numbers, read off the regular pass's program (a
+    drag's fresh geometry), equal those read off the plain-number chain built from the
+    plan's groups, group by group (None where the group closes no four-bar)."""
+    from mechsyn.kinematics import tracking
+    from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.groups import _memo
+
+    m = ex(f)
+    m = m.with_joint_points({joint: np.asarray(m.joint(joint).point, float) + 0.01})
+    kp = cached_plan(m, inputs=("A",))
+    simulate(m, {"A": input_grid(0, 360, 2)})  # the regular program kept with the system
+    memo = _memo(kp.system)
+    assert memo[("regular", id(kp.groups))][0] is kp.groups
+    ks = [k for k, s in enumerate(kp.groups.steps) if s.kind == "RRR"]
+    for k in ks:
+        memo.pop(("four-bar fold", id(kp.groups), k), None)
+    got = [tracking._four_bar_spec(kp.system, kp.groups, k) for k in ks]
+    for key in [key for key in memo if key[0] in ("four-bar fold", "regular", "scalar")]:
+        del memo[key]
+    want = [tracking._four_bar_spec(kp.system, kp.groups, k) for k in ks]  # from the groups
+    assert got == want and any(g is not None for g in got)

@@ -100,3 +100,26 @@ def test_three_phalanx_forces_both_modes(ex):
     # locked: the VLLs carry axial force; free: their "drive" force is what a spring must give
     assert set(free.reactions.effort) == {"F", "S1", "S2"}
     assert np.abs(locked.reactions.force["S1"]).max() > 0
+
+
+def test_limits_are_each_mechanisms_own_within_one_topology(ex):
+    """The limits of a P joint are numbers, not topology: mechanisms of one topology (each
+    compiled from the first's plan) with other limits each check their own."""
+    from dataclasses import replace
+
+    from mechsyn.kinematics.refill import topology_key
+
+    m = ex("fingers/two_phalanx_vll_000.yaml")
+    inputs = {"E": np.zeros(3), "S": np.array([25.0, 27.0, 33.0])}
+    assert simulate(m, inputs, vll={"S": "active"}).assembled.any()  # within [24, 34]
+    narrow = m.with_joints(tuple(replace(j, limits=(26.0, 30.0)) if j.id == "S" else j for j in m.joints))
+    free = narrow.with_joint_points({"K": np.asarray(m.joint("K").point, float) + 0.01})
+    free = free.with_joints(tuple(replace(j, limits=None) if j.id == "S" else j for j in free.joints))
+    assert topology_key(narrow, {"S": "active"}) == topology_key(m, {"S": "active"}) == \
+        topology_key(free, {"S": "active"})
+    with pytest.raises(MechsynInputError, match=r"limits \[26, 30\]"):
+        simulate(narrow, inputs, vll={"S": "active"})
+    sim = simulate(free, {"E": np.zeros(2), "S": np.array([25.0, 35.0])}, vll={"S": "active"})
+    assert not any(e.kind == "limit" for e in sim.events)  # no limits: none checked, none reported
+    with pytest.raises(MechsynInputError, match=r"limits \[24, 34\]"):
+        simulate(m, {"E": np.zeros(2), "S": np.array([25.0, 35.0])}, vll={"S": "active"})

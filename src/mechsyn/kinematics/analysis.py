@@ -26,14 +26,14 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
-from mechsyn.kinematics.groups import Plan, decompose
+from mechsyn.kinematics.groups import Plan, _topology, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
 from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
-from mechsyn.kinematics.refill import topology_key, with_geometry
-from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system
-from mechsyn.model.mechanism import Mechanism
+from mechsyn.kinematics.refill import _xy, topology_key, with_geometry
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system, frame_points
+from mechsyn.model.mechanism import Mechanism, fields_replaced
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan",
@@ -94,7 +94,9 @@ def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple
             return a.tobytes()
         return None if a is None else np.asarray(a, float).tobytes()
 
-    joints = tuple([(arr(j.point), arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints])
+    nd = np.ndarray  # a joint's float64 point (the common case) read inline, one call less per joint
+    joints = tuple([(p.tobytes() if (p := j.point).__class__ is nd and p.dtype is _F64 else arr(p),
+                     None if j.axis is None else arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints])
     named = tuple([(k, p.link, arr(p.at)) for k, p in mech.points.items()])
     return joints, named, tuple(sorted(vll.items())) if vll else (), prescribed
 
@@ -184,14 +186,14 @@ class KinematicPlan:
         if S is None:
             S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
         groups = self.groups
-        if groups is not None and any(s.data for s in groups.steps):
+        if groups is not None and not any(s.data for s in groups.steps):  # it holds for any geometry
+            return fields_replaced(self, mechanism=mech, system=S)
+        if groups is not None:
             new = KinematicPlan(mech, S, groups, self.vll, self.prescribed)
             pairs = _joint_pairs(self)
             if _coincident(new, pairs) == _coincident(self, pairs):
                 return new
-        if groups is None or any(s.data for s in groups.steps):
-            groups = decompose(S)
-        return KinematicPlan(mech, S, groups, self.vll, self.prescribed)
+        return KinematicPlan(mech, S, decompose(S), self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
                  points: list[str] | None = None, method: str = "auto", progress: Any = None,
@@ -347,32 +349,53 @@ class _InputSpec:
 
 
 def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
-    """The :class:`_InputSpec` of ``kp`` for the inputs ``names``, kept with its system."""
+    """The :class:`_InputSpec` of ``kp`` for the inputs ``names``, kept with its system:
+    what the topology decides (:func:`_input_shape`, shared by the systems of one
+    topology) with this mechanism's drawn input values and P limits."""
     mech, S = kp.mechanism, kp.system
     key = ("input spec", names)
     hit = S.cache.get(key)
     if hit is not None and hit[0] is mech and hit[1] is kp.vll:
         return hit[2]
+    shape, p_inputs, p_joints = _topology(S, kp.groups, ("input shape", names, _vll_key(kp.vll)),
+                                          lambda: _input_shape(kp, names))
+    joints = mech.joints
+    limits = list(shape.limits)
+    for n, k in p_inputs:  # the P inputs' limits (not part of the topology)
+        lim = joints[k].limits
+        limits[n] = None if lim is None else (float(lim[0]), float(lim[1]))
+    spec = fields_replaced(shape, limits=tuple(limits), u0=tuple([float(d.assembled) for d in S.drivers]),
+                           limited=any(joints[k].limits is not None for k in p_joints),
+                           limited_inputs=any(lim is not None for lim in limits))
+    S.cache[key] = (mech, kp.vll, spec)
+    return spec
+
+
+def _vll_key(vll: dict | None) -> tuple:
+    return tuple(sorted(vll.items())) if vll else ()
+
+
+def _input_shape(kp: KinematicPlan, names: tuple) -> tuple[_InputSpec, list, list]:
+    """What :func:`_input_spec` takes from the topology: the spec without the numbers
+    (drawn values, limits), the P inputs (position in ``names``, joint index) and the P
+    joints (their indices), whose limits each mechanism of the topology gives."""
+    mech, S = kp.mechanism, kp.system
     drivers = tuple(d.joint for d in S.drivers)
-    index, types, limits = [], {}, []
-    for jid in names:
-        lim = None
+    where = {j.id: k for k, j in enumerate(mech.joints)}
+    index, types, p_inputs = [], {}, []
+    for n, jid in enumerate(names):
         if jid in drivers:
             k = drivers.index(jid)
             index.append(k)
             types[jid] = S.drivers[k].type
             if types[jid] == "P":
-                lim = mech.joint(jid).limits
+                p_inputs.append((n, where[jid]))
         else:
             index.append(_not_driven(mech, jid, drivers))
-        limits.append(None if lim is None else (float(lim[0]), float(lim[1])))
-    spec = _InputSpec(names, tuple(j for j in names if _is_passive(mech, j, kp.vll)), tuple(index), types,
-                      tuple(limits), drivers, tuple(float(d.assembled) for d in S.drivers),
-                      any(j.type == "P" and j.limits is not None for j in mech.joints),
-                      all(isinstance(k, int) for k in index), any(lim is not None for lim in limits),
-                      tuple(1.0 if k in index else 0.0 for k in range(len(drivers))))
-    S.cache[key] = (mech, kp.vll, spec)
-    return spec
+    shape = _InputSpec(names, tuple(j for j in names if _is_passive(mech, j, kp.vll)), tuple(index), types,
+                       (None,) * len(names), drivers, (), False, all(isinstance(k, int) for k in index), False,
+                       tuple(1.0 if k in index else 0.0 for k in range(len(drivers))))
+    return shape, p_inputs, [k for k, j in enumerate(mech.joints) if j.type == "P"]
 
 
 def _not_driven(mech: Mechanism, jid: str, drivers: tuple) -> MechsynInputError:
@@ -453,19 +476,40 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     """The named points asked for (:func:`resolve_points`) as ``(rows, moving, idx,
     local)``: rows ``(name, link, link index, local point)``, the rows on moving links,
     their link indices and local points (m, 2), kept with the system (a cached plan's
-    call resolves them and carries them into the link frames once)."""
+    call resolves them and carries them into the link frames once). Which points, on
+    which links, is the topology's (:func:`_named_shape`, shared by its systems); the
+    local points are this geometry's (:func:`~mechsyn.kinematics.system.frame_points`
+    on floats: :meth:`~mechsyn.kinematics.system.PlanarSystem.to_locals`' numbers)."""
     key = ("named points", None if names is None else tuple(names))
     hit = S.cache.get(key)
     if hit is None:
-        pts = resolve_points(mech, names)
-        li = np.array([S.index(link) for link, _ in pts.values()], int)
-        loc = S.to_locals(li, np.array([at for _, at in pts.values()], float).reshape(-1, 2))
-        rows = [(name, link, i, x) for (name, (link, _)), i, x in zip(pts.items(), li.tolist(), loc)]
-        moving = [k for k, r in enumerate(rows) if r[2] >= 0]
-        idx = np.array([rows[k][2] for k in moving], int)
-        local = np.array([rows[k][3] for k in moving], float).reshape(-1, 2)
+        labels, li, moving, idx, where = _topology(S, None, key, lambda: _named_shape(S, mech, names))
+        joints, points = mech.joints, mech.points
+        xy = [_xy(points[name].at if j < 0 else joints[j].point) for name, j in where]
+        loc = frame_points(S.frames(), li, xy)
+        local = np.array([loc[k] for k in moving], float).reshape(-1, 2)
+        rows, r = [], 0
+        for k, ((name, link), i) in enumerate(zip(labels, li)):
+            if i >= 0:  # on a moving link: its row of ``local`` (in the same order)
+                at, r = local[r], r + 1
+            else:
+                at = np.array(loc[k], float)
+            rows.append((name, link, i, at))
         hit = S.cache[key] = (rows, moving, idx, local)
     return hit
+
+
+def _named_shape(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
+    """What :func:`_named_points` takes from the topology: the points' names and links,
+    their links' indices, the rows on moving links and their indices (an array), and
+    where each point's drawn coordinates are (``(name, -1)``: a named point; ``(name,
+    k)``: joint ``k``'s point)."""
+    pts = resolve_points(mech, names)
+    li = [S.index(link) for link, _ in pts.values()]
+    moving = [k for k, i in enumerate(li) if i >= 0]
+    index = {j.id: k for k, j in enumerate(mech.joints)}
+    where = [(name, -1) if name in mech.points else (name, index[name]) for name in pts]
+    return [(name, link) for name, (link, _) in pts.items()], li, moving, np.array([li[k] for k in moving], int), where
 
 
 def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rates_ok: np.ndarray,

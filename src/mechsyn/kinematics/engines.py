@@ -250,11 +250,13 @@ def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_in
     return out
 
 
-#: The answers of :func:`drawn_row` for the last few sweeps, by the drivers' types and drawn
-#: values and the inputs' shape: ``(the inputs' bytes, row)``. A drag or a design loop
-#: simulates the same grid again and again; equal bytes give the same row.
-_DRAWN: dict[tuple, tuple[bytes, int | None]] = {}
+#: The inputs of the last few sweeps :func:`drawn_row` searched, by their shape: ``(the
+#: inputs' bytes, the differences of one input's rows, {the drivers' types and drawn values:
+#: row})``. A drag or a design loop simulates the same grid again and again (equal bytes:
+#: the same rows), each fresh geometry with its own drawn values.
+_DRAWN: dict[tuple, tuple[bytes, tuple | None, dict]] = {}
 _DRAWN_MAX, _DRAWN_BYTES = 16, 1 << 16  # at most 16 sweeps of at most 64 KiB of inputs each
+_DRAWN_ROWS = 64  # answers kept per sweep (drawn values)
 
 
 def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
@@ -262,7 +264,8 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None.
 
     The row of the same inputs (byte for byte, up to 64 KiB of them) with the same drawn
-    values is remembered.
+    values is remembered, and for one input so are the differences of its rows (a
+    fresh geometry's drawn value is looked for on the same grid without them).
 
     Examples
     --------
@@ -283,15 +286,21 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     drawn = S.cache.get("drawn values")
     if drawn is None:
         drawn = S.cache["drawn values"] = tuple([(d.type, float(d.assembled)) for d in S.drivers])
-    key = (U.shape, U.dtype.str, drawn)
+    key = (U.shape, U.dtype.str)
     data = U.tobytes()
     hit = _DRAWN.get(key)
-    if hit is not None and hit[0] == data:
-        return hit[1]
-    k = _drawn_row_1(S.drivers[0], U[:, 0]) if U.shape[1] == 1 else _drawn_row_k(S, U)
-    if len(_DRAWN) >= _DRAWN_MAX:
-        _DRAWN.clear()  # one call (threads share the cache), not an eviction order
-    _DRAWN[key] = (data, k)
+    if hit is None or hit[0] != data:
+        if len(_DRAWN) >= _DRAWN_MAX:
+            _DRAWN.clear()  # one call (threads share the cache), not an eviction order
+        hit = _DRAWN[key] = (data, _differences(U[:, 0].copy()) if U.shape[1] == 1 else None, {})
+    rows = hit[2]
+    k = rows.get(drawn, rows)
+    if k is not rows:
+        return k
+    k = _drawn_row_1(S.drivers[0], U[:, 0], hit[1]) if U.shape[1] == 1 else _drawn_row_k(S, U)
+    if len(rows) >= _DRAWN_ROWS:
+        rows.clear()
+    rows[drawn] = k
     return k
 
 
@@ -313,14 +322,21 @@ def _drawn_row_k(S: PlanarSystem, U: np.ndarray) -> int | None:
     return None
 
 
-def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
-    """:func:`drawn_row` of one input (the same decisions on 1-D arrays: a point of a
-    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
-    ``0 < p <= d^2``, division being monotone)."""
-    u0 = float(driver.assembled)
+def _differences(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``a, d, dd`` of :func:`_drawn_row_1` for the input's rows ``u`` (N,): the rows but
+    the last, the steps to the next row and their squares."""
     a = u[:-1]
     d = u[1:] - a
-    dd = d * d
+    return a, d, d * d
+
+
+def _drawn_row_1(driver: Any, u: np.ndarray, diffs: tuple | None = None) -> int | None:
+    """:func:`drawn_row` of one input (the same decisions on 1-D arrays: a point of a
+    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
+    ``0 < p <= d^2``, division being monotone); ``diffs``: :func:`_differences` of ``u``
+    when known."""
+    u0 = float(driver.assembled)
+    a, d, dd = diffs or _differences(u)
     v = a - u0
     if driver.type == "R":
         v /= 2 * np.pi
@@ -336,8 +352,9 @@ def _drawn_row_1(driver: Any, u: np.ndarray) -> int | None:
         p *= d
         hit = p > 0.0
         hit &= p <= dd
-        if hit.any():
-            return int(hit.argmax()) + 1
+        k = int(hit.argmax())  # the first row hit (or 0 when none is)
+        if hit[k]:
+            return k + 1
     return None
 
 

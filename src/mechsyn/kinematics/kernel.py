@@ -180,13 +180,9 @@ def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None 
     point; a group's squared lengths, assembly mode, rotation vectors and known joints'
     local points) and the anchors' local points."""
     shape = shape or _shape_arrays(steps, anchor, origin)
-    fp = np.zeros((len(steps), 7), complex)
-    for s, st in enumerate(steps):
-        if st[0] == "drive":
-            fp[s, :2] = st[5], st[6]
-        else:
-            _, _, _, _, L1s, L2s, sigma, cbv1, cbv2, s1, s3 = st
-            fp[s] = complex(L1s, L2s), 0j, sigma, cbv1, cbv2, s1, s3
+    rows = [(st[5], st[6], 0j, 0j, 0j, 0j, 0j) if st[0] == "drive" else  # (one array made of the rows)
+            (complex(st[4], st[5]), 0j, st[6], st[7], st[8], st[9], st[10]) for st in steps]
+    fp = np.array(rows, complex).reshape(len(steps), 7)
     anc_s = np.array([anchor[i][1] if i in anchor else 0j for i in range(len(origin))], complex)
     return shape, fp, anc_s
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.system import Con, PlanarSystem, _axis, _to_frame, frame_points
-from mechsyn.model.mechanism import Mechanism, fields_replaced
+from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
 
 __all__ = ["joint_points", "topology_key", "with_geometry"]
 
@@ -38,11 +38,13 @@ def topology_key(mech: Mechanism, vll: dict[str, str] | None = None, prescribed:
     >>> topology_key(moved) == topology_key(m)
     True
     """
-    joints = tuple((j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "")
-                   for j in mech.joints)
-    named = tuple((k, p.link) for k, p in mech.points.items())
-    return (mech.kind, mech.ground, mech.link_names, joints, named, tuple(sorted((vll or {}).items())),
-            tuple(prescribed))
+    memo = topology_memo(mech)  # the links and joints part: computed once per topology
+    part = memo.get("topology key")
+    if part is None:
+        part = memo["topology key"] = (mech.kind, mech.ground, mech.link_names, tuple(
+            (j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "") for j in mech.joints))
+    named = tuple([(k, p.link) for k, p in mech.points.items()])  # (a dict: read each time)
+    return part + (named, tuple(sorted(vll.items())) if vll else (), tuple(prescribed))
 
 
 def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
@@ -55,9 +57,11 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
 
     The numbers are worked out on Python floats from one ``tolist`` of the points (the
     same products, sums and ``arctan2`` as :func:`build_system`'s, so the same bits), and
-    the link angles, their cosines and sines, the local points of the R pairs and the
-    scales of the rows and columns are each one NumPy call: a fresh geometry of a drag
-    or a design loop costs a few NumPy calls, not a few per joint.
+    the link angles, their cosines and sines are each one NumPy call: a fresh geometry of
+    a drag or a design loop costs a few NumPy calls, not a few per joint. What the
+    regular pass of a drag does not read is made when first read (:class:`_Refilled`:
+    the R pairs' constraint blocks, the links' drawn origins as an array), and the scales
+    of the rows and columns are shared by the systems of one topology and one size.
 
     Examples
     --------
@@ -74,24 +78,32 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
         lay = T.cache["layout"] = _layout(T)
     if lay is False:
         return None
-    first, other, rowmask, colmask, recipe = lay
-    pts = [_xy(j.point) for j in mech.joints] + [_xy(p.at) for p in mech.points.values()]
+    first, other, rowmask, colmask, recipe, scales, kept = lay
+    nd = np.ndarray  # a float64 point (the common case) read inline
+    pts = [p.tolist() if (p := j.point).__class__ is nd and p.dtype is _FLOAT else _xy(p) for j in mech.joints]
+    if mech.points:
+        pts += [_xy(p.at) for p in mech.points.values()]
     xs, ys = [p[0] for p in pts], [p[1] for p in pts]
     if not all(map(math.isfinite, xs + ys)):
         return None
     scale = max(max(xs) - min(xs), max(ys) - min(ys), 1e-9) if len(pts) > 1 else 1.0
     org = [pts[k] for k in first]
     angle0 = _frame_angles(pts, org, other, 1e-12 * scale)
-    cos, sin = np.cos(-angle0).tolist(), np.sin(-angle0).tolist()
-    frames, ang = (cos, sin, org), angle0.tolist()
+    turn = -angle0
+    frames, ang = (np.cos(turn).tolist(), np.sin(turn).tolist(), org), angle0.tolist()
     cons, drivers = _refilled(T, mech, recipe, pts, frames, ang)
     q0 = np.array([v for (x, y), a in zip(org, ang) for v in (x, y, a)], float)
+    sc = scales[0]  # the scales of the last size (read only: shared by its systems; one read, one write)
+    if sc[0] != scale:
+        sc = scales[0] = (scale, _frozen(np.where(rowmask, scale, 1.0)), _frozen(np.where(colmask, scale, 1.0)))
     # the engines' programs by topology (regular._program's shapes), shared with T
     cache = {"frames": frames, "joint_points": pts, "layout": lay, "programs": T.cache.setdefault("programs", {})}
-    return fields_replaced(T, mech=mech, origin0=np.array(org, float).reshape(-1, 2), angle0=angle0, cons=cons,
-                           drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll),
-                           row_scale=np.where(rowmask, scale, 1.0), col_scale=np.where(colmask, scale, 1.0),
-                           cache=cache)
+    S = object.__new__(_Refilled)
+    fields = S.__dict__
+    fields.update(kept)  # T's fields a geometry does not change; cons and origin0 made when first read
+    fields.update(mech=mech, angle0=angle0, drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll), row_scale=sc[1],
+                  col_scale=sc[2], cache=cache, _pending=(T.cons, cons, recipe[1:], pts, frames))
+    return S
 
 
 def joint_points(S: PlanarSystem) -> list:
@@ -133,7 +145,9 @@ def _layout(T: PlanarSystem) -> tuple | bool:
     """What :func:`with_geometry` needs of ``T``'s topology, or False when ``T`` cannot be
     refilled: the joint indices of every moving link's frame (its first joint, then the
     others in file order), which rows and columns scale with the length, and per
-    constraint how its numbers are filled (:func:`_refilled`)."""
+    constraint how its numbers are filled (:func:`_refilled`); then the row and column
+    scales of the last size refilled, ``[(scale, rows, cols)]``, and ``T``'s fields that
+    no geometry changes (its links, unknowns, equations and notes)."""
     mech = T.mech
     if T.n != 3 * len(T.links) or any(c.kind not in ("R", "angle", "line") for c in T.cons):
         return False
@@ -151,37 +165,57 @@ def _layout(T: PlanarSystem) -> tuple | bool:
                                                 "rotation" if c.role == "rotation" else "kept")
         recipe.append((how, c, index[c.joint]))
     pairs = [(i, index[c.joint]) for c in T.cons if c.kind == "R" for i in (c.a, c.b)]  # sa, sb of each R
-    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs])
+    kept = {k: v for k, v in T.__dict__.items() if k in ("links", "n", "m", "notes")}
+    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs]), [(None,)], kept
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
 
 
 def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames: tuple,
-              ang: list) -> tuple[tuple, tuple]:
-    """``T``'s constraints and drivers with the numbers of ``mech``: an R pair's local
-    points (:class:`_RPair`; ``recipe``: :func:`_layout`'s), a drive's or a P pair's drawn relative angle, a
-    line's local points, direction and drawn slide coordinate (see
-    :class:`~mechsyn.kinematics.system._Builder`)."""
-    recipe, links, joints = recipe
+              ang: list) -> tuple[list, tuple]:
+    """``T``'s constraints and drivers with the numbers of ``mech``: a drive's or a P
+    pair's drawn relative angle, a line's local points, direction and drawn slide
+    coordinate (see :class:`~mechsyn.kinematics.system._Builder`; ``recipe``:
+    :func:`_layout`'s); an R pair's block is None, made when first read
+    (:func:`_r_pairs`)."""
+    recipe = recipe[0]
     drivers = list(T.drivers)
-    block = frame_points(frames, links, [pts[k] for k in joints])
-    cons, r = [], 0
+    cons: list = [None] * len(recipe)
 
     def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)
         return (0.0 if b < 0 else ang[b]) - (0.0 if a < 0 else ang[a])
 
-    for how, c, k in recipe:
+    for r, (how, c, k) in enumerate(recipe):
         if how == "R":
-            cons.append(_RPair.of(c, block[r], block[r + 1]))
-            r += 2
-        elif how == "drive":
+            continue
+        if how == "drive":
             drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=rel(c.b, c.a))
-            cons.append(c)
+            cons[r] = c
         elif how == "rotation":
-            cons.append(fields_replaced(c, c0=rel(c.b, c.a)))
+            cons[r] = fields_replaced(c, c0=rel(c.b, c.a))
         elif how == "kept":
-            cons.append(c)
+            cons[r] = c
         else:
-            cons.append(_line(c, mech.joints[k], frames, drivers))
-    return tuple(cons), tuple(drivers)
+            cons[r] = _line(c, mech.joints[k], frames, drivers)
+    return cons, tuple(drivers)
+
+
+def _r_pairs(T_cons: tuple, cons: list, pairs: tuple, pts: list, frames: tuple) -> tuple:
+    """The constraints ``cons`` of :func:`_refilled` with every R pair's block (None there)
+    made from ``T``'s (``T_cons``): its local points ``sa``, ``sb`` (:class:`_RPair`;
+    ``pairs``: the links and joints of :func:`_layout`)."""
+    links, joints = pairs
+    block = frame_points(frames, links, [pts[k] for k in joints])
+    out, r = [], 0
+    for c, t in zip(cons, T_cons):
+        if c is None:
+            c = _RPair.of(t, block[r], block[r + 1])
+            r += 2
+        out.append(c)
+    return tuple(out)
 
 
 def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
@@ -207,6 +241,38 @@ def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
         drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=s0)
     return Con("line", c.joint, 1, a, b, sa=np.zeros(2), sb=loc(b, j.point), w=u_loc,
                c0=s0 if c.role == "lock" else 0.0, driver=c.driver, role=c.role)
+
+
+class _Refilled(PlanarSystem):
+    """A system made by :func:`with_geometry`: a :class:`PlanarSystem` whose R pairs'
+    constraint blocks (:func:`_r_pairs`) and drawn link origins ``origin0`` are made
+    when first read (the regular pass and the drawn checks of a drag never read them;
+    Newton's continuation, the rank tests and the forces do, once per system). Its
+    fields read, copy, pickle and replace as a built system's (a test).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.system import build_system
+    >>> m = ms.examples.load("crank_rocker")
+    >>> moved = m.with_joint_points({"C": (3.1, 2.9)})
+    >>> S = with_geometry(build_system(m), moved)
+    >>> "cons" in S.__dict__, [c.kind for c in S.cons], "cons" in S.__dict__
+    (False, ['R', 'angle', 'R', 'R', 'R'], True)
+    """
+
+    def __getattr__(self, name: str) -> Any:  # only a field not yet in the instance's __dict__
+        fields = self.__dict__
+        pending = fields.get("_pending")
+        if pending is None or name not in ("cons", "origin0"):
+            raise AttributeError(name)
+        template, cons, pairs, pts, frames = pending
+        if "cons" not in fields:  # (one given to fields_replaced stays)
+            fields["cons"] = _r_pairs(template, cons, pairs, pts, frames)
+        if "origin0" not in fields:
+            fields["origin0"] = np.array(frames[2], float).reshape(-1, 2)
+        fields.pop("_pending", None)  # (a thread reading at the same time made the same)
+        return fields[name]
 
 
 class _RPair(Con):

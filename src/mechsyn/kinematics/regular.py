@@ -30,6 +30,7 @@ discriminant arrays (:func:`mechsyn.kinematics.tracking.pass_fold_events`).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,37 +92,36 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     return steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs], drawn
 
 
-def _locals(S: PlanarSystem, li: list, pj: list) -> tuple[list, list]:
-    """The local points (x and y lists) of the joints ``pj`` (indices in the file) on the
-    links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`'s
+def _locals(S: PlanarSystem, li: list, pj: list) -> list:
+    """The local points (``(x, y)`` floats) of the joints ``pj`` (indices in the file) on
+    the links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`'s
     numbers, on floats."""
     pts = joint_points(S)
-    loc = frame_points(S.frames(), li, [pts[k] for k in pj])
-    return [p[0] for p in loc], [p[1] for p in loc]
+    return frame_points(S.frames(), li, [pts[k] for k in pj])
 
 
 def _filled(S: PlanarSystem, shape: tuple) -> tuple:
     """:func:`_program` of ``S`` from its topology's shape (:func:`_shape`): the local
     points, squared link lengths, drawn assembly modes and rotation vectors of ``S``."""
     steps_, anchors, origin, li, pj, drawn = shape
-    x, y = _locals(S, li, pj)
+    loc = _locals(S, li, pj)
     pt = joint_points(S)
     steps = []
     for st, ks in zip(steps_, drawn):
         if st[0] == "drive":
-            steps.append(st[:6] + (complex(x[st[6]], y[st[6]]),))
+            steps.append(st[:6] + (complex(*loc[st[6]]),))
             continue
         _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
-        ux, uy = x[i2] - x[i1], y[i2] - y[i1]  # s2 - s1 on the first link, t2 - t3 on the second
-        vx, vy = x[i3] - x[i4], y[i3] - y[i4]
+        (x1, y1), (x2, y2), (x3, y3), (x4, y4) = loc[i1], loc[i2], loc[i3], loc[i4]
+        ux, uy = x2 - x1, y2 - y1  # s2 - s1 on the first link, t2 - t3 on the second
+        vx, vy = x3 - x4, y3 - y4
         L1s, L2s = ux * ux + uy * uy, vx * vx + vy * vy
         (ax, ay), (bx, by), (cx, cy) = pt[ks[0]], pt[ks[1]], pt[ks[2]]
         cross = (cx - ax) * (by - ay) - (cy - ay) * (bx - ax)
         sigma = 1.0 if cross >= 0 else -1.0
         steps.append(("RRR", known, links, joints, L1s, L2s, sigma, complex(ux / L1s, -(uy / L1s)),
-                      complex(vx / L2s, -(vy / L2s)), complex(x[k1], y[k1]), complex(x[k3], y[k3])))
-    cx = {i: (jid, complex(x[k], y[k])) for i, (jid, k) in anchors.items()}
-    return steps, cx, origin
+                      complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]), complex(*loc[k3])))
+    return steps, {i: (jid, complex(*loc[k])) for i, (jid, k) in anchors.items()}, origin
 
 
 class _Pass:
@@ -379,11 +379,17 @@ def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
     """Keep with ``S`` the chain as plain numbers for the fold search
     (:func:`mechsyn.kinematics.tracking._scalar_program`'s layout) read off the regular
     program (the same local points, squared lengths and rotation vectors, so the same
-    numbers) instead of building it again from the groups."""
+    numbers) instead of building it again from the groups; made when first read (the
+    compiled fold search and the closed-form four-bar folds do not read it)."""
     memo = _memo(S)
     key = ("scalar", id(plan))
-    if key in memo:
-        return
+    if key not in memo:
+        memo[key] = functools.partial(_scalar_of_regular, steps, cx)
+
+
+def _scalar_of_regular(steps: list, cx: dict) -> list:
+    """:func:`_scalar_memo`'s program: the regular program's steps ``steps`` and anchors
+    ``cx`` as plain numbers."""
     prog = []
     for st in steps:
         if st[0] == "drive":
@@ -394,7 +400,7 @@ def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
         prog.append(("RRR", (k1, (s1.real, s1.imag)), (k3, (s3.real, s3.imag)), (b1, b2), L1s, L2s,
                      (cx[b1][1].real, cx[b1][1].imag), (cx[b2][1].real, cx[b2][1].imag),
                      (cbv1.real, -cbv1.imag), (cbv2.real, -cbv2.imag)))
-    memo[key] = prog
+    return prog
 
 
 @dataclass

@@ -180,17 +180,18 @@ def _drawn_checks(S: PlanarSystem, plan: Any) -> bool:
         return False
     pts = joint_points(S)
     singular = False
+    short_link, near_fold = 1e-3 * S.scale, 1e-5 * S.scale
     for ia, ib, ic in groups:
         (ax, ay), (bx, by), (cx, cy) = pts[ia], pts[ib], pts[ic]
         e1x, e1y, e2x, e2y = bx - ax, by - ay, bx - cx, by - cy
         L1, L2 = math.hypot(e1x, e1y), math.hypot(e2x, e2y)
-        short = min(L1, L2)
-        if not short >= 1e-3 * S.scale:  # degenerate or short link, NaN: the general test
+        short = L2 if L2 < L1 else L1  # min(L1, L2)
+        if not short >= short_link:  # degenerate or short link, NaN: the general test
             return False
         sine = abs(e1x * e2y - e1y * e2x) / (L1 * L2)
         if sine <= 1e-13:
             singular = True
-        elif sine * short < 1e-5 * S.scale:
+        elif sine * short < near_fold:
             return False
     S.cache["singular_drawn"] = singular
     return True

@@ -17,7 +17,7 @@ import numpy as np
 
 from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _poses_from_chain, fast_chain
-from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, circle_circle, normalised_disc
+from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, _topology, circle_circle, normalised_disc
 from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _solve_step
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
@@ -271,6 +271,8 @@ def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
     key = ("scalar", id(plan))
     prog = memo.get(key)
     if prog is not None:
+        if callable(prog):  # kept by the regular pass, made when first read (scalar_of_regular)
+            prog = memo[key] = prog()
         return prog
     prog = []
     for step in plan.steps:
@@ -593,24 +595,47 @@ def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: list, xb: list) -> f
 
 def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     """``(v, w, s, ((L1 + L2)^2, (L1 - L2)^2))`` of :func:`_four_bar_fold` for RRR step
-    ``k``, or None (kept with the system)."""
+    ``k``, or None (kept with the system). Whether the group closes a four-bar is the
+    topology's (:func:`_four_bar_form`); the numbers are read off the regular pass's
+    program when the system has one (the numbers of :func:`_scalar_program`, which is
+    read off it), else off :func:`_scalar_program`."""
     memo = _memo(S)
     key = ("four-bar fold", id(plan), k)
     if key in memo:
         return memo[key]
     out = None
-    if len(S.drivers) == 1 and plan.closed_form_rates:
-        prog = _scalar_program(S, plan)
-        cranks = {op[1]: op for op in prog if op[0] == "drive" and op[2] < 0}
-        _, (k1, sa), (k3, sc), _, L1s, L2s, *_ = prog[k]
-        ends = {kk: complex(*ss) for kk, ss in ((k1, sa), (k3, sc))}
-        crank = next((kk for kk in ends if kk in cranks), None)
-        if len(ends) == 2 and -1 in ends and crank is not None:
-            _, _, _, O, _, sgn, s_pivot = cranks[crank]
-            L1, L2 = math.sqrt(L1s), math.sqrt(L2s)
-            out = (complex(*O) - ends[-1], ends[crank] - complex(*s_pivot), sgn, ((L1 + L2) ** 2, (L1 - L2) ** 2))
+    form = _topology(S, plan, ("four-bar form", k), lambda: _four_bar_form(S, plan, k))
+    if form is not None:
+        c, on_frame, crank = form
+        regular = memo.get(("regular", id(plan)))
+        if regular is not None and regular[0] is plan:  # (steps, anchors, origin): complex local points
+            steps, cx, _ = regular[1]
+            O, sgn, pivot = steps[c][6], steps[c][5], cx[crank][1]
+            _, _, _, _, L1s, L2s, _, _, _, s1, s3 = steps[k]
+        else:
+            prog = _scalar_program(S, plan)
+            _, _, _, O, _, sgn, pivot = prog[c]
+            _, (_, s1), (_, s3), _, L1s, L2s, *_ = prog[k]
+            O, pivot, s1, s3 = complex(*O), complex(*pivot), complex(*s1), complex(*s3)
+        frame_end, crank_end = (s1, s3) if on_frame == 1 else (s3, s1)
+        L1, L2 = math.sqrt(L1s), math.sqrt(L2s)
+        out = (O - frame_end, crank_end - pivot, sgn, ((L1 + L2) ** 2, (L1 - L2) ** 2))
     memo[key] = out
     return out
+
+
+def _four_bar_form(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
+    """Whether RRR step ``k`` closes a four-bar (:func:`_four_bar_fold`; the topology
+    decides it): ``(the crank's drive step, 1 when the group's first end joint is on the
+    frame else 3, the crank's link)``, or None."""
+    if len(S.drivers) != 1 or not plan.closed_form_rates:
+        return None
+    cranks = {s.links[0]: c for c, s in enumerate(plan.steps) if s.kind == "drive_R" and s.known[0] < 0}
+    k1, k3 = plan.steps[k].known
+    if k1 == k3 or -1 not in (k1, k3):
+        return None
+    crank = k3 if k1 < 0 else k1
+    return (cranks[crank], 1 if k1 < 0 else 3, crank) if crank in cranks else None
 
 
 def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidden: int) -> float | None:
