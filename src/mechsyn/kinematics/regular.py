@@ -362,12 +362,13 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
     u0 = np.array([d.assembled for d in S.drivers], float)
     paths = [tracking_path(S, p[0], u0) for p in parts]
-    st = _pass(S, plan, np.concatenate([U] + [path for path, _ in paths]), speeds, folds=True)
+    X = np.concatenate([U] + [path for path, _ in paths])
+    st = _pass(S, plan, X, speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
     if out is None:
         return None
     q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split)
