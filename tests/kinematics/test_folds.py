@@ -169,7 +169,8 @@ def _folding_cases(ex):
         m = ex(f)
         m = m.with_joints(tuple(replace(j, point=np.array(point, float)) if j.id == jid else j for j in m.joints))
         kp = cached_plan(m, inputs=("A",))
-        for g in ((-90.0, 270.0, 4.0), (-5.0, 115.0, 3.0), (0.0, 361.0, 1.0), (500.0, -300.0, -2.5), (100.0, 261.0, 4.0)):
+        for g in ((-90.0, 270.0, 4.0), (-5.0, 115.0, 3.0), (0.0, 361.0, 1.0), (500.0, -300.0, -2.5),
+                  (100.0, 261.0, 4.0)):
             yield m.name, g, kp.system, kp.groups, np.radians(np.arange(*g))[:, None]
 
 
