@@ -240,3 +240,25 @@ def test_a_compiled_pass_scans_its_folds_compiled(ex, monkeypatch):
     for a, b in zip(got, want):
         assert {**a.to_dict(), "input": None} == {**b.to_dict(), "input": None}
         assert abs(a.input["A"] - b.input["A"]) < 1e-9, (a, b)
+
+
+def test_tracking_paths_kept_for_the_same_first_rows():
+    """A sweep of the same grid again (a drag, a design loop) takes the connecting paths
+    kept with its system; any other first rows (or drawn row) take their own, each
+    :func:`tracking_path`'s."""
+    from mechsyn.kinematics import regular
+    from mechsyn.kinematics.tracking import tracking_path
+
+    S = cached_plan(mechanism_from_dict(fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0)), inputs=("A",)).system
+    U = np.radians(np.arange(0.0, 361.0))[:, None]
+    for V in (U, U + 0.01, U[100:], np.radians(np.arange(361.0, 0.0, -2.0))[:, None]):
+        split = drawn_row(S, V)
+        got = regular._tracking_paths(S, V, split)
+        assert regular._tracking_paths(S, V.copy(), split) is got
+        firsts = [V[0]] if split is None else [V[split], V[split - 1]]
+        assert len(got) == len(firsts)
+        for (path, shift), first in zip(got, firsts):
+            want = tracking_path(S, first)
+            assert path is want[0] and shift is want[1]
+    regular._tracking_paths(S, U, drawn_row(S, U))
+    assert regular._tracking_paths(S, U, None)[0][0] is tracking_path(S, U[0])[0]  # the same rows, another split

@@ -242,6 +242,9 @@ def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc:
     return Dl, singular, np.nonzero(chg), bool(low)
 
 
+_PATHS: tuple = (None, None, None)  # fold_scan's last paths, their lengths and whole turns
+
+
 def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
               specs: np.ndarray, zero: float, singular_disc: float) -> tuple | None:
     """:func:`mechsyn.kinematics.tracking.pass_fold_events` compiled in one call
@@ -255,9 +258,15 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     mod = _compiled()
     if mod is None:
         return None
+    global _PATHS
     (ip, anc_j, _, nj, _), fp, anc_s = program
-    n0s = np.array([path.shape[0] for path, _ in paths], np.int64)
-    shifts = np.array([shift for _, shift in paths], float)
+    last = _PATHS  # the arrays of the last paths (a list kept with its system: the same again on a cached sweep)
+    if last[0] is paths:
+        n0s, shifts = last[1], last[2]
+    else:
+        n0s = np.array([path.shape[0] for path, _ in paths], np.int64)
+        shifts = np.array([shift for _, shift in paths], float)
+        _PATHS = (paths, n0s, shifts)
     return mod.fold_scan(np.array(discs), perm, b, zero, singular_disc, X, n0s, shifts, ks, specs, ip, fp, anc_j,
                          anc_s, nj)
 
