@@ -1,7 +1,9 @@
 """The regular pass through folds: its fold search on the pass's rows, the link angles and
 the connecting paths give what the per-sweep computations give, to the bit."""
 
+import importlib.util
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -150,3 +152,113 @@ def test_blank_equals_mask_assignment():
             wa[:, ~k], wb[:, ~k] = np.nan, np.nan
             _blank((a, b), k)
             assert np.array_equal(a, wa, equal_nan=True) and np.array_equal(b, wb, equal_nan=True)
+
+
+#: the tests that run the compiled scan (Numba: the fast extra; CI's .ci/steps/25-kernel.sh)
+needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
+                                 reason="Numba not installed (pip install 'mechsyn[fast]')")
+
+
+def _folding_cases(ex):
+    """:func:`_cases` and the six-bars moved so that both their groups fold (the second
+    one's folds found by the root search, some hidden by the first one's), over their
+    grids."""
+    yield from _cases(ex)
+    for f, jid, point in (("textbook/watt_sixbar.yaml", "G", (3.5, 5.0)),
+                          ("textbook/stephenson_sixbar.yaml", "F", (5.5, 3.0))):
+        m = ex(f)
+        m = m.with_joints(tuple(replace(j, point=np.array(point, float)) if j.id == jid else j for j in m.joints))
+        kp = cached_plan(m, inputs=("A",))
+        for g in ((-90.0, 270.0, 4.0), (-5.0, 115.0, 3.0), (0.0, 361.0, 1.0), (500.0, -300.0, -2.5),
+                  (100.0, 261.0, 4.0)):
+            yield m.name, g, kp.system, kp.groups, np.radians(np.arange(*g))[:, None]
+
+
+@needs_numba
+def test_compiled_fold_scan_equals_the_python_scan(ex, monkeypatch):
+    """After a compiled pass the whole fold scan runs compiled (``kernel.fold_scan``):
+    on the same discriminants it gives the Python scan's singular rows and events (every
+    field; the inputs to 1e-12: the compiled and the Python discriminant along a segment
+    differ in the last place), folds in closed form, by the root search, hidden behind
+    an upstream fold and on the connecting path, forwards and backwards."""
+    from mechsyn.kinematics import kernel, regular, tracking
+
+    seen = {"hidden": 0, "root": 0}
+    real = tracking._hidden_fold
+
+    def spy(f, fa, fb, ends, starts, i, hidden):  # which refinements the Python scan made
+        t = real(f, fa, fb, ends, starts, i, hidden)
+        seen["hidden" if hidden else "root"] += t is not None
+        return t
+
+    monkeypatch.setattr(tracking, "_hidden_fold", spy)
+    events = before = 0
+    with kernel.use("auto"):
+        for name, g, S, plan, U in _folding_cases(ex):
+            split = drawn_row(S, U)
+            parts = [U] if split is None else [U[split:], U[:split][::-1]]
+            paths = [tracking.tracking_path(S, p[0]) for p in parts]
+            X = np.concatenate([U] + [p for p, _ in paths])
+            st = regular._pass(S, plan, X, np.ones(1), folds=True)  # the compiled program, kept with S
+            steps, anchor, _ = regular._program(S, plan)
+            regular._scalar_memo(S, plan, steps, anchor)
+            sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
+            got = tracking.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
+            with kernel.use("numpy"):
+                want = tracking.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+            assert (got is None) == (want is None), (name, g)
+            for (s1, e1), (s2, e2) in zip(got or [], want or []):
+                assert np.array_equal(s1, s2), (name, g)
+                assert [{**e.to_dict(), "input": None} for e in e1] == [{**e.to_dict(), "input": None} for e in e2]
+                for a, b in zip(e1, e2):
+                    assert np.allclose(a.input, b.input, rtol=1e-12, atol=1e-12), (name, g, a, b)
+                events += len(e1)
+                before += sum(bool(e.before_sweep) for e in e1)
+    assert events >= 200 and before >= 1 and seen["root"] >= 20 and seen["hidden"] >= 2, (events, before, seen)
+
+
+@needs_numba
+def test_a_compiled_pass_scans_its_folds_compiled(ex, monkeypatch):
+    """A simulation through dead points on the compiled pass makes no Python fold scan
+    (no row-by-row Python, no Python root search): its events come from
+    ``kernel.fold_scan``, the same as the NumPy pass's."""
+    from mechsyn.kinematics import kernel, tracking
+    from mechsyn.kinematics.analysis import simulate
+
+    m = ex("textbook/watt_sixbar.yaml")
+    x = np.arange(0.0, 361.0)
+    with kernel.use("numpy"):
+        want = simulate(m, {"A": x}).events
+
+    def no_scan(*a, **k):
+        raise AssertionError("the Python fold scan ran after a compiled pass")
+
+    monkeypatch.setattr(tracking, "_fold_scan", no_scan)
+    with kernel.use("auto"):
+        got = simulate(m, {"A": x}).events
+    assert len(got) == len(want) >= 3 and sum(e.kind == "dead point" for e in got) >= 2
+    for a, b in zip(got, want):
+        assert {**a.to_dict(), "input": None} == {**b.to_dict(), "input": None}
+        assert abs(a.input["A"] - b.input["A"]) < 1e-9, (a, b)
+
+
+def test_tracking_paths_kept_for_the_same_first_rows():
+    """A sweep of the same grid again (a drag, a design loop) takes the connecting paths
+    kept with its system; any other first rows (or drawn row) take their own, each
+    :func:`tracking_path`'s."""
+    from mechsyn.kinematics import regular
+    from mechsyn.kinematics.tracking import tracking_path
+
+    S = cached_plan(mechanism_from_dict(fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0)), inputs=("A",)).system
+    U = np.radians(np.arange(0.0, 361.0))[:, None]
+    for V in (U, U + 0.01, U[100:], np.radians(np.arange(361.0, 0.0, -2.0))[:, None]):
+        split = drawn_row(S, V)
+        got = regular._tracking_paths(S, V, split)
+        assert regular._tracking_paths(S, V.copy(), split) is got
+        firsts = [V[0]] if split is None else [V[split], V[split - 1]]
+        assert len(got) == len(firsts)
+        for (path, shift), first in zip(got, firsts):
+            want = tracking_path(S, first)
+            assert path is want[0] and shift is want[1]
+    regular._tracking_paths(S, U, drawn_row(S, U))
+    assert regular._tracking_paths(S, U, None)[0][0] is tracking_path(S, U[0])[0]  # the same rows, another split

@@ -372,3 +372,183 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):  # pragma: no cover - compiled
         lz[b1] = e1 * fp[s, 3]
         lz[b2] = (jP[J2] - jP[J3]) * fp[s, 4]
     return math.nan
+
+
+@njit(inline="always", **_OPTIONS)
+def _pos(w, i, b):  # pragma: no cover - compiled
+    """The layout column of row ``i`` of tracked sweep ``w`` (0 forwards from ``b``, 1
+    backwards from ``b - 1``)."""
+    return b + i if w == 0 else b - 1 - i
+
+
+@njit(inline="always", **_OPTIONS)
+def _scan_row(X, perm, b, w, i, n0, shifts, out):  # pragma: no cover - compiled
+    """Row ``i`` of tracked sweep ``w`` into ``out``: its connecting path's row (``i <
+    n0``), else the sweep's row shifted by the whole turns ``shifts[w]``
+    (:func:`mechsyn.kinematics.tracking.pass_fold_events`' ``row``)."""
+    r = perm[_pos(w, i, b)]
+    for c in range(out.shape[0]):
+        out[c] = X[r, c] if i < n0 else X[r, c] - shifts[w, c]
+
+
+@njit(**_OPTIONS)
+def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):  # pragma: no cover - compiled
+    """:func:`scalar_disc` of step ``k`` at the input ``xa + t d`` (the numbers of
+    :func:`mechsyn.kinematics.tracking._disc_line` compiled)."""
+    u = np.empty(xa.shape[0])
+    for c in range(xa.shape[0]):
+        u[c] = xa[c] + t * d[c]
+    return scalar_disc(ip, fp, anc_j, anc_s, u, nj, k)
+
+
+@njit(**_OPTIONS)
+def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):  # pragma: no cover - compiled
+    """:func:`mechsyn.kinematics.tracking._fold_root` (xtol 1e-14) on :func:`_disc_along`:
+    the zero ``t`` in [a, b] of step ``k``'s discriminant, ``f(a) = fa``, ``f(b) = fb``;
+    NaN when the ends do not bracket a zero."""
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
+        return math.nan
+    x0, f0, x1, f1 = a, fa, b, fb
+    t = (a * fb - b * fa) / (fb - fa)
+    for _ in range(100):
+        if not a < t < b:
+            t = (a * fb - b * fa) / (fb - fa)
+            if not a < t < b:
+                t = 0.5 * (a + b)
+        ft = _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t)
+        if ft == 0.0 or not math.isfinite(ft):
+            return t
+        if (ft > 0.0) == (fa > 0.0):
+            a, fa = t, ft
+        else:
+            b, fb = t, ft
+        x0, f0, x1, f1 = x1, f1, t, ft
+        step = f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else 0.0
+        if abs(step) <= 1e-14 or b - a <= 1e-14:
+            return min(max(x1 - step, a), b)
+        t = x1 - step
+    return t
+
+
+@njit(**_OPTIONS)
+def _four_bar_t(spec, ua, ub):  # pragma: no cover - compiled
+    """:func:`mechsyn.kinematics.tracking._four_bar_fold` from its group's numbers
+    ``spec`` (:func:`mechsyn.kinematics.tracking._four_bar_numbers`: a four-bar or not,
+    ``|v|``, ``|w|``, ``arg w - arg v``, the input's sign, the two squared distances): t
+    in [0, 1] of the one fold angle between the inputs ``ua`` and ``ub``, else NaN."""
+    if spec[0] == 0.0:
+        return math.nan
+    av, aw, beta, sgn = spec[1], spec[2], spec[3], spec[4]
+    lo, hi = min(ua, ub), max(ua, ub)
+    slack = 1e-12 * (hi - lo)
+    count = 0
+    found = 0.0
+    for q in range(2):
+        c = (spec[5 + q] - av * av - aw * aw) / (2 * av * aw)
+        if not -1.0 < c < 1.0:
+            continue
+        ac = math.acos(c)
+        for psi in (ac - beta, -ac - beta):
+            u = sgn * psi
+            u += 2 * math.pi * np.rint((0.5 * (lo + hi) - u) / (2 * math.pi))
+            if lo - slack <= u <= hi + slack:
+                found = u
+                count += 1
+    if count != 1:
+        return math.nan
+    return min(1.0, max(0.0, (found - ua) / (ub - ua)))
+
+
+@njit(**_OPTIONS)
+def fold_scan(Dp, perm, b, zero, sing, X, n0s, shifts, ks, specs, ip, fp, anc_j, anc_s, nj):  # pragma: no cover
+    """:func:`mechsyn.kinematics.tracking.pass_fold_events` in one call: the masks of
+    :func:`fold_rows` (the discriminants ``Dp`` (groups, pass rows) laid out by ``perm``),
+    then each tracked sweep's scan (:func:`mechsyn.kinematics.tracking._fold_scan`, the
+    same decisions in the same order): per group (step ``ks[g]``) the rows where its
+    assembly changes, its folds in closed form (``specs[g]``, :func:`_four_bar_t`) or by
+    :func:`_fold_root` on the program's discriminant along the segment of inputs
+    (upstream groups' folds hiding its own: ``ends``, ``starts``), then its reassemblies.
+    ``X``: the pass's input rows; ``n0s``: the sweeps' connecting paths' lengths;
+    ``shifts``: their whole turns. Returns whether a change point may be near (nothing
+    scanned then), the singular rows (L,) and the events by row: sweep, row along it,
+    kind (0 the assembly ends, 1 it starts again, 2 reassembled), group, then the input
+    along the sweep (whole turns added back past the connecting path)."""
+    ng, L = Dp.shape[0], perm.shape[0]
+    nin = X.shape[1]
+    Dl = np.empty((ng, L))
+    singular = np.empty(L, np.bool_)
+    chg = np.empty((ng, max(L - 1, 0)), np.bool_)
+    low = fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg)
+    cap = 0
+    if not low:
+        for g in range(ng):
+            for t in range(L - 1):
+                cap += chg[g, t]
+    ev = np.empty((2 * cap, 4 + nin))
+    ne = 0
+    xa, xb, d = np.empty(nin), np.empty(nin), np.empty(nin)
+    for w in range(n0s.shape[0] if cap else 0):
+        n0 = n0s[w]
+        n = L - b if w == 0 else b
+        ends, starts = np.full(n, math.nan), np.full(n, math.nan)  # NaN: no fold there yet
+        rows, hide, backs = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
+        for g in range(ng):
+            nr = nb = 0
+            for i in range(1, n):
+                fa, fb = Dl[g, _pos(w, i - 1, b)], Dl[g, _pos(w, i, b)]
+                if (fa > -zero) == (fb > -zero):
+                    continue
+                if fb > -zero:
+                    backs[nb] = i
+                    nb += 1
+                hidden = 0 if math.isfinite(fa) and math.isfinite(fb) else (
+                    1 if fa > -zero and not math.isnan(ends[i]) else (
+                        -1 if fb > -zero and not math.isnan(starts[i]) else 2))
+                if hidden != 2:
+                    rows[nr], hide[nr] = i, hidden
+                    nr += 1
+            for r in range(nr):
+                i, hidden = rows[r], hide[r]
+                fa, fb = Dl[g, _pos(w, i - 1, b)], Dl[g, _pos(w, i, b)]
+                _scan_row(X, perm, b, w, i - 1, n0, shifts, xa)
+                _scan_row(X, perm, b, w, i, n0, shifts, xb)
+                for c in range(nin):
+                    d[c] = xb[c] - xa[c]
+                t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
+                if math.isnan(t) and hidden == 0:
+                    t = _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fb, 0.0, 1.0)
+                    if math.isnan(t):
+                        t = 0.0 if fa > -zero else 1.0
+                elif hidden != 0:
+                    tc = ends[i] if hidden > 0 else starts[i]
+                    fc = _disc_along(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, tc)
+                    if not fc <= -zero:
+                        continue
+                    t = (_fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fc, 0.0, tc) if hidden > 0 else
+                         _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fc, fb, tc, 1.0))
+                    if math.isnan(t):
+                        continue
+                inside = fa > -zero if hidden == 0 else hidden > 0
+                if inside:
+                    ends[i] = t if math.isnan(ends[i]) else min(t, ends[i])
+                else:
+                    starts[i] = t if math.isnan(starts[i]) else max(t, starts[i])
+                ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 0 if inside else 1, g
+                for c in range(nin):  # the numbers of xa + t (xb - xa), whole turns added back
+                    u = xa[c] + t * (xb[c] - xa[c])
+                    ev[ne, 4 + c] = u if i < n0 else u + shifts[w, c]
+                ne += 1
+            for r in range(nb):
+                i = backs[r]
+                if i < n0:
+                    continue
+                _scan_row(X, perm, b, w, i, n0, shifts, xb)
+                ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 2, g
+                for c in range(nin):
+                    ev[ne, 4 + c] = xb[c] + shifts[w, c]
+                ne += 1
+    return low, singular, ev[:ne]

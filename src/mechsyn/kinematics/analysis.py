@@ -316,15 +316,15 @@ def _finite_rows(x: np.ndarray) -> np.ndarray:
 def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) -> list[Event]:
     """The sweep's events, a ``singular`` event added at every assembled row whose rates
     are not defined and that no event flags yet, by row, in input units."""
-    events = list(sw.events)
+    units = _units(S)
+    events = [e.with_(input=units(e.input)) if e.input is not None else e for e in sw.events]
     flagged = {e.index for e in events if e.kind == "singular" and not e.before_sweep}
     for k in singular_rows:
-        if k in flagged:
-            continue
-        events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
-                            "accelerations are not defined here (null)", sw.inputs[k].tolist()))
+        if k not in flagged:  # made in input units (one object, not one and a copy)
+            events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
+                                "accelerations are not defined here (null)", units(sw.inputs[k].tolist())))
     events.sort(key=lambda e: e.index)
-    return [_event_units(S, e) for e in events]
+    return events
 
 
 @dataclass(frozen=True)
@@ -569,12 +569,11 @@ def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
         return False
 
 
-def _event_units(S: PlanarSystem, e: Event) -> Event:
-    """The event's input values by joint, in degrees (R) or lengths (P)."""
-    if e.input is None:
-        return e
-    return e.with_(input={d.joint: (math.degrees(v) if d.type == "R" else float(v))  # np.degrees' product
-                          for d, v in zip(S.drivers, e.input)})
+def _units(S: PlanarSystem):
+    """The function that gives an event's input values (a sequence, radians or lengths)
+    by joint, in degrees (R: ``math.degrees``, np.degrees' product) or lengths (P)."""
+    conv = [(d.joint, math.degrees if d.type == "R" else float) for d in S.drivers]
+    return lambda u: {j: f(v) for (j, f), v in zip(conv, u)}
 
 
 def _limit_events(S: PlanarSystem, sw: Sweep) -> list[Event]:

@@ -213,7 +213,10 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
         sing = np.concatenate([back[0][0][::-1], sing])
     q, qd, qdd = res.q, res.qd, res.qdd
     rows = np.flatnonzero(sing)
-    if rows.size:  # a group folded flat: rates not defined here
+    if 0 < rows.size <= 8:  # a group folded flat: rates not defined here (a few rows: row by row is faster)
+        for r in rows.tolist():
+            qd[r] = qdd[r] = np.nan
+    elif rows.size:
         qd[rows] = np.nan
         qdd[rows] = np.nan
     ok = res.assembled  # from the compiled pass; else rows of coordinates (q.T) reduce fastest

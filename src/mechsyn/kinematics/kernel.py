@@ -50,7 +50,7 @@ import numpy as np
 from mechsyn._extras import missing
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["MODES", "active", "disc_line", "fold_rows", "link_poses", "point_states", "program_arrays", "run", "trig",
+__all__ = ["MODES", "active", "fold_rows", "fold_scan", "link_poses", "point_states", "program_arrays", "run", "trig",
            "use", "warm"]
 
 _MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
@@ -294,6 +294,35 @@ def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc:
     return Dl, singular, np.nonzero(chg), bool(low)
 
 
+_PATHS: tuple = (None, None, None)  # fold_scan's last paths, their lengths and whole turns
+
+
+def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
+              specs: np.ndarray, zero: float, singular_disc: float) -> tuple | None:
+    """:func:`mechsyn.kinematics.tracking.pass_fold_events` compiled in one call
+    (:func:`mechsyn.kinematics._kernel_numba.fold_scan`): the masks of :func:`fold_rows`
+    and the tracked sweeps' folds (refined on the discriminant of the regular pass's
+    ``program``) and reassemblies. ``X``: the pass's input rows; ``paths``: the sweeps'
+    ``(path, shift)``; ``ks``: the groups' steps; ``specs``: their closed-form fold
+    numbers. Returns whether a change point may be near, the singular rows in the layout
+    ``perm`` and the events as rows (sweep, row, kind, group, input...); None without
+    the kernel."""
+    mod = _compiled()
+    if mod is None:
+        return None
+    global _PATHS
+    (ip, anc_j, _, nj, _), fp, anc_s = program
+    last = _PATHS  # the arrays of the last paths (a list kept with its system: the same again on a cached sweep)
+    if last[0] is paths:
+        n0s, shifts = last[1], last[2]
+    else:
+        n0s = np.array([path.shape[0] for path, _ in paths], np.int64)
+        shifts = np.array([shift for _, shift in paths], float)
+        _PATHS = (paths, n0s, shifts)
+    return mod.fold_scan(np.array(discs), perm, b, zero, singular_disc, X, n0s, shifts, ks, specs, ip, fp, anc_j,
+                         anc_s, nj)
+
+
 def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray | None:
     """Position, velocity, acceleration (3, m, N) complex of the local points ``s`` (m,
     complex) of the links ``idx`` from the links' states (``C`` (4, links, N), rates ``w``,
@@ -304,18 +333,3 @@ def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, 
     out = np.empty((3, idx.shape[0], C.shape[2]), complex)
     mod.point_states(C, w, al, idx, s, out)
     return out
-
-
-def disc_line(program: tuple, k: int, xa: list, xb: list):
-    """The normalised discriminant of RRR step ``k`` along the segment of inputs from
-    ``xa`` (t = 0) to ``xb`` (t = 1), every group in the program's drawn mode, compiled
-    (:func:`mechsyn.kinematics._kernel_numba.scalar_disc`): the fold search's function on
-    the regular pass (:func:`mechsyn.kinematics.tracking._disc_line` in Python); None
-    without the kernel."""
-    mod = _compiled()
-    if mod is None:
-        return None
-    (ip, anc_j, _, nj, _), fp, anc_s = program
-    a, d = np.array(xa, float), np.array(xb, float) - np.array(xa, float)
-    f = mod.scalar_disc
-    return lambda t: f(ip, fp, anc_j, anc_s, a + t * d, nj, k)

@@ -360,19 +360,34 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
     steps, anchor, origin = _program(S, plan)
-    parts = [U] if split is None else [U[split:], U[:split][::-1]]
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    paths = [tracking_path(S, p[0], u0) for p in parts]
+    paths = _tracking_paths(S, U, split)
     st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
     if out is None:
         return None
     q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split)
     return Folded(q, qd, qdd, out, *links)
+
+
+def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
+    """The connecting paths (:func:`mechsyn.kinematics.tracking.tracking_path`) of the
+    tracked sweeps of the inputs ``U`` (forwards from row ``split``, backwards from row
+    ``split - 1``, or the one sweep from row 0): the last answer is kept with ``S`` by
+    the first rows' bytes (a drag or a design loop sweeps the same grid again)."""
+    firsts = [U[0]] if split is None else [U[split], U[split - 1]]
+    key = (split, *[f.tobytes() for f in firsts])
+    memo = _memo(S)
+    hit = memo.get("tracking paths")
+    if hit is not None and hit[0] == key:
+        return hit[1]
+    u0 = np.array([d.assembled for d in S.drivers], float)
+    paths = [tracking_path(S, f, u0) for f in firsts]
+    memo["tracking paths"] = (key, paths)
+    return paths
 
 
 def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:

@@ -240,10 +240,14 @@ def _swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | N
     ``i`` of the tracked rows (the first ``n0`` the connecting path, the rest the sweep
     shifted by the whole turns ``shift``): :func:`_sweep_events` of one event."""
     if i < n0:  # on the way from the drawn configuration to the sweep
-        message, before = "between the drawn configuration and the first input: " + message, True
+        message, before = _ON_THE_WAY + message, True
     if not before:
         u = [x + s for x, s in zip(u, shift)]
     return max(0, i - n0), message, u, before
+
+
+#: What an event on a connecting path (:func:`tracking_path`) says first.
+_ON_THE_WAY = "between the drawn configuration and the first input: "
 
 
 def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -392,18 +396,16 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
 
 
 def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, val, changes: list,
-               n0: int, line=None) -> tuple[list, list]:
+               n0: int) -> tuple[list, list]:
     """:func:`fold_events` from the rows where each group's assembly changes
     (``changes[g]``: the rows ``i`` whose group ``g`` is assembled at ``i`` and not at
     ``i - 1`` or the other way round), its discriminant ``val(g, i)`` (a float) and the
     input rows ``row(i)`` (lists of floats): the events as ``(row, kind, message, input, group)``
-    and per group the rows where it reassembles. ``line(k, xa, xb)``: step ``k``'s
-    discriminant along a segment (the compiled pass's, every group in its drawn mode),
-    else :func:`_disc_line`'s."""
+    and per group the rows where it reassembles (compiled for the regular pass:
+    :func:`mechsyn.kinematics._kernel_numba.fold_scan`)."""
     events: list = []
     resets = []
-    seen: dict[int, list] = {}
-    row = functools.partial(_row_once, seen, row)  # the groups' folds read the same rows
+    row = functools.lru_cache(maxsize=None)(row)  # the groups' folds read the same rows, each once
     ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
     starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
@@ -424,12 +426,11 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
                 rows.append((i, 1, fa, fb))
             elif fb > -_ZERO_DISC and i in starts:
                 rows.append((i, -1, fa, fb))
-        rows.sort()  # by row (a row is one group's once)
-        for i, hidden, fa, fb in rows:
+        for i, hidden, fa, fb in rows:  # by row (``changes[g]`` is in order; a row is one group's once)
             xa, xb = row(i - 1), row(i)
             t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
             if t is None:
-                f = line(k, xa, xb) if line is not None else _disc_line(S, plan, k, sigmas, xa, xb, i - 1)
+                f = _disc_line(S, plan, k, sigmas, xa, xb, i - 1)
                 t = _hidden_fold(f, fa, fb, ends, starts, i, hidden)
             if t is None:
                 continue
@@ -439,31 +440,23 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
             else:
                 starts[i] = max(t, starts.get(i, 0.0))
             u = [a + t * (b - a) for a, b in zip(xa, xb)]  # the numbers of xa + t (xb - xa)
-            if inside:
-                events.append((i, "dead point", f"assembly ends: the group {group} folds flat (its discriminant "
-                               "changes sign: a dead point / limit of the working range)", u, group))
-            else:
-                events.append((i, "dead point", "assembly starts again here: the other limit of a working range",
-                               u, group))
+            events.append((i, "dead point", _FOLD_MESSAGES[0 if inside else 1].format(group), u, group))
         for i in backs:
             if i < n0:
                 continue
-            events.append((i, "reassembled", "assembles again after a gap, in the assembly mode of the drawn "
-                           f"configuration for the group {group} (the mode nearest the drawn one)",
-                           row(i), group))
+            events.append((i, "reassembled", _FOLD_MESSAGES[2].format(group), row(i), group))
     return events, resets
 
 
-def _row_once(seen: dict, row, i: int) -> list:
-    """``row(i)``, read once per row."""
-    x = seen.get(i)
-    if x is None:
-        x = seen[i] = row(i)
-    return x
+#: What a fold scan's events say: the assembly ends, starts again, reassembles (``{}``: the group).
+_FOLD_MESSAGES = ("assembly ends: the group {} folds flat (its discriminant changes sign: a dead point / limit of "
+                  "the working range)", "assembly starts again here: the other limit of a working range",
+                  "assembles again after a gap, in the assembly mode of the drawn configuration for the group {} "
+                  "(the mode nearest the drawn one)")
 
 
 def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: np.ndarray, split: int | None,
-                     paths: list) -> list | None:
+                     paths: list, pass_rows: np.ndarray | None = None) -> list | None:
     """:func:`fold_events` of the tracked sweeps of one regular pass (the sweep ``U`` (N,
     n_inputs), then the connecting paths ``paths`` (``(path, shift)`` of
     :func:`tracking_path`) of the one sweep, or of the sweeps forwards from row ``split``
@@ -475,28 +468,24 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
 
     The pass's rows are read once, laid out so that each sweep's rows follow each other
     (the backward sweep from right to left, then the forward one): one comparison finds
-    every row where a group's assembly changes, and :func:`_fold_scan` reads only those.
+    every row where a group's assembly changes, and :func:`_fold_scan` reads only those;
+    after a compiled pass all of it runs compiled (:func:`_compiled_fold_events`;
+    ``pass_rows``: the pass's input rows, ``U`` then the paths, when at hand).
     """
     N = U.shape[0]
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    compiled = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: its discriminant along a segment
-    line = None
-    if compiled is not None and compiled[0] is plan and kernel.active():
-        def line(k: int, xa: list, xb: list, prog=compiled[1]):
-            return kernel.disc_line(prog, k, xa, xb)
-    masks = kernel.fold_rows([discs[k] for k in ks], perm, b, _ZERO_DISC, SINGULAR_DISC)  # compiled
-    if masks is None:
-        D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
-    else:
-        D, singular, (gs, js), low = masks
+    program = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: the whole scan compiled
+    if program is not None and program[0] is plan and kernel.active():
+        X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
+        return _compiled_fold_events(S, plan, program[1], [discs[k] for k in ks], ks, perm, b, X, paths)
+    D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
     if low:
         return None
     # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
     sweeps = [(1, paths[0], U if split is None else U[split:])]
-    if split is not None:
-        sweeps.append((-1, paths[1], U[split - 1::-1]))
+    sweeps += [] if split is None else [(-1, paths[1], U[split - 1::-1])]
     changes: list = [[[] for _ in ks] for _ in sweeps]
     for g, j in zip(gs.tolist(), js.tolist()):
         if j >= b:
@@ -516,13 +505,54 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
         def val(g: int, i: int, way=way) -> float:
             return float(D[g, b + i if way > 0 else b - 1 - i])
 
-        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0, line)
+        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0)
         events = []
         for i, kind, message, u, group in found:
             index, message, u, before = _swept(i, message, u, n0, sh)
             events.append(Event(index, kind, message, u, group, before_sweep=before))
         out.append((singular[b + n0:] if way > 0 else singular[b - n0 - 1::-1], events))
     return out
+
+
+def _compiled_fold_events(S: PlanarSystem, plan: Plan, program: tuple, discs: list, ks: list, perm: np.ndarray,
+                          b: int, X: np.ndarray, paths: list) -> list | None:
+    """:func:`pass_fold_events` after a compiled pass (``program``: its arrays, ``X``: its
+    input rows): the scan compiled (:func:`mechsyn.kinematics.kernel.fold_scan`)."""
+    steps, names, messages = _topology(S, plan, "fold scan", lambda: _fold_words(plan, ks))
+    memo = _memo(S)
+    specs = memo.get(("four-bar folds", id(plan)))  # this geometry's closed-form fold numbers per group
+    if specs is None or specs[0] is not plan:
+        specs = memo[("four-bar folds", id(plan))] = (plan, np.array([_four_bar_numbers(_four_bar_spec(S, plan, k))
+                                                                      for k in ks]))
+    low, singular, found = kernel.fold_scan(program, discs, perm, b, X, paths, steps, specs[1], _ZERO_DISC,
+                                            SINGULAR_DISC)
+    if low:
+        return None
+    n0s = [path.shape[0] for path, _ in paths]
+    out = [(singular[b + n0s[0]:], [])] + ([(singular[b - n0s[1] - 1::-1], [])] if len(paths) > 1 else [])
+    for w, i, kind, g, *u in found.tolist():
+        w, i, kind, g = int(w), int(i), int(kind), int(g)
+        n0 = n0s[w]
+        out[w][1].append(Event(max(0, i - n0), "reassembled" if kind == 2 else "dead point",
+                               messages[g][kind] if i >= n0 else _ON_THE_WAY + messages[g][kind], u, names[g],
+                               before_sweep=True if i < n0 else None))
+    return out
+
+
+def _fold_words(plan: Plan, ks: list) -> tuple:
+    """The groups' steps ``ks`` as an array, their names and their events' messages."""
+    names = ["-".join(plan.steps[k].joints) for k in ks]
+    return np.array(ks, np.int64), names, [[m.format(name) for m in _FOLD_MESSAGES] for name in names]
+
+
+def _four_bar_numbers(spec: tuple | None) -> tuple:
+    """The numbers :func:`_four_bar_fold` reads off :func:`_four_bar_spec`'s ``spec``: a
+    four-bar (1) or not (0), ``|v|``, ``|w|``, ``arg w - arg v``, the input's sign, the
+    two squared distances of its folds."""
+    if spec is None:
+        return (0.0,) * 7
+    v, w, sgn, targets = spec
+    return (1.0, abs(v), abs(w), math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real), sgn, *targets)
 
 
 def _fold_rows(discs: dict, ks: list, perm: np.ndarray, b: int) -> tuple:
@@ -568,14 +598,11 @@ def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: list, xb: list) -> f
     sign), by the law of cosines: ``|v|^2 + |w|^2 + 2 |v| |w| cos(s u + arg w - arg v) =
     (L1 +- L2)^2`` with ``v = O - C``. None when the group is not such a four-bar or the
     segment holds not exactly one such angle (the numerical search decides)."""
-    spec = _four_bar_spec(S, plan, k)
-    if spec is None:
+    four, av, aw, beta, sgn, *targets = _four_bar_numbers(_four_bar_spec(S, plan, k))
+    if not four:
         return None
-    v, w, sgn, targets = spec
     ua, ub = float(xa[0]), float(xb[0])
     lo, hi = min(ua, ub), max(ua, ub)
-    av, aw = abs(v), abs(w)
-    beta = math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real)
     slack = 1e-12 * (hi - lo)
     found = []
     for D2 in targets:
