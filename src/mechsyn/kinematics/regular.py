@@ -366,7 +366,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
+    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
     if out is None:
         return None
     q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split)
