@@ -382,13 +382,13 @@ def _pos(w, i, b):  # pragma: no cover - compiled
 
 
 @njit(inline="always", **_OPTIONS)
-def _scan_row(X, perm, b, w, i, n0, shifts, out):  # pragma: no cover - compiled
+def _scan_row(X, perm, b, w, i, n0, shift, out):  # pragma: no cover - compiled
     """Row ``i`` of tracked sweep ``w`` into ``out``: its connecting path's row (``i <
-    n0``), else the sweep's row shifted by the whole turns ``shifts[w]``
+    n0``), else the sweep's row shifted by the whole turns ``shift``
     (:func:`mechsyn.kinematics.tracking.pass_fold_events`' ``row``)."""
     r = perm[_pos(w, i, b)]
     for c in range(out.shape[0]):
-        out[c] = X[r, c] if i < n0 else X[r, c] - shifts[w, c]
+        out[c] = X[r, c] if i < n0 else X[r, c] - shift[c]
 
 
 @njit(**_OPTIONS)
@@ -464,7 +464,8 @@ def _four_bar_t(spec, ua, ub):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def fold_scan(Dp, perm, b, zero, sing, X, n0s, shifts, ks, specs, ip, fp, anc_j, anc_s, nj):  # pragma: no cover
+def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip, fp, anc_j, anc_s,
+              nj):  # pragma: no cover - compiled
     """:func:`mechsyn.kinematics.tracking.pass_fold_events` in one call: the masks of
     :func:`fold_rows` (the discriminants ``Dp`` (groups, pass rows) laid out by ``perm``),
     then each tracked sweep's scan (:func:`mechsyn.kinematics.tracking._fold_scan`, the
@@ -472,11 +473,12 @@ def fold_scan(Dp, perm, b, zero, sing, X, n0s, shifts, ks, specs, ip, fp, anc_j,
     assembly changes, its folds in closed form (``specs[g]``, :func:`_four_bar_t`) or by
     :func:`_fold_root` on the program's discriminant along the segment of inputs
     (upstream groups' folds hiding its own: ``ends``, ``starts``), then its reassemblies.
-    ``X``: the pass's input rows; ``n0s``: the sweeps' connecting paths' lengths;
-    ``shifts``: their whole turns. Returns whether a change point may be near (nothing
-    scanned then), the singular rows (L,) and the events by row: sweep, row along it,
-    kind (0 the assembly ends, 1 it starts again, 2 reassembled), group, then the input
-    along the sweep (whole turns added back past the connecting path)."""
+    ``X``: the pass's input rows; ``nsw``: the number of sweeps (1 or 2), their connecting
+    paths' lengths and whole turns ``n0a``, ``sha`` (forwards) and ``n0b``, ``shb``
+    (backwards). Returns whether a change point may be near (nothing scanned then), the
+    singular rows (L,) and the events by row: sweep, row along it, kind (0 the assembly
+    ends, 1 it starts again, 2 reassembled), group, then the input along the sweep (whole
+    turns added back past the connecting path)."""
     ng, L = Dp.shape[0], perm.shape[0]
     nin = X.shape[1]
     Dl = np.empty((ng, L))
@@ -491,8 +493,8 @@ def fold_scan(Dp, perm, b, zero, sing, X, n0s, shifts, ks, specs, ip, fp, anc_j,
     ev = np.empty((2 * cap, 4 + nin))
     ne = 0
     xa, xb, d = np.empty(nin), np.empty(nin), np.empty(nin)
-    for w in range(n0s.shape[0] if cap else 0):
-        n0 = n0s[w]
+    for w in range(nsw if cap else 0):
+        n0, shift = (n0a, sha) if w == 0 else (n0b, shb)
         n = L - b if w == 0 else b
         ends, starts = np.full(n, math.nan), np.full(n, math.nan)  # NaN: no fold there yet
         rows, hide, backs = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
@@ -514,8 +516,8 @@ def fold_scan(Dp, perm, b, zero, sing, X, n0s, shifts, ks, specs, ip, fp, anc_j,
             for r in range(nr):
                 i, hidden = rows[r], hide[r]
                 fa, fb = Dl[g, _pos(w, i - 1, b)], Dl[g, _pos(w, i, b)]
-                _scan_row(X, perm, b, w, i - 1, n0, shifts, xa)
-                _scan_row(X, perm, b, w, i, n0, shifts, xb)
+                _scan_row(X, perm, b, w, i - 1, n0, shift, xa)
+                _scan_row(X, perm, b, w, i, n0, shift, xb)
                 for c in range(nin):
                     d[c] = xb[c] - xa[c]
                 t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
@@ -540,15 +542,15 @@ def fold_scan(Dp, perm, b, zero, sing, X, n0s, shifts, ks, specs, ip, fp, anc_j,
                 ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 0 if inside else 1, g
                 for c in range(nin):  # the numbers of xa + t (xb - xa), whole turns added back
                     u = xa[c] + t * (xb[c] - xa[c])
-                    ev[ne, 4 + c] = u if i < n0 else u + shifts[w, c]
+                    ev[ne, 4 + c] = u if i < n0 else u + shift[c]
                 ne += 1
             for r in range(nb):
                 i = backs[r]
                 if i < n0:
                     continue
-                _scan_row(X, perm, b, w, i, n0, shifts, xb)
+                _scan_row(X, perm, b, w, i, n0, shift, xb)
                 ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 2, g
                 for c in range(nin):
-                    ev[ne, 4 + c] = xb[c] + shifts[w, c]
+                    ev[ne, 4 + c] = xb[c] + shift[c]
                 ne += 1
     return low, singular, ev[:ne]

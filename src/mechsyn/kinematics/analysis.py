@@ -569,7 +569,7 @@ def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
         return False
 
 
-def _units(S: PlanarSystem):
+def _units(S: PlanarSystem) -> Any:
     """The function that gives an event's input values (a sequence, radians or lengths)
     by joint, in degrees (R: ``math.degrees``, np.degrees' product) or lengths (P)."""
     conv = [(d.joint, math.degrees if d.type == "R" else float) for d in S.drivers]

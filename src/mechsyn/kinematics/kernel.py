@@ -294,9 +294,6 @@ def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc:
     return Dl, singular, np.nonzero(chg), bool(low)
 
 
-_PATHS: tuple = (None, None, None)  # fold_scan's last paths, their lengths and whole turns
-
-
 def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
               specs: np.ndarray, zero: float, singular_disc: float) -> tuple | None:
     """:func:`mechsyn.kinematics.tracking.pass_fold_events` compiled in one call
@@ -310,17 +307,12 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     mod = _compiled()
     if mod is None:
         return None
-    global _PATHS
     (ip, anc_j, _, nj, _), fp, anc_s = program
-    last = _PATHS  # the arrays of the last paths (a list kept with its system: the same again on a cached sweep)
-    if last[0] is paths:
-        n0s, shifts = last[1], last[2]
-    else:
-        n0s = np.array([path.shape[0] for path, _ in paths], np.int64)
-        shifts = np.array([shift for _, shift in paths], float)
-        _PATHS = (paths, n0s, shifts)
-    return mod.fold_scan(np.array(discs), perm, b, zero, singular_disc, X, n0s, shifts, ks, specs, ip, fp, anc_j,
-                         anc_s, nj)
+    (pa, sa), (pb, sb) = paths[0], paths[-1]
+    if sa.flags.writeable or sb.flags.writeable:  # one array type for both (tracking_path's are read-only)
+        sa, sb = np.array(sa, float), np.array(sb, float)
+    return mod.fold_scan(np.array(discs), perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0],
+                         sb, ks, specs, ip, fp, anc_j, anc_s, nj)
 
 
 def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray | None:

@@ -405,7 +405,11 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
     :func:`mechsyn.kinematics._kernel_numba.fold_scan`)."""
     events: list = []
     resets = []
-    row = functools.lru_cache(maxsize=None)(row)  # the groups' folds read the same rows, each once
+    seen: dict[int, list] = {}
+
+    def read(i: int, row=row) -> list:  # the groups' folds read the same rows, each once
+        return seen[i] if i in seen else seen.setdefault(i, row(i))
+
     ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
     starts: dict[int, float] = {}  # row -> where (t) it starts again before it
     for g, k in enumerate(ks):
@@ -427,7 +431,7 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
             elif fb > -_ZERO_DISC and i in starts:
                 rows.append((i, -1, fa, fb))
         for i, hidden, fa, fb in rows:  # by row (``changes[g]`` is in order; a row is one group's once)
-            xa, xb = row(i - 1), row(i)
+            xa, xb = read(i - 1), read(i)
             t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
             if t is None:
                 f = _disc_line(S, plan, k, sigmas, xa, xb, i - 1)
@@ -444,7 +448,7 @@ def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, va
         for i in backs:
             if i < n0:
                 continue
-            events.append((i, "reassembled", _FOLD_MESSAGES[2].format(group), row(i), group))
+            events.append((i, "reassembled", _FOLD_MESSAGES[2].format(group), read(i), group))
     return events, resets
 
 
@@ -683,13 +687,12 @@ def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidd
 
 
 def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14, a: float = 0.0, b: float = 1.0) -> float | None:
-    """The zero ``t`` in [a, b] (default the segment [0, 1]) of the discriminant ``f(t)``
-    along a segment, ``f(a) = fa``, ``f(b) = fb`` (known, so not evaluated again):
-    secant steps through the last two iterates (order 1.6 on the smooth discriminant of
-    a fold), a regula falsi step of the bracket when one would leave it, stopped when the
-    next step is below ``xtol`` (about four evaluations from one input step to 1e-14 of
-    it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when the ends
-    do not bracket a zero."""
+    """The zero ``t`` in [a, b] (default [0, 1]) of the discriminant ``f(t)`` along a segment,
+    ``f(a) = fa``, ``f(b) = fb`` (known): secant steps through the last two iterates (order
+    1.6 on the smooth discriminant of a fold), regula falsi when one would leave the bracket,
+    stopped when the next step is below ``xtol`` (about four evaluations from one input step
+    to 1e-14 of it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when
+    the ends do not bracket a zero."""
     if fa == 0.0:
         return a
     if fb == 0.0:
