@@ -233,5 +233,8 @@ def test_trig_is_numpys_and_follows_the_inputs() -> None:
     c1, _ = kernel.trig([two])
     c2, _ = kernel.trig([two.reshape(4, 1)])
     assert c1.shape == (2, 2) and c2.shape == (4, 1)
+    ints = np.array([[1], [2]], np.int64)  # the bytes of two tiny floats: other numbers
+    assert np.array_equal(kernel.trig([ints.view(float)])[0], np.cos(ints.view(float)))
+    assert np.array_equal(kernel.trig([ints])[0], np.cos(ints))
     big = np.zeros((kernel._TRIG_ROWS + 1, 1))  # not kept: computed each time
     assert np.array_equal(kernel.trig([big, path])[0][-2:], np.cos(path))

@@ -209,7 +209,7 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float) 
 
 
 #: The cosines and sines of the last blocks of input rows and stacks of them
-#: (:func:`trig`), most recent first: ``(((bytes, shape) per block), (cos, sin))``; at
+#: (:func:`trig`), most recent first: ``(((bytes, shape, type) per block), (cos, sin))``; at
 #: most ``_TRIG_ROWS`` numbers.
 _TRIG: list = []
 _TRIG_MAX, _TRIG_ROWS = 16, 1 << 16
@@ -221,7 +221,7 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     stacked: the numbers the regular pass turns its drivers by. A studio's drag, a design
     loop and a cached call sweep the same inputs again and again, with other link
     lengths: the answers for the last 16 blocks of up to 65,536 numbers, and for the
-    last stacks of them, are kept, found again by the blocks' bytes and shapes, so only
+    last stacks of them, are kept, found again by the blocks' bytes, shapes and types, so only
     new inputs cost their trigonometry (a tenth of a six-bar's compiled pass). Each
     block's numbers are ``np.cos``, ``np.sin`` of that block, whatever is kept.
 
@@ -234,7 +234,7 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     """
     if blocks[0].size > _TRIG_ROWS:  # (the sweep's rows; the connecting paths after them are a few)
         return tuple(np.concatenate([f(b) for b in blocks]) for f in (np.cos, np.sin))
-    keys = tuple([(b.tobytes(), b.shape) for b in blocks])
+    keys = tuple([(b.tobytes(), b.shape, b.dtype.char) for b in blocks])
     hit = _kept(keys)
     if hit is not None:
         return hit
