@@ -410,6 +410,23 @@ def test_a_refilled_system_reads_as_a_built_one_before_and_after_its_lazy_fields
     assert not hasattr(S, "no_such_field")
 
 
+@pytest.mark.parametrize("name", ["fourbar", "watt_sixbar", "crank_rocker"])
+def test_a_drag_builds_no_constraint_block(name):
+    """The regular pass of a fresh geometry (through its dead points, events and all)
+    reads no constraint block of the refilled system: they are made only when read
+    (fails on a code that fills every R pair's block on each drag step)."""
+    import mechsyn as ms
+
+    m = ms.examples.load(name)
+    inputs = {"A": np.linspace(0, 360, 73)}
+    simulate(m, inputs)  # the topology's template, its programs' shapes built
+    B = m.joint("B").point
+    sim = simulate(m.with_joint_points({"B": B + 0.01 * (B - m.joint("A").point)}), inputs)
+    assert sim.engine == "regular pass" and isinstance(sim.system, refill._Refilled)
+    assert not {"cons", "origin0"} & set(sim.system.__dict__)
+    assert [c.kind for c in sim.system.cons] == [c.kind for c in build_system(sim.system.mech).cons]
+
+
 def test_topology_memo_goes_only_to_mechanisms_of_the_same_topology():
     """What a mechanism's topology decides is shared with the mechanisms
     with_joint_points makes of it (numbers only), and with no other: fields_replaced and

@@ -414,7 +414,10 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     ([1.0, 1.0], [0.0, 0.0], True)
     """
     cls = type(obj)
-    if not changes.keys() <= obj.__dataclass_fields__.keys() or hasattr(cls, "__post_init__"):
+    names = _FIELD_NAMES.get(cls)
+    if names is None:  # once per class: its fields, or None when it checks them in __post_init__
+        names = _FIELD_NAMES[cls] = None if hasattr(cls, "__post_init__") else frozenset(obj.__dataclass_fields__)
+    if names is None or not changes.keys() <= names:
         bad = next((k for k in changes if k not in obj.__dataclass_fields__), None)
         raise TypeError(f"{cls.__name__} has no field {bad!r}" if bad else
                         f"{cls.__name__} checks its fields in __post_init__: use dataclasses.replace")
@@ -424,6 +427,11 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     fields.update(changes)
     fields.pop("_topology_memo", None)  # a mechanism's (topology_memo): the changes may change its topology
     return new
+
+
+#: The field names of each class :func:`fields_replaced` has copied (None: it has a
+#: ``__post_init__``, refused).
+_FIELD_NAMES: dict[type, frozenset | None] = {}
 
 
 def topology_memo(mech: Mechanism) -> dict:
