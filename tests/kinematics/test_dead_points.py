@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from mechsyn.kinematics import tracking
+from mechsyn.kinematics import folds
 from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.system import build_system
 
@@ -167,8 +167,8 @@ def test_a_fold_costs_a_few_evaluations_of_its_dyad(ex, monkeypatch):
     discriminant per fold in all (Brent's method from scratch took 7.2 per fold on these
     six-bars); the rows themselves are never evaluated one by one."""
     calls = []
-    real = tracking._scalar_disc
-    monkeypatch.setattr(tracking, "_scalar_disc", lambda *a: calls.append(a[1]) or real(*a))
+    real = folds._scalar_disc
+    monkeypatch.setattr(folds, "_scalar_disc", lambda *a: calls.append(a[1]) or real(*a))
     for case in FOLDING:
         m, _ = folding(ex, case)
         calls.clear()
@@ -184,8 +184,8 @@ def test_four_bar_dead_points_in_closed_form(ex, monkeypatch):
     and its mirror, by the law of cosines on the crank's circle, without evaluating the
     discriminant, on sweeps either way and from any turn."""
     calls = []
-    real = tracking._scalar_disc
-    monkeypatch.setattr(tracking, "_scalar_disc", lambda *a: calls.append(1) or real(*a))
+    real = folds._scalar_disc
+    monkeypatch.setattr(folds, "_scalar_disc", lambda *a: calls.append(1) or real(*a))
     m = ex("textbook/fourbar.yaml")
     exact = 180.0 - np.degrees(np.arctan(2.0))
     for grid in ((0, 360, 1), (360, 0, -7), (-300, 60, 3)):

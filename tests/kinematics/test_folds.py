@@ -19,7 +19,8 @@ def _per_sweep(S, plan, st, U, split, paths, sigmas):
     """The fold search sweep by sweep: each tracked sweep's rows gathered from the pass
     (its connecting path, then its inputs shifted by whole turns), then
     :func:`fold_events` on them (the computation ``pass_fold_events`` replaces)."""
-    from mechsyn.kinematics.tracking import _sweep_events, fold_events, touch_candidates
+    from mechsyn.kinematics.folds import fold_events, touch_candidates
+    from mechsyn.kinematics.tracking import _sweep_events
 
     N = U.shape[0]
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
@@ -59,7 +60,7 @@ def test_pass_fold_events_equals_the_sweeps_fold_events(ex):
     and change-point candidates off the pass's rows laid out once; the sweep-by-sweep
     search gives the same events (every field, every bit) and singular rows, forwards,
     backwards, over several turns and where the drawn input lies outside the sweep."""
-    from mechsyn.kinematics import regular, tracking
+    from mechsyn.kinematics import regular, folds, tracking
 
     folded = backward = 0
     for name, g, S, plan, U in _cases(ex):
@@ -70,7 +71,7 @@ def test_pass_fold_events_equals_the_sweeps_fold_events(ex):
         st = regular._run(steps, anchor, np.concatenate([U] + [p for p, _ in paths]), np.ones(1), folds=True)
         regular._scalar_memo(S, plan, steps, anchor)
         sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
-        got = tracking.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+        got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
         want = _per_sweep(S, plan, st, U, split, paths, sigmas)
         assert (got is None) == (want is None), (name, g)
         if got is None:
@@ -181,17 +182,17 @@ def test_compiled_fold_scan_equals_the_python_scan(ex, monkeypatch):
     field; the inputs to 1e-12: the compiled and the Python discriminant along a segment
     differ in the last place), folds in closed form, by the root search, hidden behind
     an upstream fold and on the connecting path, forwards and backwards."""
-    from mechsyn.kinematics import kernel, regular, tracking
+    from mechsyn.kinematics import kernel, regular, folds, tracking
 
     seen = {"hidden": 0, "root": 0}
-    real = tracking._hidden_fold
+    real = folds._hidden_fold
 
     def spy(f, fa, fb, ends, starts, i, hidden):  # which refinements the Python scan made
         t = real(f, fa, fb, ends, starts, i, hidden)
         seen["hidden" if hidden else "root"] += t is not None
         return t
 
-    monkeypatch.setattr(tracking, "_hidden_fold", spy)
+    monkeypatch.setattr(folds, "_hidden_fold", spy)
     events = before = 0
     with kernel.use("auto"):
         for name, g, S, plan, U in _folding_cases(ex):
@@ -203,9 +204,9 @@ def test_compiled_fold_scan_equals_the_python_scan(ex, monkeypatch):
             steps, anchor, _ = regular._program(S, plan)
             regular._scalar_memo(S, plan, steps, anchor)
             sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
-            got = tracking.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
+            got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
             with kernel.use("numpy"):
-                want = tracking.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+                want = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
             assert (got is None) == (want is None), (name, g)
             for (s1, e1), (s2, e2) in zip(got or [], want or []):
                 assert np.array_equal(s1, s2), (name, g)
@@ -222,7 +223,7 @@ def test_a_compiled_pass_scans_its_folds_compiled(ex, monkeypatch):
     """A simulation through dead points on the compiled pass makes no Python fold scan
     (no row-by-row Python, no Python root search): its events come from
     ``kernel.fold_scan``, the same as the NumPy pass's."""
-    from mechsyn.kinematics import kernel, tracking
+    from mechsyn.kinematics import kernel, folds
     from mechsyn.kinematics.analysis import simulate
 
     m = ex("textbook/watt_sixbar.yaml")
@@ -233,7 +234,7 @@ def test_a_compiled_pass_scans_its_folds_compiled(ex, monkeypatch):
     def no_scan(*a, **k):
         raise AssertionError("the Python fold scan ran after a compiled pass")
 
-    monkeypatch.setattr(tracking, "_fold_scan", no_scan)
+    monkeypatch.setattr(folds, "_fold_scan", no_scan)
     with kernel.use("auto"):
         got = simulate(m, {"A": x}).events
     assert len(got) == len(want) >= 3 and sum(e.kind == "dead point" for e in got) >= 2

@@ -196,7 +196,7 @@ def test_fold_masks_compiled_equal_numpy(name):
     """The fold search's masks (layout, singular rows, assembly changes, a low minimum
     that sends the chain to the tracked engine) compiled and in NumPy, on passes through
     dead points, a cell whose change points the pass declines, and one without folds."""
-    from mechsyn.kinematics import tracking
+    from mechsyn.kinematics import folds
 
     m = ms.examples.load(name)
     kp = cached_plan(m)
@@ -209,9 +209,9 @@ def test_fold_masks_compiled_equal_numpy(name):
         M = X.shape[0]
         for split, n0s in ((None, (7,)), (M // 3, (5, 9))):
             rows = M - sum(n0s)
-            perm, b = tracking._pass_layout(rows, split, n0s)
-            a = tracking._fold_rows(st.discs, ks, perm, b)
-            c = kernel.fold_rows([st.discs[k] for k in ks], perm, b, tracking._ZERO_DISC, tracking.SINGULAR_DISC)
+            perm, b = folds._pass_layout(rows, split, n0s)
+            a = folds._fold_rows(st.discs, ks, perm, b)
+            c = kernel.fold_rows([st.discs[k] for k in ks], perm, b, folds._ZERO_DISC, folds.SINGULAR_DISC)
             assert np.array_equal(a[0], c[0], equal_nan=True) and np.array_equal(a[1], c[1])
             assert all(np.array_equal(x, y) for x, y in zip(a[2], c[2])) and a[3] == c[3]
 

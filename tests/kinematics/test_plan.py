@@ -138,7 +138,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
 def test_scalar_discriminant_equals_the_array_pass(ex):
     """The one-input evaluation used by the dead-point root search gives the array pass's
     discriminant of every group."""
-    from mechsyn.kinematics import dyads, tracking
+    from mechsyn.kinematics import dyads, folds
     from mechsyn.kinematics.analysis import cached_plan
 
     for f in ("textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "kinematics/peaucellier.yaml"):
@@ -148,14 +148,14 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
         S, plan = kp.system, kp.groups
         X = np.radians(input_grid(0, 350, 10))[:, None]
         tp = dyads.solve_tracked(S, plan, X)
-        prog = tracking._scalar_program(S, plan)
+        prog = folds._scalar_program(S, plan)
         for k, step in enumerate(plan.steps):
             if step.kind != "RRR":
                 continue
-            ref = tracking._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
+            ref = folds._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
             sig = [[float(s[i]) if isinstance(s, np.ndarray) else float(s) for s in tp.sigmas[:k]]
                    for i in range(len(X))]
-            got = np.array([tracking._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
+            got = np.array([folds._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
             assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
 
 
@@ -276,7 +276,7 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
 def test_fold_search_program_read_off_the_regular_program_equals_the_groups(ex):
     """The plain-number chain of the fold search, kept from the regular pass's program,
     equals number for number the one built from the plan's groups."""
-    from mechsyn.kinematics import tracking
+    from mechsyn.kinematics import folds
     from mechsyn.kinematics.groups import _memo
 
     m = ex("textbook/watt_sixbar.yaml")
@@ -285,9 +285,9 @@ def test_fold_search_program_read_off_the_regular_program_equals_the_groups(ex):
     assert any(e.kind == "dead point" for e in s.events) and s.engine == "regular pass"
     plan = compile_plan(m, inputs=("A",)).groups
     memo = _memo(s.system)
-    kept = tracking._scalar_program(s.system, plan)  # the one read off the regular program
+    kept = folds._scalar_program(s.system, plan)  # the one read off the regular program
     assert not callable(kept) and memo.pop(("scalar", id(plan))) is kept
-    assert tracking._scalar_program(s.system, plan) == kept  # built anew from the groups
+    assert folds._scalar_program(s.system, plan) == kept  # built anew from the groups
 
 
 @pytest.mark.parametrize("f, joint", [("textbook/watt_sixbar.yaml", "E"), ("textbook/fourbar.yaml", "C"),
@@ -296,7 +296,7 @@ def test_four_bar_fold_spec_read_off_the_regular_program_equals_the_groups(ex, f
     """The closed-form four-bar fold's numbers, read off the regular pass's program (a
     drag's fresh geometry), equal those read off the plain-number chain built from the
     plan's groups, group by group (None where the group closes no four-bar)."""
-    from mechsyn.kinematics import tracking
+    from mechsyn.kinematics import folds
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.groups import _memo
 
@@ -309,8 +309,8 @@ def test_four_bar_fold_spec_read_off_the_regular_program_equals_the_groups(ex, f
     ks = [k for k, s in enumerate(kp.groups.steps) if s.kind == "RRR"]
     for k in ks:
         memo.pop(("four-bar fold", id(kp.groups), k), None)
-    got = [tracking._four_bar_spec(kp.system, kp.groups, k) for k in ks]
+    got = [folds._four_bar_spec(kp.system, kp.groups, k) for k in ks]
     for key in [key for key in memo if key[0] in ("four-bar fold", "regular", "scalar")]:
         del memo[key]
-    want = [tracking._four_bar_spec(kp.system, kp.groups, k) for k in ks]  # from the groups
+    want = [folds._four_bar_spec(kp.system, kp.groups, k) for k in ks]  # from the groups
     assert got == want and any(g is not None for g in got)

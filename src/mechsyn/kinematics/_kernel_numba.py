@@ -276,7 +276,7 @@ def fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg):  # pragma: no cover -
     assembly changes (``chg`` (groups, L - 1): assembled means ``D > -zero``), and whether
     an assembled group's discriminant has a local minimum under 0.05 on an inner row of a
     sweep (rows ``b - 1`` and ``b``, the sweeps' first, are not inner):
-    :func:`mechsyn.kinematics.tracking.pass_fold_events`'s masks in one loop."""
+    :func:`mechsyn.kinematics.folds.pass_fold_events`'s masks in one loop."""
     ng, L = Dl.shape
     for t in range(L):
         singular[t] = False
@@ -329,7 +329,7 @@ def point_states(C, w, al, idx, s, out):  # pragma: no cover - compiled
 def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):  # pragma: no cover - compiled
     """The normalised discriminant of step ``k`` (an RRR group) of the program at one input
     ``u`` (k inputs), every group upstream in the program's (drawn) mode and placed as
-    :func:`mechsyn.kinematics.tracking._scalar_disc` places it (a group folded within
+    :func:`mechsyn.kinematics.folds._scalar_disc` places it (a group folded within
     1e-12 taken flat, else NaN downstream): the fold search's function along a segment,
     positions only."""
     nl = anc_j.shape[0]
@@ -385,7 +385,7 @@ def _pos(w, i, b):  # pragma: no cover - compiled
 def _scan_row(X, perm, b, w, i, n0, shift, out):  # pragma: no cover - compiled
     """Row ``i`` of tracked sweep ``w`` into ``out``: its connecting path's row (``i <
     n0``), else the sweep's row shifted by the whole turns ``shift``
-    (:func:`mechsyn.kinematics.tracking.pass_fold_events`' ``row``)."""
+    (:func:`mechsyn.kinematics.folds.pass_fold_events`' ``row``)."""
     r = perm[_pos(w, i, b)]
     for c in range(out.shape[0]):
         out[c] = X[r, c] if i < n0 else X[r, c] - shift[c]
@@ -394,7 +394,7 @@ def _scan_row(X, perm, b, w, i, n0, shift, out):  # pragma: no cover - compiled
 @njit(**_OPTIONS)
 def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):  # pragma: no cover - compiled
     """:func:`scalar_disc` of step ``k`` at the input ``xa + t d`` (the numbers of
-    :func:`mechsyn.kinematics.tracking._disc_line` compiled)."""
+    :func:`mechsyn.kinematics.folds._disc_line` compiled)."""
     u = np.empty(xa.shape[0])
     for c in range(xa.shape[0]):
         u[c] = xa[c] + t * d[c]
@@ -403,7 +403,7 @@ def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):  # pragma: no cover - co
 
 @njit(**_OPTIONS)
 def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):  # pragma: no cover - compiled
-    """:func:`mechsyn.kinematics.tracking._fold_root` (xtol 1e-14) on :func:`_disc_along`:
+    """:func:`mechsyn.kinematics.folds._fold_root` (xtol 1e-14) on :func:`_disc_along`:
     the zero ``t`` in [a, b] of step ``k``'s discriminant, ``f(a) = fa``, ``f(b) = fb``;
     NaN when the ends do not bracket a zero."""
     if fa == 0.0:
@@ -436,8 +436,8 @@ def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):  # pragma: no 
 
 @njit(**_OPTIONS)
 def _four_bar_t(spec, ua, ub):  # pragma: no cover - compiled
-    """:func:`mechsyn.kinematics.tracking._four_bar_fold` from its group's numbers
-    ``spec`` (:func:`mechsyn.kinematics.tracking._four_bar_numbers`: a four-bar or not,
+    """:func:`mechsyn.kinematics.folds._four_bar_fold` from its group's numbers
+    ``spec`` (:func:`mechsyn.kinematics.folds._four_bar_numbers`: a four-bar or not,
     ``|v|``, ``|w|``, ``arg w - arg v``, the input's sign, the two squared distances): t
     in [0, 1] of the one fold angle between the inputs ``ua`` and ``ub``, else NaN."""
     if spec[0] == 0.0:
@@ -466,9 +466,9 @@ def _four_bar_t(spec, ua, ub):  # pragma: no cover - compiled
 @njit(**_OPTIONS)
 def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip, fp, anc_j, anc_s,
               nj):  # pragma: no cover - compiled
-    """:func:`mechsyn.kinematics.tracking.pass_fold_events` in one call: the masks of
+    """:func:`mechsyn.kinematics.folds.pass_fold_events` in one call: the masks of
     :func:`fold_rows` (the discriminants ``Dp`` (groups, pass rows) laid out by ``perm``),
-    then each tracked sweep's scan (:func:`mechsyn.kinematics.tracking._fold_scan`, the
+    then each tracked sweep's scan (:func:`mechsyn.kinematics.folds._fold_scan`, the
     same decisions in the same order): per group (step ``ks[g]``) the rows where its
     assembly changes, its folds in closed form (``specs[g]``, :func:`_four_bar_t`) or by
     :func:`_fold_root` on the program's discriminant along the segment of inputs

@@ -280,7 +280,7 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
 
 
 def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc: float) -> tuple | None:
-    """:func:`mechsyn.kinematics.tracking.pass_fold_events`'s masks compiled: the
+    """:func:`mechsyn.kinematics.folds.pass_fold_events`'s masks compiled: the
     discriminants ``discs`` (one array per group, the pass's rows) laid out by ``perm``
     (groups, L), the singular rows (L,), the (group, row) pairs after which a group's
     assembly changes, and whether a change point may be near (a low local minimum);
@@ -296,7 +296,7 @@ def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc:
 
 def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
               specs: np.ndarray, zero: float, singular_disc: float) -> tuple | None:
-    """:func:`mechsyn.kinematics.tracking.pass_fold_events` compiled in one call
+    """:func:`mechsyn.kinematics.folds.pass_fold_events` compiled in one call
     (:func:`mechsyn.kinematics._kernel_numba.fold_scan`): the masks of :func:`fold_rows`
     and the tracked sweeps' folds (refined on the discriminant of the regular pass's
     ``program``) and reassemblies. ``X``: the pass's input rows; ``paths``: the sweeps'

@@ -25,7 +25,7 @@ tracked outward sweeps (tests check both agree), at the cost of one pass.
 :func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
 local minimum under 0.05 (no change or branch point near: every group keeps its drawn
 mode), and reads the folds, reassembly and singular rows of the tracked sweeps off the
-discriminant arrays (:func:`mechsyn.kinematics.tracking.pass_fold_events`).
+discriminant arrays (:func:`mechsyn.kinematics.folds.pass_fold_events`).
 """
 
 from __future__ import annotations
@@ -40,7 +40,8 @@ from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
 from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology, circle_circle, normalised_disc
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
-from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows, pass_fold_events, tracking_path
+from mechsyn.kinematics.folds import pass_fold_events
+from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows, tracking_path
 
 __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
 
@@ -392,7 +393,7 @@ def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
 
 def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
     """Keep with ``S`` the chain as plain numbers for the fold search
-    (:func:`mechsyn.kinematics.tracking._scalar_program`'s layout) read off the regular
+    (:func:`mechsyn.kinematics.folds._scalar_program`'s layout) read off the regular
     program (the same local points, squared lengths and rotation vectors, so the same
     numbers) instead of building it again from the groups; made when first read (the
     compiled fold search and the closed-form four-bar folds do not read it)."""

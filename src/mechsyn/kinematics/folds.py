@@ -1,0 +1,520 @@
+"""The fold search of a tracked sweep: where a group's assembly ends (a dead point, a
+limit of the working range) and starts again, from the groups' normalised discriminants
+(:func:`fold_events`; the regular pass's :func:`pass_fold_events`, compiled in
+:func:`mechsyn.kinematics.kernel.fold_scan` when Numba is installed), each fold refined
+on its discriminant along the input segment (a closed form where the group closes a
+four-bar, :func:`_four_bar_fold`; else secant steps, :func:`_fold_root`) and the folds
+hidden behind an upstream group's (:func:`_hidden_fold`). The branch tracking
+(:mod:`mechsyn.kinematics.tracking`) and the regular pass
+(:mod:`mechsyn.kinematics.regular`) call it.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from mechsyn.kinematics import kernel
+from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, _topology, circle_circle, normalised_disc
+from mechsyn.kinematics.positions import _State, _solve_step
+from mechsyn.kinematics.sweep import Event
+from mechsyn.kinematics.system import PlanarSystem
+
+__all__ = ["SINGULAR_DISC", "fold_events", "pass_fold_events", "touch_candidates"]
+
+
+#: Normalised discriminant below which a group counts as folded (tangent circles,
+#: collinear links): its rates there are not defined.
+SINGULAR_DISC = 1e-12
+
+
+#: Relative size of the negative discriminant still taken as zero (round-off).
+_ZERO_DISC = 1e-12
+
+
+#: What an event on a connecting path (:func:`tracking_path`) says first.
+_ON_THE_WAY = "between the drawn configuration and the first input: "
+
+
+def _swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | None = None) -> tuple:
+    """An event's row, message, input and ``before_sweep`` along the sweep from its row
+    ``i`` of the tracked rows (the first ``n0`` the connecting path, the rest the sweep
+    shifted by the whole turns ``shift``): :func:`_sweep_events` of one event."""
+    if i < n0:  # on the way from the drawn configuration to the sweep
+        message, before = _ON_THE_WAY + message, True
+    if not before:
+        u = [x + s for x, s in zip(u, shift)]
+    return max(0, i - n0), message, u, before
+
+
+def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Normalised discriminant of step ``k`` at the inputs ``X`` (M, n_inputs), upstream
+    steps solved with their modes of the sweep rows ``rows`` (M,)."""
+    st = _State(S, X.shape[0])
+    for j in range(k):
+        s = sigmas[j]
+        _solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
+    out = []
+
+    def capture(disc: np.ndarray, s_file: float) -> float:
+        out.append(disc)
+        return 1.0
+
+    with np.errstate(invalid="ignore", divide="ignore"):
+        _solve_step(S, st, plan.steps[k], X, capture)
+    return out[0]
+
+
+def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
+    """A driver-R + RRR chain as plain numbers for :func:`_scalar_disc` (built once per
+    system and plan)."""
+    memo = _memo(S)
+    key = ("scalar", id(plan))
+    prog = memo.get(key)
+    if prog is not None:
+        if callable(prog):  # kept by the regular pass, made when first read (scalar_of_regular)
+            prog = memo[key] = prog()
+        return prog
+    prog = []
+    for step in plan.steps:
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            prog.append(("drive", new, k, tuple(_local(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
+                         tuple(_local(S, new, jid))))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
+        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
+        prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
+                     L1s, L2s, tuple(s1), tuple(t3), tuple((s2 - s1) / L1s), tuple((t2 - t3) / L2s)))
+    memo[key] = prog
+    return prog
+
+
+def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
+    """Normalised discriminant ``h^2 / L1^2`` of RRR step ``k`` of a driver-R + RRR chain
+    at one input ``u``, the upstream groups in the modes ``sigmas`` (floats): the
+    formulas of :func:`_solve_step` in plain floats (a root search calls it a few times
+    per event; an array pass would cost a hundred times more per call)."""
+    pose: dict[int, tuple] = {}  # link -> (anchor x, y, local x, y, cos, sin)
+
+    def point(i: int, s: tuple) -> tuple:
+        if i < 0:
+            return s
+        ax, ay, lx, ly, c, sn = pose[i]
+        dx, dy = s[0] - lx, s[1] - ly
+        return ax + c * dx - sn * dy, ay + sn * dx + c * dy
+
+    for j, op in enumerate(prog):
+        if op[0] == "drive":
+            _, new, kk, sk, di, sgn, snew = op
+            P = point(kk, sk)
+            ck, sk_ = (1.0, 0.0) if kk < 0 else pose[kk][4:]
+            ct, st = math.cos(u[di]), sgn * math.sin(u[di])
+            pose[new] = (P[0], P[1], snew[0], snew[1], ck * ct - sk_ * st, sk_ * ct + ck * st)
+            continue
+        _, (k1, sa), (k3, sc), (b1, b2), L1s, L2s, s1, t3, bv1, bv2 = op
+        A, C = point(k1, sa), point(k3, sc)
+        dx, dy = C[0] - A[0], C[1] - A[1]
+        inv, f, g2 = circle_circle(dx, dy, L1s, L2s)  # the kernel of the array passes, on floats
+        disc = normalised_disc(inv, g2, L1s) if inv < math.inf else math.nan
+        if j == k:
+            return disc
+        if not g2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
+            g2 = 0.0 if disc > -1e-12 else math.nan
+        g = float(sigmas[j]) * (math.sqrt(g2) if g2 >= 0 else math.nan)
+        Bx, By = A[0] + f * dx - g * dy, A[1] + f * dy + g * dx
+        for link, P, loc, bv in ((b1, A, s1, bv1), (b2, C, t3, bv2)):
+            vx, vy = Bx - P[0], By - P[1]
+            pose[link] = (P[0], P[1], loc[0], loc[1], vx * bv[0] + vy * bv[1], vy * bv[0] - vx * bv[1])
+    return math.nan
+
+
+def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, xa: list, xb: list, i0: int):
+    """Discriminant of step ``k`` on the segment of inputs from ``xa`` (t = 0, row ``i0``)
+    to ``xb`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar
+    function (on floats for a driver-R + RRR chain: the numbers of ``xa + t (xb - xa)``)."""
+    dx = [b - a for a, b in zip(xa, xb)]
+    if plan.closed_form_rates:
+        prog = _scalar_program(S, plan)
+        sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
+        return lambda t: _scalar_disc(prog, k, sig, [a + t * d for a, d in zip(xa, dx)])
+    rows = np.array([i0])
+    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, np.array([[a + t * d for a, d in zip(xa, dx)]]))[0])
+
+
+def touch_candidates(disc: np.ndarray) -> np.ndarray:
+    """Rows where a group's normalised discriminant ``disc`` (per row, in sweep order) may
+    touch zero: its local minima under 0.05 among the rows where it is assembled (the
+    candidates of a change or branch point, decided by :func:`_touch`); of several groups
+    (rows of ``disc``): any candidate shows (the flat indices are not rows then)."""
+    return np.flatnonzero(_low_minima(np.where(disc > -_ZERO_DISC, np.maximum(disc, 0.0), np.nan))) + 1
+
+
+def _low_minima(d: np.ndarray) -> np.ndarray:
+    """Where (the inner rows, ``d[..., 1:-1]``) the discriminants ``d`` (NaN where not
+    assembled, else at least 0) have a local minimum under 0.05."""
+    mid = d[..., 1:-1]
+    out = mid < 0.05
+    out &= mid <= d[..., :-2]
+    out &= mid <= d[..., 2:]
+    return out
+
+
+def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.ndarray, D: np.ndarray,
+                n0: int) -> tuple[list, np.ndarray, list]:
+    """Folds and reassembly of the branched steps ``ks`` on one sweep's rows ``X`` (M,
+    n_inputs; the first ``n0`` the connecting path) from their normalised discriminants
+    ``D`` (len(ks), M), all groups at once (branch rules 2 and 4 of :func:`solve_tracked`).
+
+    A fold (the group's own discriminant changes sign between two rows, both evaluated)
+    is a dead point, its input found on the discriminant along the segment between the
+    rows (:func:`_fold_root` on :func:`_disc_line`, upstream groups in their modes
+    ``sigmas`` of the earlier row; the ends' values are ``D``'s). A group assembled at
+    one row and cut off at the next by an upstream group's fold may fold first between
+    the same rows: its discriminant at the upstream fold decides, and the earlier fold is
+    the limit of the working range (likewise where the assembly starts again). A row
+    where the group assembles after rows where it (or an upstream group) did not is a
+    reassembly. Returns the events (per group in the order of ``ks``: its folds, then its
+    reassemblies, each by row), the singular rows (M,) (a group folded flat within
+    :data:`SINGULAR_DISC`) and per group the rows where it reassembles. Every such row
+    is one where the group's assembly changes (:func:`_fold_scan`)."""
+    ok = D > -_ZERO_DISC
+    singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
+    changes: list[list[int]] = [[] for _ in ks]
+    gs, js = np.nonzero(ok[:, 1:] != ok[:, :-1])
+    for g, j in zip(gs.tolist(), js.tolist()):
+        changes[g].append(j + 1)
+    found, resets = _fold_scan(S, plan, ks, sigmas, lambda i: X[i].tolist(), lambda g, i: float(D[g, i]), changes,
+                               n0)
+    return [Event(*e) for e in found], singular, resets
+
+
+def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, val, changes: list,
+               n0: int) -> tuple[list, list]:
+    """:func:`fold_events` from the rows where each group's assembly changes
+    (``changes[g]``: the rows ``i`` whose group ``g`` is assembled at ``i`` and not at
+    ``i - 1`` or the other way round), its discriminant ``val(g, i)`` (a float) and the
+    input rows ``row(i)`` (lists of floats): the events as ``(row, kind, message, input, group)``
+    and per group the rows where it reassembles (compiled for the regular pass:
+    :func:`mechsyn.kinematics._kernel_numba.fold_scan`)."""
+    events: list = []
+    resets = []
+    seen: dict[int, list] = {}
+
+    def read(i: int, row=row) -> list:  # the groups' folds read the same rows, each once
+        return seen[i] if i in seen else seen.setdefault(i, row(i))
+
+    ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
+    starts: dict[int, float] = {}  # row -> where (t) it starts again before it
+    for g, k in enumerate(ks):
+        rows, backs = [], []
+        resets.append(backs)
+        if not changes[g]:
+            continue
+        group = "-".join(plan.steps[k].joints)
+        for i in changes[g]:
+            fa, fb = val(g, i - 1), val(g, i)
+            if fb > -_ZERO_DISC:
+                backs.append(i)
+            if math.isfinite(fa) and math.isfinite(fb):  # its own fold
+                rows.append((i, 0, fa, fb))
+            elif fa > -_ZERO_DISC and i in ends:
+                # assembled at one row and cut off by an upstream group at the next (or the
+                # other way round): its own fold may come first, hidden between the rows
+                rows.append((i, 1, fa, fb))
+            elif fb > -_ZERO_DISC and i in starts:
+                rows.append((i, -1, fa, fb))
+        for i, hidden, fa, fb in rows:  # by row (``changes[g]`` is in order; a row is one group's once)
+            xa, xb = read(i - 1), read(i)
+            t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
+            if t is None:
+                f = _disc_line(S, plan, k, sigmas, xa, xb, i - 1)
+                t = _hidden_fold(f, fa, fb, ends, starts, i, hidden)
+            if t is None:
+                continue
+            inside = fa > -_ZERO_DISC if not hidden else hidden > 0
+            if inside:
+                ends[i] = min(t, ends.get(i, 1.0))
+            else:
+                starts[i] = max(t, starts.get(i, 0.0))
+            u = [a + t * (b - a) for a, b in zip(xa, xb)]  # the numbers of xa + t (xb - xa)
+            events.append((i, "dead point", _FOLD_MESSAGES[0 if inside else 1].format(group), u, group))
+        for i in backs:
+            if i < n0:
+                continue
+            events.append((i, "reassembled", _FOLD_MESSAGES[2].format(group), read(i), group))
+    return events, resets
+
+
+#: What a fold scan's events say: the assembly ends, starts again, reassembles (``{}``: the group).
+_FOLD_MESSAGES = ("assembly ends: the group {} folds flat (its discriminant changes sign: a dead point / limit of "
+                  "the working range)", "assembly starts again here: the other limit of a working range",
+                  "assembles again after a gap, in the assembly mode of the drawn configuration for the group {} "
+                  "(the mode nearest the drawn one)")
+
+
+def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: np.ndarray, split: int | None,
+                     paths: list, pass_rows: np.ndarray | None = None) -> list | None:
+    """:func:`fold_events` of the tracked sweeps of one regular pass (the sweep ``U`` (N,
+    n_inputs), then the connecting paths ``paths`` (``(path, shift)`` of
+    :func:`tracking_path`) of the one sweep, or of the sweeps forwards from row ``split``
+    and backwards from row ``split - 1``), from the groups' normalised discriminants
+    ``discs`` (step -> its values on the pass's rows), every group in its mode
+    ``sigmas``: per sweep its singular rows and events along it (:func:`_sweep_events`);
+    None when a discriminant has a local minimum under 0.05 (:func:`touch_candidates`:
+    a change point may be near).
+
+    The pass's rows are read once, laid out so that each sweep's rows follow each other
+    (the backward sweep from right to left, then the forward one): one comparison finds
+    every row where a group's assembly changes, and :func:`_fold_scan` reads only those;
+    after a compiled pass all of it runs compiled (:func:`_compiled_fold_events`;
+    ``pass_rows``: the pass's input rows, ``U`` then the paths, when at hand).
+    """
+    N = U.shape[0]
+    n0s = tuple(path.shape[0] for path, _ in paths)
+    perm, b = _pass_layout(N, split, n0s)
+    ks = sorted(discs)
+    program = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: the whole scan compiled
+    if program is not None and program[0] is plan and kernel.active():
+        X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
+        return _compiled_fold_events(S, plan, program[1], [discs[k] for k in ks], ks, perm, b, X, paths)
+    D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
+    if low:
+        return None
+    # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
+    sweeps = [(1, paths[0], U if split is None else U[split:])]
+    sweeps += [] if split is None else [(-1, paths[1], U[split - 1::-1])]
+    changes: list = [[[] for _ in ks] for _ in sweeps]
+    for g, j in zip(gs.tolist(), js.tolist()):
+        if j >= b:
+            changes[0][g].append(j + 1 - b)
+        elif j < b - 1:
+            changes[1][g].append(b - 1 - j)
+    for ch in changes[1:]:  # found right to left: the backward sweep's rows in its order
+        for rows in ch:
+            rows.reverse()
+    out = []
+    for (way, (path, shift), V), ch in zip(sweeps, changes):
+        n0, sh = path.shape[0], shift.tolist()
+
+        def row(i: int, path=path, sh=sh, V=V, n0=n0) -> list:  # the numbers of V[i - n0] - shift
+            return path[i].tolist() if i < n0 else [x - s for x, s in zip(V[i - n0].tolist(), sh)]
+
+        def val(g: int, i: int, way=way) -> float:
+            return float(D[g, b + i if way > 0 else b - 1 - i])
+
+        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0)
+        events = []
+        for i, kind, message, u, group in found:
+            index, message, u, before = _swept(i, message, u, n0, sh)
+            events.append(Event(index, kind, message, u, group, before_sweep=before))
+        out.append((singular[b + n0:] if way > 0 else singular[b - n0 - 1::-1], events))
+    return out
+
+
+def _compiled_fold_events(S: PlanarSystem, plan: Plan, program: tuple, discs: list, ks: list, perm: np.ndarray,
+                          b: int, X: np.ndarray, paths: list) -> list | None:
+    """:func:`pass_fold_events` after a compiled pass (``program``: its arrays, ``X``: its
+    input rows): the scan compiled (:func:`mechsyn.kinematics.kernel.fold_scan`)."""
+    steps, names, messages = _topology(S, plan, "fold scan", lambda: _fold_words(plan, ks))
+    memo = _memo(S)
+    specs = memo.get(("four-bar folds", id(plan)))  # this geometry's closed-form fold numbers per group
+    if specs is None or specs[0] is not plan:
+        specs = memo[("four-bar folds", id(plan))] = (plan, np.array([_four_bar_numbers(_four_bar_spec(S, plan, k))
+                                                                      for k in ks]))
+    low, singular, found = kernel.fold_scan(program, discs, perm, b, X, paths, steps, specs[1], _ZERO_DISC,
+                                            SINGULAR_DISC)
+    if low:
+        return None
+    n0s = [path.shape[0] for path, _ in paths]
+    out = [(singular[b + n0s[0]:], [])] + ([(singular[b - n0s[1] - 1::-1], [])] if len(paths) > 1 else [])
+    for w, i, kind, g, *u in found.tolist():
+        w, i, kind, g = int(w), int(i), int(kind), int(g)
+        n0 = n0s[w]
+        out[w][1].append(Event(max(0, i - n0), "reassembled" if kind == 2 else "dead point",
+                               messages[g][kind] if i >= n0 else _ON_THE_WAY + messages[g][kind], u, names[g],
+                               before_sweep=True if i < n0 else None))
+    return out
+
+
+def _fold_words(plan: Plan, ks: list) -> tuple:
+    """The groups' steps ``ks`` as an array, their names and their events' messages."""
+    names = ["-".join(plan.steps[k].joints) for k in ks]
+    return np.array(ks, np.int64), names, [[m.format(name) for m in _FOLD_MESSAGES] for name in names]
+
+
+def _four_bar_numbers(spec: tuple | None) -> tuple:
+    """The numbers :func:`_four_bar_fold` reads off :func:`_four_bar_spec`'s ``spec``: a
+    four-bar (1) or not (0), ``|v|``, ``|w|``, ``arg w - arg v``, the input's sign, the
+    two squared distances of its folds."""
+    if spec is None:
+        return (0.0,) * 7
+    v, w, sgn, targets = spec
+    return (1.0, abs(v), abs(w), math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real), sgn, *targets)
+
+
+def _fold_rows(discs: dict, ks: list, perm: np.ndarray, b: int) -> tuple:
+    """The masks of :func:`pass_fold_events` in NumPy (:func:`mechsyn.kinematics.kernel.fold_rows`
+    compiled): the discriminants laid out (groups, L), the singular rows, the (group,
+    row) pairs after which a group's assembly changes, whether a change point may be near."""
+    D = np.empty((len(ks), len(perm)))
+    for g, k in enumerate(ks):
+        discs[k].take(perm, out=D[g])
+    ok = D > -_ZERO_DISC
+    d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
+    low = _low_minima(d)
+    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
+    singular = d[0] < SINGULAR_DISC  # some group assembled with D < SINGULAR_DISC
+    for row in d[1:]:
+        singular |= row < SINGULAR_DISC
+    return D, singular, np.nonzero(ok[:, 1:] != ok[:, :-1]), bool(low.any())
+
+
+@functools.lru_cache(maxsize=64)
+def _pass_layout(N: int, split: int | None, n0s: tuple) -> tuple[np.ndarray, int]:
+    """The order of a pass's rows (the sweep's N, then the connecting paths of ``n0s``
+    rows) in which each tracked sweep's rows follow each other: ``[U[:split], path 2
+    reversed, path 1, U[split:]]`` (or ``[path, U]``), and where the forward sweep starts."""
+    if split is None:
+        perm = np.concatenate([np.arange(N, N + n0s[0]), np.arange(N)])
+        b = 0
+    else:
+        n1, n2 = n0s
+        perm = np.concatenate([np.arange(split), np.arange(N + n1 + n2 - 1, N + n1 - 1, -1), np.arange(N, N + n1),
+                               np.arange(split, N)])
+        b = split + n2
+    perm.setflags(write=False)
+    return perm, b
+
+
+def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: list, xb: list) -> float | None:
+    """Where (t in [0, 1]) RRR step ``k`` folds on the segment of inputs from ``xa`` to
+    ``xb``, in closed form when the group closes a four-bar: one end joint on the frame,
+    the other on a crank turned by the only input about a frame pivot. The group folds
+    where ``|P(u) - C| = L1 + L2`` or ``|L1 - L2|``, ``P(u) = O + e^{i s u} w`` (``O``
+    the crank's pivot, ``w`` the joint's offset from it on the crank, ``s`` the input's
+    sign), by the law of cosines: ``|v|^2 + |w|^2 + 2 |v| |w| cos(s u + arg w - arg v) =
+    (L1 +- L2)^2`` with ``v = O - C``. None when the group is not such a four-bar or the
+    segment holds not exactly one such angle (the numerical search decides)."""
+    four, av, aw, beta, sgn, *targets = _four_bar_numbers(_four_bar_spec(S, plan, k))
+    if not four:
+        return None
+    ua, ub = float(xa[0]), float(xb[0])
+    lo, hi = min(ua, ub), max(ua, ub)
+    slack = 1e-12 * (hi - lo)
+    found = []
+    for D2 in targets:
+        c = (D2 - av * av - aw * aw) / (2 * av * aw)
+        if not -1.0 < c < 1.0:
+            continue
+        ac = math.acos(c)
+        for psi in (ac - beta, -ac - beta):
+            u = sgn * psi
+            u += 2 * math.pi * round((0.5 * (lo + hi) - u) / (2 * math.pi))
+            if lo - slack <= u <= hi + slack:
+                found.append(u)
+    if len(found) != 1:
+        return None
+    return min(1.0, max(0.0, (found[0] - ua) / (ub - ua)))
+
+
+def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
+    """``(v, w, s, ((L1 + L2)^2, (L1 - L2)^2))`` of :func:`_four_bar_fold` for RRR step
+    ``k``, or None (kept with the system). Whether the group closes a four-bar is the
+    topology's (:func:`_four_bar_form`); the numbers are read off the regular pass's
+    program when the system has one (the numbers of :func:`_scalar_program`, which is
+    read off it), else off :func:`_scalar_program`."""
+    memo = _memo(S)
+    key = ("four-bar fold", id(plan), k)
+    if key in memo:
+        return memo[key]
+    out = None
+    form = _topology(S, plan, ("four-bar form", k), lambda: _four_bar_form(S, plan, k))
+    if form is not None:
+        c, on_frame, crank = form
+        regular = memo.get(("regular", id(plan)))
+        if regular is not None and regular[0] is plan:  # (steps, anchors, origin): complex local points
+            steps, cx, _ = regular[1]
+            O, sgn, pivot = steps[c][6], steps[c][5], cx[crank][1]
+            _, _, _, _, L1s, L2s, _, _, _, s1, s3 = steps[k]
+        else:
+            prog = _scalar_program(S, plan)
+            _, _, _, O, _, sgn, pivot = prog[c]
+            _, (_, s1), (_, s3), _, L1s, L2s, *_ = prog[k]
+            O, pivot, s1, s3 = complex(*O), complex(*pivot), complex(*s1), complex(*s3)
+        frame_end, crank_end = (s1, s3) if on_frame == 1 else (s3, s1)
+        L1, L2 = math.sqrt(L1s), math.sqrt(L2s)
+        out = (O - frame_end, crank_end - pivot, sgn, ((L1 + L2) ** 2, (L1 - L2) ** 2))
+    memo[key] = out
+    return out
+
+
+def _four_bar_form(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
+    """Whether RRR step ``k`` closes a four-bar (:func:`_four_bar_fold`; the topology
+    decides it): ``(the crank's drive step, 1 when the group's first end joint is on the
+    frame else 3, the crank's link)``, or None."""
+    if len(S.drivers) != 1 or not plan.closed_form_rates:
+        return None
+    cranks = {s.links[0]: c for c, s in enumerate(plan.steps) if s.kind == "drive_R" and s.known[0] < 0}
+    k1, k3 = plan.steps[k].known
+    if k1 == k3 or -1 not in (k1, k3):
+        return None
+    crank = k3 if k1 < 0 else k1
+    return (cranks[crank], 1 if k1 < 0 else 3, crank) if crank in cranks else None
+
+
+def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidden: int) -> float | None:
+    """Where (t) a group folds between rows ``i - 1`` and ``i`` (``f`` its discriminant
+    along the segment, ``fa``, ``fb`` its values at the rows). ``hidden`` 0: its own
+    discriminant changes sign between the rows (t at the ends when the change is round-off
+    only); 1: it is assembled at row i - 1 and an upstream group ends the assembly at
+    ``ends[i]``: the group's own fold before that point, if its discriminant is negative
+    there (else None); -1: likewise after an upstream start at ``starts[i]``."""
+    if not hidden:
+        t = _fold_root(f, fa, fb)
+        return t if t is not None else (0.0 if fa > -_ZERO_DISC else 1.0)
+    tc = ends[i] if hidden > 0 else starts[i]
+    fc = f(tc)
+    if not fc <= -_ZERO_DISC:
+        return None
+    return _fold_root(f, fa, fc, b=tc) if hidden > 0 else _fold_root(f, fc, fb, a=tc)
+
+
+def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14, a: float = 0.0, b: float = 1.0) -> float | None:
+    """The zero ``t`` in [a, b] (default [0, 1]) of the discriminant ``f(t)`` along a segment,
+    ``f(a) = fa``, ``f(b) = fb`` (known): secant steps through the last two iterates (order
+    1.6 on the smooth discriminant of a fold), regula falsi when one would leave the bracket,
+    stopped when the next step is below ``xtol`` (about four evaluations from one input step
+    to 1e-14 of it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when
+    the ends do not bracket a zero."""
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
+        return None
+    x0, f0, x1, f1 = a, fa, b, fb  # the bracket [a, b] (f(a) has the sign of fa)
+    t = (a * fb - b * fa) / (fb - fa)
+    for _ in range(100):
+        if not a < t < b:
+            t = (a * fb - b * fa) / (fb - fa)
+            if not a < t < b:
+                t = 0.5 * (a + b)
+        ft = f(t)
+        if ft == 0.0 or not math.isfinite(ft):
+            return t
+        if (ft > 0.0) == (fa > 0.0):
+            a, fa = t, ft
+        else:
+            b, fb = t, ft
+        x0, f0, x1, f1 = x1, f1, t, ft
+        step = f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else 0.0
+        if abs(step) <= xtol or b - a <= xtol:
+            return min(max(x1 - step, a), b)
+        t = x1 - step
+    return t
