@@ -549,3 +549,94 @@ def test_drag_request_refusals_go_to_the_worker(case):
     assert got is None
     with pytest.raises(MechsynInputError):
         _service.simulate(bad, steps)
+
+
+def test_kernel_program_written_with_the_numbers_is_program_arrays():
+    """The compiled pass's numbers, written while a refilled system's program is filled
+    (one flat list), are those :func:`kernel.program_arrays` reads off the filled steps,
+    bit for bit; with the kernel on, the program the pass finds kept (``fp`` and the
+    anchors' local points) is that one."""
+    from mechsyn.kinematics import kernel
+    from mechsyn.kinematics.groups import _memo, _topology
+
+    rng = np.random.default_rng(11)
+    compared = 0
+    for name, m in EXAMPLES:
+        kp = compile_plan(m, inputs=tuple(j.id for j in m.joints if j.actuated))
+        if kp.groups is None or not kp.groups.closed_form_rates:
+            continue
+        new = kp.refilled(_moved(m, rng, 0.005))
+        if new.groups is None:
+            continue
+        S, plan = new.system, new.groups
+        rows: list = []
+        out = regular._filled(S, _topology(S, plan, "regular", lambda: regular._shape(S, plan)), rows)
+        _, fp, anc_s = kernel.program_arrays(*out)
+        assert np.array_equal(np.array(rows, complex).reshape(fp.shape), fp), name
+        regular._program(S, plan)
+        if kernel.active():
+            kept = _memo(S)[("kernel", id(plan))][1]
+            assert all(np.array_equal(a, b) for a, b in zip(kept[1:], (fp, anc_s))), name
+            assert kept[1].flags.c_contiguous and kept[2].flags.c_contiguous
+        compared += 1
+    assert compared >= 4
+
+
+@pytest.mark.parametrize("case", ["no point", "no axis"])
+def test_a_missing_point_or_axis_is_not_refilled_and_reported(case):
+    """A mechanism of a known topology with a joint's point (or a P joint's axis) missing
+    is not refilled (the template's numbers would be read as NaN): the general path
+    reports it with its one line, as it does without a template."""
+    from kinematics_helpers import EX
+    from mechsyn.io import load_mechanism
+
+    m = fourbar() if case == "no point" else load_mechanism(EX / "textbook/slider_crank.yaml")
+    T = build_system(m)
+    k = 2 if case == "no point" else next(i for i, j in enumerate(m.joints) if j.type == "P")
+    bad = m.with_joints(tuple(replace(j, **({"point": None} if case == "no point" else {"axis": None}))
+                              if i == k else j for i, j in enumerate(m.joints)))
+    assert refill.with_geometry(T, bad) is None
+    drive = next(j.id for j in m.joints if j.actuated)
+    compile_plan(m, inputs=(drive,))  # the topology's template
+    with pytest.raises(MechsynInputError, match="has no point" if case == "no point" else "has no axis"):
+        simulate(bad, {drive: np.linspace(0.0, 1.0, 5)})
+
+
+def test_input_spec_without_numbers_is_the_topologys():
+    """One driver given, no P joint: the inputs' spec holds no number of the geometry and
+    is the topology's, one object for every geometry; with a driver not given (a five-bar
+    swept on one input), the other keeps each geometry's own drawn value."""
+    from kinematics_helpers import EX
+    from mechsyn.io import load_mechanism
+
+    m = fourbar()
+    a = compile_plan(m, inputs=("A",))
+    b = a.with_joint_points({"C": np.asarray(m.joint("C").point, float) + 0.01})
+    assert analysis._input_spec(a, ("A",)) is analysis._input_spec(b, ("A",))
+    five = load_mechanism(EX / "textbook/five_bar_5r.yaml")
+    drives = [j.id for j in five.joints if j.actuated]
+    assert len(drives) == 2
+    kp = compile_plan(five, inputs=(drives[0],))
+    moved = kp.refilled(_moved(five, np.random.default_rng(3), 0.01))
+    for plan in (kp, moved):
+        spec = analysis._input_spec(plan, (drives[0],))
+        assert spec.u0 == tuple(float(d.assembled) for d in plan.system.drivers)
+        assert spec.u0 == tuple(float(d.assembled) for d in build_system(plan.mechanism).drivers)
+
+
+def test_named_points_of_a_refilled_system_are_the_built_ones():
+    """The named points' local coordinates of a refilled system (read off its floats)
+    are those of a system built for the moved geometry, bit for bit."""
+    rng = np.random.default_rng(5)
+    compared = 0
+    for name, m in EXAMPLES:
+        kp = compile_plan(m, inputs=tuple(j.id for j in m.joints if j.actuated))
+        new = kp.refilled(_moved(m, rng, 0.005))
+        for names in (None, [j.id for j in m.joints]):
+            got = analysis._named_points(new.system, new.mechanism, names)
+            ref = analysis._named_points(build_system(new.mechanism), new.mechanism, names)
+            assert np.array_equal(got[3], ref[3]) and got[1] == ref[1], name
+            assert [(r[0], r[1], r[2], r[3].tolist()) for r in got[0]] == \
+                [(r[0], r[1], r[2], r[3].tolist()) for r in ref[0]], name
+        compared += bool(m.points)
+    assert compared >= 3

@@ -241,8 +241,7 @@ def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) ->
         template = _TOPOLOGIES.get(key)
         if template is not None:
             _TOPOLOGIES.move_to_end(key)
-    if template is not None and all(j.point is not None and (j.type != "P" or j.axis is not None)
-                                    for j in mech.joints):
+    if template is not None:  # (a point or a P axis missing: refilled builds it anew, and reports it)
         return template.refilled(mech)
     S = build_system(mech, vll=vll, prescribed=prescribed)
     kp = KinematicPlan(mech, S, decompose(S), vll, prescribed)
@@ -341,7 +340,7 @@ class _InputSpec:
     types: dict
     limits: tuple         # per name: (lo, hi) of a P input with limits, else None
     drivers: tuple
-    u0: tuple
+    u0: tuple             # the drivers' drawn values (empty when one driver is given: not read)
     limited: bool
     driven: bool          # every input is a driven joint
     limited_inputs: bool  # an input is a P joint with limits
@@ -359,6 +358,8 @@ def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
         return hit[2]
     shape, p_inputs, p_joints = _topology(S, kp.groups, ("input shape", names, _vll_key(kp.vll)),
                                           lambda: _input_shape(kp, names))
+    if p_joints is None:  # no number of the geometry in it
+        return shape
     joints = mech.joints
     limits = list(shape.limits)
     for n, k in p_inputs:  # the P inputs' limits (not part of the topology)
@@ -378,7 +379,9 @@ def _vll_key(vll: dict | None) -> tuple:
 def _input_shape(kp: KinematicPlan, names: tuple) -> tuple[_InputSpec, list, list]:
     """What :func:`_input_spec` takes from the topology: the spec without the numbers
     (drawn values, limits), the P inputs (position in ``names``, joint index) and the P
-    joints (their indices), whose limits each mechanism of the topology gives."""
+    joints (their indices), whose limits each mechanism of the topology gives; None for
+    them when the spec is whole without numbers (no P joint, one driver and it is
+    given: the drawn values are not read, ``u0`` is empty)."""
     mech, S = kp.mechanism, kp.system
     drivers = tuple(d.joint for d in S.drivers)
     where = {j.id: k for k, j in enumerate(mech.joints)}
@@ -395,7 +398,10 @@ def _input_shape(kp: KinematicPlan, names: tuple) -> tuple[_InputSpec, list, lis
     shape = _InputSpec(names, tuple(j for j in names if _is_passive(mech, j, kp.vll)), tuple(index), types,
                        (None,) * len(names), drivers, (), False, all(isinstance(k, int) for k in index), False,
                        tuple(1.0 if k in index else 0.0 for k in range(len(drivers))))
-    return shape, p_inputs, [k for k, j in enumerate(mech.joints) if j.type == "P"]
+    p_joints = [k for k, j in enumerate(mech.joints) if j.type == "P"]
+    if not p_joints and len(drivers) == 1 and shape.driven:  # the one driver given: no drawn value, no limit read
+        return shape, p_inputs, None
+    return shape, p_inputs, p_joints
 
 
 def _not_driven(mech: Mechanism, jid: str, drivers: tuple) -> MechsynInputError:
@@ -485,16 +491,24 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     if hit is None:
         labels, li, moving, idx, where = _topology(S, None, key, lambda: _named_shape(S, mech, names))
         joints, points = mech.joints, mech.points
-        xy = [_xy(points[name].at if j < 0 else joints[j].point) for name, j in where]
+        pts = S.cache.get("joint_points")  # a refilled system's: its joints' then its named points' floats
+        if pts is not None and len(pts) == len(joints) + len(points):
+            xy = [pts[k] for _, _, k in where]
+        else:
+            xy = [_xy(points[name].at if j < 0 else joints[j].point) for name, j, _ in where]
         loc = frame_points(S.frames(), li, xy)
-        local = np.array([loc[k] for k in moving], float).reshape(-1, 2)
-        rows, r = [], 0
-        for k, ((name, link), i) in enumerate(zip(labels, li)):
-            if i >= 0:  # on a moving link: its row of ``local`` (in the same order)
-                at, r = local[r], r + 1
-            else:
-                at = np.array(loc[k], float)
-            rows.append((name, link, i, at))
+        if len(moving) == len(loc):  # every point on a moving link (the common case): rows of ``local``
+            local = np.array(loc, float).reshape(-1, 2)
+            rows = [(name, link, i, at) for (name, link), i, at in zip(labels, li, local)]
+        else:
+            local = np.array([loc[k] for k in moving], float).reshape(-1, 2)
+            rows, r = [], 0
+            for k, ((name, link), i) in enumerate(zip(labels, li)):
+                if i >= 0:  # on a moving link: its row of ``local`` (in the same order)
+                    at, r = local[r], r + 1
+                else:
+                    at = np.array(loc[k], float)
+                rows.append((name, link, i, at))
         hit = S.cache[key] = (rows, moving, idx, local)
     return hit
 
@@ -502,13 +516,15 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
 def _named_shape(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
     """What :func:`_named_points` takes from the topology: the points' names and links,
     their links' indices, the rows on moving links and their indices (an array), and
-    where each point's drawn coordinates are (``(name, -1)``: a named point; ``(name,
-    k)``: joint ``k``'s point)."""
+    where each point's drawn coordinates are (``(name, -1, n)``: a named point, the
+    ``n``-th of a refilled system's :func:`~mechsyn.kinematics.refill.joint_points`;
+    ``(name, k, k)``: joint ``k``'s point)."""
     pts = resolve_points(mech, names)
     li = [S.index(link) for link, _ in pts.values()]
     moving = [k for k, i in enumerate(li) if i >= 0]
     index = {j.id: k for k, j in enumerate(mech.joints)}
-    where = [(name, -1) if name in mech.points else (name, index[name]) for name in pts]
+    named = {name: len(index) + n for n, name in enumerate(mech.points)}  # (after the joints)
+    where = [(name, -1, named[name]) if name in named else (name, index[name], index[name]) for name in pts]
     return [(name, link) for name, (link, _) in pts.items()], li, moving, np.array([li[k] for k in moving], int), where
 
 

@@ -52,8 +52,9 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     :func:`topology_key`: the same constraints, drivers and notes with the numbers of
     ``mech``'s joint points (link frames, local points, drawn angles and slide
     coordinates, length scale), equal to :func:`build_system`'s; None when ``T`` has
-    blocks other than R pairs, angles and lines (cams, gears, belts: built anew) or a
-    point is not finite (:func:`build_system` then reports it).
+    blocks other than R pairs, angles and lines (cams, gears, belts: built anew), a
+    point is missing or not finite or a P pair has no axis (:func:`build_system` then
+    reports it).
 
     The numbers are worked out on Python floats from one ``tolist`` of the points (the
     same products, sums and ``arctan2`` as :func:`build_system`'s, so the same bits), and
@@ -79,12 +80,14 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     if lay is False:
         return None
     first, other, rowmask, colmask, recipe, scales, kept = lay
-    nd = np.ndarray  # a float64 point (the common case) read inline
-    pts = [p.tolist() if (p := j.point).__class__ is nd and p.dtype is _FLOAT else _xy(p) for j in mech.joints]
+    nd, joints = np.ndarray, mech.joints  # a float64 point (the common case) read inline
+    pts = [p.tolist() if (p := j.point).__class__ is nd and p.dtype is _FLOAT else _xy(p) for j in joints]
+    if recipe[3] and any(joints[k].axis is None for k in recipe[3]):  # a P pair without axis
+        return None
     if mech.points:
         pts += [_xy(p.at) for p in mech.points.values()]
-    xs, ys = [p[0] for p in pts], [p[1] for p in pts]
-    if not all(map(math.isfinite, xs + ys)):
+    xs, ys = [x for x, _ in pts], [y for _, y in pts]
+    if not math.isfinite(sum(xs) + sum(ys)):  # a NaN or an infinity (or sums past the float range: built anew)
         return None
     scale = max(max(xs) - min(xs), max(ys) - min(ys), 1e-9) if len(pts) > 1 else 1.0
     org = [pts[k] for k in first]
@@ -134,7 +137,10 @@ def _frame_angles(pts: list, org: list, other: list, tol: float) -> np.ndarray:
 
 
 def _xy(p: Any) -> list:
-    """A drawn point as ``[x, y]`` floats (one ``tolist`` of a float array)."""
+    """A drawn point as ``[x, y]`` floats (one ``tolist`` of a float array); none (None):
+    NaN, which :func:`with_geometry` refuses."""
+    if p is None:
+        return [math.nan, math.nan]
     return p.tolist() if type(p) is np.ndarray and p.dtype is _FLOAT else np.asarray(p, float).tolist()
 
 
@@ -145,7 +151,8 @@ def _layout(T: PlanarSystem) -> tuple | bool:
     """What :func:`with_geometry` needs of ``T``'s topology, or False when ``T`` cannot be
     refilled: the joint indices of every moving link's frame (its first joint, then the
     others in file order), which rows and columns scale with the length, and per
-    constraint how its numbers are filled (:func:`_refilled`); then the row and column
+    constraint but the R pairs how its numbers are filled (:func:`_refilled`; the R pairs'
+    links and joints for :func:`_r_pairs`); then the row and column
     scales of the last size refilled, ``[(scale, rows, cols)]``, and ``T``'s fields that
     no geometry changes (its links, unknowns, equations and notes)."""
     mech = T.mech
@@ -159,14 +166,17 @@ def _layout(T: PlanarSystem) -> tuple | bool:
         other.append(ks[1:])
     rows = np.concatenate([np.full(c.rows, c.kind != "angle") for c in T.cons]) if T.cons else np.zeros(0, bool)
     cols = np.arange(T.n) % 3 != 2
-    recipe = []
-    for c in T.cons:
+    recipe = []  # (row, how, constraint, joint index) of every constraint but the R pairs
+    for r, c in enumerate(T.cons):
         how = c.kind if c.kind != "angle" else ("drive" if c.role == "drive" else
                                                 "rotation" if c.role == "rotation" else "kept")
-        recipe.append((how, c, index[c.joint]))
+        if how != "R":
+            recipe.append((r, how, c, index[c.joint]))
     pairs = [(i, index[c.joint]) for c in T.cons if c.kind == "R" for i in (c.a, c.b)]  # sa, sb of each R
     kept = {k: v for k, v in T.__dict__.items() if k in ("links", "n", "m", "notes")}
-    return first, other, rows, cols, (recipe, [i for i, _ in pairs], [k for _, k in pairs]), [(None,)], kept
+    slides = [k for k, j in enumerate(mech.joints) if j.type == "P"]  # (their axes are read: given?)
+    return (first, other, rows, cols, ((len(T.cons), recipe), [i for i, _ in pairs], [k for _, k in pairs], slides),
+            [(None,)], kept)
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -181,16 +191,14 @@ def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames:
     coordinate (see :class:`~mechsyn.kinematics.system._Builder`; ``recipe``:
     :func:`_layout`'s); an R pair's block is None, made when first read
     (:func:`_r_pairs`)."""
-    recipe = recipe[0]
+    count, recipe = recipe[0]
     drivers = list(T.drivers)
-    cons: list = [None] * len(recipe)
+    cons: list = [None] * count
 
     def rel(b: int, a: int) -> float:  # phi_b - phi_a drawn (_Builder.angle)
         return (0.0 if b < 0 else ang[b]) - (0.0 if a < 0 else ang[a])
 
-    for r, (how, c, k) in enumerate(recipe):
-        if how == "R":
-            continue
+    for r, how, c, k in recipe:  # (the R pairs are not visited: None)
         if how == "drive":
             drivers[c.driver] = fields_replaced(drivers[c.driver], assembled=rel(c.b, c.a))
             cons[r] = c
@@ -207,7 +215,7 @@ def _r_pairs(T_cons: tuple, cons: list, pairs: tuple, pts: list, frames: tuple) 
     """The constraints ``cons`` of :func:`_refilled` with every R pair's block (None there)
     made from ``T``'s (``T_cons``): its local points ``sa``, ``sb`` (:class:`_RPair`;
     ``pairs``: the links and joints of :func:`_layout`)."""
-    links, joints = pairs
+    links, joints = pairs[:2]
     block = frame_points(frames, links, [pts[k] for k in joints])
     out, r = [], 0
     for c, t in zip(cons, T_cons):

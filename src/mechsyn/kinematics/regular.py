@@ -52,14 +52,24 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
     joints, drivers and signs, and which local joint points they take) depends on the
     topology only: it is kept in ``S.cache["programs"]``, which
     :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of one
-    topology, so a refilled system's program is its numbers put in (:func:`_filled`)."""
+    topology, so a refilled system's program is its numbers put in (:func:`_filled`).
+    With the kernel, the same numbers are written once more as the compiled pass's
+    arrays (:func:`~mechsyn.kinematics.kernel.program_arrays`' ``fp`` and ``anc_s``, kept
+    under ``("kernel", id(plan))``) while they are filled in, not read back off the steps."""
     memo = _memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
-    out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)))
+    rows: list | None = [] if kernel.active() else None
+    out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)), rows)
     memo[key] = (plan, out)
+    if rows is not None:  # (the integers of the kernel's program are the topology's)
+        steps, anchor, origin = out
+        shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
+        rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
+        flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
+        memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
     return out
 
 
@@ -101,16 +111,20 @@ def _locals(S: PlanarSystem, li: list, pj: list) -> list:
     return frame_points(S.frames(), li, [pts[k] for k in pj])
 
 
-def _filled(S: PlanarSystem, shape: tuple) -> tuple:
+def _filled(S: PlanarSystem, shape: tuple, rows: list | None = None) -> tuple:
     """:func:`_program` of ``S`` from its topology's shape (:func:`_shape`): the local
-    points, squared link lengths, drawn assembly modes and rotation vectors of ``S``."""
+    points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
+    with ``rows`` (a list), each step's row of the kernel's ``fp``
+    (:func:`~mechsyn.kinematics.kernel.program_arrays`' layout) appended to it, flat."""
     steps_, anchors, origin, li, pj, drawn = shape
     loc = _locals(S, li, pj)
     pt = joint_points(S)
     steps = []
     for st, ks in zip(steps_, drawn):
         if st[0] == "drive":
-            steps.append(st[:6] + (complex(*loc[st[6]]),))
+            steps.append(st[:6] + (s_k := complex(*loc[st[6]]),))
+            if rows is not None:
+                rows += (st[5], s_k, 0j, 0j, 0j, 0j, 0j)
             continue
         _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
         (x1, y1), (x2, y2), (x3, y3), (x4, y4) = loc[i1], loc[i2], loc[i3], loc[i4]
@@ -120,8 +134,11 @@ def _filled(S: PlanarSystem, shape: tuple) -> tuple:
         (ax, ay), (bx, by), (cx, cy) = pt[ks[0]], pt[ks[1]], pt[ks[2]]
         cross = (cx - ax) * (by - ay) - (cy - ay) * (bx - ax)
         sigma = 1.0 if cross >= 0 else -1.0
-        steps.append(("RRR", known, links, joints, L1s, L2s, sigma, complex(ux / L1s, -(uy / L1s)),
-                      complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]), complex(*loc[k3])))
+        num = (sigma, complex(ux / L1s, -(uy / L1s)), complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]),
+               complex(*loc[k3]))
+        steps.append(("RRR", known, links, joints, L1s, L2s) + num)
+        if rows is not None:
+            rows += (complex(L1s, L2s), 0j) + num
     return steps, {i: (jid, complex(*loc[k])) for i, (jid, k) in anchors.items()}, origin
 
 
