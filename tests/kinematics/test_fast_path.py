@@ -427,6 +427,29 @@ def test_a_drag_builds_no_constraint_block(name):
     assert [c.kind for c in sim.system.cons] == [c.kind for c in build_system(sim.system.mech).cons]
 
 
+@pytest.mark.parametrize("name, joint", [("crank_rocker", "D"), ("watt_sixbar", "F")])
+def test_a_drag_that_changes_the_size_makes_no_scales(name, joint):
+    """A joint on the outline moved (the size changes on each drag step): the regular
+    pass reads no row or column scale of the refilled system, made only when read, for
+    the size it was refilled with, equal to build_system's (fails on a code that makes
+    them on each step)."""
+    import mechsyn as ms
+
+    m = ms.examples.load(name)
+    inputs = {"A": np.linspace(0, 360, 73)}
+    simulate(m, inputs)
+    P = np.asarray(m.joint(joint).point, float)
+    moved = m.with_joint_points({joint: P + 0.01 * (P - m.joint("A").point)})
+    sim = simulate(moved, inputs)
+    S, ref = sim.system, build_system(moved)
+    assert sim.engine == "regular pass" and isinstance(S, refill._Refilled) and S.scale != build_system(m).scale
+    assert not {"row_scale", "col_scale", "_row_scale", "_col_scale"} & set(S.__dict__)
+    S2 = fields_replaced(S, scale=2 * S.scale)  # (its scales stay those of the size refilled with)
+    for s in (S, S2):
+        _same_numbers(s.row_scale, ref.row_scale)
+        _same_numbers(s.col_scale, ref.col_scale)
+
+
 def test_topology_memo_goes_only_to_mechanisms_of_the_same_topology():
     """What a mechanism's topology decides is shared with the mechanisms
     with_joint_points makes of it (numbers only), and with no other: fields_replaced and

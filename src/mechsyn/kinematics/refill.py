@@ -61,8 +61,8 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     the link angles, their cosines and sines are each one NumPy call: a fresh geometry of
     a drag or a design loop costs a few NumPy calls, not a few per joint. What the
     regular pass of a drag does not read is made when first read (:class:`_Refilled`:
-    the R pairs' constraint blocks, the links' drawn origins as an array), and the scales
-    of the rows and columns are shared by the systems of one topology and one size.
+    the R pairs' constraint blocks, the links' drawn origins as an array, the scales of
+    the rows and columns, these shared by the systems of one topology and one size).
 
     Examples
     --------
@@ -96,17 +96,25 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     frames, ang = (np.cos(turn).tolist(), np.sin(turn).tolist(), org), angle0.tolist()
     cons, drivers = _refilled(T, mech, recipe, pts, frames, ang)
     q0 = np.array([v for (x, y), a in zip(org, ang) for v in (x, y, a)], float)
-    sc = scales[0]  # the scales of the last size (read only: shared by its systems; one read, one write)
-    if sc[0] != scale:
-        sc = scales[0] = (scale, _frozen(np.where(rowmask, scale, 1.0)), _frozen(np.where(colmask, scale, 1.0)))
     # the engines' programs by topology (regular._program's shapes), shared with T
     cache = {"frames": frames, "joint_points": pts, "layout": lay, "programs": T.cache.setdefault("programs", {})}
     S = object.__new__(_Refilled)
     fields = S.__dict__
     fields.update(kept)  # T's fields a geometry does not change; cons and origin0 made when first read
-    fields.update(mech=mech, angle0=angle0, drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll), row_scale=sc[1],
-                  col_scale=sc[2], cache=cache, _pending=(T.cons, cons, recipe[1:], pts, frames))
+    fields.update(mech=mech, angle0=angle0, drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll), cache=cache,
+                  _pending=(T.cons, cons, recipe[1:], pts, frames), _scales=(scale, rowmask, colmask, scales))
     return S
+
+
+def _scales_of(scale: float, rowmask: np.ndarray, colmask: np.ndarray, scales: list) -> tuple:
+    """The row and column scales of a system of size ``scale`` (:func:`build_system`'s:
+    ``scale`` where a row or column is a length, else 1), read only: those of the last
+    size made are shared by its topology's systems (``scales``: :func:`_layout`'s; one
+    read, one write)."""
+    sc = scales[0]
+    if sc[0] != scale:
+        sc = scales[0] = (scale, _frozen(np.where(rowmask, scale, 1.0)), _frozen(np.where(colmask, scale, 1.0)))
+    return sc[1], sc[2]
 
 
 def joint_points(S: PlanarSystem) -> list:
@@ -253,8 +261,9 @@ def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
 
 class _Refilled(PlanarSystem):
     """A system made by :func:`with_geometry`: a :class:`PlanarSystem` whose R pairs'
-    constraint blocks (:func:`_r_pairs`) and drawn link origins ``origin0`` are made
-    when first read (the regular pass and the drawn checks of a drag never read them;
+    constraint blocks (:func:`_r_pairs`), drawn link origins ``origin0`` and row and
+    column scales (:func:`_scales_of`, for the size it was refilled with) are made when
+    first read (the regular pass and the drawn checks of a drag never read them;
     Newton's continuation, the rank tests and the forces do, once per system). Its
     fields read, copy, pickle and replace as a built system's (a test).
 
@@ -281,6 +290,28 @@ class _Refilled(PlanarSystem):
             fields["origin0"] = np.array(frames[2], float).reshape(-1, 2)
         fields.pop("_pending", None)  # (a thread reading at the same time made the same)
         return fields[name]
+
+    def _scale(self, k: int) -> np.ndarray:
+        fields, name = self.__dict__, ("_row_scale", "_col_scale")[k]
+        if name not in fields:  # (one given, None too, stays)
+            fields.setdefault(name, _scales_of(*fields["_scales"])[k])
+        return fields[name]
+
+    @property  # type: ignore[override]
+    def row_scale(self) -> np.ndarray:
+        return self._scale(0)
+
+    @row_scale.setter
+    def row_scale(self, value: Any) -> None:  # dataclasses.replace's __init__ (object.__setattr__)
+        self.__dict__["_row_scale"] = value
+
+    @property  # type: ignore[override]
+    def col_scale(self) -> np.ndarray:
+        return self._scale(1)
+
+    @col_scale.setter
+    def col_scale(self, value: Any) -> None:
+        self.__dict__["_col_scale"] = value
 
 
 class _RPair(Con):
