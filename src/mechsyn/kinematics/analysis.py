@@ -33,7 +33,7 @@ from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, 
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.refill import _xy, topology_key, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system, frame_points
-from mechsyn.model.mechanism import Mechanism, fields_replaced
+from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
 
 __all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan",
@@ -116,7 +116,7 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
     >>> cached_plan(m, inputs=("A",)) is cached_plan(m, inputs=("A",))
     True
     """
-    prescribed = tuple(j for j in inputs if _is_passive(mech, j, vll))
+    prescribed = _prescribed(mech, vll, inputs)
     key = _geometry_key(mech, vll, prescribed)
     with _PLANS_LOCK:
         entry = _PLANS.get(id(mech))
@@ -185,8 +185,11 @@ class KinematicPlan:
         S = with_geometry(self.system, mech)
         if S is None:
             S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
-        groups = self.groups
-        if groups is not None and not any(s.data for s in groups.steps):  # it holds for any geometry
+        groups, memo = self.groups, self.system.cache
+        free = memo.get("geometry-free plan")  # (whether the steps hold for any geometry: the template's)
+        if free is None or free[0] is not groups:
+            free = memo["geometry-free plan"] = (groups, groups is not None and not any(s.data for s in groups.steps))
+        if free[1]:
             return fields_replaced(self, mechanism=mech, system=S)
         if groups is not None:
             new = KinematicPlan(mech, S, groups, self.vll, self.prescribed)
@@ -573,6 +576,20 @@ def _set_nan(PVA: np.ndarray, nok: np.ndarray | None, bad: np.ndarray | None) ->
         PVA.T[:, nok] = np.nan
     if bad is not None and (nok is None or bad.tobytes() != nok.tobytes()):  # often the same rows
         PVA[1:].T[:, bad] = np.nan
+
+
+def _prescribed(mech: Mechanism, vll: dict[str, str] | None, inputs: tuple) -> tuple:
+    """The inputs that are passive VLLs (prescribed, :func:`_is_passive`): the topology's
+    (the joints' VLL modes are part of it), kept in its :func:`topology_memo` when no
+    VLL mode is asked for."""
+    if vll:
+        return tuple(j for j in inputs if _is_passive(mech, j, vll))
+    memo = topology_memo(mech)
+    key = ("prescribed", inputs)
+    out = memo.get(key)
+    if out is None:
+        out = memo[key] = tuple(j for j in inputs if _is_passive(mech, j, None))
+    return out
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:
