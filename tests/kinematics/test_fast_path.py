@@ -659,7 +659,7 @@ def test_named_points_of_a_refilled_system_are_the_built_ones():
             got = analysis._named_points(new.system, new.mechanism, names)
             ref = analysis._named_points(build_system(new.mechanism), new.mechanism, names)
             assert np.array_equal(got[3], ref[3]) and got[1] == ref[1], name
-            assert [(r[0], r[1], r[2], r[3].tolist()) for r in got[0]] == \
-                [(r[0], r[1], r[2], r[3].tolist()) for r in ref[0]], name
+            assert [(r[0], r[1], r[2], None if r[3] is None else r[3].tolist()) for r in got[0]] == \
+                [(r[0], r[1], r[2], None if r[3] is None else r[3].tolist()) for r in ref[0]], name
         compared += bool(m.points)
     assert compared >= 3

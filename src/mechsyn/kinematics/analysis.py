@@ -483,16 +483,18 @@ def _input_speeds(spec: _InputSpec, inputs: dict, speeds: dict[str, float] | Non
 
 def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
     """The named points asked for (:func:`resolve_points`) as ``(rows, moving, idx,
-    local)``: rows ``(name, link, link index, local point)``, the rows on moving links,
-    their link indices and local points (m, 2), kept with the system (a cached plan's
-    call resolves them and carries them into the link frames once). Which points, on
-    which links, is the topology's (:func:`_named_shape`, shared by its systems); the
-    local points are this geometry's (:func:`~mechsyn.kinematics.system.frame_points`
-    on floats: :meth:`~mechsyn.kinematics.system.PlanarSystem.to_locals`' numbers)."""
+    local)``: rows ``(name, link, link index, the local point of a point of the frame,
+    else None)``, the rows on moving links, their link indices and local points (m, 2),
+    kept with the system (a cached plan's call resolves them and carries them into the
+    link frames once). Which points, on which links, is the topology's
+    (:func:`_named_shape`, shared by its systems, the rows too when every point is on a
+    moving link); the local points are this geometry's
+    (:func:`~mechsyn.kinematics.system.frame_points` on floats:
+    :meth:`~mechsyn.kinematics.system.PlanarSystem.to_locals`' numbers)."""
     key = ("named points", None if names is None else tuple(names))
     hit = S.cache.get(key)
     if hit is None:
-        labels, li, moving, idx, where = _topology(S, None, key, lambda: _named_shape(S, mech, names))
+        rows, li, moving, idx, where = _topology(S, None, key, lambda: _named_shape(S, mech, names))
         joints, points = mech.joints, mech.points
         pts = S.cache.get("joint_points")  # a refilled system's: its joints' then its named points' floats
         if pts is not None and len(pts) == len(joints) + len(points):
@@ -500,25 +502,20 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
         else:
             xy = [_xy(points[name].at if j < 0 else joints[j].point) for name, j, _ in where]
         loc = frame_points(S.frames(), li, xy)
-        if len(moving) == len(loc):  # every point on a moving link (the common case): rows of ``local``
+        if len(moving) == len(loc):  # every point on a moving link (the common case): the topology's rows
             local = np.array(loc, float).reshape(-1, 2)
-            rows = [(name, link, i, at) for (name, link), i, at in zip(labels, li, local)]
         else:
             local = np.array([loc[k] for k in moving], float).reshape(-1, 2)
-            rows, r = [], 0
-            for k, ((name, link), i) in enumerate(zip(labels, li)):
-                if i >= 0:  # on a moving link: its row of ``local`` (in the same order)
-                    at, r = local[r], r + 1
-                else:
-                    at = np.array(loc[k], float)
-                rows.append((name, link, i, at))
+            rows = [(name, link, i, None if i >= 0 else np.array(loc[k], float))
+                    for k, (name, link, i, _) in enumerate(rows)]
         hit = S.cache[key] = (rows, moving, idx, local)
     return hit
 
 
 def _named_shape(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> tuple:
-    """What :func:`_named_points` takes from the topology: the points' names and links,
-    their links' indices, the rows on moving links and their indices (an array), and
+    """What :func:`_named_points` takes from the topology: its rows without the frame's
+    points (``(name, link, link index, None)``), the links' indices, the rows on moving
+    links and their indices (an array), and
     where each point's drawn coordinates are (``(name, -1, n)``: a named point, the
     ``n``-th of a refilled system's :func:`~mechsyn.kinematics.refill.joint_points`;
     ``(name, k, k)``: joint ``k``'s point)."""
@@ -528,7 +525,8 @@ def _named_shape(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> t
     index = {j.id: k for k, j in enumerate(mech.joints)}
     named = {name: len(index) + n for n, name in enumerate(mech.points)}  # (after the joints)
     where = [(name, -1, named[name]) if name in named else (name, index[name], index[name]) for name in pts]
-    return [(name, link) for name, (link, _) in pts.items()], li, moving, np.array([li[k] for k in moving], int), where
+    rows = tuple([(name, link, i, None) for (name, (link, _)), i in zip(pts.items(), li)])
+    return rows, li, moving, np.array([li[k] for k in moving], int), where
 
 
 def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rates_ok: np.ndarray,
