@@ -334,7 +334,9 @@ class Mechanism:
                 raise MechsynInputError(f"no joint {jid!r}", source=self.source, field="joints",
                                         hint=f"joints are: {', '.join(index)}")
             try:
-                arr = np.array(p, float).reshape(dim)
+                arr = np.array(p, float)
+                if arr.shape != (dim,):  # (a reshape costs twice the copy: only when needed)
+                    arr = arr.reshape(dim)
             except (TypeError, ValueError):
                 arr = np.full(dim, np.nan)
             if not all(map(math.isfinite, arr.tolist())):
