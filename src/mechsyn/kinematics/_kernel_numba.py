@@ -55,7 +55,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
     takes them); fill every link's rotation and its origin's position, velocity and
     acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
     (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
-    has rows (2, links, M), :func:`_planes`. Returns True when a group's discriminant
+    has rows (2, links, P), :func:`_planes`. Returns True when a group's discriminant
     falls below ``least`` (or is NaN) on some row."""
     M = CS.shape[0]
     ns = ip.shape[0]
@@ -152,11 +152,12 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
 
 @njit(inline="always", **_OPTIONS)
 def _planes(lz, Z):  # pragma: no cover - compiled
-    """The rotations ``lz`` (links, M) complex as planes ``Z`` (2, links, M), real and
-    imaginary parts: NumPy's ``arctan2`` of the links' angles reads contiguous rows a third
-    faster than the complex array's strided parts, with the same numbers."""
+    """The rotations ``lz`` (links, M) complex as planes ``Z`` (2, links, P), real and
+    imaginary parts of the first P <= M rows: NumPy's ``arctan2`` of the links' angles
+    reads contiguous rows a third faster than the complex array's strided parts, with the
+    same numbers."""
     for i in range(lz.shape[0]):
-        for r in range(lz.shape[1]):
+        for r in range(Z.shape[2]):
             z = lz[i, r]
             Z[0, i, r] = z.real
             Z[1, i, r] = z.imag

@@ -187,15 +187,16 @@ def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None 
     return shape, fp, anc_s
 
 
-def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: bool = False) -> tuple | None:
+def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple | None:
     """The compiled pass over the input rows ``X`` (M, k), or over the blocks of rows
     ``X`` (a list: the sweep, then the connecting paths) one after the other: ``(C, W,
     AL, D, near)``, every link's rotation and its origin's position, velocity,
     acceleration (4, links, M), its angular velocity and acceleration (links, M), the
     groups' normalised discriminants (groups, M), and whether one falls below ``least``;
-    with ``planes`` also the rotations' real and imaginary parts (2, links, M) (contiguous
-    rows for :func:`link_poses`' ``arctan2``); None without the kernel. The inputs'
-    cosines and sines are :func:`trig`'s."""
+    with ``planes`` (a number of rows, at most M) also the rotations' real and imaginary
+    parts in the first ``planes`` rows (2, links, planes) (contiguous rows for
+    :func:`link_poses`' ``arctan2``); None without the kernel. The inputs' cosines and
+    sines are :func:`trig`'s."""
     mod = _compiled()
     if mod is None:
         return None
@@ -203,10 +204,9 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     CS, SN = trig(X if isinstance(X, list) else [X])
     M, nl = CS.shape[0], anc_j.shape[0]
     C = np.empty((4, nl, M), complex)
-    z = 2 * nl if planes else 0
-    R = np.empty((2 * nl + len(groups) + z, M))  # W, AL, D and the planes: rows of one block (contiguous views)
-    W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:2 * nl + len(groups)]
-    Z = R[R.shape[0] - z:].reshape(2, z // 2, M)
+    R = np.empty((2 * nl + len(groups), M))  # W, AL and D: rows of one block (contiguous views)
+    W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
+    Z = np.empty((2, nl, min(planes, M)) if planes else (2, 0, 0))
     near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float), nj,
                             least, C, W, AL, D, Z)
     return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
@@ -281,7 +281,7 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
     C, W, AL, *Z = pass_
     q, qd, qdd = np.empty((3, n, N))  # one block, three contiguous views
     dcol, dsgn, ref, runs = angles
-    zr, zi = (Z[0][0], Z[0][1]) if Z else (C[0].real, C[0].imag)  # the planes of run(), else strided parts
+    zr, zi = (Z[0][0], Z[0][1]) if Z else (C[0].real, C[0].imag)  # the planes of run() (N rows), else strided parts
     A = np.empty((dcol.shape[0], N))
     ok = np.empty((2, N), np.bool_)  # the rows assembled, the rows with rates
     for a, b in runs:  # the links no frame driver turns (NumPy's vector loops: a third of libm's time per angle)

@@ -288,7 +288,8 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
     if prog is None or prog[0] is not plan:
         shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
         prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape))
-    C, W, AL, D, near, Z = kernel.run(prog[1], X, speeds, REGULAR_DISC, planes=True)
+    C, W, AL, D, near, Z = kernel.run(prog[1], X, speeds, REGULAR_DISC,
+                                      planes=(X[0] if isinstance(X, list) else X).shape[0])
     if near and not folds:
         return None
     return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near, D, Z)
