@@ -238,3 +238,36 @@ def test_trig_is_numpys_and_follows_the_inputs() -> None:
     assert np.array_equal(kernel.trig([ints])[0], np.cos(ints))
     big = np.zeros((kernel._TRIG_ROWS + 1, 1))  # not kept: computed each time
     assert np.array_equal(kernel.trig([big, path])[0][-2:], np.cos(path))
+
+
+@needs_numba
+@pytest.mark.parametrize("name, around", [("fourbar_folded", None), ("fourbar_dead_centre", 30.0),
+                                          ("fourbar", None), ("watt_sixbar", None)])
+def test_compiled_poses_blank_the_fold_scans_singular_rows(name, around):
+    """Through folds the compiled poses blank the rates of the rows the fold scan finds
+    singular (a group folded flat on a row) and count them: the same rows, NaN rates and
+    events as the NumPy pass, which blanks them after its poses; the sweep's rows with
+    rates are its finite ones and its singular rows (when it knows them) the assembled
+    rows without rates."""
+    m = ms.examples.load(name)
+    kp = cached_plan(m)
+    drive = kp.system.drivers[0]
+    u0 = np.degrees(drive.assembled)
+    grid = np.arange(0.0, 361.0, 1.0) if around is None else u0 + np.arange(-around, around + 0.25, 0.5)
+    sims = {}
+    for mode in ("numpy", "auto"):
+        with kernel.use(mode):
+            sims[mode] = ms.simulate(m, {drive.joint: grid})
+    a, b = sims["numpy"], sims["auto"]
+    assert a.engine == b.engine == "regular pass"
+    assert [(e.kind, e.index) for e in a.events] == [(e.kind, e.index) for e in b.events]
+    sw = b.sweep
+    finite = np.isfinite(sw.qd).all(axis=1) & np.isfinite(sw.qdd).all(axis=1)
+    assert np.array_equal(sw.rates_ok, finite)
+    singular = np.flatnonzero(sw.assembled & ~finite).tolist()
+    assert sw.singular_rows is None or sw.singular_rows == singular
+    assert singular == [e.index for e in b.events if e.kind == "singular"] or name in ("fourbar", "watt_sixbar")
+    for key in a.links:
+        assert np.array_equal(np.isnan(a.links[key].angular_velocity), np.isnan(b.links[key].angular_velocity))
+    for key in a.points:
+        assert np.array_equal(np.isnan(a.points[key].acceleration), np.isnan(b.points[key].acceleration))

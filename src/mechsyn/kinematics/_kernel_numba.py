@@ -49,22 +49,21 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
 
 
 @njit(**_OPTIONS)
-def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D):  # pragma: no cover
+def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z):  # pragma: no cover
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
     rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's, as the NumPy pass
-    takes them, and as fast as libm's in the loop); fill every link's rotation and its origin's position, velocity and
+    takes them); fill every link's rotation and its origin's position, velocity and
     acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
-    (links, M) and each RRR group's normalised discriminant ``D`` (groups, M). Returns
-    True when a group's discriminant falls below ``least`` (or is NaN) on some row."""
+    (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
+    has rows (2, links, P), :func:`_planes`. Returns True when a group's discriminant
+    falls below ``least`` (or is NaN) on some row."""
     M = CS.shape[0]
     ns = ip.shape[0]
     nl = anc_j.shape[0]
     jP = np.empty((nj, M), np.complex128)
     jV = np.empty((nj, M), np.complex128)
     jA = np.empty((nj, M), np.complex128)
-    lz = C[0]  # every link's rotation, angular velocity and acceleration, written in place
-    lw = W
-    lal = AL
+    lz, lw, lal = C[0], W, AL  # every link's rotation, angular velocity and acceleration, written in place
     near = False
     for s in range(ns):
         if ip[s, 0] == 0:  # a driver: link new turned by the input di from link k
@@ -146,7 +145,22 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             C[3, i] = jA[j]
         else:
             _point_rows(i, 0j, anc_j, anc_s, jP, jV, jA, lz, lw, lal, C[1, i], C[2, i], C[3, i], M)
+    if Z.shape[1] == nl:
+        _planes(lz, Z)
     return near
+
+
+@njit(inline="always", **_OPTIONS)
+def _planes(lz, Z):  # pragma: no cover - compiled
+    """The rotations ``lz`` (links, M) complex as planes ``Z`` (2, links, P), real and
+    imaginary parts of the first P <= M rows: NumPy's ``arctan2`` of the links' angles
+    reads contiguous rows a third faster than the complex array's strided parts, with the
+    same numbers."""
+    for i in range(lz.shape[0]):
+        for r in range(Z.shape[2]):
+            z = lz[i, r]
+            Z[0, i, r] = z.real
+            Z[1, i, r] = z.imag
 
 
 @njit(inline="always", **_OPTIONS)
@@ -168,7 +182,7 @@ def _near(a, ref):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  # pragma: no cover - compiled
+def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok, sb, sf, rok):  # pragma: no cover
     """The pose rows ``q, qd, qdd`` (3 links, N; component-major) of the first N rows of a
     pass (``C``, ``W``, ``AL`` of :func:`regular_pass`): each link's origin, its angle and
     their rates. A link turned by a frame driver (``dcol[i]`` its input's column, ``dsgn``
@@ -181,11 +195,16 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
     from ``split - 1``, or the one sweep) on its own, its runs of assembled rows unwrapped
     and each run following the run before by whole turns, the rows where a link is not
     placed blanked (NaN) in the poses and in ``C`` and the rates of rows where they are
-    not finite blanked (:func:`mechsyn.kinematics.regular._fold_poses`). Returns the rows
-    assembled (N,)."""
+    not finite blanked (:func:`mechsyn.kinematics.regular._fold_poses`), and the rates of
+    the singular rows the fold scan found (rows ``r < len(sb)``: ``sb[r]``, else ``sf[r -
+    len(sb)]``) blanked too. Writes the rows assembled into ``ok`` (N,) and, with ``folds``,
+    the rows with rates (assembled, finite, not singular) into ``rok`` (N,) (an array made
+    here would cost its unpickled type on return); returns the number of singular rows
+    (assembled, rates not defined)."""
     nl = C.shape[1]
     twopi = 2 * math.pi
-    ok = np.ones(N, np.bool_)
+    for r in range(N):
+        ok[r] = True
     for i in range(nl):
         for r in range(N):
             p, v, a = C[1, i, r], C[2, i, r], C[3, i, r]
@@ -245,27 +264,42 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd):  #
                     x = s - twopi * K
                 out[r] = x - shift if shift != 0.0 else x
                 prev, has_prev = out[r], True
-    if folds:
-        for r in range(N):
-            if not ok[r]:
-                for c in range(3 * nl):
-                    q[c, r] = math.nan
-                    qd[c, r] = math.nan
-                    qdd[c, r] = math.nan
-                for i in range(nl):  # the links' states too: a point of any link is not placed here
-                    for c in range(4):
-                        C[c, i, r] = complex(math.nan, math.nan)
-                continue
-            rates = True
+    return _blank_rows(C, q, qd, qdd, ok, sb, sf, rok) if folds else 0
+
+
+@njit(inline="always", **_OPTIONS)
+def _blank_rows(C, q, qd, qdd, ok, sb, sf, rok):  # pragma: no cover - compiled
+    """:func:`link_poses`' blanking through folds: the rows not assembled (``ok``) in the
+    poses and the links' states, the rates of the rows where they are not finite or that
+    the fold scan found singular (``sb``, ``sf``); the rows with rates into ``rok``.
+    Returns the number of assembled rows without rates."""
+    nl, N = C.shape[1], ok.shape[0]
+    singular = 0
+    nb = sb.shape[0]
+    for r in range(N):
+        rok[r] = False
+        if not ok[r]:
+            for c in range(3 * nl):
+                q[c, r] = math.nan
+                qd[c, r] = math.nan
+                qdd[c, r] = math.nan
+            for i in range(nl):  # the links' states too: a point of any link is not placed here
+                for c in range(4):
+                    C[c, i, r] = complex(math.nan, math.nan)
+            continue
+        rates = not (sb[r] if r < nb else sf[r - nb])
+        if rates:
             for c in range(3 * nl):
                 if not (math.isfinite(qd[c, r]) and math.isfinite(qdd[c, r])):
                     rates = False
                     break
-            if not rates:
-                for c in range(3 * nl):
-                    qd[c, r] = math.nan
-                    qdd[c, r] = math.nan
-    return ok
+        if not rates:
+            singular += 1
+            for c in range(3 * nl):
+                qd[c, r] = math.nan
+                qdd[c, r] = math.nan
+        rok[r] = rates
+    return singular
 
 
 @njit(**_OPTIONS)

@@ -15,6 +15,7 @@ P inputs and lengths in the file's length unit.
 from __future__ import annotations
 
 import math
+import operator
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -291,7 +292,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
         rates_ok, singular_rows = ok, []
     else:
         rates_ok = sw.rates_ok if sw.rates_ok is not None else _finite_rows(sw.qd) & _finite_rows(sw.qdd)
-        singular_rows = np.flatnonzero(ok & ~rates_ok).tolist()
+        singular_rows = sw.singular_rows if sw.singular_rows is not None else np.flatnonzero(ok & ~rates_ok).tolist()
     events = _with_singular_rows(S, sw, singular_rows) if sw.events or singular_rows else []
     deg = np.multiply(sw.q.T[2::3], _DEG, order="C")  # np.degrees' product, every link in one call
     qdT, qddT = sw.qd.T, sw.qdd.T  # rows of coordinates: a row is the view sw.qd[:, k]
@@ -325,8 +326,11 @@ def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) ->
         if k not in flagged:  # made in input units (one object, not one and a copy)
             events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                                 "accelerations are not defined here (null)", units(sw.inputs[k].tolist())))
-    events.sort(key=lambda e: e.index)
+    events.sort(key=_INDEX)
     return events
+
+
+_INDEX = operator.attrgetter("index")
 
 
 @dataclass(frozen=True)
@@ -423,11 +427,16 @@ def _input_rows(S: PlanarSystem, spec: _InputSpec, inputs: dict) -> tuple[dict, 
     """The input values as float arrays by joint and the engines' input rows ``U`` (N, k):
     radians (R) or lengths (P), drivers without input at their drawn value. Checks them
     (the same number of values, not none, driven joints, finite, P within its limits)."""
-    vals = {jid: np.asarray(v, float) for jid, v in inputs.items()}
-    lengths = {a.shape[0] if a.ndim else 1 for a in vals.values()}
-    if len(lengths) != 1:
-        raise MechsynInputError("all inputs need the same number of values", field="inputs")
-    N = lengths.pop()
+    if len(inputs) == 1:  # (one input: no set of lengths)
+        (jid, v), = inputs.items()
+        a = np.asarray(v, float)
+        vals, N = {jid: a}, a.shape[0] if a.ndim else 1
+    else:
+        vals = {jid: np.asarray(v, float) for jid, v in inputs.items()}
+        lengths = {a.shape[0] if a.ndim else 1 for a in vals.values()}
+        if len(lengths) != 1:
+            raise MechsynInputError("all inputs need the same number of values", field="inputs")
+        N = lengths.pop()
     if N == 0:
         raise MechsynInputError("the input range is empty", field="inputs")
     if not spec.driven:
@@ -543,17 +552,18 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
         nok = None if ok.all() else ~ok
         bad = None if rates_ok.all() else ~rates_ok
     states: dict[int, tuple] = {}
-    if len(moving) == 1 and sw.links is not None:  # the links' states: NaN where the poses are
-        states[moving[0]] = sw.links.point(int(idx[0]), complex(*local[0].tolist()))
-    elif moving:
-        if sw.links is not None:
+    if moving:
+        if sw.links is not None:  # the links' states: NaN where the poses are
             P, V, A = sw.links.points(idx, local.view(complex)[:, 0])
+            if len(moving) == 1:
+                states[moving[0]] = (P[0], V[0], A[0])
         else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
             PVA = _points_state(sw.q, sw.qd, sw.qdd, idx, local)
             if not sw.nan_rows:  # else NaN already: every number of a point's row depends on its row
                 _set_nan(PVA, nok, bad)
             P, V, A = PVA
-        states = dict(zip(moving, zip(P, V, A)))
+        if not states:
+            states = dict(zip(moving, zip(P, V, A)))
     pm = {}
     for k, (name, link, i, at) in enumerate(rows):
         if k in states:

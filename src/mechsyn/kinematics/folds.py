@@ -259,7 +259,7 @@ _FOLD_MESSAGES = ("assembly ends: the group {} folds flat (its discriminant chan
 
 
 def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: np.ndarray, split: int | None,
-                     paths: list, pass_rows: np.ndarray | None = None) -> list | None:
+                     paths: list, pass_rows: np.ndarray | None = None, block: np.ndarray | None = None) -> list | None:
     """:func:`fold_events` of the tracked sweeps of one regular pass (the sweep ``U`` (N,
     n_inputs), then the connecting paths ``paths`` (``(path, shift)`` of
     :func:`tracking_path`) of the one sweep, or of the sweeps forwards from row ``split``
@@ -273,7 +273,8 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     (the backward sweep from right to left, then the forward one): one comparison finds
     every row where a group's assembly changes, and :func:`_fold_scan` reads only those;
     after a compiled pass all of it runs compiled (:func:`_compiled_fold_events`;
-    ``pass_rows``: the pass's input rows, ``U`` then the paths, when at hand).
+    ``pass_rows``: the pass's input rows, ``U`` then the paths, when at hand; ``block``:
+    the discriminants as rows of one array, in the order of their steps, when at hand).
     """
     N = U.shape[0]
     n0s = tuple(path.shape[0] for path, _ in paths)
@@ -282,7 +283,8 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     program = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: the whole scan compiled
     if program is not None and program[0] is plan and kernel.active():
         X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
-        return _compiled_fold_events(S, plan, program[1], [discs[k] for k in ks], ks, perm, b, X, paths)
+        return _compiled_fold_events(S, plan, program[1], [discs[k] for k in ks] if block is None else block, ks,
+                                     perm, b, X, paths)
     D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
     if low:
         return None

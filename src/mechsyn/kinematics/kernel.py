@@ -187,13 +187,16 @@ def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None 
     return shape, fp, anc_s
 
 
-def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float) -> tuple | None:
+def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple | None:
     """The compiled pass over the input rows ``X`` (M, k), or over the blocks of rows
     ``X`` (a list: the sweep, then the connecting paths) one after the other: ``(C, W,
     AL, D, near)``, every link's rotation and its origin's position, velocity,
     acceleration (4, links, M), its angular velocity and acceleration (links, M), the
     groups' normalised discriminants (groups, M), and whether one falls below ``least``;
-    None without the kernel. The inputs' cosines and sines are :func:`trig`'s."""
+    with ``planes`` (a number of rows, at most M) also the rotations' real and imaginary
+    parts in the first ``planes`` rows (2, links, planes) (contiguous rows for
+    :func:`link_poses`' ``arctan2``); None without the kernel. The inputs' cosines and
+    sines are :func:`trig`'s."""
     mod = _compiled()
     if mod is None:
         return None
@@ -203,9 +206,10 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float) 
     C = np.empty((4, nl, M), complex)
     R = np.empty((2 * nl + len(groups), M))  # W, AL and D: rows of one block (contiguous views)
     W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
-    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float),
-                            nj, least, C, W, AL, D)
-    return C, W, AL, D, bool(near)
+    Z = np.empty((2, nl, min(planes, M)) if planes else (2, 0, 0))
+    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float), nj,
+                            least, C, W, AL, D, Z)
+    return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
 
 
 #: The cosines and sines of the last blocks of input rows and stacks of them
@@ -261,22 +265,42 @@ def _kept(keys: tuple) -> tuple | None:
 
 
 def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,
-               n: int) -> tuple:
+               n: int, parts: list | None = None) -> tuple:
     """The pose rows ``q, qd, qdd`` (n, N; component-major) of the first N rows of a
-    compiled pass (``pass_``: ``(C, W, AL)`` of :func:`run`) and the rows assembled, the
+    compiled pass (``pass_``: ``(C, W, AL)`` of :func:`run`, and its planes when it gave
+    them) and the rows assembled, the
     links' angles continuous from the drawn ones (``angles``: each link's frame driver's
-    input column or -1, its sign, its drawn angle), compiled: see
+    input column or -1, its sign, its drawn angle, and the runs ``(first, end)`` of links
+    without such a driver, whose angles are ``atan2`` of their rotations), compiled: see
     :func:`mechsyn.kinematics._kernel_numba.link_poses`. ``folds``: the sweep went
     through folds (its tracked sweeps made continuous on their own, rows not assembled
-    and rates not defined blanked)."""
-    C, W, AL = pass_
+    and rates not defined blanked; ``parts``: the fold scan's singular rows per tracked
+    sweep, :func:`mechsyn.kinematics.folds.pass_fold_events`' first items, blanked too).
+    Returns ``q, qd, qdd``, the rows assembled and, through folds, the rows whose rates
+    are defined and the number of assembled rows whose rates are not (else None, 0)."""
+    C, W, AL, *Z = pass_
     q, qd, qdd = np.empty((3, n, N))  # one block, three contiguous views
-    dcol, dsgn, ref = angles
-    z = C[0, :, :N]
-    A = np.arctan2(z.imag, z.real)  # NumPy's vector loops: a third of libm's time per angle
-    ok = _compiled().link_poses(C, W, AL, N, np.ascontiguousarray(U, float), dcol, dsgn, ref,
-                                -1 if split is None else split, folds, A, q, qd, qdd)
-    return q, qd, qdd, ok
+    dcol, dsgn, ref, runs = angles
+    zr, zi = (Z[0][0], Z[0][1]) if Z else (C[0].real, C[0].imag)  # the planes of run() (N rows), else strided parts
+    A = np.empty((dcol.shape[0], N))
+    ok = np.empty((2, N), np.bool_)  # the rows assembled, the rows with rates
+    for a, b in runs:  # the links no frame driver turns (NumPy's vector loops: a third of libm's time per angle)
+        np.arctan2(zi[a:b, :N], zr[a:b, :N], out=A[a:b])
+    if parts:  # the forward sweep's singular rows and the backward sweep's in the sweep's order
+        sf = parts[0][0]
+        sb = parts[1][0][::-1] if len(parts) > 1 else sf[:0]
+    else:
+        sf = sb = _NO_ROWS
+    singular = _compiled().link_poses(C, W, AL, N, U if U.flags.c_contiguous and U.dtype == _F64 else
+                                      np.ascontiguousarray(U, float), dcol, dsgn, ref, -1 if split is None else split,
+                                      folds, A, q, qd, qdd, ok[0], sb, sf, ok[1])
+    return q, qd, qdd, ok[0], ok[1] if folds else None, singular
+
+
+_NO_ROWS = np.zeros(0, np.bool_)
+
+
+_F64 = np.dtype(float)
 
 
 def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc: float) -> tuple | None:
@@ -299,7 +323,8 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     """:func:`mechsyn.kinematics.folds.pass_fold_events` compiled in one call
     (:func:`mechsyn.kinematics._kernel_numba.fold_scan`): the masks of :func:`fold_rows`
     and the tracked sweeps' folds (refined on the discriminant of the regular pass's
-    ``program``) and reassemblies. ``X``: the pass's input rows; ``paths``: the sweeps'
+    ``program``) and reassemblies. ``discs``: a list of arrays or one array (groups, rows);
+    ``X``: the pass's input rows; ``paths``: the sweeps'
     ``(path, shift)``; ``ks``: the groups' steps; ``specs``: their closed-form fold
     numbers. Returns whether a change point may be near, the singular rows in the layout
     ``perm`` and the events as rows (sweep, row, kind, group, input...); None without
@@ -311,7 +336,7 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     (pa, sa), (pb, sb) = paths[0], paths[-1]
     if sa.flags.writeable or sb.flags.writeable:  # one array type for both (tracking_path's are read-only)
         sa, sb = np.array(sa, float), np.array(sb, float)
-    return mod.fold_scan(np.array(discs), perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0],
+    return mod.fold_scan(discs if isinstance(discs, np.ndarray) else np.array(discs), perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0],
                          sb, ks, specs, ip, fp, anc_j, anc_s, nj)
 
 

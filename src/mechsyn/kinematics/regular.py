@@ -305,37 +305,56 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
     if prog is None or prog[0] is not plan:
         shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
         prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape))
-    C, W, AL, D, near = kernel.run(prog[1], X, speeds, REGULAR_DISC)
+    C, W, AL, D, near, Z = kernel.run(prog[1], X, speeds, REGULAR_DISC,
+                                      planes=(X[0] if isinstance(X, list) else X).shape[0])
     if near and not folds:
         return None
-    return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near)
+    return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near, D, Z)
 
 
 def _compiled_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
-                    folds: bool) -> tuple:
+                    folds: bool, parts: list | None = None) -> tuple:
     """:func:`_poses` / :func:`_fold_poses` of a compiled pass, compiled
-    (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N) and the rows
-    assembled (N,). Which links frame drivers turn is kept with the topology."""
-    dcol, dsgn = _topology(S, plan, "kernel-angles", lambda: _drive_arrays(S, plan))
-    angles = (dcol, dsgn, np.ascontiguousarray(S.q0[2::3]))  # the drawn angles: this geometry's
-    return kernel.link_poses((st.C, st.W, st.AL), U.shape[0], U, angles, split, folds, S.n)
+    (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N), the rows
+    assembled (N,), the rows with rates and the number of singular rows (through folds;
+    ``parts``: the fold scan's singular rows, blanked too). Which links frame drivers
+    turn is kept with the topology."""
+    dcol, dsgn, runs = _topology(S, plan, "kernel-angles", lambda: _drive_arrays(S, plan))
+    memo = _memo(S)
+    ref = memo.get("drawn angles")
+    if ref is None:  # the drawn angles: this geometry's
+        ref = memo["drawn angles"] = np.ascontiguousarray(S.q0[2::3])
+    pass_ = (st.C, st.W, st.AL) if st.Z is None else (st.C, st.W, st.AL, st.Z)
+    return kernel.link_poses(pass_, U.shape[0], U, (dcol, dsgn, ref, runs), split, folds, S.n, parts)
 
 
-def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
-    """Each link's frame driver's input column (-1: none) and the input's sign."""
+def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """Each link's frame driver's input column (-1: none), the input's sign, and the runs
+    ``(first, end)`` of consecutive links that no frame driver turns (their angles are
+    ``atan2`` of their rotations)."""
     drive = _drive_links(S, plan)
     nl = len(S.links)
+    free = [i for i in range(nl) if i not in drive]
+    runs = [[i, i + 1] for i in free[:1]]
+    for i in free[1:]:
+        if i == runs[-1][1]:
+            runs[-1][1] = i + 1
+        else:
+            runs.append([i, i + 1])
     return (np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
-            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float))
+            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float), tuple(map(tuple, runs)))
 
 
 class _Compiled:
     """The compiled pass's answer (:func:`mechsyn.kinematics.kernel.run`) in the terms of
     :class:`_Pass`: the links' states already gathered per link (``C``, ``W``, ``AL``),
-    the groups' discriminants by step, whether one came near a fold."""
+    the groups' discriminants by step (and as rows of one block ``D``, in the order of the
+    steps), whether one came near a fold, the rotations' real and imaginary parts ``Z``
+    (2, links, M) when the pass wrote them."""
 
-    def __init__(self, C: np.ndarray, W: np.ndarray, AL: np.ndarray, discs: dict, near: bool) -> None:
-        self.C, self.W, self.AL, self.discs, self.near = C, W, AL, discs, near
+    def __init__(self, C: np.ndarray, W: np.ndarray, AL: np.ndarray, discs: dict, near: bool,
+                 D: np.ndarray | None = None, Z: np.ndarray | None = None) -> None:
+        self.C, self.W, self.AL, self.discs, self.near, self.D, self.Z = C, W, AL, discs, near, D, Z
 
 
 def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
@@ -384,10 +403,10 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
         return _poses(S, plan, U, st, origin, split)
     _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
+    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, block=getattr(st, "D", None))
     if out is None:
         return None
-    q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split)
+    q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split, out)
     return Folded(q, qd, qdd, out, *links)
 
 
@@ -445,7 +464,9 @@ class Folded:
     events (rows counted along that sweep); from the compiled pass also the links'
     states (:class:`LinkStates`, NaN where the poses are: ``qd``'s and ``qdd``'s angle
     rows are its rates, so rows blanked later are blanked there too) and the rows
-    assembled (``assembled``, N)."""
+    assembled (``assembled``, N); from the compiled pass also the rows whose rates are
+    defined (``rates_ok``, N: the singular rows of ``parts`` already blanked) and the
+    number of assembled rows whose rates are not (``singular``)."""
 
     q: np.ndarray
     qd: np.ndarray
@@ -453,16 +474,21 @@ class Folded:
     parts: list
     links: LinkStates | None = None
     assembled: np.ndarray | None = None
+    rates_ok: np.ndarray | None = None
+    singular: int = 0
 
 
-def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
+def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None,
+                parts: list | None = None) -> tuple:
     """The pose rows ``q, qd, qdd`` (N, n) of the sweep ``U`` (the first N rows of the
     pass) through folds: NaN rows where a group is not assembled, NaN rates where they
     are not defined (inf at a group folded flat), each link's angle continuous along
-    each tracked sweep from the drawn one."""
-    if isinstance(st, _Compiled):  # and the links' states (NaN where the poses are), the rows assembled
-        q, qd, qdd, ok = _compiled_poses(S, plan, U, st, split, True)
-        return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok
+    each tracked sweep from the drawn one. Compiled, also the rates of the fold scan's
+    singular rows (``parts``, see :class:`Folded`) blanked."""
+    if isinstance(st, _Compiled):  # and the links' states (NaN where the poses are), the rows assembled, with rates
+        q, qd, qdd, ok, rates_ok, singular = _compiled_poses(S, plan, U, st, split, True, parts)
+        return (q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok,
+                None if parts is None else rates_ok, singular)
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     fin = np.isfinite(C[0].view(float)).all(axis=0)  # every link's rotation: real and imaginary parts
     ok = fin[0::2] & fin[1::2]
@@ -526,7 +552,7 @@ def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, 
     origin is its first joint, its angle continuous from the drawn one) and the links'
     complex states."""
     if isinstance(st, _Compiled):
-        q, qd, qdd, _ = _compiled_poses(S, plan, U, st, split, False)
+        q, qd, qdd, *_ = _compiled_poses(S, plan, U, st, split, False)
         return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
     C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
     _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
@@ -589,8 +615,8 @@ class LinkStates:
         """
         got = kernel.point_states(self.C, self.w, self.al, np.asarray(idx, np.int64), np.asarray(s, complex))
         if got is not None:  # compiled
-            m, N = got.shape[1:]
-            return tuple(x.view(float).reshape(m, N, 2) for x in got)
+            P, V, A = got.view(float).reshape(3, *got.shape[1:], 2)
+            return P, V, A
         Z = self.C[:, idx]
         rel = Z[0] * s[:, None]
         P = rel + Z[1]

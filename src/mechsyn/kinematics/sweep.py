@@ -24,7 +24,7 @@ __all__ = ["Sweep", "Event", "EventKind"]
 EventKind = Literal["dead point", "reassembled", "singular", "not assembled", "branch point", "limit"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Event(Mapping):
     """One event of a sweep.
 
@@ -53,6 +53,14 @@ class Event(Mapping):
     joint: str | None = None
     value: float | None = None
 
+    def __init__(self, index: int, kind: EventKind, message: str, input: Any = None, group: str | None = None,
+                 crossed: bool | None = None, before_sweep: bool | None = None, joint: str | None = None,
+                 value: float | None = None) -> None:
+        # the fields set in one update (a frozen dataclass's __init__ sets them one by one
+        # through object.__setattr__: twice the time, and an engine makes events on every sweep)
+        self.__dict__.update(index=index, kind=kind, message=message, input=input, group=group, crossed=crossed,
+                             before_sweep=before_sweep, joint=joint, value=value)
+
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: only the fields that are set, in a fixed order."""
         out: dict[str, Any] = {"index": self.index, "kind": self.kind}
@@ -74,11 +82,11 @@ class Event(Mapping):
         """A copy with some fields changed (``dataclasses.replace`` without its checks:
         an engine makes a few of these per event, on every sweep)."""
         new = object.__new__(Event)
-        new.__dict__.update(self.__dict__)
-        for key, value in changes.items():
-            if key not in _FIELDS:
-                raise TypeError(f"Event has no field {key!r}")
-            new.__dict__[key] = value
+        d = new.__dict__
+        d.update(self.__dict__)
+        d.update(changes)
+        if len(d) != len(_FIELDS):  # a name that is no field added an entry
+            raise TypeError(f"Event has no field {next(k for k in changes if k not in _FIELDS)!r}")
         return new
 
     def __getitem__(self, key: str) -> Any:
@@ -109,7 +117,9 @@ class Sweep:
     rates are all finite when the engine knows them (else None: read off ``qd, qdd``);
     ``nan_rows``: every row of ``q`` where the mechanism is not assembled, and of ``qd``,
     ``qdd`` where the rates are not defined, is NaN entirely (so anything computed from
-    such a row is NaN there without being set).
+    such a row is NaN there without being set); ``singular_rows``: the assembled rows
+    whose rates are not defined, when the engine knows them (else None: read off
+    ``assembled`` and ``rates_ok``).
     """
 
     system: Any
@@ -127,6 +137,7 @@ class Sweep:
     engine: str = "newton"
     rates_ok: Any = None
     nan_rows: bool = False
+    singular_rows: list | None = None
 
     @property
     def n(self) -> int:
