@@ -212,11 +212,14 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
 
 
-#: The cosines and sines of the last blocks of input rows and stacks of them
-#: (:func:`trig`), most recent first: ``(((bytes, shape, type) per block), (cos, sin))``; at
+#: The cosines and sines :func:`trig` keeps, most recent first, as ``(key, (cos, sin))``:
+#: of the last blocks of input rows (``_BLOCKS``: the sweeps, by ``(bytes, shape,
+#: type)``; blocks of fewer than ``_SMALL`` numbers, a connecting path, are computed) and
+#: of the last stacks of blocks (``_STACKS``: a tuple of the blocks' keys); blocks of at
 #: most ``_TRIG_ROWS`` numbers.
-_TRIG: list = []
-_TRIG_MAX, _TRIG_ROWS = 16, 1 << 16
+_BLOCKS: list = []
+_STACKS: list = []
+_TRIG_MAX, _STACKS_MAX, _TRIG_ROWS, _SMALL = 16, 4, 1 << 16, 64
 _TRIG_LOCK = threading.Lock()
 
 
@@ -224,10 +227,12 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     """NumPy's cosines and sines of the input rows ``blocks`` (float arrays (m, k))
     stacked: the numbers the regular pass turns its drivers by. A studio's drag, a design
     loop and a cached call sweep the same inputs again and again, with other link
-    lengths: the answers for the last 16 blocks of up to 65,536 numbers, and for the
-    last stacks of them, are kept, found again by the blocks' bytes, shapes and types, so only
-    new inputs cost their trigonometry (a tenth of a six-bar's compiled pass). Each
-    block's numbers are ``np.cos``, ``np.sin`` of that block, whatever is kept.
+    lengths: the answers for the last 16 blocks of up to 65,536 numbers and for the last
+    4 stacks of blocks are kept, found again by the blocks' bytes, shapes and types, so
+    only new inputs cost their trigonometry (a tenth of a six-bar's compiled pass); a
+    small block (a connecting path from the drawn input, new with each drawn crank
+    angle) is computed, not looked for. Each block's numbers are ``np.cos``, ``np.sin``
+    of that block, whatever is kept.
 
     Examples
     --------
@@ -239,29 +244,44 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     if blocks[0].size > _TRIG_ROWS:  # (the sweep's rows; the connecting paths after them are a few)
         return tuple(np.concatenate([f(b) for b in blocks]) for f in (np.cos, np.sin))
     keys = tuple([(b.tobytes(), b.shape, b.dtype.char) for b in blocks])
-    hit = _kept(keys)
+    if len(blocks) == 1:
+        return _block_trig(blocks[0], keys[0])
+    hit = _kept(_STACKS, keys)
     if hit is not None:
         return hit
-    if len(blocks) == 1:
-        out = np.cos(blocks[0]), np.sin(blocks[0])
-    else:
-        parts = [trig([b]) for b in blocks]
-        out = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
-    with _TRIG_LOCK:
-        _TRIG.insert(0, (keys, out))
-        del _TRIG[_TRIG_MAX:]
+    parts = [_block_trig(b, k) for b, k in zip(blocks, keys)]
+    out = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
+    _keep(_STACKS, keys, out, _STACKS_MAX)
     return out
 
 
-def _kept(keys: tuple) -> tuple | None:
-    """The kept cosines and sines of the blocks of ``keys`` (:func:`trig`), moved first."""
+def _block_trig(b: np.ndarray, key: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`trig` of one block (``key``: its bytes, shape and type), kept unless small."""
+    if b.size < _SMALL:
+        return np.cos(b), np.sin(b)
+    hit = _kept(_BLOCKS, key)
+    if hit is None:
+        hit = np.cos(b), np.sin(b)
+        _keep(_BLOCKS, key, hit, _TRIG_MAX)
+    return hit
+
+
+def _kept(memo: list, key: tuple) -> tuple | None:
+    """What ``memo`` (:func:`trig`'s) keeps for ``key``, moved first; None when nothing."""
     with _TRIG_LOCK:
-        for k, hit in enumerate(_TRIG):
-            if hit[0] == keys:
+        for k, hit in enumerate(memo):
+            if hit[0] == key:
                 if k:
-                    _TRIG.insert(0, _TRIG.pop(k))
+                    memo.insert(0, memo.pop(k))
                 return hit[1]
     return None
+
+
+def _keep(memo: list, key: tuple, value: tuple, most: int) -> None:
+    """Keep ``value`` for ``key`` first in ``memo``, at most ``most`` entries."""
+    with _TRIG_LOCK:
+        memo.insert(0, (key, value))
+        del memo[most:]
 
 
 def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,
