@@ -15,7 +15,6 @@ P inputs and lengths in the file's length unit.
 from __future__ import annotations
 
 import math
-import operator
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -25,7 +24,7 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.engines import PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
+from mechsyn.kinematics.engines import _INDEX, PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, _topology, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
@@ -329,8 +328,6 @@ def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) ->
     events.sort(key=_INDEX)
     return events
 
-
-_INDEX = operator.attrgetter("index")
 
 
 @dataclass(frozen=True)

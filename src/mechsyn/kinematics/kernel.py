@@ -356,8 +356,9 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     (pa, sa), (pb, sb) = paths[0], paths[-1]
     if sa.flags.writeable or sb.flags.writeable:  # one array type for both (tracking_path's are read-only)
         sa, sb = np.array(sa, float), np.array(sb, float)
-    return mod.fold_scan(discs if isinstance(discs, np.ndarray) else np.array(discs), perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0],
-                         sb, ks, specs, ip, fp, anc_j, anc_s, nj)
+    D = discs if isinstance(discs, np.ndarray) else np.array(discs)
+    return mod.fold_scan(D, perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0], sb, ks, specs,
+                         ip, fp, anc_j, anc_s, nj)
 
 
 def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray | None:

@@ -327,7 +327,7 @@ class Mechanism:
         index = memo.get("joint index")
         if index is None:
             index = memo["joint index"] = {j.id: k for k, j in enumerate(joints)}
-        dim = 2 if self.kind == "planar" else 3  # (self.dim)
+        dim = self.dim
         for jid, p in points.items():
             k = index.get(jid)
             if k is None:
