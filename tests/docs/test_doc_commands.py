@@ -1,10 +1,10 @@
 """Every ``mechsyn ...`` command shown in the README and docs runs as written.
 
 Commands are taken from fenced blocks (no language, ``bash``, ``sh``, ``shell`` or
-``console``); usage synopses with placeholders live in ``text`` blocks. Each command
-runs in-process in a temporary directory (one per page, so a command may read what an
-earlier one on the page wrote) that sees the repository's ``examples/``; ``> FILE``
-redirects its output there.
+``console``); usage synopses with placeholders live in ``text`` blocks. A page's commands
+run in-process, in page order, as one test in a temporary directory of its own (a command
+may read what an earlier one on the page wrote, on any number of workers) that sees the
+repository's ``examples/``; ``> FILE`` redirects its output there.
 
 Commands that take more than a few seconds (synthesis runs, fine grids, the 12-link
 atlas) and those reading their output run only with ``MECHSYN_DOC_COMMANDS=all``: CI
@@ -56,38 +56,22 @@ def doc_commands() -> list[tuple[str, str]]:
 
 
 def _params():
+    """One test per page: its commands run in page order in one directory (a later one may
+    read an earlier one's output), whatever the workers' distribution (``--dist load``,
+    ``worksteal`` or none). The long commands run only with ``MECHSYN_DOC_COMMANDS=all``
+    (then the page's test is marked slow)."""
+    pages: dict[str, list[str]] = {}
     for page, cmd in doc_commands():
-        long = any(k in cmd for k in LONG)
-        if long and not RUN_ALL:
-            continue
-        # one page's commands run in order on one worker (a later one may read an earlier one's output)
-        marks = [pytest.mark.xdist_group(page)] + ([pytest.mark.slow] if long else [])
-        yield pytest.param(page, cmd, id=f"{page}:{cmd[:60]}", marks=marks)
+        pages.setdefault(page, []).append(cmd)
+    for page, cmds in pages.items():
+        long = [c for c in cmds if any(k in c for k in LONG)]
+        run = cmds if RUN_ALL else [c for c in cmds if c not in long]
+        if run:
+            marks = [pytest.mark.slow] if long and RUN_ALL else []
+            yield pytest.param(page, run, id=page, marks=marks)
 
 
-@pytest.fixture(scope="session")  # not module: a worker may run another module's tests between
-def page_dirs(tmp_path_factory):  # two commands of a page, which would tear a module fixture down
-    dirs: dict[str, Path] = {}
-
-    def get(page: str) -> Path:
-        if page not in dirs:
-            dirs[page] = tmp_path_factory.mktemp(Path(page).stem)
-            (dirs[page] / "examples").symlink_to(ROOT / "examples")
-        return dirs[page]
-
-    return get
-
-
-def test_the_docs_show_commands():
-    cmds = doc_commands()
-    assert len(cmds) >= 40
-    assert sum(not any(k in c for k in LONG) for _, c in cmds) >= 30  # most run by default
-
-
-@pytest.mark.parametrize("page, command", list(_params()))
-def test_documented_command_runs(page, command, page_dirs, monkeypatch, capsys):
-    tmp_path = page_dirs(page)
-    monkeypatch.chdir(tmp_path)
+def _run(command: str, tmp_path: Path, capsys) -> None:
     words = shlex.split(command, comments=True)
     redirect = None
     if ">" in words:
@@ -102,3 +86,11 @@ def test_documented_command_runs(page, command, page_dirs, monkeypatch, capsys):
     assert out.out.strip() or out.err.strip(), f"{command} said nothing"  # a command that did nothing
     if redirect:
         (tmp_path / redirect).write_text(out.out)
+
+
+@pytest.mark.parametrize("page, commands", list(_params()))
+def test_documented_commands_run(page, commands, tmp_path, monkeypatch, capsys):
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    monkeypatch.chdir(tmp_path)
+    for command in commands:
+        _run(command, tmp_path, capsys)

@@ -314,3 +314,29 @@ def test_four_bar_fold_spec_read_off_the_regular_program_equals_the_groups(ex, f
         del memo[key]
     want = [folds._four_bar_spec(kp.system, kp.groups, k) for k in ks]  # from the groups
     assert got == want and any(g is not None for g in got)
+
+
+@pytest.mark.parametrize("gap", [0.0, 4.4e-16, 3e-13])
+def test_coincident_circle_centres_are_indeterminate_in_both_forms(gap):
+    """An RRR group whose circle centres are one point (within 1e-12 of its lengths) has no
+    determinate middle joint: NaN in the array and the scalar forms alike, whatever the last
+    bits of ``d`` (the Peaucellier cell's dead point gave 0 on one machine and 4.4e-16 on
+    another, so NaN from one pass and a discriminant of 1 from the other)."""
+    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+
+    for scale in (1e-3, 1.0, 1e4):
+        L1s = L2s = (2.0 * scale) ** 2
+        d = gap * scale
+        inv, f, g2 = circle_circle(np.array([d, 2.0 * scale]), np.zeros(2), L1s, L2s)
+        disc = normalised_disc(inv, g2, L1s)
+        assert np.isnan(disc[0]) and disc[1] == pytest.approx(0.75)
+        inv_s, f_s, g2_s = circle_circle(d, 0.0, L1s, L2s)
+        assert np.isnan(inv_s) and np.isnan(g2_s)
+
+
+def test_separate_circle_centres_are_kept():
+    """Just above the coincidence threshold (1e-10 of the lengths) the group is determinate."""
+    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+
+    inv, f, g2 = circle_circle(np.array([1e-10]), np.zeros(1), 4.0, 4.0)
+    assert np.isfinite(normalised_disc(inv, g2, 4.0)[0])

@@ -100,11 +100,12 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
         cbv1 = fp[s, 3]
         cbv2 = fp[s, 4]
         half = 0.5 * (L1s - L2s)
+        tiny = 1e-24 * (L1s + L2s)
         for r in range(M):
             d = jP[J3, r] - jP[J1, r]
             inv = d.real * d.real
             inv += d.imag * d.imag
-            inv = 1.0 / inv
+            inv = 1.0 / inv if inv > tiny else math.nan  # groups.COINCIDENT: centres one point
             f = inv * half
             f += 0.5
             g = inv * L1s
@@ -390,7 +391,7 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):  # pragma: no cover - compiled
         L1s = fp[s, 0].real
         d = jP[J3] - jP[J1]
         inv = d.real * d.real + d.imag * d.imag
-        inv = 1.0 / inv if inv > 0 else math.inf
+        inv = 1.0 / inv if inv > 1e-24 * (L1s + fp[s, 0].imag) else math.nan  # groups.COINCIDENT
         f = inv * (0.5 * (L1s - fp[s, 0].imag)) + 0.5
         g = inv * L1s - f * f
         disc = g / (inv * L1s) if inv < math.inf else math.nan

@@ -288,6 +288,11 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
+COINCIDENT = 1e-24
+"""Squared distance, over the sum of an RRR group's squared lengths, below which its two
+circle centres are one point (:func:`circle_circle`)."""
+
+
 def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: float, L2s: float) -> tuple:
     """The RRR group's kernel: the intersection of the circles ``|B - A| = L1``,
     ``|B - C| = L2`` with ``d = C - A = (dx, dy)`` (arrays, or floats for the scalar root
@@ -300,6 +305,13 @@ def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: float, L2
     places an RRR group calls it: the generic step, the fast chain, the regular pass and
     the scalar discriminant of the tracking.
 
+    Centres closer than ``1e-12 sqrt(L1^2 + L2^2)`` (:data:`COINCIDENT`, relative to the group's own
+    lengths) are coincident: the middle joint is then indeterminate (a circle of solutions,
+    or none), and ``1/|d|^2``, ``f``, ``g^2`` and the discriminant are NaN, in
+    the array and the scalar forms alike, whatever the last bits of ``d`` (the Peaucellier
+    cell at its dead point puts A and B on one spot: ``|d|`` came out 0 or 4e-16 depending
+    on the machine's rounding, and the group's discriminant NaN or 1).
+
     Examples
     --------
     >>> inv, f, g2 = circle_circle(4.0, 0.0, 9.0, 9.0)   # |d| = 4, L1 = L2 = 3
@@ -308,10 +320,12 @@ def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: float, L2
     """
     inv = dx * dx
     inv += dy * dy
+    tiny = COINCIDENT * (L1s + L2s)
     if isinstance(inv, np.ndarray):
+        inv[inv <= tiny] = np.nan  # NaN, not 1/0: quiet downstream, no warnings
         np.divide(1.0, inv, out=inv)
     else:
-        inv = 1.0 / inv if inv > 0 else math.inf
+        inv = 1.0 / inv if inv > tiny else math.nan
     f = inv * (0.5 * (L1s - L2s))
     f += 0.5
     g = inv * L1s
