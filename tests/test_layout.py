@@ -148,6 +148,7 @@ FACADE_EDGES: frozenset[str] = frozenset({
 #: link outlines moved to the kinematics geometry (SVG export without Matplotlib) and
 #: ``Mechanism.widget()`` replaced by ``mechsyn.web.widget(m)``.
 TEMPORARY_EDGES: frozenset[str] = frozenset({
+    "mechsyn.io.files:resolve_path -> mechsyn.examples",
     "mechsyn.io.files:read_text -> mechsyn.examples",
     "mechsyn.io.files:read_data -> mechsyn.examples",
     "mechsyn.io.load:read_data -> mechsyn.examples",

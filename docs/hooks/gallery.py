@@ -21,28 +21,28 @@ ROOT = Path(__file__).resolve().parents[2]
 
 GALLERY = [
     ("crank_rocker", "Crank-rocker: coupler path, speeds and accelerations",
-     ["mechsyn simulate examples/kinematics/crank_rocker.yaml --input A=0:360:2 --points M "
+     ["mechsyn simulate crank_rocker --input A=0:360:2 --points M "
       "--plot crank_rocker.png"], "crank_rocker.png"),
     ("jansen", "Jansen's leg, converted from a Pyslvs expression",
-     ["mechsyn convert examples/pyslvs/jansen.pyslvs -o jansen.yaml",
+     ["mechsyn convert pyslvs/jansen.pyslvs -o jansen.yaml",
       "mechsyn simulate jansen.yaml --input P0=0:360:3 --points P7 --plot jansen.png"], "jansen.png"),
     ("jansen_plates", "Jansen's leg as plates to cut (DXF and SVG)",
-     ["mechsyn export examples/pyslvs/jansen.pyslvs --dxf jansen.dxf --svg jansen_plates.svg "
+     ["mechsyn export pyslvs/jansen.pyslvs --dxf jansen.dxf --svg jansen_plates.svg "
       "--width 6 --hole 2.5 --clearance 0.1"], "jansen_plates.svg"),
     ("forces", "Crank-rocker: joint reactions and the balancing moment",
-     ["mechsyn forces examples/kinematics/crank_rocker.yaml --input A=0:360:5 --plot forces.png"], "forces.png"),
+     ["mechsyn forces crank_rocker --input A=0:360:5 --plot forces.png"], "forces.png"),
     ("belt", "Paper 001's belt manipulator: path of the hand, transfer functions",
-     ["mechsyn belt analyze --file examples/belt/paper001.yaml --plot belt.png"], "belt.png"),
+     ["mechsyn belt analyze --file paper001 --plot belt.png"], "belt.png"),
     ("capability", "Paper 004's 3R arm: largest speed along +x over the working region",
-     ["mechsyn capability examples/capability/paper004_3r.yaml --grid 1300:2100:100,100:900:100 "
+     ["mechsyn capability paper004_3r --grid 1300:2100:100,100:900:100 "
       "--direction 1,0 --map capability.png"], "capability.png"),
     ("burmester", "Burmester motion generation through four poses: centre-point curve and best linkage",
-     ["mechsyn synth motion examples/synthesis/poses_4.json --plot burmester.png"], "burmester.png"),
+     ["mechsyn synth motion poses_4 --plot burmester.png"], "burmester.png"),
     ("path", "Path generation: a four-bar through five targets (a published case)",
-     ["mechsyn synth path examples/synthesis/path_cases_public.json --case P2_kk5_timing --time-limit 5 "
+     ["mechsyn synth path path_cases_public --case P2_kk5_timing --time-limit 5 "
       "--restarts 2 --plot path.png"], "path.png"),
     ("fingers", "Paper 000: groups attached to a two-phalanx finger, with its VLL candidates",
-     ["mechsyn synth finger examples/fingers/two_phalanx_base_000.yaml --max-links 3 --out fingers/"],
+     ["mechsyn synth finger two_phalanx_base_000 --max-links 3 --out fingers/"],
      "fingers/fingers.png"),
     ("atlas", "The atlas of six-link chains of mobility 1",
      ["mechsyn atlas --links 6 --mobility 1 --out atlas6.png"], "atlas6.png"),

@@ -17,6 +17,10 @@ roles = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(roles)
 
 RAW_ROLE = re.compile(r":(?:func|class|meth|mod|attr|data|obj|exc):<code>")
+#: reStructuredText that survived into a code block of the built site (an indented docstring
+#: paragraph becomes a code block in Markdown: roles, double backticks and RST tables show raw)
+RAW_IN_CODE = re.compile(r":(?:func|class|meth|mod|attr|data|obj|exc|const):`|``[^`\s]|^ *={4,} +={4,}", re.M)
+_PRE = re.compile(r"<pre[^>]*>(.*?)</pre>", re.S)
 INTERNAL = "not in the project's copy"
 
 
@@ -62,6 +66,9 @@ def test_built_site_has_links_not_raw_roles(tmp_path):
     pages = {p: p.read_text(encoding="utf-8") for p in (tmp_path / "site").rglob("*.html")}
     raw = {str(p.relative_to(tmp_path)): len(RAW_ROLE.findall(t)) for p, t in pages.items() if RAW_ROLE.search(t)}
     assert raw == {}
+    in_code = {str(p.relative_to(tmp_path)): m.group(0) for p, t in pages.items() if "/api/" in str(p)
+               for block in _PRE.findall(t) for m in [RAW_IN_CODE.search(re.sub(r"<[^>]+>", "", block))] if m}
+    assert in_code == {}, in_code
     assert not [p for p, t in pages.items() if INTERNAL in t]
     links = sum(t.count('class="autorefs autorefs-internal"') for p, t in pages.items() if "/api/" in str(p))
     assert links > 300

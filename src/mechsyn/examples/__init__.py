@@ -185,6 +185,9 @@ def path(name: str) -> Path:
         rel = f"{e.folder}/{e.path.name}"
         if name in (rel, e.path.name, f"{e.folder}/{e.name}"):
             return e.path
+    shipped = root() / name  # folder/file.ext of a file outside the catalogue (a .pyslvs)
+    if len(Path(name).parts) == 2 and ".." not in Path(name).parts and shipped.is_file():
+        return shipped
     same = [e for e in _catalogue() if e.name == name]
     if same:
         return min(same, key=lambda e: e.path.suffix == ".urdf").path
@@ -195,20 +198,23 @@ def path(name: str) -> Path:
 
 
 def resolve(file: str | Path) -> Path:
-    """``file`` itself when it exists or names a folder or suffix, else the example of that
-    name when there is one (how the command line accepts ``mechsyn analyze fourbar``).
+    """``file`` itself when it exists, else the bundled example it names when there is one
+    (a stem, a file name or ``folder/file.ext``: how the command line accepts
+    ``mechsyn analyze fourbar`` and ``mechsyn convert pyslvs/jansen.pyslvs``).
 
     Examples
     --------
     >>> import mechsyn as ms
     >>> ms.examples.resolve("fourbar").name
     'fourbar.yaml'
+    >>> ms.examples.resolve("pyslvs/jansen.pyslvs").parent.name
+    'pyslvs'
     """
     p = Path(file)
-    if p.exists() or p.suffix or len(p.parts) != 1:
+    if p.exists() or p.is_absolute() or len(p.parts) > 2:
         return p
-    try:
-        return path(str(file))
+    try:  # a stem, a file name or folder/file of a bundled example
+        return path(p.as_posix())
     except MechsynInputError:
         return p
 

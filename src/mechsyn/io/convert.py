@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.io.files import read_text
+from mechsyn.io.files import read_text, resolve_path
 from mechsyn.io.load import load_mechanism, mechanism_from_dict, mechanism_text, mechanism_to_dict
 from mechsyn.io.pyslvs import pyslvs_text, read_pyslvs
 from mechsyn.model.mechanism import Mechanism
@@ -37,7 +37,7 @@ class Conversion:
 
 def load_any(path: str | os.PathLike[str]) -> Mechanism:
     """A mechanism from a mechanism file (.yaml, .json) or a Pyslvs expression (.pyslvs, .txt)."""
-    p = Path(path)
+    p = resolve_path(path)  # a bundled example's name stands for its file
     if p.suffix.lower() not in PYSLVS_SUFFIXES:
         return load_mechanism(p)
     if not p.is_file():
@@ -59,7 +59,7 @@ def convert_file(path: str | os.PathLike[str], to: str, inputs: list[tuple[int, 
     >>> c.text.splitlines()[0]  # doctest: +SKIP
     'name: crank_rocker'
     """
-    p = Path(path)
+    p = resolve_path(path)  # a bundled example's name stands for its file
     src, to = p.suffix.lower(), to.lower()
     if src in PYSLVS_SUFFIXES and to in MECHSYN_SUFFIXES:
         if not p.is_file():

@@ -54,7 +54,7 @@ _YAML_LOADER = _StrictLoader
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
-__all__ = ["is_mechanism_file", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
+__all__ = ["is_mechanism_file", "resolve_path", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
            "check_id_text"]
 
 #: Bidirectional controls and zero-width characters: they make two ids that look alike
@@ -66,6 +66,19 @@ _SURROGATE = re.compile("[\ud800-\udfff]")
 FREE_TEXT_KEYS = frozenset({"name", "title", "description", "notes", "note", "comment", "label", "text"})
 
 _BRACKETS = re.compile(r"[\[\]{}]")
+
+
+def resolve_path(path: str | os.PathLike[str]) -> Path:
+    """``path`` itself when it exists, else the bundled example it names (a stem such as
+    ``fourbar``, a file name or ``folder/file.ext``): every reader's one way to accept a
+    bundled example's name (:func:`mechsyn.examples.resolve`).
+
+    >>> resolve_path("fourbar").name
+    'fourbar.yaml'
+    """
+    from mechsyn.examples import resolve
+
+    return resolve(path)
 
 
 def read_text(path: str | os.PathLike[str], what: str = "file") -> str:

@@ -39,7 +39,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import load_mechanism, mechanism_to_dict
 from mechsyn.io.checks import numbers
-from mechsyn.io.files import read_data
+from mechsyn.io.files import read_data, resolve_path
 from mechsyn.limits import limit, limit_hint
 
 __all__ = ["Variable", "PathCase", "load_cases", "DesignVariable", "MechanismCase", "load_mechanism_case",
@@ -340,7 +340,7 @@ def load_mechanism_case(path: str | Path) -> MechanismCase:
     >>> case.problem, case.n_targets, case.names
     ('path', 8, ['B.x', 'B.y', 'C.x', 'C.y', 'M.x', 'M.y'])
     """
-    p = Path(path)
+    p = resolve_path(path)  # a bundled case's name: its mechanism is beside the bundled file
     data, _ = read_data(p, "case file", fmt="yaml")
     return mechanism_case_from_dict(data, source=str(p), base_dir=p.parent)
 

@@ -1,39 +1,35 @@
 """What every synthesis in mechsyn shares: one result base, one seed convention, one
 progress convention.
 
-Result
-    :class:`SynthesisResult` is the base of every synthesis result (path, mechanism,
-    curve, belt; the finger-design result extends it too). Its fields, all keyword-only
-    with defaults so that a subclass may add positional fields of its own:
+**Result.** :class:`SynthesisResult` is the base of every synthesis result (path,
+mechanism, curve, belt; the finger-design result extends it too). Its fields, all
+keyword-only with defaults so that a subclass may add positional fields of its own:
 
-    ========== ==========================================================================
-    error      the objective of the returned design (its unit is the problem's); ``inf``
-               or NaN when nothing feasible was found
-    feasible   whether the returned design meets every constraint
-    reason     why it does not ("" when feasible)
-    design     the design as named values (``{"r1": 2.0, ...}``)
-    x          the same design as the optimiser's vector
-    nfev       objective evaluations (0 for a closed-form construction)
-    seconds    wall-clock time of the run
-    seed       the integer seed that reproduces the run (``None``: not random)
-    interrupted  Ctrl-C ended the search: the design is the best found so far
-    ========== ==========================================================================
+| field | meaning |
+|---|---|
+| `error` | the objective of the returned design (its unit is the problem's); `inf` or NaN when nothing feasible was found |
+| `feasible` | whether the returned design meets every constraint |
+| `reason` | why it does not (`""` when feasible) |
+| `design` | the design as named values (`{"r1": 2.0, ...}`) |
+| `x` | the same design as the optimiser's vector |
+| `nfev` | objective evaluations (0 for a closed-form construction) |
+| `seconds` | wall-clock time of the run |
+| `seed` | the integer seed that reproduces the run (`None`: not random) |
+| `interrupted` | Ctrl-C ended the search: the design is the best found so far |
 
-    Like every result of mechsyn it is a :class:`mechsyn._result.Result`: a short
-    ``str``, a table in Jupyter, ``to_dict()`` (with the keys :data:`COMMON_KEYS`) and
-    ``plot(ax=None)`` where the result has a picture. Its summary puts ``error``,
-    ``feasible`` and ``reason`` first, as SciPy's ``OptimizeResult`` does.
+Like every result of mechsyn it is a :class:`mechsyn._result.Result`: a short `str`, a
+table in Jupyter, `to_dict()` (with the keys :data:`COMMON_KEYS`) and `plot(ax=None)`
+where the result has a picture. Its summary puts `error`, `feasible` and `reason` first,
+as SciPy's `OptimizeResult` does.
 
-Seeds
-    A search takes ``seed: int | None | numpy.random.Generator``. :func:`resolve_seed`
-    turns it into the one integer that is recorded in the result (give it back to repeat
-    the run); :func:`as_generator` gives the random generator of a seed.
+**Seeds.** A search takes `seed: int | None | numpy.random.Generator`.
+:func:`resolve_seed` turns it into the one integer that is recorded in the result (give it
+back to repeat the run); :func:`as_generator` gives the random generator of a seed.
 
-Progress
-    A search that reports progress calls ``callback(state)`` with a :class:`Progress`
-    (``done`` of ``total`` steps, the best error so far and a message); raising
-    :class:`KeyboardInterrupt` in the callback stops the search like Ctrl-C (the best so
-    far is returned, ``interrupted=True``).
+**Progress.** A search that reports progress calls `callback(state)` with a
+:class:`Progress` (`done` of `total` steps, the best error so far and a message); raising
+`KeyboardInterrupt` in the callback stops the search like Ctrl-C (the best so far is
+returned, `interrupted=True`).
 
 Examples
 --------

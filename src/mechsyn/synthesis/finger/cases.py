@@ -23,7 +23,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import load_mechanism, mechanism_to_dict
 from mechsyn.io.checks import numbers
-from mechsyn.io.files import read_data
+from mechsyn.io.files import read_data, resolve_path
 from mechsyn.synthesis.finger.vll import vll_ends
 
 __all__ = ["FingerVariable", "FingerCase", "load_case", "case_from_dict"]
@@ -86,7 +86,7 @@ def _err(msg: str, source: str, fld: str | None = None, hint: str | None = None)
 
 def load_case(path: str | Path) -> FingerCase:
     """Read a finger-design case (YAML or JSON); the mechanism path is relative to it."""
-    path = Path(path)
+    path = resolve_path(path)  # a bundled case's name: its mechanism is beside the bundled file
     data, _text = read_data(path, "case file")
     return case_from_dict(data, str(path), base_dir=path.parent)
 
