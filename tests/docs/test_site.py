@@ -20,7 +20,7 @@ RAW_ROLE = re.compile(r":(?:func|class|meth|mod|attr|data|obj|exc):<code>")
 #: reStructuredText that survived into a code block of the built site (an indented docstring
 #: paragraph becomes a code block in Markdown: roles, double backticks and RST tables show raw)
 RAW_IN_CODE = re.compile(r":(?:func|class|meth|mod|attr|data|obj|exc|const):`|``[^`\s]|^ *={4,} +={4,}", re.M)
-_PRE = re.compile(r"<pre[^>]*>(.*?)</pre>", re.S)
+_PRE = re.compile(r"<(?:pre|code)[^>]*>(.*?)</(?:pre|code)>", re.S)  # code blocks and inline code (a type column)
 INTERNAL = "not in the project's copy"
 
 

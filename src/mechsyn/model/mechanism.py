@@ -150,17 +150,28 @@ class Mechanism:
 
     Attributes
     ----------
-    name, kind: the file's name and ``"planar"`` or ``"spatial"``.
-    ground: the frame link's name.
-    links: every link, frame included, in file order.
-    joints: the kinematic pairs in file order.
-    points: named points fixed on links.
-    contours: independent contours as ordered joint-id lists, when the file gives them
-        (paper 003's per-contour results depend on their order).
-    states: variable-structure states (paper 002).
-    mobility: the actual mobility W declared in the file (idle mobilities included),
-        used by formulas that need W when no other source is better.
-    source: the file it was read from.
+    name : str
+        The file's name.
+    kind : str
+        ``"planar"`` or ``"spatial"``.
+    ground : str
+        The frame link's name.
+    links : tuple of Link
+        Every link, frame included, in file order.
+    joints : tuple of Joint
+        The kinematic pairs in file order.
+    points : dict of str to PointSpec
+        Named points fixed on links.
+    contours : tuple of tuple of str, or None
+        Independent contours as ordered joint-id lists, when the file gives them (paper
+        003's per-contour results depend on their order).
+    states : dict of str to StateSpec
+        Variable-structure states (paper 002), by name.
+    mobility : int or None
+        The actual mobility W declared in the file (idle mobilities included), used by
+        formulas that need W when no other source is better.
+    source : str or None
+        The file it was read from.
     """
 
     name: str

@@ -38,11 +38,16 @@ class PairKind:
 
     Attributes
     ----------
-    name: canonical type name used in mechanism files (``R``, ``P``, ...).
-    title: the field's name of the pair.
-    pair_class: class ``i`` in a spatial mechanism (``None``: given in the file).
-    higher: line or point contact (``m = 4`` in paper 003) rather than surface contact.
-    planar: may appear in a planar mechanism.
+    name : str
+        Canonical type name used in mechanism files (``R``, ``P``, ...).
+    title : str
+        The field's name of the pair.
+    pair_class : int or None
+        Class ``i`` in a spatial mechanism (``None``: given in the file).
+    higher : bool
+        Line or point contact (``m = 4`` in paper 003) rather than surface contact.
+    planar : bool
+        May appear in a planar mechanism.
     """
 
     name: str
