@@ -31,3 +31,16 @@ def cli_json(run_cli):
         return json.loads(out)
 
     return run
+
+
+def pytest_collection_modifyitems(config, items):
+    """Browser and video tests are marked by what they use (the ``browser``/``page``
+    fixtures of tests/web, an animation written as video): the default run leaves them out
+    with the slow ones (``-m 'not slow and not browser and not video'`` in pyproject.toml),
+    CI runs them with ``-m 'slow or browser or video'``."""
+    for item in items:
+        names = set(getattr(item, "fixturenames", ()))
+        if names & {"browser", "page"}:
+            item.add_marker(pytest.mark.browser)
+        if item.get_closest_marker("video") is None and "movie" in item.nodeid and "mp4" in item.nodeid:
+            item.add_marker(pytest.mark.video)
