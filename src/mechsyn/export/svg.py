@@ -59,7 +59,9 @@ def _outline_path(outline: list[tuple[float, float, float]]) -> str:
         chord = math.hypot(nx - x, ny - y)
         r = chord / (2 * abs(math.sin(theta / 2)))
         large = 1 if abs(theta) > math.pi else 0
-        sweep = 1 if b > 0 else 0  # counter-clockwise in y-up is clockwise on screen
+        # the y flip mirrors the drawing: an arc counter-clockwise in y-up (bulge > 0) runs
+        # the negative-angle way in SVG's y-down frame, sweep-flag 0
+        sweep = 0 if b > 0 else 1
         d.append(f"A {_f(r)} {_f(r)} 0 {large} {sweep} {_f(nx)} {_f(ny)}")
     d.append("Z")
     return " ".join(d)
