@@ -192,9 +192,7 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
 def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
     from mechsyn.kinematics.report import simulation_csv
 
-    if csv_out is not None:
-        write_output(csv_out, simulation_csv(sim))
-    if plot is not None:
+    if plot is not None:  # (first: a range where nothing assembles is refused before any file is written)
         from mechsyn.plot.kinematics import plot_simulation
 
         save_plot(plot, plot_simulation, sim)
@@ -202,6 +200,8 @@ def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], 
         from mechsyn.plot.kinematics import animate_simulation
 
         save_animation(animate, animate_simulation, sim, dpi=100)
+    if csv_out is not None:
+        write_output(csv_out, simulation_csv(sim))
 
 
 @app.command("forces")
@@ -231,11 +231,11 @@ def forces_cmd(
     with _over_actuation_in_cli_words(inputs), progress_bar("force analysis", n, enabled=n >= 200) as advance:
         fa = forces(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), gravity=(0.0, -gravity),
                     static=static, vll=_parse_pairs(vll, "--vll", False), method=method, progress=advance)
-    if csv_out is not None:
-        write_output(csv_out, forces_csv(fa))
-    if plot is not None:
+    if plot is not None:  # (first: nothing assembled is refused before any file is written)
         from mechsyn.plot.kinematics import plot_forces
         save_plot(plot, plot_forces, fa)
+    if csv_out is not None:
+        write_output(csv_out, forces_csv(fa))
     if is_stdout(csv_out):
         return
     if json_:
