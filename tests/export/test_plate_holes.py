@@ -109,6 +109,13 @@ def _assert_hole_in(poly: np.ndarray, centre, radius: float, what: str) -> None:
     assert gap >= radius - 1e-6 * scale, f"{what}: hole of radius {radius:g} cuts the outline ({gap:g} from it)"
 
 
+def _assert_slot_in(poly: np.ndarray, slot: np.ndarray, what: str) -> None:
+    """Every point of a slot's outline inside the plate's, none on it."""
+    scale = float(np.ptp(poly, axis=0).max())
+    for q in slot[:: max(1, len(slot) // 200)]:
+        assert _inside(poly, q) and _distance_to_boundary(poly, q) > 1e-6 * scale, f"{what}: slot cuts the outline"
+
+
 def _export(run_cli, name: str, tmp_path: Path, *extra: str) -> tuple[Path, Path] | None:
     svg, dxf = tmp_path / "p.svg", tmp_path / "p.dxf"
     code, _, err = run_cli("export", _file(name), "--svg", svg, "--dxf", dxf, *extra)
@@ -135,9 +142,13 @@ def test_every_hole_lies_inside_its_plate_in_svg_and_dxf(name, run_cli, tmp_path
     groups = root.findall("s:g/s:g", NS)
     assert groups
     n_holes = 0
+    n_slots = 0
     for g in groups:
-        (path,) = g.findall("s:path", NS)
+        (path,) = [p for p in g.findall("s:path", NS) if p.get("stroke") == "#000"]
         poly = _svg_outline(path.get("d"))
+        for slot in (p for p in g.findall("s:path", NS) if p.get("stroke") == "#d00"):  # a slider's guide
+            _assert_slot_in(poly, _svg_outline(slot.get("d")), f"{name} SVG plate {g.get('id')}")
+            n_slots += 1
         for c in g.findall("s:circle", NS):  # holes (red) and point marks (green)
             centre = (float(c.get("cx")), float(c.get("cy")))
             _assert_hole_in(poly, centre, float(c.get("r")), f"{name} SVG plate {g.get('id')}")
@@ -146,6 +157,13 @@ def test_every_hole_lies_inside_its_plate_in_svg_and_dxf(name, run_cli, tmp_path
     outlines = [np.array([(v.x, v.y) for v in dxf_path.make_path(e).flattening(1e-6)])
                 for e in msp.query("LWPOLYLINE[layer=='OUTLINE']")]
     assert len(outlines) == len(groups)
+    slots = [np.array([(v.x, v.y) for v in dxf_path.make_path(e).flattening(1e-6)])
+             for e in msp.query("LWPOLYLINE[layer=='SLOTS']")]
+    assert len(slots) == n_slots
+    for slot in slots:
+        owners = [poly for poly in outlines if _inside(poly, slot[0])]
+        assert len(owners) == 1, f"{name} DXF: a slot inside {len(owners)} outlines"
+        _assert_slot_in(owners[0], slot, f"{name} DXF")
     circles = list(msp.query("CIRCLE[layer=='HOLES' | layer=='POINTS']"))
     assert len(circles) == n_holes
     for c in circles:
