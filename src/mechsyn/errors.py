@@ -81,6 +81,23 @@ class MechsynInputError(MechsynError, ValueError):
         )
 
 
+class OverActuatedError(MechsynInputError):
+    """More independent drives than the mobility, one of them without an input: the
+    simulation would hold it at its drawn value and find no configuration. ``check`` is the
+    :class:`~mechsyn.structure.drives.DriveCheck` (``.drives``, ``.mobility``, ``.excess``,
+    the drives without an input among ``.excess``)."""
+
+    def __init__(self, message: str, *, check: object, **kw: object) -> None:
+        self.check = check
+        super().__init__(message, **kw)  # type: ignore[arg-type]
+
+    def with_source(self, source: str) -> "MechsynInputError":
+        if self.source:
+            return self
+        return OverActuatedError(self.message, check=self.check, source=source, field=self.field,
+                                 line=self.line, hint=self.hint)
+
+
 def input_boundary(what: str):
     """Decorate a function that validates user data (``fn(data, source, ...)``): a
     ``TypeError``, ``KeyError``, ``IndexError``, ``AttributeError``, ``ValueError``,

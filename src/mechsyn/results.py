@@ -21,6 +21,17 @@ from typing import Any
 import numpy as np
 
 
+def counted(n: Any, one: str, many: str | None = None) -> str:
+    """``n`` and the word for that many, as a report writes it (no "mobility(ies)").
+
+    Examples
+    --------
+    >>> counted(1, "idle mobility", "idle mobilities"), counted(3, "redundant constraint")
+    ('1 idle mobility', '3 redundant constraints')
+    """
+    return f"{n} {one if n == 1 else (many or one + 's')}"
+
+
 def to_jsonable(obj: Any) -> Any:
     """Convert ``obj`` recursively into JSON-compatible Python values.
 

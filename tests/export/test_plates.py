@@ -94,12 +94,36 @@ def test_holes_too_big_are_refused(run_cli):
 
 
 def test_a_point_at_a_hole_gives_a_round_plate_not_nan():
-    """cam_polar's follower: its named point F is the centre of its only hole R."""
+    """cam_polar's follower: its named point F is the centre of its only hole R (and of its
+    slide S: the follower is a slider's block)."""
     lay = link_plates(load_mechanism(ROOT / "examples" / "kinematics" / "cam_polar.yaml"), width=3.0,
                       hole_diameter=1.0)
     plate = next(p for p in lay.plates if p.link == "follower")
     outline = np.array(plate.outline)
     assert np.all(np.isfinite(outline))
     centre = plate.holes[0]
-    assert np.allclose(np.hypot(*(outline[:, :2] - centre).T), 1.5)   # a circle of the half width
+    # the follower slides on S: it is the slider's block, a rectangle two widths long round its pin
+    assert len(outline) == 4 and np.all(outline[:, 2] == 0)
+    assert np.allclose(np.sort(np.abs(outline[:, :2] - centre), axis=0)[-1], [3.0, 1.5])
     assert plate_outline(np.array([[1.0, 2.0], [1.0, 2.0], [1.0, 2.0]]), 2.0) == [(-1.0, 2.0, 1.0), (3.0, 2.0, 1.0)]
+
+
+def test_a_slider_gets_a_block_and_a_slot_over_its_stroke():
+    """The slider-crank (crank 1): the frame's slot spans the stroke, 2 cranks; the slider is
+    a rectangular block round its pin. A VLL cylinder's slot spans its limits; a slider that
+    no drive turns and no limits bound gets no slot, and the notes say why."""
+    lay = link_plates(load_mechanism(ROOT / "examples/textbook/slider_crank.yaml"))
+    frame = next(p for p in lay.plates if p.link == "frame")
+    ((a, b),) = frame.slots
+    assert np.linalg.norm(b - a) == pytest.approx(2.0, rel=1e-6)
+    block = next(p for p in lay.plates if p.link == "slider")
+    corners = np.array(block.outline)
+    assert len(corners) == 4 and np.all(corners[:, 2] == 0)
+    assert np.ptp(corners[:, 0]) == pytest.approx(2 * lay.width) and np.ptp(corners[:, 1]) == pytest.approx(lay.width)
+    assert block.hole_names == ["C+D"] and any("stroke 2" in n for n in lay.notes)
+    vll = link_plates(load_mechanism(ROOT / "examples/fingers/two_phalanx_vll_000.yaml"))
+    ((a, b),) = next(p for p in vll.plates if p.slots).slots
+    assert np.linalg.norm(b - a) == pytest.approx(10.0, rel=1e-9)  # limits [24, 34]
+    fixed = link_plates(load_mechanism(ROOT / "examples/structural/gripper_002_fig1_plane.yaml"))
+    assert not any(p.slots for p in fixed.plates)
+    assert any("give the joint `limits`" in n for n in fixed.notes)

@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from mechsyn.belt.design import BeltDesign
 from mechsyn.belt.kinematics import analyze
-from mechsyn.belt.straightness import tangent_deviation
+from mechsyn.belt.straightness import tangent_deviation, translation_range, translation_travel
 from mechsyn.kinematics.groups import circle_circle
 
 Array = NDArray[np.float64]
@@ -77,19 +77,6 @@ def equivalent_four_bar(design: BeltDesign, dphi: ArrayLike) -> FourBarState:
                         valid=np.isfinite(perp))
 
 
-def _run_length(dphi: Array, theta: Array, x: Array, tol: float) -> tuple[float, float, float]:
-    """Contiguous run around Δφ = 0 with |θ| <= tol on a grid: (x travel, Δφ ends)."""
-    ok = np.abs(theta) <= tol
-    i0 = int(np.argmin(np.abs(dphi)))
-    if not ok[i0]:
-        return 0.0, float(dphi[i0]), float(dphi[i0])
-    before = np.nonzero(~ok[:i0])[0]
-    after = np.nonzero(~ok[i0:])[0]
-    lo = int(before[-1] + 1) if before.size else 0
-    hi = int(i0 + after[0] - 1) if after.size else dphi.size - 1
-    return float(np.ptp(x[lo:hi + 1])), float(dphi[lo]), float(dphi[hi])
-
-
 def compare_with_four_bar(
     design: BeltDesign,
     dphi_range: tuple[float, float],
@@ -122,6 +109,9 @@ def compare_with_four_bar(
                                            float(np.degrees(grid[valid].max()))]
         else:
             entry["assembled_dphi_deg"] = None
+        states = analyze if name == "belt" else equivalent_four_bar
+        tlo, thi = translation_range(design, lo, hi, translation_tol,
+                                     theta_of=lambda g, f=states: f(design, g).theta)
         for p in ("C", "H"):
             P = pts[p]
             P0 = (zero.C if p == "C" else zero.H)[0]
@@ -134,10 +124,8 @@ def compare_with_four_bar(
                 rec[side] = ({"max_positive_deviation": float(max(dev[sel].max(), 0.0)) + 0.0,
                               "max_negative_deviation": float(max(-dev[sel].min(), 0.0)) + 0.0}
                              if np.any(sel) else None)
-            th = np.where(valid, theta, np.inf)
-            length, tlo, thi = _run_length(grid, th, np.where(valid, P[:, 0], np.nan),
-                                           translation_tol)
-            rec["translation_length"] = length
+            rec["translation_length"] = translation_travel(
+                lambda g, f=states, p=p: getattr(f(design, g), p)[:, 0], tlo, thi)
             rec["translation_dphi_deg"] = [math.degrees(tlo), math.degrees(thi)]
             entry[p] = rec
         out[name] = entry

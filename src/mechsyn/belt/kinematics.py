@@ -186,6 +186,10 @@ class MotionLaw:
         """Return Δφ(t), φ_dot(t), φ_ddot(t)."""
         raise NotImplementedError
 
+    def describe(self) -> str:  # pragma: no cover - abstract
+        """The law in words, as a report prints it (no class name)."""
+        raise NotImplementedError
+
 
 @dataclass(frozen=True)
 class ConstantSpeedLaw(MotionLaw):
@@ -204,6 +208,14 @@ class ConstantSpeedLaw(MotionLaw):
 
     def duration(self) -> float:
         return abs(self.stop - self.start) / self.omega
+
+    def describe(self) -> str:
+        """The law in words.
+
+        >>> ConstantSpeedLaw(0.0, 1.0, math.radians(60)).describe()
+        'constant speed 60 °/s'
+        """
+        return f"constant speed {math.degrees(self.omega):.4g} °/s"
 
     def evaluate(self, t: ArrayLike) -> tuple[Array, Array, Array]:
         t = np.asarray(t, dtype=float)
@@ -238,6 +250,15 @@ class TrapezoidalLaw(MotionLaw):
             return t_acc, 0.0, self.accel * t_acc
         t_cruise = (stroke - self.accel * t_acc**2) / self.omega_max
         return t_acc, t_cruise, self.omega_max
+
+    def describe(self) -> str:
+        """The law in words.
+
+        >>> TrapezoidalLaw(0.0, 1.0, math.radians(90), math.radians(180)).describe()
+        'trapezoidal speed: top 90 °/s, acceleration 180 °/s²'
+        """
+        return (f"trapezoidal speed: top {math.degrees(self.omega_max):.4g} °/s, "
+                f"acceleration {math.degrees(self.accel):.4g} °/s²")
 
     def duration(self) -> float:
         t_acc, t_cruise, _ = self._profile()
@@ -280,6 +301,10 @@ class TableLaw(MotionLaw):
             raise MechsynInputError("times in the motion table must strictly increase",
                                     field="table.t")
         object.__setattr__(self, "_spline", CubicSpline(t, phi))
+
+    def describe(self) -> str:
+        """The table's size in words."""
+        return f"table of {len(self.t)} times, spline-interpolated"
 
     def duration(self) -> float:
         return float(self.t[-1] - self.t[0])

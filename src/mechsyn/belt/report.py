@@ -110,7 +110,7 @@ class BeltReport(Result):
             "alpha0_deg": math.degrees(d.alpha0), "B0": d.B0, "synthesis": self.synthesis,
             "valid_positions": self.valid_positions, "rows": self.state.rows(), "paths": self.paths,
             "four_bar_comparison": self.four_bar_comparison,
-            "motion": {"law": type(self.law).__name__, **self.motion.to_dict()},
+            "motion": {"law": type(self.law).__name__, "law_text": self.law.describe(), **self.motion.to_dict()},
             "warnings": self.warnings,
         }
 
@@ -123,7 +123,7 @@ class BeltReport(Result):
     def motion_line(self) -> str:
         """One line: the input law's duration and the largest speeds and accelerations."""
         mx = self.motion.to_dict()["max"]
-        return (f"input law {type(self.law).__name__}: duration {self.motion.t[-1]:.4g} s; max speed "
+        return (f"input law: {self.law.describe()}; duration {self.motion.t[-1]:.4g} s; max speed "
                 f"C {mx['C_speed']:.4g}, H {mx['H_speed']:.4g}; max |a| C {mx['C_accel']:.4g}, "
                 f"H {mx['H_accel']:.4g} (unit/s, unit/s²)")
 

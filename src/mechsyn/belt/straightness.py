@@ -29,7 +29,7 @@ from mechsyn.errors import MechsynInputError
 Array = NDArray[np.float64]
 
 __all__ = ["PathQuality", "best_line_deviation", "path_quality", "tangent_deviation",
-           "translation_range"]
+           "translation_range", "translation_travel"]
 
 
 def tangent_deviation(P: Array, P0: Array, T0: Array) -> Array:
@@ -87,31 +87,32 @@ def best_line_deviation(P: Array) -> tuple[float, Array, Array]:
     return float(width[k] / 2), point, E[k]
 
 
-def _theta_at(design: BeltDesign, dphi: float) -> float:
-    return float(analyze(design, [dphi]).theta[0])
-
-
 def translation_range(design: BeltDesign, lo: float, hi: float, tol: float,
-                      samples: int = 4001) -> tuple[float, float]:
+                      samples: int = 4001, theta_of=None) -> tuple[float, float]:
     """Δφ interval around the design position (within [lo, hi], rad) over which link 2
     stays within ±``tol`` (rad) of its design attitude (|θ| <= tol); the ends are found
-    by Brent's method (scipy ``brentq``) between dense samples."""
+    by Brent's method (scipy ``brentq``) between dense samples. ``theta_of`` (Δφ array ->
+    θ array, NaN where it does not assemble) is the belt mechanism's by default; the
+    equivalent four-bar's is measured the same way (:func:`~mechsyn.belt.four_bar.compare_with_four_bar`)."""
     from scipy.optimize import brentq
 
+    theta_of = theta_of if theta_of is not None else (lambda g: analyze(design, g).theta)
     lo_c, hi_c = min(lo, 0.0), max(hi, 0.0)
     grid = np.union1d(np.linspace(lo_c, hi_c, samples), [0.0])
-    th = analyze(design, grid).theta
+    th = theta_of(grid)
     ok = np.abs(th) <= tol
     i0 = int(np.argmin(np.abs(grid)))
+    if not ok[i0]:
+        return float(grid[i0]), float(grid[i0])
     bad_before = np.nonzero(~ok[:i0])[0]
     bad_after = np.nonzero(~ok[i0:])[0]
 
     def edge(i_in: int, i_out: int) -> float:
         target = math.copysign(tol, th[i_out]) if np.isfinite(th[i_out]) else tol
-        f = lambda x: _theta_at(design, x) - target  # noqa: E731
+        f = lambda x: float(theta_of(np.array([x]))[0]) - target  # noqa: E731
         try:
             return float(brentq(f, grid[i_in], grid[i_out], xtol=1e-12))
-        except ValueError:  # NaN (slack belt) at the outer sample
+        except ValueError:  # NaN (slack belt, no assembly) at the outer sample
             return float(grid[i_in])
 
     left = edge(int(bad_before[-1] + 1), int(bad_before[-1])) if bad_before.size else lo_c
@@ -121,6 +122,13 @@ def translation_range(design: BeltDesign, lo: float, hi: float, tol: float,
     else:
         right = hi_c
     return max(left, lo), min(right, hi)
+
+
+def translation_travel(x_of, t_lo: float, t_hi: float, samples: int = 8001) -> float:
+    """A point's travel along x while Δφ runs over [t_lo, t_hi] (``x_of``: Δφ array -> x
+    array): the one measure of the report's "travel with |θ| ≤ tol", belt and four-bar alike."""
+    xr = x_of(np.linspace(t_lo, t_hi, samples))
+    return float(np.nanmax(xr) - np.nanmin(xr)) if np.any(np.isfinite(xr)) else 0.0
 
 
 @dataclass
@@ -205,8 +213,8 @@ def path_quality(
     ang = math.degrees(math.atan2(bl_dir[1], bl_dir[0]))
     ang = (ang + 90.0) % 180.0 - 90.0
     t_lo, t_hi = translation_range(design, lo, hi, translation_tol)
-    run = analyze(design, np.linspace(t_lo, t_hi, samples))
-    xr = (run.H if point == "H" else run.C)[:, 0]
+    travel = translation_travel(lambda g: (analyze(design, g).H if point == "H" else analyze(design, g).C)[:, 0],
+                                t_lo, t_hi, samples)
     return PathQuality(
         point=point,
         extent_x=float(np.ptp(P[fin, 0])), extent_y=float(np.ptp(P[fin, 1])),
@@ -216,7 +224,7 @@ def path_quality(
         max_negative_deviation=float(max(-dev.min(), 0.0)) + 0.0,
         best_line_deviation=bl_dev, best_line_angle_deg=ang,
         translation_tol_deg=math.degrees(translation_tol),
-        translation_length=float(np.nanmax(xr) - np.nanmin(xr)),
+        translation_length=travel,
         translation_dphi_deg=(math.degrees(t_lo), math.degrees(t_hi)),
     )
 

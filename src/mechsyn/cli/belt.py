@@ -217,23 +217,29 @@ def _csv_text(rep: BeltReport) -> str:
 
 
 # ----------------------------------------------------------------------- rendering
-def _table(t: Any) -> Table:
-    """A report's :class:`mechsyn.belt.report.Table` as a rich Table."""
+def _table(t: Any, rows: list[int] | None = None) -> Table:
+    """A report's :class:`mechsyn.belt.report.Table` as a rich Table (``rows``: those shown)."""
     out = Table(title=t.title, caption=t.caption or None)
     for i, col in enumerate(t.columns):
         out.add_column(col, justify="left" if i == 0 and t.labels else "right")
-    for row in t.rows:
-        out.add_row(*row)
+    for k in range(len(t.rows)) if rows is None else rows:
+        out.add_row(*t.rows[k])
     return out
 
 
 def _render_belt(rep: BeltReport) -> None:
-    """``belt analyze``'s tables on the console."""
+    """``belt analyze``'s tables on the console; the tables by position show at most 25
+    evenly spaced positions (all of them with --json or --csv), as ``simulate`` does."""
+    from mechsyn.cli.render import say_rows_shown, table_rows
+
     console.print(f"[bold]{rep.headline()}[/]")
     for w in rep.warnings:
         console.print(f"[yellow]warning:[/] {w}")
+    n = rep.state.dphi.size
+    rows = table_rows(n)
     for t in rep.tables():
-        console.print(_table(t))
+        console.print(_table(t, rows if len(t.rows) == n else None))
+    say_rows_shown(len(rows), n)
     console.print(rep.motion_line())
 
 

@@ -206,7 +206,7 @@ PARAMETER_OPTIONS: dict[str, str] = {
     "method": "--method", "tol": "--tol", "inputs": "--input", "points": "--points", "speeds": "--speed",
     "vll": "--vll", "animate": "--animate", "seed": "--seed", "time_limit": "--time-limit",
     "restarts": "--restarts", "workers": "--workers", "optimizer": "--optimizer", "direction": "--direction",
-    "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output",
+    "point": "--point", "measure": "--measure", "segment": "--segment", "link": "--output", "folder": "--folder",
     "output": "--output", "straight": "--straight", "n_links": "--links", "mobility": "--mobility",
     "actuators": "--actuators", "phi/psi": "--phi/--psi", "case_id": "--case", "target_error": "--target-error",
     "min_transmission": "--min-transmission-angle", "fold_margin": "--fold-margin", "top": "--top",

@@ -51,6 +51,8 @@ COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {
               "(local server)."),
     "convert": (("convert",), "Convert Pyslvs mechanism expressions to mechanism files and back."),
     "export": (("export",), "Export a mechanism: DXF or SVG plates to cut, an SVG drawing at a pose."),
+    "examples": (("examples",), "List the bundled example files by folder, or those a word finds; a name "
+                 "works wherever a file is taken."),
 }
 
 
@@ -123,7 +125,7 @@ def handle_sigterm() -> Any:
 #: run the NumPy pass unless ``MECHSYN_KERNEL`` says otherwise; ``serve``, ``synth`` and
 #: ``curves`` (thousands of sweeps) use the compiled one when Numba is installed.
 ONE_SHOT = frozenset({"analyze", "schema", "structure", "simulate", "forces", "capability", "atlas", "belt",
-                      "convert", "export"})
+                      "convert", "export", "examples"})
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -133,13 +135,45 @@ def main(argv: list[str] | None = None) -> int:
     143 and ``terminated`` (searches have written their best result so far, marked as
     interrupted, before that).
     """
-    pass_ = _pass_for(argv)  # its imports (NumPy) before the handlers: not cut in half by a signal
-    previous = handle_sigterm()
     try:
-        return _main(argv, pass_)
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        pass_ = _pass_for(argv)  # its imports (NumPy) before the handlers: not cut in half by a signal
+        previous = handle_sigterm()
+        try:
+            return _main(argv, pass_)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+    except (KeyboardInterrupt, Exception) as exc:
+        if not interrupted(exc):
+            raise
+        from mechsyn.cli.common import err_console
+
+        err_console.print("interrupted", highlight=False)
+        return _exit(_INTERRUPTED, argv)
+
+
+def interrupted(exc: BaseException | None) -> bool:
+    """``exc`` is a KeyboardInterrupt or was raised while one was handled: Ctrl-C during a
+    lazy import can surface as a RuntimeError or an ImportError whose cause or context is it.
+
+    Examples
+    --------
+    >>> try:
+    ...     try:
+    ...         raise KeyboardInterrupt
+    ...     except KeyboardInterrupt as ki:
+    ...         raise RuntimeError("module failed to import") from ki
+    ... except RuntimeError as err:
+    ...     interrupted(err), interrupted(RuntimeError("a bug"))
+    (True, False)
+    """
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _pass_for(argv: list[str] | None) -> Any:

@@ -446,21 +446,38 @@ def _fmt(x: float | None) -> str:
     return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
-def _formula_table(a: StructuralAnalysis, keys: list[str], title: str, rank: Any = None) -> None:
-    from mechsyn.structure.report import explain_negative, formula_title
+#: what the symbols of the formula tables count (the tables' caption, in this order)
+SYMBOLS = {"W": "W: mobility", "K": "K: independent contours", "q": "q, S: redundant constraints",
+           "S": "S: redundant constraints", "p": "scheme check: yes when pairs = links + contours - 1"}
 
-    values = {key: _fmt(a.formulas[key].value) for key in keys}
-    t = Table(title=title, show_lines=False)
+
+def _formula_table(a: StructuralAnalysis, keys: list[str], title: str, rank: Any = None) -> None:
+    from mechsyn.structure.report import formula_reasons, formula_title, formula_value_text
+
+    values = {key: formula_value_text(key, a.formulas[key].value) for key in keys}
+    symbols = {a.formulas[k].expression.split(" ", 1)[0] for k in keys}
+    if "S" in symbols and "q" in symbols:
+        symbols.discard("S")
+    elif "S" in symbols:
+        symbols.discard("q")
+    caption = "; ".join(text for s, text in SYMBOLS.items() if s in symbols)
+    t = Table(title=title, show_lines=False, caption=caption or None, caption_justify="left")
     t.add_column("formula", no_wrap=True)
     t.add_column("expression", overflow="fold")  # the long expressions wrap, numbers never do
     t.add_column("value", justify="right", no_wrap=True, min_width=max(map(len, ["value", *values.values()])))
     for key in keys:
         t.add_row(formula_title(SHORT_TITLES.get(key, key), a.formulas[key]), a.formulas[key].expression, values[key])
     console.print(t)
-    for key in keys:
-        why = explain_negative(key, a, rank)
-        if why:
-            note(f"{SHORT_TITLES.get(key, key)}: {why}")
+    for why, ks in formula_reasons(a, keys, rank):
+        note(f"{', '.join(SHORT_TITLES.get(k, k) for k in ks)}: {why}", "differs:")
+
+
+def _summary_line(line: dict[str, Any]) -> None:
+    """A line under the formula tables: what it counts, its value, the reason it differs."""
+    console.print(escape("\n".join(wrap_lines(f"{line['label']}: {line['text']}", "", "  "))), highlight=False,
+                  soft_wrap=True)
+    if line["why_it_differs"]:
+        note(line["why_it_differs"], "  differs:")
 
 
 def note(text: str, label: str = "note:") -> None:
@@ -482,21 +499,25 @@ def wrap_lines(text: str, first: str = "", rest: str = "") -> list[str]:
                          break_on_hyphens=False)
 
 
-def render(a: StructuralAnalysis, title_prefix: str = "", rank: Any = None, verdict_text: str | None = None) -> None:
+def render(a: StructuralAnalysis, title_prefix: str = "", rank: Any = None, verdict_text: str | None = None,
+           drives_text: str | None = None) -> None:
     """``mechsyn analyze``: the verdict, the formulas of the file's own kind, then (planar
     files) their spatial reading with paper 003's contours, redundancy and drives."""
-    from mechsyn.structure.report import CONTOUR_READING, READINGS, SPATIAL_OF_PLANAR, formula_sections
+    from mechsyn.structure.report import READINGS, SPATIAL_OF_PLANAR, formula_sections, formula_summary
 
     pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
     head = (f"[bold]{title_prefix}{safe(a.name)}[/]\n{a.kind} mechanism: n = {a.moving_links} moving links "
             f"(N = {a.links_with_frame}), {a.pairs} pairs ({pbc}), K = {a.independent_contours} contours")
     if verdict_text:
         head += f"\n[bold]verdict:[/] {escape(verdict_text)}"
+    if drives_text:
+        head += f"\n[bold red]drives:[/] {escape(drives_text)}"
     console.print(Panel(head, expand=False))
     own, spatial = formula_sections(a)
     _formula_table(a, own, f"Formulas ({READINGS['planar' if a.kind == 'planar' else 'spatial']})", rank)
-    console.print(f"[bold]W = {_fmt(a.mobility)}[/] ({escape(a.mobility_source)})", highlight=False)
-    console.print(f"drives: {escape(a.degrees_of_mobility_expression)}", highlight=False)
+    summary = formula_summary(a, rank)
+    _summary_line(summary["mobility"])
+    _summary_line(summary["drives"])
     if spatial:
         console.print()
         console.print(f"[bold]{SPATIAL_OF_PLANAR[0]}[/]", highlight=False)
@@ -504,10 +525,8 @@ def render(a: StructuralAnalysis, title_prefix: str = "", rank: Any = None, verd
         _formula_table(a, spatial, "Formulas (spatial reading)", rank)
     if a.contours:
         _render_contours(a)
-    console.print(
-        f"S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} ({a.redundant_constraints} redundant constraints, "
-        f"{a.idle_mobilities} idle mobilities);  G_Σ = {_fmt(a.constructive_redundancy)} "
-        f"(metric {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})", highlight=False)
+    if a.contours:
+        _summary_line(summary["redundancy"])
     if a.external is not None:
         e = a.external
         console.print(f"external (paper 002): S_a = {e.S_a}, W_f = {e.W_f}, W_rob = {e.W_rob}, "
@@ -605,11 +624,14 @@ def render_remedy_checks(checks: list[tuple[int, Remedy, RemedyCheck]]) -> None:
 def render_report(report: StructureReport) -> None:
     """The terminal tables of a structural report."""
     ra, method = report.rank, report.method
+    v = report.verdict
+    drives = v["over_actuation"]
+    text = v["text"].removesuffix(f". {drives}") if drives else v["text"]  # said on a line of its own
     if method != "rank":
-        render(report.analysis, rank=ra, verdict_text=report.verdict["text"])
+        render(report.analysis, rank=ra, verdict_text=text, drives_text=drives)
     else:
-        console.print(Panel(f"[bold]{safe(report.analysis.name)}[/]\n[bold]verdict:[/] "
-                            f"{escape(report.verdict['text'])}", expand=False))
+        console.print(Panel(f"[bold]{safe(report.analysis.name)}[/]\n[bold]verdict:[/] {escape(text)}"
+                            + (f"\n[bold red]drives:[/] {escape(drives)}" if drives else ""), expand=False))
     for n in report.notes:
         note(n)
     if ra is not None:

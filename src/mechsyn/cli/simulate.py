@@ -9,6 +9,7 @@ References
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -17,7 +18,7 @@ import typer
 from mechsyn.cli.app import app
 from mechsyn.cli.common import (check_animation_target, check_output_suffix, emit_json, is_stdout, one_stdout,
                                 parse_range, progress_bar, save_animation, save_plot, write_output)
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, OverActuatedError
 from mechsyn.io import load_mechanism
 
 InputOpt = Annotated[list[str], typer.Option(
@@ -61,6 +62,18 @@ def _parse_inputs(items: list[str]) -> dict[str, np.ndarray]:
     return out
 
 
+@contextmanager
+def _over_actuation_in_cli_words(inputs: dict[str, np.ndarray]):
+    """The library's over-actuation error with the command line's fix: ``--input`` for the
+    drive in excess, or drop its ``actuated: true``."""
+    try:
+        yield
+    except OverActuatedError as err:
+        held = ", ".join(d for d in err.check.excess if d not in inputs)
+        raise MechsynInputError(err.check.text(f"give --input for {held} or drop `actuated: true` on {held}"),
+                                source=err.source) from None
+
+
 def _parse_pairs(items: list[str] | None, option: str, number: bool) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for item in items or []:
@@ -91,7 +104,10 @@ def _parse_straight(items: list[str] | None) -> dict[str, tuple[float, float]]:
     return out
 
 
-def _check_outputs(plot: Path | None, csv_out: Path | None, json_: bool, animate: Path | None = None) -> None:
+def _check_outputs(plot: Path | None, csv_out: Path | None, json_: bool, animate: Path | None = None,
+                   method: str = "auto") -> None:
+    if method not in ("auto", "assur", "newton"):
+        raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     if animate is not None:
         check_animation_target(animate)
@@ -121,15 +137,14 @@ def simulate_cmd(
     from mechsyn.cli.render import render_simulation
     from mechsyn.kinematics.report import simulation_report
 
-    _check_outputs(plot, csv_out, json_, animate)
-    if method not in ("auto", "assur", "newton"):
-        raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
+    _check_outputs(plot, csv_out, json_, animate, method)
     mech = load_mechanism(file)
     inputs = _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
         return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
-    with progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance:
+    with (_over_actuation_in_cli_words(inputs),
+          progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance):
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
                                    vll=_parse_pairs(vll, "--vll", False), method=method, output=output,
                                    straight=_parse_straight(straight), progress=advance)
@@ -177,9 +192,7 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
 def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
     from mechsyn.kinematics.report import simulation_csv
 
-    if csv_out is not None:
-        write_output(csv_out, simulation_csv(sim))
-    if plot is not None:
+    if plot is not None:  # (first: a range where nothing assembles is refused before any file is written)
         from mechsyn.plot.kinematics import plot_simulation
 
         save_plot(plot, plot_simulation, sim)
@@ -187,6 +200,8 @@ def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], 
         from mechsyn.plot.kinematics import animate_simulation
 
         save_animation(animate, animate_simulation, sim, dpi=100)
+    if csv_out is not None:
+        write_output(csv_out, simulation_csv(sim))
 
 
 @app.command("forces")
@@ -213,14 +228,14 @@ def forces_cmd(
     mech = load_mechanism(file)
     inputs = _parse_inputs(input)
     n = len(next(iter(inputs.values())))
-    with progress_bar("force analysis", n, enabled=n >= 200) as advance:
+    with _over_actuation_in_cli_words(inputs), progress_bar("force analysis", n, enabled=n >= 200) as advance:
         fa = forces(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), gravity=(0.0, -gravity),
                     static=static, vll=_parse_pairs(vll, "--vll", False), method=method, progress=advance)
-    if csv_out is not None:
-        write_output(csv_out, forces_csv(fa))
-    if plot is not None:
+    if plot is not None:  # (first: nothing assembled is refused before any file is written)
         from mechsyn.plot.kinematics import plot_forces
         save_plot(plot, plot_forces, fa)
+    if csv_out is not None:
+        write_output(csv_out, forces_csv(fa))
     if is_stdout(csv_out):
         return
     if json_:

@@ -40,6 +40,7 @@ def synth_curve(
     box = _ground_region(ground_region)
     check_writable(out, "--out", directory=True)
     tgt = read_target(target)
+    _say_first_build(database)
     with _curve_progress() as callback:
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
                                ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
@@ -50,6 +51,17 @@ def synth_curve(
     emit_json(res.to_dict()) if as_json else render_curve_synthesis(res)
     stop_if_interrupted(res)
     _fail_if_empty(res)
+
+
+def _say_first_build(database: Optional[Path]) -> None:
+    """One line on stderr when the curve database is about to be built (its folder is empty
+    or missing): the wait that follows is the build, done once and reused."""
+    from mechsyn.synthesis.curves.database import default_database_dir
+
+    where = database if database is not None else default_database_dir()
+    if not where.is_dir() or not any(where.iterdir()):
+        err_console.print(f"building the curve database on first use (4- and 6-bar curves, once; later runs "
+                          f"reuse it) in {escape(str(where))}", highlight=False, soft_wrap=True)
 
 
 def _fraction(percent: float) -> float:
@@ -90,7 +102,8 @@ def _curve_progress() -> Iterator[Any]:
         def callback(state: dict) -> None:
             best = state.get("best")
             text = f"{100 * best:.2f} %" if isinstance(best, float) and best == best else "-"
-            prog.update(task, description=f"synth curve: {state['stage']}", completed=state.get("done", 0),
+            stage = "building the curve database" if state["stage"] == "build" else state["stage"]
+            prog.update(task, description=f"synth curve: {stage}", completed=state.get("done", 0),
                         total=state.get("total"), best=text)
 
         yield callback

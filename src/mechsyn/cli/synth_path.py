@@ -101,8 +101,10 @@ def _write_path_files(case, res, out: Optional[Path], plot: Optional[Path]) -> N
 
 @synth_app.command("function")
 def synth_function(
-    phi: str = typer.Option(..., "--phi", help="Three crank angles [deg], from the ground line, e.g. 30,60,90."),
-    psi: str = typer.Option(..., "--psi", help="Three rocker angles [deg], e.g. 100,120,135."),
+    phi: str = typer.Option(..., "--phi", help="Three crank angles [deg]: the crank's direction from its frame pivot A, "
+                            "counter-clockwise from the ground line (+x, from A to the rocker's pivot D), e.g. 30,60,90."),
+    psi: str = typer.Option(..., "--psi", help="Three rocker angles [deg]: the rocker's direction from its frame pivot D "
+                            "(D to C), counter-clockwise from the same ground line, e.g. 100,120,135."),
     ground: float = typer.Option(1.0, "--ground", help="Ground link length."),
     as_json: bool = typer.Option(False, "--json", help="Print the result as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write the linkage as a mechanism file."),

@@ -27,7 +27,7 @@ from typing import Any, NamedTuple
 
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["Example", "list", "load", "names", "path", "resolve", "root", "did_you_mean", "missing_hint"]
+__all__ = ["Example", "list", "load", "names", "path", "resolve", "root", "did_you_mean", "missing_hint", "search"]
 
 _SUFFIXES = (".yaml", ".yml", ".json", ".urdf")
 
@@ -130,6 +130,31 @@ def list() -> Catalogue:  # noqa: A001 -- ms.examples.list() reads as the field'
     return out
 
 
+def search(word: str | None = None, folder: str | None = None) -> Catalogue:
+    """The examples whose name, folder, kind or title holds ``word`` (any case), in
+    ``folder`` when given (``kinematics``, ``textbook``...: :func:`list` names them).
+
+    Examples
+    --------
+    >>> [e.name for e in search("bennett")]
+    ['bennett_tilted', 'bennett', 'bennett_4dp']
+    >>> search(folder="nowhere")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: folder: no example folder 'nowhere' (fix: folders: belt, capability, ...)
+    """
+    every = list()
+    folders = sorted({e.folder for e in every})
+    if folder is not None and folder.strip("/") not in folders:
+        close = did_you_mean(folder, folders)
+        raise MechsynInputError(f"no example folder {folder!r}", field="folder",
+                                hint=(f"did you mean {close[0]!r}? " if close else "") + "folders: "
+                                + ", ".join(folders))
+    w = (word or "").lower()
+    return Catalogue(e for e in every if (folder is None or e.folder == folder.strip("/"))
+                     and (not w or any(w in t.lower() for t in (e.name, e.folder, e.kind, e.title))))
+
+
 def did_you_mean(name: str, choices: builtins.list[str] | None = None) -> builtins.list[str]:
     """The example names (or ``choices``) closest to a mistyped ``name``, best first.
 
@@ -149,14 +174,14 @@ def missing_hint(file: str | Path) -> str:
     Examples
     --------
     >>> missing_hint("fourbarr")
-    "did you mean the example 'fourbar'? (mechsyn.examples.names() lists them all)"
+    "did you mean the example 'fourbar'? (`mechsyn examples` lists them all)"
     """
     p = Path(file)
     close = did_you_mean(p.stem) if len(p.parts) == 1 and p.suffix in ("", *_SUFFIXES) else []
     if close:
         return ("did you mean the example " + " or ".join(repr(c) for c in close)
-                + "? (mechsyn.examples.names() lists them all)")
-    return "check the path (mechsyn.examples.names() lists the bundled examples)"
+                + "? (`mechsyn examples` lists them all)")
+    return "check the path (`mechsyn examples` lists the bundled examples)"
 
 
 def names() -> builtins.list[str]:
@@ -194,7 +219,8 @@ def path(name: str) -> Path:
     close = did_you_mean(name)
     raise MechsynInputError(f"no example {name!r}", field="name",
                             hint=(f"did you mean {' or '.join(map(repr, close))}? " if close else "")
-                            + "see mechsyn.examples.names(): e.g. " + ", ".join(names()[:4]))
+                            + "`mechsyn examples` lists them (in Python: mechsyn.examples.names()), e.g. "
+                            + ", ".join(names()[:4]))
 
 
 def resolve(file: str | Path) -> Path:

@@ -1,7 +1,7 @@
 """The plates of :func:`mechsyn.export.plates.link_plates` as a DXF drawing (ezdxf).
 
 Layers: ``OUTLINE`` (closed polylines with arcs, one per plate), ``HOLES`` (circles of
-the cut diameter), ``POINTS`` (small marker circles at named points, to drill or
+the cut diameter), ``SLOTS`` (a slider's guide: closed polylines as wide as a hole), ``POINTS`` (small marker circles at named points, to drill or
 engrave) and ``LABELS`` (text, to engrave or hide). ezdxf is the optional extra
 ``cad``: ``pip install mechsyn[cad]``.
 
@@ -15,8 +15,10 @@ from __future__ import annotations
 import io
 import os
 
+import numpy as np
+
 from mechsyn.errors import MechsynInputError
-from mechsyn.export.plates import PlateLayout
+from mechsyn.export.plates import PlateLayout, plate_outline
 from mechsyn.results import write_atomic
 
 __all__ = ["layout_to_dxf", "write_dxf"]
@@ -39,7 +41,7 @@ def layout_to_dxf(layout: PlateLayout):
     doc = ezdxf.new("R2010")
     if layout.units and layout.units.lower() in _UNITS:
         doc.units = _UNITS[layout.units.lower()]
-    for name, color in (("OUTLINE", 7), ("HOLES", 1), ("POINTS", 3), ("LABELS", 5)):
+    for name, color in (("OUTLINE", 7), ("HOLES", 1), ("SLOTS", 1), ("POINTS", 3), ("LABELS", 5)):
         doc.layers.add(name, color=color)
     msp = doc.modelspace()
     for p in layout.plates:
@@ -47,6 +49,9 @@ def layout_to_dxf(layout: PlateLayout):
                            dxfattribs={"layer": "OUTLINE"})
         for c in p.holes:
             msp.add_circle((float(c[0]), float(c[1])), layout.cut_diameter / 2, dxfattribs={"layer": "HOLES"})
+        for a, b in p.slots:
+            msp.add_lwpolyline([(x, y, 0.0, 0.0, bulge) for x, y, bulge in plate_outline(np.array([a, b]),
+                                layout.cut_diameter / 2)], format="xyseb", close=True, dxfattribs={"layer": "SLOTS"})
         for c in p.markers:
             msp.add_circle((float(c[0]), float(c[1])), layout.cut_diameter / 6, dxfattribs={"layer": "POINTS"})
         msp.add_text(p.label, height=0.4 * layout.width,

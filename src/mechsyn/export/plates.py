@@ -32,7 +32,9 @@ class Plate:
     ``outline`` is a closed polyline of ``(x, y, bulge)`` vertices (DXF LWPOLYLINE
     convention: the bulge ``tan(angle / 4)`` of the arc to the next vertex, 0 for a
     straight side); ``holes`` are the hole centres, named ``hole_names`` (joint ids,
-    then named points in ``markers``).
+    then named points in ``markers``). A slider's guide has ``slots`` (the end centres of
+    slots as wide as a cut hole), its block a rectangular outline along ``block_axis``
+    (:mod:`mechsyn.export.sliders`).
     """
 
     link: str
@@ -44,6 +46,8 @@ class Plate:
     label: str
     label_at: tuple[float, float]
     size: tuple[float, float]
+    slots: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    block_axis: np.ndarray | None = None
 
     def hole_distance(self, a: str, b: str) -> float:
         """Distance between the centres of holes ``a`` and ``b``."""
@@ -53,6 +57,7 @@ class Plate:
     def to_dict(self) -> dict[str, Any]:
         return {"link": self.link, "holes": dict(zip(self.hole_names, self.holes.tolist())),
                 "markers": dict(zip(self.marker_names, self.markers.tolist())),
+                "slots": [[a.tolist(), b.tolist()] for a, b in self.slots],
                 "size": list(self.size), "label": self.label}
 
 
@@ -205,12 +210,13 @@ def link_plates(mech: Mechanism, width: float | None = None, hole_diameter: floa
     links = [n for n in mech.link_names if frame or n != mech.ground]
     width, hole_diameter = _plate_sizes([holes_of[n] for n in links], width, hole_diameter, clearance)
     cut = hole_diameter + clearance
+    slots_of, axis_of = _sliders(mech, holes_of, notes)
     plates: list[Plate] = []
     for n in links:
         if not holes_of[n] and not markers_of[n]:
             notes.append(f"link {n} has no pin or point: no plate")
             continue
-        plates.append(_plate(n, holes_of[n], markers_of[n], cut, width))
+        plates.append(_plate(n, holes_of[n], markers_of[n], cut, width, slots_of.get(n, []), axis_of.get(n)))
     sheet = _shelf_layout(plates, mech, width, width if gap is None else gap, sheet_width)
     return PlateLayout(mech.name, plates, float(width), float(hole_diameter), float(clearance),
                        sheet, mech.attrs.get("units"), notes)
@@ -233,6 +239,28 @@ def _holes_and_markers(mech: Mechanism) -> tuple[dict[str, _Marks], dict[str, _M
     for name, p in mech.points.items():
         markers_of[p.link].append((name, np.asarray(p.at, float)))
     return holes_of, markers_of, notes
+
+
+def _sliders(mech: Mechanism, holes_of: dict[str, _Marks], notes: list[str]
+             ) -> tuple[dict[str, list[tuple[np.ndarray, np.ndarray]]], dict[str, np.ndarray]]:
+    """Each P joint's parts (:func:`~mechsyn.export.sliders.slider_parts`): a pin hole on
+    the block at the slide point, a slot in the guide over the stroke; per link its slots
+    and, for a block, its slide axis (the notes of "not a pin" replaced by what is cut)."""
+    from mechsyn.export.sliders import slider_parts
+
+    slots: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    axes: dict[str, np.ndarray] = {}
+    for part in slider_parts(mech) if any(j.type == "P" for j in mech.joints) else []:
+        notes[:] = [n for n in notes if not n.startswith(f"joint {part.joint} (P)")]
+        if part.slot is None:
+            notes.append(part.note)
+            continue
+        holes_of[part.block].append((part.joint, part.point))
+        slots.setdefault(part.guide, []).append(part.slot)
+        axes.setdefault(part.block, part.axis)
+        notes.append(f"joint {part.joint} (P): {part.block} rides on a pin at {part.joint} in a slot of "
+                     f"{part.guide}, stroke {part.stroke[1] - part.stroke[0]:.6g}")
+    return slots, axes
 
 
 def _plate_sizes(holes: list[_Marks], width: float | None, hole_diameter: float | None,
@@ -264,9 +292,11 @@ def _plate_sizes(holes: list[_Marks], width: float | None, hole_diameter: float 
     return width, hole_diameter
 
 
-def _plate(n: str, hp: _Marks, mk: _Marks, cut: float, width: float) -> Plate:
+def _plate(n: str, hp: _Marks, mk: _Marks, cut: float, width: float,
+           slots: list[tuple[np.ndarray, np.ndarray]] = (), axis: np.ndarray | None = None) -> Plate:
     """Link ``n``'s plate in its own frame (centred, longest direction along x): one hole
-    per pin point, refused when two holes are too close for holes of diameter ``cut``."""
+    per pin point, refused when two holes are too close for holes of diameter ``cut``;
+    its ``slots`` (end centres) and a block's slide ``axis`` carried into the same frame."""
     scale = max(1.0, float(np.abs(np.array([q for _, q in hp + mk])).max()))
     groups: list[tuple[list[str], np.ndarray]] = []
     for jid, q in hp:  # several joints at one point of this link (a shared pin): one hole
@@ -287,9 +317,11 @@ def _plate(n: str, hp: _Marks, mk: _Marks, cut: float, width: float) -> Plate:
                 f"holes of {cut:g} in a plate {width:g} wide", field="hole_diameter",
                 hint="use smaller holes or a narrower plate")
     pts = np.vstack([holes, np.array([q for _, q in mk]).reshape(-1, 2)])
-    R = _rotation_to_x(pts)
-    local = (pts - pts.mean(axis=0)) @ R.T
-    return Plate(n, local[:len(holes)], names, local[len(holes):], [m for m, _ in mk], [], "", (0, 0), (0.0, 0.0))
+    R = _rotation_to_x(pts) if axis is None else _rotation_to_x(np.array([[0.0, 0.0], axis]))  # a block: along x
+    mean = pts.mean(axis=0)
+    local = (pts - mean) @ R.T
+    return Plate(n, local[:len(holes)], names, local[len(holes):], [m for m, _ in mk], [], "", (0, 0), (0.0, 0.0),
+                 [((a - mean) @ R.T, (b - mean) @ R.T) for a, b in slots], None if axis is None else R @ axis)
 
 
 def _shelf_layout(plates: list[Plate], mech: Mechanism, width: float, gap: float,
@@ -299,8 +331,10 @@ def _shelf_layout(plates: list[Plate], mech: Mechanism, width: float, gap: float
     r = width / 2
     sizes = []
     for p in plates:
-        allp = np.vstack([p.holes, p.markers])
-        lo, hi = allp.min(axis=0) - r, allp.max(axis=0) + r
+        p.outline = _outline(p, r)
+        corners = np.array([(x, y) for x, y, _ in p.outline])
+        lo = np.minimum(corners.min(axis=0), np.vstack([p.holes, p.markers]).min(axis=0) - r)
+        hi = np.maximum(corners.max(axis=0), np.vstack([p.holes, p.markers]).max(axis=0) + r)
         sizes.append((lo, hi))
     lengths = [hi[0] - lo[0] for lo, hi in sizes]
     if sheet_width is None:
@@ -317,8 +351,8 @@ def _shelf_layout(plates: list[Plate], mech: Mechanism, width: float, gap: float
         shift = np.array([x, y]) - np.array([lo[0], hi[1]])
         p.holes = p.holes + shift
         p.markers = p.markers + shift
-        allp = np.vstack([p.holes, p.markers])
-        p.outline = plate_outline(allp, r)
+        p.slots = [(a + shift, b + shift) for a, b in p.slots]
+        p.outline = [(float(x + shift[0]), float(y + shift[1]), bulge) for x, y, bulge in p.outline]
         p.size = (float(w), float(h))
         p.label = _label(p, mech)
         p.label_at = (x, y - h - 0.3 * width - label_h)
@@ -327,6 +361,22 @@ def _shelf_layout(plates: list[Plate], mech: Mechanism, width: float, gap: float
         sheet_w = max(sheet_w, x - gap)
     sheet_h = -(y - row_h - 1.5 * label_h) if plates else 0.0
     return float(sheet_w), float(sheet_h)
+
+
+def _outline(p: Plate, r: float) -> list[tuple[float, float, float]]:
+    """A plate's outline: the grown hull of its holes, marks and slot ends; for a slider's
+    block a rectangle along its slide axis round its pins, at least two widths long."""
+    pts = np.vstack([p.holes, p.markers, *[np.array(s) for s in p.slots]])
+    if p.block_axis is None:
+        return plate_outline(pts, r)
+    u = p.block_axis / np.linalg.norm(p.block_axis)
+    nrm = np.array([-u[1], u[0]])
+    along, across = pts @ u, pts @ nrm
+    mid = (along.min() + along.max()) / 2
+    half = max((along.max() - along.min()) / 2 + r, 2 * r)
+    n0, n1 = across.min() - r, across.max() + r
+    corners = [(mid - half, n0), (mid + half, n0), (mid + half, n1), (mid - half, n1)]  # counter-clockwise
+    return [(float(a * u[0] + c * nrm[0]), float(a * u[1] + c * nrm[1]), 0.0) for a, c in corners]
 
 
 def _label(p: Plate, mech: Mechanism) -> str:

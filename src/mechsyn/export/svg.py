@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.export.plates import PlateLayout
+from mechsyn.export.plates import PlateLayout, plate_outline
 
 __all__ = ["plates_svg", "mechanism_svg", "LINK_COLOURS"]
 
@@ -59,7 +59,9 @@ def _outline_path(outline: list[tuple[float, float, float]]) -> str:
         chord = math.hypot(nx - x, ny - y)
         r = chord / (2 * abs(math.sin(theta / 2)))
         large = 1 if abs(theta) > math.pi else 0
-        sweep = 1 if b > 0 else 0  # counter-clockwise in y-up is clockwise on screen
+        # the y flip mirrors the drawing: an arc counter-clockwise in y-up (bulge > 0) runs
+        # the negative-angle way in SVG's y-down frame, sweep-flag 0
+        sweep = 0 if b > 0 else 1
         d.append(f"A {_f(r)} {_f(r)} 0 {large} {sweep} {_f(nx)} {_f(ny)}")
     d.append("Z")
     return " ".join(d)
@@ -67,7 +69,7 @@ def _outline_path(outline: list[tuple[float, float, float]]) -> str:
 
 def plates_svg(layout: PlateLayout, labels: bool = True) -> str:
     """The plates of :func:`mechsyn.export.plates.link_plates` as SVG (cut lines in black,
-    holes in red, point marks in green, labels in blue for engraving or hiding), sized in
+    holes and a slider guide's slots in red, point marks in green, labels in blue for engraving or hiding), sized in
     the file's ``units`` (mm when it names none) so a cutter imports it at scale.
 
     Examples
@@ -90,6 +92,8 @@ def plates_svg(layout: PlateLayout, labels: bool = True) -> str:
         body.append(f'<path stroke="#000" d="{_outline_path(p.outline)}"/>')
         for c in p.holes:
             body.append(f'<circle stroke="#d00" cx="{_f(c[0])}" cy="{_f(-c[1])}" r="{_f(layout.cut_diameter / 2)}"/>')
+        for a, b in p.slots:  # a slider's guide: a slot as wide as a hole, cut like one
+            body.append(f'<path stroke="#d00" d="{_outline_path(plate_outline(np.array([a, b]), layout.cut_diameter / 2))}"/>')
         for c in p.markers:
             body.append(f'<circle stroke="#080" cx="{_f(c[0])}" cy="{_f(-c[1])}" r="{_f(layout.cut_diameter / 6)}"/>')
         if labels:

@@ -27,7 +27,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.engines import _INDEX, PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, _topology, decompose
-from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
+from mechsyn.kinematics.solve import assemble, drawn_checks, require_drives_given, singular_configuration
 from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep
@@ -284,6 +284,7 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
                                 field="change_points", hint="keep the drawn branch (change_points='keep')")
     if plan is not None and not drawn_checks(S, plan):
         assemble(S)  # checks the file configuration and the mobility
+    require_drives_given(S, spec.names)  # a drive in excess held still: nothing would assemble
     sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
     ok = sw.assembled
     complete = sw.links is not None and sw.rates_ok is None

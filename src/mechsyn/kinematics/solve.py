@@ -19,12 +19,13 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import MechsynInputError, OverActuatedError
 from mechsyn.kinematics.groups import _topology, decompose
 from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
+from mechsyn.structure.drives import DriveCheck, excess_drives
 
 __all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton", "drawn_checks"]
 
@@ -113,6 +114,45 @@ def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
     rank = int(np.sum(sv > tol))
     return {"unknowns": S.n, "equations": S.m, "rank": rank, "free": S.n - rank,
             "redundant": S.m - rank}
+
+
+def drive_check(S: PlanarSystem, given: tuple = ()) -> DriveCheck | None:
+    """The drivers of ``S`` against its mobility at the drawn configuration (None there when
+    it is singular: the rank at a dead point is not the mechanism's): the drivers given an
+    input (``given``, in order) are taken first, then the others in the file's order; a
+    driver whose rate the ones before it fix is in excess (:func:`excess_drives` on the
+    drivers' rows of ``Phi_q`` times a basis of the motions its other rows allow)."""
+    key = ("drive check", given)
+    if key in S.cache:
+        return S.cache[key]
+    out = None
+    if S.drivers and not singular_configuration(S):
+        J = S.unit_jacobian(S.jacobian(S.q0[None])[0])
+        B = S.input_matrix()
+        closure = ~np.any(B != 0, axis=1)
+        sv_all = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
+        tol = 1e-9 * max(1.0, float(sv_all.max()) if sv_all.size else 1.0)
+        _, s, vt = np.linalg.svd(J[closure], full_matrices=True)
+        motions = vt[int(np.sum(s > tol)):].T  # the rates every loop closure allows
+        names = [d.joint for d in S.drivers]
+        rows = {d: list(np.flatnonzero(B[:, k] != 0)) for k, d in enumerate(names)}
+        order = [d for d in given if d in rows] + [d for d in names if d not in given]
+        out = DriveCheck(names, motions.shape[1], excess_drives(J @ motions, rows, order, tol), "kinematics")
+    S.cache[key] = out
+    return out
+
+
+def require_drives_given(S: PlanarSystem, given: tuple) -> None:
+    """Raise :class:`~mechsyn.errors.OverActuatedError` when a driver without an input is in
+    excess (:func:`drive_check`): held at its drawn value, it would stop every other drive."""
+    if len(S.drivers) <= len(given):
+        return
+    check = drive_check(S, tuple(given))
+    idle = [d for d in (check.excess if check else []) if d not in given]
+    if idle:
+        names = ", ".join(idle)
+        raise OverActuatedError(check.text(f"give {names} an input too, or drop `actuated: true` on {names}"),
+                                check=check, source=S.mech.source or None, field="inputs")
 
 
 def generic_free(S: PlanarSystem, q: np.ndarray | None = None, trials: int = 3) -> int:

@@ -197,9 +197,21 @@ def plot_paths(sim: Any, ax: Any = None) -> Any:
     return ax
 
 
+def assembled_rows(sim: Any, what: str) -> np.ndarray:
+    """The rows of ``sim`` where the mechanism is assembled; a
+    :class:`~mechsyn.errors.MechsynInputError` when there is none (nothing to ``what``)."""
+    idx = np.flatnonzero(sim.assembled)
+    if len(idx) == 0:
+        raise MechsynInputError(f"nothing to {what}: the mechanism is not assembled at any input",
+                                hint="widen the input range, or start it inside the working range")
+    return idx
+
+
 def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
     """Four panels: mechanism and point paths; point speeds; point accelerations; link
-    angular velocities, over the input. Returns the Figure."""
+    angular velocities, over the input. Returns the Figure; a
+    :class:`~mechsyn.errors.MechsynInputError` when no input is assembled."""
+    assembled_rows(sim, "plot")
     x, xlabel = _input_axis(sim)
     fig = figure(fig, (12, 9))
     axs = fig.subplots(2, 2)
@@ -237,8 +249,9 @@ def plot_simulation(sim: Any, fig: Any = None, title: str | None = None) -> Any:
 
 def plot_forces(fa: Any, fig: Any = None, title: str | None = None) -> Any:
     """Reaction magnitudes in every joint and the balancing efforts, over the input.
-    Returns the Figure."""
+    Returns the Figure; a :class:`~mechsyn.errors.MechsynInputError` when no input is assembled."""
     sim = fa.simulation
+    assembled_rows(sim, "plot")
     x, xlabel = _input_axis(sim)
     fig = figure(fig, (13, 5))
     axs = fig.subplots(1, 2)
@@ -346,10 +359,7 @@ def animate_simulation(sim: Any, fig: Any = None, max_frames: int = 90, interval
     """
     from mechsyn.plot.animation import MechanismAnimation
 
-    idx = np.flatnonzero(sim.assembled)
-    if len(idx) == 0:
-        raise MechsynInputError("nothing to animate: the mechanism is not assembled at any input",
-                                hint="widen the input range")
+    idx = assembled_rows(sim, "animate")
     frames = idx[np.unique(np.linspace(0, len(idx) - 1, min(max_frames, len(idx))).astype(int))]
     fig = figure(_bare_figure() if fig is None and bare else fig, (6.4, 5.6))
     ax = fig.add_subplot()

@@ -257,10 +257,10 @@ def analyze_structure(mech: Mechanism, _with_states: bool = True) -> StructuralA
     g_sum = t_sum + z_sum
     forms = _mobility_formulas(mech, pbc, K, s_sum, g_sum)
     if planar:
-        mobility, source = forms["chebyshev"].value, "chebyshev"
+        mobility, source = forms["chebyshev"].value, "Chebyshev's formula (planar reading)"
     else:
         mobility = forms["somov_malyshev"].value
-        source = "somov_malyshev (paper 003: W = 6n - Σ i·p_i + S_Σ + G_Σ)"
+        source = "Somov-Malyshev's formula with paper 003's contour counts (W = 6n - Σ i·p_i + S_Σ + G_Σ)"
     h, h_ex, h_expr = _degrees_of_mobility(n, K, rows)
     actuated = [j.id for j in mech.actuated_joints]
     notes = _notes(mech, forms, rows, from_file, K, h, h_ex, mobility)
@@ -348,7 +348,8 @@ def _notes(mech: Mechanism, forms: dict[str, F.Formula], rows: list, from_file: 
     red = sum(r.redundant_constraints for r in rows)
     s_sum = sum(r.S for r in rows)
     if idle and red:
-        notes.append(f"S_Σ = {s_sum} nets {red} redundant constraint(s) against {idle} idle mobility(ies).")
+        notes.append(f"S_Σ = {s_sum} nets {red} redundant constraint{'s' if red != 1 else ''} against {idle} "
+                     f"idle mobilit{'y' if idle == 1 else 'ies'}.")
     notes += _ozol_notes(mech, forms, rows)
     planar = mech.kind == "planar"
     if planar and forms["chebyshev"].value is not None and forms["chebyshev"].value <= 0 and K:
@@ -356,7 +357,8 @@ def _notes(mech: Mechanism, forms: dict[str, F.Formula], rows: list, from_file: 
                      f"geometry is special (e.g. parallel links).")
     actuated = [j.id for j in mech.actuated_joints]
     if actuated and isinstance(mobility, (int, float)) and len(actuated) != h:
-        notes.append(f"{len(actuated)} drive(s) declared ({', '.join(actuated)}); the formulas give H = {h}.")
+        notes.append(f"{len(actuated)} drive{'s' if len(actuated) != 1 else ''} declared ({', '.join(actuated)}); "
+                     f"paper 003's rule gives H = {h}.")
     return notes
 
 

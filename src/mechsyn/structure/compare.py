@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.model.mechanism import Joint, Mechanism
+from mechsyn.results import counted
 from mechsyn.structure.rank import RankAnalysis, analyze_rank, rank_summary_lines
 from mechsyn.structure.screws import _E, InsufficientGeometry, _pad3, _unit
 
@@ -72,7 +73,7 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
     idle = len(ra.idle_mobilities)
     planar = ra.motion == "planar"
     reasons = _q_reasons(ra)
-    idle_txt = f"; it includes {idle} idle mobility(ies): {_idle_words(ra)}" if idle else ""
+    idle_txt = f"; it includes {counted(idle, 'idle mobility', 'idle mobilities')}: {_idle_words(ra)}" if idle else ""
     main = (("chebyshev", "Chebyshev W = 3n - 2p5 - p4 (planar)") if planar
             else ("malyshev", "Malyshev W = 6n - Σ i·p_i (spatial)"))
     f = fa.formulas.get(main[0])
@@ -93,8 +94,9 @@ def compare_with_formulas(fa: Any, ra: RankAnalysis) -> list[Comparison]:
                 why = "agree: the per-contour S_Σ + G_Σ matches the redundant constraints the rank method finds"
             elif w == u:
                 why = (f"W equals the useful mobility {u}: S_Σ = {fa.structural_redundancy} nets "
-                       f"{s_idle} idle mobility(ies) against redundant constraints; the rank method counts "
-                       f"{q} redundant constraint(s) and {idle} idle mobility(ies) apart (m = {m} = {u} + {idle})")
+                       f"{counted(s_idle, 'idle mobility', 'idle mobilities')} against redundant constraints; the "
+                       f"rank method counts {counted(q, 'redundant constraint')} and "
+                       f"{counted(idle, 'idle mobility', 'idle mobilities')} apart (m = {m} = {u} + {idle})")
             else:
                 bad = []
                 for rc, fc in zip(ra.contours, fa.contours):
@@ -274,7 +276,7 @@ def check_remedy(original: Mechanism, variant: Mechanism, base: RankAnalysis, me
     elif score[0]:
         why.append(f"the drives at {', '.join(r.actuated)} no longer determine the motion")
     if score[1]:
-        why.append(f"leaves {len(r.idle_mobilities)} idle mobility(ies): {_idle_words(r)}")
+        why.append(f"leaves {counted(len(r.idle_mobilities), 'idle mobility', 'idle mobilities')}: {_idle_words(r)}")
     if score[2]:
         locs = "; ".join(f"contour {c.index}: {', '.join(c.directions)}" for c in r.contours if c.redundant)
         why.append(f"leaves {r.redundant_constraints} redundant constraint(s) ({locs})")

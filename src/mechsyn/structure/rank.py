@@ -64,6 +64,7 @@ import numpy as np
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.structure.contours import independent_contours
+from mechsyn.structure.drives import excess_drives
 from mechsyn.structure.finite import LocalMobility, local_mobility
 from mechsyn.structure.idle import IdleInputs, IdleMobility, find_idle_mobilities
 from mechsyn.structure.screws import (  # noqa: F401  (re-exported: the names users import from here)
@@ -150,6 +151,7 @@ class RankAnalysis:
     shaky: bool = False
     configuration: str = "not checked"
     mobility_reading: str = ""
+    excess_drives: list[str] = field(default_factory=list)
 
     @property
     def redundant_by_contour(self) -> list[int]:
@@ -170,7 +172,8 @@ class RankAnalysis:
             "singular": self.singular, "tolerance": self.tolerance,
             "finite_mobility": self.finite_mobility, "motion": self.motion,
             "contours": [c.to_dict() for c in self.contours], "actuated": self.actuated,
-            "actuation_note": self.actuation_note, "length_scale": self.length_scale,
+            "actuation_note": self.actuation_note, "excess_drives": self.excess_drives,
+            "length_scale": self.length_scale,
             "pair_freedoms": self.pair_freedoms, "equations": self.equations, "rank": self.rank,
             "smallest_singular_values": self.smallest_singular_values,
             "near_singular": self.near_singular, "notes": self.notes,
@@ -576,7 +579,7 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     idle, _, idle_notes = find_idle_mobilities(_idle_inputs(mech, sysm, N, Z0), tol) if mobility else ([], None, [])
     notes.extend(idle_notes)
     useful = mobility - len(idle)
-    determined, anote = _actuation(sysm, N, Z0, acols, anames, len(idle), tol)
+    determined, anote, excess = _actuation(sysm, N, Z0, acols, anames, len(idle), tol)
     lm = LocalMobility(0, 0, "regular", 0, red.rank) if mobility == 0 else \
         LocalMobility(mobility, None, "not checked", None, None)
     if check_singular and mobility > 0:
@@ -586,7 +589,7 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     return RankAnalysis(
         motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
         idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
-        actuated=anames, actuation_determined=determined, actuation_note=anote,
+        actuated=anames, actuation_determined=determined, actuation_note=anote, excess_drives=excess,
         singular=lm.configuration == "singular", shaky=lm.configuration == "shaky", configuration=lm.configuration,
         mobility_reading=mobility_reading(lm.configuration, mobility, lm.finite), finite_mobility=lm.finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
         equations=lam * K, rank=red.rank, smallest_singular_values=sorted(float(x) for x in sv)[: min(4, len(sv))],
@@ -638,25 +641,25 @@ def _contour_ranks(sysm: _System, red: _Reduction, tol: float) -> list[ContourRa
 
 
 def _actuation(sysm: _System, N: np.ndarray, Z0: np.ndarray, acols: list[int], anames: list[str], idle: int,
-               tol: float) -> tuple[bool | None, str]:
+               tol: float) -> tuple[bool | None, str, list[str]]:
     """Whether the drives determine the motion (every motion left with them at rest is
-    idle), and the sentence that says so."""
+    idle), the sentence that says so, and the drives in excess (:func:`excess_drives`)."""
     if not anames:
-        return None, ""
+        return None, "", []
     mobility = N.shape[1]
     uncontrolled = Z0.shape[1] - idle
     if uncontrolled:
         return False, (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
-                       f"{mobility - idle} drive(s) needed")
-    ra = _rank(N[acols], tol) if mobility else 0
-    if ra < len(acols):
-        locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
-                  and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
-        return True, (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
-                      "are not independent (redundant actuation: the drives fight each other)"
+                       f"{mobility - idle} drive(s) needed"), []
+    rows = {name: [c for c in acols if sysm.joints[int(sysm.col_joint[c])].id == name] for name in anames}
+    excess = excess_drives(N, rows, anames, tol) if mobility else list(anames)
+    if excess:
+        locked = [d for d in excess if np.max(np.abs(N[rows[d]]), initial=0.0) <= tol] if mobility else []
+        return True, (f"the drives at {', '.join(anames)} determine the motion but {len(excess)} of them "
+                      f"({', '.join(excess)}) {'is' if len(excess) == 1 else 'are'} not independent (redundant actuation: the drives fight each other)"
                       + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
-                         if locked else ""))
-    return True, f"the drives at {', '.join(anames)} determine the motion"
+                         if locked else "")), excess
+    return True, f"the drives at {', '.join(anames)} determine the motion", []
 
 
 def _local(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, contours: list[ContourRank],

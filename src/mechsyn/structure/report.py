@@ -27,9 +27,11 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.model.mechanism import Mechanism
 from mechsyn.results import to_jsonable
 from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
+from mechsyn.structure.drives import DriveCheck, drive_check_of_formulas
 from mechsyn.structure.remedies import Remedy, find_remedies
 
-__all__ = ["StructureReport", "analyze", "to_markdown", "verdict", "formula_sections", "explain_negative"]
+__all__ = ["StructureReport", "analyze", "to_markdown", "verdict", "formula_sections", "explain_negative",
+           "drive_check", "why_it_differs", "formula_summary", "formula_reasons", "FORMULA_COUNTS"]
 
 FORMULA_TITLES = {
     "chebyshev": "Chebyshev (planar)",
@@ -85,17 +87,154 @@ def explain_negative(key: str, a: StructuralAnalysis, rank: Any = None) -> str |
         return None
     v = _fmt(f.value)
     if key in ("ozol_redundant", "redundant_from_mobility"):
-        exact = (f"; the rank method's instantaneous mobility is {rank.mobility} ({rank.useful_mobility} useful "
-                 f"+ {len(rank.idle_mobilities)} idle) and {rank.redundant_constraints} redundant constraints"
-                 if rank is not None else "")
-        return (f"{v} < 0: a count of redundant constraints is never negative for the true mobility, so the "
-                f"W = {_fmt(_used_mobility(a))} put into it is below the mechanism's instantaneous mobility "
-                f"(idle mobilities count there){exact}.")
+        w = _fmt(_used_mobility(a))
+        if rank is not None:
+            return (f"{v} < 0: it is given W = {w}, below the instantaneous mobility {rank.mobility} ({rank.useful_mobility} "
+                    f"useful + {len(rank.idle_mobilities)} idle); with that W it gives {rank.redundant_constraints}.")
+        return (f"{v} < 0: a count of redundant constraints is never negative, so the W = {w} put into it is below "
+                "the mechanism's instantaneous mobility (idle mobilities count there).")
     if a.kind == "planar" and getattr(f, "reading", "") == "spatial":
         return (f"W = {v} < 0 in the spatial reading: a planar loop repeats 3 of its 6 closure conditions and "
                 "this count takes them as independent; the planar mechanism still moves (see the verdict).")
     return (f"W = {v} < 0: the formula takes every pair's constraints as independent; some repeat (redundant "
             "constraints), so it does not mean the mechanism cannot move (see the verdict).")
+
+
+#: what each formula counts, in plain words (the first column of its row)
+FORMULA_COUNTS = {
+    "chebyshev": "mobility", "grubler": "mobility", "malyshev": "mobility", "somov_malyshev": "mobility",
+    "gokhman_contours": "independent contours", "scheme_check": "consistency",
+    "ozol_redundant": "redundant constraints", "redundant_from_mobility": "redundant constraints",
+}
+
+
+def formula_value_text(key: str, value: Any) -> str:
+    """A formula's value as printed: ``yes``/``no`` for the scheme check, else the number."""
+    if value is None:
+        return "n/a"
+    if key == "scheme_check":
+        return "yes" if value else "no"
+    return _fmt(value)
+
+
+def why_it_differs(key: str, a: StructuralAnalysis, rank: Any = None) -> str | None:
+    """One plain sentence on why formula ``key`` differs from the verdict's exact answer
+    (None when it agrees, counts topology only, or nothing exact is known to compare with:
+    no rank method, except for the spatial reading of a planar file).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> r = ms.analyze(ms.examples.load("delta"))
+    >>> why_it_differs("somov_malyshev", r.analysis, r.rank)[:61]
+    "It corrects the count by paper 003's contour by contour tally"
+    >>> why_it_differs("chebyshev", ms.analyze(ms.examples.load("fourbar")).analysis) is None
+    True
+    """
+    f = a.formulas[key]
+    reading = getattr(f, "reading", "")
+    planar_as_3d = a.kind == "planar" and reading == "spatial"
+    if f.value is None or reading == "topology" or (rank is None and not planar_as_3d):
+        return None
+    negative = explain_negative(key, a, rank)
+    if negative:
+        return negative[0].upper() + negative[1:]
+    if FORMULA_COUNTS.get(key) == "mobility":
+        exact = rank.useful_mobility if rank is not None else a.mobility
+        if f.value == exact:
+            return None
+        if planar_as_3d:
+            return (f"It counts the links as free in 3-D, where each planar loop repeats 3 out-of-plane "
+                    f"conditions; the planar mechanism's mobility is {_fmt(exact)} (the verdict).")
+        q, idle = rank.redundant_constraints, len(rank.idle_mobilities)
+        if key == "somov_malyshev":
+            return (f"It corrects the count by paper 003's contour by contour tally, which assumes each contour's "
+                    f"joints in general position; from the actual axes the rank method finds {q} redundant "
+                    f"constraint{_s(q)} and {idle} idle motion{_s(idle)}, so the mobility is {exact}.")
+        parts = ([f"{q} constraint{_s(q)} repeat{'s' if q == 1 else ''} others"] if q else []) + (
+            [f"{idle} motion{_s(idle)} {'is' if idle == 1 else 'are'} idle (a link spinning in place)"] if idle else [])
+        return (f"It takes every joint's constraints as independent and every motion as useful; here "
+                f"{' and '.join(parts)}, so the mobility is {exact}.")
+    if FORMULA_COUNTS.get(key) == "redundant constraints" and rank is not None:
+        if f.value == rank.redundant_constraints:
+            return None
+        return (f"It is given W = {_fmt(_used_mobility(a))}; with the exact instantaneous mobility "
+                f"{rank.mobility} (idle motions included) it gives {rank.redundant_constraints}.")
+    return None
+
+
+def _s(n: Any) -> str:
+    return "" if n == 1 else "s"
+
+
+def formula_summary(a: StructuralAnalysis, rank: Any = None) -> dict[str, dict[str, Any]]:
+    """The lines below the formula tables, each labelled by what it counts, with the reason
+    for any disagreement with the verdict's exact answer (``why_it_differs``, None when
+    they agree): ``mobility`` (the formulas' W), ``drives`` (paper 003's H) and
+    ``redundancy`` (paper 003's per-contour S_Σ and G_Σ).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> s = formula_summary(ms.analyze(ms.examples.load("fourbar")).analysis)
+    >>> s["redundancy"]["label"]
+    'redundant constraints per contour (paper 003), counted as a 3-D build'
+    >>> s["redundancy"]["why_it_differs"][:47]
+    'A planar loop repeats 3 out-of-plane conditions'
+    """
+    planar = a.kind == "planar"
+    v = verdict(a, rank)
+    main = "chebyshev" if planar else "somov_malyshev"
+    out = {"mobility": {
+        "counts": "mobility", "value": a.mobility, "text": f"W = {_fmt(a.mobility)}",
+        "label": "mobility by the formulas (" + ("Chebyshev, planar reading)" if planar else
+                                                  "Somov-Malyshev, paper 003)"),
+        "why_it_differs": why_it_differs(main, a, rank)}}
+    h = a.degrees_of_mobility
+    ex = (f" (reading by exclusive links: {a.degrees_of_mobility_exclusive})"
+          if a.degrees_of_mobility_exclusive != h else "")
+    out["drives"] = {"counts": "drives", "value": h, "text": a.degrees_of_mobility_expression + ex,
+                     "label": "drives by paper 003's rule (links per contour)",
+                     "why_it_differs": None if rank is None or rank.useful_mobility == h else (
+                         f"The rule counts links per contour, not the joints' axes; from the geometry the rank "
+                         f"method needs {rank.useful_mobility} drive{_s(rank.useful_mobility)}.")}
+    q, idle = v["redundant_constraints"], v["idle_mobilities"]
+    why = None
+    if planar and a.contours and q is not None and a.redundant_constraints != q:
+        why = (f"A planar loop repeats 3 out-of-plane conditions that a 3-D build must hold (parallel axes), and "
+               f"this count takes them as redundant; the planar mechanism has {_fmt(q)} (the verdict).")
+    elif not planar and rank is not None and (a.redundant_constraints, a.idle_mobilities) != (q, idle):
+        why = (f"Each contour is counted on its own with its joints in general position; from the actual axes the "
+               f"rank method finds {_fmt(q)} redundant constraint{_s(q)} and {idle} idle mobilit"
+               f"{'y' if idle == 1 else 'ies'}.")
+    out["redundancy"] = {
+        "counts": "redundant constraints", "value": a.redundant_constraints,
+        "label": "redundant constraints per contour (paper 003)" + (", counted as a 3-D build" if planar else ""),
+        "text": (f"S_Σ = {a.structural_redundancy} ({a.redundant_constraints} redundant constraint"
+                 f"{_s(a.redundant_constraints)}, {a.idle_mobilities} idle mobilit"
+                 f"{'y' if a.idle_mobilities == 1 else 'ies'}); G_Σ = {_fmt(a.constructive_redundancy)} "
+                 f"(metric constraints {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})"),
+        "why_it_differs": why}
+    return out
+
+
+def drive_check(a: StructuralAnalysis, rank: Any = None) -> DriveCheck:
+    """The declared drives against the mobility: the rank method's independent drives at the
+    drawn pose where it ran, else the formulas' mobility (drives after the first W in excess).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.io import mechanism_from_dict, mechanism_to_dict
+    >>> d = mechanism_to_dict(ms.examples.load("fourbar"))
+    >>> d["joints"][3]["actuated"] = True               # a drive on the rocker's pivot D too
+    >>> r = ms.analyze(mechanism_from_dict(d))
+    >>> drive_check(r.analysis, r.rank).text()
+    '2 drives (A, D) for mobility 1: drop `actuated: true` on D'
+    """
+    if rank is not None:
+        return DriveCheck(list(rank.actuated), int(rank.useful_mobility), list(rank.excess_drives), "rank method")
+    return drive_check_of_formulas(list(a.actuated), a.mobility)
 
 
 def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
@@ -125,7 +264,7 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
                  else " (no idle mobility)")
         out["text"] = (f"mobility {rank.useful_mobility}{split}, {rank.redundant_constraints} redundant "
                        f"constraints, {pose}; from the {out['source']}")
-        return out
+        return _with_drives(out, drive_check(a, rank))
     planar = a.kind == "planar"
     q = a.formulas["ozol_redundant"].value if planar else a.redundant_constraints
     idle = None if planar else a.idle_mobilities
@@ -136,6 +275,15 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
     out["text"] = (f"mobility W = {_fmt(a.mobility)}, {_fmt(q) if q is not None else 'n/a'} redundant "
                    f"constraints, {idle_text}; from the {out['source']}: give each joint's point and axis "
                    "for the exact rank method")
+    return _with_drives(out, drive_check(a, rank))
+
+
+def _with_drives(out: dict[str, Any], check: DriveCheck) -> dict[str, Any]:
+    """The verdict with its ``over_actuation`` line (None when no drive is in excess),
+    also said at the end of its text."""
+    out["over_actuation"] = check.text() or None
+    if check.over_actuated:
+        out["text"] += f". {check.text()}"
     return out
 
 
@@ -155,13 +303,32 @@ def _fmt(x: float) -> str:
 
 
 def _formula_rows(a: StructuralAnalysis, keys: list[str], rank: Any = None) -> list[str]:
-    rows = ["| formula | expression | value |", "|---|---|---|"]
+    rows = ["| counts | formula | expression | value |", "|---|---|---|---|"]
     for key in keys:
         f = a.formulas[key]
-        val = "n/a" if f.value is None else _fmt(f.value)
-        rows.append(f"| {formula_title(FORMULA_TITLES.get(key, key), f)} | `{f.expression}` | {val} |")
-    why = [line for line in (explain_negative(k, a, rank) for k in keys) if line]
+        rows.append(f"| {FORMULA_COUNTS.get(key, '')} | {formula_title(FORMULA_TITLES.get(key, key), f)} | "
+                    f"`{f.expression}` | {formula_value_text(key, f.value)} |")
+    why = [f"{', '.join(formula_title(FORMULA_TITLES.get(k, k), a.formulas[k]) for k in ks)}: {line}"
+           for line, ks in formula_reasons(a, keys, rank)]
     return rows + ([""] + [f"- {line}" for line in why] if why else [])
+
+
+def formula_reasons(a: StructuralAnalysis, keys: list[str], rank: Any = None) -> list[tuple[str, list[str]]]:
+    """The reasons (:func:`why_it_differs`) of the formulas ``keys`` with the formulas each
+    explains, said once; the formulas' own mobility is left to its line below the table
+    (:func:`formula_summary`)."""
+    main = "chebyshev" if a.kind == "planar" else "somov_malyshev"
+    out: dict[str, list[str]] = {}
+    for k in keys:
+        line = why_it_differs(k, a, rank) if k != main else None
+        if line:
+            out.setdefault(line, []).append(k)
+    return list(out.items())
+
+
+def _summary_bullet(line: dict[str, Any]) -> str:
+    why = f" *Differs from the verdict:* {line['why_it_differs']}" if line["why_it_differs"] else ""
+    return f"- {line['label']}: `{line['text']}`.{why}"
 
 
 def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None, level: int = 1,
@@ -171,6 +338,7 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
     h = "#" * level
     pbc = ", ".join(f"p{k} = {v}" for k, v in a.pairs_by_class.items())
     own, spatial = formula_sections(a)
+    summary = formula_summary(a, rank)
     out = [
         f"{h} {a.name}", "",
         f"{a.kind} mechanism: n = {a.moving_links} moving links (N = {a.links_with_frame} with the frame), "
@@ -178,10 +346,7 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
         f"**Verdict**: {verdict(a, rank)['text']}.", "",
         f"{h}# Formulas ({READINGS['planar' if a.kind == 'planar' else 'spatial']})", "",
         *_formula_rows(a, own, rank),
-        "", f"- mobility W = {_fmt(a.mobility)} ({a.mobility_source})",
-        f"- degrees of mobility (drives): `{a.degrees_of_mobility_expression}`"
-        + (f" (reading by exclusive links: {a.degrees_of_mobility_exclusive})"
-           if a.degrees_of_mobility_exclusive != a.degrees_of_mobility else ""),
+        "", _summary_bullet(summary["mobility"]), _summary_bullet(summary["drives"]),
     ]
     if spatial:
         out += ["", f"{h}# {SPATIAL_OF_PLANAR[0]}", "", SPATIAL_OF_PLANAR[1], "", *_formula_rows(a, spatial, rank)]
@@ -194,12 +359,7 @@ def to_markdown(a: StructuralAnalysis, remedies: Sequence[Remedy] | None = None,
             out.append(f"| {r.index}{mark} | {' '.join(r.joints)} | {pair_list(r.new_pairs)} | {r.n_j} | {r.n_k} | "
                        f"{r.S} | {r.idle_mobilities} | {_fmt(r.T)} | {r.Z} | {r.A} |")
         out += [""] + [f"- `{r.S_expression}`; `{r.T_expression}`" for r in a.contours]
-    out += [
-        "", f"- structural redundancy S_Σ = {a.structural_redundancy}{CONTOUR_READING[a.kind]} "
-        f"({a.redundant_constraints} redundant constraints, {a.idle_mobilities} idle mobilities)",
-        f"- constructive redundancy G_Σ = {_fmt(a.constructive_redundancy)} "
-        f"(metric constraints {_fmt(a.metric_constraints)}, redundant links {a.redundant_links})",
-    ]
+    out += ["", _summary_bullet(summary["redundancy"])]
     if a.external is not None:
         e = a.external
         out += ["", f"{h}# External constraints (paper 002)", "",
@@ -272,6 +432,12 @@ class StructureReport(Result):
         return self.analysis.formulas
 
     @property
+    def drive_check(self) -> DriveCheck:
+        """The declared drives against the mobility (:func:`drive_check`): ``.excess``,
+        ``.text()`` the one line of an over-actuated mechanism."""
+        return drive_check(self.analysis, self.rank)
+
+    @property
     def verdict(self) -> dict[str, Any]:
         """The answer first (:func:`verdict`): mobility, useful/idle, redundant constraints, source."""
         return verdict(self.analysis, self.rank)
@@ -298,11 +464,17 @@ class StructureReport(Result):
         data = to_jsonable(self.analysis)
         data["method"] = self.method
         data["verdict"] = self.verdict
+        data["drive_check"] = self.drive_check.to_dict()
         own, spatial = formula_sections(self.analysis)
         data["formula_readings"] = {k: getattr(f, "reading", "") or None for k, f in self.analysis.formulas.items()}
         data["formula_sections"] = {"own": own, "spatial_reading_of_planar": spatial}
         data["formula_explanations"] = {k: e for k in self.analysis.formulas
                                         if (e := explain_negative(k, self.analysis, ra))}
+        for k, f in self.analysis.formulas.items():  # the keys stay; what a user reads is beside them
+            data["formulas"][k].update(
+                label=formula_title(FORMULA_TITLES.get(k, k), f), counts=FORMULA_COUNTS.get(k),
+                value_text=formula_value_text(k, f.value), why_it_differs=why_it_differs(k, self.analysis, ra))
+        data["formula_summary"] = formula_summary(self.analysis, ra)
         data["rank"] = ra.to_dict() if ra is not None else None
         if ra is None and self.rank_unavailable:
             data["rank_unavailable"] = self.rank_unavailable

@@ -132,6 +132,11 @@ def freudenstein_coefficients(phi, psi) -> np.ndarray:
 def freudenstein_synthesis(phi, psi, ground: float = 1.0) -> FunctionSynthesisResult:
     """Four-bar generating ``psi_i = f(phi_i)`` at three positions, verified by simulation.
 
+    Angles (radians) are Freudenstein's: the crank angle ``phi`` is the direction of the
+    crank from its frame pivot A, the rocker angle ``psi`` the direction of the rocker from
+    its frame pivot D (D to C), both counter-clockwise from the ground line, which runs from
+    A to D (the +x axis of the written mechanism file).
+
     With ground ``d``: crank ``a = d / K1``, rocker ``c = d / K2``,
     coupler ``b = sqrt(a^2 + c^2 + d^2 - 2 a c K3)`` (from ``K3 = (a^2 - b^2 + c^2 + d^2)/(2ac)``).
     A negative ``a`` (or ``c``) means the link points the other way: its length is ``|a|``

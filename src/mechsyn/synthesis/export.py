@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn.errors import MechsynInputError
 from mechsyn.io import mechanism_from_dict
 from mechsyn.results import dumps, write_atomic
 from mechsyn.synthesis.fourbar import fourbar_position, rotate
@@ -21,11 +22,25 @@ def fourbar_mechanism_dict(
 
     Joints: ``A`` frame-crank at ``O2`` (actuated), ``B`` crank-coupler, ``C``
     coupler-rocker, ``D`` rocker-frame at ``O4``; the coupler point is ``points.P`` on the
-    coupler (global coordinates in the same configuration).
+    coupler (global coordinates in the same configuration). Raises
+    :class:`~mechsyn.errors.MechsynInputError` (one line) where the four-bar does not
+    assemble at ``theta2``.
+
+    Examples
+    --------
+    >>> fourbar_mechanism_dict(4.0, 1.0, 3.5, 3.0, 0.0)["joints"][1]["point"]
+    [1.0, 0.0]
+    >>> fourbar_mechanism_dict(10.0, 1.0, 2.0, 2.0, 0.0)
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: theta2: the four-bar of ground 10, crank 1, coupler 2, rocker 2 does not assemble at crank angle 0 deg (fix: give a crank angle inside its working range, or lengths where the coupler and rocker can meet)
     """
     pose = fourbar_position(r1, r2, r3, r4, theta2, branch=branch, rcx=rcx, rcy=rcy, x0=x0, y0=y0, theta0=theta0)
     if not bool(pose.assembled):
-        raise ValueError("the four-bar does not assemble at the given crank angle")
+        raise MechsynInputError(
+            f"the four-bar of ground {r1:.6g}, crank {r2:.6g}, coupler {r3:.6g}, rocker {r4:.6g} does not assemble "
+            f"at crank angle {np.degrees(theta2):.6g} deg", field="theta2",
+            hint="give a crank angle inside its working range, or lengths where the coupler and rocker can meet")
     ox, oy = rotate(np.float64(r1), np.float64(0.0), theta0)
     o4 = [float(ox + x0), float(oy + y0)]
 
