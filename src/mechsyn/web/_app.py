@@ -61,6 +61,8 @@ CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' 
 TOKEN_HEADER = "x-mechsyn-token"
 #: Seconds the server waits for each part of a request body.
 BODY_TIMEOUT = 30
+#: Requests (past the Host and token checks) answered at once; 503 beyond.
+MAX_REQUESTS = 200
 
 
 # --------------------------------------------------------------------------- middleware
@@ -74,11 +76,17 @@ def _hostname(host: str) -> str:
 
 
 class Guard:
-    """ASGI middleware: Host check, token on /api/, body size limit, security headers."""
+    """ASGI middleware: Host check, token on /api/, body size limit, security headers, at
+    most :data:`MAX_REQUESTS` requests running at once (503 beyond).
+
+    A request refused (Host, token, size) is answered at once and its connection closed:
+    it never counts against a limit; idle sockets count for nothing here.
+    """
 
     def __init__(self, app: Callable, token: str, allowed_hosts: Iterable[str], max_body: int = MAX_BODY):
         self.app, self.token, self.max_body = app, token, max_body
         self.hosts = {h.lower().strip("[]") for h in allowed_hosts}
+        self.running = 0  # requests (Host and token checked) being answered now
 
     async def __call__(self, scope: dict, receive: Callable, send: Callable) -> None:
         if scope["type"] != "http":
@@ -86,10 +94,19 @@ class Guard:
             return
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
         problem = self._check(scope, headers)
-        if problem is not None:
+        if problem is not None:  # refused before it counts: the connection closed after the answer
+            problem.headers["connection"] = "close"
             await _with_headers(problem, scope)(scope, receive, send)
             return
-        await self.app(scope, self._limited(receive), _secure_send(send, scope))
+        if self.running >= MAX_REQUESTS:
+            await _with_headers(_json_error(503, f"{self.running} requests are running already",
+                                            hint="try again in a moment"), scope)(scope, receive, send)
+            return
+        self.running += 1  # one event loop: no lock needed
+        try:
+            await self.app(scope, self._limited(receive), _secure_send(send, scope))
+        finally:
+            self.running -= 1
 
     def _check(self, scope: dict, headers: dict[str, str]) -> Response | None:
         host = _hostname(headers.get("host", ""))
@@ -435,22 +452,36 @@ def _warm_kernel() -> None:
 
 #: Seconds a client may take to send its request head (and to keep an idle connection).
 HEADER_TIMEOUT = 10
-#: Connections and requests at once; uvicorn answers 503 beyond (descriptors stay free).
-MAX_CONNECTIONS = 200
+#: Connections whose request head has not arrived yet; a new one beyond closes the oldest
+#: (a client sends its head at once: only silent sockets wait, and they hold no slot).
+MAX_PENDING_HEADS = 256
 
 
 def _header_timeout_protocol():
     """uvicorn's h11 protocol closing a connection whose request head has not arrived
     within :data:`HEADER_TIMEOUT` s (uvicorn's own keep-alive timer starts only after a
-    first response: about 1,100 silent connections locked a studio out)."""
+    first response: about 1,100 silent connections locked a studio out), and the oldest
+    such connection when more than :data:`MAX_PENDING_HEADS` wait (their descriptors stay
+    bounded). Nothing counts open sockets: :class:`Guard` counts the requests that run
+    (issue 42: 250 sockets sending a request line only made uvicorn's ``limit_concurrency``
+    answer 503 to the real user)."""
+    from collections import OrderedDict
+
     from uvicorn.protocols.http.h11_impl import H11Protocol
+
+    pending: "OrderedDict[Any, None]" = OrderedDict()  # this server's connections without a head
 
     class Protocol(H11Protocol):
         def connection_made(self, transport: Any) -> None:
             super().connection_made(transport)
             self._head_timer = self.loop.call_later(HEADER_TIMEOUT, self._head_late)
+            pending[self] = None
+            while len(pending) > MAX_PENDING_HEADS:
+                oldest, _ = pending.popitem(last=False)
+                oldest._head_late()
 
         def _head_late(self) -> None:
+            pending.pop(self, None)
             if self.cycle is None and not self.transport.is_closing():
                 self.transport.close()
 
@@ -458,9 +489,11 @@ def _header_timeout_protocol():
             super().handle_events()
             if self.cycle is not None:
                 self._head_timer.cancel()
+                pending.pop(self, None)
 
         def connection_lost(self, exc: Exception | None) -> None:
             self._head_timer.cancel()
+            pending.pop(self, None)
             super().connection_lost(exc)
 
     return Protocol
@@ -469,11 +502,12 @@ def _header_timeout_protocol():
 def server_config(app: Starlette, host: str = "127.0.0.1", port: int = 8765):
     """uvicorn's settings for the studio: the request head within :data:`HEADER_TIMEOUT` s
     (the body: :data:`BODY_TIMEOUT`, in :class:`Guard`), idle connections closed after as
-    long, at most :data:`MAX_CONNECTIONS` at once, one second to finish on exit."""
+    long, no limit on open sockets (requests are counted by :class:`Guard`), one second
+    to finish on exit."""
     import uvicorn
 
     return uvicorn.Config(app, host=host, port=port, log_level="warning", http=_header_timeout_protocol(),
-                          timeout_keep_alive=HEADER_TIMEOUT, limit_concurrency=MAX_CONNECTIONS,
+                          timeout_keep_alive=HEADER_TIMEOUT, limit_concurrency=None,
                           timeout_graceful_shutdown=1, h11_max_incomplete_event_size=64 * 1024)
 
 
