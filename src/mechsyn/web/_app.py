@@ -50,7 +50,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 from mechsyn.web import _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
 from mechsyn.web._jobs import HeavyRunner, JobTable
-from mechsyn.web._routing import _body, _bool, _heavy, _int, _json_error, _need, api
+from mechsyn.web._routing import _body, _bool, _client, _heavy, _int, _json_error, _need, api
 
 log = logging.getLogger("mechsyn.web")
 STATIC = Path(__file__).parent / "static"
@@ -193,7 +193,7 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
 
 
 #: Services run as capped, cancellable worker processes; the others are quick.
-HEAVY = frozenset({"analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
+HEAVY = frozenset({"validate", "analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
                    "simulation_csv", "animation_gif", "atlas", "atlas_mechanism"})
 
 
@@ -325,7 +325,8 @@ async def _synth_start(request: Request) -> Any:
         raise MechsynInputError(f"unknown synthesis kind {kind!r}", field="kind",
                                 hint="one of " + ", ".join(_service.SYNTHESIS_KINDS))
     fn = _service.SYNTHESIS_KINDS[kind][1]
-    return request.app.state.jobs.submit(kind, fn, data).snapshot()
+    state = request.app.state
+    return state.jobs.submit(kind, fn, data, state.heavy, _client(request)).snapshot()
 
 
 @api
@@ -526,6 +527,7 @@ def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> Non
             super().handle_exit(sig, frame)
             app.state.stopping.set()  # event streams end now; other requests get 1 s, then are cancelled
             app.state.jobs.cancel_all()
+            app.state.heavy.stop_all()  # workers killed: their requests answer 503 within the second
 
     try:
         _Server(server_config(app, host, port)).run()

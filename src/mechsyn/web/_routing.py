@@ -20,7 +20,7 @@ from starlette.responses import JSONResponse, Response
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.io.files import check_data_size, loads_json
-from mechsyn.web._jobs import Busy, ClientGone, WorkerCrashed
+from mechsyn.web._jobs import Busy, ClientGone, ServerStopping, TooLong, WorkerCrashed
 
 log = logging.getLogger("mechsyn.web")
 
@@ -47,6 +47,11 @@ def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitabl
         except (ClientDisconnect, ClientGone):  # nobody reads the answer: one line, no trace
             log.info("%s %s: the client left; its work was stopped", request.method, request.url.path)
             return _json_error(499, "client disconnected")
+        except TooLong as exc:  # a worker past its time limit (killed)
+            log.warning("%s %s: %s", request.method, request.url.path, exc)
+            return _json_error(503, str(exc), hint="try a smaller mechanism, or fewer steps or frames")
+        except ServerStopping:
+            return _json_error(503, "the server is stopping", hint="start `mechsyn serve` again")
         except WorkerCrashed as exc:
             log.warning("%s %s: %s", request.method, request.url.path, exc)
             return _json_error(500, "internal server error (the server's log has the details)")
@@ -101,11 +106,10 @@ def _bool(data: dict, key: str, default: bool) -> bool:
 
 
 def _client(request: Request) -> str:
-    """Who asks, for the per-client caps: the page's ``X-Mechsyn-Client`` id, else the
-    connection (address and port)."""
-    given = request.headers.get("x-mechsyn-client", "")[:64]
+    """Who asks, for the per-client caps: the connection (address and port), never a header
+    the client chooses (issue 42: a header let one client take every slot)."""
     peer = request.client
-    return given or (f"{peer.host}:{peer.port}" if peer else "?")
+    return f"{peer.host}:{peer.port}" if peer else "?"
 
 
 async def _heavy(request: Request, name: str, *args: Any) -> Any:

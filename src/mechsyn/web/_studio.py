@@ -253,15 +253,14 @@ def _spatial_examples(root) -> tuple[dict[str, str], ...]:
 
 def routes() -> list:
     """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`). The
-    check is quick and runs in the server's threads; forces and the exports are heavy and
-    run as capped, cancellable worker processes (:func:`mechsyn.web._routing._heavy`)."""
+    check, forces and the exports run as capped, cancellable worker processes
+    (:func:`mechsyn.web._routing._heavy`): nothing heavy in the server's process (a check
+    of a large mechanism took minutes there, issue 42)."""
 
-    def on_mechanism(name, media_type=None, heavy=True):
+    def on_mechanism(name, media_type=None):
         @api
         async def route(request) -> Any:
-            mech = _need(await _body(request), "mechanism")
-            out = await (_heavy(request, f"_studio:{name}", mech) if heavy
-                         else run_in_threadpool(globals()[name], mech))
+            out = await _heavy(request, f"_studio:{name}", _need(await _body(request), "mechanism"))
             return Response(out, media_type=media_type) if media_type else out
         return route
 
@@ -277,6 +276,6 @@ def routes() -> list:
 
     return [Route("/api/studio/examples", examples_route),
             Route("/api/studio/forces", forces_route, methods=["POST"]),
-            Route("/api/studio/check", on_mechanism("check", heavy=False), methods=["POST"]),
+            Route("/api/studio/check", on_mechanism("check"), methods=["POST"]),
             Route("/api/studio/drawing", on_mechanism("export_drawing", "image/svg+xml"), methods=["POST"]),
             Route("/api/studio/dxf", on_mechanism("export_dxf", "application/dxf"), methods=["POST"])]
