@@ -14,12 +14,14 @@ Safety of a local server (issue 15):
 * a Content-Security-Policy allowing only the server's own scripts, styles and data;
 * malformed requests answer 4xx with a JSON ``{"error", "field", "hint"}``; a bug answers
   500 ``internal server error`` and the trace goes to the server's log only;
-* request bodies parsed strictly before any work (:func:`_body`: no NaN/Infinity, no key
-  twice, no number of thousands of digits, no lone surrogate, nesting within the limit),
-  booleans are booleans (:func:`_bool`);
-* heavy work (analyze, simulate, import, export, atlas, reading a file) runs in worker
-  processes, capped per client and in all, killed when the client disconnects
-  (:class:`mechsyn.web._jobs.HeavyRunner`, issue 27).
+* request bodies parsed strictly before any work (:func:`mechsyn.web._routing._body`: no
+  NaN/Infinity, no key twice, no number of thousands of digits, no lone surrogate, nesting
+  within the limit), then validated by one schema per body (:mod:`mechsyn.web._schema`:
+  JSON types as they are, numbers within ±1e12, printable file names);
+* heavy work (the structure check, analyze, simulate, import, export, atlas, reading a
+  file, synthesis jobs) runs in worker processes, capped per connection and in all, queued
+  fairly, time-limited, killed when the client disconnects or the server stops
+  (:class:`mechsyn.web._jobs.HeavyRunner`, issues 27 and 42).
 
 References
 ----------
@@ -50,7 +52,8 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 from mechsyn.web import _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
 from mechsyn.web._jobs import HeavyRunner, JobTable
-from mechsyn.web._routing import _body, _bool, _client, _heavy, _int, _json_error, _need, api
+from mechsyn.web import _schema as S
+from mechsyn.web._routing import _client, _heavy, _json_error, _parsed, api
 
 log = logging.getLogger("mechsyn.web")
 STATIC = Path(__file__).parent / "static"
@@ -184,10 +187,7 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
 
     @api
     async def route(request: Request) -> Any:
-        data = await _body(request)
-        if service in HEAVY:
-            return await _heavy(request, service, _need(data, "mechanism"))
-        return await run_in_threadpool(getattr(_service, service), _need(data, "mechanism"))
+        return await _heavy(request, service, (await _parsed(request, S.MechanismBody)).mechanism)
 
     return route
 
@@ -222,9 +222,8 @@ async def _example(request: Request) -> Any:
 
 @api
 async def _simulate(request: Request) -> Any:
-    data = await _body(request)
-    steps = _int(data.get("steps", 180), "steps")
-    args = (_need(data, "mechanism"), steps, None, _bool(data, "rates", True))
+    body = await _parsed(request, S.SimulateBody)
+    args = (body.mechanism, body.steps, None, body.rates)
     # a mechanism of drivers and dyads (a drag's repaint: milliseconds of NumPy) in this
     # process, with the plans compiled here; the rest, and every refusal, in a worker
     quick = await run_in_threadpool(_service.quick_simulate, *args)
@@ -248,49 +247,38 @@ async def _read_file(request: Request) -> Any:
 
 @api
 async def _save_file(request: Request) -> Any:
-    data = await _body(request)
-    root = request.app.state.root
-    name = _need(data, "path")
+    body = await _parsed(request, S.SaveBody)
+    root, name = request.app.state.root, body.path
     path = _files.resolve_inside(root, name)
     suffix = _files.mechanism_suffix(path)
-    overwrite = _bool(data, "overwrite", False)
-    if (path.exists() or path.is_symlink()) and not overwrite:
+    if (path.exists() or path.is_symlink()) and not body.overwrite:
         raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
     mode = await run_in_threadpool(_files.may_replace, path)
     if not path.parent.is_dir():
         raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
-    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), suffix)
+    text = await _heavy(request, "mechanism_text", body.mechanism, suffix)
     await run_in_threadpool(write_atomic, path, text, mode)
     return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
 
 
 @api
 async def _import_text(request: Request) -> Any:
-    data = await _body(request)
-    text, name = _need(data, "text"), data.get("filename", "upload.yaml")
-    if not isinstance(text, str):
-        raise MechsynInputError("must be the file's text", field="text")
-    if not isinstance(name, str) or len(name) > _files.MAX_NAME:
-        raise MechsynInputError(f"must be a file name of at most {_files.MAX_NAME} characters", field="filename")
-    return {"mechanism": await _heavy(request, "parse_mechanism_text", text, name), "name": name}
+    body = await _parsed(request, S.ImportBody)
+    return {"mechanism": await _heavy(request, "parse_mechanism_text", body.text, body.filename),
+            "name": body.filename}
 
 
 @api
 async def _export_text(request: Request) -> Any:
-    data = await _body(request)
-    fmt = data.get("format", "yaml")
+    body = await _parsed(request, S.ExportBody)
+    fmt = body.format
     if fmt == "csv":
-        text = await _heavy(request, "simulation_csv", _need(data, "mechanism"), _int(data.get("steps", 180), "steps"))
+        text = await _heavy(request, "simulation_csv", body.mechanism, body.steps)
         return Response(text, media_type="text/csv")
     if fmt == "gif":
-        frames = _int(data.get("frames", 72), "frames")
-        if not 2 <= frames <= 360:
-            raise MechsynInputError("frames must be within 2..360", field="frames")
-        gif = await _heavy(request, "animation_gif", _need(data, "mechanism"), frames)
+        gif = await _heavy(request, "animation_gif", body.mechanism, body.frames)
         return Response(gif, media_type="image/gif")
-    if fmt not in ("yaml", "json"):
-        raise MechsynInputError(f"unknown format {str(fmt)[:20]!r}", field="format", hint="yaml, json, csv or gif")
-    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), "." + fmt)
+    text = await _heavy(request, "mechanism_text", body.mechanism, "." + fmt)
     return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
 
 
@@ -309,24 +297,20 @@ def _query_int(text: str, field: str) -> int:
 
 @api
 async def _atlas_mechanism(request: Request) -> Any:
-    data = await _body(request)
-    frame = data.get("frame")
-    inp = data.get("input")
-    mech = await _heavy(request, "atlas_mechanism", _need(data, "chain"),
-                        None if frame is None else _int(frame, "frame"), None if inp is None else _int(inp, "input"))
-    return {"mechanism": mech}
+    body = await _parsed(request, S.ChainBody)
+    return {"mechanism": await _heavy(request, "atlas_mechanism", body.chain, body.frame, body.input)}
 
 
 @api
 async def _synth_start(request: Request) -> Any:
-    data = await _body(request)
     kind = request.path_params["kind"]
     if kind not in _service.SYNTHESIS_KINDS:
-        raise MechsynInputError(f"unknown synthesis kind {kind!r}", field="kind",
+        raise MechsynInputError(f"unknown synthesis kind {kind[:40]!r}", field="kind",
                                 hint="one of " + ", ".join(_service.SYNTHESIS_KINDS))
+    params = (await _parsed(request, S.SYNTHESIS_PARAMS.get(kind, S.AnyParams))).model_dump()
     fn = _service.SYNTHESIS_KINDS[kind][1]
     state = request.app.state
-    return state.jobs.submit(kind, fn, data, state.heavy, _client(request)).snapshot()
+    return state.jobs.submit(kind, fn, params, state.heavy, _client(request)).snapshot()
 
 
 @api

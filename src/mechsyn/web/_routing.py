@@ -1,6 +1,6 @@
 """The plumbing every studio route shares: JSON in and out (:func:`api`), the request body
-parsed strictly before any work (:func:`_body`), typed fields (:func:`_need`, :func:`_int`,
-:func:`_bool`) and heavy calls as capped, cancellable worker processes (:func:`_heavy`).
+parsed strictly before any work (:func:`_body`) and validated by its schema (:func:`_parsed`,
+:mod:`mechsyn.web._schema`) and heavy calls as capped, cancellable worker processes (:func:`_heavy`).
 
 Kept apart from :mod:`mechsyn.web._app` (the app factory and its route table) so that the
 route modules (:mod:`mechsyn.web._studio`, :mod:`mechsyn.web._spatial`) use it without
@@ -14,6 +14,7 @@ import json
 import logging
 from typing import Any, Awaitable, Callable
 
+from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException
 from starlette.requests import ClientDisconnect, Request
 from starlette.responses import JSONResponse, Response
@@ -71,12 +72,21 @@ def _json_response(out: Any) -> Response:
         return Response(json.dumps(out, ensure_ascii=True, allow_nan=False), media_type="application/json")
 
 
+#: Bodies larger than this many bytes are parsed in a thread, not on the event loop.
+PARSE_INLINE = 64 * 1024
+
+
+def _decoded(raw: bytes) -> Any:
+    return check_data_size(loads_json(raw or b"null", "request body", finite=True), "request body", hidden=False)
+
+
 async def _body(request: Request) -> dict[str, Any]:
     """The request's JSON object, parsed strictly (:func:`mechsyn.io.files.loads_json` with
-    finite numbers, :func:`mechsyn.io.files.check_data_size`), before any work."""
+    finite numbers, :func:`mechsyn.io.files.check_data_size`), before any work; a large body
+    in a thread, so that the event loop keeps answering."""
     raw = await request.body()
     try:
-        data = check_data_size(loads_json(raw or b"null", "request body", finite=True), "request body", hidden=False)
+        data = _decoded(raw) if len(raw) <= PARSE_INLINE else await run_in_threadpool(_decoded, raw)
     except MechsynInputError as err:
         raise MechsynInputError(f"the request body is not acceptable JSON: {err.message}", field=err.field or "body",
                                 hint=err.hint or "send a JSON object") from None
@@ -85,24 +95,12 @@ async def _body(request: Request) -> dict[str, Any]:
     return data
 
 
-def _need(data: dict, key: str) -> Any:
-    if key not in data:
-        raise MechsynInputError("missing", field=key)
-    return data[key]
+async def _parsed(request: Request, model: type) -> Any:
+    """The request's body (:func:`_body`) validated by its schema (:mod:`mechsyn.web._schema`):
+    a wrong type, a number too large, a name that is not printable are a 400 naming the field."""
+    from mechsyn.web._schema import parse
 
-
-def _int(value: Any, field: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
-        raise MechsynInputError(f"expected a whole number, got {str(value)[:40]!r}", field=field)
-    return int(value)
-
-
-def _bool(data: dict, key: str, default: bool) -> bool:
-    """``data[key]`` when it is true or false (JSON booleans; the string "false" is refused)."""
-    value = data.get(key, default)
-    if not isinstance(value, bool):
-        raise MechsynInputError(f"must be true or false, got {str(value)[:40]!r}", field=key)
-    return value
+    return parse(model, await _body(request))
 
 
 def _client(request: Request) -> str:
