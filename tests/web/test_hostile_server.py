@@ -109,3 +109,109 @@ def test_silent_sockets_beyond_the_bound_close_the_oldest(real_server, monkeypat
     finally:
         for s in idle:
             s.close()
+
+
+# ------------------------------------------------------------------ typed bodies (finding 8)
+@pytest.mark.parametrize("change, field", [
+    ({"links": 5}, "links"), ({"ground": []}, "ground"), ({"joints": 5}, "joints"),
+    ({"joints": [5]}, "joints[0]"), ({"links": [[1]]}, "links[0]"), ({"name": 7}, "name"),
+])
+def test_the_structure_check_answers_400_to_wrong_types(client, example, change, field):
+    r = client.post("/api/studio/check", json={"mechanism": {**example("fourbar"), **change}})
+    assert r.status_code == 400, r.text
+    assert r.json()["field"] == field
+
+
+def test_the_structure_check_names_the_joint_of_a_wrongly_typed_field(client, example):
+    m = example("fourbar")
+    m["joints"][1]["links"] = 5
+    r = client.post("/api/studio/check", json={"mechanism": m})
+    assert r.status_code == 400 and r.json()["field"].startswith("joints[1]")
+    assert r.json()["element"] == {"kind": "joint", "id": m["joints"][1]["id"]}
+
+
+@pytest.mark.parametrize("axis", [[1e200, 1e200, 0], [1e300, 1e300, 1e300], [0, 1e13, 0]])
+@pytest.mark.parametrize("route", ["/api/spatial/view", "/api/spatial/plots", "/api/studio/check", "/api/validate",
+                                   "/api/analyze", "/api/export", "/api/studio/drawing"])
+def test_an_overflowing_axis_is_a_400(client, example, route, axis):
+    m = example("bennett")
+    m["joints"][2]["axis"] = axis
+    r = client.post(route, json={"mechanism": m})
+    assert r.status_code == 400, (r.status_code, r.text[:300])
+    assert r.json()["field"] == "joints[2].axis[1]" if axis[0] == 0 else "joints[2].axis[0]"
+    assert r.json()["element"] == {"kind": "joint", "id": m["joints"][2]["id"]}
+
+
+@pytest.mark.parametrize("route, body, field", [
+    ("/api/simulate", {"steps": "36"}, "steps"), ("/api/simulate", {"steps": 36.5}, "steps"),
+    ("/api/simulate", {"rates": 1}, "rates"), ("/api/export", {"format": "xls"}, "format"),
+    ("/api/export", {"format": "gif", "frames": 1000}, "frames"), ("/api/studio/forces", {"gravity": [0]}, "gravity"),
+    ("/api/studio/forces", {"speed": "fast"}, "speed"), ("/api/studio/forces", {"gravity": [0, 1e300]}, "gravity[1]"),
+    ("/api/spatial/view", {"steps": True}, "steps"), ("/api/file", {"path": "a.yaml", "overwrite": "false"}, "overwrite"),
+])
+def test_wrongly_typed_fields_are_400_naming_them(client, example, route, body, field):
+    r = client.post(route, json={"mechanism": example("fourbar"), **body})
+    assert r.status_code == 400, (r.status_code, r.text[:300])
+    assert r.json()["field"] == field
+
+
+@pytest.mark.parametrize("kind, params, field", [
+    ("fourbar_path", {"time_limit": "10"}, "time_limit"), ("fourbar_path", {"restarts": [1]}, "restarts"),
+    ("fourbar_path", {"restarts": 2.5}, "restarts"), ("fourbar_path", {"targets": "abc"}, "targets"),
+    ("fourbar_path", {"targets": [[0, 0], [1, "0"], [1, 1]]}, "targets[1][1]"),
+    ("fourbar_path", {"targets": [[0, 0, 0], [1, 0], [1, 1]]}, "targets[0]"),
+    ("fourbar_path", {"time_limit": 1e300}, "time_limit"),
+    ("curve", {"closed": "false"}, "closed"), ("curve", {"closed": 0}, "closed"), ("curve", {"max_links": "6"}, "max_links"),
+    ("motion", {"angles": ["0", 1, 2]}, "angles[0]"),
+])
+def test_wrongly_typed_synthesis_parameters_are_400_naming_the_field(client, kind, params, field):
+    body = {"targets": [[0, 0], [1, 0.2], [2, 0.1], [3, -0.4], [3.5, -1.2], [4, 0]], **params}
+    r = client.post(f"/api/synth/{kind}", json=body)
+    assert r.status_code == 400, (r.status_code, r.text[:300])
+    assert r.json()["field"] == field and "internal" not in r.json()["error"]
+
+
+# ------------------------------------------------------------------ Save and CSV (finding 8)
+@pytest.mark.parametrize("name", ["a\nb.yaml", "evil\u202eLMY.yaml", "x\u2066.yaml", "<img src=x onerror=alert(1)>.yaml",
+                                  "tab\there.yaml", "nul\u0000.yaml", "line\u2028sep.yaml", "zw\u200bj.yaml"])
+def test_save_refuses_names_that_are_not_printable_text(client, example, tmp_path, name):
+    r = client.post("/api/file", json={"path": name, "mechanism": example("fourbar")})
+    assert r.status_code == 400 and r.json()["field"] == "path", r.text
+    assert list(tmp_path.iterdir()) == []
+    r = client.post("/api/import", json={"text": "x", "filename": name})
+    assert r.status_code == 400 and r.json()["field"] == "filename"
+
+
+def test_save_keeps_ordinary_names(client, example, tmp_path):
+    for name in ("four-bar (v2) & co's.yaml", "Четырёхзвенник.yaml", "sub dir name.json"):
+        r = client.post("/api/file", json={"path": name, "mechanism": example("fourbar")})
+        assert r.status_code == 200, r.text
+    assert len(list(tmp_path.iterdir())) == 3
+
+
+def test_csv_export_escapes_formula_cells(client, example):
+    m = example("fourbar")
+    old = m["joints"][2]["id"]
+    evil = '=HYPERLINK("http://evil.example","x")'
+    m["joints"][2]["id"] = evil
+    m["points"] = {k: v for k, v in m.get("points", {}).items()}
+    for name, p in list(m["points"].items()):  # named points may be formulas too
+        m["points"]["@" + name] = m["points"].pop(name)
+    text = json.dumps(m).replace(f'"{old}"', json.dumps(evil))
+    r = client.post("/api/export", json={"mechanism": json.loads(text), "format": "csv", "steps": 8})
+    assert r.status_code == 200, r.text
+    import csv
+    import io
+
+    rows = list(csv.reader(io.StringIO(r.text)))
+    cells = [c for row in rows for c in row]
+    assert f"'{evil}_x" in cells and any(c.startswith("'@") for c in cells)
+    assert not [c for c in cells if c.startswith(("=", "+", "@")) or (c.startswith("-") and not _number(c))]
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
