@@ -215,3 +215,105 @@ def _number(text: str) -> bool:
         return True
     except ValueError:
         return False
+
+
+# ------------------------------------------------------------------ heavy work (finding 7)
+def _run_coroutine(coro):
+    """``asyncio.run(coro)`` in a thread of its own (a browser test may leave a loop running)."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(1) as pool:
+        return pool.submit(asyncio.run, coro).result()
+
+
+async def _never_gone() -> bool:
+    return False
+
+
+def test_the_queue_serves_the_client_served_least_recently_first():
+    """A cheap request of a second client waited behind every queued request of the first
+    (61 s behind others, no fairness): now it goes next."""
+    import asyncio
+
+    from mechsyn.web._jobs import HeavyRunner
+
+    runner = HeavyRunner(total=1, per_client=1, queue=4, isolate=False)
+    order, release = [], threading.Event()
+
+    def work(tag: str) -> str:
+        order.append(tag)
+        if tag == "a1":
+            release.wait(60)  # only ends a broken run
+        return tag
+
+    async def scenario():
+        first = asyncio.ensure_future(runner.call("a", _never_gone, work, "a1"))
+        await asyncio.to_thread(_wait_for, lambda: order == ["a1"], "a1 runs")
+        rest = [asyncio.ensure_future(runner.call("a", _never_gone, work, t)) for t in ("a2", "a3")]
+        await asyncio.sleep(0)
+        late = asyncio.ensure_future(runner.call("b", _never_gone, work, "b1"))
+        await asyncio.to_thread(_wait_for, lambda: runner.waiting.get("b") == 1, "b1 waits")
+        release.set()
+        return await asyncio.gather(first, *rest, late)
+
+    assert sorted(_run_coroutine(scenario())) == ["a1", "a2", "a3", "b1"]
+    assert order == ["a1", "b1", "a2", "a3"]
+
+
+def test_a_worker_past_its_time_limit_is_killed():
+    from mechsyn.web._jobs import HeavyRunner, TooLong
+
+    runner = HeavyRunner(total=1)
+
+    async def scenario():
+        with pytest.raises(TooLong):
+            await runner.call("a", _never_gone, time.sleep, 600, limit=0.5)
+
+    try:
+        _run_coroutine(scenario())
+        assert not runner.procs and not runner.running and runner.started == 1
+    finally:
+        runner.stop()
+
+
+def test_caps_are_keyed_by_the_connection_not_a_header():
+    from starlette.requests import Request
+
+    from mechsyn.web._routing import _client
+
+    def request(port: int, header: str) -> Request:
+        return Request({"type": "http", "method": "GET", "path": "/", "client": ("127.0.0.1", port),
+                        "headers": [(b"x-mechsyn-client", header.encode())]})
+
+    assert _client(request(5000, "x")) == _client(request(5000, "y")) == "127.0.0.1:5000"
+    assert _client(request(5001, "x")) != _client(request(5000, "x"))
+
+
+def test_the_check_and_synthesis_run_in_workers_and_jobs_leave_one_free(client, example):
+    """The structure check ran in the server's threads (an 801-link check: 103 s, the
+    server's RSS 261 → 1,236 MB), synthesis jobs in its threads too."""
+    runner = client.app.state.heavy
+    before = runner.started
+    r = client.post("/api/studio/check", json={"mechanism": example("fourbar")})
+    assert r.status_code == 200 and r.json()["mobility"] == 1
+    assert runner.started == before + 1  # a worker answered it
+    targets = [[0, 0], [1, 0.2], [2, 0.1], [3, -0.4], [3.5, -1.2]]
+    jobs = [client.post("/api/synth/fourbar_path", json={"targets": targets, "time_limit": 600, "restarts": 50}).json()
+            for _ in range(runner.total)]
+    try:
+        _wait_for(lambda: runner.lanes["job"] == runner.job_slots and len(runner.procs) == runner.job_slots,
+                  "the jobs' workers run")
+        _wait_for(lambda: client.get(f"/api/jobs/{jobs[0]['id']}").json()["progress"]["done"] > 0,
+                  "the first job reports progress")
+        assert runner.job_slots < runner.total  # one worker left for requests
+        r = client.post("/api/studio/check", json={"mechanism": example("fourbar")})  # served meanwhile
+        assert r.status_code == 200
+    finally:
+        workers = set(runner.procs)
+        for j in jobs:
+            client.post(f"/api/jobs/{j['id']}/cancel", json={})
+    for j in jobs:
+        _wait_for(lambda: client.get(f"/api/jobs/{j['id']}").json()["state"] == "cancelled", "cancelled")
+    _wait_for(lambda: all(w.exitcode is not None for w in workers), "the job workers end")
+    assert {w.exitcode for w in workers} == {-9}  # killed by the cancel
