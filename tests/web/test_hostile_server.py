@@ -317,3 +317,54 @@ def test_the_check_and_synthesis_run_in_workers_and_jobs_leave_one_free(client, 
         _wait_for(lambda: client.get(f"/api/jobs/{j['id']}").json()["state"] == "cancelled", "cancelled")
     _wait_for(lambda: all(w.exitcode is not None for w in workers), "the job workers end")
     assert {w.exitcode for w in workers} == {-9}  # killed by the cancel
+
+
+# ------------------------------------------------------------------ signals during heavy work (finding 7)
+def _children(pid: int) -> list[int]:
+    out = []
+    for stat in __import__("pathlib").Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+@pytest.mark.skipif(not __import__("os").path.isdir("/proc/self"), reason="reads /proc to see the worker start")
+@pytest.mark.parametrize("sig, code, word", [(__import__("signal").SIGTERM, 143, "terminated"),
+                                             (__import__("signal").SIGINT, 130, "interrupted")])
+def test_a_signal_during_a_heavy_request_gives_clean_output(tmp_path, example, sig, code, word):
+    """SIGTERM during heavy work left a traceback (CancelledError) and a plain-text 500."""
+    import httpx
+
+    from test_hostile_signals import _start_serve
+
+    p, base, token = _start_serve(tmp_path)
+    answer = {}
+
+    def heavy():
+        try:
+            answer["r"] = httpx.post(f"{base}/api/export", headers={"X-Mechsyn-Token": token}, timeout=120,
+                                     json={"mechanism": example("watt_sixbar"), "format": "gif", "frames": 360})
+        except httpx.HTTPError as exc:  # the connection closed: acceptable, no 500
+            answer["r"] = exc
+
+    t = threading.Thread(target=heavy)
+    try:
+        t.start()
+        # the worker runs: a child of the fork server (a child of serve)
+        _wait_for(lambda: any(_children(c) for c in _children(p.pid)), "the GIF worker started")
+        p.send_signal(sig)
+        out, err = p.communicate(timeout=60)
+        t.join(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.communicate()
+    assert p.returncode == code, err[-2000:]
+    assert "Traceback" not in err and "Error" not in err and err.strip().splitlines()[-1] == word, err[-2000:]
+    r = answer["r"]
+    if isinstance(r, httpx.Response):
+        assert r.status_code == 503 and r.json()["error"] == "the server is stopping", r.text[:300]
