@@ -192,6 +192,9 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
     return route
 
 
+#: The most rows of a simulation answered in the server's own process (the page asks for
+#: 180 or 181; more go to a worker).
+QUICK_STEPS = 361
 #: Services run as capped, cancellable worker processes; the others are quick.
 HEAVY = frozenset({"validate", "analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
                    "simulation_csv", "animation_gif", "atlas", "atlas_mechanism"})
@@ -224,9 +227,10 @@ async def _example(request: Request) -> Any:
 async def _simulate(request: Request) -> Any:
     body = await _parsed(request, S.SimulateBody)
     args = (body.mechanism, body.steps, None, body.rates)
-    # a mechanism of drivers and dyads (a drag's repaint: milliseconds of NumPy) in this
-    # process, with the plans compiled here; the rest, and every refusal, in a worker
-    quick = await run_in_threadpool(_service.quick_simulate, *args)
+    # a mechanism of drivers and dyads at the page's sweep (a drag's repaint: milliseconds
+    # of NumPy) in this process, with the plans compiled here; the rest, and every
+    # refusal, in a worker
+    quick = await run_in_threadpool(_service.quick_simulate, *args) if body.steps <= QUICK_STEPS else None
     return quick if quick is not None else await _heavy(request, "simulate", *args)
 
 

@@ -5,10 +5,13 @@ the structure check, import, export, atlas) or one synthesis run in a worker pro
 from a preloaded fork server, like a Jupyter kernel: nothing heavy runs in the server's own
 process (issue 42). Its caps:
 
-* ``total`` workers at once in all, of which synthesis jobs take at most ``job_slots``
-  (so a quick request always finds a worker after one finishes);
-* ``per_client`` at once per client and lane (requests, jobs), a client being the
-  connection (address and port), never a header the client chooses;
+* ``total`` workers at once for heavy requests and synthesis jobs, of which jobs take at
+  most ``job_slots`` (a heavy request finds a worker after one request finishes);
+* ``quick_slots`` more workers for the quick services (:data:`QUICK`: the structure check,
+  validate, reading and writing a file's text), which also take a free worker of the
+  others: a check never waits behind a 360-frame GIF, only behind other quick calls;
+* ``per_client`` at once per client, a client being the connection (address and port,
+  its jobs apart), never a header the client chooses;
 * a fair queue: when a worker frees, the waiting client served least recently goes first
   (a cheap request waits for one worker to finish, not behind every request of others);
 * ``queue`` calls of one client waiting or running; one more is answered 429 at once;
@@ -26,6 +29,7 @@ from __future__ import annotations
 
 import asyncio
 import itertools
+import json
 import logging
 import multiprocessing
 import os
@@ -41,6 +45,11 @@ log = logging.getLogger("mechsyn.web")
 MAX_JOBS = 4
 #: Seconds one heavy request's worker may run; killed beyond (503).
 REQUEST_SECONDS = 120.0
+#: Seconds one quick service's worker may run; killed beyond (503).
+QUICK_SECONDS = 60.0
+#: The services of the quick lane: milliseconds for a drawn mechanism, bounded by the body's size.
+QUICK = frozenset({"_studio:check", "validate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
+                   "atlas_mechanism"})
 #: Seconds one synthesis job's worker may run (its own time limit is at most 600 s, and
 #: the curve database may be built first); killed beyond (the job fails).
 JOB_SECONDS = 1200.0
@@ -192,6 +201,27 @@ def service_function(name: str | Callable[..., Any]) -> Callable[..., Any]:
     return getattr(importlib.import_module(f"mechsyn.web.{module or '_service'}"), function)
 
 
+class RawJSON:
+    """A request's answer encoded as JSON (UTF-8) by its worker: the server sends the bytes
+    as they are, with no unpickling of a large structure and no encoding in its own process.
+
+    >>> RawJSON.of({"a": [1.5, None], "b": "é"}).data
+    b'{"a":[1.5,null],"b":"\xc3\xa9"}'
+    """
+
+    __slots__ = ("data",)
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+
+    @classmethod
+    def of(cls, obj: Any) -> "RawJSON":
+        try:
+            return cls(json.dumps(obj, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode())
+        except UnicodeEncodeError:  # a lone surrogate echoed back: escaped as \uXXXX
+            return cls(json.dumps(obj, ensure_ascii=True, allow_nan=False, separators=(",", ":")).encode())
+
+
 def _label(name: str | Callable[..., Any]) -> str:
     return name if isinstance(name, str) else getattr(name, "__name__", "job")
 
@@ -199,7 +229,7 @@ def _label(name: str | Callable[..., Any]) -> str:
 def _worker(conn, name: str | Callable[..., Any], args: tuple, with_progress: bool) -> None:
     """Worker process: ``_service.<name>(*args)`` (and a progress callback when asked) sent
     back as ("ok", result), ("input", error fields) or ("bug", traceback text), after any
-    number of ("progress", state)."""
+    number of ("progress", state); a request's dict or list result as :class:`RawJSON`."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the server's to handle
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(os, "nice"):
@@ -214,6 +244,8 @@ def _worker(conn, name: str | Callable[..., Any], args: tuple, with_progress: bo
 
     try:
         out = ("ok", service_function(name)(*args, *((progress,) if with_progress else ())))
+        if not with_progress and isinstance(out[1], (dict, list)):  # a request's JSON answer
+            out = ("ok", RawJSON.of(out[1]))
     except MechsynInputError as err:
         out = ("input", {"message": err.message, "field": err.field, "hint": err.hint,
                          "source": err.source, "line": err.line, "element": getattr(err, "element", None)})
@@ -243,6 +275,7 @@ class _Ticket:
 
     def __init__(self, client: str, lane: str, seq: int) -> None:
         self.client, self.lane, self.seq, self.granted = client, lane, seq, False
+        self.pool = ""  # the workers it was granted from: "quick" or "general"
         self._loop, self._event = asyncio.get_running_loop(), asyncio.Event()
 
     def grant(self) -> None:
@@ -261,9 +294,10 @@ class HeavyRunner:
     Parameters
     ----------
     total
-        Workers running at once in all (default: the machine's CPUs, at least 2).
+        Workers running at once for heavy requests and jobs (default: the machine's CPUs, at
+        least 2).
     per_client
-        Workers running at once for one client in one lane; its further calls wait.
+        Workers running at once for one client; its further calls wait.
     queue
         Calls of one client waiting or running; one more is answered 429 at once.
     isolate
@@ -271,6 +305,8 @@ class HeavyRunner:
         time limit: for tests that patch :mod:`mechsyn.web._service`).
     job_slots
         Workers synthesis jobs may hold at once (default: all but one).
+    quick_slots
+        Workers kept for the quick services (:data:`QUICK`) besides ``total``.
 
     Examples
     --------
@@ -279,17 +315,19 @@ class HeavyRunner:
     >>> async def never():
     ...     return False
     >>> asyncio.run(runner.call("127.0.0.1:5000", never, "atlas", 4, 1))[0]["label"]
-    '4 binary'
+    '4B'
     """
 
     def __init__(self, total: int | None = None, per_client: int = 1, queue: int = 4, isolate: bool = True,
-                 job_slots: int | None = None):
+                 job_slots: int | None = None, quick_slots: int = 1):
         self.total = total or max(2, os.cpu_count() or 2)
         self.per_client, self.queue, self.isolate = per_client, queue, isolate
         self.job_slots = job_slots or max(1, self.total - 1)
-        self.running: dict[str, int] = {}  # workers running now, by client (and lane)
+        self.quick_slots = quick_slots
+        self.running: dict[str, int] = {}  # workers running now, by client
         self.waiting: dict[str, int] = {}  # calls waiting for a worker, by client
-        self.lanes = {"request": 0, "job": 0}  # workers running now, by lane
+        self.lanes = {"quick": 0, "request": 0, "job": 0}  # workers running now, by lane
+        self.pools = {"quick": 0, "general": 0}  # workers running now, by the slots they hold
         self.started = 0  # workers started since launch
         self.procs: set = set()  # the worker processes running now
         self.stopping = False
@@ -332,19 +370,30 @@ class HeavyRunner:
                 pass
 
     # ------------------------------------------------------------------ the fair queue
+    def _room(self, t: _Ticket) -> str:
+        """The slots a waiting call may take now ("quick", "general"), or "" (under the lock)."""
+        if self.running.get(t.client, 0) >= self.per_client:
+            return ""
+        if t.lane == "quick" and self.pools["quick"] < self.quick_slots:
+            return "quick"
+        if t.lane == "job" and self.lanes["job"] >= self.job_slots:
+            return ""
+        return "general" if self.pools["general"] < self.total else ""
+
     def _dispatch(self) -> None:
-        """Free workers to waiting calls (under the lock): among the calls whose client and
-        lane have room, the client served least recently first, then the oldest call."""
-        while self._tickets and sum(self.running.values()) < self.total:
-            ready = [t for t in self._tickets if self.running.get(t.client, 0) < self.per_client
-                     and (t.lane != "job" or self.lanes["job"] < self.job_slots)]
+        """Free workers to waiting calls (under the lock): among the calls that have room,
+        the client served least recently first, then the oldest call."""
+        while self._tickets:
+            ready = [(t, pool) for t in self._tickets if (pool := self._room(t))]
             if not ready:
                 return
-            t = min(ready, key=lambda t: (self._served.get(t.client, -1), t.seq))
+            t, pool = min(ready, key=lambda tp: (self._served.get(tp[0].client, -1), tp[0].seq))
             self._tickets.remove(t)
             self.waiting[t.client] -= 1
             self.running[t.client] = self.running.get(t.client, 0) + 1
             self.lanes[t.lane] += 1
+            self.pools[pool] += 1
+            t.pool = pool
             self._served[t.client] = next(self._seq)
             t.grant()
 
@@ -353,6 +402,7 @@ class HeavyRunner:
             if ticket.granted:
                 self.running[ticket.client] -= 1
                 self.lanes[ticket.lane] -= 1
+                self.pools[ticket.pool] -= 1
                 if not self.running[ticket.client]:
                     del self.running[ticket.client]
             elif ticket in self._tickets:
@@ -363,10 +413,14 @@ class HeavyRunner:
             self._dispatch()
 
     async def call(self, client: str, gone: Callable[[], Any], name: str | Callable[..., Any], *args: Any,
-                   lane: str = "request", limit: float | None = REQUEST_SECONDS,
+                   lane: str | None = None, limit: float | None = None,
                    progress: Callable[[dict], None] | None = None) -> Any:
         """``_service.<name>(*args)`` for ``client`` (``name(*args, progress)`` when
-        ``progress`` is given); ``gone()`` (awaitable) tells a disconnect or a cancel."""
+        ``progress`` is given); ``gone()`` (awaitable) tells a disconnect or a cancel.
+        ``lane`` is "quick" for the services of :data:`QUICK`, else "request" (or "job");
+        ``limit`` the seconds its worker may run (:data:`QUICK_SECONDS`, :data:`REQUEST_SECONDS`)."""
+        lane = lane or ("quick" if name in QUICK else "request")
+        limit = limit or (QUICK_SECONDS if lane == "quick" else REQUEST_SECONDS)
         if self.stopping:
             raise ServerStopping("the server is stopping")
         with self._lock:

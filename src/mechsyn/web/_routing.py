@@ -21,7 +21,7 @@ from starlette.responses import JSONResponse, Response
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.io.files import check_data_size, loads_json
-from mechsyn.web._jobs import Busy, ClientGone, ServerStopping, TooLong, WorkerCrashed
+from mechsyn.web._jobs import Busy, ClientGone, RawJSON, ServerStopping, TooLong, WorkerCrashed
 
 log = logging.getLogger("mechsyn.web")
 
@@ -64,12 +64,23 @@ def api(fn: Callable[[Request], Awaitable[Any]]) -> Callable[[Request], Awaitabl
 
 
 def _json_response(out: Any) -> Response:
-    """``out`` as JSON; text that is not valid UTF-8 (a lone surrogate echoed from a URL)
-    escaped as ``\\uXXXX`` instead of failing outside the route's error handling."""
+    """``out`` as JSON: a worker's :class:`~mechsyn.web._jobs.RawJSON` (alone, or as values
+    of a dict) sent as it is; text that is not valid UTF-8 (a lone surrogate echoed from a
+    URL) escaped as ``\\uXXXX`` instead of failing outside the route's error handling."""
+    if isinstance(out, RawJSON) or (isinstance(out, dict) and any(isinstance(v, RawJSON) for v in out.values())):
+        return Response(_encoded(out), media_type="application/json")
     try:
         return JSONResponse(out)
     except UnicodeEncodeError:
         return Response(json.dumps(out, ensure_ascii=True, allow_nan=False), media_type="application/json")
+
+
+def _encoded(out: Any) -> bytes:
+    if isinstance(out, RawJSON):
+        return out.data
+    if isinstance(out, dict):
+        return b"{" + b",".join(RawJSON.of(str(k)).data + b":" + _encoded(v) for k, v in out.items()) + b"}"
+    return RawJSON.of(out).data
 
 
 #: Bodies larger than this many bytes are parsed in a thread, not on the event loop.
