@@ -157,10 +157,14 @@ class JobTable:
 
 
 # --------------------------------------------------------------------------- heavy routes
-#: Modules the fork server imports once, so that each worker starts in milliseconds.
+#: Modules the fork server imports once, so that each worker starts in milliseconds (a
+#: synthesis worker at nice 10 on a loaded machine took tens of seconds to import SciPy's
+#: optimisers and the curve database).
 PRELOAD = ["mechsyn.web._service", "mechsyn.web._studio", "mechsyn.web._spatial", "mechsyn.io",
            "mechsyn.kinematics.analysis", "mechsyn.structure.report", "mechsyn.structure.assur",
-           "mechsyn.synthesis.chains", "mechsyn.synthesis.mechanisms"]
+           "mechsyn.synthesis.chains", "mechsyn.synthesis.mechanisms", "mechsyn.synthesis.optimize",
+           "mechsyn.synthesis.path", "mechsyn.synthesis.export", "mechsyn.synthesis.curves.database",
+           "mechsyn.synthesis.curves.synthesis"]
 
 
 class Busy(Exception):
