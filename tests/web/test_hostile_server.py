@@ -368,3 +368,26 @@ def test_a_signal_during_a_heavy_request_gives_clean_output(tmp_path, example, s
     r = answer["r"]
     if isinstance(r, httpx.Response):
         assert r.status_code == 503 and r.json()["error"] == "the server is stopping", r.text[:300]
+
+
+def test_a_job_outlives_the_event_loop_of_its_request(tmp_path):
+    """The notebook widget calls the app through a TestClient without its context: each
+    request has an event loop of its own, closed when it returns. A job (now a worker
+    process) must finish all the same."""
+    import warnings
+
+    from mechsyn.web import create_app
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        from starlette.testclient import TestClient
+
+    app = create_app(tmp_path, token=TOKEN)
+    c = TestClient(app, base_url="http://127.0.0.1", headers={"X-Mechsyn-Token": TOKEN})  # no `with`: no lifespan
+    targets = [[0, 0], [1, 0.2], [2, 0.1], [3, -0.4], [3.5, -1.2]]
+    job = c.post("/api/synth/fourbar_path", json={"targets": targets, "time_limit": 1, "restarts": 1}).json()
+    _wait_for(lambda: c.get(f"/api/jobs/{job['id']}").json()["state"] != "running", "the job ends")
+    snap = c.get(f"/api/jobs/{job['id']}").json()
+    assert snap["state"] == "done" and snap["result"]["results"], snap
+    assert app.state.heavy.started == 1
+    app.state.heavy.stop()

@@ -69,7 +69,7 @@ class Job:
         self.started = time.monotonic()
         self.ended: float | None = None
         self.version = 0
-        self.task: asyncio.Task | None = None  # the server's task waiting for the worker
+        self.thread: threading.Thread | None = None  # waits for the worker (JobTable.submit)
         self._cancel = threading.Event()
         self._lock = threading.Lock()
 
@@ -134,7 +134,7 @@ class JobTable:
 
     def submit(self, kind: str, fn, params: dict, runner: "HeavyRunner", client: str) -> Job:
         """A job of ``fn(params, progress)`` started on ``runner`` for ``client`` (a
-        connection; its jobs are capped apart from its requests). Call from the server's loop."""
+        connection; its jobs are capped apart from its requests)."""
         with self._lock:
             running = sum(j.state == "running" for j in self._jobs.values())
             if running >= MAX_JOBS:
@@ -142,7 +142,11 @@ class JobTable:
                                         hint="cancel one or wait for it to finish")
             job = Job(str(next(self._ids)), kind, fn, params)
             self._jobs[job.id] = job
-        job.task = asyncio.get_running_loop().create_task(job.run(runner, f"job {client}"))
+        # its own thread and event loop: a job outlives the request (and, in the notebook
+        # widget, the request's event loop) that started it; the thread only waits on a pipe
+        job.thread = threading.Thread(target=asyncio.run, args=(job.run(runner, f"job {client}"),), daemon=True,
+                                      name=f"mechsyn-job-{job.id}")
+        job.thread.start()
         return job
 
     def get(self, ident: str) -> Job:
