@@ -183,7 +183,7 @@ def _with_headers(response: Response, scope: dict) -> Callable:
 
 
 def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
-    """A route calling ``_service.<service>(body["mechanism"])``."""
+    """A route calling ``_service.<service>(body["mechanism"])`` in a worker process."""
 
     @api
     async def route(request: Request) -> Any:
@@ -195,9 +195,6 @@ def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
 #: The most rows of a simulation answered in the server's own process (the page asks for
 #: 180 or 181; more go to a worker).
 QUICK_STEPS = 361
-#: Services run as capped, cancellable worker processes; the others are quick.
-HEAVY = frozenset({"validate", "analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
-                   "simulation_csv", "animation_gif", "atlas", "atlas_mechanism"})
 
 
 # each route reads the app's state (root, start, start_name, jobs) from request.app.state

@@ -107,7 +107,13 @@ class Job:
             self._finish("failed", error=error_dict(err))
         except (Busy, TooLong) as exc:
             self._finish("failed", error={"message": str(exc), "field": None, "hint": None, "element": None})
-        except Exception:  # a bug (WorkerCrashed: its trace is logged already): a plain message for the page
+        except WorkerCrashed as exc:  # its trace, if any, is logged already
+            log.warning("synthesis job %s: %s", self.id, exc)
+            self._finish("failed", error={"message": "internal error in the synthesis run (see the server log)"})
+        except Exception:  # a bug: logged for the terminal, a plain message for the page
+            if runner.stopping:  # the server stopped under it: nothing to report
+                self._finish("cancelled")
+                return
             log.exception("synthesis job %s failed", self.id)
             self._finish("failed", error={"message": "internal error in the synthesis run (see the server log)"})
         else:
@@ -241,7 +247,10 @@ def _worker(conn, name: str | Callable[..., Any], args: tuple, with_progress: bo
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the server's to handle
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(os, "nice"):
-        os.nice(10)  # the server's own process (answering other clients) goes first for the CPU
+        # the server's own process (answering other clients) goes first for the CPU; a job
+        # less far behind (a worker at nice 10 on a machine busy with other programs got a
+        # fraction of a percent of a core: a 2 s search took minutes)
+        os.nice(5 if with_progress else 10)
     last = [0.0]
 
     def progress(state: dict) -> None:
@@ -462,7 +471,12 @@ class HeavyRunner:
         parent, child = self._ctx.Pipe(duplex=False)
         proc = self._ctx.Process(target=_worker, args=(child, name, args, progress is not None), daemon=True,
                                  name=f"mechsyn-{_label(name)}")
-        await loop.run_in_executor(None, proc.start)
+        try:
+            await loop.run_in_executor(None, proc.start)
+        except (EOFError, OSError) as exc:  # the fork server was stopped (the server stops) or died
+            if self.stopping:
+                raise ServerStopping("the server is stopping") from None
+            raise WorkerCrashed(f"the {_label(name)} worker did not start ({exc})") from None
         self.started += 1
         self.procs.add(proc)
         child.close()
