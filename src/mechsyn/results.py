@@ -71,6 +71,31 @@ def dumps(obj: Any, indent: int | None = 2) -> str:
     return json.dumps(to_jsonable(obj), indent=indent, ensure_ascii=False)
 
 
+#: First characters that make a spreadsheet read a CSV cell as a formula (OWASP, "CSV Injection").
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def csv_cell(text: str) -> str:
+    """A text cell of a CSV table, safe to open in a spreadsheet: a cell beginning with
+    ``= + - @``, a tab or a carriage return is prefixed with ``'`` so that it stays text
+    (the OWASP advice on CSV injection); a number (``-1.5``) is left as it is.
+
+    Examples
+    --------
+    >>> print(csv_cell('=HYPERLINK("http://x","y")_x'))
+    '=HYPERLINK("http://x","y")_x
+    >>> csv_cell("B_x"), csv_cell("-1.5")
+    ('B_x', '-1.5')
+    """
+    if not text.startswith(FORMULA_STARTS):
+        return text
+    try:
+        float(text)
+        return text
+    except ValueError:
+        return "'" + text
+
+
 def _umask_mode() -> int:
     """The mode a newly created file gets under the process's umask (0o666 & ~umask)."""
     mask = os.umask(0)

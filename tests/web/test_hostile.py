@@ -258,7 +258,7 @@ def test_a_finished_jobs_seconds_stay(monkeypatch):
 
     monkeypatch.setattr(_jobs, "time", Clock)
     job = _jobs.Job("1", "k", lambda params, progress: {"ok": True}, {})
-    job._run(lambda params, progress: {"ok": True}, {})  # finished at t = 100
+    _run_coroutine(job.run(_jobs.HeavyRunner(isolate=False), "c"))  # finished at t = 100
     now[0] = 250.0
     assert job.snapshot()["state"] == "done" and job.snapshot()["seconds"] == 0.0
 

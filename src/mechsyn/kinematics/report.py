@@ -27,7 +27,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import derived
 from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
 from mechsyn.model.mechanism import Mechanism
-from mechsyn.results import to_jsonable
+from mechsyn.results import csv_cell, to_jsonable
 
 __all__ = ["SimulationReport", "simulation_report", "simulation_csv", "forces_csv", "csv_text"]
 
@@ -170,7 +170,7 @@ def csv_text(header: list[str], columns: list[np.ndarray]) -> str:
     """
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(header)
+    w.writerow([csv_cell(h) for h in header])  # names from the file: no formula reaches a spreadsheet
     for row in zip(*columns):
         w.writerow(["" if (isinstance(v, float) and not np.isfinite(v)) else
                     (repr(float(v)) if isinstance(v, (float, np.floating)) else v) for v in row])

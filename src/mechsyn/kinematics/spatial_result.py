@@ -18,6 +18,7 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.kinematics.simulation import PointMotion, Simulation
+from mechsyn.results import csv_cell
 
 __all__ = ["SpatialSimulation", "LinkPose"]
 
@@ -140,8 +141,8 @@ class SpatialSimulation(Result):
         """Every row: the inputs, assembled, residual, every point's x, y, z."""
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
-        w.writerow([f"input_{j}" for j in self.inputs] + ["assembled", "residual"]
-                   + [f"{n}_{c}" for n in self.points for c in "xyz"])
+        w.writerow([csv_cell(f"input_{j}") for j in self.inputs] + ["assembled", "residual"]
+                   + [csv_cell(f"{n}_{c}") for n in self.points for c in "xyz"])
         for k in range(len(self.assembled)):
             row = [repr(float(v[k])) for v in self.inputs.values()] + [int(self.assembled[k])]
             row.append("" if not np.isfinite(self.residual[k]) else repr(float(self.residual[k])))

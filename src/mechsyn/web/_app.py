@@ -14,12 +14,14 @@ Safety of a local server (issue 15):
 * a Content-Security-Policy allowing only the server's own scripts, styles and data;
 * malformed requests answer 4xx with a JSON ``{"error", "field", "hint"}``; a bug answers
   500 ``internal server error`` and the trace goes to the server's log only;
-* request bodies parsed strictly before any work (:func:`_body`: no NaN/Infinity, no key
-  twice, no number of thousands of digits, no lone surrogate, nesting within the limit),
-  booleans are booleans (:func:`_bool`);
-* heavy work (analyze, simulate, import, export, atlas, reading a file) runs in worker
-  processes, capped per client and in all, killed when the client disconnects
-  (:class:`mechsyn.web._jobs.HeavyRunner`, issue 27).
+* request bodies parsed strictly before any work (:func:`mechsyn.web._routing._body`: no
+  NaN/Infinity, no key twice, no number of thousands of digits, no lone surrogate, nesting
+  within the limit), then validated by one schema per body (:mod:`mechsyn.web._schema`:
+  JSON types as they are, numbers within ±1e12, printable file names);
+* heavy work (the structure check, analyze, simulate, import, export, atlas, reading a
+  file, synthesis jobs) runs in worker processes, capped per connection and in all, queued
+  fairly, time-limited, killed when the client disconnects or the server stops
+  (:class:`mechsyn.web._jobs.HeavyRunner`, issues 27 and 42).
 
 References
 ----------
@@ -50,7 +52,8 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
 from mechsyn.web import _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
 from mechsyn.web._jobs import HeavyRunner, JobTable
-from mechsyn.web._routing import _body, _bool, _heavy, _int, _json_error, _need, api
+from mechsyn.web import _schema as S
+from mechsyn.web._routing import _client, _heavy, _json_error, _parsed, api
 
 log = logging.getLogger("mechsyn.web")
 STATIC = Path(__file__).parent / "static"
@@ -61,6 +64,8 @@ CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; img-src 'self' 
 TOKEN_HEADER = "x-mechsyn-token"
 #: Seconds the server waits for each part of a request body.
 BODY_TIMEOUT = 30
+#: Requests (past the Host and token checks) answered at once; 503 beyond.
+MAX_REQUESTS = 200
 
 
 # --------------------------------------------------------------------------- middleware
@@ -74,11 +79,17 @@ def _hostname(host: str) -> str:
 
 
 class Guard:
-    """ASGI middleware: Host check, token on /api/, body size limit, security headers."""
+    """ASGI middleware: Host check, token on /api/, body size limit, security headers, at
+    most :data:`MAX_REQUESTS` requests running at once (503 beyond).
+
+    A request refused (Host, token, size) is answered at once and its connection closed:
+    it never counts against a limit; idle sockets count for nothing here.
+    """
 
     def __init__(self, app: Callable, token: str, allowed_hosts: Iterable[str], max_body: int = MAX_BODY):
         self.app, self.token, self.max_body = app, token, max_body
         self.hosts = {h.lower().strip("[]") for h in allowed_hosts}
+        self.running = 0  # requests (Host and token checked) being answered now
 
     async def __call__(self, scope: dict, receive: Callable, send: Callable) -> None:
         if scope["type"] != "http":
@@ -86,10 +97,19 @@ class Guard:
             return
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
         problem = self._check(scope, headers)
-        if problem is not None:
+        if problem is not None:  # refused before it counts: the connection closed after the answer
+            problem.headers["connection"] = "close"
             await _with_headers(problem, scope)(scope, receive, send)
             return
-        await self.app(scope, self._limited(receive), _secure_send(send, scope))
+        if self.running >= MAX_REQUESTS:
+            await _with_headers(_json_error(503, f"{self.running} requests are running already",
+                                            hint="try again in a moment"), scope)(scope, receive, send)
+            return
+        self.running += 1  # one event loop: no lock needed
+        try:
+            await self.app(scope, self._limited(receive), _secure_send(send, scope))
+        finally:
+            self.running -= 1
 
     def _check(self, scope: dict, headers: dict[str, str]) -> Response | None:
         host = _hostname(headers.get("host", ""))
@@ -163,21 +183,18 @@ def _with_headers(response: Response, scope: dict) -> Callable:
 
 
 def _on_mechanism(service: str) -> Callable[[Request], Awaitable[Response]]:
-    """A route calling ``_service.<service>(body["mechanism"])``."""
+    """A route calling ``_service.<service>(body["mechanism"])`` in a worker process."""
 
     @api
     async def route(request: Request) -> Any:
-        data = await _body(request)
-        if service in HEAVY:
-            return await _heavy(request, service, _need(data, "mechanism"))
-        return await run_in_threadpool(getattr(_service, service), _need(data, "mechanism"))
+        return await _heavy(request, service, (await _parsed(request, S.MechanismBody)).mechanism)
 
     return route
 
 
-#: Services run as capped, cancellable worker processes; the others are quick.
-HEAVY = frozenset({"analyze", "simulate", "read_mechanism", "parse_mechanism_text", "mechanism_text",
-                   "simulation_csv", "animation_gif", "atlas", "atlas_mechanism"})
+#: The most rows of a simulation answered in the server's own process (the page asks for
+#: 180 or 181; more go to a worker).
+QUICK_STEPS = 361
 
 
 # each route reads the app's state (root, start, start_name, jobs) from request.app.state
@@ -205,12 +222,12 @@ async def _example(request: Request) -> Any:
 
 @api
 async def _simulate(request: Request) -> Any:
-    data = await _body(request)
-    steps = _int(data.get("steps", 180), "steps")
-    args = (_need(data, "mechanism"), steps, None, _bool(data, "rates", True))
-    # a mechanism of drivers and dyads (a drag's repaint: milliseconds of NumPy) in this
-    # process, with the plans compiled here; the rest, and every refusal, in a worker
-    quick = await run_in_threadpool(_service.quick_simulate, *args)
+    body = await _parsed(request, S.SimulateBody)
+    args = (body.mechanism, body.steps, None, body.rates)
+    # a mechanism of drivers and dyads at the page's sweep (a drag's repaint: milliseconds
+    # of NumPy) in this process, with the plans compiled here; the rest, and every
+    # refusal, in a worker
+    quick = await run_in_threadpool(_service.quick_simulate, *args) if body.steps <= QUICK_STEPS else None
     return quick if quick is not None else await _heavy(request, "simulate", *args)
 
 
@@ -231,49 +248,38 @@ async def _read_file(request: Request) -> Any:
 
 @api
 async def _save_file(request: Request) -> Any:
-    data = await _body(request)
-    root = request.app.state.root
-    name = _need(data, "path")
+    body = await _parsed(request, S.SaveBody)
+    root, name = request.app.state.root, body.path
     path = _files.resolve_inside(root, name)
     suffix = _files.mechanism_suffix(path)
-    overwrite = _bool(data, "overwrite", False)
-    if (path.exists() or path.is_symlink()) and not overwrite:
+    if (path.exists() or path.is_symlink()) and not body.overwrite:
         raise MechsynInputError(f"{name} exists", field="path", hint="confirm to overwrite it")
     mode = await run_in_threadpool(_files.may_replace, path)
     if not path.parent.is_dir():
         raise MechsynInputError(f"no folder {path.parent.relative_to(root).as_posix()}", field="path")
-    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), suffix)
+    text = await _heavy(request, "mechanism_text", body.mechanism, suffix)
     await run_in_threadpool(write_atomic, path, text, mode)
     return {"saved": path.relative_to(root).as_posix(), "bytes": len(text.encode())}
 
 
 @api
 async def _import_text(request: Request) -> Any:
-    data = await _body(request)
-    text, name = _need(data, "text"), data.get("filename", "upload.yaml")
-    if not isinstance(text, str):
-        raise MechsynInputError("must be the file's text", field="text")
-    if not isinstance(name, str) or len(name) > _files.MAX_NAME:
-        raise MechsynInputError(f"must be a file name of at most {_files.MAX_NAME} characters", field="filename")
-    return {"mechanism": await _heavy(request, "parse_mechanism_text", text, name), "name": name}
+    body = await _parsed(request, S.ImportBody)
+    return {"mechanism": await _heavy(request, "parse_mechanism_text", body.text, body.filename),
+            "name": body.filename}
 
 
 @api
 async def _export_text(request: Request) -> Any:
-    data = await _body(request)
-    fmt = data.get("format", "yaml")
+    body = await _parsed(request, S.ExportBody)
+    fmt = body.format
     if fmt == "csv":
-        text = await _heavy(request, "simulation_csv", _need(data, "mechanism"), _int(data.get("steps", 180), "steps"))
+        text = await _heavy(request, "simulation_csv", body.mechanism, body.steps)
         return Response(text, media_type="text/csv")
     if fmt == "gif":
-        frames = _int(data.get("frames", 72), "frames")
-        if not 2 <= frames <= 360:
-            raise MechsynInputError("frames must be within 2..360", field="frames")
-        gif = await _heavy(request, "animation_gif", _need(data, "mechanism"), frames)
+        gif = await _heavy(request, "animation_gif", body.mechanism, body.frames)
         return Response(gif, media_type="image/gif")
-    if fmt not in ("yaml", "json"):
-        raise MechsynInputError(f"unknown format {str(fmt)[:20]!r}", field="format", hint="yaml, json, csv or gif")
-    text = await _heavy(request, "mechanism_text", _need(data, "mechanism"), "." + fmt)
+    text = await _heavy(request, "mechanism_text", body.mechanism, "." + fmt)
     return Response(text, media_type="application/json" if fmt == "json" else "application/yaml")
 
 
@@ -292,23 +298,20 @@ def _query_int(text: str, field: str) -> int:
 
 @api
 async def _atlas_mechanism(request: Request) -> Any:
-    data = await _body(request)
-    frame = data.get("frame")
-    inp = data.get("input")
-    mech = await _heavy(request, "atlas_mechanism", _need(data, "chain"),
-                        None if frame is None else _int(frame, "frame"), None if inp is None else _int(inp, "input"))
-    return {"mechanism": mech}
+    body = await _parsed(request, S.ChainBody)
+    return {"mechanism": await _heavy(request, "atlas_mechanism", body.chain, body.frame, body.input)}
 
 
 @api
 async def _synth_start(request: Request) -> Any:
-    data = await _body(request)
     kind = request.path_params["kind"]
     if kind not in _service.SYNTHESIS_KINDS:
-        raise MechsynInputError(f"unknown synthesis kind {kind!r}", field="kind",
+        raise MechsynInputError(f"unknown synthesis kind {kind[:40]!r}", field="kind",
                                 hint="one of " + ", ".join(_service.SYNTHESIS_KINDS))
+    params = (await _parsed(request, S.SYNTHESIS_PARAMS.get(kind, S.AnyParams))).model_dump()
     fn = _service.SYNTHESIS_KINDS[kind][1]
-    return request.app.state.jobs.submit(kind, fn, data).snapshot()
+    state = request.app.state
+    return state.jobs.submit(kind, fn, params, state.heavy, _client(request)).snapshot()
 
 
 @api
@@ -435,22 +438,36 @@ def _warm_kernel() -> None:
 
 #: Seconds a client may take to send its request head (and to keep an idle connection).
 HEADER_TIMEOUT = 10
-#: Connections and requests at once; uvicorn answers 503 beyond (descriptors stay free).
-MAX_CONNECTIONS = 200
+#: Connections whose request head has not arrived yet; a new one beyond closes the oldest
+#: (a client sends its head at once: only silent sockets wait, and they hold no slot).
+MAX_PENDING_HEADS = 256
 
 
 def _header_timeout_protocol():
     """uvicorn's h11 protocol closing a connection whose request head has not arrived
     within :data:`HEADER_TIMEOUT` s (uvicorn's own keep-alive timer starts only after a
-    first response: about 1,100 silent connections locked a studio out)."""
+    first response: about 1,100 silent connections locked a studio out), and the oldest
+    such connection when more than :data:`MAX_PENDING_HEADS` wait (their descriptors stay
+    bounded). Nothing counts open sockets: :class:`Guard` counts the requests that run
+    (issue 42: 250 sockets sending a request line only made uvicorn's ``limit_concurrency``
+    answer 503 to the real user)."""
+    from collections import OrderedDict
+
     from uvicorn.protocols.http.h11_impl import H11Protocol
+
+    pending: "OrderedDict[Any, None]" = OrderedDict()  # this server's connections without a head
 
     class Protocol(H11Protocol):
         def connection_made(self, transport: Any) -> None:
             super().connection_made(transport)
             self._head_timer = self.loop.call_later(HEADER_TIMEOUT, self._head_late)
+            pending[self] = None
+            while len(pending) > MAX_PENDING_HEADS:
+                oldest, _ = pending.popitem(last=False)
+                oldest._head_late()
 
         def _head_late(self) -> None:
+            pending.pop(self, None)
             if self.cycle is None and not self.transport.is_closing():
                 self.transport.close()
 
@@ -458,9 +475,11 @@ def _header_timeout_protocol():
             super().handle_events()
             if self.cycle is not None:
                 self._head_timer.cancel()
+                pending.pop(self, None)
 
         def connection_lost(self, exc: Exception | None) -> None:
             self._head_timer.cancel()
+            pending.pop(self, None)
             super().connection_lost(exc)
 
     return Protocol
@@ -469,11 +488,12 @@ def _header_timeout_protocol():
 def server_config(app: Starlette, host: str = "127.0.0.1", port: int = 8765):
     """uvicorn's settings for the studio: the request head within :data:`HEADER_TIMEOUT` s
     (the body: :data:`BODY_TIMEOUT`, in :class:`Guard`), idle connections closed after as
-    long, at most :data:`MAX_CONNECTIONS` at once, one second to finish on exit."""
+    long, no limit on open sockets (requests are counted by :class:`Guard`), one second
+    to finish on exit."""
     import uvicorn
 
     return uvicorn.Config(app, host=host, port=port, log_level="warning", http=_header_timeout_protocol(),
-                          timeout_keep_alive=HEADER_TIMEOUT, limit_concurrency=MAX_CONNECTIONS,
+                          timeout_keep_alive=HEADER_TIMEOUT, limit_concurrency=None,
                           timeout_graceful_shutdown=1, h11_max_incomplete_event_size=64 * 1024)
 
 
@@ -492,6 +512,7 @@ def run_server(app: Starlette, host: str = "127.0.0.1", port: int = 8765) -> Non
             super().handle_exit(sig, frame)
             app.state.stopping.set()  # event streams end now; other requests get 1 s, then are cancelled
             app.state.jobs.cancel_all()
+            app.state.heavy.stop_all()  # workers killed: their requests answer 503 within the second
 
     try:
         _Server(server_config(app, host, port)).run()

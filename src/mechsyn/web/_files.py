@@ -61,6 +61,30 @@ def resolve_inside(root: Path, name: object, field: str = "path") -> Path:
     return target
 
 
+#: Characters a name for Save or an upload may not hold besides the unprintable ones: markup.
+MARKUP = "<>"
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name a file the studio writes or shows (None when it can):
+    printable text only (no newline, tab or other control character, no bidi override or
+    other format character such as U+202E, no line separator) and no markup (``<``, ``>``).
+
+    >>> name_problem("four-bar (v2).yaml") is None
+    True
+    >>> name_problem("evil\u202eLMY.yaml")
+    'the name holds U+202E, an invisible or control character: file names are printable text'
+    >>> name_problem("<img src=x>.yaml")
+    "the name holds '<': file names hold no markup"
+    """
+    for c in name:
+        if not c.isprintable():
+            return f"the name holds U+{ord(c):04X}, an invisible or control character: file names are printable text"
+        if c in MARKUP:
+            return f"the name holds {c!r}: file names hold no markup"
+    return None
+
+
 def mechanism_suffix(path: Path, field: str = "path", suffixes: tuple[str, ...] = MECHANISM_SUFFIXES) -> str:
     """The suffix of a mechanism file name, or an input error."""
     if path.suffix.lower() not in suffixes:

@@ -20,7 +20,7 @@ from typing import Any, Callable
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.results import to_jsonable
+from mechsyn.results import csv_cell, to_jsonable
 
 MAX_STEPS = 2000
 #: The largest mechanism :func:`quick_simulate` answers in the server's process (a
@@ -354,7 +354,8 @@ def simulation_csv(data: Any, steps: int = 180) -> str:
     cols = {**sim["joints"], **sim["points"]}
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow([f"input_{sim['input']['joint']}", "assembled"] + [f"{n}_{c}" for n in cols for c in "xy"])
+    w.writerow([csv_cell(f"input_{sim['input']['joint']}"), "assembled"]
+               + [csv_cell(f"{n}_{c}") for n in cols for c in "xy"])
     for k, u in enumerate(sim["input"]["values"]):
         row = [repr(u), int(sim["assembled"][k])]
         for n in cols:

@@ -36,7 +36,8 @@ from mechsyn.kinematics.analysis import simulate
 from mechsyn.results import to_jsonable
 from mechsyn.structure.rank import analyze_rank
 from mechsyn.web import _service
-from mechsyn.web._routing import _body, _heavy, _int, _need, api
+from mechsyn.web._routing import _heavy, _parsed, api
+from mechsyn.web._schema import SweepBody
 
 #: Largest number of rows of one sweep (the planar routes' limit).
 MAX_STEPS = _service.MAX_STEPS
@@ -276,9 +277,8 @@ def routes() -> list:
     def on_sweep(name: str):
         @api
         async def route(request) -> Any:
-            body = await _body(request)
-            return await _heavy(request, f"_spatial:{name}", _need(body, "mechanism"),
-                                _int(body.get("steps", 180), "steps"))
+            body = await _parsed(request, SweepBody)
+            return await _heavy(request, f"_spatial:{name}", body.mechanism, body.steps)
         return route
 
     return [Route("/api/spatial/view", on_sweep("view"), methods=["POST"]),

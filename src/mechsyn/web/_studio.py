@@ -41,7 +41,8 @@ from mechsyn.structure.report import analyze as structure_report
 from mechsyn.synthesis.export import fourbar_mechanism_dict
 from mechsyn.synthesis.reports import motion_report
 from mechsyn.web import _service
-from mechsyn.web._routing import _body, _heavy, _int, _need, api
+from mechsyn.web._routing import _heavy, _parsed, api
+from mechsyn.web._schema import ForcesBody, MechanismBody, mechanism_types
 from mechsyn.web._spatial import check_note
 
 
@@ -125,8 +126,7 @@ def check(data: Any) -> dict[str, Any]:
     (shown by the studio next to the element its field names).
     """
 
-    if not isinstance(data, dict):
-        raise MechsynInputError("the mechanism must be a JSON object", field="mechanism")
+    mechanism_types(data)  # a wrong type is an input error here, not a crash of the checks below
     problems = connection_problems(data)
     drives = [str(j.get("id")) for j in data.get("joints", []) if isinstance(j, dict) and j.get("actuated")]
     out: dict[str, Any] = {"mobility": None, "mobility_source": None, "drives": drives,
@@ -253,15 +253,14 @@ def _spatial_examples(root) -> tuple[dict[str, str], ...]:
 
 def routes() -> list:
     """The studio editor's routes (registered by :func:`mechsyn.web._app._routes`). The
-    check is quick and runs in the server's threads; forces and the exports are heavy and
-    run as capped, cancellable worker processes (:func:`mechsyn.web._routing._heavy`)."""
+    check, forces and the exports run as capped, cancellable worker processes
+    (:func:`mechsyn.web._routing._heavy`): nothing heavy in the server's process (a check
+    of a large mechanism took minutes there, issue 42)."""
 
-    def on_mechanism(name, media_type=None, heavy=True):
+    def on_mechanism(name, media_type=None):
         @api
         async def route(request) -> Any:
-            mech = _need(await _body(request), "mechanism")
-            out = await (_heavy(request, f"_studio:{name}", mech) if heavy
-                         else run_in_threadpool(globals()[name], mech))
+            out = await _heavy(request, f"_studio:{name}", (await _parsed(request, MechanismBody)).mechanism)
             return Response(out, media_type=media_type) if media_type else out
         return route
 
@@ -271,12 +270,11 @@ def routes() -> list:
 
     @api
     async def forces_route(request) -> Any:
-        body = await _body(request)
-        return await _heavy(request, "_studio:forces", _need(body, "mechanism"), body.get("gravity", [0.0, 0.0]),
-                            body.get("speed", 1.0), _int(body.get("steps", 180), "steps"))
+        body = await _parsed(request, ForcesBody)
+        return await _heavy(request, "_studio:forces", body.mechanism, body.gravity, body.speed, body.steps)
 
     return [Route("/api/studio/examples", examples_route),
             Route("/api/studio/forces", forces_route, methods=["POST"]),
-            Route("/api/studio/check", on_mechanism("check", heavy=False), methods=["POST"]),
+            Route("/api/studio/check", on_mechanism("check"), methods=["POST"]),
             Route("/api/studio/drawing", on_mechanism("export_drawing", "image/svg+xml"), methods=["POST"]),
             Route("/api/studio/dxf", on_mechanism("export_dxf", "application/dxf"), methods=["POST"])]
