@@ -265,7 +265,7 @@ class CurveDatabaseReport(Result):
     bytes: int
 
 
-def curve_database(directory: Any = None, *, max_links: int = 6, per_topology: int = 3000, seed: int = 0,
+def curve_database(directory: Any = None, *, max_links: int = 8, per_topology: int = 3000, seed: int = 0,
                    scheduler: Any = None, callback: Callable[[dict], None] | None = None) -> CurveDatabaseReport:
     """Build or extend the curve database of :func:`mechsyn.synthesis.curves.synthesis.synthesize_curve`
     (see :func:`mechsyn.synthesis.curves.database.build_database`) and say what it holds.

@@ -150,10 +150,9 @@ def full_plan(topo: CurveTopology):
     """The topology's batch plan with every joint (and the tracer) as an output."""
     plan = _FULL_PLANS.get(topo.key)
     if plan is None:
-        from mechsyn.io.load import mechanism_from_dict
         from mechsyn.kinematics.batch import compile_plan
 
-        plan = compile_plan(mechanism_from_dict(topo.template), points=list(topo.plan.names))
+        plan = compile_plan(topo.model, points=list(topo.plan.names))
         if list(plan.names) != list(topo.plan.names):  # the parameters must mean the same
             raise RuntimeError(f"{topo.key}: the full plan orders its points differently")
         _FULL_PLANS[topo.key] = plan

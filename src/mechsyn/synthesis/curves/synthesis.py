@@ -5,8 +5,8 @@ linkages whose tracing point follows it:
 
 1. **Normalise** the target: ``M`` points equally spaced in arc length (an open curve
    there and back), its Fourier descriptor (:mod:`.descriptors`).
-2. **Retrieve**: nearest descriptors in the database (:mod:`.database`, a SciPy
-   ``cKDTree``), for both senses of traversal; the candidates' curves are recomputed by
+2. **Retrieve**: nearest descriptors in the database (:mod:`.database`, Faiss through
+   :mod:`.index`), for both senses of traversal; the candidates' curves are recomputed by
    the batch engine and re-ranked by the exact closed-form similarity alignment (best
    rotation, scale, translation, start point, sense and mirror image at once).
 3. **Map** each retained design into the target's frame by its similarity (a linkage
@@ -107,31 +107,38 @@ def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) 
 
 
 def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool,
-              bounds: Bounds) -> list[_Seed]:
+              bounds: Bounds, deadline: float = float("inf")) -> tuple[list[_Seed], str]:
+    """The ``k`` nearest descriptors per link count and sense, aligned and mapped into
+    the target's frame (:func:`_topology_seeds`), best first; topologies are taken by
+    link count, then by their nearest descriptor, and none is begun past ``deadline``
+    (the note returned says how many were left; "" when none)."""
     w = resample(target.points, 64, closed=target.closed)
     d = fourier_descriptor(w)
-    rows: set[int] = set()
+    first: dict[int, int] = {}      # row -> its best place in a retrieval list
     for n in range(4, max_links + 1, 2):   # each link count its own share of the retrieval
-        tree, sub = db.tree(n)
-        if tree is None:
+        index, sub = db.index(n)
+        if index is None:
             continue
-        kk = min(k, len(sub))
-        for q in (d, swap_direction(d)):
-            _, ii = tree.query(q.astype(np.float32), k=kk)
-            rows.update(sub[np.atleast_1d(ii)].tolist())
-    rows_a = np.array(sorted(rows), int)
+        ii = index.search(np.stack([d, swap_direction(d)]), k)
+        for place, r in sorted((p, int(sub[i])) for row in ii for p, i in enumerate(row) if i >= 0):
+            first.setdefault(r, place)
+    rows_a = np.array(sorted(first), int)
     if crank:
         rows_a = rows_a[db.closed[rows_a]]
     if not target.closed:
         rows_a = rows_a[~db.closed[rows_a]]
-    seeds: list[_Seed] = []
     by_topo: dict[int, list[int]] = {}
     for r in rows_a.tolist():
         by_topo.setdefault(int(db.topology[r]), []).append(r)
-    for ti, rs in by_topo.items():
-        seeds += _topology_seeds(db, db.topologies[ti], rs, w, bounds.unit, bounds)
+    order = sorted(by_topo, key=lambda ti: (db.topologies[ti].n_links, min(first[r] for r in by_topo[ti]), ti))
+    seeds: list[_Seed] = []
+    for j, ti in enumerate(order):
+        if time.perf_counter() > deadline:
+            seeds.sort(key=lambda s: (s.rank, s.row))
+            return seeds, f"retrieval: {len(order) - j} of {len(order)} topologies left out at the time limit"
+        seeds += _topology_seeds(db, db.topologies[ti], by_topo[ti], w, bounds.unit, bounds)
     seeds.sort(key=lambda s: (s.rank, s.row))
-    return seeds
+    return seeds, ""
 
 
 def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np.ndarray, diag: float,
@@ -389,8 +396,12 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
             callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
 
     report("retrieve", 0, 1, float("nan"), 0)
-    seeds = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds)
+    # retrieval may use at most half of what is left (the rest: evaluation, refinement, checks)
+    seeds, note = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds,
+                            deadline=time.perf_counter() + 0.5 * (end - time.perf_counter()))
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
+    if note:
+        notes.append(note)
     run = _Run(work, bounds, o, report, end, notes=notes)
     if not seeds:
         run.notes.append("no database design matched the options (crank, links, open/closed)")
@@ -473,6 +484,7 @@ def _diverse(seeds: list[_Seed], n_refine: int, simple: bool = False) -> list[_S
 
 
 UNREFINED = 8        # retrieved designs evaluated as they are, before any refinement (answers at any limit)
+MIN_UNREFINED = 3    # of them evaluated whatever the time: an answer at any limit
 WIDEN = 8            # new retrieved seeds per round after the first
 RESTARTS = 2         # perturbed restarts per leading topology per round
 LEADERS = 3          # topologies restarted and polished per round
@@ -498,7 +510,7 @@ class _Run:
     assembled: int = 0
     interrupted: bool = False
     notes: list[str] = field(default_factory=list)
-    verify_cost: float = 0.05
+    verify_cost: float = 0.05   # seconds of one check by simulate (measured on the first candidate)
     topologies: int = 3      # topologies among the retrieved designs
 
     @property
@@ -507,16 +519,19 @@ class _Run:
 
     def deadline(self) -> float:
         """The end of refinement: the limit less the time the final checks will take
-        (``top + 2`` checks by ``simulate`` at the longest one's cost, 1.5 times)."""
-        return self.end - 1.5 * (self.o["top"] + 2) * self.verify_cost - 0.05
+        (``top + 1`` checks by ``simulate`` at the longest one's cost, 1.2 times)."""
+        return self.end - 1.2 * (self.o["top"] + 1) * self.verify_cost - 0.05
 
-    def verify(self, c: CurveCandidate) -> None:
-        """The check by ``simulate`` (once per candidate; its cost measured)."""
-        if c.verification:
+    def verify(self, c: CurveCandidate, measure: bool = False) -> None:
+        """The check by ``simulate`` (once per candidate; with ``measure`` run again, timed:
+        the first run pays for compiling the mechanism's solver)."""
+        if c.verification and not measure:
             return
-        t = time.perf_counter()
         _verify(c)
-        self.verify_cost = max(self.verify_cost, time.perf_counter() - t)
+        if measure:
+            t = time.perf_counter()
+            _verify(c)
+            self.verify_cost = time.perf_counter() - t
 
     def add(self, c: CurveCandidate | None) -> None:
         if c is None:
@@ -525,7 +540,7 @@ class _Run:
         self.nfev += c.nfev
         if self.keeps(c):
             if not self.cands:  # the first: its check measures what the final checks cost
-                self.verify(c)
+                self.verify(c, measure=True)
             self.cands.append(c)
         else:
             self.misses.append(c)
@@ -554,10 +569,13 @@ class _Run:
 
     def search(self, seeds: list[_Seed]) -> None:
         """Evaluate the best retrieved designs as they are, then refine until :meth:`stop`."""
+        import mechsyn.io.load  # noqa: F401  (the checks' imports first: their cost is measured)
+        import mechsyn.kinematics  # noqa: F401
+
         self.topologies = len({s.topo.key for s in seeds})
         try:
-            for s in seeds[:UNREFINED]:
-                if time.perf_counter() >= self.deadline():
+            for i, s in enumerate(seeds[:UNREFINED]):
+                if i >= MIN_UNREFINED and time.perf_counter() >= self.deadline():
                     break
                 self.add(_candidate(s.topo, s.params, s.start, s.stop, s.closed, self.target, 0, self.bounds,
                                     refined=False))
