@@ -246,7 +246,7 @@ class FitProblem:
             r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
             r3 = _to_polyline(F[None], starts, vecs)[0]             # sharp features -> path
         r1 = r1 / np.sqrt(len(self.T))
-        r2 = r2 / np.sqrt(P.shape[1])
+        r2 = r2 * np.sqrt(_arc_weights(P, self.closed_path))[..., None]   # a mean over arc length, as reported
         r3 = r3 * (FEATURE_WEIGHT / np.sqrt(max(len(F), 1)))
         r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1), r3.reshape(len(X), -1)],
                            axis=1) / self.diag
@@ -275,6 +275,18 @@ class FitProblem:
         X = np.vstack([x, x + h * np.eye(len(x))])
         R = self.residuals(X, keep=True)
         return (R[1:] - R[0]).T / h
+
+
+def _arc_weights(P: np.ndarray, closed: bool) -> np.ndarray:
+    """Weights ``(K, N)`` of path samples ``P (K, N, 2)`` summing to 1: each sample's share
+    of the path's length (half its two neighbouring segments), so that sums over the
+    samples are means over arc length whatever the crank's speed (uniform for a path
+    without length)."""
+    seg = np.hypot(*(np.diff(P, axis=1, append=P[:, :1] if closed else P[:, -1:])).transpose(2, 0, 1))
+    before = np.roll(seg, 1, axis=1) if closed else np.concatenate([np.zeros_like(seg[:, :1]), seg[:, :-1]], axis=1)
+    w = 0.5 * (seg + before)
+    total = w.sum(axis=1, keepdims=True)
+    return np.where(total > 0, w / np.where(total > 0, total, 1.0), 1.0 / P.shape[1])
 
 
 class OutOfTime(Exception):
