@@ -174,7 +174,7 @@ def ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
     full turn, then the larger transmission angle (5° steps), then the error; the rest
     by error; ``"accuracy"``: by error. The simplest candidate within the tolerance and
     the most accurate one are labelled (:attr:`CurveCandidate.role`); the most
-    accurate is always listed, in the last place if it would not be."""
+    accurate is always listed: after the ``top`` if it is not among them."""
     cands = sorted(cands, key=lambda c: _rank_key(c, tolerance, prefer))
     order = cands
     if prefer == "simple":
@@ -199,7 +199,7 @@ def ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
             break
         verify(c)
         if c.verified:
-            out = out[:top - 1] + [c] if len(out) >= top else out + [c]
+            out.append(c)
             break
         notes.append(f"{c.topology.key}: dropped, {c.verification}")
     for c in out:
