@@ -35,6 +35,7 @@ def synth_curve(
     out: Optional[Path] = typer.Option(None, "--out", help="Write each candidate's mechanism file and figure into DIR."),
 ) -> None:
     """Curve to mechanism: ranked 4-, 6- and 8-bar linkages tracing the target, sized to it, each re-simulated."""
+    from mechsyn.cli.main import STARTED     # the limit counts from the command's start, imports included
     from mechsyn.cli.render import render_curve_synthesis
     from mechsyn.synthesis.curves.synthesis import synthesize_curve
     from mechsyn.synthesis.curves.target import read_target
@@ -46,7 +47,7 @@ def synth_curve(
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
                                ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
                                min_transmission=min_transmission, prefer=prefer, tolerance=_fraction(tolerance),
-                               database=database, callback=callback, refinements=refinements,
+                               database=database, callback=callback, refinements=refinements, started=STARTED,
                                target_error=None if target_error is None else _fraction(target_error, "--target-error"))
     if out is not None:
         _write_out(out, res)

@@ -266,6 +266,7 @@ def synthesize_curve(
     tolerance: float = DEFAULT_TOLERANCE,
     refinements: int | None = None,
     target_error: float | None = None,
+    started: float | None = None,
 ) -> CurveSynthesisResult:
     """Ranked linkages (4 to ``max_links`` links) a designer can build whose tracing
     point follows a curve.
@@ -279,8 +280,9 @@ def synthesize_curve(
     max_links : {4, 6, 8}
         Largest linkage.
     time_limit : float
-        Seconds for the whole call, every phase included (see the module doc, "Anytime");
-        building a missing database first is not counted (a note says so).
+        Seconds for the whole call, every phase included (see the module doc, "Anytime"),
+        from ``started`` (a ``time.perf_counter()``; default: the call); building a
+        missing database first is not counted (a note says so).
     top : int
         Candidates returned (see ``prefer``; the first three of distinct topologies).
     n_refine, retrieve : int
@@ -336,7 +338,7 @@ def synthesize_curve(
     >>> c.topology.label, c.verified, c.chamfer < 0.02, c.size_ratio <= 1.5, c.role.endswith("most accurate")
     ('four-bar', True, True, True, True)
     """
-    t0 = time.perf_counter()
+    t0 = time.perf_counter() if started is None else min(started, time.perf_counter())
     o = dict(max_links=max_links, time_limit=time_limit, top=top, n_refine=n_refine, retrieve=retrieve, crank=crank,
              ground_region=ground_region, max_size=max_size, max_link_ratio=max_link_ratio,
              min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance,
