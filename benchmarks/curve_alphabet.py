@@ -84,6 +84,7 @@ def run(letters: str, time_limit: float, font: str = "DejaVu Sans", weight: str 
             first = cands[0] if cands else None
             best = min(cands, key=lambda c: c["error"]["chamfer"]) if cands else None
             rows.append({"letter": ch, "seconds": dt, "exit": r.returncode, "notes": res.get("notes", []),
+                         "search_seconds": res.get("seconds"),
                          "chamfer": best["error"]["chamfer"] if best else None,
                          "first_chamfer": first["error"]["chamfer"] if first else None,
                          "topology": best["topology"] if best else None, "links": best["links"] if best else None,
