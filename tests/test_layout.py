@@ -139,7 +139,7 @@ FACADE_EDGES: frozenset[str] = frozenset({
     "mechsyn.kinematics.spatial_result:SpatialSimulation.animate -> mechsyn.plot.spatial",
     "mechsyn.synthesis.atlas:Atlas.plot -> mechsyn.plot.atlas",
     "mechsyn.synthesis.reports:MotionReport.plot -> mechsyn.plot.synthesis",
-    "mechsyn.synthesis.curves.synthesis:CurveSynthesisResult.plot -> mechsyn.plot.curves",
+    "mechsyn.synthesis.curves.candidates:CurveSynthesisResult.plot -> mechsyn.plot.curves",
 })
 
 #: TEMPORARY (issue 28): edges of files being reworked on other branches. Each goes when

@@ -211,7 +211,7 @@ def test_cli_interrupted_curve_synthesis_writes_best_and_exits_130(run_cli, tmp_
 
     monkeypatch.setattr(curves, "_refine", refine_then_interrupt)
     code, out, err = run_cli("synth", "curve", target, "--max-links", "4", "--database", db, "--json",
-                             "--time-limit", "60")
+                             "--time-limit", "60", "--refinements", "10")
     assert code == INTERRUPT_EXIT_CODE, err
     assert err.strip().splitlines()[-1] == "interrupted"
     res = json.loads(out)

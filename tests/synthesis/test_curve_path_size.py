@@ -1,6 +1,7 @@
-"""The size bound of ``synth path`` (issue 29 / issue 24 item 4): by default a four-bar's
-frame pivots and pin circles stay within 1.5 target diagonals of the targets' centre;
-``--max-size`` / ``max_size`` lifts or changes it; literature cases keep their space."""
+"""The size bound of ``synth path`` (issue 29 / issue 24 item 4; issue 41): a four-bar's
+frame pivots and pin circles stay within ``--max-size`` / ``options.max_size`` target
+diagonals of the targets' centre; without either, the bounds a case states on its
+variables are its design space; a bound the design sits on is named with how to lift it."""
 
 from __future__ import annotations
 
@@ -28,11 +29,11 @@ def _known_case(r=(3.0, 1.0, 3.0, 2.5), rc=(1.0, 1.0)) -> tuple[PathCase, np.nda
     return case, np.array([*r, *rc])
 
 
-def test_the_known_large_linkage_is_outside_the_default_bound_and_inside_when_lifted():
+def test_the_known_large_linkage_is_outside_a_size_bound_and_inside_when_lifted():
     case, x = _known_case()
-    bounded = PathProblem(with_size_bound(case))
+    bounded = PathProblem(with_size_bound(case, 1.5))
     lifted = PathProblem(with_size_bound(case, 0))
-    assert with_size_bound(case).max_size == 1.5 and lifted.case.max_size is None
+    assert with_size_bound(case, 1.5).max_size == 1.5 and lifted.case.max_size is None
     vals = bounded.unpack(x[None])[0]
     T = case.targets
     diag = np.hypot(*np.ptp(T, axis=0))
@@ -45,21 +46,32 @@ def test_the_known_large_linkage_is_outside_the_default_bound_and_inside_when_li
     assert PathProblem(with_size_bound(case, expect / diag * 1.01)).evaluate(x[None]).feasible[0]
 
 
-def test_synth_path_keeps_the_default_size_bound():
-    case, _ = _known_case()
-    res = synthesize_path(case, seed=0, time_limit=60, restarts=1)
+def test_a_case_keeps_its_own_design_space_and_finds_its_exact_design():
+    case, x = _known_case()
+    assert with_size_bound(case).max_size is None     # no default overrides the case's variable bounds
+    res = synthesize_path(case, seed=0, time_limit=60, restarts=2)
     d = res.to_dict()
-    assert d["max_size"] == 1.5 and d["size_ratio"] is not None
-    if res.feasible:
-        assert d["size_ratio"] <= 1.5 + 1e-9
+    assert d["max_size"] is None and res.feasible and res.error < 1e-12
+    assert d["size_ratio"] > 1.5 and d["limited_by"] == ""     # larger than the old default: nothing decided it
     with pytest.raises(MechsynInputError, match="max_size"):
         with_size_bound(case, -1.0)
+
+
+def test_a_bound_that_decides_the_result_is_named_with_how_to_lift_it(cli_json, tmp_path):
+    case, _ = _known_case()
+    res = synthesize_path(case, seed=0, time_limit=60, restarts=3, max_size=2.0)
+    assert res.feasible and res.error > 1e-6 and res.size_ratio == pytest.approx(2.0, rel=1e-5)
+    assert "size bound 2" in res.limited_by and "--max-size 0" in res.limited_by
+    tight = dataclasses.replace(case, variables=tuple(
+        dataclasses.replace(v, upper=2.0) if v.name == "r1" else v for v in case.variables))
+    res = synthesize_path(tight, seed=0, time_limit=60, restarts=2)
+    assert "r1 = 2 sits on its upper bound" in res.to_dict()["limited_by"]
 
 
 def test_literature_cases_keep_their_design_space(public_cases):
     lit = public_cases["P2_kk5_timing"]
     assert with_size_bound(lit).max_size is None
-    assert with_size_bound(dataclasses.replace(lit, published=())).max_size == 1.5
+    assert with_size_bound(dataclasses.replace(lit, published=())).max_size is None
     assert with_size_bound(lit, 2.0).max_size == 2.0
 
 

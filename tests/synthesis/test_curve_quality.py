@@ -61,12 +61,24 @@ def _joint_paths(cd: dict) -> np.ndarray:
     return np.stack([sim.points[i].position for i in ids], axis=1)
 
 
+def _centroid_and_diagonal(P: np.ndarray) -> tuple[np.ndarray, float]:
+    """Independently: the centroid of the closed polyline (segment midpoints weighted
+    by length) and the diagonal of its bounding box along the eigenvectors of its
+    second moments."""
+    Q = np.roll(P, -1, axis=0)
+    L = np.hypot(*(Q - P).T)
+    mid = 0.5 * (P + Q)
+    c = (mid * L[:, None]).sum(axis=0) / L.sum()
+    _, vec = np.linalg.eigh(np.cov((mid - c).T, aweights=L))
+    R = (P - c) @ vec
+    return c, float(np.hypot(*np.ptp(R, axis=0)))
+
+
 def test_every_candidate_is_inside_the_default_bounds_and_reports_its_quality(db):
     P = _fourbar_curve(3)
-    res = synthesize_curve(P, max_links=6, top=3, n_refine=10, database=db, time_limit=300)
+    res = synthesize_curve(P, max_links=6, top=3, refinements=10, database=db, time_limit=300)
     assert res.candidates
-    centre = 0.5 * (P.min(axis=0) + P.max(axis=0))
-    diag = float(np.hypot(*np.ptp(P, axis=0)))
+    centre, diag = _centroid_and_diagonal(P)
     for c in res.candidates:
         d = c.to_dict()
         q = d["quality"]
@@ -87,14 +99,14 @@ def test_bounds_lifted_only_when_asked_and_refused_when_impossible(db):
         synthesize_curve(P, max_size=0.2, database=db)
     with pytest.raises(MechsynInputError, match="prefer"):
         synthesize_curve(P, prefer="fast", database=db)
-    res = synthesize_curve(P, max_links=4, top=2, n_refine=6, max_size=None, max_link_ratio=None,
+    res = synthesize_curve(P, max_links=4, top=2, refinements=6, max_size=None, max_link_ratio=None,
                            min_transmission=0, database=db, time_limit=300)
     assert res.to_dict()["bounds"]["max_size"] is None and res.candidates
 
 
 def test_no_candidate_within_the_bounds_reports_the_nearest_miss(db, db_path, tmp_path, run_cli):
     P = _fourbar_curve(6)
-    res = synthesize_curve(P, max_links=4, n_refine=4, min_transmission=89, database=db, time_limit=300)
+    res = synthesize_curve(P, max_links=4, refinements=4, min_transmission=89, database=db, time_limit=300)
     assert res.candidates == [] and not res.feasible
     miss = res.nearest_miss
     assert miss is not None and miss.verified and miss.min_transmission_angle < 89
@@ -110,14 +122,14 @@ def test_no_candidate_within_the_bounds_reports_the_nearest_miss(db, db_path, tm
 @pytest.mark.slow
 def test_fewest_links_first_within_the_tolerance_and_distinct_topologies(db):
     P = _fourbar_curve(8)
-    res = synthesize_curve(P, max_links=6, top=4, n_refine=16, database=db, time_limit=300)
+    res = synthesize_curve(P, max_links=6, top=4, refinements=16, database=db, time_limit=300)
     within = [c for c in res.candidates if c.chamfer <= 5e-3]
     assert within and within[0].topology.n_links == 4 and res.candidates[0] is within[0]
     links = [c.topology.n_links for c in within]
     first = res.candidates[:min(3, len(within))]
     assert len({c.topology.key for c in first}) == len(first)          # distinct topologies first
     assert links[0] == min(links)
-    acc = synthesize_curve(P, max_links=6, top=4, n_refine=16, database=db, time_limit=300, prefer="accuracy")
+    acc = synthesize_curve(P, max_links=6, top=4, refinements=16, database=db, time_limit=300, prefer="accuracy")
     errs = [c.chamfer for c in acc.candidates]
     assert errs == sorted(errs)
 
@@ -133,7 +145,7 @@ def _similar(P: np.ndarray, rng) -> tuple[np.ndarray, float]:
 @pytest.mark.slow
 def test_similar_targets_give_the_same_design_transformed(db):
     rng = np.random.default_rng(29)
-    kw = dict(max_links=6, top=3, n_refine=6, database=db, time_limit=1e4, max_size=None)
+    kw = dict(max_links=6, top=3, refinements=6, database=db, time_limit=1e4, max_size=None)
     for seed in (1, 2):
         P = _fourbar_curve(seed)
         base = synthesize_curve(P, **kw)
@@ -157,7 +169,7 @@ def test_scaled_targets_keep_their_answer_with_the_default_bounds(db):
     """x1e-3 and x1e4, turned by 90 degrees and mirrored: the bounding box maps exactly,
     so even the size bound is the same and the answer is the same design transformed."""
     P = _fourbar_curve(4)
-    kw = dict(max_links=6, top=2, n_refine=6, database=db, time_limit=1e4)
+    kw = dict(max_links=6, top=2, refinements=6, database=db, time_limit=1e4)
     base = synthesize_curve(P, **kw)
     for s, turn, mirror in ((1e-3, 1, False), (1e4, 3, True)):
         Q = np.rot90(np.eye(2), turn) @ (P * ([-1, 1] if mirror else [1, 1])).T
@@ -179,7 +191,7 @@ def test_sparse_points_are_a_smooth_curve_not_a_polygon(db):
     polygon_err = curve_errors(sparse, truth, True)[0]
     spline_err = curve_errors(spline.points, truth, True)[0]
     assert spline_err < 0.25 * polygon_err
-    res = synthesize_curve(sparse, max_links=4, top=1, n_refine=8, database=db, time_limit=300)
+    res = synthesize_curve(sparse, max_links=4, top=1, refinements=8, database=db, time_limit=300)
     assert any("smooth curve" in n for n in res.notes)
     c = res.candidates[0]
     assert curve_errors(c.path, truth, True)[0] < 0.5 * polygon_err

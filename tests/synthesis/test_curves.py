@@ -117,7 +117,7 @@ def _fourbar_curve(seed: int):
 def test_recovers_a_four_bar_curve_and_verifies_it(small_db):
     target = target_from_points(_fourbar_curve(4), closed=True)
     states = []
-    res = synthesize_curve(target, max_links=4, top=2, n_refine=6, database=load_database(small_db),
+    res = synthesize_curve(target, max_links=4, top=2, refinements=6, database=load_database(small_db),
                            callback=states.append)
     best = res.candidates[0]
     assert best.chamfer < 0.01 and best.verified
@@ -132,13 +132,14 @@ def test_recovers_a_four_bar_curve_and_verifies_it(small_db):
     P = sim.points["T"].position[1:]
     assert np.max(np.hypot(*(P[:, None, :] - target.points[None]).transpose(2, 0, 1)).min(axis=1)) \
         < 0.05 * target.diagonal
-    assert "chamfer" in str(res) and d["error"]["chamfer"] == best.chamfer
+    assert "error" in str(res) and d["error"]["chamfer"] == best.chamfer
+    assert best.role.endswith("most accurate") and d["role"] == best.role
 
 
 def test_options_are_kept_or_refused(small_db):
     target = target_from_points(_fourbar_curve(7), closed=True)
     box = (-1e9, -1e9, 1e9, 1e9)
-    res = synthesize_curve(target, max_links=6, top=3, n_refine=4, crank=True, max_link_ratio=8.0,
+    res = synthesize_curve(target, max_links=6, top=3, refinements=4, crank=True, max_link_ratio=8.0,
                            ground_region=box, database=load_database(small_db))
     for c in res.candidates:
         assert c.link_length_ratio <= 8.0 * (1 + 1e-6) and c.stop - c.start == 360.0

@@ -17,8 +17,8 @@ app.add_typer(curves_app, name="curves")
 
 @curves_app.command("build")
 def curves_build(
-    links: int = typer.Option(6, "--links", help="Topologies up to this many links: 4, 6 or 8."),
-    per_topology: int = typer.Option(3000, "--per-topology", help="Curves kept per topology."),
+    links: int = typer.Option(8, "--links", help="Topologies up to this many links: 4, 6 or 8."),
+    per_topology: int = typer.Option(3000, "--per-topology", help="Curves kept per four- and six-bar topology (a tenth of it per eight-bar one)."),
     database: Optional[Path] = typer.Option(None, "--database", help="Directory (default: the local one)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the random designs."),
     scheduler: Optional[str] = typer.Option(None, "--scheduler", help="Build on a Dask cluster (scheduler address; extra mechsyn[dask])."),

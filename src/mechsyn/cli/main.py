@@ -9,21 +9,27 @@ imported; a module imported eagerly here is picked up the same way.
 
 from __future__ import annotations
 
-import contextlib
-import importlib
-import os
-import re
-import signal
-import sys
-import threading
-from typing import Any
+import time
 
-import typer
-from typer.core import TyperCommand
+#: ``time.perf_counter()`` when the command line began loading: a command's time limit
+#: (``synth curve --time-limit``) counts from here, its own imports included.
+STARTED = time.perf_counter()
 
-from mechsyn.cli import version as _version  # noqa: F401  (the root callback: --version)
-from mechsyn.cli.app import app
-from mechsyn.errors import MechsynInputError
+import contextlib  # noqa: E402
+import importlib  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+import signal  # noqa: E402
+import sys  # noqa: E402
+import threading  # noqa: E402
+from typing import Any  # noqa: E402
+
+import typer  # noqa: E402
+from typer.core import TyperCommand  # noqa: E402
+
+from mechsyn.cli import version as _version  # noqa: F401, E402  (the root callback: --version)
+from mechsyn.cli.app import app  # noqa: E402
+from mechsyn.errors import MechsynInputError  # noqa: E402
 
 #: command -> (module(s) under mechsyn.cli, one-line help shown by ``mechsyn --help``)
 COMMANDS: dict[str, tuple[tuple[str, ...], str]] = {

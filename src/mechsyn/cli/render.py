@@ -255,6 +255,11 @@ def render_path_synthesis(case: Any, res: Any) -> None:
     console.print(f"feasible: {res.feasible}   assembled at all targets: {res.assembled_at_all_targets}   "
                   f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
                   + ("   (target error reached)" if res.target_reached else ""))
+    if res.size_ratio is not None:
+        console.print(f"size: {res.size_ratio:.4g} target diagonals about the targets' centre"
+                      + (f" (bound {res.max_size:g})" if res.max_size else " (no size bound)"), highlight=False)
+    if res.limited_by:
+        console.print(f"[bold yellow]a bound decides this result:[/] {res.limited_by}", highlight=False)
     console.print(_transmission_line(res))
 
 
@@ -293,26 +298,39 @@ def render_mechanism_synthesis(case: Any, res: Any) -> None:
 
 
 def render_curve_synthesis(res: Any) -> None:
-    """``mechsyn synth curve``: the ranked candidates, their errors and the run's notes."""
+    """``mechsyn synth curve``: the ranked candidates (the simplest within the tolerance
+    and the most accurate labelled), their errors, where each departs most, the notes."""
     tgt = res.target
     t = Table(title=f"Curve synthesis: {tgt.source} ({'closed' if tgt.closed else 'open'}, {len(tgt.points)} points)")
-    for c in ("#", "topology", "links", "chamfer", "ordered", "size", "min mu", "ratio", "input"):
-        t.add_column(c, justify="right" if c not in ("topology",) else "left", no_wrap=c != "topology")
+    for c in ("#", "topology", "error", "", "size", "mu", "ratio", "input"):
+        t.add_column(c, justify="right" if c not in ("topology", "") else "left", no_wrap=c != "",
+                     min_width=12 if c == "topology" else None)
+    short = {"simplest within tolerance": "simplest", "most accurate": "most accurate",
+             "simplest within tolerance and most accurate": "simplest, most accurate"}
     for i, c in enumerate(res.candidates, 1):
         d = c.to_dict()
         inp = d["input"]
         turn = "full turn" if c.full_turn else f"{inp['start']:.0f}..{inp['stop']:.0f}°"
-        t.add_row(str(i), d["topology"], str(d["links"]), f"{100 * c.chamfer:.2f} %",
-                  f"{100 * c.ordered:.2f} %", f"{c.size_ratio:.2f}", f"{c.min_transmission_angle:.0f}",
-                  f"{c.link_length_ratio:.1f}", f"{inp['joint']} {turn}")
+        role = short.get(c.role, "") + ("" if c.refined else (", " if c.role else "") + "not refined")
+        t.add_row(str(i), d["topology"], f"{100 * c.chamfer:.2f} %", role,
+                  f"{c.size_ratio:.2f}", f"{c.min_transmission_angle:.0f}°",
+                  f"{c.link_length_ratio:.1f}", turn)
     if res.candidates:
         console.print(t)
-    console.print(f"errors and size (radius about the target's centre) per bounding-box diagonal "
-                  f"({tgt.diagonal:.4g}); {res.refined} refined of "
-                  f"{res.retrieved} retrieved in {res.seconds:.1f} s; every candidate re-simulated by simulate"
-                  + ("; interrupted: best so far" if res.interrupted else ""))
+    for i, c in enumerate(res.candidates, 1):
+        if 0 <= c.departs_at < len(tgt.points):
+            x, y = tgt.points[c.departs_at]
+            console.print(f"{i}: departs most at points[{c.departs_at}] ({x:.4g}, {y:.4g}), "
+                          f"{100 * c.departure:.2f} % of the diagonal away", highlight=False)
+    limit = f" of {res.time_limit:g} s" if getattr(res, "time_limit", None) else ""
+    console.print(f"error: symmetric chamfer (target and path, each point to the other curve, mean over arc "
+                  f"length) / the target's diagonal ({tgt.diagonal:.4g}, along its principal axes); size: "
+                  f"radius about the target's centroid, in diagonals; {res.refined} refinements of "
+                  f"{res.retrieved} retrieved designs in {res.seconds:.1f} s{limit}; every candidate "
+                  "re-simulated by simulate" + ("; interrupted: best so far" if res.interrupted else ""),
+                  highlight=False)
     for n in res.notes:
-        console.print(f"note: {n}")
+        console.print(f"note: {n}", highlight=False)
 
 
 def _configuration_table(arm: Any, res: Any) -> tuple[Any, list[int]]:

@@ -19,20 +19,23 @@ from mechsyn.errors import MechsynInputError
 def synth_curve(
     target: Path = typer.Argument(..., help="Target curve: CSV of x,y rows, JSON {\"points\": [[x, y], ...], \"closed\": true}, or SVG (one path)."),
     max_links: int = typer.Option(8, "--max-links", help="Largest linkage: 4, 6 or 8 links."),
-    time_limit: float = typer.Option(60.0, "--time-limit", help="Seconds for retrieval and refinement."),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Seconds for the whole search (loading, retrieval, refinement, checks); the search refines and widens until then and answers with the best it has."),
+    refinements: Optional[int] = typer.Option(None, "--refinements", help="A fixed number of refinements instead (deterministic; the time limit still holds)."),
+    target_error: Optional[float] = typer.Option(None, "--target-error", help="Stop once the best error is within this [% of the diagonal] (default: once three topologies are within --tolerance)."),
     top: int = typer.Option(5, "--top", help="How many candidates to list."),
     crank: bool = typer.Option(False, "--crank", help="Only fully rotating inputs (closed targets)."),
     ground_region: Optional[str] = typer.Option(None, "--ground-region", help="Box x0,y0,x1,y1 the frame pivots must stay in."),
-    max_size: float = typer.Option(1.5, "--max-size", help="Every joint within this many target diagonals of the target's bounding-box centre over the motion (0: no bound)."),
+    max_size: float = typer.Option(1.5, "--max-size", help="Every joint within this many target diagonals of the target's centroid over the motion (0: no bound)."),
     max_link_ratio: float = typer.Option(10.0, "--max-link-ratio", help="Largest longest/shortest link length (0: no bound)."),
     min_transmission: float = typer.Option(30.0, "--min-transmission-angle", "--min-transmission", help="Smallest transmission angle [deg] over the motion (0: no bound)."),
     prefer: str = typer.Option("simple", "--prefer", help="simple: fewest links within the tolerance, then quality, then error; accuracy: error alone."),
-    tolerance: float = typer.Option(0.5, "--tolerance", help="Chamfer error [% of the diagonal] within which fewer links rank first."),
+    tolerance: float = typer.Option(0.5, "--tolerance", help="Error [% of the diagonal] within which fewer links rank first."),
     database: Optional[Path] = typer.Option(None, "--database", help="Curve database directory (default: the local one, built on first use)."),
     as_json: bool = typer.Option(False, "--json", help="Print {\"candidates\": [...]} as JSON."),
     out: Optional[Path] = typer.Option(None, "--out", help="Write each candidate's mechanism file and figure into DIR."),
 ) -> None:
     """Curve to mechanism: ranked 4-, 6- and 8-bar linkages tracing the target, sized to it, each re-simulated."""
+    from mechsyn.cli.main import STARTED     # the limit counts from the command's start, imports included
     from mechsyn.cli.render import render_curve_synthesis
     from mechsyn.synthesis.curves.synthesis import synthesize_curve
     from mechsyn.synthesis.curves.target import read_target
@@ -45,7 +48,8 @@ def synth_curve(
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
                                ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
                                min_transmission=min_transmission, prefer=prefer, tolerance=_fraction(tolerance),
-                               database=database, callback=callback)
+                               database=database, callback=callback, refinements=refinements, started=STARTED,
+                               target_error=None if target_error is None else _fraction(target_error, "--target-error"))
     if out is not None:
         _write_out(out, res)
     emit_json(res.to_dict()) if as_json else render_curve_synthesis(res)
@@ -60,13 +64,13 @@ def _say_first_build(database: Optional[Path]) -> None:
 
     where = database if database is not None else default_database_dir()
     if not where.is_dir() or not any(where.iterdir()):
-        err_console.print(f"building the curve database on first use (4- and 6-bar curves, once; later runs "
+        err_console.print(f"building the curve database on first use (4-, 6- and 8-bar curves, once; later runs "
                           f"reuse it) in {escape(str(where))}", highlight=False, soft_wrap=True)
 
 
-def _fraction(percent: float) -> float:
+def _fraction(percent: float, option: str = "--tolerance") -> float:
     if not 0 < percent < 100:
-        raise MechsynInputError(f"{percent:g}: give a percentage of the diagonal in (0, 100)", source="--tolerance")
+        raise MechsynInputError(f"{percent:g}: give a percentage of the diagonal in (0, 100)", source=option)
     return percent / 100.0
 
 

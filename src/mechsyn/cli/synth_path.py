@@ -23,7 +23,7 @@ MinTransmissionOpt = Annotated[Optional[float], typer.Option(
     "case's, else 20; 0: no limit).")]
 MaxSizeOpt = Annotated[Optional[float], typer.Option(
     "--max-size", help="Pivots and pin circles within this many target diagonals of the targets' centre "
-    "(default: the case's, else 1.5; 0: no bound).")]
+    "(default: the case's options.max_size, else none: the case's variable bounds are its design space; 0: no bound).")]
 FoldMarginOpt = Annotated[Optional[float], typer.Option(
     "--fold-margin", help="Grashof cases: how far [deg] the linkage must stay from folding flat anywhere in the "
     "turn (default: the case's, else 5).")]

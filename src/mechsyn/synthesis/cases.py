@@ -50,7 +50,6 @@ LENGTHS = ("r1", "r2", "r3", "r4")
 TIMING_TYPES = ("prescribed", "prescribed_increment", "free")
 TRANSMISSION_ANGLE_MIN_DEG = 20.0  # default margin of force transmission over the motion
 FOLD_MARGIN_DEG = 5.0  # default distance of a Grashof design from folding flat
-MAX_SIZE = 1.5  # synthesize_path's default: pivots and pin circles within this many target diagonals of the targets' centre
 
 
 def _err(msg: str, source: str | None, fld: str | None = None, hint: str | None = None) -> MechsynInputError:

@@ -232,6 +232,7 @@ class PathSynthesisResult(SynthesisResult):
     size: float | None = None          # radius of the disc about the targets' centre holding the linkage
     size_ratio: float | None = None    # size / the targets' bounding-box diagonal
     max_size: float | None = None      # the bound on size_ratio (None: lifted)
+    limited_by: str = ""               # the bounds the design sits on and how to lift them ("" when none)
 
     @property
     def target_reached(self) -> bool:
@@ -245,6 +246,7 @@ class PathSynthesisResult(SynthesisResult):
             "transmission_angle_min_deg": self.transmission_angle_min_deg,
             "fold_distance_deg": self.fold_distance_deg, "fold_margin_deg": self.fold_margin_deg,
             "size": self.size, "size_ratio": self.size_ratio, "max_size": self.max_size,
+            "limited_by": self.limited_by,
             "target_error": self.target_error, "target_reached": self.target_reached,
             "seconds": self.seconds, "seed": self.seed, "restarts": self.restarts, "nfev": self.nfev,
             "optimizer": self.optimizer, "branch": self.branch, "best_known": self.best_known,
@@ -256,26 +258,51 @@ class PathSynthesisResult(SynthesisResult):
 
 def with_size_bound(case: PathCase, max_size: float | None = None) -> PathCase:
     """The case with the size bound the search keeps: ``max_size`` when given (0: none),
-    else the case's own ``options.max_size``, else :data:`~mechsyn.synthesis.cases.MAX_SIZE`
-    (1.5 target diagonals) -- except for a literature case (one with published
-    solutions), which keeps the design space it was published with.
+    else the case's own ``options.max_size``, else none: the bounds a case states on its
+    variables (every length and pivot a case leaves free has them) are its design space,
+    and no default overrides them.
 
     >>> import dataclasses, mechsyn as ms
     >>> from mechsyn.synthesis.path import load_cases
-    >>> lit = load_cases(ms.examples.path("path_cases_public"))[0]      # published solutions
-    >>> mine = dataclasses.replace(lit, published=())
-    >>> with_size_bound(lit).max_size, with_size_bound(mine).max_size, with_size_bound(mine, 0).max_size
-    (None, 1.5, None)
+    >>> case = load_cases(ms.examples.path("path_cases_public"))[0]
+    >>> with_size_bound(case).max_size, with_size_bound(case, 2.0).max_size, with_size_bound(case, 0).max_size
+    (None, 2.0, None)
     """
     import dataclasses
-
-    from mechsyn.synthesis.cases import MAX_SIZE
 
     if max_size is not None and not max_size >= 0:
         raise MechsynInputError("must be >= 0 target diagonals (0: no bound)", field="max_size")
     if max_size is None:
-        max_size = case.max_size if case.max_size is not None else (None if case.published else MAX_SIZE)
+        max_size = case.max_size
     return dataclasses.replace(case, max_size=max_size or None)
+
+
+def bounds_deciding(case: PathCase, design: dict[str, Any], size_ratio: float | None) -> str:
+    """The bounds a design sits on (within 1e-6 of their span), each with how to lift it;
+    "" when none decides the result.
+
+    >>> import mechsyn as ms
+    >>> from mechsyn.synthesis.path import load_cases
+    >>> case = load_cases(ms.examples.path("path_cases_public"))[0]
+    >>> lo, hi = case.bounds()["r2"]
+    >>> d = {v.name: 0.5 * (v.lower + v.upper) for v in case.variables}
+    >>> bounds_deciding(case, d, None)
+    ''
+    >>> bounds_deciding(case, {**d, "r2": hi}, None).startswith(f"r2 = {hi:g} sits on its upper bound")
+    True
+    """
+    out = []
+    if case.max_size and size_ratio is not None and size_ratio >= case.max_size * (1 - 1e-6):
+        out.append(f"size {size_ratio:.4g} diagonals sits on the size bound {case.max_size:g} "
+                   "(--max-size or options.max_size; --max-size 0 lifts it)")
+    for name, (lo, hi) in case.bounds().items():
+        if name.startswith("theta2_") or name not in design or hi - lo <= 0:
+            continue
+        tol = 1e-6 * (hi - lo)
+        for side, b in (("lower", lo), ("upper", hi)):
+            if abs(float(design[name]) - b) <= tol:
+                out.append(f"{name} = {b:g} sits on its {side} bound (the case's variables; widen it there)")
+    return "; ".join(out)
 
 
 def _path_reason(check: dict[str, Any], case: PathCase) -> str:
@@ -470,6 +497,7 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
         transmission_angle_min_deg=case.transmission_angle_min_deg,
         fold_margin_deg=case.fold_margin_deg if case.grashof else None,
         resumed=resumed, size=size, size_ratio=size / diag if diag > 0 else None, max_size=case.max_size,
+        limited_by=bounds_deciding(case, design, size / diag if diag > 0 else None),
     )
 
 

@@ -29,8 +29,9 @@ Constraints (all must hold; see :meth:`PathProblem.evaluate`):
   ``mu`` between coupler and rocker must stay within ``[min, 180 - min]``);
 * input angles cyclically ordered (counter-clockwise, at most one turn) for free timing;
 * optional ``options.link_ratio_max`` (longest / shortest of ``r1..r4``);
-* a size bound ``options.max_size`` (0 or absent: none here; :func:`synthesize_path`
-  puts 1.5 where the case states none): both frame pivots and the whole circles the
+* a size bound ``options.max_size`` or ``--max-size`` (0 or absent: none; the bounds a
+  case states on its variables are its design space, no default overrides them, and the
+  result's ``limited_by`` names any bound the design sits on): both frame pivots and the whole circles the
   crank and rocker pins move on lie within ``max_size`` times the targets'
   bounding-box diagonal of the box's centre (the linkage, pivots included, fits in a
   disc ``2 max_size`` diagonals across; the pins' circles are a safe over-estimate of

@@ -246,9 +246,10 @@ def curve_candidate_files(res: Any) -> list[tuple[str, dict[str, Any], str]]:
     for i, c in enumerate(res.candidates, 1):
         d = c.to_dict()
         out.append((f"candidate_{i}.yaml", d["mechanism"], (
-            f"mechsyn synth curve: candidate {i}, {d['topology'] or c.topology.key}, tracer T\n"
+            f"mechsyn synth curve: candidate {i}, {d['topology'] or c.topology.key}, tracer T"
+            + (f" ({c.role})" if c.role else "") + ("" if c.refined else " (retrieved, not refined)") + "\n"
             f"input {d['input']['joint']} from {d['input']['start']:.3f} to {d['input']['stop']:.3f} deg; "
-            f"chamfer {100 * c.chamfer:.3f} %, ordered {100 * c.ordered:.3f} % of the target's diagonal")))
+            f"error {100 * c.chamfer:.3f} % of the target's diagonal (symmetric chamfer)")))
     return out
 
 
@@ -265,7 +266,7 @@ class CurveDatabaseReport(Result):
     bytes: int
 
 
-def curve_database(directory: Any = None, *, max_links: int = 6, per_topology: int = 3000, seed: int = 0,
+def curve_database(directory: Any = None, *, max_links: int = 8, per_topology: int = 3000, seed: int = 0,
                    scheduler: Any = None, callback: Callable[[dict], None] | None = None) -> CurveDatabaseReport:
     """Build or extend the curve database of :func:`mechsyn.synthesis.curves.synthesis.synthesize_curve`
     (see :func:`mechsyn.synthesis.curves.database.build_database`) and say what it holds.

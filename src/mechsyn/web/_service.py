@@ -542,7 +542,6 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
 
     The local curve database is built on first use (a few minutes; its progress is reported).
     """
-    from mechsyn.synthesis.curves.database import load_database
     from mechsyn.synthesis.curves.synthesis import synthesize_curve
     from mechsyn.synthesis.curves.target import target_from_points
 
@@ -553,7 +552,7 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
     time_limit = float(params.get("time_limit", 20.0))
     if not 1 <= time_limit <= 600:
         raise MechsynInputError("time limit must be within 1..600 s", field="time_limit")
-    max_links = int(params.get("max_links", 6))
+    max_links = int(params.get("max_links", 8))   # the CLI's default: the same target and limit, the same answer
     if max_links not in (4, 6, 8):
         raise MechsynInputError("max_links must be 4, 6 or 8", field="max_links")
     closed = params.get("closed")
@@ -565,15 +564,15 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
                   "best": float(best) if isinstance(best, float) and math.isfinite(best) else None,
                   "stage": str(state.get("stage", ""))})
 
-    db = load_database(None, max_links=max_links, callback=report)
-    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, database=db, callback=report)
+    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, callback=report)
     results = []
     for c in res.candidates:
         d = c.to_dict()
         results.append({"error": float(c.chamfer), "feasible": bool(c.verified), "mechanism": d["mechanism"],
                         "path": _xy(c.path),
-                        "label": f"{d['topology'] or d['topology_key']} ({d['links']} links): chamfer "
+                        "label": f"{d['topology'] or d['topology_key']} ({d['links']} links): error "
                                  f"{100 * c.chamfer:.2f} % of the diagonal, min μ {c.min_transmission_angle:.0f}°"
+                                 + (f" [{c.role}]" if c.role else "") + ("" if c.refined else " (not refined)")
                                  + ("" if c.verified else f", not verified: {c.verification}"),
                         "quality": d.get("quality")})
     notes = list(res.notes)

@@ -16,7 +16,9 @@ and the tracing point's curve is not degenerate (it moves). Each kept design is
 stored with its input range and the Fourier descriptor of its curve
 (:mod:`~mechsyn.synthesis.curves.descriptors`), ``float32``, one ``.npz`` file per
 topology in a directory (default ``$MECHSYN_CURVE_DB`` or
-``~/.cache/mechsyn/curves-v1``). Building is resumable: a topology whose file already
+``~/.cache/mechsyn/curves-v2``). The default database holds 3,000 curves of each
+four- and six-bar topology and 300 of each of the 279 eight-bar topologies (129,000
+curves). Building is resumable: a topology whose file already
 holds the requested number of curves is skipped, a short one is extended with new
 random designs (the seed continues from the count already drawn).
 """
@@ -34,20 +36,21 @@ import numpy as np
 from mechsyn.kinematics.batch import simulate_batch
 from mechsyn.results import write_atomic
 from mechsyn.synthesis.curves.descriptors import fourier_descriptor, resample
-from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology, curve_topologies
+from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology, cached_topologies, curve_topologies
 
 __all__ = ["CurveDatabase", "build_database", "load_database", "default_database_dir", "sample_designs",
            "evaluate_designs", "DEFAULT_PER_TOPOLOGY", "MIN_RANGE"]
 
 SWEEP_SAMPLES = 120          # 3 degree steps over a full turn
 MIN_RANGE = 60.0             # degrees of crank oscillation for an open arc
-DEFAULT_PER_TOPOLOGY = 3000
-DEFAULT_LINKS = 6
-VERSION = 1
+DEFAULT_PER_TOPOLOGY = 3000   # curves per four- and six-bar topology
+EIGHT_SHARE = 10               # an eight-bar topology holds per_topology / EIGHT_SHARE curves
+DEFAULT_LINKS = 8              # the default database: 4-, 6- and 8-bars (1 + 14 + 279 topologies)
+VERSION = 2                    # 2: eight-bars in the default database
 
 
 def default_database_dir() -> Path:
-    """``$MECHSYN_CURVE_DB`` or ``~/.cache/mechsyn/curves-v1``."""
+    """``$MECHSYN_CURVE_DB`` or ``~/.cache/mechsyn/curves-v2``."""
     env = os.environ.get("MECHSYN_CURVE_DB")
     if env:
         return Path(env)
@@ -143,16 +146,16 @@ class CurveDatabase:
     def __len__(self) -> int:
         return len(self.topology)
 
-    def tree(self, n_links: int):
-        """``(cKDTree, rows)`` over the descriptors of the ``n_links``-bar rows (built
-        once per link count; ``(None, rows)`` when there are none)."""
-        cache = self.__dict__.setdefault("_trees", {})
+    def index(self, n_links: int):
+        """``(DescriptorIndex, rows)`` over the descriptors of the ``n_links``-bar rows
+        (built once per link count; ``(None, rows)`` when there are none)."""
+        cache = self.__dict__.setdefault("_indexes", {})
         if n_links not in cache:
-            from scipy.spatial import cKDTree
+            from mechsyn.synthesis.curves.index import DescriptorIndex
 
             links = np.array([t.n_links for t in self.topologies])[self.topology]
             rows = np.flatnonzero(links == n_links)
-            cache[n_links] = (cKDTree(self.descriptors[rows]) if len(rows) else None, rows)
+            cache[n_links] = (DescriptorIndex(self.descriptors[rows]) if len(rows) else None, rows)
         return cache[n_links]
 
 
@@ -182,7 +185,9 @@ def _read(path: Path) -> dict | None:
 def build_database(directory: str | os.PathLike[str] | None = None, max_links: int = DEFAULT_LINKS,
                    per_topology: int = DEFAULT_PER_TOPOLOGY, seed: int = 0, batch: int = 4000,
                    callback: Callable[[dict], None] | None = None, scheduler: str | None = None) -> Path:
-    """Build or extend the curve database (resumable; see the module doc).
+    """Build or extend the curve database (resumable; see the module doc): ``per_topology``
+    curves of each four- and six-bar topology, a tenth of that (:data:`EIGHT_SHARE`) of
+    each eight-bar one.
 
     ``callback(state)`` is called after each topology with ``stage="build"``, ``done``,
     ``total`` (topologies), ``curves`` (kept so far), ``best`` (NaN) and ``nfev`` (0). With ``scheduler`` (a
@@ -196,8 +201,9 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
     for i, t in enumerate(topos):
         have = _read(_file(directory, t))
         n = 0 if have is None else len(have["ranges"])
-        if n < per_topology:
-            todo.append((i, t.key, max_links, per_topology, seed, batch, have))
+        want = per_topology if t.n_links < 8 else max(1, per_topology // EIGHT_SHARE)
+        if n < want:
+            todo.append((i, t.key, max_links, want, seed, batch, have))
     total, done, kept = len(topos), len(topos) - len(todo), 0
     if callback is not None:
         callback(_state(done, total, kept))
@@ -283,7 +289,7 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
     """Read the database (topologies up to ``max_links``); build the default small one
     (4- and 6-bars) first when there is none."""
     directory = Path(directory) if directory is not None else default_database_dir()
-    topos = curve_topologies(max(max_links, 4))
+    topos = cached_topologies(directory, max(max_links, 4)) if directory.is_dir() else curve_topologies(max(max_links, 4))
     present = [t for t in topos if _file(directory, t).exists()]
     if not present and build_if_missing:
         build_database(directory, max_links=min(max_links, DEFAULT_LINKS), per_topology=DEFAULT_PER_TOPOLOGY,

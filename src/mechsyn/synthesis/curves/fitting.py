@@ -7,6 +7,7 @@ angle) and the least-squares problem that the refinement of
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +23,7 @@ N_TRACE = 96           # input samples along the range (refinement)
 N_FINAL = 360          # input samples of the reported path and errors
 PENALTY = 1.0          # residual (in target diagonals) of an unassembled design
 
-DEFAULT_MAX_SIZE = 1.5            # every point inside this many diagonals of the target's centre
+DEFAULT_MAX_SIZE = 1.5            # every point inside this many diagonals of the target's centroid
 DEFAULT_MAX_LINK_RATIO = 10.0     # longest / shortest link length
 DEFAULT_MIN_TRANSMISSION = 30.0   # degrees, worst over the motion
 DEFAULT_TOLERANCE = 5e-3          # chamfer / diagonal within which fewer links rank first
@@ -64,25 +65,73 @@ def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
     return -np.take_along_axis(diff, k[..., None, None], axis=-2)[..., 0, :], k
 
 
+M_ERROR = 256          # points equally spaced in arc length along each curve for the reported error
+
+
+def even_points(points: np.ndarray, closed: bool, m: int = M_ERROR) -> np.ndarray:
+    """``m`` points ``(m, 2)`` equally spaced in arc length along a polyline (an open one
+    from its first point to its last, both included)."""
+    z = resample(points, m, closed=True) if closed else resample(points, 2 * m - 2, closed=False)[:m]
+    return np.stack([z.real, z.imag], axis=-1)
+
+
+def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit: float | None = None) -> float:
+    """The error of a traced path against the target: the symmetric chamfer distance,
+    point to polyline, over the target's diagonal.
+
+    .. math::
+
+        e = \\frac{1}{2D}\\left(\\frac{1}{M}\\sum_{i=1}^{M} d(a_i, B)
+            + \\frac{1}{M}\\sum_{j=1}^{M} d(b_j, A)\\right)
+
+    with ``a_i`` and ``b_j`` :data:`M_ERROR` points equally spaced in arc length along the
+    target ``A`` and the path ``B`` (each a polyline, closed or open), ``d(p, C)`` the
+    distance from ``p`` to the nearest point of polyline ``C`` and ``D`` the target's
+    diagonal (:attr:`TargetCurve.diagonal`, or ``unit``). Both terms are means over arc
+    length, so the value does not depend on how either curve is sampled, and a path lying
+    on the target scores 0 up to the polylines' chords. The first term is large where the
+    path leaves part of the target out, the second where it strays from it (a loop
+    cutting across a letter).
+
+    >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    >>> circle = TargetCurve(np.c_[np.cos(t), np.sin(t)], closed=True)
+    >>> bool(chamfer_error(np.c_[np.cos(t), np.sin(t)][::3], circle, True) < 1e-4)   # chords only
+    True
+    >>> round(chamfer_error(1.1 * np.c_[np.cos(t), np.sin(t)], circle, True) * circle.diagonal, 3)
+    0.1
+    """
+    unit = target.diagonal if unit is None else unit
+    A = even_points(target.points, target.closed)
+    B = even_points(path, closed_path)
+    a = np.linalg.norm(_to_polyline(A, *_polyline(path, closed_path))[0], axis=-1).mean()
+    b = np.linalg.norm(_to_polyline(B, *_polyline(target.points, target.closed))[0], axis=-1).mean()
+    return float(0.5 * (a + b) / unit)
+
+
 def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
                  unit: float | None = None) -> tuple[float, float]:
     """``(chamfer, ordered)`` of a traced path against the target, in target diagonals
-    (or in ``unit``)."""
+    (or in ``unit``): :func:`chamfer_error` (the error shown and ranked by) and, as a
+    diagnostic of the timing only, the RMS distance between 128 points equally spaced in
+    arc length along both, best start and sense."""
     unit = target.diagonal if unit is None else unit
-    T = target.points
-    ts, tv = _polyline(T, target.closed)
-    ps, pv = _polyline(path, closed_path)
-    a = np.linalg.norm(_to_polyline(T, ps, pv)[0], axis=-1).mean()
-    b = np.linalg.norm(_to_polyline(path, ts, tv)[0], axis=-1).mean()
-    chamfer = 0.5 * (a + b) / unit
+    chamfer = chamfer_error(path, target, closed_path, unit)
     m = 128
-    w = resample(T, m, closed=target.closed)
+    w = resample(target.points, m, closed=target.closed)
     z = resample(path, m, closed=closed_path)
     best = np.inf
     for zz in (z, z[::-1]):
         for s in range(m):
             best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
     return float(chamfer), best / unit
+
+
+def departure(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[int, float]:
+    """Where the path departs most from the target: the index of the target point
+    farthest from the path (polyline) and that distance (target units)."""
+    d = np.linalg.norm(_to_polyline(target.points, *_polyline(path, closed_path))[0], axis=-1)
+    i = int(np.argmax(d))
+    return i, float(d[i])
 
 
 # ---------------------------------------------------------------------------- evaluation
@@ -101,10 +150,9 @@ def full_plan(topo: CurveTopology):
     """The topology's batch plan with every joint (and the tracer) as an output."""
     plan = _FULL_PLANS.get(topo.key)
     if plan is None:
-        from mechsyn.io.load import mechanism_from_dict
         from mechsyn.kinematics.batch import compile_plan
 
-        plan = compile_plan(mechanism_from_dict(topo.template), points=list(topo.plan.names))
+        plan = compile_plan(topo.model, points=list(topo.plan.names))
         if list(plan.names) != list(topo.plan.names):  # the parameters must mean the same
             raise RuntimeError(f"{topo.key}: the full plan orders its points differently")
         _FULL_PLANS[topo.key] = plan
@@ -169,11 +217,15 @@ class FitProblem:
             j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
         self.link_pairs = link_pairs(self.topo)
         self.nfev = 0
+        self.deadline = float("inf")     # time.perf_counter() past which an evaluation raises OutOfTime
+        self.best = (float("inf"), None)  # (cost, x) of the best design evaluated by fun
 
     def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
         """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
         segments of the first design are used for all (the Jacobian's perturbations)."""
         X = np.atleast_2d(X)
+        if time.perf_counter() > self.deadline:
+            raise OutOfTime
         self.nfev += len(X)
         res = simulate_batch(self.plan, X, self.off, transmission=self.bounds.transmission > 0)
         P = res.paths[TRACER]
@@ -194,7 +246,7 @@ class FitProblem:
             r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
             r3 = _to_polyline(F[None], starts, vecs)[0]             # sharp features -> path
         r1 = r1 / np.sqrt(len(self.T))
-        r2 = r2 / np.sqrt(P.shape[1])
+        r2 = r2 * np.sqrt(_arc_weights(P, self.closed_path))[..., None]   # a mean over arc length, as reported
         r3 = r3 * (FEATURE_WEIGHT / np.sqrt(max(len(F), 1)))
         r = np.concatenate([r1.reshape(len(X), -1), r2.reshape(len(X), -1), r3.reshape(len(X), -1)],
                            axis=1) / self.diag
@@ -212,13 +264,34 @@ class FitProblem:
         return np.concatenate([r] + pen, axis=1)
 
     def fun(self, x: np.ndarray) -> np.ndarray:
-        return self.residuals(x[None])[0]
+        r = self.residuals(x[None])[0]
+        cost = float(r @ r)
+        if cost < self.best[0] and not self.last_bad[0]:
+            self.best = (cost, np.array(x, float))
+        return r
 
     def jac(self, x: np.ndarray) -> np.ndarray:
         h = 1e-7 * self.diag
         X = np.vstack([x, x + h * np.eye(len(x))])
         R = self.residuals(X, keep=True)
         return (R[1:] - R[0]).T / h
+
+
+def _arc_weights(P: np.ndarray, closed: bool) -> np.ndarray:
+    """Weights ``(K, N)`` of path samples ``P (K, N, 2)`` summing to 1: each sample's share
+    of the path's length (half its two neighbouring segments), so that sums over the
+    samples are means over arc length whatever the crank's speed (uniform for a path
+    without length)."""
+    seg = np.hypot(*(np.diff(P, axis=1, append=P[:, :1] if closed else P[:, -1:])).transpose(2, 0, 1))
+    before = np.roll(seg, 1, axis=1) if closed else np.concatenate([np.zeros_like(seg[:, :1]), seg[:, :-1]], axis=1)
+    w = 0.5 * (seg + before)
+    total = w.sum(axis=1, keepdims=True)
+    return np.where(total > 0, w / np.where(total > 0, total, 1.0), 1.0 / P.shape[1])
+
+
+class OutOfTime(Exception):
+    """An evaluation asked for after :attr:`FitProblem.deadline` (the refinement keeps
+    the best design it has evaluated)."""
 
 
 FEATURE_WEIGHT = 0.25  # the sharp-feature residuals against the chamfer's (both /sqrt(count))

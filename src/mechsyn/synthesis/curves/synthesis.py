@@ -5,8 +5,8 @@ linkages whose tracing point follows it:
 
 1. **Normalise** the target: ``M`` points equally spaced in arc length (an open curve
    there and back), its Fourier descriptor (:mod:`.descriptors`).
-2. **Retrieve**: nearest descriptors in the database (:mod:`.database`, a SciPy
-   ``cKDTree``), for both senses of traversal; the candidates' curves are recomputed by
+2. **Retrieve**: nearest descriptors in the database (:mod:`.database`, Faiss through
+   :mod:`.index`), for both senses of traversal; the candidates' curves are recomputed by
    the batch engine and re-ranked by the exact closed-form similarity alignment (best
    rotation, scale, translation, start point, sense and mirror image at once).
 3. **Map** each retained design into the target's frame by its similarity (a linkage
@@ -23,11 +23,22 @@ linkages whose tracing point follows it:
 5. **Check** each final candidate by re-simulating its mechanism file through the
    ordinary :func:`mechsyn.kinematics.simulate` and comparing the tracer's path.
 
-Errors are reported divided by the target's bounding-box diagonal: ``chamfer`` (mean of
-the two mean nearest distances, point to polyline) and ``ordered`` (root mean square
-distance between points equally spaced in arc length along both curves, best start
-and sense, no re-scaling: the timing of a constant-speed crank against the drawing's
-own parametrisation).
+**The error** shown and ranked by is :func:`~mechsyn.synthesis.curves.fitting.chamfer_error`:
+the symmetric chamfer distance, each curve's points (equally spaced in arc length) to the
+other curve's polyline, over the target's diagonal along its principal axes. ``ordered``
+(RMS distance between points equally spaced in arc length, best start and sense) is
+reported as a diagnostic of the timing only.
+
+**Anytime.** The time limit covers every phase (loading the database, retrieval,
+refinement and the final checks, whose cost is measured on the first candidate and
+reserved). The best retrieved designs are evaluated as they are first (an answer at any
+limit, labelled "not refined"); then a deterministic sequence of refinements runs: the
+first round of retrieved seeds (four-bars first), then rounds that refine the best
+design of each of the three leading topologies longer, restart about it (every joint
+and the tracer, the coupler point free on its plane, moved at random, seeded by the
+round) and widen to further retrieved seeds, eight-bars among them. An evaluation past
+the deadline stops the refinement under way with the best design it has evaluated. The
+search ends at the limit, at ``target_error``, after ``refinements`` or on Ctrl-C.
 
 The approach follows the retrieve-then-refine scheme of LInK (A. Nobari, A. Srivastava,
 D. Gutfreund, K. Xu and F. Ahmed, "LInK: Learning joint representations of design and
@@ -52,127 +63,18 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import simulate_batch
 from mechsyn.synthesis.curves.database import CurveDatabase, load_database
 from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
+from mechsyn.synthesis.curves.candidates import (CurveCandidate, CurveSynthesisResult, miss_reason, nearest_miss,
+                                                  ranked)
 from mechsyn.synthesis.curves.fitting import (DEFAULT_MAX_LINK_RATIO, DEFAULT_MAX_SIZE, DEFAULT_MIN_TRANSMISSION,
-                                               DEFAULT_TOLERANCE, N_FINAL, Bounds, FitProblem, curve_errors,
-                                               full_plan, input_offsets, link_pairs, link_ratio, path_sizes)
+                                               DEFAULT_TOLERANCE, N_FINAL, Bounds, FitProblem, OutOfTime,
+                                               curve_errors, departure, full_plan, input_offsets, link_pairs,
+                                               link_ratio, path_sizes)
+from mechsyn.synthesis.curves.frame import Frame
 from mechsyn.synthesis.curves.target import SPARSE_POINTS, TargetCurve, smooth_samples, target_from_points
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
-from mechsyn.synthesis.problem import Progress, SynthesisResult
+from mechsyn.synthesis.problem import Progress
 
 __all__ = ["CurveCandidate", "CurveSynthesisResult", "synthesize_curve", "curve_errors"]
-
-
-
-@dataclass
-class CurveCandidate:
-    """One ranked linkage (see :meth:`to_dict` for the reported fields)."""
-
-    topology: CurveTopology
-    params: np.ndarray              # design in the target's coordinates
-    start: float                    # input offsets from the reference, degrees
-    stop: float
-    chamfer: float                  # / bbox diagonal
-    ordered: float
-    min_transmission_angle: float
-    link_length_ratio: float
-    path: np.ndarray                # (N, 2) traced path
-    verified: bool = False
-    verification: str = ""
-    nfev: int = 0
-    reference_input: float = float("nan")   # input angle (deg) of the design's configuration
-    size: float = float("nan")              # radius about the target's centre holding every point
-    size_ratio: float = float("nan")        # size / target diagonal
-
-    def __post_init__(self) -> None:
-        if not np.isfinite(self.reference_input):
-            self.reference_input = float(self.topology.plan.reference_inputs(self.params)[0])
-
-    @property
-    def full_turn(self) -> bool:
-        """The input turns fully (a crank)."""
-        return bool(self.stop - self.start >= 360.0 - 1e-9)
-
-    def quality(self) -> dict[str, Any]:
-        """The design-quality fields: ``size`` (radius of the disc about the target's
-        bounding-box centre that holds every joint and the tracer over the whole motion,
-        target units), ``size_ratio`` (that over the target's diagonal), ``link_ratio``
-        (longest over shortest link length), ``min_transmission_angle`` (degrees, worst
-        RRR dyad over the motion) and ``full_turn``."""
-        return {"size": float(self.size), "size_ratio": float(self.size_ratio),
-                "link_ratio": float(self.link_length_ratio),
-                "min_transmission_angle": float(self.min_transmission_angle), "full_turn": self.full_turn}
-
-    def mechanism(self) -> dict:
-        t = self.topology
-        name = f"{t.name or f'{t.n_links}-bar'} tracing the target (mechsyn synth curve)"
-        return t.mechanism(self.params, name=name)
-
-    def to_dict(self) -> dict[str, Any]:
-        t = self.topology
-        ref = self.reference_input
-        return {
-            "mechanism": self.mechanism(),
-            "tracer": TRACER,
-            "input": {"joint": t.plan.input_joint, "start": ref + self.start, "stop": ref + self.stop},
-            "links": t.n_links,
-            "topology": t.label,
-            "topology_key": t.key,
-            "error": {"chamfer": self.chamfer, "ordered": self.ordered},
-            "quality": self.quality(),
-            "min_transmission_angle": self.min_transmission_angle,
-            "link_length_ratio": self.link_length_ratio,
-            "crank": self.full_turn,
-            "verified": self.verified,
-            "verification": self.verification,
-        }
-
-
-@dataclass(repr=False)
-class CurveSynthesisResult(SynthesisResult):
-    """Ranked candidates, best first (``to_dict()`` is the ``--json`` output).
-
-    A :class:`~mechsyn.synthesis.problem.SynthesisResult` for the best candidate:
-    ``error`` its chamfer error (in target diagonals; NaN without a candidate),
-    ``design`` and ``x`` its parameters, ``nfev`` the refinements' evaluations, ``seed``
-    None (the search is deterministic).
-    """
-
-    target: TargetCurve
-    candidates: list[CurveCandidate]
-    retrieved: int
-    refined: int
-    notes: list[str] = field(default_factory=list)
-    bounds: dict[str, Any] = field(default_factory=dict)
-    nearest_miss: CurveCandidate | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        miss = self.nearest_miss.to_dict() if self.nearest_miss is not None else None
-        return {"candidates": [c.to_dict() for c in self.candidates],
-                "target": {"points": self.target.points, "closed": self.target.closed,
-                           "diagonal": self.target.diagonal},
-                "bounds": self.bounds, "nearest_miss": miss,
-                "seconds": self.seconds, "retrieved": self.retrieved, "refined": self.refined,
-                "interrupted": self.interrupted, "notes": self.notes, **self.common()}
-
-    def __str__(self) -> str:
-        lines = [f"curve synthesis: {len(self.candidates)} candidates, {self.refined} refined of "
-                 f"{self.retrieved} retrieved, {self.seconds:.1f} s" + (" (interrupted)" if self.interrupted else "")]
-        for i, c in enumerate(self.candidates, 1):
-            lines.append(f"{i}. {c.topology.label} [{c.topology.key}]: "
-                         f"chamfer {100 * c.chamfer:.2f} %, ordered {100 * c.ordered:.2f} %, "
-                         f"size {c.size_ratio:.2f} diagonals, link ratio {c.link_length_ratio:.1f}, "
-                         f"min transmission {c.min_transmission_angle:.0f} deg"
-                         + (", full turn" if c.full_turn else "") + ("" if c.verified else "  NOT VERIFIED"))
-        if not self.candidates:
-            lines.append(self.reason)
-        return "\n".join(lines)
-
-    def plot(self, ax=None, top: int = 3):
-        """Target and the best candidates' paths (see :func:`mechsyn.plot.curves.plot_curve_result`)."""
-        from mechsyn.plot.curves import plot_curve_result
-
-        return plot_curve_result(self, ax=ax, top=top)
-
 
 # ------------------------------------------------------------------------------ retrieval
 
@@ -205,31 +107,38 @@ def _transform_design(params: np.ndarray, c: complex, t: complex, mirror: bool) 
 
 
 def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, crank: bool,
-              bounds: Bounds) -> list[_Seed]:
+              bounds: Bounds, deadline: float = float("inf")) -> tuple[list[_Seed], str]:
+    """The ``k`` nearest descriptors per link count and sense, aligned and mapped into
+    the target's frame (:func:`_topology_seeds`), best first; topologies are taken by
+    link count, then by their nearest descriptor, and none is begun past ``deadline``
+    (the note returned says how many were left; "" when none)."""
     w = resample(target.points, 64, closed=target.closed)
     d = fourier_descriptor(w)
-    rows: set[int] = set()
+    first: dict[int, int] = {}      # row -> its best place in a retrieval list
     for n in range(4, max_links + 1, 2):   # each link count its own share of the retrieval
-        tree, sub = db.tree(n)
-        if tree is None:
+        index, sub = db.index(n)
+        if index is None:
             continue
-        kk = min(k, len(sub))
-        for q in (d, swap_direction(d)):
-            _, ii = tree.query(q.astype(np.float32), k=kk)
-            rows.update(sub[np.atleast_1d(ii)].tolist())
-    rows_a = np.array(sorted(rows), int)
+        ii = index.search(np.stack([d, swap_direction(d)]), k)
+        for place, r in sorted((p, int(sub[i])) for row in ii for p, i in enumerate(row) if i >= 0):
+            first.setdefault(r, place)
+    rows_a = np.array(sorted(first), int)
     if crank:
         rows_a = rows_a[db.closed[rows_a]]
     if not target.closed:
         rows_a = rows_a[~db.closed[rows_a]]
-    seeds: list[_Seed] = []
     by_topo: dict[int, list[int]] = {}
     for r in rows_a.tolist():
         by_topo.setdefault(int(db.topology[r]), []).append(r)
-    for ti, rs in by_topo.items():
-        seeds += _topology_seeds(db, db.topologies[ti], rs, w, bounds.unit, bounds)
+    order = sorted(by_topo, key=lambda ti: (db.topologies[ti].n_links, min(first[r] for r in by_topo[ti]), ti))
+    seeds: list[_Seed] = []
+    for j, ti in enumerate(order):
+        if j and time.perf_counter() > deadline:   # the first topology whatever the time: an answer
+            seeds.sort(key=lambda s: (s.rank, s.row))
+            return seeds, f"retrieval: {len(order) - j} of {len(order)} topologies left out at the time limit"
+        seeds += _topology_seeds(db, db.topologies[ti], by_topo[ti], w, bounds.unit, bounds)
     seeds.sort(key=lambda s: (s.rank, s.row))
-    return seeds
+    return seeds, ""
 
 
 def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np.ndarray, diag: float,
@@ -272,27 +181,32 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
 # ----------------------------------------------------------------------------- refinement
 
 
-def _refine(seed: _Seed, target: TargetCurve, bounds: Bounds, max_nfev: int) -> CurveCandidate | None:
-    """The seed refined in the working frame (None when it does not assemble)."""
+def _refine(seed: _Seed, target: TargetCurve, bounds: Bounds, max_nfev: int,
+            deadline: float = float("inf")) -> CurveCandidate | None:
+    """The seed refined in the working frame (None when it does not assemble); at the
+    ``deadline`` (``time.perf_counter()``) the best design evaluated so far."""
     prob = FitProblem(seed.topo, target, seed.closed, seed.start, seed.stop, bounds)
+    prob.deadline = deadline
     x0 = seed.params
-    prob.fun(x0)
+    try:
+        prob.fun(x0)
+    except OutOfTime:
+        return None
     if prob.last_bad[0]:  # does not assemble over the range after the mapping
         return None
     try:
-        sol = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=1.0,
-                            max_nfev=max_nfev, xtol=1e-10, ftol=1e-10)
-        x = sol.x
-    except np.linalg.LinAlgError:  # a singular step: keep the retrieved design
-        x = x0
+        x = least_squares(prob.fun, x0, jac=prob.jac, method="trf", x_scale=1.0,
+                          max_nfev=max_nfev, xtol=1e-10, ftol=1e-10).x
+    except (np.linalg.LinAlgError, OutOfTime):  # a singular step, or out of time: the best so far
+        x = prob.best[1] if prob.best[1] is not None else x0
     return _candidate(seed.topo, x, seed.start, seed.stop, seed.closed, target, prob.nfev, bounds)
 
 
 def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, closed: bool,
-               target: TargetCurve, nfev: int, bounds: Bounds) -> CurveCandidate | None:
-    """The design's candidate in the working frame, with its errors and quality over
-    :data:`N_FINAL` input samples (lengths in ``bounds.unit``); None when it is not
-    assembled."""
+               target: TargetCurve, nfev: int, bounds: Bounds, refined: bool = True) -> CurveCandidate | None:
+    """The design's candidate in the working frame, with its errors, quality and worst
+    departure over :data:`N_FINAL` input samples (lengths in ``bounds.unit``); None when
+    it is not assembled."""
     off = input_offsets(start, stop, closed, N_FINAL)
     res = simulate_batch(full_plan(topo), x[None], off, transmission=True)
     if not res.assembled.all() or res.branch_jump[0]:
@@ -300,9 +214,11 @@ def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, cl
     path = res.paths[TRACER][0]
     ch, od = curve_errors(path, target, closed, bounds.unit)
     size = float(path_sizes(res.paths, bounds.centre)[0])
+    at, far = departure(path, target, closed)
     return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
                           float(res.min_transmission_angle[0]), float(link_ratio(x, link_pairs(topo))[0]),
-                          path, nfev=nfev, size=size, size_ratio=size / bounds.unit)
+                          path, nfev=nfev, size=size, size_ratio=size / bounds.unit, refined=refined,
+                          departs_at=at, departure=far / bounds.unit)
 
 
 def _verify(c: CurveCandidate) -> None:
@@ -330,87 +246,6 @@ def _verify(c: CurveCandidate) -> None:
     c.verification = f"simulate reproduces the path to {err / c.size:.1e} of its size" if c.verified else \
         f"simulate differs from the batch path by {err:.3g}"
 
-
-@dataclass(frozen=True)
-class _Frame:
-    """The working frame, a similarity ``w = R((z - c) / r)`` of the target's plane: ``c``
-    and ``r`` the centroid and RMS radius of the target (equally spaced in arc length),
-    ``R`` the rotation to its principal axes (the long axis along x, its third moment
-    positive) followed, when the curve then runs clockwise (closed by its chord if open;
-    without enclosed area, when its y skew is negative), by the mirror in the x axis.
-    Each part is computed from the curve itself, so a translated, scaled, rotated or
-    mirrored target has the same working coordinates (rounded to ``1e-9``: the same
-    numbers, not merely close ones) and the search the same course. A linkage mapped by a
-    similarity traces the curve so mapped, on the same assembly branch; a mirrored one
-    with its input reversed. With a ground region (an axis-parallel box) rotation and
-    mirror are left out."""
-
-    centre: complex
-    scale: float
-    turn: complex          # e^{i phi}: working x axis in target coordinates
-    mirror: bool
-
-    @classmethod
-    def of(cls, target: TargetCurve, rotate: bool = True) -> _Frame:
-        w = resample(target.points, 256, closed=target.closed)
-        c = complex(w.mean())
-        r = float(np.sqrt(np.mean(np.abs(w - c) ** 2)))
-        turn, mirror = 1.0 + 0j, False
-        if rotate:
-            u = (w - c) / r
-            m2 = np.sum(u ** 2)
-            turn = complex(np.exp(0.5j * np.angle(m2))) if abs(m2) > 1e-6 * len(u) else 1.0 + 0j
-            if np.sum(((u / turn).real) ** 3) < 0:
-                turn = -turn
-            v = (resample(target.points, 256, closed=True) - c) / (r * turn)   # an open curve: closed by its chord
-            area = 0.5 * np.sum(v.real * np.roll(v.imag, -1) - np.roll(v.real, -1) * v.imag)
-            # clockwise: mirror; no area to speak of (a figure eight): the side the y skew points to
-            mirror = bool(area < 0) if abs(area) > 1e-3 else bool(np.sum(v.imag ** 3) < 0)
-        return cls(c, r, turn, mirror)
-
-    def inward_points(self, P: np.ndarray) -> np.ndarray:
-        w = (P[..., 0] + 1j * P[..., 1] - self.centre) / (self.scale * self.turn)
-        w = np.conj(w) if self.mirror else w
-        return np.round(np.stack([w.real, w.imag], axis=-1), 9)
-
-    def outward_points(self, W: np.ndarray) -> np.ndarray:
-        w = W[..., 0] + 1j * W[..., 1]
-        z = self.centre + self.scale * self.turn * (np.conj(w) if self.mirror else w)
-        return np.stack([z.real, z.imag], axis=-1)
-
-    def inward(self, target: TargetCurve) -> TargetCurve:
-        return TargetCurve(self.inward_points(target.points), target.closed, target.source)
-
-    def bounds(self, user: TargetCurve, max_size, max_link_ratio, min_transmission, region) -> Bounds:
-        """The design bounds in working coordinates (disc about the target's bounding-box
-        centre, radius in its diagonals)."""
-        P = user.points
-        centre = self.inward_points(0.5 * (P.min(axis=0) + P.max(axis=0)))
-        unit = user.diagonal / self.scale
-        box = None
-        if region is not None:
-            lo, hi = self.inward_points(np.array(region[:2])), self.inward_points(np.array(region[2:]))
-            box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
-        return Bounds((float(centre[0]), float(centre[1])), unit, None if max_size is None else max_size * unit,
-                       max_link_ratio, float(min_transmission), box)
-
-    def outward(self, c: CurveCandidate) -> CurveCandidate:
-        """The candidate in the target's coordinates (errors and ratios unchanged; a
-        mirrored design runs its input the other way)."""
-        import dataclasses
-
-        x = self.outward_points(c.params.reshape(-1, 2)).reshape(-1)
-        path = self.outward_points(c.path)
-        start, stop = c.start, c.stop
-        if self.mirror:
-            start, stop = -stop, -start
-            n = len(path)
-            path = path[(-np.arange(n)) % n] if c.full_turn else path[::-1]
-        ref = float(c.topology.plan.reference_inputs(x)[0])
-        return dataclasses.replace(c, params=x, path=path, start=start, stop=stop, size=c.size * self.scale,
-                                   reference_input=ref)
-
-
 def synthesize_curve(
     target: TargetCurve | np.ndarray,
     *,
@@ -429,6 +264,9 @@ def synthesize_curve(
     callback: Callable[[dict], None] | None = None,
     max_nfev: int = 60,
     tolerance: float = DEFAULT_TOLERANCE,
+    refinements: int | None = None,
+    target_error: float | None = None,
+    started: float | None = None,
 ) -> CurveSynthesisResult:
     """Ranked linkages (4 to ``max_links`` links) a designer can build whose tracing
     point follows a curve.
@@ -442,51 +280,49 @@ def synthesize_curve(
     max_links : {4, 6, 8}
         Largest linkage.
     time_limit : float
-        Seconds for retrieval and refinement (no refinement starts that the longest so
-        far says would overrun it).
+        Seconds for the whole call, every phase included (see the module doc, "Anytime"),
+        from ``started`` (a ``time.perf_counter()``; default: the call); building a
+        missing database first is not counted (a note says so).
     top : int
         Candidates returned (see ``prefer``; the first three of distinct topologies).
     n_refine, retrieve : int
-        Designs refined, and nearest descriptors retrieved per query.
+        Designs refined in the first round (four-bars first with ``prefer="simple"``),
+        and nearest descriptors retrieved per query and link count.
+    refinements : int, optional
+        A fixed number of refinements (the start of the sequence a timed run follows).
+    target_error : float, optional
+        Stop once the best error is within it (default: once three topologies, or
+        ``top``, have a candidate within ``tolerance``).
     crank : bool
         Only fully rotating inputs (without it a full turn is preferred, not required).
     ground_region : (x0, y0, x1, y1), optional
         Box (target coordinates) the frame pivots must stay in.
     max_size : float or None
-        Every joint, frame pivots included, and the tracer stay over the whole motion
-        within this many target diagonals of the centre of the target's bounding box
-        (default 1.5: the linkage fits in a disc three diagonals across); None lifts it.
-    max_link_ratio : float or None
-        Largest ratio of the longest to the shortest link length (default 10); None lifts it.
-    min_transmission : float
-        Smallest transmission angle (degrees, of every RRR dyad over the input range;
-        default 30); 0 lifts it.
+        Every joint and the tracer stay over the whole motion within this many target
+        diagonals (:attr:`TargetCurve.diagonal`) of the target's centroid (default
+        1.5); None lifts it. Both are the curve's own: the bound turns with the drawing.
+    max_link_ratio, min_transmission : float or None
+        Largest longest / shortest link length (default 10; None lifts it); smallest
+        transmission angle of every RRR dyad over the motion (degrees, default 30; 0).
     prefer : {"simple", "accuracy"}
-        ``"simple"``: among candidates within ``tolerance`` fewer links first, then a full
-        turn, then the larger transmission angle (in 5° steps), then the error; the
-        others after them by error. ``"accuracy"``: by error alone.
+        ``"simple"``: within ``tolerance`` fewer links, a full turn, the larger
+        transmission angle (5° steps), then the error; the rest by error. Or by error.
     database : CurveDatabase or directory, optional
         Default: the local one (built on first use).
     tolerance : float
-        Chamfer error (in target diagonals, default 0.5 %) within which a candidate counts
-        as tracing the curve; the search ends early once three topologies (or ``top``,
-        if fewer) have a candidate within it.
+        Error (fraction of the diagonal, default 0.5 %) within which a candidate counts
+        as tracing the curve (fewest links first among those).
     callback : callable, optional
-        ``callback(state)`` with a :class:`~mechsyn.synthesis.problem.Progress` (stage,
-        best chamfer error so far, ``nfev``; it reads as the database build's dict too).
+        ``callback(state)``: a :class:`~mechsyn.synthesis.problem.Progress` (stage, best
+        error so far, ``nfev``).
 
     Returns
     -------
     CurveSynthesisResult
-        Candidates best first, within the bounds, re-simulated by ``simulate``; with none,
-        ``feasible`` false and ``nearest_miss`` the design closest to the bounds (named in
+        Candidates best first, within the bounds, checked by ``simulate``, the simplest
+        within the tolerance and the most accurate labelled (``role``; the latter always
+        listed); with none, ``nearest_miss`` the design closest to the bounds (named in
         ``reason``). Ctrl-C returns the best so far (``interrupted``).
-
-    Notes
-    -----
-    The search runs in a working frame fixed by the curve itself (:class:`_Frame`), so a
-    similar target gives the same design transformed; only the size bound, measured on
-    the bounding box as drawn, changes with a rotation other than by quarter turns.
 
     Examples
     --------
@@ -497,59 +333,96 @@ def synthesize_curve(
     >>> _ = build_database(d, max_links=4, per_topology=400)
     >>> t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
     >>> ellipse = np.c_[3 * np.cos(t), np.sin(t)]
-    >>> res = synthesize_curve(ellipse, max_links=4, top=1, n_refine=3, database=load_database(d))
+    >>> res = synthesize_curve(ellipse, max_links=4, top=1, refinements=3, database=load_database(d))
     >>> c = res.candidates[0]
-    >>> c.topology.label, c.verified, c.chamfer < 0.02, c.size_ratio <= 1.5
-    ('four-bar', True, True, True)
+    >>> c.topology.label, c.verified, c.chamfer < 0.02, c.size_ratio <= 1.5, c.role.endswith("most accurate")
+    ('four-bar', True, True, True, True)
     """
-    t0 = time.perf_counter()
-    user = _checked_target(target, max_links, time_limit, top, max_link_ratio, crank)
-    _checked_bounds(max_size, min_transmission, prefer, tolerance)
-    if database is None or isinstance(database, (str, os.PathLike)):
-        database = load_database(database, max_links=max_links, callback=callback)
+    t0 = time.perf_counter() if started is None else min(started, time.perf_counter())
     o = dict(max_links=max_links, time_limit=time_limit, top=top, n_refine=n_refine, retrieve=retrieve, crank=crank,
              ground_region=ground_region, max_size=max_size, max_link_ratio=max_link_ratio,
-             min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance)
-    return _search(user, database, t0, o, callback)
+             min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance,
+             refinements=refinements, target_error=target_error)
+    return _loaded_and_searched(target, database, t0, o, callback)
+
+
+def _loaded_and_searched(target, database, t0: float, o: dict[str, Any], callback) -> CurveSynthesisResult:
+    """The options checked, the database loaded (a first build not counted in the time),
+    the search run."""
+    user = _checked_target(target, o["max_links"], o["time_limit"], o["top"], o["max_link_ratio"], o["crank"])
+    _checked_bounds(o["max_size"], o["min_transmission"], o["prefer"], o["tolerance"], o["refinements"],
+                    o["target_error"])
+    built: list[float] = []
+    if database is None or isinstance(database, (str, os.PathLike)):
+        database = load_database(database, max_links=o["max_links"], callback=_build_timer(callback, built))
+    if built:  # a first build is not part of the search's time
+        t0 += built[-1] - built[0]
+    res = _search(user, database, t0, o, callback)
+    if built:
+        res.notes.insert(0, f"the curve database was built first ({built[-1] - built[0]:.0f} s, once; "
+                            "not counted in the time limit)")
+    return res
+
+
+def _build_timer(callback, built: list[float]):
+    """The callback passed to the database loader: it notes when a build starts and ends."""
+    def cb(state):
+        if state.get("stage") == "build":
+            built.append(time.perf_counter())
+        if callback is not None:
+            callback(state)
+    return cb
 
 
 def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, Any],
             callback: Callable[[dict], None] | None) -> CurveSynthesisResult:
     """The search of :func:`synthesize_curve` (options ``o`` checked): sparse targets
-    smoothed, the working frame, retrieval, refinement in order, ranking, mapping back."""
+    smoothed, the working frame, retrieval, the anytime refinement, ranking and the
+    checks by ``simulate``, mapping back."""
     notes: list[str] = []
     if len(user.points) < SPARSE_POINTS:
         notes.append(f"{len(user.points)} points read as samples of a smooth curve (a "
                      f"{'periodic ' if user.closed else ''}spline through them), not a polygon")
         user = smooth_samples(user)
-    frame = _Frame.of(user, rotate=o["ground_region"] is None)
+    frame = Frame.of(user, rotate=o["ground_region"] is None)
+    if o["max_size"] is not None and o["max_size"] < frame.circumradius(user):
+        raise MechsynInputError(f"{o['max_size']:g}: the disc about the target's centroid must hold the target "
+                                f"itself ({frame.circumradius(user):.3f} diagonals)", field="max_size",
+                                hint="give a larger value, or lift it")
     work = frame.inward(user)
     bounds = frame.bounds(user, o["max_size"], o["max_link_ratio"], o["min_transmission"], o["ground_region"])
+    end = t0 + o["time_limit"]
 
     def report(stage, done, total, best, nfev):
         if callback is not None:
             callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
 
     report("retrieve", 0, 1, float("nan"), 0)
-    seeds = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds)
+    # retrieval may use at most half of what is left (the rest: evaluation, refinement, checks)
+    seeds, note = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds,
+                            deadline=time.perf_counter() + 0.5 * (end - time.perf_counter()))
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
-    picked = _diverse(seeds, o["n_refine"], simple=o["prefer"] == "simple")
-    if o["prefer"] == "simple":  # four-bars first (one within tolerance is never missed), then by rank
-        picked.sort(key=lambda s: (s.topo.n_links != 4, s.rank, s.row))
-    run = _Refinement(work, bounds, o["max_nfev"], report, notes=notes)
-    run.all(picked, t0 + o["time_limit"], min(o["top"], 3), o["tolerance"])
-    if not picked:
+    if note:
+        notes.append(note)
+    run = _Run(work, bounds, o, report, end, notes=notes)
+    if not seeds:
         run.notes.append("no database design matched the options (crank, links, open/closed)")
-    out = _ranked(run.cands, o["top"], o["tolerance"], o["prefer"], run.notes)
-    miss = _nearest_miss(run.misses, bounds, run.notes) if not out else None
+    run.search(seeds)
+    out = ranked(run.cands, o["top"], o["tolerance"], o["prefer"], run.verify, run.notes)
+    miss = nearest_miss(run.misses, bounds, run.verify, run.notes) if not out else None
+    if not out and not miss:
+        run.notes.append(f"{len(seeds)} retrieved designs, {run.assembled} of them assembled over their range "
+                         f"within the time; none traced the target within the bounds")
     report("done", 1, 1, out[0].chamfer if out else float("nan"), run.nfev)
-    res = _result(user, [frame.outward(c) for c in out], time.perf_counter() - t0, len(seeds), run.done,
-                  run.nfev, run.interrupted, run.notes)
+    res = _result(user, [frame.outward(c) for c in out], time.perf_counter() - (end - o["time_limit"]),
+                  len(seeds), run.done, run.nfev, run.interrupted, run.notes)
+    res.time_limit = o["time_limit"]
     res.bounds = {"max_size": o["max_size"], "max_link_ratio": o["max_link_ratio"], "tolerance": o["tolerance"],
-                  "min_transmission_angle": o["min_transmission"], "prefer": o["prefer"]}
+                  "min_transmission_angle": o["min_transmission"], "prefer": o["prefer"],
+                  "target_error": o["target_error"], "refinements": o["refinements"]}
     res.nearest_miss = frame.outward(miss) if miss is not None else None
     if miss is not None:
-        res.reason = _miss_reason(miss, bounds)
+        res.reason = miss_reason(miss, bounds)
     return res
 
 
@@ -572,16 +445,21 @@ def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit
     return target
 
 
-def _checked_bounds(max_size: float | None, min_transmission: float, prefer: str, tolerance: float) -> None:
-    if max_size is not None and not max_size >= 0.5:
-        raise MechsynInputError(f"{max_size}: the disc must hold the target itself (at least 0.5 diagonals)",
-                                field="max_size", hint="give a value of at least 0.5, or lift it")
+def _checked_bounds(max_size: float | None, min_transmission: float, prefer: str, tolerance: float,
+                    refinements: int | None, target_error: float | None) -> None:
+    if max_size is not None and not max_size > 0:
+        raise MechsynInputError(f"{max_size}: the disc must hold the target itself", field="max_size",
+                                hint="give a positive number of target diagonals, or lift it")
     if not 0 <= min_transmission < 90:
         raise MechsynInputError("must be an angle in degrees in [0, 90)", field="min_transmission")
     if prefer not in ("simple", "accuracy"):
         raise MechsynInputError(f"{prefer!r}: choose simple or accuracy", field="prefer")
     if not 0 < tolerance < 1:
         raise MechsynInputError("must be a fraction of the diagonal in (0, 1)", field="tolerance")
+    if refinements is not None and not refinements >= 0:
+        raise MechsynInputError("must be a number of refinements >= 0", field="refinements")
+    if target_error is not None and not 0 < target_error < 1:
+        raise MechsynInputError("must be a fraction of the diagonal in (0, 1)", field="target_error")
 
 
 def _diverse(seeds: list[_Seed], n_refine: int, simple: bool = False) -> list[_Seed]:
@@ -607,51 +485,67 @@ def _diverse(seeds: list[_Seed], n_refine: int, simple: bool = False) -> list[_S
     return picked
 
 
+UNREFINED = 8        # retrieved designs evaluated as they are, before any refinement (answers at any limit)
+MIN_UNREFINED = 3    # of them evaluated whatever the time: an answer at any limit
+WIDEN = 8            # new retrieved seeds per round after the first
+RESTARTS = 2         # perturbed restarts per leading topology per round
+LEADERS = 3          # topologies restarted and polished per round
+
+
 @dataclass
-class _Refinement:
-    """The refinement stage: candidates kept (within the bounds), misses (outside),
-    refinements done, evaluations, notes."""
+class _Run:
+    """The anytime refinement: a deterministic sequence of refinements (the first round
+    of retrieved seeds, then rounds that polish and restart the best few topologies and
+    widen to further retrieved seeds), stopped by the time limit, the target error, the
+    number of refinements or Ctrl-C. Candidates inside the bounds are kept, the others
+    are misses."""
 
     target: TargetCurve
     bounds: Bounds
-    max_nfev: int
+    o: dict[str, Any]
     report: Callable[..., None]
+    end: float
     cands: list[CurveCandidate] = field(default_factory=list)
     misses: list[CurveCandidate] = field(default_factory=list)
     done: int = 0
     nfev: int = 0
+    assembled: int = 0
     interrupted: bool = False
     notes: list[str] = field(default_factory=list)
+    verify_cost: float = 0.05   # seconds of one check by simulate (measured on the first candidate)
+    topologies: int = 3      # topologies among the retrieved designs
 
-    def all(self, picked: list[_Seed], deadline: float, need: int, tolerance: float) -> None:
-        """Refine ``picked`` in order until the deadline (a refinement starts only if the
-        longest so far still fits), ``need`` topologies with a candidate within
-        ``tolerance``, or Ctrl-C."""
-        best = float("inf")
-        longest = 0.0
-        try:
-            for i, s in enumerate(picked):
-                now = time.perf_counter()
-                if now + longest > deadline:
-                    self.notes.append(f"time limit: {i} of {len(picked)} refinements done")
-                    break
-                if len({c.topology.key for c in self.cands if c.chamfer <= tolerance}) >= need:
-                    self.notes.append(f"{need} topologies within {100 * tolerance:g} % after {i} refinements")
-                    break
-                c = _refine(s, self.target, self.bounds, self.max_nfev)
-                longest = max(longest, time.perf_counter() - now)
-                self.done += 1
-                if c is not None:
-                    self.nfev += c.nfev
-                    if self.keeps(c):
-                        self.cands.append(c)
-                        best = min(best, c.chamfer)
-                    else:
-                        self.misses.append(c)
-                self.report("refine", i + 1, len(picked), best, self.nfev)
-        except KeyboardInterrupt:
-            self.interrupted = True
-            self.notes.append("interrupted: the best found so far")
+    @property
+    def best(self) -> float:
+        return min((c.chamfer for c in self.cands), default=float("inf"))
+
+    def deadline(self) -> float:
+        """The end of refinement: the limit less the time the final checks will take
+        (``top + 1`` checks by ``simulate`` at the longest one's cost, 1.2 times)."""
+        return self.end - 1.2 * (self.o["top"] + 1) * self.verify_cost - 0.05
+
+    def verify(self, c: CurveCandidate, measure: bool = False) -> None:
+        """The check by ``simulate`` (once per candidate; with ``measure`` run again, timed:
+        the first run pays for compiling the mechanism's solver)."""
+        if c.verification and not measure:
+            return
+        _verify(c)
+        if measure:
+            t = time.perf_counter()
+            _verify(c)
+            self.verify_cost = time.perf_counter() - t
+
+    def add(self, c: CurveCandidate | None) -> None:
+        if c is None:
+            return
+        self.assembled += 1
+        self.nfev += c.nfev
+        if self.keeps(c):
+            if not self.cands:  # the first: its check measures what the final checks cost
+                self.verify(c, measure=True)
+            self.cands.append(c)
+        else:
+            self.misses.append(c)
 
     def keeps(self, c: CurveCandidate) -> bool:
         """Within the size, link-ratio and transmission bounds and the ground region."""
@@ -659,74 +553,98 @@ class _Refinement:
                                  np.array([c.min_transmission_angle]))
         return bool(exc.max() <= 1e-9) and (self.bounds.region is None or _in_region(c, self.bounds.region))
 
+    def stop(self) -> str | None:
+        """Why the search ends now (None: go on)."""
+        o = self.o
+        if o["refinements"] is not None and self.done >= o["refinements"]:
+            return f"{self.done} refinements done (--refinements)"
+        if time.perf_counter() >= self.deadline():
+            return f"time limit: {self.done} refinements done"
+        if o["target_error"] is not None and self.best <= o["target_error"]:
+            return f"target error {100 * o['target_error']:g} % reached after {self.done} refinements"
+        if o["target_error"] is not None or o["refinements"] is not None:
+            return None
+        need = min(o["top"], 3, self.topologies)
+        if len({c.topology.key for c in self.cands if c.chamfer <= o["tolerance"] and c.refined}) >= need:
+            return f"{need} topologies within {100 * o['tolerance']:g} % after {self.done} refinements"
+        return None
 
-def _rank_key(c: CurveCandidate, tolerance: float, prefer: str) -> tuple:
-    if prefer == "accuracy" or c.chamfer > tolerance:
-        return (1 if prefer != "accuracy" else 0, 0, 0, 0, c.chamfer)
-    return (0, c.topology.n_links, not c.full_turn, -np.floor(c.min_transmission_angle / 5.0), c.chamfer)
+    def search(self, seeds: list[_Seed]) -> None:
+        """Evaluate the best retrieved designs as they are, then refine until :meth:`stop`."""
+        import mechsyn.io.load  # noqa: F401  (the checks' imports first: their cost is measured)
+        import mechsyn.kinematics  # noqa: F401
+
+        self.topologies = len({s.topo.key for s in seeds})
+        try:
+            for i, s in enumerate(seeds[:UNREFINED]):
+                if i >= MIN_UNREFINED and time.perf_counter() >= self.deadline():
+                    break
+                self.add(_candidate(s.topo, s.params, s.start, s.stop, s.closed, self.target, 0, self.bounds,
+                                    refined=False))
+            for s, nfev in self.tasks(seeds):
+                why = self.stop()
+                if why:
+                    self.notes.append(why)
+                    return
+                c = _refine(s, self.target, self.bounds, nfev, self.deadline())
+                self.done += 1
+                self.add(c)
+                if self.o["refinements"] is not None:
+                    self.report("refine", self.done, self.o["refinements"], self.best, self.nfev)
+                else:  # a timed run: the bar fills with the time
+                    now = time.perf_counter() - (self.end - self.o["time_limit"])
+                    self.report("refine", min(now, self.o["time_limit"]), self.o["time_limit"], self.best, self.nfev)
+            self.notes.append(f"every retrieved design refined ({self.done} refinements)")
+        except KeyboardInterrupt:
+            self.interrupted = True
+            self.notes.append("interrupted: the best found so far")
+
+    def tasks(self, seeds: list[_Seed]):
+        """The sequence of ``(seed, max_nfev)`` refinements (see the class doc); each
+        round depends only on the candidates so far, so the sequence is deterministic."""
+        simple = self.o["prefer"] == "simple"
+        first = _diverse(seeds, self.o["n_refine"], simple=simple)
+        if simple:  # four-bars first (one within tolerance is never missed), then by rank
+            first.sort(key=lambda s: (s.topo.n_links != 4, s.rank, s.row))
+        yield from ((s, self.o["max_nfev"]) for s in first)
+        used = {id(s) for s in first}
+        rest = [s for s in seeds if id(s) not in used]
+        polished: set[int] = set()
+        rnd = 0
+        while True:
+            rnd += 1
+            leaders = self.leaders()
+            for i, c in enumerate(leaders):
+                if id(c) not in polished:  # a longer refinement of the best of the topology
+                    polished.add(id(c))
+                    yield _seed_of(c), 3 * self.o["max_nfev"]
+                rng = np.random.default_rng([rnd, i])
+                for _ in range(RESTARTS):  # restarts about it: every joint and the tracer moved
+                    step = 0.05 * self.bounds.unit / np.sqrt(rnd)
+                    yield _seed_of(c, c.params + step * rng.standard_normal(len(c.params))), self.o["max_nfev"]
+            batch = _diverse(rest, WIDEN, simple=False)
+            chosen = {id(s) for s in batch}
+            rest = [s for s in rest if id(s) not in chosen]
+            yield from ((s, self.o["max_nfev"]) for s in batch)
+            if not batch and not leaders:
+                return
+
+    def leaders(self) -> list[CurveCandidate]:
+        """The best candidate of each of the :data:`LEADERS` best topologies."""
+        best: dict[str, CurveCandidate] = {}
+        for c in sorted(self.cands, key=lambda c: (c.chamfer, c.topology.key)):
+            best.setdefault(c.topology.key, c)
+        return list(best.values())[:LEADERS]
 
 
-def _ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
-            notes: list[str]) -> list[CurveCandidate]:
-    """Best first (see :func:`synthesize_curve`'s ``prefer``), distinct, each verified by
-    ``simulate``; with ``prefer="simple"`` the first three of distinct topologies where
-    that many are within the tolerance; at most ``top``."""
-    cands.sort(key=lambda c: _rank_key(c, tolerance, prefer))
-    order = cands
-    if prefer == "simple":
-        first: list[CurveCandidate] = []
-        for c in cands:
-            if c.chamfer <= tolerance and len(first) < 3 and all(o.topology.key != c.topology.key for o in first):
-                first.append(c)
-        order = first + [c for c in cands if all(c is not o for o in first)]
-    out: list[CurveCandidate] = []
-    for c in order:
-        if any(o.topology.key == c.topology.key and abs(o.chamfer - c.chamfer) < 1e-5
-               and abs(o.link_length_ratio - c.link_length_ratio) < 1e-3 * c.link_length_ratio for o in out):
-            continue
-        _verify(c)
-        if c.verified:
-            out.append(c)
-        else:
-            notes.append(f"{c.topology.key}: dropped, {c.verification}")
-        if len(out) >= top:
-            break
-    return out
-
-
-def _nearest_miss(misses: list[CurveCandidate], bounds: Bounds, notes: list[str]) -> CurveCandidate | None:
-    """The design found closest to the bounds (then the most accurate), verified."""
-    def key(c):
-        e = bounds.excess(np.array([c.size]), np.array([c.link_length_ratio]), np.array([c.min_transmission_angle]))
-        return (float(e.sum()), c.chamfer)
-
-    for c in sorted(misses, key=key):
-        _verify(c)
-        if c.verified:
-            return c
-    notes.append("no design assembled over its range was found")
-    return None
-
-
-def _miss_reason(c: CurveCandidate, bounds: Bounds) -> str:
-    """``no candidate within the bounds; nearest miss: ...`` with the options that lift them."""
-    out = []
-    if bounds.radius is not None and c.size > bounds.radius * (1 + 1e-9):
-        out.append(f"size {c.size_ratio:.2f} diagonals > {bounds.radius / bounds.unit:g} (--max-size)")
-    if bounds.link_ratio is not None and c.link_length_ratio > bounds.link_ratio * (1 + 1e-9):
-        out.append(f"link ratio {c.link_length_ratio:.1f} > {bounds.link_ratio:g} (--max-link-ratio)")
-    if c.min_transmission_angle < bounds.transmission:
-        out.append(f"transmission angle {c.min_transmission_angle:.1f}° < {bounds.transmission:g}° "
-                   "(--min-transmission-angle)")
-    if not out:
-        out.append("frame pivots outside the ground region (--ground-region)")
-    return (f"no candidate within the bounds; nearest miss: {c.topology.label}, chamfer {100 * c.chamfer:.2f} %, "
-            + ", ".join(out) + "; lift the bound named to accept it")
+def _seed_of(c: CurveCandidate, params: np.ndarray | None = None) -> _Seed:
+    """A candidate (or a design beside it) as a seed of a further refinement."""
+    return _Seed(-1, c.topology, c.params if params is None else params, c.start, c.stop, c.full_turn, c.chamfer)
 
 
 def _result(target: TargetCurve, out: list[CurveCandidate], seconds: float, retrieved: int, refined: int,
             nfev: int, interrupted: bool, notes: list[str]) -> CurveSynthesisResult:
-    """The result, its common synthesis fields from the best candidate."""
+    """The result, its common synthesis fields from the first candidate."""
     best = out[0] if out else None
     names = [f"{n}_{xy}" for n in best.topology.plan.names for xy in "xy"] if best is not None else []
     x = np.asarray(best.params, float) if best is not None else np.zeros(0)

@@ -14,7 +14,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["TargetCurve", "read_target", "target_from_points", "smooth_samples", "MAX_TARGET_BYTES",
+__all__ = ["TargetCurve", "read_target", "target_from_points", "smooth_samples", "principal_diagonal", "MAX_TARGET_BYTES",
            "MAX_TARGET_POINTS", "SPARSE_POINTS"]
 
 MAX_TARGET_BYTES = 20_000_000    # a target file larger than this is refused (a drawing is far smaller)
@@ -33,8 +33,33 @@ class TargetCurve:
 
     @property
     def diagonal(self) -> float:
-        """Length of the bounding-box diagonal (the error unit)."""
-        return float(np.hypot(*np.ptp(self.points, axis=0)))
+        """The error unit: the diagonal of the curve's bounding box along its own principal
+        axes (see :func:`principal_diagonal`), so a turned drawing keeps its unit."""
+        return principal_diagonal(self.points)
+
+
+def principal_diagonal(points: np.ndarray) -> float:
+    """Diagonal of the bounding box of ``points (n, 2)`` taken along the principal axes of
+    the polyline (second moments of the points equally spaced along it, closed by its
+    chord), so it does not change when the curve is turned; where those moments do not
+    fix the axes (a circle, a square: both eigenvalues within 1e-6) the drawing's own axes.
+
+    >>> sq = np.array([[0.0, 0.0], [2, 0], [2, 1], [0, 1]])
+    >>> t = np.radians(37.0)
+    >>> R = np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+    >>> round(principal_diagonal(sq), 3), round(principal_diagonal(sq @ R.T), 3)
+    (2.236, 2.236)
+    """
+    from mechsyn.synthesis.curves.descriptors import resample
+
+    P = np.asarray(points, float)
+    z = P[:, 0] + 1j * P[:, 1]
+    w = resample(z, 256, closed=True)
+    u = w - w.mean()
+    m2 = np.sum(u ** 2)
+    if abs(m2) > 1e-6 * np.sum(np.abs(u) ** 2):
+        z = z * np.exp(-0.5j * np.angle(m2))
+    return float(np.hypot(np.ptp(z.real), np.ptp(z.imag)))
 
 
 def target_from_points(points, closed: bool | None = None, source: str = "<points>") -> TargetCurve:
@@ -49,7 +74,10 @@ def target_from_points(points, closed: bool | None = None, source: str = "<point
     if P.ndim != 2 or P.shape[1] != 2:
         raise MechsynInputError("points must be [x, y] pairs", source=source, field="points")
     if not np.all(np.isfinite(P)):
-        raise MechsynInputError("points must be finite numbers", source=source, field="points")
+        i, k = (int(v) for v in np.argwhere(~np.isfinite(P))[0])
+        what = "NaN" if np.isnan(P[i, k]) else "infinite"
+        raise MechsynInputError(f"{'xy'[k]} is {what}", source=source, field=f"points[{i}]",
+                                hint="give finite numbers for every point")
     if len(P) > MAX_TARGET_POINTS:
         raise MechsynInputError(f"{len(P)} points: at most {MAX_TARGET_POINTS:,} are read", source=source,
                                 field="points", hint="resample the curve to fewer points")

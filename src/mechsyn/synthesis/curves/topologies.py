@@ -23,8 +23,10 @@ the rule used here is the one stated).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import json
+from dataclasses import asdict, dataclass, field
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -50,7 +52,25 @@ class CurveTopology:
     tracer: int
     name: str | None               # Watt I/II, Stephenson I/II/III, four-bar
     template: dict                 # mechanism-file dict (layout geometry), tracer point "T"
-    plan: BatchPlan
+    compiled: BatchPlan | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def model(self):
+        """The template as a :class:`~mechsyn.model.Mechanism` (read once, on first use)."""
+        m = self.__dict__.get("_model")
+        if m is None:
+            from mechsyn.io.load import mechanism_from_dict
+
+            m = mechanism_from_dict(self.template)
+            object.__setattr__(self, "_model", m)
+        return m
+
+    @property
+    def plan(self) -> BatchPlan:
+        """The batch plan (tracer output), compiled from the template on first use."""
+        if self.compiled is None:
+            object.__setattr__(self, "compiled", compile_plan(self.model, points=[TRACER]))
+        return self.compiled
 
     @property
     def n_links(self) -> int:
@@ -157,3 +177,52 @@ def curve_topologies(max_links: int = 8) -> tuple[CurveTopology, ...]:
                     key = f"{n}-{ci + 1}-f{frame}-i{inp}-t{tr}"
                     out.append(CurveTopology(key, chain, frame, inp, tr, name, tmpl, plan))
     return tuple(out)
+
+
+CACHE_FILE = "topologies.json"
+
+
+def cached_topologies(directory: Path, max_links: int) -> tuple[CurveTopology, ...]:
+    """:func:`curve_topologies` as stored in a curve database's directory (written on the
+    first call, rewritten when it does not hold them all): the atlas is enumerated once
+    per database, not on every load; the plans compile on first use. The file is keyed
+    by the code's version of the enumeration (the keys in order and the templates)."""
+    f = Path(directory) / CACHE_FILE
+    try:
+        recs = json.loads(f.read_text())
+        want = {n: k for n, k in recs["count"].items()}
+        out = tuple(_from_record(r) for r in recs["topologies"] if r["chain"]["n_links"] <= max_links)
+        if recs.get("version") == _CACHE_VERSION and all(str(n) in want for n in range(4, max_links + 1, 2)):
+            return out
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    topos = curve_topologies(max_links)
+    counts = {str(n): sum(t.n_links == n for t in topos) for n in range(4, max_links + 1, 2)}
+    data = {"version": _CACHE_VERSION, "count": counts,
+            "topologies": [{"key": t.key, "frame": t.frame, "input": t.input, "tracer": t.tracer, "name": t.name,
+                            "template": t.template, "chain": _chain_record(t.chain)} for t in topos]}
+    from mechsyn.results import write_atomic
+
+    try:
+        write_atomic(f, json.dumps(data).encode())
+    except OSError:   # a read-only database: enumerate on every load
+        pass
+    return topos
+
+
+_CACHE_VERSION = 1
+
+
+def _chain_record(c: KinematicChain) -> dict:
+    d = asdict(c)
+    d["assortment"] = {str(k): v for k, v in c.assortment.items()}
+    return d
+
+
+def _from_record(r: dict) -> CurveTopology:
+    c = dict(r["chain"])
+    c["edges"] = tuple(tuple(e) for e in c["edges"])
+    c["assortment"] = {int(k): v for k, v in c["assortment"].items()}
+    c["contracted"] = tuple(tuple(e) for e in c.get("contracted", ()))
+    return CurveTopology(r["key"], KinematicChain(**c), r["frame"], r["input"], r["tracer"], r["name"],
+                         r["template"])

@@ -1,0 +1,145 @@
+"""Issue 41: one error measure, both answers labelled, a bad point named, the anytime
+search (an answer at any limit, deterministic for a fixed number of refinements) and
+bounds that are the curve's own (centroid, principal-axes diagonal)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mechsyn.errors import MechsynInputError
+from mechsyn.synthesis.curves.candidates import MOST_ACCURATE, SIMPLEST, CurveCandidate, ranked
+from mechsyn.synthesis.curves.database import build_database, load_database
+from mechsyn.synthesis.curves.fitting import chamfer_error, departure
+from mechsyn.synthesis.curves.frame import Frame
+from mechsyn.synthesis.curves.synthesis import synthesize_curve
+from mechsyn.synthesis.curves.target import TargetCurve, principal_diagonal, read_target, target_from_points
+from mechsyn.synthesis.curves.topologies import curve_topologies
+
+
+def _turn(P: np.ndarray, deg: float) -> np.ndarray:
+    a = np.radians(deg)
+    return P @ np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]).T
+
+
+def _circle(n: int, r: float = 1.0, phase: float = 0.0) -> np.ndarray:
+    t = phase + np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return r * np.c_[np.cos(t), np.sin(t)]
+
+
+def test_a_bad_point_is_named(tmp_path):
+    P = _circle(40)
+    P[17, 1] = np.nan
+    with pytest.raises(MechsynInputError, match=r"points\[17\]: y is NaN"):
+        target_from_points(P)
+    f = tmp_path / "t.csv"
+    f.write_text("x,y\n" + "\n".join(f"{x},{y}" for x, y in _circle(30)[:5]) + "\n1.0,inf\n")
+    with pytest.raises(MechsynInputError, match=r"points\[5\]: y is infinite"):
+        read_target(f)
+
+
+def test_the_error_is_the_symmetric_chamfer_over_arc_length():
+    target = TargetCurve(_circle(400), closed=True)
+    D = target.diagonal
+    # the same circle, sampled sparsely and unevenly: about 0 whatever the sampling (chords only)
+    t = np.sort(np.random.default_rng(1).uniform(0, 2 * np.pi, 300))
+    assert chamfer_error(np.c_[np.cos(t), np.sin(t)], target, True) < 2e-4
+    # a concentric circle of radius 1.2: every point 0.2 from the other curve, both ways
+    assert chamfer_error(_circle(977, 1.2, 0.3), target, True) == pytest.approx(0.2 / D, rel=1e-3)
+    # half the circle traced (an arc): the target's other half is on average 2/pi*... away;
+    # independently, a dense numerical mean over arc length of the distances to the arc
+    arc = _circle(2000)[:1001]
+    s = np.linspace(0, 2 * np.pi, 20000, endpoint=False)
+    pts = np.c_[np.cos(s), np.sin(s)]
+    d_target = np.where(np.sin(s) >= 0, 0.0, np.minimum(np.hypot(*(pts - [1, 0]).T), np.hypot(*(pts - [-1, 0]).T)))
+    expect = 0.5 * d_target.mean() / D          # the arc's own points lie on the target
+    assert chamfer_error(arc, target, False) == pytest.approx(expect, rel=2e-3)
+
+
+def test_the_departure_is_the_target_point_farthest_from_the_path():
+    square = TargetCurve(np.array([[x, -1.0] for x in np.linspace(-1, 1, 10, endpoint=False)]
+                                  + [[1.0, y] for y in np.linspace(-1, 1, 10, endpoint=False)]
+                                  + [[x, 1.0] for x in np.linspace(1, -1, 10, endpoint=False)]
+                                  + [[-1.0, y] for y in np.linspace(1, -1, 10, endpoint=False)]), closed=True)
+    i, d = departure(_circle(720), square, True)
+    assert np.abs(square.points[i]).tolist() == [1.0, 1.0] and d == pytest.approx(np.sqrt(2) - 1, rel=1e-4)
+
+
+def test_the_diagonal_and_the_size_bound_turn_with_the_drawing():
+    rng = np.random.default_rng(3)
+    u = np.linspace(0, 1, 30, endpoint=False)    # a 6 x 2 rectangle with a bump: no symmetry fixes its frame
+    P = np.concatenate([np.c_[-3 + 6 * u, -1 + 0 * u], np.c_[3 + 0 * u, -1 + 2 * u],
+                        np.c_[3 - 6 * u, 1 + 0.4 * np.sin(np.pi * u) ** 2], np.c_[-3 + 0 * u, 1 - 2 * u]])
+    P = P + rng.normal(scale=0.01, size=P.shape)
+    a, b = target_from_points(P, closed=True), target_from_points(_turn(P, 37.0) + [5, -2], closed=True)
+    assert principal_diagonal(b.points) == pytest.approx(principal_diagonal(a.points), rel=1e-6)
+    assert np.hypot(*np.ptp(b.points, axis=0)) > 1.1 * np.hypot(*np.ptp(a.points, axis=0))  # the drawn box is not
+    fa, fb = Frame.of(a), Frame.of(b)
+    ba, bb = fa.bounds(a, 1.5, 10, 30, None), fb.bounds(b, 1.5, 10, 30, None)
+    assert ba.centre == bb.centre == (0.0, 0.0)
+    assert bb.radius / bb.unit == pytest.approx(ba.radius / ba.unit) and bb.unit == pytest.approx(ba.unit, rel=1e-6)
+    assert fb.circumradius(b) == pytest.approx(fa.circumradius(a), rel=1e-6)
+
+
+def _cand(topo, chamfer, n_fail=False):
+    c = CurveCandidate(topo, np.zeros(2 * len(topo.plan.names)), 0.0, 360.0, chamfer, chamfer, 40.0, 2.0,
+                       np.zeros((3, 2)), reference_input=0.0, size=1.0, size_ratio=1.0)
+    c.n_fail = n_fail
+    return c
+
+
+def _verify(c):
+    c.verified, c.verification = not c.n_fail, "simulate differs from the batch path by 1" if c.n_fail else "ok"
+
+
+def test_the_simplest_within_tolerance_and_the_most_accurate_are_both_listed_and_labelled():
+    topos = curve_topologies(6)
+    four, six = topos[0], next(t for t in topos if t.n_links == 6)
+    cands = [_cand(four, 0.0049), _cand(six, 0.00025)] + [_cand(four, 0.003 + 1e-4 * i) for i in range(6)]
+    notes: list[str] = []
+    out = ranked(cands, 3, 0.005, "simple", _verify, notes)
+    assert len(out) == 3 and out[0].topology.n_links == 4 and out[0].role == SIMPLEST and out[0].chamfer == 0.003
+    assert [c.role for c in out[1:]] == [MOST_ACCURATE, ""] and out[1].chamfer == 0.00025
+    out = ranked(cands, 1, 0.005, "simple", _verify, notes)      # one asked for: the most accurate after it
+    assert [(c.chamfer, c.role) for c in out] == [(0.003, SIMPLEST), (0.00025, MOST_ACCURATE)]
+    # one candidate both; a most accurate one that simulate refuses is dropped, with a note
+    bad = _cand(six, 1e-5, n_fail=True)
+    out = ranked([_cand(four, 0.001), bad], 3, 0.005, "simple", _verify, notes)
+    assert [c.role for c in out] == [f"{SIMPLEST} and {MOST_ACCURATE}"]
+    assert any("simulate differs" in n for n in notes)
+
+
+@pytest.fixture(scope="module")
+def db(tmp_path_factory):
+    d = tmp_path_factory.mktemp("curvedb41")
+    build_database(d, max_links=6, per_topology=150)
+    return load_database(d, build_if_missing=False)
+
+
+def _coupler(seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    a, b, c = rng.uniform(0.2, 0.35), rng.uniform(0.9, 1.1), rng.uniform(0.9, 1.1)
+    th = np.linspace(0, 2 * np.pi, 150, endpoint=False)
+    A = a * np.exp(1j * th)
+    d = 1.0 - A
+    t = np.abs(d) ** 2
+    al = (b * b - c * c + t) / (2 * t)
+    B = A + d * (al + 1j * np.sqrt(b * b / t - al * al))
+    M = A + (B - A) * complex(0.5, 0.4)
+    return np.c_[M.real, M.imag]
+
+
+def test_a_fixed_number_of_refinements_repeats_exactly(db):
+    kw = dict(max_links=6, top=3, refinements=5, database=db, time_limit=1e4)
+    a, b = synthesize_curve(_coupler(2), **kw), synthesize_curve(_coupler(2), **kw)
+    assert a.refined == b.refined == 5 and "5 refinements done (--refinements)" in a.notes
+    assert [c.chamfer for c in a.candidates] == [c.chamfer for c in b.candidates]
+    assert all(np.array_equal(x.params, y.params) for x, y in zip(a.candidates, b.candidates))
+
+
+def test_any_limit_answers_with_the_best_it_has(db):
+    # a limit already over when the search begins: the retrieved designs, evaluated as they are
+    res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, time_limit=1e-6)
+    assert res.candidates and res.refined == 0 and all(c.verified for c in res.candidates)
+    assert not res.candidates[0].refined and "not refined" in str(res)
+    assert any(n.startswith("time limit") for n in res.notes)
