@@ -229,8 +229,10 @@ def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool
     ``span`` (360 deg for an R drive, ± its length scale for a P drive) in ``steps``.
     Returns ``joints``/``points`` as lists of [x, y] or null (not assembled),
     ``working_ranges``, ``events`` (dead points, reassembly, singular positions),
-    ``transmission_angle`` and, for a four-bar, ``grashof``. ``rates=False`` leaves out
-    the velocities, accelerations and link angles (a smaller answer for the drag loop).
+    ``transmission_angle``, for a four-bar ``grashof`` and, with the rates, ``summary``
+    (:func:`mechsyn.kinematics.summary.motion_summary`: strokes, rocker ranges, time ratios).
+    ``rates=False`` leaves out the velocities, accelerations, link angles and the summary (a
+    smaller answer for the drag loop).
     """
     return _simulated(build(data), steps, span, rates)
 
@@ -266,6 +268,10 @@ def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, A
     }
     if _is_four_bar(mech):
         out["grashof"] = to_jsonable(derived.grashof(mech))
+    if rates:  # the Analysis tab's strokes, rocker ranges and time ratios (as `mechsyn simulate`)
+        from mechsyn.kinematics.summary import motion_summary
+
+        out["summary"] = to_jsonable(motion_summary(mech, sim))
     return out
 
 
