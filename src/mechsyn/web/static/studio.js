@@ -1,7 +1,7 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
 import { call, coalescing, eventsUrl, transport } from "./api.js";
 import { draw, el, gridStep, linkName, makeView, membership, plot, plotRowAt, positions, GROUP_COLOURS } from "./draw.js";
-import { geometryChecks, tidy, topologyKey } from "./checks.js";
+import { checkKey, geometryChecks, tidy, topologyKey } from "./checks.js";
 import { bindKeys } from "./keys.js";
 import { mountPlayer } from "./player.js";
 import { mountSynthesis } from "./synthesis.js";
@@ -164,14 +164,19 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   if (!keepFrame) state.frame = state.home;
   if (fit) fitView();
   state.errors = [];
-  const key = topologyKey(mech);
+  const key = checkKey(mech), topo = topologyKey(mech);
   if (state.check && state.check.key === key) afterCheck(mech, state.check.result, edited);
   else {
-    // the topology changed: the server's check (mobility, drives, connections) first, at once
-    state.diagnostics = geometryChecks(mech); state.check = null;
+    // the server's check (mobility, drives, connections) runs again on every change it reads.
+    // Only the places changed and the last check let it move: simulated at once meanwhile,
+    // re-done if the new check says otherwise (a four-bar moved onto one line cannot be driven)
+    const prev = state.check && state.check.topo === topo && !state.check.result.diagnostics.some((d) => d.blocks) ? state.check.result : null;
+    if (prev) afterCheck(mech, prev, edited); else state.diagnostics = geometryChecks(mech);
+    state.check = null;
     call("/api/studio/check", { mechanism: mech }).then((result) => {
       if (mech !== state.mech) return;
-      state.check = { key, result }; afterCheck(mech, result, edited); render();
+      state.check = { key, topo, result };
+      if (!prev || JSON.stringify(result) !== JSON.stringify(prev)) { afterCheck(mech, result, edited); render(); }
     }, (e) => {
       if (mech !== state.mech) return;
       state.sim = null; state.simFor = mech; state.notes = [];
