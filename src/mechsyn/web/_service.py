@@ -272,6 +272,27 @@ def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, A
         from mechsyn.kinematics.summary import motion_summary
 
         out["summary"] = to_jsonable(motion_summary(mech, sim))
+        out["slides"] = _slides(mech, sim)
+    return out
+
+
+def _slides(mech, sim) -> dict[str, Any]:
+    """Every P joint's slide along its guide (:meth:`PlanarSystem.coordinate`: from the guide
+    link's origin, the world origin for the frame), its rate and its acceleration (the rate's
+    time derivative along the motion, by a central difference) at the drive's speed."""
+    S, sw = sim.system, sim.sweep
+    if S is None or sw is None:
+        return {}
+    q, qd, qdd = (np.asarray(a, float) for a in (sw.q, sw.qd, sw.qdd))
+    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
+    out = {}
+    for j in mech.joints:
+        if j.type != "P":
+            continue
+        rate = S.coordinate_rate(q, qd, j.id)
+        acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
+        value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
+        out[j.id] = {"guide": j.links[0], "value": _finite(value), "rate": _finite(rate), "acceleration": _finite(acc)}
     return out
 
 

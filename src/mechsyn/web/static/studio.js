@@ -1,12 +1,13 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
 import { call, coalescing, eventsUrl, transport } from "./api.js";
-import { draw, el, gridStep, linkName, makeView, membership, plot, plotRowAt, positions, GROUP_COLOURS } from "./draw.js";
+import { draw, gridStep, linkName, makeView, membership, positions, GROUP_COLOURS } from "./draw.js";
 import { checkKey, geometryChecks, tidy, topologyKey } from "./checks.js";
 import { bindKeys } from "./keys.js";
 import { mountPlayer } from "./player.js";
 import { mountSynthesis } from "./synthesis.js";
 import { mountAtlas } from "./atlas.js";
 import { mountForces } from "./forces.js";
+import { mountPlots } from "./plots.js";
 import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
@@ -580,48 +581,11 @@ function renderJoints() {
   $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }));
 }
 
-function renderPlots() {
-  if (spatial()) return spatialUi.renderPlots();
-  const sim = state.sim, sel = $("plot-what");
-  if (!sim) { $("plots").replaceChildren(h("p", "no simulation", { className: "muted" })); return; }
-  if (!sim.rates) return; // an edit's first answer: the plots wait for the rates
-  const opts = Object.keys(sim.velocity).map((n) => `point:${n}`).concat(Object.keys(sim.links).map((n) => `link:${n}`));
-  if ([...sel.options].map((o) => o.value).join() !== opts.join()) {
-    const keep = sel.value;
-    sel.replaceChildren(...opts.map((o) => h("option", o.replace(":", " "), { value: o })));
-    if (opts.includes(keep)) sel.value = keep; else if (Object.keys(sim.points).length) sel.value = `point:${Object.keys(sim.points)[0]}`;
-  }
-  if (!$("tab-plots").classList.contains("on")) return;
-  const [kind, name] = (sel.value || "").split(":");
-  const xs = sim.input.values, k = state.frame, R = sim.working_ranges;
-  // the library's rates are at a drive speed of 1 rad/s (R) or 1 length unit/s (P), held constant:
-  // velocities scale with the speed, accelerations with its square
-  const w = Number($("drive-speed").value) || 1, rot = sim.input.type === "R";
-  const at = `at ${sim.input.joint} = ${w} ${rot ? "rad/s" : "units/s"}`;
-  const scale = (vals, f) => vals.map((v) => (v === null ? null : v * f));
-  let pairs;
-  if (kind === "point") {
-    const comp = (arr, i, f) => arr.map((v) => (v ? v[i] * f : null));
-    pairs = [[`velocity of ${name}`, "units/s", [{ name: "vx", values: comp(sim.velocity[name], 0, w) }, { name: "vy", values: comp(sim.velocity[name], 1, w) }]],
-      [`acceleration of ${name}`, "units/s²", [{ name: "ax", values: comp(sim.acceleration[name], 0, w * w) }, { name: "ay", values: comp(sim.acceleration[name], 1, w * w) }]]];
-  } else if (kind === "link") {
-    pairs = [[`angular velocity of ${name}`, "rad/s", [{ name: "ω", values: scale(sim.links[name].angular_velocity, w) }]],
-      [`angular acceleration of ${name}`, "rad/s²", [{ name: "α", values: scale(sim.links[name].angular_acceleration, w * w) }]]];
-  } else return;
-  const out = [];
-  const xunit = sim.input.unit === "deg" ? "°" : "units";
-  for (const [title, unit, series] of pairs) {
-    out.push(h("p", `${title} (${unit}, ${at}) against ${sim.input.joint} (${xunit})`));
-    const s = el("svg", { "data-plot": title });
-    plot(s, xs, series, k, R, { x: `${sim.input.joint} (${xunit})`, y: unit });
-    s.addEventListener("click", (ev) => { state.frame = assembledNear(plotRowAt(s, ev)); render(); });
-    out.push(s);
-  }
-  $("plots").replaceChildren(...out);
-}
+function renderPlots() { if (spatial()) spatialUi.renderPlots(); else planarPlots(); } // plots.js: the planar charts
 
 // ------------------------------------------------------------------ player, synthesis, atlas
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
+const planarPlots = mountPlots({ $, state, render, assembledNear });
 const synthUi = mountSynthesis({ $, state, render, setMech });
 mountAtlas({ $, state, render, setMech });
 const spatialUi = mountSpatialTabs({ $, state, render, showTab });
