@@ -87,7 +87,9 @@ function order(pts) {
   return pts.slice().sort((a, b) => Math.atan2(a[1] - c[1], a[0] - c[0]) - Math.atan2(b[1] - c[1], b[0] - c[0]));
 }
 
-export function pathD(v, pts) {
+// A path through the points (null: a gap); `cyclic` (a sweep over a whole turn) joins the last
+// point to the first, so a closed coupler curve has no gap where the sweep starts.
+export function pathD(v, pts, cyclic = false) {
   let d = "", pen = false;
   for (const p of pts) {
     if (!p) { pen = false; continue; }
@@ -95,7 +97,14 @@ export function pathD(v, pts) {
     d += `${pen ? "L" : "M"}${x.toFixed(1)} ${y.toFixed(1)}`;
     pen = true;
   }
+  if (cyclic && pen && pts[0] && pts.length > 2) { const [x, y] = v.toScreen(pts[0]); d += `L${x.toFixed(1)} ${y.toFixed(1)}`; }
   return d;
+}
+
+// Whether a simulation's sweep is a whole turn of an R input (its last row, one step on, is its first).
+export function wholeTurn(sim) {
+  const x = sim.input.values, n = x.length;
+  return sim.input.type === "R" && n > 2 && Math.abs(Math.abs(x[n - 1] - x[0]) + Math.abs(x[1] - x[0]) - 360) < 1e-6;
 }
 
 function muClass(mu) {
@@ -157,7 +166,7 @@ export function draw(svg, state) {
   // paths of the named points (full sweep)
   const paths = {};
   if (sim) for (const [n, pts] of Object.entries(sim.points))
-    paths[n] = el("path", { d: pathD(v, pts), class: "path", "data-path": n }, layers.paths);
+    paths[n] = el("path", { d: pathD(v, pts, wholeTurn(sim)), class: "path", "data-path": n }, layers.paths);
   // ground symbols
   for (const j of mech.joints) {
     if (!(j.links || []).includes(mech.ground) || !pos.joints[j.id]) continue;

@@ -5,7 +5,7 @@
 // shared by the charts of a tab), the max, min, mean and RMS of every series over the sweep, and
 // the plotted data as CSV.
 import uPlot from "./vendor/uPlot.esm.js";
-import { robustRange } from "./draw.js";
+import { pathD, robustRange, wholeTurn } from "./draw.js";
 import { h } from "./numeric.js";
 
 // Distinct colours (Tableau 10), one per series in the order given.
@@ -131,7 +131,7 @@ function statsTable(series, colours, unit) {
 }
 
 // An x/y plot of a point's path (equal scales) with the point at the slider's row, and its table.
-export function pathPlot(name, path, xs, xname, k) {
+export function pathPlot(name, path, xs, xname, k, cyclic = false) {
   const box = h("div", null, { className: "chart" });
   box.dataset.plot = `path of ${name}`;
   const pts = path.map((p, i) => [p, i]).filter(([p]) => p);
@@ -147,10 +147,7 @@ export function pathPlot(name, path, xs, xname, k) {
   const add = (tag, attrs, text) => { const e = document.createElementNS(NS, tag); for (const [a, v] of Object.entries(attrs)) e.setAttribute(a, v); if (text) e.textContent = text; svg.append(e); return e; };
   for (const [v, horiz] of [[x0, false], [x1, false], [y0, true], [y1, true]])
     add("text", horiz ? { x: 2, y: sy(v) + 4, class: "label" } : { x: sx(v) - 10, y: H - 6, class: "label" }, fmt(v));
-  let d = "", pen = false;
-  const full = path.every(Boolean);
-  path.forEach((p) => { if (!p) { pen = false; return; } d += `${pen ? "L" : "M"}${sx(p[0]).toFixed(1)} ${sy(p[1]).toFixed(1)}`; pen = true; });
-  if (full) d += "Z";
+  const d = pathD({ toScreen: (p) => [sx(p[0]), sy(p[1])] }, path, cyclic);
   add("rect", { x: pad, y: pad, width: W - 2 * pad, height: H - 2 * pad, class: "frame" });
   add("path", { d, class: "plotline", fill: "none", stroke: SERIES_COLOURS[0] });
   const dot = add("circle", { r: 4, fill: "#e07000" });
@@ -252,7 +249,7 @@ export function mountPlots({ $, state, render, assembledNear }) {
     const xunit = sim.input.unit === "deg" ? "°" : "units", xname = sim.input.joint;
     const marks = sim.events.filter((e) => e.kind === "dead point" && e.input[xname] !== undefined).map((e) => ({ x: +e.input[xname], kind: e.kind, text: e.message }));
     charts = chartsOf(sim, sel.value || "", w).map(([title, unit, series, note]) => (title === "path"
-      ? pathPlot(unit, series, sim.input.values, xname, state.frame)
+      ? pathPlot(unit, series, sim.input.values, xname, state.frame, wholeTurn(sim))
       : chart({ title, xs: sim.input.values, xname, xunit, yunit: unit, series, note, k: state.frame, ranges: sim.working_ranges, marks, onPick: pick, width, group: "plots" })));
     box.replaceChildren(...charts);
   }
