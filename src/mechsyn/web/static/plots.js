@@ -11,7 +11,7 @@ import { h } from "./numeric.js";
 // Distinct colours (Tableau 10), one per series in the order given.
 export const SERIES_COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"];
 
-export const fmt = (v) => (v === null || v === undefined || !Number.isFinite(v) ? "–" : Math.abs(v) >= 1e5 || (v !== 0 && Math.abs(v) < 1e-3) ? v.toExponential(3) : String(+v.toPrecision(4)));
+export const fmtValue = (v) => (v === null || v === undefined || !Number.isFinite(v) ? "–" : Math.abs(v) >= 1e5 || (v !== 0 && Math.abs(v) < 1e-3) ? v.toExponential(3) : String(+v.toPrecision(4)));
 
 // max, min, mean and RMS of the finite values (the sweep's rows are equally spaced in the input,
 // so at a constant drive speed these are the time averages over the rows shown).
@@ -57,8 +57,8 @@ export function chart(o) {
   const atSlider = h("span"), atCursor = h("span", "hover the plot for the values at the cursor", { className: "muted" });
   readout.append(atSlider, h("br"), atCursor);
   let k = o.k, u = null;
-  const xs = o.xs, xt = (x) => `${o.xname} = ${fmt(x)}${o.xunit === "°" ? "°" : ""}`;
-  const valuesAt = (i) => o.series.map((s, n) => `${s.name} = ${fmt(s.values[i])}`).filter((_, n) => !u || u.series[n + 1].show).join(", ");
+  const xs = o.xs, xt = (x) => `${o.xname} = ${fmtValue(x)}${o.xunit === "°" ? "°" : ""}`;
+  const valuesAt = (i) => o.series.map((s, n) => `${s.name} = ${fmtValue(s.values[i])}`).filter((_, n) => !u || u.series[n + 1].show).join(", ");
   const showSlider = () => { atSlider.textContent = `at the input slider, ${xt(xs[k])}: ${valuesAt(k)} ${o.yunit}`; readout.dataset.cursor = k; };
   const plugins = [{ hooks: {
     drawClear: [(p) => { // the working ranges, shaded under the curves
@@ -93,9 +93,9 @@ export function chart(o) {
     cursor: { sync: { key: o.group || "mechsyn", setSeries: false }, drag: { x: true, y: false, setScale: true }, points: { size: 6 } },
     scales: { x: { time: false }, y: { range: (p, lo, hi) => (R.clipped ? [R.lo, R.hi] : uPlot.rangeNum(hi - lo > 1e-12 * Math.max(1, Math.abs(hi)) ? lo : R.lo, hi - lo > 1e-12 * Math.max(1, Math.abs(hi)) ? hi : R.hi, 0.1, true)) } },
     axes: [{ grid: { stroke: "#e4e7ec", width: 1 }, ticks: { stroke: "#ccd" }, size: 30, font: "11px system-ui" },
-      { grid: { stroke: "#e4e7ec", width: 1 }, ticks: { stroke: "#ccd" }, size: 52, font: "11px system-ui", values: (p, ticks) => ticks.map(fmt) }],
+      { grid: { stroke: "#e4e7ec", width: 1 }, ticks: { stroke: "#ccd" }, size: 52, font: "11px system-ui", values: (p, ticks) => ticks.map(fmtValue) }],
     legend: { live: false },
-    series: [{ label: o.xname, value: (p, v) => fmt(v) }, ...o.series.map((s, i) => ({ label: s.name, stroke: colours[i], width: 1.6, spanGaps: false, value: (p, v) => fmt(v) }))],
+    series: [{ label: o.xname, value: (p, v) => fmtValue(v) }, ...o.series.map((s, i) => ({ label: s.name, stroke: colours[i], width: 1.6, spanGaps: false, value: (p, v) => fmtValue(v) }))],
   };
   const holder = h("div", null, { className: "chart-canvas", title: "drag across to zoom, double-click to zoom out; click to move the input there" });
   box.append(holder);
@@ -122,7 +122,7 @@ function statsTable(series, colours, unit) {
   series.forEach((s, i) => {
     const st = stats(s.values), tr = h("tr");
     const name = h("td", s.name); name.style.color = colours[i]; name.style.fontWeight = "600";
-    tr.append(name, ...["max", "min", "mean", "rms"].map((key) => h("td", st ? fmt(st[key]) : "–")));
+    tr.append(name, ...["max", "min", "mean", "rms"].map((key) => h("td", st ? fmtValue(st[key]) : "–")));
     tr.dataset.series = s.name;
     t.append(tr);
   });
@@ -146,7 +146,7 @@ export function pathPlot(name, path, xs, xname, k, cyclic = false) {
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`); svg.setAttribute("class", "pathplot");
   const add = (tag, attrs, text) => { const e = document.createElementNS(NS, tag); for (const [a, v] of Object.entries(attrs)) e.setAttribute(a, v); if (text) e.textContent = text; svg.append(e); return e; };
   for (const [v, horiz] of [[x0, false], [x1, false], [y0, true], [y1, true]])
-    add("text", horiz ? { x: 2, y: sy(v) + 4, class: "label" } : { x: sx(v) - 10, y: H - 6, class: "label" }, fmt(v));
+    add("text", horiz ? { x: 2, y: sy(v) + 4, class: "label" } : { x: sx(v) - 10, y: H - 6, class: "label" }, fmtValue(v));
   const d = pathD({ toScreen: (p) => [sx(p[0]), sy(p[1])] }, path, cyclic);
   add("rect", { x: pad, y: pad, width: W - 2 * pad, height: H - 2 * pad, class: "frame" });
   add("path", { d, class: "plotline", fill: "none", stroke: SERIES_COLOURS[0] });
@@ -155,19 +155,19 @@ export function pathPlot(name, path, xs, xname, k, cyclic = false) {
   const place = (row) => {
     const p = path[row];
     if (p) { dot.setAttribute("cx", sx(p[0])); dot.setAttribute("cy", sy(p[1])); }
-    readout.textContent = p ? `at the input slider, ${xname} = ${fmt(xs[row])}: x = ${fmt(p[0])}, y = ${fmt(p[1])}` : "not assembled here";
+    readout.textContent = p ? `at the input slider, ${xname} = ${fmtValue(xs[row])}: x = ${fmtValue(p[0])}, y = ${fmtValue(p[1])}` : "not assembled here";
   };
   svg.addEventListener("mousemove", (ev) => {
     const r = svg.getBoundingClientRect(), px = ((ev.clientX - r.left) / r.width) * W, py = ((ev.clientY - r.top) / r.height) * H;
     let best = null, bd = Infinity;
     path.forEach((p, i) => { if (p) { const dd = (sx(p[0]) - px) ** 2 + (sy(p[1]) - py) ** 2; if (dd < bd) { bd = dd; best = i; } } });
-    if (best !== null) readout.textContent = `nearest the cursor, ${xname} = ${fmt(xs[best])}: x = ${fmt(path[best][0])}, y = ${fmt(path[best][1])}`;
+    if (best !== null) readout.textContent = `nearest the cursor, ${xname} = ${fmtValue(xs[best])}: x = ${fmtValue(path[best][0])}, y = ${fmtValue(path[best][1])}`;
   });
   svg.addEventListener("mouseleave", () => place(k));
   box.append(svg, readout);
   const csv = h("button", "CSV", { title: "the path as CSV (input, x, y)" }); csv.dataset.csv = "";
   csv.onclick = () => download(`path_${name}.csv`, csvOf([{ name: xname, values: xs }, { name: `${name}_x`, values: path.map((p) => (p ? p[0] : null)) }, { name: `${name}_y`, values: path.map((p) => (p ? p[1] : null)) }]));
-  const tools = h("div", null, { className: "chart-tools" }); tools.append(csv, ` ${pts.length} points; width ${fmt(x1 - x0)}, height ${fmt(y1 - y0)}`);
+  const tools = h("div", null, { className: "chart-tools" }); tools.append(csv, ` ${pts.length} points; width ${fmtValue(x1 - x0)}, height ${fmtValue(y1 - y0)}`);
   box.append(tools);
   let k0 = k;
   box.cursor = (row) => { if (row === undefined || row === k0) return; k = k0 = row; place(row); };
