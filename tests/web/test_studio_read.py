@@ -15,13 +15,29 @@ import pytest
 import mechsyn as ms
 from mechsyn.kinematics.summary import motion_summary
 
-from test_browser import center, click_world, example, open_studio, shot, wait_js, wait_settled, wait_simulated
+from test_browser import center, click_world, example, new_canvas, open_studio, shot, wait_js, wait_settled, wait_simulated
 
 BANNER = "() => document.querySelector('[data-banner]').innerText"
 
 
 def banner_has(page, text, timeout=30.0):
     wait_js(page, "t => document.querySelector('[data-banner]').innerText.includes(t)", text, timeout=timeout)
+
+
+def opened(serve, page, name, mech=None):
+    """The studio open on example ``name`` (or ``mech`` under its name), simulated and analysed."""
+    srv = serve(mech or example(name), f"{name}.yaml")
+    open_studio(page, srv)
+    wait_settled(page)
+    return srv
+
+
+def analysis_text(page, until):
+    """The Analysis tab's text once the element ``until`` (a selector) or text is in it."""
+    page.click('#tabs [data-tab="analysis"]')
+    wait_js(page, """u => { const t = document.querySelector('#tab-analysis');
+        return u.startsWith('[') ? t.querySelector(u) : t.innerText.includes(u); }""", until)
+    return page.locator("#tab-analysis").inner_text()
 
 
 def numbers(text):
@@ -33,10 +49,8 @@ def test_a_fourbar_built_along_one_line_then_opened_out_moves(serve, page):
     """The structure check is cached by everything it reads: a four-bar clicked along one row
     (W = 2 at that pose, it cannot be driven) and then given a regular shape by typing a
     joint's y is checked again and simulates; before, the first answer stayed forever."""
-    srv = serve(None)
-    page.goto(srv.url)
-    wait_js(page, "() => window.__studio && window.__studio.mech")
-    page.click("#new")
+    new_canvas(page, serve(None))
+    wait_js(page, "() => window.__studio.mech.joints.length === 0")
     page.click("text=Pivot")
     click_world(page, 0, 0)
     click_world(page, 4, 0)
@@ -88,10 +102,7 @@ def hover(page, selector, fx, fy=0.5):
 
 
 def test_plots_read_values_at_the_cursor_and_the_slider(serve, page):
-    mech = example("crank_rocker")
-    srv = serve(mech, "crank_rocker.yaml")
-    open_studio(page, srv)
-    wait_settled(page)
+    opened(serve, page, "crank_rocker")
     page.locator("#input-slider").fill("40")
     page.click('#tabs [data-tab="plots"]')
     page.select_option("#plot-what", "point:M")
@@ -143,9 +154,7 @@ def test_plots_read_values_at_the_cursor_and_the_slider(serve, page):
 
 
 def test_plots_of_joints_sliders_and_transmission(serve, page):
-    srv = serve(example("slider_crank"), "slider_crank.yaml")
-    open_studio(page, srv)
-    wait_settled(page)
+    opened(serve, page, "slider_crank")
     page.click('#tabs [data-tab="plots"]')
     labels = page.eval_on_selector_all("#plot-what optgroup", "gs => gs.map(g => g.label)")
     assert labels == ["joints", "links", "motion"]  # no named point in this file
@@ -169,9 +178,7 @@ def test_forces_read_torque_with_its_sign_and_statistics(serve, page):
     mech = example("crank_rocker")
     named = lambda link: link if isinstance(link, str) else link["name"]  # noqa: E731
     mech["links"] = [{"name": "rocker", "mass": 2.0} if named(link) == "rocker" else link for link in mech["links"]]
-    srv = serve(mech, "crank_rocker.yaml")
-    open_studio(page, srv)
-    wait_settled(page)
+    opened(serve, page, "crank_rocker", mech)
     page.click('#tabs [data-tab="forces"]')
     page.check("#forces-gravity")
     wait_js(page, """() => { const f = window.__studio.forces; return f && f.mech === window.__studio.mech && f.r && f.r.gravity[1] < 0
@@ -196,12 +203,8 @@ def test_forces_read_torque_with_its_sign_and_statistics(serve, page):
 
 # the Analysis tab --------------------------------------------------------------------------------
 def test_analysis_names_the_stroke_the_rocker_range_and_the_time_ratio(serve, page):
-    srv = serve(example("slider_crank"), "slider_crank.yaml")
-    open_studio(page, srv)
-    wait_settled(page)
-    page.click('#tabs [data-tab="analysis"]')
-    wait_js(page, "() => document.querySelector('#tab-analysis [data-stroke=\"D\"]')")
-    text = page.locator("#tab-analysis").inner_text()
+    opened(serve, page, "slider_crank")
+    text = analysis_text(page, '[data-stroke="D"]')
     m = ms.examples.load("slider_crank")
     lib = motion_summary(m, ms.simulate(m, {"A": np.array(page.evaluate("window.__studio.sim.input.values"))}))
     stroke = re.search(r"slider D: stroke ([\d.]+)", text)
@@ -223,12 +226,8 @@ def test_analysis_names_the_stroke_the_rocker_range_and_the_time_ratio(serve, pa
 
 
 def test_one_working_range_through_360_and_a_closed_curve_drawn_closed(serve, page):
-    srv = serve(example("fourbar"), "fourbar.yaml")
-    open_studio(page, srv)
-    wait_settled(page)
-    page.click('#tabs [data-tab="analysis"]')
-    wait_js(page, "() => document.querySelector('#tab-analysis').innerText.includes('working range')")
-    text = page.locator("#tab-analysis").inner_text()
+    opened(serve, page, "fourbar")
+    text = analysis_text(page, "working range")
     dead = sorted(e["input"]["A"] for e in page.evaluate("window.__studio.sim.events") if e["kind"] == "dead point")
     line = next(x for x in text.split("\n") if x.startswith("working range"))
     assert line == f"working range of A: {dead[1]:.1f}° … {dead[0]:.1f}° through 360° ({dead[0] + 360 - dead[1]:.1f}° wide)"
@@ -255,9 +254,7 @@ def test_a_stale_or_missing_token_says_how_to_open_the_studio(serve, page):
 
 
 def test_new_first_pivot_arrow_keys_and_examples(serve, page):
-    srv = serve(example("crank_rocker"), "crank_rocker.yaml")
-    open_studio(page, srv)
-    wait_settled(page)
+    opened(serve, page, "crank_rocker")
     # the arrow keys step the input, again and again (held down, the key repeats)
     page.locator("#input-slider").click()
     start = page.evaluate("window.__studio.frame")
@@ -279,9 +276,7 @@ def test_new_first_pivot_arrow_keys_and_examples(serve, page):
     click_world(page, 0, 0)
     banner_has(page, "not joined to a moving link yet")
     assert "links: [" not in page.evaluate(BANNER)
-    page.click('#tabs [data-tab="analysis"]')
-    wait_js(page, "() => document.querySelector('#tab-analysis').innerText.includes('Nothing to analyse yet')")
-    assert "links: [" not in page.locator("#tab-analysis").inner_text()
+    assert "links: [" not in analysis_text(page, "Nothing to analyse yet")
     shot(page, "studio_read_first_pivot.png")
     # the examples grouped, planar first, and a search box that narrows them
     groups = page.eval_on_selector_all("#examples optgroup", "gs => gs.map(g => g.label)")
@@ -308,9 +303,7 @@ def test_taut_and_duplicate_bar_banners(serve, page):
     text = page.evaluate(BANNER)
     assert "crank2" in text and "crank3" in text and "still moves" in text
     wait_js(page, "() => window.__studio.analysis && window.__studio.analysis.structure && window.__studio.sim")
-    page.click('#tabs [data-tab="analysis"]')
-    wait_js(page, "() => document.querySelector('#tab-analysis').innerText.includes('Assur groups')")
-    assur = next(x for x in page.locator("#tab-analysis").inner_text().split("\n") if x.startswith("Assur groups"))
+    assur = next(x for x in analysis_text(page, "Assur groups").split("\n") if x.startswith("Assur groups"))
     assert "it moves" in assur and "not a mechanism" not in assur
     shot(page, "studio_read_double_parallelogram.png")
     assert page.console_errors == []
