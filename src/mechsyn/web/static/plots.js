@@ -100,7 +100,7 @@ export function chart(o) {
   const holder = h("div", null, { className: "chart-canvas", title: "drag across to zoom, double-click to zoom out; click to move the input there" });
   box.append(holder);
   u = new uPlot(opts, [xs, ...o.series.map((s) => s.values.map((v) => (v === null || !Number.isFinite(v) ? null : v)))], holder);
-  box.uplot = u;
+  box.uplot = u; box.marks = o.marks || []; // (for tests: the chart and its marked events)
   if (R.clipped) box.append(h("div", `clipped (spikes near a dead point): full range ${R.min.toPrecision(3)} … ${R.max.toPrecision(3)}; drag across to zoom`, { className: "muted clipped" }));
   if (R.clipped) box.lastChild.dataset.clipped = `${R.min} ${R.max}`;
   box.append(readout, statsTable(o.series, colours, o.yunit));
