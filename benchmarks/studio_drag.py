@@ -42,7 +42,8 @@ from web_helpers import CHROMIUM_ARGS, LiveServer  # noqa: E402
 
 # (title, file, joint dragged, point drawn, targets of the drag in the page: [(ms, issue)])
 CASES = [("four-bar", "examples/textbook/fourbar.yaml", "B", "M", [(50.0, 15)]),
-         ("Watt six-bar", "examples/textbook/watt_sixbar.yaml", "E", "P", [(100.0, 15), (30.0, 30)])]
+         ("Watt six-bar", "examples/textbook/watt_sixbar.yaml", "E", "P", [(100.0, 15), (30.0, 30)]),
+         ("Jansen leg", "examples/kinematics/jansen_leg.yaml", "P3", "foot", [(50.0, 40)])]
 
 
 def wait(page, js, arg=None, timeout=30.0):

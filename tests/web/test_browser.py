@@ -162,7 +162,8 @@ def test_undo_redo_and_animation(serve, page):
     # velocity plot of the coupler point, with the cursor at the frame shown
     page.click('#tabs [data-tab="plots"]')
     page.select_option("#plot-what", "point:M")
-    assert page.locator("#plots [data-cursor='30']").count() == 2
+    # (velocity, acceleration and position: each chart's read-out at the slider's row)
+    assert page.locator("#plots [data-cursor='30']").count() == page.locator("#plots .chart-canvas").count() == 3
     assert page.console_errors == []
 
 

@@ -46,7 +46,9 @@ def test_simulate_equals_library(client, fourbar):
                 assert p == pytest.approx(ref[k].tolist(), abs=1e-12)
     # a triple rocker: two dead points and two working ranges, reported (not printed as numbers)
     assert len([e for e in d["events"] if e["kind"] == "dead point"]) == 2
-    assert len(d["working_ranges"]) == 2
+    dead = sorted(e["input"]["A"] for e in d["events"] if e["kind"] == "dead point")
+    # one working range through 360 deg (the sweep is a whole turn), ending at the dead points
+    assert d["working_ranges"] == [pytest.approx([dead[1], dead[0] + 360], abs=1e-9)]
     assert d["grashof"]["classification"].startswith("triple rocker")
     mu = d["transmission_angle"]["B-C-D"]
     assert 0 < mu["min"] < mu["max"] <= 180

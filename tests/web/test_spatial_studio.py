@@ -116,10 +116,9 @@ def centre_of(page, jid):
         return [r.x + r.width / 2, r.y + r.height / 2]; }""", jid)
 
 
-def path_vertices(d):
-    """The (x, y) vertices of an SVG path 'M x y L x y ...'."""
-    nums = np.array(d.replace("M", " ").replace("L", " ").split(), float)
-    return nums.reshape(-1, 2)
+CHART_DATA = """() => [...document.querySelectorAll('#plots .chart')].filter(c => c.uplot).map(c => ({
+    title: c.querySelector('.chart-title').textContent, labels: c.uplot.series.slice(1).map(s => s.label),
+    data: c.uplot.data, marks: c.marks }))"""
 
 
 @pytest.mark.slow
@@ -141,20 +140,15 @@ def test_bennett_element_plots_forces_and_edits(serve, page):
     # Plots: a curve per pair angle, the axis in degrees, at the library's values
     page.click("#tabs button[data-tab=plots]")
     wait_js(page, "() => window.__spatialPlots.data && window.__spatialPlots.mech === window.__studio.mech"
-                  " && document.querySelectorAll('#plots path[data-series]').length > 0")
-    series = page.eval_on_selector_all("#plots path[data-series]", "es => es.map(e => [e.dataset.series, e.getAttribute('d')])")
-    assert [s for s, _ in series] == ["R1", "R2", "R3", "R4"]
-    labels = page.eval_on_selector_all("#plots svg text.unit", "es => es.map(e => e.textContent)")
-    assert labels == ["R1 (°)", "°"]
+                  " && document.querySelector('#plots .chart canvas')")
+    (c,) = page.evaluate(CHART_DATA)
+    assert c["labels"] == ["R1", "R2", "R3", "R4"]
+    assert c["title"] == "joint angles from the drawn pose (°) against R1 (°)"
     u = np.asarray(page.evaluate("() => window.__spatialPlots.data.input.values"))
     sim = ms.simulate(ms.examples.load("bennett"), {"R1": u})
-    Y = page.evaluate("""ks => { const s = document.querySelector('#plots svg'), m = s.__map;
-        return Object.fromEntries(Object.entries(ks).map(([k, v]) => [k, v.map(y => m.Y(y))])); }""",
-                      {key: [float(sim.joints[key][k]) for k in (10, 50, 120)] for key, _ in series})
-    for key, d in series:
-        xy = path_vertices(d)
-        assert len(xy) == len(u)
-        assert xy[[10, 50, 120], 1] == pytest.approx(Y[key], abs=0.11), key  # the path's rounding: 0.1 px
+    assert np.array(c["data"][0]) == pytest.approx(u)
+    for i, key in enumerate(c["labels"]):  # each curve at the library's values, row by row
+        assert np.array(c["data"][i + 1], float) == pytest.approx(np.asarray(sim.joints[key], float), abs=1e-6), key  # the route rounds
     set_slider(page, 30)
     wait_js(page, "() => document.querySelector('#plots [data-cursor]').dataset.cursor === '30'")
     shot(page, "studio_3d_plots.png")
@@ -209,22 +203,21 @@ def test_rssr_plots_mark_the_dead_point_and_leave_gaps(serve, page):
     open_example(serve, page, "rssr")
     page.click("#tabs button[data-tab=plots]")
     wait_js(page, "() => window.__spatialPlots.data && window.__spatialPlots.mech === window.__studio.mech"
-                  " && document.querySelectorAll('#plots path[data-series]').length > 0")
+                  " && document.querySelector('#plots .chart canvas')")
     d = page.evaluate("() => window.__spatialPlots.data")
     dead = [e for e in d["events"] if e["kind"] == "dead point"]
     assert dead
-    marks = page.evaluate("""() => [...document.querySelectorAll('#plots svg')].map(s =>
-        [...s.querySelectorAll('[data-event]')].map(g => [g.dataset.event, +g.querySelector('line').getAttribute('x1')]))""")
-    X = page.evaluate("xs => { const m = document.querySelector('#plots svg').__map; return xs.map(x => m.X(x)); }",
-                      [d["input"]["values"][e["index"]] for e in dead])
-    assert marks
-    for drawn in marks:  # every plot marks every dead point where the engine found it
-        assert [x for kind, x in drawn if kind == "dead point"] == pytest.approx(X, abs=0.01)
+    charts = page.evaluate(CHART_DATA)
+    assert charts
+    for c in charts:  # every plot marks every dead point where the engine found it
+        assert [m["x"] for m in c["marks"] if m["kind"] == "dead point"] == pytest.approx(
+            [d["input"]["values"][e["index"]] for e in dead], abs=1e-12)
     # the working range stops at the dead point: the curve has a gap, never numbers across it
     ok = np.asarray(d["assembled"])
     runs = int(ok[0]) + int(np.count_nonzero(ok[1:] & ~ok[:-1]))
     assert runs >= 2 and not ok.all()
-    assert page.get_attribute("#plots path[data-series='A']", "d").count("M") == runs
+    a = charts[0]["data"][charts[0]["labels"].index("A") + 1]
+    assert [v is not None for v in a] == ok.tolist()  # null (a gap in the curve) exactly where not assembled
     text = page.locator("#plots").inner_text()
     assert f"dead point at A = {dead[0]['input']['A']:.2f}" in text
     assert page.outside_requests == [] and page.console_errors == []

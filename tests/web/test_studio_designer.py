@@ -297,9 +297,11 @@ def test_every_example_opens_and_simulates(serve, page):
     planar_explained = {n: m for n, m in explained.items() if n not in spatial}
     assert set(planar_explained) <= {"shoe_pair_slide", "three_phalanx_base_000", "two_phalanx_base_000",
                                      "fourbar_folded", "fourbar_taut", "fourbar_shaky_dyad"}, planar_explained
-    # the finite-mobility teaching files carry no drive: the banner says how to add one
-    assert all("no drive yet" in planar_explained[n] for n in ("fourbar_taut", "fourbar_shaky_dyad")
-               if n in planar_explained), planar_explained
+    # the finite-mobility teaching files: the taut four-bar cannot move (finite mobility 0); the shaky
+    # dyad carries no drive: the banner says how to add one; the folded four-bar moves with one drive
+    assert "cannot move" in planar_explained["fourbar_taut"], planar_explained
+    assert "no drive yet" in planar_explained.get("fourbar_shaky_dyad", "no drive yet"), planar_explained
+    assert "fourbar_folded" not in planar_explained
     # the Analysis tab of a spatial file: its structure, no planar Grashof class
     page.select_option("#examples", "bennett")
     wait_js(page, "() => window.__studio.fileName.startsWith('bennett.') && window.__studio.analysis && window.__studio.analysis.structure")
@@ -406,6 +408,7 @@ def test_plots_units_spikes_full_turn_and_assembled_slider(serve, page):
     shot(page, "studio_plots.png")
     # the formulas by their names in the literature, the spatial ones marked for a planar file
     page.click('#tabs [data-tab="analysis"]')
+    page.click("#tab-analysis details.specialist > summary")  # the specialist notes, folded
     text = page.locator("#tab-analysis").inner_text()
     assert "Grübler" in text and "Chebyshev" in text and "Somov–Malyshev (spatial formula)" in text
     # a crank that turns fully reads "full turn"

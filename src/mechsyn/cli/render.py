@@ -127,9 +127,30 @@ def _derived_lines(d: dict[str, Any]) -> None:
             x0, x1, y0, y1, w, h = (fmt_number(e[k], scale=size) for k in ("x_min", "x_max", "y_min", "y_max",
                                                                           "width", "height"))
             console.print(f"path of {name}: x {x0} .. {x1}, y {y0} .. {y1} (width {w}, height {h})", highlight=False)
+    _motion_lines(d.get("motion") or {})
     for name, s in d.get("straightness", {}).items():
         console.print(f"straightness of {name} over {s['range'][0]:g}..{s['range'][1]:g}: largest deviation "
                       f"{s['max_deviation']:.6g} over a length {s['length']:.6g}", highlight=False)
+
+
+def _motion_lines(m: dict[str, Any]) -> None:
+    """The sliders' strokes, the rockers' ranges and the time ratios (``derived["motion"]``)."""
+    def ratio(t: Any) -> str:
+        return "" if not t else (f"; time ratio {t['ratio']:.4g} (working stroke {t['forward']:.4g} deg of the "
+                                 f"crank, return {t['return']:.4g} deg)")
+
+    for jid, s in m.get("sliders", {}).items():
+        lo, hi = s["min"], s["max"]
+        console.print(f"slider {jid} on {s['guide']}: stroke {s['stroke']:.6g} (slide {lo['slide']:.6g} at input "
+                      f"{lo['input']:.4g} .. {hi['slide']:.6g} at {hi['input']:.4g}){ratio(s['time_ratio'])}",
+                      highlight=False)
+    for link, r in m.get("rockers", {}).items():
+        if r["full_turn"]:
+            console.print(f"link {link} (pivot {r['pivot']}): turns fully", highlight=False)
+        else:
+            console.print(f"link {link} rocks on {r['pivot']}: range {r['range']:.4g} deg ({r['min']['angle']:.4g} at "
+                          f"input {r['min']['input']:.4g} .. {r['max']['angle']:.4g} at {r['max']['input']:.4g})"
+                          f"{ratio(r['time_ratio'])}", highlight=False)
 
 
 def render_simulation(report: Any) -> None:

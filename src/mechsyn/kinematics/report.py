@@ -26,6 +26,7 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import derived
 from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
+from mechsyn.kinematics.summary import motion_summary
 from mechsyn.model.mechanism import Mechanism
 from mechsyn.results import csv_cell, to_jsonable
 
@@ -39,7 +40,9 @@ class SimulationReport(Result):
     ``derived`` holds, where they apply: ``transmission_angle`` (per dyad: values, min,
     max in degrees), ``mechanical_advantage`` (one input: output link and values),
     ``grashof`` (a four-bar of revolute pairs), ``extent`` (bounding box of each reported
-    point's path) and ``straightness`` (per point asked for).
+    point's path), ``motion`` (planar: the sliders' strokes, the rockers' ranges and the time
+    ratios, :func:`mechsyn.kinematics.summary.motion_summary`) and ``straightness`` (per
+    point asked for).
 
     Examples
     --------
@@ -100,7 +103,7 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
     >>> m = ms.examples.load("crank_rocker")
     >>> d = derived_quantities(m, ms.simulate(m, {"A": np.linspace(0, 90, 4)}))
     >>> sorted(d)
-    ['extent', 'grashof', 'mechanical_advantage', 'transmission_angle']
+    ['extent', 'grashof', 'mechanical_advantage', 'motion', 'transmission_angle']
     """
     out: dict[str, Any] = {}
     mu = derived.transmission_angles(sim)
@@ -115,6 +118,8 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
             and all(j.type == "R" for j in mech.joints) and all(len(mech.joints_of(n)) == 2 for n in mech.link_names)):
         out["grashof"] = to_jsonable(derived.grashof(mech))
     out["extent"] = {name: derived.path_extent(pm.position) for name, pm in sim.points.items()}
+    if mech.kind == "planar":
+        out["motion"] = motion_summary(mech, sim)
     if straight:
         out["straightness"] = _straightness(sim, straight)
     return out

@@ -140,16 +140,41 @@ class Simulation(Result):
         return animate_simulation(self, fig=fig, bare=True, **kwargs)
 
     def working_ranges(self) -> list[list[float]]:
-        """Runs of consecutive assembled inputs, as [first, last] values of the main input."""
-        vals = self.inputs[self.main_input]
+        """Runs of consecutive assembled inputs, as [first, last] values of the main input.
+
+        A run that stops at a dead point the engine located between two rows (``events``)
+        ends there, not at its last row. A sweep over a whole turn of an R input is a cycle:
+        the run through its last row and its first is one range ``[first, last + 360]``
+        (``[243.43, 476.57]``: from 243.43 deg through 360 to 116.57 deg).
+        """
+        vals = np.asarray(self.inputs[self.main_input], float)
+        ok = np.asarray(self.assembled, bool)
+        n = len(vals)
+        dead = [float(e.get("input", {}).get(self.main_input)) for e in self.events
+                if e.get("kind") == "dead point" and self.main_input in (e.get("input") or {})]
+
+        def located(a: float, b: float, default: float) -> float:
+            """The dead point between rows of values a and b (b included), else default."""
+            lo, hi = min(a, b), max(a, b)
+            inside = [d for d in dead if lo < d <= hi or lo <= d < hi]
+            return min(inside, key=lambda d: abs(d - a)) if inside else default
+
         out, start = [], None
-        for k, ok in enumerate(self.assembled):
-            if ok and start is None:
+        for k in range(n):
+            if ok[k] and start is None:
                 start = k
-            if (not ok or k == len(vals) - 1) and start is not None:
-                end = k if ok else k - 1
-                out.append([float(vals[start]), float(vals[end])])
+            if (not ok[k] or k == n - 1) and start is not None:
+                end = k if ok[k] else k - 1
+                first = located(vals[start], vals[start - 1], vals[start]) if start > 0 else vals[start]
+                last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
+                out.append([float(first), float(last)])
                 start = None
+        if len(out) > 1 and ok[0] and ok[-1] and self.input_types.get(self.main_input) == "R" and n > 2:
+            step = float(np.median(np.abs(np.diff(vals))))
+            if abs(vals[-1] - vals[0]) + step >= 360.0 * (1 - 1e-9):  # a whole turn: the ends meet
+                turn = 360.0 if vals[-1] >= vals[0] else -360.0
+                out[0] = [out[-1][0], out[0][1] + turn]
+                out.pop()
         return out
 
     def to_dict(self) -> dict[str, Any]:

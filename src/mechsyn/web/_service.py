@@ -229,8 +229,10 @@ def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool
     ``span`` (360 deg for an R drive, ± its length scale for a P drive) in ``steps``.
     Returns ``joints``/``points`` as lists of [x, y] or null (not assembled),
     ``working_ranges``, ``events`` (dead points, reassembly, singular positions),
-    ``transmission_angle`` and, for a four-bar, ``grashof``. ``rates=False`` leaves out
-    the velocities, accelerations and link angles (a smaller answer for the drag loop).
+    ``transmission_angle``, for a four-bar ``grashof`` and, with the rates, ``summary``
+    (:func:`mechsyn.kinematics.summary.motion_summary`: strokes, rocker ranges, time ratios).
+    ``rates=False`` leaves out the velocities, accelerations, link angles and the summary (a
+    smaller answer for the drag loop).
     """
     return _simulated(build(data), steps, span, rates)
 
@@ -266,6 +268,31 @@ def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, A
     }
     if _is_four_bar(mech):
         out["grashof"] = to_jsonable(derived.grashof(mech))
+    if rates:  # the Analysis tab's strokes, rocker ranges and time ratios (as `mechsyn simulate`)
+        from mechsyn.kinematics.summary import motion_summary
+
+        out["summary"] = to_jsonable(motion_summary(mech, sim))
+        out["slides"] = _slides(mech, sim)
+    return out
+
+
+def _slides(mech, sim) -> dict[str, Any]:
+    """Every P joint's slide along its guide (:meth:`PlanarSystem.coordinate`: from the guide
+    link's origin, the world origin for the frame), its rate and its acceleration (the rate's
+    time derivative along the motion, by a central difference) at the drive's speed."""
+    S, sw = sim.system, sim.sweep
+    if S is None or sw is None:
+        return {}
+    q, qd, qdd = (np.asarray(a, float) for a in (sw.q, sw.qd, sw.qdd))
+    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
+    out = {}
+    for j in mech.joints:
+        if j.type != "P":
+            continue
+        rate = S.coordinate_rate(q, qd, j.id)
+        acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
+        value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
+        out[j.id] = {"guide": j.links[0], "value": _finite(value), "rate": _finite(rate), "acceleration": _finite(acc)}
     return out
 
 

@@ -68,6 +68,12 @@ def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
         for link in j.get("links", []):
             joints_of.setdefault(str(link), []).append(j)
     out = []
+    for j in joints:  # a pivot just placed: not a file error, the next step of a build
+        if len(j.get("links", [])) < 2:
+            kind = "pivot" if ground in j.get("links", []) else "joint"
+            out.append(_diag("note", f"{kind} {j.get('id')} is not joined to a moving link yet: choose Link, click "
+                             f"{j.get('id')} and then the places of the link's other joints (Enter finishes)",
+                             [("joint", str(j.get("id")))], True, "not joined yet"))
     for name, js in joints_of.items():
         if name == ground:
             continue
@@ -143,8 +149,59 @@ def check(data: Any) -> dict[str, Any]:
         return out
     out["mobility"], out["mobility_source"] = int(report.mobility), report.to_dict().get("mobility_source")
     if not out["spatial"] and not any(d["blocks"] for d in out["diagnostics"]):
-        out["diagnostics"] += drive_problems(mech, out["mobility"])
+        out["diagnostics"] += geometry_problems(data, mech, report.rank, out["mobility"])
     return out
+
+
+def geometry_problems(data: dict[str, Any], mech, rank, mobility: int) -> list[dict[str, Any]]:
+    """The drive checks against the motion the joints' places allow (the rank method's finite
+    mobility where it knows it: a four-bar drawn folded moves with one drive although its
+    instantaneous mobility is 2; one pulled taut cannot move at all), and a redundant bar named
+    when the mechanism moves only thanks to exact dimensions (a double parallelogram)."""
+    finite = getattr(rank, "finite_mobility", None) if rank is not None else None
+    if finite is None or finite >= mobility:  # (idle mobilities, a roller's spin, count in the finite one)
+        out = drive_problems(mech, mobility)
+    elif finite <= 0 < mobility:
+        return [_diag("error", f"cannot move: the links are pulled taut at the drawn places (instantaneous mobility "
+                      f"W = {mobility}, finite mobility {finite}: only an infinitesimal motion). Change a link's length "
+                      "or move a joint", [("joint", j.id) for j in mech.joints if j.actuated], True, "cannot move")]
+    else:
+        out = drive_problems(mech, finite)
+    if rank is not None and rank.redundant_constraints > 0 and (finite or mobility) >= 1 and not out:
+        out += _redundant_bars(data, rank)
+    return out
+
+
+def _redundant_bars(data: dict[str, Any], rank) -> list[dict[str, Any]]:
+    """A note naming the bars (links of two pins) any one of which repeats a constraint of the
+    others: removed, the mechanism keeps its motion and loses the redundant constraint."""
+    names = [link if isinstance(link, str) else str(link.get("name")) for link in data.get("links", [])]
+    ground = data.get("ground", "frame")
+    bars = []
+    for name in names:
+        js = [j for j in data["joints"] if name in j.get("links", [])]
+        if name == ground or len(js) != 2 or any(j.get("type") != "R" or j.get("actuated") for j in js):
+            continue
+        rest = {**data, "links": [x for x, n in zip(data["links"], names) if n != name],
+                "joints": [j for j in data["joints"] if j not in js],
+                "points": {k: p for k, p in (data.get("points") or {}).items() if p.get("link") != name}}
+        try:
+            r = structure_report(_service.build(rest)).rank
+        except MechsynInputError:
+            continue
+        if r is not None and r.redundant_constraints < rank.redundant_constraints and \
+                r.finite_mobility == rank.finite_mobility:
+            bars.append(name)
+        if len(bars) > 6:
+            break
+    if not bars:
+        return []
+    q = rank.redundant_constraints
+    which = bars[0] if len(bars) == 1 else "any one of " + _names(bars).replace(" and ", " or ")
+    return [_diag("note", f"{which} is redundant ({q} redundant constraint{'s' if q > 1 else ''}): it repeats a "
+                  "constraint the other links already make, so removing it leaves the motion as it is. It still moves "
+                  "only because its dimensions are exact (equal, parallel bars); made with a small error it would jam "
+                  "or strain", [("link", b) for b in bars], False, "redundant bar")]
 
 
 def export_drawing(data: Any) -> str:

@@ -32,8 +32,9 @@ require("httpx", "Mechanism.widget()", "notebook")  # the in-process app answers
 import traitlets  # noqa: E402  (installed with anywidget)
 
 STATIC = Path(__file__).parent / "static"
-MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
-           "atlas.js", "forces.js", "view3d.js", "tabs3d.js", "studio.js")  # view3d.js, tabs3d.js: spatial files
+MODULES = ("vendor/uPlot.esm.js", "api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js",
+           "synthesis.js", "atlas.js", "plots.js", "analysis.js", "examples.js", "forces.js", "view3d.js", "tabs3d.js",
+           "studio.js")  # view3d.js, tabs3d.js: spatial files; uPlot: the charts (plots.js)
 
 
 def _body_markup() -> str:
@@ -46,7 +47,8 @@ def widget_esm() -> str:
     parts = []
     for name in MODULES:
         text = (STATIC / name).read_text(encoding="utf-8")
-        text = re.sub(r"^import .*? from \"\./[a-z0-9]+\.js\";.*\n", "", text, flags=re.M)  # view3d: digits, comments
+        text = re.sub(r"^import .*? from \"\./[A-Za-z0-9/.]+\.js\";.*\n", "", text, flags=re.M)  # view3d: digits, comments
+        text = text.replace("export { uPlot as default };", "")  # the vendored uPlot: its class is in scope
         parts.append(f"// ---- {name}\n{text}")
     render = """
 // ---- the widget: the studio's markup in the cell, requests as messages to the kernel
@@ -85,7 +87,7 @@ def widget_css() -> str:
     """The studio's style sheet scoped to the widget: every selector prefixed with
     ``.mechsyn-studio`` (the page's html/body rules left out), so nothing of it reaches the
     notebook's own toolbar, buttons or inputs."""
-    css = (STATIC / "studio.css").read_text(encoding="utf-8")
+    css = "\n".join((STATIC / name).read_text(encoding="utf-8") for name in ("vendor/uPlot.min.css", "studio.css"))
     css = re.sub(r"/\*.*?\*/", "", css, flags=re.S)
     rules = []
     for selectors, body in re.findall(r"([^{}]+)\{([^}]*)\}", css):

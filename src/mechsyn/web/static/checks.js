@@ -11,6 +11,16 @@ export function topologyKey(m) {
     m.joints.map((j) => [j.id, j.type, j.links, !!j.actuated, ...geometry(j)])]);
 }
 
+// Everything the server's check reads: the topology and every joint as written, its place too,
+// planar files included (their mobility is the rank method's, read from the joints' places: a
+// four-bar drawn along one line has W = 2, the same four-bar drawn open W = 1), and the names of
+// the points' links (a point on a missing link is refused). Not the points' places, the masses or
+// the loads (the check does not read them).
+export function checkKey(m) {
+  return JSON.stringify([m.kind, m.ground, m.links.map(linkName), m.joints,
+    Object.entries(m.points || {}).map(([n, p]) => [n, p.link])]);
+}
+
 // The mechanism's length scale: the diagonal of its joints' bounding box (1 for fewer than two).
 export function lengthScale(m) {
   const pts = m.joints.map((j) => j.point).filter(Boolean);

@@ -87,7 +87,9 @@ function order(pts) {
   return pts.slice().sort((a, b) => Math.atan2(a[1] - c[1], a[0] - c[0]) - Math.atan2(b[1] - c[1], b[0] - c[0]));
 }
 
-export function pathD(v, pts) {
+// A path through the points (null: a gap); `cyclic` (a sweep over a whole turn) joins the last
+// point to the first, so a closed coupler curve has no gap where the sweep starts.
+export function pathD(v, pts, cyclic = false) {
   let d = "", pen = false;
   for (const p of pts) {
     if (!p) { pen = false; continue; }
@@ -95,7 +97,14 @@ export function pathD(v, pts) {
     d += `${pen ? "L" : "M"}${x.toFixed(1)} ${y.toFixed(1)}`;
     pen = true;
   }
+  if (cyclic && pen && pts[0] && pts.length > 2) { const [x, y] = v.toScreen(pts[0]); d += `L${x.toFixed(1)} ${y.toFixed(1)}`; }
   return d;
+}
+
+// Whether a simulation's sweep is a whole turn of an R input (its last row, one step on, is its first).
+export function wholeTurn(sim) {
+  const x = sim.input.values, n = x.length;
+  return sim.input.type === "R" && n > 2 && Math.abs(Math.abs(x[n - 1] - x[0]) + Math.abs(x[1] - x[0]) - 360) < 1e-6;
 }
 
 function muClass(mu) {
@@ -157,7 +166,7 @@ export function draw(svg, state) {
   // paths of the named points (full sweep)
   const paths = {};
   if (sim) for (const [n, pts] of Object.entries(sim.points))
-    paths[n] = el("path", { d: pathD(v, pts), class: "path", "data-path": n }, layers.paths);
+    paths[n] = el("path", { d: pathD(v, pts, wholeTurn(sim)), class: "path", "data-path": n }, layers.paths);
   // ground symbols
   for (const j of mech.joints) {
     if (!(j.links || []).includes(mech.ground) || !pos.joints[j.id]) continue;
@@ -288,62 +297,4 @@ export function robustRange(vals) {
   if (clipped) { lo = Math.max(lo, q(0.02) - 0.15 * core); hi = Math.min(hi, q(0.98) + 0.15 * core); }
   if (hi - lo < 1e-12 * Math.max(1, Math.abs(hi))) { lo -= 1; hi += 1; }
   return { lo, hi, clipped, min: v[0], max: v[n - 1] };
-}
-
-// A small line plot (input on x) with a cursor at index k; returns the svg. `labels`: {x, y} units.
-// `labels`: {x, y} axis units; `colours` (a colour per series, as GROUP_COLOURS, with the legend in
-// the same colour: more than two series); `marks` [{x, kind, text}] events drawn as dashed lines
-// (singular positions, dead points) with `data-event` and a title.
-export function plot(svg, xs, series, k, ranges = [], labels = {}) {
-  svg.replaceChildren();
-  const W = 300, H = 150, m = 34;
-  svg.__xs = xs;
-  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
-  const vals = series.flatMap((s) => s.values).filter((y) => y !== null && Number.isFinite(y));
-  if (!vals.length) { el("text", { x: 10, y: 20, class: "label" }, svg, "not defined over the sweep"); return svg; }
-  const R = robustRange(vals), { lo, hi } = R;
-  const x0 = xs[0], x1 = xs[xs.length - 1] || x0 + 1;
-  const X = (x) => m + ((x - x0) / (x1 - x0 || 1)) * (W - m - 6);
-  const Y = (y) => H - 16 - ((Math.min(hi, Math.max(lo, y)) - lo) / (hi - lo)) * (H - 26);
-  for (const [a, b] of ranges) el("rect", { x: X(a), y: 4, width: Math.max(1, X(b) - X(a)), height: H - 20, class: "range" }, svg);
-  el("line", { x1: m, y1: H - 16, x2: W - 6, y2: H - 16, class: "axis" }, svg);
-  el("line", { x1: m, y1: 4, x2: m, y2: H - 16, class: "axis" }, svg);
-  el("text", { x: 2, y: 12, class: "label" }, svg, hi.toPrecision(3));
-  el("text", { x: 2, y: H - 18, class: "label" }, svg, lo.toPrecision(3));
-  const fx = (v) => (Math.abs(x1 - x0) >= 20 ? v.toFixed(0) : String(+v.toPrecision(3))); // a P drive's short sweep
-  el("text", { x: m, y: H - 3, class: "label" }, svg, fx(x0));
-  el("text", { x: W - 40, y: H - 3, class: "label" }, svg, fx(x1));
-  if (labels.x) el("text", { x: W / 2 - 20, y: H - 3, class: "label unit" }, svg, labels.x);
-  if (labels.y) el("text", { x: m + 4, y: 12, class: "label unit" }, svg, labels.y);
-  if (R.clipped) el("text", { x: m + 4, y: 24, class: "label clipped", "data-clipped": `${R.min} ${R.max}` }, svg,
-    `clipped (▲▼): full range ${R.min.toPrecision(3)} … ${R.max.toPrecision(3)}`);
-  series.forEach((s, i) => {
-    let d = "", pen = false;
-    xs.forEach((x, n) => {
-      const y = s.values[n];
-      if (y === null || !Number.isFinite(y)) { pen = false; return; }
-      d += `${pen ? "L" : "M"}${X(x).toFixed(1)} ${Y(y).toFixed(1)}`; pen = true;
-      if (y > hi || y < lo) el("path", { d: y > hi ? `M${X(x) - 3} ${Y(y) + 4}l3 -5l3 5z` : `M${X(x) - 3} ${Y(y) - 4}l3 5l3 -5z`, class: "clip-mark" }, svg);
-    });
-    const colour = labels.colours ? GROUP_COLOURS[i % GROUP_COLOURS.length] : null;
-    el("path", { d, class: i ? "plotline y" : "plotline", "data-series": s.name, stroke: colour }, svg).style.stroke = colour || "";
-    el("text", { x: W - 60, y: 14 + 12 * i, class: "label", fill: colour }, svg, s.name).style.fill = colour || "";
-  });
-  for (const e of labels.marks || []) {
-    const g = el("g", { class: "event", "data-event": e.kind }, svg);
-    el("line", { x1: X(e.x), y1: 4, x2: X(e.x), y2: H - 16, class: "event-line" }, g);
-    el("text", { x: X(e.x) - 3, y: H - 19, class: "event-mark" }, g, "×");
-    el("title", {}, g, e.text);
-  }
-  el("line", { x1: X(xs[k]), y1: 4, x2: X(xs[k]), y2: H - 16, class: "cursor", "data-cursor": k }, svg);
-  svg.__map = { X, Y, x0, x1, m, W, lo, hi };
-  return svg;
-}
-
-// The row of `xs` nearest to where the plot `svg` (drawn by plot()) was clicked.
-export function plotRowAt(svg, ev) {
-  const r = svg.getBoundingClientRect(), mp = svg.__map, xs = svg.__xs, x = ((ev.clientX - r.left) / r.width) * mp.W;
-  const u = mp.x0 + ((x - mp.m) / (mp.W - mp.m - 6)) * (mp.x1 - mp.x0);
-  let best = 0; xs.forEach((v, i) => { if (Math.abs(v - u) < Math.abs(xs[best] - u)) best = i; });
-  return best;
 }

@@ -18,6 +18,19 @@ export function guardUnload(dirty) {
   window.addEventListener("beforeunload", (ev) => { if (dirty()) { ev.preventDefault(); ev.returnValue = ""; } });
 }
 
+// Why the studio could not start, in words that say how to open it: the page without its token,
+// or with the token of a server that was restarted since (a reloaded old tab).
+export function startProblem(e) {
+  if (e && e.field === "token") {
+    const has = new URLSearchParams(location.search).get("token");
+    return has ? "this tab's token is stale: the studio server was restarted since the tab was opened. Open the new URL that "
+      + "`mechsyn serve` printed in its terminal (it ends with ?token=…); edits autosaved in this browser are offered again when it opens at the same address"
+      : "this page was opened without its token. Open the URL that `mechsyn serve` printed in its terminal (it ends with ?token=…), "
+      + "or start the studio with `mechsyn serve`";
+  }
+  return errorText(e);
+}
+
 // An error answer as one line: the field it names, the message, the fix.
 export function errorText(e, prefix = "") {
   if (!e || typeof e !== "object") return prefix + String(e);

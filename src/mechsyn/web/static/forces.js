@@ -3,7 +3,8 @@
 // torque (or force) and the joint reactions over the input (the library's `forces`: kinetostatics),
 // plotted, and the reactions at the frame shown drawn as arrows on the canvas.
 import { call } from "./api.js";
-import { linkName, plot, el } from "./draw.js";
+import { linkName } from "./draw.js";
+import { chart } from "./plots.js";
 import { h } from "./numeric.js";
 import { lengthScale } from "./checks.js";
 
@@ -13,7 +14,7 @@ const num = (text) => { const v = Number(String(text).trim().replace(",", "."));
 // arrows, cursor}. A spatial file gets `spatialLines()` instead (spatial_tabs.js: no spatial statics).
 export function mountForces({ $, state, render, edit, stepsFor, spatialLines }) {
   const box = $("tab-forces");
-  let timer = null;
+  let timer = null, charts = [];
 
   function field(value, onValue, attrs = {}) {
     const i = h("input", null, { type: "text", inputMode: "decimal", value: value === undefined ? "" : String(value), ...attrs });
@@ -99,18 +100,22 @@ export function mountForces({ $, state, render, edit, stepsFor, spatialLines }) 
     const f = state.forces;
     if (f && f.mech === m && f.error) out.push(h("p", f.error, { className: "err" }));
     else if (f && f.mech === m) {
-      const r = f.r, xs = r.input.values, unit = r.input.unit === "deg" ? "°" : "units";
+      const r = f.r, xs = r.input.values, xunit = r.input.unit === "deg" ? "°" : "units", xname = r.input.joint;
+      const common = { xs, xname, xunit, k: state.frame, ranges: [], width: box.clientWidth - 24, group: "forces", onPick: (row) => { state.frame = row; render(); } };
+      charts = [];
       for (const [j, d] of Object.entries(r.drives)) {
-        const what = d.kind === "moment" ? "drive torque" : "drive force";
-        out.push(h("p", `${what} at ${j} (${d.kind === "moment" ? "N·m" : "N"} in SI) against ${r.input.joint} (${unit})`));
-        const s = el("svg", { "data-plot": `drive ${j}` });
-        plot(s, xs, [{ name: j, values: d.value }], state.frame, [], { x: `${r.input.joint} (${unit})`, y: d.kind === "moment" ? "N·m" : "N" });
-        out.push(s);
+        const moment = d.kind === "moment", second = (m.joints.find((q) => q.id === j) || { links: ["", "its second link"] }).links[1];
+        charts.push(chart({ ...common, id: `drive ${j}`, title: `${moment ? "drive torque" : "drive force"} at ${j}`, yunit: moment ? "N·m" : "N",
+          note: moment ? `the moment the drive applies to ${second}, counter-clockwise positive` : `the force the drive applies to ${second}, positive along the slide's direction`,
+          series: [{ name: moment ? `τ ${j}` : `F ${j}`, values: d.value }] }));
       }
-      out.push(h("p", `joint reactions |F| (N in SI) against ${r.input.joint} (${unit})`));
-      const s = el("svg", { "data-plot": "reactions" });
-      plot(s, xs, Object.entries(r.joints).map(([j, d]) => ({ name: j, values: d.magnitude })), state.frame, [], { x: `${r.input.joint} (${unit})`, y: "N" });
-      out.push(s);
+      const joints = Object.entries(r.joints);
+      charts.push(chart({ ...common, id: "reactions", title: "joint reactions |F|", yunit: "N", note: "the force of each joint's first link on its second",
+        series: joints.map(([j, d]) => ({ name: j, values: d.magnitude })) }));
+      charts.push(chart({ ...common, id: "reaction components", title: "joint reactions Fx, Fy", yunit: "N", note: "on each joint's second link (the first gets −F)",
+        series: joints.flatMap(([j, d]) => [0, 1].map((c) => ({ name: `${j} F${"xy"[c]}`, values: d.force.map((F) => (F ? F[c] : null)) }))) }));
+      out.push(h("p", `Sign convention: ${r.convention}; moments counter-clockwise positive. Mean and RMS are over the rows, equally spaced in ${xname} (time averages at a constant drive speed).`, { className: "muted" }));
+      out.push(...charts);
       for (const n of r.notes || []) out.push(h("p", n, { className: "muted" }));
       if (r.indeterminate) out.push(h("p", "statically indeterminate: the reactions shown are one of many (redundant constraints)", { className: "muted" }));
     } else out.push(h("p", m.joints.some((j) => j.actuated) ? "computing…" : "no drive yet", { className: "muted" }));
@@ -134,17 +139,11 @@ export function mountForces({ $, state, render, edit, stepsFor, spatialLines }) 
     return out;
   }
 
-  // The plots' cursors follow the frame shown (the tab itself is redrawn only when the mechanism changes).
+  // The charts' slider lines follow the frame shown (the tab itself is redrawn only when the mechanism changes).
   function cursor(k) {
     const f = state.forces;
     if (!f || !f.r || !box.classList.contains("on")) return;
-    const x = f.r.input.values[k];
-    for (const s of box.querySelectorAll("svg")) {
-      const c = s.querySelector("[data-cursor]");
-      if (!c || !s.__map || x === undefined) continue;
-      const px = s.__map.X(x).toFixed(1);
-      c.setAttribute("x1", px); c.setAttribute("x2", px); c.setAttribute("data-cursor", k);
-    }
+    for (const c of charts) c.cursor(k);
   }
 
   return { renderForces, forcesSoon, compute, arrows, cursor };

@@ -4,7 +4,7 @@
 // Controls where keys are typed: shortcuts wait until they are left.
 const TYPING = "input:not([type=checkbox]):not([type=radio]):not([type=range]):not([type=button]):not([type=file]), textarea";
 
-// `actions`: {undo, redo, finishLink, escape, play, fit, deleteSelection, setMode, linkMode()}.
+// `actions`: {undo, redo, finishLink, escape, play, fit, deleteSelection, setMode, linkMode(), step(±1)}.
 // `contained`: the studio is part of a bigger page (a notebook): its key events stop at `root`.
 export function bindKeys(root, actions, { contained = false } = {}) {
   const target = root.addEventListener ? root : document;
@@ -23,6 +23,7 @@ export function bindKeys(root, actions, { contained = false } = {}) {
     else if (k === "Escape") actions.escape();
     else if (k === " ") { ev.preventDefault(); actions.play(); }
     else if (k === "Delete" || k === "Backspace") { ev.preventDefault(); actions.deleteSelection(); }
+    else if ((k === "ArrowRight" || k === "ArrowLeft") && actions.step) { ev.preventDefault(); actions.step(k === "ArrowRight" ? 1 : -1); }
     else if (!ev.ctrlKey && !ev.metaKey && !ev.altKey) {
       const mode = { v: "select", g: "pivot", l: "link", p: "point", d: "drive", x: "delete", t: "target" }[k.toLowerCase()];
       if (mode) actions.setMode(mode);

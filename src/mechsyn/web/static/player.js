@@ -27,5 +27,13 @@ export function mountPlayer({ $, state, render, assembledNear }) {
   $("play").onclick = () => setPlaying(!state.playing);
   $("direction").onclick = () => { state.dir = -state.dir; };
   $("input-slider").oninput = (ev) => { state.frame = assembledNear(+ev.target.value); render(); };
+  // the arrow keys: one step of the input each (held down, the key repeats); a whole turn wraps
+  setPlaying.step = (d) => {
+    const s = $("input-slider"), max = +s.max, ok = state.sim ? state.sim.assembled : [];
+    let v = +s.value + d;
+    if (v > max || v < 0) v = ok.length && ok.every(Boolean) ? (v + max + 1) % (max + 1) : Math.min(max, Math.max(0, v));
+    s.value = v;
+    s.dispatchEvent(new Event("input"));
+  };
   return setPlaying;
 }

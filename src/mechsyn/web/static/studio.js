@@ -1,13 +1,16 @@
 // mechsyn studio: the editor's state, the canvas interaction and the side panels.
 import { call, coalescing, eventsUrl, transport } from "./api.js";
-import { draw, el, gridStep, linkName, makeView, membership, plot, plotRowAt, positions, GROUP_COLOURS } from "./draw.js";
-import { geometryChecks, tidy, topologyKey } from "./checks.js";
+import { draw, gridStep, linkName, makeView, membership, positions } from "./draw.js";
+import { checkKey, geometryChecks, tidy, topologyKey } from "./checks.js";
 import { bindKeys } from "./keys.js";
 import { mountPlayer } from "./player.js";
 import { mountSynthesis } from "./synthesis.js";
 import { mountAtlas } from "./atlas.js";
 import { mountForces } from "./forces.js";
-import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./files.js";
+import { mountPlots } from "./plots.js";
+import { analysisTab } from "./analysis.js";
+import { fillExamples } from "./examples.js";
+import { autosave, forgetWork, guardUnload, mountFiles, savedWork, startProblem } from "./files.js";
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
 import { mountSpatialTabs } from "./tabs3d.js"; // the Plots and Forces tabs of spatial files
@@ -54,6 +57,7 @@ function div(cls, text) { const d = document.createElement("div"); d.className =
 // The banner: the current errors first (each outlines the element it names), then warnings, notes.
 function renderBanner() {
   const items = state.errors.map((e) => div("err", e.message + (e.hint ? ` — fix: ${e.hint}` : "")));
+  if (state.fatal) items.unshift(div("err", state.fatal)); // files.js: the studio cannot talk to its server
   if (state.offer) {
     const o = div("note", `unsaved work from ${state.offer.saved.replace("T", " ").slice(0, 16)} UTC (${state.offer.mechanism.name}) `);
     const yes = h("button", "Restore"), no = h("button", "Dismiss");
@@ -164,14 +168,19 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   if (!keepFrame) state.frame = state.home;
   if (fit) fitView();
   state.errors = [];
-  const key = topologyKey(mech);
+  const key = checkKey(mech), topo = topologyKey(mech);
   if (state.check && state.check.key === key) afterCheck(mech, state.check.result, edited);
   else {
-    // the topology changed: the server's check (mobility, drives, connections) first, at once
-    state.diagnostics = geometryChecks(mech); state.check = null;
+    // the server's check (mobility, drives, connections) runs again on every change it reads.
+    // Only the places changed and the last check let it move: simulated at once meanwhile,
+    // re-done if the new check says otherwise (a four-bar moved onto one line cannot be driven)
+    const prev = state.check && state.check.topo === topo && !state.check.result.diagnostics.some((d) => d.blocks) ? state.check.result : null;
+    if (prev) afterCheck(mech, prev, edited); else state.diagnostics = geometryChecks(mech);
+    state.check = null;
     call("/api/studio/check", { mechanism: mech }).then((result) => {
       if (mech !== state.mech) return;
-      state.check = { key, result }; afterCheck(mech, result, edited); render();
+      state.check = { key, topo, result };
+      if (!prev || JSON.stringify(result) !== JSON.stringify(prev)) { afterCheck(mech, result, edited); render(); }
     }, (e) => {
       if (mech !== state.mech) return;
       state.sim = null; state.simFor = mech; state.notes = [];
@@ -468,62 +477,8 @@ svg.addEventListener("wheel", (ev) => {
 
 // ------------------------------------------------------------------ side panels
 
-// The structure report's formulas by the names of the literature; the spatial ones are marked
-// when read for a planar file.
-const FORMULA_NAMES = { chebyshev: "Chebyshev", grubler: "Grübler", malyshev: "Malyshev", somov_malyshev: "Somov–Malyshev",
-  gokhman_contours: "Gokhman (contours)", scheme_check: "scheme check", ozol_redundant: "Ozol (redundant constraints)",
-  redundant_from_mobility: "redundant constraints from the mobility" };
-const SPATIAL_FORMULAS = new Set(["malyshev", "somov_malyshev"]);
-
-function renderAnalysis() {
-  const box = $("tab-analysis");
-  const a = state.analysis, sim = state.sim;
-  const out = [];
-  if (state.errors.length) out.push(h("p", `Input problem: ${state.errors[0].message}`, { className: "err" }));
-  if (a && a.error) out.push(h("p", `${a.error}${a.hint ? " — fix: " + a.hint : ""}`, { className: "muted" }));
-  if (a && a.structure) {
-    const st = a.structure;
-    out.push(h("h3", `Mobility: W = ${st.mobility}` + (st.mobility_source ? ` (${st.mobility_source})` : " (formulas)")));
-    const t = h("table");
-    const planar = state.mech && state.mech.kind === "planar";
-    for (const [name, f] of Object.entries(st.formulas)) {
-      const tr = h("tr");
-      let title = FORMULA_NAMES[name] || name.replace(/_/g, " ");
-      if (planar && SPATIAL_FORMULAS.has(name)) title += " (spatial formula)"; // 6 freedoms per contour
-      tr.append(h("td", title), h("td", f.expression, { className: "formula" }));
-      t.append(tr);
-    }
-    out.push(t);
-    for (const n of st.notes || []) out.push(h("p", n, { className: "muted" }));
-  }
-  if (a && a.rank_summary) { out.push(h("h3", "Rank method (exact)")); for (const l of a.rank_summary) out.push(h("p", l, { className: "formula" })); }
-  else if (a && a.rank_unavailable) out.push(h("p", `rank method: ${a.rank_unavailable}`, { className: "muted" }));
-  if (a && a.assur) {
-    out.push(h("h3", `Assur groups: class ${a.assur.mechanism_class_roman}`));
-    out.push(h("p", a.assur.structural_formula, { className: "formula" }));
-    const ul = h("ul");
-    [...a.assur.initial_mechanisms, ...a.assur.groups].forEach((g, i) => {
-      const li = h("li");
-      const sw = h("span", "", { className: `swatch g${i % GROUP_COLOURS.length}` });
-      li.append(sw, `${g.label} (class ${g.class_roman}, order ${g.order})`);
-      ul.append(li);
-    });
-    out.push(ul);
-  } else if (a && a.assur_unavailable) out.push(h("p", `Assur groups: ${a.assur_unavailable}`, { className: "muted" }));
-  const gr = state.mech && state.mech.kind === "planar" ? (sim && sim.grashof) || (a && a.grashof) : null;
-  if (gr) { out.push(h("h3", `Grashof: ${gr.classification}`)); out.push(h("p", gr.expression, { className: "formula" })); }
-  if (sim) {
-    out.push(h("h3", "Motion"));
-    const u = sim.input.unit === "deg" ? "°" : "";
-    const full = sim.input.type === "R" && sim.assembled.every(Boolean);
-    out.push(h("p", `working range of ${sim.input.joint}: ` + (full ? "full turn (360°)" : sim.working_ranges.map(([x, y]) => `${x.toFixed(1)}${u} … ${y.toFixed(1)}${u}`).join(", ") || "none")));
-    for (const [key, t] of Object.entries(sim.transmission_angle || {}))
-      if (t.min !== null) out.push(h("p", `transmission angle ${key}: ${t.min.toFixed(1)}° … ${t.max.toFixed(1)}°`));
-    const dead = sim.events.filter((e) => e.kind === "dead point");
-    for (const e of dead) out.push(h("p", `dead point at ${Object.entries(e.input).map(([j, v]) => `${j} = ${(+v).toFixed(2)}`).join(", ")}: ${e.message}`, { className: "muted" }));
-  }
-  if (!out.length) out.push(h("p", "Analysis of the drawn mechanism appears here.", { className: "muted" }));
-  box.replaceChildren(...out);
+function renderAnalysis() { // analysis.js: the result first, the specialist notes folded
+  $("tab-analysis").replaceChildren(...analysisTab({ a: state.analysis, sim: state.sim, errors: state.errors, mech: state.mech, diagnostics: state.diagnostics }));
 }
 
 function renderElement() {
@@ -575,48 +530,11 @@ function renderJoints() {
   $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }));
 }
 
-function renderPlots() {
-  if (spatial()) return spatialUi.renderPlots();
-  const sim = state.sim, sel = $("plot-what");
-  if (!sim) { $("plots").replaceChildren(h("p", "no simulation", { className: "muted" })); return; }
-  if (!sim.rates) return; // an edit's first answer: the plots wait for the rates
-  const opts = Object.keys(sim.velocity).map((n) => `point:${n}`).concat(Object.keys(sim.links).map((n) => `link:${n}`));
-  if ([...sel.options].map((o) => o.value).join() !== opts.join()) {
-    const keep = sel.value;
-    sel.replaceChildren(...opts.map((o) => h("option", o.replace(":", " "), { value: o })));
-    if (opts.includes(keep)) sel.value = keep; else if (Object.keys(sim.points).length) sel.value = `point:${Object.keys(sim.points)[0]}`;
-  }
-  if (!$("tab-plots").classList.contains("on")) return;
-  const [kind, name] = (sel.value || "").split(":");
-  const xs = sim.input.values, k = state.frame, R = sim.working_ranges;
-  // the library's rates are at a drive speed of 1 rad/s (R) or 1 length unit/s (P), held constant:
-  // velocities scale with the speed, accelerations with its square
-  const w = Number($("drive-speed").value) || 1, rot = sim.input.type === "R";
-  const at = `at ${sim.input.joint} = ${w} ${rot ? "rad/s" : "units/s"}`;
-  const scale = (vals, f) => vals.map((v) => (v === null ? null : v * f));
-  let pairs;
-  if (kind === "point") {
-    const comp = (arr, i, f) => arr.map((v) => (v ? v[i] * f : null));
-    pairs = [[`velocity of ${name}`, "units/s", [{ name: "vx", values: comp(sim.velocity[name], 0, w) }, { name: "vy", values: comp(sim.velocity[name], 1, w) }]],
-      [`acceleration of ${name}`, "units/s²", [{ name: "ax", values: comp(sim.acceleration[name], 0, w * w) }, { name: "ay", values: comp(sim.acceleration[name], 1, w * w) }]]];
-  } else if (kind === "link") {
-    pairs = [[`angular velocity of ${name}`, "rad/s", [{ name: "ω", values: scale(sim.links[name].angular_velocity, w) }]],
-      [`angular acceleration of ${name}`, "rad/s²", [{ name: "α", values: scale(sim.links[name].angular_acceleration, w * w) }]]];
-  } else return;
-  const out = [];
-  const xunit = sim.input.unit === "deg" ? "°" : "units";
-  for (const [title, unit, series] of pairs) {
-    out.push(h("p", `${title} (${unit}, ${at}) against ${sim.input.joint} (${xunit})`));
-    const s = el("svg", { "data-plot": title });
-    plot(s, xs, series, k, R, { x: `${sim.input.joint} (${xunit})`, y: unit });
-    s.addEventListener("click", (ev) => { state.frame = assembledNear(plotRowAt(s, ev)); render(); });
-    out.push(s);
-  }
-  $("plots").replaceChildren(...out);
-}
+function renderPlots() { if (spatial()) spatialUi.renderPlots(); else planarPlots(); } // plots.js: the planar charts
 
 // ------------------------------------------------------------------ player, synthesis, atlas
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
+const planarPlots = mountPlots({ $, state, render, assembledNear });
 const synthUi = mountSynthesis({ $, state, render, setMech });
 mountAtlas({ $, state, render, setMech });
 const spatialUi = mountSpatialTabs({ $, state, render, showTab });
@@ -645,7 +563,7 @@ for (const b of root.querySelectorAll("#tabs button")) b.onclick = () => showTab
 $("finish-link").onclick = finishLink;
 $("undo").onclick = undo;
 $("redo").onclick = redo;
-$("new").onclick = () => { state.fileName = ""; state.selected = null; setMech(EMPTY(), { fit: true }); };
+$("new").onclick = () => { state.fileName = ""; $("save-name").value = ""; state.selected = null; state.sim = null; setMech(EMPTY(), { fit: true }); }; // fit: the default zoom
 if (root === document) guardUnload(() => state.dirty);
 $("fit").onclick = () => { fitView(); render(); };
 $("grid").onchange = (ev) => { state.opts.grid = ev.target.checked; render(); };
@@ -655,7 +573,7 @@ $("plot-what").onchange = renderPlots;
 $("drive-speed").onchange = () => { renderPlots(); forcesUi.forcesSoon(); };
 window.addEventListener("resize", render);
 bindKeys(root, {
-  undo, redo, finishLink, setMode, play: () => setPlaying(!state.playing), fit: () => { fitView(); render(); },
+  undo, redo, finishLink, setMode, play: () => setPlaying(!state.playing), fit: () => { fitView(); render(); }, step: setPlaying.step,
   escape: () => { state.building = []; setMode("select"); }, linkMode: () => state.mode === "link",
   deleteSelection: () => { const sel = state.selected; if (!sel) return; state.selected = null; (sel.kind === "joint" ? deleteJoint : deletePoint)(sel.id); },
 }, { contained: root !== document });
@@ -666,14 +584,14 @@ bindKeys(root, {
     $("save-name").value = s.name || "";
     for (const [k, title] of Object.entries(s.synthesis_kinds || {})) $("synth-kind").append(h("option", title, { value: k }));
     const ex = await call("/api/studio/examples");
-    for (const e of ex.examples) $("examples").append(h("option", `${e.group}/${e.name} — ${e.title}${e.kind === "planar" ? "" : ` (${e.kind})`}`, { value: e.name }));
+    fillExamples($("examples"), $("examples-search"), ex.examples, (name) => { $("examples").value = name; $("examples").dispatchEvent(new Event("change")); });
     refreshFiles();
     if (s.mechanism) openFrom(Promise.resolve({ mechanism: s.mechanism, name: s.name }));
     else setMech(EMPTY(), { record: false, fit: true });
     const w = root === document ? savedWork() : null;
     if (w && JSON.stringify(w.mechanism) !== JSON.stringify(s.mechanism)) { state.offer = w; render(); }
   } catch (e) {
-    $("banner").replaceChildren(div("err", `${e.error || e}${e.hint ? " — fix: " + e.hint : ""}`));
+    state.fatal = startProblem(e);
     state.mech = EMPTY(); render();
   }
 })();

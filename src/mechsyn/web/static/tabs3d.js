@@ -7,14 +7,15 @@
 // says so in one line and gives what the rank method reads (finite mobility, idle motions,
 // redundant constraints: whether the reactions would be unique).
 import { call } from "./api.js";
-import { el, plot, plotRowAt } from "./draw.js";
 import { h } from "./numeric.js";
+import { chart } from "./plots.js";
 
 const XYZ = ["x", "y", "z"];
 
 // `ctx`: {$, state, render, showTab}; returns {renderPlots, forcesLines}.
 export function mountSpatialTabs({ $, state, render, showTab }) {
   const sp = { mech: null, data: null, error: null, loading: false, draws: 0 };
+  let charts = [];
   window.__spatialPlots = sp; // for tests (read-only use)
 
   function fetchFor(m) {
@@ -81,14 +82,10 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
     const deg = d.input.unit === "deg", xunit = deg ? "°" : "units", w = Number($("drive-speed").value) || 1;
     const marks = d.events.filter((e) => e.kind !== "reassembled")
       .map((e) => ({ x: xs[e.index], kind: e.kind, text: `${e.kind} at ${d.input.joint} = ${(+xs[e.index]).toFixed(2)}: ${e.message}` }));
-    const out = [];
-    for (const [title, unit, series] of plotsOf(d, sel.value, w)) {
-      out.push(h("p", `${title} (${unit}) against ${d.input.joint} (${xunit}, from the drawn pose)`));
-      const s = el("svg", { "data-plot": title });
-      plot(s, xs, series, k, d.working_ranges, { x: `${d.input.joint} (${xunit})`, y: unit, colours: series.length > 2 || sel.value.startsWith("pairs"), marks });
-      s.addEventListener("click", (ev) => { state.frame = plotRowAt(s, ev); render(); });
-      out.push(s);
-    }
+    const width = box.clientWidth - 4, onPick = (row) => { state.frame = row; render(); };
+    charts = plotsOf(d, sel.value, w).map(([title, unit, series]) => chart({ title, xs, xname: d.input.joint, xunit, yunit: unit,
+      series, note: title.includes("drawn pose") ? "" : "input from the drawn pose", k, ranges: d.working_ranges, marks, onPick, width, group: "plots" })); // plots.js
+    const out = [...charts];
     for (const e of d.events) out.push(h("p", `${e.kind} at ${Object.entries(e.input).map(([j, v]) => `${j} = ${(+v).toFixed(2)}`).join(", ")}: ${e.message}`, { className: "muted" }));
     for (const n of d.notes) out.push(h("p", n, { className: "muted" }));
     box.replaceChildren(...out);
@@ -100,13 +97,8 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
   function cursor() {
     const d = sp.data;
     if (!d || sp.mech !== state.mech || !$("tab-plots").classList.contains("on")) return;
-    const k = Math.max(0, Math.min(d.input.values.length - 1, state.frame | 0)), x = d.input.values[k];
-    for (const s of $("plots").querySelectorAll("svg")) {
-      const c = s.querySelector("[data-cursor]");
-      if (!c || !s.__map) continue;
-      const px = s.__map.X(x).toFixed(1);
-      c.setAttribute("x1", px); c.setAttribute("x2", px); c.setAttribute("data-cursor", k);
-    }
+    const k = Math.max(0, Math.min(d.input.values.length - 1, state.frame | 0));
+    for (const c of charts) c.cursor(k);
   }
 
   // The Forces tab of a spatial file: one line on what is missing, then what the rank method reads.
