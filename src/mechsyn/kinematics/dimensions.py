@@ -29,7 +29,7 @@ Examples
 ...     set_length(m, "rocker", 0.05)
 ... except MechsynInputError as err:
 ...     print(err.message.split(";")[0])
-rocker = 0.05 does not assemble at the drawn input: joints B and D are 3.606 apart but coupler + rocker = 3.5 + 0.05 = 3.55 (triangle inequality BD <= coupler + rocker)
+rocker = 0.05 does not assemble at the drawn input: joints B and D are 3.606 apart but coupler + rocker = 3.5 + 0.05 = 3.55 (triangle inequality BD ≤ coupler + rocker)
 """
 
 from __future__ import annotations
@@ -399,10 +399,10 @@ def _why(geo: _Geometry, q: np.ndarray, what: str, folded: bool) -> str:
         (l1, l2, e, g, f), a, b, d = worst
         if d > a + b:
             text += (f": joints {e} and {f} are {d:.4g} apart but {l1} + {l2} = {a:.4g} + {b:.4g} = {a + b:.4g} "
-                     f"(triangle inequality {e}{f} <= {l1} + {l2})")
+                     f"(triangle inequality {e}{f} ≤ {l1} + {l2})")
         elif d < abs(a - b):
             text += (f": joints {e} and {f} are {d:.4g} apart but |{l1} - {l2}| = {abs(a - b):.4g} "
-                     f"(triangle inequality {e}{f} >= |{l1} - {l2}|)")
+                     f"(triangle inequality {e}{f} ≥ |{l1} - {l2}|)")
         else:
             worst = None
     if worst is None:
@@ -501,5 +501,5 @@ def _grashof_words(geo: _Geometry) -> str:
     v = sorted(lengths.values())
     s, p, qq, L = v
     if s + L <= p + qq:
-        return f"Grashof holds (s + l = {s + L:.4g} <= p + q = {p + qq:.4g}: the shortest link turns fully)"
+        return f"Grashof holds (s + l = {s + L:.4g} ≤ p + q = {p + qq:.4g}: the shortest link turns fully)"
     return f"non-Grashof (s + l = {s + L:.4g} > p + q = {p + qq:.4g}: no link turns fully)"

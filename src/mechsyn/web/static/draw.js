@@ -179,6 +179,7 @@ export function draw(svg, state) {
     if (!colour) for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
     if (invalid.has(`link:${name}`)) cls += " invalid";
     const g = el("g", { "data-link": name, "data-group": groupOf[name] }, layers.links);
+    if (sel === `link:${name}`) g.setAttribute("data-selected", "true");
     // a group colour is set through the CSSOM: a presentation attribute loses to the class rules
     const paint = (e, fill) => { if (colour && !cls.includes("invalid")) { e.style.stroke = colour; if (fill) e.style.fill = colour; } return e; };
     if (pts.length === 2) {
@@ -254,6 +255,8 @@ export function draw(svg, state) {
     labels(layers.labels, px + 9, py + 4, `T${i + 1}`);
   });
   if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);
+  // what other modules draw (burmester.js, robot.js, centres.js): f(layer, view, pos)
+  for (const f of Object.values(state.overlays || {})) f(layers.marks, v, pos, labels);
   // the link being built
   if (state.building && state.building.length) {
     const pts = state.building.map((b) => P(b.point));

@@ -11,6 +11,7 @@ import { autosave, forgetWork, guardUnload, mountFiles, savedWork } from "./file
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
 import { mountSpatialTabs } from "./tabs3d.js"; // the Plots and Forces tabs of spatial files
+import { mountDesign } from "./design.js"; // issue 40: dimensions, Burmester choice, robots, instant centres
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -68,7 +69,7 @@ function renderBanner() {
   if (sim && !sim.assembled[state.home] && state.simFor === state.mech)
     items.push(div("err", "not assembled at the drawn pose: the links cannot meet where they are drawn. Drag a joint until they do, or type its x and y in the Element tab"));
   else if (sim && !sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
-  for (const n of state.notes) items.push(div("note", n));
+  for (const n of state.notes.concat(designUi.notes())) items.push(div("note", n));
   const b = $("banner");
   b.replaceChildren(...items);
   b.dataset.level = items.length ? items[0].className : "";
@@ -386,6 +387,7 @@ svg.addEventListener("pointerdown", (ev) => {
     renderElement();
     return;
   }
+  if (mode === "select" && linkEl && !jointId && !pointEl) { state.selected = { kind: "link", id: linkEl.dataset.link }; render(); renderElement(); }
   if (mode === "select" || (mode !== "select" && ev.button === 1)) {
     gesture = { kind: "pan", x: ev.clientX, y: ev.clientY, view: { ...state.view } };
     svg.setPointerCapture(ev.pointerId);
@@ -531,6 +533,7 @@ function renderElement() {
   const box = $("tab-element"), sel = state.selected, m = state.mech;
   if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it (clicking again where joints coincide selects the next).", { className: "muted" })); return; }
   const out = [];
+  if (sel.kind === "link") return designUi.linkElement(box, m, sel.id);
   if (sel.kind === "joint") {
     const j = m.joints.find((x) => x.id === sel.id);
     if (!j) { state.selected = null; return renderElement(); }
@@ -572,7 +575,7 @@ function renderJoints() {
   const m = state.mech;
   if (!m) return;
   const sel = state.selected && state.selected.kind === "joint" ? state.selected.id : null;
-  $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }));
+  $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }, designUi.setLength));
 }
 
 function renderPlots() {
@@ -616,6 +619,7 @@ function renderPlots() {
 }
 
 // ------------------------------------------------------------------ player, synthesis, atlas
+const designUi = mountDesign({ $, root, state, render, setMech, rebase, setMode: (m) => setMode(m), showTab: (t) => showTab(t) });
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
 const synthUi = mountSynthesis({ $, state, render, setMech });
 mountAtlas({ $, state, render, setMech });
