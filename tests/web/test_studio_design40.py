@@ -65,3 +65,76 @@ def test_a_length_that_cannot_assemble_says_why_and_changes_nothing(serve, page)
     assert "rocker = 0.05" in text and "coupler + rocker" in text and "Grashof" in text
     assert page.evaluate("() => JSON.stringify(window.__studio.mech)") == before
     shot(page, "design_length_refused.png")
+
+
+def run_motion(page, poses):
+    """Targets clicked at ``poses`` (x, y, angle in degrees), the motion kind run to its end."""
+    from test_browser import click_world
+
+    page.click("#new")
+    page.click('#tabs button[data-tab="synthesis"]')
+    page.select_option("#synth-kind", "motion")
+    page.click('#modes button[data-mode="target"]')
+    for x, y, _ in poses:
+        click_world(page, x, y)
+    for i, (_, _, a) in enumerate(poses):
+        page.fill(f'input[data-pose="{i}"]:not([data-coord])', str(a))
+        page.press(f'input[data-pose="{i}"]:not([data-coord])', "Tab")
+    page.click("#synth-run")
+    wait_js(page, "() => document.querySelectorAll('#synth-results li').length > 0", timeout=60)
+
+
+def test_three_poses_offer_linkages_and_a_dragged_pivot(serve, page):
+    srv = serve(None)
+    page.goto(srv.url)
+    wait_js(page, "() => window.__studio && window.__studio.mech")
+    poses = [(0.0, 0.0, 0.0), (1.0, 0.5, 20.0), (2.0, 0.6, 45.0)]
+    run_motion(page, poses)
+    applies = page.locator("#synth-results button[data-apply]")
+    assert applies.count() >= 2
+    labels = page.locator("#synth-results li").all_inner_texts()
+    assert all("× the poses" in t and "min μ" in t and "Grashof" in t for t in labels)
+    assert not any("error 1" in t for t in labels)
+    # the pivots of the first result drawn
+    for kind in ("fixed", "moving", "circle", "linkage"):
+        assert page.locator(f'[data-burmester="{kind}"]').count() >= 1, kind
+    shot(page, "design_burmester3.png")
+    # a moving pivot typed: the linkage it gives is computed and offered
+    page.fill("input[name=pivot-ax]", "-0.5")
+    page.press("input[name=pivot-ax]", "Enter")
+    wait_js(page, "() => window.__studio.previewResult && window.__studio.previewResult.custom")
+    r = page.evaluate("() => window.__studio.previewResult")
+    assert r["pivots"]["moving"][0][0][0] == pytest.approx(-0.5)
+    # the linkage's moving pivot runs on a circle about its fixed pivot through the three poses
+    f = np.array(r["pivots"]["fixed"][0])
+    d = [np.linalg.norm(np.array(p) - f) for p in r["pivots"]["moving"][0]]
+    assert np.ptp(d) < 1e-9 * max(d)
+    # drag the other moving pivot
+    x, y = center(page, '[data-burmester="moving"][data-which="1"]')
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + 30, y - 20, steps=4)
+    page.mouse.up()
+    wait_js(page, "p => Math.abs(window.__studio.previewResult.pivots.moving[1][0][0] - p) > 1e-6", r["pivots"]["moving"][1][0][0])
+    assert page.locator('button[data-apply="custom"]').count() == 1
+    page.click('button[data-apply="custom"]')
+    wait_settled(page)
+    assert page.evaluate("() => window.__studio.mode") == "select"
+    m = page.evaluate("() => window.__studio.mech")
+    assert m["name"].startswith("Four-bar motion generator")
+    shot(page, "design_burmester3_applied.png")
+
+
+def test_four_poses_ranked_and_labelled(serve, page):
+    srv = serve(None)
+    page.goto(srv.url)
+    wait_js(page, "() => window.__studio && window.__studio.mech")
+    poses = [(0.0, 0.0, 0.0), (1.0, 0.5, 20.0), (2.0, 0.6, 45.0), (3.0, 0.4, 70.0)]
+    run_motion(page, poses)
+    labels = page.locator("#synth-results li").all_inner_texts()
+    assert len(labels) >= 2
+    assert all("reaches the poses on one branch, in order" in t for t in labels)
+    ratios = [float(t.split("× the poses")[0].split(";")[-1]) for t in labels]
+    assert max(ratios) <= 10
+    assert page.locator('[data-burmester="centre-curve"]').count() == 1
+    shot(page, "design_burmester4.png")

@@ -87,6 +87,92 @@ def _grashof_change(old: Any, new: Any) -> list[str]:
     return [f"the four-bar is now {b.classification} (was {a.classification}): {b.expression}"]
 
 
+# --------------------------------------------------------------------------- motion synthesis
+def motion_results(poses: Any, pivots: Any = None, show_all: bool = False) -> dict[str, Any]:
+    """The Synthesis tab's motion results through 3 to 5 ``poses`` (rows x, y, angle in
+    radians): ranked and labelled four-bars (:func:`mechsyn.synthesis.motion_choice.motion_choices`),
+    or, for 3 poses and two moving ``pivots`` (drawing coordinates at pose 1), the linkage they
+    give. Each result carries its mechanism, the guided point's path over the motion and its
+    pivots (fixed, moving, and the moving ones' positions at every pose) for the canvas; for 4
+    poses ``curves`` has the centre-point and circle-point curves (pose 1)."""
+    import numpy as np
+
+    from mechsyn.synthesis.exact import center_point_curve
+    from mechsyn.synthesis.motion_choice import linkage_from_pivots, motion_choices, motion_quality
+
+    P = np.asarray(poses, float)
+    if pivots is not None:
+        if not isinstance(pivots, list) or len(pivots) != 2:
+            raise MechsynInputError("give two moving pivots [[x, y], [x, y]]", field="pivots")
+        a, b = (np.asarray([_number(v, "pivots") for v in p], float) if isinstance(p, list) and len(p) == 2
+                else _bad_pivot() for p in pivots)
+        choices = [motion_quality(linkage_from_pivots(P, a, b), P)]
+    else:
+        choices = motion_choices(P, keep_unbuildable=show_all)
+    results = [_motion_item(c, P) for c in choices]
+    out: dict[str, Any] = {"kind": "motion", "targets": P[:, :2].tolist(), "results": results, "notes": []}
+    if pivots is None:
+        out["notes"].append(f"{len(results)} linkage{'s' if len(results) != 1 else ''} shown"
+                            + ("" if show_all else " (buildable only: one branch, the poses in order, at most "
+                               "10× the poses' size)")
+                            + ("; drag a moving pivot (◯) on the canvas or type it to see its linkage"
+                               if len(P) == 3 else ""))
+    if len(P) == 4:
+        M, Ps = center_point_curve(P, n_dir=240)
+        keep = np.linalg.norm(M - P[:, :2].mean(0), axis=1) < 5 * (float(np.ptp(P[:, :2], axis=0).max()) or 1.0)
+        from mechsyn.synthesis.exact import _rot
+
+        out["curves"] = {"centre": M[keep].tolist(), "circle": [(_rot(P[0, 2]) @ p + P[0, :2]).tolist() for p in Ps[keep]]}
+        out["notes"].append("on the canvas: the centre-point curve (red, where fixed pivots may go) and the "
+                            "circle-point curve (green, their moving pivots at pose 1)")
+    return out
+
+
+def _bad_pivot() -> Any:
+    raise MechsynInputError("a pivot is [x, y]", field="pivots")
+
+
+def _motion_item(c: Any, P: Any) -> dict[str, Any]:
+    """One motion result for the Synthesis tab."""
+    import numpy as np
+
+    from mechsyn.synthesis.exact import _rot
+    from mechsyn.synthesis.export import fourbar_mechanism_dict
+    from mechsyn.synthesis.fourbar import fourbar_position
+
+    r = c.result
+    d = r.design()
+    item: dict[str, Any] = {"error": float(r.position_error), "feasible": bool(c.buildable), "label": c.label(),
+                            "quality": to_jsonable(c.to_dict())}
+    pose = fourbar_position(d["r1"], d["r2"], d["r3"], d["r4"], c.crank_angles(), branch=r.branch, rcx=d["rcx"],
+                            rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"])
+    item["path"] = _service._xy(np.asarray(pose.C).reshape(-1, 2))
+    item["pivots"] = {"fixed": [r.O2.tolist(), r.O4.tolist()],
+                      "moving": [[(_rot(a) @ p + P[j, :2]).tolist() for j, a in enumerate(P[:, 2])] for p in (r.pA, r.pB)]}
+    try:
+        item["mechanism"] = fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(r.theta2[0]),
+                                                   branch=r.branch, rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"],
+                                                   y0=d["y0"], theta0=d["theta0"],
+                                                   name="Four-bar motion generator (Burmester)")
+    except ValueError:  # not assembled at the first pose (a defect shown with all results)
+        pass
+    return item
+
+
+def burmester(params: Any) -> dict[str, Any]:
+    """The linkage of two moving pivots picked for 3 poses (``params``: ``targets`` [x, y],
+    ``angles`` in degrees, ``pivots``), quick enough for a drag."""
+    import numpy as np
+
+    if not isinstance(params, dict):
+        raise MechsynInputError("expected {targets, angles, pivots}", field="body")
+    T = np.asarray(params.get("targets"), float)
+    A = np.asarray(params.get("angles"), float)
+    if T.shape != (3, 2) or A.shape != (3,) or not (np.isfinite(T).all() and np.isfinite(A).all()):
+        raise MechsynInputError("moving pivots are picked for 3 poses [x, y] with 3 angles", field="targets")
+    return motion_results(np.column_stack([T, np.radians(A)]), params.get("pivots"))
+
+
 # --------------------------------------------------------------------------- routes
 def routes() -> list:
     """The routes of this module (quick ones in the server's threads)."""
@@ -100,5 +186,10 @@ def routes() -> list:
         body = await _body(request)
         return await run_in_threadpool(set_dimension, _need(body, "mechanism"), _need(body, "change"))
 
-    return [Route("/api/design/dimensions", dimensions_route, methods=["POST"]),
+    @api
+    async def burmester_route(request) -> Any:
+        return await run_in_threadpool(burmester, await _body(request))
+
+    return [Route("/api/design/burmester", burmester_route, methods=["POST"]),
+            Route("/api/design/dimensions", dimensions_route, methods=["POST"]),
             Route("/api/design/dimension", dimension_route, methods=["POST"])]

@@ -252,7 +252,7 @@ export function draw(svg, state) {
       const a = (((state.targetAngles || [])[i] || 0) * Math.PI) / 180;
       el("line", { x1: px, y1: py, x2: px + 26 * Math.cos(a), y2: py - 26 * Math.sin(a), class: "pose-tick", "data-pose": i }, layers.marks);
     }
-    labels(layers.labels, px + 9, py + 4, `T${i + 1}`);
+    if (state.targets.length <= 12) labels(layers.labels, px + 9, py + 4, `T${i + 1}`); // many: no labels
   });
   if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);
   // what other modules draw (burmester.js, robot.js, centres.js): f(layer, view, pos)

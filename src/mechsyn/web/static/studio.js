@@ -621,7 +621,7 @@ function renderPlots() {
 // ------------------------------------------------------------------ player, synthesis, atlas
 const designUi = mountDesign({ $, root, state, render, setMech, rebase, setMode: (m) => setMode(m), showTab: (t) => showTab(t) });
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
-const synthUi = mountSynthesis({ $, state, render, setMech });
+const synthUi = mountSynthesis({ $, state, render, setMech, setMode: (m) => setMode(m), design: designUi });
 mountAtlas({ $, state, render, setMech });
 const spatialUi = mountSpatialTabs({ $, state, render, showTab });
 const forcesUi = mountForces({ $, state, render, edit, stepsFor, spatialLines: spatialUi.forcesLines });
