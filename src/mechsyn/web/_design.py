@@ -173,6 +173,137 @@ def burmester(params: Any) -> dict[str, Any]:
     return motion_results(np.column_stack([T, np.radians(A)]), params.get("pivots"))
 
 
+# --------------------------------------------------------------------------- instant centres, cams
+def centres(data: Any, inputs: Any = None) -> dict[str, Any]:
+    """Every pair of links' instant centre at the drive values ``inputs`` (``{drive: value}``,
+    the drawn pose when None): :func:`mechsyn.kinematics.centres.instant_centres`, links
+    numbered in file order (the frame first as drawn in the file)."""
+    from mechsyn.kinematics.centres import instant_centres
+
+    mech = _service.build(data)
+    if inputs is not None and not isinstance(inputs, dict):
+        raise MechsynInputError("inputs must be {drive: value}", field="inputs")
+    vals = {str(k): _number(v, "inputs") for k, v in (inputs or {}).items()}
+    number = {n: k + 1 for k, n in enumerate(mech.link_names)}
+    return {"centres": [{**c.to_dict(), "numbers": [number[c.links[0]], number[c.links[1]]]}
+                        for c in instant_centres(mech, vals)]}
+
+
+def cam_profiles(data: Any) -> list[dict[str, Any]]:
+    """The profile of every cam joint in the drawn pose (a circle sampled at 3° steps, or the
+    profile's points), with the cam link and its pivot (an R joint of the cam link)."""
+    import numpy as np
+
+    mech = _service.build(data)
+    out = []
+    for j in mech.joints:
+        prof = j.attrs.get("profile") if j.type == "cam" else None
+        if prof is None:
+            continue
+        if isinstance(prof, dict) and "points" in prof:
+            prof = prof["points"]
+        if isinstance(prof, dict):
+            c, r = np.asarray(prof["center"], float), float(prof["radius"])
+            t = np.radians(np.arange(0, 360, 3.0))
+            pts = np.column_stack([c[0] + r * np.cos(t), c[1] + r * np.sin(t)])
+        else:
+            pts = np.asarray(prof, float)
+        cam = j.links[0]
+        pivot = next((x.id for x in mech.joints_of(cam) if x.type == "R"), None)
+        out.append({"joint": j.id, "link": cam, "pivot": pivot, "points": pts.tolist()})
+    return out
+
+
+# --------------------------------------------------------------------------- robots
+def _tool_points(mech: Any) -> list[str]:
+    """The points a tool may be: the named points, then the joints off the frame of the link
+    with the most joints (a parallel robot's platform) and the other moving joints."""
+    counts = {n: len(mech.joints_of(n)) for n in mech.moving_links}
+    platform = max(counts, key=counts.get) if counts else None
+    on = [j.id for j in mech.joints if platform in j.links and mech.ground not in j.links]
+    rest = [j.id for j in mech.joints if mech.ground not in j.links and j.id not in on]
+    return list(mech.points) + on + rest
+
+
+def drives(data: Any) -> dict[str, Any]:
+    """Every drive's value at the drawn pose (the engine's convention: a planar R drive's angle
+    in degrees, a spatial file's drives 0 at the drawn assembly) and the tool point choices
+    with their drawn positions."""
+    import numpy as np
+
+    from mechsyn.kinematics.inverse import drawn_inputs
+
+    mech = _service.build(data)
+    values = drawn_inputs(mech)
+    out = {"drives": [{"id": j.id, "type": j.type, "value": values[j.id]} for j in mech.joints if j.actuated],
+           "tools": [], "spatial": mech.kind != "planar", "length_scale": _service._scale(mech)}
+    if len(out["drives"]) >= 2:
+        names = _tool_points(mech)
+        sim = _pose_sim(mech, values, names)
+        out["tools"] = [{"id": n, "at": np.asarray(sim.point(n)[0], float).tolist()} for n in names]
+    return out
+
+
+def _pose_sim(mech: Any, values: dict[str, float], names: list[str]) -> Any:
+    from mechsyn.kinematics.analysis import simulate
+
+    return simulate(mech, {k: [float(v)] for k, v in values.items()}, points=names)
+
+
+def _joint_names(mech: Any) -> list[str]:
+    return [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
+
+
+def pose(data: Any, values: Any) -> dict[str, Any]:
+    """The mechanism drawn with its drives at ``values`` (``{drive: value}``, the engine's
+    convention, :func:`drives`), followed from the drawn pose: ``{"mechanism"}``, or an
+    error saying it does not assemble there."""
+    from mechsyn.io import mechanism_to_dict
+    from mechsyn.kinematics.inverse import drawn_inputs, posed
+
+    mech = _service.build(data)
+    if not isinstance(values, dict):
+        raise MechsynInputError("values must be {drive: value}", field="values")
+    u = drawn_inputs(mech)
+    for k, v in values.items():
+        if k not in u:
+            raise MechsynInputError(f"{str(k)[:20]} is not a drive", field="values", hint=", ".join(u))
+        u[k] = _number(v, "values")
+    sim = _pose_sim(mech, u, _joint_names(mech))
+    if not bool(sim.assembled[0]):
+        raise MechsynInputError("the mechanism does not assemble with the drives there", field="values",
+                                hint="move the drive back")
+    return {"mechanism": mechanism_to_dict(posed(mech, sim, 0))}
+
+
+def reach(data: Any, point: Any, target: Any, steps: int = 8) -> dict[str, Any]:
+    """Inverse kinematics from the drawn pose: tool ``point`` moved in ``steps`` straight steps
+    to ``target`` (:func:`mechsyn.kinematics.inverse.simulate_inverse`); ``{"mechanism"
+    (drawn at the last target reached), "reached", "message", "values"}``."""
+    import numpy as np
+
+    from mechsyn.io import mechanism_to_dict
+    from mechsyn.kinematics.inverse import drawn_inputs, posed, simulate_inverse
+
+    mech = _service.build(data)
+    if not isinstance(point, str) or point not in _tool_points(mech):
+        raise MechsynInputError(f"{str(point)[:20]!r} is no point of this mechanism", field="point")
+    if not isinstance(target, list) or not all(isinstance(c, (int, float)) for c in target):
+        raise MechsynInputError("the target is [x, y] (or [x, y, z])", field="target")
+    T = np.asarray([_number(c, "target") for c in target], float)
+    u0 = drawn_inputs(mech)
+    p0 = np.asarray(_pose_sim(mech, u0, [point]).point(point)[0], float)
+    path = p0 + np.linspace(0, 1, steps + 1)[1:, None] * (T - p0)
+    res = simulate_inverse(mech, point, path, start=u0)
+    k = int(np.flatnonzero(res.reached)[-1]) if res.reached.any() else -1
+    out: dict[str, Any] = {"reached": bool(res.ok), "message": res.message, "mechanism": None, "values": None}
+    if k >= 0:
+        vals = {n: float(v[k]) for n, v in res.inputs.items()}
+        sim = _pose_sim(mech, vals, _joint_names(mech))
+        out["mechanism"], out["values"] = mechanism_to_dict(posed(mech, sim, 0)), vals
+    return out
+
+
 # --------------------------------------------------------------------------- routes
 def routes() -> list:
     """The routes of this module (quick ones in the server's threads)."""
@@ -190,6 +321,35 @@ def routes() -> list:
     async def burmester_route(request) -> Any:
         return await run_in_threadpool(burmester, await _body(request))
 
+    @api
+    async def drives_route(request) -> Any:
+        return await _heavy(request, "_design:drives", _need(await _body(request), "mechanism"))
+
+    @api
+    async def pose_route(request) -> Any:
+        body = await _body(request)
+        return await _heavy(request, "_design:pose", _need(body, "mechanism"), _need(body, "values"))
+
+    @api
+    async def reach_route(request) -> Any:
+        body = await _body(request)
+        return await _heavy(request, "_design:reach", _need(body, "mechanism"), _need(body, "point"),
+                            _need(body, "target"))
+
+    @api
+    async def centres_route(request) -> Any:
+        body = await _body(request)
+        return await _heavy(request, "_design:centres", _need(body, "mechanism"), body.get("inputs"))
+
+    @api
+    async def cams_route(request) -> Any:
+        return {"cams": await run_in_threadpool(cam_profiles, _need(await _body(request), "mechanism"))}
+
     return [Route("/api/design/burmester", burmester_route, methods=["POST"]),
+            Route("/api/design/centres", centres_route, methods=["POST"]),
+            Route("/api/design/cams", cams_route, methods=["POST"]),
+            Route("/api/design/drives", drives_route, methods=["POST"]),
+            Route("/api/design/pose", pose_route, methods=["POST"]),
+            Route("/api/design/reach", reach_route, methods=["POST"]),
             Route("/api/design/dimensions", dimensions_route, methods=["POST"]),
             Route("/api/design/dimension", dimension_route, methods=["POST"])]

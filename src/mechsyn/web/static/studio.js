@@ -40,6 +40,7 @@ function render() {
     renderBanner();
     renderPlayer();
     view3d.update(); // view3d: the 3-D view, its slider range and banner lines
+    designUi.update(); // issue 40: drive sliders, tool point, instant centres, planar modes hidden in 3-D
     if (spatial()) spatialUi.cursor(); else renderPlots();
     forcesUi.cursor(state.frame);
   } catch (e) {
