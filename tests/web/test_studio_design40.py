@@ -78,8 +78,8 @@ def run_motion(page, poses):
     for x, y, _ in poses:
         click_world(page, x, y)
     for i, (_, _, a) in enumerate(poses):
-        page.fill(f'input[data-pose="{i}"]:not([data-coord])', str(a))
-        page.press(f'input[data-pose="{i}"]:not([data-coord])', "Tab")
+        page.fill(f'input[data-pose="{i}"]', str(a))
+        page.press(f'input[data-pose="{i}"]', "Tab")
     page.click("#synth-run")
     wait_js(page, "() => document.querySelectorAll('#synth-results li').length > 0", timeout=60)
 
@@ -259,3 +259,23 @@ def test_unit_chosen_goes_to_the_dxf(serve, page):
         page.select_option("#export", "dxf")
     text = open(dl.value.path()).read().replace("\r", "")
     assert "$INSUNITS\n 70\n4\n" in text
+
+
+def test_pose_xy_typed_moves_the_target(serve, page):
+    srv = serve(None)
+    page.goto(srv.url)
+    wait_js(page, "() => window.__studio && window.__studio.mech")
+    from test_browser import click_world
+
+    page.click('#tabs button[data-tab="synthesis"]')
+    page.select_option("#synth-kind", "motion")
+    page.click('#modes button[data-mode="target"]')
+    for x, y in ((0, 0), (1, 0.5), (2, 0.6)):
+        click_world(page, x, y)
+    page.fill('input[data-pose-xy="1"][data-coord="y"]', "0.75")
+    page.press('input[data-pose-xy="1"][data-coord="y"]', "Enter")
+    wait_js(page, "() => window.__studio.targets[1][1] === 0.75")
+    cy = float(page.get_attribute('[data-target="1"]', "cy"))
+    assert page.evaluate("() => window.__studio.targets[1]") == [1, 0.75]
+    assert cy == pytest.approx(page.evaluate("""() => { const r = document.getElementById('canvas').getBoundingClientRect();
+        const v = window.__studio.view; return r.height / 2 - (0.75 - v.oy) * v.s; }"""), abs=0.5)

@@ -112,7 +112,7 @@ def motion_results(poses: Any, pivots: Any = None, show_all: bool = False) -> di
     results = [_motion_item(c, P) for c in choices]
     out: dict[str, Any] = {"kind": "motion", "targets": P[:, :2].tolist(), "results": results, "notes": []}
     if pivots is None:
-        out["notes"].append(f"{len(results)} linkage{'s' if len(results) != 1 else ''} shown"
+        out["notes"].append(f"{len(results)} linkage{'s' if len(results) != 1 else ''} shown, each verified by simulation"
                             + ("" if show_all else " (buildable only: one branch, the poses in order, at most "
                                "10× the poses' size)")
                             + ("; drag a moving pivot (◯) on the canvas or type it to see its linkage"

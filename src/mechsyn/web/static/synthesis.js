@@ -26,7 +26,7 @@ export function mountSynthesis({ $, state, render, setMech, setMode = () => {}, 
       // a pose's x and y typed (issue 40)
       const xy = [0, 1].map((k) => {
         const c = h("input", null, { value: String(p[k]), size: 6 });
-        c.dataset.pose = i; c.dataset.coord = "xy"[k];
+        c.dataset.poseXy = i; c.dataset.coord = "xy"[k];
         c.onchange = () => { const v = Number(c.value); if (!Number.isFinite(v)) return; state.targets[i] = state.targets[i].slice(); state.targets[i][k] = v; render(); };
         const cell = h("td"); cell.append(c); return cell;
       });
