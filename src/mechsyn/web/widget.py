@@ -33,7 +33,8 @@ import traitlets  # noqa: E402  (installed with anywidget)
 
 STATIC = Path(__file__).parent / "static"
 MODULES = ("api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js", "synthesis.js",
-           "atlas.js", "forces.js", "view3d.js", "tabs3d.js", "studio.js")  # view3d.js, tabs3d.js: spatial files
+           "atlas.js", "forces.js", "view3d.js", "tabs3d.js", "dimensions.js", "burmester.js", "robot.js", "centres.js",
+           "design.js", "studio.js")  # view3d.js, tabs3d.js: spatial files; design.js and its four: issue 40
 
 
 def _body_markup() -> str:

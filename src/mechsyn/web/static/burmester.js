@@ -9,10 +9,10 @@ import { call } from "./api.js";
 import { el, makeView } from "./draw.js";
 import { h } from "./numeric.js";
 
-const fmt = (v) => String(+(+v).toPrecision(6));
 
 // ctx: {$, state, render, setMech, setMode}
 export function mountBurmester({ $, state, render, setMech, setMode }) {
+  const fmt = (v) => String(+(+v).toPrecision(6));
   const svg = $("canvas");
   const box = h("div"); box.id = "burmester-box";
   $("synth-poses").after(box);

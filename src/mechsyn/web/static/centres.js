@@ -6,10 +6,10 @@ import { call } from "./api.js";
 import { el } from "./draw.js";
 import { h } from "./numeric.js";
 
-const fmt = (v) => String(+(+v).toPrecision(4));
 
 // ctx: {$, state, render, setMech}
 export function mountCentres({ $, state, render, setMech }) {
+  const fmt = (v) => String(+(+v).toPrecision(4));
   const cs = { mech: null, key: "", list: null, error: null, cams: null, camsFor: null };
   window.__centres = cs; // for tests (read-only use)
 

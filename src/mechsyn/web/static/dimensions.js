@@ -6,11 +6,11 @@
 import { call } from "./api.js";
 import { h } from "./numeric.js";
 
-const fmt = (v) => String(+(+v).toPrecision(8));
-const NAMES = { length: "length", side: "side", offset: "offset", angle: "guide-angle" };
+const DIMENSION_INPUTS = { length: "length", side: "side", offset: "offset", angle: "guide-angle" };
 
 // ctx: {$, state, render, setMech, rebase, renderElement}; returns {linkElement, setLength}.
 export function mountDimensions({ state, render, setMech, rebase }) {
+  const fmt = (v) => String(+(+v).toPrecision(8));
   // One typed dimension: one edit (one undo step) or, refused, the reason in the banner.
   async function change(c) {
     const mech = rebase();
@@ -41,7 +41,7 @@ export function mountDimensions({ state, render, setMech, rebase }) {
   function row(d) {
     const label = d.kind === "length" ? `length ${d.joints.join("–")}` : d.kind === "side" ? `side ${d.joints.join("–")}`
       : d.kind === "offset" ? `guide offset of ${d.joints[0]} from ${d.joints[1]}` : `guide angle of ${d.joints[0]} (°)`;
-    const inp = h("input", null, { type: "text", inputMode: "decimal", value: fmt(d.value), name: NAMES[d.kind], size: 10 });
+    const inp = h("input", null, { type: "text", inputMode: "decimal", value: fmt(d.value), name: DIMENSION_INPUTS[d.kind], size: 10 });
     inp.dataset.joints = d.joints.join(",");
     inp.onchange = () => {
       const v = Number(inp.value.trim().replace(",", "."));

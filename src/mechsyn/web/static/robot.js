@@ -8,10 +8,10 @@ import { call } from "./api.js";
 import { makeView } from "./draw.js";
 import { h } from "./numeric.js";
 
-const fmt = (v) => String(+(+v).toPrecision(6));
 
 // ctx: {$, state, render, setMech}
 export function mountRobot({ $, state, render, setMech }) {
+  const fmt = (v) => String(+(+v).toPrecision(6));
   const bar = h("span"); bar.id = "drives";
   $("input-slider").before(bar);
   const box = h("div"); box.id = "robot-box";
