@@ -412,6 +412,7 @@ def analyze(data: Any) -> dict[str, Any]:
 def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
     """The non-isomorphic chains with ``n_links`` links and ``mobility``, with a drawing layout."""
     from mechsyn.synthesis.chains import synthesize_chains
+    from mechsyn.synthesis.curves.topologies import chain_name, six_bar_name
     from mechsyn.synthesis.mechanisms import chain_layout, distinct_mechanisms
 
     if not (4 <= n_links <= 10):
@@ -419,9 +420,11 @@ def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
     out = []
     for k, chain in enumerate(synthesize_chains(n_links, mobility)):
         link_xy, joint_xy = chain_layout(chain)
-        out.append({"index": k, "label": chain.assortment_label(), "chain": chain.to_dict(),
-                    "link_xy": link_xy.tolist(), "joint_xy": joint_xy.tolist(),
-                    "mechanisms": [{"frame": c.frame, "input": c.input} for c in distinct_mechanisms(chain)]})
+        name = chain_name(chain)  # Watt, Stephenson (issue 40)
+        out.append({"index": k, "label": chain.assortment_label() + (f", {name}" if name else ""), "name": name,
+                    "chain": chain.to_dict(), "link_xy": link_xy.tolist(), "joint_xy": joint_xy.tolist(),
+                    "mechanisms": [{"frame": c.frame, "input": c.input, "name": six_bar_name(chain, c.frame)}
+                                   for c in distinct_mechanisms(chain)]})
     return out
 
 
