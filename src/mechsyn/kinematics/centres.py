@@ -33,6 +33,8 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.inverse import drawn_inputs
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["InstantCentre", "instant_centres"]
@@ -67,8 +69,6 @@ class InstantCentre:
 def _rates(mech: Mechanism, inputs: dict[str, float] | None) -> tuple[dict, dict, float]:
     """``ω`` and a reference point with its velocity of every link (the frame: 0), by one
     simulated row at ``inputs`` (the drawn pose when None)."""
-    from mechsyn.kinematics.analysis import simulate
-    from mechsyn.kinematics.inverse import drawn_inputs
 
     u = drawn_inputs(mech)
     if not u:

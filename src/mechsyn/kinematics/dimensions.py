@@ -41,6 +41,8 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.solve import newton
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["Dimension", "dimensions", "link_lengths", "set_length", "set_side", "set_slider"]
@@ -262,8 +264,6 @@ FIRST_STEP, SMALLEST_STEP = 0.125, 1.0 / 512
 def _apply(mech: Mechanism, link: str, what: str, moves: dict[str, np.ndarray], guide: tuple | None = None) -> Mechanism:
     """Re-assemble ``mech`` with the joints ``moves`` (new drawn places on ``link``, in the
     drawn configuration) or the slider ``guide`` changed: continuation from the drawn pose."""
-    from mechsyn.kinematics.solve import newton
-    from mechsyn.kinematics.system import build_system
 
     S = build_system(mech)
     u = np.array([d.assembled for d in S.drivers])

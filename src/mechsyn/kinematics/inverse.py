@@ -17,8 +17,12 @@ Examples
 --------
 >>> import numpy as np, mechsyn as ms
 >>> from mechsyn.kinematics.inverse import simulate_inverse
->>> m = ms.examples.load("five_bar_5r")
->>> p0 = ms.simulate(m, {j.id: [0.0] for j in m.actuated_joints}, points=["P"]).point("P")[0]  # doctest: +SKIP
+>>> m = ms.load("five_bar_5r")                      # two drives, A and E; tool point "tool"
+>>> r = simulate_inverse(m, "tool", [[2.2, 3.4], [2.4, 3.3]])
+>>> r.ok, ms.simulate(m, r.inputs, points=["tool"]).point("tool").round(9).tolist()
+(True, [[2.2, 3.4], [2.4, 3.3]])
+>>> simulate_inverse(m, "tool", [[2.0, 40.0]]).message[:44]
+'tool cannot follow beyond target 1 (2, 40): '
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.analysis import cached_plan, simulate
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["InverseResult", "simulate_inverse", "posed", "drawn_inputs"]
@@ -65,7 +70,6 @@ def drawn_inputs(mech: Mechanism) -> dict[str, float]:
     drives = [j.id for j in mech.joints if j.actuated]
     if mech.kind != "planar":
         return {d: 0.0 for d in drives}
-    from mechsyn.kinematics.analysis import cached_plan
 
     S = cached_plan(mech, inputs=tuple(drives)).system
     return {d.joint: (math.degrees(d.assembled) if d.type == "R" else float(d.assembled))
@@ -85,7 +89,6 @@ def simulate_inverse(mech: Mechanism, point: str, path: Any, *, start: dict[str,
     coordinates (a planar five-bar: 2; a Delta robot: 3). ``tol``: the distance to a
     target that counts as reached, relative to the mechanism's size.
     """
-    from mechsyn.kinematics.analysis import simulate
 
     drives = [j for j in mech.joints if j.actuated]
     T = np.asarray(path, float)

@@ -21,11 +21,22 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
 from starlette.concurrency import run_in_threadpool
 from starlette.routing import Route
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.io import mechanism_to_dict
+from mechsyn.kinematics import dimensions as dims
+from mechsyn.kinematics.centres import instant_centres
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.derived import grashof
+from mechsyn.kinematics.inverse import drawn_inputs, posed, simulate_inverse
 from mechsyn.results import to_jsonable
+from mechsyn.synthesis.exact import _rot, center_point_curve
+from mechsyn.synthesis.export import fourbar_mechanism_dict
+from mechsyn.synthesis.fourbar import fourbar_position
+from mechsyn.synthesis.motion_choice import linkage_from_pivots, motion_choices, motion_quality
 from mechsyn.web import _service
 from mechsyn.web._routing import _body, _heavy, _need, api
 
@@ -39,12 +50,11 @@ def _number(value: Any, field: str) -> float:
 # --------------------------------------------------------------------------- dimensions
 def dimension_list(data: Any) -> list[dict[str, Any]]:
     """Every dimension of a planar mechanism dict (:func:`mechsyn.kinematics.dimensions.dimensions`)."""
-    from mechsyn.kinematics.dimensions import dimensions
 
     mech = _service.build(data)
     if mech.kind != "planar":
         return []
-    return [d.to_dict() for d in dimensions(mech)]
+    return [d.to_dict() for d in dims.dimensions(mech)]
 
 
 def set_dimension(data: Any, change: Any) -> dict[str, Any]:
@@ -52,8 +62,6 @@ def set_dimension(data: Any, change: Any) -> dict[str, Any]:
     ``change`` is ``{"link", "kind", "value", "joints"}`` (kinds of
     :class:`mechsyn.kinematics.dimensions.Dimension`). Returns ``{"mechanism", "notes"}``;
     where it cannot assemble, the library's one-line error (nothing changes)."""
-    from mechsyn.io import mechanism_to_dict
-    from mechsyn.kinematics import dimensions as dims
 
     if not isinstance(change, dict):
         raise MechsynInputError("the change must be an object {link, kind, value}", field="change")
@@ -79,7 +87,6 @@ def _grashof_change(old: Any, new: Any) -> list[str]:
     """A four-bar whose Grashof class the change altered, in words."""
     if not _service._is_four_bar(old):
         return []
-    from mechsyn.kinematics.derived import grashof
 
     a, b = grashof(old), grashof(new)
     if a.classification == b.classification:
@@ -95,10 +102,7 @@ def motion_results(poses: Any, pivots: Any = None, show_all: bool = False) -> di
     give. Each result carries its mechanism, the guided point's path over the motion and its
     pivots (fixed, moving, and the moving ones' positions at every pose) for the canvas; for 4
     poses ``curves`` has the centre-point and circle-point curves (pose 1)."""
-    import numpy as np
 
-    from mechsyn.synthesis.exact import center_point_curve
-    from mechsyn.synthesis.motion_choice import linkage_from_pivots, motion_choices, motion_quality
 
     P = np.asarray(poses, float)
     if pivots is not None:
@@ -120,7 +124,6 @@ def motion_results(poses: Any, pivots: Any = None, show_all: bool = False) -> di
     if len(P) == 4:
         M, Ps = center_point_curve(P, n_dir=240)
         keep = np.linalg.norm(M - P[:, :2].mean(0), axis=1) < 5 * (float(np.ptp(P[:, :2], axis=0).max()) or 1.0)
-        from mechsyn.synthesis.exact import _rot
 
         out["curves"] = {"centre": M[keep].tolist(), "circle": [(_rot(P[0, 2]) @ p + P[0, :2]).tolist() for p in Ps[keep]]}
         out["notes"].append("on the canvas: the centre-point curve (red, where fixed pivots may go) and the "
@@ -134,11 +137,7 @@ def _bad_pivot() -> Any:
 
 def _motion_item(c: Any, P: Any) -> dict[str, Any]:
     """One motion result for the Synthesis tab."""
-    import numpy as np
 
-    from mechsyn.synthesis.exact import _rot
-    from mechsyn.synthesis.export import fourbar_mechanism_dict
-    from mechsyn.synthesis.fourbar import fourbar_position
 
     r = c.result
     d = r.design()
@@ -162,7 +161,6 @@ def _motion_item(c: Any, P: Any) -> dict[str, Any]:
 def burmester(params: Any) -> dict[str, Any]:
     """The linkage of two moving pivots picked for 3 poses (``params``: ``targets`` [x, y],
     ``angles`` in degrees, ``pivots``), quick enough for a drag."""
-    import numpy as np
 
     if not isinstance(params, dict):
         raise MechsynInputError("expected {targets, angles, pivots}", field="body")
@@ -178,7 +176,6 @@ def centres(data: Any, inputs: Any = None) -> dict[str, Any]:
     """Every pair of links' instant centre at the drive values ``inputs`` (``{drive: value}``,
     the drawn pose when None): :func:`mechsyn.kinematics.centres.instant_centres`, links
     numbered in file order (the frame first as drawn in the file)."""
-    from mechsyn.kinematics.centres import instant_centres
 
     mech = _service.build(data)
     if inputs is not None and not isinstance(inputs, dict):
@@ -192,7 +189,6 @@ def centres(data: Any, inputs: Any = None) -> dict[str, Any]:
 def cam_profiles(data: Any) -> list[dict[str, Any]]:
     """The profile of every cam joint in the drawn pose (a circle sampled at 3° steps, or the
     profile's points), with the cam link and its pivot (an R joint of the cam link)."""
-    import numpy as np
 
     mech = _service.build(data)
     out = []
@@ -229,9 +225,7 @@ def drives(data: Any) -> dict[str, Any]:
     """Every drive's value at the drawn pose (the engine's convention: a planar R drive's angle
     in degrees, a spatial file's drives 0 at the drawn assembly) and the tool point choices
     with their drawn positions."""
-    import numpy as np
 
-    from mechsyn.kinematics.inverse import drawn_inputs
 
     mech = _service.build(data)
     values = drawn_inputs(mech)
@@ -245,7 +239,6 @@ def drives(data: Any) -> dict[str, Any]:
 
 
 def _pose_sim(mech: Any, values: dict[str, float], names: list[str]) -> Any:
-    from mechsyn.kinematics.analysis import simulate
 
     return simulate(mech, {k: [float(v)] for k, v in values.items()}, points=names)
 
@@ -258,8 +251,6 @@ def pose(data: Any, values: Any) -> dict[str, Any]:
     """The mechanism drawn with its drives at ``values`` (``{drive: value}``, the engine's
     convention, :func:`drives`), followed from the drawn pose: ``{"mechanism"}``, or an
     error saying it does not assemble there."""
-    from mechsyn.io import mechanism_to_dict
-    from mechsyn.kinematics.inverse import drawn_inputs, posed
 
     mech = _service.build(data)
     if not isinstance(values, dict):
@@ -280,10 +271,7 @@ def reach(data: Any, point: Any, target: Any, steps: int = 8) -> dict[str, Any]:
     """Inverse kinematics from the drawn pose: tool ``point`` moved in ``steps`` straight steps
     to ``target`` (:func:`mechsyn.kinematics.inverse.simulate_inverse`); ``{"mechanism"
     (drawn at the last target reached), "reached", "message", "values"}``."""
-    import numpy as np
 
-    from mechsyn.io import mechanism_to_dict
-    from mechsyn.kinematics.inverse import drawn_inputs, posed, simulate_inverse
 
     mech = _service.build(data)
     if not isinstance(point, str) or point not in _tool_points(mech):

@@ -39,6 +39,7 @@ from mechsyn.kinematics.analysis import forces as _forces
 from mechsyn.results import to_jsonable
 from mechsyn.structure.report import analyze as structure_report
 from mechsyn.web import _service
+from mechsyn.web._design import motion_results
 from mechsyn.web._routing import _body, _heavy, _int, _need, api
 from mechsyn.web._spatial import check_note
 
@@ -198,7 +199,6 @@ def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
     labelled and ranked by :func:`mechsyn.synthesis.motion_choice.motion_choices` (the
     unbuildable ones left out unless ``params["all"]``); for 3 poses, with two moving pivots
     ``params["pivots"]`` (drawing coordinates at pose 1) the linkage they give."""
-    from mechsyn.web._design import motion_results
 
     T = np.asarray(params.get("targets"), float)
     A = np.asarray(params.get("angles", [0.0] * len(T)), float)
