@@ -279,3 +279,22 @@ def test_pose_xy_typed_moves_the_target(serve, page):
     assert page.evaluate("() => window.__studio.targets[1]") == [1, 0.75]
     assert cy == pytest.approx(page.evaluate("""() => { const r = document.getElementById('canvas').getBoundingClientRect();
         const v = window.__studio.view; return r.height / 2 - (0.75 - v.oy) * v.s; }"""), abs=0.5)
+
+
+def test_slider_guide_offset_typed_keeps_the_lengths(serve, page):
+    from test_studio_designer import select_joint
+
+    srv = serve(example("slider_crank"), "slider_crank.yaml")
+    open_studio(page, srv)
+    wait_settled(page)
+    before = lengths_drawn(page)
+    select_joint(page, "D")
+    page.click('#tabs button[data-tab="element"]')
+    page.wait_for_selector("input[name=offset]")
+    page.fill("input[name=offset]", "0.4")
+    page.press("input[name=offset]", "Enter")
+    wait_js(page, "() => Math.abs(window.__studio.mech.joints.find(j => j.id === 'D').point[1] - 0.4) < 1e-9")
+    wait_settled(page)
+    assert lengths_drawn(page) == pytest.approx(before, rel=1e-9)
+    assert page.evaluate("() => window.__studio.mech.joints.find(j => j.id === 'C').point[1]") == pytest.approx(0.4)
+    shot(page, "design_slider_offset.png")

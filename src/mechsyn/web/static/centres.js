@@ -31,7 +31,8 @@ export function mountCentres({ $, state, render, setMech }) {
   function update() {
     const m = state.mech;
     if (!m) return;
-    $("unit").value = m.unit || m.units || "";
+    const unit = m.unit || m.units || "";
+    if ($("unit").value !== unit) $("unit").value = unit;
     if (m.kind === "planar" && cs.camsFor !== m) {
       cs.camsFor = m; cs.cams = null;
       if (m.joints.some((j) => j.type === "cam")) call("/api/design/cams", { mechanism: m }).then((r) => { if (cs.camsFor === m) { cs.cams = r.cams; render(); } }, () => {});

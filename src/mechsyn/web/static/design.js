@@ -17,17 +17,22 @@ export function mountDesign(ctx) {
   const robot = mountRobot(ctx);
   const centres = mountCentres(ctx);
   ctx.$("robot").append(robot.box);
+  let shownSpatial = null;
   // the planar editing modes have no meaning in the 3-D view of a spatial file: hidden there
   function update() {
     const spatial = !!(state.mech && state.mech.kind !== "planar");
-    for (const b of ctx.root.querySelectorAll("#modes button")) b.hidden = spatial && b.dataset.mode !== "select";
-    const fin = ctx.$("finish-link"); if (fin) fin.hidden = spatial;
+    if (spatial !== shownSpatial) { // only when it changes: a drag's repaint does no DOM work here
+      shownSpatial = spatial;
+      for (const b of ctx.root.querySelectorAll("#modes button")) b.hidden = spatial && b.dataset.mode !== "select";
+      const fin = ctx.$("finish-link"); if (fin) fin.hidden = spatial;
+    }
     robot.update(); centres.update();
   }
   return {
     update,
     linkElement: dims.linkElement,
     setLength: dims.setLength,
+    guideRows: dims.guideRows,
     // notes of the last design change, shown while its mechanism is the one drawn
     notes: () => [].concat(state.designNotes && state.designNotes.mech === state.mech ? state.designNotes.notes : [],
       robot.notes(), centres.notes()),

@@ -52,7 +52,18 @@ export function mountDimensions({ state, render, setMech, rebase }) {
     return p;
   }
 
+  // A slider's (P joint's) guide: its offset and angle as design variables, in the joint's Element tab.
+  function guideRows(m, jid) {
+    const box = h("div"); box.className = "guide-dimensions";
+    call("/api/design/dimensions", { mechanism: m }).then((r) => {
+      if (state.mech !== m) return;
+      const rows = r.dimensions.filter((d) => (d.kind === "offset" || d.kind === "angle") && d.joints[0] === jid);
+      if (rows.length) box.replaceChildren(h("h4", "Guide (re-assembled, the other dimensions kept)"), ...rows.map(row));
+    }, () => {});
+    return box;
+  }
+
   // The Joints tab's bar lengths go the same way.
   const setLength = (link, v) => change({ link, kind: "length", value: v });
-  return { linkElement, setLength };
+  return { linkElement, setLength, guideRows };
 }

@@ -549,6 +549,7 @@ function renderElement() {
     links.onchange = () => edit((n) => setLinks(n, j.id, links.value));
     const row = (label, ...els) => { const p = h("p"); p.append(h("label", label + " "), ...els); return p; };
     out.push(...jointFields(j, edit), row("pair type", type), row("links", links), row("drive", drive));
+    if (j.type === "P") out.push(designUi.guideRows(m, j.id)); // issue 40: the guide's offset and angle
     const del = h("button", "Delete joint"); del.onclick = () => deleteJoint(j.id); out.push(del);
   } else {
     const p = (m.points || {})[sel.id];
