@@ -37,7 +37,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.analysis import cached_plan, simulate
 from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["InverseResult", "simulate_inverse", "posed", "drawn_inputs"]
+__all__ = ["InverseResult", "simulate_inverse", "simulate_path", "posed", "drawn_inputs", "is_point_path"]
 
 #: Gauss-Newton iterations per target; the largest step of an R drive (degrees) and of a P
 #: drive (fraction of the length scale) in one iteration.
@@ -131,6 +131,49 @@ def simulate_inverse(mech: Mechanism, point: str, path: Any, *, start: dict[str,
                       if x is not None else ""))
         break
     return InverseResult(point, T, {n: U[:, k] for k, n in enumerate(names)}, reached, out, boundary, message)
+
+
+def is_point_path(mech: Mechanism, inputs: dict[str, Any]) -> bool:
+    """Whether ``inputs`` gives a point's path (one key, a named point or an undriven joint,
+    with rows of coordinates) rather than the drives' values."""
+    if len(inputs) != 1:
+        return False
+    (key, value), = inputs.items()
+    driven = {j.id for j in mech.joints if j.actuated}
+    known = key in mech.points or any(j.id == key for j in mech.joints)
+    return known and key not in driven and np.ndim(value) == 2
+
+
+def simulate_path(mech: Mechanism, inputs: dict[str, Any], **kwargs: Any) -> Any:
+    """:func:`mechsyn.kinematics.analysis.simulate` with a point's path as the input
+    (``{"tool": rows}``, :func:`is_point_path`): the drives' values by
+    :func:`simulate_inverse`, then the forward simulation at them (its ``inputs`` are the
+    drives'; ``kwargs`` go to ``simulate``). A path that leaves the workspace raises
+    :class:`~mechsyn.errors.MechsynInputError` naming where (call :func:`simulate_inverse`
+    for the part reached).
+
+    (``simulate`` itself does not dispatch here: this module is built on it, and the
+    package keeps no import cycle.)
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> s = simulate_path(ms.load("five_bar_5r"), {"tool": [[2.2, 3.4], [2.4, 3.3]]})
+    >>> sorted(s.inputs), s.point("tool").round(9).tolist()
+    (['A', 'E'], [[2.2, 3.4], [2.4, 3.3]])
+    """
+    if not is_point_path(mech, inputs):
+        raise MechsynInputError("give one point's path, e.g. {'tool': [[x, y], ...]}", field="inputs",
+                                hint="a named point or an undriven joint, with rows of its coordinates")
+    (point, path), = inputs.items()
+    res = simulate_inverse(mech, point, path)
+    if not res.ok:
+        raise MechsynInputError(res.message, field="inputs",
+                                hint="keep the path inside the workspace, or call simulate_inverse for the part reached")
+    points = kwargs.pop("points", None)
+    if points is not None and point not in points:
+        points = list(points) + [point]
+    return simulate(mech, res.inputs, points=points, **kwargs)
 
 
 def _fmt(p: Any) -> str:
