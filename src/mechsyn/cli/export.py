@@ -36,8 +36,8 @@ def _sweep(text: str | None):
 
 
 FileArg = Annotated[Path, typer.Argument(help="Planar mechanism file (YAML, JSON or a Pyslvs .pyslvs) with joint points.")]
-DxfOpt = Annotated[Optional[Path], typer.Option("--dxf", help="Write the link plates as DXF (needs the "
-    "`cad` extra: ezdxf).")]
+DxfOpt = Annotated[Optional[Path], typer.Option("--dxf", help="Write the link plates as DXF (ezdxf, "
+    "installed with mechsyn; $INSUNITS from the file's unit).")]
 WidthOpt = Annotated[Optional[float], typer.Option("--width", help="Plate width (default: a fifth of the "
     "shortest hole spacing).")]
 HoleOpt = Annotated[Optional[float], typer.Option("--hole", help="Pin diameter (default: 40% of the "

@@ -1,9 +1,9 @@
 """The plates of :func:`mechsyn.export.plates.link_plates` as a DXF drawing (ezdxf).
 
 Layers: ``OUTLINE`` (closed polylines with arcs, one per plate), ``HOLES`` (circles of
-the cut diameter), ``SLOTS`` (a slider's guide: closed polylines as wide as a hole), ``POINTS`` (small marker circles at named points, to drill or
-engrave) and ``LABELS`` (text, to engrave or hide). ezdxf is the optional extra
-``cad``: ``pip install mechsyn[cad]``.
+    # $INSUNITS: the file's unit; a file that names none is unitless (0), never metres
+    doc.units = _UNITS.get((layout.units or "").lower(), 0)
+    for name, color in (("OUTLINE", 7), ("HOLES", 1), ("SLOTS", 1), ("POINTS", 3), ("LABELS", 5)):
 
 References
 ----------
@@ -31,7 +31,7 @@ def _ezdxf():
         import ezdxf
     except ImportError:
         raise MechsynInputError("DXF export needs ezdxf", field="dxf",
-                                hint="pip install 'mechsyn[cad]'") from None
+                                hint="pip install ezdxf (a dependency of mechsyn)") from None
     return ezdxf
 
 
@@ -39,8 +39,8 @@ def layout_to_dxf(layout: PlateLayout):
     """An ezdxf document of the plates (R2010 DXF)."""
     ezdxf = _ezdxf()
     doc = ezdxf.new("R2010")
-    if layout.units and layout.units.lower() in _UNITS:
-        doc.units = _UNITS[layout.units.lower()]
+    # $INSUNITS: the file's unit; a file that names none is unitless (0), never metres
+    doc.units = _UNITS.get((layout.units or "").lower(), 0)
     for name, color in (("OUTLINE", 7), ("HOLES", 1), ("SLOTS", 1), ("POINTS", 3), ("LABELS", 5)):
         doc.layers.add(name, color=color)
     msp = doc.modelspace()

@@ -219,7 +219,7 @@ def link_plates(mech: Mechanism, width: float | None = None, hole_diameter: floa
         plates.append(_plate(n, holes_of[n], markers_of[n], cut, width, slots_of.get(n, []), axis_of.get(n)))
     sheet = _shelf_layout(plates, mech, width, width if gap is None else gap, sheet_width)
     return PlateLayout(mech.name, plates, float(width), float(hole_diameter), float(clearance),
-                       sheet, mech.attrs.get("units"), notes)
+                       sheet, mech.attrs.get("unit"), notes)
 
 
 _Marks = list[tuple[str, np.ndarray]]

@@ -33,12 +33,13 @@ def _f(v: float) -> str:
 
 def _svg(x0: float, y0: float, w: float, h: float, body: list[str], units: str | None,
          display_width: float | None = None) -> str:
-    """An SVG document: sized in ``units`` (mm, cm, in; else mm) or ``display_width`` pixels."""
+    """An SVG document: sized in ``units`` (mm, cm, in; metres written as millimetres, SVG
+    having no metre; mm when the file names none) or ``display_width`` pixels."""
     if display_width is not None:
         size = f'width="{_f(display_width)}" height="{_f(display_width * h / w)}"'
     else:
-        unit = units if units in ("mm", "cm", "in") else "mm"
-        size = f'width="{_f(w)}{unit}" height="{_f(h)}{unit}"'
+        unit, k = {"m": ("mm", 1000.0), "cm": ("cm", 1.0), "in": ("in", 1.0)}.get(units or "", ("mm", 1.0))
+        size = f'width="{_f(w * k)}{unit}" height="{_f(h * k)}{unit}"'
     return "\n".join([
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" {size} '
@@ -192,7 +193,7 @@ def mechanism_svg(sim: Any, k: int = 0, paths: list[str] | None = None, dimensio
         body.append(f'<text x="{_f(c[0] + 1.2 * lw)}" y="{_f(-c[1] - 1.2 * lw)}" font-family="sans-serif" '
                     f'font-size="{_f(3 * lw)}">{escape(name)}</text>')
     body.append("</g>")
-    return _svg(x0, -y1, w, h, body, mech.attrs.get("units"), display_width=800)
+    return _svg(x0, -y1, w, h, body, mech.attrs.get("unit"), display_width=800)
 
 
 def _global(sim: Any, link: str, at: np.ndarray, k: int) -> np.ndarray:

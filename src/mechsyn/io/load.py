@@ -306,6 +306,10 @@ def save(mech: Mechanism | dict[str, Any], path: str | os.PathLike[str]) -> None
     write_mechanism(mech, path)
 
 
+#: The length units a file may name (``unit``).
+UNITS = ("mm", "cm", "m", "in")
+
+
 class _Builder:
     """Resolves names, checks the semantics, converts to the model."""
 
@@ -573,6 +577,14 @@ class _Builder:
             out.append(tuple(ids))
         return tuple(out)
 
+    def unit(self, spec: Any) -> str | None:
+        """The file's length unit: ``unit``, else the older ``units`` when it names one of the
+        same (mm, cm, m, in); both given and different is refused."""
+        old = (spec.units or "").strip().lower() or None
+        if spec.unit and old and old in UNITS and old != spec.unit:
+            raise self.error(["unit"], f"unit {spec.unit} and units {spec.units} disagree", "keep unit only")
+        return spec.unit or (old if old in UNITS else None)
+
     def check_connected(self, links: Sequence[Link], joints: Sequence[Joint], path: list[Any]) -> None:
         parts = link_components([link.name for link in links], [j.links for j in joints])
         if len(parts) > 1:
@@ -645,7 +657,7 @@ class _Builder:
                 add_joints=tuple(sjoints), contours=scontours, external=ext, mobility=s.mobility,
             )
         attrs = {k: v for k, v in (("description", spec.description), ("source", spec.source),
-                                   ("units", spec.units)) if v}
+                                   ("units", spec.units), ("unit", self.unit(spec))) if v}
         # display only: the colour of a joint or point the file no longer has (deleted in the
         # studio, dropped by a synthesis) is let go rather than refusing the whole mechanism
         colors = {k: v for k, v in spec.colors.items() if k in by_id or k in points}
@@ -702,7 +714,7 @@ def mechanism_to_dict(mech: Mechanism) -> dict[str, Any]:
         d["contours"] = [list(c) for c in mech.contours]
     if mech.mobility is not None:
         d["mobility"] = mech.mobility
-    for key in ("description", "source", "units", "colors"):
+    for key in ("description", "source", "unit", "units", "colors"):
         if mech.attrs.get(key):
             d[key] = mech.attrs[key]
     if mech.attrs.get("loads"):

@@ -193,7 +193,11 @@ class MechanismFile(_Strict):
     )
     description: str | None = None
     source: str | None = Field(None, description="Where the mechanism comes from (paper, figure).")
-    units: str | None = None
+    unit: Literal["mm", "cm", "m", "in"] | None = Field(
+        None, description="The length unit of every coordinate (mm, cm, m or in): DXF $INSUNITS, SVG width and "
+                          "height. A file without one is unitless (DXF $INSUNITS 0), never taken for metres.",
+    )
+    units: str | None = Field(None, description="The older spelling of unit (kept on reading; write unit).")
     colors: dict[str, str] = Field(
         default_factory=dict,
         description="Display colours by joint id or point name, as Pyslvs writes them (Green, "

@@ -50,7 +50,7 @@ from starlette.staticfiles import StaticFiles
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.results import write_atomic
-from mechsyn.web import _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
+from mechsyn.web import _design, _files, _service, _spatial, _studio  # _spatial: the 3-D view (view3d)
 from mechsyn.web._jobs import HeavyRunner, JobTable
 from mechsyn.web import _schema as S
 from mechsyn.web._routing import _client, _heavy, _json_error, _parsed, api
@@ -374,6 +374,7 @@ def _routes() -> list:
         Route("/api/jobs/{job}/events", _job_events),
         *_studio.routes(),
         *_spatial.routes(),  # view3d: POST /api/spatial/view
+        *_design.routes(),  # issue 40: dimensions, Burmester curves, instant centres, robots
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]
 

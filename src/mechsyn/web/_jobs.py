@@ -198,7 +198,7 @@ class ServerStopping(Exception):
 
 
 #: The web modules whose functions heavy calls may name as ``"module:function"``.
-SERVICE_MODULES = ("_service", "_studio", "_spatial")
+SERVICE_MODULES = ("_service", "_studio", "_spatial", "_design")
 
 
 def service_function(name: str | Callable[..., Any]) -> Callable[..., Any]:

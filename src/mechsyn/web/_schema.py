@@ -148,6 +148,45 @@ class CurveParams(Body):
 class MotionParams(Body):
     targets: Points
     angles: list[Number] | None = None
+    #: two moving pivots picked for 3 poses (drawing coordinates at pose 1)
+    pivots: Annotated[list[Annotated[list[Number], Field(min_length=2, max_length=2)]],
+                      Field(min_length=2, max_length=2)] | None = None
+    #: the unbuildable linkages too (left out by default)
+    all: bool = False
+
+
+class BurmesterBody(Body):
+    """The linkage of two moving pivots picked for 3 poses (the Synthesis tab's drag)."""
+
+    targets: Points
+    angles: list[Number]
+    pivots: Annotated[list[Annotated[list[Number], Field(min_length=2, max_length=2)]],
+                      Field(min_length=2, max_length=2)] | None = None
+
+
+class DimensionBody(MechanismBody):
+    """A typed dimension: ``change`` names the dimension and its new value."""
+
+    change: dict[str, Any]
+
+
+class PoseBody(MechanismBody):
+    """Every drive's value (``{drive: value}``)."""
+
+    values: dict[str, Number]
+
+
+class ReachBody(MechanismBody):
+    """A point of a link taken to a target (inverse kinematics)."""
+
+    point: Annotated[str, Field(min_length=1, max_length=200)]
+    target: Annotated[list[Number], Field(min_length=2, max_length=3)]
+
+
+class CentresBody(MechanismBody):
+    """Instant centres at the drive values ``inputs`` (the drawn pose when absent)."""
+
+    inputs: dict[str, Number] | None = None
 
 
 #: The parameters of each synthesis kind (a kind not listed: a JSON object of bounded numbers).

@@ -440,6 +440,7 @@ def analyze(data: Any) -> dict[str, Any]:
 def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
     """The non-isomorphic chains with ``n_links`` links and ``mobility``, with a drawing layout."""
     from mechsyn.synthesis.chains import synthesize_chains
+    from mechsyn.synthesis.curves.topologies import chain_name, six_bar_name
     from mechsyn.synthesis.mechanisms import chain_layout, distinct_mechanisms
 
     if not (4 <= n_links <= 10):
@@ -447,9 +448,11 @@ def atlas(n_links: int, mobility: int) -> list[dict[str, Any]]:
     out = []
     for k, chain in enumerate(synthesize_chains(n_links, mobility)):
         link_xy, joint_xy = chain_layout(chain)
-        out.append({"index": k, "label": chain.assortment_label(), "chain": chain.to_dict(),
-                    "link_xy": link_xy.tolist(), "joint_xy": joint_xy.tolist(),
-                    "mechanisms": [{"frame": c.frame, "input": c.input} for c in distinct_mechanisms(chain)]})
+        name = chain_name(chain)  # Watt, Stephenson (issue 40)
+        out.append({"index": k, "label": chain.assortment_label() + (f", {name}" if name else ""), "name": name,
+                    "chain": chain.to_dict(), "link_xy": link_xy.tolist(), "joint_xy": joint_xy.tolist(),
+                    "mechanisms": [{"frame": c.frame, "input": c.input, "name": six_bar_name(chain, c.frame)}
+                                   for c in distinct_mechanisms(chain)]})
     return out
 
 
@@ -529,7 +532,7 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
                 "label": f"error {res.error:.4g} (sum of squared distances), branch {branch:+d}, "
                          f"{'feasible' if res.feasible else 'infeasible'}",
                 "design": {k: float(v) for k, v in d.items() if not k.startswith("theta2")},
-                "path": _xy(res.path), "seconds": float(res.seconds),
+                "path": _xy(res.path), "curve": _fourbar_curve(d, branch), "seconds": float(res.seconds),
                 "quality": _fourbar_quality(d, res)}
         if res.feasible:
             item["mechanism"] = fourbar_mechanism_dict(
@@ -538,6 +541,17 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
         results.append(item)
     results.sort(key=lambda r: (not r["feasible"], r["error"]))
     return {"kind": "fourbar_path", "targets": case.targets.tolist(), "results": results}
+
+
+def _fourbar_curve(d: dict[str, float], branch: int) -> list:
+    """The coupler point's whole curve over a crank turn (360 positions, None where the
+    four-bar does not assemble): the candidate previewed on hover."""
+    from mechsyn.synthesis.fourbar import fourbar_position
+
+    th = np.linspace(0.0, 2 * np.pi, 361)
+    pose = fourbar_position(d["r1"], d["r2"], d["r3"], d["r4"], th, branch=branch, rcx=d["rcx"], rcy=d["rcy"],
+                            x0=d["x0"], y0=d["y0"], theta0=d["theta0"])
+    return _xy(np.where(np.asarray(pose.assembled)[:, None], np.asarray(pose.C).reshape(-1, 2), np.nan))
 
 
 def _fourbar_quality(d: dict[str, float], res: Any) -> dict[str, Any]:

@@ -38,9 +38,8 @@ from mechsyn.io import load_mechanism
 from mechsyn.kinematics.analysis import forces as _forces
 from mechsyn.results import to_jsonable
 from mechsyn.structure.report import analyze as structure_report
-from mechsyn.synthesis.export import fourbar_mechanism_dict
-from mechsyn.synthesis.reports import motion_report
 from mechsyn.web import _service
+from mechsyn.web._design import motion_results
 from mechsyn.web._routing import _heavy, _parsed, api
 from mechsyn.web._schema import ForcesBody, MechanismBody, mechanism_types
 from mechsyn.web._spatial import check_note
@@ -253,9 +252,10 @@ def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 
 
 def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
     """Motion generation through 3 to 5 clicked poses (``params["targets"]`` [x, y] and
-    ``params["angles"]`` in degrees): Burmester theory (``mechsyn synth motion``:
-    :func:`mechsyn.synthesis.reports.motion_report`), each four-bar verified by simulation,
-    ranked defect-free first, then by the smallest transmission angle."""
+    ``params["angles"]`` in degrees): Burmester theory, each four-bar verified by simulation,
+    labelled and ranked by :func:`mechsyn.synthesis.motion_choice.motion_choices` (the
+    unbuildable ones left out unless ``params["all"]``); for 3 poses, with two moving pivots
+    ``params["pivots"]`` (drawing coordinates at pose 1) the linkage they give."""
 
     T = np.asarray(params.get("targets"), float)
     A = np.asarray(params.get("angles", [0.0] * len(T)), float)
@@ -265,20 +265,9 @@ def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
     if A.shape != (len(T),) or not np.isfinite(A).all():
         raise MechsynInputError("give one angle (degrees) per pose", field="angles")
     progress({"done": 0, "total": 1, "best": None})
-    report = motion_report(np.column_stack([T, np.radians(A)]), top=5)
-    results = []
-    for r in report.all_solutions[:5]:
-        d = r.design()
-        mech = fourbar_mechanism_dict(d["r1"], d["r2"], d["r3"], d["r4"], float(r.theta2[0]), branch=r.branch,
-                                      rcx=d["rcx"], rcy=d["rcy"], x0=d["x0"], y0=d["y0"], theta0=d["theta0"],
-                                      name="Four-bar motion generator (Burmester)")
-        err = float(r.position_error)
-        results.append({"error": err, "feasible": bool(r.ok), "mechanism": mech, "path": T.tolist(),
-                        "label": f"error {err:.3g} (largest distance at a pose), min μ {r.min_transmission_deg:.0f}°"
-                                 + ("" if r.ok else ", not verified: a branch or order defect")})
-    progress({"done": 1, "total": 1, "best": min((x["error"] for x in results), default=None)})
-    return {"kind": "motion", "targets": T.tolist(), "results": results,
-            "notes": [f"{report.count} linkages found, {report.verified_count} verified by simulation"]}
+    out = motion_results(np.column_stack([T, np.radians(A)]), params.get("pivots"), bool(params.get("all", False)))
+    progress({"done": 1, "total": 1, "best": min((x["error"] for x in out["results"]), default=None)})
+    return out
 
 
 # the documented extension point of the studio's synthesis kinds

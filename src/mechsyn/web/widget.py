@@ -34,7 +34,8 @@ import traitlets  # noqa: E402  (installed with anywidget)
 STATIC = Path(__file__).parent / "static"
 MODULES = ("vendor/uPlot.esm.js", "api.js", "draw.js", "checks.js", "numeric.js", "keys.js", "files.js", "player.js",
            "synthesis.js", "atlas.js", "plots.js", "analysis.js", "examples.js", "forces.js", "view3d.js", "tabs3d.js",
-           "studio.js")  # view3d.js, tabs3d.js: spatial files; uPlot: the charts (plots.js)
+           "dimensions.js", "burmester.js", "robot.js", "centres.js", "design.js",
+           "studio.js")  # view3d.js, tabs3d.js: spatial files; uPlot: the charts (plots.js); design.js mounts its four
 
 
 def _body_markup() -> str:

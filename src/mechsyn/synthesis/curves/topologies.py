@@ -36,7 +36,7 @@ from mechsyn.synthesis import canonical
 from mechsyn.synthesis.chains import KinematicChain, synthesize_chains
 from mechsyn.synthesis.mechanisms import distinct_mechanisms, mechanism_dict
 
-__all__ = ["CurveTopology", "curve_topologies", "six_bar_name"]
+__all__ = ["CurveTopology", "curve_topologies", "six_bar_name", "chain_name"]
 
 TRACER = "T"
 
@@ -108,6 +108,26 @@ class CurveTopology:
         return out
 
 
+def chain_name(chain: KinematicChain) -> str | None:
+    """The chain's name in the literature: the four-bar chain, and the two six-bar chains of
+    two ternary and four binary links, Watt's (the ternary links jointed to each other) and
+    Stephenson's (not); None for the others.
+
+    Examples
+    --------
+    >>> from mechsyn.synthesis.chains import synthesize_chains
+    >>> sorted(chain_name(c) for c in synthesize_chains(6, 1))
+    ['Stephenson chain', 'Watt chain']
+    """
+    deg = chain.degrees()
+    if chain.n_links == 4 and deg == [2, 2, 2, 2]:
+        return "four-bar chain"
+    tern = [i for i, d in enumerate(deg) if d == 3]
+    if chain.n_links != 6 or len(tern) != 2 or sorted(deg) != [2, 2, 2, 2, 3, 3]:
+        return None
+    return "Watt chain" if chain.graph().has_edge(*tern) else "Stephenson chain"
+
+
 def six_bar_name(chain: KinematicChain, frame: int) -> str | None:
     """Watt I/II or Stephenson I/II/III by the frame link (see the module doc)."""
     if chain.n_links == 4:
@@ -116,6 +136,8 @@ def six_bar_name(chain: KinematicChain, frame: int) -> str | None:
         return None
     deg = chain.degrees()
     tern = [i for i, d in enumerate(deg) if d == 3]
+    if len(tern) != 2 or sorted(deg) != [2, 2, 2, 2, 3, 3]:
+        return None
     g = chain.graph()
     watt = g.has_edge(*tern)
     if deg[frame] == 3:

@@ -188,6 +188,7 @@ export function draw(svg, state) {
     if (!colour) for (const id of m.joints) if (muAt[id] !== undefined && muClass(muAt[id])) cls = " " + muClass(muAt[id]);
     if (invalid.has(`link:${name}`)) cls += " invalid";
     const g = el("g", { "data-link": name, "data-group": groupOf[name] }, layers.links);
+    if (sel === `link:${name}`) g.setAttribute("data-selected", "true");
     // a group colour is set through the CSSOM: a presentation attribute loses to the class rules
     const paint = (e, fill) => { if (colour && !cls.includes("invalid")) { e.style.stroke = colour; if (fill) e.style.fill = colour; } return e; };
     if (pts.length === 2) {
@@ -260,9 +261,11 @@ export function draw(svg, state) {
       const a = (((state.targetAngles || [])[i] || 0) * Math.PI) / 180;
       el("line", { x1: px, y1: py, x2: px + 26 * Math.cos(a), y2: py - 26 * Math.sin(a), class: "pose-tick", "data-pose": i }, layers.marks);
     }
-    labels(layers.labels, px + 9, py + 4, `T${i + 1}`);
+    if (state.targets.length <= 12) labels(layers.labels, px + 9, py + 4, `T${i + 1}`); // many: no labels
   });
   if (state.preview) el("path", { d: pathD(v, state.preview), class: "synth-path" }, layers.marks);
+  // what other modules draw (burmester.js, robot.js, centres.js): f(layer, view, pos)
+  for (const f of Object.values(state.overlays || {})) f(layers.marks, v, pos, labels);
   // the link being built
   if (state.building && state.building.length) {
     const pts = state.building.map((b) => P(b.point));

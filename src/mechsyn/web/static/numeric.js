@@ -108,7 +108,7 @@ export function pointFields(name, p, edit) {
 }
 
 // The Joints tab: every joint (id, x, y, type, links, drive, slide angle) and every bar's length.
-export function jointTable(m, selected, edit, select) {
+export function jointTable(m, selected, edit, select, onLength = null) {
   if (m.kind !== "planar") return spatialJointTable(m, selected, edit, select);
   const t = jointsHead(["joint", "x", "y", "type", "links", "drive", "angle °"]);
   for (const j of m.joints) {
@@ -122,7 +122,7 @@ export function jointTable(m, selected, edit, select) {
       j.type === "P" ? numberInput(axisAngle(j), (v) => edit((n) => { n.joints.find((q) => q.id === j.id).axis = axisOf(v); })) : h("span", "")];
     t.append(withCells(tr, cells, ["", "x", "y", "type", "links", "drive", "angle"]));
   }
-  return [h("h3", "Joints"), t, h("h3", "Bar lengths (the second joint moves along the bar)"), barTable(m, edit)];
+  return [h("h3", "Joints"), t, h("h3", onLength ? "Bar lengths (re-assembled on the drawn branch, the other lengths kept)" : "Bar lengths (the second joint moves along the bar)"), barTable(m, edit, onLength)];
 }
 
 // The joint table's head row, a joint's row (its name selects it), its drive box, its cells.
@@ -150,13 +150,13 @@ function withCells(tr, cells, fields) {
   return tr;
 }
 
-function barTable(m, edit) {
+function barTable(m, edit, onLength = null) {
   const lt = h("table", null, { className: "numtable" });
   lt.dataset.table = "links";
   const lh = h("tr"); for (const c of ["link", "joints", "length"]) lh.append(h("th", c)); lt.append(lh);
   for (const r of twoJointLinks(m)) {
     const tr = h("tr"); tr.dataset.row = r.name;
-    const inp = numberInput(r.length, (v) => { if (v > 0) edit((n) => setLength(n, r.name, v)); });
+    const inp = numberInput(r.length, (v) => { if (!(v > 0)) return; if (onLength) onLength(r.name, v); else edit((n) => setLength(n, r.name, v)); });
     inp.dataset.field = "length";
     const td = h("td"); td.append(inp);
     tr.append(h("td", r.name), h("td", `${r.a}–${r.b}`), td);

@@ -14,6 +14,7 @@ import { autosave, forgetWork, guardUnload, mountFiles, savedWork, startProblem 
 import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
 import { mountSpatialTabs } from "./tabs3d.js"; // the Plots and Forces tabs of spatial files
+import { mountDesign } from "./design.js"; // issue 40: dimensions, Burmester choice, robots, instant centres
 
 // Mount the studio on `root` (the page's document, or a notebook widget's element holding
 // the same markup); `onChange(mechanism)` hears every edit (the notebook widget syncs it).
@@ -42,6 +43,7 @@ function render() {
     renderBanner();
     renderPlayer();
     view3d.update(); // view3d: the 3-D view, its slider range and banner lines
+    designUi.update(); // issue 40: drive sliders, tool point, instant centres, planar modes hidden in 3-D
     if (spatial()) spatialUi.cursor(); else renderPlots();
     forcesUi.cursor(state.frame);
   } catch (e) {
@@ -72,7 +74,7 @@ function renderBanner() {
   if (sim && !sim.assembled[state.home] && state.simFor === state.mech)
     items.push(div("err", "not assembled at the drawn pose: the links cannot meet where they are drawn. Drag a joint until they do, or type its x and y in the Element tab"));
   else if (sim && !sim.assembled[state.frame]) items.push(div("note", "not assembled at this input: outside the working range"));
-  for (const n of state.notes) items.push(div("note", n));
+  for (const n of state.notes.concat(designUi.notes())) items.push(div("note", n));
   const b = $("banner");
   b.replaceChildren(...items);
   b.dataset.level = items.length ? items[0].className : "";
@@ -395,6 +397,7 @@ svg.addEventListener("pointerdown", (ev) => {
     renderElement();
     return;
   }
+  if (mode === "select" && linkEl && !jointId && !pointEl) { state.selected = { kind: "link", id: linkEl.dataset.link }; render(); renderElement(); }
   if (mode === "select" || (mode !== "select" && ev.button === 1)) {
     gesture = { kind: "pan", x: ev.clientX, y: ev.clientY, view: { ...state.view } };
     svg.setPointerCapture(ev.pointerId);
@@ -486,6 +489,7 @@ function renderElement() {
   const box = $("tab-element"), sel = state.selected, m = state.mech;
   if (!sel || !m) { box.replaceChildren(h("p", "Click a joint or point with Select to edit it (clicking again where joints coincide selects the next).", { className: "muted" })); return; }
   const out = [];
+  if (sel.kind === "link") return designUi.linkElement(box, m, sel.id);
   if (sel.kind === "joint") {
     const j = m.joints.find((x) => x.id === sel.id);
     if (!j) { state.selected = null; return renderElement(); }
@@ -500,6 +504,7 @@ function renderElement() {
     links.onchange = () => edit((n) => setLinks(n, j.id, links.value));
     const row = (label, ...els) => { const p = h("p"); p.append(h("label", label + " "), ...els); return p; };
     out.push(...jointFields(j, edit), row("pair type", type), row("links", links), row("drive", drive));
+    if (j.type === "P") out.push(designUi.guideRows(m, j.id)); // issue 40: the guide's offset and angle
     const del = h("button", "Delete joint"); del.onclick = () => deleteJoint(j.id); out.push(del);
   } else {
     const p = (m.points || {})[sel.id];
@@ -527,15 +532,16 @@ function renderJoints() {
   const m = state.mech;
   if (!m) return;
   const sel = state.selected && state.selected.kind === "joint" ? state.selected.id : null;
-  $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }));
+  $("tab-joints").replaceChildren(...jointTable(m, sel, edit, (id) => { state.selected = { kind: "joint", id }; render(); renderElement(); }, designUi.setLength));
 }
 
 function renderPlots() { if (spatial()) spatialUi.renderPlots(); else planarPlots(); } // plots.js: the planar charts
 
 // ------------------------------------------------------------------ player, synthesis, atlas
+const designUi = mountDesign({ $, root, state, render, setMech, rebase, setMode: (m) => setMode(m), showTab: (t) => showTab(t) });
 const setPlaying = mountPlayer({ $, state, render, assembledNear });
 const planarPlots = mountPlots({ $, state, render, assembledNear });
-const synthUi = mountSynthesis({ $, state, render, setMech });
+const synthUi = mountSynthesis({ $, state, render, setMech, setMode: (m) => setMode(m), design: designUi });
 mountAtlas({ $, state, render, setMech });
 const spatialUi = mountSpatialTabs({ $, state, render, showTab });
 const forcesUi = mountForces({ $, state, render, edit, stepsFor, spatialLines: spatialUi.forcesLines });

@@ -3,10 +3,10 @@
 import { call, eventsUrl, transport } from "./api.js";
 import { h } from "./numeric.js";
 
-// `ctx`: {$, state, render, setMech}; returns {renderPoses} (called when a target is added).
-export function mountSynthesis({ $, state, render, setMech }) {
+// `ctx`: {$, state, render, setMech, setMode, design}; returns {renderPoses} (called when a target is added).
+export function mountSynthesis({ $, state, render, setMech, setMode = () => {}, design = null }) {
   let source = null, job = null;
-  $("clear-targets").onclick = () => { state.targets = []; state.targetAngles = []; state.preview = null; $("target-count").textContent = 0; renderPoses(); render(); };
+  $("clear-targets").onclick = () => { state.targets = []; state.targetAngles = []; state.preview = null; state.previewResult = null; state.motionCurves = null; $("target-count").textContent = 0; renderPoses(); render(); };
 
   // Motion through poses: each clicked target is a pose of the guided body, its angle typed here
   // (degrees, counter-clockwise from x) and drawn as a tick on the canvas.
@@ -23,7 +23,14 @@ export function mountSynthesis({ $, state, render, setMech }) {
       a.dataset.pose = i;
       a.onchange = () => { const v = Number(a.value); if (!Number.isFinite(v)) return; state.targetAngles = poseAngles(); state.targetAngles[i] = v; render(); };
       const td = h("td"); td.append(a);
-      const tr = h("tr"); tr.append(h("td", `T${i + 1}`), h("td", String(p[0])), h("td", String(p[1])), td);
+      // a pose's x and y typed (issue 40)
+      const xy = [0, 1].map((k) => {
+        const c = h("input", null, { value: String(p[k]), size: 6 });
+        c.dataset.poseXy = i; c.dataset.coord = "xy"[k];
+        c.onchange = () => { const v = Number(c.value); if (!Number.isFinite(v)) return; state.targets[i] = state.targets[i].slice(); state.targets[i][k] = v; render(); };
+        const cell = h("td"); cell.append(c); return cell;
+      });
+      const tr = h("tr"); tr.append(h("td", `T${i + 1}`), ...xy, td);
       t.append(tr);
     });
     $("synth-poses").replaceChildren(h("p", "Click 3 to 5 poses (Targets), then type each pose's angle.", { className: "muted" }), t);
@@ -53,6 +60,7 @@ export function mountSynthesis({ $, state, render, setMech }) {
         // the status line tells what the list shows: its best error, not the search's internal one
         $("synth-status").textContent = `${snap.state}: ${rs.length} result${rs.length === 1 ? "" : "s"}` +
           (errs.length ? `, best error ${Math.min(...errs).toPrecision(4)}` : "") + ` in ${snap.seconds} s`;
+        state.motionCurves = snap.result.curves || null;
         showResults(rs);
         $("synth-notes").replaceChildren(...(snap.result.notes || []).map((n) => h("li", n)));
       }
@@ -75,17 +83,19 @@ export function mountSynthesis({ $, state, render, setMech }) {
       li.dataset.result = i;
       li.append(`${r.label} `);
       const q = r.quality || (r.candidate && r.candidate.quality);
-      if (q) li.append(h("span", ` size ${(+q.size).toPrecision(3)} (${(+q.size_ratio).toFixed(1)}× the target), links ${(+q.link_ratio).toFixed(1)}:1, min μ ${(+q.min_transmission_angle).toFixed(0)}°${q.full_turn ? ", full turn" : ""} `, { className: "quality" }));
+      if (q && q.link_ratio !== undefined) li.append(h("span", ` size ${(+q.size).toPrecision(3)} (${(+q.size_ratio).toFixed(1)}× the target), links ${(+q.link_ratio).toFixed(1)}:1, min μ ${(+q.min_transmission_angle).toFixed(0)}°${q.full_turn ? ", full turn" : ""} `, { className: "quality" }));
       if (r.mechanism) {
         const b = h("button", "Apply"); b.dataset.apply = i;
-        b.onclick = () => { state.preview = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); };
+        b.onclick = () => { state.preview = null; state.previewResult = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); setMode("select"); };
         li.append(b);
       }
-      li.onmouseenter = () => { state.preview = r.path; render(); };
+      // hover: the candidate's whole curve (and, for motion, its pivots) over the targets
+      li.onmouseenter = () => { state.preview = r.curve || r.path; state.previewResult = r; render(); if (design) design.burmester.renderBox(); };
       return li;
     });
     $("synth-results").replaceChildren(...items);
-    if (results.length) { state.preview = results[0].path; render(); }
+    if (results.length) { state.preview = results[0].curve || results[0].path; state.previewResult = results[0]; render(); }
+    if (design) design.burmester.renderBox();
   }
   return { renderPoses };
 }

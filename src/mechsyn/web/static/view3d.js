@@ -160,6 +160,7 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     for (const j of view.joints) items.push([scr[j.id][2] + 1e-3 * L, jointElement(j, pos[j.id], (j.axes || [])[k] || [], P, L, j.id === sel)]);
     items.sort((a, b) => a[0] - b[0]);
     for (const [, e] of items) svg.append(e);
+    declutter();
     triad(W, H);
     v3.draws += 1;
   }
@@ -194,9 +195,28 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
       const y = c[1] + 12;
       el("path", { d: `M${c[0] - 9} ${y}h18M${c[0] - 8} ${y + 5}l4 -5M${c[0] - 2} ${y + 5}l4 -5M${c[0] + 4} ${y + 5}l4 -5`, stroke: "#667", "stroke-width": 1.5, fill: "none" }, g);
     }
-    el("text", { x: (c[0] + 9).toFixed(1), y: (c[1] - 9).toFixed(1), "font-size": 11, fill: "#345" }, g, j.id);
+    el("text", { x: (c[0] + 9).toFixed(1), y: (c[1] - 9).toFixed(1), "font-size": 11, fill: "#345", class: "view3d-label", "data-at": `${c[0]},${c[1]}` }, g, j.id);
     if (selected) g.setAttribute("data-selected", "true");
     return g;
+  }
+
+  // joint labels that do not overlap (issue 40: a Delta's platform has six joints close
+  // together): each label takes the first free place of a ring of places round its joint
+  function declutter() {
+    const placed = [], free = (b) => !placed.some((o) => b.x < o.x + o.w && o.x < b.x + b.w && b.y < o.y + o.h && o.y < b.y + b.h);
+    for (const t of svg.querySelectorAll("text.view3d-label")) {
+      const [cx, cy] = t.dataset.at.split(",").map(Number), w = 7 * t.textContent.length + 2, hh = 12;
+      let box = null;
+      for (let ring = 1; ring <= 4 && !box; ring++) for (let k = 0; k < 8 && !box; k++) {
+        const a = (-Math.PI / 4) + (k * Math.PI) / 4, r = 9 + 11 * (ring - 1);
+        const x = cx + r * Math.cos(a) - (Math.cos(a) < -0.1 ? w : Math.cos(a) < 0.1 ? w / 2 : 0), y = cy - r * Math.sin(a) + 4;
+        const b = { x, y: y - hh + 2, w, h: hh };
+        if (free(b)) box = b;
+      }
+      if (!box) { t.setAttribute("visibility", "hidden"); continue; } // crowded out: the joint is still drawn
+      placed.push(box);
+      t.setAttribute("x", box.x.toFixed(1)); t.setAttribute("y", (box.y + box.h - 2).toFixed(1));
+    }
   }
 
   function triad(W, H) { // the axes x, y, z at the lower left corner
