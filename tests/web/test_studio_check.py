@@ -89,3 +89,23 @@ def test_dxf_needs_ezdxf_or_gives_plates(client, fourbar):
         assert r.status_code == 400 and "ezdxf" in r.json()["error"] and r.json()["hint"]
     else:
         assert r.status_code == 200 and "SECTION" in r.text
+
+
+def test_the_check_reads_the_finite_mobility_and_names_a_redundant_bar(client):
+    """A four-bar drawn folded moves with one drive (instantaneous mobility 2, finite 1); one
+    pulled taut cannot move (finite mobility 0); the double parallelogram moves and says which
+    bar is redundant; a pivot just placed is a next step, not a file error."""
+    def ex(name):
+        return mechanism_to_dict(load_mechanism(example_path(name)))
+
+    assert diagnostics(client, ex("fourbar_folded"))["diagnostics"] == []
+    (taut,) = diagnostics(client, ex("fourbar_taut"))["diagnostics"]
+    assert taut["blocks"] and taut["message"].startswith("cannot move") and "finite mobility 0" in taut["message"]
+    (dup,) = diagnostics(client, ex("double_parallelogram"))["diagnostics"]
+    assert not dup["blocks"] and "crank2 or crank3 is redundant" in dup["message"]
+    assert dup["elements"] == [{"kind": "link", "id": "crank2"}, {"kind": "link", "id": "crank3"}]
+    pivot = {"name": "n", "kind": "planar", "ground": "frame", "links": ["frame"],
+             "joints": [{"id": "A", "type": "R", "links": ["frame"], "point": [0, 0]}]}
+    (first,) = diagnostics(client, pivot)["diagnostics"]
+    assert first["level"] == "note" and "not joined to a moving link yet" in first["message"]
+    assert "links: [" not in first["message"]

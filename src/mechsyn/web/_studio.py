@@ -171,16 +171,24 @@ def geometry_problems(data: dict[str, Any], mech, rank, mobility: int) -> list[d
     return out
 
 
+#: The most bars :func:`_redundant_bars` removes one by one (a rank analysis each, ~10 ms).
+MAX_BARS_TRIED = 12
+
+
 def _redundant_bars(data: dict[str, Any], rank) -> list[dict[str, Any]]:
     """A note naming the bars (links of two pins) any one of which repeats a constraint of the
     others: removed, the mechanism keeps its motion and loses the redundant constraint."""
     names = [link if isinstance(link, str) else str(link.get("name")) for link in data.get("links", [])]
     ground = data.get("ground", "frame")
-    bars = []
+    candidates = []
     for name in names:
         js = [j for j in data["joints"] if name in j.get("links", [])]
-        if name == ground or len(js) != 2 or any(j.get("type") != "R" or j.get("actuated") for j in js):
-            continue
+        if name != ground and len(js) == 2 and not any(j.get("type") != "R" or j.get("actuated") for j in js):
+            candidates.append((name, js))
+    if len(candidates) > MAX_BARS_TRIED:  # a rank analysis each: the check stays quick on big files
+        return []
+    bars = []
+    for name, js in candidates:
         rest = {**data, "links": [x for x, n in zip(data["links"], names) if n != name],
                 "joints": [j for j in data["joints"] if j not in js],
                 "points": {k: p for k, p in (data.get("points") or {}).items() if p.get("link") != name}}
@@ -191,12 +199,10 @@ def _redundant_bars(data: dict[str, Any], rank) -> list[dict[str, Any]]:
         if r is not None and r.redundant_constraints < rank.redundant_constraints and \
                 r.finite_mobility == rank.finite_mobility:
             bars.append(name)
-        if len(bars) > 6:
-            break
     if not bars:
         return []
     q = rank.redundant_constraints
-    which = bars[0] if len(bars) == 1 else "any one of " + _names(bars).replace(" and ", " or ")
+    which = bars[0] if len(bars) == 1 else "any one of " + ", ".join(bars[:-1]) + " or " + bars[-1]
     return [_diag("note", f"{which} is redundant ({q} redundant constraint{'s' if q > 1 else ''}): it repeats a "
                   "constraint the other links already make, so removing it leaves the motion as it is. It still moves "
                   "only because its dimensions are exact (equal, parallel bars); made with a small error it would jam "
