@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import time
 
-#: ``time.perf_counter()`` when the command line began loading: a command's time limit
-#: (``synth curve --time-limit``) counts from here, its own imports included.
+#: ``time.perf_counter()`` when the command line began loading (or :func:`main` was called
+#: in-process with ``argv``): a command's time limit (``synth curve --time-limit``) counts
+#: from here, its own imports included.
 STARTED = time.perf_counter()
 
 import contextlib  # noqa: E402
@@ -141,6 +142,9 @@ def main(argv: list[str] | None = None) -> int:
     143 and ``terminated`` (searches have written their best result so far, marked as
     interrupted, before that).
     """
+    global STARTED
+    if argv is not None:  # called in-process (not as the console script): its time counts from now
+        STARTED = time.perf_counter()
     try:
         pass_ = _pass_for(argv)  # its imports (NumPy) before the handlers: not cut in half by a signal
         previous = handle_sigterm()

@@ -2,8 +2,10 @@
 that trace a drawn curve (retrieval from a local curve database, then least-squares
 refinement). Modules: ``topologies`` (candidates from the atlas), ``descriptors``
 (invariant Fourier descriptors, closed-form alignment), ``database`` (build / load),
-``target`` (CSV, JSON, SVG targets), ``synthesis`` (:func:`synthesize_curve`),
-``plot`` (figures; imports Matplotlib lazily).
+``index`` (nearest descriptors, Faiss), ``target`` (CSV, JSON, SVG targets), ``fitting``
+(the error measure, bounds, the least-squares problem), ``frame`` (the working frame),
+``candidates`` (the answer and its ranking), ``synthesis`` (:func:`synthesize_curve`, the
+anytime search); figures in :mod:`mechsyn.plot.curves`.
 """
 
 from typing import Any

@@ -5,14 +5,16 @@ query. Up to :data:`EXACT_UP_TO` rows the search is exact (``faiss.IndexFlatL2``
 brute-force scan: a few milliseconds at 100,000 rows of 20 numbers); above it, an
 inverted-file index (``faiss.IndexIVFFlat``: ``sqrt(n)`` k-means cells, trained once on
 a fixed sample, :data:`N_PROBE` cells visited per query) keeps a query at a million
-curves within milliseconds (``benchmarks/curve_retrieval.py``).
+curves within milliseconds (``benchmarks/curve_retrieval.py``: median 2.4 ms). Searches
+run on one thread: for a few queries OpenMP's threads cost more than they give.
 
 Faiss (J. Johnson, M. Douze and H. Jégou, "Billion-scale similarity search with GPUs",
 *IEEE Transactions on Big Data* 7(3), 535-547, 2021) is chosen over hnswlib and usearch:
 it installs from PyPI as a wheel on Linux, macOS and Windows (hnswlib ships only a source
-archive, last released in 2023, and needs a compiler), its inverted-file index builds a
-million 20-number descriptors in seconds where a graph index (HNSW, both others) took
-about 100 s for 100,000 here, and with one thread the built index and every answer are
+archive, last released in 2023, and needs a compiler), its inverted-file index built a
+million real curve descriptors in 21 s on one thread of a loaded 2-core machine where a
+graph index (HNSW, both others) took 105 s for 100,000, and with one thread the built
+index and every answer are
 deterministic.
 """
 
@@ -62,6 +64,13 @@ class DescriptorIndex:
     def search(self, queries: np.ndarray, k: int) -> np.ndarray:
         """Row indices ``(m, k)`` of the nearest descriptors to each query, nearest first
         (fewer than ``k`` rows: all of them; an inverted file's missing ones dropped)."""
+        import faiss
+
         q = np.ascontiguousarray(np.atleast_2d(queries), dtype=np.float32)
-        _, ii = self._index.search(q, min(k, self.n))
+        threads = faiss.omp_get_max_threads()
+        faiss.omp_set_num_threads(1)   # a few queries: threads cost more than they give (70 ms against 2 at load)
+        try:
+            _, ii = self._index.search(q, min(k, self.n))
+        finally:
+            faiss.omp_set_num_threads(threads)
         return ii

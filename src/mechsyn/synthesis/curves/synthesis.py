@@ -33,7 +33,7 @@ reported as a diagnostic of the timing only.
 refinement and the final checks, whose cost is measured on the first candidate and
 reserved). The best retrieved designs are evaluated as they are first (an answer at any
 limit, labelled "not refined"); then a deterministic sequence of refinements runs: the
-first round of retrieved seeds (four-bars first), then rounds that refine the best
+first round of retrieved seeds (the four-bars every third), then rounds that refine the best
 design of each of the three leading topologies longer, restart about it (every joint
 and the tracer, the coupler point free on its plane, moved at random, seeded by the
 round) and widen to further retrieved seeds, eight-bars among them. An evaluation past
@@ -286,7 +286,7 @@ def synthesize_curve(
     top : int
         Candidates returned (see ``prefer``; the first three of distinct topologies).
     n_refine, retrieve : int
-        Designs refined in the first round (four-bars first with ``prefer="simple"``),
+        Designs refined in the first round (every third a four-bar with ``prefer="simple"``),
         and nearest descriptors retrieved per query and link count.
     refinements : int, optional
         A fixed number of refinements (the start of the sequence a timed run follows).
@@ -604,8 +604,8 @@ class _Run:
         round depends only on the candidates so far, so the sequence is deterministic."""
         simple = self.o["prefer"] == "simple"
         first = _diverse(seeds, self.o["n_refine"], simple=simple)
-        if simple:  # four-bars first (one within tolerance is never missed), then by rank
-            first.sort(key=lambda s: (s.topo.n_links != 4, s.rank, s.row))
+        if simple:  # the four-bars (a third) every third, so they hold a third of any shorter time too
+            first = _every_third(first)
         yield from ((s, self.o["max_nfev"]) for s in first)
         used = {id(s) for s in first}
         rest = [s for s in seeds if id(s) not in used]
@@ -635,6 +635,25 @@ class _Run:
         for c in sorted(self.cands, key=lambda c: (c.chamfer, c.topology.key)):
             best.setdefault(c.topology.key, c)
         return list(best.values())[:LEADERS]
+
+
+def _every_third(seeds: list[_Seed]) -> list[_Seed]:
+    """The four-bars at places 0, 3, 6, ... (by rank), the others between them (by rank).
+
+    >>> from types import SimpleNamespace as S
+    >>> s = [S(topo=S(n_links=n), rank=r, row=r) for r, n in enumerate([6, 8, 4, 6, 4, 8, 4, 6])]
+    >>> [x.topo.n_links for x in _every_third(s)]
+    [4, 6, 8, 4, 6, 8, 4, 6]
+    """
+    fours = sorted((s for s in seeds if s.topo.n_links == 4), key=lambda s: (s.rank, s.row))
+    others = sorted((s for s in seeds if s.topo.n_links != 4), key=lambda s: (s.rank, s.row))
+    out: list[_Seed] = []
+    while fours or others:
+        if fours:
+            out.append(fours.pop(0))
+        out += others[:2]
+        others = others[2:]
+    return out
 
 
 def _seed_of(c: CurveCandidate, params: np.ndarray | None = None) -> _Seed:
