@@ -174,7 +174,7 @@ PRELOAD = ["mechsyn.web._service", "mechsyn.web._studio", "mechsyn.web._spatial"
            "mechsyn.kinematics.analysis", "mechsyn.structure.report", "mechsyn.structure.assur",
            "mechsyn.synthesis.chains", "mechsyn.synthesis.mechanisms", "mechsyn.synthesis.optimize",
            "mechsyn.synthesis.path", "mechsyn.synthesis.export", "mechsyn.synthesis.curves.database",
-           "mechsyn.synthesis.curves.synthesis"]
+           "mechsyn.synthesis.curves.synthesis", "mechsyn.web._warm"]
 
 
 class Busy(Exception):
@@ -240,17 +240,21 @@ def _label(name: str | Callable[..., Any]) -> str:
     return name if isinstance(name, str) else getattr(name, "__name__", "job")
 
 
-def _worker(conn, name: str | Callable[..., Any], args: tuple, with_progress: bool) -> None:
+#: The niceness of a worker by lane: the server's own process (answering other clients)
+#: goes first for the CPU; a quick call and a job less far behind than a heavy request (at
+#: nice 10 on a machine busy with other programs, a worker got a fraction of a percent of a
+#: core: a 2 s search took minutes, a four-bar's check 0.3 s instead of 0.08 s).
+NICE = {"quick": 5, "job": 5, "request": 10}
+
+
+def _worker(conn, name: str | Callable[..., Any], args: tuple, with_progress: bool, nice: int = 10) -> None:
     """Worker process: ``_service.<name>(*args)`` (and a progress callback when asked) sent
     back as ("ok", result), ("input", error fields) or ("bug", traceback text), after any
     number of ("progress", state); a request's dict or list result as :class:`RawJSON`."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the server's to handle
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if hasattr(os, "nice"):
-        # the server's own process (answering other clients) goes first for the CPU; a job
-        # less far behind (a worker at nice 10 on a machine busy with other programs got a
-        # fraction of a percent of a core: a 2 s search took minutes)
-        os.nice(5 if with_progress else 10)
+        os.nice(nice)  # :data:`NICE`
     last = [0.0]
 
     def progress(state: dict) -> None:
@@ -456,7 +460,7 @@ class HeavyRunner:
                 await ticket.wait(0.25)
             if not self.isolate:
                 return await self._in_thread(name, args, progress)
-            return await self._in_process(gone, name, args, limit, progress)
+            return await self._in_process(gone, name, args, limit, progress, lane)
         finally:
             self._release(ticket)
 
@@ -466,11 +470,12 @@ class HeavyRunner:
         return await run_in_threadpool(service_function(name), *args, *((progress,) if progress else ()))
 
     # ------------------------------------------------------------------ one worker
-    async def _in_process(self, gone: Callable[[], Any], name, args: tuple, limit: float | None, progress) -> Any:
+    async def _in_process(self, gone: Callable[[], Any], name, args: tuple, limit: float | None, progress,
+                          lane: str = "request") -> Any:
         loop = asyncio.get_running_loop()
         parent, child = self._ctx.Pipe(duplex=False)
-        proc = self._ctx.Process(target=_worker, args=(child, name, args, progress is not None), daemon=True,
-                                 name=f"mechsyn-{_label(name)}")
+        proc = self._ctx.Process(target=_worker, args=(child, name, args, progress is not None, NICE[lane]),
+                                 daemon=True, name=f"mechsyn-{_label(name)}")
         try:
             await loop.run_in_executor(None, proc.start)
         except (EOFError, OSError) as exc:  # the fork server was stopped (the server stops) or died
