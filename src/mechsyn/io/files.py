@@ -68,10 +68,11 @@ FREE_TEXT_KEYS = frozenset({"name", "title", "description", "notes", "note", "co
 _BRACKETS = re.compile(r"[\[\]{}]")
 
 
-def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
+def read_text(path: str | os.PathLike[str], what: str = "file", cap: int | None = None) -> str:
     """The UTF-8 text of ``path``; :class:`MechsynInputError` when it cannot be read.
 
-    ``what`` names the kind of file in messages (``"case file"``, ``"table"``...).
+    ``what`` names the kind of file in messages (``"case file"``, ``"table"``...); ``cap``
+    is a smaller size limit than ``file_bytes`` for a kind of file that is always small.
     """
     from mechsyn.examples import resolve
 
@@ -87,7 +88,7 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         raise MechsynInputError(f"no such {what}", source=str(p), hint=missing_hint(p))
     if p.is_dir():
         raise MechsynInputError(f"is a directory, not a {what}", source=str(p))
-    data = read_limited(p, what)
+    data = read_limited(p, what, cap)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -97,18 +98,18 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         ) from None
 
 
-def read_limited(path: str | os.PathLike[str], what: str = "file") -> bytes:
+def read_limited(path: str | os.PathLike[str], what: str = "file", cap: int | None = None) -> bytes:
     """The bytes of ``path``: a regular file (not a device such as ``/dev/zero``, a FIFO or
-    a socket, refused at once) of at most ``file_bytes`` bytes (the size is checked before
-    reading and the read stops one byte past the limit, so a file growing meanwhile is
-    refused too).
+    a socket, refused at once) of at most ``file_bytes`` bytes, or ``cap`` when that is
+    smaller (the size is checked before reading and the read stops one byte past the
+    limit, so a file growing meanwhile is refused too).
 
     >>> read_limited("/dev/zero")
     Traceback (most recent call last):
     ...
     mechsyn.errors.MechsynInputError: /dev/zero: not a regular file (a device, FIFO or socket) (fix: give the path of a file)
     """
-    cap = int(limit("file_bytes"))
+    cap = int(limit("file_bytes")) if cap is None else min(int(cap), int(limit("file_bytes")))
     too_big = f"{what} larger than the limit of {cap:,} bytes"
     try:
         info = os.stat(path)
