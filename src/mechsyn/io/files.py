@@ -23,6 +23,7 @@ import json
 import os
 import re
 import stat
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -55,7 +56,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
 __all__ = ["is_mechanism_file", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
-           "check_id_text"]
+           "check_id_text", "existing_regular", "read_json_lines"]
 
 #: Bidirectional controls and zero-width characters: they make two ids that look alike
 #: differ, or reorder what a terminal shows ("Trojan Source", CVE-2021-42574).
@@ -131,6 +132,61 @@ def read_limited(path: str | os.PathLike[str], what: str = "file", cap: int | No
     if len(data) > cap:
         raise MechsynInputError(too_big, source=str(path), hint=limit_hint("file_bytes"))
     return data
+
+
+def existing_regular(path: str | os.PathLike[str], what: str = "file") -> bool:
+    """Whether ``path`` exists, refusing (:class:`MechsynInputError`) one that exists and is
+    not a regular file: a directory, a device such as ``/dev/zero``, a FIFO (opening it
+    would block) or a socket, which must be neither read as a file nor replaced by one.
+
+    >>> existing_regular("/dev/zero", "chain stream")
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: /dev/zero: the chain stream is not a regular file (a directory, device, FIFO or socket) (fix: give the path of a file)
+    """
+    try:
+        info = os.stat(path)
+    except FileNotFoundError:
+        return False
+    except OSError as exc:
+        raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path)[:200],
+                                hint="check the path and its permissions") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise MechsynInputError(f"the {what} is not a regular file (a directory, device, FIFO or socket)",
+                                source=str(path), hint="give the path of a file")
+    return True
+
+
+def read_json_lines(path: str | os.PathLike[str], what: str = "file",
+                    line_bytes: int = 1 << 20) -> Iterator[tuple[int, Any]]:
+    """``(number, value)`` of each line of a JSON-lines file, each line read with at most
+    ``line_bytes`` characters and parsed with the nesting limit (a line of 10,000 nested
+    brackets is refused, not a RecursionError); a line that is not JSON gives
+    ``(number, None)`` (a torn last line of an interrupted run is dropped by the caller)."""
+    if not existing_regular(path, what):
+        raise MechsynInputError(f"no such {what}", source=str(path))
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    with os.fdopen(fd, encoding="utf-8", errors="strict") as fh:
+        number = 0
+        while True:
+            number += 1
+            try:
+                line = fh.readline(line_bytes + 1)
+            except UnicodeDecodeError as exc:
+                raise MechsynInputError(f"not UTF-8 text ({exc.reason})", source=str(path), line=number,
+                                        hint="delete the file (or give another) and run again") from None
+            if not line:
+                return
+            if len(line) > line_bytes:
+                raise MechsynInputError(f"a line longer than {line_bytes:,} characters", source=str(path),
+                                        line=number, hint="delete the file (or give another) and run again")
+            if _bracket_depth(line) > limit("nesting"):
+                raise MechsynInputError(f"nested more than {limit('nesting')} levels deep", source=str(path),
+                                        line=number, hint="delete the file (or give another) and run again")
+            try:
+                yield number, json.loads(line)
+            except ValueError:  # a syntax error, or an integer of thousands of digits
+                yield number, None
 
 
 def _bracket_depth(text: str) -> int:
