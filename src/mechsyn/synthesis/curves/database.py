@@ -156,6 +156,18 @@ class CurveDatabase:
         return cache[n_links]
 
 
+def _database_dir(directory: str | os.PathLike[str] | None) -> Path:
+    """The database's directory (default :func:`default_database_dir`); a path that exists
+    and is not a directory (a file, a device, a FIFO) is refused naming it."""
+    path = Path(directory) if directory is not None else default_database_dir()
+    if path.exists() and not path.is_dir():
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError("the curve database is not a directory", source=str(path), field="database",
+                                hint="give the directory of a curve database (or a new one to build)")
+    return path
+
+
 def _file(directory: Path, topo: CurveTopology) -> Path:
     return directory / f"{topo.key}.npz"
 
@@ -255,7 +267,7 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
     ``dask.distributed`` address or ``Client``) the topologies are built on a Dask
     cluster and written here.
     """
-    directory = Path(directory) if directory is not None else default_database_dir()
+    directory = _database_dir(directory)
     directory.mkdir(parents=True, exist_ok=True)
     topos = curve_topologies(max_links)
     todo = []
@@ -348,7 +360,7 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
                   build_if_missing: bool = True, callback: Callable[[dict], None] | None = None) -> CurveDatabase:
     """Read the database (topologies up to ``max_links``); build the default small one
     (4- and 6-bars) first when there is none."""
-    directory = Path(directory) if directory is not None else default_database_dir()
+    directory = _database_dir(directory)
     topos = curve_topologies(max(max_links, 4))
     present = [t for t in topos if _file(directory, t).exists()]
     if not present and build_if_missing:
