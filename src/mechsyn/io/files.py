@@ -56,7 +56,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
 __all__ = ["is_mechanism_file", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
-           "check_id_text", "existing_regular", "read_json_lines"]
+           "check_id_text", "existing_regular", "read_json_lines", "id_skeleton", "confusable_id", "visible_text"]
 
 #: Bidirectional controls and zero-width characters: they make two ids that look alike
 #: differ, or reorder what a terminal shows ("Trojan Source", CVE-2021-42574).
@@ -242,13 +242,95 @@ def check_id_text(text: str, source: str, field: str = "", free: bool = False) -
     if _SURROGATE.search(text):
         raise MechsynInputError(f"{text[:40]!r} holds a lone surrogate (not text)", source=source,
                                 field=field or None, hint="save the file as UTF-8 text")
-    hidden = None if free else HIDDEN_CHARS.search(text)
+    if free:
+        return text
+    hidden = HIDDEN_CHARS.search(text)
     if hidden:
         raise MechsynInputError(f"{text[:40]!r} holds the invisible character U+{ord(hidden.group()):04X}",
                                 source=source, field=field or None,
                                 hint="type the id again without it; ids may not hold bidirectional "
                                      "controls or zero-width characters")
+    import unicodedata
+
+    if len(text) <= 1000 and unicodedata.normalize("NFKC", text) != text:
+        raise MechsynInputError(f"{text[:40]!r} is not in its normal form (NFKC)", source=source, field=field or None,
+                                hint=f"write it as {unicodedata.normalize('NFKC', text)[:40]!r}")
+    scripts = _scripts(text)
+    if len(scripts) > 1 and text.translate(_CONFUSABLE) != text:  # e.g. "Аlpha": a Cyrillic А in Latin
+        look = next(ch for ch in text if ch.translate(_CONFUSABLE) != ch)
+        raise MechsynInputError(f"{text[:40]!r} mixes the scripts {', '.join(sorted(scripts)).lower()}: "
+                                f"U+{ord(look):04X} looks like the Latin {look.translate(_CONFUSABLE)!r}",
+                                source=source, field=field or None,
+                                hint="write each id in one script")
     return text
+
+
+#: Non-Latin letters drawn like Latin ones (Cyrillic and Greek capitals and small letters
+#: of Unicode's confusables.txt that map to one ASCII letter): the part of a TR39 skeleton
+#: that matters for ids typed in files.
+_CONFUSABLE = str.maketrans(
+    "АВЕЅІЈКМНОРСТХУҮѴԜԚԌаеіјоѕрсхуԁԛԝһӏѵ"    # Cyrillic
+    "ΑΒΕΖΗΙΚΜΝΟΡΤΥΧοινρυχκ",                   # Greek
+    "ABESIJKMHOPCTXYYVWQGaeijospcxydqwhlv"
+    "ABEZHIKMNOPTYXoivpuxk")
+#: scripts written together (Japanese, Korean): one script for the mixing check
+_ONE_SCRIPT = {"HIRAGANA": "CJK", "KATAKANA": "CJK", "HANGUL": "CJK"}
+
+
+def id_skeleton(text: str) -> str:
+    """What an id looks like: its NFKC form with Cyrillic and Greek look-alikes of Latin
+    letters replaced by them (a small TR39 skeleton). Two ids with the same skeleton
+    cannot be told apart on screen.
+
+    >>> id_skeleton("А") == id_skeleton("A")  # Cyrillic A, Latin A
+    True
+    >>> id_skeleton("Ａ₂")  # fullwidth A, subscript two
+    'A2'
+    """
+    import unicodedata
+
+    return text if text.isascii() else unicodedata.normalize("NFKC", text).translate(_CONFUSABLE)
+
+
+def confusable_id(text: str, seen: dict[str, str]) -> str | None:
+    """The id in ``seen`` (skeleton -> id, filled as ids are read) that ``text`` looks like
+    without being it, else ``None`` (and ``text`` is recorded).
+
+    >>> seen = {}
+    >>> confusable_id("A", seen), confusable_id("B", seen), confusable_id("А", seen)
+    (None, None, 'A')
+    """
+    key = id_skeleton(text)
+    other = seen.setdefault(key, text)
+    return other if other != text else None
+
+
+def _scripts(text: str) -> set[str]:
+    """The scripts of the letters of ``text`` (the first word of each letter's Unicode
+    name: LATIN, CYRILLIC, GREEK...; CJK ideographs count as one)."""
+    import unicodedata
+
+    out = set()
+    for ch in text:
+        if ch.isalpha() and not ch.isascii():
+            word = unicodedata.name(ch, "UNKNOWN").split()[0]
+            out.add(_ONE_SCRIPT.get(word, word))
+        elif ch.isalpha():
+            out.add("LATIN")
+    return out
+
+
+def visible_text(text: str, mark: bool = False) -> str:
+    r"""``text`` fit to show: bidirectional controls and zero-width characters removed, or
+    with ``mark`` written out as ``<U+202E>`` (for a page or a status line; a right-to-left
+    override would otherwise reorder what follows it).
+
+    >>> visible_text("four‮bar"), visible_text("four‮bar", mark=True)
+    ('fourbar', 'four<U+202E>bar')
+    """
+    if text.isascii():
+        return text
+    return HIDDEN_CHARS.sub((lambda m: f"<U+{ord(m.group()):04X}>") if mark else "", text)
 
 
 class _JSONDuplicate(ValueError):
