@@ -147,6 +147,8 @@ class RestartCheckpoint:
                               "index": ck._index(data["partial"]["index"], "partial.index")}
             done = data.get("done") or {}
             ck.done = {str(k): v for k, v in done.items()}
+        except MechsynInputError:
+            raise
         except (TypeError, KeyError, ValueError, AttributeError, OverflowError) as exc:
             raise MechsynInputError(f"damaged checkpoint ({type(exc).__name__})", source=str(path),
                                     field="finished", hint=_AFRESH) from None

@@ -110,7 +110,9 @@ def read_limited(path: str | os.PathLike[str], what: str = "file", cap: int | No
     ...
     mechsyn.errors.MechsynInputError: /dev/zero: not a regular file (a device, FIFO or socket) (fix: give the path of a file)
     """
-    cap = int(limit("file_bytes")) if cap is None else min(int(cap), int(limit("file_bytes")))
+    general = int(limit("file_bytes"))
+    hint = limit_hint("file_bytes") if cap is None or cap >= general else f"a {what} is far smaller"
+    cap = general if cap is None else min(int(cap), general)
     too_big = f"{what} larger than the limit of {cap:,} bytes"
     try:
         info = os.stat(path)
@@ -119,7 +121,7 @@ def read_limited(path: str | os.PathLike[str], what: str = "file", cap: int | No
                                     hint="give the path of a file")
         if info.st_size > cap:
             raise MechsynInputError(f"{what} of {info.st_size:,} bytes is larger than the limit of {cap:,}",
-                                    source=str(path), hint=limit_hint("file_bytes"))
+                                    source=str(path), hint=hint)
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO swapped in never blocks
         with os.fdopen(fd, "rb") as fh:
             if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
@@ -130,7 +132,7 @@ def read_limited(path: str | os.PathLike[str], what: str = "file", cap: int | No
         raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path),
                                 hint="check the path and its permissions") from None
     if len(data) > cap:
-        raise MechsynInputError(too_big, source=str(path), hint=limit_hint("file_bytes"))
+        raise MechsynInputError(too_big, source=str(path), hint=hint)
     return data
 
 
