@@ -370,3 +370,40 @@ def test_a_signal_at_each_phase_after_stage_one_keeps_it(message):
     assert res.interrupted and res.variants
     v = res.variants[0]
     assert v.design == v.stage1_design and np.isfinite(v.error_rms) and "criterion" in v.forces
+
+
+# ------------------------------------------------------------------ one schema per shape: wrong types
+def _edited(tmp_path, source: Path, change) -> Path:
+    """``source`` changed, written into a copy of its folder in ``tmp_path`` (relative paths kept by
+    copying the folder)."""
+    import shutil
+
+    folder = tmp_path / source.parent.name
+    shutil.copytree(source.parent, folder)
+    shutil.copytree(source.parent.parent / "textbook", tmp_path / "textbook", dirs_exist_ok=True)
+    f = folder / source.name
+    data = json.loads(f.read_text()) if f.suffix == ".json" else yaml.safe_load(f.read_text())
+    change(data)
+    f.write_text(json.dumps(data) if f.suffix == ".json" else yaml.safe_dump(data))
+    return f
+
+
+@pytest.mark.parametrize("source, args, change, words", [
+    ("fingers/finger_design_case.yaml", ["synth", "finger-design"],
+     lambda d: d.setdefault("optimizer", {}).update(vll_steps=1e308), "optimizer.vll_steps: 1e+308 is outside"),
+    ("fingers/finger_design_case.yaml", ["synth", "finger-design"],
+     lambda d: d.setdefault("optimizer", {}).update(maxiter="40"), "optimizer.maxiter: expected a whole number"),
+    ("fingers/finger_design_case.yaml", ["synth", "finger-design"],
+     lambda d: d.update(gravity=[9.81]), "gravity must be one number"),
+    ("synthesis/path_cases_public.json", ["synth", "path"], lambda d: d.update(cases=True), "cases must be a list"),
+    ("synthesis/path_cases_public.json", ["synth", "path", "--case", CASE],
+     lambda d: d["cases"][0]["best_known"].update(value=[1, "a"]), "best_known.value must be one number"),
+    ("synthesis/sixbar_path_case.yaml", ["synth", "mechanism"],
+     lambda d: d["input"].update(free="false"), "input.free: must be true or false, not str 'false'"),
+    ("synthesis/sixbar_path_case.yaml", ["synth", "mechanism"],
+     lambda d: d["variables"][0].update(length="no"), "variables[0].length: must be true or false"),
+])
+def test_wrongly_typed_settings_are_one_line_naming_the_field(run_cli, tmp_path, source, args, change, words):
+    f = _edited(tmp_path, ROOT / "examples" / source, change)
+    msg = _exit2(run_cli, *args[:2], f, *args[2:], "--time-limit", "1")
+    assert f.name in msg and words in msg, msg

@@ -108,6 +108,7 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
     :data:`MAX_TARGET_BYTES` bytes read); JSON by :func:`mechsyn.io.files.loads_json`
     (a key written twice, deep nesting and non-finite numbers refused).
     """
+    from mechsyn.io.checks import flag
     from mechsyn.io.files import check_data_size, loads_json, read_text
 
     p = Path(path)
@@ -126,10 +127,7 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
         if unknown:
             raise MechsynInputError(f"unknown key {unknown[0]!r}", source=src, field=unknown[0][:80],
                                     hint='a target holds "points" and, optionally, "closed" and "name"')
-        closed = data.get("closed")
-        if closed is not None and not isinstance(closed, bool):
-            raise MechsynInputError(f"must be true or false, not {type(closed).__name__} {closed!r:.40}",
-                                    source=src, field="closed", hint="write true or false without quotes")
+        closed = None if data.get("closed") is None else flag(data["closed"], src, "closed")
         return target_from_points(_pairs(data["points"], src), closed, src)
     if suffix == ".svg":
         d = _first_path_data(text)
