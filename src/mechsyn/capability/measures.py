@@ -150,13 +150,16 @@ def _lp_block(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarray:
     """:func:`exact_limit_lp` of the configurations ``J (B, m, n)`` as one program; a
     configuration whose program HiGHS does not solve (never seen) is solved alone."""
     from scipy.optimize import linprog  # lazy: 0.5 s of start-up
-    from scipy.sparse import block_diag
+    from scipy.sparse import csr_matrix
 
     B, m, n = J.shape
-    A = block_diag([np.hstack([J[k], -d[k][:, None]]) for k in range(B)], format="csr")
+    k = n + 1  # columns of a block: the joint rates, then s
+    rows = np.concatenate([J, -d[:, :, None]], axis=2).reshape(-1)  # each row of each block, dense
+    cols = (np.arange(B)[:, None, None] * k + np.arange(k)[None, None, :]).repeat(m, axis=1).reshape(-1)
+    A = csr_matrix((rows, cols, np.arange(B * m + 1) * k), shape=(B * m, B * k))
     c = np.tile(np.r_[np.zeros(n), -1.0], B)
-    lo = np.concatenate([np.r_[-w[k], 0.0] for k in range(B)])
-    hi = np.concatenate([np.r_[w[k], np.inf] for k in range(B)])
+    lo = np.concatenate([-w, np.zeros((B, 1))], axis=1).reshape(-1)
+    hi = np.concatenate([w, np.full((B, 1), np.inf)], axis=1).reshape(-1)
     res = linprog(c, A_eq=A, b_eq=np.zeros(B * m), bounds=np.c_[lo, hi], method="highs")
     if res.status == 0:
         return np.maximum(res.x.reshape(B, n + 1)[:, -1], 0.0)
