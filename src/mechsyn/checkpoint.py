@@ -140,17 +140,31 @@ class RestartCheckpoint:
                                     field="kind", hint=f"resume it with mechsyn {data.get('kind')}")
         ck._check_key(data.get("key"))
         try:
-            ck.finished = {int(i): _record(r, str(path), f"finished[{i}]", dim)
+            ck.finished = {ck._index(i, f"finished[{str(i)[:20]}]"): _record(r, str(path), f"finished[{i}]", dim)
                            for i, r in (data.get("finished") or {}).items()}
             if data.get("partial"):
                 ck.partial = {**_record(data["partial"], str(path), "partial", dim),
-                              "index": int(data["partial"]["index"])}
+                              "index": ck._index(data["partial"]["index"], "partial.index")}
             done = data.get("done") or {}
             ck.done = {str(k): v for k, v in done.items()}
+        except MechsynInputError:
+            raise
         except (TypeError, KeyError, ValueError, AttributeError, OverflowError) as exc:
             raise MechsynInputError(f"damaged checkpoint ({type(exc).__name__})", source=str(path),
                                     field="finished", hint=_AFRESH) from None
         return ck
+
+    def _index(self, text: Any, where: str) -> int:
+        """A restart index read from the file: an integer in ``0 ... restarts - 1`` when the
+        key holds the number of restarts (a forged ``-7`` or ``99999`` never counts as done)."""
+        if isinstance(text, bool) or not isinstance(text, (int, str)) or not (str(text).isascii() and str(text).isdigit()):
+            raise MechsynInputError(f"restart index {str(text)[:20]!r} is not a whole number", source=str(self.path),
+                                    field=where, hint=_AFRESH)
+        index, restarts = int(text), self.key.get("restarts")
+        if isinstance(restarts, int) and not 0 <= index < restarts:
+            raise MechsynInputError(f"restart index {index} is outside 0 ... {restarts - 1}", source=str(self.path),
+                                    field=where, hint=_AFRESH)
+        return index
 
     def _check_key(self, saved: Any) -> None:
         if not isinstance(saved, dict):

@@ -158,7 +158,7 @@ def test_cli_synth_curve_and_curves_build(small_db, tmp_path, cli_json, run_cli)
     assert c["links"] == 4 and c["topology"] == "four-bar" and c["tracer"] == "T"
     assert (out / "candidate_1.yaml").exists() and (out / "candidate_1.png").exists()
     code, _, err = run_cli("synth", "curve", tmp_path / "missing.csv", "--database", small_db)
-    assert code == 2 and "not found" in err
+    assert code == 2 and "no such target file" in err
     s = cli_json("curves", "build", "--links", "4", "--per-topology", "50", "--database", tmp_path / "db")
     assert s["curves"] == 50 and s["topologies"] == 1
 

@@ -244,15 +244,41 @@ def _cycle(joint: ET.Element, src: str) -> MechsynInputError:
                              hint="a URDF is a tree: remove the joint that closes the loop")
 
 
+def _urdf_numbers(joint: ET.Element, tag: str, attr: str, default: str, src: str, count: int = 3) -> list[float]:
+    """``count`` numbers of attribute ``attr`` of the joint's child ``tag`` (``default``
+    when absent), each finite and within the limit ``coordinate`` (1e100): one line naming
+    the joint and the attribute otherwise (no overflow in what is computed from them)."""
+    from mechsyn.limits import limit, limit_hint
+
+    el = joint.find(tag)
+    text = el.get(attr, default) if el is not None else default
+    where = f"joint {str(joint.get('name'))[:80]!r}: <{tag} {attr}=\"{text[:60]}\">"
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != count:
+        raise MechsynInputError(f"{where} is not {'a number' if count == 1 else f'{count} numbers'}", source=src,
+                                hint="give one number" if count == 1 else f"give {count} numbers separated by spaces")
+    big = limit("coordinate")
+    if not all(math.isfinite(v) and abs(v) <= big for v in values):
+        raise MechsynInputError(f"{where} holds a number that is not finite or beyond {big:g} in magnitude",
+                                source=src, hint="give ordinary finite numbers; " + limit_hint("coordinate"))
+    return values
+
+
 def _urdf_axis(joint: ET.Element, src: str) -> np.ndarray:
-    """The unit axis of a URDF joint (default x); a zero or non-finite axis is refused."""
-    ax = joint.find("axis")
-    axis = np.array([float(v) for v in (ax.get("xyz", "1 0 0") if ax is not None else "1 0 0").split()])
-    norm = float(np.linalg.norm(axis)) if axis.shape == (3,) else 0.0
-    if not (math.isfinite(norm) and norm > 0):
-        raise MechsynInputError(f"joint {joint.get('name')!r}: axis {' '.join(map(str, axis))!r} has no direction",
-                                source=src, hint="give <axis xyz=\"x y z\"/> with three numbers, not all zero")
-    return axis / norm
+    """The unit axis of a URDF joint (default x); a zero, non-finite or huge axis is
+    refused (the norm is taken of the axis scaled by its largest component, so no square
+    overflows)."""
+    axis = np.array(_urdf_numbers(joint, "axis", "xyz", "1 0 0", src))
+    big = float(np.abs(axis).max())
+    unit = axis / big if big > 0 else axis
+    norm = float(np.linalg.norm(unit))
+    if not norm > 0:
+        raise MechsynInputError(f"joint {str(joint.get('name'))[:80]!r}: axis {' '.join(map(str, axis))!r} has no "
+                                "direction", source=src, hint="give <axis xyz=\"x y z\"/> with three numbers, not all zero")
+    return unit / norm
 
 
 def _limits(spec: _Spec, rev: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -333,9 +359,8 @@ def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm
     fixed = [np.eye(4)]
     axes, types, names, lims, vels = [], [], [], [], []
     for j in chain:
-        o = j.find("origin")
-        xyz = [float(v) * s for v in (o.get("xyz", "0 0 0") if o is not None else "0 0 0").split()]
-        rpy = [float(v) for v in (o.get("rpy", "0 0 0") if o is not None else "0 0 0").split()]
+        xyz = [v * s for v in _urdf_numbers(j, "origin", "xyz", "0 0 0", src)]
+        rpy = _urdf_numbers(j, "origin", "rpy", "0 0 0", src)
         fixed[-1] = fixed[-1] @ _homog(_rpy(*rpy), xyz)
         jtype = j.get("type")
         if jtype == "fixed":
@@ -350,10 +375,12 @@ def _build_urdf(spec: URDFSpec, source: str | None, base_dir: Path) -> SerialArm
         lim = j.find("limit")
         f = 1.0 if rev else s
         if lim is not None and jtype != "continuous":
-            lims.append((float(lim.get("lower", "-inf")) * f, float(lim.get("upper", "inf")) * f))
+            lims.append(tuple(_urdf_numbers(j, "limit", k, "", src, 1)[0] * f if lim.get(k) is not None else inf
+                              for k, inf in (("lower", -np.inf), ("upper", np.inf))))
         else:
             lims.append((-np.inf, np.inf))
-        vels.append(float(lim.get("velocity")) * f if lim is not None and lim.get("velocity") else None)
+        vels.append(_urdf_numbers(j, "limit", "velocity", "", src, 1)[0] * f
+                    if lim is not None and lim.get("velocity") else None)
         fixed.append(np.eye(4))
     fixed[-1] = fixed[-1] @ _homog(p=spec.tool)
     n = len(types)

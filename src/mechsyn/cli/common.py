@@ -275,6 +275,9 @@ def check_writable(path: Path | None, option: str, directory: bool = False) -> N
     if path.exists() and path.is_dir() != directory:
         raise MechsynInputError(f"{path} is {'not ' if directory else ''}a directory", source=option,
                                 hint="give another path")
+    if not directory and path.exists() and not path.is_file():  # a device, FIFO or socket: never replaced
+        raise MechsynInputError(f"{path} is not a regular file (a device, FIFO or socket)", source=option,
+                                hint="give the path of a file")
     folder = path if directory else path.absolute().parent
     try:
         folder.mkdir(parents=True, exist_ok=True)

@@ -10,6 +10,7 @@ import typer
 from mechsyn.cli.common import check_writable, err_console, safe
 from mechsyn.cli.common import stop_if_interrupted as _stop
 from mechsyn.errors import MechsynInputError
+from mechsyn.io.files import existing_regular
 
 CheckpointOpt = Annotated[Optional[Path], typer.Option(
     "--checkpoint", help="Save finished restarts to this file as the run goes.")]
@@ -24,7 +25,7 @@ def checkpoint_options(checkpoint: Path | None, resume: Path | None) -> dict[str
         raise MechsynInputError("give --checkpoint or --resume, not both", source="--resume",
                                 hint="--resume FILE continues the run in FILE and keeps saving to it")
     if resume is not None:
-        if not resume.is_file():
+        if not existing_regular(resume, "checkpoint file"):
             raise MechsynInputError("no such checkpoint file", source=str(resume),
                                     hint="give the file written by --checkpoint (or start with --checkpoint FILE)")
         check_writable(resume, "--resume")

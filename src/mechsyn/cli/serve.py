@@ -75,6 +75,7 @@ def _open_browser(url: str) -> Path | None:
 def _start(target: str) -> tuple[Any, str]:
     """The mechanism a file or an example name opens with, and its name ("did you mean"
     for a mistyped example)."""
+    from mechsyn.io.files import existing_regular
     from mechsyn.web._service import example_path, read_mechanism
 
     path = Path(target)
@@ -89,7 +90,7 @@ def _start(target: str) -> tuple[Any, str]:
                 raise
             raise MechsynInputError(f"{target}: no such file or example", source="FILE",
                                     hint=f"did you mean {' or '.join(map(repr, close))}?") from None
-    elif not path.is_file():
+    elif not existing_regular(path, "mechanism file"):  # a device, FIFO, directory: refused by name
         raise MechsynInputError(f"{target}: no such file or example", source="FILE",
                                 hint="give a mechanism file or an example name such as fourbar")
     return read_mechanism(path), path.name

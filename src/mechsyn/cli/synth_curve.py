@@ -63,7 +63,9 @@ def _say_first_build(database: Optional[Path]) -> None:
     from mechsyn.synthesis.curves.database import default_database_dir
 
     where = database if database is not None else default_database_dir()
-    if not where.is_dir() or not any(where.iterdir()):
+    if where.exists() and not where.is_dir():
+        return  # not a directory: the library refuses it in one line
+    if not where.exists() or not any(where.iterdir()):
         err_console.print(f"building the curve database on first use (4-, 6- and 8-bar curves, once; later runs "
                           f"reuse it) in {escape(str(where))}", highlight=False, soft_wrap=True)
 

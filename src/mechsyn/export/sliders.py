@@ -22,6 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["SliderPart", "slider_parts"]
@@ -83,8 +86,6 @@ def slider_parts(mech: Mechanism) -> list[SliderPart]:
 
 def _drawn_coordinate(mech: Mechanism, joint: str) -> float | None:
     """The P joint's coordinate in the drawn configuration (the origin its ``limits`` use)."""
-    from mechsyn.errors import MechsynInputError
-    from mechsyn.kinematics.system import build_system
 
     try:
         S = build_system(mech)
@@ -95,9 +96,6 @@ def _drawn_coordinate(mech: Mechanism, joint: str) -> float | None:
 
 def _full_turn(mech: Mechanism):
     """The simulation of a full turn of the first drive (R) from its drawn value, or why not."""
-    from mechsyn.errors import MechsynInputError
-    from mechsyn.kinematics.analysis import simulate
-    from mechsyn.kinematics.system import build_system
 
     try:
         drivers = build_system(mech).drivers

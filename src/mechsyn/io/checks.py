@@ -228,6 +228,42 @@ def numbers(value: Any, source: str | None, field: str) -> np.ndarray:
     return a
 
 
+def flag(value: Any, source: str | None, field: str) -> bool:
+    """``value`` as a yes/no setting: ``true`` or ``false`` only (the string ``"false"`` is
+    not read as true, nor ``1`` as a flag).
+
+    >>> flag("false", "case.yaml", "input.free")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: case.yaml: input.free: must be true or false, not str 'false' ...
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise MechsynInputError(f"must be true or false, not {type(value).__name__} {value!r:.40}", source=source,
+                            field=field, hint="write true or false without quotes")
+
+
+def whole_number(value: Any, source: str | None, field: str, lowest: int = 1, highest: int = 10 ** 9) -> int:
+    """``value`` as an integer in ``[lowest, highest]``: a whole number (``3`` or ``3.0``),
+    not a boolean, a string or ``1e308`` (whose ``int`` has 309 digits).
+
+    >>> whole_number(40.0, "case.yaml", "optimizer.maxiter")
+    40
+    >>> whole_number("40", "case.yaml", "optimizer.maxiter")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: case.yaml: optimizer.maxiter: expected a whole number, got '40' ...
+    """
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+    if not ok or not np.isfinite(value) or float(value) != int(value):
+        raise MechsynInputError(f"expected a whole number, got {value!r:.40}", source=source, field=field,
+                                hint=f"write a number from {lowest:,} to {highest:,} without quotes")
+    if not lowest <= value <= highest:
+        raise MechsynInputError(f"{value:g} is outside {lowest:,} ... {highest:,}", source=source, field=field,
+                                hint=f"give a number from {lowest:,} to {highest:,}")
+    return int(value)
+
+
 def link_components(names: list[str], pairs: list[tuple[str, str]]) -> list[list[str]]:
     """The connected parts of the link graph (links joined by joints), smallest first.
 

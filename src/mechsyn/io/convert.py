@@ -40,8 +40,6 @@ def load_any(path: str | os.PathLike[str]) -> Mechanism:
     p = resolve_path(path)  # a bundled example's name stands for its file
     if p.suffix.lower() not in PYSLVS_SUFFIXES:
         return load_mechanism(p)
-    if not p.is_file():
-        raise MechsynInputError("no such file", source=str(p), hint="check the path")
     data, _ = read_pyslvs(read_text(p, "Pyslvs file"), str(p))  # regular file, size limit (issue 27)
     return mechanism_from_dict(data, str(p))
 
@@ -62,8 +60,6 @@ def convert_file(path: str | os.PathLike[str], to: str, inputs: list[tuple[int, 
     p = resolve_path(path)  # a bundled example's name stands for its file
     src, to = p.suffix.lower(), to.lower()
     if src in PYSLVS_SUFFIXES and to in MECHSYN_SUFFIXES:
-        if not p.is_file():
-            raise MechsynInputError("no such file", source=str(p), hint="check the path")
         text = read_text(p, "Pyslvs file")  # regular file, size limit, UTF-8 (issue 27)
         data, notes = read_pyslvs(text, str(p), inputs, name)
         mech = mechanism_from_dict(data, str(p))

@@ -23,6 +23,7 @@ import json
 import os
 import re
 import stat
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -55,7 +56,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 
 __all__ = ["is_mechanism_file", "resolve_path", "read_text", "read_limited", "parse_data", "read_data", "check_data_size", "loads_json",
-           "check_id_text"]
+           "check_id_text", "existing_regular", "read_json_lines", "id_skeleton", "confusable_id", "visible_text"]
 
 #: Bidirectional controls and zero-width characters: they make two ids that look alike
 #: differ, or reorder what a terminal shows ("Trojan Source", CVE-2021-42574).
@@ -81,10 +82,11 @@ def resolve_path(path: str | os.PathLike[str]) -> Path:
     return resolve(path)
 
 
-def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
+def read_text(path: str | os.PathLike[str], what: str = "file", cap: int | None = None) -> str:
     """The UTF-8 text of ``path``; :class:`MechsynInputError` when it cannot be read.
 
-    ``what`` names the kind of file in messages (``"case file"``, ``"table"``...).
+    ``what`` names the kind of file in messages (``"case file"``, ``"table"``...); ``cap``
+    is a smaller size limit than ``file_bytes`` for a kind of file that is always small.
     """
     from mechsyn.examples import resolve
 
@@ -100,7 +102,7 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         raise MechsynInputError(f"no such {what}", source=str(p), hint=missing_hint(p))
     if p.is_dir():
         raise MechsynInputError(f"is a directory, not a {what}", source=str(p))
-    data = read_limited(p, what)
+    data = read_limited(p, what, cap)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -110,18 +112,20 @@ def read_text(path: str | os.PathLike[str], what: str = "file") -> str:
         ) from None
 
 
-def read_limited(path: str | os.PathLike[str], what: str = "file") -> bytes:
+def read_limited(path: str | os.PathLike[str], what: str = "file", cap: int | None = None) -> bytes:
     """The bytes of ``path``: a regular file (not a device such as ``/dev/zero``, a FIFO or
-    a socket, refused at once) of at most ``file_bytes`` bytes (the size is checked before
-    reading and the read stops one byte past the limit, so a file growing meanwhile is
-    refused too).
+    a socket, refused at once) of at most ``file_bytes`` bytes, or ``cap`` when that is
+    smaller (the size is checked before reading and the read stops one byte past the
+    limit, so a file growing meanwhile is refused too).
 
     >>> read_limited("/dev/zero")
     Traceback (most recent call last):
     ...
     mechsyn.errors.MechsynInputError: /dev/zero: not a regular file (a device, FIFO or socket) (fix: give the path of a file)
     """
-    cap = int(limit("file_bytes"))
+    general = int(limit("file_bytes"))
+    hint = limit_hint("file_bytes") if cap is None or cap >= general else f"a {what} is far smaller"
+    cap = general if cap is None else min(int(cap), general)
     too_big = f"{what} larger than the limit of {cap:,} bytes"
     try:
         info = os.stat(path)
@@ -130,7 +134,7 @@ def read_limited(path: str | os.PathLike[str], what: str = "file") -> bytes:
                                     hint="give the path of a file")
         if info.st_size > cap:
             raise MechsynInputError(f"{what} of {info.st_size:,} bytes is larger than the limit of {cap:,}",
-                                    source=str(path), hint=limit_hint("file_bytes"))
+                                    source=str(path), hint=hint)
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO swapped in never blocks
         with os.fdopen(fd, "rb") as fh:
             if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
@@ -141,8 +145,63 @@ def read_limited(path: str | os.PathLike[str], what: str = "file") -> bytes:
         raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path),
                                 hint="check the path and its permissions") from None
     if len(data) > cap:
-        raise MechsynInputError(too_big, source=str(path), hint=limit_hint("file_bytes"))
+        raise MechsynInputError(too_big, source=str(path), hint=hint)
     return data
+
+
+def existing_regular(path: str | os.PathLike[str], what: str = "file") -> bool:
+    """Whether ``path`` exists, refusing (:class:`MechsynInputError`) one that exists and is
+    not a regular file: a directory, a device such as ``/dev/zero``, a FIFO (opening it
+    would block) or a socket, which must be neither read as a file nor replaced by one.
+
+    >>> existing_regular("/dev/zero", "chain stream")
+    Traceback (most recent call last):
+    ...
+    mechsyn.errors.MechsynInputError: /dev/zero: the chain stream is not a regular file (a directory, device, FIFO or socket) (fix: give the path of a file)
+    """
+    try:
+        info = os.stat(path)
+    except FileNotFoundError:
+        return False
+    except OSError as exc:
+        raise MechsynInputError(f"cannot read the {what}: {exc.strerror or exc}", source=str(path)[:200],
+                                hint="check the path and its permissions") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise MechsynInputError(f"the {what} is not a regular file (a directory, device, FIFO or socket)",
+                                source=str(path), hint="give the path of a file")
+    return True
+
+
+def read_json_lines(path: str | os.PathLike[str], what: str = "file",
+                    line_bytes: int = 1 << 20) -> Iterator[tuple[int, Any]]:
+    """``(number, value)`` of each line of a JSON-lines file, each line read with at most
+    ``line_bytes`` characters and parsed with the nesting limit (a line of 10,000 nested
+    brackets is refused, not a RecursionError); a line that is not JSON gives
+    ``(number, None)`` (a torn last line of an interrupted run is dropped by the caller)."""
+    if not existing_regular(path, what):
+        raise MechsynInputError(f"no such {what}", source=str(path))
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    with os.fdopen(fd, encoding="utf-8", errors="strict") as fh:
+        number = 0
+        while True:
+            number += 1
+            try:
+                line = fh.readline(line_bytes + 1)
+            except UnicodeDecodeError as exc:
+                raise MechsynInputError(f"not UTF-8 text ({exc.reason})", source=str(path), line=number,
+                                        hint="delete the file (or give another) and run again") from None
+            if not line:
+                return
+            if len(line) > line_bytes:
+                raise MechsynInputError(f"a line longer than {line_bytes:,} characters", source=str(path),
+                                        line=number, hint="delete the file (or give another) and run again")
+            if _bracket_depth(line) > limit("nesting"):
+                raise MechsynInputError(f"nested more than {limit('nesting')} levels deep", source=str(path),
+                                        line=number, hint="delete the file (or give another) and run again")
+            try:
+                yield number, json.loads(line)
+            except ValueError:  # a syntax error, or an integer of thousands of digits
+                yield number, None
 
 
 def _bracket_depth(text: str) -> int:
@@ -198,13 +257,95 @@ def check_id_text(text: str, source: str, field: str = "", free: bool = False) -
     if _SURROGATE.search(text):
         raise MechsynInputError(f"{text[:40]!r} holds a lone surrogate (not text)", source=source,
                                 field=field or None, hint="save the file as UTF-8 text")
-    hidden = None if free else HIDDEN_CHARS.search(text)
+    if free:
+        return text
+    hidden = HIDDEN_CHARS.search(text)
     if hidden:
         raise MechsynInputError(f"{text[:40]!r} holds the invisible character U+{ord(hidden.group()):04X}",
                                 source=source, field=field or None,
                                 hint="type the id again without it; ids may not hold bidirectional "
                                      "controls or zero-width characters")
+    import unicodedata
+
+    if len(text) <= 1000 and unicodedata.normalize("NFKC", text) != text:
+        raise MechsynInputError(f"{text[:40]!r} is not in its normal form (NFKC)", source=source, field=field or None,
+                                hint=f"write it as {unicodedata.normalize('NFKC', text)[:40]!r}")
+    scripts = _scripts(text)
+    if len(scripts) > 1 and text.translate(_CONFUSABLE) != text:  # e.g. "Аlpha": a Cyrillic А in Latin
+        look = next(ch for ch in text if ch.translate(_CONFUSABLE) != ch)
+        raise MechsynInputError(f"{text[:40]!r} mixes the scripts {', '.join(sorted(scripts)).lower()}: "
+                                f"U+{ord(look):04X} looks like the Latin {look.translate(_CONFUSABLE)!r}",
+                                source=source, field=field or None,
+                                hint="write each id in one script")
     return text
+
+
+#: Non-Latin letters drawn like Latin ones (Cyrillic and Greek capitals and small letters
+#: of Unicode's confusables.txt that map to one ASCII letter): the part of a TR39 skeleton
+#: that matters for ids typed in files.
+_CONFUSABLE = str.maketrans(
+    "АВЕЅІЈКМНОРСТХУҮѴԜԚԌаеіјоѕрсхуԁԛԝһӏѵ"    # Cyrillic
+    "ΑΒΕΖΗΙΚΜΝΟΡΤΥΧοινρυχκ",                   # Greek
+    "ABESIJKMHOPCTXYYVWQGaeijospcxydqwhlv"
+    "ABEZHIKMNOPTYXoivpuxk")
+#: scripts written together (Japanese, Korean): one script for the mixing check
+_ONE_SCRIPT = {"HIRAGANA": "CJK", "KATAKANA": "CJK", "HANGUL": "CJK"}
+
+
+def id_skeleton(text: str) -> str:
+    """What an id looks like: its NFKC form with Cyrillic and Greek look-alikes of Latin
+    letters replaced by them (a small TR39 skeleton). Two ids with the same skeleton
+    cannot be told apart on screen.
+
+    >>> id_skeleton("А") == id_skeleton("A")  # Cyrillic A, Latin A
+    True
+    >>> id_skeleton("Ａ₂")  # fullwidth A, subscript two
+    'A2'
+    """
+    import unicodedata
+
+    return text if text.isascii() else unicodedata.normalize("NFKC", text).translate(_CONFUSABLE)
+
+
+def confusable_id(text: str, seen: dict[str, str]) -> str | None:
+    """The id in ``seen`` (skeleton -> id, filled as ids are read) that ``text`` looks like
+    without being it, else ``None`` (and ``text`` is recorded).
+
+    >>> seen = {}
+    >>> confusable_id("A", seen), confusable_id("B", seen), confusable_id("А", seen)
+    (None, None, 'A')
+    """
+    key = id_skeleton(text)
+    other = seen.setdefault(key, text)
+    return other if other != text else None
+
+
+def _scripts(text: str) -> set[str]:
+    """The scripts of the letters of ``text`` (the first word of each letter's Unicode
+    name: LATIN, CYRILLIC, GREEK...; CJK ideographs count as one)."""
+    import unicodedata
+
+    out = set()
+    for ch in text:
+        if ch.isalpha() and not ch.isascii():
+            word = unicodedata.name(ch, "UNKNOWN").split()[0]
+            out.add(_ONE_SCRIPT.get(word, word))
+        elif ch.isalpha():
+            out.add("LATIN")
+    return out
+
+
+def visible_text(text: str, mark: bool = False) -> str:
+    r"""``text`` fit to show: bidirectional controls and zero-width characters removed, or
+    with ``mark`` written out as ``<U+202E>`` (for a page or a status line; a right-to-left
+    override would otherwise reorder what follows it).
+
+    >>> visible_text("four‮bar"), visible_text("four‮bar", mark=True)
+    ('fourbar', 'four<U+202E>bar')
+    """
+    if text.isascii():
+        return text
+    return HIDDEN_CHARS.sub((lambda m: f"<U+{ord(m.group()):04X}>") if mark else "", text)
 
 
 class _JSONDuplicate(ValueError):

@@ -545,6 +545,21 @@ class _Builder:
                              "a taut straight belt needs the anchor farther from the centre than the radius")
         return {"anchor": [float(x) for x in anchor], "radius": float(entry.radius), "wrap": entry.wrap}
 
+    def no_look_alikes(self, path0: str, texts: list[str], what: str) -> None:
+        """Refuse two ids that look the same and differ (Latin ``A`` and Cyrillic ``А``, a
+        fullwidth letter...): their skeletons (:func:`mechsyn.io.files.id_skeleton`) match."""
+        from mechsyn.io.files import confusable_id
+
+        if all(t.isascii() for t in texts):
+            return
+        seen: dict[str, str] = {}
+        for i, text in enumerate(texts):
+            other = confusable_id(text, seen)
+            if other is not None:
+                codes = " ".join(f"U+{ord(c):04X}" for c in text if not c.isascii())[:80]
+                raise self.error([path0, i], f"the {what} {text!r} ({codes}) looks like {other!r}",
+                                 f"give each {what} a name that differs on screen")
+
     def joints(self, entries: Sequence[JointEntry], path0: list[Any], names: dict[str, str],
                ids: dict[int, str], taken: set[str]) -> list[Joint]:
         out = []
@@ -631,9 +646,12 @@ class _Builder:
     def build(self) -> Mechanism:
         spec = self.spec
         links, names, ids = self._links(spec.links, "links")
+        self.no_look_alikes("links", [lk.name for lk in links], "link name")
         ground = self.resolve_link(spec.ground, ["ground"], names, ids)
         taken: set[str] = set()
         joints = self.joints(spec.joints, ["joints"], names, ids, taken)
+        self.no_look_alikes("joints", [j.id for j in joints], "joint id")
+        self.no_look_alikes("points", list(spec.points), "point name")
         self.check_connected(links, joints, ["joints"])
         by_id = {j.id: j for j in joints}
         contours = self.contours(spec.contours, ["contours"], by_id)

@@ -62,6 +62,7 @@ import networkx as nx
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.limits import limit, limit_hint
 
 __all__ = [
     "PyslvsJoint", "PyslvsMechanism", "parse_expression", "format_expression",
@@ -117,6 +118,8 @@ class _Parser:
         self.i = 0
         self.notes: list[str] = []
         self.count = 0  # joints read so far
+        self.link_names: set[str] = {FRAME}  # every link named so far (the limit counted as they come)
+        self.max_links, self.max_joints = limit("links"), limit("joints")
 
     def error(self, message: str, hint: str | None = None) -> MechsynInputError:
         pos = self.tokens[self.i][1] if self.i < len(self.tokens) else len(self.text)
@@ -173,6 +176,8 @@ class _Parser:
         ``color`` optional); ``A[deg]`` after ``P[...]`` (mechsyn's order before issue 26)
         is read too."""
         index, self.count = self.count, self.count + 1
+        if self.count > self.max_joints:
+            raise self.error(f"more than the limit of {self.max_joints:,} points (joints)", hint=limit_hint("joints"))
         self.take("J")
         self.take("[")
         jtype = self.take()
@@ -202,7 +207,7 @@ class _Parser:
                               "(along x, Pyslvs' default)")
         self.take("L")
         self.take("[")
-        links: list[str] = []
+        links: dict[str, None] = {}  # in order, looked up in constant time
         while self.peek() != "]":
             name = self.take()
             if name in "[](),":
@@ -211,12 +216,22 @@ class _Parser:
             if name in links:
                 self.i -= 1
                 raise self.error(f"link {name!r} listed twice in one joint")
-            links.append(name)
+            links[name] = None
+            self._count_link(name)
             if self.peek() == ",":
                 self.take(",")
         self.take("]")
         self.take("]")
         return PyslvsJoint(jtype, x, y, tuple(links), angle if jtype != "R" else None, color)
+
+    def _count_link(self, name: str) -> None:
+        """Count a link name against the limit ``links`` as it is read (an expression naming
+        40,000 links is refused at the 2,001st, not after reading them all)."""
+        self.link_names.add(name)
+        if len(self.link_names) > self.max_links:
+            self.i -= 1
+            raise self.error(f"more than the limit of {self.max_links:,} links (the analyses would run for hours "
+                             "or longer)", hint=limit_hint("links"))
 
     def angle(self) -> float:
         """``A[deg], `` (the comma after it included)."""
@@ -424,8 +439,6 @@ def expression_to_data(expr: PyslvsMechanism, name: str = "Pyslvs mechanism",
 def _link_names(expr: PyslvsMechanism, source: str) -> list[str]:
     """The frame, then every link in order of appearance; refused before any other work
     when there are more than the ``links`` or ``joints`` limits (:mod:`mechsyn.limits`)."""
-    from mechsyn.limits import limit, limit_hint
-
     if len(expr.joints) > limit("joints"):
         raise MechsynInputError(f"{len(expr.joints):,} points are more than the limit of {limit('joints'):,} "
                                 "joints", source=source, hint=limit_hint("joints"))

@@ -38,7 +38,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError, input_boundary
 from mechsyn.io import load_mechanism, mechanism_to_dict
-from mechsyn.io.checks import numbers
+from mechsyn.io.checks import flag, numbers
 from mechsyn.io.files import read_data, resolve_path
 from mechsyn.limits import limit, limit_hint
 
@@ -120,7 +120,7 @@ class PathCase:
             id=str(data.get("id", "case")), title=str(data.get("title", "")), targets=targets,
             timing=ttype, theta2=theta2, fixed=fixed, variables=variables, **_path_options(data, source),
             published=tuple(data.get("published_solutions") or ()),
-            best_known=best.get("value") if isinstance(best, dict) else None, raw=data,
+            best_known=_best_known(best, source), raw=data,
         )
 
 
@@ -246,12 +246,25 @@ def _path_options(data: dict, source: str | None) -> dict[str, Any]:
     return out
 
 
+def _best_known(best: Any, source: str) -> float | None:
+    """The published best error of a case (``best_known.value``), a finite number or absent."""
+    value = best.get("value") if isinstance(best, dict) else None
+    if value is None:
+        return None
+    if isinstance(value, (list, dict)):
+        raise MechsynInputError("best_known.value must be one number", source=source, field="best_known.value")
+    return float(numbers(value, source, "best_known.value"))
+
+
 def load_cases(path: str | Path) -> list[PathCase]:
     """Load one case object, or every case of a ``{"cases": [...]}`` collection."""
     path = Path(path)
     data, _ = read_data(path, "case file", fmt="json")
     if isinstance(data, dict) and "cases" in data:
         items = data["cases"]
+        if not isinstance(items, list) or not all(isinstance(c, dict) for c in items):
+            raise MechsynInputError("cases must be a list of case objects", source=str(path), field="cases",
+                                    hint='write "cases": [{"id": ..., "targets": ...}, ...]')
         return [PathCase.from_dict(c, source=f"{path}#cases[{i}]") for i, c in enumerate(items)]
     return [PathCase.from_dict(data, source=str(path))]
 
@@ -402,7 +415,7 @@ def _case_input(inp: Any, mech: Any, src: str) -> tuple[str, np.ndarray, bool, t
     values = _floats(inp["values_deg"], src, "input.values_deg").ravel()
     if len(values) < 1:
         raise _err("input.values_deg is empty", src, "input.values_deg")
-    free = bool(inp.get("free", False))
+    free = flag(inp.get("free", False), src, "input.free")
     if not free:
         return jid, values, free, None
     r = _floats(inp.get("range_deg", [float(values.min()), float(values.max())]), src, "input.range_deg")
@@ -483,7 +496,7 @@ def _design_variable(v: Any, f: str, md: dict, src: str) -> DesignVariable:
         jj = next((x for x in md["joints"] if x["id"] == tgt), None)
         if jj is None:
             raise _err(f"no joint {tgt!r} in the mechanism", src, f)
-        kind = "length" if v.get("length") else "joint"
+        kind = "length" if flag(v.get("length", False), src, f"{f}.length") else "joint"
         if kind == "length" and not jj.get("vll"):
             raise _err(f"joint {tgt} is not a variable-length link (vll)", src, f,
                        hint="`length: true` needs a P pair with `vll:`")

@@ -627,8 +627,10 @@ def synthesize_chains_to_file(
     path = Path(path)
     header = {"mechsyn_chains": 1, "n_links": n_links, "mobility": mobility,
               "include_degenerate": include_degenerate}
+    from mechsyn.io.files import existing_regular
+
     done: dict[str, list[KinematicChain]] = {}
-    if path.exists() and path.stat().st_size > 0:
+    if existing_regular(path, "chain stream") and path.stat().st_size > 0:
         if not force and not _is_chain_stream(path):
             raise MechsynInputError(
                 "exists and is not a chain stream written by mechsyn atlas; it would be overwritten",
@@ -666,44 +668,47 @@ def synthesize_chains_to_file(
 
 
 def _is_chain_stream(path: Path) -> bool:
-    """Whether ``path`` starts with the header line of a chain stream."""
+    """Whether ``path`` (a regular file) starts with the header line of a chain stream."""
+    from mechsyn.io.files import loads_json
+
     try:
         with open(path, "rb") as fh:
-            first = json.loads(fh.readline(4096).decode("utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+            first = loads_json(fh.readline(4096), str(path))
+    except (OSError, MechsynInputError):
         return False
     return isinstance(first, dict) and "mechsyn_chains" in first
 
 
 def _read_done(path: Path, header: dict) -> dict[str, list[KinematicChain]]:
+    """The completed assortments of a stream, each line read by
+    :func:`mechsyn.io.files.read_json_lines` (size and nesting limited)."""
+    from mechsyn.io.files import read_json_lines
+
     done: dict[str, list[KinematicChain]] = {}
     pending: list[KinematicChain] = []
-    with open(path, encoding="utf-8") as fh:
-        for number, line in enumerate(fh, start=1):
+    for number, record in read_json_lines(path, "chain stream"):
+        if record is None:
+            break  # torn last line of an interrupted run
+        if not isinstance(record, dict):
+            raise _damaged_line(path, number, "not a JSON object")
+        if number == 1:
+            if record != header:
+                raise MechsynInputError(
+                    "the stream file was written for another enumeration "
+                    f"({str(record)[:200]})", source=str(path),
+                    hint="give another file or delete this one",
+                )
+            continue
+        if "done" in record:
+            if not isinstance(record["done"], str):
+                raise _damaged_line(path, number, "'done' names no assortment")
+            done[record["done"]] = pending
+            pending = []
+        else:
             try:
-                record = json.loads(line)
-            except json.JSONDecodeError:
-                break  # torn last line of an interrupted run
-            if not isinstance(record, dict):
-                raise _damaged_line(path, number, "not a JSON object")
-            if number == 1:
-                if record != header:
-                    raise MechsynInputError(
-                        "the stream file was written for another enumeration "
-                        f"({record})", source=str(path),
-                        hint="give another file or delete this one",
-                    )
-                continue
-            if "done" in record:
-                if not isinstance(record["done"], str):
-                    raise _damaged_line(path, number, "'done' names no assortment")
-                done[record["done"]] = pending
-                pending = []
-            else:
-                try:
-                    pending.append(KinematicChain.from_dict(record, field=f"line {number}"))
-                except MechsynInputError as err:
-                    raise _damaged_line(path, number, f"{err.field}: {err.message}") from None
+                pending.append(KinematicChain.from_dict(record, field=f"line {number}"))
+            except MechsynInputError as err:
+                raise _damaged_line(path, number, f"{err.field}: {err.message}") from None
     return done
 
 
@@ -714,11 +719,11 @@ def _damaged_line(path: Path, number: int, what: str) -> MechsynInputError:
 
 def read_chain_stream(path: str | os.PathLike[str]) -> list[KinematicChain]:
     """Chains of a (possibly partial) stream file, completed assortments only."""
+    from mechsyn.io.files import read_json_lines
+
     path = Path(path)
-    try:
-        with open(path, encoding="utf-8") as fh:
-            header = json.loads(fh.readline())
-    except (UnicodeDecodeError, json.JSONDecodeError):
-        raise _damaged_line(path, 1, "the header is not JSON") from None
+    header = next(read_json_lines(path, "chain stream"), (1, None))[1]
+    if header is None:
+        raise _damaged_line(path, 1, "the header is not JSON")
     done = _read_done(path, header)
     return [c for cs in done.values() for c in cs]

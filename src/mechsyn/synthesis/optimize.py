@@ -388,7 +388,7 @@ def synthesize_path(
     seeds = restart_seeds(seed, restarts)
     best, problem = [np.inf], PathProblem(case)
     ck = _path_checkpoint(checkpoint, resume, case, len(problem.lower), seed, restarts, optimizer, options, target_error)
-    results = _finished_restarts(ck)
+    results = _finished_restarts(ck, problem, seeds)
     pending, loaded = _pending(results, restarts, target_error), len(results)
 
     def note(done, f):
@@ -440,11 +440,39 @@ def check_optimizer(optimizer: str) -> None:
                                 hint="one of " + ", ".join(sorted(OPTIMIZERS)))
 
 
-def _finished_restarts(ck: Any) -> list[RestartResult]:
-    """The restarts a checkpoint holds as finished (none without a checkpoint)."""
+def _finished_restarts(ck: Any, problem: PathProblem, seeds: list[int]) -> list[RestartResult]:
+    """The restarts a checkpoint holds as finished (none without a checkpoint), each checked
+    (:func:`_checked_record`) and re-evaluated: a stored fitness is never believed (nor is
+    that of the partial restart, which competes after a second Ctrl-C)."""
+    if ck is not None and ck.partial is not None:
+        ck.partial["fitness"] = _checked_record(ck, problem, seeds, ck.partial["index"], ck.partial, "partial")
     return [] if ck is None else [
-        RestartResult(index=i, seed=r["seed"], z=r["x"], fitness=r["fitness"], nfev=r["nfev"], seconds=r["seconds"])
+        RestartResult(index=i, seed=r["seed"], z=r["x"], fitness=_checked_record(ck, problem, seeds, i, r, "finished"),
+                      nfev=r["nfev"], seconds=r["seconds"])
         for i, r in sorted(ck.finished.items())]
+
+
+def _checked_record(ck: Any, problem: PathProblem, seeds: list[int], index: int, rec: dict[str, Any],
+                    where: str) -> float:
+    """The fitness of a restart read from a checkpoint, evaluated again; the record is
+    refused (:class:`MechsynInputError` naming the field) when its seed is not the one its
+    index draws or its design lies outside the case's bounds (crank angles of a free timing
+    may wrap once around)."""
+    field = f"{where}[{index}]" if where == "finished" else where
+    if rec["seed"] != seeds[index]:
+        raise MechsynInputError(f"restart {index} has the seed {rec['seed']}, not {seeds[index]}", source=str(ck.path),
+                                field=f"{field}.seed", hint="start afresh with --checkpoint (the file is not usable)")
+    z, lo, hi = np.asarray(rec["x"], float), problem.lower, problem.upper.copy()
+    m = len(problem.linkage_vars)
+    hi[m:] = np.maximum(hi[m:], lo[m:] + 2.0 * np.pi)
+    tol = 1e-9 * (hi - lo + np.abs(lo) + np.abs(hi) + 1.0)
+    bad = np.flatnonzero((z < lo - tol) | (z > hi + tol))
+    if bad.size:
+        k = int(bad[0])
+        raise MechsynInputError(f"{problem.names[k]} = {z[k]:.6g} is outside the case's bounds "
+                                f"[{problem.lower[k]:.6g}, {problem.upper[k]:.6g}]", source=str(ck.path),
+                                field=f"{field}.x", hint="start afresh with --checkpoint (the file is not usable)")
+    return float(problem.fitness(z[None, :])[0])
 
 
 def _keep_best_so_far(problem: PathProblem, trackers: list, seeds: list[int], results: list[RestartResult],

@@ -159,6 +159,18 @@ class CurveDatabase:
         return cache[n_links]
 
 
+def _database_dir(directory: str | os.PathLike[str] | None) -> Path:
+    """The database's directory (default :func:`default_database_dir`); a path that exists
+    and is not a directory (a file, a device, a FIFO) is refused naming it."""
+    path = Path(directory) if directory is not None else default_database_dir()
+    if path.exists() and not path.is_dir():
+        from mechsyn.errors import MechsynInputError
+
+        raise MechsynInputError("the curve database is not a directory", source=str(path), field="database",
+                                hint="give the directory of a curve database (or a new one to build)")
+    return path
+
+
 def _file(directory: Path, topo: CurveTopology) -> Path:
     return directory / f"{topo.key}.npz"
 
@@ -166,20 +178,86 @@ def _file(directory: Path, topo: CurveTopology) -> Path:
 _KEYS = ("designs", "ranges", "closed", "descriptors", "drawn")
 
 
-def _read(path: Path) -> dict | None:
-    """A topology's file, or None when it is missing or damaged (truncated, not an
-    ``.npz``, arrays missing or of mismatched lengths): it is then rebuilt."""
+def _read(path: Path, topo: CurveTopology | None = None) -> dict | None:
+    """A topology's file, or None when it is missing or damaged (see :func:`_read_checked`):
+    it is then rebuilt."""
+    try:
+        return _read_checked(path, topo)
+    except _Damaged:
+        return None
+
+
+class _Damaged(Exception):
+    """What is wrong with a database file (its message)."""
+
+
+#: member -> (dtype kinds, number of dimensions) of a topology's file
+_LAYOUT = {"designs": ("f", 2), "ranges": ("f", 2), "closed": ("b", 1), "descriptors": ("f", 2), "drawn": ("iu", 0)}
+_DEFLATE_RATIO = 1100  # deflate never expands more than 1032-fold: a larger declared size is forged
+
+
+def _read_checked(path: Path, topo: CurveTopology | None = None) -> dict:
+    """A topology's file, every member checked before it is loaded: a regular file, each
+    ``.npy`` header's dtype and shape (rows alike, ``2 * N_HARMONICS`` descriptor columns,
+    ``2 * joints`` design columns when ``topo`` is given) agreeing with the member's size
+    in the archive (so a header declaring 1e11 rows is refused without allocating), then
+    the values finite; :class:`_Damaged` saying what is wrong otherwise."""
+    import stat
     import zipfile
 
     try:
-        with np.load(path, allow_pickle=False) as f:
-            data = {k: f[k] for k in _KEYS}
-    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile):
-        return None
-    n = len(data["ranges"])
-    if any(len(data[k]) != n for k in ("designs", "closed", "descriptors")) or data["drawn"].shape != ():
-        return None
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise _Damaged("not a regular file")
+        with zipfile.ZipFile(path) as zf:
+            shapes = {k: _member_header(zf, k, info.st_size) for k in _KEYS}
+            _check_shapes(shapes, topo)
+            with np.load(path, allow_pickle=False) as f:
+                data = {k: f[k] for k in _KEYS}
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile, MemoryError) as exc:
+        raise _Damaged(f"not a readable .npz file ({type(exc).__name__})") from None
+    for k in ("designs", "ranges", "descriptors"):
+        if not np.isfinite(data[k]).all():
+            raise _Damaged(f"{k} holds values that are not finite numbers")
     return data
+
+
+def _member_header(zf, key: str, file_size: int) -> tuple:
+    """``(dtype, shape)`` of member ``key.npy`` from its header, checked against the
+    member's declared size (and that against its compressed size and the file's)."""
+    member = zf.getinfo(f"{key}.npy")
+    if member.compress_size > file_size or member.file_size > _DEFLATE_RATIO * member.compress_size + 4096:
+        raise _Damaged(f"{key}: the archive declares {member.file_size:,} bytes")
+    with zf.open(member) as fh:
+        version = np.lib.format.read_magic(fh)
+        read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+        shape, _, dtype = read(fh)
+        header = fh.tell()
+    kinds, ndim = _LAYOUT[key]
+    if dtype.hasobject or (dtype.kind not in kinds and not (shape and shape[0] == 0)):
+        raise _Damaged(f"{key}: dtype {dtype} (expected {'/'.join(kinds)})")
+    if header + int(np.prod(shape, dtype=object)) * dtype.itemsize != member.file_size:
+        raise _Damaged(f"{key}: the header's shape {shape} does not match the member's {member.file_size:,} bytes")
+    return shape
+
+
+def _check_shapes(shapes: dict, topo: CurveTopology | None) -> None:
+    """The members' shapes agree: as many rows each, descriptor and design widths (an
+    empty file holds 1-D empty arrays)."""
+    from mechsyn.synthesis.curves.descriptors import N_HARMONICS
+
+    n = shapes["ranges"][0] if shapes["ranges"] else -1
+    if shapes["drawn"] != ():
+        raise _Damaged(f"drawn: shape {shapes['drawn']}, expected a single number")
+    if n == 0 and all(shapes[k] == (0,) for k in ("designs", "ranges", "closed", "descriptors")):
+        return
+    widths = {"ranges": 2, "descriptors": 2 * N_HARMONICS,
+              "designs": None if topo is None else 2 * len(topo.plan.names)}
+    for k in ("designs", "ranges", "closed", "descriptors"):
+        kinds, ndim = _LAYOUT[k]
+        if len(shapes[k]) != ndim or shapes[k][0] != n or (ndim == 2 and widths[k] not in (None, shapes[k][1])):
+            want = (n, widths[k] or "P")[:ndim]
+            raise _Damaged(f"{k}: shape {shapes[k]}, expected {want}".replace("'", ""))
 
 
 def build_database(directory: str | os.PathLike[str] | None = None, max_links: int = DEFAULT_LINKS,
@@ -194,12 +272,12 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
     ``dask.distributed`` address or ``Client``) the topologies are built on a Dask
     cluster and written here.
     """
-    directory = Path(directory) if directory is not None else default_database_dir()
+    directory = _database_dir(directory)
     directory.mkdir(parents=True, exist_ok=True)
     topos = curve_topologies(max_links)
     todo = []
     for i, t in enumerate(topos):
-        have = _read(_file(directory, t))
+        have = _read(_file(directory, t), t)
         n = 0 if have is None else len(have["ranges"])
         want = per_topology if t.n_links < 8 else max(1, per_topology // EIGHT_SHARE)
         if n < want:
@@ -288,7 +366,7 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
                   build_if_missing: bool = True, callback: Callable[[dict], None] | None = None) -> CurveDatabase:
     """Read the database (topologies up to ``max_links``); build the default small one
     (4- and 6-bars) first when there is none."""
-    directory = Path(directory) if directory is not None else default_database_dir()
+    directory = _database_dir(directory)
     topos = cached_topologies(directory, max(max_links, 4)) if directory.is_dir() else curve_topologies(max(max_links, 4))
     present = [t for t in topos if _file(directory, t).exists()]
     if not present and build_if_missing:
@@ -297,13 +375,14 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
         present = [t for t in topos if _file(directory, t).exists()]
     rows_t, designs, ranges, closed, desc = [], [], [], [], []
     for ti, t in enumerate(present):
-        data = _read(_file(directory, t))
-        if data is None:
+        try:
+            data = _read_checked(_file(directory, t), t)
+        except _Damaged as exc:
             from mechsyn.errors import MechsynInputError
 
-            raise MechsynInputError("the curve database file is damaged", source=str(_file(directory, t)),
-                                    hint=f"rebuild it: mechsyn curves build --links {t.n_links} --database {directory} "
-                                         "(with the --per-topology it was built with)")
+            raise MechsynInputError(f"the curve database file is damaged: {exc}", source=str(_file(directory, t)),
+                                    hint=f"rebuild it: mechsyn curves build --links {t.n_links} "
+                                         f"--database {directory} (with the --per-topology it was built with)") from None
         if len(data["ranges"]) == 0:
             continue
         m = len(data["ranges"])

@@ -4,7 +4,6 @@ absolute and relative; arcs are refused with a clear message)."""
 
 from __future__ import annotations
 
-import json
 import os
 import re
 from dataclasses import dataclass
@@ -131,33 +130,33 @@ def smooth_samples(target: TargetCurve, m: int = 256) -> TargetCurve:
 
 
 def read_target(path: str | os.PathLike[str]) -> TargetCurve:
-    """Read a target curve file (CSV, JSON or SVG, by suffix)."""
+    """Read a target curve file (CSV, JSON or SVG, by suffix).
+
+    The file is read by :func:`mechsyn.io.files.read_text` (a regular file only, at most
+    :data:`MAX_TARGET_BYTES` bytes read); JSON by :func:`mechsyn.io.files.loads_json`
+    (a key written twice, deep nesting and non-finite numbers refused).
+    """
+    from mechsyn.io.checks import flag
+    from mechsyn.io.files import check_data_size, loads_json, read_text
+
     p = Path(path)
     src = str(p)
-    try:
-        if p.stat().st_size > MAX_TARGET_BYTES:
-            raise MechsynInputError(f"the file is larger than {MAX_TARGET_BYTES // 1_000_000} MB", source=src,
-                                    hint="a drawn target needs a few thousand points at most")
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise MechsynInputError("file not found", source=src) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise MechsynInputError(f"cannot read the file: {exc}", source=src) from None
     suffix = p.suffix.lower()
+    if suffix not in (".json", ".svg", ".csv", ".txt"):
+        raise MechsynInputError(f"unknown target format {suffix or '(no suffix)'}", source=src,
+                                hint="give a .csv (x,y rows), .json ({\"points\": ...}) or .svg (a path)")
+    text = read_text(p, "target file", cap=MAX_TARGET_BYTES)
     if suffix == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise MechsynInputError(f"invalid JSON: {exc.msg}", source=src, line=exc.lineno) from None
-        except (ValueError, RecursionError) as exc:  # a huge integer, deep nesting
-            raise MechsynInputError(f"invalid JSON: {str(exc)[:80]}", source=src) from None
+        data = check_data_size(loads_json(text, src, finite=True), src)
         if not isinstance(data, dict) or "points" not in data:
             raise MechsynInputError('expected {"points": [[x, y], ...], "closed": true}', source=src,
                                     field="points")
-        closed = data.get("closed")
-        if closed is not None and not isinstance(closed, bool):
-            raise MechsynInputError("closed must be true or false", source=src, field="closed")
-        return target_from_points(data["points"], closed, src)
+        unknown = sorted(set(data) - {"points", "closed", "name"})
+        if unknown:
+            raise MechsynInputError(f"unknown key {unknown[0]!r}", source=src, field=unknown[0][:80],
+                                    hint='a target holds "points" and, optionally, "closed" and "name"')
+        closed = None if data.get("closed") is None else flag(data["closed"], src, "closed")
+        return target_from_points(_pairs(data["points"], src), closed, src)
     if suffix == ".svg":
         d = _first_path_data(text)
         if d is None:
@@ -179,8 +178,28 @@ def read_target(path: str | os.PathLike[str]) -> TargetCurve:
                     continue
                 raise MechsynInputError(f"expected two numbers x,y, got {line!r}", source=src, line=k) from None
         return target_from_points(rows, None, src)
-    raise MechsynInputError(f"unknown target format {suffix or '(no suffix)'}", source=src,
-                            hint="give a .csv (x,y rows), .json ({\"points\": ...}) or .svg (a path)")
+
+
+def _pairs(points: object, src: str) -> list:
+    """``points`` of a JSON target checked as a list of ``[x, y]`` number pairs (a boolean
+    or a string is not a number), naming the first wrong item."""
+    if not isinstance(points, list):
+        raise MechsynInputError(f"points must be a list of [x, y] pairs, not {type(points).__name__}",
+                                source=src, field="points")
+    for k, item in enumerate(points):
+        if not (isinstance(item, list) and len(item) == 2
+                and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in item)):
+            raise MechsynInputError(f"expected [x, y] (two numbers), got {_json_repr(item)}", source=src,
+                                    field=f"points[{k}]")
+    return points
+
+
+def _json_repr(value: object) -> str:
+    """A short JSON rendering of ``value`` for a message."""
+    import json
+
+    text = json.dumps(value, ensure_ascii=True)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 _D_ATTR = re.compile(r"\sd\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")

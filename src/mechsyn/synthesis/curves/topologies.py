@@ -209,15 +209,18 @@ def cached_topologies(directory: Path, max_links: int) -> tuple[CurveTopology, .
     first call, rewritten when it does not hold them all): the atlas is enumerated once
     per database, not on every load; the plans compile on first use. The file is keyed
     by the code's version of the enumeration (the keys in order and the templates)."""
+    from mechsyn.errors import MechsynInputError
+    from mechsyn.io.files import loads_json, read_limited
+
     f = Path(directory) / CACHE_FILE
-    try:
-        recs = json.loads(f.read_text())
+    try:  # a regular file within the size limit, JSON of limited depth: anything else is damaged
+        recs = loads_json(read_limited(f, "topology cache") if f.exists() else b"null", str(f))
         want = {n: k for n, k in recs["count"].items()}
         out = tuple(_from_record(r) for r in recs["topologies"] if r["chain"]["n_links"] <= max_links)
         if recs.get("version") == _CACHE_VERSION and all(str(n) in want for n in range(4, max_links + 1, 2)):
             return out
-    except (OSError, ValueError, KeyError, TypeError):
-        pass
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, MechsynInputError, RecursionError):
+        pass  # missing or damaged: enumerated again and rewritten
     topos = curve_topologies(max_links)
     counts = {str(n): sum(t.n_links == n for t in topos) for n in range(4, max_links + 1, 2)}
     data = {"version": _CACHE_VERSION, "count": counts,

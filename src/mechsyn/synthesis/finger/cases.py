@@ -312,15 +312,18 @@ def _region_points(data: dict, md: dict, src: str) -> tuple[np.ndarray, list[str
 
 def _options(case: FingerCase, data: dict, src: str) -> None:
     """The force criterion's settings and the optimiser's budget."""
+    from mechsyn.io.checks import numbers, whole_number
+
     for key in ("gravity", "weight_moment", "tolerance_deg", "step_deg"):
         if key in data:
-            setattr(case, key, float(data[key]))
+            if isinstance(data[key], (list, dict)):
+                raise _err(f"{key} must be one number", src, key)
+            setattr(case, key, float(numbers(data[key], src, key)))
     opt = data.get("optimizer") or {}
+    if not isinstance(opt, dict):
+        raise _err("optimizer must be a mapping of settings (maxiter: 40, ...)", src, "optimizer")
     for key in ("maxiter", "popsize", "force_maxiter", "vll_steps", "candidates"):
         if key in opt:
-            val = int(opt[key])
-            if val < 1:
-                raise _err(f"optimizer.{key} must be >= 1", src, f"optimizer.{key}")
-            setattr(case, key, val)
+            setattr(case, key, whole_number(opt[key], src, f"optimizer.{key}", 1, 1_000_000))
     if case.step_deg <= 0 or case.tolerance_deg <= 0:
         raise _err("step_deg and tolerance_deg must be positive", src)

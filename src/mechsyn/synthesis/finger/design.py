@@ -418,6 +418,8 @@ def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[
             continue
         if v is not None:
             variants.append(v)
+    if ck is not None and run.state["interrupted"]:
+        ck.save()  # the finished variants (maybe none): --resume runs the others
     if not variants and run.state["interrupted"]:
         raise KeyboardInterrupt  # nothing feasible to keep
     if not variants:
@@ -453,13 +455,31 @@ def _design_variant(run: _Run, combo: tuple[str, ...]) -> VariantResult | None:
                          "the crank range or leaves the region)")
         return None
     ev1 = evaluate_locked(case, x1, combo)
+    known: dict[str, Any] = {}
+    try:
+        run.say("VLL ranges and forces of the stage-1 design")
+        ranges1, forces1 = _stage1_checks(case, x1, combo, known)
+        pop, n2 = _force_stage(run, combo, x1, f1, max(case.tolerance_deg, ev1.error_rms), ranges1, forces1)
+        chosen, ranges, forces_, improved = _pick(run, combo, x1, pop, ranges1, forces1)
+        return _variant(case, combo, x1, ev1, chosen, ranges, forces1, forces_, improved, n1 + n2)
+    except KeyboardInterrupt:  # Ctrl-C/SIGTERM in the checks: the stage-1 design is the best known
+        run.state["interrupted"] = True
+        run.notes.append(f"VLL {label}: interrupted during the checks after the search: the stage-1 design kept "
+                         "(the force stage's candidates not checked)")
+        ranges1, forces1 = _stage1_checks(case, x1, combo, known)  # a second signal ends the command
+        return _variant(case, combo, x1, ev1, x1, ranges1, forces1, forces1, False, n1)
+
+
+def _stage1_checks(case: FingerCase, x1: np.ndarray, combo: tuple[str, ...], known: dict[str, Any]
+                   ) -> tuple[dict, dict]:
+    """VLL ranges and forces of the stage-1 design, each kept in ``known`` once computed
+    (computed again after Ctrl-C only where the signal cut it short)."""
     d1 = apply_design(case, x1, combo)
-    run.say("VLL ranges and forces of the stage-1 design")
-    ranges1 = {j: vll_range(case, d1, j)[:2] for j in combo}
-    forces1 = mode_forces(case, d1, combo, ranges1)
-    pop, n2 = _force_stage(run, combo, x1, f1, max(case.tolerance_deg, ev1.error_rms), ranges1, forces1)
-    chosen, ranges, forces_, improved = _pick(run, combo, x1, pop, ranges1, forces1)
-    return _variant(case, combo, x1, ev1, chosen, ranges, forces1, forces_, improved, n1 + n2)
+    if "ranges" not in known:
+        known["ranges"] = {j: vll_range(case, d1, j)[:2] for j in combo}
+    if "forces" not in known:
+        known["forces"] = mode_forces(case, d1, combo, known["ranges"])
+    return known["ranges"], known["forces"]
 
 
 def _force_stage(run: _Run, combo: tuple[str, ...], x1: np.ndarray, f1: float, tol: float,
