@@ -123,10 +123,15 @@ def open_example(page, name):
 
 
 def joint_centres(page):
-    """Screen centres of the joints' elements, relative to the view's box."""
+    """Screen centres of the joints' marks (their elements without the labels, which move
+    aside to keep clear of each other), relative to the view's box."""
     return page.evaluate("""() => { const v = document.querySelector('#view3d').getBoundingClientRect();
         return Object.fromEntries([...document.querySelectorAll('[data-joint]')].map(e => {
-        const r = e.getBoundingClientRect(); return [e.dataset.joint, [r.x + r.width / 2 - v.x, r.y + r.height / 2 - v.y]]; })); }""")
+        const marks = [...e.children].filter(c => c.tagName !== 'text' && !c.classList.contains('selection-ring')
+            && !c.classList.contains('axis-line')).map(c => c.getBoundingClientRect());
+        const x0 = Math.min(...marks.map(b => b.left)), x1 = Math.max(...marks.map(b => b.right));
+        const y0 = Math.min(...marks.map(b => b.top)), y1 = Math.max(...marks.map(b => b.bottom));
+        const r = marks.length ? {x: x0, y: y0, width: x1 - x0, height: y1 - y0} : e.getBoundingClientRect(); return [e.dataset.joint, [r.x + r.width / 2 - v.x, r.y + r.height / 2 - v.y]]; })); }""")
 
 
 def moved(a, b, px=2.0):
