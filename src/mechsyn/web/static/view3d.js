@@ -265,11 +265,23 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     $("status").textContent = `${view.mechanism}: ${view.joints.length} joints, ${view.engine} engine${res}`;
   }
   // Called by the studio's render() after its banner and player: draws the view when shown.
+  // The player first: the studio's renderPlayer has just emptied the input's value (it has no
+  // planar sweep), and the footer is one line lower without it where the drives' sliders take
+  // its width; the picture, centred on the view, is drawn for the footer the page keeps
+  // (drawn before it, the whole picture jumped by half the footer's change at every input).
   function update() {
-    if (shown()) { show(true); draw(); player(); }
+    if (shown()) { show(true); player(); draw(); }
     else if (svg.style.display !== "none") { show(false); play(false); }
     banner();
   }
+  // the view's size changed (the window, the drives' sliders arriving, the footer wrapping):
+  // drawn again, centred on the new size
+  let size = "";
+  new ResizeObserver(([e]) => {
+    const now = `${e.contentRect.width}x${e.contentRect.height}`;
+    if (now !== size && shown()) draw();
+    size = now;
+  }).observe(svg);
 
   // ---- orbit, zoom, reset, select
   svg.addEventListener("pointerdown", (ev) => {
