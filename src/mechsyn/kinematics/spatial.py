@@ -241,8 +241,12 @@ _MESSAGES = {
                      "configuration lies between)",
     "dead point": "a limit of the working range: the drive cannot reach this value from the previous row "
                   "(singular value ratio {:.2g} where the continuation stopped)",
-    "reassembled": "assembles again after a gap (Newton from the last assembled pose; the assembly branch "
-                   "may differ from the drawn one)",
+    "reassembled": "assembles again after a gap, in another assembly than the drawn one (no motion from the "
+                   "drawn assembly reaches these rows: Newton from the last pose before the gap)",
+    "round": "reached the other way round from the drawn assembly (the input taken modulo 360 degrees): the "
+             "drawn circuit, on from the sweep's other end",
+    "refused": "not assembled here: Newton converged to a pose where pair {} is not the file's pair (its axis "
+               "reversed or a slide half-turned: another root of its equations), refused",
 }
 
 

@@ -32,7 +32,18 @@ the solver takes least-squares, minimum-norm steps.
 Lengths are measured from the centre of the joint points in units of the mechanism's
 length scale (the largest distance of a joint point from that centre), so every equation
 is dimensionless, the solver's tolerances are relative to the length scale, and a
-mechanism scaled by 1e-3 or 1e4 gives the same numbers.
+mechanism scaled by 1e-3 or 1e4 gives the same numbers. The file's coordinates carry
+rounding of one unit in the last place of their magnitude: ``ulp`` is that rounding in
+model units (``eps · max|x| / scale``), the floor of every tolerance, so a mechanism placed
+1e6 of its sizes from the origin (or a spherical linkage whose points cluster near its
+centre) is not asked to close better than its own coordinates do.
+
+The dot equations of an R pair (its axis perpendicular to two normals of the other link)
+also hold with the axis reversed on one link, and those of a P pair (three frame vectors
+kept perpendicular) with a half-turn about a frame vector: roots that are not the pair.
+:func:`pair_error` measures every pair's relative rotation against the rotation its
+reported joint value gives (``Rot(a, θ)`` for R, C and H, the identity for P); a pose is a
+true assembly only where that is zero. U and S pairs' equations admit exactly the pair.
 
 References
 ----------
@@ -143,6 +154,8 @@ class SpatialModel:
     helix: tuple[tuple[int, int, float], ...]
     drives: tuple[tuple[str, str, int], ...]
     lay: "_Layout | None" = None
+    ulp: float = float(np.finfo(float).eps)
+    pairs: "_Pairs | None" = None
 
     @property
     def n(self) -> int:
@@ -238,10 +251,64 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
             drive_rows.append((jid, "angle", rows["angle_joints"].index(jid)))
         else:
             drive_rows.append((jid, "slide", rows["slide_joints"].index(jid)))
+    big = max([float(np.abs(np.asarray(j.point, float)).max()) for j in mech.joints if j.point is not None]
+              + [float(np.abs(np.asarray(pt.at, float)).max()) for pt in mech.points.values()], default=0.0)
     M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
                      _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
-                     tuple(rows["slide_joints"]), helix, tuple(drive_rows))
-    return replace(M, lay=_layout(M))
+                     tuple(rows["slide_joints"]), helix, tuple(drive_rows),
+                     ulp=float(np.finfo(float).eps) * max(1.0, big / scale))
+    return replace(M, lay=_layout(M), pairs=_pairs(mech, index))
+
+
+# --------------------------------------------------------------------------- pair integrity
+@dataclass(frozen=True, eq=False)
+class _Pairs:
+    """The pairs whose equations admit other roots: R, C, H (axis ``a`` with ``e1``, ``e2``
+    perpendicular, ``turns``) and P (``turns`` False), between poses ``ia`` and ``ib``."""
+
+    ids: tuple[str, ...]
+    ia: np.ndarray
+    ib: np.ndarray
+    a: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+    turns: np.ndarray
+
+
+def _pairs(mech: Mechanism, index: dict[str, int]) -> _Pairs:
+    rows = []
+    for j in mech.joints:
+        if j.type in ("R", "C", "H", "P"):
+            a = _unit(np.asarray(j.axis, float))
+            e1, e2 = _perp_basis(a)
+            rows.append((j.id, index[j.links[0]], index[j.links[1]], a, e1, e2, j.type != "P"))
+    if not rows:
+        z = np.zeros((0, 3))
+        return _Pairs((), np.zeros(0, int), np.zeros(0, int), z, z, z, np.zeros(0, bool))
+    ids, ia, ib, a, e1, e2, turns = zip(*rows)
+    return _Pairs(ids, np.array(ia), np.array(ib), np.array(a), np.array(e1), np.array(e2), np.array(turns))
+
+
+def pair_error(M: SpatialModel, R: np.ndarray) -> np.ndarray:
+    """Per pose and pair (B, pairs): the largest entry of ``R_rel - Rot(a, θ)`` (R, C, H;
+    ``θ`` the pair's joint value read from ``R_rel``) or of ``R_rel - I`` (P), where
+    ``R_rel = R_a^T R_b`` is the second link's rotation relative to the first from the drawn
+    assembly. Zero (to the residual) on a true assembly; about 2 where an R axis is reversed
+    or a P pair half-turned. Because every pair's relative displacement is then the one its
+    joint values give, the joint values close every loop (their displacements compose, around
+    any loop, to the product of the links' relative poses, which is the identity)."""
+    P = M.pairs
+    if P is None or not len(P.ia):
+        return np.zeros((len(R), 0))
+    Rr = np.swapaxes(R[:, P.ia], -1, -2) @ R[:, P.ib]
+    c = np.einsum("ki,bkij,kj->bk", P.e1, Rr, P.e1)
+    s = np.einsum("ki,bkij,kj->bk", P.e2, Rr, P.e1)
+    th = np.where(P.turns, np.arctan2(s, c), 0.0)
+    K = np.einsum("ijk,nk->nij", -_EPS, P.a)              # [a]x: K y = a x y
+    aa = P.a[:, :, None] * P.a[:, None, :]
+    ct, st = np.cos(th)[..., None, None], np.sin(th)[..., None, None]
+    Rot = ct * np.eye(3) + st * K + (1 - ct) * aa
+    return np.abs(Rr - Rot).max(axis=(-1, -2))
 
 
 # --------------------------------------------------------------------------- layout

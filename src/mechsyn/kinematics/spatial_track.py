@@ -35,14 +35,36 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.spatial_model import (SpatialModel, _cross, convective, frame, helix_angles, jacobian, move,
-                                              residual, rotate)
+                                              pair_error, residual, rotate)
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 
 #: A singular value below this fraction of the largest is a lost direction (rank decisions).
 RANK_TOL = 1e-8
-#: Residual (in units of the length scale) at which the corrector accepts a pose.
+#: Residual (in units of the length scale) at which the corrector accepts a pose; the
+#: floor of :func:`newton_tol` (which also stays ``ULPS`` units in the last place of the
+#: file's coordinates above their rounding).
 NEWTON_TOL = 1e-12
+ULPS = 64
+#: Largest entry of a pair's relative rotation minus the rotation of its joint value
+#: (:func:`~mechsyn.kinematics.spatial_model.pair_error`) on an accepted pose: a true
+#: assembly has the residual's size there, a reversed axis about 2.
+PAIR_TOL = 1e-6
+
+
+def newton_tol(M: SpatialModel) -> float:
+    """The corrector's tolerance for ``M``: ``NEWTON_TOL`` of the length scale, or ``ULPS``
+    units in the last place of the file's largest coordinate (in model units) when that is
+    more (a mechanism far from the origin, or with its points clustered, cannot close better
+    than its coordinates are written)."""
+    return max(NEWTON_TOL, ULPS * M.ulp)
+
+
+def singular_tol(M: SpatialModel) -> float:
+    """``σ_r / σ_1`` under which a row is singular: the accuracy Newton reaches at a singular
+    point (the square root of its tolerance, as it converges only linearly there), at least
+    ``RANK_TOL``."""
+    return max(RANK_TOL, 10 * np.sqrt(newton_tol(M)))
 #: Largest predictor step in a block (radians; lengths in units of the length scale): the
 #: second-order predictor's error is then about ``MAX_STEP³ / 6`` of the twists' scale,
 #: well inside Newton's reach; every row is still checked on its own (residual and branch
@@ -200,6 +222,10 @@ class Tracker:
         self.halvings = 0
         self.c0 = link_centres(M)
         self.blocks = _blocks(M)
+        self.tol = newton_tol(M)
+        self.rank_tol = max(RANK_TOL, 100 * self.tol)
+        self.rejected = 0  # converged poses refused by the pair check (another root of the equations)
+        self.last_bad, self.last_pair, self.refused = np.zeros(0, bool), [], []
 
     def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
         """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
@@ -218,7 +244,7 @@ class Tracker:
         Jc = Jr.reshape(J.shape)
         if self.rank is None:  # the regular rank: at the drawn assembly, by an SVD
             s0 = np.linalg.svd(Jc[0], compute_uv=False)
-            self.rank = int(np.count_nonzero(s0 > RANK_TOL * s0[0])) if s0.size and s0[0] > 0 else 0
+            self.rank = int(np.count_nonzero(s0 > self.rank_tol * s0[0])) if s0.size and s0[0] > 0 else 0
         rows = J.shape[1] < J.shape[2]
         G = Jc @ Jc.transpose(0, 2, 1) if rows else Jc.transpose(0, 2, 1) @ Jc
         k = G.shape[1]
@@ -264,7 +290,7 @@ class Tracker:
             F = frame(self.M, R, p)
             g = residual(self.M, F, href, target)
             err = np.abs(g).max(axis=1)
-            done |= err < NEWTON_TOL
+            done |= err < self.tol
             if it >= 10:  # no longer converging: give up on those
                 failed |= ~done & (err > 0.5 * last)
             active = ~done & ~failed
@@ -287,7 +313,23 @@ class Tracker:
             failed |= moved > limit
             dx[failed] = 0.0
             R, p = move(R, p, dx)
-        return R, p, done & ~failed, (F, g, fresh, fidx)
+        return R, p, self.true_pairs(R, done & ~failed), (F, g, fresh, fidx)
+
+    def true_pairs(self, R: np.ndarray, ok: np.ndarray) -> np.ndarray:
+        """``ok`` without the poses whose pairs are not the file's (a reversed R axis, a
+        half-turned P pair: :func:`~mechsyn.kinematics.spatial_model.pair_error`)."""
+        self.last_bad, self.last_pair = np.zeros(len(ok), bool), [""] * len(ok)
+        if not ok.any() or not len(self.M.pairs.ia):
+            return ok
+        bad = np.zeros(len(ok), bool)
+        err = pair_error(self.M, R[ok])
+        bad[ok] = err.max(axis=1) > PAIR_TOL
+        self.rejected += int(bad.sum())
+        self.last_bad, self.last_pair = bad, [""] * len(ok)
+        for b, e in zip(np.flatnonzero(ok), err):
+            if e.max() > PAIR_TOL:
+                self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
+        return ok & ~bad
 
     def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
         """One predictor-corrector step of a single pose; (the new state or None, the
@@ -358,70 +400,158 @@ class Tracker:
         return st
 
     def reassemble(self, st: State, U: np.ndarray, rows: np.ndarray) -> tuple[int, State] | None:
-        """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges,
-        and its state; all rows tried in one batch."""
+        """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges to
+        a true assembly, and its state; all rows tried in one batch. ``refused`` lists the
+        rows before it (row, pair) where Newton converged to another root of a pair's
+        equations (:meth:`true_pairs`)."""
         B = len(rows)
         rep = np.zeros(B, int)
         R, p, ok, _ = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
+        j = int(np.argmax(ok)) if ok.any() else B
+        bad = np.flatnonzero(self.last_bad[:j])
+        self.refused = [(int(rows[b]), self.last_pair[b]) for b in bad]
         if not ok.any():
             return None
-        j = int(np.argmax(ok))
         return int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None])
 
 
 # --------------------------------------------------------------------------- the walk
 @dataclass
 class Walk:
-    """Poses of every row (NaN where not reached) and the events met on the way."""
+    """Poses of every row (NaN where not reached), how each was reached (``how``: 0 not, 1
+    by moving from the drawn assembly, 2 the same going the other way round with the R input
+    taken modulo 360, 3 by re-assembly in another assembly) and the events met on the way."""
 
     R: np.ndarray
     p: np.ndarray
     href: np.ndarray
     ok: np.ndarray
     events: list
+    how: np.ndarray | None = None
 
-    def put(self, k: int | np.ndarray, st: State) -> None:
+    def put(self, k: int | np.ndarray, st: State, how: int = 1) -> None:
         self.R[k], self.p[k], self.href[k] = st.R, st.p, st.href
         self.ok[k] = True
+        self.how[k] = how
 
     def at(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.R[k:k + 1], self.p[k:k + 1], self.href[k:k + 1]
 
 
-def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
+def walk(tr: Tracker, start: State, U: np.ndarray, event: Any, first: Any = None) -> Walk:
     """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
     inputs): to the row nearest it, then outwards both ways by blocks of rows
-    (:func:`_blocks_along`). ``event(index, kind, detail)`` makes the event dicts."""
+    (:func:`_blocks_along`) as far as the mechanism moves. Then, by one rule, the rows left:
+
+    1. a sweep of one R (or H) input that reached one end goes on past it with the rows left
+       taken modulo 360 degrees (the other way round from the drawn assembly: the rows a
+       full-turn sweep could not reach forwards are reached backwards, on the drawn circuit);
+    2. rows still left are re-assembled by Newton from the last pose before each gap, in
+       row order: another assembly than the drawn one (no motion from the drawn assembly
+       reaches them), each such stretch an event ``reassembled``.
+
+    ``event(index, kind, detail)`` makes the event dicts; ``first(target)``, when given,
+    reaches the row nearest the drawn input instead of :meth:`Tracker.advance` (a singular
+    drawn assembly)."""
     M = tr.M
     N = len(U)
     w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
-             np.zeros((N, len(M.helix))), np.zeros(N, bool), [])
+             np.zeros((N, len(M.helix))), np.zeros(N, bool), [], np.zeros(N, np.int8))
     k0 = int(np.argmin(np.abs(U).max(axis=1)))
-    st = tr.advance(start, np.zeros(U.shape[1]), U[k0])
-    if st is None:
+    ends = []
+    st0 = tr.advance(start, np.zeros(U.shape[1]), U[k0]) if first is None else None
+    for order in (np.arange(k0, N), np.arange(k0, -1, -1)):
+        st = st0 if first is None else first(U[order[:2]])
+        if st is None:
+            ends.append(None)
+            continue
+        if not w.ok[k0]:
+            w.put(k0, st)
+        ends.append(_blocks_along(tr, w, st, U, k0, order[1:], event))
+    if not w.ok[k0]:
         w.events.append(event(k0, "not assembled", None))
-        return w
-    w.put(k0, st)
-    for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1)):
-        _blocks_along(tr, w, st, U, k0, order, event)
+    _round(tr, w, U, ends, event)
+    _reassemble_rest(tr, w, U, event)
     w.events.sort(key=lambda e: e["index"])
     return w
 
 
-def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any) -> None:
-    """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
-    each from the last row of the one before; the rows reached go into ``w``."""
-    prev, i, stride, gap = k0, 0, MAX_STRIDE, False
-    while i < len(order):
-        if gap:  # the first row after the gap where Newton from the last pose converges
-            k = tr.reassemble(st, U, order[i:])
-            if k is None:
-                break
-            where = i + int(np.flatnonzero(order[i:] == k[0])[0])
-            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1])
-            w.events.append(event(first, "reassembled", None))
-            st, prev, gap, i = k[1], k[0], False, where + 1
+def _turning(M: SpatialModel, U: np.ndarray) -> int | None:
+    """The column of ``U`` of the sweep's one moving input when it is an angle, else None."""
+    moving = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
+    if len(moving) != 1 or not M.lay.d_angle[moving[0]]:
+        return None
+    return int(moving[0])
+
+
+def _round(tr: Tracker, w: Walk, U: np.ndarray, ends: list, event: Any) -> None:
+    """Rule 1 of :func:`walk`: past an end the walk reached, on to the rows left with the
+    input taken modulo 2π (beyond the last row upwards, or below the first downwards)."""
+    col = _turning(tr.M, U)
+    if col is None or w.ok.all():
+        return
+    N = len(U)
+    up = U[-1, col] >= U[0, col]
+    for st, end, sign in ((ends[0], N - 1, 1.0), (ends[1], 0, -1.0)):
+        left = np.flatnonzero(~w.ok)
+        if st is None or not w.ok[end] or not len(left) or (w.how[end] != 1):
             continue
+        d = sign * (1 if up else -1)  # +1: inputs grow past this end
+        V = U.copy()
+        shift = np.mod(d * (U[left, col] - U[end, col]), 2 * np.pi)
+        shift[shift < 1e-12] = 2 * np.pi  # the end's own input: a full turn on
+        V[left, col] = U[end, col] + d * shift
+        order = left[np.argsort(shift, kind="stable")]
+        before = w.ok.copy()
+        _blocks_along(tr, w, st, V, end, order, event, how=2)
+        got = np.flatnonzero(w.ok & ~before)
+        if len(got):
+            w.events.append(event(int(got[0]), "round", None))
+    _same_angle(w, U, col)
+
+
+def _same_angle(w: Walk, U: np.ndarray, col: int) -> None:
+    """Rows left whose input equals, modulo 2π, that of a row reached by moving from the
+    drawn assembly take its pose (an R input is an angle: 360 is 0)."""
+    key = np.round(np.mod(U[:, col], 2 * np.pi) / (2 * np.pi) * 1e9).astype(np.int64) % 1_000_000_000
+    seen = {int(key[k]): k for k in np.flatnonzero(w.ok & (w.how == 1))}
+    for k in np.flatnonzero(~w.ok):
+        src = seen.get(int(key[k]))
+        if src is not None:
+            w.R[k], w.p[k], w.href[k] = w.R[src], w.p[src], w.href[src]
+            w.ok[k], w.how[k] = True, 2
+
+
+def _reassemble_rest(tr: Tracker, w: Walk, U: np.ndarray, event: Any) -> None:
+    """Rule 2 of :func:`walk`: each gap left, in row order, re-assembled by Newton from the
+    pose of the row before it (the first row of the gap where Newton converges to a true
+    assembly), then walked on forwards and back into the gap as far as the mechanism moves."""
+    N = len(U)
+    for i in range(1, N):
+        if w.ok[i] or not w.ok[i - 1]:
+            continue
+        rows = np.arange(i, N)
+        rows = rows[:int(np.argmax(np.append(w.ok[rows], True)))]  # up to the next assembled row
+        got = tr.reassemble(tr.state(*w.at(i - 1), U[i - 1][None]), U, rows)
+        for k, jid in tr.refused:
+            w.events.append(event(k, "refused", jid))
+        if got is None:
+            continue
+        k, st = got
+        w.put(k, st, how=3)
+        _blocks_along(tr, w, st, U, k, rows[rows > k], event, how=3)
+        _blocks_along(tr, w, st, U, k, rows[rows < k][::-1], event, how=3)
+        w.events.append(event(int(rows[np.argmax(w.ok[rows])]), "reassembled", None))
+
+
+def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any,
+                  how: int = 1) -> State | None:
+    """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
+    each from the last row of the one before, until the first row it cannot reach (a
+    ``dead point`` event there); the rows reached go into ``w``. Returns the state of the
+    last row when it reached the end of ``order``, else None."""
+    prev, i, stride = k0, 0, MAX_STRIDE
+    while i < len(order):
         j = min(i + stride, len(order)) - 1
         rows = order[i:j + 1]
         n, size, poses, nxt = tr.block(st, U[prev], U[rows])
@@ -432,29 +562,18 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
             k = int(rows[0])
             nxt = tr.advance(st, U[prev], U[k])
             if nxt is None:
-                w.events.append(event(k, "dead point", st.lin.ratio[0]))
-                i, gap = i + 1, True
-                continue
+                if not w.ok[k]:
+                    w.events.append(event(k, "dead point", st.lin.ratio[0]))
+                return None
             n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
         done = rows[:n]
         w.R[done], w.p[done], w.href[done] = poses
         w.ok[done] = True
+        w.how[done] = how
         st, prev, i = nxt, int(done[-1]), i + n
         reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
-
-
-def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray) -> int:
-    """From the reassembled row ``rows[0]`` (state ``st``) back through the gap's rows while
-    the mechanism follows (so the gap ends where the mechanism stops assembling, not where
-    Newton first converged); returns the first row of the assembled stretch."""
-    w.put(int(rows[0]), st)
-    for prev, k in zip(rows[:-1], rows[1:]):
-        st = tr.advance(st, U[prev], U[k])
-        if st is None:
-            return int(prev)
-        w.put(int(k), st)
-    return int(rows[-1])
+    return st
 
 
 def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
