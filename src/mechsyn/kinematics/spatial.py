@@ -53,7 +53,9 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
-from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, crossings, walk
+from mechsyn.kinematics.spatial_singular import crossings
+from mechsyn.kinematics.spatial_model import pair_error
+from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
 from mechsyn.model.mechanism import Mechanism
 
@@ -239,8 +241,8 @@ def _input_dict(M: SpatialModel, u: np.ndarray) -> dict[str, float]:
 _MESSAGES = {
     "not assembled": "the drawn assembly cannot be moved to this input (a dead point or a singular "
                      "configuration lies between)",
-    "dead point": "a limit of the working range: the drive cannot reach this value from the previous row "
-                  "(singular value ratio {:.2g} where the continuation stopped)",
+    "dead point": "a limit of the working range (its input refined between the last row reached and this "
+                  "one): the drive cannot go on (singular value ratio {:.2g} where the continuation stopped)",
     "reassembled": "assembles again after a gap, in another assembly than the drawn one (no motion from the "
                    "drawn assembly reaches these rows: Newton from the last pose before the gap)",
     "round": "reached the other way round from the drawn assembly (the input taken modulo 360 degrees): the "
@@ -256,7 +258,7 @@ def _regular_rank(tr: Tracker, st: State) -> None:
     singular, ``tr.rank`` becomes the higher rank and ``tr.drawn_singular`` is set."""
     rows = np.unique([0, len(st.g) // 2, len(st.g) - 1])
     sv = np.linalg.svd(st.lin.Jc[rows], compute_uv=False)
-    rank = int(np.max(np.count_nonzero(sv > RANK_TOL * sv[:, :1], axis=1)))
+    rank = int(np.max(np.count_nonzero(sv > tr.rank_tol * sv[:, :1], axis=1)))
     if rank > (tr.rank or 0):
         tr.drawn_singular, tr.rank, st.lin.r = tr.rank, rank, rank
         st.lin.__dict__.pop("ratio", None)
@@ -267,8 +269,14 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
     the rank test and the rates of all assembled rows at once."""
     M = tr.M
 
-    def event(k: int, kind: str, detail: Any) -> dict:
-        return {"index": k, "kind": kind, "input": _input_dict(M, U[k]), "message": _MESSAGES[kind].format(detail)}
+    def event(k: int, kind: str, detail: Any, at: np.ndarray | None = None, last: int | None = None) -> dict:
+        """An event at row ``k``; ``at``: its input's offset from row ``k``'s (a refined limit);
+        ``last``: the assembled row it bounds."""
+        e = {"index": k, "kind": kind, "input": _input_dict(M, U[k] if at is None else U[k] + at),
+             "message": _MESSAGES[kind].format(detail)}
+        if last is not None:
+            e["last"] = int(last)
+        return e
 
     w = walk(tr, start, U, event)
     N, n = len(U), M.n
@@ -278,26 +286,66 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
     idx = np.flatnonzero(w.ok)
     if len(idx):
         st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
+        keep = _verify(tr, w, idx, st, event)
+        if not keep.all():
+            idx, st = idx[keep], st.take(np.flatnonzero(keep))
+    if len(idx):
         _regular_rank(tr, st)
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
         out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
         x1, x2 = tr.rates(st, np.broadcast_to(sp, (len(idx), len(sp))), refine=2)
-        regular = st.lin.ratio >= RANK_TOL
+        regular = st.lin.ratio >= singular_tol(M)
+        found = crossings(tr, w, U, out.ratio, st.lin.Jc, idx)
+        on_row = {c[3] for c in found if c[3] is not None}
+        regular &= ~np.isin(idx, list(on_row))
         out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
-        for k, r in zip(idx[~regular], st.lin.ratio[~regular]):
-            out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, U[k]),
-                               "message": f"singular configuration: the Jacobian's rank drops below {st.lin.r} "
-                                          f"(singular value ratio {r:.2g}); rates not defined here (null)"})
-        for k, u, r in crossings(tr, w, U, out.ratio):
-            out.events.append({"index": k, "kind": "singular", "crossed": True, "input": _input_dict(M, u),
-                               "message": f"a singular configuration lies between rows {k - 1} and {k + 1} "
-                                          f"(singular value ratio {r:.2g} there): the sweep passes it on the "
-                                          "branch it was on (the predictor's tangent)"})
+        _singular_events(M, out, U, idx[~regular], found)
         out.events.sort(key=lambda e: e["index"])
     if progress is not None:
         progress(N)
     return out
+
+
+def _verify(tr: Tracker, w: Any, idx: np.ndarray, st: State, event: Any) -> np.ndarray:
+    """Every row the walk assembled checked again before it is reported: its closure
+    residual and the pair check (each R, C, H, P pair's relative rotation is the one its
+    reported joint value gives, so the joint values close every loop:
+    :func:`~mechsyn.kinematics.spatial_model.pair_error`); a row that fails is not assembled,
+    with an event naming the pair. Returns the mask of ``idx`` (the assembled rows, state
+    ``st``) kept."""
+    M = tr.M
+    err = pair_error(M, st.R)
+    res = np.abs(st.g).max(axis=1)
+    bad = (res > closure_tol(tr)) | (err.max(axis=1, initial=0.0) > PAIR_TOL)
+    for k, e in zip(idx[bad], err[bad]):
+        w.ok[k] = False
+        w.events.append(event(int(k), "refused", M.pairs.ids[int(np.argmax(e))] if e.size else "-"))
+    return ~bad
+
+
+def closure_tol(tr: Tracker) -> float:
+    """The largest closure residual a reported row may carry: ``CLOSURE_TOL`` of the length
+    scale, or ten times the corrector's tolerance where the file's coordinates need more."""
+    return max(CLOSURE_TOL, 10 * tr.tol)
+
+
+def _singular_events(M: SpatialModel, out: _Rows, U: np.ndarray, rows: np.ndarray, found: list) -> None:
+    """Events of the singular rows (rates null) and of the crossings between rows."""
+    on_row = {c[3]: c for c in found if c[3] is not None}
+    for k in rows:
+        r = out.ratio[k]
+        u = on_row[k][1] if k in on_row else U[k]
+        out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, u),
+                           "message": f"singular configuration (singular value ratio {r:.2g}): a change or "
+                                      "dead point on this row; rates not defined here (null)"})
+    for k, u, r, at in found:
+        if at is not None:
+            continue
+        out.events.append({"index": int(k), "kind": "singular", "crossed": True, "input": _input_dict(M, u),
+                           "message": f"a singular configuration lies between rows {k} and {k + 1} (singular "
+                                      f"value ratio {r:.2g} there): the sweep passes it on the branch it was on "
+                                      "(the predictor's tangent)"})
 
 
 def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.ndarray], sp: np.ndarray,
@@ -328,9 +376,9 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
                      "held at their drawn position (minimum-norm steps and rates)")
     if tr.halvings:
         notes.append(f"the continuation step was halved {tr.halvings} time(s) where the corrector had trouble")
-    bad = ok & (rows.res > CLOSURE_TOL)
+    bad = ok & (rows.res > closure_tol(tr))
     if bad.any():
-        notes.append(f"closure residual above {CLOSURE_TOL:g} of the length scale at {int(bad.sum())} row(s)")
+        notes.append(f"closure residual above {closure_tol(tr):g} of the length scale at {int(bad.sum())} row(s)")
     types = {jid: mech.joint(jid).type for jid in inputs}
     speeds = {d[0]: float(v * (L if d[1] == "slide" else 1.0)) for d, v in zip(M.drives, sp) if d[0] in inputs}
     return SpatialSimulation(

@@ -71,6 +71,8 @@ def singular_tol(M: SpatialModel) -> float:
 #: guard). Measured: 0.35 / 0.5 / 0.75 / 1.0 give Bennett sweeps of 52 / 48 / 41 / 39 ms.
 MAX_STEP = 0.75
 MAX_HALVINGS = 12
+#: Events and working-range limits are refined to this fraction of the row step.
+REFINE = 1e-6
 MAX_STRIDE = 64
 
 
@@ -226,6 +228,8 @@ class Tracker:
         self.rank_tol = max(RANK_TOL, 100 * self.tol)
         self.rejected = 0  # converged poses refused by the pair check (another root of the equations)
         self.last_bad, self.last_pair, self.refused = np.zeros(0, bool), [], []
+        self.left_singular = False  # a singular pose was left (leave): the branch taken is a choice
+        self._left: tuple | None = None
 
     def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
         """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
@@ -331,7 +335,7 @@ class Tracker:
                 self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
         return ok & ~bad
 
-    def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
+    def step(self, st: State, du: np.ndarray, target: np.ndarray, iters: int = 8) -> tuple[State | None, float]:
         """One predictor-corrector step of a single pose; (the new state or None, the
         predictor's step size). The new state keeps the corrector's linearisation (of
         the predicted pose): good for the next predictor; the rates reported are
@@ -341,7 +345,8 @@ class Tracker:
         if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
             return None, size
         R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]),
+                                                   iters=iters)
         if not ok[0]:
             return None, size
         if not len(rows):
@@ -382,13 +387,14 @@ class Tracker:
             new = self.state(R[last], p[last], href[last], Ub[last])
         return n, size, (R[:n], p[:n], href[:n]), new
 
-    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray, iters: int = 8) -> State | None:
         """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
-        ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
+        ``2^-MAX_HALVINGS`` of it; None when it cannot get there. ``iters``: Newton steps a
+        try (more next to a singular point, where Newton converges only linearly)."""
         t, h = 0.0, 1.0
         while t < 1.0:
             h = min(h, 1.0 - t)
-            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
+            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0), iters)
             if nxt is None:
                 if h < 0.5 ** MAX_HALVINGS:
                     return None
@@ -415,6 +421,75 @@ class Tracker:
         return int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None])
 
 
+# --------------------------------------------------------------------------- leaving a singular pose
+def _null_motions(tr: Tracker, st: State) -> np.ndarray:
+    """The directions (k, 6 n) of the Jacobian's near-null space at ``st`` that move a
+    joint point (not idle spins), each signed so its largest entry is positive."""
+    M = tr.M
+    Jc = st.lin.Jc[0]
+    _, s, Vt = np.linalg.svd(Jc, full_matrices=True)
+    s = np.concatenate([s, np.zeros(Vt.shape[0] - len(s))])
+    tol = singular_tol(M) * s[0]
+    out = []
+    for v in Vt[s < tol]:
+        x = st.lin.twists(v[None, :, None])[0, :, 0]
+        X = x.reshape(M.n, 6)
+        move_pt = 0.0
+        for j in M.mech.joints:
+            if j.point is None:
+                continue
+            x0 = M.local(j.point)
+            for link in j.links:
+                i = M.index(link)
+                if i < M.n:
+                    y = st.R[0, i] @ x0 + st.p[0, i]
+                    move_pt = max(move_pt, float(np.abs(X[i, 3:] + np.cross(X[i, :3], y)).max()))
+        if move_pt > 1e-6:
+            out.append(x if x[np.argmax(np.abs(x))] > 0 else -x)
+    return np.array(out).reshape(-1, 6 * M.n)
+
+
+def leave(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+    """From a singular pose ``st`` (at inputs ``u0``) to ``u1``, or None: Newton from the pose moved by
+    the tangent and ``±σ`` along each null direction that moves a joint point (see
+    :mod:`mechsyn.kinematics.spatial_singular`)."""
+    du = u1 - u0
+    size = float(np.abs(du).max(initial=0.0))
+    if size == 0.0:
+        return st
+    N = _null_motions(tr, st)
+    if not len(N):
+        return None
+    x1, x2 = tr.rates(st, du[None])
+    base = x1[0] + 0.5 * x2[0]
+    sig = np.array([1.0, 3.0, 0.3]) * np.sqrt(size)
+    sig = np.concatenate([sig, [size, 3 * size]])
+    guesses = [base]
+    for v in N:
+        for g in sig:
+            guesses += [base + g * v, base - g * v]
+    memo = getattr(tr, "_left", None)
+    if memo is not None and memo[0] is st:  # the other way from the same pose: the same branch
+        d_prev, x_prev = memo[1], memo[2]
+        guesses.insert(0, -x_prev * (size / d_prev))
+    X = np.array(guesses)
+    B = len(X)
+    rep = np.zeros(B, int)
+    R, p = move(st.R[rep], st.p[rep], X)
+    R, p, ok, _ = tr.correct(R, p, st.href[rep], np.broadcast_to(u1, (B, len(u1))), np.full(B, np.inf), iters=30)
+    if not ok.any():
+        return None
+    if memo is not None and memo[0] is st and ok[0]:
+        j = 0
+    else:
+        dist = np.abs(R - st.R[rep]).max(axis=(1, 2, 3)) + np.abs(p - st.p[rep]).max(axis=(1, 2))
+        dist = np.where(ok, dist, np.inf)
+        j = int(np.argmax(dist <= dist.min() * (1 + 1e-6) + 1e-12))
+    tr._left = (st, size, X[j])
+    tr.left_singular = True
+    return tr.state(R[j:j + 1], p[j:j + 1], st.href, u1[None])
+
+
 # --------------------------------------------------------------------------- the walk
 @dataclass
 class Walk:
@@ -438,7 +513,7 @@ class Walk:
         return self.R[k:k + 1], self.p[k:k + 1], self.href[k:k + 1]
 
 
-def walk(tr: Tracker, start: State, U: np.ndarray, event: Any, first: Any = None) -> Walk:
+def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
     """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
     inputs): to the row nearest it, then outwards both ways by blocks of rows
     (:func:`_blocks_along`) as far as the mechanism moves. Then, by one rule, the rows left:
@@ -450,18 +525,17 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any, first: Any = None
        row order: another assembly than the drawn one (no motion from the drawn assembly
        reaches them), each such stretch an event ``reassembled``.
 
-    ``event(index, kind, detail)`` makes the event dicts; ``first(target)``, when given,
-    reaches the row nearest the drawn input instead of :meth:`Tracker.advance` (a singular
-    drawn assembly)."""
+    ``event(index, kind, detail)`` makes the event dicts. From a singular pose (a file
+    drawn at a dead or change point) the first row each way is reached by :func:`leave`."""
     M = tr.M
     N = len(U)
     w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
              np.zeros((N, len(M.helix))), np.zeros(N, bool), [], np.zeros(N, np.int8))
     k0 = int(np.argmin(np.abs(U).max(axis=1)))
     ends = []
-    st0 = tr.advance(start, np.zeros(U.shape[1]), U[k0]) if first is None else None
+    z = np.zeros(U.shape[1])
+    st = tr.advance(start, z, U[k0]) or leave(tr, start, z, U[k0])
     for order in (np.arange(k0, N), np.arange(k0, -1, -1)):
-        st = st0 if first is None else first(U[order[:2]])
         if st is None:
             ends.append(None)
             continue
@@ -560,10 +634,11 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
             continue
         if n == 0:  # a single row: halve within it
             k = int(rows[0])
-            nxt = tr.advance(st, U[prev], U[k])
+            nxt = tr.advance(st, U[prev], U[k]) or leave(tr, st, U[prev], U[k])
             if nxt is None:
                 if not w.ok[k]:
-                    w.events.append(event(k, "dead point", st.lin.ratio[0]))
+                    lim = limit(tr, st, U[prev], U[k])
+                    w.events.append(event(k, "dead point", st.lin.ratio[0], at=lim - U[k], last=prev))
                 return None
             n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
         done = rows[:n]
@@ -574,6 +649,23 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
         reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
     return st
+
+
+def limit(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
+    """The input where the motion from ``st`` (at ``u0``, assembled) towards ``u1`` (not
+    reached) stops: bisection on whether Newton from the nearest pose reached converges to
+    a true assembly (on either branch that meets there), to ``REFINE`` of the step."""
+    lo, hi = 0.0, 1.0
+    R, p, href = st.R, st.p, st.href
+    inf = np.array([np.inf])
+    while hi - lo > REFINE:
+        t = 0.5 * (lo + hi)
+        R1, p1, ok, _ = tr.correct(R, p, href, (u0 + t * (u1 - u0))[None], inf, iters=12)
+        if ok[0]:
+            R, p, lo = R1, p1, t
+        else:
+            hi = t
+    return u0 + lo * (u1 - u0)
 
 
 def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -595,66 +687,3 @@ def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndar
     for q, (a, b) in enumerate(pairs):
         x2 += np.outer(d[:, a] * d[:, b], X2[c + q] - X2[a] - X2[b])
     return x1, x2
-
-
-# --------------------------------------------------------------------------- crossings
-GOLDEN_STEPS = 40
-
-
-def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list[tuple[int, np.ndarray, float]]:
-    """Singular configurations the sweep passes between rows: ``(row, inputs, ratio)``.
-
-    ``σ_r / σ_1`` is zero at a singular configuration and, along a motion through it,
-    grows like the distance ``|t - t*|`` on both sides (a V), while a regular minimum is
-    smooth (``a + c t²``). A row whose ratio is a local minimum with its two neighbours'
-    sum at least four times its own (every V passes: ``2 Δ / |δ| >= 4`` for a zero at
-    ``δ`` within half a row; a smooth minimum passes only when it is sharp for its depth,
-    ``c Δ² >= a``, i.e. near-singular) is refined by a golden-section search of the ratio
-    over the inputs between its neighbours, each pose reached by continuation from the
-    row; it is a crossing when the smallest ratio found is under ``RANK_TOL``."""
-    out = []
-    N = len(U)
-    for k in range(1, N - 1):
-        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]):
-            continue
-        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
-        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= RANK_TOL):
-            continue
-        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
-        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
-            continue  # not on one straight stretch of the sweep
-        found = _golden(tr, w, U, k)
-        if found is not None and found[1] < RANK_TOL:
-            out.append((k, found[0], found[1]))
-    return out
-
-
-def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, float] | None:
-    """The least ``σ_r / σ_1`` between rows ``k - 1`` and ``k + 1`` (golden section)."""
-    st = tr.state(*w.at(k), U[k][None])
-    lo, hi = U[k - 1], U[k + 1]
-
-    def f(t: float) -> float:
-        u = lo + t * (hi - lo)
-        nxt = tr.advance(st, U[k], u)
-        if nxt is None:
-            return np.inf
-        return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
-
-    halvings = tr.halvings  # the search's own step halvings are not the sweep's trouble
-    g = (np.sqrt(5) - 1) / 2
-    a, b = 0.0, 1.0
-    c, d = b - g * (b - a), a + g * (b - a)
-    fc, fd = f(c), f(d)
-    for _ in range(GOLDEN_STEPS):
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - g * (b - a)
-            fc = f(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + g * (b - a)
-            fd = f(d)
-    tr.halvings = halvings
-    t, best = (c, fc) if fc < fd else (d, fd)
-    return (lo + t * (hi - lo), best) if np.isfinite(best) else None

@@ -1,0 +1,173 @@
+"""Singular configurations of a spatial sweep (used by :mod:`mechsyn.kinematics.spatial`):
+where the Jacobian of the constraints and drives loses rank along the path, and how the walk
+leaves a singular pose (a file drawn at a dead point or a change point).
+
+**Crossings by the sign of a determinant.** Between two rows ``k`` and ``k + 1`` of one motion
+the Jacobian ``J`` (constraints and drives, in twists at the links' centres) keeps its regular
+rank ``r`` unless the path crosses a singular configuration. With ``U_k``, ``V_k`` the first
+``r`` left and right singular vectors of ``J_k``, ``d(t) = det(U_kᵀ J(t) V_k)`` equals
+``σ_1 ... σ_r > 0`` at ``t = 0`` and is zero where ``J(t)`` has rank below ``r``; a simple crossing
+(a change or bifurcation point, where two branches meet) makes it change sign (Allgower and
+Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobian's
+determinant). The pairs where it can change at all are few: by Weyl's inequality
+``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
+the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
+of the two rows; only those pairs get an SVD. A sign change is bracketed and refined by
+bisection, each pose reached by continuation from row ``k``, to ``REFINE`` of the row step, and
+reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
+makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
+row's neighbours) are refined by a golden-section search as before.
+
+**Leaving a singular pose** (:func:`~mechsyn.kinematics.spatial_track.leave`). At a dead point of the input the mechanism moves like the square
+root of the input step, at a change point along either of two branches: the linear predictor
+of the continuation cannot leave such a pose. ``leave`` tries Newton from the pose moved by
+the minimum-norm tangent plus ``±σ`` along each null direction of ``J`` that moves a joint
+point (``σ`` a few multiples of ``√|Δu|`` and ``|Δu|``), and keeps the converged true assembly
+nearest the pose (ties: the positive direction first, each null vector signed so that its
+largest entry is positive) — or, leaving the same pose the other way, the one nearest the
+branch it left by first (the same branch through a change point).
+
+References
+----------
+.. [1] E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*, SIAM,
+   2003, ch. 8 (detecting bifurcation points along a path).
+.. [2] C. M. Gosselin and J. Angeles, "Singularity analysis of closed-loop kinematic chains",
+   *IEEE Trans. Robotics and Automation* 6(3), 281-290, 1990.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, singular_tol, svd_ratio
+
+__all__ = ["crossings", "REFINE"]
+
+GOLDEN_STEPS = 40
+
+
+# --------------------------------------------------------------------------- crossings
+def _svd_bases(Jc: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
+    U, _, Vt = np.linalg.svd(Jc, full_matrices=False)
+    return U[..., :r], Vt[..., :r, :]
+
+
+def _sign(Ub: np.ndarray, Vb: np.ndarray, Jc: np.ndarray) -> np.ndarray:
+    return np.sign(np.linalg.det(np.swapaxes(Ub, -1, -2) @ Jc @ np.swapaxes(Vb, -1, -2)))
+
+
+def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
+              Jc: np.ndarray, idx: np.ndarray) -> list[tuple[int, np.ndarray, float, int | None]]:
+    """Singular configurations the sweep passes: ``(row, inputs, ratio, on_row)`` with
+    ``on_row`` the row it falls on (within ``REFINE`` of the step) or None (see the module
+    doc). ``Jc`` (B, m, k): the Jacobians of the assembled rows ``idx``; ``ratio``: every
+    row's ``σ_r / σ_1`` (NaN where not assembled)."""
+    r = tr.rank
+    if not r or len(idx) < 2:
+        return []
+    pos = {int(k): i for i, k in enumerate(idx)}
+    same = (w.ok[:-1] & w.ok[1:]) & (w.how[:-1] == w.how[1:])
+    ks = np.flatnonzero(same)
+    if not len(ks):
+        return []
+    a, b = np.array([pos[k] for k in ks]), np.array([pos[k + 1] for k in ks])
+    norm = np.linalg.norm(Jc, axis=(1, 2))
+    low = np.nan_to_num(ratio[idx]) * norm / np.sqrt(max(r, 1))  # lower bounds of σ_r
+    jump = np.linalg.norm(Jc[b] - Jc[a], axis=(1, 2))
+    near = (low[a] <= 2 * jump) | (low[b] <= 2 * jump)
+    tol = singular_tol(tr.M)
+    near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
+    out = []
+    if near.any():
+        Ub, Vb = _svd_bases(Jc[a[near]], r)
+        flips = _sign(Ub, Vb, Jc[b[near]]) <= 0
+        for k, ub, vb in zip(ks[near][flips], Ub[flips], Vb[flips]):
+            found = _bisect(tr, w, U, int(k), ub, vb)
+            if found is not None:
+                out.append(found)
+    seen = {c[0] for c in out} | {c[0] + 1 for c in out}
+    out += [c for c in _v_minima(tr, w, U, ratio) if c[0] not in seen and c[0] - 1 not in seen]
+    return out
+
+
+def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
+            vb: np.ndarray) -> tuple[int, np.ndarray, float, int | None] | None:
+    """The crossing between rows ``k`` and ``k + 1`` by bisection on the sign of
+    ``det(U_kᵀ J V_k)``; None when none is found (the sign change was not a rank drop)."""
+    st = tr.state(*w.at(k), U[k][None])
+    lo, hi = 0.0, 1.0
+    halvings = tr.halvings
+    best = 1.0
+    while hi - lo > REFINE:
+        t = 0.5 * (lo + hi)
+        u = U[k] + t * (U[k + 1] - U[k])
+        nxt = tr.advance(st, U[k], u, iters=40)  # Newton converges only linearly next to the singular point
+        if nxt is None:  # it stalls even so
+            break
+        Jc = tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc
+        s = _sign(ub, vb, Jc[0])
+        best = float(svd_ratio(Jc, tr.rank)[0])
+        if s > 0:
+            lo = t
+        else:
+            hi = t
+    tr.halvings = halvings
+    t = 0.5 * (lo + hi)
+    if best > 1e3 * singular_tol(tr.M) and hi - lo <= REFINE:
+        return None  # the determinant changed sign without the rank dropping: a frame effect
+    on = k if t < REFINE else (k + 1 if t > 1 - REFINE else None)
+    return k, U[k] + t * (U[k + 1] - U[k]), best, on
+
+
+def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list:
+    """Rows whose ratio is a sharp local minimum (``r0 + r2 >= 4 r1``: every V passes)
+    refined by a golden-section search; a crossing where it falls under the singular
+    tolerance."""
+    out = []
+    tol = singular_tol(tr.M)
+    for k in range(1, len(U) - 1):
+        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]) or len({w.how[k - 1], w.how[k], w.how[k + 1]}) > 1:
+            continue
+        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
+        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= tol):
+            continue
+        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
+        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
+            continue  # not on one straight stretch of the sweep
+        found = _golden(tr, w, U, k)
+        if found is not None and found[1] < tol:
+            out.append((k, found[0], found[1], None))
+    return out
+
+
+def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, float] | None:
+    """The least ``σ_r / σ_1`` between rows ``k - 1`` and ``k + 1`` (golden section)."""
+    st = tr.state(*w.at(k), U[k][None])
+    lo, hi = U[k - 1], U[k + 1]
+
+    def f(t: float) -> float:
+        u = lo + t * (hi - lo)
+        nxt = tr.advance(st, U[k], u)
+        if nxt is None:
+            return np.inf
+        return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
+
+    halvings = tr.halvings  # the search's own step halvings are not the sweep's trouble
+    g = (np.sqrt(5) - 1) / 2
+    a, b = 0.0, 1.0
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    for _ in range(GOLDEN_STEPS):
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    tr.halvings = halvings
+    t, best = (c, fc) if fc < fd else (d, fd)
+    return (lo + t * (hi - lo), best) if np.isfinite(best) else None
