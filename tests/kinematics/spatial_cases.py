@@ -100,7 +100,7 @@ def spherical_fourbar(a, b, c, d, phi0, centre=(0.0, 0.0, 0.0), radius=1.0, bran
 
 
 # --------------------------------------------------------------------------- RSSR
-def rssr_at_dead_point(r=1.0, rod=None):
+def rssr_at_dead_point(r=2.0, rod=None):
     """An RSSR (crank radius ``r`` about z at the origin; rocker radius 1 about x through
     ``(3, 2, 1)``) drawn at a dead point of its crank: the rod ``B C`` is perpendicular to the
     rocker's circle there (``∂f/∂ψ = 0``), so the crank angle is at a limit of its range.
@@ -113,7 +113,16 @@ def rssr_at_dead_point(r=1.0, rod=None):
     def Cpt(psi):
         return Dp + np.cos(psi) * e1 + np.sin(psi) * e2
 
-    phi_star = np.radians(20.0)
+    def far(phi):  # the largest distance from the crank pin to the rocker's circle
+        B = r * np.array([np.cos(phi), np.sin(phi), 0.0])
+        q = Dp - B
+        return np.sqrt((q @ [1, 0, 0]) ** 2 + (np.hypot(q @ e1, q @ e2) + 1) ** 2)
+
+    grid = np.radians(np.arange(0, 360, 0.5))
+    f = np.array([far(t) for t in grid])
+    rising = np.gradient(f) > 0
+    goal = f.min() + 0.25 * (f.max() - f.min())  # a rod this long: a dead point on the rising side
+    phi_star = float(grid[rising][np.argmin(np.abs(f[rising] - goal))])
     Bs = r * np.array([np.cos(phi_star), np.sin(phi_star), 0.0])
     # ψ* with C'(ψ*)·(C(ψ*) - B*) = 0: (-sin ψ e1 + cos ψ e2)·(D - B*) = 0
     q = Dp - Bs

@@ -12,11 +12,14 @@ Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobia
 determinant). The pairs where it can change at all are few: by Weyl's inequality
 ``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
 the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
-of the two rows; only those pairs get an SVD. A sign change is bracketed and refined by
-bisection, each pose reached by continuation from row ``k``, to ``REFINE`` of the row step, and
+of the two rows; only those pairs get an SVD. A sign change is bracketed and refined (below) and
 reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
 makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
-row's neighbours) are refined by a golden-section search as before.
+row's neighbours) are candidates too. Each candidate is refined by a golden-section search of
+``σ_r/σ_1`` over its bracket to ``REFINE`` of the step (a V about the crossing on either branch
+that meets there, so it does not matter which one Newton lands on that close to it; the sign of
+the determinant does, which is why it only brackets) and is a crossing where the least ratio is
+under the singular tolerance.
 
 **Leaving a singular pose** (:func:`~mechsyn.kinematics.spatial_track.leave`). At a dead point of the input the mechanism moves like the square
 root of the input step, at a change point along either of two branches: the linear predictor
@@ -45,7 +48,6 @@ from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, singular_tol
 
 __all__ = ["crossings", "REFINE"]
 
-GOLDEN_STEPS = 40
 
 
 # --------------------------------------------------------------------------- crossings
@@ -94,31 +96,15 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
 
 def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
             vb: np.ndarray) -> tuple[int, np.ndarray, float, int | None] | None:
-    """The crossing between rows ``k`` and ``k + 1`` by bisection on the sign of
-    ``det(U_kᵀ J V_k)``; None when none is found (the sign change was not a rank drop)."""
-    st = tr.state(*w.at(k), U[k][None])
-    lo, hi = 0.0, 1.0
-    halvings = tr.halvings
-    best = 1.0
-    while hi - lo > REFINE:
-        t = 0.5 * (lo + hi)
-        u = U[k] + t * (U[k + 1] - U[k])
-        nxt = tr.advance(st, U[k], u, iters=40)  # Newton converges only linearly next to the singular point
-        if nxt is None:  # it stalls even so
-            break
-        Jc = tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc
-        s = _sign(ub, vb, Jc[0])
-        best = float(svd_ratio(Jc, tr.rank)[0])
-        if s > 0:
-            lo = t
-        else:
-            hi = t
-    tr.halvings = halvings
-    t = 0.5 * (lo + hi)
-    if best > 1e3 * singular_tol(tr.M) and hi - lo <= REFINE:
-        return None  # the determinant changed sign without the rank dropping: a frame effect
+    """The crossing between rows ``k`` and ``k + 1`` (where ``det(U_kᵀ J V_k)`` changed
+    sign): the least ``σ_r / σ_1`` between them (:func:`_golden`); None when it is not a
+    rank drop (the sign changed by a frame effect)."""
+    found = _golden(tr, w, U, [k, k + 1])
+    if found is None or found[1] >= singular_tol(tr.M):
+        return None
+    t = float((found[0] - U[k]) @ (U[k + 1] - U[k]) / ((U[k + 1] - U[k]) @ (U[k + 1] - U[k])))
     on = k if t < REFINE else (k + 1 if t > 1 - REFINE else None)
-    return k, U[k] + t * (U[k + 1] - U[k]), best, on
+    return k, found[0], found[1], on
 
 
 def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list:
@@ -136,20 +122,26 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list:
         a, b = U[k] - U[k - 1], U[k + 1] - U[k]
         if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
             continue  # not on one straight stretch of the sweep
-        found = _golden(tr, w, U, k)
+        found = _golden(tr, w, U, [k - 1, k, k + 1])
         if found is not None and found[1] < tol:
             out.append((k, found[0], found[1], None))
     return out
 
 
-def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, float] | None:
-    """The least ``σ_r / σ_1`` between rows ``k - 1`` and ``k + 1`` (golden section)."""
-    st = tr.state(*w.at(k), U[k][None])
-    lo, hi = U[k - 1], U[k + 1]
+def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.ndarray, float] | None:
+    """The least ``σ_r / σ_1`` over the inputs from row ``rows[0]`` to row ``rows[-1]``
+    (golden section to ``REFINE`` of a row step, each pose reached by continuation from the
+    nearest of ``rows``, many Newton steps a try: next to a singular point Newton converges
+    only linearly). The ratio is a V about a crossing on either branch that meets there, so
+    a hop between them does not move the minimum."""
+    states = {k: tr.state(*w.at(k), U[k][None]) for k in rows}
+    lo, hi = U[rows[0]], U[rows[-1]]
+    span = len(rows) - 1
 
     def f(t: float) -> float:
         u = lo + t * (hi - lo)
-        nxt = tr.advance(st, U[k], u)
+        k = rows[int(np.clip(np.rint(t * span), 0, span))]
+        nxt = tr.advance(states[k], U[k], u, iters=40)
         if nxt is None:
             return np.inf
         return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
@@ -159,7 +151,7 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, fl
     a, b = 0.0, 1.0
     c, d = b - g * (b - a), a + g * (b - a)
     fc, fd = f(c), f(d)
-    for _ in range(GOLDEN_STEPS):
+    while b - a > REFINE / span:
         if fc < fd:
             b, d, fd = d, c, fc
             c = b - g * (b - a)
