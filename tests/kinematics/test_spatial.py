@@ -245,7 +245,7 @@ def test_rssr_working_range_dead_points_and_gap():
     clear = margin > 1e-6
     assert np.array_equal(s.assembled[clear], want[clear])
     kinds = [e["kind"] for e in s.events]
-    assert "dead point" in kinds and "round" in kinds  # the gap closed the other way round (modulo 360)
+    assert "dead point" in kinds and "other way round" in kinds  # the gap closed the other way round (modulo 360)
     assert np.isnan(s.point("C")[~s.assembled]).all()
     d = s.to_dict()
     gap = np.flatnonzero(~s.assembled)
@@ -342,7 +342,7 @@ def test_cli_json_is_to_dict_and_text_fits_80_columns(capsys, monkeypatch):
     monkeypatch.setenv("COLUMNS", "80")
     assert main(["simulate", "rssr", "-i", "A=0:360:5"]) == 0
     out = capsys.readouterr().out
-    assert "dead point" in out and "round" in out
+    assert "dead point" in out and "other way round" in out
     assert max(len(line) for line in out.splitlines()) <= 80
 
 

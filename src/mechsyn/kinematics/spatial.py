@@ -120,9 +120,9 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
     """(N, drives) targets in model units: radians, or lengths over the scale."""
     N = len(next(iter(inputs.values())))
     U = np.zeros((N, len(M.drives)))
-    for k, (jid, kind, _) in enumerate(M.drives):
+    for k, (jid, kind, kk) in enumerate(M.drives):
         if jid in inputs:
-            U[:, k] = np.radians(inputs[jid]) if kind == "angle" else inputs[jid] / M.scale
+            U[:, k] = np.radians(inputs[jid]) - M.zeros[kk] if kind == "angle" else inputs[jid] / M.scale
     return U
 
 
@@ -231,11 +231,13 @@ class _Rows:
     theta: np.ndarray
     slide: np.ndarray
     events: list
+    how: np.ndarray | None = None
 
 
 def _input_dict(M: SpatialModel, u: np.ndarray) -> dict[str, float]:
-    return {jid: float(np.degrees(v)) if kind == "angle" else float(v * M.scale)
-            for (jid, kind, _), v in zip(M.drives, u)}
+    """Model targets -> the inputs as the user gives them (deg from the joint's zero, lengths)."""
+    return {jid: float(np.degrees(v + M.zeros[kk])) if kind == "angle" else float(v * M.scale)
+            for (jid, kind, kk), v in zip(M.drives, u)}
 
 
 _MESSAGES = {
@@ -245,7 +247,7 @@ _MESSAGES = {
                   "one): the drive cannot go on (singular value ratio {:.2g} where the continuation stopped)",
     "reassembled": "assembles again after a gap, in another assembly than the drawn one (no motion from the "
                    "drawn assembly reaches these rows: Newton from the last pose before the gap)",
-    "round": "reached the other way round from the drawn assembly (the input taken modulo 360 degrees): the "
+    "other way round": "reached the other way round from the drawn assembly (the input taken modulo 360 degrees): the "
              "drawn circuit, on from the sweep's other end",
     "refused": "not assembled here: Newton converged to a pose where pair {} is not the file's pair (its axis "
                "reversed or a slide half-turned: another root of its equations), refused",
@@ -282,7 +284,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
     N, n = len(U), M.n
     out = _Rows(w.R[:, :-1], w.p[:, :-1], np.full((N, 6 * n), np.nan), np.full((N, 6 * n), np.nan), w.ok,
                 np.full(N, np.nan), np.full(N, np.nan), np.full((N, M.angles.size), np.nan),
-                np.full((N, M.slides.size), np.nan), w.events)
+                np.full((N, M.slides.size), np.nan), w.events, w.how)
     idx = np.flatnonzero(w.ok)
     if len(idx):
         st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
@@ -363,7 +365,10 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     pm = {}
     for name, (link, at) in pts.items():
         pm[name] = _point_motion(M, rows, X, Xd, link, M.local(at))
-    joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok)) for k, jid in enumerate(M.angle_joints)}
+    joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok) + M.zeros[k]) for k, jid in enumerate(M.angle_joints)}
+    for jid, v in inputs.items():  # an input joint reads its input (the same turn)
+        if jid in joints:
+            joints[jid] = np.where(ok, v, np.nan)
     joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
                    for k, jid in enumerate(M.slide_joints)})
     notes = []
@@ -379,12 +384,41 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     bad = ok & (rows.res > closure_tol(tr))
     if bad.any():
         notes.append(f"closure residual above {closure_tol(tr):g} of the length scale at {int(bad.sum())} row(s)")
+    notes += _reach_notes(M, tr, U, rows)
     types = {jid: mech.joint(jid).type for jid in inputs}
     speeds = {d[0]: float(v * (L if d[1] == "slide" else 1.0)) for d, v in zip(M.drives, sp) if d[0] in inputs}
     return SpatialSimulation(
         mechanism=mech.name, inputs=inputs, input_types=types, speeds=speeds, assembled=ok, points=pm,
         links=links, joints=joints, residual=rows.res, singular_ratio=rows.ratio, length_scale=L,
-        rank=tr.rank, idle=idle, events=rows.events, notes=notes, model=M)
+        rank=tr.rank, idle=idle, events=rows.events, notes=notes, model=M,
+        reached=np.where(ok, rows.how, 0).astype(int), held=tuple(d[0] for d in M.drives if d[0] not in inputs),
+        zero={d[0]: float(np.degrees(M.zeros[d[2]])) for d in M.drives if d[0] in inputs and d[1] == "angle"})
+
+
+def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> list[str]:
+    """What the summary says about how the rows were reached (:func:`~.spatial_track.walk`)."""
+    notes = []
+    how = np.where(rows.ok, rows.how, 0)
+    if (how == 2).any():
+        notes.append(f"{int((how == 2).sum())} row(s) reached going the other way round from the drawn assembly "
+                     "(the input modulo 360): the drawn circuit")
+    if (how == 3).any():
+        notes.append(f"{int((how == 3).sum())} row(s) in another assembly than the drawn one: no motion from the "
+                     "drawn assembly reaches them (re-assembled by Newton after a gap)")
+    if tr.rejected:
+        notes.append(f"{tr.rejected} converged pose(s) refused: another root of a pair's equations (an R axis "
+                     "reversed or a slide half-turned), not the file's pairs")
+    col = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
+    if len(col) == 1 and M.lay.d_angle[col[0]]:
+        u = U[:, col[0]]
+        turns = rows.ok & (np.abs(np.mod(u + np.pi, 2 * np.pi) - np.pi) < 1e-9) & (np.abs(u) > 1e-9)
+        off = [k for k in np.flatnonzero(turns) if np.abs(rows.R[k] - np.eye(3)).max() > 1e-6
+               or np.abs(rows.p[k]).max() > 1e-6]
+        if off:
+            v = _input_dict(M, U[off[0]])[M.drives[col[0]][0]]
+            notes.append(f"at {M.drives[col[0]][0]} = {v:.6g} (the drawn input, a turn on) the mechanism is in "
+                         "another assembly than drawn: its circuit takes more than one turn of the input")
+    return notes
 
 
 def _point_motion(M: SpatialModel, rows: _Rows, X: np.ndarray, Xd: np.ndarray, link: str,

@@ -59,6 +59,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -156,6 +157,9 @@ class SpatialModel:
     lay: "_Layout | None" = None
     ulp: float = float(np.finfo(float).eps)
     pairs: "_Pairs | None" = None
+    #: per angle joint (``angle_joints``), its input's value at the drawn assembly (rad):
+    #: :func:`input_zero`
+    zeros: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -257,7 +261,64 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
                      _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
                      tuple(rows["slide_joints"]), helix, tuple(drive_rows),
                      ulp=float(np.finfo(float).eps) * max(1.0, big / scale))
-    return replace(M, lay=_layout(M), pairs=_pairs(mech, index))
+    zeros = np.array([input_zero(mech, mech.joint(jid)) for jid in M.angle_joints], float)
+    return replace(M, lay=_layout(M), pairs=_pairs(mech, index), zeros=zeros)
+
+
+# --------------------------------------------------------------------------- input zeros
+def _p3(v: Any) -> np.ndarray:
+    v = np.asarray(v, float)
+    return np.pad(v, (0, 3 - len(v)))
+
+
+def reference_direction(mech: Mechanism, link: str) -> np.ndarray:
+    """A link's reference line in the drawn assembly (3-D): from its first joint's point (file
+    order) to the first other joint point apart from it, the planar engines' rule (a crank's
+    angle is its line's); the frame's is ``+x``, as is that of a link with one point."""
+    x = np.array([1.0, 0.0, 0.0])
+    if link == mech.ground:
+        return x
+    pts = [_p3(j.point) for j in mech.joints_of(link) if j.point is not None]
+    size = max((float(np.abs(p - pts[0]).max()) for p in pts), default=0.0)
+    for p in pts[1:]:
+        if np.linalg.norm(p - pts[0]) > 1e-12 * max(size, 1e-300):
+            return p - pts[0]
+    return x
+
+
+def input_zero(mech: Mechanism, j: Joint) -> float:
+    """The value (rad) of the input of R, H or C pair ``j`` in the drawn assembly: the angle
+    about its axis from its zero (on the first link) to the second link's reference line
+    (:func:`reference_direction`). The zero is the file's ``zero`` direction; for a planar
+    mechanism (axis ``z``) the first link's reference line, so that an input means what the
+    planar engines make of it (the angle of the driven link's line, relative to the first
+    link's); else there is none and the drawn pose is 0.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.examples.load("crank_rocker")
+    >>> A = m.joint(next(j.id for j in m.joints if j.actuated))
+    >>> round(float(np.degrees(input_zero(m, A))), 6) == round(float(np.degrees(np.arctan2(
+    ...     *(reference_direction(m, A.links[1])[[1, 0]])))), 6)
+    True
+    """
+    if j.type not in ("R", "H", "C"):
+        return 0.0
+    z = j.attrs.get("zero")
+    planar = mech.kind == "planar"
+    if z is None and not planar:
+        return 0.0
+    a = np.array([0.0, 0.0, 1.0]) if planar else _unit(np.asarray(j.axis, float))
+    z = reference_direction(mech, j.links[0]) if z is None else np.asarray(z, float)
+    r = reference_direction(mech, j.links[1])
+    z, r = z - (z @ a) * a, r - (r @ a) * a
+    if not np.linalg.norm(r) > 1e-12 * np.linalg.norm(reference_direction(mech, j.links[1])):
+        raise MechsynInputError(
+            f"joint {j.id}: link {j.links[1]!r}'s reference line (its first joint to its first other joint) runs "
+            "along the axis, so the zero cannot measure its angle", source=mech.source, field=f"joints[{j.id}].zero",
+            hint="remove `zero` (the input is then measured from the drawn pose)")
+    return float(np.arctan2(a @ np.cross(z, r), z @ r))
 
 
 # --------------------------------------------------------------------------- pair integrity

@@ -580,7 +580,7 @@ def _round(tr: Tracker, w: Walk, U: np.ndarray, ends: list, event: Any) -> None:
         _blocks_along(tr, w, st, V, end, order, event, how=2)
         got = np.flatnonzero(w.ok & ~before)
         if len(got):
-            w.events.append(event(int(got[0]), "round", None))
+            w.events.append(event(int(got[0]), "other way round", None))
     _same_angle(w, U, col)
 
 
