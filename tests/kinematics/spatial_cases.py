@@ -148,3 +148,35 @@ def rssr_at_dead_point(r=2.0, rod=None):
         {"id": "C", "type": "S", "links": ["rod", "rocker"], "point": Cs.tolist()},
         _r("D", "frame", "rocker", Dp, [1, 0, 0])]}, "rssr_dead")
     return m, float(np.degrees(phi_star)), psi
+
+
+def rssr_taut():
+    """An RSSR drawn with its rod at the largest distance between the crank pin's circle and
+    the rocker pin's circle (over both angles): stretched taut, it cannot move at all (finite
+    mobility 0 besides the rod's idle spin) though it has two instantaneous motions."""
+    Dp = np.array([3.0, 2.0, 1.0])
+
+    def pins(phi, psi):
+        return np.array([np.cos(phi), np.sin(phi), 0.0]), Dp + [0.0, np.cos(psi), np.sin(psi)]
+
+    def dist(x):
+        B, C = pins(*x)
+        return np.linalg.norm(C - B)
+
+    g = np.radians(np.arange(0, 360, 2.0))
+    best = max(((a, b) for a in g for b in g), key=dist)
+    x = np.array(best)
+    for _ in range(60):  # Newton on the gradient of the squared distance (a smooth maximum)
+        h = 1e-5
+        f = lambda y: dist(y) ** 2  # noqa: E731
+        gr = np.array([(f(x + h * e) - f(x - h * e)) / (2 * h) for e in np.eye(2)])
+        H = np.array([[(f(x + h * (ei + ej)) - f(x + h * (ei - ej)) - f(x - h * (ei - ej)) + f(x - h * (ei + ej)))
+                       / (4 * h * h) for ej in np.eye(2)] for ei in np.eye(2)])
+        x = x - np.linalg.solve(H, gr)
+    B, C = pins(*x)
+    return mechanism_from_dict({"name": "taut RSSR", "kind": "spatial", "ground": "frame",
+                                "links": ["frame", "crank", "rod", "rocker"], "joints": [
+        _r("A", "frame", "crank", [0, 0, 0], [0, 0, 1], True),
+        {"id": "B", "type": "S", "links": ["crank", "rod"], "point": B.tolist()},
+        {"id": "C", "type": "S", "links": ["rod", "rocker"], "point": C.tolist()},
+        _r("D", "frame", "rocker", Dp, [1, 0, 0])]}, "rssr_taut")

@@ -216,3 +216,19 @@ def test_text_and_csv_carry_joint_values_link_orientations_and_refined_events():
     assert np.linalg.norm(rv) == pytest.approx(angle, abs=1e-9)
     D = (float(vals["joint_D"]) + 180) % 360 - 180
     assert abs(D) == pytest.approx(angle, abs=1e-9)  # the rocker turns about D only
+
+
+# --------------------------------------------------------------------------- 7. the verdict's first words
+def test_analyze_headline_leads_with_what_the_mechanism_does():
+    from spatial_cases import rssr_taut
+
+    from mechsyn.structure.rank import motion_headline
+    from mechsyn.structure.report import verdict
+
+    taut = ms.analyze_rank(rssr_taut())  # stretched: only the rod's idle spin is finite
+    assert motion_headline(taut) == "rigid (finite mobility 0; besides 1 idle motion), shaky: 2 instantaneous motions"
+    assert taut.drives_needed == 0 and "locked" in taut.actuation_note and "redundant" not in taut.actuation_note
+    four = ms.analyze_rank(ms.examples.load("fourbar_taut"))
+    assert motion_headline(four) == "rigid (finite mobility 0), shaky: 2 instantaneous motions"
+    v = verdict(ms.analyze(ms.examples.load("rssr")).analysis, ms.analyze_rank(ms.examples.load("rssr")))
+    assert v["text"].startswith("moves with 1 degree of freedom (finite; besides 1 idle motion); drives needed: 1")

@@ -582,10 +582,15 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     if check_singular and mobility > 0:
         progress("singularity")
         lm, contours = _local(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
+    drives = useful if lm.finite is None else max(lm.finite - len(idle), 0)  # from the finite mobility
+    if lm.finite is not None and drives == 0 and mobility and anames:
+        spins = f" besides {_n(len(idle), 'idle motion')}" if idle else ""
+        determined, anote = True, (f"the drive(s) at {', '.join(anames)} are locked: the mechanism is rigid "
+                                   f"(finite mobility 0{spins}), no drive can move it")
     sv = red.singular_values
     return RankAnalysis(
         motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
-        idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
+        idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=drives,
         actuated=anames, actuation_determined=determined, actuation_note=anote,
         singular=lm.configuration == "singular", shaky=lm.configuration == "shaky", configuration=lm.configuration,
         mobility_reading=mobility_reading(lm.configuration, mobility, lm.finite), finite_mobility=lm.finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
@@ -645,13 +650,20 @@ def _actuation(sysm: _System, N: np.ndarray, Z0: np.ndarray, acols: list[int], a
         return None, ""
     mobility = N.shape[1]
     uncontrolled = Z0.shape[1] - idle
+    locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
+              and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
     if uncontrolled:
+        if locked:  # a drive at a dead centre: the geometry holds it, the rest moves
+            return False, (f"the drive(s) at {', '.join(locked)} are locked at this pose (a dead centre: they cannot "
+                           f"move the mechanism here); {uncontrolled} useful motion(s) undetermined")
         return False, (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
                        f"{mobility - idle} drive(s) needed")
     ra = _rank(N[acols], tol) if mobility else 0
     if ra < len(acols):
-        locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
-                  and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
+        if len(locked) >= len(acols) - ra:  # the geometry holds them, not the other drives
+            return True, (f"the drive(s) at {', '.join(locked)} are locked: the mechanism cannot move them at "
+                          "this pose" + (f"; the drives at {', '.join(a for a in anames if a not in locked)} "
+                                         "determine the motion" if len(locked) < len(anames) else ""))
         return True, (f"the drives at {', '.join(anames)} determine the motion but {len(acols) - ra} of them "
                       "are not independent (redundant actuation: the drives fight each other)"
                       + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
@@ -716,9 +728,40 @@ def mobility_reading(configuration: str, instantaneous: int, finite: int | None)
 
 
 # --------------------------------------------------------------------------- report
+def _n(k: int, word: str) -> str:
+    return f"{k} {word}" + ("" if k == 1 else "s")
+
+
+def motion_headline(ra: RankAnalysis) -> str:
+    """What the mechanism does, first: rigid or moving with how many finite degrees of
+    freedom, then the instantaneous count where it differs (shaky or singular), idle motions
+    apart.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> motion_headline(ms.analyze_rank(ms.examples.load("fourbar_taut")))
+    'rigid (finite mobility 0), shaky: 2 instantaneous motions'
+    >>> motion_headline(ms.analyze_rank(ms.examples.load("rssr")))
+    'moves with 1 degree of freedom (finite; besides 1 idle motion)'
+    """
+    idle = len(ra.idle_mobilities)
+    spins = f"; besides {_n(idle, 'idle motion')}" if idle else ""
+    if ra.finite_mobility is None:
+        return (f"instantaneous mobility {ra.useful_mobility}{spins.replace(';', ',')} (the finite mobility "
+                f"{'was not checked' if ra.configuration == 'not checked' else 'is unknown'})")
+    finite = max(ra.finite_mobility - idle, 0)
+    if finite == 0:
+        head = f"rigid (finite mobility 0{spins})"
+        return head + (f", shaky: {_n(ra.useful_mobility, 'instantaneous motion')}" if ra.useful_mobility else "")
+    head = f"moves with {_n(finite, 'degree')} of freedom (finite{spins})".replace("degrees of", "degrees of")
+    return head + (f", instantaneously {ra.useful_mobility}" if ra.useful_mobility > finite else "")
+
+
 def rank_summary_lines(ra: RankAnalysis) -> list[str]:
     """The rank answer in a few plain lines (terminal and Markdown reports)."""
     lines = [
+        motion_headline(ra)[0].upper() + motion_headline(ra)[1:],
         f"{ra.motion} motion: F = {ra.pair_freedoms} pair freedoms, {ra.equations} loop-closure equations, "
         f"rank {ra.rank} (tolerance {ra.tolerance:.2g}, length scale {ra.length_scale:.4g})",
         f"instantaneous mobility m = {ra.pair_freedoms} - {ra.rank} = {ra.mobility} = {ra.useful_mobility} useful"
