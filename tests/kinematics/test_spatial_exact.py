@@ -232,3 +232,21 @@ def test_analyze_headline_leads_with_what_the_mechanism_does():
     assert motion_headline(four) == "rigid (finite mobility 0), shaky: 2 instantaneous motions"
     v = verdict(ms.analyze(ms.examples.load("rssr")).analysis, ms.analyze_rank(ms.examples.load("rssr")))
     assert v["text"].startswith("moves with 1 degree of freedom (finite; besides 1 idle motion); drives needed: 1")
+
+
+# --------------------------------------------------------------------------- 8. the ladder's finite check
+def test_a_pose_without_redundant_constraints_is_regular_without_following_it(monkeypatch):
+    """Rank = number of closure equations: the closure map is a submersion there, so its zero
+    set is a manifold (implicit function theorem) and every instantaneous motion is finite;
+    the motion is not followed. With redundant constraints it still is."""
+    import mechsyn.structure.rank as rank_mod
+
+    calls = []
+    real = rank_mod.local_mobility
+    monkeypatch.setattr(rank_mod, "local_mobility", lambda *a, **k: calls.append(1) or real(*a, **k))
+    r = ms.analyze_rank(ms.examples.load("fourbar"))
+    assert (r.redundant_constraints, r.finite_mobility, r.configuration, calls) == (0, 1, "regular", [])
+    b = ms.analyze_rank(ms.examples.load("bennett"))
+    assert (b.redundant_constraints, b.finite_mobility, b.configuration) == (3, 1, "regular") and calls
+    t = ms.analyze_rank(ms.examples.load("fourbar_taut"))
+    assert t.configuration == "shaky"  # q = 1: followed, and found rigid

@@ -678,6 +678,11 @@ def _local(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, conto
     F, equations = sysm.twists.shape[0], sysm.lam * len(sysm.contours)
     if not sysm.contours:  # an open chain: every pair freedom is a finite motion
         return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
+    if rank == equations:  # provably regular: no need to follow the motion
+        # the loop-closure map has a surjective derivative here, so by the implicit function
+        # theorem its zero set is a manifold of dimension F - rank near the pose: every
+        # instantaneous motion extends to a finite one and the rank is the same nearby
+        return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
 
     def null(theta: np.ndarray) -> tuple[int, np.ndarray]:
         red = _reduce(sysm, theta, tol)
