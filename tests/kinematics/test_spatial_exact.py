@@ -250,3 +250,50 @@ def test_a_pose_without_redundant_constraints_is_regular_without_following_it(mo
     assert (b.redundant_constraints, b.finite_mobility, b.configuration) == (3, 1, "regular") and calls
     t = ms.analyze_rank(ms.examples.load("fourbar_taut"))
     assert t.configuration == "shaky"  # q = 1: followed, and found rigid
+
+
+def test_a_multi_drive_path_has_the_rates_of_its_derivative():
+    """Two Delta arms along a curved path in input space: the platform's velocity and
+    acceleration are those of the motion in time with R1 at 1 rad/s (central differences of
+    the reported positions, which converge as h²: checked at two steps)."""
+    m = ms.examples.load("delta")
+    errs = []
+    for n in (101, 201):
+        t = np.linspace(0, 1, n)
+        s = ms.simulate(m, {"R1": 20 * t - 10, "R2": 10 * np.sin(2 * t)})
+        assert s.assembled.all() and any("one path" in x for x in s.notes)
+        name = list(s.points)[-1]
+        P, V, A = s.point(name), s.points[name].velocity, s.points[name].acceleration
+        dt = np.radians(20 / (n - 1))
+        fv = (P[2:] - P[:-2]) / (2 * dt)
+        fa = (P[2:] - 2 * P[1:-1] + P[:-2]) / dt ** 2
+        errs.append((np.abs(fv - V[1:-1]).max() / np.abs(V).max(), np.abs(fa - A[1:-1]).max() / np.abs(A).max()))
+    (v1, a1), (v2, a2) = errs
+    assert v2 < v1 / 3 and a2 < a1 / 3 and v2 < 1e-5 and a2 < 1e-4  # second order: a quarter when h halves
+
+
+def test_c_and_u_pairs_can_be_driven():
+    """A C pair driven by its slide and turn, a right-angled U pair by its two angles: the
+    point on the driven link where the closed-form displacement puts it, velocities too."""
+    from mechsyn.io import mechanism_from_dict
+
+    c = mechanism_from_dict({"name": "C", "kind": "spatial", "ground": "frame", "links": ["frame", "s"], "joints": [
+        {"id": "C1", "type": "C", "links": ["frame", "s"], "point": [0, 0, 0], "axis": [0, 0, 1], "actuated": True}],
+        "points": {"Q": {"link": "s", "at": [1, 0, 0]}}}, "c.yaml")
+    z, th = np.array([0.0, 0.5, 1.0]), np.array([0.0, 90.0, 180.0])
+    s = ms.simulate(c, {"C1": z, "C1/turn": th}, points=["Q"])
+    want = np.stack([np.cos(np.radians(th)), np.sin(np.radians(th)), z], axis=1)
+    assert np.allclose(s.point("Q"), want, atol=1e-12)
+    w = np.pi  # one path: the turn follows the slide, 180 degrees per unit of slide at the slide's speed 1
+    assert np.allclose(s.points["Q"].velocity, np.stack([-w * want[:, 1], w * want[:, 0], np.ones(3)], axis=1),
+                       atol=1e-12)
+    assert np.allclose(s.joints["C1/slide"], z) and np.allclose(s.joints["C1"], th)
+    u = mechanism_from_dict({"name": "U", "kind": "spatial", "ground": "frame", "links": ["frame", "u"], "joints": [
+        {"id": "U1", "type": "U", "links": ["frame", "u"], "point": [0, 0, 0], "axis": [0, 0, 1], "axis2": [1, 0, 0],
+         "actuated": True}], "points": {"Q": {"link": "u", "at": [0, 1, 0]}}}, "u.yaml")
+    a, b = np.array([0.0, 90.0, 30.0]), np.array([0.0, 0.0, 50.0])
+    s = ms.simulate(u, {"U1": a, "U1/2": b}, points=["Q"])
+    want = [rot([0, 0, 1], np.radians(x)) @ rot([1, 0, 0], np.radians(y)) @ [0, 1, 0] for x, y in zip(a, b)]
+    assert np.allclose(s.point("Q"), want, atol=1e-12)
+    with pytest.raises(ms.MechsynInputError, match="takes"):
+        ms.simulate(u, {"U1/turn": a})

@@ -21,13 +21,16 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io import load_mechanism
 
 InputOpt = Annotated[list[str], typer.Option(
-    "--input", "-i", metavar="J=A:B:S", help="Driven joint and its values: J=START:STOP:STEP (deg for R, length for P), "
-                          "or J=V1,V2,... Repeat for several inputs (same number of values).")]
+    "--input", "-i", metavar="J=A:B:S", help="Driven joint and its values: J=START:STOP:STEP or J=V1,V2,... "
+                          "R, H: deg (planar: the driven link's angle; spatial: from the joint's zero, else from the "
+                          "drawn pose); P: length. Spatial C: J= slide, J/turn= angle; U: J=, J/2= angles. Repeat "
+                          "for several inputs (same number of values).")]
 SpeedOpt = Annotated[Optional[list[str]], typer.Option(
     "--speed", metavar="J=V", help="Input rate J=V (rad/s for R, length/s for P; default 1).")]
 VllOpt = Annotated[Optional[list[str]], typer.Option(
     "--vll", metavar="J=MODE", help="Variable-length link mode J=locked|free|active (paper 000's two modes).")]
-MethodOpt = Annotated[str, typer.Option("--method", help="auto | assur | newton")]
+MethodOpt = Annotated[str, typer.Option("--method", help="auto | assur | newton (planar files; a spatial file "
+                                                          "takes the spatial engine)")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON on stdout.")]
 CsvOpt = Annotated[Optional[Path], typer.Option("--csv", help="Write a CSV table.")]
 PlotOpt = Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG plot.")]
@@ -117,7 +120,8 @@ def simulate_cmd(
     plot: PlotOpt = None,
     animate: Annotated[Optional[Path], typer.Option("--animate", help="Write an animation: .gif, .mp4 (the video extra) or .html (a self-contained player).")] = None,
 ) -> None:
-    """Positions, velocities and accelerations of a planar mechanism over its input."""
+    """Positions, velocities and accelerations of a planar or spatial mechanism over its inputs
+    (a spatial file: every link's pose and joint value too, by continuation from the drawn pose)."""
     from mechsyn.cli.render import render_simulation
     from mechsyn.kinematics.report import simulation_report
 
@@ -128,6 +132,11 @@ def simulate_cmd(
     inputs = _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
+        planar_only = [o for o, given in (("--vll", vll), ("--method", method != "auto"), ("--output", output),
+                                          ("--straight", straight)) if given]
+        if planar_only:
+            raise MechsynInputError(f"{', '.join(planar_only)} applies to planar files only; {file} is spatial",
+                                    source=planar_only[0], hint=f"remove {', '.join(planar_only)}")
         return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
     with progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance:
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
@@ -167,7 +176,7 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
         emit_json(sim.to_dict())
         return
     width = shutil.get_terminal_size().columns
-    lines = str(sim).splitlines() + [f"{e['kind']} at {', '.join(f'{j} = {v:.6g}' for j, v in e['input'].items())}: "
+    lines = str(sim).splitlines() + [f"{e['kind']} at {', '.join(f'{j} = {v:.10g}' for j, v in e['input'].items())}: "
                                      f"{e['message']}" for e in sim.events]
     for line in lines:
         typer.echo(textwrap.fill(line, width, subsequent_indent=" " * 13))

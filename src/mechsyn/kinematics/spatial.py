@@ -86,21 +86,38 @@ class SpatialEngine:
         return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
 
 
+#: The inputs a pair takes: its id, and for a C pair ``<id>/turn``, for a U pair ``<id>/2``.
+INPUT_NAMES = {"R": ("",), "H": ("",), "P": ("",), "C": ("", "/turn"), "U": ("", "/2")}
+
+
+def input_kind(mech: Mechanism, name: str) -> str:
+    """The pair type an input ``name`` moves as: ``"R"`` for an angle (R, H, a C pair's turn,
+    a U pair's angles), ``"P"`` for a slide (P, a C pair's slide)."""
+    jid, _, part = name.partition("/")
+    t = mech.joint(jid).type
+    return "P" if t == "P" or (t == "C" and not part) else ("H" if t == "H" else "R")
+
+
 def _check_inputs(mech: Mechanism, inputs: dict[str, Any]) -> dict[str, np.ndarray]:
     if not inputs:
         raise MechsynInputError("no input given", field="inputs",
                                 hint="give the driven joint's values, e.g. R1=0:360:1 on the command line")
     out = {}
-    for jid, v in inputs.items():
+    for name, v in inputs.items():
+        jid, slash, part = name.partition("/")
         try:
             j = mech.joint(jid)
         except KeyError:
             raise MechsynInputError(f"no joint {jid!r} to drive", source=mech.source, field="inputs",
                                     hint="one of " + ", ".join(j.id for j in mech.joints)) from None
-        if j.type not in ("R", "P", "H"):
-            raise MechsynInputError(f"joint {jid} ({j.type} pair) cannot take an input: only R, P and H pairs do",
-                                    source=mech.source, field="inputs", hint="drive an R, P or H pair")
-        out[jid] = np.atleast_1d(np.asarray(v, float))
+        if j.type not in INPUT_NAMES:
+            raise MechsynInputError(f"joint {jid} ({j.type} pair) cannot take an input: only R, P, H, C and U pairs "
+                                    "do", source=mech.source, field="inputs", hint="drive an R, P, H, C or U pair")
+        if slash + part not in INPUT_NAMES[j.type]:
+            raise MechsynInputError(f"input {name!r}: a {j.type} pair takes "
+                                    + " and ".join(repr(jid + s) for s in INPUT_NAMES[j.type]), source=mech.source,
+                                    field="inputs", hint="a C pair: C=slide, C/turn=angle; a U pair: U, U/2 (angles)")
+        out[name] = np.atleast_1d(np.asarray(v, float))
     sizes = {len(v) for v in out.values()}
     if len(sizes) != 1:
         raise MechsynInputError("the inputs have different numbers of values", field="inputs",
@@ -190,9 +207,8 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
     if points is None and not mech.points:
         points = [j.id for j in mech.joints if j.point is not None]
     pts = resolve_points(mech, points)
-    # input rates (default 1); the drives held at their drawn value do not move
-    sp = np.array([float((speeds or {}).get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives])
-    sp = np.where([d[1] == "slide" for d in M.drives], sp / M.scale, sp)
+    U = _input_matrix(M, inputs)
+    sp, spp, path_note = _input_rates(M, inputs, speeds, U)
     tr = Tracker(M)
     n = M.n
     R0, p0 = np.tile(np.eye(3), (1, n + 1, 1, 1)), np.zeros((1, n + 1, 3))
@@ -202,8 +218,7 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
         later = None
     except MechsynInputError as exc:  # perhaps only the drawn assembly is singular: judge on the sweep
         later = exc
-    U = _input_matrix(M, inputs)
-    rows = _sweep_rows(tr, start, U, sp, progress)
+    rows = _sweep_rows(tr, start, U, (sp, spp), progress)
     if later is not None:
         if not rows.ok.any():
             raise MechsynInputError(
@@ -214,7 +229,55 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
         R = np.concatenate([rows.R[k], np.eye(3)[None]])[None]
         p = np.vstack([rows.p[k], np.zeros((1, 3))])[None]
         _check_determined(M, tr.state(R, p, np.zeros((1, len(M.helix))), U[k][None]), pts)
-    return _result(mech, M, tr, inputs, sp, pts, U, rows, start)
+    return _result(mech, M, tr, inputs, sp[0], pts, U, rows, [path_note] if path_note else [])
+
+
+def _second_derivative(f: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``d²f/dx²`` of samples ``f`` at increasing or decreasing ``x`` (at least 3): the
+    three-point formula inside, the second derivative of the cubic through the first (last)
+    four points at the ends (of the parabola through three when there are only three)."""
+    out = np.empty_like(f)
+    h0, h1 = np.diff(x)[:-1], np.diff(x)[1:]
+    out[1:-1] = 2 * ((f[2:] - f[1:-1]) / h1 - (f[1:-1] - f[:-2]) / h0) / (h0 + h1)
+    k = min(4, len(f))
+    for sl, at in ((slice(0, k), 0), (slice(len(f) - k, len(f)), len(f) - 1)):
+        c = np.polyfit(x[sl] - x[at], f[sl], k - 1)
+        out[at] = 2 * c[-3]
+    return out
+
+
+def _input_rates(M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
+                 U: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+    """Per row, the drives' rates and their time derivatives (model units), and a note.
+
+    With one moving input, or ``speeds`` given for every input, each input moves at its
+    speed (default 1) and the drives held at their drawn value do not move. Several inputs
+    without their speeds are a path: the main (first) input moves at its speed ``s`` and
+    every other follows the path, ``u̇_j = s du_j/du_1`` and ``ü_j = s² d²u_j/du_1²`` (the
+    path's derivatives, second-order differences of the given input values: exact on
+    straight and parabolic paths); a path along which the main input does not move
+    monotonically falls back to constant speeds, with a note."""
+    N, D = U.shape
+    scale = np.array([1.0 if kind == "angle" else 1.0 / M.scale for _, kind, _ in M.drives])
+    given = {d[0]: float((speeds or {}).get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives}
+    const = np.broadcast_to(np.array(list(given.values())) * scale, (N, D)).copy()
+    moving = [k for k in range(D) if np.ptp(U[:, k]) > 0]
+    names = [M.drives[k][0] for k in moving]
+    if len(moving) < 2 or all(n in (speeds or {}) for n in names) or N < 3:
+        return const, np.zeros((N, D)), ""
+    main = next(k for k, d in enumerate(M.drives) if d[0] == next(iter(inputs)))
+    u = U[:, main]
+    du = np.diff(u)
+    if not (np.all(du > 0) or np.all(du < 0)):
+        return const, np.zeros((N, D)), (f"the inputs {', '.join(names)} move together but {M.drives[main][0]} does "
+                                         "not move one way along them: every input at its constant speed")
+    s = given[M.drives[main][0]] * scale[main]
+    sp, spp = np.zeros((N, D)), np.zeros((N, D))
+    for k in moving:
+        sp[:, k] = s * np.gradient(U[:, k], u, edge_order=2)
+        spp[:, k] = s * s * _second_derivative(U[:, k], u)
+    return sp, spp, (f"the inputs {', '.join(names)} follow one path: rates from its derivative with "
+                     f"{M.drives[main][0]} at its speed")
 
 
 @dataclass
@@ -266,7 +329,8 @@ def _regular_rank(tr: Tracker, st: State) -> None:
         st.lin.__dict__.pop("ratio", None)
 
 
-def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progress: Any) -> _Rows:
+def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarray, np.ndarray],
+                progress: Any) -> _Rows:
     """Poses of every row by continuation from the drawn assembly, then the closure residual,
     the rank test and the rates of all assembled rows at once."""
     M = tr.M
@@ -296,7 +360,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
         out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
-        x1, x2 = tr.rates(st, np.broadcast_to(sp, (len(idx), len(sp))), refine=2)
+        x1, x2 = tr.rates(st, rates[0][idx], refine=2, ddu=rates[1][idx])
         regular = st.lin.ratio >= singular_tol(M)
         found = crossings(tr, w, U, out.ratio, st.lin.Jc, idx)
         on_row = {c[3] for c in found if c[3] is not None}
@@ -351,7 +415,7 @@ def _singular_events(M: SpatialModel, out: _Rows, U: np.ndarray, rows: np.ndarra
 
 
 def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.ndarray], sp: np.ndarray,
-            pts: dict, U: np.ndarray, rows: _Rows, start: State) -> SpatialSimulation:
+            pts: dict, U: np.ndarray, rows: _Rows, more: list[str]) -> SpatialSimulation:
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
@@ -366,9 +430,11 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     for name, (link, at) in pts.items():
         pm[name] = _point_motion(M, rows, X, Xd, link, M.local(at))
     joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok) + M.zeros[k]) for k, jid in enumerate(M.angle_joints)}
-    for jid, v in inputs.items():  # an input joint reads its input (the same turn)
-        if jid in joints:
-            joints[jid] = np.where(ok, v, np.nan)
+    for name, v in inputs.items():  # an input reads as itself (the same turn)
+        key = name + "/slide" if mech.joint(name.partition("/")[0]).type == "C" and "/" not in name else \
+            name.replace("/turn", "")
+        if key in joints:
+            joints[key] = np.where(ok, v, np.nan)
     joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
                    for k, jid in enumerate(M.slide_joints)})
     notes = []
@@ -384,8 +450,8 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     bad = ok & (rows.res > closure_tol(tr))
     if bad.any():
         notes.append(f"closure residual above {closure_tol(tr):g} of the length scale at {int(bad.sum())} row(s)")
-    notes += _reach_notes(M, tr, U, rows)
-    types = {jid: mech.joint(jid).type for jid in inputs}
+    notes += _reach_notes(M, tr, U, rows) + more
+    types = {jid: input_kind(mech, jid) for jid in inputs}
     speeds = {d[0]: float(v * (L if d[1] == "slide" else 1.0)) for d, v in zip(M.drives, sp) if d[0] in inputs}
     return SpatialSimulation(
         mechanism=mech.name, inputs=inputs, input_types=types, speeds=speeds, assembled=ok, points=pm,

@@ -16,7 +16,7 @@ kind                      equation                               pairs
 coincidence (3 rows)      ``x_a - x_b = 0``                      R, U, S
 dot (1 row)               ``u_a · w_b = u_0 · w_0``              R (2), U (1), C, H (2), P (3)
 line (1 row)              ``(x_b - x_a) · n_a = 0``              C, H, P (2 each)
-angle / slide (drives)    ``θ = θ_in``, ``(x_b - x_a) · a = s``  R, H (angle); P (slide)
+angle / slide (drives)    ``θ = θ_in``, ``(x_b - x_a) · a = s``  R, H, C, U (angle); P, C (slide)
 helix (1 row)             ``s - h θ = 0``                        H
 ========================  =====================================  =============================
 
@@ -201,6 +201,15 @@ def _pair_rows(j: Joint, ia: int, ib: int, x: np.ndarray | None, rows: dict[str,
         e1, e2 = _perp_basis(a)
         rows["angle"].append((ia, ib, a, e1, e1, e2, 0.0))
         rows["angle_joints"].append(j.id)
+    if t == "U" and abs(float(a @ _unit(np.asarray(j.axis2, float)))) < 1e-9:
+        # a right-angled cross: its two angles, each an angle row with the axis on the link it
+        # is fixed to: the second arm turning about the first axis (on the first link), and
+        # the first arm turning about the second axis reversed (on the second link: the
+        # second link turns by +θ2 about it relative to the first)
+        a2 = _unit(np.asarray(j.axis2, float))
+        rows["angle"].append((ia, ib, a, a2, a2, np.cross(a, a2), 0.0))
+        rows["angle"].append((ib, ia, -a2, a, a, np.cross(-a2, a), 0.0))
+        rows["angle_joints"] += [j.id, j.id + "/2"]
     if t in ("P", "C", "H"):
         rows["slide"].append((ia, ib, x, x, a, z, 0.0))
         rows["slide_joints"].append(j.id)
@@ -221,10 +230,14 @@ def _check_joint(mech: Mechanism, j: Joint) -> None:
     if j.type == "U" and j.axis2 is None:
         raise MechsynInputError(f"joint {j.id} (U) has no axis2", source=src, field=f"joints[{j.id}].axis2",
                                 hint="give axis2: the cross's arm fixed in the second link")
-    if j.actuated and j.type not in ("R", "P", "H"):
-        raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P and H pairs can be driven "
-                                "(one input each)", source=src, field=f"joints[{j.id}].actuated",
-                                hint="drive an R, P or H pair (split a C pair into R + P)")
+    if j.actuated and j.type not in ("R", "P", "H", "C", "U"):
+        raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P, H, C and U pairs can be driven",
+                                source=src, field=f"joints[{j.id}].actuated", hint="drive an R, P, H, C or U pair")
+    if j.type == "U" and j.axis is not None and j.axis2 is not None and abs(
+            float(_unit(np.asarray(j.axis, float)) @ _unit(np.asarray(j.axis2, float)))) > 1e-9 and j.actuated:
+        raise MechsynInputError(f"joint {j.id} (U) is driven, but its axes are not at right angles: its two "
+                                "angles are defined for a right-angled cross only", source=src,
+                                field=f"joints[{j.id}].axis2", hint="make axis2 perpendicular to axis")
 
 
 def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
@@ -249,19 +262,20 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
     helix = tuple((rows["angle_joints"].index(j.id), rows["slide_joints"].index(j.id), (j.pitch or 0.0) / scale)
                   for j in mech.joints if j.type == "H")
     drive_rows = []
-    for jid in drives:
+    for name in drives:
+        jid, _, part = name.partition("/")
         j = mech.joint(jid)
-        if j.type in ("R", "H"):
-            drive_rows.append((jid, "angle", rows["angle_joints"].index(jid)))
+        if j.type in ("R", "H", "U") or (j.type == "C" and part == "turn"):
+            drive_rows.append((name, "angle", rows["angle_joints"].index(name if j.type == "U" else jid)))
         else:
-            drive_rows.append((jid, "slide", rows["slide_joints"].index(jid)))
+            drive_rows.append((name, "slide", rows["slide_joints"].index(jid)))
     big = max([float(np.abs(np.asarray(j.point, float)).max()) for j in mech.joints if j.point is not None]
               + [float(np.abs(np.asarray(pt.at, float)).max()) for pt in mech.points.values()], default=0.0)
     M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
                      _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
                      tuple(rows["slide_joints"]), helix, tuple(drive_rows),
                      ulp=float(np.finfo(float).eps) * max(1.0, big / scale))
-    zeros = np.array([input_zero(mech, mech.joint(jid)) for jid in M.angle_joints], float)
+    zeros = np.array([input_zero(mech, mech.joint(jid.partition("/")[0])) for jid in M.angle_joints], float)
     return replace(M, lay=_layout(M), pairs=_pairs(mech, index), zeros=zeros)
 
 
@@ -304,7 +318,7 @@ def input_zero(mech: Mechanism, j: Joint) -> float:
     True
     """
     if j.type not in ("R", "H", "C"):
-        return 0.0
+        return 0.0  # (a U pair's angles are measured from the drawn cross)
     z = j.attrs.get("zero")
     planar = mech.kind == "planar"
     if z is None and not planar:

@@ -262,15 +262,20 @@ class Tracker:
             href = helix_angles(self.M, F, href)
         return State(R, p, href, F, self.lin(jacobian(self.M, F), R, p), g)
 
-    def rates(self, st: State, du: np.ndarray, refine: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    def rates(self, st: State, du: np.ndarray, refine: int = 0,
+              ddu: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
-        derivatives (``J ξ' = du``, ``J ξ'' = -γ(ξ')``); ``refine``: steps of iterative
-        refinement (2 for the rates reported, none for a predictor)."""
+        derivatives (``J ξ' = du``, ``J ξ'' = ü - γ(ξ')``, ``ü = ddu``: the drives' second
+        derivatives, zero by default); ``refine``: steps of iterative refinement (2 for the
+        rates reported, none for a predictor)."""
         F = st.F if st.F is not None else frame(self.M, st.R, st.p)
         b = np.zeros(st.g.shape)
         b[:, self.m_c:] = du
         x1 = st.lin.solve(b, refine)
-        return x1, st.lin.solve(-convective(self.M, F, x1), refine)
+        b2 = -convective(self.M, F, x1)
+        if ddu is not None:
+            b2[:, self.m_c:] += ddu
+        return x1, st.lin.solve(b2, refine)
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
                 iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
