@@ -318,7 +318,7 @@ def test_spatial_engine_answers_spatial_files_only():
 
 def test_bad_inputs_name_the_fix():
     m = ms.examples.load("rssr")
-    with pytest.raises(MechsynInputError, match="only R, P and H"):
+    with pytest.raises(MechsynInputError, match="only R, P, H, C and U"):
         ms.simulate(m, {"B": np.array([0.0, 1.0])})
     cam = replace(m, joints=tuple(replace(j, type="E") if j.id == "C" else j for j in m.joints))
     with pytest.raises(MechsynInputError, match="R, P, C, U, S and H pairs"):

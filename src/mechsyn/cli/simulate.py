@@ -132,11 +132,7 @@ def simulate_cmd(
     inputs = _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
-        planar_only = [o for o, given in (("--vll", vll), ("--method", method != "auto"), ("--output", output),
-                                          ("--straight", straight)) if given]
-        if planar_only:
-            raise MechsynInputError(f"{', '.join(planar_only)} applies to planar files only; {file} is spatial",
-                                    source=planar_only[0], hint=f"remove {', '.join(planar_only)}")
+        _planar_only(file, vll=vll, method=method != "auto", output=output, straight=straight)
         return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
     with progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance:
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
@@ -149,6 +145,14 @@ def simulate_cmd(
         emit_json(report.to_dict())
         return
     render_simulation(report)
+
+
+def _planar_only(file: Path, **given: Any) -> None:
+    """Refuse the options that only planar files take (exit 2), naming them."""
+    bad = [f"--{k}" for k, v in given.items() if v]
+    if bad:
+        raise MechsynInputError(f"{', '.join(bad)} applies to planar files only; {file} is spatial", source=bad[0],
+                                hint=f"remove {', '.join(bad)}")
 
 
 def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str] | None, speed: list[str] | None,

@@ -205,7 +205,7 @@ class SpatialSimulation(Result):
         others = len([j for j in self.joints if j != self.main_input])
         if len(ks) < len(x) or shown < len(names) or njoints < others:
             lines.append(f"({len(ks)} of {len(x)} rows, {njoints} of {others} joints, {shown} of {len(names)} "
-                         "points; --csv for all, with link orientations)")
+                         "points; --csv: all, link poses too)")
         return "\n".join(lines)
 
     def _travel(self, name: str) -> float:

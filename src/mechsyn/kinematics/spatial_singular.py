@@ -48,6 +48,13 @@ from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, singular_tol
 
 __all__ = ["crossings", "REFINE"]
 
+#: Newton steps past the tolerance on each pose of the search: next to a singular point
+#: Newton reaches a residual ε only within √ε of the pose (it converges linearly there), which
+#: blurs the ratio's V by that much; each further step halves the distance.
+POLISH = 8
+#: Points a zoom step of the search evaluates at once (the bracket shrinks by ``(ZOOM - 1) / 2``).
+ZOOM = 17
+
 
 
 # --------------------------------------------------------------------------- crossings
@@ -90,8 +97,7 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
             if found is not None:
                 out.append(found)
     seen = {c[0] for c in out} | {c[0] + 1 for c in out}
-    out += [c for c in _v_minima(tr, w, U, ratio) if c[0] not in seen and c[0] - 1 not in seen]
-    return out
+    return out + _v_minima(tr, w, U, ratio, seen)
 
 
 def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
@@ -107,14 +113,16 @@ def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
     return k, found[0], found[1], on
 
 
-def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list:
+def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set) -> list:
     """Rows whose ratio is a sharp local minimum (``r0 + r2 >= 4 r1``: every V passes)
     refined by a golden-section search; a crossing where it falls under the singular
-    tolerance."""
+    tolerance. Rows in ``seen`` (next to a crossing found by the determinant) are skipped."""
     out = []
     tol = singular_tol(tr.M)
     for k in range(1, len(U) - 1):
         if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]) or len({w.how[k - 1], w.how[k], w.how[k + 1]}) > 1:
+            continue
+        if seen & {k - 1, k, k + 1}:
             continue
         r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
         if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= tol):
@@ -129,37 +137,51 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list:
 
 
 def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.ndarray, float] | None:
-    """The least ``σ_r / σ_1`` over the inputs from row ``rows[0]`` to row ``rows[-1]``
-    (golden section to ``REFINE`` of a row step, each pose reached by continuation from the
-    nearest of ``rows``, many Newton steps a try: next to a singular point Newton converges
-    only linearly). The ratio is a V about a crossing on either branch that meets there, so
-    a hop between them does not move the minimum."""
+    """The least ``σ_r / σ_1`` over the inputs from row ``rows[0]`` to row ``rows[-1]``, to
+    ``REFINE`` of a row step: a zoom of ``ZOOM`` points at a time, each batch predicted from
+    the nearest of ``rows`` (the Taylor predictor), corrected by Newton together and polished
+    ``POLISH`` steps past the tolerance (next to a singular point Newton converges only
+    linearly, and reaches a residual ε only within √ε of the pose, which blurs the V by that
+    much); the bracket then shrinks to the two cells about the least. The ratio is a V about
+    a crossing on either branch that meets there, so it does not matter which one Newton
+    lands on that close to it."""
+    from mechsyn.kinematics.spatial_model import move
+    from mechsyn.kinematics.spatial_track import _taylor
+
     states = {k: tr.state(*w.at(k), U[k][None]) for k in rows}
     lo, hi = U[rows[0]], U[rows[-1]]
     span = len(rows) - 1
+    tol, halvings = tr.tol, tr.halvings
 
-    def f(t: float) -> float:
-        u = lo + t * (hi - lo)
-        k = rows[int(np.clip(np.rint(t * span), 0, span))]
-        nxt = tr.advance(states[k], U[k], u, iters=40)
-        if nxt is None:
-            return np.inf
-        return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
+    def f(ts: np.ndarray) -> np.ndarray:
+        out = np.full(len(ts), np.inf)
+        near = np.clip(np.rint(ts * span), 0, span).astype(int)
+        for j in np.unique(near):
+            k, sel = rows[j], np.flatnonzero(near == j)
+            st = states[k]
+            u = lo + ts[sel, None] * (hi - lo)
+            x1, x2 = _taylor(tr, st, u - U[k])
+            z = np.zeros(len(sel), int)
+            R, p = move(st.R[z], st.p[z], x1 + 0.5 * x2)
+            R, p, ok, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=40)
+            tr.tol = 0.0
+            R, p, _, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=POLISH)
+            tr.tol = tol
+            if ok.any():
+                good = np.flatnonzero(ok)
+                out[sel[good]] = svd_ratio(tr.state(R[good], p[good], st.href[z[good]], u[good]).lin.Jc, tr.rank)
+        return out
 
-    halvings = tr.halvings  # the search's own step halvings are not the sweep's trouble
-    g = (np.sqrt(5) - 1) / 2
     a, b = 0.0, 1.0
-    c, d = b - g * (b - a), a + g * (b - a)
-    fc, fd = f(c), f(d)
+    best_t, best = 0.5, np.inf
     while b - a > REFINE / span:
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - g * (b - a)
-            fc = f(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + g * (b - a)
-            fd = f(d)
+        ts = np.linspace(a, b, ZOOM)
+        fs = f(ts)
+        i = int(np.argmin(fs))
+        if not np.isfinite(fs[i]):
+            break
+        best_t, best = ts[i], fs[i]
+        h = (b - a) / (ZOOM - 1)
+        a, b = max(0.0, ts[i] - h), min(1.0, ts[i] + h)
     tr.halvings = halvings
-    t, best = (c, fc) if fc < fd else (d, fd)
-    return (lo + t * (hi - lo), best) if np.isfinite(best) else None
+    return (lo + best_t * (hi - lo), float(best)) if np.isfinite(best) else None
