@@ -376,8 +376,8 @@ def pair_error(M: SpatialModel, R: np.ndarray) -> np.ndarray:
     if P is None or not len(P.ia):
         return np.zeros((len(R), 0))
     Rr = np.swapaxes(R[:, P.ia], -1, -2) @ R[:, P.ib]
-    c = np.einsum("ki,bkij,kj->bk", P.e1, Rr, P.e1)
-    s = np.einsum("ki,bkij,kj->bk", P.e2, Rr, P.e1)
+    r1 = matvec(Rr, P.e1)                                 # R_rel e1 (B, pairs, 3)
+    c, s = _dot(r1, P.e1), _dot(r1, P.e2)
     th = np.where(P.turns, np.arctan2(s, c), 0.0)
     K = np.einsum("ijk,nk->nij", -_EPS, P.a)              # [a]x: K y = a x y
     aa = P.a[:, :, None] * P.a[:, None, :]

@@ -82,9 +82,11 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     if not len(ks):
         return []
     a, b = np.array([pos[k] for k in ks]), np.array([pos[k + 1] for k in ks])
-    norm = np.linalg.norm(Jc, axis=(1, 2))
+    flat = Jc.reshape(len(Jc), -1)
+    norm = np.sqrt(np.einsum("bi,bi->b", flat, flat))
     low = np.nan_to_num(ratio[idx]) * norm / np.sqrt(max(r, 1))  # lower bounds of σ_r
-    jump = np.linalg.norm(Jc[b] - Jc[a], axis=(1, 2))
+    d = flat[b] - flat[a]
+    jump = np.sqrt(np.einsum("bi,bi->b", d, d))
     near = (low[a] <= 2 * jump) | (low[b] <= 2 * jump)
     tol = singular_tol(tr.M)
     near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
