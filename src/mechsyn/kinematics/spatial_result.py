@@ -260,7 +260,9 @@ class SpatialSimulation(Result):
             "joints": {j: mask(v) for j, v in self.joints.items()}, "working_ranges": self.working_ranges(),
             "residual": mask(self.residual), "length_scale": self.length_scale,
             "rank": self.rank, "idle": self.idle, "events": self.events, "notes": self.notes,
-            "units": {"input": "deg (R, H) or length (P) from the drawn assembly", "angular_velocity": "rad/s",
+            "reached": self.reached if self.reached is not None else ok.astype(int), "held": list(self.held),
+            "zero": self.zero,
+            "units": {"input": "deg (R, H, C/turn, U) from the joint's zero, or length (P, C)", "angular_velocity": "rad/s",
                       "angular_acceleration": "rad/s^2", "residual": "fraction of length_scale"},
         }
 
