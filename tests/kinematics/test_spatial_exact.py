@@ -188,6 +188,10 @@ def test_a_zero_makes_an_input_the_same_pose_as_the_planar_engines():
     assert np.allclose(s.point("C")[:, :2], want, atol=1e-9) and s.zero["A"] == pytest.approx(np.degrees(np.arctan2(2, 1)))
     drawn = np.degrees(np.arctan2(2, 1))  # the crank line A -> B as drawn
     assert input_zero(planar, planar.joint("A")) == pytest.approx(np.radians(drawn))
+    from mechsyn.kinematics.spatial import simulate_spatial
+
+    handed = simulate_spatial(planar, {"A": g}, points=["C"])  # a planar file handed to the spatial engine
+    assert np.allclose(handed.point("C")[:, :2], want, atol=1e-9) and np.allclose(handed.point("C")[:, 2], 0)
     s0 = ms.simulate(_fourbar_3d(None), {"A": g - drawn}, points=["C"])
     assert np.allclose(s0.point("C"), s.point("C"), atol=1e-9)
     assert np.allclose(s.joints["A"], g)

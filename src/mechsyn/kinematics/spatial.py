@@ -52,7 +52,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
-from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
+from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial, planar_as_spatial
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
 from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
@@ -185,6 +185,7 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
     >>> s.engine, s.point("C").shape, bool(s.assembled.all())
     ('spatial', (3, 3), True)
     """
+    mech = planar_as_spatial(mech)  # a planar file: its 3-D equivalent, with the planar zero
     inputs = _check_inputs(mech, inputs)
     M = compile_spatial(mech, _drives(mech, inputs))
     if M.n < SMALL_LINKS:  # BLAS does not thread matrices this small

@@ -300,6 +300,29 @@ def reference_direction(mech: Mechanism, link: str) -> np.ndarray:
     return x
 
 
+def planar_as_spatial(mech: Mechanism) -> Mechanism:
+    """A planar mechanism as the spatial engine's file: its 3-D equivalent
+    (:func:`~mechsyn.structure.screws.as_spatial`: points at ``z = 0``, R axes along ``z``)
+    with every R pair's ``zero`` set to the planar zero (the first link's reference line, the
+    frame's ``x``), so that an input means the same pose as in the planar engines.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = planar_as_spatial(ms.examples.load("fourbar"))
+    >>> m.kind, m.joint("A").attrs["zero"]
+    ('spatial', [1.0, 0.0, 0.0])
+    """
+    from mechsyn.structure.screws import as_spatial
+
+    if mech.kind == "spatial":
+        return mech
+    out = as_spatial(mech)
+    joints = tuple(replace(j, attrs={**j.attrs, "zero": [float(v) for v in reference_direction(mech, j.links[0])]})
+                   if j.type == "R" else j for j in out.joints)
+    return replace(out, joints=joints)
+
+
 def input_zero(mech: Mechanism, j: Joint) -> float:
     """The value (rad) of the input of R, H or C pair ``j`` in the drawn assembly: the angle
     about its axis from its zero (on the first link) to the second link's reference line
