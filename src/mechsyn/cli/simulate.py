@@ -120,20 +120,18 @@ def simulate_cmd(
     plot: PlotOpt = None,
     animate: Annotated[Optional[Path], typer.Option("--animate", help="Write an animation: .gif, .mp4 (the video extra) or .html (a self-contained player).")] = None,
 ) -> None:
-    """Positions, velocities and accelerations of a planar or spatial mechanism over its inputs
-    (a spatial file: every link's pose and joint value too, by continuation from the drawn pose)."""
+    """Positions, velocities and accelerations (spatial files: link poses, joint values) over the inputs."""
     from mechsyn.cli.render import render_simulation
     from mechsyn.kinematics.report import simulation_report
 
     _check_outputs(plot, csv_out, json_, animate)
     if method not in ("auto", "assur", "newton"):
         raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
-    mech = load_mechanism(file)
-    inputs = _parse_inputs(input)
+    mech, inputs = load_mechanism(file), _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
-        _planar_only(file, vll=vll, method=method != "auto", output=output, straight=straight)
-        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
+        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate,
+                                 _planar_only(file, vll=vll, method=method != "auto", output=output, straight=straight))
     with progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance:
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
                                    vll=_parse_pairs(vll, "--vll", False), method=method, output=output,
@@ -156,7 +154,8 @@ def _planar_only(file: Path, **given: Any) -> None:
 
 
 def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str] | None, speed: list[str] | None,
-                      json_: bool, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
+                      json_: bool, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path],
+                      _checked: None = None) -> None:
     """``mechsyn simulate`` on a spatial file: one call of the spatial engine, its result's own
     summary, events and table (``--json``: its ``to_dict()``)."""
     import shutil
