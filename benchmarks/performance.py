@@ -159,7 +159,7 @@ def rank(runs: int, tmp: str) -> None:
             env = {} if threads == "default" else {"OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
             outs = [json.loads(run([PY, "-c", RANK, str(f)], env)[2]) for _ in range(runs if loops < 100 else 1)]
             res[loops, threads] = min(outs, key=lambda o: o["cpu"])
-    for loops, key, target in ((66, "rank199", 0.4), (666, "rank1999", 10.0)):
+    for loops, key, target in ((66, "rank199", 0.4), (666, "rank1999", 2.0)):  # issue 38
         worst = max((res[loops, t] for t in ("default", "1", "2")), key=lambda o: o["cpu"])
         walls = "/".join(f"{res[loops, t]['s']:.2f}" for t in ("default", "1", "2"))
         ok = all((res[loops, t]["m"], res[loops, t]["q"]) == (1, 0) for t in ("default", "1", "2"))

@@ -13,7 +13,7 @@ Then the growth with size (issue 17 §3): ladders of 49 to 1,999 joints, the who
 default BLAS threads (``analyze_rank`` limits BLAS to one thread itself), against the same
 analysis forced onto one dense SVD (the method before the contour-by-contour elimination)
 up to 601 joints; the answers are checked equal, and the growth exponent is fitted between
-199 and 1,999 joints. Targets: 199 joints <= 0.4 s, 1,999 joints <= 10 s, exponent <= 1.3.
+199 and 1,999 joints. Targets: 199 joints <= 0.4 s, 1,999 joints <= 2 s (issue 38), exponent <= 1.3.
 
 Run: PYTHONPATH=src python benchmarks/rank.py [--quick]
 Times are the minimum of several runs; on a machine shared with other jobs they are noisy.

@@ -95,7 +95,8 @@ def test_analyze_leads_with_the_verdict_of_the_rank_method(run_cli, cli_json):
     assert (verdict["mobility"], verdict["idle_mobilities"], verdict["redundant_constraints"]) == (1, 0, 0)
     assert verdict["source"].startswith("exact rank method")
     flat = " ".join(out.replace("│", " ").split())
-    assert flat.index("verdict: mobility 1 (no idle mobility), 0 redundant constraints") < flat.index("Formulas")
+    assert flat.index("verdict: moves with 1 degree of freedom (finite); drives needed: 1; instantaneous mobility 1 "
+                      "(no idle mobility), 0 redundant constraints") < flat.index("Formulas")
 
 
 def test_spatial_readings_of_a_planar_file_stand_apart_and_say_so(run_cli, cli_json):

@@ -131,7 +131,7 @@ def test_bad_files_exit_2(capsys, tmp_path):
     assert code == 0  # issue 25: spatial files are simulated (tests/kinematics/test_spatial.py)
     f.write_text(f.read_text().replace("type: R", "type: E"))
     code, _, err = run(capsys, "simulate", f, "--input", "A=0:1:1")
-    assert code == 2 and "only R, P and H" in err
+    assert code == 2 and "only R, P, H, C and U" in err
     code, _, err = run(capsys, "forces", EX / "kinematics/crank_rocker.yaml", "--input", "A=0:1:1",
                        "--gravity", "nan")
     assert code == 2

@@ -245,7 +245,7 @@ def test_rssr_working_range_dead_points_and_gap():
     clear = margin > 1e-6
     assert np.array_equal(s.assembled[clear], want[clear])
     kinds = [e["kind"] for e in s.events]
-    assert "dead point" in kinds and "reassembled" in kinds
+    assert "dead point" in kinds and "other way round" in kinds  # the gap closed the other way round (modulo 360)
     assert np.isnan(s.point("C")[~s.assembled]).all()
     d = s.to_dict()
     gap = np.flatnonzero(~s.assembled)
@@ -304,8 +304,8 @@ def test_change_points_reported_and_passed_on_the_drawn_branch():
     assert s.assembled.all() and np.nanmax(s.residual) < 1e-9
     assert np.abs(s.point("C") - s.point("B") - [4, 0, 0]).max() < 1e-6
     sing = [e for e in s.events if e["kind"] == "singular"]
-    crank = sorted(round(e["input"]["A"] + 60, 6) for e in sing)
-    assert crank == [0.0, 180.0, 360.0]
+    crank = sorted(e["input"]["A"] + 60 for e in sing)
+    assert np.allclose(crank, [0.0, 180.0, 360.0], rtol=0, atol=1e-6 * 0.7)  # refined to 1e-6 of the step
     at_row = [e for e in sing if not e.get("crossed")]
     assert len(at_row) == 1 and np.isnan(s.points["C"].velocity[at_row[0]["index"]]).all()
 
@@ -318,7 +318,7 @@ def test_spatial_engine_answers_spatial_files_only():
 
 def test_bad_inputs_name_the_fix():
     m = ms.examples.load("rssr")
-    with pytest.raises(MechsynInputError, match="only R, P and H"):
+    with pytest.raises(MechsynInputError, match="only R, P, H, C and U"):
         ms.simulate(m, {"B": np.array([0.0, 1.0])})
     cam = replace(m, joints=tuple(replace(j, type="E") if j.id == "C" else j for j in m.joints))
     with pytest.raises(MechsynInputError, match="R, P, C, U, S and H pairs"):
@@ -342,7 +342,7 @@ def test_cli_json_is_to_dict_and_text_fits_80_columns(capsys, monkeypatch):
     monkeypatch.setenv("COLUMNS", "80")
     assert main(["simulate", "rssr", "-i", "A=0:360:5"]) == 0
     out = capsys.readouterr().out
-    assert "dead point" in out and "reassembled" in out
+    assert "dead point" in out and "other way round" in out
     assert max(len(line) for line in out.splitlines()) <= 80
 
 

@@ -55,7 +55,7 @@ def test_plots_route_is_ms_simulate_over_the_view_rows(client):
 def test_plots_route_marks_the_rssr_dead_point_and_slides_in_length(client):
     p = client.post("/api/spatial/plots", json={"mechanism": spatial_dict("rssr"), "steps": 180}).json()
     dead = [e for e in p["events"] if e["kind"] == "dead point"]
-    assert dead and all(p["assembled"][e["index"] - 1] for e in dead)
+    assert dead and all(p["assembled"][e.get("last", e["index"] - 1)] for e in dead)  # the row it bounds
     ok = np.asarray(p["assembled"])
     for pair in p["pairs"].values():  # rows not assembled are None, never numbers
         assert all((x is None) == (not good) for x, good in zip(pair["values"], ok))

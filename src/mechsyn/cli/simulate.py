@@ -22,13 +22,16 @@ from mechsyn.errors import MechsynInputError, OverActuatedError
 from mechsyn.io import load_mechanism
 
 InputOpt = Annotated[list[str], typer.Option(
-    "--input", "-i", metavar="J=A:B:S", help="Driven joint and its values: J=START:STOP:STEP (deg for R, length for P), "
-                          "or J=V1,V2,... Repeat for several inputs (same number of values).")]
+    "--input", "-i", metavar="J=A:B:S", help="Driven joint and its values: J=START:STOP:STEP or J=V1,V2,... "
+                          "R, H: deg (planar: the driven link's angle; spatial: from the joint's zero, else from the "
+                          "drawn pose); P: length. Spatial C: J= slide, J/turn= angle; U: J=, J/2= angles. Repeat "
+                          "for several inputs (same number of values).")]
 SpeedOpt = Annotated[Optional[list[str]], typer.Option(
     "--speed", metavar="J=V", help="Input rate J=V (rad/s for R, length/s for P; default 1).")]
 VllOpt = Annotated[Optional[list[str]], typer.Option(
     "--vll", metavar="J=MODE", help="Variable-length link mode J=locked|free|active (paper 000's two modes).")]
-MethodOpt = Annotated[str, typer.Option("--method", help="auto | assur | newton")]
+MethodOpt = Annotated[str, typer.Option("--method", help="auto | assur | newton (planar files; a spatial file "
+                                                          "takes the spatial engine)")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON on stdout.")]
 CsvOpt = Annotated[Optional[Path], typer.Option("--csv", help="Write a CSV table.")]
 PlotOpt = Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG plot.")]
@@ -133,16 +136,16 @@ def simulate_cmd(
     plot: PlotOpt = None,
     animate: Annotated[Optional[Path], typer.Option("--animate", help="Write an animation: .gif, .mp4 (the video extra) or .html (a self-contained player).")] = None,
 ) -> None:
-    """Positions, velocities and accelerations of a planar mechanism over its input."""
+    """Positions, velocities and accelerations (spatial files: link poses, joint values) over the inputs."""
     from mechsyn.cli.render import render_simulation
     from mechsyn.kinematics.report import simulation_report
 
     _check_outputs(plot, csv_out, json_, animate, method)
-    mech = load_mechanism(file)
-    inputs = _parse_inputs(input)
+    mech, inputs = load_mechanism(file), _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
     if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
-        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate)
+        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate,
+                                 _planar_only(file, vll=vll, method=method != "auto", output=output, straight=straight))
     with (_over_actuation_in_cli_words(inputs),
           progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance):
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
@@ -157,8 +160,17 @@ def simulate_cmd(
     render_simulation(report)
 
 
+def _planar_only(file: Path, **given: Any) -> None:
+    """Refuse the options that only planar files take (exit 2), naming them."""
+    bad = [f"--{k}" for k, v in given.items() if v]
+    if bad:
+        raise MechsynInputError(f"{', '.join(bad)} applies to planar files only; {file} is spatial", source=bad[0],
+                                hint=f"remove {', '.join(bad)}")
+
+
 def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str] | None, speed: list[str] | None,
-                      json_: bool, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
+                      json_: bool, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path],
+                      _checked: None = None) -> None:
     """``mechsyn simulate`` on a spatial file: one call of the spatial engine, its result's own
     summary, events and table (``--json``: its ``to_dict()``)."""
     import shutil
@@ -182,7 +194,7 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
         emit_json(sim.to_dict())
         return
     width = shutil.get_terminal_size().columns
-    lines = str(sim).splitlines() + [f"{e['kind']} at {', '.join(f'{j} = {v:.6g}' for j, v in e['input'].items())}: "
+    lines = str(sim).splitlines() + [f"{e['kind']} at {', '.join(f'{j} = {v:.10g}' for j, v in e['input'].items())}: "
                                      f"{e['message']}" for e in sim.events]
     for line in lines:
         typer.echo(textwrap.fill(line, width, subsequent_indent=" " * 13))

@@ -30,8 +30,8 @@ def _ezdxf():
     try:
         import ezdxf
     except ImportError:
-        raise MechsynInputError("DXF export needs ezdxf", field="dxf",
-                                hint="pip install ezdxf (a dependency of mechsyn)") from None
+        raise MechsynInputError("DXF export needs ezdxf (a dependency of mechsyn, missing here)", field="dxf",
+                                hint='pip install "mechsyn[cad]" (or pip install ezdxf)') from None
     return ezdxf
 
 

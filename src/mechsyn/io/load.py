@@ -414,6 +414,8 @@ class _Builder:
                 raise self.error(path + ["limits"], "limits must be [min, max] with min <= max")
             limits = (float(entry.limits[0]), float(entry.limits[1]))
         attrs = {"description": entry.description} if entry.description else {}
+        if entry.zero is not None:
+            attrs["zero"] = self.zero(entry, path, jtype, axis)
         if entry.profile is not None:
             if jtype != "cam":
                 raise self.error(path + ["profile"], "only a cam pair has a profile", "remove `profile`")
@@ -495,6 +497,18 @@ class _Builder:
         axis2 = self.vector(entry.axis2, path + ["axis2"], "axis2", unit=True)
         normal = self.vector(entry.normal, path + ["normal"], "normal", unit=True)
         return point, axis, axis2, normal
+
+    def zero(self, entry: JointEntry, path: list[Any], jtype: str, axis: Any) -> list[float]:
+        """A spatial R, H or C pair's input zero: a direction perpendicular to its axis."""
+        if self.kind != "spatial" or jtype not in ("R", "H", "C"):
+            raise self.error(path + ["zero"], "only an R, H or C pair of a spatial mechanism has a zero",
+                             "remove `zero` (a planar input is the driven link's angle)")
+        z = np.asarray(self.vector(entry.zero, path + ["zero"], "zero direction"), float)
+        a = np.asarray(axis, float)
+        if z.shape != (3,) or not np.linalg.norm(z) > 0 or abs(z @ a) > 1e-6 * np.linalg.norm(z) * np.linalg.norm(a):
+            raise self.error(path + ["zero"], "zero must be a nonzero direction [dx, dy, dz] perpendicular to the axis",
+                             "give a direction at right angles to `axis`")
+        return [float(v) for v in z]
 
     def check_type_fields(self, entry: JointEntry, path: list[Any], jtype: str) -> None:
         """Pitch, ratio and vll belong to H, gear and prismatic pairs only."""
@@ -714,6 +728,8 @@ def _joint_dict(j: Joint, kind: str) -> dict[str, Any]:
         for key in ("anchor", "radius", "wrap"):
             if j.attrs.get(key) is not None:
                 d[key] = j.attrs[key]
+    if j.attrs.get("zero") is not None:
+        d["zero"] = list(j.attrs["zero"])
     if j.attrs.get("description"):
         d["description"] = j.attrs["description"]
     return d

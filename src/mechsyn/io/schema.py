@@ -116,6 +116,10 @@ class JointEntry(_Strict):
         None, description="Unit axis: rotation axis (R, H, C, U first axis), sliding direction (P), plane normal (E).",
     )
     axis2: list[Number] | None = Field(None, description="U: second axis, fixed in the second link.")
+    zero: list[Number] | None = Field(
+        None, description=("Spatial R, H or C pair: the direction (perpendicular to the axis, fixed on the first "
+                           "link) from which its input angle is measured, to the second link's reference line "
+                           "(its first joint to its first other joint). Without it the drawn pose is 0."))
     normal: list[Number] | None = Field(None, description="Higher pairs: contact normal / line of action.")
     pitch: Number | None = Field(None, description="H: lead per radian of rotation.")
     ratio: Number | None = Field(None, description="gear: angular velocity ratio of the second link to the first.")

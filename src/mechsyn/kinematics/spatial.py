@@ -52,8 +52,10 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
-from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
-from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, crossings, walk
+from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial, planar_as_spatial
+from mechsyn.kinematics.spatial_singular import crossings
+from mechsyn.kinematics.spatial_model import pair_error
+from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
 from mechsyn.model.mechanism import Mechanism
 
@@ -84,21 +86,38 @@ class SpatialEngine:
         return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
 
 
+#: The inputs a pair takes: its id, and for a C pair ``<id>/turn``, for a U pair ``<id>/2``.
+INPUT_NAMES = {"R": ("",), "H": ("",), "P": ("",), "C": ("", "/turn"), "U": ("", "/2")}
+
+
+def input_kind(mech: Mechanism, name: str) -> str:
+    """The pair type an input ``name`` moves as: ``"R"`` for an angle (R, H, a C pair's turn,
+    a U pair's angles), ``"P"`` for a slide (P, a C pair's slide)."""
+    jid, _, part = name.partition("/")
+    t = mech.joint(jid).type
+    return "P" if t == "P" or (t == "C" and not part) else ("H" if t == "H" else "R")
+
+
 def _check_inputs(mech: Mechanism, inputs: dict[str, Any]) -> dict[str, np.ndarray]:
     if not inputs:
         raise MechsynInputError("no input given", field="inputs",
                                 hint="give the driven joint's values, e.g. R1=0:360:1 on the command line")
     out = {}
-    for jid, v in inputs.items():
+    for name, v in inputs.items():
+        jid, slash, part = name.partition("/")
         try:
             j = mech.joint(jid)
         except KeyError:
             raise MechsynInputError(f"no joint {jid!r} to drive", source=mech.source, field="inputs",
                                     hint="one of " + ", ".join(j.id for j in mech.joints)) from None
-        if j.type not in ("R", "P", "H"):
-            raise MechsynInputError(f"joint {jid} ({j.type} pair) cannot take an input: only R, P and H pairs do",
-                                    source=mech.source, field="inputs", hint="drive an R, P or H pair")
-        out[jid] = np.atleast_1d(np.asarray(v, float))
+        if j.type not in INPUT_NAMES:
+            raise MechsynInputError(f"joint {jid} ({j.type} pair) cannot take an input: only R, P, H, C and U pairs "
+                                    "do", source=mech.source, field="inputs", hint="drive an R, P, H, C or U pair")
+        if slash + part not in INPUT_NAMES[j.type]:
+            raise MechsynInputError(f"input {name!r}: a {j.type} pair takes "
+                                    + " and ".join(repr(jid + s) for s in INPUT_NAMES[j.type]), source=mech.source,
+                                    field="inputs", hint="a C pair: C=slide, C/turn=angle; a U pair: U, U/2 (angles)")
+        out[name] = np.atleast_1d(np.asarray(v, float))
     sizes = {len(v) for v in out.values()}
     if len(sizes) != 1:
         raise MechsynInputError("the inputs have different numbers of values", field="inputs",
@@ -118,9 +137,9 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
     """(N, drives) targets in model units: radians, or lengths over the scale."""
     N = len(next(iter(inputs.values())))
     U = np.zeros((N, len(M.drives)))
-    for k, (jid, kind, _) in enumerate(M.drives):
+    for k, (jid, kind, kk) in enumerate(M.drives):
         if jid in inputs:
-            U[:, k] = np.radians(inputs[jid]) if kind == "angle" else inputs[jid] / M.scale
+            U[:, k] = np.radians(inputs[jid]) - M.zeros[kk] if kind == "angle" else inputs[jid] / M.scale
     return U
 
 
@@ -166,6 +185,7 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
     >>> s.engine, s.point("C").shape, bool(s.assembled.all())
     ('spatial', (3, 3), True)
     """
+    mech = planar_as_spatial(mech)  # a planar file: its 3-D equivalent, with the planar zero
     inputs = _check_inputs(mech, inputs)
     M = compile_spatial(mech, _drives(mech, inputs))
     if M.n < SMALL_LINKS:  # BLAS does not thread matrices this small
@@ -188,9 +208,8 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
     if points is None and not mech.points:
         points = [j.id for j in mech.joints if j.point is not None]
     pts = resolve_points(mech, points)
-    # input rates (default 1); the drives held at their drawn value do not move
-    sp = np.array([float((speeds or {}).get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives])
-    sp = np.where([d[1] == "slide" for d in M.drives], sp / M.scale, sp)
+    U = _input_matrix(M, inputs)
+    sp, spp, path_note = _input_rates(M, inputs, speeds, U)
     tr = Tracker(M)
     n = M.n
     R0, p0 = np.tile(np.eye(3), (1, n + 1, 1, 1)), np.zeros((1, n + 1, 3))
@@ -200,8 +219,7 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
         later = None
     except MechsynInputError as exc:  # perhaps only the drawn assembly is singular: judge on the sweep
         later = exc
-    U = _input_matrix(M, inputs)
-    rows = _sweep_rows(tr, start, U, sp, progress)
+    rows = _sweep_rows(tr, start, U, (sp, spp), progress)
     if later is not None:
         if not rows.ok.any():
             raise MechsynInputError(
@@ -212,7 +230,55 @@ def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], s
         R = np.concatenate([rows.R[k], np.eye(3)[None]])[None]
         p = np.vstack([rows.p[k], np.zeros((1, 3))])[None]
         _check_determined(M, tr.state(R, p, np.zeros((1, len(M.helix))), U[k][None]), pts)
-    return _result(mech, M, tr, inputs, sp, pts, U, rows, start)
+    return _result(mech, M, tr, inputs, sp[0], pts, U, rows, [path_note] if path_note else [])
+
+
+def _second_derivative(f: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``d²f/dx²`` of samples ``f`` at increasing or decreasing ``x`` (at least 3): the
+    three-point formula inside, the second derivative of the cubic through the first (last)
+    four points at the ends (of the parabola through three when there are only three)."""
+    out = np.empty_like(f)
+    h0, h1 = np.diff(x)[:-1], np.diff(x)[1:]
+    out[1:-1] = 2 * ((f[2:] - f[1:-1]) / h1 - (f[1:-1] - f[:-2]) / h0) / (h0 + h1)
+    k = min(4, len(f))
+    for sl, at in ((slice(0, k), 0), (slice(len(f) - k, len(f)), len(f) - 1)):
+        c = np.polyfit(x[sl] - x[at], f[sl], k - 1)
+        out[at] = 2 * c[-3]
+    return out
+
+
+def _input_rates(M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
+                 U: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+    """Per row, the drives' rates and their time derivatives (model units), and a note.
+
+    With one moving input, or ``speeds`` given for every input, each input moves at its
+    speed (default 1) and the drives held at their drawn value do not move. Several inputs
+    without their speeds are a path: the main (first) input moves at its speed ``s`` and
+    every other follows the path, ``u̇_j = s du_j/du_1`` and ``ü_j = s² d²u_j/du_1²`` (the
+    path's derivatives, second-order differences of the given input values: exact on
+    straight and parabolic paths); a path along which the main input does not move
+    monotonically falls back to constant speeds, with a note."""
+    N, D = U.shape
+    scale = np.array([1.0 if kind == "angle" else 1.0 / M.scale for _, kind, _ in M.drives])
+    given = {d[0]: float((speeds or {}).get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives}
+    const = np.broadcast_to(np.array(list(given.values())) * scale, (N, D)).copy()
+    moving = [k for k in range(D) if np.ptp(U[:, k]) > 0]
+    names = [M.drives[k][0] for k in moving]
+    if len(moving) < 2 or all(n in (speeds or {}) for n in names) or N < 3:
+        return const, np.zeros((N, D)), ""
+    main = next(k for k, d in enumerate(M.drives) if d[0] == next(iter(inputs)))
+    u = U[:, main]
+    du = np.diff(u)
+    if not (np.all(du > 0) or np.all(du < 0)):
+        return const, np.zeros((N, D)), (f"the inputs {', '.join(names)} move together but {M.drives[main][0]} does "
+                                         "not move one way along them: every input at its constant speed")
+    s = given[M.drives[main][0]] * scale[main]
+    sp, spp = np.zeros((N, D)), np.zeros((N, D))
+    for k in moving:
+        sp[:, k] = s * np.gradient(U[:, k], u, edge_order=2)
+        spp[:, k] = s * s * _second_derivative(U[:, k], u)
+    return sp, spp, (f"the inputs {', '.join(names)} follow one path: rates from its derivative with "
+                     f"{M.drives[main][0]} at its speed")
 
 
 @dataclass
@@ -229,20 +295,26 @@ class _Rows:
     theta: np.ndarray
     slide: np.ndarray
     events: list
+    how: np.ndarray | None = None
 
 
 def _input_dict(M: SpatialModel, u: np.ndarray) -> dict[str, float]:
-    return {jid: float(np.degrees(v)) if kind == "angle" else float(v * M.scale)
-            for (jid, kind, _), v in zip(M.drives, u)}
+    """Model targets -> the inputs as the user gives them (deg from the joint's zero, lengths)."""
+    return {jid: float(np.degrees(v + M.zeros[kk])) if kind == "angle" else float(v * M.scale)
+            for (jid, kind, kk), v in zip(M.drives, u)}
 
 
 _MESSAGES = {
     "not assembled": "the drawn assembly cannot be moved to this input (a dead point or a singular "
                      "configuration lies between)",
-    "dead point": "a limit of the working range: the drive cannot reach this value from the previous row "
-                  "(singular value ratio {:.2g} where the continuation stopped)",
-    "reassembled": "assembles again after a gap (Newton from the last assembled pose; the assembly branch "
-                   "may differ from the drawn one)",
+    "dead point": "a limit of the working range (its input refined between the last row reached and this "
+                  "one): the drive cannot go on (singular value ratio {:.2g} where the continuation stopped)",
+    "reassembled": "assembles again after a gap, in another assembly than the drawn one (no motion from the "
+                   "drawn assembly reaches these rows: Newton from the last pose before the gap)",
+    "other way round": "reached the other way round from the drawn assembly (the input taken modulo 360 degrees): the "
+             "drawn circuit, on from the sweep's other end",
+    "refused": "not assembled here: Newton converged to a pose where pair {} is not the file's pair (its axis "
+               "reversed or a slide half-turned: another root of its equations), refused",
 }
 
 
@@ -252,52 +324,99 @@ def _regular_rank(tr: Tracker, st: State) -> None:
     singular, ``tr.rank`` becomes the higher rank and ``tr.drawn_singular`` is set."""
     rows = np.unique([0, len(st.g) // 2, len(st.g) - 1])
     sv = np.linalg.svd(st.lin.Jc[rows], compute_uv=False)
-    rank = int(np.max(np.count_nonzero(sv > RANK_TOL * sv[:, :1], axis=1)))
+    rank = int(np.max(np.count_nonzero(sv > tr.rank_tol * sv[:, :1], axis=1)))
     if rank > (tr.rank or 0):
         tr.drawn_singular, tr.rank, st.lin.r = tr.rank, rank, rank
         st.lin.__dict__.pop("ratio", None)
 
 
-def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progress: Any) -> _Rows:
+def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarray, np.ndarray],
+                progress: Any) -> _Rows:
     """Poses of every row by continuation from the drawn assembly, then the closure residual,
     the rank test and the rates of all assembled rows at once."""
     M = tr.M
 
-    def event(k: int, kind: str, detail: Any) -> dict:
-        return {"index": k, "kind": kind, "input": _input_dict(M, U[k]), "message": _MESSAGES[kind].format(detail)}
+    def event(k: int, kind: str, detail: Any, at: np.ndarray | None = None, last: int | None = None) -> dict:
+        """An event at row ``k``; ``at``: its input's offset from row ``k``'s (a refined limit);
+        ``last``: the assembled row it bounds."""
+        e = {"index": k, "kind": kind, "input": _input_dict(M, U[k] if at is None else U[k] + at),
+             "message": _MESSAGES[kind].format(detail)}
+        if last is not None:
+            e["last"] = int(last)
+        return e
 
     w = walk(tr, start, U, event)
     N, n = len(U), M.n
     out = _Rows(w.R[:, :-1], w.p[:, :-1], np.full((N, 6 * n), np.nan), np.full((N, 6 * n), np.nan), w.ok,
                 np.full(N, np.nan), np.full(N, np.nan), np.full((N, M.angles.size), np.nan),
-                np.full((N, M.slides.size), np.nan), w.events)
+                np.full((N, M.slides.size), np.nan), w.events, w.how)
     idx = np.flatnonzero(w.ok)
     if len(idx):
         st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
+        keep = _verify(tr, w, idx, st, event)
+        if not keep.all():
+            idx, st = idx[keep], st.take(np.flatnonzero(keep))
+    if len(idx):
         _regular_rank(tr, st)
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
         out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
-        x1, x2 = tr.rates(st, np.broadcast_to(sp, (len(idx), len(sp))), refine=2)
-        regular = st.lin.ratio >= RANK_TOL
+        x1, x2 = tr.rates(st, rates[0][idx], refine=2, ddu=rates[1][idx])
+        regular = st.lin.ratio >= singular_tol(M)
+        found = crossings(tr, w, U, out.ratio, st.lin.Jc, idx)
+        on_row = {c[3] for c in found if c[3] is not None}
+        regular &= ~np.isin(idx, list(on_row))
         out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
-        for k, r in zip(idx[~regular], st.lin.ratio[~regular]):
-            out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, U[k]),
-                               "message": f"singular configuration: the Jacobian's rank drops below {st.lin.r} "
-                                          f"(singular value ratio {r:.2g}); rates not defined here (null)"})
-        for k, u, r in crossings(tr, w, U, out.ratio):
-            out.events.append({"index": k, "kind": "singular", "crossed": True, "input": _input_dict(M, u),
-                               "message": f"a singular configuration lies between rows {k - 1} and {k + 1} "
-                                          f"(singular value ratio {r:.2g} there): the sweep passes it on the "
-                                          "branch it was on (the predictor's tangent)"})
+        _singular_events(M, out, U, idx[~regular], found)
         out.events.sort(key=lambda e: e["index"])
     if progress is not None:
         progress(N)
     return out
 
 
+def _verify(tr: Tracker, w: Any, idx: np.ndarray, st: State, event: Any) -> np.ndarray:
+    """Every row the walk assembled checked again before it is reported: its closure
+    residual and the pair check (each R, C, H, P pair's relative rotation is the one its
+    reported joint value gives, so the joint values close every loop:
+    :func:`~mechsyn.kinematics.spatial_model.pair_error`); a row that fails is not assembled,
+    with an event naming the pair. Returns the mask of ``idx`` (the assembled rows, state
+    ``st``) kept."""
+    M = tr.M
+    err = pair_error(M, st.R)
+    res = np.abs(st.g).max(axis=1)
+    bad = (res > closure_tol(tr)) | (err.max(axis=1, initial=0.0) > PAIR_TOL)
+    for k, e in zip(idx[bad], err[bad]):
+        w.ok[k] = False
+        w.events.append(event(int(k), "refused", M.pairs.ids[int(np.argmax(e))] if e.size else "-"))
+    return ~bad
+
+
+def closure_tol(tr: Tracker) -> float:
+    """The largest closure residual a reported row may carry: ``CLOSURE_TOL`` of the length
+    scale, or ten times the corrector's tolerance where the file's coordinates need more."""
+    return max(CLOSURE_TOL, 10 * tr.tol)
+
+
+def _singular_events(M: SpatialModel, out: _Rows, U: np.ndarray, rows: np.ndarray, found: list) -> None:
+    """Events of the singular rows (rates null) and of the crossings between rows."""
+    on_row = {c[3]: c for c in found if c[3] is not None}
+    for k in rows:
+        r = out.ratio[k]
+        u = on_row[k][1] if k in on_row else U[k]
+        out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, u),
+                           "message": f"singular configuration (singular value ratio {r:.2g}): a change or "
+                                      "dead point on this row; rates not defined here (null)"})
+    for k, u, r, at in found:
+        if at is not None:
+            continue
+        out.events.append({"index": int(k), "kind": "singular", "crossed": True, "input": _input_dict(M, u),
+                           "message": f"a singular configuration lies between rows {k} and {k + 1} (singular "
+                                      f"value ratio {r:.2g} there): the sweep passes it on the branch it was on "
+                                      "(the predictor's tangent)"})
+
+
 def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.ndarray], sp: np.ndarray,
-            pts: dict, U: np.ndarray, rows: _Rows, start: State) -> SpatialSimulation:
+            pts: dict, U: np.ndarray, rows: _Rows, more: list[str]) -> SpatialSimulation:
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
@@ -311,7 +430,12 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     pm = {}
     for name, (link, at) in pts.items():
         pm[name] = _point_motion(M, rows, X, Xd, link, M.local(at))
-    joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok)) for k, jid in enumerate(M.angle_joints)}
+    joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok) + M.zeros[k]) for k, jid in enumerate(M.angle_joints)}
+    for name, v in inputs.items():  # an input reads as itself (the same turn)
+        key = name + "/slide" if mech.joint(name.partition("/")[0]).type == "C" and "/" not in name else \
+            name.replace("/turn", "")
+        if key in joints:
+            joints[key] = np.where(ok, v, np.nan)
     joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
                    for k, jid in enumerate(M.slide_joints)})
     notes = []
@@ -324,15 +448,44 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
                      "held at their drawn position (minimum-norm steps and rates)")
     if tr.halvings:
         notes.append(f"the continuation step was halved {tr.halvings} time(s) where the corrector had trouble")
-    bad = ok & (rows.res > CLOSURE_TOL)
+    bad = ok & (rows.res > closure_tol(tr))
     if bad.any():
-        notes.append(f"closure residual above {CLOSURE_TOL:g} of the length scale at {int(bad.sum())} row(s)")
-    types = {jid: mech.joint(jid).type for jid in inputs}
+        notes.append(f"closure residual above {closure_tol(tr):g} of the length scale at {int(bad.sum())} row(s)")
+    notes += _reach_notes(M, tr, U, rows) + more
+    types = {jid: input_kind(mech, jid) for jid in inputs}
     speeds = {d[0]: float(v * (L if d[1] == "slide" else 1.0)) for d, v in zip(M.drives, sp) if d[0] in inputs}
     return SpatialSimulation(
         mechanism=mech.name, inputs=inputs, input_types=types, speeds=speeds, assembled=ok, points=pm,
         links=links, joints=joints, residual=rows.res, singular_ratio=rows.ratio, length_scale=L,
-        rank=tr.rank, idle=idle, events=rows.events, notes=notes, model=M)
+        rank=tr.rank, idle=idle, events=rows.events, notes=notes, model=M,
+        reached=np.where(ok, rows.how, 0).astype(int), held=tuple(d[0] for d in M.drives if d[0] not in inputs),
+        zero={d[0]: float(np.degrees(M.zeros[d[2]])) for d in M.drives if d[0] in inputs and d[1] == "angle"})
+
+
+def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> list[str]:
+    """What the summary says about how the rows were reached (:func:`~.spatial_track.walk`)."""
+    notes = []
+    how = np.where(rows.ok, rows.how, 0)
+    if (how == 2).any():
+        notes.append(f"{int((how == 2).sum())} row(s) reached going the other way round from the drawn assembly "
+                     "(the input modulo 360): the drawn circuit")
+    if (how == 3).any():
+        notes.append(f"{int((how == 3).sum())} row(s) in another assembly than the drawn one: no motion from the "
+                     "drawn assembly reaches them (re-assembled by Newton after a gap)")
+    if tr.rejected:
+        notes.append(f"{tr.rejected} converged pose(s) refused: another root of a pair's equations (an R axis "
+                     "reversed or a slide half-turned), not the file's pairs")
+    col = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
+    if len(col) == 1 and M.lay.d_angle[col[0]]:
+        u = U[:, col[0]]
+        turns = rows.ok & (np.abs(np.mod(u + np.pi, 2 * np.pi) - np.pi) < 1e-9) & (np.abs(u) > 1e-9)
+        off = [k for k in np.flatnonzero(turns) if np.abs(rows.R[k] - np.eye(3)).max() > 1e-6
+               or np.abs(rows.p[k]).max() > 1e-6]
+        if off:
+            v = _input_dict(M, U[off[0]])[M.drives[col[0]][0]]
+            notes.append(f"at {M.drives[col[0]][0]} = {v:.6g} (the drawn input, a turn on) the mechanism is in "
+                         "another assembly than drawn: its circuit takes more than one turn of the input")
+    return notes
 
 
 def _point_motion(M: SpatialModel, rows: _Rows, X: np.ndarray, Xd: np.ndarray, link: str,

@@ -16,7 +16,7 @@ kind                      equation                               pairs
 coincidence (3 rows)      ``x_a - x_b = 0``                      R, U, S
 dot (1 row)               ``u_a · w_b = u_0 · w_0``              R (2), U (1), C, H (2), P (3)
 line (1 row)              ``(x_b - x_a) · n_a = 0``              C, H, P (2 each)
-angle / slide (drives)    ``θ = θ_in``, ``(x_b - x_a) · a = s``  R, H (angle); P (slide)
+angle / slide (drives)    ``θ = θ_in``, ``(x_b - x_a) · a = s``  R, H, C, U (angle); P, C (slide)
 helix (1 row)             ``s - h θ = 0``                        H
 ========================  =====================================  =============================
 
@@ -32,7 +32,18 @@ the solver takes least-squares, minimum-norm steps.
 Lengths are measured from the centre of the joint points in units of the mechanism's
 length scale (the largest distance of a joint point from that centre), so every equation
 is dimensionless, the solver's tolerances are relative to the length scale, and a
-mechanism scaled by 1e-3 or 1e4 gives the same numbers.
+mechanism scaled by 1e-3 or 1e4 gives the same numbers. The file's coordinates carry
+rounding of one unit in the last place of their magnitude: ``ulp`` is that rounding in
+model units (``eps · max|x| / scale``), the floor of every tolerance, so a mechanism placed
+1e6 of its sizes from the origin (or a spherical linkage whose points cluster near its
+centre) is not asked to close better than its own coordinates do.
+
+The dot equations of an R pair (its axis perpendicular to two normals of the other link)
+also hold with the axis reversed on one link, and those of a P pair (three frame vectors
+kept perpendicular) with a half-turn about a frame vector: roots that are not the pair.
+:func:`pair_error` measures every pair's relative rotation against the rotation its
+reported joint value gives (``Rot(a, θ)`` for R, C and H, the identity for P); a pose is a
+true assembly only where that is zero. U and S pairs' equations admit exactly the pair.
 
 References
 ----------
@@ -48,6 +59,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -143,6 +155,11 @@ class SpatialModel:
     helix: tuple[tuple[int, int, float], ...]
     drives: tuple[tuple[str, str, int], ...]
     lay: "_Layout | None" = None
+    ulp: float = float(np.finfo(float).eps)
+    pairs: "_Pairs | None" = None
+    #: per angle joint (``angle_joints``), its input's value at the drawn assembly (rad):
+    #: :func:`input_zero`
+    zeros: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -184,6 +201,15 @@ def _pair_rows(j: Joint, ia: int, ib: int, x: np.ndarray | None, rows: dict[str,
         e1, e2 = _perp_basis(a)
         rows["angle"].append((ia, ib, a, e1, e1, e2, 0.0))
         rows["angle_joints"].append(j.id)
+    if t == "U" and abs(float(a @ _unit(np.asarray(j.axis2, float)))) < 1e-9:
+        # a right-angled cross: its two angles, each an angle row with the axis on the link it
+        # is fixed to: the second arm turning about the first axis (on the first link), and
+        # the first arm turning about the second axis reversed (on the second link: the
+        # second link turns by +θ2 about it relative to the first)
+        a2 = _unit(np.asarray(j.axis2, float))
+        rows["angle"].append((ia, ib, a, a2, a2, np.cross(a, a2), 0.0))
+        rows["angle"].append((ib, ia, -a2, a, a, np.cross(-a2, a), 0.0))
+        rows["angle_joints"] += [j.id, j.id + "/2"]
     if t in ("P", "C", "H"):
         rows["slide"].append((ia, ib, x, x, a, z, 0.0))
         rows["slide_joints"].append(j.id)
@@ -204,10 +230,14 @@ def _check_joint(mech: Mechanism, j: Joint) -> None:
     if j.type == "U" and j.axis2 is None:
         raise MechsynInputError(f"joint {j.id} (U) has no axis2", source=src, field=f"joints[{j.id}].axis2",
                                 hint="give axis2: the cross's arm fixed in the second link")
-    if j.actuated and j.type not in ("R", "P", "H"):
-        raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P and H pairs can be driven "
-                                "(one input each)", source=src, field=f"joints[{j.id}].actuated",
-                                hint="drive an R, P or H pair (split a C pair into R + P)")
+    if j.actuated and j.type not in ("R", "P", "H", "C", "U"):
+        raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P, H, C and U pairs can be driven",
+                                source=src, field=f"joints[{j.id}].actuated", hint="drive an R, P, H, C or U pair")
+    if j.type == "U" and j.axis is not None and j.axis2 is not None and abs(
+            float(_unit(np.asarray(j.axis, float)) @ _unit(np.asarray(j.axis2, float)))) > 1e-9 and j.actuated:
+        raise MechsynInputError(f"joint {j.id} (U) is driven, but its axes are not at right angles: its two "
+                                "angles are defined for a right-angled cross only", source=src,
+                                field=f"joints[{j.id}].axis2", hint="make axis2 perpendicular to axis")
 
 
 def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
@@ -232,16 +262,151 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
     helix = tuple((rows["angle_joints"].index(j.id), rows["slide_joints"].index(j.id), (j.pitch or 0.0) / scale)
                   for j in mech.joints if j.type == "H")
     drive_rows = []
-    for jid in drives:
+    for name in drives:
+        jid, _, part = name.partition("/")
         j = mech.joint(jid)
-        if j.type in ("R", "H"):
-            drive_rows.append((jid, "angle", rows["angle_joints"].index(jid)))
+        if j.type in ("R", "H", "U") or (j.type == "C" and part == "turn"):
+            drive_rows.append((name, "angle", rows["angle_joints"].index(name if j.type == "U" else jid)))
         else:
-            drive_rows.append((jid, "slide", rows["slide_joints"].index(jid)))
+            drive_rows.append((name, "slide", rows["slide_joints"].index(jid)))
+    big = max([float(np.abs(np.asarray(j.point, float)).max()) for j in mech.joints if j.point is not None]
+              + [float(np.abs(np.asarray(pt.at, float)).max()) for pt in mech.points.values()], default=0.0)
     M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
                      _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
-                     tuple(rows["slide_joints"]), helix, tuple(drive_rows))
-    return replace(M, lay=_layout(M))
+                     tuple(rows["slide_joints"]), helix, tuple(drive_rows),
+                     ulp=float(np.finfo(float).eps) * max(1.0, big / scale))
+    zeros = np.array([input_zero(mech, mech.joint(jid.partition("/")[0])) for jid in M.angle_joints], float)
+    return replace(M, lay=_layout(M), pairs=_pairs(mech, index), zeros=zeros)
+
+
+# --------------------------------------------------------------------------- input zeros
+def _p3(v: Any) -> np.ndarray:
+    v = np.asarray(v, float)
+    return np.pad(v, (0, 3 - len(v)))
+
+
+def reference_direction(mech: Mechanism, link: str) -> np.ndarray:
+    """A link's reference line in the drawn assembly (3-D): from its first joint's point (file
+    order) to the first other joint point apart from it, the planar engines' rule (a crank's
+    angle is its line's); the frame's is ``+x``, as is that of a link with one point."""
+    x = np.array([1.0, 0.0, 0.0])
+    if link == mech.ground:
+        return x
+    pts = [_p3(j.point) for j in mech.joints_of(link) if j.point is not None]
+    size = max((float(np.abs(p - pts[0]).max()) for p in pts), default=0.0)
+    for p in pts[1:]:
+        if np.linalg.norm(p - pts[0]) > 1e-12 * max(size, 1e-300):
+            return p - pts[0]
+    return x
+
+
+def planar_as_spatial(mech: Mechanism) -> Mechanism:
+    """A planar mechanism as the spatial engine's file: its 3-D equivalent
+    (:func:`~mechsyn.structure.screws.as_spatial`: points at ``z = 0``, R axes along ``z``)
+    with every R pair's ``zero`` set to the planar zero (the first link's reference line, the
+    frame's ``x``), so that an input means the same pose as in the planar engines.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = planar_as_spatial(ms.examples.load("fourbar"))
+    >>> m.kind, m.joint("A").attrs["zero"]
+    ('spatial', [1.0, 0.0, 0.0])
+    """
+    from mechsyn.structure.screws import as_spatial
+
+    if mech.kind == "spatial":
+        return mech
+    out = as_spatial(mech)
+    joints = tuple(replace(j, attrs={**j.attrs, "zero": [float(v) for v in reference_direction(mech, j.links[0])]})
+                   if j.type == "R" else j for j in out.joints)
+    return replace(out, joints=joints)
+
+
+def input_zero(mech: Mechanism, j: Joint) -> float:
+    """The value (rad) of the input of R, H or C pair ``j`` in the drawn assembly: the angle
+    about its axis from its zero (on the first link) to the second link's reference line
+    (:func:`reference_direction`). The zero is the file's ``zero`` direction; for a planar
+    mechanism (axis ``z``) the first link's reference line, so that an input means what the
+    planar engines make of it (the angle of the driven link's line, relative to the first
+    link's); else there is none and the drawn pose is 0.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> m = ms.examples.load("crank_rocker")
+    >>> A = m.joint(next(j.id for j in m.joints if j.actuated))
+    >>> round(float(np.degrees(input_zero(m, A))), 6) == round(float(np.degrees(np.arctan2(
+    ...     *(reference_direction(m, A.links[1])[[1, 0]])))), 6)
+    True
+    """
+    if j.type not in ("R", "H", "C"):
+        return 0.0  # (a U pair's angles are measured from the drawn cross)
+    z = j.attrs.get("zero")
+    planar = mech.kind == "planar"
+    if z is None and not planar:
+        return 0.0
+    a = np.array([0.0, 0.0, 1.0]) if planar else _unit(np.asarray(j.axis, float))
+    z = reference_direction(mech, j.links[0]) if z is None else np.asarray(z, float)
+    r = reference_direction(mech, j.links[1])
+    z, r = z - (z @ a) * a, r - (r @ a) * a
+    if not np.linalg.norm(r) > 1e-12 * np.linalg.norm(reference_direction(mech, j.links[1])):
+        raise MechsynInputError(
+            f"joint {j.id}: link {j.links[1]!r}'s reference line (its first joint to its first other joint) runs "
+            "along the axis, so the zero cannot measure its angle", source=mech.source, field=f"joints[{j.id}].zero",
+            hint="remove `zero` (the input is then measured from the drawn pose)")
+    return float(np.arctan2(a @ np.cross(z, r), z @ r))
+
+
+# --------------------------------------------------------------------------- pair integrity
+@dataclass(frozen=True, eq=False)
+class _Pairs:
+    """The pairs whose equations admit other roots: R, C, H (axis ``a`` with ``e1``, ``e2``
+    perpendicular, ``turns``) and P (``turns`` False), between poses ``ia`` and ``ib``."""
+
+    ids: tuple[str, ...]
+    ia: np.ndarray
+    ib: np.ndarray
+    a: np.ndarray
+    e1: np.ndarray
+    e2: np.ndarray
+    turns: np.ndarray
+
+
+def _pairs(mech: Mechanism, index: dict[str, int]) -> _Pairs:
+    rows = []
+    for j in mech.joints:
+        if j.type in ("R", "C", "H", "P"):
+            a = _unit(np.asarray(j.axis, float))
+            e1, e2 = _perp_basis(a)
+            rows.append((j.id, index[j.links[0]], index[j.links[1]], a, e1, e2, j.type != "P"))
+    if not rows:
+        z = np.zeros((0, 3))
+        return _Pairs((), np.zeros(0, int), np.zeros(0, int), z, z, z, np.zeros(0, bool))
+    ids, ia, ib, a, e1, e2, turns = zip(*rows)
+    return _Pairs(ids, np.array(ia), np.array(ib), np.array(a), np.array(e1), np.array(e2), np.array(turns))
+
+
+def pair_error(M: SpatialModel, R: np.ndarray) -> np.ndarray:
+    """Per pose and pair (B, pairs): the largest entry of ``R_rel - Rot(a, θ)`` (R, C, H;
+    ``θ`` the pair's joint value read from ``R_rel``) or of ``R_rel - I`` (P), where
+    ``R_rel = R_a^T R_b`` is the second link's rotation relative to the first from the drawn
+    assembly. Zero (to the residual) on a true assembly; about 2 where an R axis is reversed
+    or a P pair half-turned. Because every pair's relative displacement is then the one its
+    joint values give, the joint values close every loop (their displacements compose, around
+    any loop, to the product of the links' relative poses, which is the identity)."""
+    P = M.pairs
+    if P is None or not len(P.ia):
+        return np.zeros((len(R), 0))
+    Rr = np.swapaxes(R[:, P.ia], -1, -2) @ R[:, P.ib]
+    r1 = matvec(Rr, P.e1)                                 # R_rel e1 (B, pairs, 3)
+    c, s = _dot(r1, P.e1), _dot(r1, P.e2)
+    th = np.where(P.turns, np.arctan2(s, c), 0.0)
+    K = np.einsum("ijk,nk->nij", -_EPS, P.a)              # [a]x: K y = a x y
+    aa = P.a[:, :, None] * P.a[:, None, :]
+    ct, st = np.cos(th)[..., None, None], np.sin(th)[..., None, None]
+    Rot = ct * np.eye(3) + st * K + (1 - ct) * aa
+    return np.abs(Rr - Rot).max(axis=(-1, -2))
 
 
 # --------------------------------------------------------------------------- layout

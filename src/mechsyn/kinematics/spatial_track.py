@@ -35,20 +35,44 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.spatial_model import (SpatialModel, _cross, convective, frame, helix_angles, jacobian, move,
-                                              residual, rotate)
+                                              pair_error, residual, rotate)
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 
 #: A singular value below this fraction of the largest is a lost direction (rank decisions).
 RANK_TOL = 1e-8
-#: Residual (in units of the length scale) at which the corrector accepts a pose.
+#: Residual (in units of the length scale) at which the corrector accepts a pose; the
+#: floor of :func:`newton_tol` (which also stays ``ULPS`` units in the last place of the
+#: file's coordinates above their rounding).
 NEWTON_TOL = 1e-12
+ULPS = 64
+#: Largest entry of a pair's relative rotation minus the rotation of its joint value
+#: (:func:`~mechsyn.kinematics.spatial_model.pair_error`) on an accepted pose: a true
+#: assembly has the residual's size there, a reversed axis about 2.
+PAIR_TOL = 1e-6
+
+
+def newton_tol(M: SpatialModel) -> float:
+    """The corrector's tolerance for ``M``: ``NEWTON_TOL`` of the length scale, or ``ULPS``
+    units in the last place of the file's largest coordinate (in model units) when that is
+    more (a mechanism far from the origin, or with its points clustered, cannot close better
+    than its coordinates are written)."""
+    return max(NEWTON_TOL, ULPS * M.ulp)
+
+
+def singular_tol(M: SpatialModel) -> float:
+    """``σ_r / σ_1`` under which a row is singular: the accuracy Newton reaches at a singular
+    point (the square root of its tolerance, as it converges only linearly there), at least
+    ``RANK_TOL``."""
+    return max(RANK_TOL, 10 * np.sqrt(newton_tol(M)))
 #: Largest predictor step in a block (radians; lengths in units of the length scale): the
 #: second-order predictor's error is then about ``MAX_STEP³ / 6`` of the twists' scale,
 #: well inside Newton's reach; every row is still checked on its own (residual and branch
 #: guard). Measured: 0.35 / 0.5 / 0.75 / 1.0 give Bennett sweeps of 52 / 48 / 41 / 39 ms.
 MAX_STEP = 0.75
 MAX_HALVINGS = 12
+#: Events and working-range limits are refined to this fraction of the row step.
+REFINE = 1e-6
 MAX_STRIDE = 64
 
 
@@ -200,6 +224,12 @@ class Tracker:
         self.halvings = 0
         self.c0 = link_centres(M)
         self.blocks = _blocks(M)
+        self.tol = newton_tol(M)
+        self.rank_tol = max(RANK_TOL, 100 * self.tol)
+        self.rejected = 0  # converged poses refused by the pair check (another root of the equations)
+        self.last_bad, self.last_pair, self.refused = np.zeros(0, bool), [], []
+        self.left_singular = False  # a singular pose was left (leave): the branch taken is a choice
+        self._left: tuple | None = None
 
     def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
         """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
@@ -218,7 +248,7 @@ class Tracker:
         Jc = Jr.reshape(J.shape)
         if self.rank is None:  # the regular rank: at the drawn assembly, by an SVD
             s0 = np.linalg.svd(Jc[0], compute_uv=False)
-            self.rank = int(np.count_nonzero(s0 > RANK_TOL * s0[0])) if s0.size and s0[0] > 0 else 0
+            self.rank = int(np.count_nonzero(s0 > self.rank_tol * s0[0])) if s0.size and s0[0] > 0 else 0
         rows = J.shape[1] < J.shape[2]
         G = Jc @ Jc.transpose(0, 2, 1) if rows else Jc.transpose(0, 2, 1) @ Jc
         k = G.shape[1]
@@ -232,15 +262,20 @@ class Tracker:
             href = helix_angles(self.M, F, href)
         return State(R, p, href, F, self.lin(jacobian(self.M, F), R, p), g)
 
-    def rates(self, st: State, du: np.ndarray, refine: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    def rates(self, st: State, du: np.ndarray, refine: int = 0,
+              ddu: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
-        derivatives (``J ξ' = du``, ``J ξ'' = -γ(ξ')``); ``refine``: steps of iterative
-        refinement (2 for the rates reported, none for a predictor)."""
+        derivatives (``J ξ' = du``, ``J ξ'' = ü - γ(ξ')``, ``ü = ddu``: the drives' second
+        derivatives, zero by default); ``refine``: steps of iterative refinement (2 for the
+        rates reported, none for a predictor)."""
         F = st.F if st.F is not None else frame(self.M, st.R, st.p)
         b = np.zeros(st.g.shape)
         b[:, self.m_c:] = du
         x1 = st.lin.solve(b, refine)
-        return x1, st.lin.solve(-convective(self.M, F, x1), refine)
+        b2 = -convective(self.M, F, x1)
+        if ddu is not None:
+            b2[:, self.m_c:] += ddu
+        return x1, st.lin.solve(b2, refine)
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
                 iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
@@ -264,7 +299,7 @@ class Tracker:
             F = frame(self.M, R, p)
             g = residual(self.M, F, href, target)
             err = np.abs(g).max(axis=1)
-            done |= err < NEWTON_TOL
+            done |= err < self.tol
             if it >= 10:  # no longer converging: give up on those
                 failed |= ~done & (err > 0.5 * last)
             active = ~done & ~failed
@@ -287,9 +322,25 @@ class Tracker:
             failed |= moved > limit
             dx[failed] = 0.0
             R, p = move(R, p, dx)
-        return R, p, done & ~failed, (F, g, fresh, fidx)
+        return R, p, self.true_pairs(R, done & ~failed), (F, g, fresh, fidx)
 
-    def step(self, st: State, du: np.ndarray, target: np.ndarray) -> tuple[State | None, float]:
+    def true_pairs(self, R: np.ndarray, ok: np.ndarray) -> np.ndarray:
+        """``ok`` without the poses whose pairs are not the file's (a reversed R axis, a
+        half-turned P pair: :func:`~mechsyn.kinematics.spatial_model.pair_error`)."""
+        self.last_bad, self.last_pair = np.zeros(len(ok), bool), [""] * len(ok)
+        if not ok.any() or not len(self.M.pairs.ia):
+            return ok
+        bad = np.zeros(len(ok), bool)
+        err = pair_error(self.M, R[ok])
+        bad[ok] = err.max(axis=1) > PAIR_TOL
+        self.rejected += int(bad.sum())
+        self.last_bad, self.last_pair = bad, [""] * len(ok)
+        for b, e in zip(np.flatnonzero(ok), err):
+            if e.max() > PAIR_TOL:
+                self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
+        return ok & ~bad
+
+    def step(self, st: State, du: np.ndarray, target: np.ndarray, iters: int = 8) -> tuple[State | None, float]:
         """One predictor-corrector step of a single pose; (the new state or None, the
         predictor's step size). The new state keeps the corrector's linearisation (of
         the predicted pose): good for the next predictor; the rates reported are
@@ -299,7 +350,8 @@ class Tracker:
         if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
             return None, size
         R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]))
+        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]),
+                                                   iters=iters)
         if not ok[0]:
             return None, size
         if not len(rows):
@@ -340,13 +392,14 @@ class Tracker:
             new = self.state(R[last], p[last], href[last], Ub[last])
         return n, size, (R[:n], p[:n], href[:n]), new
 
-    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray, iters: int = 8) -> State | None:
         """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
-        ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
+        ``2^-MAX_HALVINGS`` of it; None when it cannot get there. ``iters``: Newton steps a
+        try (more next to a singular point, where Newton converges only linearly)."""
         t, h = 0.0, 1.0
         while t < 1.0:
             h = min(h, 1.0 - t)
-            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0))
+            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0), iters)
             if nxt is None:
                 if h < 0.5 ** MAX_HALVINGS:
                     return None
@@ -358,31 +411,108 @@ class Tracker:
         return st
 
     def reassemble(self, st: State, U: np.ndarray, rows: np.ndarray) -> tuple[int, State] | None:
-        """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges,
-        and its state; all rows tried in one batch."""
+        """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges to
+        a true assembly, and its state; all rows tried in one batch. ``refused`` lists the
+        rows before it (row, pair) where Newton converged to another root of a pair's
+        equations (:meth:`true_pairs`)."""
         B = len(rows)
         rep = np.zeros(B, int)
         R, p, ok, _ = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
+        j = int(np.argmax(ok)) if ok.any() else B
+        bad = np.flatnonzero(self.last_bad[:j])
+        self.refused = [(int(rows[b]), self.last_pair[b]) for b in bad]
         if not ok.any():
             return None
-        j = int(np.argmax(ok))
         return int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None])
+
+
+# --------------------------------------------------------------------------- leaving a singular pose
+def _null_motions(tr: Tracker, st: State) -> np.ndarray:
+    """The directions (k, 6 n) of the Jacobian's near-null space at ``st`` that move a
+    joint point (not idle spins), each signed so its largest entry is positive."""
+    M = tr.M
+    Jc = st.lin.Jc[0]
+    _, s, Vt = np.linalg.svd(Jc, full_matrices=True)
+    s = np.concatenate([s, np.zeros(Vt.shape[0] - len(s))])
+    tol = singular_tol(M) * s[0]
+    out = []
+    for v in Vt[s < tol]:
+        x = st.lin.twists(v[None, :, None])[0, :, 0]
+        X = x.reshape(M.n, 6)
+        move_pt = 0.0
+        for j in M.mech.joints:
+            if j.point is None:
+                continue
+            x0 = M.local(j.point)
+            for link in j.links:
+                i = M.index(link)
+                if i < M.n:
+                    y = st.R[0, i] @ x0 + st.p[0, i]
+                    move_pt = max(move_pt, float(np.abs(X[i, 3:] + np.cross(X[i, :3], y)).max()))
+        if move_pt > 1e-6:
+            out.append(x if x[np.argmax(np.abs(x))] > 0 else -x)
+    return np.array(out).reshape(-1, 6 * M.n)
+
+
+def leave(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+    """From a singular pose ``st`` (at inputs ``u0``) to ``u1``, or None: Newton from the pose moved by
+    the tangent and ``±σ`` along each null direction that moves a joint point (see
+    :mod:`mechsyn.kinematics.spatial_singular`)."""
+    du = u1 - u0
+    size = float(np.abs(du).max(initial=0.0))
+    if size == 0.0:
+        return st
+    N = _null_motions(tr, st)
+    if not len(N):
+        return None
+    x1, x2 = tr.rates(st, du[None])
+    base = x1[0] + 0.5 * x2[0]
+    sig = np.array([1.0, 3.0, 0.3]) * np.sqrt(size)
+    sig = np.concatenate([sig, [size, 3 * size]])
+    guesses = [base]
+    for v in N:
+        for g in sig:
+            guesses += [base + g * v, base - g * v]
+    memo = getattr(tr, "_left", None)
+    if memo is not None and memo[0] is st:  # the other way from the same pose: the same branch
+        d_prev, x_prev = memo[1], memo[2]
+        guesses.insert(0, -x_prev * (size / d_prev))
+    X = np.array(guesses)
+    B = len(X)
+    rep = np.zeros(B, int)
+    R, p = move(st.R[rep], st.p[rep], X)
+    R, p, ok, _ = tr.correct(R, p, st.href[rep], np.broadcast_to(u1, (B, len(u1))), np.full(B, np.inf), iters=30)
+    if not ok.any():
+        return None
+    if memo is not None and memo[0] is st and ok[0]:
+        j = 0
+    else:
+        dist = np.abs(R - st.R[rep]).max(axis=(1, 2, 3)) + np.abs(p - st.p[rep]).max(axis=(1, 2))
+        dist = np.where(ok, dist, np.inf)
+        j = int(np.argmax(dist <= dist.min() * (1 + 1e-6) + 1e-12))
+    tr._left = (st, size, X[j])
+    tr.left_singular = True
+    return tr.state(R[j:j + 1], p[j:j + 1], st.href, u1[None])
 
 
 # --------------------------------------------------------------------------- the walk
 @dataclass
 class Walk:
-    """Poses of every row (NaN where not reached) and the events met on the way."""
+    """Poses of every row (NaN where not reached), how each was reached (``how``: 0 not, 1
+    by moving from the drawn assembly, 2 the same going the other way round with the R input
+    taken modulo 360, 3 by re-assembly in another assembly) and the events met on the way."""
 
     R: np.ndarray
     p: np.ndarray
     href: np.ndarray
     ok: np.ndarray
     events: list
+    how: np.ndarray | None = None
 
-    def put(self, k: int | np.ndarray, st: State) -> None:
+    def put(self, k: int | np.ndarray, st: State, how: int = 1) -> None:
         self.R[k], self.p[k], self.href[k] = st.R, st.p, st.href
         self.ok[k] = True
+        self.how[k] = how
 
     def at(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.R[k:k + 1], self.p[k:k + 1], self.href[k:k + 1]
@@ -391,37 +521,116 @@ class Walk:
 def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
     """Every row of the inputs ``U`` (N, drives) from the drawn assembly ``start`` (at zero
     inputs): to the row nearest it, then outwards both ways by blocks of rows
-    (:func:`_blocks_along`). ``event(index, kind, detail)`` makes the event dicts."""
+    (:func:`_blocks_along`) as far as the mechanism moves. Then, by one rule, the rows left:
+
+    1. a sweep of one R (or H) input that reached one end goes on past it with the rows left
+       taken modulo 360 degrees (the other way round from the drawn assembly: the rows a
+       full-turn sweep could not reach forwards are reached backwards, on the drawn circuit);
+    2. rows still left are re-assembled by Newton from the last pose before each gap, in
+       row order: another assembly than the drawn one (no motion from the drawn assembly
+       reaches them), each such stretch an event ``reassembled``.
+
+    ``event(index, kind, detail)`` makes the event dicts. From a singular pose (a file
+    drawn at a dead or change point) the first row each way is reached by :func:`leave`."""
     M = tr.M
     N = len(U)
     w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
-             np.zeros((N, len(M.helix))), np.zeros(N, bool), [])
+             np.zeros((N, len(M.helix))), np.zeros(N, bool), [], np.zeros(N, np.int8))
     k0 = int(np.argmin(np.abs(U).max(axis=1)))
-    st = tr.advance(start, np.zeros(U.shape[1]), U[k0])
-    if st is None:
+    ends = []
+    z = np.zeros(U.shape[1])
+    st = tr.advance(start, z, U[k0]) or leave(tr, start, z, U[k0])
+    for order in (np.arange(k0, N), np.arange(k0, -1, -1)):
+        if st is None:
+            ends.append(None)
+            continue
+        if not w.ok[k0]:
+            w.put(k0, st)
+        ends.append(_blocks_along(tr, w, st, U, k0, order[1:], event))
+    if not w.ok[k0]:
         w.events.append(event(k0, "not assembled", None))
-        return w
-    w.put(k0, st)
-    for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1)):
-        _blocks_along(tr, w, st, U, k0, order, event)
+    _round(tr, w, U, ends, event)
+    _reassemble_rest(tr, w, U, event)
     w.events.sort(key=lambda e: e["index"])
     return w
 
 
-def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any) -> None:
-    """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
-    each from the last row of the one before; the rows reached go into ``w``."""
-    prev, i, stride, gap = k0, 0, MAX_STRIDE, False
-    while i < len(order):
-        if gap:  # the first row after the gap where Newton from the last pose converges
-            k = tr.reassemble(st, U, order[i:])
-            if k is None:
-                break
-            where = i + int(np.flatnonzero(order[i:] == k[0])[0])
-            first = _back_into_gap(tr, w, k[1], U, order[i:where + 1][::-1])
-            w.events.append(event(first, "reassembled", None))
-            st, prev, gap, i = k[1], k[0], False, where + 1
+def _turning(M: SpatialModel, U: np.ndarray) -> int | None:
+    """The column of ``U`` of the sweep's one moving input when it is an angle, else None."""
+    moving = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
+    if len(moving) != 1 or not M.lay.d_angle[moving[0]]:
+        return None
+    return int(moving[0])
+
+
+def _round(tr: Tracker, w: Walk, U: np.ndarray, ends: list, event: Any) -> None:
+    """Rule 1 of :func:`walk`: past an end the walk reached, on to the rows left with the
+    input taken modulo 2π (beyond the last row upwards, or below the first downwards)."""
+    col = _turning(tr.M, U)
+    if col is None or w.ok.all():
+        return
+    N = len(U)
+    up = U[-1, col] >= U[0, col]
+    for st, end, sign in ((ends[0], N - 1, 1.0), (ends[1], 0, -1.0)):
+        left = np.flatnonzero(~w.ok)
+        if st is None or not w.ok[end] or not len(left) or (w.how[end] != 1):
             continue
+        d = sign * (1 if up else -1)  # +1: inputs grow past this end
+        V = U.copy()
+        shift = np.mod(d * (U[left, col] - U[end, col]), 2 * np.pi)
+        shift[shift < 1e-12] = 2 * np.pi  # the end's own input: a full turn on
+        V[left, col] = U[end, col] + d * shift
+        order = left[np.argsort(shift, kind="stable")]
+        before = w.ok.copy()
+        _blocks_along(tr, w, st, V, end, order, event, how=2)
+        got = np.flatnonzero(w.ok & ~before)
+        if len(got):
+            w.events.append(event(int(got[0]), "other way round", None))
+    _same_angle(w, U, col)
+
+
+def _same_angle(w: Walk, U: np.ndarray, col: int) -> None:
+    """Rows left whose input equals, modulo 2π, that of a row reached by moving from the
+    drawn assembly take its pose (an R input is an angle: 360 is 0)."""
+    key = np.round(np.mod(U[:, col], 2 * np.pi) / (2 * np.pi) * 1e9).astype(np.int64) % 1_000_000_000
+    seen = {int(key[k]): k for k in np.flatnonzero(w.ok & (w.how == 1))}
+    for k in np.flatnonzero(~w.ok):
+        src = seen.get(int(key[k]))
+        if src is not None:
+            w.R[k], w.p[k], w.href[k] = w.R[src], w.p[src], w.href[src]
+            w.ok[k], w.how[k] = True, 2
+
+
+def _reassemble_rest(tr: Tracker, w: Walk, U: np.ndarray, event: Any) -> None:
+    """Rule 2 of :func:`walk`: each gap left, in row order, re-assembled by Newton from the
+    pose of the row before it (the first row of the gap where Newton converges to a true
+    assembly), then walked on forwards and back into the gap as far as the mechanism moves."""
+    N = len(U)
+    for i in range(1, N):
+        if w.ok[i] or not w.ok[i - 1]:
+            continue
+        rows = np.arange(i, N)
+        rows = rows[:int(np.argmax(np.append(w.ok[rows], True)))]  # up to the next assembled row
+        got = tr.reassemble(tr.state(*w.at(i - 1), U[i - 1][None]), U, rows)
+        for k, jid in tr.refused:
+            w.events.append(event(k, "refused", jid))
+        if got is None:
+            continue
+        k, st = got
+        w.put(k, st, how=3)
+        _blocks_along(tr, w, st, U, k, rows[rows > k], event, how=3)
+        _blocks_along(tr, w, st, U, k, rows[rows < k][::-1], event, how=3)
+        w.events.append(event(int(rows[np.argmax(w.ok[rows])]), "reassembled", None))
+
+
+def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any,
+                  how: int = 1) -> State | None:
+    """Walk along ``order`` by blocks of rows of adaptive length (:meth:`Tracker.block`),
+    each from the last row of the one before, until the first row it cannot reach (a
+    ``dead point`` event there); the rows reached go into ``w``. Returns the state of the
+    last row when it reached the end of ``order``, else None."""
+    prev, i, stride = k0, 0, MAX_STRIDE
+    while i < len(order):
         j = min(i + stride, len(order)) - 1
         rows = order[i:j + 1]
         n, size, poses, nxt = tr.block(st, U[prev], U[rows])
@@ -430,31 +639,38 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
             continue
         if n == 0:  # a single row: halve within it
             k = int(rows[0])
-            nxt = tr.advance(st, U[prev], U[k])
+            nxt = tr.advance(st, U[prev], U[k]) or leave(tr, st, U[prev], U[k])
             if nxt is None:
-                w.events.append(event(k, "dead point", st.lin.ratio[0]))
-                i, gap = i + 1, True
-                continue
+                if not w.ok[k]:
+                    lim = limit(tr, st, U[prev], U[k])
+                    w.events.append(event(k, "dead point", st.lin.ratio[0], at=lim - U[k], last=prev))
+                return None
             n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
         done = rows[:n]
         w.R[done], w.p[done], w.href[done] = poses
         w.ok[done] = True
+        w.how[done] = how
         st, prev, i = nxt, int(done[-1]), i + n
         reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
+    return st
 
 
-def _back_into_gap(tr: Tracker, w: Walk, st: State, U: np.ndarray, rows: np.ndarray) -> int:
-    """From the reassembled row ``rows[0]`` (state ``st``) back through the gap's rows while
-    the mechanism follows (so the gap ends where the mechanism stops assembling, not where
-    Newton first converged); returns the first row of the assembled stretch."""
-    w.put(int(rows[0]), st)
-    for prev, k in zip(rows[:-1], rows[1:]):
-        st = tr.advance(st, U[prev], U[k])
-        if st is None:
-            return int(prev)
-        w.put(int(k), st)
-    return int(rows[-1])
+def limit(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
+    """The input where the motion from ``st`` (at ``u0``, assembled) towards ``u1`` (not
+    reached) stops: bisection on whether Newton from the nearest pose reached converges to
+    a true assembly (on either branch that meets there), to ``REFINE`` of the step."""
+    lo, hi = 0.0, 1.0
+    R, p, href = st.R, st.p, st.href
+    inf = np.array([np.inf])
+    while hi - lo > REFINE:
+        t = 0.5 * (lo + hi)
+        R1, p1, ok, _ = tr.correct(R, p, href, (u0 + t * (u1 - u0))[None], inf, iters=12)
+        if ok[0]:
+            R, p, lo = R1, p1, t
+        else:
+            hi = t
+    return u0 + lo * (u1 - u0)
 
 
 def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -476,66 +692,3 @@ def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndar
     for q, (a, b) in enumerate(pairs):
         x2 += np.outer(d[:, a] * d[:, b], X2[c + q] - X2[a] - X2[b])
     return x1, x2
-
-
-# --------------------------------------------------------------------------- crossings
-GOLDEN_STEPS = 40
-
-
-def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray) -> list[tuple[int, np.ndarray, float]]:
-    """Singular configurations the sweep passes between rows: ``(row, inputs, ratio)``.
-
-    ``σ_r / σ_1`` is zero at a singular configuration and, along a motion through it,
-    grows like the distance ``|t - t*|`` on both sides (a V), while a regular minimum is
-    smooth (``a + c t²``). A row whose ratio is a local minimum with its two neighbours'
-    sum at least four times its own (every V passes: ``2 Δ / |δ| >= 4`` for a zero at
-    ``δ`` within half a row; a smooth minimum passes only when it is sharp for its depth,
-    ``c Δ² >= a``, i.e. near-singular) is refined by a golden-section search of the ratio
-    over the inputs between its neighbours, each pose reached by continuation from the
-    row; it is a crossing when the smallest ratio found is under ``RANK_TOL``."""
-    out = []
-    N = len(U)
-    for k in range(1, N - 1):
-        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]):
-            continue
-        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
-        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= RANK_TOL):
-            continue
-        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
-        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
-            continue  # not on one straight stretch of the sweep
-        found = _golden(tr, w, U, k)
-        if found is not None and found[1] < RANK_TOL:
-            out.append((k, found[0], found[1]))
-    return out
-
-
-def _golden(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[np.ndarray, float] | None:
-    """The least ``σ_r / σ_1`` between rows ``k - 1`` and ``k + 1`` (golden section)."""
-    st = tr.state(*w.at(k), U[k][None])
-    lo, hi = U[k - 1], U[k + 1]
-
-    def f(t: float) -> float:
-        u = lo + t * (hi - lo)
-        nxt = tr.advance(st, U[k], u)
-        if nxt is None:
-            return np.inf
-        return float(svd_ratio(tr.state(nxt.R, nxt.p, nxt.href, u[None]).lin.Jc, tr.rank)[0])
-
-    halvings = tr.halvings  # the search's own step halvings are not the sweep's trouble
-    g = (np.sqrt(5) - 1) / 2
-    a, b = 0.0, 1.0
-    c, d = b - g * (b - a), a + g * (b - a)
-    fc, fd = f(c), f(d)
-    for _ in range(GOLDEN_STEPS):
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - g * (b - a)
-            fc = f(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + g * (b - a)
-            fd = f(d)
-    tr.halvings = halvings
-    t, best = (c, fc) if fc < fd else (d, fd)
-    return (lo + t * (hi - lo), best) if np.isfinite(best) else None

@@ -585,10 +585,15 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     if check_singular and mobility > 0:
         progress("singularity")
         lm, contours = _local(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
+    drives = useful if lm.finite is None else max(lm.finite - len(idle), 0)  # from the finite mobility
+    if lm.finite is not None and drives == 0 and mobility and anames:
+        spins = f" besides {_n(len(idle), 'idle motion')}" if idle else ""
+        determined, anote = True, (f"the drive(s) at {', '.join(anames)} are locked: the mechanism is rigid "
+                                   f"(finite mobility 0{spins}), no drive can move it")
     sv = red.singular_values
     return RankAnalysis(
         motion="planar" if planar else "spatial", mobility=mobility, useful_mobility=useful,
-        idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=useful,
+        idle_mobilities=idle, redundant_constraints=redundant, contours=contours, drives_needed=drives,
         actuated=anames, actuation_determined=determined, actuation_note=anote, excess_drives=excess,
         singular=lm.configuration == "singular", shaky=lm.configuration == "shaky", configuration=lm.configuration,
         mobility_reading=mobility_reading(lm.configuration, mobility, lm.finite), finite_mobility=lm.finite, tolerance=float(tol), length_scale=float(sysm.scale), pair_freedoms=F,
@@ -648,13 +653,21 @@ def _actuation(sysm: _System, N: np.ndarray, Z0: np.ndarray, acols: list[int], a
         return None, "", []
     mobility = N.shape[1]
     uncontrolled = Z0.shape[1] - idle
+    locked = [j.id for k, j in enumerate(sysm.joints) if j.actuated and mobility
+              and np.max(np.abs(N[sysm.col_joint == k]), initial=0.0) <= tol]
     if uncontrolled:
+        if locked:  # a drive at a dead centre: the geometry holds it, the rest moves
+            return False, (f"the drive(s) at {', '.join(locked)} are locked at this pose (a dead centre: they cannot "
+                           f"move the mechanism here); {uncontrolled} useful motion(s) undetermined"), []
         return False, (f"the drives at {', '.join(anames)} leave {uncontrolled} useful motion(s) undetermined: "
                        f"{mobility - idle} drive(s) needed"), []
     rows = {name: [c for c in acols if sysm.joints[int(sysm.col_joint[c])].id == name] for name in anames}
     excess = excess_drives(N, rows, anames, tol) if mobility else list(anames)
     if excess:
-        locked = [d for d in excess if np.max(np.abs(N[rows[d]]), initial=0.0) <= tol] if mobility else []
+        if mobility and all(d in locked for d in excess):  # the geometry holds them, not the other drives
+            return True, (f"the drive(s) at {', '.join(locked)} are locked: the mechanism cannot move them at "
+                          "this pose" + (f"; the drives at {', '.join(a for a in anames if a not in locked)} "
+                                         "determine the motion" if len(locked) < len(anames) else "")), []
         return True, (f"the drives at {', '.join(anames)} determine the motion but {len(excess)} of them "
                       f"({', '.join(excess)}) {'is' if len(excess) == 1 else 'are'} not independent (redundant actuation: the drives fight each other)"
                       + (f"; the mechanism locks the drive(s) at {', '.join(locked)}: they cannot move"
@@ -668,6 +681,11 @@ def _local(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, conto
     the notes and the contours' reasons amended."""
     F, equations = sysm.twists.shape[0], sysm.lam * len(sysm.contours)
     if not sysm.contours:  # an open chain: every pair freedom is a finite motion
+        return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
+    if rank == equations:  # provably regular: no need to follow the motion
+        # the loop-closure map has a surjective derivative here, so by the implicit function
+        # theorem its zero set is a manifold of dimension F - rank near the pose: every
+        # instantaneous motion extends to a finite one and the rank is the same nearby
         return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
 
     def null(theta: np.ndarray) -> tuple[int, np.ndarray]:
@@ -719,9 +737,40 @@ def mobility_reading(configuration: str, instantaneous: int, finite: int | None)
 
 
 # --------------------------------------------------------------------------- report
+def _n(k: int, word: str) -> str:
+    return f"{k} {word}" + ("" if k == 1 else "s")
+
+
+def motion_headline(ra: RankAnalysis) -> str:
+    """What the mechanism does, first: rigid or moving with how many finite degrees of
+    freedom, then the instantaneous count where it differs (shaky or singular), idle motions
+    apart.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> motion_headline(ms.analyze_rank(ms.examples.load("fourbar_taut")))
+    'rigid (finite mobility 0), shaky: 2 instantaneous motions'
+    >>> motion_headline(ms.analyze_rank(ms.examples.load("rssr")))
+    'moves with 1 degree of freedom (finite; besides 1 idle motion)'
+    """
+    idle = len(ra.idle_mobilities)
+    spins = f"; besides {_n(idle, 'idle motion')}" if idle else ""
+    if ra.finite_mobility is None:
+        return (f"instantaneous mobility {ra.useful_mobility}{spins.replace(';', ',')} (the finite mobility "
+                f"{'was not checked' if ra.configuration == 'not checked' else 'is unknown'})")
+    finite = max(ra.finite_mobility - idle, 0)
+    if finite == 0:
+        head = f"rigid (finite mobility 0{spins})"
+        return head + (f", shaky: {_n(ra.useful_mobility, 'instantaneous motion')}" if ra.useful_mobility else "")
+    head = f"moves with {_n(finite, 'degree')} of freedom (finite{spins})".replace("degrees of", "degrees of")
+    return head + (f", instantaneously {ra.useful_mobility}" if ra.useful_mobility > finite else "")
+
+
 def rank_summary_lines(ra: RankAnalysis) -> list[str]:
     """The rank answer in a few plain lines (terminal and Markdown reports)."""
     lines = [
+        motion_headline(ra)[0].upper() + motion_headline(ra)[1:],
         f"{ra.motion} motion: F = {ra.pair_freedoms} pair freedoms, {ra.equations} loop-closure equations, "
         f"rank {ra.rank} (tolerance {ra.tolerance:.2g}, length scale {ra.length_scale:.4g})",
         f"instantaneous mobility m = {ra.pair_freedoms} - {ra.rank} = {ra.mobility} = {ra.useful_mobility} useful"

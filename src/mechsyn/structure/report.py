@@ -262,7 +262,11 @@ def verdict(a: StructuralAnalysis, rank: Any = None) -> dict[str, Any]:
         idle = len(rank.idle_mobilities)
         split = (f" (instantaneous {rank.mobility} = {rank.useful_mobility} useful + {idle} idle)" if idle
                  else " (no idle mobility)")
-        out["text"] = (f"mobility {rank.useful_mobility}{split}, {rank.redundant_constraints} redundant "
+        from mechsyn.structure.rank import motion_headline
+
+        out["drives_needed"] = rank.drives_needed
+        out["text"] = (f"{motion_headline(rank)}; drives needed: {rank.drives_needed}; instantaneous mobility "
+                       f"{rank.useful_mobility}{split}, {rank.redundant_constraints} redundant "
                        f"constraints, {pose}; from the {out['source']}")
         return _with_drives(out, drive_check(a, rank))
     planar = a.kind == "planar"

@@ -44,8 +44,9 @@ MAX_STEPS = _service.MAX_STEPS
 
 
 def _sweep_of(mech, steps: int) -> tuple[str, np.ndarray, int]:
-    """The first drive, its inputs from the drawn assembly and the row of the drawn pose: a
-    full turn for an R or H drive (row 0), ± half the length scale for a P drive (the middle
+    """The first drive, its inputs and the row of the drawn pose: a full turn from the drawn
+    pose's input for an R, H or U drive (row 0; the input is measured from the joint's
+    ``zero`` when the file gives one), ± half the length scale for a P or C drive (the middle
     row of an odd number of rows: ``steps`` or one more)."""
     drives = [j for j in mech.joints if j.actuated]
     if not drives:
@@ -54,12 +55,15 @@ def _sweep_of(mech, steps: int) -> tuple[str, np.ndarray, int]:
     if not 2 <= int(steps) <= MAX_STEPS:
         raise MechsynInputError(f"steps must be within 2..{MAX_STEPS}", field="steps")
     n, drive = int(steps), drives[0]
-    if drive.type == "P":
+    if drive.type in ("P", "C"):  # a C pair's input is its slide
         pts = np.array([j.point for j in mech.joints if j.point is not None], float)
         span = float(np.ptp(pts, axis=0).max()) if len(pts) > 1 else 1.0
         n |= 1
         return drive.id, span * (np.arange(n) - n // 2) / (n - 1), n // 2  # the middle one exactly 0
-    return drive.id, np.linspace(0.0, 360.0, n + 1)[:n], 0
+    from mechsyn.kinematics.spatial_model import input_zero
+
+    drawn = float(np.degrees(input_zero(mech, drive)))  # the drawn pose's input (its zero: the file format)
+    return drive.id, drawn + np.linspace(0.0, 360.0, n + 1)[:n], 0
 
 
 def engine_problem(data: Any) -> str | None:

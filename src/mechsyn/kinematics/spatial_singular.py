@@ -1,0 +1,189 @@
+"""Singular configurations of a spatial sweep (used by :mod:`mechsyn.kinematics.spatial`):
+where the Jacobian of the constraints and drives loses rank along the path, and how the walk
+leaves a singular pose (a file drawn at a dead point or a change point).
+
+**Crossings by the sign of a determinant.** Between two rows ``k`` and ``k + 1`` of one motion
+the Jacobian ``J`` (constraints and drives, in twists at the links' centres) keeps its regular
+rank ``r`` unless the path crosses a singular configuration. With ``U_k``, ``V_k`` the first
+``r`` left and right singular vectors of ``J_k``, ``d(t) = det(U_kᵀ J(t) V_k)`` equals
+``σ_1 ... σ_r > 0`` at ``t = 0`` and is zero where ``J(t)`` has rank below ``r``; a simple crossing
+(a change or bifurcation point, where two branches meet) makes it change sign (Allgower and
+Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobian's
+determinant). The pairs where it can change at all are few: by Weyl's inequality
+``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
+the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
+of the two rows; only those pairs get an SVD. A sign change is bracketed and refined (below) and
+reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
+makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
+row's neighbours) are candidates too. Each candidate is refined by a golden-section search of
+``σ_r/σ_1`` over its bracket to ``REFINE`` of the step (a V about the crossing on either branch
+that meets there, so it does not matter which one Newton lands on that close to it; the sign of
+the determinant does, which is why it only brackets) and is a crossing where the least ratio is
+under the singular tolerance.
+
+**Leaving a singular pose** (:func:`~mechsyn.kinematics.spatial_track.leave`). At a dead point of the input the mechanism moves like the square
+root of the input step, at a change point along either of two branches: the linear predictor
+of the continuation cannot leave such a pose. ``leave`` tries Newton from the pose moved by
+the minimum-norm tangent plus ``±σ`` along each null direction of ``J`` that moves a joint
+point (``σ`` a few multiples of ``√|Δu|`` and ``|Δu|``), and keeps the converged true assembly
+nearest the pose (ties: the positive direction first, each null vector signed so that its
+largest entry is positive) — or, leaving the same pose the other way, the one nearest the
+branch it left by first (the same branch through a change point).
+
+References
+----------
+.. [1] E. L. Allgower and K. Georg, *Introduction to Numerical Continuation Methods*, SIAM,
+   2003, ch. 8 (detecting bifurcation points along a path).
+.. [2] C. M. Gosselin and J. Angeles, "Singularity analysis of closed-loop kinematic chains",
+   *IEEE Trans. Robotics and Automation* 6(3), 281-290, 1990.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, singular_tol, svd_ratio
+
+__all__ = ["crossings", "REFINE"]
+
+#: Newton steps past the tolerance on each pose of the search: next to a singular point
+#: Newton reaches a residual ε only within √ε of the pose (it converges linearly there), which
+#: blurs the ratio's V by that much; each further step halves the distance.
+POLISH = 8
+#: Points a zoom step of the search evaluates at once (the bracket shrinks by ``(ZOOM - 1) / 2``).
+ZOOM = 17
+
+
+
+# --------------------------------------------------------------------------- crossings
+def _svd_bases(Jc: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
+    U, _, Vt = np.linalg.svd(Jc, full_matrices=False)
+    return U[..., :r], Vt[..., :r, :]
+
+
+def _sign(Ub: np.ndarray, Vb: np.ndarray, Jc: np.ndarray) -> np.ndarray:
+    return np.sign(np.linalg.det(np.swapaxes(Ub, -1, -2) @ Jc @ np.swapaxes(Vb, -1, -2)))
+
+
+def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
+              Jc: np.ndarray, idx: np.ndarray) -> list[tuple[int, np.ndarray, float, int | None]]:
+    """Singular configurations the sweep passes: ``(row, inputs, ratio, on_row)`` with
+    ``on_row`` the row it falls on (within ``REFINE`` of the step) or None (see the module
+    doc). ``Jc`` (B, m, k): the Jacobians of the assembled rows ``idx``; ``ratio``: every
+    row's ``σ_r / σ_1`` (NaN where not assembled)."""
+    r = tr.rank
+    if not r or len(idx) < 2:
+        return []
+    pos = {int(k): i for i, k in enumerate(idx)}
+    same = (w.ok[:-1] & w.ok[1:]) & (w.how[:-1] == w.how[1:])
+    ks = np.flatnonzero(same)
+    if not len(ks):
+        return []
+    a, b = np.array([pos[k] for k in ks]), np.array([pos[k + 1] for k in ks])
+    flat = Jc.reshape(len(Jc), -1)
+    norm = np.sqrt(np.einsum("bi,bi->b", flat, flat))
+    low = np.nan_to_num(ratio[idx]) * norm / np.sqrt(max(r, 1))  # lower bounds of σ_r
+    d = flat[b] - flat[a]
+    jump = np.sqrt(np.einsum("bi,bi->b", d, d))
+    near = (low[a] <= 2 * jump) | (low[b] <= 2 * jump)
+    tol = singular_tol(tr.M)
+    near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
+    out = []
+    if near.any():
+        Ub, Vb = _svd_bases(Jc[a[near]], r)
+        flips = _sign(Ub, Vb, Jc[b[near]]) <= 0
+        for k, ub, vb in zip(ks[near][flips], Ub[flips], Vb[flips]):
+            found = _bisect(tr, w, U, int(k), ub, vb)
+            if found is not None:
+                out.append(found)
+    seen = {c[0] for c in out} | {c[0] + 1 for c in out}
+    return out + _v_minima(tr, w, U, ratio, seen)
+
+
+def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
+            vb: np.ndarray) -> tuple[int, np.ndarray, float, int | None] | None:
+    """The crossing between rows ``k`` and ``k + 1`` (where ``det(U_kᵀ J V_k)`` changed
+    sign): the least ``σ_r / σ_1`` between them (:func:`_golden`); None when it is not a
+    rank drop (the sign changed by a frame effect)."""
+    found = _golden(tr, w, U, [k, k + 1])
+    if found is None or found[1] >= singular_tol(tr.M):
+        return None
+    t = float((found[0] - U[k]) @ (U[k + 1] - U[k]) / ((U[k + 1] - U[k]) @ (U[k + 1] - U[k])))
+    on = k if t < REFINE else (k + 1 if t > 1 - REFINE else None)
+    return k, found[0], found[1], on
+
+
+def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set) -> list:
+    """Rows whose ratio is a sharp local minimum (``r0 + r2 >= 4 r1``: every V passes)
+    refined by a golden-section search; a crossing where it falls under the singular
+    tolerance. Rows in ``seen`` (next to a crossing found by the determinant) are skipped."""
+    out = []
+    tol = singular_tol(tr.M)
+    for k in range(1, len(U) - 1):
+        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]) or len({w.how[k - 1], w.how[k], w.how[k + 1]}) > 1:
+            continue
+        if seen & {k - 1, k, k + 1}:
+            continue
+        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
+        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= tol):
+            continue
+        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
+        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
+            continue  # not on one straight stretch of the sweep
+        found = _golden(tr, w, U, [k - 1, k, k + 1])
+        if found is not None and found[1] < tol:
+            out.append((k, found[0], found[1], None))
+    return out
+
+
+def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.ndarray, float] | None:
+    """The least ``σ_r / σ_1`` over the inputs from row ``rows[0]`` to row ``rows[-1]``, to
+    ``REFINE`` of a row step: a zoom of ``ZOOM`` points at a time, each batch predicted from
+    the nearest of ``rows`` (the Taylor predictor), corrected by Newton together and polished
+    ``POLISH`` steps past the tolerance (next to a singular point Newton converges only
+    linearly, and reaches a residual ε only within √ε of the pose, which blurs the V by that
+    much); the bracket then shrinks to the two cells about the least. The ratio is a V about
+    a crossing on either branch that meets there, so it does not matter which one Newton
+    lands on that close to it."""
+    from mechsyn.kinematics.spatial_model import move
+    from mechsyn.kinematics.spatial_track import _taylor
+
+    states = {k: tr.state(*w.at(k), U[k][None]) for k in rows}
+    lo, hi = U[rows[0]], U[rows[-1]]
+    span = len(rows) - 1
+    tol, halvings = tr.tol, tr.halvings
+
+    def f(ts: np.ndarray) -> np.ndarray:
+        out = np.full(len(ts), np.inf)
+        near = np.clip(np.rint(ts * span), 0, span).astype(int)
+        for j in np.unique(near):
+            k, sel = rows[j], np.flatnonzero(near == j)
+            st = states[k]
+            u = lo + ts[sel, None] * (hi - lo)
+            x1, x2 = _taylor(tr, st, u - U[k])
+            z = np.zeros(len(sel), int)
+            R, p = move(st.R[z], st.p[z], x1 + 0.5 * x2)
+            R, p, ok, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=40)
+            tr.tol = 0.0
+            R, p, _, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=POLISH)
+            tr.tol = tol
+            if ok.any():
+                good = np.flatnonzero(ok)
+                out[sel[good]] = svd_ratio(tr.state(R[good], p[good], st.href[z[good]], u[good]).lin.Jc, tr.rank)
+        return out
+
+    a, b = 0.0, 1.0
+    best_t, best = 0.5, np.inf
+    while b - a > REFINE / span:
+        ts = np.linspace(a, b, ZOOM)
+        fs = f(ts)
+        i = int(np.argmin(fs))
+        if not np.isfinite(fs[i]):
+            break
+        best_t, best = ts[i], fs[i]
+        h = (b - a) / (ZOOM - 1)
+        a, b = max(0.0, ts[i] - h), min(1.0, ts[i] + h)
+    tr.halvings = halvings
+    return (lo + best_t * (hi - lo), float(best)) if np.isfinite(best) else None
