@@ -391,3 +391,17 @@ def test_a_job_outlives_the_event_loop_of_its_request(tmp_path):
     assert snap["state"] == "done" and snap["result"]["results"], snap
     assert app.state.heavy.started == 1
     app.state.heavy.stop()
+
+
+def test_a_stopped_fork_server_is_started_again():
+    """``stop()`` killed the fork server but left it remembered as alive: the next worker of
+    the process (another app, a notebook's next widget) failed with "unexpected EOF"."""
+    from mechsyn.web._jobs import HeavyRunner
+
+    for _ in range(2):
+        runner = HeavyRunner(total=1)
+        runner.warm()
+        try:
+            assert _run_coroutine(runner.call("a", _never_gone, len, [1, 2, 3])) == 3
+        finally:
+            runner.stop()

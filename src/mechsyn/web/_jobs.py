@@ -373,12 +373,17 @@ class HeavyRunner:
             return
         from multiprocessing import forkserver
 
-        pid = getattr(forkserver._forkserver, "_forkserver_pid", None)  # CPython's private state
-        if pid:
+        server = forkserver._forkserver  # CPython's private state
+        with server._lock:
+            pid = getattr(server, "_forkserver_pid", None)
+            if not pid:
+                return
             try:
                 os.kill(pid, signal.SIGKILL)
             except ProcessLookupError:
                 pass
+            if hasattr(server, "_stop_unlocked"):  # reaped and forgotten: the next call starts a new one
+                server._stop_unlocked()  # (killed but remembered, it was believed alive: "unexpected EOF")
 
     def stop_all(self) -> None:
         """The server stops: every worker killed now, waiting calls end (:class:`ServerStopping`),
