@@ -122,6 +122,7 @@ const simulateSoon = coalescing(
   ({ r, ms }, { mech, t0, edited }) => {
     state.simulations += 1;
     state.lastSimMs = ms;
+    checkAfterSim(mech);
     if (mech !== state.mech && !state.dragging) return; // a newer mechanism is on its way
     state.sim = r; state.simFor = mech; state.errors = []; state.notes = r.notes || [];
     const home = homeOf(r);
@@ -135,11 +136,18 @@ const simulateSoon = coalescing(
   },
   (e, { mech }) => {
     state.simulations += 1;
+    checkAfterSim(mech);
     if (mech !== state.mech && !state.dragging) return;
     state.sim = null; state.simFor = mech; state.notes = [];
     state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
     render(); renderAnalysis();
   });
+
+// The check deferred by setMech until the edited mechanism's first simulation answer.
+function checkAfterSim(mech) {
+  if (!state.afterSim || mech !== state.mech) return;
+  const run = state.afterSim; state.afterSim = null; run();
+}
 
 let analyseTimer = null;
 function analyseSoon() {
@@ -171,7 +179,7 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
   if (fit) fitView();
   state.errors = [];
   const key = checkKey(mech), topo = topologyKey(mech);
-  if (state.check && state.check.key === key) afterCheck(mech, state.check.result, edited);
+  if (state.check && state.check.key === key) { state.afterSim = null; afterCheck(mech, state.check.result, edited); }
   else {
     // the server's check (mobility, drives, connections) runs again on every change it reads.
     // Only the places changed and the last check let it move: simulated at once meanwhile,
@@ -179,22 +187,30 @@ function setMech(mech, { record = true, fit = false, keepFrame = false, opened =
     const prev = state.check && state.check.topo === topo && !state.check.result.diagnostics.some((d) => d.blocks) ? state.check.result : null;
     if (prev) afterCheck(mech, prev, edited); else state.diagnostics = geometryChecks(mech);
     state.check = null;
-    call("/api/studio/check", { mechanism: mech }).then((result) => {
-      if (mech !== state.mech) return;
-      state.check = { key, topo, result };
-      if (!prev || JSON.stringify(result) !== JSON.stringify(prev)) { afterCheck(mech, result, edited); render(); }
-    }, (e) => {
-      if (mech !== state.mech) return;
-      state.sim = null; state.simFor = mech; state.notes = [];
-      state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
-      render(); renderAnalysis();
-    });
+    // (asked once the repaint's simulation is back: the two would share the server's cores)
+    const later = prev && mech.joints.some((j) => j.actuated);
+    state.afterSim = later ? () => runCheck(mech, key, topo, prev, edited) : null;
+    if (!later) runCheck(mech, key, topo, prev, edited);
   }
   analyseSoon();
   render();
   renderElement();
   if ($("tab-forces").classList.contains("on")) { forcesUi.renderForces(); forcesUi.forcesSoon(); }
   if (spatial()) renderPlots(); // the spatial plots' sweep (asked for while the Plots tab is shown)
+}
+
+// The server's check of `mech`; its answer replaces `prev` (the answer simulated meanwhile) when they differ.
+function runCheck(mech, key, topo, prev, edited) {
+  call("/api/studio/check", { mechanism: mech }).then((result) => {
+    if (mech !== state.mech) return;
+    state.check = { key, topo, result };
+    if (!prev || JSON.stringify(result) !== JSON.stringify(prev)) { afterCheck(mech, result, prev ? undefined : edited); render(); }
+  }, (e) => {
+    if (mech !== state.mech) return;
+    state.sim = null; state.simFor = mech; state.notes = [];
+    state.errors = [{ message: e.error || String(e), hint: e.hint, field: e.field, element: e.element }];
+    render(); renderAnalysis();
+  });
 }
 
 // Simulate unless the checks say it is pointless (a structure, drives that fight, loose parts).
