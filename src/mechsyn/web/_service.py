@@ -497,7 +497,9 @@ def fourbar_path_case(targets: list, time_limit: float) -> Any:
     var += [{"name": r, "lower": -L, "upper": L} for r in ("rcx", "rcy")]
     var += [{"name": f"theta2_{i + 1}", "lower": 0.0, "upper": 2 * math.pi} for i in range(len(T))]
     return PathCase.from_dict({"id": "studio", "targets": T.tolist(), "timing": {"type": "free"},
-                               "variables": var, "options": {"grashof": "crank-rocker"}}, source="targets")
+                               # the bounds above are the studio's, not the user's: the default size bound applies
+                               "variables": var, "options": {"grashof": "crank-rocker", "max_size": 1.5}},
+                              source="targets")
 
 
 def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
