@@ -45,43 +45,82 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import operator
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
 from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, crossings, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
+from mechsyn.kinematics.sweep import Event
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.structure.screws import as_spatial
 
-__all__ = ["SpatialEngine", "simulate_spatial", "RANK_TOL", "CLOSURE_TOL"]
+__all__ = ["SpatialEngine", "simulate_spatial", "planar_as_spatial", "RANK_TOL", "CLOSURE_TOL"]
+
+_INDEX = operator.attrgetter("index")
 
 #: Largest residual of an accepted row that the result may carry (the issue's bound).
 CLOSURE_TOL = 1e-9
 
 
 class SpatialEngine:
-    """The spatial engine behind :func:`mechsyn.simulate`: answers for ``kind: spatial``
-    mechanisms (None for planar ones, which other engines answer).
+    """The spatial engine behind :func:`mechsyn.simulate`: every ``kind: spatial``
+    mechanism, and a planar mechanism of R and P pairs as its 3-D equivalent
+    (:func:`planar_as_spatial`), so that it can check the planar engines.
 
     Examples
     --------
     >>> import mechsyn as ms
-    >>> s = SpatialEngine().sweep(ms.examples.load("bennett"), {"R1": ms.input_grid(0, 90, 45)})
+    >>> s = SpatialEngine().simulate(ms.examples.load("bennett"), {"R1": ms.input_grid(0, 90, 45)})
     >>> s.engine, s.point("R3").shape, bool(s.residual.max() < 1e-9)
     ('spatial', (3, 3), True)
+    >>> p = SpatialEngine().simulate(ms.examples.load("crank_rocker"), {"A": [60.0, 90.0]})
+    >>> p.point("M").shape, bool(abs(p.point("M")[:, 2]).max() == 0.0)
+    ((2, 3), True)
     """
 
     name = "spatial"
 
-    def sweep(self, mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
-              points: list[str] | None = None, progress: Any = None, **_: Any) -> SpatialSimulation | None:
-        if mech.kind != "spatial":
-            return None
-        return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
+    def simulate(self, mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
+                 points: list[str] | None = None, progress: Any = None, **_: Any) -> SpatialSimulation:
+        if mech.kind == "spatial":
+            return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
+        spatial, zero = planar_as_spatial(mech, tuple(inputs))
+        values = {jid: np.asarray(v, float) for jid, v in inputs.items()}
+        res = simulate_spatial(spatial, {jid: v - zero[jid] for jid, v in values.items()}, speeds=speeds,
+                               points=points, progress=progress)
+        events = [e.with_(input={j: v + zero[j] for j, v in e.input.items()}) for e in res.events]
+        return replace(res, inputs={jid: np.atleast_1d(v) for jid, v in values.items()}, events=events)
+
+
+def planar_as_spatial(mech: Mechanism, inputs: tuple[str, ...]) -> tuple[Mechanism, dict[str, float]]:
+    """A planar mechanism of R and P pairs as a spatial one
+    (:func:`mechsyn.structure.screws.as_spatial`: points at ``z = 0``, R axes along ``z``)
+    and the planar value of each driven joint in the drawn configuration (degrees for R,
+    lengths for P): a planar input ``u`` is the spatial engine's ``u - zero`` (its inputs
+    are measured from the drawn assembly), so an input value is the same pose in both.
+    Anything else is an :class:`~mechsyn.errors.EngineDeclined`."""
+    other = next((j for j in mech.joints if j.type not in ("R", "P")), None)
+    if other is not None:
+        raise EngineDeclined("spatial", mech.name, f"joint {other.id} is a {other.type} pair; it takes planar "
+                                                   "mechanisms of R and P pairs only")
+    vll = next((j for j in mech.joints if j.vll), None)
+    if vll is not None:
+        raise EngineDeclined("spatial", mech.name, f"joint {vll.id} is a VLL ({vll.vll}); it takes plain R and "
+                                                   "P pairs only")
+    drivers = build_system(mech).drivers
+    zero = {d.joint: float(np.degrees(d.assembled)) if d.type == "R" else float(d.assembled) for d in drivers}
+    for jid in inputs:
+        if jid not in zero:
+            raise MechsynInputError(f"joint {jid!r} is not driven", source=mech.source, field="inputs",
+                                    hint="driven joints: " + (", ".join(zero) or "(none)"))
+    return as_spatial(mech), zero
 
 
 def _check_inputs(mech: Mechanism, inputs: dict[str, Any]) -> dict[str, np.ndarray]:
@@ -263,8 +302,8 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
     the rank test and the rates of all assembled rows at once."""
     M = tr.M
 
-    def event(k: int, kind: str, detail: Any) -> dict:
-        return {"index": k, "kind": kind, "input": _input_dict(M, U[k]), "message": _MESSAGES[kind].format(detail)}
+    def event(k: int, kind: str, detail: Any) -> Event:
+        return Event(k, kind, _MESSAGES[kind].format(detail), input=_input_dict(M, U[k]))  # type: ignore[arg-type]
 
     w = walk(tr, start, U, event)
     N, n = len(U), M.n
@@ -282,15 +321,14 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
         regular = st.lin.ratio >= RANK_TOL
         out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
         for k, r in zip(idx[~regular], st.lin.ratio[~regular]):
-            out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, U[k]),
-                               "message": f"singular configuration: the Jacobian's rank drops below {st.lin.r} "
-                                          f"(singular value ratio {r:.2g}); rates not defined here (null)"})
+            out.events.append(Event(int(k), "singular", "singular configuration: the Jacobian's rank drops below "
+                                    f"{st.lin.r} (singular value ratio {r:.2g}); rates not defined here (null)",
+                                    input=_input_dict(M, U[k])))
         for k, u, r in crossings(tr, w, U, out.ratio):
-            out.events.append({"index": k, "kind": "singular", "crossed": True, "input": _input_dict(M, u),
-                               "message": f"a singular configuration lies between rows {k - 1} and {k + 1} "
-                                          f"(singular value ratio {r:.2g} there): the sweep passes it on the "
-                                          "branch it was on (the predictor's tangent)"})
-        out.events.sort(key=lambda e: e["index"])
+            out.events.append(Event(k, "singular", f"a singular configuration lies between rows {k - 1} and {k + 1} "
+                                    f"(singular value ratio {r:.2g} there): the sweep passes it on the branch it "
+                                    "was on (the predictor's tangent)", input=_input_dict(M, u), crossed=True))
+        out.events.sort(key=_INDEX)
     if progress is not None:
         progress(N)
     return out

@@ -16,8 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn._result import Result
-from mechsyn.kinematics.simulation import PointMotion, Simulation
+from mechsyn.kinematics.simulation import Motion, PointMotion
 
 __all__ = ["SpatialSimulation", "LinkPose"]
 
@@ -41,8 +40,8 @@ def _unit(t: str) -> str:
     return "length" if t == "P" else "deg"
 
 
-@dataclass(repr=False)
-class SpatialSimulation(Result):
+@dataclass(repr=False, kw_only=True)
+class SpatialSimulation(Motion):
     """Motion of a spatial mechanism over a sweep of its drives.
 
     ``s.point("P")`` gives (N, 3) positions, ``s.link("platform").rotation`` (N, 3, 3)
@@ -61,12 +60,6 @@ class SpatialSimulation(Result):
 
     _plot = "spatial:plot_spatial"
 
-    mechanism: str
-    inputs: dict[str, np.ndarray]
-    input_types: dict[str, str]
-    speeds: dict[str, float]
-    assembled: np.ndarray
-    points: dict[str, PointMotion]
     links: dict[str, LinkPose]
     joints: dict[str, np.ndarray]
     residual: np.ndarray
@@ -74,22 +67,9 @@ class SpatialSimulation(Result):
     length_scale: float
     rank: int
     idle: int
-    events: list[dict] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
     engine: str = "spatial"
     method: str = "spatial continuation"
     model: Any = field(default=None, repr=False, metadata={"json": False})
-
-    main_input = Simulation.main_input
-    working_ranges = Simulation.working_ranges
-
-    def point(self, name: str) -> np.ndarray:
-        """Positions (N, 3) of the named point ``name`` (NaN where not assembled)."""
-        return Simulation.point(self, name)  # type: ignore[arg-type]
-
-    def link(self, name: str) -> LinkPose:
-        """Rotation, translation, angular velocity and acceleration of link ``name``."""
-        return Simulation.link(self, name)  # type: ignore[arg-type,return-value]
 
     def _summary(self) -> list[tuple[str, str]]:
         x = self.inputs[self.main_input]
