@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.system import Con, PlanarSystem, _axis, _to_frame, frame_points
+from mechsyn.kinematics.plane import to_frame
+from mechsyn.kinematics.system import Con, PlanarSystem, _axis, frame_points
 from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
 
 __all__ = ["joint_points", "topology_key", "with_geometry"]
@@ -243,8 +244,8 @@ def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
     def loc(i: int, p: Any, direction: bool = False) -> np.ndarray:  # S.to_local / to_local_dir
         if i < 0:
             return np.asarray(p, float)
-        return _to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
-            _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
+        return to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
+            to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
 
     u = _axis(j)
     u_loc = loc(a, u, direction=True)
