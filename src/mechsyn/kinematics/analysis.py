@@ -24,14 +24,14 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import EngineDeclined, MechsynInputError
-from mechsyn.kinematics.engines import (_INDEX, ENGINES, PLANAR_ENGINES, SPATIAL_ENGINE, engine_named,  # noqa: F401
+from mechsyn.kinematics.engines import (ENGINES, PLANAR_ENGINES, SPATIAL_ENGINE, engine_named,  # noqa: F401
                                         first_sweep)
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, _topology, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
-from mechsyn.kinematics.simulation import (LinkMotion, Motion, PointMotion, Simulation, _unit,  # noqa: F401
+from mechsyn.kinematics.simulation import (LinkMotion, Motion, PointMotion, Simulation,  # noqa: F401
                                           input_grid, resolve_points)
-from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.sweep import Event, Sweep, by_row
 from mechsyn.kinematics.refill import _xy, topology_key, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system, frame_points
 from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
@@ -336,7 +336,7 @@ def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) ->
         if k not in flagged:  # made in input units (one object, not one and a copy)
             events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                                 "accelerations are not defined here (null)", units(sw.inputs[k].tolist())))
-    events.sort(key=_INDEX)
+    events.sort(key=by_row)
     return events
 
 
@@ -681,7 +681,7 @@ class ForceAnalysis(Result):
         r = self.reactions
         return {
             "mechanism": sim.mechanism,
-            "input": {"joint": main, "values": sim.inputs[main], "unit": _unit(sim.input_types[main]),
+            "input": {"joint": main, "values": sim.inputs[main], "unit": sim.input_unit(main),
                       "speed": sim.speeds[main]},
             "assembled": ok,
             "static": self.static,

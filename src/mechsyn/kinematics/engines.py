@@ -42,7 +42,6 @@ Examples
 
 from __future__ import annotations
 
-import operator
 from collections.abc import Callable
 from typing import Any, Protocol
 
@@ -54,7 +53,7 @@ from mechsyn.kinematics.groups import Plan
 from mechsyn.kinematics.regular import Folded, sweep_through_folds
 from mechsyn.kinematics.solve import sweep as newton_sweep
 from mechsyn.kinematics.spatial import SpatialEngine
-from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.sweep import Event, Sweep, by_row
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
 
@@ -462,8 +461,5 @@ def merged_events(k: int, bwd: list[Event], fwd: list[Event]) -> list[Event]:
                               message=_BACK_MESSAGES.get(e.kind, e.message)))
     for e in fwd:
         events.append(e.with_(index=e.index + k, before_sweep=None))
-    events.sort(key=_INDEX)
+    events.sort(key=by_row)
     return events
-
-
-_INDEX = operator.attrgetter("index")

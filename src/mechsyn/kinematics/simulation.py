@@ -92,6 +92,10 @@ class Motion(Result):
     def main_input(self) -> str:
         return next(iter(self.inputs))
 
+    def input_unit(self, joint: str) -> str:
+        """The unit of input ``joint``'s values: ``"deg"`` (R, H) or ``"length"`` (P)."""
+        return _unit(self.input_types[joint])
+
     def point(self, name: str) -> np.ndarray:
         """Positions (N, 2 or 3) of named point ``name`` over the sweep (NaN where not assembled)."""
         if name not in self.points:

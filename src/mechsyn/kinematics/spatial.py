@@ -45,7 +45,6 @@ References
 
 from __future__ import annotations
 
-import operator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -56,14 +55,12 @@ from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial
 from mechsyn.kinematics.spatial_track import RANK_TOL, State, Tracker, crossings, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
-from mechsyn.kinematics.sweep import Event
+from mechsyn.kinematics.sweep import Event, by_row
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 from mechsyn.structure.screws import as_spatial
 
 __all__ = ["SpatialEngine", "simulate_spatial", "planar_as_spatial", "RANK_TOL", "CLOSURE_TOL"]
-
-_INDEX = operator.attrgetter("index")
 
 #: Largest residual of an accepted row that the result may carry (the issue's bound).
 CLOSURE_TOL = 1e-9
@@ -328,7 +325,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, sp: np.ndarray, progre
             out.events.append(Event(k, "singular", f"a singular configuration lies between rows {k - 1} and {k + 1} "
                                     f"(singular value ratio {r:.2g} there): the sweep passes it on the branch it "
                                     "was on (the predictor's tangent)", input=_input_dict(M, u), crossed=True))
-        out.events.sort(key=_INDEX)
+        out.events.sort(key=by_row)
     if progress is not None:
         progress(N)
     return out

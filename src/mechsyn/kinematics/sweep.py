@@ -12,13 +12,14 @@ reads like that dictionary (``e["kind"]``, ``e.get("input")``).
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 import numpy as np
 
-__all__ = ["Sweep", "Event", "EventKind"]
+__all__ = ["Sweep", "Event", "EventKind", "by_row"]
 
 #: What an event reports.
 EventKind = Literal["dead point", "reassembled", "singular", "not assembled", "branch point", "limit"]
@@ -100,6 +101,9 @@ class Event(Mapping):
 
 
 _FIELDS = frozenset(f.name for f in fields(Event))
+
+#: The sort key of events: their row (``events.sort(key=by_row)``).
+by_row = operator.attrgetter("index")
 
 
 @dataclass

@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.cams import CamCurve, _cam_curve
+from mechsyn.kinematics.cams import CamCurve, cam_curve
 from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate, to_frame
 from mechsyn.model.mechanism import Joint, Mechanism
@@ -724,7 +724,7 @@ class _Builder:
         else:
             centre, rho = j.point, 0.0
         tvar = len(self.q0) + len(self.extra_q)
-        curve = _cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
+        curve = cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
                            lambda p, _a=a_name: loc(_a, p), self.src, j.id)
         self.extra_q.append(curve.closest(loc(a_name, centre)))
         self.cons.append(Con("curve", j.id, 2, a, b, sb=loc(b_name, centre), tvar=tvar, curve=curve, role="pair"))
