@@ -236,7 +236,9 @@ class Simulation(Motion):
         return super().animate(fig, bare=True, **kwargs)
 
     def to_dict(self) -> dict[str, Any]:
-        return {**super().to_dict(), "vll": self.vll,
+        d = super().to_dict()
+        notes = d.pop("notes")  # (the keys in the order the JSON has always had)
+        return {**d, "vll": self.vll, "notes": notes,
                 "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"}}
 
 
