@@ -98,6 +98,30 @@ class OverActuatedError(MechsynInputError):
                                  line=self.line, hint=self.hint)
 
 
+class EngineDeclined(MechsynInputError):
+    """A kinematics engine asked for by name (``simulate(..., method=NAME)``) cannot treat
+    this mechanism or these options; the message says why in one line and the hint names
+    the way out (``method="auto"`` takes the first engine that can).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.errors import EngineDeclined
+    >>> try:
+    ...     ms.examples.load("slider_crank").simulate(A=(0, 90, 45), method="regular pass")
+    ... except EngineDeclined as e:
+    ...     print(e.message)
+    the regular pass engine cannot simulate Slider-crank mechanism: it takes chains of R drivers and RRR dyads only
+    >>> issubclass(EngineDeclined, ms.MechsynError)
+    True
+    """
+
+    def __init__(self, engine: str, mechanism: str, why: str) -> None:
+        super().__init__(f"the {engine} engine cannot simulate {mechanism}: {why}", field="method",
+                         hint='method="auto" takes the first engine that can')
+        self.engine, self.mechanism, self.why = engine, mechanism, why
+
+
 def input_boundary(what: str):
     """Decorate a function that validates user data (``fn(data, source, ...)``): a
     ``TypeError``, ``KeyError``, ``IndexError``, ``AttributeError``, ``ValueError``,

@@ -92,3 +92,52 @@ def test_event_json_keys():
     e = Event(0, "singular", "folded", input=[0.1], crossed=False)
     assert list(e.to_dict()) == ["index", "kind", "input", "crossed", "message"]
     assert e.get("group") is None and e["crossed"] is False
+
+
+def test_every_engine_by_its_name_and_a_decline_in_one_line(ex):
+    """``ENGINES`` names every engine once; ``method=NAME`` runs that engine alone (any of
+    ``regular_pass``, ``regular-pass``, ``Regular Pass``); one that cannot treat the
+    mechanism raises ``EngineDeclined`` (a ``MechsynInputError``) saying why in one line,
+    an unknown name lists the names."""
+    from mechsyn.errors import EngineDeclined, MechsynError
+    from mechsyn.kinematics import ENGINES
+    from mechsyn.kinematics.engines import engine_named
+
+    names = [e.name for e in ENGINES]
+    assert len(set(names)) == len(names) and names[-1] == "spatial"
+    m = ex("kinematics/crank_rocker.yaml")
+    for spelled in ("regular_pass", "regular-pass", "Regular Pass"):
+        assert engine_named(spelled) is ENGINES[0]
+        assert m.simulate(A=(0, 90, 45), method=spelled).engine == "regular pass"
+    with pytest.raises(EngineDeclined) as err:
+        simulate(ex("kinematics/cam_roller.yaml"), {"O": np.array([0.0, 10.0])}, method="tracked groups")
+    assert isinstance(err.value, MechsynError) and isinstance(err.value, MechsynInputError)
+    assert err.value.engine == "tracked groups" and "\n" not in str(err.value)
+    assert "does not split into drivers and dyads" in err.value.why
+    with pytest.raises(EngineDeclined, match="takes planar mechanisms"):
+        simulate(ex("spatial/bennett_tilted.yaml"), {"R1": np.array([0.0])}, method="newton")
+    with pytest.raises(MechsynInputError, match="unknown method 'magic'.*regular pass, tracked chain"):
+        m.simulate(A=(0, 90, 45), method="magic")
+
+
+def test_one_motion_for_every_engine(ex):
+    """The planar and the spatial results are one ``Motion``: the same fields, methods and
+    JSON keys (``to_dict``), a table for each (2-D and 3-D points)."""
+    import mechsyn as ms
+    from mechsyn.kinematics import Motion
+
+    m = ex("kinematics/crank_rocker.yaml")
+    planar = m.simulate(A=(0, 90, 30))
+    spatial = m.simulate(A=(0, 90, 30), method="spatial")
+    bennett = ms.simulate(ms.examples.load("bennett"), {"R1": ms.input_grid(0, 90, 30)})
+    common = {"mechanism", "input", "inputs", "assembled", "points", "links", "working_ranges", "events",
+              "method", "engine", "notes"}
+    for s in (planar, spatial, bennett):
+        assert isinstance(s, Motion) and common <= set(s.to_dict())
+        assert s.working_ranges() and s.point(next(iter(s.points))).shape[0] == 4
+        assert all(isinstance(e, Event) for e in s.events)
+    assert np.abs(spatial.point("M")[:, :2] - planar.point("M")).max() < 1e-9
+    assert spatial.inputs["A"].tolist() == planar.inputs["A"].tolist()
+    pd = pytest.importorskip("pandas")
+    cols = spatial.to_pandas().columns
+    assert {"M_x", "M_y", "M_z", "M_vz"} <= set(cols) and isinstance(planar.to_pandas(), pd.DataFrame)

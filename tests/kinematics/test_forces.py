@@ -6,7 +6,7 @@ import pytest
 from mechsyn.io import mechanism_from_dict
 from mechsyn.kinematics.analysis import forces, input_grid
 from mechsyn.kinematics.forces import loads_from_file, mass_model
-from mechsyn.kinematics.system import _cross2
+from mechsyn.kinematics.plane import cross
 
 from kinematics_helpers import ex, fourbar_dict  # noqa: F401
 
@@ -120,7 +120,7 @@ def test_static_fourbar_moment_balance():
     # with a moment on the rocker it is not a two-force member; the coupler is: force at C along BC
     B = S.point(q, S.index("coupler"), S.to_local("coupler", m.joint("B").point))
     Fc = fa.reactions.force["C"]
-    assert np.allclose(_cross2(Fc, C - B), 0, atol=1e-10)
+    assert np.allclose(cross(Fc, C - B), 0, atol=1e-10)
     assert np.isfinite(F).all() and np.isfinite(D).all()
 
 
@@ -205,12 +205,12 @@ def test_every_link_is_in_equilibrium(ex, rel, inp, vll):
         PG, _, aG = S.point_state(q, qd, qdd, i, mm.com[i])
         Fi = mm.mass[i] * (np.asarray(g) - aG)
         Fsum += Fi
-        Msum += _cross2(PG, Fi) - mm.inertia[i] * qdd[:, 3 * i + 2]
+        Msum += cross(PG, Fi) - mm.inertia[i] * qdd[:, 3 * i + 2]
         for k in range(len(loads.link)):
             if loads.link[k] == i:
                 P = S.point(q, i, loads.at[k])
                 Fsum += loads.force[k]
-                Msum += _cross2(P, np.broadcast_to(loads.force[k], P.shape)) + loads.moment[k]
+                Msum += cross(P, np.broadcast_to(loads.force[k], P.shape)) + loads.moment[k]
         for j in m.joints_of(name):
             sign = 1.0 if j.links[1] == name else -1.0  # reported: on the second link by the first
             side = S.index(j.links[1]) if S.index(j.links[1]) >= 0 else S.index(j.links[0])
@@ -220,7 +220,7 @@ def test_every_link_is_in_equilibrium(ex, rel, inp, vll):
                 P = np.broadcast_to(j.point, P.shape)
             F = sign * R.force[j.id]
             Fsum += F
-            Msum += _cross2(P, F) + sign * R.moment[j.id]
+            Msum += cross(P, F) + sign * R.moment[j.id]
             if j.id in R.effort and j.type == "R":
                 Msum += sign * R.effort[j.id]
         scale = np.abs(Fi).max() + 1.0

@@ -94,11 +94,10 @@ def _same(a, b):
             assert all(abs(e.input[k] - f.input[k]) < 1e-9 for k in e.input), (e, f)
 
 
-def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
+def test_one_pass_equals_the_tracked_sweep(ex):
     """Where no group comes near a fold, the one array pass (``regular_sweep``) answers;
     with dead points the regular pass goes on through them (``sweep_through_folds``).
     Either way the engine gives what the tracked outward sweeps give."""
-    from mechsyn.kinematics import analysis
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.engines import drawn_row
     from mechsyn.kinematics.regular import regular_sweep
@@ -128,9 +127,7 @@ def test_one_pass_equals_the_tracked_sweep(ex, monkeypatch):
                     for k, arr in enumerate((sw.q, sw.qd, sw.qdd)):
                         assert np.allclose(sw.links.point(i, np.zeros(2))[k], arr[:, 3 * i:3 * i + 2], atol=1e-12,
                                            equal_nan=True)
-            with monkeypatch.context() as mp:  # without the regular pass: the tracked chain
-                mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
-                tracked = simulate(m, {j: x})
+            tracked = simulate(m, {j: x}, method="tracked chain")  # the engine by its name
             assert tracked.engine == "tracked chain"
             _same(fast, tracked)
 
@@ -187,27 +184,23 @@ def test_a_speed_that_is_not_a_number_is_refused(ex):
         assert err.value.field == "speeds"
 
 
-def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex, monkeypatch):
+def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex):
     """A five-bar driven at the frame and between two moving links (B): the one pass turns
     the second link with the first and gives what the tracked sweep gives."""
-    from mechsyn.kinematics import analysis
-
     m = ex("textbook/five_bar_5r.yaml")
     m = m.with_joints(tuple(replace(j, actuated=j.id in ("A", "B")) for j in m.joints))
     x = input_grid(-5, 5, 1)
     inp, speeds = {"A": x, "B": 0.5 * x}, {"A": 1.0, "B": 0.7}
     fast = simulate(m, inp, speeds=speeds)
     assert fast.sweep.links is not None and not fast.events
-    with monkeypatch.context() as mp:
-        mp.setattr(analysis, "PLANAR_ENGINES", analysis.PLANAR_ENGINES[1:])
-        tracked = simulate(m, inp, speeds=speeds)
+    tracked = simulate(m, inp, speeds=speeds, method="tracked chain")
     _same(fast, tracked)
 
 
 @pytest.mark.parametrize("f, j, grid", [("textbook/watt_sixbar.yaml", "A", (0, 360, 2)),     # through folds
                                         ("kinematics/crank_rocker.yaml", "A", (0, 360, 5)),  # regular pass
                                         ("textbook/watt_sixbar.yaml", "A", (100, 130, 0.5))])
-def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid, monkeypatch):
+def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid):
     """Every named point (and joint) of a sweep, computed for all points at once, equals
     :meth:`PlanarSystem.point_state` of that point alone with its rows not assembled (and
     its rates where they are not defined) NaN, bit for bit; with the regular pass's link
@@ -216,10 +209,8 @@ def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid, m
 
     m = ex(f)
     names = list(m.points) + [jj.id for jj in m.joints]
-    for engines in (analysis.PLANAR_ENGINES, analysis.PLANAR_ENGINES[1:]):
-        with monkeypatch.context() as mp:
-            mp.setattr(analysis, "PLANAR_ENGINES", engines)
-            s = simulate(m, {j: input_grid(*grid)}, points=names)
+    for method in ("regular pass", "tracked chain"):
+        s = simulate(m, {j: input_grid(*grid)}, points=names, method=method)
         S, sw = s.system, s.sweep
         ok = s.assembled
         rates = ok & np.isfinite(sw.qd).all(axis=1) & np.isfinite(sw.qdd).all(axis=1)

@@ -127,19 +127,16 @@ def test_five_bar_two_inputs(ex):
 
 
 @pytest.mark.parametrize("name", ["watt_sixbar", "stephenson_sixbar"])
-def test_sixbars_assur_equals_newton(ex, name):
+def test_sixbars_keep_their_links_rigid(ex, name):
+    """Every link of a six-bar's closed-form sweep keeps its joint distances, and the two
+    links of each joint put it at one point (the engines' agreement with each other is
+    the conformance suite's, tests/kinematics/test_conformance.py)."""
     m = ex(f"textbook/{name}.yaml")
     plan = dyads.decompose(build_system(m))
     assert [s.kind for s in plan.steps] == ["drive_R", "RRR", "RRR"]
     x = input_grid(60, 110, 1)  # within the first working range (the base four-bar is non-Grashof)
     a = simulate(m, {"A": x}, method="assur")
-    b = simulate(m, {"A": x}, method="newton")
-    assert a.assembled.all() and b.assembled.all()
-    for link in a.links:
-        assert np.abs(a.links[link].angle - b.links[link].angle).max() < 1e-9
-        assert np.abs(a.links[link].angular_velocity - b.links[link].angular_velocity).max() < 1e-9
-        assert np.abs(a.links[link].angular_acceleration - b.links[link].angular_acceleration).max() < 1e-8
-    # every link keeps its joint distances
+    assert a.assembled.all()
     S = a.system
     q = a.sweep.q
     for link in S.links:

@@ -13,6 +13,7 @@ import pytest
 import mechsyn as ms
 from mechsyn.cli.main import main
 from mechsyn.errors import MechsynInputError
+from mechsyn.errors import EngineDeclined
 from mechsyn.kinematics.spatial import SpatialEngine
 
 
@@ -310,10 +311,18 @@ def test_change_points_reported_and_passed_on_the_drawn_branch():
     assert len(at_row) == 1 and np.isnan(s.points["C"].velocity[at_row[0]["index"]]).all()
 
 
-def test_spatial_engine_answers_spatial_files_only():
+def test_spatial_engine_takes_planar_r_and_p_pairs_only():
+    """A planar file of R and P pairs goes through as its 3-D equivalent (the same pose at
+    the same input value, z = 0); a cam is declined in one line that names it."""
     eng = SpatialEngine()
     assert eng.name == "spatial"
-    assert eng.sweep(ms.examples.load("crank_rocker"), {"A": np.array([0.0])}) is None
+    m = ms.examples.load("crank_rocker")
+    s = eng.simulate(m, {"A": np.array([0.0, 75.0])})
+    p = m.simulate({"A": np.array([0.0, 75.0])})
+    assert s.inputs["A"].tolist() == [0.0, 75.0] and np.abs(s.point("M")[:, 2]).max() == 0.0
+    assert np.abs(s.point("M")[:, :2] - p.point("M")).max() < 1e-9
+    with pytest.raises(EngineDeclined, match="joint K is a cam pair"):
+        eng.simulate(ms.examples.load("cam_roller"), {"O": np.array([0.0])})
 
 
 def test_bad_inputs_name_the_fix():

@@ -133,3 +133,26 @@ def test_slider_crank_loop_closure():
         assert np.all(np.sign(p.B[:, 0] - p.A[:, 0]) == -branch)
     bad = slider_crank_position(1.0, 0.2, 3.0, t)
     assert not bad.assembled.any() and np.all(np.isnan(bad.C))
+
+
+@pytest.mark.parametrize("branch", [-1, 1])
+def test_folded_coupler_point_is_the_law_of_cosines_pose_with_its_cosine_clipped(branch):
+    """``coupler_point(..., folded=True)`` (the RRR kernel's circle intersection) equals the
+    law-of-cosines pose ``theta3 = gamma - branch acos(ca)`` where the four-bar assembles
+    and, with ``ca`` clipped to [-1, 1], where it does not (the coupler laid along ``d``):
+    the least-squares residual of path synthesis is finite everywhere."""
+    rng = np.random.default_rng(7)
+    r1, r2, r3, r4 = (rng.uniform(0.3, 3.0, (200, 1)) for _ in range(4))
+    th = rng.uniform(0, 2 * np.pi, (200, 5))
+    rcx, rcy = rng.uniform(-1, 1, (2, 200, 1))
+    cx, cy, ok = coupler_point(r1, r2, r3, r4, th, branch, rcx, rcy, folded=True)
+    assert 0 < ok.mean() < 1 and np.isfinite(cx).all() and np.isfinite(cy).all()
+    ax, ay = r2 * np.cos(th), r2 * np.sin(th)
+    dx, dy = r1 - ax, -ay
+    d = np.hypot(dx, dy)
+    t3 = np.arctan2(dy, dx) - branch * np.arccos(np.clip((r3 * r3 + d * d - r4 * r4) / (2 * r3 * d), -1, 1))
+    wx = ax + rcx * np.cos(t3) - rcy * np.sin(t3)
+    wy = ay + rcx * np.sin(t3) + rcy * np.cos(t3)
+    assert np.abs(cx - wx).max() < 1e-9 and np.abs(cy - wy).max() < 1e-9
+    nx, ny, ok2 = coupler_point(r1, r2, r3, r4, th, branch, rcx, rcy)
+    assert np.array_equal(ok, ok2) and np.isnan(nx[~ok]).all() and np.array_equal(nx[ok], cx[ok])

@@ -30,8 +30,9 @@ SpeedOpt = Annotated[Optional[list[str]], typer.Option(
     "--speed", metavar="J=V", help="Input rate J=V (rad/s for R, length/s for P; default 1).")]
 VllOpt = Annotated[Optional[list[str]], typer.Option(
     "--vll", metavar="J=MODE", help="Variable-length link mode J=locked|free|active (paper 000's two modes).")]
-MethodOpt = Annotated[str, typer.Option("--method", help="auto | assur | newton (planar files; a spatial file "
-                                                          "takes the spatial engine)")]
+MethodOpt = Annotated[str, typer.Option(
+    "--method", help="auto | assur | an engine: regular-pass, tracked-chain, tracked-groups, newton, spatial "
+                     "(a planar file of R and P pairs in 3-D)")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON on stdout.")]
 CsvOpt = Annotated[Optional[Path], typer.Option("--csv", help="Write a CSV table.")]
 PlotOpt = Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG plot.")]
@@ -109,8 +110,7 @@ def _parse_straight(items: list[str] | None) -> dict[str, tuple[float, float]]:
 
 def _check_outputs(plot: Path | None, csv_out: Path | None, json_: bool, animate: Path | None = None,
                    method: str = "auto") -> None:
-    if method not in ("auto", "assur", "newton"):
-        raise MechsynInputError(f"unknown method {method!r}", source="--method", hint="auto, assur or newton")
+    _check_method(method)
     check_output_suffix(plot, (".png", ".pdf", ".svg"), "--plot")
     if animate is not None:
         check_animation_target(animate)
@@ -143,9 +143,10 @@ def simulate_cmd(
     _check_outputs(plot, csv_out, json_, animate, method)
     mech, inputs = load_mechanism(file), _parse_inputs(input)
     names = [p.strip() for p in points.split(",") if p.strip()] if points else None
-    if mech.kind == "spatial":  # hook (issue 25): the spatial engine's result renders itself
-        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate,
-                                 _planar_only(file, vll=vll, method=method != "auto", output=output, straight=straight))
+    if mech.kind == "spatial" or method == "spatial":  # the spatial engine's result renders itself
+        _planar_only(file, mech.kind, vll=vll, method=method not in ("auto", "spatial"), output=output,
+                     straight=straight)
+        return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate, method)
     with (_over_actuation_in_cli_words(inputs),
           progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance):
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
@@ -160,17 +161,29 @@ def simulate_cmd(
     render_simulation(report)
 
 
-def _planar_only(file: Path, **given: Any) -> None:
-    """Refuse the options that only planar files take (exit 2), naming them."""
-    bad = [f"--{k}" for k, v in given.items() if v]
+def _planar_only(file: Path, kind: str, **given: Any) -> None:
+    """Refuse the options that only planar files take (exit 2) on a spatial file, naming them."""
+    bad = [f"--{k}" for k, v in given.items() if v] if kind == "spatial" else []
     if bad:
         raise MechsynInputError(f"{', '.join(bad)} applies to planar files only; {file} is spatial", source=bad[0],
                                 hint=f"remove {', '.join(bad)}")
 
 
+def _check_method(method: str) -> None:
+    """``--method``: auto, assur or the name of an engine."""
+    if method in ("auto", "assur"):
+        return
+    from mechsyn.kinematics.engines import engine_named
+
+    try:
+        engine_named(method)
+    except MechsynInputError as exc:
+        raise MechsynInputError(exc.message, source="--method", hint=exc.hint) from None
+
+
 def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str] | None, speed: list[str] | None,
                       json_: bool, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path],
-                      _checked: None = None) -> None:
+                      method: str = "auto") -> None:
     """``mechsyn simulate`` on a spatial file: one call of the spatial engine, its result's own
     summary, events and table (``--json``: its ``to_dict()``)."""
     import shutil
@@ -181,7 +194,8 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
 
     n = len(next(iter(inputs.values())))
     with progress_bar("simulating", n, enabled=n >= 200) as advance:
-        sim = simulate(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names, progress=advance)
+        sim = simulate(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names, progress=advance,
+                       method=method)
     if csv_out is not None:
         write_output(csv_out, sim.csv())
     if plot is not None:

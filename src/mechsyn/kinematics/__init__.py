@@ -2,9 +2,12 @@
 
 Modules, from the entry points down (docs/architecture.md):
 
-* ``analysis``: :func:`simulate`, :func:`forces`, the compiled plan and its cache;
-* ``engines``: the ``Engine`` protocol and the planar engines tried in order (regular
-  pass, tracked chain, tracked groups, Newton); ``sweep``: ``Sweep`` and ``Event``;
+* ``analysis``: :func:`simulate` (``method="auto"`` or an engine's name), :func:`forces`,
+  the compiled plan and its cache;
+* ``engines``: ``ENGINES`` (every engine by a unique name), the ``Engine`` protocol and the
+  planar engines tried in order (regular pass, tracked chain, tracked groups, Newton), the
+  spatial engine last; ``sweep``: ``Sweep`` and ``Event``; ``simulation``: ``Motion``, the
+  result every engine fills (``Simulation`` planar, ``SpatialSimulation`` in 3-D);
 * ``regular`` (one-pass regular sweep), ``tracking`` (assembly modes through folds and
   change points), ``chain`` (driver-R + RRR chains, closed-form rates), ``positions``
   (generic group steps), ``groups`` (plan, decomposition, the RRR kernel),
@@ -27,7 +30,8 @@ References
 
 from typing import Any
 
-__all__ = ["simulate", "forces", "input_grid", "compile_plan", "cached_plan", "KinematicPlan"]
+__all__ = ["simulate", "forces", "input_grid", "compile_plan", "cached_plan", "KinematicPlan", "Motion", "Simulation",
+           "ENGINES"]
 
 
 def __getattr__(name: str) -> Any:  # lazy: importing the package stays cheap

@@ -23,19 +23,20 @@ from typing import Any
 import numpy as np
 
 from mechsyn._result import Result
-from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.engines import _INDEX, PLANAR_ENGINES, SPATIAL_ENGINE, first_sweep
+from mechsyn.errors import EngineDeclined, MechsynInputError
+from mechsyn.kinematics.engines import (ENGINES, PLANAR_ENGINES, SPATIAL_ENGINE, engine_named,  # noqa: F401
+                                        first_sweep)
 from mechsyn.kinematics.forces import Reactions, kinetostatics
 from mechsyn.kinematics.groups import Plan, _topology, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, require_drives_given, singular_configuration
-from mechsyn.kinematics.simulation import (LinkMotion, PointMotion, Simulation, _unit,  # noqa: F401
+from mechsyn.kinematics.simulation import (LinkMotion, Motion, PointMotion, Simulation,  # noqa: F401
                                           input_grid, resolve_points)
-from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.sweep import Event, Sweep, by_row
 from mechsyn.kinematics.refill import _xy, topology_key, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system, frame_points
 from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
 
-__all__ = ["Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
+__all__ = ["ENGINES", "Motion", "Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan",
            "ForceAnalysis", "forces"]
 
@@ -66,8 +67,12 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     """
     if not inputs:
         raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
+    engine = SPATIAL_ENGINE if mech.kind == "spatial" and method == "auto" else \
+        None if method in ("auto", "assur") else engine_named(method)
+    if hasattr(engine, "simulate"):  # an engine of whole mechanisms (the spatial one)
+        return engine.simulate(mech, inputs, speeds=speeds, points=points, progress=progress)
     if mech.kind == "spatial":
-        return SPATIAL_ENGINE.sweep(mech, inputs, speeds=speeds, points=points, progress=progress)
+        raise EngineDeclined(method, mech.name, "it takes planar mechanisms; this one is spatial")
     return _simulate_plan(cached_plan(mech, vll=vll, inputs=tuple(inputs)), inputs, speeds, points, method, progress,
                           change_points)  # KinematicPlan.simulate without its call
 
@@ -275,7 +280,11 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     vals, U = _input_rows(S, spec, inputs)
     sp, speed_of = _input_speeds(spec, inputs, speeds)
     named = _named_points(S, mech, points)
-    plan = kp.groups if method in ("auto", "assur") else None
+    plan, engines = kp.groups, PLANAR_ENGINES
+    if method not in ("auto", "assur"):
+        engines = (engine_named(method),)
+        if engines[0].name == "newton":
+            plan = None
     if method == "assur" and plan is None:
         raise MechsynInputError("the mechanism does not decompose into drivers and dyads", field="method",
                                 hint="use the Newton method")
@@ -285,7 +294,9 @@ def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dic
     if plan is not None and not drawn_checks(S, plan):
         assemble(S)  # checks the file configuration and the mobility
     require_drives_given(S, spec.names)  # a drive in excess held still: nothing would assemble
-    sw = first_sweep(PLANAR_ENGINES, S, plan, U, sp, change_points=change_points, progress=progress)
+    sw = first_sweep(engines, S, plan, U, sp, change_points=change_points, progress=progress)
+    if sw is None:  # one engine asked for by name, and it declined
+        raise EngineDeclined(engines[0].name, mech.name, engines[0].declined(S, plan, change_points))
     ok = sw.assembled
     complete = sw.links is not None and sw.rates_ok is None
     if complete:  # the regular pass without folds: every row assembled with finite rates
@@ -326,7 +337,7 @@ def _with_singular_rows(S: PlanarSystem, sw: Sweep, singular_rows: list[int]) ->
         if k not in flagged:  # made in input units (one object, not one and a copy)
             events.append(Event(k, "singular", "singular configuration: assembled, but the velocities and "
                                 "accelerations are not defined here (null)", units(sw.inputs[k].tolist())))
-    events.sort(key=_INDEX)
+    events.sort(key=by_row)
     return events
 
 
@@ -671,7 +682,7 @@ class ForceAnalysis(Result):
         r = self.reactions
         return {
             "mechanism": sim.mechanism,
-            "input": {"joint": main, "values": sim.inputs[main], "unit": _unit(sim.input_types[main]),
+            "input": {"joint": main, "values": sim.inputs[main], "unit": sim.input_unit(main),
                       "speed": sim.speeds[main]},
             "assembled": ok,
             "static": self.static,

@@ -12,7 +12,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 
-__all__ = ["CamCurve"]
+__all__ = ["CamCurve", "cam_curve"]
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class CamCurve:
         return float(ts[np.argmin(np.sum((pts - p) ** 2, axis=1))])
 
 
-def _cam_curve(profile: Any, center_local: np.ndarray, rho: float, contact_local: np.ndarray,
+def cam_curve(profile: Any, center_local: np.ndarray, rho: float, contact_local: np.ndarray,
                to_local: Any, source: str, jid: str) -> CamCurve:
     """Build the offset curve followed by the roller centre from the joint's profile."""
     from scipy.interpolate import make_interp_spline

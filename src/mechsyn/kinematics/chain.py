@@ -16,10 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, _cons_of, _cross, _local, _memo, _topology,
+from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, _cons_of, _local, _memo, _topology,
                                        circle_circle, normalised_disc)
 from mechsyn.kinematics.positions import TrackedPositions, _continuous_angles, solve_positions
 from mechsyn.kinematics.rates import batch_rates
+from mechsyn.kinematics.plane import cross
 from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["ChainResult", "chain_supported", "fast_chain", "solve_all"]
@@ -296,7 +297,7 @@ def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list[DriveOp | RRROp],
         t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
         L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
         A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
-        sigma = 1.0 if _cross(C0 - A0, B0 - A0) >= 0 else -1.0
+        sigma = 1.0 if cross(C0 - A0, B0 - A0) >= 0 else -1.0
         anchor[b1] = (J1, s1)
         anchor[b2] = (J3, t3)
         prog.append(RRROp(si, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, (s2 - s1) / L1s, (t2 - t3) / L2s))

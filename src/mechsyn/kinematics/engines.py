@@ -42,22 +42,22 @@ Examples
 
 from __future__ import annotations
 
-import operator
 from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
 
+from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.chain import solve_all
 from mechsyn.kinematics.groups import Plan
 from mechsyn.kinematics.regular import Folded, sweep_through_folds
 from mechsyn.kinematics.solve import sweep as newton_sweep
 from mechsyn.kinematics.spatial import SpatialEngine
-from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.sweep import Event, Sweep, by_row
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
 
-__all__ = ["Engine", "PLANAR_ENGINES", "SPATIAL_ENGINE", "RegularPass", "TrackedChain", "TrackedGroups", "Newton",
+__all__ = ["Engine", "ENGINES", "engine_named", "PLANAR_ENGINES", "SPATIAL_ENGINE", "RegularPass", "TrackedChain", "TrackedGroups", "Newton",
            "first_sweep", "drawn_row", "outward", "merged", "merged_events"]
 
 
@@ -106,6 +106,16 @@ class RegularPass:
         return Sweep(system, inputs, speeds, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", links=links,
                      engine=self.name)
 
+    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
+        """Why :meth:`sweep` gave None, in one line."""
+        if plan is None:
+            return _NO_PLAN
+        if change_points != "keep":
+            return "it follows the drawn branch only (change_points='keep')"
+        if not plan.closed_form_rates or system.n != 3 * len(system.links):
+            return "it takes chains of R drivers and RRR dyads only"
+        return "a group's discriminant has a minimum near zero (a change or branch point may be near)"
+
 
 class TrackedChain:
     """A driver-R + RRR chain through folds and change points, rates in closed form."""
@@ -123,6 +133,10 @@ class TrackedChain:
             return [_tracked_sweep(system, U, speeds, r, self.name, progress) for U, r in zip(parts, res)]
 
         return outward(system, inputs, run)
+
+    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
+        """Why :meth:`sweep` gave None, in one line."""
+        return _NO_PLAN if plan is None else "it takes chains of R drivers and RRR dyads only"
 
 
 class TrackedGroups:
@@ -147,6 +161,14 @@ class TrackedGroups:
 
         return outward(system, inputs, run)
 
+    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
+        """Why :meth:`sweep` gave None, in one line."""
+        return _NO_PLAN
+
+
+#: Why an engine of drivers and Assur groups declines a mechanism without such a plan.
+_NO_PLAN = "the mechanism does not split into drivers and dyads"
+
 
 class Newton:
     """Newton continuation of the constraint equations: every planar mechanism."""
@@ -169,15 +191,45 @@ class Newton:
 
         return outward(system, inputs, run)
 
+    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
+        """Why :meth:`sweep` gave None, in one line."""
+        return "it follows the drawn branch only (change_points='keep')"
+
 
 #: The planar engines in the order :func:`first_sweep` tries them.
 PLANAR_ENGINES: tuple[Engine, ...] = (RegularPass(), TrackedChain(), TrackedGroups(), Newton())
 
 #: The engine of ``kind: spatial`` mechanisms (:class:`mechsyn.kinematics.spatial.SpatialEngine`).
-#: A spatial mechanism has no planar system and no Assur plan, so it takes the mechanism
-#: itself and answers with a :class:`~mechsyn.kinematics.spatial_result.SpatialSimulation`
-#: (``engine == "spatial"``): the same result interface as the planar engines' ``Simulation``.
+#: It takes the mechanism itself (``simulate(mech, inputs, ...)``: no planar system, no
+#: Assur plan) and answers with a :class:`~mechsyn.kinematics.spatial_result.SpatialSimulation`,
+#: a :class:`~mechsyn.kinematics.simulation.Motion` like the planar engines' ``Simulation``.
+#: It also takes planar mechanisms of R and P pairs, as their 3-D equivalent (an oracle
+#: for the planar engines).
 SPATIAL_ENGINE = SpatialEngine()
+
+#: Every engine, each by a unique ``name``: ``simulate(..., method=NAME)`` runs that one
+#: alone (:func:`engine_named`). The planar engines sweep a compiled planar system
+#: (``sweep(system, plan, inputs, speeds, ...)`` behind the planar front end of
+#: :func:`mechsyn.kinematics.analysis.simulate`); an engine with a ``simulate`` method
+#: takes the mechanism whole (the spatial one).
+ENGINES: tuple[Any, ...] = PLANAR_ENGINES + (SPATIAL_ENGINE,)
+
+
+def engine_named(name: str) -> Any:
+    """The engine of :data:`ENGINES` called ``name`` (spaces, ``-`` and ``_`` alike, any
+    case), or a :class:`~mechsyn.errors.MechsynInputError` listing the names.
+
+    Examples
+    --------
+    >>> engine_named("regular_pass").name, engine_named("Spatial").name
+    ('regular pass', 'spatial')
+    """
+    key = name.replace("_", " ").replace("-", " ").lower()
+    for e in ENGINES:
+        if e.name == key:
+            return e
+    raise MechsynInputError(f"unknown method {name!r}", field="method",
+                            hint="auto, assur or an engine: " + ", ".join(e.name for e in ENGINES))
 
 
 def first_sweep(engines: tuple[Engine, ...], system: Any, plan: Any, inputs: np.ndarray, speeds: np.ndarray, *,
@@ -409,8 +461,5 @@ def merged_events(k: int, bwd: list[Event], fwd: list[Event]) -> list[Event]:
                               message=_BACK_MESSAGES.get(e.kind, e.message)))
     for e in fwd:
         events.append(e.with_(index=e.index + k, before_sweep=None))
-    events.sort(key=_INDEX)
+    events.sort(key=by_row)
     return events
-
-
-_INDEX = operator.attrgetter("index")

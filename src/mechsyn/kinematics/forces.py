@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.system import PlanarSystem, _apply, _cross2, _rot
+from mechsyn.kinematics.plane import cos_sin, cross, rotate
+from mechsyn.kinematics.system import PlanarSystem
 
 __all__ = ["MassModel", "mass_model", "Loads", "loads_from_file", "kinetostatics", "Reactions"]
 
@@ -116,8 +117,8 @@ def generalised_loads(S: PlanarSystem, q: np.ndarray, qdd: np.ndarray | None, qd
     nl = len(S.links)
     for i in range(nl):
         r, phi = q[:, 3 * i:3 * i + 2], q[:, 3 * i + 2]
-        c, s = _rot(phi)
-        Ac = _apply(c, s, mm.com[i])
+        c, s = cos_sin(phi)
+        Ac = rotate(c, s, mm.com[i])
         F = np.broadcast_to(mm.mass[i] * gravity, (N, 2)).copy()
         M = np.zeros(N)
         if qdd is not None and (mm.mass[i] > 0 or mm.inertia[i] > 0):
@@ -127,15 +128,15 @@ def generalised_loads(S: PlanarSystem, q: np.ndarray, qdd: np.ndarray | None, qd
             F -= mm.mass[i] * aG
             M -= mm.inertia[i] * al
         Q[:, 3 * i:3 * i + 2] += F
-        Q[:, 3 * i + 2] += M + _cross2(Ac, F)
+        Q[:, 3 * i + 2] += M + cross(Ac, F)
     for k in range(len(loads.link)):
         i = loads.link[k]
         phi = q[:, 3 * i + 2]
-        c, s = _rot(phi)
-        As = _apply(c, s, loads.at[k])
+        c, s = cos_sin(phi)
+        As = rotate(c, s, loads.at[k])
         F = np.broadcast_to(loads.force[k], (N, 2))
         Q[:, 3 * i:3 * i + 2] += F
-        Q[:, 3 * i + 2] += loads.moment[k] + _cross2(As, F)
+        Q[:, 3 * i + 2] += loads.moment[k] + cross(As, F)
     return Q
 
 
@@ -208,7 +209,7 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
             F, M_r = g[:, :2], g[:, 2]
             r = q[:, 3 * side:3 * side + 2]
             P = _joint_point(S, q, j.id, side)
-            M_P = M_r - _cross2(P - r, F)
+            M_P = M_r - cross(P - r, F)
             F = sign * F
             M_P = sign * M_P
             F[~ok] = np.nan
@@ -258,7 +259,7 @@ def _gear_tooth_force(S: PlanarSystem, con, q: np.ndarray, force: dict, moment: 
         n = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]
     # the couple on gear b by gear a from the ratio constraint (the force part is zero)
     couple_b = moment[j.id]
-    lever = _cross2(P - Ob, n)
+    lever = cross(P - Ob, n)
     F = (couple_b / lever)[:, None] * n          # on gear b, by gear a
     force[j.id] = F
     moment[j.id] = np.where(np.isfinite(couple_b), 0.0, np.nan)

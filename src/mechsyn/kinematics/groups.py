@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn.kinematics.plane import cross, dot
 from mechsyn.kinematics.system import Con, PlanarSystem
 
 __all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose", "normalised_disc"]
@@ -280,12 +281,8 @@ def _line(S: PlanarSystem, jid: str) -> Con:
     return next(c for c in _cons_of(S, jid) if c.kind == "line" and c.role == "pair")
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
 COINCIDENT = 1e-24

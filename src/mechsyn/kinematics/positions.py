@@ -30,8 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import Plan, Sigma, Step, circle_circle, normalised_disc, _cons_of, _cross, _dot, _line, _local, _rel_angle
-from mechsyn.kinematics.system import Con, PlanarSystem, _apply, _perp, _rot
+from mechsyn.kinematics.groups import Plan, Sigma, Step, circle_circle, normalised_disc, _cons_of, _line, _local, _rel_angle
+from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate
+from mechsyn.kinematics.system import Con, PlanarSystem
 
 __all__ = ["TrackedPositions", "solve_positions"]
 
@@ -52,8 +53,8 @@ class _State:
 
     def point(self, i: int, s: np.ndarray) -> np.ndarray:
         r, phi = self.pose(i)
-        c, sn = _rot(phi)
-        return r + _apply(c, sn, s)
+        c, sn = cos_sin(phi)
+        return r + rotate(c, sn, s)
 
     def set(self, i: int, r: np.ndarray, phi: np.ndarray) -> None:
         self.r[:, i] = r
@@ -151,8 +152,8 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
 
 
 def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
-    c, sn = _rot(phi)
-    st.set(i, P - _apply(c, sn, s_local), phi)
+    c, sn = cos_sin(phi)
+    st.set(i, P - rotate(c, sn, s_local), phi)
 
 
 def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
@@ -185,17 +186,17 @@ def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma:
     val = u[:, drive.driver]
     if drive.a == k:
         ra, pa = st.pose(k)
-        ca, sa_ = _rot(pa)
-        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        ca, sa_ = cos_sin(pa)
+        w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
         Pa = st.point(k, line.sa)
-        Pb = ra + val[:, None] * w + n * _dot(n, Pa - ra)[:, None]
+        Pb = ra + val[:, None] * w + n * dot(n, Pa - ra)[:, None]
         _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
     else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
         pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
-        ca, sa_ = _rot(pa)
-        w, n = _apply(ca, sa_, drive.w), _apply(ca, sa_, line.w)
+        ca, sa_ = cos_sin(pa)
+        w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
         Pb = st.point(k, drive.sb)
-        Oa = w * (_dot(w, Pb) - val)[:, None] + n * _dot(n, Pb - _apply(ca, sa_, line.sa))[:, None]
+        Oa = w * (dot(w, Pb) - val)[:, None] + n * dot(n, Pb - rotate(ca, sa_, line.sa))[:, None]
         st.set(new, Oa, pa)
     return 1.0
 
@@ -214,11 +215,11 @@ def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     inv, f, g2 = circle_circle(d[:, 0], d[:, 1], L1s, L2s)
     disc = normalised_disc(inv, g2, L1s)
     if sigma is None or callable(sigma):
-        s_file = 1.0 if _cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
+        s_file = 1.0 if cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
         sigma = s_file if sigma is None else sigma(disc, s_file)
     g2 = np.where((g2 < 0) & (disc > -1e-12), 0.0, g2)  # a fold within round-off
     g = np.sqrt(np.where(g2 >= 0, g2, np.nan))
-    B = A + f[:, None] * d + (sigma * g)[:, None] * _perp(d)
+    B = A + f[:, None] * d + (sigma * g)[:, None] * perp(d)
     beta1 = np.arctan2(*(s2 - s1)[::-1])
     beta2 = np.arctan2(*(t2 - t3)[::-1])
     phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
@@ -250,17 +251,17 @@ def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     s_k = line.sa if line.a == kp else line.sb
     Pk = st.point(kp, s_k)
     phi_axis = st.pose(line.a)[1] if line.a == kp else phi_p
-    ca, sa_ = _rot(phi_axis)
-    w = _perp(_apply(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
-    cp, sp = _rot(phi_p)
+    ca, sa_ = cos_sin(phi_axis)
+    w = perp(rotate(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
+    cp, sp = cos_sin(phi_p)
     tB = _local(S, lp, J2)
-    Q = Pk + _apply(cp, sp, tB - t_p)
+    Q = Pk + rotate(cp, sp, tB - t_p)
     L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
-    p = _dot(w, Q - A)
-    cc = _dot(Q - A, Q - A) - L1 ** 2
+    p = dot(w, Q - A)
+    cc = dot(Q - A, Q - A) - L1 ** 2
     disc = p ** 2 - cc
     if sigma is None or callable(sigma):
-        lam0 = _dot(w[0], S.mech.joint(J2).point - Q[0])
+        lam0 = dot(w[0], S.mech.joint(J2).point - Q[0])
         s_file = 1.0 if lam0 + p[0] >= 0 else -1.0
         sigma = s_file if sigma is None else sigma(disc / L1 ** 2, s_file)
     disc = np.where((disc < 0) & (disc > -1e-12 * L1 ** 2), 0.0, disc)
@@ -293,7 +294,7 @@ def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     Rc = np.array([[cc, -sc], [sc, cc]])
     e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
     d = C - A
-    D = np.sqrt(_dot(d, d))
+    D = np.sqrt(dot(d, d))
     delta = np.arctan2(d[:, 1], d[:, 0])
     nu = np.arctan2(n_loc[1], n_loc[0])
     ratio = e / D
@@ -348,16 +349,16 @@ def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.nd
              s_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A P pair's line condition ``n . (P_b - P_a) = 0`` as ``n . X = h`` for the unknown
     position ``X`` of the local point ``s_ref`` of a link whose angle ``phi_u`` is known."""
-    cu, su = _rot(phi_u)
+    cu, su = cos_sin(phi_u)
     if con.b == unknown:
         _, pa = st.pose(con.a)
-        ca, sa_ = _rot(pa)
-        n = _apply(ca, sa_, con.w)
+        ca, sa_ = cos_sin(pa)
+        n = rotate(ca, sa_, con.w)
         Pa = st.point(con.a, con.sa)
-        return n, _dot(n, Pa - _apply(cu, su, con.sb - s_ref))
-    n = _apply(cu, su, con.w)
+        return n, dot(n, Pa - rotate(cu, su, con.sb - s_ref))
+    n = rotate(cu, su, con.w)
     Pb = st.point(con.b, con.sb)
-    return n, _dot(n, Pb - _apply(cu, su, con.sa - s_ref))
+    return n, dot(n, Pb - rotate(cu, su, con.sa - s_ref))
 
 
 def _solve2(w1: np.ndarray, h1: np.ndarray, w2: np.ndarray, h2: np.ndarray) -> np.ndarray:

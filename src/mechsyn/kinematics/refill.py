@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.system import Con, PlanarSystem, _axis, _to_frame, frame_points
+from mechsyn.kinematics.plane import to_frame
+from mechsyn.kinematics.system import Con, PlanarSystem, frame_points
 from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
 
 __all__ = ["joint_points", "topology_key", "with_geometry"]
@@ -243,10 +244,10 @@ def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
     def loc(i: int, p: Any, direction: bool = False) -> np.ndarray:  # S.to_local / to_local_dir
         if i < 0:
             return np.asarray(p, float)
-        return _to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
-            _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
+        return to_frame(cos[i], sin[i], p[0], p[1]) if direction else \
+            to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
 
-    u = _axis(j)
+    u = np.asarray(j.axis, float)  # given: build_system refuses a P pair without axis
     u_loc = loc(a, u, direction=True)
     if c.role == "pair":
         return Con("line", c.joint, 1, a, b, sa=loc(a, j.point), sb=loc(b, j.point),

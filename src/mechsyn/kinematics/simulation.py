@@ -9,9 +9,10 @@ engine, planar or spatial, can build its result without importing the entry poin
 
 from __future__ import annotations
 
+import importlib
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -24,7 +25,7 @@ from mechsyn.model.mechanism import Mechanism
 if TYPE_CHECKING:
     from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points"]
+__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points"]
 
 
 @dataclass
@@ -49,22 +50,28 @@ class LinkMotion:
                 "angular_acceleration": self.angular_acceleration}
 
 
-@dataclass(repr=False)
-class Simulation(Result):
-    """Motion of a mechanism over a sweep of input values (see the module doc).
+@dataclass(repr=False, kw_only=True)
+class Motion(Result):
+    """What every engine's simulation is (a sweep of the inputs): the inputs, the rows
+    where the mechanism is assembled, the named points' and the links' motion, the events
+    of the sweep, the engine that ran and its notes.
 
-    ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
-    table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
+    Which class fills which field:
 
-    Examples
-    --------
-    >>> import mechsyn as ms
-    >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 360, 10))
-    >>> s.point("M").shape, bool(s.assembled.all())
-    ((37, 2), True)
+    ======================  ==============================  ===============================
+    field                   :class:`Simulation` (planar)    ``SpatialSimulation`` (spatial)
+    ======================  ==============================  ===============================
+    ``points``              (N, 2) positions and rates      (N, 3)
+    ``links``               :class:`LinkMotion` (angle)     ``LinkPose`` (rotation matrix)
+    ``events``              :class:`~mechsyn.kinematics.sweep.Event`, both
+    ``method``              ``"assur"`` or ``"newton"``     ``"spatial continuation"``
+    extra fields            ``vll``, ``sweep``, ``system``  ``joints``, ``residual``, ...
+    ======================  ==============================  ===============================
+
+    Inputs are in degrees (R) or the file's length unit (P), an input value the same pose
+    in every engine; points in the length unit (per s, per s^2); rows not assembled are
+    NaN (JSON ``null``).
     """
-
-    _plot = "kinematics:plot_paths"
 
     mechanism: str
     inputs: dict[str, np.ndarray]         # joint -> values (deg for R, length for P)
@@ -72,72 +79,37 @@ class Simulation(Result):
     speeds: dict[str, float]
     assembled: np.ndarray
     points: dict[str, PointMotion]
-    links: dict[str, LinkMotion]
+    links: dict[str, Any]
+    engine: str
+    method: str
     events: list[Event] = field(default_factory=list)
-    method: str = "newton"
-    engine: str = "newton"
     notes: list[str] = field(default_factory=list)
-    vll: dict[str, str] = field(default_factory=dict)
-    sweep: Sweep | None = field(default=None, repr=False)
-    system: PlanarSystem | None = field(default=None, repr=False)
+
+    #: ``"module:function"`` in :mod:`mechsyn.plot` that animates this result.
+    _animate: ClassVar[str] = "kinematics:animate_simulation"
 
     @property
     def main_input(self) -> str:
         return next(iter(self.inputs))
 
-    def _summary(self) -> list[tuple[str, str]]:
-        x = self.inputs[self.main_input]
-        unit = _unit(self.input_types[self.main_input])
-        rows = [("mechanism", self.mechanism), ("method", f"{self.method} ({self.engine})"),
-                ("input", f"{self.main_input}: {len(x)} values, {x[0]:g} to {x[-1]:g} {unit}" if len(x) else "none"),
-                ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
-                ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
-        if self.events:
-            rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
-        return rows
+    def input_unit(self, joint: str) -> str:
+        """The unit of input ``joint``'s values: ``"deg"`` (R, H) or ``"length"`` (P)."""
+        return _unit(self.input_types[joint])
 
     def point(self, name: str) -> np.ndarray:
-        """Positions (N, 2) of named point ``name`` over the sweep (NaN where not assembled)."""
+        """Positions (N, 2 or 3) of named point ``name`` over the sweep (NaN where not assembled)."""
         if name not in self.points:
             raise MechsynInputError(f"no point {name!r} in this simulation", field="points",
                                     hint="one of " + (", ".join(self.points) or "none: pass points=[...]"))
         return self.points[name].position
 
-    def link(self, name: str) -> LinkMotion:
-        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
+    def link(self, name: str) -> Any:
+        """The motion of link ``name`` over the sweep (:class:`LinkMotion`: angle in degrees,
+        angular velocity and acceleration; in 3-D a pose)."""
         if name not in self.links:
             raise MechsynInputError(f"no link {name!r} in this simulation", field="link",
                                     hint="one of " + ", ".join(self.links))
         return self.links[name]
-
-    def to_pandas(self) -> Any:
-        """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
-        every point's x, y, vx, vy, ax, ay and every link's angle, omega, alpha."""
-        from mechsyn._extras import require
-
-        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
-        cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
-        cols["assembled"] = self.assembled
-        for name, pm in self.points.items():
-            for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
-                cols[f"{name}_{key}x"], cols[f"{name}_{key}y"] = arr[:, 0], arr[:, 1]
-        for name, lm in self.links.items():
-            cols[f"{name}_angle"], cols[f"{name}_omega"] = lm.angle, lm.angular_velocity
-            cols[f"{name}_alpha"] = lm.angular_acceleration
-        return pd.DataFrame(cols)
-
-    def animate(self, fig: Any = None, **kwargs: Any) -> Any:
-        """The mechanism moving over the sweep: a
-        :class:`~mechsyn.plot.animation.MechanismAnimation` that plays when it is a notebook
-        cell's value and saves with ``anim.save("m.gif")`` (``.mp4``, ``.html``).
-
-        Without ``fig`` it is drawn on a bare Matplotlib Figure (no pyplot, so a notebook
-        shows the player, not a still frame); pass ``fig=plt.figure()`` to play it in a
-        Matplotlib window with ``plt.show()``. ``kwargs`` go to
-        :func:`mechsyn.plot.kinematics.animate_simulation` (``max_frames``, ``interval``)."""
-        from mechsyn.plot.kinematics import animate_simulation
-
-        return animate_simulation(self, fig=fig, bare=True, **kwargs)
 
     def working_ranges(self) -> list[list[float]]:
         """Runs of consecutive assembled inputs, as [first, last] values of the main input.
@@ -177,7 +149,46 @@ class Simulation(Result):
                 out.pop()
         return out
 
+    def to_pandas(self) -> Any:
+        """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
+        every point's x, y (z), vx, vy, ..., ax, ... and every link's numbers by row
+        (angle, omega, alpha; a 3-D link's translation and rates by component)."""
+        from mechsyn._extras import require
+
+        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
+        cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
+        cols["assembled"] = self.assembled
+        for name, pm in self.points.items():
+            for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
+                for c, col in zip("xyz", arr.T):
+                    cols[f"{name}_{key}{c}"] = col
+        for name, lm in self.links.items():
+            for key, arr in lm.to_dict().items():
+                arr = np.asarray(arr)
+                key = _COLUMNS.get(key, key)
+                if arr.ndim == 1:
+                    cols[f"{name}_{key}"] = arr
+                elif arr.ndim == 2:
+                    for c, col in zip("xyz", arr.T):
+                        cols[f"{name}_{key}_{c}"] = col
+        return pd.DataFrame(cols)
+
+    def animate(self, fig: Any = None, **kwargs: Any) -> Any:
+        """The mechanism moving over the sweep: a Matplotlib animation that plays when it is a
+        notebook cell's value and saves with ``anim.save("m.gif")`` (``.mp4``, ``.html``).
+
+        Without ``fig`` it is drawn on a bare Matplotlib Figure (no pyplot, so a notebook
+        shows the player, not a still frame); pass ``fig=plt.figure()`` to play it in a
+        Matplotlib window with ``plt.show()``. ``kwargs`` go to the function named in
+        ``_animate`` (:func:`mechsyn.plot.kinematics.animate_simulation`: ``max_frames``,
+        ``interval``)."""
+        module, name = self._animate.split(":")
+        draw = getattr(importlib.import_module(f"mechsyn.plot.{module}"), name)
+        return draw(self, fig=fig, **kwargs)
+
     def to_dict(self) -> dict[str, Any]:
+        """The fields every engine's result shares as plain values (rows not assembled
+        None); a subclass adds its own."""
         ok = self.assembled
 
         def mask(a: np.ndarray) -> list:
@@ -198,10 +209,62 @@ class Simulation(Result):
             "events": [e.to_dict() for e in self.events],
             "method": self.method,
             "engine": self.engine,
-            "vll": self.vll,
             "notes": self.notes,
-            "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"},
         }
+
+
+#: The table's names of a link's rates (:meth:`Motion.to_pandas`).
+_COLUMNS = {"angular_velocity": "omega", "angular_acceleration": "alpha"}
+
+
+@dataclass(repr=False, kw_only=True)
+class Simulation(Motion):
+    """Motion of a planar mechanism over a sweep of input values (see the module doc).
+
+    ``s.point("M")`` and ``s.link("coupler").angle`` give the arrays, ``s.to_pandas()`` a
+    table, ``s.plot()`` the mechanism and its point paths, ``s.animate()`` the motion.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 360, 10))
+    >>> s.point("M").shape, bool(s.assembled.all())
+    ((37, 2), True)
+    """
+
+    _plot = "kinematics:plot_paths"
+
+    links: dict[str, LinkMotion]
+    method: str = "newton"
+    engine: str = "newton"
+    vll: dict[str, str] = field(default_factory=dict)
+    sweep: Sweep | None = field(default=None, repr=False)
+    system: PlanarSystem | None = field(default=None, repr=False)
+
+    def _summary(self) -> list[tuple[str, str]]:
+        x = self.inputs[self.main_input]
+        unit = _unit(self.input_types[self.main_input])
+        rows = [("mechanism", self.mechanism), ("method", f"{self.method} ({self.engine})"),
+                ("input", f"{self.main_input}: {len(x)} values, {x[0]:g} to {x[-1]:g} {unit}" if len(x) else "none"),
+                ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
+                ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
+        if self.events:
+            rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
+        return rows
+
+    def link(self, name: str) -> LinkMotion:
+        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
+        return super().link(name)
+
+    def animate(self, fig: Any = None, **kwargs: Any) -> Any:
+        """:meth:`Motion.animate` (a :class:`~mechsyn.plot.animation.MechanismAnimation`)."""
+        return super().animate(fig, bare=True, **kwargs)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = super().to_dict()
+        notes = d.pop("notes")  # (the keys in the order the JSON has always had)
+        return {**d, "vll": self.vll, "notes": notes,
+                "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"}}
 
 
 def _unit(t: str) -> str:

@@ -45,45 +45,78 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from mechsyn.errors import MechsynInputError
+from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial, planar_as_spatial
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
 from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
+from mechsyn.kinematics.sweep import Event, as_event, by_row
+from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["SpatialEngine", "simulate_spatial", "RANK_TOL", "CLOSURE_TOL"]
+__all__ = ["SpatialEngine", "simulate_spatial", "planar_as_spatial", "RANK_TOL", "CLOSURE_TOL"]
 
 #: Largest residual of an accepted row that the result may carry (the issue's bound).
 CLOSURE_TOL = 1e-9
 
 
 class SpatialEngine:
-    """The spatial engine behind :func:`mechsyn.simulate`: answers for ``kind: spatial``
-    mechanisms (None for planar ones, which other engines answer).
+    """The spatial engine behind :func:`mechsyn.simulate`: every ``kind: spatial``
+    mechanism, and a planar mechanism of R and P pairs as its 3-D equivalent
+    (:func:`planar_as_spatial`), so that it can check the planar engines.
 
     Examples
     --------
     >>> import mechsyn as ms
-    >>> s = SpatialEngine().sweep(ms.examples.load("bennett"), {"R1": ms.input_grid(0, 90, 45)})
+    >>> s = SpatialEngine().simulate(ms.examples.load("bennett"), {"R1": ms.input_grid(0, 90, 45)})
     >>> s.engine, s.point("R3").shape, bool(s.residual.max() < 1e-9)
     ('spatial', (3, 3), True)
+    >>> p = SpatialEngine().simulate(ms.examples.load("crank_rocker"), {"A": [60.0, 90.0]})
+    >>> p.point("M").shape, bool(abs(p.point("M")[:, 2]).max() == 0.0)
+    ((2, 3), True)
     """
 
     name = "spatial"
 
-    def sweep(self, mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
-              points: list[str] | None = None, progress: Any = None, **_: Any) -> SpatialSimulation | None:
-        if mech.kind != "spatial":
-            return None
-        return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
+    def simulate(self, mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
+                 points: list[str] | None = None, progress: Any = None, **_: Any) -> SpatialSimulation:
+        if mech.kind == "spatial":
+            return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
+        slides = _planar_slides(mech, tuple(inputs))  # an R input's zero is the planar one already
+        values = {jid: np.asarray(v, float) for jid, v in inputs.items()}
+        res = simulate_spatial(mech, {j: v - slides.get(j, 0.0) for j, v in values.items()}, speeds=speeds,
+                               points=points, progress=progress)
+        events = [as_event(e).with_(input={j: v + slides.get(j, 0.0) for j, v in e["input"].items()})
+                  if isinstance(e.get("input"), dict) else as_event(e) for e in res.events]
+        return replace(res, inputs={jid: np.atleast_1d(v) for jid, v in values.items()}, events=events)
+
+
+def _planar_slides(mech: Mechanism, inputs: tuple[str, ...]) -> dict[str, float]:
+    """The drawn slide of each driven P joint of a planar mechanism (the spatial engine
+    measures a slide from the drawn assembly, the planar engines from the joint's origin);
+    a mechanism the spatial engine cannot take as its 3-D equivalent (a pair other than R
+    and P, a VLL) is an :class:`~mechsyn.errors.EngineDeclined`."""
+    other = next((j for j in mech.joints if j.type not in ("R", "P")), None)
+    if other is not None:
+        raise EngineDeclined("spatial", mech.name, f"joint {other.id} is a {other.type} pair; it takes planar "
+                                                   "mechanisms of R and P pairs only")
+    vll = next((j for j in mech.joints if j.vll), None)
+    if vll is not None:
+        raise EngineDeclined("spatial", mech.name, f"joint {vll.id} is a VLL ({vll.vll}); it takes plain R and "
+                                                   "P pairs only")
+    drivers = {d.joint: d for d in build_system(mech).drivers}
+    for jid in inputs:
+        if jid not in drivers:
+            raise MechsynInputError(f"joint {jid!r} is not driven", source=mech.source, field="inputs",
+                                    hint="driven joints: " + (", ".join(drivers) or "(none)"))
+    return {j: float(d.assembled) for j, d in drivers.items() if d.type == "P" and j in inputs}
 
 
 #: The inputs a pair takes: its id, and for a C pair ``<id>/turn``, for a U pair ``<id>/2``.
@@ -457,7 +490,7 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     return SpatialSimulation(
         mechanism=mech.name, inputs=inputs, input_types=types, speeds=speeds, assembled=ok, points=pm,
         links=links, joints=joints, residual=rows.res, singular_ratio=rows.ratio, length_scale=L,
-        rank=tr.rank, idle=idle, events=rows.events, notes=notes, model=M,
+        rank=tr.rank, idle=idle, events=[as_event(e) for e in rows.events], notes=notes, model=M,
         reached=np.where(ok, rows.how, 0).astype(int), held=tuple(d[0] for d in M.drives if d[0] not in inputs),
         zero={d[0]: float(np.degrees(M.zeros[d[2]])) for d in M.drives if d[0] in inputs and d[1] == "angle"})
 

@@ -16,8 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn._result import Result
-from mechsyn.kinematics.simulation import PointMotion, Simulation
+from mechsyn.kinematics.simulation import Motion, PointMotion
 from mechsyn.results import csv_cell
 
 __all__ = ["SpatialSimulation", "LinkPose"]
@@ -77,8 +76,8 @@ def _unit(t: str) -> str:
     return "length" if t == "P" else "deg"
 
 
-@dataclass(repr=False)
-class SpatialSimulation(Result):
+@dataclass(repr=False, kw_only=True)
+class SpatialSimulation(Motion):
     """Motion of a spatial mechanism over a sweep of its drives.
 
     ``s.point("P")`` gives (N, 3) positions, ``s.link("platform").rotation`` (N, 3, 3)
@@ -97,12 +96,6 @@ class SpatialSimulation(Result):
 
     _plot = "spatial:plot_spatial"
 
-    mechanism: str
-    inputs: dict[str, np.ndarray]
-    input_types: dict[str, str]
-    speeds: dict[str, float]
-    assembled: np.ndarray
-    points: dict[str, PointMotion]
     links: dict[str, LinkPose]
     joints: dict[str, np.ndarray]
     residual: np.ndarray
@@ -110,8 +103,6 @@ class SpatialSimulation(Result):
     length_scale: float
     rank: int
     idle: int
-    events: list[dict] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
     engine: str = "spatial"
     method: str = "spatial continuation"
     model: Any = field(default=None, repr=False, metadata={"json": False})
@@ -123,8 +114,6 @@ class SpatialSimulation(Result):
     #: per input joint, its value at the drawn assembly (deg, length): the input's zero is the
     #: joint's zero (see the file format), so the drawn assembly is at this value
     zero: dict[str, float] = field(default_factory=dict)
-
-    main_input = Simulation.main_input
 
     def working_ranges(self) -> list[list[float]]:
         """Runs of consecutive assembled rows as ``[first, last]`` values of the main input,
@@ -144,14 +133,6 @@ class SpatialSimulation(Result):
             out.append([ends.get((k, k - 1), float(vals[k])), ends.get((j, j + 1), float(vals[j]))])
             k = j + 1
         return out
-
-    def point(self, name: str) -> np.ndarray:
-        """Positions (N, 3) of the named point ``name`` (NaN where not assembled)."""
-        return Simulation.point(self, name)  # type: ignore[arg-type]
-
-    def link(self, name: str) -> LinkPose:
-        """Rotation, translation, angular velocity and acceleration of link ``name``."""
-        return Simulation.link(self, name)  # type: ignore[arg-type,return-value]
 
     def _summary(self) -> list[tuple[str, str]]:
         ok = self.assembled

@@ -12,13 +12,14 @@ reads like that dictionary (``e["kind"]``, ``e.get("input")``).
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 import numpy as np
 
-__all__ = ["Sweep", "Event", "EventKind"]
+__all__ = ["Sweep", "Event", "EventKind", "by_row"]
 
 #: What an event reports.
 EventKind = Literal["dead point", "reassembled", "singular", "not assembled", "branch point", "limit"]
@@ -34,7 +35,8 @@ class Event(Mapping):
     ``group``: the Assur group concerned (its joints, e.g. ``"B-C-D"``); ``crossed``: a
     singular point passed between two rows (not at a row); ``before_sweep``: the event lies
     between the drawn configuration and the first row; ``joint``, ``value``: a VLL and its
-    length (``limit``).
+    length (``limit``); ``last``: the assembled row a refined limit bounds (a dead point of
+    the spatial engine, whose ``input`` is then the refined value, not the row's).
 
     Examples
     --------
@@ -52,14 +54,15 @@ class Event(Mapping):
     before_sweep: bool | None = None
     joint: str | None = None
     value: float | None = None
+    last: int | None = None
 
     def __init__(self, index: int, kind: EventKind, message: str, input: Any = None, group: str | None = None,
                  crossed: bool | None = None, before_sweep: bool | None = None, joint: str | None = None,
-                 value: float | None = None) -> None:
+                 value: float | None = None, last: int | None = None) -> None:
         # the fields set in one update (a frozen dataclass's __init__ sets them one by one
         # through object.__setattr__: twice the time, and an engine makes events on every sweep)
         self.__dict__.update(index=index, kind=kind, message=message, input=input, group=group, crossed=crossed,
-                             before_sweep=before_sweep, joint=joint, value=value)
+                             before_sweep=before_sweep, joint=joint, value=value, last=last)
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: only the fields that are set, in a fixed order."""
@@ -76,6 +79,8 @@ class Event(Mapping):
         out["message"] = self.message
         if self.before_sweep is not None:
             out["before_sweep"] = self.before_sweep
+        if self.last is not None:
+            out["last"] = self.last
         return out
 
     def with_(self, **changes: Any) -> "Event":
@@ -100,6 +105,14 @@ class Event(Mapping):
 
 
 _FIELDS = frozenset(f.name for f in fields(Event))
+
+def as_event(e: "Event | dict[str, Any]") -> Event:
+    """An :class:`Event` from an event or its mapping form (the keys are its fields)."""
+    return e if isinstance(e, Event) else Event(**e)
+
+
+#: The sort key of events: their row (``events.sort(key=by_row)``).
+by_row = operator.attrgetter("index")
 
 
 @dataclass

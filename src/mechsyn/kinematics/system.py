@@ -51,8 +51,9 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.cams import CamCurve, _cam_curve
+from mechsyn.kinematics.cams import CamCurve, cam_curve
 from mechsyn.kinematics.compiled import one_configuration
+from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate, to_frame
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
 
@@ -63,30 +64,12 @@ VLL_MODES = {"active": "active", "driven": "active", "passive": "passive", "free
              "locked": "locked", "rigid": "locked"}
 
 
-def _rot(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    return np.cos(phi), np.sin(phi)
 
 
-def _apply(c: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``A(phi) v`` for a batch of angles (``c, s`` shape (N,)) and a vector ``v`` (2,) or (N, 2)."""
-    vx, vy = v[..., 0], v[..., 1]
-    x = c * vx - s * vy
-    out = np.empty(x.shape + (2,))
-    out[..., 0] = x
-    out[..., 1] = s * vx + c * vy
-    return out
 
 
-def _perp(v: np.ndarray) -> np.ndarray:
-    """``R90 v``: the vector turned by +90 degrees."""
-    out = np.empty(v.shape)
-    out[..., 0] = -v[..., 1]
-    out[..., 1] = v[..., 0]
-    return out
 
 
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
 
 
 # --------------------------------------------------------------------------- constraints
@@ -175,7 +158,7 @@ class PlanarSystem:
         if i < 0:
             return np.asarray(p, float)
         cos, sin, org = self.frames()
-        return _to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
+        return to_frame(cos[i], sin[i], p[0] - org[i][0], p[1] - org[i][1])
 
     def to_locals(self, idx: np.ndarray, pts: np.ndarray) -> np.ndarray:
         """:meth:`to_local` of the points ``pts`` (m, 2) on the links ``idx`` (m,; -1: the
@@ -201,22 +184,22 @@ class PlanarSystem:
 
     def point(self, q: np.ndarray, i: int, s: np.ndarray) -> np.ndarray:
         r, phi = self.pose(q, i)
-        c, sn = _rot(phi)
-        return r + _apply(c, sn, s)
+        c, sn = cos_sin(phi)
+        return r + rotate(c, sn, s)
 
     def point_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, i: int,
                     s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration of the local point ``s`` on link ``i``."""
         r, phi = self.pose(q, i)
-        c, sn = _rot(phi)
-        As = _apply(c, sn, s)
+        c, sn = cos_sin(phi)
+        As = rotate(c, sn, s)
         if i < 0:
             z = np.zeros_like(As)
             return r + As, z, z
         v, w = qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
         a, al = qdd[:, 3 * i:3 * i + 2], qdd[:, 3 * i + 2]
-        return (r + As, v + w[:, None] * _perp(As),
-                a + al[:, None] * _perp(As) - (w ** 2)[:, None] * As)
+        return (r + As, v + w[:, None] * perp(As),
+                a + al[:, None] * perp(As) - (w ** 2)[:, None] * As)
 
     def points_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray,
                      s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -255,8 +238,8 @@ class PlanarSystem:
         u_loc = self.to_local_dir(j.links[0], _axis(j))
         sb = self.to_local(j.links[1], j.point)
         ra, pa = self.pose(q, a)
-        c, s = _rot(pa)
-        return _dot(_apply(c, s, u_loc), self.point(q, b, sb) - ra)
+        c, s = cos_sin(pa)
+        return dot(rotate(c, s, u_loc), self.point(q, b, sb) - ra)
 
     def coordinate_rate(self, q: np.ndarray, qd: np.ndarray, joint: str) -> np.ndarray:
         """Time derivative of :meth:`coordinate` (by the Jacobian of the coordinate)."""
@@ -270,7 +253,7 @@ class PlanarSystem:
         if i < 0:
             return np.asarray(u, float)
         cos, sin, _ = self.frames()
-        return _to_frame(cos[i], sin[i], u[0], u[1])
+        return to_frame(cos[i], sin[i], u[0], u[1])
 
     # -- equations -----------------------------------------------------------------
     def residual(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
@@ -326,15 +309,12 @@ class PlanarSystem:
 
 
 def frame_points(frames: tuple, idx: list, xy: list) -> list:
-    """Points ``xy`` in the frames of links ``idx`` (-1: frame): :func:`_to_frame` on floats."""
+    """Points ``xy`` in the frames of links ``idx`` (-1: frame): :func:`to_frame` on floats."""
     cos, sin, org = frames  # (c dx - s dy, s dx + c dy), dx and dy named as they are first used
     return [(x, y) if i < 0 else (cos[i] * (dx := x - org[i][0]) - sin[i] * (dy := y - org[i][1]),
                                   sin[i] * dx + cos[i] * dy) for i, (x, y) in zip(idx, xy)]
 
 
-def _to_frame(c: float, s: float, dx: float, dy: float) -> np.ndarray:
-    """The vector ``(dx, dy)`` turned by the angle whose cosine and sine are ``c``, ``s``."""
-    return np.array([c * dx - s * dy, s * dx + c * dy], float)
 
 
 def _one(S: PlanarSystem) -> Any:
@@ -361,22 +341,22 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         return (S.link_angle_i(q, con.b) - S.link_angle_i(q, con.a) - val)[:, None]
     if k == "line":
         ra, pa = S.pose(q, con.a)
-        c, s = _rot(pa)
-        w = _apply(c, s, con.w)
+        c, s = cos_sin(pa)
+        w = rotate(c, s, con.w)
         d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
-        return (_dot(w, d) - val)[:, None]
+        return (dot(w, d) - val)[:, None]
     if k == "gear":
         pa, pb, pc = (S.link_angle_i(q, i) for i in (con.a, con.b, con.c))
         return ((pb - pc) - con.k * (pa - pc) - con.c0)[:, None]
     if k == "curve":
         ra, pa = S.pose(q, con.a)
-        c, s = _rot(pa)
+        c, s = cos_sin(pa)
         O = con.curve.eval(q[:, con.tvar])
-        return S.point(q, con.b, con.sb) - ra - _apply(c, s, O)
+        return S.point(q, con.b, con.sb) - ra - rotate(c, s, O)
     if k == "belt":
         D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-        d2 = _dot(D, D)
+        d2 = dot(D, D)
         r = con.radius
         with np.errstate(invalid="ignore"):
             b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))   # NaN: belt not taut and straight
@@ -404,8 +384,8 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
             if i < 0:
                 continue
             _, phi = S.pose(q, i)
-            c, sn = _rot(phi)
-            _put(J, row, i, sign * eye, sign * _perp(_apply(c, sn, s)))
+            c, sn = cos_sin(phi)
+            _put(J, row, i, sign * eye, sign * perp(rotate(c, sn, s)))
         return
     if k == "angle":
         one = np.ones((N, 1))
@@ -414,18 +394,18 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
         return
     if k == "line":
         ra, pa = S.pose(q, con.a)
-        c, s = _rot(pa)
-        w = _apply(c, s, con.w)
+        c, s = cos_sin(pa)
+        w = rotate(c, s, con.w)
         Pa = S.point(q, con.a, con.sa)
         Pb = S.point(q, con.b, con.sb)
         d = Pb - Pa
         if con.a >= 0:
-            Asa = _apply(c, s, con.sa)
-            _put(J, row, con.a, -w[:, None, :], (_dot(_perp(w), d) - _dot(w, _perp(Asa)))[:, None])
+            Asa = rotate(c, s, con.sa)
+            _put(J, row, con.a, -w[:, None, :], (dot(perp(w), d) - dot(w, perp(Asa)))[:, None])
         if con.b >= 0:
             _, pb = S.pose(q, con.b)
-            cb, sb = _rot(pb)
-            _put(J, row, con.b, w[:, None, :], _dot(w, _perp(_apply(cb, sb, con.sb)))[:, None])
+            cb, sb = cos_sin(pb)
+            _put(J, row, con.b, w[:, None, :], dot(w, perp(rotate(cb, sb, con.sb)))[:, None])
         return
     if k == "gear":
         one = np.ones((N, 1))
@@ -436,16 +416,16 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
     if k == "curve":
         eye = np.broadcast_to(np.eye(2), (N, 2, 2))
         ra, pa = S.pose(q, con.a)
-        c, s = _rot(pa)
+        c, s = cos_sin(pa)
         t = q[:, con.tvar]
         O, O1 = con.curve.eval(t), con.curve.eval(t, 1)
         if con.b >= 0:
             _, pb = S.pose(q, con.b)
-            cb, sb = _rot(pb)
-            _put(J, row, con.b, eye, _perp(_apply(cb, sb, con.sb)))
+            cb, sb = cos_sin(pb)
+            _put(J, row, con.b, eye, perp(rotate(cb, sb, con.sb)))
         if con.a >= 0:
-            _put(J, row, con.a, -eye, -_perp(_apply(c, s, O)))
-        J[:, row:row + 2, con.tvar] = -_apply(c, s, O1)
+            _put(J, row, con.a, -eye, -perp(rotate(c, s, O)))
+        J[:, row:row + 2, con.tvar] = -rotate(c, s, O1)
         return
     if k == "belt":
         g, _, _ = _belt_terms(S, con, q)
@@ -453,8 +433,8 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
             if i < 0:
                 continue
             _, phi = S.pose(q, i)
-            c, sn = _rot(phi)
-            dphi = sign * _dot(g, _perp(_apply(c, sn, sl)))
+            c, sn = cos_sin(phi)
+            dphi = sign * dot(g, perp(rotate(c, sn, sl)))
             if i == con.b:
                 dphi = dphi + con.sigma * con.radius
             _put(J, row, i, sign * g[:, None, :], dphi[:, None])
@@ -466,11 +446,11 @@ def _belt_terms(S: PlanarSystem, con: Con, q: np.ndarray) -> tuple[np.ndarray, n
     """Unit belt direction ``g = (b D - σ r R90 D)/d²`` (anchor to tangent point), ``D``
     and the free length ``b`` of a belt constraint (NaN where ``d <= r``)."""
     D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-    d2 = _dot(D, D)
+    d2 = dot(D, D)
     r = con.radius
     with np.errstate(invalid="ignore"):
         b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))
-    g = (b[:, None] * D - con.sigma * r * _perp(D)) / d2[:, None]
+    g = (b[:, None] * D - con.sigma * r * perp(D)) / d2[:, None]
     return g, D, b
 
 
@@ -484,58 +464,58 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
             if i < 0:
                 continue
             _, phi = S.pose(q, i)
-            c, sn = _rot(phi)
+            c, sn = cos_sin(phi)
             w = qd[:, 3 * i + 2]
-            out = out + sign * (w ** 2)[:, None] * _apply(c, sn, s)
+            out = out + sign * (w ** 2)[:, None] * rotate(c, sn, s)
         return np.broadcast_to(out, (q.shape[0], 2)) if np.ndim(out) else np.zeros((q.shape[0], 2))
     if k == "line":
         _, pa = S.pose(q, con.a)
-        c, s = _rot(pa)
-        w = _apply(c, s, con.w)
+        c, s = cos_sin(pa)
+        w = rotate(c, s, con.w)
         va, wa = _link_rates(S, qd, con.a)
         vb, wb = _link_rates(S, qd, con.b)
-        Asa = _apply(c, s, con.sa)
+        Asa = rotate(c, s, con.sa)
         _, pb = S.pose(q, con.b)
-        cb, sb = _rot(pb)
-        Asb = _apply(cb, sb, con.sb)
+        cb, sb = cos_sin(pb)
+        Asb = rotate(cb, sb, con.sb)
         d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-        dd = vb + wb[:, None] * _perp(Asb) - va - wa[:, None] * _perp(Asa)
-        g = (wa ** 2 * _dot(w, d) - 2 * wa * _dot(_perp(w), dd)
-             + wb ** 2 * _dot(w, Asb) - wa ** 2 * _dot(w, Asa))
+        dd = vb + wb[:, None] * perp(Asb) - va - wa[:, None] * perp(Asa)
+        g = (wa ** 2 * dot(w, d) - 2 * wa * dot(perp(w), dd)
+             + wb ** 2 * dot(w, Asb) - wa ** 2 * dot(w, Asa))
         return g[:, None]
     if k == "curve":
         _, pa = S.pose(q, con.a)
-        c, s = _rot(pa)
+        c, s = cos_sin(pa)
         _, pb = S.pose(q, con.b)
-        cb, sb = _rot(pb)
+        cb, sb = cos_sin(pb)
         _, wa = _link_rates(S, qd, con.a)
         _, wb = _link_rates(S, qd, con.b)
         t, td = q[:, con.tvar], qd[:, con.tvar]
         O, O1, O2 = (con.curve.eval(t, d) for d in (0, 1, 2))
-        g = ((wb ** 2)[:, None] * _apply(cb, sb, con.sb) - (wa ** 2)[:, None] * _apply(c, s, O)
-             + (2 * wa * td)[:, None] * _perp(_apply(c, s, O1)) + (td ** 2)[:, None] * _apply(c, s, O2))
+        g = ((wb ** 2)[:, None] * rotate(cb, sb, con.sb) - (wa ** 2)[:, None] * rotate(c, s, O)
+             + (2 * wa * td)[:, None] * perp(rotate(c, s, O1)) + (td ** 2)[:, None] * rotate(c, s, O2))
         return g
     if k == "belt":
         # Phi'' = dg/dt . D' + g . D'' + σ r phi_b'' with D'' = (terms in q'') - w_b² A_b s_b
         # + w_a² A_a s_a, and dg/dt = w_g R90 g, w_g = (R90 D . D')/d² + σ r (D . D')/(d² b)
         # (g turns with D's direction less the tangent offset arcsin(r/d)).
         g, D, b = _belt_terms(S, con, q)
-        d2 = _dot(D, D)
+        d2 = dot(D, D)
         out = 0.0
         Dd = 0.0
         for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
             if i < 0:
                 continue
             _, phi = S.pose(q, i)
-            c, sn = _rot(phi)
-            As = _apply(c, sn, sl)
+            c, sn = cos_sin(phi)
+            As = rotate(c, sn, sl)
             v, w = _link_rates(S, qd, i)
-            Dd = Dd + sign * (v + w[:, None] * _perp(As))
-            out = out + sign * w ** 2 * _dot(g, As)
+            Dd = Dd + sign * (v + w[:, None] * perp(As))
+            out = out + sign * w ** 2 * dot(g, As)
         if np.ndim(Dd) == 0:
             return np.zeros((q.shape[0], 1))
-        wg = _dot(_perp(D), Dd) / d2 + con.sigma * con.radius * _dot(D, Dd) / (d2 * b)
-        return (out - wg * _dot(_perp(g), Dd))[:, None]
+        wg = dot(perp(D), Dd) / d2 + con.sigma * con.radius * dot(D, Dd) / (d2 * b)
+        return (out - wg * dot(perp(g), Dd))[:, None]
     raise AssertionError(k)
 
 
@@ -744,7 +724,7 @@ class _Builder:
         else:
             centre, rho = j.point, 0.0
         tvar = len(self.q0) + len(self.extra_q)
-        curve = _cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
+        curve = cam_curve(profile, loc(a_name, centre), rho, loc(a_name, j.point),
                            lambda p, _a=a_name: loc(_a, p), self.src, j.id)
         self.extra_q.append(curve.closest(loc(a_name, centre)))
         self.cons.append(Con("curve", j.id, 2, a, b, sb=loc(b_name, centre), tvar=tvar, curve=curve, role="pair"))
@@ -771,9 +751,6 @@ class _Builder:
                               "(a pulley usually turns on its carrier there)")
 
 
-def _cross2(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """2-D cross product ``a x b`` (a scalar per row)."""
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -785,11 +762,11 @@ def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarra
     else:
         i3 = 3 * np.asarray(idx)
         xy, a, sx, sy = np.stack([i3, i3 + 1]), i3 + 2, s[:, 0, None], s[:, 1, None]
-    cs, R = np.empty((2, m, N)), np.empty((3, m, N))  # cos, sin; -ay, ax, ay: _perp(A s) is R[:2], A s R[1:]
+    cs, R = np.empty((2, m, N)), np.empty((3, m, N))  # cos, sin; -ay, ax, ay: perp(A s) is R[:2], A s R[1:]
     np.cos(qT[a], out=cs[0])
     np.sin(qT[a], out=cs[1])
-    X, Y = cs * sx, cs * sy  # (c sx, sn sx), (c sy, sn sy): the products of _apply
-    np.subtract(X[0], Y[1], out=R[1])  # A(phi) s, as _apply
+    X, Y = cs * sx, cs * sy  # (c sx, sn sx), (c sy, sn sy): the products of rotate
+    np.subtract(X[0], Y[1], out=R[1])  # A(phi) s, as rotate
     np.add(X[1], Y[0], out=R[2])
     np.negative(R[2], out=R[0])
     w, al, out = qdT[a], qddT[a], np.empty((3, m, N, 2))

@@ -63,25 +63,24 @@ def fourbar_position(
 ) -> FourBarPose:
     """Closed-form position of a four-bar linkage (all arguments broadcast).
 
-    ``B`` is the intersection of the circles (``A``, ``r3``) and (``O4``, ``r4``):
-    with ``d = |O4 - A|`` and ``gamma`` the direction of ``A -> O4``,
-    ``cos(alpha) = (r3^2 + d^2 - r4^2) / (2 r3 d)`` and ``theta3 = gamma - branch * alpha``.
+    ``B = A + r3 u`` is the intersection of the circles (``A``, ``r3``) and (``O4``, ``r4``)
+    (:func:`coupler_direction`, the RRR kernel); ``theta3`` the direction of ``u``: with
+    ``d = |O4 - A|`` and ``gamma`` the direction of ``A -> O4``, ``theta3 = gamma - branch *
+    alpha``, ``cos(alpha) = (r3^2 + d^2 - r4^2) / (2 r3 d)``.
     The coupler point is ``C = R(theta0) [A + rcx u + rcy n] + (x0, y0)`` with
     ``u = (cos theta3, sin theta3)``, ``n = (-sin theta3, cos theta3)``.
     """
     r1, r2, r3, r4, theta2 = np.broadcast_arrays(*(np.asarray(v, float) for v in (r1, r2, r3, r4, theta2)))
     ax, ay = r2 * np.cos(theta2), r2 * np.sin(theta2)
-    dx, dy = r1 - ax, -ay
-    d = np.hypot(dx, dy)
     with np.errstate(divide="ignore", invalid="ignore"):
-        cos_alpha = (r3 * r3 + d * d - r4 * r4) / (2.0 * r3 * d)
-        assembled = (np.abs(cos_alpha) <= 1.0) & (r3 > 0) & (r4 > 0) & (d > 0)
-        alpha = np.where(assembled, np.arccos(np.where(assembled, cos_alpha, 0.0)), np.nan)
-        gamma = np.arctan2(dy, dx)
-        theta3 = gamma - branch * alpha
-        bx, by = ax + r3 * np.cos(theta3), ay + r3 * np.sin(theta3)
+        ux, uy, assembled = coupler_direction(ax, ay, r1, r3, r4, branch)
+        assembled &= (r3 > 0) & (r4 > 0)
+        ux, uy = np.where(assembled, ux, np.nan), np.where(assembled, uy, np.nan)
+        theta3 = np.arctan2(uy, ux)
+        bx, by = ax + r3 * ux, ay + r3 * uy
         theta4 = np.arctan2(by, bx - r1)
-        cos_mu = (r3 * r3 + r4 * r4 - d * d) / (2.0 * r3 * r4)
+        d2 = (r1 - ax) ** 2 + ay * ay
+        cos_mu = (r3 * r3 + r4 * r4 - d2) / (2.0 * r3 * r4)
         mu = np.where(assembled, np.arccos(np.clip(cos_mu, -1.0, 1.0)), np.nan)
     ux, uy = np.cos(theta3), np.sin(theta3)
     cx = ax + rcx * ux - rcy * uy
@@ -97,23 +96,40 @@ def fourbar_position(
     )
 
 
-def coupler_point(r1, r2, r3, r4, theta2, branch: int = -1, rcx=0.0, rcy=0.0, x0=0.0, y0=0.0, theta0=0.0):
-    """Coupler point only, ``(Cx, Cy, assembled)``: the lean form of :func:`fourbar_position`.
+def coupler_direction(ax, ay, r1, r3, r4, branch: int = -1, folded: bool = False):
+    """The coupler's unit direction ``(ux, uy)`` from the crank pin ``A = (ax, ay)`` and
+    whether the four-bar assembles, by the RRR kernel
+    :func:`mechsyn.kinematics.groups.circle_circle` (the circles (``A``, ``r3``) and
+    (``O4``, ``r4``)): with ``d = O4 - A``, ``u = (f d - branch g R90 d) / r3`` (``f d``
+    and ``g |d|`` are the coupler's components along and across ``d``).
 
-    Same geometry without inverse trigonometry, by the RRR kernel
-    :func:`mechsyn.kinematics.groups.circle_circle`: with ``d = O4 - A``, the coupler
-    direction is ``u = (f d - branch g R90 d) / r3`` (``f d`` and ``g |d|`` are the coupler's
-    components along and across ``d``). NaN where the linkage cannot be assembled.
+    Where it does not assemble, ``u`` is NaN, or with ``folded`` the folded direction
+    ``sign(f) d / |d|`` (the coupler laid along ``d``: the pose nearest to assembling,
+    which keeps a least-squares residual finite).
+    """
+    dx, dy = r1 - ax, -ay
+    _, f, g2 = circle_circle(np.asarray(dx, float), np.asarray(dy, float), r3 * r3, r4 * r4)
+    assembled = g2 >= 0
+    if folded:
+        g2 = np.maximum(g2, 0.0)
+    g = np.sqrt(g2)
+    ux = (f * dx + branch * g * dy) / r3
+    uy = (f * dy - branch * g * dx) / r3
+    if folded and not assembled.all():
+        n = np.hypot(ux, uy)  # 1 where assembled (to round-off); |f d| / r3 where folded
+        ux, uy = np.where(assembled, ux, ux / n), np.where(assembled, uy, uy / n)
+    return ux, uy, assembled
+
+
+def coupler_point(r1, r2, r3, r4, theta2, branch: int = -1, rcx=0.0, rcy=0.0, x0=0.0, y0=0.0, theta0=0.0,
+                  folded: bool = False):
+    """Coupler point only, ``(Cx, Cy, assembled)``: the lean form of :func:`fourbar_position`
+    (:func:`coupler_direction`: NaN where the linkage cannot be assembled, or with
+    ``folded`` the folded pose there).
     """
     ax, ay = r2 * np.cos(theta2), r2 * np.sin(theta2)
-    dx, dy = r1 - ax, -ay
     with np.errstate(divide="ignore", invalid="ignore"):
-        # the RRR kernel: B - A = f d - branch g R90 d (circles (A, r3) and (O4, r4))
-        _, f, g2 = circle_circle(np.asarray(dx, float), np.asarray(dy, float), r3 * r3, r4 * r4)
-        assembled = g2 >= 0
-        g = np.sqrt(g2)
-        ux = (f * dx + branch * g * dy) / r3
-        uy = (f * dy - branch * g * dx) / r3
+        ux, uy, assembled = coupler_direction(ax, ay, r1, r3, r4, branch, folded)
         cx = ax + rcx * ux - rcy * uy
         cy = ay + rcx * uy + rcy * ux
     c0, s0 = np.cos(theta0), np.sin(theta0)

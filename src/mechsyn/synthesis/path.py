@@ -349,7 +349,8 @@ class PathProblem:
     def residuals(self, z: np.ndarray) -> np.ndarray:
         """Residual vector ``C - Cd`` (length ``2n``) for local least-squares polishing.
 
-        Where the linkage cannot assemble, the arccos argument is clipped and a large
+        Where the linkage cannot assemble, the coupler is laid along the pivots' line (its
+        folded pose, :func:`~mechsyn.synthesis.fourbar.coupler_direction`) and a large
         residual proportional to the violation is appended, so a polisher is pushed back to
         feasible designs (its result is accepted only if feasible).
         """
@@ -361,17 +362,8 @@ class PathProblem:
         case = self.case
         vals, th, _ = self.unpack(Z)
         r1, r2, r3, r4 = (vals[k][:, None] for k in LENGTHS)
-        ax, ay = r2 * np.cos(th), r2 * np.sin(th)
-        dx, dy = r1 - ax, -ay
-        d = np.hypot(dx, dy)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ca = np.clip((r3 * r3 + d * d - r4 * r4) / (2.0 * r3 * d), -1.0, 1.0)
-        t3 = np.arctan2(dy, dx) - case.branch * np.arccos(ca)
-        cx = ax + vals["rcx"][:, None] * np.cos(t3) - vals["rcy"][:, None] * np.sin(t3)
-        cy = ay + vals["rcx"][:, None] * np.sin(t3) + vals["rcy"][:, None] * np.cos(t3)
-        t0 = vals["theta0"][:, None]
-        gx = np.cos(t0) * cx - np.sin(t0) * cy + vals["x0"][:, None]
-        gy = np.sin(t0) * cx + np.cos(t0) * cy + vals["y0"][:, None]
+        gx, gy, _ = coupler_point(r1, r2, r3, r4, th, case.branch, *(vals[k][:, None] for k in
+                                  ("rcx", "rcy", "x0", "y0", "theta0")), folded=True)
         viol = self.evaluate(Z).violation
         return np.concatenate([gx - case.targets[:, 0], gy - case.targets[:, 1],
                                1e3 * np.sqrt(self.penalty_base) * viol[:, None]], axis=1)

@@ -25,7 +25,8 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io import mechanism_from_dict
 from mechsyn.kinematics.forces import kinetostatics
 from mechsyn.kinematics.solve import assemble
-from mechsyn.kinematics.system import _rot, build_system
+from mechsyn.kinematics.plane import cos_sin
+from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger.cases import FingerCase
 from mechsyn.synthesis.finger.evaluation import INFEASIBLE, Objective, apply_design, evaluate_drawn, evaluate_locked
 from mechsyn.synthesis.finger.vll import copy_mechanism, points_in_region, vll_ends
@@ -64,7 +65,7 @@ def redraw(case: FingerCase, design: dict, lengths: dict[str, float]) -> dict | 
         if link == ground:
             return [float(v) for v in u]
         i = S.index(link)
-        c, sn = _rot(q[:, 3 * i + 2] - S.q0[3 * i + 2])
+        c, sn = cos_sin(q[:, 3 * i + 2] - S.q0[3 * i + 2])
         u = np.asarray(u, float)
         return [float(c[0] * u[0] - sn[0] * u[1]), float(sn[0] * u[0] + c[0] * u[1])]
 
