@@ -78,3 +78,16 @@ def test_built_site_has_links_not_raw_roles(tmp_path):
         assert text.count("Output of") >= 2, page
     assert 'src="../run/getting-started/crank_rocker.svg"' in (tmp_path / "site" / "getting-started"
                                                                 / "index.html").read_text(encoding="utf-8")
+
+
+HISTORY = re.compile(r"\b[Ii]ssues? \d+\b|\b(?:main|commit) `?[0-9a-f]{7}\b|\bstop \d+\b|was not reproduced")
+
+
+def test_user_guides_carry_no_development_history():
+    """The user guides describe mechsyn as it is; issue numbers, commit hashes and what an
+    earlier version did are kept in docs/changelog.md (the development notes)."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+    hits = [f"{p.relative_to(ROOT)}:{n}: {m.group(0)}" for p in pages if p.name != "changelog.md"
+            for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) for m in [HISTORY.search(line)] if m]
+    assert hits == []
+    assert HISTORY.search((ROOT / "docs" / "changelog.md").read_text(encoding="utf-8"))  # the history is kept
