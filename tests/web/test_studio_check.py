@@ -39,7 +39,7 @@ def test_structure_and_extra_drives(client, fourbar):
     two = copy.deepcopy(fourbar)
     two["joints"][3]["actuated"] = True
     (msg,) = diagnostics(client, two)["diagnostics"]
-    assert msg["message"].startswith("2 drives for mobility W = 1") and msg["elements"] == [{"kind": "joint", "id": "D"}]
+    assert msg["message"].startswith("2 drives (A, D) for mobility 1: ") and msg["elements"] == [{"kind": "joint", "id": "D"}]
 
 
 def test_loose_parts_in_the_studio_words(client, fourbar):

@@ -217,7 +217,7 @@ def test_two_drives_and_coincident_joints_are_reported(serve, page):
     wait_settled(page)
     page.click("text=Drive")
     page.mouse.click(*center(page, '[data-joint="D"]'))
-    banner_has(page, "2 drives for mobility W = 1")
+    banner_has(page, "2 drives (A, D) for mobility 1")
     assert page.locator('[data-joint="D"].invalid').count() == 1
     shot(page, "studio_mistake.png")
     page.click("#undo")

@@ -37,6 +37,7 @@ from mechsyn.export.plates import link_plates
 from mechsyn.io import load_mechanism
 from mechsyn.kinematics.analysis import forces as _forces
 from mechsyn.results import to_jsonable
+from mechsyn.structure.drives import DriveCheck
 from mechsyn.structure.report import analyze as structure_report
 from mechsyn.web import _service
 from mechsyn.web._design import motion_results
@@ -99,9 +100,10 @@ def connection_problems(data: dict[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
-    """A structure with a drive, more drives than the mobility, fewer (motion undetermined),
-    none at all."""
+def drive_problems(mech, mobility: int, excess: list[str] | None = None) -> list[dict[str, Any]]:
+    """A structure with a drive, more drives than the mobility (``excess``: the rank method's
+    drives in excess, :func:`mechsyn.structure.drives.excess_drives`; else the last ones),
+    fewer (motion undetermined), none at all."""
     drives = [j.id for j in mech.joints if j.actuated]
     els = [("joint", d) for d in drives]
     n = len(drives)
@@ -109,9 +111,11 @@ def drive_problems(mech, mobility: int) -> list[dict[str, Any]]:
         return [_diag("error", f"this is a structure, not a mechanism (mobility W = {mobility}): nothing can "
                       f"move, so the drive on {_names(drives)} cannot turn it. Delete a link or a joint, or "
                       "remove the drive", els, True, "a structure: cannot turn")]
-    if n > mobility >= 1:
-        return [_diag("error", f"{n} drives for mobility W = {mobility}: the drives fight each other. Remove "
-                      f"the drive on {_names(drives[mobility:])} (Drive, then click it)", els[mobility:], True, "one drive too many")]
+    if n > mobility >= 1:  # the same line as analyze's verdict and simulate's refusal
+        extra = [d for d in (excess or drives[mobility:]) if d in drives] or drives[mobility:]
+        line = DriveCheck(drives, mobility, extra, "rank method").text(
+            fix=f"the drives fight each other; remove the drive on {_names(extra)} (Drive, then click it)")
+        return [_diag("error", line, [("joint", d) for d in extra], True, "one drive too many")]
     if n == 0 and mobility >= 1:
         return [_diag("note", f"no drive yet (mobility W = {mobility}): select the input joint and press "
                       "Drive to move the mechanism", [], True, "no drive yet")]
@@ -158,14 +162,15 @@ def geometry_problems(data: dict[str, Any], mech, rank, mobility: int) -> list[d
     instantaneous mobility is 2; one pulled taut cannot move at all), and a redundant bar named
     when the mechanism moves only thanks to exact dimensions (a double parallelogram)."""
     finite = getattr(rank, "finite_mobility", None) if rank is not None else None
+    excess = list(getattr(rank, "excess_drives", None) or [])
     if finite is None or finite >= mobility:  # (idle mobilities, a roller's spin, count in the finite one)
-        out = drive_problems(mech, mobility)
+        out = drive_problems(mech, mobility, excess)
     elif finite <= 0 < mobility:
         return [_diag("error", f"cannot move: the links are pulled taut at the drawn places (instantaneous mobility "
                       f"W = {mobility}, finite mobility {finite}: only an infinitesimal motion). Change a link's length "
                       "or move a joint", [("joint", j.id) for j in mech.joints if j.actuated], True, "cannot move")]
     else:
-        out = drive_problems(mech, finite)
+        out = drive_problems(mech, finite, excess)
     if rank is not None and rank.redundant_constraints > 0 and (finite or mobility) >= 1 and not out:
         out += _redundant_bars(data, rank)
     return out
