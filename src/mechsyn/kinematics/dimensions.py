@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.solve import newton
+from mechsyn.kinematics.solve import newton, worst_joint
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 
@@ -417,15 +417,7 @@ def _why(geo: _Geometry, q: np.ndarray, what: str, folded: bool) -> str:
 def _worst_joint(geo: _Geometry, q: np.ndarray) -> str:
     """The joint whose equations are furthest from holding with the new dimension at ``q``."""
     St = geo.system(1.0)
-    u = np.array([d.assembled for d in St.drivers])
-    r = np.abs(St.residual(q[None], u[None])[0] / St.row_scale)
-    row, best, worst = 0, -1.0, "?"
-    for con in St.cons:
-        v = float(r[row:row + con.rows].max())
-        if v > best:
-            best, worst = v, con.joint
-        row += con.rows
-    return worst
+    return worst_joint(St, q, np.array([d.assembled for d in St.drivers]))
 
 
 def _binary_dyads(mech: Mechanism) -> list[tuple[str, str, str, str, str]]:

@@ -281,14 +281,14 @@ def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
     q, ok = newton(S, S.q0, u_asm, max_iter=30)
     src = S.mech.source or "<mechanism>"
     if not ok:
-        worst = _worst_joint(S, S.q0, u_asm)
+        worst = worst_joint(S, S.q0, u_asm)
         raise MechsynInputError(
             f"the joint points of the file do not assemble (largest error at joint {worst})", source=src,
             hint="check the joint points: each link's joints must keep their distances")
     moved = _rel_step(S, (q - S.q0)[:3 * len(S.links)]) if S.links else 0.0
     if moved > 1e-6:
         raise MechsynInputError(
-            f"the file's configuration is not assembled: joint {_worst_joint(S, S.q0, u_asm)} is off "
+            f"the file's configuration is not assembled: joint {worst_joint(S, S.q0, u_asm)} is off "
             f"by up to {moved * S.scale:.3g}", source=src,
             hint="give joint points of one consistent configuration")
     _require_determined(S, q)
@@ -308,7 +308,8 @@ def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
     return qq
 
 
-def _worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
+def worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
+    """The joint whose equations are furthest from holding at ``q`` with the inputs ``u``."""
     r = np.abs(S.residual(q[None], u[None])[0] / S.row_scale)
     row, best, worst = 0, -1.0, "?"
     for con in S.cons:
