@@ -336,7 +336,7 @@ class HeavyRunner:
     >>> async def never():
     ...     return False
     >>> asyncio.run(runner.call("127.0.0.1:5000", never, "atlas", 4, 1))[0]["label"]
-    '4B'
+    '4B, four-bar chain'
     """
 
     def __init__(self, total: int | None = None, per_client: int = 1, queue: int = 4, isolate: bool = True,
