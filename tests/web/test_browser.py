@@ -307,3 +307,15 @@ def test_draw_a_target_curve(serve, page):
     assert page.locator("#synth-kind option").count() == 3  # path, curve, motion
     page.click("#clear-targets")
     assert page.locator("[data-target]").count() == 0
+
+
+def test_a_name_with_bidi_controls_is_shown_with_them_visible(serve, page):
+    """A mechanism name holding a right-to-left override (U+202E) is shown with the control
+    written out, never applied: the status line reads what the file holds."""
+    m = example("fourbar")
+    m["name"] = "four\u202ebar"
+    srv = serve(m, "")
+    open_studio(page, srv)
+    wait_js(page, "() => document.querySelector('#status').textContent.includes('<U+202E>')")
+    text = page.locator("#status").text_content()
+    assert "four<U+202E>bar" in text and "\u202e" not in text

@@ -3,6 +3,12 @@
 // change is one edit: `edit(fn)` applies fn to a copy of the mechanism, re-simulates, one undo step.
 import { linkName, membership } from "./draw.js";
 
+// Bidirectional controls and zero-width characters written visibly (<U+202E>): a name from a
+// file or a request shows what it holds, never text reordered or hidden by them (the same set
+// as mechsyn.io.files.HIDDEN_CHARS; "Trojan Source", CVE-2021-42574).
+const HIDDEN = /[\u061c\u200b-\u200f\u202a-\u202e\u2060-\u2064\u2066-\u2069\ufeff]/g;
+export const visible = (s) => String(s ?? "").replace(HIDDEN, (c) => `<U+${c.charCodeAt(0).toString(16).toUpperCase().padStart(4, "0")}>`);
+
 export function h(tag, text, attrs = {}) {
   const e = document.createElement(tag);
   if (text !== undefined && text !== null) e.textContent = text;

@@ -11,7 +11,7 @@ import { mountPlots } from "./plots.js";
 import { analysisTab } from "./analysis.js";
 import { fillExamples } from "./examples.js";
 import { autosave, forgetWork, guardUnload, mountFiles, savedWork, startProblem } from "./files.js";
-import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, PAIR_NAMES } from "./numeric.js";
+import { axisOf, h, jointFields, jointTable, pointFields, setLinks, setType, spatialJointFields, visible, PAIR_NAMES } from "./numeric.js";
 import { mountView3d } from "./view3d.js"; // view3d: the 3-D view of spatial files
 import { mountSpatialTabs } from "./tabs3d.js"; // the Plots and Forces tabs of spatial files
 import { mountDesign } from "./design.js"; // issue 40: dimensions, Burmester choice, robots, instant centres
@@ -61,7 +61,7 @@ function renderBanner() {
   const items = state.errors.map((e) => div("err", e.message + (e.hint ? ` — fix: ${e.hint}` : "")));
   if (state.fatal) items.unshift(div("err", state.fatal)); // files.js: the studio cannot talk to its server
   if (state.offer) {
-    const o = div("note", `unsaved work from ${state.offer.saved.replace("T", " ").slice(0, 16)} UTC (${state.offer.mechanism.name}) `);
+    const o = div("note", `unsaved work from ${state.offer.saved.replace("T", " ").slice(0, 16)} UTC (${visible(state.offer.mechanism.name)}) `);
     const yes = h("button", "Restore"), no = h("button", "Dismiss");
     yes.dataset.restore = ""; no.dataset.dismiss = "";
     yes.onclick = () => { const w = state.offer; state.offer = null; state.fileName = w.name || ""; setMech(w.mechanism, { fit: true }); };
@@ -101,7 +101,7 @@ function statusLine() {
   const m = state.mech;
   if (!m) return "";
   const moving = m.links.length - 1;
-  return `${m.name}: ${moving} moving links, ${m.joints.length} joints` + (state.sim ? `, ${state.sim.method}` : "");
+  return `${visible(m.name)}: ${moving} moving links, ${m.joints.length} joints` + (state.sim ? `, ${state.sim.method}` : "");
 }
 
 // ------------------------------------------------------------------ simulation and analysis
