@@ -92,8 +92,11 @@ def check_note(data: Any) -> dict[str, Any]:
         return rigid
     problem = engine_problem(data)
     if problem is None:
-        msg = ("spatial mechanism: 3-D view (drag to orbit, wheel to zoom, Reset; the input slider moves the "
-               "first drive); structure and rank analysis in the Analysis tab")
+        drives = sum(1 for j in (data.get("joints") or []) if isinstance(j, dict) and j.get("actuated"))
+        moves = ("each drive has its own slider below the drawing, the long one sweeps the first" if drives > 1
+                 else "the input slider moves the drive")
+        msg = (f"spatial mechanism: 3-D view (drag to orbit, wheel to zoom, Reset; {moves}); structure and rank "
+               "analysis in the Analysis tab")
     else:
         msg = ("spatial mechanism: structure and rank analysis only (see the Analysis tab); the drawing is its "
                f"top view. Spatial kinematics cannot move it: {problem}")
