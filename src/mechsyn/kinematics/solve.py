@@ -14,6 +14,7 @@ Velocities: ``Phi_q q' = B u'``; accelerations: ``Phi_q q'' = gamma + B u''``
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,9 @@ __all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton", "d
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     if J.shape[0] == J.shape[1]:
         try:
-            lu = sla.lu_factor(J, check_finite=False)
+            with warnings.catch_warnings():  # a singular J: the least-squares step below
+                warnings.simplefilter("ignore", sla.LinAlgWarning)
+                lu = sla.lu_factor(J, check_finite=False)
             x = sla.lu_solve(lu, rhs, check_finite=False)
             if np.all(np.isfinite(x)):
                 return x
@@ -320,6 +323,11 @@ def worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
     return worst
 
 
+#: The smallest pivot of the dimensionless Jacobian's LU, over its largest, below which the
+#: configuration is taken as singular (round-off of a pivot that is zero in exact arithmetic).
+SINGULAR_PIVOT = 1e-13
+
+
 def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, float]:
     """LU of ``Phi_q`` at q, ``dq/du`` (n, k), det sign and a singularity measure.
 
@@ -331,12 +339,17 @@ def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, 
     B = S.input_matrix() / S.row_scale[:, None]
     if J.shape[0] == J.shape[1]:
         try:
-            lu = sla.lu_factor(J, check_finite=False)
+            with warnings.catch_warnings():  # an exactly zero pivot: the singular point is handled below
+                warnings.simplefilter("ignore", sla.LinAlgWarning)
+                lu = sla.lu_factor(J, check_finite=False)
             X = sla.lu_solve(lu, B, check_finite=False)
             d = np.abs(np.diag(lu[0]))
             piv = int(np.sum(lu[1] != np.arange(len(lu[1]))))
             sign = float(np.prod(np.sign(np.diag(lu[0]))) * (-1) ** piv)
-            if np.all(np.isfinite(X)):
+            # a pivot within round-off of zero is a singular point, whatever the LAPACK's last
+            # bits (0 with one, 3e-17 and a tangent of 1e16 with another): the least-squares
+            # tangent below, the same everywhere
+            if np.all(np.isfinite(X)) and d.min() > SINGULAR_PIVOT * d.max():
                 return lu, X * S.col_scale[:, None], sign, float(d.min() / max(d.max(), 1e-300))
         except (sla.LinAlgError, ValueError):
             pass
@@ -475,14 +488,39 @@ def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
             return nxt
     elif nxt is not None or len(hist) < 2:
         if nxt is None and not regular:
-            cand, ok = newton(S, q0 + X0 @ (u - u0), u, max_iter=40)
-            return cand if ok else None
+            return _leave_singular(S, q0, X0, u0, u)
         return nxt
     pred = _extrapolate(hist, u)
     cand, ok = newton(S, pred, u, max_iter=40, polish=True)
     if ok:
         return cand
     return nxt
+
+
+def _leave_singular(S: PlanarSystem, q0: np.ndarray, X0: np.ndarray, u0: np.ndarray,
+                    u: np.ndarray) -> np.ndarray | None:
+    """The first configuration at ``u`` from a singular one ``q0`` (a file drawn at a dead
+    centre or folded): Newton from the tangent's guess, else from guesses along the
+    Jacobian's null direction, on its positive side first (near a fold the configuration
+    moves as the square root of the input's step, so the guesses are that far out). Which
+    of the branches meeting at ``q0`` is taken is arbitrary (the sweep's notes say so); the
+    rule only makes it the same whatever the linear algebra's pivoting (an exactly singular
+    LU gave a usable tangent with one LAPACK and none with another)."""
+    pred = q0 + X0 @ (u - u0)
+    cand, ok = newton(S, pred, u, max_iter=40)
+    if ok:
+        return cand
+    unit = np.array([1.0 if d.type == "R" else S.scale for d in S.drivers])
+    reach = float(np.sqrt(np.max(np.abs(u - u0) / unit, initial=0.0)))
+    v = np.linalg.svd(S.unit_jacobian(S.jacobian(q0[None])[0]))[2][-1]
+    v *= np.sign(v[np.argmax(np.abs(v))])
+    dq = v * S.col_scale
+    dq *= S.scale / max(float(np.linalg.norm(dq)), 1e-300)
+    for guess in (pred + reach * dq, pred - reach * dq, pred + 0.3 * reach * dq, pred - 0.3 * reach * dq):
+        cand, ok = newton(S, guess, u, max_iter=40)
+        if ok:
+            return cand
+    return None
 
 
 def _elbows(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
