@@ -12,7 +12,6 @@ import socket
 import subprocess
 import sys
 import textwrap
-import time
 from pathlib import Path
 
 import pytest
@@ -21,6 +20,7 @@ from mechsyn.io import load_mechanism, mechanism_to_dict
 from mechsyn.web._service import example_path
 
 from web_helpers import TOKEN, LiveServer
+from web_helpers import wait_for as _wait_for
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 
@@ -270,15 +270,6 @@ def _post_raw(port: int, path: str, body: bytes, send_all: bool = True) -> socke
             f"Content-Type: application/json\r\nContent-Length: {len(body)}\r\n\r\n").encode()
     s.sendall(head + (body if send_all else body[: len(body) // 3]))
     return s
-
-
-def _wait_for(predicate, what: str, limit: float = 120.0) -> None:
-    """Wait for a readiness signal (``predicate()``); the limit only stops a broken run."""
-    deadline = time.monotonic() + limit
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"never happened: {what}")
-        time.sleep(0.02)
 
 
 def test_heavy_work_stops_when_its_client_leaves_and_others_are_answered(tmp_path):

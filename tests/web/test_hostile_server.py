@@ -18,14 +18,7 @@ from mechsyn.io import load_mechanism, mechanism_to_dict
 from mechsyn.web._service import example_path
 
 from web_helpers import TOKEN, free_port
-
-
-def _wait_for(predicate, what: str, limit: float = 120.0) -> None:
-    deadline = time.monotonic() + limit
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"never happened: {what}")
-        time.sleep(0.02)
+from web_helpers import wait_for as _wait_for
 
 
 @pytest.fixture

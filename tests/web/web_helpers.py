@@ -48,3 +48,12 @@ class LiveServer:
     def stop(self) -> None:
         self.server.should_exit = True
         self.thread.join(timeout=10)
+
+
+def wait_for(predicate, what: str, limit: float = 120.0) -> None:
+    """Wait for a readiness signal (``predicate()``); the limit only stops a broken run."""
+    deadline = time.monotonic() + limit
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"never happened: {what}")
+        time.sleep(0.02)
