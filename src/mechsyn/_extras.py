@@ -41,7 +41,7 @@ EXTRAS: dict[str, str] = {
     "pynauty": "nauty",
     "ezdxf": "cad",
     "imageio_ffmpeg": "video",
-    "numba": "fast",
+    "numba": "fast",  # a base dependency since issue 37; an install older than that lacks it
     "mkdocs": "docs",
     "starlette": "web",  # base dependencies today; an install older than issue 26 lacks them
     "uvicorn": "web",

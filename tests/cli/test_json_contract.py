@@ -17,17 +17,6 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 CRANK_ROCKER = EXAMPLES / "kinematics/crank_rocker.yaml"
 
 
-@pytest.fixture(autouse=True)
-def _one_pass():
-    """The command and the library call on the same regular pass: a one-shot command takes
-    the NumPy pass (mechsyn.cli.main.ONE_SHOT), so the library call here does too (with
-    Numba installed the compiled pass agrees with it to round-off, not bit for bit)."""
-    from mechsyn.kinematics import kernel
-
-    with kernel.use("numpy"):
-        yield
-
-
 def same_json(cli_json, args: list, report) -> None:
     """The command's ``--json`` equals ``report.to_dict()`` after a JSON round trip."""
     got = cli_json(*args)

@@ -1,8 +1,7 @@
 """The conformance suite of the kinematics engines (issue 37), in the shape of
 scikit-learn's ``parametrize_with_checks``: one parametrized test runs every engine of
 :data:`mechsyn.kinematics.ENGINES` on every bundled example with a driven R joint, under
-each backend of the regular pass (NumPy; Numba when installed), and compares it with the
-spatial engine on the drawn cycle.
+the one kernel of the regular pass, and compares it with the spatial engine on the drawn cycle.
 
 The oracle is the spatial engine on the planar file's 3-D equivalent: another formulation
 (each pair's constraint equations on the link poses, predictor-corrector continuation),
@@ -39,7 +38,7 @@ import pytest
 
 import mechsyn as ms
 from mechsyn.errors import EngineDeclined, MechsynInputError
-from mechsyn.kinematics import ENGINES, kernel
+from mechsyn.kinematics import ENGINES
 from mechsyn.kinematics.analysis import cached_plan
 from mechsyn.model.mechanism import Mechanism
 
@@ -110,7 +109,6 @@ def _examples() -> list[tuple[str, Mechanism, str]]:
 
 
 EXAMPLES = _examples()
-BACKENDS = ["numpy", "numba"]
 
 
 @functools.lru_cache(maxsize=None)
@@ -146,25 +144,21 @@ def _drawn_range(assembled: np.ndarray) -> np.ndarray:
     return ok
 
 
-@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("engine", [e.name for e in ENGINES])
 @pytest.mark.parametrize("name", [e[0] for e in EXAMPLES])
-def test_engine_agrees_with_the_spatial_engine(name, engine, backend):
-    if backend == "numba" and not _numba():
-        pytest.skip("Numba not installed (pip install 'mechsyn[fast]')")
+def test_engine_agrees_with_the_spatial_engine(name, engine):
     _, m, joint = next(e for e in EXAMPLES if e[0] == name)
     if name in ORACLE_DECLINES:
         with pytest.raises(MechsynInputError, match=ORACLE_DECLINES[name]):
             _oracle(name)
         pytest.skip(f"the oracle declines {name}: {ORACLE_DECLINES[name]}")
     declared = DECLINES[engine].get(name)
-    with kernel.use(backend):
-        try:
-            s = ms.simulate(m, {joint: _cycle(m, joint)}, method=engine)
-        except EngineDeclined as exc:
-            assert declared is not None, f"{engine} declines {name}, undeclared: {exc.why}"
-            assert declared in exc.why and "\n" not in str(exc)
-            return
+    try:
+        s = ms.simulate(m, {joint: _cycle(m, joint)}, method=engine)
+    except EngineDeclined as exc:
+        assert declared is not None, f"{engine} declines {name}, undeclared: {exc.why}"
+        assert declared in exc.why and "\n" not in str(exc)
+        return
     assert declared is None, f"{engine} declared to decline {name} ({declared}) but answers: remove it from DECLINES"
     assert s.engine == engine and isinstance(s, ms.kinematics.Motion)
     ref = _oracle(name) if engine != "spatial" else ms.simulate(m, {joint: _cycle(m, joint)}, method="newton")
@@ -189,14 +183,6 @@ def test_engine_agrees_with_the_spatial_engine(name, engine, backend):
     mine, theirs = _limit_rows(s), _limit_rows(ref)
     assert all(min(abs(i - k) for k in theirs) <= 1 for i in mine), (mine, theirs)
     assert all(min(abs(i - k) for k in mine) <= 1 for i in theirs), (mine, theirs)
-
-
-def _numba() -> bool:
-    try:
-        import numba  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 def test_every_engine_is_compared_on_enough_examples():

@@ -1,7 +1,6 @@
 """The regular pass through folds: its fold search on the pass's rows, the link angles and
 the connecting paths give what the per-sweep computations give, to the bit."""
 
-import importlib.util
 import math
 from dataclasses import replace
 
@@ -55,36 +54,6 @@ def _cases(ex):
             yield m.name, g, kp.system, kp.groups, np.radians(np.arange(*g))[:, None]
 
 
-def test_pass_fold_events_equals_the_sweeps_fold_events(ex):
-    """``pass_fold_events`` reads every tracked sweep's folds, reassembly, singular rows
-    and change-point candidates off the pass's rows laid out once; the sweep-by-sweep
-    search gives the same events (every field, every bit) and singular rows, forwards,
-    backwards, over several turns and where the drawn input lies outside the sweep."""
-    from mechsyn.kinematics import regular, folds, tracking
-
-    folded = backward = 0
-    for name, g, S, plan, U in _cases(ex):
-        split = drawn_row(S, U)
-        steps, anchor, _ = regular._program(S, plan)
-        parts = [U] if split is None else [U[split:], U[:split][::-1]]
-        paths = [tracking.tracking_path(S, p[0]) for p in parts]
-        st = regular._run(steps, anchor, np.concatenate([U] + [p for p, _ in paths]), np.ones(1), folds=True)
-        regular._scalar_memo(S, plan, steps, anchor)
-        sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
-        got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
-        want = _per_sweep(S, plan, st, U, split, paths, sigmas)
-        assert (got is None) == (want is None), (name, g)
-        if got is None:
-            continue
-        folded += bool(sum(len(ev) for _, ev in got))
-        backward += split is not None and bool(got[1][1])
-        assert len(got) == len(want) == (1 if split is None else 2)
-        for (s1, e1), (s2, e2) in zip(got, want):
-            assert np.array_equal(s1, s2), (name, g)
-            assert [e.to_dict() for e in e1] == [e.to_dict() for e in e2], (name, g)
-    assert folded >= 20 and backward >= 5, (folded, backward)  # most pass dead points, some backwards
-
-
 def test_gap_angles_wrapped_as_np_remainder_wraps_them():
     """The link angles of a sweep with gaps are wrapped next to the drawn angles in place
     (``fresh``) without ``np.remainder``'s division when the drawn angles lie within half
@@ -135,31 +104,6 @@ def test_tracking_path_is_kept_and_read_only():
     assert tracking_path(S, np.array([u0]))[0].shape == (1, 1)  # at the drawn input: the drawn values
 
 
-def test_blank_equals_mask_assignment():
-    """The gaps' NaN written by runs of columns (few runs) or by one masked copy (many):
-    what boolean-mask assignment writes."""
-    from mechsyn.kinematics.regular import _blank
-
-    rng = np.random.default_rng(3)
-    for runs in (0, 1, 3, 40):
-        keep = np.ones(200, bool)
-        for a in rng.integers(0, 200, runs):
-            keep[a:a + rng.integers(1, 4)] = False
-        for ends in ((), (0,), (199,), (0, 199)):
-            k = keep.copy()
-            k[list(ends)] = False
-            a, b = rng.normal(size=(5, 200)), rng.normal(size=(3, 200))
-            wa, wb = a.copy(), b.copy()
-            wa[:, ~k], wb[:, ~k] = np.nan, np.nan
-            _blank((a, b), k)
-            assert np.array_equal(a, wa, equal_nan=True) and np.array_equal(b, wb, equal_nan=True)
-
-
-#: the tests that run the compiled scan (Numba: the fast extra; CI's .ci/steps/25-kernel.sh)
-needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
-                                 reason="Numba not installed (pip install 'mechsyn[fast]')")
-
-
 def _folding_cases(ex):
     """:func:`_cases` and the six-bars moved so that both their groups fold (the second
     one's folds found by the root search, some hidden by the first one's), over their
@@ -175,14 +119,14 @@ def _folding_cases(ex):
             yield m.name, g, kp.system, kp.groups, np.radians(np.arange(*g))[:, None]
 
 
-@needs_numba
-def test_compiled_fold_scan_equals_the_python_scan(ex, monkeypatch):
-    """After a compiled pass the whole fold scan runs compiled (``kernel.fold_scan``):
-    on the same discriminants it gives the Python scan's singular rows and events (every
-    field; the inputs to 1e-12: the compiled and the Python discriminant along a segment
-    differ in the last place), folds in closed form, by the root search, hidden behind
-    an upstream fold and on the connecting path, forwards and backwards."""
-    from mechsyn.kinematics import kernel, regular, folds, tracking
+def test_the_kernels_fold_scan_equals_the_sweeps_python_scan(ex, monkeypatch):
+    """``pass_fold_events`` reads every tracked sweep's folds, reassembly, singular rows
+    and change-point candidates off the pass's rows laid out once, by the kernel
+    (``kernel.fold_scan``); the tracked engine's sweep-by-sweep search in Python
+    (:func:`fold_events`) gives the same events (every field; inputs to 1e-12) and
+    singular rows, forwards, backwards, over several turns, where the drawn input lies
+    outside the sweep, and where an upstream group's fold hides a group's own."""
+    from mechsyn.kinematics import regular, folds, tracking
 
     seen = {"hidden": 0, "root": 0}
     real = folds._hidden_fold
@@ -193,50 +137,51 @@ def test_compiled_fold_scan_equals_the_python_scan(ex, monkeypatch):
         return t
 
     monkeypatch.setattr(folds, "_hidden_fold", spy)
-    events = before = 0
-    with kernel.use("auto"):
-        for name, g, S, plan, U in _folding_cases(ex):
-            split = drawn_row(S, U)
-            parts = [U] if split is None else [U[split:], U[:split][::-1]]
-            paths = [tracking.tracking_path(S, p[0]) for p in parts]
-            X = np.concatenate([U] + [p for p, _ in paths])
-            st = regular._pass(S, plan, X, np.ones(1), folds=True)  # the compiled program, kept with S
-            steps, anchor, _ = regular._program(S, plan)
-            regular._scalar_memo(S, plan, steps, anchor)
-            sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
-            got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
-            with kernel.use("numpy"):
-                want = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths)
-            assert (got is None) == (want is None), (name, g)
-            for (s1, e1), (s2, e2) in zip(got or [], want or []):
-                assert np.array_equal(s1, s2), (name, g)
-                assert [{**e.to_dict(), "input": None} for e in e1] == [{**e.to_dict(), "input": None} for e in e2]
-                for a, b in zip(e1, e2):
-                    assert np.allclose(a.input, b.input, rtol=1e-12, atol=1e-12), (name, g, a, b)
-                events += len(e1)
-                before += sum(bool(e.before_sweep) for e in e1)
+    events = before = folded = backward = 0
+    for name, g, S, plan, U in _folding_cases(ex):
+        split = drawn_row(S, U)
+        parts = [U] if split is None else [U[split:], U[:split][::-1]]
+        paths = [tracking.tracking_path(S, p[0]) for p in parts]
+        X = np.concatenate([U] + [p for p, _ in paths])
+        st = regular._pass(S, plan, X, np.ones(1), folds=True)
+        steps, anchor, _ = regular._program(S, plan)
+        regular._scalar_memo(S, plan, steps, anchor)
+        sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
+        got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
+        want = _per_sweep(S, plan, st, U, split, paths, sigmas)
+        assert (got is None) == (want is None), (name, g)
+        if got is None:
+            continue
+        folded += bool(sum(len(ev) for _, ev in got))
+        backward += split is not None and bool(got[1][1])
+        assert len(got) == len(want) == (1 if split is None else 2)
+        for (s1, e1), (s2, e2) in zip(got, want):
+            assert np.array_equal(s1, s2), (name, g)
+            assert [{**e.to_dict(), "input": None} for e in e1] == [{**e.to_dict(), "input": None} for e in e2]
+            for a, b in zip(e1, e2):
+                assert np.allclose(a.input, b.input, rtol=1e-12, atol=1e-12), (name, g, a, b)
+            events += len(e1)
+            before += sum(bool(e.before_sweep) for e in e1)
+    assert folded >= 20 and backward >= 5, (folded, backward)  # most pass dead points, some backwards
     assert events >= 200 and before >= 1 and seen["root"] >= 20 and seen["hidden"] >= 2, (events, before, seen)
 
 
-@needs_numba
-def test_a_compiled_pass_scans_its_folds_compiled(ex, monkeypatch):
-    """A simulation through dead points on the compiled pass makes no Python fold scan
+def test_the_regular_pass_scans_its_folds_in_the_kernel(ex, monkeypatch):
+    """A simulation through dead points on the regular pass makes no Python fold scan
     (no row-by-row Python, no Python root search): its events come from
-    ``kernel.fold_scan``, the same as the NumPy pass's."""
-    from mechsyn.kinematics import kernel, folds
+    ``kernel.fold_scan``, the same as the tracked chain's."""
+    from mechsyn.kinematics import folds
     from mechsyn.kinematics.analysis import simulate
 
     m = ex("textbook/watt_sixbar.yaml")
     x = np.arange(0.0, 361.0)
-    with kernel.use("numpy"):
-        want = simulate(m, {"A": x}).events
+    want = simulate(m, {"A": x}, method="tracked chain").events
 
     def no_scan(*a, **k):
         raise AssertionError("the Python fold scan ran after a compiled pass")
 
     monkeypatch.setattr(folds, "_fold_scan", no_scan)
-    with kernel.use("auto"):
-        got = simulate(m, {"A": x}).events
+    got = simulate(m, {"A": x}, method="regular pass").events
     assert len(got) == len(want) >= 3 and sum(e.kind == "dead point" for e in got) >= 2
     for a, b in zip(got, want):
         assert {**a.to_dict(), "input": None} == {**b.to_dict(), "input": None}

@@ -1,10 +1,14 @@
-"""The compiled regular pass (mechsyn.kinematics.kernel, issue 30) against the NumPy pass it
-compiles: the same states, discriminants and fold flags on every planar example (and a
-moved copy of each) whose plan the regular pass takes, and the same simulations."""
+"""The kernel of the regular pass (mechsyn.kinematics.kernel, issues 30 and 37) against the
+closed-form chain of the tracked engine (chain.solve_all, the same formulas written on
+arrays of real pairs): the same states, rates and discriminants on every planar example
+(and a moved copy of each) whose plan the regular pass takes, and the same simulations.
+CI runs these tests under NUMBA_DISABLE_JIT=1 with coverage (.ci/steps/25-kernel.sh)."""
 
 from __future__ import annotations
 
-import importlib.util
+import os
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -14,19 +18,6 @@ import mechsyn as ms
 from mechsyn.kinematics import kernel, regular
 from mechsyn.kinematics.analysis import cached_plan
 from mechsyn.model.mechanism import Mechanism
-
-#: the tests that run the compiled pass (Numba: the fast extra; CI's .ci/steps/25-kernel.sh)
-needs_numba = pytest.mark.skipif(importlib.util.find_spec("numba") is None,
-                                 reason="Numba not installed (pip install 'mechsyn[fast]')")
-
-
-@pytest.fixture(autouse=True)
-def _kernel_on():
-    """These tests compare the compiled pass with the NumPy one: the kernel in its
-    default mode, whatever the environment said."""
-    with kernel.use("auto"):
-        yield
-
 
 def _scale(m: Mechanism) -> float:
     pts = np.array([j.point for j in m.joints if j.point is not None and len(j.point) == 2], float)
@@ -70,59 +61,70 @@ def test_the_examples_have_chains_with_folds_and_several_drivers():
     assert any(len(cached_plan(m).system.drivers) > 1 for _, m in CHAINS)
 
 
-@needs_numba
+
+
 @pytest.mark.parametrize("name,mech", CHAINS, ids=[n for n, _ in CHAINS])
-def test_compiled_pass_equals_the_numpy_pass(name, mech):
+def test_the_kernel_pass_equals_the_closed_form_chain(name, mech):
+    """Every link's rotation, its origin's position, velocity and acceleration, its rates
+    and every group's discriminant from the kernel, against the tracked engine's chain
+    (:func:`mechsyn.kinematics.chain.solve_all`) and the discriminant of
+    :func:`mechsyn.kinematics.groups.circle_circle` on the chain's joints."""
+    from mechsyn.kinematics.chain import fast_chain, solve_all
+    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+
     kp = cached_plan(mech)
     S, plan = kp.system, kp.groups
     k = len(S.drivers)
     u0 = np.array([d.assembled for d in S.drivers])
     rng = np.random.default_rng(7)
-    wide = np.radians(np.arange(-180.0, 541.0, 0.5))  # a full turn and more: folds if the chain has any
+    wide = np.radians(np.arange(-180.0, 541.0, 2.5))  # a full turn and more: folds if the chain has any
     X = np.column_stack([wide if i == 0 else u0[i] + rng.uniform(-0.3, 0.3, wide.size) for i in range(k)])
     speeds = np.linspace(1.0, 2.0, k)
     steps, anchor, origin = regular._program(S, plan)
-    st = regular._run(steps, anchor, X, speeds, folds=True)
-    C0 = regular._states(st, origin, X.shape[0], len(S.links))
     C, W, AL, D, near = kernel.run(kernel.program_arrays(steps, anchor, origin), X, speeds, regular.REGULAR_DISC)
-    assert near == st.near
-    groups = sorted(st.discs)
-    D0 = np.stack([st.discs[g] for g in groups])
-    assert np.array_equal(np.isnan(D0), np.isnan(D))
-    assert np.allclose(D0, D, rtol=1e-12, atol=1e-12, equal_nan=True)
-    # rounding (NumPy's and libm's sines differ in the last place) grows as a group
-    # folds, as 1 / disc^2 for the accelerations: rows clear of folds agree to 1e-14
-    # relative times that, element by element
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q, qd, qdd = solve_all(S, plan, X, speeds)
+        r = fast_chain(S, plan, X, speeds, rates=True)
+        D0 = []
+        for st in steps:
+            if st[0] == "RRR":
+                (J1, _, J3), L1s, L2s = st[3], st[4], st[5]
+                d = r.points[J3] - r.points[J1]
+                inv, _, g = circle_circle(d[:, 0].copy(), d[:, 1].copy(), L1s, L2s)
+                D0.append(normalised_disc(inv, g, L1s))
+    D0 = np.array(D0)
+    assert near == (not np.nanmin(D0) >= regular.REGULAR_DISC)
+    fin = np.isfinite(D0)
+    assert np.array_equal(fin, np.isfinite(D)) and np.allclose(D0[fin], D[fin], rtol=1e-9, atol=1e-9)
+    # rounding grows as a group folds, as 1 / disc^2 for the accelerations: rows clear of
+    # folds agree to 1e-12 relative times that, element by element
     clear = (D0 > 1e-3).all(axis=0)
     grow = 1.0 / D0[:, clear].min(axis=0) ** 2
     size = _scale(mech)
-    pairs = [(C0[0], C[0], 1.0)] + [(C0[i], C[i], size) for i in (1, 2, 3)]
-    pairs += [(np.stack([np.broadcast_to(st.link[i][j], arr[i].shape) for i in range(len(S.links))]), arr, 1.0)
-              for arr, j in ((W, 1), (AL, 2))]
-    for a, b, unit in pairs:
-        assert np.array_equal(np.isnan(a[:, clear]), np.isnan(b[:, clear]))
-        a, b = a[:, clear], b[:, clear]
-        ok = np.isfinite(a)
-        tol = 1e-14 * (unit + np.abs(a)) * grow
-        assert np.all(np.abs(a[ok] - b[ok]) <= tol[ok])
+    nl = len(S.links)
+    x, y, a = (slice(c, 3 * nl, 3) for c in range(3))
+    pairs = [(np.exp(1j * q[:, a].T), C[0], 1.0)]
+    pairs += [((v[:, x] + 1j * v[:, y]).T, C[i], size) for i, v in ((1, q), (2, qd), (3, qdd))]
+    pairs += [(qd[:, a].T, W, 1.0), (qdd[:, a].T, AL, 1.0)]
+    for want, got, unit in pairs:
+        want, got = want[:, clear], got[:, clear]
+        assert np.array_equal(np.isnan(want), np.isnan(got))
+        ok = np.isfinite(want)
+        tol = 1e-12 * (unit + np.abs(want)) * grow
+        assert np.all(np.abs(want[ok] - got[ok]) <= tol[ok]), name
 
 
-@needs_numba
 @pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar", "stephenson_sixbar", "fourbar", "jansen_leg"])
 @pytest.mark.parametrize("grid", [(0, 360, 1), (-720, 720, 3), (400, 40, -2)])
-def test_simulations_are_the_same_with_and_without_the_kernel(name, grid):
+def test_the_regular_pass_simulates_as_the_tracked_chain(name, grid):
     """Poses, rates, named points, link angles and events of ``simulate`` over several
     turns, forwards and backwards, from inside and outside the drawn input (the Watt
-    six-bar and the textbook four-bar through their dead points)."""
+    six-bar and the textbook four-bar through their dead points): the kernel's regular
+    pass and the tracked chain (the same branch rules on the NumPy closed-form chain)."""
     m = ms.examples.load(name)
     drive = next(j.id for j in m.joints if j.actuated)
-    sims = {}
-    for mode in ("numpy", "auto"):
-        with kernel.use(mode):
-            assert kernel.active() == (mode == "auto")
-            sims[mode] = m.simulate(**{drive: grid})
-    a, b = sims["numpy"], sims["auto"]
-    assert a.engine == b.engine == "regular pass"
+    a, b = (ms.simulate(m, {drive: grid}, method=e) for e in ("tracked chain", "regular pass"))
+    assert (a.engine, b.engine) == ("tracked chain", "regular pass")
     assert [(e.kind, e.index, e.message) for e in a.events] == [(e.kind, e.index, e.message) for e in b.events]
     for e, f in zip(a.events, b.events):
         assert np.allclose(list(e.input.values()), list(f.input.values()), rtol=1e-12, atol=1e-12)
@@ -137,83 +139,57 @@ def test_simulations_are_the_same_with_and_without_the_kernel(name, grid):
     assert np.array_equal(a.assembled, b.assembled)
 
 
-def test_numpy_mode_turns_the_kernel_off():
-    with kernel.use("numpy"):
-        assert not kernel.active()
-        kp = cached_plan(ms.examples.load("crank_rocker"))
-        steps, anchor, origin = regular._program(kp.system, kp.groups)
-        prog = kernel.program_arrays(steps, anchor, origin)
-        assert kernel.run(prog, np.zeros((3, 1)), np.ones(1), 0.05) is None
-        assert isinstance(regular._pass(kp.system, kp.groups, np.zeros((3, 1)), np.ones(1), True), regular._Pass)
+def test_numba_is_imported_by_the_first_sweep_only():
+    """Importing mechsyn (its kinematics, its command line) imports no Numba: a command
+    that runs no sweep does not pay for it; the first sweep does."""
+    code = ("import sys, mechsyn, mechsyn.kinematics, mechsyn.cli.main; assert 'numba' not in sys.modules; "
+            "import mechsyn as ms; ms.examples.load('crank_rocker').simulate(A=(0, 360, 30)); "
+            "assert 'numba' in sys.modules")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    subprocess.run([sys.executable, "-c", code], check=True, env=env, timeout=300)
 
 
-def test_the_environment_is_read_once_and_a_wrong_mode_is_one_clear_error(monkeypatch):
-    from mechsyn.errors import MechsynInputError
-
-    monkeypatch.setattr(kernel, "_MODE", None)  # as in a new process
-    monkeypatch.setenv("MECHSYN_KERNEL", "fastest")
-    with pytest.raises(MechsynInputError, match="MECHSYN_KERNEL='fastest' is not one of auto, numba, numpy"):
-        kernel.active()
-    with pytest.raises(MechsynInputError, match="is not one of"):
-        kernel.use("fastest").__enter__()
-    monkeypatch.setenv("MECHSYN_KERNEL", " NumPy ")
-    assert not kernel.active() and kernel._MODE == "numpy"
-    monkeypatch.setenv("MECHSYN_KERNEL", "auto")  # read once: the first use decided
-    assert not kernel.active()
-
-
-def test_numba_asked_for_without_numba_names_the_extra(monkeypatch):
-    monkeypatch.setattr(kernel, "_MODULE", False)  # as after a failed import of Numba
-    with kernel.use("numba"), pytest.raises(ImportError, match=r'pip install "mechsyn\[fast\]"'):
-        kernel.active()
-
-
-def test_one_shot_commands_keep_the_numpy_pass(monkeypatch):
-    """``mechsyn simulate`` runs one sweep: Numba's load would cost it more than it saves;
-    the setting is the command's only (the caller's mode is as it was)."""
-    from mechsyn.cli.main import ONE_SHOT, main
-
-    monkeypatch.delenv("MECHSYN_KERNEL", raising=False)
-    seen = []
-    import mechsyn.kinematics.regular as reg
-
-    real = reg._pass
-
-    def spy(*a, **k):
-        seen.append(kernel.active())
-        return real(*a, **k)
-
-    monkeypatch.setattr(reg, "_pass", spy)
-    assert "simulate" in ONE_SHOT and "serve" not in ONE_SHOT and "synth" not in ONE_SHOT
-    assert main(["simulate", "examples/kinematics/crank_rocker.yaml", "-i", "A=0:360:10"]) == 0
-    assert seen and not any(seen)
-    assert kernel.active() == (importlib.util.find_spec("numba") is not None)  # the caller's setting again
-
-
-@needs_numba
-@pytest.mark.parametrize("name", ["watt_sixbar", "fourbar", "stephenson_sixbar", "peaucellier", "crank_rocker"])
-def test_fold_masks_compiled_equal_numpy(name):
-    """The fold search's masks (layout, singular rows, assembly changes, a low minimum
-    that sends the chain to the tracked engine) compiled and in NumPy, on passes through
-    dead points, a cell whose change points the pass declines, and one without folds."""
+def _numpy_fold_masks(discs: dict, ks: list, perm: np.ndarray, b: int) -> tuple:
+    """The fold scan's masks in NumPy (the test's oracle): the discriminants laid out
+    (groups, L), the singular rows, the (group, row) pairs after which a group's assembly
+    changes, whether a change point may be near."""
     from mechsyn.kinematics import folds
 
-    m = ms.examples.load(name)
-    kp = cached_plan(m)
+    D = np.stack([discs[k][perm] for k in ks])
+    ok = D > -folds._ZERO_DISC
+    d = np.where(ok, np.maximum(D, 0.0), np.nan)
+    low = folds._low_minima(d)
+    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
+    with np.errstate(invalid="ignore"):
+        singular = (d < folds.SINGULAR_DISC).any(axis=0)
+    return D, singular, np.nonzero(ok[:, 1:] != ok[:, :-1]), bool(low.any())
+
+
+@pytest.mark.parametrize("name", ["watt_sixbar", "fourbar", "stephenson_sixbar", "peaucellier", "crank_rocker"])
+def test_the_kernels_fold_masks_equal_numpys(name):
+    """The fold search's masks (layout, singular rows, assembly changes, a low minimum
+    that sends the chain to the tracked engine) from the kernel and in NumPy, on passes
+    through dead points, a cell whose change points the pass declines, and one without
+    folds."""
+    from mechsyn.kinematics import folds
+
+    kp = cached_plan(ms.examples.load(name))
     S, plan = kp.system, kp.groups
-    steps, anchor, origin = regular._program(S, plan)
     for grid in (np.arange(0.0, 361.0), np.arange(-400.0, 400.0, 3.0)):
         X = np.radians(grid)[:, None]
-        st = regular._run(steps, anchor, X, np.ones(1), folds=True)
+        st = regular._pass(S, plan, X, np.ones(1), folds=True)
         ks = sorted(st.discs)
         M = X.shape[0]
         for split, n0s in ((None, (7,)), (M // 3, (5, 9))):
-            rows = M - sum(n0s)
-            perm, b = folds._pass_layout(rows, split, n0s)
-            a = folds._fold_rows(st.discs, ks, perm, b)
-            c = kernel.fold_rows([st.discs[k] for k in ks], perm, b, folds._ZERO_DISC, folds.SINGULAR_DISC)
-            assert np.array_equal(a[0], c[0], equal_nan=True) and np.array_equal(a[1], c[1])
-            assert all(np.array_equal(x, y) for x, y in zip(a[2], c[2])) and a[3] == c[3]
+            perm, b = folds._pass_layout(M - sum(n0s), split, n0s)
+            want = _numpy_fold_masks(st.discs, ks, perm, b)
+            ng, L = len(ks), perm.shape[0]
+            Dl, singular, chg = np.empty((ng, L)), np.empty(L, np.bool_), np.empty((ng, L - 1), np.bool_)
+            low = kernel._nb().fold_rows(np.array([st.discs[k] for k in ks]), perm, b, folds._ZERO_DISC,
+                                         folds.SINGULAR_DISC, Dl, singular, chg)
+            assert np.array_equal(want[0], Dl, equal_nan=True) and np.array_equal(want[1], singular)
+            assert all(np.array_equal(x, y) for x, y in zip(want[2], np.nonzero(chg))) and want[3] == low
+
 
 
 def test_trig_is_numpys_and_follows_the_inputs() -> None:
@@ -240,26 +216,21 @@ def test_trig_is_numpys_and_follows_the_inputs() -> None:
     assert np.array_equal(kernel.trig([big, path])[0][-2:], np.cos(path))
 
 
-@needs_numba
+
 @pytest.mark.parametrize("name, around", [("fourbar_folded", None), ("fourbar_dead_centre", 30.0),
                                           ("fourbar", None), ("watt_sixbar", None)])
-def test_compiled_poses_blank_the_fold_scans_singular_rows(name, around):
-    """Through folds the compiled poses blank the rates of the rows the fold scan finds
+def test_the_kernels_poses_blank_the_fold_scans_singular_rows(name, around):
+    """Through folds the kernel's poses blank the rates of the rows the fold scan finds
     singular (a group folded flat on a row) and count them: the same rows, NaN rates and
-    events as the NumPy pass, which blanks them after its poses; the sweep's rows with
-    rates are its finite ones and its singular rows (when it knows them) the assembled
-    rows without rates."""
+    events as the tracked chain; the sweep's rows with rates are its finite ones and its
+    singular rows (when it knows them) the assembled rows without rates."""
     m = ms.examples.load(name)
     kp = cached_plan(m)
     drive = kp.system.drivers[0]
     u0 = np.degrees(drive.assembled)
     grid = np.arange(0.0, 361.0, 1.0) if around is None else u0 + np.arange(-around, around + 0.25, 0.5)
-    sims = {}
-    for mode in ("numpy", "auto"):
-        with kernel.use(mode):
-            sims[mode] = ms.simulate(m, {drive.joint: grid})
-    a, b = sims["numpy"], sims["auto"]
-    assert a.engine == b.engine == "regular pass"
+    a, b = (ms.simulate(m, {drive.joint: grid}, method=e) for e in ("tracked chain", "regular pass"))
+    assert (a.engine, b.engine) == ("tracked chain", "regular pass")
     assert [(e.kind, e.index) for e in a.events] == [(e.kind, e.index) for e in b.events]
     sw = b.sweep
     finite = np.isfinite(sw.qd).all(axis=1) & np.isfinite(sw.qdd).all(axis=1)

@@ -16,9 +16,7 @@ import time
 #: from here, its own imports included.
 STARTED = time.perf_counter()
 
-import contextlib  # noqa: E402
 import importlib  # noqa: E402
-import os  # noqa: E402
 import re  # noqa: E402
 import signal  # noqa: E402
 import sys  # noqa: E402
@@ -127,14 +125,6 @@ def handle_sigterm() -> Any:
     return None
 
 
-#: Commands that run a sweep or a few: importing and loading Numba's compiled pass
-#: (:mod:`mechsyn.kinematics.kernel`, about 0.4 s) costs them more than it saves, so they
-#: run the NumPy pass unless ``MECHSYN_KERNEL`` says otherwise; ``serve``, ``synth`` and
-#: ``curves`` (thousands of sweeps) use the compiled one when Numba is installed.
-ONE_SHOT = frozenset({"analyze", "schema", "structure", "simulate", "forces", "capability", "atlas", "belt",
-                      "convert", "export", "examples"})
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; bad input exits with status 2 and one message.
 
@@ -146,10 +136,9 @@ def main(argv: list[str] | None = None) -> int:
     if argv is not None:  # called in-process (not as the console script): its time counts from now
         STARTED = time.perf_counter()
     try:
-        pass_ = _pass_for(argv)  # its imports (NumPy) before the handlers: not cut in half by a signal
         previous = handle_sigterm()
         try:
-            return _main(argv, pass_)
+            return _main(argv)
         finally:
             if previous is not None:
                 signal.signal(signal.SIGTERM, previous)
@@ -186,22 +175,9 @@ def interrupted(exc: BaseException | None) -> bool:
     return False
 
 
-def _pass_for(argv: list[str] | None) -> Any:
-    """The regular pass of this command: the NumPy one for the :data:`ONE_SHOT` commands
-    (for this command only: an in-process caller keeps its own), unless
-    ``MECHSYN_KERNEL`` says."""
-    args = sys.argv[1:] if argv is None else argv
-    if "MECHSYN_KERNEL" in os.environ or not args or args[0] not in ONE_SHOT:
-        return contextlib.nullcontext()
-    from mechsyn.kinematics import kernel  # these commands import NumPy anyway
-
-    return kernel.use("numpy")
-
-
-def _main(argv: list[str] | None, pass_: Any) -> int:
+def _main(argv: list[str] | None) -> int:
     try:
-        with pass_:
-            status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
+        status = build_cli().main(args=argv, prog_name="mechsyn", standalone_mode=False)
     except KeyboardInterrupt:
         status = _INTERRUPTED
     except MechsynInputError as error:

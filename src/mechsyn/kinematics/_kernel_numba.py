@@ -1,11 +1,10 @@
 """The regular pass's arithmetic compiled with Numba (imported only through
-:mod:`mechsyn.kinematics.kernel`, only when Numba is installed: ``pip install mechsyn[fast]``).
+:mod:`mechsyn.kinematics.kernel`, on the first sweep). Under ``NUMBA_DISABLE_JIT=1`` the
+same functions run as plain Python (CI measures the kernel's coverage that way).
 
 The chain's steps one after the other, each over all rows in one compiled loop (the
 step's constants held in registers, no temporaries, the joints' and links' states as
-complex arrays by row): the same operations in the same order as
-:class:`mechsyn.kinematics.regular._Pass` does on its arrays, so the same numbers to a few
-units in the last place (tests compare the two on every example). The program is the
+complex arrays by row). The program is the
 regular pass's (:func:`mechsyn.kinematics.regular._program`) as arrays
 (:func:`mechsyn.kinematics.kernel.program_arrays`). Step by step over all rows is 30 %
 faster than row by row over all steps (crank-rocker 24 -> 17 us, Watt six-bar 40 -> 28 us
@@ -20,16 +19,16 @@ import numpy as np
 from numba import njit
 
 #: Numba options: compiled once per machine and kept (``cache``), NumPy's floating-point
-#: rules (a division by zero gives inf, a square root of a negative number NaN, as the
-#: NumPy pass), the GIL released (the studio's threads).
+#: rules (a division by zero gives inf, a square root of a negative number NaN, as
+#: NumPy's), the GIL released (the studio's threads).
 _OPTIONS = dict(cache=True, nogil=True, error_model="numpy")
 
 
 @njit(inline="always", **_OPTIONS)
-def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M):  # pragma: no cover
+def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M):
     """Position, velocity, acceleration (rows ``M``) of the local point ``s`` of link
     ``i`` (-1: the frame) from the link's anchor joint into ``outP``, ``outV``, ``outA``:
-    ``regular._Pass.point``."""
+    ``P = P_a + z (s - s_a)``, ``V = V_a + i w (P - P_a)``, ``A = A_a + (i al - w^2) (P - P_a)``."""
     if i < 0:
         for r in range(M):
             outP[r] = s
@@ -49,10 +48,9 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
 
 
 @njit(**_OPTIONS)
-def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z):  # pragma: no cover
+def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z):
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
-    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's, as the NumPy pass
-    takes them); fill every link's rotation and its origin's position, velocity and
+    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's); fill every link's rotation and its origin's position, velocity and
     acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
     (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
     has rows (2, links, P), :func:`_planes`. Returns True when a group's discriminant
@@ -152,7 +150,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
 
 
 @njit(inline="always", **_OPTIONS)
-def _planes(lz, Z):  # pragma: no cover - compiled
+def _planes(lz, Z):
     """The rotations ``lz`` (links, M) complex as planes ``Z`` (2, links, P), real and
     imaginary parts of the first P <= M rows: NumPy's ``arctan2`` of the links' angles
     reads contiguous rows a third faster than the complex array's strided parts, with the
@@ -165,7 +163,7 @@ def _planes(lz, Z):  # pragma: no cover - compiled
 
 
 @njit(inline="always", **_OPTIONS)
-def _near(a, ref):  # pragma: no cover - compiled
+def _near(a, ref):
     """``ref + wrap(a - ref)``: the angle ``a`` moved by whole turns next to ``ref``
     (``wrap`` to [-pi, pi) by the floored remainder, as ``np.remainder``). With ``a`` an
     ``atan2`` and ``ref`` within half a turn, ``a - ref + pi`` lies in [-pi, 3 pi]: the
@@ -183,7 +181,7 @@ def _near(a, ref):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok, sb, sf, rok):  # pragma: no cover
+def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok, sb, sf, rok):
     """The pose rows ``q, qd, qdd`` (3 links, N; component-major) of the first N rows of a
     pass (``C``, ``W``, ``AL`` of :func:`regular_pass`): each link's origin, its angle and
     their rates. A link turned by a frame driver (``dcol[i]`` its input's column, ``dsgn``
@@ -269,7 +267,7 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
 
 
 @njit(inline="always", **_OPTIONS)
-def _blank_rows(C, q, qd, qdd, ok, sb, sf, rok):  # pragma: no cover - compiled
+def _blank_rows(C, q, qd, qdd, ok, sb, sf, rok):
     """:func:`link_poses`' blanking through folds: the rows not assembled (``ok``) in the
     poses and the links' states, the rates of the rows where they are not finite or that
     the fold scan found singular (``sb``, ``sf``); the rows with rates into ``rok``.
@@ -304,7 +302,7 @@ def _blank_rows(C, q, qd, qdd, ok, sb, sf, rok):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg):  # pragma: no cover - compiled
+def fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg):
     """The regular pass's discriminants ``Dp`` (groups, pass rows) laid out in the tracked
     sweeps' order ``perm`` into ``Dl`` (groups, L), the rows where some assembled group is
     within ``sing`` of folding flat (``singular`` (L,)), the rows after which a group's
@@ -343,7 +341,7 @@ def fold_rows(Dp, perm, b, zero, sing, Dl, singular, chg):  # pragma: no cover -
 
 
 @njit(**_OPTIONS)
-def point_states(C, w, al, idx, s, out):  # pragma: no cover - compiled
+def point_states(C, w, al, idx, s, out):
     """Position, velocity, acceleration ``out`` (3, m, N) complex of the local points ``s``
     (m,) of the links ``idx`` (m,) from the links' states ``C`` (4, links, N) and rates
     ``w``, ``al`` (links, N): :meth:`mechsyn.kinematics.regular.LinkStates.points`'
@@ -361,7 +359,7 @@ def point_states(C, w, al, idx, s, out):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):  # pragma: no cover - compiled
+def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):
     """The normalised discriminant of step ``k`` (an RRR group) of the program at one input
     ``u`` (k inputs), every group upstream in the program's (drawn) mode and placed as
     :func:`mechsyn.kinematics.folds._scalar_disc` places it (a group folded within
@@ -410,14 +408,14 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):  # pragma: no cover - compiled
 
 
 @njit(inline="always", **_OPTIONS)
-def _pos(w, i, b):  # pragma: no cover - compiled
+def _pos(w, i, b):
     """The layout column of row ``i`` of tracked sweep ``w`` (0 forwards from ``b``, 1
     backwards from ``b - 1``)."""
     return b + i if w == 0 else b - 1 - i
 
 
 @njit(inline="always", **_OPTIONS)
-def _scan_row(X, perm, b, w, i, n0, shift, out):  # pragma: no cover - compiled
+def _scan_row(X, perm, b, w, i, n0, shift, out):
     """Row ``i`` of tracked sweep ``w`` into ``out``: its connecting path's row (``i <
     n0``), else the sweep's row shifted by the whole turns ``shift``
     (:func:`mechsyn.kinematics.folds.pass_fold_events`' ``row``)."""
@@ -427,7 +425,7 @@ def _scan_row(X, perm, b, w, i, n0, shift, out):  # pragma: no cover - compiled
 
 
 @njit(**_OPTIONS)
-def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):  # pragma: no cover - compiled
+def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):
     """:func:`scalar_disc` of step ``k`` at the input ``xa + t d`` (the numbers of
     :func:`mechsyn.kinematics.folds._disc_line` compiled)."""
     u = np.empty(xa.shape[0])
@@ -437,7 +435,7 @@ def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):  # pragma: no cover - co
 
 
 @njit(**_OPTIONS)
-def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):  # pragma: no cover - compiled
+def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):
     """:func:`mechsyn.kinematics.folds._fold_root` (xtol 1e-14) on :func:`_disc_along`:
     the zero ``t`` in [a, b] of step ``k``'s discriminant, ``f(a) = fa``, ``f(b) = fb``;
     NaN when the ends do not bracket a zero."""
@@ -470,7 +468,7 @@ def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):  # pragma: no 
 
 
 @njit(**_OPTIONS)
-def _four_bar_t(spec, ua, ub):  # pragma: no cover - compiled
+def _four_bar_t(spec, ua, ub):
     """:func:`mechsyn.kinematics.folds._four_bar_fold` from its group's numbers
     ``spec`` (:func:`mechsyn.kinematics.folds._four_bar_numbers`: a four-bar or not,
     ``|v|``, ``|w|``, ``arg w - arg v``, the input's sign, the two squared distances): t
@@ -500,7 +498,7 @@ def _four_bar_t(spec, ua, ub):  # pragma: no cover - compiled
 
 @njit(**_OPTIONS)
 def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip, fp, anc_j, anc_s,
-              nj):  # pragma: no cover - compiled
+              nj):
     """:func:`mechsyn.kinematics.folds.pass_fold_events` in one call: the masks of
     :func:`fold_rows` (the discriminants ``Dp`` (groups, pass rows) laid out by ``perm``),
     then each tracked sweep's scan (:func:`mechsyn.kinematics.folds._fold_scan`, the

@@ -261,38 +261,20 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     """The Sweep of the regular pass through folds: the tracked sweeps' singular rows
     (rates not defined) and events, forwards and backwards from row ``k`` when the drawn
     input values lie inside the sweep."""
-    (sing, ev), *back = res.parts
+    (_, ev), *back = res.parts
     q, qd, qdd = res.q, res.qd, res.qdd
-    rates_ok = res.rates_ok  # from the compiled pass: the singular rows already blanked
-    if rates_ok is None:
-        _blank_singular(qd, qdd, sing if not back else np.concatenate([back[0][0][::-1], sing]))
-        # rates NaN on whole rows (Folded's rows, and the singular ones): one coordinate tells a row
-        rates_ok = np.isfinite(qd.T[0]) & np.isfinite(qdd.T[0])
-    ok = res.assembled  # from the compiled pass; else rows of coordinates (q.T) reduce fastest
-    if ok is None:
-        ok = np.isfinite(q.T).all(axis=0)
+    rates_ok, ok = res.rates_ok, res.assembled  # the singular rows already blanked
     nan = np.empty((2, U.shape[0]))
     nan.fill(np.nan)
     sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine, rates_ok=rates_ok,
                nan_rows=True, links=res.links,
-               singular_rows=[] if res.rates_ok is not None and not res.singular else None)
+               singular_rows=None if res.singular else [])
     if not back:
         sw.events = _tracked_events(ev, bool(ok[0]), U[0])
     else:
         sw.events = merged_events(k, _tracked_events(back[0][1], bool(ok[k - 1]), U[k - 1]),
                                   _tracked_events(ev, bool(ok[k]), U[k]))
     return sw
-
-
-def _blank_singular(qd: np.ndarray, qdd: np.ndarray, sing: np.ndarray) -> None:
-    """NaN into the rates (N, n) of the rows ``sing`` (N,), where a group is folded flat."""
-    rows = np.flatnonzero(sing)
-    if 0 < rows.size <= 8:  # a few rows: row by row is faster
-        for r in rows.tolist():
-            qd[r] = qdd[r] = np.nan
-    elif rows.size:
-        qd[rows] = np.nan
-        qdd[rows] = np.nan
 
 
 def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_input: np.ndarray) -> list[Event]:

@@ -1,7 +1,7 @@
 """The fold search of a tracked sweep: where a group's assembly ends (a dead point, a
 limit of the working range) and starts again, from the groups' normalised discriminants
-(:func:`fold_events`; the regular pass's :func:`pass_fold_events`, compiled in
-:func:`mechsyn.kinematics.kernel.fold_scan` when Numba is installed), each fold refined
+(:func:`fold_events`; the regular pass's :func:`pass_fold_events`, by the kernel's
+:func:`mechsyn.kinematics.kernel.fold_scan`), each fold refined
 on its discriminant along the input segment (a closed form where the group closes a
 four-bar, :func:`_four_bar_fold`; else secant steps, :func:`_fold_root`) and the folds
 hidden behind an upstream group's (:func:`_hidden_fold`). The branch tracking
@@ -270,9 +270,8 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     a change point may be near).
 
     The pass's rows are read once, laid out so that each sweep's rows follow each other
-    (the backward sweep from right to left, then the forward one): one comparison finds
-    every row where a group's assembly changes, and :func:`_fold_scan` reads only those;
-    after a compiled pass all of it runs compiled (:func:`_compiled_fold_events`;
+    (the backward sweep from right to left, then the forward one), and the kernel scans
+    them (:func:`mechsyn.kinematics.kernel.fold_scan`, the decisions of :func:`_fold_scan`;
     ``pass_rows``: the pass's input rows, ``U`` then the paths, when at hand; ``block``:
     the discriminants as rows of one array, in the order of their steps, when at hand).
     """
@@ -280,49 +279,16 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    program = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: the whole scan compiled
-    if program is not None and program[0] is plan and kernel.active():
-        X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
-        return _compiled_fold_events(S, plan, program[1], [discs[k] for k in ks] if block is None else block, ks,
-                                     perm, b, X, paths)
-    D, singular, (gs, js), low = _fold_rows(discs, ks, perm, b)
-    if low:
-        return None
-    # the sweeps: forwards from Y[b] (the path first), backwards from Y[b - 1]
-    sweeps = [(1, paths[0], U if split is None else U[split:])]
-    sweeps += [] if split is None else [(-1, paths[1], U[split - 1::-1])]
-    changes: list = [[[] for _ in ks] for _ in sweeps]
-    for g, j in zip(gs.tolist(), js.tolist()):
-        if j >= b:
-            changes[0][g].append(j + 1 - b)
-        elif j < b - 1:
-            changes[1][g].append(b - 1 - j)
-    for ch in changes[1:]:  # found right to left: the backward sweep's rows in its order
-        for rows in ch:
-            rows.reverse()
-    out = []
-    for (way, (path, shift), V), ch in zip(sweeps, changes):
-        n0, sh = path.shape[0], shift.tolist()
-
-        def row(i: int, path=path, sh=sh, V=V, n0=n0) -> list:  # the numbers of V[i - n0] - shift
-            return path[i].tolist() if i < n0 else [x - s for x, s in zip(V[i - n0].tolist(), sh)]
-
-        def val(g: int, i: int, way=way) -> float:
-            return float(D[g, b + i if way > 0 else b - 1 - i])
-
-        found, _ = _fold_scan(S, plan, ks, sigmas, row, val, ch, n0)
-        events = []
-        for i, kind, message, u, group in found:
-            index, message, u, before = _swept(i, message, u, n0, sh)
-            events.append(Event(index, kind, message, u, group, before_sweep=before))
-        out.append((singular[b + n0:] if way > 0 else singular[b - n0 - 1::-1], events))
-    return out
+    program = _memo(S)[("kernel", id(plan))][1]  # the pass's program (regular._program keeps it)
+    X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
+    return _compiled_fold_events(S, plan, program, [discs[k] for k in ks] if block is None else block, ks,
+                                 perm, b, X, paths)
 
 
 def _compiled_fold_events(S: PlanarSystem, plan: Plan, program: tuple, discs: list, ks: list, perm: np.ndarray,
                           b: int, X: np.ndarray, paths: list) -> list | None:
-    """:func:`pass_fold_events` after a compiled pass (``program``: its arrays, ``X``: its
-    input rows): the scan compiled (:func:`mechsyn.kinematics.kernel.fold_scan`)."""
+    """:func:`pass_fold_events` by the kernel (``program``: the pass's arrays, ``X``: its
+    input rows; :func:`mechsyn.kinematics.kernel.fold_scan`)."""
     steps, names, messages = _topology(S, plan, "fold scan", lambda: _fold_words(plan, ks))
     memo = _memo(S)
     specs = memo.get(("four-bar folds", id(plan)))  # this geometry's closed-form fold numbers per group
@@ -358,23 +324,6 @@ def _four_bar_numbers(spec: tuple | None) -> tuple:
         return (0.0,) * 7
     v, w, sgn, targets = spec
     return (1.0, abs(v), abs(w), math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real), sgn, *targets)
-
-
-def _fold_rows(discs: dict, ks: list, perm: np.ndarray, b: int) -> tuple:
-    """The masks of :func:`pass_fold_events` in NumPy (:func:`mechsyn.kinematics.kernel.fold_rows`
-    compiled): the discriminants laid out (groups, L), the singular rows, the (group,
-    row) pairs after which a group's assembly changes, whether a change point may be near."""
-    D = np.empty((len(ks), len(perm)))
-    for g, k in enumerate(ks):
-        discs[k].take(perm, out=D[g])
-    ok = D > -_ZERO_DISC
-    d = np.where(ok, np.maximum(D, 0.0), np.nan)  # as touch_candidates reads it
-    low = _low_minima(d)
-    low[:, max(b - 2, 0):b] = False  # the sweeps' first rows (Y[b - 1], Y[b]) are no inner rows
-    singular = d[0] < SINGULAR_DISC  # some group assembled with D < SINGULAR_DISC
-    for row in d[1:]:
-        singular |= row < SINGULAR_DISC
-    return D, singular, np.nonzero(ok[:, 1:] != ok[:, :-1]), bool(low.any())
 
 
 @functools.lru_cache(maxsize=64)

@@ -1,27 +1,26 @@
-"""The compiled kernel of the regular pass (issue 30): the same program and the same
-arithmetic as :class:`mechsyn.kinematics.regular._Pass`, row by row in compiled code
-instead of array by array, when Numba is installed (``pip install mechsyn[fast]``).
+"""The kernel of the planar closed-form sweep (issue 30, one kernel since issue 37): the
+regular pass's program run by Numba-compiled functions
+(:mod:`mechsyn.kinematics._kernel_numba`), row by row in compiled code.
 
-The regular pass (:func:`mechsyn.kinematics.regular.sweep_through_folds`) spends, in
-NumPy, a few dozen array operations per group; on a sweep of a few hundred rows that is
-most of a ``simulate`` call. Compiled, one row of a six-bar is a few hundred floating-point
-operations with no temporaries. The kernel is not another engine: it runs the regular
-pass's own program (:func:`program_arrays` writes it as integer and complex arrays), gives
-the same discriminants, rotations and joint states, and the engine around it (fold
-events, angles, results) is unchanged. Without Numba, or with the environment variable
-``MECHSYN_KERNEL=numpy`` (read at the first sweep of the process) or within
-:func:`use` ``("numpy")``, the NumPy pass runs; tests run both and compare them (they
-agree to round-off: a few units in the last place, more near a fold).
+The regular pass (:func:`mechsyn.kinematics.regular.sweep_through_folds`) is a program of
+drive ops and RRR group ops (:func:`program_arrays` writes it as integer and complex
+arrays); :func:`run` runs it over the input rows and returns one record: every link's
+rotation and its origin's position, velocity and acceleration, the links' rates, the
+groups' normalised discriminants and whether one came near a fold. The fold scan
+(:func:`fold_scan`), the links' poses (:func:`link_poses`) and named points
+(:func:`point_states`) read that record. There is one implementation: the compiled
+functions are plain Python functions under ``NUMBA_DISABLE_JIT=1`` (CI measures their
+line coverage that way, .ci/steps/25-kernel.sh).
 
-Numba compiles the kernel on its first use on a machine (a few seconds) and keeps the
-machine code beside the module (``__pycache__``); later processes load it (about 0.1 s,
-plus 0.3 s to import Numba): a one-shot command pays that once, a studio or a synthesis
-loop over thousands of designs gains on every call.
+Numba is a required dependency. It is imported on the first sweep, not when mechsyn
+is imported: it compiles the kernel on its first use on a machine (a few seconds) and
+keeps the machine code beside the module (``__pycache__``); later processes load it
+(about 0.1 s, plus 0.3 s to import Numba).
 
 Examples
 --------
 The crank-rocker's program is a driver and one RRR group; run over two crank angles it
-gives the group's normalised discriminant per row (None when the kernel is off):
+gives the group's normalised discriminant per row:
 
 >>> import numpy as np
 >>> import mechsyn as ms
@@ -32,90 +31,25 @@ gives the group's normalised discriminant per row (None when the kernel is off):
 >>> prog[0][0][:, 0].tolist()  # the steps' ops: 0 a driver, 1 an RRR group
 [0, 1]
 >>> out = run(prog, np.radians([[0.0], [90.0]]), np.ones(1), 0.05)
->>> out is None or (out[3].shape == (1, 2) and not out[4])
-True
+>>> out[3].shape, out[4]
+((1, 2), False)
 """
 
 from __future__ import annotations
 
-import contextlib
 import importlib
-import os
 import threading
-from collections.abc import Iterator
 from types import ModuleType
 
 import numpy as np
 
-from mechsyn._extras import missing
-from mechsyn.errors import MechsynInputError
-
-__all__ = ["MODES", "active", "fold_rows", "fold_scan", "link_poses", "point_states", "program_arrays", "run", "trig",
-           "use", "warm"]
-
-_MODULE: ModuleType | None | bool = None  # the compiled module; False: not available
-_MODE: str | None = None  # the mode in force: MECHSYN_KERNEL read at the first use, or set by use()
+__all__ = ["fold_scan", "link_poses", "point_states", "program_arrays", "run", "trig", "warm"]
 
 
-#: The values of ``MECHSYN_KERNEL``: ``auto`` (the default) compiled when Numba is
-#: installed, ``numba`` compiled or an error naming the extra, ``numpy`` never compiled.
-MODES = ("auto", "numba", "numpy")
-
-
-def _checked(mode: str) -> str:
-    mode = mode.strip().lower() or "auto"
-    if mode not in MODES:
-        raise MechsynInputError(f"MECHSYN_KERNEL={mode!r} is not one of {', '.join(MODES)}",
-                                field="MECHSYN_KERNEL", hint="unset it, or set auto, numba or numpy")
-    return mode
-
-
-def _compiled() -> ModuleType | None:
-    """The Numba module (:mod:`mechsyn.kinematics._kernel_numba`), imported on first use;
-    None without Numba (``auto``) or in the mode ``numpy``. The mode is ``MECHSYN_KERNEL``
-    as it is at the first use in the process (read once: a sweep is microseconds), or
-    what :func:`use` sets."""
-    global _MODULE, _MODE
-    mode = _MODE
-    if mode is None:
-        mode = _MODE = _checked(os.environ.get("MECHSYN_KERNEL", "auto"))
-    if mode == "numpy":
-        return None
-    if _MODULE is None:
-        try:
-            _MODULE = importlib.import_module("mechsyn.kinematics._kernel_numba")
-        except ImportError:
-            _MODULE = False
-    if not _MODULE and mode == "numba":
-        raise missing("numba", "MECHSYN_KERNEL=numba (the compiled regular pass)")
-    return _MODULE or None
-
-
-@contextlib.contextmanager
-def use(mode: str) -> Iterator[None]:
-    """The regular pass compiled or not within the block (``mode``: auto, numba or numpy;
-    for the whole process, every thread), the mode before it after: one-shot commands
-    run the NumPy pass this way (:data:`mechsyn.cli.main.ONE_SHOT`).
-
-    Examples
-    --------
-    >>> with use("numpy"):
-    ...     active()
-    False
-    """
-    global _MODE
-    new = _checked(mode)
-    old = _MODE
-    _MODE = new
-    try:
-        yield
-    finally:
-        _MODE = old
-
-
-def active() -> bool:
-    """Whether the regular pass runs compiled (Numba installed, the mode not ``numpy``)."""
-    return _compiled() is not None
+def _nb() -> ModuleType:
+    """The compiled functions (:mod:`mechsyn.kinematics._kernel_numba`), imported on the
+    first sweep: importing Numba costs a one-shot command that runs no sweep nothing."""
+    return importlib.import_module("mechsyn.kinematics._kernel_numba")
 
 
 #: A four-bar with two dead points and a coupler point (crank sqrt 5, coupler and rocker
@@ -133,10 +67,7 @@ _WARM_FOURBAR = {
 def warm() -> bool:
     """Import Numba and compile (or load from its cache) the kernel's functions now, by
     sweeping a four-bar through its dead points, so that the first sweep a user asks for
-    does not wait for them (the studio calls this while it starts). False when the
-    kernel is off."""
-    if _compiled() is None:
-        return False
+    does not wait for them (the studio calls this while it starts). Returns True."""
     from mechsyn.io import mechanism_from_dict
 
     mechanism_from_dict(_WARM_FOURBAR, source="kernel.warm").simulate(A=(0, 360, 30))
@@ -187,7 +118,7 @@ def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None 
     return shape, fp, anc_s
 
 
-def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple | None:
+def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple:
     """The compiled pass over the input rows ``X`` (M, k), or over the blocks of rows
     ``X`` (a list: the sweep, then the connecting paths) one after the other: ``(C, W,
     AL, D, near)``, every link's rotation and its origin's position, velocity,
@@ -195,11 +126,7 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     groups' normalised discriminants (groups, M), and whether one falls below ``least``;
     with ``planes`` (a number of rows, at most M) also the rotations' real and imaginary
     parts in the first ``planes`` rows (2, links, planes) (contiguous rows for
-    :func:`link_poses`' ``arctan2``); None without the kernel. The inputs' cosines and
-    sines are :func:`trig`'s."""
-    mod = _compiled()
-    if mod is None:
-        return None
+    :func:`link_poses`' ``arctan2``). The inputs' cosines and sines are :func:`trig`'s."""
     (ip, anc_j, org_j, nj, groups), fp, anc_s = program
     CS, SN = trig(X if isinstance(X, list) else [X])
     M, nl = CS.shape[0], anc_j.shape[0]
@@ -207,7 +134,7 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     R = np.empty((2 * nl + len(groups), M))  # W, AL and D: rows of one block (contiguous views)
     W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
     Z = np.empty((2, nl, min(planes, M)) if planes else (2, 0, 0))
-    near = mod.regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float), nj,
+    near = _nb().regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float), nj,
                             least, C, W, AL, D, Z)
     return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
 
@@ -311,7 +238,7 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
         sb = parts[1][0][::-1] if len(parts) > 1 else sf[:0]
     else:
         sf = sb = _NO_ROWS
-    singular = _compiled().link_poses(C, W, AL, N, U if U.flags.c_contiguous and U.dtype == _F64 else
+    singular = _nb().link_poses(C, W, AL, N, U if U.flags.c_contiguous and U.dtype == _F64 else
                                       np.ascontiguousarray(U, float), dcol, dsgn, ref, -1 if split is None else split,
                                       folds, A, q, qd, qdd, ok[0], sb, sf, ok[1])
     return q, qd, qdd, ok[0], ok[1] if folds else None, singular
@@ -323,23 +250,8 @@ _NO_ROWS = np.zeros(0, np.bool_)
 _F64 = np.dtype(float)
 
 
-def fold_rows(discs: list, perm: np.ndarray, b: int, zero: float, singular_disc: float) -> tuple | None:
-    """:func:`mechsyn.kinematics.folds.pass_fold_events`'s masks compiled: the
-    discriminants ``discs`` (one array per group, the pass's rows) laid out by ``perm``
-    (groups, L), the singular rows (L,), the (group, row) pairs after which a group's
-    assembly changes, and whether a change point may be near (a low local minimum);
-    None without the kernel."""
-    mod = _compiled()
-    if mod is None:
-        return None
-    ng, L = len(discs), perm.shape[0]
-    Dl, singular, chg = np.empty((ng, L)), np.empty(L, np.bool_), np.empty((ng, max(L - 1, 0)), np.bool_)
-    low = mod.fold_rows(np.array(discs), perm, b, zero, singular_disc, Dl, singular, chg)
-    return Dl, singular, np.nonzero(chg), bool(low)
-
-
 def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
-              specs: np.ndarray, zero: float, singular_disc: float) -> tuple | None:
+              specs: np.ndarray, zero: float, singular_disc: float) -> tuple:
     """:func:`mechsyn.kinematics.folds.pass_fold_events` compiled in one call
     (:func:`mechsyn.kinematics._kernel_numba.fold_scan`): the masks of :func:`fold_rows`
     and the tracked sweeps' folds (refined on the discriminant of the regular pass's
@@ -347,27 +259,20 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     ``X``: the pass's input rows; ``paths``: the sweeps'
     ``(path, shift)``; ``ks``: the groups' steps; ``specs``: their closed-form fold
     numbers. Returns whether a change point may be near, the singular rows in the layout
-    ``perm`` and the events as rows (sweep, row, kind, group, input...); None without
-    the kernel."""
-    mod = _compiled()
-    if mod is None:
-        return None
+    ``perm`` and the events as rows (sweep, row, kind, group, input...)."""
     (ip, anc_j, _, nj, _), fp, anc_s = program
     (pa, sa), (pb, sb) = paths[0], paths[-1]
     if sa.flags.writeable or sb.flags.writeable:  # one array type for both (tracking_path's are read-only)
         sa, sb = np.array(sa, float), np.array(sb, float)
     D = discs if isinstance(discs, np.ndarray) else np.array(discs)
-    return mod.fold_scan(D, perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0], sb, ks, specs,
+    return _nb().fold_scan(D, perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0], sb, ks, specs,
                          ip, fp, anc_j, anc_s, nj)
 
 
-def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray | None:
+def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
     """Position, velocity, acceleration (3, m, N) complex of the local points ``s`` (m,
     complex) of the links ``idx`` from the links' states (``C`` (4, links, N), rates ``w``,
-    ``al`` (links, N)), compiled; None without the kernel."""
-    mod = _compiled()
-    if mod is None:
-        return None
+    ``al`` (links, N))."""
     out = np.empty((3, idx.shape[0], C.shape[2]), complex)
-    mod.point_states(C, w, al, idx, s, out)
+    _nb().point_states(C, w, al, idx, s, out)
     return out

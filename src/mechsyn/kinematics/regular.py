@@ -36,8 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
-from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology, circle_circle, normalised_disc
+from mechsyn.kinematics.chain import _chain_program, _drive_links
+from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.folds import pass_fold_events
@@ -53,23 +53,22 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
     topology only: it is kept in ``S.cache["programs"]``, which
     :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of one
     topology, so a refilled system's program is its numbers put in (:func:`_filled`).
-    With the kernel, the same numbers are written once more as the compiled pass's
-    arrays (:func:`~mechsyn.kinematics.kernel.program_arrays`' ``fp`` and ``anc_s``, kept
-    under ``("kernel", id(plan))``) while they are filled in, not read back off the steps."""
+    The same numbers are written once more as the kernel's arrays
+    (:func:`~mechsyn.kinematics.kernel.program_arrays`' ``fp`` and ``anc_s``, kept under
+    ``("kernel", id(plan))``) while they are filled in, not read back off the steps."""
     memo = _memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
-    rows: list | None = [] if kernel.active() else None
+    rows: list = []
     out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)), rows)
     memo[key] = (plan, out)
-    if rows is not None:  # (the integers of the kernel's program are the topology's)
-        steps, anchor, origin = out
-        shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
-        rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
-        flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
-        memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
+    steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
+    shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
+    rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
+    flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
+    memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
     return out
 
 
@@ -111,10 +110,10 @@ def _locals(S: PlanarSystem, li: list, pj: list) -> list:
     return frame_points(S.frames(), li, [pts[k] for k in pj])
 
 
-def _filled(S: PlanarSystem, shape: tuple, rows: list | None = None) -> tuple:
+def _filled(S: PlanarSystem, shape: tuple, rows: list) -> tuple:
     """:func:`_program` of ``S`` from its topology's shape (:func:`_shape`): the local
     points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
-    with ``rows`` (a list), each step's row of the kernel's ``fp``
+    each step's row of the kernel's ``fp``
     (:func:`~mechsyn.kinematics.kernel.program_arrays`' layout) appended to it, flat."""
     steps_, anchors, origin, li, pj, drawn = shape
     loc = _locals(S, li, pj)
@@ -123,8 +122,7 @@ def _filled(S: PlanarSystem, shape: tuple, rows: list | None = None) -> tuple:
     for st, ks in zip(steps_, drawn):
         if st[0] == "drive":
             steps.append(st[:6] + (s_k := complex(*loc[st[6]]),))
-            if rows is not None:
-                rows += (st[5], s_k, 0j, 0j, 0j, 0j, 0j)
+            rows += (st[5], s_k, 0j, 0j, 0j, 0j, 0j)
             continue
         _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
         (x1, y1), (x2, y2), (x3, y3), (x4, y4) = loc[i1], loc[i2], loc[i3], loc[i4]
@@ -137,113 +135,8 @@ def _filled(S: PlanarSystem, shape: tuple, rows: list | None = None) -> tuple:
         num = (sigma, complex(ux / L1s, -(uy / L1s)), complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]),
                complex(*loc[k3]))
         steps.append(("RRR", known, links, joints, L1s, L2s) + num)
-        if rows is not None:
-            rows += (complex(L1s, L2s), 0j) + num
+        rows += (complex(L1s, L2s), 0j) + num
     return steps, {i: (jid, complex(*loc[k])) for i, (jid, k) in anchors.items()}, origin
-
-
-class _Pass:
-    """The joints' and links' states of one regular pass (rows ``M``)."""
-
-    def __init__(self, M: int, anchor: dict) -> None:
-        self.M, self.anchor = M, anchor
-        self.joint: dict[str, tuple] = {}  # id -> (P, V, A): complex arrays or numbers
-        self.link: dict[int, tuple] = {}   # link -> (e^{i phi}, omega, alpha)
-        self.discs: dict[int, np.ndarray] = {}  # step -> the group's normalised discriminant
-        self.near = False  # a group came near a fold (below REGULAR_DISC)
-
-    def point(self, i: int, s: complex) -> tuple:
-        """State of the local point ``s`` of link ``i`` (the frame: -1)."""
-        if i < 0:
-            return s, 0j, 0j
-        jid, sa = self.anchor[i]
-        P, V, A = self.joint[jid]
-        z, w, al = self.link[i]
-        rel = z * (s - sa)
-        if (not isinstance(w, np.ndarray) and isinstance(al, float) and al == 0.0
-                and not isinstance(V, np.ndarray) and V == 0 and not isinstance(A, np.ndarray) and A == 0):
-            # a link turned at constant speed about a frame pivot (a crank): two products
-            return rel + P, rel * (1j * w), rel * (-w * w)
-        iw_rel = rel * 1j
-        acc = iw_rel * al if not isinstance(al, float) or al != 0.0 else None
-        iw_rel *= w
-        Pn = rel + P
-        Vn = iw_rel + V
-        rel *= w * w
-        An = A - rel if acc is None else (acc - rel) + A
-        return Pn, Vn, An
-
-    def drive(self, step: tuple, U: np.ndarray, speeds: np.ndarray) -> None:
-        _, new, k, jid, di, sgn, s_k = step
-        z = np.empty(self.M, complex)
-        th = U[:, di]
-        np.cos(th, out=z.real)
-        np.sin(th, out=z.imag)
-        if sgn < 0:
-            np.negative(z.imag, out=z.imag)
-        if k < 0:
-            self.joint[jid] = (s_k, 0j, 0j)
-            self.link[new] = (z, sgn * float(speeds[di]), 0.0)
-        else:
-            zk, wk, alk = self.link[k]
-            self.joint.setdefault(jid, self.point(k, s_k))
-            self.link[new] = (z * zk, wk + sgn * float(speeds[di]), alk)
-
-    def rrr(self, step: tuple, least: float, folds: bool) -> np.ndarray | None:
-        """Place one RRR dyad and return its normalised discriminant (per row); None when
-        it falls below ``least`` and ``folds`` is false. With ``folds`` a folded row is NaN
-        (a fold within round-off is taken flat, as :func:`mechsyn.kinematics.chain.fast_chain`
-        takes it) and NaN propagates downstream."""
-        _, (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s, sigma, cbv1, cbv2, s1, s3 = step
-        A = self.joint.get(J1) or self.point(k1, s1)
-        C = self.joint.get(J3) or self.point(k3, s3)
-        self.joint[J1], self.joint[J3] = A, C
-        d = np.subtract(C[0], A[0]) if isinstance(C[0], np.ndarray) or isinstance(A[0], np.ndarray) \
-            else np.full(self.M, C[0] - A[0])
-        inv, f, g = circle_circle(d.real, d.imag, L1s, L2s)
-        disc = normalised_disc(inv, g, L1s)
-        if not disc.min() >= least:  # NaN too
-            if not folds:
-                return None
-            self.near = True
-            np.maximum(g, 0.0, out=g, where=g > -1e-12)
-        np.sqrt(g, out=g)
-        if sigma < 0:
-            np.negative(g, out=g)
-        u = np.empty(self.M, complex)
-        u.real, u.imag = f, g
-        e1 = d * u
-        B = e1 + A[0]
-        e2 = B - C[0]
-        self.joint[J2] = (B,) + self._rates(A, C, e1, e2, (b1, b2), (cbv1, cbv2))
-        return disc
-
-    def _rates(self, A: tuple, C: tuple, e1: np.ndarray, e2: np.ndarray, links: tuple, cbv: tuple) -> tuple:
-        """The dyad's link rotations and rates; the middle joint's velocity, acceleration."""
-        ce1, ce2 = e1.conjugate(), e2.conjugate()
-        den = (ce1 * e2).imag  # e1 x e2
-        np.divide(1.0, den, out=den)
-        dv = C[1] - A[1]
-        w1 = (dv * ce2).real
-        w1 *= den
-        w2 = (dv * ce1).real
-        w2 *= den
-        w1s = w1 * w1
-        da = (C[2] - A[2]) + w1s * e1
-        da -= (w2 * w2) * e2
-        a1 = (da * ce2).real
-        a1 *= den
-        a2 = (da * ce1).real
-        a2 *= den
-        self.link[links[0]] = (e1 * cbv[0], w1, a1)
-        self.link[links[1]] = (e2 * cbv[1], w2, a2)
-        ie1 = e1 * 1j
-        VB = ie1 * w1
-        VB += A[1]
-        AB = ie1 * a1
-        AB -= w1s * e1
-        AB += A[2]
-        return VB, AB
 
 
 def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
@@ -268,43 +161,16 @@ def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
-    steps, anchor, origin = _program(S, plan)
     st = _pass(S, plan, _regular_rows(S, U, split), speeds, folds=False)
-    return None if st is None else _poses(S, plan, U, st, origin, split)
+    return None if st is None else _poses(S, plan, U, st, split)
 
 
-def _run(steps: list, anchor: dict, X: np.ndarray, speeds: np.ndarray, folds: bool) -> _Pass | None:
-    """One pass of the chain's steps over the input rows ``X``; the groups' normalised
-    discriminants in ``discs`` (by step). None when a group comes near a fold and
-    ``folds`` is false."""
-    st = _Pass(X.shape[0], anchor)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        for k, step in enumerate(steps):
-            if step[0] == "drive":
-                st.drive(step, X, speeds)
-                continue
-            disc = st.rrr(step, REGULAR_DISC, folds)
-            if disc is None:
-                return None
-            st.discs[k] = disc
-    return st
-
-
-def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
-          folds: bool) -> _Pass | _Compiled | None:
+def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray, folds: bool) -> _Compiled | None:
     """One pass of the regular program over the input rows ``X`` (or the blocks of rows
-    ``X``, a list, one after the other): compiled (:mod:`mechsyn.kinematics.kernel`) when
-    Numba is installed, else :func:`_run`; the same states and discriminants either way.
+    ``X``, a list, one after the other) by the kernel (:func:`mechsyn.kinematics.kernel.run`).
     None when a group comes near a fold and ``folds`` is false."""
-    steps, anchor, origin = _program(S, plan)
-    if not kernel.active():
-        return _run(steps, anchor, np.concatenate(X) if isinstance(X, list) else X, speeds, folds)
-    memo = _memo(S)
-    key = ("kernel", id(plan))
-    prog = memo.get(key)
-    if prog is None or prog[0] is not plan:
-        shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
-        prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape))
+    _program(S, plan)
+    prog = _memo(S)[("kernel", id(plan))]
     C, W, AL, D, near, Z = kernel.run(prog[1], X, speeds, REGULAR_DISC,
                                       planes=(X[0] if isinstance(X, list) else X).shape[0])
     if near and not folds:
@@ -312,10 +178,9 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
     return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near, D, Z)
 
 
-def _compiled_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
-                    folds: bool, parts: list | None = None) -> tuple:
-    """:func:`_poses` / :func:`_fold_poses` of a compiled pass, compiled
-    (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N), the rows
+def _link_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
+                folds: bool, parts: list | None = None) -> tuple:
+    """The poses of a pass, by the kernel (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N), the rows
     assembled (N,), the rows with rates and the number of singular rows (through folds;
     ``parts``: the fold scan's singular rows, blanked too). Which links frame drivers
     turn is kept with the topology."""
@@ -346,8 +211,7 @@ def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray, 
 
 
 class _Compiled:
-    """The compiled pass's answer (:func:`mechsyn.kinematics.kernel.run`) in the terms of
-    :class:`_Pass`: the links' states already gathered per link (``C``, ``W``, ``AL``),
+    """The pass's record (:func:`mechsyn.kinematics.kernel.run`): the links' states gathered per link (``C``, ``W``, ``AL``),
     the groups' discriminants by step (and as rows of one block ``D``, in the order of the
     steps), whether one came near a fold, the rotations' real and imaginary parts ``Z``
     (2, links, M) when the pass wrote them."""
@@ -400,14 +264,15 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     paths = _tracking_paths(S, U, split)
     st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
     if not st.near:
-        return _poses(S, plan, U, st, origin, split)
+        return _poses(S, plan, U, st, split)
     _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, block=getattr(st, "D", None))
+    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, block=st.D)
     if out is None:
         return None
-    q, qd, qdd, *links = _fold_poses(S, plan, U, st, origin, split, out)
-    return Folded(q, qd, qdd, out, *links)
+    q, qd, qdd, ok, rates_ok, singular = _link_poses(S, plan, U, st, split, True, out)
+    return Folded(q.T, qd.T, qdd.T, out, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok, rates_ok,
+                  singular)
 
 
 def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
@@ -461,102 +326,28 @@ class Folded:
     n) with NaN rows where the mechanism is not assembled and NaN rates where they are
     not defined (the group folded flat), and per tracked sweep (the one sweep, or the
     sweeps forwards from the drawn input values and backwards) its singular rows and
-    events (rows counted along that sweep); from the compiled pass also the links'
-    states (:class:`LinkStates`, NaN where the poses are: ``qd``'s and ``qdd``'s angle
-    rows are its rates, so rows blanked later are blanked there too) and the rows
-    assembled (``assembled``, N); from the compiled pass also the rows whose rates are
-    defined (``rates_ok``, N: the singular rows of ``parts`` already blanked) and the
-    number of assembled rows whose rates are not (``singular``)."""
+    events (rows counted along that sweep); the links' states (:class:`LinkStates`, NaN
+    where the poses are: ``qd``'s and ``qdd``'s angle rows are its rates, so rows
+    blanked later are blanked there too), the rows assembled (``assembled``, N), the rows
+    whose rates are defined (``rates_ok``, N: the singular rows of ``parts`` already
+    blanked) and the number of assembled rows whose rates are not (``singular``)."""
 
     q: np.ndarray
     qd: np.ndarray
     qdd: np.ndarray
     parts: list
-    links: LinkStates | None = None
-    assembled: np.ndarray | None = None
-    rates_ok: np.ndarray | None = None
-    singular: int = 0
+    links: LinkStates
+    assembled: np.ndarray
+    rates_ok: np.ndarray
+    singular: int
 
 
-def _fold_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None,
-                parts: list | None = None) -> tuple:
-    """The pose rows ``q, qd, qdd`` (N, n) of the sweep ``U`` (the first N rows of the
-    pass) through folds: NaN rows where a group is not assembled, NaN rates where they
-    are not defined (inf at a group folded flat), each link's angle continuous along
-    each tracked sweep from the drawn one. Compiled, also the rates of the fold scan's
-    singular rows (``parts``, see :class:`Folded`) blanked."""
-    if isinstance(st, _Compiled):  # and the links' states (NaN where the poses are), the rows assembled, with rates
-        q, qd, qdd, ok, rates_ok, singular = _compiled_poses(S, plan, U, st, split, True, parts)
-        return (q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok,
-                None if parts is None else rates_ok, singular)
-    C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
-    fin = np.isfinite(C[0].view(float)).all(axis=0)  # every link's rotation: real and imaginary parts
-    ok = fin[0::2] & fin[1::2]
-    parts = (slice(None),) if split is None else (slice(split, None), slice(split - 1, None, -1))
-    _link_angles(S, plan, U, C[0].real, C[0].imag, ok, q[2::3], parts=parts)
-    rates = np.isfinite(qd).all(axis=0)
-    rates &= np.isfinite(qdd).all(axis=0)
-    _blank((q, qd, qdd), ok)
-    rates |= ~ok  # the rows where rates are not defined though the group is assembled (folded flat)
-    _blank((qd, qdd), rates)
-    return q.T, qd.T, qdd.T
-
-
-def _blank(arrays: tuple, keep: np.ndarray) -> None:
-    """NaN into the columns of ``arrays`` (n, N) where ``keep`` (N,) is false: by runs of
-    columns (a sweep's gaps are a few runs), or all at once when there are many."""
-    if keep.all():
-        return
-    edges = np.flatnonzero(keep[1:] != keep[:-1]).tolist()
-    if len(edges) > 16:
-        for a in arrays:
-            np.copyto(a, np.nan, where=~keep)
-        return
-    bounds = ([] if keep[0] else [0]) + [e + 1 for e in edges] + ([] if keep[-1] else [len(keep)])
-    for a, b in zip(bounds[0::2], bounds[1::2]):
-        for x in arrays:
-            x[:, a:b] = np.nan
-
-
-def _pose_arrays(S: PlanarSystem, st: _Pass, origin: list, N: int) -> tuple:
-    """The links' complex states (:func:`_states`) and the pose rows ``q, qd, qdd`` (n, N,
-    component-major) of the first N rows of a pass, the dyads' link angles left to fill."""
-    nl = len(S.links)
-    compiled = isinstance(st, _Compiled)
-    C = st.C[:, :, :N] if compiled else _states(st, origin, N, nl)
-    q, qd, qdd = (np.empty((S.n, N)) for _ in range(3))
-    for buf, x in ((q, C[1]), (qd, C[2]), (qdd, C[3])):
-        buf[0::3], buf[1::3] = x.real, x.imag
-    if compiled:
-        qd[2::3], qdd[2::3] = st.W[:, :N], st.AL[:, :N]
-        return C, q, qd, qdd
-    for i in range(nl):  # angular velocity and acceleration
-        for buf, x in ((qd, st.link[i][1]), (qdd, st.link[i][2])):
-            buf[3 * i + 2] = x[:N] if isinstance(x, np.ndarray) else x
-    return C, q, qd, qdd
-
-
-def _states(st: _Pass, origin: list, N: int, nl: int) -> np.ndarray:
-    """Every link's rotation and its origin's position, velocity, acceleration in the
-    first N rows of a pass (4, n_links, N)."""
-    C = np.empty((4, nl, N), complex)
-    for i in range(nl):
-        j = origin[i]
-        for k, x in enumerate((st.link[i][0],) + (st.joint[j] if j in st.joint else st.point(i, 0j))):
-            C[k, i] = x[:N] if isinstance(x, np.ndarray) else x
-    return C
-
-
-def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Pass, origin: list, split: int | None) -> tuple:
-    """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass (every link's
-    origin is its first joint, its angle continuous from the drawn one) and the links'
-    complex states."""
-    if isinstance(st, _Compiled):
-        q, qd, qdd, *_ = _compiled_poses(S, plan, U, st, split, False)
-        return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
-    C, q, qd, qdd = _pose_arrays(S, st, origin, U.shape[0])
-    _link_angles(S, plan, U, C[0].real, C[0].imag, None, q[2::3], split)
-    return q.T, qd.T, qdd.T, LinkStates(C, qd[2::3], qdd[2::3])
+def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Compiled, split: int | None) -> tuple:
+    """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass clear of folds
+    (every link's origin is its first joint, its angle continuous from the drawn one) and
+    the links' complex states."""
+    q, qd, qdd, *_ = _link_poses(S, plan, U, st, split, False)
+    return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
 
 
 class LinkStates:
@@ -579,21 +370,7 @@ class LinkStates:
         N = C.shape[2]
         got = kernel.point_states(C, self.w, self.al, np.array([i], np.int64),
                                   np.array([s if isinstance(s, complex) else complex(s[0], s[1])]))
-        if got is not None:  # compiled
-            P, V, A = got[:, 0].view(float).reshape(3, N, 2)
-            return P, V, A
-        w = self.w[i]
-        out = np.empty((3, N), complex)
-        rel = C[0, i] * (s if isinstance(s, complex) else complex(s[0], s[1]))
-        np.add(rel, C[1, i], out=out[0])
-        irel = rel * 1j
-        np.multiply(irel, self.al[i], out=out[2])
-        irel *= w
-        np.add(irel, C[2, i], out=out[1])
-        rel *= w ** 2
-        out[2] -= rel
-        out[2] += C[3, i]
-        P, V, A = out.view(float).reshape(3, N, 2)
+        P, V, A = got[:, 0].view(float).reshape(3, N, 2)
         return P, V, A
 
     def points(self, idx: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -614,19 +391,5 @@ class LinkStates:
         ((2, 12, 2), True)
         """
         got = kernel.point_states(self.C, self.w, self.al, np.asarray(idx, np.int64), np.asarray(s, complex))
-        if got is not None:  # compiled
-            P, V, A = got.view(float).reshape(3, *got.shape[1:], 2)
-            return P, V, A
-        Z = self.C[:, idx]
-        rel = Z[0] * s[:, None]
-        P = rel + Z[1]
-        irel = rel * 1j
-        w = self.w[idx]
-        A = irel * self.al[idx]
-        irel *= w
-        V = irel + Z[2]
-        rel *= w ** 2
-        A -= rel
-        A += Z[3]
-        m, N = rel.shape
-        return tuple(x.view(float).reshape(m, N, 2) for x in (P, V, A))
+        P, V, A = got.view(float).reshape(3, *got.shape[1:], 2)
+        return P, V, A

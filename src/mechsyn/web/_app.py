@@ -424,7 +424,7 @@ def create_app(root: str | Path = ".", start: dict[str, Any] | None = None, toke
 @contextlib.asynccontextmanager
 async def _lifespan(app: Starlette):
     await asyncio.get_running_loop().run_in_executor(None, app.state.heavy.warm)
-    # Numba's compiled pass, when installed, loaded (or compiled, once per machine) beside
+    # the kernel's compiled pass (Numba) loaded (or compiled, once per machine) beside
     # the server's start rather than on the first drag
     threading.Thread(target=_warm_kernel, name="mechsyn-kernel-warm", daemon=True).start()
     yield
