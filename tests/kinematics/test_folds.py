@@ -145,7 +145,6 @@ def test_the_kernels_fold_scan_equals_the_sweeps_python_scan(ex, monkeypatch):
         X = np.concatenate([U] + [p for p, _ in paths])
         st = regular._pass(S, plan, X, np.ones(1), folds=True)
         steps, anchor, _ = regular._program(S, plan)
-        regular._scalar_memo(S, plan, steps, anchor)
         sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
         got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
         want = _per_sweep(S, plan, st, U, split, paths, sigmas)

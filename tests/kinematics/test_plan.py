@@ -135,8 +135,9 @@ def test_one_pass_equals_the_tracked_sweep(ex):
 def test_scalar_discriminant_equals_the_array_pass(ex):
     """The one-input evaluation used by the dead-point root search gives the array pass's
     discriminant of every group."""
-    from mechsyn.kinematics import dyads, folds
+    from mechsyn.kinematics import dyads, folds, kernel
     from mechsyn.kinematics.analysis import cached_plan
+    from mechsyn.kinematics.regular import kernel_program
 
     for f in ("textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "kinematics/peaucellier.yaml"):
         m = ex(f)
@@ -145,14 +146,14 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
         S, plan = kp.system, kp.groups
         X = np.radians(input_grid(0, 350, 10))[:, None]
         tp = dyads.solve_tracked(S, plan, X)
-        prog = folds._scalar_program(S, plan)
+        prog = kernel_program(S, plan)
         for k, step in enumerate(plan.steps):
             if step.kind != "RRR":
                 continue
             ref = folds._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
-            sig = [[float(s[i]) if isinstance(s, np.ndarray) else float(s) for s in tp.sigmas[:k]]
+            sig = [np.array([float(s[i]) if isinstance(s, np.ndarray) else float(s or 1.0) for s in tp.sigmas])
                    for i in range(len(X))]
-            got = np.array([folds._scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
+            got = np.array([kernel.scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
             assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
 
 
@@ -264,29 +265,12 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
 
 
-def test_fold_search_program_read_off_the_regular_program_equals_the_groups(ex):
-    """The plain-number chain of the fold search, kept from the regular pass's program,
-    equals number for number the one built from the plan's groups."""
-    from mechsyn.kinematics import folds
-    from mechsyn.kinematics.groups import _memo
-
-    m = ex("textbook/watt_sixbar.yaml")
-    m = m.with_joint_points({"E": np.asarray(m.joint("E").point, float) + 0.01})
-    s = simulate(m, {"A": input_grid(0, 360, 2)})
-    assert any(e.kind == "dead point" for e in s.events) and s.engine == "regular pass"
-    plan = compile_plan(m, inputs=("A",)).groups
-    memo = _memo(s.system)
-    kept = folds._scalar_program(s.system, plan)  # the one read off the regular program
-    assert not callable(kept) and memo.pop(("scalar", id(plan))) is kept
-    assert folds._scalar_program(s.system, plan) == kept  # built anew from the groups
-
-
 @pytest.mark.parametrize("f, joint", [("textbook/watt_sixbar.yaml", "E"), ("textbook/fourbar.yaml", "C"),
                                       ("kinematics/crank_rocker.yaml", "C")])
-def test_four_bar_fold_spec_read_off_the_regular_program_equals_the_groups(ex, f, joint):
-    """The closed-form four-bar fold's numbers, read off the regular pass's program (a
-    drag's fresh geometry), equal those read off the plain-number chain built from the
-    plan's groups, group by group (None where the group closes no four-bar)."""
+def test_four_bar_fold_spec_of_a_refilled_geometry_equals_a_fresh_plans(ex, f, joint):
+    """The closed-form four-bar fold's numbers, read off the regular pass's program of a
+    drag's refilled geometry, equal those of a plan compiled afresh for the moved
+    mechanism, group by group (None where the group closes no four-bar)."""
     from mechsyn.kinematics import folds
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.groups import _memo
@@ -301,10 +285,13 @@ def test_four_bar_fold_spec_read_off_the_regular_program_equals_the_groups(ex, f
     for k in ks:
         memo.pop(("four-bar fold", id(kp.groups), k), None)
     got = [folds._four_bar_spec(kp.system, kp.groups, k) for k in ks]
-    for key in [key for key in memo if key[0] in ("four-bar fold", "regular", "scalar")]:
-        del memo[key]
-    want = [folds._four_bar_spec(kp.system, kp.groups, k) for k in ks]  # from the groups
-    assert got == want and any(g is not None for g in got)
+    fresh = compile_plan(m, inputs=("A",))
+    assert fresh.system is not kp.system
+    want = [folds._four_bar_spec(fresh.system, fresh.groups, k) for k in ks]
+    assert [g is None for g in got] == [w is None for w in want] and any(g is not None for g in got)
+    for g, w in zip(got, want):
+        if g is not None:
+            assert g[2] == w[2] and np.allclose([g[0], g[1], *g[3]], [w[0], w[1], *w[3]], rtol=1e-13, atol=1e-13)
 
 
 @pytest.mark.parametrize("gap", [0.0, 4.4e-16, 3e-13])

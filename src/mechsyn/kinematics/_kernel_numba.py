@@ -47,6 +47,26 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
         outA[r] = (acc - rel * (w * w)) + jA[j, r]
 
 
+@njit(inline="always", **_OPTIONS)
+def circle(d, L1s, L2s):
+    """The RRR group's circle intersection, written once for every pass of the kernel:
+    with ``d = C - A`` (complex) and the squared lengths ``L1s``, ``L2s`` of the group's
+    links, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g^2 = L1^2 / |d|^2 - f^2`` (the
+    middle joint at ``B = A + d (f + i sigma g)``) and the normalised discriminant
+    ``g^2 |d|^2 / L1^2`` (below zero the circles do not meet). Centres within
+    :data:`mechsyn.kinematics.groups.COINCIDENT` of one point: NaN (the middle joint is
+    indeterminate); the operations of :func:`mechsyn.kinematics.groups.circle_circle`,
+    so the same numbers."""
+    inv = d.real * d.real
+    inv += d.imag * d.imag
+    inv = 1.0 / inv if inv > 1e-24 * (L1s + L2s) else math.nan
+    f = inv * (0.5 * (L1s - L2s))
+    f += 0.5
+    g = inv * L1s
+    g -= f * f
+    return f, g, g / (inv * L1s)
+
+
 @njit(**_OPTIONS)
 def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z):
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
@@ -97,18 +117,9 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
         neg = fp[s, 2].real < 0
         cbv1 = fp[s, 3]
         cbv2 = fp[s, 4]
-        half = 0.5 * (L1s - L2s)
-        tiny = 1e-24 * (L1s + L2s)
         for r in range(M):
             d = jP[J3, r] - jP[J1, r]
-            inv = d.real * d.real
-            inv += d.imag * d.imag
-            inv = 1.0 / inv if inv > tiny else math.nan  # groups.COINCIDENT: centres one point
-            f = inv * half
-            f += 0.5
-            g = inv * L1s
-            g -= f * f
-            disc = g / (inv * L1s)
+            f, g, disc = circle(d, L1s, L2s)
             D[slot, r] = disc
             if not disc >= least:
                 near = True
@@ -359,12 +370,11 @@ def point_states(C, w, al, idx, s, out):
 
 
 @njit(**_OPTIONS)
-def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):
+def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg):
     """The normalised discriminant of step ``k`` (an RRR group) of the program at one input
-    ``u`` (k inputs), every group upstream in the program's (drawn) mode and placed as
-    :func:`mechsyn.kinematics.folds._scalar_disc` places it (a group folded within
-    1e-12 taken flat, else NaN downstream): the fold search's function along a segment,
-    positions only."""
+    ``u`` (k inputs), every group upstream in its mode ``sg[s]`` (+1 or -1, by step; the
+    drawn modes: ``fp[:, 2].real``), a group folded within 1e-12 taken flat, else NaN
+    downstream: the fold search's function along a segment, positions only."""
     nl = anc_j.shape[0]
     jP = np.zeros(nj, np.complex128)
     lz = np.zeros(nl, np.complex128)
@@ -386,21 +396,15 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k):
             jP[J1] = fp[s, 5] if k1 < 0 else lz[k1] * (fp[s, 5] - anc_s[k1]) + jP[anc_j[k1]]
         if ip[s, 9]:
             jP[J3] = fp[s, 6] if k3 < 0 else lz[k3] * (fp[s, 6] - anc_s[k3]) + jP[anc_j[k3]]
-        L1s = fp[s, 0].real
-        d = jP[J3] - jP[J1]
-        inv = d.real * d.real + d.imag * d.imag
-        inv = 1.0 / inv if inv > 1e-24 * (L1s + fp[s, 0].imag) else math.nan  # groups.COINCIDENT
-        f = inv * (0.5 * (L1s - fp[s, 0].imag)) + 0.5
-        g = inv * L1s - f * f
-        disc = g / (inv * L1s) if inv < math.inf else math.nan
+        f, g, disc = circle(jP[J3] - jP[J1], fp[s, 0].real, fp[s, 0].imag)
         if s == k:
             return disc
         if not g >= 0:
             g = 0.0 if disc > -1e-12 else math.nan
         g = math.sqrt(g) if g >= 0.0 else math.nan
-        if fp[s, 2].real < 0:
+        if sg[s] < 0:
             g = -g
-        e1 = d * complex(f, g)
+        e1 = (jP[J3] - jP[J1]) * complex(f, g)
         jP[J2] = e1 + jP[J1]
         lz[b1] = e1 * fp[s, 3]
         lz[b2] = (jP[J2] - jP[J3]) * fp[s, 4]
@@ -425,17 +429,17 @@ def _scan_row(X, perm, b, w, i, n0, shift, out):
 
 
 @njit(**_OPTIONS)
-def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t):
+def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t, sg):
     """:func:`scalar_disc` of step ``k`` at the input ``xa + t d`` (the numbers of
-    :func:`mechsyn.kinematics.folds._disc_line` compiled)."""
+    :func:`mechsyn.kinematics.folds._disc_line`), the groups in the modes ``sg``."""
     u = np.empty(xa.shape[0])
     for c in range(xa.shape[0]):
         u[c] = xa[c] + t * d[c]
-    return scalar_disc(ip, fp, anc_j, anc_s, u, nj, k)
+    return scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg)
 
 
 @njit(**_OPTIONS)
-def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):
+def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b, sg):
     """:func:`mechsyn.kinematics.folds._fold_root` (xtol 1e-14) on :func:`_disc_along`:
     the zero ``t`` in [a, b] of step ``k``'s discriminant, ``f(a) = fa``, ``f(b) = fb``;
     NaN when the ends do not bracket a zero."""
@@ -452,7 +456,7 @@ def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b):
             t = (a * fb - b * fa) / (fb - fa)
             if not a < t < b:
                 t = 0.5 * (a + b)
-        ft = _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t)
+        ft = _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t, sg)
         if ft == 0.0 or not math.isfinite(ft):
             return t
         if (ft > 0.0) == (fa > 0.0):
@@ -526,6 +530,9 @@ def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip
     ev = np.empty((2 * cap, 4 + nin))
     ne = 0
     xa, xb, d = np.empty(nin), np.empty(nin), np.empty(nin)
+    sg = np.empty(fp.shape[0])  # every group in its drawn mode
+    for st in range(fp.shape[0]):
+        sg[st] = fp[st, 2].real
     for w in range(nsw if cap else 0):
         n0, shift = (n0a, sha) if w == 0 else (n0b, shb)
         n = L - b if w == 0 else b
@@ -555,16 +562,16 @@ def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip
                     d[c] = xb[c] - xa[c]
                 t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
                 if math.isnan(t) and hidden == 0:
-                    t = _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fb, 0.0, 1.0)
+                    t = _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fb, 0.0, 1.0, sg)
                     if math.isnan(t):
                         t = 0.0 if fa > -zero else 1.0
                 elif hidden != 0:
                     tc = ends[i] if hidden > 0 else starts[i]
-                    fc = _disc_along(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, tc)
+                    fc = _disc_along(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, tc, sg)
                     if not fc <= -zero:
                         continue
-                    t = (_fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fc, 0.0, tc) if hidden > 0 else
-                         _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fc, fb, tc, 1.0))
+                    t = (_fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fc, 0.0, tc, sg) if hidden > 0 else
+                         _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fc, fb, tc, 1.0, sg))
                     if math.isnan(t):
                         continue
                 inside = fa > -zero if hidden == 0 else hidden > 0

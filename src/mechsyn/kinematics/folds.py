@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, _topology, circle_circle, normalised_disc
+from mechsyn.kinematics.groups import Plan, _memo, _topology
 from mechsyn.kinematics.positions import _State, _solve_step
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
@@ -67,82 +67,21 @@ def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray
     return out[0]
 
 
-def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
-    """A driver-R + RRR chain as plain numbers for :func:`_scalar_disc` (built once per
-    system and plan)."""
-    memo = _memo(S)
-    key = ("scalar", id(plan))
-    prog = memo.get(key)
-    if prog is not None:
-        if callable(prog):  # kept by the regular pass, made when first read (scalar_of_regular)
-            prog = memo[key] = prog()
-        return prog
-    prog = []
-    for step in plan.steps:
-        if step.kind == "drive_R":
-            (new,), (k,), (jid,) = step.links, step.known, step.joints
-            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
-            prog.append(("drive", new, k, tuple(_local(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
-                         tuple(_local(S, new, jid))))
-            continue
-        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
-        L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
-        prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
-                     L1s, L2s, tuple(s1), tuple(t3), tuple((s2 - s1) / L1s), tuple((t2 - t3) / L2s)))
-    memo[key] = prog
-    return prog
-
-
-def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
-    """Normalised discriminant ``h^2 / L1^2`` of RRR step ``k`` of a driver-R + RRR chain
-    at one input ``u``, the upstream groups in the modes ``sigmas`` (floats): the
-    formulas of :func:`_solve_step` in plain floats (a root search calls it a few times
-    per event; an array pass would cost a hundred times more per call)."""
-    pose: dict[int, tuple] = {}  # link -> (anchor x, y, local x, y, cos, sin)
-
-    def point(i: int, s: tuple) -> tuple:
-        if i < 0:
-            return s
-        ax, ay, lx, ly, c, sn = pose[i]
-        dx, dy = s[0] - lx, s[1] - ly
-        return ax + c * dx - sn * dy, ay + sn * dx + c * dy
-
-    for j, op in enumerate(prog):
-        if op[0] == "drive":
-            _, new, kk, sk, di, sgn, snew = op
-            P = point(kk, sk)
-            ck, sk_ = (1.0, 0.0) if kk < 0 else pose[kk][4:]
-            ct, st = math.cos(u[di]), sgn * math.sin(u[di])
-            pose[new] = (P[0], P[1], snew[0], snew[1], ck * ct - sk_ * st, sk_ * ct + ck * st)
-            continue
-        _, (k1, sa), (k3, sc), (b1, b2), L1s, L2s, s1, t3, bv1, bv2 = op
-        A, C = point(k1, sa), point(k3, sc)
-        dx, dy = C[0] - A[0], C[1] - A[1]
-        inv, f, g2 = circle_circle(dx, dy, L1s, L2s)  # the kernel of the array passes, on floats
-        disc = normalised_disc(inv, g2, L1s) if inv < math.inf else math.nan
-        if j == k:
-            return disc
-        if not g2 >= 0:  # folded (NaN downstream, as in the array pass) or round-off
-            g2 = 0.0 if disc > -1e-12 else math.nan
-        g = float(sigmas[j]) * (math.sqrt(g2) if g2 >= 0 else math.nan)
-        Bx, By = A[0] + f * dx - g * dy, A[1] + f * dy + g * dx
-        for link, P, loc, bv in ((b1, A, s1, bv1), (b2, C, t3, bv2)):
-            vx, vy = Bx - P[0], By - P[1]
-            pose[link] = (P[0], P[1], loc[0], loc[1], vx * bv[0] + vy * bv[1], vy * bv[0] - vx * bv[1])
-    return math.nan
-
-
 def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, xa: list, xb: list, i0: int):
     """Discriminant of step ``k`` on the segment of inputs from ``xa`` (t = 0, row ``i0``)
     to ``xb`` (t = 1), the upstream groups in their modes of row ``i0``: a scalar
-    function (on floats for a driver-R + RRR chain: the numbers of ``xa + t (xb - xa)``)."""
+    function (for a driver-R + RRR chain the kernel's, on the regular pass's program:
+    the numbers of ``xa + t (xb - xa)``)."""
     dx = [b - a for a, b in zip(xa, xb)]
     if plan.closed_form_rates:
-        prog = _scalar_program(S, plan)
-        sig = [float(s[i0]) if isinstance(s, np.ndarray) else float(s) for s in sigmas[:k]]
-        return lambda t: _scalar_disc(prog, k, sig, [a + t * d for a, d in zip(xa, dx)])
+        from mechsyn.kinematics.regular import kernel_program  # (regular imports this module)
+
+        prog = kernel_program(S, plan)
+        sg = np.ones(len(plan.steps))
+        for j, s in enumerate(sigmas[:k]):
+            if s is not None:
+                sg[j] = float(s[i0]) if isinstance(s, np.ndarray) else float(s)
+        return lambda t: kernel.scalar_disc(prog, k, sg, np.array([a + t * d for a, d in zip(xa, dx)]))
     rows = np.array([i0])
     return lambda t: float(_disc_at(S, plan, k, sigmas, rows, np.array([[a + t * d for a, d in zip(xa, dx)]]))[0])
 
@@ -352,34 +291,15 @@ def _four_bar_fold(S: PlanarSystem, plan: Plan, k: int, xa: list, xb: list) -> f
     sign), by the law of cosines: ``|v|^2 + |w|^2 + 2 |v| |w| cos(s u + arg w - arg v) =
     (L1 +- L2)^2`` with ``v = O - C``. None when the group is not such a four-bar or the
     segment holds not exactly one such angle (the numerical search decides)."""
-    four, av, aw, beta, sgn, *targets = _four_bar_numbers(_four_bar_spec(S, plan, k))
-    if not four:
-        return None
-    ua, ub = float(xa[0]), float(xb[0])
-    lo, hi = min(ua, ub), max(ua, ub)
-    slack = 1e-12 * (hi - lo)
-    found = []
-    for D2 in targets:
-        c = (D2 - av * av - aw * aw) / (2 * av * aw)
-        if not -1.0 < c < 1.0:
-            continue
-        ac = math.acos(c)
-        for psi in (ac - beta, -ac - beta):
-            u = sgn * psi
-            u += 2 * math.pi * round((0.5 * (lo + hi) - u) / (2 * math.pi))
-            if lo - slack <= u <= hi + slack:
-                found.append(u)
-    if len(found) != 1:
-        return None
-    return min(1.0, max(0.0, (found[0] - ua) / (ub - ua)))
+    t = kernel.four_bar_fold(np.array(_four_bar_numbers(_four_bar_spec(S, plan, k))), float(xa[0]), float(xb[0]))
+    return None if math.isnan(t) else float(t)
 
 
 def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     """``(v, w, s, ((L1 + L2)^2, (L1 - L2)^2))`` of :func:`_four_bar_fold` for RRR step
     ``k``, or None (kept with the system). Whether the group closes a four-bar is the
     topology's (:func:`_four_bar_form`); the numbers are read off the regular pass's
-    program when the system has one (the numbers of :func:`_scalar_program`, which is
-    read off it), else off :func:`_scalar_program`."""
+    program."""
     memo = _memo(S)
     key = ("four-bar fold", id(plan), k)
     if key in memo:
@@ -387,17 +307,13 @@ def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     out = None
     form = _topology(S, plan, ("four-bar form", k), lambda: _four_bar_form(S, plan, k))
     if form is not None:
+        from mechsyn.kinematics.regular import kernel_program  # (regular imports this module)
+
+        kernel_program(S, plan)  # the regular program (steps, anchors, origin: complex local points) kept with S
         c, on_frame, crank = form
-        regular = memo.get(("regular", id(plan)))
-        if regular is not None and regular[0] is plan:  # (steps, anchors, origin): complex local points
-            steps, cx, _ = regular[1]
-            O, sgn, pivot = steps[c][6], steps[c][5], cx[crank][1]
-            _, _, _, _, L1s, L2s, _, _, _, s1, s3 = steps[k]
-        else:
-            prog = _scalar_program(S, plan)
-            _, _, _, O, _, sgn, pivot = prog[c]
-            _, (_, s1), (_, s3), _, L1s, L2s, *_ = prog[k]
-            O, pivot, s1, s3 = complex(*O), complex(*pivot), complex(*s1), complex(*s3)
+        steps, cx, _ = memo[("regular", id(plan))][1]
+        O, sgn, pivot = steps[c][6], steps[c][5], cx[crank][1]
+        _, _, _, _, L1s, L2s, _, _, _, s1, s3 = steps[k]
         frame_end, crank_end = (s1, s3) if on_frame == 1 else (s3, s1)
         L1, L2 = math.sqrt(L1s), math.sqrt(L2s)
         out = (O - frame_end, crank_end - pivot, sgn, ((L1 + L2) ** 2, (L1 - L2) ** 2))

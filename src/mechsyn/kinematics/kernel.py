@@ -43,7 +43,8 @@ from types import ModuleType
 
 import numpy as np
 
-__all__ = ["fold_scan", "link_poses", "point_states", "program_arrays", "run", "trig", "warm"]
+__all__ = ["fold_scan", "four_bar_fold", "link_poses", "point_states", "program_arrays", "run", "scalar_disc", "trig",
+           "warm"]
 
 
 def _nb() -> ModuleType:
@@ -276,3 +277,21 @@ def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, 
     out = np.empty((3, idx.shape[0], C.shape[2]), complex)
     _nb().point_states(C, w, al, idx, s, out)
     return out
+
+
+def scalar_disc(program: tuple, k: int, sg: np.ndarray, u: np.ndarray) -> float:
+    """The normalised discriminant of RRR step ``k`` of the regular pass's ``program`` at
+    one input ``u`` (floats, one per driver), every upstream group in its mode ``sg``
+    (floats +1 / -1 by step): the function the fold search refines a fold on, placed by
+    the kernel's one circle intersection (:func:`mechsyn.kinematics._kernel_numba.circle`).
+    """
+    (ip, anc_j, _, nj, _), fp, anc_s = program
+    return _nb().scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg)
+
+
+def four_bar_fold(spec: np.ndarray, ua: float, ub: float) -> float:
+    """Where (t in [0, 1]) a group closing a four-bar folds between the inputs ``ua`` and
+    ``ub``, in closed form from its numbers ``spec``
+    (:func:`mechsyn.kinematics.folds._four_bar_numbers`); NaN when not exactly one fold
+    angle lies there (the numerical search decides)."""
+    return _nb()._four_bar_t(spec, ua, ub)

@@ -30,7 +30,6 @@ discriminant arrays (:func:`mechsyn.kinematics.folds.pass_fold_events`).
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,6 +69,13 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
     flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
     memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
     return out
+
+
+def kernel_program(S: PlanarSystem, plan: Plan) -> tuple:
+    """The regular pass's program of ``S`` as the kernel's arrays
+    (:func:`~mechsyn.kinematics.kernel.program_arrays`), kept with ``S``."""
+    _program(S, plan)
+    return _memo(S)[("kernel", id(plan))][1]
 
 
 def _shape(S: PlanarSystem, plan: Plan) -> tuple:
@@ -169,13 +175,12 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
     """One pass of the regular program over the input rows ``X`` (or the blocks of rows
     ``X``, a list, one after the other) by the kernel (:func:`mechsyn.kinematics.kernel.run`).
     None when a group comes near a fold and ``folds`` is false."""
-    _program(S, plan)
-    prog = _memo(S)[("kernel", id(plan))]
-    C, W, AL, D, near, Z = kernel.run(prog[1], X, speeds, REGULAR_DISC,
+    prog = kernel_program(S, plan)
+    C, W, AL, D, near, Z = kernel.run(prog, X, speeds, REGULAR_DISC,
                                       planes=(X[0] if isinstance(X, list) else X).shape[0])
     if near and not folds:
         return None
-    return _Compiled(C, W, AL, dict(zip(prog[1][0][4], D)), near, D, Z)
+    return _Compiled(C, W, AL, dict(zip(prog[0][4], D)), near, D, Z)
 
 
 def _link_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
@@ -265,7 +270,6 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
     if not st.near:
         return _poses(S, plan, U, st, split)
-    _scalar_memo(S, plan, steps, anchor)
     sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
     out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, block=st.D)
     if out is None:
@@ -290,34 +294,6 @@ def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
     paths = [tracking_path(S, f, u0) for f in firsts]
     memo["tracking paths"] = (key, paths)
     return paths
-
-
-def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
-    """Keep with ``S`` the chain as plain numbers for the fold search
-    (:func:`mechsyn.kinematics.folds._scalar_program`'s layout) read off the regular
-    program (the same local points, squared lengths and rotation vectors, so the same
-    numbers) instead of building it again from the groups; made when first read (the
-    compiled fold search and the closed-form four-bar folds do not read it)."""
-    memo = _memo(S)
-    key = ("scalar", id(plan))
-    if key not in memo:
-        memo[key] = functools.partial(_scalar_of_regular, steps, cx)
-
-
-def _scalar_of_regular(steps: list, cx: dict) -> list:
-    """:func:`_scalar_memo`'s program: the regular program's steps ``steps`` and anchors
-    ``cx`` as plain numbers."""
-    prog = []
-    for st in steps:
-        if st[0] == "drive":
-            _, new, k, _jid, di, sgn, s_k = st
-            prog.append(("drive", new, k, (s_k.real, s_k.imag), di, sgn, (cx[new][1].real, cx[new][1].imag)))
-            continue
-        _, (k1, k3), (b1, b2), _j, L1s, L2s, _sigma, cbv1, cbv2, s1, s3 = st
-        prog.append(("RRR", (k1, (s1.real, s1.imag)), (k3, (s3.real, s3.imag)), (b1, b2), L1s, L2s,
-                     (cx[b1][1].real, cx[b1][1].imag), (cx[b2][1].real, cx[b2][1].imag),
-                     (cbv1.real, -cbv1.imag), (cbv2.real, -cbv2.imag)))
-    return prog
 
 
 @dataclass
