@@ -206,3 +206,33 @@ def test_no_inputs_or_no_designs():
     assert none.paths["P"].shape == (0, 36, 2) and none.sigmas.shape == (0, 2)
     empty = simulate_batch(plan, plan.parameters(mech), np.array([]), transmission=True)
     assert empty.paths["P"].shape == (1, 0, 2) and np.isnan(empty.min_transmission_angle[0])
+
+
+@pytest.mark.parametrize("name", ["crank_rocker", "watt_sixbar"])
+def test_one_designs_rows_are_a_motion_equal_to_simulate(name):
+    """Asked for one design, the batch answers a Motion: the input joint's values as
+    simulate measures them, the same assembled rows and point positions as simulate, no
+    rates (NaN, said in the notes), and a dead point said in the notes."""
+    import mechsyn as ms
+
+    mech = ms.examples.load(name)
+    names = [j.id for j in mech.joints] + list(mech.points)
+    plan = compile_plan(mech, points=names)
+    designs = np.stack([plan.parameters(mech), 1.5 * plan.parameters(mech)])
+    off = np.arange(0.0, 360.0, 3.0)
+    res = simulate_batch(plan, designs, off)
+    m = res.motion(1)
+    assert isinstance(m, ms.kinematics.Motion) and m.engine == "batch" and m.mechanism == mech.name
+    one = res.motion(0)
+    sim = simulate(mech, {plan.input_joint: plan.reference_input + off}, points=names)
+    np.testing.assert_allclose(one.inputs[plan.input_joint], sim.inputs[plan.input_joint], atol=1e-9)
+    np.testing.assert_array_equal(one.assembled, sim.assembled)
+    for n in names:
+        np.testing.assert_allclose(one.point(n), sim.points[n].position, atol=1e-9)
+        np.testing.assert_allclose(m.point(n), 1.5 * one.point(n), atol=1e-9)  # the design scaled by 1.5
+        assert np.isnan(one.points[n].velocity).all()
+    assert any("velocities" in note for note in one.notes)
+    assert any("dead point" in note for note in one.notes) == (not sim.assembled.all())
+    assert one.to_dict()["engine"] == "batch"
+    if sim.assembled.all():
+        assert one.working_ranges() == sim.working_ranges()

@@ -66,12 +66,16 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
+
+if TYPE_CHECKING:
+    from mechsyn.kinematics.simulation import Motion
 
 __all__ = ["BatchPlan", "BatchResult", "compile_plan", "simulate_batch", "design_parameters"]
 
@@ -100,6 +104,7 @@ class BatchPlan:
     dyads: tuple[tuple[str, str, str], ...] = ()
     reference_input: float = 0.0
     crank_line: tuple[int, int] | None = None
+    mechanism: str = field(default="", compare=False)  # the name of the mechanism it was compiled from
 
     def reference_inputs(self, designs: np.ndarray) -> np.ndarray:
         """Input angle (degrees) of each design's reference configuration, as
@@ -151,11 +156,50 @@ class BatchResult:
     min_transmission_angle: np.ndarray | None = None   # (K,) degrees, 0..90
     sigmas: np.ndarray | None = None        # (K, n_dyads) assembly mode of each dyad (+1 / -1)
     notes: list[str] = field(default_factory=list)
+    plan: BatchPlan | None = field(default=None, repr=False)
+    reference_inputs: np.ndarray | None = None   # (K,) degrees: each design's drawn input (simulate's)
 
     @property
     def full_cycle(self) -> np.ndarray:
         """Designs assembled over the whole sweep without a stepped-over dead point."""
         return ~self.dead_point & ~self.branch_jump
+
+    def motion(self, k: int = 0) -> "Motion":
+        """The rows of design ``k`` as a :class:`~mechsyn.kinematics.Motion`, the result
+        every engine gives: the input joint's values as :func:`mechsyn.kinematics.simulate`
+        measures them (the design's drawn input plus the offsets), the rows assembled, the
+        plan's output points. The batch places positions only: the points' velocities and
+        accelerations are NaN and there are no links or located events (the notes say so,
+        and name a dead point or a stepped-over one).
+
+        Examples
+        --------
+        >>> import mechsyn as ms
+        >>> mech = ms.examples.load("crank_rocker")
+        >>> plan = compile_plan(mech)
+        >>> m = simulate_batch(plan, plan.parameters(mech), np.arange(0.0, 360.0, 10.0)).motion()
+        >>> m.engine, m.assembled.shape, m.point("M").shape
+        ('batch', (36,), (36, 2))
+        """
+        from mechsyn.kinematics.simulation import Motion, PointMotion
+
+        plan, u = self.plan, np.asarray(self.inputs, float)
+        if plan is None or self.reference_inputs is None:
+            raise MechsynInputError("this result keeps no plan: it was not made by simulate_batch",
+                                    field="motion", hint="call simulate_batch")
+        off = u[k] if u.ndim == 2 else u
+        nan = np.full((off.shape[0], 2), np.nan)
+        notes = ["the batch engine places positions only: velocities and accelerations are not computed (NaN); "
+                 "ms.simulate gives them"]
+        if self.dead_point[k]:
+            notes.append("not assembled on every row: a dead point within the sweep (the batch does not locate it)")
+        if self.branch_jump[k]:
+            notes.append("a dead point stepped over between two rows: the rows on either side lie on different "
+                         "assembly branches; refine the input step")
+        return Motion(mechanism=plan.mechanism, inputs={plan.input_joint: float(self.reference_inputs[k]) + off},
+                      input_types={plan.input_joint: "R"}, speeds={plan.input_joint: 1.0},
+                      assembled=self.assembled[k], links={}, engine="batch", method="batch", notes=notes,
+                      points={n: PointMotion(p[k], nan, nan.copy()) for n, p in self.paths.items()})
 
 
 def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
@@ -226,7 +270,7 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     return BatchPlan(names=names, ops=program, outputs=tuple(points),
                      input_joint=drv.id, input_sign=sign, n_dyads=len(dyads),
                      links=tuple(ln.name for ln in mech.links), dyads=tuple(dyads), reference_input=ref,
-                     crank_line=line)
+                     crank_line=line, mechanism=mech.name)
 
 
 def _batch_driver(mech: Mechanism, src: str):
@@ -473,7 +517,7 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     sig = np.stack([c[2][:, 0] for c in run.dyad_consts], axis=1) if run.dyad_consts else np.zeros((K, 0))
     return BatchResult(inputs=np.asarray(inputs, float), paths=paths, assembled=run.ok,
                        dead_point=~run.ok.all(axis=1), branch_jump=run.jump, min_transmission_angle=mu,
-                       sigmas=sig)
+                       sigmas=sig, plan=plan, reference_inputs=plan.reference_inputs(designs))
 
 
 _BLOCK = 1 << 14
