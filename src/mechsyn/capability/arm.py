@@ -165,6 +165,58 @@ class SerialArm:
         J, p = self._geometric_jacobian(self._frames(q))
         return p, J[:, :3, :]
 
+    def joint_axes(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The tool-point Jacobian and the joint axes ``z_i`` in the base frame, both
+        (N, 3, n) (a planar arm in the plane z = 0: R axes along z, P axes along their link).
+
+        >>> from mechsyn.capability.arm_file import arm_from_dict
+        >>> arm = arm_from_dict({"kind": "planar_serial", "link_lengths": [1.0],
+        ...                      "joint_speed_limits_deg_s": [10]})
+        >>> J, Z = arm.joint_axes(np.zeros((1, 1)))
+        >>> (J[0, :, 0] + 0.0).tolist(), Z[0, :, 0].tolist()
+        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0])
+        """
+        q = np.atleast_2d(np.asarray(q, float))
+        rev = self.is_revolute
+        if self.kind == "planar":
+            J = np.concatenate([self.fk_and_jacobian(q)[1], np.zeros((q.shape[0], 1, self.n))], axis=1)
+            return J, np.where(rev, np.array([0.0, 0.0, 1.0])[:, None], J)
+        Jg = self._geometric_jacobian(self._frames(q))[0]
+        return Jg[:, :3], np.where(rev, Jg[:, 3:], Jg[:, :3])
+
+    def jacobian_derivative(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Derivatives ``d(J(q) u) / dq_k`` of the tool velocity of fixed joint rates ``u``,
+        shape (N, n, task_dim), for configurations ``q`` (N, n) and rates ``u`` (N, n).
+
+        For a serial chain, column i of J (R: ``z_i x (p - o_i)``, P: ``z_i``) turns with
+        every R joint k <= i (``z_k x J_i``) and, for an R joint i, follows the tool when
+        a joint k > i moves (``z_i x J_k``); so row k is
+        ``[k is R] z_k x sum_{i>=k} u_i J_i + (sum_{i<k, R} u_i z_i) x J_k``: one suffix and
+        one prefix sum, linear in the number of joints (the chain-rule sensitivity of the
+        capability measures, :func:`mechsyn.capability.maps.measure_gradient`).
+
+        Examples
+        --------
+        >>> from mechsyn.capability.arm_file import arm_from_dict
+        >>> arm = arm_from_dict({"kind": "planar_serial", "link_lengths": [1.0, 1.0],
+        ...                      "joint_speed_limits_deg_s": [10, 10]})
+        >>> q, u = np.array([[0.3, 0.5]]), np.array([[1.0, -2.0]])
+        >>> D, e = arm.jacobian_derivative(q, u), 1e-6 * np.eye(2)
+        >>> fd = [(arm.jacobian(q + e[k]) - arm.jacobian(q - e[k]))[0] @ u[0] / 2e-6 for k in range(2)]
+        >>> bool(np.allclose(D[0], fd, atol=1e-8))
+        True
+        """
+        q = np.atleast_2d(np.asarray(q, float))
+        u = np.broadcast_to(np.asarray(u, float), q.shape)
+        rev = self.is_revolute
+        J, Z = self.joint_axes(q)
+        uJ = J * u[:, None, :]
+        suffix = np.cumsum(uJ[:, :, ::-1], axis=2)[:, :, ::-1]  # sum_{i>=k} u_i J_i
+        uZ = np.where(rev, Z * u[:, None, :], 0.0)
+        prefix = np.cumsum(uZ, axis=2) - uZ  # sum_{i<k, R} u_i z_i
+        D = np.where(rev, np.cross(Z, suffix, axis=1), 0.0) + np.cross(prefix, J, axis=1)
+        return np.swapaxes(D, 1, 2)[:, :, :self.task_dim]
+
     def geometric_jacobian(self, q: np.ndarray) -> np.ndarray:
         """Spatial arms: (N, 6, n) Jacobian, rows (v_x, v_y, v_z, w_x, w_y, w_z)."""
         if self.kind == "planar":

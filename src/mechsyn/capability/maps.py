@@ -25,7 +25,7 @@ import numpy as np
 from mechsyn._result import Result
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
 from mechsyn.capability.measures import (
-    MEASURES, component_limit, exact_limit, min_norm_limit, stepped_limit,
+    MEASURES, component_limit, exact_limit, min_norm_limit, min_norm_rates, optimal_rates, stepped_limit,
 )
 from mechsyn.errors import MechsynInputError
 from mechsyn.parallel import run_tasks
@@ -231,52 +231,177 @@ def continuous_best(arm: SerialArm, points: np.ndarray, direction, measure: str 
     return best_q, best_v
 
 
+#: the continuous measure whose ascent a stepped one follows (stepping is monotone)
+_SMOOTH = {"stepped": "exact", "stepped_min_norm": "min_norm"}
+
+
+def measure_gradient(arm: SerialArm, q: np.ndarray, direction, measure: str = "exact"
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """A measure at configurations ``q`` (N, n) and its gradient over the joints (N, n).
+
+    Sensitivity of the optimum (the envelope theorem): the exact limit is
+    ``y . J(q) u`` with the dual vector ``y`` and the optimal rates ``u``
+    (:func:`~mechsyn.capability.measures.optimal_rates`), the component limit the same
+    with ``y = d`` and ``u = w sign(J^T d)``, so their gradient is ``y . d(J u)/dq``
+    (:meth:`SerialArm.jacobian_derivative`, linear in the number of joints). The
+    minimum-norm limit ``w_i / |q_dot_i|`` of its worst joint i differentiates through
+    ``q_dot = W^-1 J^T (J W^-1 J^T)^-1 d``. Where the measure is not smooth (ties between
+    facets or joints) this is the gradient of the piece that is active. A stepped measure
+    gives its continuous measure and that one's gradient (stepping is monotone).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> q = np.radians([[80.0, 30.0, -60.0]])
+    >>> v, g = measure_gradient(arm, q, [1.0, 0.0])
+    >>> e = 1e-7 * np.eye(3)
+    >>> fd = [(measure_values(arm, q + e[k], [1, 0]) - measure_values(arm, q - e[k], [1, 0]))[0] / 2e-7
+    ...       for k in range(3)]
+    >>> bool(np.allclose(g[0], fd, rtol=1e-5))
+    True
+    """
+    base = _SMOOTH.get(measure, measure)
+    if base not in MEASURES:
+        raise ValueError(f"unknown measure {measure!r}; one of {', '.join(MEASURES)}")
+    q = np.atleast_2d(np.asarray(q, float))
+    J, w = arm.jacobian(q), arm.qd_max
+    d = np.broadcast_to(np.asarray(direction, float) / np.linalg.norm(direction), (q.shape[0], arm.task_dim))
+    if base == "min_norm":
+        return _min_norm_gradient(arm, q, J, d)
+    if base == "exact":
+        v, y = exact_limit(J, w, d, dual=True)
+        u = optimal_rates(J, w, d, v, y)
+    else:
+        y = d
+        u = w * np.sign(np.einsum("nmk,nm->nk", J, d))
+        v = component_limit(J, w, d)
+    return v, np.einsum("nkm,nm->nk", arm.jacobian_derivative(q, u), y)
+
+
+def _min_norm_gradient(arm: SerialArm, q: np.ndarray, J: np.ndarray, d: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`measure_gradient` of the minimum-norm limit ``w_i / |q_dot_i|`` (worst joint
+    i). With ``lam = A^-1 d``, ``A = J W^-1 J^T``: ``dq_dot_i/dq_k = W^-1_i (dJ_i/dq_k . lam
+    - J_i . A^-1 (dJ/dq_k q_dot + J W^-1 c_k))``, ``c_k[j] = dJ_j/dq_k . lam``; the sums
+    over j are a suffix and a prefix sum of 3x3 matrices (as in
+    :meth:`SerialArm.jacobian_derivative`)."""
+    N, m, n = J.shape
+    winv = 1.0 / np.asarray(arm.weights, float)
+    qd, ok = min_norm_rates(J, d, arm.weights)
+    v = min_norm_limit(J, arm.qd_max, d, arm.weights)
+    Ainv = np.linalg.pinv((J * winv) @ np.swapaxes(J, 1, 2), hermitian=True)
+    lam = np.einsum("nij,nj->ni", Ainv, d)
+    J3, Z = arm.joint_axes(q)
+    rev = arm.is_revolute
+    lam3 = np.concatenate([lam, np.zeros((N, 3 - m))], axis=1)
+    i = np.argmax(np.abs(qd) / arm.qd_max, axis=1)  # the worst joint
+    rows = np.arange(N)
+    Ji, zi = J3[rows, :, i], Z[rows, :, i]
+    k = np.arange(n)
+    # a_k = dJ_i/dq_k . lam: z_k x J_i (R joint k <= i), z_i x J_k (k > i, R joint i)
+    a = np.where(rev & (k <= i[:, None]), np.einsum("nmk,nm->nk", np.cross(Z, Ji[:, :, None], axis=1), lam3), 0.0)
+    a += np.where((k > i[:, None]) & rev[i][:, None],
+                  np.einsum("nmk,nm->nk", np.cross(zi[:, :, None], J3, axis=1), lam3), 0.0)
+    b = arm.jacobian_derivative(q, qd)  # (N, n, m)
+    # e_k = sum_j winv_j J_j (dJ_j/dq_k . lam): [sum_{j>=k} winv_j J_j (J_j x lam)^T] z_k (R k)
+    # + [sum_{j<k, R} winv_j J_j (lam x z_j)^T] J_k
+    wJ = J3 * winv
+    Mj = np.einsum("nak,nbk->nkab", wJ, np.cross(J3, lam3[:, :, None], axis=1))
+    suffix = np.cumsum(Mj[:, ::-1], axis=1)[:, ::-1]
+    Pj = np.where(rev[:, None, None], np.einsum("nak,nbk->nkab", wJ, np.cross(lam3[:, :, None], Z, axis=1)), 0.0)
+    prefix = np.cumsum(Pj, axis=1) - Pj
+    e = np.where(rev[:, None], np.einsum("nkab,nbk->nka", suffix, Z), 0.0) + np.einsum("nkab,nbk->nka", prefix, J3)
+    dqd = winv[i][:, None] * (a - np.einsum("nm,nmj,nkj->nk", J[rows, :, i], Ainv, b + e[:, :, :m]))
+    qdi = qd[rows, i]
+    g = np.where((ok & (v > 0))[:, None], -v[:, None] * dqd / np.where(qdi != 0, qdi, 1.0)[:, None], 0.0)
+    return v, g
+
+
 def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
                             measure: str = "exact", respect_limits: bool = True,
                             iterations: int = 40, step: float = 0.2
                             ) -> tuple[np.ndarray, np.ndarray]:
-    """Local search over the self-motion manifold from configurations ``q0`` (K, n).
+    """Local ascent over the self-motion manifold from configurations ``q0`` (K, n).
 
-    Pattern search in the null space of J: each iteration tries ``q +/- h v_j`` for every
-    null-space basis vector ``v_j`` (from the SVD of J), pulls each trial back onto the
-    point with damped least squares (:func:`ik_numeric`), keeps the best improving one
-    (within the limits), and halves ``h`` where nothing improves; a start whose ``h``
-    falls below 1e-6 is done. Vectorised over the K starts, each independent of the
-    others; deterministic. ``point`` is one (task_dim,) or one per start (K, task_dim),
-    so the starts of many grid points run together. Returns the refined ``q`` (K, n)
-    and their measure (K,).
+    Each iteration moves along the measure's gradient (:func:`measure_gradient`)
+    projected onto the null space of J (the tangent of the self-motion), by ``2h``, ``h``
+    and ``h/2``, and by ``h`` and ``h/2`` along the shortest combination of that gradient
+    and the one found a step ``h`` ahead in the last iteration (the measure is a minimum
+    of smooth pieces; where two meet in a ridge, their gradients point across it and the
+    combination along it); each trial is pulled back onto the point with damped least
+    squares (:func:`ik_numeric`); the best improving one (within the limits) is kept
+    with its step as the next ``h``; where none improves, ``h`` is divided by 4, and a
+    start whose ``h`` falls below 1e-6, or whose projected gradient vanishes, is done.
+    Five trials per start and iteration, each linear in the number of joints (a search
+    along every null direction cost a number of trials that grew with the joints, each
+    of them growing too). A stepped measure ascends its continuous measure (stepping is
+    monotone, so the same configurations are best). Vectorised over the K starts, each
+    independent of the others; deterministic. ``point`` is one (task_dim,) or one per
+    start (K, task_dim), so the starts of many grid points run together. Returns the
+    refined ``q`` (K, n) and their measure (K,).
     """
     q = np.atleast_2d(np.asarray(q0, float)).copy()
     K, n = q.shape
     r = arm.task_dim
+    base = _SMOOTH.get(measure, measure)
     target = np.broadcast_to(np.asarray(point, float), (K, r))
-    val = measure_values(arm, q, direction, measure)
+    val = measure_values(arm, q, direction, base)
     h = np.full(K, step)
+    other = np.zeros((K, n))  # the gradient one step ahead (the far side of a ridge)
     active = np.arange(K) if n > r else np.arange(0)
+    scale = np.array([2.0, 1.0, 0.5, 1.0, 0.5])  # along the gradient, then along the ridge
     for _ in range(iterations):
         if not active.size:
             break
         qa = q[active]
         A = qa.shape[0]
-        _, _, Vt = np.linalg.svd(arm.jacobian(qa))
-        null = Vt[:, r:, :]  # (A, n - r, n)
-        moves = np.concatenate([null, -null], axis=1) * h[active][:, None, None]  # (A, T, n)
-        T = moves.shape[1]
-        trial, ok = ik_numeric(arm, np.repeat(target[active], T, axis=0),
-                               (qa[:, None, :] + moves).reshape(-1, n),
+        J = arm.jacobian(qa)
+        g = _null_part(J, measure_gradient(arm, qa, direction, base)[1])
+        ridge = _min_norm_combination(g, _null_part(J, other[active]))
+        moving = np.linalg.norm(g, axis=1) > 1e-12 * np.maximum(np.abs(val[active]), 1e-300)
+        dirs = np.stack([_unit(g)] * 3 + [_unit(ridge)] * 2, axis=1)  # (A, 5, n)
+        trial, ok = ik_numeric(arm, np.repeat(target[active], 5, axis=0),
+                               (qa[:, None, :] + h[active][:, None, None] * scale[:, None] * dirs).reshape(-1, n),
                                respect_limits=respect_limits, iterations=30, tol=1e-9)
-        tv = measure_values(arm, trial, direction, measure)
+        tv = measure_values(arm, trial, direction, base)
         if respect_limits:
             ok &= arm.within_limits(trial)
-        tv = np.where(ok, tv, -np.inf).reshape(A, T)
+        tv = np.where(ok, tv, -np.inf).reshape(A, 5)
+        trial = trial.reshape(A, 5, n)
+        ahead = np.where(np.isfinite(tv[:, 1])[:, None], trial[:, 1], qa)
+        other[active] = measure_gradient(arm, ahead, direction, base)[1]
         k = np.argmax(tv, axis=1)
         best = tv[np.arange(A), k]
-        better = best > val[active] + 1e-12 * np.abs(val[active])
-        q[active[better]] = trial.reshape(A, T, n)[np.arange(A), k][better]
+        better = moving & (best > val[active] + 1e-12 * np.abs(val[active]))
+        q[active[better]] = trial[np.arange(A), k][better]
         val[active] = np.where(better, best, val[active])
-        h[active] = np.where(better, h[active], h[active] / 2)
-        active = active[h[active] >= 1e-6]
-    return q, val
+        h[active] = np.where(better, np.minimum(h[active] * scale[k], 16 * step), h[active] / 4)
+        active = active[moving & (h[active] >= 1e-6)]
+    return q, (val if base == measure else measure_values(arm, q, direction, measure))
+
+
+def _null_part(J: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """``g`` (N, n) without its part in the row space of ``J`` (N, m, n): its projection
+    on the tangent of the self-motion, ``g - J^T (J J^T)^+ J g``."""
+    JJt = np.linalg.pinv(J @ np.swapaxes(J, 1, 2), hermitian=True)
+    return g - np.einsum("nmk,nm->nk", J, np.einsum("nij,njk,nk->ni", JJt, J, g))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = np.linalg.norm(v, axis=1, keepdims=True)
+    return v / np.where(norm > 0, norm, 1.0)
+
+
+def _min_norm_combination(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The shortest vector on the segment between ``a`` and ``b`` (rows): the steepest
+    ascent of the minimum of two smooth pieces (gradients ``a``, ``b``), along their
+    ridge when they point across it; ``a`` when ``b`` is zero."""
+    diff = a - b
+    dd = np.einsum("nk,nk->n", diff, diff)
+    t = np.clip(-np.einsum("nk,nk->n", diff, b) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    t = np.where((dd > 0) & np.any(b != 0, axis=1), t, 1.0)
+    return t[:, None] * a + (1 - t[:, None]) * b
 
 
 @dataclass(repr=False)
