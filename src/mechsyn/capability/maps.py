@@ -253,7 +253,7 @@ def measure_gradient(arm: SerialArm, q: np.ndarray, direction, measure: str = "e
     --------
     >>> import mechsyn as ms
     >>> arm = ms.examples.load("paper004_3r")
-    >>> q = np.radians([[80.0, 30.0, -60.0]])
+    >>> q = np.radians([[80.0, 25.0, -70.0]])
     >>> v, g = measure_gradient(arm, q, [1.0, 0.0])
     >>> e = 1e-7 * np.eye(3)
     >>> fd = [(measure_values(arm, q + e[k], [1, 0]) - measure_values(arm, q - e[k], [1, 0]))[0] / 2e-7
@@ -264,11 +264,19 @@ def measure_gradient(arm: SerialArm, q: np.ndarray, direction, measure: str = "e
     base = _SMOOTH.get(measure, measure)
     if base not in MEASURES:
         raise ValueError(f"unknown measure {measure!r}; one of {', '.join(MEASURES)}")
-    q = np.atleast_2d(np.asarray(q, float))
-    J, w = arm.jacobian(q), arm.qd_max
+    v, g, _ = _value_gradient(arm, np.atleast_2d(np.asarray(q, float)), direction, base)
+    return v, g
+
+
+def _value_gradient(arm: SerialArm, q: np.ndarray, direction, base: str
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`measure_gradient` of a continuous measure ``base``, and the Jacobians
+    (N, task_dim, n), from one computation of the joint frames."""
+    axes = arm.joint_axes(q)
+    J, w = axes[0][:, :arm.task_dim], arm.qd_max
     d = np.broadcast_to(np.asarray(direction, float) / np.linalg.norm(direction), (q.shape[0], arm.task_dim))
     if base == "min_norm":
-        return _min_norm_gradient(arm, q, J, d)
+        return (*_min_norm_gradient(arm, q, axes, d), J)
     if base == "exact":
         v, y = exact_limit(J, w, d, dual=True)
         u = optimal_rates(J, w, d, v, y)
@@ -276,23 +284,24 @@ def measure_gradient(arm: SerialArm, q: np.ndarray, direction, measure: str = "e
         y = d
         u = w * np.sign(np.einsum("nmk,nm->nk", J, d))
         v = component_limit(J, w, d)
-    return v, np.einsum("nkm,nm->nk", arm.jacobian_derivative(q, u), y)
+    return v, np.einsum("nkm,nm->nk", arm.jacobian_derivative(q, u, axes), y), J
 
 
-def _min_norm_gradient(arm: SerialArm, q: np.ndarray, J: np.ndarray, d: np.ndarray
+def _min_norm_gradient(arm: SerialArm, q: np.ndarray, axes: tuple[np.ndarray, np.ndarray], d: np.ndarray
                        ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`measure_gradient` of the minimum-norm limit ``w_i / |q_dot_i|`` (worst joint
     i). With ``lam = A^-1 d``, ``A = J W^-1 J^T``: ``dq_dot_i/dq_k = W^-1_i (dJ_i/dq_k . lam
     - J_i . A^-1 (dJ/dq_k q_dot + J W^-1 c_k))``, ``c_k[j] = dJ_j/dq_k . lam``; the sums
     over j are a suffix and a prefix sum of 3x3 matrices (as in
     :meth:`SerialArm.jacobian_derivative`)."""
+    J3, Z = axes
+    J = J3[:, :arm.task_dim]
     N, m, n = J.shape
     winv = 1.0 / np.asarray(arm.weights, float)
     qd, ok = min_norm_rates(J, d, arm.weights)
     v = min_norm_limit(J, arm.qd_max, d, arm.weights)
     Ainv = np.linalg.pinv((J * winv) @ np.swapaxes(J, 1, 2), hermitian=True)
     lam = np.einsum("nij,nj->ni", Ainv, d)
-    J3, Z = arm.joint_axes(q)
     rev = arm.is_revolute
     lam3 = np.concatenate([lam, np.zeros((N, 3 - m))], axis=1)
     i = np.argmax(np.abs(qd) / arm.qd_max, axis=1)  # the worst joint
@@ -303,7 +312,7 @@ def _min_norm_gradient(arm: SerialArm, q: np.ndarray, J: np.ndarray, d: np.ndarr
     a = np.where(rev & (k <= i[:, None]), np.einsum("nmk,nm->nk", np.cross(Z, Ji[:, :, None], axis=1), lam3), 0.0)
     a += np.where((k > i[:, None]) & rev[i][:, None],
                   np.einsum("nmk,nm->nk", np.cross(zi[:, :, None], J3, axis=1), lam3), 0.0)
-    b = arm.jacobian_derivative(q, qd)  # (N, n, m)
+    b = arm.jacobian_derivative(q, qd, axes)  # (N, n, m)
     # e_k = sum_j winv_j J_j (dJ_j/dq_k . lam): [sum_{j>=k} winv_j J_j (J_j x lam)^T] z_k (R k)
     # + [sum_{j<k, R} winv_j J_j (lam x z_j)^T] J_k
     wJ = J3 * winv
@@ -346,7 +355,7 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
     r = arm.task_dim
     base = _SMOOTH.get(measure, measure)
     target = np.broadcast_to(np.asarray(point, float), (K, r))
-    val = measure_values(arm, q, direction, base)
+    val, grad, jac = _value_gradient(arm, q, direction, base)  # at q; each trial's come with it
     h = np.full(K, step)
     other = np.zeros((K, n))  # the gradient one step ahead (the far side of a ridge)
     active = np.arange(K) if n > r else np.arange(0)
@@ -354,27 +363,27 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
     for _ in range(iterations):
         if not active.size:
             break
-        qa = q[active]
+        qa, J = q[active], jac[active]
         A = qa.shape[0]
-        J = arm.jacobian(qa)
-        g = _null_part(J, measure_gradient(arm, qa, direction, base)[1])
+        g = _null_part(J, grad[active])
         ridge = _min_norm_combination(g, _null_part(J, other[active]))
         moving = np.linalg.norm(g, axis=1) > 1e-12 * np.maximum(np.abs(val[active]), 1e-300)
         dirs = np.stack([_unit(g)] * 3 + [_unit(ridge)] * 2, axis=1)  # (A, 5, n)
         trial, ok = ik_numeric(arm, np.repeat(target[active], 5, axis=0),
                                (qa[:, None, :] + h[active][:, None, None] * scale[:, None] * dirs).reshape(-1, n),
                                respect_limits=respect_limits, iterations=30, tol=1e-9)
-        tv = measure_values(arm, trial, direction, base)
+        tv, tg, tJ = (x.reshape(A, 5, *x.shape[1:]) for x in _value_gradient(arm, trial, direction, base))
         if respect_limits:
             ok &= arm.within_limits(trial)
-        tv = np.where(ok, tv, -np.inf).reshape(A, 5)
+        tv = np.where(ok.reshape(A, 5), tv, -np.inf)
         trial = trial.reshape(A, 5, n)
-        ahead = np.where(np.isfinite(tv[:, 1])[:, None], trial[:, 1], qa)
-        other[active] = measure_gradient(arm, ahead, direction, base)[1]
+        other[active] = np.where(np.isfinite(tv[:, 1])[:, None], tg[:, 1], grad[active])
         k = np.argmax(tv, axis=1)
-        best = tv[np.arange(A), k]
+        pick = np.arange(A), k
+        best = tv[pick]
         better = moving & (best > val[active] + 1e-12 * np.abs(val[active]))
-        q[active[better]] = trial[np.arange(A), k][better]
+        up = active[better]
+        q[up], grad[up], jac[up] = trial[pick][better], tg[pick][better], tJ[pick][better]
         val[active] = np.where(better, best, val[active])
         h[active] = np.where(better, np.minimum(h[active] * scale[k], 16 * step), h[active] / 4)
         active = active[moving & (h[active] >= 1e-6)]
