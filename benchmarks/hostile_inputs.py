@@ -14,9 +14,14 @@
    wide, all NaN, a header declaring 1e11 rows) and an atlas stream line of 10,000
    nested brackets. Each must answer one line on stderr and exit 2 within 15 s, with no
    traceback; printed as a table.
+4. With ``--studio``, a real ``mechsyn serve`` (started as benchmarks/studio_server.py
+   does): ``POST /api/spatial/view`` with a joint axis (1e300, 1e300, 1e300) must be a
+   400, and a client with its token must be served within 3 s while 250 connections that
+   sent a request line only are held open. (The 8 clients hammering the structure check:
+   benchmarks/studio_server.py.)
 
     python benchmarks/hostile_inputs.py [--links 5000 10000 20000 40000] [--joints 20 40 80 100]
-                                        [--skip-outside]
+                                        [--skip-outside] [--studio]
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import io
 import os
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -173,14 +179,61 @@ def outside() -> bool:
     return ok
 
 
+def studio() -> bool:
+    """The issue's server cases against a real ``mechsyn serve``; True when both hold."""
+    import socket
+
+    import httpx
+
+    sys.path.insert(0, str(HERE))
+    from studio_server import start_server
+
+    from mechsyn.io import load_mechanism, mechanism_to_dict
+    from mechsyn.web._service import example_path
+
+    p, base, headers = start_server()
+    idle: list[socket.socket] = []
+    try:
+        m = mechanism_to_dict(load_mechanism(example_path("bennett")))
+        m["joints"][2]["axis"] = [1e300, 1e300, 1e300]
+        r = httpx.post(f"{base}/api/spatial/view", json={"mechanism": m}, headers=headers, timeout=60)
+        axis_ok = r.status_code == 400
+        print(f"studio: POST /api/spatial/view, axis (1e300, 1e300, 1e300): {r.status_code} "
+              f"{r.text[:120]!r}  {'holds' if axis_ok else 'FAILS'}")
+        port = int(base.rsplit(":", 1)[1])
+        for _ in range(250):
+            s = socket.create_connection(("127.0.0.1", port))
+            s.sendall(b"GET /api/start HTTP/1.1\r\n")
+            idle.append(s)
+        time.sleep(1.0)
+        t0 = time.perf_counter()
+        r = httpx.get(f"{base}/api/start", headers=headers, timeout=60)
+        dt = time.perf_counter() - t0
+        idle_ok = r.status_code == 200 and dt < 3
+        print(f"studio: GET /api/start with its token, 250 idle connections open: {r.status_code} in "
+              f"{dt * 1000:.0f} ms  {'holds' if idle_ok else 'FAILS'}")
+        return axis_ok and idle_ok
+    finally:
+        for s in idle:
+            s.close()
+        p.send_signal(signal.SIGINT)
+        try:
+            p.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            p.kill()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--links", type=int, nargs="*", default=[5_000, 10_000, 20_000, 40_000])
     ap.add_argument("--joints", type=int, nargs="*", default=[20, 40, 80, 100])
     ap.add_argument("--skip-outside", action="store_true", help="leave out the outside CLI check")
+    ap.add_argument("--studio", action="store_true", help="also the server cases (a real mechsyn serve)")
     args = ap.parse_args()
     if not args.skip_outside and not outside():
         print("the outside check FAILS")
+    if args.studio and not studio():
+        print("the studio check FAILS")
     pyslvs(args.links)
     capability(args.joints)
 

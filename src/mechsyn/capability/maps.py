@@ -335,13 +335,14 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
 
     Each iteration moves along the measure's gradient (:func:`measure_gradient`)
     projected onto the null space of J (the tangent of the self-motion), by ``2h``, ``h``
-    and ``h/2``, and by ``h`` and ``h/2`` along the shortest combination of that gradient
-    and the one found a step ``h`` ahead in the last iteration (the measure is a minimum
-    of smooth pieces; where two meet in a ridge, their gradients point across it and the
-    combination along it); each trial is pulled back onto the point with damped least
-    squares (:func:`ik_numeric`); the best improving one (within the limits) is kept
-    with its step as the next ``h``; where none improves, ``h`` is divided by 4, and a
-    start whose ``h`` falls below 1e-6, or whose projected gradient vanishes, is done.
+    and ``h/2``, and by ``h`` and ``h/2`` along the shortest vector in the convex hull of
+    that gradient and the gradients at the last iteration's trials (gradient sampling:
+    the measure is a minimum of smooth pieces; where pieces meet in a ridge, their
+    gradients point across it and that vector along it); each trial is pulled back onto
+    the point with damped least squares (:func:`ik_numeric`); the best improving one
+    (within the limits) is kept with its step as the next ``h``; where none improves,
+    ``h`` is divided by 4, and a start whose ``h`` falls below 1e-6, or whose projected
+    gradient vanishes, is done.
     Five trials per start and iteration, each linear in the number of joints (a search
     along every null direction cost a number of trials that grew with the joints, each
     of them growing too). A stepped measure ascends its continuous measure (stepping is
@@ -357,7 +358,7 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
     target = np.broadcast_to(np.asarray(point, float), (K, r))
     val, grad, jac = _value_gradient(arm, q, direction, base)  # at q; each trial's come with it
     h = np.full(K, step)
-    other = np.zeros((K, n))  # the gradient one step ahead (the far side of a ridge)
+    sampled = np.repeat(grad[:, None, :], 5, axis=1)  # the gradients at the last trials (around q)
     active = np.arange(K) if n > r else np.arange(0)
     scale = np.array([2.0, 1.0, 0.5, 1.0, 0.5])  # along the gradient, then along the ridge
     for _ in range(iterations):
@@ -366,7 +367,8 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
         qa, J = q[active], jac[active]
         A = qa.shape[0]
         g = _null_part(J, grad[active])
-        ridge = _min_norm_combination(g, _null_part(J, other[active]))
+        bundle = np.concatenate([g[:, None], _null_part(J[:, None], sampled[active])], axis=1)
+        ridge = _min_norm_combination(bundle)
         moving = np.linalg.norm(g, axis=1) > 1e-12 * np.maximum(np.abs(val[active]), 1e-300)
         dirs = np.stack([_unit(g)] * 3 + [_unit(ridge)] * 2, axis=1)  # (A, 5, n)
         trial, ok = ik_numeric(arm, np.repeat(target[active], 5, axis=0),
@@ -377,7 +379,7 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
             ok &= arm.within_limits(trial)
         tv = np.where(ok.reshape(A, 5), tv, -np.inf)
         trial = trial.reshape(A, 5, n)
-        other[active] = np.where(np.isfinite(tv[:, 1])[:, None], tg[:, 1], grad[active])
+        sampled[active] = np.where(np.isfinite(tv)[:, :, None], tg, grad[active][:, None])
         k = np.argmax(tv, axis=1)
         pick = np.arange(A), k
         best = tv[pick]
@@ -391,10 +393,10 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
 
 
 def _null_part(J: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """``g`` (N, n) without its part in the row space of ``J`` (N, m, n): its projection
-    on the tangent of the self-motion, ``g - J^T (J J^T)^+ J g``."""
-    JJt = np.linalg.pinv(J @ np.swapaxes(J, 1, 2), hermitian=True)
-    return g - np.einsum("nmk,nm->nk", J, np.einsum("nij,njk,nk->ni", JJt, J, g))
+    """``g`` (..., n) without its part in the row space of ``J`` (..., m, n): its
+    projection on the tangent of the self-motion, ``g - J^T (J J^T)^+ J g``."""
+    JJt = np.linalg.pinv(J @ np.swapaxes(J, -1, -2), hermitian=True)
+    return g - np.einsum("...mk,...m->...k", J, np.einsum("...ij,...jk,...k->...i", JJt, J, g))
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -402,15 +404,19 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.where(norm > 0, norm, 1.0)
 
 
-def _min_norm_combination(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The shortest vector on the segment between ``a`` and ``b`` (rows): the steepest
-    ascent of the minimum of two smooth pieces (gradients ``a``, ``b``), along their
-    ridge when they point across it; ``a`` when ``b`` is zero."""
-    diff = a - b
-    dd = np.einsum("nk,nk->n", diff, diff)
-    t = np.clip(-np.einsum("nk,nk->n", diff, b) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
-    t = np.where((dd > 0) & np.any(b != 0, axis=1), t, 1.0)
-    return t[:, None] * a + (1 - t[:, None]) * b
+def _min_norm_combination(V: np.ndarray, rounds: int = 50) -> np.ndarray:
+    """The shortest vector in the convex hull of the rows of ``V`` (N, k, n) (Frank and
+    Wolfe with exact line search, from ``V[:, 0]``): the steepest ascent of a minimum of
+    smooth pieces whose gradients are the rows (gradient sampling, Burke, Lewis and
+    Overton 2005); along a ridge where gradients from its two sides point across it."""
+    x = V[:, 0].copy()
+    for _ in range(rounds):
+        j = np.argmin(np.einsum("nkj,nj->nk", V, x), axis=1)
+        diff = x - V[np.arange(len(j)), j]
+        dd = np.einsum("nj,nj->n", diff, diff)
+        t = np.clip(np.einsum("nj,nj->n", diff, x) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+        x -= t[:, None] * diff
+    return x
 
 
 @dataclass(repr=False)
