@@ -108,3 +108,15 @@ def test_urdf_chain_and_the_same_chain_written_planar_give_equal_answers(tmp_pat
     assert ru.continuous_best["exact"] > ru.best["exact"]
     assert ru.continuous_best["exact"] == pytest.approx(rp.continuous_best["exact"], rel=1e-6)
     np.testing.assert_allclose(ru.continuous_best["q_deg"], rp.continuous_best["q_deg"], atol=1e-3)
+
+
+def test_a_start_not_reached_stays_unreached_and_the_others_are_refined():
+    from mechsyn.capability.maps import self_motion
+
+    arm = load_arm(UR5)
+    p = np.array([400.0, 200.0, 300.0])
+    q, valid = self_motion(arm, p, seeds=16)
+    q = np.vstack([q[valid][:2], np.full(6, np.nan)])
+    qr, vr = refine_over_self_motion(arm, p, q, (1, 0, 0), iterations=5)
+    assert np.isneginf(vr[2]) and np.isnan(qr[2]).all()
+    assert np.all(vr[:2] >= measure_values(arm, q[:2], (1, 0, 0)))

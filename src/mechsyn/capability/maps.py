@@ -356,10 +356,13 @@ def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
     r = arm.task_dim
     base = _SMOOTH.get(measure, measure)
     target = np.broadcast_to(np.asarray(point, float), (K, r))
-    val, grad, jac = _value_gradient(arm, q, direction, base)  # at q; each trial's come with it
+    good = np.all(np.isfinite(q), axis=1)  # a NaN row (not reached) stays as it is, at -inf
+    val, grad, jac = np.full(K, -np.inf), np.zeros((K, n)), np.zeros((K, r, n))
+    if good.any():  # at q; each trial's come with it
+        val[good], grad[good], jac[good] = _value_gradient(arm, q[good], direction, base)
     h = np.full(K, step)
     sampled = np.repeat(grad[:, None, :], 5, axis=1)  # the gradients at the last trials (around q)
-    active = np.arange(K) if n > r else np.arange(0)
+    active = np.flatnonzero(good) if n > r else np.arange(0)
     scale = np.array([2.0, 1.0, 0.5, 1.0, 0.5])  # along the gradient, then along the ridge
     for _ in range(iterations):
         if not active.size:
