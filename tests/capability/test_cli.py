@@ -167,3 +167,20 @@ def test_bad_arm_file_exit_2(tmp_path, capsys):
     assert main(["capability", str(bad), "--point", "1,1", "--direction", "1,0"]) == 2
     err = capsys.readouterr().err
     assert "arm.yaml" in err and "joint_speed_limits_deg_s" in err
+
+
+def test_long_arm_table_fits_80_columns(capsys, tmp_path, monkeypatch):
+    """A 12-joint arm's point table lists the joint values below the measures, wrapped to
+    the terminal, instead of one column per joint (a 100-joint arm's table was 2,000 wide)."""
+    from mechsyn.cli import render
+
+    monkeypatch.setattr(render.console, "width", 80)
+    arm = tmp_path / "arm12.yaml"
+    arm.write_text(f"kind: planar_serial\nlink_lengths: {[0.1] * 12}\njoint_speed_limits_deg_s: {[10] * 12}\n")
+    assert main(["capability", str(arm), "--direction", "1,0", "--point", "0.3,0.2"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert max(len(line) for line in lines) <= 80
+    best = [line for line in lines if " best " in f" {line} "]
+    assert best and best[0].split()[0].isdigit()  # the best configuration's row, numbered
+    listed = [line for line in lines if line.startswith(f"{best[0].split()[0]}: q (deg) = ")]
+    assert listed, lines  # its joint values below the table

@@ -22,20 +22,20 @@ References
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
 from mechsyn.capability.maps import (
     CapabilityMap, capability_map, continuous_best, interpolate_configuration,
-    measure_values, refine_over_self_motion, self_motion,
+    measure_gradient, measure_values, refine_over_self_motion, self_motion,
 )
 from mechsyn.capability.measures import (
     MEASURES, VelocityEllipse, VelocityPolytope, all_measures, component_limit,
-    exact_limit, exact_limit_lp, min_norm_limit, min_norm_rates, stepped_limit,
+    exact_limit, exact_limit_lp, min_norm_limit, min_norm_rates, optimal_rates, stepped_limit,
     velocity_ellipse, velocity_polytope,
 )
 
 __all__ = [
     "SerialArm", "arm_from_dict", "ik_numeric", "ik_planar_3r", "load_arm",
     "CapabilityMap", "capability_map", "continuous_best", "interpolate_configuration",
-    "measure_values", "refine_over_self_motion", "self_motion",
+    "measure_gradient", "measure_values", "refine_over_self_motion", "self_motion",
     "MEASURES", "VelocityEllipse", "VelocityPolytope", "all_measures", "component_limit",
-    "exact_limit", "exact_limit_lp", "min_norm_limit", "min_norm_rates", "stepped_limit",
+    "exact_limit", "exact_limit_lp", "min_norm_limit", "min_norm_rates", "optimal_rates", "stepped_limit",
     "velocity_ellipse", "velocity_polytope",
 ]
 

@@ -25,7 +25,7 @@ import numpy as np
 from mechsyn._result import Result
 from mechsyn.capability.arm import SerialArm, ik_numeric, ik_planar_3r
 from mechsyn.capability.measures import (
-    MEASURES, component_limit, exact_limit, min_norm_limit, stepped_limit,
+    MEASURES, component_limit, exact_limit, min_norm_limit, min_norm_rates, optimal_rates, stepped_limit,
 )
 from mechsyn.errors import MechsynInputError
 from mechsyn.parallel import run_tasks
@@ -231,52 +231,195 @@ def continuous_best(arm: SerialArm, points: np.ndarray, direction, measure: str 
     return best_q, best_v
 
 
+#: the continuous measure whose ascent a stepped one follows (stepping is monotone)
+_SMOOTH = {"stepped": "exact", "stepped_min_norm": "min_norm"}
+
+
+def measure_gradient(arm: SerialArm, q: np.ndarray, direction, measure: str = "exact"
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """A measure at configurations ``q`` (N, n) and its gradient over the joints (N, n).
+
+    Sensitivity of the optimum (the envelope theorem): the exact limit is
+    ``y . J(q) u`` with the dual vector ``y`` and the optimal rates ``u``
+    (:func:`~mechsyn.capability.measures.optimal_rates`), the component limit the same
+    with ``y = d`` and ``u = w sign(J^T d)``, so their gradient is ``y . d(J u)/dq``
+    (:meth:`SerialArm.jacobian_derivative`, linear in the number of joints). The
+    minimum-norm limit ``w_i / |q_dot_i|`` of its worst joint i differentiates through
+    ``q_dot = W^-1 J^T (J W^-1 J^T)^-1 d``. Where the measure is not smooth (ties between
+    facets or joints) this is the gradient of the piece that is active. A stepped measure
+    gives its continuous measure and that one's gradient (stepping is monotone).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> arm = ms.examples.load("paper004_3r")
+    >>> q = np.radians([[80.0, 25.0, -70.0]])
+    >>> v, g = measure_gradient(arm, q, [1.0, 0.0])
+    >>> e = 1e-7 * np.eye(3)
+    >>> fd = [(measure_values(arm, q + e[k], [1, 0]) - measure_values(arm, q - e[k], [1, 0]))[0] / 2e-7
+    ...       for k in range(3)]
+    >>> bool(np.allclose(g[0], fd, rtol=1e-5))
+    True
+    """
+    base = _SMOOTH.get(measure, measure)
+    if base not in MEASURES:
+        raise ValueError(f"unknown measure {measure!r}; one of {', '.join(MEASURES)}")
+    v, g, _ = _value_gradient(arm, np.atleast_2d(np.asarray(q, float)), direction, base)
+    return v, g
+
+
+def _value_gradient(arm: SerialArm, q: np.ndarray, direction, base: str
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`measure_gradient` of a continuous measure ``base``, and the Jacobians
+    (N, task_dim, n), from one computation of the joint frames."""
+    axes = arm.joint_axes(q)
+    J, w = axes[0][:, :arm.task_dim], arm.qd_max
+    d = np.broadcast_to(np.asarray(direction, float) / np.linalg.norm(direction), (q.shape[0], arm.task_dim))
+    if base == "min_norm":
+        return (*_min_norm_gradient(arm, q, axes, d), J)
+    if base == "exact":
+        v, y = exact_limit(J, w, d, dual=True)
+        u = optimal_rates(J, w, d, v, y)
+    else:
+        y = d
+        u = w * np.sign(np.einsum("nmk,nm->nk", J, d))
+        v = component_limit(J, w, d)
+    return v, np.einsum("nkm,nm->nk", arm.jacobian_derivative(q, u, axes), y), J
+
+
+def _min_norm_gradient(arm: SerialArm, q: np.ndarray, axes: tuple[np.ndarray, np.ndarray], d: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`measure_gradient` of the minimum-norm limit ``w_i / |q_dot_i|`` (worst joint
+    i). With ``lam = A^-1 d``, ``A = J W^-1 J^T``: ``dq_dot_i/dq_k = W^-1_i (dJ_i/dq_k . lam
+    - J_i . A^-1 (dJ/dq_k q_dot + J W^-1 c_k))``, ``c_k[j] = dJ_j/dq_k . lam``; the sums
+    over j are a suffix and a prefix sum of 3x3 matrices (as in
+    :meth:`SerialArm.jacobian_derivative`)."""
+    J3, Z = axes
+    J = J3[:, :arm.task_dim]
+    N, m, n = J.shape
+    winv = 1.0 / np.asarray(arm.weights, float)
+    qd, ok = min_norm_rates(J, d, arm.weights)
+    v = min_norm_limit(J, arm.qd_max, d, arm.weights)
+    Ainv = np.linalg.pinv((J * winv) @ np.swapaxes(J, 1, 2), hermitian=True)
+    lam = np.einsum("nij,nj->ni", Ainv, d)
+    rev = arm.is_revolute
+    lam3 = np.concatenate([lam, np.zeros((N, 3 - m))], axis=1)
+    i = np.argmax(np.abs(qd) / arm.qd_max, axis=1)  # the worst joint
+    rows = np.arange(N)
+    Ji, zi = J3[rows, :, i], Z[rows, :, i]
+    k = np.arange(n)
+    # a_k = dJ_i/dq_k . lam: z_k x J_i (R joint k <= i), z_i x J_k (k > i, R joint i)
+    a = np.where(rev & (k <= i[:, None]), np.einsum("nmk,nm->nk", np.cross(Z, Ji[:, :, None], axis=1), lam3), 0.0)
+    a += np.where((k > i[:, None]) & rev[i][:, None],
+                  np.einsum("nmk,nm->nk", np.cross(zi[:, :, None], J3, axis=1), lam3), 0.0)
+    b = arm.jacobian_derivative(q, qd, axes)  # (N, n, m)
+    # e_k = sum_j winv_j J_j (dJ_j/dq_k . lam): [sum_{j>=k} winv_j J_j (J_j x lam)^T] z_k (R k)
+    # + [sum_{j<k, R} winv_j J_j (lam x z_j)^T] J_k
+    wJ = J3 * winv
+    Mj = np.einsum("nak,nbk->nkab", wJ, np.cross(J3, lam3[:, :, None], axis=1))
+    suffix = np.cumsum(Mj[:, ::-1], axis=1)[:, ::-1]
+    Pj = np.where(rev[:, None, None], np.einsum("nak,nbk->nkab", wJ, np.cross(lam3[:, :, None], Z, axis=1)), 0.0)
+    prefix = np.cumsum(Pj, axis=1) - Pj
+    e = np.where(rev[:, None], np.einsum("nkab,nbk->nka", suffix, Z), 0.0) + np.einsum("nkab,nbk->nka", prefix, J3)
+    dqd = winv[i][:, None] * (a - np.einsum("nm,nmj,nkj->nk", J[rows, :, i], Ainv, b + e[:, :, :m]))
+    qdi = qd[rows, i]
+    g = np.where((ok & (v > 0))[:, None], -v[:, None] * dqd / np.where(qdi != 0, qdi, 1.0)[:, None], 0.0)
+    return v, g
+
+
 def refine_over_self_motion(arm: SerialArm, point, q0: np.ndarray, direction,
                             measure: str = "exact", respect_limits: bool = True,
                             iterations: int = 40, step: float = 0.2
                             ) -> tuple[np.ndarray, np.ndarray]:
-    """Local search over the self-motion manifold from configurations ``q0`` (K, n).
+    """Local ascent over the self-motion manifold from configurations ``q0`` (K, n).
 
-    Pattern search in the null space of J: each iteration tries ``q +/- h v_j`` for every
-    null-space basis vector ``v_j`` (from the SVD of J), pulls each trial back onto the
-    point with damped least squares (:func:`ik_numeric`), keeps the best improving one
-    (within the limits), and halves ``h`` where nothing improves; a start whose ``h``
-    falls below 1e-6 is done. Vectorised over the K starts, each independent of the
-    others; deterministic. ``point`` is one (task_dim,) or one per start (K, task_dim),
-    so the starts of many grid points run together. Returns the refined ``q`` (K, n)
-    and their measure (K,).
+    Each iteration moves along the measure's gradient (:func:`measure_gradient`)
+    projected onto the null space of J (the tangent of the self-motion), by ``2h``, ``h``
+    and ``h/2``, and by ``h`` and ``h/2`` along the shortest vector in the convex hull of
+    that gradient and the gradients at the last iteration's trials (gradient sampling:
+    the measure is a minimum of smooth pieces; where pieces meet in a ridge, their
+    gradients point across it and that vector along it); each trial is pulled back onto
+    the point with damped least squares (:func:`ik_numeric`); the best improving one
+    (within the limits) is kept with its step as the next ``h``; where none improves,
+    ``h`` is divided by 4, and a start whose ``h`` falls below 1e-6, or whose projected
+    gradient vanishes, is done.
+    Five trials per start and iteration, each linear in the number of joints (a search
+    along every null direction cost a number of trials that grew with the joints, each
+    of them growing too). A stepped measure ascends its continuous measure (stepping is
+    monotone, so the same configurations are best). Vectorised over the K starts, each
+    independent of the others; deterministic. ``point`` is one (task_dim,) or one per
+    start (K, task_dim), so the starts of many grid points run together. Returns the
+    refined ``q`` (K, n) and their measure (K,).
     """
     q = np.atleast_2d(np.asarray(q0, float)).copy()
     K, n = q.shape
     r = arm.task_dim
+    base = _SMOOTH.get(measure, measure)
     target = np.broadcast_to(np.asarray(point, float), (K, r))
-    val = measure_values(arm, q, direction, measure)
+    good = np.all(np.isfinite(q), axis=1)  # a NaN row (not reached) stays as it is, at -inf
+    val, grad, jac = np.full(K, -np.inf), np.zeros((K, n)), np.zeros((K, r, n))
+    if good.any():  # at q; each trial's come with it
+        val[good], grad[good], jac[good] = _value_gradient(arm, q[good], direction, base)
     h = np.full(K, step)
-    active = np.arange(K) if n > r else np.arange(0)
+    sampled = np.repeat(grad[:, None, :], 5, axis=1)  # the gradients at the last trials (around q)
+    active = np.flatnonzero(good) if n > r else np.arange(0)
+    scale = np.array([2.0, 1.0, 0.5, 1.0, 0.5])  # along the gradient, then along the ridge
     for _ in range(iterations):
         if not active.size:
             break
-        qa = q[active]
+        qa, J = q[active], jac[active]
         A = qa.shape[0]
-        _, _, Vt = np.linalg.svd(arm.jacobian(qa))
-        null = Vt[:, r:, :]  # (A, n - r, n)
-        moves = np.concatenate([null, -null], axis=1) * h[active][:, None, None]  # (A, T, n)
-        T = moves.shape[1]
-        trial, ok = ik_numeric(arm, np.repeat(target[active], T, axis=0),
-                               (qa[:, None, :] + moves).reshape(-1, n),
+        g = _null_part(J, grad[active])
+        bundle = np.concatenate([g[:, None], _null_part(J[:, None], sampled[active])], axis=1)
+        ridge = _min_norm_combination(bundle)
+        moving = np.linalg.norm(g, axis=1) > 1e-12 * np.maximum(np.abs(val[active]), 1e-300)
+        dirs = np.stack([_unit(g)] * 3 + [_unit(ridge)] * 2, axis=1)  # (A, 5, n)
+        trial, ok = ik_numeric(arm, np.repeat(target[active], 5, axis=0),
+                               (qa[:, None, :] + h[active][:, None, None] * scale[:, None] * dirs).reshape(-1, n),
                                respect_limits=respect_limits, iterations=30, tol=1e-9)
-        tv = measure_values(arm, trial, direction, measure)
+        tv, tg, tJ = (x.reshape(A, 5, *x.shape[1:]) for x in _value_gradient(arm, trial, direction, base))
         if respect_limits:
             ok &= arm.within_limits(trial)
-        tv = np.where(ok, tv, -np.inf).reshape(A, T)
+        tv = np.where(ok.reshape(A, 5), tv, -np.inf)
+        trial = trial.reshape(A, 5, n)
+        sampled[active] = np.where(np.isfinite(tv)[:, :, None], tg, grad[active][:, None])
         k = np.argmax(tv, axis=1)
-        best = tv[np.arange(A), k]
-        better = best > val[active] + 1e-12 * np.abs(val[active])
-        q[active[better]] = trial.reshape(A, T, n)[np.arange(A), k][better]
+        pick = np.arange(A), k
+        best = tv[pick]
+        better = moving & (best > val[active] + 1e-12 * np.abs(val[active]))
+        up = active[better]
+        q[up], grad[up], jac[up] = trial[pick][better], tg[pick][better], tJ[pick][better]
         val[active] = np.where(better, best, val[active])
-        h[active] = np.where(better, h[active], h[active] / 2)
-        active = active[h[active] >= 1e-6]
-    return q, val
+        h[active] = np.where(better, np.minimum(h[active] * scale[k], 16 * step), h[active] / 4)
+        active = active[moving & (h[active] >= 1e-6)]
+    return q, (val if base == measure else measure_values(arm, q, direction, measure))
+
+
+def _null_part(J: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """``g`` (..., n) without its part in the row space of ``J`` (..., m, n): its
+    projection on the tangent of the self-motion, ``g - J^T (J J^T)^+ J g``."""
+    JJt = np.linalg.pinv(J @ np.swapaxes(J, -1, -2), hermitian=True)
+    return g - np.einsum("...mk,...m->...k", J, np.einsum("...ij,...jk,...k->...i", JJt, J, g))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    norm = np.linalg.norm(v, axis=1, keepdims=True)
+    return v / np.where(norm > 0, norm, 1.0)
+
+
+def _min_norm_combination(V: np.ndarray, rounds: int = 50) -> np.ndarray:
+    """The shortest vector in the convex hull of the rows of ``V`` (N, k, n) (Frank and
+    Wolfe with exact line search, from ``V[:, 0]``): the steepest ascent of a minimum of
+    smooth pieces whose gradients are the rows (gradient sampling, Burke, Lewis and
+    Overton 2005); along a ridge where gradients from its two sides point across it."""
+    x = V[:, 0].copy()
+    for _ in range(rounds):
+        j = np.argmin(np.einsum("nkj,nj->nk", V, x), axis=1)
+        diff = x - V[np.arange(len(j)), j]
+        dd = np.einsum("nj,nj->n", diff, diff)
+        t = np.clip(np.einsum("nj,nj->n", diff, x) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+        x -= t[:, None] * diff
+    return x
 
 
 @dataclass(repr=False)

@@ -51,7 +51,7 @@ def _prep(J, w, d):
     return J, w, d / norm
 
 
-def exact_limit(J, w, d) -> np.ndarray:
+def exact_limit(J, w, d, dual: bool = False):
     """Largest speed of pure motion along ``d`` (see module docstring), shape (N,).
 
     2-D tasks: the closed form over the zonotope's facets, vectorised. Candidate normals
@@ -60,34 +60,49 @@ def exact_limit(J, w, d) -> np.ndarray:
     ``d``). Normals perpendicular to ``d`` give no bound; if no normal is left (J = 0)
     the limit is 0. Other task dimensions: facet enumeration (see the module docstring),
     a linear program for rank-deficient Jacobians.
+
+    With ``dual``, also the optimal dual vectors ``y`` (N, m), ``y . d = 1``: the normal
+    of the bounding facet, scaled so that the limit is ``sum_i w_i |J_i . y|`` (zero rows
+    where no facet bounds); :func:`optimal_rates` gives the joint rates that attain it.
+
+    >>> s, y = exact_limit(np.array([[1.0, 1.0], [0.0, 1.0]]), [1.0, 1.0], [1.0, 0.0], dual=True)
+    >>> s.tolist(), y.tolist()
+    ([1.0], [[1.0, -1.0]])
     """
     J, w, d = _prep(J, w, d)
     m, n = J.shape[1], J.shape[2]
     if m != 2:
         if m < 2 or m > 6 or n > 12:
-            return exact_limit_lp(J, w, d)
-        return _exact_limit_facets(J, w, d)
+            return exact_limit_lp(J, w, d, dual=dual)
+        return _exact_limit_facets(J, w, d, dual)
     G = J * w[:, None, :]  # (N, 2, n) generators
     P = np.stack([-G[:, 1], G[:, 0]], 1)  # perpendiculars
     normals = np.concatenate([P, G], axis=2)  # (N, 2, 2n)
-    return _limit_from_normals(G, normals, d)
+    s, y = _limit_from_normals(G, normals, d)
+    return (s, y) if dual else s
 
 
-def _limit_from_normals(G: np.ndarray, normals: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """``min_k h(n_k) / |n_k . d|`` over candidate normals (N, m, K); 0 if none bounds."""
+def _limit_from_normals(G: np.ndarray, normals: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``min_k h(n_k) / |n_k . d|`` over candidate normals (N, m, K); 0 if none bounds.
+    Also the minimising normal scaled to ``y . d = 1`` (the dual vector; 0 if none)."""
     length = np.linalg.norm(normals, axis=1)  # (N, K)
     size = length.max(axis=1, keepdims=True)
     usable = length > _PERP_TOL * size
     unit = normals / np.where(usable, length, 1.0)[:, None, :]
     h = np.abs(np.einsum("nik,nij->nkj", unit, G)).sum(-1)  # support values (N, 2n)
-    nd = np.abs(np.einsum("nik,ni->nk", unit, d))
+    sd = np.einsum("nik,ni->nk", unit, d)
+    nd = np.abs(sd)
     usable &= nd > _PERP_TOL
     ratio = np.where(usable, h / np.where(usable, nd, 1.0), np.inf)
-    s = ratio.min(axis=1)
-    return np.where(np.isfinite(s), s, 0.0)
+    k = ratio.argmin(axis=1)
+    rows = np.arange(len(k))
+    s = ratio[rows, k]
+    bounded = np.isfinite(s)
+    y = unit[rows, :, k] / np.where(bounded, sd[rows, k], 1.0)[:, None]
+    return np.where(bounded, s, 0.0), np.where(bounded[:, None], y, 0.0)
 
 
-def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarray:
+def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray, dual: bool = False):
     """m-D closed form: the facet normals of a full-dimensional zonotope are the normals
     of the hyperplanes spanned by (m-1)-subsets of generators (generalised cross products,
     by cofactors); configurations whose J is rank-deficient go to the linear program."""
@@ -97,7 +112,7 @@ def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarr
     G = J * w[:, None, :]
     subsets = np.array(list(combinations(range(n), m - 1)))  # (C, m-1)
     if subsets.size == 0:
-        return exact_limit_lp(J, w, d)
+        return exact_limit_lp(J, w, d, dual=dual)
     if m == 3:  # cross products g_i x g_j of the generator pairs
         a, b = G[:, :, subsets[:, 0]], G[:, :, subsets[:, 1]]  # (N, 3, C)
         normals = np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
@@ -110,15 +125,15 @@ def _exact_limit_facets(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarr
             minor = np.delete(sub, r, axis=2)  # (N, C, m-1, m-1)
             normals[:, r, :] = (-1) ** r * np.linalg.det(minor)
     normals = np.concatenate([normals, G], axis=2)
-    out = _limit_from_normals(G, normals, d)
+    out, y = _limit_from_normals(G, normals, d)
     sv = np.linalg.svd(G, compute_uv=False)
     deficient = sv[:, -1] <= 1e-9 * np.maximum(sv[:, 0], 1e-300)
     if deficient.any():
-        out[deficient] = exact_limit_lp(J[deficient], w[deficient], d[deficient])
-    return out
+        out[deficient], y[deficient] = exact_limit_lp(J[deficient], w[deficient], d[deficient], dual=True)
+    return (out, y) if dual else out
 
 
-def exact_limit_lp(J, w, d) -> np.ndarray:
+def exact_limit_lp(J, w, d, dual: bool = False):
     """The same as :func:`exact_limit` by linear programming, any task dimension.
 
     ``max s`` over ``(q_dot, s)`` s.t. ``J q_dot - s d = 0``, ``-w <= q_dot <= w``,
@@ -126,7 +141,9 @@ def exact_limit_lp(J, w, d) -> np.ndarray:
     independent, so up to :data:`_LP_BLOCK` variables of them are solved as one program
     with a block-diagonal constraint matrix (maximising the sum of the ``s`` maximises
     each): one call per block instead of one per configuration, whose fixed cost
-    (about 9 ms) made a long URDF chain's capability cost seconds per joint.
+    (about 9 ms) made a long URDF chain's capability cost seconds per joint. With
+    ``dual``, also the dual vectors ``y`` (N, m) of the equality rows, ``y . d = 1``
+    (as :func:`exact_limit`).
 
     >>> J = np.array([[[1.0, 0.0, 1.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]]] * 3)
     >>> exact_limit_lp(J, [1.0, 2.0, 0.5], [1.0, 0.0, 0.0]).round(6).tolist()
@@ -134,21 +151,23 @@ def exact_limit_lp(J, w, d) -> np.ndarray:
     """
     J, w, d = _prep(J, w, d)
     N, m, n = J.shape
-    out = np.zeros(N)
+    out, y = np.zeros(N), np.zeros((N, m))
     per = max(1, _LP_BLOCK // (n + 1))
     for start in range(0, N, per):
         stop = min(N, start + per)
-        out[start:stop] = _lp_block(J[start:stop], w[start:stop], d[start:stop])
-    return out
+        out[start:stop], y[start:stop] = _lp_block(J[start:stop], w[start:stop], d[start:stop])
+    return (out, y) if dual else out
 
 
 #: variables of one block-diagonal linear program of :func:`exact_limit_lp`
 _LP_BLOCK = 20_000
 
 
-def _lp_block(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """:func:`exact_limit_lp` of the configurations ``J (B, m, n)`` as one program; a
-    configuration whose program HiGHS does not solve (never seen) is solved alone."""
+def _lp_block(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`exact_limit_lp` of the configurations ``J (B, m, n)`` as one program, with
+    the dual vectors (the equality rows' marginals, scaled to ``y . d = 1``; 0 where
+    that is not possible); a configuration whose program HiGHS does not solve (never
+    seen) is solved alone."""
     from scipy.optimize import linprog  # lazy: 0.5 s of start-up
     from scipy.sparse import csr_matrix
 
@@ -160,12 +179,42 @@ def _lp_block(J: np.ndarray, w: np.ndarray, d: np.ndarray) -> np.ndarray:
     c = np.tile(np.r_[np.zeros(n), -1.0], B)
     lo = np.concatenate([-w, np.zeros((B, 1))], axis=1).reshape(-1)
     hi = np.concatenate([w, np.full((B, 1), np.inf)], axis=1).reshape(-1)
-    res = linprog(c, A_eq=A, b_eq=np.zeros(B * m), bounds=np.c_[lo, hi], method="highs")
+    # no presolve: its reductions of a block of independent small programs cost twice the solve
+    res = linprog(c, A_eq=A, b_eq=np.zeros(B * m), bounds=np.c_[lo, hi], method="highs",
+                  options={"presolve": False})
     if res.status == 0:
-        return np.maximum(res.x.reshape(B, n + 1)[:, -1], 0.0)
+        lam = res.eqlin.marginals.reshape(B, m)
+        ld = np.einsum("bm,bm->b", lam, d)
+        ok = np.abs(ld) > _PERP_TOL * np.maximum(np.linalg.norm(lam, axis=1), 1e-300)
+        y = np.where(ok[:, None], lam / np.where(ok, ld, 1.0)[:, None], 0.0)
+        return np.maximum(res.x.reshape(B, n + 1)[:, -1], 0.0), y
     if B == 1:
-        return np.zeros(1)
-    return np.concatenate([_lp_block(J[k:k + 1], w[k:k + 1], d[k:k + 1]) for k in range(B)])
+        return np.zeros(1), np.zeros((1, m))
+    parts = [_lp_block(J[k:k + 1], w[k:k + 1], d[k:k + 1]) for k in range(B)]
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+def optimal_rates(J, w, d, limit, y) -> np.ndarray:
+    """Joint rates (N, n) attaining :func:`exact_limit` ``limit`` along ``d``, from its
+    dual vectors ``y``: ``w_i sign(J_i . y)`` for every joint whose column is not
+    perpendicular to ``y`` (complementary slackness), the rest the least-norm rates
+    that close ``J q_dot = limit d``.
+
+    >>> J = np.array([[1.0, 1.0], [0.0, 1.0]])
+    >>> s, y = exact_limit(J, [1.0, 1.0], [1.0, 0.0], dual=True)
+    >>> optimal_rates(J, [1.0, 1.0], [1.0, 0.0], s, y).tolist()
+    [[1.0, 0.0]]
+    """
+    J, w, d = _prep(J, w, d)
+    G = J * w[:, None, :]
+    gy = np.einsum("nmk,nm->nk", G, np.asarray(y, float))
+    limit = np.asarray(limit, float)
+    free = np.abs(gy) <= 1e-9 * np.maximum(limit, 1e-300)[:, None]
+    qd = np.where(free, 0.0, w * np.sign(gy))
+    rest = limit[:, None] * d - np.einsum("nmk,nk->nm", J, qd)
+    JF = np.where(free[:, None, :], J, 0.0)
+    lam = np.einsum("nij,nj->ni", np.linalg.pinv(JF @ np.swapaxes(JF, 1, 2), hermitian=True), rest)
+    return qd + np.einsum("nmk,nm->nk", JF, lam)
 
 
 def component_limit(J, w, d) -> np.ndarray:

@@ -354,43 +354,54 @@ def render_curve_synthesis(res: Any) -> None:
         console.print(f"note: {n}", highlight=False)
 
 
-def _configuration_table(arm: Any, res: Any) -> tuple[Any, list[int]]:
-    """The table of configurations (the best 12 of many) and the indices shown."""
+#: Arms with more joints than this get their joint values below the table, wrapped to the
+#: terminal, instead of one column per joint (a 100-joint arm's table was 2,000 columns wide).
+JOINT_COLUMNS_MAX = 6
+
+
+def _configuration_table(arm: Any, res: Any) -> tuple[Any, list[int], list[tuple[str, Any]]]:
+    """The table of configurations (the best 12 of many), the indices shown, and the rows'
+    labels with their configurations (the joint values listed below a long arm's table)."""
     from rich import box
 
     from mechsyn.capability.measures import MEASURES
 
-    configs = res.configurations
+    configs, wide = res.configurations, arm.n <= JOINT_COLUMNS_MAX
     table = Table(box=box.SIMPLE_HEAD, pad_edge=False, title=f"{arm.name}: speed along "
                   f"({', '.join(f'{c:g}' for c in np.round(res.direction, 4))}) at ({', '.join(f'{c:g}' for c in res.point)})")
-    table.add_column("")
-    for name in arm.joint_names:
+    table.add_column("" if wide else "config")
+    for name in arm.joint_names if wide else ():
         table.add_column(name, justify="right", no_wrap=True, min_width=6)
     for head in ("exact", "compon.", "min-nrm", "st.mn", "stepped"):
         table.add_column(head, justify="right", no_wrap=True)
     shown = list(range(len(configs)))
     if len(configs) > 15:  # many IK solutions (spatial arms): the best ones
         shown = sorted(np.argsort([-c[res.measure] for c in configs], kind="stable")[:12].tolist())
-    for k in shown:
-        c, best = configs[k], k == res.best_index
-        table.add_row("best" if best else "", *[f"{v:.1f}" for v in c["q_deg"]],
-                      *[f"{c[mn]:.2f}" for mn in MEASURES], style="bold green" if best else None)
+    rows = [(f"{k + 1}" + (" best" if k == res.best_index else ""), configs[k], k == res.best_index) for k in shown]
     if res.continuous_best:
-        cb = res.continuous_best
-        table.add_row("cont", *[f"{v:.1f}" for v in cb["q_deg"]], *[f"{cb[mn]:.2f}" for mn in MEASURES], style="cyan")
-    return table, shown
+        rows.append(("cont", res.continuous_best, False))
+    for label, c, best in rows:
+        joints = [f"{v:.1f}" for v in c["q_deg"]] if wide else []
+        style = "bold green" if best else ("cyan" if label == "cont" else None)
+        table.add_row(label if not wide else ("best" if best else "cont" if label == "cont" else ""),
+                      *joints, *[f"{c[mn]:.2f}" for mn in MEASURES], style=style)
+    return table, shown, [] if wide else [(label.split()[0], c) for label, c, _ in rows]
 
 
 def render_point_capability(arm: Any, res: Any, step: float) -> None:
-    """``mechsyn capability --point``: every configuration's joints and measures, the best marked."""
-    from mechsyn.cli.common import SafeConsole
-
+    """``mechsyn capability --point``: every configuration's joints and measures, the best marked
+    (a long arm's joint values listed below the table, wrapped to the terminal)."""
     from mechsyn.capability.point import MEASURE_HELP
 
     measure, configs, cb = res.measure, res.configurations, res.continuous_best
-    table, shown = _configuration_table(arm, res)
-    need = 12 + 8 * arm.n + 50
+    from mechsyn.cli.common import SafeConsole
+
+    table, shown, listed = _configuration_table(arm, res)
+    need = 12 + 8 * arm.n + 50 if not listed else 0
     (console if console.is_terminal or console.width >= need else SafeConsole(width=need)).print(table)
+    unit = "deg" if arm.is_revolute.all() else "deg; prismatic joints: length"
+    for label, c in listed:
+        console.print(f"{label}: q ({unit}) = " + ", ".join(f"{v:.1f}" for v in c["q_deg"]), highlight=False)
     if len(shown) < len(configs):
         console.print(f"showing the best {len(shown)} of {len(configs)} configurations (all with --json)")
     if not configs:
