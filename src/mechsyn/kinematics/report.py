@@ -28,6 +28,7 @@ from mechsyn.kinematics import derived
 from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
 from mechsyn.kinematics.summary import motion_summary
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.progress import ProgressCallback
 from mechsyn.results import csv_cell, to_jsonable
 
 __all__ = ["SimulationReport", "simulation_report", "simulation_csv", "forces_csv", "csv_text"]
@@ -160,7 +161,7 @@ def _slides(mech: Mechanism, sim: Simulation) -> dict[str, Any]:
 def simulation_report(mech: Mechanism, inputs: dict[str, np.ndarray], *, speeds: dict[str, float] | None = None,
                       points: list[str] | None = None, vll: dict[str, str] | None = None, method: str = "auto",
                       output: str | None = None, straight: dict[str, tuple[float, float]] | None = None,
-                      progress: Any = None, rates: bool = True) -> SimulationReport:
+                      progress: ProgressCallback | None = None, rates: bool = True) -> SimulationReport:
     """Simulate ``mech`` over ``inputs`` (see :func:`mechsyn.simulate`) and derive what a
     designer reads off the motion (see :func:`derived_quantities`).
 

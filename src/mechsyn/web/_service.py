@@ -12,6 +12,7 @@ import math
 import re
 import threading
 from collections import OrderedDict
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -19,6 +20,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.simulation import rows
+from mechsyn.progress import Progress, ProgressCallback
 from mechsyn.results import to_jsonable
 
 MAX_STEPS = 2000
@@ -446,10 +448,11 @@ def fourbar_path_case(targets: list, time_limit: float) -> Any:
                               source="targets")
 
 
-def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) -> dict[str, Any]:
     """Four-bar path synthesis through ``params["targets"]``: ranked results (both branches).
 
-    ``progress`` receives ``{"done", "total", "best"}`` and may raise :class:`Cancelled`.
+    ``progress`` receives a :class:`mechsyn.progress.Progress` (restarts of both branches)
+    and may raise :class:`Cancelled`.
     """
     from mechsyn.synthesis.export import fourbar_mechanism_dict
     from mechsyn.synthesis.optimize import synthesize_path
@@ -466,10 +469,9 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
     for b, branch in enumerate(branches):
         bcase = _with_branch(case, branch)
 
-        def report(state, b=b):
-            best, total = state.best_error, state.total
-            progress({"done": b * total + state.done, "total": len(branches) * total,
-                      "best": None if not math.isfinite(best) else float(best)})
+        def report(state: Progress, b=b) -> None:  # the restarts of both branches, one after the other
+            progress(replace(state, done=b * state.total + state.done, total=len(branches) * state.total,
+                             stage=f"{state.stage}, branch {branches[b]:+d}"))
 
         res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
                               callback=report)
@@ -518,12 +520,10 @@ def _fourbar_quality(d: dict[str, float], res: Any) -> dict[str, Any]:
 
 
 def _with_branch(case, branch: int):
-    import dataclasses
-
-    return dataclasses.replace(case, branch=branch)
+    return replace(case, branch=branch)
 
 
-def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+def synthesize_curve_points(params: dict[str, Any], progress: ProgressCallback) -> dict[str, Any]:
     """Curve to mechanism (:mod:`mechsyn.synthesis.curves`): ranked 4- to ``max_links``-bar
     linkages whose tracing point follows the clicked or drawn curve ``params["targets"]``.
 
@@ -545,13 +545,7 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
     closed = params.get("closed")
     target = target_from_points(T, closed=None if closed is None else bool(closed), source="clicked curve")
 
-    def report(state: dict) -> None:
-        best = state.get("best")
-        progress({"done": int(state.get("done") or 0), "total": int(state.get("total") or 1),
-                  "best": float(best) if isinstance(best, float) and math.isfinite(best) else None,
-                  "stage": str(state.get("stage", ""))})
-
-    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, callback=report)
+    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, callback=progress)
     results = []
     for c in res.candidates:
         d = c.to_dict()
@@ -570,7 +564,7 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
 
 # Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
 # Each result dict: {"kind", "targets", "results": [{"label", "error", "feasible", "mechanism", "path"}]}.
-SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, Callable[[dict], None]], dict]]] = {
+SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, ProgressCallback], dict]]] = {
     "fourbar_path": ("Four-bar path through the clicked points", synthesize_fourbar_path),
     "curve": ("Curve to mechanism over the atlas (4- to 8-bars)", synthesize_curve_points),
 }
