@@ -208,12 +208,13 @@ class Motion(Result):
         def kept(parts: dict[str, Any]) -> dict[str, Any]:
             return {k: rows(v, ok) for k, v in parts.items() if rates or k not in _RATES}
 
+        values = {j: rows(v) for j, v in self.inputs.items()}
         return {
             "mechanism": self.mechanism,
-            "input": {"joint": main, "type": self.input_types[main], "values": rows(self.inputs[main]),
+            "input": {"joint": main, "type": self.input_types[main], "values": values[main],
                       "unit": self.input_unit(main), "speed": self.speeds[main]},
-            "inputs": {j: {"values": rows(v), "type": self.input_types[j], "unit": self.input_unit(j),
-                           "speed": self.speeds[j]} for j, v in self.inputs.items()},
+            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": self.input_unit(j),
+                           "speed": self.speeds[j]} for j, v in values.items()},
             "assembled": ok.tolist(),
             "rates": bool(rates),
             "points": {name: kept(pm.to_dict()) for name, pm in self.points.items()},

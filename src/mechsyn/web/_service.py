@@ -470,8 +470,10 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) 
         bcase = _with_branch(case, branch)
 
         def report(state: Progress, b=b) -> None:  # the restarts of both branches, one after the other
+            best = min((e for e in (state.best, *(r["error"] for r in results if r["feasible"])) if e is not None),
+                       default=None)
             progress(replace(state, done=b * state.total + state.done, total=len(branches) * state.total,
-                             stage=f"{state.stage}, branch {branches[b]:+d}"))
+                             stage=f"{state.stage}, branch {branches[b]:+d}", best=best))
 
         res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
                               callback=report)
