@@ -560,7 +560,7 @@ const setPlaying = mountPlayer({ $, state, render, assembledNear });
 const planarPlots = mountPlots({ $, state, render, assembledNear });
 const synthUi = mountSynthesis({ $, state, render, setMech, setMode: (m) => setMode(m), design: designUi });
 mountAtlas({ $, state, render, setMech });
-const spatialUi = mountSpatialTabs({ $, state, render, showTab });
+const spatialUi = mountSpatialTabs({ $, state, render, showTab, motionOf: view3d.motionOf });
 const forcesUi = mountForces({ $, state, render, edit, stepsFor, spatialLines: spatialUi.forcesLines });
 
 // ------------------------------------------------------------------ files

@@ -6,14 +6,14 @@
 // the input slider's row as the cursor. Forces: spatial statics are not in the library; the tab
 // says so in one line and gives what the rank method reads (finite mobility, idle motions,
 // redundant constraints: whether the reactions would be unique).
-import { call } from "./api.js";
 import { h } from "./numeric.js";
 import { chart } from "./plots.js";
 
 const XYZ = ["x", "y", "z"];
 
 // `ctx`: {$, state, render, showTab}; returns {renderPlots, forcesLines}.
-export function mountSpatialTabs({ $, state, render, showTab }) {
+// `motionOf(mech)`: the 3-D view's request of the sweep (view3d.js), shared.
+export function mountSpatialTabs({ $, state, render, showTab, motionOf }) {
   const sp = { mech: null, data: null, error: null, loading: false, draws: 0 };
   let charts = [];
   window.__spatialPlots = sp; // for tests (read-only use)
@@ -21,7 +21,7 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
   function fetchFor(m) {
     if (sp.mech === m) return;
     sp.mech = m; sp.data = null; sp.error = null; sp.loading = true;
-    call("/api/spatial/simulate", { mechanism: m }).then((d) => {
+    motionOf(m).then((d) => {
       if (sp.mech !== m) return;
       sp.data = d; sp.loading = false; renderPlots();
     }, (e) => {

@@ -107,7 +107,18 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     v3.cam = { ...HOME, centre, radius, s: (0.42 * Math.min(r.width || 800, r.height || 600)) / radius, perspective: persp.checked };
   }
 
-  // ---- opening a mechanism: the sweep from the server, once per mechanism
+  // ---- the sweep from the server, once per mechanism: one request for the view and the Plots tab
+  let asked = { key: "", motion: null };
+  function motionOf(mech) {
+    const key = JSON.stringify(mech);
+    if (asked.key !== key) {
+      const motion = call("/api/spatial/simulate", { mechanism: mech });
+      motion.catch(() => { if (asked.motion === motion) asked = { key: "", motion: null }; }); // asked again later
+      asked = { key, motion };
+    }
+    return asked.motion;
+  }
+
   function open(mech) {
     if (!mech || mech.kind === "planar") { v3.key = ""; v3.view = null; v3.error = null; show(false); return; }
     const key = JSON.stringify(mech);
@@ -118,7 +129,7 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     v3.key = key; v3.error = null; v3.loading = true;
     if (!same) v3.view = null;
     v3.mech = mech;
-    call("/api/spatial/simulate", { mechanism: mech }).then((motion) => {
+    motionOf(mech).then((motion) => {
       if (v3.key !== key) return;
       const view = sceneOf(motion, mech);
       v3.view = view; v3.loading = false;
@@ -373,5 +384,5 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     ev.preventDefault(); ev.stopImmediatePropagation(); play(!v3.playing);
   }, true);
 
-  return { open, shown, update };
+  return { open, shown, update, motionOf };
 }
