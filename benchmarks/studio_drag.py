@@ -116,7 +116,7 @@ def check(page, point: str) -> float:
     mech, sim = page.evaluate("[window.__studio.mech, window.__studio.sim]")
     lib = simulate(mechanism_from_dict(mech), {sim["input"]["joint"]: np.array(sim["input"]["values"])},
                    points=[point])
-    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"][point]], float)
+    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"][point]["position"]], float)
     ref = lib.points[point].position
     assert np.array_equal(np.isnan(got), np.isnan(ref)), "assembled frames differ"
     return float(np.nanmax(np.abs(got - ref)))

@@ -137,7 +137,7 @@ def main() -> None:
         heaviest = [("POST", "/api/export", {"mechanism": six, "format": "gif", "frames": 360}),
                     ("POST", "/api/analyze", {"mechanism": six}),
                     ("POST", "/api/simulate", {"mechanism": six, "steps": 2000}),
-                    ("POST", "/api/spatial/view", {"mechanism": bennett, "steps": 2000}),
+                    ("POST", "/api/spatial/simulate", {"mechanism": bennett, "steps": 2000}),
                     ("GET", "/api/atlas?links=10", None),
                     ("POST", "/api/studio/check", {"mechanism": big})]
         checks = [("POST", "/api/studio/check", {"mechanism": big})]

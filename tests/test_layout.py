@@ -113,7 +113,7 @@ def test_no_source_file_over_800_lines():
 #: the longest entry that matches a module decides its layer.
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechsyn._version", "mechsyn.errors", "mechsyn._result", "mechsyn.interrupt", "mechsyn.limits",
-     "mechsyn.parallel", "mechsyn.results", "mechsyn._extras"),                          # no mechsyn model needed
+     "mechsyn.parallel", "mechsyn.progress", "mechsyn.results", "mechsyn._extras"),      # no mechsyn model needed
     ("mechsyn.model",),                                                # the one Mechanism
     ("mechsyn.io", "mechsyn.checkpoint"),                              # files: read, check, write
     ("mechsyn.structure",),                                            # structural analysis

@@ -15,9 +15,10 @@ The contract, the same on every back end:
 * **Identical results.** The results come back in task order, whatever order the
   workers finish in; a task must depend only on its arguments (seeds travel in them),
   so the answer equals the single-process run.
-* **Progress.** ``progress(done, total, index, result)`` is called in the calling
-  process each time a task finishes, wherever it ran (``index``: the task's position;
-  a CLI advances its progress bar, a caller may use finished results at once).
+* **Progress.** Each time a task finishes, wherever it ran, ``on_result(index, result)``
+  (``index``: the task's position; a caller may use finished results at once) and then
+  ``progress(state)`` (:class:`mechsyn.progress.Progress`: tasks ``done`` of ``total``,
+  stage ``"tasks"``) are called in the calling process.
 * **Deadline.** ``deadline`` (a ``time.time()`` value): tasks not started by then are not
   started (their result is ``None``); running tasks finish, so a task that can run long
   takes the deadline among its arguments and honours it itself.
@@ -48,8 +49,9 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.progress import ProgressCallback, report
 
-ProgressFn = Callable[[int, int, int, Any], None]
+ResultFn = Callable[[int, Any], None]
 StopFn = Callable[[int, Any], bool]
 
 __all__ = ["run_tasks", "dask_client", "check_parallel_options"]
@@ -95,38 +97,38 @@ def dask_client(scheduler: Any):
 
 
 def run_tasks(fn: Callable[..., Any], tasks: Sequence[tuple], *, workers: int = 1,
-              scheduler: Any = None, progress: ProgressFn | None = None,
-              deadline: float | None = None, stop: StopFn | None = None) -> list[Any]:
+              scheduler: Any = None, progress: ProgressCallback | None = None,
+              deadline: float | None = None, stop: StopFn | None = None,
+              on_result: ResultFn | None = None) -> list[Any]:
     """Run ``fn(*args)`` for every ``args`` of ``tasks``; results in task order.
 
     See the module docstring for the back ends (``workers``, ``scheduler``) and the
-    contract (identical results, ``progress``, ``deadline``, ``stop``, Ctrl-C). Tasks
-    that were not run (deadline, early stop) give ``None``.
+    contract (identical results, ``on_result``, ``progress``, ``deadline``, ``stop``,
+    Ctrl-C). Tasks that were not run (deadline, early stop) give ``None``.
     """
     tasks = list(tasks)
     results: list[Any] = [None] * len(tasks)
     if not tasks:
         return results
+    book = _Book(len(tasks), progress, stop, on_result)
     if scheduler is not None:
-        return _run_dask(fn, tasks, results, scheduler, progress, deadline, stop)
+        return _run_dask(fn, tasks, results, scheduler, book, deadline)
     if workers <= 1 or len(tasks) == 1:
         for i, args in enumerate(tasks):
             if deadline is not None and time.time() >= deadline and i > 0:
                 break
-            results[i] = fn(*args)
-            if progress is not None:
-                progress(i + 1, len(tasks), i, results[i])
-            if stop is not None and stop(i, results[i]):
+            book.finished(i, fn(*args), results)
+            if i + 1 >= book.limit:  # stopped early (or the last task)
                 break
         return results
-    return _run_pool(fn, tasks, results, workers, progress, deadline, stop)
+    return _run_pool(fn, tasks, results, workers, book, deadline)
 
 
 class _Book:
     """Bookkeeping shared by the pool and Dask loops: which tasks still count."""
 
-    def __init__(self, n: int, progress: ProgressFn | None, stop: StopFn | None):
-        self.n, self.progress, self.stop = n, progress, stop
+    def __init__(self, n: int, progress: ProgressCallback | None, stop: StopFn | None, on_result: ResultFn | None):
+        self.n, self.progress, self.stop, self.on_result = n, progress, stop, on_result
         self.limit = n  # tasks at index >= limit are not started any more (early stop)
         self.done = 0
 
@@ -134,16 +136,16 @@ class _Book:
         """Keep a finished task's result (whatever its index), report it, apply ``stop``."""
         results[i] = result
         self.done += 1
-        if self.progress is not None:
-            self.progress(self.done, self.n, i, result)
+        if self.on_result is not None:
+            self.on_result(i, result)
+        report(self.progress, self.done, self.n, "tasks")
         if i < self.limit and self.stop is not None and self.stop(i, result):
             self.limit = i + 1
 
 
-def _run_pool(fn, tasks, results, workers, progress, deadline, stop) -> list[Any]:
+def _run_pool(fn, tasks, results, workers, book: _Book, deadline) -> list[Any]:
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-    book = _Book(len(tasks), progress, stop)
     pool = ProcessPoolExecutor(max_workers=workers)
     try:
         queue = list(range(len(tasks)))
@@ -151,7 +153,7 @@ def _run_pool(fn, tasks, results, workers, progress, deadline, stop) -> list[Any
         # with a deadline or a stop: the pool just full, so later tasks stay unstarted;
         # otherwise a task more per worker waits queued, so that no worker waits while
         # this process takes in a result
-        depth = workers if deadline is not None or stop is not None else 2 * workers
+        depth = workers if deadline is not None or book.stop is not None else 2 * workers
         while queue or running:
             while queue and len(running) < depth:
                 i = queue.pop(0)
@@ -181,11 +183,10 @@ def _guarded(fn, deadline, first, *args):
     return fn(*args)
 
 
-def _run_dask(fn, tasks, results, scheduler, progress, deadline, stop) -> list[Any]:
+def _run_dask(fn, tasks, results, scheduler, book: _Book, deadline) -> list[Any]:
     client, owned = dask_client(scheduler)
     from dask.distributed import as_completed
 
-    book = _Book(len(tasks), progress, stop)
     futures: list[Any] = []
     try:
         futures = [client.submit(_guarded, fn, deadline, i == 0, *args, pure=False,

@@ -22,10 +22,11 @@ TASKS = [(i, i + 1) for i in range(7)]
 
 
 def test_order_progress_and_early_stop_in_one_process():
-    seen = []
-    out = run_tasks(operator.mul, TASKS, progress=lambda d, t, i, r: seen.append((d, t, i, r)))
+    seen, states = [], []
+    out = run_tasks(operator.mul, TASKS, on_result=lambda i, r: seen.append((i, r)), progress=states.append)
     assert out == [i * (i + 1) for i in range(7)]
-    assert seen == [(i + 1, 7, i, i * (i + 1)) for i in range(7)]
+    assert seen == [(i, i * (i + 1)) for i in range(7)]
+    assert [(p.done, p.total, p.stage) for p in states] == [(i + 1, 7, "tasks") for i in range(7)]
     assert run_tasks(operator.mul, TASKS, stop=lambda i, r: r >= 6) == [0, 2, 6, None, None, None, None]
 
 
@@ -46,7 +47,7 @@ def test_local_processes_equal_one_process():
     assert out == [i * (i + 1) for i in range(7)]
     seen = []
     stopped = run_tasks(operator.mul, TASKS, workers=2, stop=lambda i, r: r >= 6,
-                        progress=lambda d, t, i, r: seen.append(i))
+                        on_result=lambda i, r: seen.append(i))
     assert_early_stop_contract(stopped)
     assert sorted(seen) == [i for i, r in enumerate(stopped) if r is not None]  # each once
 
@@ -54,12 +55,12 @@ def test_local_processes_equal_one_process():
 def test_early_stop_keeps_later_results_that_finished_first():
     from mechsyn.parallel import _Book
 
-    results, seen = [None] * 7, []
-    book = _Book(7, lambda d, t, i, r: seen.append((d, i)), lambda i, r: r >= 6)
+    results, found, states = [None] * 7, [], []
+    book = _Book(7, states.append, lambda i, r: r >= 6, lambda i, r: found.append(i))
     for i in (0, 1, 3, 2):  # task 3 finishes before the stopping task 2
         book.finished(i, i * (i + 1), results)
     assert results == [0, 2, 6, 12, None, None, None] and book.limit == 3
-    assert seen == [(1, 0), (2, 1), (3, 3), (4, 2)]
+    assert found == [0, 1, 3, 2] and [(p.done, p.total) for p in states] == [(1, 7), (2, 7), (3, 7), (4, 7)]
 
 
 def test_options_checked():
@@ -75,8 +76,9 @@ def test_atlas_with_local_processes_is_the_same_atlas(tmp_path):
     two = synthesize_chains(10, 1, workers=2, progress=ticks.append)
     assert [c.edges for c in one] == [c.edges for c in two] and len(two) == 230
     assert [c.certificate for c in one] == [c.certificate for c in two]
-    assert sum(ticks) == pytest.approx(n_units(10, 1))  # shares of the assortments, from the workers
-    assert len(ticks) >= n_units(10, 1) and all(0 < t <= 1 for t in ticks)
+    # shares of the assortments, from the workers, counted up to all of them
+    assert ticks[-1].done == pytest.approx(n_units(10, 1)) and ticks[-1].total == n_units(10, 1)
+    assert len(ticks) >= n_units(10, 1) and all(0 < b.done - a.done <= 1 for a, b in zip(ticks, ticks[1:]))
     streamed = synthesize_chains_to_file(tmp_path / "c.jsonl", 10, 1, workers=2)
     assert [c.edges for c in streamed] == [c.edges for c in one]
 
@@ -93,7 +95,7 @@ def client():
 def test_dask_local_cluster_equals_one_process(client):
     seen = []
     out = run_tasks(operator.mul, TASKS, scheduler=client,
-                    progress=lambda d, t, i, r: seen.append(i))
+                    on_result=lambda i, r: seen.append(i))
     assert out == [i * (i + 1) for i in range(7)] and sorted(seen) == list(range(7))
     stopped = run_tasks(operator.mul, TASKS, scheduler=client, stop=lambda i, r: r >= 6)
     assert_early_stop_contract(stopped)

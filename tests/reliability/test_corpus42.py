@@ -362,8 +362,8 @@ def test_a_signal_at_each_phase_after_stage_one_keeps_it(message):
     case = load_case(ROOT / "examples" / "fingers" / "finger_design_case.yaml")
     case.maxiter, case.force_maxiter = 6, 3
 
-    def progress(msg):
-        if msg.startswith(message):
+    def progress(state):
+        if state.message.startswith(message):
             raise KeyboardInterrupt
 
     res = design_finger(case, seed=1, time_limit=60, progress=progress)

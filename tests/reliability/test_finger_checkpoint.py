@@ -38,8 +38,8 @@ def _same(a, b):
     return da == db
 
 
-def _stop_in_second_variant(msg):
-    if msg.startswith("VLL S2: stage 1, generation 2/"):
+def _stop_in_second_variant(state):
+    if state.message.startswith("VLL S2: stage 1, generation 2/"):
         raise KeyboardInterrupt
 
 
@@ -66,8 +66,8 @@ def test_interrupted_in_the_second_variant_then_resumed_gives_the_uninterrupted_
 
 
 def test_interrupt_before_a_variant_evaluated_anything_keeps_the_earlier_ones(case, uninterrupted, tmp_path):
-    def stop(msg):
-        if msg.startswith("VLL S2: stage 1 (targets"):
+    def stop(state):
+        if state.message.startswith("VLL S2: stage 1 (targets"):
             raise KeyboardInterrupt
 
     ck = tmp_path / "ck.json"

@@ -86,8 +86,8 @@ def test_finger_design_interrupted_keeps_stage1_best():
     case = load_case(FINGER_CASE)
     case.maxiter, case.popsize, case.force_maxiter = 200, 8, 4
 
-    def progress(msg):
-        if "generation 6/" in msg:
+    def progress(state):
+        if "generation 6/" in state.message:
             raise KeyboardInterrupt
 
     res = design_finger(case, seed=1, time_limit=120, progress=progress)
@@ -228,14 +228,14 @@ def test_capability_map_interrupted_keeps_the_finished_chunks():
     arm = load_arm(CAPABILITY_ARM)
     xs, ys = np.linspace(1300, 2100, 5), np.linspace(100, 900, 4)
     full = capability_map(arm, xs, ys, [1, 0])
-    part = capability_map(arm, xs, ys, [1, 0], chunk=6, advance=_interrupt_after(2))
+    part = capability_map(arm, xs, ys, [1, 0], chunk=6, progress=_interrupt_after(2))
     assert part.interrupted and part.done().sum() == 12  # two chunks of 6 points (x outer)
     done = part.done()
     assert np.array_equal(part.value[done], full.value[done], equal_nan=True)
     assert np.isnan(part.value[~done]).all() and len(part.table()) == 12
     assert part.to_dict()["computed_points"] == 12 and not full.to_dict()["interrupted"]
     # the chunk whose progress call was interrupted is kept too
-    assert capability_map(arm, xs, ys, [1, 0], chunk=6, advance=_interrupt_after(1)).done().sum() == 6
+    assert capability_map(arm, xs, ys, [1, 0], chunk=6, progress=_interrupt_after(1)).done().sum() == 6
 
 
 def test_cli_capability_map_interrupted_writes_solved_points_and_exits_130(run_cli, tmp_path, monkeypatch):

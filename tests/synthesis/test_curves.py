@@ -11,6 +11,7 @@ import pytest
 from mechsyn.errors import MechsynInputError
 from mechsyn.io.load import mechanism_from_dict
 from mechsyn.kinematics import simulate
+from mechsyn.progress import Progress
 from mechsyn.synthesis.curves.database import build_database, load_database
 from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
 from mechsyn.synthesis.curves.synthesis import synthesize_curve
@@ -121,7 +122,7 @@ def test_recovers_a_four_bar_curve_and_verifies_it(small_db):
                            callback=states.append)
     best = res.candidates[0]
     assert best.chamfer < 0.01 and best.verified
-    assert {"stage", "done", "total", "best", "nfev"} <= set(states[-1])
+    assert all(isinstance(s, Progress) for s in states) and states[-1].stage
     d = res.to_dict()["candidates"][0]
     assert set(d) >= {"mechanism", "tracer", "input", "links", "topology", "error", "min_transmission_angle"}
     # the reported mechanism, input and tracer re-simulate to the reported path
@@ -171,7 +172,8 @@ def test_default_database_builds_on_first_use(tmp_path, monkeypatch):
     states = []
     db = load_database(max_links=4, callback=states.append)
     assert len(db) == 40 and (tmp_path / "cache").is_dir()
-    assert states[0]["done"] == 0 and states[-1]["done"] == states[-1]["total"] == 1
+    assert states[0].done == 0 and states[-1].done == states[-1].total == 1 and states[-1].stage == "build"
+    assert states[-1].message == "40 curves"
     with pytest.raises(MechsynInputError, match="no curve database"):
         load_database(tmp_path / "empty", build_if_missing=False)
 

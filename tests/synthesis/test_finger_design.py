@@ -38,9 +38,10 @@ def small(case):
 @pytest.fixture(scope="module")
 def result():
     case = small(load_case(CASE))
-    msgs: list[str] = []
-    res = design_finger(case, seed=3, time_limit=60, progress=msgs.append)
-    res.messages = msgs
+    states: list = []
+    res = design_finger(case, seed=3, time_limit=60, progress=states.append)
+    res.messages = [p.message for p in states]
+    res.states = states
     return case, res
 
 
@@ -104,6 +105,8 @@ def test_progress_reports_best_error_so_far(result):
                                         for t in res.messages) if m]
     assert len(best) >= 2 and all(b <= a for a, b in zip(best, best[1:]))
     assert best[-1] == pytest.approx(res.best_variant.stage1_error_rms, rel=1e-3)   # printed to 4 digits
+    generations = [p for p in res.states if "stage 1, generation" in p.message and p.best is not None]
+    assert generations[-1].best == pytest.approx(best[-1], rel=1e-3) and generations[-1].total
 
 
 def test_force_stage_never_increases_peak_reaction(result):

@@ -124,7 +124,7 @@ def test_serve_fourbar_drag_joint_path_follows(serve, page):
     mech = page.evaluate("window.__studio.mech")
     sim = page.evaluate("window.__studio.sim")
     lib = simulate(mechanism_from_dict(mech), {"A": np.array(sim["input"]["values"])}, points=["M"])
-    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"]["M"]], float)
+    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"]["M"]["position"]], float)
     assert np.allclose(got, lib.points["M"].position, equal_nan=True)
     # each joint and each path follows the contract; nothing fetched from outside; no errors
     assert sorted(page.eval_on_selector_all("[data-joint]", "es => es.map(e => e.dataset.joint)")) == list("ABCD")
@@ -234,7 +234,7 @@ def test_synthesise_fourbar_through_five_points(serve, page):
     page.wait_for_selector('[data-path="P"]')
     wait_js(page, "() => window.__studio.sim && window.__studio.mech.name.includes('clicked')")
     sim = page.evaluate("window.__studio.sim")
-    path = np.array([p for p in sim["points"]["P"] if p is not None])
+    path = np.array([p for p in sim["points"]["P"]["position"] if p is not None])
     clicked = np.array(page.evaluate("window.__studio.targets"))
     gap = max(np.min(np.linalg.norm(path - t, axis=1)) for t in clicked)
     best = page.locator("[data-result='0']").inner_text()

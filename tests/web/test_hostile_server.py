@@ -124,7 +124,7 @@ def test_the_structure_check_names_the_joint_of_a_wrongly_typed_field(client, ex
 
 
 @pytest.mark.parametrize("axis", [[1e200, 1e200, 0], [1e300, 1e300, 1e300], [0, 1e13, 0]])
-@pytest.mark.parametrize("route", ["/api/spatial/view", "/api/spatial/plots", "/api/studio/check", "/api/validate",
+@pytest.mark.parametrize("route", ["/api/spatial/simulate", "/api/studio/check", "/api/validate",
                                    "/api/analyze", "/api/export", "/api/studio/drawing"])
 def test_an_overflowing_axis_is_a_400(client, example, route, axis):
     m = example("bennett")
@@ -140,7 +140,7 @@ def test_an_overflowing_axis_is_a_400(client, example, route, axis):
     ("/api/simulate", {"rates": 1}, "rates"), ("/api/export", {"format": "xls"}, "format"),
     ("/api/export", {"format": "gif", "frames": 1000}, "frames"), ("/api/studio/forces", {"gravity": [0]}, "gravity"),
     ("/api/studio/forces", {"speed": "fast"}, "speed"), ("/api/studio/forces", {"gravity": [0, 1e300]}, "gravity[1]"),
-    ("/api/spatial/view", {"steps": True}, "steps"), ("/api/file", {"path": "a.yaml", "overwrite": "false"}, "overwrite"),
+    ("/api/spatial/simulate", {"steps": True}, "steps"), ("/api/file", {"path": "a.yaml", "overwrite": "false"}, "overwrite"),
 ])
 def test_wrongly_typed_fields_are_400_naming_them(client, example, route, body, field):
     r = client.post(route, json={"mechanism": example("fourbar"), **body})

@@ -28,30 +28,56 @@ def test_examples_list_and_open(client):
     assert bad.status_code == 400 and bad.json()["field"] == "example" and "fourbar" in bad.json()["hint"]
 
 
-def test_simulate_equals_library(client, fourbar):
+def test_simulate_is_the_motions_to_dict(client, fourbar):
+    """The studio draws the library's Motion: the route's answer is
+    ``simulation_report(...).to_dict()``, i.e. the Simulation's ``to_dict()`` with its derived
+    quantities, nothing of its own."""
+    import json
+
     from mechsyn.kinematics.analysis import simulate
+    from mechsyn.kinematics.report import simulation_report
 
     r = client.post("/api/simulate", json={"mechanism": fourbar, "steps": 90})
     assert r.status_code == 200
     d = r.json()
     u = np.array(d["input"]["values"])
     assert u[0] == pytest.approx(np.degrees(np.arctan2(2, 1)))  # the sweep starts at the drawn pose
-    assert d["joints"]["B"][0] == pytest.approx([1, 2])  # index 0 is the file's configuration
-    lib = simulate(load_mechanism(example_path("fourbar")), {"A": u}, points=["M", "C"])
-    for name, got in (("M", d["points"]["M"]), ("C", d["joints"]["C"])):
-        ref = lib.points[name].position
-        for k, p in enumerate(got):
-            assert (p is None) == (not lib.assembled[k])
-            if p is not None:
-                assert p == pytest.approx(ref[k].tolist(), abs=1e-12)
+    assert d["points"]["B"]["position"][0] == pytest.approx([1, 2])  # index 0 is the file's configuration
+    mech = load_mechanism(example_path("fourbar"))
+    names = ["A", "B", "C", "D", "M"]
+    lib = simulate(mech, {"A": u}, points=names)
+    assert {k: v for k, v in d.items() if k != "derived"} == json.loads(json.dumps(lib.to_dict()))
+    assert d == json.loads(json.dumps(simulation_report(mech, {"A": u}, points=names).to_dict()))
+    for k, p in enumerate(d["points"]["M"]["position"]):
+        assert (p is None) == (not lib.assembled[k])
     # a triple rocker: two dead points and two working ranges, reported (not printed as numbers)
     assert len([e for e in d["events"] if e["kind"] == "dead point"]) == 2
     dead = sorted(e["input"]["A"] for e in d["events"] if e["kind"] == "dead point")
     # one working range through 360 deg (the sweep is a whole turn), ending at the dead points
     assert d["working_ranges"] == [pytest.approx([dead[1], dead[0] + 360], abs=1e-9)]
-    assert d["grashof"]["classification"].startswith("triple rocker")
-    mu = d["transmission_angle"]["B-C-D"]
+    assert d["derived"]["grashof"]["classification"].startswith("triple rocker")
+    mu = d["derived"]["transmission_angle"]["B-C-D"]
     assert 0 < mu["min"] < mu["max"] <= 180
+
+
+def test_simulate_route_is_the_cli_json(client, fourbar, tmp_path, cli_json):
+    """``mechsyn simulate --json`` over the studio's sweep prints the route's answer (both on
+    the NumPy pass, which a one-shot command takes: ``mechsyn.cli.main.ONE_SHOT``)."""
+    import json
+
+    from mechsyn.io import mechanism_to_dict
+    from mechsyn.kinematics import kernel
+
+    six = mechanism_to_dict(load_mechanism(example_path("watt_sixbar")))
+    for mech in (fourbar, six):
+        with kernel.use("numpy"):
+            d = client.post("/api/simulate", json={"mechanism": mech, "steps": 36}).json()
+        u = d["input"]["values"]
+        path = tmp_path / "m.json"
+        path.write_text(json.dumps(mech))
+        got = cli_json("simulate", path, "--input", f"{d['input']['joint']}={u[0]!r}:{u[-1]!r}:{10.0!r}",
+                       "--points", ",".join(d["points"]))
+        assert got == d
 
 
 def test_analyze(client):
@@ -282,15 +308,16 @@ def test_fourbar_path_synthesis_job(client):
     assert best["feasible"] and best["error"] < 1e-3 * np.ptp(targets, axis=0).max() ** 2
     # the applied mechanism simulates and its point passes through the targets
     d = client.post("/api/simulate", json={"mechanism": best["mechanism"], "steps": 720}).json()
-    path = np.array([p for p in d["points"]["P"] if p is not None])
+    path = np.array([p for p in d["points"]["P"]["position"] if p is not None])
     gap = max(np.min(np.linalg.norm(path - t, axis=1)) for t in targets)
     assert gap < 0.05 * np.ptp(targets, axis=0).max()
     # buildable: inside the default size bound, its quality listed; the transmission angle
     # is the simulated one's worst (the crank-rocker's extremes in closed form)
     q = best["quality"]
     assert q["size_ratio"] <= 1.5 + 1e-9 and q["link_ratio"] >= 1 and q["full_turn"]
-    sim_mu = min(min(v["min"], 180 - v["max"]) for v in d["transmission_angle"].values())
-    assert abs(q["min_transmission_angle"] - sim_mu) < 1.0, (q, d["transmission_angle"])
+    mu = d["derived"]["transmission_angle"]
+    sim_mu = min(min(v["min"], 180 - v["max"]) for v in mu.values())
+    assert abs(q["min_transmission_angle"] - sim_mu) < 1.0, (q, mu)
 
 
 def test_synthesis_cancel_and_bad_input(client):
@@ -317,9 +344,14 @@ def test_events_stream(client):
 def test_simulate_without_rates(client, fourbar):
     full = client.post("/api/simulate", json={"mechanism": fourbar, "steps": 60}).json()
     lean = client.post("/api/simulate", json={"mechanism": fourbar, "steps": 60, "rates": False}).json()
-    assert lean["velocity"] == {} and lean["links"] == {} and not lean["rates"]
-    for key in ("joints", "points", "events", "working_ranges", "transmission_angle", "assembled"):
+    assert not lean["rates"] and full["rates"]
+    assert {k: sorted(p) for k, p in lean["points"].items()} == {k: ["position"] for k in full["points"]}
+    assert all(sorted(v) == ["angle"] for v in lean["links"].values())
+    for key in ("events", "working_ranges", "assembled"):
         assert lean[key] == full[key]
+    assert {k: p["position"] for k, p in lean["points"].items()} == {k: p["position"] for k, p in full["points"].items()}
+    assert lean["derived"]["transmission_angle"] == full["derived"]["transmission_angle"]
+    assert "motion" not in lean["derived"] and "motion" in full["derived"]
     assert client.post("/api/simulate", json={"mechanism": fourbar, "rates": "no"}).status_code == 400
 
 

@@ -27,23 +27,24 @@ def column(rows, i=None):
     return np.array([np.nan if v is None else (v if i is None else v[i]) for v in rows], float)
 
 
-def test_plots_route_is_ms_simulate_over_the_view_rows(client):
+def test_spatial_route_is_ms_simulate_and_the_cli_json(client, cli_json, tmp_path):
+    """The 3-D view and the Plots tab draw the library's SpatialSimulation: the route answers its
+    ``to_dict()``, which ``mechsyn simulate --json`` prints for the same inputs."""
+    import json
+
     mech = spatial_dict("bennett")
-    p = client.post("/api/spatial/plots", json={"mechanism": mech, "steps": 90}).json()
-    v = client.post("/api/spatial/view", json={"mechanism": mech, "steps": 90}).json()
-    assert p["input"] == v["input"] and p["assembled"] == v["assembled"] and p["home"] == v["home"]
+    p = client.post("/api/spatial/simulate", json={"mechanism": mech, "steps": 90}).json()
     u = np.asarray(p["input"]["values"])
     sim = ms.simulate(ms.examples.load("bennett"), {"R1": u})
-    assert sorted(p["pairs"]) == ["R1", "R2", "R3", "R4"]
-    for key, pair in p["pairs"].items():
-        assert pair["unit"] == "deg" and pair["kind"] == "angle"
-        assert np.allclose(column(pair["values"]), sim.joints[key], atol=1e-7), key
-    # the drive's own angle is the input
-    assert np.allclose(column(p["pairs"]["R1"]["values"]), u, atol=1e-7)
+    assert p == json.loads(json.dumps(sim.to_dict()))
+    path = tmp_path / "bennett.json"
+    path.write_text(json.dumps(mech))
+    assert cli_json("simulate", path, "--input", f"R1={float(u[0])!r}:{float(u[-1])!r}:4.0") == p
+    assert sorted(p["joints"]) == ["R1", "R2", "R3", "R4"]
+    assert np.allclose(column(p["joints"]["R1"]), u, atol=1e-7)  # the drive's own angle is the input
     L = p["length_scale"]
     for name, pt in p["points"].items():
         X = np.array([column(pt["position"], i) for i in range(3)]).T
-        assert np.allclose(X, sim.point(name), atol=1e-9 * L)
         V = np.array([column(pt["velocity"], i) for i in range(3)]).T
         h = np.radians(u[1] - u[0])  # independent: fourth-order central differences per radian of R1
         dX = (-X[4:] + 8 * X[3:-1] - 8 * X[1:-3] + X[:-4]) / (12 * h)
@@ -52,14 +53,14 @@ def test_plots_route_is_ms_simulate_over_the_view_rows(client):
     assert np.allclose(w, [0.0, 0.0, 1.0], atol=1e-9)  # the crank turns about R1's axis z at 1 rad/s
 
 
-def test_plots_route_marks_the_rssr_dead_point_and_slides_in_length(client):
-    p = client.post("/api/spatial/plots", json={"mechanism": spatial_dict("rssr"), "steps": 180}).json()
+def test_spatial_route_marks_the_rssr_dead_point_and_refuses_a_planar_file(client):
+    p = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("rssr"), "steps": 180}).json()
     dead = [e for e in p["events"] if e["kind"] == "dead point"]
     assert dead and all(p["assembled"][e.get("last", e["index"] - 1)] for e in dead)  # the row it bounds
     ok = np.asarray(p["assembled"])
-    for pair in p["pairs"].values():  # rows not assembled are None, never numbers
-        assert all((x is None) == (not good) for x, good in zip(pair["values"], ok))
-    planar = client.post("/api/spatial/plots", json={"mechanism": spatial_dict("fourbar")})
+    for values in p["joints"].values():  # rows not assembled are None, never numbers
+        assert all((x is None) == (not good) for x, good in zip(values, ok))
+    planar = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("fourbar")})
     assert planar.status_code == 400 and planar.json()["field"] == "kind"
 
 
@@ -87,9 +88,9 @@ def test_check_calls_a_broken_bennett_rigid_with_the_finite_mobility_reading(cli
     kept = diagnostics(_moved("R2", 0.4 * axis))
     assert kept[0]["level"] == "note" and kept[0]["message"].startswith("spatial mechanism: 3-D view")
     # ... and its paths are those of the drawn file (every joint point but R2's own is unchanged)
-    a = client.post("/api/spatial/view", json={"mechanism": spatial_dict("bennett"), "steps": 36}).json()
-    b = client.post("/api/spatial/view", json={"mechanism": _moved("R2", 0.4 * axis), "steps": 36}).json()
-    assert np.allclose(np.array(a["paths"]["R3"]["position"]), np.array(b["paths"]["R3"]["position"]),
+    a = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("bennett"), "steps": 36}).json()
+    b = client.post("/api/spatial/simulate", json={"mechanism": _moved("R2", 0.4 * axis), "steps": 36}).json()
+    assert np.allclose(np.array(a["points"]["R3"]["position"]), np.array(b["points"]["R3"]["position"]),
                        atol=1e-9 * a["length_scale"])
     # the files that cannot move were already refused with the drives named: the tilted Bennett
     tilted = diagnostics(spatial_dict("bennett_tilted"))

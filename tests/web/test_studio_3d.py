@@ -24,16 +24,26 @@ def spatial_dict(name):
 
 
 def rows(view, jid):
-    """(N, 3) positions of joint ``jid`` (NaN where not assembled)."""
+    """(N, 3) positions of joint ``jid`` in a scene (NaN where not assembled)."""
     j = next(j for j in view["joints"] if j["id"] == jid)
     return np.array([p if p is not None else [np.nan] * 3 for p in j["position"]], float)
 
 
-def test_view_route_bennett_rigid_and_from_the_drawn_pose(client):
+def scene_of(page, motion, mech):
+    """The page's scene (``sceneOf`` of static/view3d.js: joints and axes placed by the links'
+    poses) of the simulation ``motion`` of ``mech``."""
+    return page.evaluate("async ([m, mech]) => (await import('/static/view3d.js')).sceneOf(m, mech)", [motion, mech])
+
+
+def test_scene_of_bennett_rigid_and_from_the_drawn_pose(client, serve, page):
+    """The route answers the SpatialSimulation's to_dict; the page places the joints and their
+    axes from the links' poses: rigid links keep their lengths, neighbouring axes their twist,
+    the drawn pose is row ``home``."""
     mech = spatial_dict("bennett")
-    r = client.post("/api/spatial/view", json={"mechanism": mech, "steps": 90})
+    r = client.post("/api/spatial/simulate", json={"mechanism": mech, "steps": 90})
     assert r.status_code == 200, r.text
-    v = r.json()
+    page.goto(serve(None).url)
+    v = scene_of(page, r.json(), mech)
     assert v["engine"] == "spatial" and len(v["assembled"]) == 90 and all(v["assembled"])
     L = v["length_scale"]
     k0 = v["home"]
@@ -50,25 +60,32 @@ def test_view_route_bennett_rigid_and_from_the_drawn_pose(client):
         assert np.ptp(c) < 1e-5, (a, b)
     assert np.ptp(rows(v, "R3")[:, 2]) > 0.1 * L  # R3 leaves the plane z = const of R2's circle
     assert v["residual"] < 1e-9 and set(v["paths"]) == {"R2", "R3"}
+    # rows not assembled are None in the scene too (the RSSR crank does not turn fully)
+    rssr = spatial_dict("rssr")
+    w = scene_of(page, client.post("/api/spatial/simulate", json={"mechanism": rssr, "steps": 60}).json(), rssr)
+    ok = np.array(w["assembled"])
+    assert ok.any() and not ok.all()
+    for j in w["joints"]:
+        assert all((p is None) == (not good) for p, good in zip(j["position"], ok)), j["id"]
 
 
 @pytest.mark.slow
-def test_view_route_rows_not_assembled_are_null_and_refusals_name_the_fix(client):
-    v = client.post("/api/spatial/view", json={"mechanism": spatial_dict("rssr"), "steps": 180}).json()
+def test_spatial_route_rows_not_assembled_are_null_and_refusals_name_the_fix(client):
+    v = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("rssr"), "steps": 180}).json()
     ok = np.array(v["assembled"])
     assert ok.any() and not ok.all()  # the RSSR crank does not turn fully
-    for j in v["joints"]:
-        assert all((p is None) == (not good) for p, good in zip(j["position"], ok)), j["id"]
+    for name, pm in v["points"].items():
+        assert all((p is None) == (not good) for p, good in zip(pm["position"], ok)), name
     assert any(e["kind"] == "dead point" for e in v["events"])
-    planar = client.post("/api/spatial/view", json={"mechanism": spatial_dict("fourbar")})
+    planar = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("fourbar")})
     assert planar.status_code == 400 and planar.json()["field"] == "kind"
-    contact = client.post("/api/spatial/view", json={"mechanism": spatial_dict("gripper_003")})
+    contact = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("gripper_003")})
     assert contact.status_code == 400 and "line_contact" in contact.json()["error"] and contact.json()["hint"]
-    # a P drive: the drawn pose is the middle row, input 0 exactly
-    p = client.post("/api/spatial/view", json={"mechanism": spatial_dict("stewart_6ups"), "steps": 180}).json()
-    assert len(p["assembled"]) == 181 and p["home"] == 90 and p["input"]["values"][90] == 0.0
+    # a P drive: the drawn pose is the middle row (the page's home), input 0 exactly
+    p = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("stewart_6ups"), "steps": 180}).json()
+    assert len(p["assembled"]) == 181 and p["input"]["values"][90] == 0.0
     assert p["assembled"][90] and p["input"]["type"] == "P"
-    bad = client.post("/api/spatial/view", json={"mechanism": spatial_dict("bennett"), "steps": 1})
+    bad = client.post("/api/spatial/simulate", json={"mechanism": spatial_dict("bennett"), "steps": 1})
     assert bad.status_code == 400 and bad.json()["field"] == "steps"
 
 
@@ -83,7 +100,7 @@ def test_check_note_says_3d_where_the_engine_moves_the_file(client):
     assert "line_contact" in refused[0]["message"]
 
 
-def test_view_route_loads_no_matplotlib(tmp_path):
+def test_spatial_route_loads_no_matplotlib(tmp_path):
     """The 3-D view is drawn by the page: the route and the check load no Matplotlib."""
     import os
     import subprocess
@@ -102,7 +119,7 @@ def test_view_route_loads_no_matplotlib(tmp_path):
         with TestClient(app, base_url="http://127.0.0.1", headers={{"X-Mechsyn-Token": "t"}}) as c:
             for name in ("bennett", "delta"):
                 m = mechanism_to_dict(load_mechanism(example_path(name)))
-                for path in ("/api/spatial/view", "/api/studio/check"):
+                for path in ("/api/spatial/simulate", "/api/studio/check"):
                     r = c.post(path, json={{"mechanism": m, "steps": 12}})
                     assert r.status_code == 200, (path, r.text)
         assert "matplotlib" not in sys.modules, "a 3-D view route imported matplotlib"

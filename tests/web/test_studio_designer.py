@@ -133,7 +133,7 @@ def test_numeric_editing_one_undo_step(serve, page):
     sim = page.evaluate("window.__studio.sim")
     lib = simulate(mechanism_from_dict(page.evaluate("window.__studio.mech")), {"A": np.array(sim["input"]["values"])},
                    points=["M"])
-    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"]["M"]], float)
+    got = np.array([p if p is not None else [np.nan, np.nan] for p in sim["points"]["M"]["position"]], float)
     assert np.allclose(got, lib.points["M"].position, equal_nan=True)
     page.click("#undo")
     assert page.evaluate("window.__studio.mech.joints.find(j => j.id === 'B').point") == [1.0, 2.0]
@@ -158,7 +158,7 @@ def test_slider_angle_typed_and_turned_by_its_handle(serve, page):
     wait_js(page, "() => Math.abs(window.__studio.mech.joints.find(j => j.id === 'D').axis[1] - 0.5) < 1e-9")
     wait_simulated(page)
     # the slider moves along the typed direction: C's path is a segment at 30 degrees
-    c = np.array([p for p in page.evaluate("window.__studio.sim.joints.C") if p is not None])
+    c = np.array([p for p in page.evaluate("window.__studio.sim.points.C.position") if p is not None])
     d = c - c[0]
     far = d[np.argmax(np.linalg.norm(d, axis=1))]
     assert abs(np.degrees(np.arctan2(far[1], far[0])) % 180 - 30) < 1e-6
@@ -399,7 +399,7 @@ def test_plots_units_spikes_full_turn_and_assembled_slider(serve, page):
     titles = page.eval_on_selector_all("#plots p", "ps => ps.map(p => p.textContent)")
     assert "units/s" in titles[0] and "units/s²" in titles[1] and "rad/s" in titles[0]
     # near the dead points the acceleration spikes: the y-range is clipped and says so
-    acc = np.array([p for p in page.evaluate("window.__studio.sim.acceleration.M") if p is not None])
+    acc = np.array([p for p in page.evaluate("window.__studio.sim.points.M.acceleration") if p is not None])
     spread = np.ptp(acc, axis=0).max()
     core = max(np.percentile(acc[:, i], 98) - np.percentile(acc[:, i], 2) for i in range(2))
     assert spread > 4 * core  # the case of the issue
@@ -484,7 +484,7 @@ def test_motion_through_three_poses(serve, page):
     assert ref.all_solutions[0].position_error < 1e-9
     mech = page.evaluate("window.__studio.mech")
     assert np.allclose(mech["points"]["P"]["at"], targets[0], atol=1e-9)
-    path = np.array([p for p in page.evaluate("window.__studio.sim.points.P") if p is not None])
+    path = np.array([p for p in page.evaluate("window.__studio.sim.points.P.position") if p is not None])
     step = np.max(np.linalg.norm(np.diff(path, axis=0), axis=1))
     assert max(np.min(np.linalg.norm(path - t, axis=1)) for t in targets) <= step
     assert page.console_errors == []

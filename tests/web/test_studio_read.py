@@ -77,11 +77,11 @@ def test_a_fourbar_built_along_one_line_then_opened_out_moves(serve, page):
     result = page.evaluate("window.__studio.check.result")
     assert result["mobility"] == 1 and not any(d["blocks"] for d in result["diagnostics"])
     sim = page.evaluate("window.__studio.sim")
-    C = np.array([p for p in sim["joints"]["C"] if p is not None])
+    C = np.array([p for p in sim["points"]["C"]["position"] if p is not None])
     assert sim["assembled"][0] and len(C) > 10 and np.ptp(C, axis=0).max() > 0.1  # it moves
     lib = ms.simulate(ms.load(page.evaluate("window.__studio.mech")), {"A": np.array(sim["input"]["values"])})
     ok = lib.assembled
-    assert np.allclose(np.array([p if p else [np.nan] * 2 for p in sim["joints"]["C"]], float)[ok], lib.point("C")[ok])
+    assert np.allclose(np.array([p if p else [np.nan] * 2 for p in sim["points"]["C"]["position"]], float)[ok], lib.point("C")[ok])
     assert "W = 2" not in page.evaluate(BANNER) and "cannot move" not in page.evaluate(BANNER)
     shot(page, "studio_read_opened_fourbar.png")
     assert page.console_errors == []
@@ -108,7 +108,7 @@ def test_plots_read_values_at_the_cursor_and_the_slider(serve, page):
     page.select_option("#plot-what", "point:M")
     wait_js(page, "() => document.querySelectorAll('#plots .chart-canvas canvas').length === 3")
     sim = page.evaluate("window.__studio.sim")
-    v = np.array(sim["velocity"]["M"], float)
+    v = np.array(sim["points"]["M"]["velocity"], float)
     # the read-out at the slider: the velocity of M at row 40, as the library's
     readout = page.locator('#plots [data-plot="velocity of M"] [data-readout]')
     assert readout.get_attribute("data-cursor") == "40"
@@ -145,7 +145,7 @@ def test_plots_read_values_at_the_cursor_and_the_slider(serve, page):
         page.click('#plots [data-plot="acceleration of M"] [data-csv]')
     table = list(csv.reader(io.StringIO(open(dl.value.path()).read())))
     assert table[0] == ["A (°)", "ax (units/s²)", "ay (units/s²)", "|a| (units/s²)"]
-    a = np.array(sim["acceleration"]["M"], float)
+    a = np.array(sim["points"]["M"]["acceleration"], float)
     assert np.allclose(np.array(table[1:], float)[:, 1:3], a)
     # the coupler path as an x/y plot with its read-out
     assert page.locator('#plots [data-plot="path of M"] svg path').count() == 1
@@ -161,8 +161,8 @@ def test_plots_of_joints_sliders_and_transmission(serve, page):
     page.select_option("#plot-what", "joint:D")
     wait_js(page, "() => document.querySelector('#plots [data-plot=\"slide of D along its guide\"] canvas')")
     sim = page.evaluate("window.__studio.sim")
-    s = np.array(sim["slides"]["D"]["value"], float)
-    assert np.allclose(s, np.array(sim["joints"]["D"], float)[:, 0])  # a guide along x from the origin
+    s = np.array(sim["derived"]["slides"]["D"]["value"], float)
+    assert np.allclose(s, np.array(sim["points"]["D"]["position"], float)[:, 0])  # a guide along x from the origin
     assert np.ptp(s) == pytest.approx(2.0, rel=1e-3)  # the stroke: twice the crank
     page.select_option("#plot-what", "joint:A")
     wait_js(page, "() => document.querySelector('#plots [data-plot=\"angle of joint A\"] canvas')")

@@ -23,7 +23,7 @@ def test_widget_answers_like_the_server(widget):
     assert start["ok"] and start["id"] == 1 and start["data"]["mechanism"] == widget.value
     sim = widget.answer({"id": 2, "path": "/api/simulate", "method": "POST",
                          "body": {"mechanism": widget.value, "steps": 12}})
-    assert sim["ok"] and len(sim["data"]["joints"]["B"]) == 12
+    assert sim["ok"] and len(sim["data"]["points"]["B"]["position"]) == 12
     bad = widget.answer({"id": 3, "path": "/api/simulate", "method": "POST", "body": {"mechanism": {}}})
     assert not bad["ok"] and bad["data"]["field"]
     assert not widget.answer({"id": 4, "path": "/etc/passwd", "method": "GET"})["ok"]

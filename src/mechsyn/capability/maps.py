@@ -29,6 +29,7 @@ from mechsyn.capability.measures import (
 )
 from mechsyn.errors import MechsynInputError
 from mechsyn.parallel import run_tasks
+from mechsyn.progress import ProgressCallback, counter
 
 BRANCHES = {"negative": (-1,), "positive": (1,), "both": (-1, 1)}
 
@@ -521,19 +522,19 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
                    measure: str = "exact", q1: np.ndarray | None = None,
                    branch: str = "negative", respect_limits: bool = True,
                    continuous: bool = False, chunk: int = 2048,
-                   advance: Callable[[int], None] | None = None,
+                   progress: ProgressCallback | None = None,
                    workers: int = 1, scheduler=None) -> CapabilityMap:
     """Best configuration and V_max at every grid point (paper 004, Table 2).
 
     ``q1`` (radians) samples the self-motion (default: 20 deg steps over q1's limits, the
     paper's choice); ``continuous`` uses :func:`continuous_best` instead (planar 3R), or
     refines the best 8 IK solutions with :func:`refine_over_self_motion` (other arms).
-    The grid is solved in chunks of ``chunk`` points; ``advance(k)`` is called after
-    each chunk of k points (for a progress bar). ``workers`` (local processes) or
+    The grid is solved in chunks of ``chunk`` points; ``progress(state)``
+    (:class:`mechsyn.progress.Progress`: points done of all) is called after each chunk. ``workers`` (local processes) or
     ``scheduler`` (a Dask cluster) solve the chunks in parallel
     (:func:`mechsyn.parallel.run_tasks`): every point's answer depends only on the point,
     so the map is the same. Spatial arms need ``z`` (the grid lies in the plane z = const).
-    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``advance``) returns the chunks
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) returns the chunks
     finished so far, ``interrupted=True`` and ``computed`` marking their points (NaN
     elsewhere); it propagates when no chunk had finished.
 
@@ -556,14 +557,15 @@ def capability_map(arm: SerialArm, xs, ys, direction, *, z: float | None = None,
 
     got: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
-    def progress(done: int, total: int, index: int, result) -> None:
-        got[index] = result  # kept before the callback, which may raise Ctrl-C
-        if advance is not None:
-            advance(len(result[0]))
+    advance = counter(progress, P, "points")
+
+    def finished(index: int, result) -> None:
+        got[index] = result  # kept before the progress callback, which may raise Ctrl-C
+        advance(len(result[0]))
 
     interrupted = False
     try:
-        run_tasks(_map_chunk, tasks, workers=workers, scheduler=scheduler, progress=progress)
+        run_tasks(_map_chunk, tasks, workers=workers, scheduler=scheduler, on_result=finished)
     except KeyboardInterrupt:
         if not got:
             raise
@@ -680,7 +682,7 @@ def _interpolated(arm: SerialArm, cmap: CapabilityMap, at: np.ndarray) -> dict[s
 def capability_grid(arm: SerialArm, xs, ys, direction, *, z: float | None = None, measure: str = "exact",
                     q1: np.ndarray | None = None, branch: str = "negative", respect_limits: bool = True,
                     continuous: bool = False, interpolate: Any = None,
-                    advance: Callable[[int], None] | None = None, workers: int = 1,
+                    progress: ProgressCallback | None = None, workers: int = 1,
                     scheduler: Any = None) -> CapabilityMap:
     """:func:`capability_map` with its inputs checked, the chunk size fit to the inverse
     kinematics (closed form or numeric), and the optimal configuration interpolated at
@@ -695,7 +697,7 @@ def capability_grid(arm: SerialArm, xs, ys, direction, *, z: float | None = None
         Direction of motion, finite and non-zero.
     z : float, optional
         The grid's plane z = const; required for spatial arms.
-    measure, q1, branch, respect_limits, continuous, advance, workers, scheduler
+    measure, q1, branch, respect_limits, continuous, progress, workers, scheduler
         As for :func:`capability_map`.
     interpolate : array_like, optional
         A point (x, y) inside the grid.
@@ -728,7 +730,7 @@ def capability_grid(arm: SerialArm, xs, ys, direction, *, z: float | None = None
         raise MechsynInputError(f"unknown measure {measure!r}", field="measure", hint=", ".join(MEASURES))
     cmap = capability_map(arm, xs, ys, d, z=z, measure=measure, q1=q1, branch=branch,
                           respect_limits=respect_limits, continuous=continuous,
-                          chunk=2048 if is_closed_form(arm) else 64, advance=advance,
+                          chunk=2048 if is_closed_form(arm) else 64, progress=progress,
                           workers=workers, scheduler=scheduler)
     if interpolate is not None:
         cmap.interpolated = _interpolated(arm, cmap, np.asarray(interpolate, float))

@@ -18,7 +18,7 @@ from typing import Annotated, Optional
 import typer
 
 from mechsyn.cli.app import app
-from mechsyn.cli.common import emit_json, err_console, strip_control, write_output
+from mechsyn.cli.common import emit_json, err_console, progress_bar, strip_control, write_output
 from mechsyn.io import json_schema, load_mechanism
 from mechsyn.structure.report import analyze as structure_report
 
@@ -36,8 +36,8 @@ def _analyze_reporting(mech, **options):
     err_console.print(f"large mechanism: {len(mech.joints)} joints, {len(mech.links)} links, "
                       f"{cycle_rank(mech)} contours; the rank method's work grows about linearly for chains "
                       f"of loops (2,000 joints: a few seconds)", highlight=False)
-    with err_console.status("rank method") as status:
-        return structure_report(mech, progress=lambda stage: status.update(f"rank method: {stage}"), **options)
+    with progress_bar("rank method") as progress:
+        return structure_report(mech, progress=progress, **options)
 
 
 @app.command("analyze")

@@ -80,9 +80,9 @@ def atlas(
 
     _check_files(out, stream, mechanisms, links, mobility)
     check_parallel_options(workers, scheduler)
-    with progress_bar(f"{links}-link chains, F={mobility}", n_units(links, mobility)) as advance:
+    with progress_bar(f"{links}-link chains, F={mobility}", n_units(links, mobility)) as progress:
         result = chain_atlas(links, mobility, include_degenerate=include_degenerate, inputs=inputs,
-                             stream=stream, force=force, workers=workers, scheduler=scheduler, progress=advance)
+                             stream=stream, force=force, workers=workers, scheduler=scheduler, progress=progress)
     _write_files(result, out, mechanisms, stream)
     if json_out:
         emit_json(result.to_dict())

@@ -151,8 +151,8 @@ def _grid(arm, grid: str, options: dict, map_png: Optional[Path], csv_out: Optio
                                 hint="e.g. --grid 1300:2100:200,100:900:200")
     xs, ys = _values(parts[0], "--grid"), _values(parts[1], "--grid")
     total = xs.size * ys.size
-    with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as advance:
-        cmap = capability_grid(arm, xs, ys, advance=advance, **options)
+    with progress_bar("capability map", total, enabled=total >= 2000 or not is_closed_form(arm)) as progress:
+        cmap = capability_grid(arm, xs, ys, progress=progress, **options)
     one_stdout(json_out, csv_out)
     if csv_out is not None:
         write_output(csv_out, cmap.to_csv())

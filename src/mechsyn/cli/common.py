@@ -21,6 +21,7 @@ from rich.markup import escape
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.io.files import HIDDEN_CHARS, is_mechanism_file
+from mechsyn.progress import Progress, ProgressCallback, counter
 from mechsyn.results import dumps, write_atomic
 
 T = TypeVar("T")
@@ -377,49 +378,39 @@ def parse_range(text: str, option: str, example: str = "0:360:1") -> tuple[float
 
 
 @contextmanager
-def progress_bar(description: str, total: int | None, enabled: bool = True) -> Iterator[Any]:
-    """A rich progress bar on stderr (silent when ``enabled`` is false or not a TTY).
-
-    Yields a callable ``advance(n=1)``.
+def progress_bar(description: str, total: float | None = None, enabled: bool = True,
+                 best: str = "best {:.6g}") -> Iterator[ProgressCallback | None]:
+    """The command line's one view of a long computation's progress: a rich progress bar
+    on stderr drawn from each :class:`mechsyn.progress.Progress` (``done`` of ``total``,
+    the stage and message beside ``description``, the best so far formatted by ``best``,
+    the time elapsed). Yields the ``progress`` callable to hand to the library call, or
+    None (nothing to report) when ``enabled`` is false or stderr is not a terminal.
+    ``total`` is used until a state gives its own.
     """
-    if not enabled or not err_console.is_terminal:
-        yield lambda n=1: None
-        return
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
-    with Progress(
-        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-        TimeRemainingColumn(), console=err_console, transient=True,
-    ) as progress:
-        task = progress.add_task(description, total=total)
-        yield lambda n=1: progress.advance(task, n)
-
-
-@contextmanager
-def restart_progress(description: str, total: int, enabled: bool = True) -> Iterator[Any]:
-    """A progress bar of a multi-start search on stderr (restarts done, best error so far),
-    when ``enabled`` and stderr is a terminal. Yields ``callback(state)`` (a
-    :class:`mechsyn.synthesis.problem.Progress`) or None."""
     if not enabled or not err_console.is_terminal:
         yield None
         return
-    from rich.progress import TimeElapsedColumn
+    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn
+    from rich.progress import Progress as Bar
 
-    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total} restarts"),
-                  TextColumn("best error {task.fields[best]}"), TimeElapsedColumn(),
-                  console=err_console, transient=True) as prog:
-        task = prog.add_task(description, total=total, best="-")
+    with Bar(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[count]}"),
+             TextColumn("{task.fields[best]}"), TimeElapsedColumn(), console=err_console, transient=True) as bar:
+        task = bar.add_task(escape(description), total=total, count="", best="")
 
-        def progress(state: Any) -> None:
-            best = state.best_error
-            prog.update(task, completed=state.done, best=f"{best:.6g}" if np.isfinite(best) else "-")
+        def progress(state: Progress) -> None:
+            of = state.total if state.total is not None else total
+            words = ": ".join(w for w in (description, state.stage, state.message) if w)
+            bar.update(task, description=escape(words), completed=state.done, total=of,
+                       count=f"{state.done:g}/{of:g}" if of else "",
+                       best="" if state.best is None else best.format(state.best))
 
         yield progress
 
 
 def track(items: Iterable[T], description: str, total: int | None = None) -> Iterator[T]:
     """Iterate with a progress bar on stderr when it is a terminal."""
-    with progress_bar(description, total) as advance:
+    with progress_bar(description, total) as progress:
+        advance = counter(progress, total)
         for item in items:
             yield item
             advance()

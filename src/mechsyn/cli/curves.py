@@ -30,15 +30,9 @@ def curves_build(
 
     if links not in (4, 6, 8):  # --links here, --max-links in synth curve
         raise MechsynInputError(f"{links} links: choose 4, 6 or 8", source="--links")
-    with progress_bar("curves build", len(curve_topologies(links)), enabled=not as_json) as advance:
-        seen = {"done": 0}
-
-        def callback(state: dict) -> None:
-            advance(state["done"] - seen["done"])
-            seen["done"] = state["done"]
-
+    with progress_bar("curves build", len(curve_topologies(links)), enabled=not as_json) as progress:
         report = curve_database(database, max_links=links, per_topology=per_topology, seed=seed,
-                                scheduler=scheduler, callback=callback)
+                                scheduler=scheduler, callback=progress)
     if as_json:
         emit_json(report.to_dict())
         return

@@ -148,10 +148,10 @@ def simulate_cmd(
                      straight=straight)
         return _simulate_spatial(mech, inputs, names, speed, json_, csv_out, plot, animate, method)
     with (_over_actuation_in_cli_words(inputs),
-          progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as advance):
+          progress_bar("simulating", n := len(next(iter(inputs.values()))), enabled=n >= 200) as progress):
         report = simulation_report(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names,
                                    vll=_parse_pairs(vll, "--vll", False), method=method, output=output,
-                                   straight=_parse_straight(straight), progress=advance)
+                                   straight=_parse_straight(straight), progress=progress)
     _write_simulation_files(report.simulation, csv_out, plot, animate)
     if is_stdout(csv_out):
         return
@@ -193,8 +193,8 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
     from mechsyn.plot.spatial import animate_spatial, plot_spatial
 
     n = len(next(iter(inputs.values())))
-    with progress_bar("simulating", n, enabled=n >= 200) as advance:
-        sim = simulate(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names, progress=advance,
+    with progress_bar("simulating", n, enabled=n >= 200) as progress:
+        sim = simulate(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names, progress=progress,
                        method=method)
     if csv_out is not None:
         write_output(csv_out, sim.csv())
@@ -254,9 +254,9 @@ def forces_cmd(
     mech = load_mechanism(file)
     inputs = _parse_inputs(input)
     n = len(next(iter(inputs.values())))
-    with _over_actuation_in_cli_words(inputs), progress_bar("force analysis", n, enabled=n >= 200) as advance:
+    with _over_actuation_in_cli_words(inputs), progress_bar("force analysis", n, enabled=n >= 200) as progress:
         fa = forces(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), gravity=(0.0, -gravity),
-                    static=static, vll=_parse_pairs(vll, "--vll", False), method=method, progress=advance)
+                    static=static, vll=_parse_pairs(vll, "--vll", False), method=method, progress=progress)
     if plot is not None:  # (first: nothing assembled is refused before any file is written)
         from mechsyn.plot.kinematics import plot_forces
         save_plot(plot, plot_forces, fa)

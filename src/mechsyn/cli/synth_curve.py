@@ -2,16 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Optional
+from typing import Optional
 
 import typer
 from rich.markup import escape
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import check_writable, emit_json, err_console, parse_floats, stop_if_interrupted
+from mechsyn.cli.common import check_writable, emit_json, err_console, parse_floats, progress_bar, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
 
@@ -44,7 +42,7 @@ def synth_curve(
     check_writable(out, "--out", directory=True)
     tgt = read_target(target)
     _say_first_build(database)
-    with _curve_progress() as callback:
+    with progress_bar("synth curve", best="best {:.2%}") as callback:
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
                                ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
                                min_transmission=min_transmission, prefer=prefer, tolerance=_fraction(tolerance),
@@ -90,29 +88,6 @@ def _ground_region(text: Optional[str]) -> Optional[tuple[float, ...]]:
     if not (box[0] < box[2] and box[1] < box[3]):
         raise MechsynInputError("expected x0,y0,x1,y1 with x0 < x1 and y0 < y1", source="--ground-region")
     return box
-
-
-@contextmanager
-def _curve_progress() -> Iterator[Any]:
-    """A progress bar of the stages of curve synthesis on stderr when it is a terminal."""
-    if not err_console.is_terminal:
-        yield None
-        return
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TextColumn("best {task.fields[best]}"), TimeElapsedColumn(),
-                  console=err_console, transient=True) as prog:
-        task = prog.add_task("synth curve", total=None, best="-")
-
-        def callback(state: dict) -> None:
-            best = state.get("best")
-            text = f"{100 * best:.2f} %" if isinstance(best, float) and best == best else "-"
-            stage = "building the curve database" if state["stage"] == "build" else state["stage"]
-            prog.update(task, description=f"synth curve: {stage}", completed=state.get("done", 0),
-                        total=state.get("total"), best=text)
-
-        yield callback
 
 
 def _write_out(out: Path, res) -> None:

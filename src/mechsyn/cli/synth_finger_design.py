@@ -13,11 +13,10 @@ from pathlib import Path
 from typing import Any, Optional
 
 import typer
-from rich.markup import escape
 from mechsyn.cli.common import Table  # cells fold, numbers never cut
 
 from mechsyn.cli.app import synth_app
-from mechsyn.cli.common import ForceOpt, check_output_suffix, check_overwrite, console, emit_json, err_console
+from mechsyn.cli.common import ForceOpt, check_output_suffix, check_overwrite, console, emit_json, progress_bar
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
@@ -47,12 +46,8 @@ def finger_design(
     check_overwrite(out, "--out", force)
     ck = checkpoint_options(checkpoint, resume)
     case = load_case(case_file)
-    if json_out or not err_console.is_terminal:
-        res = design_finger(case, seed=seed, time_limit=time_limit, **ck)
-    else:  # a status line on stderr with the stage and the best value so far
-        with err_console.status("finger design") as status:
-            res = design_finger(case, seed=seed, time_limit=time_limit, **ck,
-                                progress=lambda msg: status.update(escape(msg)))
+    with progress_bar("finger design", enabled=not json_out) as progress:  # the stage and the best so far
+        res = design_finger(case, seed=seed, time_limit=time_limit, **ck, progress=progress)
     _write(case, res, out, plot)
     if json_out:
         emit_json(res)

@@ -9,7 +9,7 @@ import typer
 
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import (ForceOpt, OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, TimeLimitOpt, WorkersOpt,
-                                check_output_suffix, check_overwrite, emit_json, restart_progress)
+                                check_output_suffix, check_overwrite, emit_json, progress_bar)
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
@@ -61,7 +61,7 @@ def synth_mechanism(
     check_overwrite(out, "--out", force)
     ck = checkpoint_options(checkpoint, resume)
     case = load_mechanism_case(case_file)
-    with restart_progress("synth mechanism", restarts, enabled=not as_json) as progress:
+    with progress_bar("synth mechanism", restarts, enabled=not as_json) as progress:
         res = mechanism_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
                                   workers=workers, scheduler=scheduler, callback=progress, **ck)
     _write_files(case_file, case, res, out, plot)

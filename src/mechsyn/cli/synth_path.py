@@ -11,7 +11,7 @@ import typer
 from mechsyn.cli.app import synth_app
 from mechsyn.cli.common import (ForceOpt, OptimizerOpt, RestartsOpt, SchedulerOpt, SeedOpt, Table, TimeLimitOpt, WorkersOpt,
                                 check_output_suffix, check_overwrite, check_writable, console, emit_json, parse_floats,
-                                restart_progress, save_plot, say_written)
+                                progress_bar, save_plot, say_written)
 from mechsyn.cli.resume import CheckpointOpt, ResumeOpt, checkpoint_options, stop_if_interrupted
 from mechsyn.errors import MechsynInputError
 
@@ -60,7 +60,7 @@ def synth_path(
     _check_outputs(out, plot, force)
     ck = checkpoint_options(checkpoint, resume)
     case = select_case(load_cases(case_file), case_id, source=str(case_file))
-    with restart_progress(f"synth path {case.id}", restarts) as progress:
+    with progress_bar(f"synth path {case.id}", restarts) as progress:
         res = path_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                              scheduler=scheduler, optimizer=optimizer, target_error=target_error,
                              min_transmission=min_transmission, fold_margin=fold_margin, max_size=max_size, callback=progress, **ck)

@@ -48,6 +48,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.progress import ProgressCallback, counter, report
 from mechsyn.kinematics.chain import solve_all
 from mechsyn.kinematics.groups import Plan
 from mechsyn.kinematics.regular import Folded, sweep_through_folds
@@ -68,14 +69,14 @@ class Engine(Protocol):
 
     ``plan``: the mechanism's decomposition into drivers and Assur groups
     (:class:`mechsyn.kinematics.groups.Plan`), None when it has none or Newton is asked
-    for; ``change_points``: ``"keep"`` or ``"switch"``; ``progress``: called with the
-    number of rows done, or None.
+    for; ``change_points``: ``"keep"`` or ``"switch"``; ``progress``: ``progress(state)``
+    (:class:`mechsyn.progress.Progress`: rows done of the sweep's), or None.
     """
 
     name: str
 
     def sweep(self, system: Any, plan: Any, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
         ...
 
 
@@ -86,7 +87,7 @@ class RegularPass:
     name = "regular pass"
 
     def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
         if plan is None or change_points != "keep":
             return None
         k = drawn_row(system, inputs)
@@ -94,8 +95,7 @@ class RegularPass:
         if res is None:
             return None
         N = inputs.shape[0]
-        if progress is not None:
-            progress(N)
+        report(progress, N, N, "sweep")
         if isinstance(res, Folded):  # through folds: the tracked sweeps' singular rows and events
             return _folded_sweep(system, inputs, speeds, k, res, self.name)
         q, qd, qdd, links = res
@@ -123,14 +123,15 @@ class TrackedChain:
     name = "tracked chain"
 
     def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
         if plan is None or not plan.closed_form_rates:
             return None
         switch = change_points == "switch"
+        advance = counter(progress, len(inputs), "sweep")
 
         def run(parts: list) -> list[Sweep]:
             res = solve_tracked_rates(system, plan, parts, speeds, switch=switch)
-            return [_tracked_sweep(system, U, speeds, r, self.name, progress) for U, r in zip(parts, res)]
+            return [_tracked_sweep(system, U, speeds, r, self.name, advance) for U, r in zip(parts, res)]
 
         return outward(system, inputs, run)
 
@@ -145,10 +146,11 @@ class TrackedGroups:
     name = "tracked groups"
 
     def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
         if plan is None:
             return None
         switch = change_points == "switch"
+        advance = counter(progress, len(inputs), "sweep")
 
         def run(parts: list) -> list[Sweep]:
             out = []
@@ -156,7 +158,7 @@ class TrackedGroups:
                 tracked = solve_tracked(system, plan, U, switch=switch)
                 q, qd, qdd = solve_all(system, plan, U, speeds, tracked=tracked)
                 res = (q, qd, qdd, tracked.singular, tracked.events)
-                out.append(_tracked_sweep(system, U, speeds, res, self.name, progress))
+                out.append(_tracked_sweep(system, U, speeds, res, self.name, advance))
             return out
 
         return outward(system, inputs, run)
@@ -176,10 +178,10 @@ class Newton:
     name = "newton"
 
     def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
         if change_points != "keep":
             return None
-        tick = (lambda: progress(1)) if progress is not None else None
+        tick = counter(progress, len(inputs), "sweep") if progress is not None else None
 
         def run(parts: list) -> list[Sweep]:
             out = []
@@ -233,7 +235,7 @@ def engine_named(name: str) -> Any:
 
 
 def first_sweep(engines: tuple[Engine, ...], system: Any, plan: Any, inputs: np.ndarray, speeds: np.ndarray, *,
-                change_points: str = "keep", progress: Callable[[int], Any] | None = None) -> Sweep | None:
+                change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
     """The sweep of the first of ``engines`` that answers (None when none does)."""
     for engine in engines:
         sw = engine.sweep(system, plan, inputs, speeds, change_points=change_points, progress=progress)
@@ -243,7 +245,7 @@ def first_sweep(engines: tuple[Engine, ...], system: Any, plan: Any, inputs: np.
 
 
 def _tracked_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, res: tuple, engine: str,
-                   progress: Callable[[int], Any] | None) -> Sweep:
+                   advance: Callable[[int], None]) -> Sweep:
     """A tracked engine's arrays, singular rows and group events as a Sweep."""
     q, qd, qdd, singular, tr_events = res
     N = U.shape[0]
@@ -252,8 +254,7 @@ def _tracked_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, res: tuple, e
     ok = np.all(np.isfinite(q), axis=1)
     sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
     sw.events = _tracked_events(tr_events, bool(ok[0]), U[0])
-    if progress is not None:
-        progress(N)
+    advance(N)
     return sw
 
 

@@ -28,6 +28,7 @@ from mechsyn.kinematics import derived
 from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
 from mechsyn.kinematics.summary import motion_summary
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.progress import ProgressCallback
 from mechsyn.results import csv_cell, to_jsonable
 
 __all__ = ["SimulationReport", "simulation_report", "simulation_csv", "forces_csv", "csv_text"]
@@ -41,8 +42,10 @@ class SimulationReport(Result):
     max in degrees), ``mechanical_advantage`` (one input: output link and values),
     ``grashof`` (a four-bar of revolute pairs), ``extent`` (bounding box of each reported
     point's path), ``motion`` (planar: the sliders' strokes, the rockers' ranges and the time
-    ratios, :func:`mechsyn.kinematics.summary.motion_summary`) and ``straightness`` (per
-    point asked for).
+    ratios, :func:`mechsyn.kinematics.summary.motion_summary`), ``slides`` (planar: every P
+    joint's slide, its rate and acceleration) and ``straightness`` (per point asked for).
+    Without the rates (``rates=False``) the mechanical advantage, the motion summary and the
+    slides are left out.
 
     Examples
     --------
@@ -57,10 +60,14 @@ class SimulationReport(Result):
 
     simulation: Simulation = field(metadata={"json": False})
     derived: dict[str, Any] = field(default_factory=dict)
+    #: whether the rates and the quantities made of them are in the report (``to_dict``)
+    rates: bool = True
 
     def to_dict(self) -> dict[str, Any]:
-        """The simulation's dict with the derived quantities under ``derived``."""
-        return {**self.simulation.to_dict(), "derived": self.derived}
+        """The simulation's dict (:meth:`~mechsyn.kinematics.simulation.Motion.to_dict`) with
+        the derived quantities under ``derived``: what ``mechsyn simulate --json`` prints and
+        the studio draws."""
+        return {**self.simulation.to_dict(self.rates), "derived": to_jsonable(self.derived)}
 
     def plot(self, ax: Any = None, **kwargs: Any) -> Any:
         """Draw the simulation (see :func:`mechsyn.plot.kinematics.plot_simulation`)."""
@@ -89,12 +96,14 @@ def _straightness(sim: Simulation, straight: dict[str, tuple[float, float]]) -> 
 
 
 def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = None,
-                       straight: dict[str, tuple[float, float]] | None = None) -> dict[str, Any]:
-    """Transmission angles, mechanical advantage, Grashof's class, path extents and the
-    straightness of path segments of ``sim`` (see :class:`SimulationReport`).
+                       straight: dict[str, tuple[float, float]] | None = None, rates: bool = True) -> dict[str, Any]:
+    """Transmission angles, mechanical advantage, Grashof's class, path extents, the
+    sliders' slides and the straightness of path segments of ``sim`` (see
+    :class:`SimulationReport`).
 
     ``output``: the output link of the mechanical advantage (default: the last link
-    pivoted on the frame); ``straight``: point name -> (first, last) main input value.
+    pivoted on the frame); ``straight``: point name -> (first, last) main input value;
+    ``rates=False`` leaves out what is made of the rates (see :class:`SimulationReport`).
 
     Examples
     --------
@@ -111,24 +120,48 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
         out["transmission_angle"] = {k: {"values": _finite_or_none(v), "min": _nan_stat(np.nanmin, v),
                                          "max": _nan_stat(np.nanmax, v)} for k, v in mu.items()}
     out_link = output or derived.default_output_link(mech, list(sim.inputs))
-    if out_link is not None and len(sim.inputs) == 1:
+    if rates and out_link is not None and len(sim.inputs) == 1:
         ma = derived.mechanical_advantage(sim, out_link)
         out["mechanical_advantage"] = {"output": out_link, "values": _finite_or_none(ma)}
     if (mech.kind == "planar" and len(mech.links) == 4 and len(mech.joints) == 4  # a planar four-bar only
             and all(j.type == "R" for j in mech.joints) and all(len(mech.joints_of(n)) == 2 for n in mech.link_names)):
         out["grashof"] = to_jsonable(derived.grashof(mech))
     out["extent"] = {name: derived.path_extent(pm.position) for name, pm in sim.points.items()}
-    if mech.kind == "planar":
+    if mech.kind == "planar" and rates:
         out["motion"] = motion_summary(mech, sim)
+        slides = _slides(mech, sim)
+        if slides:
+            out["slides"] = slides
     if straight:
         out["straightness"] = _straightness(sim, straight)
+    return out
+
+
+def _slides(mech: Mechanism, sim: Simulation) -> dict[str, Any]:
+    """Every P joint's slide along its guide (:meth:`PlanarSystem.coordinate`: from the guide
+    link's origin, the world origin for the frame), its rate and its acceleration (the rate's
+    time derivative along the motion, by a central difference) at the drive's speed."""
+    S, sw = sim.system, sim.sweep
+    if S is None or sw is None:
+        return {}
+    q, qd, qdd = (np.asarray(a, float) for a in (sw.q, sw.qd, sw.qdd))
+    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
+    out = {}
+    for j in mech.joints:
+        if j.type != "P":
+            continue
+        rate = S.coordinate_rate(q, qd, j.id)
+        acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
+        value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
+        out[j.id] = {"guide": j.links[0], "value": _finite_or_none(value), "rate": _finite_or_none(rate),
+                     "acceleration": _finite_or_none(acc)}
     return out
 
 
 def simulation_report(mech: Mechanism, inputs: dict[str, np.ndarray], *, speeds: dict[str, float] | None = None,
                       points: list[str] | None = None, vll: dict[str, str] | None = None, method: str = "auto",
                       output: str | None = None, straight: dict[str, tuple[float, float]] | None = None,
-                      progress: Any = None) -> SimulationReport:
+                      progress: ProgressCallback | None = None, rates: bool = True) -> SimulationReport:
     """Simulate ``mech`` over ``inputs`` (see :func:`mechsyn.simulate`) and derive what a
     designer reads off the motion (see :func:`derived_quantities`).
 
@@ -144,6 +177,9 @@ def simulation_report(mech: Mechanism, inputs: dict[str, np.ndarray], *, speeds:
         Output link of the mechanical advantage.
     straight : dict of str to (float, float), optional
         Point name -> the main input's range over which to measure straightness.
+    rates : bool, default True
+        False leaves the rates and what is made of them out of the report (a smaller
+        answer, the studio's drag).
 
     Returns
     -------
@@ -158,7 +194,7 @@ def simulation_report(mech: Mechanism, inputs: dict[str, np.ndarray], *, speeds:
     [0.0, 30.0, 60.0, 90.0]
     """
     sim = simulate(mech, inputs, speeds=speeds, points=points, vll=vll, method=method, progress=progress)
-    return SimulationReport(sim, derived_quantities(mech, sim, output, straight))
+    return SimulationReport(sim, derived_quantities(mech, sim, output, straight, rates), rates)
 
 
 def csv_text(header: list[str], columns: list[np.ndarray]) -> str:

@@ -25,7 +25,7 @@ from mechsyn.model.mechanism import Mechanism
 if TYPE_CHECKING:
     from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points"]
+__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points", "rows"]
 
 
 @dataclass
@@ -93,7 +93,7 @@ class Motion(Result):
         return next(iter(self.inputs))
 
     def input_unit(self, joint: str) -> str:
-        """The unit of input ``joint``'s values: ``"deg"`` (R, H) or ``"length"`` (P)."""
+        """The unit of input ``joint``'s values: ``"deg"`` (R) or ``"length"`` (P)."""
         return _unit(self.input_types[joint])
 
     def point(self, name: str) -> np.ndarray:
@@ -186,31 +186,68 @@ class Motion(Result):
         draw = getattr(importlib.import_module(f"mechsyn.plot.{module}"), name)
         return draw(self, fig=fig, **kwargs)
 
-    def to_dict(self) -> dict[str, Any]:
-        """The fields every engine's result shares as plain values (rows not assembled
-        None); a subclass adds its own."""
-        ok = self.assembled
+    def to_dict(self, rates: bool = True) -> dict[str, Any]:
+        """The fields every engine's result shares, as JSON values (lists, ``None`` for a row
+        not assembled or not finite): what ``mechsyn simulate --json`` prints and the studio
+        draws; a subclass adds its own.
 
-        def mask(a: np.ndarray) -> list:
-            out = np.asarray(a, float).tolist()
-            return [v if good else None for v, good in zip(out, ok)]
+        ``rates=False`` leaves out the velocities and accelerations of the points and links
+        (``"rates": false`` says so): a smaller answer, e.g. for the studio's drag.
 
+        Examples
+        --------
+        >>> import json, mechsyn as ms
+        >>> s = ms.examples.load("crank_rocker").simulate(A=(0, 90, 30))
+        >>> d = s.to_dict(rates=False)
+        >>> d["input"]["type"], sorted(d["points"]["M"]), d["rates"], len(json.dumps(d)) > 0
+        ('R', ['position'], False, True)
+        """
+        ok = np.asarray(self.assembled, bool)
         main = self.main_input
+
+        def kept(parts: dict[str, Any]) -> dict[str, Any]:
+            return {k: rows(v, ok) for k, v in parts.items() if rates or k not in _RATES}
+
+        values = {j: rows(v) for j, v in self.inputs.items()}
         return {
             "mechanism": self.mechanism,
-            "input": {"joint": main, "values": self.inputs[main], "unit": _unit(self.input_types[main]),
-                      "speed": self.speeds[main]},
-            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": _unit(self.input_types[j]),
-                           "speed": self.speeds[j]} for j, v in self.inputs.items()},
-            "assembled": ok,
-            "points": {name: {k: mask(v) for k, v in pm.to_dict().items()} for name, pm in self.points.items()},
-            "links": {name: {k: mask(v) for k, v in lm.to_dict().items()} for name, lm in self.links.items()},
+            "input": {"joint": main, "type": self.input_types[main], "values": values[main],
+                      "unit": self.input_unit(main), "speed": self.speeds[main]},
+            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": self.input_unit(j),
+                           "speed": self.speeds[j]} for j, v in values.items()},
+            "assembled": ok.tolist(),
+            "rates": bool(rates),
+            "points": {name: kept(pm.to_dict()) for name, pm in self.points.items()},
+            "links": {name: kept(lm.to_dict()) for name, lm in self.links.items()},
             "working_ranges": self.working_ranges(),
             "events": [e.to_dict() for e in self.events],
             "method": self.method,
             "engine": self.engine,
-            "notes": self.notes,
+            "notes": list(self.notes),
         }
+
+
+#: The rates among the parts of a point's or a link's motion (left out by ``to_dict(rates=False)``).
+_RATES = frozenset({"velocity", "acceleration", "angular_velocity", "angular_acceleration"})
+
+
+def rows(a: Any, ok: np.ndarray | None = None) -> list:
+    """Array ``a`` (N, ...) as JSON values: a list of its rows, ``None`` for a row not
+    ``ok`` or with a number that is not finite (JSON has no NaN).
+
+    Examples
+    --------
+    >>> rows(np.array([[1.0, 2.0], [np.nan, 0.0], [3.0, 4.0]]), np.array([True, True, False]))
+    [[1.0, 2.0], None, None]
+    """
+    a = np.asarray(a, float)
+    good = np.isfinite(a).all(axis=tuple(range(1, a.ndim)))
+    if ok is not None:
+        good &= ok
+    out = a.tolist()
+    for k in np.flatnonzero(~good).tolist():
+        out[k] = None
+    return out
 
 
 #: The table's names of a link's rates (:meth:`Motion.to_pandas`).
@@ -260,8 +297,8 @@ class Simulation(Motion):
         """:meth:`Motion.animate` (a :class:`~mechsyn.plot.animation.MechanismAnimation`)."""
         return super().animate(fig, bare=True, **kwargs)
 
-    def to_dict(self) -> dict[str, Any]:
-        d = super().to_dict()
+    def to_dict(self, rates: bool = True) -> dict[str, Any]:
+        d = super().to_dict(rates)
         notes = d.pop("notes")  # (the keys in the order the JSON has always had)
         return {**d, "vll": self.vll, "notes": notes,
                 "units": {"angle": "deg", "angular_velocity": "rad/s", "angular_acceleration": "rad/s^2"}}

@@ -53,6 +53,7 @@ import numpy as np
 from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial, planar_as_spatial
+from mechsyn.progress import report
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
 from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
@@ -402,8 +403,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
         out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
         _singular_events(M, out, U, idx[~regular], found)
         out.events.sort(key=lambda e: e["index"])
-    if progress is not None:
-        progress(N)
+    report(progress, N, N, "sweep")
     return out
 
 

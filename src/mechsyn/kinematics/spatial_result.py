@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.simulation import Motion, PointMotion
+from mechsyn.kinematics.simulation import Motion, PointMotion, rows
 from mechsyn.results import csv_cell
 
 __all__ = ["SpatialSimulation", "LinkPose"]
@@ -223,27 +223,22 @@ class SpatialSimulation(Motion):
             w.writerow(row)
         return buf.getvalue()
 
-    def to_dict(self) -> dict[str, Any]:
-        ok = self.assembled
+    def input_unit(self, joint: str) -> str:
+        """The unit of input ``joint``'s values: ``"length"`` (P) or ``"deg"`` (R, H, U)."""
+        return _unit(self.input_types[joint])
 
-        def mask(a: np.ndarray) -> list:
-            return [v if good else None for v, good in zip(np.asarray(a, float).tolist(), ok)]
-
-        main = self.main_input
+    def to_dict(self, rates: bool = True) -> dict[str, Any]:
+        """:meth:`Motion.to_dict` and the spatial fields: ``joints`` (every pair's value from
+        its zero), ``residual``, ``length_scale``, ``rank``, ``idle``, ``reached``, ``held``,
+        ``zero`` and the units."""
+        ok = np.asarray(self.assembled, bool)
         return {
-            "mechanism": self.mechanism, "engine": self.engine, "method": self.method,
-            "input": {"joint": main, "values": self.inputs[main], "unit": _unit(self.input_types[main]),
-                      "speed": self.speeds[main]},
-            "inputs": {j: {"values": v, "type": self.input_types[j], "unit": _unit(self.input_types[j]),
-                           "speed": self.speeds[j]} for j, v in self.inputs.items()},
-            "assembled": ok,
-            "points": {n: {k: mask(v) for k, v in pm.to_dict().items()} for n, pm in self.points.items()},
-            "links": {n: {k: mask(v) for k, v in lp.to_dict().items()} for n, lp in self.links.items()},
-            "joints": {j: mask(v) for j, v in self.joints.items()}, "working_ranges": self.working_ranges(),
-            "residual": mask(self.residual), "length_scale": self.length_scale,
-            "rank": self.rank, "idle": self.idle, "events": self.events, "notes": self.notes,
-            "reached": self.reached if self.reached is not None else ok.astype(int), "held": list(self.held),
-            "zero": self.zero,
+            **super().to_dict(rates),
+            "joints": {j: rows(v, ok) for j, v in self.joints.items()},
+            "residual": rows(self.residual, ok), "length_scale": float(self.length_scale),
+            "rank": int(self.rank), "idle": int(self.idle),
+            "reached": (self.reached if self.reached is not None else ok.astype(int)).tolist(),
+            "held": list(self.held), "zero": {k: float(v) for k, v in self.zero.items()},
             "units": {"input": "deg (R, H, C/turn, U) from the joint's zero, or length (P, C)", "angular_velocity": "rad/s",
                       "angular_acceleration": "rad/s^2", "residual": "fraction of length_scale"},
         }

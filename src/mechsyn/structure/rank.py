@@ -57,12 +57,13 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from mechsyn.model.contour import contour_links
 from mechsyn.model.mechanism import Joint, Mechanism
+from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.contours import independent_contours
 from mechsyn.structure.drives import excess_drives
 from mechsyn.structure.finite import LocalMobility, local_mobility
@@ -504,13 +505,14 @@ def _gauss_newton_step(sysm: "_System", theta: np.ndarray, tol: float) -> tuple[
 
 def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None = None,
                  check_singular: bool = True, seed: int = 0,
-                 progress: Callable[[str], None] | None = None) -> RankAnalysis:
+                 progress: ProgressCallback | None = None) -> RankAnalysis:
     """Screw-theory rank analysis of ``mech`` at its assembled configuration.
 
     ``planar`` defaults to the file's kind (a planar file is analysed with planar
     motion, 3 equations per contour; see :func:`as_spatial` for the 3-D picture).
-    ``progress`` is called with the name of each stage as it starts (``"contours"``,
-    ``"rank"``, ``"idle"``, ``"singularity"``). BLAS runs on one thread meanwhile: the
+    ``progress(state)`` (:class:`mechsyn.progress.Progress`) is called as each stage
+    starts: stages done of 4, the stage's name (``"contours"``, ``"rank"``, ``"idle"``,
+    ``"singularity"``). BLAS runs on one thread meanwhile: the
     method makes many small decompositions, which threads only slow down (and on a
     loaded machine by 10-50x). Raises :class:`InsufficientGeometry` when a joint lacks
     the geometry its twists need.
@@ -544,11 +546,11 @@ def analyze_rank(mech: Mechanism, planar: bool | None = None, tol: float | None 
     [(['rod'], 'group', [0.6376, 0.3188, 0.7013])]
     """
     if len(mech.joints) < SMALL_JOINTS:  # BLAS does not thread matrices this small
-        return _analyze_rank(mech, planar, tol, check_singular, seed, progress or (lambda stage: None))
+        return _analyze_rank(mech, planar, tol, check_singular, seed, progress)
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=1, user_api="blas"):
-        return _analyze_rank(mech, planar, tol, check_singular, seed, progress or (lambda stage: None))
+        return _analyze_rank(mech, planar, tol, check_singular, seed, progress)
 
 
 #: Below this many joints :func:`analyze_rank` leaves the BLAS threads alone: its matrices
@@ -558,14 +560,14 @@ SMALL_JOINTS = 24
 
 
 def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check_singular: bool, seed: int,
-                  progress: Callable[[str], None]) -> RankAnalysis:
+                  progress: ProgressCallback | None) -> RankAnalysis:
     planar = mech.kind == "planar" if planar is None else planar
-    progress("contours")
+    report(progress, 0, 4, "contours")
     sysm = _build_system(mech, planar)
     lam, K, F = sysm.lam, len(sysm.contours), sysm.twists.shape[0]
     tol = _default_tolerance(mech, sysm) if tol is None else tol
     notes: list[str] = []
-    progress("rank")
+    report(progress, 1, 4, "rank")
     red = _reduce(sysm, np.zeros(F), tol)
     near = _near_singular_note(red.singular_values, tol, F, lam * K, red.rank, notes)
     mobility, redundant, N = F - red.rank, lam * K - red.rank, red.null
@@ -573,7 +575,7 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     if sum(c.redundant for c in contours) != redundant:  # borderline singular values: say so
         notes.append(f"per-contour counts ({', '.join(str(c.redundant) for c in contours)}) and the total "
                      f"{redundant} differ at this tolerance: a singular value is close to it")
-    progress("idle")
+    report(progress, 2, 4, "idle")
     acols, anames = _actuated_columns(sysm)
     Z0 = _null(N[acols], tol) if mobility and acols else np.eye(mobility)
     idle, _, idle_notes = find_idle_mobilities(_idle_inputs(mech, sysm, N, Z0), tol) if mobility else ([], None, [])
@@ -583,7 +585,7 @@ def _analyze_rank(mech: Mechanism, planar: bool | None, tol: float | None, check
     lm = LocalMobility(0, 0, "regular", 0, red.rank) if mobility == 0 else \
         LocalMobility(mobility, None, "not checked", None, None)
     if check_singular and mobility > 0:
-        progress("singularity")
+        report(progress, 3, 4, "singularity")
         lm, contours = _local(sysm, N, tol, red.rank, len(idle), contours, notes, seed)
     drives = useful if lm.finite is None else max(lm.finite - len(idle), 0)  # from the finite mobility
     if lm.finite is not None and drives == 0 and mobility and anames:

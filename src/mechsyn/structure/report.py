@@ -18,13 +18,14 @@ References
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.progress import ProgressCallback
 from mechsyn.results import to_jsonable
 from mechsyn.structure.analysis import StructuralAnalysis, analyze_structure
 from mechsyn.structure.drives import DriveCheck, drive_check_of_formulas
@@ -532,7 +533,7 @@ def _rank_or_reason(mech: Mechanism, tol: float | None) -> tuple[Any, str | None
 
 def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, max_variants: int = 10,
             tol: float | None = None, as_spatial: bool = False,
-            progress: Callable[[str], None] | None = None) -> StructureReport:
+            progress: ProgressCallback | None = None) -> StructureReport:
     """Structural analysis of ``mech`` by the classic formulas and, where the joints' geometry
     is given, the rank method (screw theory), side by side.
 
@@ -553,7 +554,8 @@ def analyze(mech: Mechanism, method: str | None = None, remedies: bool = False, 
     as_spatial : bool
         Analyse a planar mechanism as a spatial one (R axes along z).
     progress : callable, optional
-        Called with the name of each stage of the rank method (large mechanisms).
+        ``progress(state)`` (:class:`mechsyn.progress.Progress`) at each stage of the rank
+        method (large mechanisms).
 
     Returns
     -------

@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 from mechsyn._result import Result
+from mechsyn.progress import ProgressCallback
 from mechsyn.synthesis.chains import (KinematicChain, link_assortments, synthesize_chains,
                                       synthesize_chains_to_file)
 from mechsyn.synthesis.mechanisms import distinct_mechanisms, frame_orbits, mechanism_dict
@@ -124,7 +125,7 @@ class Atlas(Result):
 
 def chain_atlas(n_links: int, mobility: int = 1, *, include_degenerate: bool = False, inputs: bool = False,
                 stream: str | os.PathLike[str] | None = None, force: bool = False, workers: int = 1,
-                scheduler: Any = None, progress: Callable[[int], None] | None = None) -> Atlas:
+                scheduler: Any = None, progress: ProgressCallback | None = None) -> Atlas:
     """Number and topological synthesis of planar simple-jointed kinematic chains.
 
     Parameters

@@ -52,6 +52,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.limits import limit, limit_hint
 from mechsyn.parallel import run_tasks
+from mechsyn.progress import ProgressCallback, counter
 from mechsyn.synthesis import canonical
 from mechsyn.synthesis.contracted import (ContractedGraph, compositions, contracted_graphs, degenerate_mask,
                                           edge_automorphisms, expand, has_bridge, is_fractionated_contracted,
@@ -503,20 +504,20 @@ def _enumerate_units(
     n_links: int, mobility: int, include_degenerate: bool,
     units: Sequence[tuple[str, dict[int, int]]],
     unit_done: Callable[[str, list[KinematicChain]], None],
-    workers: int = 1, scheduler=None, progress: Callable[[float], None] | None = None,
+    workers: int = 1, scheduler=None, advance: Callable[[float], None] | None = None,
 ) -> None:
     """Chains of ``units``: ``unit_done(key, chains)`` for each unit, in the units' order;
-    ``progress(fraction)`` as the work goes (the fractions add up to one per unit).
+    ``advance(fraction)`` as the work goes (the fractions add up to one per unit).
 
-    In one process: unit after unit, ``progress(1)`` after each. With ``workers`` or
+    In one process: unit after unit, ``advance(1)`` after each. With ``workers`` or
     ``scheduler`` (:func:`mechsyn.parallel.run_tasks`): the contracted graphs of all units
     in parallel, then their chains in tasks of about equal work (:func:`_split_tasks`),
     the largest first, so that the workers end together; each finished task advances
-    ``progress`` by its share of its unit. A unit is handed on as soon as it and every
+    by its share of its unit. A unit is handed on as soon as it and every
     unit before it are complete, so the chains and their order are those of the
     single-process run.
     """
-    tick = progress if progress is not None else (lambda fraction: None)
+    tick = advance if advance is not None else (lambda fraction: None)
     if workers <= 1 and scheduler is None:
         for key, assortment in units:
             unit_done(key, _unit_chains(n_links, mobility, assortment, include_degenerate))
@@ -543,7 +544,7 @@ def _enumerate_units(
                 tick(1)  # a unit without contracted graphs: done at once
             flushed[0] += 1
 
-    def finished(done: int, total: int, index: int, chains: list[KinematicChain]) -> None:
+    def finished(index: int, chains: list[KinematicChain]) -> None:
         t = order[index]
         found[t] = chains
         pending[parts[t][0]] -= 1
@@ -553,24 +554,24 @@ def _enumerate_units(
     flush()
     run_tasks(_graph_chains, [(n_links, mobility, units[parts[t][0]][1], include_degenerate, parts[t][1],
                                backend) for t in order], workers=workers, scheduler=scheduler,
-              progress=finished)
+              on_result=finished)
 
 
 def synthesize_chains(
     n_links: int,
     mobility: int = 1,
     include_degenerate: bool = False,
-    progress: Callable[[float], None] | None = None,
+    progress: ProgressCallback | None = None,
     workers: int = 1,
     scheduler=None,
 ) -> list[KinematicChain]:
     """Topological synthesis: all non-isomorphic planar chains with ``n`` links.
 
     Non-degenerate chains only, unless ``include_degenerate`` (then flagged). Fractionated
-    chains and chains with non-planar graphs are included and flagged. ``progress(x)``
-    is called as the work goes, the ``x`` adding up to one per assortment (in one
-    process 1 after each; with workers each finished task's share, from wherever it
-    ran, :func:`n_units` in all). Chains are ordered by assortment, then by
+    chains and chains with non-planar graphs are included and flagged. ``progress(state)``
+    (:class:`mechsyn.progress.Progress`) is called as the work goes: assortments done
+    (in one process one after each; with workers each finished task's share, from
+    wherever it ran) of :func:`n_units`. Chains are ordered by assortment, then by
     contracted graph. ``workers`` (local processes) or ``scheduler`` (a Dask cluster)
     share the work (:func:`mechsyn.parallel.run_tasks`); the chains are the same, in the
     same order.
@@ -584,8 +585,9 @@ def synthesize_chains(
     _check_request(n_links, mobility)
     chains: list[KinematicChain] = []
 
-    _enumerate_units(n_links, mobility, include_degenerate, _units(n_links, mobility),
-                     lambda key, found: chains.extend(found), workers, scheduler, progress)
+    units = _units(n_links, mobility)
+    _enumerate_units(n_links, mobility, include_degenerate, units, lambda key, found: chains.extend(found),
+                     workers, scheduler, counter(progress, len(units), "assortments"))
     _check_distinct(chains)
     return chains
 
@@ -609,7 +611,7 @@ def synthesize_chains_to_file(
     n_links: int,
     mobility: int = 1,
     include_degenerate: bool = False,
-    progress: Callable[[float], None] | None = None,
+    progress: ProgressCallback | None = None,
     force: bool = False,
     workers: int = 1,
     scheduler=None,
@@ -647,9 +649,9 @@ def synthesize_chains_to_file(
     tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
     os.replace(tmp, path)
     computed: dict[str, list[KinematicChain]] = {}
-    if progress is not None:
-        for _ in done:
-            progress(1)
+    advance = counter(progress, len(units), "assortments")
+    for _ in done:
+        advance(1)
     with open(path, "a", encoding="utf-8") as fh:
 
         def unit_done(key: str, found: list[KinematicChain]) -> None:
@@ -661,7 +663,7 @@ def synthesize_chains_to_file(
 
         _enumerate_units(n_links, mobility, include_degenerate,
                          [(k, a) for k, a in units if k not in done], unit_done, workers, scheduler,
-                         progress)
+                         advance)
     chains = [c for key, _ in units for c in (done[key] if key in done else computed[key])]
     _check_distinct(chains)
     return chains

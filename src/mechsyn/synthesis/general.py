@@ -491,16 +491,16 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
 
     def report(r: int, f: float) -> None:
         if callback is not None:
-            callback(Progress(done=r, total=restarts, best_error=min(best[0], f), message="restarts"))
+            callback(Progress(done=r, total=restarts, stage="restarts", best=min(best[0], f)))
 
-    def finished(done: int, total: int, index: int, out) -> None:
+    def finished(index: int, out) -> None:
         r = tasks[index][1]
         outs[r] = out
         best[0] = min(best[0], out[1])
         if ck is not None:  # saved before the progress callback, which may raise Ctrl-C
             ck.finish(r, seed=seeds[r], x=out[0], fitness=out[1], nfev=out[2])
         if callback is not None:
-            callback(Progress(done=len(outs), total=restarts, best_error=best[0], message="restarts"))
+            callback(Progress(done=len(outs), total=restarts, stage="restarts", best=best[0]))
 
     seeds = restart_seeds(seed, restarts)
     trackers = [BestSoFar() if local else None for _ in seeds]
@@ -510,7 +510,7 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     interrupted = False
     try:
         run_tasks(_mechanism_restart, tasks, workers=workers, scheduler=scheduler,
-                  progress=finished, deadline=deadline - 0.1 * time_limit)
+                  on_result=finished, deadline=deadline - 0.1 * time_limit)
     except KeyboardInterrupt:  # Ctrl-C: keep the best design evaluated so far
         interrupted = True
         for r, t in enumerate(trackers):

@@ -394,7 +394,7 @@ def synthesize_path(
     def note(done, f):
         best[0] = min(best[0], f) if f < problem.penalty_base else best[0]  # feasible scores only
         if callback is not None:
-            callback(Progress(done=done, total=restarts, best_error=best[0], message="restarts"))
+            callback(Progress(done=done, total=restarts, stage="restarts", best=best[0]))
 
     local = workers <= 1 and scheduler is None
     done = [len(results)]
@@ -405,7 +405,7 @@ def synthesize_path(
         if ck is not None and t is not None and t.x is not None and ck.due():
             ck.offer(index, seeds[index], problem.expand(t.x[None, :])[0], t.f, force=True)
 
-    def finished(count, total, index, r):
+    def finished(index, r):
         done[0] = len(results) + 1
         results.append(r)
         if ck is not None:  # saved before the progress callback, which may raise Ctrl-C
@@ -420,7 +420,7 @@ def synthesize_path(
         if results and callback is not None:
             note(len(results), min(r.fitness for r in results))
         run_tasks(_run_restart, jobs, workers=workers, scheduler=scheduler,
-                  progress=finished, deadline=deadline - reserve,
+                  on_result=finished, deadline=deadline - reserve,
                   stop=None if target_error is None else (lambda i, r: r.fitness <= target_error))
     except KeyboardInterrupt:
         interrupted = True

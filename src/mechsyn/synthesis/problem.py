@@ -27,9 +27,9 @@ as SciPy's `OptimizeResult` does.
 back to repeat the run); :func:`as_generator` gives the random generator of a seed.
 
 **Progress.** A search that reports progress calls `callback(state)` with a
-:class:`Progress` (`done` of `total` steps, the best error so far and a message); raising
-`KeyboardInterrupt` in the callback stops the search like Ctrl-C (the best so far is
-returned, `interrupted=True`).
+:class:`mechsyn.progress.Progress` (`done` of `total` steps, the stage, the best error so
+far, a message: the one progress protocol of mechsyn); raising `KeyboardInterrupt` in the
+callback stops the search like Ctrl-C (the best so far is returned, `interrupted=True`).
 
 Examples
 --------
@@ -42,7 +42,7 @@ Examples
 (7, True)
 >>> float(as_generator(1).random()) == float(np.random.default_rng(1).random())
 True
->>> Progress(done=2, total=10, best_error=0.25).fraction
+>>> Progress(done=2, total=10, best=0.25).fraction
 0.2
 """
 
@@ -50,12 +50,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterator
+from typing import Any
 
 import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
+from mechsyn.progress import Progress, ProgressCallback  # noqa: F401  (re-exported: a search's progress)
 
 __all__ = ["COMMON_KEYS", "Progress", "ProgressCallback", "SeedLike", "SynthesisResult",
            "as_generator", "resolve_seed"]
@@ -122,56 +123,6 @@ class SynthesisResult(Result):
         if hasattr(out["design"], "to_dict"):
             out["design"] = out["design"].to_dict()
         return out
-
-
-@dataclass(frozen=True)
-class Progress:
-    """State of a running search, given to ``callback(state)``.
-
-    ``done`` of ``total`` steps (restarts, refinements; ``total`` None when unknown),
-    ``best_error`` the best feasible error so far (``inf`` before the first), ``message``
-    what runs now (a stage name), ``nfev`` the evaluations so far when known.
-
-    Examples
-    --------
-    >>> from mechsyn.synthesis.problem import Progress
-    >>> seen = []
-    >>> callback = seen.append                     # e.g. synthesize_path(case, callback=...)
-    >>> callback(Progress(done=1, total=4, best_error=0.02, message="restarts"))
-    >>> seen[0].fraction, seen[0]["best"]          # also reads like the curve database's dict
-    (0.25, 0.02)
-    """
-
-    done: int
-    total: int | None
-    best_error: float = math.inf
-    message: str = ""
-    nfev: int | None = None
-
-    @property
-    def fraction(self) -> float | None:
-        """``done / total``, None when the total is unknown."""
-        return None if not self.total else self.done / self.total
-
-    # the curve database's callback receives plain dicts with these keys; a Progress reads
-    # the same way, so one callback serves both
-    _KEYS = {"stage": "message", "done": "done", "total": "total", "best": "best_error", "nfev": "nfev"}
-
-    def __getitem__(self, key: str) -> Any:
-        return getattr(self, self._KEYS[key])
-
-    def get(self, key: str, default: Any = None) -> Any:
-        return self[key] if key in self._KEYS else default
-
-    def keys(self) -> Iterator[str]:
-        return iter(self._KEYS)
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._KEYS)
-
-
-#: ``callback(state)`` of a search.
-ProgressCallback = Callable[[Progress], None]
 
 
 def resolve_seed(seed: SeedLike) -> int:

@@ -18,12 +18,13 @@ Springer, 2011, ch. 4-5.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable, Sequence, TypeVar
+from typing import Any, Sequence, TypeVar
 
 import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
+from mechsyn.progress import ProgressCallback
 from mechsyn.structure.analysis import analyze_structure
 from mechsyn.synthesis.curves.database import build_database, load_database
 from mechsyn.synthesis.exact import motion_synthesis, to_jsonable_motion
@@ -77,7 +78,7 @@ def _with_margins(case: Any, min_transmission: float | None, fold_margin: float 
 def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10,
                    workers: int = 1, scheduler: Any = None, optimizer: str = "de",
                    target_error: float | None = None, min_transmission: float | None = None,
-                   fold_margin: float | None = None, callback: Callable[..., None] | None = None,
+                   fold_margin: float | None = None, callback: ProgressCallback | None = None,
                    max_size: float | None = None, **search: Any) -> Any:
     """Path generation of ``case`` with the designer's margins (see
     :func:`mechsyn.synthesis.optimize.synthesize_path`).
@@ -134,7 +135,7 @@ def _check_budget(time_limit: float, restarts: int) -> None:
 
 def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, restarts: int = 3,
                         optimizer: str = "de", workers: int = 1, scheduler: Any = None,
-                        callback: Callable[..., None] | None = None, **search: Any) -> Any:
+                        callback: ProgressCallback | None = None, **search: Any) -> Any:
     """Synthesis of any planar mechanism file (see
     :func:`mechsyn.synthesis.general.synthesize_mechanism`), its budget checked first.
 
@@ -267,7 +268,7 @@ class CurveDatabaseReport(Result):
 
 
 def curve_database(directory: Any = None, *, max_links: int = 8, per_topology: int = 3000, seed: int = 0,
-                   scheduler: Any = None, callback: Callable[[dict], None] | None = None) -> CurveDatabaseReport:
+                   scheduler: Any = None, callback: ProgressCallback | None = None) -> CurveDatabaseReport:
     """Build or extend the curve database of :func:`mechsyn.synthesis.curves.synthesis.synthesize_curve`
     (see :func:`mechsyn.synthesis.curves.database.build_database`) and say what it holds.
 

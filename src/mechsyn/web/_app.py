@@ -373,7 +373,7 @@ def _routes() -> list:
         Route("/api/jobs/{job}/cancel", _job_cancel, methods=["POST"]),
         Route("/api/jobs/{job}/events", _job_events),
         *_studio.routes(),
-        *_spatial.routes(),  # view3d: POST /api/spatial/view
+        *_spatial.routes(),  # view3d, tabs3d: POST /api/spatial/simulate
         *_design.routes(),  # issue 40: dimensions, Burmester curves, instant centres, robots
         Mount("/static", StaticFiles(directory=STATIC), name="static"),
     ]

@@ -20,8 +20,9 @@ process (issue 42). Its caps:
   (bliss, BLAS) is a 500 for that request, not the end of the server.
 
 A :class:`Job` is one synthesis run ``fn(params, progress)`` in such a worker; the worker
-sends its progress (at most every :data:`PROGRESS_EVERY` s) and the server keeps the latest
-state, which the routes stream as server-sent events (:meth:`Job.snapshot`). Cancel kills
+sends its progress (a :class:`mechsyn.progress.Progress`, at most every
+:data:`PROGRESS_EVERY` s) and the server keeps the latest state's ``to_dict()``, which the
+routes stream as server-sent events (:meth:`Job.snapshot`). Cancel kills
 its worker.
 """
 
@@ -39,6 +40,7 @@ import time
 from typing import Any, Callable
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.progress import Progress, ProgressCallback
 from mechsyn.web._service import Cancelled, error_dict
 
 log = logging.getLogger("mechsyn.web")
@@ -60,10 +62,10 @@ PROGRESS_EVERY = 0.1
 class Job:
     """One synthesis run: ``state`` is running, done, failed or cancelled (:meth:`run`)."""
 
-    def __init__(self, ident: str, kind: str, fn: Callable[[dict, Callable[[dict], None]], dict], params: dict):
+    def __init__(self, ident: str, kind: str, fn: Callable[[dict, ProgressCallback], dict], params: dict):
         self.id, self.kind, self.fn, self.params = ident, kind, fn, params
         self.state = "running"
-        self.progress: dict[str, Any] = {"done": 0, "total": 1, "best": None}
+        self.progress: dict[str, Any] = Progress().to_dict()  # the latest state, as the events send it
         self.result: dict[str, Any] | None = None
         self.error: dict[str, Any] | None = None
         self.started = time.monotonic()
@@ -76,13 +78,14 @@ class Job:
     def cancel(self) -> None:
         self._cancel.set()
 
-    def _report(self, state: dict) -> None:
-        """The run's progress; raises :class:`Cancelled` once cancel was asked (its worker is
-        then killed, or a run in a thread stops at this report)."""
+    def _report(self, state: Progress) -> None:
+        """The run's progress (:class:`mechsyn.progress.Progress`, kept as its ``to_dict()``);
+        raises :class:`Cancelled` once cancel was asked (its worker is then killed, or a run
+        in a thread stops at this report)."""
         if self._cancel.is_set():
             raise Cancelled()
         with self._lock:
-            self.progress = dict(state)
+            self.progress = state.to_dict()
             self.version += 1
 
     def _finish(self, state: str, result: dict | None = None, error: dict | None = None) -> None:
@@ -257,11 +260,11 @@ def _worker(conn, name: str | Callable[..., Any], args: tuple, with_progress: bo
         os.nice(nice)  # :data:`NICE`
     last = [0.0]
 
-    def progress(state: dict) -> None:
+    def progress(state: Progress) -> None:
         now = time.monotonic()
         if now - last[0] >= PROGRESS_EVERY:
             last[0] = now
-            conn.send(("progress", dict(state)))
+            conn.send(("progress", state))
 
     try:
         out = ("ok", service_function(name)(*args, *((progress,) if with_progress else ())))
@@ -440,7 +443,7 @@ class HeavyRunner:
 
     async def call(self, client: str, gone: Callable[[], Any], name: str | Callable[..., Any], *args: Any,
                    lane: str | None = None, limit: float | None = None,
-                   progress: Callable[[dict], None] | None = None) -> Any:
+                   progress: ProgressCallback | None = None) -> Any:
         """``_service.<name>(*args)`` for ``client`` (``name(*args, progress)`` when
         ``progress`` is given); ``gone()`` (awaitable) tells a disconnect or a cancel.
         ``lane`` is "quick" for the services of :data:`QUICK`, else "request" (or "job");

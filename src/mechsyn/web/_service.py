@@ -7,20 +7,21 @@ reports land (``mechsyn.analyze``, an incremental ``simulate``), only this modul
 
 from __future__ import annotations
 
-import csv
 import functools
-import io
 import math
 import re
 import threading
 from collections import OrderedDict
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.results import csv_cell, to_jsonable
+from mechsyn.kinematics.simulation import rows
+from mechsyn.progress import Progress, ProgressCallback
+from mechsyn.results import to_jsonable
 
 MAX_STEPS = 2000
 #: The largest mechanism :func:`quick_simulate` answers in the server's process (a
@@ -174,22 +175,9 @@ def validate(data: Any) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- simulation
-def _finite(a: np.ndarray) -> list:
-    """The numbers as a list, None where not finite (JSON null)."""
-    a = np.asarray(a, float).ravel()
-    out = a.tolist()
-    for k in np.flatnonzero(~np.isfinite(a)).tolist():
-        out[k] = None
-    return out
-
-
 def _xy(a: np.ndarray) -> list:
     """The points as [x, y] lists, None where a coordinate is not finite (not assembled)."""
-    a = np.asarray(a, float)
-    out = a.tolist()
-    for k in np.flatnonzero(~np.isfinite(a).all(axis=1)).tolist():
-        out[k] = None
-    return out
+    return rows(a)
 
 
 def _driver_start(mech, jid: str) -> float:
@@ -204,7 +192,11 @@ def _driver_start(mech, jid: str) -> float:
 
 
 def _sweep(mech, steps: int, span: float | None) -> tuple[Any, np.ndarray]:
-    """The first drive and its input values, starting at the drawn configuration."""
+    """The first drive and its input values, starting at the drawn configuration: the grid
+    of :func:`~mechsyn.kinematics.simulation.input_grid` (``mechsyn simulate --input
+    A=START:STOP:STEP`` gives the same numbers)."""
+    from mechsyn.kinematics.simulation import input_grid
+
     drives = [j for j in mech.joints if j.actuated]
     if not drives:
         raise MechsynInputError("no drive: nothing moves", field="joints",
@@ -216,84 +208,49 @@ def _sweep(mech, steps: int, span: float | None) -> tuple[Any, np.ndarray]:
     n = int(steps)
     if drive.type == "P":
         span = _scale(mech) if span is None else span
-        return drive, start + np.linspace(-span / 2, span / 2, n)
+        return drive, input_grid(start - span / 2, start + span / 2, span / (n - 1))[:n]
     if span is None or abs(span - 360.0) < 1e-12:
-        return drive, start + np.linspace(0.0, 360.0, n + 1)[:n]
-    return drive, start + np.linspace(0, span, n)
+        return drive, input_grid(start, start + 360.0 - 360.0 / n, 360.0 / n)[:n]
+    return drive, input_grid(start, start + span, span / (n - 1))[:n]
+
+
+def sweep_inputs(data: Any, steps: int = 180, span: float | None = None) -> dict[str, np.ndarray]:
+    """The studio's sweep of a planar mechanism dict: ``{first drive: values}`` from the
+    drawn configuration over ``span`` (360 deg for an R drive, the length scale around the
+    drawn slide for a P drive) in ``steps``."""
+    drive, values = _sweep(build(data), steps, span)
+    return {drive.id: values}
 
 
 def simulate(data: Any, steps: int = 180, span: float | None = None, rates: bool = True) -> dict[str, Any]:
-    """Positions of every joint and named point over a sweep of the first drive.
-
-    The sweep starts at the drawn configuration (index 0 is the file's pose) and covers
-    ``span`` (360 deg for an R drive, ± its length scale for a P drive) in ``steps``.
-    Returns ``joints``/``points`` as lists of [x, y] or null (not assembled),
-    ``working_ranges``, ``events`` (dead points, reassembly, singular positions),
-    ``transmission_angle``, for a four-bar ``grashof`` and, with the rates, ``summary``
-    (:func:`mechsyn.kinematics.summary.motion_summary`: strokes, rocker ranges, time ratios).
-    ``rates=False`` leaves out the velocities, accelerations, link angles and the summary (a
+    """The simulation of a planar mechanism dict over the studio's sweep of its first drive
+    (:func:`sweep_inputs`; index 0 is the file's pose), reporting every joint and named
+    point: :meth:`SimulationReport.to_dict <mechsyn.kinematics.report.SimulationReport.to_dict>`,
+    the :class:`~mechsyn.kinematics.simulation.Motion`'s dict with its derived quantities,
+    exactly what ``mechsyn simulate --json`` prints for the same inputs and points.
+    ``rates=False`` leaves out the velocities, accelerations and what is made of them (a
     smaller answer for the drag loop).
+
+    Examples
+    --------
+    >>> from mechsyn.io import load_mechanism, mechanism_to_dict
+    >>> d = simulate(mechanism_to_dict(load_mechanism(example_path("fourbar"))), 36)
+    >>> d["input"]["joint"], len(d["assembled"]), sorted(d["points"])
+    ('A', 36, ['A', 'B', 'C', 'D', 'M'])
     """
     return _simulated(build(data), steps, span, rates)
 
 
 def _simulated(mech, steps: int, span: float | None, rates: bool) -> dict[str, Any]:
-    from mechsyn.kinematics import derived
-    from mechsyn.kinematics.analysis import simulate as _simulate
+    from mechsyn.kinematics.report import simulation_report
 
     drive, values = _sweep(mech, steps, span)
-    names = [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
-    sim = _simulate(mech, {drive.id: values}, points=names)
-    ok = sim.assembled
-    mu = derived.transmission_angles(sim)
-    out: dict[str, Any] = {
-        "mechanism": mech.name,
-        "input": {"joint": drive.id, "type": drive.type, "values": _finite(values),
-                  "unit": "deg" if drive.type == "R" else "length"},
-        "assembled": ok.tolist(),
-        "joints": {j.id: _xy(sim.points[j.id].position) for j in mech.joints if j.id in sim.points},
-        "points": {p: _xy(sim.points[p].position) for p in mech.points},
-        "velocity": {p: _xy(pm.velocity) for p, pm in sim.points.items()} if rates else {},
-        "acceleration": {p: _xy(pm.acceleration) for p, pm in sim.points.items()} if rates else {},
-        "links": {name: {"angle": _finite(lm.angle), "angular_velocity": _finite(lm.angular_velocity),
-                         "angular_acceleration": _finite(lm.angular_acceleration)}
-                  for name, lm in sim.links.items()} if rates else {},
-        "rates": rates,
-        "working_ranges": sim.working_ranges(),
-        "events": to_jsonable(sim.events),
-        "notes": list(sim.notes),
-        "transmission_angle": {k: {"values": _finite(v), "min": _nan_stat(np.nanmin, v),
-                                   "max": _nan_stat(np.nanmax, v)} for k, v in mu.items()},
-        "method": sim.method,
-    }
-    if _is_four_bar(mech):
-        out["grashof"] = to_jsonable(derived.grashof(mech))
-    if rates:  # the Analysis tab's strokes, rocker ranges and time ratios (as `mechsyn simulate`)
-        from mechsyn.kinematics.summary import motion_summary
-
-        out["summary"] = to_jsonable(motion_summary(mech, sim))
-        out["slides"] = _slides(mech, sim)
-    return out
+    return simulation_report(mech, {drive.id: values}, points=_reported(mech), rates=rates).to_dict()
 
 
-def _slides(mech, sim) -> dict[str, Any]:
-    """Every P joint's slide along its guide (:meth:`PlanarSystem.coordinate`: from the guide
-    link's origin, the world origin for the frame), its rate and its acceleration (the rate's
-    time derivative along the motion, by a central difference) at the drive's speed."""
-    S, sw = sim.system, sim.sweep
-    if S is None or sw is None:
-        return {}
-    q, qd, qdd = (np.asarray(a, float) for a in (sw.q, sw.qd, sw.qdd))
-    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
-    out = {}
-    for j in mech.joints:
-        if j.type != "P":
-            continue
-        rate = S.coordinate_rate(q, qd, j.id)
-        acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
-        value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
-        out[j.id] = {"guide": j.links[0], "value": _finite(value), "rate": _finite(rate), "acceleration": _finite(acc)}
-    return out
+def _reported(mech) -> list[str]:
+    """The points the studio reports: every joint, then the named points."""
+    return [j.id for j in mech.joints if j.id not in mech.points] + list(mech.points)
 
 
 #: Templates of the mechanisms parsed from the studio's requests, by the request's
@@ -358,11 +315,6 @@ def _quick(data: dict, steps: int, span: float | None, rates: bool, key: str) ->
         return None  # reported by the worker's simulate, as without this path
 
 
-def _nan_stat(f: Callable, v: np.ndarray) -> float | None:
-    v = np.asarray(v, float)
-    return float(f(v)) if np.isfinite(v).any() else None
-
-
 def _is_four_bar(mech) -> bool:
     """A planar four-bar of revolute pairs (the only linkage a Grashof class describes; a
     spatial Bennett linkage has four R pairs too)."""
@@ -376,20 +328,14 @@ def _scale(mech) -> float:
 
 
 def simulation_csv(data: Any, steps: int = 180) -> str:
-    """The simulation as CSV: input, assembled, then x, y of every joint and point."""
-    sim = simulate(data, steps)
-    cols = {**sim["joints"], **sim["points"]}
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow([csv_cell(f"input_{sim['input']['joint']}"), "assembled"]
-               + [csv_cell(f"{n}_{c}") for n in cols for c in "xy"])
-    for k, u in enumerate(sim["input"]["values"]):
-        row = [repr(u), int(sim["assembled"][k])]
-        for n in cols:
-            p = cols[n][k]
-            row += ["", ""] if p is None else [repr(p[0]), repr(p[1])]
-        w.writerow(row)
-    return buf.getvalue()
+    """The simulation as CSV (``mechsyn simulate --csv``:
+    :func:`mechsyn.kinematics.report.simulation_csv`) over the studio's sweep."""
+    from mechsyn.kinematics.analysis import simulate as _simulate
+    from mechsyn.kinematics.report import simulation_csv as _csv
+
+    mech = build(data)
+    drive, values = _sweep(mech, steps, None)
+    return _csv(_simulate(mech, {drive.id: values}, points=_reported(mech)))
 
 
 def animation_gif(data: Any, frames: int = 72) -> bytes:
@@ -502,10 +448,11 @@ def fourbar_path_case(targets: list, time_limit: float) -> Any:
                               source="targets")
 
 
-def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) -> dict[str, Any]:
     """Four-bar path synthesis through ``params["targets"]``: ranked results (both branches).
 
-    ``progress`` receives ``{"done", "total", "best"}`` and may raise :class:`Cancelled`.
+    ``progress`` receives a :class:`mechsyn.progress.Progress` (restarts of both branches)
+    and may raise :class:`Cancelled`.
     """
     from mechsyn.synthesis.export import fourbar_mechanism_dict
     from mechsyn.synthesis.optimize import synthesize_path
@@ -522,10 +469,11 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: Callable[[dict], N
     for b, branch in enumerate(branches):
         bcase = _with_branch(case, branch)
 
-        def report(state, b=b):
-            best, total = state.best_error, state.total
-            progress({"done": b * total + state.done, "total": len(branches) * total,
-                      "best": None if not math.isfinite(best) else float(best)})
+        def report(state: Progress, b=b) -> None:  # the restarts of both branches, one after the other
+            best = min((e for e in (state.best, *(r["error"] for r in results if r["feasible"])) if e is not None),
+                       default=None)
+            progress(replace(state, done=b * state.total + state.done, total=len(branches) * state.total,
+                             stage=f"{state.stage}, branch {branches[b]:+d}", best=best))
 
         res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
                               callback=report)
@@ -574,12 +522,10 @@ def _fourbar_quality(d: dict[str, float], res: Any) -> dict[str, Any]:
 
 
 def _with_branch(case, branch: int):
-    import dataclasses
-
-    return dataclasses.replace(case, branch=branch)
+    return replace(case, branch=branch)
 
 
-def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], None]) -> dict[str, Any]:
+def synthesize_curve_points(params: dict[str, Any], progress: ProgressCallback) -> dict[str, Any]:
     """Curve to mechanism (:mod:`mechsyn.synthesis.curves`): ranked 4- to ``max_links``-bar
     linkages whose tracing point follows the clicked or drawn curve ``params["targets"]``.
 
@@ -601,13 +547,7 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
     closed = params.get("closed")
     target = target_from_points(T, closed=None if closed is None else bool(closed), source="clicked curve")
 
-    def report(state: dict) -> None:
-        best = state.get("best")
-        progress({"done": int(state.get("done") or 0), "total": int(state.get("total") or 1),
-                  "best": float(best) if isinstance(best, float) and math.isfinite(best) else None,
-                  "stage": str(state.get("stage", ""))})
-
-    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, callback=report)
+    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, callback=progress)
     results = []
     for c in res.candidates:
         d = c.to_dict()
@@ -626,7 +566,7 @@ def synthesize_curve_points(params: dict[str, Any], progress: Callable[[dict], N
 
 # Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
 # Each result dict: {"kind", "targets", "results": [{"label", "error", "feasible", "mechanism", "path"}]}.
-SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, Callable[[dict], None]], dict]]] = {
+SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, ProgressCallback], dict]]] = {
     "fourbar_path": ("Four-bar path through the clicked points", synthesize_fourbar_path),
     "curve": ("Curve to mechanism over the atlas (4- to 8-bars)", synthesize_curve_points),
 }

@@ -36,6 +36,7 @@ from mechsyn.export.dxf import layout_to_dxf
 from mechsyn.export.plates import link_plates
 from mechsyn.io import load_mechanism
 from mechsyn.kinematics.analysis import forces as _forces
+from mechsyn.progress import Progress, ProgressCallback
 from mechsyn.results import to_jsonable
 from mechsyn.structure.drives import DriveCheck
 from mechsyn.structure.report import analyze as structure_report
@@ -261,7 +262,7 @@ def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 
     return to_jsonable(_forces(mech, {drive.id: values}, speeds={drive.id: w}, gravity=g).to_dict())
 
 
-def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
+def synthesize_motion(params: dict[str, Any], progress: ProgressCallback) -> dict[str, Any]:
     """Motion generation through 3 to 5 clicked poses (``params["targets"]`` [x, y] and
     ``params["angles"]`` in degrees): Burmester theory, each four-bar verified by simulation,
     labelled and ranked by :func:`mechsyn.synthesis.motion_choice.motion_choices` (the
@@ -275,9 +276,9 @@ def synthesize_motion(params: dict[str, Any], progress) -> dict[str, Any]:
                                 hint="then type each pose's angle in the Synthesis tab")
     if A.shape != (len(T),) or not np.isfinite(A).all():
         raise MechsynInputError("give one angle (degrees) per pose", field="angles")
-    progress({"done": 0, "total": 1, "best": None})
+    progress(Progress(0, 1, "Burmester"))
     out = motion_results(np.column_stack([T, np.radians(A)]), params.get("pivots"), bool(params.get("all", False)))
-    progress({"done": 1, "total": 1, "best": min((x["error"] for x in out["results"]), default=None)})
+    progress(Progress(1, 1, "Burmester", min((x["error"] for x in out["results"]), default=None)))
     return out
 
 

@@ -27,13 +27,13 @@ from __future__ import annotations
 
 import io
 import os
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from mechsyn.kinematics.batch import simulate_batch
+from mechsyn.progress import ProgressCallback, report
 from mechsyn.results import write_atomic
 from mechsyn.synthesis.curves.descriptors import fourier_descriptor, resample
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology, cached_topologies, curve_topologies
@@ -262,13 +262,14 @@ def _check_shapes(shapes: dict, topo: CurveTopology | None) -> None:
 
 def build_database(directory: str | os.PathLike[str] | None = None, max_links: int = DEFAULT_LINKS,
                    per_topology: int = DEFAULT_PER_TOPOLOGY, seed: int = 0, batch: int = 4000,
-                   callback: Callable[[dict], None] | None = None, scheduler: str | None = None) -> Path:
+                   callback: ProgressCallback | None = None, scheduler: str | None = None) -> Path:
     """Build or extend the curve database (resumable; see the module doc): ``per_topology``
     curves of each four- and six-bar topology, a tenth of that (:data:`EIGHT_SHARE`) of
     each eight-bar one.
 
-    ``callback(state)`` is called after each topology with ``stage="build"``, ``done``,
-    ``total`` (topologies), ``curves`` (kept so far), ``best`` (NaN) and ``nfev`` (0). With ``scheduler`` (a
+    ``callback(state)`` (:class:`mechsyn.progress.Progress`) is called after each topology
+    with stage ``"build"``, topologies ``done`` of ``total`` and the curves kept so far in its
+    ``message``. With ``scheduler`` (a
     ``dask.distributed`` address or ``Client``) the topologies are built on a Dask
     cluster and written here.
     """
@@ -283,8 +284,7 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
         if n < want:
             todo.append((i, t.key, max_links, want, seed, batch, have))
     total, done, kept = len(topos), len(topos) - len(todo), 0
-    if callback is not None:
-        callback(_state(done, total, kept))
+    report(callback, done, total, "build", message=f"{kept} curves")
     if scheduler is not None and todo:
         client = _dask_client(scheduler)
         futures = client.map(_build_one, todo, pure=False)
@@ -295,22 +295,15 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
             _write(directory / f"{key}.npz", data)
             done += 1
             kept += len(data["ranges"])
-            if callback is not None:
-                callback(_state(done, total, kept))
+            report(callback, done, total, "build", message=f"{kept} curves")
         return directory
     for job in todo:
         key, data = _build_one(job)
         _write(directory / f"{key}.npz", data)
         done += 1
         kept += len(data["ranges"])
-        if callback is not None:
-            callback(_state(done, total, kept))
+        report(callback, done, total, "build", message=f"{kept} curves")
     return directory
-
-
-def _state(done: int, total: int, kept: int) -> dict:
-    """Progress state of a build (the synthesis callback's keys, plus ``curves``)."""
-    return {"stage": "build", "done": done, "total": total, "best": float("nan"), "nfev": 0, "curves": kept}
 
 
 def _dask_client(scheduler):
@@ -363,7 +356,7 @@ def _build_one(job) -> tuple[str, dict]:
 
 
 def load_database(directory: str | os.PathLike[str] | None = None, max_links: int = 8,
-                  build_if_missing: bool = True, callback: Callable[[dict], None] | None = None) -> CurveDatabase:
+                  build_if_missing: bool = True, callback: ProgressCallback | None = None) -> CurveDatabase:
     """Read the database (topologies up to ``max_links``); build the default small one
     (4- and 6-bars) first when there is none."""
     directory = _database_dir(directory)

@@ -72,7 +72,7 @@ from mechsyn.synthesis.curves.fitting import (DEFAULT_MAX_LINK_RATIO, DEFAULT_MA
 from mechsyn.synthesis.curves.frame import Frame
 from mechsyn.synthesis.curves.target import SPARSE_POINTS, TargetCurve, smooth_samples, target_from_points
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
-from mechsyn.synthesis.problem import Progress
+from mechsyn.progress import Progress, ProgressCallback
 
 __all__ = ["CurveCandidate", "CurveSynthesisResult", "synthesize_curve", "curve_errors"]
 
@@ -261,7 +261,7 @@ def synthesize_curve(
     min_transmission: float = DEFAULT_MIN_TRANSMISSION,
     prefer: str = "simple",
     database: CurveDatabase | str | os.PathLike[str] | None = None,
-    callback: Callable[[dict], None] | None = None,
+    callback: ProgressCallback | None = None,
     max_nfev: int = 60,
     tolerance: float = DEFAULT_TOLERANCE,
     refinements: int | None = None,
@@ -313,8 +313,8 @@ def synthesize_curve(
         Error (fraction of the diagonal, default 0.5 %) within which a candidate counts
         as tracing the curve (fewest links first among those).
     callback : callable, optional
-        ``callback(state)``: a :class:`~mechsyn.synthesis.problem.Progress` (stage, best
-        error so far, ``nfev``).
+        ``callback(state)``: a :class:`mechsyn.progress.Progress` (stage, done of total,
+        the best error so far; the database build's stage ``"build"`` when it builds).
 
     Returns
     -------
@@ -367,7 +367,7 @@ def _loaded_and_searched(target, database, t0: float, o: dict[str, Any], callbac
 def _build_timer(callback, built: list[float]):
     """The callback passed to the database loader: it notes when a build starts and ends."""
     def cb(state):
-        if state.get("stage") == "build":
+        if state.stage == "build":
             built.append(time.perf_counter())
         if callback is not None:
             callback(state)
@@ -375,7 +375,7 @@ def _build_timer(callback, built: list[float]):
 
 
 def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, Any],
-            callback: Callable[[dict], None] | None) -> CurveSynthesisResult:
+            callback: ProgressCallback | None) -> CurveSynthesisResult:
     """The search of :func:`synthesize_curve` (options ``o`` checked): sparse targets
     smoothed, the working frame, retrieval, the anytime refinement, ranking and the
     checks by ``simulate``, mapping back."""
@@ -395,7 +395,7 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
 
     def report(stage, done, total, best, nfev):
         if callback is not None:
-            callback(Progress(done=done, total=total, best_error=best, message=stage, nfev=nfev))
+            callback(Progress(done=done, total=total, stage=stage, best=best))
 
     report("retrieve", 0, 1, float("nan"), 0)
     # retrieval may use at most half of what is left (the rest: evaluation, refinement, checks)

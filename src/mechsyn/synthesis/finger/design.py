@@ -55,6 +55,7 @@ import numpy as np
 from mechsyn.checkpoint import open_search_checkpoint
 from mechsyn.errors import MechsynInputError
 from mechsyn.interrupt import BestSoFar
+from mechsyn.progress import Progress, ProgressCallback
 from mechsyn.synthesis.finger.cases import FingerCase
 from mechsyn.synthesis.finger.evaluation import INFEASIBLE, FingerEvaluation, Objective, apply_design, evaluate_locked
 from mechsyn.synthesis.finger.modes import force_objective, mode_forces, underactuated_paths, vll_range
@@ -208,14 +209,14 @@ class _Run:
     case: FingerCase
     seed: int
     deadline: float
-    progress: Callable[[str], None] | None
+    progress: ProgressCallback | None
     notes: list[str] = field(default_factory=list)
     stopped: bool = False
     state: dict = field(default_factory=lambda: {"interrupted": False})
 
-    def say(self, msg: str) -> None:
+    def say(self, msg: str, done: int = 0, total: int | None = None, best: float | None = None) -> None:
         if self.progress:
-            self.progress(msg)
+            self.progress(Progress(done, total, "finger design", best, msg))
 
     def reporter(self, label: str, stage: str, maxiter: int, what: str) -> Callable[[int, float], None] | None:
         """``report(generation, best)`` for :func:`_de`: a progress line, ``what`` formats the best."""
@@ -224,7 +225,8 @@ class _Run:
 
         def report(g: int, best: float) -> None:
             self.say(f"VLL {label}: {stage}, generation {g}/{maxiter}, best " + (
-                what.format(best) if best < INFEASIBLE else "design still infeasible"))
+                what.format(best) if best < INFEASIBLE else "design still infeasible"),
+                g, maxiter, best if best < INFEASIBLE else None)
         return report
 
 
@@ -275,7 +277,7 @@ def _de(f: Callable[[np.ndarray], np.ndarray], bounds: list[tuple[float, float]]
 
 
 def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
-                  progress: Callable[[str], None] | None = None, checkpoint: Any = None,
+                  progress: ProgressCallback | None = None, checkpoint: Any = None,
                   resume: bool = False) -> FingerDesign:
     """Run paper 000's steps 8-13 on ``case`` (see the module doc).
 
@@ -299,7 +301,8 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     time_limit : float
         Seconds for the optimisation stages; the final checks still run.
     progress : callable, optional
-        ``progress(message)`` with the stage and the best value so far.
+        ``progress(state)`` (:class:`mechsyn.progress.Progress`): the generation done of
+        the stage's, the best value so far, and the stage in words in its ``message``.
     checkpoint : path-like, optional
         Checkpoint file, written whole after each finished variant.
     resume : bool
@@ -398,7 +401,7 @@ def _run_variant(run: _Run, combo: tuple[str, ...], ck: Any) -> VariantResult | 
     return v
 
 
-def _design(case: FingerCase, seed: int, time_limit: float, progress: Callable[[str], None] | None,
+def _design(case: FingerCase, seed: int, time_limit: float, progress: ProgressCallback | None,
             checkpoint: Any = None, resume: bool = False) -> FingerDesign:
     ck = _finger_checkpoint(checkpoint, resume, case, seed)
     t0 = time.monotonic()

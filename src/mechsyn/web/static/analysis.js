@@ -26,7 +26,7 @@ export function rangeText([a, b], rot) {
 
 // The motion summary of the simulation (the library's `motion_summary`, as `mechsyn simulate`).
 function summaryLines(sim) {
-  const s = sim.summary, out = [], rot = sim.input.type === "R", x = (v) => (rot ? deg(((v % 360) + 360) % 360) : n3(v)), J = sim.input.joint;
+  const s = sim.derived.motion, out = [], rot = sim.input.type === "R", x = (v) => (rot ? deg(((v % 360) + 360) % 360) : n3(v)), J = sim.input.joint;
   if (!s) return out;
   const ratio = (t) => (t ? `; time ratio ${n3(t.ratio)} (working stroke ${deg(t.forward)} of the crank, return ${deg(t.return)})` : "");
   for (const [j, sl] of Object.entries(s.sliders || {})) {
@@ -51,7 +51,7 @@ function motion(sim) {
   const full = rot && sim.assembled.every(Boolean);
   out.push(h("p", `working range of ${sim.input.joint}: ` + (full ? "full turn (360°)" : sim.working_ranges.map((r) => rangeText(r, rot)).join(", ") || "none")));
   out.push(...summaryLines(sim));
-  for (const [key, t] of Object.entries(sim.transmission_angle || {}))
+  for (const [key, t] of Object.entries(sim.derived.transmission_angle || {}))
     if (t.min !== null) out.push(h("p", `transmission angle ${key}: ${t.min.toFixed(1)}° … ${t.max.toFixed(1)}°`));
   const dead = sim.events.filter((e) => e.kind === "dead point");
   for (const e of dead) out.push(h("p", `dead point at ${Object.entries(e.input).map(([j, v]) => `${j} = ${(+v).toFixed(2)}`).join(", ")}: ${e.message}`, { className: "muted" }));
@@ -102,7 +102,7 @@ export function analysisTab({ a, sim, errors, mech, diagnostics = [] }) {
     const f = a.structure.formulas || {}, main = f.chebyshev || f.grubler;
     if (main) out.push(h("p", `${f.chebyshev ? "Chebyshev–Grübler" : "Grübler"}: ${main.expression}`, { className: "formula" }));
   }
-  const gr = planar ? (sim && sim.grashof) || (a && a.grashof) : null;
+  const gr = planar ? (sim && sim.derived.grashof) || (a && a.grashof) : null;
   if (gr) { out.push(h("h3", `Grashof: ${gr.classification}`)); out.push(h("p", gr.expression, { className: "formula" })); }
   if (sim) out.push(...motion(sim));
   if (a && a.assur) {

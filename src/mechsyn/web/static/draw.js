@@ -43,8 +43,9 @@ export function makeView(svg, view) {
 export function positions(mech, sim, k) {
   const joints = {}, points = {};
   const ok = !!(sim && sim.assembled[k]);
-  for (const j of mech.joints) joints[j.id] = ok && sim.joints[j.id] && sim.joints[j.id][k] ? sim.joints[j.id][k] : j.point;
-  for (const [n, p] of Object.entries(mech.points || {})) points[n] = ok && sim.points[n] && sim.points[n][k] ? sim.points[n][k] : p.at;
+  const at = (n) => ok && sim.points[n] && sim.points[n].position[k]; // the simulation's points: every joint, every named point
+  for (const j of mech.joints) joints[j.id] = at(j.id) || j.point;
+  for (const [n, p] of Object.entries(mech.points || {})) points[n] = at(n) || p.at;
   return { joints, points, assembled: ok };
 }
 
@@ -161,12 +162,13 @@ export function draw(svg, state) {
   const labels = placeLabels();
   const groupOf = (opts.assurColours && state.analysis && state.analysis.groupOf) || {};
   const muAt = {};
-  if (sim && sim.transmission_angle)
-    for (const [key, t] of Object.entries(sim.transmission_angle)) muAt[key.split("-")[1]] = t.values[k];
+  if (sim && sim.derived.transmission_angle)
+    for (const [key, t] of Object.entries(sim.derived.transmission_angle)) muAt[key.split("-")[1]] = t.values[k];
   // paths of the named points (full sweep)
   const paths = {};
-  if (sim) for (const [n, pts] of Object.entries(sim.points))
-    paths[n] = el("path", { d: pathD(v, pts, wholeTurn(sim)), class: "path", "data-path": n }, layers.paths);
+  const named = sim ? Object.keys(mech.points || {}).filter((n) => sim.points[n]) : [];
+  for (const n of named)
+    paths[n] = el("path", { d: pathD(v, sim.points[n].position, wholeTurn(sim)), class: "path", "data-path": n }, layers.paths);
   // ground symbols
   for (const j of mech.joints) {
     if (!(j.links || []).includes(mech.ground) || !pos.joints[j.id]) continue;
@@ -236,8 +238,8 @@ export function draw(svg, state) {
   // dead points: × on every path where a working range ends
   if (sim) for (const ev of sim.events) {
     if (ev.kind !== "dead point") continue;
-    for (const pts of Object.values(sim.points)) {
-      const p = pts[ev.index] || pts[ev.index - 1];
+    for (const n of named) {
+      const pts = sim.points[n].position, p = pts[ev.index] || pts[ev.index - 1];
       if (!p) continue;
       const [px, py] = P(p);
       el("path", { d: `M${px - 6} ${py - 6}L${px + 6} ${py + 6}M${px - 6} ${py + 6}L${px + 6} ${py - 6}`,

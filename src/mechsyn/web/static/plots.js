@@ -183,10 +183,11 @@ export function mountPlots({ $, state, render, assembledNear }) {
   let made = null, charts = [];
   const pick = (row) => { state.frame = assembledNear(row); render(); };
   function options(sim) {
-    const groups = [["points", Object.keys(sim.points).map((n) => [`point:${n}`, `point ${n}`])],
-      ["joints", Object.keys(sim.joints).map((n) => [`joint:${n}`, `joint ${n}${(sim.slides || {})[n] ? " (slide)" : ""}`])],
+    const m = state.mech, slides = sim.derived.slides || {};
+    const groups = [["points", Object.keys(m.points || {}).filter((n) => sim.points[n]).map((n) => [`point:${n}`, `point ${n}`])],
+      ["joints", m.joints.filter((j) => sim.points[j.id]).map(({ id: n }) => [`joint:${n}`, `joint ${n}${slides[n] ? " (slide)" : ""}`])],
       ["links", Object.keys(sim.links).map((n) => [`link:${n}`, `link ${n}`])],
-      ["motion", Object.keys(sim.transmission_angle || {}).length ? [["transmission", "transmission angle"]] : []]];
+      ["motion", Object.keys(sim.derived.transmission_angle || {}).length ? [["transmission", "transmission angle"]] : []]];
     return groups.filter(([, o]) => o.length);
   }
   function fillSelect(sel, sim) {
@@ -194,7 +195,7 @@ export function mountPlots({ $, state, render, assembledNear }) {
     if ([...sel.options].map((o) => o.value).join() === values.join()) return;
     const keep = sel.value;
     sel.replaceChildren(...groups.map(([label, o]) => { const g = h("optgroup", null, { label }); g.append(...o.map(([v, t]) => h("option", t, { value: v }))); return g; }));
-    if (values.includes(keep)) sel.value = keep; else if (Object.keys(sim.points).length) sel.value = `point:${Object.keys(sim.points)[0]}`;
+    if (values.includes(keep)) sel.value = keep; else if (values.length) sel.value = values[0];
   }
   // [title, unit, series, note] of each chart of the quantity chosen, at drive speed w.
   function chartsOf(sim, what, w) {
@@ -203,7 +204,7 @@ export function mountPlots({ $, state, render, assembledNear }) {
     const sc = (vals, f) => vals.map((v) => (v === null ? null : v * f));
     const comp = (arr, i, f) => arr.map((v) => (v ? v[i] * f : null)), norm = (arr, f) => arr.map((v) => (v ? Math.hypot(v[0], v[1]) * f : null));
     if (kind === "point") {
-      const pos = sim.points[name] || sim.joints[name], v = sim.velocity[name], a = sim.acceleration[name];
+      const { position: pos, velocity: v, acceleration: a } = sim.points[name];
       return [[`velocity of ${name}`, "units/s", [{ name: "vx", values: comp(v, 0, w) }, { name: "vy", values: comp(v, 1, w) }, { name: "speed |v|", values: norm(v, w) }], at],
         [`acceleration of ${name}`, "units/s²", [{ name: "ax", values: comp(a, 0, w * w) }, { name: "ay", values: comp(a, 1, w * w) }, { name: "|a|", values: norm(a, w * w) }], at],
         [`position of ${name}`, "units", [{ name: "x", values: comp(pos, 0, 1) }, { name: "y", values: comp(pos, 1, 1) }]], ["path", name, pos]];
@@ -214,8 +215,8 @@ export function mountPlots({ $, state, render, assembledNear }) {
         [`angular velocity of ${name}`, "rad/s", [{ name: "ω", values: sc(l.angular_velocity, w) }], at],
         [`angular acceleration of ${name}`, "rad/s²", [{ name: "α", values: sc(l.angular_acceleration, w * w) }], at]];
     }
-    if (kind === "joint" && (sim.slides || {})[name]) {
-      const s = sim.slides[name];
+    if (kind === "joint" && (sim.derived.slides || {})[name]) {
+      const s = sim.derived.slides[name];
       return [[`slide of ${name} along its guide`, "units", [{ name: "s", values: s.value }], `from the origin of ${s.guide}`],
         [`slide rate of ${name}`, "units/s", [{ name: "ṡ", values: sc(s.rate, w) }], at],
         [`slide acceleration of ${name}`, "units/s²", [{ name: "s̈", values: sc(s.acceleration, w * w) }], at]];
@@ -233,7 +234,7 @@ export function mountPlots({ $, state, render, assembledNear }) {
         [`angular acceleration of joint ${name}`, "rad/s²", [{ name: "φ̈", values: diff("angular_acceleration", w * w) }], at]];
     }
     if (kind === "transmission")
-      return [["transmission angle", "°", Object.entries(sim.transmission_angle).map(([key, t]) => ({ name: `μ ${key}`, values: t.values })), "90° is best, under 40° poor"]];
+      return [["transmission angle", "°", Object.entries(sim.derived.transmission_angle).map(([key, t]) => ({ name: `μ ${key}`, values: t.values })), "90° is best, under 40° poor"]];
     return [];
   }
   function renderPlots() {

@@ -93,8 +93,8 @@ export function mountRobot({ $, state, render, setMech }) {
     if (!m || !rb.tool) return null;
     if (m.kind === "planar" && !drawn && state.simFor === m) {
       const sim = state.sim, k = state.frame;
-      const src = sim && (sim.points[rb.tool] || sim.joints[rb.tool]);
-      if (src && src[k]) return src[k].slice();
+      const src = sim && sim.points[rb.tool];
+      if (src && src.position[k]) return src.position[k].slice();
     }
     const p = (m.points || {})[rb.tool];
     if (p) return p.at.slice();

@@ -88,7 +88,7 @@ function renderPlayer() {
   if (sim) {
     const u = sim.input.values[state.frame];
     text = `${sim.input.joint} = ${u.toFixed(1)}${sim.input.unit === "deg" ? "°" : ""}`;
-    for (const [key, t] of Object.entries(sim.transmission_angle || {})) {
+    for (const [key, t] of Object.entries(sim.derived.transmission_angle || {})) {
       const mu = t.values[state.frame];
       if (mu !== null) text += `  μ(${key}) = ${mu.toFixed(1)}°`;
     }
@@ -235,8 +235,9 @@ function rebase() {
   const { sim, frame: k } = state;
   if (!sim || k === state.home || !sim.assembled[k]) return clone(state.mech);
   const m = clone(state.mech);
-  for (const j of m.joints) if (sim.joints[j.id] && sim.joints[j.id][k]) j.point = sim.joints[j.id][k].slice();
-  for (const [n, p] of Object.entries(m.points || {})) if (sim.points[n] && sim.points[n][k]) p.at = sim.points[n][k].slice();
+  const at = (n) => sim.points[n] && sim.points[n].position[k];
+  for (const j of m.joints) if (at(j.id)) j.point = at(j.id).slice();
+  for (const [n, p] of Object.entries(m.points || {})) if (at(n)) p.at = at(n).slice();
   state.frame = state.home;
   return m;
 }
@@ -245,7 +246,7 @@ function rebase() {
 function fitView() {
   const m = state.mech;
   const pts = m ? m.joints.map((j) => j.point).concat(Object.values(m.points || {}).map((p) => p.at)) : [];
-  if (state.sim) for (const ps of Object.values(state.sim.points)) for (const p of ps) if (p) pts.push(p);
+  if (state.sim) for (const ps of Object.values(state.sim.points)) for (const p of ps.position) if (p) pts.push(p);
   if (!pts.length) { state.view = { s: 60, ox: 3, oy: 2 }; return; }
   const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
   const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
@@ -559,7 +560,7 @@ const setPlaying = mountPlayer({ $, state, render, assembledNear });
 const planarPlots = mountPlots({ $, state, render, assembledNear });
 const synthUi = mountSynthesis({ $, state, render, setMech, setMode: (m) => setMode(m), design: designUi });
 mountAtlas({ $, state, render, setMech });
-const spatialUi = mountSpatialTabs({ $, state, render, showTab });
+const spatialUi = mountSpatialTabs({ $, state, render, showTab, motionOf: view3d.motionOf });
 const forcesUi = mountForces({ $, state, render, edit, stepsFor, spatialLines: spatialUi.forcesLines });
 
 // ------------------------------------------------------------------ files

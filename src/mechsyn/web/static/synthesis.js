@@ -46,10 +46,10 @@ export function mountSynthesis({ $, state, render, setMech, setMode = () => {}, 
     $("synth-run").disabled = true; $("synth-cancel").disabled = false;
     $("synth-results").replaceChildren(); $("synth-notes").replaceChildren();
     const show = (snap) => {
-      const p = snap.progress;
-      $("synth-progress").max = p.total; $("synth-progress").value = snap.state === "running" ? p.done : p.total;
-      const stage = p.stage && p.stage !== snap.state ? ` (${p.stage})` : "";
-      $("synth-status").textContent = `${snap.state}${stage}: ${p.done}/${p.total}, best so far ${p.best === null || p.best === undefined ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
+      const p = snap.progress, of = p.total || 1; // mechsyn.progress.Progress's to_dict
+      $("synth-progress").max = of; $("synth-progress").value = snap.state === "running" ? p.done : of;
+      const words = [p.stage, p.message].filter((w) => w && w !== snap.state).join(": "), stage = words ? ` (${words})` : "";
+      $("synth-status").textContent = `${snap.state}${stage}: ${p.done}${p.total ? "/" + p.total : ""}, best so far ${p.best === null ? "–" : p.best.toPrecision(4)}, ${snap.seconds} s`;
     };
     const end = (snap) => {
       show(snap);

@@ -1,19 +1,19 @@
 // The Plots and Forces tabs of a spatial file (the planar ones are studio.js's renderPlots and
-// forces.js). Plots: the spatial engine's sweep (POST /api/spatial/plots, web/_spatial.py: the
-// SpatialSimulation of `ms.simulate`, the 3-D view's rows) drawn against the input: every pair's
+// forces.js). Plots: the spatial engine's sweep (POST /api/spatial/simulate, web/_spatial.py: the
+// SpatialSimulation's to_dict, the 3-D view's rows) drawn against the input: every pair's
 // angle (or slide), a named point's coordinates, velocity and acceleration, a link's angular
 // velocity and acceleration, with units, the events (singular positions, dead points) marked and
 // the input slider's row as the cursor. Forces: spatial statics are not in the library; the tab
 // says so in one line and gives what the rank method reads (finite mobility, idle motions,
 // redundant constraints: whether the reactions would be unique).
-import { call } from "./api.js";
 import { h } from "./numeric.js";
 import { chart } from "./plots.js";
 
 const XYZ = ["x", "y", "z"];
 
 // `ctx`: {$, state, render, showTab}; returns {renderPlots, forcesLines}.
-export function mountSpatialTabs({ $, state, render, showTab }) {
+// `motionOf(mech)`: the 3-D view's request of the sweep (view3d.js), shared.
+export function mountSpatialTabs({ $, state, render, showTab, motionOf }) {
   const sp = { mech: null, data: null, error: null, loading: false, draws: 0 };
   let charts = [];
   window.__spatialPlots = sp; // for tests (read-only use)
@@ -21,7 +21,7 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
   function fetchFor(m) {
     if (sp.mech === m) return;
     sp.mech = m; sp.data = null; sp.error = null; sp.loading = true;
-    call("/api/spatial/plots", { mechanism: m }).then((d) => {
+    motionOf(m).then((d) => {
       if (sp.mech !== m) return;
       sp.data = d; sp.loading = false; renderPlots();
     }, (e) => {
@@ -30,13 +30,20 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
     });
   }
 
+  // A pair's value is a slide (a P pair's, or a C or H pair's "<id>/slide") or an angle.
+  const kindOf = (key) => (key.endsWith("/slide") || (state.mech.joints.find((j) => j.id === key) || {}).type === "P" ? "slide" : "angle");
+  // The link a point rides on: a named point's, or a joint's second link.
+  const linkOf = (name) => ((state.mech.points || {})[name] || {}).link || (state.mech.joints.find((j) => j.id === name) || { links: [] }).links[1];
+
   // The quantities offered: the pairs' angles (and slides), each point, each moving link.
   function options(d) {
-    const kinds = new Set(Object.values(d.pairs).map((p) => p.kind));
+    const kinds = new Set(Object.keys(d.joints).map(kindOf));
     const out = [];
     if (kinds.has("angle")) out.push(["pairs:angle", "joint angles"]);
     if (kinds.has("slide")) out.push(["pairs:slide", "joint slides"]);
-    for (const n of Object.keys(d.points)) out.push([`point:${n}`, `point ${n}`]);
+    const m = state.mech, named = Object.keys(m.points || {}); // the 3-D view's paths: the named points, else the joints off the frame
+    const shown = (n) => (named.length ? named.includes(n) : !(m.joints.find((j) => j.id === n) || { links: [m.ground] }).links.includes(m.ground));
+    for (const n of Object.keys(d.points).filter(shown)) out.push([`point:${n}`, `point ${n}`]);
     for (const n of Object.keys(d.links)) out.push([`link:${n}`, `link ${n}`]);
     return out;
   }
@@ -47,13 +54,13 @@ export function mountSpatialTabs({ $, state, render, showTab }) {
     const rot = d.input.type !== "P", rate = rot ? "rad/s" : "units/s", at = `at ${d.input.joint} = ${w} ${rate}`;
     const comp = (rows, f) => XYZ.map((c, i) => ({ name: c, values: rows.map((v) => (v ? v[i] * f : null)) }));
     if (kind === "pairs") {
-      const ps = Object.entries(d.pairs).filter(([, p]) => p.kind === name);
+      const ps = Object.entries(d.joints).filter(([k]) => kindOf(k) === name);
       const unit = name === "angle" ? "°" : "units";
-      return [[`${name === "angle" ? "joint angles" : "joint slides"} from the drawn pose`, unit, ps.map(([k, p]) => ({ name: k, values: p.values }))]];
+      return [[`${name === "angle" ? "joint angles" : "joint slides"} from the drawn pose`, unit, ps.map(([k, values]) => ({ name: k, values }))]];
     }
     if (kind === "point") {
       const p = d.points[name];
-      return [[`position of ${name} on ${p.link}`, "units", comp(p.position, 1)],
+      return [[`position of ${name} on ${linkOf(name)}`, "units", comp(p.position, 1)],
         [`velocity of ${name}, ${at}`, "units/s", comp(p.velocity, w)],
         [`acceleration of ${name}, ${at}`, "units/s²", comp(p.acceleration, w * w)]];
     }

@@ -1,5 +1,5 @@
-// The 3-D view of spatial mechanisms: the server's spatial kinematics (/api/spatial/view,
-// web/_spatial.py) drawn in SVG, orthographic or perspective, orbit (drag), zoom (wheel),
+// The 3-D view of spatial mechanisms: the server's spatial kinematics (/api/spatial/simulate,
+// web/_spatial.py: the SpatialSimulation's to_dict, as `mechsyn simulate --json`) drawn in SVG, orthographic or perspective, orbit (drag), zoom (wheel),
 // reset (button or double-click). Joints by type (R, C, H: a short shaft along the axis;
 // P: a block along its slide; S: a ball; U: the crossed arms), links as bars (plates for
 // three joints or more, the convex outline of their joints), the frame dashed with ground
@@ -45,6 +45,37 @@ function camera(cam, W, H) {
   };
 }
 
+// The scene at every row (sceneOf): the simulation `motion` (every moving link's pose over the
+// rows, x = rotation x0 + translation) placed on the file `mech`: each joint's position (carried
+// by its second link) and axes (its axis by its first link, a U joint's axis2 by its second;
+// `mechsyn.plot.spatial.joint_frames` draws them the same way), the paths of the named points
+// (else of every joint off the frame), the row of the drawn pose (`home`: the middle row of a P
+// or C drive's sweep) and the largest closure residual. The rest of the motion (input, assembled,
+// events, notes, length_scale) is passed on; `joints` here is the joints' geometry (the motion's
+// pair values stay under `pairs`).
+export function sceneOf(motion, mech) {
+  const n = motion.assembled.length, I = [[1, 0, 0], [0, 1, 0], [0, 0, 1]], O = [0, 0, 0];
+  const pose = (link, k) => { const l = motion.links[link]; return !l ? [I, O] : l.rotation[k] ? [l.rotation[k], l.translation[k]] : null; };
+  const apply = (R, x, t = O) => [0, 1, 2].map((i) => R[i][0] * x[0] + R[i][1] * x[1] + R[i][2] * x[2] + t[i]);
+  const joints = mech.joints.filter((j) => j.point).map((j) => {
+    const position = [], axes = [];
+    for (let k = 0; k < n; k++) {
+      const a = pose(j.links[0], k), b = pose(j.links[1] || j.links[0], k);
+      if (!motion.assembled[k] || !a || !b) { position.push(null); axes.push(null); continue; }
+      position.push(apply(b[0], j.point, b[1]));
+      axes.push([j.axis && apply(a[0], unit(j.axis)), j.axis2 && apply(b[0], unit(j.axis2))].filter(Boolean));
+    }
+    return { id: j.id, type: j.type, links: j.links, actuated: !!j.actuated, position, axes };
+  });
+  const named = Object.keys(mech.points || {});
+  const shown = named.length ? named : mech.joints.filter((j) => j.point && !j.links.includes(mech.ground)).map((j) => j.id);
+  const linkOf = (name) => (named.includes(name) ? mech.points[name].link : mech.joints.find((j) => j.id === name).links[1]);
+  const paths = Object.fromEntries(shown.filter((p) => motion.points[p]).map((p) => [p, { link: linkOf(p), position: motion.points[p].position }]));
+  const res = motion.residual.filter((r, k) => r !== null && motion.assembled[k]);
+  return { ...motion, pairs: motion.joints, joints, paths, links: mech.links.map((l) => (typeof l === "string" ? l : l.name)), ground: mech.ground,
+    home: ["P", "C"].includes(motion.input.type) ? n >> 1 : 0, residual: res.length ? Math.max(...res) : null };
+}
+
 export function mountView3d({ $, state, svg: canvas, render, select }) {
   const svg = el("svg", { id: "view3d", role: "img", "aria-label": "3-D view of the spatial mechanism" });
   Object.assign(svg.style, { width: "100%", height: "100%", display: "none", background: "#fff", touchAction: "none", userSelect: "none", cursor: "move" });
@@ -76,7 +107,18 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     v3.cam = { ...HOME, centre, radius, s: (0.42 * Math.min(r.width || 800, r.height || 600)) / radius, perspective: persp.checked };
   }
 
-  // ---- opening a mechanism: the sweep from the server, once per mechanism
+  // ---- the sweep from the server, once per mechanism: one request for the view and the Plots tab
+  let asked = { key: "", motion: null };
+  function motionOf(mech) {
+    const key = JSON.stringify(mech);
+    if (asked.key !== key) {
+      const motion = call("/api/spatial/simulate", { mechanism: mech });
+      motion.catch(() => { if (asked.motion === motion) asked = { key: "", motion: null }; }); // asked again later
+      asked = { key, motion };
+    }
+    return asked.motion;
+  }
+
   function open(mech) {
     if (!mech || mech.kind === "planar") { v3.key = ""; v3.view = null; v3.error = null; show(false); return; }
     const key = JSON.stringify(mech);
@@ -87,8 +129,9 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     v3.key = key; v3.error = null; v3.loading = true;
     if (!same) v3.view = null;
     v3.mech = mech;
-    call("/api/spatial/view", { mechanism: mech }).then((view) => {
+    motionOf(mech).then((motion) => {
       if (v3.key !== key) return;
+      const view = sceneOf(motion, mech);
       v3.view = view; v3.loading = false;
       if (!same || !v3.cam) { show(true); fit(); }
       state.frame = view.home;
@@ -341,5 +384,5 @@ export function mountView3d({ $, state, svg: canvas, render, select }) {
     ev.preventDefault(); ev.stopImmediatePropagation(); play(!v3.playing);
   }, true);
 
-  return { open, shown, update };
+  return { open, shown, update, motionOf };
 }
