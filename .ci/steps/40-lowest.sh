@@ -14,7 +14,7 @@ uv pip install --quiet --resolution lowest-direct -e ".[test]"
 python - <<'PY'
 from importlib.metadata import version
 names = ("numpy", "scipy", "networkx", "matplotlib", "pydantic", "typer", "click", "rich", "pyyaml",
-         "python-igraph", "threadpoolctl")
+         "python-igraph", "threadpoolctl", "numba")
 print("lowest:", ", ".join(f"{n} {version(n)}" for n in names))
 PY
 MPLBACKEND=Agg python -m pytest -q -p no:cacheprovider -n auto

@@ -15,7 +15,7 @@ import pytest
 from kinematics_helpers import driven_planar_examples, fourbar
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import analysis
-from mechsyn.kinematics import refill, regular
+from mechsyn.kinematics import kernel, refill
 from mechsyn.kinematics.analysis import compile_plan, simulate
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
 from mechsyn.kinematics.refill import topology_key
@@ -295,7 +295,7 @@ def test_regular_program_of_a_refilled_system_is_the_built_ones():
         compared += 1
         moved = new.mechanism
         ref = build_system(moved)
-        assert regular._program(new.system, new.groups) == regular._program(ref, new.groups), name
+        assert kernel.chain_steps(new.system, new.groups) == kernel.chain_steps(ref, new.groups), name
     assert compared >= 4
 
 
@@ -593,10 +593,10 @@ def test_kernel_program_written_with_the_numbers_is_program_arrays():
             continue
         S, plan = new.system, new.groups
         rows: list = []
-        out = regular._filled(S, _topology(S, plan, "regular", lambda: regular._shape(S, plan)), rows)
+        out = kernel._filled(S, _topology(S, plan, "regular", lambda: kernel._shape(S, plan)), rows)
         _, fp, anc_s = kernel.program_arrays(*out)
         assert np.array_equal(np.array(rows, complex).reshape(fp.shape), fp), name
-        regular._program(S, plan)
+        kernel.chain_steps(S, plan)
         kept = _memo(S)[("kernel", id(plan))][1]
         assert all(np.array_equal(a, b) for a, b in zip(kept[1:], (fp, anc_s))), name
         assert kept[1].flags.c_contiguous and kept[2].flags.c_contiguous

@@ -126,7 +126,7 @@ def test_the_kernels_fold_scan_equals_the_sweeps_python_scan(ex, monkeypatch):
     (:func:`fold_events`) gives the same events (every field; inputs to 1e-12) and
     singular rows, forwards, backwards, over several turns, where the drawn input lies
     outside the sweep, and where an upstream group's fold hides a group's own."""
-    from mechsyn.kinematics import regular, folds, tracking
+    from mechsyn.kinematics import kernel, regular, folds, tracking
 
     seen = {"hidden": 0, "root": 0}
     real = folds._hidden_fold
@@ -144,7 +144,7 @@ def test_the_kernels_fold_scan_equals_the_sweeps_python_scan(ex, monkeypatch):
         paths = [tracking.tracking_path(S, p[0]) for p in parts]
         X = np.concatenate([U] + [p for p, _ in paths])
         st = regular._pass(S, plan, X, np.ones(1), folds=True)
-        steps, anchor, _ = regular._program(S, plan)
+        steps, anchor, _ = kernel.chain_steps(S, plan)
         sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
         got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
         want = _per_sweep(S, plan, st, U, split, paths, sigmas)

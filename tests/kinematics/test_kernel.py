@@ -80,7 +80,7 @@ def test_the_kernel_pass_equals_the_closed_form_chain(name, mech):
     wide = np.radians(np.arange(-180.0, 541.0, 2.5))  # a full turn and more: folds if the chain has any
     X = np.column_stack([wide if i == 0 else u0[i] + rng.uniform(-0.3, 0.3, wide.size) for i in range(k)])
     speeds = np.linspace(1.0, 2.0, k)
-    steps, anchor, origin = regular._program(S, plan)
+    steps, anchor, origin = kernel.chain_steps(S, plan)
     C, W, AL, D, near = kernel.run(kernel.program_arrays(steps, anchor, origin), X, speeds, regular.REGULAR_DISC)
     with np.errstate(invalid="ignore", divide="ignore"):
         q, qd, qdd = solve_all(S, plan, X, speeds)

@@ -137,7 +137,7 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
     discriminant of every group."""
     from mechsyn.kinematics import dyads, folds, kernel
     from mechsyn.kinematics.analysis import cached_plan
-    from mechsyn.kinematics.regular import kernel_program
+    from mechsyn.kinematics.kernel import program as kernel_program
 
     for f in ("textbook/watt_sixbar.yaml", "textbook/stephenson_sixbar.yaml", "kinematics/peaucellier.yaml"):
         m = ex(f)
@@ -150,7 +150,7 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
         for k, step in enumerate(plan.steps):
             if step.kind != "RRR":
                 continue
-            ref = folds._disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
+            ref = folds.disc_at(S, plan, k, tp.sigmas, np.arange(len(X)), X)
             sig = [np.array([float(s[i]) if isinstance(s, np.ndarray) else float(s or 1.0) for s in tp.sigmas])
                    for i in range(len(X))]
             got = np.array([kernel.scalar_disc(prog, k, sig[i], X[i]) for i in range(len(X))])
@@ -238,7 +238,7 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.chain import _chain_program_
     from mechsyn.kinematics.groups import DriveOp, _local
-    from mechsyn.kinematics.regular import _program
+    from mechsyn.kinematics.kernel import chain_steps as _program
 
     m = ex(f)
     j = next(jj.id for jj in m.joints if jj.actuated)

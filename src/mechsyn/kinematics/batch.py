@@ -66,16 +66,13 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.simulation import Motion, PointMotion
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
-
-if TYPE_CHECKING:
-    from mechsyn.kinematics.simulation import Motion
 
 __all__ = ["BatchPlan", "BatchResult", "compile_plan", "simulate_batch", "design_parameters"]
 
@@ -164,7 +161,7 @@ class BatchResult:
         """Designs assembled over the whole sweep without a stepped-over dead point."""
         return ~self.dead_point & ~self.branch_jump
 
-    def motion(self, k: int = 0) -> "Motion":
+    def motion(self, k: int = 0) -> Motion:
         """The rows of design ``k`` as a :class:`~mechsyn.kinematics.Motion`, the result
         every engine gives: the input joint's values as :func:`mechsyn.kinematics.simulate`
         measures them (the design's drawn input plus the offsets), the rows assembled, the
@@ -181,8 +178,6 @@ class BatchResult:
         >>> m.engine, m.assembled.shape, m.point("M").shape
         ('batch', (36,), (36, 2))
         """
-        from mechsyn.kinematics.simulation import Motion, PointMotion
-
         plan, u = self.plan, np.asarray(self.inputs, float)
         if plan is None or self.reference_inputs is None:
             raise MechsynInputError("this result keeps no plan: it was not made by simulate_batch",

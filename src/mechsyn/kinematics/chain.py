@@ -37,7 +37,7 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     inputs = np.atleast_2d(np.asarray(inputs, float))
     if plan.closed_form_rates:
         sig = tracked.sigmas if tracked is not None else None
-        return _poses_from_chain(S, plan, inputs, fast_chain(S, plan, inputs, speeds, rates=True, sigmas=sig))
+        return poses_from_chain(S, plan, inputs, fast_chain(S, plan, inputs, speeds, rates=True, sigmas=sig))
     q = tracked.q if tracked is not None else solve_positions(S, plan, inputs)[0]
     ok = np.all(np.isfinite(q), axis=1)
     qd = np.full_like(q, np.nan)
@@ -49,13 +49,13 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     return q, qd, qdd
 
 
-def _poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
+def poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult") -> tuple:
     """Pose coordinates (origin, angle) and their rates from a chain's anchors and rotations."""
     with np.errstate(invalid="ignore", over="ignore"):  # inf rates at singular rows become NaN
         return _poses_from_chain_(S, plan, U, r)
 
 
-def _drive_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
+def frame_driven_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
     """Links turned by a frame driver: link -> (driver index, sign of the input), kept
     in the system's memo for the plan (a sweep's angles of these links are the inputs)."""
     memo = _memo(S)
@@ -165,7 +165,7 @@ def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
 def _angle_links(S: PlanarSystem, plan: Plan) -> tuple:
     """The links turned by frame drivers, the others (a slice when they are a range) and
     the columns of their angles in ``q``."""
-    drive_links = _drive_links(S, plan)
+    drive_links = frame_driven_links(S, plan)
     others = [i for i in range(len(S.links)) if i not in drive_links]
     cols = [3 * i + 2 for i in others]
     if others and others == list(range(others[0], others[-1] + 1)):
@@ -231,7 +231,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     nl = len(S.links)
     speeds = np.ones(U.shape[1]) if speeds is None else np.asarray(speeds, float)
     want = joints if joints is not None else [j.id for j in S.mech.joints]
-    prog, anchor = _chain_program(S, plan, sigmas)
+    prog, anchor = chain_program(S, plan, sigmas)
     # outputs stored component-major ((2, N) and (nl, N) buffers, returned transposed) so
     # that every chunk writes contiguous memory
     # outputs stored component-major (one (joints, 2, N) buffer per kind and (nl, N)
@@ -260,7 +260,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
     return out
 
 
-def _chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list[DriveOp | RRROp], dict]:
+def chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list[DriveOp | RRROp], dict]:
     """The chain's steps as typed ops, and every link's anchor joint (built once per
     system and plan; the signs ``sigmas`` put in per call)."""
     memo = _memo(S)

@@ -38,7 +38,7 @@ _ZERO_DISC = 1e-12
 _ON_THE_WAY = "between the drawn configuration and the first input: "
 
 
-def _swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | None = None) -> tuple:
+def swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | None = None) -> tuple:
     """An event's row, message, input and ``before_sweep`` along the sweep from its row
     ``i`` of the tracked rows (the first ``n0`` the connecting path, the rest the sweep
     shifted by the whole turns ``shift``): :func:`_sweep_events` of one event."""
@@ -49,7 +49,7 @@ def _swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | N
     return max(0, i - n0), message, u, before
 
 
-def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
+def disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
     """Normalised discriminant of step ``k`` at the inputs ``X`` (M, n_inputs), upstream
     steps solved with their modes of the sweep rows ``rows`` (M,)."""
     st = _State(S, X.shape[0])
@@ -74,16 +74,14 @@ def _disc_line(S: PlanarSystem, plan: Plan, k: int, sigmas: list, xa: list, xb: 
     the numbers of ``xa + t (xb - xa)``)."""
     dx = [b - a for a, b in zip(xa, xb)]
     if plan.closed_form_rates:
-        from mechsyn.kinematics.regular import kernel_program  # (regular imports this module)
-
-        prog = kernel_program(S, plan)
+        prog = kernel.program(S, plan)
         sg = np.ones(len(plan.steps))
         for j, s in enumerate(sigmas[:k]):
             if s is not None:
                 sg[j] = float(s[i0]) if isinstance(s, np.ndarray) else float(s)
         return lambda t: kernel.scalar_disc(prog, k, sg, np.array([a + t * d for a, d in zip(xa, dx)]))
     rows = np.array([i0])
-    return lambda t: float(_disc_at(S, plan, k, sigmas, rows, np.array([[a + t * d for a, d in zip(xa, dx)]]))[0])
+    return lambda t: float(disc_at(S, plan, k, sigmas, rows, np.array([[a + t * d for a, d in zip(xa, dx)]]))[0])
 
 
 def touch_candidates(disc: np.ndarray) -> np.ndarray:
@@ -218,7 +216,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    program = _memo(S)[("kernel", id(plan))][1]  # the pass's program (regular._program keeps it)
+    program = _memo(S)[("kernel", id(plan))][1]  # the pass's program (kernel.chain_steps keeps it)
     X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
     return _compiled_fold_events(S, plan, program, [discs[k] for k in ks] if block is None else block, ks,
                                  perm, b, X, paths)
@@ -307,9 +305,7 @@ def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     out = None
     form = _topology(S, plan, ("four-bar form", k), lambda: _four_bar_form(S, plan, k))
     if form is not None:
-        from mechsyn.kinematics.regular import kernel_program  # (regular imports this module)
-
-        kernel_program(S, plan)  # the regular program (steps, anchors, origin: complex local points) kept with S
+        kernel.program(S, plan)  # the regular program (steps, anchors, origin: complex local points) kept with S
         c, on_frame, crank = form
         steps, cx, _ = memo[("regular", id(plan))][1]
         O, sgn, pivot = steps[c][6], steps[c][5], cx[crank][1]

@@ -97,7 +97,7 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     frames, ang = (np.cos(turn).tolist(), np.sin(turn).tolist(), org), angle0.tolist()
     cons, drivers = _refilled(T, mech, recipe, pts, frames, ang)
     q0 = np.array([v for (x, y), a in zip(org, ang) for v in (x, y, a)], float)
-    # the engines' programs by topology (regular._program's shapes), shared with T
+    # the engines' programs by topology (kernel.chain_steps' shapes), shared with T
     cache = {"frames": frames, "joint_points": pts, "layout": lay, "programs": T.cache.setdefault("programs", {})}
     S = object.__new__(_Refilled)
     fields = S.__dict__

@@ -35,114 +35,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.chain import _chain_program, _drive_links
-from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology
-from mechsyn.kinematics.refill import joint_points
-from mechsyn.kinematics.system import PlanarSystem, frame_points
+from mechsyn.kinematics.chain import frame_driven_links
+from mechsyn.kinematics.groups import Plan, _memo, _topology
+from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.folds import pass_fold_events
-from mechsyn.kinematics.tracking import REGULAR_DISC, _regular_rows, tracking_path
+from mechsyn.kinematics.tracking import REGULAR_DISC, regular_rows, tracking_path
 
 __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
-
-
-def _program(S: PlanarSystem, plan: Plan) -> tuple:
-    """The chain's steps with complex constants, every link's anchor and origin joint
-    (built once per system and plan). Its shape (:func:`_shape`: the steps' links,
-    joints, drivers and signs, and which local joint points they take) depends on the
-    topology only: it is kept in ``S.cache["programs"]``, which
-    :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of one
-    topology, so a refilled system's program is its numbers put in (:func:`_filled`).
-    The same numbers are written once more as the kernel's arrays
-    (:func:`~mechsyn.kinematics.kernel.program_arrays`' ``fp`` and ``anc_s``, kept under
-    ``("kernel", id(plan))``) while they are filled in, not read back off the steps."""
-    memo = _memo(S)
-    key = ("regular", id(plan))
-    hit = memo.get(key)
-    if hit is not None and hit[0] is plan:
-        return hit[1]
-    rows: list = []
-    out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)), rows)
-    memo[key] = (plan, out)
-    steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
-    shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
-    rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
-    flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
-    memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
-    return out
-
-
-def kernel_program(S: PlanarSystem, plan: Plan) -> tuple:
-    """The regular pass's program of ``S`` as the kernel's arrays
-    (:func:`~mechsyn.kinematics.kernel.program_arrays`), kept with ``S``."""
-    _program(S, plan)
-    return _memo(S)[("kernel", id(plan))][1]
-
-
-def _shape(S: PlanarSystem, plan: Plan) -> tuple:
-    """The topology of :func:`_program`: its steps without numbers (a drive's links,
-    joint, driver and sign; an RRR group's known links, links and joints), each link's
-    anchor joint, origin joint, the (link, joint) pairs whose local points the numbers
-    take, as index lists (link, joint's index in the file), and the file indices of
-    every RRR group's joints (its drawn assembly mode)."""
-    prog, anchor = _chain_program(S, plan, None)
-    pairs: dict[tuple[int, str], int] = {}
-
-    def at(i: int, jid: str) -> int:
-        return pairs.setdefault((i, jid), len(pairs))
-
-    steps = []
-    for op in prog:
-        if isinstance(op, DriveOp):  # the joint's local point on k (the frame: its fixed point)
-            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign, at(op.known, op.joint)))
-        else:
-            (k1, k3), (b1, b2), (J1, J2, J3) = op.known, op.links, op.joints
-            steps.append(("RRR", op.known, op.links, op.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
-                          at(k1, J1), at(k3, J3)))
-    anchors = {i: (jid, at(i, jid)) for i, (jid, _) in anchor.items()}
-    origin = []  # the joint at every link's origin (its first joint), by link
-    for i, name in enumerate(S.links):
-        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)
-        origin.append(j0)
-    index = {j.id: k for k, j in enumerate(S.mech.joints)}
-    drawn = [(index[st[3][0]], index[st[3][1]], index[st[3][2]]) if st[0] == "RRR" else None for st in steps]
-    return steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs], drawn
-
-
-def _locals(S: PlanarSystem, li: list, pj: list) -> list:
-    """The local points (``(x, y)`` floats) of the joints ``pj`` (indices in the file) on
-    the links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`'s
-    numbers, on floats."""
-    pts = joint_points(S)
-    return frame_points(S.frames(), li, [pts[k] for k in pj])
-
-
-def _filled(S: PlanarSystem, shape: tuple, rows: list) -> tuple:
-    """:func:`_program` of ``S`` from its topology's shape (:func:`_shape`): the local
-    points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
-    each step's row of the kernel's ``fp``
-    (:func:`~mechsyn.kinematics.kernel.program_arrays`' layout) appended to it, flat."""
-    steps_, anchors, origin, li, pj, drawn = shape
-    loc = _locals(S, li, pj)
-    pt = joint_points(S)
-    steps = []
-    for st, ks in zip(steps_, drawn):
-        if st[0] == "drive":
-            steps.append(st[:6] + (s_k := complex(*loc[st[6]]),))
-            rows += (st[5], s_k, 0j, 0j, 0j, 0j, 0j)
-            continue
-        _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
-        (x1, y1), (x2, y2), (x3, y3), (x4, y4) = loc[i1], loc[i2], loc[i3], loc[i4]
-        ux, uy = x2 - x1, y2 - y1  # s2 - s1 on the first link, t2 - t3 on the second
-        vx, vy = x3 - x4, y3 - y4
-        L1s, L2s = ux * ux + uy * uy, vx * vx + vy * vy
-        (ax, ay), (bx, by), (cx, cy) = pt[ks[0]], pt[ks[1]], pt[ks[2]]
-        cross = (cx - ax) * (by - ay) - (cy - ay) * (bx - ax)
-        sigma = 1.0 if cross >= 0 else -1.0
-        num = (sigma, complex(ux / L1s, -(uy / L1s)), complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]),
-               complex(*loc[k3]))
-        steps.append(("RRR", known, links, joints, L1s, L2s) + num)
-        rows += (complex(L1s, L2s), 0j) + num
-    return steps, {i: (jid, complex(*loc[k])) for i, (jid, k) in anchors.items()}, origin
 
 
 def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
@@ -167,7 +66,7 @@ def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
-    st = _pass(S, plan, _regular_rows(S, U, split), speeds, folds=False)
+    st = _pass(S, plan, regular_rows(S, U, split), speeds, folds=False)
     return None if st is None else _poses(S, plan, U, st, split)
 
 
@@ -175,7 +74,7 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
     """One pass of the regular program over the input rows ``X`` (or the blocks of rows
     ``X``, a list, one after the other) by the kernel (:func:`mechsyn.kinematics.kernel.run`).
     None when a group comes near a fold and ``folds`` is false."""
-    prog = kernel_program(S, plan)
+    prog = kernel.program(S, plan)
     C, W, AL, D, near, Z = kernel.run(prog, X, speeds, REGULAR_DISC,
                                       planes=(X[0] if isinstance(X, list) else X).shape[0])
     if near and not folds:
@@ -202,7 +101,7 @@ def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray, 
     """Each link's frame driver's input column (-1: none), the input's sign, and the runs
     ``(first, end)`` of consecutive links that no frame driver turns (their angles are
     ``atan2`` of their rotations)."""
-    drive = _drive_links(S, plan)
+    drive = frame_driven_links(S, plan)
     nl = len(S.links)
     free = [i for i in range(nl) if i not in drive]
     runs = [[i, i + 1] for i in free[:1]]
@@ -265,7 +164,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
-    steps, anchor, origin = _program(S, plan)
+    steps, anchor, origin = kernel.chain_steps(S, plan)
     paths = _tracking_paths(S, U, split)
     st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
     if not st.near:

@@ -15,10 +15,10 @@ import math
 
 import numpy as np
 
-from mechsyn.kinematics.chain import _poses_from_chain, fast_chain
+from mechsyn.kinematics.chain import poses_from_chain, fast_chain
 from mechsyn.kinematics.groups import Plan, _cons_of
 from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _solve_step
-from mechsyn.kinematics.folds import SINGULAR_DISC, _disc_at, _swept, fold_events, touch_candidates
+from mechsyn.kinematics.folds import SINGULAR_DISC, disc_at, swept, fold_events, touch_candidates
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -61,7 +61,7 @@ def _kinds(S: PlanarSystem) -> tuple[tuple, float]:
     return kinds, (S.scale if "P" in kinds else 1.0)
 
 
-def _regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
+def regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
     """The rows ``U`` followed by the connecting paths from the drawn input values to the
     sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
     else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
@@ -149,7 +149,7 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     out = []
     for (X, n0, shift), U, seg, evs in zip(rows, parts, segs, raw_events):
         sweep_rows = slice(seg.start + n0, seg.stop)
-        q, qd, qdd = _poses_from_chain(S, plan, U, r.rows(sweep_rows))
+        q, qd, qdd = poses_from_chain(S, plan, U, r.rows(sweep_rows))
         out.append((q, qd, qdd, singular[sweep_rows], _sweep_events(evs, n0, shift)))
     return out
 
@@ -221,7 +221,7 @@ def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
     sh = shift.tolist()
     out = []
     for e in raw_events:
-        index, message, u, before = _swept(e.index, e.message, e.input, n0, sh, e.before_sweep)
+        index, message, u, before = swept(e.index, e.message, e.input, n0, sh, e.before_sweep)
         out.append(e.with_(index=index, message=message, input=u, before_sweep=before))
     return out
 
@@ -291,7 +291,7 @@ def _touch(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, i: 
     def at(t: np.ndarray) -> np.ndarray:
         t = np.asarray(t, float)
         P = X[i] + np.where(t[:, None] >= 0, t[:, None] * db, t[:, None] * da)
-        return _disc_at(S, plan, k, sigmas, np.full(len(t), i), P)
+        return disc_at(S, plan, k, sigmas, np.full(len(t), i), P)
 
     h = 1e-6
 
