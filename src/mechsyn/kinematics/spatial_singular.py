@@ -58,13 +58,20 @@ ZOOM = 17
 
 
 # --------------------------------------------------------------------------- crossings
-def _svd_bases(Jc: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
-    U, _, Vt = np.linalg.svd(Jc, full_matrices=False)
-    return U[..., :r], Vt[..., :r, :]
-
-
-def _sign(Ub: np.ndarray, Vb: np.ndarray, Jc: np.ndarray) -> np.ndarray:
-    return np.sign(np.linalg.det(np.swapaxes(Ub, -1, -2) @ Jc @ np.swapaxes(Vb, -1, -2)))
+def _flips(Ja: np.ndarray, Jb: np.ndarray, r: int) -> np.ndarray:
+    """Whether ``det(U_aᵀ J_b V_a)`` is not positive, for pairs of Jacobians ``Ja``, ``Jb``
+    (B, m, k) of regular rank ``r`` at ``Ja`` (``U_a``, ``V_a``: its first ``r`` singular
+    vectors). At full column rank (``r = k``) ``det(J_aᵀ J_b) = det(Σ_a) det(U_aᵀ J_b V_a)``
+    (``det(V_a)² = 1``), at full row rank (``r = m``) ``det(J_b J_aᵀ)`` likewise: the same sign
+    without an SVD; otherwise the bases by an SVD."""
+    m, k = Ja.shape[1:]
+    if r == k:
+        return np.linalg.det(np.swapaxes(Ja, -1, -2) @ Jb) <= 0
+    if r == m:
+        return np.linalg.det(Jb @ np.swapaxes(Ja, -1, -2)) <= 0
+    Ua, _, Vat = np.linalg.svd(Ja, full_matrices=False)
+    Ua, Vat = Ua[..., :r], Vat[..., :r, :]
+    return np.linalg.det(np.swapaxes(Ua, -1, -2) @ Jb @ np.swapaxes(Vat, -1, -2)) <= 0
 
 
 def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
@@ -92,18 +99,15 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
     out = []
     if near.any():
-        Ub, Vb = _svd_bases(Jc[a[near]], r)
-        flips = _sign(Ub, Vb, Jc[b[near]]) <= 0
-        for k, ub, vb in zip(ks[near][flips], Ub[flips], Vb[flips]):
-            found = _bisect(tr, w, U, int(k), ub, vb)
+        for k in ks[near][_flips(Jc[a[near]], Jc[b[near]], r)]:
+            found = _bisect(tr, w, U, int(k))
             if found is not None:
                 out.append(found)
     seen = {c[0] for c in out} | {c[0] + 1 for c in out}
     return out + _v_minima(tr, w, U, ratio, seen)
 
 
-def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
-            vb: np.ndarray) -> tuple[int, np.ndarray, float, int | None] | None:
+def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[int, np.ndarray, float, int | None] | None:
     """The crossing between rows ``k`` and ``k + 1`` (where ``det(U_kᵀ J V_k)`` changed
     sign): the least ``σ_r / σ_1`` between them (:func:`_golden`); None when it is not a
     rank drop (the sign changed by a frame effect)."""
@@ -119,22 +123,24 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set)
     """Rows whose ratio is a sharp local minimum (``r0 + r2 >= 4 r1``: every V passes)
     refined by a golden-section search; a crossing where it falls under the singular
     tolerance. Rows in ``seen`` (next to a crossing found by the determinant) are skipped."""
-    out = []
     tol = singular_tol(tr.M)
-    for k in range(1, len(U) - 1):
-        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]) or len({w.how[k - 1], w.how[k], w.how[k + 1]}) > 1:
-            continue
+    if len(U) < 3:
+        return []
+    ok, how = w.ok, w.how
+    same = ok[:-2] & ok[1:-1] & ok[2:] & (how[:-2] == how[1:-1]) & (how[1:-1] == how[2:])
+    r0, r1, r2 = ratio[:-2], ratio[1:-1], ratio[2:]
+    with np.errstate(invalid="ignore"):
+        vee = same & (r1 <= r0) & (r1 <= r2) & (r0 + r2 >= 4 * r1) & (r1 >= tol)
+    a, b = U[1:-1] - U[:-2], U[2:] - U[1:-1]
+    ab = np.einsum("ij,ij->i", a, b)
+    vee &= (ab > 0) & (np.abs(ab) >= (1 - 1e-9) * np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+    out = []  # (the last test: on one straight stretch of the sweep)
+    for k in np.flatnonzero(vee) + 1:
         if seen & {k - 1, k, k + 1}:
             continue
-        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
-        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= tol):
-            continue
-        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
-        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
-            continue  # not on one straight stretch of the sweep
         found = _golden(tr, w, U, [k - 1, k, k + 1])
         if found is not None and found[1] < tol:
-            out.append((k, found[0], found[1], None))
+            out.append((int(k), found[0], found[1], None))
     return out
 
 
