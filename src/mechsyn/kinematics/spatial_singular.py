@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, singular_tol, svd_ratio
+from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, polished_ratio, singular_tol
 
 __all__ = ["crossings", "REFINE"]
 
@@ -159,7 +159,7 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
     states = {k: tr.state(*w.at(k), U[k][None]) for k in rows}
     lo, hi = U[rows[0]], U[rows[-1]]
     span = len(rows) - 1
-    tol, halvings = tr.tol, tr.halvings
+    tol = tr.tol
 
     def f(ts: np.ndarray) -> np.ndarray:
         out = np.full(len(ts), np.inf)
@@ -171,25 +171,50 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
             x1, x2 = _taylor(tr, st, u - U[k])
             z = np.zeros(len(sel), int)
             R, p = move(st.R[z], st.p[z], x1 + 0.5 * x2)
-            R, p, ok, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=40)
-            tr.tol = 0.0
-            R, p, _, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=POLISH)
-            tr.tol = tol
-            if ok.any():
-                good = np.flatnonzero(ok)
-                out[sel[good]] = svd_ratio(tr.state(R[good], p[good], st.href[z[good]], u[good]).lin.Jc, tr.rank)
+            out[sel] = polished_ratio(tr, R, p, st.href[z], u, polish=POLISH)
         return out
 
     a, b = 0.0, 1.0
     best_t, best = 0.5, np.inf
+    seen_t, seen_f = [], []
     while b - a > REFINE / span:
         ts = np.linspace(a, b, ZOOM)
         fs = f(ts)
+        seen_t.append(ts)
+        seen_f.append(fs)
         i = int(np.argmin(fs))
         if not np.isfinite(fs[i]):
             break
         best_t, best = ts[i], fs[i]
         h = (b - a) / (ZOOM - 1)
         a, b = max(0.0, ts[i] - h), min(1.0, ts[i] + h)
-    tr.halvings = halvings
-    return (lo + best_t * (hi - lo), float(best)) if np.isfinite(best) else None
+    if not np.isfinite(best):
+        return None
+    best_t = _apex(np.concatenate(seen_t), np.concatenate(seen_f), best_t, np.sqrt(tol))
+    return lo + best_t * (hi - lo), float(best)
+
+
+def _apex(t: np.ndarray, f: np.ndarray, t0: float, clean: float) -> float:
+    """The apex of the V ``f = |λ(t)|`` (``λ`` smooth with a simple root: a crossing) sampled
+    at ``t``, least at ``t0``: the root of ``λ`` fitted (a quadratic, a line through fewer than
+    five points) to the three samples a side nearest ``t0`` that are *clean*, ``f >= clean``,
+    negative on the left. Within ``δ`` of the crossing Newton's pose is off by about
+    ``ε / σ_r`` (``ε`` its residual, at rounding when polished), which moves ``σ_r`` by about
+    as much: relatively ``ε / σ_r²``, under ``1e-4`` where ``σ_r / σ_1 >= √tol``, so the clean
+    samples lie on the V to that accuracy while those nearer the apex are blurred (the least
+    sample alone is only within ``√ε`` of it). ``t0`` when there is no clean sample on a side,
+    or the root falls outside the nearest clean ones (a touch, not a simple crossing)."""
+    t, i = np.unique(t, return_index=True)
+    f = f[i]
+    good = np.isfinite(f) & (f >= clean)
+    left, right = np.flatnonzero(good & (t < t0)), np.flatnonzero(good & (t > t0))
+    left, right = left[np.argsort(t0 - t[left])[:3]], right[np.argsort(t[right] - t0)[:3]]
+    if not len(left) or not len(right) or len(left) + len(right) < 3:
+        return t0
+    x = np.concatenate([t[left], t[right]]) - t0
+    scale = np.abs(x).max()
+    c = np.polyfit(x / scale, np.concatenate([-f[left], f[right]]), 2 if len(x) >= 5 else 1)
+    roots = np.roots(c)
+    roots = roots.real[np.abs(roots.imag) <= 1e-12 * (1 + np.abs(roots.real))] * scale + t0
+    roots = roots[(roots > t[left].max()) & (roots < t[right].min())]
+    return float(roots[np.argmin(np.abs(roots - t0))]) if len(roots) else t0
