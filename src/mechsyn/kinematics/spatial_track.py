@@ -112,7 +112,8 @@ class Lin:
         out = np.zeros(B)
         if k == self.r:
             with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-                out = 1.0 / np.sqrt(np.linalg.norm(self.G, axis=(1, 2)) * np.linalg.norm(self.Ginv, axis=(1, 2)))
+                out = 1.0 / np.sqrt(np.sqrt(np.einsum("bij,bij->b", self.G, self.G)
+                                            * np.einsum("bij,bij->b", self.Ginv, self.Ginv)))
             out = np.nan_to_num(out)
         exact = out < 1e-3
         if exact.any():
@@ -242,7 +243,7 @@ class Tracker:
         file measures from."""
         B, n = len(J), self.M.n
         C = rotate(R[:, :-1], self.c0) + p[:, :-1]
-        Jr = J.reshape(B, -1, n, 6).copy()
+        Jr = J.reshape(B, -1, n, 6)  # (J is :func:`jacobian`'s, fresh: changed in place)
         rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
         Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
         Jc = Jr.reshape(J.shape)
@@ -252,7 +253,8 @@ class Tracker:
         rows = J.shape[1] < J.shape[2]
         G = Jc @ Jc.transpose(0, 2, 1) if rows else Jc.transpose(0, 2, 1) @ Jc
         k = G.shape[1]
-        G[:, np.arange(k), np.arange(k)] += 1e-14 * np.abs(G).max(axis=(1, 2))[:, None] + 1e-300
+        diag = G[:, np.arange(k), np.arange(k)]  # (a Gram matrix's largest entry is on its diagonal)
+        G[:, np.arange(k), np.arange(k)] = diag + (1e-14 * diag.max(axis=1, initial=0.0)[:, None] + 1e-300)
         return Lin(Jc, G, rows, self.rank, C)
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
