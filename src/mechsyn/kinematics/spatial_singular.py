@@ -83,17 +83,17 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     r = tr.rank
     if not r or len(idx) < 2:
         return []
-    pos = {int(k): i for i, k in enumerate(idx)}
     same = (w.ok[:-1] & w.ok[1:]) & (w.how[:-1] == w.how[1:])
     ks = np.flatnonzero(same)
     if not len(ks):
         return []
-    a, b = np.array([pos[k] for k in ks]), np.array([pos[k + 1] for k in ks])
+    a = np.searchsorted(idx, ks)  # the positions of rows k and k + 1 in idx (its rows are w.ok's)
+    b = a + 1
     flat = Jc.reshape(len(Jc), -1)
     norm = np.sqrt(np.einsum("bi,bi->b", flat, flat))
     low = np.nan_to_num(ratio[idx]) * norm / np.sqrt(max(r, 1))  # lower bounds of σ_r
-    d = flat[b] - flat[a]
-    jump = np.sqrt(np.einsum("bi,bi->b", d, d))
+    d = np.diff(flat, axis=0)
+    jump = np.sqrt(np.einsum("bi,bi->b", d, d))[a]
     near = (low[a] <= 2 * jump) | (low[b] <= 2 * jump)
     tol = singular_tol(tr.M)
     near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
