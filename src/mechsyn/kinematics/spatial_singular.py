@@ -12,14 +12,17 @@ Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobia
 determinant). The pairs where it can change at all are few: by Weyl's inequality
 ``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
 the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
-of the two rows; only those pairs get an SVD. A sign change is bracketed and refined (below) and
+of the two rows; only those pairs are tested (:func:`_flips`: at full column or row rank by
+``det(J_kᵀ J_{k+1})`` or ``det(J_{k+1} J_kᵀ)``, of the same sign, else by an SVD). A sign change
+is bracketed and refined (below) and
 reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
 makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
-row's neighbours) are candidates too. Each candidate is refined by a golden-section search of
-``σ_r/σ_1`` over its bracket to ``REFINE`` of the step (a V about the crossing on either branch
-that meets there, so it does not matter which one Newton lands on that close to it; the sign of
-the determinant does, which is why it only brackets) and is a crossing where the least ratio is
-under the singular tolerance.
+row's neighbours) are candidates too. Each candidate is bracketed by a zoom of ``σ_r/σ_1``
+over its bracket to ``REFINE`` of the step (a V about the crossing on either branch that meets
+there, so it does not matter which one Newton lands on that close to it; the sign of the
+determinant does, which is why it only brackets), is a crossing where the least ratio is under
+the singular tolerance, and is located at the apex of the V fitted to its clean samples
+(:func:`_apex`).
 
 **Leaving a singular pose** (:func:`~mechsyn.kinematics.spatial_track.leave`). At a dead point of the input the mechanism moves like the square
 root of the input step, at a change point along either of two branches: the linear predictor
