@@ -180,3 +180,26 @@ def rssr_taut():
         {"id": "B", "type": "S", "links": ["crank", "rod"], "point": B.tolist()},
         {"id": "C", "type": "S", "links": ["rod", "rocker"], "point": C.tolist()},
         _r("D", "frame", "rocker", Dp, [1, 0, 0])]}, "rssr_taut")
+
+
+# --------------------------------------------------------------------------- Sarrus
+def sarrus(alpha=40.0, leg_a=1.0, leg_b=(1.3, 1.6)):
+    """A Sarrus linkage: leg A (axes along x, both links ``leg_a`` long, its crank A1 at
+    ``alpha`` degrees above the horizontal, driven) and leg B (axes along y, links ``leg_b``)
+    hold the top, which translates along z at height ``2 leg_a sin(alpha + A1)``. Leg A is
+    stretched (A1, A2, A3 on one line, a change point) at ``A1 = 90 - alpha``; where B's reach
+    ``sum(leg_b)`` is less than ``2 leg_a`` the input stops (leg B stretched, a dead point) at
+    ``A1 = asin(sum(leg_b) / (2 leg_a)) - alpha``. Returns the mechanism."""
+    al = np.radians(alpha)
+    h = 2 * leg_a * np.sin(al)
+    b1, b2 = leg_b
+    beta = np.arcsin((b1 * b1 + h * h - b2 * b2) / (2 * h * b1))
+    ex, ey = [1, 0, 0], [0, 1, 0]
+    joints = [_r("A1", "frame", "a1", [1, 0, 0], ex, actuated=True),
+              _r("A2", "a1", "a2", [1, leg_a * np.cos(al), leg_a * np.sin(al)], ex),
+              _r("A3", "a2", "top", [1, 0, h], ex),
+              _r("B3", "top", "b2", [0, 1, h], ey),
+              _r("B2", "b2", "b1", [b1 * np.cos(beta), 1, b1 * np.sin(beta)], ey),
+              _r("B1", "b1", "frame", [0, 1, 0], ey)]
+    return mechanism_from_dict({"name": "Sarrus", "kind": "spatial", "ground": "frame",
+                                "links": ["frame", "a1", "a2", "top", "b2", "b1"], "joints": joints}, "sarrus")

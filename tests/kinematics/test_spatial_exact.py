@@ -11,7 +11,7 @@ import pytest
 import mechsyn as ms
 from mechsyn.kinematics.spatial_model import compile_spatial, pair_error
 from mechsyn.kinematics.spatial_track import NEWTON_TOL, Tracker
-from spatial_cases import bricard, loop_error, rot, rssr_at_dead_point, spherical_fourbar
+from spatial_cases import bricard, loop_error, rot, rssr_at_dead_point, sarrus, spherical_fourbar
 
 SING_POS = 10 * np.sqrt(NEWTON_TOL)  # position accuracy on a singular row (Newton converges linearly there)
 
@@ -85,6 +85,33 @@ def test_change_point_of_a_spherical_four_bar_found_at_every_step_and_offset(ste
         assert not sing[0].get("crossed") and np.isnan(s.points["C"].velocity[on_row]).all()
     regular = ~on_row
     assert np.isfinite(s.points["C"].velocity[regular]).all()
+
+
+@pytest.mark.parametrize("alpha", [40.0, 23.7])
+@pytest.mark.parametrize("step,offset", [(1.0, 0.0), (0.7, 0.31), (2.9, 0.5), (0.13, 0.05)])
+def test_sarrus_change_and_fold_inputs_exact_to_a_millionth_of_the_step(alpha, step, offset):
+    """A Sarrus linkage built here, driven at A1. With two equal legs of equal links both
+    stretch at ``A1 = 90 - alpha`` (a change point: one singular event there); with leg B
+    shorter (reach 1.8 against leg A's 2) the input stops where leg B is stretched, at
+    ``A1 = asin(0.9) - alpha`` (a dead point, the working range's end). Both located to 1e-6
+    of the step (the golden search alone gave 1e-5, the bisection alone 5e-7, both from one
+    side), at steps and offsets that put the point anywhere between rows."""
+    g = np.arange(-20 + offset, 110 - alpha, step)
+    s = ms.simulate(sarrus(alpha, leg_b=(1.0, 1.0)), {"A1": g})
+    assert s.assembled.all()
+    z = 2 * np.sin(np.radians(alpha + g))  # the top's height, from leg A's isosceles triangle
+    assert np.abs(s.point("A3")[:, 2] - z).max() < SING_POS
+    sing = [e for e in s.events if e["kind"] == "singular"]
+    assert len(sing) == 1 and abs(sing[0]["input"]["A1"] - (90 - alpha)) < 1e-6 * step
+    s = ms.simulate(sarrus(alpha, leg_b=(0.8, 1.0)), {"A1": g})
+    h = 2 * np.sin(np.radians(alpha + g))  # leg B reaches heights from 0.2 to 1.8
+    clear = np.minimum(np.abs(h - 0.2), np.abs(h - 1.8)) > 1e-9
+    assert np.array_equal(s.assembled[clear], ((h >= 0.2) & (h <= 1.8))[clear])
+    fold = np.degrees(np.arcsin(0.9)) - alpha
+    (lo, hi), = [r for r in s.working_ranges() if r[0] <= 0 <= r[1]]
+    assert abs(hi - fold) < 1e-6 * step
+    dead = [e for e in s.events if e["kind"] == "dead point" and e["index"] == np.argmax(g > fold)]
+    assert len(dead) == 1 and abs(dead[0]["input"]["A1"] - fold) < 1e-6 * step
 
 
 # --------------------------------------------------------------------------- 3. any size and place

@@ -594,14 +594,18 @@ def jacobian(M: SpatialModel, F: Frame) -> np.ndarray:
     (columns ``6 i .. 6 i + 5``)."""
     lay = M.lay
     B = F.xa.shape[0]
-    J = np.repeat(lay.J0[None], B, axis=0)
+    k = 6 * M.n
+    J = np.empty((B, lay.J0.shape[0], k))
+    J[:] = lay.J0[:, :k]
     c, nv = _scalar_coefficients(M, F)
     # d(x)/dω = -[x]x, the matrix of y -> y x x: ε_ijk x_k
     Sa = np.einsum("ijk,bnk->bnij", _EPS, F.xa)
     Sb = np.einsum("ijk,bnk->bnij", _EPS, F.xb)
-    J[:, lay.ri, lay.ci] = np.concatenate([Sa.reshape(B, -1), -Sb.reshape(B, -1), c.reshape(B, -1),
-                                           -c.reshape(B, -1), -nv.reshape(B, -1), nv.reshape(B, -1)], axis=1)
-    return J[:, :, :6 * M.n]
+    keep = lay.ci < k  # the frame's columns are not unknowns
+    J[:, lay.ri[keep], lay.ci[keep]] = np.concatenate(
+        [Sa.reshape(B, -1), -Sb.reshape(B, -1), c.reshape(B, -1), -c.reshape(B, -1), -nv.reshape(B, -1),
+         nv.reshape(B, -1)], axis=1)[:, keep]
+    return J
 
 
 def convective(M: SpatialModel, F: Frame, xi: np.ndarray) -> np.ndarray:

@@ -12,14 +12,17 @@ Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobia
 determinant). The pairs where it can change at all are few: by Weyl's inequality
 ``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
 the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
-of the two rows; only those pairs get an SVD. A sign change is bracketed and refined (below) and
+of the two rows; only those pairs are tested (:func:`_flips`: at full column or row rank by
+``det(J_kᵀ J_{k+1})`` or ``det(J_{k+1} J_kᵀ)``, of the same sign, else by an SVD). A sign change
+is bracketed and refined (below) and
 reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
 makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
-row's neighbours) are candidates too. Each candidate is refined by a golden-section search of
-``σ_r/σ_1`` over its bracket to ``REFINE`` of the step (a V about the crossing on either branch
-that meets there, so it does not matter which one Newton lands on that close to it; the sign of
-the determinant does, which is why it only brackets) and is a crossing where the least ratio is
-under the singular tolerance.
+row's neighbours) are candidates too. Each candidate is bracketed by a zoom of ``σ_r/σ_1``
+over its bracket to ``REFINE`` of the step (a V about the crossing on either branch that meets
+there, so it does not matter which one Newton lands on that close to it; the sign of the
+determinant does, which is why it only brackets), is a crossing where the least ratio is under
+the singular tolerance, and is located at the apex of the V fitted to its clean samples
+(:func:`_apex`).
 
 **Leaving a singular pose** (:func:`~mechsyn.kinematics.spatial_track.leave`). At a dead point of the input the mechanism moves like the square
 root of the input step, at a change point along either of two branches: the linear predictor
@@ -44,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, singular_tol, svd_ratio
+from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, polished_ratio, singular_tol
 
 __all__ = ["crossings", "REFINE"]
 
@@ -58,13 +61,20 @@ ZOOM = 17
 
 
 # --------------------------------------------------------------------------- crossings
-def _svd_bases(Jc: np.ndarray, r: int) -> tuple[np.ndarray, np.ndarray]:
-    U, _, Vt = np.linalg.svd(Jc, full_matrices=False)
-    return U[..., :r], Vt[..., :r, :]
-
-
-def _sign(Ub: np.ndarray, Vb: np.ndarray, Jc: np.ndarray) -> np.ndarray:
-    return np.sign(np.linalg.det(np.swapaxes(Ub, -1, -2) @ Jc @ np.swapaxes(Vb, -1, -2)))
+def _flips(Ja: np.ndarray, Jb: np.ndarray, r: int) -> np.ndarray:
+    """Whether ``det(U_aᵀ J_b V_a)`` is not positive, for pairs of Jacobians ``Ja``, ``Jb``
+    (B, m, k) of regular rank ``r`` at ``Ja`` (``U_a``, ``V_a``: its first ``r`` singular
+    vectors). At full column rank (``r = k``) ``det(J_aᵀ J_b) = det(Σ_a) det(U_aᵀ J_b V_a)``
+    (``det(V_a)² = 1``), at full row rank (``r = m``) ``det(J_b J_aᵀ)`` likewise: the same sign
+    without an SVD; otherwise the bases by an SVD."""
+    m, k = Ja.shape[1:]
+    if r == k:
+        return np.linalg.det(np.swapaxes(Ja, -1, -2) @ Jb) <= 0
+    if r == m:
+        return np.linalg.det(Jb @ np.swapaxes(Ja, -1, -2)) <= 0
+    Ua, _, Vat = np.linalg.svd(Ja, full_matrices=False)
+    Ua, Vat = Ua[..., :r], Vat[..., :r, :]
+    return np.linalg.det(np.swapaxes(Ua, -1, -2) @ Jb @ np.swapaxes(Vat, -1, -2)) <= 0
 
 
 def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
@@ -76,34 +86,31 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     r = tr.rank
     if not r or len(idx) < 2:
         return []
-    pos = {int(k): i for i, k in enumerate(idx)}
     same = (w.ok[:-1] & w.ok[1:]) & (w.how[:-1] == w.how[1:])
     ks = np.flatnonzero(same)
     if not len(ks):
         return []
-    a, b = np.array([pos[k] for k in ks]), np.array([pos[k + 1] for k in ks])
+    a = np.searchsorted(idx, ks)  # the positions of rows k and k + 1 in idx (its rows are w.ok's)
+    b = a + 1
     flat = Jc.reshape(len(Jc), -1)
     norm = np.sqrt(np.einsum("bi,bi->b", flat, flat))
     low = np.nan_to_num(ratio[idx]) * norm / np.sqrt(max(r, 1))  # lower bounds of σ_r
-    d = flat[b] - flat[a]
-    jump = np.sqrt(np.einsum("bi,bi->b", d, d))
+    d = np.diff(flat, axis=0)
+    jump = np.sqrt(np.einsum("bi,bi->b", d, d))[a]
     near = (low[a] <= 2 * jump) | (low[b] <= 2 * jump)
     tol = singular_tol(tr.M)
     near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
     out = []
     if near.any():
-        Ub, Vb = _svd_bases(Jc[a[near]], r)
-        flips = _sign(Ub, Vb, Jc[b[near]]) <= 0
-        for k, ub, vb in zip(ks[near][flips], Ub[flips], Vb[flips]):
-            found = _bisect(tr, w, U, int(k), ub, vb)
+        for k in ks[near][_flips(Jc[a[near]], Jc[b[near]], r)]:
+            found = _bisect(tr, w, U, int(k))
             if found is not None:
                 out.append(found)
     seen = {c[0] for c in out} | {c[0] + 1 for c in out}
     return out + _v_minima(tr, w, U, ratio, seen)
 
 
-def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int, ub: np.ndarray,
-            vb: np.ndarray) -> tuple[int, np.ndarray, float, int | None] | None:
+def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[int, np.ndarray, float, int | None] | None:
     """The crossing between rows ``k`` and ``k + 1`` (where ``det(U_kᵀ J V_k)`` changed
     sign): the least ``σ_r / σ_1`` between them (:func:`_golden`); None when it is not a
     rank drop (the sign changed by a frame effect)."""
@@ -119,22 +126,24 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set)
     """Rows whose ratio is a sharp local minimum (``r0 + r2 >= 4 r1``: every V passes)
     refined by a golden-section search; a crossing where it falls under the singular
     tolerance. Rows in ``seen`` (next to a crossing found by the determinant) are skipped."""
-    out = []
     tol = singular_tol(tr.M)
-    for k in range(1, len(U) - 1):
-        if not (w.ok[k - 1] and w.ok[k] and w.ok[k + 1]) or len({w.how[k - 1], w.how[k], w.how[k + 1]}) > 1:
-            continue
+    if len(U) < 3:
+        return []
+    ok, how = w.ok, w.how
+    same = ok[:-2] & ok[1:-1] & ok[2:] & (how[:-2] == how[1:-1]) & (how[1:-1] == how[2:])
+    r0, r1, r2 = ratio[:-2], ratio[1:-1], ratio[2:]
+    with np.errstate(invalid="ignore"):
+        vee = same & (r1 <= r0) & (r1 <= r2) & (r0 + r2 >= 4 * r1) & (r1 >= tol)
+    a, b = U[1:-1] - U[:-2], U[2:] - U[1:-1]
+    ab = np.einsum("ij,ij->i", a, b)
+    vee &= (ab > 0) & (np.abs(ab) >= (1 - 1e-9) * np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+    out = []  # (the last test: on one straight stretch of the sweep)
+    for k in np.flatnonzero(vee) + 1:
         if seen & {k - 1, k, k + 1}:
             continue
-        r0, r1, r2 = ratio[k - 1], ratio[k], ratio[k + 1]
-        if not (r1 <= r0 and r1 <= r2 and r0 + r2 >= 4 * r1 and r1 >= tol):
-            continue
-        a, b = U[k] - U[k - 1], U[k + 1] - U[k]
-        if a @ b <= 0 or abs(a @ b) < (1 - 1e-9) * np.linalg.norm(a) * np.linalg.norm(b):
-            continue  # not on one straight stretch of the sweep
         found = _golden(tr, w, U, [k - 1, k, k + 1])
         if found is not None and found[1] < tol:
-            out.append((k, found[0], found[1], None))
+            out.append((int(k), found[0], found[1], None))
     return out
 
 
@@ -153,7 +162,7 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
     states = {k: tr.state(*w.at(k), U[k][None]) for k in rows}
     lo, hi = U[rows[0]], U[rows[-1]]
     span = len(rows) - 1
-    tol, halvings = tr.tol, tr.halvings
+    tol = tr.tol
 
     def f(ts: np.ndarray) -> np.ndarray:
         out = np.full(len(ts), np.inf)
@@ -165,25 +174,50 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
             x1, x2 = _taylor(tr, st, u - U[k])
             z = np.zeros(len(sel), int)
             R, p = move(st.R[z], st.p[z], x1 + 0.5 * x2)
-            R, p, ok, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=40)
-            tr.tol = 0.0
-            R, p, _, _ = tr.correct(R, p, st.href[z], u, np.full(len(sel), np.inf), iters=POLISH)
-            tr.tol = tol
-            if ok.any():
-                good = np.flatnonzero(ok)
-                out[sel[good]] = svd_ratio(tr.state(R[good], p[good], st.href[z[good]], u[good]).lin.Jc, tr.rank)
+            out[sel] = polished_ratio(tr, R, p, st.href[z], u, polish=POLISH)
         return out
 
     a, b = 0.0, 1.0
     best_t, best = 0.5, np.inf
+    seen_t, seen_f = [], []
     while b - a > REFINE / span:
         ts = np.linspace(a, b, ZOOM)
         fs = f(ts)
+        seen_t.append(ts)
+        seen_f.append(fs)
         i = int(np.argmin(fs))
         if not np.isfinite(fs[i]):
             break
         best_t, best = ts[i], fs[i]
         h = (b - a) / (ZOOM - 1)
         a, b = max(0.0, ts[i] - h), min(1.0, ts[i] + h)
-    tr.halvings = halvings
-    return (lo + best_t * (hi - lo), float(best)) if np.isfinite(best) else None
+    if not np.isfinite(best):
+        return None
+    best_t = _apex(np.concatenate(seen_t), np.concatenate(seen_f), best_t, np.sqrt(tol))
+    return lo + best_t * (hi - lo), float(best)
+
+
+def _apex(t: np.ndarray, f: np.ndarray, t0: float, clean: float) -> float:
+    """The apex of the V ``f = |λ(t)|`` (``λ`` smooth with a simple root: a crossing) sampled
+    at ``t``, least at ``t0``: the root of ``λ`` fitted (a quadratic, a line through fewer than
+    five points) to the three samples a side nearest ``t0`` that are *clean*, ``f >= clean``,
+    negative on the left. Within ``δ`` of the crossing Newton's pose is off by about
+    ``ε / σ_r`` (``ε`` its residual, at rounding when polished), which moves ``σ_r`` by about
+    as much: relatively ``ε / σ_r²``, under ``1e-4`` where ``σ_r / σ_1 >= √tol``, so the clean
+    samples lie on the V to that accuracy while those nearer the apex are blurred (the least
+    sample alone is only within ``√ε`` of it). ``t0`` when there is no clean sample on a side,
+    or the root falls outside the nearest clean ones (a touch, not a simple crossing)."""
+    t, i = np.unique(t, return_index=True)
+    f = f[i]
+    good = np.isfinite(f) & (f >= clean)
+    left, right = np.flatnonzero(good & (t < t0)), np.flatnonzero(good & (t > t0))
+    left, right = left[np.argsort(t0 - t[left])[:3]], right[np.argsort(t[right] - t0)[:3]]
+    if not len(left) or not len(right) or len(left) + len(right) < 3:
+        return t0
+    x = np.concatenate([t[left], t[right]]) - t0
+    scale = np.abs(x).max()
+    c = np.polyfit(x / scale, np.concatenate([-f[left], f[right]]), 2 if len(x) >= 5 else 1)
+    roots = np.roots(c)
+    roots = roots.real[np.abs(roots.imag) <= 1e-12 * (1 + np.abs(roots.real))] * scale + t0
+    roots = roots[(roots > t[left].max()) & (roots < t[right].min())]
+    return float(roots[np.argmin(np.abs(roots - t0))]) if len(roots) else t0

@@ -112,7 +112,8 @@ class Lin:
         out = np.zeros(B)
         if k == self.r:
             with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-                out = 1.0 / np.sqrt(np.linalg.norm(self.G, axis=(1, 2)) * np.linalg.norm(self.Ginv, axis=(1, 2)))
+                out = 1.0 / np.sqrt(np.sqrt(np.einsum("bij,bij->b", self.G, self.G)
+                                            * np.einsum("bij,bij->b", self.Ginv, self.Ginv)))
             out = np.nan_to_num(out)
         exact = out < 1e-3
         if exact.any():
@@ -242,7 +243,7 @@ class Tracker:
         file measures from."""
         B, n = len(J), self.M.n
         C = rotate(R[:, :-1], self.c0) + p[:, :-1]
-        Jr = J.reshape(B, -1, n, 6).copy()
+        Jr = J.reshape(B, -1, n, 6)  # (J is :func:`jacobian`'s, fresh: changed in place)
         rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
         Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
         Jc = Jr.reshape(J.shape)
@@ -252,7 +253,8 @@ class Tracker:
         rows = J.shape[1] < J.shape[2]
         G = Jc @ Jc.transpose(0, 2, 1) if rows else Jc.transpose(0, 2, 1) @ Jc
         k = G.shape[1]
-        G[:, np.arange(k), np.arange(k)] += 1e-14 * np.abs(G).max(axis=(1, 2))[:, None] + 1e-300
+        diag = G[:, np.arange(k), np.arange(k)]  # (a Gram matrix's largest entry is on its diagonal)
+        G[:, np.arange(k), np.arange(k)] = diag + (1e-14 * diag.max(axis=1, initial=0.0)[:, None] + 1e-300)
         return Lin(Jc, G, rows, self.rank, C)
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
@@ -659,7 +661,8 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
 def limit(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
     """The input where the motion from ``st`` (at ``u0``, assembled) towards ``u1`` (not
     reached) stops: bisection on whether Newton from the nearest pose reached converges to
-    a true assembly (on either branch that meets there), to ``REFINE`` of the step."""
+    a true assembly (on either branch that meets there), to ``REFINE`` of the step, then the
+    fold itself from the poses before it (:func:`_fold`)."""
     lo, hi = 0.0, 1.0
     R, p, href = st.R, st.p, st.href
     inf = np.array([np.inf])
@@ -670,7 +673,56 @@ def limit(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
             R, p, lo = R1, p1, t
         else:
             hi = t
-    return u0 + lo * (u1 - u0)
+    return u0 + _fold(tr, (R, p, href), u0, u1, lo) * (u1 - u0)
+
+
+def _fold(tr: Tracker, pose: tuple, u0: np.ndarray, u1: np.ndarray, lo: float) -> float:
+    """The fold (turning point of the input) next to ``lo``, the last fraction of the step
+    from ``u0`` to ``u1`` where Newton converged (from the pose ``pose`` there). Near the
+    fold the branch turns back: the input is ``t* - c s²`` and ``σ_r/σ_1`` is ``a |s|`` in
+    a parameter ``s`` along it, so the input is a series ``t* + q2 ρ² + q3 ρ³`` in the ratio
+    ``ρ``; it is fitted to polished poses at ``lo - 4^j REFINE`` whose ratio is clean
+    (``>= √tol``, where Newton's blur is below ``1e-4`` of it: see
+    :func:`~mechsyn.kinematics.spatial_singular._apex`). Bisection alone stops early by up
+    to ``REFINE``, as Newton converges only linearly there. ``lo`` when the fit does not
+    land within ``4 REFINE`` past it."""
+    ts = lo - REFINE * 4.0 ** np.arange(1, 7)
+    ts = ts[ts > 0]
+    if len(ts) < 2:
+        return lo
+    B = len(ts)
+    z = np.zeros(B, int)
+    rho = polished_ratio(tr, pose[0][z], pose[1][z], pose[2][z], u0 + ts[:, None] * (u1 - u0))
+    clean = np.isfinite(rho) & (rho >= np.sqrt(tr.tol))
+    if clean.sum() < 2:
+        return lo
+    r = rho[clean]
+    A = np.stack([np.ones_like(r), r * r] + ([r ** 3] if clean.sum() > 2 else []), axis=1)
+    t_star = float(np.linalg.lstsq(A, ts[clean], rcond=None)[0][0])
+    return t_star if lo <= t_star <= lo + 4 * REFINE else lo
+
+
+def polished_ratio(tr: Tracker, R: np.ndarray, p: np.ndarray, href: np.ndarray, u: np.ndarray,
+                   iters: int = 40, polish: int = 8) -> np.ndarray:
+    """``σ_r / σ_1`` (B,) at the poses Newton reaches from ``R``, ``p`` at the inputs ``u``
+    (B, drives), inf where it does not converge: ``iters`` steps to the tolerance, then
+    ``polish`` more past it (next to a singular point Newton converges only linearly and
+    reaches a residual ε only within √ε of the pose, which blurs the ratio)."""
+    B = len(u)
+    inf = np.full(B, np.inf)
+    R, p, ok, _ = tr.correct(R, p, href, u, inf, iters=iters)
+    tol, halvings = tr.tol, tr.halvings
+    tr.tol = 0.0
+    try:
+        R, p, _, _ = tr.correct(R, p, href, u, inf, iters=polish)
+    finally:
+        tr.tol = tol
+        tr.halvings = halvings
+    out = np.full(B, np.inf)
+    if ok.any():
+        good = np.flatnonzero(ok)
+        out[good] = svd_ratio(tr.state(R[good], p[good], href[good], u[good]).lin.Jc, tr.rank)
+    return out
 
 
 def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
