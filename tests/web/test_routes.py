@@ -61,17 +61,15 @@ def test_simulate_is_the_motions_to_dict(client, fourbar):
 
 
 def test_simulate_route_is_the_cli_json(client, fourbar, tmp_path, cli_json):
-    """``mechsyn simulate --json`` over the studio's sweep prints the route's answer (both on
-    the NumPy pass, which a one-shot command takes: ``mechsyn.cli.main.ONE_SHOT``)."""
+    """``mechsyn simulate --json`` over the studio's sweep prints the route's answer (one
+    regular pass for both)."""
     import json
 
     from mechsyn.io import mechanism_to_dict
-    from mechsyn.kinematics import kernel
 
     six = mechanism_to_dict(load_mechanism(example_path("watt_sixbar")))
     for mech in (fourbar, six):
-        with kernel.use("numpy"):
-            d = client.post("/api/simulate", json={"mechanism": mech, "steps": 36}).json()
+        d = client.post("/api/simulate", json={"mechanism": mech, "steps": 36}).json()
         u = d["input"]["values"]
         path = tmp_path / "m.json"
         path.write_text(json.dumps(mech))
