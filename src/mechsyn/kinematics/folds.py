@@ -17,8 +17,8 @@ import math
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.groups import Plan, _cons_of, _local, _memo, _topology, circle_circle, normalised_disc
-from mechsyn.kinematics.positions import _State, _solve_step
+from mechsyn.kinematics.groups import Plan, circle_circle, cons_of, geometry_memo, local_point, normalised_disc
+from mechsyn.kinematics.positions import PoseState, solve_step
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -52,10 +52,10 @@ def _swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | N
 def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
     """Normalised discriminant of step ``k`` at the inputs ``X`` (M, n_inputs), upstream
     steps solved with their modes of the sweep rows ``rows`` (M,)."""
-    st = _State(S, X.shape[0])
+    st = PoseState(S, X.shape[0])
     for j in range(k):
         s = sigmas[j]
-        _solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
+        solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
     out = []
 
     def capture(disc: np.ndarray, s_file: float) -> float:
@@ -63,14 +63,14 @@ def _disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray
         return 1.0
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        _solve_step(S, st, plan.steps[k], X, capture)
+        solve_step(S, st, plan.steps[k], X, capture)
     return out[0]
 
 
 def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
     """A driver-R + RRR chain as plain numbers for :func:`_scalar_disc` (built once per
     system and plan)."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("scalar", id(plan))
     prog = memo.get(key)
     if prog is not None:
@@ -81,15 +81,15 @@ def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
     for step in plan.steps:
         if step.kind == "drive_R":
             (new,), (k,), (jid,) = step.links, step.known, step.joints
-            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
-            prog.append(("drive", new, k, tuple(_local(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
-                         tuple(_local(S, new, jid))))
+            con = next(c for c in cons_of(S, jid) if c.role == "drive")
+            prog.append(("drive", new, k, tuple(local_point(S, k, jid)), con.driver, 1.0 if con.b == new else -1.0,
+                         tuple(local_point(S, new, jid))))
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        s1, s2 = local_point(S, b1, J1), local_point(S, b1, J2)
+        t2, t3 = local_point(S, b2, J2), local_point(S, b2, J3)
         L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
-        prog.append(("RRR", (k1, tuple(_local(S, k1, J1))), (k3, tuple(_local(S, k3, J3))), (b1, b2),
+        prog.append(("RRR", (k1, tuple(local_point(S, k1, J1))), (k3, tuple(local_point(S, k3, J3))), (b1, b2),
                      L1s, L2s, tuple(s1), tuple(t3), tuple((s2 - s1) / L1s), tuple((t2 - t3) / L2s)))
     memo[key] = prog
     return prog
@@ -98,7 +98,7 @@ def _scalar_program(S: PlanarSystem, plan: Plan) -> list:
 def _scalar_disc(prog: list, k: int, sigmas: list, u: np.ndarray) -> float:
     """Normalised discriminant ``h^2 / L1^2`` of RRR step ``k`` of a driver-R + RRR chain
     at one input ``u``, the upstream groups in the modes ``sigmas`` (floats): the
-    formulas of :func:`_solve_step` in plain floats (a root search calls it a few times
+    formulas of :func:`solve_step` in plain floats (a root search calls it a few times
     per event; an array pass would cost a hundred times more per call)."""
     pose: dict[int, tuple] = {}  # link -> (anchor x, y, local x, y, cos, sin)
 
@@ -280,7 +280,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    program = _memo(S).get(("kernel", id(plan)))  # the compiled pass's program: the whole scan compiled
+    program = geometry_memo(S).get(("kernel", id(plan)))  # the compiled pass's program: the whole scan compiled
     if program is not None and program[0] is plan and kernel.active():
         X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
         return _compiled_fold_events(S, plan, program[1], [discs[k] for k in ks] if block is None else block, ks,
@@ -323,8 +323,8 @@ def _compiled_fold_events(S: PlanarSystem, plan: Plan, program: tuple, discs: li
                           b: int, X: np.ndarray, paths: list) -> list | None:
     """:func:`pass_fold_events` after a compiled pass (``program``: its arrays, ``X``: its
     input rows): the scan compiled (:func:`mechsyn.kinematics.kernel.fold_scan`)."""
-    steps, names, messages = _topology(S, plan, "fold scan", lambda: _fold_words(plan, ks))
-    memo = _memo(S)
+    steps, names, messages = S.topology.product("fold scan", lambda: _fold_words(plan, ks), plan)
+    memo = geometry_memo(S)
     specs = memo.get(("four-bar folds", id(plan)))  # this geometry's closed-form fold numbers per group
     if specs is None or specs[0] is not plan:
         specs = memo[("four-bar folds", id(plan))] = (plan, np.array([_four_bar_numbers(_four_bar_spec(S, plan, k))
@@ -431,12 +431,12 @@ def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     topology's (:func:`_four_bar_form`); the numbers are read off the regular pass's
     program when the system has one (the numbers of :func:`_scalar_program`, which is
     read off it), else off :func:`_scalar_program`."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("four-bar fold", id(plan), k)
     if key in memo:
         return memo[key]
     out = None
-    form = _topology(S, plan, ("four-bar form", k), lambda: _four_bar_form(S, plan, k))
+    form = S.topology.product(("four-bar form", k), lambda: _four_bar_form(S, plan, k), plan)
     if form is not None:
         c, on_frame, crank = form
         regular = memo.get(("regular", id(plan)))

@@ -37,7 +37,7 @@ import numpy as np
 
 from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import _chain_program, _drive_links, _link_angles
-from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology, circle_circle, normalised_disc
+from mechsyn.kinematics.groups import DriveOp, Plan, circle_circle, geometry_memo, local_point, normalised_disc
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.folds import pass_fold_events
@@ -56,17 +56,17 @@ def _program(S: PlanarSystem, plan: Plan) -> tuple:
     With the kernel, the same numbers are written once more as the compiled pass's
     arrays (:func:`~mechsyn.kinematics.kernel.program_arrays`' ``fp`` and ``anc_s``, kept
     under ``("kernel", id(plan))``) while they are filled in, not read back off the steps."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
     rows: list | None = [] if kernel.active() else None
-    out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)), rows)
+    out = _filled(S, S.topology.product("regular", lambda: _shape(S, plan), plan), rows)
     memo[key] = (plan, out)
     if rows is not None:  # (the integers of the kernel's program are the topology's)
         steps, anchor, origin = out
-        shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
+        shape = S.topology.product("kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0], plan)
         rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
         flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
         memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
@@ -96,7 +96,7 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     anchors = {i: (jid, at(i, jid)) for i, (jid, _) in anchor.items()}
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
-        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)
+        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
         origin.append(j0)
     index = {j.id: k for k, j in enumerate(S.mech.joints)}
     drawn = [(index[st[3][0]], index[st[3][1]], index[st[3][2]]) if st[0] == "RRR" else None for st in steps]
@@ -299,11 +299,11 @@ def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray,
     steps, anchor, origin = _program(S, plan)
     if not kernel.active():
         return _run(steps, anchor, np.concatenate(X) if isinstance(X, list) else X, speeds, folds)
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("kernel", id(plan))
     prog = memo.get(key)
     if prog is None or prog[0] is not plan:
-        shape = _topology(S, plan, "kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0])
+        shape = S.topology.product("kernel", lambda: kernel.program_arrays(steps, anchor, origin)[0], plan)
         prog = memo[key] = (plan, kernel.program_arrays(steps, anchor, origin, shape))
     C, W, AL, D, near, Z = kernel.run(prog[1], X, speeds, REGULAR_DISC,
                                       planes=(X[0] if isinstance(X, list) else X).shape[0])
@@ -319,8 +319,8 @@ def _compiled_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled",
     assembled (N,), the rows with rates and the number of singular rows (through folds;
     ``parts``: the fold scan's singular rows, blanked too). Which links frame drivers
     turn is kept with the topology."""
-    dcol, dsgn, runs = _topology(S, plan, "kernel-angles", lambda: _drive_arrays(S, plan))
-    memo = _memo(S)
+    dcol, dsgn, runs = S.topology.product("kernel-angles", lambda: _drive_arrays(S, plan), plan)
+    memo = geometry_memo(S)
     ref = memo.get("drawn angles")
     if ref is None:  # the drawn angles: this geometry's
         ref = memo["drawn angles"] = np.ascontiguousarray(S.q0[2::3])
@@ -417,7 +417,7 @@ def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
     the first rows' bytes (a drag or a design loop sweeps the same grid again)."""
     firsts = [U[0]] if split is None else [U[split], U[split - 1]]
     key = (split, *[f.tobytes() for f in firsts])
-    memo = _memo(S)
+    memo = geometry_memo(S)
     hit = memo.get("tracking paths")
     if hit is not None and hit[0] == key:
         return hit[1]
@@ -433,7 +433,7 @@ def _scalar_memo(S: PlanarSystem, plan: Plan, steps: list, cx: dict) -> None:
     program (the same local points, squared lengths and rotation vectors, so the same
     numbers) instead of building it again from the groups; made when first read (the
     compiled fold search and the closed-form four-bar folds do not read it)."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("scalar", id(plan))
     if key not in memo:
         memo[key] = functools.partial(_scalar_of_regular, steps, cx)
