@@ -477,12 +477,12 @@ def test_drawn_row_of_each_fresh_geometry_on_one_grid():
     kp = compile_plan(m, inputs=("A",))
     U = np.radians(np.arange(-180.0, 541.0, 2.5))[:, None]
     rng = np.random.default_rng(4)
-    engines._DRAWN.clear()
+    engines.CACHE.clear()
     for _ in range(12):
         S = kp.refilled(m.with_joint_points({"B": m.joint("B").point + rng.uniform(-0.3, 0.3, 2)})).system
         want = engines._drawn_row_1(S.drivers[0], U[:, 0].copy())
         assert engines.drawn_row(S, U) == want and engines.drawn_row(S, U.copy()) == want
-    assert len(engines._DRAWN) == 1 and len(next(iter(engines._DRAWN.values()))[2]) == 12
+    assert len(engines.CACHE.get(("input grid", U.shape, U.dtype.str))[2]) == 12
 
 
 def test_fields_replaced_is_dataclasses_replace():

@@ -30,7 +30,7 @@ from mechsyn.kinematics.solve import assemble, drawn_checks, require_drives_give
 from mechsyn.kinematics.simulation import (LinkMotion, Motion, PointMotion, Simulation,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep, by_row
-from mechsyn.kinematics.refill import point_xy, with_geometry
+from mechsyn.kinematics.refill import joint_points, point_xy, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system, frame_points, points_state_array
 from mechsyn.kinematics.topology import CACHE, Topology, topology_of
 from mechsyn.model.mechanism import Mechanism, fields_replaced
@@ -99,8 +99,8 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
     """:func:`compile_plan`, reusing the plan compiled for the same mechanism object with
     the same geometry and options (a moved joint point or a new VLL mode compiles anew),
     kept in the kinematics' one cache (:data:`~mechsyn.kinematics.topology.CACHE`) under
-    the mechanism's :class:`~mechsyn.kinematics.topology.Topology` and its geometry's
-    numbers.
+    the mechanism's identity (a frozen mechanism: its topology too), the options and its
+    geometry's numbers, never under its topology alone.
 
     Examples
     --------
@@ -110,11 +110,10 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
     True
     """
     prescribed = _prescribed(mech, vll, inputs)
-    T = topology_of(mech, vll, prescribed)
-    key = (T, "plan", id(mech), _geometry_key(mech))
+    key = ("plan", id(mech), tuple(sorted(vll.items())) if vll else (), prescribed, _geometry_key(mech))
     kp = CACHE.get(key)
     if kp is None or kp.mechanism is not mech:  # (an id of a mechanism gone, reused)
-        kp = _compiled(mech, vll, prescribed, T)
+        kp = _compiled(mech, vll, prescribed)
         CACHE.put(key, kp)
     return kp
 
@@ -206,12 +205,11 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
     return _compiled(mech, vll, tuple(j for j in inputs if _is_passive(mech, j, vll)))
 
 
-def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple,
-              T: Topology | None = None) -> KinematicPlan:
+def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> KinematicPlan:
     """:func:`compile_plan` with the prescribed inputs found: the template of the
     mechanism's topology (a plan of it whose numbers are replaced, never an answer)
     refilled with its numbers, or built and kept as the template."""
-    T = topology_of(mech, vll, prescribed) if T is None else T
+    T = topology_of(mech, vll, prescribed)
     template = CACHE.get((T, "template"))
     if template is not None:  # (a point or a P axis missing: refilled builds it anew, and reports it)
         return template.refilled(mech)
@@ -472,8 +470,8 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     if hit is None:
         rows, li, moving, idx, where = S.topology.product(key, lambda: _named_shape(S, mech, names))
         joints, points = mech.joints, mech.points
-        pts = S.cache.get("joint_points")  # a refilled system's: its joints' then its named points' floats
-        if pts is not None and len(pts) == len(joints) + len(points):
+        pts = joint_points(S)  # a refilled system's: its joints' then its named points' floats
+        if len(pts) == len(joints) + len(points):
             xy = [pts[k] for _, _, k in where]
         else:
             xy = [point_xy(points[name].at if j < 0 else joints[j].point) for name, j, _ in where]

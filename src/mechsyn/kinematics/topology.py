@@ -14,7 +14,7 @@ layout, the shape of the inputs and named points) is built once per topology and
 the one cache of the kinematics package, :data:`CACHE`: a bounded LRU keyed by the
 :class:`Topology` (with the name of the product and, where it depends on a decomposition,
 that decomposition). A geometry-dependent answer is never kept under a topology alone:
-the compiled plans are kept under the topology *and* the geometry's numbers
+the compiled plans are kept under the mechanism and its geometry's numbers
 (:func:`mechsyn.kinematics.analysis.cached_plan`), a decomposition under the topology and
 which of its joints coincide (the only geometry it depends on).
 
@@ -154,10 +154,14 @@ class LRUCache:
         return len(self._data)
 
 
-#: The kinematics package's one cache: what a topology decides (:meth:`Topology.product`)
-#: and the compiled plans of the last mechanisms simulated
-#: (:func:`~mechsyn.kinematics.analysis.cached_plan`), every key starting with a
-#: :class:`Topology`; at most 256 entries (a few topologies' programs and plans).
+#: The kinematics package's one cache, at most 256 entries: what a topology decides, under
+#: ``(Topology, name[, id(plan)])`` (:meth:`Topology.product`: the engines' programs, the
+#: refill layout, the decompositions, the template a new geometry is refilled from); the
+#: compiled plans of the last mechanisms simulated, under ``("plan", id(mechanism),
+#: VLL modes, prescribed inputs, the geometry's numbers)``
+#: (:func:`~mechsyn.kinematics.analysis.cached_plan`); the input grids of the last sweeps,
+#: under ``("input grid", shape, dtype)`` (:func:`~mechsyn.kinematics.engines.drawn_row`).
+#: A geometry-dependent answer is never kept under a topology alone.
 CACHE = LRUCache(256)
 
 
