@@ -100,3 +100,21 @@ def test_topology_pickles_and_repr():
     assert pickle.loads(pickle.dumps(T)) == T
     assert isinstance(T, Topology) and repr(T).startswith("Topology(3 moving links")
     assert CACHE.maxsize == 256
+
+
+def test_a_studio_drag_reuses_the_topology(monkeypatch):
+    """The studio's simulate of a dragged mechanism (parsed anew from the page's dict at
+    each step) builds no constraint system and nothing of the topology again: its plan is
+    refilled from what the topology keeps, and the cache gains only entries keyed by the
+    new numbers."""
+    from kinematics_helpers import fourbar_dict
+    from mechsyn.web import _service
+
+    _service.simulate(fourbar_dict(g=4.0), steps=36)  # the first step: the topology is built
+    puts, built = [], []
+    put = CACHE.put
+    monkeypatch.setattr(CACHE, "put", lambda key, value: (puts.append(key), put(key, value))[1])
+    monkeypatch.setattr(analysis, "build_system", lambda *a, **k: built.append(a) or build_system(*a, **k))
+    out = [_service.simulate(fourbar_dict(g=g), steps=36) for g in (4.05, 4.1, 4.15)]
+    assert not built and puts and all(not isinstance(k[0], Topology) for k in puts)
+    assert all(o["points"] != out[0]["points"] for o in out[1:])  # each step its own numbers
