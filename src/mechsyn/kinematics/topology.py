@@ -58,9 +58,9 @@ def topology_key(mech: Mechanism, vll: dict[str, str] | None = None, prescribed:
     """
     joints = tuple([(j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "")
                     for j in mech.joints])
-    named = tuple([(k, p.link) for k, p in mech.points.items()])
-    return (mech.kind, mech.ground, mech.link_names, joints, named, tuple(sorted(vll.items())) if vll else (),
-            tuple(prescribed))
+    named = tuple([(k, p.link) for k, p in mech.points.items()]) if mech.points else ()
+    return (mech.kind, mech.ground, tuple([link.name for link in mech.links]), joints, named,
+            tuple(sorted(vll.items())) if vll else (), tuple(prescribed))
 
 
 class Topology:
