@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import zlib
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -18,7 +18,7 @@ from mechsyn.kinematics import analysis
 from mechsyn.kinematics import kernel, refill
 from mechsyn.kinematics.analysis import compile_plan, simulate
 from mechsyn.kinematics.solve import assemble, drawn_checks, singular_configuration
-from mechsyn.kinematics.refill import topology_key
+from mechsyn.kinematics.topology import CACHE, LRUCache, topology_key, topology_of
 from mechsyn.kinematics.system import Con, build_system, frame_points
 from mechsyn.model.mechanism import Mechanism, PointSpec, fields_replaced
 
@@ -55,7 +55,7 @@ def _run(m: Mechanism, inputs: dict) -> tuple:
 def _slow(m: Mechanism, inputs: dict, monkeypatch: pytest.MonkeyPatch) -> tuple:
     """The general path: no template, the rank machinery for the drawn checks."""
     with monkeypatch.context() as mp:
-        mp.setattr(analysis, "_TOPOLOGIES", type(analysis._TOPOLOGIES)())
+        mp.setattr(analysis, "CACHE", LRUCache(CACHE.maxsize))
         mp.setattr(analysis, "drawn_checks", lambda S, plan: False)
         return _run(m, inputs)
 
@@ -63,7 +63,7 @@ def _slow(m: Mechanism, inputs: dict, monkeypatch: pytest.MonkeyPatch) -> tuple:
 def _fast(template: Mechanism, m: Mechanism, inputs: dict, monkeypatch: pytest.MonkeyPatch) -> tuple:
     """``m`` simulated from the template compiled for ``template`` (same topology)."""
     with monkeypatch.context() as mp:
-        mp.setattr(analysis, "_TOPOLOGIES", type(analysis._TOPOLOGIES)())
+        mp.setattr(analysis, "CACHE", LRUCache(CACHE.maxsize))
         try:
             compile_plan(template, inputs=tuple(inputs))
         except MechsynInputError:
@@ -315,7 +315,7 @@ def test_drawn_checks_fire_on_each_fresh_geometry_of_one_topology():
              ("regular again", m.with_joint_points({"C": C + [-0.02, 0.01]}), True, False)]
     for label, moved, settled, singular in cases:
         new = kp.refilled(moved)
-        assert new.groups is kp.groups and new.system.cache["programs"] is kp.system.cache["programs"], label
+        assert new.groups is kp.groups and new.topology is kp.topology, label
         assert drawn_checks(new.system, new.groups) is settled, label
         fresh = build_system(moved)
         if settled:
@@ -450,24 +450,22 @@ def test_a_drag_that_changes_the_size_makes_no_scales(name, joint):
         _same_numbers(s.col_scale, ref.col_scale)
 
 
-def test_topology_memo_goes_only_to_mechanisms_of_the_same_topology():
-    """What a mechanism's topology decides is shared with the mechanisms
-    with_joint_points makes of it (numbers only), and with no other: fields_replaced and
-    dataclasses.replace start without it, so a changed topology gets its own key."""
-    from mechsyn.model.mechanism import topology_memo
-
+def test_topology_is_shared_only_by_mechanisms_of_the_same_topology():
+    """Mechanisms with_joint_points makes of one (numbers only) have its Topology (equal,
+    the same hash, one entry of the cache); a P pair for an R pair or a renamed link is
+    another topology, and the frozen mechanism keeps nothing of it in its fields."""
     m = fourbar()
-    key = topology_key(m)
+    T = topology_of(m)
     moved = m.with_joint_points({"C": m.joint("C").point + [0.05, 0.0]})
-    assert topology_memo(moved) is topology_memo(m) and topology_key(moved) == key
+    assert topology_of(moved) == T and hash(topology_of(moved)) == hash(T) and topology_key(moved) == T.key
+    assert set(moved.__dict__) == set(m.__dict__) == {f.name for f in fields(m)}
     slider = fields_replaced(m, joints=tuple(replace(j, type="P", axis=np.array([1.0, 0.0])) if j.id == "C" else j
                                             for j in m.joints))
     renamed = replace(m, links=m.links[:-1] + (replace(m.links[-1], name="arm"),),
                       joints=tuple(replace(j, links=tuple("arm" if x == m.links[-1].name else x for x in j.links))
                                    for j in m.joints))
     for other in (slider, renamed):
-        assert "_topology_memo" not in other.__dict__
-        assert topology_key(other) != key and topology_memo(other) is not topology_memo(m)
+        assert topology_of(other) != T and topology_key(other) != T.key
 
 
 def test_drawn_row_of_each_fresh_geometry_on_one_grid():
@@ -479,12 +477,12 @@ def test_drawn_row_of_each_fresh_geometry_on_one_grid():
     kp = compile_plan(m, inputs=("A",))
     U = np.radians(np.arange(-180.0, 541.0, 2.5))[:, None]
     rng = np.random.default_rng(4)
-    engines._DRAWN.clear()
+    engines.CACHE.clear()
     for _ in range(12):
         S = kp.refilled(m.with_joint_points({"B": m.joint("B").point + rng.uniform(-0.3, 0.3, 2)})).system
         want = engines._drawn_row_1(S.drivers[0], U[:, 0].copy())
         assert engines.drawn_row(S, U) == want and engines.drawn_row(S, U.copy()) == want
-    assert len(engines._DRAWN) == 1 and len(next(iter(engines._DRAWN.values()))[2]) == 12
+    assert len(engines.CACHE.get(("input grid", U.shape, U.dtype.str))[2]) == 12
 
 
 def test_fields_replaced_is_dataclasses_replace():
@@ -580,7 +578,7 @@ def test_kernel_program_written_with_the_numbers_is_program_arrays():
     bit for bit; with the kernel on, the program the pass finds kept (``fp`` and the
     anchors' local points) is that one."""
     from mechsyn.kinematics import kernel
-    from mechsyn.kinematics.groups import _memo, _topology
+    from mechsyn.kinematics.groups import geometry_memo
 
     rng = np.random.default_rng(11)
     compared = 0
@@ -593,11 +591,11 @@ def test_kernel_program_written_with_the_numbers_is_program_arrays():
             continue
         S, plan = new.system, new.groups
         rows: list = []
-        out = kernel._filled(S, _topology(S, plan, "regular", lambda: kernel._shape(S, plan)), rows)
+        out = kernel._filled(S, S.topology.product("regular", lambda: kernel._shape(S, plan), plan), rows)
         _, fp, anc_s = kernel.program_arrays(*out)
         assert np.array_equal(np.array(rows, complex).reshape(fp.shape), fp), name
         kernel.chain_steps(S, plan)
-        kept = _memo(S)[("kernel", id(plan))][1]
+        kept = geometry_memo(S)[("kernel", id(plan))][1]
         assert all(np.array_equal(a, b) for a, b in zip(kept[1:], (fp, anc_s))), name
         assert kept[1].flags.c_contiguous and kept[2].flags.c_contiguous
         compared += 1

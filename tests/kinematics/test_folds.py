@@ -60,7 +60,7 @@ def test_gap_angles_wrapped_as_np_remainder_wraps_them():
     a turn: the same numbers, bit for bit, as the wrap of the copying path, on atan2
     angles including the edges (+-pi, +-0, the neighbours of pi) and NaN gaps; drawn
     angles beyond half a turn take ``np.remainder`` itself."""
-    from mechsyn.kinematics.positions import _continuous_angles
+    from mechsyn.kinematics.positions import continuous_angles
 
     rng = np.random.default_rng(7)
     edges = np.array([math.pi, -math.pi, 0.0, -0.0, np.nextafter(math.pi, 0), np.nextafter(-math.pi, 0), 1e-300])
@@ -74,8 +74,8 @@ def test_gap_angles_wrapped_as_np_remainder_wraps_them():
         phi[:, ~ok] = np.where(rng.random((m, 1)) < 0.5, np.nan, phi[:, ~ok])  # upstream links stay finite
         ref = rng.choice(np.concatenate([rng.uniform(-math.pi, math.pi, 4), edges,
                                          [4.0, -7.0] if trial % 3 == 0 else []]), (m, 1))
-        want = _continuous_angles(phi.T.copy(), ref[:, 0], ok).T  # the copying path (np.remainder)
-        got = _continuous_angles(phi.copy(), ref, ok, fresh=True)
+        want = continuous_angles(phi.T.copy(), ref[:, 0], ok).T  # the copying path (np.remainder)
+        got = continuous_angles(phi.copy(), ref, ok, fresh=True)
         runs = np.flatnonzero(ok)
         assert np.array_equal(got[:, runs].view(np.int64), want[:, runs].view(np.int64)), trial
 

@@ -157,16 +157,18 @@ def test_scalar_discriminant_equals_the_array_pass(ex):
             assert np.allclose(got, ref, atol=1e-12, equal_nan=True), (f, k)
 
 
-def test_cached_plans_do_not_keep_mechanisms_alive(ex):
+def test_cached_plans_do_not_keep_mechanisms_alive(ex, monkeypatch):
     import gc
     import weakref
 
     from mechsyn.kinematics import analysis
+    from mechsyn.kinematics.topology import LRUCache
 
+    monkeypatch.setattr(analysis, "CACHE", LRUCache(8))
     m = ex("kinematics/crank_rocker.yaml")
-    simulate(m, {"A": input_grid(0, 90, 30)})
+    simulate(m, {"A": input_grid(0, 90, 30)})  # (the first of its topology: the template is a copy)
     ref = weakref.ref(m)
-    for _ in range(analysis._PLANS_MAX):  # later mechanisms push it out of the bounded cache
+    for _ in range(analysis.CACHE.maxsize):  # later mechanisms push it out of the bounded cache
         simulate(ex("kinematics/crank_rocker.yaml"), {"A": input_grid(0, 90, 30)})
     del m
     gc.collect()
@@ -237,7 +239,7 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     vectors, anchors)."""
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.chain import _chain_program_
-    from mechsyn.kinematics.groups import DriveOp, _local
+    from mechsyn.kinematics.groups import DriveOp, local_point
     from mechsyn.kinematics.kernel import chain_steps as _program
 
     m = ex(f)
@@ -247,19 +249,19 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     pts = {k: np.asarray(m.joint(k).point, float) + np.asarray(v) for k, v in moved.items()}
     kp2 = compile_plan(m.with_joint_points(pts), inputs=(j,))
     S = kp2.system
-    assert S.cache["programs"] is kp.system.cache["programs"]  # shared by the topology
+    assert S.topology == kp.system.topology  # what the topology decides: kept by it
     steps, cx, origin = _program(S, kp2.groups)
     prog, anchor = _chain_program_(S, kp2.groups)
     want = []
     for op in prog:
         if isinstance(op, DriveOp):
             want.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
-                          complex(*_local(S, op.known, op.joint))))
+                          complex(*local_point(S, op.known, op.joint))))
         else:
             (k1, k3), (J1, _, J3) = op.known, op.joints
             want.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
                          complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
-                         complex(*_local(S, k1, J1)), complex(*_local(S, k3, J3))))
+                         complex(*local_point(S, k1, J1)), complex(*local_point(S, k3, J3))))
     assert steps == want
     assert cx == {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
     assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
@@ -273,13 +275,13 @@ def test_four_bar_fold_spec_of_a_refilled_geometry_equals_a_fresh_plans(ex, f, j
     mechanism, group by group (None where the group closes no four-bar)."""
     from mechsyn.kinematics import folds
     from mechsyn.kinematics.analysis import cached_plan
-    from mechsyn.kinematics.groups import _memo
+    from mechsyn.kinematics.groups import geometry_memo
 
     m = ex(f)
     m = m.with_joint_points({joint: np.asarray(m.joint(joint).point, float) + 0.01})
     kp = cached_plan(m, inputs=("A",))
     simulate(m, {"A": input_grid(0, 360, 2)})  # the regular program kept with the system
-    memo = _memo(kp.system)
+    memo = geometry_memo(kp.system)
     assert memo[("regular", id(kp.groups))][0] is kp.groups
     ks = [k for k, s in enumerate(kp.groups.steps) if s.kind == "RRR"]
     for k in ks:

@@ -64,12 +64,13 @@ def test_drawn_row_remembered_equals_the_row_computed(ex, f, j):
     for g in grids:
         U = np.radians(g)[:, None]
         want = None if len(U) < 2 else engines._drawn_row_1(S.drivers[0], U[:, 0].copy())
-        engines._DRAWN.clear()
+        engines.CACHE.clear()
         assert engines.drawn_row(S, U) == want  # computed
         assert engines.drawn_row(S, U.copy()) == want  # remembered
     big = np.radians(input_grid(-180, 540, 0.005))[:, None]  # over 64 KiB: computed, not kept
-    engines._DRAWN.clear()
-    assert engines.drawn_row(S, big) == engines._drawn_row_1(S.drivers[0], big[:, 0].copy()) and not engines._DRAWN
+    engines.CACHE.clear()
+    assert engines.drawn_row(S, big) == engines._drawn_row_1(S.drivers[0], big[:, 0].copy())
+    assert engines.CACHE.get(("input grid", big.shape, big.dtype.str)) is None
     other = cached_plan(ex("textbook/stephenson_sixbar.yaml"), inputs=("A",)).system
     U = np.radians(u0 + input_grid(-30, 30, 0.5))[:, None]
     assert engines.drawn_row(S, U) is not None

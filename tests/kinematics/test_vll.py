@@ -107,7 +107,7 @@ def test_limits_are_each_mechanisms_own_within_one_topology(ex):
     compiled from the first's plan) with other limits each check their own."""
     from dataclasses import replace
 
-    from mechsyn.kinematics.refill import topology_key
+    from mechsyn.kinematics.topology import topology_key
 
     m = ex("fingers/two_phalanx_vll_000.yaml")
     inputs = {"E": np.zeros(3), "S": np.array([25.0, 27.0, 33.0])}

@@ -199,7 +199,7 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
     its sign) takes the input itself; the others ``atan2`` of their rotation, made
     continuous (``A``: the rotations' ``atan2``, links by rows, from NumPy, whose vector
     loops take a third of libm's time) and started next to their drawn angle ``ref[i]``
-    (:func:`mechsyn.kinematics.positions._continuous_angles`): without ``folds`` one
+    (:func:`mechsyn.kinematics.positions.continuous_angles`): without ``folds`` one
     unwrapped run whose rows ``split`` and ``split - 1`` (when ``split`` >= 0) each start
     next to ``ref``; with ``folds`` each tracked sweep (forwards from ``split``, backwards
     from ``split - 1``, or the one sweep) on its own, its runs of assembled rows unwrapped

@@ -15,8 +15,6 @@ P inputs and lengths in the file's length unit.
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,14 +25,15 @@ from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.engines import (ENGINES, PLANAR_ENGINES, SPATIAL_ENGINE, engine_named,  # noqa: F401
                                         first_sweep)
 from mechsyn.kinematics.forces import Reactions, kinetostatics
-from mechsyn.kinematics.groups import Plan, _topology, decompose
+from mechsyn.kinematics.groups import Plan, decompose
 from mechsyn.kinematics.solve import assemble, drawn_checks, require_drives_given, singular_configuration
 from mechsyn.kinematics.simulation import (LinkMotion, Motion, PointMotion, Simulation,  # noqa: F401
                                           input_grid, resolve_points)
 from mechsyn.kinematics.sweep import Event, Sweep, by_row
-from mechsyn.kinematics.refill import _xy, topology_key, with_geometry
-from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, _points_state, build_system, frame_points
-from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
+from mechsyn.kinematics.refill import joint_points, point_xy, with_geometry
+from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system, frame_points, points_state_array
+from mechsyn.kinematics.topology import CACHE, Topology, topology_of
+from mechsyn.model.mechanism import Mechanism, fields_replaced
 
 __all__ = ["ENGINES", "Motion", "Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan",
@@ -77,23 +76,10 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
                           change_points)  # KinematicPlan.simulate without its call
 
 
-#: Compiled plans of the last few mechanisms simulated (a plan holds its mechanism, so a
-#: weak mapping would keep every mechanism alive: the cache is bounded instead), by the
-#: mechanism's identity and then by the geometry and options they were compiled for.
-_PLANS: "OrderedDict[int, tuple[Mechanism, dict]]" = OrderedDict()
-_PLANS_LOCK = threading.Lock()
-_PLANS_MAX = 8
-#: A compiled plan of each of the last topologies simulated
-#: (:func:`~mechsyn.kinematics.refill.topology_key`): a mechanism of the same topology
-#: with other numbers (a drag, a design loop) has its system refilled from it.
-_TOPOLOGIES: "OrderedDict[tuple, KinematicPlan]" = OrderedDict()
-_TOPOLOGIES_MAX = 32
-
-
-def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> tuple:
-    """What a compiled plan depends on besides the (frozen) topology: the joint points and
-    axes, joint attributes (cam profiles, belts), named points, VLL modes, prescribed
-    inputs. The arrays are mutable, so their bytes are part of the key."""
+def _geometry_key(mech: Mechanism) -> tuple:
+    """What a compiled plan depends on besides its topology: the joint points and axes,
+    joint attributes (cam profiles, belts) and named points. The arrays are mutable, so
+    their bytes are part of the key."""
     def arr(a: Any) -> bytes | None:  # the bytes of the float64 array (a native one read as it is)
         if a.__class__ is np.ndarray and a.dtype is _F64:
             return a.tobytes()
@@ -103,7 +89,7 @@ def _geometry_key(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple
     joints = tuple([(p.tobytes() if (p := j.point).__class__ is nd and p.dtype is _F64 else arr(p),
                      None if j.axis is None else arr(j.axis), repr(j.attrs) if j.attrs else "") for j in mech.joints])
     named = tuple([(k, p.link, arr(p.at)) for k, p in mech.points.items()])
-    return joints, named, tuple(sorted(vll.items())) if vll else (), prescribed
+    return joints, named
 
 
 _F64 = np.dtype(float)
@@ -111,8 +97,10 @@ _F64 = np.dtype(float)
 
 def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
     """:func:`compile_plan`, reusing the plan compiled for the same mechanism object with
-    the same geometry and options (a moved joint point or a new VLL mode compiles anew);
-    the plans of the last eight mechanisms are kept.
+    the same geometry and options (a moved joint point or a new VLL mode compiles anew),
+    kept in the kinematics' one cache (:data:`~mechsyn.kinematics.topology.CACHE`) under
+    the mechanism's identity (a frozen mechanism: its topology too), the options and its
+    geometry's numbers, never under its topology alone.
 
     Examples
     --------
@@ -122,25 +110,11 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
     True
     """
     prescribed = _prescribed(mech, vll, inputs)
-    key = _geometry_key(mech, vll, prescribed)
-    with _PLANS_LOCK:
-        entry = _PLANS.get(id(mech))
-        if entry is not None and entry[0] is mech:
-            _PLANS.move_to_end(id(mech))
-            kp = entry[1].get(key)
-            if kp is not None:
-                return kp
-    kp = _compiled(mech, vll, prescribed)
-    with _PLANS_LOCK:
-        entry = _PLANS.get(id(mech))
-        if entry is None or entry[0] is not mech:
-            entry = _PLANS[id(mech)] = (mech, {})
-        if len(entry[1]) >= _PLANS_MAX:
-            entry[1].pop(next(iter(entry[1])))
-        entry[1][key] = kp
-        _PLANS.move_to_end(id(mech))
-        while len(_PLANS) > _PLANS_MAX:
-            _PLANS.popitem(last=False)
+    key = ("plan", id(mech), tuple(sorted(vll.items())) if vll else (), prescribed, _geometry_key(mech))
+    kp = CACHE.get(key)
+    if kp is None or kp.mechanism is not mech:  # (an id of a mechanism gone, reused)
+        kp = _compiled(mech, vll, prescribed)
+        CACHE.put(key, kp)
     return kp
 
 
@@ -180,28 +154,26 @@ class KinematicPlan:
         rebuilt. Named points keep their drawn positions."""
         return self.refilled(self.mechanism.with_joint_points(points))
 
+    @property
+    def topology(self) -> Topology:
+        """The mechanism's :class:`~mechsyn.kinematics.topology.Topology` (its system's),
+        which every plan :meth:`refilled` from this one holds."""
+        return self.system.topology
+
     def refilled(self, mech: Mechanism) -> "KinematicPlan":
         """The plan of ``mech``, a mechanism of this plan's topology
-        (:func:`~mechsyn.kinematics.refill.topology_key`) with other numbers: the
+        (:func:`~mechsyn.kinematics.topology.topology_key`) with other numbers: the
         constraint system refilled with its geometry
         (:func:`~mechsyn.kinematics.refill.with_geometry`, built anew for cams, gears and
         belts) and the same decomposition, found anew only where it depends on the
-        geometry (a double joint is two R pairs at one point)."""
+        geometry (a double joint is two R pairs at one point: :func:`_decomposition`)."""
         S = with_geometry(self.system, mech)
         if S is None:
             S = build_system(mech, vll=self.vll, prescribed=self.prescribed)
-        groups, memo = self.groups, self.system.cache
-        free = memo.get("geometry-free plan")  # (whether the steps hold for any geometry: the template's)
-        if free is None or free[0] is not groups:
-            free = memo["geometry-free plan"] = (groups, groups is not None and not any(s.data for s in groups.steps))
-        if free[1]:
+        groups = self.groups
+        if groups is not None and groups.geometry_free:
             return fields_replaced(self, mechanism=mech, system=S)
-        if groups is not None:
-            new = KinematicPlan(mech, S, groups, self.vll, self.prescribed)
-            pairs = _joint_pairs(self)
-            if _coincident(new, pairs) == _coincident(self, pairs):
-                return new
-        return KinematicPlan(mech, S, decompose(S), self.vll, self.prescribed)
+        return KinematicPlan(mech, S, _decomposition(S), self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
                  points: list[str] | None = None, method: str = "auto", progress: Any = None,
@@ -210,29 +182,21 @@ class KinematicPlan:
         return _simulate_plan(self, inputs, speeds, points, method, progress, change_points)
 
 
-def _coincident(kp: "KinematicPlan", pairs: tuple[np.ndarray, np.ndarray]) -> bytes:
-    """Which of the pairs of R joints sharing a link (``pairs``: their indices, see
-    :func:`_joint_pairs`) are at one point (within 1e-9 of the size, as
-    :func:`~mechsyn.kinematics.groups.decompose` tests for a double joint): the only
-    geometry a decomposition depends on (kept with the plan's system)."""
-    memo = kp.system.cache.get("coincident")
-    if memo is None:
-        ia, ib = pairs
-        pts = np.array([j.point for j in kp.mechanism.joints], float)
-        memo = kp.system.cache["coincident"] = (
-            np.abs(pts[ia] - pts[ib]).max(axis=1) <= 1e-9 * kp.system.scale).tobytes()
-    return memo
-
-
-def _joint_pairs(kp: "KinematicPlan") -> tuple[np.ndarray, np.ndarray]:
-    """The indices of every pair of R joints that share a link (kept with the template)."""
-    memo = kp.system.cache.get("joint_pairs")
-    if memo is None:
-        joints = kp.mechanism.joints
+def _decomposition(S: PlanarSystem) -> Plan | None:
+    """:func:`~mechsyn.kinematics.groups.decompose` of ``S``, kept by its topology under
+    which of its pairs of R joints sharing a link are at one point (within 1e-9 of the
+    size, as ``decompose`` tests for a double joint): the only geometry a decomposition
+    depends on."""
+    def pairs() -> tuple[np.ndarray, np.ndarray]:
+        joints = S.mech.joints
         r = [k for k, j in enumerate(joints) if j.type == "R"]
-        pairs = [(a, b) for i, a in enumerate(r) for b in r[i + 1:] if set(joints[a].links) & set(joints[b].links)]
-        memo = kp.system.cache["joint_pairs"] = tuple(np.array(pairs, int).reshape(-1, 2).T)
-    return memo
+        ab = [(a, b) for i, a in enumerate(r) for b in r[i + 1:] if set(joints[a].links) & set(joints[b].links)]
+        return tuple(np.array(ab, int).reshape(-1, 2).T)
+
+    ia, ib = S.topology.product("R joint pairs", pairs)
+    pts = np.array([j.point for j in S.mech.joints], float)
+    one = (np.abs(pts[ia] - pts[ib]).max(axis=1) <= 1e-9 * S.scale).tobytes()
+    return S.topology.product(("decomposition", one), lambda: decompose(S))
 
 
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
@@ -243,20 +207,16 @@ def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tup
 
 def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> KinematicPlan:
     """:func:`compile_plan` with the prescribed inputs found: the template of the
-    mechanism's topology refilled with its numbers, or built and kept as the template."""
-    key = topology_key(mech, vll, prescribed)
-    with _PLANS_LOCK:
-        template = _TOPOLOGIES.get(key)
-        if template is not None:
-            _TOPOLOGIES.move_to_end(key)
+    mechanism's topology (a plan of it whose numbers are replaced, never an answer)
+    refilled with its numbers, or built and kept as the template."""
+    T = topology_of(mech, vll, prescribed)
+    template = CACHE.get((T, "template"))
     if template is not None:  # (a point or a P axis missing: refilled builds it anew, and reports it)
         return template.refilled(mech)
     S = build_system(mech, vll=vll, prescribed=prescribed)
-    kp = KinematicPlan(mech, S, decompose(S), vll, prescribed)
-    with _PLANS_LOCK:
-        _TOPOLOGIES[key] = kp
-        while len(_TOPOLOGIES) > _TOPOLOGIES_MAX:
-            _TOPOLOGIES.popitem(last=False)
+    kp = KinematicPlan(mech, S, _decomposition(S), vll, prescribed)
+    seed = fields_replaced(mech)  # (the template holds no mechanism of the caller's)
+    CACHE.put((T, "template"), fields_replaced(kp, mechanism=seed, system=fields_replaced(S, mech=seed, cache={})))
     return kp
 
 
@@ -372,8 +332,8 @@ def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
     hit = S.cache.get(key)
     if hit is not None and hit[0] is mech and hit[1] is kp.vll:
         return hit[2]
-    shape, p_inputs, p_joints = _topology(S, kp.groups, ("input shape", names, _vll_key(kp.vll)),
-                                          lambda: _input_shape(kp, names))
+    shape, p_inputs, p_joints = S.topology.product(("input shape", names), lambda: _input_shape(kp, names),
+                                                 kp.groups)
     if p_joints is None:  # no number of the geometry in it
         return shape
     joints = mech.joints
@@ -386,10 +346,6 @@ def _input_spec(kp: KinematicPlan, names: tuple) -> _InputSpec:
                            limited_inputs=any(lim is not None for lim in limits))
     S.cache[key] = (mech, kp.vll, spec)
     return spec
-
-
-def _vll_key(vll: dict | None) -> tuple:
-    return tuple(sorted(vll.items())) if vll else ()
 
 
 def _input_shape(kp: KinematicPlan, names: tuple) -> tuple[_InputSpec, list, list]:
@@ -512,13 +468,13 @@ def _named_points(S: PlanarSystem, mech: Mechanism, names: list[str] | None) -> 
     key = ("named points", None if names is None else tuple(names))
     hit = S.cache.get(key)
     if hit is None:
-        rows, li, moving, idx, where = _topology(S, None, key, lambda: _named_shape(S, mech, names))
+        rows, li, moving, idx, where = S.topology.product(key, lambda: _named_shape(S, mech, names))
         joints, points = mech.joints, mech.points
-        pts = S.cache.get("joint_points")  # a refilled system's: its joints' then its named points' floats
-        if pts is not None and len(pts) == len(joints) + len(points):
+        pts = joint_points(S)  # a refilled system's: its joints' then its named points' floats
+        if len(pts) == len(joints) + len(points):
             xy = [pts[k] for _, _, k in where]
         else:
-            xy = [_xy(points[name].at if j < 0 else joints[j].point) for name, j, _ in where]
+            xy = [point_xy(points[name].at if j < 0 else joints[j].point) for name, j, _ in where]
         loc = frame_points(S.frames(), li, xy)
         if len(moving) == len(loc):  # every point on a moving link (the common case): the topology's rows
             local = np.array(loc, float).reshape(-1, 2)
@@ -567,7 +523,7 @@ def _point_motions(S: PlanarSystem, sw: Sweep, named: tuple, ok: np.ndarray, rat
             if len(moving) == 1:
                 states[moving[0]] = (P[0], V[0], A[0])
         else:  # NaN rows stay NaN row by row (and rows not assembled or singular are set NaN)
-            PVA = _points_state(sw.q, sw.qd, sw.qdd, idx, local)
+            PVA = points_state_array(sw.q, sw.qd, sw.qdd, idx, local)
             if not sw.nan_rows:  # else NaN already: every number of a point's row depends on its row
                 _set_nan(PVA, nok, bad)
             P, V, A = PVA
@@ -596,17 +552,8 @@ def _set_nan(PVA: np.ndarray, nok: np.ndarray | None, bad: np.ndarray | None) ->
 
 
 def _prescribed(mech: Mechanism, vll: dict[str, str] | None, inputs: tuple) -> tuple:
-    """The inputs that are passive VLLs (prescribed, :func:`_is_passive`): the topology's
-    (the joints' VLL modes are part of it), kept in its :func:`topology_memo` when no
-    VLL mode is asked for."""
-    if vll:
-        return tuple(j for j in inputs if _is_passive(mech, j, vll))
-    memo = topology_memo(mech)
-    key = ("prescribed", inputs)
-    out = memo.get(key)
-    if out is None:
-        out = memo[key] = tuple(j for j in inputs if _is_passive(mech, j, None))
-    return out
+    """The inputs that are passive VLLs (prescribed, :func:`_is_passive`)."""
+    return tuple([j for j in inputs if _is_passive(mech, j, vll)])
 
 
 def _is_passive(mech: Mechanism, jid: str, vll: dict[str, str] | None) -> bool:

@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, _cons_of, _local, _memo, _topology,
-                                       circle_circle, normalised_disc)
-from mechsyn.kinematics.positions import TrackedPositions, _continuous_angles, solve_positions
+from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, circle_circle, cons_of,
+                                       geometry_memo, local_point, normalised_disc)
+from mechsyn.kinematics.positions import TrackedPositions, continuous_angles, solve_positions
 from mechsyn.kinematics.rates import batch_rates
 from mechsyn.kinematics.plane import cross
 from mechsyn.kinematics.system import PlanarSystem
@@ -58,14 +58,14 @@ def poses_from_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, r: "ChainResult
 def frame_driven_links(S: PlanarSystem, plan: Plan) -> dict[int, tuple[int, float]]:
     """Links turned by a frame driver: link -> (driver index, sign of the input), kept
     in the system's memo for the plan (a sweep's angles of these links are the inputs)."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     hit = memo.get(("drive_links", id(plan)))
     if hit is not None and hit[0] is plan:
         return hit[1]
     out = {}
     for step in plan.steps:
         if step.kind == "drive_R" and step.known[0] < 0:
-            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            con = next(c for c in cons_of(S, step.joints[0]) if c.role == "drive")
             out[step.links[0]] = (con.driver, 1.0 if con.b == step.links[0] else -1.0)
     memo[("drive_links", id(plan))] = (plan, out)
     return out
@@ -128,7 +128,7 @@ def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, cos: np.ndarray, si
     """Continuous angles of the chain's links into ``out`` (nl, N) from their rotations
     ``cos``, ``sin`` (nl, N or more rows): the links of frame drivers take the input
     itself, the others ``atan2`` made continuous (``ok`` None: every row assembled;
-    ``split``: see :func:`_continuous_angles`; ``parts``: the rows (slices, in the
+    ``split``: see :func:`continuous_angles`; ``parts``: the rows (slices, in the
     order swept) of sweeps tracked on their own, each made continuous from its start)."""
     drive_links, others, ref = _angle_plan(S, plan)
     N = out.shape[1]
@@ -141,9 +141,9 @@ def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, cos: np.ndarray, si
     if parts is not None:
         for rows in parts:
             if ok[rows].any():
-                _continuous_angles(ang[:, rows], ref, ok[rows], None, fresh=True)
+                continuous_angles(ang[:, rows], ref, ok[rows], None, fresh=True)
     elif ok is None or ok.any():
-        _continuous_angles(ang, ref, ok, split, fresh=True)
+        continuous_angles(ang, ref, ok, split, fresh=True)
     if not isinstance(others, slice):
         out[others] = ang
 
@@ -153,11 +153,11 @@ def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
     and their drawn angles (m, 1), kept with the system; the links (the topology's) in
     ``S.cache["programs"]``, which a refilled geometry shares
     (:func:`~mechsyn.kinematics.refill.with_geometry`)."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("angles", id(plan))
     hit = memo.get(key)
     if hit is None or hit[0] is not plan:
-        drive_links, others, cols = _topology(S, plan, "angles", lambda: _angle_links(S, plan))
+        drive_links, others, cols = S.topology.product("angles", lambda: _angle_links(S, plan), plan)
         hit = memo[key] = (plan, (drive_links, others, S.q0[cols][:, None]))
     return hit[1]
 
@@ -263,7 +263,7 @@ def fast_chain(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray | 
 def chain_program(S: PlanarSystem, plan: Plan, sigmas: list | None) -> tuple[list[DriveOp | RRROp], dict]:
     """The chain's steps as typed ops, and every link's anchor joint (built once per
     system and plan; the signs ``sigmas`` put in per call)."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("chain", id(plan))
     if key not in memo:
         memo[key] = _chain_program_(S, plan)
@@ -287,14 +287,14 @@ def _chain_program_(S: PlanarSystem, plan: Plan) -> tuple[list[DriveOp | RRROp],
     for si, step in enumerate(plan.steps):
         if step.kind == "drive_R":
             (new,), (k,), (jid,) = step.links, step.known, step.joints
-            con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+            con = next(c for c in cons_of(S, jid) if c.role == "drive")
             sgn = 1.0 if con.b == new else -1.0
-            anchor[new] = (jid, _local(S, new, jid))
+            anchor[new] = (jid, local_point(S, new, jid))
             prog.append(DriveOp(new, k, jid, con.driver, sgn))
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-        s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-        t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+        s1, s2 = local_point(S, b1, J1), local_point(S, b1, J2)
+        t2, t3 = local_point(S, b2, J2), local_point(S, b2, J3)
         L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
         A0, B0, C0 = (S.mech.joint(j).point for j in (J1, J2, J3))
         sigma = 1.0 if cross(C0 - A0, B0 - A0) >= 0 else -1.0
@@ -369,20 +369,20 @@ class _Chunk:
             self.rot[new] = ("cs", ck * ct - sk * st, sk * ct + ck * st)
             if self.rates:
                 self.rate[new] = (self.rate[k][0] + sgn * speeds[di], self.rate[k][1])
-            self.jst[jid] = self.point(k, jid, _local(self.S, k, jid))
+            self.jst[jid] = self.point(k, jid, local_point(self.S, k, jid))
 
     def rrr(self, op: RRROp, want: list) -> None:
         """The RRR kernel: ``B = A + f d + sigma g R90 d`` (see :func:`fast_chain`)."""
         (k1, k3), (b1, b2), (J1, J2, J3), L1s, L2s = op.known, op.links, op.joints, op.L1s, op.L2s
         sigma, bv1, bv2 = op.sigma, op.bv1, op.bv2
         S, sl, jst = self.S, self.sl, self.jst
-        A = self.point(k1, J1, _local(S, k1, J1))
-        C = self.point(k3, J3, _local(S, k3, J3))
+        A = self.point(k1, J1, local_point(S, k1, J1))
+        C = self.point(k3, J3, local_point(S, k3, J3))
         jst[J1], jst[J3] = A, C
         dx = C[0] - A[0]
         dy = C[1] - A[1]
         inv, f, g = circle_circle(dx, dy, L1s, L2s)
-        if isinstance(sigma, RRRChooser):  # a chooser: the signs from the discriminant of positions._solve_step
+        if isinstance(sigma, RRRChooser):  # a chooser: the signs from the discriminant of positions.solve_step
             sigma = self._choose(sigma, A, dx, dy, normalised_disc(inv, g, L1s))
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
@@ -484,7 +484,7 @@ class _Chunk:
             else:
                 j = self.S.mech.joint(jid)
                 side = self.S.index(j.links[1]) if self.S.index(j.links[1]) >= 0 else self.S.index(j.links[0])
-                P = self.point(side, None, _local(self.S, side, jid))
+                P = self.point(side, None, local_point(self.S, side, jid))
             o.points[jid][sl, 0], o.points[jid][sl, 1] = P[0], P[1]
             if rates:
                 o.velocities[jid][sl, 0], o.velocities[jid][sl, 1] = P[2], P[3]

@@ -56,6 +56,7 @@ from mechsyn.kinematics.solve import sweep as newton_sweep
 from mechsyn.kinematics.spatial import SpatialEngine
 from mechsyn.kinematics.sweep import Event, Sweep, by_row
 from mechsyn.kinematics.system import PlanarSystem
+from mechsyn.kinematics.topology import CACHE
 from mechsyn.kinematics.tracking import solve_tracked, solve_tracked_rates
 
 __all__ = ["Engine", "ENGINES", "engine_named", "PLANAR_ENGINES", "SPATIAL_ENGINE", "RegularPass", "TrackedChain", "TrackedGroups", "Newton",
@@ -295,12 +296,12 @@ def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_in
     return out
 
 
-#: The inputs of the last few sweeps :func:`drawn_row` searched, by their shape: ``(the
-#: inputs' bytes, the differences of one input's rows, {the drivers' types and drawn values:
+#: The inputs of the sweeps :func:`drawn_row` searched are kept in the kinematics' one
+#: cache (:data:`~mechsyn.kinematics.topology.CACHE`) by their shape: ``(the inputs'
+#: bytes, the differences of one input's rows, {the drivers' types and drawn values:
 #: row})``. A drag or a design loop simulates the same grid again and again (equal bytes:
 #: the same rows), each fresh geometry with its own drawn values.
-_DRAWN: dict[tuple, tuple[bytes, tuple | None, dict]] = {}
-_DRAWN_MAX, _DRAWN_BYTES = 16, 1 << 16  # at most 16 sweeps of at most 64 KiB of inputs each
+_DRAWN_BYTES = 1 << 16  # sweeps of at most 64 KiB of inputs
 _DRAWN_ROWS = 64  # answers kept per sweep (drawn values)
 
 
@@ -328,16 +329,13 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
         return None
     if U.nbytes > _DRAWN_BYTES:  # a long sweep: its own cost dwarfs the search, not kept
         return _drawn_row_1(S.drivers[0], U[:, 0]) if U.shape[1] == 1 else _drawn_row_k(S, U)
-    drawn = S.cache.get("drawn values")
-    if drawn is None:
-        drawn = S.cache["drawn values"] = tuple([(d.type, float(d.assembled)) for d in S.drivers])
-    key = (U.shape, U.dtype.str)
+    drawn = tuple([(d.type, float(d.assembled)) for d in S.drivers])
+    key = ("input grid", U.shape, U.dtype.str)
     data = U.tobytes()
-    hit = _DRAWN.get(key)
+    hit = CACHE.get(key)
     if hit is None or hit[0] != data:
-        if len(_DRAWN) >= _DRAWN_MAX:
-            _DRAWN.clear()  # one call (threads share the cache), not an eviction order
-        hit = _DRAWN[key] = (data, _differences(U[:, 0].copy()) if U.shape[1] == 1 else None, {})
+        hit = (data, _differences(U[:, 0].copy()) if U.shape[1] == 1 else None, {})
+        CACHE.put(key, hit)
     rows = hit[2]
     k = rows.get(drawn, rows)
     if k is not rows:

@@ -17,8 +17,8 @@ import math
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.groups import Plan, _memo, _topology
-from mechsyn.kinematics.positions import _State, _solve_step
+from mechsyn.kinematics.groups import Plan, geometry_memo
+from mechsyn.kinematics.positions import PoseState, solve_step
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -52,10 +52,10 @@ def swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | No
 def disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
     """Normalised discriminant of step ``k`` at the inputs ``X`` (M, n_inputs), upstream
     steps solved with their modes of the sweep rows ``rows`` (M,)."""
-    st = _State(S, X.shape[0])
+    st = PoseState(S, X.shape[0])
     for j in range(k):
         s = sigmas[j]
-        _solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
+        solve_step(S, st, plan.steps[j], X, s[rows] if isinstance(s, np.ndarray) else s)
     out = []
 
     def capture(disc: np.ndarray, s_file: float) -> float:
@@ -63,7 +63,7 @@ def disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray,
         return 1.0
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        _solve_step(S, st, plan.steps[k], X, capture)
+        solve_step(S, st, plan.steps[k], X, capture)
     return out[0]
 
 
@@ -216,7 +216,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    program = _memo(S)[("kernel", id(plan))][1]  # the pass's program (kernel.chain_steps keeps it)
+    program = geometry_memo(S)[("kernel", id(plan))][1]  # the pass's program (kernel.chain_steps keeps it)
     X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
     return _compiled_fold_events(S, plan, program, [discs[k] for k in ks] if block is None else block, ks,
                                  perm, b, X, paths)
@@ -226,8 +226,8 @@ def _compiled_fold_events(S: PlanarSystem, plan: Plan, program: tuple, discs: li
                           b: int, X: np.ndarray, paths: list) -> list | None:
     """:func:`pass_fold_events` by the kernel (``program``: the pass's arrays, ``X``: its
     input rows; :func:`mechsyn.kinematics.kernel.fold_scan`)."""
-    steps, names, messages = _topology(S, plan, "fold scan", lambda: _fold_words(plan, ks))
-    memo = _memo(S)
+    steps, names, messages = S.topology.product("fold scan", lambda: _fold_words(plan, ks), plan)
+    memo = geometry_memo(S)
     specs = memo.get(("four-bar folds", id(plan)))  # this geometry's closed-form fold numbers per group
     if specs is None or specs[0] is not plan:
         specs = memo[("four-bar folds", id(plan))] = (plan, np.array([_four_bar_numbers(_four_bar_spec(S, plan, k))
@@ -298,12 +298,12 @@ def _four_bar_spec(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     ``k``, or None (kept with the system). Whether the group closes a four-bar is the
     topology's (:func:`_four_bar_form`); the numbers are read off the regular pass's
     program."""
-    memo = _memo(S)
+    memo = geometry_memo(S)
     key = ("four-bar fold", id(plan), k)
     if key in memo:
         return memo[key]
     out = None
-    form = _topology(S, plan, ("four-bar form", k), lambda: _four_bar_form(S, plan, k))
+    form = S.topology.product(("four-bar form", k), lambda: _four_bar_form(S, plan, k), plan)
     if form is not None:
         kernel.program(S, plan)  # the regular program (steps, anchors, origin: complex local points) kept with S
         c, on_frame, crank = form

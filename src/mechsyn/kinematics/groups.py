@@ -23,7 +23,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
@@ -105,12 +104,28 @@ class Plan:
         """A driver-R + RRR chain (asked on every sweep and per dead point: kept)."""
         return all(s.kind in ("drive_R", "RRR") for s in self.steps)
 
+    @cached_property
+    def geometry_free(self) -> bool:
+        """The steps hold for every geometry of the topology (no double joint: two R pairs
+        found at one point)."""
+        return not any(s.data for s in self.steps)
+
     def describe(self) -> list[str]:
         return [f"{s.kind} ({', '.join(s.joints)})" for s in self.steps]
 
 
-def _cons_of(S: PlanarSystem, jid: str) -> list[Con]:
-    memo = _memo(S)
+def cons_of(S: PlanarSystem, jid: str) -> list[Con]:
+    """The constraints of ``S`` that joint ``jid`` writes (in ``S.cons`` order), kept in
+    :func:`geometry_memo`.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.system import build_system
+    >>> [(c.kind, c.role) for c in cons_of(build_system(ms.examples.load("crank_rocker")), "A")]
+    [('R', 'pair'), ('angle', 'drive')]
+    """
+    memo = geometry_memo(S)
     key = ("cons", jid)
     out = memo.get(key)
     if out is None:
@@ -241,27 +256,28 @@ def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, lin
     return False
 
 
-def _memo(S: PlanarSystem) -> dict:
-    """Per-system cache of look-ups that depend only on the system (local joint points,
-    constraints of a joint): a plan evaluated many times (events, drags) reuses them."""
+def geometry_memo(S: PlanarSystem) -> dict:
+    """The look-ups of ``S``'s geometry that a plan evaluated many times (events, drags)
+    reuses: local joint points, constraints of a joint, the filled programs. Kept with
+    the system (a field of it: a new geometry starts with an empty one); what the
+    topology alone decides is kept by ``S.topology``
+    (:meth:`~mechsyn.kinematics.topology.Topology.product`)."""
     return S.cache.setdefault("groups", {})
 
 
-def _topology(S: PlanarSystem, plan: Any, name: str, build: Callable[[], Any]) -> Any:
-    """``build()``, what ``plan``'s topology alone decides (steps, links, joints: no
-    number of the geometry), kept under ``(name, id(plan))`` in ``S.cache["programs"]``,
-    which :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of
-    one topology: a refilled geometry finds it built."""
-    shared = S.cache.setdefault("programs", {})
-    key = (name, id(plan))
-    hit = shared.get(key)
-    if hit is None or hit[0] is not plan:
-        hit = shared[key] = (plan, build())
-    return hit[1]
+def local_point(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
+    """Joint ``jid``'s drawn point in the frame of link ``i`` (-1: the frame, the point
+    itself), kept in :func:`geometry_memo`.
 
-
-def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
-    memo = _memo(S)
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.system import build_system
+    >>> S = build_system(ms.examples.load("crank_rocker"))
+    >>> local_point(S, 0, "A").tolist()   # the crank's frame has its origin at A
+    [0.0, 0.0]
+    """
+    memo = geometry_memo(S)
     key = ("local", i, jid)
     out = memo.get(key)
     if out is None:
@@ -271,18 +287,17 @@ def _local(S: PlanarSystem, i: int, jid: str) -> np.ndarray:
     return out
 
 
-def _rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:
-    """Constant ``phi_to - phi_from`` of a P joint between links frm and to."""
-    con = next(c for c in _cons_of(S, jid) if c.kind == "angle" and c.role == "rotation")
+def rel_angle(S: PlanarSystem, jid: str, frm: int, to: int) -> float:
+    """The constant angle ``phi_to - phi_frm`` between the links ``frm`` and ``to`` of the
+    P joint ``jid`` (its rotation constraint's drawn value, radians)."""
+    con = next(c for c in cons_of(S, jid) if c.kind == "angle" and c.role == "rotation")
     return con.c0 if (con.a, con.b) == (frm, to) else -con.c0
 
 
-def _line(S: PlanarSystem, jid: str) -> Con:
-    return next(c for c in _cons_of(S, jid) if c.kind == "line" and c.role == "pair")
-
-
-
-
+def pair_line(S: PlanarSystem, jid: str) -> Con:
+    """The line constraint of the P joint ``jid`` (its pair: the slide's direction and
+    local points)."""
+    return next(c for c in cons_of(S, jid) if c.kind == "line" and c.role == "pair")
 
 
 COINCIDENT = 1e-24

@@ -43,7 +43,7 @@ from types import ModuleType
 import numpy as np
 
 from mechsyn.kinematics.chain import chain_program
-from mechsyn.kinematics.groups import DriveOp, Plan, _local, _memo, _topology
+from mechsyn.kinematics.groups import DriveOp, Plan, geometry_memo, local_point
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 
@@ -83,22 +83,24 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     """The chain's steps with complex constants, every link's anchor and origin joint
     (built once per system and plan). Its shape (:func:`_shape`: the steps' links,
     joints, drivers and signs, and which local joint points they take) depends on the
-    topology only: it is kept in ``S.cache["programs"]``, which
-    :func:`~mechsyn.kinematics.refill.with_geometry` shares among the systems of one
-    topology, so a refilled system's program is its numbers put in (:func:`_filled`).
-    The same numbers are written once more as the kernel's arrays
-    (:func:`program_arrays`' ``fp`` and ``anc_s``, kept under
-    ``("kernel", id(plan))``) while they are filled in, not read back off the steps."""
-    memo = _memo(S)
+    topology only: it is the topology's product ``"regular"``
+    (:meth:`~mechsyn.kinematics.topology.Topology.product`, kept in the one cache and
+    shared by every system of that topology, a refilled one too), so a refilled
+    system's steps are its numbers put in (:func:`_filled`). The same numbers are
+    written once more as the kernel's arrays (:func:`program_arrays`' ``fp`` and
+    ``anc_s``, kept with ``S`` under ``("kernel", id(plan))``; their integers are the
+    topology's product ``"kernel"``) while they are filled in, not read back off the
+    steps."""
+    memo = geometry_memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
     rows: list = []
-    out = _filled(S, _topology(S, plan, "regular", lambda: _shape(S, plan)), rows)
+    out = _filled(S, S.topology.product("regular", lambda: _shape(S, plan), plan), rows)
     memo[key] = (plan, out)
     steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
-    shape = _topology(S, plan, "kernel", lambda: program_arrays(steps, anchor, origin)[0])
+    shape = S.topology.product("kernel", lambda: program_arrays(steps, anchor, origin)[0], plan)
     rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
     flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
     memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
@@ -109,7 +111,7 @@ def program(S: PlanarSystem, plan: Plan) -> tuple:
     """The regular pass's program of ``S`` as the kernel's arrays (:func:`program_arrays`),
     kept with ``S``."""
     chain_steps(S, plan)
-    return _memo(S)[("kernel", id(plan))][1]
+    return geometry_memo(S)[("kernel", id(plan))][1]
 
 
 def _shape(S: PlanarSystem, plan: Plan) -> tuple:
@@ -135,7 +137,7 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     anchors = {i: (jid, at(i, jid)) for i, (jid, _) in anchor.items()}
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
-        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(_local(S, i, j.id))), None)
+        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
         origin.append(j0)
     index = {j.id: k for k, j in enumerate(S.mech.joints)}
     drawn = [(index[st[3][0]], index[st[3][1]], index[st[3][2]]) if st[0] == "RRR" else None for st in steps]

@@ -30,15 +30,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import Plan, Sigma, Step, circle_circle, normalised_disc, _cons_of, _line, _local, _rel_angle
+from mechsyn.kinematics.groups import (Plan, Sigma, Step, circle_circle, cons_of, local_point, normalised_disc, pair_line,
+                                       rel_angle)
 from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate
 from mechsyn.kinematics.system import Con, PlanarSystem
 
 __all__ = ["TrackedPositions", "solve_positions"]
 
 
-class _State:
-    """Poses of the links known so far, for all N inputs."""
+class PoseState:
+    """The poses of the links known so far, for all N inputs: origins ``r`` (N, nl, 2) and
+    angles ``phi`` (N, nl), NaN until a step places the link (:func:`solve_step`).
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.system import build_system
+    >>> st = PoseState(build_system(ms.examples.load("crank_rocker")), 4)
+    >>> st.r.shape, st.phi.shape, [a.shape for a in st.pose(-1)]
+    ((4, 3, 2), (4, 3), [(4, 2), (4,)])
+    """
 
     def __init__(self, S: PlanarSystem, N: int) -> None:
         self.S = S
@@ -89,7 +100,7 @@ def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
     return out
 
 
-def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None,
+def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None,
                        fresh: bool = False) -> np.ndarray:
     """Link angles made continuous along a sweep: start near the file's angles ``ref``,
     unwrap each run of assembled rows and keep the turn count across gaps (``phi`` (N,
@@ -99,9 +110,17 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
     configuration, between rows ``split - 1`` and ``split``: both rows start near
     ``ref`` and the angles are unwrapped away from them (as two runs would be).
     ``fresh``: ``phi`` (m, N) is a work array of ``atan2`` angles the answer is written
-    into (the answer is ``phi`` itself)."""
+    into (the answer is ``phi`` itself).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> phi = np.radians([[170.0], [-170.0], [-150.0]])
+    >>> np.degrees(continuous_angles(phi, np.radians([160.0]), None)).round(6).ravel().tolist()
+    [170.0, 190.0, 210.0]
+    """
     if ref.ndim == 1:
-        return _continuous_angles(phi.T, ref[:, None], ok, split).T
+        return continuous_angles(phi.T, ref[:, None], ok, split).T
     refs = ref[:, 0].tolist()
     if ok is None or ok.all():  # one run: unwrap, then put the start row(s) next to ref
         block = _unwrap_rows(phi, inplace=fresh)
@@ -151,38 +170,40 @@ def _continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, 
     return sub
 
 
-def _pin(st: _State, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
+def _pin(st: PoseState, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
     c, sn = cos_sin(phi)
     st.set(i, P - rotate(c, sn, s_local), phi)
 
 
-def _solve_step(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
-    """Solve one step in place; return its assembly sign (sigma) for the branch: ``sigma``
-    given (a number or one per row), None (the drawn mode) or a chooser called with the
-    normalised discriminant and the drawn mode."""
+def solve_step(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+    """Solve one step of a plan in place in ``st`` (the poses of its new links at the
+    inputs ``u``, radians or lengths per driver, (N, nd)); return its assembly sign
+    (sigma) for the branch: ``sigma`` given (a number or one per row), None (the drawn
+    mode) or a chooser called with the normalised discriminant and the drawn mode.
+    A step kind without a closed form raises ``_NotHandled`` (Newton then)."""
     kernel = _STEP_KERNELS.get(step.kind)
     if kernel is None:
         raise _NotHandled
     return kernel(S, st, step, u, sigma)
 
 
-def _step_drive_R(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_drive_R(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """A link turned by an R drive about a known link."""
     (new,), (k,), (jid,) = step.links, step.known, step.joints
-    con = next(c for c in _cons_of(S, jid) if c.role == "drive")
+    con = next(c for c in cons_of(S, jid) if c.role == "drive")
     th = u[:, con.driver]
     _, phik = st.pose(k)
     phi = phik + th if con.b == new else phik - th
-    P = st.point(k, _local(S, k, jid))
-    _pin(st, new, P, _local(S, new, jid), phi)
+    P = st.point(k, local_point(S, k, jid))
+    _pin(st, new, P, local_point(S, new, jid), phi)
     return 1.0
 
 
-def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_drive_P(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """A link slid by a P drive along a known link."""
     (new,), (k,), (jid,) = step.links, step.known, step.joints
-    drive = next(c for c in _cons_of(S, jid) if c.role == "drive")
-    line = _line(S, jid)
+    drive = next(c for c in cons_of(S, jid) if c.role == "drive")
+    line = pair_line(S, jid)
     val = u[:, drive.driver]
     if drive.a == k:
         ra, pa = st.pose(k)
@@ -190,9 +211,9 @@ def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma:
         w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
         Pa = st.point(k, line.sa)
         Pb = ra + val[:, None] * w + n * dot(n, Pa - ra)[:, None]
-        _pin(st, new, Pb, drive.sb, pa + _rel_angle(S, jid, k, new))
+        _pin(st, new, Pb, drive.sb, pa + rel_angle(S, jid, k, new))
     else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
-        pa = st.pose(k)[1] + _rel_angle(S, jid, k, new)
+        pa = st.pose(k)[1] + rel_angle(S, jid, k, new)
         ca, sa_ = cos_sin(pa)
         w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
         Pb = st.point(k, drive.sb)
@@ -201,15 +222,15 @@ def _step_drive_P(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma:
     return 1.0
 
 
-def _step_RRR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_RRR(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RRR dyad: the intersection of two circles."""
     A_s, B_s = step.known
     b1, b2 = step.links
     J1, J2, J3 = step.joints
-    A = st.point(A_s, _local(S, A_s, J1))
-    C = st.point(B_s, _local(S, B_s, J3))
-    s1, s2 = _local(S, b1, J1), _local(S, b1, J2)
-    t2, t3 = _local(S, b2, J2), _local(S, b2, J3)
+    A = st.point(A_s, local_point(S, A_s, J1))
+    C = st.point(B_s, local_point(S, B_s, J3))
+    s1, s2 = local_point(S, b1, J1), local_point(S, b1, J2)
+    t2, t3 = local_point(S, b2, J2), local_point(S, b2, J3)
     L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
     d = C - A
     inv, f, g2 = circle_circle(d[:, 0], d[:, 1], L1s, L2s)
@@ -238,14 +259,14 @@ def _oriented(step: Step, kind: str) -> tuple:
     return b2, b1, B_s, A_s, J3, J1
 
 
-def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_RRP(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RRP / PRR dyad: the intersection of a circle and a line."""
     # orient as R(J_r) - R(J2) - P(J_p): link `lr` pinned at A, link `lp` slides on `kp`
     lr, lp, kr, kp, Jr, Jp = _oriented(step, "RRP")
     J2 = step.joints[1]
-    A = st.point(kr, _local(S, kr, Jr))
-    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
-    line = _line(S, Jp)
+    A = st.point(kr, local_point(S, kr, Jr))
+    phi_p = st.pose(kp)[1] + rel_angle(S, Jp, kp, lp)
+    line = pair_line(S, Jp)
     # the P joint's point on lp and the known line through kp's joint point
     t_p = line.sb if line.b == lp else line.sa
     s_k = line.sa if line.a == kp else line.sb
@@ -254,9 +275,9 @@ def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     ca, sa_ = cos_sin(phi_axis)
     w = perp(rotate(ca, sa_, line.w)) * -1.0  # slide direction (line.w is the normal)
     cp, sp = cos_sin(phi_p)
-    tB = _local(S, lp, J2)
+    tB = local_point(S, lp, J2)
     Q = Pk + rotate(cp, sp, tB - t_p)
-    L1 = np.linalg.norm(_local(S, lr, J2) - _local(S, lr, Jr))
+    L1 = np.linalg.norm(local_point(S, lr, J2) - local_point(S, lr, Jr))
     p = dot(w, Q - A)
     cc = dot(Q - A, Q - A) - L1 ** 2
     disc = p ** 2 - cc
@@ -268,28 +289,28 @@ def _step_RRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     root = np.sqrt(np.where(disc >= 0, disc, np.nan))
     lam = -p + sigma * root
     B = Q + lam[:, None] * w
-    sr = _local(S, lr, Jr)
-    beta = np.arctan2(*(_local(S, lr, J2) - sr)[::-1])
+    sr = local_point(S, lr, Jr)
+    beta = np.arctan2(*(local_point(S, lr, J2) - sr)[::-1])
     phi_r = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta
     _pin(st, lr, A, sr, phi_r)
     _pin(st, lp, B, tB, phi_p)
     return sigma
 
 
-def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_RPR(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RPR dyad: the slide line keeps its offset from both pivots."""
     A_s, B_s = step.known
     b1, b2 = step.links
     J1, J2, J3 = step.joints
-    A = st.point(A_s, _local(S, A_s, J1))
-    C = st.point(B_s, _local(S, B_s, J3))
-    c = _rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
-    line = _line(S, J2)
+    A = st.point(A_s, local_point(S, A_s, J1))
+    C = st.point(B_s, local_point(S, B_s, J3))
+    c = rel_angle(S, J2, b1, b2)  # phi_b2 - phi_b1
+    line = pair_line(S, J2)
     n_loc = line.w if line.a == b1 else np.array([np.cos(c) * line.w[0] - np.sin(c) * line.w[1],
                                                   np.sin(c) * line.w[0] + np.cos(c) * line.w[1]])
     # n_loc: the slide normal in b1's frame
-    sA, sP = _local(S, b1, J1), _local(S, b1, J2)
-    tC, tP = _local(S, b2, J3), _local(S, b2, J2)
+    sA, sP = local_point(S, b1, J1), local_point(S, b1, J2)
+    tC, tP = local_point(S, b2, J3), local_point(S, b2, J2)
     cc, sc = np.cos(c), np.sin(c)
     Rc = np.array([[cc, -sc], [sc, cc]])
     e = float(n_loc @ (sP - sA) - n_loc @ (Rc @ (tP - tC)))
@@ -310,31 +331,31 @@ def _step_RPR(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sig
     return sigma
 
 
-def _step_RPP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_RPP(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """RPP / PPR dyad: orientations from the P pairs, position from two lines."""
     # orient as R(Jr) on link lr - P(J2) - P(Jp) on link lp sliding on kp
     lr, lp, kr, kp, Jr, Jp = _oriented(step, "RPP")
     J2 = step.joints[1]
-    phi_p = st.pose(kp)[1] + _rel_angle(S, Jp, kp, lp)
-    phi_r = phi_p + _rel_angle(S, J2, lp, lr)
-    A = st.point(kr, _local(S, kr, Jr))
-    _pin(st, lr, A, _local(S, lr, Jr), phi_r)
-    w1, h1 = _line_eq(S, st, _line(S, J2), lp, phi_p, np.zeros(2))
-    w2, h2 = _line_eq(S, st, _line(S, Jp), lp, phi_p, np.zeros(2))
+    phi_p = st.pose(kp)[1] + rel_angle(S, Jp, kp, lp)
+    phi_r = phi_p + rel_angle(S, J2, lp, lr)
+    A = st.point(kr, local_point(S, kr, Jr))
+    _pin(st, lr, A, local_point(S, lr, Jr), phi_r)
+    w1, h1 = _line_eq(S, st, pair_line(S, J2), lp, phi_p, np.zeros(2))
+    w2, h2 = _line_eq(S, st, pair_line(S, Jp), lp, phi_p, np.zeros(2))
     st.set(lp, _solve2(w1, h1, w2, h2), phi_p)
     return 1.0
 
 
-def _step_PRP(S: PlanarSystem, st: _State, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
+def _step_PRP(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
     """PRP dyad: the intersection of two slide lines."""
     A_s, B_s = step.known
     b1, b2 = step.links
     J1, J2, J3 = step.joints
-    phi1 = st.pose(A_s)[1] + _rel_angle(S, J1, A_s, b1)
-    phi2 = st.pose(B_s)[1] + _rel_angle(S, J3, B_s, b2)
-    sB, tB = _local(S, b1, J2), _local(S, b2, J2)
-    w1, h1 = _line_eq(S, st, _line(S, J1), b1, phi1, sB)
-    w2, h2 = _line_eq(S, st, _line(S, J3), b2, phi2, tB)
+    phi1 = st.pose(A_s)[1] + rel_angle(S, J1, A_s, b1)
+    phi2 = st.pose(B_s)[1] + rel_angle(S, J3, B_s, b2)
+    sB, tB = local_point(S, b1, J2), local_point(S, b2, J2)
+    w1, h1 = _line_eq(S, st, pair_line(S, J1), b1, phi1, sB)
+    w2, h2 = _line_eq(S, st, pair_line(S, J3), b2, phi2, tB)
     B = _solve2(w1, h1, w2, h2)
     _pin(st, b1, B, sB, phi1)
     _pin(st, b2, B, tB, phi2)
@@ -345,7 +366,7 @@ _STEP_KERNELS = {"drive_R": _step_drive_R, "drive_P": _step_drive_P, "RRR": _ste
                  "PRR": _step_RRP, "RPR": _step_RPR, "RPP": _step_RPP, "PPR": _step_RPP, "PRP": _step_PRP}
 
 
-def _line_eq(S: PlanarSystem, st: "_State", con: Con, unknown: int, phi_u: np.ndarray,
+def _line_eq(S: PlanarSystem, st: "PoseState", con: Con, unknown: int, phi_u: np.ndarray,
              s_ref: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A P pair's line condition ``n . (P_b - P_a) = 0`` as ``n . X = h`` for the unknown
     position ``X`` of the local point ``s_ref`` of a link whose angle ``phi_u`` is known."""
@@ -381,16 +402,16 @@ def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,
     previous one (links turned by a driver keep the input's own value).
     """
     inputs = np.atleast_2d(np.asarray(inputs, float))
-    st = _State(S, inputs.shape[0])
+    st = PoseState(S, inputs.shape[0])
     out_sig = []
     for k, step in enumerate(plan.steps):
-        out_sig.append(_solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
-    return _pose_rows(S, st, plan), out_sig
+        out_sig.append(solve_step(S, st, step, inputs, None if sigmas is None else sigmas[k]))
+    return pose_rows(S, st, plan), out_sig
 
 
-def _pose_rows(S: PlanarSystem, st: _State, plan: Plan) -> np.ndarray:
-    """The solved state as pose rows ``q`` (x, y, angle of every link), the dyads' link
-    angles unwrapped to turn continuously from the file's configuration."""
+def pose_rows(S: PlanarSystem, st: PoseState, plan: Plan) -> np.ndarray:
+    """The solved state ``st`` as pose rows ``q`` (N, n: x, y, angle of every link), the
+    dyads' link angles unwrapped to turn continuously from the file's configuration."""
     nl = len(S.links)
     q = np.empty((st.phi.shape[0], S.n))
     q[:, 0:3 * nl:3] = st.r[:, :, 0]
@@ -399,7 +420,7 @@ def _pose_rows(S: PlanarSystem, st: _State, plan: Plan) -> np.ndarray:
     dyad_links = sorted({i for step in plan.steps if not step.kind.startswith("drive") for i in step.links})
     ok = np.all(np.isfinite(phi), axis=1)
     if dyad_links and ok.any():
-        phi[:, dyad_links] = _continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
+        phi[:, dyad_links] = continuous_angles(phi[:, dyad_links], S.q0[[3 * i + 2 for i in dyad_links]], ok)
     q[:, 2:3 * nl:3] = phi
     return q
 

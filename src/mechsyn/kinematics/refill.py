@@ -1,6 +1,7 @@
 """A new geometry in a compiled topology: the fast path of a drag or a design loop.
 
-Two planar mechanisms with the same :func:`topology_key` (links, joints and their pair
+Two planar mechanisms with the same
+:func:`~mechsyn.kinematics.topology.topology_key` (links, joints and their pair
 types, drives, VLL modes, prescribed inputs) differ only in numbers: joint points, P
 axes, named points. :func:`with_geometry` fills the numbers of one into the constraint
 system compiled for the other (link frames, local joint points, drawn angles and slide
@@ -19,38 +20,15 @@ import numpy as np
 
 from mechsyn.kinematics.plane import to_frame
 from mechsyn.kinematics.system import Con, PlanarSystem, frame_points
-from mechsyn.model.mechanism import Mechanism, fields_replaced, topology_memo
+from mechsyn.model.mechanism import Mechanism, fields_replaced
 
-__all__ = ["joint_points", "topology_key", "with_geometry"]
-
-
-def topology_key(mech: Mechanism, vll: dict[str, str] | None = None, prescribed: tuple[str, ...] = ()) -> tuple:
-    """What a compiled system depends on besides the numbers of the geometry: the kind,
-    the links (frame first), every joint's id, pair type, links, drive, VLL mode, ratio
-    and extra attributes, the VLL modes asked for and the prescribed inputs. Two
-    mechanisms with the same key differ only in their joint points, P axes and named
-    points, so :func:`with_geometry` fills one's numbers into the other's system.
-
-    Examples
-    --------
-    >>> import mechsyn as ms
-    >>> m = ms.examples.load("crank_rocker")
-    >>> moved = m.with_joint_points({"C": (3.1, 2.9)})
-    >>> topology_key(moved) == topology_key(m)
-    True
-    """
-    memo = topology_memo(mech)  # the links and joints part: computed once per topology
-    part = memo.get("topology key")
-    if part is None:
-        part = memo["topology key"] = (mech.kind, mech.ground, mech.link_names, tuple(
-            (j.id, j.type, j.links, j.actuated, j.vll, j.ratio, repr(j.attrs) if j.attrs else "") for j in mech.joints))
-    named = tuple([(k, p.link) for k, p in mech.points.items()])  # (a dict: read each time)
-    return part + (named, tuple(sorted(vll.items())) if vll else (), tuple(prescribed))
+__all__ = ["joint_points", "point_xy", "with_geometry"]
 
 
 def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     """The system of ``mech`` built from ``T``, the system of a mechanism of the same
-    :func:`topology_key`: the same constraints, drivers and notes with the numbers of
+    :class:`~mechsyn.kinematics.topology.Topology` (which it holds): the same constraints,
+    drivers and notes with the numbers of
     ``mech``'s joint points (link frames, local points, drawn angles and slide
     coordinates, length scale), equal to :func:`build_system`'s; None when ``T`` has
     blocks other than R pairs, angles and lines (cams, gears, belts: built anew), a
@@ -75,18 +53,16 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     >>> bool(np.array_equal(S.q0, build_system(moved).q0))
     True
     """
-    lay = T.cache.get("layout")
-    if lay is None:
-        lay = T.cache["layout"] = _layout(T)
+    lay = T.topology.product("refill layout", lambda: _layout(T))
     if lay is False:
         return None
     first, other, rowmask, colmask, recipe, scales, kept = lay
     nd, joints = np.ndarray, mech.joints  # a float64 point (the common case) read inline
-    pts = [p.tolist() if (p := j.point).__class__ is nd and p.dtype is _FLOAT else _xy(p) for j in joints]
+    pts = [p.tolist() if (p := j.point).__class__ is nd and p.dtype is _FLOAT else point_xy(p) for j in joints]
     if recipe[3] and any(joints[k].axis is None for k in recipe[3]):  # a P pair without axis
         return None
     if mech.points:
-        pts += [_xy(p.at) for p in mech.points.values()]
+        pts += [point_xy(p.at) for p in mech.points.values()]
     xs, ys = [x for x, _ in pts], [y for _, y in pts]
     if not math.isfinite(sum(xs) + sum(ys)):  # a NaN or an infinity (or sums past the float range: built anew)
         return None
@@ -97,13 +73,12 @@ def with_geometry(T: PlanarSystem, mech: Mechanism) -> PlanarSystem | None:
     frames, ang = (np.cos(turn).tolist(), np.sin(turn).tolist(), org), angle0.tolist()
     cons, drivers = _refilled(T, mech, recipe, pts, frames, ang)
     q0 = np.array([v for (x, y), a in zip(org, ang) for v in (x, y, a)], float)
-    # the engines' programs by topology (kernel.chain_steps' shapes), shared with T
-    cache = {"frames": frames, "joint_points": pts, "layout": lay, "programs": T.cache.setdefault("programs", {})}
+    cache = {"frames": frames, "joint_points": pts}
     S = object.__new__(_Refilled)
     fields = S.__dict__
     fields.update(kept)  # T's fields a geometry does not change; cons and origin0 made when first read
     fields.update(mech=mech, angle0=angle0, drivers=drivers, q0=q0, scale=scale, vll=dict(T.vll), cache=cache,
-                  _pending=(T.cons, cons, recipe[1:], pts, frames), _scales=(scale, rowmask, colmask, scales))
+                  topology=T.topology, _pending=(T.cons, cons, recipe[1:], pts, frames), _scales=(scale, rowmask, colmask, scales))
     return S
 
 
@@ -145,9 +120,16 @@ def _frame_angles(pts: list, org: list, other: list, tol: float) -> np.ndarray:
     return np.arctan2(dy, dx)
 
 
-def _xy(p: Any) -> list:
+def point_xy(p: Any) -> list:
     """A drawn point as ``[x, y]`` floats (one ``tolist`` of a float array); none (None):
-    NaN, which :func:`with_geometry` refuses."""
+    NaN, which :func:`with_geometry` refuses.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> point_xy(np.array([1.0, 2.5])), point_xy((3, 4)), point_xy(None)
+    ([1.0, 2.5], [3.0, 4.0], [nan, nan])
+    """
     if p is None:
         return [math.nan, math.nan]
     return p.tolist() if type(p) is np.ndarray and p.dtype is _FLOAT else np.asarray(p, float).tolist()

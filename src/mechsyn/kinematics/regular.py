@@ -36,7 +36,7 @@ import numpy as np
 
 from mechsyn.kinematics import kernel
 from mechsyn.kinematics.chain import frame_driven_links
-from mechsyn.kinematics.groups import Plan, _memo, _topology
+from mechsyn.kinematics.groups import Plan, geometry_memo
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.folds import pass_fold_events
 from mechsyn.kinematics.tracking import REGULAR_DISC, regular_rows, tracking_path
@@ -88,8 +88,8 @@ def _link_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", spl
     assembled (N,), the rows with rates and the number of singular rows (through folds;
     ``parts``: the fold scan's singular rows, blanked too). Which links frame drivers
     turn is kept with the topology."""
-    dcol, dsgn, runs = _topology(S, plan, "kernel-angles", lambda: _drive_arrays(S, plan))
-    memo = _memo(S)
+    dcol, dsgn, runs = S.topology.product("kernel-angles", lambda: _drive_arrays(S, plan), plan)
+    memo = geometry_memo(S)
     ref = memo.get("drawn angles")
     if ref is None:  # the drawn angles: this geometry's
         ref = memo["drawn angles"] = np.ascontiguousarray(S.q0[2::3])
@@ -185,7 +185,7 @@ def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
     the first rows' bytes (a drag or a design loop sweeps the same grid again)."""
     firsts = [U[0]] if split is None else [U[split], U[split - 1]]
     key = (split, *[f.tobytes() for f in firsts])
-    memo = _memo(S)
+    memo = geometry_memo(S)
     hit = memo.get("tracking paths")
     if hit is not None and hit[0] == key:
         return hit[1]

@@ -21,7 +21,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from mechsyn.errors import MechsynInputError, OverActuatedError
-from mechsyn.kinematics.groups import _topology, decompose
+from mechsyn.kinematics.groups import decompose
 from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.sweep import Event, Sweep
@@ -251,7 +251,7 @@ def _drawn_groups(S: PlanarSystem, plan: Any) -> list | None:
         index = {j.id: k for k, j in enumerate(S.mech.joints)}
         return [tuple(index[j] for j in s.joints) for s in plan.steps if s.kind == "RRR"] if ok else None
 
-    return _topology(S, plan, "drawn checks", build)
+    return S.topology.product("drawn checks", build, plan)
 
 
 def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:

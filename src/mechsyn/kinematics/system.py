@@ -54,6 +54,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.cams import CamCurve, cam_curve
 from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate, to_frame
+from mechsyn.kinematics.topology import Topology, topology_of
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
 
@@ -129,9 +130,12 @@ class PlanarSystem:
     row_scale: np.ndarray | None = None
     col_scale: np.ndarray | None = None
     #: what the engines compute once per system and reuse (the assembled configuration,
-    #: the groups' look-ups and programs, the compiled one-configuration equations): a
-    #: field of the compiled system, so a new geometry starts with an empty one
+    #: the groups' look-ups, the compiled one-configuration equations): this geometry's
+    #: answers, a field of the compiled system, so a new geometry starts with an empty one
     cache: dict = field(default_factory=dict, repr=False, compare=False)
+    #: the mechanism's :class:`~mechsyn.kinematics.topology.Topology` (with the VLL modes
+    #: and prescribed inputs compiled): what the systems of one topology share is kept by it
+    topology: Topology | None = field(default=None, repr=False, compare=False)
 
     def unit_jacobian(self, J: np.ndarray) -> np.ndarray:
         """``Phi_q`` (..., m, n) made dimensionless by the mechanism's length scale: rows of
@@ -213,7 +217,7 @@ class PlanarSystem:
         >>> P.shape, bool(np.array_equal(A[1], S.point_state(q, q, q, 1, np.array([0.5, 0.2]))[2]))
         ((2, 4, 2), True)
         """
-        return tuple(_points_state(q, qd, qdd, idx, s))
+        return tuple(points_state_array(q, qd, qdd, idx, s))
 
     def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
         """Angles (N,) of link index ``i`` (frame: zeros)."""
@@ -560,7 +564,8 @@ def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
     cols = np.ones(len(q0))
     cols[0:3 * n_links:3] = cols[1:3 * n_links:3] = scale
     return PlanarSystem(mech, tuple(moving), origin0, angle0, tuple(b.cons), tuple(b.drivers), len(q0), m, q0,
-                        scale, vll=modes, notes=tuple(b.notes), row_scale=rows, col_scale=cols)
+                        scale, vll=modes, notes=tuple(b.notes), row_scale=rows, col_scale=cols,
+                        topology=topology_of(mech, vll, prescribed))
 
 
 def _check_joints(mech: Mechanism, src: str) -> None:
@@ -751,10 +756,19 @@ class _Builder:
                               "(a pulley usually turns on its carrier there)")
 
 
+def points_state_array(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """:meth:`PlanarSystem.points_state` as one array (3, m, N, 2): the positions,
+    velocities and accelerations of the points ``s`` (m, 2; local) of the links ``idx``
+    (m,) over the configurations ``q`` and their rates ``qd``, ``qdd`` (N, n), so that a
+    caller masks all three at once.
 
-
-def _points_state(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """:meth:`PlanarSystem.points_state` as one array (3, m, N, 2) (a caller masks all three at once)."""
+    Examples
+    --------
+    >>> import numpy as np
+    >>> q = np.array([[1.0, 2.0, np.pi / 2]]); qd = np.array([[0.0, 0.0, 1.0]]); qdd = np.zeros((1, 3))
+    >>> (points_state_array(q, qd, qdd, np.array([0]), np.array([[1.0, 0.0]])).round(12)[:, 0, 0] + 0.0).tolist()
+    [[1.0, 3.0], [-1.0, 0.0], [0.0, -1.0]]
+    """
     m, N, qT, qdT, qddT = len(idx), q.shape[0], q.T, qd.T, qdd.T  # q.T (n, N): rows are coordinates
     if m == 1:  # one point: views of its link's rows, its local point as two floats
         i = 3 * int(idx[0])

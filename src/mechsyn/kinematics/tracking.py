@@ -16,8 +16,8 @@ import math
 import numpy as np
 
 from mechsyn.kinematics.chain import poses_from_chain, fast_chain
-from mechsyn.kinematics.groups import Plan, _cons_of
-from mechsyn.kinematics.positions import TrackedPositions, _State, _pose_rows, _solve_step
+from mechsyn.kinematics.groups import Plan, cons_of
+from mechsyn.kinematics.positions import PoseState, TrackedPositions, pose_rows, solve_step
 from mechsyn.kinematics.folds import SINGULAR_DISC, disc_at, swept, fold_events, touch_candidates
 from mechsyn.kinematics.sweep import Event
 from mechsyn.kinematics.system import PlanarSystem
@@ -103,21 +103,21 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     """
     X, n0, shift = _tracking_rows(S, inputs)
     M = X.shape[0]
-    st = _State(S, M)
+    st = PoseState(S, M)
     sigmas: list = []
     discs: dict = {}
     singular = np.zeros(M, bool)
     raw_events: list = []
     for k, step in enumerate(plan.steps):
         if step.kind not in BRANCHED:
-            sigmas.append(_solve_step(S, st, step, X, None))
+            sigmas.append(solve_step(S, st, step, X, None))
             continue
         choose = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular)
-        sigmas.append(_solve_step(S, st, step, X, choose))
-    q = _pose_rows(S, st, plan)
+        sigmas.append(solve_step(S, st, step, X, choose))
+    q = pose_rows(S, st, plan)
     for step in plan.steps:  # a link driven from the frame takes the input's own turn count
         if step.kind == "drive_R" and step.known[0] < 0:
-            con = next(c for c in _cons_of(S, step.joints[0]) if c.role == "drive")
+            con = next(c for c in cons_of(S, step.joints[0]) if c.role == "drive")
             sgn = 1.0 if con.b == step.links[0] else -1.0
             q[n0:, 3 * step.links[0] + 2] += sgn * shift[con.driver]
     sig_out = [s[n0:] if isinstance(s, np.ndarray) else s for s in sigmas]

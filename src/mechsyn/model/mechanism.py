@@ -321,8 +321,7 @@ class Mechanism:
         """The same mechanism with some joints moved (``{joint id: (x, y)}``): only
         numbers change (no parsing, no validation of the structure), so a simulation of
         the result reuses the compiled program of every mechanism of the same topology
-        (:func:`mechsyn.kinematics.refill.topology_key`), and shares this mechanism's
-        :func:`topology_memo`. Named points keep their drawn positions. An unknown joint
+        (:class:`mechsyn.kinematics.topology.Topology`). Named points keep their drawn positions. An unknown joint
         or a point that is not ``dim`` finite numbers raises
         :class:`~mechsyn.errors.MechsynInputError`.
 
@@ -334,10 +333,7 @@ class Mechanism:
         [3.1, 2.9]
         """
         joints = list(self.joints)
-        memo = topology_memo(self)
-        index = memo.get("joint index")
-        if index is None:
-            index = memo["joint index"] = {j.id: k for k, j in enumerate(joints)}
+        index = {j.id: k for k, j in enumerate(joints)}
         dim = self.dim
         for jid, p in points.items():
             k = index.get(jid)
@@ -355,9 +351,7 @@ class Mechanism:
                                         source=self.source, field=f"joints.{jid}.point",
                                         hint="give e.g. (x, y) in the file's length unit")
             joints[k] = fields_replaced(joints[k], point=arr)
-        new = fields_replaced(self, joints=tuple(joints))
-        new.__dict__["_topology_memo"] = memo  # the same topology: what it decides is shared
-        return new
+        return fields_replaced(self, joints=tuple(joints))
 
     def widget(self, root: str = ".") -> MechanismWidget:
         """This mechanism in mechsyn studio's editor as a Jupyter widget (``mechsyn[web,notebook]``);
@@ -415,8 +409,7 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     hundred nanoseconds instead of the generated ``__init__``'s microseconds, which a
     fresh geometry paid per joint, constraint and driver on every call of a drag. The
     names are checked against the class's fields, and a class with a ``__post_init__``
-    (whose checks this would skip) is refused. A mechanism's :func:`topology_memo` is
-    not carried over.
+    (whose checks this would skip) is refused.
 
     Examples
     --------
@@ -438,7 +431,6 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
     fields = new.__dict__
     fields.update(obj.__dict__)
     fields.update(changes)
-    fields.pop("_topology_memo", None)  # a mechanism's (topology_memo): the changes may change its topology
     return new
 
 
@@ -447,23 +439,3 @@ def fields_replaced(obj: Any, **changes: Any) -> Any:
 _FIELD_NAMES: dict[type, frozenset | None] = {}
 
 
-def topology_memo(mech: Mechanism) -> dict:
-    """A dict kept with ``mech`` for what its topology alone decides (its links, joints'
-    ids, types, links and drives, named points' links; no number of its geometry), shared
-    with the mechanisms :meth:`Mechanism.with_joint_points` makes of it (they differ in
-    joint points only) and not carried over by :func:`fields_replaced` nor
-    ``dataclasses.replace``. A drag's fresh mechanism finds what its topology decides
-    (:func:`mechsyn.kinematics.refill.topology_key`, the joints' indices) computed.
-
-    Examples
-    --------
-    >>> import mechsyn as ms
-    >>> m = ms.examples.load("crank_rocker")
-    >>> topology_memo(m)["x"] = 1
-    >>> topology_memo(m.with_joint_points({"C": (3.1, 2.9)})).get("x"), topology_memo(fields_replaced(m)).get("x")
-    (1, None)
-    """
-    memo = mech.__dict__.get("_topology_memo")
-    if memo is None:
-        memo = mech.__dict__.setdefault("_topology_memo", {})
-    return memo

@@ -112,7 +112,7 @@ def _build(case: MechanismCase, x: np.ndarray, fast: bool = True) -> tuple[Any, 
 class _Template:
     """A case's mechanism parsed once (the file's design, locked VLLs merged) and its
     compiled plan: every design is the same topology
-    (:func:`~mechsyn.kinematics.refill.topology_key`) with other numbers, so its
+    (:func:`~mechsyn.kinematics.topology.topology_key`) with other numbers, so its
     mechanism is the template's with the design's joint points, P axes and named points
     (:func:`~mechsyn.synthesis.designs.design_numbers`), checked by the reader's geometry
     checks (:func:`~mechsyn.io.checks.check_geometry`), and its plan the template's
