@@ -416,9 +416,12 @@ def test_kinematics_computes_without_reading_drawing_or_terminal_packages():
 #: made public, moved to the module that uses it, or the two modules are one.
 KINEMATICS_PRIVATE_IMPORTS_MAX = 10
 #: The kinematics' caches are its one bounded LRU, ``kinematics.topology.CACHE`` (issue
-#: 37); TEMPORARY: the memoized pure functions of the regular pass's files being
-#: rewritten on another branch (each goes with its rewrite).
-TEMPORARY_KINEMATICS_CACHES = frozenset({"folds.py:_pass_layout", "tracking.py:_tracking_path"})
+#: 37); TEMPORARY: what the regular pass still keeps on its own, each to go into
+#: ``topology.CACHE`` or away: two memoized pure functions (the row layout of a pass
+#: through folds, the connecting path from the drawn inputs) and the kernel's kept
+#: cosines and sines of the last input blocks and stacks (``kernel.trig``).
+TEMPORARY_KINEMATICS_CACHES = frozenset({"folds.py:_pass_layout", "tracking.py:_tracking_path",
+                                         "kernel.py:_BLOCKS", "kernel.py:_STACKS"})
 
 
 def kinematics_private_imports(root: Path = KINEMATICS) -> list[str]:
@@ -440,7 +443,8 @@ def test_kinematics_modules_import_few_private_names():
 
 def test_the_kinematics_cache_is_one():
     """No ``lru_cache``/``cache`` decorator in kinematics but the temporary ones, and the
-    only module-level LRU is ``topology.CACHE``."""
+    only module-level LRU (or other store filled at run time: a mapping, or a list,
+    dict or set that starts empty) is ``topology.CACHE``."""
     found = set()
     for path in sorted(KINEMATICS.glob("*.py")):
         tree = ast.parse(path.read_text(encoding="utf-8"))
@@ -451,10 +455,15 @@ def test_the_kinematics_cache_is_one():
                     if name.split(".")[-1] in ("lru_cache", "cache"):
                         found.add(f"{path.name}:{node.name}")
         for node in tree.body:
-            if isinstance(node, (ast.Assign, ast.AnnAssign)) and isinstance(node.value, ast.Call):
-                called = ast.unparse(node.value.func).split(".")[-1]
-                if called in ("OrderedDict", "LRUCache", "WeakValueDictionary", "WeakKeyDictionary"):
-                    found.add(f"{path.name}:{ast.unparse(node.targets[0] if isinstance(node, ast.Assign) else node.target)}")
+            if not isinstance(node, (ast.Assign, ast.AnnAssign)) or node.value is None:
+                continue
+            value, target = node.value, node.targets[0] if isinstance(node, ast.Assign) else node.target
+            called = ast.unparse(value.func).split(".")[-1] if isinstance(value, ast.Call) else ""
+            empty = (isinstance(value, (ast.List, ast.Set)) and not value.elts
+                     or isinstance(value, ast.Dict) and not value.keys
+                     or called in ("dict", "list", "set", "defaultdict") and not value.args and not value.keywords)
+            if empty or called in ("OrderedDict", "LRUCache", "WeakValueDictionary", "WeakKeyDictionary"):
+                found.add(f"{path.name}:{ast.unparse(target)}")
     assert found == {"topology.py:CACHE"} | TEMPORARY_KINEMATICS_CACHES
 
 

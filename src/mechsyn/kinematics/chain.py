@@ -150,9 +150,9 @@ def _link_angles(S: PlanarSystem, plan: Plan, U: np.ndarray, cos: np.ndarray, si
 
 def _angle_plan(S: PlanarSystem, plan: Plan) -> tuple:
     """The links turned by frame drivers, the others (a slice when they are a range)
-    and their drawn angles (m, 1), kept with the system; the links (the topology's) in
-    ``S.cache["programs"]``, which a refilled geometry shares
-    (:func:`~mechsyn.kinematics.refill.with_geometry`)."""
+    and their drawn angles (m, 1), kept with the system; the links (the topology's):
+    the :class:`~mechsyn.kinematics.topology.Topology`'s product ``"angles"``, which a
+    refilled geometry shares (:func:`~mechsyn.kinematics.refill.with_geometry`)."""
     memo = geometry_memo(S)
     key = ("angles", id(plan))
     hit = memo.get(key)
