@@ -114,6 +114,22 @@ def test_sarrus_change_and_fold_inputs_exact_to_a_millionth_of_the_step(alpha, s
     assert len(dead) == 1 and abs(dead[0]["input"]["A1"] - fold) < 1e-6 * step
 
 
+@pytest.mark.parametrize("step,offset", [(2.0, 0.0), (3.0, 0.0), (1.7, 0.3), (0.9, 0.1)])
+def test_sarrus_rank_two_crossings_found_over_a_full_turn(step, offset):
+    """The equal-legged Sarrus (both legs stretched or folded flat at once: two singular
+    values vanish together, so the determinant keeps its sign and the ratio's V is bent)
+    over nearly a full turn of A1: its four change points at ``A1 = -90 - alpha, -alpha,
+    90 - alpha, 180 - alpha`` are each reported once, within 1e-6 of the step (at steps 2 and 3
+    the two folds flat, at -40 and 140, were missed: neither a sign change nor a sharp V)."""
+    alpha = 40.0
+    g = np.arange(-185 + offset, 175, step)
+    s = ms.simulate(sarrus(alpha, leg_b=(1.0, 1.0)), {"A1": g})
+    assert s.assembled.all()
+    got = sorted(e["input"]["A1"] for e in s.events if e["kind"] == "singular")
+    want = [-90 - alpha, -alpha, 90 - alpha, 180 - alpha]
+    assert len(got) == 4 and np.abs(np.array(got) - want).max() < 1e-6 * step
+
+
 # --------------------------------------------------------------------------- 3. any size and place
 @pytest.mark.parametrize("centre,radius", [((1e-3, 0, 0), 1.0), ((1e4, -2e3, 5e3), 1.0), ((1e6, -3e5, 5e5), 1.0),
                                            ((1.0, 0.5, -0.2), 1e-6), ((1.0, 0.5, -0.2), 1e-3)])

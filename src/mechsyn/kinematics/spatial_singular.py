@@ -107,7 +107,7 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
             if found is not None:
                 out.append(found)
     seen = {c[0] for c in out} | {c[0] + 1 for c in out}
-    return out + _v_minima(tr, w, U, ratio, seen)
+    return out + _v_minima(tr, w, U, ratio, seen, Jc, idx)
 
 
 def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[int, np.ndarray, float, int | None] | None:
@@ -122,10 +122,14 @@ def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[int, np.ndarra
     return k, found[0], found[1], on
 
 
-def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set) -> list:
-    """Rows whose ratio is a sharp local minimum (``r0 + r2 >= 4 r1``: every V passes)
-    refined by a golden-section search; a crossing where it falls under the singular
-    tolerance. Rows in ``seen`` (next to a crossing found by the determinant) are skipped."""
+def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set, Jc: np.ndarray,
+              idx: np.ndarray) -> list:
+    """Rows whose ratio is a local minimum that may touch zero refined by a golden-section
+    search; a crossing where it falls under the singular tolerance. A local minimum may touch
+    zero when it is a sharp V (``r0 + r2 >= 4 r1``: every symmetric V passes) or when
+    :func:`_may_touch` allows it (a crossing where two singular values vanish at once keeps
+    the determinant's sign, and its V is bent by the largest one's change). Rows in ``seen``
+    (next to a crossing found by the determinant) are skipped."""
     tol = singular_tol(tr.M)
     if len(U) < 3:
         return []
@@ -133,18 +137,34 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set)
     same = ok[:-2] & ok[1:-1] & ok[2:] & (how[:-2] == how[1:-1]) & (how[1:-1] == how[2:])
     r0, r1, r2 = ratio[:-2], ratio[1:-1], ratio[2:]
     with np.errstate(invalid="ignore"):
-        vee = same & (r1 <= r0) & (r1 <= r2) & (r0 + r2 >= 4 * r1) & (r1 >= tol)
+        low = same & (r1 <= r0) & (r1 <= r2) & (r1 >= tol)
+        vee = r0 + r2 >= 4 * r1
     a, b = U[1:-1] - U[:-2], U[2:] - U[1:-1]
     ab = np.einsum("ij,ij->i", a, b)
-    vee &= (ab > 0) & (np.abs(ab) >= (1 - 1e-9) * np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+    low &= (ab > 0) & (np.abs(ab) >= (1 - 1e-9) * np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
     out = []  # (the last test: on one straight stretch of the sweep)
-    for k in np.flatnonzero(vee) + 1:
+    for k in np.flatnonzero(low) + 1:
         if seen & {k - 1, k, k + 1}:
+            continue
+        if not vee[k - 1] and not _may_touch(Jc[np.searchsorted(idx, k) + np.arange(-1, 2)], tr.rank):
             continue
         found = _golden(tr, w, U, [k - 1, k, k + 1])
         if found is not None and found[1] < tol:
             out.append((int(k), found[0], found[1], None))
     return out
+
+
+def _may_touch(J3: np.ndarray, r: int, samples: int = 17) -> bool:
+    """Whether ``σ_r`` may vanish between the first and last of three consecutive rows'
+    Jacobians ``J3`` (3, m, k): along the path ``J(t)`` differs from the piecewise linear
+    interpolation of the rows by at most about ``‖Δ²J‖ / 8`` (the second difference), so by
+    Weyl's inequality ``σ_r`` can vanish only where ``σ_r`` of the interpolation is within
+    that of zero (taken within four times it, ``‖Δ²J‖ / 2``, sampled at ``samples`` points)."""
+    curv = np.linalg.norm(J3[2] - 2 * J3[1] + J3[0], 2)
+    t = np.linspace(0.0, 1.0, samples // 2 + 1)[:, None, None]
+    lines = np.concatenate([J3[0] + t * (J3[1] - J3[0]), J3[1] + t[1:] * (J3[2] - J3[1])])
+    sv = np.linalg.svd(lines, compute_uv=False)[:, r - 1]
+    return bool(sv.min() <= 0.5 * curv)
 
 
 def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.ndarray, float] | None:
