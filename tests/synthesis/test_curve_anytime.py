@@ -143,3 +143,64 @@ def test_any_limit_answers_with_the_best_it_has(db):
     assert res.candidates and res.refined == 0 and all(c.verified for c in res.candidates)
     assert not res.candidates[0].refined and "not refined" in str(res)
     assert any(n.startswith("time limit") for n in res.notes)
+
+
+class _Ticks:
+    """An injected clock: every reading advances it by ``step`` seconds (no real time)."""
+
+    def __init__(self, step: float):
+        self.t, self.step = 1000.0, step
+
+    def __call__(self) -> float:
+        self.t += self.step
+        return self.t
+
+
+def test_a_timed_run_uses_its_limit_and_keeps_it(db, monkeypatch):
+    # the clock reads are the only time: a run that does not reach its target error
+    # refines until the limit, less the final checks' share, and ends within 5 % of it
+    from mechsyn.synthesis.curves import fitting
+
+    clock = _Ticks(0.05)
+    monkeypatch.setattr(fitting, "CLOCK", [clock])
+    res = synthesize_curve(_coupler(3), max_links=6, top=3, database=db, time_limit=10.0, target_error=1e-12)
+    assert res.candidates and res.refined >= 3
+    assert res.candidates[0].chamfer > 1e-12 and any(n.startswith("time limit") for n in res.notes)
+    assert 0.8 * 10.0 <= res.seconds <= 1.05 * 10.0
+
+
+@pytest.mark.parametrize("spent", [0.95, 3.0])
+def test_a_run_whose_start_used_its_time_still_answers_within_it(db, monkeypatch, spent):
+    # the process's start (imports, loading) took 95 % of the limit, or three times it: one
+    # retrieved design within the bounds, evaluated and checked, is the answer, and nothing
+    # more is begun (the few clock reads of that minimum are the only time added)
+    from mechsyn.synthesis.curves import fitting
+
+    clock = _Ticks(0.01)
+    monkeypatch.setattr(fitting, "CLOCK", [clock])
+    res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, time_limit=4.0,
+                           started=clock() - spent * 4.0)
+    assert res.candidates and res.refined == 0 and res.candidates[0].verified
+    assert not res.candidates[0].refined and any(n.startswith("time limit") for n in res.notes)
+    assert res.seconds <= spent * 4.0 + 0.05 * 4.0
+
+
+def test_the_database_is_packed_once_and_mapped_after(tmp_path):
+    from mechsyn.synthesis.curves import database as dbm
+
+    build_database(tmp_path, max_links=6, per_topology=40)
+    first = load_database(tmp_path, build_if_missing=False)      # read from the files, then packed
+    assert (tmp_path / dbm.PACKED / "manifest.json").is_file()
+    again = load_database(tmp_path, build_if_missing=False)      # mapped from the pack
+    assert isinstance(again.designs, np.memmap) and not isinstance(first.designs, np.memmap)
+    for k in ("topology", "designs", "ranges", "closed", "descriptors"):
+        np.testing.assert_array_equal(getattr(first, k), getattr(again, k))
+    six = next(r for r in range(len(again)) if again.topologies[again.topology[r]].n_links == 6)
+    assert again.design(0).shape == (10,) and again.design(six).shape == (16,)   # 7 joints and the tracer
+    # a damaged pack is read again from the files; a file changed since packing is repacked
+    (tmp_path / dbm.PACKED / "designs.npy").write_bytes(b"\x93NUMPY broken")
+    assert not isinstance(load_database(tmp_path, build_if_missing=False).designs, np.memmap)
+    build_database(tmp_path, max_links=6, per_topology=60)       # extends every file
+    grown = load_database(tmp_path, build_if_missing=False)
+    assert len(grown) > len(first) and not isinstance(grown.designs, np.memmap)
+    assert len(load_database(tmp_path, build_if_missing=False)) == len(grown)

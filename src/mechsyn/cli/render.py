@@ -277,10 +277,10 @@ def render_path_synthesis(case: Any, res: Any) -> None:
                   f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
                   + ("   (target error reached)" if res.target_reached else ""))
     if res.size_ratio is not None:
-        console.print(f"size: {res.size_ratio:.4g} target diagonals about the targets' centre"
+        console.print(f"size: {res.size_ratio:.4g} target diagonals about the targets' centroid"
                       + (f" (bound {res.max_size:g})" if res.max_size else " (no size bound)"), highlight=False)
-    if res.limited_by:
-        console.print(f"[bold yellow]a bound decides this result:[/] {res.limited_by}", highlight=False)
+    if res.reason:   # why it is infeasible, or the bound that decides it and how to lift it
+        console.print(f"[bold yellow]{escape(res.reason)}[/]", highlight=False)
     console.print(_transmission_line(res))
 
 

@@ -18,6 +18,16 @@ from mechsyn.synthesis.curves.descriptors import resample
 from mechsyn.synthesis.curves.target import TargetCurve
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
 
+
+def now() -> float:
+    """The search's clock, ``time.perf_counter()``: every deadline of the curve search is read
+    from it (a test may replace :data:`CLOCK` with a clock of its own)."""
+    return CLOCK[0]()
+
+
+#: the clock :func:`now` reads, in a one-entry list
+CLOCK = [time.perf_counter]
+
 M_TARGET = 64          # target points for the residuals
 N_TRACE = 96           # input samples along the range (refinement)
 N_FINAL = 360          # input samples of the reported path and errors
@@ -217,14 +227,14 @@ class FitProblem:
             j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
         self.link_pairs = link_pairs(self.topo)
         self.nfev = 0
-        self.deadline = float("inf")     # time.perf_counter() past which an evaluation raises OutOfTime
+        self.deadline = float("inf")     # now() past which an evaluation raises OutOfTime
         self.best = (float("inf"), None)  # (cost, x) of the best design evaluated by fun
 
     def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
         """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
         segments of the first design are used for all (the Jacobian's perturbations)."""
         X = np.atleast_2d(X)
-        if time.perf_counter() > self.deadline:
+        if now() > self.deadline:
             raise OutOfTime
         self.nfev += len(X)
         res = simulate_batch(self.plan, X, self.off, transmission=self.bounds.transmission > 0)
