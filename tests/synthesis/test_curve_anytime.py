@@ -10,7 +10,7 @@ import pytest
 from mechsyn.errors import MechsynInputError
 from mechsyn.synthesis.curves.candidates import MOST_ACCURATE, SIMPLEST, CurveCandidate, ranked
 from mechsyn.synthesis.curves.database import build_database, load_database
-from mechsyn.synthesis.curves.fitting import chamfer_error, departure
+from mechsyn.synthesis.curves.fitting import chamfer_error, curve_errors, departure, nearest_chamfer
 from mechsyn.synthesis.curves.frame import Frame
 from mechsyn.synthesis.curves.synthesis import synthesize_curve
 from mechsyn.synthesis.curves.target import TargetCurve, principal_diagonal, read_target, target_from_points
@@ -53,7 +53,36 @@ def test_the_error_is_the_symmetric_chamfer_over_arc_length():
     pts = np.c_[np.cos(s), np.sin(s)]
     d_target = np.where(np.sin(s) >= 0, 0.0, np.minimum(np.hypot(*(pts - [1, 0]).T), np.hypot(*(pts - [-1, 0]).T)))
     expect = 0.5 * d_target.mean() / D          # the arc's own points lie on the target
-    assert chamfer_error(arc, target, False) == pytest.approx(expect, rel=2e-3)
+    assert nearest_chamfer(arc, target, False) == pytest.approx(expect, rel=2e-3)
+    # in order, the missing half is matched to the arc's nearer end too (the start is free):
+    # the same value, up to the 64 samples' mean over arc length
+    assert chamfer_error(arc, target, False) == pytest.approx(expect, rel=1e-2)
+
+
+def test_the_error_sees_the_order_a_loop_that_cuts_across_loses():
+    # the circle's quarters visited in the order 1, 3, 2, 4, the path jumping across the
+    # inside between them, against a loop going round the circle 0.2 outside it: the
+    # order-free measure prefers the one cutting across (0.069 against 0.2), the error (in
+    # order) the one going round (0.26 against 0.2)
+    target = TargetCurve(_circle(400), closed=True)
+    D = target.diagonal
+
+    def quarter(k):
+        s = np.linspace(k * np.pi / 2, (k + 1) * np.pi / 2, 200)
+        return np.c_[np.cos(s), np.sin(s)]
+
+    across, round_ = np.vstack([quarter(0), quarter(2), quarter(1), quarter(3)]), _circle(800, 1.2)
+    assert nearest_chamfer(across, target, True) < 0.5 * nearest_chamfer(round_, target, True)
+    assert chamfer_error(across, target, True) > 1.2 * chamfer_error(round_, target, True)
+    assert chamfer_error(round_, target, True) == pytest.approx(0.2 / D, rel=1e-3)
+    assert chamfer_error(across, target, True) >= nearest_chamfer(across, target, True)
+    ch, near, _ = curve_errors(across, target, True)
+    assert ch == chamfer_error(across, target, True) and near == nearest_chamfer(across, target, True)
+    # whatever the start point and the sense of the path (a path with corners: up to its sampling)
+    for P in (np.roll(round_, 333, axis=0), round_[::-1]):
+        assert chamfer_error(P, target, True) == pytest.approx(chamfer_error(round_, target, True), rel=1e-4)
+    for P in (np.roll(across, 333, axis=0), across[::-1]):
+        assert chamfer_error(P, target, True) == pytest.approx(chamfer_error(across, target, True), rel=3e-2)
 
 
 def test_the_departure_is_the_target_point_farthest_from_the_path():

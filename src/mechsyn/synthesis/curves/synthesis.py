@@ -24,8 +24,11 @@ linkages whose tracing point follows it:
    ordinary :func:`mechsyn.kinematics.simulate` and comparing the tracer's path.
 
 **The error** shown and ranked by is :func:`~mechsyn.synthesis.curves.fitting.chamfer_error`:
-the symmetric chamfer distance, each curve's points (equally spaced in arc length) to the
-other curve's polyline, over the target's diagonal along its principal axes. ``ordered``
+the symmetric chamfer distance along the curves in order, each curve's points (equally
+spaced in arc length) to the other curve's polyline where a correspondence running along
+both in order puts them, over the target's diagonal along its principal axes: a loop that
+cuts across a letter loses to one that goes round it. ``nearest`` (the order-free chamfer,
+each point to the nearest point of the other curve anywhere) is reported beside it. ``ordered``
 (RMS distance between points equally spaced in arc length, best start and sense) is
 reported as a diagnostic of the timing only.
 
@@ -212,13 +215,13 @@ def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, cl
     if not res.assembled.all() or res.branch_jump[0]:
         return None
     path = res.paths[TRACER][0]
-    ch, od = curve_errors(path, target, closed, bounds.unit)
+    ch, near, od = curve_errors(path, target, closed, bounds.unit)
     size = float(path_sizes(res.paths, bounds.centre)[0])
     at, far = departure(path, target, closed)
     return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
                           float(res.min_transmission_angle[0]), float(link_ratio(x, link_pairs(topo))[0]),
                           path, nfev=nfev, size=size, size_ratio=size / bounds.unit, refined=refined,
-                          departs_at=at, departure=far / bounds.unit)
+                          departs_at=at, departure=far / bounds.unit, nearest=near)
 
 
 def _verify(c: CurveCandidate) -> None:
