@@ -148,7 +148,7 @@ def table(files: list[Path]) -> str:
     """The docs' Markdown table of one or more result files (a row group per file)."""
     lines = []
     for f in files:
-        rows = json.loads(f.read_text())
+        rows = sorted(json.loads(f.read_text()), key=lambda r: r["letter"])   # a letter run again: in its place
         limit = float(rows[0]["limit"])
         head = "| " + f"{limit:g} s" + " | " + " | ".join(r["letter"] for r in rows) + " |"
         lines += [head, "|---" * (len(rows) + 1) + "|"]
@@ -199,6 +199,7 @@ def _path(cand: dict) -> list:
 
 def gallery(rows: list[dict], path: Path) -> None:
     """Each letter (grey) and its best path (blue within 2 %, red beyond), error in the title."""
+    rows = sorted(rows, key=lambda r: r["letter"])
     import matplotlib
 
     matplotlib.use("Agg")
