@@ -344,8 +344,8 @@ def render_curve_synthesis(res: Any) -> None:
             console.print(f"{i}: departs most at points[{c.departs_at}] ({x:.4g}, {y:.4g}), "
                           f"{100 * c.departure:.2f} % of the diagonal away", highlight=False)
     limit = f" of {res.time_limit:g} s" if getattr(res, "time_limit", None) else ""
-    console.print(f"error: symmetric chamfer (target and path, each point to the other curve, mean over arc "
-                  f"length) / the target's diagonal ({tgt.diagonal:.4g}, along its principal axes); size: "
+    console.print(f"error: symmetric chamfer along both curves in order (target and path, each point to the "
+                  f"other curve where the order puts it, mean over arc length) / the target's diagonal ({tgt.diagonal:.4g}, along its principal axes); size: "
                   f"radius about the target's centroid, in diagonals; {res.refined} refinements of "
                   f"{res.retrieved} retrieved designs in {res.seconds:.1f} s{limit}; every candidate "
                   "re-simulated by simulate" + ("; interrupted: best so far" if res.interrupted else ""),
