@@ -2,7 +2,7 @@
 
 Run from the repository root::
 
-    python benchmarks/curve_anytime.py [--short 4] [--limit 30] [--turn 37] [--seeds 3]
+    python benchmarks/curve_anytime.py [--short 4] [--limit 30] [--turn 37] [--seeds 3] [--no-turn]
 
 Through the CLI (one process per run, CLI defaults, the default database):
 
@@ -59,6 +59,7 @@ def main() -> None:
     ap.add_argument("--limit", type=float, default=30.0)
     ap.add_argument("--turn", type=float, default=37.0)
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--no-turn", action="store_true", help="the short limits only")
     args = ap.parse_args()
     rng4, rng6 = np.random.default_rng(41_004), np.random.default_rng(41_006)
     a = np.radians(args.turn)
@@ -68,10 +69,11 @@ def main() -> None:
         for i in range(args.seeds):
             res, dt, code = cli(random_linkage_curve(4, rng4) * 50.0, args.short, tmp)
             c = res["candidates"][0] if res["candidates"] else None
-            print(f"four-bar {i + 1}, --time-limit {args.short:g}: exit {code}, {dt:.1f} s wall, "
+            print(f"four-bar {i + 1}, --time-limit {args.short:g}: exit {code}, {dt:.2f} s wall "
+                  f"(load average {os.getloadavg()[0]:.1f}), "
                   + (f"{c['topology']} at {100 * c['error']['chamfer']:.2f} %"
                      + ("" if c["refined"] else " (retrieved, not refined)") if c else "no candidate"), flush=True)
-        for i in range(args.seeds):
+        for i in range(0 if args.no_turn else args.seeds):
             P = random_linkage_curve(6, rng6) * 50.0
             r0, t0, _ = cli(P, args.limit, tmp)
             r1, t1, _ = cli(P @ R.T, args.limit, tmp)

@@ -160,7 +160,7 @@ def best_fourbar_by_synth_path(points: np.ndarray, time_limit: float, seed: int 
         run = max(runs, key=len)
         P = P[run]
     tgt = target_from_points(points, closed=True)
-    ch, _ = curve_errors(P, tgt, closed)
+    ch = curve_errors(P, tgt, closed)[0]
     return ch, P, closed
 
 

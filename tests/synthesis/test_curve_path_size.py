@@ -13,6 +13,7 @@ import pytest
 from dimsynth_data import public_cases, public_data  # noqa: F401  (fixtures)
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.synthesis.curves.target import principal_diagonal
 from mechsyn.synthesis.fourbar import fourbar_position
 from mechsyn.synthesis.optimize import synthesize_path, with_size_bound
 from mechsyn.synthesis.path import PathCase, PathProblem
@@ -36,8 +37,13 @@ def test_the_known_large_linkage_is_outside_a_size_bound_and_inside_when_lifted(
     assert with_size_bound(case, 1.5).max_size == 1.5 and lifted.case.max_size is None
     vals = bounded.unpack(x[None])[0]
     T = case.targets
-    diag = np.hypot(*np.ptp(T, axis=0))
-    centre = 0.5 * (T.min(axis=0) + T.max(axis=0))
+    diag = principal_diagonal(T)
+    # independently: the centroid of the closed polyline through the targets (each side's
+    # midpoint weighted by its length), not the bounding box's centre
+    sides = np.roll(T, -1, axis=0) - T
+    w = np.hypot(*sides.T)
+    centre = ((T + 0.5 * sides) * w[:, None]).sum(axis=0) / w.sum()
+    assert np.hypot(*(centre - 0.5 * (T.min(axis=0) + T.max(axis=0)))) > 0.05 * diag
     # independently: pivot O2 at the origin, O4 at (r1, 0); crank and rocker circles
     expect = max(np.hypot(*centre) + x[1], np.hypot(*(centre - [x[0], 0])) + x[3])
     assert bounded.size(vals)[0] == pytest.approx(expect)
@@ -62,6 +68,7 @@ def test_a_bound_that_decides_the_result_is_named_with_how_to_lift_it(cli_json, 
     res = synthesize_path(case, seed=0, time_limit=60, restarts=3, max_size=2.0)
     assert res.feasible and res.error > 1e-6 and res.size_ratio == pytest.approx(2.0, rel=1e-5)
     assert "size bound 2" in res.limited_by and "--max-size 0" in res.limited_by
+    assert res.reason == f"a bound decides this result: {res.limited_by}" == res.to_dict()["reason"]
     tight = dataclasses.replace(case, variables=tuple(
         dataclasses.replace(v, upper=2.0) if v.name == "r1" else v for v in case.variables))
     res = synthesize_path(tight, seed=0, time_limit=60, restarts=2)
@@ -85,3 +92,18 @@ def test_case_option_and_cli_option(tmp_path, cli_json):
     f.write_text(json.dumps(case.raw))
     data = cli_json("synth", "path", f, "--restarts", "1", "--time-limit", "30", "--max-size", "0")
     assert data["max_size"] is None and data["feasible"]
+
+
+def test_an_angle_limit_the_design_sits_on_is_named_too():
+    from mechsyn.synthesis.optimize import bounds_deciding
+
+    case, x = _known_case()
+    d = dict(zip(("r1", "r2", "r3", "r4", "rcx", "rcy"), x))
+    lim = case.transmission_angle_min_deg
+    on = bounds_deciding(case, d, None, {"worst_transmission_angle_deg": lim, "fold_distance_deg": 40.0})
+    assert on.startswith(f"the worst transmission angle {lim:g} deg sits on its limit") and "0 lifts it" in on
+    assert bounds_deciding(case, d, None, {"worst_transmission_angle_deg": lim + 0.5}) == ""
+    assert "fold" not in on     # a case without a Grashof constraint has no fold margin
+    grashof = dataclasses.replace(case, grashof=True, fold_margin_deg=5.0)
+    both = bounds_deciding(grashof, d, None, {"worst_transmission_angle_deg": 35.0, "fold_distance_deg": 5.0})
+    assert "sits on the fold margin 5 (--fold-margin" in both and "transmission" not in both

@@ -277,10 +277,10 @@ def render_path_synthesis(case: Any, res: Any) -> None:
                   f"branch {case.branch}   {res.restarts} restart{'s' if res.restarts != 1 else ''}, {res.seconds:.1f} s"
                   + ("   (target error reached)" if res.target_reached else ""))
     if res.size_ratio is not None:
-        console.print(f"size: {res.size_ratio:.4g} target diagonals about the targets' centre"
+        console.print(f"size: {res.size_ratio:.4g} target diagonals about the targets' centroid"
                       + (f" (bound {res.max_size:g})" if res.max_size else " (no size bound)"), highlight=False)
-    if res.limited_by:
-        console.print(f"[bold yellow]a bound decides this result:[/] {res.limited_by}", highlight=False)
+    if res.reason:   # why it is infeasible, or the bound that decides it and how to lift it
+        console.print(f"[bold yellow]{escape(res.reason)}[/]", highlight=False)
     console.print(_transmission_line(res))
 
 
@@ -344,8 +344,8 @@ def render_curve_synthesis(res: Any) -> None:
             console.print(f"{i}: departs most at points[{c.departs_at}] ({x:.4g}, {y:.4g}), "
                           f"{100 * c.departure:.2f} % of the diagonal away", highlight=False)
     limit = f" of {res.time_limit:g} s" if getattr(res, "time_limit", None) else ""
-    console.print(f"error: symmetric chamfer (target and path, each point to the other curve, mean over arc "
-                  f"length) / the target's diagonal ({tgt.diagonal:.4g}, along its principal axes); size: "
+    console.print(f"error: symmetric chamfer along both curves in order (target and path, each point to the "
+                  f"other curve where the order puts it, mean over arc length) / the target's diagonal ({tgt.diagonal:.4g}, along its principal axes); size: "
                   f"radius about the target's centroid, in diagonals; {res.refined} refinements of "
                   f"{res.retrieved} retrieved designs in {res.seconds:.1f} s{limit}; every candidate "
                   "re-simulated by simulate" + ("; interrupted: best so far" if res.interrupted else ""),

@@ -229,8 +229,8 @@ class PathSynthesisResult(SynthesisResult):
     transmission_angle_min_deg: float | None = None
     fold_margin_deg: float | None = None
     resumed: int = 0
-    size: float | None = None          # radius of the disc about the targets' centre holding the linkage
-    size_ratio: float | None = None    # size / the targets' bounding-box diagonal
+    size: float | None = None          # radius of the disc about the targets' centroid holding the linkage
+    size_ratio: float | None = None    # size / the targets' diagonal (principal axes)
     max_size: float | None = None      # the bound on size_ratio (None: lifted)
     limited_by: str = ""               # the bounds the design sits on and how to lift them ("" when none)
 
@@ -277,9 +277,12 @@ def with_size_bound(case: PathCase, max_size: float | None = None) -> PathCase:
     return dataclasses.replace(case, max_size=max_size or None)
 
 
-def bounds_deciding(case: PathCase, design: dict[str, Any], size_ratio: float | None) -> str:
-    """The bounds a design sits on (within 1e-6 of their span), each with how to lift it;
-    "" when none decides the result.
+def bounds_deciding(case: PathCase, design: dict[str, Any], size_ratio: float | None,
+                    check: dict[str, Any] | None = None) -> str:
+    """The bounds a design sits on (within 1e-6 of their span: a variable's bounds, the size
+    bound, and with ``check`` (:func:`~mechsyn.synthesis.path.evaluate_design`'s) the
+    smallest transmission angle and the fold margin, of 90 degrees), each with how to lift
+    it; "" when none decides the result.
 
     >>> import mechsyn as ms
     >>> from mechsyn.synthesis.path import load_cases
@@ -295,6 +298,7 @@ def bounds_deciding(case: PathCase, design: dict[str, Any], size_ratio: float | 
     if case.max_size and size_ratio is not None and size_ratio >= case.max_size * (1 - 1e-6):
         out.append(f"size {size_ratio:.4g} diagonals sits on the size bound {case.max_size:g} "
                    "(--max-size or options.max_size; --max-size 0 lifts it)")
+    out += _angles_deciding(case, check or {})
     for name, (lo, hi) in case.bounds().items():
         if name.startswith("theta2_") or name not in design or hi - lo <= 0:
             continue
@@ -303,6 +307,19 @@ def bounds_deciding(case: PathCase, design: dict[str, Any], size_ratio: float | 
             if abs(float(design[name]) - b) <= tol:
                 out.append(f"{name} = {b:g} sits on its {side} bound (the case's variables; widen it there)")
     return "; ".join(out)
+
+
+def _angles_deciding(case: PathCase, check: dict[str, Any]) -> list[str]:
+    """The transmission-angle limit and the fold margin where the design's angle sits on them."""
+    out = []
+    mu, fold = check.get("worst_transmission_angle_deg"), check.get("fold_distance_deg")
+    if case.transmission_angle_min_deg and mu is not None and mu <= case.transmission_angle_min_deg + 9e-5:
+        out.append(f"the worst transmission angle {mu:.4g} deg sits on its limit {case.transmission_angle_min_deg:g} "
+                   "(--min-transmission-angle or options.transmission_angle_min_deg; 0 lifts it)")
+    if case.grashof and case.fold_margin_deg and fold is not None and fold <= case.fold_margin_deg + 9e-5:
+        out.append(f"the nearest approach to folding flat {fold:.4g} deg sits on the fold margin "
+                   f"{case.fold_margin_deg:g} (--fold-margin or options.fold_margin_deg; 0 lifts it)")
+    return out
 
 
 def _path_reason(check: dict[str, Any], case: PathCase) -> str:
@@ -510,10 +527,11 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
     design = problem.design(win.z)
     check = evaluate_design(case, design)
     size = float(problem.size(problem.unpack(np.asarray(win.z, float)[None])[0])[0])
-    diag = float(np.hypot(*np.ptp(case.targets, axis=0)))
+    diag = problem.frame[1]
+    deciding = bounds_deciding(case, design, size / diag if diag > 0 else None, check)
     return PathSynthesisResult(
         case_id=case.id, error=check["error"], design=design, x=np.asarray(win.z, float),
-        reason=_path_reason(check, case),
+        reason=_path_reason(check, case) or (f"a bound decides this result: {deciding}" if deciding else ""),
         assembled_at_all_targets=check["assembled_at_all_targets"], feasible=check["feasible"],
         seconds=time.time() - t0, seed=seed, restarts=len(results), nfev=sum(r.nfev for r in results),
         optimizer=optimizer, branch=case.branch, targets=case.targets, path=check["path"],
@@ -525,7 +543,7 @@ def _path_result(case: PathCase, problem: PathProblem, results: list[RestartResu
         transmission_angle_min_deg=case.transmission_angle_min_deg,
         fold_margin_deg=case.fold_margin_deg if case.grashof else None,
         resumed=resumed, size=size, size_ratio=size / diag if diag > 0 else None, max_size=case.max_size,
-        limited_by=bounds_deciding(case, design, size / diag if diag > 0 else None),
+        limited_by=deciding,
     )
 
 

@@ -32,10 +32,12 @@ Constraints (all must hold; see :meth:`PathProblem.evaluate`):
 * a size bound ``options.max_size`` or ``--max-size`` (0 or absent: none; the bounds a
   case states on its variables are its design space, no default overrides them, and the
   result's ``limited_by`` names any bound the design sits on): both frame pivots and the whole circles the
-  crank and rocker pins move on lie within ``max_size`` times the targets'
-  bounding-box diagonal of the box's centre (the linkage, pivots included, fits in a
-  disc ``2 max_size`` diagonals across; the pins' circles are a safe over-estimate of
-  the arcs they sweep);
+  crank and rocker pins move on lie within ``max_size`` diagonals of the targets'
+  centroid, both the curve's own as in ``synth curve``
+  (:func:`~mechsyn.synthesis.curves.target.principal_frame`: the centroid of the polyline
+  through the targets and the diagonal along its principal axes, so the bound turns with
+  the drawing; the linkage, pivots included, fits in a disc ``2 max_size`` diagonals
+  across; the pins' circles are a safe over-estimate of the arcs they sweep);
 * variable bounds.
 
 Feasibility first: an infeasible design scores ``U + violation`` where ``U`` is an upper
@@ -315,11 +317,20 @@ class PathProblem:
         error = np.where(np.isfinite(error), error, np.inf)
         return Evaluation(error=error, violation=viol, assembled_at_all_targets=assembled_all)
 
+    @property
+    def frame(self) -> tuple[np.ndarray, float]:
+        """The targets' centroid ``(2,)`` and diagonal (:func:`~mechsyn.synthesis.curves.target.principal_frame`)."""
+        f = self.__dict__.get("_frame")
+        if f is None:
+            from mechsyn.synthesis.curves.target import principal_frame
+
+            f = self.__dict__["_frame"] = principal_frame(self.case.targets)
+        return f
+
     def size(self, vals: dict[str, np.ndarray]) -> np.ndarray:
-        """Radius ``(P,)`` about the targets' bounding-box centre of the disc holding both
-        frame pivots and the circles of the crank and rocker pins."""
-        T = self.case.targets
-        c = 0.5 * (T.min(axis=0) + T.max(axis=0))
+        """Radius ``(P,)`` about the targets' centroid (:attr:`frame`) of the disc holding
+        both frame pivots and the circles of the crank and rocker pins."""
+        c = self.frame[0]
         a0 = np.hypot(vals["x0"] - c[0], vals["y0"] - c[1])
         bx = vals["x0"] + vals["r1"] * np.cos(vals["theta0"])
         by = vals["y0"] + vals["r1"] * np.sin(vals["theta0"])
@@ -327,8 +338,7 @@ class PathProblem:
         return np.maximum(a0 + np.abs(vals["r2"]), b0 + np.abs(vals["r4"]))
 
     def _size_violation(self, vals: dict[str, np.ndarray]) -> np.ndarray:
-        T = self.case.targets
-        limit = self.case.max_size * max(float(np.hypot(*np.ptp(T, axis=0))), 1e-300)
+        limit = self.case.max_size * max(self.frame[1], 1e-300)
         return np.maximum(0.0, self.size(vals) / limit - 1.0)
 
     def _bound_violation(self, z, vals, th) -> np.ndarray:

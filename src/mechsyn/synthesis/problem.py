@@ -9,7 +9,7 @@ keyword-only with defaults so that a subclass may add positional fields of its o
 |---|---|
 | `error` | the objective of the returned design (its unit is the problem's); `inf` or NaN when nothing feasible was found |
 | `feasible` | whether the returned design meets every constraint |
-| `reason` | why it does not (`""` when feasible) |
+| `reason` | why it does not; when it does, a bound the design sits on that decides it, and how to lift it (`""`: none) |
 | `design` | the design as named values (`{"r1": 2.0, ...}`) |
 | `x` | the same design as the optimiser's vector |
 | `nfev` | objective evaluations (0 for a closed-form construction) |

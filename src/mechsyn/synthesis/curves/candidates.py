@@ -29,7 +29,7 @@ class CurveCandidate:
     params: np.ndarray              # design in the target's coordinates
     start: float                    # input offsets from the reference, degrees
     stop: float
-    chamfer: float                  # the error: symmetric chamfer / the target's diagonal
+    chamfer: float                  # the error: symmetric chamfer along the curves in order / the diagonal
     ordered: float                  # timing diagnostic (not ranked by)
     min_transmission_angle: float
     link_length_ratio: float
@@ -44,6 +44,7 @@ class CurveCandidate:
     role: str = ""                          # SIMPLEST, MOST_ACCURATE, both, or ""
     departs_at: int = -1                    # index of the target point farthest from the path
     departure: float = float("nan")         # that distance / the target's diagonal
+    nearest: float = float("nan")           # the order-free chamfer / the diagonal (a diagnostic)
 
     def __post_init__(self) -> None:
         if not np.isfinite(self.reference_input):
@@ -81,7 +82,7 @@ class CurveCandidate:
             "topology_key": t.key,
             "role": self.role,
             "refined": self.refined,
-            "error": {"chamfer": self.chamfer, "ordered": self.ordered},
+            "error": {"chamfer": self.chamfer, "nearest": self.nearest, "ordered": self.ordered},
             "departs_most": {"point": self.departs_at, "distance": self.departure},
             "quality": self.quality(),
             "min_transmission_angle": self.min_transmission_angle,
@@ -131,8 +132,10 @@ class CurveSynthesisResult(SynthesisResult):
         return {"candidates": [c.to_dict() for c in self.candidates],
                 "target": {"points": self.target.points, "closed": self.target.closed,
                            "diagonal": self.target.diagonal},
-                "error_measure": "symmetric chamfer (points to polyline, both ways, mean over arc length) / "
-                                 "the diagonal of the target's principal-axes bounding box",
+                "error_measure": "symmetric chamfer along the curves in order (points to polyline, both ways, "
+                                 "mean over arc length, a correspondence running along both curves in order) / "
+                                 "the diagonal of the target's principal-axes bounding box; nearest: the same "
+                                 "without the order",
                 "bounds": self.bounds, "nearest_miss": miss, "time_limit": self.time_limit,
                 "seconds": self.seconds, "retrieved": self.retrieved, "refined": self.refined,
                 "interrupted": self.interrupted, "notes": self.notes, **self.common()}

@@ -138,13 +138,17 @@ class CurveDatabase:
 
     topologies: tuple[CurveTopology, ...]
     topology: np.ndarray        # (n,) index into topologies
-    designs: list[np.ndarray]   # per row, (P,) float
+    designs: np.ndarray         # (n, Pmax) float32, row r's first 2 * points(topology) columns its design
     ranges: np.ndarray          # (n, 2) degrees (offsets from the reference)
     closed: np.ndarray          # (n,) bool
     descriptors: np.ndarray     # (n, D) float32
 
     def __len__(self) -> int:
         return len(self.topology)
+
+    def design(self, row: int) -> np.ndarray:
+        """Row ``row``'s design ``(P,)`` (float, in its topology's ``plan.names`` order)."""
+        return np.asarray(self.designs[row, :_width(self.topologies[int(self.topology[row])])], float)
 
     def index(self, n_links: int):
         """``(DescriptorIndex, rows)`` over the descriptors of the ``n_links``-bar rows
@@ -251,8 +255,7 @@ def _check_shapes(shapes: dict, topo: CurveTopology | None) -> None:
         raise _Damaged(f"drawn: shape {shapes['drawn']}, expected a single number")
     if n == 0 and all(shapes[k] == (0,) for k in ("designs", "ranges", "closed", "descriptors")):
         return
-    widths = {"ranges": 2, "descriptors": 2 * N_HARMONICS,
-              "designs": None if topo is None else 2 * len(topo.plan.names)}
+    widths = {"ranges": 2, "descriptors": 2 * N_HARMONICS, "designs": None if topo is None else _width(topo)}
     for k in ("designs", "ranges", "closed", "descriptors"):
         kinds, ndim = _LAYOUT[k]
         if len(shapes[k]) != ndim or shapes[k][0] != n or (ndim == 2 and widths[k] not in (None, shapes[k][1])):
@@ -357,8 +360,14 @@ def _build_one(job) -> tuple[str, dict]:
 
 def load_database(directory: str | os.PathLike[str] | None = None, max_links: int = 8,
                   build_if_missing: bool = True, callback: ProgressCallback | None = None) -> CurveDatabase:
-    """Read the database (topologies up to ``max_links``); build the default small one
-    (4- and 6-bars) first when there is none."""
+    """Read the database (topologies up to ``max_links``); build the default one first when
+    there is none.
+
+    The topologies' files are read and checked once and packed into one memory-mapped
+    set of arrays (``packed/`` in the directory, keyed by the files' names, sizes and
+    modification times): later loads map it in milliseconds instead of decompressing and
+    checking every file again (a second or more, several under load).
+    """
     directory = _database_dir(directory)
     topos = cached_topologies(directory, max(max_links, 4)) if directory.is_dir() else curve_topologies(max(max_links, 4))
     present = [t for t in topos if _file(directory, t).exists()]
@@ -366,6 +375,17 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
         build_database(directory, max_links=min(max_links, DEFAULT_LINKS), per_topology=DEFAULT_PER_TOPOLOGY,
                        callback=callback)
         present = [t for t in topos if _file(directory, t).exists()]
+    stamp = _stamp(directory, present)
+    packed = _read_packed(directory, present, stamp)
+    if packed is not None:
+        return packed
+    db = _read_files(directory, present)
+    _write_packed(directory, db, stamp)
+    return db
+
+
+def _read_files(directory: Path, present: list[CurveTopology]) -> CurveDatabase:
+    """The database from the topologies' files, each checked (:func:`_read_checked`)."""
     rows_t, designs, ranges, closed, desc = [], [], [], [], []
     for ti, t in enumerate(present):
         try:
@@ -380,7 +400,7 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
             continue
         m = len(data["ranges"])
         rows_t.append(np.full(m, ti))
-        designs.extend(np.asarray(data["designs"], float))
+        designs.append(np.asarray(data["designs"], np.float32))
         ranges.append(data["ranges"])
         closed.append(data["closed"])
         desc.append(data["descriptors"])
@@ -389,5 +409,76 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
 
         raise MechsynInputError(f"no curve database in {directory}", field="database",
                                 hint="run `mechsyn curves build`")
-    return CurveDatabase(tuple(present), np.concatenate(rows_t), designs, np.concatenate(ranges).astype(float),
+    width = max(d.shape[1] for d in designs)
+    padded = np.concatenate([np.pad(d, ((0, 0), (0, width - d.shape[1]))) for d in designs])
+    return CurveDatabase(tuple(present), np.concatenate(rows_t), padded, np.concatenate(ranges).astype(float),
                          np.concatenate(closed).astype(bool), np.concatenate(desc).astype(np.float32))
+
+
+def _width(topo: CurveTopology) -> int:
+    """Design columns of a topology: its joints and the tracer, x and y each (read from the
+    template, without compiling the plan)."""
+    return 2 * (len(topo.template["joints"]) + 1)
+
+
+PACKED = "packed"      # the packed arrays' folder inside the database directory
+_PACKED_KEYS = ("topology", "designs", "ranges", "closed", "descriptors")
+_PACKED_KINDS = {"topology": "iu", "designs": "f", "ranges": "f", "closed": "b", "descriptors": "f"}
+
+
+def _stamp(directory: Path, present: list[CurveTopology]) -> list:
+    """What the packed arrays depend on: each topology file's key, size and modification time."""
+    out = []
+    for t in present:
+        st = os.stat(_file(directory, t))
+        out.append([t.key, st.st_size, st.st_mtime_ns])
+    return out
+
+
+def _read_packed(directory: Path, present: list[CurveTopology], stamp: list) -> CurveDatabase | None:
+    """The packed arrays, memory-mapped, when their manifest matches ``stamp`` and they are
+    whole (shapes, kinds, finite values, topology indices in range); None otherwise (they
+    are then packed again from the files)."""
+    import json
+
+    from mechsyn.errors import MechsynInputError
+    from mechsyn.io.files import read_limited
+
+    folder = directory / PACKED
+    try:
+        manifest = json.loads(read_limited(folder / "manifest.json", "curve database manifest", cap=1 << 24))
+        if manifest.get("version") != VERSION or manifest.get("sources") != stamp:
+            return None
+        a = {k: np.load(folder / f"{k}.npy", mmap_mode="r", allow_pickle=False) for k in _PACKED_KEYS}
+    except (OSError, ValueError, TypeError, AttributeError, MechsynInputError):
+        return None
+    n = len(a["topology"])
+    shapes_ok = all(a[k].dtype.kind in _PACKED_KINDS[k] and len(a[k]) == n for k in _PACKED_KEYS) and n > 0
+    if not shapes_ok or a["designs"].ndim != 2 or a["ranges"].shape[1:] != (2,) or a["descriptors"].ndim != 2:
+        return None
+    top = a["topology"]
+    if top.min() < 0 or top.max() >= len(present) or a["designs"].shape[1] < max(_width(t) for t in present):
+        return None
+    if not all(np.isfinite(a[k]).all() for k in ("designs", "ranges", "descriptors")):
+        return None
+    return CurveDatabase(tuple(present), np.asarray(top, np.intp), a["designs"], np.asarray(a["ranges"], float),
+                         np.asarray(a["closed"], bool), a["descriptors"])
+
+
+def _write_packed(directory: Path, db: CurveDatabase, stamp: list) -> None:
+    """Pack the database's arrays for :func:`_read_packed` (the manifest last; a read-only
+    directory is left as it is)."""
+    import json
+
+    folder = directory / PACKED
+    arrays = {"topology": db.topology.astype(np.int32), "designs": db.designs, "ranges": db.ranges.astype(np.float32),
+              "closed": db.closed, "descriptors": db.descriptors}
+    try:
+        (folder / "manifest.json").unlink(missing_ok=True)
+        for k, v in arrays.items():
+            buf = io.BytesIO()
+            np.save(buf, np.ascontiguousarray(v), allow_pickle=False)
+            write_atomic(folder / f"{k}.npy", buf.getvalue())
+        write_atomic(folder / "manifest.json", json.dumps({"version": VERSION, "sources": stamp}))
+    except OSError:
+        pass

@@ -18,6 +18,16 @@ from mechsyn.synthesis.curves.descriptors import resample
 from mechsyn.synthesis.curves.target import TargetCurve
 from mechsyn.synthesis.curves.topologies import TRACER, CurveTopology
 
+
+def now() -> float:
+    """The search's clock, ``time.perf_counter()``: every deadline of the curve search is read
+    from it (a test may replace :data:`CLOCK` with a clock of its own)."""
+    return CLOCK[0]()
+
+
+#: the clock :func:`now` reads, in a one-entry list
+CLOCK = [time.perf_counter]
+
 M_TARGET = 64          # target points for the residuals
 N_TRACE = 96           # input samples along the range (refinement)
 N_FINAL = 360          # input samples of the reported path and errors
@@ -75,9 +85,107 @@ def even_points(points: np.ndarray, closed: bool, m: int = M_ERROR) -> np.ndarra
     return np.stack([z.real, z.imag], axis=-1)
 
 
-def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit: float | None = None) -> float:
-    """The error of a traced path against the target: the symmetric chamfer distance,
-    point to polyline, over the target's diagonal.
+M_ORDER = 64           # points along each curve for the error's monotone correspondence
+ROLL_STEP = 4          # start points tried first (every 4th), then every one about the best two
+FINE = 4               # polyline points per sample step for the distances (the curves, not their chords)
+
+
+def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit: float | None = None,
+                  m: int = M_ORDER) -> float:
+    """The error of a traced path against the target: the symmetric chamfer distance
+    along the curves in order, over the target's diagonal.
+
+    .. math::
+
+        e = \\frac{1}{2D}\\min_{W}\\frac{1}{2m}\\sum_{(i, j) \\in W} w_{ij}
+            \\left(d(a_i, B_j) + d(b_j, A_i)\\right)
+
+    with ``a_i`` and ``b_j`` ``m`` points equally spaced in arc length along the target
+    ``A`` and the path ``B`` (each a polyline, closed or open), ``A_i`` and ``B_j`` the
+    stretch of the other curve beside point ``i`` or ``j`` (from the point before to the
+    point after, resampled :data:`FINE` times finer), ``d`` the distance from a point to it, ``D`` the target's diagonal (:attr:`TargetCurve.diagonal`, or ``unit``)
+    and ``W`` a correspondence that runs along both curves in order (a monotone path from
+    ``(0, 0)`` to ``(m-1, m-1)``, steps weighted ``w = 2`` diagonally and 1 along one curve,
+    so the weights sum to ``2m``), from any start point of a closed curve and in either
+    sense. Each point is thus matched to the other curve near where the order puts it: a
+    path lying on the target scores 0 up to the polylines' chords, whatever the sampling,
+    and the value is at least the order-free :func:`nearest_chamfer`; a loop that cuts
+    across a letter, its pieces near parts of the outline visited out of order, scores
+    more than one that goes round it. Computed by dynamic time warping (the row recursion
+    as a prefix minimum), over every start point near the best of every
+    :data:`ROLL_STEP`-th.
+
+    >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    >>> circle = TargetCurve(np.c_[np.cos(t), np.sin(t)], closed=True)
+    >>> bool(chamfer_error(np.c_[np.cos(t + 1), np.sin(t + 1)][::3], circle, True) < 2e-4)   # chords only
+    True
+    >>> round(chamfer_error(1.1 * np.c_[np.cos(t), np.sin(t)], circle, True) * circle.diagonal, 3)
+    0.1
+    >>> eight = np.c_[np.cos(t), np.sin(t) * np.sign(np.cos(t / 2))]   # the halves in another order
+    >>> bool(chamfer_error(eight, circle, True) > 3 * nearest_chamfer(eight, circle, True))
+    True
+    """
+    unit = target.diagonal if unit is None else unit
+    Af = _fine(target.points, target.closed, m)
+    best = np.inf
+    for Bf in (_fine(path, closed_path, m), _fine(path[::-1], closed_path, m)):
+        c = 0.5 * (_beside(Af[::FINE], Bf, closed_path) + _beside(Bf[::FINE], Af, target.closed).T)
+        if not (target.closed or closed_path):
+            best = min(best, float(_dtw(c[None])[0]))
+            continue
+        coarse = np.arange(0, m, ROLL_STEP)
+        e = _dtw(_rolled(c, coarse, target.closed))
+        near = {(s + k) % m for s in coarse[np.argsort(e)[:2]] for k in range(1 - ROLL_STEP, ROLL_STEP)}
+        best = min(best, float(e.min()), float(_dtw(_rolled(c, np.array(sorted(near)), target.closed)).min()))
+    return float(best / unit)
+
+
+def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.ndarray:
+    """``(n, m)``: distance from each point of ``X`` to the stretch of polyline ``F`` (``k``
+    segments per sample: the samples are ``F[::k]``) beside its sample ``j``, from sample
+    ``j - 1`` to sample ``j + 1`` (one side at an open end)."""
+    S0, V = _polyline(F, closed)
+    d = X[:, None, :] - S0[None]
+    t = np.clip(np.sum(d * V[None], axis=-1) / np.maximum(np.sum(V ** 2, axis=-1), 1e-300), 0.0, 1.0)
+    seg = np.linalg.norm(d - t[..., None] * V[None], axis=-1).reshape(len(X), -1, k).min(axis=2)
+    if closed:   # seg[:, j]: from sample j to j + 1
+        return np.minimum(seg, np.roll(seg, 1, axis=1))
+    out = np.empty((len(X), seg.shape[1] + 1))
+    out[:, :-1], out[:, -1] = seg, seg[:, -1]
+    out[:, 1:] = np.minimum(out[:, 1:], seg)
+    return out
+
+
+def _fine(points: np.ndarray, closed: bool, m: int, k: int = FINE) -> np.ndarray:
+    """Points equally spaced in arc length, ``k`` per step of ``m`` samples (``[::k]``)."""
+    return even_points(points, closed, k * m if closed else k * (m - 1) + 1)
+
+
+def _rolled(c: np.ndarray, shifts: np.ndarray, rows: bool) -> np.ndarray:
+    """``(V, m, m)``: the cost matrix with the closed curve's start moved by each shift."""
+    m = c.shape[0]
+    idx = (shifts[:, None] + np.arange(m)[None, :]) % m
+    return c[idx] if rows else np.swapaxes(c.T[idx], 1, 2)
+
+
+def _dtw(C: np.ndarray) -> np.ndarray:
+    """``(V,)``: the least weighted sum over monotone paths of each cost matrix ``C (V, n, m)``
+    (diagonal steps weighted 2, others 1), over ``n + m``."""
+    V, n, m = C.shape
+    D = 2 * C[:, 0, :1] + np.concatenate([np.zeros((V, 1)), np.cumsum(C[:, 0, 1:], axis=1)], axis=1)
+    for i in range(1, n):
+        c = C[:, i]
+        E = D + c
+        E[:, 1:] = np.minimum(E[:, 1:], D[:, :-1] + 2 * c[:, 1:])
+        cc = np.cumsum(c, axis=1)
+        D = cc + np.minimum.accumulate(E - cc, axis=1)   # along the row: D[j] = min(E[j], D[j-1] + c[j])
+    return D[:, -1] / (n + m)
+
+
+def nearest_chamfer(path: np.ndarray, target: TargetCurve, closed_path: bool, unit: float | None = None) -> float:
+    """The order-free symmetric chamfer of a path against the target (a diagnostic: each
+    point to the nearest point of the other curve, wherever it is along it), over the
+    target's diagonal.
 
     .. math::
 
@@ -95,9 +203,9 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
 
     >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
     >>> circle = TargetCurve(np.c_[np.cos(t), np.sin(t)], closed=True)
-    >>> bool(chamfer_error(np.c_[np.cos(t), np.sin(t)][::3], circle, True) < 1e-4)   # chords only
+    >>> bool(nearest_chamfer(np.c_[np.cos(t), np.sin(t)][::3], circle, True) < 1e-4)   # chords only
     True
-    >>> round(chamfer_error(1.1 * np.c_[np.cos(t), np.sin(t)], circle, True) * circle.diagonal, 3)
+    >>> round(nearest_chamfer(1.1 * np.c_[np.cos(t), np.sin(t)], circle, True) * circle.diagonal, 3)
     0.1
     """
     unit = target.diagonal if unit is None else unit
@@ -109,13 +217,15 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
 
 
 def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
-                 unit: float | None = None) -> tuple[float, float]:
-    """``(chamfer, ordered)`` of a traced path against the target, in target diagonals
-    (or in ``unit``): :func:`chamfer_error` (the error shown and ranked by) and, as a
-    diagnostic of the timing only, the RMS distance between 128 points equally spaced in
-    arc length along both, best start and sense."""
+                 unit: float | None = None) -> tuple[float, float, float]:
+    """``(chamfer, nearest, ordered)`` of a traced path against the target, in target
+    diagonals (or in ``unit``): :func:`chamfer_error` (the error shown and ranked by), the
+    order-free :func:`nearest_chamfer` and, as a diagnostic of the timing only, the RMS
+    distance between 128 points equally spaced in arc length along both, best start and
+    sense."""
     unit = target.diagonal if unit is None else unit
     chamfer = chamfer_error(path, target, closed_path, unit)
+    nearest = nearest_chamfer(path, target, closed_path, unit)
     m = 128
     w = resample(target.points, m, closed=target.closed)
     z = resample(path, m, closed=closed_path)
@@ -123,7 +233,7 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
     for zz in (z, z[::-1]):
         for s in range(m):
             best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
-    return float(chamfer), best / unit
+    return float(chamfer), float(nearest), best / unit
 
 
 def departure(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[int, float]:
@@ -217,14 +327,14 @@ class FitProblem:
             j["id"] == n and f"L{self.topo.frame}" in j["links"] for j in self.topo.template["joints"])]
         self.link_pairs = link_pairs(self.topo)
         self.nfev = 0
-        self.deadline = float("inf")     # time.perf_counter() past which an evaluation raises OutOfTime
+        self.deadline = float("inf")     # now() past which an evaluation raises OutOfTime
         self.best = (float("inf"), None)  # (cost, x) of the best design evaluated by fun
 
     def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
         """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
         segments of the first design are used for all (the Jacobian's perturbations)."""
         X = np.atleast_2d(X)
-        if time.perf_counter() > self.deadline:
+        if now() > self.deadline:
             raise OutOfTime
         self.nfev += len(X)
         res = simulate_batch(self.plan, X, self.off, transmission=self.bounds.transmission > 0)

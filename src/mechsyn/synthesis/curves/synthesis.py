@@ -24,8 +24,11 @@ linkages whose tracing point follows it:
    ordinary :func:`mechsyn.kinematics.simulate` and comparing the tracer's path.
 
 **The error** shown and ranked by is :func:`~mechsyn.synthesis.curves.fitting.chamfer_error`:
-the symmetric chamfer distance, each curve's points (equally spaced in arc length) to the
-other curve's polyline, over the target's diagonal along its principal axes. ``ordered``
+the symmetric chamfer distance along the curves in order, each curve's points (equally
+spaced in arc length) to the other curve's polyline where a correspondence running along
+both in order puts them, over the target's diagonal along its principal axes: a loop that
+cuts across a letter loses to one that goes round it. ``nearest`` (the order-free chamfer,
+each point to the nearest point of the other curve anywhere) is reported beside it. ``ordered``
 (RMS distance between points equally spaced in arc length, best start and sense) is
 reported as a diagnostic of the timing only.
 
@@ -51,13 +54,11 @@ descriptors instead of a neural encoder.
 from __future__ import annotations
 
 import os
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import simulate_batch
@@ -67,7 +68,7 @@ from mechsyn.synthesis.curves.candidates import (CurveCandidate, CurveSynthesisR
                                                   ranked)
 from mechsyn.synthesis.curves.fitting import (DEFAULT_MAX_LINK_RATIO, DEFAULT_MAX_SIZE, DEFAULT_MIN_TRANSMISSION,
                                                DEFAULT_TOLERANCE, N_FINAL, Bounds, FitProblem, OutOfTime,
-                                               curve_errors, departure, full_plan, input_offsets, link_pairs,
+                                               curve_errors, departure, full_plan, input_offsets, link_pairs, now,
                                                link_ratio, path_sizes)
 from mechsyn.synthesis.curves.frame import Frame
 from mechsyn.synthesis.curves.target import SPARSE_POINTS, TargetCurve, smooth_samples, target_from_points
@@ -133,7 +134,7 @@ def _retrieve(db: CurveDatabase, target: TargetCurve, k: int, max_links: int, cr
     order = sorted(by_topo, key=lambda ti: (db.topologies[ti].n_links, min(first[r] for r in by_topo[ti]), ti))
     seeds: list[_Seed] = []
     for j, ti in enumerate(order):
-        if j and time.perf_counter() > deadline:   # the first topology whatever the time: an answer
+        if j and now() > deadline:   # the first topology whatever the time: an answer
             seeds.sort(key=lambda s: (s.rank, s.row))
             return seeds, f"retrieval: {len(order) - j} of {len(order)} topologies left out at the time limit"
         seeds += _topology_seeds(db, db.topologies[ti], by_topo[ti], w, bounds.unit, bounds)
@@ -147,7 +148,7 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
     its frame, each with its alignment error and bound violations."""
     rs_a = np.array(rs)
     offs = np.array([input_offsets(*db.ranges[r], bool(db.closed[r])) for r in rs])
-    X = np.array([db.designs[r] for r in rs])
+    X = np.array([db.design(r) for r in rs])
     P = simulate_batch(topo.plan, X, offs, flags=False).paths[TRACER]
     fine = np.all(np.isfinite(P), axis=(1, 2))
     if not fine.any():
@@ -165,7 +166,7 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
         mir = bool(al.mirror[j])
         if mir:  # a mirrored linkage runs its input the other way
             a, b = -b, -a
-        params = _transform_design(np.asarray(db.designs[r], float), complex(al.c[j]), complex(al.t[j]), mir)
+        params = _transform_design(db.design(r), complex(al.c[j]), complex(al.t[j]), mir)
         out.append(_Seed(r, topo, params, a, b, bool(db.closed[r]), float(al.rms[j]) / diag))
     if out:  # the mapped designs' size, link ratio and transmission angle over their range
         Xs = np.array([s.params for s in out])
@@ -184,7 +185,9 @@ def _topology_seeds(db: CurveDatabase, topo: CurveTopology, rs: list[int], w: np
 def _refine(seed: _Seed, target: TargetCurve, bounds: Bounds, max_nfev: int,
             deadline: float = float("inf")) -> CurveCandidate | None:
     """The seed refined in the working frame (None when it does not assemble); at the
-    ``deadline`` (``time.perf_counter()``) the best design evaluated so far."""
+    ``deadline`` (``now()``) the best design evaluated so far."""
+    from scipy.optimize import least_squares   # here: a run out of time before refining never loads it
+
     prob = FitProblem(seed.topo, target, seed.closed, seed.start, seed.stop, bounds)
     prob.deadline = deadline
     x0 = seed.params
@@ -212,13 +215,13 @@ def _candidate(topo: CurveTopology, x: np.ndarray, start: float, stop: float, cl
     if not res.assembled.all() or res.branch_jump[0]:
         return None
     path = res.paths[TRACER][0]
-    ch, od = curve_errors(path, target, closed, bounds.unit)
+    ch, near, od = curve_errors(path, target, closed, bounds.unit)
     size = float(path_sizes(res.paths, bounds.centre)[0])
     at, far = departure(path, target, closed)
     return CurveCandidate(topo, x, start, stop if not closed else start + 360.0, ch, od,
                           float(res.min_transmission_angle[0]), float(link_ratio(x, link_pairs(topo))[0]),
                           path, nfev=nfev, size=size, size_ratio=size / bounds.unit, refined=refined,
-                          departs_at=at, departure=far / bounds.unit)
+                          departs_at=at, departure=far / bounds.unit, nearest=near)
 
 
 def _verify(c: CurveCandidate) -> None:
@@ -338,7 +341,7 @@ def synthesize_curve(
     >>> c.topology.label, c.verified, c.chamfer < 0.02, c.size_ratio <= 1.5, c.role.endswith("most accurate")
     ('four-bar', True, True, True, True)
     """
-    t0 = time.perf_counter() if started is None else min(started, time.perf_counter())
+    t0 = now() if started is None else min(started, now())
     o = dict(max_links=max_links, time_limit=time_limit, top=top, n_refine=n_refine, retrieve=retrieve, crank=crank,
              ground_region=ground_region, max_size=max_size, max_link_ratio=max_link_ratio,
              min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance,
@@ -368,7 +371,7 @@ def _build_timer(callback, built: list[float]):
     """The callback passed to the database loader: it notes when a build starts and ends."""
     def cb(state):
         if state.stage == "build":
-            built.append(time.perf_counter())
+            built.append(now())
         if callback is not None:
             callback(state)
     return cb
@@ -398,9 +401,11 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
             callback(Progress(done=done, total=total, stage=stage, best=best))
 
     report("retrieve", 0, 1, float("nan"), 0)
-    # retrieval may use at most half of what is left (the rest: evaluation, refinement, checks)
+    _warm_checks(database.topologies[0])
+    # retrieval may use at most a third of what is left (the rest: the first evaluations and
+    # check, which load compiled kernels, refinement and the final checks)
     seeds, note = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds,
-                            deadline=time.perf_counter() + 0.5 * (end - time.perf_counter()))
+                            deadline=now() + (end - now()) / 3)
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
     if note:
         notes.append(note)
@@ -414,7 +419,7 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
         run.notes.append(f"{len(seeds)} retrieved designs, {run.assembled} of them assembled over their range "
                          f"within the time; none traced the target within the bounds")
     report("done", 1, 1, out[0].chamfer if out else float("nan"), run.nfev)
-    res = _result(user, [frame.outward(c) for c in out], time.perf_counter() - (end - o["time_limit"]),
+    res = _result(user, [frame.outward(c) for c in out], now() - (end - o["time_limit"]),
                   len(seeds), run.done, run.nfev, run.interrupted, run.notes)
     res.time_limit = o["time_limit"]
     res.bounds = {"max_size": o["max_size"], "max_link_ratio": o["max_link_ratio"], "tolerance": o["tolerance"],
@@ -424,6 +429,19 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
     if miss is not None:
         res.reason = miss_reason(miss, bounds)
     return res
+
+
+def _warm_checks(topo: CurveTopology) -> None:
+    """The check by ``simulate`` run once on a topology's own drawing, so that its imports
+    and compiled kernels load (1-2 s on a loaded machine) before the time is shared out
+    among the phases, not inside the first check."""
+    from mechsyn.io.load import mechanism_from_dict  # noqa: F401  (the checks' reader)
+    from mechsyn.kinematics import simulate
+
+    try:
+        simulate(topo.model, {topo.plan.input_joint: [0.0, 1.0]}, points=[TRACER])
+    except MechsynInputError:   # the drawing itself does not run: the first check loads them instead
+        pass
 
 
 def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit: float, top: int,
@@ -490,6 +508,8 @@ MIN_UNREFINED = 3    # of them evaluated whatever the time: an answer at any lim
 WIDEN = 8            # new retrieved seeds per round after the first
 RESTARTS = 2         # perturbed restarts per leading topology per round
 LEADERS = 3          # topologies restarted and polished per round
+EXIT_RESERVE = 0.25  # seconds left at the end for mapping back, output and the exit (measured 0.1 s
+                     # after a search at load 10 on 2 cores, the CLI skipping the collector at exit)
 
 
 @dataclass
@@ -521,8 +541,10 @@ class _Run:
 
     def deadline(self) -> float:
         """The end of refinement: the limit less the time the final checks will take
-        (``top + 1`` checks by ``simulate`` at the longest one's cost, 1.2 times)."""
-        return self.end - 1.2 * (self.o["top"] + 1) * self.verify_cost - 0.05
+        (``top + 1`` checks by ``simulate`` at the measured cost, 1.2 times) and
+        :data:`EXIT_RESERVE` (at most a tenth of the limit)."""
+        reserve = min(EXIT_RESERVE, 0.1 * self.o["time_limit"])
+        return self.end - 1.2 * (self.o["top"] + 1) * self.verify_cost - reserve
 
     def verify(self, c: CurveCandidate, measure: bool = False) -> None:
         """The check by ``simulate`` (once per candidate; with ``measure`` run again, timed:
@@ -531,9 +553,9 @@ class _Run:
             return
         _verify(c)
         if measure:
-            t = time.perf_counter()
+            t = now()
             _verify(c)
-            self.verify_cost = time.perf_counter() - t
+            self.verify_cost = now() - t
 
     def add(self, c: CurveCandidate | None) -> None:
         if c is None:
@@ -558,7 +580,7 @@ class _Run:
         o = self.o
         if o["refinements"] is not None and self.done >= o["refinements"]:
             return f"{self.done} refinements done (--refinements)"
-        if time.perf_counter() >= self.deadline():
+        if now() >= self.deadline():
             return f"time limit: {self.done} refinements done"
         if o["target_error"] is not None and self.best <= o["target_error"]:
             return f"target error {100 * o['target_error']:g} % reached after {self.done} refinements"
@@ -571,14 +593,11 @@ class _Run:
 
     def search(self, seeds: list[_Seed]) -> None:
         """Evaluate the best retrieved designs as they are, then refine until :meth:`stop`."""
-        import mechsyn.io.load  # noqa: F401  (the checks' imports first: their cost is measured)
-        import mechsyn.kinematics  # noqa: F401
-
         self.topologies = len({s.topo.key for s in seeds})
         try:
             for i, s in enumerate(seeds[:UNREFINED]):
-                if i >= MIN_UNREFINED and time.perf_counter() >= self.deadline():
-                    break
+                if now() >= self.deadline() and (self.cands or i >= MIN_UNREFINED):
+                    break   # out of time: one design within the bounds is an answer
                 self.add(_candidate(s.topo, s.params, s.start, s.stop, s.closed, self.target, 0, self.bounds,
                                     refined=False))
             for s, nfev in self.tasks(seeds):
@@ -592,8 +611,8 @@ class _Run:
                 if self.o["refinements"] is not None:
                     self.report("refine", self.done, self.o["refinements"], self.best, self.nfev)
                 else:  # a timed run: the bar fills with the time
-                    now = time.perf_counter() - (self.end - self.o["time_limit"])
-                    self.report("refine", min(now, self.o["time_limit"]), self.o["time_limit"], self.best, self.nfev)
+                    used = now() - (self.end - self.o["time_limit"])
+                    self.report("refine", min(used, self.o["time_limit"]), self.o["time_limit"], self.best, self.nfev)
             self.notes.append(f"every retrieved design refined ({self.done} refinements)")
         except KeyboardInterrupt:
             self.interrupted = True

@@ -49,16 +49,30 @@ def principal_diagonal(points: np.ndarray) -> float:
     >>> round(principal_diagonal(sq), 3), round(principal_diagonal(sq @ R.T), 3)
     (2.236, 2.236)
     """
+    return principal_frame(points)[1]
+
+
+def principal_frame(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """The curve's own centre and size: the centroid ``(2,)`` of the polyline through
+    ``points`` closed by its chord (of points equally spaced along it) and its
+    :func:`principal_diagonal`; both turn and move with the drawing.
+
+    >>> sq = np.array([[0.0, 0.0], [2, 0], [2, 1], [0, 1]])
+    >>> c, d = principal_frame(sq + [5, 0])
+    >>> c.round(6).tolist(), round(d, 3)
+    ([6.0, 0.5], 2.236)
+    """
     from mechsyn.synthesis.curves.descriptors import resample
 
     P = np.asarray(points, float)
     z = P[:, 0] + 1j * P[:, 1]
     w = resample(z, 256, closed=True)
-    u = w - w.mean()
+    centre = w.mean()
+    u = w - centre
     m2 = np.sum(u ** 2)
     if abs(m2) > 1e-6 * np.sum(np.abs(u) ** 2):
         z = z * np.exp(-0.5j * np.angle(m2))
-    return float(np.hypot(np.ptp(z.real), np.ptp(z.imag)))
+    return np.array([centre.real, centre.imag]), float(np.hypot(np.ptp(z.real), np.ptp(z.imag)))
 
 
 def target_from_points(points, closed: bool | None = None, source: str = "<points>") -> TargetCurve:
