@@ -44,3 +44,15 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.browser)
         if item.get_closest_marker("video") is None and "movie" in item.nodeid and "mp4" in item.nodeid:
             item.add_marker(pytest.mark.video)
+
+
+def pytest_configure(config):
+    """Compile the regular pass's kernel (Numba) once, in the controlling process, before
+    any worker or CLI subprocess needs it: on a fresh checkout each xdist worker and each
+    subprocess test that starts while Numba's on-disk cache is still empty would compile
+    it again (tens of seconds each); afterwards they load it (about a second)."""
+    if hasattr(config, "workerinput"):  # an xdist worker: the controller warmed the cache
+        return
+    from mechsyn.kinematics import kernel
+
+    kernel.warm()
