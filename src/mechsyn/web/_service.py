@@ -449,7 +449,8 @@ def fourbar_path_case(targets: list, time_limit: float) -> Any:
 
 
 def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) -> dict[str, Any]:
-    """Four-bar path synthesis through ``params["targets"]``: ranked results (both branches).
+    """Four-bar path synthesis through ``params["targets"]``: ranked results (both branches),
+    each with its report's ``reason`` (:class:`~mechsyn.synthesis.optimize.PathSynthesisResult`).
 
     ``progress`` receives a :class:`mechsyn.progress.Progress` (restarts of both branches)
     and may raise :class:`Cancelled`.
@@ -478,7 +479,10 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) 
         res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
                               callback=report)
         d = {**bcase.fixed, **res.design}
+        # reason: the report's own (as `synth path` shows it): why it is infeasible, or the
+        # bound the design sits on that decides it and how to lift it ("" when none)
         item = {"error": float(res.error), "feasible": bool(res.feasible), "branch": branch,
+                "reason": res.to_dict()["reason"],
                 "label": f"error {res.error:.4g} (sum of squared distances), branch {branch:+d}, "
                          f"{'feasible' if res.feasible else 'infeasible'}",
                 "design": {k: float(v) for k, v in d.items() if not k.startswith("theta2")},
@@ -565,7 +569,8 @@ def synthesize_curve_points(params: dict[str, Any], progress: ProgressCallback) 
 
 
 # Synthesis kinds the studio offers: name -> (title, function(params, progress) -> result dict).
-# Each result dict: {"kind", "targets", "results": [{"label", "error", "feasible", "mechanism", "path"}]}.
+# Each result dict: {"kind", "targets", "results": [{"label", "error", "feasible", "mechanism", "path"}]};
+# a result may carry its report's "reason" and the dict "notes" (shown as text under it).
 SYNTHESIS_KINDS: dict[str, tuple[str, Callable[[dict, ProgressCallback], dict]]] = {
     "fourbar_path": ("Four-bar path through the clicked points", synthesize_fourbar_path),
     "curve": ("Curve to mechanism over the atlas (4- to 8-bars)", synthesize_curve_points),

@@ -89,6 +89,8 @@ export function mountSynthesis({ $, state, render, setMech, setMode = () => {}, 
         b.onclick = () => { state.preview = null; state.previewResult = null; state.fileName = ""; setMech(r.mechanism, { fit: true }); setMode("select"); };
         li.append(b);
       }
+      // the report's reason (synth path's): why it is infeasible, or the bound that decides it and how to lift it
+      if (r.reason) { const why = h("div", r.reason, { className: "reason" }); why.dataset.reason = i; li.append(why); }
       // hover: the candidate's whole curve (and, for motion, its pivots) over the targets
       li.onmouseenter = () => { state.preview = r.curve || r.path; state.previewResult = r; render(); if (design) design.burmester.renderBox(); };
       return li;
