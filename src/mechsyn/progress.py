@@ -33,10 +33,10 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
-__all__ = ["Progress", "ProgressCallback", "counter", "report"]
+__all__ = ["Progress", "ProgressCallback", "counter", "report", "shifted"]
 
 
 @dataclass(frozen=True)
@@ -111,3 +111,27 @@ def counter(progress: ProgressCallback | None, total: float | None = None,
         report(progress, done[0], total, stage)
 
     return advance
+
+
+def shifted(progress: ProgressCallback | None, before: float, total: float | None) -> ProgressCallback | None:
+    """The ``progress`` of one part of a run (a sweep computed in two parts outwards from
+    its drawn row): each state of the part is passed on with the ``before`` steps of the
+    parts before it added to its ``done``, of the run's ``total`` (None: nothing listens).
+
+    Examples
+    --------
+    >>> seen = []
+    >>> second = shifted(seen.append, 3, 5)
+    >>> second(Progress(done=1, total=2, stage="sweep"))
+    >>> seen
+    [Progress(done=4, total=5, stage='sweep', best=None, message='')]
+    >>> shifted(None, 3, 5) is None
+    True
+    """
+    if progress is None:
+        return None
+
+    def part(state: Progress) -> None:
+        progress(replace(state, done=before + state.done, total=total))
+
+    return part
