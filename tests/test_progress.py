@@ -75,7 +75,7 @@ def test_searches_report_the_best_so_far(tmp_path):
     cap = _states(lambda p: capability_map(arm, np.linspace(1300, 2100, 3), np.linspace(100, 900, 3), [1, 0],
                                            chunk=4, progress=p))
     assert [(s.done, s.total, s.stage) for s in cap] == [(4, 9, "points"), (8, 9, "points"), (9, 9, "points")]
-    db = _states(lambda p: build_database(tmp_path, max_links=4, per_topology=20, callback=p))
+    db = _states(lambda p: build_database(tmp_path, max_links=4, per_topology=20, progress=p))
     assert (db[-1].done, db[-1].total, db[-1].stage, db[-1].message) == (1, 1, "build", "20 curves")
     # path and mechanism synthesis: tests/synthesis/test_problem.py (restarts done of all, the best)
 
