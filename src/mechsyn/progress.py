@@ -6,7 +6,10 @@ mechanism and finger synthesis, the atlas, the curve-database build, capability 
 ``progress(state)`` that it calls with a :class:`Progress` as the work goes:
 
 * ``done`` of ``total`` (``total`` None when unknown: rows, restarts, tasks, units of
-  work), both counted from the start of the run, so a reader shows the latest one;
+  work), both counted from the start of the run, or of its stage when a stage counts its
+  own steps (curve synthesis: build, retrieve, refine; finger design: the generations of
+  each variant's stage); ``0 <= done <= total``, and ``done`` never goes back within a
+  stage, so a reader shows the latest one (a part of a run: :func:`shifted`);
 * ``stage``: what runs now (``"sweep"``, ``"restarts"``, ``"contours"``, ``"build"``...);
 * ``best``: the best error (or fitness) so far, None before the first;
 * ``message``: a line for a person (``""`` when the rest says it all).
