@@ -6,7 +6,10 @@ mechanism and finger synthesis, the atlas, the curve-database build, capability 
 ``progress(state)`` that it calls with a :class:`Progress` as the work goes:
 
 * ``done`` of ``total`` (``total`` None when unknown: rows, restarts, tasks, units of
-  work), both counted from the start of the run, so a reader shows the latest one;
+  work), both counted from the start of the run, or of its stage when a stage counts its
+  own steps (curve synthesis: build, retrieve, refine; finger design: the generations of
+  each variant's stage); ``0 <= done <= total``, and ``done`` never goes back within a
+  stage, so a reader shows the latest one (a part of a run: :func:`shifted`);
 * ``stage``: what runs now (``"sweep"``, ``"restarts"``, ``"contours"``, ``"build"``...);
 * ``best``: the best error (or fitness) so far, None before the first;
 * ``message``: a line for a person (``""`` when the rest says it all).
@@ -33,10 +36,10 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
-__all__ = ["Progress", "ProgressCallback", "counter", "report"]
+__all__ = ["Progress", "ProgressCallback", "counter", "report", "shifted"]
 
 
 @dataclass(frozen=True)
@@ -111,3 +114,27 @@ def counter(progress: ProgressCallback | None, total: float | None = None,
         report(progress, done[0], total, stage)
 
     return advance
+
+
+def shifted(progress: ProgressCallback | None, before: float, total: float | None) -> ProgressCallback | None:
+    """The ``progress`` of one part of a run (a sweep computed in two parts outwards from
+    its drawn row): each state of the part is passed on with the ``before`` steps of the
+    parts before it added to its ``done``, of the run's ``total`` (None: nothing listens).
+
+    Examples
+    --------
+    >>> seen = []
+    >>> second = shifted(seen.append, 3, 5)
+    >>> second(Progress(done=1, total=2, stage="sweep"))
+    >>> seen
+    [Progress(done=4, total=5, stage='sweep', best=None, message='')]
+    >>> shifted(None, 3, 5) is None
+    True
+    """
+    if progress is None:
+        return None
+
+    def part(state: Progress) -> None:
+        progress(replace(state, done=before + state.done, total=total))
+
+    return part

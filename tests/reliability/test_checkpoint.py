@@ -41,7 +41,7 @@ def uninterrupted(case):
 
 
 def _run(case, path, resume=False, progress=None):
-    return synthesize_path(case, seed=3, restarts=3, time_limit=120, options=OPTS, callback=progress,
+    return synthesize_path(case, seed=3, restarts=3, time_limit=120, options=OPTS, progress=progress,
                            checkpoint=path, resume=resume)
 
 
@@ -188,7 +188,7 @@ def test_mechanism_search_interrupted_then_resumed_gives_the_uninterrupted_desig
             "options": {"maxiter": 5, "popsize": 4, "init_oversample": 1}}
     full = synthesize_mechanism(case, **args)
     ck = tmp_path / "m.ckpt.json"
-    first = synthesize_mechanism(case, checkpoint=ck, callback=_stop_after_first, **args)
+    first = synthesize_mechanism(case, checkpoint=ck, progress=_stop_after_first, **args)
     assert first.interrupted and list(read_checkpoint(ck)["finished"]) == ["0"]
     resumed = synthesize_mechanism(case, checkpoint=ck, resume=True, **args)
     assert not resumed.interrupted and resumed.design == full.design and resumed.error == full.error

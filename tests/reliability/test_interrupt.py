@@ -48,7 +48,7 @@ def test_best_so_far_keeps_lowest_finite_row():
 def test_path_search_interrupted_by_callback_returns_best_so_far():
     case = load_cases(CASES)[0]
     res = synthesize_path(case, seed=0, restarts=3, time_limit=60, options={"maxiter": 300},
-                          callback=_interrupt_after(20))
+                          progress=_interrupt_after(20))
     assert res.interrupted and res.restarts == 1
     assert res.feasible and np.isfinite(res.error)
     # the reported error belongs to the reported design
@@ -71,7 +71,7 @@ def test_mechanism_search_interrupted_by_callback_returns_best_so_far():
     from mechsyn.synthesis.general import load_mechanism_case, synthesize_mechanism
 
     case = load_mechanism_case(SLIDER_CASE)
-    res = synthesize_mechanism(case, seed=0, time_limit=60, restarts=2, callback=_interrupt_after(5))
+    res = synthesize_mechanism(case, seed=0, time_limit=60, restarts=2, progress=_interrupt_after(5))
     assert res.interrupted and res.feasible
     x = np.array([res.design[n] for n in case.names])
     assert evaluate_mechanism(case, x).error == pytest.approx(res.error, rel=1e-9)

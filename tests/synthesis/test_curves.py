@@ -119,7 +119,7 @@ def test_recovers_a_four_bar_curve_and_verifies_it(small_db):
     target = target_from_points(_fourbar_curve(4), closed=True)
     states = []
     res = synthesize_curve(target, max_links=4, top=2, refinements=6, database=load_database(small_db),
-                           callback=states.append)
+                           progress=states.append)
     best = res.candidates[0]
     assert best.chamfer < 0.01 and best.verified
     assert all(isinstance(s, Progress) for s in states) and states[-1].stage
@@ -170,7 +170,7 @@ def test_default_database_builds_on_first_use(tmp_path, monkeypatch):
     monkeypatch.setattr(database, "DEFAULT_PER_TOPOLOGY", 40)
     monkeypatch.setenv("MECHSYN_CURVE_DB", str(tmp_path / "cache"))
     states = []
-    db = load_database(max_links=4, callback=states.append)
+    db = load_database(max_links=4, progress=states.append)
     assert len(db) == 40 and (tmp_path / "cache").is_dir()
     assert states[0].done == 0 and states[-1].done == states[-1].total == 1 and states[-1].stage == "build"
     assert states[-1].message == "40 curves"

@@ -40,7 +40,6 @@ def result():
     case = small(load_case(CASE))
     states: list = []
     res = design_finger(case, seed=3, time_limit=60, progress=states.append)
-    res.messages = [p.message for p in states]
     res.states = states
     return case, res
 
@@ -101,11 +100,14 @@ def test_progress_reports_best_error_so_far(result):
     _case, res = result
     import re
 
-    best = [float(m.group(1)) for m in (re.search(r"stage 1, generation \d+/\d+, best RMS error (\S+) deg", t)
-                                        for t in res.messages) if m]
+    first = next(p.stage for p in res.states if p.stage.endswith(": stage 1"))  # "VLL S: stage 1"
+    stage1 = [p for p in res.states if p.stage == first]  # its generations, counted within it
+    assert [p.done for p in stage1] == list(range(1, len(stage1) + 1))
+    best = [float(m.group(1)) for m in (re.search(r"generation \d+/\d+, best RMS error (\S+) deg", p.message)
+                                        for p in stage1) if m]
     assert len(best) >= 2 and all(b <= a for a, b in zip(best, best[1:]))
     assert best[-1] == pytest.approx(res.best_variant.stage1_error_rms, rel=1e-3)   # printed to 4 digits
-    generations = [p for p in res.states if "stage 1, generation" in p.message and p.best is not None]
+    generations = [p for p in stage1 if p.best is not None]
     assert generations[-1].best == pytest.approx(best[-1], rel=1e-3) and generations[-1].total
 
 

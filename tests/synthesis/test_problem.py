@@ -45,7 +45,7 @@ def test_every_synthesis_result_is_one(cls):
 
 def test_path_result_has_the_common_keys_and_repeats_with_int_and_generator():
     states: list[Progress] = []
-    a = _path(11, callback=states.append)
+    a = _path(11, progress=states.append)
     assert isinstance(a, SynthesisResult) and set(COMMON_KEYS) <= set(a.to_dict())
     assert a.seed == 11 and a.x.size > 0 and set(a.design) >= {"r1", "r2", "r3", "r4"}
     assert a.feasible == (a.reason == "" or a.reason.startswith("a bound decides this result"))
@@ -62,7 +62,7 @@ def test_mechanism_result_has_the_common_keys_and_repeats():
     states: list[Progress] = []
     run = lambda seed, **kw: synthesize_mechanism(case, seed=seed, time_limit=60, restarts=1,  # noqa: E731
                                                   options=FAST, n_polish=1, **kw)
-    a = run(np.random.default_rng(3), callback=states.append)
+    a = run(np.random.default_rng(3), progress=states.append)
     d = a.to_dict()
     assert set(COMMON_KEYS) <= set(d) and d["design"] == a.design and np.array_equal(d["x"], a.x)
     assert a.x.size == len(a.design) and states and states[-1].done == 1

@@ -32,7 +32,7 @@ def curves_build(
         raise MechsynInputError(f"{links} links: choose 4, 6 or 8", source="--links")
     with progress_bar("curves build", len(curve_topologies(links)), enabled=not as_json) as progress:
         report = curve_database(database, max_links=links, per_topology=per_topology, seed=seed,
-                                scheduler=scheduler, callback=progress)
+                                scheduler=scheduler, progress=progress)
     if as_json:
         emit_json(report.to_dict())
         return

@@ -42,11 +42,11 @@ def synth_curve(
     check_writable(out, "--out", directory=True)
     tgt = read_target(target)
     _say_first_build(database)
-    with progress_bar("synth curve", best="best {:.2%}") as callback:
+    with progress_bar("synth curve", best="best {:.2%}") as progress:
         res = synthesize_curve(tgt, max_links=max_links, time_limit=time_limit, top=top, crank=crank,
                                ground_region=box, max_size=max_size or None, max_link_ratio=max_link_ratio or None,
                                min_transmission=min_transmission, prefer=prefer, tolerance=_fraction(tolerance),
-                               database=database, callback=callback, refinements=refinements, started=STARTED,
+                               database=database, progress=progress, refinements=refinements, started=STARTED,
                                target_error=None if target_error is None else _fraction(target_error, "--target-error"))
     if out is not None:
         _write_out(out, res)

@@ -63,7 +63,7 @@ def synth_mechanism(
     case = load_mechanism_case(case_file)
     with progress_bar("synth mechanism", restarts, enabled=not as_json) as progress:
         res = mechanism_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
-                                  workers=workers, scheduler=scheduler, callback=progress, **ck)
+                                  workers=workers, scheduler=scheduler, progress=progress, **ck)
     _write_files(case_file, case, res, out, plot)
     if as_json:
         emit_json(res.to_dict())

@@ -63,7 +63,7 @@ def synth_path(
     with progress_bar(f"synth path {case.id}", restarts) as progress:
         res = path_synthesis(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
                              scheduler=scheduler, optimizer=optimizer, target_error=target_error,
-                             min_transmission=min_transmission, fold_margin=fold_margin, max_size=max_size, callback=progress, **ck)
+                             min_transmission=min_transmission, fold_margin=fold_margin, max_size=max_size, progress=progress, **ck)
     _write_path_files(case, res, out, plot)
     if as_json:
         emit_json(res.to_dict())

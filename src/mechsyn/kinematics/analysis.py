@@ -34,6 +34,7 @@ from mechsyn.kinematics.refill import joint_points, point_xy, with_geometry
 from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system, frame_points, points_state_array
 from mechsyn.kinematics.topology import CACHE, Topology, topology_of
 from mechsyn.model.mechanism import Mechanism, fields_replaced
+from mechsyn.progress import ProgressCallback
 
 __all__ = ["ENGINES", "Motion", "Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan",
@@ -42,7 +43,7 @@ __all__ = ["ENGINES", "Motion", "Simulation", "PointMotion", "LinkMotion", "simu
 
 def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
              points: list[str] | None = None, vll: dict[str, str] | None = None,
-             method: str = "auto", progress: Any = None, change_points: str = "keep") -> Simulation:
+             method: str = "auto", progress: ProgressCallback | None = None, change_points: str = "keep") -> Simulation:
     """Positions, velocities and accelerations over a sweep of the inputs.
 
     ``inputs``: joint id -> values (degrees for R, length for P), all of the same
@@ -176,7 +177,7 @@ class KinematicPlan:
         return KinematicPlan(mech, S, _decomposition(S), self.vll, self.prescribed)
 
     def simulate(self, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
-                 points: list[str] | None = None, method: str = "auto", progress: Any = None,
+                 points: list[str] | None = None, method: str = "auto", progress: ProgressCallback | None = None,
                  change_points: str = "keep") -> Simulation:
         """The sweep of :func:`simulate` with this plan."""
         return _simulate_plan(self, inputs, speeds, points, method, progress, change_points)
@@ -226,7 +227,8 @@ _RAD, _DEG = math.pi / 180.0, 180.0 / math.pi
 
 
 def _simulate_plan(kp: KinematicPlan, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
-                   points: list[str] | None, method: str, progress: Any, change_points: str = "keep") -> Simulation:
+                   points: list[str] | None, method: str, progress: ProgressCallback | None,
+                   change_points: str = "keep") -> Simulation:
     if change_points not in ("keep", "switch"):
         raise MechsynInputError(f"change_points must be 'keep' or 'switch', not {change_points!r}",
                                 field="change_points")
@@ -665,7 +667,7 @@ class ForceAnalysis(Result):
 
 def forces(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None = None,
            gravity: tuple[float, float] = (0.0, 0.0), static: bool = False, vll: dict[str, str] | None = None,
-           method: str = "auto", progress: Any = None) -> ForceAnalysis:
+           method: str = "auto", progress: ProgressCallback | None = None) -> ForceAnalysis:
     """Kinetostatic (or static) analysis over a sweep of the inputs.
 
     Examples

@@ -48,7 +48,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.progress import ProgressCallback, counter, report
+from mechsyn.progress import ProgressCallback, counter, report, shifted
 from mechsyn.kinematics.chain import solve_all
 from mechsyn.kinematics.groups import Plan
 from mechsyn.kinematics.regular import Folded, sweep_through_folds
@@ -182,14 +182,14 @@ class Newton:
               change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
         if change_points != "keep":
             return None
-        tick = counter(progress, len(inputs), "sweep") if progress is not None else None
 
         def run(parts: list) -> list[Sweep]:
-            out = []
-            for U in parts:
-                sw = newton_sweep(system, U, speeds, progress=tick)
+            out, before = [], 0
+            for U in parts:  # rows counted over the parts: the sweep's rows done of all
+                sw = newton_sweep(system, U, speeds, progress=shifted(progress, before, len(inputs)))
                 sw.engine = self.name
                 out.append(sw)
+                before += len(U)
             return out
 
         return outward(system, inputs, run)

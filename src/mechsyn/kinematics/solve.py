@@ -26,6 +26,7 @@ from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.kinematics.system import PlanarSystem
+from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.drives import DriveCheck, excess_drives
 
 __all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton", "drawn_checks"]
@@ -636,14 +637,16 @@ def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters
 
 
 def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
-          progress=None, refine_limits: bool = True) -> Sweep:
+          progress: ProgressCallback | None = None, refine_limits: bool = True) -> Sweep:
     """Positions, velocities, accelerations over input values (N, n_inputs), by continuation.
 
     ``speeds`` are the input rates (rad/s or length/s; default 1 for every input).
     Events (``dead point``: the input where assembly ends, refined by bisection;
     ``reassembled``: the mechanism assembles again after a gap, possibly on another
     branch; ``singular``: ``det Phi_q`` changes sign between two steps, a branch point
-    was crossed) are listed in ``Sweep.events``.
+    was crossed) are listed in ``Sweep.events``. ``progress(state)``
+    (:class:`mechsyn.progress.Progress`, stage ``"sweep"``) is called after each row: rows
+    done of all.
     """
     inputs = np.atleast_2d(np.asarray(inputs, float))
     N, k = inputs.shape
@@ -685,8 +688,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                 cur, cur_u, hist = got, u, [(u, got, _factor(S, got))]
         if cur is not None:
             cur, hist = _store(S, out, inputs, i, cur, hist, speeds, refine_limits, events)
-        if progress is not None:
-            progress()
+        report(progress, i + 1, N, "sweep")
     assembled = np.all(np.isfinite(q), axis=1)
     for i in np.flatnonzero(np.isfinite(sig) & (sig < 1e-6)).tolist():
         events.append(Event(i, "singular", input=inputs[i].tolist(),
@@ -698,7 +700,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
 
 
 def _sweep_shifted(S: PlanarSystem, inputs: np.ndarray, shift: np.ndarray, speeds: np.ndarray | None,
-                   progress: Any, refine_limits: bool) -> Sweep:
+                   progress: ProgressCallback | None, refine_limits: bool) -> Sweep:
     """The sweep of inputs shifted by whole turns ``shift`` next to the file's values,
     given back at the inputs' own values."""
     sw = sweep(S, inputs - shift, speeds, progress, refine_limits)

@@ -53,7 +53,7 @@ import numpy as np
 from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
 from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial, planar_as_spatial
-from mechsyn.progress import report
+from mechsyn.progress import ProgressCallback, report
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
 from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
@@ -87,7 +87,8 @@ class SpatialEngine:
     name = "spatial"
 
     def simulate(self, mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
-                 points: list[str] | None = None, progress: Any = None, **_: Any) -> SpatialSimulation:
+                 points: list[str] | None = None, progress: ProgressCallback | None = None,
+                 **_: Any) -> SpatialSimulation:
         if mech.kind == "spatial":
             return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
         slides = _planar_slides(mech, tuple(inputs))  # an R input's zero is the planar one already
@@ -204,7 +205,7 @@ def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.n
 
 
 def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
-                     points: list[str] | None = None, progress: Any = None) -> SpatialSimulation:
+                     points: list[str] | None = None, progress: ProgressCallback | None = None) -> SpatialSimulation:
     """Kinematics of a spatial mechanism over a sweep of its drives (see the module doc).
 
     ``inputs``: joint id -> values, measured from the drawn assembly (degrees for R and H,
@@ -238,7 +239,7 @@ SMALL_LINKS = 0
 
 
 def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
-              points: list[str] | None, progress: Any) -> SpatialSimulation:
+              points: list[str] | None, progress: ProgressCallback | None) -> SpatialSimulation:
     if points is None and not mech.points:
         points = [j.id for j in mech.joints if j.point is not None]
     pts = resolve_points(mech, points)
@@ -365,7 +366,7 @@ def _regular_rank(tr: Tracker, st: State) -> None:
 
 
 def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarray, np.ndarray],
-                progress: Any) -> _Rows:
+                progress: ProgressCallback | None) -> _Rows:
     """Poses of every row by continuation from the drawn assembly, then the closure residual,
     the rank test and the rates of all assembled rows at once."""
     M = tr.M

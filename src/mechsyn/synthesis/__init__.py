@@ -22,7 +22,7 @@ Structural (number and type) synthesis
 Dimensional synthesis
     :mod:`~mechsyn.synthesis.problem`
         what every synthesis shares: :class:`SynthesisResult`, the seed convention,
-        :class:`Progress` for callbacks;
+        :class:`Progress` for ``progress(state)``;
     :mod:`~mechsyn.synthesis.cases`
         the case files of path generation (:func:`load_cases`) and of any mechanism
         file (:func:`load_mechanism_case`); no solver runs there;

@@ -435,7 +435,7 @@ def _mechanism_checkpoint(path, resume, case, dim, seed, restarts, optimizer, op
 
 def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 3,
                          optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 3,
-                         callback: ProgressCallback | None = None,
+                         progress: ProgressCallback | None = None,
                          workers: int = 1, scheduler: Any = None,
                          batch: bool = True, checkpoint: Any = None, resume: bool = False,
                          fast: bool = True) -> MechanismSynthesisResult:
@@ -453,9 +453,9 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     :func:`evaluate_mechanism_design`) or parsed and built anew: the same result.
 
     ``seed``: an int, ``None`` or a ``numpy.random.Generator`` (the result's ``seed`` is
-    the int that repeats the run). ``callback(state)`` gets a
+    the int that repeats the run). ``progress(state)`` gets a
     :class:`~mechsyn.synthesis.problem.Progress` (restarts done, the best fitness so far).
-    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``callback``) ends the search and
+    Ctrl-C (:class:`KeyboardInterrupt`, also raised by ``progress``) ends the search and
     returns the best design evaluated so far with ``interrupted=True``. ``checkpoint``
     (a file) saves the finished restarts as the run goes; ``resume=True`` runs only the
     others (as :func:`mechsyn.synthesis.optimize.synthesize_path`).
@@ -490,8 +490,8 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
     outs: dict[int, tuple] = {} if ck is None else {i: (r["x"], r["fitness"], r["nfev"]) for i, r in ck.finished.items()}
 
     def report(r: int, f: float) -> None:
-        if callback is not None:
-            callback(Progress(done=r, total=restarts, stage="restarts", best=min(best[0], f)))
+        if progress is not None:
+            progress(Progress(done=r, total=restarts, stage="restarts", best=min(best[0], f)))
 
     def finished(index: int, out) -> None:
         r = tasks[index][1]
@@ -499,8 +499,8 @@ def synthesize_mechanism(case: MechanismCase, *, seed: SeedLike = 0, time_limit:
         best[0] = min(best[0], out[1])
         if ck is not None:  # saved before the progress callback, which may raise Ctrl-C
             ck.finish(r, seed=seeds[r], x=out[0], fitness=out[1], nfev=out[2])
-        if callback is not None:
-            callback(Progress(done=len(outs), total=restarts, stage="restarts", best=best[0]))
+        if progress is not None:
+            progress(Progress(done=len(outs), total=restarts, stage="restarts", best=best[0]))
 
     seeds = restart_seeds(seed, restarts)
     trackers = [BestSoFar() if local else None for _ in seeds]

@@ -349,13 +349,13 @@ def default_target_error(case: PathCase) -> float | None:
 def synthesize_path(
     case: PathCase, *, seed: SeedLike = 0, time_limit: float = 60.0, restarts: int = 10, workers: int = 1,
     optimizer: str = "de", options: dict[str, Any] | None = None, n_polish: int = 5,
-    callback: ProgressCallback | None = None, scheduler: Any = None,
+    progress: ProgressCallback | None = None, scheduler: Any = None,
     target_error: float | None = None, checkpoint: Any = None, resume: bool = False, max_size: float | None = None,
 ) -> PathSynthesisResult:
     """Optimise a path-generation case (see the module docstring for the pipeline).
 
     ``seed``: an int, ``None`` or a ``numpy.random.Generator``; the result's ``seed`` is
-    the int that repeats the run. ``callback(state)`` is called as the run goes, with a
+    the int that repeats the run. ``progress(state)`` is called as the run goes, with a
     :class:`~mechsyn.synthesis.problem.Progress` (restarts done of ``restarts``, the best
     feasible error so far).
     With ``workers > 1`` restarts run in that many local processes, with ``scheduler``
@@ -368,7 +368,7 @@ def synthesize_path(
     restart (in seed order) whose result reaches it; with workers, a later restart that had
     already finished is left out too, so the result is the single-process one.
 
-    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``callback``) ends the search
+    Ctrl-C (:class:`KeyboardInterrupt`, also when raised by ``progress``) ends the search
     and returns the best design evaluated so far with ``interrupted=True`` (serial runs;
     with workers, the restarts finished so far); it propagates only when nothing was
     evaluated yet.
@@ -410,8 +410,8 @@ def synthesize_path(
 
     def note(done, f):
         best[0] = min(best[0], f) if f < problem.penalty_base else best[0]  # feasible scores only
-        if callback is not None:
-            callback(Progress(done=done, total=restarts, stage="restarts", best=best[0]))
+        if progress is not None:
+            progress(Progress(done=done, total=restarts, stage="restarts", best=best[0]))
 
     local = workers <= 1 and scheduler is None
     done = [len(results)]
@@ -434,7 +434,7 @@ def synthesize_path(
              reserve, target_error, trackers[i]) for i, s in enumerate(seeds) if i in pending]
     interrupted = False
     try:
-        if results and callback is not None:
+        if results and progress is not None:
             note(len(results), min(r.fitness for r in results))
         run_tasks(_run_restart, jobs, workers=workers, scheduler=scheduler,
                   on_result=finished, deadline=deadline - reserve,

@@ -26,10 +26,10 @@ as SciPy's `OptimizeResult` does.
 :func:`resolve_seed` turns it into the one integer that is recorded in the result (give it
 back to repeat the run); :func:`as_generator` gives the random generator of a seed.
 
-**Progress.** A search that reports progress calls `callback(state)` with a
+**Progress.** A search that reports progress calls `progress(state)` with a
 :class:`mechsyn.progress.Progress` (`done` of `total` steps, the stage, the best error so
-far, a message: the one progress protocol of mechsyn); raising `KeyboardInterrupt` in the
-callback stops the search like Ctrl-C (the best so far is returned, `interrupted=True`).
+far, a message: the one progress protocol of mechsyn); raising `KeyboardInterrupt` in
+`progress` stops the search like Ctrl-C (the best so far is returned, `interrupted=True`).
 
 Examples
 --------

@@ -78,7 +78,7 @@ def _with_margins(case: Any, min_transmission: float | None, fold_margin: float 
 def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restarts: int = 10,
                    workers: int = 1, scheduler: Any = None, optimizer: str = "de",
                    target_error: float | None = None, min_transmission: float | None = None,
-                   fold_margin: float | None = None, callback: ProgressCallback | None = None,
+                   fold_margin: float | None = None, progress: ProgressCallback | None = None,
                    max_size: float | None = None, **search: Any) -> Any:
     """Path generation of ``case`` with the designer's margins (see
     :func:`mechsyn.synthesis.optimize.synthesize_path`).
@@ -86,7 +86,7 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     Parameters
     ----------
     case : PathCase
-    seed, time_limit, restarts, workers, scheduler, optimizer, callback
+    seed, time_limit, restarts, workers, scheduler, optimizer, progress
         As for :func:`~mechsyn.synthesis.optimize.synthesize_path`.
     target_error : float, optional
         Stop once a design reaches this error; None: the case's best known error + 1 %
@@ -122,7 +122,7 @@ def path_synthesis(case: Any, *, seed: int = 0, time_limit: float = 60.0, restar
     case = _with_margins(case, min_transmission, fold_margin)
     stop_at = default_target_error(case) if target_error is None else (target_error or None)
     return synthesize_path(case, seed=seed, time_limit=time_limit, restarts=restarts, workers=workers,
-                           optimizer=optimizer, callback=callback, scheduler=scheduler, target_error=stop_at,
+                           optimizer=optimizer, progress=progress, scheduler=scheduler, target_error=stop_at,
                            max_size=max_size, **search)
 
 
@@ -135,7 +135,7 @@ def _check_budget(time_limit: float, restarts: int) -> None:
 
 def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, restarts: int = 3,
                         optimizer: str = "de", workers: int = 1, scheduler: Any = None,
-                        callback: ProgressCallback | None = None, **search: Any) -> Any:
+                        progress: ProgressCallback | None = None, **search: Any) -> Any:
     """Synthesis of any planar mechanism file (see
     :func:`mechsyn.synthesis.general.synthesize_mechanism`), its budget checked first.
 
@@ -151,7 +151,7 @@ def mechanism_synthesis(case: Any, *, seed: int = 0, time_limit: float = 30.0, r
     """
     _check_budget(time_limit, restarts)
     return synthesize_mechanism(case, seed=seed, time_limit=time_limit, restarts=restarts, optimizer=optimizer,
-                                callback=callback, workers=workers, scheduler=scheduler, **search)
+                                progress=progress, workers=workers, scheduler=scheduler, **search)
 
 
 def _fourbar_dict(design: dict[str, float], theta2: float, branch: int, name: str) -> dict[str, Any]:
@@ -268,7 +268,7 @@ class CurveDatabaseReport(Result):
 
 
 def curve_database(directory: Any = None, *, max_links: int = 8, per_topology: int = 3000, seed: int = 0,
-                   scheduler: Any = None, callback: ProgressCallback | None = None) -> CurveDatabaseReport:
+                   scheduler: Any = None, progress: ProgressCallback | None = None) -> CurveDatabaseReport:
     """Build or extend the curve database of :func:`mechsyn.synthesis.curves.synthesis.synthesize_curve`
     (see :func:`mechsyn.synthesis.curves.database.build_database`) and say what it holds.
 
@@ -287,7 +287,7 @@ def curve_database(directory: Any = None, *, max_links: int = 8, per_topology: i
     if per_topology < 1:
         raise MechsynInputError("must be at least 1", field="per_topology")
     path = build_database(directory, max_links=max_links, per_topology=per_topology, seed=seed,
-                          callback=callback, scheduler=scheduler)
+                          progress=progress, scheduler=scheduler)
     db = load_database(path, max_links=max_links, build_if_missing=False)
     return CurveDatabaseReport(str(path), len(db.topologies), len(db), int(db.closed.sum()),
                                int((~db.closed).sum()), sum(f.stat().st_size for f in Path(path).glob("*.npz")))

@@ -472,14 +472,14 @@ class HeavyRunner:
         finally:
             self._release(ticket)
 
-    async def _in_thread(self, name, args: tuple, progress) -> Any:
+    async def _in_thread(self, name, args: tuple, progress: ProgressCallback | None) -> Any:
         from starlette.concurrency import run_in_threadpool
 
         return await run_in_threadpool(service_function(name), *args, *((progress,) if progress else ()))
 
     # ------------------------------------------------------------------ one worker
-    async def _in_process(self, gone: Callable[[], Any], name, args: tuple, limit: float | None, progress,
-                          lane: str = "request") -> Any:
+    async def _in_process(self, gone: Callable[[], Any], name, args: tuple, limit: float | None,
+                          progress: ProgressCallback | None, lane: str = "request") -> Any:
         loop = asyncio.get_running_loop()
         parent, child = self._ctx.Pipe(duplex=False)
         proc = self._ctx.Process(target=_worker, args=(child, name, args, progress is not None, NICE[lane]),

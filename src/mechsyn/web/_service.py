@@ -477,7 +477,7 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) 
                              stage=f"{state.stage}, branch {branches[b]:+d}", best=best))
 
         res = synthesize_path(bcase, seed=b, time_limit=time_limit / len(branches), restarts=restarts,
-                              callback=report)
+                              progress=report)
         d = {**bcase.fixed, **res.design}
         # reason: the report's own (as `synth path` shows it): why it is infeasible, or the
         # bound the design sits on that decides it and how to lift it ("" when none)
@@ -551,7 +551,7 @@ def synthesize_curve_points(params: dict[str, Any], progress: ProgressCallback) 
     closed = params.get("closed")
     target = target_from_points(T, closed=None if closed is None else bool(closed), source="clicked curve")
 
-    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, callback=progress)
+    res = synthesize_curve(target, max_links=max_links, time_limit=time_limit, top=5, progress=progress)
     results = []
     for c in res.candidates:
         d = c.to_dict()

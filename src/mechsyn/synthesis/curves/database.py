@@ -265,12 +265,12 @@ def _check_shapes(shapes: dict, topo: CurveTopology | None) -> None:
 
 def build_database(directory: str | os.PathLike[str] | None = None, max_links: int = DEFAULT_LINKS,
                    per_topology: int = DEFAULT_PER_TOPOLOGY, seed: int = 0, batch: int = 4000,
-                   callback: ProgressCallback | None = None, scheduler: str | None = None) -> Path:
+                   progress: ProgressCallback | None = None, scheduler: str | None = None) -> Path:
     """Build or extend the curve database (resumable; see the module doc): ``per_topology``
     curves of each four- and six-bar topology, a tenth of that (:data:`EIGHT_SHARE`) of
     each eight-bar one.
 
-    ``callback(state)`` (:class:`mechsyn.progress.Progress`) is called after each topology
+    ``progress(state)`` (:class:`mechsyn.progress.Progress`) is called after each topology
     with stage ``"build"``, topologies ``done`` of ``total`` and the curves kept so far in its
     ``message``. With ``scheduler`` (a
     ``dask.distributed`` address or ``Client``) the topologies are built on a Dask
@@ -287,7 +287,7 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
         if n < want:
             todo.append((i, t.key, max_links, want, seed, batch, have))
     total, done, kept = len(topos), len(topos) - len(todo), 0
-    report(callback, done, total, "build", message=f"{kept} curves")
+    report(progress, done, total, "build", message=f"{kept} curves")
     if scheduler is not None and todo:
         client = _dask_client(scheduler)
         futures = client.map(_build_one, todo, pure=False)
@@ -298,14 +298,14 @@ def build_database(directory: str | os.PathLike[str] | None = None, max_links: i
             _write(directory / f"{key}.npz", data)
             done += 1
             kept += len(data["ranges"])
-            report(callback, done, total, "build", message=f"{kept} curves")
+            report(progress, done, total, "build", message=f"{kept} curves")
         return directory
     for job in todo:
         key, data = _build_one(job)
         _write(directory / f"{key}.npz", data)
         done += 1
         kept += len(data["ranges"])
-        report(callback, done, total, "build", message=f"{kept} curves")
+        report(progress, done, total, "build", message=f"{kept} curves")
     return directory
 
 
@@ -359,7 +359,7 @@ def _build_one(job) -> tuple[str, dict]:
 
 
 def load_database(directory: str | os.PathLike[str] | None = None, max_links: int = 8,
-                  build_if_missing: bool = True, callback: ProgressCallback | None = None) -> CurveDatabase:
+                  build_if_missing: bool = True, progress: ProgressCallback | None = None) -> CurveDatabase:
     """Read the database (topologies up to ``max_links``); build the default one first when
     there is none.
 
@@ -373,7 +373,7 @@ def load_database(directory: str | os.PathLike[str] | None = None, max_links: in
     present = [t for t in topos if _file(directory, t).exists()]
     if not present and build_if_missing:
         build_database(directory, max_links=min(max_links, DEFAULT_LINKS), per_topology=DEFAULT_PER_TOPOLOGY,
-                       callback=callback)
+                       progress=progress)
         present = [t for t in topos if _file(directory, t).exists()]
     stamp = _stamp(directory, present)
     packed = _read_packed(directory, present, stamp)

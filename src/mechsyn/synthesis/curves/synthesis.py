@@ -264,7 +264,7 @@ def synthesize_curve(
     min_transmission: float = DEFAULT_MIN_TRANSMISSION,
     prefer: str = "simple",
     database: CurveDatabase | str | os.PathLike[str] | None = None,
-    callback: ProgressCallback | None = None,
+    progress: ProgressCallback | None = None,
     max_nfev: int = 60,
     tolerance: float = DEFAULT_TOLERANCE,
     refinements: int | None = None,
@@ -315,8 +315,8 @@ def synthesize_curve(
     tolerance : float
         Error (fraction of the diagonal, default 0.5 %) within which a candidate counts
         as tracing the curve (fewest links first among those).
-    callback : callable, optional
-        ``callback(state)``: a :class:`mechsyn.progress.Progress` (stage, done of total,
+    progress : callable, optional
+        ``progress(state)``: a :class:`mechsyn.progress.Progress` (stage, done of total,
         the best error so far; the database build's stage ``"build"`` when it builds).
 
     Returns
@@ -346,10 +346,11 @@ def synthesize_curve(
              ground_region=ground_region, max_size=max_size, max_link_ratio=max_link_ratio,
              min_transmission=min_transmission, prefer=prefer, max_nfev=max_nfev, tolerance=tolerance,
              refinements=refinements, target_error=target_error)
-    return _loaded_and_searched(target, database, t0, o, callback)
+    return _loaded_and_searched(target, database, t0, o, progress)
 
 
-def _loaded_and_searched(target, database, t0: float, o: dict[str, Any], callback) -> CurveSynthesisResult:
+def _loaded_and_searched(target, database, t0: float, o: dict[str, Any],
+                         progress: ProgressCallback | None) -> CurveSynthesisResult:
     """The options checked, the database loaded (a first build not counted in the time),
     the search run."""
     user = _checked_target(target, o["max_links"], o["time_limit"], o["top"], o["max_link_ratio"], o["crank"])
@@ -357,28 +358,28 @@ def _loaded_and_searched(target, database, t0: float, o: dict[str, Any], callbac
                     o["target_error"])
     built: list[float] = []
     if database is None or isinstance(database, (str, os.PathLike)):
-        database = load_database(database, max_links=o["max_links"], callback=_build_timer(callback, built))
+        database = load_database(database, max_links=o["max_links"], progress=_build_timer(progress, built))
     if built:  # a first build is not part of the search's time
         t0 += built[-1] - built[0]
-    res = _search(user, database, t0, o, callback)
+    res = _search(user, database, t0, o, progress)
     if built:
         res.notes.insert(0, f"the curve database was built first ({built[-1] - built[0]:.0f} s, once; "
                             "not counted in the time limit)")
     return res
 
 
-def _build_timer(callback, built: list[float]):
-    """The callback passed to the database loader: it notes when a build starts and ends."""
+def _build_timer(progress: ProgressCallback | None, built: list[float]) -> ProgressCallback:
+    """The progress callback passed to the database loader: it notes when a build starts and ends."""
     def cb(state):
         if state.stage == "build":
             built.append(now())
-        if callback is not None:
-            callback(state)
+        if progress is not None:
+            progress(state)
     return cb
 
 
 def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, Any],
-            callback: ProgressCallback | None) -> CurveSynthesisResult:
+            progress: ProgressCallback | None) -> CurveSynthesisResult:
     """The search of :func:`synthesize_curve` (options ``o`` checked): sparse targets
     smoothed, the working frame, retrieval, the anytime refinement, ranking and the
     checks by ``simulate``, mapping back."""
@@ -397,8 +398,8 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
     end = t0 + o["time_limit"]
 
     def report(stage, done, total, best, nfev):
-        if callback is not None:
-            callback(Progress(done=done, total=total, stage=stage, best=best))
+        if progress is not None:
+            progress(Progress(done=done, total=total, stage=stage, best=best))
 
     report("retrieve", 0, 1, float("nan"), 0)
     _warm_checks(database.topologies[0])

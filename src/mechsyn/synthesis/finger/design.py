@@ -219,14 +219,17 @@ class _Run:
             self.progress(Progress(done, total, "finger design", best, msg))
 
     def reporter(self, label: str, stage: str, maxiter: int, what: str) -> Callable[[int, float], None] | None:
-        """``report(generation, best)`` for :func:`_de`: a progress line, ``what`` formats the best."""
-        if not self.progress:
+        """``report(generation, best)`` for :func:`_de`: the generations done of the stage
+        ``VLL label: stage`` (counted within it), ``what`` formats the best."""
+        progress = self.progress
+        if not progress:
             return None
 
         def report(g: int, best: float) -> None:
-            self.say(f"VLL {label}: {stage}, generation {g}/{maxiter}, best " + (
-                what.format(best) if best < INFEASIBLE else "design still infeasible"),
-                g, maxiter, best if best < INFEASIBLE else None)
+            ok = best < INFEASIBLE
+            progress(Progress(g, maxiter, f"VLL {label}: {stage}", best if ok else None,
+                              f"generation {g}/{maxiter}, best " + (what.format(best) if ok else
+                                                                    "design still infeasible")))
         return report
 
 
@@ -301,8 +304,9 @@ def design_finger(case: FingerCase, seed: int = 0, time_limit: float = 60.0,
     time_limit : float
         Seconds for the optimisation stages; the final checks still run.
     progress : callable, optional
-        ``progress(state)`` (:class:`mechsyn.progress.Progress`): the generation done of
-        the stage's, the best value so far, and the stage in words in its ``message``.
+        ``progress(state)`` (:class:`mechsyn.progress.Progress`): the generations done of
+        the stage's (``stage`` ``"VLL S: stage 1"``, ``"VLL S: force stage"``: counted within
+        it), the best value so far; steps between them in words (stage ``"finger design"``).
     checkpoint : path-like, optional
         Checkpoint file, written whole after each finished variant.
     resume : bool
