@@ -39,7 +39,7 @@ def _same(a, b):
 
 
 def _stop_in_second_variant(state):
-    if state.message.startswith("VLL S2: stage 1, generation 2/"):
+    if state.stage == "VLL S2: stage 1" and state.message.startswith("generation 2/"):
         raise KeyboardInterrupt
 
 
