@@ -58,6 +58,26 @@ def test_path_job_carries_the_reports_reason(client):
     assert any("sits on the size bound 1.5" in r for r in decided), got
 
 
+@pytest.mark.slow
+def test_max_size_0_lifts_the_size_bound(client):
+    """``max_size: 0`` (as ``synth path --max-size 0``): the known design's case is decided by
+    no size bound, and the best design found is larger than the default bound allows."""
+    job = client.post("/api/synth/fourbar_path",
+                      json={"targets": _targets(), "time_limit": 120.0, "restarts": 1, "max_size": 0}).json()
+    s = _wait(client, job["id"], timeout=300)
+    assert s["state"] == "done", s
+    results = s["result"]["results"]
+    assert not any("size bound" in r["reason"] for r in results), [r["reason"] for r in results]
+    assert results[0]["feasible"] and results[0]["quality"]["size_ratio"] > 1.5, results[0]["quality"]
+
+
+@pytest.mark.parametrize("value, message", [(-1, "greater than or equal to 0"), ("abc", "must be a number")])
+def test_a_negative_or_untyped_max_size_is_400_naming_it(client, value, message):
+    r = client.post("/api/synth/fourbar_path", json={"targets": _targets(), "max_size": value})
+    assert r.status_code == 400, (r.status_code, r.text[:300])
+    assert r.json()["field"] == "max_size" and message in r.json()["error"], r.json()
+
+
 def test_the_page_shows_each_results_reason(serve, page):
     srv = serve(None)
     new_canvas(page, srv)

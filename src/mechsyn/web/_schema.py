@@ -34,6 +34,7 @@ from pydantic_core import PydanticCustomError
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.web import _files
+from mechsyn.web._service import PATH_MAX_SIZE
 
 #: The largest magnitude of a number in a request (a mechanism's coordinates, axes,
 #: masses; a target point): products and squares of such numbers stay far from overflow.
@@ -136,6 +137,8 @@ class FourbarPathParams(Body):
     targets: Points
     time_limit: Number = 10.0
     restarts: int = 4
+    #: the size bound in target diagonals, as ``synth path --max-size`` (0: none)
+    max_size: Annotated[Number, Field(ge=0)] = PATH_MAX_SIZE
 
 
 class CurveParams(Body):

@@ -423,12 +423,18 @@ def atlas_mechanism(chain: dict[str, Any], frame: int | None = None, input_link:
 
 
 # --------------------------------------------------------------------------- synthesis
+#: The studio's size bound of a four-bar path run [target diagonals] (the library's default;
+#: a run's ``max_size`` replaces it, 0: none).
+PATH_MAX_SIZE = 1.5
+
+
 class Cancelled(Exception):
     """Raised inside a progress callback to stop a synthesis run."""
 
 
-def fourbar_path_case(targets: list, time_limit: float) -> Any:
-    """A four-bar path case through clicked ``targets`` (free timing, bounds from their extent)."""
+def fourbar_path_case(targets: list, time_limit: float, max_size: float = PATH_MAX_SIZE) -> Any:
+    """A four-bar path case through clicked ``targets`` (free timing, bounds from their extent),
+    its size bound ``options.max_size`` ``max_size`` target diagonals (0: none; as ``synth path --max-size``)."""
     from mechsyn.synthesis.path import PathCase
 
     T = np.asarray(targets, float)
@@ -443,8 +449,8 @@ def fourbar_path_case(targets: list, time_limit: float) -> Any:
     var += [{"name": r, "lower": -L, "upper": L} for r in ("rcx", "rcy")]
     var += [{"name": f"theta2_{i + 1}", "lower": 0.0, "upper": 2 * math.pi} for i in range(len(T))]
     return PathCase.from_dict({"id": "studio", "targets": T.tolist(), "timing": {"type": "free"},
-                               # the bounds above are the studio's, not the user's: the default size bound applies
-                               "variables": var, "options": {"grashof": "crank-rocker", "max_size": 1.5}},
+                               # the bounds above are the studio's, not the user's: the size bound applies
+                               "variables": var, "options": {"grashof": "crank-rocker", "max_size": max_size}},
                               source="targets")
 
 
@@ -464,7 +470,7 @@ def synthesize_fourbar_path(params: dict[str, Any], progress: ProgressCallback) 
     restarts = int(params.get("restarts", 4))
     if not 1 <= restarts <= 50:
         raise MechsynInputError("restarts must be within 1..50", field="restarts")
-    case = fourbar_path_case(params.get("targets"), time_limit)
+    case = fourbar_path_case(params.get("targets"), time_limit, float(params.get("max_size", PATH_MAX_SIZE)))
     results = []
     branches = (-1, 1)
     for b, branch in enumerate(branches):

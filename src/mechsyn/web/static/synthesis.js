@@ -14,6 +14,7 @@ export function mountSynthesis({ $, state, render, setMech, setMode = () => {}, 
   function renderPoses() {
     const on = $("synth-kind").value === "motion";
     state.showPoses = on;
+    $("synth-size").hidden = !["", "fourbar_path"].includes($("synth-kind").value); // the path run's size bound
     if (!on) { $("synth-poses").replaceChildren(); return; }
     const t = h("table", null, { className: "numtable" });
     t.dataset.table = "poses";
@@ -41,7 +42,8 @@ export function mountSynthesis({ $, state, render, setMech, setMode = () => {}, 
     try {
       const kind = $("synth-kind").value || "fourbar_path";
       job = await call(`/api/synth/${kind}`, { targets: state.targets, time_limit: +$("synth-time").value,
-        ...(kind === "motion" ? { angles: poseAngles() } : {}) });
+        ...(kind === "motion" ? { angles: poseAngles() } : {}),
+        ...(kind === "fourbar_path" ? { max_size: $("synth-max-size").value === "" ? NaN : +$("synth-max-size").value } : {}) });
     } catch (e) { $("synth-status").textContent = `${e.error}${e.hint ? " — fix: " + e.hint : ""}`; return; }
     $("synth-run").disabled = true; $("synth-cancel").disabled = false;
     $("synth-results").replaceChildren(); $("synth-notes").replaceChildren();
