@@ -377,15 +377,16 @@ def _configuration_table(arm: Any, res: Any) -> tuple[Any, list[int], list[tuple
     shown = list(range(len(configs)))
     if len(configs) > 15:  # many IK solutions (spatial arms): the best ones
         shown = sorted(np.argsort([-c[res.measure] for c in configs], kind="stable")[:12].tolist())
-    rows = [(f"{k + 1}" + (" best" if k == res.best_index else ""), configs[k], k == res.best_index) for k in shown]
+    # (name, tag, configuration): a long arm's rows are named by number, the wide table's by tag only
+    rows = [(f"{k + 1}", "best" if k == res.best_index else "", configs[k]) for k in shown]
     if res.continuous_best:
-        rows.append(("cont", res.continuous_best, False))
-    for label, c, best in rows:
+        rows.append(("cont", "cont", res.continuous_best))
+    styles = {"best": "bold green", "cont": "cyan", "": None}
+    for name, tag, c in rows:
+        label = tag if wide else (f"{name} best" if tag == "best" else name)
         joints = [f"{v:.1f}" for v in c["q_deg"]] if wide else []
-        style = "bold green" if best else ("cyan" if label == "cont" else None)
-        table.add_row(label if not wide else ("best" if best else "cont" if label == "cont" else ""),
-                      *joints, *[f"{c[mn]:.2f}" for mn in MEASURES], style=style)
-    return table, shown, [] if wide else [(label.split()[0], c) for label, c, _ in rows]
+        table.add_row(label, *joints, *[f"{c[mn]:.2f}" for mn in MEASURES], style=styles[tag])
+    return table, shown, [] if wide else [(name, c) for name, _, c in rows]
 
 
 def render_point_capability(arm: Any, res: Any, step: float) -> None:
