@@ -21,9 +21,10 @@ more equation each); it
   halved down to ``1/4096`` of a row;
 * takes velocities ``ξ = J⁺ b`` (``b``: the input rates on the drive rows) and accelerations
   ``ξ̇ = -J⁺ γ`` from the same Jacobian in twist form, never by differencing positions;
-* handles idle mobilities (a rod spinning between two ball joints, a Delta's bars): they
-  are the null space of ``J``, and the minimum-norm steps and rates leave them at rest
-  (the idle links keep their drawn spin). Drives that leave a motion of a joint point or
+* handles idle mobilities: a bar between two ball joints (a Delta's, an RSSR's rod) is no
+  unknown (one distance equation between its ends: its pose follows them with no spin from
+  the drawn one); other idle motions are the null space of ``J``, and the minimum-norm steps
+  and rates leave them at rest (the idle links keep their drawn spin, to first order). Drives that leave a motion of a joint point or
   a named point free are refused at the start (the motion would be arbitrary);
 * reports, never hides: the closure residual of every row (``residual``, in units of the
   length scale), rows where the Jacobian's regular rank drops (``singular``: its ``r``-th
@@ -52,7 +53,7 @@ import numpy as np
 
 from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
-from mechsyn.kinematics.spatial_model import SpatialModel, compile_spatial, planar_as_spatial
+from mechsyn.kinematics.spatial_model import SpatialModel, bar_motion, compile_spatial, planar_as_spatial
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
@@ -454,16 +455,16 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
-    X = rows.xi.reshape(len(ok), M.n, 6)
-    Xd = rows.xid.reshape(len(ok), M.n, 6)
+    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid)
+    X, Xd = X.reshape(len(ok), -1, 6), Xd.reshape(len(ok), -1, 6)
     links = {}
-    for i, name in enumerate(M.links):
-        Ri, pi = rows.R[:, i], rows.p[:, i]
-        t = c - np.einsum("kij,j->ki", Ri, c) + L * pi
-        links[name] = LinkPose(Ri, t, X[:, i, :3], Xd[:, i, :3])
+    for i, name in enumerate(M.all_links):
+        t = c - np.einsum("kij,j->ki", R[:, i], c) + L * p[:, i]
+        links[name] = LinkPose(R[:, i], t, X[:, i, :3], Xd[:, i, :3])
     pm = {}
     for name, (link, at) in pts.items():
-        pm[name] = _point_motion(M, rows, X, Xd, link, M.local(at))
+        i = M.all_links.index(link) if link in M.all_links else None
+        pm[name] = _point_motion(M, ok, (R, p, X, Xd), i, M.local(at))
     joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok) + M.zeros[k]) for k, jid in enumerate(M.angle_joints)}
     for name, v in inputs.items():  # an input reads as itself (the same turn)
         key = name + "/slide" if mech.joint(name.partition("/")[0]).type == "C" and "/" not in name else \
@@ -473,10 +474,11 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
                    for k, jid in enumerate(M.slide_joints)})
     notes = []
-    idle = M.n * 6 - tr.rank
+    rank = tr.rank + 5 * len(M.bars)  # (a bar's two S pairs: five more than its distance)
+    idle = 6 * len(M.all_links) - rank
     if tr.drawn_singular is not None:
-        notes.append(f"the file's configuration is singular (rank {tr.drawn_singular} there, {tr.rank} along the "
-                     "sweep): the branch chosen from it is arbitrary")
+        notes.append(f"the file's configuration is singular (rank {tr.drawn_singular + rank - tr.rank} there, "
+                     f"{rank} along the sweep): the branch chosen from it is arbitrary")
     if idle:
         notes.append(f"{idle} idle motion(s) with the drives at rest (e.g. a rod spinning between ball joints): "
                      "held at their drawn position (minimum-norm steps and rates)")
@@ -491,7 +493,7 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     return SpatialSimulation(
         mechanism=mech.name, inputs=inputs, input_types=types, speeds=speeds, assembled=ok, points=pm,
         links=links, joints=joints, residual=rows.res, singular_ratio=rows.ratio, length_scale=L,
-        rank=tr.rank, idle=idle, events=[as_event(e) for e in rows.events], notes=notes, model=M,
+        rank=rank, idle=idle, events=[as_event(e) for e in rows.events], notes=notes, model=M,
         reached=np.where(ok, rows.how, 0).astype(int), held=tuple(d[0] for d in M.drives if d[0] not in inputs),
         zero={d[0]: float(np.degrees(M.zeros[d[2]])) for d in M.drives if d[0] in inputs and d[1] == "angle"})
 
@@ -522,21 +524,22 @@ def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> li
     return notes
 
 
-def _point_motion(M: SpatialModel, rows: _Rows, X: np.ndarray, Xd: np.ndarray, link: str,
-                  x0: np.ndarray) -> PointMotion:
+def _point_motion(M: SpatialModel, ok: np.ndarray, motion: tuple, i: int | None, x0: np.ndarray) -> PointMotion:
+    """A point ``x0`` (model units) of link ``i`` of :attr:`SpatialModel.all_links` (None:
+    the frame), with ``motion`` the poses and twists of all links."""
     L, c = M.scale, M.centre
-    i = M.index(link)
-    N = len(rows.ok)
-    if i == M.n:
+    N = len(ok)
+    if i is None:
         P = np.tile(c + L * x0, (N, 1))
-        P[~rows.ok] = np.nan
-        z = np.where(rows.ok[:, None], 0.0, np.nan) * np.ones((N, 3))
-        return PointMotion(P, z, z.copy(), link)
-    x = np.einsum("kij,j->ki", rows.R[:, i], x0) + rows.p[:, i]
+        P[~ok] = np.nan
+        z = np.where(ok[:, None], 0.0, np.nan) * np.ones((N, 3))
+        return PointMotion(P, z, z.copy(), M.mech.ground)
+    R, p, X, Xd = motion
+    x = np.einsum("kij,j->ki", R[:, i], x0) + p[:, i]
     w, v, wd, vd = X[:, i, :3], X[:, i, 3:], Xd[:, i, :3], Xd[:, i, 3:]
     xd = v + np.cross(w, x)
     xdd = vd + np.cross(wd, x) + np.cross(w, xd)
-    return PointMotion(c + L * x, L * xd, L * xdd, link)
+    return PointMotion(c + L * x, L * xd, L * xdd, M.all_links[i])
 
 
 def _unwrap(a: np.ndarray, ok: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ dot (1 row)               ``u_a · w_b = u_0 · w_0``              R (2), U (1),
 line (1 row)              ``(x_b - x_a) · n_a = 0``              C, H, P (2 each)
 angle / slide (drives)    ``θ = θ_in``, ``(x_b - x_a) · a = s``  R, H, C, U (angle); P, C (slide)
 helix (1 row)             ``s - h θ = 0``                        H
+distance (1 row)          ``(|x_a - x_b|² - ℓ²) / 2ℓ = 0``       an S-S bar
 ========================  =====================================  =============================
 
 with ``x_a``, ``u_a``, ``n_a`` fixed on the pair's first link and ``x_b``, ``w_b`` on its
@@ -25,6 +26,12 @@ second. A revolute pair keeps its point and two vectors of the second link perpe
 to the axis of the first (five equations, the five constraints of a class-5 pair); a
 prismatic pair keeps the three frame vectors of the links perpendicular as drawn
 (no relative rotation) and the second link's point on the first link's line; and so on.
+A *bar* (a link with no other joint than two S pairs, to two other links, and no named
+point) is not an unknown: its two pairs are the one distance equation between its ends on
+those links (the exact elimination of its pose: five of its six equations fix the bar given
+its ends, the sixth is the distance; its spin about its line is an idle motion). Its pose is
+reported as the least rotation taking its drawn line to its line (:func:`bar_motion`: no spin
+from the drawn assembly), its rates as those of its ends with no spin: ``ω = d × ḋ / |d|²``.
 The equations of a pair are exactly its class, so the rank of the stacked Jacobian is the
 rank method's (:mod:`mechsyn.structure.rank`), and redundant constraints only add rows:
 the solver takes least-squares, minimum-norm steps.
@@ -148,6 +155,7 @@ class SpatialModel:
     pc: _Kind
     dot: _Kind
     line: _Kind
+    dist: _Kind
     angles: _Kind
     slides: _Kind
     angle_joints: tuple[str, ...]
@@ -160,6 +168,8 @@ class SpatialModel:
     #: per angle joint (``angle_joints``), its input's value at the drawn assembly (rad):
     #: :func:`input_zero`
     zeros: np.ndarray | None = None
+    #: the S-S bars not solved for (their poses from ``dist``'s ends, in order)
+    bars: tuple[str, ...] = ()
 
     @property
     def n(self) -> int:
@@ -167,13 +177,21 @@ class SpatialModel:
 
     @property
     def n_constraints(self) -> int:
-        return 3 * self.pc.size + self.dot.size + self.line.size + len(self.helix)
+        return 3 * self.pc.size + self.dot.size + self.line.size + self.dist.size + len(self.helix)
+
+    @property
+    def all_links(self) -> tuple[str, ...]:
+        """The moving links solved for, then the bars."""
+        return self.links + self.bars
 
     def local(self, x: np.ndarray) -> np.ndarray:
         """File coordinates -> the model's (centred, in units of the length scale)."""
         return (np.asarray(x, float) - self.centre) / self.scale
 
     def index(self, link: str) -> int:
+        """A link's pose: ``n`` for the frame, above it for a bar (no unknown)."""
+        if link in self.bars:
+            return self.n + 1 + self.bars.index(link)
         return self.n if link == self.mech.ground else self.links.index(link)
 
 
@@ -252,13 +270,21 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
     centre = pts.mean(axis=0) if len(pts) else np.zeros(3)
     spread = float(np.max(np.linalg.norm(pts - centre, axis=1))) if len(pts) else 0.0
     scale = spread if spread > 0 else max(1.0, float(np.abs(centre).max(initial=0.0)))
-    links = tuple(mech.moving_links)
+    bars = _bars(mech)
+    links = tuple(link for link in mech.moving_links if link not in bars)
     index = {name: k for k, name in enumerate(links)}
     index[mech.ground] = len(links)
-    rows: dict[str, list] = {k: [] for k in ("pc", "dot", "line", "angle", "slide", "angle_joints", "slide_joints")}
+    rows: dict[str, list] = {k: [] for k in ("pc", "dot", "line", "dist", "angle", "slide", "angle_joints",
+                                             "slide_joints")}
+    local = {j.id: (np.asarray(j.point, float) - centre) / scale for j in mech.joints if j.point is not None}
     for j in mech.joints:
-        x = (np.asarray(j.point, float) - centre) / scale if j.point is not None else np.zeros(3)
-        _pair_rows(j, index[j.links[0]], index[j.links[1]], x, rows)
+        if not bars.keys() & set(j.links):
+            _pair_rows(j, index[j.links[0]], index[j.links[1]], local.get(j.id, np.zeros(3)), rows)
+    z = np.zeros(3)
+    for bar, (j1, j2) in bars.items():
+        a, b = (next(link for link in j.links if link != bar) for j in (j1, j2))
+        ell = float(np.linalg.norm(local[j1.id] - local[j2.id]))
+        rows["dist"].append((index[a], index[b], local[j1.id], local[j2.id], z, z, ell))
     helix = tuple((rows["angle_joints"].index(j.id), rows["slide_joints"].index(j.id), (j.pitch or 0.0) / scale)
                   for j in mech.joints if j.type == "H")
     drive_rows = []
@@ -272,11 +298,26 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
     big = max([float(np.abs(np.asarray(j.point, float)).max()) for j in mech.joints if j.point is not None]
               + [float(np.abs(np.asarray(pt.at, float)).max()) for pt in mech.points.values()], default=0.0)
     M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
-                     _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
+                     _kind(rows["dist"]), _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
                      tuple(rows["slide_joints"]), helix, tuple(drive_rows),
-                     ulp=float(np.finfo(float).eps) * max(1.0, big / scale))
+                     ulp=float(np.finfo(float).eps) * max(1.0, big / scale), bars=tuple(bars))
     zeros = np.array([input_zero(mech, mech.joint(jid.partition("/")[0])) for jid in M.angle_joints], float)
     return replace(M, lay=_layout(M), pairs=_pairs(mech, index), zeros=zeros)
+
+
+def _bars(mech: Mechanism) -> dict[str, tuple[Joint, Joint]]:
+    """The S-S bars not solved for (see the module doc): link -> its two S pairs, each to
+    another link that is not such a bar, their points apart."""
+    named = {p.link for p in mech.points.values()}
+    cand = {}
+    for link in mech.moving_links:
+        js = mech.joints_of(link)
+        if link not in named and len(js) == 2 and all(j.type == "S" and not j.actuated for j in js):
+            ends = [next((x for x in j.links if x != link), link) for j in js]
+            if ends[0] != ends[1] and link not in ends and np.linalg.norm(
+                    np.subtract(js[0].point, js[1].point)) > 0:
+                cand[link] = (js[0], js[1], ends)
+    return {link: (j1, j2) for link, (j1, j2, ends) in cand.items() if not cand.keys() & set(ends)}
 
 
 # --------------------------------------------------------------------------- input zeros
@@ -444,9 +485,10 @@ def _slices(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray
 
 
 def _layout(M: SpatialModel) -> _Layout:
-    pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
+    pc, dt, ln, an, sl, ds = M.pc, M.dot, M.line, M.angles, M.slides, M.dist
     pidx, ploc, psl = _slices([("xa", pc.ia, pc.va), ("xb", pc.ib, pc.vb), ("la", ln.ia, ln.va),
-                               ("lb", ln.ib, ln.vb), ("sa", sl.ia, sl.va), ("sb", sl.ib, sl.vb)])
+                               ("lb", ln.ib, ln.vb), ("sa", sl.ia, sl.va), ("sb", sl.ib, sl.vb),
+                               ("da", ds.ia, ds.va), ("db", ds.ib, ds.vb)])
     vidx, vloc, vsl = _slices([("u", dt.ia, dt.va), ("w", dt.ib, dt.vb), ("ln", ln.ia, ln.n),
                                ("aa", an.ia, an.va), ("e1b", an.ib, an.vb), ("e1a", an.ia, an.n),
                                ("e2a", an.ia, an.m), ("sn", sl.ia, sl.n)])
@@ -466,8 +508,8 @@ def _layout(M: SpatialModel) -> _Layout:
     d_meas = np.array([kk if kind == "angle" else an.size + kk for _, kind, kk in M.drives], int)
     d_links = [(an.ia[kk], an.ib[kk]) if kind == "angle" else (sl.ia[kk], sl.ib[kk]) for _, kind, kk in M.drives]
     h_sl = h[:, 1].astype(int)
-    sa = np.concatenate([dt.ia, ln.ia, sl.ia[h_sl], [a for a, _ in d_links]]).astype(int)
-    sb = np.concatenate([dt.ib, ln.ib, sl.ib[h_sl], [b for _, b in d_links]]).astype(int)
+    sa = np.concatenate([dt.ia, ln.ia, ds.ia, sl.ia[h_sl], [a for a, _ in d_links]]).astype(int)
+    sb = np.concatenate([dt.ib, ln.ib, ds.ib, sl.ib[h_sl], [b for _, b in d_links]]).astype(int)
     srow = 3 * k + np.arange(len(sa))
     for links in (sa, sb, sa, sb):  # c at a, -c at b, -n at a, +n at b
         ri.append(np.repeat(srow, 3))
@@ -567,7 +609,9 @@ def residual(M: SpatialModel, F: Frame, helix_ref: np.ndarray, target: np.ndarra
     B = len(target)
     d = np.concatenate([F.theta, F.s], axis=1)[:, lay.d_meas] - target
     d[:, lay.d_angle] = wrap(d[:, lay.d_angle])
-    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0]
+    bar, ell = F.da - F.db, M.dist.c0
+    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0,
+             (_dot(bar, bar) - ell * ell) / (2 * ell)]
     if M.helix:
         parts.append(F.s[:, lay.h_sl] - lay.h_pitch * helix_angles(M, F, helix_ref))
     parts.append(d)
@@ -578,8 +622,9 @@ def _scalar_coefficients(M: SpatialModel, F: Frame) -> tuple[np.ndarray, np.ndar
     """``c`` and ``n`` of the scalar rows, each ``c · (ω_a - ω_b) + n · (v_b - v_a)``."""
     lay = M.lay
     c_slide = _cross(F.sn, F.sb)
-    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb)]
-    ns = [np.zeros_like(F.u), F.ln]
+    d = (F.da - F.db) / M.dist.c0[:, None]  # (x_a × d = x_b × d: one c for both links)
+    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb), _cross(F.da, d)]
+    ns = [np.zeros_like(F.u), F.ln, -d]
     if M.helix:
         cs.append(c_slide[:, lay.h_sl] + lay.h_pitch[:, None] * F.aa[:, lay.h_ang])
         ns.append(F.sn[:, lay.h_sl])
@@ -622,7 +667,11 @@ def convective(M: SpatialModel, F: Frame, xi: np.ndarray) -> np.ndarray:
     wa, wb = w[:, dt.ia], w[:, dt.ib]
     ud, wd = _cross(wa, F.u), _cross(wb, F.w)
     g_dot = _dot(_cross(wa, ud), F.w) + 2 * _dot(ud, wd) + _dot(F.u, _cross(wb, wd))
-    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln)]
+    ds = M.dist
+    wa, wb = w[:, ds.ia], w[:, ds.ib]
+    va, vb = v[:, ds.ia] + _cross(wa, F.da), v[:, ds.ib] + _cross(wb, F.db)
+    g_dist = (_dot(va - vb, va - vb) + _dot(F.da - F.db, _cross(wa, va) - _cross(wb, vb))) / ds.c0
+    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln), g_dist]
     if M.helix or M.drives:
         g_slide = _line_gamma(w, v, sl.ia, sl.ib, F.sa, F.sb, F.sn)
         g_angle = _dot(w[:, an.ib] - w[:, an.ia], _cross(w[:, an.ia], F.aa))
@@ -640,3 +689,41 @@ def _line_gamma(w: np.ndarray, v: np.ndarray, ia: np.ndarray, ib: np.ndarray, xa
     nd = _cross(wa, nv)
     return (_dot(_cross(wb, vb) - _cross(wa, va), nv) + 2 * _dot(vb - va, nd)
             + _dot(xb - xa, _cross(wa, nd)))
+
+
+# --------------------------------------------------------------------------- bars
+def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
+               xid: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Poses ``(R, p)`` (N, links, ...) and twists ``ξ``, ``ξ̇`` (N, 6 links) of
+    :attr:`SpatialModel.all_links` from those of the links solved for (the frame's pose not
+    included): each bar from its ends ``y_1``, ``y_2`` on the links it joins, turned by the
+    least rotation from its drawn line ``d_0`` to ``d = y_2 - y_1`` (Rodrigues' formula with
+    ``k = d_0 × d``, over ``1 + cos``), moving at ``ω = d × ḋ / |d|²``,
+    ``ω̇ = d × d̈ / |d|²`` (no spin about its line) and ``v = ẏ_1 - ω × y_1``,
+    ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``."""
+    N, n = len(R), M.n
+    if not M.bars:
+        return R, p, xi, xid
+    ds = M.dist
+    z = np.zeros((N, 1, 6))
+    X, Xd = (np.concatenate([x.reshape(N, n, 6), z], axis=1) for x in (xi, xid))
+    R1 = np.concatenate([R, np.broadcast_to(np.eye(3), (N, 1, 3, 3))], axis=1)
+    p1 = np.concatenate([p, np.zeros((N, 1, 3))], axis=1)
+    ends = []
+    for i, x0 in ((ds.ia, ds.va), (ds.ib, ds.vb)):
+        y = rotate(R1[:, i], x0) + p1[:, i]
+        w, v, wd, vd = X[:, i, :3], X[:, i, 3:], Xd[:, i, :3], Xd[:, i, 3:]
+        yd = v + _cross(w, y)
+        ends.append((y, yd, vd + _cross(wd, y) + _cross(w, yd)))
+    (y1, y1d, y1dd), (y2, y2d, y2dd) = ends
+    d, d0 = y2 - y1, ds.vb - ds.va
+    k, c = _cross(d0, d) / ds.c0[:, None] ** 2, _dot(d0, d) / ds.c0 ** 2
+    K = np.einsum("ijk,bnk->bnij", -_EPS, k)
+    Rb = np.eye(3) + K + K @ K / (1 + c)[..., None, None]
+    pb = 0.5 * (y1 + y2 - rotate(Rb, ds.va + ds.vb))
+    l2 = _dot(d, d)[..., None]
+    w, wd = _cross(d, y2d - y1d) / l2, _cross(d, y2dd - y1dd) / l2
+    Xb = np.concatenate([w, y1d - _cross(w, y1)], axis=2)
+    Xbd = np.concatenate([wd, y1dd - _cross(wd, y1) - _cross(w, y1d)], axis=2)
+    return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1),
+            np.concatenate([X[:, :n], Xb], axis=1).reshape(N, -1), np.concatenate([Xd[:, :n], Xbd], axis=1).reshape(N, -1))
