@@ -8,7 +8,8 @@ check that follows the motion numerically) against the papers' formulas
 loop-closure matrix, the floor of any rank-based tool (what a user who hand-assembles
 the screw matrix would get).
 
-Then the growth with size (issue 17 §3): ladders of 49 to 1,999 joints, the whole
+Then the growth with size (issue 17 §3): ladders of 49 to 1,999 joints (planar, and seen in
+3-D: the finite-mobility check's shortcut by the subgroup the twists generate), the whole
 ``analyze_rank`` (contours, rank, idle mobilities, singularity check) with the machine's
 default BLAS threads (``analyze_rank`` limits BLAS to one thread itself), against the same
 analysis forced onto one dense SVD (the method before the contour-by-contour elimination)
@@ -89,7 +90,7 @@ def main() -> None:
 def scaling(quick: bool = False) -> None:
     """Ladders of growing size: elimination against one dense SVD, answers checked equal."""
     sizes = [16, 66, 200] if quick else [16, 66, 200, 666]
-    print(f"\n{'ladder joints':>13} {'rank s':>8} {'dense SVD s':>12} {'ratio':>6}  answer (m, q, useful)")
+    print(f"\n{'ladder joints':>13} {'rank s':>8} {'in 3-D s':>9} {'dense SVD s':>12} {'ratio':>6}  answer (m, q, useful)")
     times = {}
     for loops in sizes:
         mech = mechanism_from_dict(ladder(loops))
@@ -97,6 +98,8 @@ def scaling(quick: bool = False) -> None:
         r = analyze_rank(mech)
         t = timeit(lambda: analyze_rank(mech), repeat=3 if n < 1000 else 2)
         times[n] = t
+        mech3 = as_spatial(mech)  # 3 redundant constraints a loop: regular by its subgroup's dimension
+        t3 = timeit(lambda: analyze_rank(mech3), repeat=3 if n < 1000 else 2)
         dense = ""
         if n <= 601:
             saved = rank_mod.DENSE_MAX_FREEDOMS
@@ -112,7 +115,7 @@ def scaling(quick: bool = False) -> None:
             dense = f"{td:12.3f} {td / t:6.1f}"
         else:
             dense = f"{'-':>12} {'-':>6}"
-        print(f"{n:13d} {t:8.3f} {dense}  ({r.mobility}, {r.redundant_constraints}, {r.useful_mobility})")
+        print(f"{n:13d} {t:8.3f} {t3:9.3f} {dense}  ({r.mobility}, {r.redundant_constraints}, {r.useful_mobility})")
     ns = sorted(n for n in times if n >= 199)
     if len(ns) >= 2:
         slope = np.polyfit(np.log(ns), np.log([times[n] for n in ns]), 1)[0]

@@ -66,7 +66,7 @@ from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.contours import independent_contours
 from mechsyn.structure.drives import excess_drives
-from mechsyn.structure.finite import LocalMobility, local_mobility
+from mechsyn.structure.finite import LocalMobility, local_mobility, subgroup_dimension
 from mechsyn.structure.idle import IdleInputs, IdleMobility, find_idle_mobilities
 from mechsyn.structure.screws import (  # noqa: F401  (re-exported: the names users import from here)
     _AXIS_NAMES,
@@ -684,10 +684,10 @@ def _local(sysm: _System, N: np.ndarray, tol: float, rank: int, idle: int, conto
     F, equations = sysm.twists.shape[0], sysm.lam * len(sysm.contours)
     if not sysm.contours:  # an open chain: every pair freedom is a finite motion
         return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
-    if rank == equations:  # provably regular: no need to follow the motion
-        # the loop-closure map has a surjective derivative here, so by the implicit function
-        # theorem its zero set is a manifold of dimension F - rank near the pose: every
-        # instantaneous motion extends to a finite one and the rank is the same nearby
+    if rank in (equations, len(sysm.contours) * subgroup_dimension(sysm.twists)):  # provably regular
+        # the loop-closure map (into the subgroup the twists generate: planar or spherical
+        # mechanisms in 3-D) has a surjective derivative here, so by the implicit function
+        # theorem its zero set is a manifold of dimension F - rank near the pose (finite.py)
         return LocalMobility(N.shape[1], N.shape[1], "regular", N.shape[1], rank), contours
 
     def null(theta: np.ndarray) -> tuple[int, np.ndarray]:
