@@ -591,11 +591,6 @@ class Frame:
         return out
 
 
-def frame(M: SpatialModel, R: np.ndarray, p: np.ndarray) -> Frame:
-    """The model's points, vectors and pair coordinates at poses ``(R, p)``."""
-    return Frame(M, R, p)
-
-
 # --------------------------------------------------------------------------- equations
 def helix_angles(M: SpatialModel, F: Frame, helix_ref: np.ndarray) -> np.ndarray:
     """The H pairs' rotations unwrapped next to ``helix_ref`` (their previous values)."""

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.spatial_model import (SpatialModel, _cross, convective, frame, helix_angles, jacobian, move,
+from mechsyn.kinematics.spatial_model import (Frame, SpatialModel, _cross, convective, helix_angles, jacobian, move,
                                               pair_error, residual, rotate)
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
@@ -125,7 +125,7 @@ class Lin:
         B = len(y)
         Y = y.reshape(B, self.C.shape[1], 6, -1)
         X = Y.copy()
-        X[:, :, 3:] += _cross_cols(self.C, Y[:, :, :3])
+        X[:, :, 3:] += np.moveaxis(_cross(self.C[:, :, None], np.moveaxis(Y[:, :, :3], 2, -1)), -1, 2)
         return X.reshape(y.shape)
 
     def _once(self, b: np.ndarray) -> np.ndarray:
@@ -168,13 +168,6 @@ def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
     sv = np.linalg.svd(Jc, compute_uv=False)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.nan_to_num(sv[:, r - 1] / sv[:, 0])
-
-
-def _cross_cols(c: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """``c × w`` for ``c`` (B, n, 3) and columns ``w`` (B, n, 3, k)."""
-    c = c[..., None]
-    return np.stack([c[:, :, 1] * w[:, :, 2] - c[:, :, 2] * w[:, :, 1], c[:, :, 2] * w[:, :, 0] - c[:, :, 0] * w[:, :, 2],
-                     c[:, :, 0] * w[:, :, 1] - c[:, :, 1] * w[:, :, 0]], axis=2)
 
 
 @dataclass
@@ -258,7 +251,7 @@ class Tracker:
         return Lin(Jc, G, rows, self.rank, C)
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
-        F = frame(self.M, R, p)
+        F = Frame(self.M, R, p)
         g = residual(self.M, F, href, target)
         if self.M.helix:
             href = helix_angles(self.M, F, href)
@@ -270,7 +263,7 @@ class Tracker:
         derivatives (``J ξ' = du``, ``J ξ'' = ü - γ(ξ')``, ``ü = ddu``: the drives' second
         derivatives, zero by default); ``refine``: steps of iterative refinement (2 for the
         rates reported, none for a predictor)."""
-        F = st.F if st.F is not None else frame(self.M, st.R, st.p)
+        F = st.F if st.F is not None else Frame(self.M, st.R, st.p)
         b = np.zeros(st.g.shape)
         b[:, self.m_c:] = du
         x1 = st.lin.solve(b, refine)
@@ -298,7 +291,7 @@ class Tracker:
         done, failed, on_fresh = np.zeros(B, bool), np.zeros(B, bool), np.zeros(B, bool)
         fresh, fidx = None, np.zeros(0, int)
         for it in range(iters):
-            F = frame(self.M, R, p)
+            F = Frame(self.M, R, p)
             g = residual(self.M, F, href, target)
             err = np.abs(g).max(axis=1)
             done |= err < self.tol
