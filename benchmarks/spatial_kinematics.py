@@ -32,15 +32,17 @@ as CPU time of the process (steadier when other processes compete for the cores)
 ratios are mechsyn's CPU time over the reference's, both measured in this process. The
 references compute positions only; mechsyn also gives every link's pose, velocities and
 accelerations, the closure residual and the rank test of every row, and (Delta) moves
-all ten links (60 unknowns against the loop's 3).
+all ten links (24 unknowns, each S-S bar one distance equation between its ends, against
+the loop's 3).
 
-Where the time goes (wall time of the parts at load 3): the walk is 36 of a Bennett sweep's
-50 ms (12 blocks of up to 42 rows, 5 to 8 Newton iterations each, every iteration some 100
+Where the time goes (CPU time of the parts at load 12): the walk is 33 of a Bennett sweep's
+48 ms (12 blocks of up to 42 rows, 5 to 8 Newton iterations each, every iteration some 100
 NumPy calls on arrays of a few hundred numbers: NumPy's per-call cost, not arithmetic), the
-rates, rank test and Jacobians of all rows at once the rest. On the Delta (151 ms): the walk
-52 ms (10 blocks of 64 rows, 8 iterations each, 60 unknowns), the inverses of the 601 Gram
-matrices (54 x 54) of the rates and rank test about 40 ms, the rates' solves 19 ms, the
-Jacobians and Gram matrices of all rows about 30 ms, the crossing test 7 ms.
+rates, rank test and Jacobians of all rows at once the rest. On the Delta (62 ms; 146 ms
+with its 60 unknowns): the walk 31 ms (10 blocks of 64 rows, 6 chord iterations each), the
+inverses of the 601 Gram matrices (24 x 24) of the rates and rank test about 8 ms, the
+rates' solves 5 ms, the Jacobians of all rows about 8 ms, the result (the bars' poses from
+their ends) 6 ms, the crossing test 2 ms.
 """
 
 from __future__ import annotations
