@@ -90,7 +90,8 @@ def main() -> None:
 def scaling(quick: bool = False) -> None:
     """Ladders of growing size: elimination against one dense SVD, answers checked equal."""
     sizes = [16, 66, 200] if quick else [16, 66, 200, 666]
-    print(f"\n{'ladder joints':>13} {'rank s':>8} {'in 3-D s':>9} {'dense SVD s':>12} {'ratio':>6}  answer (m, q, useful)")
+    print(f"\n{'ladder joints':>13} {'rank s':>8} {'in 3-D s':>9} {'dense SVD s':>12} {'ratio':>6}  "
+          "answer (m, q, useful)")
     times = {}
     for loops in sizes:
         mech = mechanism_from_dict(ladder(loops))

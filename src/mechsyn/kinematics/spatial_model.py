@@ -721,4 +721,5 @@ def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
     Xb = np.concatenate([w, y1d - _cross(w, y1)], axis=2)
     Xbd = np.concatenate([wd, y1dd - _cross(wd, y1) - _cross(w, y1d)], axis=2)
     return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1),
-            np.concatenate([X[:, :n], Xb], axis=1).reshape(N, -1), np.concatenate([Xd[:, :n], Xbd], axis=1).reshape(N, -1))
+            np.concatenate([X[:, :n], Xb], axis=1).reshape(N, -1),
+            np.concatenate([Xd[:, :n], Xbd], axis=1).reshape(N, -1))
