@@ -84,7 +84,7 @@ _EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
 _EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 
 
-_I1, _I2 = np.array([1, 2, 0]), np.array([2, 0, 1])
+_I, _I1, _I2 = np.arange(3), np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -693,7 +693,7 @@ def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
     :attr:`SpatialModel.all_links` from those of the links solved for (the frame's pose not
     included): each bar from its ends ``y_1``, ``y_2`` on the links it joins, turned by the
     least rotation from its drawn line ``d_0`` to ``d = y_2 - y_1`` (Rodrigues' formula with
-    ``k = d_0 × d``, over ``1 + cos``), moving at ``ω = d × ḋ / |d|²``,
+    ``k = d_0 × d``: ``cos I + [k]x + k kᵀ / (1 + cos)``), moving at ``ω = d × ḋ / |d|²``,
     ``ω̇ = d × d̈ / |d|²`` (no spin about its line) and ``v = ẏ_1 - ω × y_1``,
     ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``."""
     N, n = len(R), M.n
@@ -713,8 +713,9 @@ def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
     (y1, y1d, y1dd), (y2, y2d, y2dd) = ends
     d, d0 = y2 - y1, ds.vb - ds.va
     k, c = _cross(d0, d) / ds.c0[:, None] ** 2, _dot(d0, d) / ds.c0 ** 2
-    K = np.einsum("ijk,bnk->bnij", -_EPS, k)
-    Rb = np.eye(3) + K + K @ K / (1 + c)[..., None, None]
+    # ([k]x² = k kᵀ - |k|² I and |k|² = 1 - c²)
+    Rb = np.einsum("ijk,bnk->bnij", -_EPS, k) + k[..., :, None] * (k / (1 + c)[..., None])[..., None, :]
+    Rb[..., _I, _I] += c[..., None]
     pb = 0.5 * (y1 + y2 - rotate(Rb, ds.va + ds.vb))
     l2 = _dot(d, d)[..., None]
     w, wd = _cross(d, y2d - y1d) / l2, _cross(d, y2dd - y1dd) / l2
