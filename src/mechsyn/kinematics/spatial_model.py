@@ -604,9 +604,10 @@ def residual(M: SpatialModel, F: Frame, helix_ref: np.ndarray, target: np.ndarra
     B = len(target)
     d = np.concatenate([F.theta, F.s], axis=1)[:, lay.d_meas] - target
     d[:, lay.d_angle] = wrap(d[:, lay.d_angle])
-    bar, ell = F.da - F.db, M.dist.c0
-    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0,
-             (_dot(bar, bar) - ell * ell) / (2 * ell)]
+    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0]
+    if M.bars:
+        bar, ell = F.da - F.db, M.dist.c0
+        parts.append((_dot(bar, bar) - ell * ell) / (2 * ell))
     if M.helix:
         parts.append(F.s[:, lay.h_sl] - lay.h_pitch * helix_angles(M, F, helix_ref))
     parts.append(d)
@@ -617,9 +618,12 @@ def _scalar_coefficients(M: SpatialModel, F: Frame) -> tuple[np.ndarray, np.ndar
     """``c`` and ``n`` of the scalar rows, each ``c · (ω_a - ω_b) + n · (v_b - v_a)``."""
     lay = M.lay
     c_slide = _cross(F.sn, F.sb)
-    d = (F.da - F.db) / M.dist.c0[:, None]  # (x_a × d = x_b × d: one c for both links)
-    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb), _cross(F.da, d)]
-    ns = [np.zeros_like(F.u), F.ln, -d]
+    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb)]
+    ns = [np.zeros_like(F.u), F.ln]
+    if M.bars:
+        d = (F.da - F.db) / M.dist.c0[:, None]  # (x_a × d = x_b × d: one c for both links)
+        cs.append(_cross(F.da, d))
+        ns.append(-d)
     if M.helix:
         cs.append(c_slide[:, lay.h_sl] + lay.h_pitch[:, None] * F.aa[:, lay.h_ang])
         ns.append(F.sn[:, lay.h_sl])
@@ -662,11 +666,12 @@ def convective(M: SpatialModel, F: Frame, xi: np.ndarray) -> np.ndarray:
     wa, wb = w[:, dt.ia], w[:, dt.ib]
     ud, wd = _cross(wa, F.u), _cross(wb, F.w)
     g_dot = _dot(_cross(wa, ud), F.w) + 2 * _dot(ud, wd) + _dot(F.u, _cross(wb, wd))
-    ds = M.dist
-    wa, wb = w[:, ds.ia], w[:, ds.ib]
-    va, vb = v[:, ds.ia] + _cross(wa, F.da), v[:, ds.ib] + _cross(wb, F.db)
-    g_dist = (_dot(va - vb, va - vb) + _dot(F.da - F.db, _cross(wa, va) - _cross(wb, vb))) / ds.c0
-    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln), g_dist]
+    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln)]
+    if M.bars:
+        ds = M.dist
+        wa, wb = w[:, ds.ia], w[:, ds.ib]
+        va, vb = v[:, ds.ia] + _cross(wa, F.da), v[:, ds.ib] + _cross(wb, F.db)
+        parts.append((_dot(va - vb, va - vb) + _dot(F.da - F.db, _cross(wa, va) - _cross(wb, vb))) / ds.c0)
     if M.helix or M.drives:
         g_slide = _line_gamma(w, v, sl.ia, sl.ib, F.sa, F.sb, F.sn)
         g_angle = _dot(w[:, an.ib] - w[:, an.ia], _cross(w[:, an.ia], F.aa))
