@@ -18,6 +18,7 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.summary import is_full_turn
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.limits import limit, limit_hint
 from mechsyn.model.mechanism import Mechanism
@@ -141,12 +142,10 @@ class Motion(Result):
                 last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
                 out.append([float(first), float(last)])
                 start = None
-        if len(out) > 1 and ok[0] and ok[-1] and self.input_types.get(self.main_input) == "R" and n > 2:
-            step = float(np.median(np.abs(np.diff(vals))))
-            if abs(vals[-1] - vals[0]) + step >= 360.0 * (1 - 1e-9):  # a whole turn: the ends meet
-                turn = 360.0 if vals[-1] >= vals[0] else -360.0
-                out[0] = [out[-1][0], out[0][1] + turn]
-                out.pop()
+        if len(out) > 1 and ok[0] and ok[-1] and is_full_turn(vals, self.input_types.get(self.main_input)):
+            turn = 360.0 if vals[-1] >= vals[0] else -360.0  # a whole turn: the ends meet
+            out[0] = [out[-1][0], out[0][1] + turn]
+            out.pop()
         return out
 
     def to_pandas(self) -> Any:

@@ -29,7 +29,7 @@ from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.drives import DriveCheck, excess_drives
 
-__all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton", "drawn_checks"]
+__all__ = ["Sweep", "assemble", "sweep", "check_mobility", "newton", "drawn_checks"]
 
 
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -90,23 +90,6 @@ def _rel_step(S: PlanarSystem, dq: np.ndarray) -> float:
     """The largest change of ``dq`` (the first unknowns, or all n) relative to the
     mechanism's size (lengths) or in radians (angles)."""
     return float(np.abs(dq / S.col_scale[:len(dq)]).max()) if dq.size else 0.0
-
-
-def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
-          accel: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Velocities and accelerations (n,) at one configuration ``q`` (n,)."""
-    J = S.jacobian(q[None])[0]
-    B = S.input_matrix()
-    ud = np.asarray(speeds, float)
-    udd = np.zeros_like(ud) if accel is None else np.asarray(accel, float)
-    if J.shape[0] == J.shape[1]:
-        lu = sla.lu_factor(J, check_finite=False)
-        qd = sla.lu_solve(lu, B @ ud, check_finite=False)
-        qdd = sla.lu_solve(lu, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)
-    else:
-        qd = sla.lstsq(J, B @ ud, check_finite=False)[0]
-        qdd = sla.lstsq(J, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)[0]
-    return qd, qdd
 
 
 def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:

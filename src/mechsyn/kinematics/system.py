@@ -53,7 +53,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.cams import CamCurve, cam_curve
 from mechsyn.kinematics.compiled import one_configuration
-from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate, to_frame
+from mechsyn.kinematics.plane import cos_sin, dot, perp, rotate, to_frame
 from mechsyn.kinematics.topology import Topology, topology_of
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
@@ -63,14 +63,6 @@ __all__ = ["PlanarSystem", "build_system", "VLL_MODES", "CamCurve"]
 #: Accepted spellings of the VLL modes on the command line.
 VLL_MODES = {"active": "active", "driven": "active", "passive": "passive", "free": "passive",
              "locked": "locked", "rigid": "locked"}
-
-
-
-
-
-
-
-
 
 
 # --------------------------------------------------------------------------- constraints
@@ -191,34 +183,6 @@ class PlanarSystem:
         c, sn = cos_sin(phi)
         return r + rotate(c, sn, s)
 
-    def point_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, i: int,
-                    s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity, acceleration of the local point ``s`` on link ``i``."""
-        r, phi = self.pose(q, i)
-        c, sn = cos_sin(phi)
-        As = rotate(c, sn, s)
-        if i < 0:
-            z = np.zeros_like(As)
-            return r + As, z, z
-        v, w = qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
-        a, al = qdd[:, 3 * i:3 * i + 2], qdd[:, 3 * i + 2]
-        return (r + As, v + w[:, None] * perp(As),
-                a + al[:, None] * perp(As) - (w ** 2)[:, None] * As)
-
-    def points_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray,
-                     s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`point_state` of the local points ``s`` (m, 2) of the moving links ``idx`` (m,)
-        at once (m, N, 2), the same arithmetic (so the same numbers) in a few array operations.
-
-        >>> import numpy as np, mechsyn as ms
-        >>> S = build_system(ms.examples.load("crank_rocker"))
-        >>> q = S.q0[None] + np.linspace(0, 0.1, 4)[:, None]
-        >>> P, V, A = S.points_state(q, q, q, np.array([0, 1]), np.array([[1.0, 0.0], [0.5, 0.2]]))
-        >>> P.shape, bool(np.array_equal(A[1], S.point_state(q, q, q, 1, np.array([0.5, 0.2]))[2]))
-        ((2, 4, 2), True)
-        """
-        return tuple(points_state_array(q, qd, qdd, idx, s))
-
     def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
         """Angles (N,) of link index ``i`` (frame: zeros)."""
         return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
@@ -302,6 +266,21 @@ class PlanarSystem:
                 out[:, row:row + con.rows] = g
             row += con.rows
         return out
+
+    def rates(self, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Velocities and accelerations (N, n) of the configurations ``q`` (N, n) at the
+        input speeds ``speeds`` (k,): ``Phi_q q' = B u'`` and ``Phi_q q'' = gamma``
+        (Haug 1989, eqs. 3.3.9-3.3.11) solved for every configuration at once (a redundant
+        system: the least-squares rates, by the pseudo-inverse)."""
+        N = q.shape[0]
+        J = self.jacobian(q)
+        rhs = np.broadcast_to(self.input_matrix() @ np.asarray(speeds, float), (N, self.m))
+        if self.m == self.n:
+            qd = np.linalg.solve(J, rhs[..., None])[..., 0]
+            return qd, np.linalg.solve(J, self.gamma(q, qd)[..., None])[..., 0]
+        pinv = np.linalg.pinv(J)
+        qd = np.einsum("nij,nj->ni", pinv, rhs)
+        return qd, np.einsum("nij,nj->ni", pinv, self.gamma(q, qd))
 
     def rows_of(self, joint: str) -> list[int]:
         rows, row = [], 0
