@@ -35,6 +35,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.analysis import drawn_inputs, simulate
+from mechsyn.kinematics.plane import to_frame
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["InverseResult", "simulate_inverse", "simulate_path", "posed", "is_point_path"]
@@ -213,9 +214,8 @@ def _posed_planar(mech: Mechanism, sim: Any, row: int) -> Mechanism:
         if j.id in sim.points:
             ch["point"] = np.asarray(sim.points[j.id].position[row], float)
         if j.axis is not None and j.links[0] in turn:
-            c, s = math.cos(turn[j.links[0]]), math.sin(turn[j.links[0]])
             a = np.asarray(j.axis, float)
-            ch["axis"] = np.array([c * a[0] - s * a[1], s * a[0] + c * a[1]])
+            ch["axis"] = to_frame(math.cos(turn[j.links[0]]), math.sin(turn[j.links[0]]), a[0], a[1])
         joints.append(replace(j, **ch) if ch else j)
     points = {n: replace(p, at=np.asarray(sim.points[n].position[row], float)) if n in sim.points else p
               for n, p in mech.points.items()}

@@ -123,8 +123,7 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
     if rates and out_link is not None and len(sim.inputs) == 1:
         ma = derived.mechanical_advantage(sim, out_link)
         out["mechanical_advantage"] = {"output": out_link, "values": _finite_or_none(ma)}
-    if (mech.kind == "planar" and len(mech.links) == 4 and len(mech.joints) == 4  # a planar four-bar only
-            and all(j.type == "R" for j in mech.joints) and all(len(mech.joints_of(n)) == 2 for n in mech.link_names)):
+    if derived.is_fourbar(mech):
         out["grashof"] = to_jsonable(derived.grashof(mech))
     out["extent"] = {name: derived.path_extent(pm.position) for name, pm in sim.points.items()}
     if mech.kind == "planar" and rates:
