@@ -65,8 +65,6 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     >>> s.link("crank").angle.round(6).tolist()
     [0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0]
     """
-    if not inputs:
-        raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     engine = SPATIAL_ENGINE if mech.kind == "spatial" and method == "auto" else \
         None if method in ("auto", "assur") else engine_named(method)
     if hasattr(engine, "simulate"):  # an engine of whole mechanisms (the spatial one)
@@ -223,7 +221,7 @@ def _decomposition(S: PlanarSystem) -> Plan | None:
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
     """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
     input values, which decides whether a passive VLL is prescribed)."""
-    return _compiled(mech, vll, tuple(j for j in inputs if _is_passive(mech, j, vll)))
+    return _compiled(mech, vll, _prescribed(mech, vll, inputs))
 
 
 def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> KinematicPlan:

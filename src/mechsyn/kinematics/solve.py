@@ -679,7 +679,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                                   "dead point; the branch may switch here and positions are accurate only to "
                                   "about the square root of the solver tolerance"))
     events.sort(key=lambda e: e.index)
-    return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)
+    return Sweep(S, inputs, speeds, q, qd, qdd, assembled, events)
 
 
 def _sweep_shifted(S: PlanarSystem, inputs: np.ndarray, shift: np.ndarray, speeds: np.ndarray | None,
