@@ -59,7 +59,7 @@ def transmission_angles(sim) -> dict[str, np.ndarray]:
             u = pts[jr] - pts[J2]
             j = S.mech.joint(jp)
             a = S.index(j.links[0])
-            ang = S.link_angle_i(np.nan_to_num(q), a)
+            ang = S.pose(np.nan_to_num(q), a)[1]
             ax = np.asarray(S.to_local_dir(j.links[0], j.axis))
             c, s = np.cos(ang), np.sin(ang)
             v = np.stack([-(s * ax[0] + c * ax[1]), c * ax[0] - s * ax[1]], axis=1)  # slide normal

@@ -183,13 +183,9 @@ class PlanarSystem:
         c, sn = cos_sin(phi)
         return r + rotate(c, sn, s)
 
-    def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
-        """Angles (N,) of link index ``i`` (frame: zeros)."""
-        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
-
     def link_angle(self, q: np.ndarray, link: str) -> np.ndarray:
-        i = self.index(link)
-        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
+        """Angles (N,) of link ``link`` (the frame: zeros)."""
+        return self.pose(q, self.index(link))[1]
 
     def driver_index(self, joint: str) -> int:
         for k, d in enumerate(self.drivers):
@@ -309,19 +305,13 @@ def _axis(j: Joint) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ per-constraint code
-def _link_rates(sys_: PlanarSystem, qd: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
-    if i < 0:
-        return np.zeros((qd.shape[0], 2)), np.zeros(qd.shape[0])
-    return qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
-
-
 def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.ndarray:
     k = con.kind
     if k == "R":
         return S.point(q, con.a, con.sa) - S.point(q, con.b, con.sb)
     if k == "angle":
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
-        return (S.link_angle_i(q, con.b) - S.link_angle_i(q, con.a) - val)[:, None]
+        return (S.pose(q, con.b)[1] - S.pose(q, con.a)[1] - val)[:, None]
     if k == "line":
         ra, pa = S.pose(q, con.a)
         c, s = cos_sin(pa)
@@ -330,7 +320,7 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
         return (dot(w, d) - val)[:, None]
     if k == "gear":
-        pa, pb, pc = (S.link_angle_i(q, i) for i in (con.a, con.b, con.c))
+        pa, pb, pc = (S.pose(q, i)[1] for i in (con.a, con.b, con.c))
         return ((pb - pc) - con.k * (pa - pc) - con.c0)[:, None]
     if k == "curve":
         ra, pa = S.pose(q, con.a)
@@ -343,7 +333,7 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         r = con.radius
         with np.errstate(invalid="ignore"):
             b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))   # NaN: belt not taut and straight
-        rel = S.link_angle_i(q, con.b) - np.arctan2(D[:, 1], D[:, 0]) - con.ref
+        rel = S.pose(q, con.b)[1] - np.arctan2(D[:, 1], D[:, 0]) - con.ref
         rel = np.mod(rel + np.pi, 2 * np.pi) - np.pi                 # continuous within half a turn
         return (b - r * np.arctan2(b, r) + con.sigma * r * rel - con.c0)[:, None]
     raise AssertionError(k)
@@ -455,8 +445,8 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         _, pa = S.pose(q, con.a)
         c, s = cos_sin(pa)
         w = rotate(c, s, con.w)
-        va, wa = _link_rates(S, qd, con.a)
-        vb, wb = _link_rates(S, qd, con.b)
+        va, wa = S.pose(qd, con.a)
+        vb, wb = S.pose(qd, con.b)
         Asa = rotate(c, s, con.sa)
         _, pb = S.pose(q, con.b)
         cb, sb = cos_sin(pb)
@@ -471,8 +461,8 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         c, s = cos_sin(pa)
         _, pb = S.pose(q, con.b)
         cb, sb = cos_sin(pb)
-        _, wa = _link_rates(S, qd, con.a)
-        _, wb = _link_rates(S, qd, con.b)
+        _, wa = S.pose(qd, con.a)
+        _, wb = S.pose(qd, con.b)
         t, td = q[:, con.tvar], qd[:, con.tvar]
         O, O1, O2 = (con.curve.eval(t, d) for d in (0, 1, 2))
         g = ((wb ** 2)[:, None] * rotate(cb, sb, con.sb) - (wa ** 2)[:, None] * rotate(c, s, O)
@@ -492,7 +482,7 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
             _, phi = S.pose(q, i)
             c, sn = cos_sin(phi)
             As = rotate(c, sn, sl)
-            v, w = _link_rates(S, qd, i)
+            v, w = S.pose(qd, i)
             Dd = Dd + sign * (v + w[:, None] * perp(As))
             out = out + sign * w ** 2 * dot(g, As)
         if np.ndim(Dd) == 0:
@@ -624,7 +614,7 @@ class _Builder:
     def angle(self, b: int, a: int) -> float:
         """``phi_b - phi_a`` in the drawn configuration."""
         p, q0 = self.partial, self.q0[None]
-        return float(p.link_angle_i(q0, b)[0] - p.link_angle_i(q0, a)[0])
+        return float(p.pose(q0, b)[1][0] - p.pose(q0, a)[1][0])
 
     def add(self, j: Joint) -> None:
         getattr(self, "_" + j.type)(j)
@@ -687,7 +677,7 @@ class _Builder:
             ratio = -r1 / r2 if between else r1 / r2
         a, b, c = idx(a_name), idx(b_name), idx(cname)
         q0a = self.q0[None]
-        pa_, pb_, pc_ = (self.partial.link_angle_i(q0a, i)[0] for i in (a, b, c))
+        pa_, pb_, pc_ = (self.partial.pose(q0a, i)[1][0] for i in (a, b, c))
         self.cons.append(Con("gear", j.id, 1, a, b, c=c, k=ratio,
                              c0=float((pb_ - pc_) - ratio * (pa_ - pc_)), role="pair"))
 
@@ -726,7 +716,7 @@ class _Builder:
         con = Con("belt", j.id, 1, a, b, sa=sa, sb=sb, radius=float(j.attrs["radius"]),
                   sigma=BELT_WRAPS[j.attrs["wrap"]], role="pair")
         D = j.point - np.asarray(j.attrs["anchor"], float)
-        con = replace(con, ref=float(p.link_angle_i(self.q0[None], b)[0] - np.arctan2(D[1], D[0])))
+        con = replace(con, ref=float(p.pose(self.q0[None], b)[1][0] - np.arctan2(D[1], D[0])))
         c0 = float(_residual(p, con, self.q0[None], np.zeros((1, 0)))[0, 0])
         self.cons.append(replace(con, c0=c0))
         if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id
