@@ -300,10 +300,6 @@ class Simulation(Motion):
             rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
         return rows
 
-    def link(self, name: str) -> LinkMotion:
-        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
-        return super().link(name)
-
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:
         """:meth:`Motion.animate` (a :class:`~mechsyn.plot.animation.MechanismAnimation`)."""
         return super().animate(fig, bare=True, **kwargs)

@@ -95,12 +95,17 @@ def _rel_step(S: PlanarSystem, dq: np.ndarray) -> float:
 def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
     """Rank of ``Phi_q`` at ``q``: free coordinates beyond the inputs, redundant constraints."""
     q = S.q0 if q is None else q
-    J = S.unit_jacobian(S.jacobian(q[None])[0])  # dimensionless: the same rank at any scale
-    sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
-    tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
-    rank = int(np.sum(sv > tol))
+    rank = _rank(S.unit_jacobian(S.jacobian(q[None])[0]))[0]  # dimensionless: the same rank at any scale
     return {"unknowns": S.n, "equations": S.m, "rank": rank, "free": S.n - rank,
             "redundant": S.m - rank}
+
+
+def _rank(J: np.ndarray) -> tuple[int, float]:
+    """The rank of a dimensionless ``Phi_q`` and the tolerance it is counted with: its
+    singular values above 1e-9 of the largest (and of 1)."""
+    sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
+    tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
+    return int(np.sum(sv > tol)), tol
 
 
 def drive_check(S: PlanarSystem, given: tuple = ()) -> DriveCheck | None:
@@ -117,8 +122,7 @@ def drive_check(S: PlanarSystem, given: tuple = ()) -> DriveCheck | None:
         J = S.unit_jacobian(S.jacobian(S.q0[None])[0])
         B = S.input_matrix()
         closure = ~np.any(B != 0, axis=1)
-        sv_all = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
-        tol = 1e-9 * max(1.0, float(sv_all.max()) if sv_all.size else 1.0)
+        tol = _rank(J)[1]
         _, s, vt = np.linalg.svd(J[closure], full_matrices=True)
         motions = vt[int(np.sum(s > tol)):].T  # the rates every loop closure allows
         names = [d.joint for d in S.drivers]
@@ -238,21 +242,19 @@ def _drawn_groups(S: PlanarSystem, plan: Any) -> list | None:
     return S.topology.product("drawn checks", build, plan)
 
 
-def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:
-    info = check_mobility(S, q)
-    src = S.mech.source or "<mechanism>"
-    if info["free"] > 0 and generic_free(S, q) == 0:
-        return info  # a singular file configuration (dead centre, folded): reported by the sweep
-    if info["free"] > 0:
+def _require_determined(S: PlanarSystem, q: np.ndarray) -> None:
+    """Raise when the inputs leave free coordinates at ``q`` (a singular file configuration,
+    a dead centre or folded, is not: the sweep reports it)."""
+    free = check_mobility(S, q)["free"]
+    if free > 0 and generic_free(S, q) > 0:
         passive = [j for j, mode in S.vll.items() if mode == "passive"]
         hint = "mark more joints actuated"
         if passive:
             hint = (f"lock the free VLL ({', '.join(f'--vll {p}=locked' for p in passive)}) or give its "
                     f"length as an input (--input {passive[0]}=...)")
         raise MechsynInputError(
-            f"the mechanism has {info['free']} free coordinate(s) beyond its {len(S.drivers)} input(s): "
-            "its motion is not determined by the inputs", source=src, hint=hint)
-    return info
+            f"the mechanism has {free} free coordinate(s) beyond its {len(S.drivers)} input(s): "
+            "its motion is not determined by the inputs", source=S.mech.source or "<mechanism>", hint=hint)
 
 
 def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
