@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from mechsyn.io import load_mechanism, mechanism_from_dict
+from mechsyn.kinematics.plane import cos_sin, perp, rotate
 
 EX = Path(__file__).resolve().parents[2] / "examples"
 
@@ -17,6 +18,20 @@ def ex():
     def load(rel: str):
         return load_mechanism(EX / rel)
     return load
+
+
+def point_state(S, q, qd, qdd, i, s):
+    """Position, velocity and acceleration (N, 2) of the local point ``s`` on link ``i`` of
+    ``S`` (-1: the frame) over the poses ``q`` and their rates, one point on its own:
+    ``P = r + A s``, ``v = r' + w R90 A s``, ``a = r'' + alpha R90 A s - w^2 A s`` (the
+    tests' oracle of the library's batched point states, the same arithmetic)."""
+    if i < 0:
+        z = np.zeros((q.shape[0], 2))
+        return z + rotate(*cos_sin(np.zeros(q.shape[0])), s), z, z
+    As = rotate(*cos_sin(q[:, 3 * i + 2]), s)
+    w, al = qd[:, 3 * i + 2], qdd[:, 3 * i + 2]
+    return (q[:, 3 * i:3 * i + 2] + As, qd[:, 3 * i:3 * i + 2] + w[:, None] * perp(As),
+            qdd[:, 3 * i:3 * i + 2] + al[:, None] * perp(As) - (w ** 2)[:, None] * As)
 
 
 def fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0, branch=1, extra=None):

@@ -8,7 +8,7 @@ from mechsyn.kinematics.analysis import forces, input_grid
 from mechsyn.kinematics.forces import loads_from_file, mass_model
 from mechsyn.kinematics.plane import cross
 
-from kinematics_helpers import ex, fourbar_dict  # noqa: F401
+from kinematics_helpers import ex, fourbar_dict, point_state  # noqa: F401
 
 
 def power_residual(fa):
@@ -22,7 +22,7 @@ def power_residual(fa):
     g = np.asarray(fa.gravity)
     terms = []
     for i, name in enumerate(S.links):
-        _, vG, aG = S.point_state(q, qd, qdd, i, mm.com[i])
+        _, vG, aG = point_state(S, q, qd, qdd, i, mm.com[i])
         w, al = qd[:, 3 * i + 2], qdd[:, 3 * i + 2]
         terms.append(mm.mass[i] * (vG @ g))
         if not fa.static:  # the static case has no inertia loads
@@ -30,7 +30,7 @@ def power_residual(fa):
             terms.append(-mm.inertia[i] * al * w)
     for k in range(len(loads.link)):
         i = loads.link[k]
-        _, vP, _ = S.point_state(q, qd, qdd, i, loads.at[k])
+        _, vP, _ = point_state(S, q, qd, qdd, i, loads.at[k])
         terms.append(vP @ loads.force[k] + loads.moment[k] * qd[:, 3 * i + 2])
     for k, d in enumerate(S.drivers):
         if d.joint in fa.reactions.effort:
@@ -202,7 +202,7 @@ def test_every_link_is_in_equilibrium(ex, rel, inp, vll):
     for i, name in enumerate(S.links):
         Fsum = np.zeros((len(q), 2))
         Msum = np.zeros(len(q))
-        PG, _, aG = S.point_state(q, qd, qdd, i, mm.com[i])
+        PG, _, aG = point_state(S, q, qd, qdd, i, mm.com[i])
         Fi = mm.mass[i] * (np.asarray(g) - aG)
         Fsum += Fi
         Msum += cross(PG, Fi) - mm.inertia[i] * qdd[:, 3 * i + 2]

@@ -9,9 +9,9 @@ import pytest
 
 import mechsyn as ms
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.analysis import drawn_inputs, simulate
 from mechsyn.kinematics.centres import instant_centres
-from mechsyn.kinematics.inverse import drawn_inputs, posed, simulate_inverse
+from mechsyn.kinematics.inverse import posed, simulate_inverse
 
 
 def test_five_bar_tool_follows_a_line_and_the_forward_simulation_agrees():

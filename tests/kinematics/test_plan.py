@@ -7,7 +7,7 @@ import pytest
 
 from mechsyn.kinematics.analysis import compile_plan, input_grid, simulate
 
-from kinematics_helpers import ex  # noqa: F401
+from kinematics_helpers import ex, point_state  # noqa: F401
 
 
 def test_with_joint_points_equals_a_fresh_simulation(ex):
@@ -205,9 +205,9 @@ def test_one_pass_with_a_drive_between_moving_links_equals_the_tracked_sweep(ex)
                                         ("textbook/watt_sixbar.yaml", "A", (100, 130, 0.5))])
 def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid):
     """Every named point (and joint) of a sweep, computed for all points at once, equals
-    :meth:`PlanarSystem.point_state` of that point alone with its rows not assembled (and
-    its rates where they are not defined) NaN, bit for bit; with the regular pass's link
-    states and without them (the tracked chain)."""
+    the state of that point alone (``kinematics_helpers.point_state``) with its rows not
+    assembled (and its rates where they are not defined) NaN, bit for bit; with the regular
+    pass's link states and without them (the tracked chain)."""
     from mechsyn.kinematics import analysis
 
     m = ex(f)
@@ -218,7 +218,7 @@ def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid):
         ok = s.assembled
         rates = ok & np.isfinite(sw.qd).all(axis=1) & np.isfinite(sw.qdd).all(axis=1)
         for name, (link, at) in analysis.resolve_points(m, names).items():
-            want = S.point_state(sw.q, sw.qd, sw.qdd, S.index(link), S.to_local(link, at))
+            want = point_state(S, sw.q, sw.qd, sw.qdd, S.index(link), S.to_local(link, at))
             for k, (got, ref) in enumerate(zip((s.points[name].position, s.points[name].velocity,
                                                 s.points[name].acceleration), want)):
                 ref = ref.copy()

@@ -8,7 +8,7 @@ from mechsyn.kinematics.analysis import input_grid, simulate
 from mechsyn.kinematics.solve import check_mobility
 from mechsyn.kinematics.system import build_system
 
-from kinematics_helpers import ex  # noqa: F401
+from kinematics_helpers import ex, point_state  # noqa: F401
 
 
 def vll_length(sim, joint="S"):
@@ -92,7 +92,7 @@ def test_three_phalanx_forces_both_modes(ex):
     for fa in (locked, free):
         sim = fa.simulation
         S, sw = sim.system, sim.sweep
-        tip = S.point_state(sw.q, sw.qd, sw.qdd, S.index("distal"), S.to_local("distal", np.array([0.0, 95.0])))
+        tip = point_state(S, sw.q, sw.qd, sw.qdd, S.index("distal"), S.to_local("distal", np.array([0.0, 95.0])))
         power = tip[1] @ np.array([-2.0, 0.5])
         for k, dr in enumerate(S.drivers):
             power = power + fa.reactions.effort[dr.joint] * sw.speeds[k]

@@ -11,8 +11,8 @@ Modules, from the entry points down (docs/architecture.md):
 * ``regular`` (one-pass regular sweep), ``tracking`` (assembly modes through folds and
   change points), ``chain`` (driver-R + RRR chains, closed-form rates), ``positions``
   (generic group steps), ``groups`` (plan, decomposition, the RRR kernel),
-  ``solve`` (Newton continuation, assembly, mobility), ``rates`` (batched rates),
-  ``system`` (link poses, constraint equations, analytic and dimensionless Jacobian);
+  ``solve`` (Newton continuation, assembly, mobility), ``system`` (link poses,
+  constraint equations, analytic and dimensionless Jacobian, batched rates);
 * ``batch`` (many designs of one topology), ``forces`` (kinetostatics), ``derived``
   (transmission angle, mechanical advantage, Grashof, path extent, straightness),
   ``report``; ``dyads`` keeps the Assur-group names for callers outside the package.

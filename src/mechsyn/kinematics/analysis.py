@@ -37,7 +37,7 @@ from mechsyn.model.mechanism import Mechanism, fields_replaced
 from mechsyn.progress import ProgressCallback
 
 __all__ = ["ENGINES", "Motion", "Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
-           "KinematicPlan", "compile_plan", "cached_plan",
+           "KinematicPlan", "compile_plan", "cached_plan", "drawn_inputs",
            "ForceAnalysis", "forces"]
 
 
@@ -65,8 +65,6 @@ def simulate(mech: Mechanism, inputs: dict[str, np.ndarray], speeds: dict[str, f
     >>> s.link("crank").angle.round(6).tolist()
     [0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0]
     """
-    if not inputs:
-        raise MechsynInputError("no input given", field="inputs", hint="give the driven joint's values, e.g. A=0:360:1 on the command line")
     engine = SPATIAL_ENGINE if mech.kind == "spatial" and method == "auto" else \
         None if method in ("auto", "assur") else engine_named(method)
     if hasattr(engine, "simulate"):  # an engine of whole mechanisms (the spatial one)
@@ -117,6 +115,26 @@ def cached_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tupl
         kp = _compiled(mech, vll, prescribed)
         CACHE.put(key, kp)
     return kp
+
+
+def drawn_inputs(mech: Mechanism) -> dict[str, float]:
+    """Every drive's value at the drawn pose, in the engine's convention: a planar R drive's
+    angle (deg) and P drive's slide as the file draws them, 0 for a spatial file's drives
+    (its inputs are measured from the drawn assembly). The pose-level analyses
+    (:mod:`mechsyn.kinematics.inverse`, :mod:`mechsyn.kinematics.centres`) start there.
+
+    Examples
+    --------
+    >>> import mechsyn as ms
+    >>> {k: round(v, 6) for k, v in drawn_inputs(ms.examples.load("crank_rocker")).items()}
+    {'A': 60.0}
+    """
+    drives = [j.id for j in mech.joints if j.actuated]
+    if mech.kind != "planar":
+        return {d: 0.0 for d in drives}
+    S = cached_plan(mech, inputs=tuple(drives)).system
+    return {d.joint: (math.degrees(d.assembled) if d.type == "R" else float(d.assembled))
+            for d in S.drivers if d.joint in drives}
 
 
 @dataclass(frozen=True, eq=False)
@@ -203,7 +221,7 @@ def _decomposition(S: PlanarSystem) -> Plan | None:
 def compile_plan(mech: Mechanism, vll: dict[str, str] | None = None, inputs: tuple = ()) -> KinematicPlan:
     """Compile a mechanism for :func:`simulate` (``inputs``: the joints that will be given
     input values, which decides whether a passive VLL is prescribed)."""
-    return _compiled(mech, vll, tuple(j for j in inputs if _is_passive(mech, j, vll)))
+    return _compiled(mech, vll, _prescribed(mech, vll, inputs))
 
 
 def _compiled(mech: Mechanism, vll: dict[str, str] | None, prescribed: tuple) -> KinematicPlan:

@@ -33,8 +33,8 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.analysis import simulate
-from mechsyn.kinematics.inverse import drawn_inputs
+from mechsyn.kinematics.analysis import drawn_inputs, simulate
+from mechsyn.kinematics.plane import perp  # k × v: v turned by +90 degrees
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["InstantCentre", "instant_centres"]
@@ -68,7 +68,8 @@ class InstantCentre:
 
 def _rates(mech: Mechanism, inputs: dict[str, float] | None) -> tuple[dict, dict, float]:
     """``ω`` and a reference point with its velocity of every link (the frame: 0), by one
-    simulated row at ``inputs`` (the drawn pose when None)."""
+    simulated row at ``inputs`` (the drawn pose when None), and the mechanism's length
+    scale (its system's)."""
 
     u = drawn_inputs(mech)
     if not u:
@@ -88,14 +89,7 @@ def _rates(mech: Mechanism, inputs: dict[str, float] | None) -> tuple[dict, dict
             pm = sim.points[j.id]
             for link in j.links:
                 ref.setdefault(link, (np.asarray(pm.position[0], float), np.asarray(pm.velocity[0], float)))
-    pts = np.array([np.asarray(j.point, float)[:2] for j in mech.joints if j.point is not None])
-    scale = float(np.ptp(pts, axis=0).max()) if len(pts) > 1 else 1.0
-    return omega, ref, scale
-
-
-def _kz(v: np.ndarray) -> np.ndarray:
-    """``k × v``: ``v`` turned by +90 degrees."""
-    return np.array([-v[1], v[0]])
+    return omega, ref, sim.system.scale
 
 
 def instant_centres(mech: Mechanism, inputs: dict[str, float] | None = None) -> list[InstantCentre]:
@@ -117,7 +111,7 @@ def instant_centres(mech: Mechanism, inputs: dict[str, float] | None = None) -> 
         qb, vb = ref.get(b, (np.zeros(2), np.zeros(2)))
         if not (math.isfinite(wa) and math.isfinite(wb)):
             continue
-        c = vb - va + wa * _kz(qa) - wb * _kz(qb)
+        c = vb - va + wa * perp(qa) - wb * perp(qb)
         dw = wa - wb
         ratio = wb / wa if abs(wa) > 1e-12 * (abs(wa) + abs(wb) + 1e-300) and wa != 0 else None
         speed = float(np.linalg.norm(c)) + (abs(wa) + abs(wb)) * scale
@@ -125,7 +119,7 @@ def instant_centres(mech: Mechanism, inputs: dict[str, float] | None = None) -> 
             # (no relative motion at all, a dead centre of the pair: no direction either;
             # speeds are those of the drives at 1 rad/s, 1 unit/s: ``scale`` is their size)
             t = c / np.linalg.norm(c) if np.linalg.norm(c) > 1e-9 * scale else None
-            out.append(InstantCentre((a, b), None, None if t is None else _kz(t), rjoint.get(tuple(sorted((a, b)))),
+            out.append(InstantCentre((a, b), None, None if t is None else perp(t), rjoint.get(tuple(sorted((a, b)))),
                                      ratio))
             continue
         p = np.array([c[1], -c[0]]) / dw  # k × P = c / dw

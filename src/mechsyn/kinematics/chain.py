@@ -19,7 +19,6 @@ import numpy as np
 from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, circle_circle, cons_of,
                                        geometry_memo, local_point, normalised_disc)
 from mechsyn.kinematics.positions import TrackedPositions, continuous_angles, solve_positions
-from mechsyn.kinematics.rates import batch_rates
 from mechsyn.kinematics.plane import cross
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -45,7 +44,7 @@ def solve_all(S: PlanarSystem, plan: Plan, inputs: np.ndarray, speeds: np.ndarra
     idx = np.flatnonzero(ok)
     for start in range(0, len(idx), chunk):
         sel = idx[start:start + chunk]
-        qd[sel], qdd[sel] = batch_rates(S, q[sel], speeds)
+        qd[sel], qdd[sel] = S.rates(q[sel], speeds)
     return q, qd, qdd
 
 

@@ -27,7 +27,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.groups import decompose
 from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["transmission_angles", "mechanical_advantage", "grashof", "Grashof", "path_extent",
+__all__ = ["transmission_angles", "mechanical_advantage", "grashof", "Grashof", "is_fourbar", "path_extent",
            "straightness", "default_output_link"]
 
 
@@ -59,7 +59,7 @@ def transmission_angles(sim) -> dict[str, np.ndarray]:
             u = pts[jr] - pts[J2]
             j = S.mech.joint(jp)
             a = S.index(j.links[0])
-            ang = S.link_angle_i(np.nan_to_num(q), a)
+            ang = S.pose(np.nan_to_num(q), a)[1]
             ax = np.asarray(S.to_local_dir(j.links[0], j.axis))
             c, s = np.cos(ang), np.sin(ang)
             v = np.stack([-(s * ax[0] + c * ax[1]), c * ax[0] - s * ax[1]], axis=1)  # slide normal
@@ -157,6 +157,13 @@ def grashof(mech: Mechanism) -> Grashof:
     named = {"frame": lengths[ground], "crank": lengths[crank], "coupler": lengths[coupler],
              "rocker": lengths[rocker]}
     return Grashof(named, s, l, p, q, g, cls, expr)
+
+
+def is_fourbar(mech: Mechanism) -> bool:
+    """A planar four-bar of R pairs (four links, four R joints, two on every link): the
+    mechanisms :func:`grashof` classifies."""
+    return (mech.kind == "planar" and len(mech.links) == 4 and len(mech.joints) == 4
+            and all(j.type == "R" for j in mech.joints) and all(len(mech.joints_of(n)) == 2 for n in mech.link_names))
 
 
 def path_extent(path: np.ndarray) -> dict[str, float]:

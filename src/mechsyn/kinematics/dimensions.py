@@ -41,6 +41,9 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.derived import is_fourbar
+from mechsyn.kinematics.groups import circle_circle
+from mechsyn.kinematics.plane import cross, perp, to_frame
 from mechsyn.kinematics.solve import newton, worst_joint
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
@@ -193,7 +196,7 @@ def set_side(mech: Mechanism, link: str, joints: tuple[str, str], length: float)
         third = next(ids for ids, _ in places if a not in ids and b not in ids)
         c = third[0]
         pa, pb, pc = (_xy(mech.joint(x).point) for x in (a, b, c))
-        pc_new = _third(pa, moves[b], np.linalg.norm(pc - pa), np.linalg.norm(pc - pb), _side(pa, pb, pc))
+        pc_new = _third(pa, pb, pc, moves[b])
         moves.update({x: pc_new for x in third})
         if pc_new is None:
             raise MechsynInputError(f"side {a}–{b} of {link} = {L:.6g} breaks the triangle inequality with its "
@@ -239,21 +242,18 @@ def _moved_along(mech: Mechanism, link: str, a: str, b: str, L: float) -> dict[s
     return {x: pa + L * u for x in _place_of(mech, link, b)}
 
 
-def _side(pa: np.ndarray, pb: np.ndarray, pc: np.ndarray) -> float:
-    d, e = pb - pa, pc - pa
-    return 1.0 if d[0] * e[1] - d[1] * e[0] >= 0 else -1.0
-
-
-def _third(pa: np.ndarray, pb: np.ndarray, ra: float, rb: float, side: float) -> np.ndarray | None:
-    """The point ``ra`` from ``pa`` and ``rb`` from ``pb`` on ``side`` of the line a→b."""
-    d = pb - pa
-    L = float(np.linalg.norm(d))
-    x = (L * L + ra * ra - rb * rb) / (2 * L)
-    h2 = ra * ra - x * x
-    if h2 < -1e-12 * max(ra, rb) ** 2:
+def _third(pa: np.ndarray, pb: np.ndarray, pc: np.ndarray, pb_new: np.ndarray) -> np.ndarray | None:
+    """The third vertex of the triangle ``pa, pb, pc`` when ``pb`` moves to ``pb_new``: the
+    point at its distances from ``pa`` and ``pb`` on the same side of the line a→b (the
+    RRR group's circle intersection, :func:`~mechsyn.kinematics.groups.circle_circle`),
+    None where the circles do not meet."""
+    d = pb_new - pa
+    side = 1.0 if cross(pb - pa, pc - pa) >= 0 else -1.0
+    ra2, rb2 = float((pc - pa) @ (pc - pa)), float((pc - pb) @ (pc - pb))
+    inv, f, g2 = circle_circle(float(d[0]), float(d[1]), ra2, rb2)
+    if not g2 >= -1e-12 * max(ra2, rb2) * inv:  # (NaN: a side of zero length)
         return None
-    u = d / L
-    return pa + x * u + side * math.sqrt(max(h2, 0.0)) * np.array([-u[1], u[0]])
+    return pa + f * d + side * math.sqrt(max(g2, 0.0)) * perp(d)
 
 
 # --------------------------------------------------------------------------- solving
@@ -382,10 +382,10 @@ class _Geometry:
 
 
 def _turned(S: Any, q: np.ndarray, link: str, local_dir: np.ndarray) -> np.ndarray:
+    """The direction ``local_dir`` of ``link``'s frame at the configuration ``q``."""
     i = S.index(link)
     phi = 0.0 if i < 0 else float(q[3 * i + 2])
-    c, s = math.cos(phi), math.sin(phi)
-    return np.array([c * local_dir[0] - s * local_dir[1], s * local_dir[0] + c * local_dir[1]])
+    return to_frame(math.cos(phi), math.sin(phi), local_dir[0], local_dir[1])
 
 
 # --------------------------------------------------------------------------- why not
@@ -409,7 +409,7 @@ def _why(geo: _Geometry, q: np.ndarray, what: str, folded: bool) -> str:
         text += f": the links at joint {_worst_joint(geo, q)} cannot close their loop"
         if folded:
             text += " (the drawn branch passes a dead point before reaching it)"
-    if len(mech.links) == 4 and len(mech.joints) == 4 and all(j.type == "R" for j in mech.joints):
+    if is_fourbar(mech):
         text += "; " + _grashof_words(geo)
     return text
 

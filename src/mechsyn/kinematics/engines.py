@@ -100,12 +100,9 @@ class RegularPass:
         if isinstance(res, Folded):  # through folds: the tracked sweeps' singular rows and events
             return _folded_sweep(system, inputs, speeds, k, res, self.name)
         q, qd, qdd, links = res
-        nan = np.empty((2, N))  # Newton's det_sign and sigma_min, not computed here (empty + fill:
-        nan.fill(np.nan)        # np.full and np.ones are Python functions around these two calls)
-        ok = np.empty(N, bool)
+        ok = np.empty(N, bool)  # (empty + fill: np.ones is a Python function around these two calls)
         ok.fill(True)
-        return Sweep(system, inputs, speeds, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", links=links,
-                     engine=self.name)
+        return Sweep(system, inputs, speeds, q, qd, qdd, ok, [], links=links, engine=self.name)
 
     def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
         """Why :meth:`sweep` gave None, in one line."""
@@ -186,9 +183,7 @@ class Newton:
         def run(parts: list) -> list[Sweep]:
             out, before = [], 0
             for U in parts:  # rows counted over the parts: the sweep's rows done of all
-                sw = newton_sweep(system, U, speeds, progress=shifted(progress, before, len(inputs)))
-                sw.engine = self.name
-                out.append(sw)
+                out.append(newton_sweep(system, U, speeds, progress=shifted(progress, before, len(inputs))))
                 before += len(U)
             return out
 
@@ -249,14 +244,11 @@ def _tracked_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, res: tuple, e
                    advance: Callable[[int], None]) -> Sweep:
     """A tracked engine's arrays, singular rows and group events as a Sweep."""
     q, qd, qdd, singular, tr_events = res
-    N = U.shape[0]
     qd[singular] = np.nan  # a group folded flat: rates not defined here
     qdd[singular] = np.nan
     ok = np.all(np.isfinite(q), axis=1)
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, np.full(N, np.nan), np.full(N, np.nan), [], method="assur", engine=engine)
-    sw.events = _tracked_events(tr_events, bool(ok[0]), U[0])
-    advance(N)
-    return sw
+    advance(U.shape[0])
+    return Sweep(S, U, sp, q, qd, qdd, ok, _tracked_events(tr_events, bool(ok[0]), U[0]), engine=engine)
 
 
 def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None, res: Folded, engine: str) -> Sweep:
@@ -266,10 +258,7 @@ def _folded_sweep(S: PlanarSystem, U: np.ndarray, sp: np.ndarray, k: int | None,
     (_, ev), *back = res.parts
     q, qd, qdd = res.q, res.qd, res.qdd
     rates_ok, ok = res.rates_ok, res.assembled  # the singular rows already blanked
-    nan = np.empty((2, U.shape[0]))
-    nan.fill(np.nan)
-    sw = Sweep(S, U, sp, q, qd, qdd, ok, nan[0], nan[1], [], method="assur", engine=engine, rates_ok=rates_ok,
-               nan_rows=True, links=res.links,
+    sw = Sweep(S, U, sp, q, qd, qdd, ok, [], engine=engine, rates_ok=rates_ok, nan_rows=True, links=res.links,
                singular_rows=None if res.singular else [])
     if not back:
         sw.events = _tracked_events(ev, bool(ok[0]), U[0])
@@ -421,8 +410,7 @@ def merged(S: PlanarSystem, U: np.ndarray, k: int, fwd: Sweep, bwd: Sweep) -> Sw
         return np.concatenate([a[::-1], b])
 
     return Sweep(S, U, fwd.speeds, cat(bwd.q, fwd.q), cat(bwd.qd, fwd.qd), cat(bwd.qdd, fwd.qdd),
-                 cat(bwd.assembled, fwd.assembled), cat(bwd.det_sign, fwd.det_sign),
-                 cat(bwd.sigma_min, fwd.sigma_min), events, method=fwd.method, engine=fwd.engine)
+                 cat(bwd.assembled, fwd.assembled), events, engine=fwd.engine)
 
 
 #: What a dead point and a reassembly found going back from the drawn configuration say.

@@ -252,7 +252,7 @@ def _gear_tooth_force(S: PlanarSystem, con, q: np.ndarray, force: dict, moment: 
     Ob = S.point(q, con.c, S.to_local(c_name, axle[b_name].point))
     if j.normal is not None:
         n0 = S.to_local_dir(c_name, j.normal)
-        cc, ss = np.cos(S.link_angle_i(q, con.c)), np.sin(S.link_angle_i(q, con.c))
+        cc, ss = np.cos(S.pose(q, con.c)[1]), np.sin(S.pose(q, con.c)[1])
         n = np.stack([cc * n0[0] - ss * n0[1], ss * n0[0] + cc * n0[1]], axis=1)
     else:
         d = Ob - Oa

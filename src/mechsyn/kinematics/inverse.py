@@ -34,10 +34,11 @@ from typing import Any
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.analysis import cached_plan, simulate
+from mechsyn.kinematics.analysis import drawn_inputs, simulate
+from mechsyn.kinematics.plane import to_frame
 from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["InverseResult", "simulate_inverse", "simulate_path", "posed", "drawn_inputs", "is_point_path"]
+__all__ = ["InverseResult", "simulate_inverse", "simulate_path", "posed", "is_point_path"]
 
 #: Gauss-Newton iterations per target; the largest step of an R drive (degrees) and of a P
 #: drive (fraction of the length scale) in one iteration.
@@ -61,19 +62,6 @@ class InverseResult:
     @property
     def ok(self) -> bool:
         return bool(self.reached.all())
-
-
-def drawn_inputs(mech: Mechanism) -> dict[str, float]:
-    """Every drive's value at the drawn pose, in the engine's convention: a planar R drive's
-    angle (deg) and P drive's slide as the file draws them, 0 for a spatial file's drives
-    (its inputs are measured from the drawn assembly)."""
-    drives = [j.id for j in mech.joints if j.actuated]
-    if mech.kind != "planar":
-        return {d: 0.0 for d in drives}
-
-    S = cached_plan(mech, inputs=tuple(drives)).system
-    return {d.joint: (math.degrees(d.assembled) if d.type == "R" else float(d.assembled))
-            for d in S.drivers if d.joint in drives}
 
 
 def _scale(mech: Mechanism) -> float:
@@ -226,9 +214,8 @@ def _posed_planar(mech: Mechanism, sim: Any, row: int) -> Mechanism:
         if j.id in sim.points:
             ch["point"] = np.asarray(sim.points[j.id].position[row], float)
         if j.axis is not None and j.links[0] in turn:
-            c, s = math.cos(turn[j.links[0]]), math.sin(turn[j.links[0]])
             a = np.asarray(j.axis, float)
-            ch["axis"] = np.array([c * a[0] - s * a[1], s * a[0] + c * a[1]])
+            ch["axis"] = to_frame(math.cos(turn[j.links[0]]), math.sin(turn[j.links[0]]), a[0], a[1])
         joints.append(replace(j, **ch) if ch else j)
     points = {n: replace(p, at=np.asarray(sim.points[n].position[row], float)) if n in sim.points else p
               for n, p in mech.points.items()}

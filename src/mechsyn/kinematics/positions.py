@@ -180,11 +180,8 @@ def solve_step(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma:
     inputs ``u``, radians or lengths per driver, (N, nd)); return its assembly sign
     (sigma) for the branch: ``sigma`` given (a number or one per row), None (the drawn
     mode) or a chooser called with the normalised discriminant and the drawn mode.
-    A step kind without a closed form raises ``_NotHandled`` (Newton then)."""
-    kernel = _STEP_KERNELS.get(step.kind)
-    if kernel is None:
-        raise _NotHandled
-    return kernel(S, st, step, u, sigma)
+    Every step kind of :func:`~mechsyn.kinematics.groups.decompose` has one."""
+    return _STEP_KERNELS[step.kind](S, st, step, u, sigma)
 
 
 def _step_drive_R(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: Sigma) -> float | np.ndarray:
@@ -387,10 +384,6 @@ def _solve2(w1: np.ndarray, h1: np.ndarray, w2: np.ndarray, h2: np.ndarray) -> n
     det = w1[:, 0] * w2[:, 1] - w1[:, 1] * w2[:, 0]
     det = np.where(np.abs(det) < 1e-12, np.nan, det)
     return np.stack([(h1 * w2[:, 1] - h2 * w1[:, 1]) / det, (w1[:, 0] * h2 - w2[:, 0] * h1) / det], axis=1)
-
-
-class _NotHandled(Exception):
-    pass
 
 
 def solve_positions(S: PlanarSystem, plan: Plan, inputs: np.ndarray,

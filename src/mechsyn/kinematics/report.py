@@ -26,6 +26,7 @@ from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import derived
 from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
+from mechsyn.kinematics.simulation import rows
 from mechsyn.kinematics.summary import motion_summary
 from mechsyn.model.mechanism import Mechanism
 from mechsyn.progress import ProgressCallback
@@ -74,10 +75,6 @@ class SimulationReport(Result):
         return self.simulation.plot(ax=ax, **kwargs)
 
 
-def _finite_or_none(values: np.ndarray) -> list[float | None]:
-    return [None if not np.isfinite(x) else float(x) for x in values]
-
-
 def _nan_stat(f: Any, values: np.ndarray) -> float | None:
     v = np.asarray(values, float)
     return None if not np.isfinite(v).any() else float(f(v))
@@ -117,14 +114,13 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
     out: dict[str, Any] = {}
     mu = derived.transmission_angles(sim)
     if mu:
-        out["transmission_angle"] = {k: {"values": _finite_or_none(v), "min": _nan_stat(np.nanmin, v),
+        out["transmission_angle"] = {k: {"values": rows(v), "min": _nan_stat(np.nanmin, v),
                                          "max": _nan_stat(np.nanmax, v)} for k, v in mu.items()}
     out_link = output or derived.default_output_link(mech, list(sim.inputs))
     if rates and out_link is not None and len(sim.inputs) == 1:
         ma = derived.mechanical_advantage(sim, out_link)
-        out["mechanical_advantage"] = {"output": out_link, "values": _finite_or_none(ma)}
-    if (mech.kind == "planar" and len(mech.links) == 4 and len(mech.joints) == 4  # a planar four-bar only
-            and all(j.type == "R" for j in mech.joints) and all(len(mech.joints_of(n)) == 2 for n in mech.link_names)):
+        out["mechanical_advantage"] = {"output": out_link, "values": rows(ma)}
+    if derived.is_fourbar(mech):
         out["grashof"] = to_jsonable(derived.grashof(mech))
     out["extent"] = {name: derived.path_extent(pm.position) for name, pm in sim.points.items()}
     if mech.kind == "planar" and rates:
@@ -153,8 +149,8 @@ def _slides(mech: Mechanism, sim: Simulation) -> dict[str, Any]:
         rate = S.coordinate_rate(q, qd, j.id)
         acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
         value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
-        out[j.id] = {"guide": j.links[0], "value": _finite_or_none(value), "rate": _finite_or_none(rate),
-                     "acceleration": _finite_or_none(acc)}
+        out[j.id] = {"guide": j.links[0], "value": rows(value), "rate": rows(rate),
+                     "acceleration": rows(acc)}
     return out
 
 
@@ -218,11 +214,6 @@ def csv_text(header: list[str], columns: list[np.ndarray]) -> str:
     return buf.getvalue()
 
 
-def _input_columns(sim: Simulation) -> tuple[list[str], list[np.ndarray]]:
-    header = [f"input_{j}" for j in sim.inputs] + ["assembled"]
-    return header, [sim.inputs[j] for j in sim.inputs] + [sim.assembled.astype(int)]
-
-
 def simulation_csv(sim: Simulation) -> str:
     """The simulation as a CSV table: inputs, assembled, each point's position, velocity and
     acceleration, each link's angle, angular velocity and acceleration.
@@ -235,15 +226,7 @@ def simulation_csv(sim: Simulation) -> str:
     >>> simulation_csv(s).splitlines()[0].split(",")[:3]
     ['input_A', 'assembled', 'M_x']
     """
-    header, cols = _input_columns(sim)
-    for name, pm in sim.points.items():
-        for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
-            header += [f"{name}_{key}x", f"{name}_{key}y"]
-            cols += [arr[:, 0], arr[:, 1]]
-    for name, lm in sim.links.items():
-        header += [f"{name}_angle", f"{name}_omega", f"{name}_alpha"]
-        cols += [lm.angle, lm.angular_velocity, lm.angular_acceleration]
-    return csv_text(header, cols)
+    return _csv(sim.columns())
 
 
 def forces_csv(fa: ForceAnalysis) -> str:
@@ -259,11 +242,14 @@ def forces_csv(fa: ForceAnalysis) -> str:
     ['input_A', 'assembled', 'A_Fx', 'A_Fy']
     """
     R = fa.reactions
-    header, cols = _input_columns(fa.simulation)
+    cols = fa.simulation.columns(motion=False)
     for j, F in R.force.items():
-        header += [f"{j}_Fx", f"{j}_Fy", f"{j}_F", f"{j}_M"]
-        cols += [F[:, 0], F[:, 1], np.linalg.norm(F, axis=1), R.moment[j]]
+        cols.update({f"{j}_Fx": F[:, 0], f"{j}_Fy": F[:, 1], f"{j}_F": np.linalg.norm(F, axis=1), f"{j}_M": R.moment[j]})
     for j, e in R.effort.items():
-        header.append(f"drive_{j}_{R.effort_kind[j]}")
-        cols.append(e)
-    return csv_text(header, cols)
+        cols[f"drive_{j}_{R.effort_kind[j]}"] = e
+    return _csv(cols)
+
+
+def _csv(cols: dict[str, np.ndarray]) -> str:
+    """:func:`csv_text` of named columns (``assembled`` as 0 and 1)."""
+    return csv_text(list(cols), [c.astype(int) if k == "assembled" else c for k, c in cols.items()])

@@ -18,6 +18,7 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
+from mechsyn.kinematics.summary import is_full_turn
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.limits import limit, limit_hint
 from mechsyn.model.mechanism import Mechanism
@@ -141,28 +142,32 @@ class Motion(Result):
                 last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
                 out.append([float(first), float(last)])
                 start = None
-        if len(out) > 1 and ok[0] and ok[-1] and self.input_types.get(self.main_input) == "R" and n > 2:
-            step = float(np.median(np.abs(np.diff(vals))))
-            if abs(vals[-1] - vals[0]) + step >= 360.0 * (1 - 1e-9):  # a whole turn: the ends meet
-                turn = 360.0 if vals[-1] >= vals[0] else -360.0
-                out[0] = [out[-1][0], out[0][1] + turn]
-                out.pop()
+        if len(out) > 1 and ok[0] and ok[-1] and is_full_turn(vals, self.input_types.get(self.main_input)):
+            turn = 360.0 if vals[-1] >= vals[0] else -360.0  # a whole turn: the ends meet
+            out[0] = [out[-1][0], out[0][1] + turn]
+            out.pop()
         return out
 
-    def to_pandas(self) -> Any:
-        """A :class:`pandas.DataFrame`, one row per input value: the inputs, ``assembled``,
-        every point's x, y (z), vx, vy, ..., ax, ... and every link's numbers by row
-        (angle, omega, alpha; a 3-D link's translation and rates by component)."""
-        from mechsyn._extras import require
+    def columns(self, motion: bool = True) -> dict[str, np.ndarray]:
+        """The result as named columns, one row per input value: the inputs, ``assembled``,
+        then (``motion``) every point's x, y (z), vx, vy, ..., ax, ... and every link's
+        numbers by row (angle, omega, alpha; a 3-D link's translation and rates by
+        component): the columns of :meth:`to_pandas` and of the CSV tables
+        (:mod:`mechsyn.kinematics.report`).
 
-        pd = require("pandas", "Simulation.to_pandas()")  # to_dict() needs nothing
+        Examples
+        --------
+        >>> import mechsyn as ms
+        >>> list(ms.examples.load("crank_rocker").simulate(A=(0, 90, 30)).columns())[:5]
+        ['input_A', 'assembled', 'M_x', 'M_y', 'M_vx']
+        """
         cols: dict[str, Any] = {f"input_{j}": v for j, v in self.inputs.items()}
         cols["assembled"] = self.assembled
-        for name, pm in self.points.items():
+        for name, pm in self.points.items() if motion else ():
             for key, arr in (("", pm.position), ("v", pm.velocity), ("a", pm.acceleration)):
                 for c, col in zip("xyz", arr.T):
                     cols[f"{name}_{key}{c}"] = col
-        for name, lm in self.links.items():
+        for name, lm in self.links.items() if motion else ():
             for key, arr in lm.to_dict().items():
                 arr = np.asarray(arr)
                 key = _COLUMNS.get(key, key)
@@ -171,7 +176,13 @@ class Motion(Result):
                 elif arr.ndim == 2:
                     for c, col in zip("xyz", arr.T):
                         cols[f"{name}_{key}_{c}"] = col
-        return pd.DataFrame(cols)
+        return cols
+
+    def to_pandas(self) -> Any:
+        """A :class:`pandas.DataFrame` of :meth:`columns`, one row per input value."""
+        from mechsyn._extras import require
+
+        return require("pandas", "Simulation.to_pandas()").DataFrame(self.columns())  # to_dict() needs nothing
 
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:
         """The mechanism moving over the sweep: a Matplotlib animation that plays when it is a
@@ -288,10 +299,6 @@ class Simulation(Motion):
         if self.events:
             rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
         return rows
-
-    def link(self, name: str) -> LinkMotion:
-        """Angle (deg), angular velocity and acceleration of link ``name`` over the sweep."""
-        return super().link(name)
 
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:
         """:meth:`Motion.animate` (a :class:`~mechsyn.plot.animation.MechanismAnimation`)."""

@@ -29,7 +29,7 @@ from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.drives import DriveCheck, excess_drives
 
-__all__ = ["Sweep", "assemble", "sweep", "rates", "check_mobility", "newton", "drawn_checks"]
+__all__ = ["Sweep", "assemble", "sweep", "check_mobility", "newton", "drawn_checks"]
 
 
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -92,32 +92,20 @@ def _rel_step(S: PlanarSystem, dq: np.ndarray) -> float:
     return float(np.abs(dq / S.col_scale[:len(dq)]).max()) if dq.size else 0.0
 
 
-def rates(S: PlanarSystem, q: np.ndarray, speeds: np.ndarray,
-          accel: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Velocities and accelerations (n,) at one configuration ``q`` (n,)."""
-    J = S.jacobian(q[None])[0]
-    B = S.input_matrix()
-    ud = np.asarray(speeds, float)
-    udd = np.zeros_like(ud) if accel is None else np.asarray(accel, float)
-    if J.shape[0] == J.shape[1]:
-        lu = sla.lu_factor(J, check_finite=False)
-        qd = sla.lu_solve(lu, B @ ud, check_finite=False)
-        qdd = sla.lu_solve(lu, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)
-    else:
-        qd = sla.lstsq(J, B @ ud, check_finite=False)[0]
-        qdd = sla.lstsq(J, S.gamma(q[None], qd[None])[0] + B @ udd, check_finite=False)[0]
-    return qd, qdd
-
-
 def check_mobility(S: PlanarSystem, q: np.ndarray | None = None) -> dict:
     """Rank of ``Phi_q`` at ``q``: free coordinates beyond the inputs, redundant constraints."""
     q = S.q0 if q is None else q
-    J = S.unit_jacobian(S.jacobian(q[None])[0])  # dimensionless: the same rank at any scale
-    sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
-    tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
-    rank = int(np.sum(sv > tol))
+    rank = _rank(S.unit_jacobian(S.jacobian(q[None])[0]))[0]  # dimensionless: the same rank at any scale
     return {"unknowns": S.n, "equations": S.m, "rank": rank, "free": S.n - rank,
             "redundant": S.m - rank}
+
+
+def _rank(J: np.ndarray) -> tuple[int, float]:
+    """The rank of a dimensionless ``Phi_q`` and the tolerance it is counted with: its
+    singular values above 1e-9 of the largest (and of 1)."""
+    sv = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
+    tol = 1e-9 * max(1.0, float(sv.max()) if sv.size else 1.0)
+    return int(np.sum(sv > tol)), tol
 
 
 def drive_check(S: PlanarSystem, given: tuple = ()) -> DriveCheck | None:
@@ -134,8 +122,7 @@ def drive_check(S: PlanarSystem, given: tuple = ()) -> DriveCheck | None:
         J = S.unit_jacobian(S.jacobian(S.q0[None])[0])
         B = S.input_matrix()
         closure = ~np.any(B != 0, axis=1)
-        sv_all = np.linalg.svd(J, compute_uv=False) if J.size else np.zeros(0)
-        tol = 1e-9 * max(1.0, float(sv_all.max()) if sv_all.size else 1.0)
+        tol = _rank(J)[1]
         _, s, vt = np.linalg.svd(J[closure], full_matrices=True)
         motions = vt[int(np.sum(s > tol)):].T  # the rates every loop closure allows
         names = [d.joint for d in S.drivers]
@@ -255,21 +242,19 @@ def _drawn_groups(S: PlanarSystem, plan: Any) -> list | None:
     return S.topology.product("drawn checks", build, plan)
 
 
-def _require_determined(S: PlanarSystem, q: np.ndarray) -> dict:
-    info = check_mobility(S, q)
-    src = S.mech.source or "<mechanism>"
-    if info["free"] > 0 and generic_free(S, q) == 0:
-        return info  # a singular file configuration (dead centre, folded): reported by the sweep
-    if info["free"] > 0:
+def _require_determined(S: PlanarSystem, q: np.ndarray) -> None:
+    """Raise when the inputs leave free coordinates at ``q`` (a singular file configuration,
+    a dead centre or folded, is not: the sweep reports it)."""
+    free = check_mobility(S, q)["free"]
+    if free > 0 and generic_free(S, q) > 0:
         passive = [j for j, mode in S.vll.items() if mode == "passive"]
         hint = "mark more joints actuated"
         if passive:
             hint = (f"lock the free VLL ({', '.join(f'--vll {p}=locked' for p in passive)}) or give its "
                     f"length as an input (--input {passive[0]}=...)")
         raise MechsynInputError(
-            f"the mechanism has {info['free']} free coordinate(s) beyond its {len(S.drivers)} input(s): "
-            "its motion is not determined by the inputs", source=src, hint=hint)
-    return info
+            f"the mechanism has {free} free coordinate(s) beyond its {len(S.drivers)} input(s): "
+            "its motion is not determined by the inputs", source=S.mech.source or "<mechanism>", hint=hint)
 
 
 def assemble(S: PlanarSystem, u: np.ndarray | None = None) -> np.ndarray:
@@ -696,7 +681,7 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
                                   "dead point; the branch may switch here and positions are accurate only to "
                                   "about the square root of the solver tolerance"))
     events.sort(key=lambda e: e.index)
-    return Sweep(S, inputs, speeds, q, qd, qdd, assembled, det_sign, sig, events)
+    return Sweep(S, inputs, speeds, q, qd, qdd, assembled, events)
 
 
 def _sweep_shifted(S: PlanarSystem, inputs: np.ndarray, shift: np.ndarray, speeds: np.ndarray | None,

@@ -121,9 +121,8 @@ class Sweep:
 
     ``q, qd, qdd`` have shape (N, n) with NaN rows where the mechanism is not assembled;
     ``inputs`` (N, n_inputs) in radians (R) or length (P); ``speeds`` the input rates;
-    ``det_sign``, ``sigma_min``: the sign of ``det Phi_q`` and the pivot ratio (Newton;
-    NaN otherwise); ``method``: ``"assur"`` (closed form) or ``"newton"``; ``engine``: the
-    name of the engine that computed it; ``links``: the links' complex states
+    ``engine``: the name of the engine that computed it (:attr:`method`: ``"newton"`` for
+    Newton's continuation, else ``"assur"``, the closed form); ``links``: the links' complex states
     (:class:`mechsyn.kinematics.regular.LinkStates`) when the one regular pass computed the
     sweep (every row assembled with finite rates; through folds, from the compiled pass,
     NaN where the poses are), else None; ``rates_ok``: the rows whose
@@ -142,15 +141,18 @@ class Sweep:
     qd: np.ndarray
     qdd: np.ndarray
     assembled: np.ndarray
-    det_sign: np.ndarray
-    sigma_min: np.ndarray
     events: list[Event] = field(default_factory=list)
-    method: str = "newton"
     links: Any = None
     engine: str = "newton"
     rates_ok: Any = None
     nan_rows: bool = False
     singular_rows: list | None = None
+
+    @property
+    def method(self) -> str:
+        """``"newton"`` (Newton's continuation) or ``"assur"`` (the closed form of the
+        Assur groups)."""
+        return "newton" if self.engine == "newton" else "assur"
 
     @property
     def n(self) -> int:

@@ -53,7 +53,7 @@ import numpy as np
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.cams import CamCurve, cam_curve
 from mechsyn.kinematics.compiled import one_configuration
-from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate, to_frame
+from mechsyn.kinematics.plane import cos_sin, dot, perp, rotate, to_frame
 from mechsyn.kinematics.topology import Topology, topology_of
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.model.pairs import BELT_WRAPS
@@ -63,14 +63,6 @@ __all__ = ["PlanarSystem", "build_system", "VLL_MODES", "CamCurve"]
 #: Accepted spellings of the VLL modes on the command line.
 VLL_MODES = {"active": "active", "driven": "active", "passive": "passive", "free": "passive",
              "locked": "locked", "rigid": "locked"}
-
-
-
-
-
-
-
-
 
 
 # --------------------------------------------------------------------------- constraints
@@ -191,41 +183,9 @@ class PlanarSystem:
         c, sn = cos_sin(phi)
         return r + rotate(c, sn, s)
 
-    def point_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, i: int,
-                    s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, velocity, acceleration of the local point ``s`` on link ``i``."""
-        r, phi = self.pose(q, i)
-        c, sn = cos_sin(phi)
-        As = rotate(c, sn, s)
-        if i < 0:
-            z = np.zeros_like(As)
-            return r + As, z, z
-        v, w = qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
-        a, al = qdd[:, 3 * i:3 * i + 2], qdd[:, 3 * i + 2]
-        return (r + As, v + w[:, None] * perp(As),
-                a + al[:, None] * perp(As) - (w ** 2)[:, None] * As)
-
-    def points_state(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, idx: np.ndarray,
-                     s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`point_state` of the local points ``s`` (m, 2) of the moving links ``idx`` (m,)
-        at once (m, N, 2), the same arithmetic (so the same numbers) in a few array operations.
-
-        >>> import numpy as np, mechsyn as ms
-        >>> S = build_system(ms.examples.load("crank_rocker"))
-        >>> q = S.q0[None] + np.linspace(0, 0.1, 4)[:, None]
-        >>> P, V, A = S.points_state(q, q, q, np.array([0, 1]), np.array([[1.0, 0.0], [0.5, 0.2]]))
-        >>> P.shape, bool(np.array_equal(A[1], S.point_state(q, q, q, 1, np.array([0.5, 0.2]))[2]))
-        ((2, 4, 2), True)
-        """
-        return tuple(points_state_array(q, qd, qdd, idx, s))
-
-    def link_angle_i(self, q: np.ndarray, i: int) -> np.ndarray:
-        """Angles (N,) of link index ``i`` (frame: zeros)."""
-        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
-
     def link_angle(self, q: np.ndarray, link: str) -> np.ndarray:
-        i = self.index(link)
-        return np.zeros(q.shape[0]) if i < 0 else q[:, 3 * i + 2]
+        """Angles (N,) of link ``link`` (the frame: zeros)."""
+        return self.pose(q, self.index(link))[1]
 
     def driver_index(self, joint: str) -> int:
         for k, d in enumerate(self.drivers):
@@ -303,6 +263,21 @@ class PlanarSystem:
             row += con.rows
         return out
 
+    def rates(self, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Velocities and accelerations (N, n) of the configurations ``q`` (N, n) at the
+        input speeds ``speeds`` (k,): ``Phi_q q' = B u'`` and ``Phi_q q'' = gamma``
+        (Haug 1989, eqs. 3.3.9-3.3.11) solved for every configuration at once (a redundant
+        system: the least-squares rates, by the pseudo-inverse)."""
+        N = q.shape[0]
+        J = self.jacobian(q)
+        rhs = np.broadcast_to(self.input_matrix() @ np.asarray(speeds, float), (N, self.m))
+        if self.m == self.n:
+            qd = np.linalg.solve(J, rhs[..., None])[..., 0]
+            return qd, np.linalg.solve(J, self.gamma(q, qd)[..., None])[..., 0]
+        pinv = np.linalg.pinv(J)
+        qd = np.einsum("nij,nj->ni", pinv, rhs)
+        return qd, np.einsum("nij,nj->ni", pinv, self.gamma(q, qd))
+
     def rows_of(self, joint: str) -> list[int]:
         rows, row = [], 0
         for con in self.cons:
@@ -330,19 +305,13 @@ def _axis(j: Joint) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ per-constraint code
-def _link_rates(sys_: PlanarSystem, qd: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
-    if i < 0:
-        return np.zeros((qd.shape[0], 2)), np.zeros(qd.shape[0])
-    return qd[:, 3 * i:3 * i + 2], qd[:, 3 * i + 2]
-
-
 def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.ndarray:
     k = con.kind
     if k == "R":
         return S.point(q, con.a, con.sa) - S.point(q, con.b, con.sb)
     if k == "angle":
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
-        return (S.link_angle_i(q, con.b) - S.link_angle_i(q, con.a) - val)[:, None]
+        return (S.pose(q, con.b)[1] - S.pose(q, con.a)[1] - val)[:, None]
     if k == "line":
         ra, pa = S.pose(q, con.a)
         c, s = cos_sin(pa)
@@ -351,7 +320,7 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
         return (dot(w, d) - val)[:, None]
     if k == "gear":
-        pa, pb, pc = (S.link_angle_i(q, i) for i in (con.a, con.b, con.c))
+        pa, pb, pc = (S.pose(q, i)[1] for i in (con.a, con.b, con.c))
         return ((pb - pc) - con.k * (pa - pc) - con.c0)[:, None]
     if k == "curve":
         ra, pa = S.pose(q, con.a)
@@ -364,7 +333,7 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         r = con.radius
         with np.errstate(invalid="ignore"):
             b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))   # NaN: belt not taut and straight
-        rel = S.link_angle_i(q, con.b) - np.arctan2(D[:, 1], D[:, 0]) - con.ref
+        rel = S.pose(q, con.b)[1] - np.arctan2(D[:, 1], D[:, 0]) - con.ref
         rel = np.mod(rel + np.pi, 2 * np.pi) - np.pi                 # continuous within half a turn
         return (b - r * np.arctan2(b, r) + con.sigma * r * rel - con.c0)[:, None]
     raise AssertionError(k)
@@ -476,8 +445,8 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         _, pa = S.pose(q, con.a)
         c, s = cos_sin(pa)
         w = rotate(c, s, con.w)
-        va, wa = _link_rates(S, qd, con.a)
-        vb, wb = _link_rates(S, qd, con.b)
+        va, wa = S.pose(qd, con.a)
+        vb, wb = S.pose(qd, con.b)
         Asa = rotate(c, s, con.sa)
         _, pb = S.pose(q, con.b)
         cb, sb = cos_sin(pb)
@@ -492,8 +461,8 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         c, s = cos_sin(pa)
         _, pb = S.pose(q, con.b)
         cb, sb = cos_sin(pb)
-        _, wa = _link_rates(S, qd, con.a)
-        _, wb = _link_rates(S, qd, con.b)
+        _, wa = S.pose(qd, con.a)
+        _, wb = S.pose(qd, con.b)
         t, td = q[:, con.tvar], qd[:, con.tvar]
         O, O1, O2 = (con.curve.eval(t, d) for d in (0, 1, 2))
         g = ((wb ** 2)[:, None] * rotate(cb, sb, con.sb) - (wa ** 2)[:, None] * rotate(c, s, O)
@@ -513,7 +482,7 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
             _, phi = S.pose(q, i)
             c, sn = cos_sin(phi)
             As = rotate(c, sn, sl)
-            v, w = _link_rates(S, qd, i)
+            v, w = S.pose(qd, i)
             Dd = Dd + sign * (v + w[:, None] * perp(As))
             out = out + sign * w ** 2 * dot(g, As)
         if np.ndim(Dd) == 0:
@@ -645,7 +614,7 @@ class _Builder:
     def angle(self, b: int, a: int) -> float:
         """``phi_b - phi_a`` in the drawn configuration."""
         p, q0 = self.partial, self.q0[None]
-        return float(p.link_angle_i(q0, b)[0] - p.link_angle_i(q0, a)[0])
+        return float(p.pose(q0, b)[1][0] - p.pose(q0, a)[1][0])
 
     def add(self, j: Joint) -> None:
         getattr(self, "_" + j.type)(j)
@@ -708,7 +677,7 @@ class _Builder:
             ratio = -r1 / r2 if between else r1 / r2
         a, b, c = idx(a_name), idx(b_name), idx(cname)
         q0a = self.q0[None]
-        pa_, pb_, pc_ = (self.partial.link_angle_i(q0a, i)[0] for i in (a, b, c))
+        pa_, pb_, pc_ = (self.partial.pose(q0a, i)[1][0] for i in (a, b, c))
         self.cons.append(Con("gear", j.id, 1, a, b, c=c, k=ratio,
                              c0=float((pb_ - pc_) - ratio * (pa_ - pc_)), role="pair"))
 
@@ -747,7 +716,7 @@ class _Builder:
         con = Con("belt", j.id, 1, a, b, sa=sa, sb=sb, radius=float(j.attrs["radius"]),
                   sigma=BELT_WRAPS[j.attrs["wrap"]], role="pair")
         D = j.point - np.asarray(j.attrs["anchor"], float)
-        con = replace(con, ref=float(p.link_angle_i(self.q0[None], b)[0] - np.arctan2(D[1], D[0])))
+        con = replace(con, ref=float(p.pose(self.q0[None], b)[1][0] - np.arctan2(D[1], D[0])))
         c0 = float(_residual(p, con, self.q0[None], np.zeros((1, 0)))[0, 0])
         self.cons.append(replace(con, c0=c0))
         if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id

@@ -29,9 +29,9 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.io import mechanism_to_dict
 from mechsyn.kinematics import dimensions as dims
 from mechsyn.kinematics.centres import instant_centres
-from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinematics.analysis import drawn_inputs, simulate
 from mechsyn.kinematics.derived import grashof
-from mechsyn.kinematics.inverse import drawn_inputs, posed, simulate_inverse
+from mechsyn.kinematics.inverse import posed, simulate_inverse
 from mechsyn.results import to_jsonable
 from mechsyn.synthesis.exact import _rot, center_point_curve
 from mechsyn.synthesis.export import fourbar_mechanism_dict
