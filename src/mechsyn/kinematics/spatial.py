@@ -59,7 +59,7 @@ from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
 from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
-from mechsyn.kinematics.sweep import Event, as_event, by_row
+from mechsyn.kinematics.sweep import Event, as_event
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
 

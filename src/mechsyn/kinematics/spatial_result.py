@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.simulation import Motion, PointMotion, rows
+from mechsyn.kinematics.simulation import Motion, rows
 from mechsyn.results import csv_cell
 
 __all__ = ["SpatialSimulation", "LinkPose"]

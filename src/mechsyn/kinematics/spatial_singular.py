@@ -43,7 +43,6 @@ References
 
 from __future__ import annotations
 
-from typing import Any
 
 import numpy as np
 

@@ -30,7 +30,7 @@ from mechsyn.io import mechanism_to_dict
 from mechsyn.kinematics import dimensions as dims
 from mechsyn.kinematics.centres import instant_centres
 from mechsyn.kinematics.analysis import drawn_inputs, simulate
-from mechsyn.kinematics.derived import grashof
+from mechsyn.kinematics.derived import grashof, is_fourbar
 from mechsyn.kinematics.inverse import posed, simulate_inverse
 from mechsyn.results import to_jsonable
 from mechsyn.synthesis.exact import _rot, center_point_curve
@@ -86,7 +86,7 @@ def set_dimension(data: Any, change: Any) -> dict[str, Any]:
 
 def _grashof_change(old: Any, new: Any) -> list[str]:
     """A four-bar whose Grashof class the change altered, in words."""
-    if not _service._is_four_bar(old):
+    if not is_fourbar(old):
         return []
 
     a, b = grashof(old), grashof(new)

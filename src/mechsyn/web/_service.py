@@ -315,13 +315,6 @@ def _quick(data: dict, steps: int, span: float | None, rates: bool, key: str) ->
         return None  # reported by the worker's simulate, as without this path
 
 
-def _is_four_bar(mech) -> bool:
-    """A planar four-bar of revolute pairs (the only linkage a Grashof class describes; a
-    spatial Bennett linkage has four R pairs too)."""
-    return (mech.kind == "planar" and len(mech.links) == 4 and len(mech.joints) == 4
-            and all(j.type == "R" for j in mech.joints))
-
-
 def _scale(mech) -> float:
     pts = np.array([j.point[:2] for j in mech.joints if j.point is not None], float)
     return float(np.ptp(pts, axis=0).max()) if len(pts) > 1 else 1.0
@@ -378,7 +371,7 @@ def analyze(data: Any) -> dict[str, Any]:
         out["assur"] = to_jsonable(assur_decomposition(mech))
     except MechsynInputError as err:
         out["assur"], out["assur_unavailable"] = None, err.message
-    out["grashof"] = to_jsonable(derived.grashof(mech)) if _is_four_bar(mech) else None
+    out["grashof"] = to_jsonable(derived.grashof(mech)) if derived.is_fourbar(mech) else None
     return out
 
 
