@@ -327,12 +327,31 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
     return float(chamfer), float(nearest), best / unit
 
 
-def departure(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[int, float]:
-    """Where the path departs most from the target: the index of the target point
-    farthest from the path (polyline) and that distance (target units)."""
-    d = np.linalg.norm(_to_polyline(target.points, *_polyline(path, closed_path))[0], axis=-1)
-    i = int(np.argmax(d))
-    return i, float(d[i])
+def departure(path: np.ndarray, target: TargetCurve, closed_path: bool, m: int = M_ORDER) -> tuple[int, float]:
+    """Where the path departs most from the target, in order: the index of the target
+    point farthest from the stretch of the path that the correspondence in order of
+    :func:`chamfer_error` puts beside it, and that distance (target units). For a loop
+    that cuts across a letter, the parts of the outline it passes near but out of order
+    count as departed from.
+
+    >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    >>> circle = TargetCurve(np.c_[np.cos(t), np.sin(t)], closed=True)
+    >>> upper = np.c_[np.cos(t), np.abs(np.sin(t))]      # the upper half twice: the lower is left out
+    >>> i, d = departure(upper, circle, True)
+    >>> bool(circle.points[i, 1] < -0.5), bool(d > 1.0)
+    (True, True)
+    """
+    Af, Bf = _fine(target.points, target.closed, m), _fine(path, closed_path, m)
+    c = 0.5 * (_beside(Af[::FINE], Bf, closed_path) + _beside(Bf[::FINE], Af, target.closed).T)
+    W, _ = correspondence(c, target.closed, closed_path)
+    P = np.asarray(target.points, float)
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+    total = arc[-1] + (float(np.linalg.norm(P[0] - P[-1])) if target.closed else 0.0)
+    at = np.rint(arc / (total / (m if target.closed else m - 1))).astype(int)   # each point's sample
+    at = at % m if target.closed else np.minimum(at, m - 1)
+    D = np.where(_beside_mask(W, closed_path, FINE)[at], _seg_dist(P, Bf, closed_path), np.inf).min(axis=1)
+    i = int(np.argmax(D))
+    return i, float(D[i])
 
 
 # ---------------------------------------------------------------------------- evaluation
