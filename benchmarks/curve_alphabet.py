@@ -6,7 +6,11 @@ Run from the repository root::
                                         [--weight normal] [--figure docs/figures/curve_alphabet.png]
                                         [--json out.json]
     python benchmarks/curve_alphabet.py --table out60.json out120.json [--figure F.png]   # the docs' table
+    python benchmarks/curve_alphabet.py --font "Liberation Sans" --weight bold --pick 10 --time-limit 100
+                                        # ten held-out capitals of a font not used in development
 
+``--pick N`` draws N capitals at random (``numpy.random.default_rng(--seed)``, default
+seed 41), sorted, instead of ``--letters``: a held-out set chosen before any was run.
 With ``--json`` the rows are written after every letter (a run cut short keeps the letters
 done; run again with the same ``--json`` and the letters done are skipped).
 
@@ -238,6 +242,8 @@ def gallery(rows: list[dict], path: Path) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--letters", default=string.ascii_uppercase)
+    ap.add_argument("--pick", type=int, default=None, help="draw this many capitals at random instead")
+    ap.add_argument("--seed", type=int, default=41, help="the seed of --pick")
     ap.add_argument("--time-limit", type=float, default=60.0)
     ap.add_argument("--font", default="DejaVu Sans")
     ap.add_argument("--weight", default="normal")
@@ -250,8 +256,10 @@ def main() -> None:
         if args.figure:
             gallery(json.loads(Path(args.table[-1]).read_text()), Path(args.figure))
         return
-    print(f"{args.font} {args.weight}, time limit {args.time_limit:g} s per letter, CLI defaults")
-    rows = run(args.letters, args.time_limit, args.font, args.weight, Path(args.json) if args.json else None)
+    letters = args.letters if args.pick is None else "".join(
+        sorted(string.ascii_uppercase[i] for i in np.random.default_rng(args.seed).choice(26, args.pick, replace=False)))
+    print(f"{args.font} {args.weight}, time limit {args.time_limit:g} s per letter, CLI defaults, letters {letters}")
+    rows = run(letters, args.time_limit, args.font, args.weight, Path(args.json) if args.json else None)
     if args.figure:
         gallery(rows, Path(args.figure))
 

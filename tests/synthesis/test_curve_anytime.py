@@ -166,8 +166,12 @@ def test_a_fixed_number_of_refinements_repeats_exactly(db):
     assert all(np.array_equal(x.params, y.params) for x, y in zip(a.candidates, b.candidates))
 
 
-def test_any_limit_answers_with_the_best_it_has(db):
+def test_any_limit_answers_with_the_best_it_has(db, monkeypatch):
     # a limit already over when the search begins: the retrieved designs, evaluated as they are
+    # (and checked: the checks loaded before in this process)
+    from mechsyn.synthesis.curves import synthesis
+
+    monkeypatch.setattr(synthesis, "_CHECKS_LOADED", [1.0])
     res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, time_limit=1e-6)
     assert res.candidates and res.refined == 0 and all(c.verified for c in res.candidates)
     assert not res.candidates[0].refined and "not refined" in str(res)
@@ -201,12 +205,14 @@ def test_a_timed_run_uses_its_limit_and_keeps_it(db, monkeypatch):
 @pytest.mark.parametrize("spent", [0.95, 3.0])
 def test_a_run_whose_start_used_its_time_still_answers_within_it(db, monkeypatch, spent):
     # the process's start (imports, loading) took 95 % of the limit, or three times it: one
-    # retrieved design within the bounds, evaluated and checked, is the answer, and nothing
-    # more is begun (the few clock reads of that minimum are the only time added)
-    from mechsyn.synthesis.curves import fitting
+    # retrieved design within the bounds, evaluated and checked (the checks loaded before in
+    # this process), is the answer, and nothing more is begun (the few clock reads of that
+    # minimum are the only time added)
+    from mechsyn.synthesis.curves import fitting, synthesis
 
     clock = _Ticks(0.01)
     monkeypatch.setattr(fitting, "CLOCK", [clock])
+    monkeypatch.setattr(synthesis, "_CHECKS_LOADED", [1.0])
     res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, time_limit=4.0,
                            started=clock() - spent * 4.0)
     assert res.candidates and res.refined == 0 and res.candidates[0].verified
@@ -233,3 +239,74 @@ def test_the_database_is_packed_once_and_mapped_after(tmp_path):
     grown = load_database(tmp_path, build_if_missing=False)
     assert len(grown) > len(first) and not isinstance(grown.designs, np.memmap)
     assert len(load_database(tmp_path, build_if_missing=False)) == len(grown)
+
+
+def test_the_answer_comes_before_the_checks_load(db, monkeypatch):
+    # the checks by simulate not loaded yet in this process and no time left to load them
+    # (the start took 90 % of the limit): the retrieved design is answered unchecked,
+    # labelled so, without loading them; with the time to load them, it is checked
+    from mechsyn.synthesis.curves import fitting, synthesis
+    from mechsyn.synthesis.curves.candidates import UNCHECKED
+
+    def refuse(c):
+        raise AssertionError("the check was begun")
+
+    clock = _Ticks(0.01)
+    monkeypatch.setattr(fitting, "CLOCK", [clock])
+    monkeypatch.setattr(synthesis, "_CHECKS_LOADED", [])
+    monkeypatch.setattr(synthesis, "_verify", refuse)
+    res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, time_limit=4.0,
+                           started=clock() - 0.9 * 4.0)
+    c = res.candidates[0]
+    assert not c.verified and c.verification == UNCHECKED and "NOT CHECKED" in c.describe(res.target)
+    assert any(n.startswith("answered before the check by simulate") for n in res.notes)
+    assert res.seconds <= 4.0 * 1.05
+    monkeypatch.undo()
+    monkeypatch.setattr(synthesis, "_CHECKS_LOADED", [])
+    res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, refinements=0, time_limit=1e4)
+    assert res.candidates and all(c.verified for c in res.candidates) and synthesis._CHECKS_LOADED
+
+
+def test_the_refinement_measures_each_point_where_the_order_puts_it():
+    # the refinement's residuals are taken along the correspondence in order that the error
+    # is: a path round the target is measured to its nearest stretch; one that runs along the
+    # target's upper half twice (on the target: each of its points about 0 from it,
+    # order-free) is measured to the stretch its order puts beside each point, far away
+    from mechsyn.synthesis.curves.fitting import Bounds, FitProblem, _seg_dist
+
+    target = TargetCurve(_circle(400), closed=True)
+    prob = FitProblem(curve_topologies(4)[0], target, True, 0.0, 360.0,
+                      Bounds((0.0, 0.0), 1.0, None, None, 0.0, None))
+    t = np.linspace(0, 2 * np.pi, 96, endpoint=False)
+    round_ = 1.1 * np.c_[np.cos(t + 1), np.sin(t + 1)]
+    eight = np.c_[np.cos(t), np.sin(t) * np.sign(np.cos(t / 2))]
+    for P, far in ((round_, False), (eight, True)):
+        k1, k2, _ = prob.matched(P[None], np.array([False]), keep=False)
+        D, D2 = _seg_dist(prob.T, P, True), _seg_dist(P, prob.Af, True)
+        matched, nearest = D[np.arange(len(D)), k1[0]].mean(), D.min(axis=1).mean()
+        matched2, nearest2 = D2[np.arange(len(D2)), k2[0]].mean(), D2.min(axis=1).mean()
+        if far:
+            assert matched > 2 * nearest and nearest2 < 1e-3 and matched2 > 0.1
+        else:
+            assert matched == pytest.approx(nearest) == pytest.approx(0.1, rel=0.02)
+            assert matched2 == pytest.approx(nearest2) == pytest.approx(0.1, rel=0.02)
+
+
+def test_a_turned_six_bar_curve_is_traced_as_well_as_drawn(db):
+    # a six-bar's own coupler curve (a database design's), as drawn and turned by 37 degrees
+    # about a far point, with the same fixed number of refinements: the curve's own frame
+    # makes the two searches the same, so the errors agree (within 20 % asked)
+    from mechsyn.kinematics.batch import simulate_batch
+    from mechsyn.synthesis.curves.fitting import input_offsets
+    from mechsyn.synthesis.curves.topologies import TRACER
+
+    rows = [r for r in range(len(db.closed)) if db.closed[r] and db.topologies[db.topology[r]].n_links == 6]
+    r = rows[len(rows) // 2]
+    topo = db.topologies[db.topology[r]]
+    off = input_offsets(*db.ranges[r], True, 200)
+    P = simulate_batch(topo.plan, db.design(r)[None], off[None], flags=False).paths[TRACER][0]
+    kw = dict(max_links=6, top=2, refinements=3, database=db, time_limit=1e4)
+    a = synthesize_curve(P, **kw)
+    b = synthesize_curve(_turn(P - [40.0, -25.0], 37.0), **kw)
+    ea, eb = (min(c.chamfer for c in res.candidates) for res in (a, b))
+    assert ea < 0.05 and eb == pytest.approx(ea, rel=0.2)

@@ -19,6 +19,9 @@ __all__ = ["CurveCandidate", "CurveSynthesisResult", "SIMPLEST", "MOST_ACCURATE"
 
 SIMPLEST = "simplest within tolerance"
 MOST_ACCURATE = "most accurate"
+#: the verification of a candidate answered before the check by ``simulate`` could be
+#: loaded within the time limit (listed, labelled, not dropped)
+UNCHECKED = "not checked by simulate: the time limit came first"
 
 
 @dataclass
@@ -104,7 +107,8 @@ class CurveCandidate:
         return (f"{self.topology.label} [{self.topology.key}]{tag}{raw}: error {100 * self.chamfer:.2f} %{where}; "
                 f"size {self.size_ratio:.2f} diagonals, link ratio {self.link_length_ratio:.1f}, "
                 f"min transmission {self.min_transmission_angle:.0f} deg" + (", full turn" if self.full_turn else "")
-                + ("" if self.verified else "  NOT VERIFIED"))
+                + ("" if self.verified else "  NOT CHECKED (time limit)" if self.verification == UNCHECKED
+                   else "  NOT VERIFIED"))
 
 
 @dataclass(repr=False)
@@ -172,7 +176,8 @@ def _same(a: CurveCandidate, b: CurveCandidate) -> bool:
 def ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str, verify,
            notes: list[str]) -> list[CurveCandidate]:
     """Best first, distinct, each checked by ``verify(candidate)`` (dropped, with a
-    note, when it fails); at most ``top``. ``prefer="simple"``: among candidates within
+    note, when it fails; kept when the time left no check, :data:`UNCHECKED`); at most
+    ``top``. ``prefer="simple"``: among candidates within
     ``tolerance`` fewer links first (the first three of distinct topologies), then a
     full turn, then the larger transmission angle (5° steps), then the error; the rest
     by error; ``"accuracy"``: by error. The simplest candidate within the tolerance and
@@ -193,7 +198,7 @@ def ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
         if any(_same(o, c) for o in out):
             continue
         verify(c)
-        if c.verified:
+        if _answer(c):
             out.append(c)
         else:
             notes.append(f"{c.topology.key}: dropped, {c.verification}")
@@ -201,7 +206,7 @@ def ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
         if any(c is o for o in out) or (out and c.chamfer >= min(o.chamfer for o in out)):
             break
         verify(c)
-        if c.verified:
+        if _answer(c):
             out.append(c)
             break
         notes.append(f"{c.topology.key}: dropped, {c.verification}")
@@ -216,6 +221,11 @@ def ranked(cands: list[CurveCandidate], top: int, tolerance: float, prefer: str,
     return out
 
 
+def _answer(c: CurveCandidate) -> bool:
+    """Checked by ``simulate``, or not checked for want of time (labelled)."""
+    return c.verified or c.verification == UNCHECKED
+
+
 def nearest_miss(misses: list[CurveCandidate], bounds: Bounds, verify, notes: list[str]) -> CurveCandidate | None:
     """The design found closest to the bounds (then the most accurate), verified."""
     def key(c):
@@ -224,7 +234,7 @@ def nearest_miss(misses: list[CurveCandidate], bounds: Bounds, verify, notes: li
 
     for c in sorted(misses, key=key):
         verify(c)
-        if c.verified:
+        if _answer(c):
             return c
     notes.append("no design assembled over its input range was found")
     return None

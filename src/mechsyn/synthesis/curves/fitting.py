@@ -111,9 +111,10 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
     path lying on the target scores 0 up to the polylines' chords, whatever the sampling,
     and the value is at least the order-free :func:`nearest_chamfer`; a loop that cuts
     across a letter, its pieces near parts of the outline visited out of order, scores
-    more than one that goes round it. Computed by dynamic time warping (the row recursion
-    as a prefix minimum), over every start point near the best of every
-    :data:`ROLL_STEP`-th.
+    more than one that goes round it. Computed by dynamic time warping (H. Sakoe and S.
+    Chiba, *IEEE Trans. Acoustics, Speech, and Signal Processing* 26(1), 1978; the row
+    recursion as a prefix minimum), over every start point near the best of every
+    :data:`ROLL_STEP`-th (:func:`_in_order`).
 
     >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
     >>> circle = TargetCurve(np.c_[np.cos(t), np.sin(t)], closed=True)
@@ -130,30 +131,109 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
     best = np.inf
     for Bf in (_fine(path, closed_path, m), _fine(path[::-1], closed_path, m)):
         c = 0.5 * (_beside(Af[::FINE], Bf, closed_path) + _beside(Bf[::FINE], Af, target.closed).T)
-        if not (target.closed or closed_path):
-            best = min(best, float(_dtw(c[None])[0]))
-            continue
-        coarse = np.arange(0, m, ROLL_STEP)
-        e = _dtw(_rolled(c, coarse, target.closed))
-        near = {(s + k) % m for s in coarse[np.argsort(e)[:2]] for k in range(1 - ROLL_STEP, ROLL_STEP)}
-        best = min(best, float(e.min()), float(_dtw(_rolled(c, np.array(sorted(near)), target.closed)).min()))
+        best = min(best, _in_order(c, target.closed, closed_path)[0])
     return float(best / unit)
+
+
+def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
+              around: int | None = None) -> tuple[float, int]:
+    """The least weighted cost over correspondences in order of a cost matrix ``c (n, m)``
+    (:func:`_dtw`) and the start shift of the closed curve it is reached at (the rows'
+    when they are closed, else the columns'; 0 when neither is): every
+    :data:`ROLL_STEP`-th shift, then every one about the best two; with ``around`` (a
+    shift found before) only those within :data:`ROLL_STEP` of it."""
+    if not (rows_closed or cols_closed):
+        return float(_dtw(c[None])[0]), 0
+    n = c.shape[0] if rows_closed else c.shape[1]
+    if around is None:
+        coarse = np.arange(0, n, ROLL_STEP)
+        e = _dtw(_rolled(c, coarse, rows_closed))
+        near = sorted({(s + k) % n for s in coarse[np.argsort(e)[:2]] for k in range(1 - ROLL_STEP, ROLL_STEP)})
+    else:
+        near = sorted({(around + k) % n for k in range(-ROLL_STEP, ROLL_STEP + 1)})
+    f = _dtw(_rolled(c, np.array(near), rows_closed))
+    i = int(np.argmin(f))
+    return float(f[i]), int(near[i])
+
+
+def _rolled(c: np.ndarray, shifts: np.ndarray, rows: bool) -> np.ndarray:
+    """``(V, n, m)``: the cost matrix with the closed curve's start (its rows' or its
+    columns') moved by each shift."""
+    n = c.shape[0] if rows else c.shape[1]
+    idx = (shifts[:, None] + np.arange(n)[None, :]) % n
+    return c[idx] if rows else np.swapaxes(c.T[idx], 1, 2)
+
+
+def _dtw(C: np.ndarray, full: bool = False) -> np.ndarray:
+    """``(V,)``: the least weighted sum over monotone paths of each cost matrix ``C (V, n, m)``
+    (diagonal steps weighted 2, others 1), over ``n + m``; with ``full`` the sums to every
+    cell ``(V, n, m)`` (not divided)."""
+    V, n, m = C.shape
+    D = 2 * C[:, 0, :1] + np.concatenate([np.zeros((V, 1)), np.cumsum(C[:, 0, 1:], axis=1)], axis=1)
+    rows = [D]
+    for i in range(1, n):
+        c = C[:, i]
+        E = D + c
+        E[:, 1:] = np.minimum(E[:, 1:], D[:, :-1] + 2 * c[:, 1:])
+        cc = np.cumsum(c, axis=1)
+        D = cc + np.minimum.accumulate(E - cc, axis=1)   # along the row: D[j] = min(E[j], D[j-1] + c[j])
+        if full:
+            rows.append(D)
+    return np.stack(rows, axis=1) if full else D[:, -1] / (n + m)
+
+
+def _dtw_pairs(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows and columns ``(L,)`` of the least-cost monotone path of :func:`_dtw` through
+    one cost matrix ``C (n, m)``, from ``(0, 0)`` to ``(n-1, m-1)`` (backtracked)."""
+    D = _dtw(C[None], full=True)[0]
+    i, j = C.shape[0] - 1, C.shape[1] - 1
+    rows, cols = [i], [j]
+    while i or j:
+        c = C[i, j]
+        if i and j and D[i - 1, j - 1] + 2 * c <= min(D[i - 1, j], D[i, j - 1]) + c:
+            i, j = i - 1, j - 1
+        elif not j or (i and D[i - 1, j] <= D[i, j - 1]):
+            i -= 1
+        else:
+            j -= 1
+        rows.append(i)
+        cols.append(j)
+    return np.array(rows[::-1]), np.array(cols[::-1])
 
 
 def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.ndarray:
     """``(n, m)``: distance from each point of ``X`` to the stretch of polyline ``F`` (``k``
     segments per sample: the samples are ``F[::k]``) beside its sample ``j``, from sample
     ``j - 1`` to sample ``j + 1`` (one side at an open end)."""
+    return _stretches(_seg_dist(X, F, closed), closed, k)
+
+
+def _seg_dist(X: np.ndarray, F: np.ndarray, closed: bool) -> np.ndarray:
+    """``(n, S)``: distance from each point of ``X`` to each segment of polyline ``F``."""
     S0, V = _polyline(F, closed)
     d = X[:, None, :] - S0[None]
     t = np.clip(np.sum(d * V[None], axis=-1) / np.maximum(np.sum(V ** 2, axis=-1), 1e-300), 0.0, 1.0)
-    seg = np.linalg.norm(d - t[..., None] * V[None], axis=-1).reshape(len(X), -1, k).min(axis=2)
+    return np.linalg.norm(d - t[..., None] * V[None], axis=-1)
+
+
+def _stretches(seg: np.ndarray, closed: bool, k: int) -> np.ndarray:
+    """Segment distances ``(n, S)`` (``k`` segments per sample step) reduced to the
+    stretch beside each sample (see :func:`_beside`)."""
+    seg = seg.reshape(len(seg), -1, k).min(axis=2)
     if closed:   # seg[:, j]: from sample j to j + 1
         return np.minimum(seg, np.roll(seg, 1, axis=1))
-    out = np.empty((len(X), seg.shape[1] + 1))
+    out = np.empty((len(seg), seg.shape[1] + 1))
     out[:, :-1], out[:, -1] = seg, seg[:, -1]
     out[:, 1:] = np.minimum(out[:, 1:], seg)
     return out
+
+
+def _beside_mask(W: np.ndarray, closed: bool, k: int) -> np.ndarray:
+    """``(n, S)``: the segments (``k`` per sample step of the columns' curve) beside the
+    column samples matched to each row by ``W (n, m)``: those from sample ``j - 1`` to
+    ``j + 1`` about each matched ``j``."""
+    near = W | np.roll(W, -1, axis=1) if closed else W[:, :-1] | W[:, 1:]
+    return np.repeat(near, k, axis=1)
 
 
 def _fine(points: np.ndarray, closed: bool, m: int, k: int = FINE) -> np.ndarray:
@@ -161,25 +241,36 @@ def _fine(points: np.ndarray, closed: bool, m: int, k: int = FINE) -> np.ndarray
     return even_points(points, closed, k * m if closed else k * (m - 1) + 1)
 
 
-def _rolled(c: np.ndarray, shifts: np.ndarray, rows: bool) -> np.ndarray:
-    """``(V, m, m)``: the cost matrix with the closed curve's start moved by each shift."""
-    m = c.shape[0]
-    idx = (shifts[:, None] + np.arange(m)[None, :]) % m
-    return c[idx] if rows else np.swapaxes(c.T[idx], 1, 2)
+def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool,
+                   hint: tuple[bool, int] | None = None) -> tuple[np.ndarray, tuple[bool, int]]:
+    """``(n, m)`` boolean: the pairs (row sample, column sample) matched by the least-cost
+    correspondence in order of cost matrix ``c (n, m)`` (the rows a target's samples, the
+    columns a path's), from any start point of a closed curve and in either sense of the
+    columns: the correspondence :func:`chamfer_error` takes its value along; and the sense
+    and start shift it has, a ``hint`` for the next call on a nearby curve (then only that
+    sense and the shifts about it are tried).
 
-
-def _dtw(C: np.ndarray) -> np.ndarray:
-    """``(V,)``: the least weighted sum over monotone paths of each cost matrix ``C (V, n, m)``
-    (diagonal steps weighted 2, others 1), over ``n + m``."""
-    V, n, m = C.shape
-    D = 2 * C[:, 0, :1] + np.concatenate([np.zeros((V, 1)), np.cumsum(C[:, 0, 1:], axis=1)], axis=1)
-    for i in range(1, n):
-        c = C[:, i]
-        E = D + c
-        E[:, 1:] = np.minimum(E[:, 1:], D[:, :-1] + 2 * c[:, 1:])
-        cc = np.cumsum(c, axis=1)
-        D = cc + np.minimum.accumulate(E - cc, axis=1)   # along the row: D[j] = min(E[j], D[j-1] + c[j])
-    return D[:, -1] / (n + m)
+    >>> t = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    >>> a = np.c_[np.cos(t), np.sin(t)]
+    >>> c = np.linalg.norm(a[:, None] - np.roll(a[::-1], 3, axis=0)[None], axis=-1)
+    >>> W, hint = correspondence(c, True, True)
+    >>> bool(np.all(c[W] < 1e-12)), int(W.sum()), hint[0]
+    (True, 8, True)
+    """
+    n, m = c.shape
+    senses = (False, True) if hint is None else (hint[0],)
+    around = None if hint is None else hint[1]
+    (_, shift), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around), rev)
+                           for rev in senses), key=lambda x: x[0][0])
+    cc = c[:, ::-1] if rev else c
+    i, j = _dtw_pairs(_rolled(cc, np.array([shift]), rows_closed)[0] if rows_closed or cols_closed else cc)
+    if rows_closed:
+        i = (i + shift) % n
+    elif cols_closed:
+        j = (j + shift) % m
+    W = np.zeros((n, m), bool)
+    W[i, m - 1 - j if rev else j] = True
+    return W, (rev, shift)
 
 
 def nearest_chamfer(path: np.ndarray, target: TargetCurve, closed_path: bool, unit: float | None = None) -> float:
@@ -236,12 +327,31 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
     return float(chamfer), float(nearest), best / unit
 
 
-def departure(path: np.ndarray, target: TargetCurve, closed_path: bool) -> tuple[int, float]:
-    """Where the path departs most from the target: the index of the target point
-    farthest from the path (polyline) and that distance (target units)."""
-    d = np.linalg.norm(_to_polyline(target.points, *_polyline(path, closed_path))[0], axis=-1)
-    i = int(np.argmax(d))
-    return i, float(d[i])
+def departure(path: np.ndarray, target: TargetCurve, closed_path: bool, m: int = M_ORDER) -> tuple[int, float]:
+    """Where the path departs most from the target, in order: the index of the target
+    point farthest from the stretch of the path that the correspondence in order of
+    :func:`chamfer_error` puts beside it, and that distance (target units). For a loop
+    that cuts across a letter, the parts of the outline it passes near but out of order
+    count as departed from.
+
+    >>> t = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    >>> circle = TargetCurve(np.c_[np.cos(t), np.sin(t)], closed=True)
+    >>> upper = np.c_[np.cos(t), np.abs(np.sin(t))]      # the upper half twice: the lower is left out
+    >>> i, d = departure(upper, circle, True)
+    >>> bool(circle.points[i, 1] < -0.5), bool(d > 1.0)
+    (True, True)
+    """
+    Af, Bf = _fine(target.points, target.closed, m), _fine(path, closed_path, m)
+    c = 0.5 * (_beside(Af[::FINE], Bf, closed_path) + _beside(Bf[::FINE], Af, target.closed).T)
+    W, _ = correspondence(c, target.closed, closed_path)
+    P = np.asarray(target.points, float)
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+    total = arc[-1] + (float(np.linalg.norm(P[0] - P[-1])) if target.closed else 0.0)
+    at = np.rint(arc / (total / (m if target.closed else m - 1))).astype(int)   # each point's sample
+    at = at % m if target.closed else np.minimum(at, m - 1)
+    D = np.where(_beside_mask(W, closed_path, FINE)[at], _seg_dist(P, Bf, closed_path), np.inf).min(axis=1)
+    i = int(np.argmax(D))
+    return i, float(D[i])
 
 
 # ---------------------------------------------------------------------------- evaluation
@@ -314,12 +424,12 @@ class FitProblem:
 
     def __post_init__(self) -> None:
         self.off = input_offsets(self.start, self.stop, self.closed_path)
-        self.T = resample(self.target.points, M_TARGET, closed=self.target.closed)
-        if not self.target.closed:  # resample there and back: keep the way there
-            self.T = resample(self.target.points, 2 * M_TARGET - 2, closed=False)[:M_TARGET]
-        self.T = np.stack([self.T.real, self.T.imag], axis=-1)
-        self.ts, self.tv = _polyline(self.target.points, self.target.closed)
+        self.Af = _fine(self.target.points, self.target.closed, M_TARGET)   # the target, as the error sees it
+        self.T = self.Af[::FINE]
+        self.ts, self.tv = _polyline(self.Af, self.target.closed)
         self.features = sharp_features(self.target.points, self.target.closed)
+        self.feature_at = np.argmin(np.linalg.norm(self.features[:, None] - self.T[None], axis=-1), axis=1) \
+            if len(self.features) else np.zeros(0, int)
         self.diag = 1.0   # the working frame's length unit
         self.plan = full_plan(self.topo)
         names = self.topo.plan.names
@@ -329,6 +439,8 @@ class FitProblem:
         self.nfev = 0
         self.deadline = float("inf")     # now() past which an evaluation raises OutOfTime
         self.best = (float("inf"), None)  # (cost, x) of the best design evaluated by fun
+        self.hint: tuple[bool, int] | None = None   # the last correspondence's sense and start shift
+        self.last_match: tuple[np.ndarray, tuple] | None = None   # (path, its matched segments)
 
     def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
         """Residual vectors ``(K, R)`` of designs ``X (K, P)``; with ``keep`` the nearest
@@ -344,17 +456,10 @@ class FitProblem:
         starts = P if self.closed_path else P[:, :-1]
         vecs = (np.roll(P, -1, axis=1) if self.closed_path else P[:, 1:]) - starts
         F = self.features
-        if keep:
-            r1, k1 = _to_polyline(self.T[None], starts[:1], vecs[:1])
-            r2, k2 = _to_polyline(P[:1], self.ts[None], self.tv[None])
-            r3, k3 = _to_polyline(F[None], starts[:1], vecs[:1])
-            r1 = np.concatenate([r1, _to_polyline(self.T[None], starts[1:], vecs[1:], k1)[0]])
-            r2 = np.concatenate([r2, _to_polyline(P[1:], self.ts[None], self.tv[None], k2)[0]])
-            r3 = np.concatenate([r3, _to_polyline(F[None], starts[1:], vecs[1:], k3)[0]])
-        else:
-            r1 = _to_polyline(self.T[None], starts, vecs)[0]        # target -> path
-            r2 = _to_polyline(P, self.ts[None], self.tv[None])[0]   # path -> target
-            r3 = _to_polyline(F[None], starts, vecs)[0]             # sharp features -> path
+        k1, k2, k3 = self.matched(P, bad, keep)    # segments matched in order (keep: the first design's)
+        r1 = _to_polyline(self.T[None], starts, vecs, k1)[0]        # target -> path
+        r2 = _to_polyline(P, self.ts[None], self.tv[None], k2)[0]   # path -> target
+        r3 = _to_polyline(F[None], starts, vecs, k3)[0] if len(F) else np.zeros((len(X), 0, 2))
         r1 = r1 / np.sqrt(len(self.T))
         r2 = r2 * np.sqrt(_arc_weights(P, self.closed_path))[..., None]   # a mean over arc length, as reported
         r3 = r3 * (FEATURE_WEIGHT / np.sqrt(max(len(F), 1)))
@@ -372,6 +477,47 @@ class FitProblem:
             pen.append(out * 10.0)
         self.last_bad = bad
         return np.concatenate([r] + pen, axis=1)
+
+    def matched(self, P: np.ndarray, bad: np.ndarray, keep: bool) -> tuple[np.ndarray, ...]:
+        """The segments each residual is measured to, for paths ``P (K, N, 2)``: ``(K, M)``
+        path segments for the target's samples, ``(K, N)`` target segments for the path's
+        samples, ``(K, F)`` path segments for the sharp features; each the nearest among
+        those beside the samples a correspondence in order matches it to
+        (:func:`correspondence`, the one :func:`chamfer_error` is taken along), so that a
+        loop cutting across a letter is drawn to the parts of the outline its order puts it
+        beside, not to the nearest stroke. With ``keep`` the first design's, for all (the
+        Jacobian's perturbations)."""
+        K = 1 if keep else len(P)
+        last = self.last_match
+        if K == 1 and last is not None and np.array_equal(last[0], P[0]):   # the Jacobian at fun's design
+            ks = list(last[1])
+        else:
+            ks = self._match(P, bad, K)
+            if K == 1:
+                self.last_match = (P[0].copy(), tuple(ks))
+        if keep:
+            ks = [np.broadcast_to(k, (len(P),) + k.shape[1:]) for k in ks]
+        return tuple(ks)
+
+    def _match(self, P: np.ndarray, bad: np.ndarray, K: int) -> list[np.ndarray]:
+        """The matched segments of :meth:`matched` for the first ``K`` paths."""
+        ks = [np.zeros((K, len(self.T)), int), np.zeros((K, P.shape[1]), int),
+              np.zeros((K, len(self.features)), int)]
+        for d in range(K):
+            if bad[d]:
+                continue
+            D1 = _seg_dist(self.T, P[d], self.closed_path)                  # (M, S1)
+            D2 = _seg_dist(P[d], self.Af, self.target.closed)               # (N, S2)
+            c = 0.5 * (_stretches(D1, self.closed_path, 1) + _stretches(D2, self.target.closed, FINE).T)
+            W, self.hint = correspondence(c, self.target.closed, self.closed_path, self.hint)   # (M, N); the
+            # next evaluations are of nearby designs: their correspondence is sought about this one
+            m1 = _beside_mask(W, self.closed_path, 1)
+            ks[0][d] = np.argmin(np.where(m1, D1, np.inf), axis=1)
+            ks[1][d] = np.argmin(np.where(_beside_mask(W.T, self.target.closed, FINE), D2, np.inf), axis=1)
+            if len(self.features):
+                D3 = _seg_dist(self.features, P[d], self.closed_path)
+                ks[2][d] = np.argmin(np.where(m1[self.feature_at], D3, np.inf), axis=1)
+        return ks
 
     def fun(self, x: np.ndarray) -> np.ndarray:
         r = self.residuals(x[None])[0]

@@ -13,10 +13,12 @@ linkages whose tracing point follows it:
    whose joints are rotated, scaled, translated or mirrored traces the curve so
    transformed, on the same assembly branch, mirrored with its input reversed).
 4. **Refine** the best few dozen by ``scipy.optimize.least_squares`` on the joint and
-   tracer coordinates: residuals are the symmetric chamfer distances (each target
-   point to the traced polyline, each traced point to the target polyline), with the
-   similarity re-solved in closed form before each refinement; the Jacobian is one
-   batch evaluation of all perturbed designs. A design must stay assembled on its
+   tracer coordinates: residuals are the symmetric chamfer distances in order (each
+   target point to the traced polyline, each traced point to the target polyline, each
+   to the stretch beside the samples the error's correspondence in order matches it to:
+   :meth:`~mechsyn.synthesis.curves.fitting.FitProblem.matched`), so the refinement
+   minimises the measure the candidates are ranked by; the Jacobian is one batch
+   evaluation of all perturbed designs, the matched segments held fixed. A design must stay assembled on its
    branch over the whole input range (no dead point, no stepped-over dead point);
    leaving it is penalised, never accepted. Options: a crank (fully rotating input),
    a ground region for the frame pivots, a largest link-length ratio.
@@ -35,7 +37,9 @@ reported as a diagnostic of the timing only.
 **Anytime.** The time limit covers every phase (loading the database, retrieval,
 refinement and the final checks, whose cost is measured on the first candidate and
 reserved). The best retrieved designs are evaluated as they are first (an answer at any
-limit, labelled "not refined"); then a deterministic sequence of refinements runs: the
+limit, labelled "not refined"), before the checks by ``simulate`` load (Numba and the
+compiled kernels: the largest cost of a short run); a check that cannot load by the limit
+is not begun and the answer is given unchecked, labelled so; then a deterministic sequence of refinements runs: the
 first round of retrieved seeds (the four-bars every third), then rounds that refine the best
 design of each of the three leading topologies longer, restart about it (every joint
 and the tracer, the coupler point free on its plane, moved at random, seeded by the
@@ -64,8 +68,8 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import simulate_batch
 from mechsyn.synthesis.curves.database import CurveDatabase, load_database
 from mechsyn.synthesis.curves.descriptors import align, fourier_descriptor, resample, swap_direction
-from mechsyn.synthesis.curves.candidates import (CurveCandidate, CurveSynthesisResult, miss_reason, nearest_miss,
-                                                  ranked)
+from mechsyn.synthesis.curves.candidates import (UNCHECKED, CurveCandidate, CurveSynthesisResult, miss_reason,
+                                                  nearest_miss, ranked)
 from mechsyn.synthesis.curves.fitting import (DEFAULT_MAX_LINK_RATIO, DEFAULT_MAX_SIZE, DEFAULT_MIN_TRANSMISSION,
                                                DEFAULT_TOLERANCE, N_FINAL, Bounds, FitProblem, OutOfTime,
                                                curve_errors, departure, full_plan, input_offsets, link_pairs, now,
@@ -402,7 +406,7 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
             progress(Progress(done=done, total=total, stage=stage, best=best))
 
     report("retrieve", 0, 1, float("nan"), 0)
-    _warm_checks(database.topologies[0])
+    loaded = now() - t0     # what the start cost this process: the measure of its pace
     # retrieval may use at most a third of what is left (the rest: the first evaluations and
     # check, which load compiled kernels, refinement and the final checks)
     seeds, note = _retrieve(database, work, o["retrieve"], o["max_links"], o["crank"], bounds,
@@ -410,7 +414,8 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
     report("retrieve", 1, 1, seeds[0].score if seeds else float("nan"), 0)
     if note:
         notes.append(note)
-    run = _Run(work, bounds, o, report, end, notes=notes)
+    run = _Run(work, bounds, o, report, end, notes=notes,
+               load_cost=0.0 if _CHECKS_LOADED else max(MIN_LOAD_COST, LOAD_FACTOR * loaded))
     if not seeds:
         run.notes.append("no database design matched the options (crank, links, open/closed)")
     run.search(seeds)
@@ -430,19 +435,6 @@ def _search(user: TargetCurve, database: CurveDatabase, t0: float, o: dict[str, 
     if miss is not None:
         res.reason = miss_reason(miss, bounds)
     return res
-
-
-def _warm_checks(topo: CurveTopology) -> None:
-    """The check by ``simulate`` run once on a topology's own drawing, so that its imports
-    and compiled kernels load (1-2 s on a loaded machine) before the time is shared out
-    among the phases, not inside the first check."""
-    from mechsyn.io.load import mechanism_from_dict  # noqa: F401  (the checks' reader)
-    from mechsyn.kinematics import simulate
-
-    try:
-        simulate(topo.model, {topo.plan.input_joint: [0.0, 1.0]}, points=[TRACER])
-    except MechsynInputError:   # the drawing itself does not run: the first check loads them instead
-        pass
 
 
 def _checked_target(target: TargetCurve | np.ndarray, max_links: int, time_limit: float, top: int,
@@ -504,6 +496,11 @@ def _diverse(seeds: list[_Seed], n_refine: int, simple: bool = False) -> list[_S
     return picked
 
 
+MIN_LOAD_COST = 0.5  # seconds, at least, expected for loading the checks (simulate's imports and kernels)
+LOAD_FACTOR = 1.5    # ... and this many times what the process's start cost it (imports, database):
+                     # measured 4.7 s against 3.3 s at a load average of 11 on 2 cores
+#: the seconds the checks took to load in this process (empty: not loaded yet)
+_CHECKS_LOADED: list[float] = []
 UNREFINED = 8        # retrieved designs evaluated as they are, before any refinement (answers at any limit)
 MIN_UNREFINED = 3    # of them evaluated whatever the time: an answer at any limit
 WIDEN = 8            # new retrieved seeds per round after the first
@@ -534,6 +531,7 @@ class _Run:
     interrupted: bool = False
     notes: list[str] = field(default_factory=list)
     verify_cost: float = 0.05   # seconds of one check by simulate (measured on the first candidate)
+    load_cost: float = 0.0      # seconds the checks' first loading is expected to take (0: loaded)
     topologies: int = 3      # topologies among the retrieved designs
 
     @property
@@ -544,19 +542,36 @@ class _Run:
         """The end of refinement: the limit less the time the final checks will take
         (``top + 1`` checks by ``simulate`` at the measured cost, 1.2 times) and
         :data:`EXIT_RESERVE` (at most a tenth of the limit)."""
-        reserve = min(EXIT_RESERVE, 0.1 * self.o["time_limit"])
-        return self.end - 1.2 * (self.o["top"] + 1) * self.verify_cost - reserve
+        return self.end - 1.2 * (self.o["top"] + 1) * self.verify_cost - self.load_cost - self.reserve()
 
     def verify(self, c: CurveCandidate, measure: bool = False) -> None:
         """The check by ``simulate`` (once per candidate; with ``measure`` run again, timed:
-        the first run pays for compiling the mechanism's solver)."""
-        if c.verification and not measure:
+        the first run pays for compiling the mechanism's solver). Before the checks are
+        loaded in this process (``simulate``'s imports and compiled kernels), a check that
+        cannot load by the limit is not begun: the candidate is answered unchecked,
+        labelled :data:`~mechsyn.synthesis.curves.candidates.UNCHECKED`."""
+        if c.verification and c.verification != UNCHECKED and not measure:
             return
+        if self.load_cost and now() + self.load_cost > self.end - self.reserve():
+            c.verified, c.verification = False, UNCHECKED
+            if not any(n.startswith("answered before") for n in self.notes):
+                self.notes.append("answered before the check by simulate could load within the time limit "
+                                  f"(its imports and compiled kernels, about {self.load_cost:.1f} s here)")
+            return
+        t = now()
         _verify(c)
+        if self.load_cost:   # loaded now
+            self.load_cost = 0.0
+            _CHECKS_LOADED.append(now() - t)
+            measure = True
         if measure:
             t = now()
             _verify(c)
             self.verify_cost = now() - t
+
+    def reserve(self) -> float:
+        """Seconds kept at the end for mapping back, output and the exit."""
+        return min(EXIT_RESERVE, 0.1 * self.o["time_limit"])
 
     def add(self, c: CurveCandidate | None) -> None:
         if c is None:
@@ -564,8 +579,6 @@ class _Run:
         self.assembled += 1
         self.nfev += c.nfev
         if self.keeps(c):
-            if not self.cands:  # the first: its check measures what the final checks cost
-                self.verify(c, measure=True)
             self.cands.append(c)
         else:
             self.misses.append(c)
@@ -601,6 +614,8 @@ class _Run:
                     break   # out of time: one design within the bounds is an answer
                 self.add(_candidate(s.topo, s.params, s.start, s.stop, s.closed, self.target, 0, self.bounds,
                                     refined=False))
+            if self.cands:   # the answer first, then the checks loaded (if the time allows) and measured
+                self.verify(min(self.cands, key=lambda c: c.chamfer), measure=True)
             for s, nfev in self.tasks(seeds):
                 why = self.stop()
                 if why:
