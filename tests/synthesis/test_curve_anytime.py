@@ -261,10 +261,13 @@ def test_the_answer_comes_before_the_checks_load(db, monkeypatch):
     assert not c.verified and c.verification == UNCHECKED and "NOT CHECKED" in c.describe(res.target)
     assert any(n.startswith("answered before the check by simulate") for n in res.notes)
     assert res.seconds <= 4.0 * 1.05
+    from mechsyn.cli.render import _checked  # the text's closing line does not claim the check
+    assert _checked(res.candidates) == f"0 of {len(res.candidates)} candidates re-simulated by simulate"
     monkeypatch.undo()
     monkeypatch.setattr(synthesis, "_CHECKS_LOADED", [])
     res = synthesize_curve(_coupler(4), max_links=6, top=3, database=db, refinements=0, time_limit=1e4)
     assert res.candidates and all(c.verified for c in res.candidates) and synthesis._CHECKS_LOADED
+    assert _checked(res.candidates) == "every candidate re-simulated by simulate"
 
 
 def test_the_refinement_measures_each_point_where_the_order_puts_it():

@@ -347,11 +347,19 @@ def render_curve_synthesis(res: Any) -> None:
     console.print(f"error: symmetric chamfer along both curves in order (target and path, each point to the "
                   f"other curve where the order puts it, mean over arc length) / the target's diagonal ({tgt.diagonal:.4g}, along its principal axes); size: "
                   f"radius about the target's centroid, in diagonals; {res.refined} refinements of "
-                  f"{res.retrieved} retrieved designs in {res.seconds:.1f} s{limit}; every candidate "
-                  "re-simulated by simulate" + ("; interrupted: best so far" if res.interrupted else ""),
+                  f"{res.retrieved} retrieved designs in {res.seconds:.1f} s{limit}; {_checked(res.candidates)}"
+                  + ("; interrupted: best so far" if res.interrupted else ""),
                   highlight=False)
     for n in res.notes:
         console.print(f"note: {n}", highlight=False)
+
+
+def _checked(candidates) -> str:
+    """What the closing line says of the candidates' check by ``simulate`` (a short time limit
+    can answer before the check has run)."""
+    n = sum(bool(c.verified) for c in candidates)
+    return ("every candidate re-simulated by simulate" if n == len(candidates)
+            else f"{n} of {len(candidates)} candidates re-simulated by simulate")
 
 
 #: Arms with more joints than this get their joint values below the table, wrapped to the
