@@ -302,21 +302,20 @@ def test_coincident_circle_centres_are_indeterminate_in_both_forms(gap):
     determinate middle joint: NaN in the array and the scalar forms alike, whatever the last
     bits of ``d`` (the Peaucellier cell's dead point gave 0 on one machine and 4.4e-16 on
     another, so NaN from one pass and a discriminant of 1 from the other)."""
-    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+    from mechsyn.kinematics.groups import circle_circle
 
     for scale in (1e-3, 1.0, 1e4):
         L1s = L2s = (2.0 * scale) ** 2
         d = gap * scale
-        inv, f, g2 = circle_circle(np.array([d, 2.0 * scale]), np.zeros(2), L1s, L2s)
-        disc = normalised_disc(inv, g2, L1s)
+        f, g2, disc = circle_circle(np.array([d, 2.0 * scale]), np.zeros(2), L1s, L2s)
         assert np.isnan(disc[0]) and disc[1] == pytest.approx(0.75)
-        inv_s, f_s, g2_s = circle_circle(d, 0.0, L1s, L2s)
-        assert np.isnan(inv_s) and np.isnan(g2_s)
+        f_s, g2_s, disc_s = circle_circle(d, 0.0, L1s, L2s)
+        assert np.isnan(f_s) and np.isnan(g2_s) and np.isnan(disc_s)
 
 
 def test_separate_circle_centres_are_kept():
     """Just above the coincidence threshold (1e-10 of the lengths) the group is determinate."""
-    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+    from mechsyn.kinematics.groups import circle_circle
 
-    inv, f, g2 = circle_circle(np.array([1e-10]), np.zeros(1), 4.0, 4.0)
-    assert np.isfinite(normalised_disc(inv, g2, 4.0)[0])
+    f, g2, disc = circle_circle(np.array([1e-10]), np.zeros(1), 4.0, 4.0)
+    assert np.isfinite(disc[0])

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.kinematics.groups import (DriveOp, Plan, RRRChooser, RRROp, circle_circle, cons_of,
-                                       geometry_memo, local_point, normalised_disc)
+                                       geometry_memo, local_point)
 from mechsyn.kinematics.positions import TrackedPositions, continuous_angles, solve_positions
 from mechsyn.kinematics.rates import batch_rates
 from mechsyn.kinematics.plane import cross
@@ -381,9 +381,9 @@ class _Chunk:
         jst[J1], jst[J3] = A, C
         dx = C[0] - A[0]
         dy = C[1] - A[1]
-        inv, f, g = circle_circle(dx, dy, L1s, L2s)
+        f, g, disc = circle_circle(dx, dy, L1s, L2s)
         if isinstance(sigma, RRRChooser):  # a chooser: the signs from the discriminant of positions.solve_step
-            sigma = self._choose(sigma, A, dx, dy, normalised_disc(inv, g, L1s))
+            sigma = self._choose(sigma, A, dx, dy, disc)
         np.maximum(g, 0.0, out=g, where=g > -1e-12)
         np.sqrt(g, out=g)
         if isinstance(sigma, np.ndarray):
