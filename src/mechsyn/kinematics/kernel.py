@@ -37,7 +37,6 @@ gives the group's normalised discriminant per row:
 from __future__ import annotations
 
 import importlib
-import threading
 from types import ModuleType
 
 import numpy as np
@@ -46,6 +45,7 @@ from mechsyn.kinematics.chain import chain_program
 from mechsyn.kinematics.groups import DriveOp, Plan, geometry_memo, local_point
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
+from mechsyn.kinematics.topology import CACHE
 
 __all__ = ["chain_steps", "fold_scan", "four_bar_fold", "link_poses", "point_states", "program", "program_arrays", "run",
            "scalar_disc", "trig", "warm"]
@@ -246,27 +246,22 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
 
 
-#: The cosines and sines :func:`trig` keeps, most recent first, as ``(key, (cos, sin))``:
-#: of the last blocks of input rows (``_BLOCKS``: the sweeps, by ``(bytes, shape,
-#: type)``; blocks of fewer than ``_SMALL`` numbers, a connecting path, are computed) and
-#: of the last stacks of blocks (``_STACKS``: a tuple of the blocks' keys); blocks of at
-#: most ``_TRIG_ROWS`` numbers.
-_BLOCKS: list = []
-_STACKS: list = []
-_TRIG_MAX, _STACKS_MAX, _TRIG_ROWS, _SMALL = 16, 4, 1 << 16, 64
-_TRIG_LOCK = threading.Lock()
+#: The largest block of input rows (numbers) whose cosines and sines :func:`trig` keeps,
+#: and the smallest (a connecting path from the drawn input, new with each drawn crank
+#: angle, is computed, not looked for).
+_TRIG_ROWS, _SMALL = 1 << 13, 64
 
 
 def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     """NumPy's cosines and sines of the input rows ``blocks`` (float arrays (m, k))
     stacked: the numbers the regular pass turns its drivers by. A studio's drag, a design
     loop and a cached call sweep the same inputs again and again, with other link
-    lengths: the answers for the last 16 blocks of up to 65,536 numbers and for the last
-    4 stacks of blocks are kept, found again by the blocks' bytes, shapes and types, so
-    only new inputs cost their trigonometry (a tenth of a six-bar's compiled pass); a
-    small block (a connecting path from the drawn input, new with each drawn crank
-    angle) is computed, not looked for. Each block's numbers are ``np.cos``, ``np.sin``
-    of that block, whatever is kept.
+    lengths: the answers for blocks of up to 8,192 numbers and for stacks of blocks are
+    kept in the one cache (:data:`mechsyn.kinematics.topology.CACHE`, under ``("trig",
+    bytes, shape, type)`` of the blocks: at most 128 kB an entry), so only new inputs
+    cost their trigonometry (a tenth of a six-bar's compiled pass); a small block is
+    computed, not looked for. Each block's numbers are ``np.cos``, ``np.sin`` of that
+    block, whatever is kept.
 
     Examples
     --------
@@ -275,47 +270,28 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     >>> bool(np.array_equal(c, np.cos(X)) and np.array_equal(s, np.sin(X)))
     True
     """
-    if blocks[0].size > _TRIG_ROWS:  # (the sweep's rows; the connecting paths after them are a few)
+    if sum(b.size for b in blocks) > _TRIG_ROWS:
         return tuple(np.concatenate([f(b) for b in blocks]) for f in (np.cos, np.sin))
     keys = tuple([(b.tobytes(), b.shape, b.dtype.char) for b in blocks])
     if len(blocks) == 1:
         return _block_trig(blocks[0], keys[0])
-    hit = _kept(_STACKS, keys)
-    if hit is not None:
-        return hit
-    parts = [_block_trig(b, k) for b, k in zip(blocks, keys)]
-    out = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
-    _keep(_STACKS, keys, out, _STACKS_MAX)
-    return out
+    hit = CACHE.get(("trig", keys))
+    if hit is None:
+        parts = [_block_trig(b, k) for b, k in zip(blocks, keys)]
+        hit = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
+        CACHE.put(("trig", keys), hit)
+    return hit
 
 
 def _block_trig(b: np.ndarray, key: tuple) -> tuple[np.ndarray, np.ndarray]:
     """:func:`trig` of one block (``key``: its bytes, shape and type), kept unless small."""
     if b.size < _SMALL:
         return np.cos(b), np.sin(b)
-    hit = _kept(_BLOCKS, key)
+    hit = CACHE.get(("trig", key))
     if hit is None:
         hit = np.cos(b), np.sin(b)
-        _keep(_BLOCKS, key, hit, _TRIG_MAX)
+        CACHE.put(("trig", key), hit)
     return hit
-
-
-def _kept(memo: list, key: tuple) -> tuple | None:
-    """What ``memo`` (:func:`trig`'s) keeps for ``key``, moved first; None when nothing."""
-    with _TRIG_LOCK:
-        for k, hit in enumerate(memo):
-            if hit[0] == key:
-                if k:
-                    memo.insert(0, memo.pop(k))
-                return hit[1]
-    return None
-
-
-def _keep(memo: list, key: tuple, value: tuple, most: int) -> None:
-    """Keep ``value`` for ``key`` first in ``memo``, at most ``most`` entries."""
-    with _TRIG_LOCK:
-        memo.insert(0, (key, value))
-        del memo[most:]
 
 
 def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,

@@ -10,7 +10,6 @@ whose velocity is continuous (``change_points="keep"``) or takes the other one
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -187,13 +186,15 @@ def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = No
     follow each other); ``u0``: the drawn input values when known. Both arrays are
     read-only: a sweep of the same first inputs from the same drawn values (a cached or
     a refilled geometry: the path does not depend on the links) takes them again."""
-    a = [float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist()
-    return _tracking_path(*_kinds(S), tuple(a), tuple(first.tolist()))
+    a = tuple([float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist())
+    kinds, scale = _kinds(S)
+    b = tuple(first.tolist())
+    return S.topology.product(("tracking path", scale, a, b), lambda: _tracking_path(kinds, scale, a, b))
 
 
-@functools.lru_cache(maxsize=256)
 def _tracking_path(kinds: tuple, scale: float, u0: tuple, first: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`tracking_path` of the drivers' types ``kinds`` and the size ``scale``."""
+    """:func:`tracking_path` of the drivers' types ``kinds`` (the topology's) and the
+    size ``scale``, kept as the topology's product with the numbers it depends on."""
     shift = [b - c for b, c in zip(first, _turned(kinds, u0, first))]  # the numbers of first - (first - turns)
     path = _connecting_path(kinds, scale, list(u0), [b - c for b, c in zip(first, shift)])
     out = path, np.array(shift)
