@@ -81,7 +81,7 @@ def test_the_kernel_pass_equals_the_closed_form_chain(name, mech):
     X = np.column_stack([wide if i == 0 else u0[i] + rng.uniform(-0.3, 0.3, wide.size) for i in range(k)])
     speeds = np.linspace(1.0, 2.0, k)
     steps, anchor, origin = kernel.chain_steps(S, plan)
-    C, W, AL, D, near = kernel.run(kernel.program_arrays(steps, anchor, origin), X, speeds, regular.REGULAR_DISC)
+    C, W, AL, D, near = kernel.run(kernel.program(S, plan), X, speeds, regular.REGULAR_DISC)
     with np.errstate(invalid="ignore", divide="ignore"):
         q, qd, qdd = solve_all(S, plan, X, speeds)
         r = fast_chain(S, plan, X, speeds, rates=True)
@@ -241,3 +241,40 @@ def test_the_kernels_poses_blank_the_fold_scans_singular_rows(name, around):
         assert np.array_equal(np.isnan(a.links[key].angular_velocity), np.isnan(b.links[key].angular_velocity))
     for key in a.points:
         assert np.array_equal(np.isnan(a.points[key].acceleration), np.isnan(b.points[key].acceleration))
+
+
+@pytest.mark.parametrize("name", ["fourbar", "watt_sixbar"])
+def test_the_batch_dyads_are_the_kernels_circle(name):
+    """The batch engine places its dyads by the kernel's circle intersection
+    (``batch_dyad``): over a sweep through dead points, its assembled rows are the rows
+    where every group of the regular pass's program assembles, and its least
+    transmission angle the least ``|sin|`` of the angle between each group's links over
+    those rows, read off its joints (rows where a group's discriminant is within 1e-12
+    of zero may go either way: the batch places the crank by its own arithmetic, whose
+    last bits differ)."""
+    from mechsyn.kinematics.batch import compile_plan as batch_plan, simulate_batch
+
+    m = ms.examples.load(name)
+    kp = cached_plan(m)
+    S, plan = kp.system, kp.groups
+    bp = batch_plan(m, points=[j.id for j in m.joints])
+    offs = np.arange(0.0, 360.0, 2.0)
+    res = simulate_batch(bp, bp.parameters(m), offs, transmission=True)
+    u = np.radians(res.motion(0).inputs[bp.input_joint])[:, None]  # the inputs as simulate measures them
+    steps, _, _ = kernel.chain_steps(S, plan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        C, W, AL, D, near = kernel.run(kernel.program(S, plan), u, np.ones(1), regular.REGULAR_DISC)
+    ok, clear = (D >= 0).all(axis=0), ~(np.abs(D) <= 1e-12).any(axis=0)  # (NaN downstream of a fold)
+    assert np.array_equal(res.assembled[0][clear], ok[clear]) and clear.sum() >= len(offs) - 4 and near
+    ok = res.assembled[0]
+    sin_mu = np.inf
+    for st in steps:
+        if st[0] != "RRR":
+            continue
+        J1, J2, J3 = st[3]
+        P = {j: res.paths[j][0][ok] for j in (J1, J2, J3)}
+        e1, e2 = P[J2] - P[J1], P[J2] - P[J3]
+        s = np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) / (np.hypot(*e1.T) * np.hypot(*e2.T))
+        sin_mu = min(sin_mu, s.min())
+    assert res.min_transmission_angle[0] == pytest.approx(np.degrees(np.arcsin(sin_mu)), abs=1e-5)
+    assert np.isnan(res.paths[steps[-1][3][1]][0][~ok]).all()

@@ -215,7 +215,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    program = geometry_memo(S)[("kernel", id(plan))][1]  # the pass's program (kernel.chain_steps keeps it)
+    program = kernel.program(S, plan)  # the pass's program (kept with S)
     X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
     return _compiled_fold_events(S, plan, program, [discs[k] for k in ks] if block is None else block, ks,
                                  perm, b, X, paths)

@@ -3,7 +3,7 @@ regular pass's program run by Numba-compiled functions
 (:mod:`mechsyn.kinematics._kernel_numba`), row by row in compiled code.
 
 The regular pass (:func:`mechsyn.kinematics.regular.sweep_through_folds`) is a program of
-drive ops and RRR group ops (:func:`program_arrays` writes it as integer and complex
+drive ops and RRR group ops (:func:`program` gives it as integer and complex
 arrays); :func:`run` runs it over the input rows and returns one record: every link's
 rotation and its origin's position, velocity and acceleration, the links' rates, the
 groups' normalised discriminants and whether one came near a fold. The fold scan
@@ -47,7 +47,7 @@ from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.topology import CACHE
 
-__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "link_poses", "point_states", "program", "program_arrays", "run",
+__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "link_poses", "point_states", "program", "run",
            "scalar_disc", "trig", "warm"]
 
 
@@ -87,7 +87,7 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     (:meth:`~mechsyn.kinematics.topology.Topology.product`, kept in the one cache and
     shared by every system of that topology, a refilled one too), so a refilled
     system's steps are its numbers put in (:func:`_filled`). The same numbers are
-    written once more as the kernel's arrays (:func:`program_arrays`' ``fp`` and
+    written once more as the kernel's arrays (:func:`program`'s ``fp`` and
     ``anc_s``, kept with ``S`` under ``("kernel", id(plan))``; their integers are the
     topology's product ``"kernel"``) while they are filled in, not read back off the
     steps."""
@@ -100,7 +100,7 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     out = _filled(S, S.topology.product("regular", lambda: _shape(S, plan), plan), rows)
     memo[key] = (plan, out)
     steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
-    shape = S.topology.product("kernel", lambda: program_arrays(steps, anchor, origin)[0], plan)
+    shape = S.topology.product("kernel", lambda: _shape_arrays(steps, anchor, origin), plan)
     rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
     flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
     memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
@@ -108,8 +108,11 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
 
 
 def program(S: PlanarSystem, plan: Plan) -> tuple:
-    """The regular pass's program of ``S`` as the kernel's arrays (:func:`program_arrays`),
-    kept with ``S``."""
+    """The regular pass's program of ``S`` as the kernel's arrays, kept with ``S``:
+    :func:`_shape_arrays`' integers (the topology's) and the numbers ``fp`` (steps, 7)
+    complex (a driver's sign and joint point; a group's squared lengths, assembly mode,
+    rotation vectors and known joints' local points, :func:`_filled`) and the anchors'
+    local points."""
     chain_steps(S, plan)
     return geometry_memo(S)[("kernel", id(plan))][1]
 
@@ -156,7 +159,7 @@ def _filled(S: PlanarSystem, shape: tuple, rows: list) -> tuple:
     """:func:`chain_steps` of ``S`` from its topology's shape (:func:`_shape`): the local
     points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
     each step's row of the kernel's ``fp``
-    (:func:`program_arrays`' layout) appended to it, flat."""
+    (:func:`program`'s layout) appended to it, flat."""
     steps_, anchors, origin, li, pj, drawn = shape
     loc = _locals(S, li, pj)
     pt = joint_points(S)
@@ -208,21 +211,6 @@ def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
     anc_j = np.array([jx(anchor[i][0]) if i in anchor else -1 for i in range(nl)], np.int64)
     org_j = np.array([jx(j) if j is not None and j in placed else -1 for j in origin], np.int64)
     return ip, anc_j, org_j, len(index), groups
-
-
-def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None = None) -> tuple:
-    """The regular pass's program (:func:`chain_steps`: its steps,
-    the links' anchors as ``(joint, complex local point)``, the links' origin joints) as
-    the kernel's arrays: :func:`_shape_arrays`' integers (``shape`` when already known for
-    the topology) and the numbers ``fp`` (steps, 7) complex (a driver's sign and joint
-    point; a group's squared lengths, assembly mode, rotation vectors and known joints'
-    local points) and the anchors' local points."""
-    shape = shape or _shape_arrays(steps, anchor, origin)
-    rows = [(st[5], st[6], 0j, 0j, 0j, 0j, 0j) if st[0] == "drive" else  # (one array made of the rows)
-            (complex(st[4], st[5]), 0j, st[6], st[7], st[8], st[9], st[10]) for st in steps]
-    fp = np.array(rows, complex).reshape(len(steps), 7)
-    anc_s = np.array([anchor[i][1] if i in anchor else 0j for i in range(len(origin))], complex)
-    return shape, fp, anc_s
 
 
 def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple:
