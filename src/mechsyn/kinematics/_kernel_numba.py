@@ -113,13 +113,15 @@ def batch_dyad(d, L1s, L2s, sigma, L12, shift, mode, ok, w, disc, sin_mu):
 
 
 @njit(**_OPTIONS)
-def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z):
+def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z, SG):
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
     rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's); fill every link's rotation and its origin's position, velocity and
     acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
     (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
-    has rows (2, links, P), :func:`_planes`. Returns True when a group's discriminant
-    falls below ``least`` (or is NaN) on some row."""
+    has rows (2, links, P), :func:`_planes`. Every group in its drawn mode (``fp[:,
+    2]``), or when ``SG`` (steps, M) has M columns, in the mode ``SG[step, row]`` (+1 or
+    -1: the tracked chain's signs by row). Returns True when a group's discriminant falls
+    below ``least`` (or is NaN) on some row."""
     M = CS.shape[0]
     ns = ip.shape[0]
     nl = anc_j.shape[0]
@@ -160,6 +162,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
         L1s = fp[s, 0].real
         L2s = fp[s, 0].imag
         neg = fp[s, 2].real < 0
+        by_row = SG.shape[1] == M
         cbv1 = fp[s, 3]
         cbv2 = fp[s, 4]
         for r in range(M):
@@ -171,7 +174,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
                 if g > -1e-12 and g < 0.0:
                     g = 0.0
             g = math.sqrt(g) if g >= 0.0 else math.nan
-            if neg:
+            if (SG[s, r] < 0.0) if by_row else neg:
                 g = -g
             e1 = d * complex(f, g)
             B = e1 + jP[J1, r]

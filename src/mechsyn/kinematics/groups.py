@@ -30,7 +30,7 @@ import numpy as np
 from mechsyn.kinematics.plane import cross, dot
 from mechsyn.kinematics.system import Con, PlanarSystem
 
-__all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose"]
+__all__ = ["Chooser", "Sigma", "Plan", "Step", "circle_circle", "decompose"]
 
 
 #: Chooses the assembly sign of a branched group per input row from the group's
@@ -39,51 +39,6 @@ Chooser = Callable[[np.ndarray, float], np.ndarray | float]
 #: The assembly mode asked of a branched group: one sign for every row (+1 or -1), one
 #: sign per row (an array), the drawn mode (None) or a :data:`Chooser`.
 Sigma = float | np.ndarray | Chooser | None
-
-
-@dataclass(frozen=True)
-class RRRChooser:
-    """A chooser of an RRR group in a chain program, with the drawn middle joint (which
-    gives the drawn mode)."""
-
-    choose: Chooser
-    drawn_b: np.ndarray
-
-
-@dataclass(frozen=True)
-class DriveOp:
-    """A chain program's drive: link ``new`` turned by the R drive at joint ``joint``
-    (input ``driver``, ``sign`` +1 when ``new`` is the pair's second link) about the
-    known link ``known`` (-1: the frame)."""
-
-    new: int
-    known: int
-    joint: str
-    driver: int
-    sign: float
-
-
-@dataclass(frozen=True)
-class RRROp:
-    """A chain program's RRR group (plan step ``step``): middle joint ``joints[1]`` found
-    from the known end joints ``joints[0]`` (on link ``known[0]``) and ``joints[2]`` (on
-    ``known[1]``); ``L1s``, ``L2s`` the squared lengths of its links ``links``; ``sigma``
-    its assembly mode; ``bv1``, ``bv2`` each link's local end-to-middle vector over its
-    squared length (the link's rotation from the joint-to-joint vector)."""
-
-    step: int
-    known: tuple[int, int]
-    links: tuple[int, int]
-    joints: tuple[str, str, str]
-    L1s: float
-    L2s: float
-    sigma: float | np.ndarray | RRRChooser
-    bv1: np.ndarray
-    bv2: np.ndarray
-
-    def with_sigma(self, sigma: float | np.ndarray | RRRChooser) -> "RRROp":
-        """The same group in another assembly mode (the signs of one sweep)."""
-        return RRROp(self.step, self.known, self.links, self.joints, self.L1s, self.L2s, sigma, self.bv1, self.bv2)
 
 
 @dataclass(frozen=True)

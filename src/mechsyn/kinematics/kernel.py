@@ -41,8 +41,7 @@ from types import ModuleType
 
 import numpy as np
 
-from mechsyn.kinematics.chain import chain_program
-from mechsyn.kinematics.groups import DriveOp, Plan, geometry_memo, local_point
+from mechsyn.kinematics.groups import Plan, cons_of, geometry_memo, local_point
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.topology import CACHE
@@ -122,22 +121,25 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     joint, driver and sign; an RRR group's known links, links and joints), each link's
     anchor joint, origin joint, the (link, joint) pairs whose local points the numbers
     take, as index lists (link, joint's index in the file), and the file indices of
-    every RRR group's joints (its drawn assembly mode)."""
-    prog, anchor = chain_program(S, plan, None)
+    every RRR group's joints (its drawn assembly mode). A link's anchor is the joint that
+    places it: a drive's joint, an RRR group's end joint on it."""
     pairs: dict[tuple[int, str], int] = {}
 
     def at(i: int, jid: str) -> int:
         return pairs.setdefault((i, jid), len(pairs))
 
-    steps = []
-    for op in prog:
-        if isinstance(op, DriveOp):  # the joint's local point on k (the frame: its fixed point)
-            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign, at(op.known, op.joint)))
-        else:
-            (k1, k3), (b1, b2), (J1, J2, J3) = op.known, op.links, op.joints
-            steps.append(("RRR", op.known, op.links, op.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
-                          at(k1, J1), at(k3, J3)))
-    anchors = {i: (jid, at(i, jid)) for i, (jid, _) in anchor.items()}
+    steps, anchors = [], {}
+    for step in plan.steps:
+        if step.kind == "drive_R":  # the joint's local point on k (the frame: its fixed point)
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in cons_of(S, jid) if c.role == "drive")
+            steps.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0, at(k, jid)))
+            anchors[new] = (jid, at(new, jid))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        steps.append(("RRR", step.known, step.links, step.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
+                      at(k1, J1), at(k3, J3)))
+        anchors[b1], anchors[b2] = (J1, at(b1, J1)), (J3, at(b2, J3))
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
@@ -213,7 +215,8 @@ def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
     return ip, anc_j, org_j, len(index), groups
 
 
-def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple:
+def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0,
+        signs: np.ndarray | None = None) -> tuple:
     """The compiled pass over the input rows ``X`` (M, k), or over the blocks of rows
     ``X`` (a list: the sweep, then the connecting paths) one after the other: ``(C, W,
     AL, D, near)``, every link's rotation and its origin's position, velocity,
@@ -221,7 +224,9 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     groups' normalised discriminants (groups, M), and whether one falls below ``least``;
     with ``planes`` (a number of rows, at most M) also the rotations' real and imaginary
     parts in the first ``planes`` rows (2, links, planes) (contiguous rows for
-    :func:`link_poses`' ``arctan2``). The inputs' cosines and sines are :func:`trig`'s."""
+    :func:`link_poses`' ``arctan2``); ``signs`` (steps, M): every group's assembly mode
+    by row (the tracked chain's), else the drawn modes. The inputs' cosines and sines are
+    :func:`trig`'s."""
     (ip, anc_j, org_j, nj, groups), fp, anc_s = program
     CS, SN = trig(X if isinstance(X, list) else [X])
     M, nl = CS.shape[0], anc_j.shape[0]
@@ -230,7 +235,7 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
     Z = np.empty((2, nl, min(planes, M)) if planes else (2, 0, 0))
     near = _nb().regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float), nj,
-                            least, C, W, AL, D, Z)
+                            least, C, W, AL, D, Z, _NO_SIGNS if signs is None else signs)
     return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
 
 
@@ -316,6 +321,7 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
 
 
 _NO_ROWS = np.zeros(0, np.bool_)
+_NO_SIGNS = np.zeros((0, 0))
 
 
 _F64 = np.dtype(float)
