@@ -87,18 +87,19 @@ def batch_dyad(d, L1s, L2s, sigma, L12, shift, mode, ok, w, disc, sin_mu):
     designs (rows of ``d`` = C - A, (n, N) complex; per design the squared lengths
     ``L1s``, ``L2s``, the assembly mode ``sigma`` and ``L12 = L1 L2``, (n,)): by
     :func:`circle`, ``w = f + i sigma g`` (``w - 1`` when ``shift``; NaN where the dyad
-    does not assemble) into ``w``, the normalised discriminant into ``disc`` and the
-    rows assembled (``g^2 >= 0``) into ``ok`` (``mode`` 1: written, 2: and-ed, 0: left);
+    does not assemble) into ``w``, the normalised discriminant into ``disc`` (when it
+    has rows) and the rows assembled (``g^2 >= 0``) into ``ok`` (``mode`` 1: written, 2: and-ed, 0: left);
     with ``sin_mu`` (n,) (else empty) the least ``sin mu = |d|^2 g / (L1 L2)`` of each
     design's assembled rows kept in it."""
     n, N = d.shape
-    least = sin_mu.shape[0] > 0
+    least, discs = sin_mu.shape[0] > 0, disc.shape[0] > 0
     for k in range(n):
         L1, L2, s, lo = L1s[k], L2s[k], sigma[k], math.inf
         for r in range(N):
             z = d[k, r]
             f, g, dc = circle(z, L1, L2)
-            disc[k, r] = dc
+            if discs:
+                disc[k, r] = dc
             good = g >= 0.0
             if mode == 1:
                 ok[k, r] = good

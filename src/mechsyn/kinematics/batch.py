@@ -617,7 +617,7 @@ class _Run:
         flags and the transmission angle on the way."""
         n = k1 - k0
         L1s, L2s, sigma, L12 = (c[k0:k1] for c in self.dyad_consts[j])
-        w, disc = self.w[j][:n], self.disc[:n]
+        w, disc = self.w[j][:n], self.disc[:n] if self.flags else _NO_DISC
         sin_mu = self.sin_mu[k0:k1] if self.sin_mu is not None else _NONE
         importlib.import_module("mechsyn.kinematics._kernel_numba").batch_dyad(
             d, L1s, L2s, sigma, L12, 1.0 if shift else 0.0, mode, self.ok[k0:k1], w, disc, sin_mu)
@@ -626,7 +626,7 @@ class _Run:
         return w
 
 
-_NONE = np.zeros(0)
+_NONE, _NO_DISC = np.zeros(0), np.zeros((0, 0))
 
 
 def _placed(step: tuple) -> list[int]:
