@@ -12,9 +12,9 @@ angles by
   of the same size comes first), run in its own virtual environment
   ``benchmarks/.env-kinematics`` (created and filled with ``pip install pylinkage
   numba`` on first use);
-* mechsyn: the closed-form Assur-dyad path ``dyads.fast_chain``, vectorised with NumPy
-  over all angles in cache-sized chunks (positions of all joints; then also their
-  velocities and accelerations and the links' angular rates), and the whole public
+* mechsyn: the closed-form core, the kernel's pass (:func:`mechsyn.kinematics.kernel.run`:
+  every link's state and rates, compiled) and the joints' states from it (positions;
+  then also their velocities and accelerations), and the whole public
   ``simulate`` call (poses, rates, points, events, angles) for reference.
 
 It prints steps per second, the ratios and the largest differences of the joint
@@ -126,19 +126,21 @@ def mechsyn_setup():
 
 
 def mechsyn_positions(S, plan, U):
-    """Positions of all four joints (pylinkage returns all four too)."""
-    from mechsyn.kinematics import dyads
-
-    r = dyads.fast_chain(S, plan, U, rates=False, rotations=False)
-    return r.points["B"], r.points["C"]
+    """Positions of the joints B and C (pylinkage returns all four joints)."""
+    (PB, _, _), (PC, _, _) = mechsyn_kinematics(S, plan, U, np.ones(1))
+    return PB, PC
 
 
 def mechsyn_kinematics(S, plan, U, speeds):
-    """Positions, velocities, accelerations of all joints and link angular rates."""
-    from mechsyn.kinematics import dyads
+    """Positions, velocities, accelerations of the joints B and C: the kernel's pass (every
+    link's state and rates) and the joints' states from it."""
+    from mechsyn.kinematics import kernel
+    from mechsyn.kinematics.groups import local_point
 
-    r = dyads.fast_chain(S, plan, U, speeds, rates=True, rotations=False)
-    return [(r.points[j], r.velocities[j], r.accelerations[j]) for j in ("B", "C")]
+    C, W, AL, *_ = kernel.run(kernel.program(S, plan), U, speeds, 0.0)
+    idx = np.array([S.index("crank"), S.index("rocker")])
+    P = kernel.point_states(C, W, AL, idx, np.array([complex(*local_point(S, i, j)) for i, j in zip(idx, "BC")]))
+    return [tuple(P[c, k].view(float).reshape(-1, 2) for c in range(3)) for k in range(2)]
 
 
 def best_of(f, repeats: int) -> float:
@@ -181,9 +183,9 @@ def main() -> None:
           f"compile + first run: {pl['compile_and_first_positions']:.2f} s (positions), "
           f"{pl['compile_and_first_kinematics']:.2f} s (kinematics)")
     rows = [
-        ("positions", "pylinkage step_fast", pl["positions"], "mechsyn dyads.fast_chain", t_pos),
+        ("positions", "pylinkage step_fast", pl["positions"], "mechsyn kernel.run", t_pos),
         ("positions + velocities + accelerations", "pylinkage step_fast_with_kinematics", pl["kinematics"],
-         "mechsyn dyads.fast_chain(rates=True)", t_kin),
+         "mechsyn kernel.run", t_kin),
     ]
     for what, n1, t1, n2, t2 in rows:
         print(f"\n{what}:")

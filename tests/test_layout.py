@@ -415,13 +415,7 @@ def test_kinematics_computes_without_reading_drawing_or_terminal_packages():
 #: module from another (issue 37: 48 at its start): a helper another module needs is
 #: made public, moved to the module that uses it, or the two modules are one.
 KINEMATICS_PRIVATE_IMPORTS_MAX = 10
-#: The kinematics' caches are its one bounded LRU, ``kinematics.topology.CACHE`` (issue
-#: 37); TEMPORARY: what the regular pass still keeps on its own, each to go into
-#: ``topology.CACHE`` or away: two memoized pure functions (the row layout of a pass
-#: through folds, the connecting path from the drawn inputs) and the kernel's kept
-#: cosines and sines of the last input blocks and stacks (``kernel.trig``).
-TEMPORARY_KINEMATICS_CACHES = frozenset({"folds.py:_pass_layout", "tracking.py:_tracking_path",
-                                         "kernel.py:_BLOCKS", "kernel.py:_STACKS"})
+#: The kinematics' caches are its one bounded LRU, ``kinematics.topology.CACHE``.
 
 
 def kinematics_private_imports(root: Path = KINEMATICS) -> list[str]:
@@ -442,7 +436,7 @@ def test_kinematics_modules_import_few_private_names():
 
 
 def test_the_kinematics_cache_is_one():
-    """No ``lru_cache``/``cache`` decorator in kinematics but the temporary ones, and the
+    """No ``lru_cache``/``cache`` decorator in kinematics, and the
     only module-level LRU (or other store filled at run time: a mapping, or a list,
     dict or set that starts empty) is ``topology.CACHE``."""
     found = set()
@@ -464,7 +458,7 @@ def test_the_kinematics_cache_is_one():
                      or called in ("dict", "list", "set", "defaultdict") and not value.args and not value.keywords)
             if empty or called in ("OrderedDict", "LRUCache", "WeakValueDictionary", "WeakKeyDictionary"):
                 found.add(f"{path.name}:{ast.unparse(target)}")
-    assert found == {"topology.py:CACHE"} | TEMPORARY_KINEMATICS_CACHES
+    assert found == {"topology.py:CACHE"}
 
 
 def test_the_private_import_count_sees_both_forms(tmp_path):

@@ -572,36 +572,6 @@ def test_drag_request_refusals_go_to_the_worker(case):
         _service.simulate(bad, steps)
 
 
-def test_kernel_program_written_with_the_numbers_is_program_arrays():
-    """The compiled pass's numbers, written while a refilled system's program is filled
-    (one flat list), are those :func:`kernel.program_arrays` reads off the filled steps,
-    bit for bit; with the kernel on, the program the pass finds kept (``fp`` and the
-    anchors' local points) is that one."""
-    from mechsyn.kinematics import kernel
-    from mechsyn.kinematics.groups import geometry_memo
-
-    rng = np.random.default_rng(11)
-    compared = 0
-    for name, m in EXAMPLES:
-        kp = compile_plan(m, inputs=tuple(j.id for j in m.joints if j.actuated))
-        if kp.groups is None or not kp.groups.closed_form_rates:
-            continue
-        new = kp.refilled(_moved(m, rng, 0.005))
-        if new.groups is None:
-            continue
-        S, plan = new.system, new.groups
-        rows: list = []
-        out = kernel._filled(S, S.topology.product("regular", lambda: kernel._shape(S, plan), plan), rows)
-        _, fp, anc_s = kernel.program_arrays(*out)
-        assert np.array_equal(np.array(rows, complex).reshape(fp.shape), fp), name
-        kernel.chain_steps(S, plan)
-        kept = geometry_memo(S)[("kernel", id(plan))][1]
-        assert all(np.array_equal(a, b) for a, b in zip(kept[1:], (fp, anc_s))), name
-        assert kept[1].flags.c_contiguous and kept[2].flags.c_contiguous
-        compared += 1
-    assert compared >= 4
-
-
 @pytest.mark.parametrize("case", ["no point", "no axis"])
 def test_a_missing_point_or_axis_is_not_refilled_and_reported(case):
     """A mechanism of a known topology with a joint's point (or a P joint's axis) missing

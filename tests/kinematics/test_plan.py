@@ -234,12 +234,11 @@ def test_named_points_in_one_batch_equal_each_point_on_its_own(ex, f, j, grid):
                                       ("textbook/stephenson_sixbar.yaml", {})])
 def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(ex, f, moved):
     """The regular pass's program of a refilled system (its topology's shape, the numbers
-    of the moved geometry put in) equals, number for number, the program built from the
-    chain's ops of that system (local points, squared lengths, drawn modes, rotation
-    vectors, anchors)."""
+    of the moved geometry put in) equals the program written out from the groups of that
+    system (local points, squared lengths, drawn modes, rotation vectors, anchors), to
+    the last bits of its arithmetic."""
     from mechsyn.kinematics.analysis import cached_plan
-    from mechsyn.kinematics.chain import _chain_program_
-    from mechsyn.kinematics.groups import DriveOp, local_point
+    from mechsyn.kinematics.groups import cons_of, local_point
     from mechsyn.kinematics.kernel import chain_steps as _program
 
     m = ex(f)
@@ -251,19 +250,30 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     S = kp2.system
     assert S.topology == kp.system.topology  # what the topology decides: kept by it
     steps, cx, origin = _program(S, kp2.groups)
-    prog, anchor = _chain_program_(S, kp2.groups)
-    want = []
-    for op in prog:
-        if isinstance(op, DriveOp):
-            want.append(("drive", op.new, op.known, op.joint, op.driver, op.sign,
-                          complex(*local_point(S, op.known, op.joint))))
-        else:
-            (k1, k3), (J1, _, J3) = op.known, op.joints
-            want.append(("RRR", op.known, op.links, op.joints, op.L1s, op.L2s, op.sigma,
-                         complex(*op.bv1).conjugate(), complex(*op.bv2).conjugate(),
-                         complex(*local_point(S, k1, J1)), complex(*local_point(S, k3, J3))))
-    assert steps == want
-    assert cx == {i: (jid, complex(*s)) for i, (jid, s) in anchor.items()}
+    want, anchor = [], {}
+
+    def lp(i: int, jid: str) -> complex:
+        return complex(*local_point(S, i, jid))
+
+    for step in kp2.groups.steps:  # the program from the groups, written out here
+        if step.kind == "drive_R":
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in cons_of(S, jid) if c.role == "drive")
+            want.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0, lp(k, jid)))
+            anchor[new] = (jid, lp(new, jid))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        u, v = lp(b1, J2) - lp(b1, J1), lp(b2, J2) - lp(b2, J3)
+        A0, B0, C0 = (complex(*m.with_joint_points(pts).joint(jj).point) for jj in (J1, J2, J3))
+        sigma = 1.0 if ((C0 - A0).conjugate() * (B0 - A0)).imag >= 0 else -1.0
+        want.append(("RRR", step.known, step.links, step.joints, abs(u) ** 2, abs(v) ** 2, sigma,
+                     (u / abs(u) ** 2).conjugate(), (v / abs(v) ** 2).conjugate(), lp(k1, J1), lp(k3, J3)))
+        anchor[b1], anchor[b2] = (J1, lp(b1, J1)), (J3, lp(b2, J3))
+    assert [w[:4] for w in want] == [st[:4] for st in steps]
+    for w, st in zip(want, steps):  # the numbers, to the last bits of their arithmetic
+        assert np.allclose(np.array(w[4:], complex), np.array(st[4:], complex), rtol=1e-14, atol=1e-14 * S.scale)
+    assert cx.keys() == anchor.keys() and all(cx[i][0] == anchor[i][0] for i in anchor)
+    assert np.allclose([cx[i][1] for i in anchor], [anchor[i][1] for i in anchor], rtol=1e-14, atol=1e-14 * S.scale)
     assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
 
 
@@ -302,21 +312,20 @@ def test_coincident_circle_centres_are_indeterminate_in_both_forms(gap):
     determinate middle joint: NaN in the array and the scalar forms alike, whatever the last
     bits of ``d`` (the Peaucellier cell's dead point gave 0 on one machine and 4.4e-16 on
     another, so NaN from one pass and a discriminant of 1 from the other)."""
-    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+    from mechsyn.kinematics.groups import circle_circle
 
     for scale in (1e-3, 1.0, 1e4):
         L1s = L2s = (2.0 * scale) ** 2
         d = gap * scale
-        inv, f, g2 = circle_circle(np.array([d, 2.0 * scale]), np.zeros(2), L1s, L2s)
-        disc = normalised_disc(inv, g2, L1s)
+        f, g2, disc = circle_circle(np.array([d, 2.0 * scale]), np.zeros(2), L1s, L2s)
         assert np.isnan(disc[0]) and disc[1] == pytest.approx(0.75)
-        inv_s, f_s, g2_s = circle_circle(d, 0.0, L1s, L2s)
-        assert np.isnan(inv_s) and np.isnan(g2_s)
+        f_s, g2_s, disc_s = circle_circle(d, 0.0, L1s, L2s)
+        assert np.isnan(f_s) and np.isnan(g2_s) and np.isnan(disc_s)
 
 
 def test_separate_circle_centres_are_kept():
     """Just above the coincidence threshold (1e-10 of the lengths) the group is determinate."""
-    from mechsyn.kinematics.groups import circle_circle, normalised_disc
+    from mechsyn.kinematics.groups import circle_circle
 
-    inv, f, g2 = circle_circle(np.array([1e-10]), np.zeros(1), 4.0, 4.0)
-    assert np.isfinite(normalised_disc(inv, g2, 4.0)[0])
+    f, g2, disc = circle_circle(np.array([1e-10]), np.zeros(1), 4.0, 4.0)
+    assert np.isfinite(disc[0])

@@ -59,12 +59,12 @@ def equivalent_four_bar(design: BeltDesign, dphi: ArrayLike) -> FourBarState:
     A = np.stack([-a * np.sin(dphi), a * np.cos(dphi)], axis=-1)
     D = B0[None, :] - A
     # the RRR kernel: B = A + f D + sign g R90 D (circles (A, r) and (B0, b0))
-    _, f, g2 = circle_circle(D[:, 0], D[:, 1], r**2, b0**2)
+    f, g2, _ = circle_circle(D[:, 0], D[:, 1], r**2, b0**2)
     with np.errstate(invalid="ignore"):
         perp = np.sqrt(g2)
     # the branch sign from the design position: A=(0,a), B=(r, a) on which side of A B0
     D0 = B0 - np.array([0.0, a])
-    _, f0, _ = circle_circle(float(D0[0]), float(D0[1]), r**2, b0**2)
+    f0, _, _ = circle_circle(float(D0[0]), float(D0[1]), r**2, b0**2)
     Bdesign = np.array([0.0, a]) + f0 * D0
     sign = 1.0 if (np.array([r, a]) - Bdesign) @ np.array([-D0[1], D0[0]]) > 0 else -1.0
     B = A + f[:, None] * D + (sign * perp)[:, None] * np.stack([-D[:, 1], D[:, 0]], axis=-1)

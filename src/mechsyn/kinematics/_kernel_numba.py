@@ -6,7 +6,7 @@ The chain's steps one after the other, each over all rows in one compiled loop (
 step's constants held in registers, no temporaries, the joints' and links' states as
 complex arrays by row). The program is the
 regular pass's (:func:`mechsyn.kinematics.kernel.chain_steps`) as arrays
-(:func:`mechsyn.kinematics.kernel.program_arrays`). Step by step over all rows is 30 %
+(:func:`mechsyn.kinematics.kernel.program`). Step by step over all rows is 30 %
 faster than row by row over all steps (crank-rocker 24 -> 17 us, Watt six-bar 40 -> 28 us
 for 361 rows), with the same bits.
 """
@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 from numba import njit
+
+from mechsyn.kinematics.groups import COINCIDENT
 
 #: Numba options: compiled once per machine and kept (``cache``), NumPy's floating-point
 #: rules (a division by zero gives inf, a square root of a negative number NaN, as
@@ -49,17 +51,19 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
 
 @njit(inline="always", **_OPTIONS)
 def circle(d, L1s, L2s):
-    """The RRR group's circle intersection, written once for every pass of the kernel:
-    with ``d = C - A`` (complex) and the squared lengths ``L1s``, ``L2s`` of the group's
-    links, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g^2 = L1^2 / |d|^2 - f^2`` (the
-    middle joint at ``B = A + d (f + i sigma g)``) and the normalised discriminant
-    ``g^2 |d|^2 / L1^2`` (below zero the circles do not meet). Centres within
-    :data:`mechsyn.kinematics.groups.COINCIDENT` of one point: NaN (the middle joint is
-    indeterminate); the operations of :func:`mechsyn.kinematics.groups.circle_circle`,
-    so the same numbers."""
+    """The RRR group's circle intersection, the one implementation (every engine that
+    places an RRR group runs it: the passes here, and through :func:`circles` the generic
+    steps, the tracked chain, the batch and synthesis,
+    :func:`mechsyn.kinematics.groups.circle_circle`): with ``d = C - A`` (complex) and
+    the squared lengths ``L1s``, ``L2s`` of the group's links, ``f = 1/2 + (L1^2 -
+    L2^2) / (2 |d|^2)``, ``g^2 = L1^2 / |d|^2 - f^2`` (the middle joint at ``B = A + d (f
+    + i sigma g)``) and the normalised discriminant ``g^2 |d|^2 / L1^2`` (below zero the
+    circles do not meet; 1 when the first link stands square on ``d``, 0 when the group
+    is folded flat). Centres within :data:`mechsyn.kinematics.groups.COINCIDENT` of one
+    point: NaN (the middle joint is indeterminate)."""
     inv = d.real * d.real
     inv += d.imag * d.imag
-    inv = 1.0 / inv if inv > 1e-24 * (L1s + L2s) else math.nan
+    inv = 1.0 / inv if inv > COINCIDENT * (L1s + L2s) else math.nan
     f = inv * (0.5 * (L1s - L2s))
     f += 0.5
     g = inv * L1s
@@ -68,13 +72,57 @@ def circle(d, L1s, L2s):
 
 
 @njit(**_OPTIONS)
-def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z):
+def circles(dx, dy, L1, L2, F, G, Dsc):
+    """:func:`circle` over the rows of ``dx``, ``dy`` (n,) with the squared lengths
+    ``L1``, ``L2`` (n,) or (1,) each: ``f``, ``g^2`` and the normalised discriminant into
+    ``F``, ``G``, ``Dsc`` (n,)."""
+    one1, one2 = L1.shape[0] == 1, L2.shape[0] == 1
+    for r in range(dx.shape[0]):
+        F[r], G[r], Dsc[r] = circle(complex(dx[r], dy[r]), L1[0 if one1 else r], L2[0 if one2 else r])
+
+
+@njit(**_OPTIONS)
+def batch_dyad(d, L1s, L2s, sigma, L12, shift, mode, ok, w, disc, sin_mu):
+    """One RRR dyad of :func:`mechsyn.kinematics.batch.simulate_batch` on a block of
+    designs (rows of ``d`` = C - A, (n, N) complex; per design the squared lengths
+    ``L1s``, ``L2s``, the assembly mode ``sigma`` and ``L12 = L1 L2``, (n,)): by
+    :func:`circle`, ``w = f + i sigma g`` (``w - 1`` when ``shift``; NaN where the dyad
+    does not assemble) into ``w``, the normalised discriminant into ``disc`` (when it
+    has rows) and the rows assembled (``g^2 >= 0``) into ``ok`` (``mode`` 1: written, 2: and-ed, 0: left);
+    with ``sin_mu`` (n,) (else empty) the least ``sin mu = |d|^2 g / (L1 L2)`` of each
+    design's assembled rows kept in it."""
+    n, N = d.shape
+    least, discs = sin_mu.shape[0] > 0, disc.shape[0] > 0
+    for k in range(n):
+        L1, L2, s, lo = L1s[k], L2s[k], sigma[k], math.inf
+        for r in range(N):
+            z = d[k, r]
+            f, g, dc = circle(z, L1, L2)
+            if discs:
+                disc[k, r] = dc
+            good = g >= 0.0
+            if mode == 1:
+                ok[k, r] = good
+            elif mode == 2:
+                ok[k, r] = ok[k, r] and good
+            beta = math.sqrt(g) if good else math.nan
+            w[k, r] = complex(f - shift, s * beta)
+            if least and good:
+                lo = min(lo, (z.real * z.real + z.imag * z.imag) * beta / L12[k])
+        if least:
+            sin_mu[k] = min(sin_mu[k], lo)
+
+
+@njit(**_OPTIONS)
+def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z, SG):
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
     rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's); fill every link's rotation and its origin's position, velocity and
     acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
     (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
-    has rows (2, links, P), :func:`_planes`. Returns True when a group's discriminant
-    falls below ``least`` (or is NaN) on some row."""
+    has rows (2, links, P), :func:`_planes`. Every group in its drawn mode (``fp[:,
+    2]``), or when ``SG`` (steps, M) has M columns, in the mode ``SG[step, row]`` (+1 or
+    -1: the tracked chain's signs by row). Returns True when a group's discriminant falls
+    below ``least`` (or is NaN) on some row."""
     M = CS.shape[0]
     ns = ip.shape[0]
     nl = anc_j.shape[0]
@@ -115,6 +163,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
         L1s = fp[s, 0].real
         L2s = fp[s, 0].imag
         neg = fp[s, 2].real < 0
+        by_row = SG.shape[1] == M
         cbv1 = fp[s, 3]
         cbv2 = fp[s, 4]
         for r in range(M):
@@ -126,7 +175,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
                 if g > -1e-12 and g < 0.0:
                     g = 0.0
             g = math.sqrt(g) if g >= 0.0 else math.nan
-            if neg:
+            if (SG[s, r] < 0.0) if by_row else neg:
                 g = -g
             e1 = d * complex(f, g)
             B = e1 + jP[J1, r]

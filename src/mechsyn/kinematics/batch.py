@@ -12,7 +12,8 @@ passes, with planar points as complex numbers:
 * RRR dyad with known end joints ``A``, ``C`` and lengths ``L1 = |B0 - A0|``,
   ``L2 = |B0 - C0|``: with ``d = C - A``, ``t = |d|^2``,
   ``alpha = (L1^2 - L2^2 + t) / (2 t)`` and ``beta^2 = L1^2 / t - alpha^2``,
-  ``B = A + d (alpha + i sigma beta)``; ``sigma`` is the assembly mode of the reference
+  ``B = A + d (alpha + i sigma beta)`` (the kernel's one circle intersection,
+  :func:`mechsyn.kinematics._kernel_numba.circle`); ``sigma`` is the assembly mode of the reference
   configuration (sign of ``(C0 - A0) x (B0 - A0)``), kept over the whole sweep;
 * any other point ``p`` of a link known from two of its points ``A``, ``B`` is
   ``A + (B - A) (p0 - A0) / (B0 - A0)`` (a rigid motion as one complex ratio).
@@ -65,6 +66,7 @@ True
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -509,7 +511,7 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     mu = None
     if transmission:
         mu = np.degrees(np.arcsin(np.clip(np.where(np.isfinite(run.sin_mu), run.sin_mu, np.nan), 0, 1)))
-    sig = np.stack([c[2][:, 0] for c in run.dyad_consts], axis=1) if run.dyad_consts else np.zeros((K, 0))
+    sig = np.stack([c[2] for c in run.dyad_consts], axis=1) if run.dyad_consts else np.zeros((K, 0))
     return BatchResult(inputs=np.asarray(inputs, float), paths=paths, assembled=run.ok,
                        dead_point=~run.ok.all(axis=1), branch_jump=run.jump, min_transmission_angle=mu,
                        sigmas=sig, plan=plan, reference_inputs=plan.reference_inputs(designs))
@@ -541,9 +543,6 @@ class _Run:
         self.u = u if u.ndim == 2 else None
         with np.errstate(divide="ignore", invalid="ignore"):
             self.dyad_consts, self.point_consts = _constants(plan.ops, X)
-        # per dyad: the number of assembly-mode changes up to each design (a block has one mode
-        # when the count does not change inside it)
-        self.flips = [np.concatenate([[0], np.cumsum(c[2][1:, 0] != c[2][:-1, 0])]) for c in self.dyad_consts]
         kc = min(K, max(1, _BLOCK // max(N, 1)))
         n_slots = 1 + max((max(st[8]) for st in plan.ops if st[0] == "rrr"), default=-1)
         placed = [p for st in plan.ops if st[0] != "mask" for p in _placed(st) if p not in out]
@@ -551,8 +550,7 @@ class _Run:
         self.d = [pool[st[8][0]] for st in plan.ops if st[0] == "rrr"]
         self.w = [pool[st[8][1]] for st in plan.ops if st[0] == "rrr"]
         self.pts = {p: np.empty((kc, N), complex) for p in placed}
-        self.t, self.al, self.be = (np.empty((kc, N)) for _ in range(3))
-        self.good = np.empty((kc, N), dtype=bool)
+        self.disc = np.empty((kc, N))
 
     def block(self, k0: int, k1: int) -> None:
         """Run the program on designs ``k0:k1``."""
@@ -614,41 +612,21 @@ class _Run:
 
     def _w(self, j: int, d: np.ndarray, k0: int, k1: int, shift: bool, mode: int) -> np.ndarray:
         """``w = alpha + i sigma beta`` of dyad ``j`` (``w - 1`` when ``shift``) from ``d``
-        on a block; the assembled mask, the flags and the transmission angle on the way."""
+        on a block, by the kernel's circle intersection
+        (:func:`mechsyn.kinematics._kernel_numba.batch_dyad`); the assembled mask, the
+        flags and the transmission angle on the way."""
         n = k1 - k0
-        h, L1s, sigma, L12 = (c[k0:k1] for c in self.dyad_consts[j])
-        w, t, al, be = self.w[j][:n], self.t[:n], self.al[:n], self.be[:n]
-        sq = w.view(float)                        # w is free until it is built: scratch
-        s = sq.reshape(-1)[:t.size].reshape(t.shape)
-        np.square(d.view(float), out=sq)
-        np.add(sq[:, 0::2], sq[:, 1::2], out=t)   # t = |d|^2
-        np.divide(h, t, out=al)
-        al += 0.5                                 # alpha
-        np.divide(L1s, t, out=be)
-        be -= np.multiply(al, al, out=s)          # beta^2
-        ok = self.ok[k0:k1]
-        if mode == 1:
-            np.greater_equal(be, 0, out=ok)
-        elif mode == 2:
-            ok &= np.greater_equal(be, 0, out=self.good[:n])
+        L1s, L2s, sigma, L12 = (c[k0:k1] for c in self.dyad_consts[j])
+        w, disc = self.w[j][:n], self.disc[:n] if self.flags else _NO_DISC
+        sin_mu = self.sin_mu[k0:k1] if self.sin_mu is not None else _NONE
+        importlib.import_module("mechsyn.kinematics._kernel_numba").batch_dyad(
+            d, L1s, L2s, sigma, L12, 1.0 if shift else 0.0, mode, self.ok[k0:k1], w, disc, sin_mu)
         if self.flags:
-            self.jump[k0:k1] |= _stepped_over(np.divide(np.multiply(be, t, out=s), np.maximum(L1s, 1e-300), out=s))
-        flips = self.flips[j]
-        one = sigma[0, 0] if flips[k1 - 1] == flips[k0] else 0.0   # one assembly mode in the block
-        beta = np.sqrt(be, out=w.imag if one else be)   # NaN where the dyad does not assemble
-        if self.sin_mu is not None:
-            sin_mu = np.divide(np.multiply(beta, t, out=t), L12, out=t)   # sin mu = t beta / (L1 L2)
-            sm = np.fmin.reduce(sin_mu, axis=1, initial=np.inf)        # NaN samples left out
-            self.sin_mu[k0:k1] = np.fmin(self.sin_mu[k0:k1], sm)
-        if not one:
-            np.multiply(be, sigma, out=w.imag)
-        elif one < 0:
-            np.negative(w.imag, out=w.imag)
-        if shift:
-            np.subtract(al, 1.0, out=w.real)
-        else:
-            np.copyto(w.real, al)                 # alpha, beta worked contiguous, then w built
+            self.jump[k0:k1] |= _stepped_over(disc)
         return w
+
+
+_NONE, _NO_DISC = np.zeros(0), np.zeros((0, 0))
 
 
 def _placed(step: tuple) -> list[int]:
@@ -659,9 +637,8 @@ def _placed(step: tuple) -> list[int]:
 
 
 def _constants(program: tuple, X: np.ndarray) -> tuple[list, dict]:
-    """Per-design constants of the program as ``(K, 1)`` columns: per dyad ``h = (L1^2
-    - L2^2) / 2``, ``L1^2``, the assembly mode ``sigma`` and ``L1 L2``; per placed point
-    ``(a, b)`` with the point at ``A + d (a + b w)`` (crank points: ``(None, p0 - O)``);
+    """Per-design constants of the program: per dyad ``L1^2``, ``L2^2``, the assembly
+    mode ``sigma`` and ``L1 L2`` (K,); per placed point as ``(K, 1)`` columns ``(a, b)`` with the point at ``A + d (a + b w)`` (crank points: ``(None, p0 - O)``);
     per fused dyad ``("d", j)`` the ``(a, b)`` of its ``d``."""
     dyads, points = [], {}
     geo = []
@@ -674,7 +651,7 @@ def _constants(program: tuple, X: np.ndarray) -> tuple[list, dict]:
             r1, r3 = X[:, p2] - X[:, p1], X[:, p2] - X[:, p3]
             L1s, L2s = (r1 * r1.conj()).real, (r3 * r3.conj()).real
             sigma = np.where(((X[:, p3] - X[:, p1]).conj() * r1).imag >= 0, 1.0, -1.0)
-            dyads.append(tuple(c[:, None] for c in (0.5 * (L1s - L2s), L1s, sigma, np.sqrt(L1s * L2s))))
+            dyads.append((L1s, L2s, sigma, np.sqrt(L1s * L2s)))
             geo.append((p1, p3, r1, r3))
             for p, side in pts:
                 points[p] = tuple(c[:, None] for c in _side(X, geo[-1], p, side))

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from mechsyn.kinematics.groups import Plan, Step, circle_circle, decompose
 from mechsyn.kinematics.positions import TrackedPositions, solve_positions
-from mechsyn.kinematics.chain import ChainResult, chain_supported, fast_chain, solve_all
+from mechsyn.kinematics.chain import chain_poses, solve_all, tracked_pass
 from mechsyn.kinematics.tracking import BRANCHED, REGULAR_DISC, SINGULAR_DISC, solve_tracked, solve_tracked_rates
 
 __all__ = [
-    "Plan", "Step", "circle_circle", "decompose", "solve_positions", "ChainResult",
-    "chain_supported", "fast_chain", "solve_all", "BRANCHED", "REGULAR_DISC", "SINGULAR_DISC",
+    "Plan", "Step", "circle_circle", "decompose", "solve_positions", "chain_poses",
+    "tracked_pass", "solve_all", "BRANCHED", "REGULAR_DISC", "SINGULAR_DISC",
     "TrackedPositions", "solve_tracked", "solve_tracked_rates"
 ]

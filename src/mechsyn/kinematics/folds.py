@@ -11,7 +11,6 @@ hidden behind an upstream group's (:func:`_hidden_fold`). The branch tracking
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -216,7 +215,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
     n0s = tuple(path.shape[0] for path, _ in paths)
     perm, b = _pass_layout(N, split, n0s)
     ks = sorted(discs)
-    program = geometry_memo(S)[("kernel", id(plan))][1]  # the pass's program (kernel.chain_steps keeps it)
+    program = kernel.program(S, plan)  # the pass's program (kept with S)
     X = np.concatenate([U] + [path for path, _ in paths]) if pass_rows is None else pass_rows
     return _compiled_fold_events(S, plan, program, [discs[k] for k in ks] if block is None else block, ks,
                                  perm, b, X, paths)
@@ -263,11 +262,11 @@ def _four_bar_numbers(spec: tuple | None) -> tuple:
     return (1.0, abs(v), abs(w), math.atan2(w.imag, w.real) - math.atan2(v.imag, v.real), sgn, *targets)
 
 
-@functools.lru_cache(maxsize=64)
 def _pass_layout(N: int, split: int | None, n0s: tuple) -> tuple[np.ndarray, int]:
     """The order of a pass's rows (the sweep's N, then the connecting paths of ``n0s``
     rows) in which each tracked sweep's rows follow each other: ``[U[:split], path 2
-    reversed, path 1, U[split:]]`` (or ``[path, U]``), and where the forward sweep starts."""
+    reversed, path 1, U[split:]]`` (or ``[path, U]``), and where the forward sweep starts
+    (a few microseconds: not kept)."""
     if split is None:
         perm = np.concatenate([np.arange(N, N + n0s[0]), np.arange(N)])
         b = 0
@@ -276,7 +275,6 @@ def _pass_layout(N: int, split: int | None, n0s: tuple) -> tuple[np.ndarray, int
         perm = np.concatenate([np.arange(split), np.arange(N + n1 + n2 - 1, N + n1 - 1, -1), np.arange(N, N + n1),
                                np.arange(split, N)])
         b = split + n2
-    perm.setflags(write=False)
     return perm, b
 
 

@@ -6,11 +6,11 @@ A mechanism of R and P pairs whose links can be found one driver at a time and t
 at a time (a *dyad*: two links, three pairs, joined to links already known) is solved in
 closed form (Artobolevsky, *Theory of Mechanisms and Machines*, ch. 4; the dyads RRR,
 RRP, PRR, RPR, RPP, PRP). :func:`decompose` finds the plan; :func:`circle_circle` is the
-RRR group's kernel (the intersection of two circles, with its normalised discriminant)
-used by every engine that places an RRR group: the generic steps
-(:mod:`mechsyn.kinematics.positions`), the fast chain (:mod:`mechsyn.kinematics.chain`),
-the regular pass (:mod:`mechsyn.kinematics.regular`) and the branch tracking
-(:mod:`mechsyn.kinematics.tracking`).
+RRR group's kernel on arrays (the intersection of two circles, with its normalised
+discriminant): the kernel's one implementation (:mod:`mechsyn.kinematics._kernel_numba`,
+which the regular pass runs row by row) over arrays, for the generic steps
+(:mod:`mechsyn.kinematics.positions`), the tracked chain (:mod:`mechsyn.kinematics.chain`)
+and synthesis.
 
 References
 ----------
@@ -19,6 +19,7 @@ References
 
 from __future__ import annotations
 
+import importlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,7 +30,7 @@ import numpy as np
 from mechsyn.kinematics.plane import cross, dot
 from mechsyn.kinematics.system import Con, PlanarSystem
 
-__all__ = ["Chooser", "DriveOp", "RRRChooser", "RRROp", "Sigma", "Plan", "Step", "circle_circle", "decompose", "normalised_disc"]
+__all__ = ["Chooser", "Sigma", "Plan", "Step", "circle_circle", "decompose"]
 
 
 #: Chooses the assembly sign of a branched group per input row from the group's
@@ -38,51 +39,6 @@ Chooser = Callable[[np.ndarray, float], np.ndarray | float]
 #: The assembly mode asked of a branched group: one sign for every row (+1 or -1), one
 #: sign per row (an array), the drawn mode (None) or a :data:`Chooser`.
 Sigma = float | np.ndarray | Chooser | None
-
-
-@dataclass(frozen=True)
-class RRRChooser:
-    """A chooser of an RRR group in a chain program, with the drawn middle joint (which
-    gives the drawn mode)."""
-
-    choose: Chooser
-    drawn_b: np.ndarray
-
-
-@dataclass(frozen=True)
-class DriveOp:
-    """A chain program's drive: link ``new`` turned by the R drive at joint ``joint``
-    (input ``driver``, ``sign`` +1 when ``new`` is the pair's second link) about the
-    known link ``known`` (-1: the frame)."""
-
-    new: int
-    known: int
-    joint: str
-    driver: int
-    sign: float
-
-
-@dataclass(frozen=True)
-class RRROp:
-    """A chain program's RRR group (plan step ``step``): middle joint ``joints[1]`` found
-    from the known end joints ``joints[0]`` (on link ``known[0]``) and ``joints[2]`` (on
-    ``known[1]``); ``L1s``, ``L2s`` the squared lengths of its links ``links``; ``sigma``
-    its assembly mode; ``bv1``, ``bv2`` each link's local end-to-middle vector over its
-    squared length (the link's rotation from the joint-to-joint vector)."""
-
-    step: int
-    known: tuple[int, int]
-    links: tuple[int, int]
-    joints: tuple[str, str, str]
-    L1s: float
-    L2s: float
-    sigma: float | np.ndarray | RRRChooser
-    bv1: np.ndarray
-    bv2: np.ndarray
-
-    def with_sigma(self, sigma: float | np.ndarray | RRRChooser) -> "RRROp":
-        """The same group in another assembly mode (the signs of one sweep)."""
-        return RRROp(self.step, self.known, self.links, self.joints, self.L1s, self.L2s, sigma, self.bv1, self.bv2)
 
 
 @dataclass(frozen=True)
@@ -305,48 +261,40 @@ COINCIDENT = 1e-24
 circle centres are one point (:func:`circle_circle`)."""
 
 
-def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: float, L2s: float) -> tuple:
-    """The RRR group's kernel: the intersection of the circles ``|B - A| = L1``,
-    ``|B - C| = L2`` with ``d = C - A = (dx, dy)`` (arrays, or floats for the scalar root
-    searches of the branch tracking; the same operations, so the same numbers).
+def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: np.ndarray | float,
+                  L2s: np.ndarray | float) -> tuple:
+    """The RRR group's kernel on arrays (or floats): the intersection of the circles
+    ``|B - A| = L1``, ``|B - C| = L2`` with ``d = C - A = (dx, dy)``, run by the kernel's
+    one implementation (:func:`mechsyn.kinematics._kernel_numba.circle`, compiled, over
+    every row; the lengths broadcast).
 
-    Returns ``1/|d|^2``, ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)`` and
-    ``g^2 = L1^2 / |d|^2 - f^2``: ``B = A + f d + sigma g R90 d`` and
-    ``g^2 |d|^2 / L1^2 = g^2 / (1/|d|^2 L1^2)`` is the group's normalised discriminant
-    (:func:`normalised_disc`; below zero the circles do not meet). Every engine that
-    places an RRR group calls it: the generic step, the fast chain, the regular pass and
-    the scalar discriminant of the tracking.
+    Returns ``f = 1/2 + (L1^2 - L2^2) / (2 |d|^2)``, ``g^2 = L1^2 / |d|^2 - f^2`` (``B =
+    A + f d + sigma g R90 d``) and the group's normalised discriminant ``g^2 |d|^2 /
+    L1^2`` (below zero the circles do not meet; 1 when the first link stands square on
+    ``d``, 0 when the group is folded flat), in the shape of the arguments broadcast
+    (floats when they are numbers).
 
-    Centres closer than ``1e-12 sqrt(L1^2 + L2^2)`` (:data:`COINCIDENT`, relative to the group's own
-    lengths) are coincident: the middle joint is then indeterminate (a circle of solutions,
-    or none), and ``1/|d|^2``, ``f``, ``g^2`` and the discriminant are NaN, in
-    the array and the scalar forms alike, whatever the last bits of ``d`` (the Peaucellier
-    cell at its dead point puts A and B on one spot: ``|d|`` came out 0 or 4e-16 depending
-    on the machine's rounding, and the group's discriminant NaN or 1).
+    Centres closer than ``1e-12 sqrt(L1^2 + L2^2)`` (:data:`COINCIDENT`, relative to the
+    group's own lengths) are coincident: the middle joint is then indeterminate (a circle
+    of solutions, or none), and ``f``, ``g^2`` and the discriminant are NaN, whatever the
+    last bits of ``d`` (the Peaucellier cell at its dead point puts A and B on one spot:
+    ``|d|`` came out 0 or 4e-16 depending on the machine's rounding, and the group's
+    discriminant NaN or 1).
 
     Examples
     --------
-    >>> inv, f, g2 = circle_circle(4.0, 0.0, 9.0, 9.0)   # |d| = 4, L1 = L2 = 3
-    >>> f, round(g2 * 16, 12), round(normalised_disc(inv, g2, 9.0), 6)
+    >>> f, g2, disc = circle_circle(4.0, 0.0, 9.0, 9.0)   # |d| = 4, L1 = L2 = 3
+    >>> f, round(g2 * 16, 12), round(disc, 6)
     (0.5, 5.0, 0.555556)
     """
-    inv = dx * dx
-    inv += dy * dy
-    tiny = COINCIDENT * (L1s + L2s)
-    if isinstance(inv, np.ndarray):
-        inv[inv <= tiny] = np.nan  # NaN, not 1/0: quiet downstream, no warnings
-        np.divide(1.0, inv, out=inv)
-    else:
-        inv = 1.0 / inv if inv > tiny else math.nan
-    f = inv * (0.5 * (L1s - L2s))
-    f += 0.5
-    g = inv * L1s
-    g -= f * f
-    return inv, f, g
-
-
-def normalised_disc(inv: np.ndarray | float, g2: np.ndarray | float, L1s: float) -> np.ndarray | float:
-    """The RRR group's normalised discriminant ``h^2 / L1^2`` (``h`` the height of the
-    middle joint over ``d``) from :func:`circle_circle`'s ``1/|d|^2`` and ``g^2``: 1 when
-    the first link stands square on ``d``, 0 when the group is folded flat."""
-    return g2 / (inv * L1s)
+    dx, dy, L1, L2 = (np.asarray(v, float) for v in (dx, dy, L1s, L2s))
+    shape = np.broadcast_shapes(dx.shape, dy.shape, L1.shape, L2.shape)
+    n = math.prod(shape)
+    rows = [np.ascontiguousarray(np.broadcast_to(v, shape)).reshape(n) for v in (dx, dy)]
+    lens = [v.reshape(1) if v.size == 1 else np.ascontiguousarray(np.broadcast_to(v, shape)).reshape(n)
+            for v in (L1, L2)]
+    out = np.empty((3, n))
+    importlib.import_module("mechsyn.kinematics._kernel_numba").circles(*rows, *lens, *out)
+    if not shape:
+        return float(out[0, 0]), float(out[1, 0]), float(out[2, 0])
+    return tuple(out.reshape((3,) + shape))

@@ -3,7 +3,7 @@ regular pass's program run by Numba-compiled functions
 (:mod:`mechsyn.kinematics._kernel_numba`), row by row in compiled code.
 
 The regular pass (:func:`mechsyn.kinematics.regular.sweep_through_folds`) is a program of
-drive ops and RRR group ops (:func:`program_arrays` writes it as integer and complex
+drive ops and RRR group ops (:func:`program` gives it as integer and complex
 arrays); :func:`run` runs it over the input rows and returns one record: every link's
 rotation and its origin's position, velocity and acceleration, the links' rates, the
 groups' normalised discriminants and whether one came near a fold. The fold scan
@@ -37,17 +37,16 @@ gives the group's normalised discriminant per row:
 from __future__ import annotations
 
 import importlib
-import threading
 from types import ModuleType
 
 import numpy as np
 
-from mechsyn.kinematics.chain import chain_program
-from mechsyn.kinematics.groups import DriveOp, Plan, geometry_memo, local_point
+from mechsyn.kinematics.groups import Plan, cons_of, geometry_memo, local_point
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
+from mechsyn.kinematics.topology import CACHE
 
-__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "link_poses", "point_states", "program", "program_arrays", "run",
+__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "link_poses", "point_states", "program", "run",
            "scalar_disc", "trig", "warm"]
 
 
@@ -87,7 +86,7 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     (:meth:`~mechsyn.kinematics.topology.Topology.product`, kept in the one cache and
     shared by every system of that topology, a refilled one too), so a refilled
     system's steps are its numbers put in (:func:`_filled`). The same numbers are
-    written once more as the kernel's arrays (:func:`program_arrays`' ``fp`` and
+    written once more as the kernel's arrays (:func:`program`'s ``fp`` and
     ``anc_s``, kept with ``S`` under ``("kernel", id(plan))``; their integers are the
     topology's product ``"kernel"``) while they are filled in, not read back off the
     steps."""
@@ -100,7 +99,7 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     out = _filled(S, S.topology.product("regular", lambda: _shape(S, plan), plan), rows)
     memo[key] = (plan, out)
     steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
-    shape = S.topology.product("kernel", lambda: program_arrays(steps, anchor, origin)[0], plan)
+    shape = S.topology.product("kernel", lambda: _shape_arrays(steps, anchor, origin), plan)
     rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
     flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
     memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
@@ -108,8 +107,11 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
 
 
 def program(S: PlanarSystem, plan: Plan) -> tuple:
-    """The regular pass's program of ``S`` as the kernel's arrays (:func:`program_arrays`),
-    kept with ``S``."""
+    """The regular pass's program of ``S`` as the kernel's arrays, kept with ``S``:
+    :func:`_shape_arrays`' integers (the topology's) and the numbers ``fp`` (steps, 7)
+    complex (a driver's sign and joint point; a group's squared lengths, assembly mode,
+    rotation vectors and known joints' local points, :func:`_filled`) and the anchors'
+    local points."""
     chain_steps(S, plan)
     return geometry_memo(S)[("kernel", id(plan))][1]
 
@@ -119,22 +121,25 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     joint, driver and sign; an RRR group's known links, links and joints), each link's
     anchor joint, origin joint, the (link, joint) pairs whose local points the numbers
     take, as index lists (link, joint's index in the file), and the file indices of
-    every RRR group's joints (its drawn assembly mode)."""
-    prog, anchor = chain_program(S, plan, None)
+    every RRR group's joints (its drawn assembly mode). A link's anchor is the joint that
+    places it: a drive's joint, an RRR group's end joint on it."""
     pairs: dict[tuple[int, str], int] = {}
 
     def at(i: int, jid: str) -> int:
         return pairs.setdefault((i, jid), len(pairs))
 
-    steps = []
-    for op in prog:
-        if isinstance(op, DriveOp):  # the joint's local point on k (the frame: its fixed point)
-            steps.append(("drive", op.new, op.known, op.joint, op.driver, op.sign, at(op.known, op.joint)))
-        else:
-            (k1, k3), (b1, b2), (J1, J2, J3) = op.known, op.links, op.joints
-            steps.append(("RRR", op.known, op.links, op.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
-                          at(k1, J1), at(k3, J3)))
-    anchors = {i: (jid, at(i, jid)) for i, (jid, _) in anchor.items()}
+    steps, anchors = [], {}
+    for step in plan.steps:
+        if step.kind == "drive_R":  # the joint's local point on k (the frame: its fixed point)
+            (new,), (k,), (jid,) = step.links, step.known, step.joints
+            con = next(c for c in cons_of(S, jid) if c.role == "drive")
+            steps.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0, at(k, jid)))
+            anchors[new] = (jid, at(new, jid))
+            continue
+        (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
+        steps.append(("RRR", step.known, step.links, step.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
+                      at(k1, J1), at(k3, J3)))
+        anchors[b1], anchors[b2] = (J1, at(b1, J1)), (J3, at(b2, J3))
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
@@ -156,7 +161,7 @@ def _filled(S: PlanarSystem, shape: tuple, rows: list) -> tuple:
     """:func:`chain_steps` of ``S`` from its topology's shape (:func:`_shape`): the local
     points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
     each step's row of the kernel's ``fp``
-    (:func:`program_arrays`' layout) appended to it, flat."""
+    (:func:`program`'s layout) appended to it, flat."""
     steps_, anchors, origin, li, pj, drawn = shape
     loc = _locals(S, li, pj)
     pt = joint_points(S)
@@ -210,22 +215,8 @@ def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
     return ip, anc_j, org_j, len(index), groups
 
 
-def program_arrays(steps: list, anchor: dict, origin: list, shape: tuple | None = None) -> tuple:
-    """The regular pass's program (:func:`chain_steps`: its steps,
-    the links' anchors as ``(joint, complex local point)``, the links' origin joints) as
-    the kernel's arrays: :func:`_shape_arrays`' integers (``shape`` when already known for
-    the topology) and the numbers ``fp`` (steps, 7) complex (a driver's sign and joint
-    point; a group's squared lengths, assembly mode, rotation vectors and known joints'
-    local points) and the anchors' local points."""
-    shape = shape or _shape_arrays(steps, anchor, origin)
-    rows = [(st[5], st[6], 0j, 0j, 0j, 0j, 0j) if st[0] == "drive" else  # (one array made of the rows)
-            (complex(st[4], st[5]), 0j, st[6], st[7], st[8], st[9], st[10]) for st in steps]
-    fp = np.array(rows, complex).reshape(len(steps), 7)
-    anc_s = np.array([anchor[i][1] if i in anchor else 0j for i in range(len(origin))], complex)
-    return shape, fp, anc_s
-
-
-def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0) -> tuple:
+def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0,
+        signs: np.ndarray | None = None) -> tuple:
     """The compiled pass over the input rows ``X`` (M, k), or over the blocks of rows
     ``X`` (a list: the sweep, then the connecting paths) one after the other: ``(C, W,
     AL, D, near)``, every link's rotation and its origin's position, velocity,
@@ -233,7 +224,9 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     groups' normalised discriminants (groups, M), and whether one falls below ``least``;
     with ``planes`` (a number of rows, at most M) also the rotations' real and imaginary
     parts in the first ``planes`` rows (2, links, planes) (contiguous rows for
-    :func:`link_poses`' ``arctan2``). The inputs' cosines and sines are :func:`trig`'s."""
+    :func:`link_poses`' ``arctan2``); ``signs`` (steps, M): every group's assembly mode
+    by row (the tracked chain's), else the drawn modes. The inputs' cosines and sines are
+    :func:`trig`'s."""
     (ip, anc_j, org_j, nj, groups), fp, anc_s = program
     CS, SN = trig(X if isinstance(X, list) else [X])
     M, nl = CS.shape[0], anc_j.shape[0]
@@ -242,31 +235,26 @@ def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, 
     W, AL, D = R[:nl], R[nl:2 * nl], R[2 * nl:]
     Z = np.empty((2, nl, min(planes, M)) if planes else (2, 0, 0))
     near = _nb().regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, np.ascontiguousarray(speeds, float), nj,
-                            least, C, W, AL, D, Z)
+                            least, C, W, AL, D, Z, _NO_SIGNS if signs is None else signs)
     return (C, W, AL, D, bool(near), Z) if planes else (C, W, AL, D, bool(near))
 
 
-#: The cosines and sines :func:`trig` keeps, most recent first, as ``(key, (cos, sin))``:
-#: of the last blocks of input rows (``_BLOCKS``: the sweeps, by ``(bytes, shape,
-#: type)``; blocks of fewer than ``_SMALL`` numbers, a connecting path, are computed) and
-#: of the last stacks of blocks (``_STACKS``: a tuple of the blocks' keys); blocks of at
-#: most ``_TRIG_ROWS`` numbers.
-_BLOCKS: list = []
-_STACKS: list = []
-_TRIG_MAX, _STACKS_MAX, _TRIG_ROWS, _SMALL = 16, 4, 1 << 16, 64
-_TRIG_LOCK = threading.Lock()
+#: The largest block of input rows (numbers) whose cosines and sines :func:`trig` keeps,
+#: and the smallest (a connecting path from the drawn input, new with each drawn crank
+#: angle, is computed, not looked for).
+_TRIG_ROWS, _SMALL = 1 << 13, 64
 
 
 def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     """NumPy's cosines and sines of the input rows ``blocks`` (float arrays (m, k))
     stacked: the numbers the regular pass turns its drivers by. A studio's drag, a design
     loop and a cached call sweep the same inputs again and again, with other link
-    lengths: the answers for the last 16 blocks of up to 65,536 numbers and for the last
-    4 stacks of blocks are kept, found again by the blocks' bytes, shapes and types, so
-    only new inputs cost their trigonometry (a tenth of a six-bar's compiled pass); a
-    small block (a connecting path from the drawn input, new with each drawn crank
-    angle) is computed, not looked for. Each block's numbers are ``np.cos``, ``np.sin``
-    of that block, whatever is kept.
+    lengths: the answers for blocks of up to 8,192 numbers and for stacks of blocks are
+    kept in the one cache (:data:`mechsyn.kinematics.topology.CACHE`, under ``("trig",
+    bytes, shape, type)`` of the blocks: at most 128 kB an entry), so only new inputs
+    cost their trigonometry (a tenth of a six-bar's compiled pass); a small block is
+    computed, not looked for. Each block's numbers are ``np.cos``, ``np.sin`` of that
+    block, whatever is kept.
 
     Examples
     --------
@@ -275,47 +263,28 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     >>> bool(np.array_equal(c, np.cos(X)) and np.array_equal(s, np.sin(X)))
     True
     """
-    if blocks[0].size > _TRIG_ROWS:  # (the sweep's rows; the connecting paths after them are a few)
+    if sum(b.size for b in blocks) > _TRIG_ROWS:
         return tuple(np.concatenate([f(b) for b in blocks]) for f in (np.cos, np.sin))
     keys = tuple([(b.tobytes(), b.shape, b.dtype.char) for b in blocks])
     if len(blocks) == 1:
         return _block_trig(blocks[0], keys[0])
-    hit = _kept(_STACKS, keys)
-    if hit is not None:
-        return hit
-    parts = [_block_trig(b, k) for b, k in zip(blocks, keys)]
-    out = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
-    _keep(_STACKS, keys, out, _STACKS_MAX)
-    return out
+    hit = CACHE.get(("trig", keys))
+    if hit is None:
+        parts = [_block_trig(b, k) for b, k in zip(blocks, keys)]
+        hit = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
+        CACHE.put(("trig", keys), hit)
+    return hit
 
 
 def _block_trig(b: np.ndarray, key: tuple) -> tuple[np.ndarray, np.ndarray]:
     """:func:`trig` of one block (``key``: its bytes, shape and type), kept unless small."""
     if b.size < _SMALL:
         return np.cos(b), np.sin(b)
-    hit = _kept(_BLOCKS, key)
+    hit = CACHE.get(("trig", key))
     if hit is None:
         hit = np.cos(b), np.sin(b)
-        _keep(_BLOCKS, key, hit, _TRIG_MAX)
+        CACHE.put(("trig", key), hit)
     return hit
-
-
-def _kept(memo: list, key: tuple) -> tuple | None:
-    """What ``memo`` (:func:`trig`'s) keeps for ``key``, moved first; None when nothing."""
-    with _TRIG_LOCK:
-        for k, hit in enumerate(memo):
-            if hit[0] == key:
-                if k:
-                    memo.insert(0, memo.pop(k))
-                return hit[1]
-    return None
-
-
-def _keep(memo: list, key: tuple, value: tuple, most: int) -> None:
-    """Keep ``value`` for ``key`` first in ``memo``, at most ``most`` entries."""
-    with _TRIG_LOCK:
-        memo.insert(0, (key, value))
-        del memo[most:]
 
 
 def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,
@@ -352,6 +321,7 @@ def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | 
 
 
 _NO_ROWS = np.zeros(0, np.bool_)
+_NO_SIGNS = np.zeros((0, 0))
 
 
 _F64 = np.dtype(float)

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import (Plan, Sigma, Step, circle_circle, cons_of, local_point, normalised_disc, pair_line,
+from mechsyn.kinematics.groups import (Plan, Sigma, Step, circle_circle, cons_of, local_point, pair_line,
                                        rel_angle)
 from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate
 from mechsyn.kinematics.system import Con, PlanarSystem
@@ -230,8 +230,7 @@ def _step_RRR(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: 
     t2, t3 = local_point(S, b2, J2), local_point(S, b2, J3)
     L1s, L2s = float(np.sum((s2 - s1) ** 2)), float(np.sum((t2 - t3) ** 2))
     d = C - A
-    inv, f, g2 = circle_circle(d[:, 0], d[:, 1], L1s, L2s)
-    disc = normalised_disc(inv, g2, L1s)
+    f, g2, disc = circle_circle(d[:, 0], d[:, 1], L1s, L2s)
     if sigma is None or callable(sigma):
         s_file = 1.0 if cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
         sigma = s_file if sigma is None else sigma(disc, s_file)

@@ -10,12 +10,11 @@ whose velocity is continuous (``change_points="keep"``) or takes the other one
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
-from mechsyn.kinematics.chain import poses_from_chain, fast_chain
+from mechsyn.kinematics.chain import chain_poses, tracked_pass
 from mechsyn.kinematics.groups import Plan, cons_of
 from mechsyn.kinematics.positions import PoseState, TrackedPositions, pose_rows, solve_step
 from mechsyn.kinematics.folds import SINGULAR_DISC, disc_at, swept, fold_events, touch_candidates
@@ -129,8 +128,9 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
                         switch: bool = False) -> list[tuple]:
     """:func:`solve_tracked` and :func:`mechsyn.kinematics.chain.solve_all` of a driver-R + RRR chain for several
     sweeps (``parts``: arrays of input rows, each reached from the drawn configuration on
-    its own) in one array pass of :func:`fast_chain`: each group's signs are chosen by
-    the branch rules on its discriminant, sweep by sweep, as the pass reaches the group.
+    its own) by the kernel's program (:func:`mechsyn.kinematics.chain.tracked_pass`):
+    each group's signs are chosen by the branch rules on its discriminant, sweep by
+    sweep, in the order of the steps.
     Returns per sweep ``q, qd, qdd`` (N, n), its singular rows and its events."""
     parts = [np.atleast_2d(np.asarray(p, float)) for p in parts]
     rows = [_tracking_rows(S, p) for p in parts]
@@ -145,11 +145,11 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     # the sweeps' own rows (not shifted by turns: the same numbers as an untracked pass);
     # the choosers' events and root searches use the shifted rows
     E = np.vstack([blk for (X, n0, _), U in zip(rows, parts) for blk in (X[:n0], U)])
-    r = fast_chain(S, plan, E, speeds, rates=True, sigmas=sigmas, chunk=max(E.shape[0], 1))
+    C, W, AL, _ = tracked_pass(S, plan, E, speeds, sigmas)
     out = []
     for (X, n0, shift), U, seg, evs in zip(rows, parts, segs, raw_events):
         sweep_rows = slice(seg.start + n0, seg.stop)
-        q, qd, qdd = poses_from_chain(S, plan, U, r.rows(sweep_rows))
+        q, qd, qdd = chain_poses(S, plan, U, C[:, :, sweep_rows], W[:, sweep_rows], AL[:, sweep_rows])
         out.append((q, qd, qdd, singular[sweep_rows], _sweep_events(evs, n0, shift)))
     return out
 
@@ -187,13 +187,15 @@ def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = No
     follow each other); ``u0``: the drawn input values when known. Both arrays are
     read-only: a sweep of the same first inputs from the same drawn values (a cached or
     a refilled geometry: the path does not depend on the links) takes them again."""
-    a = [float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist()
-    return _tracking_path(*_kinds(S), tuple(a), tuple(first.tolist()))
+    a = tuple([float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist())
+    kinds, scale = _kinds(S)
+    b = tuple(first.tolist())
+    return S.topology.product(("tracking path", scale, a, b), lambda: _tracking_path(kinds, scale, a, b))
 
 
-@functools.lru_cache(maxsize=256)
 def _tracking_path(kinds: tuple, scale: float, u0: tuple, first: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`tracking_path` of the drivers' types ``kinds`` and the size ``scale``."""
+    """:func:`tracking_path` of the drivers' types ``kinds`` (the topology's) and the
+    size ``scale``, kept as the topology's product with the numbers it depends on."""
     shift = [b - c for b, c in zip(first, _turned(kinds, u0, first))]  # the numbers of first - (first - turns)
     path = _connecting_path(kinds, scale, list(u0), [b - c for b, c in zip(first, shift)])
     out = path, np.array(shift)

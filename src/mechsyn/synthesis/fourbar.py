@@ -108,7 +108,7 @@ def coupler_direction(ax, ay, r1, r3, r4, branch: int = -1, folded: bool = False
     which keeps a least-squares residual finite).
     """
     dx, dy = r1 - ax, -ay
-    _, f, g2 = circle_circle(np.asarray(dx, float), np.asarray(dy, float), r3 * r3, r4 * r4)
+    f, g2, _ = circle_circle(np.asarray(dx, float), np.asarray(dy, float), r3 * r3, r4 * r4)
     assembled = g2 >= 0
     if folded:
         g2 = np.maximum(g2, 0.0)
