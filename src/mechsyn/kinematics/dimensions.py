@@ -250,8 +250,8 @@ def _third(pa: np.ndarray, pb: np.ndarray, pc: np.ndarray, pb_new: np.ndarray) -
     d = pb_new - pa
     side = 1.0 if cross(pb - pa, pc - pa) >= 0 else -1.0
     ra2, rb2 = float((pc - pa) @ (pc - pa)), float((pc - pb) @ (pc - pb))
-    inv, f, g2 = circle_circle(float(d[0]), float(d[1]), ra2, rb2)
-    if not g2 >= -1e-12 * max(ra2, rb2) * inv:  # (NaN: a side of zero length)
+    f, g2, disc = circle_circle(float(d[0]), float(d[1]), ra2, rb2)
+    if not disc >= -1e-12:  # (NaN: a side of zero length)
         return None
     return pa + f * d + side * math.sqrt(max(g2, 0.0)) * perp(d)
 
