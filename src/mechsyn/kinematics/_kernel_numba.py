@@ -478,34 +478,42 @@ def _scan_row(X, perm, b, w, i, n0, shift, out):
 
 
 @njit(**_OPTIONS)
-def _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t, sg):
+def _disc_along(c, t):
     """:func:`scalar_disc` of step ``k`` at the input ``xa + t d`` (the numbers of
-    :func:`mechsyn.kinematics.folds._disc_line`), the groups in the modes ``sg``."""
+    :func:`mechsyn.kinematics.folds._disc_line`), the groups in the modes ``sg``; ``c``:
+    ``(ip, fp, anc_j, anc_s, nj, k, xa, d, sg)``."""
+    ip, fp, anc_j, anc_s, nj, k, xa, d, sg = c
     u = np.empty(xa.shape[0])
-    for c in range(xa.shape[0]):
-        u[c] = xa[c] + t * d[c]
+    for i in range(xa.shape[0]):
+        u[i] = xa[i] + t * d[i]
     return scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg)
 
 
 @njit(**_OPTIONS)
-def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b, sg):
-    """:func:`mechsyn.kinematics.folds._fold_root` (xtol 1e-14) on :func:`_disc_along`:
-    the zero ``t`` in [a, b] of step ``k``'s discriminant, ``f(a) = fa``, ``f(b) = fb``;
-    NaN when the ends do not bracket a zero."""
+def fold_root(c, fa, fb, a, b):
+    """The zero ``t`` in [a, b] of a group's discriminant ``f(c, t)`` along a segment of
+    inputs, ``f(a) = fa``, ``f(b) = fb`` (known): secant steps through the last two
+    iterates (order 1.6 on the smooth discriminant of a fold), regula falsi when one would
+    leave the bracket, stopped when the next step is below 1e-14 (about four evaluations
+    from one input step to 1e-14 of it; Dahlquist and Bjorck, *Numerical Methods*, 1974,
+    sec. 6.3). NaN when the ends do not bracket a zero. ``f(c, t)`` is
+    :func:`_disc_along`: compiled, the program's discriminant; run as plain Python
+    (:func:`mechsyn.kinematics.kernel.hidden_fold`), the callable ``c`` (the generic
+    steps' discriminant, :mod:`mechsyn.kinematics.folds`)."""
     if fa == 0.0:
         return a
     if fb == 0.0:
         return b
     if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
         return math.nan
-    x0, f0, x1, f1 = a, fa, b, fb
+    x0, f0, x1, f1 = a, fa, b, fb  # the bracket [a, b] (f(a) has the sign of fa)
     t = (a * fb - b * fa) / (fb - fa)
     for _ in range(100):
         if not a < t < b:
             t = (a * fb - b * fa) / (fb - fa)
             if not a < t < b:
                 t = 0.5 * (a + b)
-        ft = _disc_along(ip, fp, anc_j, anc_s, nj, k, xa, d, t, sg)
+        ft = _disc_along(c, t)
         if ft == 0.0 or not math.isfinite(ft):
             return t
         if (ft > 0.0) == (fa > 0.0):
@@ -518,6 +526,39 @@ def _fold_root(ip, fp, anc_j, anc_s, nj, k, xa, d, fa, fb, a, b, sg):
             return min(max(x1 - step, a), b)
         t = x1 - step
     return t
+
+
+@njit(**_OPTIONS)
+def hidden_fold(c, fa, fb, tc, hidden, zero):
+    """Where (t) a group folds between two rows (``_disc_along(c, t)`` its discriminant along the
+    segment, ``fa``, ``fb`` its values at the rows). ``hidden`` 0: its own discriminant
+    changes sign between the rows (t at the ends when the change is round-off only); 1:
+    it is assembled at the first row and an upstream group ends the assembly at ``tc``:
+    the group's own fold before that point, if its discriminant is negative there (else
+    NaN); -1: likewise after an upstream start at ``tc``."""
+    if hidden == 0:
+        t = fold_root(c, fa, fb, 0.0, 1.0)
+        return t if not math.isnan(t) else (0.0 if fa > -zero else 1.0)
+    fc = _disc_along(c, tc)
+    if not fc <= -zero:
+        return math.nan
+    return fold_root(c, fa, fc, 0.0, tc) if hidden > 0 else fold_root(c, fc, fb, tc, 1.0)
+
+
+@njit(**_OPTIONS)
+def _refine(c, g, i, hidden, xa, xb, fa, fb, ends, starts):
+    """The kernel's refinement of a fold of :func:`scan_sweep` between the inputs ``xa``
+    and ``xb``: in closed form (:func:`_four_bar_t`) or by :func:`hidden_fold` on the
+    program's discriminant; ``c``: ``(ip, fp, anc_j, anc_s, nj, ks, specs, sg, zero)``."""
+    ip, fp, anc_j, anc_s, nj, ks, specs, sg, zero = c
+    t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
+    if not math.isnan(t):
+        return t
+    d = np.empty(xa.shape[0])
+    for k in range(xa.shape[0]):
+        d[k] = xb[k] - xa[k]
+    tc = 0.0 if hidden == 0 else (ends[i] if hidden > 0 else starts[i])
+    return hidden_fold((ip, fp, anc_j, anc_s, nj, ks[g], xa, d, sg), fa, fb, tc, hidden, zero)
 
 
 @njit(**_OPTIONS)
@@ -550,21 +591,82 @@ def _four_bar_t(spec, ua, ub):
 
 
 @njit(**_OPTIONS)
+def scan_sweep(D, X, n0, shift, zero, c, ev, ne, w):
+    """The fold scan of one tracked sweep, the one implementation (the kernel's
+    :func:`fold_scan` runs it compiled, the tracked groups run it as plain Python,
+    :func:`mechsyn.kinematics.folds.fold_events`): from the groups' normalised
+    discriminants ``D`` (groups, n) on the sweep's input rows ``X`` (n, inputs; the first
+    ``n0`` its connecting path, the rest shifted by the whole turns ``shift``), per group
+    the rows where its assembly changes (assembled: ``D > -zero``), its folds (both rows
+    evaluated: its own; assembled at one row and cut off at the next by an upstream
+    group's fold: its own fold may come first, hidden between the rows: ``ends``,
+    ``starts``), each refined by :func:`_refine` ``(c, g, i, hidden, xa, xb, fa, fb,
+    ends, starts)`` (t in [0, 1] between rows ``i - 1`` and ``i``, NaN: none; run as plain
+    Python, the context ``c`` brings its own refinement), then its
+    reassemblies. Writes the events as rows of ``ev`` from row ``ne``: ``w``, row, kind
+    (0 the assembly ends, 1 it starts again, 2 reassembled), group, then the input (whole
+    turns added back past the connecting path); returns the next free row."""
+    ng, n = D.shape
+    nin = X.shape[1]
+    ends, starts = np.full(n, math.nan), np.full(n, math.nan)  # NaN: no fold there yet
+    rows, hide, backs = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
+    xa, xb = np.empty(nin), np.empty(nin)
+    for g in range(ng):
+        nr = nb = 0
+        for i in range(1, n):
+            fa, fb = D[g, i - 1], D[g, i]
+            if (fa > -zero) == (fb > -zero):
+                continue
+            if fb > -zero:
+                backs[nb] = i
+                nb += 1
+            hidden = 0 if math.isfinite(fa) and math.isfinite(fb) else (
+                1 if fa > -zero and not math.isnan(ends[i]) else (
+                    -1 if fb > -zero and not math.isnan(starts[i]) else 2))
+            if hidden != 2:
+                rows[nr], hide[nr] = i, hidden
+                nr += 1
+        for r in range(nr):
+            i, hidden = rows[r], hide[r]
+            fa, fb = D[g, i - 1], D[g, i]
+            for k in range(nin):
+                xa[k], xb[k] = X[i - 1, k], X[i, k]
+            t = _refine(c, g, i, hidden, xa, xb, fa, fb, ends, starts)
+            if math.isnan(t):
+                continue
+            inside = fa > -zero if hidden == 0 else hidden > 0
+            if inside:
+                ends[i] = t if math.isnan(ends[i]) else min(t, ends[i])
+            else:
+                starts[i] = t if math.isnan(starts[i]) else max(t, starts[i])
+            ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 0 if inside else 1, g
+            for k in range(nin):  # the numbers of xa + t (xb - xa), whole turns added back
+                u = xa[k] + t * (xb[k] - xa[k])
+                ev[ne, 4 + k] = u if i < n0 else u + shift[k]
+            ne += 1
+        for r in range(nb):
+            i = backs[r]
+            if i < n0:
+                continue
+            ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 2, g
+            for k in range(nin):
+                ev[ne, 4 + k] = X[i, k] + shift[k]
+            ne += 1
+    return ne
+
+
+@njit(**_OPTIONS)
 def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip, fp, anc_j, anc_s,
               nj):
     """:func:`mechsyn.kinematics.folds.pass_fold_events` in one call: the masks of
     :func:`fold_rows` (the discriminants ``Dp`` (groups, pass rows) laid out by ``perm``),
-    then each tracked sweep's scan (:func:`mechsyn.kinematics.folds._fold_scan`, the
-    same decisions in the same order): per group (step ``ks[g]``) the rows where its
-    assembly changes, its folds in closed form (``specs[g]``, :func:`_four_bar_t`) or by
-    :func:`_fold_root` on the program's discriminant along the segment of inputs
-    (upstream groups' folds hiding its own: ``ends``, ``starts``), then its reassemblies.
-    ``X``: the pass's input rows; ``nsw``: the number of sweeps (1 or 2), their connecting
-    paths' lengths and whole turns ``n0a``, ``sha`` (forwards) and ``n0b``, ``shb``
-    (backwards). Returns whether a change point may be near (nothing scanned then), the
-    singular rows (L,) and the events by row: sweep, row along it, kind (0 the assembly
-    ends, 1 it starts again, 2 reassembled), group, then the input along the sweep (whole
-    turns added back past the connecting path)."""
+    then each tracked sweep's :func:`scan_sweep` on its rows, folds refined in closed form
+    (``specs[g]``, :func:`_four_bar_t`) or on the program's discriminant along the
+    segment of inputs (:func:`_refine`, every group in its drawn mode). ``X``: the pass's
+    input rows; ``nsw``: the number of sweeps (1 or 2), their connecting paths' lengths
+    and whole turns ``n0a``, ``sha`` (forwards) and ``n0b``, ``shb`` (backwards). Returns
+    whether a change point may be near (nothing scanned then), the singular rows (L,) and
+    the events by row: sweep, row along it, kind, group, input (:func:`scan_sweep`)."""
     ng, L = Dp.shape[0], perm.shape[0]
     nin = X.shape[1]
     Dl = np.empty((ng, L))
@@ -578,68 +680,17 @@ def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip
                 cap += chg[g, t]
     ev = np.empty((2 * cap, 4 + nin))
     ne = 0
-    xa, xb, d = np.empty(nin), np.empty(nin), np.empty(nin)
     sg = np.empty(fp.shape[0])  # every group in its drawn mode
     for st in range(fp.shape[0]):
         sg[st] = fp[st, 2].real
+    c = (ip, fp, anc_j, anc_s, nj, ks, specs, sg, zero)
     for w in range(nsw if cap else 0):
         n0, shift = (n0a, sha) if w == 0 else (n0b, shb)
         n = L - b if w == 0 else b
-        ends, starts = np.full(n, math.nan), np.full(n, math.nan)  # NaN: no fold there yet
-        rows, hide, backs = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
-        for g in range(ng):
-            nr = nb = 0
-            for i in range(1, n):
-                fa, fb = Dl[g, _pos(w, i - 1, b)], Dl[g, _pos(w, i, b)]
-                if (fa > -zero) == (fb > -zero):
-                    continue
-                if fb > -zero:
-                    backs[nb] = i
-                    nb += 1
-                hidden = 0 if math.isfinite(fa) and math.isfinite(fb) else (
-                    1 if fa > -zero and not math.isnan(ends[i]) else (
-                        -1 if fb > -zero and not math.isnan(starts[i]) else 2))
-                if hidden != 2:
-                    rows[nr], hide[nr] = i, hidden
-                    nr += 1
-            for r in range(nr):
-                i, hidden = rows[r], hide[r]
-                fa, fb = Dl[g, _pos(w, i - 1, b)], Dl[g, _pos(w, i, b)]
-                _scan_row(X, perm, b, w, i - 1, n0, shift, xa)
-                _scan_row(X, perm, b, w, i, n0, shift, xb)
-                for c in range(nin):
-                    d[c] = xb[c] - xa[c]
-                t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
-                if math.isnan(t) and hidden == 0:
-                    t = _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fb, 0.0, 1.0, sg)
-                    if math.isnan(t):
-                        t = 0.0 if fa > -zero else 1.0
-                elif hidden != 0:
-                    tc = ends[i] if hidden > 0 else starts[i]
-                    fc = _disc_along(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, tc, sg)
-                    if not fc <= -zero:
-                        continue
-                    t = (_fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fa, fc, 0.0, tc, sg) if hidden > 0 else
-                         _fold_root(ip, fp, anc_j, anc_s, nj, ks[g], xa, d, fc, fb, tc, 1.0, sg))
-                    if math.isnan(t):
-                        continue
-                inside = fa > -zero if hidden == 0 else hidden > 0
-                if inside:
-                    ends[i] = t if math.isnan(ends[i]) else min(t, ends[i])
-                else:
-                    starts[i] = t if math.isnan(starts[i]) else max(t, starts[i])
-                ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 0 if inside else 1, g
-                for c in range(nin):  # the numbers of xa + t (xb - xa), whole turns added back
-                    u = xa[c] + t * (xb[c] - xa[c])
-                    ev[ne, 4 + c] = u if i < n0 else u + shift[c]
-                ne += 1
-            for r in range(nb):
-                i = backs[r]
-                if i < n0:
-                    continue
-                _scan_row(X, perm, b, w, i, n0, shift, xb)
-                ev[ne, 0], ev[ne, 1], ev[ne, 2], ev[ne, 3] = w, i, 2, g
-                for c in range(nin):
-                    ev[ne, 4 + c] = xb[c] + shift[c]
-                ne += 1
+        Dw, Xw = np.empty((ng, n)), np.empty((n, nin))  # the sweep's rows in its order
+        for i in range(n):
+            _scan_row(X, perm, b, w, i, n0, shift, Xw[i])
+            for g in range(ng):
+                Dw[g, i] = Dl[g, _pos(w, i, b)]
+        ne = scan_sweep(Dw, Xw, n0, shift, zero, c, ev, ne, w)
     return low, singular, ev[:ne]

@@ -3,8 +3,10 @@ limit of the working range) and starts again, from the groups' normalised discri
 (:func:`fold_events`; the regular pass's :func:`pass_fold_events`, by the kernel's
 :func:`mechsyn.kinematics.kernel.fold_scan`), each fold refined
 on its discriminant along the input segment (a closed form where the group closes a
-four-bar, :func:`_four_bar_fold`; else secant steps, :func:`_fold_root`) and the folds
-hidden behind an upstream group's (:func:`_hidden_fold`). The branch tracking
+four-bar, :func:`_four_bar_fold`; else secant steps, :func:`_hidden_fold`) and the folds
+hidden behind an upstream group's. The scan and the refinement are the kernel's, one
+implementation: compiled on the regular pass's program, run as plain Python on the
+generic group steps (:func:`mechsyn.kinematics.kernel.scan_sweep`). The branch tracking
 (:mod:`mechsyn.kinematics.tracking`) and the regular pass
 (:mod:`mechsyn.kinematics.regular`) call it.
 """
@@ -109,7 +111,7 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
 
     A fold (the group's own discriminant changes sign between two rows, both evaluated)
     is a dead point, its input found on the discriminant along the segment between the
-    rows (:func:`_fold_root` on :func:`_disc_line`, upstream groups in their modes
+    rows (:func:`_hidden_fold` on :func:`_disc_line`, upstream groups in their modes
     ``sigmas`` of the earlier row; the ends' values are ``D``'s). A group assembled at
     one row and cut off at the next by an upstream group's fold may fold first between
     the same rows: its discriminant at the upstream fold decides, and the earlier fold is
@@ -121,70 +123,36 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     is one where the group's assembly changes (:func:`_fold_scan`)."""
     ok = D > -_ZERO_DISC
     singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
-    changes: list[list[int]] = [[] for _ in ks]
-    gs, js = np.nonzero(ok[:, 1:] != ok[:, :-1])
-    for g, j in zip(gs.tolist(), js.tolist()):
-        changes[g].append(j + 1)
-    found, resets = _fold_scan(S, plan, ks, sigmas, lambda i: X[i].tolist(), lambda g, i: float(D[g, i]), changes,
-                               n0)
-    return [Event(*e) for e in found], singular, resets
+    found = _fold_scan(S, plan, ks, sigmas, X, D, n0)
+    names = ["-".join(plan.steps[k].joints) for k in ks]
+    events = [Event(int(i), "reassembled" if kind == 2 else "dead point", _FOLD_MESSAGES[int(kind)].format(names[int(g)]),
+                    u, names[int(g)]) for _, i, kind, g, *u in found.tolist()]
+    back = ok[:, 1:] & ~ok[:, :-1]  # the rows where each group assembles again
+    return events, singular, [(np.flatnonzero(r) + 1).tolist() for r in back]
 
 
-def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, row, val, changes: list,
-               n0: int) -> tuple[list, list]:
-    """:func:`fold_events` from the rows where each group's assembly changes
-    (``changes[g]``: the rows ``i`` whose group ``g`` is assembled at ``i`` and not at
-    ``i - 1`` or the other way round), its discriminant ``val(g, i)`` (a float) and the
-    input rows ``row(i)`` (lists of floats): the events as ``(row, kind, message, input, group)``
-    and per group the rows where it reassembles (compiled for the regular pass:
-    :func:`mechsyn.kinematics._kernel_numba.fold_scan`)."""
-    events: list = []
-    resets = []
-    seen: dict[int, list] = {}
+def _fold_scan(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.ndarray, D: np.ndarray,
+               n0: int) -> np.ndarray:
+    """:func:`fold_events`' events as rows (sweep, row, kind, group, input): the kernel's
+    scan of one sweep (:func:`mechsyn.kinematics.kernel.scan_sweep`) run as plain Python,
+    each fold refined in closed form where the group closes a four-bar
+    (:func:`_four_bar_fold`), else on the group's discriminant along the segment of inputs
+    (:func:`_disc_line`, upstream groups in their modes ``sigmas`` of the earlier row;
+    :func:`_hidden_fold`)."""
+    return kernel.scan_sweep(np.ascontiguousarray(D, float), np.ascontiguousarray(X, float), n0, _ZERO_DISC,
+                             _refine, (S, plan, ks, sigmas))
 
-    def read(i: int, row=row) -> list:  # the groups' folds read the same rows, each once
-        return seen[i] if i in seen else seen.setdefault(i, row(i))
 
-    ends: dict[int, float] = {}    # row -> where (t) the assembly ends before it, groups so far
-    starts: dict[int, float] = {}  # row -> where (t) it starts again before it
-    for g, k in enumerate(ks):
-        rows, backs = [], []
-        resets.append(backs)
-        if not changes[g]:
-            continue
-        group = "-".join(plan.steps[k].joints)
-        for i in changes[g]:
-            fa, fb = val(g, i - 1), val(g, i)
-            if fb > -_ZERO_DISC:
-                backs.append(i)
-            if math.isfinite(fa) and math.isfinite(fb):  # its own fold
-                rows.append((i, 0, fa, fb))
-            elif fa > -_ZERO_DISC and i in ends:
-                # assembled at one row and cut off by an upstream group at the next (or the
-                # other way round): its own fold may come first, hidden between the rows
-                rows.append((i, 1, fa, fb))
-            elif fb > -_ZERO_DISC and i in starts:
-                rows.append((i, -1, fa, fb))
-        for i, hidden, fa, fb in rows:  # by row (``changes[g]`` is in order; a row is one group's once)
-            xa, xb = read(i - 1), read(i)
-            t = _four_bar_fold(S, plan, k, xa, xb) if not hidden else None
-            if t is None:
-                f = _disc_line(S, plan, k, sigmas, xa, xb, i - 1)
-                t = _hidden_fold(f, fa, fb, ends, starts, i, hidden)
-            if t is None:
-                continue
-            inside = fa > -_ZERO_DISC if not hidden else hidden > 0
-            if inside:
-                ends[i] = min(t, ends.get(i, 1.0))
-            else:
-                starts[i] = max(t, starts.get(i, 0.0))
-            u = [a + t * (b - a) for a, b in zip(xa, xb)]  # the numbers of xa + t (xb - xa)
-            events.append((i, "dead point", _FOLD_MESSAGES[0 if inside else 1].format(group), u, group))
-        for i in backs:
-            if i < n0:
-                continue
-            events.append((i, "reassembled", _FOLD_MESSAGES[2].format(group), read(i), group))
-    return events, resets
+def _refine(c: tuple, g: int, i: int, hidden: int, xa: np.ndarray, xb: np.ndarray, fa: float, fb: float,
+            ends: np.ndarray, starts: np.ndarray) -> float:
+    """Where (t) group ``g`` of the scan folds between rows ``i - 1`` and ``i`` (inputs
+    ``xa``, ``xb``), NaN when it does not (:func:`_fold_scan`'s refinement)."""
+    S, plan, ks, sigmas = c
+    t = _four_bar_fold(S, plan, ks[g], xa, xb) if not hidden else None
+    if t is None:
+        t = _hidden_fold(_disc_line(S, plan, ks[g], sigmas, xa.tolist(), xb.tolist(), i - 1), fa, fb, ends, starts,
+                         i, hidden)
+    return math.nan if t is None else t
 
 
 #: What a fold scan's events say: the assembly ends, starts again, reassembles (``{}``: the group).
@@ -329,53 +297,15 @@ def _four_bar_form(S: PlanarSystem, plan: Plan, k: int) -> tuple | None:
     return (cranks[crank], 1 if k1 < 0 else 3, crank) if crank in cranks else None
 
 
-def _hidden_fold(f, fa: float, fb: float, ends: dict, starts: dict, i: int, hidden: int) -> float | None:
+def _hidden_fold(f, fa: float, fb: float, ends: np.ndarray, starts: np.ndarray, i: int,
+                 hidden: int) -> float | None:
     """Where (t) a group folds between rows ``i - 1`` and ``i`` (``f`` its discriminant
-    along the segment, ``fa``, ``fb`` its values at the rows). ``hidden`` 0: its own
+    along the segment, ``fa``, ``fb`` its values at the rows), by the kernel's refinement
+    (:func:`mechsyn.kinematics.kernel.hidden_fold`). ``hidden`` 0: its own
     discriminant changes sign between the rows (t at the ends when the change is round-off
     only); 1: it is assembled at row i - 1 and an upstream group ends the assembly at
     ``ends[i]``: the group's own fold before that point, if its discriminant is negative
     there (else None); -1: likewise after an upstream start at ``starts[i]``."""
-    if not hidden:
-        t = _fold_root(f, fa, fb)
-        return t if t is not None else (0.0 if fa > -_ZERO_DISC else 1.0)
-    tc = ends[i] if hidden > 0 else starts[i]
-    fc = f(tc)
-    if not fc <= -_ZERO_DISC:
-        return None
-    return _fold_root(f, fa, fc, b=tc) if hidden > 0 else _fold_root(f, fc, fb, a=tc)
-
-
-def _fold_root(f, fa: float, fb: float, xtol: float = 1e-14, a: float = 0.0, b: float = 1.0) -> float | None:
-    """The zero ``t`` in [a, b] (default [0, 1]) of the discriminant ``f(t)`` along a segment,
-    ``f(a) = fa``, ``f(b) = fb`` (known): secant steps through the last two iterates (order
-    1.6 on the smooth discriminant of a fold), regula falsi when one would leave the bracket,
-    stopped when the next step is below ``xtol`` (about four evaluations from one input step
-    to 1e-14 of it; Dahlquist and Bjorck, *Numerical Methods*, 1974, sec. 6.3). None when
-    the ends do not bracket a zero."""
-    if fa == 0.0:
-        return a
-    if fb == 0.0:
-        return b
-    if (fa > 0.0) == (fb > 0.0) or not (math.isfinite(fa) and math.isfinite(fb)):
-        return None
-    x0, f0, x1, f1 = a, fa, b, fb  # the bracket [a, b] (f(a) has the sign of fa)
-    t = (a * fb - b * fa) / (fb - fa)
-    for _ in range(100):
-        if not a < t < b:
-            t = (a * fb - b * fa) / (fb - fa)
-            if not a < t < b:
-                t = 0.5 * (a + b)
-        ft = f(t)
-        if ft == 0.0 or not math.isfinite(ft):
-            return t
-        if (ft > 0.0) == (fa > 0.0):
-            a, fa = t, ft
-        else:
-            b, fb = t, ft
-        x0, f0, x1, f1 = x1, f1, t, ft
-        step = f1 * (x1 - x0) / (f1 - f0) if f1 != f0 else 0.0
-        if abs(step) <= xtol or b - a <= xtol:
-            return min(max(x1 - step, a), b)
-        t = x1 - step
-    return t
+    tc = 0.0 if not hidden else float(ends[i] if hidden > 0 else starts[i])
+    t = kernel.hidden_fold(f, fa, fb, tc, hidden, _ZERO_DISC)
+    return None if math.isnan(t) else float(t)

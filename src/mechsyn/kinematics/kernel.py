@@ -37,6 +37,7 @@ gives the group's normalised discriminant per row:
 from __future__ import annotations
 
 import importlib
+import types
 from types import ModuleType
 
 import numpy as np
@@ -46,8 +47,8 @@ from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.topology import CACHE
 
-__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "link_poses", "point_states", "program", "run",
-           "scalar_disc", "trig", "warm"]
+__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "hidden_fold", "link_poses", "point_states", "program",
+           "run", "scalar_disc", "scan_sweep", "trig", "warm"]
 
 
 def _nb() -> ModuleType:
@@ -344,6 +345,48 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     D = discs if isinstance(discs, np.ndarray) else np.array(discs)
     return _nb().fold_scan(D, perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0], sb, ks, specs,
                          ip, fp, anc_j, anc_s, nj)
+
+
+def scan_sweep(D: np.ndarray, X: np.ndarray, n0: int, zero: float, refine, c) -> np.ndarray:
+    """The kernel's fold scan of one tracked sweep
+    (:func:`mechsyn.kinematics._kernel_numba.scan_sweep`, the source :func:`fold_scan`
+    compiles) run as plain Python with a Python refinement ``refine(c, g, i, hidden, xa,
+    xb, fa, fb, ends, starts)`` (and its context ``c``) in place of the program's: the
+    tracked groups' (:func:`mechsyn.kinematics.folds.fold_events`), whose discriminants
+    come from the generic group steps. ``D`` (groups, n): the groups' normalised
+    discriminants on the input rows ``X`` (n, inputs), the first ``n0`` a connecting
+    path. Returns the events as rows (sweep 0, row, kind, group, input)."""
+    cap = int(np.count_nonzero((D[:, 1:] > -zero) != (D[:, :-1] > -zero)))
+    ev = np.empty((2 * cap, 4 + X.shape[1]))
+    ne = _plain()["scan_sweep"](D, X, n0, np.zeros(X.shape[1]), zero, (refine, c), ev, 0, 0)
+    return ev[:ne]
+
+
+def hidden_fold(f, fa: float, fb: float, tc: float, hidden: int, zero: float) -> float:
+    """The kernel's fold refinement between two rows
+    (:func:`mechsyn.kinematics._kernel_numba.hidden_fold`) run as plain Python on a
+    discriminant ``f(t)`` along the segment (a Python callable): t, or NaN."""
+    return _plain()["hidden_fold"](f, fa, fb, tc, hidden, zero)
+
+
+def _plain() -> dict:
+    """The compiled functions' plain Python source, calling each other plain (a
+    namespace of :mod:`mechsyn.kinematics._kernel_numba` whose functions are their
+    ``py_func``; the same functions under ``NUMBA_DISABLE_JIT=1``), with the two leaves
+    that read the program replaced by a Python context's own: ``_refine(c, ...)`` calls
+    ``c[0](c[1], ...)`` and ``_disc_along(c, t)`` calls ``c(t)``. Kept in the one cache."""
+    ns = CACHE.get(("plain kernel",))
+    if ns is None:
+        nb = _nb()
+        ns = dict(vars(nb))
+        for name, fn in vars(nb).items():
+            py = getattr(fn, "py_func", fn)
+            if isinstance(py, types.FunctionType) and py.__module__ == nb.__name__:
+                ns[name] = types.FunctionType(py.__code__, ns, py.__name__, py.__defaults__, py.__closure__)
+        ns["_refine"] = lambda c, *args: c[0](c[1], *args)
+        ns["_disc_along"] = lambda c, t: c(t)
+        CACHE.put(("plain kernel",), ns)
+    return ns
 
 
 def point_states(C: np.ndarray, w: np.ndarray, al: np.ndarray, idx: np.ndarray, s: np.ndarray) -> np.ndarray:
