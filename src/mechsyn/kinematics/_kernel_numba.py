@@ -81,6 +81,29 @@ def circles(dx, dy, L1, L2, F, G, Dsc):
         F[r], G[r], Dsc[r] = circle(complex(dx[r], dy[r]), L1[0 if one1 else r], L2[0 if one2 else r])
 
 
+@njit(inline="always", **_OPTIONS)
+def place(d, f, g, disc, sigma):
+    """The RRR group's middle joint from :func:`circle`'s ``f``, ``g^2`` and normalised
+    discriminant, the one implementation (the passes here, and through :func:`places` the
+    generic steps): ``B - A = d (f + i sigma g)`` in the assembly mode ``sigma`` (+1 or
+    -1), a fold within round-off (``g^2 < 0``, the discriminant above -1e-12) taken flat;
+    NaN where the circles do not meet."""
+    if g < 0.0 and disc > -1e-12:
+        g = 0.0
+    g = math.sqrt(g) if g >= 0.0 else math.nan
+    return d * complex(f, -g if sigma < 0.0 else g)
+
+
+@njit(**_OPTIONS)
+def places(dx, dy, F, G, Dsc, sig, EX, EY):
+    """:func:`place` over the rows of ``dx``, ``dy``, ``F``, ``G``, ``Dsc`` (n,) with the
+    modes ``sig`` (n,) or (1,): ``B - A`` into ``EX``, ``EY`` (n,)."""
+    one = sig.shape[0] == 1
+    for r in range(dx.shape[0]):
+        e = place(complex(dx[r], dy[r]), F[r], G[r], Dsc[r], sig[0 if one else r])
+        EX[r], EY[r] = e.real, e.imag
+
+
 @njit(**_OPTIONS)
 def batch_dyad(d, L1s, L2s, sigma, L12, shift, mode, ok, w, disc, sin_mu):
     """One RRR dyad of :func:`mechsyn.kinematics.batch.simulate_batch` on a block of
@@ -162,7 +185,6 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             _point_rows(k3, fp[s, 6], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[J3], jV[J3], jA[J3], M)
         L1s = fp[s, 0].real
         L2s = fp[s, 0].imag
-        neg = fp[s, 2].real < 0
         by_row = SG.shape[1] == M
         cbv1 = fp[s, 3]
         cbv2 = fp[s, 4]
@@ -172,12 +194,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             D[slot, r] = disc
             if not disc >= least:
                 near = True
-                if g > -1e-12 and g < 0.0:
-                    g = 0.0
-            g = math.sqrt(g) if g >= 0.0 else math.nan
-            if (SG[s, r] < 0.0) if by_row else neg:
-                g = -g
-            e1 = d * complex(f, g)
+            e1 = place(d, f, g, disc, (SG[s, r] if by_row else fp[s, 2].real))
             B = e1 + jP[J1, r]
             e2 = B - jP[J3, r]
             ce1, ce2 = e1.conjugate(), e2.conjugate()
@@ -448,12 +465,7 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg):
         f, g, disc = circle(jP[J3] - jP[J1], fp[s, 0].real, fp[s, 0].imag)
         if s == k:
             return disc
-        if not g >= 0:
-            g = 0.0 if disc > -1e-12 else math.nan
-        g = math.sqrt(g) if g >= 0.0 else math.nan
-        if sg[s] < 0:
-            g = -g
-        e1 = (jP[J3] - jP[J1]) * complex(f, g)
+        e1 = place(jP[J3] - jP[J1], f, g, disc, sg[s])
         jP[J2] = e1 + jP[J1]
         lz[b1] = e1 * fp[s, 3]
         lz[b2] = (jP[J2] - jP[J3]) * fp[s, 4]

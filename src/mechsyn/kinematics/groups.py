@@ -30,7 +30,7 @@ import numpy as np
 from mechsyn.kinematics.plane import cross, dot
 from mechsyn.kinematics.system import Con, PlanarSystem
 
-__all__ = ["Chooser", "Sigma", "Plan", "Step", "circle_circle", "decompose"]
+__all__ = ["Chooser", "Sigma", "Plan", "Step", "circle_circle", "circle_middle", "decompose"]
 
 
 #: Chooses the assembly sign of a branched group per input row from the group's
@@ -298,3 +298,26 @@ def circle_circle(dx: np.ndarray | float, dy: np.ndarray | float, L1s: np.ndarra
     if not shape:
         return float(out[0, 0]), float(out[1, 0]), float(out[2, 0])
     return tuple(out.reshape((3,) + shape))
+
+
+def circle_middle(d: np.ndarray, f: np.ndarray, g2: np.ndarray, disc: np.ndarray,
+                  sigma: np.ndarray | float) -> np.ndarray:
+    """The RRR group's middle joint on arrays: ``B - A = f d + sigma g R90 d`` (N, 2)
+    from ``d = C - A`` (N, 2) and :func:`circle_circle`'s ``f``, ``g^2`` and normalised
+    discriminant (N,) in the assembly modes ``sigma`` (a number or (N,)), by the
+    kernel's one implementation (:func:`mechsyn.kinematics._kernel_numba.place`: a fold
+    within round-off taken flat, NaN where the circles do not meet).
+
+    Examples
+    --------
+    >>> d = np.array([[4.0, 0.0]])
+    >>> f, g2, disc = circle_circle(d[:, 0], d[:, 1], 9.0, 9.0)
+    >>> circle_middle(d, f, g2, disc, -1.0).round(6).tolist()   # B = (2, -sqrt 5)
+    [[2.0, -2.236068]]
+    """
+    sig = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma, float), (1,) if np.ndim(sigma) == 0 else f.shape))
+    out = np.empty((2, d.shape[0]))
+    importlib.import_module("mechsyn.kinematics._kernel_numba").places(
+        np.ascontiguousarray(d[:, 0]), np.ascontiguousarray(d[:, 1]), *(np.ascontiguousarray(v, float)
+                                                                        for v in (f, g2, disc)), sig, *out)
+    return out.T

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechsyn.kinematics.groups import (Plan, Sigma, Step, circle_circle, cons_of, local_point, pair_line,
+from mechsyn.kinematics.groups import (Plan, Sigma, Step, circle_circle, circle_middle, cons_of, local_point, pair_line,
                                        rel_angle)
 from mechsyn.kinematics.plane import cos_sin, cross, dot, perp, rotate
 from mechsyn.kinematics.system import Con, PlanarSystem
@@ -234,9 +234,7 @@ def _step_RRR(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sigma: 
     if sigma is None or callable(sigma):
         s_file = 1.0 if cross(d[0], (S.mech.joint(J2).point - A[0]))[()] >= 0 else -1.0
         sigma = s_file if sigma is None else sigma(disc, s_file)
-    g2 = np.where((g2 < 0) & (disc > -1e-12), 0.0, g2)  # a fold within round-off
-    g = np.sqrt(np.where(g2 >= 0, g2, np.nan))
-    B = A + f[:, None] * d + (sigma * g)[:, None] * perp(d)
+    B = A + circle_middle(d, f, g2, disc, sigma)
     beta1 = np.arctan2(*(s2 - s1)[::-1])
     beta2 = np.arctan2(*(t2 - t3)[::-1])
     phi1 = np.arctan2((B - A)[:, 1], (B - A)[:, 0]) - beta1
