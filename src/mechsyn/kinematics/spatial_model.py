@@ -91,6 +91,8 @@ _EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 
 
 _I, _I1, _I2 = np.arange(3), np.array([1, 2, 0]), np.array([2, 0, 1])
+_SKEW = -_EPS.transpose(2, 0, 1).reshape(3, 9)  # ω @ _SKEW: [ω]x (ω x y = [ω]x y), flattened
+_EYE9 = np.eye(3).ravel()
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -540,20 +542,23 @@ def exp_twists(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     w, v = x[:, :3], x[:, 3:]
     th2 = (w * w).sum(axis=1)
-    th = np.sqrt(th2)
-    K = np.zeros((len(x), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
-    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
-    K2 = K @ K
-    a = np.sinc(th / np.pi)                       # sin θ / θ
-    b = 0.5 * np.sinc(th / (2 * np.pi)) ** 2      # (1 - cos θ) / θ²
-    small = th < 1e-2
-    ths = np.where(small, 1.0, th)
-    c = np.where(small, 1.0 / 6 - th2 / 120 + th2 * th2 / 5040, (ths - np.sin(ths)) / ths ** 3)
-    E = K * a[:, None, None] + K2 * b[:, None, None]
-    V = K * b[:, None, None] + K2 * c[:, None, None]
-    E[:, [0, 1, 2], [0, 1, 2]] += 1.0
-    t = v + matvec(V, v)
+    q = th2 * th2
+    # sin θ / θ, (1 - cos θ) / θ², (θ - sin θ) / θ³: their series to θ⁴ below θ = 1e-2 (the
+    # next terms under an ulp), most of a Newton walk's steps
+    a, b, c = 1 - th2 / 6 + q / 120, 0.5 - th2 / 24 + q / 720, 1.0 / 6 - th2 / 120 + q / 5040
+    small = th2 < 1e-4
+    if not small.all():
+        ths = np.sqrt(np.where(small, 1.0, th2))
+        h, s = np.sin(0.5 * ths), np.sin(ths)
+        a = np.where(small, a, s / ths)
+        b = np.where(small, b, 2 * (h / ths) ** 2)
+        c = np.where(small, c, (ths - s) / ths ** 3)
+    # E = I + a [ω]x + b [ω]x², [ω]x² = ω ωᵀ - θ² I; t = (I + b [ω]x + c [ω]x²) v
+    bw = b[:, None] * w
+    E = ((bw[:, :, None] * w[:, None, :]).reshape(-1, 9) + (a[:, None] * w) @ _SKEW
+         + (1 - b * th2)[:, None] * _EYE9).reshape(-1, 3, 3)
+    wv = _cross(w, v)
+    t = v + b[:, None] * wv + c[:, None] * _cross(w, wv)
     return E, t
 
 
