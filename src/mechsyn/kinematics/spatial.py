@@ -22,10 +22,11 @@ more equation each); it
 * takes velocities ``ξ = J⁺ b`` (``b``: the input rates on the drive rows) and accelerations
   ``ξ̇ = -J⁺ γ`` from the same Jacobian in twist form, never by differencing positions;
 * handles idle mobilities: a bar between two ball joints (a Delta's, an RSSR's rod) is no
-  unknown (one distance equation between its ends: its pose follows them with no spin from
-  the drawn one); other idle motions are the null space of ``J``, and the minimum-norm steps
-  and rates leave them at rest (the idle links keep their drawn spin, to first order). Drives that leave a motion of a joint point or
-  a named point free are refused at the start (the motion would be arbitrary);
+  unknown (one distance equation between its ends: its pose follows them, carried from row
+  to row with no spin, defined through any turn of its line); other idle motions are the
+  null space of ``J``, and the minimum-norm steps and rates leave them at rest (the idle
+  links keep their drawn spin, to first order). Drives that leave a motion of a joint point
+  or a named point free are refused at the start (the motion would be arbitrary);
 * reports, never hides: the closure residual of every row (``residual``, in units of the
   length scale), rows where the Jacobian's regular rank drops (``singular``: its ``r``-th
   singular value below ``1e-8`` of the largest; rates NaN there), singular configurations
@@ -447,7 +448,7 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
-    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid)
+    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid, ok)
     X, Xd = X.reshape(len(ok), -1, 6), Xd.reshape(len(ok), -1, 6)
     links = {}
     for i, name in enumerate(M.all_links):

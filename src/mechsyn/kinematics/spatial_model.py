@@ -29,9 +29,15 @@ prismatic pair keeps the three frame vectors of the links perpendicular as drawn
 A *bar* (a link with no other joint than two S pairs, to two other links, and no named
 point) is not an unknown: its two pairs are the one distance equation between its ends on
 those links (the exact elimination of its pose: five of its six equations fix the bar given
-its ends, the sixth is the distance; its spin about its line is an idle motion). Its pose is
-reported as the least rotation taking its drawn line to its line (:func:`bar_motion`: no spin
-from the drawn assembly), its rates as those of its ends with no spin: ``ω = d × ḋ / |d|²``.
+its ends, the sixth is the distance; its spin about its line is an idle motion). Its rates
+are those of its ends with no spin: ``ω = d × ḋ / |d|²``; its pose is carried along the sweep
+the same way (:func:`bar_motion`): from row to row by the least rotation between its lines,
+from the least rotation of its drawn line onto its line at the row nearest the drawn line.
+So the pose is defined and continuous wherever the line goes, also through the opposite of
+its drawn line (a drag-link's coupler turning fully), where the least rotation from the
+drawn line is undefined; no rule that depends on the row's line alone can be (there is no
+continuous rotation taking one line to every line: the hairy ball theorem), so the pose
+depends on the path (a bar whose line sweeps a loop comes back turned about it).
 The equations of a pair are exactly its class, so the rank of the stacked Jacobian is the
 rank method's (:mod:`mechsyn.structure.rank`), and redundant constraints only add rows:
 the solver takes least-squares, minimum-norm steps.
@@ -85,6 +91,8 @@ _EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 
 
 _I, _I1, _I2 = np.arange(3), np.array([1, 2, 0]), np.array([2, 0, 1])
+_SKEW = -_EPS.transpose(2, 0, 1).reshape(3, 9)  # ω @ _SKEW: [ω]x (ω x y = [ω]x y), flattened
+_EYE9 = np.eye(3).ravel()
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -534,20 +542,23 @@ def exp_twists(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     w, v = x[:, :3], x[:, 3:]
     th2 = (w * w).sum(axis=1)
-    th = np.sqrt(th2)
-    K = np.zeros((len(x), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -w[:, 2], w[:, 1], -w[:, 0]
-    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = w[:, 2], -w[:, 1], w[:, 0]
-    K2 = K @ K
-    a = np.sinc(th / np.pi)                       # sin θ / θ
-    b = 0.5 * np.sinc(th / (2 * np.pi)) ** 2      # (1 - cos θ) / θ²
-    small = th < 1e-2
-    ths = np.where(small, 1.0, th)
-    c = np.where(small, 1.0 / 6 - th2 / 120 + th2 * th2 / 5040, (ths - np.sin(ths)) / ths ** 3)
-    E = K * a[:, None, None] + K2 * b[:, None, None]
-    V = K * b[:, None, None] + K2 * c[:, None, None]
-    E[:, [0, 1, 2], [0, 1, 2]] += 1.0
-    t = v + matvec(V, v)
+    q = th2 * th2
+    # sin θ / θ, (1 - cos θ) / θ², (θ - sin θ) / θ³: their series to θ⁴ below θ = 1e-2 (the
+    # next terms under an ulp), most of a Newton walk's steps
+    a, b, c = 1 - th2 / 6 + q / 120, 0.5 - th2 / 24 + q / 720, 1.0 / 6 - th2 / 120 + q / 5040
+    small = th2 < 1e-4
+    if not small.all():
+        ths = np.sqrt(np.where(small, 1.0, th2))
+        h, s = np.sin(0.5 * ths), np.sin(ths)
+        a = np.where(small, a, s / ths)
+        b = np.where(small, b, 2 * (h / ths) ** 2)
+        c = np.where(small, c, (ths - s) / ths ** 3)
+    # E = I + a [ω]x + b [ω]x², [ω]x² = ω ωᵀ - θ² I; t = (I + b [ω]x + c [ω]x²) v
+    bw = b[:, None] * w
+    E = ((bw[:, :, None] * w[:, None, :]).reshape(-1, 9) + (a[:, None] * w) @ _SKEW
+         + (1 - b * th2)[:, None] * _EYE9).reshape(-1, 3, 3)
+    wv = _cross(w, v)
+    t = v + b[:, None] * wv + c[:, None] * _cross(w, wv)
     return E, t
 
 
@@ -692,15 +703,65 @@ def _line_gamma(w: np.ndarray, v: np.ndarray, ia: np.ndarray, ib: np.ndarray, xa
 
 
 # --------------------------------------------------------------------------- bars
+def _bar_frames(d0: np.ndarray, d: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """Rotations (N, bars, 3, 3) of the bars with drawn lines ``d0`` (bars, 3) along their
+    lines ``d`` (N, bars, 3) over the rows of a sweep (``ok``: the rows assembled), carried
+    along the sweep with no spin about their lines (see :func:`bar_motion`).
+
+    Each row's rotation is written ``T = C Rot(u_0, φ)``: a chart ``C`` taking the drawn unit
+    line ``u_0`` to the line ``u`` (the least rotation from ``u_0`` where ``u · u_0 ≥ 0``, else
+    a half-turn about ``e_1`` then the least rotation from ``-u_0``: both well conditioned),
+    turned first about the drawn line by the bar's spin ``φ``. Between consecutive assembled
+    rows the bar turns by the least rotation ``Q`` from one line to the next (its discrete
+    parallel transport), which adds ``δ = atan2(Q a_k · b_{k+1}, Q a_k · a_{k+1})`` to ``φ``
+    (``a``, ``b``: the chart's images of ``e_1``, ``e_2``); so ``φ`` is a cumulative sum, zero
+    at each stretch's row nearest the drawn line."""
+    u0 = d0 / np.linalg.norm(d0, axis=1)[:, None]
+    e1 = _cross(u0, np.eye(3)[np.argmin(np.abs(u0), axis=1)])  # (⟂ u_0, as _perp_basis)
+    e1 /= np.sqrt(_dot(e1, e1))[:, None]
+    e2 = _cross(u0, e1)
+    u = d / np.sqrt(_dot(d, d))[..., None]
+    c = _dot(u0, u)
+    s = np.where(c >= 0, 1.0, -1.0)[..., None]
+    h, den = s * u0 + u, (1 + np.abs(c))[..., None]
+    a = e1 - h * _dot(u, e1)[..., None] / den
+    b = s * (e2 - h * _dot(u, e2)[..., None] / den)
+    ck = _dot(u[:-1], u[1:])[..., None]
+    qa = a[:-1] - (u[:-1] + u[1:]) * _dot(u[1:], a[:-1])[..., None] / np.where(1 + ck > 1e-8, 1 + ck, np.inf)
+    link = (ok[:-1] & ok[1:])[:, None]
+    delta = np.where(link, np.arctan2(_dot(qa, b[1:]), _dot(qa, a[1:])), 0.0)
+    phi = np.concatenate([np.zeros((1, len(d0))), np.cumsum(delta, axis=0)])
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
+    cols = np.arange(len(d0))
+    for lo, hi in zip(edges[::2], edges[1::2]):  # each stretch of assembled rows from its anchor
+        phi[lo:hi] -= phi[lo + np.argmax(c[lo:hi], axis=0), cols]
+    phi[~ok] = 0.0
+    cp, sp = np.cos(phi)[..., None], np.sin(phi)[..., None]
+    A, Bv = cp * a + sp * b, cp * b - sp * a
+    return A[..., :, None] * e1[:, None, :] + Bv[..., :, None] * e2[:, None, :] + u[..., :, None] * u0[:, None, :]
+
+
 def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
-               xid: np.ndarray) -> tuple[np.ndarray, ...]:
+               xid: np.ndarray, ok: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
     """Poses ``(R, p)`` (N, links, ...) and twists ``ξ``, ``ξ̇`` (N, 6 links) of
     :attr:`SpatialModel.all_links` from those of the links solved for (the frame's pose not
-    included): each bar from its ends ``y_1``, ``y_2`` on the links it joins, turned by the
-    least rotation from its drawn line ``d_0`` to ``d = y_2 - y_1`` (Rodrigues' formula with
-    ``k = d_0 × d``: ``cos I + [k]x + k kᵀ / (1 + cos)``), moving at ``ω = d × ḋ / |d|²``,
-    ``ω̇ = d × d̈ / |d|²`` (no spin about its line) and ``v = ẏ_1 - ω × y_1``,
-    ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``."""
+    included), over the rows of a sweep in order (``ok``: the rows assembled; default all).
+    Each bar runs between its ends ``y_1``, ``y_2`` on the links it joins, on the line
+    ``d = y_2 - y_1``, moving at ``ω = d × ḋ / |d|²``, ``ω̇ = d × d̈ / |d|²`` (no spin about its
+    line: its spin is an idle motion) and ``v = ẏ_1 - ω × y_1``, ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``.
+
+    Its rotation is carried along the sweep the same way, with no spin (:func:`_bar_frames`):
+    from one assembled row to the next it turns by the least rotation between their lines,
+    and in each stretch of assembled rows the row nearest the drawn line (largest
+    ``d_0 · d``) is the least rotation from the drawn line ``d_0``. No rule that depends on
+    the line alone can do this: a rotation taking ``d_0`` to every line ``d`` continuously
+    would be a continuous section of ``SO(3) -> S²``, which does not exist (hairy ball
+    theorem); the least rotation, ``cos I + [k]x + k kᵀ / (1 + cos)`` with ``k = d_0 × d``, is
+    undefined where ``d`` is opposite ``d_0`` (a drag-link's coupler turning fully). The price
+    of continuity: the pose depends on the path, not on the row's line alone (a bar brought
+    back to its line along a loop has turned about it by the solid angle its line swept) and,
+    by the square of the step, on the rows sampled; a row not assembled (but with poses)
+    takes its chart's rotation."""
     N, n = len(R), M.n
     if not M.bars:
         return R, p, xi, xid
@@ -716,11 +777,8 @@ def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
         yd = v + _cross(w, y)
         ends.append((y, yd, vd + _cross(wd, y) + _cross(w, yd)))
     (y1, y1d, y1dd), (y2, y2d, y2dd) = ends
-    d, d0 = y2 - y1, ds.vb - ds.va
-    k, c = _cross(d0, d) / ds.c0[:, None] ** 2, _dot(d0, d) / ds.c0 ** 2
-    # ([k]x² = k kᵀ - |k|² I and |k|² = 1 - c²)
-    Rb = np.einsum("ijk,bnk->bnij", -_EPS, k) + k[..., :, None] * (k / (1 + c)[..., None])[..., None, :]
-    Rb[..., _I, _I] += c[..., None]
+    d = y2 - y1
+    Rb = _bar_frames(ds.vb - ds.va, d, np.ones(N, bool) if ok is None else np.asarray(ok, bool))
     pb = 0.5 * (y1 + y2 - rotate(Rb, ds.va + ds.vb))
     l2 = _dot(d, d)[..., None]
     w, wd = _cross(d, y2d - y1d) / l2, _cross(d, y2dd - y1dd) / l2
