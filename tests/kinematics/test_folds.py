@@ -84,7 +84,7 @@ def test_tracking_path_is_kept_and_read_only():
     """A tracking path depends on the drivers' types, the drawn and the first input values
     only: a refilled geometry takes the same (read-only) arrays; the path steps at most 1
     degree towards the first inputs moved by whole turns next to the drawn ones."""
-    from mechsyn.kinematics.tracking import tracking_path
+    from mechsyn.kinematics.sweep import tracking_path
 
     m = mechanism_from_dict(fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0))
     S = cached_plan(m, inputs=("A",)).system
@@ -192,7 +192,7 @@ def test_tracking_paths_kept_for_the_same_first_rows():
     kept with its system; any other first rows (or drawn row) take their own, each
     :func:`tracking_path`'s."""
     from mechsyn.kinematics import regular
-    from mechsyn.kinematics.tracking import tracking_path
+    from mechsyn.kinematics.sweep import tracking_path
 
     S = cached_plan(mechanism_from_dict(fourbar_dict(a=1.0, b=3.5, c=3.0, g=4.0, theta=60.0)), inputs=("A",)).system
     U = np.radians(np.arange(0.0, 361.0))[:, None]

@@ -12,7 +12,8 @@ from __future__ import annotations
 from mechsyn.kinematics.groups import Plan, Step, circle_circle, decompose
 from mechsyn.kinematics.positions import TrackedPositions, solve_positions
 from mechsyn.kinematics.chain import chain_poses, solve_all, tracked_pass
-from mechsyn.kinematics.tracking import BRANCHED, REGULAR_DISC, SINGULAR_DISC, solve_tracked, solve_tracked_rates
+from mechsyn.kinematics.sweep import REGULAR_DISC
+from mechsyn.kinematics.tracking import BRANCHED, SINGULAR_DISC, solve_tracked, solve_tracked_rates
 
 __all__ = [
     "Plan", "Step", "circle_circle", "decompose", "solve_positions", "chain_poses",

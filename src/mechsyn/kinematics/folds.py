@@ -35,7 +35,7 @@ SINGULAR_DISC = 1e-12
 _ZERO_DISC = 1e-12
 
 
-#: What an event on a connecting path (:func:`tracking_path`) says first.
+#: What an event on a connecting path (:func:`~mechsyn.kinematics.sweep.tracking_path`) says first.
 _ON_THE_WAY = "between the drawn configuration and the first input: "
 
 
@@ -166,7 +166,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, discs: dict, sigmas: list, U: 
                      paths: list, pass_rows: np.ndarray | None = None, block: np.ndarray | None = None) -> list | None:
     """:func:`fold_events` of the tracked sweeps of one regular pass (the sweep ``U`` (N,
     n_inputs), then the connecting paths ``paths`` (``(path, shift)`` of
-    :func:`tracking_path`) of the one sweep, or of the sweeps forwards from row ``split``
+    :func:`~mechsyn.kinematics.sweep.tracking_path`) of the one sweep, or of the sweeps forwards from row ``split``
     and backwards from row ``split - 1``), from the groups' normalised discriminants
     ``discs`` (step -> its values on the pass's rows), every group in its mode
     ``sigmas``: per sweep its singular rows and events along it (:func:`_sweep_events`);

@@ -19,7 +19,7 @@ equation one array operation instead of two:
 
 :func:`regular_sweep` evaluates the sweep and the connecting paths from the drawn input
 values together and gives up (None) as soon as a group's discriminant falls below
-:data:`mechsyn.kinematics.tracking.REGULAR_DISC`: no group then folds, touches a change
+:data:`mechsyn.kinematics.sweep.REGULAR_DISC`: no group then folds, touches a change
 point or reassembles, every group keeps its drawn mode and the answer is that of the
 tracked outward sweeps (tests check both agree), at the cost of one pass.
 :func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
@@ -39,7 +39,7 @@ from mechsyn.kinematics.chain import frame_driven_links
 from mechsyn.kinematics.groups import Plan, geometry_memo
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.folds import pass_fold_events
-from mechsyn.kinematics.tracking import REGULAR_DISC, regular_rows, tracking_path
+from mechsyn.kinematics.sweep import REGULAR_DISC, regular_rows, tracking_path
 
 __all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
 
@@ -179,7 +179,7 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
 
 
 def _tracking_paths(S: PlanarSystem, U: np.ndarray, split: int | None) -> list:
-    """The connecting paths (:func:`mechsyn.kinematics.tracking.tracking_path`) of the
+    """The connecting paths (:func:`mechsyn.kinematics.sweep.tracking_path`) of the
     tracked sweeps of the inputs ``U`` (forwards from row ``split``, backwards from row
     ``split - 1``, or the one sweep from row 0): the last answer is kept with ``S`` by
     the first rows' bytes (a drag or a design loop sweeps the same grid again)."""

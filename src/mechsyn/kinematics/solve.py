@@ -24,7 +24,7 @@ from mechsyn.errors import MechsynInputError, OverActuatedError
 from mechsyn.kinematics.groups import decompose
 from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
-from mechsyn.kinematics.sweep import Event, Sweep
+from mechsyn.kinematics.sweep import Event, Sweep, connecting_path
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.drives import DriveCheck, excess_drives
@@ -424,15 +424,6 @@ def _turns(S: PlanarSystem, u: np.ndarray) -> np.ndarray:
     return out
 
 
-def _newton_path(S: PlanarSystem, u0: np.ndarray, u1: np.ndarray) -> np.ndarray:
-    """Inputs strictly between the drawn values ``u0`` and ``u1``, at most 5 degrees (R) or
-    5 % of the mechanism's size (P) apart."""
-    h = np.array([np.radians(5.0) if d.type == "R" else 0.05 * S.scale for d in S.drivers])
-    n = int(min(2000, max(1, np.ceil(np.max(np.abs(u1 - u0) / h)))))
-    t = np.arange(1, n) / n
-    return u0[None, :] + t[:, None] * (u1 - u0)[None, :]
-
-
 def _extrapolate(hist: list, u: np.ndarray) -> np.ndarray:
     """Predict the configuration at ``u`` by the polynomial through the last (up to three)
     configurations of the run, in the arc length of the inputs (the smooth branch)."""
@@ -708,7 +699,9 @@ def _approach(S: PlanarSystem, q_start: np.ndarray, u_asm: np.ndarray, u_first: 
     be reached)."""
     hist = [(u_asm, q_start, _factor(S, q_start))]
     nxt = None
-    for u in list(_newton_path(S, u_asm, u_first)) + [u_first]:
+    kinds = tuple(d.type for d in S.drivers)  # the path in steps of 5 degrees (R) or 5 % of the size (P)
+    path = connecting_path(kinds, S.scale, u_asm.tolist(), u_first.tolist(), step=5.0, max_rows=2000)[1:]
+    for u in list(path) + [u_first]:
         nxt = _continue(S, hist, u)
         if nxt is None:
             break

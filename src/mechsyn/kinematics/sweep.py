@@ -12,6 +12,7 @@ reads like that dictionary (``e["kind"]``, ``e.get("input")``).
 
 from __future__ import annotations
 
+import math
 import operator
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
@@ -19,7 +20,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-__all__ = ["Sweep", "Event", "EventKind", "by_row"]
+__all__ = ["Sweep", "Event", "EventKind", "by_row", "REGULAR_DISC", "connecting_path", "regular_rows",
+           "tracking_path"]
 
 #: What an event reports.
 EventKind = Literal["dead point", "reassembled", "singular", "not assembled", "branch point", "limit"]
@@ -157,3 +159,80 @@ class Sweep:
     @property
     def n(self) -> int:
         return self.q.shape[0]
+
+
+# --------------------------------------------------------------------------- connecting paths
+#: Smallest normalised discriminant of every group over a sweep for which
+#: :func:`mechsyn.kinematics.regular.regular_sweep` answers (below it
+#: :func:`mechsyn.kinematics.tracking.solve_tracked` looks for folds and change points: its
+#: candidates are local minima under 0.05).
+REGULAR_DISC = 0.05 + 1e-9
+
+
+def turned(kinds: tuple, u0: list, first: list) -> list:
+    """The first input values ``first`` moved by whole turns (R inputs, ``kinds`` the
+    drivers' types) to the values nearest the drawn ones ``u0`` (lists of floats)."""
+    return [b - 2 * math.pi * round((b - a) / (2 * math.pi)) if kind == "R" else b
+            for a, b, kind in zip(u0, first, kinds)]
+
+
+def connecting_path(kinds: tuple, scale: float, u0: list, u1: list, step: float = 1.0,
+                    max_rows: int = 4000) -> np.ndarray:
+    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded; sequences of floats)
+    in steps of at most ``step`` degrees (R) or ``step`` % of the mechanism's size
+    ``scale`` (P), ``u0`` the first row: the way every engine reaches a sweep from the
+    drawn configuration (the tracked engines by 1-degree steps, Newton's continuation by
+    5-degree ones without the first row)."""
+    h_r, h_p = math.radians(step), step / 100 * scale
+    most = max(abs(b - a) / (h_r if kind == "R" else h_p) for a, b, kind in zip(u0, u1, kinds))
+    n = int(min(max_rows, max(1, math.ceil(most))))
+    if n == 1:  # the drawn values themselves (t = 0)
+        return np.array([u0], float)
+    t = np.arange(n) / n
+    out = np.empty((n, len(u0)))
+    for k, (a, b) in enumerate(zip(u0, u1)):  # u0 + t (u1 - u0), column by column
+        np.multiply(t, b - a, out=out[:, k])
+        out[:, k] += a
+    return out
+
+
+def _kinds(S: Any) -> tuple[tuple, float]:
+    """The drivers' types of the planar system ``S`` and the size the connecting paths' P
+    steps are measured by."""
+    kinds = tuple(d.type for d in S.drivers)
+    return kinds, (S.scale if "P" in kinds else 1.0)
+
+
+def regular_rows(S: Any, U: np.ndarray, split: int | None) -> np.ndarray:
+    """The rows ``U`` followed by the connecting paths from the drawn input values to the
+    sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
+    else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
+    kinds, scale = _kinds(S)
+    u0 = [float(d.assembled) for d in S.drivers]
+    ends = [0] if split is None else [split, split - 1]
+    return np.concatenate([U] + [connecting_path(kinds, scale, u0, turned(kinds, u0, U[e].tolist())) for e in ends])
+
+
+def tracking_path(S: Any, first: np.ndarray, u0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The connecting path from the drawn input values to a tracked sweep whose first
+    input values are ``first``, and the whole turns ``shift`` the sweep is tracked
+    shifted by (R inputs a whole number of turns from the drawn values are the same
+    configurations: the sweep is tracked next to the drawn values, so that its rows
+    follow each other); ``u0``: the drawn input values when known. Both arrays are
+    read-only: a sweep of the same first inputs from the same drawn values (a cached or
+    a refilled geometry: the path does not depend on the links) takes them again."""
+    a = tuple([float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist())
+    kinds, scale = _kinds(S)
+    b = tuple(first.tolist())
+    return S.topology.product(("tracking path", scale, a, b), lambda: _tracking_path(kinds, scale, a, b))
+
+
+def _tracking_path(kinds: tuple, scale: float, u0: tuple, first: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`tracking_path` of the drivers' types ``kinds`` (the topology's) and the
+    size ``scale``, kept as the topology's product with the numbers it depends on."""
+    shift = [b - c for b, c in zip(first, turned(kinds, u0, first))]  # the numbers of first - (first - turns)
+    path = connecting_path(kinds, scale, list(u0), [b - c for b, c in zip(first, shift)])
+    out = path, np.array(shift)
+    for x in out:
+        x.setflags(write=False)
+    return out

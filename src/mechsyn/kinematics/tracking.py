@@ -10,7 +10,6 @@ whose velocity is continuous (``change_points="keep"``) or takes the other one
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -18,62 +17,14 @@ from mechsyn.kinematics.chain import chain_poses, tracked_pass
 from mechsyn.kinematics.groups import Plan, cons_of
 from mechsyn.kinematics.positions import PoseState, TrackedPositions, pose_rows, solve_step
 from mechsyn.kinematics.folds import SINGULAR_DISC, disc_at, swept, fold_events, touch_candidates
-from mechsyn.kinematics.sweep import Event
+from mechsyn.kinematics.sweep import Event, tracking_path
 from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["BRANCHED", "REGULAR_DISC", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates", "tracking_path"]
+__all__ = ["BRANCHED", "SINGULAR_DISC", "solve_tracked", "solve_tracked_rates"]
 
 
 #: Kinds of group with two assembly modes (a sign ``sigma`` chooses one).
 BRANCHED = ("RRR", "RRP", "PRR", "RPR")
-
-
-#: The longest step of a connecting path's R inputs.
-_DEGREE = math.radians(1.0)
-
-
-def _turned(kinds: tuple, u0: list, first: list) -> list:
-    """The first input values ``first`` moved by whole turns (R inputs, ``kinds`` the
-    drivers' types) to the values nearest the drawn ones ``u0`` (lists of floats)."""
-    return [b - 2 * math.pi * round((b - a) / (2 * math.pi)) if kind == "R" else b
-            for a, b, kind in zip(u0, first, kinds)]
-
-
-def _connecting_path(kinds: tuple, scale: float, u0: list, u1: list, max_rows: int = 4000) -> np.ndarray:
-    """Inputs from the drawn values ``u0`` towards ``u1`` (excluded; lists of floats) in
-    steps of at most 1 degree (R) or 1 % of the mechanism's size ``scale`` (P)."""
-    most = max(abs(b - a) / (_DEGREE if kind == "R" else 0.01 * scale) for a, b, kind in zip(u0, u1, kinds))
-    n = int(min(max_rows, max(1, math.ceil(most))))
-    if n == 1:  # the drawn values themselves (t = 0)
-        return np.array([u0])
-    t = np.arange(n) / n
-    out = np.empty((n, len(u0)))
-    for k, (a, b) in enumerate(zip(u0, u1)):  # u0 + t (u1 - u0), column by column
-        np.multiply(t, b - a, out=out[:, k])
-        out[:, k] += a
-    return out
-
-
-def _kinds(S: PlanarSystem) -> tuple[tuple, float]:
-    """The drivers' types and the size the connecting paths' P steps are measured by."""
-    kinds = tuple(d.type for d in S.drivers)
-    return kinds, (S.scale if "P" in kinds else 1.0)
-
-
-def regular_rows(S: PlanarSystem, U: np.ndarray, split: int | None) -> np.ndarray:
-    """The rows ``U`` followed by the connecting paths from the drawn input values to the
-    sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
-    else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
-    kinds, scale = _kinds(S)
-    u0 = [float(d.assembled) for d in S.drivers]
-    ends = [0] if split is None else [split, split - 1]
-    return np.concatenate([U] + [_connecting_path(kinds, scale, u0, _turned(kinds, u0, U[e].tolist())) for e in ends])
-
-
-#: Smallest normalised discriminant of every group over a sweep for which
-#: :func:`mechsyn.kinematics.regular.regular_sweep` answers (below it :func:`solve_tracked` looks for folds and
-#: change points: its candidates are local minima under 0.05).
-REGULAR_DISC = 0.05 + 1e-9
 
 
 def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool = False) -> TrackedPositions:
@@ -177,31 +128,6 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
     U = np.atleast_2d(np.asarray(inputs, float))
     path, shift = tracking_path(S, U[0])
     return np.vstack([path, U - shift]), path.shape[0], shift
-
-
-def tracking_path(S: PlanarSystem, first: np.ndarray, u0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The connecting path from the drawn input values to a tracked sweep whose first
-    input values are ``first``, and the whole turns ``shift`` the sweep is tracked
-    shifted by (R inputs a whole number of turns from the drawn values are the same
-    configurations: the sweep is tracked next to the drawn values, so that its rows
-    follow each other); ``u0``: the drawn input values when known. Both arrays are
-    read-only: a sweep of the same first inputs from the same drawn values (a cached or
-    a refilled geometry: the path does not depend on the links) takes them again."""
-    a = tuple([float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist())
-    kinds, scale = _kinds(S)
-    b = tuple(first.tolist())
-    return S.topology.product(("tracking path", scale, a, b), lambda: _tracking_path(kinds, scale, a, b))
-
-
-def _tracking_path(kinds: tuple, scale: float, u0: tuple, first: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`tracking_path` of the drivers' types ``kinds`` (the topology's) and the
-    size ``scale``, kept as the topology's product with the numbers it depends on."""
-    shift = [b - c for b, c in zip(first, _turned(kinds, u0, first))]  # the numbers of first - (first - turns)
-    path = _connecting_path(kinds, scale, list(u0), [b - c for b, c in zip(first, shift)])
-    out = path, np.array(shift)
-    for x in out:
-        x.setflags(write=False)
-    return out
 
 
 def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
