@@ -58,10 +58,8 @@ class OneConfiguration:
         nl = len(S.links)
         self.m, self.n, self.nl = S.m, S.n, nl
         blocks: dict[str, list] = {k: [] for k in _KINDS}
-        row = 0
-        for con in S.cons:
+        for row, con in S.blocks():
             blocks[con.kind].append((row, con))
-            row += con.rows
 
         def link(i: int) -> int:  # the frame: an extra all-zero pose row
             return nl if i < 0 else i

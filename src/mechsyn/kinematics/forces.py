@@ -190,15 +190,13 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
     if len(idx):
         J[idx] = S.jacobian(q[idx])
     force, moment, effort, kinds = {}, {}, {}, {}
-    row = 0
     rows_by_joint: dict[str, list[int]] = {}
     drive_rows: dict[str, int] = {}
-    for con in S.cons:
+    for row, con in S.blocks():
         if con.role in ("drive",):
             drive_rows[con.joint] = row
         else:
             rows_by_joint.setdefault(con.joint, []).extend(range(row, row + con.rows))
-        row += con.rows
     for j in S.mech.joints:
         rows = rows_by_joint.get(j.id, [])
         a, b = (S.index(x) for x in j.links)
@@ -219,15 +217,13 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
             effort[j.id] = -lam[:, drive_rows[j.id]]
             kinds[j.id] = "moment" if j.type == "R" else "force"
     tension = {}
-    row = 0
-    for con in S.cons:
+    for row, con in S.blocks():
         if con.kind == "gear":
             _gear_tooth_force(S, con, q, force, moment)
         if con.kind == "belt":
             # the belt row's Jacobian is g (the unit run from anchor to tangent point) on the
             # pulley's link: the force there is -λ g, so the tension is λ
             tension[con.joint] = lam[:, row].copy()
-        row += con.rows
     return Reactions(force, moment, effort, kinds, indeterminate, lam, tension)
 
 

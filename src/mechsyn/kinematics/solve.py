@@ -300,12 +300,11 @@ def _reach(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> np.ndarray:
 def worst_joint(S: PlanarSystem, q: np.ndarray, u: np.ndarray) -> str:
     """The joint whose equations are furthest from holding at ``q`` with the inputs ``u``."""
     r = np.abs(S.residual(q[None], u[None])[0] / S.row_scale)
-    row, best, worst = 0, -1.0, "?"
-    for con in S.cons:
+    best, worst = -1.0, "?"
+    for row, con in S.blocks():
         v = float(r[row:row + con.rows].max())
         if v > best:
             best, worst = v, con.joint
-        row += con.rows
     return worst
 
 

@@ -45,7 +45,9 @@ References
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
+from itertools import accumulate
 from typing import Any
 
 import numpy as np
@@ -225,10 +227,8 @@ class PlanarSystem:
         if q.shape[0] == 1 and (one := _one(self)) is not None:  # Newton's one configuration
             return one.residual(q[0], u[0])[None]
         out = np.empty((q.shape[0], self.m))
-        row = 0
-        for con in self.cons:
+        for row, con in self.blocks():
             out[:, row:row + con.rows] = _residual(self, con, q, u)
-            row += con.rows
         return out
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
@@ -236,31 +236,25 @@ class PlanarSystem:
         if q.shape[0] == 1 and (one := _one(self)) is not None:
             return one.jacobian(q[0])[None]
         J = np.zeros((q.shape[0], self.m, self.n))
-        row = 0
-        for con in self.cons:
+        for row, con in self.blocks():
             _jacobian(self, con, q, J, row)
-            row += con.rows
         return J
 
     def input_matrix(self) -> np.ndarray:
         """``B`` with ``Phi_q q' = B u'`` (rows of drivers are 1 in their input column)."""
         B = np.zeros((self.m, len(self.drivers)))
-        row = 0
-        for con in self.cons:
+        for row, con in self.blocks():
             if con.driver is not None:
                 B[row, con.driver] = 1.0
-            row += con.rows
         return B
 
     def gamma(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """Velocity-dependent right-hand side of ``Phi_q q'' = gamma + B u''``."""
         out = np.zeros((q.shape[0], self.m))
-        row = 0
-        for con in self.cons:
+        for row, con in self.blocks():
             g = _gamma(self, con, q, qd)
             if g is not None:
                 out[:, row:row + con.rows] = g
-            row += con.rows
         return out
 
     def rates(self, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -279,12 +273,16 @@ class PlanarSystem:
         return qd, np.einsum("nij,nj->ni", pinv, self.gamma(q, qd))
 
     def rows_of(self, joint: str) -> list[int]:
-        rows, row = [], 0
-        for con in self.cons:
-            if con.joint == joint:
-                rows.extend(range(row, row + con.rows))
-            row += con.rows
-        return rows
+        return [r for row, con in self.blocks() if con.joint == joint for r in range(row, row + con.rows)]
+
+    def blocks(self) -> Iterator[tuple[int, Con]]:
+        """Every constraint block with its first row of ``Phi``: ``(row, con)`` in
+        ``cons`` order (the rows of a block are ``row .. row + con.rows - 1``; the first
+        rows kept in :attr:`cache`)."""
+        rows = self.cache.get("block rows")
+        if rows is None:
+            rows = self.cache["block rows"] = [0, *accumulate(c.rows for c in self.cons)]
+        return zip(rows, self.cons)
 
 
 def frame_points(frames: tuple, idx: list, xy: list) -> list:
