@@ -112,6 +112,14 @@ def decompose(S: PlanarSystem) -> Plan | None:
         a, b = joints[jid].links
         return S.index(a), S.index(b)
 
+    def other(jid: str, link: int) -> int:  # the link joint ``jid`` joins to ``link``
+        return (set(ends(jid)) - {link}).pop()
+
+    def closing(link: int, skip: str | None = None) -> list[str]:
+        """The joints of ``link`` (not used, not driven, not ``skip``) to a known link."""
+        return [j for j in link_joints.get(link, []) if j not in used and j != skip
+                and (set(ends(j)) - {link}) <= known and j not in drivers]
+
     progress = True
     while progress and len(known) < len(S.links) + 1:
         progress = False
@@ -130,29 +138,22 @@ def decompose(S: PlanarSystem) -> Plan | None:
         for b1 in range(len(S.links)):
             if b1 in known:
                 continue
-            j1s = [j for j in link_joints.get(b1, []) if j not in used and (set(ends(j)) - {b1}) <= known
-                   and j not in drivers]
+            j1s = closing(b1)
             if len(j1s) != 1:
                 continue
             J1 = j1s[0]
             for J2 in link_joints.get(b1, []):
                 if J2 in used or J2 == J1 or J2 in drivers:
                     continue
-                a2, c2 = ends(J2)
-                b2 = c2 if a2 == b1 else a2
-                if b2 in known:
-                    continue
-                j3s = [j for j in link_joints.get(b2, []) if j not in used and j != J2
-                       and (set(ends(j)) - {b2}) <= known and j not in drivers]
+                b2 = other(J2, b1)
+                j3s = [] if b2 in known else closing(b2, J2)
                 if len(j3s) != 1:
                     continue
                 J3 = j3s[0]
                 types = "".join(_jtype(S, j) for j in (J1, J2, J3))
                 if types not in ("RRR", "RRP", "PRR", "RPR", "RPP", "PPR", "PRP"):
                     continue  # PPP: not a dyad of a planar mechanism
-                k1 = (set(ends(J1)) - {b1}).pop()
-                k3 = (set(ends(J3)) - {b2}).pop()
-                steps.append(Step(types, (b1, b2), (k1, k3), (J1, J2, J3), {}))
+                steps.append(Step(types, (b1, b2), (other(J1, b1), other(J3, b2)), (J1, J2, J3), {}))
                 known.update((b1, b2))
                 used.update((J1, J2, J3))
                 progress = True
@@ -160,7 +161,7 @@ def decompose(S: PlanarSystem) -> Plan | None:
             if progress:
                 break
         if not progress:
-            progress = _double_joint_dyad(S, known, used, drivers, link_joints, ends, steps)
+            progress = _double_joint_dyad(S, known, used, drivers, link_joints, other, closing, steps)
     if len(known) < len(S.links) + 1:
         return None
     if set(j.id for j in mech.joints) - used:
@@ -168,7 +169,7 @@ def decompose(S: PlanarSystem) -> Plan | None:
     return Plan(tuple(steps))
 
 
-def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, link_joints: dict, ends,
+def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, link_joints: dict, other, closing,
                        steps: list) -> bool:
     """A dyad whose middle joint is a *double joint*: links ``b1`` and ``b2`` both pinned to
     a third link ``m`` at one point (two R pairs ``b1-m``, ``b2-m`` at the same place).
@@ -182,30 +183,26 @@ def _double_joint_dyad(S: PlanarSystem, known: set, used: set, drivers: set, lin
     for b1 in range(len(S.links)):
         if b1 in known:
             continue
-        j1s = [j for j in link_joints.get(b1, []) if j not in used and j not in drivers
-               and (set(ends(j)) - {b1}) <= known]
+        j1s = closing(b1)
         if len(j1s) != 1 or _jtype(S, j1s[0]) != "R":
             continue
         for J2a in link_joints.get(b1, []):
             if J2a in used or J2a in drivers or _jtype(S, J2a) != "R":
                 continue
-            m = (set(ends(J2a)) - {b1}).pop()
+            m = other(J2a, b1)
             if m in known:
                 continue
             for J2b in link_joints.get(m, []):
                 if J2b == J2a or J2b in used or J2b in drivers or _jtype(S, J2b) != "R":
                     continue
-                b2 = (set(ends(J2b)) - {m}).pop()
+                b2 = other(J2b, m)
                 if b2 in known or b2 == b1 or np.abs(pts[J2a] - pts[J2b]).max() > 1e-9 * S.scale:
                     continue
-                j3s = [j for j in link_joints.get(b2, []) if j not in used and j not in drivers and j != J2b
-                       and (set(ends(j)) - {b2}) <= known]
+                j3s = closing(b2, J2b)
                 if len(j3s) != 1 or _jtype(S, j3s[0]) != "R":
                     continue
                 J1, J3 = j1s[0], j3s[0]
-                k1 = (set(ends(J1)) - {b1}).pop()
-                k3 = (set(ends(J3)) - {b2}).pop()
-                steps.append(Step("RRR", (b1, b2), (k1, k3), (J1, J2a, J3), {"double": J2b}))
+                steps.append(Step("RRR", (b1, b2), (other(J1, b1), other(J3, b2)), (J1, J2a, J3), {"double": J2b}))
                 known.update((b1, b2))
                 used.update((J1, J3, J2b))
                 return True
