@@ -165,11 +165,13 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
     lam = np.full((N, S.m), np.nan)
     idx = np.flatnonzero(ok)
     indeterminate = False
+    J = np.zeros((N, S.m, S.n))
     if len(idx):
         qq = q[idx]
         Q = generalised_loads(S, qq, None if qdd is None else qdd[idx], None if qd is None else qd[idx],
                               mm, loads, np.asarray(gravity, float))
-        JT = np.transpose(S.jacobian(qq), (0, 2, 1))
+        J[idx] = Jq = S.jacobian(qq)  # (assembled once: the reactions below read its rows)
+        JT = np.transpose(Jq, (0, 2, 1))
         if S.n == S.m:
             try:
                 lam[idx] = np.linalg.solve(JT, Q[..., None])[..., 0]
@@ -177,18 +179,15 @@ def kinetostatics(S: PlanarSystem, q: np.ndarray, qd: np.ndarray | None = None, 
                 # singular positions (e.g. a flat, collinear linkage): the reactions are
                 # not determined there; they stay NaN and the position counts as singular
                 # (singular values of the dimensionless Jacobian: the same at any scale)
-                sv = np.linalg.svd(S.unit_jacobian(np.transpose(JT, (0, 2, 1))), compute_uv=False)
+                sv = np.linalg.svd(S.unit_jacobian(Jq), compute_uv=False)
                 regular = sv[:, -1] > 1e-12 * np.maximum(sv[:, 0], 1e-300)
                 if np.any(regular):
                     lam[idx[regular]] = np.linalg.solve(JT[regular], Q[regular][..., None])[..., 0]
                 ok[idx[~regular]] = False
         else:
             lam[idx] = np.einsum("nij,nj->ni", np.linalg.pinv(JT), Q)
-        sv = np.linalg.svd(S.unit_jacobian(JT[0].T), compute_uv=False)
+        sv = np.linalg.svd(S.unit_jacobian(Jq[0]), compute_uv=False)
         indeterminate = bool(np.sum(sv > 1e-9 * sv.max()) < S.m)
-    J = np.zeros((N, S.m, S.n))
-    if len(idx):
-        J[idx] = S.jacobian(q[idx])
     force, moment, effort, kinds = {}, {}, {}, {}
     rows_by_joint: dict[str, list[int]] = {}
     drive_rows: dict[str, int] = {}
