@@ -24,7 +24,7 @@ from mechsyn.errors import MechsynInputError, OverActuatedError
 from mechsyn.kinematics.groups import decompose
 from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
-from mechsyn.kinematics.sweep import Event, Sweep, connecting_path
+from mechsyn.kinematics.sweep import Event, Sweep, connecting_path, driver_kinds, turns
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.structure.drives import DriveCheck, excess_drives
@@ -351,13 +351,6 @@ def _solve_with(S: PlanarSystem, fac: tuple, rhs: np.ndarray) -> np.ndarray:
     return sla.lstsq(fac[0], rhs, check_finite=False)[0] * S.col_scale
 
 
-def _rates_from(S: PlanarSystem, q: np.ndarray, fac: tuple, X: np.ndarray,
-                speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    qd = X @ speeds
-    qdd = _solve_with(S, fac, S.gamma(q[None], qd[None])[0])
-    return qd, qdd
-
-
 def _settle(S: PlanarSystem, q: np.ndarray, u: np.ndarray, fac: tuple) -> tuple[np.ndarray, tuple]:
     """Near a singular configuration (pivot ratio below 1e-3), Newton's iterations continued
     to round-off: at a fold Newton converges only linearly, so the sweep's tolerance leaves
@@ -412,15 +405,6 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
     if qm is None:
         return None
     return _track(S, qm, um, ub, depth - 1)
-
-
-def _turns(S: PlanarSystem, u: np.ndarray) -> np.ndarray:
-    """Whole turns (as radians) between R inputs ``u`` and the file's values."""
-    out = np.zeros(len(S.drivers))
-    for k, d in enumerate(S.drivers):
-        if d.type == "R":
-            out[k] = 2 * np.pi * np.round((u[k] - d.assembled) / (2 * np.pi))
-    return out
 
 
 def _extrapolate(hist: list, u: np.ndarray) -> np.ndarray:
@@ -507,9 +491,7 @@ def _elbows(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
     mech = S.mech
 
     def glob(i: int, jid: str) -> np.ndarray:
-        s = S.to_local(S.links[i], mech.joint(jid).point)
-        c, sn = np.cos(q[3 * i + 2]), np.sin(q[3 * i + 2])
-        return q[3 * i:3 * i + 2] + np.array([c * s[0] - sn * s[1], sn * s[0] + c * s[1]])
+        return S.point(q[None], i, S.to_local(S.links[i], mech.joint(jid).point))[0]
 
     for j in mech.joints:
         if j.type != "R":
@@ -629,7 +611,8 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
         raise ValueError(f"expected {len(S.drivers)} input columns, got {k}")
     # an R input differing from the file's angle by whole turns is the same configuration:
     # start from the equivalent value nearest the file's (a full turn could cross a toggle)
-    shift = _turns(S, inputs[0])
+    kinds, _ = driver_kinds(S)
+    shift = np.array(turns(kinds, [d.assembled for d in S.drivers], inputs[0].tolist()))
     if np.any(shift):
         return _sweep_shifted(S, inputs, shift, speeds, progress, refine_limits)
     speeds = np.ones(k) if speeds is None else np.asarray(speeds, float)
@@ -698,7 +681,7 @@ def _approach(S: PlanarSystem, q_start: np.ndarray, u_asm: np.ndarray, u_first: 
     be reached)."""
     hist = [(u_asm, q_start, _factor(S, q_start))]
     nxt = None
-    kinds = tuple(d.type for d in S.drivers)  # the path in steps of 5 degrees (R) or 5 % of the size (P)
+    kinds, _ = driver_kinds(S)  # the path in steps of 5 degrees (R) or 5 % of the size (P)
     path = connecting_path(kinds, S.scale, u_asm.tolist(), u_first.tolist(), step=5.0, max_rows=2000)[1:]
     for u in list(path) + [u_first]:
         nxt = _continue(S, hist, u)
@@ -719,7 +702,8 @@ def _fill(S: PlanarSystem, out: tuple, j: int, qj: np.ndarray, f: tuple, speeds:
     q, qd, qdd, det_sign, sig = out
     q[j] = qj
     fac, X, det_sign[j], sig[j] = f
-    qd[j], qdd[j] = _rates_from(S, qj, fac, X, speeds)
+    qd[j] = X @ speeds
+    qdd[j] = _solve_with(S, fac, S.gamma(qj[None], qd[j][None])[0])
     if sig[j] < 1e-6:  # singular: the rates are not defined here
         qd[j] = qdd[j] = np.nan
 

@@ -21,7 +21,7 @@ from typing import Any, Literal
 import numpy as np
 
 __all__ = ["Sweep", "Event", "EventKind", "by_row", "REGULAR_DISC", "connecting_path", "regular_rows",
-           "tracking_path"]
+           "tracking_path", "turns", "driver_kinds"]
 
 #: What an event reports.
 EventKind = Literal["dead point", "reassembled", "singular", "not assembled", "branch point", "limit"]
@@ -169,11 +169,17 @@ class Sweep:
 REGULAR_DISC = 0.05 + 1e-9
 
 
-def turned(kinds: tuple, u0: list, first: list) -> list:
-    """The first input values ``first`` moved by whole turns (R inputs, ``kinds`` the
-    drivers' types) to the values nearest the drawn ones ``u0`` (lists of floats)."""
-    return [b - 2 * math.pi * round((b - a) / (2 * math.pi)) if kind == "R" else b
+def turns(kinds: tuple, u0: list, first: list) -> list:
+    """The whole turns (radians; 0 for a P input) between the input values ``first`` and
+    the drawn ones ``u0`` (R inputs, ``kinds`` the drivers' types; sequences of floats)."""
+    return [2 * math.pi * round((b - a) / (2 * math.pi)) if kind == "R" else 0.0
             for a, b, kind in zip(u0, first, kinds)]
+
+
+def turned(kinds: tuple, u0: list, first: list) -> list:
+    """The first input values ``first`` moved by whole turns (:func:`turns`) to the values
+    nearest the drawn ones ``u0``."""
+    return [b - t for b, t in zip(first, turns(kinds, u0, first))]
 
 
 def connecting_path(kinds: tuple, scale: float, u0: list, u1: list, step: float = 1.0,
@@ -196,7 +202,7 @@ def connecting_path(kinds: tuple, scale: float, u0: list, u1: list, step: float 
     return out
 
 
-def _kinds(S: Any) -> tuple[tuple, float]:
+def driver_kinds(S: Any) -> tuple[tuple, float]:
     """The drivers' types of the planar system ``S`` and the size the connecting paths' P
     steps are measured by."""
     kinds = tuple(d.type for d in S.drivers)
@@ -207,7 +213,7 @@ def regular_rows(S: Any, U: np.ndarray, split: int | None) -> np.ndarray:
     """The rows ``U`` followed by the connecting paths from the drawn input values to the
     sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
     else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
-    kinds, scale = _kinds(S)
+    kinds, scale = driver_kinds(S)
     u0 = [float(d.assembled) for d in S.drivers]
     ends = [0] if split is None else [split, split - 1]
     return np.concatenate([U] + [connecting_path(kinds, scale, u0, turned(kinds, u0, U[e].tolist())) for e in ends])
@@ -222,7 +228,7 @@ def tracking_path(S: Any, first: np.ndarray, u0: np.ndarray | None = None) -> tu
     read-only: a sweep of the same first inputs from the same drawn values (a cached or
     a refilled geometry: the path does not depend on the links) takes them again."""
     a = tuple([float(d.assembled) for d in S.drivers] if u0 is None else u0.tolist())
-    kinds, scale = _kinds(S)
+    kinds, scale = driver_kinds(S)
     b = tuple(first.tolist())
     return S.topology.product(("tracking path", scale, a, b), lambda: _tracking_path(kinds, scale, a, b))
 
