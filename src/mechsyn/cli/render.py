@@ -47,8 +47,8 @@ def say_rows_shown(shown: int, total: int) -> None:
 
 def _events(sim: Any) -> None:
     for e in sim.events:
-        where = ", ".join(f"{k} = {v:.6g}" for k, v in e["input"].items()) if isinstance(e.get("input"), dict) else ""
-        console.print(f"[yellow]{e['kind']}[/] {where}: {escape(e['message'])}", highlight=False)
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in e.input.items()) if isinstance(e.input, dict) else ""
+        console.print(f"[yellow]{e.kind}[/] {where}: {escape(e.message)}", highlight=False)
 
 
 def _point_tables(sim: Any, rows: list[int], head: str) -> None:

@@ -123,8 +123,8 @@ class Motion(Result):
         vals = np.asarray(self.inputs[self.main_input], float)
         ok = np.asarray(self.assembled, bool)
         n = len(vals)
-        dead = [float(e.get("input", {}).get(self.main_input)) for e in self.events
-                if e.get("kind") == "dead point" and self.main_input in (e.get("input") or {})]
+        dead = [float(e.input[self.main_input]) for e in self.events
+                if e.kind == "dead point" and self.main_input in (e.input or {})]
 
         def located(a: float, b: float, default: float) -> float:
             """The dead point between rows of values a and b (b included), else default."""
@@ -297,7 +297,7 @@ class Simulation(Motion):
                 ("assembled", f"{int(np.count_nonzero(self.assembled))} of {len(self.assembled)}"),
                 ("points", ", ".join(self.points) or "-"), ("links", ", ".join(self.links) or "-")]
         if self.events:
-            rows.append(("events", "; ".join(sorted({str(e.get("kind")) for e in self.events}))))
+            rows.append(("events", "; ".join(sorted({str(e.kind) for e in self.events}))))
         return rows
 
     def animate(self, fig: Any = None, **kwargs: Any) -> Any:

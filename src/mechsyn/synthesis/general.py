@@ -274,7 +274,7 @@ def evaluate_mechanism_design(case: MechanismCase, x: np.ndarray, fast: bool = T
         except (MechsynInputError, ValueError, np.linalg.LinAlgError) as exc:
             return MechanismEvaluation(False, f"cannot sweep: {exc}", violation=1e3)
         q, ok, method, sig = sw.q, sw.assembled, "newton", None
-        branch_viol = float(sum(1 for e in sw.events if e.get("kind") in ("branch point", "singular")))
+        branch_viol = float(sum(1 for e in sw.events if e.kind in ("branch point", "singular")))
     bad = infeasibility(int((~ok).sum()), len(grid), branch_viol, viol_order, method)
     if bad is not None:
         return bad
