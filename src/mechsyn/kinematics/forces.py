@@ -246,9 +246,7 @@ def _gear_tooth_force(S: PlanarSystem, con, q: np.ndarray, force: dict, moment: 
     Oa = S.point(q, con.c, S.to_local(c_name, axle[a_name].point))
     Ob = S.point(q, con.c, S.to_local(c_name, axle[b_name].point))
     if j.normal is not None:
-        n0 = S.to_local_dir(c_name, j.normal)
-        cc, ss = np.cos(S.pose(q, con.c)[1]), np.sin(S.pose(q, con.c)[1])
-        n = np.stack([cc * n0[0] - ss * n0[1], ss * n0[0] + cc * n0[1]], axis=1)
+        n = rotate(*S.rotation(q, con.c), S.to_local_dir(c_name, j.normal))
     else:
         d = Ob - Oa
         n = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.linalg.norm(d, axis=1)[:, None]

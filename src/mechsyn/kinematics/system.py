@@ -180,6 +180,10 @@ class PlanarSystem:
             return np.zeros((q.shape[0], 2)), z
         return q[:, 3 * i:3 * i + 2], q[:, 3 * i + 2]
 
+    def rotation(self, q: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """``cos phi, sin phi`` (N,) of link ``i`` (the frame: 1 and 0)."""
+        return cos_sin(self.pose(q, i)[1])
+
     def point(self, q: np.ndarray, i: int, s: np.ndarray) -> np.ndarray:
         r, phi = self.pose(q, i)
         c, sn = cos_sin(phi)
@@ -311,8 +315,7 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
         return (S.pose(q, con.b)[1] - S.pose(q, con.a)[1] - val)[:, None]
     if k == "line":
-        ra, pa = S.pose(q, con.a)
-        c, s = cos_sin(pa)
+        c, s = S.rotation(q, con.a)
         w = rotate(c, s, con.w)
         d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
         val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
@@ -321,8 +324,8 @@ def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.nda
         pa, pb, pc = (S.pose(q, i)[1] for i in (con.a, con.b, con.c))
         return ((pb - pc) - con.k * (pa - pc) - con.c0)[:, None]
     if k == "curve":
-        ra, pa = S.pose(q, con.a)
-        c, s = cos_sin(pa)
+        ra = S.pose(q, con.a)[0]
+        c, s = S.rotation(q, con.a)
         O = con.curve.eval(q[:, con.tvar])
         return S.point(q, con.b, con.sb) - ra - rotate(c, s, O)
     if k == "belt":
@@ -354,8 +357,7 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
         for i, s, sign in ((con.a, con.sa, 1.0), (con.b, con.sb, -1.0)):
             if i < 0:
                 continue
-            _, phi = S.pose(q, i)
-            c, sn = cos_sin(phi)
+            c, sn = S.rotation(q, i)
             _put(J, row, i, sign * eye, sign * perp(rotate(c, sn, s)))
         return
     if k == "angle":
@@ -364,8 +366,7 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
         _put(J, row, con.a, None, -one)
         return
     if k == "line":
-        ra, pa = S.pose(q, con.a)
-        c, s = cos_sin(pa)
+        c, s = S.rotation(q, con.a)
         w = rotate(c, s, con.w)
         Pa = S.point(q, con.a, con.sa)
         Pb = S.point(q, con.b, con.sb)
@@ -374,8 +375,7 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
             Asa = rotate(c, s, con.sa)
             _put(J, row, con.a, -w[:, None, :], (dot(perp(w), d) - dot(w, perp(Asa)))[:, None])
         if con.b >= 0:
-            _, pb = S.pose(q, con.b)
-            cb, sb = cos_sin(pb)
+            cb, sb = S.rotation(q, con.b)
             _put(J, row, con.b, w[:, None, :], dot(w, perp(rotate(cb, sb, con.sb)))[:, None])
         return
     if k == "gear":
@@ -386,13 +386,11 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
         return
     if k == "curve":
         eye = np.broadcast_to(np.eye(2), (N, 2, 2))
-        ra, pa = S.pose(q, con.a)
-        c, s = cos_sin(pa)
+        c, s = S.rotation(q, con.a)
         t = q[:, con.tvar]
         O, O1 = con.curve.eval(t), con.curve.eval(t, 1)
         if con.b >= 0:
-            _, pb = S.pose(q, con.b)
-            cb, sb = cos_sin(pb)
+            cb, sb = S.rotation(q, con.b)
             _put(J, row, con.b, eye, perp(rotate(cb, sb, con.sb)))
         if con.a >= 0:
             _put(J, row, con.a, -eye, -perp(rotate(c, s, O)))
@@ -403,8 +401,7 @@ def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int)
         for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
             if i < 0:
                 continue
-            _, phi = S.pose(q, i)
-            c, sn = cos_sin(phi)
+            c, sn = S.rotation(q, i)
             dphi = sign * dot(g, perp(rotate(c, sn, sl)))
             if i == con.b:
                 dphi = dphi + con.sigma * con.radius
@@ -434,20 +431,17 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         for i, s, sign in ((con.a, con.sa, 1.0), (con.b, con.sb, -1.0)):
             if i < 0:
                 continue
-            _, phi = S.pose(q, i)
-            c, sn = cos_sin(phi)
+            c, sn = S.rotation(q, i)
             w = qd[:, 3 * i + 2]
             out = out + sign * (w ** 2)[:, None] * rotate(c, sn, s)
         return np.broadcast_to(out, (q.shape[0], 2)) if np.ndim(out) else np.zeros((q.shape[0], 2))
     if k == "line":
-        _, pa = S.pose(q, con.a)
-        c, s = cos_sin(pa)
+        c, s = S.rotation(q, con.a)
         w = rotate(c, s, con.w)
         va, wa = S.pose(qd, con.a)
         vb, wb = S.pose(qd, con.b)
         Asa = rotate(c, s, con.sa)
-        _, pb = S.pose(q, con.b)
-        cb, sb = cos_sin(pb)
+        cb, sb = S.rotation(q, con.b)
         Asb = rotate(cb, sb, con.sb)
         d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
         dd = vb + wb[:, None] * perp(Asb) - va - wa[:, None] * perp(Asa)
@@ -455,10 +449,8 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
              + wb ** 2 * dot(w, Asb) - wa ** 2 * dot(w, Asa))
         return g[:, None]
     if k == "curve":
-        _, pa = S.pose(q, con.a)
-        c, s = cos_sin(pa)
-        _, pb = S.pose(q, con.b)
-        cb, sb = cos_sin(pb)
+        c, s = S.rotation(q, con.a)
+        cb, sb = S.rotation(q, con.b)
         _, wa = S.pose(qd, con.a)
         _, wb = S.pose(qd, con.b)
         t, td = q[:, con.tvar], qd[:, con.tvar]
@@ -477,8 +469,7 @@ def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarr
         for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
             if i < 0:
                 continue
-            _, phi = S.pose(q, i)
-            c, sn = cos_sin(phi)
+            c, sn = S.rotation(q, i)
             As = rotate(c, sn, sl)
             v, w = S.pose(qd, i)
             Dd = Dd + sign * (v + w[:, None] * perp(As))
