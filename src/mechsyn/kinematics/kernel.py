@@ -47,8 +47,8 @@ from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.topology import CACHE
 
-__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "hidden_fold", "link_poses", "point_states", "program",
-           "run", "scalar_disc", "scan_sweep", "trig", "warm"]
+__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "hidden_fold", "layout", "link_poses", "numbers",
+           "point_states", "program", "run", "scalar_disc", "scan_sweep", "trig", "warm"]
 
 
 def _nb() -> ModuleType:
@@ -85,25 +85,25 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     joints, drivers and signs, and which local joint points they take) depends on the
     topology only: it is the topology's product ``"regular"``
     (:meth:`~mechsyn.kinematics.topology.Topology.product`, kept in the one cache and
-    shared by every system of that topology, a refilled one too), so a refilled
-    system's steps are its numbers put in (:func:`_filled`). The same numbers are
-    written once more as the kernel's arrays (:func:`program`'s ``fp`` and
-    ``anc_s``, kept with ``S`` under ``("kernel", id(plan))``; their integers are the
-    topology's product ``"kernel"``) while they are filled in, not read back off the
-    steps."""
+    shared by every system of that topology, a refilled one too), and so are the
+    program's integers (:func:`_shape_arrays`, the product ``"kernel"``). The numbers
+    are :func:`numbers` of ``S``'s local points (the kernel's ``fp`` and ``anc_s``,
+    kept with ``S`` under ``("kernel", id(plan))``: :func:`program`); the steps are
+    read off them."""
     memo = geometry_memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
-    rows: list = []
-    out = _filled(S, S.topology.product("regular", lambda: _shape(S, plan), plan), rows)
+    shape, (ints, table) = layout(S, plan)
+    steps_, anchors, origin, li, pj = shape
+    fp, anc_s = numbers(table, [_locals(S, li, pj)], [joint_points(S)])
+    memo[("kernel", id(plan))] = (plan, (ints, fp[0], anc_s[0]))
+    rows, anc = fp[0].tolist(), anc_s[0].tolist()
+    steps = [st[:6] + (r[1],) if st[0] == "drive" else st[:4] + (r[0].real, r[0].imag, r[2].real, *r[3:])
+             for st, r in zip(steps_, rows)]
+    out = steps, {i: (jid, anc[i]) for i, (jid, _) in anchors.items()}, origin
     memo[key] = (plan, out)
-    steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
-    shape = S.topology.product("kernel", lambda: _shape_arrays(steps, anchor, origin), plan)
-    rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
-    flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
-    memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
     return out
 
 
@@ -111,24 +111,50 @@ def program(S: PlanarSystem, plan: Plan) -> tuple:
     """The regular pass's program of ``S`` as the kernel's arrays, kept with ``S``:
     :func:`_shape_arrays`' integers (the topology's) and the numbers ``fp`` (steps, 7)
     complex (a driver's sign and joint point; a group's squared lengths, assembly mode,
-    rotation vectors and known joints' local points, :func:`_filled`) and the anchors'
+    rotation vectors and known joints' local points, :func:`numbers`) and the anchors'
     local points."""
     chain_steps(S, plan)
     return geometry_memo(S)[("kernel", id(plan))][1]
 
 
+def layout(S: PlanarSystem, plan: Plan) -> tuple:
+    """The topology's products of the program: :func:`_shape` (``"regular"``) and
+    :func:`_shape_arrays` (``"kernel"``: the program's integers and the table
+    :func:`numbers` fills its numbers by), built once per topology and plan."""
+    shape = S.topology.product("regular", lambda: _shape(S, plan), plan)
+    return shape, S.topology.product("kernel", lambda: _shape_arrays(shape), plan)
+
+
+def numbers(table: tuple, loc: list | np.ndarray, pt: list | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The program's numbers ``fp`` (K, steps, 7) and ``anc_s`` (K, links) of ``K``
+    designs of one topology (:func:`mechsyn.kinematics._kernel_numba.fill`, the one
+    implementation): ``table`` the topology's (:func:`_shape_arrays`' second item),
+    ``loc`` (K, pairs) the local points of the (link, joint) pairs it names, ``pt`` (K,
+    joints) the drawn joint points in file order (complex arrays, or lists of ``(x,
+    y)``)."""
+    fi, anc_p = table
+    loc, pt = (np.ascontiguousarray(np.asarray(a, float).view(complex)[..., 0] if isinstance(a, list) else a)
+               for a in (loc, pt))
+    fp = np.empty((loc.shape[0], fi.shape[0], 7), complex)
+    anc_s = np.empty((loc.shape[0], anc_p.shape[0]), complex)
+    _nb().fill(fi, anc_p, loc, pt, fp, anc_s)
+    return fp, anc_s
+
+
 def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     """The topology of :func:`chain_steps`: its steps without numbers (a drive's links,
-    joint, driver and sign; an RRR group's known links, links and joints), each link's
-    anchor joint, origin joint, the (link, joint) pairs whose local points the numbers
-    take, as index lists (link, joint's index in the file), and the file indices of
-    every RRR group's joints (its drawn assembly mode). A link's anchor is the joint that
-    places it: a drive's joint, an RRR group's end joint on it."""
+    joint, driver and sign, the pair of its joint point; an RRR group's known links,
+    links and joints, its pairs ``s1, s2, t2, t3, k1, k3`` and the file indices of its
+    joints: its drawn assembly mode), each link's anchor (joint, pair), origin joint,
+    and the (link, joint) pairs whose local points the numbers take, as index lists
+    (link, joint's index in the file). A link's anchor is the joint that places it: a
+    drive's joint, an RRR group's end joint on it."""
     pairs: dict[tuple[int, str], int] = {}
 
     def at(i: int, jid: str) -> int:
         return pairs.setdefault((i, jid), len(pairs))
 
+    index = {j.id: k for k, j in enumerate(S.mech.joints)}
     steps, anchors = [], {}
     for step in plan.steps:
         if step.kind == "drive_R":  # the joint's local point on k (the frame: its fixed point)
@@ -139,15 +165,13 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
         steps.append(("RRR", step.known, step.links, step.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
-                      at(k1, J1), at(k3, J3)))
+                      at(k1, J1), at(k3, J3), index[J1], index[J2], index[J3]))
         anchors[b1], anchors[b2] = (J1, at(b1, J1)), (J3, at(b2, J3))
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
         origin.append(j0)
-    index = {j.id: k for k, j in enumerate(S.mech.joints)}
-    drawn = [(index[st[3][0]], index[st[3][1]], index[st[3][2]]) if st[0] == "RRR" else None for st in steps]
-    return steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs], drawn
+    return steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs]
 
 
 def _locals(S: PlanarSystem, li: list, pj: list) -> list:
@@ -158,40 +182,15 @@ def _locals(S: PlanarSystem, li: list, pj: list) -> list:
     return frame_points(S.frames(), li, [pts[k] for k in pj])
 
 
-def _filled(S: PlanarSystem, shape: tuple, rows: list) -> tuple:
-    """:func:`chain_steps` of ``S`` from its topology's shape (:func:`_shape`): the local
-    points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
-    each step's row of the kernel's ``fp``
-    (:func:`program`'s layout) appended to it, flat."""
-    steps_, anchors, origin, li, pj, drawn = shape
-    loc = _locals(S, li, pj)
-    pt = joint_points(S)
-    steps = []
-    for st, ks in zip(steps_, drawn):
-        if st[0] == "drive":
-            steps.append(st[:6] + (s_k := complex(*loc[st[6]]),))
-            rows += (st[5], s_k, 0j, 0j, 0j, 0j, 0j)
-            continue
-        _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
-        (x1, y1), (x2, y2), (x3, y3), (x4, y4) = loc[i1], loc[i2], loc[i3], loc[i4]
-        ux, uy = x2 - x1, y2 - y1  # s2 - s1 on the first link, t2 - t3 on the second
-        vx, vy = x3 - x4, y3 - y4
-        L1s, L2s = ux * ux + uy * uy, vx * vx + vy * vy
-        (ax, ay), (bx, by), (cx, cy) = pt[ks[0]], pt[ks[1]], pt[ks[2]]
-        cross = (cx - ax) * (by - ay) - (cy - ay) * (bx - ax)
-        sigma = 1.0 if cross >= 0 else -1.0
-        num = (sigma, complex(ux / L1s, -(uy / L1s)), complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]),
-               complex(*loc[k3]))
-        steps.append(("RRR", known, links, joints, L1s, L2s) + num)
-        rows += (complex(L1s, L2s), 0j) + num
-    return steps, {i: (jid, complex(*loc[k])) for i, (jid, k) in anchors.items()}, origin
-
-
-def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
+def _shape_arrays(shape: tuple) -> tuple:
     """The program's integers (they depend on the topology only): joint indices, per step
     ``ip`` (op, links, joints, which joints to place from a link's point first, the
     group's row in the discriminants), each link's anchor joint and origin joint (-1:
-    found from its anchor), the number of joints, and the steps of the RRR groups."""
+    found from its anchor), the number of joints, and the steps of the RRR groups; and
+    the table :func:`numbers` fills the numbers by (``fi``: per step the pairs and
+    joints of :func:`_shape`, a driver's sign, the op in its last column; each link's
+    anchor pair, -1: none)."""
+    steps, anchor, origin = shape[:3]
     index: dict[str, int] = {}
 
     def jx(jid: str) -> int:
@@ -199,21 +198,25 @@ def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
 
     placed: set[str] = set()
     ip = np.zeros((len(steps), 11), np.int64)
+    fi = np.zeros((len(steps), 10), np.int64)
     groups = []
     for s, st in enumerate(steps):
         if st[0] == "drive":
-            _, new, k, jid, di, _sgn = st[:6]
+            _, new, k, jid, di, sgn, pair = st
             ip[s, :6] = (0, new, k, jx(jid), di, int(k >= 0 and jid not in placed))
+            fi[s, :2] = (pair, sgn)
             placed.add(jid)
             continue
         _, (k1, k3), (b1, b2), (J1, J2, J3) = st[:4]
         ip[s] = (1, k1, k3, b1, b2, jx(J1), jx(J2), jx(J3), int(J1 not in placed), int(J3 not in placed), len(groups))
+        fi[s] = (*st[4:], 1)
         placed.update((J1, J2, J3))
         groups.append(s)
     nl = len(origin)
     anc_j = np.array([jx(anchor[i][0]) if i in anchor else -1 for i in range(nl)], np.int64)
+    anc_p = np.array([anchor[i][1] if i in anchor else -1 for i in range(nl)], np.int64)
     org_j = np.array([jx(j) if j is not None and j in placed else -1 for j in origin], np.int64)
-    return ip, anc_j, org_j, len(index), groups
+    return (ip, anc_j, org_j, len(index), groups), (fi, anc_p)
 
 
 def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0,
