@@ -4,7 +4,9 @@ same functions run as plain Python (CI measures the kernel's coverage that way).
 
 The chain's steps one after the other, each over all rows in one compiled loop (the
 step's constants held in registers, no temporaries, the joints' and links' states as
-complex arrays by row). The program is the
+complex arrays by row): the positions (:func:`_positions`, the one placement: the
+regular pass, the fold search's discriminant and the batch of designs run it), then the
+rates. The program is the
 regular pass's (:func:`mechsyn.kinematics.kernel.chain_steps`) as arrays
 (:func:`mechsyn.kinematics.kernel.program`). Step by step over all rows is 30 %
 faster than row by row over all steps (crank-rocker 24 -> 17 us, Watt six-bar 40 -> 28 us
@@ -27,13 +29,13 @@ _OPTIONS = dict(cache=True, nogil=True, error_model="numpy")
 
 
 @njit(inline="always", **_OPTIONS)
-def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M):
-    """Position, velocity, acceleration (rows ``M``) of the local point ``s`` of link
-    ``i`` (-1: the frame) from the link's anchor joint into ``outP``, ``outV``, ``outA``:
-    ``P = P_a + z (s - s_a)``, ``V = V_a + i w (P - P_a)``, ``A = A_a + (i al - w^2) (P - P_a)``."""
+def _rate_rows(i, s, anc_j, anc_s, jV, jA, lz, lw, lal, outV, outA, M):
+    """Velocity and acceleration (rows ``M``) of the local point ``s`` of link ``i`` (-1:
+    the frame) from the link's anchor joint into ``outV``, ``outA``: ``V = V_a + i w (P -
+    P_a)``, ``A = A_a + (i al - w^2) (P - P_a)`` with ``P - P_a = z (s - s_a)``
+    (:func:`_place_rows` places ``P``)."""
     if i < 0:
         for r in range(M):
-            outP[r] = s
             outV[r] = 0j
             outA[r] = 0j
         return
@@ -44,7 +46,6 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
         w = lw[i, r]
         irel = rel * 1j
         acc = irel * lal[i, r]
-        outP[r] = rel + jP[j, r]
         outV[r] = irel * w + jV[j, r]
         outA[r] = (acc - rel * (w * w)) + jA[j, r]
 
@@ -154,13 +155,16 @@ def _place_rows(i, s, anc_j, anc_s, jP, lz, out, M):
 
 
 @njit(inline="always", **_OPTIONS)
-def _positions(ip, fp, anc_j, anc_s, CS, SN, last, sg, jP, lz, D):
+def _positions(ip, fp, anc_j, anc_s, CS, SN, last, SG, jP, lz, D):
     """The program's steps ``0..last``, positions only, over the input rows whose cosines
-    and sines are ``CS``, ``SN`` (M, k): every placed joint's position ``jP`` (joints, M),
-    every placed link's rotation ``lz`` (links, M) and each RRR group's normalised
-    discriminant ``D`` (its row ``ip[s, 10]``), each group in the mode ``sg[s]`` (+1 or
-    -1), placed by :func:`circle` and :func:`place` as :func:`regular_pass` places it."""
+    and sines are ``CS``, ``SN`` (M, k), the one placement (:func:`regular_pass`,
+    :func:`scalar_disc` and :func:`batch_pass` run it): every placed joint's position
+    ``jP`` (joints, M), every placed link's rotation ``lz`` (links, M) and each RRR
+    group's normalised discriminant ``D`` (its row ``ip[s, 10]``), by :func:`circle` and
+    :func:`place`, each group in its drawn mode (``fp[s, 2]``) or, when ``SG`` (steps, M)
+    has M columns, in the mode ``SG[s, row]``."""
     M = CS.shape[0]
+    by_row = SG.shape[1] == M
     for s in range(last + 1):
         if ip[s, 0] == 0:  # a driver: link new turned by the input di from link k
             new, k, j, di = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
@@ -181,12 +185,12 @@ def _positions(ip, fp, anc_j, anc_s, CS, SN, last, sg, jP, lz, D):
             _place_rows(k1, fp[s, 5], anc_j, anc_s, jP, lz, jP[J1], M)
         if ip[s, 9]:
             _place_rows(k3, fp[s, 6], anc_j, anc_s, jP, lz, jP[J3], M)
-        L1s, L2s, sigma, cbv1, cbv2 = fp[s, 0].real, fp[s, 0].imag, sg[s], fp[s, 3], fp[s, 4]
+        L1s, L2s, cbv1, cbv2 = fp[s, 0].real, fp[s, 0].imag, fp[s, 3], fp[s, 4]
         for r in range(M):
             d = jP[J3, r] - jP[J1, r]
             f, g, disc = circle(d, L1s, L2s)
             D[slot, r] = disc
-            e1 = place(d, f, g, disc, sigma)
+            e1 = place(d, f, g, disc, SG[s, r] if by_row else fp[s, 2].real)
             B = e1 + jP[J1, r]
             jP[J2, r] = B
             lz[b1, r] = e1 * cbv1
@@ -210,13 +214,11 @@ def batch_pass(ip, fp, anc_j, anc_s, nj, CS, SN, out_l, out_s, P, ok, jump, sin_
     jP = np.empty((nj, N), np.complex128)
     lz = np.empty((nl, N), np.complex128)
     D = np.empty((ns, N))
-    sg = np.empty(ns)
+    drawn = np.empty((0, 0))
     least = sin_mu.shape[0] > 0
     for k in range(K):
         c = 0 if CS.shape[0] == 1 else k
-        for s in range(ns):
-            sg[s] = fp[k, s, 2].real
-        _positions(ip, fp[k], anc_j, anc_s[k], CS[c], SN[c], ns - 1, sg, jP, lz, D)
+        _positions(ip, fp[k], anc_j, anc_s[k], CS[c], SN[c], ns - 1, drawn, jP, lz, D)
         okk = ok[k]
         okk[:] = True
         lo = math.inf
@@ -249,13 +251,15 @@ def batch_pass(ip, fp, anc_j, anc_s, nj, CS, SN, out_l, out_s, P, ok, jump, sin_
 @njit(**_OPTIONS)
 def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z, SG):
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
-    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's); fill every link's rotation and its origin's position, velocity and
-    acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
-    (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
-    has rows (2, links, P), :func:`_planes`. Every group in its drawn mode (``fp[:,
-    2]``), or when ``SG`` (steps, M) has M columns, in the mode ``SG[step, row]`` (+1 or
-    -1: the tracked chain's signs by row). Returns True when a group's discriminant falls
-    below ``least`` (or is NaN) on some row."""
+    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's): the positions
+    (:func:`_positions`), then the rates step by step; fill every link's rotation and its
+    origin's position, velocity and acceleration ``C`` (4, links, M), its angular
+    velocity and acceleration ``W``, ``AL`` (links, M), each RRR group's normalised
+    discriminant ``D`` (groups, M) and, when ``Z`` has rows (2, links, P),
+    :func:`_planes`. Every group in its drawn mode (``fp[:, 2]``), or when ``SG`` (steps,
+    M) has M columns, in the mode ``SG[step, row]`` (+1 or -1: the tracked chain's signs
+    by row). Returns True when a group's discriminant falls below ``least`` (or is NaN)
+    on some row."""
     M = CS.shape[0]
     ns = ip.shape[0]
     nl = anc_j.shape[0]
@@ -263,50 +267,34 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
     jV = np.empty((nj, M), np.complex128)
     jA = np.empty((nj, M), np.complex128)
     lz, lw, lal = C[0], W, AL  # every link's rotation, angular velocity and acceleration, written in place
+    _positions(ip, fp, anc_j, anc_s, CS, SN, ns - 1, SG, jP, lz, D)
     near = False
+    for g in range(D.shape[0]):
+        for r in range(M):
+            if not D[g, r] >= least:
+                near = True
     for s in range(ns):
         if ip[s, 0] == 0:  # a driver: link new turned by the input di from link k
-            new, k, j, di, need = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4], ip[s, 5]
-            sgn = fp[s, 0].real
-            spd = sgn * speeds[di]
+            new, k, j, di = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
+            spd = fp[s, 0].real * speeds[di]
             if k < 0:
-                sk = fp[s, 1]
-                for r in range(M):
-                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di])
-                    lw[new, r] = spd
-                    lal[new, r] = 0.0
-                    jP[j, r] = sk
-                    jV[j, r] = 0j
-                    jA[j, r] = 0j
-            else:
-                if need:
-                    _point_rows(k, fp[s, 1], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[j], jV[j], jA[j], M)
-                for r in range(M):
-                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di]) * lz[k, r]
-                    lw[new, r] = lw[k, r] + spd
-                    lal[new, r] = lal[k, r]
+                _rate_rows(-1, 0j, anc_j, anc_s, jV, jA, lz, lw, lal, jV[j], jA[j], M)
+            elif ip[s, 5]:
+                _rate_rows(k, fp[s, 1], anc_j, anc_s, jV, jA, lz, lw, lal, jV[j], jA[j], M)
+            for r in range(M):
+                lw[new, r] = spd if k < 0 else lw[k, r] + spd
+                lal[new, r] = 0.0 if k < 0 else lal[k, r]
             continue
         # an RRR group: joints J1 (on known link k1), J3 (on k3), its links b1, b2 meet at J2
         k1, k3, b1, b2 = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
-        J1, J2, J3, slot = ip[s, 5], ip[s, 6], ip[s, 7], ip[s, 10]
+        J1, J2, J3 = ip[s, 5], ip[s, 6], ip[s, 7]
         if ip[s, 8]:
-            _point_rows(k1, fp[s, 5], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[J1], jV[J1], jA[J1], M)
+            _rate_rows(k1, fp[s, 5], anc_j, anc_s, jV, jA, lz, lw, lal, jV[J1], jA[J1], M)
         if ip[s, 9]:
-            _point_rows(k3, fp[s, 6], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[J3], jV[J3], jA[J3], M)
-        L1s = fp[s, 0].real
-        L2s = fp[s, 0].imag
-        by_row = SG.shape[1] == M
-        cbv1 = fp[s, 3]
-        cbv2 = fp[s, 4]
+            _rate_rows(k3, fp[s, 6], anc_j, anc_s, jV, jA, lz, lw, lal, jV[J3], jA[J3], M)
         for r in range(M):
-            d = jP[J3, r] - jP[J1, r]
-            f, g, disc = circle(d, L1s, L2s)
-            D[slot, r] = disc
-            if not disc >= least:
-                near = True
-            e1 = place(d, f, g, disc, (SG[s, r] if by_row else fp[s, 2].real))
-            B = e1 + jP[J1, r]
-            e2 = B - jP[J3, r]
+            B = jP[J2, r]
+            e1, e2 = B - jP[J1, r], B - jP[J3, r]
             ce1, ce2 = e1.conjugate(), e2.conjugate()
             den = 1.0 / (ce1 * e2).imag
             dv = jV[J3, r] - jV[J1, r]
@@ -317,10 +305,9 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             da -= (w2 * w2) * e2
             a1 = (da * ce2).real * den
             a2 = (da * ce1).real * den
-            lz[b1, r], lw[b1, r], lal[b1, r] = e1 * cbv1, w1, a1
-            lz[b2, r], lw[b2, r], lal[b2, r] = e2 * cbv2, w2, a2
+            lw[b1, r], lal[b1, r] = w1, a1
+            lw[b2, r], lal[b2, r] = w2, a2
             ie1 = e1 * 1j
-            jP[J2, r] = B
             jV[J2, r] = ie1 * w1 + jV[J1, r]
             jA[J2, r] = (ie1 * a1 - w1s * e1) + jA[J1, r]
     for i in range(nl):  # each link's origin: its first joint, or its point (0, 0) from its anchor
@@ -330,7 +317,8 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             C[2, i] = jV[j]
             C[3, i] = jA[j]
         else:
-            _point_rows(i, 0j, anc_j, anc_s, jP, jV, jA, lz, lw, lal, C[1, i], C[2, i], C[3, i], M)
+            _place_rows(i, 0j, anc_j, anc_s, jP, lz, C[1, i], M)
+            _rate_rows(i, 0j, anc_j, anc_s, jV, jA, lz, lw, lal, C[2, i], C[3, i], M)
     if Z.shape[1] == nl:
         _planes(lz, Z)
     return near
@@ -558,7 +546,7 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg):
     jP = np.zeros((nj, 1), np.complex128)
     lz = np.zeros((anc_j.shape[0], 1), np.complex128)
     D = np.empty((ip.shape[0], 1))
-    _positions(ip, fp, anc_j, anc_s, CS, SN, k, sg, jP, lz, D)
+    _positions(ip, fp, anc_j, anc_s, CS, SN, k, sg.reshape(-1, 1), jP, lz, D)
     return D[ip[k, 10], 0]
 
 

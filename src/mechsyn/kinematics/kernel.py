@@ -8,7 +8,11 @@ arrays); :func:`run` runs it over the input rows and returns one record: every l
 rotation and its origin's position, velocity and acceleration, the links' rates, the
 groups' normalised discriminants and whether one came near a fold. The fold scan
 (:func:`fold_scan`), the links' poses (:func:`link_poses`) and named points
-(:func:`point_states`) read that record. There is one implementation: the compiled
+(:func:`point_states`) read that record. The program's integers are the topology's
+(:func:`layout`); its numbers are filled by one compiled function for one system or
+for many designs at once (:func:`numbers`), and the batch engine
+(:func:`mechsyn.kinematics.batch.simulate_batch`) runs the same program's placement
+over many designs (positions only). There is one implementation: the compiled
 functions are plain Python functions under ``NUMBA_DISABLE_JIT=1`` (CI measures their
 line coverage that way, .ci/steps/25-kernel.sh).
 
@@ -38,6 +42,7 @@ from __future__ import annotations
 
 import importlib
 import types
+from itertools import chain
 from types import ModuleType
 
 import numpy as np
@@ -97,7 +102,9 @@ def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
         return hit[1]
     shape, (ints, table) = layout(S, plan)
     steps_, anchors, origin, li, pj = shape
-    fp, anc_s = numbers(table, [_locals(S, li, pj)], [joint_points(S)])
+    loc, pt = (np.fromiter(chain.from_iterable(a), float).view(complex)[None] for a in (_locals(S, li, pj),
+                                                                                        joint_points(S)))
+    fp, anc_s = numbers(table, loc, pt)
     memo[("kernel", id(plan))] = (plan, (ints, fp[0], anc_s[0]))
     rows, anc = fp[0].tolist(), anc_s[0].tolist()
     steps = [st[:6] + (r[1],) if st[0] == "drive" else st[:4] + (r[0].real, r[0].imag, r[2].real, *r[3:])
@@ -125,16 +132,13 @@ def layout(S: PlanarSystem, plan: Plan) -> tuple:
     return shape, S.topology.product("kernel", lambda: _shape_arrays(shape), plan)
 
 
-def numbers(table: tuple, loc: list | np.ndarray, pt: list | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def numbers(table: tuple, loc: np.ndarray, pt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The program's numbers ``fp`` (K, steps, 7) and ``anc_s`` (K, links) of ``K``
     designs of one topology (:func:`mechsyn.kinematics._kernel_numba.fill`, the one
     implementation): ``table`` the topology's (:func:`_shape_arrays`' second item),
     ``loc`` (K, pairs) the local points of the (link, joint) pairs it names, ``pt`` (K,
-    joints) the drawn joint points in file order (complex arrays, or lists of ``(x,
-    y)``)."""
+    joints) the drawn joint points in file order (complex, C-contiguous)."""
     fi, anc_p = table
-    loc, pt = (np.ascontiguousarray(np.asarray(a, float).view(complex)[..., 0] if isinstance(a, list) else a)
-               for a in (loc, pt))
     fp = np.empty((loc.shape[0], fi.shape[0], 7), complex)
     anc_s = np.empty((loc.shape[0], anc_p.shape[0]), complex)
     _nb().fill(fi, anc_p, loc, pt, fp, anc_s)
