@@ -217,7 +217,7 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     if plan is None or not plan.closed_form_rates:
         raise MechsynInputError("the mechanism is not solved by a crank and RRR dyads in closed form", source=src,
                                 field="joints", hint="the batch engine needs a dyad-decomposable mechanism; use simulate")
-    shape, ((ip, anc_j, _, nj, groups), (fi, anc_p)) = kernel.layout(S, plan)
+    *_, pj, (ip, anc_j, _, nj, groups), (fi, anc_p) = kernel.layout(S, plan)
     points = list(mech.points) or [j.id for j in mech.joints] if points is None else list(points)
     for p in points:
         if p not in index:
@@ -230,7 +230,7 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     p0 = np.asarray(cj[0].point, float)
     size = float(np.ptp(np.array([j.point for j in mech.joints], float), axis=0).max())
     other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12 * size), None)
-    prog = (ip, anc_j, nj, fi, anc_p, np.array(shape[4], np.int64), groups, np.array(on, np.int64),
+    prog = (ip, anc_j, nj, fi, anc_p, np.array(pj, np.int64), groups, np.array(on, np.int64),
             np.array([index[p] for p in points], np.int64))
     dyads = tuple(plan.steps[k].joints for k in groups)
     return BatchPlan(names=names, program=prog, outputs=tuple(points), input_joint=drv.id,
