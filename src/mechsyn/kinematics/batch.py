@@ -289,7 +289,7 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     transmission : bool
         Also give the minimum transmission angle of each design (degrees).
     flags : bool
-        Compute the ``branch_jump`` flags (a few extra array passes).
+        Compute the ``branch_jump`` flags (one more loop over each group's rows).
 
     Returns
     -------
