@@ -26,6 +26,7 @@ from mechsyn.kinematics.groups import COINCIDENT
 #: rules (a division by zero gives inf, a square root of a negative number NaN, as
 #: NumPy's), the GIL released (the studio's threads).
 _OPTIONS = dict(cache=True, nogil=True, error_model="numpy")
+_ALL = np.zeros(0, np.int8)  # (_positions: every rotation and joint written)
 
 
 @njit(inline="always", **_OPTIONS)
@@ -155,29 +156,36 @@ def _place_rows(i, s, anc_j, anc_s, jP, lz, out, M):
 
 
 @njit(inline="always", **_OPTIONS)
-def _positions(ip, fp, anc_j, anc_s, CS, SN, last, SG, jP, lz, D):
+def _kept(keep, x):
+    """Whether :func:`_positions` writes the rotation or joint ``x`` (``keep`` empty: all)."""
+    return keep.shape[0] == 0 or keep[x] != 0
+
+
+@njit(inline="always", **_OPTIONS)
+def _positions(ip, fp, anc_j, anc_s, CS, SN, last, SG, jP, lz, D, keep):
     """The program's steps ``0..last``, positions only, over the input rows whose cosines
     and sines are ``CS``, ``SN`` (M, k), the one placement (:func:`regular_pass`,
     :func:`scalar_disc` and :func:`batch_pass` run it): every placed joint's position
     ``jP`` (joints, M), every placed link's rotation ``lz`` (links, M) and each RRR
     group's normalised discriminant ``D`` (its row ``ip[s, 10]``), by :func:`circle` and
     :func:`place`, each group in its drawn mode (``fp[s, 2]``) or, when ``SG`` (steps, M)
-    has M columns, in the mode ``SG[s, row]``."""
+    has M columns, in the mode ``SG[s, row]``. ``keep`` (links + joints) 0 / 1: the
+    rotations and joints written (a joint an end of a group reads is always written),
+    empty: all (the batch keeps only what its outputs need: a store per row and link or
+    joint is a fifth of its time)."""
     M = CS.shape[0]
+    nl = anc_j.shape[0]
     by_row = SG.shape[1] == M
     for s in range(last + 1):
         if ip[s, 0] == 0:  # a driver: link new turned by the input di from link k
             new, k, j, di = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
             sgn = fp[s, 0].real
-            if k < 0:
-                _place_rows(-1, fp[s, 1], anc_j, anc_s, jP, lz, jP[j], M)
+            if (k < 0 or ip[s, 5]) and _kept(keep, nl + j):
+                _place_rows(k, fp[s, 1], anc_j, anc_s, jP, lz, jP[j], M)
+            if _kept(keep, new):
                 for r in range(M):
-                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di])
-            else:
-                if ip[s, 5]:
-                    _place_rows(k, fp[s, 1], anc_j, anc_s, jP, lz, jP[j], M)
-                for r in range(M):
-                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di]) * lz[k, r]
+                    z = complex(CS[r, di], sgn * SN[r, di])
+                    lz[new, r] = z if k < 0 else z * lz[k, r]
             continue
         k1, k3, b1, b2 = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
         J1, J2, J3, slot = ip[s, 5], ip[s, 6], ip[s, 7], ip[s, 10]
@@ -186,23 +194,27 @@ def _positions(ip, fp, anc_j, anc_s, CS, SN, last, SG, jP, lz, D):
         if ip[s, 9]:
             _place_rows(k3, fp[s, 6], anc_j, anc_s, jP, lz, jP[J3], M)
         L1s, L2s, cbv1, cbv2 = fp[s, 0].real, fp[s, 0].imag, fp[s, 3], fp[s, 4]
+        k1, k2, kj = _kept(keep, b1), _kept(keep, b2), _kept(keep, nl + J2)
         for r in range(M):
             d = jP[J3, r] - jP[J1, r]
             f, g, disc = circle(d, L1s, L2s)
             D[slot, r] = disc
             e1 = place(d, f, g, disc, SG[s, r] if by_row else fp[s, 2].real)
             B = e1 + jP[J1, r]
-            jP[J2, r] = B
-            lz[b1, r] = e1 * cbv1
-            lz[b2, r] = (B - jP[J3, r]) * cbv2
+            if kj:
+                jP[J2, r] = B
+            if k1:
+                lz[b1, r] = e1 * cbv1
+            if k2:
+                lz[b2, r] = (B - jP[J3, r]) * cbv2
 
 
 @njit(**_OPTIONS)
-def batch_pass(ip, fp, anc_j, anc_s, nj, CS, SN, out_l, out_s, P, ok, jump, sin_mu, flags):
+def batch_pass(ip, fp, anc_j, anc_s, nj, keep, CS, SN, out_l, out_s, P, ok, jump, sin_mu, flags):
     """The program over ``K`` designs (its numbers ``fp`` (K, steps, 7), ``anc_s`` (K,
     links), :func:`fill`) times the input rows whose cosines and sines are ``CS``, ``SN``
     (1 or K, N, 1): per design the positions of the steps (:func:`_positions`, every
-    group in its drawn mode), then the rows where every group assembles (discriminant
+    group in its drawn mode, the rotations and joints ``keep`` names), then the rows where every group assembles (discriminant
     >= 0) into ``ok`` (K, N), the positions of the points ``out_s`` (K, m) on the links
     ``out_l`` (m,) into ``P`` (m, K, N), NaN where not assembled; with ``flags`` a
     group's discriminant with a positive local minimum whose parabola through its two
@@ -218,7 +230,7 @@ def batch_pass(ip, fp, anc_j, anc_s, nj, CS, SN, out_l, out_s, P, ok, jump, sin_
     least = sin_mu.shape[0] > 0
     for k in range(K):
         c = 0 if CS.shape[0] == 1 else k
-        _positions(ip, fp[k], anc_j, anc_s[k], CS[c], SN[c], ns - 1, drawn, jP, lz, D)
+        _positions(ip, fp[k], anc_j, anc_s[k], CS[c], SN[c], ns - 1, drawn, jP, lz, D, keep)
         okk = ok[k]
         okk[:] = True
         lo = math.inf
@@ -267,7 +279,7 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
     jV = np.empty((nj, M), np.complex128)
     jA = np.empty((nj, M), np.complex128)
     lz, lw, lal = C[0], W, AL  # every link's rotation, angular velocity and acceleration, written in place
-    _positions(ip, fp, anc_j, anc_s, CS, SN, ns - 1, SG, jP, lz, D)
+    _positions(ip, fp, anc_j, anc_s, CS, SN, ns - 1, SG, jP, lz, D, _ALL)
     near = False
     for g in range(D.shape[0]):
         for r in range(M):
@@ -546,7 +558,7 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg):
     jP = np.zeros((nj, 1), np.complex128)
     lz = np.zeros((anc_j.shape[0], 1), np.complex128)
     D = np.empty((ip.shape[0], 1))
-    _positions(ip, fp, anc_j, anc_s, CS, SN, k, sg.reshape(-1, 1), jP, lz, D)
+    _positions(ip, fp, anc_j, anc_s, CS, SN, k, sg.reshape(-1, 1), jP, lz, D, _ALL)
     return D[ip[k, 10], 0]
 
 

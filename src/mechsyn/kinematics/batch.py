@@ -230,8 +230,15 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     p0 = np.asarray(cj[0].point, float)
     size = float(np.ptp(np.array([j.point for j in mech.joints], float), axis=0).max())
     other = next((j for j in cj[1:] if np.linalg.norm(np.asarray(j.point, float) - p0) > 1e-12 * size), None)
+    # what the outputs need: their links, the links later joints are placed from, those links' anchors and
+    # every group's end joints (the rest is not written)
+    links = sorted(({*on} | {st[2] for st in ip if st[0] == 0} | {st[1] for st in ip if st[0] and st[8]}
+                    | {st[2] for st in ip if st[0] and st[9]}) - {-1})
+    keep = np.zeros(len(anc_j) + nj, np.int8)
+    keep[links] = 1
+    keep[len(anc_j) + np.r_[anc_j[links], ip[groups][:, [5, 7]].ravel()].astype(int)] = 1
     prog = (ip, anc_j, nj, fi, anc_p, np.array(pj, np.int64), groups, np.array(on, np.int64),
-            np.array([index[p] for p in points], np.int64))
+            np.array([index[p] for p in points], np.int64), keep)
     dyads = tuple(plan.steps[k].joints for k in groups)
     return BatchPlan(names=names, program=prog, outputs=tuple(points), input_joint=drv.id,
                      input_sign=1.0 if drv.links[0] == mech.ground else -1.0, n_dyads=len(dyads),
@@ -307,7 +314,7 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     K, N = len(X), u.shape[-1]
     if u.ndim == 2 and u.shape[0] != K:
         raise MechsynInputError(f"inputs have {u.shape[0]} rows for {K} designs", source="inputs")
-    ip, anc_j, nj, fi, anc_p, pairs, groups, out_l, out_p = plan.program
+    ip, anc_j, nj, fi, anc_p, pairs, groups, out_l, out_p, keep = plan.program
     P = np.empty((len(out_l), K, N), complex)
     ok, jump = np.empty((K, N), bool), np.zeros(K, bool)
     sin_mu = np.full(K, np.inf) if transmission else _NONE
@@ -316,7 +323,7 @@ def simulate_batch(plan: BatchPlan, designs: np.ndarray, inputs: np.ndarray,
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         fp, anc_s = kernel.numbers((fi, anc_p), X[:, pairs], X)
         importlib.import_module("mechsyn.kinematics._kernel_numba").batch_pass(
-            ip, fp, anc_j, anc_s, nj, CS, SN, out_l, X[:, out_p], P, ok, jump, sin_mu, flags and N >= 3)
+            ip, fp, anc_j, anc_s, nj, keep, CS, SN, out_l, X[:, out_p], P, ok, jump, sin_mu, flags and N >= 3)
     mu = None
     if transmission:
         mu = np.degrees(np.arcsin(np.clip(np.where(np.isfinite(sin_mu), sin_mu, np.nan), 0, 1)))
