@@ -38,11 +38,12 @@ designs at once by the kernel's one fill (:func:`mechsyn.kinematics.kernel.numbe
 in each design's reference frame: a link's local points are its points' reference
 coordinates, so its rotation is 1 at offset 0 and the crank turns by the offset itself.
 One compiled pass (:func:`mechsyn.kinematics._kernel_numba.batch_pass`) then runs the
-program's ops design by design over the input rows, positions only (the regular pass's
-placement, :func:`mechsyn.kinematics._kernel_numba._positions`; one design's rows stay
-in the processor's cache), and from the same pass's discriminants and joints the
-assembled rows, the flags, the transmission angle and the named output points (NaN
-where the mechanism is not assembled).
+program's ops design by design over the input rows, positions only (the regular
+pass's placement, :func:`mechsyn.kinematics._kernel_numba._positions`), writing only
+the link rotations and joints the outputs need (``keep``, found once by
+:func:`compile_plan`: a store per row is a fifth of the pass), and from the same pass's
+discriminants and joints the assembled rows, the flags, the transmission angle and the
+named output points (NaN where the mechanism is not assembled).
 
 Examples
 --------
