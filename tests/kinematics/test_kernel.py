@@ -252,14 +252,14 @@ def test_the_kernels_poses_blank_the_fold_scans_singular_rows(name, around):
 
 
 @pytest.mark.parametrize("name", ["fourbar", "watt_sixbar"])
-def test_the_batch_dyads_are_the_kernels_circle(name):
-    """The batch engine places its dyads by the kernel's circle intersection
-    (``batch_dyad``): over a sweep through dead points, its assembled rows are the rows
+def test_the_batch_runs_the_kernels_program(name):
+    """The batch engine runs the regular pass's program (``batch_pass``, the kernel's
+    circle intersection): over a sweep through dead points, its assembled rows are the rows
     where every group of the regular pass's program assembles, and its least
     transmission angle the least ``|sin|`` of the angle between each group's links over
     those rows, read off its joints (rows where a group's discriminant is within 1e-12
-    of zero may go either way: the batch places the crank by its own arithmetic, whose
-    last bits differ)."""
+    of zero may go either way: the batch turns the crank from its drawn configuration,
+    the regular pass from its frame, and the last bits differ)."""
     from mechsyn.kinematics.batch import compile_plan as batch_plan, simulate_batch
 
     m = ms.examples.load(name)

@@ -4,7 +4,9 @@ same functions run as plain Python (CI measures the kernel's coverage that way).
 
 The chain's steps one after the other, each over all rows in one compiled loop (the
 step's constants held in registers, no temporaries, the joints' and links' states as
-complex arrays by row). The program is the
+complex arrays by row): the positions (:func:`_positions`, the one placement: the
+regular pass, the fold search's discriminant and the batch of designs run it), then the
+rates. The program is the
 regular pass's (:func:`mechsyn.kinematics.kernel.chain_steps`) as arrays
 (:func:`mechsyn.kinematics.kernel.program`). Step by step over all rows is 30 %
 faster than row by row over all steps (crank-rocker 24 -> 17 us, Watt six-bar 40 -> 28 us
@@ -24,16 +26,17 @@ from mechsyn.kinematics.groups import COINCIDENT
 #: rules (a division by zero gives inf, a square root of a negative number NaN, as
 #: NumPy's), the GIL released (the studio's threads).
 _OPTIONS = dict(cache=True, nogil=True, error_model="numpy")
+_ALL = np.zeros(0, np.int8)  # (_positions: every rotation and joint written)
 
 
 @njit(inline="always", **_OPTIONS)
-def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M):
-    """Position, velocity, acceleration (rows ``M``) of the local point ``s`` of link
-    ``i`` (-1: the frame) from the link's anchor joint into ``outP``, ``outV``, ``outA``:
-    ``P = P_a + z (s - s_a)``, ``V = V_a + i w (P - P_a)``, ``A = A_a + (i al - w^2) (P - P_a)``."""
+def _rate_rows(i, s, anc_j, anc_s, jV, jA, lz, lw, lal, outV, outA, M):
+    """Velocity and acceleration (rows ``M``) of the local point ``s`` of link ``i`` (-1:
+    the frame) from the link's anchor joint into ``outV``, ``outA``: ``V = V_a + i w (P -
+    P_a)``, ``A = A_a + (i al - w^2) (P - P_a)`` with ``P - P_a = z (s - s_a)``
+    (:func:`_place_rows` places ``P``)."""
     if i < 0:
         for r in range(M):
-            outP[r] = s
             outV[r] = 0j
             outA[r] = 0j
         return
@@ -44,7 +47,6 @@ def _point_rows(i, s, anc_j, anc_s, jP, jV, jA, lz, lw, lal, outP, outV, outA, M
         w = lw[i, r]
         irel = rel * 1j
         acc = irel * lal[i, r]
-        outP[r] = rel + jP[j, r]
         outV[r] = irel * w + jV[j, r]
         outA[r] = (acc - rel * (w * w)) + jA[j, r]
 
@@ -105,47 +107,171 @@ def places(dx, dy, F, G, Dsc, sig, EX, EY):
 
 
 @njit(**_OPTIONS)
-def batch_dyad(d, L1s, L2s, sigma, L12, shift, mode, ok, w, disc, sin_mu):
-    """One RRR dyad of :func:`mechsyn.kinematics.batch.simulate_batch` on a block of
-    designs (rows of ``d`` = C - A, (n, N) complex; per design the squared lengths
-    ``L1s``, ``L2s``, the assembly mode ``sigma`` and ``L12 = L1 L2``, (n,)): by
-    :func:`circle`, ``w = f + i sigma g`` (``w - 1`` when ``shift``; NaN where the dyad
-    does not assemble) into ``w``, the normalised discriminant into ``disc`` (when it
-    has rows) and the rows assembled (``g^2 >= 0``) into ``ok`` (``mode`` 1: written, 2: and-ed, 0: left);
-    with ``sin_mu`` (n,) (else empty) the least ``sin mu = |d|^2 g / (L1 L2)`` of each
-    design's assembled rows kept in it."""
-    n, N = d.shape
-    least, discs = sin_mu.shape[0] > 0, disc.shape[0] > 0
-    for k in range(n):
-        L1, L2, s, lo = L1s[k], L2s[k], sigma[k], math.inf
-        for r in range(N):
-            z = d[k, r]
-            f, g, dc = circle(z, L1, L2)
-            if discs:
-                disc[k, r] = dc
-            good = g >= 0.0
-            if mode == 1:
-                ok[k, r] = good
-            elif mode == 2:
-                ok[k, r] = ok[k, r] and good
-            beta = math.sqrt(g) if good else math.nan
-            w[k, r] = complex(f - shift, s * beta)
-            if least and good:
-                lo = min(lo, (z.real * z.real + z.imag * z.imag) * beta / L12[k])
+def fill(fi, anc_p, loc, pt, fp, anc_s):
+    """The numbers of the program of ``K`` designs of one topology, the one
+    implementation (:func:`mechsyn.kinematics.kernel.chain_steps` fills one system's,
+    :func:`mechsyn.kinematics.batch.simulate_batch` many designs'): from the local
+    points ``loc`` (K, pairs) complex of the (link, joint) pairs ``fi`` names and the
+    drawn joint points ``pt`` (K, joints) complex, each step's row of ``fp`` (K, steps,
+    7): a driver's sign and its joint's point on the known link; an RRR group's squared
+    lengths ``L1^2 + i L2^2``, its drawn assembly mode (the sign of ``(C - A) x (B -
+    A)``), its links' rotation vectors ``conj(u) / |u|^2`` (``u`` the link's vector from
+    its end joint to the middle joint, in its local points) and its known joints' local
+    points; and every link's anchor point ``anc_s`` (K, links) (0 without an anchor).
+    ``fi`` (steps, 10): a driver's pair and sign; a group's pairs ``s1, s2`` (first
+    link), ``t2, t3`` (second link), ``k1, k3`` (its end joints on the known links) and
+    its three joints' indices in ``pt``; the step's op (0 a driver, 1 a group) last."""
+    for k in range(loc.shape[0]):
+        lk, pk = loc[k], pt[k]
+        for s in range(fi.shape[0]):
+            row = fp[k, s]
+            row[:] = 0j
+            if fi[s, 9] == 0:
+                row[0], row[1] = float(fi[s, 1]), lk[fi[s, 0]]
+                continue
+            u, v = lk[fi[s, 1]] - lk[fi[s, 0]], lk[fi[s, 2]] - lk[fi[s, 3]]
+            L1s = u.real * u.real + u.imag * u.imag
+            L2s = v.real * v.real + v.imag * v.imag
+            a, b, c = pk[fi[s, 6]], pk[fi[s, 7]], pk[fi[s, 8]]
+            cross = (c.real - a.real) * (b.imag - a.imag) - (c.imag - a.imag) * (b.real - a.real)
+            row[0], row[2] = complex(L1s, L2s), 1.0 if cross >= 0 else -1.0
+            row[3], row[4] = complex(u.real / L1s, -(u.imag / L1s)), complex(v.real / L2s, -(v.imag / L2s))
+            row[5], row[6] = lk[fi[s, 4]], lk[fi[s, 5]]
+        for i in range(anc_p.shape[0]):
+            anc_s[k, i] = lk[anc_p[i]] if anc_p[i] >= 0 else 0j
+
+
+@njit(inline="always", **_OPTIONS)
+def _place_rows(i, s, anc_j, anc_s, jP, lz, out, M):
+    """Position (rows ``M``) of the local point ``s`` of link ``i`` (-1: the frame) from
+    the link's anchor joint into ``out``: ``P = P_a + z (s - s_a)``."""
+    if i < 0:
+        for r in range(M):
+            out[r] = s
+        return
+    j = anc_j[i]
+    sa = s - anc_s[i]
+    for r in range(M):
+        out[r] = lz[i, r] * sa + jP[j, r]
+
+
+@njit(inline="always", **_OPTIONS)
+def _kept(keep, x):
+    """Whether :func:`_positions` writes the rotation or joint ``x`` (``keep`` empty: all)."""
+    return keep.shape[0] == 0 or keep[x] != 0
+
+
+@njit(inline="always", **_OPTIONS)
+def _positions(ip, fp, anc_j, anc_s, CS, SN, last, SG, jP, lz, D, keep):
+    """The program's steps ``0..last``, positions only, over the input rows whose cosines
+    and sines are ``CS``, ``SN`` (M, k), the one placement (:func:`regular_pass`,
+    :func:`scalar_disc` and :func:`batch_pass` run it): every placed joint's position
+    ``jP`` (joints, M), every placed link's rotation ``lz`` (links, M) and each RRR
+    group's normalised discriminant ``D`` (its row ``ip[s, 10]``), by :func:`circle` and
+    :func:`place`, each group in its drawn mode (``fp[s, 2]``) or, when ``SG`` (steps, M)
+    has M columns, in the mode ``SG[s, row]``. ``keep`` (links + joints) 0 / 1: the
+    rotations and joints written (a joint an end of a group reads is always written),
+    empty: all (the batch keeps only what its outputs need: a store per row and link or
+    joint is a fifth of its time)."""
+    M = CS.shape[0]
+    nl = anc_j.shape[0]
+    by_row = SG.shape[1] == M
+    for s in range(last + 1):
+        if ip[s, 0] == 0:  # a driver: link new turned by the input di from link k
+            new, k, j, di = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
+            sgn = fp[s, 0].real
+            if (k < 0 or ip[s, 5]) and _kept(keep, nl + j):
+                _place_rows(k, fp[s, 1], anc_j, anc_s, jP, lz, jP[j], M)
+            if _kept(keep, new):
+                for r in range(M):
+                    z = complex(CS[r, di], sgn * SN[r, di])
+                    lz[new, r] = z if k < 0 else z * lz[k, r]
+            continue
+        k1, k3, b1, b2 = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
+        J1, J2, J3, slot = ip[s, 5], ip[s, 6], ip[s, 7], ip[s, 10]
+        if ip[s, 8]:
+            _place_rows(k1, fp[s, 5], anc_j, anc_s, jP, lz, jP[J1], M)
+        if ip[s, 9]:
+            _place_rows(k3, fp[s, 6], anc_j, anc_s, jP, lz, jP[J3], M)
+        L1s, L2s, cbv1, cbv2 = fp[s, 0].real, fp[s, 0].imag, fp[s, 3], fp[s, 4]
+        k1, k2, kj = _kept(keep, b1), _kept(keep, b2), _kept(keep, nl + J2)
+        for r in range(M):
+            d = jP[J3, r] - jP[J1, r]
+            f, g, disc = circle(d, L1s, L2s)
+            D[slot, r] = disc
+            e1 = place(d, f, g, disc, SG[s, r] if by_row else fp[s, 2].real)
+            B = e1 + jP[J1, r]
+            if kj:
+                jP[J2, r] = B
+            if k1:
+                lz[b1, r] = e1 * cbv1
+            if k2:
+                lz[b2, r] = (B - jP[J3, r]) * cbv2
+
+
+@njit(**_OPTIONS)
+def batch_pass(ip, fp, anc_j, anc_s, nj, keep, CS, SN, out_l, out_s, P, ok, jump, sin_mu, flags):
+    """The program over ``K`` designs (its numbers ``fp`` (K, steps, 7), ``anc_s`` (K,
+    links), :func:`fill`) times the input rows whose cosines and sines are ``CS``, ``SN``
+    (1 or K, N, 1): per design the positions of the steps (:func:`_positions`, every
+    group in its drawn mode, the rotations and joints ``keep`` names), then the rows where every group assembles (discriminant
+    >= 0) into ``ok`` (K, N), the positions of the points ``out_s`` (K, m) on the links
+    ``out_l`` (m,) into ``P`` (m, K, N), NaN where not assembled; with ``flags`` a
+    group's discriminant with a positive local minimum whose parabola through its two
+    neighbours dips below zero (a fold stepped over between rows) into ``jump`` (K,);
+    when ``sin_mu`` (K,) has rows, the least ``sin mu = |d| sqrt(disc) / L2`` (the
+    transmission angle at the middle joint) of each group's assembled rows."""
+    K, ns, nl = fp.shape[0], ip.shape[0], anc_j.shape[0]
+    N = CS.shape[1]
+    jP = np.empty((nj, N), np.complex128)
+    lz = np.empty((nl, N), np.complex128)
+    D = np.empty((ns, N))
+    drawn = np.empty((0, 0))
+    least = sin_mu.shape[0] > 0
+    for k in range(K):
+        c = 0 if CS.shape[0] == 1 else k
+        _positions(ip, fp[k], anc_j, anc_s[k], CS[c], SN[c], ns - 1, drawn, jP, lz, D, keep)
+        okk = ok[k]
+        okk[:] = True
+        lo = math.inf
+        for s in range(ns):
+            if ip[s, 0] == 0:
+                continue
+            Dg, J1, J3, L2s = D[ip[s, 10]], ip[s, 5], ip[s, 7], fp[k, s, 0].imag
+            for r in range(N):
+                x = Dg[r]
+                if not x >= 0.0:
+                    okk[r] = False
+                elif least:
+                    d = jP[J3, r] - jP[J1, r]
+                    lo = min(lo, math.sqrt(x * (d.real * d.real + d.imag * d.imag) / L2s))
+            for r in range(1, N - 1 if flags else 1):
+                a, m, b = Dg[r - 1], Dg[r], Dg[r + 1]
+                curv = b - 2 * m + a
+                if 0.0 < m <= a and m <= b and curv > 0 and m - (b - a) ** 2 / (8 * curv) < 0:
+                    jump[k] = True
         if least:
-            sin_mu[k] = min(sin_mu[k], lo)
+            sin_mu[k] = lo
+        for q in range(out_l.shape[0]):
+            out = P[q, k]
+            _place_rows(out_l[q], out_s[k, q], anc_j, anc_s[k], jP, lz, out, N)
+            for r in range(N):
+                if not okk[r]:
+                    out[r] = complex(math.nan, math.nan)
 
 
 @njit(**_OPTIONS)
 def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, AL, D, Z, SG):
     """Run the program (``ip`` int (steps, 11), ``fp`` complex (steps, 7)) over the input
-    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's); fill every link's rotation and its origin's position, velocity and
-    acceleration ``C`` (4, links, M), its angular velocity and acceleration ``W``, ``AL``
-    (links, M), each RRR group's normalised discriminant ``D`` (groups, M) and, when ``Z``
-    has rows (2, links, P), :func:`_planes`. Every group in its drawn mode (``fp[:,
-    2]``), or when ``SG`` (steps, M) has M columns, in the mode ``SG[step, row]`` (+1 or
-    -1: the tracked chain's signs by row). Returns True when a group's discriminant falls
-    below ``least`` (or is NaN) on some row."""
+    rows whose cosines and sines are ``CS``, ``SN`` (M, k; NumPy's): the positions
+    (:func:`_positions`), then the rates step by step; fill every link's rotation and its
+    origin's position, velocity and acceleration ``C`` (4, links, M), its angular
+    velocity and acceleration ``W``, ``AL`` (links, M), each RRR group's normalised
+    discriminant ``D`` (groups, M) and, when ``Z`` has rows (2, links, P),
+    :func:`_planes`. Every group in its drawn mode (``fp[:, 2]``), or when ``SG`` (steps,
+    M) has M columns, in the mode ``SG[step, row]`` (+1 or -1: the tracked chain's signs
+    by row). Returns True when a group's discriminant falls below ``least`` (or is NaN)
+    on some row."""
     M = CS.shape[0]
     ns = ip.shape[0]
     nl = anc_j.shape[0]
@@ -153,50 +279,34 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
     jV = np.empty((nj, M), np.complex128)
     jA = np.empty((nj, M), np.complex128)
     lz, lw, lal = C[0], W, AL  # every link's rotation, angular velocity and acceleration, written in place
+    _positions(ip, fp, anc_j, anc_s, CS, SN, ns - 1, SG, jP, lz, D, _ALL)
     near = False
+    for g in range(D.shape[0]):
+        for r in range(M):
+            if not D[g, r] >= least:
+                near = True
     for s in range(ns):
         if ip[s, 0] == 0:  # a driver: link new turned by the input di from link k
-            new, k, j, di, need = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4], ip[s, 5]
-            sgn = fp[s, 0].real
-            spd = sgn * speeds[di]
+            new, k, j, di = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
+            spd = fp[s, 0].real * speeds[di]
             if k < 0:
-                sk = fp[s, 1]
-                for r in range(M):
-                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di])
-                    lw[new, r] = spd
-                    lal[new, r] = 0.0
-                    jP[j, r] = sk
-                    jV[j, r] = 0j
-                    jA[j, r] = 0j
-            else:
-                if need:
-                    _point_rows(k, fp[s, 1], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[j], jV[j], jA[j], M)
-                for r in range(M):
-                    lz[new, r] = complex(CS[r, di], sgn * SN[r, di]) * lz[k, r]
-                    lw[new, r] = lw[k, r] + spd
-                    lal[new, r] = lal[k, r]
+                _rate_rows(-1, 0j, anc_j, anc_s, jV, jA, lz, lw, lal, jV[j], jA[j], M)
+            elif ip[s, 5]:
+                _rate_rows(k, fp[s, 1], anc_j, anc_s, jV, jA, lz, lw, lal, jV[j], jA[j], M)
+            for r in range(M):
+                lw[new, r] = spd if k < 0 else lw[k, r] + spd
+                lal[new, r] = 0.0 if k < 0 else lal[k, r]
             continue
         # an RRR group: joints J1 (on known link k1), J3 (on k3), its links b1, b2 meet at J2
         k1, k3, b1, b2 = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
-        J1, J2, J3, slot = ip[s, 5], ip[s, 6], ip[s, 7], ip[s, 10]
+        J1, J2, J3 = ip[s, 5], ip[s, 6], ip[s, 7]
         if ip[s, 8]:
-            _point_rows(k1, fp[s, 5], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[J1], jV[J1], jA[J1], M)
+            _rate_rows(k1, fp[s, 5], anc_j, anc_s, jV, jA, lz, lw, lal, jV[J1], jA[J1], M)
         if ip[s, 9]:
-            _point_rows(k3, fp[s, 6], anc_j, anc_s, jP, jV, jA, lz, lw, lal, jP[J3], jV[J3], jA[J3], M)
-        L1s = fp[s, 0].real
-        L2s = fp[s, 0].imag
-        by_row = SG.shape[1] == M
-        cbv1 = fp[s, 3]
-        cbv2 = fp[s, 4]
+            _rate_rows(k3, fp[s, 6], anc_j, anc_s, jV, jA, lz, lw, lal, jV[J3], jA[J3], M)
         for r in range(M):
-            d = jP[J3, r] - jP[J1, r]
-            f, g, disc = circle(d, L1s, L2s)
-            D[slot, r] = disc
-            if not disc >= least:
-                near = True
-            e1 = place(d, f, g, disc, (SG[s, r] if by_row else fp[s, 2].real))
-            B = e1 + jP[J1, r]
-            e2 = B - jP[J3, r]
+            B = jP[J2, r]
+            e1, e2 = B - jP[J1, r], B - jP[J3, r]
             ce1, ce2 = e1.conjugate(), e2.conjugate()
             den = 1.0 / (ce1 * e2).imag
             dv = jV[J3, r] - jV[J1, r]
@@ -207,10 +317,9 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             da -= (w2 * w2) * e2
             a1 = (da * ce2).real * den
             a2 = (da * ce1).real * den
-            lz[b1, r], lw[b1, r], lal[b1, r] = e1 * cbv1, w1, a1
-            lz[b2, r], lw[b2, r], lal[b2, r] = e2 * cbv2, w2, a2
+            lw[b1, r], lal[b1, r] = w1, a1
+            lw[b2, r], lal[b2, r] = w2, a2
             ie1 = e1 * 1j
-            jP[J2, r] = B
             jV[J2, r] = ie1 * w1 + jV[J1, r]
             jA[J2, r] = (ie1 * a1 - w1s * e1) + jA[J1, r]
     for i in range(nl):  # each link's origin: its first joint, or its point (0, 0) from its anchor
@@ -220,7 +329,8 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
             C[2, i] = jV[j]
             C[3, i] = jA[j]
         else:
-            _point_rows(i, 0j, anc_j, anc_s, jP, jV, jA, lz, lw, lal, C[1, i], C[2, i], C[3, i], M)
+            _place_rows(i, 0j, anc_j, anc_s, jP, lz, C[1, i], M)
+            _rate_rows(i, 0j, anc_j, anc_s, jV, jA, lz, lw, lal, C[2, i], C[3, i], M)
     if Z.shape[1] == nl:
         _planes(lz, Z)
     return near
@@ -440,36 +550,16 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg):
     """The normalised discriminant of step ``k`` (an RRR group) of the program at one input
     ``u`` (k inputs), every group upstream in its mode ``sg[s]`` (+1 or -1, by step; the
     drawn modes: ``fp[:, 2].real``), a group folded within 1e-12 taken flat, else NaN
-    downstream: the fold search's function along a segment, positions only."""
-    nl = anc_j.shape[0]
-    jP = np.zeros(nj, np.complex128)
-    lz = np.zeros(nl, np.complex128)
-    for s in range(k + 1):
-        if ip[s, 0] == 0:
-            new, kk, j, di, need = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4], ip[s, 5]
-            z = complex(math.cos(u[di]), fp[s, 0].real * math.sin(u[di]))
-            if kk < 0:
-                jP[j] = fp[s, 1]
-                lz[new] = z
-            else:
-                if need:
-                    jP[j] = lz[kk] * (fp[s, 1] - anc_s[kk]) + jP[anc_j[kk]]
-                lz[new] = z * lz[kk]
-            continue
-        k1, k3, b1, b2 = ip[s, 1], ip[s, 2], ip[s, 3], ip[s, 4]
-        J1, J2, J3 = ip[s, 5], ip[s, 6], ip[s, 7]
-        if ip[s, 8]:
-            jP[J1] = fp[s, 5] if k1 < 0 else lz[k1] * (fp[s, 5] - anc_s[k1]) + jP[anc_j[k1]]
-        if ip[s, 9]:
-            jP[J3] = fp[s, 6] if k3 < 0 else lz[k3] * (fp[s, 6] - anc_s[k3]) + jP[anc_j[k3]]
-        f, g, disc = circle(jP[J3] - jP[J1], fp[s, 0].real, fp[s, 0].imag)
-        if s == k:
-            return disc
-        e1 = place(jP[J3] - jP[J1], f, g, disc, sg[s])
-        jP[J2] = e1 + jP[J1]
-        lz[b1] = e1 * fp[s, 3]
-        lz[b2] = (jP[J2] - jP[J3]) * fp[s, 4]
-    return math.nan
+    downstream (:func:`_positions` on one row): the fold search's function along a
+    segment."""
+    CS, SN = np.empty((1, u.shape[0])), np.empty((1, u.shape[0]))
+    for i in range(u.shape[0]):
+        CS[0, i], SN[0, i] = math.cos(u[i]), math.sin(u[i])
+    jP = np.zeros((nj, 1), np.complex128)
+    lz = np.zeros((anc_j.shape[0], 1), np.complex128)
+    D = np.empty((ip.shape[0], 1))
+    _positions(ip, fp, anc_j, anc_s, CS, SN, k, sg.reshape(-1, 1), jP, lz, D, _ALL)
+    return D[ip[k, 10], 0]
 
 
 @njit(inline="always", **_OPTIONS)

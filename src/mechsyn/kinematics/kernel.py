@@ -8,7 +8,11 @@ arrays); :func:`run` runs it over the input rows and returns one record: every l
 rotation and its origin's position, velocity and acceleration, the links' rates, the
 groups' normalised discriminants and whether one came near a fold. The fold scan
 (:func:`fold_scan`), the links' poses (:func:`link_poses`) and named points
-(:func:`point_states`) read that record. There is one implementation: the compiled
+(:func:`point_states`) read that record. The program's integers are the topology's
+(:func:`layout`); its numbers are filled by one compiled function for one system or
+for many designs at once (:func:`numbers`), and the batch engine
+(:func:`mechsyn.kinematics.batch.simulate_batch`) runs the same program's placement
+over many designs (positions only). There is one implementation: the compiled
 functions are plain Python functions under ``NUMBA_DISABLE_JIT=1`` (CI measures their
 line coverage that way, .ci/steps/25-kernel.sh).
 
@@ -38,6 +42,7 @@ from __future__ import annotations
 
 import importlib
 import types
+from itertools import chain
 from types import ModuleType
 
 import numpy as np
@@ -47,8 +52,8 @@ from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.topology import CACHE
 
-__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "hidden_fold", "link_poses", "point_states", "program",
-           "run", "scalar_disc", "scan_sweep", "trig", "warm"]
+__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "hidden_fold", "layout", "link_poses", "numbers",
+           "point_states", "program", "run", "scalar_disc", "scan_sweep", "trig", "warm"]
 
 
 def _nb() -> ModuleType:
@@ -81,73 +86,112 @@ def warm() -> bool:
 
 def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
     """The chain's steps with complex constants, every link's anchor and origin joint
-    (built once per system and plan). Its shape (:func:`_shape`: the steps' links,
-    joints, drivers and signs, and which local joint points they take) depends on the
-    topology only: it is the topology's product ``"regular"``
-    (:meth:`~mechsyn.kinematics.topology.Topology.product`, kept in the one cache and
-    shared by every system of that topology, a refilled one too), so a refilled
-    system's steps are its numbers put in (:func:`_filled`). The same numbers are
-    written once more as the kernel's arrays (:func:`program`'s ``fp`` and
-    ``anc_s``, kept with ``S`` under ``("kernel", id(plan))``; their integers are the
-    topology's product ``"kernel"``) while they are filled in, not read back off the
-    steps."""
+    (built once per system and plan). Its shape and the program's integers depend on the
+    topology only (:func:`layout`). The numbers
+    are :func:`numbers` of ``S``'s local points (the kernel's ``fp`` and ``anc_s``,
+    kept with ``S`` under ``("kernel", id(plan))``: :func:`program`); the steps are
+    read off them."""
     memo = geometry_memo(S)
     key = ("regular", id(plan))
     hit = memo.get(key)
     if hit is not None and hit[0] is plan:
         return hit[1]
-    rows: list = []
-    out = _filled(S, S.topology.product("regular", lambda: _shape(S, plan), plan), rows)
+    steps_, anchors, origin, li, pj, ints, table = layout(S, plan)
+    loc, pt = (np.fromiter(chain.from_iterable(a), float).view(complex)[None] for a in (_locals(S, li, pj),
+                                                                                        joint_points(S)))
+    fp, anc_s = numbers(table, loc, pt)
+    memo[("kernel", id(plan))] = (plan, (ints, fp[0], anc_s[0]))
+    rows, anc = fp[0].tolist(), anc_s[0].tolist()
+    steps = [st + (r[1],) if st[0] == "drive" else st + (r[0].real, r[0].imag, r[2].real, *r[3:])
+             for st, r in zip(steps_, rows)]
+    out = steps, {i: (jid, anc[i]) for i, (jid, _) in anchors.items()}, origin
     memo[key] = (plan, out)
-    steps, anchor, origin = out  # (the integers of the kernel's program are the topology's)
-    shape = S.topology.product("kernel", lambda: _shape_arrays(steps, anchor, origin), plan)
-    rows += [anchor[i][1] if i in anchor else 0j for i in range(len(origin))]  # anc_s after fp's rows
-    flat, n = np.array(rows, complex), 7 * len(steps)  # one array, two contiguous views
-    memo[("kernel", id(plan))] = (plan, (shape, flat[:n].reshape(len(steps), 7), flat[n:]))
     return out
 
 
 def program(S: PlanarSystem, plan: Plan) -> tuple:
     """The regular pass's program of ``S`` as the kernel's arrays, kept with ``S``:
-    :func:`_shape_arrays`' integers (the topology's) and the numbers ``fp`` (steps, 7)
+    :func:`_shape`'s integers (the topology's) and the numbers ``fp`` (steps, 7)
     complex (a driver's sign and joint point; a group's squared lengths, assembly mode,
-    rotation vectors and known joints' local points, :func:`_filled`) and the anchors'
+    rotation vectors and known joints' local points, :func:`numbers`) and the anchors'
     local points."""
     chain_steps(S, plan)
     return geometry_memo(S)[("kernel", id(plan))][1]
 
 
+def layout(S: PlanarSystem, plan: Plan) -> tuple:
+    """The program's topology (:func:`_shape`), the topology's product ``"kernel"``
+    (:meth:`~mechsyn.kinematics.topology.Topology.product`): built once per topology and
+    plan, shared by every system of that topology (a refilled one too) and by the batch
+    engine's designs."""
+    return S.topology.product("kernel", lambda: _shape(S, plan), plan)
+
+
+def numbers(table: tuple, loc: np.ndarray, pt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The program's numbers ``fp`` (K, steps, 7) and ``anc_s`` (K, links) of ``K``
+    designs of one topology (:func:`mechsyn.kinematics._kernel_numba.fill`, the one
+    implementation): ``table`` the topology's (:func:`_shape`'s last item),
+    ``loc`` (K, pairs) the local points of the (link, joint) pairs it names, ``pt`` (K,
+    joints) the drawn joint points in file order (complex, C-contiguous)."""
+    fi, anc_p = table
+    fp = np.empty((loc.shape[0], fi.shape[0], 7), complex)
+    anc_s = np.empty((loc.shape[0], anc_p.shape[0]), complex)
+    _nb().fill(fi, anc_p, loc, pt, fp, anc_s)
+    return fp, anc_s
+
+
 def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     """The topology of :func:`chain_steps`: its steps without numbers (a drive's links,
     joint, driver and sign; an RRR group's known links, links and joints), each link's
-    anchor joint, origin joint, the (link, joint) pairs whose local points the numbers
-    take, as index lists (link, joint's index in the file), and the file indices of
-    every RRR group's joints (its drawn assembly mode). A link's anchor is the joint that
-    places it: a drive's joint, an RRR group's end joint on it."""
+    anchor (joint, pair), origin joint, the (link, joint) pairs whose local points the
+    numbers take, as index lists (link, joint's index in the file); then the program's
+    integers: per step ``ip`` (op, links, joints by their index in the program, which
+    joints to place from a link's point first, the group's row in the discriminants),
+    each link's anchor joint and origin joint (-1: found from its anchor), the number of
+    joints and the steps of the RRR groups; and the table :func:`numbers` fills the
+    numbers by (``fi``: per step a driver's pair and sign, a group's pairs ``s1, s2, t2,
+    t3, k1, k3`` and its joints' indices in the file (its drawn assembly mode), the op
+    last; each link's anchor pair, -1: none). A link's anchor is the joint that places
+    it: a drive's joint, an RRR group's end joint on it."""
     pairs: dict[tuple[int, str], int] = {}
+    order: dict[str, int] = {}
 
     def at(i: int, jid: str) -> int:
         return pairs.setdefault((i, jid), len(pairs))
 
-    steps, anchors = [], {}
-    for step in plan.steps:
+    def jx(jid: str) -> int:
+        return order.setdefault(jid, len(order))
+
+    index = {j.id: k for k, j in enumerate(S.mech.joints)}
+    steps, anchors, placed, groups = [], {}, set(), []
+    ip, fi = np.zeros((len(plan.steps), 11), np.int64), np.zeros((len(plan.steps), 10), np.int64)
+    for s, step in enumerate(plan.steps):
         if step.kind == "drive_R":  # the joint's local point on k (the frame: its fixed point)
             (new,), (k,), (jid,) = step.links, step.known, step.joints
             con = next(c for c in cons_of(S, jid) if c.role == "drive")
-            steps.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0, at(k, jid)))
+            steps.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0))
+            ip[s, :6] = (0, new, k, jx(jid), con.driver, int(k >= 0 and jid not in placed))
+            fi[s, :2] = (at(k, jid), steps[-1][5])
             anchors[new] = (jid, at(new, jid))
+            placed.add(jid)
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-        steps.append(("RRR", step.known, step.links, step.joints, at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3),
-                      at(k1, J1), at(k3, J3)))
+        steps.append(("RRR", step.known, step.links, step.joints))
+        ip[s] = (1, k1, k3, b1, b2, jx(J1), jx(J2), jx(J3), int(J1 not in placed), int(J3 not in placed), len(groups))
+        fi[s] = (at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3), at(k1, J1), at(k3, J3), index[J1], index[J2],
+                 index[J3], 1)
         anchors[b1], anchors[b2] = (J1, at(b1, J1)), (J3, at(b2, J3))
+        placed.update((J1, J2, J3))
+        groups.append(s)
     origin = []  # the joint at every link's origin (its first joint), by link
     for i, name in enumerate(S.links):
         j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
         origin.append(j0)
-    index = {j.id: k for k, j in enumerate(S.mech.joints)}
-    drawn = [(index[st[3][0]], index[st[3][1]], index[st[3][2]]) if st[0] == "RRR" else None for st in steps]
-    return steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs], drawn
+    anc_j = np.array([jx(anchors[i][0]) if i in anchors else -1 for i in range(len(origin))], np.int64)
+    anc_p = np.array([anchors[i][1] if i in anchors else -1 for i in range(len(origin))], np.int64)
+    org_j = np.array([jx(j) if j is not None and j in placed else -1 for j in origin], np.int64)
+    return (steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs],
+            (ip, anc_j, org_j, len(order), groups), (fi, anc_p))
 
 
 def _locals(S: PlanarSystem, li: list, pj: list) -> list:
@@ -156,64 +200,6 @@ def _locals(S: PlanarSystem, li: list, pj: list) -> list:
     numbers, on floats."""
     pts = joint_points(S)
     return frame_points(S.frames(), li, [pts[k] for k in pj])
-
-
-def _filled(S: PlanarSystem, shape: tuple, rows: list) -> tuple:
-    """:func:`chain_steps` of ``S`` from its topology's shape (:func:`_shape`): the local
-    points, squared link lengths, drawn assembly modes and rotation vectors of ``S``;
-    each step's row of the kernel's ``fp``
-    (:func:`program`'s layout) appended to it, flat."""
-    steps_, anchors, origin, li, pj, drawn = shape
-    loc = _locals(S, li, pj)
-    pt = joint_points(S)
-    steps = []
-    for st, ks in zip(steps_, drawn):
-        if st[0] == "drive":
-            steps.append(st[:6] + (s_k := complex(*loc[st[6]]),))
-            rows += (st[5], s_k, 0j, 0j, 0j, 0j, 0j)
-            continue
-        _, known, links, joints, i1, i2, i3, i4, k1, k3 = st
-        (x1, y1), (x2, y2), (x3, y3), (x4, y4) = loc[i1], loc[i2], loc[i3], loc[i4]
-        ux, uy = x2 - x1, y2 - y1  # s2 - s1 on the first link, t2 - t3 on the second
-        vx, vy = x3 - x4, y3 - y4
-        L1s, L2s = ux * ux + uy * uy, vx * vx + vy * vy
-        (ax, ay), (bx, by), (cx, cy) = pt[ks[0]], pt[ks[1]], pt[ks[2]]
-        cross = (cx - ax) * (by - ay) - (cy - ay) * (bx - ax)
-        sigma = 1.0 if cross >= 0 else -1.0
-        num = (sigma, complex(ux / L1s, -(uy / L1s)), complex(vx / L2s, -(vy / L2s)), complex(*loc[k1]),
-               complex(*loc[k3]))
-        steps.append(("RRR", known, links, joints, L1s, L2s) + num)
-        rows += (complex(L1s, L2s), 0j) + num
-    return steps, {i: (jid, complex(*loc[k])) for i, (jid, k) in anchors.items()}, origin
-
-
-def _shape_arrays(steps: list, anchor: dict, origin: list) -> tuple:
-    """The program's integers (they depend on the topology only): joint indices, per step
-    ``ip`` (op, links, joints, which joints to place from a link's point first, the
-    group's row in the discriminants), each link's anchor joint and origin joint (-1:
-    found from its anchor), the number of joints, and the steps of the RRR groups."""
-    index: dict[str, int] = {}
-
-    def jx(jid: str) -> int:
-        return index.setdefault(jid, len(index))
-
-    placed: set[str] = set()
-    ip = np.zeros((len(steps), 11), np.int64)
-    groups = []
-    for s, st in enumerate(steps):
-        if st[0] == "drive":
-            _, new, k, jid, di, _sgn = st[:6]
-            ip[s, :6] = (0, new, k, jx(jid), di, int(k >= 0 and jid not in placed))
-            placed.add(jid)
-            continue
-        _, (k1, k3), (b1, b2), (J1, J2, J3) = st[:4]
-        ip[s] = (1, k1, k3, b1, b2, jx(J1), jx(J2), jx(J3), int(J1 not in placed), int(J3 not in placed), len(groups))
-        placed.update((J1, J2, J3))
-        groups.append(s)
-    nl = len(origin)
-    anc_j = np.array([jx(anchor[i][0]) if i in anchor else -1 for i in range(nl)], np.int64)
-    org_j = np.array([jx(j) if j is not None and j in placed else -1 for j in origin], np.int64)
-    return ip, anc_j, org_j, len(index), groups
 
 
 def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0,
