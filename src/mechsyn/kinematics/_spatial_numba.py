@@ -224,32 +224,92 @@ def move(R, p, x, R2, p2):
 
 
 @njit(**_OPTIONS)
+def _spd_inverse(G, Gi):
+    """``G⁻¹`` of a symmetric positive definite ``G`` into ``Gi`` by its Cholesky factor:
+    ``G = Uᵀ U``, ``G⁻¹ = V Vᵀ`` with ``V = U⁻¹`` (the loops run along rows, without
+    reductions, so they vectorise); False when ``G`` is not positive definite to rounding."""
+    k = G.shape[0]
+    U, V = G.copy(), np.zeros((k, k))
+    for j in range(k):
+        if not U[j, j] > 0.0:
+            return False
+        d = 1.0 / math.sqrt(U[j, j])
+        for c in range(j, k):
+            U[j, c] *= d
+        for i in range(j + 1, k):
+            f = U[j, i]
+            for c in range(i, k):
+                U[i, c] -= f * U[j, c]
+    for i in range(k - 1, -1, -1):
+        V[i, i] = 1.0
+        for t in range(i + 1, k):
+            f = U[i, t]
+            for c in range(t, k):
+                V[i, c] -= f * V[t, c]
+        d = 1.0 / U[i, i]
+        for c in range(i, k):
+            V[i, c] *= d
+    Gi[:] = V @ V.T
+    return True
+
+
+@njit(**_OPTIONS)
 def gram(J, rows, Gi):
     """The inverse ``Gi`` of the damped Gram matrix of ``J`` (``J Jᵀ`` when ``rows``, else
     ``Jᵀ J``, plus ``1e-14`` of its largest diagonal entry), and the lower bound
     ``1 / √(‖G‖_F ‖G⁻¹‖_F)`` of ``σ_r / σ_1`` (0 where not finite)."""
     G = J @ J.T if rows else J.T @ J
-    top = 0.0
+    top = trace = 0.0
     for i in range(G.shape[0]):
-        top = max(top, G[i, i])
+        top, trace = max(top, G[i, i]), trace + G[i, i]
     for i in range(G.shape[0]):
         G[i, i] += 1e-14 * top + 1e-300
-    if not np.all(np.isfinite(G)):
+    if not np.isfinite(trace):  # (a NaN or inf in J is one on the diagonal)
         Gi[:] = np.nan
         return 0.0
-    Gi[:] = np.linalg.inv(G)
-    out = 1.0 / math.sqrt(math.sqrt(np.sum(G * G) * np.sum(Gi * Gi)))
+    if not _spd_inverse(G, Gi):  # (positive definite but for rounding: a rank drop)
+        Gi[:] = np.linalg.inv(G)
+    sg = si = 0.0
+    for i in range(G.shape[0]):
+        for j in range(G.shape[1]):
+            sg += G[i, j] * G[i, j]
+            si += Gi[i, j] * Gi[i, j]
+    out = 1.0 / math.sqrt(math.sqrt(sg * si))
     return out if np.isfinite(out) else 0.0
+
+
+@njit(inline="always", **_OPTIONS)
+def _apply(J, Gi, rows, b, t, y):
+    """``y += J⁺ b`` by ``Gi`` (``t``: scratch of ``Gi``'s size); the products along rows."""
+    t[:] = 0.0
+    if rows:  # Jᵀ (Gi b)
+        for r in range(Gi.shape[0]):
+            for c in range(Gi.shape[1]):
+                t[c] += b[r] * Gi[r, c]
+        for r in range(J.shape[0]):
+            for c in range(J.shape[1]):
+                y[c] += t[r] * J[r, c]
+    else:  # Gi (Jᵀ b)
+        for r in range(J.shape[0]):
+            for c in range(J.shape[1]):
+                t[c] += b[r] * J[r, c]
+        for r in range(Gi.shape[0]):
+            for c in range(Gi.shape[1]):
+                y[c] += t[r] * Gi[r, c]
 
 
 @njit(**_OPTIONS)
 def solve(J, Gi, C, rows, b, refine, out):
     """``J⁺ b`` by the inverse Gram matrix ``Gi`` with ``refine`` steps of iterative
     refinement, as twists at the origin into ``out`` (6 n) (``v = u + c × ω``)."""
-    y = J.T @ (Gi @ b) if rows else Gi @ (J.T @ b)
+    t, y, e = np.empty(Gi.shape[0]), np.zeros(J.shape[1]), np.empty(J.shape[0])
+    _apply(J, Gi, rows, b, t, y)
     for _ in range(refine):
-        e = b - J @ y
-        y += J.T @ (Gi @ e) if rows else Gi @ (J.T @ e)
+        for r in range(J.shape[0]):
+            e[r] = b[r]
+            for c in range(J.shape[1]):
+                e[r] -= J[r, c] * y[c]
+        _apply(J, Gi, rows, e, t, y)
     for k in range(C.shape[0]):
         w = (y[6 * k], y[6 * k + 1], y[6 * k + 2])
         v = _ax((y[6 * k + 3], y[6 * k + 4], y[6 * k + 5]), 1.0, _x((C[k, 0], C[k, 1], C[k, 2]), w))
@@ -258,19 +318,32 @@ def solve(J, Gi, C, rows, b, refine, out):
 
 
 @njit(**_OPTIONS)
-def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl):
-    """:func:`evaluate` and :func:`gram` at every pose of a batch (B, ...)."""
+def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, x1, x2):
+    """:func:`evaluate` and :func:`gram` at every pose of a batch (B, ...) (``Gi`` (B, ...),
+    or with no columns: not kept), and, where ``du`` (B, drives) has rows, the rates with
+    two steps of refinement: ``J x1 = (0, du)``, ``J x2 = (0, ddu) - γ(x1)``."""
     W = np.empty((T[0].shape[0], 4, 3))
+    m, nc = g.shape[1], g.shape[1] - U.shape[1]
+    Gs, rhs, gam = np.empty((J.shape[1], J.shape[1]) if rows else (J.shape[2], J.shape[2])), np.zeros(m), np.empty((1, m))
     for b in range(R.shape[0]):
+        Gb = Gi[b] if Gi.shape[1] else Gs
         evaluate(R[b], p[b], T, href[b], U[b], W, g[b], J[b], C[b], th[b], sl[b])
-        bound[b] = gram(J[b], rows, Gi[b])
+        bound[b] = gram(J[b], rows, Gb)
+        if du.shape[0]:
+            rhs[:nc] = 0.0
+            rhs[nc:] = du[b]
+            solve(J[b], Gb, C[b], rows, rhs, 2, x1[b])
+            convective(T, R[b:b + 1], p[b:b + 1], x1[b:b + 1], W, gam)
+            rhs[:] = -gam[0]
+            rhs[nc:] += ddu[b]
+            solve(J[b], Gb, C[b], rows, rhs, 2, x2[b])
 
 
 @njit(**_OPTIONS)
-def solves(J, Gi, C, rows, b, refine, out):
-    """:func:`solve` for every pose of a batch."""
+def solves(J, Gi, C, rows, b, out):
+    """:func:`solve` (no refinement) for every pose of a batch."""
     for k in range(J.shape[0]):
-        solve(J[k], Gi[k], C[k], rows, b[k], refine, out[k])
+        solve(J[k], Gi[k], C[k], rows, b[k], 0, out[k])
 
 
 @njit(**_OPTIONS)
@@ -286,8 +359,9 @@ def correct(T, R, p, href, U, limit, iters, tol, Ja, Ga, Ca, rows, first, ok, th
     ``U`` (B, drives) (see :meth:`mechsyn.kinematics.spatial_track.Tracker.correct`):
     ``ok`` is set where a pose's residual fell under ``tol`` without the corrector moving
     it further than ``limit``. Chord steps with the linearisation ``Ja``, ``Ga``, ``Ca``
-    (of an anchor pose; none when ``Ja`` has no rows) while the residual falls at least
-    tenfold per step, else with the Jacobian of the current iterate. ``first``: stop at
+    (of an anchor pose, or the latest one an earlier pose took; none when ``Ja`` has no
+    rows: each pose starts with its own) while the residual falls at least tenfold per
+    step, else with the Jacobian of the current iterate. ``first``: stop at
     the first pose that fails (the rest are left). ``th``, ``sl``: the measured angles
     and slides of the last iterate."""
     m, nk = T[2].shape[0], 6 * (R.shape[1] - 1)
@@ -295,9 +369,9 @@ def correct(T, R, p, href, U, limit, iters, tol, Ja, Ga, Ca, rows, first, ok, th
     g, dx = np.empty(m), np.empty(nk)
     J, C, Gi = np.empty((m, nk)), np.empty((R.shape[1] - 1, 3)), np.empty_like(Ga)
     no_J = np.empty((0, nk))
+    Jl, Gl, Cl = Ja, Ga, Ca
     for b in range(R.shape[0]):
-        Jl, Gl, Cl = Ja, Ga, Ca
-        have = Ja.shape[0] > 0
+        have = Ja.shape[0] > 0  # (then the latest linearisation: the anchor's or a row's before)
         moved, last, done = 0.0, np.inf, False
         for i in range(iters):
             evaluate(R[b], p[b], T, href[b], U[b], W, g, no_J, C, th[b], sl[b])
@@ -331,10 +405,13 @@ def pair_errors(R, pi, pf, out):
     for b in range(R.shape[0]):
         for j in range(pi.shape[0]):
             Ra, Rb = R[b, pi[j, 0]], R[b, pi[j, 1]]
-            Rr = Ra.T @ Rb
             a, e1, e2 = pf[j, 0], pf[j, 1], pf[j, 2]
-            r1 = Rr @ e1
-            t = math.atan2(r1 @ e2, r1 @ e1) if pi[j, 2] else 0.0
+            Rr = np.empty((3, 3))
+            for i in range(3):
+                for k in range(3):
+                    Rr[i, k] = Ra[0, i] * Rb[0, k] + Ra[1, i] * Rb[1, k] + Ra[2, i] * Rb[2, k]
+            r1 = (_d(Rr[0], e1), _d(Rr[1], e1), _d(Rr[2], e1))
+            t = math.atan2(_d(r1, e2), _d(r1, e1)) if pi[j, 2] else 0.0
             ct, st = math.cos(t), math.sin(t)
             worst = 0.0
             for i in range(3):
@@ -343,3 +420,77 @@ def pair_errors(R, pi, pf, out):
                     rot = (ct if i == k else 0.0) + st * K + (1 - ct) * a[i] * a[k]
                     worst = max(worst, abs(Rr[i, k] - rot))
             out[b, j] = worst
+
+
+@njit(inline="always", **_OPTIONS)
+def _end(R, p, X, Xd, k, i, x0):
+    """A bar's end ``x0`` on link ``i`` (the frame: ``i = n``) at row ``k``: its position,
+    velocity and acceleration."""
+    if i >= R.shape[1]:
+        return x0, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    y = (_d(R[k, i, 0], x0) + p[k, i, 0], _d(R[k, i, 1], x0) + p[k, i, 1], _d(R[k, i, 2], x0) + p[k, i, 2])
+    w, v = _twist(X[k], i, R.shape[1])
+    wd, vd = _twist(Xd[k], i, R.shape[1])
+    yd = _ax(v, 1.0, _x(w, y))
+    return y, yd, _ax(_ax(vd, 1.0, _x(wd, y)), 1.0, _x(w, yd))
+
+
+@njit(**_OPTIONS)
+def bars(R, p, X, Xd, ia, ib, va, vb, Rb, pb, Xb, Xbd):
+    """The bars' poses ``Rb``, ``pb`` and twists ``Xb``, ``Xbd`` over the rows of a sweep
+    from those of the links they join (``R`` (N, n, 3, 3), ``p``, ``X``, ``Xd`` (N, 6 n);
+    bar ``j`` from ``va[j]`` on link ``ia[j]`` to ``vb[j]`` on ``ib[j]``, ``n`` the frame):
+    see :func:`mechsyn.kinematics.spatial_model.bar_motion`. The bar's spin ``φ`` about its
+    drawn line is carried from row to row by the least rotation between the lines, through
+    every row with a pose, and is zero at the row of each stretch nearest the drawn line."""
+    N = R.shape[0]
+    A, Bv, Uu = np.empty((N, 3)), np.empty((N, 3)), np.empty((N, 3))
+    c, phi = np.empty(N), np.empty(N)
+    for j in range(ia.shape[0]):
+        u0 = _ax(vb[j], -1.0, va[j])
+        u0 = _ax((0.0, 0.0, 0.0), 1.0 / math.sqrt(_d(u0, u0)), u0)
+        m = 0 if abs(u0[0]) <= min(abs(u0[1]), abs(u0[2])) else (1 if abs(u0[1]) <= abs(u0[2]) else 2)
+        e1 = _x(u0, (1.0 if m == 0 else 0.0, 1.0 if m == 1 else 0.0, 1.0 if m == 2 else 0.0))
+        e1 = _ax((0.0, 0.0, 0.0), 1.0 / math.sqrt(_d(e1, e1)), e1)
+        e2 = _x(u0, e1)
+        for k in range(N):
+            y1, y1d, y1dd = _end(R, p, X, Xd, k, ia[j], (va[j, 0], va[j, 1], va[j, 2]))
+            y2, y2d, y2dd = _end(R, p, X, Xd, k, ib[j], (vb[j, 0], vb[j, 1], vb[j, 2]))
+            d = _ax(y2, -1.0, y1)
+            l2 = _d(d, d)
+            w = _ax((0.0, 0.0, 0.0), 1.0 / l2, _x(d, _ax(y2d, -1.0, y1d)))
+            wd = _ax((0.0, 0.0, 0.0), 1.0 / l2, _x(d, _ax(y2dd, -1.0, y1dd)))
+            v = _ax(y1d, -1.0, _x(w, y1))
+            vd = _ax(_ax(y1dd, -1.0, _x(wd, y1)), -1.0, _x(w, y1d))
+            u = _ax((0.0, 0.0, 0.0), 1.0 / math.sqrt(l2), d)
+            c[k] = _d(u0, u)
+            s = 1.0 if c[k] >= 0 else -1.0
+            h = _ax(u, s, u0)
+            a = _ax(e1, -_d(u, e1) / (1 + abs(c[k])), h)
+            b = _ax(e2, -_d(u, e2) / (1 + abs(c[k])), h)
+            for i in range(3):
+                A[k, i], Bv[k, i], Uu[k, i] = a[i], s * b[i], u[i]
+                Xb[k, 6 * j + i], Xb[k, 6 * j + 3 + i] = w[i], v[i]
+                Xbd[k, 6 * j + i], Xbd[k, 6 * j + 3 + i] = wd[i], vd[i]
+                pb[k, j, i] = 0.5 * (y1[i] + y2[i])
+        k = 0
+        while k < N:  # each stretch of rows with poses, from its row nearest the drawn line
+            lo = best = k
+            phi[k] = 0.0
+            k += 1
+            while k < N and np.isfinite(c[k]) and np.isfinite(c[k - 1]):
+                u, a = (Uu[k, 0], Uu[k, 1], Uu[k, 2]), (A[k - 1, 0], A[k - 1, 1], A[k - 1, 2])
+                ck = 1.0 + _d((Uu[k - 1, 0], Uu[k - 1, 1], Uu[k - 1, 2]), u)
+                qa = _ax(a, -_d(u, a) / ck, _ax(u, 1.0, (Uu[k - 1, 0], Uu[k - 1, 1], Uu[k - 1, 2]))) if ck > 1e-8 else a
+                phi[k] = phi[k - 1] + math.atan2(_d(qa, Bv[k]), _d(qa, A[k]))
+                best = k if c[k] > c[best] else best
+                k += 1
+            top = phi[best]
+            for r in range(lo, k):
+                cp, sp = math.cos(phi[r] - top), math.sin(phi[r] - top)
+                for i in range(3):
+                    a_i, b_i = cp * A[r, i] + sp * Bv[r, i], cp * Bv[r, i] - sp * A[r, i]
+                    for t in range(3):
+                        Rb[r, j, i, t] = a_i * e1[t] + b_i * e2[t] + Uu[r, i] * u0[t]
+                for i in range(3):
+                    pb[r, j, i] -= 0.5 * _d(Rb[r, j, i], _ax(va[j], 1.0, vb[j]))

@@ -225,11 +225,7 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
     mech = planar_as_spatial(mech)  # a planar file: its 3-D equivalent, with the planar zero
     inputs = _check_inputs(mech, inputs)
     M = compile_spatial(mech, _drives(mech, inputs))
-    from threadpoolctl import threadpool_limits  # deferred: finding the BLAS costs more than a small sweep
-
-    with threadpool_limits(limits=1, user_api="blas"):  # many small solves: threads only contend (measured
-        # on a Bennett sweep: 74 ms with one thread, 156 ms with two on a busy machine)
-        return _simulate(mech, M, inputs, speeds, points, progress)
+    return _simulate(mech, M, inputs, speeds, points, progress)
 
 
 def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
@@ -381,7 +377,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
                 np.full((N, M.slides.size), np.nan), w.events, w.how)
     idx = np.flatnonzero(w.ok)
     if len(idx):
-        st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
+        st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx], rates=(rates[0][idx], rates[1][idx]))
         keep = _verify(tr, w, idx, st, event)
         if not keep.all():
             idx, st = idx[keep], st.take(np.flatnonzero(keep))
@@ -390,7 +386,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
         out.theta[idx], out.slide[idx] = st.theta, st.s
-        x1, x2 = tr.rates(st, rates[0][idx], refine=2, ddu=rates[1][idx])
+        x1, x2 = st.x
         regular = st.lin.ratio >= singular_tol(M)
         found = crossings(tr, w, U, out.ratio, st.lin.Jc, idx)
         on_row = {c[3] for c in found if c[3] is not None}
@@ -448,7 +444,7 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
-    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid, ok)
+    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid)
     X, Xd = X.reshape(len(ok), -1, 6), Xd.reshape(len(ok), -1, 6)
     links = {}
     for i, name in enumerate(M.all_links):

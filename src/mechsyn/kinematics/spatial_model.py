@@ -86,18 +86,6 @@ __all__ = ["SpatialModel", "compile_spatial", "SPATIAL_PAIRS", "move", "tables"]
 
 #: Pair types the spatial engine moves.
 SPATIAL_PAIRS = ("R", "P", "C", "U", "S", "H")
-_cross = np.cross
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return (a * b).sum(axis=-1)
-
-
-def rotate(R: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``R @ x`` over the last axes for rotations ``R`` (..., k, 3, 3) and vectors ``x`` (k, 3),
-    as three products of columns (a stack of 3 x 3 products against a broadcast vector is
-    several times slower in NumPy)."""
-    return R[..., 0] * x[:, 0, None] + R[..., 1] * x[:, 1, None] + R[..., 2] * x[:, 2, None]
 
 
 def _rows(x: np.ndarray) -> np.ndarray:
@@ -498,87 +486,39 @@ def helix_angles(M: SpatialModel, theta: np.ndarray, helix_ref: np.ndarray) -> n
 
 
 # --------------------------------------------------------------------------- bars
-def _bar_frames(d0: np.ndarray, d: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Rotations (N, bars, 3, 3) of the bars with drawn lines ``d0`` (bars, 3) along their
-    lines ``d`` (N, bars, 3) over the rows of a sweep (``ok``: the rows assembled), carried
-    along the sweep with no spin about their lines (see :func:`bar_motion`).
-
-    Each row's rotation is written ``T = C Rot(u_0, φ)``: a chart ``C`` taking the drawn unit
-    line ``u_0`` to the line ``u`` (the least rotation from ``u_0`` where ``u · u_0 ≥ 0``, else
-    a half-turn about ``e_1`` then the least rotation from ``-u_0``: both well conditioned),
-    turned first about the drawn line by the bar's spin ``φ``. Between consecutive assembled
-    rows the bar turns by the least rotation ``Q`` from one line to the next (its discrete
-    parallel transport), which adds ``δ = atan2(Q a_k · b_{k+1}, Q a_k · a_{k+1})`` to ``φ``
-    (``a``, ``b``: the chart's images of ``e_1``, ``e_2``); so ``φ`` is a cumulative sum, zero
-    at each stretch's row nearest the drawn line."""
-    u0 = d0 / np.linalg.norm(d0, axis=1)[:, None]
-    e1 = _cross(u0, np.eye(3)[np.argmin(np.abs(u0), axis=1)])  # (⟂ u_0, as _perp_basis)
-    e1 /= np.sqrt(_dot(e1, e1))[:, None]
-    e2 = _cross(u0, e1)
-    u = d / np.sqrt(_dot(d, d))[..., None]
-    c = _dot(u0, u)
-    s = np.where(c >= 0, 1.0, -1.0)[..., None]
-    h, den = s * u0 + u, (1 + np.abs(c))[..., None]
-    a = e1 - h * _dot(u, e1)[..., None] / den
-    b = s * (e2 - h * _dot(u, e2)[..., None] / den)
-    ck = _dot(u[:-1], u[1:])[..., None]
-    qa = a[:-1] - (u[:-1] + u[1:]) * _dot(u[1:], a[:-1])[..., None] / np.where(1 + ck > 1e-8, 1 + ck, np.inf)
-    link = (ok[:-1] & ok[1:])[:, None]
-    delta = np.where(link, np.arctan2(_dot(qa, b[1:]), _dot(qa, a[1:])), 0.0)
-    phi = np.concatenate([np.zeros((1, len(d0))), np.cumsum(delta, axis=0)])
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
-    cols = np.arange(len(d0))
-    for lo, hi in zip(edges[::2], edges[1::2]):  # each stretch of assembled rows from its anchor
-        phi[lo:hi] -= phi[lo + np.argmax(c[lo:hi], axis=0), cols]
-    phi[~ok] = 0.0
-    cp, sp = np.cos(phi)[..., None], np.sin(phi)[..., None]
-    A, Bv = cp * a + sp * b, cp * b - sp * a
-    return A[..., :, None] * e1[:, None, :] + Bv[..., :, None] * e2[:, None, :] + u[..., :, None] * u0[:, None, :]
-
-
 def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
-               xid: np.ndarray, ok: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+               xid: np.ndarray) -> tuple[np.ndarray, ...]:
     """Poses ``(R, p)`` (N, links, ...) and twists ``ξ``, ``ξ̇`` (N, 6 links) of
     :attr:`SpatialModel.all_links` from those of the links solved for (the frame's pose not
-    included), over the rows of a sweep in order (``ok``: the rows assembled; default all).
-    Each bar runs between its ends ``y_1``, ``y_2`` on the links it joins, on the line
+    included), over the rows of a sweep in order (NaN where a row has no pose). Each bar
+    runs between its ends ``y_1``, ``y_2`` on the links it joins, on the line
     ``d = y_2 - y_1``, moving at ``ω = d × ḋ / |d|²``, ``ω̇ = d × d̈ / |d|²`` (no spin about its
-    line: its spin is an idle motion) and ``v = ẏ_1 - ω × y_1``, ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``.
+    line: its spin is an idle motion) and ``v = ẏ_1 - ω × y_1``, ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``
+    (:func:`mechsyn.kinematics._spatial_numba.bars`).
 
-    Its rotation is carried along the sweep the same way, with no spin (:func:`_bar_frames`):
-    from one assembled row to the next it turns by the least rotation between their lines,
-    and in each stretch of assembled rows the row nearest the drawn line (largest
-    ``d_0 · d``) is the least rotation from the drawn line ``d_0``. No rule that depends on
-    the line alone can do this: a rotation taking ``d_0`` to every line ``d`` continuously
-    would be a continuous section of ``SO(3) -> S²``, which does not exist (hairy ball
-    theorem); the least rotation, ``cos I + [k]x + k kᵀ / (1 + cos)`` with ``k = d_0 × d``, is
-    undefined where ``d`` is opposite ``d_0`` (a drag-link's coupler turning fully). The price
-    of continuity: the pose depends on the path, not on the row's line alone (a bar brought
-    back to its line along a loop has turned about it by the solid angle its line swept) and,
-    by the square of the step, on the rows sampled; a row not assembled (but with poses)
-    takes its chart's rotation."""
-    N, n = len(R), M.n
-    if not M.bars:
+    Its rotation is carried along the sweep the same way, with no spin: ``T = C Rot(u_0, φ)``,
+    a chart ``C`` taking the drawn unit line ``u_0`` to the line ``u`` (the least rotation
+    from ``u_0`` where ``u · u_0 ≥ 0``, else a half-turn about ``e_1`` then the least rotation
+    from ``-u_0``: both well conditioned), turned first about the drawn line by the bar's
+    spin ``φ``. From one row with a pose to the next the bar turns by the least rotation
+    ``Q`` between their lines (its discrete parallel transport), which adds
+    ``δ = atan2(Q a_k · b_{k+1}, Q a_k · a_{k+1})`` to ``φ`` (``a``, ``b``: the chart's images
+    of ``e_1``, ``e_2``); in each stretch of rows with poses (a row refused after the walk
+    included) the row nearest the drawn line (largest ``d_0 · d``) has ``φ = 0``, the least
+    rotation from the drawn line ``d_0``. No rule that depends on the line alone can do
+    this: a rotation taking ``d_0`` to every line ``d`` continuously would be a continuous
+    section of ``SO(3) -> S²``, which does not exist (hairy ball theorem); the least
+    rotation, ``cos I + [k]x + k kᵀ / (1 + cos)`` with ``k = d_0 × d``, is undefined where
+    ``d`` is opposite ``d_0`` (a drag-link's coupler turning fully). The price of
+    continuity: the pose depends on the path, not on the row's line alone (a bar brought
+    back to its line along a loop has turned about it by the solid angle its line swept)
+    and, by the square of the step, on the rows sampled."""
+    N, nb = len(R), len(M.bars)
+    if not nb:
         return R, p, xi, xid
     ds = M.dist
-    z = np.zeros((N, 1, 6))
-    X, Xd = (np.concatenate([x.reshape(N, n, 6), z], axis=1) for x in (xi, xid))
-    R1 = np.concatenate([R, np.broadcast_to(np.eye(3), (N, 1, 3, 3))], axis=1)
-    p1 = np.concatenate([p, np.zeros((N, 1, 3))], axis=1)
-    ends = []
-    for i, x0 in ((ds.ia, ds.va), (ds.ib, ds.vb)):
-        y = rotate(R1[:, i], x0) + p1[:, i]
-        w, v, wd, vd = X[:, i, :3], X[:, i, 3:], Xd[:, i, :3], Xd[:, i, 3:]
-        yd = v + _cross(w, y)
-        ends.append((y, yd, vd + _cross(wd, y) + _cross(w, yd)))
-    (y1, y1d, y1dd), (y2, y2d, y2dd) = ends
-    d = y2 - y1
-    Rb = _bar_frames(ds.vb - ds.va, d, np.ones(N, bool) if ok is None else np.asarray(ok, bool))
-    pb = 0.5 * (y1 + y2 - rotate(Rb, ds.va + ds.vb))
-    l2 = _dot(d, d)[..., None]
-    w, wd = _cross(d, y2d - y1d) / l2, _cross(d, y2dd - y1dd) / l2
-    Xb = np.concatenate([w, y1d - _cross(w, y1)], axis=2)
-    Xbd = np.concatenate([wd, y1dd - _cross(wd, y1) - _cross(w, y1d)], axis=2)
-    return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1),
-            np.concatenate([X[:, :n], Xb], axis=1).reshape(N, -1),
-            np.concatenate([Xd[:, :n], Xbd], axis=1).reshape(N, -1))
+    Rb, pb, Xb, Xbd = np.empty((N, nb, 3, 3)), np.empty((N, nb, 3)), np.empty((N, 6 * nb)), np.empty((N, 6 * nb))
+    numba_kernel().bars(*(np.ascontiguousarray(x, float) for x in (R, p, xi, xid)), ds.ia, ds.ib, ds.va, ds.vb,
+                        Rb, pb, Xb, Xbd)
+    return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1), np.concatenate([xi, Xb], axis=1),
+            np.concatenate([xid, Xbd], axis=1))

@@ -100,7 +100,7 @@ class Lin:
         """``σ_r / σ_1`` per pose, 0 where the rank has dropped: exact (an SVD) where it is
         under ``1e-3``; elsewhere a lower bound within a factor ``√k`` (``bound``, for a
         Gram matrix of rank ``k = r``), which is enough to tell a regular pose."""
-        B, k = self.Gi.shape[:2]
+        B, k = len(self.Jc), min(self.Jc.shape[1:])
         if self.r == 0:
             return np.ones(B)
         out = self.bound.copy() if k == self.r else np.zeros(B)
@@ -117,10 +117,10 @@ class Lin:
         X[:, :, 3:] += np.cross(self.C[:, :, :, None], Y[:, :, :3], axisa=2, axisb=2, axisc=2)
         return X.reshape(y.shape)
 
-    def solve(self, b: np.ndarray, refine: int = 0) -> np.ndarray:
+    def solve(self, b: np.ndarray) -> np.ndarray:
         """``J⁺ b`` (B, 6 n) as twists at the origin, for right-hand sides ``b`` (B, m)."""
         out = np.empty((len(b), self.Jc.shape[2]))
-        numba_kernel().solves(self.Jc, self.Gi, self.C, self.rows, np.ascontiguousarray(b, float), refine, out)
+        numba_kernel().solves(self.Jc, self.Gi, self.C, self.rows, np.ascontiguousarray(b, float), out)
         return out
 
     def take(self, idx: np.ndarray) -> "Lin":
@@ -146,11 +146,12 @@ class State:
     s: np.ndarray
     lin: Lin
     g: np.ndarray
+    x: tuple | None = None
 
     def take(self, idx: Any) -> "State":
         idx = np.atleast_1d(idx)
         return State(self.R[idx], self.p[idx], self.href[idx], self.theta[idx], self.s[idx], self.lin.take(idx),
-                     self.g[idx])
+                     self.g[idx], None if self.x is None else (self.x[0][idx], self.x[1][idx]))
 
 
 class Tracker:
@@ -171,7 +172,8 @@ class Tracker:
         self.left_singular = False  # a singular pose was left (leave): the branch taken is a choice
         self._left: tuple | None = None
 
-    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
+    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
+              rates: tuple | None = None) -> State:
         """The residuals, the pairs' angles and slides and the linearisation at B poses:
         the Jacobian in twists ``(ω, u)`` with ``u`` the velocity of each link's centre ``c``
         (``v = u + c × ω``) and the inverse of its Gram matrix.
@@ -181,37 +183,35 @@ class Tracker:
         (a rod between two ball joints has its centre on its line), so minimum-norm rates
         and steps give the spin no component: idle spins stay at rest, whichever point the
         file measures from. The regular rank is the drawn assembly's (the first state's),
-        by an SVD."""
+        by an SVD. With ``rates`` (the drives' rates and their derivatives, each (B,
+        drives)) the state keeps no inverse Gram matrices but the rates of :meth:`rates`
+        (two steps of refinement) in ``x``."""
         M, B, n, m = self.M, len(R), self.M.n, self.m
         R, p = np.ascontiguousarray(R, float), np.ascontiguousarray(p, float)
         q = m if self.rows else 6 * n
-        g, J, Gi = np.empty((B, m)), np.empty((B, m, 6 * n)), np.empty((B, q, q))
-        C, bound = np.empty((B, n, 3)), np.empty(B)
+        g, J, Gi = np.empty((B, m)), np.empty((B, m, 6 * n)), np.empty((B, 0, 0) if rates else (B, q, q))
+        C, bound, x1, x2 = np.empty((B, n, 3)), np.empty(B), np.empty((B, 6 * n)), np.empty((B, 6 * n))
         th, s = np.empty((B, M.angles.size)), np.empty((B, M.slides.size))
+        du, ddu = (np.ascontiguousarray(r, float) for r in rates) if rates else (np.empty((0, len(M.drives))),) * 2
         numba_kernel().states(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
-                     self.rows, g, J, Gi, C, bound, th, s)
+                              self.rows, g, J, Gi, C, bound, th, s, du, ddu, x1, x2)
         if self.rank is None:
             s0 = np.linalg.svd(J[0], compute_uv=False)
             self.rank = int(np.count_nonzero(s0 > self.rank_tol * s0[0])) if s0.size and s0[0] > 0 else 0
         if M.helix:
             href = helix_angles(M, th, href)
-        return State(R, p, href, th, s, Lin(J, Gi, bound, self.rows, self.rank, C), g)
+        return State(R, p, href, th, s, Lin(J, Gi, bound, self.rows, self.rank, C), g, (x1, x2) if rates else None)
 
-    def rates(self, st: State, du: np.ndarray, refine: int = 0,
-              ddu: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
-        derivatives (``J ξ' = du``, ``J ξ'' = ü - γ(ξ')``, ``ü = ddu``: the drives' second
-        derivatives, zero by default); ``refine``: steps of iterative refinement (2 for the
-        rates reported, none for a predictor)."""
+    def rates(self, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Twists (B, 6 n) of the links per input step ``du`` (B, drives) for a predictor:
+        first and second derivatives (``J ξ' = du``, ``J ξ'' = -γ(ξ')``); the rates reported
+        come from :meth:`state` (with steps of iterative refinement)."""
         b = np.zeros(st.g.shape)
         b[:, self.m_c:] = du
-        x1 = st.lin.solve(b, refine)
+        x1 = st.lin.solve(b)
         b2 = np.empty(b.shape)
         numba_kernel().convective(self.M.tables, st.R, st.p, x1, np.empty((len(self.M.tables[0]), 4, 3)), b2)
-        b2 = -b2
-        if ddu is not None:
-            b2[:, self.m_c:] += ddu
-        return x1, st.lin.solve(b2, refine)
+        return x1, st.lin.solve(-b2)
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
                 iters: int = 8, anchor: Lin | None = None, first: bool = False) -> tuple:
