@@ -53,6 +53,12 @@ def _wrap(a):
     return math.pi - (math.pi - a) % (2 * math.pi)
 
 
+@njit(inline="always", **_OPTIONS)
+def _skew(a, i, j):
+    """Entry ``(i, j)`` of ``[a]x`` (``[a]x y = a × y``)."""
+    return 0.0 if i == j else (a[3 - i - j] if (j - i) % 3 == 2 else -a[3 - i - j])
+
+
 @njit(**_OPTIONS)
 def world(R, p, it, loc, W):
     """Every item's points and vectors at the pose into ``W`` (items, 4, 3): slot 1 on the
@@ -207,13 +213,7 @@ def move(R, p, x, R2, p2):
         E = np.empty((3, 3))
         for i in range(3):
             for j in range(3):
-                E[i, j] = b * w[i] * w[j] + (1 - b * t2 if i == j else 0.0)
-        E[0, 1] -= a * w[2]
-        E[0, 2] += a * w[1]
-        E[1, 0] += a * w[2]
-        E[1, 2] -= a * w[0]
-        E[2, 0] -= a * w[1]
-        E[2, 1] += a * w[0]
+                E[i, j] = b * w[i] * w[j] + (1 - b * t2 if i == j else 0.0) + a * _skew(w, i, j)
         Rk, pk = R[k].copy(), (p[k, 0], p[k, 1], p[k, 2])
         for i in range(3):
             for j in range(3):
@@ -279,23 +279,19 @@ def gram(J, rows, Gi):
 
 
 @njit(inline="always", **_OPTIONS)
+def _acc(A, x, y):
+    """``y += Aᵀ x`` along the rows of ``A`` (no reductions: it vectorises)."""
+    for r in range(A.shape[0]):
+        for c in range(A.shape[1]):
+            y[c] += x[r] * A[r, c]
+
+
+@njit(inline="always", **_OPTIONS)
 def _apply(J, Gi, rows, b, t, y):
-    """``y += J⁺ b`` by ``Gi`` (``t``: scratch of ``Gi``'s size); the products along rows."""
+    """``y += J⁺ b`` by ``Gi`` (``t``: scratch of ``Gi``'s size): ``Jᵀ (Gi b)`` or ``Gi (Jᵀ b)``."""
     t[:] = 0.0
-    if rows:  # Jᵀ (Gi b)
-        for r in range(Gi.shape[0]):
-            for c in range(Gi.shape[1]):
-                t[c] += b[r] * Gi[r, c]
-        for r in range(J.shape[0]):
-            for c in range(J.shape[1]):
-                y[c] += t[r] * J[r, c]
-    else:  # Gi (Jᵀ b)
-        for r in range(J.shape[0]):
-            for c in range(J.shape[1]):
-                t[c] += b[r] * J[r, c]
-        for r in range(Gi.shape[0]):
-            for c in range(Gi.shape[1]):
-                y[c] += t[r] * Gi[r, c]
+    _acc(Gi if rows else J, b, t)  # (Gi is symmetric)
+    _acc(J if rows else Gi, t, y)
 
 
 @njit(**_OPTIONS)
@@ -318,10 +314,10 @@ def solve(J, Gi, C, rows, b, refine, out):
 
 
 @njit(**_OPTIONS)
-def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, x1, x2):
+def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, refine, x1, x2):
     """:func:`evaluate` and :func:`gram` at every pose of a batch (B, ...) (``Gi`` (B, ...),
     or with no columns: not kept), and, where ``du`` (B, drives) has rows, the rates with
-    two steps of refinement: ``J x1 = (0, du)``, ``J x2 = (0, ddu) - γ(x1)``."""
+    ``refine`` steps of refinement: ``J x1 = (0, du)``, ``J x2 = (0, ddu) - γ(x1)``."""
     W = np.empty((T[0].shape[0], 4, 3))
     m, nc = g.shape[1], g.shape[1] - U.shape[1]
     Gs, rhs, gam = np.empty((J.shape[1], J.shape[1]) if rows else (J.shape[2], J.shape[2])), np.zeros(m), np.empty((1, m))
@@ -332,18 +328,11 @@ def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, x1, x2):
         if du.shape[0]:
             rhs[:nc] = 0.0
             rhs[nc:] = du[b]
-            solve(J[b], Gb, C[b], rows, rhs, 2, x1[b])
+            solve(J[b], Gb, C[b], rows, rhs, refine, x1[b])
             convective(T, R[b:b + 1], p[b:b + 1], x1[b:b + 1], W, gam)
             rhs[:] = -gam[0]
             rhs[nc:] += ddu[b]
-            solve(J[b], Gb, C[b], rows, rhs, 2, x2[b])
-
-
-@njit(**_OPTIONS)
-def solves(J, Gi, C, rows, b, out):
-    """:func:`solve` (no refinement) for every pose of a batch."""
-    for k in range(J.shape[0]):
-        solve(J[k], Gi[k], C[k], rows, b[k], 0, out[k])
+            solve(J[b], Gb, C[b], rows, rhs, refine, x2[b])
 
 
 @njit(**_OPTIONS)
@@ -416,8 +405,7 @@ def pair_errors(R, pi, pf, out):
             worst = 0.0
             for i in range(3):
                 for k in range(3):
-                    K = 0.0 if i == k else (a[3 - i - k] if (k - i) % 3 == 2 else -a[3 - i - k])
-                    rot = (ct if i == k else 0.0) + st * K + (1 - ct) * a[i] * a[k]
+                    rot = (ct if i == k else 0.0) + st * _skew(a, i, k) + (1 - ct) * a[i] * a[k]
                     worst = max(worst, abs(Rr[i, k] - rot))
             out[b, j] = worst
 

@@ -117,12 +117,6 @@ class Lin:
         X[:, :, 3:] += np.cross(self.C[:, :, :, None], Y[:, :, :3], axisa=2, axisb=2, axisc=2)
         return X.reshape(y.shape)
 
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        """``J⁺ b`` (B, 6 n) as twists at the origin, for right-hand sides ``b`` (B, m)."""
-        out = np.empty((len(b), self.Jc.shape[2]))
-        numba_kernel().solves(self.Jc, self.Gi, self.C, self.rows, np.ascontiguousarray(b, float), out)
-        return out
-
     def take(self, idx: np.ndarray) -> "Lin":
         return Lin(self.Jc[idx], self.Gi[idx], self.bound[idx], self.rows, self.r, self.C[idx])
 
@@ -173,7 +167,7 @@ class Tracker:
         self._left: tuple | None = None
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
-              rates: tuple | None = None) -> State:
+              rates: tuple | None = None, refine: int = 2) -> State:
         """The residuals, the pairs' angles and slides and the linearisation at B poses:
         the Jacobian in twists ``(ω, u)`` with ``u`` the velocity of each link's centre ``c``
         (``v = u + c × ω``) and the inverse of its Gram matrix.
@@ -184,8 +178,9 @@ class Tracker:
         and steps give the spin no component: idle spins stay at rest, whichever point the
         file measures from. The regular rank is the drawn assembly's (the first state's),
         by an SVD. With ``rates`` (the drives' rates and their derivatives, each (B,
-        drives)) the state keeps no inverse Gram matrices but the rates of :meth:`rates`
-        (two steps of refinement) in ``x``."""
+        drives)) the state keeps no inverse Gram matrices but the rates ``x`` (first and
+        second derivatives, ``J ξ' = u̇``, ``J ξ'' = ü - γ(ξ')``) with ``refine`` steps of
+        iterative refinement."""
         M, B, n, m = self.M, len(R), self.M.n, self.m
         R, p = np.ascontiguousarray(R, float), np.ascontiguousarray(p, float)
         q = m if self.rows else 6 * n
@@ -194,7 +189,7 @@ class Tracker:
         th, s = np.empty((B, M.angles.size)), np.empty((B, M.slides.size))
         du, ddu = (np.ascontiguousarray(r, float) for r in rates) if rates else (np.empty((0, len(M.drives))),) * 2
         numba_kernel().states(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
-                              self.rows, g, J, Gi, C, bound, th, s, du, ddu, x1, x2)
+                              self.rows, g, J, Gi, C, bound, th, s, du, ddu, refine, x1, x2)
         if self.rank is None:
             s0 = np.linalg.svd(J[0], compute_uv=False)
             self.rank = int(np.count_nonzero(s0 > self.rank_tol * s0[0])) if s0.size and s0[0] > 0 else 0
@@ -203,15 +198,11 @@ class Tracker:
         return State(R, p, href, th, s, Lin(J, Gi, bound, self.rows, self.rank, C), g, (x1, x2) if rates else None)
 
     def rates(self, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Twists (B, 6 n) of the links per input step ``du`` (B, drives) for a predictor:
-        first and second derivatives (``J ξ' = du``, ``J ξ'' = -γ(ξ')``); the rates reported
-        come from :meth:`state` (with steps of iterative refinement)."""
-        b = np.zeros(st.g.shape)
-        b[:, self.m_c:] = du
-        x1 = st.lin.solve(b)
-        b2 = np.empty(b.shape)
-        numba_kernel().convective(self.M.tables, st.R, st.p, x1, np.empty((len(self.M.tables[0]), 4, 3)), b2)
-        return x1, st.lin.solve(-b2)
+        """Twists (B, 6 n) of the links per input step ``du`` (B, drives) at the poses of
+        ``st`` (one, or B) for a predictor: first and second derivatives (``J ξ' = du``,
+        ``J ξ'' = -γ(ξ')``), without refinement."""
+        z = np.zeros(len(du), int) if len(st.R) == 1 else slice(None)
+        return self.state(st.R[z], st.p[z], st.href[z], np.zeros(du.shape), (du, np.zeros(du.shape)), 0).x
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
                 iters: int = 8, anchor: Lin | None = None, first: bool = False) -> tuple:
@@ -251,17 +242,6 @@ class Tracker:
                 self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
         return ok & ~self.last_bad
 
-    def step(self, st: State, du: np.ndarray, target: np.ndarray, iters: int = 8) -> tuple[State | None, float]:
-        """One predictor-corrector step of a single pose; (the new state or None, the
-        predictor's step size)."""
-        x1, x2 = self.rates(st, du[None])
-        size = float(np.abs(x1).max(initial=0.0))
-        if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
-            return None, size
-        R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        R, p, ok, _ = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]), iters=iters)
-        return (self.state(R, p, st.href, target[None]) if ok[0] else None), size
-
     def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
         """The rows ``Ub`` (K, drives) after the pose ``st`` (at inputs ``u0``), predicted
         from its tangents (:func:`_taylor`) and corrected in one call, first by chord steps
@@ -285,14 +265,14 @@ class Tracker:
             href = helix_angles(self.M, th, href)
         return n, size, (R[:n], p[:n], href[:n]), self.state(R[n - 1:n], p[n - 1:n], href[n - 1:n], Ub[n - 1:n])
 
-    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray, iters: int = 8) -> State | None:
-        """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
-        ``2^-MAX_HALVINGS`` of it; None when it cannot get there. ``iters``: Newton steps a
-        try (more next to a singular point, where Newton converges only linearly)."""
+    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+        """From ``st`` at inputs ``u0`` to ``u1`` by blocks of one row (:meth:`block`), halving
+        the step at trouble down to ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
         t, h = 0.0, 1.0
         while t < 1.0:
             h = min(h, 1.0 - t)
-            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0), iters)
+            _, size, _, nxt = self.block(st, u0 + t * (u1 - u0), (u0 + (t + h) * (u1 - u0))[None])
+            size = float(size[0])
             if nxt is None:
                 if h < 0.5 ** MAX_HALVINGS:
                     return None
@@ -629,7 +609,7 @@ def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndar
     D[np.arange(c), cols] = 1.0
     for q, (a, b) in enumerate(pairs):
         D[c + q, cols[a]] = D[c + q, cols[b]] = 1.0
-    X1, X2 = tr.rates(st.take(np.zeros(len(D), int)), D)
+    X1, X2 = tr.rates(st, D)
     d = du[:, cols]
     x1, x2 = d @ X1[:c], (d * d) @ X2[:c]
     for q, (a, b) in enumerate(pairs):
