@@ -58,7 +58,7 @@ from mechsyn.kinematics.spatial_model import SpatialModel, bar_motion, compile_s
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
-from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
+from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, point_speeds, singular_tol, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
 from mechsyn.kinematics.sweep import Event, as_event
 from mechsyn.kinematics.system import build_system
@@ -183,25 +183,13 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
 def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
     """Refuse drives that leave a joint point or a named point free to move at the pose
     ``st`` (one pose)."""
-    lin = st.lin
-    _, _, Vt = np.linalg.svd(lin.Jc[0], full_matrices=True)
-    N = lin.twists(Vt[lin.r:].T[None])[0]  # the motions with every drive at rest, as (ω, v)
-    if N.size == 0:
-        return
-    X = N.reshape(M.n, 6, -1)
-    worst = 0.0
-    checks = [(M.index(j.links[k]), M.local(j.point)) for j in M.mech.joints if j.point is not None
-              for k in (0, 1)]
-    checks += [(M.index(link), M.local(at)) for link, at in pts.values()]
-    for i, x0 in checks:
-        if i < M.n:
-            x = st.R[0, i] @ x0 + st.p[0, i]
-            w, v = X[i, :3], X[i, 3:]
-            worst = max(worst, float(np.abs(v + np.cross(w.T, x).T).max(initial=0.0)))
+    _, _, Vt = np.linalg.svd(st.lin.Jc[0], full_matrices=True)
+    N = st.lin.twists(Vt[st.lin.r:].T[None])[0].T  # the motions with every drive at rest, as (ω, v)
+    worst = point_speeds(M, st, N, tuple((M.index(link), M.local(at)) for link, at in pts.values())).max(initial=0.0)
     if worst > 1e-6:
         raise MechsynInputError(
             f"with the drives {', '.join(d[0] for d in M.drives)} at rest the mechanism can still move "
-            f"({N.shape[1]} free motion(s), not only idle spins): its motion is not determined",
+            f"({len(N)} free motion(s), not only idle spins): its motion is not determined",
             source=M.mech.source, field="joints[].actuated",
             hint="mark more joints actuated: true (each needs an input or keeps its drawn value)")
 

@@ -300,31 +300,27 @@ class Tracker:
 
 
 # --------------------------------------------------------------------------- leaving a singular pose
+def point_speeds(M: SpatialModel, st: State, X: np.ndarray, extra: tuple = ()) -> np.ndarray:
+    """The largest speed of a joint point, or of a point ``extra`` (link index, local point),
+    in each of the motions ``X`` (k, 6 n) (twists at the origin) at the first pose of ``st``."""
+    X = X.reshape(len(X), M.n, 6)
+    out = np.zeros(len(X))
+    for i, x0 in [(M.index(link), M.local(j.point)) for j in M.mech.joints if j.point is not None
+                  for link in j.links] + list(extra):
+        if i < M.n:
+            y = st.R[0, i] @ x0 + st.p[0, i]
+            out = np.maximum(out, np.abs(X[:, i, 3:] + np.cross(X[:, i, :3], y)).max(axis=1))
+    return out
+
+
 def _null_motions(tr: Tracker, st: State) -> np.ndarray:
     """The directions (k, 6 n) of the Jacobian's near-null space at ``st`` that move a
     joint point (not idle spins), each signed so its largest entry is positive."""
-    M = tr.M
-    Jc = st.lin.Jc[0]
-    _, s, Vt = np.linalg.svd(Jc, full_matrices=True)
+    _, s, Vt = np.linalg.svd(st.lin.Jc[0], full_matrices=True)
     s = np.concatenate([s, np.zeros(Vt.shape[0] - len(s))])
-    tol = singular_tol(M) * s[0]
-    out = []
-    for v in Vt[s < tol]:
-        x = st.lin.twists(v[None, :, None])[0, :, 0]
-        X = x.reshape(M.n, 6)
-        move_pt = 0.0
-        for j in M.mech.joints:
-            if j.point is None:
-                continue
-            x0 = M.local(j.point)
-            for link in j.links:
-                i = M.index(link)
-                if i < M.n:
-                    y = st.R[0, i] @ x0 + st.p[0, i]
-                    move_pt = max(move_pt, float(np.abs(X[i, 3:] + np.cross(X[i, :3], y)).max()))
-        if move_pt > 1e-6:
-            out.append(x if x[np.argmax(np.abs(x))] > 0 else -x)
-    return np.array(out).reshape(-1, 6 * M.n)
+    x = st.lin.twists(Vt[s < singular_tol(tr.M) * s[0]].T[None])[0].T
+    x = x[point_speeds(tr.M, st, x) > 1e-6]
+    return x * np.sign(x[np.arange(len(x)), np.argmax(np.abs(x), axis=1)])[:, None]
 
 
 def leave(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
