@@ -165,35 +165,34 @@ def _line_gamma(W, q, wa, va, wb, vb):
 
 @njit(**_OPTIONS)
 def convective(T, R, p, X, W, out):
-    """``γ`` (B, m) at the poses ``R``, ``p`` (B, ...) and origin twists ``X`` (B, 6 n):
-    every residual's second time derivative with ``ξ̇ = 0``."""
+    """``γ`` (m,) at the pose ``R``, ``p`` and origin twists ``X`` (6 n): every residual's
+    second time derivative with ``ξ̇ = 0``."""
     it, loc, ri, rf = T[0], T[1], T[2], T[3]
-    n = R.shape[1] - 1
-    for b in range(R.shape[0]):
-        world(R[b], p[b], it, loc, W)
-        for r in range(ri.shape[0]):
-            kind, q, q2, aux = ri[r, 0], ri[r, 1], ri[r, 2], ri[r, 3]
-            wa, va = _twist(X[b], it[q, 1], n)
-            wb, vb = _twist(X[b], it[q, 2], n)
-            if kind == 0:
-                ga = _x(wa, _ax(va, 1.0, _x(wa, _v(W, q, 0))))
-                gb = _x(wb, _ax(vb, 1.0, _x(wb, _v(W, q, 1))))
-                out[b, r] = ga[aux] - gb[aux]
-            elif kind == 1:
-                u, w = _v(W, q, 0), _v(W, q, 1)
-                ud, wd = _x(wa, u), _x(wb, w)
-                out[b, r] = _d(_x(wa, ud), w) + 2 * _d(ud, wd) + _d(u, _x(wb, wd))
-            elif kind == 2 or kind == 6:
-                out[b, r] = _line_gamma(W, q, wa, va, wb, vb)
-            elif kind == 3:
-                xa, xb = _v(W, q, 0), _v(W, q, 1)
-                Va, Vb = _ax(va, 1.0, _x(wa, xa)), _ax(vb, 1.0, _x(wb, xb))
-                dv = _ax(Va, -1.0, Vb)
-                out[b, r] = (_d(dv, dv) + _d(_ax(xa, -1.0, xb), _ax(_x(wa, Va), -1.0, _x(wb, Vb)))) / rf[r]
-            else:
-                qa = q2 if kind == 4 else q  # the angle's item
-                ga = _d(_ax(wb, -1.0, wa), _x(wa, _v(W, qa, 0)))
-                out[b, r] = _line_gamma(W, q, wa, va, wb, vb) - rf[r] * ga if kind == 4 else ga
+    n = R.shape[0] - 1
+    world(R, p, it, loc, W)
+    for r in range(ri.shape[0]):
+        kind, q, q2, aux = ri[r, 0], ri[r, 1], ri[r, 2], ri[r, 3]
+        wa, va = _twist(X, it[q, 1], n)
+        wb, vb = _twist(X, it[q, 2], n)
+        if kind == 0:
+            ga = _x(wa, _ax(va, 1.0, _x(wa, _v(W, q, 0))))
+            gb = _x(wb, _ax(vb, 1.0, _x(wb, _v(W, q, 1))))
+            out[r] = ga[aux] - gb[aux]
+        elif kind == 1:
+            u, w = _v(W, q, 0), _v(W, q, 1)
+            ud, wd = _x(wa, u), _x(wb, w)
+            out[r] = _d(_x(wa, ud), w) + 2 * _d(ud, wd) + _d(u, _x(wb, wd))
+        elif kind == 2 or kind == 6:
+            out[r] = _line_gamma(W, q, wa, va, wb, vb)
+        elif kind == 3:
+            xa, xb = _v(W, q, 0), _v(W, q, 1)
+            Va, Vb = _ax(va, 1.0, _x(wa, xa)), _ax(vb, 1.0, _x(wb, xb))
+            dv = _ax(Va, -1.0, Vb)
+            out[r] = (_d(dv, dv) + _d(_ax(xa, -1.0, xb), _ax(_x(wa, Va), -1.0, _x(wb, Vb)))) / rf[r]
+        else:
+            qa = q2 if kind == 4 else q  # the angle's item
+            ga = _d(_ax(wb, -1.0, wa), _x(wa, _v(W, qa, 0)))
+            out[r] = _line_gamma(W, q, wa, va, wb, vb) - rf[r] * ga if kind == 4 else ga
 
 
 @njit(**_OPTIONS)
@@ -320,7 +319,7 @@ def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, refine, 
     ``refine`` steps of refinement: ``J x1 = (0, du)``, ``J x2 = (0, ddu) - γ(x1)``."""
     W = np.empty((T[0].shape[0], 4, 3))
     m, nc = g.shape[1], g.shape[1] - U.shape[1]
-    Gs, rhs, gam = np.empty((J.shape[1], J.shape[1]) if rows else (J.shape[2], J.shape[2])), np.zeros(m), np.empty((1, m))
+    Gs, rhs, gam = np.empty((J.shape[1], J.shape[1]) if rows else (J.shape[2], J.shape[2])), np.zeros(m), np.empty(m)
     for b in range(R.shape[0]):
         Gb = Gi[b] if Gi.shape[1] else Gs
         evaluate(R[b], p[b], T, href[b], U[b], W, g[b], J[b], C[b], th[b], sl[b])
@@ -329,8 +328,8 @@ def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, refine, 
             rhs[:nc] = 0.0
             rhs[nc:] = du[b]
             solve(J[b], Gb, C[b], rows, rhs, refine, x1[b])
-            convective(T, R[b:b + 1], p[b:b + 1], x1[b:b + 1], W, gam)
-            rhs[:] = -gam[0]
+            convective(T, R[b], p[b], x1[b], W, gam)
+            rhs[:] = -gam
             rhs[nc:] += ddu[b]
             solve(J[b], Gb, C[b], rows, rhs, refine, x2[b])
 

@@ -54,7 +54,7 @@ import numpy as np
 
 from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
-from mechsyn.kinematics.spatial_model import SpatialModel, bar_motion, compile_spatial, drive_angle, planar_as_spatial
+from mechsyn.kinematics.spatial_model import SpatialModel, bar_motion, compile_spatial, planar_as_spatial
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
@@ -489,7 +489,7 @@ def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> li
         notes.append(f"{tr.rejected} converged pose(s) refused: another root of a pair's equations (an R axis "
                      "reversed or a slide half-turned), not the file's pairs")
     col = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
-    if len(col) == 1 and drive_angle(M)[col[0]]:
+    if len(col) == 1 and M.drives[col[0]][1] == "angle":
         u = U[:, col[0]]
         turns = rows.ok & (np.abs(np.mod(u + np.pi, 2 * np.pi) - np.pi) < 1e-9) & (np.abs(u) > 1e-9)
         off = [k for k in np.flatnonzero(turns) if np.abs(rows.R[k] - np.eye(3)).max() > 1e-6

@@ -450,11 +450,6 @@ def tables(M: SpatialModel) -> tuple:
             ang.astype(np.int64), sl.astype(np.int64))
 
 
-def drive_angle(M: SpatialModel) -> np.ndarray:
-    """Per drive, whether it is an angle."""
-    return np.array([kind == "angle" for _, kind, _ in M.drives], bool)
-
-
 # --------------------------------------------------------------------------- poses
 # Batches of B poses: rotations R (B, n + 1, 3, 3), positions p (B, n + 1, 3) (the frame
 # last, at rest), twists (B, 6 n), targets (B, drives).
@@ -473,16 +468,11 @@ def move(R: np.ndarray, p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.nd
     return R2, p2
 
 
-def wrap(a: np.ndarray) -> np.ndarray:
-    """Angles to (-π, π]."""
-    return np.pi - np.mod(np.pi - a, 2 * np.pi)
-
-
 def helix_angles(M: SpatialModel, theta: np.ndarray, helix_ref: np.ndarray) -> np.ndarray:
     """The H pairs' rotations unwrapped next to ``helix_ref`` (their previous values), from
     the pairs' angles ``theta`` (B, angles)."""
     h = np.array([a for a, _, _ in M.helix], int)
-    return helix_ref + wrap(theta[:, h] - helix_ref)
+    return helix_ref + np.pi - np.mod(np.pi - theta[:, h] + helix_ref, 2 * np.pi)  # (the change to (-π, π])
 
 
 # --------------------------------------------------------------------------- bars

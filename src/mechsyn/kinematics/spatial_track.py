@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.spatial_model import SpatialModel, drive_angle, helix_angles, move, numba_kernel, pair_error
+from mechsyn.kinematics.spatial_model import SpatialModel, helix_angles, move, numba_kernel, pair_error
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 
@@ -427,7 +427,7 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
 def _turning(M: SpatialModel, U: np.ndarray) -> int | None:
     """The column of ``U`` of the sweep's one moving input when it is an angle, else None."""
     moving = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
-    if len(moving) != 1 or not drive_angle(M)[moving[0]]:
+    if len(moving) != 1 or M.drives[moving[0]][1] != "angle":
         return None
     return int(moving[0])
 
