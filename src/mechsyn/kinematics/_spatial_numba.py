@@ -197,29 +197,31 @@ def convective(T, R, p, X, W, out):
 
 @njit(**_OPTIONS)
 def move(R, p, x, R2, p2):
-    """The pose ``R``, ``p`` displaced by the twists ``x`` (6 n) of the moving links (``exp``
-    of each twist, Murray et al., eq. 2.36) into ``R2``, ``p2`` (may be ``R``, ``p``)."""
-    for k in range(R.shape[0] - 1):
-        w, v = (x[6 * k], x[6 * k + 1], x[6 * k + 2]), (x[6 * k + 3], x[6 * k + 4], x[6 * k + 5])
-        t2 = _d(w, w)
-        if t2 < 1e-4:  # sin θ / θ, (1 - cos θ) / θ², (θ - sin θ) / θ³ by their series to θ⁴
-            a, b, c = 1 - t2 / 6 + t2 * t2 / 120, 0.5 - t2 / 24 + t2 * t2 / 720, 1.0 / 6 - t2 / 120 + t2 * t2 / 5040
-        else:
-            t = math.sqrt(t2)
-            a, b, c = math.sin(t) / t, 2 * (math.sin(0.5 * t) / t) ** 2, (t - math.sin(t)) / (t * t2)
-        wv = _x(w, v)
-        tr = _ax(_ax(v, b, wv), c, _x(w, wv))
-        E = np.empty((3, 3))
-        for i in range(3):
-            for j in range(3):
-                E[i, j] = b * w[i] * w[j] + (1 - b * t2 if i == j else 0.0) + a * _skew(w, i, j)
-        Rk, pk = R[k].copy(), (p[k, 0], p[k, 1], p[k, 2])
-        for i in range(3):
-            for j in range(3):
-                R2[k, i, j] = E[i, 0] * Rk[0, j] + E[i, 1] * Rk[1, j] + E[i, 2] * Rk[2, j]
-            p2[k, i] = E[i, 0] * pk[0] + E[i, 1] * pk[1] + E[i, 2] * pk[2] + tr[i]
-    n = R.shape[0] - 1
-    R2[n], p2[n] = R[n], p[n]
+    """The poses ``R``, ``p`` (B, ...) displaced by the twists ``x`` (B, 6 n) of the moving
+    links (``exp`` of each twist, Murray et al., eq. 2.36) into ``R2``, ``p2`` (may be ``R``,
+    ``p``)."""
+    n = R.shape[1] - 1
+    for b in range(R.shape[0]):
+        for k in range(n):
+            w, v = (x[b, 6 * k], x[b, 6 * k + 1], x[b, 6 * k + 2]), (x[b, 6 * k + 3], x[b, 6 * k + 4], x[b, 6 * k + 5])
+            t2 = _d(w, w)
+            if t2 < 1e-4:  # sin θ / θ, (1 - cos θ) / θ², (θ - sin θ) / θ³ by their series to θ⁴
+                a, c, e = 1 - t2 / 6 + t2 * t2 / 120, 0.5 - t2 / 24 + t2 * t2 / 720, 1.0 / 6 - t2 / 120 + t2 * t2 / 5040
+            else:
+                t = math.sqrt(t2)
+                a, c, e = math.sin(t) / t, 2 * (math.sin(0.5 * t) / t) ** 2, (t - math.sin(t)) / (t * t2)
+            wv = _x(w, v)
+            tr = _ax(_ax(v, c, wv), e, _x(w, wv))
+            E = np.empty((3, 3))
+            for i in range(3):
+                for j in range(3):
+                    E[i, j] = c * w[i] * w[j] + (1 - c * t2 if i == j else 0.0) + a * _skew(w, i, j)
+            Rk, pk = R[b, k].copy(), (p[b, k, 0], p[b, k, 1], p[b, k, 2])
+            for i in range(3):
+                for j in range(3):
+                    R2[b, k, i, j] = E[i, 0] * Rk[0, j] + E[i, 1] * Rk[1, j] + E[i, 2] * Rk[2, j]
+                p2[b, k, i] = E[i, 0] * pk[0] + E[i, 1] * pk[1] + E[i, 2] * pk[2] + tr[i]
+        R2[b, n], p2[b, n] = R[b, n], p[b, n]
 
 
 @njit(**_OPTIONS)
@@ -258,9 +260,7 @@ def gram(J, rows, Gi):
     ``Jᵀ J``, plus ``1e-14`` of its largest diagonal entry), and the lower bound
     ``1 / √(‖G‖_F ‖G⁻¹‖_F)`` of ``σ_r / σ_1`` (0 where not finite)."""
     G = J @ J.T if rows else J.T @ J
-    top = trace = 0.0
-    for i in range(G.shape[0]):
-        top, trace = max(top, G[i, i]), trace + G[i, i]
+    top, trace = np.max(np.diag(G)), np.sum(np.diag(G))
     for i in range(G.shape[0]):
         G[i, i] += 1e-14 * top + 1e-300
     if not np.isfinite(trace):  # (a NaN or inf in J is one on the diagonal)
@@ -268,12 +268,7 @@ def gram(J, rows, Gi):
         return 0.0
     if not _spd_inverse(G, Gi):  # (positive definite but for rounding: a rank drop)
         Gi[:] = np.linalg.inv(G)
-    sg = si = 0.0
-    for i in range(G.shape[0]):
-        for j in range(G.shape[1]):
-            sg += G[i, j] * G[i, j]
-            si += Gi[i, j] * Gi[i, j]
-    out = 1.0 / math.sqrt(math.sqrt(sg * si))
+    out = 1.0 / math.sqrt(math.sqrt(np.sum(G * G) * np.sum(Gi * Gi)))
     return out if np.isfinite(out) else 0.0
 
 
@@ -335,13 +330,6 @@ def states(T, R, p, href, U, rows, g, J, Gi, C, bound, th, sl, du, ddu, refine, 
 
 
 @njit(**_OPTIONS)
-def moves(R, p, x, R2, p2):
-    """:func:`move` for every pose of a batch."""
-    for b in range(R.shape[0]):
-        move(R[b], p[b], x[b], R2[b], p2[b])
-
-
-@njit(**_OPTIONS)
 def correct(T, R, p, href, U, limit, iters, tol, Ja, Ga, Ca, rows, first, ok, th, sl):
     """Newton corrections of the poses ``R``, ``p`` (B, ...) in place towards the inputs
     ``U`` (B, drives) (see :meth:`mechsyn.kinematics.spatial_track.Tracker.correct`):
@@ -354,9 +342,8 @@ def correct(T, R, p, href, U, limit, iters, tol, Ja, Ga, Ca, rows, first, ok, th
     and slides of the last iterate."""
     m, nk = T[2].shape[0], 6 * (R.shape[1] - 1)
     W = np.empty((T[0].shape[0], 4, 3))
-    g, dx = np.empty(m), np.empty(nk)
+    g, dx, no_J = np.empty(m), np.empty(nk), np.empty((0, nk))
     J, C, Gi = np.empty((m, nk)), np.empty((R.shape[1] - 1, 3)), np.empty_like(Ga)
-    no_J = np.empty((0, nk))
     Jl, Gl, Cl = Ja, Ga, Ca
     for b in range(R.shape[0]):
         have = Ja.shape[0] > 0  # (then the latest linearisation: the anchor's or a row's before)
@@ -378,7 +365,8 @@ def correct(T, R, p, href, U, limit, iters, tol, Ja, Ga, Ca, rows, first, ok, th
             moved += np.max(np.abs(dx))
             if moved > limit[b]:
                 break
-            move(R[b], p[b], -dx, R[b], p[b])
+            dx *= -1.0
+            move(R[b:b + 1], p[b:b + 1], dx.reshape(1, nk), R[b:b + 1], p[b:b + 1])
         ok[b] = done
         if first and not done:
             return

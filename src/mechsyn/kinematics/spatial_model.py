@@ -442,10 +442,8 @@ def tables(M: SpatialModel) -> tuple:
     ri += [(5, ang[k], 0, col) if kind == "angle" else (6, sl[k], 0, col) for col, (_, kind, k) in enumerate(M.drives)]
     rf = np.concatenate([np.zeros(3 * M.pc.size), M.dot.c0, M.line.c0, M.dist.c0, [h for _, _, h in M.helix],
                          np.zeros(len(M.drives))])
-    cen = np.zeros((M.n, 3))
-    for i, link in enumerate(M.links):
-        pts = [M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
-        cen[i] = np.mean(pts, axis=0) if pts else 0.0
+    cen = np.array([np.mean([M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
+                            or [np.zeros(3)], axis=0) for link in M.links]).reshape(-1, 3)
     return (it, np.ascontiguousarray(loc), np.array(ri, np.int64).reshape(-1, 4), rf.astype(float), cen,
             ang.astype(np.int64), sl.astype(np.int64))
 
@@ -464,7 +462,7 @@ def move(R: np.ndarray, p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.nd
     ([0.0, 1.0, 0.0], [0.63662, 0.63662, 0.0])
     """
     R2, p2 = np.empty(R.shape), np.empty(p.shape)
-    numba_kernel().moves(np.ascontiguousarray(R, float), np.ascontiguousarray(p, float), np.ascontiguousarray(x, float), R2, p2)
+    numba_kernel().move(*(np.ascontiguousarray(a, float) for a in (R, p, x)), R2, p2)
     return R2, p2
 
 

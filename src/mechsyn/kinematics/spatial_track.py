@@ -205,11 +205,12 @@ class Tracker:
         return self.state(st.R[z], st.p[z], st.href[z], np.zeros(du.shape), (du, np.zeros(du.shape)), 0).x
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
-                iters: int = 8, anchor: Lin | None = None, first: bool = False) -> tuple:
+                iters: int = 8, anchor: Lin | None = None, first: bool = False, tol: float | None = None) -> tuple:
         """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
         those that converged without moving further than ``limit`` and are true assemblies
         (:meth:`true_pairs`), and the pairs' angles at the last iterate. ``first``: stop at
-        the first pose that fails (a block keeps its rows up to there).
+        the first pose that fails (a block keeps its rows up to there); ``tol``: the residual
+        to reach (default the tracker's; 0 polishes ``iters`` steps).
 
         Chord steps: each pose keeps its linearisation (``anchor``'s, the first pose of
         ``anchor`` serving all, when given) while its residual falls at least tenfold per
@@ -218,14 +219,12 @@ class Tracker:
         B, M = len(R), self.M
         R, p = np.array(R, float, order="C"), np.array(p, float, order="C")
         q = self.m if self.rows else 6 * M.n
-        if anchor is None:
-            Ja, Ga, Ca = np.empty((0, 6 * M.n)), np.empty((q, q)), np.empty((M.n, 3))
-        else:
-            Ja, Ga, Ca = anchor.Jc[0], anchor.Gi[0], anchor.C[0]
+        Ja, Ga, Ca = (np.empty((0, 6 * M.n)), np.empty((q, q)), np.empty((M.n, 3))) if anchor is None else (
+            anchor.Jc[0], anchor.Gi[0], anchor.C[0])
         ok, th, s = np.zeros(B, bool), np.zeros((B, M.angles.size)), np.zeros((B, M.slides.size))
         numba_kernel().correct(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
-                      np.broadcast_to(np.asarray(limit, float), (B,)).copy(), iters, self.tol, Ja, Ga, Ca, self.rows,
-                      first, ok, th, s)
+                               np.broadcast_to(np.asarray(limit, float), (B,)).copy(), iters,
+                               self.tol if tol is None else tol, Ja, Ga, Ca, self.rows, first, ok, th, s)
         return R, p, self.true_pairs(R, ok), th
 
     def true_pairs(self, R: np.ndarray, ok: np.ndarray) -> np.ndarray:
@@ -237,9 +236,8 @@ class Tracker:
         err = pair_error(self.M, R[ok])
         self.last_bad[ok] = err.max(axis=1) > PAIR_TOL
         self.rejected += int(self.last_bad.sum())
-        for b, e in zip(np.flatnonzero(ok), err):
-            if e.max() > PAIR_TOL:
-                self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
+        for b, e in zip(np.flatnonzero(self.last_bad), err[self.last_bad[ok]]):
+            self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
         return ok & ~self.last_bad
 
     def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
@@ -578,13 +576,7 @@ def polished_ratio(tr: Tracker, R: np.ndarray, p: np.ndarray, href: np.ndarray, 
     B = len(u)
     inf = np.full(B, np.inf)
     R, p, ok, _ = tr.correct(R, p, href, u, inf, iters=iters)
-    tol, halvings = tr.tol, tr.halvings
-    tr.tol = 0.0
-    try:
-        R, p, _, _ = tr.correct(R, p, href, u, inf, iters=polish)
-    finally:
-        tr.tol = tol
-        tr.halvings = halvings
+    R, p, _, _ = tr.correct(R, p, href, u, inf, iters=polish, tol=0.0)
     out = np.full(B, np.inf)
     if ok.any():
         good = np.flatnonzero(ok)
