@@ -58,7 +58,7 @@ from mechsyn.kinematics.spatial_model import SpatialModel, bar_motion, compile_s
 from mechsyn.progress import ProgressCallback, report
 from mechsyn.kinematics.spatial_singular import crossings
 from mechsyn.kinematics.spatial_model import pair_error
-from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, singular_tol, walk
+from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, point_speeds, singular_tol, walk
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
 from mechsyn.kinematics.sweep import Event, as_event
 from mechsyn.kinematics.system import build_system
@@ -183,25 +183,13 @@ def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
 def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
     """Refuse drives that leave a joint point or a named point free to move at the pose
     ``st`` (one pose)."""
-    lin = st.lin
-    _, _, Vt = np.linalg.svd(lin.Jc[0], full_matrices=True)
-    N = lin.twists(Vt[lin.r:].T[None])[0]  # the motions with every drive at rest, as (ω, v)
-    if N.size == 0:
-        return
-    X = N.reshape(M.n, 6, -1)
-    worst = 0.0
-    checks = [(M.index(j.links[k]), M.local(j.point)) for j in M.mech.joints if j.point is not None
-              for k in (0, 1)]
-    checks += [(M.index(link), M.local(at)) for link, at in pts.values()]
-    for i, x0 in checks:
-        if i < M.n:
-            x = st.R[0, i] @ x0 + st.p[0, i]
-            w, v = X[i, :3], X[i, 3:]
-            worst = max(worst, float(np.abs(v + np.cross(w.T, x).T).max(initial=0.0)))
+    _, _, Vt = np.linalg.svd(st.lin.Jc[0], full_matrices=True)
+    N = st.lin.twists(Vt[st.lin.r:].T[None])[0].T  # the motions with every drive at rest, as (ω, v)
+    worst = point_speeds(M, st, N, tuple((M.index(link), M.local(at)) for link, at in pts.values())).max(initial=0.0)
     if worst > 1e-6:
         raise MechsynInputError(
             f"with the drives {', '.join(d[0] for d in M.drives)} at rest the mechanism can still move "
-            f"({N.shape[1]} free motion(s), not only idle spins): its motion is not determined",
+            f"({len(N)} free motion(s), not only idle spins): its motion is not determined",
             source=M.mech.source, field="joints[].actuated",
             hint="mark more joints actuated: true (each needs an input or keeps its drawn value)")
 
@@ -225,11 +213,7 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
     mech = planar_as_spatial(mech)  # a planar file: its 3-D equivalent, with the planar zero
     inputs = _check_inputs(mech, inputs)
     M = compile_spatial(mech, _drives(mech, inputs))
-    from threadpoolctl import threadpool_limits  # deferred: finding the BLAS costs more than a small sweep
-
-    with threadpool_limits(limits=1, user_api="blas"):  # many small solves: threads only contend (measured
-        # on a Bennett sweep: 74 ms with one thread, 156 ms with two on a busy machine)
-        return _simulate(mech, M, inputs, speeds, points, progress)
+    return _simulate(mech, M, inputs, speeds, points, progress)
 
 
 def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
@@ -381,7 +365,7 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
                 np.full((N, M.slides.size), np.nan), w.events, w.how)
     idx = np.flatnonzero(w.ok)
     if len(idx):
-        st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx])
+        st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx], rates=(rates[0][idx], rates[1][idx]))
         keep = _verify(tr, w, idx, st, event)
         if not keep.all():
             idx, st = idx[keep], st.take(np.flatnonzero(keep))
@@ -389,8 +373,8 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
         _regular_rank(tr, st)
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
         out.ratio[idx] = st.lin.ratio
-        out.theta[idx], out.slide[idx] = st.F.theta, st.F.s
-        x1, x2 = tr.rates(st, rates[0][idx], refine=2, ddu=rates[1][idx])
+        out.theta[idx], out.slide[idx] = st.theta, st.s
+        x1, x2 = st.x
         regular = st.lin.ratio >= singular_tol(M)
         found = crossings(tr, w, U, out.ratio, st.lin.Jc, idx)
         on_row = {c[3] for c in found if c[3] is not None}
@@ -448,7 +432,7 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
-    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid, ok)
+    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid)
     X, Xd = X.reshape(len(ok), -1, 6), Xd.reshape(len(ok), -1, 6)
     links = {}
     for i, name in enumerate(M.all_links):
@@ -505,7 +489,7 @@ def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> li
         notes.append(f"{tr.rejected} converged pose(s) refused: another root of a pair's equations (an R axis "
                      "reversed or a slide half-turned), not the file's pairs")
     col = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
-    if len(col) == 1 and M.lay.d_angle[col[0]]:
+    if len(col) == 1 and M.drives[col[0]][1] == "angle":
         u = U[:, col[0]]
         turns = rows.ok & (np.abs(np.mod(u + np.pi, 2 * np.pi) - np.pi) < 1e-9) & (np.abs(u) > 1e-9)
         off = [k for k in np.flatnonzero(turns) if np.abs(rows.R[k] - np.eye(3)).max() > 1e-6

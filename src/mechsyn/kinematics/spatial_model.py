@@ -71,7 +71,9 @@ References
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass, replace
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -80,40 +82,10 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.model.mechanism import Joint, Mechanism
 from mechsyn.structure.screws import _perp_basis, _unit
 
-__all__ = ["SpatialModel", "compile_spatial", "SPATIAL_PAIRS", "exp_twists"]
+__all__ = ["SpatialModel", "compile_spatial", "SPATIAL_PAIRS", "move", "tables"]
 
 #: Pair types the spatial engine moves.
 SPATIAL_PAIRS = ("R", "P", "C", "U", "S", "H")
-
-_EPS = np.zeros((3, 3, 3))
-_EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
-_EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
-
-
-_I, _I1, _I2 = np.arange(3), np.array([1, 2, 0]), np.array([2, 0, 1])
-_SKEW = -_EPS.transpose(2, 0, 1).reshape(3, 9)  # ω @ _SKEW: [ω]x (ω x y = [ω]x y), flattened
-_EYE9 = np.eye(3).ravel()
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product over the last axis (fewer NumPy calls than ``np.cross``)."""
-    return a[..., _I1] * b[..., _I2] - a[..., _I2] * b[..., _I1]
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return (a * b).sum(axis=-1)
-
-
-def rotate(R: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``R @ x`` over the last axes for rotations ``R`` (..., k, 3, 3) and vectors ``x`` (k, 3),
-    as three products of columns (a stack of 3 x 3 products against a broadcast vector is
-    several times slower in NumPy)."""
-    return R[..., 0] * x[:, 0, None] + R[..., 1] * x[:, 1, None] + R[..., 2] * x[:, 2, None]
-
-
-def matvec(A: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``A @ x`` over the last axes for matrices ``A`` (..., 3, 3) and vectors ``x`` (..., 3)."""
-    return A[..., 0] * x[..., 0, None] + A[..., 1] * x[..., 1, None] + A[..., 2] * x[..., 2, None]
 
 
 def _rows(x: np.ndarray) -> np.ndarray:
@@ -170,7 +142,8 @@ class SpatialModel:
     slide_joints: tuple[str, ...]
     helix: tuple[tuple[int, int, float], ...]
     drives: tuple[tuple[str, str, int], ...]
-    lay: "_Layout | None" = None
+    #: the equations as the compiled functions' tables (:func:`tables`)
+    tables: tuple = ()
     ulp: float = float(np.finfo(float).eps)
     pairs: "_Pairs | None" = None
     #: per angle joint (``angle_joints``), its input's value at the drawn assembly (rad):
@@ -310,7 +283,7 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
                      tuple(rows["slide_joints"]), helix, tuple(drive_rows),
                      ulp=float(np.finfo(float).eps) * max(1.0, big / scale), bars=tuple(bars))
     zeros = np.array([input_zero(mech, mech.joint(jid.partition("/")[0])) for jid in M.angle_joints], float)
-    return replace(M, lay=_layout(M), pairs=_pairs(mech, index), zeros=zeros)
+    return replace(M, tables=tables(M), pairs=_pairs(mech, index), zeros=zeros)
 
 
 def _bars(mech: Mechanism) -> dict[str, tuple[Joint, Joint]]:
@@ -411,29 +384,24 @@ def input_zero(mech: Mechanism, j: Joint) -> float:
 @dataclass(frozen=True, eq=False)
 class _Pairs:
     """The pairs whose equations admit other roots: R, C, H (axis ``a`` with ``e1``, ``e2``
-    perpendicular, ``turns``) and P (``turns`` False), between poses ``ia`` and ``ib``."""
+    perpendicular, turning) and P (not turning), as :func:`pair_error`'s arrays: ``pi``
+    (pairs, 3) the two links and whether the pair turns, ``pf`` (pairs, 3, 3) ``a``, ``e1``,
+    ``e2``."""
 
     ids: tuple[str, ...]
-    ia: np.ndarray
-    ib: np.ndarray
-    a: np.ndarray
-    e1: np.ndarray
-    e2: np.ndarray
-    turns: np.ndarray
+    pi: np.ndarray
+    pf: np.ndarray
 
 
 def _pairs(mech: Mechanism, index: dict[str, int]) -> _Pairs:
-    rows = []
+    ids, pi, pf = [], [], []
     for j in mech.joints:
         if j.type in ("R", "C", "H", "P"):
             a = _unit(np.asarray(j.axis, float))
-            e1, e2 = _perp_basis(a)
-            rows.append((j.id, index[j.links[0]], index[j.links[1]], a, e1, e2, j.type != "P"))
-    if not rows:
-        z = np.zeros((0, 3))
-        return _Pairs((), np.zeros(0, int), np.zeros(0, int), z, z, z, np.zeros(0, bool))
-    ids, ia, ib, a, e1, e2, turns = zip(*rows)
-    return _Pairs(ids, np.array(ia), np.array(ib), np.array(a), np.array(e1), np.array(e2), np.array(turns))
+            ids.append(j.id)
+            pi.append((index[j.links[0]], index[j.links[1]], int(j.type != "P")))
+            pf.append((a, *_perp_basis(a)))
+    return _Pairs(tuple(ids), np.array(pi, np.int64).reshape(-1, 3), np.array(pf, float).reshape(-1, 3, 3))
 
 
 def pair_error(M: SpatialModel, R: np.ndarray) -> np.ndarray:
@@ -444,346 +412,101 @@ def pair_error(M: SpatialModel, R: np.ndarray) -> np.ndarray:
     or a P pair half-turned. Because every pair's relative displacement is then the one its
     joint values give, the joint values close every loop (their displacements compose, around
     any loop, to the product of the links' relative poses, which is the identity)."""
-    P = M.pairs
-    if P is None or not len(P.ia):
-        return np.zeros((len(R), 0))
-    Rr = np.swapaxes(R[:, P.ia], -1, -2) @ R[:, P.ib]
-    r1 = matvec(Rr, P.e1)                                 # R_rel e1 (B, pairs, 3)
-    c, s = _dot(r1, P.e1), _dot(r1, P.e2)
-    th = np.where(P.turns, np.arctan2(s, c), 0.0)
-    K = np.einsum("ijk,nk->nij", -_EPS, P.a)              # [a]x: K y = a x y
-    aa = P.a[:, :, None] * P.a[:, None, :]
-    ct, st = np.cos(th)[..., None, None], np.sin(th)[..., None, None]
-    Rot = ct * np.eye(3) + st * K + (1 - ct) * aa
-    return np.abs(Rr - Rot).max(axis=(-1, -2))
+    out = np.zeros((len(R), len(M.pairs.ids)))
+    if out.size:
+        numba_kernel().pair_errors(np.ascontiguousarray(R), M.pairs.pi, M.pairs.pf, out)
+    return out
 
 
-# --------------------------------------------------------------------------- layout
-@dataclass(frozen=True, eq=False)
-class _Layout:
-    """Gather and scatter indices of the equations, built once per model: every link-fixed
-    point (``pidx``, ``ploc``) and vector (``vidx``, ``vloc``) transformed in one product,
-    every variable Jacobian entry written in one scatter (``ri``, ``ci``) over a template
-    holding the constant ones, the scalar rows' links (``sa``, ``sb``)."""
-
-    pidx: np.ndarray
-    ploc: np.ndarray
-    vidx: np.ndarray
-    vloc: np.ndarray
-    psl: dict
-    vsl: dict
-    J0: np.ndarray
-    ri: np.ndarray
-    ci: np.ndarray
-    h_ang: np.ndarray
-    h_sl: np.ndarray
-    h_pitch: np.ndarray
-    d_meas: np.ndarray
-    d_angle: np.ndarray
+# --------------------------------------------------------------------------- tables
+def numba_kernel() -> ModuleType:
+    """The compiled functions (:mod:`mechsyn.kinematics._spatial_numba`), imported on the
+    first spatial sweep (importing Numba costs a command that moves nothing)."""
+    return importlib.import_module("mechsyn.kinematics._spatial_numba")
 
 
-def _slices(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, dict]:
-    sl, start = {}, 0
-    for name, idx, _ in parts:
-        sl[name] = slice(start, start + len(idx))
-        start += len(idx)
-    idx = np.concatenate([p[1] for p in parts]).astype(int)
-    loc = np.concatenate([p[2].reshape(-1, 3) for p in parts])
-    return idx, loc, sl
-
-
-def _layout(M: SpatialModel) -> _Layout:
-    pc, dt, ln, an, sl, ds = M.pc, M.dot, M.line, M.angles, M.slides, M.dist
-    pidx, ploc, psl = _slices([("xa", pc.ia, pc.va), ("xb", pc.ib, pc.vb), ("la", ln.ia, ln.va),
-                               ("lb", ln.ib, ln.vb), ("sa", sl.ia, sl.va), ("sb", sl.ib, sl.vb),
-                               ("da", ds.ia, ds.va), ("db", ds.ib, ds.vb)])
-    vidx, vloc, vsl = _slices([("u", dt.ia, dt.va), ("w", dt.ib, dt.vb), ("ln", ln.ia, ln.n),
-                               ("aa", an.ia, an.va), ("e1b", an.ib, an.vb), ("e1a", an.ia, an.n),
-                               ("e2a", an.ia, an.m), ("sn", sl.ia, sl.n)])
-    n, k = M.n, pc.size
-    m = M.n_constraints + len(M.drives)
-    J0 = np.zeros((m, 6 * (n + 1)))
-    rows = np.arange(3 * k).reshape(k, 3)
-    ar = np.arange(3)
-    J0[rows, 6 * pc.ia[:, None] + 3 + ar] = 1.0
-    J0[rows, 6 * pc.ib[:, None] + 3 + ar] = -1.0
-    ri, ci = [], []
-    for links in (pc.ia, pc.ib):  # the 3 x 3 blocks d(x)/dω of the coincidences
-        ri.append(np.broadcast_to(rows[:, :, None], (k, 3, 3)).ravel())
-        ci.append(np.broadcast_to((6 * links[:, None] + ar)[:, None, :], (k, 3, 3)).ravel())
-    h = np.array(M.helix, float).reshape(-1, 3)
-    d_angle = np.array([kind == "angle" for _, kind, _ in M.drives], bool)
-    d_meas = np.array([kk if kind == "angle" else an.size + kk for _, kind, kk in M.drives], int)
-    d_links = [(an.ia[kk], an.ib[kk]) if kind == "angle" else (sl.ia[kk], sl.ib[kk]) for _, kind, kk in M.drives]
-    h_sl = h[:, 1].astype(int)
-    sa = np.concatenate([dt.ia, ln.ia, ds.ia, sl.ia[h_sl], [a for a, _ in d_links]]).astype(int)
-    sb = np.concatenate([dt.ib, ln.ib, ds.ib, sl.ib[h_sl], [b for _, b in d_links]]).astype(int)
-    srow = 3 * k + np.arange(len(sa))
-    for links in (sa, sb, sa, sb):  # c at a, -c at b, -n at a, +n at b
-        ri.append(np.repeat(srow, 3))
-        ci.append((6 * links[:, None] + ar).ravel())
-    ci[-2:] = [c + 3 for c in ci[-2:]]
-    return _Layout(pidx, ploc, vidx, vloc, psl, vsl, J0, np.concatenate(ri), np.concatenate(ci),
-                   h[:, 0].astype(int), h[:, 1].astype(int), h[:, 2], d_meas, d_angle)
+def tables(M: SpatialModel) -> tuple:
+    """The equations as the compiled functions' tables (see :mod:`mechsyn.kinematics._spatial_numba`):
+    items ``it`` (kind, links), ``loc`` (their four local vectors), rows ``ri`` (kind, item,
+    second item, component or input column), ``rf`` (constants), the links' centres, the
+    items of the angles and slides measured. Rows in :func:`residual`'s order: coincidences,
+    dots, lines, distances, helices, drives."""
+    kinds = [(0, M.pc), (1, M.dot), (2, M.line), (3, M.dist), (4, M.angles), (2, M.slides)]
+    first = np.cumsum([0] + [kd.size for _, kd in kinds])
+    it = np.concatenate([np.stack([np.full(kd.size, c), kd.ia, kd.ib], 1) for c, kd in kinds]).astype(np.int64)
+    loc = np.concatenate([np.stack([kd.va, kd.vb, kd.n, kd.m], 1) for _, kd in kinds]).reshape(-1, 4, 3)
+    ang, sl = first[4] + np.arange(M.angles.size), first[5] + np.arange(M.slides.size)
+    ri = [(0, first[0] + q, 0, c) for q in range(M.pc.size) for c in range(3)]
+    ri += [(c, first[c] + q, 0, 0) for c in (1, 2, 3) for q in range(kinds[c][1].size)]
+    ri += [(4, sl[s], ang[a], h) for h, (a, s, _) in enumerate(M.helix)]
+    ri += [(5, ang[k], 0, col) if kind == "angle" else (6, sl[k], 0, col) for col, (_, kind, k) in enumerate(M.drives)]
+    rf = np.concatenate([np.zeros(3 * M.pc.size), M.dot.c0, M.line.c0, M.dist.c0, [h for _, _, h in M.helix],
+                         np.zeros(len(M.drives))])
+    cen = np.array([np.mean([M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
+                            or [np.zeros(3)], axis=0) for link in M.links]).reshape(-1, 3)
+    return (it, np.ascontiguousarray(loc), np.array(ri, np.int64).reshape(-1, 4), rf.astype(float), cen,
+            ang.astype(np.int64), sl.astype(np.int64))
 
 
 # --------------------------------------------------------------------------- poses
-# Every function below works on a batch of B poses at once: rotations R (B, n + 1, 3, 3),
-# positions p (B, n + 1, 3) (the frame last, at rest), twists (B, 6 n), targets (B, drives).
-def exp_twists(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotations ``E`` (k, 3, 3) and translations ``t`` (k, 3) of ``exp`` of the twists
-    ``x`` (k, 6) = ``(ω, v)``: the displacement ``y = E y + t`` (Murray et al. [2]_, eq. 2.36).
+# Batches of B poses: rotations R (B, n + 1, 3, 3), positions p (B, n + 1, 3) (the frame
+# last, at rest), twists (B, 6 n), targets (B, drives).
+def move(R: np.ndarray, p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Poses ``(R, p)`` displaced by the twists ``x`` (B, 6 n) of the moving links (the
+    exponential of each twist: Murray et al. [2]_, eq. 2.36).
 
     Examples
     --------
-    >>> E, t = exp_twists(np.array([[0, 0, np.pi / 2, 1.0, 0, 0]]))
-    >>> np.round(E[0] @ [1.0, 0, 0], 12).tolist(), np.round(t[0], 6).tolist()
+    >>> R, p = move(np.eye(3)[None, None].repeat(2, 1), np.zeros((1, 2, 3)), np.array([[0, 0, np.pi / 2, 1.0, 0, 0]]))
+    >>> np.round(R[0, 0] @ [1.0, 0, 0], 12).tolist(), np.round(p[0, 0], 6).tolist()
     ([0.0, 1.0, 0.0], [0.63662, 0.63662, 0.0])
     """
-    w, v = x[:, :3], x[:, 3:]
-    th2 = (w * w).sum(axis=1)
-    q = th2 * th2
-    # sin θ / θ, (1 - cos θ) / θ², (θ - sin θ) / θ³: their series to θ⁴ below θ = 1e-2 (the
-    # next terms under an ulp), most of a Newton walk's steps
-    a, b, c = 1 - th2 / 6 + q / 120, 0.5 - th2 / 24 + q / 720, 1.0 / 6 - th2 / 120 + q / 5040
-    small = th2 < 1e-4
-    if not small.all():
-        ths = np.sqrt(np.where(small, 1.0, th2))
-        h, s = np.sin(0.5 * ths), np.sin(ths)
-        a = np.where(small, a, s / ths)
-        b = np.where(small, b, 2 * (h / ths) ** 2)
-        c = np.where(small, c, (ths - s) / ths ** 3)
-    # E = I + a [ω]x + b [ω]x², [ω]x² = ω ωᵀ - θ² I; t = (I + b [ω]x + c [ω]x²) v
-    bw = b[:, None] * w
-    E = ((bw[:, :, None] * w[:, None, :]).reshape(-1, 9) + (a[:, None] * w) @ _SKEW
-         + (1 - b * th2)[:, None] * _EYE9).reshape(-1, 3, 3)
-    wv = _cross(w, v)
-    t = v + b[:, None] * wv + c[:, None] * _cross(w, wv)
-    return E, t
-
-
-def move(R: np.ndarray, p: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Poses ``(R, p)`` displaced by the twists ``x`` (B, 6 n) of the moving links."""
-    B, n1 = p.shape[:2]
-    E, t = exp_twists(x.reshape(-1, 6))
-    E = E.reshape(B, n1 - 1, 3, 3)
-    R2, p2 = R.copy(), p.copy()
-    R2[:, :-1] = E @ R[:, :-1]
-    p2[:, :-1] = matvec(E, p[:, :-1]) + t.reshape(B, n1 - 1, 3)
+    R2, p2 = np.empty(R.shape), np.empty(p.shape)
+    numba_kernel().move(*(np.ascontiguousarray(a, float) for a in (R, p, x)), R2, p2)
     return R2, p2
 
 
-def wrap(a: np.ndarray) -> np.ndarray:
-    """Angles to (-π, π]."""
-    return np.pi - np.mod(np.pi - a, 2 * np.pi)
-
-
-class Frame:
-    """World coordinates of the model's link-fixed points and vectors at poses ``(R, p)``,
-    and the pairs' rotations ``theta`` (rad, from the drawn assembly, in (-π, π]) and slides
-    ``s`` (model units), each with the batch axis first. Attributes are views of two arrays
-    (see :class:`_Layout`)."""
-
-    def __init__(self, M: SpatialModel, R: np.ndarray, p: np.ndarray) -> None:
-        lay = M.lay
-        P = rotate(R[:, lay.pidx], lay.ploc) + p[:, lay.pidx]
-        V = rotate(R[:, lay.vidx], lay.vloc)
-        for name, sl in lay.psl.items():
-            setattr(self, name, P[:, sl])
-        for name, sl in lay.vsl.items():
-            setattr(self, name, V[:, sl])
-        self.theta = np.arctan2(_dot(self.e1b, self.e2a), _dot(self.e1b, self.e1a))
-        self.s = _dot(self.sb - self.sa, self.sn)
-
-    def take(self, idx: np.ndarray) -> "Frame":
-        """The frame of the poses ``idx`` of the batch."""
-        out = object.__new__(Frame)
-        out.__dict__.update({k: v[idx] for k, v in vars(self).items()})
-        return out
-
-
-# --------------------------------------------------------------------------- equations
-def helix_angles(M: SpatialModel, F: Frame, helix_ref: np.ndarray) -> np.ndarray:
-    """The H pairs' rotations unwrapped next to ``helix_ref`` (their previous values)."""
-    return helix_ref + wrap(F.theta[:, M.lay.h_ang] - helix_ref)
-
-
-def residual(M: SpatialModel, F: Frame, helix_ref: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """Residuals (B, m) of the constraint equations, then of the drives (``target``: input
-    values, rad or model units). ``helix_ref``: the H pairs' unwrapped angles before."""
-    lay = M.lay
-    B = len(target)
-    d = np.concatenate([F.theta, F.s], axis=1)[:, lay.d_meas] - target
-    d[:, lay.d_angle] = wrap(d[:, lay.d_angle])
-    parts = [(F.xa - F.xb).reshape(B, -1), _dot(F.u, F.w) - M.dot.c0, _dot(F.lb - F.la, F.ln) - M.line.c0]
-    if M.bars:
-        bar, ell = F.da - F.db, M.dist.c0
-        parts.append((_dot(bar, bar) - ell * ell) / (2 * ell))
-    if M.helix:
-        parts.append(F.s[:, lay.h_sl] - lay.h_pitch * helix_angles(M, F, helix_ref))
-    parts.append(d)
-    return np.concatenate(parts, axis=1)
-
-
-def _scalar_coefficients(M: SpatialModel, F: Frame) -> tuple[np.ndarray, np.ndarray]:
-    """``c`` and ``n`` of the scalar rows, each ``c · (ω_a - ω_b) + n · (v_b - v_a)``."""
-    lay = M.lay
-    c_slide = _cross(F.sn, F.sb)
-    cs = [_cross(F.u, F.w), _cross(F.ln, F.lb)]
-    ns = [np.zeros_like(F.u), F.ln]
-    if M.bars:
-        d = (F.da - F.db) / M.dist.c0[:, None]  # (x_a × d = x_b × d: one c for both links)
-        cs.append(_cross(F.da, d))
-        ns.append(-d)
-    if M.helix:
-        cs.append(c_slide[:, lay.h_sl] + lay.h_pitch[:, None] * F.aa[:, lay.h_ang])
-        ns.append(F.sn[:, lay.h_sl])
-    if M.drives:
-        cs.append(np.concatenate([-F.aa, c_slide], axis=1)[:, lay.d_meas])
-        ns.append(np.concatenate([np.zeros_like(F.aa), F.sn], axis=1)[:, lay.d_meas])
-    return np.concatenate(cs, axis=1), np.concatenate(ns, axis=1)
-
-
-def jacobian(M: SpatialModel, F: Frame) -> np.ndarray:
-    """Jacobians (B, m, 6 n) of :func:`residual` in the links' twists ``(ω_i, v_i)``
-    (columns ``6 i .. 6 i + 5``)."""
-    lay = M.lay
-    B = F.xa.shape[0]
-    k = 6 * M.n
-    J = np.empty((B, lay.J0.shape[0], k))
-    J[:] = lay.J0[:, :k]
-    c, nv = _scalar_coefficients(M, F)
-    # d(x)/dω = -[x]x, the matrix of y -> y x x: ε_ijk x_k
-    Sa = np.einsum("ijk,bnk->bnij", _EPS, F.xa)
-    Sb = np.einsum("ijk,bnk->bnij", _EPS, F.xb)
-    keep = lay.ci < k  # the frame's columns are not unknowns
-    J[:, lay.ri[keep], lay.ci[keep]] = np.concatenate(
-        [Sa.reshape(B, -1), -Sb.reshape(B, -1), c.reshape(B, -1), -c.reshape(B, -1), -nv.reshape(B, -1),
-         nv.reshape(B, -1)], axis=1)[:, keep]
-    return J
-
-
-def convective(M: SpatialModel, F: Frame, xi: np.ndarray) -> np.ndarray:
-    """``γ`` (B, m): the second time derivative of every residual at the twists ``xi``
-    (B, 6 n) with ``ξ̇ = 0``, so that the accelerations solve ``J ξ̇ = ü - γ``."""
-    lay = M.lay
-    B = xi.shape[0]
-    X = np.zeros((B, M.n + 1, 6))
-    X[:, :-1] = xi.reshape(B, -1, 6)
-    w, v = X[..., :3], X[..., 3:]
-    pc, dt, ln, an, sl = M.pc, M.dot, M.line, M.angles, M.slides
-    wa, wb = w[:, pc.ia], w[:, pc.ib]
-    g_pc = _cross(wa, v[:, pc.ia] + _cross(wa, F.xa)) - _cross(wb, v[:, pc.ib] + _cross(wb, F.xb))
-    wa, wb = w[:, dt.ia], w[:, dt.ib]
-    ud, wd = _cross(wa, F.u), _cross(wb, F.w)
-    g_dot = _dot(_cross(wa, ud), F.w) + 2 * _dot(ud, wd) + _dot(F.u, _cross(wb, wd))
-    parts = [g_pc.reshape(B, -1), g_dot, _line_gamma(w, v, ln.ia, ln.ib, F.la, F.lb, F.ln)]
-    if M.bars:
-        ds = M.dist
-        wa, wb = w[:, ds.ia], w[:, ds.ib]
-        va, vb = v[:, ds.ia] + _cross(wa, F.da), v[:, ds.ib] + _cross(wb, F.db)
-        parts.append((_dot(va - vb, va - vb) + _dot(F.da - F.db, _cross(wa, va) - _cross(wb, vb))) / ds.c0)
-    if M.helix or M.drives:
-        g_slide = _line_gamma(w, v, sl.ia, sl.ib, F.sa, F.sb, F.sn)
-        g_angle = _dot(w[:, an.ib] - w[:, an.ia], _cross(w[:, an.ia], F.aa))
-        if M.helix:
-            parts.append(g_slide[:, lay.h_sl] - lay.h_pitch * g_angle[:, lay.h_ang])
-        parts.append(np.concatenate([g_angle, g_slide], axis=1)[:, lay.d_meas])
-    return np.concatenate(parts, axis=1)
-
-
-def _line_gamma(w: np.ndarray, v: np.ndarray, ia: np.ndarray, ib: np.ndarray, xa: np.ndarray,
-                xb: np.ndarray, nv: np.ndarray) -> np.ndarray:
-    """``γ`` of ``(x_b - x_a) · n_a``."""
-    wa, wb = w[:, ia], w[:, ib]
-    va, vb = v[:, ia] + _cross(wa, xa), v[:, ib] + _cross(wb, xb)
-    nd = _cross(wa, nv)
-    return (_dot(_cross(wb, vb) - _cross(wa, va), nv) + 2 * _dot(vb - va, nd)
-            + _dot(xb - xa, _cross(wa, nd)))
+def helix_angles(M: SpatialModel, theta: np.ndarray, helix_ref: np.ndarray) -> np.ndarray:
+    """The H pairs' rotations unwrapped next to ``helix_ref`` (their previous values), from
+    the pairs' angles ``theta`` (B, angles)."""
+    h = np.array([a for a, _, _ in M.helix], int)
+    return helix_ref + np.pi - np.mod(np.pi - theta[:, h] + helix_ref, 2 * np.pi)  # (the change to (-π, π])
 
 
 # --------------------------------------------------------------------------- bars
-def _bar_frames(d0: np.ndarray, d: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Rotations (N, bars, 3, 3) of the bars with drawn lines ``d0`` (bars, 3) along their
-    lines ``d`` (N, bars, 3) over the rows of a sweep (``ok``: the rows assembled), carried
-    along the sweep with no spin about their lines (see :func:`bar_motion`).
-
-    Each row's rotation is written ``T = C Rot(u_0, φ)``: a chart ``C`` taking the drawn unit
-    line ``u_0`` to the line ``u`` (the least rotation from ``u_0`` where ``u · u_0 ≥ 0``, else
-    a half-turn about ``e_1`` then the least rotation from ``-u_0``: both well conditioned),
-    turned first about the drawn line by the bar's spin ``φ``. Between consecutive assembled
-    rows the bar turns by the least rotation ``Q`` from one line to the next (its discrete
-    parallel transport), which adds ``δ = atan2(Q a_k · b_{k+1}, Q a_k · a_{k+1})`` to ``φ``
-    (``a``, ``b``: the chart's images of ``e_1``, ``e_2``); so ``φ`` is a cumulative sum, zero
-    at each stretch's row nearest the drawn line."""
-    u0 = d0 / np.linalg.norm(d0, axis=1)[:, None]
-    e1 = _cross(u0, np.eye(3)[np.argmin(np.abs(u0), axis=1)])  # (⟂ u_0, as _perp_basis)
-    e1 /= np.sqrt(_dot(e1, e1))[:, None]
-    e2 = _cross(u0, e1)
-    u = d / np.sqrt(_dot(d, d))[..., None]
-    c = _dot(u0, u)
-    s = np.where(c >= 0, 1.0, -1.0)[..., None]
-    h, den = s * u0 + u, (1 + np.abs(c))[..., None]
-    a = e1 - h * _dot(u, e1)[..., None] / den
-    b = s * (e2 - h * _dot(u, e2)[..., None] / den)
-    ck = _dot(u[:-1], u[1:])[..., None]
-    qa = a[:-1] - (u[:-1] + u[1:]) * _dot(u[1:], a[:-1])[..., None] / np.where(1 + ck > 1e-8, 1 + ck, np.inf)
-    link = (ok[:-1] & ok[1:])[:, None]
-    delta = np.where(link, np.arctan2(_dot(qa, b[1:]), _dot(qa, a[1:])), 0.0)
-    phi = np.concatenate([np.zeros((1, len(d0))), np.cumsum(delta, axis=0)])
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], ok.astype(int), [0]])))
-    cols = np.arange(len(d0))
-    for lo, hi in zip(edges[::2], edges[1::2]):  # each stretch of assembled rows from its anchor
-        phi[lo:hi] -= phi[lo + np.argmax(c[lo:hi], axis=0), cols]
-    phi[~ok] = 0.0
-    cp, sp = np.cos(phi)[..., None], np.sin(phi)[..., None]
-    A, Bv = cp * a + sp * b, cp * b - sp * a
-    return A[..., :, None] * e1[:, None, :] + Bv[..., :, None] * e2[:, None, :] + u[..., :, None] * u0[:, None, :]
-
-
 def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
-               xid: np.ndarray, ok: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+               xid: np.ndarray) -> tuple[np.ndarray, ...]:
     """Poses ``(R, p)`` (N, links, ...) and twists ``ξ``, ``ξ̇`` (N, 6 links) of
     :attr:`SpatialModel.all_links` from those of the links solved for (the frame's pose not
-    included), over the rows of a sweep in order (``ok``: the rows assembled; default all).
-    Each bar runs between its ends ``y_1``, ``y_2`` on the links it joins, on the line
+    included), over the rows of a sweep in order (NaN where a row has no pose). Each bar
+    runs between its ends ``y_1``, ``y_2`` on the links it joins, on the line
     ``d = y_2 - y_1``, moving at ``ω = d × ḋ / |d|²``, ``ω̇ = d × d̈ / |d|²`` (no spin about its
-    line: its spin is an idle motion) and ``v = ẏ_1 - ω × y_1``, ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``.
+    line: its spin is an idle motion) and ``v = ẏ_1 - ω × y_1``, ``v̇ = ÿ_1 - ω̇ × y_1 - ω × ẏ_1``
+    (:func:`mechsyn.kinematics._spatial_numba.bars`).
 
-    Its rotation is carried along the sweep the same way, with no spin (:func:`_bar_frames`):
-    from one assembled row to the next it turns by the least rotation between their lines,
-    and in each stretch of assembled rows the row nearest the drawn line (largest
-    ``d_0 · d``) is the least rotation from the drawn line ``d_0``. No rule that depends on
-    the line alone can do this: a rotation taking ``d_0`` to every line ``d`` continuously
-    would be a continuous section of ``SO(3) -> S²``, which does not exist (hairy ball
-    theorem); the least rotation, ``cos I + [k]x + k kᵀ / (1 + cos)`` with ``k = d_0 × d``, is
-    undefined where ``d`` is opposite ``d_0`` (a drag-link's coupler turning fully). The price
-    of continuity: the pose depends on the path, not on the row's line alone (a bar brought
-    back to its line along a loop has turned about it by the solid angle its line swept) and,
-    by the square of the step, on the rows sampled; a row not assembled (but with poses)
-    takes its chart's rotation."""
-    N, n = len(R), M.n
-    if not M.bars:
+    Its rotation is carried along the sweep the same way, with no spin: ``T = C Rot(u_0, φ)``,
+    a chart ``C`` taking the drawn unit line ``u_0`` to the line ``u`` (the least rotation
+    from ``u_0`` where ``u · u_0 ≥ 0``, else a half-turn about ``e_1`` then the least rotation
+    from ``-u_0``: both well conditioned), turned first about the drawn line by the bar's
+    spin ``φ``. From one row with a pose to the next the bar turns by the least rotation
+    ``Q`` between their lines (its discrete parallel transport), which adds
+    ``δ = atan2(Q a_k · b_{k+1}, Q a_k · a_{k+1})`` to ``φ`` (``a``, ``b``: the chart's images
+    of ``e_1``, ``e_2``); in each stretch of rows with poses (a row refused after the walk
+    included) the row nearest the drawn line (largest ``d_0 · d``) has ``φ = 0``, the least
+    rotation from the drawn line ``d_0``. No rule that depends on the line alone can do
+    this: a rotation taking ``d_0`` to every line ``d`` continuously would be a continuous
+    section of ``SO(3) -> S²``, which does not exist (hairy ball theorem); the least
+    rotation, ``cos I + [k]x + k kᵀ / (1 + cos)`` with ``k = d_0 × d``, is undefined where
+    ``d`` is opposite ``d_0`` (a drag-link's coupler turning fully). The price of
+    continuity: the pose depends on the path, not on the row's line alone (a bar brought
+    back to its line along a loop has turned about it by the solid angle its line swept)
+    and, by the square of the step, on the rows sampled."""
+    N, nb = len(R), len(M.bars)
+    if not nb:
         return R, p, xi, xid
     ds = M.dist
-    z = np.zeros((N, 1, 6))
-    X, Xd = (np.concatenate([x.reshape(N, n, 6), z], axis=1) for x in (xi, xid))
-    R1 = np.concatenate([R, np.broadcast_to(np.eye(3), (N, 1, 3, 3))], axis=1)
-    p1 = np.concatenate([p, np.zeros((N, 1, 3))], axis=1)
-    ends = []
-    for i, x0 in ((ds.ia, ds.va), (ds.ib, ds.vb)):
-        y = rotate(R1[:, i], x0) + p1[:, i]
-        w, v, wd, vd = X[:, i, :3], X[:, i, 3:], Xd[:, i, :3], Xd[:, i, 3:]
-        yd = v + _cross(w, y)
-        ends.append((y, yd, vd + _cross(wd, y) + _cross(w, yd)))
-    (y1, y1d, y1dd), (y2, y2d, y2dd) = ends
-    d = y2 - y1
-    Rb = _bar_frames(ds.vb - ds.va, d, np.ones(N, bool) if ok is None else np.asarray(ok, bool))
-    pb = 0.5 * (y1 + y2 - rotate(Rb, ds.va + ds.vb))
-    l2 = _dot(d, d)[..., None]
-    w, wd = _cross(d, y2d - y1d) / l2, _cross(d, y2dd - y1dd) / l2
-    Xb = np.concatenate([w, y1d - _cross(w, y1)], axis=2)
-    Xbd = np.concatenate([wd, y1dd - _cross(wd, y1) - _cross(w, y1d)], axis=2)
-    return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1),
-            np.concatenate([X[:, :n], Xb], axis=1).reshape(N, -1),
-            np.concatenate([Xd[:, :n], Xbd], axis=1).reshape(N, -1))
+    Rb, pb, Xb, Xbd = np.empty((N, nb, 3, 3)), np.empty((N, nb, 3)), np.empty((N, 6 * nb)), np.empty((N, 6 * nb))
+    numba_kernel().bars(*(np.ascontiguousarray(x, float) for x in (R, p, xi, xid)), ds.ia, ds.ib, ds.va, ds.vb,
+                        Rb, pb, Xb, Xbd)
+    return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1), np.concatenate([xi, Xb], axis=1),
+            np.concatenate([xid, Xbd], axis=1))

@@ -92,10 +92,11 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     a = np.searchsorted(idx, ks)  # the positions of rows k and k + 1 in idx (its rows are w.ok's)
     b = a + 1
     flat = Jc.reshape(len(Jc), -1)
-    norm = np.sqrt(np.einsum("bi,bi->b", flat, flat))
-    low = np.nan_to_num(ratio[idx]) * norm / np.sqrt(max(r, 1))  # lower bounds of σ_r
-    d = np.diff(flat, axis=0)
-    jump = np.sqrt(np.einsum("bi,bi->b", d, d))[a]
+    n2 = np.einsum("bi,bi->b", flat, flat)
+    low = np.nan_to_num(ratio[idx]) * np.sqrt(n2) / np.sqrt(max(r, 1))  # lower bounds of σ_r
+    # ‖J_b - J_a‖_F of consecutive rows without their difference, its rounding added (over, never under)
+    s2 = n2[:-1] + n2[1:]
+    jump = np.sqrt(np.maximum(s2 - 2 * np.einsum("bi,bi->b", flat[:-1], flat[1:]), 0.0) + 1e-14 * s2)[a]
     near = (low[a] <= 2 * jump) | (low[b] <= 2 * jump)
     tol = singular_tol(tr.M)
     near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event

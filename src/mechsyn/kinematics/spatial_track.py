@@ -34,8 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from mechsyn.kinematics.spatial_model import (Frame, SpatialModel, _cross, convective, helix_angles, jacobian, move,
-                                              pair_error, residual, rotate)
+from mechsyn.kinematics.spatial_model import SpatialModel, helix_angles, move, numba_kernel, pair_error
 
 __all__ = ["Tracker", "State", "RANK_TOL", "NEWTON_TOL", "MAX_STEP"]
 
@@ -79,42 +78,32 @@ MAX_STRIDE = 64
 @dataclass
 class Lin:
     """Jacobians ``Jc`` (B, m, 6 n) at B poses, in twists taken at the links' centres ``C``
-    (B, n, 3) (see :meth:`Tracker.lin`), and their minimum-norm least-squares solutions.
+    (B, n, 3) (see :meth:`Tracker.state`), and their minimum-norm least-squares solutions.
 
-    The solutions use the smaller Gram matrix (``Jc^T Jc`` or ``Jc Jc^T``) with a damping
-    ``μ = 1e-14`` of its largest diagonal entry, then two steps of iterative refinement
-    (iterated Tikhonov: each step multiplies the damping's error by ``μ / (σ² + μ)``), so
-    the answer is the pseudo-inverse's to rounding wherever ``σ_r / σ_1`` is above about
-    ``1e-5``; the solution stays in the row space of ``Jc`` (no idle component) by
-    construction. A batched linear solve costs a few percent of a batched SVD.
+    The solutions use the smaller Gram matrix (``Jc^T Jc`` or ``Jc Jc^T``, ``rows``) with a
+    damping ``μ = 1e-14`` of its largest diagonal entry, through its inverse ``Gi``, then
+    steps of iterative refinement (iterated Tikhonov: each step multiplies the damping's
+    error by ``μ / (σ² + μ)``), so the answer is the pseudo-inverse's to rounding wherever
+    ``σ_r / σ_1`` is above about ``1e-5``; the solution stays in the row space of ``Jc``
+    (no idle component) by construction. ``bound``: ``1 / √(‖G‖_F ‖G⁻¹‖_F)`` per pose.
     """
 
     Jc: np.ndarray
-    G: np.ndarray
+    Gi: np.ndarray
+    bound: np.ndarray
     rows: bool
     r: int
     C: np.ndarray
 
     @functools.cached_property
-    def Ginv(self) -> np.ndarray:
-        """The inverse of the damped Gram matrix (one inversion serves every solve)."""
-        return np.linalg.inv(self.G)
-
-    @functools.cached_property
     def ratio(self) -> np.ndarray:
         """``σ_r / σ_1`` per pose, 0 where the rank has dropped: exact (an SVD) where it is
-        under ``1e-3``; elsewhere a lower bound within a factor ``√k``
-        (``1 / √(‖G‖_F ‖G⁻¹‖_F)`` for a Gram matrix of rank ``k = r``), which is enough to
-        tell a regular pose."""
-        B, k = self.G.shape[:2]
+        under ``1e-3``; elsewhere a lower bound within a factor ``√k`` (``bound``, for a
+        Gram matrix of rank ``k = r``), which is enough to tell a regular pose."""
+        B, k = len(self.Jc), min(self.Jc.shape[1:])
         if self.r == 0:
             return np.ones(B)
-        out = np.zeros(B)
-        if k == self.r:
-            with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-                out = 1.0 / np.sqrt(np.sqrt(np.einsum("bij,bij->b", self.G, self.G)
-                                            * np.einsum("bij,bij->b", self.Ginv, self.Ginv)))
-            out = np.nan_to_num(out)
+        out = self.bound.copy() if k == self.r else np.zeros(B)
         exact = out < 1e-3
         if exact.any():
             out[exact] = svd_ratio(self.Jc[exact], self.r)
@@ -125,42 +114,11 @@ class Lin:
         B = len(y)
         Y = y.reshape(B, self.C.shape[1], 6, -1)
         X = Y.copy()
-        X[:, :, 3:] += np.moveaxis(_cross(self.C[:, :, None], np.moveaxis(Y[:, :, :3], 2, -1)), -1, 2)
+        X[:, :, 3:] += np.cross(self.C[:, :, :, None], Y[:, :, :3], axisa=2, axisb=2, axisc=2)
         return X.reshape(y.shape)
 
-    def _once(self, b: np.ndarray) -> np.ndarray:
-        JT = self.Jc.transpose(0, 2, 1)
-        if self.rows:
-            return JT @ (self.Ginv @ b)
-        return self.Ginv @ (JT @ b)
-
-    def solve(self, b: np.ndarray, refine: int = 0) -> np.ndarray:
-        b = b[..., None]
-        y = self._once(b)
-        for _ in range(refine):
-            y += self._once(b - self.Jc @ y)
-        return self.twists(y)[..., 0]
-
     def take(self, idx: np.ndarray) -> "Lin":
-        out = Lin(self.Jc[idx], self.G[idx], self.rows, self.r, self.C[idx])
-        out.__dict__["Ginv"] = self.Ginv[idx]
-        return out
-
-
-class AnchorLin:
-    """The linearisation ``lin`` of one pose serving many (the chord steps of a block of
-    rows): all of them solved in one product with its inverse Gram matrix."""
-
-    def __init__(self, lin: Lin) -> None:
-        self.lin = lin
-
-    def solve(self, b: np.ndarray) -> np.ndarray:
-        L = self.lin
-        J, Gi = L.Jc[0], L.Ginv[0]
-        y = (b @ Gi.T) @ J if L.rows else (b @ J) @ Gi.T  # (Gi is symmetric to rounding)
-        Y = y.reshape(len(b), -1, 6)
-        Y[:, :, 3:] += _cross(L.C[0], Y[:, :, :3])
-        return y
+        return Lin(self.Jc[idx], self.Gi[idx], self.bound[idx], self.rows, self.r, self.C[idx])
 
 
 def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
@@ -172,39 +130,22 @@ def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
 
 @dataclass
 class State:
-    """B assembled poses: link poses, unwrapped H angles, frame, linearisation, residuals."""
+    """B assembled poses: link poses, unwrapped H angles, the pairs' angles and slides,
+    linearisation, residuals."""
 
     R: np.ndarray
     p: np.ndarray
     href: np.ndarray
-    F: Any
+    theta: np.ndarray
+    s: np.ndarray
     lin: Lin
     g: np.ndarray
+    x: tuple | None = None
 
     def take(self, idx: Any) -> "State":
         idx = np.atleast_1d(idx)
-        F = None if self.F is None else self.F.take(idx)
-        return State(self.R[idx], self.p[idx], self.href[idx], F, self.lin.take(idx), self.g[idx])
-
-
-def link_centres(M: SpatialModel) -> np.ndarray:
-    """Centre of each moving link (n, 3, model units): the mean of its joints' points."""
-    c = np.zeros((M.n, 3))
-    for i, link in enumerate(M.links):
-        pts = [M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
-        if pts:
-            c[i] = np.mean(pts, axis=0)
-    return c
-
-
-def _blocks(M: SpatialModel) -> tuple[np.ndarray, np.ndarray]:
-    """(row, moving link) of every block of the Jacobian that may be non-zero."""
-    lay = M.lay
-    r0, c0 = np.nonzero(lay.J0)
-    rows = np.concatenate([lay.ri, r0])
-    links = np.concatenate([lay.ci, c0]) // 6
-    pairs = np.unique(np.stack([rows, links], axis=1)[links < M.n], axis=0)
-    return pairs[:, 0], pairs[:, 1]
+        return State(self.R[idx], self.p[idx], self.href[idx], self.theta[idx], self.s[idx], self.lin.take(idx),
+                     self.g[idx], None if self.x is None else (self.x[0][idx], self.x[1][idx]))
 
 
 class Tracker:
@@ -213,11 +154,11 @@ class Tracker:
     def __init__(self, M: SpatialModel) -> None:
         self.M = M
         self.m_c = M.n_constraints
+        self.m = self.m_c + len(M.drives)
+        self.rows = self.m < 6 * M.n  # the Gram matrix J Jᵀ (else Jᵀ J)
         self.rank: int | None = None
         self.drawn_singular: int | None = None  # the drawn assembly's rank when below the sweep's
         self.halvings = 0
-        self.c0 = link_centres(M)
-        self.blocks = _blocks(M)
         self.tol = newton_tol(M)
         self.rank_tol = max(RANK_TOL, 100 * self.tol)
         self.rejected = 0  # converged poses refused by the pair check (another root of the equations)
@@ -225,176 +166,111 @@ class Tracker:
         self.left_singular = False  # a singular pose was left (leave): the branch taken is a choice
         self._left: tuple | None = None
 
-    def lin(self, J: np.ndarray, R: np.ndarray, p: np.ndarray) -> Lin:
-        """The pseudo-inverse of ``J`` (at poses ``R``, ``p``) at the regular rank, in twists
-        ``(ω, u)`` with ``u`` the velocity of each link's centre ``c`` (``v = u + c × ω``).
+    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
+              rates: tuple | None = None, refine: int = 2) -> State:
+        """The residuals, the pairs' angles and slides and the linearisation at B poses:
+        the Jacobian in twists ``(ω, u)`` with ``u`` the velocity of each link's centre ``c``
+        (``v = u + c × ω``) and the inverse of its Gram matrix.
 
         A minimum-norm solution in these coordinates is orthogonal to the idle motions,
         and an idle spin of a link about a line through its centre is ``(a, 0)`` there
         (a rod between two ball joints has its centre on its line), so minimum-norm rates
         and steps give the spin no component: idle spins stay at rest, whichever point the
-        file measures from."""
-        B, n = len(J), self.M.n
-        C = rotate(R[:, :-1], self.c0) + p[:, :-1]
-        Jr = J.reshape(B, -1, n, 6)  # (J is :func:`jacobian`'s, fresh: changed in place)
-        rr, ll = self.blocks  # J_v (c × ω) = (J_v × c) · ω: the ω columns, where J has entries
-        Jr[:, rr, ll, :3] += _cross(Jr[:, rr, ll, 3:], C[:, ll])
-        Jc = Jr.reshape(J.shape)
-        if self.rank is None:  # the regular rank: at the drawn assembly, by an SVD
-            s0 = np.linalg.svd(Jc[0], compute_uv=False)
+        file measures from. The regular rank is the drawn assembly's (the first state's),
+        by an SVD. With ``rates`` (the drives' rates and their derivatives, each (B,
+        drives)) the state keeps no inverse Gram matrices but the rates ``x`` (first and
+        second derivatives, ``J ξ' = u̇``, ``J ξ'' = ü - γ(ξ')``) with ``refine`` steps of
+        iterative refinement."""
+        M, B, n, m = self.M, len(R), self.M.n, self.m
+        R, p = np.ascontiguousarray(R, float), np.ascontiguousarray(p, float)
+        q = m if self.rows else 6 * n
+        g, J, Gi = np.empty((B, m)), np.empty((B, m, 6 * n)), np.empty((B, 0, 0) if rates else (B, q, q))
+        C, bound, x1, x2 = np.empty((B, n, 3)), np.empty(B), np.empty((B, 6 * n)), np.empty((B, 6 * n))
+        th, s = np.empty((B, M.angles.size)), np.empty((B, M.slides.size))
+        du, ddu = (np.ascontiguousarray(r, float) for r in rates) if rates else (np.empty((0, len(M.drives))),) * 2
+        numba_kernel().states(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
+                              self.rows, g, J, Gi, C, bound, th, s, du, ddu, refine, x1, x2)
+        if self.rank is None:
+            s0 = np.linalg.svd(J[0], compute_uv=False)
             self.rank = int(np.count_nonzero(s0 > self.rank_tol * s0[0])) if s0.size and s0[0] > 0 else 0
-        rows = J.shape[1] < J.shape[2]
-        G = Jc @ Jc.transpose(0, 2, 1) if rows else Jc.transpose(0, 2, 1) @ Jc
-        k = G.shape[1]
-        diag = G[:, np.arange(k), np.arange(k)]  # (a Gram matrix's largest entry is on its diagonal)
-        G[:, np.arange(k), np.arange(k)] = diag + (1e-14 * diag.max(axis=1, initial=0.0)[:, None] + 1e-300)
-        return Lin(Jc, G, rows, self.rank, C)
+        if M.helix:
+            href = helix_angles(M, th, href)
+        return State(R, p, href, th, s, Lin(J, Gi, bound, self.rows, self.rank, C), g, (x1, x2) if rates else None)
 
-    def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray) -> State:
-        F = Frame(self.M, R, p)
-        g = residual(self.M, F, href, target)
-        if self.M.helix:
-            href = helix_angles(self.M, F, href)
-        return State(R, p, href, F, self.lin(jacobian(self.M, F), R, p), g)
-
-    def rates(self, st: State, du: np.ndarray, refine: int = 0,
-              ddu: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Twists (B, 6 n) of the links per input step ``du`` (B, drives): first and second
-        derivatives (``J ξ' = du``, ``J ξ'' = ü - γ(ξ')``, ``ü = ddu``: the drives' second
-        derivatives, zero by default); ``refine``: steps of iterative refinement (2 for the
-        rates reported, none for a predictor)."""
-        F = st.F if st.F is not None else Frame(self.M, st.R, st.p)
-        b = np.zeros(st.g.shape)
-        b[:, self.m_c:] = du
-        x1 = st.lin.solve(b, refine)
-        b2 = -convective(self.M, F, x1)
-        if ddu is not None:
-            b2[:, self.m_c:] += ddu
-        return x1, st.lin.solve(b2, refine)
+    def rates(self, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Twists (B, 6 n) of the links per input step ``du`` (B, drives) at the poses of
+        ``st`` (one, or B) for a predictor: first and second derivatives (``J ξ' = du``,
+        ``J ξ'' = -γ(ξ')``), without refinement."""
+        z = np.zeros(len(du), int) if len(st.R) == 1 else slice(None)
+        return self.state(st.R[z], st.p[z], st.href[z], np.zeros(du.shape), (du, np.zeros(du.shape)), 0).x
 
     def correct(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray, limit: np.ndarray,
-                iters: int = 8, lin0: AnchorLin | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+                iters: int = 8, anchor: Lin | None = None, first: bool = False, tol: float | None = None) -> tuple:
         """Newton corrections of B poses to the inputs ``target``: the poses, a mask of
-        those that converged without moving further than ``limit``, and ``(frame,
-        residuals, fresh, rows)`` of the last iterate: ``fresh`` the last Jacobian taken
-        (of an earlier iterate), for the poses ``rows``; None and no rows when none was.
+        those that converged without moving further than ``limit`` and are true assemblies
+        (:meth:`true_pairs`), and the pairs' angles at the last iterate. ``first``: stop at
+        the first pose that fails (a block keeps its rows up to there); ``tol``: the residual
+        to reach (default the tracker's; 0 polishes ``iters`` steps).
 
-        Chord steps: each pose keeps its linearisation (``lin0``'s for all, when given)
-        while its residual falls at least tenfold per step (the predictor lands close, so
-        that is most steps); the poses whose residual falls less, or that have none, get
-        the Jacobian of their current iterate (with those already on fresh ones), and all
-        of them do once a quarter of the poses still correcting would (rows next to slow
-        ones soon slow down too: measured on the examples, fewer instructions than
-        either always or never renewing all)."""
-        B = len(R)
-        moved, last = np.zeros(B), np.full(B, np.inf)
-        done, failed, on_fresh = np.zeros(B, bool), np.zeros(B, bool), np.zeros(B, bool)
-        fresh, fidx = None, np.zeros(0, int)
-        for it in range(iters):
-            F = Frame(self.M, R, p)
-            g = residual(self.M, F, href, target)
-            err = np.abs(g).max(axis=1)
-            done |= err < self.tol
-            if it >= 10:  # no longer converging: give up on those
-                failed |= ~done & (err > 0.5 * last)
-            active = ~done & ~failed
-            if not active.any():
-                break
-            renew = active & ((err > 0.1 * last) | (~on_fresh if lin0 is None else False))
-            if renew.any():
-                on_fresh = active if renew.sum() > 0.25 * active.sum() else active & (renew | on_fresh)
-                fidx = np.flatnonzero(on_fresh)
-                fresh = self.lin(jacobian(self.M, F.take(fidx) if len(fidx) < B else F), R[fidx], p[fidx])
-            last = err
-            dx = np.zeros((B, 6 * self.M.n))
-            if len(fidx):
-                dx[fidx] = -fresh.solve(g[fidx])
-            chord = active & ~on_fresh
-            if chord.any():
-                dx[chord] = -lin0.solve(g[chord])
-            dx[~active] = 0.0
-            moved += np.abs(dx).max(axis=1)
-            failed |= moved > limit
-            dx[failed] = 0.0
-            R, p = move(R, p, dx)
-        return R, p, self.true_pairs(R, done & ~failed), (F, g, fresh, fidx)
+        Chord steps: each pose keeps its linearisation (``anchor``'s, the first pose of
+        ``anchor`` serving all, when given) while its residual falls at least tenfold per
+        step (the predictor lands close, so that is most steps); else it takes the Jacobian
+        of its current iterate (:func:`mechsyn.kinematics._spatial_numba.correct`)."""
+        B, M = len(R), self.M
+        R, p = np.array(R, float, order="C"), np.array(p, float, order="C")
+        q = self.m if self.rows else 6 * M.n
+        Ja, Ga, Ca = (np.empty((0, 6 * M.n)), np.empty((q, q)), np.empty((M.n, 3))) if anchor is None else (
+            anchor.Jc[0], anchor.Gi[0], anchor.C[0])
+        ok, th, s = np.zeros(B, bool), np.zeros((B, M.angles.size)), np.zeros((B, M.slides.size))
+        numba_kernel().correct(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
+                               np.broadcast_to(np.asarray(limit, float), (B,)).copy(), iters,
+                               self.tol if tol is None else tol, Ja, Ga, Ca, self.rows, first, ok, th, s)
+        return R, p, self.true_pairs(R, ok), th
 
     def true_pairs(self, R: np.ndarray, ok: np.ndarray) -> np.ndarray:
         """``ok`` without the poses whose pairs are not the file's (a reversed R axis, a
         half-turned P pair: :func:`~mechsyn.kinematics.spatial_model.pair_error`)."""
         self.last_bad, self.last_pair = np.zeros(len(ok), bool), [""] * len(ok)
-        if not ok.any() or not len(self.M.pairs.ia):
+        if not ok.any() or not len(self.M.pairs.ids):
             return ok
-        bad = np.zeros(len(ok), bool)
         err = pair_error(self.M, R[ok])
-        bad[ok] = err.max(axis=1) > PAIR_TOL
-        self.rejected += int(bad.sum())
-        self.last_bad, self.last_pair = bad, [""] * len(ok)
-        for b, e in zip(np.flatnonzero(ok), err):
-            if e.max() > PAIR_TOL:
-                self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
-        return ok & ~bad
-
-    def step(self, st: State, du: np.ndarray, target: np.ndarray, iters: int = 8) -> tuple[State | None, float]:
-        """One predictor-corrector step of a single pose; (the new state or None, the
-        predictor's step size). The new state keeps the corrector's linearisation (of
-        the predicted pose): good for the next predictor; the rates reported are
-        computed afresh at every row (:func:`mechsyn.kinematics.spatial._sweep_rows`)."""
-        x1, x2 = self.rates(st, du[None])
-        size = float(np.abs(x1).max(initial=0.0))
-        if size > MAX_STEP:  # too far for the Taylor predictor: the caller subdivides
-            return None, size
-        R, p = move(st.R, st.p, x1 + 0.5 * x2)
-        R, p, ok, (F, g, lin, rows) = self.correct(R, p, st.href, target[None], np.array([0.5 * size + 1e-9]),
-                                                   iters=iters)
-        if not ok[0]:
-            return None, size
-        if not len(rows):
-            return self.state(R, p, st.href, target[None]), size
-        href = helix_angles(self.M, F, st.href) if self.M.helix else st.href
-        return State(R, p, href, F, lin, g), size
+        self.last_bad[ok] = err.max(axis=1) > PAIR_TOL
+        self.rejected += int(self.last_bad.sum())
+        for b, e in zip(np.flatnonzero(self.last_bad), err[self.last_bad[ok]]):
+            self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
+        return ok & ~self.last_bad
 
     def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
         """The rows ``Ub`` (K, drives) after the pose ``st`` (at inputs ``u0``), predicted
-        from its tangents (:func:`_taylor`) and corrected in one batch, first by chord steps
-        with the linearisation of ``st`` (:class:`AnchorLin`). Returns the number ``n`` of
-        rows accepted from the first on (each converged without moving further than half
-        its predictor's step, which is at most ``MAX_STEP``), the predictor's step size of
-        every row, the accepted poses ``(R, p, href)`` and the state of the last of them
-        (its linearisation that of the corrector, as in :meth:`step`)."""
-        K = len(Ub)
-        zero = np.zeros(K, int)
+        from its tangents (:func:`_taylor`) and corrected in one call, first by chord steps
+        with the linearisation of ``st``. Returns the number ``n`` of rows accepted from the
+        first on (each converged without moving further than half its predictor's step,
+        which is at most ``MAX_STEP``), the predictor's step size of every row, the accepted
+        poses ``(R, p, href)`` and the state of the last of them."""
         x1, x2 = _taylor(self, st, Ub - u0)
         size = np.abs(x1).max(axis=1)
         K = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         if K == 0:
             return 0, size, None, None
-        zero = zero[:K]
+        zero = np.zeros(K, int)
         R, p = move(st.R[zero], st.p[zero], x1[:K] + 0.5 * x2[:K])
         href = st.href[zero]
-        R, p, ok, (F, g, lin, rows) = self.correct(R, p, href, Ub[:K], 0.5 * size[:K] + 1e-9,
-                                                   lin0=AnchorLin(st.lin))
+        R, p, ok, th = self.correct(R, p, href, Ub[:K], 0.5 * size[:K] + 1e-9, anchor=st.lin, first=True)
         n = int(np.argmin(np.append(ok, False)))
         if n == 0:
             return 0, size, None, None
         if self.M.helix:
-            href = helix_angles(self.M, F, href)
-        last = slice(n - 1, n)
-        at = np.flatnonzero(rows == n - 1)
-        if len(at):  # the corrector's linearisation of the last row (as in step)
-            new = State(R[last], p[last], href[last], F.take(np.arange(n - 1, n)), lin.take(at), g[last])
-        else:
-            new = self.state(R[last], p[last], href[last], Ub[last])
-        return n, size, (R[:n], p[:n], href[:n]), new
+            href = helix_angles(self.M, th, href)
+        return n, size, (R[:n], p[:n], href[:n]), self.state(R[n - 1:n], p[n - 1:n], href[n - 1:n], Ub[n - 1:n])
 
-    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray, iters: int = 8) -> State | None:
-        """From ``st`` at inputs ``u0`` to ``u1``, halving the step at trouble down to
-        ``2^-MAX_HALVINGS`` of it; None when it cannot get there. ``iters``: Newton steps a
-        try (more next to a singular point, where Newton converges only linearly)."""
+    def advance(self, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
+        """From ``st`` at inputs ``u0`` to ``u1`` by blocks of one row (:meth:`block`), halving
+        the step at trouble down to ``2^-MAX_HALVINGS`` of it; None when it cannot get there."""
         t, h = 0.0, 1.0
         while t < 1.0:
             h = min(h, 1.0 - t)
-            nxt, size = self.step(st, h * (u1 - u0), u0 + (t + h) * (u1 - u0), iters)
+            _, size, _, nxt = self.block(st, u0 + t * (u1 - u0), (u0 + (t + h) * (u1 - u0))[None])
+            size = float(size[0])
             if nxt is None:
                 if h < 0.5 ** MAX_HALVINGS:
                     return None
@@ -422,31 +298,27 @@ class Tracker:
 
 
 # --------------------------------------------------------------------------- leaving a singular pose
+def point_speeds(M: SpatialModel, st: State, X: np.ndarray, extra: tuple = ()) -> np.ndarray:
+    """The largest speed of a joint point, or of a point ``extra`` (link index, local point),
+    in each of the motions ``X`` (k, 6 n) (twists at the origin) at the first pose of ``st``."""
+    X = X.reshape(len(X), M.n, 6)
+    out = np.zeros(len(X))
+    for i, x0 in [(M.index(link), M.local(j.point)) for j in M.mech.joints if j.point is not None
+                  for link in j.links] + list(extra):
+        if i < M.n:
+            y = st.R[0, i] @ x0 + st.p[0, i]
+            out = np.maximum(out, np.abs(X[:, i, 3:] + np.cross(X[:, i, :3], y)).max(axis=1))
+    return out
+
+
 def _null_motions(tr: Tracker, st: State) -> np.ndarray:
     """The directions (k, 6 n) of the Jacobian's near-null space at ``st`` that move a
     joint point (not idle spins), each signed so its largest entry is positive."""
-    M = tr.M
-    Jc = st.lin.Jc[0]
-    _, s, Vt = np.linalg.svd(Jc, full_matrices=True)
+    _, s, Vt = np.linalg.svd(st.lin.Jc[0], full_matrices=True)
     s = np.concatenate([s, np.zeros(Vt.shape[0] - len(s))])
-    tol = singular_tol(M) * s[0]
-    out = []
-    for v in Vt[s < tol]:
-        x = st.lin.twists(v[None, :, None])[0, :, 0]
-        X = x.reshape(M.n, 6)
-        move_pt = 0.0
-        for j in M.mech.joints:
-            if j.point is None:
-                continue
-            x0 = M.local(j.point)
-            for link in j.links:
-                i = M.index(link)
-                if i < M.n:
-                    y = st.R[0, i] @ x0 + st.p[0, i]
-                    move_pt = max(move_pt, float(np.abs(X[i, 3:] + np.cross(X[i, :3], y)).max()))
-        if move_pt > 1e-6:
-            out.append(x if x[np.argmax(np.abs(x))] > 0 else -x)
-    return np.array(out).reshape(-1, 6 * M.n)
+    x = st.lin.twists(Vt[s < singular_tol(tr.M) * s[0]].T[None])[0].T
+    x = x[point_speeds(tr.M, st, x) > 1e-6]
+    return x * np.sign(x[np.arange(len(x)), np.argmax(np.abs(x), axis=1)])[:, None]
 
 
 def leave(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> State | None:
@@ -553,7 +425,7 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
 def _turning(M: SpatialModel, U: np.ndarray) -> int | None:
     """The column of ``U`` of the sweep's one moving input when it is an angle, else None."""
     moving = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
-    if len(moving) != 1 or not M.lay.d_angle[moving[0]]:
+    if len(moving) != 1 or M.drives[moving[0]][1] != "angle":
         return None
     return int(moving[0])
 
@@ -704,13 +576,7 @@ def polished_ratio(tr: Tracker, R: np.ndarray, p: np.ndarray, href: np.ndarray, 
     B = len(u)
     inf = np.full(B, np.inf)
     R, p, ok, _ = tr.correct(R, p, href, u, inf, iters=iters)
-    tol, halvings = tr.tol, tr.halvings
-    tr.tol = 0.0
-    try:
-        R, p, _, _ = tr.correct(R, p, href, u, inf, iters=polish)
-    finally:
-        tr.tol = tol
-        tr.halvings = halvings
+    R, p, _, _ = tr.correct(R, p, href, u, inf, iters=polish, tol=0.0)
     out = np.full(B, np.inf)
     if ok.any():
         good = np.flatnonzero(ok)
@@ -731,7 +597,7 @@ def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndar
     D[np.arange(c), cols] = 1.0
     for q, (a, b) in enumerate(pairs):
         D[c + q, cols[a]] = D[c + q, cols[b]] = 1.0
-    X1, X2 = tr.rates(st.take(np.zeros(len(D), int)), D)
+    X1, X2 = tr.rates(st, D)
     d = du[:, cols]
     x1, x2 = d @ X1[:c], (d * d) @ X2[:c]
     for q, (a, b) in enumerate(pairs):
