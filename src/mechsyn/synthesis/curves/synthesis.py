@@ -42,8 +42,10 @@ compiled kernels: the largest cost of a short run); a check that cannot load by 
 is not begun and the answer is given unchecked, labelled so; then a deterministic sequence of refinements runs: the
 first round of retrieved seeds (the four-bars every third), then rounds that refine the best
 design of each of the three leading topologies longer, restart about it (every joint
-and the tracer, the coupler point free on its plane, moved at random, seeded by the
-round) and widen to further retrieved seeds, eight-bars among them. An evaluation past
+and the tracer, the coupler point free on its plane, moved at random by a wide and a
+narrow step in turn, seeded by the round) and widen to further retrieved seeds, eight-bars
+among them; a topology far behind the best drops out of the race (no further seeds, no
+restarts: :meth:`_Run.tasks`). An evaluation past
 the deadline stops the refinement under way with the best design it has evaluated. The
 search ends at the limit, at ``target_error``, after ``refinements`` or on Ctrl-C.
 
@@ -643,11 +645,12 @@ class _Run:
         """The sequence of ``(seed, max_nfev)`` refinements (see the class doc); each
         round depends only on the candidates so far, so the sequence is deterministic.
 
-        After the first round the refinements race (E. Even-Dar, S. Mannor and Y. Mansour,
-        "Action elimination and stopping conditions for the multi-armed bandit and
-        reinforcement learning problems", *JMLR* 7, 2006): a topology refined
-        :data:`RACE_TRIES` times whose best is more than :data:`RACE` times the best of all
-        gets no further retrieved seeds, and the leading topology gets one restart more;
+        The topologies race (E. Even-Dar, S. Mannor and Y. Mansour, "Action elimination and
+        stopping conditions for the multi-armed bandit and reinforcement learning problems",
+        *JMLR* 7, 2006): a topology refined :data:`RACE_TRIES` times whose best is more than
+        :data:`RACE` times the best of all gets no further retrieved seeds (in the first round
+        either), a leader as far behind is neither polished nor restarted, and the leading
+        topology gets one restart more;
         the restarts about a leader alternate a wide and a narrow step
         (:data:`RESTART_STEPS`): the in-order error has many local minima (its
         correspondence changes along the way), a wide step leaves the basin, a narrow one
@@ -656,7 +659,9 @@ class _Run:
         first = _diverse(seeds, self.o["n_refine"], simple=simple)
         if simple:  # the four-bars (a third) every third, so they hold a third of any shorter time too
             first = _every_third(first)
-        yield from ((s, self.o["max_nfev"]) for s in first)
+        for s in first:   # a topology out of the race is out of the first round's remainder too
+            if self.racing(s.topo.key):
+                yield s, self.o["max_nfev"]
         used = {id(s) for s in first}
         rest = [s for s in seeds if id(s) not in used]
         polished: set[int] = set()
@@ -665,6 +670,8 @@ class _Run:
             rnd += 1
             leaders = self.leaders()
             for i, c in enumerate(leaders):
+                if i and c.chamfer > RACE * self.best:   # out of the race: no polish, no restart
+                    continue
                 if id(c) not in polished:  # a longer refinement of the best of the topology
                     polished.add(id(c))
                     yield _seed_of(c), 3 * self.o["max_nfev"]
