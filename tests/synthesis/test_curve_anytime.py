@@ -317,21 +317,28 @@ def test_a_turned_six_bar_curve_is_traced_as_well_as_drawn(db):
 
 def test_a_topology_far_behind_gets_no_further_seeds():
     # the race: a topology refined RACE_TRIES times whose best is beyond RACE times the best
-    # of all is out of the widening; one refined fewer times, or close enough, stays in
+    # of all is out of the widening; one refined fewer times, or close enough, stays in; with
+    # prefer="simple" a simpler one stays in once the best is within the tolerance
     from types import SimpleNamespace as S
 
     from mechsyn.synthesis.curves import synthesis
 
-    run = synthesis._Run(None, None, {}, lambda *a: None, 0.0)
-    run.cands = [S(chamfer=0.01, topology=S(key="lead")), S(chamfer=0.01 * synthesis.RACE * 1.01,
-                                                              topology=S(key="behind"))]
-    run.tries = {"lead": 9, "behind": synthesis.RACE_TRIES}
-    assert run.racing("lead") and not run.racing("behind")
+    lead, behind, four = S(key="lead", n_links=6), S(key="behind", n_links=6), S(key="four", n_links=4)
+    run = synthesis._Run(None, None, {"prefer": "simple", "tolerance": 0.005}, lambda *a: None, 0.0)
+    run.cands = [S(chamfer=0.01, topology=lead), S(chamfer=0.01 * synthesis.RACE * 1.01, topology=behind),
+                 S(chamfer=0.03, topology=four)]
+    run.tries = {"lead": 9, "behind": synthesis.RACE_TRIES, "four": synthesis.RACE_TRIES}
+    assert run.racing(lead) and not run.racing(behind) and not run.racing(four)
     run.tries["behind"] -= 1
-    assert run.racing("behind") and run.racing("never refined")
+    assert run.racing(behind) and run.racing(S(key="never refined", n_links=8))
     run.tries["behind"] += 1
     run.cands[1].chamfer = 0.01 * synthesis.RACE
-    assert run.racing("behind")
+    assert run.racing(behind)
+    run.cands[0].chamfer = 0.004           # the best within the tolerance: the simpler back in
+    run.tries["eight"] = synthesis.RACE_TRIES   # refined, no candidate: out
+    assert run.racing(four) and not run.racing(S(key="eight", n_links=8))
+    run.o["prefer"] = "accuracy"
+    assert not run.racing(four)
 
 
 def test_the_curve_search_loads_no_graph_library():

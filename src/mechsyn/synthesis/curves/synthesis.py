@@ -659,18 +659,21 @@ class _Run:
         first = _diverse(seeds, self.o["n_refine"], simple=simple)
         if simple:  # the four-bars (a third) every third, so they hold a third of any shorter time too
             first = _every_third(first)
+        later: list[_Seed] = []
         for s in first:   # a topology out of the race is out of the first round's remainder too
-            if self.racing(s.topo.key):
+            if self.racing(s.topo):
                 yield s, self.o["max_nfev"]
+            else:         # ... its seeds kept, should it come back
+                later.append(s)
         used = {id(s) for s in first}
-        rest = [s for s in seeds if id(s) not in used]
+        rest = sorted(later, key=lambda s: (s.rank, s.row)) + [s for s in seeds if id(s) not in used]
         polished: set[int] = set()
         rnd = 0
         while True:
             rnd += 1
             leaders = self.leaders()
             for i, c in enumerate(leaders):
-                if i and c.chamfer > RACE * self.best:   # out of the race: no polish, no restart
+                if i and c.chamfer > RACE * self.best and not self.racing(c.topology):   # out of the race
                     continue
                 if id(c) not in polished:  # a longer refinement of the best of the topology
                     polished.add(id(c))
@@ -679,20 +682,25 @@ class _Run:
                 for k in range(RESTARTS + (i == 0)):  # restarts about it: every joint and the tracer moved
                     step = RESTART_STEPS[k % len(RESTART_STEPS)] * self.bounds.unit / np.sqrt(rnd)
                     yield _seed_of(c, _moved(c, step, rng)), self.o["max_nfev"]
-            rest = [s for s in rest if self.racing(s.topo.key)]
-            batch = _diverse(rest, WIDEN, simple=False)
+            batch = _diverse([s for s in rest if self.racing(s.topo)], WIDEN, simple=False)
             chosen = {id(s) for s in batch}
             rest = [s for s in rest if id(s) not in chosen]
             yield from ((s, self.o["max_nfev"]) for s in batch)
             if not batch and not leaders:
                 return
 
-    def racing(self, key: str) -> bool:
+    def racing(self, topo: CurveTopology) -> bool:
         """Whether a topology still gets retrieved seeds: refined fewer than
-        :data:`RACE_TRIES` times, or its best within :data:`RACE` times the best of all."""
-        if self.tries.get(key, 0) < RACE_TRIES:
+        :data:`RACE_TRIES` times, or its best within :data:`RACE` times the best of all, or
+        (``prefer="simple"``) fewer links than the best design's once that is within the
+        tolerance (a simpler linkage within it would be listed first)."""
+        if self.tries.get(topo.key, 0) < RACE_TRIES:
             return True
-        mine = min((c.chamfer for c in self.cands if c.topology.key == key), default=float("inf"))
+        if self.o.get("prefer") == "simple" and self.cands:
+            lead = min(self.cands, key=lambda c: c.chamfer)
+            if lead.chamfer <= self.o["tolerance"] and topo.n_links < lead.topology.n_links:
+                return True
+        mine = min((c.chamfer for c in self.cands if c.topology.key == topo.key), default=float("inf"))
         return mine <= RACE * self.best
 
     def leaders(self) -> list[CurveCandidate]:
