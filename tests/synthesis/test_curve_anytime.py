@@ -313,3 +313,46 @@ def test_a_turned_six_bar_curve_is_traced_as_well_as_drawn(db):
     b = synthesize_curve(_turn(P - [40.0, -25.0], 37.0), **kw)
     ea, eb = (min(c.chamfer for c in res.candidates) for res in (a, b))
     assert ea < 0.05 and eb == pytest.approx(ea, rel=0.2)
+
+
+def test_a_topology_far_behind_gets_no_further_seeds():
+    # the race: a topology refined RACE_TRIES times whose best is beyond RACE times the best
+    # of all is out of the widening; one refined fewer times, or close enough, stays in; with
+    # prefer="simple" a simpler one stays in once the best is within the tolerance
+    from types import SimpleNamespace as S
+
+    from mechsyn.synthesis.curves import synthesis
+
+    lead, behind, four = S(key="lead", n_links=6), S(key="behind", n_links=6), S(key="four", n_links=4)
+    run = synthesis._Run(None, None, {"prefer": "simple", "tolerance": 0.005}, lambda *a: None, 0.0)
+    run.cands = [S(chamfer=0.01, topology=lead), S(chamfer=0.01 * synthesis.RACE * 1.01, topology=behind),
+                 S(chamfer=0.03, topology=four)]
+    run.tries = {"lead": 9, "behind": synthesis.RACE_TRIES, "four": synthesis.RACE_TRIES}
+    assert run.racing(lead) and not run.racing(behind) and not run.racing(four)
+    run.tries["behind"] -= 1
+    assert run.racing(behind) and run.racing(S(key="never refined", n_links=8))
+    run.tries["behind"] += 1
+    run.cands[1].chamfer = 0.01 * synthesis.RACE
+    assert run.racing(behind)
+    run.cands[0].chamfer = 0.004           # the best within the tolerance: the simpler back in
+    run.tries["eight"] = synthesis.RACE_TRIES   # refined, no candidate: out
+    assert run.racing(four) and not run.racing(S(key="eight", n_links=8))
+    run.o["prefer"] = "accuracy"
+    assert not run.racing(four)
+
+
+def test_the_curve_search_loads_no_graph_library():
+    # networkx (0.2-0.7 s) serves the atlas's enumeration, not a search through a built database
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import mechsyn
+
+    src = str(Path(mechsyn.__file__).resolve().parent.parent)   # this tree's mechsyn in the child too
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([src, os.environ.get("PYTHONPATH", "")])}
+    code = ("import sys, mechsyn.synthesis.curves.synthesis, mechsyn.cli.curves; "
+            "print('networkx' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
+    assert out.stdout.strip() == "False"

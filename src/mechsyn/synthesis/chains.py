@@ -46,7 +46,8 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import networkx as nx
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from mechsyn.errors import MechsynInputError
@@ -54,9 +55,10 @@ from mechsyn.limits import limit, limit_hint
 from mechsyn.parallel import run_tasks
 from mechsyn.progress import ProgressCallback, counter
 from mechsyn.synthesis import canonical
-from mechsyn.synthesis.contracted import (ContractedGraph, compositions, contracted_graphs, degenerate_mask,
-                                          edge_automorphisms, expand, has_bridge, is_fractionated_contracted,
-                                          orbit_representatives, simple_mask)
+
+if TYPE_CHECKING:   # networkx (imported by the graph functions here and by the contracted graphs) costs
+    import networkx as nx   # 0.2-0.7 s: loaded where a graph is built, not by readers of stored chains
+    from mechsyn.synthesis.contracted import ContractedGraph
 
 __all__ = [
     "KinematicChain",
@@ -215,6 +217,8 @@ def is_degenerate(edges: Sequence[Sequence[int]], n_links: int | None = None) ->
 
 def is_fractionated(edges: Sequence[Sequence[int]], n_links: int | None = None) -> bool:
     """True when a cut link splits the chain (its mobility then adds up over the parts)."""
+    import networkx as nx
+
     pairs, n = _normalise_edges(edges, n_links)
     g = nx.Graph(pairs)
     g.add_nodes_from(range(n))
@@ -261,6 +265,8 @@ class KinematicChain:
         return deg
 
     def graph(self) -> nx.Graph:
+        import networkx as nx
+
         g = nx.Graph()
         g.add_nodes_from(range(self.n_links))
         g.add_edges_from(self.edges)
@@ -352,6 +358,8 @@ def _check_chain_counts(d: dict, n: int, edges: list, field: str) -> int:
     if mobility != 3 * (n - 1) - 2 * len(edges):
         raise MechsynInputError(f"mobility {mobility}, but {n} links and {len(edges)} joints give "
                                 f"{3 * (n - 1) - 2 * len(edges)}", field=f"{field}.mobility")
+    import networkx as nx
+
     g = nx.Graph(edges)
     g.add_nodes_from(range(n))
     if not nx.is_connected(g):
@@ -397,6 +405,8 @@ def _unit_graphs(
     backend: str | None = None,
 ) -> list[ContractedGraph | None]:
     """Stage 1 of one assortment: its contracted graphs (``[None]``: the single loop)."""
+    from mechsyn.synthesis.contracted import contracted_graphs, has_bridge
+
     if backend is not None:
         canonical.set_backend(backend)
     n2 = assortment.get(2, 0)
@@ -413,6 +423,11 @@ def _graph_chains(
     graphs: Sequence[ContractedGraph | None], backend: str | None = None,
 ) -> list[KinematicChain]:
     """Stage 2: the chains of some contracted graphs of one assortment, in their order."""
+    import networkx as nx
+
+    from mechsyn.synthesis.contracted import (compositions, degenerate_mask, edge_automorphisms, expand,
+                                              is_fractionated_contracted, orbit_representatives, simple_mask)
+
     if backend is not None:
         canonical.set_backend(backend)
     n2 = assortment.get(2, 0)

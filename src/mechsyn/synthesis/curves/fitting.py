@@ -136,13 +136,17 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
 
 
 def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
-              around: int | None = None) -> tuple[float, int]:
+              around: int | None = None, full: bool = False) -> tuple[float, int] | tuple[float, int, np.ndarray]:
     """The least weighted cost over correspondences in order of a cost matrix ``c (n, m)``
     (:func:`_dtw`) and the start shift of the closed curve it is reached at (the rows'
     when they are closed, else the columns'; 0 when neither is): every
     :data:`ROLL_STEP`-th shift, then every one about the best two; with ``around`` (a
-    shift found before) only those within :data:`ROLL_STEP` of it."""
+    shift found before) only those within :data:`ROLL_STEP` of it; with ``full`` also the
+    sums to every cell of the best (for :func:`_dtw_pairs`)."""
     if not (rows_closed or cols_closed):
+        if full:
+            D = _dtw(c[None], full=True)[0]
+            return float(D[-1, -1] / sum(c.shape)), 0, D
         return float(_dtw(c[None])[0]), 0
     n = c.shape[0] if rows_closed else c.shape[1]
     if around is None:
@@ -151,6 +155,11 @@ def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
         near = sorted({(s + k) % n for s in coarse[np.argsort(e)[:2]] for k in range(1 - ROLL_STEP, ROLL_STEP)})
     else:
         near = sorted({(around + k) % n for k in range(-ROLL_STEP, ROLL_STEP + 1)})
+    if full:
+        D = _dtw(_rolled(c, np.array(near), rows_closed), full=True)
+        f = D[:, -1, -1] / sum(c.shape)
+        i = int(np.argmin(f))
+        return float(f[i]), int(near[i]), D[i]
     f = _dtw(_rolled(c, np.array(near), rows_closed))
     i = int(np.argmin(f))
     return float(f[i]), int(near[i])
@@ -182,17 +191,19 @@ def _dtw(C: np.ndarray, full: bool = False) -> np.ndarray:
     return np.stack(rows, axis=1) if full else D[:, -1] / (n + m)
 
 
-def _dtw_pairs(C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _dtw_pairs(C: np.ndarray, D: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The rows and columns ``(L,)`` of the least-cost monotone path of :func:`_dtw` through
-    one cost matrix ``C (n, m)``, from ``(0, 0)`` to ``(n-1, m-1)`` (backtracked)."""
-    D = _dtw(C[None], full=True)[0]
+    one cost matrix ``C (n, m)``, from ``(0, 0)`` to ``(n-1, m-1)`` (backtracked; ``D`` its
+    sums to every cell when known)."""
+    Dl = (_dtw(C[None], full=True)[0] if D is None else D).tolist()   # scalar look-ups: lists
+    Cl = C.tolist()
     i, j = C.shape[0] - 1, C.shape[1] - 1
     rows, cols = [i], [j]
     while i or j:
-        c = C[i, j]
-        if i and j and D[i - 1, j - 1] + 2 * c <= min(D[i - 1, j], D[i, j - 1]) + c:
+        c = Cl[i][j]
+        if i and j and Dl[i - 1][j - 1] + 2 * c <= min(Dl[i - 1][j], Dl[i][j - 1]) + c:
             i, j = i - 1, j - 1
-        elif not j or (i and D[i - 1, j] <= D[i, j - 1]):
+        elif not j or (i and Dl[i - 1][j] <= Dl[i][j - 1]):
             i -= 1
         else:
             j -= 1
@@ -211,9 +222,12 @@ def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.nda
 def _seg_dist(X: np.ndarray, F: np.ndarray, closed: bool) -> np.ndarray:
     """``(n, S)``: distance from each point of ``X`` to each segment of polyline ``F``."""
     S0, V = _polyline(F, closed)
-    d = X[:, None, :] - S0[None]
-    t = np.clip(np.sum(d * V[None], axis=-1) / np.maximum(np.sum(V ** 2, axis=-1), 1e-300), 0.0, 1.0)
-    return np.linalg.norm(d - t[..., None] * V[None], axis=-1)
+    dx, dy = X[:, :1] - S0[:, 0], X[:, 1:] - S0[:, 1]                  # (n, S) each: x and y apart
+    vx, vy = V[:, 0], V[:, 1]
+    t = np.clip((dx * vx + dy * vy) / np.maximum(vx * vx + vy * vy, 1e-300), 0.0, 1.0)
+    dx -= t * vx
+    dy -= t * vy
+    return np.sqrt(dx * dx + dy * dy)
 
 
 def _stretches(seg: np.ndarray, closed: bool, k: int) -> np.ndarray:
@@ -260,10 +274,10 @@ def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool,
     n, m = c.shape
     senses = (False, True) if hint is None else (hint[0],)
     around = None if hint is None else hint[1]
-    (_, shift), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around), rev)
-                           for rev in senses), key=lambda x: x[0][0])
+    (_, shift, D), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around, full=True),
+                               rev) for rev in senses), key=lambda x: x[0][0])
     cc = c[:, ::-1] if rev else c
-    i, j = _dtw_pairs(_rolled(cc, np.array([shift]), rows_closed)[0] if rows_closed or cols_closed else cc)
+    i, j = _dtw_pairs(_rolled(cc, np.array([shift]), rows_closed)[0] if rows_closed or cols_closed else cc, D)
     if rows_closed:
         i = (i + shift) % n
     elif cols_closed:

@@ -42,8 +42,10 @@ compiled kernels: the largest cost of a short run); a check that cannot load by 
 is not begun and the answer is given unchecked, labelled so; then a deterministic sequence of refinements runs: the
 first round of retrieved seeds (the four-bars every third), then rounds that refine the best
 design of each of the three leading topologies longer, restart about it (every joint
-and the tracer, the coupler point free on its plane, moved at random, seeded by the
-round) and widen to further retrieved seeds, eight-bars among them. An evaluation past
+and the tracer, the coupler point free on its plane, moved at random by a wide and a
+narrow step in turn, seeded by the round) and widen to further retrieved seeds, eight-bars
+among them; a topology far behind the best drops out of the race (no further seeds, no
+restarts: :meth:`_Run.tasks`). An evaluation past
 the deadline stops the refinement under way with the best design it has evaluated. The
 search ends at the limit, at ``target_error``, after ``refinements`` or on Ctrl-C.
 
@@ -504,7 +506,10 @@ _CHECKS_LOADED: list[float] = []
 UNREFINED = 8        # retrieved designs evaluated as they are, before any refinement (answers at any limit)
 MIN_UNREFINED = 3    # of them evaluated whatever the time: an answer at any limit
 WIDEN = 8            # new retrieved seeds per round after the first
-RESTARTS = 2         # perturbed restarts per leading topology per round
+RESTARTS = 2         # perturbed restarts per leading topology per round (the leader one more)
+RESTART_STEPS = (0.12, 0.04)   # their steps in turn, in target diagonals (over the square root of the round)
+RACE = 1.25          # a topology whose best is beyond this many times the best of all ...
+RACE_TRIES = 3       # ... after this many refinements gets no further retrieved seeds
 LEADERS = 3          # topologies restarted and polished per round
 EXIT_RESERVE = 0.25  # seconds left at the end for mapping back, output and the exit (measured 0.1 s
                      # after a search at load 10 on 2 cores, the CLI skipping the collector at exit)
@@ -533,6 +538,7 @@ class _Run:
     verify_cost: float = 0.05   # seconds of one check by simulate (measured on the first candidate)
     load_cost: float = 0.0      # seconds the checks' first loading is expected to take (0: loaded)
     topologies: int = 3      # topologies among the retrieved designs
+    tries: dict[str, int] = field(default_factory=dict)   # refinements begun per topology
 
     @property
     def best(self) -> float:
@@ -623,6 +629,7 @@ class _Run:
                     return
                 c = _refine(s, self.target, self.bounds, nfev, self.deadline())
                 self.done += 1
+                self.tries[s.topo.key] = self.tries.get(s.topo.key, 0) + 1
                 self.add(c)
                 if self.o["refinements"] is not None:
                     self.report("refine", self.done, self.o["refinements"], self.best, self.nfev)
@@ -636,33 +643,65 @@ class _Run:
 
     def tasks(self, seeds: list[_Seed]):
         """The sequence of ``(seed, max_nfev)`` refinements (see the class doc); each
-        round depends only on the candidates so far, so the sequence is deterministic."""
+        round depends only on the candidates so far, so the sequence is deterministic.
+
+        The topologies race (E. Even-Dar, S. Mannor and Y. Mansour, "Action elimination and
+        stopping conditions for the multi-armed bandit and reinforcement learning problems",
+        *JMLR* 7, 2006): a topology refined :data:`RACE_TRIES` times whose best is more than
+        :data:`RACE` times the best of all gets no further retrieved seeds (in the first round
+        either), a leader as far behind is neither polished nor restarted, and the leading
+        topology gets one restart more;
+        the restarts about a leader alternate a wide and a narrow step
+        (:data:`RESTART_STEPS`): the in-order error has many local minima (its
+        correspondence changes along the way), a wide step leaves the basin, a narrow one
+        searches about it."""
         simple = self.o["prefer"] == "simple"
         first = _diverse(seeds, self.o["n_refine"], simple=simple)
         if simple:  # the four-bars (a third) every third, so they hold a third of any shorter time too
             first = _every_third(first)
-        yield from ((s, self.o["max_nfev"]) for s in first)
+        later: list[_Seed] = []
+        for s in first:   # a topology out of the race is out of the first round's remainder too
+            if self.racing(s.topo):
+                yield s, self.o["max_nfev"]
+            else:         # ... its seeds kept, should it come back
+                later.append(s)
         used = {id(s) for s in first}
-        rest = [s for s in seeds if id(s) not in used]
+        rest = sorted(later, key=lambda s: (s.rank, s.row)) + [s for s in seeds if id(s) not in used]
         polished: set[int] = set()
         rnd = 0
         while True:
             rnd += 1
             leaders = self.leaders()
             for i, c in enumerate(leaders):
+                if i and c.chamfer > RACE * self.best and not self.racing(c.topology):   # out of the race
+                    continue
                 if id(c) not in polished:  # a longer refinement of the best of the topology
                     polished.add(id(c))
                     yield _seed_of(c), 3 * self.o["max_nfev"]
                 rng = np.random.default_rng([rnd, i])
-                for _ in range(RESTARTS):  # restarts about it: every joint and the tracer moved
-                    step = 0.05 * self.bounds.unit / np.sqrt(rnd)
-                    yield _seed_of(c, c.params + step * rng.standard_normal(len(c.params))), self.o["max_nfev"]
-            batch = _diverse(rest, WIDEN, simple=False)
+                for k in range(RESTARTS + (i == 0)):  # restarts about it: every joint and the tracer moved
+                    step = RESTART_STEPS[k % len(RESTART_STEPS)] * self.bounds.unit / np.sqrt(rnd)
+                    yield _seed_of(c, _moved(c, step, rng)), self.o["max_nfev"]
+            batch = _diverse([s for s in rest if self.racing(s.topo)], WIDEN, simple=False)
             chosen = {id(s) for s in batch}
             rest = [s for s in rest if id(s) not in chosen]
             yield from ((s, self.o["max_nfev"]) for s in batch)
             if not batch and not leaders:
                 return
+
+    def racing(self, topo: CurveTopology) -> bool:
+        """Whether a topology still gets retrieved seeds: refined fewer than
+        :data:`RACE_TRIES` times, or its best within :data:`RACE` times the best of all, or
+        (``prefer="simple"``) fewer links than the best design's once that is within the
+        tolerance (a simpler linkage within it would be listed first)."""
+        if self.tries.get(topo.key, 0) < RACE_TRIES:
+            return True
+        if self.o.get("prefer") == "simple" and self.cands:
+            lead = min(self.cands, key=lambda c: c.chamfer)
+            if lead.chamfer <= self.o["tolerance"] and topo.n_links < lead.topology.n_links:
+                return True
+        mine = min((c.chamfer for c in self.cands if c.topology.key == topo.key), default=float("inf"))
+        return mine <= RACE * self.best
 
     def leaders(self) -> list[CurveCandidate]:
         """The best candidate of each of the :data:`LEADERS` best topologies."""
@@ -689,6 +728,18 @@ def _every_third(seeds: list[_Seed]) -> list[_Seed]:
         out += others[:2]
         others = others[2:]
     return out
+
+
+def _moved(c: CurveCandidate, step: float, rng: np.random.Generator) -> np.ndarray:
+    """The design moved at random (every joint and the tracer, normal with deviation
+    ``step``): the first of the moves by ``step``, ``step / 2`` and ``step / 4`` whose
+    mechanism is assembled over the candidate's range (one batch evaluation), else the
+    first move (its refinement then finds it unassembled)."""
+    scales = np.repeat([1.0, 0.5, 0.25], 2)
+    X = c.params + step * scales[:, None] * rng.standard_normal((len(scales), len(c.params)))
+    res = simulate_batch(c.topology.plan, X, input_offsets(c.start, c.stop, c.full_turn))
+    fine = res.assembled.all(axis=1) & ~res.branch_jump   # as the refinement asks (no stepped-over dead point)
+    return X[int(np.argmax(fine))]
 
 
 def _seed_of(c: CurveCandidate, params: np.ndarray | None = None) -> _Seed:

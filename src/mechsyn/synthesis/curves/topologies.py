@@ -34,7 +34,6 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.batch import BatchPlan, compile_plan
 from mechsyn.synthesis import canonical
 from mechsyn.synthesis.chains import KinematicChain, synthesize_chains
-from mechsyn.synthesis.mechanisms import distinct_mechanisms, mechanism_dict
 
 __all__ = ["CurveTopology", "curve_topologies", "six_bar_name", "chain_name"]
 
@@ -169,6 +168,8 @@ def curve_topologies(max_links: int = 8) -> tuple[CurveTopology, ...]:
     """
     if max_links not in (4, 6, 8):
         raise MechsynInputError(f"max links {max_links}: choose 4, 6 or 8", field="max_links")
+    from mechsyn.synthesis.mechanisms import distinct_mechanisms, mechanism_dict   # here: it loads networkx
+
     out: list[CurveTopology] = []
     for n in range(4, max_links + 1, 2):
         for ci, chain in enumerate(synthesize_chains(n, 1)):
