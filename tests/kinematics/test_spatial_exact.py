@@ -173,6 +173,29 @@ def test_rssr_drawn_at_a_dead_point_sweeps_every_row_that_assembles():
     assert lo == pytest.approx(b, abs=1e-6)
 
 
+@pytest.mark.parametrize("r", [1.7, 2.0, 2.9])
+def test_rssr_full_turn_assembles_the_crank_range_no_motion_reaches(r):
+    """Drawn at a dead point, the crank of these RSSRs works in two separate ranges (two
+    circuits): a full turn of the input assembles every row of both, the one no motion from
+    the drawn pose reaches re-assembled from the row after its gap (it lies before the first
+    row reached) and said so (``reached`` 3, one ``reassembled`` event), the rocker on a
+    closed-form root everywhere."""
+    m, phi_star, psi = rssr_at_dead_point(r)
+    g = np.arange(-179.5, 180, 0.7)
+    s = ms.simulate(m, {"A": g})
+    truth = np.array([psi(phi_star + u) for u in g])
+    want = np.isfinite(truth[:, 0])
+    edge = np.zeros(len(g), bool)  # rows next to a range's end: closer to it than the test can tell
+    for e in np.flatnonzero(np.diff(want.astype(int))):
+        edge[max(0, e - 1):e + 3] = True
+    assert np.array_equal(s.assembled[~edge], want[~edge])
+    assert (s.reached == 3).any() and (s.reached == 1).any()
+    assert len([e for e in s.events if e["kind"] == "reassembled"]) == 1
+    D = np.radians(s.joints["D"])
+    err = np.nanmin(np.abs(np.angle(np.exp(1j * (D[s.assembled, None] - truth[s.assembled])))), axis=1)
+    assert err.max() < SING_POS
+
+
 def test_spherical_four_bar_drawn_at_its_change_point_sweeps_both_ways():
     m, axes = spherical_fourbar(30, 70, 50, 50, 0.0)
     g = ms.input_grid(-180, 180, 1)

@@ -393,9 +393,9 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
     1. a sweep of one R (or H) input that reached one end goes on past it with the rows left
        taken modulo 360 degrees (the other way round from the drawn assembly: the rows a
        full-turn sweep could not reach forwards are reached backwards, on the drawn circuit);
-    2. rows still left are re-assembled by Newton from the last pose before each gap, in
-       row order: another assembly than the drawn one (no motion from the drawn assembly
-       reaches them), each such stretch an event ``reassembled``.
+    2. rows still left are re-assembled by Newton from the pose next to each gap (the row
+       before it, then the row after it): another assembly than the drawn one (no motion
+       from the drawn assembly reaches them), each such stretch an event ``reassembled``.
 
     ``event(index, kind, detail)`` makes the event dicts. From a singular pose (a file
     drawn at a dead or change point) the first row each way is reached by :func:`leave`."""
@@ -469,25 +469,28 @@ def _same_angle(w: Walk, U: np.ndarray, col: int) -> None:
 
 
 def _reassemble_rest(tr: Tracker, w: Walk, U: np.ndarray, event: Any) -> None:
-    """Rule 2 of :func:`walk`: each gap left, in row order, re-assembled by Newton from the
-    pose of the row before it (the first row of the gap where Newton converges to a true
-    assembly), then walked on forwards and back into the gap as far as the mechanism moves."""
+    """Rule 2 of :func:`walk`: each gap left re-assembled by Newton from the pose of the row
+    next to it, first from the row before it (gaps in row order), then from the row after it
+    (gaps in reverse order: a gap before the first row reached has no row before it); the
+    first row of the gap, counted from that side, where Newton converges to a true assembly,
+    then walked on both ways as far as the mechanism moves."""
     N = len(U)
-    for i in range(1, N):
-        if w.ok[i] or not w.ok[i - 1]:
-            continue
-        rows = np.arange(i, N)
-        rows = rows[:int(np.argmax(np.append(w.ok[rows], True)))]  # up to the next assembled row
-        got = tr.reassemble(tr.state(*w.at(i - 1), U[i - 1][None]), U, rows)
-        for k, jid in tr.refused:
-            w.events.append(event(k, "refused", jid))
-        if got is None:
-            continue
-        k, st = got
-        w.put(k, st, how=3)
-        _blocks_along(tr, w, st, U, k, rows[rows > k], event, how=3)
-        _blocks_along(tr, w, st, U, k, rows[rows < k][::-1], event, how=3)
-        w.events.append(event(int(rows[np.argmax(w.ok[rows])]), "reassembled", None))
+    for side in (-1, 1):
+        for i in (range(1, N) if side < 0 else range(N - 2, -1, -1)):
+            if w.ok[i] or not w.ok[i + side]:
+                continue
+            rows = np.arange(i, N) if side < 0 else np.arange(i, -1, -1)
+            rows = rows[:int(np.argmax(np.append(w.ok[rows], True)))]  # up to the next assembled row
+            got = tr.reassemble(tr.state(*w.at(i + side), U[i + side][None]), U, rows)
+            for k, jid in tr.refused:
+                w.events.append(event(k, "refused", jid))
+            if got is None:
+                continue
+            k, st = got
+            w.put(k, st, how=3)
+            _blocks_along(tr, w, st, U, k, np.sort(rows[rows > k]), event, how=3)
+            _blocks_along(tr, w, st, U, k, np.sort(rows[rows < k])[::-1], event, how=3)
+            w.events.append(event(int(rows[np.argmax(w.ok[rows])]), "reassembled", None))
 
 
 def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order: np.ndarray, event: Any,
