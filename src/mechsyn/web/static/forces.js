@@ -14,7 +14,7 @@ const num = (text) => { const v = Number(String(text).trim().replace(",", "."));
 // arrows, cursor}. A spatial file gets `spatialLines()` instead (spatial_tabs.js: no spatial statics).
 export function mountForces({ $, state, render, edit, stepsFor, spatialLines }) {
   const box = $("tab-forces");
-  let timer = null, charts = [];
+  let timer = null, charts = [], asked = 0;
 
   function field(value, onValue, attrs = {}) {
     const i = h("input", null, { type: "text", inputMode: "decimal", value: value === undefined ? "" : String(value), ...attrs });
@@ -75,14 +75,17 @@ export function mountForces({ $, state, render, edit, stepsFor, spatialLines }) 
   }
 
   async function compute() {
-    const mech = state.mech;
+    const mech = state.mech, ask = ++asked;  // only the latest request's answer is shown
     if (!mech || mech.kind !== "planar" || !mech.joints.some((j) => j.actuated)) { state.forces = null; return renderForces(); }
     try {
       const r = await call("/api/studio/forces", { mechanism: mech, steps: stepsFor(mech), speed: num($("drive-speed").value) ?? 1,
         gravity: $("forces-gravity").checked ? [0, -9.81] : [0, 0] });
-      if (mech !== state.mech) return;
+      if (mech !== state.mech || ask !== asked) return;
       state.forces = { mech, r };
-    } catch (e) { state.forces = { mech, error: e.error || String(e) }; }
+    } catch (e) {
+      if (ask !== asked) return;
+      state.forces = { mech, error: e.error || String(e) };
+    }
     renderForces(); render();
   }
   function forcesSoon() { clearTimeout(timer); if (box.classList.contains("on")) timer = setTimeout(compute, 150); }
