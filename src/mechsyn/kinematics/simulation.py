@@ -312,7 +312,7 @@ class Simulation(Motion):
 
 
 def _unit(t: str) -> str:
-    return "deg" if t == "R" else "length"
+    return "length" if t == "P" else "deg"  # (an angle: R, and a spatial file's H, C/turn, U)
 
 
 def input_grid(start: float, stop: float, step: float) -> np.ndarray:
