@@ -54,9 +54,16 @@ def _wrap(a):
 
 
 @njit(inline="always", **_OPTIONS)
-def _skew(a, i, j):
-    """Entry ``(i, j)`` of ``[a]x`` (``[a]x y = a × y``)."""
-    return 0.0 if i == j else (a[3 - i - j] if (j - i) % 3 == 2 else -a[3 - i - j])
+def _rotation(w, a, c, t2):
+    """``(1 - c t2) I + a [w]x + c w wᵀ`` (3, 3): with ``|w|² = t2``, ``a = sin θ / θ`` and
+    ``c = (1 - cos θ) / θ²`` the rotation by the angle ``θ = |w|`` about ``w`` (Rodrigues)."""
+    E = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            k = 3 - i - j
+            skew = 0.0 if i == j else (w[k] if (j - i) % 3 == 2 else -w[k])  # [w]x y = w × y
+            E[i, j] = c * w[i] * w[j] + (1 - c * t2 if i == j else 0.0) + a * skew
+    return E
 
 
 @njit(**_OPTIONS)
@@ -212,46 +219,13 @@ def move(R, p, x, R2, p2):
                 a, c, e = math.sin(t) / t, 2 * (math.sin(0.5 * t) / t) ** 2, (t - math.sin(t)) / (t * t2)
             wv = _x(w, v)
             tr = _ax(_ax(v, c, wv), e, _x(w, wv))
-            E = np.empty((3, 3))
-            for i in range(3):
-                for j in range(3):
-                    E[i, j] = c * w[i] * w[j] + (1 - c * t2 if i == j else 0.0) + a * _skew(w, i, j)
+            E = _rotation(w, a, c, t2)
             Rk, pk = R[b, k].copy(), (p[b, k, 0], p[b, k, 1], p[b, k, 2])
             for i in range(3):
                 for j in range(3):
                     R2[b, k, i, j] = E[i, 0] * Rk[0, j] + E[i, 1] * Rk[1, j] + E[i, 2] * Rk[2, j]
                 p2[b, k, i] = E[i, 0] * pk[0] + E[i, 1] * pk[1] + E[i, 2] * pk[2] + tr[i]
         R2[b, n], p2[b, n] = R[b, n], p[b, n]
-
-
-@njit(**_OPTIONS)
-def _spd_inverse(G, Gi):
-    """``G⁻¹`` of a symmetric positive definite ``G`` into ``Gi`` by its Cholesky factor:
-    ``G = Uᵀ U``, ``G⁻¹ = V Vᵀ`` with ``V = U⁻¹`` (the loops run along rows, without
-    reductions, so they vectorise); False when ``G`` is not positive definite to rounding."""
-    k = G.shape[0]
-    U, V = G.copy(), np.zeros((k, k))
-    for j in range(k):
-        if not U[j, j] > 0.0:
-            return False
-        d = 1.0 / math.sqrt(U[j, j])
-        for c in range(j, k):
-            U[j, c] *= d
-        for i in range(j + 1, k):
-            f = U[j, i]
-            for c in range(i, k):
-                U[i, c] -= f * U[j, c]
-    for i in range(k - 1, -1, -1):
-        V[i, i] = 1.0
-        for t in range(i + 1, k):
-            f = U[i, t]
-            for c in range(t, k):
-                V[i, c] -= f * V[t, c]
-        d = 1.0 / U[i, i]
-        for c in range(i, k):
-            V[i, c] *= d
-    Gi[:] = V @ V.T
-    return True
 
 
 @njit(**_OPTIONS)
@@ -266,40 +240,24 @@ def gram(J, rows, Gi):
     if not np.isfinite(trace):  # (a NaN or inf in J is one on the diagonal)
         Gi[:] = np.nan
         return 0.0
-    if not _spd_inverse(G, Gi):  # (positive definite but for rounding: a rank drop)
-        Gi[:] = np.linalg.inv(G)
+    Gi[:] = np.linalg.inv(G)
     out = 1.0 / math.sqrt(math.sqrt(np.sum(G * G) * np.sum(Gi * Gi)))
     return out if np.isfinite(out) else 0.0
 
 
 @njit(inline="always", **_OPTIONS)
-def _acc(A, x, y):
-    """``y += Aᵀ x`` along the rows of ``A`` (no reductions: it vectorises)."""
-    for r in range(A.shape[0]):
-        for c in range(A.shape[1]):
-            y[c] += x[r] * A[r, c]
-
-
-@njit(inline="always", **_OPTIONS)
-def _apply(J, Gi, rows, b, t, y):
-    """``y += J⁺ b`` by ``Gi`` (``t``: scratch of ``Gi``'s size): ``Jᵀ (Gi b)`` or ``Gi (Jᵀ b)``."""
-    t[:] = 0.0
-    _acc(Gi if rows else J, b, t)  # (Gi is symmetric)
-    _acc(J if rows else Gi, t, y)
+def _apply(J, Gi, rows, b):
+    """``J⁺ b`` by ``Gi``: ``Jᵀ (Gi b)`` or ``Gi (Jᵀ b)``."""
+    return J.T @ (Gi @ b) if rows else Gi @ (J.T @ b)
 
 
 @njit(**_OPTIONS)
 def solve(J, Gi, C, rows, b, refine, out):
     """``J⁺ b`` by the inverse Gram matrix ``Gi`` with ``refine`` steps of iterative
     refinement, as twists at the origin into ``out`` (6 n) (``v = u + c × ω``)."""
-    t, y, e = np.empty(Gi.shape[0]), np.zeros(J.shape[1]), np.empty(J.shape[0])
-    _apply(J, Gi, rows, b, t, y)
+    y = _apply(J, Gi, rows, b)
     for _ in range(refine):
-        for r in range(J.shape[0]):
-            e[r] = b[r]
-            for c in range(J.shape[1]):
-                e[r] -= J[r, c] * y[c]
-        _apply(J, Gi, rows, e, t, y)
+        y += _apply(J, Gi, rows, b - J @ y)
     for k in range(C.shape[0]):
         w = (y[6 * k], y[6 * k + 1], y[6 * k + 2])
         v = _ax((y[6 * k + 3], y[6 * k + 4], y[6 * k + 5]), 1.0, _x((C[k, 0], C[k, 1], C[k, 2]), w))
@@ -380,21 +338,10 @@ def pair_errors(R, pi, pf, out):
     :func:`mechsyn.kinematics.spatial_model.pair_error`)."""
     for b in range(R.shape[0]):
         for j in range(pi.shape[0]):
-            Ra, Rb = R[b, pi[j, 0]], R[b, pi[j, 1]]
-            a, e1, e2 = pf[j, 0], pf[j, 1], pf[j, 2]
-            Rr = np.empty((3, 3))
-            for i in range(3):
-                for k in range(3):
-                    Rr[i, k] = Ra[0, i] * Rb[0, k] + Ra[1, i] * Rb[1, k] + Ra[2, i] * Rb[2, k]
-            r1 = (_d(Rr[0], e1), _d(Rr[1], e1), _d(Rr[2], e1))
-            t = math.atan2(_d(r1, e2), _d(r1, e1)) if pi[j, 2] else 0.0
-            ct, st = math.cos(t), math.sin(t)
-            worst = 0.0
-            for i in range(3):
-                for k in range(3):
-                    rot = (ct if i == k else 0.0) + st * _skew(a, i, k) + (1 - ct) * a[i] * a[k]
-                    worst = max(worst, abs(Rr[i, k] - rot))
-            out[b, j] = worst
+            Rr = R[b, pi[j, 0]].T @ R[b, pi[j, 1]]
+            r1 = Rr @ pf[j, 1]
+            t = math.atan2(_d(r1, pf[j, 2]), _d(r1, pf[j, 1])) if pi[j, 2] else 0.0
+            out[b, j] = np.max(np.abs(Rr - _rotation(pf[j, 0], math.sin(t), 1 - math.cos(t), 1.0)))
 
 
 @njit(inline="always", **_OPTIONS)

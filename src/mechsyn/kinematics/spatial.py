@@ -361,8 +361,8 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
     w = walk(tr, start, U, event)
     N, n = len(U), M.n
     out = _Rows(w.R[:, :-1], w.p[:, :-1], np.full((N, 6 * n), np.nan), np.full((N, 6 * n), np.nan), w.ok,
-                np.full(N, np.nan), np.full(N, np.nan), np.full((N, M.angles.size), np.nan),
-                np.full((N, M.slides.size), np.nan), w.events, w.how)
+                np.full(N, np.nan), np.full(N, np.nan), np.full((N, len(M.angle_joints)), np.nan),
+                np.full((N, len(M.slide_joints)), np.nan), w.events, w.how)
     idx = np.flatnonzero(w.ok)
     if len(idx):
         st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx], rates=(rates[0][idx], rates[1][idx]))

@@ -88,33 +88,9 @@ __all__ = ["SpatialModel", "compile_spatial", "SPATIAL_PAIRS", "move", "tables"]
 SPATIAL_PAIRS = ("R", "P", "C", "U", "S", "H")
 
 
-def _rows(x: np.ndarray) -> np.ndarray:
-    return np.asarray(x, float).reshape(-1, 3)
-
-
-@dataclass(frozen=True, eq=False)
-class _Kind:
-    """The equations of one kind: link indices ``ia``, ``ib`` and link-fixed vectors."""
-
-    ia: np.ndarray
-    ib: np.ndarray
-    va: np.ndarray        # x_a (coincidence, line, slide) or u_a (dot, angle axis)
-    vb: np.ndarray        # x_b or w_b
-    n: np.ndarray         # n_a (line, slide); e1 of the first link (angle)
-    m: np.ndarray         # e2 of the first link (angle)
-    c0: np.ndarray
-
-    @property
-    def size(self) -> int:
-        return len(self.ia)
-
-
-def _kind(rows: list[tuple]) -> _Kind:
-    z = np.zeros((0, 3))
-    if not rows:
-        return _Kind(np.zeros(0, int), np.zeros(0, int), z, z, z, z, np.zeros(0))
-    ia, ib, va, vb, n, m, c0 = zip(*rows)
-    return _Kind(np.array(ia), np.array(ib), _rows(va), _rows(vb), _rows(n), _rows(m), np.array(c0, float))
+#: The kinds of equations' items (link-fixed points and vectors on the two links of a pair) and
+#: their codes in the compiled tables (:func:`tables`): a slide's item is a line's.
+ITEMS = {"pc": 0, "dot": 1, "line": 2, "dist": 3, "angle": 4, "slide": 2}
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,8 +98,8 @@ class SpatialModel:
     """A spatial mechanism compiled into its constraint equations (see the module doc).
 
     ``links`` are the moving links (pose ``k``); the frame is pose ``len(links)``.
-    ``angles`` and ``slides`` measure the R/H/C rotations and P/H/C slides of the pairs
-    named in ``angle_joints`` and ``slide_joints`` (drives and the coordinates reported);
+    The equations measure the R/H/C rotations and P/H/C slides of the pairs named in
+    ``angle_joints`` and ``slide_joints`` (drives and the coordinates reported);
     ``drives`` lists ``(joint id, "angle" | "slide", index)`` in the order of the inputs;
     ``helix`` holds ``(angle index, slide index, pitch / scale)`` of the H pairs.
     """
@@ -132,12 +108,6 @@ class SpatialModel:
     links: tuple[str, ...]
     centre: np.ndarray
     scale: float
-    pc: _Kind
-    dot: _Kind
-    line: _Kind
-    dist: _Kind
-    angles: _Kind
-    slides: _Kind
     angle_joints: tuple[str, ...]
     slide_joints: tuple[str, ...]
     helix: tuple[tuple[int, int, float], ...]
@@ -149,7 +119,7 @@ class SpatialModel:
     #: per angle joint (``angle_joints``), its input's value at the drawn assembly (rad):
     #: :func:`input_zero`
     zeros: np.ndarray | None = None
-    #: the S-S bars not solved for (their poses from ``dist``'s ends, in order)
+    #: the S-S bars not solved for (their poses from the ends of their distance equations, in order)
     bars: tuple[str, ...] = ()
 
     @property
@@ -158,7 +128,7 @@ class SpatialModel:
 
     @property
     def n_constraints(self) -> int:
-        return 3 * self.pc.size + self.dot.size + self.line.size + self.dist.size + len(self.helix)
+        return len(self.tables[2]) - len(self.drives)
 
     @property
     def all_links(self) -> tuple[str, ...]:
@@ -278,12 +248,10 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
             drive_rows.append((name, "slide", rows["slide_joints"].index(jid)))
     big = max([float(np.abs(np.asarray(j.point, float)).max()) for j in mech.joints if j.point is not None]
               + [float(np.abs(np.asarray(pt.at, float)).max()) for pt in mech.points.values()], default=0.0)
-    M = SpatialModel(mech, links, centre, scale, _kind(rows["pc"]), _kind(rows["dot"]), _kind(rows["line"]),
-                     _kind(rows["dist"]), _kind(rows["angle"]), _kind(rows["slide"]), tuple(rows["angle_joints"]),
-                     tuple(rows["slide_joints"]), helix, tuple(drive_rows),
-                     ulp=float(np.finfo(float).eps) * max(1.0, big / scale), bars=tuple(bars))
+    M = SpatialModel(mech, links, centre, scale, tuple(rows["angle_joints"]), tuple(rows["slide_joints"]), helix,
+                     tuple(drive_rows), ulp=float(np.finfo(float).eps) * max(1.0, big / scale), bars=tuple(bars))
     zeros = np.array([input_zero(mech, mech.joint(jid.partition("/")[0])) for jid in M.angle_joints], float)
-    return replace(M, tables=tables(M), pairs=_pairs(mech, index), zeros=zeros)
+    return replace(M, tables=tables(M, rows), pairs=_pairs(mech, index), zeros=zeros)
 
 
 def _bars(mech: Mechanism) -> dict[str, tuple[Joint, Joint]]:
@@ -425,27 +393,26 @@ def numba_kernel() -> ModuleType:
     return importlib.import_module("mechsyn.kinematics._spatial_numba")
 
 
-def tables(M: SpatialModel) -> tuple:
-    """The equations as the compiled functions' tables (see :mod:`mechsyn.kinematics._spatial_numba`):
-    items ``it`` (kind, links), ``loc`` (their four local vectors), rows ``ri`` (kind, item,
-    second item, component or input column), ``rf`` (constants), the links' centres, the
-    items of the angles and slides measured. Rows in :func:`residual`'s order: coincidences,
-    dots, lines, distances, helices, drives."""
-    kinds = [(0, M.pc), (1, M.dot), (2, M.line), (3, M.dist), (4, M.angles), (2, M.slides)]
-    first = np.cumsum([0] + [kd.size for _, kd in kinds])
-    it = np.concatenate([np.stack([np.full(kd.size, c), kd.ia, kd.ib], 1) for c, kd in kinds]).astype(np.int64)
-    loc = np.concatenate([np.stack([kd.va, kd.vb, kd.n, kd.m], 1) for _, kd in kinds]).reshape(-1, 4, 3)
-    ang, sl = first[4] + np.arange(M.angles.size), first[5] + np.arange(M.slides.size)
-    ri = [(0, first[0] + q, 0, c) for q in range(M.pc.size) for c in range(3)]
-    ri += [(c, first[c] + q, 0, 0) for c in (1, 2, 3) for q in range(kinds[c][1].size)]
-    ri += [(4, sl[s], ang[a], h) for h, (a, s, _) in enumerate(M.helix)]
-    ri += [(5, ang[k], 0, col) if kind == "angle" else (6, sl[k], 0, col) for col, (_, kind, k) in enumerate(M.drives)]
-    rf = np.concatenate([np.zeros(3 * M.pc.size), M.dot.c0, M.line.c0, M.dist.c0, [h for _, _, h in M.helix],
-                         np.zeros(len(M.drives))])
+def tables(M: SpatialModel, rows: dict[str, list]) -> tuple:
+    """The equations ``rows`` of :func:`_pair_rows` (per kind of :data:`ITEMS`, a list of
+    ``(ia, ib, va, vb, n, m, c0)``) as the compiled functions' tables (see
+    :mod:`mechsyn.kinematics._spatial_numba`): items ``it`` (kind, links), ``loc`` (their four
+    local vectors), rows ``ri`` (kind, item, second item, component or input column), ``rf``
+    (constants), the links' centres, the items of the angles and slides measured. Rows in
+    :func:`residual`'s order: coincidences, dots, lines, distances, helices, drives."""
+    items = [(code, *t) for kind, code in ITEMS.items() for t in rows[kind]]
+    first = dict(zip(ITEMS, np.cumsum([0] + [len(rows[k]) for k in ITEMS])))
+    ang, sl = (first[k] + np.arange(len(rows[k]), dtype=np.int64) for k in ("angle", "slide"))
+    eqs = [(0, first["pc"] + q, 0, c, 0.0) for q in range(len(rows["pc"])) for c in range(3)]
+    eqs += [(ITEMS[k], first[k] + q, 0, 0, t[-1]) for k in ("dot", "line", "dist") for q, t in enumerate(rows[k])]
+    eqs += [(4, sl[s], ang[a], h, pitch) for h, (a, s, pitch) in enumerate(M.helix)]
+    eqs += [(5, ang[k], 0, col, 0.0) if kind == "angle" else (6, sl[k], 0, col, 0.0)
+            for col, (_, kind, k) in enumerate(M.drives)]
     cen = np.array([np.mean([M.local(j.point) for j in M.mech.joints if link in j.links and j.point is not None]
                             or [np.zeros(3)], axis=0) for link in M.links]).reshape(-1, 3)
-    return (it, np.ascontiguousarray(loc), np.array(ri, np.int64).reshape(-1, 4), rf.astype(float), cen,
-            ang.astype(np.int64), sl.astype(np.int64))
+    return (np.array([t[:3] for t in items], np.int64).reshape(-1, 3),
+            np.array([t[3:7] for t in items], float).reshape(-1, 4, 3),
+            np.array([e[:4] for e in eqs], np.int64).reshape(-1, 4), np.array([e[4] for e in eqs], float), cen, ang, sl)
 
 
 # --------------------------------------------------------------------------- poses
@@ -504,9 +471,10 @@ def bar_motion(M: SpatialModel, R: np.ndarray, p: np.ndarray, xi: np.ndarray,
     N, nb = len(R), len(M.bars)
     if not nb:
         return R, p, xi, xid
-    ds = M.dist
+    it, loc = M.tables[0], M.tables[1]
+    d = np.flatnonzero(it[:, 0] == ITEMS["dist"])  # the bars' ends, in order
     Rb, pb, Xb, Xbd = np.empty((N, nb, 3, 3)), np.empty((N, nb, 3)), np.empty((N, 6 * nb)), np.empty((N, 6 * nb))
-    numba_kernel().bars(*(np.ascontiguousarray(x, float) for x in (R, p, xi, xid)), ds.ia, ds.ib, ds.va, ds.vb,
-                        Rb, pb, Xb, Xbd)
+    numba_kernel().bars(*(np.ascontiguousarray(x, float) for x in (R, p, xi, xid)), it[d, 1], it[d, 2],
+                        loc[d, 0], loc[d, 1], Rb, pb, Xb, Xbd)
     return (np.concatenate([R, Rb], axis=1), np.concatenate([p, pb], axis=1), np.concatenate([xi, Xb], axis=1),
             np.concatenate([xid, Xbd], axis=1))

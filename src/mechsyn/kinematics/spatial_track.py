@@ -186,7 +186,7 @@ class Tracker:
         q = m if self.rows else 6 * n
         g, J, Gi = np.empty((B, m)), np.empty((B, m, 6 * n)), np.empty((B, 0, 0) if rates else (B, q, q))
         C, bound, x1, x2 = np.empty((B, n, 3)), np.empty(B), np.empty((B, 6 * n)), np.empty((B, 6 * n))
-        th, s = np.empty((B, M.angles.size)), np.empty((B, M.slides.size))
+        th, s = np.empty((B, len(M.angle_joints))), np.empty((B, len(M.slide_joints)))
         du, ddu = (np.ascontiguousarray(r, float) for r in rates) if rates else (np.empty((0, len(M.drives))),) * 2
         numba_kernel().states(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
                               self.rows, g, J, Gi, C, bound, th, s, du, ddu, refine, x1, x2)
@@ -221,7 +221,7 @@ class Tracker:
         q = self.m if self.rows else 6 * M.n
         Ja, Ga, Ca = (np.empty((0, 6 * M.n)), np.empty((q, q)), np.empty((M.n, 3))) if anchor is None else (
             anchor.Jc[0], anchor.Gi[0], anchor.C[0])
-        ok, th, s = np.zeros(B, bool), np.zeros((B, M.angles.size)), np.zeros((B, M.slides.size))
+        ok, th, s = np.zeros(B, bool), np.zeros((B, len(M.angle_joints))), np.zeros((B, len(M.slide_joints)))
         numba_kernel().correct(M.tables, R, p, np.ascontiguousarray(href, float), np.ascontiguousarray(target, float),
                                np.broadcast_to(np.asarray(limit, float), (B,)).copy(), iters,
                                self.tol if tol is None else tol, Ja, Ga, Ca, self.rows, first, ok, th, s)
