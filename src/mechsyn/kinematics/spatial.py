@@ -47,22 +47,23 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from mechsyn.errors import EngineDeclined, MechsynInputError
 from mechsyn.kinematics.simulation import PointMotion, resolve_points
-from mechsyn.kinematics.spatial_model import SpatialModel, bar_motion, compile_spatial, planar_as_spatial
-from mechsyn.progress import ProgressCallback, report
-from mechsyn.kinematics.spatial_singular import crossings
-from mechsyn.kinematics.spatial_model import pair_error
-from mechsyn.kinematics.spatial_track import PAIR_TOL, RANK_TOL, State, Tracker, point_speeds, singular_tol, walk
+from mechsyn.kinematics.spatial_model import (INPUT_NAMES, SpatialModel, bar_motion, compile_spatial, input_kind,
+                                              pair_error, planar_as_spatial)
 from mechsyn.kinematics.spatial_result import LinkPose, SpatialSimulation
-from mechsyn.kinematics.sweep import Event, as_event
+from mechsyn.kinematics.spatial_singular import crossings
+from mechsyn.kinematics.spatial_track import (PAIR_TOL, RANK_TOL, State, Tracker, Walk, free_motions, singular_tol,
+                                              turning_column, walk)
+from mechsyn.kinematics.sweep import as_event
 from mechsyn.kinematics.system import build_system
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.progress import ProgressCallback, report
 
 __all__ = ["SpatialEngine", "simulate_spatial", "planar_as_spatial", "RANK_TOL", "CLOSURE_TOL"]
 
@@ -91,15 +92,11 @@ class SpatialEngine:
     def simulate(self, mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
                  points: list[str] | None = None, progress: ProgressCallback | None = None,
                  **_: Any) -> SpatialSimulation:
-        if mech.kind == "spatial":
-            return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
-        slides = _planar_slides(mech, tuple(inputs))  # an R input's zero is the planar one already
-        values = {jid: np.asarray(v, float) for jid, v in inputs.items()}
-        res = simulate_spatial(mech, {j: v - slides.get(j, 0.0) for j, v in values.items()}, speeds=speeds,
-                               points=points, progress=progress)
-        events = [as_event(e).with_(input={j: v + slides.get(j, 0.0) for j, v in e["input"].items()})
-                  if isinstance(e.get("input"), dict) else as_event(e) for e in res.events]
-        return replace(res, inputs={jid: np.atleast_1d(v) for jid, v in values.items()}, events=events)
+        if mech.kind != "spatial":  # a P input's zero: the joint's origin (an R input's: planar_as_spatial)
+            slides = _planar_slides(mech, tuple(inputs))
+            mech = replace(mech, joints=tuple(replace(j, attrs={**j.attrs, "slide0": slides[j.id]}) if j.id in slides
+                                              else j for j in mech.joints))
+        return simulate_spatial(mech, inputs, speeds=speeds, points=points, progress=progress)
 
 
 def _planar_slides(mech: Mechanism, inputs: tuple[str, ...]) -> dict[str, float]:
@@ -123,40 +120,25 @@ def _planar_slides(mech: Mechanism, inputs: tuple[str, ...]) -> dict[str, float]
     return {j: float(d.assembled) for j, d in drivers.items() if d.type == "P" and j in inputs}
 
 
-#: The inputs a pair takes: its id, and for a C pair ``<id>/turn``, for a U pair ``<id>/2``.
-INPUT_NAMES = {"R": ("",), "H": ("",), "P": ("",), "C": ("", "/turn"), "U": ("", "/2")}
-
-
-def input_kind(mech: Mechanism, name: str) -> str:
-    """The pair type an input ``name`` moves as: ``"R"`` for an angle (R, H, a C pair's turn,
-    a U pair's angles), ``"P"`` for a slide (P, a C pair's slide)."""
-    jid, _, part = name.partition("/")
-    t = mech.joint(jid).type
-    return "P" if t == "P" or (t == "C" and not part) else ("H" if t == "H" else "R")
-
-
 def _check_inputs(mech: Mechanism, inputs: dict[str, Any]) -> dict[str, np.ndarray]:
+    """The inputs as float arrays, checked: each the input of a joint (:data:`INPUT_NAMES`),
+    as many values each, all finite."""
     if not inputs:
         raise MechsynInputError("no input given", field="inputs",
                                 hint="give the driven joint's values, e.g. R1=0:360:1 on the command line")
-    out = {}
-    for name, v in inputs.items():
-        jid, slash, part = name.partition("/")
-        try:
-            j = mech.joint(jid)
-        except KeyError:
+    for name in inputs:
+        jid = name.partition("/")[0]
+        j = next((j for j in mech.joints if j.id == jid), None)
+        if j is None:
             raise MechsynInputError(f"no joint {jid!r} to drive", source=mech.source, field="inputs",
-                                    hint="one of " + ", ".join(j.id for j in mech.joints)) from None
-        if j.type not in INPUT_NAMES:
-            raise MechsynInputError(f"joint {jid} ({j.type} pair) cannot take an input: only R, P, H, C and U pairs "
-                                    "do", source=mech.source, field="inputs", hint="drive an R, P, H, C or U pair")
-        if slash + part not in INPUT_NAMES[j.type]:
-            raise MechsynInputError(f"input {name!r}: a {j.type} pair takes "
-                                    + " and ".join(repr(jid + s) for s in INPUT_NAMES[j.type]), source=mech.source,
-                                    field="inputs", hint="a C pair: C=slide, C/turn=angle; a U pair: U, U/2 (angles)")
-        out[name] = np.atleast_1d(np.asarray(v, float))
-    sizes = {len(v) for v in out.values()}
-    if len(sizes) != 1:
+                                    hint="one of " + ", ".join(j.id for j in mech.joints))
+        takes = [jid + part for part in INPUT_NAMES.get(j.type, ())]
+        if name not in takes:
+            what = " and ".join(map(repr, takes)) or "no input (only R, P, H, C and U pairs do)"
+            raise MechsynInputError(f"input {name!r}: a {j.type} pair takes {what}", source=mech.source, field="inputs",
+                                    hint="a C pair: C=slide, C/turn=angle; a U pair: U, U/2 (angles)")
+    out = {name: np.atleast_1d(np.asarray(v, float)) for name, v in inputs.items()}
+    if len({len(v) for v in out.values()}) != 1:
         raise MechsynInputError("the inputs have different numbers of values", field="inputs",
                                 hint="give every driven joint as many values")
     for jid, v in out.items():
@@ -165,33 +147,26 @@ def _check_inputs(mech: Mechanism, inputs: dict[str, Any]) -> dict[str, np.ndarr
     return out
 
 
-def _drives(mech: Mechanism, inputs: dict[str, np.ndarray]) -> tuple[str, ...]:
-    """The input joints, then the file's other driven joints (held at their drawn value)."""
-    return tuple(inputs) + tuple(j.id for j in mech.joints if j.actuated and j.id not in inputs)
-
-
 def _input_matrix(M: SpatialModel, inputs: dict[str, np.ndarray]) -> np.ndarray:
-    """(N, drives) targets in model units: radians, or lengths over the scale."""
-    N = len(next(iter(inputs.values())))
-    U = np.zeros((N, len(M.drives)))
+    """(N, drives) targets in model units (radians, or lengths over the scale) from the
+    drawn assembly; the drives without input at 0 (as drawn)."""
+    U = np.zeros((len(next(iter(inputs.values()))), len(M.drives)))
     for k, (jid, kind, kk) in enumerate(M.drives):
         if jid in inputs:
-            U[:, k] = np.radians(inputs[jid]) - M.zeros[kk] if kind == "angle" else inputs[jid] / M.scale
+            U[:, k] = np.radians(inputs[jid]) - M.zeros[kk] if kind == "angle" else inputs[jid] / M.scale - M.slide0[kk]
     return U
 
 
-def _check_determined(M: SpatialModel, st: State, pts: dict[str, tuple[str, np.ndarray]]) -> None:
-    """Refuse drives that leave a joint point or a named point free to move at the pose
-    ``st`` (one pose)."""
-    _, _, Vt = np.linalg.svd(st.lin.Jc[0], full_matrices=True)
-    N = st.lin.twists(Vt[st.lin.r:].T[None])[0].T  # the motions with every drive at rest, as (ω, v)
-    worst = point_speeds(M, st, N, tuple((M.index(link), M.local(at)) for link, at in pts.values())).max(initial=0.0)
-    if worst > 1e-6:
-        raise MechsynInputError(
-            f"with the drives {', '.join(d[0] for d in M.drives)} at rest the mechanism can still move "
-            f"({len(N)} free motion(s), not only idle spins): its motion is not determined",
-            source=M.mech.source, field="joints[].actuated",
-            hint="mark more joints actuated: true (each needs an input or keeps its drawn value)")
+def _undetermined(M: SpatialModel, free: int, drawn: bool) -> MechsynInputError:
+    """The error of drives that leave ``free`` motions of a joint point or a named point
+    (``drawn``: no row of the sweep assembled, so only the drawn assembly could be judged)."""
+    return MechsynInputError(
+        f"with the drives {', '.join(d[0] for d in M.drives)} at rest the mechanism can still move "
+        f"({free} free motion(s), not only idle spins): its motion is not determined" + (
+            ", or the drawn assembly is singular (e.g. a change point, where branches meet) and the sweep cannot "
+            "leave it" if drawn else ""), source=M.mech.source, field="joints[].actuated",
+        hint="mark more joints actuated: true (each needs an input or keeps its drawn value)"
+             + (", or draw the mechanism away from the singular position" if drawn else ""))
 
 
 def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, float] | None = None,
@@ -212,37 +187,26 @@ def simulate_spatial(mech: Mechanism, inputs: dict[str, Any], speeds: dict[str, 
     """
     mech = planar_as_spatial(mech)  # a planar file: its 3-D equivalent, with the planar zero
     inputs = _check_inputs(mech, inputs)
-    M = compile_spatial(mech, _drives(mech, inputs))
-    return _simulate(mech, M, inputs, speeds, points, progress)
-
-
-def _simulate(mech: Mechanism, M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[str, float] | None,
-              points: list[str] | None, progress: ProgressCallback | None) -> SpatialSimulation:
+    # the drives: the inputs, then the file's other driven joints (held at their drawn value)
+    M = compile_spatial(mech, tuple(inputs) + tuple(j.id for j in mech.joints if j.actuated and j.id not in inputs))
     if points is None and not mech.points:
         points = [j.id for j in mech.joints if j.point is not None]
     pts = resolve_points(mech, points)
     U = _input_matrix(M, inputs)
     sp, spp, path_note = _input_rates(M, inputs, speeds, U)
     tr = Tracker(M)
-    n = M.n
-    R0, p0 = np.tile(np.eye(3), (1, n + 1, 1, 1)), np.zeros((1, n + 1, 3))
-    start = tr.state(R0, p0, np.zeros((1, len(M.helix))), np.zeros((1, len(M.drives))))
-    try:
-        _check_determined(M, start, pts)
-        later = None
-    except MechsynInputError as exc:  # perhaps only the drawn assembly is singular: judge on the sweep
-        later = exc
+    start = tr.state(np.tile(np.eye(3), (1, M.n + 1, 1, 1)), np.zeros((1, M.n + 1, 3)), np.zeros((1, len(M.helix))),
+                     np.zeros((1, len(M.drives))))  # the drawn assembly
+    extra = tuple((M.index(link), M.local(at)) for link, at in pts.values())
+    free = len(free_motions(tr, start, tr.rank_tol, extra))
     rows = _sweep_rows(tr, start, U, (sp, spp), progress)
-    if later is not None:
+    if free:  # perhaps only the drawn assembly is singular: judged again at the sweep's most regular row
+        k = int(np.argmax(np.where(rows.ok, rows.ratio, -1.0)))
         if not rows.ok.any():
-            raise MechsynInputError(
-                f"{later.message}, or the drawn assembly is singular (e.g. a change point, where "
-                "branches meet) and the sweep cannot leave it", source=M.mech.source, field=later.field,
-                hint=f"{later.hint}, or draw the mechanism away from the singular position")
-        k = int(np.argmax(np.where(rows.ok, rows.ratio, -1.0)))  # the most regular row
-        R = np.concatenate([rows.R[k], np.eye(3)[None]])[None]
-        p = np.vstack([rows.p[k], np.zeros((1, 3))])[None]
-        _check_determined(M, tr.state(R, p, np.zeros((1, len(M.helix))), U[k][None]), pts)
+            raise _undetermined(M, free, True)
+        free = len(free_motions(tr, tr.state(*rows.at(k), U[k][None]), tr.rank_tol, extra))
+        if free:
+            raise _undetermined(M, free, False)
     return _result(mech, M, tr, inputs, sp[0], pts, U, rows, [path_note] if path_note else [])
 
 
@@ -279,7 +243,7 @@ def _input_rates(M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[st
     names = [M.drives[k][0] for k in moving]
     if len(moving) < 2 or all(n in (speeds or {}) for n in names) or N < 3:
         return const, np.zeros((N, D)), ""
-    main = next(k for k, d in enumerate(M.drives) if d[0] == next(iter(inputs)))
+    main = 0  # (the inputs are the first drives, in order)
     u = U[:, main]
     du = np.diff(u)
     if not (np.all(du > 0) or np.all(du < 0)):
@@ -294,26 +258,9 @@ def _input_rates(M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[st
                      f"{M.drives[main][0]} at its speed")
 
 
-@dataclass
-class _Rows:
-    """Per-row arrays of a sweep (link poses and twists in model units)."""
-
-    R: np.ndarray
-    p: np.ndarray
-    xi: np.ndarray
-    xid: np.ndarray
-    ok: np.ndarray
-    res: np.ndarray
-    ratio: np.ndarray
-    theta: np.ndarray
-    slide: np.ndarray
-    events: list
-    how: np.ndarray | None = None
-
-
 def _input_dict(M: SpatialModel, u: np.ndarray) -> dict[str, float]:
     """Model targets -> the inputs as the user gives them (deg from the joint's zero, lengths)."""
-    return {jid: float(np.degrees(v + M.zeros[kk])) if kind == "angle" else float(v * M.scale)
+    return {jid: float(np.degrees(v + M.zeros[kk])) if kind == "angle" else float((v + M.slide0[kk]) * M.scale)
             for (jid, kind, kk), v in zip(M.drives, u)}
 
 
@@ -328,6 +275,10 @@ _MESSAGES = {
              "drawn circuit, on from the sweep's other end",
     "refused": "not assembled here: Newton converged to a pose where pair {} is not the file's pair (its axis "
                "reversed or a slide half-turned: another root of its equations), refused",
+    "singular": "singular configuration (singular value ratio {:.2g}): a change or dead point on this row; rates "
+                "not defined here (null)",
+    "crossed": "a singular configuration lies between this row and the next (singular value ratio {:.2g} there): "
+               "the sweep passes it on the branch it was on (the predictor's tangent)",
 }
 
 
@@ -344,7 +295,7 @@ def _regular_rank(tr: Tracker, st: State) -> None:
 
 
 def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarray, np.ndarray],
-                progress: ProgressCallback | None) -> _Rows:
+                progress: ProgressCallback | None) -> Walk:
     """Poses of every row by continuation from the drawn assembly, then the closure residual,
     the rank test and the rates of all assembled rows at once."""
     M = tr.M
@@ -358,17 +309,16 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
             e["last"] = int(last)
         return e
 
-    w = walk(tr, start, U, event)
-    N, n = len(U), M.n
-    out = _Rows(w.R[:, :-1], w.p[:, :-1], np.full((N, 6 * n), np.nan), np.full((N, 6 * n), np.nan), w.ok,
-                np.full(N, np.nan), np.full(N, np.nan), np.full((N, len(M.angle_joints)), np.nan),
-                np.full((N, len(M.slide_joints)), np.nan), w.events, w.how)
-    idx = np.flatnonzero(w.ok)
-    if len(idx):
-        st = tr.state(w.R[idx], w.p[idx], w.href[idx], U[idx], rates=(rates[0][idx], rates[1][idx]))
-        keep = _verify(tr, w, idx, st, event)
-        if not keep.all():
-            idx, st = idx[keep], st.take(np.flatnonzero(keep))
+    out = walk(tr, start, U, event)
+    N = len(U)
+    out.xi, out.xid = np.full((N, 6 * M.n), np.nan), np.full((N, 6 * M.n), np.nan)
+    out.res, out.ratio = np.full(N, np.nan), np.full(N, np.nan)
+    out.theta, out.slide = np.full((N, len(M.angle_joints)), np.nan), np.full((N, len(M.slide_joints)), np.nan)
+    for _ in range(2):  # (again when the check refuses rows: the state of the others)
+        idx = np.flatnonzero(out.ok)
+        st = tr.state(out.R[idx], out.p[idx], out.href[idx], U[idx], rates=(rates[0][idx], rates[1][idx]))
+        if _verify(tr, out, idx, st, event).all():
+            break
     if len(idx):
         _regular_rank(tr, st)
         out.res[idx] = np.abs(st.g[:, :tr.m_c]).max(axis=1, initial=0.0)
@@ -376,11 +326,11 @@ def _sweep_rows(tr: Tracker, start: State, U: np.ndarray, rates: tuple[np.ndarra
         out.theta[idx], out.slide[idx] = st.theta, st.s
         x1, x2 = st.x
         regular = st.lin.ratio >= singular_tol(M)
-        found = crossings(tr, w, U, out.ratio, st.lin.Jc, idx)
+        found = crossings(tr, out, U, out.ratio, st.lin.Jc, idx)
         on_row = {c[3] for c in found if c[3] is not None}
         regular &= ~np.isin(idx, list(on_row))
         out.xi[idx[regular]], out.xid[idx[regular]] = x1[regular], x2[regular]
-        _singular_events(M, out, U, idx[~regular], found)
+        _singular_events(out, U, idx[~regular], found, event)
         out.events.sort(key=lambda e: e["index"])
     report(progress, N, N, "sweep")
     return out
@@ -409,46 +359,30 @@ def closure_tol(tr: Tracker) -> float:
     return max(CLOSURE_TOL, 10 * tr.tol)
 
 
-def _singular_events(M: SpatialModel, out: _Rows, U: np.ndarray, rows: np.ndarray, found: list) -> None:
-    """Events of the singular rows (rates null) and of the crossings between rows."""
-    on_row = {c[3]: c for c in found if c[3] is not None}
-    for k in rows:
-        r = out.ratio[k]
-        u = on_row[k][1] if k in on_row else U[k]
-        out.events.append({"index": int(k), "kind": "singular", "input": _input_dict(M, u),
-                           "message": f"singular configuration (singular value ratio {r:.2g}): a change or "
-                                      "dead point on this row; rates not defined here (null)"})
-    for k, u, r, at in found:
-        if at is not None:
-            continue
-        out.events.append({"index": int(k), "kind": "singular", "crossed": True, "input": _input_dict(M, u),
-                           "message": f"a singular configuration lies between rows {k} and {k + 1} (singular "
-                                      f"value ratio {r:.2g} there): the sweep passes it on the branch it was on "
-                                      "(the predictor's tangent)"})
+def _singular_events(out: Walk, U: np.ndarray, rows: np.ndarray, found: list, event: Any) -> None:
+    """Events of the singular rows (rates null) and of the crossings between rows (``kind``
+    ``singular``, ``crossed``)."""
+    on_row = {c[3]: c[1] - U[c[3]] for c in found if c[3] is not None}
+    out.events += [event(int(k), "singular", out.ratio[k], at=on_row.get(k)) for k in rows]
+    out.events += [{**event(int(k), "crossed", r, at=u - U[k]), "kind": "singular", "crossed": True}
+                   for k, u, r, at in found if at is None]
 
 
 def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.ndarray], sp: np.ndarray,
-            pts: dict, U: np.ndarray, rows: _Rows, more: list[str]) -> SpatialSimulation:
+            pts: dict, U: np.ndarray, rows: Walk, more: list[str]) -> SpatialSimulation:
     """The result in the file's units."""
     L, c = M.scale, M.centre
     ok = rows.ok
-    R, p, X, Xd = bar_motion(M, rows.R, rows.p, rows.xi, rows.xid)
+    R, p, X, Xd = bar_motion(M, rows.R[:, :-1], rows.p[:, :-1], rows.xi, rows.xid)
     X, Xd = X.reshape(len(ok), -1, 6), Xd.reshape(len(ok), -1, 6)
-    links = {}
-    for i, name in enumerate(M.all_links):
-        t = c - np.einsum("kij,j->ki", R[:, i], c) + L * p[:, i]
-        links[name] = LinkPose(R[:, i], t, X[:, i, :3], Xd[:, i, :3])
-    pm = {}
-    for name, (link, at) in pts.items():
-        i = M.all_links.index(link) if link in M.all_links else None
-        pm[name] = _point_motion(M, ok, (R, p, X, Xd), i, M.local(at))
+    links = {name: LinkPose(R[:, i], c - np.einsum("kij,j->ki", R[:, i], c) + L * p[:, i], X[:, i, :3], Xd[:, i, :3])
+             for i, name in enumerate(M.all_links)}
+    pm = {name: _point_motion(M, ok, (R, p, X, Xd), link, M.local(at)) for name, (link, at) in pts.items()}
     joints = {jid: np.degrees(_unwrap(rows.theta[:, k], ok) + M.zeros[k]) for k, jid in enumerate(M.angle_joints)}
-    for name, v in inputs.items():  # an input reads as itself (the same turn)
-        key = name + "/slide" if mech.joint(name.partition("/")[0]).type == "C" and "/" not in name else \
-            name.replace("/turn", "")
-        if key in joints:
-            joints[key] = np.where(ok, v, np.nan)
-    joints.update({jid + ("/slide" if jid in joints else ""): rows.slide[:, k] * L  # a C or H pair: both
+    for name, v in inputs.items():  # an angle input reads as itself (the same turn)
+        if input_kind(mech, name) != "P":
+            joints[name.replace("/turn", "")] = np.where(ok, v, np.nan)
+    joints.update({jid + ("/slide" if jid in joints else ""): (rows.slide[:, k] + M.slide0[k]) * L  # C, H: both
                    for k, jid in enumerate(M.slide_joints)})
     notes = []
     rank = tr.rank + 5 * len(M.bars)  # (a bar's two S pairs: five more than its distance)
@@ -472,10 +406,10 @@ def _result(mech: Mechanism, M: SpatialModel, tr: Tracker, inputs: dict[str, np.
         links=links, joints=joints, residual=rows.res, singular_ratio=rows.ratio, length_scale=L,
         rank=rank, idle=idle, events=[as_event(e) for e in rows.events], notes=notes, model=M,
         reached=np.where(ok, rows.how, 0).astype(int), held=tuple(d[0] for d in M.drives if d[0] not in inputs),
-        zero={d[0]: float(np.degrees(M.zeros[d[2]])) for d in M.drives if d[0] in inputs and d[1] == "angle"})
+        zero={k: v for k, v in _input_dict(M, np.zeros(len(M.drives))).items() if k in inputs})
 
 
-def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> list[str]:
+def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: Walk) -> list[str]:
     """What the summary says about how the rows were reached (:func:`~.spatial_track.walk`)."""
     notes = []
     how = np.where(rows.ok, rows.how, 0)
@@ -488,35 +422,33 @@ def _reach_notes(M: SpatialModel, tr: Tracker, U: np.ndarray, rows: _Rows) -> li
     if tr.rejected:
         notes.append(f"{tr.rejected} converged pose(s) refused: another root of a pair's equations (an R axis "
                      "reversed or a slide half-turned), not the file's pairs")
-    col = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
-    if len(col) == 1 and M.drives[col[0]][1] == "angle":
-        u = U[:, col[0]]
+    col = turning_column(M, U)
+    if col is not None:
+        u, name = U[:, col], M.drives[col][0]
         turns = rows.ok & (np.abs(np.mod(u + np.pi, 2 * np.pi) - np.pi) < 1e-9) & (np.abs(u) > 1e-9)
         off = [k for k in np.flatnonzero(turns) if np.abs(rows.R[k] - np.eye(3)).max() > 1e-6
                or np.abs(rows.p[k]).max() > 1e-6]
         if off:
-            v = _input_dict(M, U[off[0]])[M.drives[col[0]][0]]
-            notes.append(f"at {M.drives[col[0]][0]} = {v:.6g} (the drawn input, a turn on) the mechanism is in "
-                         "another assembly than drawn: its circuit takes more than one turn of the input")
+            notes.append(f"at {name} = {_input_dict(M, U[off[0]])[name]:.6g} (the drawn input, a turn on) the "
+                         "mechanism is in another assembly than drawn: its circuit takes more than one turn of the "
+                         "input")
     return notes
 
 
-def _point_motion(M: SpatialModel, ok: np.ndarray, motion: tuple, i: int | None, x0: np.ndarray) -> PointMotion:
-    """A point ``x0`` (model units) of link ``i`` of :attr:`SpatialModel.all_links` (None:
-    the frame), with ``motion`` the poses and twists of all links."""
+def _point_motion(M: SpatialModel, ok: np.ndarray, motion: tuple, link: str, x0: np.ndarray) -> PointMotion:
+    """A point ``x0`` (model units) of ``link`` (the frame, or one of :attr:`SpatialModel.all_links`),
+    with ``motion`` the poses and twists of all links."""
     L, c = M.scale, M.centre
-    N = len(ok)
-    if i is None:
-        P = np.tile(c + L * x0, (N, 1))
-        P[~ok] = np.nan
-        z = np.where(ok[:, None], 0.0, np.nan) * np.ones((N, 3))
-        return PointMotion(P, z, z.copy(), M.mech.ground)
+    if link not in M.all_links:  # the frame: at rest
+        z = np.where(ok[:, None], 0.0, np.nan) * np.ones((1, 3))
+        return PointMotion(c + L * x0 + z, z, z.copy(), link)
     R, p, X, Xd = motion
+    i = M.all_links.index(link)
     x = np.einsum("kij,j->ki", R[:, i], x0) + p[:, i]
     w, v, wd, vd = X[:, i, :3], X[:, i, 3:], Xd[:, i, :3], Xd[:, i, 3:]
     xd = v + np.cross(w, x)
     xdd = vd + np.cross(wd, x) + np.cross(w, xd)
-    return PointMotion(c + L * x, L * xd, L * xdd, M.all_links[i])
+    return PointMotion(c + L * x, L * xd, L * xdd, link)
 
 
 def _unwrap(a: np.ndarray, ok: np.ndarray) -> np.ndarray:

@@ -88,6 +88,18 @@ __all__ = ["SpatialModel", "compile_spatial", "SPATIAL_PAIRS", "move", "tables"]
 SPATIAL_PAIRS = ("R", "P", "C", "U", "S", "H")
 
 
+#: The inputs a pair takes: its id, and for a C pair ``<id>/turn``, for a U pair ``<id>/2``.
+INPUT_NAMES = {"R": ("",), "H": ("",), "P": ("",), "C": ("", "/turn"), "U": ("", "/2")}
+
+
+def input_kind(mech: Mechanism, name: str) -> str:
+    """The pair type an input ``name`` moves as: ``"R"`` for an angle (R, a C pair's turn,
+    a U pair's angles), ``"H"`` for an H pair's, ``"P"`` for a slide (P, a C pair's slide)."""
+    jid, _, part = name.partition("/")
+    t = mech.joint(jid).type
+    return "P" if t == "P" or (t == "C" and not part) else ("H" if t == "H" else "R")
+
+
 #: The kinds of equations' items (link-fixed points and vectors on the two links of a pair) and
 #: their codes in the compiled tables (:func:`tables`): a slide's item is a line's.
 ITEMS = {"pc": 0, "dot": 1, "line": 2, "dist": 3, "angle": 4, "slide": 2}
@@ -119,6 +131,9 @@ class SpatialModel:
     #: per angle joint (``angle_joints``), its input's value at the drawn assembly (rad):
     #: :func:`input_zero`
     zeros: np.ndarray | None = None
+    #: per slide joint (``slide_joints``), its input's value at the drawn assembly (model units):
+    #: its attribute ``slide0`` (the spatial engine's of a planar P joint), else 0
+    slide0: np.ndarray | None = None
     #: the S-S bars not solved for (their poses from the ends of their distance equations, in order)
     bars: tuple[str, ...] = ()
 
@@ -151,37 +166,30 @@ def _pair_rows(j: Joint, ia: int, ib: int, x: np.ndarray | None, rows: dict[str,
     z = np.zeros(3)
     t = j.type
     a = _unit(np.asarray(j.axis, float)) if j.axis is not None else None
+    n1, n2 = _perp_basis(a) if a is not None else (z, z)
     if t in ("R", "U", "S"):
         rows["pc"].append((ia, ib, x, x, z, z, 0.0))
     if t in ("R", "C", "H"):
-        n1, n2 = _perp_basis(a)
         rows["dot"] += [(ia, ib, a, n1, z, z, 0.0), (ia, ib, a, n2, z, z, 0.0)]
+        rows["angle"].append((ia, ib, a, n1, n1, n2, 0.0))
+        rows["angle_joints"].append(j.id)
+    if t in ("P", "C", "H"):
+        rows["line"] += [(ia, ib, x, x, n1, z, 0.0), (ia, ib, x, x, n2, z, 0.0)]
+        rows["slide"].append((ia, ib, x, x, a, z, 0.0))
+        rows["slide_joints"].append(j.id)
+    if t == "P":  # the three frame vectors kept perpendicular as drawn
+        e = np.eye(3)
+        rows["dot"] += [(ia, ib, e[k], e[(k + 1) % 3], z, z, 0.0) for k in range(3)]
     if t == "U":
         a2 = _unit(np.asarray(j.axis2, float))
         rows["dot"].append((ia, ib, a, a2, z, z, float(a @ a2)))
-    if t == "P":
-        e = np.eye(3)
-        rows["dot"] += [(ia, ib, e[0], e[1], z, z, 0.0), (ia, ib, e[1], e[2], z, z, 0.0),
-                        (ia, ib, e[2], e[0], z, z, 0.0)]
-    if t in ("P", "C", "H"):
-        n1, n2 = _perp_basis(a)
-        rows["line"] += [(ia, ib, x, x, n1, z, 0.0), (ia, ib, x, x, n2, z, 0.0)]
-    if t in ("R", "C", "H"):
-        e1, e2 = _perp_basis(a)
-        rows["angle"].append((ia, ib, a, e1, e1, e2, 0.0))
-        rows["angle_joints"].append(j.id)
-    if t == "U" and abs(float(a @ _unit(np.asarray(j.axis2, float)))) < 1e-9:
-        # a right-angled cross: its two angles, each an angle row with the axis on the link it
-        # is fixed to: the second arm turning about the first axis (on the first link), and
-        # the first arm turning about the second axis reversed (on the second link: the
-        # second link turns by +θ2 about it relative to the first)
-        a2 = _unit(np.asarray(j.axis2, float))
-        rows["angle"].append((ia, ib, a, a2, a2, np.cross(a, a2), 0.0))
-        rows["angle"].append((ib, ia, -a2, a, a, np.cross(-a2, a), 0.0))
-        rows["angle_joints"] += [j.id, j.id + "/2"]
-    if t in ("P", "C", "H"):
-        rows["slide"].append((ia, ib, x, x, a, z, 0.0))
-        rows["slide_joints"].append(j.id)
+        if abs(float(a @ a2)) < 1e-9:
+            # a right-angled cross: its two angles, each an angle row with the axis on the link it
+            # is fixed to: the second arm turning about the first axis (on the first link), and
+            # the first arm turning about the second axis reversed (on the second link: the
+            # second link turns by +θ2 about it relative to the first)
+            rows["angle"] += [(ia, ib, a, a2, a2, np.cross(a, a2), 0.0), (ib, ia, -a2, a, a, np.cross(-a2, a), 0.0)]
+            rows["angle_joints"] += [j.id, j.id + "/2"]
 
 
 def _check_joint(mech: Mechanism, j: Joint) -> None:
@@ -190,15 +198,12 @@ def _check_joint(mech: Mechanism, j: Joint) -> None:
         raise MechsynInputError(
             f"joint {j.id} is a {j.type} pair: spatial kinematics moves R, P, C, U, S and H pairs",
             source=src, field=f"joints[{j.id}].type", hint="model the pair with R, P, C, U, S or H pairs")
-    if j.type != "P" and j.point is None:
-        raise MechsynInputError(f"joint {j.id} ({j.type}) has no point", source=src,
-                                field=f"joints[{j.id}].point", hint="give point: [x, y, z]")
-    if j.type != "S" and j.axis is None:
-        raise MechsynInputError(f"joint {j.id} ({j.type}) has no axis", source=src,
-                                field=f"joints[{j.id}].axis", hint="give axis: [dx, dy, dz]")
-    if j.type == "U" and j.axis2 is None:
-        raise MechsynInputError(f"joint {j.id} (U) has no axis2", source=src, field=f"joints[{j.id}].axis2",
-                                hint="give axis2: the cross's arm fixed in the second link")
+    for attr, needed, hint in (("point", j.type != "P", "give point: [x, y, z]"),
+                               ("axis", j.type != "S", "give axis: [dx, dy, dz]"),
+                               ("axis2", j.type == "U", "give axis2: the cross's arm fixed in the second link")):
+        if needed and getattr(j, attr) is None:
+            raise MechsynInputError(f"joint {j.id} ({j.type}) has no {attr}", source=src,
+                                    field=f"joints[{j.id}].{attr}", hint=hint)
     if j.actuated and j.type not in ("R", "P", "H", "C", "U"):
         raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P, H, C and U pairs can be driven",
                                 source=src, field=f"joints[{j.id}].actuated", hint="drive an R, P, H, C or U pair")
@@ -238,20 +243,15 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
         rows["dist"].append((index[a], index[b], local[j1.id], local[j2.id], z, z, ell))
     helix = tuple((rows["angle_joints"].index(j.id), rows["slide_joints"].index(j.id), (j.pitch or 0.0) / scale)
                   for j in mech.joints if j.type == "H")
-    drive_rows = []
-    for name in drives:
-        jid, _, part = name.partition("/")
-        j = mech.joint(jid)
-        if j.type in ("R", "H", "U") or (j.type == "C" and part == "turn"):
-            drive_rows.append((name, "angle", rows["angle_joints"].index(name if j.type == "U" else jid)))
-        else:
-            drive_rows.append((name, "slide", rows["slide_joints"].index(jid)))
+    drive_rows = [(name, "slide", rows["slide_joints"].index(name)) if input_kind(mech, name) == "P" else
+                  (name, "angle", rows["angle_joints"].index(name.replace("/turn", ""))) for name in drives]
     big = max([float(np.abs(np.asarray(j.point, float)).max()) for j in mech.joints if j.point is not None]
               + [float(np.abs(np.asarray(pt.at, float)).max()) for pt in mech.points.values()], default=0.0)
     M = SpatialModel(mech, links, centre, scale, tuple(rows["angle_joints"]), tuple(rows["slide_joints"]), helix,
                      tuple(drive_rows), ulp=float(np.finfo(float).eps) * max(1.0, big / scale), bars=tuple(bars))
     zeros = np.array([input_zero(mech, mech.joint(jid.partition("/")[0])) for jid in M.angle_joints], float)
-    return replace(M, tables=tables(M, rows), pairs=_pairs(mech, index), zeros=zeros)
+    slide0 = np.array([mech.joint(jid).attrs.get("slide0", 0.0) for jid in M.slide_joints], float) / scale
+    return replace(M, tables=tables(M, rows), pairs=_pairs(mech, index), zeros=zeros, slide0=slide0)
 
 
 def _bars(mech: Mechanism) -> dict[str, tuple[Joint, Joint]]:

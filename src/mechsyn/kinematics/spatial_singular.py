@@ -12,8 +12,7 @@ Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobia
 determinant). The pairs where it can change at all are few: by Weyl's inequality
 ``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
 the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
-of the two rows; only those pairs are tested (:func:`_flips`: at full column or row rank by
-``det(J_kᵀ J_{k+1})`` or ``det(J_{k+1} J_kᵀ)``, of the same sign, else by an SVD). A sign change
+of the two rows; only those pairs are tested (:func:`_flips`). A sign change
 is bracketed and refined (below) and
 reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
 makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
@@ -46,7 +45,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, polished_ratio, singular_tol
+from mechsyn.kinematics.spatial_model import move
+from mechsyn.kinematics.spatial_track import REFINE, Tracker, Walk, polished_ratio, singular_tol, taylor
 
 __all__ = ["crossings", "REFINE"]
 
@@ -63,17 +63,9 @@ ZOOM = 17
 def _flips(Ja: np.ndarray, Jb: np.ndarray, r: int) -> np.ndarray:
     """Whether ``det(U_aᵀ J_b V_a)`` is not positive, for pairs of Jacobians ``Ja``, ``Jb``
     (B, m, k) of regular rank ``r`` at ``Ja`` (``U_a``, ``V_a``: its first ``r`` singular
-    vectors). At full column rank (``r = k``) ``det(J_aᵀ J_b) = det(Σ_a) det(U_aᵀ J_b V_a)``
-    (``det(V_a)² = 1``), at full row rank (``r = m``) ``det(J_b J_aᵀ)`` likewise: the same sign
-    without an SVD; otherwise the bases by an SVD."""
-    m, k = Ja.shape[1:]
-    if r == k:
-        return np.linalg.det(np.swapaxes(Ja, -1, -2) @ Jb) <= 0
-    if r == m:
-        return np.linalg.det(Jb @ np.swapaxes(Ja, -1, -2)) <= 0
+    vectors, by an SVD: the pairs tested are few)."""
     Ua, _, Vat = np.linalg.svd(Ja, full_matrices=False)
-    Ua, Vat = Ua[..., :r], Vat[..., :r, :]
-    return np.linalg.det(np.swapaxes(Ua, -1, -2) @ Jb @ np.swapaxes(Vat, -1, -2)) <= 0
+    return np.linalg.det(np.swapaxes(Ua[..., :r], -1, -2) @ Jb @ np.swapaxes(Vat[..., :r, :], -1, -2)) <= 0
 
 
 def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
@@ -85,10 +77,7 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     r = tr.rank
     if not r or len(idx) < 2:
         return []
-    same = (w.ok[:-1] & w.ok[1:]) & (w.how[:-1] == w.how[1:])
-    ks = np.flatnonzero(same)
-    if not len(ks):
-        return []
+    ks = np.flatnonzero((w.ok[:-1] & w.ok[1:]) & (w.how[:-1] == w.how[1:]))  # pairs of rows on one motion
     a = np.searchsorted(idx, ks)  # the positions of rows k and k + 1 in idx (its rows are w.ok's)
     b = a + 1
     flat = Jc.reshape(len(Jc), -1)
@@ -101,25 +90,13 @@ def crossings(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray,
     tol = singular_tol(tr.M)
     near &= (ratio[ks] >= tol) & (ratio[ks + 1] >= tol)  # a singular row is its own event
     out = []
-    if near.any():
-        for k in ks[near][_flips(Jc[a[near]], Jc[b[near]], r)]:
-            found = _bisect(tr, w, U, int(k))
-            if found is not None:
-                out.append(found)
+    for k in ks[near][_flips(Jc[a[near]], Jc[b[near]], r)].tolist():
+        found = _golden(tr, w, U, [k, k + 1])  # (None: the sign changed by a frame effect, not a rank drop)
+        if found is not None:  # on a row when within REFINE of the step of it
+            t = float((found[0] - U[k]) @ (U[k + 1] - U[k]) / ((U[k + 1] - U[k]) @ (U[k + 1] - U[k])))
+            out.append((k, *found, k if t < REFINE else (k + 1 if t > 1 - REFINE else None)))
     seen = {c[0] for c in out} | {c[0] + 1 for c in out}
     return out + _v_minima(tr, w, U, ratio, seen, Jc, idx)
-
-
-def _bisect(tr: Tracker, w: Walk, U: np.ndarray, k: int) -> tuple[int, np.ndarray, float, int | None] | None:
-    """The crossing between rows ``k`` and ``k + 1`` (where ``det(U_kᵀ J V_k)`` changed
-    sign): the least ``σ_r / σ_1`` between them (:func:`_golden`); None when it is not a
-    rank drop (the sign changed by a frame effect)."""
-    found = _golden(tr, w, U, [k, k + 1])
-    if found is None or found[1] >= singular_tol(tr.M):
-        return None
-    t = float((found[0] - U[k]) @ (U[k + 1] - U[k]) / ((U[k + 1] - U[k]) @ (U[k + 1] - U[k])))
-    on = k if t < REFINE else (k + 1 if t > 1 - REFINE else None)
-    return k, found[0], found[1], on
 
 
 def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set, Jc: np.ndarray,
@@ -131,8 +108,6 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set,
     the determinant's sign, and its V is bent by the largest one's change). Rows in ``seen``
     (next to a crossing found by the determinant) are skipped."""
     tol = singular_tol(tr.M)
-    if len(U) < 3:
-        return []
     ok, how = w.ok, w.how
     same = ok[:-2] & ok[1:-1] & ok[2:] & (how[:-2] == how[1:-1]) & (how[1:-1] == how[2:])
     r0, r1, r2 = ratio[:-2], ratio[1:-1], ratio[2:]
@@ -149,8 +124,8 @@ def _v_minima(tr: Tracker, w: Walk, U: np.ndarray, ratio: np.ndarray, seen: set,
         if not vee[k - 1] and not _may_touch(Jc[np.searchsorted(idx, k) + np.arange(-1, 2)], tr.rank):
             continue
         found = _golden(tr, w, U, [k - 1, k, k + 1])
-        if found is not None and found[1] < tol:
-            out.append((int(k), found[0], found[1], None))
+        if found is not None:
+            out.append((int(k), *found, None))
     return out
 
 
@@ -175,10 +150,8 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
     linearly, and reaches a residual ε only within √ε of the pose, which blurs the V by that
     much); the bracket then shrinks to the two cells about the least. The ratio is a V about
     a crossing on either branch that meets there, so it does not matter which one Newton
-    lands on that close to it."""
-    from mechsyn.kinematics.spatial_model import move
-    from mechsyn.kinematics.spatial_track import _taylor
-
+    lands on that close to it. None when the least ratio is not under the singular
+    tolerance (:func:`~mechsyn.kinematics.spatial_track.singular_tol`): no crossing."""
     states = {k: tr.state(*w.at(k), U[k][None]) for k in rows}
     lo, hi = U[rows[0]], U[rows[-1]]
     span = len(rows) - 1
@@ -191,7 +164,7 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
             k, sel = rows[j], np.flatnonzero(near == j)
             st = states[k]
             u = lo + ts[sel, None] * (hi - lo)
-            x1, x2 = _taylor(tr, st, u - U[k])
+            x1, x2 = taylor(tr, st, u - U[k])
             z = np.zeros(len(sel), int)
             R, p = move(st.R[z], st.p[z], x1 + 0.5 * x2)
             out[sel] = polished_ratio(tr, R, p, st.href[z], u, polish=POLISH)
@@ -211,7 +184,7 @@ def _golden(tr: Tracker, w: Walk, U: np.ndarray, rows: list[int]) -> tuple[np.nd
         best_t, best = ts[i], fs[i]
         h = (b - a) / (ZOOM - 1)
         a, b = max(0.0, ts[i] - h), min(1.0, ts[i] + h)
-    if not np.isfinite(best):
+    if not best < singular_tol(tr.M):  # (nor where Newton did not converge)
         return None
     best_t = _apex(np.concatenate(seen_t), np.concatenate(seen_f), best_t, np.sqrt(tol))
     return lo + best_t * (hi - lo), float(best)

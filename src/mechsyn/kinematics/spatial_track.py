@@ -117,9 +117,6 @@ class Lin:
         X[:, :, 3:] += np.cross(self.C[:, :, :, None], Y[:, :, :3], axisa=2, axisb=2, axisc=2)
         return X.reshape(y.shape)
 
-    def take(self, idx: np.ndarray) -> "Lin":
-        return Lin(self.Jc[idx], self.Gi[idx], self.bound[idx], self.rows, self.r, self.C[idx])
-
 
 def svd_ratio(Jc: np.ndarray, r: int) -> np.ndarray:
     """``σ_r / σ_1`` of each of the matrices ``Jc`` (B, m, k) by an SVD (0 where ``σ_1 = 0``)."""
@@ -142,11 +139,6 @@ class State:
     g: np.ndarray
     x: tuple | None = None
 
-    def take(self, idx: Any) -> "State":
-        idx = np.atleast_1d(idx)
-        return State(self.R[idx], self.p[idx], self.href[idx], self.theta[idx], self.s[idx], self.lin.take(idx),
-                     self.g[idx], None if self.x is None else (self.x[0][idx], self.x[1][idx]))
-
 
 class Tracker:
     """Predictor-corrector continuation of one model (see the module doc)."""
@@ -162,8 +154,7 @@ class Tracker:
         self.tol = newton_tol(M)
         self.rank_tol = max(RANK_TOL, 100 * self.tol)
         self.rejected = 0  # converged poses refused by the pair check (another root of the equations)
-        self.last_bad, self.last_pair, self.refused = np.zeros(0, bool), [], []
-        self.left_singular = False  # a singular pose was left (leave): the branch taken is a choice
+        self.last_pair = np.zeros(0, object)  # per pose of the last correction: the pair refused, or ""
         self._left: tuple | None = None
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
@@ -229,25 +220,24 @@ class Tracker:
 
     def true_pairs(self, R: np.ndarray, ok: np.ndarray) -> np.ndarray:
         """``ok`` without the poses whose pairs are not the file's (a reversed R axis, a
-        half-turned P pair: :func:`~mechsyn.kinematics.spatial_model.pair_error`)."""
-        self.last_bad, self.last_pair = np.zeros(len(ok), bool), [""] * len(ok)
-        if not ok.any() or not len(self.M.pairs.ids):
-            return ok
-        err = pair_error(self.M, R[ok])
-        self.last_bad[ok] = err.max(axis=1) > PAIR_TOL
-        self.rejected += int(self.last_bad.sum())
-        for b, e in zip(np.flatnonzero(self.last_bad), err[self.last_bad[ok]]):
-            self.last_pair[b] = self.M.pairs.ids[int(np.argmax(e))]
-        return ok & ~self.last_bad
+        half-turned P pair: :func:`~mechsyn.kinematics.spatial_model.pair_error`), whose
+        pair ``last_pair`` names."""
+        self.last_pair = np.full(len(ok), "", object)
+        if ok.any() and len(self.M.pairs.ids):
+            err = pair_error(self.M, R[ok])
+            bad = err.max(axis=1) > PAIR_TOL
+            self.last_pair[np.flatnonzero(ok)[bad]] = [self.M.pairs.ids[e] for e in np.argmax(err[bad], axis=1)]
+            self.rejected += int(bad.sum())
+        return ok & (self.last_pair == "")
 
     def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
         """The rows ``Ub`` (K, drives) after the pose ``st`` (at inputs ``u0``), predicted
-        from its tangents (:func:`_taylor`) and corrected in one call, first by chord steps
+        from its tangents (:func:`taylor`) and corrected in one call, first by chord steps
         with the linearisation of ``st``. Returns the number ``n`` of rows accepted from the
         first on (each converged without moving further than half its predictor's step,
         which is at most ``MAX_STEP``), the predictor's step size of every row, the accepted
         poses ``(R, p, href)`` and the state of the last of them."""
-        x1, x2 = _taylor(self, st, Ub - u0)
+        x1, x2 = taylor(self, st, Ub - u0)
         size = np.abs(x1).max(axis=1)
         K = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         if K == 0:
@@ -281,20 +271,19 @@ class Tracker:
             h = min(1.0, 2 * h)
         return st
 
-    def reassemble(self, st: State, U: np.ndarray, rows: np.ndarray) -> tuple[int, State] | None:
+    def reassemble(self, st: State, U: np.ndarray, rows: np.ndarray) -> tuple[list, tuple[int, State] | None]:
         """The first of ``rows`` (after a gap) where Newton from the pose ``st`` converges to
-        a true assembly, and its state; all rows tried in one batch. ``refused`` lists the
-        rows before it (row, pair) where Newton converged to another root of a pair's
+        a true assembly, and its state (None: none does); all rows tried in one batch. First
+        the rows before it (row, pair) where Newton converged to another root of a pair's
         equations (:meth:`true_pairs`)."""
         B = len(rows)
         rep = np.zeros(B, int)
         R, p, ok, _ = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
         j = int(np.argmax(ok)) if ok.any() else B
-        bad = np.flatnonzero(self.last_bad[:j])
-        self.refused = [(int(rows[b]), self.last_pair[b]) for b in bad]
+        refused = [(int(rows[b]), self.last_pair[b]) for b in np.flatnonzero(self.last_pair[:j] != "")]
         if not ok.any():
-            return None
-        return int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None])
+            return refused, None
+        return refused, (int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None]))
 
 
 # --------------------------------------------------------------------------- leaving a singular pose
@@ -311,13 +300,15 @@ def point_speeds(M: SpatialModel, st: State, X: np.ndarray, extra: tuple = ()) -
     return out
 
 
-def _null_motions(tr: Tracker, st: State) -> np.ndarray:
-    """The directions (k, 6 n) of the Jacobian's near-null space at ``st`` that move a
-    joint point (not idle spins), each signed so its largest entry is positive."""
+def free_motions(tr: Tracker, st: State, tol: float, extra: tuple = ()) -> np.ndarray:
+    """The motions (k, 6 n) at the first pose of ``st`` with every drive at rest (the null
+    space of the Jacobian: its singular values under ``tol`` of the largest, as twists at the
+    origin) that move a joint point or a point ``extra`` (link index, local point), not idle
+    spins; each signed so that its largest entry is positive."""
     _, s, Vt = np.linalg.svd(st.lin.Jc[0], full_matrices=True)
     s = np.concatenate([s, np.zeros(Vt.shape[0] - len(s))])
-    x = st.lin.twists(Vt[s < singular_tol(tr.M) * s[0]].T[None])[0].T
-    x = x[point_speeds(tr.M, st, x) > 1e-6]
+    x = st.lin.twists(Vt[s <= tol * s[0]].T[None])[0].T
+    x = x[point_speeds(tr.M, st, x, extra) > 1e-6]
     return x * np.sign(x[np.arange(len(x)), np.argmax(np.abs(x), axis=1)])[:, None]
 
 
@@ -329,21 +320,16 @@ def leave(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> State | Non
     size = float(np.abs(du).max(initial=0.0))
     if size == 0.0:
         return st
-    N = _null_motions(tr, st)
+    N = free_motions(tr, st, singular_tol(tr.M))
     if not len(N):
         return None
     x1, x2 = tr.rates(st, du[None])
     base = x1[0] + 0.5 * x2[0]
-    sig = np.array([1.0, 3.0, 0.3]) * np.sqrt(size)
-    sig = np.concatenate([sig, [size, 3 * size]])
-    guesses = [base]
-    for v in N:
-        for g in sig:
-            guesses += [base + g * v, base - g * v]
-    memo = getattr(tr, "_left", None)
-    if memo is not None and memo[0] is st:  # the other way from the same pose: the same branch
-        d_prev, x_prev = memo[1], memo[2]
-        guesses.insert(0, -x_prev * (size / d_prev))
+    sig = np.concatenate([np.array([1.0, 3.0, 0.3]) * np.sqrt(size), [size, 3 * size]])
+    guesses = [base] + [base + sign * g * v for v in N for g in sig for sign in (1.0, -1.0)]
+    same = tr._left is not None and tr._left[0] is st  # the other way from the same pose: the same branch
+    if same:
+        guesses.insert(0, -tr._left[2] * (size / tr._left[1]))
     X = np.array(guesses)
     B = len(X)
     rep = np.zeros(B, int)
@@ -351,14 +337,13 @@ def leave(tr: Tracker, st: State, u0: np.ndarray, u1: np.ndarray) -> State | Non
     R, p, ok, _ = tr.correct(R, p, st.href[rep], np.broadcast_to(u1, (B, len(u1))), np.full(B, np.inf), iters=30)
     if not ok.any():
         return None
-    if memo is not None and memo[0] is st and ok[0]:
+    if same and ok[0]:
         j = 0
     else:
         dist = np.abs(R - st.R[rep]).max(axis=(1, 2, 3)) + np.abs(p - st.p[rep]).max(axis=(1, 2))
         dist = np.where(ok, dist, np.inf)
         j = int(np.argmax(dist <= dist.min() * (1 + 1e-6) + 1e-12))
     tr._left = (st, size, X[j])
-    tr.left_singular = True
     return tr.state(R[j:j + 1], p[j:j + 1], st.href, u1[None])
 
 
@@ -374,10 +359,19 @@ class Walk:
     href: np.ndarray
     ok: np.ndarray
     events: list
-    how: np.ndarray | None = None
+    how: np.ndarray
+    #: then, of the rows reported (NaN elsewhere: :func:`mechsyn.kinematics.spatial._sweep_rows`),
+    #: the rates (twists), the closure residual, ``σ_r / σ_1`` and the pairs' angles and slides
+    xi: np.ndarray | None = None
+    xid: np.ndarray | None = None
+    res: np.ndarray | None = None
+    ratio: np.ndarray | None = None
+    theta: np.ndarray | None = None
+    slide: np.ndarray | None = None
 
-    def put(self, k: int | np.ndarray, st: State, how: int = 1) -> None:
-        self.R[k], self.p[k], self.href[k] = st.R, st.p, st.href
+    def put(self, k: int | np.ndarray, R: np.ndarray, p: np.ndarray, href: np.ndarray, how: int = 1) -> None:
+        """Rows ``k`` reached (``how``) at the poses ``R``, ``p`` (H angles ``href``)."""
+        self.R[k], self.p[k], self.href[k] = R, p, href
         self.ok[k] = True
         self.how[k] = how
 
@@ -404,25 +398,21 @@ def walk(tr: Tracker, start: State, U: np.ndarray, event: Any) -> Walk:
     w = Walk(np.full((N, M.n + 1, 3, 3), np.nan), np.full((N, M.n + 1, 3), np.nan),
              np.zeros((N, len(M.helix))), np.zeros(N, bool), [], np.zeros(N, np.int8))
     k0 = int(np.argmin(np.abs(U).max(axis=1)))
-    ends = []
     z = np.zeros(U.shape[1])
     st = tr.advance(start, z, U[k0]) or leave(tr, start, z, U[k0])
-    for order in (np.arange(k0, N), np.arange(k0, -1, -1)):
-        if st is None:
-            ends.append(None)
-            continue
-        if not w.ok[k0]:
-            w.put(k0, st)
-        ends.append(_blocks_along(tr, w, st, U, k0, order[1:], event))
-    if not w.ok[k0]:
+    if st is None:
         w.events.append(event(k0, "not assembled", None))
+    else:
+        w.put(k0, st.R, st.p, st.href)
+    ends = [None if st is None else _blocks_along(tr, w, st, U, k0, order, event)
+            for order in (np.arange(k0 + 1, N), np.arange(k0 - 1, -1, -1))]
     _round(tr, w, U, ends, event)
     _reassemble_rest(tr, w, U, event)
     w.events.sort(key=lambda e: e["index"])
     return w
 
 
-def _turning(M: SpatialModel, U: np.ndarray) -> int | None:
+def turning_column(M: SpatialModel, U: np.ndarray) -> int | None:
     """The column of ``U`` of the sweep's one moving input when it is an angle, else None."""
     moving = np.flatnonzero(np.ptp(U, axis=0) > 0) if len(U) else []
     if len(moving) != 1 or M.drives[moving[0]][1] != "angle":
@@ -433,7 +423,7 @@ def _turning(M: SpatialModel, U: np.ndarray) -> int | None:
 def _round(tr: Tracker, w: Walk, U: np.ndarray, ends: list, event: Any) -> None:
     """Rule 1 of :func:`walk`: past an end the walk reached, on to the rows left with the
     input taken modulo 2π (beyond the last row upwards, or below the first downwards)."""
-    col = _turning(tr.M, U)
+    col = turning_column(tr.M, U)
     if col is None or w.ok.all():
         return
     N = len(U)
@@ -464,8 +454,7 @@ def _same_angle(w: Walk, U: np.ndarray, col: int) -> None:
     for k in np.flatnonzero(~w.ok):
         src = seen.get(int(key[k]))
         if src is not None:
-            w.R[k], w.p[k], w.href[k] = w.R[src], w.p[src], w.href[src]
-            w.ok[k], w.how[k] = True, 2
+            w.put(k, *w.at(src), how=2)
 
 
 def _reassemble_rest(tr: Tracker, w: Walk, U: np.ndarray, event: Any) -> None:
@@ -481,13 +470,13 @@ def _reassemble_rest(tr: Tracker, w: Walk, U: np.ndarray, event: Any) -> None:
                 continue
             rows = np.arange(i, N) if side < 0 else np.arange(i, -1, -1)
             rows = rows[:int(np.argmax(np.append(w.ok[rows], True)))]  # up to the next assembled row
-            got = tr.reassemble(tr.state(*w.at(i + side), U[i + side][None]), U, rows)
-            for k, jid in tr.refused:
+            refused, got = tr.reassemble(tr.state(*w.at(i + side), U[i + side][None]), U, rows)
+            for k, jid in refused:
                 w.events.append(event(k, "refused", jid))
             if got is None:
                 continue
             k, st = got
-            w.put(k, st, how=3)
+            w.put(k, st.R, st.p, st.href, how=3)
             _blocks_along(tr, w, st, U, k, np.sort(rows[rows > k]), event, how=3)
             _blocks_along(tr, w, st, U, k, np.sort(rows[rows < k])[::-1], event, how=3)
             w.events.append(event(int(rows[np.argmax(w.ok[rows])]), "reassembled", None))
@@ -516,11 +505,8 @@ def _blocks_along(tr: Tracker, w: Walk, st: State, U: np.ndarray, k0: int, order
                     w.events.append(event(k, "dead point", st.lin.ratio[0], at=lim - U[k], last=prev))
                 return None
             n, poses, size = 1, (nxt.R, nxt.p, nxt.href), np.zeros(1)
-        done = rows[:n]
-        w.R[done], w.p[done], w.href[done] = poses
-        w.ok[done] = True
-        w.how[done] = how
-        st, prev, i = nxt, int(done[-1]), i + n
+        w.put(rows[:n], *poses, how)
+        st, prev, i = nxt, int(rows[n - 1]), i + n
         reach = int(np.argmin(np.append(size <= MAX_STEP, False)))  # the rows the predictor reaches
         stride = max(1, stride // 2) if n < reach else min(2 * stride, MAX_STRIDE)  # trouble: shorter blocks
     return st
@@ -587,7 +573,7 @@ def polished_ratio(tr: Tracker, R: np.ndarray, p: np.ndarray, href: np.ndarray, 
     return out
 
 
-def _taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def taylor(tr: Tracker, st: State, du: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The predictor's twists (first and second derivative) of B rows from the pose ``st``
     along their input steps ``du`` (B, drives), without a solve per row: the first
     derivative is linear in ``du`` and the second quadratic, so the pose solves for the unit
