@@ -236,26 +236,25 @@ def _input_rates(M: SpatialModel, inputs: dict[str, np.ndarray], speeds: dict[st
     straight and parabolic paths); a path along which the main input does not move
     monotonically falls back to constant speeds, with a note."""
     N, D = U.shape
+    speeds = speeds or {}
     scale = np.array([1.0 if kind == "angle" else 1.0 / M.scale for _, kind, _ in M.drives])
-    given = {d[0]: float((speeds or {}).get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives}
-    const = np.broadcast_to(np.array(list(given.values())) * scale, (N, D)).copy()
+    given = np.array([float(speeds.get(d[0], 1.0)) if d[0] in inputs else 0.0 for d in M.drives]) * scale
     moving = [k for k in range(D) if np.ptp(U[:, k]) > 0]
     names = [M.drives[k][0] for k in moving]
-    if len(moving) < 2 or all(n in (speeds or {}) for n in names) or N < 3:
-        return const, np.zeros((N, D)), ""
-    main = 0  # (the inputs are the first drives, in order)
-    u = U[:, main]
-    du = np.diff(u)
-    if not (np.all(du > 0) or np.all(du < 0)):
-        return const, np.zeros((N, D)), (f"the inputs {', '.join(names)} move together but {M.drives[main][0]} does "
-                                         "not move one way along them: every input at its constant speed")
-    s = given[M.drives[main][0]] * scale[main]
+    if len(moving) < 2 or all(n in speeds for n in names) or N < 3:
+        return np.tile(given, (N, 1)), np.zeros((N, D)), ""
+    u = U[:, 0]  # the main input's (the inputs are the first drives, in order)
+    if not (np.all(np.diff(u) > 0) or np.all(np.diff(u) < 0)):
+        return np.tile(given, (N, 1)), np.zeros((N, D)), (
+            f"the inputs {', '.join(names)} move together but {M.drives[0][0]} does not move one way along them: "
+            "every input at its constant speed")
+    s = given[0]
     sp, spp = np.zeros((N, D)), np.zeros((N, D))
     for k in moving:
         sp[:, k] = s * np.gradient(U[:, k], u, edge_order=2)
         spp[:, k] = s * s * _second_derivative(U[:, k], u)
     return sp, spp, (f"the inputs {', '.join(names)} follow one path: rates from its derivative with "
-                     f"{M.drives[main][0]} at its speed")
+                     f"{M.drives[0][0]} at its speed")
 
 
 def _input_dict(M: SpatialModel, u: np.ndarray) -> dict[str, float]:

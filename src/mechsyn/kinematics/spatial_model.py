@@ -207,8 +207,8 @@ def _check_joint(mech: Mechanism, j: Joint) -> None:
     if j.actuated and j.type not in ("R", "P", "H", "C", "U"):
         raise MechsynInputError(f"joint {j.id} ({j.type}) is driven, but only R, P, H, C and U pairs can be driven",
                                 source=src, field=f"joints[{j.id}].actuated", hint="drive an R, P, H, C or U pair")
-    if j.type == "U" and j.axis is not None and j.axis2 is not None and abs(
-            float(_unit(np.asarray(j.axis, float)) @ _unit(np.asarray(j.axis2, float)))) > 1e-9 and j.actuated:
+    if j.type == "U" and j.actuated and abs(float(_unit(np.asarray(j.axis, float))
+                                                  @ _unit(np.asarray(j.axis2, float)))) > 1e-9:
         raise MechsynInputError(f"joint {j.id} (U) is driven, but its axes are not at right angles: its two "
                                 "angles are defined for a right-angled cross only", source=src,
                                 field=f"joints[{j.id}].axis2", hint="make axis2 perpendicular to axis")
@@ -228,10 +228,8 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
     scale = spread if spread > 0 else max(1.0, float(np.abs(centre).max(initial=0.0)))
     bars = _bars(mech)
     links = tuple(link for link in mech.moving_links if link not in bars)
-    index = {name: k for k, name in enumerate(links)}
-    index[mech.ground] = len(links)
-    rows: dict[str, list] = {k: [] for k in ("pc", "dot", "line", "dist", "angle", "slide", "angle_joints",
-                                             "slide_joints")}
+    index = {name: k for k, name in enumerate(links + (mech.ground,))}
+    rows: dict[str, list] = {k: [] for k in (*ITEMS, "angle_joints", "slide_joints")}
     local = {j.id: (np.asarray(j.point, float) - centre) / scale for j in mech.joints if j.point is not None}
     for j in mech.joints:
         if not bars.keys() & set(j.links):
@@ -239,8 +237,8 @@ def compile_spatial(mech: Mechanism, drives: tuple[str, ...]) -> SpatialModel:
     z = np.zeros(3)
     for bar, (j1, j2) in bars.items():
         a, b = (next(link for link in j.links if link != bar) for j in (j1, j2))
-        ell = float(np.linalg.norm(local[j1.id] - local[j2.id]))
-        rows["dist"].append((index[a], index[b], local[j1.id], local[j2.id], z, z, ell))
+        rows["dist"].append((index[a], index[b], local[j1.id], local[j2.id], z, z,
+                             float(np.linalg.norm(local[j1.id] - local[j2.id]))))
     helix = tuple((rows["angle_joints"].index(j.id), rows["slide_joints"].index(j.id), (j.pitch or 0.0) / scale)
                   for j in mech.joints if j.type == "H")
     drive_rows = [(name, "slide", rows["slide_joints"].index(name)) if input_kind(mech, name) == "P" else
