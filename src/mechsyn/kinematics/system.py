@@ -392,8 +392,11 @@ class _Blocks:
 
     def put(self, J: np.ndarray, cols: tuple, dr: Any, dphi: Any) -> None:
         """A link's entries in the blocks' rows of ``J``: ``dr`` (..., 2) at the columns of its
-        origin (None: none), ``dphi`` at its angle's (``cols``: the three, ``ca``, ``cb`` or ``cc``)."""
-        if dr is not None:
+        origin (None: none; a number: that times the identity of a point's two rows, only its
+        diagonal written), ``dphi`` at its angle's (``cols``: the three, ``ca``, ``cb`` or ``cc``)."""
+        if isinstance(dr, float):
+            J[:, self.idx, cols[0] + (0, 1)] = dr
+        elif dr is not None:
             J[:, self.idx, cols[0]] = dr[..., 0]
             J[:, self.idx, cols[1]] = dr[..., 1]
         J[:, self.idx, cols[2]] = dphi
@@ -407,9 +410,6 @@ class _Blocks:
         return np.stack([c.curve.eval(t[:, k], der) for k, c in enumerate(self.cons)], axis=1)
 
 
-_EYE = np.eye(2)
-
-
 class _Pins(_Blocks):
     """R pair: ``P_a - P_b`` (2 rows)."""
 
@@ -417,8 +417,8 @@ class _Pins(_Blocks):
         return E.P[:, self.sa] - E.R[:, self.sb] - E.T[:, self.sb]
 
     def jacobian(self, J: np.ndarray, E: _At) -> None:
-        self.put(J, self.ca, _EYE, perp(E.T[:, self.sa]))
-        self.put(J, self.cb, -_EYE, -perp(E.T[:, self.sb]))
+        self.put(J, self.ca, 1.0, perp(E.T[:, self.sa]))
+        self.put(J, self.cb, -1.0, -perp(E.T[:, self.sb]))
 
     def gamma(self, E: _At) -> np.ndarray:
         return E.w[:, self.sa, None] ** 2 * E.T[:, self.sa] - E.w[:, self.sb, None] ** 2 * E.T[:, self.sb]
@@ -456,7 +456,7 @@ class _Lines(_Blocks):
     def gamma(self, E: _At) -> np.ndarray:
         w, Asa, Asb, wa, wb = E.T[:, self.w], E.T[:, self.sa], E.T[:, self.sb], E.w[:, self.sa], E.w[:, self.sb]
         dd = E.v[:, self.sb] + wb[..., None] * perp(Asb) - E.v[:, self.sa] - wa[..., None] * perp(Asa)
-        return (wa ** 2 * dot(w, self.d(E)) - 2 * wa * dot(perp(w), dd)
+        return (wa ** 2 * dot(w, E.P[:, self.sb] - E.P[:, self.sa]) - 2 * wa * dot(perp(w), dd)
                 + wb ** 2 * dot(w, Asb) - wa ** 2 * dot(w, Asa))
 
 
@@ -469,8 +469,8 @@ class _Curves(_Blocks):
 
     def jacobian(self, J: np.ndarray, E: _At) -> None:
         t = E.q[:, self.tvar]
-        self.put(J, self.cb, _EYE, perp(E.T[:, self.sb]))
-        self.put(J, self.ca, -_EYE, -perp(E.turned(self.a, self.curve(t, 0))))
+        self.put(J, self.cb, 1.0, perp(E.T[:, self.sb]))
+        self.put(J, self.ca, -1.0, -perp(E.turned(self.a, self.curve(t, 0))))
         J[:, self.idx, self.tvar[:, None]] = -E.turned(self.a, self.curve(t, 1))
 
     def gamma(self, E: _At) -> np.ndarray:
