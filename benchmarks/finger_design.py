@@ -7,9 +7,8 @@ Prints, in one process (ratios; medians of repeats):
    optimiser calls), the one-design closed form (``evaluate_locked``, what it called
    before) and the kinematics engine's Newton continuation of the full file
    (``simulate``, what a user would otherwise call), with their largest differences;
-2. one configuration's residual and Jacobian: the compiled equations
-   (``kinematics.compiled``) against the per-constraint code on a one-row batch, and the
-   underactuated redraw (Newton continuation to a VLL length) with and without them;
+2. one configuration's residual and Jacobian, alone (Newton's call) and per configuration
+   of a batch (a sweep's), and the underactuated redraw (Newton continuation to a VLL length);
 3. whole runs of the bundled case for three seeds (design, errors, VLL range, forces:
    compare them between versions; ``--time-limit`` large enough that no run stops early).
 
@@ -24,10 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-import mechsyn.kinematics.system as system
 from mechsyn.io import mechanism_from_dict
 from mechsyn.kinematics.analysis import simulate
-from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.kinematics.system import build_system
 from mechsyn.synthesis.finger.cases import load_case
 from mechsyn.synthesis.finger.design import design_finger
@@ -75,31 +72,16 @@ def one_configuration_equations(case) -> None:
     x = np.array([14.0, 6.0, 8.0, 48.0, 123.69006753])
     d = apply_design(case, x, ("S",))
     S = build_system(mechanism_from_dict(d), vll={"S": "free"}, prescribed=("S",))
-    one = one_configuration(S)
     q, u = S.q0 + 0.01, np.array([dr.assembled for dr in S.drivers])
     q1, u1 = q[None], u[None]
-    blocks = per_call(lambda: (system.PlanarSystem.residual(S, np.vstack([q, q]), np.vstack([u, u])),
-                               system.PlanarSystem.jacobian(S, np.vstack([q, q]))), 300) / 2
-    compiled = per_call(lambda: (S.residual(q1, u1), S.jacobian(q1)), 2000)
-    diff = max(np.abs(one.residual(q, u) - system.PlanarSystem.residual(S, np.vstack([q, q]), np.vstack([u, u]))[0]).max(),
-               np.abs(one.jacobian(q) - system.PlanarSystem.jacobian(S, np.vstack([q, q]))[0]).max())
+    qN, uN = np.repeat(q1, 361, axis=0), np.repeat(u1, 361, axis=0)
+    one = per_call(lambda: (S.residual(q1, u1), S.jacobian(q1)), 2000)
+    batch = per_call(lambda: (S.residual(qN, uN), S.jacobian(qN)), 50) / 361
     print(f"2. one configuration ({S.m} equations, {S.n} unknowns), residual + Jacobian:")
-    print(f"   compiled                   {compiled * 1e6:8.1f} us")
-    print(f"   per-constraint blocks      {blocks * 1e6:8.1f} us   ratio {blocks / compiled:5.1f}x   "
-          f"largest difference {diff:.1e}")
+    print(f"   alone                      {one * 1e6:8.1f} us")
+    print(f"   in a batch of 361          {batch * 1e6:8.1f} us per configuration")
     lengths = {"S": 30.0}
-    with_c = per_call(lambda: redraw(case, d, lengths), 5)
-    saved = system._one
-    system._one = lambda S: None  # the per-constraint code only
-    try:
-        without = per_call(lambda: redraw(case, d, lengths), 5)
-        d_old = redraw(case, d, lengths)
-    finally:
-        system._one = saved
-    d_new = redraw(case, d, lengths)
-    dd = max(np.abs(np.subtract(a["point"], b["point"])).max() for a, b in zip(d_new["joints"], d_old["joints"]))
-    print(f"   redraw at S = 30 (Newton continuation): compiled {with_c * 1e3:7.2f} ms, per-constraint "
-          f"{without * 1e3:7.2f} ms, ratio {without / with_c:4.1f}x, largest joint difference {dd:.1e}")
+    print(f"   redraw at S = 30 (Newton continuation): {per_call(lambda: redraw(case, d, lengths), 5) * 1e3:7.2f} ms")
 
 
 def whole_runs(seeds: list[int], time_limit: float) -> None:

@@ -11,7 +11,8 @@ from mechsyn.limits import limit
 __all__ = ["ExpressionError", "evaluate", "polar_points"]
 
 _FUNCS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "sqrt": np.sqrt, "abs": np.abs}
-_OPS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply, ast.Div: np.divide, ast.Pow: np.power}
+_OPS = {ast.Add: np.add, ast.Sub: np.subtract, ast.Mult: np.multiply, ast.Div: np.divide, ast.Pow: np.power,
+        ast.USub: np.negative, ast.UAdd: np.positive}
 
 
 class ExpressionError(ValueError):
@@ -36,22 +37,19 @@ def evaluate(text: str, t: np.ndarray) -> np.ndarray:
     except (RecursionError, MemoryError):
         raise ExpressionError(f"{text[:60]!r}... is nested too deeply") from None
 
+    names = {"t": t, "pi": np.pi}
+
     def ev(node: ast.AST):
-        if isinstance(node, ast.Expression):
-            return ev(node.body)
         if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
             return float(node.value)
         if isinstance(node, ast.Name):
-            if node.id == "t":
-                return t
-            if node.id == "pi":
-                return np.pi
+            if node.id in names:
+                return names[node.id]
             raise ExpressionError(f"unknown name {node.id!r} in {text!r}")
         if isinstance(node, ast.BinOp) and type(node.op) in _OPS:
             return _OPS[type(node.op)](ev(node.left), ev(node.right))
-        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
-            v = ev(node.operand)
-            return -v if isinstance(node.op, ast.USub) else v
+        if isinstance(node, ast.UnaryOp) and type(node.op) in _OPS:
+            return _OPS[type(node.op)](ev(node.operand))
         if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in _FUNCS
                 and len(node.args) == 1 and not node.keywords):
             return _FUNCS[node.func.id](ev(node.args[0]))
@@ -59,7 +57,7 @@ def evaluate(text: str, t: np.ndarray) -> np.ndarray:
 
     with np.errstate(all="ignore"):
         try:
-            value = ev(tree)
+            value = ev(tree.body)
         except RecursionError:
             raise ExpressionError(f"{text[:60]!r}... is nested too deeply") from None
         out = np.broadcast_to(np.asarray(value, float), t.shape)

@@ -22,6 +22,7 @@ import scipy.linalg as sla
 
 from mechsyn.errors import MechsynInputError, OverActuatedError
 from mechsyn.kinematics.groups import decompose
+from mechsyn.kinematics.plane import cross
 from mechsyn.kinematics.positions import solve_positions
 from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.sweep import Event, Sweep, connecting_path, driver_kinds, turns
@@ -32,18 +33,25 @@ from mechsyn.structure.drives import DriveCheck, excess_drives
 __all__ = ["Sweep", "assemble", "sweep", "check_mobility", "newton", "drawn_checks"]
 
 
+def _lu(J: np.ndarray) -> tuple | None:
+    """The LU factors of a square ``J`` (an exactly singular one too: a zero pivot, no
+    warning), None when ``J`` is not square or LAPACK refuses it."""
+    if J.shape[0] != J.shape[1]:
+        return None
+    try:
+        with warnings.catch_warnings():  # a singular J: the callers' least-squares answer
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            return sla.lu_factor(J, check_finite=False)
+    except (sla.LinAlgError, ValueError):
+        return None
+
+
 def _solve_lin(J: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    if J.shape[0] == J.shape[1]:
-        try:
-            with warnings.catch_warnings():  # a singular J: the least-squares step below
-                warnings.simplefilter("ignore", sla.LinAlgWarning)
-                lu = sla.lu_factor(J, check_finite=False)
-            x = sla.lu_solve(lu, rhs, check_finite=False)
-            if np.all(np.isfinite(x)):
-                return x
-        except (sla.LinAlgError, ValueError):
-            pass
-    return sla.lstsq(J, rhs, check_finite=False, lapack_driver="gelsy")[0]
+    """``J x = rhs`` by LU, else (not square, singular) in the least-squares sense."""
+    lu = _lu(J)
+    x = None if lu is None else sla.lu_solve(lu, rhs, check_finite=False)
+    return x if x is not None and np.all(np.isfinite(x)) else sla.lstsq(J, rhs, check_finite=False,
+                                                                           lapack_driver="gelsy")[0]
 
 
 def newton(S: PlanarSystem, q: np.ndarray, u: np.ndarray, tol: float | None = None,
@@ -322,22 +330,17 @@ def _factor(S: PlanarSystem, q: np.ndarray) -> tuple[object, np.ndarray, float, 
     """
     J = S.unit_jacobian(S.jacobian(q[None])[0])
     B = S.input_matrix() / S.row_scale[:, None]
-    if J.shape[0] == J.shape[1]:
-        try:
-            with warnings.catch_warnings():  # an exactly zero pivot: the singular point is handled below
-                warnings.simplefilter("ignore", sla.LinAlgWarning)
-                lu = sla.lu_factor(J, check_finite=False)
-            X = sla.lu_solve(lu, B, check_finite=False)
-            d = np.abs(np.diag(lu[0]))
-            piv = int(np.sum(lu[1] != np.arange(len(lu[1]))))
-            sign = float(np.prod(np.sign(np.diag(lu[0]))) * (-1) ** piv)
-            # a pivot within round-off of zero is a singular point, whatever the LAPACK's last
-            # bits (0 with one, 3e-17 and a tangent of 1e16 with another): the least-squares
-            # tangent below, the same everywhere
-            if np.all(np.isfinite(X)) and d.min() > SINGULAR_PIVOT * d.max():
-                return lu, X * S.col_scale[:, None], sign, float(d.min() / max(d.max(), 1e-300))
-        except (sla.LinAlgError, ValueError):
-            pass
+    lu = _lu(J)
+    if lu is not None:
+        X = sla.lu_solve(lu, B, check_finite=False)
+        d = np.abs(np.diag(lu[0]))
+        piv = int(np.sum(lu[1] != np.arange(len(lu[1]))))
+        sign = float(np.prod(np.sign(np.diag(lu[0]))) * (-1) ** piv)
+        # a pivot within round-off of zero is a singular point, whatever the LAPACK's last
+        # bits (0 with one, 3e-17 and a tangent of 1e16 with another): the least-squares
+        # tangent below, the same everywhere
+        if np.all(np.isfinite(X)) and d.min() > SINGULAR_PIVOT * d.max():
+            return lu, X * S.col_scale[:, None], sign, float(d.min() / max(d.max(), 1e-300))
     X = sla.lstsq(J, B, check_finite=False)[0] * S.col_scale[:, None]
     sv = np.linalg.svd(J, compute_uv=False)
     return (J,), X, 0.0, float(sv[min(J.shape) - 1] / max(sv.max(), 1e-300)) if sv.size else 1.0
@@ -402,9 +405,7 @@ def _track(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, depth
         return None
     um = ua + du / 2
     qm = _track(S, q, ua, um, depth - 1, X)
-    if qm is None:
-        return None
-    return _track(S, qm, um, ub, depth - 1)
+    return None if qm is None else _track(S, qm, um, ub, depth - 1)
 
 
 def _extrapolate(hist: list, u: np.ndarray) -> np.ndarray:
@@ -417,15 +418,11 @@ def _extrapolate(hist: list, u: np.ndarray) -> np.ndarray:
         return hist[-1][1]
     direction = step / norm
     s = [float(direction @ (h[0] - u_last)) for h in hist[-3:]]
-    qs = [h[1] for h in hist[-3:]]
-    pred = np.zeros_like(qs[0])
-    for a, (sa, qa) in enumerate(zip(s, qs)):
-        w = 1.0
-        for b, sb in enumerate(s):
-            if b != a:
-                w *= (norm - sb) / (sa - sb) if sa != sb else 0.0
-        pred += w * qa
-    return pred
+
+    def weight(a: int) -> float:  # the Lagrange basis polynomial of node a at the arc length norm
+        return math.prod((norm - sb) / (s[a] - sb) if s[a] != sb else 0.0 for b, sb in enumerate(s) if b != a)
+
+    return sum(weight(a) * h[1] for a, h in enumerate(hist[-3:]))
 
 
 def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
@@ -442,19 +439,12 @@ def _continue(S: PlanarSystem, hist: list, u: np.ndarray) -> np.ndarray | None:
     u0, q0, (_, X0, det0, sig0) = hist[-1]
     regular = sig0 >= 1e-6
     nxt = _track(S, q0, u0, u, X=X0) if regular else None
-    if nxt is not None and len(hist) >= 2:
-        det1 = _factor(S, nxt)[2]
-        if det1 * det0 >= 0:
-            return nxt
-    elif nxt is not None or len(hist) < 2:
-        if nxt is None and not regular:
-            return _leave_singular(S, q0, X0, u0, u)
+    if len(hist) < 2:  # no run to extrapolate: the tangent's answer, or off the singular start
+        return nxt if nxt is not None or regular else _leave_singular(S, q0, X0, u0, u)
+    if nxt is not None and _factor(S, nxt)[2] * det0 >= 0:
         return nxt
-    pred = _extrapolate(hist, u)
-    cand, ok = newton(S, pred, u, max_iter=40, polish=True)
-    if ok:
-        return cand
-    return nxt
+    cand, ok = newton(S, _extrapolate(hist, u), u, max_iter=40, polish=True)
+    return cand if ok else nxt
 
 
 def _leave_singular(S: PlanarSystem, q0: np.ndarray, X0: np.ndarray, u0: np.ndarray,
@@ -487,25 +477,19 @@ def _elbows(S: PlanarSystem, q: np.ndarray) -> np.ndarray:
     """Assembly-mode signature of a configuration: at every R pair joining two moving links
     that each carry another joint, the side to which the second link turns from the first
     (the sign of ``(P_J - P_a) x (P_b - P_J)``; for a dyad, its assembly mode)."""
-    out = []
-    mech = S.mech
+    mech, out = S.mech, []
 
-    def glob(i: int, jid: str) -> np.ndarray:
-        return S.point(q[None], i, S.to_local(S.links[i], mech.joint(jid).point))[0]
+    def glob(link: str, jid: str) -> np.ndarray:  # the joint's point on the link at q
+        return S.point(q[None], S.index(link), S.to_local(link, mech.joint(jid).point))[0]
+
+    def other(j: Any, link: str) -> str | None:  # the link's first joint other than j
+        return next((k.id for k in mech.joints_of(link) if k.id != j.id), None)
 
     for j in mech.joints:
-        if j.type != "R":
-            continue
-        a, b = (S.index(n) for n in j.links)
-        if a < 0 or b < 0:
-            continue
-        oa = [k.id for k in mech.joints_of(j.links[0]) if k.id != j.id]
-        ob = [k.id for k in mech.joints_of(j.links[1]) if k.id != j.id]
-        if not oa or not ob:
-            continue
-        P, Pa, Pb = glob(a, j.id), glob(a, oa[0]), glob(b, ob[0])
-        d1, d2 = P - Pa, Pb - P
-        out.append(np.sign(d1[0] * d2[1] - d1[1] * d2[0]))
+        a, b = j.links
+        if j.type == "R" and mech.ground not in (a, b) and (oa := other(j, a)) and (ob := other(j, b)):
+            P = glob(a, j.id)
+            out.append(np.sign(cross(P - glob(a, oa), glob(b, ob) - P)))
     return np.array(out)
 
 
@@ -575,7 +559,8 @@ def _crossing(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, de
     return (ua + ub) / 2
 
 
-def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray, iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
+def _limit(S: PlanarSystem, q: np.ndarray, ua: np.ndarray, ub: np.ndarray,
+           iters: int = 30) -> tuple[np.ndarray, np.ndarray]:
     """Bisection for the last input between ua (assembled) and ub (not) that assembles."""
     for _ in range(iters):
         um = (ua + ub) / 2
@@ -617,11 +602,8 @@ def sweep(S: PlanarSystem, inputs: np.ndarray, speeds: np.ndarray | None = None,
         return _sweep_shifted(S, inputs, shift, speeds, progress, refine_limits)
     speeds = np.ones(k) if speeds is None else np.asarray(speeds, float)
     q_start = assemble(S)
-    q = np.full((N, S.n), np.nan)
-    qd = np.full((N, S.n), np.nan)
-    qdd = np.full((N, S.n), np.nan)
-    det_sign = np.full(N, np.nan)
-    sig = np.full(N, np.nan)
+    q, qd, qdd = np.full((3, N, S.n), np.nan)  # positions, velocities, accelerations
+    det_sign, sig = np.full((2, N), np.nan)  # the sign of det Phi_q and the pivot ratio
     out = (q, qd, qdd, det_sign, sig)
     events: list[Event] = []
     u_asm = np.array([d.assembled for d in S.drivers])
@@ -715,11 +697,7 @@ def _reassemble(S: PlanarSystem, out: tuple, inputs: np.ndarray, i: int, q_start
     those Newton reaches from the drawn and from the last one), the branch followed
     backwards into the gap as far as it assembles; None when none is found."""
     u = inputs[i]
-    cands = []
-    for guess in (q_start, q_last):
-        c, good = newton(S, guess, u, max_iter=15)
-        if good:
-            cands.append(c)
+    cands = [c for c, good in (newton(S, guess, u, max_iter=15) for guess in (q_start, q_last)) if good]
     if not cands:
         return None
     cand = _nearest_mode(S, cands, u, q_start, drawn_det)

@@ -54,7 +54,6 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.cams import CamCurve, cam_curve
-from mechsyn.kinematics.compiled import one_configuration
 from mechsyn.kinematics.plane import cos_sin, dot, perp, rotate, to_frame
 from mechsyn.kinematics.topology import Topology, topology_of
 from mechsyn.model.mechanism import Joint, Mechanism
@@ -124,7 +123,7 @@ class PlanarSystem:
     row_scale: np.ndarray | None = None
     col_scale: np.ndarray | None = None
     #: what the engines compute once per system and reuse (the assembled configuration,
-    #: the groups' look-ups, the compiled one-configuration equations): this geometry's
+    #: the groups' look-ups, the equations gathered by kind): this geometry's
     #: answers, a field of the compiled system, so a new geometry starts with an empty one
     cache: dict = field(default_factory=dict, repr=False, compare=False)
     #: the mechanism's :class:`~mechsyn.kinematics.topology.Topology` (with the VLL modes
@@ -228,21 +227,20 @@ class PlanarSystem:
     # -- equations -----------------------------------------------------------------
     def residual(self, q: np.ndarray, u: np.ndarray) -> np.ndarray:
         """``Phi(q, u)``, shape (N, m); ``u`` has shape (N, n_inputs)."""
-        if q.shape[0] == 1 and (one := _one(self)) is not None:  # Newton's one configuration
-            return one.residual(q[0], u[0])[None]
-        out = np.empty((q.shape[0], self.m))
-        for row, con in self.blocks():
-            out[:, row:row + con.rows] = _residual(self, con, q, u)
+        eqs = self.equations()
+        E, out = _At(self, eqs, q), np.empty((q.shape[0], self.m))
+        u = np.concatenate([u, np.zeros((q.shape[0], 1))], axis=1)  # input column -1: none
+        for G in eqs.kinds:
+            out[:, G.idx] = G.residual(E, u)
         return out
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """``Phi_q``, shape (N, m, n)."""
-        if q.shape[0] == 1 and (one := _one(self)) is not None:
-            return one.jacobian(q[0])[None]
-        J = np.zeros((q.shape[0], self.m, self.n))
-        for row, con in self.blocks():
-            _jacobian(self, con, q, J, row)
-        return J
+        eqs = self.equations()
+        E, J = _At(self, eqs, q), np.zeros((q.shape[0], self.m, self.n + 3))  # the last 3 columns: the frame's
+        for G in eqs.kinds:
+            G.jacobian(J, E)
+        return J[..., :self.n]
 
     def input_matrix(self) -> np.ndarray:
         """``B`` with ``Phi_q q' = B u'`` (rows of drivers are 1 in their input column)."""
@@ -254,11 +252,10 @@ class PlanarSystem:
 
     def gamma(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """Velocity-dependent right-hand side of ``Phi_q q'' = gamma + B u''``."""
-        out = np.zeros((q.shape[0], self.m))
-        for row, con in self.blocks():
-            g = _gamma(self, con, q, qd)
-            if g is not None:
-                out[:, row:row + con.rows] = g
+        eqs = self.equations()
+        E, out = _At(self, eqs, q, qd), np.empty((q.shape[0], self.m))
+        for G in eqs.kinds:
+            out[:, G.idx] = G.gamma(E)
         return out
 
     def rates(self, q: np.ndarray, speeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -279,6 +276,13 @@ class PlanarSystem:
     def rows_of(self, joint: str) -> list[int]:
         return [r for row, con in self.blocks() if con.joint == joint for r in range(row, row + con.rows)]
 
+    def equations(self) -> _Equations:
+        """The constraint equations gathered by kind (:class:`_Equations`), kept in :attr:`cache`."""
+        eqs = self.cache.get("equations")
+        if eqs is None:
+            eqs = self.cache["equations"] = _Equations(self)
+        return eqs
+
     def blocks(self) -> Iterator[tuple[int, Con]]:
         """Every constraint block with its first row of ``Phi``: ``(row, con)`` in
         ``cons`` order (the rows of a block are ``row .. row + con.rows - 1``; the first
@@ -296,196 +300,224 @@ def frame_points(frames: tuple, idx: list, xy: list) -> list:
                                   sin[i] * dx + cos[i] * dy) for i, (x, y) in zip(idx, xy)]
 
 
-
-
-def _one(S: PlanarSystem) -> Any:
-    return one_configuration(S)
-
-
 def _axis(j: Joint) -> np.ndarray:
     return np.asarray(j.axis, float)  # given: build_system refuses a P pair without axis
 
 
-# ------------------------------------------------------------------ per-constraint code
-def _residual(S: PlanarSystem, con: Con, q: np.ndarray, u: np.ndarray) -> np.ndarray:
-    k = con.kind
-    if k == "R":
-        return S.point(q, con.a, con.sa) - S.point(q, con.b, con.sb)
-    if k == "angle":
-        val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
-        return (S.pose(q, con.b)[1] - S.pose(q, con.a)[1] - val)[:, None]
-    if k == "line":
-        c, s = S.rotation(q, con.a)
-        w = rotate(c, s, con.w)
-        d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-        val = con.c0 + (u[:, con.driver] if con.driver is not None else 0.0)
-        return (dot(w, d) - val)[:, None]
-    if k == "gear":
-        pa, pb, pc = (S.pose(q, i)[1] for i in (con.a, con.b, con.c))
-        return ((pb - pc) - con.k * (pa - pc) - con.c0)[:, None]
-    if k == "curve":
-        ra = S.pose(q, con.a)[0]
-        c, s = S.rotation(q, con.a)
-        O = con.curve.eval(q[:, con.tvar])
-        return S.point(q, con.b, con.sb) - ra - rotate(c, s, O)
-    if k == "belt":
-        D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-        d2 = dot(D, D)
-        r = con.radius
+# ------------------------------------------------------------------ the equations, kind by kind
+class _Equations:
+    """The constraint blocks of a system gathered by kind (:class:`_Blocks`), once per system
+    (:meth:`PlanarSystem.equations`), and the table of every local vector they turn with a
+    link (joint points, line directions): its links ``link`` (M,; -1 the frame), vectors
+    ``vec`` (M, 2) and their quarter turns ``vec_perp``. An evaluation turns the whole
+    table at once (:class:`_At`) and each kind reads its blocks' rows of it, so the
+    equations of a kind are a few whole-array operations over all its blocks and a batch of
+    configurations, one configuration of Newton's method as well as a sweep."""
+
+    def __init__(self, S: PlanarSystem, blocks: Any = None) -> None:
+        self.links: list = []
+        self.vecs: list = []
+        by: dict = {}
+        for row, con in S.blocks() if blocks is None else blocks:
+            by.setdefault(_KINDS[con.kind], []).append((row, con))
+        self.kinds = [kind(S, self, items) for kind, items in by.items()]
+        self.link = np.array(self.links, int)
+        self.vec = np.array(self.vecs, float).reshape(-1, 2)
+        self.vec_perp = perp(self.vec)
+
+    def add(self, links: np.ndarray, vecs: list) -> slice:
+        """Rows of the table for the vectors ``vecs`` (None: zero) on the links ``links``."""
+        start = len(self.links)
+        self.links += links.tolist()
+        self.vecs += [(0.0, 0.0) if v is None else tuple(v) for v in vecs]
+        return slice(start, len(self.links))
+
+
+class _At:
+    """The poses of a batch of configurations ``q`` (N, n) (and their rates ``qd``) and the
+    table of :class:`_Equations` turned with them: ``T`` (N, M, 2) the vectors ``A(phi) s``,
+    ``R`` their links' origins, ``P = R + T`` the points; the frame (pose zero) is the last
+    link, so that link -1 is the frame. ``phi``, ``cos``, ``sin`` (N, nl + 1) are the links'
+    angles; with ``qd``, ``v`` (N, M, 2) and ``w`` (N, M) are the velocities and angular
+    velocities of the table's links."""
+
+    def __init__(self, S: PlanarSystem, eqs: _Equations, q: np.ndarray, qd: np.ndarray | None = None) -> None:
+        self.q, self.qd = q, qd
+        r, self.phi = _poses(S, q)
+        self.cos, self.sin = cos_sin(self.phi)
+        c, s = self.cos[:, eqs.link, None], self.sin[:, eqs.link, None]
+        self.R, self.T = r[:, eqs.link], c * eqs.vec + s * eqs.vec_perp
+        self.P = self.R + self.T
+        if qd is not None:
+            v, w = _poses(S, qd)
+            self.v, self.w = v[:, eqs.link], w[:, eqs.link]
+
+    def turned(self, i: np.ndarray, s: np.ndarray) -> np.ndarray:
+        """``A(phi_i) s`` (N, K, 2) of local vectors ``s`` (N, K, 2) outside the table (cam curves)."""
+        return rotate(self.cos[:, i], self.sin[:, i], s)
+
+
+def _poses(S: PlanarSystem, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The origins (N, nl + 1, 2) and angles (N, nl + 1) of the links in ``q``, the frame last."""
+    nl = len(S.links)
+    P = np.zeros((q.shape[0], nl + 1, 3))
+    P[:, :nl] = q[:, :3 * nl].reshape(-1, nl, 3)
+    return P[..., :2], P[..., 2]
+
+
+class _Blocks:
+    """The constraint blocks of one kind gathered into arrays (K blocks of ``rows`` rows):
+    their rows of ``Phi`` (``idx``), links (``a``, ``b``, a gear's carrier ``c``; -1 the
+    frame), the first columns of those links in ``Phi_q`` (``ca``, ``cb``, ``cc``: the
+    three columns of each, the frame's ``n`` and after, dropped), the rows of their local
+    vectors ``sa`` (on ``a``), ``sb`` (on ``b``) and ``w`` (on ``a``) in the table of
+    :class:`_Equations`, constants ``c0``, gear ratios ``k`` (1 for an angle), input
+    columns ``drv`` (-1: none), and the blocks themselves (``cons``: cam curves)."""
+
+    def __init__(self, S: PlanarSystem, eqs: _Equations, items: list) -> None:
+        self.cons = [c for _, c in items]
+        first = np.array([r for r, _ in items])
+        self.idx = first if self.cons[0].rows == 1 else first[:, None] + np.arange(self.cons[0].rows)
+        shape = first.shape + (1,) * (self.idx.ndim - 1)  # (K,) for one-row blocks, else (K, 1)
+        self.a, self.b, self.c, self.tvar = (np.array([getattr(c, f) for c in self.cons])
+                                             for f in ("a", "b", "c", "tvar"))
+        self.ca, self.cb, self.cc = (tuple(np.where(i < 0, S.n, 3 * i).reshape(shape) + d for d in range(3))
+                                     for i in (self.a, self.b, self.c))
+        self.sa, self.sb, self.w = (eqs.add(i, [getattr(c, f) for c in self.cons])
+                                    for i, f in ((self.a, "sa"), (self.b, "sb"), (self.a, "w")))
+        self.c0, self.radius, self.sigma, self.ref = (np.array([getattr(c, f) for c in self.cons], float)
+                                                      for f in ("c0", "radius", "sigma", "ref"))
+        self.k = np.array([c.k if c.kind == "gear" else 1.0 for c in self.cons])
+        self.drv = np.array([-1 if c.driver is None else c.driver for c in self.cons])
+
+    def put(self, J: np.ndarray, cols: tuple, dr: Any, dphi: Any) -> None:
+        """A link's entries in the blocks' rows of ``J``: ``dr`` (..., 2) at the columns of its
+        origin (None: none; a number: that times the identity of a point's two rows, only its
+        diagonal written), ``dphi`` at its angle's (``cols``: the three, ``ca``, ``cb`` or ``cc``)."""
+        if isinstance(dr, float):
+            J[:, self.idx, cols[0] + (0, 1)] = dr
+        elif dr is not None:
+            J[:, self.idx, cols[0]] = dr[..., 0]
+            J[:, self.idx, cols[1]] = dr[..., 1]
+        J[:, self.idx, cols[2]] = dphi
+
+    def gamma(self, E: _At) -> Any:
+        """The blocks' rows of ``gamma`` (0: none, as for angles and gears)."""
+        return 0.0
+
+    def curve(self, t: np.ndarray, der: int) -> np.ndarray:
+        """The cam curves ``O(t)`` (or a derivative) of the blocks at their parameters (N, K, 2)."""
+        return np.stack([c.curve.eval(t[:, k], der) for k, c in enumerate(self.cons)], axis=1)
+
+
+class _Pins(_Blocks):
+    """R pair: ``P_a - P_b`` (2 rows)."""
+
+    def residual(self, E: _At, u: np.ndarray) -> np.ndarray:
+        return E.P[:, self.sa] - E.R[:, self.sb] - E.T[:, self.sb]
+
+    def jacobian(self, J: np.ndarray, E: _At) -> None:
+        self.put(J, self.ca, 1.0, perp(E.T[:, self.sa]))
+        self.put(J, self.cb, -1.0, -perp(E.T[:, self.sb]))
+
+    def gamma(self, E: _At) -> np.ndarray:
+        return E.w[:, self.sa, None] ** 2 * E.T[:, self.sa] - E.w[:, self.sb, None] ** 2 * E.T[:, self.sb]
+
+
+class _Turns(_Blocks):
+    """Angle (drive, P pair's rotation, idle roller) and gear pair (ratio ``k``, carrier
+    ``c``; an angle: ``k = 1``, ``c`` the frame): ``(phi_b - phi_c) - k (phi_a - phi_c) - c0 - u``."""
+
+    def residual(self, E: _At, u: np.ndarray) -> np.ndarray:
+        pa, pb, pc = E.phi[:, self.a], E.phi[:, self.b], E.phi[:, self.c]
+        return (pb - pc) - self.k * (pa - pc) - (self.c0 + u[:, self.drv])
+
+    def jacobian(self, J: np.ndarray, E: _At) -> None:
+        self.put(J, self.cc, None, self.k - 1.0)
+        self.put(J, self.cb, None, 1.0)
+        self.put(J, self.ca, None, -self.k)
+
+
+class _Lines(_Blocks):
+    """Line (P pair, driven or locked slide): ``w . (P_b - P_a) - c0 - u`` with ``w = A_a w_loc``."""
+
+    def d(self, E: _At) -> np.ndarray:
+        """``P_b - P_a`` (N, K, 2)."""
+        return E.P[:, self.sb] - E.R[:, self.sa] - E.T[:, self.sa]
+
+    def residual(self, E: _At, u: np.ndarray) -> np.ndarray:
+        return dot(E.T[:, self.w], self.d(E)) - (self.c0 + u[:, self.drv])
+
+    def jacobian(self, J: np.ndarray, E: _At) -> None:
+        w = E.T[:, self.w]
+        self.put(J, self.ca, -w, dot(perp(w), self.d(E)) - dot(w, perp(E.T[:, self.sa])))
+        self.put(J, self.cb, w, dot(w, perp(E.T[:, self.sb])))
+
+    def gamma(self, E: _At) -> np.ndarray:
+        w, Asa, Asb, wa, wb = E.T[:, self.w], E.T[:, self.sa], E.T[:, self.sb], E.w[:, self.sa], E.w[:, self.sb]
+        dd = E.v[:, self.sb] + wb[..., None] * perp(Asb) - E.v[:, self.sa] - wa[..., None] * perp(Asa)
+        return (wa ** 2 * dot(w, E.P[:, self.sb] - E.P[:, self.sa]) - 2 * wa * dot(perp(w), dd)
+                + wb ** 2 * dot(w, Asb) - wa ** 2 * dot(w, Asa))
+
+
+class _Curves(_Blocks):
+    """Cam (roller centre on the offset curve ``O(t)`` of cam ``a``): ``P_b - r_a - A_a O(t)``
+    (2 rows; ``t`` the unknown ``tvar``)."""
+
+    def residual(self, E: _At, u: np.ndarray) -> np.ndarray:
+        return E.P[:, self.sb] - E.R[:, self.sa] - E.turned(self.a, self.curve(E.q[:, self.tvar], 0))
+
+    def jacobian(self, J: np.ndarray, E: _At) -> None:
+        t = E.q[:, self.tvar]
+        self.put(J, self.cb, 1.0, perp(E.T[:, self.sb]))
+        self.put(J, self.ca, -1.0, -perp(E.turned(self.a, self.curve(t, 0))))
+        J[:, self.idx, self.tvar[:, None]] = -E.turned(self.a, self.curve(t, 1))
+
+    def gamma(self, E: _At) -> np.ndarray:
+        t, td, wa, wb = E.q[:, self.tvar], E.qd[:, self.tvar, None], E.w[:, self.sa, None], E.w[:, self.sb, None]
+        O, O1, O2 = (E.turned(self.a, self.curve(t, d)) for d in (0, 1, 2))
+        return wb ** 2 * E.T[:, self.sb] - wa ** 2 * O + 2 * wa * td * perp(O1) + td ** 2 * O2
+
+
+class _Belts(_Blocks):
+    """Belt (see the module doc): ``b - r atan(b / r) + σ r (φ_b - δ) - const`` (1 row)."""
+
+    def terms(self, E: _At) -> tuple:
+        """``D = P - E`` (N, K, 2), ``d²``, the free length ``b`` (NaN where ``d <= r``), the
+        unit belt direction ``g = (b D - σ r R90 D) / d²`` and ``σ r``."""
+        D = E.P[:, self.sb] - E.P[:, self.sa]
+        d2, r = dot(D, D), self.radius
         with np.errstate(invalid="ignore"):
-            b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))   # NaN: belt not taut and straight
-        rel = S.pose(q, con.b)[1] - np.arctan2(D[:, 1], D[:, 0]) - con.ref
-        rel = np.mod(rel + np.pi, 2 * np.pi) - np.pi                 # continuous within half a turn
-        return (b - r * np.arctan2(b, r) + con.sigma * r * rel - con.c0)[:, None]
-    raise AssertionError(k)
+            b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))  # NaN: belt not taut and straight
+        return D, d2, b, (b[..., None] * D - (self.sigma * r)[:, None] * perp(D)) / d2[..., None], self.sigma * r
 
+    def residual(self, E: _At, u: np.ndarray) -> np.ndarray:
+        D, _, b, _, sr = self.terms(E)
+        rel = E.phi[:, self.b] - np.arctan2(D[..., 1], D[..., 0]) - self.ref
+        rel = np.mod(rel + np.pi, 2 * np.pi) - np.pi  # continuous within half a turn
+        return b - self.radius * np.arctan2(b, self.radius) + sr * rel - self.c0
 
-def _put(J: np.ndarray, row: int, i: int, vals_r: np.ndarray | None, vals_phi: np.ndarray) -> None:
-    """Add entries for link i: vals_r (N, rows, 2) and vals_phi (N, rows)."""
-    if i < 0:
-        return
-    if vals_r is not None:
-        J[:, row:row + vals_phi.shape[1], 3 * i:3 * i + 2] += vals_r
-    J[:, row:row + vals_phi.shape[1], 3 * i + 2] += vals_phi
+    def jacobian(self, J: np.ndarray, E: _At) -> None:
+        _, _, _, g, sr = self.terms(E)
+        self.put(J, self.ca, -g, -dot(g, perp(E.T[:, self.sa])))
+        self.put(J, self.cb, g, dot(g, perp(E.T[:, self.sb])) + sr)
 
-
-def _jacobian(S: PlanarSystem, con: Con, q: np.ndarray, J: np.ndarray, row: int) -> None:
-    N = q.shape[0]
-    k = con.kind
-    if k == "R":
-        eye = np.broadcast_to(np.eye(2), (N, 2, 2))
-        for i, s, sign in ((con.a, con.sa, 1.0), (con.b, con.sb, -1.0)):
-            if i < 0:
-                continue
-            c, sn = S.rotation(q, i)
-            _put(J, row, i, sign * eye, sign * perp(rotate(c, sn, s)))
-        return
-    if k == "angle":
-        one = np.ones((N, 1))
-        _put(J, row, con.b, None, one)
-        _put(J, row, con.a, None, -one)
-        return
-    if k == "line":
-        c, s = S.rotation(q, con.a)
-        w = rotate(c, s, con.w)
-        Pa = S.point(q, con.a, con.sa)
-        Pb = S.point(q, con.b, con.sb)
-        d = Pb - Pa
-        if con.a >= 0:
-            Asa = rotate(c, s, con.sa)
-            _put(J, row, con.a, -w[:, None, :], (dot(perp(w), d) - dot(w, perp(Asa)))[:, None])
-        if con.b >= 0:
-            cb, sb = S.rotation(q, con.b)
-            _put(J, row, con.b, w[:, None, :], dot(w, perp(rotate(cb, sb, con.sb)))[:, None])
-        return
-    if k == "gear":
-        one = np.ones((N, 1))
-        _put(J, row, con.b, None, one)
-        _put(J, row, con.a, None, -con.k * one)
-        _put(J, row, con.c, None, (con.k - 1.0) * one)
-        return
-    if k == "curve":
-        eye = np.broadcast_to(np.eye(2), (N, 2, 2))
-        c, s = S.rotation(q, con.a)
-        t = q[:, con.tvar]
-        O, O1 = con.curve.eval(t), con.curve.eval(t, 1)
-        if con.b >= 0:
-            cb, sb = S.rotation(q, con.b)
-            _put(J, row, con.b, eye, perp(rotate(cb, sb, con.sb)))
-        if con.a >= 0:
-            _put(J, row, con.a, -eye, -perp(rotate(c, s, O)))
-        J[:, row:row + 2, con.tvar] = -rotate(c, s, O1)
-        return
-    if k == "belt":
-        g, _, _ = _belt_terms(S, con, q)
-        for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
-            if i < 0:
-                continue
-            c, sn = S.rotation(q, i)
-            dphi = sign * dot(g, perp(rotate(c, sn, sl)))
-            if i == con.b:
-                dphi = dphi + con.sigma * con.radius
-            _put(J, row, i, sign * g[:, None, :], dphi[:, None])
-        return
-    raise AssertionError(k)
-
-
-def _belt_terms(S: PlanarSystem, con: Con, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Unit belt direction ``g = (b D - σ r R90 D)/d²`` (anchor to tangent point), ``D``
-    and the free length ``b`` of a belt constraint (NaN where ``d <= r``)."""
-    D = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-    d2 = dot(D, D)
-    r = con.radius
-    with np.errstate(invalid="ignore"):
-        b = np.sqrt(np.where(d2 > r * r, d2 - r * r, np.nan))
-    g = (b[:, None] * D - con.sigma * r * perp(D)) / d2[:, None]
-    return g, D, b
-
-
-def _gamma(S: PlanarSystem, con: Con, q: np.ndarray, qd: np.ndarray) -> np.ndarray | None:
-    k = con.kind
-    if k in ("angle", "gear"):
-        return None
-    if k == "R":
-        out = 0.0
-        for i, s, sign in ((con.a, con.sa, 1.0), (con.b, con.sb, -1.0)):
-            if i < 0:
-                continue
-            c, sn = S.rotation(q, i)
-            w = qd[:, 3 * i + 2]
-            out = out + sign * (w ** 2)[:, None] * rotate(c, sn, s)
-        return np.broadcast_to(out, (q.shape[0], 2)) if np.ndim(out) else np.zeros((q.shape[0], 2))
-    if k == "line":
-        c, s = S.rotation(q, con.a)
-        w = rotate(c, s, con.w)
-        va, wa = S.pose(qd, con.a)
-        vb, wb = S.pose(qd, con.b)
-        Asa = rotate(c, s, con.sa)
-        cb, sb = S.rotation(q, con.b)
-        Asb = rotate(cb, sb, con.sb)
-        d = S.point(q, con.b, con.sb) - S.point(q, con.a, con.sa)
-        dd = vb + wb[:, None] * perp(Asb) - va - wa[:, None] * perp(Asa)
-        g = (wa ** 2 * dot(w, d) - 2 * wa * dot(perp(w), dd)
-             + wb ** 2 * dot(w, Asb) - wa ** 2 * dot(w, Asa))
-        return g[:, None]
-    if k == "curve":
-        c, s = S.rotation(q, con.a)
-        cb, sb = S.rotation(q, con.b)
-        _, wa = S.pose(qd, con.a)
-        _, wb = S.pose(qd, con.b)
-        t, td = q[:, con.tvar], qd[:, con.tvar]
-        O, O1, O2 = (con.curve.eval(t, d) for d in (0, 1, 2))
-        g = ((wb ** 2)[:, None] * rotate(cb, sb, con.sb) - (wa ** 2)[:, None] * rotate(c, s, O)
-             + (2 * wa * td)[:, None] * perp(rotate(c, s, O1)) + (td ** 2)[:, None] * rotate(c, s, O2))
-        return g
-    if k == "belt":
+    def gamma(self, E: _At) -> np.ndarray:
         # Phi'' = dg/dt . D' + g . D'' + σ r phi_b'' with D'' = (terms in q'') - w_b² A_b s_b
         # + w_a² A_a s_a, and dg/dt = w_g R90 g, w_g = (R90 D . D')/d² + σ r (D . D')/(d² b)
         # (g turns with D's direction less the tangent offset arcsin(r/d)).
-        g, D, b = _belt_terms(S, con, q)
-        d2 = dot(D, D)
-        out = 0.0
-        Dd = 0.0
-        for i, sl, sign in ((con.b, con.sb, 1.0), (con.a, con.sa, -1.0)):
-            if i < 0:
-                continue
-            c, sn = S.rotation(q, i)
-            As = rotate(c, sn, sl)
-            v, w = S.pose(qd, i)
-            Dd = Dd + sign * (v + w[:, None] * perp(As))
-            out = out + sign * w ** 2 * dot(g, As)
-        if np.ndim(Dd) == 0:
-            return np.zeros((q.shape[0], 1))
-        wg = dot(perp(D), Dd) / d2 + con.sigma * con.radius * dot(D, Dd) / (d2 * b)
-        return (out - wg * dot(perp(g), Dd))[:, None]
-    raise AssertionError(k)
+        D, d2, b, g, sr = self.terms(E)
+        Asa, Asb, wa, wb = E.T[:, self.sa], E.T[:, self.sb], E.w[:, self.sa], E.w[:, self.sb]
+        Dd = E.v[:, self.sb] + wb[..., None] * perp(Asb) - E.v[:, self.sa] - wa[..., None] * perp(Asa)
+        wg = dot(perp(D), Dd) / d2 + sr * dot(D, Dd) / (d2 * b)
+        return wb ** 2 * dot(g, Asb) - wa ** 2 * dot(g, Asa) - wg * dot(perp(g), Dd)
+
+
+#: The blocks of every kind of constraint (an angle is a gear of ratio 1 about the frame).
+_KINDS = {"R": _Pins, "angle": _Turns, "gear": _Turns, "line": _Lines, "curve": _Curves, "belt": _Belts}
 
 
 # --------------------------------------------------------------------------- building
-def _dir_angle(v: np.ndarray) -> float:
-    return float(np.arctan2(v[1], v[0]))
-
-
 def build_system(mech: Mechanism, vll: dict[str, str] | None = None,
                  prescribed: tuple[str, ...] = ()) -> PlanarSystem:
     """Compile a planar mechanism with joint points into a :class:`PlanarSystem`.
@@ -577,10 +609,8 @@ def _link_frames(mech: Mechanism) -> tuple[np.ndarray, np.ndarray, float]:
         pts = [np.asarray(j.attrs["anchor"], float) if j.type == "belt" and j.links[0] == name else j.point
                for j in mech.joints_of(name)]
         origin0[i] = pts[0]
-        for p in pts[1:]:
-            if math.hypot(*(p - pts[0])) > 1e-12 * scale:
-                angle0[i] = _dir_angle(p - pts[0])
-                break
+        d = next((p - pts[0] for p in pts[1:] if math.hypot(*(p - pts[0])) > 1e-12 * scale), (0.0, 0.0))
+        angle0[i] = np.arctan2(d[1], d[0])  # towards the first other joint point away from the origin
     return origin0, angle0, scale
 
 
@@ -706,7 +736,8 @@ class _Builder:
                   sigma=BELT_WRAPS[j.attrs["wrap"]], role="pair")
         D = j.point - np.asarray(j.attrs["anchor"], float)
         con = replace(con, ref=float(p.pose(self.q0[None], b)[1][0] - np.arctan2(D[1], D[0])))
-        c0 = float(_residual(p, con, self.q0[None], np.zeros((1, 0)))[0, 0])
+        eqs = _Equations(p, [(0, con)])
+        c0 = float(eqs.kinds[0].residual(_At(p, eqs, self.q0[None]), None)[0, 0])
         self.cons.append(replace(con, c0=c0))
         if not any(x.type == "R" and set(x.links) & {b_name} and x.id != j.id
                    and np.linalg.norm(x.point - j.point) < 1e-9 * p.scale for x in self.mech.joints):
