@@ -35,7 +35,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.chain import frame_driven_links
 from mechsyn.kinematics.groups import Plan, geometry_memo
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.folds import pass_fold_events
@@ -70,59 +69,14 @@ def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray
     return None if st is None else _poses(S, plan, U, st, split)
 
 
-def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray, folds: bool) -> _Compiled | None:
+def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray, folds: bool) -> tuple | None:
     """One pass of the regular program over the input rows ``X`` (or the blocks of rows
-    ``X``, a list, one after the other) by the kernel (:func:`mechsyn.kinematics.kernel.run`).
-    None when a group comes near a fold and ``folds`` is false."""
-    prog = kernel.program(S, plan)
-    C, W, AL, D, near, Z = kernel.run(prog, X, speeds, REGULAR_DISC,
-                                      planes=(X[0] if isinstance(X, list) else X).shape[0])
-    if near and not folds:
-        return None
-    return _Compiled(C, W, AL, dict(zip(prog[0][4], D)), near, D, Z)
-
-
-def _link_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
-                folds: bool, parts: list | None = None) -> tuple:
-    """The poses of a pass, by the kernel (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N), the rows
-    assembled (N,), the rows with rates and the number of singular rows (through folds;
-    ``parts``: the fold scan's singular rows, blanked too). Which links frame drivers
-    turn is kept with the topology."""
-    dcol, dsgn, runs = S.topology.product("kernel-angles", lambda: _drive_arrays(S, plan), plan)
-    memo = geometry_memo(S)
-    ref = memo.get("drawn angles")
-    if ref is None:  # the drawn angles: this geometry's
-        ref = memo["drawn angles"] = np.ascontiguousarray(S.q0[2::3])
-    pass_ = (st.C, st.W, st.AL) if st.Z is None else (st.C, st.W, st.AL, st.Z)
-    return kernel.link_poses(pass_, U.shape[0], U, (dcol, dsgn, ref, runs), split, folds, S.n, parts)
-
-
-def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray, tuple]:
-    """Each link's frame driver's input column (-1: none), the input's sign, and the runs
-    ``(first, end)`` of consecutive links that no frame driver turns (their angles are
-    ``atan2`` of their rotations)."""
-    drive = frame_driven_links(S, plan)
-    nl = len(S.links)
-    free = [i for i in range(nl) if i not in drive]
-    runs = [[i, i + 1] for i in free[:1]]
-    for i in free[1:]:
-        if i == runs[-1][1]:
-            runs[-1][1] = i + 1
-        else:
-            runs.append([i, i + 1])
-    return (np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
-            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float), tuple(map(tuple, runs)))
-
-
-class _Compiled:
-    """The pass's record (:func:`mechsyn.kinematics.kernel.run`): the links' states gathered per link (``C``, ``W``, ``AL``),
-    the groups' discriminants by step (and as rows of one block ``D``, in the order of the
-    steps), whether one came near a fold, the rotations' real and imaginary parts ``Z``
-    (2, links, M) when the pass wrote them."""
-
-    def __init__(self, C: np.ndarray, W: np.ndarray, AL: np.ndarray, discs: dict, near: bool,
-                 D: np.ndarray | None = None, Z: np.ndarray | None = None) -> None:
-        self.C, self.W, self.AL, self.discs, self.near, self.D, self.Z = C, W, AL, discs, near, D, Z
+    ``X``, a list, one after the other) by the kernel: its record ``(C, W, AL, D, near,
+    Z)`` (:func:`mechsyn.kinematics.kernel.run`, the rotations' planes of the first
+    block's rows). None when a group comes near a fold and ``folds`` is false."""
+    rec = kernel.run(kernel.program(S, plan), X, speeds, REGULAR_DISC,
+                     planes=(X[0] if isinstance(X, list) else X).shape[0])
+    return None if rec[4] and not folds else rec
 
 
 def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
@@ -164,17 +118,15 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
-    steps, anchor, origin = kernel.chain_steps(S, plan)
     paths = _tracking_paths(S, U, split)
     st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
-    if not st.near:
+    if not st[4]:
         return _poses(S, plan, U, st, split)
-    sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, block=st.D)
+    out = pass_fold_events(S, plan, st[3], U, split, paths)
     if out is None:
         return None
-    q, qd, qdd, ok, rates_ok, singular = _link_poses(S, plan, U, st, split, True, out)
-    return Folded(q.T, qd.T, qdd.T, out, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok, rates_ok,
+    q, qd, qdd, ok, rates_ok, singular = kernel.link_poses(S, plan, st[:3] + st[5:], U, split, True, out)
+    return Folded(q.T, qd.T, qdd.T, out, LinkStates(st[0][:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok, rates_ok,
                   singular)
 
 
@@ -217,12 +169,12 @@ class Folded:
     singular: int
 
 
-def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Compiled, split: int | None) -> tuple:
+def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: tuple, split: int | None) -> tuple:
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass clear of folds
     (every link's origin is its first joint, its angle continuous from the drawn one) and
     the links' complex states."""
-    q, qd, qdd, *_ = _link_poses(S, plan, U, st, split, False)
-    return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
+    q, qd, qdd, *_ = kernel.link_poses(S, plan, st[:3] + st[5:], U, split, False)
+    return q.T, qd.T, qdd.T, LinkStates(st[0][:, :, :U.shape[0]], qd[2::3], qdd[2::3])
 
 
 class LinkStates:

@@ -51,19 +51,18 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     take the other branch instead (``sigma`` kept: a parallelogram becomes an
     anti-parallelogram there); the events say so.
     """
-    X, n0, shift = _tracking_rows(S, inputs)
+    rows = _tracking_rows(S, inputs)
+    X, n0, shift = rows
     M = X.shape[0]
     st = PoseState(S, M)
-    sigmas: list = []
+    sigmas: list = [None] * len(plan.steps)
     discs: dict = {}
     singular = np.zeros(M, bool)
     raw_events: list = []
     for k, step in enumerate(plan.steps):
-        if step.kind not in BRANCHED:
-            sigmas.append(solve_step(S, st, step, X, None))
-            continue
-        choose = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular)
-        sigmas.append(solve_step(S, st, step, X, choose))
+        choose = _chooser(S, plan, k, sigmas, [rows], [slice(0, M)], switch, [raw_events], singular, discs) \
+            if step.kind in BRANCHED else None
+        sigmas[k] = solve_step(S, st, step, X, choose)
     q = pose_rows(S, st, plan)
     for step in plan.steps:  # a link driven from the frame takes the input's own turn count
         if step.kind == "drive_R" and step.known[0] < 0:
@@ -92,7 +91,7 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     raw_events: list = [[] for _ in parts]
     for k, step in enumerate(plan.steps):
         if step.kind in BRANCHED:
-            sigmas[k] = _parts_chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
+            sigmas[k] = _chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
     # the sweeps' own rows (not shifted by turns: the same numbers as an untracked pass);
     # the choosers' events and root searches use the shifted rows
     E = np.vstack([blk for (X, n0, _), U in zip(rows, parts) for blk in (X[:n0], U)])
@@ -105,11 +104,14 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     return out
 
 
-def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
-                   raw_events: list, singular: np.ndarray):
-    """The sign chooser of branched step ``k`` over several sweeps' rows (``segs`` of the
-    pass): the branch rules (:func:`_branch_signs`) applied to each sweep's rows alone;
-    the signs are also put in ``sigmas[k]``."""
+def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
+             raw_events: list, singular: np.ndarray, discs: dict | None = None):
+    """The sign chooser of branched step ``k`` over one or several sweeps' rows (``segs``
+    of the pass, ``rows`` their :func:`_tracking_rows`): called with the step's
+    normalised discriminant and the drawn mode, it applies the branch rules
+    (:func:`_branch_signs`) to each sweep's rows alone, records the events (per sweep in
+    ``raw_events``), the singular rows and the discriminant (in ``discs``, when given),
+    puts the signs in ``sigmas[k]`` and returns them."""
     def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
         sig = np.empty(len(disc))
         for (X, n0, _), seg, evs in zip(rows, segs, raw_events):
@@ -117,6 +119,8 @@ def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list
             sig[seg], found, sing = _branch_signs(S, plan, k, up, X, disc[seg], s_file, n0, switch)
             evs.extend(found)
             singular[seg][sing] = True
+        if discs is not None:
+            discs[k] = disc
         sigmas[k] = sig
         return sig
     return choose
@@ -128,20 +132,6 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
     U = np.atleast_2d(np.asarray(inputs, float))
     path, shift = tracking_path(S, U[0])
     return np.vstack([path, U - shift]), path.shape[0], shift
-
-
-def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
-             discs: dict, raw_events: list, singular: np.ndarray):
-    """The sign chooser of branched step ``k``: called with the step's normalised
-    discriminant and the drawn mode, it applies the branch rules (:func:`_branch_signs`),
-    records the discriminant, events and singular rows, and returns the signs."""
-    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
-        sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
-        discs[k] = disc
-        raw_events.extend(evs)
-        singular[sing] = True
-        return sig
-    return choose
 
 
 def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
