@@ -36,18 +36,7 @@ _ZERO_DISC = 1e-12
 
 
 #: What an event on a connecting path (:func:`~mechsyn.kinematics.sweep.tracking_path`) says first.
-_ON_THE_WAY = "between the drawn configuration and the first input: "
-
-
-def swept(i: int, message: str, u: list, n0: int, shift: list, before: bool | None = None) -> tuple:
-    """An event's row, message, input and ``before_sweep`` along the sweep from its row
-    ``i`` of the tracked rows (the first ``n0`` the connecting path, the rest the sweep
-    shifted by the whole turns ``shift``): :func:`_sweep_events` of one event."""
-    if i < n0:  # on the way from the drawn configuration to the sweep
-        message, before = _ON_THE_WAY + message, True
-    if not before:
-        u = [x + s for x, s in zip(u, shift)]
-    return max(0, i - n0), message, u, before
+ON_THE_WAY = "between the drawn configuration and the first input: "
 
 
 def disc_at(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -184,7 +173,7 @@ def pass_fold_events(S: PlanarSystem, plan: Plan, D: np.ndarray, U: np.ndarray, 
         w, i, kind, g = int(w), int(i), int(kind), int(g)
         n0 = n0s[w]
         out[w][1].append(Event(max(0, i - n0), "reassembled" if kind == 2 else "dead point",
-                               messages[g][kind] if i >= n0 else _ON_THE_WAY + messages[g][kind], u, names[g],
+                               messages[g][kind] if i >= n0 else ON_THE_WAY + messages[g][kind], u, names[g],
                                before_sweep=True if i < n0 else None))
     return out
 

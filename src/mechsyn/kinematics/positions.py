@@ -78,32 +78,19 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 def _unwrap_rows(p: np.ndarray) -> np.ndarray:
     """``np.unwrap(p, axis=-1)`` for angles whose steps stay below a whole turn (as those of
-    ``atan2`` do), into a copy: the whole turns removed are counted exactly (a step of
-    exactly half a turn is kept, as ``np.unwrap`` keeps it)."""
+    ``atan2`` do), into a copy: the whole turns of each step counted (a step of exactly
+    half a turn is kept, as ``np.unwrap`` keeps it) and removed as the kernel removes them
+    (:func:`mechsyn.kinematics._kernel_numba.link_poses`)."""
     out = np.array(p, float)
-    if p.shape[-1] > 1:
-        k = np.subtract(p[..., 1:], p[..., :-1])
-        if not k.size or (k.max() <= math.pi and k.min() >= -math.pi):  # no step over half a turn
-            return out
-        k /= 2 * np.pi
-        np.rint(k, out=k)
-        jumps = np.flatnonzero(k)  # (NaN counts as a jump)
-        if len(jumps) > 16:  # many turns: count them all at once
-            np.cumsum(k, axis=-1, out=k)
-            k *= 2 * np.pi
-            out[..., 1:] -= k
-        elif len(jumps):  # a few: each shifts the rest of its row
-            o2, k2 = out.reshape(-1, out.shape[-1]), k.reshape(-1, k.shape[-1])
-            for j in jumps.tolist():
-                row, col = divmod(j, k2.shape[1])
-                o2[row, col + 1:] -= 2 * np.pi * k2[row, col]
+    out[..., 1:] -= 2 * np.pi * np.cumsum(np.rint(np.diff(p, axis=-1) / (2 * np.pi)), axis=-1)
     return out
 
 
 def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None) -> np.ndarray:
-    """Link angles ``phi`` (N, m) made continuous along a sweep: start near the file's
-    angles ``ref`` (m,), unwrap each run of assembled rows and keep the turn count across
-    gaps (``ok`` None: every row assembled). The kernel's passes do the same
+    """Link angles ``phi`` (N, m) made continuous along a sweep: each moved by whole turns
+    next to the file's angles ``ref`` (m,), each run of assembled rows unwrapped, the
+    turn count kept across gaps (``ok`` None: every row assembled). The kernel's passes
+    do the same
     (:func:`mechsyn.kinematics._kernel_numba.link_poses`).
 
     Examples
@@ -113,18 +100,12 @@ def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None) -
     >>> np.degrees(continuous_angles(phi, np.radians([160.0]), None)).round(6).ravel().tolist()
     [170.0, 190.0, 210.0]
     """
-    phi, col = phi.T, ref[:, None]
-    if ok is None or ok.all():  # one run: unwrap, then put the start row next to ref
-        block = _unwrap_rows(phi)
-        for i, (a, b, r0) in enumerate(zip(phi[:, 0].tolist(), block[:, 0].tolist(), ref.tolist())):
-            turns = round((b - (r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi))) / (2 * math.pi))
-            if turns:
-                block[i] -= 2 * math.pi * turns
-        return block.T
-    sub = col + _wrap(phi - col)
+    col = ref[:, None]
+    sub = col + _wrap(phi.T - col)  # every angle next to ref, then
     # the runs of assembled rows [a, b): each unwrapped, then shifted by whole turns to
     # follow the run before (on floats: a run's first angles are not changed by its
     # unwrapping)
+    ok = np.ones(sub.shape[1], bool) if ok is None else ok
     edges = np.flatnonzero(ok[1:] != ok[:-1])
     bounds = ([0] if ok[0] else []) + (edges + 1).tolist() + ([len(ok)] if ok[-1] else [])
     prev = None

@@ -17,15 +17,15 @@ equation one array operation instead of two:
   ``e2 = B - C`` its links turn at ``omega_1 = Re((v_C - v_A) conj(e2)) / (e1 x e2)``,
   ``omega_2 = Re((v_C - v_A) conj(e1)) / (e1 x e2)`` and likewise for the accelerations.
 
-:func:`regular_sweep` evaluates the sweep and the connecting paths from the drawn input
-values together and gives up (None) as soon as a group's discriminant falls below
-:data:`mechsyn.kinematics.sweep.REGULAR_DISC`: no group then folds, touches a change
-point or reassembles, every group keeps its drawn mode and the answer is that of the
-tracked outward sweeps (tests check both agree), at the cost of one pass.
-:func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
-local minimum under 0.05 (no change or branch point near: every group keeps its drawn
-mode), and reads the folds, reassembly and singular rows of the tracked sweeps off the
-discriminant arrays (:func:`mechsyn.kinematics.folds.pass_fold_events`).
+:func:`sweep_through_folds` evaluates the sweep and the connecting paths from the drawn
+input values together in one pass. When no group's discriminant falls below
+:data:`mechsyn.kinematics.sweep.REGULAR_DISC`, no group folds, touches a change point
+or reassembles, every group keeps its drawn mode and the answer is that of the tracked
+outward sweeps (tests check both agree). Else it goes on through the folds when no
+group's discriminant has a local minimum under 0.05 (no change or branch point near:
+every group keeps its drawn mode), and reads the folds, reassembly and singular rows of
+the tracked sweeps off the discriminant arrays
+(:func:`mechsyn.kinematics.folds.pass_fold_events`).
 """
 
 from __future__ import annotations
@@ -38,35 +38,9 @@ from mechsyn.kinematics import kernel
 from mechsyn.kinematics.groups import Plan, geometry_memo
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.folds import pass_fold_events
-from mechsyn.kinematics.sweep import REGULAR_DISC, regular_rows, tracking_path
+from mechsyn.kinematics.sweep import REGULAR_DISC, tracking_path
 
-__all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
-
-
-def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
-                  split: int | None) -> tuple | None:
-    """Poses and rates (N, n) of a driver-R + RRR chain over the inputs ``U`` (N, k) in
-    one pass, with the links' complex states (:class:`LinkStates`); None when a group
-    comes near a fold on the sweep or on the way to it from the drawn configuration
-    (``split``: the row after the drawn input values, see
-    :func:`mechsyn.kinematics.engines.drawn_row`; :func:`sweep_through_folds` goes on
-    through folds).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from mechsyn.io import load_mechanism
-    >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
-    >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
-    >>> U = np.radians(input_grid(0, 360, 1))[:, None]
-    >>> q, qd, qdd, links = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
-    >>> q.shape, bool(np.allclose(links.z, np.exp(1j * q[:, 2::3].T)))
-    ((361, 9), True)
-    """
-    if not plan.closed_form_rates or S.n != 3 * len(S.links):
-        return None
-    st = _pass(S, plan, regular_rows(S, U, split), speeds, folds=False)
-    return None if st is None else _poses(S, plan, U, st, split)
+__all__ = ["sweep_through_folds", "Folded", "LinkStates"]
 
 
 def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray, folds: bool) -> tuple | None:
@@ -86,7 +60,8 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     One pass over the sweep's rows and the connecting paths from the drawn input values
     (those of :func:`mechsyn.kinematics.tracking.solve_tracked_rates`) gives every group's
     normalised discriminant as an array. When no group comes near a fold the answer is
-    :func:`regular_sweep`'s ``(q, qd, qdd, links)``. Else, when no group's discriminant
+    ``(q, qd, qdd, links)``: poses and rates (N, n) and the links' complex states
+    (:class:`LinkStates`). Else, when no group's discriminant
     has a local minimum under 0.05 (no change or branch point can be near, so every group
     keeps its drawn mode on every row and the pass's rows are the tracked ones), the
     events of each sweep (the one sweep, or forwards and backwards from the drawn
@@ -99,14 +74,22 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
 
     Examples
     --------
+    A crank-rocker clear of folds:
+
+    >>> import numpy as np
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.analysis import cached_plan, input_grid
+    >>> kp = cached_plan(ms.examples.load("crank_rocker"), inputs=("A",))
+    >>> U = np.radians(input_grid(0, 360, 1))[:, None]
+    >>> q, qd, qdd, links = sweep_through_folds(kp.system, kp.groups, U, np.ones(1), None)
+    >>> q.shape, bool(np.allclose(links.z, np.exp(1j * q[:, 2::3].T)))
+    ((361, 9), True)
+
     A textbook four-bar (crank sqrt(5), coupler and rocker sqrt(10), frame 5) from 100 to
     260 degrees, one sweep (the drawn crank angle, 63.4 degrees, lies outside it): its
     working range ends and starts again at the law-of-cosines angles 116.565 and 243.435
     degrees, the 31 rows between them not assembled.
 
-    >>> import numpy as np
-    >>> import mechsyn as ms
-    >>> from mechsyn.kinematics.analysis import cached_plan
     >>> kp = cached_plan(ms.examples.load("fourbar"), inputs=("A",))
     >>> res = sweep_through_folds(kp.system, kp.groups, np.radians(np.arange(100.0, 261.0, 4.0))[:, None],
     ...                           np.ones(1), None)
@@ -192,13 +175,9 @@ class LinkStates:
 
     def point(self, i: int, s: complex | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (N, 2) of the local point ``s`` (x, y, or a
-        complex number) of link ``i``: views of one array (3, N, 2)."""
-        C = self.C
-        N = C.shape[2]
-        got = kernel.point_states(C, self.w, self.al, np.array([i], np.int64),
-                                  np.array([s if isinstance(s, complex) else complex(s[0], s[1])]))
-        P, V, A = got[:, 0].view(float).reshape(3, N, 2)
-        return P, V, A
+        complex number) of link ``i``: :meth:`points` of one point."""
+        P, V, A = self.points(np.array([i]), np.array([s if isinstance(s, complex) else complex(s[0], s[1])]))
+        return P[0], V[0], A[0]
 
     def points(self, idx: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (m, N, 2) of the local points ``s`` (m,
@@ -212,7 +191,7 @@ class LinkStates:
         >>> from mechsyn.kinematics.analysis import compile_plan
         >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
         >>> U = np.radians(np.arange(0.0, 360.0, 30.0))[:, None]
-        >>> *_, links = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
+        >>> *_, links = sweep_through_folds(kp.system, kp.groups, U, np.ones(1), None)
         >>> P, V, A = links.points(np.array([0, 1]), np.array([1 + 0j, 0.5 + 0.2j]))
         >>> P.shape, bool(np.array_equal(A[1], links.point(1, (0.5, 0.2))[2]))
         ((2, 12, 2), True)

@@ -16,7 +16,7 @@ import numpy as np
 from mechsyn.kinematics.chain import chain_poses, tracked_pass
 from mechsyn.kinematics.groups import Plan, cons_of
 from mechsyn.kinematics.positions import PoseState, TrackedPositions, pose_rows, solve_step
-from mechsyn.kinematics.folds import SINGULAR_DISC, disc_at, swept, fold_events, touch_candidates
+from mechsyn.kinematics.folds import ON_THE_WAY, SINGULAR_DISC, disc_at, fold_events, touch_candidates
 from mechsyn.kinematics.sweep import Event, tracking_path
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -135,12 +135,19 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
 
 
 def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
-    """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
+    """Events of the tracked rows (the first ``n0`` the connecting path, the rest the
+    sweep shifted by the whole turns ``shift``) as events of the sweep: their row along
+    it, the connecting path's marked (``before_sweep``, their message says so), the
+    sweep's inputs with the whole turns added back."""
     sh = shift.tolist()
     out = []
     for e in raw_events:
-        index, message, u, before = swept(e.index, e.message, e.input, n0, sh, e.before_sweep)
-        out.append(e.with_(index=index, message=message, input=u, before_sweep=before))
+        message, before, u = e.message, e.before_sweep, e.input
+        if e.index < n0:  # on the way from the drawn configuration to the sweep
+            message, before = ON_THE_WAY + message, True
+        if not before:
+            u = [x + s for x, s in zip(u, sh)]
+        out.append(e.with_(index=max(0, e.index - n0), message=message, input=u, before_sweep=before))
     return out
 
 
