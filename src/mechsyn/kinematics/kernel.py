@@ -62,15 +62,25 @@ def _nb() -> ModuleType:
     return importlib.import_module("mechsyn.kinematics._kernel_numba")
 
 
+#: A four-bar with two dead points and a coupler point (crank sqrt 5, coupler and rocker
+#: sqrt 10, frame 5): one sweep of it calls every compiled function (:func:`warm`).
+_WARM_FOURBAR = {
+    "name": "warm-up four-bar", "kind": "planar", "ground": "frame", "links": ["frame", "crank", "coupler", "rocker"],
+    "joints": [{"id": "A", "type": "R", "links": ["frame", "crank"], "point": [0, 0], "actuated": True},
+               {"id": "B", "type": "R", "links": ["crank", "coupler"], "point": [1, 2]},
+               {"id": "C", "type": "R", "links": ["coupler", "rocker"], "point": [4, 3]},
+               {"id": "D", "type": "R", "links": ["rocker", "frame"], "point": [5, 0]}],
+    "points": {"M": {"link": "coupler", "at": [3, 4]}},
+}
+
+
 def warm() -> bool:
     """Import Numba and compile (or load from its cache) the kernel's functions now, by
-    sweeping the bundled four-bar with two dead points and a coupler point (crank sqrt
-    5, coupler and rocker sqrt 10, frame 5: one sweep of it calls every compiled
-    function) through its dead points, so that the first sweep a user asks for does not
-    wait for them (the studio calls this while it starts). Returns True."""
-    from mechsyn.examples import load
+    sweeping a four-bar through its dead points, so that the first sweep a user asks for
+    does not wait for them (the studio calls this while it starts). Returns True."""
+    from mechsyn.io import mechanism_from_dict
 
-    load("fourbar").simulate(A=(0, 360, 30))
+    mechanism_from_dict(_WARM_FOURBAR, source="kernel.warm").simulate(A=(0, 360, 30))
     return True
 
 
