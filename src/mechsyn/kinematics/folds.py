@@ -113,9 +113,9 @@ def fold_events(S: PlanarSystem, plan: Plan, ks: list[int], sigmas: list, X: np.
     ok = D > -_ZERO_DISC
     singular = (ok & (D < SINGULAR_DISC)).any(axis=0)
     found = _fold_scan(S, plan, ks, sigmas, X, D, n0)
-    names = ["-".join(plan.steps[k].joints) for k in ks]
-    events = [Event(int(i), "reassembled" if kind == 2 else "dead point", _FOLD_MESSAGES[int(kind)].format(names[int(g)]),
-                    u, names[int(g)]) for _, i, kind, g, *u in found.tolist()]
+    _, names, messages = _fold_words(plan, ks)
+    events = [Event(int(i), "reassembled" if kind == 2 else "dead point", messages[int(g)][int(kind)], u,
+                    names[int(g)]) for _, i, kind, g, *u in found.tolist()]
     back = ok[:, 1:] & ~ok[:, :-1]  # the rows where each group assembles again
     return events, singular, [(np.flatnonzero(r) + 1).tolist() for r in back]
 

@@ -153,17 +153,16 @@ def _step_drive_P(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sig
     drive = next(c for c in cons_of(S, jid) if c.role == "drive")
     line = pair_line(S, jid)
     val = u[:, drive.driver]
+    ra, pa = st.pose(k)
+    if drive.a != k:  # the new link carries the axis
+        pa = pa + rel_angle(S, jid, k, new)
+    ca, sa_ = cos_sin(pa)
+    w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
     if drive.a == k:
-        ra, pa = st.pose(k)
-        ca, sa_ = cos_sin(pa)
-        w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
         Pa = st.point(k, line.sa)
         Pb = ra + val[:, None] * w + n * dot(n, Pa - ra)[:, None]
         _pin(st, new, Pb, drive.sb, pa + rel_angle(S, jid, k, new))
-    else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
-        pa = st.pose(k)[1] + rel_angle(S, jid, k, new)
-        ca, sa_ = cos_sin(pa)
-        w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
+    else:  # O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
         Pb = st.point(k, drive.sb)
         Oa = w * (dot(w, Pb) - val)[:, None] + n * dot(n, Pb - rotate(ca, sa_, line.sa))[:, None]
         st.set(new, Oa, pa)

@@ -89,7 +89,9 @@ def _scales_of(scale: float, rowmask: np.ndarray, colmask: np.ndarray, scales: l
     read, one write)."""
     sc = scales[0]
     if sc[0] != scale:
-        sc = scales[0] = (scale, _frozen(np.where(rowmask, scale, 1.0)), _frozen(np.where(colmask, scale, 1.0)))
+        sc = scales[0] = (scale, np.where(rowmask, scale, 1.0), np.where(colmask, scale, 1.0))
+        sc[1].setflags(write=False)
+        sc[2].setflags(write=False)
     return sc[1], sc[2]
 
 
@@ -168,11 +170,6 @@ def _layout(T: PlanarSystem) -> tuple | bool:
     slides = [k for k, j in enumerate(mech.joints) if j.type == "P"]  # (their axes are read: given?)
     return (first, other, rows, cols, ((len(T.cons), recipe), [i for i, _ in pairs], [k for _, k in pairs], slides),
             [(None,)], kept)
-
-
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
 
 
 def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames: tuple,
