@@ -374,12 +374,14 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
     its sign) takes the input itself; the others ``atan2`` of their rotation, made
     continuous (``A``: the rotations' ``atan2``, links by rows, from NumPy, whose vector
     loops take a third of libm's time) and started next to their drawn angle ``ref[i]``
-    (:func:`mechsyn.kinematics.positions.continuous_angles`'s rule): each tracked sweep
+    (:func:`mechsyn.kinematics.positions.continuous_angles`): without ``folds`` one
+    unwrapped run whose rows ``split`` and ``split - 1`` (when ``split`` >= 0) each start
+    next to ``ref`` (the fast path: no wrap per row); with ``folds`` each tracked sweep
     (forwards from ``split``, backwards from ``split - 1``, or the one sweep) on its own,
     every angle moved by whole turns next to ``ref``, its runs of assembled rows unwrapped
-    and each run following the run before by whole turns. With ``folds`` (else every row
-    is assembled) the rows where a link is not placed are blanked (NaN) in the poses and
-    in ``C``, the rates of rows where they are not finite blanked, and the rates of
+    and each run following the run before by whole turns, the rows where a link is not
+    placed blanked (NaN) in the poses and in ``C``, the rates of rows where they are not
+    finite blanked, and the rates of
     the singular rows the fold scan found (rows ``r < len(sb)``: ``sb[r]``, else ``sf[r -
     len(sb)]``) blanked too. Writes the rows assembled into ``ok`` (N,) and, with ``folds``,
     the rows with rates (assembled, finite, not singular) into ``rok`` (N,) (an array made
@@ -405,6 +407,27 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
             for r in range(N):
                 out[r] = U[r, dcol[i]] * dsgn[i]
             continue
+        for r in range(N):
+            out[r] = A[i, r]
+        if not folds:  # one run, unwrapped forwards, its start row(s) next to the drawn angle
+            raw = out[0]
+            K = 0.0
+            for r in range(1, N):
+                a = out[r]
+                d = a - raw
+                if d > 3.0 or d < -3.0:  # else |d / 2 pi| < 0.48: no whole turn (rint 0), no division
+                    K += np.rint(d / twopi)
+                raw = a
+                out[r] = a - twopi * K
+            for part in range(2 if split >= 0 else 1):
+                row = 0 if split < 0 else (split if part == 0 else split - 1)
+                lo, hi = (0, N) if split < 0 else ((split, N) if part == 0 else (0, split))
+                a0 = A[i, row]
+                turns = np.rint((out[row] - _near(a0, ref[i])) / twopi)
+                if turns != 0.0:
+                    for r in range(lo, hi):
+                        out[r] -= twopi * turns
+            continue
         for part in range(2 if split >= 0 else 1):  # each tracked sweep in its own order
             start, n, step = (0, N, 1) if split < 0 else ((split, N - split, 1) if part == 0 else (split - 1, split, -1))
             has_prev, in_run = False, False
@@ -414,7 +437,7 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
                 if not ok[r]:
                     in_run = False
                     continue
-                s = _near(A[i, r], ref[i])
+                s = _near(out[r], ref[i])
                 if not in_run:
                     in_run, raw, K = True, s, 0.0
                     x = s

@@ -217,12 +217,12 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     """NumPy's cosines and sines of the input rows ``blocks`` (float arrays (m, k))
     stacked: the numbers the regular pass turns its drivers by. A studio's drag, a design
     loop and a cached call sweep the same inputs again and again, with other link
-    lengths: the answers for blocks of 64 to 8,192 numbers are kept in the one cache
-    (:data:`mechsyn.kinematics.topology.CACHE`, under ``("trig", bytes, shape, type)`` of
-    the block: at most 128 kB an entry), so only new inputs cost their trigonometry (a
-    tenth of a six-bar's compiled pass); a smaller block (a connecting path from the
-    drawn input, new with each drawn crank angle) is computed, not looked for. Each
-    block's numbers are ``np.cos``, ``np.sin`` of that block, whatever is kept.
+    lengths: the answers for blocks of up to 8,192 numbers and for stacks of blocks are
+    kept in the one cache (:data:`mechsyn.kinematics.topology.CACHE`, under ``("trig",
+    bytes, shape, type)`` of the blocks: at most 128 kB an entry), so only new inputs
+    cost their trigonometry (a tenth of a six-bar's compiled pass); a small block is
+    computed, not looked for. Each block's numbers are ``np.cos``, ``np.sin`` of that
+    block, whatever is kept.
 
     Examples
     --------
@@ -231,20 +231,27 @@ def trig(blocks: list) -> tuple[np.ndarray, np.ndarray]:
     >>> bool(np.array_equal(c, np.cos(X)) and np.array_equal(s, np.sin(X)))
     True
     """
-    parts = [_block_trig(b) for b in blocks]
-    return parts[0] if len(parts) == 1 else (np.concatenate([c for c, _ in parts]),
-                                             np.concatenate([s for _, s in parts]))
+    if sum(b.size for b in blocks) > _TRIG_ROWS:
+        return tuple(np.concatenate([f(b) for b in blocks]) for f in (np.cos, np.sin))
+    keys = tuple([(b.tobytes(), b.shape, b.dtype.char) for b in blocks])
+    if len(blocks) == 1:
+        return _block_trig(blocks[0], keys[0])
+    hit = CACHE.get(("trig", keys))
+    if hit is None:
+        parts = [_block_trig(b, k) for b, k in zip(blocks, keys)]
+        hit = np.concatenate([c for c, _ in parts]), np.concatenate([s for _, s in parts])
+        CACHE.put(("trig", keys), hit)
+    return hit
 
 
-def _block_trig(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`trig` of one block, kept unless small or large."""
-    if not _SMALL <= b.size <= _TRIG_ROWS:
+def _block_trig(b: np.ndarray, key: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`trig` of one block (``key``: its bytes, shape and type), kept unless small."""
+    if b.size < _SMALL:
         return np.cos(b), np.sin(b)
-    key = ("trig", b.tobytes(), b.shape, b.dtype.char)
-    hit = CACHE.get(key)
+    hit = CACHE.get(("trig", key))
     if hit is None:
         hit = np.cos(b), np.sin(b)
-        CACHE.put(key, hit)
+        CACHE.put(("trig", key), hit)
     return hit
 
 
@@ -266,7 +273,8 @@ def link_poses(S: PlanarSystem, plan: Plan, pass_: tuple, U: np.ndarray, split: 
     N, nl = U.shape[0], C.shape[1]
     dcol, dsgn, runs = layout(S, plan)[4]
     q, qd, qdd = np.empty((3, S.n, N))  # one block, three contiguous views
-    q[3 * nl:] = qd[3 * nl:] = qdd[3 * nl:] = np.nan  # (unknowns other than the links' poses: none here)
+    if S.n > 3 * nl:  # unknowns other than the links' poses (none in a regular pass)
+        q[3 * nl:] = qd[3 * nl:] = qdd[3 * nl:] = np.nan
     zr, zi = (Z[0][0], Z[0][1]) if Z else (C[0].real, C[0].imag)  # the planes of run() (N rows), else strided parts
     A = np.empty((nl, N))
     ok = np.empty((2, N), np.bool_)  # the rows assembled, the rows with rates

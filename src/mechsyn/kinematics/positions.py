@@ -87,10 +87,9 @@ def _unwrap_rows(p: np.ndarray) -> np.ndarray:
 
 
 def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None) -> np.ndarray:
-    """Link angles ``phi`` (N, m) made continuous along a sweep: each moved by whole turns
-    next to the file's angles ``ref`` (m,), each run of assembled rows unwrapped, the
-    turn count kept across gaps (``ok`` None: every row assembled). The kernel's passes
-    do the same
+    """Link angles ``phi`` (N, m) made continuous along a sweep: started next to the
+    file's angles ``ref`` (m,), each run of assembled rows unwrapped, the turn count
+    kept across gaps (``ok`` None: every row assembled). The kernel's passes do the same
     (:func:`mechsyn.kinematics._kernel_numba.link_poses`).
 
     Examples
@@ -100,12 +99,18 @@ def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None) -
     >>> np.degrees(continuous_angles(phi, np.radians([160.0]), None)).round(6).ravel().tolist()
     [170.0, 190.0, 210.0]
     """
-    col = ref[:, None]
-    sub = col + _wrap(phi.T - col)  # every angle next to ref, then
+    phi, col = phi.T, ref[:, None]
+    if ok is None or ok.all():  # one run: unwrapped, then moved by whole turns to start next to ref
+        block = _unwrap_rows(phi)
+        for i, (a, b, r0) in enumerate(zip(phi[:, 0].tolist(), block[:, 0].tolist(), ref.tolist())):
+            turns = round((b - (r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi))) / (2 * math.pi))
+            if turns:
+                block[i] -= 2 * math.pi * turns
+        return block.T
+    sub = col + _wrap(phi - col)  # every angle next to ref, then
     # the runs of assembled rows [a, b): each unwrapped, then shifted by whole turns to
     # follow the run before (on floats: a run's first angles are not changed by its
     # unwrapping)
-    ok = np.ones(sub.shape[1], bool) if ok is None else ok
     edges = np.flatnonzero(ok[1:] != ok[:-1])
     bounds = ([0] if ok[0] else []) + (edges + 1).tolist() + ([len(ok)] if ok[-1] else [])
     prev = None
