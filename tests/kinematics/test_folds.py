@@ -24,8 +24,9 @@ def _per_sweep(S, plan, st, U, split, paths, sigmas):
     N = U.shape[0]
     parts = [U] if split is None else [U[split:], U[:split][::-1]]
     order = [np.arange(N)] if split is None else [np.arange(split, N), np.arange(split - 1, -1, -1)]
-    start, out, ks = N, [], sorted(st.discs)
-    D = np.stack([st.discs[k] for k in ks])
+    from mechsyn.kinematics import kernel
+
+    start, out, ks, D = N, [], list(kernel.program(S, plan)[0][4]), st[3]
     tracks = []
     for (path, shift), p, idx in zip(paths, parts, order):
         n0 = path.shape[0]
@@ -52,32 +53,6 @@ def _cases(ex):
         kp = cached_plan(m, inputs=(j,))
         for g in grids:
             yield m.name, g, kp.system, kp.groups, np.radians(np.arange(*g))[:, None]
-
-
-def test_gap_angles_wrapped_as_np_remainder_wraps_them():
-    """The link angles of a sweep with gaps are wrapped next to the drawn angles in place
-    (``fresh``) without ``np.remainder``'s division when the drawn angles lie within half
-    a turn: the same numbers, bit for bit, as the wrap of the copying path, on atan2
-    angles including the edges (+-pi, +-0, the neighbours of pi) and NaN gaps; drawn
-    angles beyond half a turn take ``np.remainder`` itself."""
-    from mechsyn.kinematics.positions import continuous_angles
-
-    rng = np.random.default_rng(7)
-    edges = np.array([math.pi, -math.pi, 0.0, -0.0, np.nextafter(math.pi, 0), np.nextafter(-math.pi, 0), 1e-300])
-    for trial in range(300):
-        m, n = 3, 80
-        phi = np.arctan2(rng.normal(size=(m, n)), rng.normal(size=(m, n)))
-        phi.flat[rng.integers(0, m * n, 25)] = rng.choice(edges, 25)
-        ok = np.ones(n, bool)
-        for a in rng.integers(1, n - 1, 3):  # gaps: their rows not assembled
-            ok[a:a + rng.integers(1, 9)] = False
-        phi[:, ~ok] = np.where(rng.random((m, 1)) < 0.5, np.nan, phi[:, ~ok])  # upstream links stay finite
-        ref = rng.choice(np.concatenate([rng.uniform(-math.pi, math.pi, 4), edges,
-                                         [4.0, -7.0] if trial % 3 == 0 else []]), (m, 1))
-        want = continuous_angles(phi.T.copy(), ref[:, 0], ok).T  # the copying path (np.remainder)
-        got = continuous_angles(phi.copy(), ref, ok, fresh=True)
-        runs = np.flatnonzero(ok)
-        assert np.array_equal(got[:, runs].view(np.int64), want[:, runs].view(np.int64)), trial
 
 
 def test_tracking_path_is_kept_and_read_only():
@@ -129,14 +104,14 @@ def test_the_kernels_fold_scan_equals_the_sweeps_python_scan(ex, monkeypatch):
     from mechsyn.kinematics import kernel, regular, folds, tracking
 
     seen = {"hidden": 0, "root": 0}
-    real = folds._hidden_fold
+    real = kernel._plain()["hidden_fold"]
 
-    def spy(f, fa, fb, ends, starts, i, hidden):  # which refinements the Python scan made
-        t = real(f, fa, fb, ends, starts, i, hidden)
-        seen["hidden" if hidden else "root"] += t is not None
+    def spy(f, fa, fb, tc, hidden, zero):  # which refinements the Python scan made
+        t = real(f, fa, fb, tc, hidden, zero)
+        seen["hidden" if hidden else "root"] += not math.isnan(t)
         return t
 
-    monkeypatch.setattr(folds, "_hidden_fold", spy)
+    monkeypatch.setitem(kernel._plain(), "hidden_fold", spy)
     events = before = folded = backward = 0
     for name, g, S, plan, U in _folding_cases(ex):
         split = drawn_row(S, U)
@@ -144,9 +119,9 @@ def test_the_kernels_fold_scan_equals_the_sweeps_python_scan(ex, monkeypatch):
         paths = [tracking.tracking_path(S, p[0]) for p in parts]
         X = np.concatenate([U] + [p for p, _ in paths])
         st = regular._pass(S, plan, X, np.ones(1), folds=True)
-        steps, anchor, _ = kernel.chain_steps(S, plan)
-        sigmas = [1.0 if s[0] == "drive" else s[6] for s in steps]
-        got = folds.pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, X)
+        fp = kernel.program(S, plan)[1]
+        sigmas = [1.0 if s.kind == "drive_R" else fp[k, 2].real for k, s in enumerate(plan.steps)]
+        got = folds.pass_fold_events(S, plan, st[3], U, split, paths, X)
         want = _per_sweep(S, plan, st, U, split, paths, sigmas)
         assert (got is None) == (want is None), (name, g)
         if got is None:

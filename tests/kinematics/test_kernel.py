@@ -82,20 +82,22 @@ def test_the_kernel_pass_equals_the_generic_steps(name, mech):
     wide = np.radians(np.arange(-180.0, 541.0, 2.5))  # a full turn and more: folds if the chain has any
     X = np.column_stack([wide if i == 0 else u0[i] + rng.uniform(-0.3, 0.3, wide.size) for i in range(k)])
     speeds = np.linspace(1.0, 2.0, k)
-    steps, anchor, origin = kernel.chain_steps(S, plan)
-    C, W, AL, D, near = kernel.run(kernel.program(S, plan), X, speeds, regular.REGULAR_DISC)
+    prog = kernel.program(S, plan)
+    fp = prog[1]
+    C, W, AL, D, near = kernel.run(prog, X, speeds, regular.REGULAR_DISC)
 
     def joint(i: int, jid: str) -> np.ndarray:  # a joint's complex position on link i (-1: the frame)
         s = complex(*local_point(S, i, jid))
         return np.full(len(X), s) if i < 0 else q[:, 3 * i] + 1j * q[:, 3 * i + 1] + np.exp(1j * q[:, 3 * i + 2]) * s
 
     with np.errstate(invalid="ignore", divide="ignore"):
-        q = solve_positions(S, plan, X, [st[6] if st[0] == "RRR" else None for st in steps])[0]
+        q = solve_positions(S, plan, X, [fp[s, 2].real if st.kind == "RRR" else None
+                                         for s, st in enumerate(plan.steps)])[0]
         D0 = []
-        for st in steps:
-            if st[0] == "RRR":
-                d = joint(st[1][1], st[3][2]) - joint(st[1][0], st[3][0])
-                D0.append(circle_circle(d.real, d.imag, st[4], st[5])[2])
+        for s, st in enumerate(plan.steps):
+            if st.kind == "RRR":
+                d = joint(st.known[1], st.joints[2]) - joint(st.known[0], st.joints[0])
+                D0.append(circle_circle(d.real, d.imag, fp[s, 0].real, fp[s, 0].imag)[2])
     D0 = np.array(D0)
     assert near == (not np.nanmin(D0) >= regular.REGULAR_DISC)
     fin = np.isfinite(D0)
@@ -185,14 +187,15 @@ def test_the_kernels_fold_masks_equal_numpys(name):
     for grid in (np.arange(0.0, 361.0), np.arange(-400.0, 400.0, 3.0)):
         X = np.radians(grid)[:, None]
         st = regular._pass(S, plan, X, np.ones(1), folds=True)
-        ks = sorted(st.discs)
+        ks = kernel.program(S, plan)[0][4]
+        discs = dict(zip(ks, st[3]))
         M = X.shape[0]
         for split, n0s in ((None, (7,)), (M // 3, (5, 9))):
             perm, b = folds._pass_layout(M - sum(n0s), split, n0s)
-            want = _numpy_fold_masks(st.discs, ks, perm, b)
+            want = _numpy_fold_masks(discs, ks, perm, b)
             ng, L = len(ks), perm.shape[0]
             Dl, singular, chg = np.empty((ng, L)), np.empty(L, np.bool_), np.empty((ng, L - 1), np.bool_)
-            low = kernel._nb().fold_rows(np.array([st.discs[k] for k in ks]), perm, b, folds._ZERO_DISC,
+            low = kernel._nb().fold_rows(st[3], perm, b, folds._ZERO_DISC,
                                          folds.SINGULAR_DISC, Dl, singular, chg)
             assert np.array_equal(want[0], Dl, equal_nan=True) and np.array_equal(want[1], singular)
             assert all(np.array_equal(x, y) for x, y in zip(want[2], np.nonzero(chg))) and want[3] == low
@@ -269,20 +272,19 @@ def test_the_batch_runs_the_kernels_program(name):
     offs = np.arange(0.0, 360.0, 2.0)
     res = simulate_batch(bp, bp.parameters(m), offs, transmission=True)
     u = np.radians(res.motion(0).inputs[bp.input_joint])[:, None]  # the inputs as simulate measures them
-    steps, _, _ = kernel.chain_steps(S, plan)
     with np.errstate(invalid="ignore", divide="ignore"):
         C, W, AL, D, near = kernel.run(kernel.program(S, plan), u, np.ones(1), regular.REGULAR_DISC)
     ok, clear = (D >= 0).all(axis=0), ~(np.abs(D) <= 1e-12).any(axis=0)  # (NaN downstream of a fold)
     assert np.array_equal(res.assembled[0][clear], ok[clear]) and clear.sum() >= len(offs) - 4 and near
     ok = res.assembled[0]
     sin_mu = np.inf
-    for st in steps:
-        if st[0] != "RRR":
+    for st in plan.steps:
+        if st.kind != "RRR":
             continue
-        J1, J2, J3 = st[3]
+        J1, J2, J3 = st.joints
         P = {j: res.paths[j][0][ok] for j in (J1, J2, J3)}
         e1, e2 = P[J2] - P[J1], P[J2] - P[J3]
         s = np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) / (np.hypot(*e1.T) * np.hypot(*e2.T))
         sin_mu = min(sin_mu, s.min())
     assert res.min_transmission_angle[0] == pytest.approx(np.degrees(np.arcsin(sin_mu)), abs=1e-5)
-    assert np.isnan(res.paths[steps[-1][3][1]][0][~ok]).all()
+    assert np.isnan(res.paths[plan.steps[-1].joints[1]][0][~ok]).all()

@@ -95,12 +95,12 @@ def _same(a, b):
 
 
 def test_one_pass_equals_the_tracked_sweep(ex):
-    """Where no group comes near a fold, the one array pass (``regular_sweep``) answers;
-    with dead points the regular pass goes on through them (``sweep_through_folds``).
+    """Where no group comes near a fold, the one array pass answers with the links'
+    states; with dead points the regular pass goes on through them (a ``Folded``).
     Either way the engine gives what the tracked outward sweeps give."""
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.engines import drawn_row
-    from mechsyn.kinematics.regular import regular_sweep
+    from mechsyn.kinematics.regular import Folded, sweep_through_folds
 
     cases = [("kinematics/crank_rocker.yaml", "A", True), ("kinematics/jansen_leg.yaml", "P0", True),
              ("textbook/fourbar.yaml", "A", False), ("textbook/watt_sixbar.yaml", "A", False)]
@@ -110,7 +110,8 @@ def test_one_pass_equals_the_tracked_sweep(ex):
         for grid in ((0, 360, 1), (-90, 500, 7), (200, 260, 0.5)):
             x = input_grid(*grid)
             U = np.radians(x)[:, None]
-            got = regular_sweep(kp.system, kp.groups, U, np.ones(1), drawn_row(kp.system, U))
+            got = sweep_through_folds(kp.system, kp.groups, U, np.ones(1), drawn_row(kp.system, U))
+            got = None if isinstance(got, Folded) else got
             assert (got is not None) == regular or grid[1] - grid[0] < 360, (f, grid)
             if got is not None:
                 q, qd, qdd, links = got
@@ -239,7 +240,7 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     the last bits of its arithmetic."""
     from mechsyn.kinematics.analysis import cached_plan
     from mechsyn.kinematics.groups import cons_of, local_point
-    from mechsyn.kinematics.kernel import chain_steps as _program
+    from mechsyn.kinematics.kernel import program as _program
 
     m = ex(f)
     j = next(jj.id for jj in m.joints if jj.actuated)
@@ -249,32 +250,29 @@ def test_regular_program_refilled_by_topology_equals_one_built_from_the_groups(e
     kp2 = compile_plan(m.with_joint_points(pts), inputs=(j,))
     S = kp2.system
     assert S.topology == kp.system.topology  # what the topology decides: kept by it
-    steps, cx, origin = _program(S, kp2.groups)
+    _, fp, anc_s = _program(S, kp2.groups)
     want, anchor = [], {}
 
     def lp(i: int, jid: str) -> complex:
         return complex(*local_point(S, i, jid))
 
-    for step in kp2.groups.steps:  # the program from the groups, written out here
+    for step in kp2.groups.steps:  # the program's numbers from the groups, written out here
         if step.kind == "drive_R":
             (new,), (k,), (jid,) = step.links, step.known, step.joints
             con = next(c for c in cons_of(S, jid) if c.role == "drive")
-            want.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0, lp(k, jid)))
-            anchor[new] = (jid, lp(new, jid))
+            want.append((1.0 if con.b == new else -1.0, lp(k, jid), 0, 0, 0, 0, 0))
+            anchor[new] = lp(new, jid)
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
         u, v = lp(b1, J2) - lp(b1, J1), lp(b2, J2) - lp(b2, J3)
         A0, B0, C0 = (complex(*m.with_joint_points(pts).joint(jj).point) for jj in (J1, J2, J3))
         sigma = 1.0 if ((C0 - A0).conjugate() * (B0 - A0)).imag >= 0 else -1.0
-        want.append(("RRR", step.known, step.links, step.joints, abs(u) ** 2, abs(v) ** 2, sigma,
-                     (u / abs(u) ** 2).conjugate(), (v / abs(v) ** 2).conjugate(), lp(k1, J1), lp(k3, J3)))
-        anchor[b1], anchor[b2] = (J1, lp(b1, J1)), (J3, lp(b2, J3))
-    assert [w[:4] for w in want] == [st[:4] for st in steps]
-    for w, st in zip(want, steps):  # the numbers, to the last bits of their arithmetic
-        assert np.allclose(np.array(w[4:], complex), np.array(st[4:], complex), rtol=1e-14, atol=1e-14 * S.scale)
-    assert cx.keys() == anchor.keys() and all(cx[i][0] == anchor[i][0] for i in anchor)
-    assert np.allclose([cx[i][1] for i in anchor], [anchor[i][1] for i in anchor], rtol=1e-14, atol=1e-14 * S.scale)
-    assert origin == [next(jj.id for jj in m.joints_of(name)) for name in S.links]
+        want.append((abs(u) ** 2 + 1j * abs(v) ** 2, 0, sigma, (u / abs(u) ** 2).conjugate(),
+                     (v / abs(v) ** 2).conjugate(), lp(k1, J1), lp(k3, J3)))
+        anchor[b1], anchor[b2] = lp(b1, J1), lp(b2, J3)
+    # the numbers, to the last bits of their arithmetic
+    assert np.allclose(np.array(want, complex), fp, rtol=1e-14, atol=1e-14 * S.scale)
+    assert np.allclose([anchor[i] for i in sorted(anchor)], anc_s[sorted(anchor)], rtol=1e-14, atol=1e-14 * S.scale)
 
 
 @pytest.mark.parametrize("f, joint", [("textbook/watt_sixbar.yaml", "E"), ("textbook/fourbar.yaml", "C"),
@@ -292,18 +290,15 @@ def test_four_bar_fold_spec_of_a_refilled_geometry_equals_a_fresh_plans(ex, f, j
     kp = cached_plan(m, inputs=("A",))
     simulate(m, {"A": input_grid(0, 360, 2)})  # the regular program kept with the system
     memo = geometry_memo(kp.system)
-    assert memo[("regular", id(kp.groups))][0] is kp.groups
+    assert memo[("kernel", id(kp.groups))][0] is kp.groups
     ks = [k for k, s in enumerate(kp.groups.steps) if s.kind == "RRR"]
-    for k in ks:
-        memo.pop(("four-bar fold", id(kp.groups), k), None)
-    got = [folds._four_bar_spec(kp.system, kp.groups, k) for k in ks]
+    memo.pop(("four-bar folds", id(kp.groups), tuple(ks)), None)
+    got = folds._four_bar_specs(kp.system, kp.groups, ks)
     fresh = compile_plan(m, inputs=("A",))
     assert fresh.system is not kp.system
-    want = [folds._four_bar_spec(fresh.system, fresh.groups, k) for k in ks]
-    assert [g is None for g in got] == [w is None for w in want] and any(g is not None for g in got)
-    for g, w in zip(got, want):
-        if g is not None:
-            assert g[2] == w[2] and np.allclose([g[0], g[1], *g[3]], [w[0], w[1], *w[3]], rtol=1e-13, atol=1e-13)
+    want = folds._four_bar_specs(fresh.system, fresh.groups, ks)
+    assert np.array_equal(got[:, 0], want[:, 0]) and got[:, 0].any() and np.array_equal(got[:, 4], want[:, 4])
+    assert np.allclose(got, want, rtol=1e-13, atol=1e-13)
 
 
 @pytest.mark.parametrize("gap", [0.0, 4.4e-16, 3e-13])

@@ -7,8 +7,7 @@ step's constants held in registers, no temporaries, the joints' and links' state
 complex arrays by row): the positions (:func:`_positions`, the one placement: the
 regular pass, the fold search's discriminant and the batch of designs run it), then the
 rates. The program is the
-regular pass's (:func:`mechsyn.kinematics.kernel.chain_steps`) as arrays
-(:func:`mechsyn.kinematics.kernel.program`). Step by step over all rows is 30 %
+regular pass's as arrays (:func:`mechsyn.kinematics.kernel.program`). Step by step over all rows is 30 %
 faster than row by row over all steps (crank-rocker 24 -> 17 us, Watt six-bar 40 -> 28 us
 for 361 rows), with the same bits.
 """
@@ -109,7 +108,7 @@ def places(dx, dy, F, G, Dsc, sig, EX, EY):
 @njit(**_OPTIONS)
 def fill(fi, anc_p, loc, pt, fp, anc_s):
     """The numbers of the program of ``K`` designs of one topology, the one
-    implementation (:func:`mechsyn.kinematics.kernel.chain_steps` fills one system's,
+    implementation (:func:`mechsyn.kinematics.kernel.program` fills one system's,
     :func:`mechsyn.kinematics.batch.simulate_batch` many designs'): from the local
     points ``loc`` (K, pairs) complex of the (link, joint) pairs ``fi`` names and the
     drawn joint points ``pt`` (K, joints) complex, each step's row of ``fp`` (K, steps,
@@ -377,11 +376,12 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
     loops take a third of libm's time) and started next to their drawn angle ``ref[i]``
     (:func:`mechsyn.kinematics.positions.continuous_angles`): without ``folds`` one
     unwrapped run whose rows ``split`` and ``split - 1`` (when ``split`` >= 0) each start
-    next to ``ref``; with ``folds`` each tracked sweep (forwards from ``split``, backwards
-    from ``split - 1``, or the one sweep) on its own, its runs of assembled rows unwrapped
+    next to ``ref`` (the fast path: no wrap per row); with ``folds`` each tracked sweep
+    (forwards from ``split``, backwards from ``split - 1``, or the one sweep) on its own,
+    every angle moved by whole turns next to ``ref``, its runs of assembled rows unwrapped
     and each run following the run before by whole turns, the rows where a link is not
-    placed blanked (NaN) in the poses and in ``C`` and the rates of rows where they are
-    not finite blanked (:func:`mechsyn.kinematics.regular._fold_poses`), and the rates of
+    placed blanked (NaN) in the poses and in ``C``, the rates of rows where they are not
+    finite blanked, and the rates of
     the singular rows the fold scan found (rows ``r < len(sb)``: ``sb[r]``, else ``sf[r -
     len(sb)]``) blanked too. Writes the rows assembled into ``ok`` (N,) and, with ``folds``,
     the rows with rates (assembled, finite, not singular) into ``rok`` (N,) (an array made
@@ -444,7 +444,7 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
                     shift = twopi * np.rint((x - prev) / twopi) if has_prev else 0.0
                 else:
                     d = s - raw
-                    if d > 3.0 or d < -3.0:  # as above
+                    if d > 3.0 or d < -3.0:  # else |d / 2 pi| < 0.48: no whole turn (rint 0), no division
                         K += np.rint(d / twopi)
                     raw = s
                     x = s - twopi * K
@@ -600,7 +600,7 @@ def fold_root(c, fa, fb, a, b):
     from one input step to 1e-14 of it; Dahlquist and Bjorck, *Numerical Methods*, 1974,
     sec. 6.3). NaN when the ends do not bracket a zero. ``f(c, t)`` is
     :func:`_disc_along`: compiled, the program's discriminant; run as plain Python
-    (:func:`mechsyn.kinematics.kernel.hidden_fold`), the callable ``c`` (the generic
+    (:func:`mechsyn.kinematics.kernel.scan_sweep`), the callable ``c`` (the generic
     steps' discriminant, :mod:`mechsyn.kinematics.folds`)."""
     if fa == 0.0:
         return a
@@ -649,24 +649,36 @@ def hidden_fold(c, fa, fb, tc, hidden, zero):
 
 @njit(**_OPTIONS)
 def _refine(c, g, i, hidden, xa, xb, fa, fb, ends, starts):
-    """The kernel's refinement of a fold of :func:`scan_sweep` between the inputs ``xa``
-    and ``xb``: in closed form (:func:`_four_bar_t`) or by :func:`hidden_fold` on the
-    program's discriminant; ``c``: ``(ip, fp, anc_j, anc_s, nj, ks, specs, sg, zero)``."""
-    ip, fp, anc_j, anc_s, nj, ks, specs, sg, zero = c
+    """The kernel's refinement of a fold of group ``g`` of :func:`scan_sweep` between rows
+    ``i - 1`` and ``i`` (the inputs ``xa`` and ``xb``): in closed form
+    (:func:`_four_bar_t`) or by :func:`hidden_fold` on the group's discriminant along the
+    segment (:func:`_segment`); ``c``: the groups' closed-form numbers, the round-off
+    zero, then what :func:`_segment` reads."""
+    specs, zero = c[0], c[1]
     t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
     if not math.isnan(t):
         return t
+    tc = 0.0 if hidden == 0 else (ends[i] if hidden > 0 else starts[i])
+    return hidden_fold(_segment(c, g, i, xa, xb), fa, fb, tc, hidden, zero)
+
+
+@njit(**_OPTIONS)
+def _segment(c, g, i, xa, xb):
+    """What :func:`_disc_along` reads for group ``g`` on the segment of inputs from ``xa``
+    to ``xb``: the program, the group's step, ``xa``, ``xb - xa`` and every group's mode
+    (``c``: ``(specs, zero, ip, fp, anc_j, anc_s, nj, ks, sg)``; run as plain Python,
+    the context's own discriminant, :func:`mechsyn.kinematics.kernel.scan_sweep`)."""
+    _, _, ip, fp, anc_j, anc_s, nj, ks, sg = c
     d = np.empty(xa.shape[0])
     for k in range(xa.shape[0]):
         d[k] = xb[k] - xa[k]
-    tc = 0.0 if hidden == 0 else (ends[i] if hidden > 0 else starts[i])
-    return hidden_fold((ip, fp, anc_j, anc_s, nj, ks[g], xa, d, sg), fa, fb, tc, hidden, zero)
+    return ip, fp, anc_j, anc_s, nj, ks[g], xa, d, sg
 
 
 @njit(**_OPTIONS)
 def _four_bar_t(spec, ua, ub):
-    """:func:`mechsyn.kinematics.folds._four_bar_fold` from its group's numbers
-    ``spec`` (:func:`mechsyn.kinematics.folds._four_bar_numbers`: a four-bar or not,
+    """Where a group closing a four-bar folds, from its numbers ``spec``
+    (:func:`mechsyn.kinematics.folds._four_bar_specs`: a four-bar or not,
     ``|v|``, ``|w|``, ``arg w - arg v``, the input's sign, the two squared distances): t
     in [0, 1] of the one fold angle between the inputs ``ua`` and ``ub``, else NaN."""
     if spec[0] == 0.0:
@@ -704,7 +716,7 @@ def scan_sweep(D, X, n0, shift, zero, c, ev, ne, w):
     group's fold: its own fold may come first, hidden between the rows: ``ends``,
     ``starts``), each refined by :func:`_refine` ``(c, g, i, hidden, xa, xb, fa, fb,
     ends, starts)`` (t in [0, 1] between rows ``i - 1`` and ``i``, NaN: none; run as plain
-    Python, the context ``c`` brings its own refinement), then its
+    Python, the context ``c`` brings its own discriminant), then its
     reassemblies. Writes the events as rows of ``ev`` from row ``ne``: ``w``, row, kind
     (0 the assembly ends, 1 it starts again, 2 reassembled), group, then the input (whole
     turns added back past the connecting path); returns the next free row."""
@@ -785,7 +797,7 @@ def fold_scan(Dp, perm, b, zero, sing, X, nsw, n0a, sha, n0b, shb, ks, specs, ip
     sg = np.empty(fp.shape[0])  # every group in its drawn mode
     for st in range(fp.shape[0]):
         sg[st] = fp[st, 2].real
-    c = (ip, fp, anc_j, anc_s, nj, ks, specs, sg, zero)
+    c = (specs, zero, ip, fp, anc_j, anc_s, nj, ks, sg)
     for w in range(nsw if cap else 0):
         n0, shift = (n0a, sha) if w == 0 else (n0b, shb)
         n = L - b if w == 0 else b

@@ -218,7 +218,7 @@ def compile_plan(mech: Mechanism, points: list[str] | None = None) -> BatchPlan:
     if plan is None or not plan.closed_form_rates:
         raise MechsynInputError("the mechanism is not solved by a crank and RRR dyads in closed form", source=src,
                                 field="joints", hint="the batch engine needs a dyad-decomposable mechanism; use simulate")
-    *_, pj, (ip, anc_j, _, nj, groups), (fi, anc_p) = kernel.layout(S, plan)
+    _, pj, (ip, anc_j, _, nj, groups), (fi, anc_p), _ = kernel.layout(S, plan)
     points = list(mech.points) or [j.id for j in mech.joints] if points is None else list(points)
     for p in points:
         if p not in index:

@@ -52,7 +52,7 @@ from mechsyn.kinematics.refill import joint_points
 from mechsyn.kinematics.system import PlanarSystem, frame_points
 from mechsyn.kinematics.topology import CACHE
 
-__all__ = ["chain_steps", "fold_scan", "four_bar_fold", "hidden_fold", "layout", "link_poses", "numbers",
+__all__ = ["fold_scan", "layout", "link_poses", "numbers",
            "point_states", "program", "run", "scalar_disc", "scan_sweep", "trig", "warm"]
 
 
@@ -84,39 +84,23 @@ def warm() -> bool:
     return True
 
 
-def chain_steps(S: PlanarSystem, plan: Plan) -> tuple:
-    """The chain's steps with complex constants, every link's anchor and origin joint
-    (built once per system and plan). Its shape and the program's integers depend on the
-    topology only (:func:`layout`). The numbers
-    are :func:`numbers` of ``S``'s local points (the kernel's ``fp`` and ``anc_s``,
-    kept with ``S`` under ``("kernel", id(plan))``: :func:`program`); the steps are
-    read off them."""
-    memo = geometry_memo(S)
-    key = ("regular", id(plan))
-    hit = memo.get(key)
-    if hit is not None and hit[0] is plan:
-        return hit[1]
-    steps_, anchors, origin, li, pj, ints, table = layout(S, plan)
-    loc, pt = (np.fromiter(chain.from_iterable(a), float).view(complex)[None] for a in (_locals(S, li, pj),
-                                                                                        joint_points(S)))
-    fp, anc_s = numbers(table, loc, pt)
-    memo[("kernel", id(plan))] = (plan, (ints, fp[0], anc_s[0]))
-    rows, anc = fp[0].tolist(), anc_s[0].tolist()
-    steps = [st + (r[1],) if st[0] == "drive" else st + (r[0].real, r[0].imag, r[2].real, *r[3:])
-             for st, r in zip(steps_, rows)]
-    out = steps, {i: (jid, anc[i]) for i, (jid, _) in anchors.items()}, origin
-    memo[key] = (plan, out)
-    return out
-
-
 def program(S: PlanarSystem, plan: Plan) -> tuple:
     """The regular pass's program of ``S`` as the kernel's arrays, kept with ``S``:
     :func:`_shape`'s integers (the topology's) and the numbers ``fp`` (steps, 7)
     complex (a driver's sign and joint point; a group's squared lengths, assembly mode,
     rotation vectors and known joints' local points, :func:`numbers`) and the anchors'
-    local points."""
-    chain_steps(S, plan)
-    return geometry_memo(S)[("kernel", id(plan))][1]
+    local points ``anc_s`` (links,) complex (:func:`numbers` of ``S``'s local points)."""
+    memo = geometry_memo(S)
+    hit = memo.get(("kernel", id(plan)))
+    if hit is not None and hit[0] is plan:
+        return hit[1]
+    li, pj, ints, table, _ = layout(S, plan)
+    pts = joint_points(S)
+    loc = frame_points(S.frames(), li, [pts[k] for k in pj])
+    fp, anc_s = numbers(table, *(np.fromiter(chain.from_iterable(a), float).view(complex)[None] for a in (loc, pts)))
+    out = ints, fp[0], anc_s[0]
+    memo[("kernel", id(plan))] = (plan, out)
+    return out
 
 
 def layout(S: PlanarSystem, plan: Plan) -> tuple:
@@ -130,7 +114,7 @@ def layout(S: PlanarSystem, plan: Plan) -> tuple:
 def numbers(table: tuple, loc: np.ndarray, pt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The program's numbers ``fp`` (K, steps, 7) and ``anc_s`` (K, links) of ``K``
     designs of one topology (:func:`mechsyn.kinematics._kernel_numba.fill`, the one
-    implementation): ``table`` the topology's (:func:`_shape`'s last item),
+    implementation): ``table`` the topology's (:func:`_shape`'s),
     ``loc`` (K, pairs) the local points of the (link, joint) pairs it names, ``pt`` (K,
     joints) the drawn joint points in file order (complex, C-contiguous)."""
     fi, anc_p = table
@@ -141,18 +125,19 @@ def numbers(table: tuple, loc: np.ndarray, pt: np.ndarray) -> tuple[np.ndarray, 
 
 
 def _shape(S: PlanarSystem, plan: Plan) -> tuple:
-    """The topology of :func:`chain_steps`: its steps without numbers (a drive's links,
-    joint, driver and sign; an RRR group's known links, links and joints), each link's
-    anchor (joint, pair), origin joint, the (link, joint) pairs whose local points the
-    numbers take, as index lists (link, joint's index in the file); then the program's
+    """The topology of :func:`program`: the (link, joint) pairs whose local points the
+    numbers take, as index lists (link, joint's index in the file); the program's
     integers: per step ``ip`` (op, links, joints by their index in the program, which
     joints to place from a link's point first, the group's row in the discriminants),
     each link's anchor joint and origin joint (-1: found from its anchor), the number of
-    joints and the steps of the RRR groups; and the table :func:`numbers` fills the
+    joints and the steps of the RRR groups; the table :func:`numbers` fills the
     numbers by (``fi``: per step a driver's pair and sign, a group's pairs ``s1, s2, t2,
     t3, k1, k3`` and its joints' indices in the file (its drawn assembly mode), the op
-    last; each link's anchor pair, -1: none). A link's anchor is the joint that places
-    it: a drive's joint, an RRR group's end joint on it."""
+    last; each link's anchor pair, -1: none); and the links' angles of
+    :func:`link_poses` (each link's frame driver's input column, -1: none, the input's
+    sign, and the runs ``(first, end)`` of the other links). A link's anchor is the
+    joint that places it: a drive's joint, an RRR group's end joint on it; its origin
+    is its first joint."""
     pairs: dict[tuple[int, str], int] = {}
     order: dict[str, int] = {}
 
@@ -162,44 +147,40 @@ def _shape(S: PlanarSystem, plan: Plan) -> tuple:
     def jx(jid: str) -> int:
         return order.setdefault(jid, len(order))
 
+    nl = len(S.links)
     index = {j.id: k for k, j in enumerate(S.mech.joints)}
-    steps, anchors, placed, groups = [], {}, set(), []
+    anchors, placed, groups = {}, set(), []
+    dcol, dsgn = np.full(nl, -1, np.int64), np.ones(nl)
     ip, fi = np.zeros((len(plan.steps), 11), np.int64), np.zeros((len(plan.steps), 10), np.int64)
     for s, step in enumerate(plan.steps):
         if step.kind == "drive_R":  # the joint's local point on k (the frame: its fixed point)
             (new,), (k,), (jid,) = step.links, step.known, step.joints
             con = next(c for c in cons_of(S, jid) if c.role == "drive")
-            steps.append(("drive", new, k, jid, con.driver, 1.0 if con.b == new else -1.0))
+            sign = 1.0 if con.b == new else -1.0
             ip[s, :6] = (0, new, k, jx(jid), con.driver, int(k >= 0 and jid not in placed))
-            fi[s, :2] = (at(k, jid), steps[-1][5])
+            fi[s, :2] = (at(k, jid), sign)
+            if k < 0:
+                dcol[new], dsgn[new] = con.driver, sign
             anchors[new] = (jid, at(new, jid))
             placed.add(jid)
             continue
         (k1, k3), (b1, b2), (J1, J2, J3) = step.known, step.links, step.joints
-        steps.append(("RRR", step.known, step.links, step.joints))
         ip[s] = (1, k1, k3, b1, b2, jx(J1), jx(J2), jx(J3), int(J1 not in placed), int(J3 not in placed), len(groups))
         fi[s] = (at(b1, J1), at(b1, J2), at(b2, J2), at(b2, J3), at(k1, J1), at(k3, J3), index[J1], index[J2],
                  index[J3], 1)
         anchors[b1], anchors[b2] = (J1, at(b1, J1)), (J3, at(b2, J3))
         placed.update((J1, J2, J3))
         groups.append(s)
-    origin = []  # the joint at every link's origin (its first joint), by link
-    for i, name in enumerate(S.links):
-        j0 = next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
-        origin.append(j0)
-    anc_j = np.array([jx(anchors[i][0]) if i in anchors else -1 for i in range(len(origin))], np.int64)
-    anc_p = np.array([anchors[i][1] if i in anchors else -1 for i in range(len(origin))], np.int64)
+    origin = [next((j.id for j in S.mech.joints_of(name) if not np.any(local_point(S, i, j.id))), None)
+              for i, name in enumerate(S.links)]  # the joint at every link's origin (its first joint), by link
+    anc_j = np.array([jx(anchors[i][0]) if i in anchors else -1 for i in range(nl)], np.int64)
+    anc_p = np.array([anchors[i][1] if i in anchors else -1 for i in range(nl)], np.int64)
     org_j = np.array([jx(j) if j is not None and j in placed else -1 for j in origin], np.int64)
-    return (steps, anchors, origin, [i for i, _ in pairs], [index[jid] for _, jid in pairs],
-            (ip, anc_j, org_j, len(order), groups), (fi, anc_p))
-
-
-def _locals(S: PlanarSystem, li: list, pj: list) -> list:
-    """The local points (``(x, y)`` floats) of the joints ``pj`` (indices in the file) on
-    the links ``li`` (-1: the frame, the point itself): :meth:`PlanarSystem.to_locals`'s
-    numbers, on floats."""
-    pts = joint_points(S)
-    return frame_points(S.frames(), li, [pts[k] for k in pj])
+    free = np.flatnonzero(dcol < 0)  # the links no frame driver turns, as runs of consecutive links
+    cuts = np.flatnonzero(np.diff(free) != 1) + 1
+    runs = tuple((int(r[0]), int(r[-1]) + 1) for r in np.split(free, cuts) if r.size)
+    return ([i for i, _ in pairs], [index[jid] for _, jid in pairs], (ip, anc_j, org_j, len(order), groups),
+            (fi, anc_p), (dcol, dsgn, runs))
 
 
 def run(program: tuple, X: np.ndarray | list, speeds: np.ndarray, least: float, planes: int = 0,
@@ -274,52 +255,50 @@ def _block_trig(b: np.ndarray, key: tuple) -> tuple[np.ndarray, np.ndarray]:
     return hit
 
 
-def link_poses(pass_: tuple, N: int, U: np.ndarray, angles: tuple, split: int | None, folds: bool,
-               n: int, parts: list | None = None) -> tuple:
-    """The pose rows ``q, qd, qdd`` (n, N; component-major) of the first N rows of a
-    compiled pass (``pass_``: ``(C, W, AL)`` of :func:`run`, and its planes when it gave
-    them) and the rows assembled, the
-    links' angles continuous from the drawn ones (``angles``: each link's frame driver's
-    input column or -1, its sign, its drawn angle, and the runs ``(first, end)`` of links
-    without such a driver, whose angles are ``atan2`` of their rotations), compiled: see
-    :func:`mechsyn.kinematics._kernel_numba.link_poses`. ``folds``: the sweep went
-    through folds (its tracked sweeps made continuous on their own, rows not assembled
-    and rates not defined blanked; ``parts``: the fold scan's singular rows per tracked
-    sweep, :func:`mechsyn.kinematics.folds.pass_fold_events`' first items, blanked too).
+def link_poses(S: PlanarSystem, plan: Plan, pass_: tuple, U: np.ndarray, split: int | None, folds: bool,
+               parts: list | None = None) -> tuple:
+    """The pose rows ``q, qd, qdd`` (n, N; component-major) of the first N rows (``U``
+    (N, k) their inputs) of a pass of ``S``'s program (``pass_``: ``(C, W, AL)`` of
+    :func:`run`, and its planes when it gave them) and the rows assembled, the links'
+    angles continuous from the drawn ones (a link a frame driver turns takes its input,
+    the others ``atan2`` of their rotations: :func:`_shape`'s angles), compiled: see
+    :func:`mechsyn.kinematics._kernel_numba.link_poses`. ``folds``: the sweep may not
+    be assembled throughout (each tracked sweep made continuous on its own, rows not
+    assembled and rates not defined blanked, in the poses and in ``C``; ``parts``: the
+    fold scan's singular rows per tracked sweep,
+    :func:`mechsyn.kinematics.folds.pass_fold_events`' first items, blanked too).
     Returns ``q, qd, qdd``, the rows assembled and, through folds, the rows whose rates
     are defined and the number of assembled rows whose rates are not (else None, 0)."""
     C, W, AL, *Z = pass_
-    q, qd, qdd = np.empty((3, n, N))  # one block, three contiguous views
-    dcol, dsgn, ref, runs = angles
+    N, nl = U.shape[0], C.shape[1]
+    dcol, dsgn, runs = layout(S, plan)[4]
+    q, qd, qdd = np.empty((3, S.n, N))  # one block, three contiguous views
+    if S.n > 3 * nl:  # unknowns other than the links' poses (none in a regular pass)
+        q[3 * nl:] = qd[3 * nl:] = qdd[3 * nl:] = np.nan
     zr, zi = (Z[0][0], Z[0][1]) if Z else (C[0].real, C[0].imag)  # the planes of run() (N rows), else strided parts
-    A = np.empty((dcol.shape[0], N))
+    A = np.empty((nl, N))
     ok = np.empty((2, N), np.bool_)  # the rows assembled, the rows with rates
     for a, b in runs:  # the links no frame driver turns (NumPy's vector loops: a third of libm's time per angle)
         np.arctan2(zi[a:b, :N], zr[a:b, :N], out=A[a:b])
-    if parts:  # the forward sweep's singular rows and the backward sweep's in the sweep's order
-        sf = parts[0][0]
-        sb = parts[1][0][::-1] if len(parts) > 1 else sf[:0]
-    else:
-        sf = sb = _NO_ROWS
+    sb = parts[1][0][::-1] if parts and len(parts) > 1 else _NO_ROWS  # the sweeps' singular rows in the sweep's
+    sf = parts[0][0] if parts else np.zeros(N if folds else 0, np.bool_)  # order (backward, then forward)
     singular = _nb().link_poses(C, W, AL, N, U if U.flags.c_contiguous and U.dtype == _F64 else
-                                      np.ascontiguousarray(U, float), dcol, dsgn, ref, -1 if split is None else split,
-                                      folds, A, q, qd, qdd, ok[0], sb, sf, ok[1])
+                                np.ascontiguousarray(U, float), dcol, dsgn, S.q0[2:3 * nl:3].copy(),
+                                -1 if split is None else split, folds, A, q, qd, qdd, ok[0], sb, sf, ok[1])
     return q, qd, qdd, ok[0], ok[1] if folds else None, singular
 
 
 _NO_ROWS = np.zeros(0, np.bool_)
 _NO_SIGNS = np.zeros((0, 0))
-
-
 _F64 = np.dtype(float)
 
 
-def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
+def fold_scan(program: tuple, D: np.ndarray, perm: np.ndarray, b: int, X: np.ndarray, paths: list, ks: np.ndarray,
               specs: np.ndarray, zero: float, singular_disc: float) -> tuple:
     """:func:`mechsyn.kinematics.folds.pass_fold_events` compiled in one call
     (:func:`mechsyn.kinematics._kernel_numba.fold_scan`): the masks of :func:`fold_rows`
     and the tracked sweeps' folds (refined on the discriminant of the regular pass's
-    ``program``) and reassemblies. ``discs``: a list of arrays or one array (groups, rows);
+    ``program``) and reassemblies. ``D`` (groups, rows): the groups' discriminants;
     ``X``: the pass's input rows; ``paths``: the sweeps'
     ``(path, shift)``; ``ks``: the groups' steps; ``specs``: their closed-form fold
     numbers. Returns whether a change point may be near, the singular rows in the layout
@@ -328,39 +307,34 @@ def fold_scan(program: tuple, discs: list, perm: np.ndarray, b: int, X: np.ndarr
     (pa, sa), (pb, sb) = paths[0], paths[-1]
     if sa.flags.writeable or sb.flags.writeable:  # one array type for both (tracking_path's are read-only)
         sa, sb = np.array(sa, float), np.array(sb, float)
-    D = discs if isinstance(discs, np.ndarray) else np.array(discs)
     return _nb().fold_scan(D, perm, b, zero, singular_disc, X, len(paths), pa.shape[0], sa, pb.shape[0], sb, ks, specs,
-                         ip, fp, anc_j, anc_s, nj)
+                           ip, fp, anc_j, anc_s, nj)
 
 
-def scan_sweep(D: np.ndarray, X: np.ndarray, n0: int, zero: float, refine, c) -> np.ndarray:
+def scan_sweep(D: np.ndarray, X: np.ndarray, n0: int, zero: float, specs: np.ndarray, line) -> np.ndarray:
     """The kernel's fold scan of one tracked sweep
     (:func:`mechsyn.kinematics._kernel_numba.scan_sweep`, the source :func:`fold_scan`
-    compiles) run as plain Python with a Python refinement ``refine(c, g, i, hidden, xa,
-    xb, fa, fb, ends, starts)`` (and its context ``c``) in place of the program's: the
-    tracked groups' (:func:`mechsyn.kinematics.folds.fold_events`), whose discriminants
-    come from the generic group steps. ``D`` (groups, n): the groups' normalised
-    discriminants on the input rows ``X`` (n, inputs), the first ``n0`` a connecting
-    path. Returns the events as rows (sweep 0, row, kind, group, input)."""
+    compiles) run as plain Python, each fold refined by the kernel's refinement on a
+    Python discriminant: ``line(g, i, xa, xb)`` gives group ``g``'s discriminant ``f(t)``
+    on the segment of inputs from ``xa`` (row ``i - 1``) to ``xb`` (the tracked groups',
+    :func:`mechsyn.kinematics.folds.fold_events`, whose discriminants come from the
+    generic group steps); ``specs``: the groups' closed-form fold numbers. ``D`` (groups,
+    n): the groups' normalised discriminants on the input rows ``X`` (n, inputs), the
+    first ``n0`` a connecting path. Returns the events as rows (sweep 0, row, kind,
+    group, input)."""
     cap = int(np.count_nonzero((D[:, 1:] > -zero) != (D[:, :-1] > -zero)))
     ev = np.empty((2 * cap, 4 + X.shape[1]))
-    ne = _plain()["scan_sweep"](D, X, n0, np.zeros(X.shape[1]), zero, (refine, c), ev, 0, 0)
+    ne = _plain()["scan_sweep"](D, X, n0, np.zeros(X.shape[1]), zero, (specs, zero, line), ev, 0, 0)
     return ev[:ne]
-
-
-def hidden_fold(f, fa: float, fb: float, tc: float, hidden: int, zero: float) -> float:
-    """The kernel's fold refinement between two rows
-    (:func:`mechsyn.kinematics._kernel_numba.hidden_fold`) run as plain Python on a
-    discriminant ``f(t)`` along the segment (a Python callable): t, or NaN."""
-    return _plain()["hidden_fold"](f, fa, fb, tc, hidden, zero)
 
 
 def _plain() -> dict:
     """The compiled functions' plain Python source, calling each other plain (a
     namespace of :mod:`mechsyn.kinematics._kernel_numba` whose functions are their
     ``py_func``; the same functions under ``NUMBA_DISABLE_JIT=1``), with the two leaves
-    that read the program replaced by a Python context's own: ``_refine(c, ...)`` calls
-    ``c[0](c[1], ...)`` and ``_disc_along(c, t)`` calls ``c(t)``. Kept in the one cache."""
+    that read the program replaced by a Python context's own: ``_segment(c, g, i, xa,
+    xb)`` calls ``c[2](g, i, xa, xb)`` (a discriminant ``f(t)``) and ``_disc_along(f,
+    t)`` calls ``f(t)``. Kept in the one cache."""
     ns = CACHE.get(("plain kernel",))
     if ns is None:
         nb = _nb()
@@ -369,8 +343,8 @@ def _plain() -> dict:
             py = getattr(fn, "py_func", fn)
             if isinstance(py, types.FunctionType) and py.__module__ == nb.__name__:
                 ns[name] = types.FunctionType(py.__code__, ns, py.__name__, py.__defaults__, py.__closure__)
-        ns["_refine"] = lambda c, *args: c[0](c[1], *args)
-        ns["_disc_along"] = lambda c, t: c(t)
+        ns["_segment"] = lambda c, g, i, xa, xb: c[2](g, i, xa, xb)
+        ns["_disc_along"] = lambda f, t: f(t)
         CACHE.put(("plain kernel",), ns)
     return ns
 
@@ -392,11 +366,3 @@ def scalar_disc(program: tuple, k: int, sg: np.ndarray, u: np.ndarray) -> float:
     """
     (ip, anc_j, _, nj, _), fp, anc_s = program
     return _nb().scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg)
-
-
-def four_bar_fold(spec: np.ndarray, ua: float, ub: float) -> float:
-    """Where (t in [0, 1]) a group closing a four-bar folds between the inputs ``ua`` and
-    ``ub``, in closed form from its numbers ``spec``
-    (:func:`mechsyn.kinematics.folds._four_bar_numbers`); NaN when not exactly one fold
-    angle lies there (the numerical search decides)."""
-    return _nb()._four_bar_t(spec, ua, ub)

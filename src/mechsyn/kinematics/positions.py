@@ -76,41 +76,21 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return (x + np.pi) % (2 * np.pi) - np.pi
 
 
-def _unwrap_rows(p: np.ndarray, inplace: bool = False) -> np.ndarray:
+def _unwrap_rows(p: np.ndarray) -> np.ndarray:
     """``np.unwrap(p, axis=-1)`` for angles whose steps stay below a whole turn (as those of
-    ``atan2`` do): the whole turns removed are counted exactly (a step of exactly half a
-    turn is kept, as ``np.unwrap`` keeps it); ``inplace``: into ``p`` itself."""
-    out = p if inplace else np.array(p, float)
-    if p.shape[-1] > 1:
-        k = np.subtract(p[..., 1:], p[..., :-1])
-        if not k.size or (k.max() <= math.pi and k.min() >= -math.pi):  # no step over half a turn
-            return out
-        k /= 2 * np.pi
-        np.rint(k, out=k)
-        jumps = np.flatnonzero(k)  # (NaN counts as a jump)
-        if len(jumps) > 16:  # many turns: count them all at once
-            np.cumsum(k, axis=-1, out=k)
-            k *= 2 * np.pi
-            out[..., 1:] -= k
-        elif len(jumps):  # a few: each shifts the rest of its row
-            o2, k2 = out.reshape(-1, out.shape[-1]), k.reshape(-1, k.shape[-1])
-            for j in jumps.tolist():
-                row, col = divmod(j, k2.shape[1])
-                o2[row, col + 1:] -= 2 * np.pi * k2[row, col]
+    ``atan2`` do), into a copy: the whole turns of each step counted (a step of exactly
+    half a turn is kept, as ``np.unwrap`` keeps it) and removed as the kernel removes them
+    (:func:`mechsyn.kinematics._kernel_numba.link_poses`)."""
+    out = np.array(p, float)
+    out[..., 1:] -= 2 * np.pi * np.cumsum(np.rint(np.diff(p, axis=-1) / (2 * np.pi)), axis=-1)
     return out
 
 
-def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, split: int | None = None,
-                       fresh: bool = False) -> np.ndarray:
-    """Link angles made continuous along a sweep: start near the file's angles ``ref``,
-    unwrap each run of assembled rows and keep the turn count across gaps (``phi`` (N,
-    m), or (m, N) with ``ref`` (m, 1); ``ok`` None: every row assembled).
-
-    ``split``: the sweep (assembled throughout) was run outwards from the drawn
-    configuration, between rows ``split - 1`` and ``split``: both rows start near
-    ``ref`` and the angles are unwrapped away from them (as two runs would be).
-    ``fresh``: ``phi`` (m, N) is a work array of ``atan2`` angles the answer is written
-    into (the answer is ``phi`` itself).
+def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None) -> np.ndarray:
+    """Link angles ``phi`` (N, m) made continuous along a sweep: started next to the
+    file's angles ``ref`` (m,), each run of assembled rows unwrapped, the turn count
+    kept across gaps (``ok`` None: every row assembled). The kernel's passes do the same
+    (:func:`mechsyn.kinematics._kernel_numba.link_poses`).
 
     Examples
     --------
@@ -119,55 +99,31 @@ def continuous_angles(phi: np.ndarray, ref: np.ndarray, ok: np.ndarray | None, s
     >>> np.degrees(continuous_angles(phi, np.radians([160.0]), None)).round(6).ravel().tolist()
     [170.0, 190.0, 210.0]
     """
-    if ref.ndim == 1:
-        return continuous_angles(phi.T, ref[:, None], ok, split).T
-    refs = ref[:, 0].tolist()
-    if ok is None or ok.all():  # one run: unwrap, then put the start row(s) next to ref
-        block = _unwrap_rows(phi, inplace=fresh)
-        parts = ((0, slice(None)),) if split is None else ((split, slice(split, None)), (split - 1, slice(0, split)))
-        for row, rows in parts:  # the few start values on floats (the numbers of _wrap)
-            got = block[:, row].tolist()
-            for i, (a, b, r0) in enumerate(zip(got if block is phi else phi[:, row].tolist(), got, refs)):
-                near = r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi)
-                turns = round((b - near) / (2 * math.pi))
-                if turns:
-                    block[i, rows] -= 2 * math.pi * turns
-        return block
-    if fresh:  # ref + _wrap(phi - ref), in place (elementwise: on a backward sweep's rows forwards)
-        sub = phi[:, ::-1] if phi.strides[1] < 0 else phi
-        np.subtract(sub, ref, out=sub)
-        sub += np.pi
-        if all(-math.pi <= r <= math.pi for r in refs):
-            # phi of atan2 and ref within half a turn: sub in [-pi, 3 pi], so the remainder
-            # is one step of 2 pi or none (a step down exact: Sterbenz), as np.remainder
-            # takes it (fmod, then + 2 pi when negative), without its division
-            # (each step only when some angle needs it: fmax, fmin pass over NaN gaps)
-            if np.fmax.reduce(sub, axis=None) >= 2 * np.pi:
-                np.subtract(sub, 2 * np.pi, out=sub, where=sub >= 2 * np.pi)
-            if np.fmin.reduce(sub, axis=None) < 0.0:
-                np.add(sub, 2 * np.pi, out=sub, where=sub < 0.0)
-        else:
-            np.remainder(sub, 2 * np.pi, out=sub)
-        sub -= np.pi
-        np.add(ref, sub, out=sub)
-        sub = phi
-    else:
-        sub = ref + _wrap(phi - ref)
-    # the runs of assembled rows [a, b): each unwrapped in place, then shifted by whole
-    # turns to follow the run before (on floats: a run's first angles are not changed by
-    # its unwrapping)
+    phi, col = phi.T, ref[:, None]
+    if ok is None or ok.all():  # one run: unwrapped, then moved by whole turns to start next to ref
+        block = _unwrap_rows(phi)
+        for i, (a, b, r0) in enumerate(zip(phi[:, 0].tolist(), block[:, 0].tolist(), ref.tolist())):
+            turns = round((b - (r0 + ((a - r0 + math.pi) % (2 * math.pi) - math.pi))) / (2 * math.pi))
+            if turns:
+                block[i] -= 2 * math.pi * turns
+        return block.T
+    sub = col + _wrap(phi - col)  # every angle next to ref, then
+    # the runs of assembled rows [a, b): each unwrapped, then shifted by whole turns to
+    # follow the run before (on floats: a run's first angles are not changed by its
+    # unwrapping)
     edges = np.flatnonzero(ok[1:] != ok[:-1])
     bounds = ([0] if ok[0] else []) + (edges + 1).tolist() + ([len(ok)] if ok[-1] else [])
     prev = None
     for a, b in zip(bounds[0::2], bounds[1::2]):
-        block = _unwrap_rows(sub[:, a:b], inplace=True)
+        sub[:, a:b] = _unwrap_rows(sub[:, a:b])
+        block = sub[:, a:b]
         if prev is not None:
             for i, (x, y) in enumerate(zip(block[:, 0].tolist(), prev)):
                 turns = round((x - y) / (2 * math.pi))
                 if turns:
                     block[i] -= 2 * math.pi * turns
         prev = block[:, -1].tolist()
-    return sub
+    return sub.T
 
 
 def _pin(st: PoseState, i: int, P: np.ndarray, s_local: np.ndarray, phi: np.ndarray) -> None:
@@ -202,17 +158,16 @@ def _step_drive_P(S: PlanarSystem, st: PoseState, step: Step, u: np.ndarray, sig
     drive = next(c for c in cons_of(S, jid) if c.role == "drive")
     line = pair_line(S, jid)
     val = u[:, drive.driver]
+    ra, pa = st.pose(k)
+    if drive.a != k:  # the new link carries the axis
+        pa = pa + rel_angle(S, jid, k, new)
+    ca, sa_ = cos_sin(pa)
+    w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
     if drive.a == k:
-        ra, pa = st.pose(k)
-        ca, sa_ = cos_sin(pa)
-        w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
         Pa = st.point(k, line.sa)
         Pb = ra + val[:, None] * w + n * dot(n, Pa - ra)[:, None]
         _pin(st, new, Pb, drive.sb, pa + rel_angle(S, jid, k, new))
-    else:  # the new link carries the axis: O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
-        pa = st.pose(k)[1] + rel_angle(S, jid, k, new)
-        ca, sa_ = cos_sin(pa)
-        w, n = rotate(ca, sa_, drive.w), rotate(ca, sa_, line.w)
+    else:  # O_a = u (u.P_b - s) + n (n.(P_b - A_a s_a))
         Pb = st.point(k, drive.sb)
         Oa = w * (dot(w, Pb) - val)[:, None] + n * dot(n, Pb - rotate(ca, sa_, line.sa))[:, None]
         st.set(new, Oa, pa)

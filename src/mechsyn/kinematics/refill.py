@@ -89,7 +89,9 @@ def _scales_of(scale: float, rowmask: np.ndarray, colmask: np.ndarray, scales: l
     read, one write)."""
     sc = scales[0]
     if sc[0] != scale:
-        sc = scales[0] = (scale, _frozen(np.where(rowmask, scale, 1.0)), _frozen(np.where(colmask, scale, 1.0)))
+        sc = scales[0] = (scale, np.where(rowmask, scale, 1.0), np.where(colmask, scale, 1.0))
+        sc[1].setflags(write=False)
+        sc[2].setflags(write=False)
     return sc[1], sc[2]
 
 
@@ -170,18 +172,13 @@ def _layout(T: PlanarSystem) -> tuple | bool:
             [(None,)], kept)
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
-
-
 def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames: tuple,
               ang: list) -> tuple[list, tuple]:
     """``T``'s constraints and drivers with the numbers of ``mech``: a drive's or a P
     pair's drawn relative angle, a line's local points, direction and drawn slide
     coordinate (see :class:`~mechsyn.kinematics.system._Builder`; ``recipe``:
-    :func:`_layout`'s); an R pair's block is None, made when first read
-    (:func:`_r_pairs`)."""
+    :func:`_layout`'s); an R pair's block is None, made when the system's constraints
+    are first read (:func:`_r_pairs`)."""
     count, recipe = recipe[0]
     drivers = list(T.drivers)
     cons: list = [None] * count
@@ -204,17 +201,12 @@ def _refilled(T: PlanarSystem, mech: Mechanism, recipe: list, pts: list, frames:
 
 def _r_pairs(T_cons: tuple, cons: list, pairs: tuple, pts: list, frames: tuple) -> tuple:
     """The constraints ``cons`` of :func:`_refilled` with every R pair's block (None there)
-    made from ``T``'s (``T_cons``): its local points ``sa``, ``sb`` (:class:`_RPair`;
-    ``pairs``: the links and joints of :func:`_layout`)."""
+    made from ``T``'s (``T_cons``) with its local points ``sa``, ``sb`` (``pairs``: the
+    links and joints of :func:`_layout`)."""
     links, joints = pairs[:2]
-    block = frame_points(frames, links, [pts[k] for k in joints])
-    out, r = [], 0
-    for c, t in zip(cons, T_cons):
-        if c is None:
-            c = _RPair.of(t, block[r], block[r + 1])
-            r += 2
-        out.append(c)
-    return tuple(out)
+    block = iter(frame_points(frames, links, [pts[k] for k in joints]))
+    return tuple(fields_replaced(t, sa=np.array(next(block)), sb=np.array(next(block))) if c is None else c
+                 for c, t in zip(cons, T_cons))
 
 
 def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
@@ -243,8 +235,8 @@ def _line(c: Con, j: Any, frames: tuple, drivers: list) -> Con:
 
 
 class _Refilled(PlanarSystem):
-    """A system made by :func:`with_geometry`: a :class:`PlanarSystem` whose R pairs'
-    constraint blocks (:func:`_r_pairs`), drawn link origins ``origin0`` and row and
+    """A system made by :func:`with_geometry`: a :class:`PlanarSystem` whose constraint
+    blocks (the R pairs', :func:`_r_pairs`), drawn link origins ``origin0`` and row and
     column scales (:func:`_scales_of`, for the size it was refilled with) are made when
     first read (the regular pass and the drawn checks of a drag never read them;
     Newton's continuation, the rank tests and the forces do, once per system). Its
@@ -295,56 +287,3 @@ class _Refilled(PlanarSystem):
     @col_scale.setter
     def col_scale(self, value: Any) -> None:
         self.__dict__["_col_scale"] = value
-
-
-class _RPair(Con):
-    """An R pair's constraint in a refilled system: a :class:`Con` whose local points
-    ``sa``, ``sb`` are kept as floats and made arrays when first read. The regular pass
-    and the drawn checks never read them (they carry the points themselves); Newton's
-    continuation, the rank tests and the forces do, once per system. Equal field for
-    field to the constraint :func:`build_system` makes (a test).
-
-    Examples
-    --------
-    >>> c = _RPair.of(Con("R", "B", 2, 0, 1, role="pair"), (1.0, 0.0), (0.5, 0.25))
-    >>> c.sa.tolist(), c.sb.tolist(), c.kind, c.role
-    ([1.0, 0.0], [0.5, 0.25], 'R', 'pair')
-    """
-
-    @classmethod
-    def of(cls, c: Con, sa: tuple, sb: tuple) -> "_RPair":
-        """``c`` (an R pair's constraint) with the local points ``sa``, ``sb`` (floats)."""
-        new = object.__new__(cls)
-        fields = new.__dict__
-        fields.update(c.__dict__)
-        fields["sa"] = fields["sb"] = None  # (the property's; the points wait in _xy)
-        fields["_xy"] = (sa, sb)
-        return new
-
-    def _point(self, k: int) -> np.ndarray:
-        fields = self.__dict__
-        xy = fields.pop("_xy", None)
-        if xy is not None:  # both made at once (a copy or a pickle carries what is there)
-            fields["_sa"], fields["_sb"] = np.array(xy[0], float), np.array(xy[1], float)
-        return fields["_sb" if k else "_sa"]
-
-    def _set(self, k: int, value: Any) -> None:  # dataclasses.replace's __init__ (object.__setattr__)
-        if "_xy" in self.__dict__:
-            self._point(k)
-        self.__dict__["_sb" if k else "_sa"] = value
-
-    @property  # type: ignore[override]
-    def sa(self) -> np.ndarray:
-        return self._point(0)
-
-    @sa.setter
-    def sa(self, value: Any) -> None:
-        self._set(0, value)
-
-    @property  # type: ignore[override]
-    def sb(self) -> np.ndarray:
-        return self._point(1)
-
-    @sb.setter
-    def sb(self, value: Any) -> None:
-        self._set(1, value)

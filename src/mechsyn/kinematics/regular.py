@@ -17,15 +17,15 @@ equation one array operation instead of two:
   ``e2 = B - C`` its links turn at ``omega_1 = Re((v_C - v_A) conj(e2)) / (e1 x e2)``,
   ``omega_2 = Re((v_C - v_A) conj(e1)) / (e1 x e2)`` and likewise for the accelerations.
 
-:func:`regular_sweep` evaluates the sweep and the connecting paths from the drawn input
-values together and gives up (None) as soon as a group's discriminant falls below
-:data:`mechsyn.kinematics.sweep.REGULAR_DISC`: no group then folds, touches a change
-point or reassembles, every group keeps its drawn mode and the answer is that of the
-tracked outward sweeps (tests check both agree), at the cost of one pass.
-:func:`sweep_through_folds` goes on through the folds when no group's discriminant has a
-local minimum under 0.05 (no change or branch point near: every group keeps its drawn
-mode), and reads the folds, reassembly and singular rows of the tracked sweeps off the
-discriminant arrays (:func:`mechsyn.kinematics.folds.pass_fold_events`).
+:func:`sweep_through_folds` evaluates the sweep and the connecting paths from the drawn
+input values together in one pass. When no group's discriminant falls below
+:data:`mechsyn.kinematics.sweep.REGULAR_DISC`, no group folds, touches a change point
+or reassembles, every group keeps its drawn mode and the answer is that of the tracked
+outward sweeps (tests check both agree). Else it goes on through the folds when no
+group's discriminant has a local minimum under 0.05 (no change or branch point near:
+every group keeps its drawn mode), and reads the folds, reassembly and singular rows of
+the tracked sweeps off the discriminant arrays
+(:func:`mechsyn.kinematics.folds.pass_fold_events`).
 """
 
 from __future__ import annotations
@@ -35,94 +35,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from mechsyn.kinematics import kernel
-from mechsyn.kinematics.chain import frame_driven_links
 from mechsyn.kinematics.groups import Plan, geometry_memo
 from mechsyn.kinematics.system import PlanarSystem
 from mechsyn.kinematics.folds import pass_fold_events
-from mechsyn.kinematics.sweep import REGULAR_DISC, regular_rows, tracking_path
+from mechsyn.kinematics.sweep import REGULAR_DISC, tracking_path
 
-__all__ = ["regular_sweep", "sweep_through_folds", "Folded", "LinkStates"]
-
-
-def regular_sweep(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
-                  split: int | None) -> tuple | None:
-    """Poses and rates (N, n) of a driver-R + RRR chain over the inputs ``U`` (N, k) in
-    one pass, with the links' complex states (:class:`LinkStates`); None when a group
-    comes near a fold on the sweep or on the way to it from the drawn configuration
-    (``split``: the row after the drawn input values, see
-    :func:`mechsyn.kinematics.engines.drawn_row`; :func:`sweep_through_folds` goes on
-    through folds).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from mechsyn.io import load_mechanism
-    >>> from mechsyn.kinematics.analysis import compile_plan, input_grid
-    >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
-    >>> U = np.radians(input_grid(0, 360, 1))[:, None]
-    >>> q, qd, qdd, links = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
-    >>> q.shape, bool(np.allclose(links.z, np.exp(1j * q[:, 2::3].T)))
-    ((361, 9), True)
-    """
-    if not plan.closed_form_rates or S.n != 3 * len(S.links):
-        return None
-    st = _pass(S, plan, regular_rows(S, U, split), speeds, folds=False)
-    return None if st is None else _poses(S, plan, U, st, split)
+__all__ = ["sweep_through_folds", "Folded", "LinkStates"]
 
 
-def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray, folds: bool) -> _Compiled | None:
+def _pass(S: PlanarSystem, plan: Plan, X: np.ndarray | list, speeds: np.ndarray, folds: bool) -> tuple | None:
     """One pass of the regular program over the input rows ``X`` (or the blocks of rows
-    ``X``, a list, one after the other) by the kernel (:func:`mechsyn.kinematics.kernel.run`).
-    None when a group comes near a fold and ``folds`` is false."""
-    prog = kernel.program(S, plan)
-    C, W, AL, D, near, Z = kernel.run(prog, X, speeds, REGULAR_DISC,
-                                      planes=(X[0] if isinstance(X, list) else X).shape[0])
-    if near and not folds:
-        return None
-    return _Compiled(C, W, AL, dict(zip(prog[0][4], D)), near, D, Z)
-
-
-def _link_poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: "_Compiled", split: int | None,
-                folds: bool, parts: list | None = None) -> tuple:
-    """The poses of a pass, by the kernel (:func:`mechsyn.kinematics.kernel.link_poses`): ``q, qd, qdd`` (n, N), the rows
-    assembled (N,), the rows with rates and the number of singular rows (through folds;
-    ``parts``: the fold scan's singular rows, blanked too). Which links frame drivers
-    turn is kept with the topology."""
-    dcol, dsgn, runs = S.topology.product("kernel-angles", lambda: _drive_arrays(S, plan), plan)
-    memo = geometry_memo(S)
-    ref = memo.get("drawn angles")
-    if ref is None:  # the drawn angles: this geometry's
-        ref = memo["drawn angles"] = np.ascontiguousarray(S.q0[2::3])
-    pass_ = (st.C, st.W, st.AL) if st.Z is None else (st.C, st.W, st.AL, st.Z)
-    return kernel.link_poses(pass_, U.shape[0], U, (dcol, dsgn, ref, runs), split, folds, S.n, parts)
-
-
-def _drive_arrays(S: PlanarSystem, plan: Plan) -> tuple[np.ndarray, np.ndarray, tuple]:
-    """Each link's frame driver's input column (-1: none), the input's sign, and the runs
-    ``(first, end)`` of consecutive links that no frame driver turns (their angles are
-    ``atan2`` of their rotations)."""
-    drive = frame_driven_links(S, plan)
-    nl = len(S.links)
-    free = [i for i in range(nl) if i not in drive]
-    runs = [[i, i + 1] for i in free[:1]]
-    for i in free[1:]:
-        if i == runs[-1][1]:
-            runs[-1][1] = i + 1
-        else:
-            runs.append([i, i + 1])
-    return (np.array([drive[i][0] if i in drive else -1 for i in range(nl)], np.int64),
-            np.array([drive[i][1] if i in drive else 1.0 for i in range(nl)], float), tuple(map(tuple, runs)))
-
-
-class _Compiled:
-    """The pass's record (:func:`mechsyn.kinematics.kernel.run`): the links' states gathered per link (``C``, ``W``, ``AL``),
-    the groups' discriminants by step (and as rows of one block ``D``, in the order of the
-    steps), whether one came near a fold, the rotations' real and imaginary parts ``Z``
-    (2, links, M) when the pass wrote them."""
-
-    def __init__(self, C: np.ndarray, W: np.ndarray, AL: np.ndarray, discs: dict, near: bool,
-                 D: np.ndarray | None = None, Z: np.ndarray | None = None) -> None:
-        self.C, self.W, self.AL, self.discs, self.near, self.D, self.Z = C, W, AL, discs, near, D, Z
+    ``X``, a list, one after the other) by the kernel: its record ``(C, W, AL, D, near,
+    Z)`` (:func:`mechsyn.kinematics.kernel.run`, the rotations' planes of the first
+    block's rows). None when a group comes near a fold and ``folds`` is false."""
+    rec = kernel.run(kernel.program(S, plan), X, speeds, REGULAR_DISC,
+                     planes=(X[0] if isinstance(X, list) else X).shape[0])
+    return None if rec[4] and not folds else rec
 
 
 def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.ndarray,
@@ -132,7 +60,8 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     One pass over the sweep's rows and the connecting paths from the drawn input values
     (those of :func:`mechsyn.kinematics.tracking.solve_tracked_rates`) gives every group's
     normalised discriminant as an array. When no group comes near a fold the answer is
-    :func:`regular_sweep`'s ``(q, qd, qdd, links)``. Else, when no group's discriminant
+    ``(q, qd, qdd, links)``: poses and rates (N, n) and the links' complex states
+    (:class:`LinkStates`). Else, when no group's discriminant
     has a local minimum under 0.05 (no change or branch point can be near, so every group
     keeps its drawn mode on every row and the pass's rows are the tracked ones), the
     events of each sweep (the one sweep, or forwards and backwards from the drawn
@@ -145,14 +74,22 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
 
     Examples
     --------
+    A crank-rocker clear of folds:
+
+    >>> import numpy as np
+    >>> import mechsyn as ms
+    >>> from mechsyn.kinematics.analysis import cached_plan, input_grid
+    >>> kp = cached_plan(ms.examples.load("crank_rocker"), inputs=("A",))
+    >>> U = np.radians(input_grid(0, 360, 1))[:, None]
+    >>> q, qd, qdd, links = sweep_through_folds(kp.system, kp.groups, U, np.ones(1), None)
+    >>> q.shape, bool(np.allclose(links.z, np.exp(1j * q[:, 2::3].T)))
+    ((361, 9), True)
+
     A textbook four-bar (crank sqrt(5), coupler and rocker sqrt(10), frame 5) from 100 to
     260 degrees, one sweep (the drawn crank angle, 63.4 degrees, lies outside it): its
     working range ends and starts again at the law-of-cosines angles 116.565 and 243.435
     degrees, the 31 rows between them not assembled.
 
-    >>> import numpy as np
-    >>> import mechsyn as ms
-    >>> from mechsyn.kinematics.analysis import cached_plan
     >>> kp = cached_plan(ms.examples.load("fourbar"), inputs=("A",))
     >>> res = sweep_through_folds(kp.system, kp.groups, np.radians(np.arange(100.0, 261.0, 4.0))[:, None],
     ...                           np.ones(1), None)
@@ -164,17 +101,15 @@ def sweep_through_folds(S: PlanarSystem, plan: Plan, U: np.ndarray, speeds: np.n
     """
     if not plan.closed_form_rates or S.n != 3 * len(S.links):
         return None
-    steps, anchor, origin = kernel.chain_steps(S, plan)
     paths = _tracking_paths(S, U, split)
     st = _pass(S, plan, [U] + [path for path, _ in paths], speeds, folds=True)
-    if not st.near:
+    if not st[4]:
         return _poses(S, plan, U, st, split)
-    sigmas = [1.0 if step[0] == "drive" else step[6] for step in steps]  # every group in its drawn mode
-    out = pass_fold_events(S, plan, st.discs, sigmas, U, split, paths, block=st.D)
+    out = pass_fold_events(S, plan, st[3], U, split, paths)
     if out is None:
         return None
-    q, qd, qdd, ok, rates_ok, singular = _link_poses(S, plan, U, st, split, True, out)
-    return Folded(q.T, qd.T, qdd.T, out, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok, rates_ok,
+    q, qd, qdd, ok, rates_ok, singular = kernel.link_poses(S, plan, st[:3] + st[5:], U, split, True, out)
+    return Folded(q.T, qd.T, qdd.T, out, LinkStates(st[0][:, :, :U.shape[0]], qd[2::3], qdd[2::3]), ok, rates_ok,
                   singular)
 
 
@@ -217,12 +152,12 @@ class Folded:
     singular: int
 
 
-def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: _Compiled, split: int | None) -> tuple:
+def _poses(S: PlanarSystem, plan: Plan, U: np.ndarray, st: tuple, split: int | None) -> tuple:
     """The pose rows ``q, qd, qdd`` (N, n) of the first N rows of a pass clear of folds
     (every link's origin is its first joint, its angle continuous from the drawn one) and
     the links' complex states."""
-    q, qd, qdd, *_ = _link_poses(S, plan, U, st, split, False)
-    return q.T, qd.T, qdd.T, LinkStates(st.C[:, :, :U.shape[0]], qd[2::3], qdd[2::3])
+    q, qd, qdd, *_ = kernel.link_poses(S, plan, st[:3] + st[5:], U, split, False)
+    return q.T, qd.T, qdd.T, LinkStates(st[0][:, :, :U.shape[0]], qd[2::3], qdd[2::3])
 
 
 class LinkStates:
@@ -240,13 +175,9 @@ class LinkStates:
 
     def point(self, i: int, s: complex | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (N, 2) of the local point ``s`` (x, y, or a
-        complex number) of link ``i``: views of one array (3, N, 2)."""
-        C = self.C
-        N = C.shape[2]
-        got = kernel.point_states(C, self.w, self.al, np.array([i], np.int64),
-                                  np.array([s if isinstance(s, complex) else complex(s[0], s[1])]))
-        P, V, A = got[:, 0].view(float).reshape(3, N, 2)
-        return P, V, A
+        complex number) of link ``i``: :meth:`points` of one point."""
+        P, V, A = self.points(np.array([i]), np.array([s if isinstance(s, complex) else complex(s[0], s[1])]))
+        return P[0], V[0], A[0]
 
     def points(self, idx: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, velocity, acceleration (m, N, 2) of the local points ``s`` (m,
@@ -260,7 +191,7 @@ class LinkStates:
         >>> from mechsyn.kinematics.analysis import compile_plan
         >>> kp = compile_plan(load_mechanism("examples/kinematics/crank_rocker.yaml"), inputs=("A",))
         >>> U = np.radians(np.arange(0.0, 360.0, 30.0))[:, None]
-        >>> *_, links = regular_sweep(kp.system, kp.groups, U, np.ones(1), None)
+        >>> *_, links = sweep_through_folds(kp.system, kp.groups, U, np.ones(1), None)
         >>> P, V, A = links.points(np.array([0, 1]), np.array([1 + 0j, 0.5 + 0.2j]))
         >>> P.shape, bool(np.array_equal(A[1], links.point(1, (0.5, 0.2))[2]))
         ((2, 12, 2), True)

@@ -20,7 +20,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-__all__ = ["Sweep", "Event", "EventKind", "by_row", "REGULAR_DISC", "connecting_path", "regular_rows",
+__all__ = ["Sweep", "Event", "EventKind", "by_row", "REGULAR_DISC", "connecting_path",
            "tracking_path", "turns", "driver_kinds"]
 
 #: What an event reports.
@@ -67,23 +67,11 @@ class Event(Mapping):
                              before_sweep=before_sweep, joint=joint, value=value, last=last)
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON form: only the fields that are set, in a fixed order."""
-        out: dict[str, Any] = {"index": self.index, "kind": self.kind}
-        if self.input is not None:
-            out["input"] = self.input
-        if self.joint is not None:
-            out["joint"] = self.joint
-            out["value"] = self.value
-        if self.group is not None:
-            out["group"] = self.group
-        if self.crossed is not None:
-            out["crossed"] = self.crossed
-        out["message"] = self.message
-        if self.before_sweep is not None:
-            out["before_sweep"] = self.before_sweep
-        if self.last is not None:
-            out["last"] = self.last
-        return out
+        """The JSON form: only the fields that are set, in a fixed order (``index``,
+        ``kind`` and ``message`` always; ``value`` with its ``joint``)."""
+        d = self.__dict__
+        keep = _ALWAYS_WITH_JOINT if d["joint"] is not None else _ALWAYS
+        return {k: d[k] for k in _KEYS if k in keep or (d[k] is not None and k != "value")}
 
     def with_(self, **changes: Any) -> "Event":
         """A copy with some fields changed (``dataclasses.replace`` without its checks:
@@ -107,6 +95,9 @@ class Event(Mapping):
 
 
 _FIELDS = frozenset(f.name for f in fields(Event))
+#: The JSON form's keys in their order, and those it always has (:meth:`Event.to_dict`).
+_KEYS = ("index", "kind", "input", "joint", "value", "group", "crossed", "message", "before_sweep", "last")
+_ALWAYS, _ALWAYS_WITH_JOINT = frozenset({"index", "kind", "message"}), frozenset({"index", "kind", "message", "value"})
 
 def as_event(e: "Event | dict[str, Any]") -> Event:
     """An :class:`Event` from an event or its mapping form (the keys are its fields)."""
@@ -163,7 +154,7 @@ class Sweep:
 
 # --------------------------------------------------------------------------- connecting paths
 #: Smallest normalised discriminant of every group over a sweep for which
-#: :func:`mechsyn.kinematics.regular.regular_sweep` answers (below it
+#: :func:`mechsyn.kinematics.regular.sweep_through_folds` answers without a fold scan (below it
 #: :func:`mechsyn.kinematics.tracking.solve_tracked` looks for folds and change points: its
 #: candidates are local minima under 0.05).
 REGULAR_DISC = 0.05 + 1e-9
@@ -207,16 +198,6 @@ def driver_kinds(S: Any) -> tuple[tuple, float]:
     steps are measured by."""
     kinds = tuple(d.type for d in S.drivers)
     return kinds, (S.scale if "P" in kinds else 1.0)
-
-
-def regular_rows(S: Any, U: np.ndarray, split: int | None) -> np.ndarray:
-    """The rows ``U`` followed by the connecting paths from the drawn input values to the
-    sweep (to rows ``split`` and ``split - 1`` when the drawn values lie between them,
-    else to row 0), for :func:`mechsyn.kinematics.regular.regular_sweep`."""
-    kinds, scale = driver_kinds(S)
-    u0 = [float(d.assembled) for d in S.drivers]
-    ends = [0] if split is None else [split, split - 1]
-    return np.concatenate([U] + [connecting_path(kinds, scale, u0, turned(kinds, u0, U[e].tolist())) for e in ends])
 
 
 def tracking_path(S: Any, first: np.ndarray, u0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:

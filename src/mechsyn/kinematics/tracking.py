@@ -16,7 +16,7 @@ import numpy as np
 from mechsyn.kinematics.chain import chain_poses, tracked_pass
 from mechsyn.kinematics.groups import Plan, cons_of
 from mechsyn.kinematics.positions import PoseState, TrackedPositions, pose_rows, solve_step
-from mechsyn.kinematics.folds import SINGULAR_DISC, disc_at, swept, fold_events, touch_candidates
+from mechsyn.kinematics.folds import ON_THE_WAY, SINGULAR_DISC, disc_at, fold_events, touch_candidates
 from mechsyn.kinematics.sweep import Event, tracking_path
 from mechsyn.kinematics.system import PlanarSystem
 
@@ -51,19 +51,18 @@ def solve_tracked(S: PlanarSystem, plan: Plan, inputs: np.ndarray, switch: bool 
     take the other branch instead (``sigma`` kept: a parallelogram becomes an
     anti-parallelogram there); the events say so.
     """
-    X, n0, shift = _tracking_rows(S, inputs)
+    rows = _tracking_rows(S, inputs)
+    X, n0, shift = rows
     M = X.shape[0]
     st = PoseState(S, M)
-    sigmas: list = []
+    sigmas: list = [None] * len(plan.steps)
     discs: dict = {}
     singular = np.zeros(M, bool)
     raw_events: list = []
     for k, step in enumerate(plan.steps):
-        if step.kind not in BRANCHED:
-            sigmas.append(solve_step(S, st, step, X, None))
-            continue
-        choose = _chooser(S, plan, k, sigmas, X, n0, switch, discs, raw_events, singular)
-        sigmas.append(solve_step(S, st, step, X, choose))
+        choose = _chooser(S, plan, k, sigmas, [rows], [slice(0, M)], switch, [raw_events], singular, discs) \
+            if step.kind in BRANCHED else None
+        sigmas[k] = solve_step(S, st, step, X, choose)
     q = pose_rows(S, st, plan)
     for step in plan.steps:  # a link driven from the frame takes the input's own turn count
         if step.kind == "drive_R" and step.known[0] < 0:
@@ -92,7 +91,7 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     raw_events: list = [[] for _ in parts]
     for k, step in enumerate(plan.steps):
         if step.kind in BRANCHED:
-            sigmas[k] = _parts_chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
+            sigmas[k] = _chooser(S, plan, k, sigmas, rows, segs, switch, raw_events, singular)
     # the sweeps' own rows (not shifted by turns: the same numbers as an untracked pass);
     # the choosers' events and root searches use the shifted rows
     E = np.vstack([blk for (X, n0, _), U in zip(rows, parts) for blk in (X[:n0], U)])
@@ -105,11 +104,14 @@ def solve_tracked_rates(S: PlanarSystem, plan: Plan, parts: list, speeds: np.nda
     return out
 
 
-def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
-                   raw_events: list, singular: np.ndarray):
-    """The sign chooser of branched step ``k`` over several sweeps' rows (``segs`` of the
-    pass): the branch rules (:func:`_branch_signs`) applied to each sweep's rows alone;
-    the signs are also put in ``sigmas[k]``."""
+def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list, segs: list, switch: bool,
+             raw_events: list, singular: np.ndarray, discs: dict | None = None):
+    """The sign chooser of branched step ``k`` over one or several sweeps' rows (``segs``
+    of the pass, ``rows`` their :func:`_tracking_rows`): called with the step's
+    normalised discriminant and the drawn mode, it applies the branch rules
+    (:func:`_branch_signs`) to each sweep's rows alone, records the events (per sweep in
+    ``raw_events``), the singular rows and the discriminant (in ``discs``, when given),
+    puts the signs in ``sigmas[k]`` and returns them."""
     def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
         sig = np.empty(len(disc))
         for (X, n0, _), seg, evs in zip(rows, segs, raw_events):
@@ -117,6 +119,8 @@ def _parts_chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, rows: list
             sig[seg], found, sing = _branch_signs(S, plan, k, up, X, disc[seg], s_file, n0, switch)
             evs.extend(found)
             singular[seg][sing] = True
+        if discs is not None:
+            discs[k] = disc
         sigmas[k] = sig
         return sig
     return choose
@@ -130,27 +134,20 @@ def _tracking_rows(S: PlanarSystem, inputs: np.ndarray) -> tuple[np.ndarray, int
     return np.vstack([path, U - shift]), path.shape[0], shift
 
 
-def _chooser(S: PlanarSystem, plan: Plan, k: int, sigmas: list, X: np.ndarray, n0: int, switch: bool,
-             discs: dict, raw_events: list, singular: np.ndarray):
-    """The sign chooser of branched step ``k``: called with the step's normalised
-    discriminant and the drawn mode, it applies the branch rules (:func:`_branch_signs`),
-    records the discriminant, events and singular rows, and returns the signs."""
-    def choose(disc: np.ndarray, s_file: float) -> np.ndarray:
-        sig, evs, sing = _branch_signs(S, plan, k, sigmas, X, disc, s_file, n0, switch)
-        discs[k] = disc
-        raw_events.extend(evs)
-        singular[sing] = True
-        return sig
-    return choose
-
-
 def _sweep_events(raw_events: list, n0: int, shift: np.ndarray) -> list:
-    """Events of the tracked rows as events of the sweep (the connecting path's marked)."""
+    """Events of the tracked rows (the first ``n0`` the connecting path, the rest the
+    sweep shifted by the whole turns ``shift``) as events of the sweep: their row along
+    it, the connecting path's marked (``before_sweep``, their message says so), the
+    sweep's inputs with the whole turns added back."""
     sh = shift.tolist()
     out = []
     for e in raw_events:
-        index, message, u, before = swept(e.index, e.message, e.input, n0, sh, e.before_sweep)
-        out.append(e.with_(index=index, message=message, input=u, before_sweep=before))
+        message, before, u = e.message, e.before_sweep, e.input
+        if e.index < n0:  # on the way from the drawn configuration to the sweep
+            message, before = ON_THE_WAY + message, True
+        if not before:
+            u = [x + s for x, s in zip(u, sh)]
+        out.append(e.with_(index=max(0, e.index - n0), message=message, input=u, before_sweep=before))
     return out
 
 
