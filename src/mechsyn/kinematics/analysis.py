@@ -35,6 +35,7 @@ from mechsyn.kinematics.system import VLL_MODES, PlanarSystem, build_system, fra
 from mechsyn.kinematics.topology import CACHE, Topology, topology_of
 from mechsyn.model.mechanism import Mechanism, fields_replaced
 from mechsyn.progress import ProgressCallback
+from mechsyn.results import csv_table
 
 __all__ = ["ENGINES", "Motion", "Simulation", "PointMotion", "LinkMotion", "simulate", "input_grid", "resolve_points",
            "KinematicPlan", "compile_plan", "cached_plan", "drawn_inputs",
@@ -666,6 +667,31 @@ class ForceAnalysis(Result):
                           "or force (P) the actuator applies to the second link",
         }
 
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The inputs, ``assembled``, each joint's reaction (``A_Fx``, ``A_Fy``, ``A_F``
+        = |F|, ``A_M``) and each drive's balancing effort, one row per input value."""
+        R = self.reactions
+        cols = self.simulation.columns(motion=False)
+        for j, F in R.force.items():
+            cols.update({f"{j}_Fx": F[:, 0], f"{j}_Fy": F[:, 1], f"{j}_F": np.linalg.norm(F, axis=1),
+                         f"{j}_M": R.moment[j]})
+        for j, e in R.effort.items():
+            cols[f"drive_{j}_{R.effort_kind[j]}"] = e
+        return cols
+
+    def csv(self) -> str:
+        """:meth:`columns` as a CSV table (:func:`mechsyn.results.csv_table`): what
+        ``mechsyn forces --csv`` writes.
+
+        Examples
+        --------
+        >>> import mechsyn as ms
+        >>> f = ms.forces(ms.examples.load("crank_rocker"), {"A": ms.input_grid(0, 90, 45)}, static=True)
+        >>> f.csv().splitlines()[0].split(",")[:4]
+        ['input_A', 'assembled', 'A_Fx', 'A_Fy']
+        """
+        return csv_table(self.columns())
 
     def notes(self) -> list[str]:
         """Warnings on the result: belts that would have to push (they go slack)."""

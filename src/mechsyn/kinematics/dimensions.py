@@ -42,7 +42,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.derived import is_fourbar
-from mechsyn.kinematics.groups import circle_circle
+from mechsyn.kinematics.groups import circle_circle, decompose
 from mechsyn.kinematics.plane import cross, perp, to_frame
 from mechsyn.kinematics.solve import newton, worst_joint
 from mechsyn.kinematics.system import build_system
@@ -317,8 +317,16 @@ class _Geometry:
         self.old = {j: S.to_local(link, _xy(mech.joint(j).point)) for j in moves}
         self.new = {j: S.to_local(link, np.asarray(p, float)) for j, p in moves.items()}
 
-    def local(self, jid: str, t: float) -> np.ndarray:
+    def between(self, jid: str, t: float) -> np.ndarray:
+        """Moved joint ``jid``'s local point a fraction ``t`` of the way to its new place."""
         return self.old[jid] + t * (self.new[jid] - self.old[jid])
+
+    def local(self, link: str, jid: str, p: np.ndarray | None = None) -> np.ndarray:
+        """Joint ``jid``'s drawn point (or the point ``p``) in ``link``'s frame, with the new
+        dimension."""
+        if link == self.link and jid in self.new:
+            return self.new[jid]
+        return self.S.to_local(link, _xy(self.S.mech.joint(jid).point if p is None else p))
 
     def line(self, t: float) -> tuple[np.ndarray, np.ndarray, float]:
         """The guide at ``t``: a point on it and its direction (drawn coordinates), the turn."""
@@ -338,9 +346,9 @@ class _Geometry:
             ch: dict[str, Any] = {}
             if con.joint in self.old:
                 if con.a == self.i and con.sa is not None:
-                    ch["sa"] = self.local(con.joint, t)
+                    ch["sa"] = self.between(con.joint, t)
                 if con.b == self.i and con.sb is not None:
-                    ch["sb"] = self.local(con.joint, t)
+                    ch["sb"] = self.between(con.joint, t)
             elif line is not None and con.joint == self.guide[0]:
                 p, ut, turn = line
                 ul = S.to_local_dir(self.link, ut)
@@ -353,11 +361,9 @@ class _Geometry:
             cons.append(replace(con, **ch) if ch else con)
         return replace(S, cons=tuple(cons), cache={})
 
-    def place(self, q: np.ndarray, link: str, jid: str, p: np.ndarray) -> np.ndarray:
-        """Where the drawn point ``p`` of joint ``jid`` on ``link`` is at ``q`` (new geometry)."""
-        S = self.S
-        s = self.local(jid, 1.0) if link == self.link and jid in self.old else S.to_local(link, p)
-        return S.point(q[None], S.index(link), s)[0]
+    def place(self, q: np.ndarray, link: str, jid: str, p: np.ndarray | None = None) -> np.ndarray:
+        """Where the point :meth:`local` of ``link`` is at ``q`` (new geometry)."""
+        return self.S.point(q[None], self.S.index(link), self.local(link, jid, p))[0]
 
     def mechanism(self, q: np.ndarray) -> Mechanism:
         S, mech = self.S, self.S.mech
@@ -369,15 +375,15 @@ class _Geometry:
             if line is not None and j.id == self.guide[0]:
                 p, ut, _ = line
                 on = b if S.index(b) >= 0 else a
-                ch["point"] = self.place(q, a, j.id, p) if on == a else self.place(q, b, j.id, _xy(j.point))
+                ch["point"] = self.place(q, a, j.id, p) if on == a else self.place(q, b, j.id)
                 ch["axis"] = _turned(S, q, a, S.to_local_dir(a, ut))
             elif j.point is not None and (S.index(b) >= 0 or S.index(a) >= 0):
                 on = b if S.index(b) >= 0 else a
-                ch["point"] = self.place(q, on, j.id, _xy(j.point))
+                ch["point"] = self.place(q, on, j.id)
                 if j.type == "P" and j.axis is not None:
                     ch["axis"] = _turned(S, q, a, S.to_local_dir(a, _xy(j.axis)))
             joints.append(replace(j, **ch) if ch else j)
-        points = {n: replace(ps, at=self.place(q, ps.link, "", _xy(ps.at))) for n, ps in mech.points.items()}
+        points = {n: replace(ps, at=self.place(q, ps.link, "", ps.at)) for n, ps in mech.points.items()}
         return replace(mech, joints=tuple(joints), points=points)
 
 
@@ -420,78 +426,37 @@ def _worst_joint(geo: _Geometry, q: np.ndarray) -> str:
     return worst_joint(St, q, np.array([d.assembled for d in St.drivers]))
 
 
-def _binary_dyads(mech: Mechanism) -> list[tuple[str, str, str, str, str]]:
-    """``(l1, l2, E, G, F)``: two moving links of R joints, neither driven, joined by the R
-    joint ``G``, with ``E`` another place of ``l1`` and ``F`` one of ``l2`` (an RRR dyad)."""
-    free = [n for n in mech.moving_links
-            if all(j.type == "R" for j in mech.joints_of(n)) and not any(j.actuated for j in mech.joints_of(n))]
-    out = []
-    for g in mech.joints:
-        l1, l2 = g.links
-        if g.type != "R" or l1 not in free or l2 not in free:
-            continue
-        for e_ids, _ in _places(mech, l1):
-            for f_ids, _ in _places(mech, l2):
-                if g.id not in e_ids and g.id not in f_ids:
-                    e = next((x for x in e_ids if mech.joint(x).other(l1) != l2), e_ids[0])
-                    f = next((x for x in f_ids if mech.joint(x).other(l2) != l1), f_ids[0])
-                    out.append((l1, l2, e, g.id, f))
-    return out
-
-
-def _solvable_dyads(mech: Mechanism) -> list[tuple[str, str, str, str, str]]:
-    """The RRR dyads of :func:`_binary_dyads` in the order they are solved: each one's outer
-    joints on the frame, a driven link or the links of a dyad before it."""
-    known = {mech.ground} | {j.other(mech.ground) for j in mech.joints if j.actuated and mech.ground in j.links}
-    todo, out = _binary_dyads(mech), []
-    while True:
-        ready = [d for d in todo if d[0] not in known and d[1] not in known
-                 and mech.joint(d[2]).other(d[0]) in known and mech.joint(d[4]).other(d[1]) in known]
-        if not ready:
-            return out
-        for d in ready:
-            if d[0] not in known and d[1] not in known:
-                out.append(d)
-                known |= {d[0], d[1]}
-
-
 def _worst_dyad(geo: _Geometry, q: np.ndarray) -> tuple | None:
-    """The dyad nearest to (or furthest past) its triangle inequality with the new dimension:
-    its outer joints' places carried by their other links at ``q``, its sides' new lengths."""
-    mech = geo.S.mech
+    """The RRR dyad of the mechanism's decomposition
+    (:func:`~mechsyn.kinematics.groups.decompose`) nearest to (or furthest past) its
+    triangle inequality with the new dimension: ``((l1, l2, E, G, F), a, b, d)``, the dyad's
+    links ``l1, l2`` joined at ``G``, its outer joints ``E, F`` carried by their known links
+    at ``q`` ``d`` apart, its sides ``a = EG`` on ``l1`` and ``b = GF`` on ``l2`` (new lengths)."""
+    S = geo.S
+    plan = decompose(S)
     best, score = None, -np.inf
-    for l1, l2, e, g, f in _solvable_dyads(mech):
-        a = _side_len(geo, l1, e, g)
-        b = _side_len(geo, l2, g, f)
-        pe = _outer(geo, q, mech.joint(e), l1)
-        pf = _outer(geo, q, mech.joint(f), l2)
+    for step in plan.steps if plan is not None else ():
+        if step.kind != "RRR":
+            continue
+        (l1, l2), (e, g, f) = (S.links[i] for i in step.links), step.joints
+        a, b = _side_len(geo, l1, e, g), _side_len(geo, l2, g, f)
+        pe, pf = (geo.place(q, S.mech.joint(j).other(link), j) for j, link in ((e, l1), (f, l2)))
         d = float(np.linalg.norm(pe - pf))
-        s = max(d - (a + b), abs(a - b) - d) / geo.S.scale
+        s = max(d - (a + b), abs(a - b) - d) / S.scale
         if s > score:
             best, score = ((l1, l2, e, g, f), a, b, d), s
     return best
 
 
 def _side_len(geo: _Geometry, link: str, j1: str, j2: str) -> float:
-    S = geo.S
-    p1, p2 = (geo.local(j, 1.0) if link == geo.link and j in geo.old else S.to_local(link, _xy(S.mech.joint(j).point))
-              for j in (j1, j2))
-    return float(np.linalg.norm(p1 - p2))
-
-
-def _outer(geo: _Geometry, q: np.ndarray, j: Any, dyad_link: str) -> np.ndarray:
-    other = j.other(dyad_link)
-    return geo.place(q, other, j.id, _xy(j.point))
+    """The distance of joints ``j1`` and ``j2`` on ``link`` with the new dimension."""
+    return float(np.linalg.norm(geo.local(link, j1) - geo.local(link, j2)))
 
 
 def _grashof_words(geo: _Geometry) -> str:
-    S, mech = geo.S, geo.S.mech
-    lengths = {}
-    for name in mech.link_names:
-        a, b = mech.joints_of(name)
-        lengths[name] = _side_len(geo, name, a.id, b.id)
-    v = sorted(lengths.values())
-    s, p, qq, L = v
+    """Grashof's condition of the four-bar with the new dimension, in words."""
+    mech = geo.S.mech
+    s, p, qq, L = sorted(_side_len(geo, name, *(j.id for j in mech.joints_of(name))) for name in mech.link_names)
     if s + L <= p + qq:
         return f"Grashof holds (s + l = {s + L:.4g} ≤ p + q = {p + qq:.4g}: the shortest link turns fully)"
     return f"non-Grashof (s + l = {s + L:.4g} > p + q = {p + qq:.4g}: no link turns fully)"

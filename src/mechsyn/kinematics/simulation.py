@@ -22,6 +22,7 @@ from mechsyn.kinematics.summary import is_full_turn
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.limits import limit, limit_hint
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.results import csv_table
 
 if TYPE_CHECKING:
     from mechsyn.kinematics.system import PlanarSystem
@@ -152,8 +153,7 @@ class Motion(Result):
         """The result as named columns, one row per input value: the inputs, ``assembled``,
         then (``motion``) every point's x, y (z), vx, vy, ..., ax, ... and every link's
         numbers by row (angle, omega, alpha; a 3-D link's translation and rates by
-        component): the columns of :meth:`to_pandas` and of the CSV tables
-        (:mod:`mechsyn.kinematics.report`).
+        component): the columns of :meth:`to_pandas` and of :meth:`csv`.
 
         Examples
         --------
@@ -177,6 +177,18 @@ class Motion(Result):
                     for c, col in zip("xyz", arr.T):
                         cols[f"{name}_{key}_{c}"] = col
         return cols
+
+    def csv(self) -> str:
+        """:meth:`columns` as a CSV table (:func:`mechsyn.results.csv_table`): what
+        ``mechsyn simulate --csv`` writes.
+
+        Examples
+        --------
+        >>> import mechsyn as ms
+        >>> ms.examples.load("crank_rocker").simulate(A=(0, 90, 30)).csv().splitlines()[0].split(",")[:3]
+        ['input_A', 'assembled', 'M_x']
+        """
+        return csv_table(self.columns())
 
     def to_pandas(self) -> Any:
         """A :class:`pandas.DataFrame` of :meth:`columns`, one row per input value."""
