@@ -243,7 +243,7 @@ def forces_cmd(
 ) -> None:
     """Joint reactions and the balancing moment/force at each driven joint over the input."""
     from mechsyn.cli.render import render_forces
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
 
     _check_outputs(plot, csv_out, json_)
     if not np.isfinite(gravity):

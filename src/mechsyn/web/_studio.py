@@ -35,7 +35,7 @@ from mechsyn.export.drawing import drawing_of
 from mechsyn.export.dxf import layout_to_dxf
 from mechsyn.export.plates import link_plates
 from mechsyn.io import load_mechanism
-from mechsyn.kinematics.analysis import forces as _forces
+from mechsyn.kinetostatics import forces as _forces
 from mechsyn.progress import Progress, ProgressCallback
 from mechsyn.results import to_jsonable
 from mechsyn.structure.drives import DriveCheck
