@@ -27,7 +27,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.groups import decompose
 from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["transmission_angles", "mechanical_advantage", "grashof", "Grashof", "is_fourbar", "path_extent",
+__all__ = ["transmission_angles", "mechanical_advantage", "slide", "grashof", "Grashof", "is_fourbar", "path_extent",
            "straightness", "default_output_link"]
 
 
@@ -90,18 +90,29 @@ def mechanical_advantage(sim, output: str) -> np.ndarray:
     if output not in sim.links:
         raise MechsynInputError(f"no moving link {output!r}", field="output",
                                 hint=f"links: {', '.join(sim.links)}")
-    w_in = sim.speeds[main]
-    S = sim.system
-    mech = S.mech
-    slide = next((j for j in mech.joints if j.type == "P" and set(j.links) == {mech.ground, output}), None)
-    if slide is not None:
-        out_rate = np.asarray(S.coordinate_rate(sim.sweep.q, sim.sweep.qd, slide.id))
-    else:
-        out_rate = sim.links[output].angular_velocity
+    mech = sim.system.mech
+    p = next((j.id for j in mech.joints if j.type == "P" and set(j.links) == {mech.ground, output}), None)
+    out_rate = slide(sim, p)[1] if p is not None else sim.links[output].angular_velocity
     with np.errstate(divide="ignore", invalid="ignore"):
-        ma = np.abs(w_in / out_rate)
+        ma = np.abs(sim.speeds[main] / out_rate)
     ma[~sim.assembled] = np.nan
     return ma
+
+
+def slide(sim, joint: str, acceleration: bool = False) -> tuple[np.ndarray, ...]:
+    """P joint ``joint``'s slide along its guide over a planar simulation
+    (:meth:`~mechsyn.kinematics.system.PlanarSystem.coordinate`: from the guide link's
+    origin, the world origin for the frame; NaN where not assembled) and its rate at the
+    drives' speeds; with ``acceleration`` also the rate's time derivative along the motion
+    (a central difference)."""
+    S, q, qd, qdd = sim.system, sim.sweep.q, sim.sweep.qd, sim.sweep.qdd
+    value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), joint), np.nan)
+    rate = S.coordinate_rate(q, qd, joint)
+    if not acceleration:
+        return value, rate
+    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
+    ahead, back = (S.coordinate_rate(q + sh * qd, qd + sh * qdd, joint) for sh in (h, -h))
+    return value, rate, (ahead - back) / (2 * h)
 
 
 @dataclass(frozen=True)

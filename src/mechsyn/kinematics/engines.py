@@ -115,29 +115,6 @@ class RegularPass:
         return "a group's discriminant has a minimum near zero (a change or branch point may be near)"
 
 
-class TrackedChain:
-    """A driver-R + RRR chain through folds and change points, rates in closed form."""
-
-    name = "tracked chain"
-
-    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
-        if plan is None or not plan.closed_form_rates:
-            return None
-        switch = change_points == "switch"
-        advance = counter(progress, len(inputs), "sweep")
-
-        def run(parts: list) -> list[Sweep]:
-            res = solve_tracked_rates(system, plan, parts, speeds, switch=switch)
-            return [_tracked_sweep(system, U, speeds, r, self.name, advance) for U, r in zip(parts, res)]
-
-        return outward(system, inputs, run)
-
-    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
-        """Why :meth:`sweep` gave None, in one line."""
-        return _NO_PLAN if plan is None else "it takes chains of R drivers and RRR dyads only"
-
-
 class TrackedGroups:
     """Any mechanism of drivers and dyads, rates by batched linear solves."""
 
@@ -145,25 +122,48 @@ class TrackedGroups:
 
     def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
               change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
-        if plan is None:
+        if not self.takes(plan):
             return None
         switch = change_points == "switch"
         advance = counter(progress, len(inputs), "sweep")
 
         def run(parts: list) -> list[Sweep]:
-            out = []
-            for U in parts:
-                tracked = solve_tracked(system, plan, U, switch=switch)
-                q, qd, qdd = solve_all(system, plan, U, speeds, tracked=tracked)
-                res = (q, qd, qdd, tracked.singular, tracked.events)
-                out.append(_tracked_sweep(system, U, speeds, res, self.name, advance))
-            return out
+            res = self.solved(system, plan, parts, speeds, switch)
+            return [_tracked_sweep(system, U, speeds, r, self.name, advance) for U, r in zip(parts, res)]
 
         return outward(system, inputs, run)
+
+    def takes(self, plan: Plan | None) -> bool:
+        """Whether the engine answers for a mechanism of this plan."""
+        return plan is not None
+
+    def solved(self, system: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray, switch: bool) -> list:
+        """``(q, qd, qdd, singular rows, group events)`` of each of ``parts`` (input rows)."""
+        out = []
+        for U in parts:
+            tracked = solve_tracked(system, plan, U, switch=switch)
+            out.append((*solve_all(system, plan, U, speeds, tracked=tracked), tracked.singular, tracked.events))
+        return out
 
     def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
         """Why :meth:`sweep` gave None, in one line."""
         return _NO_PLAN
+
+
+class TrackedChain(TrackedGroups):
+    """A driver-R + RRR chain through folds and change points, rates in closed form: the
+    tracked groups' sweep with the chain's solver."""
+
+    name = "tracked chain"
+
+    def takes(self, plan: Plan | None) -> bool:
+        return plan is not None and plan.closed_form_rates
+
+    def solved(self, system: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray, switch: bool) -> list:
+        return solve_tracked_rates(system, plan, parts, speeds, switch=switch)
+
+    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
+        return _NO_PLAN if plan is None else "it takes chains of R drivers and RRR dyads only"
 
 
 #: Why an engine of drivers and Assur groups declines a mechanism without such a plan.

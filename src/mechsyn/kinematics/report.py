@@ -133,23 +133,15 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
 
 
 def _slides(mech: Mechanism, sim: Simulation) -> dict[str, Any]:
-    """Every P joint's slide along its guide (:meth:`PlanarSystem.coordinate`: from the guide
-    link's origin, the world origin for the frame), its rate and its acceleration (the rate's
-    time derivative along the motion, by a central difference) at the drive's speed."""
-    S, sw = sim.system, sim.sweep
-    if S is None or sw is None:
+    """Every P joint's slide along its guide, its rate and its acceleration
+    (:func:`~mechsyn.kinematics.derived.slide`)."""
+    if sim.system is None or sim.sweep is None:
         return {}
-    q, qd, qdd = (np.asarray(a, float) for a in (sw.q, sw.qd, sw.qdd))
-    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
     out = {}
     for j in mech.joints:
-        if j.type != "P":
-            continue
-        rate = S.coordinate_rate(q, qd, j.id)
-        acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
-        value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
-        out[j.id] = {"guide": j.links[0], "value": rows(value), "rate": rows(rate),
-                     "acceleration": rows(acc)}
+        if j.type == "P":
+            value, rate, acc = derived.slide(sim, j.id, acceleration=True)
+            out[j.id] = {"guide": j.links[0], "value": rows(value), "rate": rows(rate), "acceleration": rows(acc)}
     return out
 
 

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn.kinematics.derived import slide
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["motion_summary", "is_full_turn"]
@@ -137,9 +138,8 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
     >>> round(s["sliders"]["D"]["time_ratio"]["ratio"], 6)
     1.0
     """
-    S, sweep = getattr(sim, "system", None), getattr(sim, "sweep", None)
     out: dict[str, Any] = {"full_turn": False, "sliders": {}, "rockers": {}}
-    if mech.kind != "planar" or S is None or sweep is None or len(sim.inputs) != 1:
+    if mech.kind != "planar" or getattr(sim, "sweep", None) is None or len(sim.inputs) != 1:
         return out
     main = sim.main_input
     x = np.asarray(sim.inputs[main], float)
@@ -149,13 +149,10 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
     out["full_turn"] = cyclic
     # the rates are per unit time at the input's speed; d/dx in the input's own unit (deg or length)
     rate_x = float(sim.speeds.get(main, 1.0)) * (180.0 / np.pi if kind == "R" else 1.0)
-    q = np.asarray(sweep.q, float)
     for j in mech.joints:
         if j.type != "P" or j.id == main or j.actuated:
             continue
-        s = np.asarray(S.coordinate(np.nan_to_num(q), j.id), float)
-        sd = np.asarray(S.coordinate_rate(q, np.asarray(sweep.qd, float), j.id), float)
-        s[~ok] = np.nan
+        s, sd = slide(sim, j.id)
         r = _range_of(x, s, sd / rate_x, ok, cyclic)
         if r is None:
             continue
