@@ -71,12 +71,16 @@ def _xy(p: Any) -> np.ndarray:
     return np.asarray(p, float)[:2]
 
 
-def _pivot(mech: Mechanism, guide: str) -> Any:
-    """The pivot a slider's offset is measured from: on the guide link, the drive's R joint,
-    else its first R joint (None when it has none)."""
-    rs = [j for j in mech.joints_of(guide) if j.type == "R"]
-    driven = [j for j in rs if j.actuated]
-    return (driven or rs or [None])[0]
+def _guide(mech: Mechanism, j: Any) -> tuple[str, Any, np.ndarray, float, float]:
+    """Slider ``j``'s guide ``(link, pivot, origin, offset, angle)``: its link (the joint's
+    first), the pivot its offset is measured from (on the guide link, the drive's R joint,
+    else its first R joint; None when it has none), that pivot's place (else the joint's),
+    the guide line's signed distance from it and its direction (radians from x)."""
+    rs = [x for x in mech.joints_of(j.links[0]) if x.type == "R"]
+    piv = ([x for x in rs if x.actuated] or rs or [None])[0]
+    u = _xy(j.axis) / np.linalg.norm(_xy(j.axis))
+    o = _xy((piv or j).point)
+    return j.links[0], piv, o, float(np.array([-u[1], u[0]]) @ (_xy(j.point) - o)), math.atan2(u[1], u[0])
 
 
 def dimensions(mech: Mechanism) -> list[Dimension]:
@@ -94,24 +98,19 @@ def dimensions(mech: Mechanism) -> list[Dimension]:
         places = _places(mech, name)
         if any(j.type not in ("R", "P") for j in mech.joints_of(name)):
             continue
-        slides = any(j.type == "P" for j in mech.joints_of(name))
-        ends = [ids[0] for ids, _ in places]
-        if len(places) == 2 and not slides:
-            out.append(Dimension(name, "length", tuple(ends), float(np.linalg.norm(places[0][1] - places[1][1]))))
+        sides = [(places[k], places[(k + 1) % len(places)]) for k in range(len(places))]  # round the plate
+        if len(places) == 2 and not any(j.type == "P" for j in mech.joints_of(name)):
+            (a, pa), (b, pb) = sides[0]
+            out.append(Dimension(name, "length", (a[0], b[0]), float(np.linalg.norm(pa - pb))))
         elif len(places) >= 3:
-            for k in range(3 if len(places) == 3 else len(places)):
-                (a, pa), (b, pb) = places[k], places[(k + 1) % len(places)]
-                out.append(Dimension(name, "side", (a[0], b[0]), float(np.linalg.norm(pa - pb))))
+            out += [Dimension(name, "side", (a[0], b[0]), float(np.linalg.norm(pa - pb))) for (a, pa), (b, pb) in sides]
     for j in mech.joints:
         if j.type != "P" or j.axis is None:
             continue
-        guide = j.links[0]
-        piv = _pivot(mech, guide)
-        u = _xy(j.axis) / np.linalg.norm(_xy(j.axis))
-        out.append(Dimension(guide, "angle", (j.id,), math.degrees(math.atan2(u[1], u[0]))))
+        guide, piv, _, e0, a0 = _guide(mech, j)
+        out.append(Dimension(guide, "angle", (j.id,), math.degrees(a0)))
         if piv is not None:
-            n = np.array([-u[1], u[0]])
-            out.append(Dimension(guide, "offset", (j.id, piv.id), float(n @ (_xy(j.point) - _xy(piv.point)))))
+            out.append(Dimension(guide, "offset", (j.id, piv.id), e0))
     return out
 
 
@@ -214,13 +213,7 @@ def set_slider(mech: Mechanism, joint: str, *, offset: float | None = None,
     j = mech.joint(joint)
     if j.type != "P":
         raise MechsynInputError(f"joint {joint} is not a slider (P joint)", field="offset")
-    guide = j.links[0]
-    piv = _pivot(mech, guide)
-    u = _xy(j.axis) / np.linalg.norm(_xy(j.axis))
-    n = np.array([-u[1], u[0]])
-    o = _xy(piv.point) if piv is not None else _xy(j.point)
-    e0 = float(n @ (_xy(j.point) - o))
-    a0 = math.atan2(u[1], u[0])
+    guide, piv, o, e0, a0 = _guide(mech, j)
     for v, what in ((offset, "offset"), (angle, "angle")):
         if v is not None and not math.isfinite(float(v)):
             raise MechsynInputError(f"the guide's {what} must be a number, not {v!r}", field=what)
