@@ -147,27 +147,15 @@ def grashof(mech: Mechanism) -> Grashof:
     coupler = next(n for n in mech.link_names if n not in (ground, crank, rocker))
     vals = sorted(lengths.values())
     s, p, q, l = vals[0], vals[1], vals[2], vals[3]
-    tol = 1e-9 * l
-    shortest = min(lengths, key=lengths.get)
-    if abs((s + l) - (p + q)) <= tol:
-        cls, g = "change point (s + l = p + q)", True
-    elif s + l < p + q:
-        g = True
-        if shortest == ground:
-            cls = "double crank (drag link)"
-        elif shortest == crank:
-            cls = "crank-rocker"
-        elif shortest == rocker:
-            cls = "rocker-crank (the output turns fully)"
-        else:
-            cls = "double rocker (Grashof)"
-    else:
-        cls, g = "triple rocker (non-Grashof)", False
-    rel = "<" if s + l < p + q - tol else ("=" if abs(s + l - p - q) <= tol else ">")
+    rel = "=" if abs((s + l) - (p + q)) <= 1e-9 * l else ("<" if s + l < p + q else ">")
+    by_shortest = {ground: "double crank (drag link)", crank: "crank-rocker",
+                   rocker: "rocker-crank (the output turns fully)"}  # (Grashof: which link is the shortest)
+    cls = {"=": "change point (s + l = p + q)", ">": "triple rocker (non-Grashof)"}.get(rel) or by_shortest.get(
+        min(lengths, key=lengths.get), "double rocker (Grashof)")
     expr = f"s + l = {s:.6g} + {l:.6g} = {s + l:.6g} {rel} p + q = {p:.6g} + {q:.6g} = {p + q:.6g}"
     named = {"frame": lengths[ground], "crank": lengths[crank], "coupler": lengths[coupler],
              "rocker": lengths[rocker]}
-    return Grashof(named, s, l, p, q, g, cls, expr)
+    return Grashof(named, s, l, p, q, rel != ">", cls, expr)
 
 
 def is_fourbar(mech: Mechanism) -> bool:

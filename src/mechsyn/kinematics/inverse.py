@@ -237,10 +237,9 @@ def _posed_spatial(mech: Mechanism, sim: Any, row: int) -> Mechanism:
             ch["point"] = Rb @ np.asarray(j.point, float) + tb
         if j.axis is not None:
             ch["axis"] = Ra @ np.asarray(j.axis, float)
-        if getattr(j, "axis2", None) is not None:
-            ch["axis2"] = Rb @ np.asarray(j.axis2, float)
-        if getattr(j, "normal", None) is not None:
-            ch["normal"] = Ra @ np.asarray(j.normal, float)
+        for attr, R in (("axis2", Rb), ("normal", Ra)):  # (a second axis turns with the second link)
+            if getattr(j, attr, None) is not None:
+                ch[attr] = R @ np.asarray(getattr(j, attr), float)
         joints.append(replace(j, **ch) if ch else j)
     points = {}
     for n, p in mech.points.items():
