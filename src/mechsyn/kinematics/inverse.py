@@ -79,10 +79,8 @@ def simulate_inverse(mech: Mechanism, point: str, path: Any, *, start: dict[str,
     """
 
     drives = [j for j in mech.joints if j.actuated]
-    T = np.asarray(path, float)
+    T = np.atleast_2d(np.asarray(path, float))  # (one target: a row)
     d = 2 if mech.kind == "planar" else 3
-    if T.ndim == 1:
-        T = T[None]
     if T.ndim != 2 or T.shape[1] != d or not np.isfinite(T).all():
         raise MechsynInputError(f"the path of {point} must be rows of {d} numbers", field="path")
     if len(drives) != d:

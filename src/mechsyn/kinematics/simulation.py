@@ -133,16 +133,12 @@ class Motion(Result):
             inside = [d for d in dead if lo < d <= hi or lo <= d < hi]
             return min(inside, key=lambda d: abs(d - a)) if inside else default
 
-        out, start = [], None
-        for k in range(n):
-            if ok[k] and start is None:
-                start = k
-            if (not ok[k] or k == n - 1) and start is not None:
-                end = k if ok[k] else k - 1
-                first = located(vals[start], vals[start - 1], vals[start]) if start > 0 else vals[start]
-                last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
-                out.append([float(first), float(last)])
-                start = None
+        out = []
+        edges = np.flatnonzero(np.diff(np.r_[False, ok, False]))  # each run's first row and the row after it
+        for start, end in zip(edges[::2].tolist(), (edges[1::2] - 1).tolist()):
+            first = located(vals[start], vals[start - 1], vals[start]) if start > 0 else vals[start]
+            last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
+            out.append([float(first), float(last)])
         if len(out) > 1 and ok[0] and ok[-1] and is_full_turn(vals, self.input_types.get(self.main_input)):
             turn = 360.0 if vals[-1] >= vals[0] else -360.0  # a whole turn: the ends meet
             out[0] = [out[-1][0], out[0][1] + turn]
