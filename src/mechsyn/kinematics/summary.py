@@ -160,10 +160,8 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
         u = np.asarray(j.axis, float)[:2] / np.linalg.norm(np.asarray(j.axis, float)[:2]) if on_frame else None
         pos = sim.points[j.id].position if j.id in sim.points else None
 
-        def at(c, u=u, pos=pos, s=s):
-            p = None
-            if u is not None and pos is not None:
-                p = (pos[c["row"]][:2] + (c["value"] - s[c["row"]]) * u).tolist()
+        def at(c, u=u, pos=pos, s=s):  # the block's place there for a guide on the frame
+            p = None if u is None or pos is None else (pos[c["row"]][:2] + (c["value"] - s[c["row"]]) * u).tolist()
             return {"input": c["input"], "slide": c["value"], "point": p}
 
         out["sliders"][j.id] = {"guide": j.links[0], "block": j.links[1], "stroke": r["span"],
@@ -181,15 +179,12 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
         good = np.isfinite(ang)
         if good.any():  # continuous over each run (the engine's angles may jump by 360)
             ang[good] = np.degrees(np.unwrap(np.radians(ang[good])))
-        if cyclic and abs(ang[-1] - ang[0]) > 180.0:  # one turn of the crank turns it once: a crank too
-            out["rockers"][link] = {"pivot": j.id, "full_turn": True, "range": 360.0, "min": None, "max": None,
-                                    "time_ratio": None}
+        full = cyclic and abs(ang[-1] - ang[0]) > 180.0  # one turn of the crank turns it once: a crank too
+        r = None if full else _range_of(x, ang, np.asarray(lm.angular_velocity, float) * 180.0 / np.pi / rate_x, ok,
+                                        cyclic)
+        if r is None and not full:
             continue
-        w = np.asarray(lm.angular_velocity, float) * 180.0 / np.pi
-        r = _range_of(x, ang, w / rate_x, ok, cyclic)
-        if r is None:
-            continue
-        full = r["span"] >= 360.0 * (1 - 1e-9)
+        full = full or r["span"] >= 360.0 * (1 - 1e-9)
         out["rockers"][link] = {
             "pivot": j.id, "full_turn": bool(full), "range": 360.0 if full else r["span"],
             "min": None if full else {"input": r["min"]["input"], "angle": r["min"]["value"]},
