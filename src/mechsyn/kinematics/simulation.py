@@ -355,11 +355,8 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
 def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:
     """Named points (file ``points`` or joint ids) -> (link, assembled coordinates)."""
     out: dict[str, tuple[str, np.ndarray]] = {}
-    if names is None:
-        if mech.points:
-            names = list(mech.points)
-        else:
-            names = [j.id for j in mech.joints]
+    if names is None:  # the file's named points, else every joint
+        names = list(mech.points) or [j.id for j in mech.joints]
     for name in names:
         if name in mech.points:
             p = mech.points[name]
