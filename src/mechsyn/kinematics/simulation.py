@@ -18,7 +18,6 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.summary import is_full_turn
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.limits import limit, limit_hint
 from mechsyn.model.mechanism import Mechanism
@@ -27,7 +26,7 @@ from mechsyn.results import csv_table
 if TYPE_CHECKING:
     from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points", "rows"]
+__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points", "rows", "is_full_turn"]
 
 
 @dataclass
@@ -321,6 +320,23 @@ class Simulation(Motion):
 
 def _unit(t: str) -> str:
     return "deg" if t == "R" else "length"
+
+
+def is_full_turn(values: np.ndarray, input_type: str) -> bool:
+    """True when an R input's values cover a whole turn (the last row, one step on, is the
+    first again, e.g. 0, 2, ..., 358; or 0 ... 360 with its end repeated).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> is_full_turn(np.arange(0, 360, 2.0), "R"), is_full_turn(np.arange(0, 180, 2.0), "R")
+    (True, False)
+    """
+    x = np.asarray(values, float)
+    if input_type != "R" or len(x) < 3 or not np.isfinite(x).all():
+        return False
+    step = float(np.median(np.abs(np.diff(x))))
+    return bool(abs(x[-1] - x[0]) + step >= 360.0 * (1 - 1e-9))
 
 
 def input_grid(start: float, stop: float, step: float) -> np.ndarray:

@@ -25,26 +25,10 @@ from typing import Any
 import numpy as np
 
 from mechsyn.kinematics.derived import slide
+from mechsyn.kinematics.simulation import is_full_turn
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["motion_summary", "is_full_turn"]
-
-
-def is_full_turn(values: np.ndarray, input_type: str) -> bool:
-    """True when an R input's values cover a whole turn (the last row, one step on, is the
-    first again, e.g. 0, 2, ..., 358; or 0 ... 360 with its end repeated).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> is_full_turn(np.arange(0, 360, 2.0), "R"), is_full_turn(np.arange(0, 180, 2.0), "R")
-    (True, False)
-    """
-    x = np.asarray(values, float)
-    if input_type != "R" or len(x) < 3 or not np.isfinite(x).all():
-        return False
-    step = float(np.median(np.abs(np.diff(x))))
-    return bool(abs(x[-1] - x[0]) + step >= 360.0 * (1 - 1e-9))
 
 
 def _hermite_stop(fa: float, fb: float, da: float, db: float, h: float) -> tuple[float, float]:
