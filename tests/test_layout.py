@@ -117,7 +117,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("mechsyn.model",),                                                # the one Mechanism
     ("mechsyn.io", "mechsyn.checkpoint"),                              # files: read, check, write
     ("mechsyn.structure",),                                            # structural analysis
-    ("mechsyn.kinematics",),                                           # positions, rates, forces
+    ("mechsyn.kinematics",),                                           # positions, rates
+    ("mechsyn.kinetostatics",),                                        # forces of the motion
     ("mechsyn.export", "mechsyn.belt", "mechsyn.capability", "mechsyn.synthesis"),  # applications
     ("mechsyn.plot",),                                                 # Matplotlib figures
     ("mechsyn.examples",),                                             # the bundled files, by name
@@ -133,7 +134,7 @@ FACADE_EDGES: frozenset[str] = frozenset({
     "mechsyn.model.mechanism:Mechanism.to_dict -> mechsyn.io.load",
     "mechsyn.model.mechanism:Mechanism.analyze -> mechsyn.structure.report",
     "mechsyn.model.mechanism:Mechanism.simulate -> mechsyn.kinematics.analysis",
-    "mechsyn.model.mechanism:Mechanism.forces -> mechsyn.kinematics.analysis",
+    "mechsyn.model.mechanism:Mechanism.forces -> mechsyn.kinetostatics",
     "mechsyn.model.mechanism:_inputs -> mechsyn.kinematics.analysis",
     "mechsyn.kinematics.spatial_result:SpatialSimulation.animate -> mechsyn.plot.spatial",
     "mechsyn.synthesis.atlas:Atlas.plot -> mechsyn.plot.atlas",
@@ -406,7 +407,8 @@ def third_party_imports(path: Path) -> set[str]:
 
 
 def test_kinematics_computes_without_reading_drawing_or_terminal_packages():
-    bad = {p.name: sorted(third_party_imports(p) & set(KINEMATICS_FORBIDDEN)) for p in KINEMATICS.rglob("*.py")}
+    computing = [*KINEMATICS.rglob("*.py"), *(PACKAGE / "kinetostatics").rglob("*.py")]  # (its forces too)
+    bad = {p.name: sorted(third_party_imports(p) & set(KINEMATICS_FORBIDDEN)) for p in computing}
     bad = {k: v for k, v in bad.items() if v}
     assert not bad, f"kinematics modules importing {KINEMATICS_FORBIDDEN}: {bad}"
 

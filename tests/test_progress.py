@@ -127,7 +127,8 @@ def test_a_studio_job_keeps_the_progress_as_its_dict():
 def _long_computations():
     """Every public long computation of mechsyn (issue 37, item 7)."""
     from mechsyn.capability.maps import capability_grid, capability_map
-    from mechsyn.kinematics.analysis import KinematicPlan, forces, simulate
+    from mechsyn.kinematics.analysis import KinematicPlan, simulate
+    from mechsyn.kinetostatics import forces
     from mechsyn.kinematics.report import simulation_report
     from mechsyn.kinematics.solve import sweep
     from mechsyn.kinematics.spatial import SpatialEngine, simulate_spatial
@@ -186,7 +187,7 @@ def test_the_newton_solver_reports_progress_records_itself():
 
 
 def test_forces_and_reports_of_a_sweep_pass_its_progress_on():
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
     from mechsyn.kinematics.report import simulation_report
 
     mech = ms.examples.load("crank_rocker")

@@ -49,9 +49,10 @@ _LAZY: dict[str, str] = {
     "analyze_structure": "mechsyn.structure.analysis", "analyze_rank": "mechsyn.structure.rank",
     "find_remedies": "mechsyn.structure.remedies",
     # kinematics
-    "simulate": "mechsyn.kinematics.analysis", "forces": "mechsyn.kinematics.analysis",
-    "input_grid": "mechsyn.kinematics.analysis", "Simulation": "mechsyn.kinematics.analysis",
-    "ForceAnalysis": "mechsyn.kinematics.analysis",
+    "simulate": "mechsyn.kinematics.analysis", "input_grid": "mechsyn.kinematics.analysis",
+    "Simulation": "mechsyn.kinematics.analysis",
+    # kinetostatics
+    "forces": "mechsyn.kinetostatics.analysis", "ForceAnalysis": "mechsyn.kinetostatics.analysis",
     # capability (paper 004)
     "SerialArm": "mechsyn.capability.arm", "load_arm": "mechsyn.capability.arm_file",
     "capability_map": "mechsyn.capability.maps", "CapabilityMap": "mechsyn.capability.maps",

@@ -7,7 +7,9 @@ of them, with NumPy arrays and scalars inside, into plain JSON types, and
 
 from __future__ import annotations
 
+import csv
 import dataclasses
+import io
 import json
 import math
 import os
@@ -94,6 +96,29 @@ def csv_cell(text: str) -> str:
         return text
     except ValueError:
         return "'" + text
+
+
+def csv_table(columns: Mapping[str, Any]) -> str:
+    """Named columns of one length as a CSV table: the names as a header row
+    (:func:`csv_cell`), floats as their ``repr`` (no digit lost), empty cells where not
+    finite, booleans as 0 and 1 (a result's ``columns()``: ``assembled``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> print(csv_table({"x": np.array([1.5, np.nan]), "ok": np.array([True, False])}), end="")
+    x,ok
+    1.5,1
+    ,0
+    """
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow([csv_cell(h) for h in columns])  # names from the file: no formula reaches a spreadsheet
+    cols = [np.asarray(c).astype(int) if np.asarray(c).dtype == bool else c for c in columns.values()]
+    for row in zip(*cols):
+        w.writerow(["" if (isinstance(v, float) and not np.isfinite(v)) else
+                    (repr(float(v)) if isinstance(v, (float, np.floating)) else v) for v in row])
+    return buf.getvalue()
 
 
 def _umask_mode() -> int:

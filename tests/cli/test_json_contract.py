@@ -35,7 +35,8 @@ def test_simulate_json_is_the_report(cli_json):
 
 
 def test_forces_json_is_the_report(cli_json):
-    from mechsyn.kinematics.analysis import forces, input_grid
+    from mechsyn.kinematics.analysis import input_grid
+    from mechsyn.kinetostatics import forces
 
     fa = forces(load_mechanism(CRANK_ROCKER), {"A": input_grid(0, 360, 45)}, gravity=(0.0, -9.81))
     same_json(cli_json, ["forces", CRANK_ROCKER, "-i", "A=0:360:45", "--gravity", "9.81"], fa)

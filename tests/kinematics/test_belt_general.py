@@ -337,7 +337,7 @@ def test_sweep_stops_where_the_anchor_reaches_the_pulley():
 def test_static_forces_belt_tension_and_virtual_power():
     # a downward load on H (left of A) turns the hand counter-clockwise about A; the belt
     # holds it by a tension along its straight run, pulling the pulley towards B0
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
 
     d = mechanism_to_dict(load_mechanism(FILE))
     d["loads"] = [{"link": "hand", "force": [0.0, -100.0], "point": "H"}]

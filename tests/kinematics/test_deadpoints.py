@@ -67,7 +67,7 @@ def double_parallelogram():
 def test_redundant_parallelogram_passes_its_change_points():
     """An overconstrained (redundant) double parallelogram: least-squares Newton, the change
     points at 180 and 360 degrees reported as singular, the motion continued on its branch."""
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
     from mechsyn.kinematics.solve import check_mobility
 
     m = double_parallelogram()

@@ -471,7 +471,7 @@ def test_topology_is_shared_only_by_mechanisms_of_the_same_topology():
 
 def test_drawn_row_of_each_fresh_geometry_on_one_grid():
     """A drag simulates one grid with a new drawn input each time: the row found for each
-    is the one computed from scratch (the grid's differences are kept with its bytes)."""
+    is the one computed from scratch (the rows are kept with the grid's bytes)."""
     from mechsyn.kinematics import engines
 
     m = fourbar()
@@ -481,9 +481,9 @@ def test_drawn_row_of_each_fresh_geometry_on_one_grid():
     engines.CACHE.clear()
     for _ in range(12):
         S = kp.refilled(m.with_joint_points({"B": m.joint("B").point + rng.uniform(-0.3, 0.3, 2)})).system
-        want = engines._drawn_row_1(S.drivers[0], U[:, 0].copy())
+        want = engines._segment_row(S.drivers, U.copy())
         assert engines.drawn_row(S, U) == want and engines.drawn_row(S, U.copy()) == want
-    assert len(engines.CACHE.get(("input grid", U.shape, U.dtype.str))[2]) == 12
+    assert len(engines.CACHE.get(("input grid", U.shape, U.dtype.str))[1]) == 12
 
 
 def test_fields_replaced_is_dataclasses_replace():

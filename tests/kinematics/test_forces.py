@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from mechsyn.io import mechanism_from_dict
-from mechsyn.kinematics.analysis import forces, input_grid
-from mechsyn.kinematics.forces import loads_from_file, mass_model
+from mechsyn.kinematics.analysis import input_grid
+from mechsyn.kinetostatics import forces
+from mechsyn.kinetostatics.reactions import loads_from_file, mass_model
 from mechsyn.kinematics.plane import cross
 
 from kinematics_helpers import ex, fourbar_dict, point_state  # noqa: F401

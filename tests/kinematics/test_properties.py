@@ -6,7 +6,8 @@ from hypothesis import strategies as st
 
 from mechsyn.io import mechanism_from_dict
 from mechsyn.kinematics import derived
-from mechsyn.kinematics.analysis import forces, simulate
+from mechsyn.kinematics.analysis import simulate
+from mechsyn.kinetostatics import forces
 from mechsyn.kinematics.solve import assemble, newton
 from mechsyn.kinematics.system import build_system
 
@@ -62,7 +63,7 @@ def test_random_fourbar(a, b, c, g, theta, branch, dtheta):
     fa = forces(m, {"A": np.array([theta])}, gravity=(0, -9.81))
     sim = fa.simulation
     Ss, sw = sim.system, sim.sweep
-    from mechsyn.kinematics.forces import loads_from_file, mass_model
+    from mechsyn.kinetostatics.reactions import loads_from_file, mass_model
 
     mm = mass_model(Ss)
     ld = loads_from_file(Ss, mm)

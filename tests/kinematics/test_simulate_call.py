@@ -63,18 +63,51 @@ def test_drawn_row_remembered_equals_the_row_computed(ex, f, j):
              u0 + input_grid(5, 90, 5), input_grid(-180, 540, 2.5), u0 + 720 + input_grid(-5, 5, 10)]
     for g in grids:
         U = np.radians(g)[:, None]
-        want = None if len(U) < 2 else engines._drawn_row_1(S.drivers[0], U[:, 0].copy())
+        want = None if len(U) < 2 else engines._segment_row(S.drivers, U.copy())
         engines.CACHE.clear()
         assert engines.drawn_row(S, U) == want  # computed
         assert engines.drawn_row(S, U.copy()) == want  # remembered
     big = np.radians(input_grid(-180, 540, 0.005))[:, None]  # over 64 KiB: computed, not kept
     engines.CACHE.clear()
-    assert engines.drawn_row(S, big) == engines._drawn_row_1(S.drivers[0], big[:, 0].copy())
+    assert engines.drawn_row(S, big) == engines._segment_row(S.drivers, big.copy())
     assert engines.CACHE.get(("input grid", big.shape, big.dtype.str)) is None
     other = cached_plan(ex("textbook/stephenson_sixbar.yaml"), inputs=("A",)).system
     U = np.radians(u0 + input_grid(-30, 30, 0.5))[:, None]
     assert engines.drawn_row(S, U) is not None
-    assert engines.drawn_row(other, U) == engines._drawn_row_1(other.drivers[0], U[:, 0].copy())
+    assert engines.drawn_row(other, U) == engines._segment_row(other.drivers, U.copy())
+
+
+def test_drawn_row_of_several_inputs_is_the_first_segment_through_the_drawn_values():
+    """Two inputs (R and P, or two R): the row of the first segment that holds the drawn
+    values (an R value up to whole turns), checked against a plain loop over the rows
+    (a point of the segment: on its line, between its ends)."""
+    class Driver:
+        def __init__(self, type_, assembled):
+            self.type, self.assembled = type_, assembled
+
+    def by_loop(drivers, U):
+        for k in range(1, len(U)):
+            a, d = U[k - 1], U[k] - U[k - 1]
+            for turn in (-1, 0, 1, 2, 3):
+                v = np.array([dr.assembled + (2 * np.pi * (np.rint((a[i] - dr.assembled) / (2 * np.pi)) + turn - 1)
+                                               if dr.type == "R" else 0.0) for i, dr in enumerate(drivers)])
+                t = float((v - a) @ d / (d @ d))
+                if 0 < t <= 1 and np.abs(a + t * d - v).max() <= 1e-12 * (1 + np.abs(v).max()):
+                    return k
+        return None
+
+    rng = np.random.default_rng(7)
+    found = 0
+    for trial in range(200):
+        drivers = [Driver("R", rng.uniform(-7, 7)), Driver("P" if trial % 2 else "R", rng.uniform(-1, 1))]
+        U = np.stack([np.linspace(rng.uniform(-10, 0), rng.uniform(0, 10), 40),
+                      np.linspace(rng.uniform(-2, 0), rng.uniform(0, 2), 40)], axis=1)
+        if trial % 3 == 0:  # the second input held at its drawn value: the first decides
+            U[:, 1] = drivers[1].assembled
+        want = engines._segment_row(drivers, U)
+        assert want == by_loop(drivers, U), trial
+        found += want is not None
+    assert found >= 50  # (rows found, not only None)
 
 
 def test_a_sweep_through_folds_is_nan_on_whole_rows(ex):

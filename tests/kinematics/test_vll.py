@@ -81,7 +81,7 @@ def test_bad_vll_options(ex):
 def test_three_phalanx_forces_both_modes(ex):
     """Virtual power balance of the three-phalanx finger, locked and free (prescribed)."""
     from mechsyn.io import mechanism_to_dict, mechanism_from_dict
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
 
     d = mechanism_to_dict(ex("fingers/three_phalanx_vll_000.yaml"))
     d["loads"] = [{"link": "distal", "force": [-2.0, 0.5], "at": [0, 95]}]

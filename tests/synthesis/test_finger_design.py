@@ -124,7 +124,7 @@ def test_mode_forces_match_engine_newton_on_full_file(result):
     """Both modes' peaks from the fast merged model equal the kinematics engine's Newton
     solution of the full file (cylinder + piston; VLL locked, then free and held)."""
     case, res = result
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
 
     v = res.best_variant
     mech = mechanism_from_dict(v.mechanism)

@@ -429,7 +429,7 @@ def test_forces_tab_equals_the_library(serve, page):
     page.click('#tabs [data-tab="forces"]')
     wait_js(page, "() => window.__studio.forces && window.__studio.forces.mech === window.__studio.mech && window.__studio.forces.r")
     from mechsyn.io import mechanism_from_dict
-    from mechsyn.kinematics.analysis import forces
+    from mechsyn.kinetostatics import forces
 
     def library(m, gravity):
         r = page.evaluate("window.__studio.forces.r")

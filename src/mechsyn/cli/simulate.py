@@ -217,8 +217,6 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
 
 
 def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], animate: Optional[Path]) -> None:
-    from mechsyn.kinematics.report import simulation_csv
-
     if plot is not None:  # (first: a range where nothing assembles is refused before any file is written)
         from mechsyn.plot.kinematics import plot_simulation
 
@@ -228,7 +226,7 @@ def _write_simulation_files(sim, csv_out: Optional[Path], plot: Optional[Path], 
 
         save_animation(animate, animate_simulation, sim, dpi=100)
     if csv_out is not None:
-        write_output(csv_out, simulation_csv(sim))
+        write_output(csv_out, sim.csv())
 
 
 @app.command("forces")
@@ -246,8 +244,7 @@ def forces_cmd(
 ) -> None:
     """Joint reactions and the balancing moment/force at each driven joint over the input."""
     from mechsyn.cli.render import render_forces
-    from mechsyn.kinematics.analysis import forces
-    from mechsyn.kinematics.report import forces_csv
+    from mechsyn.kinetostatics import forces
 
     _check_outputs(plot, csv_out, json_)
     if not np.isfinite(gravity):
@@ -262,7 +259,7 @@ def forces_cmd(
         from mechsyn.plot.kinematics import plot_forces
         save_plot(plot, plot_forces, fa)
     if csv_out is not None:
-        write_output(csv_out, forces_csv(fa))
+        write_output(csv_out, fa.csv())
     if is_stdout(csv_out):
         return
     if json_:

@@ -1,9 +1,10 @@
-"""Planar kinematics and force analysis.
+"""Kinematics: positions, velocities and accelerations of planar and spatial mechanisms
+(their forces: :mod:`mechsyn.kinetostatics`).
 
 Modules, from the entry points down (docs/architecture.md):
 
-* ``analysis``: :func:`simulate` (``method="auto"`` or an engine's name), :func:`forces`,
-  the compiled plan and its cache;
+* ``analysis``: :func:`simulate` (``method="auto"`` or an engine's name), the compiled
+  plan and its cache;
 * ``engines``: ``ENGINES`` (every engine by a unique name), the ``Engine`` protocol and the
   planar engines tried in order (regular pass, tracked chain, tracked groups, Newton), the
   spatial engine last; ``sweep``: ``Sweep`` and ``Event``; ``simulation``: ``Motion``, the
@@ -13,7 +14,7 @@ Modules, from the entry points down (docs/architecture.md):
   (generic group steps), ``groups`` (plan, decomposition, the RRR kernel),
   ``solve`` (Newton continuation, assembly, mobility), ``system`` (link poses,
   constraint equations, analytic and dimensionless Jacobian, batched rates);
-* ``batch`` (many designs of one topology), ``forces`` (kinetostatics), ``derived``
+* ``batch`` (many designs of one topology), ``derived``
   (transmission angle, mechanical advantage, Grashof, path extent, straightness),
   ``report``; ``dyads`` keeps the Assur-group names for callers outside the package.
 
@@ -30,7 +31,7 @@ References
 
 from typing import Any
 
-__all__ = ["simulate", "forces", "input_grid", "compile_plan", "cached_plan", "KinematicPlan", "Motion", "Simulation",
+__all__ = ["simulate", "input_grid", "compile_plan", "cached_plan", "KinematicPlan", "Motion", "Simulation",
            "ENGINES"]
 
 

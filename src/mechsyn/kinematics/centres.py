@@ -115,13 +115,12 @@ def instant_centres(mech: Mechanism, inputs: dict[str, float] | None = None) -> 
         dw = wa - wb
         ratio = wb / wa if abs(wa) > 1e-12 * (abs(wa) + abs(wb) + 1e-300) and wa != 0 else None
         speed = float(np.linalg.norm(c)) + (abs(wa) + abs(wb)) * scale
+        joint = rjoint.get(tuple(sorted((a, b))))
         if abs(dw) * scale <= 1e-9 * speed:  # a relative translation: the centre at infinity
             # (no relative motion at all, a dead centre of the pair: no direction either;
             # speeds are those of the drives at 1 rad/s, 1 unit/s: ``scale`` is their size)
             t = c / np.linalg.norm(c) if np.linalg.norm(c) > 1e-9 * scale else None
-            out.append(InstantCentre((a, b), None, None if t is None else perp(t), rjoint.get(tuple(sorted((a, b)))),
-                                     ratio))
-            continue
-        p = np.array([c[1], -c[0]]) / dw  # k × P = c / dw
-        out.append(InstantCentre((a, b), p, None, rjoint.get(tuple(sorted((a, b)))), ratio))
+            out.append(InstantCentre((a, b), None, None if t is None else perp(t), joint, ratio))
+        else:
+            out.append(InstantCentre((a, b), np.array([c[1], -c[0]]) / dw, None, joint, ratio))  # k × P = c / dw
     return out

@@ -27,7 +27,7 @@ from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.groups import decompose
 from mechsyn.model.mechanism import Mechanism
 
-__all__ = ["transmission_angles", "mechanical_advantage", "grashof", "Grashof", "is_fourbar", "path_extent",
+__all__ = ["transmission_angles", "mechanical_advantage", "slide", "grashof", "Grashof", "is_fourbar", "path_extent",
            "straightness", "default_output_link"]
 
 
@@ -90,18 +90,29 @@ def mechanical_advantage(sim, output: str) -> np.ndarray:
     if output not in sim.links:
         raise MechsynInputError(f"no moving link {output!r}", field="output",
                                 hint=f"links: {', '.join(sim.links)}")
-    w_in = sim.speeds[main]
-    S = sim.system
-    mech = S.mech
-    slide = next((j for j in mech.joints if j.type == "P" and set(j.links) == {mech.ground, output}), None)
-    if slide is not None:
-        out_rate = np.asarray(S.coordinate_rate(sim.sweep.q, sim.sweep.qd, slide.id))
-    else:
-        out_rate = sim.links[output].angular_velocity
+    mech = sim.system.mech
+    p = next((j.id for j in mech.joints if j.type == "P" and set(j.links) == {mech.ground, output}), None)
+    out_rate = slide(sim, p)[1] if p is not None else sim.links[output].angular_velocity
     with np.errstate(divide="ignore", invalid="ignore"):
-        ma = np.abs(w_in / out_rate)
+        ma = np.abs(sim.speeds[main] / out_rate)
     ma[~sim.assembled] = np.nan
     return ma
+
+
+def slide(sim, joint: str, acceleration: bool = False) -> tuple[np.ndarray, ...]:
+    """P joint ``joint``'s slide along its guide over a planar simulation
+    (:meth:`~mechsyn.kinematics.system.PlanarSystem.coordinate`: from the guide link's
+    origin, the world origin for the frame; NaN where not assembled) and its rate at the
+    drives' speeds; with ``acceleration`` also the rate's time derivative along the motion
+    (a central difference)."""
+    S, q, qd, qdd = sim.system, sim.sweep.q, sim.sweep.qd, sim.sweep.qdd
+    value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), joint), np.nan)
+    rate = S.coordinate_rate(q, qd, joint)
+    if not acceleration:
+        return value, rate
+    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
+    ahead, back = (S.coordinate_rate(q + sh * qd, qd + sh * qdd, joint) for sh in (h, -h))
+    return value, rate, (ahead - back) / (2 * h)
 
 
 @dataclass(frozen=True)
@@ -136,27 +147,15 @@ def grashof(mech: Mechanism) -> Grashof:
     coupler = next(n for n in mech.link_names if n not in (ground, crank, rocker))
     vals = sorted(lengths.values())
     s, p, q, l = vals[0], vals[1], vals[2], vals[3]
-    tol = 1e-9 * l
-    shortest = min(lengths, key=lengths.get)
-    if abs((s + l) - (p + q)) <= tol:
-        cls, g = "change point (s + l = p + q)", True
-    elif s + l < p + q:
-        g = True
-        if shortest == ground:
-            cls = "double crank (drag link)"
-        elif shortest == crank:
-            cls = "crank-rocker"
-        elif shortest == rocker:
-            cls = "rocker-crank (the output turns fully)"
-        else:
-            cls = "double rocker (Grashof)"
-    else:
-        cls, g = "triple rocker (non-Grashof)", False
-    rel = "<" if s + l < p + q - tol else ("=" if abs(s + l - p - q) <= tol else ">")
+    rel = "=" if abs((s + l) - (p + q)) <= 1e-9 * l else ("<" if s + l < p + q else ">")
+    by_shortest = {ground: "double crank (drag link)", crank: "crank-rocker",
+                   rocker: "rocker-crank (the output turns fully)"}  # (Grashof: which link is the shortest)
+    cls = {"=": "change point (s + l = p + q)", ">": "triple rocker (non-Grashof)"}.get(rel) or by_shortest.get(
+        min(lengths, key=lengths.get), "double rocker (Grashof)")
     expr = f"s + l = {s:.6g} + {l:.6g} = {s + l:.6g} {rel} p + q = {p:.6g} + {q:.6g} = {p + q:.6g}"
     named = {"frame": lengths[ground], "crank": lengths[crank], "coupler": lengths[coupler],
              "rocker": lengths[rocker]}
-    return Grashof(named, s, l, p, q, g, cls, expr)
+    return Grashof(named, s, l, p, q, rel != ">", cls, expr)
 
 
 def is_fourbar(mech: Mechanism) -> bool:

@@ -42,7 +42,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics.derived import is_fourbar
-from mechsyn.kinematics.groups import circle_circle
+from mechsyn.kinematics.groups import circle_circle, decompose
 from mechsyn.kinematics.plane import cross, perp, to_frame
 from mechsyn.kinematics.solve import newton, worst_joint
 from mechsyn.kinematics.system import build_system
@@ -71,12 +71,16 @@ def _xy(p: Any) -> np.ndarray:
     return np.asarray(p, float)[:2]
 
 
-def _pivot(mech: Mechanism, guide: str) -> Any:
-    """The pivot a slider's offset is measured from: on the guide link, the drive's R joint,
-    else its first R joint (None when it has none)."""
-    rs = [j for j in mech.joints_of(guide) if j.type == "R"]
-    driven = [j for j in rs if j.actuated]
-    return (driven or rs or [None])[0]
+def _guide(mech: Mechanism, j: Any) -> tuple[str, Any, np.ndarray, float, float]:
+    """Slider ``j``'s guide ``(link, pivot, origin, offset, angle)``: its link (the joint's
+    first), the pivot its offset is measured from (on the guide link, the drive's R joint,
+    else its first R joint; None when it has none), that pivot's place (else the joint's),
+    the guide line's signed distance from it and its direction (radians from x)."""
+    rs = [x for x in mech.joints_of(j.links[0]) if x.type == "R"]
+    piv = ([x for x in rs if x.actuated] or rs or [None])[0]
+    u = _xy(j.axis) / np.linalg.norm(_xy(j.axis))
+    o = _xy((piv or j).point)
+    return j.links[0], piv, o, float(np.array([-u[1], u[0]]) @ (_xy(j.point) - o)), math.atan2(u[1], u[0])
 
 
 def dimensions(mech: Mechanism) -> list[Dimension]:
@@ -94,24 +98,19 @@ def dimensions(mech: Mechanism) -> list[Dimension]:
         places = _places(mech, name)
         if any(j.type not in ("R", "P") for j in mech.joints_of(name)):
             continue
-        slides = any(j.type == "P" for j in mech.joints_of(name))
-        ends = [ids[0] for ids, _ in places]
-        if len(places) == 2 and not slides:
-            out.append(Dimension(name, "length", tuple(ends), float(np.linalg.norm(places[0][1] - places[1][1]))))
+        sides = [(places[k], places[(k + 1) % len(places)]) for k in range(len(places))]  # round the plate
+        if len(places) == 2 and not any(j.type == "P" for j in mech.joints_of(name)):
+            (a, pa), (b, pb) = sides[0]
+            out.append(Dimension(name, "length", (a[0], b[0]), float(np.linalg.norm(pa - pb))))
         elif len(places) >= 3:
-            for k in range(3 if len(places) == 3 else len(places)):
-                (a, pa), (b, pb) = places[k], places[(k + 1) % len(places)]
-                out.append(Dimension(name, "side", (a[0], b[0]), float(np.linalg.norm(pa - pb))))
+            out += [Dimension(name, "side", (a[0], b[0]), float(np.linalg.norm(pa - pb))) for (a, pa), (b, pb) in sides]
     for j in mech.joints:
         if j.type != "P" or j.axis is None:
             continue
-        guide = j.links[0]
-        piv = _pivot(mech, guide)
-        u = _xy(j.axis) / np.linalg.norm(_xy(j.axis))
-        out.append(Dimension(guide, "angle", (j.id,), math.degrees(math.atan2(u[1], u[0]))))
+        guide, piv, _, e0, a0 = _guide(mech, j)
+        out.append(Dimension(guide, "angle", (j.id,), math.degrees(a0)))
         if piv is not None:
-            n = np.array([-u[1], u[0]])
-            out.append(Dimension(guide, "offset", (j.id, piv.id), float(n @ (_xy(j.point) - _xy(piv.point)))))
+            out.append(Dimension(guide, "offset", (j.id, piv.id), e0))
     return out
 
 
@@ -214,13 +213,7 @@ def set_slider(mech: Mechanism, joint: str, *, offset: float | None = None,
     j = mech.joint(joint)
     if j.type != "P":
         raise MechsynInputError(f"joint {joint} is not a slider (P joint)", field="offset")
-    guide = j.links[0]
-    piv = _pivot(mech, guide)
-    u = _xy(j.axis) / np.linalg.norm(_xy(j.axis))
-    n = np.array([-u[1], u[0]])
-    o = _xy(piv.point) if piv is not None else _xy(j.point)
-    e0 = float(n @ (_xy(j.point) - o))
-    a0 = math.atan2(u[1], u[0])
+    guide, piv, o, e0, a0 = _guide(mech, j)
     for v, what in ((offset, "offset"), (angle, "angle")):
         if v is not None and not math.isfinite(float(v)):
             raise MechsynInputError(f"the guide's {what} must be a number, not {v!r}", field=what)
@@ -317,8 +310,16 @@ class _Geometry:
         self.old = {j: S.to_local(link, _xy(mech.joint(j).point)) for j in moves}
         self.new = {j: S.to_local(link, np.asarray(p, float)) for j, p in moves.items()}
 
-    def local(self, jid: str, t: float) -> np.ndarray:
+    def between(self, jid: str, t: float) -> np.ndarray:
+        """Moved joint ``jid``'s local point a fraction ``t`` of the way to its new place."""
         return self.old[jid] + t * (self.new[jid] - self.old[jid])
+
+    def local(self, link: str, jid: str, p: np.ndarray | None = None) -> np.ndarray:
+        """Joint ``jid``'s drawn point (or the point ``p``) in ``link``'s frame, with the new
+        dimension."""
+        if link == self.link and jid in self.new:
+            return self.new[jid]
+        return self.S.to_local(link, _xy(self.S.mech.joint(jid).point if p is None else p))
 
     def line(self, t: float) -> tuple[np.ndarray, np.ndarray, float]:
         """The guide at ``t``: a point on it and its direction (drawn coordinates), the turn."""
@@ -338,9 +339,9 @@ class _Geometry:
             ch: dict[str, Any] = {}
             if con.joint in self.old:
                 if con.a == self.i and con.sa is not None:
-                    ch["sa"] = self.local(con.joint, t)
+                    ch["sa"] = self.between(con.joint, t)
                 if con.b == self.i and con.sb is not None:
-                    ch["sb"] = self.local(con.joint, t)
+                    ch["sb"] = self.between(con.joint, t)
             elif line is not None and con.joint == self.guide[0]:
                 p, ut, turn = line
                 ul = S.to_local_dir(self.link, ut)
@@ -353,11 +354,9 @@ class _Geometry:
             cons.append(replace(con, **ch) if ch else con)
         return replace(S, cons=tuple(cons), cache={})
 
-    def place(self, q: np.ndarray, link: str, jid: str, p: np.ndarray) -> np.ndarray:
-        """Where the drawn point ``p`` of joint ``jid`` on ``link`` is at ``q`` (new geometry)."""
-        S = self.S
-        s = self.local(jid, 1.0) if link == self.link and jid in self.old else S.to_local(link, p)
-        return S.point(q[None], S.index(link), s)[0]
+    def place(self, q: np.ndarray, link: str, jid: str, p: np.ndarray | None = None) -> np.ndarray:
+        """Where the point :meth:`local` of ``link`` is at ``q`` (new geometry)."""
+        return self.S.point(q[None], self.S.index(link), self.local(link, jid, p))[0]
 
     def mechanism(self, q: np.ndarray) -> Mechanism:
         S, mech = self.S, self.S.mech
@@ -369,15 +368,15 @@ class _Geometry:
             if line is not None and j.id == self.guide[0]:
                 p, ut, _ = line
                 on = b if S.index(b) >= 0 else a
-                ch["point"] = self.place(q, a, j.id, p) if on == a else self.place(q, b, j.id, _xy(j.point))
+                ch["point"] = self.place(q, a, j.id, p) if on == a else self.place(q, b, j.id)
                 ch["axis"] = _turned(S, q, a, S.to_local_dir(a, ut))
             elif j.point is not None and (S.index(b) >= 0 or S.index(a) >= 0):
                 on = b if S.index(b) >= 0 else a
-                ch["point"] = self.place(q, on, j.id, _xy(j.point))
+                ch["point"] = self.place(q, on, j.id)
                 if j.type == "P" and j.axis is not None:
                     ch["axis"] = _turned(S, q, a, S.to_local_dir(a, _xy(j.axis)))
             joints.append(replace(j, **ch) if ch else j)
-        points = {n: replace(ps, at=self.place(q, ps.link, "", _xy(ps.at))) for n, ps in mech.points.items()}
+        points = {n: replace(ps, at=self.place(q, ps.link, "", ps.at)) for n, ps in mech.points.items()}
         return replace(mech, joints=tuple(joints), points=points)
 
 
@@ -420,78 +419,37 @@ def _worst_joint(geo: _Geometry, q: np.ndarray) -> str:
     return worst_joint(St, q, np.array([d.assembled for d in St.drivers]))
 
 
-def _binary_dyads(mech: Mechanism) -> list[tuple[str, str, str, str, str]]:
-    """``(l1, l2, E, G, F)``: two moving links of R joints, neither driven, joined by the R
-    joint ``G``, with ``E`` another place of ``l1`` and ``F`` one of ``l2`` (an RRR dyad)."""
-    free = [n for n in mech.moving_links
-            if all(j.type == "R" for j in mech.joints_of(n)) and not any(j.actuated for j in mech.joints_of(n))]
-    out = []
-    for g in mech.joints:
-        l1, l2 = g.links
-        if g.type != "R" or l1 not in free or l2 not in free:
-            continue
-        for e_ids, _ in _places(mech, l1):
-            for f_ids, _ in _places(mech, l2):
-                if g.id not in e_ids and g.id not in f_ids:
-                    e = next((x for x in e_ids if mech.joint(x).other(l1) != l2), e_ids[0])
-                    f = next((x for x in f_ids if mech.joint(x).other(l2) != l1), f_ids[0])
-                    out.append((l1, l2, e, g.id, f))
-    return out
-
-
-def _solvable_dyads(mech: Mechanism) -> list[tuple[str, str, str, str, str]]:
-    """The RRR dyads of :func:`_binary_dyads` in the order they are solved: each one's outer
-    joints on the frame, a driven link or the links of a dyad before it."""
-    known = {mech.ground} | {j.other(mech.ground) for j in mech.joints if j.actuated and mech.ground in j.links}
-    todo, out = _binary_dyads(mech), []
-    while True:
-        ready = [d for d in todo if d[0] not in known and d[1] not in known
-                 and mech.joint(d[2]).other(d[0]) in known and mech.joint(d[4]).other(d[1]) in known]
-        if not ready:
-            return out
-        for d in ready:
-            if d[0] not in known and d[1] not in known:
-                out.append(d)
-                known |= {d[0], d[1]}
-
-
 def _worst_dyad(geo: _Geometry, q: np.ndarray) -> tuple | None:
-    """The dyad nearest to (or furthest past) its triangle inequality with the new dimension:
-    its outer joints' places carried by their other links at ``q``, its sides' new lengths."""
-    mech = geo.S.mech
+    """The RRR dyad of the mechanism's decomposition
+    (:func:`~mechsyn.kinematics.groups.decompose`) nearest to (or furthest past) its
+    triangle inequality with the new dimension: ``((l1, l2, E, G, F), a, b, d)``, the dyad's
+    links ``l1, l2`` joined at ``G``, its outer joints ``E, F`` carried by their known links
+    at ``q`` ``d`` apart, its sides ``a = EG`` on ``l1`` and ``b = GF`` on ``l2`` (new lengths)."""
+    S = geo.S
+    plan = decompose(S)
     best, score = None, -np.inf
-    for l1, l2, e, g, f in _solvable_dyads(mech):
-        a = _side_len(geo, l1, e, g)
-        b = _side_len(geo, l2, g, f)
-        pe = _outer(geo, q, mech.joint(e), l1)
-        pf = _outer(geo, q, mech.joint(f), l2)
+    for step in plan.steps if plan is not None else ():
+        if step.kind != "RRR":
+            continue
+        (l1, l2), (e, g, f) = (S.links[i] for i in step.links), step.joints
+        a, b = _side_len(geo, l1, e, g), _side_len(geo, l2, g, f)
+        pe, pf = (geo.place(q, S.mech.joint(j).other(link), j) for j, link in ((e, l1), (f, l2)))
         d = float(np.linalg.norm(pe - pf))
-        s = max(d - (a + b), abs(a - b) - d) / geo.S.scale
+        s = max(d - (a + b), abs(a - b) - d) / S.scale
         if s > score:
             best, score = ((l1, l2, e, g, f), a, b, d), s
     return best
 
 
 def _side_len(geo: _Geometry, link: str, j1: str, j2: str) -> float:
-    S = geo.S
-    p1, p2 = (geo.local(j, 1.0) if link == geo.link and j in geo.old else S.to_local(link, _xy(S.mech.joint(j).point))
-              for j in (j1, j2))
-    return float(np.linalg.norm(p1 - p2))
-
-
-def _outer(geo: _Geometry, q: np.ndarray, j: Any, dyad_link: str) -> np.ndarray:
-    other = j.other(dyad_link)
-    return geo.place(q, other, j.id, _xy(j.point))
+    """The distance of joints ``j1`` and ``j2`` on ``link`` with the new dimension."""
+    return float(np.linalg.norm(geo.local(link, j1) - geo.local(link, j2)))
 
 
 def _grashof_words(geo: _Geometry) -> str:
-    S, mech = geo.S, geo.S.mech
-    lengths = {}
-    for name in mech.link_names:
-        a, b = mech.joints_of(name)
-        lengths[name] = _side_len(geo, name, a.id, b.id)
-    v = sorted(lengths.values())
-    s, p, qq, L = v
+    """Grashof's condition of the four-bar with the new dimension, in words."""
+    mech = geo.S.mech
+    s, p, qq, L = sorted(_side_len(geo, name, *(j.id for j in mech.joints_of(name))) for name in mech.link_names)
     if s + L <= p + qq:
         return f"Grashof holds (s + l = {s + L:.4g} ≤ p + q = {p + qq:.4g}: the shortest link turns fully)"
     return f"non-Grashof (s + l = {s + L:.4g} > p + q = {p + qq:.4g}: no link turns fully)"

@@ -115,29 +115,6 @@ class RegularPass:
         return "a group's discriminant has a minimum near zero (a change or branch point may be near)"
 
 
-class TrackedChain:
-    """A driver-R + RRR chain through folds and change points, rates in closed form."""
-
-    name = "tracked chain"
-
-    def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
-              change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
-        if plan is None or not plan.closed_form_rates:
-            return None
-        switch = change_points == "switch"
-        advance = counter(progress, len(inputs), "sweep")
-
-        def run(parts: list) -> list[Sweep]:
-            res = solve_tracked_rates(system, plan, parts, speeds, switch=switch)
-            return [_tracked_sweep(system, U, speeds, r, self.name, advance) for U, r in zip(parts, res)]
-
-        return outward(system, inputs, run)
-
-    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
-        """Why :meth:`sweep` gave None, in one line."""
-        return _NO_PLAN if plan is None else "it takes chains of R drivers and RRR dyads only"
-
-
 class TrackedGroups:
     """Any mechanism of drivers and dyads, rates by batched linear solves."""
 
@@ -145,25 +122,48 @@ class TrackedGroups:
 
     def sweep(self, system: PlanarSystem, plan: Plan | None, inputs: np.ndarray, speeds: np.ndarray, *,
               change_points: str = "keep", progress: ProgressCallback | None = None) -> Sweep | None:
-        if plan is None:
+        if not self.takes(plan):
             return None
         switch = change_points == "switch"
         advance = counter(progress, len(inputs), "sweep")
 
         def run(parts: list) -> list[Sweep]:
-            out = []
-            for U in parts:
-                tracked = solve_tracked(system, plan, U, switch=switch)
-                q, qd, qdd = solve_all(system, plan, U, speeds, tracked=tracked)
-                res = (q, qd, qdd, tracked.singular, tracked.events)
-                out.append(_tracked_sweep(system, U, speeds, res, self.name, advance))
-            return out
+            res = self.solved(system, plan, parts, speeds, switch)
+            return [_tracked_sweep(system, U, speeds, r, self.name, advance) for U, r in zip(parts, res)]
 
         return outward(system, inputs, run)
+
+    def takes(self, plan: Plan | None) -> bool:
+        """Whether the engine answers for a mechanism of this plan."""
+        return plan is not None
+
+    def solved(self, system: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray, switch: bool) -> list:
+        """``(q, qd, qdd, singular rows, group events)`` of each of ``parts`` (input rows)."""
+        out = []
+        for U in parts:
+            tracked = solve_tracked(system, plan, U, switch=switch)
+            out.append((*solve_all(system, plan, U, speeds, tracked=tracked), tracked.singular, tracked.events))
+        return out
 
     def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
         """Why :meth:`sweep` gave None, in one line."""
         return _NO_PLAN
+
+
+class TrackedChain(TrackedGroups):
+    """A driver-R + RRR chain through folds and change points, rates in closed form: the
+    tracked groups' sweep with the chain's solver."""
+
+    name = "tracked chain"
+
+    def takes(self, plan: Plan | None) -> bool:
+        return plan is not None and plan.closed_form_rates
+
+    def solved(self, system: PlanarSystem, plan: Plan, parts: list, speeds: np.ndarray, switch: bool) -> list:
+        return solve_tracked_rates(system, plan, parts, speeds, switch=switch)
+
+    def declined(self, system: PlanarSystem, plan: Plan | None, change_points: str) -> str:
+        return _NO_PLAN if plan is None else "it takes chains of R drivers and RRR dyads only"
 
 
 #: Why an engine of drivers and Assur groups declines a mechanism without such a plan.
@@ -285,11 +285,11 @@ def _tracked_events(tracked_events: list[Event], first_assembled: bool, first_in
     return out
 
 
-#: The inputs of the sweeps :func:`drawn_row` searched are kept in the kinematics' one
-#: cache (:data:`~mechsyn.kinematics.topology.CACHE`) by their shape: ``(the inputs'
-#: bytes, the differences of one input's rows, {the drivers' types and drawn values:
-#: row})``. A drag or a design loop simulates the same grid again and again (equal bytes:
-#: the same rows), each fresh geometry with its own drawn values.
+#: The rows :func:`drawn_row` found are kept in the kinematics' one cache
+#: (:data:`~mechsyn.kinematics.topology.CACHE`) by the inputs' shape: ``(the inputs'
+#: bytes, {the drivers' types and drawn values: row})``. A drag or a design loop simulates
+#: the same grid again and again (equal bytes: the same rows), each geometry with its own
+#: drawn values.
 _DRAWN_BYTES = 1 << 16  # sweeps of at most 64 KiB of inputs
 _DRAWN_ROWS = 64  # answers kept per sweep (drawn values)
 
@@ -299,8 +299,7 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     row ``k - 1`` to row ``k`` (R inputs up to whole turns), else None.
 
     The row of the same inputs (byte for byte, up to 64 KiB of them) with the same drawn
-    values is remembered, and for one input so are the differences of its rows (a
-    fresh geometry's drawn value is looked for on the same grid without them).
+    values is remembered.
 
     Examples
     --------
@@ -317,77 +316,57 @@ def drawn_row(S: PlanarSystem, U: np.ndarray) -> int | None:
     if U.shape[0] < 2:
         return None
     if U.nbytes > _DRAWN_BYTES:  # a long sweep: its own cost dwarfs the search, not kept
-        return _drawn_row_1(S.drivers[0], U[:, 0]) if U.shape[1] == 1 else _drawn_row_k(S, U)
+        return _segment_row(S.drivers, U)
     drawn = tuple([(d.type, float(d.assembled)) for d in S.drivers])
     key = ("input grid", U.shape, U.dtype.str)
     data = U.tobytes()
     hit = CACHE.get(key)
     if hit is None or hit[0] != data:
-        hit = (data, _differences(U[:, 0].copy()) if U.shape[1] == 1 else None, {})
+        hit = (data, {})
         CACHE.put(key, hit)
-    rows = hit[2]
+    rows = hit[1]
     k = rows.get(drawn, rows)
-    if k is not rows:
-        return k
-    k = _drawn_row_1(S.drivers[0], U[:, 0], hit[1]) if U.shape[1] == 1 else _drawn_row_k(S, U)
-    if len(rows) >= _DRAWN_ROWS:
-        rows.clear()
-    rows[drawn] = k
+    if k is rows:
+        if len(rows) >= _DRAWN_ROWS:
+            rows.clear()
+        k = rows[drawn] = _segment_row(S.drivers, U)
     return k
 
 
-def _drawn_row_k(S: PlanarSystem, U: np.ndarray) -> int | None:
-    """:func:`drawn_row` of several inputs."""
-    u0 = np.array([d.assembled for d in S.drivers], float)
-    isR = np.array([d.type == "R" for d in S.drivers])
-    a, d = U[:-1], np.diff(U, axis=0)
-    dd = np.einsum("ij,ij->i", d, d)
-    turns = u0 + 2 * np.pi * np.round((a - u0) / (2 * np.pi))  # (N-1, k)
-    for shift in (0.0, 2 * np.pi, -2 * np.pi):
-        v = np.where(isR, turns + shift if shift else turns, u0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            t = np.einsum("ij,ij->i", v - a, d) / dd
-        off = np.abs(a + t[:, None] * d - v).max(axis=1)
-        hit = (dd > 0) & (t > 0.0) & (t <= 1.0) & (off <= 1e-12 * (1 + np.abs(v).max(axis=1)))
-        if hit.any():
-            return int(np.argmax(hit)) + 1
-    return None
-
-
-def _differences(u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``a, d, dd`` of :func:`_drawn_row_1` for the input's rows ``u`` (N,): the rows but
-    the last, the steps to the next row and their squares."""
-    a = u[:-1]
-    d = u[1:] - a
-    return a, d, d * d
-
-
-def _drawn_row_1(driver: Any, u: np.ndarray, diffs: tuple | None = None) -> int | None:
-    """:func:`drawn_row` of one input (the same decisions on 1-D arrays: a point of a
-    segment is always on its line, and with ``p = (v - a) d``, ``0 < p / d^2 <= 1`` is
-    ``0 < p <= d^2``, division being monotone); ``diffs``: :func:`_differences` of ``u``
-    when known."""
-    u0 = float(driver.assembled)
-    a, d, dd = diffs or _differences(u)
-    v = a - u0
-    if driver.type == "R":
-        v /= 2 * np.pi
-        np.rint(v, out=v)
-        v *= 2 * np.pi
-        v += u0
-        shifts = (0.0, 2 * np.pi, -2 * np.pi)
-    else:
-        v[:] = u0
-        shifts = (0.0,)
-    for shift in shifts:
-        p = (v + shift - a) if shift else v - a
-        p *= d
-        hit = p > 0.0
-        hit &= p <= dd
+def _segment_row(drivers: Any, U: np.ndarray) -> int | None:
+    """:func:`drawn_row`, searched: the first segment from row ``k - 1`` to row ``k`` that
+    holds the drivers' drawn values (R: the turn nearest each row, or the one before or
+    after), with ``p = (v - a) . d``: ``0 < p <= d . d``; with several inputs the drawn
+    values must also lie on the segment's line (one input: always)."""
+    u0 = np.array([d.assembled for d in drivers], float)
+    isR = np.array([d.type == "R" for d in drivers])
+    a = U[:-1]
+    d = U[1:] - a
+    dd = _dot(d, d)
+    v = a - u0  # the drawn values in the turn of each row
+    v /= 2 * np.pi
+    np.rint(v, out=v)
+    v *= 2 * np.pi
+    v += u0
+    if not isR.all():
+        v[:, ~isR] = u0[~isR]
+    for shift in (0.0, 2 * np.pi, -2 * np.pi) if isR.any() else (0.0,):
+        w = v + shift * isR if shift else v
+        p = _dot(w - a, d)
+        hit = (p > 0.0) & (p <= dd)
+        if U.shape[1] > 1:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                off = np.abs(a + (p / dd)[:, None] * d - w).max(axis=1)
+            hit &= off <= 1e-12 * (1 + np.abs(w).max(axis=1))
         k = int(hit.argmax())  # the first row hit (or 0 when none is)
         if hit[k]:
             return k + 1
     return None
+
+
+def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The row-wise dot products of ``x`` and ``y`` (N, k)."""
+    return (x * y).sum(axis=1) if x.shape[1] > 1 else (x * y).reshape(-1)
 
 
 def outward(S: PlanarSystem, U: np.ndarray, run: Callable[[list], list[Sweep]]) -> Sweep:

@@ -79,10 +79,8 @@ def simulate_inverse(mech: Mechanism, point: str, path: Any, *, start: dict[str,
     """
 
     drives = [j for j in mech.joints if j.actuated]
-    T = np.asarray(path, float)
+    T = np.atleast_2d(np.asarray(path, float))  # (one target: a row)
     d = 2 if mech.kind == "planar" else 3
-    if T.ndim == 1:
-        T = T[None]
     if T.ndim != 2 or T.shape[1] != d or not np.isfinite(T).all():
         raise MechsynInputError(f"the path of {point} must be rows of {d} numbers", field="path")
     if len(drives) != d:
@@ -237,10 +235,9 @@ def _posed_spatial(mech: Mechanism, sim: Any, row: int) -> Mechanism:
             ch["point"] = Rb @ np.asarray(j.point, float) + tb
         if j.axis is not None:
             ch["axis"] = Ra @ np.asarray(j.axis, float)
-        if getattr(j, "axis2", None) is not None:
-            ch["axis2"] = Rb @ np.asarray(j.axis2, float)
-        if getattr(j, "normal", None) is not None:
-            ch["normal"] = Ra @ np.asarray(j.normal, float)
+        for attr, R in (("axis2", Rb), ("normal", Ra)):  # (a second axis turns with the second link)
+            if getattr(j, attr, None) is not None:
+                ch[attr] = R @ np.asarray(getattr(j, attr), float)
         joints.append(replace(j, **ch) if ch else j)
     points = {}
     for n, p in mech.points.items():

@@ -1,10 +1,11 @@
 """The simulation report: a :class:`~mechsyn.kinematics.analysis.Simulation` with the
 quantities a designer reads off it (transmission angles, mechanical advantage, Grashof's
-class, path extents, straightness of a path segment), and the CSV tables of a simulation
-and of a force analysis.
+class, path extents, straightness of a path segment).
 
-``mechsyn simulate --json`` prints :meth:`SimulationReport.to_dict`; ``mechsyn simulate
---csv`` writes :func:`simulation_csv`, ``mechsyn forces --csv`` :func:`forces_csv`.
+``mechsyn simulate --json`` prints :meth:`SimulationReport.to_dict`. The CSV tables
+(``--csv``) are files, not computing: a result's ``csv()`` (:meth:`Motion.csv
+<mechsyn.kinematics.simulation.Motion.csv>`) writes its ``columns()`` with
+:func:`mechsyn.results.csv_table`.
 
 References
 ----------
@@ -15,8 +16,6 @@ Oxford University Press, 2017, ch. 1 and 3 (see :mod:`mechsyn.kinematics.derived
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -25,14 +24,14 @@ import numpy as np
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
 from mechsyn.kinematics import derived
-from mechsyn.kinematics.analysis import ForceAnalysis, Simulation, simulate
+from mechsyn.kinematics.analysis import Simulation, simulate
 from mechsyn.kinematics.simulation import rows
 from mechsyn.kinematics.summary import motion_summary
 from mechsyn.model.mechanism import Mechanism
 from mechsyn.progress import ProgressCallback
-from mechsyn.results import csv_cell, to_jsonable
+from mechsyn.results import to_jsonable
 
-__all__ = ["SimulationReport", "simulation_report", "simulation_csv", "forces_csv", "csv_text"]
+__all__ = ["SimulationReport", "simulation_report", "derived_quantities"]
 
 
 @dataclass(repr=False)
@@ -134,23 +133,15 @@ def derived_quantities(mech: Mechanism, sim: Simulation, output: str | None = No
 
 
 def _slides(mech: Mechanism, sim: Simulation) -> dict[str, Any]:
-    """Every P joint's slide along its guide (:meth:`PlanarSystem.coordinate`: from the guide
-    link's origin, the world origin for the frame), its rate and its acceleration (the rate's
-    time derivative along the motion, by a central difference) at the drive's speed."""
-    S, sw = sim.system, sim.sweep
-    if S is None or sw is None:
+    """Every P joint's slide along its guide, its rate and its acceleration
+    (:func:`~mechsyn.kinematics.derived.slide`)."""
+    if sim.system is None or sim.sweep is None:
         return {}
-    q, qd, qdd = (np.asarray(a, float) for a in (sw.q, sw.qd, sw.qdd))
-    h = 1e-4 / max(1.0, float(np.nanmax(np.abs(qd))) if np.isfinite(qd).any() else 1.0)
     out = {}
     for j in mech.joints:
-        if j.type != "P":
-            continue
-        rate = S.coordinate_rate(q, qd, j.id)
-        acc = (S.coordinate_rate(q + h * qd, qd + h * qdd, j.id) - S.coordinate_rate(q - h * qd, qd - h * qdd, j.id)) / (2 * h)
-        value = np.where(sim.assembled, S.coordinate(np.nan_to_num(q), j.id), np.nan)
-        out[j.id] = {"guide": j.links[0], "value": rows(value), "rate": rows(rate),
-                     "acceleration": rows(acc)}
+        if j.type == "P":
+            value, rate, acc = derived.slide(sim, j.id, acceleration=True)
+            out[j.id] = {"guide": j.links[0], "value": rows(value), "rate": rows(rate), "acceleration": rows(acc)}
     return out
 
 
@@ -191,65 +182,3 @@ def simulation_report(mech: Mechanism, inputs: dict[str, np.ndarray], *, speeds:
     """
     sim = simulate(mech, inputs, speeds=speeds, points=points, vll=vll, method=method, progress=progress)
     return SimulationReport(sim, derived_quantities(mech, sim, output, straight, rates), rates)
-
-
-def csv_text(header: list[str], columns: list[np.ndarray]) -> str:
-    """A CSV table (``repr`` of floats, so no digit is lost; empty cells where not finite).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from mechsyn.kinematics.report import csv_text
-    >>> print(csv_text(["x", "y"], [np.array([1.5, np.nan]), np.array([2.0, 3.0])]), end="")
-    x,y
-    1.5,2.0
-    ,3.0
-    """
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow([csv_cell(h) for h in header])  # names from the file: no formula reaches a spreadsheet
-    for row in zip(*columns):
-        w.writerow(["" if (isinstance(v, float) and not np.isfinite(v)) else
-                    (repr(float(v)) if isinstance(v, (float, np.floating)) else v) for v in row])
-    return buf.getvalue()
-
-
-def simulation_csv(sim: Simulation) -> str:
-    """The simulation as a CSV table: inputs, assembled, each point's position, velocity and
-    acceleration, each link's angle, angular velocity and acceleration.
-
-    Examples
-    --------
-    >>> import numpy as np, mechsyn as ms
-    >>> from mechsyn.kinematics.report import simulation_csv
-    >>> s = ms.simulate(ms.examples.load("crank_rocker"), {"A": np.array([0.0, 90.0])})
-    >>> simulation_csv(s).splitlines()[0].split(",")[:3]
-    ['input_A', 'assembled', 'M_x']
-    """
-    return _csv(sim.columns())
-
-
-def forces_csv(fa: ForceAnalysis) -> str:
-    """A force analysis as a CSV table: inputs, assembled, each joint's reaction (Fx, Fy,
-    |F|, M) and each drive's balancing effort.
-
-    Examples
-    --------
-    >>> import mechsyn as ms
-    >>> from mechsyn.kinematics.report import forces_csv
-    >>> f = ms.forces(ms.examples.load("crank_rocker"), {"A": ms.input_grid(0, 90, 45)}, static=True)
-    >>> forces_csv(f).splitlines()[0].split(",")[:4]
-    ['input_A', 'assembled', 'A_Fx', 'A_Fy']
-    """
-    R = fa.reactions
-    cols = fa.simulation.columns(motion=False)
-    for j, F in R.force.items():
-        cols.update({f"{j}_Fx": F[:, 0], f"{j}_Fy": F[:, 1], f"{j}_F": np.linalg.norm(F, axis=1), f"{j}_M": R.moment[j]})
-    for j, e in R.effort.items():
-        cols[f"drive_{j}_{R.effort_kind[j]}"] = e
-    return _csv(cols)
-
-
-def _csv(cols: dict[str, np.ndarray]) -> str:
-    """:func:`csv_text` of named columns (``assembled`` as 0 and 1)."""
-    return csv_text(list(cols), [c.astype(int) if k == "assembled" else c for k, c in cols.items()])

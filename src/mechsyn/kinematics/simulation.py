@@ -18,15 +18,15 @@ import numpy as np
 
 from mechsyn._result import Result
 from mechsyn.errors import MechsynInputError
-from mechsyn.kinematics.summary import is_full_turn
 from mechsyn.kinematics.sweep import Event, Sweep
 from mechsyn.limits import limit, limit_hint
 from mechsyn.model.mechanism import Mechanism
+from mechsyn.results import csv_table
 
 if TYPE_CHECKING:
     from mechsyn.kinematics.system import PlanarSystem
 
-__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points", "rows"]
+__all__ = ["Motion", "Simulation", "PointMotion", "LinkMotion", "input_grid", "resolve_points", "rows", "is_full_turn"]
 
 
 @dataclass
@@ -132,16 +132,12 @@ class Motion(Result):
             inside = [d for d in dead if lo < d <= hi or lo <= d < hi]
             return min(inside, key=lambda d: abs(d - a)) if inside else default
 
-        out, start = [], None
-        for k in range(n):
-            if ok[k] and start is None:
-                start = k
-            if (not ok[k] or k == n - 1) and start is not None:
-                end = k if ok[k] else k - 1
-                first = located(vals[start], vals[start - 1], vals[start]) if start > 0 else vals[start]
-                last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
-                out.append([float(first), float(last)])
-                start = None
+        out = []
+        edges = np.flatnonzero(np.diff(np.r_[False, ok, False]))  # each run's first row and the row after it
+        for start, end in zip(edges[::2].tolist(), (edges[1::2] - 1).tolist()):
+            first = located(vals[start], vals[start - 1], vals[start]) if start > 0 else vals[start]
+            last = located(vals[end], vals[end + 1], vals[end]) if end < n - 1 else vals[end]
+            out.append([float(first), float(last)])
         if len(out) > 1 and ok[0] and ok[-1] and is_full_turn(vals, self.input_types.get(self.main_input)):
             turn = 360.0 if vals[-1] >= vals[0] else -360.0  # a whole turn: the ends meet
             out[0] = [out[-1][0], out[0][1] + turn]
@@ -152,8 +148,7 @@ class Motion(Result):
         """The result as named columns, one row per input value: the inputs, ``assembled``,
         then (``motion``) every point's x, y (z), vx, vy, ..., ax, ... and every link's
         numbers by row (angle, omega, alpha; a 3-D link's translation and rates by
-        component): the columns of :meth:`to_pandas` and of the CSV tables
-        (:mod:`mechsyn.kinematics.report`).
+        component): the columns of :meth:`to_pandas` and of :meth:`csv`.
 
         Examples
         --------
@@ -177,6 +172,18 @@ class Motion(Result):
                     for c, col in zip("xyz", arr.T):
                         cols[f"{name}_{key}_{c}"] = col
         return cols
+
+    def csv(self) -> str:
+        """:meth:`columns` as a CSV table (:func:`mechsyn.results.csv_table`): what
+        ``mechsyn simulate --csv`` writes.
+
+        Examples
+        --------
+        >>> import mechsyn as ms
+        >>> ms.examples.load("crank_rocker").simulate(A=(0, 90, 30)).csv().splitlines()[0].split(",")[:3]
+        ['input_A', 'assembled', 'M_x']
+        """
+        return csv_table(self.columns())
 
     def to_pandas(self) -> Any:
         """A :class:`pandas.DataFrame` of :meth:`columns`, one row per input value."""
@@ -315,6 +322,23 @@ def _unit(t: str) -> str:
     return "length" if t == "P" else "deg"  # (an angle: R, and a spatial file's H, C/turn, U)
 
 
+def is_full_turn(values: np.ndarray, input_type: str) -> bool:
+    """True when an R input's values cover a whole turn (the last row, one step on, is the
+    first again, e.g. 0, 2, ..., 358; or 0 ... 360 with its end repeated).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> is_full_turn(np.arange(0, 360, 2.0), "R"), is_full_turn(np.arange(0, 180, 2.0), "R")
+    (True, False)
+    """
+    x = np.asarray(values, float)
+    if input_type != "R" or len(x) < 3 or not np.isfinite(x).all():
+        return False
+    step = float(np.median(np.abs(np.diff(x))))
+    return bool(abs(x[-1] - x[0]) + step >= 360.0 * (1 - 1e-9))
+
+
 def input_grid(start: float, stop: float, step: float) -> np.ndarray:
     """``start, start + step, ..., stop`` (stop included when on the grid).
 
@@ -347,11 +371,8 @@ def input_grid(start: float, stop: float, step: float) -> np.ndarray:
 def resolve_points(mech: Mechanism, names: list[str] | None) -> dict[str, tuple[str, np.ndarray]]:
     """Named points (file ``points`` or joint ids) -> (link, assembled coordinates)."""
     out: dict[str, tuple[str, np.ndarray]] = {}
-    if names is None:
-        if mech.points:
-            names = list(mech.points)
-        else:
-            names = [j.id for j in mech.joints]
+    if names is None:  # the file's named points, else every joint
+        names = list(mech.points) or [j.id for j in mech.joints]
     for name in names:
         if name in mech.points:
             p = mech.points[name]

@@ -24,26 +24,11 @@ from typing import Any
 
 import numpy as np
 
+from mechsyn.kinematics.derived import slide
+from mechsyn.kinematics.simulation import is_full_turn
 from mechsyn.model.mechanism import Mechanism
 
 __all__ = ["motion_summary", "is_full_turn"]
-
-
-def is_full_turn(values: np.ndarray, input_type: str) -> bool:
-    """True when an R input's values cover a whole turn (the last row, one step on, is the
-    first again, e.g. 0, 2, ..., 358; or 0 ... 360 with its end repeated).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> is_full_turn(np.arange(0, 360, 2.0), "R"), is_full_turn(np.arange(0, 180, 2.0), "R")
-    (True, False)
-    """
-    x = np.asarray(values, float)
-    if input_type != "R" or len(x) < 3 or not np.isfinite(x).all():
-        return False
-    step = float(np.median(np.abs(np.diff(x))))
-    return bool(abs(x[-1] - x[0]) + step >= 360.0 * (1 - 1e-9))
 
 
 def _hermite_stop(fa: float, fb: float, da: float, db: float, h: float) -> tuple[float, float]:
@@ -137,9 +122,8 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
     >>> round(s["sliders"]["D"]["time_ratio"]["ratio"], 6)
     1.0
     """
-    S, sweep = getattr(sim, "system", None), getattr(sim, "sweep", None)
     out: dict[str, Any] = {"full_turn": False, "sliders": {}, "rockers": {}}
-    if mech.kind != "planar" or S is None or sweep is None or len(sim.inputs) != 1:
+    if mech.kind != "planar" or getattr(sim, "sweep", None) is None or len(sim.inputs) != 1:
         return out
     main = sim.main_input
     x = np.asarray(sim.inputs[main], float)
@@ -149,13 +133,10 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
     out["full_turn"] = cyclic
     # the rates are per unit time at the input's speed; d/dx in the input's own unit (deg or length)
     rate_x = float(sim.speeds.get(main, 1.0)) * (180.0 / np.pi if kind == "R" else 1.0)
-    q = np.asarray(sweep.q, float)
     for j in mech.joints:
         if j.type != "P" or j.id == main or j.actuated:
             continue
-        s = np.asarray(S.coordinate(np.nan_to_num(q), j.id), float)
-        sd = np.asarray(S.coordinate_rate(q, np.asarray(sweep.qd, float), j.id), float)
-        s[~ok] = np.nan
+        s, sd = slide(sim, j.id)
         r = _range_of(x, s, sd / rate_x, ok, cyclic)
         if r is None:
             continue
@@ -163,10 +144,8 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
         u = np.asarray(j.axis, float)[:2] / np.linalg.norm(np.asarray(j.axis, float)[:2]) if on_frame else None
         pos = sim.points[j.id].position if j.id in sim.points else None
 
-        def at(c, u=u, pos=pos, s=s):
-            p = None
-            if u is not None and pos is not None:
-                p = (pos[c["row"]][:2] + (c["value"] - s[c["row"]]) * u).tolist()
+        def at(c, u=u, pos=pos, s=s):  # the block's place there for a guide on the frame
+            p = None if u is None or pos is None else (pos[c["row"]][:2] + (c["value"] - s[c["row"]]) * u).tolist()
             return {"input": c["input"], "slide": c["value"], "point": p}
 
         out["sliders"][j.id] = {"guide": j.links[0], "block": j.links[1], "stroke": r["span"],
@@ -184,15 +163,12 @@ def motion_summary(mech: Mechanism, sim: Any) -> dict[str, Any]:
         good = np.isfinite(ang)
         if good.any():  # continuous over each run (the engine's angles may jump by 360)
             ang[good] = np.degrees(np.unwrap(np.radians(ang[good])))
-        if cyclic and abs(ang[-1] - ang[0]) > 180.0:  # one turn of the crank turns it once: a crank too
-            out["rockers"][link] = {"pivot": j.id, "full_turn": True, "range": 360.0, "min": None, "max": None,
-                                    "time_ratio": None}
+        full = cyclic and abs(ang[-1] - ang[0]) > 180.0  # one turn of the crank turns it once: a crank too
+        r = None if full else _range_of(x, ang, np.asarray(lm.angular_velocity, float) * 180.0 / np.pi / rate_x, ok,
+                                        cyclic)
+        if r is None and not full:
             continue
-        w = np.asarray(lm.angular_velocity, float) * 180.0 / np.pi
-        r = _range_of(x, ang, w / rate_x, ok, cyclic)
-        if r is None:
-            continue
-        full = r["span"] >= 360.0 * (1 - 1e-9)
+        full = full or r["span"] >= 360.0 * (1 - 1e-9)
         out["rockers"][link] = {
             "pivot": j.id, "full_turn": bool(full), "range": 360.0 if full else r["span"],
             "min": None if full else {"input": r["min"]["input"], "angle": r["min"]["value"]},

@@ -29,7 +29,8 @@ if TYPE_CHECKING:  # NetworkX is imported by graph() only: reading and analysing
 
     # The facade methods below return the upper layers' results: named here for the types only;
     # the methods import their module when called (the facade edges of tests/test_layout.py).
-    from mechsyn.kinematics.analysis import ForceAnalysis, Simulation
+    from mechsyn.kinematics.analysis import Simulation
+    from mechsyn.kinetostatics.analysis import ForceAnalysis
     from mechsyn.structure.report import StructureReport
     from mechsyn.web.widget import MechanismWidget
 
@@ -308,7 +309,7 @@ class Mechanism:
                method: str = "auto", **joint_inputs: Any) -> ForceAnalysis:
         """Joint reactions and drive efforts over a sweep: :func:`mechsyn.forces`, inputs as
         in :meth:`simulate`."""
-        from mechsyn.kinematics.analysis import forces
+        from mechsyn.kinetostatics import forces
 
         return forces(self, _inputs(inputs, joint_inputs), speeds=speeds, gravity=gravity, static=static,
                       vll=vll, method=method)

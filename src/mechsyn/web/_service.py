@@ -322,13 +322,12 @@ def _scale(mech) -> float:
 
 def simulation_csv(data: Any, steps: int = 180) -> str:
     """The simulation as CSV (``mechsyn simulate --csv``:
-    :func:`mechsyn.kinematics.report.simulation_csv`) over the studio's sweep."""
+    :meth:`mechsyn.kinematics.simulation.Motion.csv`) over the studio's sweep."""
     from mechsyn.kinematics.analysis import simulate as _simulate
-    from mechsyn.kinematics.report import simulation_csv as _csv
 
     mech = build(data)
     drive, values = _sweep(mech, steps, None)
-    return _csv(_simulate(mech, {drive.id: values}, points=_reported(mech)))
+    return _simulate(mech, {drive.id: values}, points=_reported(mech)).csv()
 
 
 def animation_gif(data: Any, frames: int = 72) -> bytes:

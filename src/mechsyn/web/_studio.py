@@ -35,7 +35,7 @@ from mechsyn.export.drawing import drawing_of
 from mechsyn.export.dxf import layout_to_dxf
 from mechsyn.export.plates import link_plates
 from mechsyn.io import load_mechanism
-from mechsyn.kinematics.analysis import forces as _forces
+from mechsyn.kinetostatics import forces as _forces
 from mechsyn.progress import Progress, ProgressCallback
 from mechsyn.results import to_jsonable
 from mechsyn.structure.drives import DriveCheck
@@ -250,7 +250,7 @@ def forces(data: Any, gravity: Any = (0.0, 0.0), speed: Any = 1.0, steps: int = 
     (``mechsyn forces``: kinetostatics with the file's link masses, inertias and loads, the
     drive turning at ``speed`` rad/s, or moving at ``speed`` units/s, held constant).
 
-    Returns the library's :meth:`~mechsyn.kinematics.analysis.ForceAnalysis.to_dict`.
+    Returns the library's :meth:`~mechsyn.kinetostatics.analysis.ForceAnalysis.to_dict`.
     """
 
     if not isinstance(gravity, (list, tuple)) or len(gravity) != 2:

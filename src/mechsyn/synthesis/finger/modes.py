@@ -23,7 +23,7 @@ import numpy as np
 
 from mechsyn.errors import MechsynInputError
 from mechsyn.io import mechanism_from_dict
-from mechsyn.kinematics.forces import kinetostatics
+from mechsyn.kinetostatics.reactions import kinetostatics
 from mechsyn.kinematics.solve import assemble
 from mechsyn.kinematics.plane import cos_sin
 from mechsyn.kinematics.system import build_system
