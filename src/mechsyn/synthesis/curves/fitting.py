@@ -7,6 +7,7 @@ angle) and the least-squares problem that the refinement of
 
 from __future__ import annotations
 
+import importlib
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -56,16 +57,9 @@ def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
     """Vectors from points ``X (..., n, 2)`` to their nearest point on the polyline
     (``starts``, ``vecs`` ``(..., S, 2)``), and the index of that segment ``(..., n)``.
     With ``k`` given, the segments are those (fixed correspondences, for Jacobians)."""
-    if k is not None:
-        shape = np.broadcast_shapes(X.shape[:-1], k.shape, starts.shape[:-2] + k.shape[-1:])
-        st = np.take_along_axis(np.broadcast_to(starts, shape[:-1] + starts.shape[-2:]),
-                                np.broadcast_to(k, shape)[..., None], axis=-2)
-        ve = np.take_along_axis(np.broadcast_to(vecs, shape[:-1] + vecs.shape[-2:]),
-                                np.broadcast_to(k, shape)[..., None], axis=-2)
-        d = X - st
-        L2 = np.sum(ve ** 2, axis=-1)
-        t = np.clip(np.sum(d * ve, axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
-        return t[..., None] * ve - d, k
+    if k is not None:   # X (KX, n, 2), starts and vecs (KS, S, 2), k (K, n); KX and KS 1 or K
+        return _compiled().toward(*(np.ascontiguousarray(a, float) for a in (X, starts, vecs)),
+                             np.ascontiguousarray(k, np.int64)), k
     d = X[..., :, None, :] - starts[..., None, :, :]                   # (..., n, S, 2)
     L2 = np.sum(vecs ** 2, axis=-1)[..., None, :]
     t = np.clip(np.sum(d * vecs[..., None, :, :], axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
@@ -136,80 +130,33 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
 
 
 def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
-              around: int | None = None, full: bool = False) -> tuple[float, int] | tuple[float, int, np.ndarray]:
+              around: int | None = None) -> tuple[float, int]:
     """The least weighted cost over correspondences in order of a cost matrix ``c (n, m)``
-    (:func:`_dtw`) and the start shift of the closed curve it is reached at (the rows'
-    when they are closed, else the columns'; 0 when neither is): every
-    :data:`ROLL_STEP`-th shift, then every one about the best two; with ``around`` (a
-    shift found before) only those within :data:`ROLL_STEP` of it; with ``full`` also the
-    sums to every cell of the best (for :func:`_dtw_pairs`)."""
+    (:func:`mechsyn.synthesis.curves._numba.costs`) and the start shift of the closed
+    curve it is reached at (the rows' when they are closed, else the columns'; 0 when
+    neither is): every :data:`ROLL_STEP`-th shift, then every one about the best two; with
+    ``around`` (a shift found before) only those within :data:`ROLL_STEP` of it."""
+    dtw = _compiled()
+    c = np.ascontiguousarray(c, float)
     if not (rows_closed or cols_closed):
-        if full:
-            D = _dtw(c[None], full=True)[0]
-            return float(D[-1, -1] / sum(c.shape)), 0, D
-        return float(_dtw(c[None])[0]), 0
+        return float(dtw.costs(c, np.zeros(1, np.int64), True)[0]), 0
     n = c.shape[0] if rows_closed else c.shape[1]
     if around is None:
         coarse = np.arange(0, n, ROLL_STEP)
-        e = _dtw(_rolled(c, coarse, rows_closed))
-        near = sorted({(s + k) % n for s in coarse[np.argsort(e)[:2]] for k in range(1 - ROLL_STEP, ROLL_STEP)})
+        e = dtw.costs(c, coarse, rows_closed)
+        near = sorted({(s + k) % n for s in coarse[np.argsort(e, kind="stable")[:2]]
+                       for k in range(1 - ROLL_STEP, ROLL_STEP)})
     else:
         near = sorted({(around + k) % n for k in range(-ROLL_STEP, ROLL_STEP + 1)})
-    if full:
-        D = _dtw(_rolled(c, np.array(near), rows_closed), full=True)
-        f = D[:, -1, -1] / sum(c.shape)
-        i = int(np.argmin(f))
-        return float(f[i]), int(near[i]), D[i]
-    f = _dtw(_rolled(c, np.array(near), rows_closed))
+    f = dtw.costs(c, np.array(near, np.int64), rows_closed)
     i = int(np.argmin(f))
     return float(f[i]), int(near[i])
 
 
-def _rolled(c: np.ndarray, shifts: np.ndarray, rows: bool) -> np.ndarray:
-    """``(V, n, m)``: the cost matrix with the closed curve's start (its rows' or its
-    columns') moved by each shift."""
-    n = c.shape[0] if rows else c.shape[1]
-    idx = (shifts[:, None] + np.arange(n)[None, :]) % n
-    return c[idx] if rows else np.swapaxes(c.T[idx], 1, 2)
-
-
-def _dtw(C: np.ndarray, full: bool = False) -> np.ndarray:
-    """``(V,)``: the least weighted sum over monotone paths of each cost matrix ``C (V, n, m)``
-    (diagonal steps weighted 2, others 1), over ``n + m``; with ``full`` the sums to every
-    cell ``(V, n, m)`` (not divided)."""
-    V, n, m = C.shape
-    D = 2 * C[:, 0, :1] + np.concatenate([np.zeros((V, 1)), np.cumsum(C[:, 0, 1:], axis=1)], axis=1)
-    rows = [D]
-    for i in range(1, n):
-        c = C[:, i]
-        E = D + c
-        E[:, 1:] = np.minimum(E[:, 1:], D[:, :-1] + 2 * c[:, 1:])
-        cc = np.cumsum(c, axis=1)
-        D = cc + np.minimum.accumulate(E - cc, axis=1)   # along the row: D[j] = min(E[j], D[j-1] + c[j])
-        if full:
-            rows.append(D)
-    return np.stack(rows, axis=1) if full else D[:, -1] / (n + m)
-
-
-def _dtw_pairs(C: np.ndarray, D: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The rows and columns ``(L,)`` of the least-cost monotone path of :func:`_dtw` through
-    one cost matrix ``C (n, m)``, from ``(0, 0)`` to ``(n-1, m-1)`` (backtracked; ``D`` its
-    sums to every cell when known)."""
-    Dl = (_dtw(C[None], full=True)[0] if D is None else D).tolist()   # scalar look-ups: lists
-    Cl = C.tolist()
-    i, j = C.shape[0] - 1, C.shape[1] - 1
-    rows, cols = [i], [j]
-    while i or j:
-        c = Cl[i][j]
-        if i and j and Dl[i - 1][j - 1] + 2 * c <= min(Dl[i - 1][j], Dl[i][j - 1]) + c:
-            i, j = i - 1, j - 1
-        elif not j or (i and Dl[i - 1][j] <= Dl[i][j - 1]):
-            i -= 1
-        else:
-            j -= 1
-        rows.append(i)
-        cols.append(j)
-    return np.array(rows[::-1]), np.array(cols[::-1])
+def _compiled() -> Any:
+    """The compiled correspondence and distances (:mod:`mechsyn.synthesis.curves._numba`),
+    imported on first use."""
+    return importlib.import_module("mechsyn.synthesis.curves._numba")
 
 
 def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.ndarray:
@@ -221,25 +168,13 @@ def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.nda
 
 def _seg_dist(X: np.ndarray, F: np.ndarray, closed: bool) -> np.ndarray:
     """``(n, S)``: distance from each point of ``X`` to each segment of polyline ``F``."""
-    S0, V = _polyline(F, closed)
-    dx, dy = X[:, :1] - S0[:, 0], X[:, 1:] - S0[:, 1]                  # (n, S) each: x and y apart
-    vx, vy = V[:, 0], V[:, 1]
-    t = np.clip((dx * vx + dy * vy) / np.maximum(vx * vx + vy * vy, 1e-300), 0.0, 1.0)
-    dx -= t * vx
-    dy -= t * vy
-    return np.sqrt(dx * dx + dy * dy)
+    return _compiled().seg_dist(np.ascontiguousarray(X, float), np.ascontiguousarray(F, float), closed)
 
 
 def _stretches(seg: np.ndarray, closed: bool, k: int) -> np.ndarray:
     """Segment distances ``(n, S)`` (``k`` segments per sample step) reduced to the
     stretch beside each sample (see :func:`_beside`)."""
-    seg = seg.reshape(len(seg), -1, k).min(axis=2)
-    if closed:   # seg[:, j]: from sample j to j + 1
-        return np.minimum(seg, np.roll(seg, 1, axis=1))
-    out = np.empty((len(seg), seg.shape[1] + 1))
-    out[:, :-1], out[:, -1] = seg, seg[:, -1]
-    out[:, 1:] = np.minimum(out[:, 1:], seg)
-    return out
+    return _compiled().stretches(np.ascontiguousarray(seg, float), closed, k)
 
 
 def _beside_mask(W: np.ndarray, closed: bool, k: int) -> np.ndarray:
@@ -274,10 +209,9 @@ def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool,
     n, m = c.shape
     senses = (False, True) if hint is None else (hint[0],)
     around = None if hint is None else hint[1]
-    (_, shift, D), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around, full=True),
-                               rev) for rev in senses), key=lambda x: x[0][0])
-    cc = c[:, ::-1] if rev else c
-    i, j = _dtw_pairs(_rolled(cc, np.array([shift]), rows_closed)[0] if rows_closed or cols_closed else cc, D)
+    (_, shift), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around), rev)
+                           for rev in senses), key=lambda x: x[0][0])
+    i, j = _compiled().pairs(np.ascontiguousarray(c[:, ::-1] if rev else c, float), shift, rows_closed)
     if rows_closed:
         i = (i + shift) % n
     elif cols_closed:
