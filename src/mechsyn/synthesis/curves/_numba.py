@@ -161,3 +161,23 @@ def toward(X, S, V, k):
             out[d, i, 0] = t * vx - dx
             out[d, i, 1] = t * vy - dy
     return out
+
+
+@njit(**_OPTIONS)
+def nearest_beside(D, W, closed, k):
+    """``(n,)``: for each row of segment distances ``D (n, S)`` (``k`` segments per sample
+    step of the columns' curve) the nearest segment among those beside the samples matched
+    to the row by ``W (n, m)``, from the sample before each to the one after (the first
+    such segment where several are as near)."""
+    n, S = D.shape
+    m = W.shape[1]
+    out = np.zeros(n, np.int64)
+    for i in range(n):
+        best = np.inf
+        for s in range(S):
+            g = s // k
+            h = g + 1 if g + 1 < m else 0
+            if (W[i, g] or W[i, h]) and D[i, s] < best:
+                best = D[i, s]
+                out[i] = s
+    return out

@@ -156,7 +156,12 @@ def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
 def _compiled() -> Any:
     """The compiled correspondence and distances (:mod:`mechsyn.synthesis.curves._numba`),
     imported on first use."""
-    return importlib.import_module("mechsyn.synthesis.curves._numba")
+    if not _COMPILED:
+        _COMPILED.append(importlib.import_module("mechsyn.synthesis.curves._numba"))
+    return _COMPILED[0]
+
+
+_COMPILED: list[Any] = []   # the compiled module, once imported
 
 
 def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.ndarray:
@@ -268,10 +273,8 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
     m = 128
     w = resample(target.points, m, closed=target.closed)
     z = resample(path, m, closed=closed_path)
-    best = np.inf
-    for zz in (z, z[::-1]):
-        for s in range(m):
-            best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
+    rolls = (np.arange(m)[None, :] - np.arange(m)[:, None]) % m      # row s: the start moved by s
+    best = min(float(np.sqrt(np.mean(np.abs(zz[rolls] - w) ** 2, axis=1)).min()) for zz in (z, z[::-1]))
     return float(chamfer), float(nearest), best / unit
 
 
@@ -459,12 +462,12 @@ class FitProblem:
             c = 0.5 * (_stretches(D1, self.closed_path, 1) + _stretches(D2, self.target.closed, FINE).T)
             W, self.hint = correspondence(c, self.target.closed, self.closed_path, self.hint)   # (M, N); the
             # next evaluations are of nearby designs: their correspondence is sought about this one
-            m1 = _beside_mask(W, self.closed_path, 1)
-            ks[0][d] = np.argmin(np.where(m1, D1, np.inf), axis=1)
-            ks[1][d] = np.argmin(np.where(_beside_mask(W.T, self.target.closed, FINE), D2, np.inf), axis=1)
+            near = _compiled().nearest_beside
+            ks[0][d] = near(D1, W, self.closed_path, 1)
+            ks[1][d] = near(D2, np.ascontiguousarray(W.T), self.target.closed, FINE)
             if len(self.features):
                 D3 = _seg_dist(self.features, P[d], self.closed_path)
-                ks[2][d] = np.argmin(np.where(m1[self.feature_at], D3, np.inf), axis=1)
+                ks[2][d] = near(D3, W[self.feature_at], self.closed_path, 1)
         return ks
 
     def fun(self, x: np.ndarray) -> np.ndarray:
