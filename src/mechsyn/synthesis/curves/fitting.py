@@ -129,25 +129,20 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
     return float(best / unit)
 
 
-def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
-              around: int | None = None) -> tuple[float, int]:
+def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool) -> tuple[float, int]:
     """The least weighted cost over correspondences in order of a cost matrix ``c (n, m)``
     (:func:`mechsyn.synthesis.curves._numba.costs`) and the start shift of the closed
     curve it is reached at (the rows' when they are closed, else the columns'; 0 when
-    neither is): every :data:`ROLL_STEP`-th shift, then every one about the best two; with
-    ``around`` (a shift found before) only those within :data:`ROLL_STEP` of it."""
+    neither is): every :data:`ROLL_STEP`-th shift, then every one about the best two."""
     dtw = _compiled()
     c = np.ascontiguousarray(c, float)
     if not (rows_closed or cols_closed):
         return float(dtw.costs(c, np.zeros(1, np.int64), True)[0]), 0
     n = c.shape[0] if rows_closed else c.shape[1]
-    if around is None:
-        coarse = np.arange(0, n, ROLL_STEP)
-        e = dtw.costs(c, coarse, rows_closed)
-        near = sorted({(s + k) % n for s in coarse[np.argsort(e, kind="stable")[:2]]
-                       for k in range(1 - ROLL_STEP, ROLL_STEP)})
-    else:
-        near = sorted({(around + k) % n for k in range(-ROLL_STEP, ROLL_STEP + 1)})
+    coarse = np.arange(0, n, ROLL_STEP)
+    e = dtw.costs(c, coarse, rows_closed)
+    best2 = coarse[np.argsort(e, kind="stable")[:2]]
+    near = sorted({(s + k) % n for s in best2 for k in range(1 - ROLL_STEP, ROLL_STEP)})
     f = dtw.costs(c, np.array(near, np.int64), rows_closed)
     i = int(np.argmin(f))
     return float(f[i]), int(near[i])
@@ -195,27 +190,23 @@ def _fine(points: np.ndarray, closed: bool, m: int, k: int = FINE) -> np.ndarray
     return even_points(points, closed, k * m if closed else k * (m - 1) + 1)
 
 
-def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool,
-                   hint: tuple[bool, int] | None = None) -> tuple[np.ndarray, tuple[bool, int]]:
+def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool) -> tuple[np.ndarray, tuple[bool, int]]:
     """``(n, m)`` boolean: the pairs (row sample, column sample) matched by the least-cost
     correspondence in order of cost matrix ``c (n, m)`` (the rows a target's samples, the
     columns a path's), from any start point of a closed curve and in either sense of the
-    columns: the correspondence :func:`chamfer_error` takes its value along; and the sense
-    and start shift it has, a ``hint`` for the next call on a nearby curve (then only that
-    sense and the shifts about it are tried).
+    columns: the correspondence :func:`chamfer_error` takes its value along; and its sense
+    (columns reversed) and start shift.
 
     >>> t = np.linspace(0, 2 * np.pi, 8, endpoint=False)
     >>> a = np.c_[np.cos(t), np.sin(t)]
     >>> c = np.linalg.norm(a[:, None] - np.roll(a[::-1], 3, axis=0)[None], axis=-1)
-    >>> W, hint = correspondence(c, True, True)
-    >>> bool(np.all(c[W] < 1e-12)), int(W.sum()), hint[0]
+    >>> W, (reversed_, shift) = correspondence(c, True, True)
+    >>> bool(np.all(c[W] < 1e-12)), int(W.sum()), reversed_
     (True, 8, True)
     """
     n, m = c.shape
-    senses = (False, True) if hint is None else (hint[0],)
-    around = None if hint is None else hint[1]
-    (_, shift), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around), rev)
-                           for rev in senses), key=lambda x: x[0][0])
+    (_, shift), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed), rev)
+                           for rev in (False, True)), key=lambda x: x[0][0])
     i, j = _compiled().pairs(np.ascontiguousarray(c[:, ::-1] if rev else c, float), shift, rows_closed)
     if rows_closed:
         i = (i + shift) % n
@@ -390,7 +381,6 @@ class FitProblem:
         self.nfev = 0
         self.deadline = float("inf")     # now() past which an evaluation raises OutOfTime
         self.best = (float("inf"), None)  # (cost, x) of the best design evaluated by fun
-        self.hint: tuple[bool, int] | None = None   # the last correspondence's sense and start shift
         self.last_match: tuple[np.ndarray, tuple] | None = None   # (path, its matched segments)
 
     def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
@@ -460,8 +450,8 @@ class FitProblem:
             D1 = _seg_dist(self.T, P[d], self.closed_path)                  # (M, S1)
             D2 = _seg_dist(P[d], self.Af, self.target.closed)               # (N, S2)
             c = 0.5 * (_stretches(D1, self.closed_path, 1) + _stretches(D2, self.target.closed, FINE).T)
-            W, self.hint = correspondence(c, self.target.closed, self.closed_path, self.hint)   # (M, N); the
-            # next evaluations are of nearby designs: their correspondence is sought about this one
+            W, _ = correspondence(c, self.target.closed, self.closed_path)   # (M, N): over every start and
+            # sense, as the error is taken (one sought about the previous one can stay in a worse start)
             near = _compiled().nearest_beside
             ks[0][d] = near(D1, W, self.closed_path, 1)
             ks[1][d] = near(D2, np.ascontiguousarray(W.T), self.target.closed, FINE)
