@@ -7,6 +7,7 @@ angle) and the least-squares problem that the refinement of
 
 from __future__ import annotations
 
+import importlib
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -56,16 +57,9 @@ def _to_polyline(X: np.ndarray, starts: np.ndarray, vecs: np.ndarray,
     """Vectors from points ``X (..., n, 2)`` to their nearest point on the polyline
     (``starts``, ``vecs`` ``(..., S, 2)``), and the index of that segment ``(..., n)``.
     With ``k`` given, the segments are those (fixed correspondences, for Jacobians)."""
-    if k is not None:
-        shape = np.broadcast_shapes(X.shape[:-1], k.shape, starts.shape[:-2] + k.shape[-1:])
-        st = np.take_along_axis(np.broadcast_to(starts, shape[:-1] + starts.shape[-2:]),
-                                np.broadcast_to(k, shape)[..., None], axis=-2)
-        ve = np.take_along_axis(np.broadcast_to(vecs, shape[:-1] + vecs.shape[-2:]),
-                                np.broadcast_to(k, shape)[..., None], axis=-2)
-        d = X - st
-        L2 = np.sum(ve ** 2, axis=-1)
-        t = np.clip(np.sum(d * ve, axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
-        return t[..., None] * ve - d, k
+    if k is not None:   # X (KX, n, 2), starts and vecs (KS, S, 2), k (K, n); KX and KS 1 or K
+        return _compiled().toward(*(np.ascontiguousarray(a, float) for a in (X, starts, vecs)),
+                             np.ascontiguousarray(k, np.int64)), k
     d = X[..., :, None, :] - starts[..., None, :, :]                   # (..., n, S, 2)
     L2 = np.sum(vecs ** 2, axis=-1)[..., None, :]
     t = np.clip(np.sum(d * vecs[..., None, :, :], axis=-1) / np.where(L2 > 0, L2, 1.0), 0.0, 1.0)
@@ -135,81 +129,34 @@ def chamfer_error(path: np.ndarray, target: TargetCurve, closed_path: bool, unit
     return float(best / unit)
 
 
-def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool,
-              around: int | None = None, full: bool = False) -> tuple[float, int] | tuple[float, int, np.ndarray]:
+def _in_order(c: np.ndarray, rows_closed: bool, cols_closed: bool) -> tuple[float, int]:
     """The least weighted cost over correspondences in order of a cost matrix ``c (n, m)``
-    (:func:`_dtw`) and the start shift of the closed curve it is reached at (the rows'
-    when they are closed, else the columns'; 0 when neither is): every
-    :data:`ROLL_STEP`-th shift, then every one about the best two; with ``around`` (a
-    shift found before) only those within :data:`ROLL_STEP` of it; with ``full`` also the
-    sums to every cell of the best (for :func:`_dtw_pairs`)."""
+    (:func:`mechsyn.synthesis.curves._numba.costs`) and the start shift of the closed
+    curve it is reached at (the rows' when they are closed, else the columns'; 0 when
+    neither is): every :data:`ROLL_STEP`-th shift, then every one about the best two."""
+    dtw = _compiled()
+    c = np.ascontiguousarray(c, float)
     if not (rows_closed or cols_closed):
-        if full:
-            D = _dtw(c[None], full=True)[0]
-            return float(D[-1, -1] / sum(c.shape)), 0, D
-        return float(_dtw(c[None])[0]), 0
+        return float(dtw.costs(c, np.zeros(1, np.int64), True)[0]), 0
     n = c.shape[0] if rows_closed else c.shape[1]
-    if around is None:
-        coarse = np.arange(0, n, ROLL_STEP)
-        e = _dtw(_rolled(c, coarse, rows_closed))
-        near = sorted({(s + k) % n for s in coarse[np.argsort(e)[:2]] for k in range(1 - ROLL_STEP, ROLL_STEP)})
-    else:
-        near = sorted({(around + k) % n for k in range(-ROLL_STEP, ROLL_STEP + 1)})
-    if full:
-        D = _dtw(_rolled(c, np.array(near), rows_closed), full=True)
-        f = D[:, -1, -1] / sum(c.shape)
-        i = int(np.argmin(f))
-        return float(f[i]), int(near[i]), D[i]
-    f = _dtw(_rolled(c, np.array(near), rows_closed))
+    coarse = np.arange(0, n, ROLL_STEP)
+    e = dtw.costs(c, coarse, rows_closed)
+    best2 = coarse[np.argsort(e, kind="stable")[:2]]
+    near = sorted({(s + k) % n for s in best2 for k in range(1 - ROLL_STEP, ROLL_STEP)})
+    f = dtw.costs(c, np.array(near, np.int64), rows_closed)
     i = int(np.argmin(f))
     return float(f[i]), int(near[i])
 
 
-def _rolled(c: np.ndarray, shifts: np.ndarray, rows: bool) -> np.ndarray:
-    """``(V, n, m)``: the cost matrix with the closed curve's start (its rows' or its
-    columns') moved by each shift."""
-    n = c.shape[0] if rows else c.shape[1]
-    idx = (shifts[:, None] + np.arange(n)[None, :]) % n
-    return c[idx] if rows else np.swapaxes(c.T[idx], 1, 2)
+def _compiled() -> Any:
+    """The compiled correspondence and distances (:mod:`mechsyn.synthesis.curves._numba`),
+    imported on first use."""
+    if not _COMPILED:
+        _COMPILED.append(importlib.import_module("mechsyn.synthesis.curves._numba"))
+    return _COMPILED[0]
 
 
-def _dtw(C: np.ndarray, full: bool = False) -> np.ndarray:
-    """``(V,)``: the least weighted sum over monotone paths of each cost matrix ``C (V, n, m)``
-    (diagonal steps weighted 2, others 1), over ``n + m``; with ``full`` the sums to every
-    cell ``(V, n, m)`` (not divided)."""
-    V, n, m = C.shape
-    D = 2 * C[:, 0, :1] + np.concatenate([np.zeros((V, 1)), np.cumsum(C[:, 0, 1:], axis=1)], axis=1)
-    rows = [D]
-    for i in range(1, n):
-        c = C[:, i]
-        E = D + c
-        E[:, 1:] = np.minimum(E[:, 1:], D[:, :-1] + 2 * c[:, 1:])
-        cc = np.cumsum(c, axis=1)
-        D = cc + np.minimum.accumulate(E - cc, axis=1)   # along the row: D[j] = min(E[j], D[j-1] + c[j])
-        if full:
-            rows.append(D)
-    return np.stack(rows, axis=1) if full else D[:, -1] / (n + m)
-
-
-def _dtw_pairs(C: np.ndarray, D: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """The rows and columns ``(L,)`` of the least-cost monotone path of :func:`_dtw` through
-    one cost matrix ``C (n, m)``, from ``(0, 0)`` to ``(n-1, m-1)`` (backtracked; ``D`` its
-    sums to every cell when known)."""
-    Dl = (_dtw(C[None], full=True)[0] if D is None else D).tolist()   # scalar look-ups: lists
-    Cl = C.tolist()
-    i, j = C.shape[0] - 1, C.shape[1] - 1
-    rows, cols = [i], [j]
-    while i or j:
-        c = Cl[i][j]
-        if i and j and Dl[i - 1][j - 1] + 2 * c <= min(Dl[i - 1][j], Dl[i][j - 1]) + c:
-            i, j = i - 1, j - 1
-        elif not j or (i and Dl[i - 1][j] <= Dl[i][j - 1]):
-            i -= 1
-        else:
-            j -= 1
-        rows.append(i)
-        cols.append(j)
-    return np.array(rows[::-1]), np.array(cols[::-1])
+_COMPILED: list[Any] = []   # the compiled module, once imported
 
 
 def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.ndarray:
@@ -221,25 +168,13 @@ def _beside(X: np.ndarray, F: np.ndarray, closed: bool, k: int = FINE) -> np.nda
 
 def _seg_dist(X: np.ndarray, F: np.ndarray, closed: bool) -> np.ndarray:
     """``(n, S)``: distance from each point of ``X`` to each segment of polyline ``F``."""
-    S0, V = _polyline(F, closed)
-    dx, dy = X[:, :1] - S0[:, 0], X[:, 1:] - S0[:, 1]                  # (n, S) each: x and y apart
-    vx, vy = V[:, 0], V[:, 1]
-    t = np.clip((dx * vx + dy * vy) / np.maximum(vx * vx + vy * vy, 1e-300), 0.0, 1.0)
-    dx -= t * vx
-    dy -= t * vy
-    return np.sqrt(dx * dx + dy * dy)
+    return _compiled().seg_dist(np.ascontiguousarray(X, float), np.ascontiguousarray(F, float), closed)
 
 
 def _stretches(seg: np.ndarray, closed: bool, k: int) -> np.ndarray:
     """Segment distances ``(n, S)`` (``k`` segments per sample step) reduced to the
     stretch beside each sample (see :func:`_beside`)."""
-    seg = seg.reshape(len(seg), -1, k).min(axis=2)
-    if closed:   # seg[:, j]: from sample j to j + 1
-        return np.minimum(seg, np.roll(seg, 1, axis=1))
-    out = np.empty((len(seg), seg.shape[1] + 1))
-    out[:, :-1], out[:, -1] = seg, seg[:, -1]
-    out[:, 1:] = np.minimum(out[:, 1:], seg)
-    return out
+    return _compiled().stretches(np.ascontiguousarray(seg, float), closed, k)
 
 
 def _beside_mask(W: np.ndarray, closed: bool, k: int) -> np.ndarray:
@@ -255,29 +190,24 @@ def _fine(points: np.ndarray, closed: bool, m: int, k: int = FINE) -> np.ndarray
     return even_points(points, closed, k * m if closed else k * (m - 1) + 1)
 
 
-def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool,
-                   hint: tuple[bool, int] | None = None) -> tuple[np.ndarray, tuple[bool, int]]:
+def correspondence(c: np.ndarray, rows_closed: bool, cols_closed: bool) -> tuple[np.ndarray, tuple[bool, int]]:
     """``(n, m)`` boolean: the pairs (row sample, column sample) matched by the least-cost
     correspondence in order of cost matrix ``c (n, m)`` (the rows a target's samples, the
     columns a path's), from any start point of a closed curve and in either sense of the
-    columns: the correspondence :func:`chamfer_error` takes its value along; and the sense
-    and start shift it has, a ``hint`` for the next call on a nearby curve (then only that
-    sense and the shifts about it are tried).
+    columns: the correspondence :func:`chamfer_error` takes its value along; and its sense
+    (columns reversed) and start shift.
 
     >>> t = np.linspace(0, 2 * np.pi, 8, endpoint=False)
     >>> a = np.c_[np.cos(t), np.sin(t)]
     >>> c = np.linalg.norm(a[:, None] - np.roll(a[::-1], 3, axis=0)[None], axis=-1)
-    >>> W, hint = correspondence(c, True, True)
-    >>> bool(np.all(c[W] < 1e-12)), int(W.sum()), hint[0]
+    >>> W, (reversed_, shift) = correspondence(c, True, True)
+    >>> bool(np.all(c[W] < 1e-12)), int(W.sum()), reversed_
     (True, 8, True)
     """
     n, m = c.shape
-    senses = (False, True) if hint is None else (hint[0],)
-    around = None if hint is None else hint[1]
-    (_, shift, D), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed, around, full=True),
-                               rev) for rev in senses), key=lambda x: x[0][0])
-    cc = c[:, ::-1] if rev else c
-    i, j = _dtw_pairs(_rolled(cc, np.array([shift]), rows_closed)[0] if rows_closed or cols_closed else cc, D)
+    (_, shift), rev = min(((_in_order(c[:, ::-1] if rev else c, rows_closed, cols_closed), rev)
+                           for rev in (False, True)), key=lambda x: x[0][0])
+    i, j = _compiled().pairs(np.ascontiguousarray(c[:, ::-1] if rev else c, float), shift, rows_closed)
     if rows_closed:
         i = (i + shift) % n
     elif cols_closed:
@@ -334,10 +264,8 @@ def curve_errors(path: np.ndarray, target: TargetCurve, closed_path: bool,
     m = 128
     w = resample(target.points, m, closed=target.closed)
     z = resample(path, m, closed=closed_path)
-    best = np.inf
-    for zz in (z, z[::-1]):
-        for s in range(m):
-            best = min(best, float(np.sqrt(np.mean(np.abs(np.roll(zz, s) - w) ** 2))))
+    rolls = (np.arange(m)[None, :] - np.arange(m)[:, None]) % m      # row s: the start moved by s
+    best = min(float(np.sqrt(np.mean(np.abs(zz[rolls] - w) ** 2, axis=1)).min()) for zz in (z, z[::-1]))
     return float(chamfer), float(nearest), best / unit
 
 
@@ -453,7 +381,6 @@ class FitProblem:
         self.nfev = 0
         self.deadline = float("inf")     # now() past which an evaluation raises OutOfTime
         self.best = (float("inf"), None)  # (cost, x) of the best design evaluated by fun
-        self.hint: tuple[bool, int] | None = None   # the last correspondence's sense and start shift
         self.last_match: tuple[np.ndarray, tuple] | None = None   # (path, its matched segments)
 
     def residuals(self, X: np.ndarray, keep: bool = False) -> np.ndarray:
@@ -523,14 +450,14 @@ class FitProblem:
             D1 = _seg_dist(self.T, P[d], self.closed_path)                  # (M, S1)
             D2 = _seg_dist(P[d], self.Af, self.target.closed)               # (N, S2)
             c = 0.5 * (_stretches(D1, self.closed_path, 1) + _stretches(D2, self.target.closed, FINE).T)
-            W, self.hint = correspondence(c, self.target.closed, self.closed_path, self.hint)   # (M, N); the
-            # next evaluations are of nearby designs: their correspondence is sought about this one
-            m1 = _beside_mask(W, self.closed_path, 1)
-            ks[0][d] = np.argmin(np.where(m1, D1, np.inf), axis=1)
-            ks[1][d] = np.argmin(np.where(_beside_mask(W.T, self.target.closed, FINE), D2, np.inf), axis=1)
+            W, _ = correspondence(c, self.target.closed, self.closed_path)   # (M, N): over every start and
+            # sense, as the error is taken (one sought about the previous one can stay in a worse start)
+            near = _compiled().nearest_beside
+            ks[0][d] = near(D1, W, self.closed_path, 1)
+            ks[1][d] = near(D2, np.ascontiguousarray(W.T), self.target.closed, FINE)
             if len(self.features):
                 D3 = _seg_dist(self.features, P[d], self.closed_path)
-                ks[2][d] = np.argmin(np.where(m1[self.feature_at], D3, np.inf), axis=1)
+                ks[2][d] = near(D3, W[self.feature_at], self.closed_path, 1)
         return ks
 
     def fun(self, x: np.ndarray) -> np.ndarray:
