@@ -136,7 +136,6 @@ FACADE_EDGES: frozenset[str] = frozenset({
     "mechsyn.model.mechanism:Mechanism.simulate -> mechsyn.kinematics.analysis",
     "mechsyn.model.mechanism:Mechanism.forces -> mechsyn.kinetostatics",
     "mechsyn.model.mechanism:_inputs -> mechsyn.kinematics.analysis",
-    "mechsyn.kinematics.spatial_result:SpatialSimulation.animate -> mechsyn.plot.spatial",
     "mechsyn.synthesis.atlas:Atlas.plot -> mechsyn.plot.atlas",
     "mechsyn.synthesis.reports:MotionReport.plot -> mechsyn.plot.synthesis",
     "mechsyn.synthesis.curves.candidates:CurveSynthesisResult.plot -> mechsyn.plot.curves",

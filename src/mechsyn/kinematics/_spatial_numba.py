@@ -229,6 +229,36 @@ def move(R, p, x, R2, p2):
 
 
 @njit(**_OPTIONS)
+def _spd_inverse(G, Gi):
+    """``G⁻¹`` of a symmetric positive definite ``G`` into ``Gi`` by its Cholesky factor:
+    ``G = Uᵀ U``, ``G⁻¹ = V Vᵀ`` with ``V = U⁻¹`` (the loops run along rows, without
+    reductions, so they vectorise); False when ``G`` is not positive definite to rounding."""
+    k = G.shape[0]
+    U, V = G.copy(), np.zeros((k, k))
+    for j in range(k):
+        if not U[j, j] > 0.0:
+            return False
+        d = 1.0 / math.sqrt(U[j, j])
+        for c in range(j, k):
+            U[j, c] *= d
+        for i in range(j + 1, k):
+            f = U[j, i]
+            for c in range(i, k):
+                U[i, c] -= f * U[j, c]
+    for i in range(k - 1, -1, -1):
+        V[i, i] = 1.0
+        for t in range(i + 1, k):
+            f = U[i, t]
+            for c in range(t, k):
+                V[i, c] -= f * V[t, c]
+        d = 1.0 / U[i, i]
+        for c in range(i, k):
+            V[i, c] *= d
+    Gi[:] = V @ V.T
+    return True
+
+
+@njit(**_OPTIONS)
 def gram(J, rows, Gi):
     """The inverse ``Gi`` of the damped Gram matrix of ``J`` (``J Jᵀ`` when ``rows``, else
     ``Jᵀ J``, plus ``1e-14`` of its largest diagonal entry), and the lower bound
@@ -240,24 +270,40 @@ def gram(J, rows, Gi):
     if not np.isfinite(trace):  # (a NaN or inf in J is one on the diagonal)
         Gi[:] = np.nan
         return 0.0
-    Gi[:] = np.linalg.inv(G)
+    if not _spd_inverse(G, Gi):  # (positive definite but for rounding: a rank drop)
+        Gi[:] = np.linalg.inv(G)
     out = 1.0 / math.sqrt(math.sqrt(np.sum(G * G) * np.sum(Gi * Gi)))
     return out if np.isfinite(out) else 0.0
 
 
 @njit(inline="always", **_OPTIONS)
-def _apply(J, Gi, rows, b):
-    """``J⁺ b`` by ``Gi``: ``Jᵀ (Gi b)`` or ``Gi (Jᵀ b)``."""
-    return J.T @ (Gi @ b) if rows else Gi @ (J.T @ b)
+def _acc(A, x, y):
+    """``y += Aᵀ x`` along the rows of ``A`` (no reductions: it vectorises)."""
+    for r in range(A.shape[0]):
+        for c in range(A.shape[1]):
+            y[c] += x[r] * A[r, c]
+
+
+@njit(inline="always", **_OPTIONS)
+def _apply(J, Gi, rows, b, t, y):
+    """``y += J⁺ b`` by ``Gi`` (``t``: scratch of ``Gi``'s size): ``Jᵀ (Gi b)`` or ``Gi (Jᵀ b)``."""
+    t[:] = 0.0
+    _acc(Gi if rows else J, b, t)  # (Gi is symmetric)
+    _acc(J if rows else Gi, t, y)
 
 
 @njit(**_OPTIONS)
 def solve(J, Gi, C, rows, b, refine, out):
     """``J⁺ b`` by the inverse Gram matrix ``Gi`` with ``refine`` steps of iterative
     refinement, as twists at the origin into ``out`` (6 n) (``v = u + c × ω``)."""
-    y = _apply(J, Gi, rows, b)
+    t, y, e = np.empty(Gi.shape[0]), np.zeros(J.shape[1]), np.empty(J.shape[0])
+    _apply(J, Gi, rows, b, t, y)
     for _ in range(refine):
-        y += _apply(J, Gi, rows, b - J @ y)
+        for r in range(J.shape[0]):
+            e[r] = b[r]
+            for c in range(J.shape[1]):
+                e[r] -= J[r, c] * y[c]
+        _apply(J, Gi, rows, e, t, y)
     for k in range(C.shape[0]):
         w = (y[6 * k], y[6 * k + 1], y[6 * k + 2])
         v = _ax((y[6 * k + 3], y[6 * k + 4], y[6 * k + 5]), 1.0, _x((C[k, 0], C[k, 1], C[k, 2]), w))

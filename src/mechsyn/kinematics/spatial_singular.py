@@ -12,7 +12,8 @@ Georg [1]_, sec. 8.1: bifurcation detection by the sign of the augmented Jacobia
 determinant). The pairs where it can change at all are few: by Weyl's inequality
 ``σ_r(J(t)) >= σ_r(J_k) - ‖J(t) - J_k‖``, so a crossing needs ``σ_r(J_k)`` (a lower bound from
 the Gram matrix) within ``‖J_{k+1} - J_k‖_F`` (twice, for the path's curvature) of zero at one
-of the two rows; only those pairs are tested (:func:`_flips`). A sign change
+of the two rows; only those pairs are tested (:func:`_flips`: at full column or row rank by
+``det(J_kᵀ J_{k+1})`` or ``det(J_{k+1} J_kᵀ)``, of the same sign, else by an SVD). A sign change
 is bracketed and refined (below) and
 reported with its input value; a crossing that falls on a row (within ``REFINE`` of the step)
 makes that row singular. Minima of ``σ_r/σ_1`` that touch zero without a sign change (a V at a
@@ -63,7 +64,14 @@ ZOOM = 17
 def _flips(Ja: np.ndarray, Jb: np.ndarray, r: int) -> np.ndarray:
     """Whether ``det(U_aᵀ J_b V_a)`` is not positive, for pairs of Jacobians ``Ja``, ``Jb``
     (B, m, k) of regular rank ``r`` at ``Ja`` (``U_a``, ``V_a``: its first ``r`` singular
-    vectors, by an SVD: the pairs tested are few)."""
+    vectors). At full column rank (``r = k``) ``det(J_aᵀ J_b) = det(Σ_a) det(U_aᵀ J_b V_a)``
+    (``det(V_a)² = 1``), at full row rank (``r = m``) ``det(J_b J_aᵀ)`` likewise: the same sign
+    without an SVD (which would cost more than the rest of a sweep); otherwise the bases by an SVD."""
+    m, k = Ja.shape[1:]
+    if r == k:
+        return np.linalg.det(np.swapaxes(Ja, -1, -2) @ Jb) <= 0
+    if r == m:
+        return np.linalg.det(Jb @ np.swapaxes(Ja, -1, -2)) <= 0
     Ua, _, Vat = np.linalg.svd(Ja, full_matrices=False)
     return np.linalg.det(np.swapaxes(Ua[..., :r], -1, -2) @ Jb @ np.swapaxes(Vat[..., :r, :], -1, -2)) <= 0
 

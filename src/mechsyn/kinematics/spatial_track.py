@@ -154,7 +154,7 @@ class Tracker:
         self.tol = newton_tol(M)
         self.rank_tol = max(RANK_TOL, 100 * self.tol)
         self.rejected = 0  # converged poses refused by the pair check (another root of the equations)
-        self.last_pair = np.zeros(0, object)  # per pose of the last correction: the pair refused, or ""
+        self.last_pair: dict[int, str] = {}  # the poses of the last correction refused: their pair
         self._left: tuple | None = None
 
     def state(self, R: np.ndarray, p: np.ndarray, href: np.ndarray, target: np.ndarray,
@@ -222,13 +222,16 @@ class Tracker:
         """``ok`` without the poses whose pairs are not the file's (a reversed R axis, a
         half-turned P pair: :func:`~mechsyn.kinematics.spatial_model.pair_error`), whose
         pair ``last_pair`` names."""
-        self.last_pair = np.full(len(ok), "", object)
+        self.last_pair = {}
         if ok.any() and len(self.M.pairs.ids):
             err = pair_error(self.M, R[ok])
             bad = err.max(axis=1) > PAIR_TOL
-            self.last_pair[np.flatnonzero(ok)[bad]] = [self.M.pairs.ids[e] for e in np.argmax(err[bad], axis=1)]
-            self.rejected += int(bad.sum())
-        return ok & (self.last_pair == "")
+            self.last_pair = {int(b): self.M.pairs.ids[int(np.argmax(e))]
+                              for b, e in zip(np.flatnonzero(ok)[bad], err[bad])}
+            self.rejected += len(self.last_pair)
+        true = ok.copy()
+        true[list(self.last_pair)] = False
+        return true
 
     def block(self, st: State, u0: np.ndarray, Ub: np.ndarray) -> tuple[int, np.ndarray, Any, Any]:
         """The rows ``Ub`` (K, drives) after the pose ``st`` (at inputs ``u0``), predicted
@@ -280,7 +283,7 @@ class Tracker:
         rep = np.zeros(B, int)
         R, p, ok, _ = self.correct(st.R[rep], st.p[rep], st.href[rep], U[rows], np.full(B, np.inf), iters=30)
         j = int(np.argmax(ok)) if ok.any() else B
-        refused = [(int(rows[b]), self.last_pair[b]) for b in np.flatnonzero(self.last_pair[:j] != "")]
+        refused = [(int(rows[b]), pair) for b, pair in sorted(self.last_pair.items()) if b < j]
         if not ok.any():
             return refused, None
         return refused, (int(rows[j]), self.state(R[j:j + 1], p[j:j + 1], st.href, U[rows[j]][None]))
