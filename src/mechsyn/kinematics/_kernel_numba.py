@@ -337,10 +337,8 @@ def regular_pass(ip, fp, anc_j, anc_s, org_j, CS, SN, speeds, nj, least, C, W, A
 
 @njit(inline="always", **_OPTIONS)
 def _planes(lz, Z):
-    """The rotations ``lz`` (links, M) complex as planes ``Z`` (2, links, P), real and
-    imaginary parts of the first P <= M rows: NumPy's ``arctan2`` of the links' angles
-    reads contiguous rows a third faster than the complex array's strided parts, with the
-    same numbers."""
+    """The rotations ``lz`` (links, M) as planes ``Z`` (2, links, P <= M rows), real and imaginary
+    parts: NumPy's ``arctan2`` reads contiguous rows a third faster, with the same numbers."""
     for i in range(lz.shape[0]):
         for r in range(Z.shape[2]):
             z = lz[i, r]
@@ -376,12 +374,11 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
     loops take a third of libm's time) and started next to their drawn angle ``ref[i]``
     (:func:`mechsyn.kinematics.positions.continuous_angles`): without ``folds`` one
     unwrapped run whose rows ``split`` and ``split - 1`` (when ``split`` >= 0) each start
-    next to ``ref`` (the fast path: no wrap per row); with ``folds`` each tracked sweep
-    (forwards from ``split``, backwards from ``split - 1``, or the one sweep) on its own,
-    every angle moved by whole turns next to ``ref``, its runs of assembled rows unwrapped
+    next to ``ref``; with ``folds`` each tracked sweep (forwards from ``split``, backwards
+    from ``split - 1``, or the one sweep) on its own, its runs of assembled rows unwrapped
     and each run following the run before by whole turns, the rows where a link is not
-    placed blanked (NaN) in the poses and in ``C``, the rates of rows where they are not
-    finite blanked, and the rates of
+    placed blanked (NaN) in the poses and in ``C`` and the rates of rows where they are
+    not finite blanked (:func:`mechsyn.kinematics.regular._fold_poses`), and the rates of
     the singular rows the fold scan found (rows ``r < len(sb)``: ``sb[r]``, else ``sf[r -
     len(sb)]``) blanked too. Writes the rows assembled into ``ok`` (N,) and, with ``folds``,
     the rows with rates (assembled, finite, not singular) into ``rok`` (N,) (an array made
@@ -455,10 +452,8 @@ def link_poses(C, W, AL, N, U, dcol, dsgn, ref, split, folds, A, q, qd, qdd, ok,
 
 @njit(inline="always", **_OPTIONS)
 def _blank_rows(C, q, qd, qdd, ok, sb, sf, rok):
-    """:func:`link_poses`' blanking through folds: the rows not assembled (``ok``) in the
-    poses and the links' states, the rates of the rows where they are not finite or that
-    the fold scan found singular (``sb``, ``sf``); the rows with rates into ``rok``.
-    Returns the number of assembled rows without rates."""
+    """:func:`link_poses`' blanking through folds (rows not assembled, rates not finite or
+    singular: ``sb``, ``sf``); the rows with rates into ``rok``; returns how many have none."""
     nl, N = C.shape[1], ok.shape[0]
     singular = 0
     nb = sb.shape[0]
@@ -564,16 +559,14 @@ def scalar_disc(ip, fp, anc_j, anc_s, u, nj, k, sg):
 
 @njit(inline="always", **_OPTIONS)
 def _pos(w, i, b):
-    """The layout column of row ``i`` of tracked sweep ``w`` (0 forwards from ``b``, 1
-    backwards from ``b - 1``)."""
+    """The layout column of row ``i`` of tracked sweep ``w`` (0 forwards from ``b``, 1 backwards)."""
     return b + i if w == 0 else b - 1 - i
 
 
 @njit(inline="always", **_OPTIONS)
 def _scan_row(X, perm, b, w, i, n0, shift, out):
-    """Row ``i`` of tracked sweep ``w`` into ``out``: its connecting path's row (``i <
-    n0``), else the sweep's row shifted by the whole turns ``shift``
-    (:func:`mechsyn.kinematics.folds.pass_fold_events`' ``row``)."""
+    """Row ``i`` of tracked sweep ``w`` into ``out``: its connecting path's row (``i < n0``), else the
+    sweep's row less the whole turns ``shift`` (:func:`mechsyn.kinematics.folds.pass_fold_events`)."""
     r = perm[_pos(w, i, b)]
     for c in range(out.shape[0]):
         out[c] = X[r, c] if i < n0 else X[r, c] - shift[c]
@@ -649,11 +642,9 @@ def hidden_fold(c, fa, fb, tc, hidden, zero):
 
 @njit(**_OPTIONS)
 def _refine(c, g, i, hidden, xa, xb, fa, fb, ends, starts):
-    """The kernel's refinement of a fold of group ``g`` of :func:`scan_sweep` between rows
-    ``i - 1`` and ``i`` (the inputs ``xa`` and ``xb``): in closed form
-    (:func:`_four_bar_t`) or by :func:`hidden_fold` on the group's discriminant along the
-    segment (:func:`_segment`); ``c``: the groups' closed-form numbers, the round-off
-    zero, then what :func:`_segment` reads."""
+    """The refinement of a fold of group ``g`` between rows ``i - 1`` and ``i`` (inputs
+    ``xa``, ``xb``): :func:`_four_bar_t`, else :func:`hidden_fold` along :func:`_segment`;
+    ``c``: the groups' closed-form numbers, the round-off zero, then :func:`_segment`'s."""
     specs, zero = c[0], c[1]
     t = _four_bar_t(specs[g], xa[0], xb[0]) if hidden == 0 else math.nan
     if not math.isnan(t):
@@ -664,10 +655,8 @@ def _refine(c, g, i, hidden, xa, xb, fa, fb, ends, starts):
 
 @njit(**_OPTIONS)
 def _segment(c, g, i, xa, xb):
-    """What :func:`_disc_along` reads for group ``g`` on the segment of inputs from ``xa``
-    to ``xb``: the program, the group's step, ``xa``, ``xb - xa`` and every group's mode
-    (``c``: ``(specs, zero, ip, fp, anc_j, anc_s, nj, ks, sg)``; run as plain Python,
-    the context's own discriminant, :func:`mechsyn.kinematics.kernel.scan_sweep`)."""
+    """:func:`_disc_along`'s context for group ``g`` from ``xa`` to ``xb`` (compiled: the
+    program's; as plain Python a callable of the context, :func:`mechsyn.kinematics.kernel.scan_sweep`)."""
     _, _, ip, fp, anc_j, anc_s, nj, ks, sg = c
     d = np.empty(xa.shape[0])
     for k in range(xa.shape[0]):
