@@ -1,4 +1,4 @@
-"""Benchmark: the alphabet as target curves through the CLI (issue 29, issue 41; after LInK's LINK-ABC).
+"""Benchmark: the alphabet as target curves through the CLI (after LInK's LINK-ABC).
 
 Run from the repository root::
 

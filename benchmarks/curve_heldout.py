@@ -1,4 +1,4 @@
-"""Benchmark: held-out curves against issue 29's bar (buildable, simplest, any scale).
+"""Benchmark: held-out curves (buildable, simplest, any scale).
 
 Run from the repository root::
 

@@ -1,4 +1,4 @@
-"""Benchmark: nearest-descriptor retrieval of synth curve at a million curves (issue 41).
+"""Benchmark: nearest-descriptor retrieval of synth curve at a million curves.
 
 Run from the repository root::
 

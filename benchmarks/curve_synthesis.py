@@ -1,4 +1,4 @@
-"""Benchmark: curve to mechanism (issue 16).
+"""Benchmark: curve to mechanism.
 
 Run from the repository root::
 

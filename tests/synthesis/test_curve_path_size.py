@@ -1,4 +1,4 @@
-"""The size bound of ``synth path`` (issue 29 / issue 24 item 4; issue 41): a four-bar's
+"""The size bound of ``synth path``: a four-bar's
 frame pivots and pin circles stay within ``--max-size`` / ``options.max_size`` target
 diagonals of the targets' centre; without either, the bounds a case states on its
 variables are its design space; a bound the design sits on is named with how to lift it."""

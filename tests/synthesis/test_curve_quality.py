@@ -1,4 +1,4 @@
-"""Curve synthesis a designer can build (issue 29): size, link-ratio and transmission
+"""Curve synthesis a designer can build: size, link-ratio and transmission
 bounds, fewest links first, invariance to similarity transforms, sparse targets, sharp
 features, no empty answer with exit status 0, and target files that fail in one line."""
 
