@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 import mechsyn as ms
-from mechsyn.kinematics.report import simulation_csv
 from mechsyn.kinematics.spatial_model import compile_spatial, pair_error
 from mechsyn.kinematics.spatial_track import NEWTON_TOL, Tracker
 from spatial_cases import bricard, loop_error, rot, rssr_at_dead_point, sarrus, spherical_fourbar
@@ -279,7 +278,7 @@ def test_text_and_csv_carry_joint_values_link_orientations_and_refined_events():
     lo = s.working_ranges()[0][0]
     assert f"{lo:.7g}" in text and "dead point at A=" in text
     assert "D" in s.table().splitlines()[0].split()  # the rocker's angle, a joint value
-    rows = simulation_csv(s).splitlines()  # (Motion.columns: the CSV of every engine)
+    rows = s.csv().splitlines()  # (Motion.columns: the CSV of every engine)
     head = rows[0].split(",")
     for col in ("joint_D", "rocker_rx_deg", "rocker_translation_z", "reached"):
         assert col in head

@@ -190,7 +190,6 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
     import textwrap
 
     from mechsyn.kinematics.analysis import simulate
-    from mechsyn.kinematics.report import simulation_csv
     from mechsyn.plot.spatial import animate_spatial, plot_spatial
 
     n = len(next(iter(inputs.values())))
@@ -198,7 +197,7 @@ def _simulate_spatial(mech: Any, inputs: dict[str, np.ndarray], names: list[str]
         sim = simulate(mech, inputs, speeds=_parse_pairs(speed, "--speed", True), points=names, progress=progress,
                        method=method)
     if csv_out is not None:
-        write_output(csv_out, simulation_csv(sim))
+        write_output(csv_out, sim.csv())
     if plot is not None:
         save_plot(plot, plot_spatial, sim)
     if animate is not None:
