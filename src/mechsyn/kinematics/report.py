@@ -3,8 +3,8 @@ quantities a designer reads off it (transmission angles, mechanical advantage, G
 class, path extents, straightness of a path segment).
 
 ``mechsyn simulate --json`` prints :meth:`SimulationReport.to_dict`. The CSV tables
-(``--csv``) are files, not computing: a result's ``csv()`` (:meth:`Motion.csv
-<mechsyn.kinematics.simulation.Motion.csv>`) writes its ``columns()`` with
+(``--csv``) are files, not computing: a result's ``csv()``
+(:meth:`~mechsyn.kinematics.simulation.Motion.csv`) writes its ``columns()`` with
 :func:`mechsyn.results.csv_table`.
 
 References
