@@ -6,7 +6,7 @@ Run from the repository root::
 
     python benchmarks/spatial_kinematics.py [--repeats 5]
 
-Cases (issue 25 item 4):
+Cases:
 
 * ``Bennett``: examples/textbook/bennett.yaml, R1 over 0..360 deg, 361 inputs (target < 50 ms);
 * ``spherical 4-bar``: examples/textbook/spherical_fourbar.yaml, A over 0..360 deg,

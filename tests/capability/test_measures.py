@@ -59,6 +59,18 @@ def test_closed_form_on_arm_singularities():
     assert min_norm_limit(J[0], w, (0, 1))[0] > 0
 
 
+def test_polytope_of_an_almost_stretched_arm_keeps_its_digits():
+    # a thin sliver of a zonogon: the facet normals from the generators, not from Qhull's
+    # fit to nearly collinear vertices (which gave 0.0101635013, 2.3e-7 too large)
+    arm = arm_from_dict({"kind": "planar_serial", "link_lengths": [900, 700, 500],
+                         "joint_speed_limits_deg_s": [4, 6, 10]})
+    J = arm.jacobian(np.array([0.5, 1.1444091796875e-05, 0.0]))[0]
+    for angle in (2.0, 0.3, 1.6, 4.0):
+        d = np.array([np.cos(angle), np.sin(angle)])
+        exact = exact_limit(J, arm.qd_max, d)[0]
+        assert velocity_polytope(J, arm.qd_max).directional_limit(d) == pytest.approx(exact, rel=1e-9)
+
+
 @settings(max_examples=40, deadline=None)
 @given(st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3),
        st.floats(0.0, 2 * np.pi))

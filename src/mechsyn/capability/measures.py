@@ -325,11 +325,28 @@ def velocity_polytope(J, w) -> VelocityPolytope:
         if m == 2:  # order counter-clockwise
             c = verts - verts.mean(0)
             verts = verts[np.argsort(np.arctan2(c[:, 1], c[:, 0]))]
-        eq = np.unique(np.round(hull.equations, 12), axis=0)
-        normals = eq[:, :-1] @ basis.T
+        if m == 2:  # a zonogon's edges are its generators: normals +-perp(g_k), exactly
+            normals = _zonogon_normals(G)
+        else:
+            eq = np.unique(np.round(hull.equations, 12), axis=0)
+            normals = eq[:, :-1] @ basis.T
     normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
     offsets = np.abs(normals @ G).sum(1)
     return VelocityPolytope(verts, normals, offsets, null.T)
+
+
+def _zonogon_normals(G: np.ndarray) -> np.ndarray:
+    """Unit outward normals of the planar zonotope (zonogon) of generators ``G`` (2, n).
+
+    Each edge of a zonogon is a generator (parallel generators make one edge), so its
+    normals are ``+-perp(g_k)`` of the non-zero generators. Taken from the generators, not
+    from the hull: near a singular configuration the zonogon is a thin sliver and Qhull's
+    normals, fitted to nearly collinear vertices, lose digits (a planar 3R arm almost
+    stretched out gave a directional limit 2.3e-7 too large, relative)."""
+    norms = np.linalg.norm(G, axis=0)
+    g = G[:, norms > 1e-12 * norms.max()] / norms[norms > 1e-12 * norms.max()]
+    perp = np.stack([-g[1], g[0]], 1)
+    return np.unique(np.round(np.concatenate([perp, -perp]), 15), axis=0)
 
 
 @dataclass
