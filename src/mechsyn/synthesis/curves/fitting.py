@@ -177,14 +177,6 @@ def _stretches(seg: np.ndarray, closed: bool, k: int) -> np.ndarray:
     return _compiled().stretches(np.ascontiguousarray(seg, float), closed, k)
 
 
-def _beside_mask(W: np.ndarray, closed: bool, k: int) -> np.ndarray:
-    """``(n, S)``: the segments (``k`` per sample step of the columns' curve) beside the
-    column samples matched to each row by ``W (n, m)``: those from sample ``j - 1`` to
-    ``j + 1`` about each matched ``j``."""
-    near = W | np.roll(W, -1, axis=1) if closed else W[:, :-1] | W[:, 1:]
-    return np.repeat(near, k, axis=1)
-
-
 def _fine(points: np.ndarray, closed: bool, m: int, k: int = FINE) -> np.ndarray:
     """Points equally spaced in arc length, ``k`` per step of ``m`` samples (``[::k]``)."""
     return even_points(points, closed, k * m if closed else k * (m - 1) + 1)
@@ -291,7 +283,8 @@ def departure(path: np.ndarray, target: TargetCurve, closed_path: bool, m: int =
     total = arc[-1] + (float(np.linalg.norm(P[0] - P[-1])) if target.closed else 0.0)
     at = np.rint(arc / (total / (m if target.closed else m - 1))).astype(int)   # each point's sample
     at = at % m if target.closed else np.minimum(at, m - 1)
-    D = np.where(_beside_mask(W, closed_path, FINE)[at], _seg_dist(P, Bf, closed_path), np.inf).min(axis=1)
+    seg = _seg_dist(P, Bf, closed_path)
+    D = seg[np.arange(len(P)), _compiled().nearest_beside(seg, np.ascontiguousarray(W[at]), closed_path, FINE)]
     i = int(np.argmax(D))
     return i, float(D[i])
 
